@@ -1,0 +1,44 @@
+# A thin wrapper around CMake (see README.md).
+#   make          build (Release) into build/, the program at build/rayes
+#   make render   install what is missing, build, render the default scene to out/
+#   make test     install what is missing, build, run every test (Release, then
+#                 AddressSanitizer + UndefinedBehaviorSanitizer)
+#   make bench    build the benchmarks
+#   make format   clang-format the sources
+JOBS ?= $(shell nproc)
+
+.PHONY: all build render test test-release test-asan deps deps-test bench format clean
+
+all: build
+
+build:
+	@test -f build/CMakeCache.txt || cmake -S . -B build -DCMAKE_BUILD_TYPE=Release
+	cmake --build build -j $(JOBS)
+
+deps:
+	tools/install-deps
+
+deps-test:
+	tools/install-deps --test
+
+render: deps build
+	mkdir -p out
+	build/rayes render cornell -o out/default.exr -o out/default.png
+
+test: deps-test test-release test-asan
+
+test-release: build
+	cd build && ctest --output-on-failure -j $(JOBS)
+
+test-asan:
+	@test -f build-asan/CMakeCache.txt || cmake -S . -B build-asan -DCMAKE_BUILD_TYPE=Debug -DRAYES_SANITIZE=ON
+	cmake --build build-asan -j $(JOBS)
+	cd build-asan && ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 ctest --output-on-failure -j $(JOBS)
+
+bench: build
+
+format:
+	clang-format -i $$(git ls-files '*.c' '*.h')
+
+clean:
+	rm -rf build build-asan build-tsan out

@@ -1,0 +1,233 @@
+/*
+ * rayes.h — the public C API of rayes.
+ *
+ * rayes renders with distribution ray tracing and the multiresolution
+ * radiosity cache of Pixar's technical memo 12-06. A program builds a scene
+ * through this header (readers for scene files do the same), commits it, and
+ * renders it with a set of options.
+ *
+ * Conventions (see docs/api.md and STYLE.md):
+ *  - Objects are opaque handles with _new, _retain and _release.
+ *  - A scene is edited, then committed. Every commit bumps the scene's
+ *    timestamp, which radiosity cache entries are checked against.
+ *  - Fallible calls return RayesError; the scene keeps the first error
+ *    message until rayes_scene_clear_error().
+ *  - A scene may be edited by one thread at a time. Rendering a committed
+ *    scene may run while nobody edits it.
+ *  - Lengths are in the scene's units (the benchmark scenes use millimetres),
+ *    colours are linear RGB, angles are in degrees, matrices are row-major
+ *    4 x 4 and map column vectors: p' = M p.
+ *
+ * This header compiles as C11 and as C++ (tests/api proves it).
+ */
+#ifndef RAYES_RAYES_H
+#define RAYES_RAYES_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "rayes/version.h"
+
+#if defined(__GNUC__)
+#define RAYES_API __attribute__((visibility("default")))
+#else
+#define RAYES_API
+#endif
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* Error codes. RAYES_OK is zero; everything else is a failure. */
+typedef enum RayesError {
+    RAYES_OK = 0,
+    RAYES_ERROR_INVALID_ARGUMENT = 1, /* a parameter is out of range or NULL */
+    RAYES_ERROR_INVALID_OPERATION = 2, /* the call is not allowed in this state */
+    RAYES_ERROR_OUT_OF_MEMORY = 3,
+    RAYES_ERROR_IO = 4,                /* a file could not be read or written */
+    RAYES_ERROR_PARSE = 5,             /* a file's contents are malformed */
+    RAYES_ERROR_CANCELLED = 6          /* the progress callback asked to stop */
+} RayesError;
+
+/* A short English name of an error code; never NULL, static storage. */
+RAYES_API const char *rayes_error_string(RayesError error);
+
+/* The version string, e.g. "0.1.0"; static storage. */
+RAYES_API const char *rayes_version_string(void);
+
+/* ---------------------------------------------------------------- scene */
+
+typedef struct RayesScene RayesScene;
+
+/* Creates an empty scene with a reference count of one, a default camera
+ * and the default shader "matte". Returns NULL when out of memory. */
+RAYES_API RayesScene *rayes_scene_new(void);
+RAYES_API void rayes_scene_retain(RayesScene *scene);
+/* Drops a reference; the last one frees the scene. NULL is ignored. */
+RAYES_API void rayes_scene_release(RayesScene *scene);
+
+/* The first error message recorded since the last clear, or "" if none.
+ * Borrowed: valid until the next call on the scene. */
+RAYES_API const char *rayes_scene_get_error(const RayesScene *scene);
+RAYES_API void rayes_scene_clear_error(RayesScene *scene);
+
+/* A pinhole camera at eye looking at target, with the given up vector and
+ * vertical field of view in degrees (0 < fov < 180). */
+RAYES_API RayesError rayes_scene_set_camera(RayesScene *scene, const float eye[3],
+                                            const float target[3], const float up[3],
+                                            float fov_y_degrees);
+
+/* The transform applied to geometry added from now on: world_from_object,
+ * row-major. The identity at first. */
+RAYES_API RayesError rayes_scene_set_transform(RayesScene *scene,
+                                               const float world_from_object[16]);
+
+/* Shader parameters, given by name; the shader's class table says which
+ * names and types it understands. Unknown names get one warning. */
+typedef enum RayesParamType {
+    RAYES_PARAM_NONE = 0,
+    RAYES_PARAM_FLOAT = 1,  /* value[0] */
+    RAYES_PARAM_COLOR = 2,  /* value[0..2], linear RGB */
+    RAYES_PARAM_STRING = 3  /* string */
+} RayesParamType;
+
+typedef struct RayesParam {
+    const char *name;    /* e.g. "Kd" */
+    RayesParamType type;
+    float value[3];      /* FLOAT and COLOR values */
+    const char *string;  /* STRING value, copied by the callee */
+} RayesParam;
+
+/* The surface shader of geometry added from now on: a built-in class name
+ * ("matte", "plastic", "mirror", "constant") with parameters. The
+ * parameters are copied. An unknown class is RAYES_ERROR_INVALID_ARGUMENT. */
+RAYES_API RayesError rayes_scene_set_shader(RayesScene *scene, const char *name,
+                                            const RayesParam *params, size_t n_params);
+
+/* The shading rate of geometry added from now on: the area of a
+ * micropolygon in pixels (RenderMan's ShadingRate). Default 1. */
+RAYES_API RayesError rayes_scene_set_shading_rate(RayesScene *scene, float shading_rate);
+
+/* A bilinear patch with corners P[0] = (u0,v0), P[1] = (u1,v0),
+ * P[2] = (u0,v1), P[3] = (u1,v1), as RenderMan's Patch "bilinear". */
+RAYES_API RayesError rayes_scene_bilinear_patch(RayesScene *scene, const float P[4][3]);
+
+/* A bicubic Bezier patch of 16 control points, row-major with u varying
+ * fastest (P[4*j + i] is the i-th point of row j). */
+RAYES_API RayesError rayes_scene_bicubic_patch(RayesScene *scene, const float P[16][3]);
+
+/* A polygon mesh: n_faces faces, face f having n_verts[f] vertices (3 or 4,
+ * convex, counter-clockwise seen from the front), indices into P (n_points
+ * points, three floats each). Quads become bilinear patches, triangles
+ * triangular patches. */
+RAYES_API RayesError rayes_scene_polygon_mesh(RayesScene *scene, size_t n_faces,
+                                              const int *n_verts, const int *indices,
+                                              size_t n_points, const float *P);
+
+/* A sphere of the given radius centred at the object-space origin. */
+RAYES_API RayesError rayes_scene_sphere(RayesScene *scene, float radius);
+
+/* A one-sided emitting quad (an area light) with vertices P[0..3] in order
+ * around the quad; it emits radiance L from the side toward which
+ * (P1 - P0) x (P2 - P0) points, and is seen by the camera. */
+RAYES_API RayesError rayes_scene_area_light(RayesScene *scene, const float P[4][3],
+                                            const float L[3]);
+
+/* Ends an edit: checks the scene and bumps its timestamp. Rendering an
+ * uncommitted scene is RAYES_ERROR_INVALID_OPERATION. */
+RAYES_API RayesError rayes_scene_commit(RayesScene *scene);
+
+/* The number of commits so far (the scene timestamp of memo section 3.2). */
+RAYES_API uint64_t rayes_scene_get_timestamp(const RayesScene *scene);
+
+/* -------------------------------------------------------------- options */
+
+typedef enum RayesQuality {
+    RAYES_QUALITY_PREVIEW = 0,   /* 4 shadow rays, 4 diffuse rays */
+    RAYES_QUALITY_FINAL = 1,     /* 64 shadow; 1024 diffuse at depth 0, 64 deeper */
+    RAYES_QUALITY_REFERENCE = 2  /* 64 shadow and 4096 diffuse at depth 0, 1 and 1 deeper */
+} RayesQuality;
+
+typedef enum RayesFilter {
+    RAYES_FILTER_BOX = 0,       /* width 1 pixel by default */
+    RAYES_FILTER_GAUSSIAN = 1   /* width 2 pixels by default, alpha 2 */
+} RayesFilter;
+
+/* Progress: fraction done in [0, 1]. Return nonzero to cancel the render.
+ * Called from worker threads, one call at a time. */
+typedef int (*RayesProgressFn)(void *user, double fraction);
+
+typedef struct RayesRenderOptions {
+    size_t struct_size;        /* sizeof(RayesRenderOptions), set by _init */
+    int width, height;         /* pixels */
+    int spp;                   /* pixel samples */
+    int threads;               /* 0: one per core */
+    int bounces;               /* maximum diffuse depth */
+    int shadow_rays;           /* shadow rays per shading point at depth 0 */
+    int shadow_rays_deep;      /* shadow rays per shading point deeper */
+    int diffuse_rays;          /* diffuse rays per shading point at depth 0 */
+    int diffuse_rays_deep;     /* diffuse rays per shading point deeper */
+    int specular_depth;        /* maximum specular depth */
+    RayesFilter filter;
+    float filter_width;        /* pixels */
+    uint64_t seed;             /* changes every random number */
+    int tile_size;             /* pixels */
+    RayesProgressFn progress;  /* may be NULL */
+    void *progress_user;
+} RayesRenderOptions;
+
+/* Fills options with the defaults of a quality preset: 512 x 512, 4 pixel
+ * samples, all cores, 1 bounce, box filter, seed 0. */
+RAYES_API void rayes_render_options_init(RayesRenderOptions *options, RayesQuality quality);
+
+/* ---------------------------------------------------------------- stats */
+
+typedef struct RayesStats RayesStats;
+
+typedef enum RayesStatKind {
+    RAYES_STAT_COUNT = 0,   /* an integer count */
+    RAYES_STAT_REAL = 1,    /* a real value (seconds, a ratio) */
+    RAYES_STAT_STRING = 2,  /* text */
+    RAYES_STAT_COUNTS = 3   /* an array of counts */
+} RayesStatKind;
+
+/* One statistic. Names are paths such as "rays/shadow" or "time/total_s";
+ * the JSON statistics nest on the slashes. */
+typedef struct RayesStat {
+    const char *name;
+    RayesStatKind kind;
+    uint64_t count;          /* COUNT */
+    double real;             /* REAL */
+    const char *string;      /* STRING */
+    const uint64_t *counts;  /* COUNTS */
+    size_t n_counts;
+} RayesStat;
+
+RAYES_API size_t rayes_stats_size(const RayesStats *stats);
+/* The i-th statistic, in a stable order; borrowed, valid while stats lives. */
+RAYES_API const RayesStat *rayes_stats_get(const RayesStats *stats, size_t i);
+/* The statistic of that name, or NULL. */
+RAYES_API const RayesStat *rayes_stats_find(const RayesStats *stats, const char *name);
+RAYES_API void rayes_stats_free(RayesStats *stats);
+
+/* --------------------------------------------------------------- render */
+
+typedef struct RayesImage {
+    int width, height;  /* pixels */
+    float *rgba;        /* width * height * 4 floats, linear RGB and alpha, top row first */
+} RayesImage;
+
+/* Renders a committed scene. On success *image (free with
+ * rayes_image_free) and, if stats is not NULL, *stats (free with
+ * rayes_stats_free) are new. Thread-safe against other renders of the same
+ * committed scene. */
+RAYES_API RayesError rayes_render(RayesScene *scene, const RayesRenderOptions *options,
+                                  RayesImage **image, RayesStats **stats);
+
+RAYES_API void rayes_image_free(RayesImage *image);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* RAYES_RAYES_H */

@@ -1,0 +1,351 @@
+/*
+ * accel/accel.c — the Embree 3 implementation of accel.h.
+ *
+ * Layout: per object with quad grids, one RTC_GEOMETRY_TYPE_GRID whose
+ * grid buffer lists its grids (startVertexID = the grid's first vertex in
+ * the shared vertex array, stride = nu); per object with triangular grids,
+ * one RTC_GEOMETRY_TYPE_TRIANGLE whose index buffer lists every
+ * micropolygon. Geom records map (geomID, primID) back to grids.
+ *
+ * Embree with TBB builds on its own threads; commit happens once, before
+ * any query, and queries are concurrent (Embree's contract).
+ */
+#include "accel/accel.h"
+
+#include <embree3/rtcore.h>
+#include <math.h>
+#include <stdatomic.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "util/check.h"
+
+typedef struct MicroTri {
+    uint32_t grid;     /* patch id */
+    uint8_t i, j;      /* lattice position of the cell */
+    uint8_t upper;     /* 0: (i,j),(i+1,j),(i,j+1); 1: (i+1,j),(i+1,j+1),(i,j+1) */
+} MicroTri;
+
+typedef struct Geom {
+    int triangular;
+    uint32_t *grids;   /* quad: primID -> grid index */
+    MicroTri *tris;    /* triangle: primID -> micropolygon */
+} Geom;
+
+struct Accel {
+    RTCDevice device;
+    RTCScene scene;
+    const GridSet *gs;
+    Geom *geoms;       /* indexed by geomID */
+    size_t n_geoms;
+    atomic_llong bytes; /* Embree's allocations, from the memory monitor */
+    char error[256];   /* the first Embree error */
+};
+
+static void on_error(void *user, enum RTCError code, const char *str)
+{
+    Accel *a = user;
+    if (a->error[0] == '\0')
+        snprintf(a->error, sizeof a->error, "Embree error %d: %s", (int)code, str ? str : "");
+}
+
+static bool on_memory(void *user, ssize_t bytes, bool post)
+{
+    Accel *a = user;
+    (void)post;
+    atomic_fetch_add(&a->bytes, (long long)bytes);
+    return true;
+}
+
+static int add_geom(Accel *a, Geom g)
+{
+    Geom *geoms = realloc(a->geoms, (a->n_geoms + 1) * sizeof *geoms);
+    if (!geoms)
+        return -1;
+    a->geoms = geoms;
+    a->geoms[a->n_geoms++] = g;
+    return 0;
+}
+
+static int build_quads(Accel *a, const uint32_t *idx, size_t n, uint32_t mask)
+{
+    const GridSet *gs = a->gs;
+    RTCGeometry geom = rtcNewGeometry(a->device, RTC_GEOMETRY_TYPE_GRID);
+    rtcSetSharedGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, gs->P, 0,
+                               sizeof(Vec3), gs->n_vertices);
+    struct RTCGrid *grids = rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_GRID, 0, RTC_FORMAT_GRID,
+                                             sizeof(struct RTCGrid), n);
+    Geom g = {.triangular = 0, .grids = malloc(n * sizeof(uint32_t))};
+    if (!grids || !g.grids) {
+        free(g.grids);
+        rtcReleaseGeometry(geom);
+        return -1;
+    }
+    for (size_t k = 0; k < n; k++) {
+        const Grid *src = &gs->grids[idx[k]];
+        grids[k] = (struct RTCGrid){src->first_vertex, src->nu, src->nu, src->nv};
+        g.grids[k] = idx[k];
+    }
+    rtcSetGeometryMask(geom, mask);
+    rtcCommitGeometry(geom);
+    unsigned id = rtcAttachGeometry(a->scene, geom);
+    rtcReleaseGeometry(geom);
+    RY_CHECK(id == a->n_geoms);
+    return add_geom(a, g);
+}
+
+static size_t count_tris(const GridSet *gs, const uint32_t *idx, size_t n)
+{
+    size_t t = 0;
+    for (size_t k = 0; k < n; k++) {
+        size_t s = gs->grids[idx[k]].nu;
+        t += s * s;
+    }
+    return t;
+}
+
+static void tri_vertices(const Grid *g, const MicroTri *m, uint32_t v[3])
+{
+    uint32_t n = g->nu, i = m->i, j = m->j, b = g->first_vertex;
+    if (!m->upper) {
+        v[0] = b + geom_tri_vertex(n, i, j);
+        v[1] = b + geom_tri_vertex(n, i + 1, j);
+        v[2] = b + geom_tri_vertex(n, i, j + 1);
+    } else {
+        v[0] = b + geom_tri_vertex(n, i + 1, j);
+        v[1] = b + geom_tri_vertex(n, i + 1, j + 1);
+        v[2] = b + geom_tri_vertex(n, i, j + 1);
+    }
+}
+
+static int build_tris(Accel *a, const uint32_t *idx, size_t n, uint32_t mask)
+{
+    const GridSet *gs = a->gs;
+    size_t n_tris = count_tris(gs, idx, n);
+    RTCGeometry geom = rtcNewGeometry(a->device, RTC_GEOMETRY_TYPE_TRIANGLE);
+    rtcSetSharedGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, gs->P, 0,
+                               sizeof(Vec3), gs->n_vertices);
+    uint32_t(*tri)[3] = rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
+                                                3 * sizeof(uint32_t), n_tris);
+    Geom g = {.triangular = 1, .tris = malloc(n_tris * sizeof(MicroTri))};
+    if (!tri || !g.tris) {
+        free(g.tris);
+        rtcReleaseGeometry(geom);
+        return -1;
+    }
+    size_t t = 0;
+    for (size_t k = 0; k < n; k++) {
+        const Grid *src = &gs->grids[idx[k]];
+        uint32_t s = src->nu;
+        for (uint32_t j = 0; j < s; j++)
+            for (uint32_t i = 0; i + j < s; i++)
+                for (uint8_t up = 0; up < 2; up++) {
+                    if (up && i + j + 1 >= s)
+                        continue;
+                    g.tris[t] = (MicroTri){idx[k], (uint8_t)i, (uint8_t)j, up};
+                    tri_vertices(src, &g.tris[t], tri[t]);
+                    t++;
+                }
+    }
+    RY_CHECK(t == n_tris);
+    rtcSetGeometryMask(geom, mask);
+    rtcCommitGeometry(geom);
+    unsigned id = rtcAttachGeometry(a->scene, geom);
+    rtcReleaseGeometry(geom);
+    RY_CHECK(id == a->n_geoms);
+    return add_geom(a, g);
+}
+
+/* Adds the geometries of one object: its quad grids, then its triangular. */
+static int build_object(Accel *a, uint32_t object, uint32_t mask, uint32_t *scratch)
+{
+    const GridSet *gs = a->gs;
+    for (int triangular = 0; triangular < 2; triangular++) {
+        size_t n = 0;
+        for (size_t k = 0; k < gs->n_grids; k++)
+            if (gs->grids[k].object == object && gs->grids[k].triangular == triangular)
+                scratch[n++] = (uint32_t)k;
+        if (n == 0)
+            continue;
+        int rc = triangular ? build_tris(a, scratch, n, mask) : build_quads(a, scratch, n, mask);
+        if (rc != 0)
+            return -1;
+    }
+    return 0;
+}
+
+Accel *accel_new(const GridSet *gs, const uint32_t *object_mask, size_t n_objects, char *err,
+                 size_t err_size)
+{
+    Accel *a = calloc(1, sizeof *a);
+    uint32_t *scratch = malloc((gs->n_grids + 1) * sizeof *scratch);
+    if (!a || !scratch) {
+        free(a);
+        free(scratch);
+        snprintf(err, err_size, "out of memory building the ray tracing structure");
+        return NULL;
+    }
+    a->gs = gs;
+    atomic_init(&a->bytes, 0);
+    a->device = rtcNewDevice("verbose=0");
+    if (!a->device) {
+        snprintf(err, err_size, "cannot create an Embree device (error %d)",
+                 (int)rtcGetDeviceError(NULL));
+        free(a);
+        free(scratch);
+        return NULL;
+    }
+    rtcSetDeviceErrorFunction(a->device, on_error, a);
+    rtcSetDeviceMemoryMonitorFunction(a->device, on_memory, a);
+    a->scene = rtcNewScene(a->device);
+    rtcSetSceneBuildQuality(a->scene, RTC_BUILD_QUALITY_MEDIUM);
+    int rc = 0;
+    for (size_t o = 0; o < n_objects && rc == 0; o++)
+        rc = build_object(a, (uint32_t)o, object_mask[o], scratch);
+    free(scratch);
+    if (rc == 0)
+        rtcCommitScene(a->scene);
+    if (rc != 0 || a->error[0]) {
+        snprintf(err, err_size, "%s", a->error[0] ? a->error : "out of memory in Embree");
+        accel_free(a);
+        return NULL;
+    }
+    return a;
+}
+
+void accel_free(Accel *a)
+{
+    if (!a)
+        return;
+    for (size_t k = 0; k < a->n_geoms; k++) {
+        free(a->geoms[k].grids);
+        free(a->geoms[k].tris);
+    }
+    free(a->geoms);
+    if (a->scene)
+        rtcReleaseScene(a->scene);
+    if (a->device)
+        rtcReleaseDevice(a->device);
+    free(a);
+}
+
+static void set_ray(struct RTCRay *r, const Ray *ray)
+{
+    r->org_x = ray->o.x;
+    r->org_y = ray->o.y;
+    r->org_z = ray->o.z;
+    r->dir_x = ray->d.x;
+    r->dir_y = ray->d.y;
+    r->dir_z = ray->d.z;
+    r->tnear = ray->tnear;
+    r->tfar = ray->tfar;
+    r->time = 0.0f;
+    r->mask = ray->mask;
+    r->id = 0;
+    r->flags = 0;
+}
+
+static Vec3 unit_or_zero(Vec3 n)
+{
+    float l = v3_length(n);
+    return l > 0.0f && isfinite(l) ? v3_scale(n, 1.0f / l) : v3(0, 0, 0);
+}
+
+static void quad_hit(const Accel *a, const Geom *g, unsigned prim, float u, float v, Hit *hit)
+{
+    const GridSet *gs = a->gs;
+    const Grid *grid = &gs->grids[g->grids[prim]];
+    int w = grid->nu, h = grid->nv;
+    float fu = u * (float)(w - 1), fv = v * (float)(h - 1);
+    int x = RY_MIN((int)fu, w - 2), y = RY_MIN((int)fv, h - 2);
+    x = RY_MAX(x, 0);
+    y = RY_MAX(y, 0);
+    fu = fminf(fmaxf(fu - (float)x, 0.0f), 1.0f);
+    fv = fminf(fmaxf(fv - (float)y, 0.0f), 1.0f);
+    uint32_t b = grid->first_vertex + (uint32_t)(y * w + x);
+    hit->grid = g->grids[prim];
+    hit->gu = u;
+    hit->gv = v;
+    hit->n_vertex = 4;
+    hit->vertex[0] = b;
+    hit->vertex[1] = b + 1;
+    hit->vertex[2] = b + (uint32_t)w;
+    hit->vertex[3] = b + (uint32_t)w + 1;
+    hit->weight[0] = (1.0f - fu) * (1.0f - fv);
+    hit->weight[1] = fu * (1.0f - fv);
+    hit->weight[2] = (1.0f - fu) * fv;
+    hit->weight[3] = fu * fv;
+    const Vec3 *P = gs->P;
+    /* The cell normal from its diagonals: 2 dPdu x dPdv for a parallelogram. */
+    hit->Ng = unit_or_zero(v3_cross(v3_sub(P[hit->vertex[3]], P[hit->vertex[0]]),
+                                    v3_sub(P[hit->vertex[2]], P[hit->vertex[1]])));
+}
+
+static void tri_hit(const Accel *a, const Geom *g, unsigned prim, float u, float v, Hit *hit)
+{
+    const GridSet *gs = a->gs;
+    const MicroTri *m = &g->tris[prim];
+    const Grid *grid = &gs->grids[m->grid];
+    uint32_t vtx[3];
+    tri_vertices(grid, m, vtx);
+    float w[3] = {1.0f - u - v, u, v};
+    /* Lattice coordinates of the three vertices, for the patch barycentrics. */
+    float li[3], lj[3];
+    if (!m->upper) {
+        li[0] = m->i, lj[0] = m->j, li[1] = m->i + 1, lj[1] = m->j, li[2] = m->i, lj[2] = m->j + 1;
+    } else {
+        li[0] = m->i + 1, lj[0] = m->j, li[1] = m->i + 1, lj[1] = m->j + 1;
+        li[2] = m->i, lj[2] = m->j + 1;
+    }
+    float n = grid->nu;
+    hit->grid = m->grid;
+    hit->gu = (w[0] * li[0] + w[1] * li[1] + w[2] * li[2]) / n;
+    hit->gv = (w[0] * lj[0] + w[1] * lj[1] + w[2] * lj[2]) / n;
+    hit->n_vertex = 3;
+    for (int k = 0; k < 3; k++) {
+        hit->vertex[k] = vtx[k];
+        hit->weight[k] = w[k];
+    }
+    hit->vertex[3] = vtx[0];
+    hit->weight[3] = 0.0f;
+    const Vec3 *P = gs->P;
+    hit->Ng = unit_or_zero(v3_cross(v3_sub(P[vtx[1]], P[vtx[0]]), v3_sub(P[vtx[2]], P[vtx[0]])));
+}
+
+int accel_intersect(const Accel *a, const Ray *ray, Hit *hit)
+{
+    struct RTCIntersectContext ctx;
+    rtcInitIntersectContext(&ctx);
+    struct RTCRayHit rh;
+    set_ray(&rh.ray, ray);
+    rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+    rh.hit.primID = RTC_INVALID_GEOMETRY_ID;
+    rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+    rtcIntersect1(a->scene, &ctx, &rh);
+    if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID)
+        return 0;
+    const Geom *g = &a->geoms[rh.hit.geomID];
+    if (g->triangular)
+        tri_hit(a, g, rh.hit.primID, rh.hit.u, rh.hit.v, hit);
+    else
+        quad_hit(a, g, rh.hit.primID, rh.hit.u, rh.hit.v, hit);
+    hit->t = rh.ray.tfar;
+    return 1;
+}
+
+int accel_occluded(const Accel *a, const Ray *ray)
+{
+    struct RTCIntersectContext ctx;
+    rtcInitIntersectContext(&ctx);
+    struct RTCRay r;
+    set_ray(&r, ray);
+    rtcOccluded1(a->scene, &ctx, &r);
+    return r.tfar < 0.0f;
+}
+
+size_t accel_memory_bytes(const Accel *a)
+{
+    long long b = atomic_load(&a->bytes);
+    return b > 0 ? (size_t)b : 0;
+}

@@ -1,0 +1,63 @@
+/*
+ * accel/accel.h — ray tracing against diced grids. The only module that
+ * sees Embree (DESIGN.md).
+ *
+ * Quad grids become Embree GRID geometry and triangular grids TRIANGLE
+ * geometry, one Embree geometry of each kind per object, all sharing the
+ * GridSet's vertex array (no copy). A hit leads back to its patch (the grid
+ * index, which is the patch id), its micropolygon's vertices and the
+ * interpolation weights inside it, and its position in the whole grid (the
+ * coordinates the radiosity cache interpolates with).
+ *
+ * Each object has a ray mask: a ray hits an object only if their masks
+ * share a bit (RayesRayType bits).
+ *
+ * Memory: the Accel borrows the GridSet, which must outlive it.
+ * Thread-safety: queries are thread-safe after accel_new returns; threads
+ * that trace must have FTZ/DAZ set (util/thread does).
+ */
+#ifndef RAYES_ACCEL_ACCEL_H
+#define RAYES_ACCEL_ACCEL_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "geom/geom.h"
+#include "util/vec.h"
+
+typedef struct Accel Accel;
+
+typedef struct Ray {
+    Vec3 o, d;           /* origin and direction (need not be unit length) */
+    float tnear, tfar;   /* the segment searched, in units of |d| */
+    uint32_t mask;       /* RayesRayType bits */
+} Ray;
+
+typedef struct Hit {
+    float t;             /* distance along d, in units of |d| */
+    uint32_t grid;       /* the patch id (index of its grid) */
+    Vec3 Ng;             /* unit geometric normal, on the side of dPdu x dPdv; zero if the
+                            micropolygon is degenerate */
+    float gu, gv;        /* position in the grid: quad: [0,1]^2 over the whole grid;
+                            triangle: barycentrics (b1, b2) in the patch */
+    uint32_t vertex[4];  /* vertices (GridSet indices) of the micropolygon hit */
+    float weight[4];     /* their interpolation weights (bilinear or barycentric) */
+    int n_vertex;        /* 4 (quad cell) or 3 (triangle) */
+} Hit;
+
+/* Builds the acceleration structure. object_mask[o] is object o's ray
+ * mask. Returns NULL and fills err on failure. */
+Accel *accel_new(const GridSet *gs, const uint32_t *object_mask, size_t n_objects,
+                 char *err, size_t err_size);
+void accel_free(Accel *accel);
+
+/* The nearest hit in [tnear, tfar]; returns 1 and fills hit, or 0. */
+int accel_intersect(const Accel *accel, const Ray *ray, Hit *hit);
+
+/* Returns 1 if anything lies in [tnear, tfar]. */
+int accel_occluded(const Accel *accel, const Ray *ray);
+
+/* Bytes Embree reported allocating for the structure. */
+size_t accel_memory_bytes(const Accel *accel);
+
+#endif /* RAYES_ACCEL_ACCEL_H */

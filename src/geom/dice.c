@@ -1,0 +1,300 @@
+/*
+ * geom/dice.c — splitting primitives into patches and dicing patches into
+ * grids (DESIGN.md "Geometry: patches and grids").
+ *
+ * A patch domain is a rectangle [u0,u1] x [v0,v1] of the primitive's
+ * parameters, or for triangles a sub-triangle given by three barycentric
+ * corners. Its size is estimated on a 5 x 5 lattice of surface points; if
+ * dicing it at the camera's rate would need more than GEOM_MAX_GRID - 1
+ * micropolygons along a direction, the domain is split in two along that
+ * direction (triangles: in four at the edge midpoints) and each half is
+ * estimated again, nearer halves getting finer rates. Splitting is
+ * depth-first in a fixed order, so patch ids are deterministic.
+ */
+#include "geom/geom.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "util/check.h"
+
+#define LATTICE 5           /* estimation lattice, per side */
+#define MAX_SPLIT_DEPTH 24  /* a bound on recursion for degenerate input */
+
+typedef struct Domain {
+    float c[3][2]; /* quad: c[0] = (u0, v0), c[1] = (u1, v1); triangle: three corners */
+    int triangular;
+} Domain;
+
+typedef struct Estimate {
+    int n_u, n_v;  /* micropolygons needed along u and v (triangle: n_u per edge) */
+} Estimate;
+
+void geom_gridset_init(GridSet *gs)
+{
+    memset(gs, 0, sizeof *gs);
+}
+
+void geom_gridset_fini(GridSet *gs)
+{
+    free(gs->grids);
+    free(gs->P);
+    free(gs->N);
+    free(gs->dPdu);
+    free(gs->dPdv);
+    free(gs->uv);
+    memset(gs, 0, sizeof *gs);
+}
+
+/* The primitive's (u, v) at lattice position (a, b) in [0,1]^2 of a domain
+ * (for triangles a + b <= 1 addresses the sub-triangle barycentrically). */
+static void domain_uv(const Domain *d, float a, float b, float *u, float *v)
+{
+    if (!d->triangular) {
+        *u = d->c[0][0] + (d->c[1][0] - d->c[0][0]) * a;
+        *v = d->c[0][1] + (d->c[1][1] - d->c[0][1]) * b;
+    } else {
+        float w = 1.0f - a - b;
+        *u = w * d->c[0][0] + a * d->c[1][0] + b * d->c[2][0];
+        *v = w * d->c[0][1] + a * d->c[1][1] + b * d->c[2][1];
+    }
+}
+
+static Vec3 domain_point(const Prim *prim, const Domain *d, float a, float b)
+{
+    Vec3 P, du, dv;
+    float u, v;
+    domain_uv(d, a, b, &u, &v);
+    geom_prim_eval(prim, u, v, &P, &du, &dv);
+    return P;
+}
+
+static Estimate estimate(const Prim *prim, const Domain *d, const DiceCamera *cam)
+{
+    Vec3 p[LATTICE][LATTICE];
+    Bounds3 box = bounds_empty();
+    const float step = 1.0f / (LATTICE - 1);
+    for (int j = 0; j < LATTICE; j++)
+        for (int i = 0; i < LATTICE; i++) {
+            if (d->triangular && i + j > LATTICE - 1)
+                continue;
+            p[j][i] = domain_point(prim, d, (float)i * step, (float)j * step);
+            box = bounds_add(box, p[j][i]);
+        }
+    /* Lengths of the lattice lines along u (rows) and v (columns); for
+     * triangles also along the third edge, c1 -> c2 (the diagonals). */
+    const int last = LATTICE - 1;
+    float len_u = 0.0f, len_v = 0.0f, len_w = 0.0f;
+    for (int j = 0; j < LATTICE; j++) {
+        float lu = 0.0f, lv = 0.0f;
+        int end = d->triangular ? last - j : last; /* last i (or j) of the line */
+        for (int i = 0; i < end; i++) {
+            lu += v3_length(v3_sub(p[j][i + 1], p[j][i]));
+            lv += v3_length(v3_sub(p[i + 1][j], p[i][j]));
+        }
+        len_u = fmaxf(len_u, lu);
+        len_v = fmaxf(len_v, lv);
+    }
+    if (d->triangular)
+        for (int j = 0; j < last; j++)
+            len_w += v3_length(v3_sub(p[j + 1][last - 1 - j], p[j][last - j]));
+    float dist = fmaxf(bounds_distance(box, cam->eye), cam->min_distance);
+    float target = sqrtf(fmaxf(prim->shading_rate, 1e-6f)) * cam->pixel_angle * dist;
+    Estimate e;
+    if (d->triangular) {
+        float len = fmaxf(len_u, fmaxf(len_v, len_w));
+        e.n_u = e.n_v = (int)fminf(ceilf(len / target), 1e6f);
+    } else {
+        e.n_u = (int)fminf(ceilf(len_u / target), 1e6f);
+        e.n_v = (int)fminf(ceilf(len_v / target), 1e6f);
+    }
+    e.n_u = RY_MAX(e.n_u, 1);
+    e.n_v = RY_MAX(e.n_v, 1);
+    return e;
+}
+
+static int reserve(GridSet *gs, size_t n_vertices)
+{
+    if (gs->n_grids == gs->cap_grids) {
+        size_t cap = gs->cap_grids ? 2 * gs->cap_grids : 64;
+        Grid *g = realloc(gs->grids, cap * sizeof *g);
+        if (!g)
+            return -1;
+        gs->grids = g;
+        gs->cap_grids = cap;
+    }
+    if (gs->n_vertices + n_vertices > gs->cap_vertices) {
+        size_t cap = gs->cap_vertices ? 2 * gs->cap_vertices : 4096;
+        while (cap < gs->n_vertices + n_vertices)
+            cap *= 2;
+        /* One spare vertex: Embree reads 16 bytes for the last float3. */
+        Vec3 *P = realloc(gs->P, (cap + 1) * sizeof *P);
+        if (P)
+            gs->P = P;
+        Vec3 *N = realloc(gs->N, cap * sizeof *N);
+        if (N)
+            gs->N = N;
+        Vec3 *du = realloc(gs->dPdu, cap * sizeof *du);
+        if (du)
+            gs->dPdu = du;
+        Vec3 *dv = realloc(gs->dPdv, cap * sizeof *dv);
+        if (dv)
+            gs->dPdv = dv;
+        float(*uv)[2] = realloc(gs->uv, cap * sizeof *uv);
+        if (uv)
+            gs->uv = uv;
+        if (!P || !N || !du || !dv || !uv)
+            return -1;
+        gs->cap_vertices = cap;
+    }
+    return 0;
+}
+
+static void put_vertex(GridSet *gs, size_t k, const Prim *prim, float u, float v)
+{
+    geom_prim_eval(prim, u, v, &gs->P[k], &gs->dPdu[k], &gs->dPdv[k]);
+    gs->N[k] = geom_prim_normal(prim, u, v);
+    gs->uv[k][0] = u;
+    gs->uv[k][1] = v;
+}
+
+/* Mean edge and largest normal change per length over neighbour pairs. */
+static void measure(const GridSet *gs, size_t a, size_t b, double *sum, size_t *n, float *curv)
+{
+    float len = v3_length(v3_sub(gs->P[a], gs->P[b]));
+    *sum += len;
+    (*n)++;
+    if (len > 0.0f)
+        *curv = fmaxf(*curv, v3_length(v3_sub(gs->N[a], gs->N[b])) / len);
+}
+
+static int dice_quad(GridSet *gs, const Prim *prim, uint32_t prim_index, const Domain *d, Estimate e)
+{
+    int nu = RY_MIN(e.n_u, GEOM_MAX_GRID - 1) + 1, nv = RY_MIN(e.n_v, GEOM_MAX_GRID - 1) + 1;
+    if (reserve(gs, (size_t)nu * nv) != 0)
+        return -1;
+    Grid *g = &gs->grids[gs->n_grids];
+    *g = (Grid){.prim = prim_index, .object = prim->object, .first_vertex = (uint32_t)gs->n_vertices,
+                .nu = (uint16_t)nu, .nv = (uint16_t)nv};
+    memcpy(g->uv, d->c, sizeof g->uv);
+    size_t base = gs->n_vertices;
+    for (int j = 0; j < nv; j++)
+        for (int i = 0; i < nu; i++) {
+            float u, v;
+            domain_uv(d, (float)i / (nu - 1), (float)j / (nv - 1), &u, &v);
+            put_vertex(gs, base + (size_t)j * nu + i, prim, u, v);
+        }
+    double sum = 0.0;
+    size_t n = 0;
+    float curv = 0.0f;
+    for (int j = 0; j < nv; j++)
+        for (int i = 0; i < nu; i++) {
+            size_t k = base + (size_t)j * nu + i;
+            if (i + 1 < nu)
+                measure(gs, k, k + 1, &sum, &n, &curv);
+            if (j + 1 < nv)
+                measure(gs, k, k + nu, &sum, &n, &curv);
+        }
+    g->edge = n ? (float)(sum / (double)n) : 0.0f;
+    g->curvature = curv;
+    gs->n_vertices += (size_t)nu * nv;
+    gs->n_grids++;
+    return 0;
+}
+
+static int dice_triangle(GridSet *gs, const Prim *prim, uint32_t prim_index, const Domain *d,
+                         Estimate e)
+{
+    uint32_t n = (uint32_t)RY_MIN(e.n_u, GEOM_MAX_GRID - 1);
+    size_t count = (size_t)(n + 1) * (n + 2) / 2;
+    if (reserve(gs, count) != 0)
+        return -1;
+    Grid *g = &gs->grids[gs->n_grids];
+    *g = (Grid){.prim = prim_index, .object = prim->object, .first_vertex = (uint32_t)gs->n_vertices,
+                .nu = (uint16_t)n, .nv = 0, .triangular = 1};
+    memcpy(g->uv, d->c, sizeof g->uv);
+    size_t base = gs->n_vertices;
+    for (uint32_t j = 0; j <= n; j++)
+        for (uint32_t i = 0; i + j <= n; i++) {
+            float u, v;
+            domain_uv(d, (float)i / n, (float)j / n, &u, &v);
+            put_vertex(gs, base + geom_tri_vertex(n, i, j), prim, u, v);
+        }
+    double sum = 0.0;
+    size_t m = 0;
+    float curv = 0.0f;
+    for (uint32_t j = 0; j <= n; j++)
+        for (uint32_t i = 0; i + j < n; i++) {
+            size_t k = base + geom_tri_vertex(n, i, j);
+            measure(gs, k, base + geom_tri_vertex(n, i + 1, j), &sum, &m, &curv);
+            measure(gs, k, base + geom_tri_vertex(n, i, j + 1), &sum, &m, &curv);
+        }
+    g->edge = m ? (float)(sum / (double)m) : 0.0f;
+    g->curvature = curv;
+    gs->n_vertices += count;
+    gs->n_grids++;
+    return 0;
+}
+
+static int split_dice(GridSet *gs, const Prim *prim, uint32_t prim_index, const Domain *d,
+                      const DiceCamera *cam, int depth)
+{
+    const int max_n = GEOM_MAX_GRID - 1;
+    Estimate e = estimate(prim, d, cam);
+    int split_u = e.n_u > max_n, split_v = e.n_v > max_n;
+    if ((!split_u && !split_v) || depth >= MAX_SPLIT_DEPTH)
+        return d->triangular ? dice_triangle(gs, prim, prim_index, d, e)
+                             : dice_quad(gs, prim, prim_index, d, e);
+    if (d->triangular) {
+        /* Four sub-triangles at the edge midpoints; corners 0, 1, 2 first,
+         * the middle one last. */
+        float m01[2], m12[2], m20[2];
+        for (int k = 0; k < 2; k++) {
+            m01[k] = 0.5f * (d->c[0][k] + d->c[1][k]);
+            m12[k] = 0.5f * (d->c[1][k] + d->c[2][k]);
+            m20[k] = 0.5f * (d->c[2][k] + d->c[0][k]);
+        }
+        const float *corners[4][3] = {{d->c[0], m01, m20}, {m01, d->c[1], m12},
+                                      {m20, m12, d->c[2]}, {m12, m20, m01}};
+        for (int s = 0; s < 4; s++) {
+            Domain sub = {.triangular = 1};
+            for (int c = 0; c < 3; c++)
+                memcpy(sub.c[c], corners[s][c], sizeof sub.c[c]);
+            if (split_dice(gs, prim, prim_index, &sub, cam, depth + 1) != 0)
+                return -1;
+        }
+        return 0;
+    }
+    /* Split the direction that needs it more (both if both far exceed). */
+    if (split_u && split_v) {
+        split_u = e.n_u * 2 > e.n_v;
+        split_v = e.n_v * 2 > e.n_u;
+    }
+    int su = split_u ? 2 : 1, sv = split_v ? 2 : 1;
+    for (int j = 0; j < sv; j++)
+        for (int i = 0; i < su; i++) {
+            Domain sub = *d;
+            float du = (d->c[1][0] - d->c[0][0]) / su, dv = (d->c[1][1] - d->c[0][1]) / sv;
+            sub.c[0][0] = d->c[0][0] + du * i;
+            sub.c[1][0] = i + 1 == su ? d->c[1][0] : d->c[0][0] + du * (i + 1);
+            sub.c[0][1] = d->c[0][1] + dv * j;
+            sub.c[1][1] = j + 1 == sv ? d->c[1][1] : d->c[0][1] + dv * (j + 1);
+            if (split_dice(gs, prim, prim_index, &sub, cam, depth + 1) != 0)
+                return -1;
+        }
+    return 0;
+}
+
+int geom_dice_prim(GridSet *gs, const Prim *prim, uint32_t prim_index, const DiceCamera *cam)
+{
+    Domain d = {.triangular = prim->type == PRIM_TRIANGLE};
+    if (d.triangular) {
+        const float c[3][2] = {{0, 0}, {1, 0}, {0, 1}};
+        memcpy(d.c, c, sizeof c);
+    } else {
+        const float c[3][2] = {{0, 0}, {1, 1}, {0, 0}};
+        memcpy(d.c, c, sizeof c);
+    }
+    return split_dice(gs, prim, prim_index, &d, cam, 0);
+}

@@ -1,0 +1,113 @@
+/*
+ * geom/geom.h — primitives, patches and grids (DESIGN.md "Geometry").
+ *
+ * A primitive (bilinear patch, bicubic Bezier patch, triangle, sphere) is
+ * split into patches small enough to dice into one grid of at most
+ * GEOM_MAX_GRID x GEOM_MAX_GRID vertices (triangles: a triangular grid of at
+ * most GEOM_MAX_GRID - 1 subdivisions per edge). The dicing rate comes from
+ * the camera: a micropolygon edge of about sqrt(shading rate) pixels at the
+ * patch's distance from the eye, whether or not the patch is in view (the
+ * "spherical projection" of RenderMan), at least one micropolygon per side.
+ *
+ * A patch's global id is its index in the GridSet, which holds one grid per
+ * patch: patches and grids are numbered alike, in primitive order, so ids
+ * do not depend on threads. Grid vertices are structure-of-arrays in the
+ * GridSet; quad grids are row-major (u fastest), triangular grids are rows
+ * j = 0..n of n - j + 1 vertices (barycentric b1 = i/n, b2 = j/n).
+ *
+ * Memory: a GridSet owns its arrays (geom_gridset_fini frees them).
+ * Thread-safety: dicing writes only into its own GridSet; reading a
+ * finished GridSet is thread-safe.
+ */
+#ifndef RAYES_GEOM_GEOM_H
+#define RAYES_GEOM_GEOM_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "util/vec.h"
+
+#define GEOM_MAX_GRID 17 /* vertices per side: 16 x 16 micropolygons */
+
+typedef enum PrimType {
+    PRIM_BILINEAR = 1, /* cp[0..3] = P00, P10, P01, P11 */
+    PRIM_BICUBIC = 2,  /* cp[0..15] Bezier, row-major, u fastest */
+    PRIM_TRIANGLE = 3, /* cp[0..2]; (u, v) are barycentrics of cp[1], cp[2] */
+    PRIM_SPHERE = 4    /* sphere.radius at the origin of sphere.world_from_object */
+} PrimType;
+
+typedef struct Prim {
+    PrimType type;
+    uint32_t object;       /* the object (shader, attributes) it belongs to */
+    float shading_rate;    /* micropolygon area in pixels */
+    union {
+        Vec3 cp[16];       /* world-space control points */
+        struct {
+            Mat4 world_from_object;
+            Mat4 normal_from_object; /* inverse transpose, for normals */
+            float radius;
+        } sphere;
+    };
+} Prim;
+
+/* Evaluates a primitive at parameters (u, v): position and derivatives, in
+ * world space. */
+void geom_prim_eval(const Prim *prim, float u, float v, Vec3 *P, Vec3 *dPdu, Vec3 *dPdv);
+
+/* The unit normal at (u, v): dPdu x dPdv, or at a degenerate point (a pole,
+ * a collapsed patch row) the normal a little way inside the patch. */
+Vec3 geom_prim_normal(const Prim *prim, float u, float v);
+
+typedef struct Grid {
+    uint32_t prim;         /* the primitive it was diced from */
+    uint32_t object;       /* the primitive's object */
+    uint32_t first_vertex; /* index of its first vertex in the GridSet */
+    uint16_t nu, nv;       /* quad: vertices in u and v; triangle: nu = n subdivisions, nv = 0 */
+    uint8_t triangular;    /* 1 for a triangular grid */
+    float edge;            /* mean micropolygon edge length, scene units */
+    float curvature;       /* largest |dN| / |dP| between neighbouring vertices, 1/units */
+    float uv[3][2];        /* corners in the primitive's (u, v): quad (u0,v0), (u1,v1);
+                              triangle: the three corners */
+} Grid;
+
+typedef struct GridSet {
+    Grid *grids;           /* one per patch; the index is the patch id */
+    size_t n_grids;
+    Vec3 *P;               /* vertex positions, world */
+    Vec3 *N;               /* unit normals, world (front = dPdu x dPdv) */
+    Vec3 *dPdu, *dPdv;     /* derivatives with respect to the primitive's u, v */
+    float (*uv)[2];        /* the primitive's (u, v) at the vertex */
+    size_t n_vertices;
+    size_t cap_grids, cap_vertices;
+} GridSet;
+
+/* How the camera sets dicing rates. */
+typedef struct DiceCamera {
+    Vec3 eye;              /* camera position, world */
+    float pixel_angle;     /* radians subtended by one pixel */
+    float min_distance;    /* distances are clamped to this (the eye inside a patch) */
+} DiceCamera;
+
+void geom_gridset_init(GridSet *gs);
+void geom_gridset_fini(GridSet *gs);
+
+/* Splits prim into patches and dices each into a grid appended to gs.
+ * Returns 0, or -1 when out of memory (gs keeps what was added). */
+int geom_dice_prim(GridSet *gs, const Prim *prim, uint32_t prim_index, const DiceCamera *cam);
+
+/* Vertex count of a grid. */
+static inline size_t geom_grid_n_vertices(const Grid *g)
+{
+    return g->triangular ? (size_t)(g->nu + 1) * (g->nu + 2) / 2 : (size_t)g->nu * g->nv;
+}
+
+/* Index, within a triangular grid of n subdivisions, of vertex (i, j). */
+static inline uint32_t geom_tri_vertex(uint32_t n, uint32_t i, uint32_t j)
+{
+    return j * (n + 1) - j * (j - 1) / 2 + i;
+}
+
+/* Bernstein polynomials of degree 3 at t, and their derivatives. */
+void geom_bezier_basis(float t, float b[4], float db[4]);
+
+#endif /* RAYES_GEOM_GEOM_H */

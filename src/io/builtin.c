@@ -1,0 +1,177 @@
+/*
+ * io/builtin.c — the built-in scenes of builtin.h, with the numbers of
+ * ../shared/data/cornell-box.md and cornell-teapots.md (millimetres,
+ * right-handed, y up; quads listed in order around, front side
+ * counter-clockwise).
+ */
+#include "io/builtin.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "io/bpt.h"
+
+const char *const io_builtin_scene_names[] = {"cornell", "cornell-teapots", NULL};
+
+typedef struct Quad {
+    float P[4][3];
+} Quad;
+
+static const float white[3] = {0.725f, 0.71f, 0.68f};
+static const float red[3] = {0.63f, 0.065f, 0.05f};
+static const float green[3] = {0.14f, 0.45f, 0.091f};
+
+static RayesError matte(RayesScene *s, const float Cs[3])
+{
+    RayesParam p = {"Cs", RAYES_PARAM_COLOR, {Cs[0], Cs[1], Cs[2]}, NULL};
+    return rayes_scene_set_shader(s, "matte", &p, 1);
+}
+
+static RayesError quads(RayesScene *s, const Quad *q, size_t n)
+{
+    int nv[8], idx[32];
+    RayesError e = RAYES_OK;
+    for (size_t i = 0; i < n && e == RAYES_OK; i++) {
+        nv[0] = 4;
+        for (int k = 0; k < 4; k++)
+            idx[k] = k;
+        e = rayes_scene_polygon_mesh(s, 1, nv, idx, 4, &q[i].P[0][0]);
+    }
+    return e;
+}
+
+/* The box, the light and the camera, shared by both Cornell scenes. */
+static RayesError cornell_shell(RayesScene *s)
+{
+    static const Quad white_quads[] = {
+        {{{552.8f, 0, 0}, {0, 0, 0}, {0, 0, 559.2f}, {549.6f, 0, 559.2f}}},               /* floor */
+        {{{556, 548.8f, 0}, {556, 548.8f, 559.2f}, {0, 548.8f, 559.2f}, {0, 548.8f, 0}}}, /* ceiling */
+        {{{549.6f, 0, 559.2f}, {0, 0, 559.2f}, {0, 548.8f, 559.2f}, {556, 548.8f, 559.2f}}}, /* back */
+    };
+    static const Quad green_wall = {{{0, 0, 559.2f}, {0, 0, 0}, {0, 548.8f, 0}, {0, 548.8f, 559.2f}}};
+    static const Quad red_wall = {
+        {{552.8f, 0, 0}, {549.6f, 0, 559.2f}, {556, 548.8f, 559.2f}, {556, 548.8f, 0}}};
+    static const float light[4][3] = {
+        {343, 548.7f, 227}, {343, 548.7f, 332}, {213, 548.7f, 332}, {213, 548.7f, 227}};
+    static const float L[3] = {17, 12, 4};
+    static const float eye[3] = {278, 273, -800}, target[3] = {278, 273, 0}, up[3] = {0, 1, 0};
+    RayesError e = rayes_scene_set_camera(s, eye, target, up, 39.3077f);
+    if (e == RAYES_OK)
+        e = matte(s, white);
+    if (e == RAYES_OK)
+        e = quads(s, white_quads, 3);
+    if (e == RAYES_OK)
+        e = matte(s, green);
+    if (e == RAYES_OK)
+        e = quads(s, &green_wall, 1);
+    if (e == RAYES_OK)
+        e = matte(s, red);
+    if (e == RAYES_OK)
+        e = quads(s, &red_wall, 1);
+    if (e == RAYES_OK)
+        e = rayes_scene_area_light(s, light, L);
+    return e;
+}
+
+static RayesError cornell_blocks(RayesScene *s)
+{
+    static const Quad blocks[] = {
+        /* short block */
+        {{{130, 165, 65}, {82, 165, 225}, {240, 165, 272}, {290, 165, 114}}},
+        {{{290, 0, 114}, {290, 165, 114}, {240, 165, 272}, {240, 0, 272}}},
+        {{{130, 0, 65}, {130, 165, 65}, {290, 165, 114}, {290, 0, 114}}},
+        {{{82, 0, 225}, {82, 165, 225}, {130, 165, 65}, {130, 0, 65}}},
+        {{{240, 0, 272}, {240, 165, 272}, {82, 165, 225}, {82, 0, 225}}},
+        /* tall block */
+        {{{423, 330, 247}, {265, 330, 296}, {314, 330, 456}, {472, 330, 406}}},
+        {{{423, 0, 247}, {423, 330, 247}, {472, 330, 406}, {472, 0, 406}}},
+        {{{472, 0, 406}, {472, 330, 406}, {314, 330, 456}, {314, 0, 456}}},
+        {{{314, 0, 456}, {314, 330, 456}, {265, 330, 296}, {265, 0, 296}}},
+        {{{265, 0, 296}, {265, 330, 296}, {423, 330, 247}, {423, 0, 247}}},
+    };
+    RayesError e = matte(s, white);
+    return e == RAYES_OK ? quads(s, blocks, sizeof blocks / sizeof blocks[0]) : e;
+}
+
+/* world = T(tx, 0, tz) * Ry(theta) * S(45) * (x, z, -y): the teapot data is z up. */
+static void teapot_transform(float theta_degrees, float tx, float tz, float m[16])
+{
+    double th = theta_degrees * M_PI / 180.0;
+    float c = (float)cos(th), s = (float)sin(th), k = 45.0f;
+    /* Ry(theta) * (x, z, -y): x' = c x - s y, y' = z, z' = -s x - c y. */
+    const float r[16] = {
+        k * c,  -k * s, 0, tx,
+        0,      0,      k, 0,
+        -k * s, -k * c, 0, tz,
+        0,      0,      0, 1,
+    };
+    memcpy(m, r, sizeof r);
+}
+
+static RayesError cornell_teapots(RayesScene *s, const char *data_dir, char *err, size_t err_size)
+{
+    char path[4096];
+    if (!data_dir) {
+        snprintf(err, err_size,
+                 "cornell-teapots needs teapot.bpt: give the data directory with --data DIR "
+                 "or RAYES_DATA");
+        return RAYES_ERROR_IO;
+    }
+    snprintf(path, sizeof path, "%s/teapot.bpt", data_dir);
+    FILE *f = fopen(path, "rb");
+    if (!f) {
+        snprintf(err, err_size,
+                 "%s: cannot open the teapot patches; point --data (or RAYES_DATA) at the "
+                 "directory holding teapot.bpt",
+                 path);
+        return RAYES_ERROR_IO;
+    }
+    fclose(f);
+    static const float chrome[3] = {0.9f, 0.9f, 0.9f}, grey[3] = {0.7f, 0.7f, 0.7f};
+    float m[16];
+    RayesParam mirror = {"specularcolor", RAYES_PARAM_COLOR, {chrome[0], chrome[1], chrome[2]},
+                         NULL};
+    RayesError e = rayes_scene_set_shader(s, "mirror", &mirror, 1);
+    teapot_transform(35.0f, 395.0f, 370.0f, m);
+    if (e == RAYES_OK)
+        e = rayes_scene_set_transform(s, m);
+    if (e == RAYES_OK && (e = io_read_bpt(path, s, err, err_size)) != RAYES_OK)
+        return e;
+    if (e == RAYES_OK)
+        e = matte(s, grey);
+    teapot_transform(150.0f, 160.0f, 195.0f, m);
+    if (e == RAYES_OK)
+        e = rayes_scene_set_transform(s, m);
+    if (e == RAYES_OK && (e = io_read_bpt(path, s, err, err_size)) != RAYES_OK)
+        return e;
+    static const float identity[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
+    if (e == RAYES_OK)
+        e = rayes_scene_set_transform(s, identity);
+    return e;
+}
+
+RayesError io_builtin_scene(const char *name, const char *data_dir, RayesScene *s, char *err,
+                            size_t err_size)
+{
+    RayesError e;
+    err[0] = '\0';
+    if (strcmp(name, "cornell") == 0) {
+        e = cornell_shell(s);
+        if (e == RAYES_OK)
+            e = cornell_blocks(s);
+    } else if (strcmp(name, "cornell-teapots") == 0) {
+        e = cornell_shell(s);
+        if (e == RAYES_OK)
+            e = cornell_teapots(s, data_dir, err, err_size);
+    } else {
+        snprintf(err, err_size, "unknown scene \"%s\" (built-in scenes: cornell, cornell-teapots)",
+                 name);
+        return RAYES_ERROR_INVALID_ARGUMENT;
+    }
+    if (e == RAYES_OK)
+        e = rayes_scene_commit(s);
+    if (e != RAYES_OK && err[0] == '\0')
+        snprintf(err, err_size, "scene %s: %s", name, rayes_scene_get_error(s));
+    return e;
+}

@@ -1,0 +1,52 @@
+/*
+ * io/image.h — writing and reading images: OpenEXR (through OpenEXRCore's
+ * C API) and PNG (libpng).
+ *
+ * Pixels are RGBA floats, linear, top row first, width * height * 4.
+ * Writers are atomic: they write a temporary file beside the target and
+ * rename it, so the target appears whole or not at all (an existing target
+ * is left untouched on failure). Errors fill err (one line naming the
+ * file and what went wrong) and return nonzero RayesError.
+ * Thread-safety: all functions are reentrant.
+ */
+#ifndef RAYES_IO_IMAGE_H
+#define RAYES_IO_IMAGE_H
+
+#include <stddef.h>
+
+#include "rayes/rayes.h"
+
+typedef enum ImageFormat {
+    IMAGE_FORMAT_UNKNOWN = 0,
+    IMAGE_FORMAT_EXR = 1,
+    IMAGE_FORMAT_PNG = 2
+} ImageFormat;
+
+/* The format named by a path's extension (.exr, .png, any case). */
+ImageFormat io_image_format_from_path(const char *path);
+
+/* EXR: half-float R, G, B, A channels, ZIP compression, scanlines, with a
+ * "renderer" string attribute. */
+RayesError io_write_exr(const char *path, int width, int height, const float *rgba,
+                        char *err, size_t err_size);
+
+/* PNG: 8-bit RGBA, sRGB-encoded (the sRGB transfer curve applied to the
+ * clamped linear values, alpha linear), with an sRGB chunk. */
+RayesError io_write_png(const char *path, int width, int height, const float *rgba,
+                        char *err, size_t err_size);
+
+/* Dispatch on the extension; an unknown extension is INVALID_ARGUMENT. */
+RayesError io_write_image(const char *path, int width, int height, const float *rgba,
+                          char *err, size_t err_size);
+
+/* Reads an EXR file with R, G, B (and optionally A; 1 if absent) channels of
+ * any pixel type, scanline or tiled. *rgba is new (free()). */
+RayesError io_read_exr(const char *path, int *width, int *height, float **rgba,
+                       char *err, size_t err_size);
+
+/* Reads a PNG (any bit depth/colour type, converted to RGBA) and decodes
+ * sRGB to linear. *rgba is new (free()). */
+RayesError io_read_png(const char *path, int *width, int *height, float **rgba,
+                       char *err, size_t err_size);
+
+#endif /* RAYES_IO_IMAGE_H */

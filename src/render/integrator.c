@@ -1,0 +1,289 @@
+/*
+ * render/integrator.c — the uncached distribution ray tracer, the memo's
+ * "without caching" baseline: a camera or specular hit runs the shader's
+ * lighting() at the hit; a diffuse hit runs diffuselighting() at that one
+ * point (one shading point, counted at its diffuse depth). Area lights are
+ * seen by camera and specular rays; diffuse rays see them as black because
+ * direct lighting already integrates them (no double counting).
+ *
+ * Every random number is a function of a key: the camera path's key, then
+ * hash_combine(key, ray index) for each child ray, so images do not depend
+ * on threads or order.
+ */
+#include "render/integrator.h"
+
+#include <math.h>
+#include <string.h>
+
+#include "util/check.h"
+#include "util/rng.h"
+#include "util/sampling.h"
+
+static float ray_epsilon(const Worker *w)
+{
+    return 1e-5f * w->rs->scene_radius;
+}
+
+/* The shading inputs of one hit: a 1-point context. */
+typedef struct HitPoint {
+    float P[3], N[3], Ng[3], dPdu[3], dPdv[3], I[3], Cs[3], Os[3];
+    float u, v, du, dv;
+    uint64_t key;
+    RayDiff diff;
+    float curvature;
+} HitPoint;
+
+static void store3(float out[3], Vec3 v)
+{
+    out[0] = v.x;
+    out[1] = v.y;
+    out[2] = v.z;
+}
+
+/* Interpolates the grid at a hit; N and Ng face the incoming ray. Returns
+ * 1 if the front side (dPdu x dPdv) was hit. */
+static int hit_point(const Worker *w, const Ray *ray, const Hit *hit, HitPoint *hp)
+{
+    const GridSet *gs = w->rs->gs;
+    Vec3 N = v3(0, 0, 0), du = N, dv = N;
+    float u = 0.0f, v = 0.0f;
+    for (int k = 0; k < hit->n_vertex; k++) {
+        uint32_t i = hit->vertex[k];
+        float wk = hit->weight[k];
+        N = v3_madd(N, gs->N[i], wk);
+        du = v3_madd(du, gs->dPdu[i], wk);
+        dv = v3_madd(dv, gs->dPdv[i], wk);
+        u += gs->uv[i][0] * wk;
+        v += gs->uv[i][1] * wk;
+    }
+    N = v3_normalize(N);
+    Vec3 Ng = v3_length(hit->Ng) > 0.0f ? hit->Ng : N;
+    int front = v3_dot(Ng, ray->d) < 0.0f;
+    if (!front) {
+        N = v3_neg(N);
+        Ng = v3_neg(Ng);
+    }
+    if (v3_dot(N, Ng) < 0.0f) /* interpolation across a silhouette */
+        N = Ng;
+    store3(hp->P, v3_madd(ray->o, ray->d, hit->t));
+    store3(hp->N, N);
+    store3(hp->Ng, Ng);
+    store3(hp->dPdu, du);
+    store3(hp->dPdv, dv);
+    store3(hp->I, ray->d);
+    hp->u = u;
+    hp->v = v;
+    hp->du = hp->dv = 0.0f;
+    hp->curvature = gs->grids[hit->grid].curvature;
+    return front;
+}
+
+static Vec3 shade_hit(Worker *w, const Ray *ray, const Hit *hit, const RenderObject *obj,
+                      uint32_t kind, int diffuse_depth, int specular_depth, uint64_t key,
+                      RayDiff diff)
+{
+    HitPoint hp;
+    hit_point(w, ray, hit, &hp);
+    memcpy(hp.Cs, obj->Cs, sizeof hp.Cs);
+    memcpy(hp.Os, obj->Os, sizeof hp.Os);
+    hp.key = key;
+    hp.diff = (RayDiff){diff.width + diff.spread * hit->t, diff.spread};
+    PathState ps = {w, &hp.key, &hp.diff, &hp.curvature};
+    RayesShadeCtx ctx = {
+        .n_points = 1,
+        .ray_type = kind,
+        .diffuse_depth = diffuse_depth,
+        .specular_depth = specular_depth,
+        .P = (const float(*)[3])hp.P,
+        .N = (const float(*)[3])hp.N,
+        .Ng = (const float(*)[3])hp.Ng,
+        .dPdu = (const float(*)[3])hp.dPdu,
+        .dPdv = (const float(*)[3])hp.dPdv,
+        .u = &hp.u,
+        .v = &hp.v,
+        .s = &hp.u,
+        .t = &hp.v,
+        .du = &hp.du,
+        .dv = &hp.dv,
+        .I = (const float(*)[3])hp.I,
+        .Cs = (const float(*)[3])hp.Cs,
+        .Os = (const float(*)[3])hp.Os,
+        .renderer = &ps,
+    };
+    float Ci[1][3], Oi[1][3];
+    RayesShadeOutputs out = {Ci, Oi, NULL};
+    w->stats.shading_points[RY_MIN(diffuse_depth, RENDER_MAX_DEPTH)]++;
+    if (kind == RAYES_RAY_DIFFUSE)
+        shade_run_diffuselighting(&render_services, &ctx, obj->shader, &out);
+    else
+        shade_run_lighting(&render_services, &ctx, obj->shader, &out);
+    return v3(Ci[0][0], Ci[0][1], Ci[0][2]);
+}
+
+Vec3 integrator_trace(Worker *w, const Ray *ray, uint32_t kind, int diffuse_depth,
+                      int specular_depth, uint64_t key, RayDiff diff, float *alpha)
+{
+    Hit hit;
+    if (alpha)
+        *alpha = 0.0f;
+    if (!accel_intersect(w->rs->accel, ray, &hit))
+        return v3(0, 0, 0);
+    if (alpha)
+        *alpha = 1.0f;
+    const RenderObject *obj = &w->rs->objects[w->rs->gs->grids[hit.grid].object];
+    if (obj->light >= 0) {
+        /* Emitters: seen by camera and specular rays, on their front side. */
+        if (kind == RAYES_RAY_DIFFUSE || v3_dot(hit.Ng, ray->d) >= 0.0f)
+            return v3(0, 0, 0);
+        return w->rs->lights[obj->light].L;
+    }
+    return shade_hit(w, ray, &hit, obj, kind, diffuse_depth, specular_depth, key, diff);
+}
+
+/* ------------------------------------------------------------ services */
+
+static Vec3 load3(const float p[3])
+{
+    return v3(p[0], p[1], p[2]);
+}
+
+static Vec3 offset_origin(const Worker *w, Vec3 P, Vec3 Ng)
+{
+    return v3_madd(P, Ng, ray_epsilon(w));
+}
+
+/* Direct light from one quad light at one point, n shadow rays. */
+static void light_point(Worker *w, const RayesShadeCtx *ctx, size_t i, const Light *l,
+                        uint32_t pattern, int n, float exponent, Vec3 *diffuse, Vec3 *spec)
+{
+    Vec3 P = load3(ctx->P[i]), N = load3(ctx->N[i]), Ng = load3(ctx->Ng[i]);
+    Vec3 o = offset_origin(w, P, Ng);
+    Vec3 V = ctx->I ? v3_neg(load3(ctx->I[i])) : v3(0, 0, 0);
+    Vec3 sum_d = v3(0, 0, 0), sum_s = v3(0, 0, 0);
+    for (int s = 0; s < n; s++) {
+        float a, b;
+        cmj_sample_2d((uint32_t)s, (uint32_t)n, pattern, &a, &b);
+        Vec3 y, ny;
+        light_quad_eval(l, a, b, &y, &ny);
+        Vec3 wi = v3_sub(y, o);
+        float d2 = v3_dot(wi, wi);
+        float cos_x = v3_dot(N, wi), cos_y = -v3_dot(ny, wi); /* both scaled by |wi| (and |ny|) */
+        if (cos_x <= 0.0f || cos_y <= 0.0f || v3_dot(Ng, wi) <= 0.0f || d2 <= 0.0f)
+            continue;
+        Ray shadow = {o, wi, 0.0f, 1.0f - 1e-4f, RAYES_RAY_SHADOW};
+        w->stats.rays_shadow++;
+        if (accel_occluded(w->rs->accel, &shadow))
+            continue;
+        float G = cos_x * cos_y / (d2 * d2); /* cos cos' |J| / d^2 with |ny| = |J| */
+        sum_d = v3_madd(sum_d, l->L, G);
+        if (spec) {
+            Vec3 H = v3_normalize(v3_add(v3_scale(wi, 1.0f / sqrtf(d2)), V));
+            float nh = fmaxf(v3_dot(N, H), 0.0f);
+            float f = (exponent + 8.0f) / (8.0f * (float)M_PI) * powf(nh, exponent);
+            sum_s = v3_madd(sum_s, l->L, G * f);
+        }
+    }
+    *diffuse = v3_add(*diffuse, v3_scale(sum_d, 1.0f / ((float)M_PI * n)));
+    if (spec)
+        *spec = v3_add(*spec, v3_scale(sum_s, 1.0f / n));
+}
+
+static void svc_direct_lighting(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
+                                int n_shadow_rays, const float *roughness, float (*diffuse)[3],
+                                float (*specular)[3])
+{
+    (void)sv;
+    const PathState *ps = ctx->renderer;
+    Worker *w = ps->w;
+    int n = n_shadow_rays > 0 ? n_shadow_rays
+            : ctx->diffuse_depth == 0 ? w->set->shadow_rays
+                                      : w->set->shadow_rays_deep;
+    int want_spec = specular && ctx->I;
+    for (size_t i = 0; i < ctx->n_points; i++) {
+        Vec3 d = v3(0, 0, 0), s = v3(0, 0, 0);
+        float e = roughness && roughness[i] > 0.0f ? 1.0f / roughness[i] : 10.0f;
+        for (size_t l = 0; l < w->rs->n_lights && n > 0; l++) {
+            uint32_t pattern = (uint32_t)hash_combine(hash_combine(ps->keys[i], DIM_LIGHT), l);
+            light_point(w, ctx, i, &w->rs->lights[l], pattern, n, e, &d, want_spec ? &s : NULL);
+        }
+        if (diffuse)
+            store3(diffuse[i], d);
+        if (specular)
+            store3(specular[i], s);
+    }
+}
+
+static void svc_indirect_diffuse(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
+                                 int n_rays, float (*out)[3])
+{
+    (void)sv;
+    const PathState *ps = ctx->renderer;
+    Worker *w = ps->w;
+    int depth = ctx->diffuse_depth;
+    int n = n_rays > 0 ? n_rays : depth == 0 ? w->set->diffuse_rays : w->set->diffuse_rays_deep;
+    if (depth >= w->set->bounces)
+        n = 0;
+    /* Each ray stands for 1/n of the hemisphere: its spread never shrinks. */
+    float lobe_spread = n > 0 ? 1.0f / sqrtf((float)n) : 0.0f;
+    for (size_t i = 0; i < ctx->n_points; i++) {
+        Vec3 P = load3(ctx->P[i]), N = load3(ctx->N[i]), Ng = load3(ctx->Ng[i]);
+        Vec3 o = offset_origin(w, P, Ng), sum = v3(0, 0, 0);
+        uint64_t key = hash_combine(ps->keys[i], DIM_DIFFUSE);
+        RayDiff diff = {ps->diff[i].width, fmaxf(ps->diff[i].spread, lobe_spread)};
+        for (int s = 0; s < n; s++) {
+            float a, b;
+            cmj_sample_2d((uint32_t)s, (uint32_t)n, (uint32_t)key, &a, &b);
+            Vec3 d = sample_cosine_hemisphere(N, a, b);
+            if (v3_dot(d, Ng) <= 0.0f)
+                continue; /* below the geometric surface: no light from there */
+            Ray ray = {o, d, 0.0f, INFINITY, RAYES_RAY_DIFFUSE};
+            w->stats.rays_diffuse++;
+            Vec3 L = integrator_trace(w, &ray, RAYES_RAY_DIFFUSE, depth + 1, ctx->specular_depth,
+                                      hash_combine(key, (uint64_t)s + 1), diff, NULL);
+            sum = v3_add(sum, L);
+        }
+        store3(out[i], n > 0 ? v3_scale(sum, 1.0f / n) : v3(0, 0, 0));
+    }
+}
+
+static void svc_indirect_specular(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
+                                  const float (*dir)[3], float (*out)[3])
+{
+    (void)sv;
+    const PathState *ps = ctx->renderer;
+    Worker *w = ps->w;
+    for (size_t i = 0; i < ctx->n_points; i++) {
+        if (ctx->specular_depth >= w->set->specular_depth) {
+            store3(out[i], v3(0, 0, 0));
+            continue;
+        }
+        Vec3 d = v3_normalize(load3(dir[i])), Ng = load3(ctx->Ng[i]);
+        Vec3 o = v3_madd(load3(ctx->P[i]), Ng, v3_dot(d, Ng) >= 0.0f ? ray_epsilon(w)
+                                                                       : -ray_epsilon(w));
+        /* A mirror keeps the spread and adds the curvature's share. */
+        float width = ps->diff[i].width;
+        RayDiff diff = {width, ps->diff[i].spread + 2.0f * ps->curvature[i] * width};
+        Ray ray = {o, d, 0.0f, INFINITY, RAYES_RAY_SPECULAR};
+        w->stats.rays_specular++;
+        Vec3 L = integrator_trace(w, &ray, RAYES_RAY_SPECULAR, ctx->diffuse_depth,
+                                  ctx->specular_depth + 1,
+                                  hash_combine(ps->keys[i], DIM_SPECULAR), diff, NULL);
+        store3(out[i], L);
+    }
+}
+
+static int svc_supports(const RayesShaderServices *sv, const char *service)
+{
+    (void)sv;
+    return strcmp(service, "direct_lighting") == 0 || strcmp(service, "indirect_diffuse") == 0 ||
+           strcmp(service, "indirect_specular") == 0;
+}
+
+const RayesShaderServices render_services = {
+    .abi_version = RAYES_SHADER_ABI_VERSION,
+    .struct_size = sizeof(RayesShaderServices),
+    .direct_lighting = svc_direct_lighting,
+    .indirect_diffuse = svc_indirect_diffuse,
+    .indirect_specular = svc_indirect_specular,
+    .supports = svc_supports,
+};

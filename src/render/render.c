@@ -1,0 +1,175 @@
+/*
+ * render/render.c — the frame: camera, tiles on the thread pool, pixel
+ * samples and the film filter.
+ *
+ * Film and determinism: a tile owns its pixels and computes every sample
+ * that reaches them through the filter, including the samples of a margin
+ * of neighbouring pixels (recomputed, not shared: a sample is a pure
+ * function of its pixel, index and seed). So a pixel's value never depends
+ * on which thread rendered which tile, nor on the order tiles finish.
+ * A box filter of width 1 has no margin.
+ */
+#include "render/render.h"
+
+#include <math.h>
+#include <pthread.h>
+#include <stdatomic.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "render/integrator.h"
+#include "util/check.h"
+#include "util/rng.h"
+#include "util/thread.h"
+
+Camera render_camera(Vec3 eye, Vec3 target, Vec3 up, float fov_y_degrees)
+{
+    Camera c;
+    c.eye = eye;
+    c.forward = v3_normalize(v3_sub(target, eye));
+    c.right = v3_normalize(v3_cross(c.forward, up));
+    c.up = v3_cross(c.right, c.forward);
+    c.tan_half_fov = tanf(0.5f * fov_y_degrees * (float)(M_PI / 180.0));
+    return c;
+}
+
+typedef struct Frame {
+    const RenderScene *rs;
+    const RenderSettings *set;
+    float *rgba;
+    Worker *workers;
+    int tiles_x, tiles_y;
+    float radius;             /* filter radius, pixels */
+    int margin;               /* pixels of neighbours whose samples reach a tile */
+    atomic_int cancelled;
+    atomic_size_t tiles_done;
+    pthread_mutex_t progress_lock;
+} Frame;
+
+static float filter_weight(const Frame *f, float dx, float dy)
+{
+    float r = f->radius;
+    if (fabsf(dx) > r || fabsf(dy) > r)
+        return 0.0f;
+    if (f->set->filter == 0)
+        return 1.0f;
+    const float alpha = 2.0f;
+    float edge = expf(-alpha * r * r);
+    return fmaxf(0.0f, expf(-alpha * dx * dx) - edge) * fmaxf(0.0f, expf(-alpha * dy * dy) - edge);
+}
+
+static Ray camera_ray(const RenderScene *rs, const RenderSettings *set, float x, float y)
+{
+    const Camera *c = &rs->camera;
+    float aspect = (float)set->width / (float)set->height;
+    float sx = (2.0f * x / (float)set->width - 1.0f) * aspect * c->tan_half_fov;
+    float sy = (1.0f - 2.0f * y / (float)set->height) * c->tan_half_fov;
+    Vec3 d = v3_normalize(v3_add(c->forward, v3_add(v3_scale(c->right, sx), v3_scale(c->up, sy))));
+    return (Ray){c->eye, d, 0.0f, INFINITY, RAYES_RAY_CAMERA};
+}
+
+/* All samples of pixel (px, py), splatted into the tile's accumulators. */
+static void render_pixel(Frame *f, Worker *w, int px, int py, int x0, int y0, int tw, int th,
+                         float (*acc)[5])
+{
+    const RenderSettings *set = f->set;
+    uint64_t pixel_key = hash_combine(hash_combine(set->seed, (uint64_t)py), (uint64_t)px);
+    uint32_t pattern = (uint32_t)hash_combine(pixel_key, DIM_PIXEL);
+    RayDiff diff = {0.0f, 2.0f * f->rs->camera.tan_half_fov / (float)set->height};
+    for (int s = 0; s < set->spp; s++) {
+        float jx, jy;
+        cmj_sample_2d((uint32_t)s, (uint32_t)set->spp, pattern, &jx, &jy);
+        float x = (float)px + jx, y = (float)py + jy;
+        Ray ray = camera_ray(f->rs, set, x, y);
+        float alpha;
+        w->stats.rays_camera++;
+        Vec3 L = integrator_trace(w, &ray, RAYES_RAY_CAMERA, 0, 0,
+                                  hash_combine(pixel_key, (uint64_t)s + 1), diff, &alpha);
+        for (int qy = RY_MAX(py - f->margin, y0); qy <= RY_MIN(py + f->margin, y0 + th - 1); qy++)
+            for (int qx = RY_MAX(px - f->margin, x0); qx <= RY_MIN(px + f->margin, x0 + tw - 1);
+                 qx++) {
+                float wgt = filter_weight(f, x - ((float)qx + 0.5f), y - ((float)qy + 0.5f));
+                if (wgt <= 0.0f)
+                    continue;
+                float *a = acc[(qy - y0) * tw + (qx - x0)];
+                a[0] += wgt * L.x;
+                a[1] += wgt * L.y;
+                a[2] += wgt * L.z;
+                a[3] += wgt * alpha;
+                a[4] += wgt;
+            }
+    }
+}
+
+static void report_progress(Frame *f)
+{
+    size_t done = atomic_fetch_add(&f->tiles_done, 1) + 1;
+    if (!f->set->progress)
+        return;
+    pthread_mutex_lock(&f->progress_lock);
+    double fraction = (double)done / (double)((size_t)f->tiles_x * f->tiles_y);
+    if (f->set->progress(f->set->progress_user, fraction))
+        atomic_store(&f->cancelled, 1);
+    pthread_mutex_unlock(&f->progress_lock);
+}
+
+static void render_tile(void *ctx, size_t task, int worker)
+{
+    Frame *f = ctx;
+    const RenderSettings *set = f->set;
+    if (atomic_load(&f->cancelled))
+        return;
+    int ts = set->tile_size;
+    int x0 = (int)(task % (size_t)f->tiles_x) * ts, y0 = (int)(task / (size_t)f->tiles_x) * ts;
+    int tw = RY_MIN(ts, set->width - x0), th = RY_MIN(ts, set->height - y0);
+    float(*acc)[5] = calloc((size_t)tw * th, sizeof *acc);
+    RY_CHECK(acc != NULL);
+    Worker *w = &f->workers[worker];
+    for (int py = RY_MAX(y0 - f->margin, 0); py < RY_MIN(y0 + th + f->margin, set->height); py++)
+        for (int px = RY_MAX(x0 - f->margin, 0); px < RY_MIN(x0 + tw + f->margin, set->width); px++)
+            render_pixel(f, w, px, py, x0, y0, tw, th, acc);
+    for (int y = 0; y < th; y++)
+        for (int x = 0; x < tw; x++) {
+            const float *a = acc[y * tw + x];
+            float *out = &f->rgba[4 * ((size_t)(y0 + y) * set->width + (x0 + x))];
+            float inv = a[4] > 0.0f ? 1.0f / a[4] : 0.0f;
+            for (int c = 0; c < 4; c++)
+                out[c] = a[c] * inv;
+        }
+    free(acc);
+    report_progress(f);
+}
+
+static void merge_stats(RenderStats *into, const RenderStats *s)
+{
+    into->rays_camera += s->rays_camera;
+    into->rays_shadow += s->rays_shadow;
+    into->rays_diffuse += s->rays_diffuse;
+    into->rays_specular += s->rays_specular;
+    for (int d = 0; d <= RENDER_MAX_DEPTH; d++)
+        into->shading_points[d] += s->shading_points[d];
+}
+
+int render_frame(const RenderScene *rs, const RenderSettings *set, float *rgba, RenderStats *stats)
+{
+    int threads = set->threads > 0 ? set->threads : thread_count_cores();
+    Frame f = {.rs = rs, .set = set, .rgba = rgba};
+    f.tiles_x = (set->width + set->tile_size - 1) / set->tile_size;
+    f.tiles_y = (set->height + set->tile_size - 1) / set->tile_size;
+    f.radius = 0.5f * set->filter_width;
+    f.margin = RY_MAX((int)ceilf(f.radius + 0.5f) - 1, 0);
+    atomic_init(&f.cancelled, 0);
+    atomic_init(&f.tiles_done, 0);
+    pthread_mutex_init(&f.progress_lock, NULL);
+    f.workers = calloc((size_t)threads, sizeof *f.workers);
+    RY_CHECK(f.workers != NULL);
+    for (int i = 0; i < threads; i++)
+        f.workers[i] = (Worker){.rs = rs, .set = set};
+    memset(rgba, 0, sizeof(float) * 4 * (size_t)set->width * set->height);
+    thread_parallel_for(threads, (size_t)f.tiles_x * f.tiles_y, render_tile, &f);
+    for (int i = 0; i < threads; i++)
+        merge_stats(stats, &f.workers[i].stats);
+    free(f.workers);
+    pthread_mutex_destroy(&f.progress_lock);
+    return atomic_load(&f.cancelled) ? 1 : 0;
+}

@@ -1,0 +1,74 @@
+/*
+ * render/render.h — the integrator and the frame loop (DESIGN.md "The
+ * frame, end to end"): camera rays with differentials over tiles on a
+ * thread pool; lighting() at camera and specular hits, diffuselighting()
+ * at diffuse hits (no cache yet: the memo's "without caching" baseline);
+ * services for shaders; film with box or Gaussian filtering.
+ *
+ * Inputs are immutable during a frame and shared by all workers; each
+ * worker has its own statistics, merged at the end in worker order (sums of
+ * integers, so the merge order does not matter).
+ */
+#ifndef RAYES_RENDER_RENDER_H
+#define RAYES_RENDER_RENDER_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "accel/accel.h"
+#include "geom/geom.h"
+#include "shade/light.h"
+#include "shade/shade.h"
+#include "util/vec.h"
+
+#define RENDER_MAX_DEPTH 16 /* diffuse depths counted separately in statistics */
+
+typedef struct RenderObject {
+    const ShaderInstance *shader; /* surface shader (NULL for lights) */
+    float Cs[3], Os[3];           /* surface colour and opacity */
+    int light;                    /* index of the light it emits as, or -1 */
+} RenderObject;
+
+typedef struct Camera {
+    Vec3 eye;
+    Vec3 forward, right, up;      /* orthonormal frame */
+    float tan_half_fov;           /* tangent of half the vertical field of view */
+} Camera;
+
+typedef struct RenderScene {
+    const GridSet *gs;
+    const Accel *accel;
+    const RenderObject *objects;
+    size_t n_objects;
+    const Light *lights;
+    size_t n_lights;
+    Camera camera;
+    float scene_radius;           /* for ray offsets */
+} RenderScene;
+
+typedef struct RenderSettings {
+    int width, height, spp, threads, tile_size;
+    int bounces;                  /* maximum diffuse depth */
+    int specular_depth;           /* maximum specular depth */
+    int shadow_rays, shadow_rays_deep;
+    int diffuse_rays, diffuse_rays_deep;
+    int filter;                   /* 0 box, 1 Gaussian */
+    float filter_width;           /* pixels */
+    uint64_t seed;
+    int (*progress)(void *user, double fraction); /* nonzero: cancel */
+    void *progress_user;
+} RenderSettings;
+
+typedef struct RenderStats {
+    uint64_t rays_camera, rays_shadow, rays_diffuse, rays_specular;
+    uint64_t shading_points[RENDER_MAX_DEPTH + 1]; /* by diffuse depth */
+} RenderStats;
+
+/* Camera from eye, target, up and vertical field of view in degrees. */
+Camera render_camera(Vec3 eye, Vec3 target, Vec3 up, float fov_y_degrees);
+
+/* Renders a frame into rgba (width * height * 4 floats, top row first) and
+ * adds to stats. Returns 0, or 1 if the progress callback cancelled. */
+int render_frame(const RenderScene *rs, const RenderSettings *set, float *rgba, RenderStats *stats);
+
+#endif /* RAYES_RENDER_RENDER_H */

@@ -1,0 +1,221 @@
+/*
+ * session/session.c — one render: prepare (dice, build the ray tracing
+ * structure), the frame, and statistics; plus the small public calls
+ * (options, errors, versions, images).
+ *
+ * Memory: everything a render allocates is freed before rayes_render
+ * returns, except the image and statistics handed to the caller.
+ */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "accel/accel.h"
+#include "rayes/rayes.h"
+#include "render/render.h"
+#include "scene/scene.h"
+#include "session/stats.h"
+#include "util/log.h"
+#include "util/thread.h"
+
+const char *rayes_error_string(RayesError e)
+{
+    switch (e) {
+    case RAYES_OK: return "no error";
+    case RAYES_ERROR_INVALID_ARGUMENT: return "invalid argument";
+    case RAYES_ERROR_INVALID_OPERATION: return "invalid operation";
+    case RAYES_ERROR_OUT_OF_MEMORY: return "out of memory";
+    case RAYES_ERROR_IO: return "input/output error";
+    case RAYES_ERROR_PARSE: return "parse error";
+    case RAYES_ERROR_CANCELLED: return "cancelled";
+    }
+    return "unknown error";
+}
+
+const char *rayes_version_string(void)
+{
+    return RAYES_VERSION_STRING;
+}
+
+void rayes_render_options_init(RayesRenderOptions *o, RayesQuality quality)
+{
+    memset(o, 0, sizeof *o);
+    o->struct_size = sizeof *o;
+    o->width = o->height = 512;
+    o->spp = 4;
+    o->threads = 0;
+    o->bounces = 1;
+    o->specular_depth = 4;
+    o->filter = RAYES_FILTER_BOX;
+    o->filter_width = 1.0f;
+    o->tile_size = 32;
+    switch (quality) {
+    case RAYES_QUALITY_PREVIEW:
+        o->shadow_rays = o->shadow_rays_deep = 4;
+        o->diffuse_rays = o->diffuse_rays_deep = 4;
+        break;
+    case RAYES_QUALITY_FINAL:
+        o->shadow_rays = o->shadow_rays_deep = 64;
+        o->diffuse_rays = 1024;
+        o->diffuse_rays_deep = 64;
+        break;
+    case RAYES_QUALITY_REFERENCE:
+        o->shadow_rays = 64;
+        o->shadow_rays_deep = 1;
+        o->diffuse_rays = 4096;
+        o->diffuse_rays_deep = 1;
+        break;
+    }
+}
+
+void rayes_image_free(RayesImage *image)
+{
+    if (!image)
+        return;
+    free(image->rgba);
+    free(image);
+}
+
+static RayesError check_options(RayesScene *scene, const RayesRenderOptions *o)
+{
+    const char *what = NULL;
+    if (o->struct_size != sizeof *o)
+        what = "options: struct_size mismatch (call rayes_render_options_init)";
+    else if (o->width < 1 || o->height < 1 || o->width > 65536 || o->height > 65536)
+        what = "options: resolution must be 1 to 65536 pixels per side";
+    else if (o->spp < 1 || o->spp > 1 << 20)
+        what = "options: pixel samples must be 1 to 1048576";
+    else if (o->bounces < 0 || o->bounces > 64 || o->specular_depth < 0 || o->specular_depth > 64)
+        what = "options: depths must be 0 to 64";
+    else if (o->shadow_rays < 0 || o->shadow_rays_deep < 0 || o->diffuse_rays < 0 ||
+             o->diffuse_rays_deep < 0 || o->shadow_rays > 1 << 20 || o->diffuse_rays > 1 << 20)
+        what = "options: ray counts must be 0 to 1048576";
+    else if (!(o->filter_width > 0.0f) || o->filter_width > 16.0f ||
+             (o->filter != RAYES_FILTER_BOX && o->filter != RAYES_FILTER_GAUSSIAN))
+        what = "options: filter width must be in (0, 16]";
+    else if (o->tile_size < 1 || o->threads < 0 || o->threads > 1024)
+        what = "options: tile size must be positive and threads 0 to 1024";
+    if (!what)
+        return RAYES_OK;
+    if (scene->error[0] == '\0')
+        snprintf(scene->error, sizeof scene->error, "%s", what);
+    return RAYES_ERROR_INVALID_ARGUMENT;
+}
+
+static RenderSettings settings_from(const RayesRenderOptions *o)
+{
+    RenderSettings s = {
+        .width = o->width, .height = o->height, .spp = o->spp, .threads = o->threads,
+        .tile_size = o->tile_size, .bounces = o->bounces, .specular_depth = o->specular_depth,
+        .shadow_rays = o->shadow_rays, .shadow_rays_deep = o->shadow_rays_deep,
+        .diffuse_rays = o->diffuse_rays, .diffuse_rays_deep = o->diffuse_rays_deep,
+        .filter = o->filter == RAYES_FILTER_GAUSSIAN, .filter_width = o->filter_width,
+        .seed = o->seed, .progress = o->progress, .progress_user = o->progress_user,
+    };
+    if (s.threads == 0)
+        s.threads = thread_count_cores();
+    return s;
+}
+
+/* The render-side view of the scene's objects. */
+static RenderObject *render_objects(const RayesScene *scene)
+{
+    RenderObject *ro = calloc(scene->n_objects + 1, sizeof *ro);
+    if (!ro)
+        return NULL;
+    for (size_t i = 0; i < scene->n_objects; i++) {
+        const SceneObject *so = &scene->objects[i];
+        ro[i].shader = so->shader.cls ? &so->shader : NULL;
+        memcpy(ro[i].Cs, so->Cs, sizeof ro[i].Cs);
+        memcpy(ro[i].Os, so->Os, sizeof ro[i].Os);
+        ro[i].light = so->light;
+    }
+    return ro;
+}
+
+static uint32_t *object_masks(const RayesScene *scene)
+{
+    uint32_t *m = calloc(scene->n_objects + 1, sizeof *m);
+    if (m)
+        for (size_t i = 0; i < scene->n_objects; i++)
+            m[i] = scene->objects[i].ray_mask;
+    return m;
+}
+
+static RayesError fail(RayesScene *scene, RayesError e, const char *msg)
+{
+    if (scene->error[0] == '\0')
+        snprintf(scene->error, sizeof scene->error, "%s", msg);
+    return e;
+}
+
+RayesError rayes_render(RayesScene *scene, const RayesRenderOptions *opt, RayesImage **image,
+                        RayesStats **stats_out)
+{
+    if (!scene || !opt || !image)
+        return RAYES_ERROR_INVALID_ARGUMENT;
+    *image = NULL;
+    if (stats_out)
+        *stats_out = NULL;
+    if (scene->timestamp == 0 || scene->dirty)
+        return fail(scene, RAYES_ERROR_INVALID_OPERATION, "render: the scene is not committed");
+    RayesError e = check_options(scene, opt);
+    if (e != RAYES_OK)
+        return e;
+    double t0 = time_now();
+    RenderSettings set = settings_from(opt);
+    GridSet gs;
+    geom_gridset_init(&gs);
+    RenderObject *objects = render_objects(scene);
+    uint32_t *masks = object_masks(scene);
+    RayesImage *img = calloc(1, sizeof *img);
+    float *rgba = malloc(sizeof(float) * 4 * (size_t)set.width * set.height);
+    Accel *accel = NULL;
+    RenderStats rstats = {0};
+    char err[300] = "";
+    if (!objects || !masks || !img || !rgba || scene_prepare(scene, set.height, &gs) != 0) {
+        e = fail(scene, RAYES_ERROR_OUT_OF_MEMORY, "render: out of memory preparing the scene");
+        goto done;
+    }
+    accel = accel_new(&gs, masks, scene->n_objects, err, sizeof err);
+    if (!accel) {
+        e = fail(scene, RAYES_ERROR_OUT_OF_MEMORY, err);
+        goto done;
+    }
+    double t1 = time_now();
+    Bounds3 b = scene_bounds(scene);
+    RenderScene rs = {
+        .gs = &gs, .accel = accel, .objects = objects, .n_objects = scene->n_objects,
+        .lights = scene->lights, .n_lights = scene->n_lights,
+        .camera = render_camera(scene->eye, scene->target, scene->up, scene->fov_y),
+        .scene_radius = scene->n_prims ? fmaxf(0.5f * v3_length(v3_sub(b.hi, b.lo)), 1e-6f) : 1.0f,
+    };
+    if (render_frame(&rs, &set, rgba, &rstats) != 0) {
+        e = fail(scene, RAYES_ERROR_CANCELLED, "render: cancelled");
+        goto done;
+    }
+    double t2 = time_now();
+    if (stats_out) {
+        SessionTimes times = {t2 - t0, t1 - t0, t2 - t1};
+        *stats_out = session_stats_new(&set, &rstats, &gs, &times, accel_memory_bytes(accel));
+        if (!*stats_out) {
+            e = fail(scene, RAYES_ERROR_OUT_OF_MEMORY, "render: out of memory for statistics");
+            goto done;
+        }
+    }
+    img->width = set.width;
+    img->height = set.height;
+    img->rgba = rgba;
+    *image = img;
+    img = NULL;
+    rgba = NULL;
+done:
+    accel_free(accel);
+    geom_gridset_fini(&gs);
+    free(objects);
+    free(masks);
+    free(rgba);
+    free(img);
+    return e;
+}

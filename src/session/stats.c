@@ -1,0 +1,95 @@
+/*
+ * session/stats.c — RayesStats: a flat list of named statistics in a fixed
+ * order. Names and strings are static or owned by the list.
+ */
+#include "session/stats.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+#include "util/log.h"
+
+#define MAX_STATS 64
+
+struct RayesStats {
+    RayesStat items[MAX_STATS];
+    size_t n;
+    uint64_t by_depth[RENDER_MAX_DEPTH + 1];
+};
+
+static void count(RayesStats *s, const char *name, uint64_t v)
+{
+    if (s->n < MAX_STATS)
+        s->items[s->n++] = (RayesStat){.name = name, .kind = RAYES_STAT_COUNT, .count = v};
+}
+
+static void real(RayesStats *s, const char *name, double v)
+{
+    if (s->n < MAX_STATS)
+        s->items[s->n++] = (RayesStat){.name = name, .kind = RAYES_STAT_REAL, .real = v};
+}
+
+RayesStats *session_stats_new(const RenderSettings *set, const RenderStats *rs, const GridSet *gs,
+                              const SessionTimes *t, size_t accel_bytes)
+{
+    RayesStats *s = calloc(1, sizeof *s);
+    if (!s)
+        return NULL;
+    real(s, "time/total_s", t->total_s);
+    real(s, "time/prepare_s", t->prepare_s);
+    real(s, "time/render_s", t->render_s);
+    uint64_t total = 0;
+    int deepest = 0;
+    for (int d = 0; d <= RENDER_MAX_DEPTH; d++) {
+        s->by_depth[d] = rs->shading_points[d];
+        total += rs->shading_points[d];
+        if (rs->shading_points[d])
+            deepest = d;
+    }
+    count(s, "shading_points/total", total);
+    s->items[s->n++] = (RayesStat){.name = "shading_points/by_depth", .kind = RAYES_STAT_COUNTS,
+                                   .counts = s->by_depth, .n_counts = (size_t)deepest + 1};
+    count(s, "rays/total", rs->rays_camera + rs->rays_shadow + rs->rays_diffuse + rs->rays_specular);
+    count(s, "rays/camera", rs->rays_camera);
+    count(s, "rays/shadow", rs->rays_shadow);
+    count(s, "rays/diffuse", rs->rays_diffuse);
+    count(s, "rays/specular", rs->rays_specular);
+    count(s, "grids", gs->n_grids);
+    count(s, "grid_vertices", gs->n_vertices);
+    count(s, "memory/peak_rss_bytes", mem_peak_rss_bytes());
+    count(s, "memory/accel_bytes", accel_bytes);
+    size_t geom_bytes = gs->n_vertices * (4 * sizeof(Vec3) + 2 * sizeof(float)) +
+                        gs->n_grids * sizeof(Grid);
+    count(s, "memory/grid_bytes", geom_bytes);
+    count(s, "resolution/width", (uint64_t)set->width);
+    count(s, "resolution/height", (uint64_t)set->height);
+    count(s, "spp", (uint64_t)set->spp);
+    count(s, "threads", (uint64_t)set->threads);
+    count(s, "bounces", (uint64_t)set->bounces);
+    count(s, "shadow_rays", (uint64_t)set->shadow_rays);
+    count(s, "diffuse_rays", (uint64_t)set->diffuse_rays);
+    return s;
+}
+
+size_t rayes_stats_size(const RayesStats *s)
+{
+    return s ? s->n : 0;
+}
+
+const RayesStat *rayes_stats_get(const RayesStats *s, size_t i)
+{
+    return s && i < s->n ? &s->items[i] : NULL;
+}
+
+const RayesStat *rayes_stats_find(const RayesStats *s, const char *name)
+{
+    for (size_t i = 0; s && i < s->n; i++)
+        if (strcmp(s->items[i].name, name) == 0)
+            return &s->items[i];
+    return NULL;
+}
+
+void rayes_stats_free(RayesStats *s)
+{
+    free(s);
+}

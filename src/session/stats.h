@@ -1,0 +1,21 @@
+/*
+ * session/stats.h — the statistics of one render as a RayesStats list
+ * (rayes.h), named as the JSON keys are: "rays/shadow", "time/total_s",
+ * "shading_points/by_depth" ...
+ */
+#ifndef RAYES_SESSION_STATS_H
+#define RAYES_SESSION_STATS_H
+
+#include "geom/geom.h"
+#include "rayes/rayes.h"
+#include "render/render.h"
+
+typedef struct SessionTimes {
+    double total_s, prepare_s, render_s;
+} SessionTimes;
+
+/* A new statistics list (free with rayes_stats_free), or NULL. */
+RayesStats *session_stats_new(const RenderSettings *set, const RenderStats *rs, const GridSet *gs,
+                              const SessionTimes *times, size_t accel_bytes);
+
+#endif /* RAYES_SESSION_STATS_H */

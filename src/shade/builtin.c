@@ -1,0 +1,242 @@
+/*
+ * shade/builtin.c — RenderMan's classic surfaces: matte, plastic, a tinted
+ * mirror (shinymetal without an environment map) and constant.
+ *
+ * Each has a separate diffuselighting with exactly the view-independent
+ * terms of its lighting: for matte and constant the two are the same; for
+ * plastic it drops the highlight; for the mirror it is black (no diffuse
+ * lobe). Scratch arrays live on the stack, SHADE_CHUNK points at a time.
+ * Parameters follow RenderMan's names and defaults; matte's Ke
+ * (incandescence, as in OBJ and pbrt) is an extension used by furnace
+ * tests and emissive surfaces seen by diffuse rays.
+ */
+#include "shade/builtin.h"
+
+#include <stddef.h>
+#include <string.h>
+
+#include "shade/shade.h"
+
+typedef struct MatteParams {
+    float Ka, Kd;
+    float Ke[3];
+} MatteParams;
+
+typedef struct PlasticParams {
+    float Ka, Kd, Ks, roughness;
+    float specularcolor[3];
+} PlasticParams;
+
+typedef struct MirrorParams {
+    float Kr;
+    float specularcolor[3];
+} MirrorParams;
+
+static float cs(const RayesShadeCtx *ctx, size_t i, int c)
+{
+    return ctx->Cs ? ctx->Cs[i][c] : 1.0f;
+}
+
+static void set_opacity(const RayesShadeCtx *ctx, RayesShadeOutputs *out)
+{
+    for (size_t i = 0; i < ctx->n_points; i++)
+        for (int c = 0; c < 3; c++)
+            out->Oi[i][c] = ctx->Os ? ctx->Os[i][c] : 1.0f;
+}
+
+/* Ci = Cs Kd (direct + indirect diffuse) + emit, on one chunk. */
+static void diffuse_chunk(const RayesShaderServices *sv, const RayesShadeCtx *ctx, float Kd,
+                          const float emit[3], RayesShadeOutputs *out)
+{
+    float dd[SHADE_CHUNK][3], id[SHADE_CHUNK][3];
+    sv->direct_lighting(sv, ctx, 0, NULL, dd, NULL);
+    sv->indirect_diffuse(sv, ctx, 0, id);
+    for (size_t i = 0; i < ctx->n_points; i++)
+        for (int c = 0; c < 3; c++)
+            out->Ci[i][c] = cs(ctx, i, c) * Kd * (dd[i][c] + id[i][c]) + emit[c];
+    if (out->Irradiance)
+        for (size_t i = 0; i < ctx->n_points; i++)
+            for (int c = 0; c < 3; c++)
+                out->Irradiance[i][c] = 3.14159265f * (dd[i][c] + id[i][c]);
+}
+
+/* Calls fn on SHADE_CHUNK-point slices of ctx and out. */
+typedef void (*ChunkFn)(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
+                        const void *params, RayesShadeOutputs *out);
+
+static void by_chunks(const RayesShaderServices *sv, const RayesShadeCtx *ctx, const void *params,
+                      RayesShadeOutputs *out, ChunkFn fn)
+{
+    for (size_t start = 0; start < ctx->n_points; start += SHADE_CHUNK) {
+        size_t n = ctx->n_points - start < SHADE_CHUNK ? ctx->n_points - start : SHADE_CHUNK;
+        RayesShadeCtx sub;
+        shade_ctx_slice(ctx, start, n, &sub);
+        RayesShadeOutputs o = {out->Ci + start, out->Oi + start,
+                               out->Irradiance ? out->Irradiance + start : NULL};
+        fn(sv, &sub, params, &o);
+    }
+    set_opacity(ctx, out);
+}
+
+/* ---- matte */
+
+static void matte_chunk(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
+                        const void *params, RayesShadeOutputs *out)
+{
+    const MatteParams *p = params;
+    diffuse_chunk(sv, ctx, p->Kd, p->Ke, out);
+}
+
+static void matte_lighting(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
+                           const void *params, RayesShadeOutputs *out)
+{
+    by_chunks(sv, ctx, params, out, matte_chunk);
+}
+
+static const RayesShaderParamDesc matte_params[] = {
+    {"Ka", RAYES_PARAM_FLOAT, offsetof(MatteParams, Ka), {1, 0, 0}},
+    {"Kd", RAYES_PARAM_FLOAT, offsetof(MatteParams, Kd), {1, 0, 0}},
+    {"Ke", RAYES_PARAM_COLOR, offsetof(MatteParams, Ke), {0, 0, 0}},
+};
+
+const RayesShaderClass shade_class_matte = {
+    .abi_version = RAYES_SHADER_ABI_VERSION,
+    .struct_size = sizeof(RayesShaderClass),
+    .name = "matte",
+    .params_size = sizeof(MatteParams),
+    .params = matte_params,
+    .n_params = sizeof matte_params / sizeof matte_params[0],
+    .lighting = matte_lighting,
+    .diffuselighting = matte_lighting, /* matte is view-independent throughout */
+};
+
+/* ---- plastic */
+
+static void plastic_diffuse_chunk(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
+                                  const void *params, RayesShadeOutputs *out)
+{
+    const PlasticParams *p = params;
+    static const float black[3] = {0, 0, 0};
+    diffuse_chunk(sv, ctx, p->Kd, black, out);
+}
+
+static void plastic_chunk(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
+                          const void *params, RayesShadeOutputs *out)
+{
+    const PlasticParams *p = params;
+    float dd[SHADE_CHUNK][3], id[SHADE_CHUNK][3], ds[SHADE_CHUNK][3], rough[SHADE_CHUNK];
+    for (size_t i = 0; i < ctx->n_points; i++)
+        rough[i] = p->roughness;
+    sv->direct_lighting(sv, ctx, 0, rough, dd, ds);
+    sv->indirect_diffuse(sv, ctx, 0, id);
+    for (size_t i = 0; i < ctx->n_points; i++)
+        for (int c = 0; c < 3; c++)
+            out->Ci[i][c] = cs(ctx, i, c) * p->Kd * (dd[i][c] + id[i][c]) +
+                            p->specularcolor[c] * p->Ks * ds[i][c];
+}
+
+static void plastic_lighting(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
+                             const void *params, RayesShadeOutputs *out)
+{
+    by_chunks(sv, ctx, params, out, plastic_chunk);
+}
+
+static void plastic_diffuselighting(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
+                                    const void *params, RayesShadeOutputs *out)
+{
+    by_chunks(sv, ctx, params, out, plastic_diffuse_chunk);
+}
+
+static const RayesShaderParamDesc plastic_params[] = {
+    {"Ka", RAYES_PARAM_FLOAT, offsetof(PlasticParams, Ka), {1, 0, 0}},
+    {"Kd", RAYES_PARAM_FLOAT, offsetof(PlasticParams, Kd), {0.5f, 0, 0}},
+    {"Ks", RAYES_PARAM_FLOAT, offsetof(PlasticParams, Ks), {0.5f, 0, 0}},
+    {"roughness", RAYES_PARAM_FLOAT, offsetof(PlasticParams, roughness), {0.1f, 0, 0}},
+    {"specularcolor", RAYES_PARAM_COLOR, offsetof(PlasticParams, specularcolor), {1, 1, 1}},
+};
+
+const RayesShaderClass shade_class_plastic = {
+    .abi_version = RAYES_SHADER_ABI_VERSION,
+    .struct_size = sizeof(RayesShaderClass),
+    .name = "plastic",
+    .params_size = sizeof(PlasticParams),
+    .params = plastic_params,
+    .n_params = sizeof plastic_params / sizeof plastic_params[0],
+    .lighting = plastic_lighting,
+    .diffuselighting = plastic_diffuselighting,
+};
+
+/* ---- mirror */
+
+static void mirror_chunk(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
+                         const void *params, RayesShadeOutputs *out)
+{
+    const MirrorParams *p = params;
+    float dir[SHADE_CHUNK][3], L[SHADE_CHUNK][3];
+    for (size_t i = 0; i < ctx->n_points; i++) {
+        const float *I = ctx->I[i], *N = ctx->N[i];
+        float d = 2.0f * (I[0] * N[0] + I[1] * N[1] + I[2] * N[2]);
+        for (int c = 0; c < 3; c++)
+            dir[i][c] = I[c] - d * N[c];
+    }
+    sv->indirect_specular(sv, ctx, (const float(*)[3])dir, L);
+    for (size_t i = 0; i < ctx->n_points; i++)
+        for (int c = 0; c < 3; c++)
+            out->Ci[i][c] = p->Kr * p->specularcolor[c] * L[i][c];
+}
+
+static void mirror_lighting(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
+                            const void *params, RayesShadeOutputs *out)
+{
+    by_chunks(sv, ctx, params, out, mirror_chunk);
+}
+
+static void black(const RayesShaderServices *sv, const RayesShadeCtx *ctx, const void *params,
+                  RayesShadeOutputs *out)
+{
+    (void)sv;
+    (void)params;
+    memset(out->Ci, 0, ctx->n_points * sizeof *out->Ci);
+    if (out->Irradiance)
+        memset(out->Irradiance, 0, ctx->n_points * sizeof *out->Irradiance);
+    set_opacity(ctx, out);
+}
+
+static const RayesShaderParamDesc mirror_params[] = {
+    {"Kr", RAYES_PARAM_FLOAT, offsetof(MirrorParams, Kr), {1, 0, 0}},
+    {"specularcolor", RAYES_PARAM_COLOR, offsetof(MirrorParams, specularcolor), {1, 1, 1}},
+};
+
+const RayesShaderClass shade_class_mirror = {
+    .abi_version = RAYES_SHADER_ABI_VERSION,
+    .struct_size = sizeof(RayesShaderClass),
+    .name = "mirror",
+    .params_size = sizeof(MirrorParams),
+    .params = mirror_params,
+    .n_params = sizeof mirror_params / sizeof mirror_params[0],
+    .lighting = mirror_lighting,
+    .diffuselighting = black, /* a perfect mirror has no view-independent lobe */
+};
+
+/* ---- constant */
+
+static void constant_lighting(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
+                              const void *params, RayesShadeOutputs *out)
+{
+    (void)sv;
+    (void)params;
+    for (size_t i = 0; i < ctx->n_points; i++)
+        for (int c = 0; c < 3; c++)
+            out->Ci[i][c] = cs(ctx, i, c);
+    if (out->Irradiance)
+        memset(out->Irradiance, 0, ctx->n_points * sizeof *out->Irradiance);
+    set_opacity(ctx, out);
+}
+
+const RayesShaderClass shade_class_constant = {
+    .abi_version = RAYES_SHADER_ABI_VERSION,
+    .struct_size = sizeof(RayesShaderClass),
+    .name = "constant",
+    .lighting = constant_lighting,
+    .diffuselighting = constant_lighting,
+};

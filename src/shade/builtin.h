@@ -1,0 +1,15 @@
+/*
+ * shade/builtin.h — the built-in shader classes. They are written against
+ * rayes/shader.h only, exactly as a plugin would be.
+ */
+#ifndef RAYES_SHADE_BUILTIN_H
+#define RAYES_SHADE_BUILTIN_H
+
+#include "rayes/shader.h"
+
+extern const RayesShaderClass shade_class_matte;    /* Lambertian: Ka, Kd, Ke */
+extern const RayesShaderClass shade_class_plastic;  /* Ka, Kd, Ks, roughness, specularcolor */
+extern const RayesShaderClass shade_class_mirror;   /* perfect specular: Kr, specularcolor */
+extern const RayesShaderClass shade_class_constant; /* Ci = Cs */
+
+#endif /* RAYES_SHADE_BUILTIN_H */

@@ -1,0 +1,133 @@
+/*
+ * shade/shade.c — the class registry, parameter blocks and method dispatch
+ * with the fallbacks of DESIGN.md. Thread-safe: the registry is a constant
+ * table; instances are read-only after shade_instance_init.
+ */
+#include "shade/shade.h"
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "shade/builtin.h"
+#include "util/log.h"
+
+static const RayesShaderClass *const builtin_classes[] = {
+    &shade_class_matte, &shade_class_plastic, &shade_class_mirror, &shade_class_constant,
+};
+
+const RayesShaderClass *shade_find_class(const char *name)
+{
+    for (size_t i = 0; i < sizeof builtin_classes / sizeof builtin_classes[0]; i++)
+        if (strcmp(builtin_classes[i]->name, name) == 0)
+            return builtin_classes[i];
+    /* RenderMan's shinymetal is a mirror here until environment maps land. */
+    if (strcmp(name, "shinymetal") == 0)
+        return &shade_class_mirror;
+    return NULL;
+}
+
+static const RayesShaderParamDesc *find_param(const RayesShaderClass *cls, const char *name)
+{
+    for (size_t i = 0; i < cls->n_params; i++)
+        if (strcmp(cls->params[i].name, name) == 0)
+            return &cls->params[i];
+    return NULL;
+}
+
+static void set_param(void *block, const RayesShaderParamDesc *d, RayesParamType type,
+                      const float value[3], const char *string)
+{
+    char *at = (char *)block + d->offset;
+    if (d->type == RAYES_PARAM_FLOAT)
+        memcpy(at, value, sizeof(float));
+    else if (d->type == RAYES_PARAM_COLOR) {
+        float c[3] = {value[0], type == RAYES_PARAM_FLOAT ? value[0] : value[1],
+                      type == RAYES_PARAM_FLOAT ? value[0] : value[2]};
+        memcpy(at, c, sizeof c);
+    } else if (d->type == RAYES_PARAM_STRING)
+        snprintf(at, 64, "%s", string ? string : "");
+}
+
+int shade_instance_init(ShaderInstance *inst, const RayesShaderClass *cls,
+                        const RayesParam *params, size_t n_params, char *err, size_t err_size)
+{
+    inst->cls = cls;
+    inst->params = calloc(1, cls->params_size ? cls->params_size : 1);
+    if (!inst->params) {
+        snprintf(err, err_size, "out of memory");
+        return -1;
+    }
+    for (size_t i = 0; i < cls->n_params; i++)
+        set_param(inst->params, &cls->params[i], cls->params[i].type,
+                  cls->params[i].default_value, "");
+    for (size_t i = 0; i < n_params; i++) {
+        const RayesShaderParamDesc *d = find_param(cls, params[i].name);
+        char key[96];
+        snprintf(key, sizeof key, "param:%s:%s", cls->name, params[i].name);
+        if (!d) {
+            log_warning_once(key, "shader \"%s\" has no parameter \"%s\"; ignored", cls->name,
+                             params[i].name);
+            continue;
+        }
+        int ok = d->type == params[i].type ||
+                 (d->type == RAYES_PARAM_COLOR && params[i].type == RAYES_PARAM_FLOAT);
+        if (!ok) {
+            log_warning_once(key, "shader \"%s\" parameter \"%s\" has the wrong type; ignored",
+                             cls->name, params[i].name);
+            continue;
+        }
+        set_param(inst->params, d, params[i].type, params[i].value, params[i].string);
+    }
+    return 0;
+}
+
+void shade_instance_fini(ShaderInstance *inst)
+{
+    free(inst->params);
+    inst->params = NULL;
+}
+
+void shade_ctx_slice(const RayesShadeCtx *ctx, size_t start, size_t count, RayesShadeCtx *sub)
+{
+    *sub = *ctx;
+    sub->n_points = count;
+#define SLICE(f)                                  \
+    if (ctx->f)                                   \
+        sub->f = ctx->f + start;
+    SLICE(P) SLICE(N) SLICE(Ng) SLICE(dPdu) SLICE(dPdv) SLICE(u) SLICE(v) SLICE(s) SLICE(t)
+    SLICE(du) SLICE(dv) SLICE(I) SLICE(Cs) SLICE(Os)
+#undef SLICE
+}
+
+void shade_run_lighting(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
+                        const ShaderInstance *inst, RayesShadeOutputs *out)
+{
+    const RayesShaderClass *cls = inst->cls;
+    if (cls->prelighting)
+        cls->prelighting(sv, ctx, inst->params, out);
+    cls->lighting(sv, ctx, inst->params, out);
+    if (cls->postlighting)
+        cls->postlighting(sv, ctx, inst->params, out);
+}
+
+void shade_run_diffuselighting(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
+                               const ShaderInstance *inst, RayesShadeOutputs *out)
+{
+    const RayesShaderClass *cls = inst->cls;
+    RayesShadeCtx c = *ctx;
+    c.I = NULL; /* view independence: diffuselighting never sees I */
+    if (cls->prelighting)
+        cls->prelighting(sv, &c, inst->params, out);
+    if (cls->diffuselighting) {
+        cls->diffuselighting(sv, &c, inst->params, out);
+        return;
+    }
+    char key[96];
+    snprintf(key, sizeof key, "nodiffuselighting:%s", cls->name);
+    log_warning_once(key,
+                     "shader \"%s\" has no diffuselighting method; using the diffuse part of "
+                     "its lighting method",
+                     cls->name);
+    cls->lighting(sv, &c, inst->params, out);
+}

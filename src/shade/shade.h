@@ -1,0 +1,47 @@
+/*
+ * shade/shade.h — shader classes, shader instances and the helpers built-in
+ * shaders share (DESIGN.md "The shading system").
+ *
+ * A ShaderInstance is a class plus a parameter block filled from the
+ * class's parameter table (defaults, then the parameters a scene gave by
+ * name). Instances are immutable once made and shared by all threads.
+ */
+#ifndef RAYES_SHADE_SHADE_H
+#define RAYES_SHADE_SHADE_H
+
+#include <stddef.h>
+
+#include "rayes/shader.h"
+
+typedef struct ShaderInstance {
+    const RayesShaderClass *cls;
+    void *params;               /* the parameter block, cls->params_size bytes, owned */
+} ShaderInstance;
+
+/* The built-in class of that name, or NULL. */
+const RayesShaderClass *shade_find_class(const char *name);
+
+/* Makes an instance: defaults, then params by name. Unknown names and type
+ * mismatches get a warning naming the shader and the parameter (once per
+ * class and name). Returns 0, or -1 (out of memory, err filled). */
+int shade_instance_init(ShaderInstance *inst, const RayesShaderClass *cls,
+                        const RayesParam *params, size_t n_params, char *err, size_t err_size);
+void shade_instance_fini(ShaderInstance *inst);
+
+/* Runs diffuselighting, or the fallback for classes without it: lighting
+ * with I absent, whose services then return only view-independent (diffuse)
+ * lobes; warns once per class. */
+void shade_run_diffuselighting(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
+                               const ShaderInstance *inst, RayesShadeOutputs *out);
+
+/* Runs prelighting (if any) and lighting, then postlighting (if any). */
+void shade_run_lighting(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
+                        const ShaderInstance *inst, RayesShadeOutputs *out);
+
+/* Points per chunk when a shader needs scratch arrays on the stack. */
+#define SHADE_CHUNK 64
+
+/* The sub-context of points [start, start + count) of ctx. */
+void shade_ctx_slice(const RayesShadeCtx *ctx, size_t start, size_t count, RayesShadeCtx *sub);
+
+#endif /* RAYES_SHADE_SHADE_H */

@@ -1,0 +1,23 @@
+/*
+ * util/log.h — warnings and diagnostics on standard error, and the time
+ * and memory readings that statistics use.
+ *
+ * log_warning_once prints a message once per distinct key for the life of
+ * the process (a fixed-size table; thread-safe).
+ */
+#ifndef RAYES_UTIL_LOG_H
+#define RAYES_UTIL_LOG_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+void log_warning(const char *fmt, ...) __attribute__((format(printf, 1, 2)));
+void log_warning_once(const char *key, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+
+/* Seconds on a monotonic clock. */
+double time_now(void);
+
+/* The process's peak resident set size in bytes (0 if unknown). */
+uint64_t mem_peak_rss_bytes(void);
+
+#endif /* RAYES_UTIL_LOG_H */

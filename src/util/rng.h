@@ -1,0 +1,53 @@
+/*
+ * util/rng.h — deterministic random numbers and stratified samples.
+ *
+ * rayes draws no number from a stream whose state depends on the order of
+ * work: every sample is a pure function of a 64-bit key that names where it
+ * is used (pixel, pixel sample, bounce, dimension; or cache key, vertex,
+ * dimension; DESIGN.md "Determinism"). Keys are built with hash_combine.
+ *
+ * Stratified sets use Kensler's correlated multi-jittered sampling (Pixar
+ * technical memo 13-01): any count n, stratified in 2D and in each 1D
+ * projection, with a pattern chosen by a 32-bit seed.
+ */
+#ifndef RAYES_UTIL_RNG_H
+#define RAYES_UTIL_RNG_H
+
+#include <stdint.h>
+
+/* The splitmix64 finaliser: a bijective 64-bit mix. */
+static inline uint64_t hash_u64(uint64_t x)
+{
+    x += 0x9e3779b97f4a7c15ull;
+    x = (x ^ (x >> 30)) * 0xbf58476d1ce4e5b9ull;
+    x = (x ^ (x >> 27)) * 0x94d049bb133111ebull;
+    return x ^ (x >> 31);
+}
+
+/* A key for b used under key a. Order matters: (a, b) != (b, a). */
+static inline uint64_t hash_combine(uint64_t a, uint64_t b)
+{
+    return hash_u64(a ^ (hash_u64(b) + 0x632be59bd9b4e019ull + (a << 6) + (a >> 2)));
+}
+
+/* A float in [0, 1) from a key. */
+static inline float rng_float(uint64_t key)
+{
+    return (float)(hash_u64(key) >> 40) * (1.0f / 16777216.0f);
+}
+
+/* The s-th of n correlated multi-jittered points in [0,1)^2 for pattern
+ * seed p (0 <= s < n). */
+void cmj_sample_2d(uint32_t s, uint32_t n, uint32_t p, float *x, float *y);
+
+/* Sample dimensions: the second argument of hash_combine when a key names
+ * what a sample is for. */
+enum {
+    DIM_PIXEL = 1,      /* pixel sample positions */
+    DIM_LIGHT = 2,      /* shadow-ray positions on lights */
+    DIM_DIFFUSE = 3,    /* diffuse-ray directions */
+    DIM_SPECULAR = 4,   /* specular rays */
+    DIM_PATH = 5        /* child path keys */
+};
+
+#endif /* RAYES_UTIL_RNG_H */

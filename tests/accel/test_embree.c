@@ -1,0 +1,124 @@
+/* Embree hits on known geometry (accel/). */
+#include "accel/accel.h"
+#include "rayes/shader.h"
+#include "test.h"
+#include "util/thread.h"
+
+static GridSet scene(void)
+{
+    GridSet gs;
+    geom_gridset_init(&gs);
+    DiceCamera cam = {.eye = v3(0, 0, -100), .pixel_angle = 0.01f, .min_distance = 1e-3f};
+    /* Object 0: a 10 x 10 square at z = 0 (one 11 x 11 grid). */
+    Prim quad = {.type = PRIM_BILINEAR, .object = 0, .shading_rate = 1.0f};
+    quad.cp[0] = v3(-5, -5, 0), quad.cp[1] = v3(5, -5, 0), quad.cp[2] = v3(-5, 5, 0),
+    quad.cp[3] = v3(5, 5, 0);
+    geom_dice_prim(&gs, &quad, 0, &cam);
+    /* Object 1: a triangle at z = 10 behind it, off to the side. */
+    Prim tri = {.type = PRIM_TRIANGLE, .object = 1, .shading_rate = 1.0f};
+    tri.cp[0] = v3(20, 0, 10), tri.cp[1] = v3(28, 0, 10), tri.cp[2] = v3(20, 8, 10);
+    geom_dice_prim(&gs, &tri, 1, &cam);
+    return gs;
+}
+
+static void test_quad_grid_hit(void)
+{
+    GridSet gs = scene();
+    uint32_t masks[2] = {RAYES_RAY_CAMERA | RAYES_RAY_SHADOW, RAYES_RAY_CAMERA};
+    char err[256];
+    Accel *a = accel_new(&gs, masks, 2, err, sizeof err);
+    CHECK(a != NULL);
+    if (!a)
+        return;
+    Ray r = {v3(2.5f, -1.25f, -10), v3(0, 0, 1), 0.0f, 1e9f, RAYES_RAY_CAMERA};
+    Hit h;
+    CHECK(accel_intersect(a, &r, &h));
+    CHECK(h.grid == 0);
+    CHECK_NEAR(h.t, 10.0, 1e-4);
+    CHECK_NEAR(h.gu, 0.75, 1e-5);    /* (2.5 + 5) / 10 */
+    CHECK_NEAR(h.gv, 0.375, 1e-5);   /* (-1.25 + 5) / 10 */
+    CHECK(h.n_vertex == 4);
+    /* The weights reproduce the hit point. */
+    Vec3 P = v3(0, 0, 0);
+    float wsum = 0.0f;
+    for (int k = 0; k < 4; k++) {
+        P = v3_madd(P, gs.P[h.vertex[k]], h.weight[k]);
+        wsum += h.weight[k];
+    }
+    CHECK_NEAR(wsum, 1.0, 1e-6);
+    CHECK_NEAR(P.x, 2.5, 1e-4);
+    CHECK_NEAR(P.y, -1.25, 1e-4);
+    CHECK_NEAR(fabsf(h.Ng.z), 1.0, 1e-5);
+    CHECK(h.Ng.z > 0.0f); /* dPdu x dPdv = +z */
+    /* Misses, segments and masks. */
+    Ray miss = {v3(6, 0, -10), v3(0, 0, 1), 0.0f, 1e9f, RAYES_RAY_CAMERA};
+    CHECK(!accel_intersect(a, &miss, &h));
+    Ray shorty = {v3(0, 0, -10), v3(0, 0, 1), 0.0f, 9.0f, RAYES_RAY_CAMERA};
+    CHECK(!accel_occluded(a, &shorty));
+    Ray through = {v3(0, 0, -10), v3(0, 0, 1), 0.0f, 11.0f, RAYES_RAY_SHADOW};
+    CHECK(accel_occluded(a, &through));
+    Ray diffuse = {v3(0, 0, -10), v3(0, 0, 1), 0.0f, 11.0f, RAYES_RAY_DIFFUSE};
+    CHECK(!accel_occluded(a, &diffuse)); /* object 0 is invisible to diffuse rays */
+    accel_free(a);
+    geom_gridset_fini(&gs);
+}
+
+static void test_triangle_grid_hit(void)
+{
+    GridSet gs = scene();
+    uint32_t masks[2] = {RAYES_RAY_CAMERA, RAYES_RAY_CAMERA};
+    char err[256];
+    Accel *a = accel_new(&gs, masks, 2, err, sizeof err);
+    CHECK(a != NULL);
+    if (!a)
+        return;
+    Ray r = {v3(22, 2, 0), v3(0, 0, 1), 0.0f, 1e9f, RAYES_RAY_CAMERA};
+    Hit h;
+    CHECK(accel_intersect(a, &r, &h));
+    CHECK(h.grid == 1);
+    CHECK(h.n_vertex == 3);
+    CHECK_NEAR(h.t, 10.0, 1e-4);
+    CHECK_NEAR(h.gu, 0.25, 1e-4); /* barycentrics of the patch: (22-20)/8, (2-0)/8 */
+    CHECK_NEAR(h.gv, 0.25, 1e-4);
+    Vec3 P = v3(0, 0, 0);
+    for (int k = 0; k < 3; k++)
+        P = v3_madd(P, gs.P[h.vertex[k]], h.weight[k]);
+    CHECK_NEAR(P.x, 22.0, 1e-4);
+    CHECK_NEAR(P.y, 2.0, 1e-4);
+    CHECK(h.Ng.z > 0.99f);
+    accel_free(a);
+    geom_gridset_fini(&gs);
+}
+
+/* Hits from several threads agree with hits from one (queries are
+ * concurrent-safe once built). */
+typedef struct Par {
+    const Accel *a;
+    int mismatches;
+} Par;
+
+static void par_task(void *ctx, size_t task, int worker)
+{
+    (void)worker;
+    Par *p = ctx;
+    float x = -4.9f + 9.8f * (float)(task % 100) / 99.0f, y = -4.9f + 9.8f * (float)(task / 100) / 99.0f;
+    Ray r = {v3(x, y, -10), v3(0, 0, 1), 0.0f, 1e9f, RAYES_RAY_CAMERA};
+    Hit h;
+    if (!accel_intersect(p->a, &r, &h) || fabsf(h.t - 10.0f) > 1e-3f)
+        __atomic_add_fetch(&p->mismatches, 1, __ATOMIC_RELAXED);
+}
+
+static void test_concurrent_queries(void)
+{
+    GridSet gs = scene();
+    uint32_t masks[2] = {RAYES_RAY_CAMERA, RAYES_RAY_CAMERA};
+    char err[256];
+    Accel *a = accel_new(&gs, masks, 2, err, sizeof err);
+    Par p = {a, 0};
+    thread_parallel_for(4, 10000, par_task, &p);
+    CHECK(p.mismatches == 0);
+    accel_free(a);
+    geom_gridset_fini(&gs);
+}
+
+TEST_MAIN(TEST(test_quad_grid_hit), TEST(test_triangle_grid_hit), TEST(test_concurrent_queries))

@@ -1,0 +1,197 @@
+/* Patch evaluation and dicing (geom/). */
+#include <string.h>
+
+#include "geom/geom.h"
+#include "test.h"
+
+static Prim bilinear(Vec3 a, Vec3 b, Vec3 c, Vec3 d)
+{
+    Prim p = {.type = PRIM_BILINEAR, .shading_rate = 1.0f};
+    p.cp[0] = a, p.cp[1] = b, p.cp[2] = c, p.cp[3] = d;
+    return p;
+}
+
+static void test_bezier_basis(void)
+{
+    for (float t = 0.0f; t <= 1.0f; t += 0.125f) {
+        float b[4], db[4];
+        geom_bezier_basis(t, b, db);
+        CHECK_NEAR(b[0] + b[1] + b[2] + b[3], 1.0, 1e-6);
+        CHECK_NEAR(db[0] + db[1] + db[2] + db[3], 0.0, 1e-5);
+    }
+    float b[4], db[4];
+    geom_bezier_basis(0.5f, b, db);
+    CHECK_NEAR(b[1], 0.375, 1e-7);
+    CHECK_NEAR(db[0], -0.75, 1e-7);
+}
+
+/* A bicubic patch whose control points are the bilinear interpolation of
+ * four corners on a 1/3 lattice is that bilinear patch exactly. */
+static void test_bicubic_reproduces_bilinear(void)
+{
+    Vec3 c[4] = {v3(0, 0, 0), v3(3, 0, 1), v3(0, 2, 0), v3(3, 3, 2)};
+    Prim bl = bilinear(c[0], c[1], c[2], c[3]);
+    Prim bc = {.type = PRIM_BICUBIC, .shading_rate = 1.0f};
+    for (int j = 0; j < 4; j++)
+        for (int i = 0; i < 4; i++) {
+            Vec3 a = v3_lerp(c[0], c[1], i / 3.0f), b = v3_lerp(c[2], c[3], i / 3.0f);
+            bc.cp[4 * j + i] = v3_lerp(a, b, j / 3.0f);
+        }
+    for (float v = 0.0f; v <= 1.0f; v += 0.25f)
+        for (float u = 0.0f; u <= 1.0f; u += 0.25f) {
+            Vec3 P1, du1, dv1, P2, du2, dv2;
+            geom_prim_eval(&bl, u, v, &P1, &du1, &dv1);
+            geom_prim_eval(&bc, u, v, &P2, &du2, &dv2);
+            CHECK_NEAR(v3_length(v3_sub(P1, P2)), 0.0, 1e-5);
+            CHECK_NEAR(v3_length(v3_sub(du1, du2)), 0.0, 1e-4);
+            CHECK_NEAR(v3_length(v3_sub(dv1, dv2)), 0.0, 1e-4);
+        }
+}
+
+static void test_bilinear_known_values(void)
+{
+    Prim p = bilinear(v3(0, 0, 0), v3(2, 0, 0), v3(0, 4, 0), v3(2, 4, 2));
+    Vec3 P, du, dv;
+    geom_prim_eval(&p, 0.5f, 0.5f, &P, &du, &dv);
+    CHECK_NEAR(P.x, 1.0, 1e-6);
+    CHECK_NEAR(P.y, 2.0, 1e-6);
+    CHECK_NEAR(P.z, 0.5, 1e-6);
+    CHECK_NEAR(du.x, 2.0, 1e-6);
+    CHECK_NEAR(du.z, 1.0, 1e-6);
+    CHECK_NEAR(dv.y, 4.0, 1e-6);
+    Vec3 n = geom_prim_normal(&p, 0.0f, 0.0f);
+    CHECK_NEAR(n.z, 1.0, 1e-6); /* dPdu x dPdv = x cross y */
+}
+
+static void test_sphere_eval_and_normal(void)
+{
+    Prim s = {.type = PRIM_SPHERE, .shading_rate = 1.0f};
+    s.sphere.world_from_object = mat4_translate(1, 2, 3);
+    s.sphere.normal_from_object = mat4_identity();
+    s.sphere.radius = 2.0f;
+    Vec3 P, du, dv;
+    geom_prim_eval(&s, 0.0f, 0.5f, &P, &du, &dv);
+    CHECK_NEAR(P.x, 3.0, 1e-5);
+    CHECK_NEAR(P.y, 2.0, 1e-5);
+    CHECK_NEAR(P.z, 3.0, 1e-5);
+    Vec3 n = geom_prim_normal(&s, 0.0f, 0.5f);
+    CHECK_NEAR(n.x, 1.0, 1e-5);
+    Vec3 pole = geom_prim_normal(&s, 0.3f, 0.0f); /* degenerate dPdu: still defined */
+    CHECK_NEAR(pole.z, -1.0, 1e-5);
+}
+
+/* A degenerate row (the teapot lid's apex) still gets the limit normal. */
+static void test_degenerate_bicubic_normal(void)
+{
+    Prim bc = {.type = PRIM_BICUBIC, .shading_rate = 1.0f};
+    for (int j = 0; j < 4; j++)
+        for (int i = 0; i < 4; i++) {
+            /* The first two rows at one height: a smooth dome, not a cone. */
+            static const float z[4] = {1.0f, 1.0f, 0.8f, 0.5f};
+            float r = j / 3.0f, a = 1.5707963f * i / 3.0f;
+            bc.cp[4 * j + i] = v3(r * cosf(a), r * sinf(a), z[j]);
+        }
+    Vec3 n = geom_prim_normal(&bc, 0.5f, 0.0f);
+    CHECK(fabsf(n.z) > 0.99f);
+}
+
+static DiceCamera camera(void)
+{
+    DiceCamera c = {.eye = v3(0, 0, -100), .pixel_angle = 0.01f, .min_distance = 1e-3f};
+    return c;
+}
+
+/* A 10 x 10 square 100 units away needs 10 micropolygons per side at 1 pixel
+ * = 1 unit: one 11 x 11 grid. */
+static void test_dicing_rate_from_camera(void)
+{
+    GridSet gs;
+    geom_gridset_init(&gs);
+    Prim p = bilinear(v3(-5, -5, 0), v3(5, -5, 0), v3(-5, 5, 0), v3(5, 5, 0));
+    DiceCamera cam = camera();
+    CHECK(geom_dice_prim(&gs, &p, 0, &cam) == 0);
+    CHECK(gs.n_grids == 1);
+    CHECK(gs.grids[0].nu == 11 && gs.grids[0].nv == 11);
+    CHECK(gs.n_vertices == 121);
+    CHECK_NEAR(gs.grids[0].edge, 1.0, 1e-4);
+    CHECK_NEAR(gs.grids[0].curvature, 0.0, 1e-6);
+    /* Shading rate 4 (area) halves the rate per side. */
+    geom_gridset_fini(&gs);
+    p.shading_rate = 4.0f;
+    CHECK(geom_dice_prim(&gs, &p, 0, &cam) == 0);
+    CHECK(gs.grids[0].nu == 6 && gs.grids[0].nv == 6);
+    geom_gridset_fini(&gs);
+}
+
+/* A large patch splits into grids of at most 17 x 17, covering it exactly. */
+static void test_split_limits_grid_size(void)
+{
+    GridSet gs;
+    geom_gridset_init(&gs);
+    Prim p = bilinear(v3(-50, -20, 0), v3(50, -20, 0), v3(-50, 20, 0), v3(50, 20, 0));
+    DiceCamera cam = camera();
+    CHECK(geom_dice_prim(&gs, &p, 7, &cam) == 0);
+    CHECK(gs.n_grids > 1);
+    double area = 0.0;
+    for (size_t g = 0; g < gs.n_grids; g++) {
+        const Grid *gr = &gs.grids[g];
+        CHECK(gr->nu >= 2 && gr->nu <= GEOM_MAX_GRID && gr->nv >= 2 && gr->nv <= GEOM_MAX_GRID);
+        CHECK(gr->prim == 7);
+        area += (gr->uv[1][0] - gr->uv[0][0]) * (gr->uv[1][1] - gr->uv[0][1]);
+        const Vec3 *P = &gs.P[gr->first_vertex];
+        CHECK(P[0].z == 0.0f);
+    }
+    CHECK_NEAR(area, 1.0, 1e-6);
+    geom_gridset_fini(&gs);
+}
+
+/* Nearer parts dice finer: a floor receding from the camera. */
+static void test_distance_based_rates(void)
+{
+    GridSet gs;
+    geom_gridset_init(&gs);
+    Prim p = bilinear(v3(-20, -5, -90), v3(20, -5, -90), v3(-20, -5, 400), v3(20, -5, 400));
+    DiceCamera cam = camera();
+    CHECK(geom_dice_prim(&gs, &p, 0, &cam) == 0);
+    float near_edge = 1e9f, far_edge = 0.0f;
+    for (size_t g = 0; g < gs.n_grids; g++) {
+        float z = gs.P[gs.grids[g].first_vertex].z;
+        if (z < -80.0f)
+            near_edge = fminf(near_edge, gs.grids[g].edge);
+        if (z > 300.0f)
+            far_edge = fmaxf(far_edge, gs.grids[g].edge);
+    }
+    CHECK(far_edge > 3.0f * near_edge);
+    geom_gridset_fini(&gs);
+}
+
+static void test_triangle_grid_counts(void)
+{
+    GridSet gs;
+    geom_gridset_init(&gs);
+    Prim t = {.type = PRIM_TRIANGLE, .shading_rate = 1.0f};
+    t.cp[0] = v3(0, 0, 0), t.cp[1] = v3(8, 0, 0), t.cp[2] = v3(0, 8, 0);
+    DiceCamera cam = camera();
+    CHECK(geom_dice_prim(&gs, &t, 0, &cam) == 0);
+    CHECK(gs.n_grids == 1 && gs.grids[0].triangular);
+    uint32_t n = gs.grids[0].nu;
+    CHECK(n >= 8 && n <= 12); /* the hypotenuse is 11.3 units */
+    CHECK(gs.n_vertices == (n + 1) * (n + 2) / 2);
+    CHECK(geom_tri_vertex(n, 0, n) == gs.n_vertices - 1);
+    Vec3 apex = gs.P[geom_tri_vertex(n, 0, n)];
+    CHECK_NEAR(apex.y, 8.0, 1e-5);
+    geom_gridset_fini(&gs);
+    /* A big triangle splits into four at a time: 1 + 3k patches. */
+    t.cp[1] = v3(100, 0, 0), t.cp[2] = v3(0, 100, 0);
+    CHECK(geom_dice_prim(&gs, &t, 0, &cam) == 0);
+    CHECK((gs.n_grids - 1) % 3 == 0 && gs.n_grids >= 16);
+    for (size_t g = 0; g < gs.n_grids; g++)
+        CHECK(gs.grids[g].nu <= GEOM_MAX_GRID - 1);
+    geom_gridset_fini(&gs);
+}
+
+TEST_MAIN(TEST(test_bezier_basis), TEST(test_bicubic_reproduces_bilinear),
+          TEST(test_bilinear_known_values), TEST(test_sphere_eval_and_normal),
+          TEST(test_degenerate_bicubic_normal), TEST(test_dicing_rate_from_camera),
+          TEST(test_split_limits_grid_size), TEST(test_distance_based_rates),
+          TEST(test_triangle_grid_counts))

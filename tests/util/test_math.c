@@ -1,0 +1,116 @@
+/* Vectors, matrices, hashing and sampling (util/). */
+#include "test.h"
+#include "util/rng.h"
+#include "util/sampling.h"
+#include "util/vec.h"
+
+static void test_matrix_inverse(void)
+{
+    Mat4 m = mat4_mul(mat4_translate(3, -2, 7),
+                      mat4_mul(mat4_rotate(35.0f, v3(0, 1, 0)), mat4_scale(45, 45, 45)));
+    Mat4 inv;
+    CHECK(mat4_invert(m, &inv));
+    Mat4 id = mat4_mul(m, inv);
+    for (int i = 0; i < 4; i++)
+        for (int j = 0; j < 4; j++)
+            CHECK_NEAR(id.m[i][j], i == j ? 1.0 : 0.0, 1e-5);
+    Mat4 singular = mat4_scale(1, 0, 1);
+    CHECK(!mat4_invert(singular, &inv));
+}
+
+static void test_rotation_is_right_handed(void)
+{
+    /* 90 degrees about +y takes +z to +x (x' = x cos + z sin). */
+    Mat4 r = mat4_rotate(90.0f, v3(0, 1, 0));
+    Vec3 p = mat4_vector(&r, v3(0, 0, 1));
+    CHECK_NEAR(p.x, 1.0, 1e-6);
+    CHECK_NEAR(p.z, 0.0, 1e-6);
+}
+
+static void test_basis_is_orthonormal(void)
+{
+    const Vec3 ns[] = {v3(0, 0, 1), v3(0, 0, -1), v3(1, 0, 0), v3_normalize(v3(1, 2, -3))};
+    for (size_t i = 0; i < sizeof ns / sizeof ns[0]; i++) {
+        Vec3 t, b;
+        v3_basis(ns[i], &t, &b);
+        CHECK_NEAR(v3_dot(t, ns[i]), 0.0, 1e-6);
+        CHECK_NEAR(v3_dot(b, ns[i]), 0.0, 1e-6);
+        CHECK_NEAR(v3_dot(t, b), 0.0, 1e-6);
+        CHECK_NEAR(v3_length(t), 1.0, 1e-6);
+        CHECK_NEAR(v3_dot(v3_cross(t, b), ns[i]), 1.0, 1e-6); /* right-handed */
+    }
+}
+
+/* Every count n gets one sample per column of its m x k strata and one per
+ * row: the multi-jittered property. */
+static void test_cmj_stratified(void)
+{
+    for (uint32_t n = 1; n <= 70; n++) {
+        uint32_t m = 1;
+        while ((m + 1) * (m + 1) <= n)
+            m++;
+        uint32_t k = (n + m - 1) / m;
+        int cells[80][80] = {{0}};
+        for (uint32_t s = 0; s < n; s++) {
+            float x, y;
+            cmj_sample_2d(s, n, 1234u + n, &x, &y);
+            CHECK(x >= 0.0f && x < 1.0f && y >= 0.0f && y < 1.0f);
+            cells[(int)(x * m)][(int)(y * k)]++;
+        }
+        int worst = 0;
+        for (uint32_t i = 0; i < m; i++)
+            for (uint32_t j = 0; j < k; j++)
+                worst = cells[i][j] > worst ? cells[i][j] : worst;
+        CHECK(worst <= 1);
+    }
+}
+
+static void test_cmj_deterministic_and_pattern_dependent(void)
+{
+    float x1, y1, x2, y2, x3, y3;
+    cmj_sample_2d(3, 16, 42, &x1, &y1);
+    cmj_sample_2d(3, 16, 42, &x2, &y2);
+    cmj_sample_2d(3, 16, 43, &x3, &y3);
+    CHECK(x1 == x2 && y1 == y2);
+    CHECK(x1 != x3 || y1 != y3);
+}
+
+static void test_hash_combine_is_ordered(void)
+{
+    CHECK(hash_combine(1, 2) != hash_combine(2, 1));
+    CHECK(hash_combine(7, 9) == hash_combine(7, 9));
+    CHECK(rng_float(5) >= 0.0f && rng_float(5) < 1.0f);
+}
+
+/* Cosine-weighted directions: E[cos] = 2/3, E[cos^2] = 1/2, all above. */
+static void test_cosine_hemisphere_moments(void)
+{
+    Vec3 n = v3_normalize(v3(0.3f, -0.5f, 0.8f));
+    const uint32_t N = 4096;
+    double m1 = 0.0, m2 = 0.0;
+    for (uint32_t s = 0; s < N; s++) {
+        float a, b;
+        cmj_sample_2d(s, N, 99, &a, &b);
+        Vec3 d = sample_cosine_hemisphere(n, a, b);
+        CHECK_NEAR(v3_length(d), 1.0, 1e-5);
+        float c = v3_dot(d, n);
+        CHECK(c >= -1e-6f);
+        m1 += c;
+        m2 += c * c;
+    }
+    CHECK_NEAR(m1 / N, 2.0 / 3.0, 2e-3);
+    CHECK_NEAR(m2 / N, 0.5, 2e-3);
+}
+
+static void test_bounds_distance(void)
+{
+    Bounds3 b = {v3(0, 0, 0), v3(1, 1, 1)};
+    CHECK_NEAR(bounds_distance(b, v3(0.5f, 0.5f, 0.5f)), 0.0, 0.0);
+    CHECK_NEAR(bounds_distance(b, v3(4, 1, 1)), 3.0, 1e-6);
+    CHECK_NEAR(bounds_distance(b, v3(-3, -4, 0.5f)), 5.0, 1e-6);
+}
+
+TEST_MAIN(TEST(test_matrix_inverse), TEST(test_rotation_is_right_handed),
+          TEST(test_basis_is_orthonormal), TEST(test_cmj_stratified),
+          TEST(test_cmj_deterministic_and_pattern_dependent), TEST(test_hash_combine_is_ordered),
+          TEST(test_cosine_hemisphere_moments), TEST(test_bounds_distance))
