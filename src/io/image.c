@@ -16,6 +16,7 @@
  * makes them unique among processes; O_EXCL catches anything else).
  */
 #include "io/image.h"
+#include "io/image_internal.h"
 
 #include <errno.h>
 #include <fcntl.h>
@@ -28,16 +29,6 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
-/* Module-private functions, used by image_exr.c and image_png.c, which
- * repeat these declarations (image.h is the module's public contract). */
-typedef RayesError (*IoBodyWriter)(FILE *file, const char *path, const void *data, char *err,
-                                   size_t err_size);
-void io_set_error(char *err, size_t err_size, const char *fmt, ...)
-    __attribute__((format(printf, 3, 4)));
-void io_set_errno_error(char *err, size_t err_size, int errnum, const char *fmt, ...)
-    __attribute__((format(printf, 4, 5)));
-RayesError io_write_via_temp(const char *path, IoBodyWriter write_body, const void *data,
-                             char *err, size_t err_size);
 
 static atomic_ulong n_temp_files;
 
@@ -125,8 +116,7 @@ static RayesError report_create_failure(const char *path, int errnum, char *err,
     if (!slash)
         snprintf(dir_path, sizeof dir_path, ".");
     else /* "/name" lives in "/" */
-        snprintf(dir_path, sizeof dir_path, "%.*s", slash == path ? 1 : (int)(slash - path),
-                 path);
+        snprintf(dir_path, sizeof dir_path, "%.*s", slash == path ? 1 : (int)(slash - path), path);
     struct stat st;
     /* ENOENT also comes from directories that refuse new files (/proc). */
     if (errnum == ENOENT && stat(dir_path, &st) != 0)
@@ -134,8 +124,7 @@ static RayesError report_create_failure(const char *path, int errnum, char *err,
     else if (errnum == ENOTDIR)
         io_set_error(err, err_size, "%s: %s is not a directory", path, dir_path);
     else
-        io_set_errno_error(err, err_size, errnum, "%s: cannot create a file in %s", path,
-                           dir_path);
+        io_set_errno_error(err, err_size, errnum, "%s: cannot create a file in %s", path, dir_path);
     return errnum == ENOMEM ? RAYES_ERROR_OUT_OF_MEMORY : RAYES_ERROR_IO;
 }
 
@@ -161,8 +150,8 @@ static RayesError close_temp(FILE *file, const char *path, RayesError rv, char *
  * after removing the temporary file. The file is open for writing only;
  * write_body may use stdio on it or write to fileno(file) directly, but not
  * both, and must not close it. */
-RayesError io_write_via_temp(const char *path, IoBodyWriter write_body, const void *data,
-                             char *err, size_t err_size)
+RayesError io_write_via_temp(const char *path, IoBodyWriter write_body, const void *data, char *err,
+                             size_t err_size)
 {
     size_t tmp_bytes = strlen(path) + 64;
     char *tmp = malloc(tmp_bytes);

@@ -6,7 +6,11 @@
  * Writers are atomic: they write a temporary file beside the target and
  * rename it, so the target appears whole or not at all (an existing target
  * is left untouched on failure). Errors fill err (one line naming the
- * file and what went wrong) and return nonzero RayesError.
+ * file and what went wrong; err may be NULL or err_size 0) and return
+ * nonzero RayesError: INVALID_ARGUMENT for bad parameters, IO when the
+ * system refuses (a missing directory, a full disk), PARSE for a file that
+ * is not a readable image, OUT_OF_MEMORY. On failure a reader sets *rgba
+ * to NULL and *width and *height to 0.
  * Thread-safety: all functions are reentrant.
  */
 #ifndef RAYES_IO_IMAGE_H
@@ -39,8 +43,10 @@ RayesError io_write_png(const char *path, int width, int height, const float *rg
 RayesError io_write_image(const char *path, int width, int height, const float *rgba,
                           char *err, size_t err_size);
 
-/* Reads an EXR file with R, G, B (and optionally A; 1 if absent) channels of
- * any pixel type, scanline or tiled. *rgba is new (free()). */
+/* Reads part 0 of an EXR file with R, G, B (and optionally A; 1 if absent)
+ * channels of any pixel type, scanline or tiled (a mipmap's full level);
+ * the data window is the image. DWAA/DWAB files are not readable (the
+ * OpenEXRCore of Debian 12 cannot decompress them). *rgba is new (free()). */
 RayesError io_read_exr(const char *path, int *width, int *height, float **rgba,
                        char *err, size_t err_size);
 

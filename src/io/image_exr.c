@@ -4,29 +4,32 @@
  *
  * Writing: one scanline part, half R, G, B, A, ZIP compression (16 lines a
  * chunk), and a "renderer" string attribute. The library converts our
- * floats to half while packing; values above 65504 become infinity, as in
- * any half file. The bytes go to the temporary file of io_write_via_temp
- * through our own write function, so the library never opens a file.
+ * floats to half while packing; values too large for half (65520 and up)
+ * become infinity, as in any half file. The bytes go to the temporary file
+ * of io_write_via_temp through our own write function, so the library
+ * never opens a file.
  *
  * Reading: part 0 of any flat (not deep) file, scanline or tiled (level 0
- * of a mipmap), half, float or uint channels, whose data window becomes the
- * image. R, G and B are required, A is 1 when absent, other channels are
- * skipped. Pixels are decoded straight into the interleaved RGBA floats.
+ * of a mipmap), half, float or uint channels (uint values become floats as
+ * numbers), whose data window becomes the image. R, G and B are required,
+ * A is 1 when absent, other channels are skipped. Every compression but
+ * DWAA/DWAB, which OpenEXRCore 3.1 cannot decompress (its message says so).
  *
- * OpenEXRCore (3.1) quirks this file works around:
+ * OpenEXRCore 3.1.5 quirks this file works around:
  *  - The coding pipelines list channels sorted by name (A, B, G, R), not in
  *    the order they were added, so pointers are bound by channel_name.
- *  - The decoder's fast unpack paths for interleaved output are wrong in
- *    3.1.5: the "interleave" and "interleave_rev" routines write the
- *    channels in reverse order, the "rev" one writes through channel 3's
- *    pointer even when that channel is skipped (NULL), and the 3-channel
- *    planar one reads the third channel one element after the second.
- *    Which one runs depends on the channel set and pixel types, so after
+ *  - The decoder's specialised unpack routines cannot be trusted: for our
+ *    interleaved RGBA floats it picked its reversed-interleave routine,
+ *    which stored A in R, B in G and so on; with a skipped channel it wrote
+ *    through that channel's NULL pointer; and its 3-channel planar routine
+ *    reads the third channel one element after the second. So after
  *    exr_decoding_choose_default_routines (kept for reading and
  *    decompressing) we install our own unpack step, unpack_rgba, which
  *    converts the decompressed chunk (line by line, channel by channel,
  *    little-endian) into our RGBA floats. The encoder has a single generic
  *    pack routine, which is correct and converts float to half itself.
+ *  - A chunk stored raw (as large as its pixels) still goes through the
+ *    B44 decoder; decode_chunk skips decompression for such chunks.
  *  - Without an error handler the library prints to stderr; ours keeps the
  *    first message for err instead. Global defaults (exr_set_default_*)
  *    are not touched, so other threads' contexts are unaffected.
@@ -34,6 +37,7 @@
  * Thread-safety: reentrant; each call has its own context and file.
  */
 #include "io/image.h"
+#include "io/image_internal.h"
 
 #include <errno.h>
 #include <fcntl.h>
@@ -48,15 +52,6 @@
 
 #include <openexr.h>
 
-/* Module-private, defined in image.c. */
-typedef RayesError (*IoBodyWriter)(FILE *file, const char *path, const void *data, char *err,
-                                   size_t err_size);
-void io_set_error(char *err, size_t err_size, const char *fmt, ...)
-    __attribute__((format(printf, 3, 4)));
-void io_set_errno_error(char *err, size_t err_size, int errnum, const char *fmt, ...)
-    __attribute__((format(printf, 4, 5)));
-RayesError io_write_via_temp(const char *path, IoBodyWriter write_body, const void *data,
-                             char *err, size_t err_size);
 
 /* Limits on images we read: a side keeps a line of RGBA floats within the
  * library's int32 line stride, and the pixel count keeps a forged header
@@ -66,15 +61,15 @@ RayesError io_write_via_temp(const char *path, IoBodyWriter write_body, const vo
 
 /* What one EXR call shares with the library's callbacks (user_data). */
 typedef struct ExrIo {
-    int fd;                 /* the file read or written; owned by the caller */
-    int sys_errno;          /* the first failed read or write's errno, or 0 */
-    bool short_read;        /* a read met the end of the file */
-    char first_error[256];  /* the library's first message, "" if none */
+    int fd;                /* the file read or written; owned by the caller */
+    int sys_errno;         /* the first failed read or write's errno, or 0 */
+    bool short_read;       /* a read met the end of the file */
+    char first_error[256]; /* the library's first message, "" if none */
 } ExrIo;
 
 typedef struct ExrImage {
-    int width, height;  /* pixels */
-    const float *rgba;  /* width * height * 4, top row first */
+    int width, height; /* pixels */
+    const float *rgba; /* width * height * 4, top row first */
 } ExrImage;
 
 /* ------------------------------------------------------------ callbacks */
@@ -163,15 +158,19 @@ static exr_context_initializer_t make_initializer(ExrIo *io)
 }
 
 /* Fills err with "PATH: doing: why" from what io saw, and returns the
- * RayesError for rv. */
+ * RayesError for rv. Our errno and end-of-file notes explain I/O failures
+ * better than the library can; for anything else its message is the one
+ * (a short read may be the library probing, not the cause). */
 static RayesError report(const ExrIo *io, exr_result_t rv, const char *path, const char *doing,
                          RayesError otherwise, char *err, size_t err_size)
 {
-    if (io->sys_errno != 0) {
+    bool io_failure = rv == EXR_ERR_READ_IO || rv == EXR_ERR_WRITE_IO ||
+                      rv == EXR_ERR_FILE_ACCESS || io->first_error[0] == '\0';
+    if (io_failure && io->sys_errno != 0) {
         io_set_errno_error(err, err_size, io->sys_errno, "%s: %s", path, doing);
         return RAYES_ERROR_IO;
     }
-    if (io->short_read) {
+    if (io_failure && io->short_read) {
         io_set_error(err, err_size, "%s: %s: the file is truncated", path, doing);
         return RAYES_ERROR_PARSE;
     }
@@ -207,8 +206,7 @@ static exr_result_t define_part(exr_context_t ctx, const ExrImage *image)
     static const char *const names[4] = {"R", "G", "B", "A"};
     for (int i = 0; i < 4 && rv == EXR_ERR_SUCCESS; i++)
         rv = exr_add_channel(ctx, part, names[i], EXR_PIXEL_HALF,
-                             i == 3 ? EXR_PERCEPTUALLY_LINEAR : EXR_PERCEPTUALLY_LOGARITHMIC, 1,
-                             1);
+                             i == 3 ? EXR_PERCEPTUALLY_LINEAR : EXR_PERCEPTUALLY_LOGARITHMIC, 1, 1);
     if (rv == EXR_ERR_SUCCESS)
         rv = exr_attr_set_string(ctx, part, "renderer", "rayes");
     return rv;
@@ -216,8 +214,7 @@ static exr_result_t define_part(exr_context_t ctx, const ExrImage *image)
 
 /* Points the encoder's channels (sorted by name) at the interleaved floats
  * of the chunk's first line. */
-static void bind_encode_channels(exr_encode_pipeline_t *encoder, const float *first_line,
-                                 int width)
+static void bind_encode_channels(exr_encode_pipeline_t *encoder, const float *first_line, int width)
 {
     for (int c = 0; c < encoder->channel_count; c++) {
         exr_coding_channel_info_t *chan = &encoder->channels[c];
@@ -352,8 +349,8 @@ static void convert_line(float *dst, const uint8_t *src, int n, uint16_t data_ty
             continue;
         }
         const uint8_t *b = src + 4 * x;
-        uint32_t bits = (uint32_t)b[0] | (uint32_t)b[1] << 8 | (uint32_t)b[2] << 16 |
-                        (uint32_t)b[3] << 24;
+        uint32_t bits =
+            (uint32_t)b[0] | (uint32_t)b[1] << 8 | (uint32_t)b[2] << 16 | (uint32_t)b[3] << 24;
         if (data_type == EXR_PIXEL_UINT) {
             *dst = (float)bits;
         } else {
@@ -389,10 +386,17 @@ static exr_result_t unpack_rgba(exr_decode_pipeline_t *decoder)
     return EXR_ERR_SUCCESS;
 }
 
-/* Decodes one chunk whose top-left pixel is (x, y) in file coordinates.
- * The first call (*initialized false) sets the decoder up. */
-static exr_result_t decode_chunk(exr_const_context_t ctx, exr_decode_pipeline_t *decoder,
-                                 bool *initialized, const exr_chunk_info_t *cinfo, int x, int y,
+/* A decoding pipeline reused across the chunks of one image. */
+typedef exr_result_t (*ExrStage)(exr_decode_pipeline_t *pipe);
+typedef struct ExrDecoder {
+    exr_decode_pipeline_t pipe; /* set up by the first chunk */
+    bool initialized;           /* pipe holds buffers to destroy */
+    ExrStage decompress;        /* the library's choice for compressed chunks */
+} ExrDecoder;
+
+/* Decodes one chunk whose top-left pixel is (x, y) in file coordinates. */
+static exr_result_t decode_chunk(exr_const_context_t ctx, ExrDecoder *decoder,
+                                 const exr_chunk_info_t *cinfo, int x, int y,
                                  const ExrTarget *target)
 {
     int64_t col = (int64_t)x - target->x0, row = (int64_t)y - target->y0;
@@ -401,20 +405,27 @@ static exr_result_t decode_chunk(exr_const_context_t ctx, exr_decode_pipeline_t 
     if (col < 0 || row < 0 || cinfo->width <= 0 || cinfo->height <= 0 ||
         col + cinfo->width > target->width || row + cinfo->height > target->height)
         return EXR_ERR_CORRUPT_CHUNK;
-    exr_result_t rv = *initialized ? exr_decoding_update(ctx, 0, cinfo, decoder)
-                                   : exr_decoding_initialize(ctx, 0, cinfo, decoder);
+    exr_decode_pipeline_t *pipe = &decoder->pipe;
+    exr_result_t rv = decoder->initialized ? exr_decoding_update(ctx, 0, cinfo, pipe)
+                                           : exr_decoding_initialize(ctx, 0, cinfo, pipe);
     if (rv != EXR_ERR_SUCCESS)
         return rv;
-    bind_decode_channels(decoder, target->rgba + ((size_t)row * target->width + (size_t)col) * 4,
+    bind_decode_channels(pipe, target->rgba + ((size_t)row * target->width + (size_t)col) * 4,
                          target->width);
-    if (!*initialized) {
-        *initialized = true;
-        rv = exr_decoding_choose_default_routines(ctx, 0, decoder);
+    if (!decoder->initialized) {
+        decoder->initialized = true;
+        rv = exr_decoding_choose_default_routines(ctx, 0, pipe);
         if (rv != EXR_ERR_SUCCESS)
             return rv;
+        decoder->decompress = pipe->decompress_fn;
     }
-    decoder->unpack_and_convert_fn = unpack_rgba;
-    return exr_decoding_run(ctx, 0, decoder);
+    /* A chunk as large as its pixels was stored raw, because compressing
+     * did not pay; that is how the C++ library reads it. OpenEXRCore 3.1.5
+     * runs its B44 decoder over such a chunk anyway, in place, which
+     * scrambles B44 files whose channels are all float. */
+    pipe->decompress_fn = cinfo->packed_size == cinfo->unpacked_size ? NULL : decoder->decompress;
+    pipe->unpack_and_convert_fn = unpack_rgba;
+    return exr_decoding_run(ctx, 0, pipe);
 }
 
 static exr_result_t read_scanlines(exr_const_context_t ctx, const ExrTarget *target)
@@ -423,18 +434,16 @@ static exr_result_t read_scanlines(exr_const_context_t ctx, const ExrTarget *tar
     exr_result_t rv = exr_get_scanlines_per_chunk(ctx, 0, &lines_per_chunk);
     if (rv == EXR_ERR_SUCCESS && lines_per_chunk <= 0)
         rv = EXR_ERR_INVALID_ATTR;
-    exr_decode_pipeline_t decoder = EXR_DECODE_PIPELINE_INITIALIZER;
-    bool initialized = false;
+    ExrDecoder decoder = {.pipe = EXR_DECODE_PIPELINE_INITIALIZER};
     int64_t end = (int64_t)target->y0 + target->height;
     for (int64_t y = target->y0; y < end && rv == EXR_ERR_SUCCESS; y += lines_per_chunk) {
         exr_chunk_info_t cinfo;
         rv = exr_read_scanline_chunk_info(ctx, 0, (int)y, &cinfo);
         if (rv == EXR_ERR_SUCCESS)
-            rv = decode_chunk(ctx, &decoder, &initialized, &cinfo, target->x0, cinfo.start_y,
-                              target);
+            rv = decode_chunk(ctx, &decoder, &cinfo, target->x0, cinfo.start_y, target);
     }
-    if (initialized)
-        exr_decoding_destroy(ctx, &decoder);
+    if (decoder.initialized)
+        exr_decoding_destroy(ctx, &decoder.pipe);
     return rv;
 }
 
@@ -447,22 +456,21 @@ static exr_result_t read_tiles(exr_const_context_t ctx, const ExrTarget *target)
     if (rv == EXR_ERR_SUCCESS &&
         (tile_w <= 0 || tile_h <= 0 || level_w != target->width || level_h != target->height))
         rv = EXR_ERR_INVALID_ATTR;
-    exr_decode_pipeline_t decoder = EXR_DECODE_PIPELINE_INITIALIZER;
-    bool initialized = false;
-    int n_x = (int)(((int64_t)level_w + tile_w - 1) / tile_w);
-    int n_y = (int)(((int64_t)level_h + tile_h - 1) / tile_h);
+    ExrDecoder decoder = {.pipe = EXR_DECODE_PIPELINE_INITIALIZER};
+    int n_x = rv == EXR_ERR_SUCCESS ? (int)(((int64_t)level_w + tile_w - 1) / tile_w) : 0;
+    int n_y = rv == EXR_ERR_SUCCESS ? (int)(((int64_t)level_h + tile_h - 1) / tile_h) : 0;
     for (int ty = 0; ty < n_y && rv == EXR_ERR_SUCCESS; ty++) {
         for (int tx = 0; tx < n_x && rv == EXR_ERR_SUCCESS; tx++) {
             exr_chunk_info_t cinfo;
+            /* Level 0 only: the full-resolution image of a mipmap. */
             rv = exr_read_tile_chunk_info(ctx, 0, tx, ty, 0, 0, &cinfo);
-            /* Tile (tx, ty) starts tx * tile_w pixels into the data window. */
             if (rv == EXR_ERR_SUCCESS)
-                rv = decode_chunk(ctx, &decoder, &initialized, &cinfo,
-                                  target->x0 + tx * tile_w, target->y0 + ty * tile_h, target);
+                rv = decode_chunk(ctx, &decoder, &cinfo, target->x0 + tx * tile_w,
+                                  target->y0 + ty * tile_h, target);
         }
     }
-    if (initialized)
-        exr_decoding_destroy(ctx, &decoder);
+    if (decoder.initialized)
+        exr_decoding_destroy(ctx, &decoder.pipe);
     return rv;
 }
 
@@ -561,8 +569,7 @@ RayesError io_read_exr(const char *path, int *width, int *height, float **rgba, 
     RayesError status = RAYES_OK;
     ExrTarget target = {0};
     if (rv != EXR_ERR_SUCCESS)
-        status = report(&io, rv, path, "not a readable EXR file", RAYES_ERROR_PARSE, err,
-                        err_size);
+        status = report(&io, rv, path, "not a readable EXR file", RAYES_ERROR_PARSE, err, err_size);
     else
         status = read_part(ctx, &io, path, &target, err, err_size);
     if (ctx)

@@ -20,6 +20,7 @@
  * Thread-safety: reentrant; each call has its own libpng structures.
  */
 #include "io/image.h"
+#include "io/image_internal.h"
 
 #include <errno.h>
 #include <math.h>
@@ -32,15 +33,6 @@
 
 #include <png.h>
 
-/* Module-private, defined in image.c. */
-typedef RayesError (*IoBodyWriter)(FILE *file, const char *path, const void *data, char *err,
-                                   size_t err_size);
-void io_set_error(char *err, size_t err_size, const char *fmt, ...)
-    __attribute__((format(printf, 3, 4)));
-void io_set_errno_error(char *err, size_t err_size, int errnum, const char *fmt, ...)
-    __attribute__((format(printf, 4, 5)));
-RayesError io_write_via_temp(const char *path, IoBodyWriter write_body, const void *data,
-                             char *err, size_t err_size);
 
 /* Limits on images we read (see image_exr.c): 2^28 pixels is 4 GiB of
  * floats, far beyond any render, and stops a forged header early. */
@@ -49,19 +41,19 @@ RayesError io_write_via_temp(const char *path, IoBodyWriter write_body, const vo
 /* One PNG call's state, shared with libpng's callbacks (error and I/O
  * pointer). */
 typedef struct PngIo {
-    FILE *file;           /* read or written; owned by the caller */
-    int sys_errno;        /* errno of the first failed read or write, or 0 */
-    bool truncated;       /* a read met the end of the file */
-    char message[256];    /* libpng's first error message, "" if none */
-    uint8_t *pixels;      /* reading: 8-bit RGBA, width * height * 4; owned */
-    png_bytep *rows;      /* reading: height pointers into pixels; owned */
-    png_uint_32 width;    /* reading: pixels */
-    png_uint_32 height;   /* reading: pixels */
+    FILE *file;         /* read or written; owned by the caller */
+    int sys_errno;      /* errno of the first failed read or write, or 0 */
+    bool truncated;     /* a read met the end of the file */
+    char message[256];  /* libpng's first error message, "" if none */
+    uint8_t *pixels;    /* reading: 8-bit RGBA, width * height * 4; owned */
+    png_bytep *rows;    /* reading: height pointers into pixels; owned */
+    png_uint_32 width;  /* reading: pixels */
+    png_uint_32 height; /* reading: pixels */
 } PngIo;
 
 typedef struct PngImage {
-    int width, height;  /* pixels */
-    const float *rgba;  /* width * height * 4, top row first */
+    int width, height; /* pixels */
+    const float *rgba; /* width * height * 4, top row first */
 } PngImage;
 
 /* ------------------------------------------------------------ callbacks */
@@ -178,9 +170,9 @@ static RayesError write_png_body(FILE *file, const char *path, const void *data,
     const PngImage *image = data;
     PngIo io = {.file = file};
     uint8_t *row = malloc((size_t)image->width * 4);
-    png_structp png = row ? png_create_write_struct(PNG_LIBPNG_VER_STRING, &io, on_png_error,
-                                                    on_png_warning)
-                          : NULL;
+    png_structp png =
+        row ? png_create_write_struct(PNG_LIBPNG_VER_STRING, &io, on_png_error, on_png_warning)
+            : NULL;
     png_infop info = png ? png_create_info_struct(png) : NULL;
     RayesError rv = RAYES_OK;
     if (!info) {

@@ -5,19 +5,19 @@
  * libraries directly, dispatch by extension, and failures: a missing
  * directory, garbage and truncated files, a write that runs out of room
  * (RLIMIT_FSIZE), each with a one-line message naming the file, no
- * temporary file left behind and an existing target untouched.
+ * temporary file left behind and an existing target untouched; and
+ * threads writing one target at once.
  *
  * Scratch files go under RAYES_TEST_TMP/io_image, a directory of our own
  * because other tests share RAYES_TEST_TMP and may run at the same time.
  */
 #include <dirent.h>
-#include <errno.h>
+#include <pthread.h>
 #include <signal.h>
 #include <stdint.h>
 #include <string.h>
 #include <sys/resource.h>
 #include <sys/stat.h>
-#include <unistd.h>
 
 #include <OpenEXR/openexr.h>
 #include <png.h>
@@ -136,12 +136,12 @@ static float srgb_decode(int v8)
 /* ----------------------------------------------- EXR files of other kinds */
 
 typedef struct TestExr {
-    exr_pixel_type_t type;        /* of every channel */
-    int has_alpha;                /* A besides R, G, B */
-    int has_extra;                /* an extra float channel "Z" to skip */
-    int tile;                     /* tile size, or 0 for scanlines */
+    exr_pixel_type_t type; /* of every channel */
+    int has_alpha;         /* A besides R, G, B */
+    int has_extra;         /* an extra float channel "Z" to skip */
+    int tile;              /* tile size, or 0 for scanlines */
     exr_compression_t compression;
-    int width, height, x0, y0;    /* data window */
+    int width, height, x0, y0; /* data window */
 } TestExr;
 
 static void bind_test_channels(exr_encode_pipeline_t *enc, const float *first, int width)
@@ -160,8 +160,8 @@ static void bind_test_channels(exr_encode_pipeline_t *enc, const float *first, i
 
 /* Encodes one chunk with top-left pixel (x, y) relative to the window. */
 static exr_result_t encode_test_chunk(exr_context_t ctx, exr_encode_pipeline_t *enc, int *init,
-                                      const exr_chunk_info_t *cinfo, const float *rgba,
-                                      int width, int x, int y)
+                                      const exr_chunk_info_t *cinfo, const float *rgba, int width,
+                                      int x, int y)
 {
     exr_result_t rv = *init ? exr_encoding_update(ctx, 0, cinfo, enc)
                             : exr_encoding_initialize(ctx, 0, cinfo, enc);
@@ -186,8 +186,8 @@ static exr_result_t write_test_pixels(exr_context_t ctx, const TestExr *t, const
             for (int tx = 0; tx * t->tile < t->width && !rv; tx++) {
                 rv = exr_write_tile_chunk_info(ctx, 0, tx, ty, 0, 0, &cinfo);
                 if (!rv)
-                    rv = encode_test_chunk(ctx, &enc, &init, &cinfo, rgba, t->width,
-                                           tx * t->tile, ty * t->tile);
+                    rv = encode_test_chunk(ctx, &enc, &init, &cinfo, rgba, t->width, tx * t->tile,
+                                           ty * t->tile);
             }
     } else {
         int32_t lines = 1;
@@ -248,8 +248,8 @@ static int write_test_exr(const char *path, const TestExr *t, const float *rgba)
 static void test_exr_round_trip(void)
 {
     enum { W = 7, H = 5 };
-    static const float specials[] = {0.0f,  1.0f,  65504.0f, 0.5f,      1e-3f, 6.1035156e-5f,
-                                     1e-5f, 3e-7f, 3.14159f, -2.5f,     0.18f, 1000.25f};
+    static const float specials[] = {0.0f,  1.0f,  65504.0f, 0.5f,  1e-3f, 6.1035156e-5f,
+                                     1e-5f, 3e-7f, 3.14159f, -2.5f, 0.18f, 1000.25f};
     float rgba[W * H * 4];
     for (int i = 0; i < W * H * 4; i++)
         rgba[i] = specials[i % (sizeof specials / sizeof specials[0])] * (i % 5 == 4 ? -1 : 1);
@@ -270,7 +270,7 @@ static void test_exr_round_trip(void)
         for (int i = 0; i < W * H * 4; i++)
             CHECK_NEAR(back[i], rgba[i], half_tolerance(rgba[i]));
     if (back) {
-        CHECK(back[0] == 0.0f);       /* 0 and 1 and max half are exact */
+        CHECK(back[0] == 0.0f); /* 0 and 1 and max half are exact */
         CHECK(back[1] == 1.0f);
         CHECK(back[2] == 65504.0f);
     }
@@ -283,8 +283,17 @@ static void test_exr_header(void)
 {
     char path[512], err[512] = "";
     scratch(path, sizeof path, "header.exr");
+    /* Noise does not compress, so chunks are stored raw: read them back too. */
     float *rgba = noise_image(19, 37, 7);
     CHECK(io_write_exr(path, 19, 37, rgba, err, sizeof err) == RAYES_OK);
+    int w = 0, h = 0;
+    float *back = NULL;
+    CHECK(io_read_exr(path, &w, &h, &back, err, sizeof err) == RAYES_OK);
+    int mismatches = 0;
+    for (int i = 0; back && w == 19 && h == 37 && i < 19 * 37 * 4; i++)
+        mismatches += !(fabs(back[i] - rgba[i]) <= half_tolerance(rgba[i]));
+    CHECK(back != NULL && mismatches == 0);
+    free(back);
     free(rgba);
 
     exr_context_t ctx = NULL;
@@ -371,8 +380,8 @@ static void test_png_round_trip(void)
     int worst = 0;
     for (int i = 0; back && w == W && h == H && i < W * H * 4; i++) {
         /* Compare in the file's space: re-encoding must give the same code. */
-        int want = i % 4 == 3 ? (int)(fminf(fmaxf(rgba[i], 0.0f), 1.0f) * 255.0f + 0.5f)
-                              : srgb8(rgba[i]);
+        int want =
+            i % 4 == 3 ? (int)(fminf(fmaxf(rgba[i], 0.0f), 1.0f) * 255.0f + 0.5f) : srgb8(rgba[i]);
         int got = i % 4 == 3 ? (int)(back[i] * 255.0f + 0.5f) : srgb8(back[i]);
         int diff = abs(want - got);
         worst = diff > worst ? diff : worst;
@@ -438,13 +447,13 @@ static void test_format_dispatch(void)
     char path[512], err[512] = "";
     int w, h;
     float *back = NULL;
-    CHECK(io_write_image(scratch(path, sizeof path, "dispatch.EXR"), 2, 2, rgba, err,
-                         sizeof err) == RAYES_OK);
+    CHECK(io_write_image(scratch(path, sizeof path, "dispatch.EXR"), 2, 2, rgba, err, sizeof err) ==
+          RAYES_OK);
     CHECK(io_read_exr(path, &w, &h, &back, err, sizeof err) == RAYES_OK);
     CHECK(back && back[1] == 0.5f);
     free(back);
-    CHECK(io_write_image(scratch(path, sizeof path, "dispatch.png"), 2, 2, rgba, err,
-                         sizeof err) == RAYES_OK);
+    CHECK(io_write_image(scratch(path, sizeof path, "dispatch.png"), 2, 2, rgba, err, sizeof err) ==
+          RAYES_OK);
     CHECK(io_read_png(path, &w, &h, &back, err, sizeof err) == RAYES_OK);
     CHECK(back && w == 2 && h == 2);
     free(back);
@@ -496,7 +505,7 @@ static void check_read_fails(const char *path, int exr)
 {
     char err[512] = "";
     int w = -1, h = -1;
-    float *rgba = (float *)&w; /* must be replaced by NULL */
+    float sentinel = 0.0f, *rgba = &sentinel; /* must be replaced by NULL */
     RayesError rv = exr ? io_read_exr(path, &w, &h, &rgba, err, sizeof err)
                         : io_read_png(path, &w, &h, &rgba, err, sizeof err);
     CHECK(rv != RAYES_OK);
@@ -583,7 +592,59 @@ static void test_failed_write_keeps_target(void)
     }
 }
 
+/* Threads writing the same target at once: every write succeeds, and the
+ * file read afterwards is one whole image, not a mix. */
+typedef struct Writer {
+    const char *path; /* shared target */
+    float value;      /* this thread's constant colour */
+    int n_failures;   /* writes that did not return RAYES_OK */
+} Writer;
+
+static void *write_repeatedly(void *arg)
+{
+    Writer *writer = arg;
+    float rgba[16 * 16 * 4];
+    for (int i = 0; i < 16 * 16 * 4; i++)
+        rgba[i] = i % 4 == 3 ? 1.0f : writer->value;
+    for (int k = 0; k < 8; k++) {
+        char err[512];
+        writer->n_failures += io_write_image(writer->path, 16, 16, rgba, err, sizeof err) != 0;
+    }
+    return NULL;
+}
+
+static void test_concurrent_writes(void)
+{
+    const char *names[] = {"shared.exr", "shared.png"};
+    for (int f = 0; f < 2; f++) {
+        char path[512], err[512] = "";
+        scratch(path, sizeof path, names[f]);
+        enum { N_THREADS = 4 };
+        pthread_t threads[N_THREADS];
+        Writer writers[N_THREADS];
+        for (int t = 0; t < N_THREADS; t++) {
+            writers[t] = (Writer){path, 0.25f * (float)(t + 1), 0};
+            CHECK(pthread_create(&threads[t], NULL, write_repeatedly, &writers[t]) == 0);
+        }
+        for (int t = 0; t < N_THREADS; t++) {
+            pthread_join(threads[t], NULL);
+            CHECK(writers[t].n_failures == 0);
+        }
+        int w = 0, h = 0;
+        float *back = NULL;
+        RayesError rv = f == 0 ? io_read_exr(path, &w, &h, &back, err, sizeof err)
+                               : io_read_png(path, &w, &h, &back, err, sizeof err);
+        CHECK(rv == RAYES_OK && w == 16 && h == 16);
+        int uniform = back != NULL;
+        for (int i = 0; back && i < 16 * 16 * 4; i++)
+            uniform &= back[i] == back[i % 4];
+        CHECK(uniform);
+        CHECK(count_leftovers(SCRATCH_DIR, names[f]) == 0);
+        free(back);
+    }
+}
+
 TEST_MAIN(TEST(test_exr_round_trip), TEST(test_exr_header), TEST(test_exr_reads_other_layouts),
           TEST(test_png_round_trip), TEST(test_png_reads_grey), TEST(test_format_dispatch),
           TEST(test_bad_arguments), TEST(test_missing_directory), TEST(test_read_bad_files),
-          TEST(test_failed_write_keeps_target))
+          TEST(test_failed_write_keeps_target), TEST(test_concurrent_writes))
