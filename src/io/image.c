@@ -29,7 +29,6 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
-
 static atomic_ulong n_temp_files;
 
 /* Library messages may carry newlines; the contract is one line. */

@@ -52,7 +52,6 @@
 
 #include <openexr.h>
 
-
 /* Limits on images we read: a side keeps a line of RGBA floats within the
  * library's int32 line stride, and the pixel count keeps a forged header
  * from asking for an absurd allocation (2^28 pixels is 4 GiB of floats). */

@@ -33,7 +33,6 @@
 
 #include <png.h>
 
-
 /* Limits on images we read (see image_exr.c): 2^28 pixels is 4 GiB of
  * floats, far beyond any render, and stops a forged header early. */
 #define MAX_PIXELS ((uint64_t)1 << 28)
