@@ -1,0 +1,120 @@
+/*
+ * cache/cache.h — the multiresolution cache of memo section 3 (radiosity,
+ * and later opacity and irradiance), knowing nothing of shading: a miss
+ * calls the fill function it is given.
+ *
+ * Structure (memo 3.1, DESIGN.md "The multiresolution cache"):
+ *  - three resolutions (COARSE, MEDIUM, FINE), each with its own share of the
+ *    byte budget (default 25% / 25% / 50% of 100 MB) and least-recently-used
+ *    replacement;
+ *  - each resolution is split into shards (a lock, a hash table, an LRU list
+ *    and an equal part of the resolution's budget); LRU is exact within a
+ *    shard;
+ *  - entries hold RGB half floats per vertex and are reference-counted; an
+ *    entry held by anyone is pinned (off its LRU list, never evicted);
+ *  - each thread has a CacheLocal: a small direct-mapped table of entries it
+ *    holds references to, so repeated coherent lookups take no lock;
+ *  - an entry being filled by one thread is waited for by others (never
+ *    returned half-written);
+ *  - every entry records the timestamp it was filled at; an entry older than
+ *    the cache's current timestamp is a miss and is dropped (memo 3.2).
+ *
+ * Budget: header, payload and hash-slot bytes of every resident entry are
+ * counted; the budget is never exceeded. When an entry cannot fit (a budget
+ * smaller than one entry, or everything pinned), the lookup fills a private
+ * entry that is not inserted and is freed when released: rendering stays
+ * correct, just slower.
+ *
+ * Thread-safety: cache_* functions are thread-safe; a CacheLocal belongs to
+ * one thread.
+ */
+#ifndef RAYES_CACHE_CACHE_H
+#define RAYES_CACHE_CACHE_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+typedef enum CacheLevel {
+    CACHE_COARSE = 0,
+    CACHE_MEDIUM = 1,
+    CACHE_FINE = 2,
+    CACHE_N_LEVELS = 3
+} CacheLevel;
+
+typedef enum CacheType {
+    CACHE_RADIOSITY = 0,
+    CACHE_OPACITY = 1,
+    CACHE_IRRADIANCE = 2,
+    CACHE_N_TYPES = 3
+} CacheType;
+
+/* What an entry is for. Two keys are equal iff all fields are. */
+typedef struct CacheKey {
+    uint32_t patch;    /* patch id (instance included) */
+    uint16_t depth;    /* diffuse depth */
+    uint8_t segment;   /* motion segment */
+    uint8_t side;      /* 0: front (dPdu x dPdv), 1: back */
+    uint8_t type;      /* CacheType */
+    uint8_t level;     /* CacheLevel */
+} CacheKey;
+
+/* Fills n_values RGB values for key (float, any finite or infinite value;
+ * the cache clamps to the largest finite half). Must depend only on key and
+ * user so that a refill gives the same bytes. Called without locks held. */
+typedef void (*CacheFillFn)(void *user, const CacheKey *key, size_t n_values, float (*out)[3]);
+
+typedef struct Cache Cache;
+typedef struct CacheEntry CacheEntry;
+
+/* Per level and data type counters. */
+typedef struct CacheCounters {
+    uint64_t lookups, hits, misses, fills, evictions;
+} CacheCounters;
+
+typedef struct CacheStats {
+    uint64_t budget_bytes;                          /* whole budget */
+    uint64_t level_budget_bytes[CACHE_N_LEVELS];
+    uint64_t entries[CACHE_N_LEVELS];               /* resident now */
+    uint64_t bytes[CACHE_N_LEVELS];                 /* counted now */
+    uint64_t peak_bytes[CACHE_N_LEVELS];
+    CacheCounters counters[CACHE_N_LEVELS][CACHE_N_TYPES];
+} CacheStats;
+
+/* A new cache with a byte budget split by fractions split[level] (summing to
+ * at most 1). Returns NULL when out of memory. */
+Cache *cache_new(uint64_t budget_bytes, const float split[CACHE_N_LEVELS]);
+/* Frees the cache; no entry may be held. */
+void cache_free(Cache *cache);
+
+/* The current timestamp, and a new one (returns it). Entries filled before
+ * the bump are never returned after it. */
+uint64_t cache_timestamp(const Cache *cache);
+uint64_t cache_bump_timestamp(Cache *cache);
+
+/* A thread's local part. CACHE_LOCAL_SLOTS entries per level may be held. */
+#define CACHE_LOCAL_SLOTS 32
+
+typedef struct CacheLocal {
+    Cache *cache;
+    CacheEntry *slots[CACHE_N_LEVELS][CACHE_LOCAL_SLOTS]; /* held references */
+    CacheCounters counters[CACHE_N_LEVELS][CACHE_N_TYPES]; /* merged on fini */
+} CacheLocal;
+
+void cache_local_init(CacheLocal *local, Cache *cache);
+/* Releases every held entry and adds the counters to the cache's. */
+void cache_local_fini(CacheLocal *local);
+
+/* The values (n_values RGB half floats, 3 * n_values uint16_t) of the entry
+ * for key, filling it with fill(user, key, ...) on a miss. The entry stays
+ * valid until the next lookup of the same level through this CacheLocal, or
+ * cache_local_fini. n_values must be the same for every lookup of a key. */
+const uint16_t *cache_lookup(CacheLocal *local, const CacheKey *key, size_t n_values,
+                             CacheFillFn fill, void *user);
+
+/* The statistics so far (counters of finished CacheLocals only). */
+void cache_get_stats(const Cache *cache, CacheStats *stats);
+
+/* Bytes an entry of n_values values is charged (header + payload + slot). */
+size_t cache_entry_bytes(size_t n_values);
+
+#endif /* RAYES_CACHE_CACHE_H */

@@ -1,0 +1,66 @@
+/* Half floats (util/half.h) against GCC's _Float16 over every float bit
+ * pattern in a large stride, and at the digest's listed values. */
+#include <stdint.h>
+#include <string.h>
+
+#include "test.h"
+#include "util/half.h"
+
+static uint16_t ref_half(float f)
+{
+    _Float16 h = (_Float16)f;
+    uint16_t u;
+    memcpy(&u, &h, sizeof u);
+    return u;
+}
+
+static void test_known_values(void)
+{
+    CHECK(half_from_float(65504.0f) == 0x7bff);
+    CHECK(half_from_float(65520.0f) == 0x7c00);
+    CHECK(half_from_float(1e5f) == 0x7c00);
+    CHECK(half_from_float(6.1035e-5f) == 0x0400);
+    CHECK(half_from_float(5.96e-8f) == 0x0001);
+    CHECK(half_from_float(2.9e-8f) == 0x0000);
+    CHECK(half_from_float(3.0e-8f) == 0x0001);
+    CHECK(half_from_float(0.1f) == 0x2e66);
+    CHECK(half_from_float_clamped(1e9f) == 0x7bff);
+    CHECK(half_from_float_clamped(-1e9f) == 0xfbff);
+    CHECK(half_from_float_clamped(0.0f / 0.0f) == 0x0000);
+    CHECK(half_to_float(0x3c00) == 1.0f);
+    CHECK(half_to_float(0x0001) == 0x1p-24f);
+}
+
+static void test_matches_float16_everywhere(void)
+{
+    int mismatches = 0;
+    for (uint64_t bits = 0; bits <= 0xffffffffull; bits += 997) {
+        uint32_t b = (uint32_t)bits;
+        float f;
+        memcpy(&f, &b, sizeof f);
+        uint16_t mine = half_from_float(f), ref = ref_half(f);
+        if (f != f) /* NaN: any quiet NaN will do */
+            mismatches += (mine & 0x7c00) != 0x7c00 || (mine & 0x3ff) == 0;
+        else
+            mismatches += mine != ref;
+    }
+    CHECK(mismatches == 0);
+}
+
+static void test_round_trip_all_halves(void)
+{
+    int bad = 0;
+    for (uint32_t h = 0; h < 0x10000; h++) {
+        if ((h & 0x7c00) == 0x7c00 && (h & 0x3ff))
+            continue; /* NaN payloads */
+        bad += half_from_float(half_to_float((uint16_t)h)) != h;
+        _Float16 r;
+        uint16_t u = (uint16_t)h;
+        memcpy(&r, &u, sizeof r);
+        bad += half_to_float((uint16_t)h) != (float)r;
+    }
+    CHECK(bad == 0);
+}
+
+TEST_MAIN(TEST(test_known_values), TEST(test_matches_float16_everywhere),
+          TEST(test_round_trip_all_halves))
