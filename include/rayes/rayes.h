@@ -172,12 +172,20 @@ typedef struct RayesRenderOptions {
     float filter_width;        /* pixels */
     uint64_t seed;             /* changes every random number */
     int tile_size;             /* pixels */
+    int cache;                 /* 1: the radiosity cache at diffuse hits (default); 0: off */
+    double cache_mb;           /* cache budget in megabytes (10^6 bytes), default 100 */
+    float cache_split[3];      /* budget shares of coarse, medium, fine (default .25 .25 .5) */
+    int cache_resolution;      /* -1: chosen by ray differentials (default); 0, 1, 2: always
+                                  coarse, medium, fine */
+    float cache_k;             /* the coarsest resolution whose micropolygon edge is below
+                                  cache_k times the ray footprint is used (default 1) */
     RayesProgressFn progress;  /* may be NULL */
     void *progress_user;
 } RayesRenderOptions;
 
 /* Fills options with the defaults of a quality preset: 512 x 512, 4 pixel
- * samples, all cores, 1 bounce, box filter, seed 0. */
+ * samples, all cores, 1 bounce, box filter, seed 0, the radiosity cache on
+ * with 100 MB. The reference preset turns the cache off (nothing cached). */
 RAYES_API void rayes_render_options_init(RayesRenderOptions *options, RayesQuality quality);
 
 /* ---------------------------------------------------------------- stats */

@@ -68,6 +68,13 @@ static void usage(FILE *f)
           "  --filter box|gaussian   pixel filter (default box)\n"
           "  --filter-width W        filter width in pixels (default 1 box, 2 gaussian)\n"
           "  --seed N                changes every random number (default 0)\n"
+          "  --cache on|off          the radiosity cache at diffuse hits (default on; off for\n"
+          "                          --quality reference)\n"
+          "  --cache-mb MB           cache budget in megabytes (default 100)\n"
+          "  --cache-split C,M,F     budget shares of coarse, medium, fine (default .25,.25,.5)\n"
+          "  --cache-resolution R    auto (by ray differentials), coarse, medium or fine\n"
+          "  --cache-k K             use the coarsest resolution whose micropolygons are at\n"
+          "                          most K times the ray footprint (default 1)\n"
           "  --data DIR              data directory (teapot.bpt); default $RAYES_DATA\n"
           "  --stats FILE.json       write statistics as JSON\n"
           "  --quiet                 no progress bar and no summary\n",
@@ -119,6 +126,32 @@ static void parse_res(const char *s, RayesRenderOptions *o)
     } else {
         o->width = o->height = (int)parse_long("--res", s, 1, 65536);
     }
+}
+
+static void parse_split(const char *s, float split[3])
+{
+    char buf[128], *save = NULL;
+    snprintf(buf, sizeof buf, "%s", s);
+    float sum = 0.0f;
+    for (int i = 0; i < 3; i++) {
+        char *tok = strtok_r(i == 0 ? buf : NULL, ",", &save);
+        split[i] = parse_float("--cache-split", tok, 0.0f, 1.0f);
+        sum += split[i];
+    }
+    if (strtok_r(NULL, ",", &save) || sum > 1.0001f)
+        die_usage("--cache-split: expected three shares C,M,F summing to at most 1, got \"%s\"",
+                  s);
+}
+
+static int parse_resolution(const char *s)
+{
+    static const char *const names[] = {"coarse", "medium", "fine"};
+    if (strcmp(s, "auto") == 0)
+        return -1;
+    for (int i = 0; i < 3; i++)
+        if (strcmp(s, names[i]) == 0)
+            return i;
+    die_usage("--cache-resolution: expected auto, coarse, medium or fine, got \"%s\"", s);
 }
 
 static RayesQuality parse_quality(const char *s)
@@ -194,6 +227,18 @@ static void parse_args(int argc, char **argv, Args *a)
             filter_width_set = 1;
         } else if (strcmp(o, "--seed") == 0)
             opt->seed = (uint64_t)parse_long(o, v, 0, LONG_MAX);
+        else if (strcmp(o, "--cache") == 0) {
+            if (strcmp(v, "on") != 0 && strcmp(v, "off") != 0)
+                die_usage("--cache: expected on or off, got \"%s\"", v);
+            opt->cache = strcmp(v, "on") == 0;
+        } else if (strcmp(o, "--cache-mb") == 0)
+            opt->cache_mb = parse_float(o, v, 0.0f, 1e7f);
+        else if (strcmp(o, "--cache-split") == 0)
+            parse_split(v, opt->cache_split);
+        else if (strcmp(o, "--cache-resolution") == 0)
+            opt->cache_resolution = parse_resolution(v);
+        else if (strcmp(o, "--cache-k") == 0)
+            opt->cache_k = parse_float(o, v, 1e-3f, 1e3f);
         else if (strcmp(o, "--data") == 0)
             a->data_dir = v;
         else if (strcmp(o, "--stats") == 0)
@@ -273,6 +318,20 @@ static void summary(const Args *a, const RayesStats *s)
            (unsigned long long)stat_count(s, "rays/shadow"),
            (unsigned long long)stat_count(s, "rays/diffuse"),
            (unsigned long long)stat_count(s, "rays/specular"));
+    if (rayes_stats_find(s, "cache/budget_bytes")) {
+        static const char *const lv[3] = {"coarse", "medium", "fine"};
+        printf("  cache         %.0f MB:", (double)stat_count(s, "cache/budget_bytes") / 1e6);
+        for (int l = 0; l < 3; l++) {
+            char k1[64], k2[64], k3[64];
+            snprintf(k1, sizeof k1, "cache/%s/hit_rate", lv[l]);
+            snprintf(k2, sizeof k2, "cache/%s/lookups", lv[l]);
+            snprintf(k3, sizeof k3, "cache/%s/entries", lv[l]);
+            printf("%s %s %.2f%% of %llu (%llu entries)", l ? "," : "", lv[l],
+                   100.0 * stat_real(s, k1), (unsigned long long)stat_count(s, k2),
+                   (unsigned long long)stat_count(s, k3));
+        }
+        printf("\n");
+    }
     printf("  memory        %.1f MB peak resident\n",
            (double)stat_count(s, "memory/peak_rss_bytes") / 1e6);
 }

@@ -1,8 +1,9 @@
 /*
- * render/integrator.c — the uncached distribution ray tracer, the memo's
- * "without caching" baseline: a camera or specular hit runs the shader's
- * lighting() at the hit; a diffuse hit runs diffuselighting() at that one
- * point (one shading point, counted at its diffuse depth). Area lights are
+ * render/integrator.c — distribution ray tracing: a camera or specular hit
+ * runs the shader's lighting() at the hit; a diffuse hit reads the
+ * radiosity cache (radiosity.c), or with the cache off (the memo's "without
+ * caching" baseline) runs diffuselighting() at that one point (one shading
+ * point, counted at its diffuse depth). Area lights are
  * seen by camera and specular rays; diffuse rays see them as black because
  * direct lighting already integrates them (no double counting).
  *
@@ -11,6 +12,8 @@
  * on threads or order.
  */
 #include "render/integrator.h"
+
+#include "render/radiosity.h"
 
 #include <math.h>
 #include <string.h>
@@ -137,6 +140,8 @@ Vec3 integrator_trace(Worker *w, const Ray *ray, uint32_t kind, int diffuse_dept
             return v3(0, 0, 0);
         return w->rs->lights[obj->light].L;
     }
+    if (kind == RAYES_RAY_DIFFUSE && w->set->cache)
+        return radiosity_at_hit(w, ray, &hit, diffuse_depth, diff);
     return shade_hit(w, ray, &hit, obj, kind, diffuse_depth, specular_depth, key, diff);
 }
 

@@ -18,6 +18,7 @@ typedef struct Worker {
     const RenderScene *rs;
     const RenderSettings *set;
     RenderStats stats;
+    CacheLocal cache;             /* this thread's part of the radiosity cache */
 } Worker;
 
 /* What a shading context's `renderer` points to: per point, the sample key

@@ -163,12 +163,18 @@ int render_frame(const RenderScene *rs, const RenderSettings *set, float *rgba, 
     pthread_mutex_init(&f.progress_lock, NULL);
     f.workers = calloc((size_t)threads, sizeof *f.workers);
     RY_CHECK(f.workers != NULL);
-    for (int i = 0; i < threads; i++)
+    for (int i = 0; i < threads; i++) {
         f.workers[i] = (Worker){.rs = rs, .set = set};
+        if (set->cache)
+            cache_local_init(&f.workers[i].cache, set->cache);
+    }
     memset(rgba, 0, sizeof(float) * 4 * (size_t)set->width * set->height);
     thread_parallel_for(threads, (size_t)f.tiles_x * f.tiles_y, render_tile, &f);
-    for (int i = 0; i < threads; i++)
+    for (int i = 0; i < threads; i++) {
         merge_stats(stats, &f.workers[i].stats);
+        if (set->cache)
+            cache_local_fini(&f.workers[i].cache);
+    }
     free(f.workers);
     pthread_mutex_destroy(&f.progress_lock);
     return atomic_load(&f.cancelled) ? 1 : 0;

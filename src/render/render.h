@@ -1,8 +1,9 @@
 /*
  * render/render.h — the integrator and the frame loop (DESIGN.md "The
  * frame, end to end"): camera rays with differentials over tiles on a
- * thread pool; lighting() at camera and specular hits, diffuselighting()
- * at diffuse hits (no cache yet: the memo's "without caching" baseline);
+ * thread pool; lighting() at camera and specular hits; at diffuse hits the
+ * radiosity cache, or with it off diffuselighting() at the hit (the memo's
+ * "without caching" baseline);
  * services for shaders; film with box or Gaussian filtering.
  *
  * Inputs are immutable during a frame and shared by all workers; each
@@ -16,6 +17,7 @@
 #include <stdint.h>
 
 #include "accel/accel.h"
+#include "cache/cache.h"
 #include "geom/geom.h"
 #include "shade/light.h"
 #include "shade/shade.h"
@@ -57,6 +59,9 @@ typedef struct RenderSettings {
     uint64_t seed;
     int (*progress)(void *user, double fraction); /* nonzero: cancel */
     void *progress_user;
+    Cache *cache;                 /* the radiosity cache, or NULL: uncached */
+    int cache_resolution;         /* -1: by differentials; else a forced CacheLevel */
+    float cache_k;                /* resolution rule constant (DESIGN.md) */
 } RenderSettings;
 
 typedef struct RenderStats {

@@ -12,6 +12,7 @@
 #include <string.h>
 
 #include "accel/accel.h"
+#include "cache/cache.h"
 #include "rayes/rayes.h"
 #include "render/render.h"
 #include "scene/scene.h"
@@ -50,6 +51,13 @@ void rayes_render_options_init(RayesRenderOptions *o, RayesQuality quality)
     o->filter = RAYES_FILTER_BOX;
     o->filter_width = 1.0f;
     o->tile_size = 32;
+    o->cache = quality != RAYES_QUALITY_REFERENCE;
+    o->cache_mb = 100.0;
+    o->cache_split[0] = 0.25f;
+    o->cache_split[1] = 0.25f;
+    o->cache_split[2] = 0.5f;
+    o->cache_resolution = -1;
+    o->cache_k = 1.0f;
     switch (quality) {
     case RAYES_QUALITY_PREVIEW:
         o->shadow_rays = o->shadow_rays_deep = 4;
@@ -96,6 +104,12 @@ static RayesError check_options(RayesScene *scene, const RayesRenderOptions *o)
         what = "options: filter width must be in (0, 16]";
     else if (o->tile_size < 1 || o->threads < 0 || o->threads > 1024)
         what = "options: tile size must be positive and threads 0 to 1024";
+    else if (!(o->cache_mb >= 0.0) || o->cache_mb > 1e7 || !(o->cache_k > 0.0f) ||
+             o->cache_resolution < -1 || o->cache_resolution > 2 || o->cache_split[0] < 0.0f ||
+             o->cache_split[1] < 0.0f || o->cache_split[2] < 0.0f ||
+             !(o->cache_split[0] + o->cache_split[1] + o->cache_split[2] <= 1.0001f))
+        what = "options: cache budget 0 to 1e7 MB, split shares >= 0 summing to at most 1, "
+               "k > 0, resolution -1 to 2";
     if (!what)
         return RAYES_OK;
     if (scene->error[0] == '\0')
@@ -112,6 +126,7 @@ static RenderSettings settings_from(const RayesRenderOptions *o)
         .diffuse_rays = o->diffuse_rays, .diffuse_rays_deep = o->diffuse_rays_deep,
         .filter = o->filter == RAYES_FILTER_GAUSSIAN, .filter_width = o->filter_width,
         .seed = o->seed, .progress = o->progress, .progress_user = o->progress_user,
+        .cache_resolution = o->cache_resolution, .cache_k = o->cache_k,
     };
     if (s.threads == 0)
         s.threads = thread_count_cores();
@@ -172,6 +187,7 @@ RayesError rayes_render(RayesScene *scene, const RayesRenderOptions *opt, RayesI
     RayesImage *img = calloc(1, sizeof *img);
     float *rgba = malloc(sizeof(float) * 4 * (size_t)set.width * set.height);
     Accel *accel = NULL;
+    Cache *cache = NULL;
     RenderStats rstats = {0};
     char err[300] = "";
     if (!objects || !masks || !img || !rgba || scene_prepare(scene, set.height, &gs) != 0) {
@@ -182,6 +198,14 @@ RayesError rayes_render(RayesScene *scene, const RayesRenderOptions *opt, RayesI
     if (!accel) {
         e = fail(scene, RAYES_ERROR_OUT_OF_MEMORY, err);
         goto done;
+    }
+    if (opt->cache) {
+        cache = cache_new((uint64_t)(opt->cache_mb * 1e6), opt->cache_split);
+        if (!cache) {
+            e = fail(scene, RAYES_ERROR_OUT_OF_MEMORY, "render: out of memory for the cache");
+            goto done;
+        }
+        set.cache = cache;
     }
     double t1 = time_now();
     Bounds3 b = scene_bounds(scene);
@@ -199,6 +223,11 @@ RayesError rayes_render(RayesScene *scene, const RayesRenderOptions *opt, RayesI
     if (stats_out) {
         SessionTimes times = {t2 - t0, t1 - t0, t2 - t1};
         *stats_out = session_stats_new(&set, &rstats, &gs, &times, accel_memory_bytes(accel));
+        if (*stats_out && cache) {
+            CacheStats cs;
+            cache_get_stats(cache, &cs);
+            session_stats_add_cache(*stats_out, &cs);
+        }
         if (!*stats_out) {
             e = fail(scene, RAYES_ERROR_OUT_OF_MEMORY, "render: out of memory for statistics");
             goto done;
@@ -211,6 +240,7 @@ RayesError rayes_render(RayesScene *scene, const RayesRenderOptions *opt, RayesI
     img = NULL;
     rgba = NULL;
 done:
+    cache_free(cache);
     accel_free(accel);
     geom_gridset_fini(&gs);
     free(objects);

@@ -9,7 +9,7 @@
 
 #include "util/log.h"
 
-#define MAX_STATS 64
+#define MAX_STATS 128
 
 struct RayesStats {
     RayesStat items[MAX_STATS];
@@ -69,6 +69,32 @@ RayesStats *session_stats_new(const RenderSettings *set, const RenderStats *rs, 
     count(s, "shadow_rays", (uint64_t)set->shadow_rays);
     count(s, "diffuse_rays", (uint64_t)set->diffuse_rays);
     return s;
+}
+
+void session_stats_add_cache(RayesStats *s, const CacheStats *cs)
+{
+    static const char *const names[CACHE_N_LEVELS][8] = {
+        {"cache/coarse/lookups", "cache/coarse/hits", "cache/coarse/misses", "cache/coarse/fills",
+         "cache/coarse/evictions", "cache/coarse/entries", "cache/coarse/bytes",
+         "cache/coarse/hit_rate"},
+        {"cache/medium/lookups", "cache/medium/hits", "cache/medium/misses", "cache/medium/fills",
+         "cache/medium/evictions", "cache/medium/entries", "cache/medium/bytes",
+         "cache/medium/hit_rate"},
+        {"cache/fine/lookups", "cache/fine/hits", "cache/fine/misses", "cache/fine/fills",
+         "cache/fine/evictions", "cache/fine/entries", "cache/fine/bytes", "cache/fine/hit_rate"},
+    };
+    count(s, "cache/budget_bytes", cs->budget_bytes);
+    for (int l = 0; l < CACHE_N_LEVELS; l++) {
+        const CacheCounters *c = &cs->counters[l][CACHE_RADIOSITY];
+        count(s, names[l][0], c->lookups);
+        count(s, names[l][1], c->hits);
+        count(s, names[l][2], c->misses);
+        count(s, names[l][3], c->fills);
+        count(s, names[l][4], c->evictions);
+        count(s, names[l][5], cs->entries[l]);
+        count(s, names[l][6], cs->bytes[l]);
+        real(s, names[l][7], c->lookups ? (double)c->hits / (double)c->lookups : 0.0);
+    }
 }
 
 size_t rayes_stats_size(const RayesStats *s)

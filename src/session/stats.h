@@ -6,6 +6,7 @@
 #ifndef RAYES_SESSION_STATS_H
 #define RAYES_SESSION_STATS_H
 
+#include "cache/cache.h"
 #include "geom/geom.h"
 #include "rayes/rayes.h"
 #include "render/render.h"
@@ -17,5 +18,10 @@ typedef struct SessionTimes {
 /* A new statistics list (free with rayes_stats_free), or NULL. */
 RayesStats *session_stats_new(const RenderSettings *set, const RenderStats *rs, const GridSet *gs,
                               const SessionTimes *times, size_t accel_bytes);
+
+/* Adds the "cache" block: budget_bytes and, per resolution, lookups, hits,
+ * misses, fills, evictions, entries, bytes and hit_rate (radiosity only for
+ * now; a later data type adds a per-type split). */
+void session_stats_add_cache(RayesStats *stats, const CacheStats *cs);
 
 #endif /* RAYES_SESSION_STATS_H */

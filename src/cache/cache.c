@@ -1,0 +1,401 @@
+/*
+ * cache/cache.c — the multiresolution cache (memo section 3.1 and 3.2): three
+ * resolutions, each in CACHE_SHARDS shards; a shard is a mutex, a chained
+ * hash table, an LRU list of unpinned entries and a byte budget.
+ *
+ * Entry layout: a CacheEntry header followed by 3 * n_values half floats.
+ * An entry is
+ *   - resident: in its shard's hash table (counted in the shard's bytes), or
+ *     private: filled for one lookup when it could not fit, never shared;
+ *   - pinned while refs > 0 (held by CacheLocal slots or a thread waiting for
+ *     it), else on the shard's LRU list (least recently used at lru.next);
+ *   - ready once its values are written; lookups of an entry that is not
+ *     ready wait on the shard's condition variable.
+ * A resident entry found stale (older timestamp) is unlinked from the table;
+ * if nobody holds it, it is freed at once, otherwise by its last release.
+ * Its bytes stay counted until it is freed, so the budget is never exceeded.
+ *
+ * Locks: one shard lock at a time; the fill function runs with no lock held
+ * (it may look up other keys: a fill at diffuse depth d only looks up depth
+ * d + 1, so waits cannot form a cycle). CacheLocal slots are touched only by
+ * their thread.
+ */
+#include "cache/cache.h"
+
+#include <pthread.h>
+#include <stdatomic.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "util/check.h"
+#include "util/half.h"
+#include "util/rng.h"
+
+#define CACHE_SHARDS 8
+
+struct CacheEntry {
+    CacheKey key;
+    uint64_t timestamp;           /* cache timestamp when filled */
+    uint64_t hash;                /* of key */
+    CacheEntry *hnext;            /* hash chain */
+    CacheEntry *prev, *next;      /* LRU links, while unpinned and resident */
+    uint32_t refs;                /* holders; under the shard lock (private: always 1) */
+    uint32_t n_values;
+    uint8_t ready;                /* values written */
+    uint8_t resident;             /* in the hash table */
+    uint8_t private_entry;        /* never in a table; freed by its only release */
+    uint16_t values[];            /* RGB halves, 3 * n_values */
+};
+
+typedef struct Shard {
+    pthread_mutex_t lock;
+    pthread_cond_t filled;        /* an entry became ready */
+    CacheEntry **table;           /* n_slots chains, NULL if the budget allows none */
+    size_t n_slots;               /* a power of two */
+    CacheEntry lru;               /* sentinel: lru.next is least recently used */
+    uint64_t budget, bytes, peak; /* bytes: table + resident and dropped-but-held entries */
+    uint64_t entries;             /* resident */
+    uint64_t evictions[CACHE_N_TYPES];
+} Shard;
+
+struct Cache {
+    Shard shards[CACHE_N_LEVELS][CACHE_SHARDS];
+    uint64_t budget;
+    uint64_t level_budget[CACHE_N_LEVELS];
+    atomic_uint_fast64_t timestamp;
+    pthread_mutex_t counters_lock;
+    CacheCounters counters[CACHE_N_LEVELS][CACHE_N_TYPES];
+};
+
+/* Nominal values per entry, for sizing hash tables (memo Figure 2 sizes). */
+static const size_t nominal_values[CACHE_N_LEVELS] = {4, 25, 289};
+
+size_t cache_entry_bytes(size_t n_values)
+{
+    return sizeof(CacheEntry) + 3 * sizeof(uint16_t) * n_values;
+}
+
+static uint64_t key_hash(const CacheKey *k)
+{
+    uint64_t a = (uint64_t)k->patch | (uint64_t)k->depth << 32 | (uint64_t)k->segment << 48 |
+                 (uint64_t)k->side << 56;
+    uint64_t b = (uint64_t)k->type | (uint64_t)k->level << 8;
+    return hash_combine(hash_u64(a), b);
+}
+
+static int key_equal(const CacheKey *a, const CacheKey *b)
+{
+    return a->patch == b->patch && a->depth == b->depth && a->segment == b->segment &&
+           a->side == b->side && a->type == b->type && a->level == b->level;
+}
+
+static void shard_init(Shard *s, uint64_t budget, size_t nominal)
+{
+    pthread_mutex_init(&s->lock, NULL);
+    pthread_cond_init(&s->filled, NULL);
+    s->lru.prev = s->lru.next = &s->lru;
+    s->budget = budget;
+    /* The largest power of two of slots that, with nominal entries, fits. */
+    size_t per = sizeof(CacheEntry *) + cache_entry_bytes(nominal);
+    size_t n = 1;
+    while ((n * 2) * per <= budget && n < ((size_t)1 << 24))
+        n *= 2;
+    if (n * sizeof(CacheEntry *) > budget)
+        return; /* not even one slot: every lookup fills privately */
+    s->table = calloc(n, sizeof *s->table);
+    if (!s->table)
+        return;
+    s->n_slots = n;
+    s->bytes = s->peak = n * sizeof(CacheEntry *);
+}
+
+Cache *cache_new(uint64_t budget_bytes, const float split[CACHE_N_LEVELS])
+{
+    Cache *c = calloc(1, sizeof *c);
+    if (!c)
+        return NULL;
+    c->budget = budget_bytes;
+    atomic_init(&c->timestamp, 1);
+    pthread_mutex_init(&c->counters_lock, NULL);
+    for (int l = 0; l < CACHE_N_LEVELS; l++) {
+        float f = split[l] < 0.0f ? 0.0f : split[l];
+        c->level_budget[l] = (uint64_t)((double)budget_bytes * f);
+        for (int s = 0; s < CACHE_SHARDS; s++)
+            shard_init(&c->shards[l][s], c->level_budget[l] / CACHE_SHARDS, nominal_values[l]);
+    }
+    return c;
+}
+
+void cache_free(Cache *c)
+{
+    if (!c)
+        return;
+    for (int l = 0; l < CACHE_N_LEVELS; l++)
+        for (int s = 0; s < CACHE_SHARDS; s++) {
+            Shard *sh = &c->shards[l][s];
+            for (size_t i = 0; i < sh->n_slots; i++)
+                for (CacheEntry *e = sh->table[i], *next; e; e = next) {
+                    next = e->hnext;
+                    RY_CHECK(e->refs == 0); /* nobody may hold an entry now */
+                    free(e);
+                }
+            free(sh->table);
+            pthread_mutex_destroy(&sh->lock);
+            pthread_cond_destroy(&sh->filled);
+        }
+    pthread_mutex_destroy(&c->counters_lock);
+    free(c);
+}
+
+uint64_t cache_timestamp(const Cache *c)
+{
+    return atomic_load(&((Cache *)c)->timestamp);
+}
+
+uint64_t cache_bump_timestamp(Cache *c)
+{
+    return atomic_fetch_add(&c->timestamp, 1) + 1;
+}
+
+static Shard *shard_of(Cache *c, const CacheKey *k, uint64_t hash)
+{
+    return &c->shards[k->level][(hash >> 40) % CACHE_SHARDS];
+}
+
+static void lru_unlink(CacheEntry *e)
+{
+    e->prev->next = e->next;
+    e->next->prev = e->prev;
+    e->prev = e->next = NULL;
+}
+
+static void lru_append(Shard *s, CacheEntry *e) /* as most recently used */
+{
+    e->prev = s->lru.prev;
+    e->next = &s->lru;
+    s->lru.prev->next = e;
+    s->lru.prev = e;
+}
+
+/* Removes e from its hash chain. Caller holds the shard lock. */
+static void table_unlink(Shard *s, CacheEntry *e)
+{
+    CacheEntry **p = &s->table[e->hash & (s->n_slots - 1)];
+    while (*p != e)
+        p = &(*p)->hnext;
+    *p = e->hnext;
+    e->resident = 0;
+    s->entries--;
+}
+
+static void entry_free(Shard *s, CacheEntry *e)
+{
+    s->bytes -= cache_entry_bytes(e->n_values);
+    free(e);
+}
+
+/* Evicts least recently used entries until `need` more bytes fit. Returns 1
+ * if they fit. Caller holds the shard lock. */
+static int make_room(Shard *s, uint64_t need)
+{
+    while (s->bytes + need > s->budget && s->lru.next != &s->lru) {
+        CacheEntry *victim = s->lru.next;
+        lru_unlink(victim);
+        table_unlink(s, victim);
+        s->evictions[victim->key.type]++;
+        entry_free(s, victim);
+    }
+    return s->bytes + need <= s->budget;
+}
+
+/* Drops a reference. Caller does not hold the shard lock. */
+static void release(Cache *c, CacheEntry *e)
+{
+    if (e->private_entry) {
+        free(e);
+        return;
+    }
+    Shard *s = shard_of(c, &e->key, e->hash);
+    pthread_mutex_lock(&s->lock);
+    RY_DCHECK(e->refs > 0);
+    if (--e->refs == 0) {
+        if (e->resident)
+            lru_append(s, e);
+        else
+            entry_free(s, e); /* dropped as stale while held */
+    }
+    pthread_mutex_unlock(&s->lock);
+}
+
+void cache_local_init(CacheLocal *local, Cache *cache)
+{
+    memset(local, 0, sizeof *local);
+    local->cache = cache;
+}
+
+void cache_local_fini(CacheLocal *local)
+{
+    Cache *c = local->cache;
+    for (int l = 0; l < CACHE_N_LEVELS; l++)
+        for (int i = 0; i < CACHE_LOCAL_SLOTS; i++)
+            if (local->slots[l][i]) {
+                release(c, local->slots[l][i]);
+                local->slots[l][i] = NULL;
+            }
+    pthread_mutex_lock(&c->counters_lock);
+    for (int l = 0; l < CACHE_N_LEVELS; l++)
+        for (int t = 0; t < CACHE_N_TYPES; t++) {
+            CacheCounters *to = &c->counters[l][t];
+            const CacheCounters *from = &local->counters[l][t];
+            to->lookups += from->lookups;
+            to->hits += from->hits;
+            to->misses += from->misses;
+            to->fills += from->fills;
+        }
+    pthread_mutex_unlock(&c->counters_lock);
+    memset(local->counters, 0, sizeof local->counters);
+}
+
+/* Finds a current entry and takes a reference (waiting until it is ready),
+ * or inserts a new pinned, unready entry for the caller to fill (*inserted =
+ * 1), or returns NULL if none fits. Drops a stale entry it meets. */
+static CacheEntry *find_or_insert(Cache *c, const CacheKey *key, uint64_t hash, size_t n_values,
+                                  int *inserted)
+{
+    Shard *s = shard_of(c, key, hash);
+    uint64_t now = cache_timestamp(c);
+    *inserted = 0;
+    pthread_mutex_lock(&s->lock);
+    CacheEntry *e = NULL;
+    if (s->table) {
+        for (e = s->table[hash & (s->n_slots - 1)]; e; e = e->hnext)
+            if (e->hash == hash && key_equal(&e->key, key))
+                break;
+        if (e && e->timestamp < now) { /* stale: a miss; drop it */
+            table_unlink(s, e);
+            if (e->refs == 0) {
+                lru_unlink(e);
+                entry_free(s, e);
+            }
+            e = NULL;
+        }
+    }
+    if (e) {
+        if (e->refs++ == 0)
+            lru_unlink(e);
+        while (!e->ready)
+            pthread_cond_wait(&s->filled, &s->lock);
+        pthread_mutex_unlock(&s->lock);
+        return e;
+    }
+    uint64_t need = cache_entry_bytes(n_values);
+    if (s->table && make_room(s, need) && (e = malloc(need)) != NULL) {
+        memset(e, 0, sizeof *e);
+        e->key = *key;
+        e->hash = hash;
+        e->timestamp = now;
+        e->n_values = (uint32_t)n_values;
+        e->refs = 1;
+        e->resident = 1;
+        CacheEntry **chain = &s->table[hash & (s->n_slots - 1)];
+        e->hnext = *chain;
+        *chain = e;
+        s->entries++;
+        s->bytes += need;
+        s->peak = s->bytes > s->peak ? s->bytes : s->peak;
+        *inserted = 1;
+    }
+    pthread_mutex_unlock(&s->lock);
+    return e;
+}
+
+/* Runs the fill and stores halves; publishes a resident entry. */
+static void fill_entry(Cache *c, CacheEntry *e, CacheFillFn fill, void *user)
+{
+    size_t n = e->n_values;
+    float(*tmp)[3] = malloc((n ? n : 1) * sizeof *tmp);
+    RY_CHECK(tmp != NULL);
+    fill(user, &e->key, n, tmp);
+    for (size_t i = 0; i < n; i++)
+        for (int k = 0; k < 3; k++)
+            e->values[3 * i + k] = half_from_float_clamped(tmp[i][k]);
+    free(tmp);
+    if (!e->resident) {
+        e->ready = 1;
+        return;
+    }
+    Shard *s = shard_of(c, &e->key, e->hash);
+    pthread_mutex_lock(&s->lock);
+    e->ready = 1;
+    pthread_cond_broadcast(&s->filled);
+    pthread_mutex_unlock(&s->lock);
+}
+
+const uint16_t *cache_lookup(CacheLocal *local, const CacheKey *key, size_t n_values,
+                             CacheFillFn fill, void *user)
+{
+    Cache *c = local->cache;
+    uint64_t hash = key_hash(key);
+    CacheCounters *ctr = &local->counters[key->level][key->type];
+    CacheEntry **slot = &local->slots[key->level][hash % CACHE_LOCAL_SLOTS];
+    ctr->lookups++;
+    CacheEntry *held = *slot;
+    if (held && held->hash == hash && key_equal(&held->key, key) &&
+        held->timestamp == cache_timestamp(c) && held->ready) {
+        ctr->hits++; /* the lock-free path of coherent lookups */
+        return held->values;
+    }
+    if (held) {
+        *slot = NULL;
+        release(c, held);
+    }
+    int inserted;
+    CacheEntry *e = find_or_insert(c, key, hash, n_values, &inserted);
+    if (e && !inserted) {
+        ctr->hits++;
+    } else {
+        ctr->misses++;
+        ctr->fills++;
+        if (!e) { /* cannot fit: a private entry, correct but not shared */
+            e = calloc(1, cache_entry_bytes(n_values));
+            RY_CHECK(e != NULL);
+            e->key = *key;
+            e->hash = hash;
+            e->timestamp = cache_timestamp(c);
+            e->n_values = (uint32_t)n_values;
+            e->refs = 1;
+            e->private_entry = 1;
+        }
+        fill_entry(c, e, fill, user);
+    }
+    RY_CHECK(e->n_values == n_values);
+    /* The fill may have looked up other keys through this local part and
+     * parked one in our slot: release it before taking the slot. */
+    if (*slot)
+        release(c, *slot);
+    *slot = e;
+    return e->values;
+}
+
+void cache_get_stats(const Cache *cc, CacheStats *st)
+{
+    Cache *c = (Cache *)cc;
+    memset(st, 0, sizeof *st);
+    st->budget_bytes = c->budget;
+    pthread_mutex_lock(&c->counters_lock);
+    memcpy(st->counters, c->counters, sizeof st->counters);
+    pthread_mutex_unlock(&c->counters_lock);
+    for (int l = 0; l < CACHE_N_LEVELS; l++) {
+        st->level_budget_bytes[l] = c->level_budget[l];
+        for (int s = 0; s < CACHE_SHARDS; s++) {
+            Shard *sh = &c->shards[l][s];
+            pthread_mutex_lock(&sh->lock);
+            st->entries[l] += sh->entries;
+            st->bytes[l] += sh->bytes;
+            st->peak_bytes[l] += sh->peak;
+            for (int t = 0; t < CACHE_N_TYPES; t++)
+                st->counters[l][t].evictions += sh->evictions[t];
+            pthread_mutex_unlock(&sh->lock);
+        }
+    }
+}

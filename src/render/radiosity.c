@@ -1,0 +1,321 @@
+/*
+ * render/radiosity.c — the multiresolution radiosity cache at diffuse-ray
+ * hits (memo sections 3.2 and 4.3).
+ *
+ * At a diffuse hit the resolution is chosen from the ray's footprint (the
+ * coarsest level whose micropolygon edge is at most k times the footprint,
+ * DESIGN.md), the entry for (patch, diffuse depth, side, RADIOSITY, level)
+ * is looked up, and on a miss filled by running prelighting and
+ * diffuselighting on every vertex of the grid at that level; the hit's value
+ * is interpolated: bilinear in the quad cell, barycentric in the triangle.
+ *
+ * Level layouts, per grid:
+ *   quad FINE    all nu x nv vertices, in vertex order;
+ *   quad MEDIUM  knots 0, 4, 8, ... and the last, in u and in v (memo Fig. 2);
+ *   quad COARSE  the 4 corners;
+ *   tri  FINE    all vertices of the n-subdivision lattice;
+ *   tri  MEDIUM  the lattice of m = ceil(n / 4) subdivisions, its points
+ *                interpolated on the fine grid (exact vertices when 4 | n);
+ *   tri  COARSE  the 3 corners.
+ * A MEDIUM layout with the same points as FINE or COARSE is aliased to that
+ * level (no duplicate entries).
+ *
+ * A fill's random numbers depend only on the key and the render seed, so an
+ * evicted entry refills to the same bytes and images do not depend on the
+ * cache size or on threads.
+ */
+#include "render/radiosity.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "util/check.h"
+#include "util/half.h"
+#include "util/rng.h"
+
+/* Knots of the medium level along a side of n fine vertices. */
+static int medium_knots(int n)
+{
+    return (n - 1 + 3) / 4 + 1; /* 0, 4, ..., and n - 1 */
+}
+
+static int medium_knot(int k, int n) /* fine index of knot k */
+{
+    return RY_MIN(4 * k, n - 1);
+}
+
+static int tri_medium_m(int n)
+{
+    return (n + 3) / 4;
+}
+
+/* The level actually stored for a requested one (aliasing MEDIUM). */
+static int effective_level(const Grid *g, int level)
+{
+    if (level != CACHE_MEDIUM)
+        return level;
+    if (g->triangular) {
+        int m = tri_medium_m(g->nu);
+        return m == g->nu ? CACHE_FINE : m == 1 ? CACHE_COARSE : CACHE_MEDIUM;
+    }
+    int mu = medium_knots(g->nu), mv = medium_knots(g->nv);
+    if (mu == g->nu && mv == g->nv)
+        return CACHE_FINE;
+    if (mu == 2 && mv == 2)
+        return CACHE_COARSE;
+    return CACHE_MEDIUM;
+}
+
+static size_t level_values(const Grid *g, int level)
+{
+    if (g->triangular) {
+        size_t n = level == CACHE_FINE ? g->nu : level == CACHE_MEDIUM ? tri_medium_m(g->nu) : 1;
+        return (n + 1) * (n + 2) / 2;
+    }
+    if (level == CACHE_FINE)
+        return (size_t)g->nu * g->nv;
+    if (level == CACHE_MEDIUM)
+        return (size_t)medium_knots(g->nu) * medium_knots(g->nv);
+    return 4;
+}
+
+/* Mean micropolygon edge of a level. */
+static float level_edge(const Grid *g, int level)
+{
+    if (level == CACHE_FINE)
+        return g->edge;
+    if (g->triangular) {
+        float n = g->nu;
+        return g->edge * (level == CACHE_MEDIUM ? n / (float)tri_medium_m(g->nu) : n);
+    }
+    float su = g->nu - 1, sv = g->nv - 1;
+    if (level == CACHE_COARSE)
+        return g->edge * 0.5f * (su + sv);
+    return g->edge * 0.5f * (su / (medium_knots(g->nu) - 1) + sv / (medium_knots(g->nv) - 1));
+}
+
+int radiosity_choose_level(const Grid *g, float footprint, float k, int forced)
+{
+    if (forced >= 0)
+        return effective_level(g, forced);
+    for (int level = CACHE_COARSE; level < CACHE_FINE; level++)
+        if (level_edge(g, level) <= k * footprint)
+            return effective_level(g, level);
+    return CACHE_FINE;
+}
+
+/* --------------------------------------------------------------- fills */
+
+typedef struct FillJob {
+    Worker *w;
+    uint32_t grid;
+} FillJob;
+
+/* Barycentric sample of a triangular fine grid at lattice coordinates
+ * (x, y), 0 <= x, y, x + y <= n: its three vertices and weights. */
+static void tri_cell(int n, float x, float y, int vi[3][2], float wt[3])
+{
+    int i = RY_MIN((int)floorf(x), n - 1), j = RY_MIN((int)floorf(y), n - 1);
+    i = RY_MAX(i, 0);
+    j = RY_MAX(j, 0);
+    if (i + j > n - 1) { /* on the last diagonal: step back into a cell */
+        if (i > 0)
+            i = n - 1 - j;
+        else
+            j = n - 1 - i;
+    }
+    float fx = x - (float)i, fy = y - (float)j;
+    if (fx + fy <= 1.0f || i + j + 1 > n - 1) {
+        int v[3][2] = {{i, j}, {i + 1, j}, {i, j + 1}};
+        float w[3] = {1.0f - fx - fy, fx, fy};
+        memcpy(vi, v, sizeof v);
+        memcpy(wt, w, sizeof w);
+    } else {
+        int v[3][2] = {{i + 1, j}, {i + 1, j + 1}, {i, j + 1}};
+        float w[3] = {1.0f - fy, fx + fy - 1.0f, 1.0f - fx};
+        memcpy(vi, v, sizeof v);
+        memcpy(wt, w, sizeof w);
+    }
+}
+
+typedef struct FillPoints {
+    float (*P)[3], (*N)[3], (*dPdu)[3], (*dPdv)[3], (*Cs)[3], (*Os)[3], (*Ci)[3], (*Oi)[3];
+    float *u, *v, *du, *dv, *curv;
+    uint64_t *keys;
+    RayDiff *diff;
+} FillPoints;
+
+/* Point p of the fill takes fine vertices vtx[0..n) with weights wt. */
+static void put_point(const GridSet *gs, const Grid *g, FillPoints *fp, size_t p,
+                      const uint32_t *vtx, const float *wt, int nv, int side)
+{
+    Vec3 P = v3(0, 0, 0), N = P, du = P, dv = P;
+    float u = 0.0f, v = 0.0f;
+    for (int k = 0; k < nv; k++) {
+        uint32_t i = g->first_vertex + vtx[k];
+        P = v3_madd(P, gs->P[i], wt[k]);
+        N = v3_madd(N, gs->N[i], wt[k]);
+        du = v3_madd(du, gs->dPdu[i], wt[k]);
+        dv = v3_madd(dv, gs->dPdv[i], wt[k]);
+        u += gs->uv[i][0] * wt[k];
+        v += gs->uv[i][1] * wt[k];
+    }
+    N = v3_normalize(N);
+    if (side)
+        N = v3_neg(N);
+    memcpy(fp->P[p], &P, sizeof fp->P[p]);
+    memcpy(fp->N[p], &N, sizeof fp->N[p]);
+    memcpy(fp->dPdu[p], &du, sizeof fp->dPdu[p]);
+    memcpy(fp->dPdv[p], &dv, sizeof fp->dPdv[p]);
+    fp->u[p] = u;
+    fp->v[p] = v;
+}
+
+/* Positions of the level's points on the fine grid. */
+static void layout_points(const GridSet *gs, const Grid *g, int level, int side, FillPoints *fp)
+{
+    size_t p = 0;
+    if (!g->triangular) {
+        int nu = g->nu, nv = g->nv;
+        int mu = level == CACHE_FINE ? nu : level == CACHE_MEDIUM ? medium_knots(nu) : 2;
+        int mv = level == CACHE_FINE ? nv : level == CACHE_MEDIUM ? medium_knots(nv) : 2;
+        for (int j = 0; j < mv; j++)
+            for (int i = 0; i < mu; i++) {
+                int fi = level == CACHE_FINE ? i : level == CACHE_MEDIUM ? medium_knot(i, nu) : i * (nu - 1);
+                int fj = level == CACHE_FINE ? j : level == CACHE_MEDIUM ? medium_knot(j, nv) : j * (nv - 1);
+                uint32_t vtx = (uint32_t)(fj * nu + fi);
+                float one = 1.0f;
+                put_point(gs, g, fp, p++, &vtx, &one, 1, side);
+            }
+        return;
+    }
+    int n = g->nu;
+    int m = level == CACHE_FINE ? n : level == CACHE_MEDIUM ? tri_medium_m(n) : 1;
+    for (int j = 0; j <= m; j++)
+        for (int i = 0; i + j <= m; i++) {
+            int vi[3][2];
+            float wt[3];
+            tri_cell(n, (float)i * n / m, (float)j * n / m, vi, wt);
+            uint32_t vtx[3];
+            for (int k = 0; k < 3; k++)
+                vtx[k] = geom_tri_vertex((uint32_t)n, (uint32_t)vi[k][0], (uint32_t)vi[k][1]);
+            put_point(gs, g, fp, p++, vtx, wt, 3, side);
+        }
+}
+
+/* CacheFillFn: shade every point of the level with diffuselighting. */
+static void fill_radiosity(void *user, const CacheKey *key, size_t n, float (*out)[3])
+{
+    FillJob *job = user;
+    Worker *w = job->w;
+    const GridSet *gs = w->rs->gs;
+    const Grid *g = &gs->grids[key->patch];
+    const RenderObject *obj = &w->rs->objects[g->object];
+    FillPoints fp;
+    float(*f3)[3] = malloc(n * 8 * sizeof *f3);
+    float *f1 = malloc(n * 5 * sizeof *f1);
+    fp.keys = malloc(n * sizeof *fp.keys);
+    fp.diff = malloc(n * sizeof *fp.diff);
+    RY_CHECK(f3 && f1 && fp.keys && fp.diff);
+    fp.P = f3, fp.N = f3 + n, fp.dPdu = f3 + 2 * n, fp.dPdv = f3 + 3 * n;
+    fp.Cs = f3 + 4 * n, fp.Os = f3 + 5 * n, fp.Ci = f3 + 6 * n, fp.Oi = f3 + 7 * n;
+    fp.u = f1, fp.v = f1 + n, fp.du = f1 + 2 * n, fp.dv = f1 + 3 * n, fp.curv = f1 + 4 * n;
+    layout_points(gs, g, key->level, key->side, &fp);
+    uint64_t fill_key = hash_combine(hash_combine(w->set->seed, 0x7261646f73ull /* "rados" */),
+                                     ((uint64_t)key->patch << 32) | ((uint64_t)key->depth << 16) |
+                                         ((uint64_t)key->side << 8) | key->level);
+    float width = level_edge(g, key->level);
+    for (size_t i = 0; i < n; i++) {
+        memcpy(fp.Cs[i], obj->Cs, sizeof fp.Cs[i]);
+        memcpy(fp.Os[i], obj->Os, sizeof fp.Os[i]);
+        fp.du[i] = fp.dv[i] = 0.0f;
+        fp.curv[i] = g->curvature;
+        fp.keys[i] = hash_combine(fill_key, i);
+        fp.diff[i] = (RayDiff){width, 0.0f};
+    }
+    PathState ps = {w, fp.keys, fp.diff, fp.curv};
+    RayesShadeCtx ctx = {
+        .n_points = n, .ray_type = RAYES_RAY_DIFFUSE, .diffuse_depth = key->depth,
+        .specular_depth = 0,
+        .P = (const float(*)[3])fp.P, .N = (const float(*)[3])fp.N,
+        .Ng = (const float(*)[3])fp.N, .dPdu = (const float(*)[3])fp.dPdu,
+        .dPdv = (const float(*)[3])fp.dPdv, .u = fp.u, .v = fp.v, .s = fp.u, .t = fp.v,
+        .du = fp.du, .dv = fp.dv, .I = NULL, .Cs = (const float(*)[3])fp.Cs,
+        .Os = (const float(*)[3])fp.Os, .renderer = &ps,
+    };
+    RayesShadeOutputs o = {fp.Ci, fp.Oi, NULL};
+    w->stats.shading_points[RY_MIN(key->depth, RENDER_MAX_DEPTH)] += n;
+    shade_run_diffuselighting(&render_services, &ctx, obj->shader, &o);
+    memcpy(out, fp.Ci, n * sizeof *out);
+    free(f3);
+    free(f1);
+    free(fp.keys);
+    free(fp.diff);
+}
+
+/* -------------------------------------------------------- interpolation */
+
+static Vec3 value(const uint16_t *vals, size_t i)
+{
+    return v3(half_to_float(vals[3 * i]), half_to_float(vals[3 * i + 1]),
+              half_to_float(vals[3 * i + 2]));
+}
+
+/* Bilinear at (x, y) in knot-grid coordinates of an mu x mv lattice. */
+static Vec3 bilinear(const uint16_t *vals, int mu, int mv, float x, float y)
+{
+    int i = RY_MAX(RY_MIN((int)x, mu - 2), 0), j = RY_MAX(RY_MIN((int)y, mv - 2), 0);
+    float fx = fminf(fmaxf(x - i, 0.0f), 1.0f), fy = fminf(fmaxf(y - j, 0.0f), 1.0f);
+    Vec3 a = v3_lerp(value(vals, (size_t)j * mu + i), value(vals, (size_t)j * mu + i + 1), fx);
+    Vec3 b = v3_lerp(value(vals, (size_t)(j + 1) * mu + i),
+                     value(vals, (size_t)(j + 1) * mu + i + 1), fx);
+    return v3_lerp(a, b, fy);
+}
+
+/* Knot-grid coordinate of fine index position x along n vertices. */
+static float medium_coord(float x, int n)
+{
+    int m = medium_knots(n);
+    int k = RY_MIN((int)(x / 4.0f), m - 2);
+    int a = medium_knot(k, n), b = medium_knot(k + 1, n);
+    return (float)k + (x - (float)a) / (float)(b - a);
+}
+
+Vec3 radiosity_interpolate(const Grid *g, const Hit *hit, int level, const uint16_t *vals)
+{
+    if (!g->triangular) {
+        float x = hit->gu * (g->nu - 1), y = hit->gv * (g->nv - 1);
+        if (level == CACHE_FINE)
+            return bilinear(vals, g->nu, g->nv, x, y);
+        if (level == CACHE_COARSE)
+            return bilinear(vals, 2, 2, hit->gu, hit->gv);
+        return bilinear(vals, medium_knots(g->nu), medium_knots(g->nv),
+                        medium_coord(x, g->nu), medium_coord(y, g->nv));
+    }
+    int n = g->nu;
+    int m = level == CACHE_FINE ? n : level == CACHE_MEDIUM ? tri_medium_m(n) : 1;
+    int vi[3][2];
+    float wt[3];
+    tri_cell(m, hit->gu * m, hit->gv * m, vi, wt);
+    Vec3 r = v3(0, 0, 0);
+    for (int k = 0; k < 3; k++)
+        r = v3_madd(r, value(vals, geom_tri_vertex((uint32_t)m, (uint32_t)vi[k][0],
+                                                   (uint32_t)vi[k][1])),
+                    wt[k]);
+    return r;
+}
+
+Vec3 radiosity_at_hit(Worker *w, const Ray *ray, const Hit *hit, int diffuse_depth, RayDiff diff)
+{
+    const Grid *g = &w->rs->gs->grids[hit->grid];
+    float footprint = diff.width + diff.spread * hit->t;
+    int level = radiosity_choose_level(g, footprint, w->set->cache_k, w->set->cache_resolution);
+    int side = v3_dot(hit->Ng, ray->d) < 0.0f ? 0 : 1;
+    CacheKey key = {.patch = hit->grid, .depth = (uint16_t)diffuse_depth, .segment = 0,
+                    .side = (uint8_t)side, .type = CACHE_RADIOSITY, .level = (uint8_t)level};
+    FillJob job = {w, hit->grid};
+    const uint16_t *vals =
+        cache_lookup(&w->cache, &key, level_values(g, level), fill_radiosity, &job);
+    return radiosity_interpolate(g, hit, level, vals);
+}

@@ -1,0 +1,22 @@
+/*
+ * render/radiosity.h — private to render/: the radiosity cache at diffuse
+ * hits (radiosity.c).
+ */
+#ifndef RAYES_RENDER_RADIOSITY_H
+#define RAYES_RENDER_RADIOSITY_H
+
+#include "render/integrator.h"
+
+/* The cache level for a hit on grid g with the given ray footprint: the
+ * coarsest whose micropolygon edge is at most k * footprint, or `forced`
+ * (>= 0), after aliasing a MEDIUM level that equals FINE or COARSE. */
+int radiosity_choose_level(const Grid *g, float footprint, float k, int forced);
+
+/* The cached radiosity leaving the hit toward the ray (filling the entry on
+ * a miss). */
+Vec3 radiosity_at_hit(Worker *w, const Ray *ray, const Hit *hit, int diffuse_depth, RayDiff diff);
+
+/* Interpolates a level's values at a hit. */
+Vec3 radiosity_interpolate(const Grid *g, const Hit *hit, int level, const uint16_t *values);
+
+#endif /* RAYES_RENDER_RADIOSITY_H */
