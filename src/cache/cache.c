@@ -67,6 +67,8 @@ struct Cache {
     CacheCounters counters[CACHE_N_LEVELS][CACHE_N_TYPES];
 };
 
+const int cache_local_slots[CACHE_N_LEVELS] = {256, 64, 16}; /* powers of two */
+
 /* Nominal values per entry, for sizing hash tables (memo Figure 2 sizes). */
 static const size_t nominal_values[CACHE_N_LEVELS] = {4, 25, 289};
 
@@ -237,7 +239,7 @@ void cache_local_fini(CacheLocal *local)
 {
     Cache *c = local->cache;
     for (int l = 0; l < CACHE_N_LEVELS; l++)
-        for (int i = 0; i < CACHE_LOCAL_SLOTS; i++)
+        for (int i = 0; i < cache_local_slots[l]; i++)
             if (local->slots[l][i]) {
                 release(c, local->slots[l][i]);
                 local->slots[l][i] = NULL;
@@ -337,7 +339,7 @@ const uint16_t *cache_lookup(CacheLocal *local, const CacheKey *key, size_t n_va
     Cache *c = local->cache;
     uint64_t hash = key_hash(key);
     CacheCounters *ctr = &local->counters[key->level][key->type];
-    CacheEntry **slot = &local->slots[key->level][hash % CACHE_LOCAL_SLOTS];
+    CacheEntry **slot = &local->slots[key->level][hash & (uint64_t)(cache_local_slots[key->level] - 1)];
     ctr->lookups++;
     CacheEntry *held = *slot;
     if (held && held->hash == hash && key_equal(&held->key, key) &&

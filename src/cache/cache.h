@@ -91,8 +91,12 @@ void cache_free(Cache *cache);
 uint64_t cache_timestamp(const Cache *cache);
 uint64_t cache_bump_timestamp(Cache *cache);
 
-/* A thread's local part. CACHE_LOCAL_SLOTS entries per level may be held. */
-#define CACHE_LOCAL_SLOTS 32
+/* A thread's local part: a direct-mapped table of held entries per level,
+ * largest for COARSE, whose lookups are the least coherent and whose entries
+ * are the smallest (cache_local_slots[level] slots; at most
+ * CACHE_LOCAL_SLOTS). */
+#define CACHE_LOCAL_SLOTS 256
+extern const int cache_local_slots[CACHE_N_LEVELS];
 
 typedef struct CacheLocal {
     Cache *cache;

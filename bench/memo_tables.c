@@ -1,0 +1,314 @@
+/*
+ * bench/memo_tables.c — the memo's Table 1 and Table 4 on cornell-teapots,
+ * measured in one run so that ratios are taken on one machine state.
+ *
+ *   memo_tables table1 [--size N] [--spp N] [--bounces-max B] [--accuracy-spp N]
+ *                      [--accuracy-size N] [--out DIR] [--data DIR] [--threads N]
+ *   memo_tables table4 [...same...] [--budgets MB,MB,...]
+ *
+ * table1: preview quality, bounces 1..B (default 3), caching off and on:
+ * shading points, rays, time, speed-up and hit rates per resolution.
+ * table4: one bounce at cache budgets 0 (off), 1, 4, 16, 64, 256 MB.
+ * Both then measure bias: the same rows at --accuracy-spp pixel samples
+ * (default 64) and --accuracy-size pixels (default: half of --size), the
+ * relative difference of the cached and uncached image means and the
+ * largest relative difference of their 32 x 32 tile means. Images (PNG) and
+ * a JSON record of every row go to --out (default bench-out/).
+ */
+#include <errno.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+
+#include "io/builtin.h"
+#include "io/image.h"
+#include "rayes/rayes.h"
+
+typedef struct Args {
+    const char *mode, *data, *out;
+    int size, spp, bounces_max, accuracy_spp, accuracy_size, threads;
+    double budgets[16];
+    int n_budgets;
+} Args;
+
+typedef struct Row {
+    int bounces, cache;
+    double budget_mb;
+    double time_s;
+    unsigned long long shading_points, rays, shadow, diffuse;
+    double hit[3];
+    float *rgba;
+    int w, h;
+} Row;
+
+static void die(const char *msg)
+{
+    fprintf(stderr, "memo_tables: %s\n", msg);
+    exit(1);
+}
+
+static const RayesStat *find(const RayesStats *s, const char *name)
+{
+    return rayes_stats_find(s, name);
+}
+
+static Row run(const Args *a, int size, int spp, int bounces, int cache, double budget_mb)
+{
+    RayesScene *scene = rayes_scene_new();
+    char err[1024];
+    if (!scene || io_builtin_scene("cornell-teapots", a->data, scene, err, sizeof err) != RAYES_OK)
+        die(err);
+    RayesRenderOptions o;
+    rayes_render_options_init(&o, RAYES_QUALITY_PREVIEW);
+    o.width = o.height = size;
+    o.spp = spp;
+    o.bounces = bounces;
+    o.threads = a->threads;
+    o.cache = cache;
+    o.cache_mb = budget_mb;
+    RayesImage *img;
+    RayesStats *st;
+    if (rayes_render(scene, &o, &img, &st) != RAYES_OK)
+        die(rayes_scene_get_error(scene));
+    Row r = {.bounces = bounces, .cache = cache, .budget_mb = budget_mb};
+    r.time_s = find(st, "time/total_s")->real;
+    r.shading_points = find(st, "shading_points/total")->count;
+    r.rays = find(st, "rays/total")->count;
+    r.shadow = find(st, "rays/shadow")->count;
+    r.diffuse = find(st, "rays/diffuse")->count;
+    static const char *const hr[3] = {"cache/coarse/hit_rate", "cache/medium/hit_rate",
+                                      "cache/fine/hit_rate"};
+    for (int l = 0; l < 3; l++)
+        r.hit[l] = cache ? find(st, hr[l])->real : 0.0;
+    r.rgba = img->rgba;
+    r.w = img->width;
+    r.h = img->height;
+    img->rgba = NULL;
+    rayes_image_free(img);
+    rayes_stats_free(st);
+    rayes_scene_release(scene);
+    return r;
+}
+
+static void save(const Args *a, const Row *r, const char *tag)
+{
+    char path[1024], err[1024];
+    snprintf(path, sizeof path, "%s/%s-b%d-%s.png", a->out, tag, r->bounces,
+             r->cache ? "cached" : "uncached");
+    if (io_write_image(path, r->w, r->h, r->rgba, err, sizeof err) != RAYES_OK)
+        die(err);
+}
+
+static void human(char *buf, size_t n, double v)
+{
+    if (v >= 1e9)
+        snprintf(buf, n, "%.2fB", v / 1e9);
+    else if (v >= 1e6)
+        snprintf(buf, n, "%.2fM", v / 1e6);
+    else if (v >= 1e3)
+        snprintf(buf, n, "%.1fk", v / 1e3);
+    else
+        snprintf(buf, n, "%.0f", v);
+}
+
+/* Mean of the RGB average over a region. */
+static double region_mean(const Row *r, int x0, int y0, int w, int h)
+{
+    double s = 0.0;
+    for (int y = y0; y < y0 + h; y++)
+        for (int x = x0; x < x0 + w; x++) {
+            const float *p = &r->rgba[4 * ((size_t)y * r->w + x)];
+            s += (p[0] + p[1] + p[2]) / 3.0;
+        }
+    return s / ((double)w * h);
+}
+
+/* Relative difference of the means, and the largest over 32 x 32 tiles. */
+static void accuracy(const Row *on, const Row *off, double *mean_rel, double *tile_rel)
+{
+    double m_on = region_mean(on, 0, 0, on->w, on->h), m_off = region_mean(off, 0, 0, off->w, off->h);
+    *mean_rel = fabs(m_on - m_off) / m_off;
+    *tile_rel = 0.0;
+    for (int ty = 0; ty + 32 <= on->h; ty += 32)
+        for (int tx = 0; tx + 32 <= on->w; tx += 32) {
+            double a = region_mean(on, tx, ty, 32, 32), b = region_mean(off, tx, ty, 32, 32);
+            if (b > 1e-4) /* tiles of pure black (the open front) have no relative error */
+                *tile_rel = fmax(*tile_rel, fabs(a - b) / b);
+        }
+}
+
+static void parse(int argc, char **argv, Args *a)
+{
+    a->mode = argc > 1 ? argv[1] : "";
+    a->out = "bench-out";
+    a->size = 512;
+    a->spp = 4;
+    a->bounces_max = 3;
+    a->accuracy_spp = 64;
+    a->threads = 0;
+    const double budgets[] = {0, 1, 4, 16, 64, 256};
+    a->n_budgets = 6;
+    memcpy(a->budgets, budgets, sizeof budgets);
+    for (int i = 2; i + 1 < argc; i += 2) {
+        const char *o = argv[i], *v = argv[i + 1];
+        if (strcmp(o, "--size") == 0)
+            a->size = atoi(v);
+        else if (strcmp(o, "--spp") == 0)
+            a->spp = atoi(v);
+        else if (strcmp(o, "--bounces-max") == 0)
+            a->bounces_max = atoi(v);
+        else if (strcmp(o, "--accuracy-spp") == 0)
+            a->accuracy_spp = atoi(v);
+        else if (strcmp(o, "--accuracy-size") == 0)
+            a->accuracy_size = atoi(v);
+        else if (strcmp(o, "--threads") == 0)
+            a->threads = atoi(v);
+        else if (strcmp(o, "--data") == 0)
+            a->data = v;
+        else if (strcmp(o, "--out") == 0)
+            a->out = v;
+        else if (strcmp(o, "--budgets") == 0) {
+            a->n_budgets = 0;
+            for (char *s = (char *)v; *s && a->n_budgets < 16; s += strcspn(s, ",") + (s[strcspn(s, ",")] != 0))
+                a->budgets[a->n_budgets++] = atof(s);
+        } else
+            die("unknown option (see the comment at the top of bench/memo_tables.c)");
+    }
+    if (a->accuracy_size == 0)
+        a->accuracy_size = a->size / 2;
+    if ((strcmp(a->mode, "table1") && strcmp(a->mode, "table4")) || a->size < 32 || a->spp < 1)
+        die("usage: memo_tables table1|table4 [--size N] [--spp N] ...");
+    if (mkdir(a->out, 0777) != 0 && errno != EEXIST)
+        die("cannot create the output directory");
+}
+
+static void json_row(FILE *j, const Row *r, int first)
+{
+    fprintf(j,
+            "%s\n    {\"bounces\": %d, \"cache\": %d, \"budget_mb\": %g, \"time_s\": %.3f, "
+            "\"shading_points\": %llu, \"rays\": %llu, \"shadow_rays\": %llu, "
+            "\"diffuse_rays\": %llu, \"hit_rate\": {\"coarse\": %.5f, \"medium\": %.5f, "
+            "\"fine\": %.5f}}",
+            first ? "" : ",", r->bounces, r->cache, r->budget_mb, r->time_s, r->shading_points,
+            r->rays, r->shadow, r->diffuse, r->hit[0], r->hit[1], r->hit[2]);
+}
+
+static void table1(const Args *a, FILE *j)
+{
+    printf("Table 1 (cornell-teapots, preview: 4 shadow + 4 diffuse rays, %dx%d, %d spp)\n",
+           a->size, a->size, a->spp);
+    printf("%-3s | %9s %9s %8s | %9s %9s %8s | %8s | %s\n", "b", "sh.pts", "rays", "time",
+           "sh.pts", "rays", "time", "speed-up", "hit % coarse/medium/fine");
+    fprintf(j, "{\"table\": 1, \"size\": %d, \"spp\": %d, \"rows\": [", a->size, a->spp);
+    double t1_on = 0.0;
+    for (int b = 1; b <= a->bounces_max; b++) {
+        Row off = run(a, a->size, a->spp, b, 0, 100), on = run(a, a->size, a->spp, b, 1, 100);
+        char s1[32], s2[32], s3[32], s4[32];
+        human(s1, sizeof s1, off.shading_points);
+        human(s2, sizeof s2, off.rays);
+        human(s3, sizeof s3, on.shading_points);
+        human(s4, sizeof s4, on.rays);
+        printf("%-3d | %9s %9s %7.2fs | %9s %9s %7.2fs | %8.2f | %.2f / %.2f / %.2f\n", b, s1, s2,
+               off.time_s, s3, s4, on.time_s, off.time_s / on.time_s, 100 * on.hit[0],
+               100 * on.hit[1], 100 * on.hit[2]);
+        fflush(stdout);
+        if (b == 1)
+            t1_on = on.time_s;
+        else
+            printf("    cached time %d bounces / 1 bounce: %.2f\n", b, on.time_s / t1_on);
+        json_row(j, &off, b == 1);
+        json_row(j, &on, 0);
+        save(a, &off, "table1");
+        save(a, &on, "table1");
+        free(off.rgba);
+        free(on.rgba);
+    }
+    fprintf(j, "\n  ]");
+}
+
+static void table4(const Args *a, FILE *j)
+{
+    printf("Table 4 (cornell-teapots, 1 bounce, preview, %dx%d, %d spp)\n", a->size, a->size,
+           a->spp);
+    printf("%-9s | %6s %6s %6s | %9s %9s %8s\n", "cache", "coarse", "medium", "fine", "sh.pts",
+           "rays", "time");
+    fprintf(j, "{\"table\": 4, \"size\": %d, \"spp\": %d, \"rows\": [", a->size, a->spp);
+    for (int i = 0; i < a->n_budgets; i++) {
+        double mb = a->budgets[i];
+        Row r = run(a, a->size, a->spp, 1, mb > 0.0, mb);
+        char s1[32], s2[32];
+        human(s1, sizeof s1, r.shading_points);
+        human(s2, sizeof s2, r.rays);
+        printf("%6g MB | %6.2f %6.2f %6.2f | %9s %9s %7.2fs\n", mb, 100 * r.hit[0],
+               100 * r.hit[1], 100 * r.hit[2], s1, s2, r.time_s);
+        fflush(stdout);
+        json_row(j, &r, i == 0);
+        free(r.rgba);
+    }
+    fprintf(j, "\n  ]");
+}
+
+/* Bias of caching at each bounce count (table1) or budget (table4). */
+static void bias(const Args *a, FILE *j)
+{
+    printf("Accuracy (%dx%d, %d spp): cached vs uncached image\n", a->accuracy_size,
+           a->accuracy_size, a->accuracy_spp);
+    printf("%-12s | %16s | %22s\n", "row", "mean rel. diff", "max 32x32 tile rel. diff");
+    fprintf(j, ",\n  \"accuracy\": {\"size\": %d, \"spp\": %d, \"rows\": [", a->accuracy_size,
+            a->accuracy_spp);
+    int rows = strcmp(a->mode, "table1") == 0 ? a->bounces_max : a->n_budgets;
+    int first = 1;
+    Row off = {0};
+    for (int i = 0; i < rows; i++) {
+        int b = strcmp(a->mode, "table1") == 0 ? i + 1 : 1;
+        double mb = strcmp(a->mode, "table1") == 0 ? 100.0 : a->budgets[i];
+        if (mb <= 0.0)
+            continue;
+        if (!off.rgba || off.bounces != b) {
+            free(off.rgba);
+            off = run(a, a->accuracy_size, a->accuracy_spp, b, 0, 100);
+            save(a, &off, "accuracy");
+        }
+        Row on = run(a, a->accuracy_size, a->accuracy_spp, b, 1, mb);
+        save(a, &on, "accuracy");
+        double mrel, trel;
+        accuracy(&on, &off, &mrel, &trel);
+        char label[32];
+        snprintf(label, sizeof label, "b=%d %gMB", b, mb);
+        printf("%-12s | %15.3f%% | %21.3f%%\n", label, 100 * mrel, 100 * trel);
+        fflush(stdout);
+        fprintf(j, "%s\n    {\"bounces\": %d, \"budget_mb\": %g, \"mean_rel\": %.6f, "
+                   "\"max_tile_rel\": %.6f}",
+                first ? "" : ",", b, mb, mrel, trel);
+        first = 0;
+        free(on.rgba);
+    }
+    free(off.rgba);
+    fprintf(j, "\n  ]}\n}\n");
+}
+
+int main(int argc, char **argv)
+{
+    Args a = {0};
+    parse(argc, argv, &a);
+    if (!a.data)
+        a.data = getenv("RAYES_DATA");
+    char path[1024];
+    snprintf(path, sizeof path, "%s/%s.json", a.out, a.mode);
+    FILE *j = fopen(path, "w");
+    if (!j)
+        die("cannot write the JSON record");
+    if (strcmp(a.mode, "table1") == 0)
+        table1(&a, j);
+    else
+        table4(&a, j);
+    if (a.accuracy_spp > 0)
+        bias(&a, j);
+    else
+        fprintf(j, "\n}\n");
+    fclose(j);
+    printf("wrote %s and the images beside it\n", path);
+    return 0;
+}
