@@ -2,12 +2,13 @@
 #   make          build (Release) into build/, the program at build/rayes
 #   make render   install what is missing, build, render the default scene to out/
 #   make test     install what is missing, build, run every test (Release, then
-#                 AddressSanitizer + UndefinedBehaviorSanitizer)
+#                 AddressSanitizer + UndefinedBehaviorSanitizer, then the threaded
+#                 tests under ThreadSanitizer)
 #   make bench    build the benchmarks
 #   make format   clang-format the sources
 JOBS ?= $(shell nproc)
 
-.PHONY: all build render test test-release test-asan deps deps-test bench format clean
+.PHONY: all build render test test-release test-asan test-tsan deps deps-test bench format clean
 
 all: build
 
@@ -25,7 +26,7 @@ render: deps build
 	mkdir -p out
 	build/rayes render cornell -o out/default.exr -o out/default.png
 
-test: deps-test test-release test-asan
+test: deps-test test-release test-asan test-tsan
 
 test-release: build
 	cd build && ctest --output-on-failure -j $(JOBS)
@@ -34,6 +35,15 @@ test-asan:
 	@test -f build-asan/CMakeCache.txt || cmake -S . -B build-asan -DCMAKE_BUILD_TYPE=Debug -DRAYES_SANITIZE=ON
 	cmake --build build-asan -j $(JOBS)
 	cd build-asan && ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 ctest --output-on-failure -j $(JOBS)
+
+# ThreadSanitizer on the threaded code of our own: the cache (its stress
+# test hammers a tiny budget from many threads) and the renderer's thread
+# pool. Embree and TBB are not instrumented, so renders are left to ASan.
+TSAN_TESTS = cache_test_cache cache_test_cache_stress util_test_math util_test_half
+test-tsan:
+	@test -f build-tsan/CMakeCache.txt || cmake -S . -B build-tsan -DCMAKE_BUILD_TYPE=RelWithDebInfo -DRAYES_TSAN=ON
+	cmake --build build-tsan -j $(JOBS) --target $(TSAN_TESTS)
+	cd build-tsan && TSAN_OPTIONS=halt_on_error=1 ctest --output-on-failure -R '^(cache|util)/'
 
 bench: build
 

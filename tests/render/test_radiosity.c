@@ -1,0 +1,159 @@
+/*
+ * The radiosity cache in the renderer (render/): interpolation reproduces a
+ * linear function exactly at every resolution, for quad grids of every size
+ * and triangular grids of every subdivision; levels alias as documented;
+ * images do not depend on the cache budget (evicted entries refill to the
+ * same bytes) nor on threads.
+ */
+#include <string.h>
+
+#include "io/builtin.h"
+#include "rayes/rayes.h"
+#include "render/radiosity.h"
+#include "test.h"
+#include "util/half.h"
+
+static float linear(float gu, float gv)
+{
+    return 2.0f + 3.0f * gu - 1.5f * gv;
+}
+
+static int knots(int n)
+{
+    return (n - 1 + 3) / 4 + 1;
+}
+
+static int knot(int k, int n)
+{
+    return 4 * k < n - 1 ? 4 * k : n - 1;
+}
+
+/* The documented layouts (radiosity.c): values of the linear function. */
+static size_t quad_values(const Grid *g, int level, uint16_t *v)
+{
+    int mu = level == CACHE_FINE ? g->nu : level == CACHE_MEDIUM ? knots(g->nu) : 2;
+    int mv = level == CACHE_FINE ? g->nv : level == CACHE_MEDIUM ? knots(g->nv) : 2;
+    size_t n = 0;
+    for (int j = 0; j < mv; j++)
+        for (int i = 0; i < mu; i++) {
+            int fi = level == CACHE_FINE ? i : level == CACHE_MEDIUM ? knot(i, g->nu) : i * (g->nu - 1);
+            int fj = level == CACHE_FINE ? j : level == CACHE_MEDIUM ? knot(j, g->nv) : j * (g->nv - 1);
+            float f = linear((float)fi / (g->nu - 1), (float)fj / (g->nv - 1));
+            for (int c = 0; c < 3; c++)
+                v[3 * n + c] = half_from_float(f);
+            n++;
+        }
+    return n;
+}
+
+static size_t tri_values(const Grid *g, int level, uint16_t *v)
+{
+    int m = level == CACHE_FINE ? g->nu : level == CACHE_MEDIUM ? (g->nu + 3) / 4 : 1;
+    size_t n = 0;
+    for (int j = 0; j <= m; j++)
+        for (int i = 0; i + j <= m; i++) {
+            float f = linear((float)i / m, (float)j / m);
+            for (int c = 0; c < 3; c++)
+                v[3 * n + c] = half_from_float(f);
+            n++;
+        }
+    return n;
+}
+
+static void test_interpolation_is_exact_for_linear_functions(void)
+{
+    static uint16_t vals[3 * 17 * 17];
+    int worst_level_checks = 0;
+    for (int tri = 0; tri < 2; tri++)
+        for (int nu = tri ? 1 : 2; nu <= (tri ? 16 : 17); nu++)
+            for (int nv = tri ? 0 : 2; nv <= (tri ? 0 : 17); nv++) {
+                Grid g = {.nu = (uint16_t)nu, .nv = (uint16_t)nv, .triangular = (uint8_t)tri,
+                          .edge = 1.0f};
+                for (int requested = 0; requested < 3; requested++) {
+                    int level = radiosity_choose_level(&g, 0.0f, 1.0f, requested);
+                    if (tri)
+                        tri_values(&g, level, vals);
+                    else
+                        quad_values(&g, level, vals);
+                    for (int s = 0; s < 25; s++) {
+                        float a = (float)(s % 5) / 4.0f * 0.999f, b = (float)(s / 5) / 4.0f * 0.999f;
+                        if (tri && a + b > 1.0f) {
+                            a = 1.0f - a;
+                            b = 1.0f - b;
+                        }
+                        Hit h = {.gu = a, .gv = b};
+                        Vec3 r = radiosity_interpolate(&g, &h, level, vals);
+                        /* Half precision at values around 2..5: 2^-9 relative. */
+                        CHECK_NEAR(r.x, linear(a, b), 5e-3);
+                        worst_level_checks++;
+                    }
+                }
+            }
+    CHECK(worst_level_checks > 1000);
+}
+
+static void test_medium_aliasing(void)
+{
+    Grid small = {.nu = 5, .nv = 5, .edge = 1.0f};  /* knots 0, 4: the corners */
+    Grid two = {.nu = 2, .nv = 2, .edge = 1.0f};    /* knots are every vertex */
+    Grid big = {.nu = 17, .nv = 12, .edge = 1.0f};
+    CHECK(radiosity_choose_level(&small, 0.0f, 1.0f, CACHE_MEDIUM) == CACHE_COARSE);
+    CHECK(radiosity_choose_level(&two, 0.0f, 1.0f, CACHE_MEDIUM) == CACHE_FINE);
+    CHECK(radiosity_choose_level(&big, 0.0f, 1.0f, CACHE_MEDIUM) == CACHE_MEDIUM);
+}
+
+/* The coarsest level whose micropolygon edge is at most k x footprint. */
+static void test_level_choice(void)
+{
+    Grid g = {.nu = 17, .nv = 17, .edge = 1.0f}; /* edges: fine 1, medium 4, coarse 16 */
+    CHECK(radiosity_choose_level(&g, 0.5f, 1.0f, -1) == CACHE_FINE);
+    CHECK(radiosity_choose_level(&g, 1.0f, 1.0f, -1) == CACHE_FINE);
+    CHECK(radiosity_choose_level(&g, 4.0f, 1.0f, -1) == CACHE_MEDIUM);
+    CHECK(radiosity_choose_level(&g, 15.9f, 1.0f, -1) == CACHE_MEDIUM);
+    CHECK(radiosity_choose_level(&g, 16.0f, 1.0f, -1) == CACHE_COARSE);
+    CHECK(radiosity_choose_level(&g, 8.0f, 2.0f, -1) == CACHE_COARSE); /* k scales the rule */
+}
+
+static RayesImage *render(double cache_mb, int threads, int cache)
+{
+    RayesScene *s = rayes_scene_new();
+    char err[512];
+    CHECK(io_builtin_scene("cornell-teapots", RAYES_TEST_DATA, s, err, sizeof err) == RAYES_OK);
+    RayesRenderOptions o;
+    rayes_render_options_init(&o, RAYES_QUALITY_PREVIEW);
+    o.width = o.height = 40;
+    o.spp = 1;
+    o.bounces = 2;
+    o.threads = threads;
+    o.cache = cache;
+    o.cache_mb = cache_mb;
+    RayesImage *img = NULL;
+    CHECK(rayes_render(s, &o, &img, NULL) == RAYES_OK);
+    rayes_scene_release(s);
+    return img;
+}
+
+static int same(const RayesImage *a, const RayesImage *b)
+{
+    return a && b && memcmp(a->rgba, b->rgba, sizeof(float) * 4 * (size_t)a->width * a->height) == 0;
+}
+
+/* 100 MB holds everything; 0.05 MB evicts constantly; 0 fills privately. */
+static void test_same_bytes_for_any_budget_and_threads(void)
+{
+    RayesImage *ref = render(100, 1, 1);
+    const double budgets[] = {0.05, 0.0, 100};
+    const int threads[] = {2, 3, 4};
+    for (int i = 0; i < 3; i++) {
+        RayesImage *img = render(budgets[i], threads[i], 1);
+        CHECK(same(ref, img));
+        rayes_image_free(img);
+    }
+    RayesImage *off = render(100, 2, 0);
+    CHECK(!same(ref, off)); /* caching changes the estimate (it is biased) */
+    rayes_image_free(off);
+    rayes_image_free(ref);
+}
+
+TEST_MAIN(TEST(test_interpolation_is_exact_for_linear_functions), TEST(test_medium_aliasing),
+          TEST(test_level_choice), TEST(test_same_bytes_for_any_budget_and_threads))
