@@ -336,6 +336,23 @@ static void summary(const Args *a, const RayesStats *s)
            (double)stat_count(s, "memory/peak_rss_bytes") / 1e6);
 }
 
+/* Fails early, before a long render, when an output's directory cannot be
+ * written. */
+static int check_output_dir(const char *path)
+{
+    char dir[4096];
+    const char *slash = strrchr(path, '/');
+    if (!slash)
+        snprintf(dir, sizeof dir, ".");
+    else
+        snprintf(dir, sizeof dir, "%.*s", slash == path ? 1 : (int)(slash - path), path);
+    if (access(dir, W_OK) == 0)
+        return 0;
+    fprintf(stderr, "rayes: %s: cannot write: directory %s %s\n", path, dir,
+            errno == ENOENT ? "does not exist" : "is not writable");
+    return -1;
+}
+
 static int cmd_render(int argc, char **argv)
 {
     Args a = {0};
@@ -345,6 +362,11 @@ static int cmd_render(int argc, char **argv)
         snprintf(default_out, sizeof default_out, "%s.exr", a.scene);
         a.outputs[a.n_outputs++] = default_out;
     }
+    for (int i = 0; i < a.n_outputs; i++)
+        if (check_output_dir(a.outputs[i]) != 0)
+            return 1;
+    if (a.stats_path && check_output_dir(a.stats_path) != 0)
+        return 1;
     RayesScene *scene = rayes_scene_new();
     char err[1024];
     if (!scene) {
@@ -369,18 +391,24 @@ static int cmd_render(int argc, char **argv)
         rayes_scene_release(scene);
         return e == RAYES_ERROR_CANCELLED ? 130 : 1;
     }
-    int status = 0;
-    for (int i = 0; i < a.n_outputs && status == 0; i++)
-        if (io_write_image(a.outputs[i], img->width, img->height, img->rgba, err, sizeof err) !=
-            RAYES_OK) {
+    int status = 0, written = 0; /* outputs written whole */
+    while (written < a.n_outputs && status == 0) {
+        if (io_write_image(a.outputs[written], img->width, img->height, img->rgba, err,
+                           sizeof err) == RAYES_OK) {
+            written++;
+        } else {
             fprintf(stderr, "rayes: %s\n", err);
             status = 1;
         }
+    }
     if (status == 0 && a.stats_path &&
         io_stats_json_save(a.stats_path, stats, a.scene, err, sizeof err) != RAYES_OK) {
         fprintf(stderr, "rayes: %s\n", err);
         status = 1;
     }
+    /* A failed run leaves none of its outputs behind. */
+    for (int i = 0; status != 0 && i < written; i++)
+        unlink(a.outputs[i]);
     if (status == 0 && !a.quiet) {
         summary(&a, stats);
         for (int i = 0; i < a.n_outputs; i++)

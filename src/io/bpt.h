@@ -12,8 +12,10 @@
 #include "rayes/rayes.h"
 
 /* Reads the file and adds its patches to the scene (with the scene's
- * current transform and shader). On error returns nonzero, adds nothing,
- * and fills err with one line "file:line: what was expected". */
+ * current transform and shader). On a malformed file returns nonzero, adds
+ * nothing, and fills err with one line "file:line:col: what was expected"
+ * ("file:line:" for an index checked after reading). Running out of memory
+ * while adding patches may leave the ones already added. */
 RayesError io_read_bpt(const char *path, RayesScene *scene, char *err, size_t err_size);
 
 /* The same from a buffer (for tests and fuzzing); name is used in errors. */

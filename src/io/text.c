@@ -79,7 +79,12 @@ static int describe_token(TextReader *r, const char *tok, size_t n, const char *
 {
     if (n == 0)
         return text_error(r, "expected %s, found the end of the file", what);
-    return text_error(r, "expected %s, found \"%.20s%s\"", what, tok, n > 20 ? "..." : "");
+    char shown[24]; /* printable ASCII only: errors are one clean line */
+    size_t k = 0;
+    for (; k < 20 && tok[k]; k++)
+        shown[k] = tok[k] >= 0x20 && tok[k] < 0x7f && tok[k] != '"' ? tok[k] : '?';
+    shown[k] = '\0';
+    return text_error(r, "expected %s, found \"%s%s\"", what, shown, n > 20 ? "..." : "");
 }
 
 int text_long(TextReader *r, long *out, long lo, long hi, const char *what)

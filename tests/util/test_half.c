@@ -6,6 +6,10 @@
 #include "test.h"
 #include "util/half.h"
 
+/* GCC has _Float16 on x86-64; clang 14 does not: then only the known values
+ * and the half -> float -> half round trip are checked. */
+#if defined(__FLT16_MAX__)
+#define HAVE_FLOAT16 1
 static uint16_t ref_half(float f)
 {
     _Float16 h = (_Float16)f;
@@ -13,6 +17,8 @@ static uint16_t ref_half(float f)
     memcpy(&u, &h, sizeof u);
     return u;
 }
+
+#endif
 
 static void test_known_values(void)
 {
@@ -33,6 +39,7 @@ static void test_known_values(void)
 
 static void test_matches_float16_everywhere(void)
 {
+#ifdef HAVE_FLOAT16
     int mismatches = 0;
     for (uint64_t bits = 0; bits <= 0xffffffffull; bits += 997) {
         uint32_t b = (uint32_t)bits;
@@ -45,6 +52,7 @@ static void test_matches_float16_everywhere(void)
             mismatches += mine != ref;
     }
     CHECK(mismatches == 0);
+#endif
 }
 
 static void test_round_trip_all_halves(void)
@@ -54,10 +62,12 @@ static void test_round_trip_all_halves(void)
         if ((h & 0x7c00) == 0x7c00 && (h & 0x3ff))
             continue; /* NaN payloads */
         bad += half_from_float(half_to_float((uint16_t)h)) != h;
+#ifdef HAVE_FLOAT16
         _Float16 r;
         uint16_t u = (uint16_t)h;
         memcpy(&r, &u, sizeof r);
         bad += half_to_float((uint16_t)h) != (float)r;
+#endif
     }
     CHECK(bad == 0);
 }

@@ -1,0 +1,278 @@
+/*
+ * tests/app/test_cli.c — the rayes command line (src/app/main.c), run as a
+ * child process: exit status 0 on success, 1 for bad input or a failed
+ * write, 2 for usage errors; every error is exactly one line on stderr
+ * naming what is wrong; a tiny render writes its PNG, EXR and statistics;
+ * a failed write leaves nothing at the target; --quiet prints nothing.
+ *
+ * Each run gets its stdout and stderr in files under
+ * RAYES_TEST_TMP/app_cli (our own directory: other tests share
+ * RAYES_TEST_TMP and may run at the same time), runs in that directory so
+ * a default output name cannot land elsewhere, and sees RAYES_DATA only
+ * when a case sets it.
+ */
+#include <errno.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include "test.h"
+
+#ifndef RAYES_BIN
+#error "RAYES_BIN must name the rayes program"
+#endif
+#ifndef RAYES_TEST_TMP
+#error "RAYES_TEST_TMP must name a scratch directory"
+#endif
+#ifndef RAYES_TEST_DATA
+#error "RAYES_TEST_DATA must name the shared data directory"
+#endif
+
+#define SCRATCH_DIR RAYES_TEST_TMP "/app_cli"
+#define OUT_FILE SCRATCH_DIR "/stdout.txt"
+#define ERR_FILE SCRATCH_DIR "/stderr.txt"
+
+extern char **environ;
+
+/* What one run left behind. */
+typedef struct Run {
+    int status;     /* exit status, or -1 if the child did not exit normally */
+    char out[8192]; /* stdout, NUL-terminated (truncated) */
+    char err[8192]; /* stderr, NUL-terminated (truncated) */
+} Run;
+
+/* ------------------------------------------------------------- helpers */
+
+static void read_file(const char *path, char *buf, size_t size)
+{
+    FILE *f = fopen(path, "rb");
+    size_t n = f ? fread(buf, 1, size - 1, f) : 0;
+    buf[n] = '\0';
+    if (f)
+        fclose(f);
+}
+
+/* Runs RAYES_BIN with argv (NULL-terminated, without the program name) in
+ * SCRATCH_DIR, RAYES_DATA removed from the environment and set to data if
+ * data is not NULL. */
+static void run(Run *r, const char *data, const char *const *argv)
+{
+    const char *args[32] = {RAYES_BIN};
+    int n = 1;
+    for (; argv[n - 1] && n < 31; n++)
+        args[n] = argv[n - 1];
+    args[n] = NULL;
+
+    char data_var[4200];
+    snprintf(data_var, sizeof data_var, "RAYES_DATA=%s", data ? data : "");
+    const char *env[512];
+    int m = 0;
+    for (char **e = environ; *e && m < 510; e++)
+        if (strncmp(*e, "RAYES_DATA=", 11) != 0)
+            env[m++] = *e;
+    if (data)
+        env[m++] = data_var;
+    env[m] = NULL;
+
+    fflush(NULL);
+    pid_t pid = fork();
+    if (pid == 0) {
+        FILE *o = freopen(OUT_FILE, "w", stdout);
+        FILE *e = freopen(ERR_FILE, "w", stderr);
+        if (!o || !e || chdir(SCRATCH_DIR) != 0)
+            _exit(127);
+        execve(RAYES_BIN, (char *const *)args, (char *const *)env);
+        _exit(127);
+    }
+    int ws = 0;
+    r->status = -1;
+    if (pid > 0 && waitpid(pid, &ws, 0) == pid && WIFEXITED(ws))
+        r->status = WEXITSTATUS(ws);
+    read_file(OUT_FILE, r->out, sizeof r->out);
+    read_file(ERR_FILE, r->err, sizeof r->err);
+}
+
+static int count_char(const char *s, char c)
+{
+    int n = 0;
+    for (; *s; s++)
+        n += *s == c;
+    return n;
+}
+
+static int exists(const char *path)
+{
+    struct stat st;
+    return stat(path, &st) == 0;
+}
+
+static long file_size(const char *path)
+{
+    struct stat st;
+    return stat(path, &st) == 0 ? (long)st.st_size : -1;
+}
+
+/* Runs and checks a failure: the status, one line on stderr containing
+ * each of the NULL-terminated `names`, nothing on stdout. */
+static void expect_error(int status, const char *data, const char *const *argv,
+                         const char *const *names)
+{
+    static Run r;
+    run(&r, data, argv);
+    CHECK(r.status == status);
+    CHECK(count_char(r.err, '\n') == 1);
+    CHECK(r.err[0] != '\0' && r.err[strlen(r.err) - 1] == '\n');
+    CHECK(r.out[0] == '\0');
+    int named = 1;
+    for (int i = 0; names[i]; i++)
+        named &= strstr(r.err, names[i]) != NULL;
+    CHECK(named);
+    if (r.status != status || count_char(r.err, '\n') != 1 || !named)
+        fprintf(stderr, "  rayes %s ...: status %d, stderr:\n%s", argv[0] ? argv[0] : "",
+                r.status, r.err);
+}
+
+#define ARGS(...) ((const char *const[]){__VA_ARGS__, NULL})
+
+static void setup(void)
+{
+    mkdir(RAYES_TEST_TMP, 0777);
+    mkdir(SCRATCH_DIR, 0777); /* EEXIST is fine */
+}
+
+/* --------------------------------------------------------------- tests */
+
+static void test_version_and_help(void)
+{
+    static Run r;
+    setup();
+    run(&r, NULL, ARGS("--version"));
+    CHECK(r.status == 0);
+    CHECK(strncmp(r.out, "rayes ", 6) == 0);
+    CHECK(strchr("0123456789", r.out[6]) != NULL && strchr(r.out, '.') != NULL);
+    CHECK(count_char(r.out, '\n') == 1);
+    CHECK(r.err[0] == '\0');
+
+    run(&r, NULL, ARGS("--help"));
+    CHECK(r.status == 0);
+    CHECK(strstr(r.out, "usage:") != NULL && strstr(r.out, "--spp") != NULL);
+    CHECK(r.err[0] == '\0');
+}
+
+/* No arguments: the usage goes to stderr (several lines; it is the answer,
+ * not an error message) and the status is 2. */
+static void test_no_arguments(void)
+{
+    static Run r;
+    const char *const none[] = {NULL};
+    setup();
+    run(&r, NULL, none);
+    CHECK(r.status == 2);
+    CHECK(strstr(r.err, "usage:") != NULL);
+    CHECK(r.out[0] == '\0');
+}
+
+static void test_usage_errors(void)
+{
+    setup();
+    expect_error(2, NULL, ARGS("frobnicate"), ARGS("frobnicate"));
+    expect_error(2, NULL, ARGS("render", "--spp", "x"), ARGS("--spp", "\"x\""));
+    expect_error(2, NULL, ARGS("render", "--spp", "0"), ARGS("--spp"));
+    expect_error(2, NULL, ARGS("render", "--spp"), ARGS("--spp"));
+    expect_error(2, NULL, ARGS("render", "--res", "0"), ARGS("--res"));
+    expect_error(2, NULL, ARGS("render", "--res", "16x"), ARGS("--res"));
+    expect_error(2, NULL, ARGS("render", "--quality", "best"), ARGS("--quality", "best"));
+    expect_error(2, NULL, ARGS("render", "--bogus", "1"), ARGS("--bogus"));
+    expect_error(2, NULL, ARGS("render", "-o", "out.txt"), ARGS("out.txt", ".png"));
+    expect_error(2, NULL, ARGS("render", "cornell", "cornell-teapots"), ARGS("one scene"));
+    expect_error(2, NULL, ARGS("render", "nosuchscene", "--res", "16"), ARGS("nosuchscene"));
+    CHECK(!exists(SCRATCH_DIR "/nosuchscene.exr"));
+}
+
+static void test_missing_data(void)
+{
+    setup();
+    expect_error(1, NULL, ARGS("render", "cornell-teapots", "--res", "16", "--quiet"),
+                 ARGS("teapot.bpt", "--data"));
+    expect_error(1, NULL,
+                 ARGS("render", "cornell-teapots", "--res", "16", "--data",
+                      SCRATCH_DIR "/no-such-dir"),
+                 ARGS(SCRATCH_DIR "/no-such-dir/teapot.bpt"));
+    expect_error(1, SCRATCH_DIR "/no-such-env-dir",
+                 ARGS("render", "cornell-teapots", "--res", "16"),
+                 ARGS(SCRATCH_DIR "/no-such-env-dir/teapot.bpt"));
+    CHECK(!exists(SCRATCH_DIR "/cornell-teapots.exr"));
+}
+
+static void test_render_outputs(void)
+{
+    static Run r;
+    setup();
+    remove(SCRATCH_DIR "/a.png");
+    remove(SCRATCH_DIR "/a.exr");
+    remove(SCRATCH_DIR "/s.json");
+    run(&r, NULL,
+        ARGS("render", "cornell", "--res", "16", "--spp", "1", "--threads", "2", "-o",
+             SCRATCH_DIR "/a.png", "-o", SCRATCH_DIR "/a.exr", "--stats", SCRATCH_DIR "/s.json",
+             "--quiet"));
+    CHECK(r.status == 0);
+    CHECK(r.out[0] == '\0');
+    CHECK(r.err[0] == '\0');
+    if (r.status != 0)
+        fprintf(stderr, "  stderr: %s", r.err);
+    CHECK(file_size(SCRATCH_DIR "/a.png") > 8);
+    CHECK(file_size(SCRATCH_DIR "/a.exr") > 8);
+    CHECK(file_size(SCRATCH_DIR "/s.json") > 2);
+    char json[8192];
+    read_file(SCRATCH_DIR "/s.json", json, sizeof json);
+    CHECK(json[0] == '{' && strstr(json, "\"scene\": \"cornell\"") != NULL);
+}
+
+/* Without --quiet the summary goes to stdout and names each output. */
+static void test_render_summary(void)
+{
+    static Run r;
+    setup();
+    run(&r, RAYES_TEST_DATA,
+        ARGS("render", "--res", "8x4", "--spp", "1", "--threads", "1", "-o",
+             SCRATCH_DIR "/b.png"));
+    CHECK(r.status == 0);
+    CHECK(strstr(r.out, "cornell, 8x4, 1 spp") != NULL);
+    CHECK(strstr(r.out, SCRATCH_DIR "/b.png") != NULL);
+    CHECK(file_size(SCRATCH_DIR "/b.png") > 8);
+}
+
+/* RAYES_DATA alone finds the teapot patches. */
+static void test_data_from_environment(void)
+{
+    static Run r;
+    setup();
+    remove(SCRATCH_DIR "/t.png");
+    run(&r, RAYES_TEST_DATA,
+        ARGS("render", "cornell-teapots", "--res", "8", "--spp", "1", "--threads", "1",
+             "--quiet", "-o", SCRATCH_DIR "/t.png"));
+    CHECK(r.status == 0);
+    CHECK(r.err[0] == '\0' && r.out[0] == '\0');
+    CHECK(file_size(SCRATCH_DIR "/t.png") > 8);
+}
+
+static void test_unwritable_output(void)
+{
+    setup();
+    expect_error(1, NULL,
+                 ARGS("render", "--res", "8", "--spp", "1", "--quiet", "-o",
+                      SCRATCH_DIR "/missing-dir/x.png"),
+                 ARGS(SCRATCH_DIR "/missing-dir/x.png"));
+    CHECK(!exists(SCRATCH_DIR "/missing-dir/x.png"));
+    CHECK(!exists(SCRATCH_DIR "/missing-dir"));
+    expect_error(1, NULL,
+                 ARGS("render", "--res", "8", "--spp", "1", "--quiet", "-o",
+                      SCRATCH_DIR "/c.png", "--stats", SCRATCH_DIR "/missing-dir/s.json"),
+                 ARGS(SCRATCH_DIR "/missing-dir/s.json"));
+    CHECK(!exists(SCRATCH_DIR "/missing-dir"));
+}
+
+TEST_MAIN(TEST(test_version_and_help), TEST(test_no_arguments), TEST(test_usage_errors),
+          TEST(test_missing_data), TEST(test_render_outputs), TEST(test_render_summary),
+          TEST(test_data_from_environment), TEST(test_unwritable_output))
