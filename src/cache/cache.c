@@ -54,6 +54,7 @@ typedef struct Shard {
     size_t n_slots;               /* a power of two */
     CacheEntry lru;               /* sentinel: lru.next is least recently used */
     uint64_t budget, bytes, peak; /* bytes: table + resident and dropped-but-held entries */
+    uint64_t lru_bytes;           /* bytes of the entries on the LRU list (evictable) */
     uint64_t entries;             /* resident */
     uint64_t evictions[CACHE_N_TYPES];
 } Shard;
@@ -91,7 +92,8 @@ static int key_equal(const CacheKey *a, const CacheKey *b)
            a->side == b->side && a->type == b->type && a->level == b->level;
 }
 
-static void shard_init(Shard *s, uint64_t budget, size_t nominal)
+/* Returns 0, or -1 when out of memory. */
+static int shard_init(Shard *s, uint64_t budget, size_t nominal)
 {
     pthread_mutex_init(&s->lock, NULL);
     pthread_cond_init(&s->filled, NULL);
@@ -103,12 +105,13 @@ static void shard_init(Shard *s, uint64_t budget, size_t nominal)
     while ((n * 2) * per <= budget && n < ((size_t)1 << 24))
         n *= 2;
     if (n * sizeof(CacheEntry *) > budget)
-        return; /* not even one slot: every lookup fills privately */
+        return 0; /* not even one slot: every lookup fills privately */
     s->table = calloc(n, sizeof *s->table);
     if (!s->table)
-        return;
+        return -1;
     s->n_slots = n;
     s->bytes = s->peak = n * sizeof(CacheEntry *);
+    return 0;
 }
 
 Cache *cache_new(uint64_t budget_bytes, const float split[CACHE_N_LEVELS])
@@ -116,6 +119,7 @@ Cache *cache_new(uint64_t budget_bytes, const float split[CACHE_N_LEVELS])
     Cache *c = calloc(1, sizeof *c);
     if (!c)
         return NULL;
+    int failed = 0;
     c->budget = budget_bytes;
     atomic_init(&c->timestamp, 1);
     pthread_mutex_init(&c->counters_lock, NULL);
@@ -123,7 +127,13 @@ Cache *cache_new(uint64_t budget_bytes, const float split[CACHE_N_LEVELS])
         float f = split[l] < 0.0f ? 0.0f : split[l];
         c->level_budget[l] = (uint64_t)((double)budget_bytes * f);
         for (int s = 0; s < CACHE_SHARDS; s++)
-            shard_init(&c->shards[l][s], c->level_budget[l] / CACHE_SHARDS, nominal_values[l]);
+            if (shard_init(&c->shards[l][s], c->level_budget[l] / CACHE_SHARDS,
+                           nominal_values[l]) != 0)
+                failed = 1;
+    }
+    if (failed) {
+        cache_free(c);
+        return NULL;
     }
     return c;
 }
@@ -164,8 +174,9 @@ static Shard *shard_of(Cache *c, const CacheKey *k, uint64_t hash)
     return &c->shards[k->level][(hash >> 40) % CACHE_SHARDS];
 }
 
-static void lru_unlink(CacheEntry *e)
+static void lru_unlink(Shard *s, CacheEntry *e)
 {
+    s->lru_bytes -= cache_entry_bytes(e->n_values);
     e->prev->next = e->next;
     e->next->prev = e->prev;
     e->prev = e->next = NULL;
@@ -173,6 +184,7 @@ static void lru_unlink(CacheEntry *e)
 
 static void lru_append(Shard *s, CacheEntry *e) /* as most recently used */
 {
+    s->lru_bytes += cache_entry_bytes(e->n_values);
     e->prev = s->lru.prev;
     e->next = &s->lru;
     s->lru.prev->next = e;
@@ -197,12 +209,15 @@ static void entry_free(Shard *s, CacheEntry *e)
 }
 
 /* Evicts least recently used entries until `need` more bytes fit. Returns 1
- * if they fit. Caller holds the shard lock. */
+ * if they fit; evicts nothing if they cannot fit even with every unpinned
+ * entry gone. Caller holds the shard lock. */
 static int make_room(Shard *s, uint64_t need)
 {
+    if (s->bytes - s->lru_bytes + need > s->budget)
+        return 0;
     while (s->bytes + need > s->budget && s->lru.next != &s->lru) {
         CacheEntry *victim = s->lru.next;
-        lru_unlink(victim);
+        lru_unlink(s, victim);
         table_unlink(s, victim);
         s->evictions[victim->key.type]++;
         entry_free(s, victim);
@@ -221,7 +236,10 @@ static void release(Cache *c, CacheEntry *e)
     pthread_mutex_lock(&s->lock);
     RY_DCHECK(e->refs > 0);
     if (--e->refs == 0) {
-        if (e->resident)
+        if (e->resident && e->timestamp < cache_timestamp(c)) {
+            table_unlink(s, e); /* stale: let it go now rather than age out */
+            entry_free(s, e);
+        } else if (e->resident)
             lru_append(s, e);
         else
             entry_free(s, e); /* dropped as stale while held */
@@ -276,7 +294,7 @@ static CacheEntry *find_or_insert(Cache *c, const CacheKey *key, uint64_t hash, 
         if (e && e->timestamp < now) { /* stale: a miss; drop it */
             table_unlink(s, e);
             if (e->refs == 0) {
-                lru_unlink(e);
+                lru_unlink(s, e);
                 entry_free(s, e);
             }
             e = NULL;
@@ -284,7 +302,7 @@ static CacheEntry *find_or_insert(Cache *c, const CacheKey *key, uint64_t hash, 
     }
     if (e) {
         if (e->refs++ == 0)
-            lru_unlink(e);
+            lru_unlink(s, e);
         while (!e->ready)
             pthread_cond_wait(&s->filled, &s->lock);
         pthread_mutex_unlock(&s->lock);
@@ -322,10 +340,13 @@ static void fill_entry(Cache *c, CacheEntry *e, CacheFillFn fill, void *user)
         for (int k = 0; k < 3; k++)
             e->values[3 * i + k] = half_from_float_clamped(tmp[i][k]);
     free(tmp);
-    if (!e->resident) {
+    if (e->private_entry) { /* never shared: nobody can be waiting */
         e->ready = 1;
         return;
     }
+    /* A shared entry, even one dropped as stale during the fill (resident is
+     * then 0, written under the lock), may have waiters: publish under the
+     * lock and wake them. */
     Shard *s = shard_of(c, &e->key, e->hash);
     pthread_mutex_lock(&s->lock);
     e->ready = 1;
@@ -337,6 +358,7 @@ const uint16_t *cache_lookup(CacheLocal *local, const CacheKey *key, size_t n_va
                              CacheFillFn fill, void *user)
 {
     Cache *c = local->cache;
+    RY_CHECK(key->level < CACHE_N_LEVELS && key->type < CACHE_N_TYPES);
     uint64_t hash = key_hash(key);
     CacheCounters *ctr = &local->counters[key->level][key->type];
     CacheEntry **slot = &local->slots[key->level][hash & (uint64_t)(cache_local_slots[key->level] - 1)];
