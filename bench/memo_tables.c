@@ -4,6 +4,7 @@
  *
  *   memo_tables table1 [--size N] [--spp N] [--bounces-max B] [--accuracy-spp N]
  *                      [--accuracy-size N] [--out DIR] [--data DIR] [--threads N]
+ *                      [--cache-k K]
  *   memo_tables table4 [...same...] [--budgets MB,MB,...]
  *
  * table1: preview quality, bounces 1..B (default 3), caching off and on:
@@ -29,6 +30,7 @@
 typedef struct Args {
     const char *mode, *data, *out;
     int size, spp, bounces_max, accuracy_spp, accuracy_size, threads;
+    double cache_k;
     double budgets[16];
     int n_budgets;
 } Args;
@@ -68,6 +70,7 @@ static Row run(const Args *a, int size, int spp, int bounces, int cache, double 
     o.threads = a->threads;
     o.cache = cache;
     o.cache_mb = budget_mb;
+    o.cache_k = (float)a->cache_k;
     RayesImage *img;
     RayesStats *st;
     if (rayes_render(scene, &o, &img, &st) != RAYES_OK)
@@ -125,8 +128,10 @@ static double region_mean(const Row *r, int x0, int y0, int w, int h)
     return s / ((double)w * h);
 }
 
-/* Relative difference of the means, and the largest over 32 x 32 tiles. */
-static void accuracy(const Row *on, const Row *off, double *mean_rel, double *tile_rel)
+/* Relative difference of the means, and the largest over 32 x 32 tiles
+ * (whose position and means go to *where). */
+static void accuracy(const Row *on, const Row *off, double *mean_rel, double *tile_rel,
+                     char *where, size_t where_size)
 {
     double m_on = region_mean(on, 0, 0, on->w, on->h), m_off = region_mean(off, 0, 0, off->w, off->h);
     *mean_rel = fabs(m_on - m_off) / m_off;
@@ -134,8 +139,11 @@ static void accuracy(const Row *on, const Row *off, double *mean_rel, double *ti
     for (int ty = 0; ty + 32 <= on->h; ty += 32)
         for (int tx = 0; tx + 32 <= on->w; tx += 32) {
             double a = region_mean(on, tx, ty, 32, 32), b = region_mean(off, tx, ty, 32, 32);
-            if (b > 1e-4) /* tiles of pure black (the open front) have no relative error */
-                *tile_rel = fmax(*tile_rel, fabs(a - b) / b);
+            if (b > 1e-4 && fabs(a - b) / b > *tile_rel) { /* black tiles have no relative error */
+                *tile_rel = fabs(a - b) / b;
+                snprintf(where, where_size, "tile at (%d, %d): cached %.4f, uncached %.4f", tx, ty,
+                         a, b);
+            }
         }
 }
 
@@ -148,6 +156,7 @@ static void parse(int argc, char **argv, Args *a)
     a->bounces_max = 3;
     a->accuracy_spp = 64;
     a->threads = 0;
+    a->cache_k = 1.0;
     const double budgets[] = {0, 1, 4, 16, 64, 256};
     a->n_budgets = 6;
     memcpy(a->budgets, budgets, sizeof budgets);
@@ -163,6 +172,8 @@ static void parse(int argc, char **argv, Args *a)
             a->accuracy_spp = atoi(v);
         else if (strcmp(o, "--accuracy-size") == 0)
             a->accuracy_size = atoi(v);
+        else if (strcmp(o, "--cache-k") == 0)
+            a->cache_k = atof(v);
         else if (strcmp(o, "--threads") == 0)
             a->threads = atoi(v);
         else if (strcmp(o, "--data") == 0)
@@ -274,10 +285,11 @@ static void bias(const Args *a, FILE *j)
         Row on = run(a, a->accuracy_size, a->accuracy_spp, b, 1, mb);
         save(a, &on, "accuracy");
         double mrel, trel;
-        accuracy(&on, &off, &mrel, &trel);
+        char where[128] = "";
+        accuracy(&on, &off, &mrel, &trel, where, sizeof where);
         char label[32];
         snprintf(label, sizeof label, "b=%d %gMB", b, mb);
-        printf("%-12s | %15.3f%% | %21.3f%%\n", label, 100 * mrel, 100 * trel);
+        printf("%-12s | %15.3f%% | %21.3f%%  %s\n", label, 100 * mrel, 100 * trel, where);
         fflush(stdout);
         fprintf(j, "%s\n    {\"bounces\": %d, \"budget_mb\": %g, \"mean_rel\": %.6f, "
                    "\"max_tile_rel\": %.6f}",

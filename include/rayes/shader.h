@@ -74,6 +74,8 @@ typedef struct RayesShadeCtx {
     const float (*Cs)[3];       /* surface colour (default 1) */
     const float (*Os)[3];       /* surface opacity (default 1) */
     void *renderer;             /* the renderer's private state; pass it back untouched */
+    size_t first_point;         /* index of point 0 in the renderer's own per-point state;
+                                   a context made of points [a, b) of another adds a */
 } RayesShadeCtx;
 
 /* The outputs of a method call, n_points each. Irradiance may be NULL. */

@@ -27,13 +27,18 @@ static float ray_epsilon(const Worker *w)
     return 1e-5f * w->rs->scene_radius;
 }
 
+float integrator_ray_offset(const Worker *w, const Grid *g)
+{
+    return ray_epsilon(w) + 0.5f * g->edge * g->edge * g->curvature;
+}
+
 /* The shading inputs of one hit: a 1-point context. */
 typedef struct HitPoint {
     float P[3], N[3], Ng[3], dPdu[3], dPdv[3], I[3], Cs[3], Os[3];
     float u, v, du, dv;
     uint64_t key;
     RayDiff diff;
-    float curvature;
+    float curvature, offset;
 } HitPoint;
 
 static void store3(float out[3], Vec3 v)
@@ -78,6 +83,7 @@ static int hit_point(const Worker *w, const Ray *ray, const Hit *hit, HitPoint *
     hp->v = v;
     hp->du = hp->dv = 0.0f;
     hp->curvature = gs->grids[hit->grid].curvature;
+    hp->offset = integrator_ray_offset(w, &gs->grids[hit->grid]);
     return front;
 }
 
@@ -91,7 +97,7 @@ static Vec3 shade_hit(Worker *w, const Ray *ray, const Hit *hit, const RenderObj
     memcpy(hp.Os, obj->Os, sizeof hp.Os);
     hp.key = key;
     hp.diff = (RayDiff){diff.width + diff.spread * hit->t, diff.spread};
-    PathState ps = {w, &hp.key, &hp.diff, &hp.curvature};
+    PathState ps = {w, &hp.key, &hp.diff, &hp.curvature, &hp.offset};
     RayesShadeCtx ctx = {
         .n_points = 1,
         .ray_type = kind,
@@ -152,17 +158,19 @@ static Vec3 load3(const float p[3])
     return v3(p[0], p[1], p[2]);
 }
 
-static Vec3 offset_origin(const Worker *w, Vec3 P, Vec3 Ng)
+/* The renderer's index of the context's point i. */
+static size_t point(const RayesShadeCtx *ctx, size_t i)
 {
-    return v3_madd(P, Ng, ray_epsilon(w));
+    return ctx->first_point + i;
 }
 
 /* Direct light from one quad light at one point, n shadow rays. */
 static void light_point(Worker *w, const RayesShadeCtx *ctx, size_t i, const Light *l,
                         uint32_t pattern, int n, float exponent, Vec3 *diffuse, Vec3 *spec)
 {
+    const PathState *ps = ctx->renderer;
     Vec3 P = load3(ctx->P[i]), N = load3(ctx->N[i]), Ng = load3(ctx->Ng[i]);
-    Vec3 o = offset_origin(w, P, Ng);
+    Vec3 o = v3_madd(P, Ng, ps->offset[point(ctx, i)]);
     Vec3 V = ctx->I ? v3_neg(load3(ctx->I[i])) : v3(0, 0, 0);
     Vec3 sum_d = v3(0, 0, 0), sum_s = v3(0, 0, 0);
     for (int s = 0; s < n; s++) {
@@ -175,7 +183,11 @@ static void light_point(Worker *w, const RayesShadeCtx *ctx, size_t i, const Lig
         float cos_x = v3_dot(N, wi), cos_y = -v3_dot(ny, wi); /* both scaled by |wi| (and |ny|) */
         if (cos_x <= 0.0f || cos_y <= 0.0f || v3_dot(Ng, wi) <= 0.0f || d2 <= 0.0f)
             continue;
-        Ray shadow = {o, wi, 0.0f, 1.0f - 1e-4f, RAYES_RAY_SHADOW};
+        /* tnear skips surfaces through the origin itself: a grid vertex on a
+         * corner line (a floor vertex against a wall) lies in the other
+         * surface's plane, and would shadow itself. */
+        float near = ray_epsilon(w) / sqrtf(d2);
+        Ray shadow = {o, wi, near, 1.0f - 1e-4f, RAYES_RAY_SHADOW};
         w->stats.rays_shadow++;
         if (accel_occluded(w->rs->accel, &shadow))
             continue;
@@ -208,7 +220,8 @@ static void svc_direct_lighting(const RayesShaderServices *sv, const RayesShadeC
         Vec3 d = v3(0, 0, 0), s = v3(0, 0, 0);
         float e = roughness && roughness[i] > 0.0f ? 1.0f / roughness[i] : 10.0f;
         for (size_t l = 0; l < w->rs->n_lights && n > 0; l++) {
-            uint32_t pattern = (uint32_t)hash_combine(hash_combine(ps->keys[i], DIM_LIGHT), l);
+            uint32_t pattern =
+                (uint32_t)hash_combine(hash_combine(ps->keys[point(ctx, i)], DIM_LIGHT), l);
             light_point(w, ctx, i, &w->rs->lights[l], pattern, n, e, &d, want_spec ? &s : NULL);
         }
         if (diffuse)
@@ -231,10 +244,11 @@ static void svc_indirect_diffuse(const RayesShaderServices *sv, const RayesShade
     /* Each ray stands for 1/n of the hemisphere: its spread never shrinks. */
     float lobe_spread = n > 0 ? 1.0f / sqrtf((float)n) : 0.0f;
     for (size_t i = 0; i < ctx->n_points; i++) {
+        size_t j = point(ctx, i);
         Vec3 P = load3(ctx->P[i]), N = load3(ctx->N[i]), Ng = load3(ctx->Ng[i]);
-        Vec3 o = offset_origin(w, P, Ng), sum = v3(0, 0, 0);
-        uint64_t key = hash_combine(ps->keys[i], DIM_DIFFUSE);
-        RayDiff diff = {ps->diff[i].width, fmaxf(ps->diff[i].spread, lobe_spread)};
+        Vec3 o = v3_madd(P, Ng, ps->offset[j]), sum = v3(0, 0, 0);
+        uint64_t key = hash_combine(ps->keys[j], DIM_DIFFUSE);
+        RayDiff diff = {ps->diff[j].width, fmaxf(ps->diff[j].spread, lobe_spread)};
         for (int s = 0; s < n; s++) {
             float a, b;
             cmj_sample_2d((uint32_t)s, (uint32_t)n, (uint32_t)key, &a, &b);
@@ -262,17 +276,18 @@ static void svc_indirect_specular(const RayesShaderServices *sv, const RayesShad
             store3(out[i], v3(0, 0, 0));
             continue;
         }
+        size_t j = point(ctx, i);
         Vec3 d = v3_normalize(load3(dir[i])), Ng = load3(ctx->Ng[i]);
-        Vec3 o = v3_madd(load3(ctx->P[i]), Ng, v3_dot(d, Ng) >= 0.0f ? ray_epsilon(w)
-                                                                       : -ray_epsilon(w));
+        float off = ps->offset[j];
+        Vec3 o = v3_madd(load3(ctx->P[i]), Ng, v3_dot(d, Ng) >= 0.0f ? off : -off);
         /* A mirror keeps the spread and adds the curvature's share. */
-        float width = ps->diff[i].width;
-        RayDiff diff = {width, ps->diff[i].spread + 2.0f * ps->curvature[i] * width};
-        Ray ray = {o, d, 0.0f, INFINITY, RAYES_RAY_SPECULAR};
+        float width = ps->diff[j].width;
+        RayDiff diff = {width, ps->diff[j].spread + 2.0f * ps->curvature[j] * width};
+        Ray ray = {o, d, ray_epsilon(w), INFINITY, RAYES_RAY_SPECULAR};
         w->stats.rays_specular++;
         Vec3 L = integrator_trace(w, &ray, RAYES_RAY_SPECULAR, ctx->diffuse_depth,
                                   ctx->specular_depth + 1,
-                                  hash_combine(ps->keys[i], DIM_SPECULAR), diff, NULL);
+                                  hash_combine(ps->keys[j], DIM_SPECULAR), diff, NULL);
         store3(out[i], L);
     }
 }

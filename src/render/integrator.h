@@ -21,15 +21,26 @@ typedef struct Worker {
     CacheLocal cache;             /* this thread's part of the radiosity cache */
 } Worker;
 
-/* What a shading context's `renderer` points to: per point, the sample key
- * its random numbers derive from, the ray differential that arrived (width
- * = footprint at the point) and the grid's curvature. */
+/* What a shading context's `renderer` points to: per point (indexed from
+ * ctx->first_point), the sample key its random numbers derive from, the ray
+ * differential that arrived (width = footprint at the point), the grid's
+ * curvature, and how far rays leaving the point start from it. */
 typedef struct PathState {
     Worker *w;
     const uint64_t *keys;
     const RayDiff *diff;
     const float *curvature;
+    const float *offset;
 } PathState;
+
+/* How far rays leaving a point of grid g start from it, along its normal:
+ * the ray epsilon plus a bound on the sagitta of neighbouring grids' chords.
+ * Adjacent patches diced at different rates do not share boundary vertices,
+ * and on a curved surface a neighbour's micropolygons run inside a vertex
+ * on the true surface by up to edge^2 * curvature / 8; rays from a grid's
+ * boundary vertex (every cache fill has them) would otherwise hit the
+ * neighbour from behind. The bound allows neighbours twice as coarse. */
+float integrator_ray_offset(const Worker *w, const Grid *g);
 
 extern const RayesShaderServices render_services;
 

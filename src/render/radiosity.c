@@ -4,7 +4,7 @@
  *
  * At a diffuse hit the resolution is chosen from the ray's footprint (the
  * coarsest level whose micropolygon edge is at most k times the footprint,
- * DESIGN.md), the entry for (patch, diffuse depth, side, RADIOSITY, level)
+ * DESIGN.md, and bends through at most RADIOSITY_MAX_BEND), the entry for (patch, diffuse depth, side, RADIOSITY, level)
  * is looked up, and on a miss filled by running prelighting and
  * diffuselighting on every vertex of the grid at that level; the hit's value
  * is interpolated: bilinear in the quad cell, barycentric in the triangle.
@@ -95,13 +95,23 @@ static float level_edge(const Grid *g, int level)
     return g->edge * 0.5f * (su / (medium_knots(g->nu) - 1) + sv / (medium_knots(g->nv) - 1));
 }
 
+/* The largest angle (radians) a level's micropolygon may bend through,
+ * edge x the grid's curvature. Radiosity on a curved surface follows the
+ * cosine of its normal to the light, which bilinear interpolation across a
+ * strongly bent cell undershoots: on the benchmark's matte teapot the coarse
+ * level alone darkened the ceiling above it by 3% (measured, 64 spp). 0.5
+ * brings that under 1% for 0.5% more shading points. */
+#define RADIOSITY_MAX_BEND 0.5f
+
 int radiosity_choose_level(const Grid *g, float footprint, float k, int forced)
 {
     if (forced >= 0)
         return effective_level(g, forced);
-    for (int level = CACHE_COARSE; level < CACHE_FINE; level++)
-        if (level_edge(g, level) <= k * footprint)
+    for (int level = CACHE_COARSE; level < CACHE_FINE; level++) {
+        float edge = level_edge(g, level);
+        if (edge <= k * footprint && edge * g->curvature <= RADIOSITY_MAX_BEND)
             return effective_level(g, level);
+    }
     return CACHE_FINE;
 }
 
@@ -141,7 +151,7 @@ static void tri_cell(int n, float x, float y, int vi[3][2], float wt[3])
 
 typedef struct FillPoints {
     float (*P)[3], (*N)[3], (*dPdu)[3], (*dPdv)[3], (*Cs)[3], (*Os)[3], (*Ci)[3], (*Oi)[3];
-    float *u, *v, *du, *dv, *curv;
+    float *u, *v, *du, *dv, *curv, *offset;
     uint64_t *keys;
     RayDiff *diff;
 } FillPoints;
@@ -214,13 +224,14 @@ static void fill_radiosity(void *user, const CacheKey *key, size_t n, float (*ou
     const RenderObject *obj = &w->rs->objects[g->object];
     FillPoints fp;
     float(*f3)[3] = malloc(n * 8 * sizeof *f3);
-    float *f1 = malloc(n * 5 * sizeof *f1);
+    float *f1 = malloc(n * 6 * sizeof *f1);
     fp.keys = malloc(n * sizeof *fp.keys);
     fp.diff = malloc(n * sizeof *fp.diff);
     RY_CHECK(f3 && f1 && fp.keys && fp.diff);
     fp.P = f3, fp.N = f3 + n, fp.dPdu = f3 + 2 * n, fp.dPdv = f3 + 3 * n;
     fp.Cs = f3 + 4 * n, fp.Os = f3 + 5 * n, fp.Ci = f3 + 6 * n, fp.Oi = f3 + 7 * n;
     fp.u = f1, fp.v = f1 + n, fp.du = f1 + 2 * n, fp.dv = f1 + 3 * n, fp.curv = f1 + 4 * n;
+    fp.offset = f1 + 5 * n;
     layout_points(gs, g, key->level, key->side, &fp);
     uint64_t fill_key = hash_combine(hash_combine(w->set->seed, 0x7261646f73ull /* "rados" */),
                                      ((uint64_t)key->patch << 32) | ((uint64_t)key->depth << 16) |
@@ -231,10 +242,11 @@ static void fill_radiosity(void *user, const CacheKey *key, size_t n, float (*ou
         memcpy(fp.Os[i], obj->Os, sizeof fp.Os[i]);
         fp.du[i] = fp.dv[i] = 0.0f;
         fp.curv[i] = g->curvature;
+        fp.offset[i] = integrator_ray_offset(w, g);
         fp.keys[i] = hash_combine(fill_key, i);
         fp.diff[i] = (RayDiff){width, 0.0f};
     }
-    PathState ps = {w, fp.keys, fp.diff, fp.curv};
+    PathState ps = {w, fp.keys, fp.diff, fp.curv, fp.offset};
     RayesShadeCtx ctx = {
         .n_points = n, .ray_type = RAYES_RAY_DIFFUSE, .diffuse_depth = key->depth,
         .specular_depth = 0,

@@ -8,7 +8,8 @@
 #include "render/integrator.h"
 
 /* The cache level for a hit on grid g with the given ray footprint: the
- * coarsest whose micropolygon edge is at most k * footprint, or `forced`
+ * coarsest whose micropolygon edge is at most k * footprint and whose
+ * micropolygons bend through at most 0.5 radians (edge x curvature), or `forced`
  * (>= 0), after aliasing a MEDIUM level that equals FINE or COARSE. */
 int radiosity_choose_level(const Grid *g, float footprint, float k, int forced);
 

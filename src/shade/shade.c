@@ -92,6 +92,7 @@ void shade_ctx_slice(const RayesShadeCtx *ctx, size_t start, size_t count, Rayes
 {
     *sub = *ctx;
     sub->n_points = count;
+    sub->first_point = ctx->first_point + start;
 #define SLICE(f)                                  \
     if (ctx->f)                                   \
         sub->f = ctx->f + start;
