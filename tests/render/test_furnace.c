@@ -11,7 +11,8 @@
 #include "rayes/rayes.h"
 #include "test.h"
 
-static double furnace_mean(float albedo, int bounces, int diffuse_rays, int threads)
+/* cache: -2 off; -1 on, resolution by differentials; 0..2 forced level. */
+static double furnace_mean(float albedo, int bounces, int diffuse_rays, int threads, int cache)
 {
     RayesScene *s = rayes_scene_new();
     float eye[3] = {0, 0, 0}, target[3] = {0, 0, 1}, up[3] = {0, 1, 0};
@@ -31,6 +32,8 @@ static double furnace_mean(float albedo, int bounces, int diffuse_rays, int thre
     o.bounces = bounces;
     o.diffuse_rays = o.diffuse_rays_deep = diffuse_rays;
     o.threads = threads;
+    o.cache = cache != -2;
+    o.cache_resolution = cache >= 0 ? cache : -1;
     RayesImage *img = NULL;
     CHECK(rayes_render(s, &o, &img, NULL) == RAYES_OK);
     double sum = 0.0;
@@ -49,9 +52,23 @@ static void test_furnace_each_bounce_count(void)
     const float a = 0.5f;
     double expected = 1.0;
     for (int b = 0; b <= 3; b++) {
-        double m = furnace_mean(a, b, 4, 2);
+        double m = furnace_mean(a, b, 4, 2, -1);
         CHECK_NEAR(m / expected, 1.0, 0.01);
         expected = expected * a + 1.0;
+    }
+}
+
+/* Every cache resolution, and no cache, conserve energy: a fill point on a
+ * patch boundary of the curved sphere must not see a neighbour from behind. */
+static void test_furnace_each_resolution(void)
+{
+    const float a = 0.8f;
+    double finite = 0.0, ak = 1.0;
+    for (int k = 0; k <= 6; k++, ak *= a)
+        finite += ak;
+    for (int cache = -2; cache <= 2; cache++) {
+        double m = furnace_mean(a, 6, 2, 2, cache);
+        CHECK_NEAR(m / finite, 1.0, 0.005);
     }
 }
 
@@ -63,9 +80,10 @@ static void test_furnace_converges_to_infinite_sum(void)
     double finite = 0.0, ak = 1.0;
     for (int k = 0; k <= 12; k++, ak *= a)
         finite += ak;
-    double m = furnace_mean(a, 12, 1, 2);
+    double m = furnace_mean(a, 12, 1, 2, -1);
     CHECK_NEAR(m / finite, 1.0, 0.01);
     CHECK(m < 1.0 / (1.0 - a));
 }
 
-TEST_MAIN(TEST(test_furnace_each_bounce_count), TEST(test_furnace_converges_to_infinite_sum))
+TEST_MAIN(TEST(test_furnace_each_bounce_count), TEST(test_furnace_each_resolution),
+          TEST(test_furnace_converges_to_infinite_sum))
