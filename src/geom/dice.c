@@ -159,13 +159,17 @@ static void put_vertex(GridSet *gs, size_t k, const Prim *prim, float u, float v
     gs->uv[k][1] = v;
 }
 
-/* Mean edge and largest normal change per length over neighbour pairs. */
+/* One neighbour pair, in one of two passes: the first sums edge lengths;
+ * the second takes the largest normal change per length, over pairs no
+ * shorter than a tenth of the mean edge (a collapsed row, the teapot lid's
+ * apex, has pairs of length ~0 whose ratio means nothing). */
 static void measure(const GridSet *gs, size_t a, size_t b, double *sum, size_t *n, float *curv)
 {
     float len = v3_length(v3_sub(gs->P[a], gs->P[b]));
-    *sum += len;
-    (*n)++;
-    if (len > 0.0f)
+    if (!curv) {
+        *sum += len;
+        (*n)++;
+    } else if (len > 0.1f * (float)(*sum / (double)(*n ? *n : 1)))
         *curv = fmaxf(*curv, v3_length(v3_sub(gs->N[a], gs->N[b])) / len);
 }
 
@@ -188,14 +192,15 @@ static int dice_quad(GridSet *gs, const Prim *prim, uint32_t prim_index, const D
     double sum = 0.0;
     size_t n = 0;
     float curv = 0.0f;
-    for (int j = 0; j < nv; j++)
-        for (int i = 0; i < nu; i++) {
-            size_t k = base + (size_t)j * nu + i;
-            if (i + 1 < nu)
-                measure(gs, k, k + 1, &sum, &n, &curv);
-            if (j + 1 < nv)
-                measure(gs, k, k + nu, &sum, &n, &curv);
-        }
+    for (int pass = 0; pass < 2; pass++)
+        for (int j = 0; j < nv; j++)
+            for (int i = 0; i < nu; i++) {
+                size_t k = base + (size_t)j * nu + i;
+                if (i + 1 < nu)
+                    measure(gs, k, k + 1, &sum, &n, pass ? &curv : NULL);
+                if (j + 1 < nv)
+                    measure(gs, k, k + nu, &sum, &n, pass ? &curv : NULL);
+            }
     g->edge = n ? (float)(sum / (double)n) : 0.0f;
     g->curvature = curv;
     gs->n_vertices += (size_t)nu * nv;
@@ -224,12 +229,13 @@ static int dice_triangle(GridSet *gs, const Prim *prim, uint32_t prim_index, con
     double sum = 0.0;
     size_t m = 0;
     float curv = 0.0f;
-    for (uint32_t j = 0; j <= n; j++)
-        for (uint32_t i = 0; i + j < n; i++) {
-            size_t k = base + geom_tri_vertex(n, i, j);
-            measure(gs, k, base + geom_tri_vertex(n, i + 1, j), &sum, &m, &curv);
-            measure(gs, k, base + geom_tri_vertex(n, i, j + 1), &sum, &m, &curv);
-        }
+    for (int pass = 0; pass < 2; pass++)
+        for (uint32_t j = 0; j <= n; j++)
+            for (uint32_t i = 0; i + j < n; i++) {
+                size_t k = base + geom_tri_vertex(n, i, j);
+                measure(gs, k, base + geom_tri_vertex(n, i + 1, j), &sum, &m, pass ? &curv : NULL);
+                measure(gs, k, base + geom_tri_vertex(n, i, j + 1), &sum, &m, pass ? &curv : NULL);
+            }
     g->edge = m ? (float)(sum / (double)m) : 0.0f;
     g->curvature = curv;
     gs->n_vertices += count;

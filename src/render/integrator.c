@@ -29,7 +29,8 @@ static float ray_epsilon(const Worker *w)
 
 float integrator_ray_offset(const Worker *w, const Grid *g)
 {
-    return ray_epsilon(w) + 0.5f * g->edge * g->edge * g->curvature;
+    /* Never more than a micropolygon edge, whatever the curvature estimate. */
+    return ray_epsilon(w) + fminf(0.5f * g->edge * g->edge * g->curvature, g->edge);
 }
 
 /* The shading inputs of one hit: a 1-point context. */
