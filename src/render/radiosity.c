@@ -50,6 +50,24 @@ static int tri_medium_m(int n)
     return (n + 3) / 4;
 }
 
+/* Points per side of a quad level along a side of n fine vertices, and the
+ * fine index of its k-th point. */
+static int quad_level_points(int level, int n)
+{
+    return level == CACHE_FINE ? n : level == CACHE_MEDIUM ? medium_knots(n) : 2;
+}
+
+static int quad_level_index(int level, int k, int n)
+{
+    return level == CACHE_FINE ? k : level == CACHE_MEDIUM ? medium_knot(k, n) : k * (n - 1);
+}
+
+/* Subdivisions of a triangular level of a grid of n subdivisions. */
+static int tri_level_m(int level, int n)
+{
+    return level == CACHE_FINE ? n : level == CACHE_MEDIUM ? tri_medium_m(n) : 1;
+}
+
 /* The level actually stored for a requested one (aliasing MEDIUM). */
 static int effective_level(const Grid *g, int level)
 {
@@ -70,14 +88,10 @@ static int effective_level(const Grid *g, int level)
 static size_t level_values(const Grid *g, int level)
 {
     if (g->triangular) {
-        size_t n = level == CACHE_FINE ? g->nu : level == CACHE_MEDIUM ? tri_medium_m(g->nu) : 1;
+        size_t n = (size_t)tri_level_m(level, g->nu);
         return (n + 1) * (n + 2) / 2;
     }
-    if (level == CACHE_FINE)
-        return (size_t)g->nu * g->nv;
-    if (level == CACHE_MEDIUM)
-        return (size_t)medium_knots(g->nu) * medium_knots(g->nv);
-    return 4;
+    return (size_t)quad_level_points(level, g->nu) * (size_t)quad_level_points(level, g->nv);
 }
 
 /* Mean micropolygon edge of a level. */
@@ -188,12 +202,10 @@ static void layout_points(const GridSet *gs, const Grid *g, int level, int side,
     size_t p = 0;
     if (!g->triangular) {
         int nu = g->nu, nv = g->nv;
-        int mu = level == CACHE_FINE ? nu : level == CACHE_MEDIUM ? medium_knots(nu) : 2;
-        int mv = level == CACHE_FINE ? nv : level == CACHE_MEDIUM ? medium_knots(nv) : 2;
+        int mu = quad_level_points(level, nu), mv = quad_level_points(level, nv);
         for (int j = 0; j < mv; j++)
             for (int i = 0; i < mu; i++) {
-                int fi = level == CACHE_FINE ? i : level == CACHE_MEDIUM ? medium_knot(i, nu) : i * (nu - 1);
-                int fj = level == CACHE_FINE ? j : level == CACHE_MEDIUM ? medium_knot(j, nv) : j * (nv - 1);
+                int fi = quad_level_index(level, i, nu), fj = quad_level_index(level, j, nv);
                 uint32_t vtx = (uint32_t)(fj * nu + fi);
                 float one = 1.0f;
                 put_point(gs, g, fp, p++, &vtx, &one, 1, side);
@@ -201,7 +213,7 @@ static void layout_points(const GridSet *gs, const Grid *g, int level, int side,
         return;
     }
     int n = g->nu;
-    int m = level == CACHE_FINE ? n : level == CACHE_MEDIUM ? tri_medium_m(n) : 1;
+    int m = tri_level_m(level, n);
     for (int j = 0; j <= m; j++)
         for (int i = 0; i + j <= m; i++) {
             int vi[3][2];
@@ -306,7 +318,7 @@ Vec3 radiosity_interpolate(const Grid *g, const Hit *hit, int level, const uint1
                         medium_coord(x, g->nu), medium_coord(y, g->nv));
     }
     int n = g->nu;
-    int m = level == CACHE_FINE ? n : level == CACHE_MEDIUM ? tri_medium_m(n) : 1;
+    int m = tri_level_m(level, n);
     int vi[3][2];
     float wt[3];
     tri_cell(m, hit->gu * m, hit->gv * m, vi, wt);
