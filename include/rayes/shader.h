@@ -7,9 +7,12 @@
  * grid, or a batch of ray hits): inputs are structure-of-arrays, owned by
  * the renderer and valid for the call only; outputs are separate arrays.
  *
- *   displacement     at dicing             writes P, N            (later)
- *   opacity          shadow rays           writes Oi              (later)
- *   prelighting      before lighting       illumination-independent work
+ *   displacement     at dicing, on every fine-grid vertex: writes out->P (the
+ *                    renderer recomputes N from the displaced grid)
+ *   opacity          shadow and transmission rays: writes Oi
+ *   prelighting      before lighting or diffuselighting: illumination-independent
+ *                    work (texture lookups), kept in ctx->scratch for the
+ *                    methods that follow on the same points
  *   lighting         camera and specular hits: Ci, Oi, complete and view-dependent
  *   diffuselighting  diffuse hits and radiosity cache fills: Ci, Oi, optional
  *                    Irradiance; view-independent: ctx->I is NULL here
@@ -26,7 +29,13 @@
  * Radiance-like service results are in the scene's radiance units.
  *
  * Thread-safety: methods run concurrently on many threads with distinct
- * contexts; a shader must not keep mutable state outside its outputs.
+ * contexts; a shader must not keep mutable state outside its outputs and
+ * its scratch.
+ *
+ * Plugins: a shared object NAME.so on the shader search path that exports
+ * RAYES_SHADER_ENTRY_NAME, a RayesShaderEntry returning its class (whose
+ * name is NAME). The renderer refuses a class whose abi_version differs
+ * from its own.
  */
 #ifndef RAYES_SHADER_H
 #define RAYES_SHADER_H
@@ -41,7 +50,7 @@ extern "C" {
 #endif
 
 /* Bumped whenever a struct below changes incompatibly. */
-#define RAYES_SHADER_ABI_VERSION 1u
+#define RAYES_SHADER_ABI_VERSION 2u
 
 /* Ray types: one flag set. */
 typedef enum RayesRayType {
@@ -76,6 +85,10 @@ typedef struct RayesShadeCtx {
     void *renderer;             /* the renderer's private state; pass it back untouched */
     size_t first_point;         /* index of point 0 in the renderer's own per-point state;
                                    a context made of points [a, b) of another adds a */
+    void *scratch;              /* the class's scratch_size bytes per point, shared by the
+                                   methods run on these points (prelighting writes it,
+                                   lighting reads it); point i at scratch + i * scratch_size;
+                                   NULL when scratch_size is 0 */
 } RayesShadeCtx;
 
 /* The outputs of a method call, n_points each. Irradiance may be NULL. */
@@ -83,6 +96,7 @@ typedef struct RayesShadeOutputs {
     float (*Ci)[3];         /* outgoing radiance toward the viewer (or radiosity) */
     float (*Oi)[3];         /* opacity */
     float (*Irradiance)[3]; /* diffuselighting's optional irradiance (memo 6.2) */
+    float (*P)[3];          /* displacement: the displaced positions (input P copied in) */
 } RayesShadeOutputs;
 
 typedef struct RayesShaderServices RayesShaderServices;
@@ -113,25 +127,44 @@ typedef struct RayesShaderClass {
     RayesShaderMethod lighting;        /* required */
     RayesShaderMethod diffuselighting; /* may be NULL: the diffuse lobes of lighting */
     RayesShaderMethod postlighting;    /* may be NULL */
+    size_t scratch_size;               /* bytes of scratch per point (ctx->scratch) */
 } RayesShaderClass;
 
+/* What a plugin exports under RAYES_SHADER_ENTRY_NAME. */
+typedef const RayesShaderClass *(*RayesShaderEntry)(void);
+#define RAYES_SHADER_ENTRY_NAME "rayes_shader_entry"
+
+
 /* Everything a shader may ask of the renderer. Each function takes the
- * services table and the context it was given. */
+ * services table and the context it was given. A function the renderer
+ * lacks is NULL; supports() names the ones present, so the table can grow
+ * (new members are appended; struct_size says how many there are). */
 struct RayesShaderServices {
     uint32_t abi_version;
     uint32_t struct_size;
 
-    /* Direct lighting from the scene's lights with n_shadow_rays shadow rays
-     * per light and point (0: the renderer's setting). Per point:
+    /* Direct lighting from the scene's lights with n_shadow_rays shadow
+     * rays per light and point (0: the renderer's setting). category
+     * selects lights as RenderMan's illuminance does: NULL or "" all
+     * lights, "name" those whose category list holds name, "-name" those
+     * whose list does not. Ambient lights are excluded (see ambient). Per
+     * point:
      *   diffuse[i]  = (1/pi) * integral of L_light cos(theta) dw (so a Lambertian
      *                 surface of albedo a reflects a * diffuse[i]);
      *   specular[i] = integral of L_light f(w) cos(theta) dw with the normalised
-     *                 Blinn-Phong lobe f = (e + 8) / (8 pi) (N.H)^e, e = 1 / roughness[i].
-     * Either output may be NULL. specular needs I: in diffuselighting it is
-     * set to zero. */
+     *                 Blinn-Phong lobe f = (e + 8) / (8 pi) (N.H)^e, e = 1 / roughness[i]
+     *                 (roughness NULL: 0.1).
+     * Area and environment lights are sampled with multiple importance
+     * sampling against each lobe. Either output may be NULL. specular
+     * needs I: in diffuselighting it is set to zero. */
     void (*direct_lighting)(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
-                            int n_shadow_rays, const float *roughness, float (*diffuse)[3],
-                            float (*specular)[3]);
+                            int n_shadow_rays, const char *category, const float *roughness,
+                            float (*diffuse)[3], float (*specular)[3]);
+
+    /* The light of ambient lights (RenderMan's ambient()): a Lambertian
+     * surface of albedo a reflects a * out[i]. Counted apart from global
+     * illumination. */
+    void (*ambient)(const RayesShaderServices *sv, const RayesShadeCtx *ctx, float (*out)[3]);
 
     /* Indirect diffuse: (1/pi) * integral of incident indirect radiance
      * cos(theta) dw over the hemisphere of N, with n_rays cosine-distributed
@@ -140,14 +173,61 @@ struct RayesShaderServices {
     void (*indirect_diffuse)(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
                              int n_rays, float (*out)[3]);
 
-    /* Indirect specular: the radiance arriving along the unit directions
-     * dir[i] (a perfect specular lobe), one specular ray per point. Zero
-     * beyond the maximum specular depth. */
+    /* Indirect specular: radiance arriving around the unit directions
+     * dir[i]. roughness NULL (or roughness[i] 0): a perfect mirror, one ray;
+     * otherwise the mean over n_rays directions drawn from the normalised
+     * Blinn-Phong lobe of exponent 1 / roughness[i] about dir[i] (0 rays:
+     * the renderer's setting), which is the lobe's integral divided by its
+     * albedo. Zero beyond the maximum specular depth. */
     void (*indirect_specular)(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
-                              const float (*dir)[3], float (*out)[3]);
+                              const float (*dir)[3], const float *roughness, int n_rays,
+                              float (*out)[3]);
+
+    /* Refraction: the radiance arriving along dir[i], a direction that
+     * crosses the surface (into or out of it); one ray, counted as a
+     * specular bounce. */
+    void (*indirect_refraction)(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
+                                const float (*dir)[3], float (*out)[3]);
+
+    /* Transmission (RenderMan's transmission()): the fraction of light that
+     * passes from each point to the world-space point to[i], through the
+     * opacity of what lies between (1: nothing in the way). */
+    void (*transmission)(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
+                         const float (*to)[3], float (*out)[3]);
+
+    /* A texture lookup: the image file name (found on the texture search
+     * path; EXR or PNG) at (s[i], t[i]), (0,0) the top-left corner, filtered
+     * over ds[i] x dt[i] in texture space (NULL: ctx->du and ctx->dv, right
+     * when s and t are u and v), wrapping periodically. rgb receives linear
+     * colour; alpha (may be NULL) the alpha channel, 1 if absent. Returns 0,
+     * or -1 when the texture cannot be read (one warning; rgb is then 0 and
+     * alpha 1). */
+    int (*texture)(const RayesShaderServices *sv, const RayesShadeCtx *ctx, const char *name,
+                   const float *s, const float *t, const float *ds, const float *dt,
+                   float (*rgb)[3], float *alpha);
+
+    /* Gradient (Perlin) noise in [-1, 1], zero on integer lattice points. */
+    float (*noise)(const RayesShaderServices *sv, const float p[3]);
+    /* Fractal sums of noise over octaves, frequency multiplied by
+     * lacunarity and amplitude by gain per octave: fbm sums noise,
+     * turbulence sums its absolute value. */
+    float (*fbm)(const RayesShaderServices *sv, const float p[3], int octaves, float lacunarity,
+                 float gain);
+    float (*turbulence)(const RayesShaderServices *sv, const float p[3], int octaves,
+                        float lacunarity, float gain);
+
+    /* Attribute of the object being shaded ("object:id", "displacementbound",
+     * "shadingrate") and option of the render ("resolution", "bounces",
+     * "samples", "shadowrays", "diffuserays", "quality"): writes up to n
+     * floats to value and returns how many the attribute has, or 0 if
+     * unknown. */
+    int (*attribute)(const RayesShaderServices *sv, const RayesShadeCtx *ctx, const char *name,
+                     float *value, int n);
+    int (*option)(const RayesShaderServices *sv, const RayesShadeCtx *ctx, const char *name,
+                  float *value, int n);
 
     /* Nonzero if the renderer offers the named service ("direct_lighting",
-     * "indirect_diffuse", "indirect_specular", ...), so the table can grow. */
+     * "ambient", "texture", ...), so the table can grow. */
     int (*supports)(const RayesShaderServices *sv, const char *service);
 };
 

@@ -18,6 +18,7 @@
 #include <math.h>
 #include <string.h>
 
+#include "shade/noise.h"
 #include "util/check.h"
 #include "util/rng.h"
 #include "util/sampling.h"
@@ -121,7 +122,7 @@ static Vec3 shade_hit(Worker *w, const Ray *ray, const Hit *hit, const RenderObj
         .renderer = &ps,
     };
     float Ci[1][3], Oi[1][3];
-    RayesShadeOutputs out = {Ci, Oi, NULL};
+    RayesShadeOutputs out = {Ci, Oi, NULL, NULL};
     w->stats.shading_points[RY_MIN(diffuse_depth, RENDER_MAX_DEPTH)]++;
     if (kind == RAYES_RAY_DIFFUSE)
         shade_run_diffuselighting(&render_services, &ctx, obj->shader, &out);
@@ -207,10 +208,11 @@ static void light_point(Worker *w, const RayesShadeCtx *ctx, size_t i, const Lig
 }
 
 static void svc_direct_lighting(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
-                                int n_shadow_rays, const float *roughness, float (*diffuse)[3],
-                                float (*specular)[3])
+                                int n_shadow_rays, const char *category, const float *roughness,
+                                float (*diffuse)[3], float (*specular)[3])
 {
     (void)sv;
+    (void)category; /* every light is an area light without categories, for now */
     const PathState *ps = ctx->renderer;
     Worker *w = ps->w;
     int n = n_shadow_rays > 0 ? n_shadow_rays
@@ -219,7 +221,7 @@ static void svc_direct_lighting(const RayesShaderServices *sv, const RayesShadeC
     int want_spec = specular && ctx->I;
     for (size_t i = 0; i < ctx->n_points; i++) {
         Vec3 d = v3(0, 0, 0), s = v3(0, 0, 0);
-        float e = roughness && roughness[i] > 0.0f ? 1.0f / roughness[i] : 10.0f;
+        float e = 1.0f / (roughness && roughness[i] > 0.0f ? roughness[i] : 0.1f);
         for (size_t l = 0; l < w->rs->n_lights && n > 0; l++) {
             uint32_t pattern =
                 (uint32_t)hash_combine(hash_combine(ps->keys[point(ctx, i)], DIM_LIGHT), l);
@@ -266,8 +268,33 @@ static void svc_indirect_diffuse(const RayesShaderServices *sv, const RayesShade
     }
 }
 
+static void svc_ambient(const RayesShaderServices *sv, const RayesShadeCtx *ctx, float (*out)[3])
+{
+    (void)sv;
+    memset(out, 0, ctx->n_points * sizeof *out); /* no ambient lights yet */
+}
+
+/* Radiance along d from point i of ctx, a specular or refracted ray. */
+static Vec3 trace_specular(const RayesShadeCtx *ctx, size_t i, Vec3 d, uint64_t key)
+{
+    const PathState *ps = ctx->renderer;
+    Worker *w = ps->w;
+    size_t j = point(ctx, i);
+    Vec3 Ng = load3(ctx->Ng[i]);
+    float off = ps->offset[j];
+    Vec3 o = v3_madd(load3(ctx->P[i]), Ng, v3_dot(d, Ng) >= 0.0f ? off : -off);
+    /* A mirror keeps the spread and adds the curvature's share. */
+    float width = ps->diff[j].width;
+    RayDiff diff = {width, ps->diff[j].spread + 2.0f * ps->curvature[j] * width};
+    Ray ray = {o, d, ray_epsilon(w), INFINITY, RAYES_RAY_SPECULAR};
+    w->stats.rays_specular++;
+    return integrator_trace(w, &ray, RAYES_RAY_SPECULAR, ctx->diffuse_depth,
+                            ctx->specular_depth + 1, key, diff, NULL);
+}
+
 static void svc_indirect_specular(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
-                                  const float (*dir)[3], float (*out)[3])
+                                  const float (*dir)[3], const float *roughness, int n_rays,
+                                  float (*out)[3])
 {
     (void)sv;
     const PathState *ps = ctx->renderer;
@@ -277,34 +304,166 @@ static void svc_indirect_specular(const RayesShaderServices *sv, const RayesShad
             store3(out[i], v3(0, 0, 0));
             continue;
         }
-        size_t j = point(ctx, i);
-        Vec3 d = v3_normalize(load3(dir[i])), Ng = load3(ctx->Ng[i]);
-        float off = ps->offset[j];
-        Vec3 o = v3_madd(load3(ctx->P[i]), Ng, v3_dot(d, Ng) >= 0.0f ? off : -off);
-        /* A mirror keeps the spread and adds the curvature's share. */
-        float width = ps->diff[j].width;
-        RayDiff diff = {width, ps->diff[j].spread + 2.0f * ps->curvature[j] * width};
-        Ray ray = {o, d, ray_epsilon(w), INFINITY, RAYES_RAY_SPECULAR};
-        w->stats.rays_specular++;
-        Vec3 L = integrator_trace(w, &ray, RAYES_RAY_SPECULAR, ctx->diffuse_depth,
-                                  ctx->specular_depth + 1,
-                                  hash_combine(ps->keys[j], DIM_SPECULAR), diff, NULL);
-        store3(out[i], L);
+        uint64_t key = hash_combine(ps->keys[point(ctx, i)], DIM_SPECULAR);
+        Vec3 d = v3_normalize(load3(dir[i]));
+        float r = roughness ? roughness[i] : 0.0f;
+        if (r <= 0.0f) {
+            store3(out[i], trace_specular(ctx, i, d, key));
+            continue;
+        }
+        /* A glossy lobe: directions with density proportional to cos^e of
+         * their angle to d; those below the surface bring nothing. */
+        int n = n_rays > 0 ? n_rays
+                : ctx->diffuse_depth == 0 ? w->set->diffuse_rays
+                                          : w->set->diffuse_rays_deep;
+        float e = 1.0f / r;
+        Vec3 Ng = load3(ctx->Ng[i]), sum = v3(0, 0, 0), t, b;
+        v3_basis(d, &t, &b);
+        for (int s = 0; s < n; s++) {
+            float a1, a2;
+            cmj_sample_2d((uint32_t)s, (uint32_t)n, (uint32_t)key, &a1, &a2);
+            float cos_t = powf(a1, 1.0f / (e + 1.0f)), sin_t = sqrtf(fmaxf(0.0f, 1.0f - cos_t * cos_t));
+            float phi = 2.0f * (float)M_PI * a2;
+            Vec3 wi = v3_add(v3_add(v3_scale(t, sin_t * cosf(phi)), v3_scale(b, sin_t * sinf(phi))),
+                             v3_scale(d, cos_t));
+            if (v3_dot(wi, Ng) <= 0.0f)
+                continue;
+            sum = v3_add(sum, trace_specular(ctx, i, wi, hash_combine(key, (uint64_t)s + 1)));
+        }
+        store3(out[i], n > 0 ? v3_scale(sum, 1.0f / n) : v3(0, 0, 0));
     }
 }
+
+static void svc_indirect_refraction(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
+                                    const float (*dir)[3], float (*out)[3])
+{
+    (void)sv;
+    const PathState *ps = ctx->renderer;
+    for (size_t i = 0; i < ctx->n_points; i++) {
+        if (ctx->specular_depth >= ps->w->set->specular_depth) {
+            store3(out[i], v3(0, 0, 0));
+            continue;
+        }
+        uint64_t key = hash_combine(ps->keys[point(ctx, i)], DIM_REFRACTION);
+        store3(out[i], trace_specular(ctx, i, v3_normalize(load3(dir[i])), key));
+    }
+}
+
+static void svc_transmission(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
+                             const float (*to)[3], float (*out)[3])
+{
+    (void)sv;
+    const PathState *ps = ctx->renderer;
+    Worker *w = ps->w;
+    for (size_t i = 0; i < ctx->n_points; i++) {
+        Vec3 P = load3(ctx->P[i]), d = v3_sub(load3(to[i]), P);
+        float len = v3_length(d);
+        float vis = 1.0f;
+        if (len > 0.0f) {
+            Vec3 Ng = load3(ctx->Ng[i]);
+            float off = ps->offset[point(ctx, i)];
+            Vec3 o = v3_madd(P, Ng, v3_dot(d, Ng) >= 0.0f ? off : -off);
+            Vec3 wi = v3_sub(load3(to[i]), o);
+            Ray shadow = {o, wi, ray_epsilon(w) / v3_length(wi), 1.0f - 1e-4f, RAYES_RAY_SHADOW};
+            w->stats.rays_shadow++;
+            vis = accel_occluded(w->rs->accel, &shadow) ? 0.0f : 1.0f; /* all surfaces opaque */
+        }
+        store3(out[i], v3(vis, vis, vis));
+    }
+}
+
+static int svc_texture(const RayesShaderServices *sv, const RayesShadeCtx *ctx, const char *name,
+                       const float *s, const float *t, const float *ds, const float *dt,
+                       float (*rgb)[3], float *alpha)
+{
+    (void)sv, (void)name, (void)s, (void)t, (void)ds, (void)dt;
+    memset(rgb, 0, ctx->n_points * sizeof *rgb);
+    for (size_t i = 0; alpha && i < ctx->n_points; i++)
+        alpha[i] = 1.0f;
+    return -1; /* no textures yet */
+}
+
+static float svc_noise(const RayesShaderServices *sv, const float p[3])
+{
+    (void)sv;
+    return noise3(p[0], p[1], p[2]);
+}
+
+static float svc_fbm(const RayesShaderServices *sv, const float p[3], int octaves,
+                     float lacunarity, float gain)
+{
+    (void)sv;
+    return noise_fbm(p, octaves, lacunarity, gain);
+}
+
+static float svc_turbulence(const RayesShaderServices *sv, const float p[3], int octaves,
+                            float lacunarity, float gain)
+{
+    (void)sv;
+    return noise_turbulence(p, octaves, lacunarity, gain);
+}
+
+static int svc_attribute(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
+                         const char *name, float *value, int n)
+{
+    (void)sv, (void)ctx, (void)name, (void)value, (void)n;
+    return 0;
+}
+
+static int put_floats(float *value, int n, const float *have, int n_have)
+{
+    for (int k = 0; k < n && k < n_have; k++)
+        value[k] = have[k];
+    return n_have;
+}
+
+static int svc_option(const RayesShaderServices *sv, const RayesShadeCtx *ctx, const char *name,
+                      float *value, int n)
+{
+    (void)sv;
+    const RenderSettings *set = ((const PathState *)ctx->renderer)->w->set;
+    if (strcmp(name, "resolution") == 0)
+        return put_floats(value, n, (float[]){(float)set->width, (float)set->height}, 2);
+    if (strcmp(name, "bounces") == 0)
+        return put_floats(value, n, (float[]){(float)set->bounces}, 1);
+    if (strcmp(name, "samples") == 0)
+        return put_floats(value, n, (float[]){(float)set->spp}, 1);
+    if (strcmp(name, "shadowrays") == 0)
+        return put_floats(value, n, (float[]){(float)set->shadow_rays, (float)set->shadow_rays_deep}, 2);
+    if (strcmp(name, "diffuserays") == 0)
+        return put_floats(value, n,
+                          (float[]){(float)set->diffuse_rays, (float)set->diffuse_rays_deep}, 2);
+    return 0;
+}
+
+static const char *const service_names[] = {
+    "direct_lighting", "ambient", "indirect_diffuse", "indirect_specular", "indirect_refraction",
+    "transmission", "noise", "fbm", "turbulence", "attribute", "option",
+};
 
 static int svc_supports(const RayesShaderServices *sv, const char *service)
 {
     (void)sv;
-    return strcmp(service, "direct_lighting") == 0 || strcmp(service, "indirect_diffuse") == 0 ||
-           strcmp(service, "indirect_specular") == 0;
+    for (size_t i = 0; i < sizeof service_names / sizeof service_names[0]; i++)
+        if (strcmp(service, service_names[i]) == 0)
+            return 1;
+    return 0;
 }
 
 const RayesShaderServices render_services = {
     .abi_version = RAYES_SHADER_ABI_VERSION,
     .struct_size = sizeof(RayesShaderServices),
     .direct_lighting = svc_direct_lighting,
+    .ambient = svc_ambient,
     .indirect_diffuse = svc_indirect_diffuse,
     .indirect_specular = svc_indirect_specular,
+    .indirect_refraction = svc_indirect_refraction,
+    .transmission = svc_transmission,
+    .texture = svc_texture,
+    .noise = svc_noise,
+    .fbm = svc_fbm,
+    .turbulence = svc_turbulence,
+    .attribute = svc_attribute,
+    .option = svc_option,
     .supports = svc_supports,
 };

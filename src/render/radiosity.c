@@ -268,7 +268,7 @@ static void fill_radiosity(void *user, const CacheKey *key, size_t n, float (*ou
         .du = fp.du, .dv = fp.dv, .I = NULL, .Cs = (const float(*)[3])fp.Cs,
         .Os = (const float(*)[3])fp.Os, .renderer = &ps,
     };
-    RayesShadeOutputs o = {fp.Ci, fp.Oi, NULL};
+    RayesShadeOutputs o = {fp.Ci, fp.Oi, NULL, NULL};
     w->stats.shading_points[RY_MIN(key->depth, RENDER_MAX_DEPTH)] += n;
     shade_run_diffuselighting(&render_services, &ctx, obj->shader, &o);
     memcpy(out, fp.Ci, n * sizeof *out);

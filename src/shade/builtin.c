@@ -49,7 +49,7 @@ static void diffuse_chunk(const RayesShaderServices *sv, const RayesShadeCtx *ct
                           const float emit[3], RayesShadeOutputs *out)
 {
     float dd[SHADE_CHUNK][3], id[SHADE_CHUNK][3];
-    sv->direct_lighting(sv, ctx, 0, NULL, dd, NULL);
+    sv->direct_lighting(sv, ctx, 0, NULL, NULL, dd, NULL);
     sv->indirect_diffuse(sv, ctx, 0, id);
     for (size_t i = 0; i < ctx->n_points; i++)
         for (int c = 0; c < 3; c++)
@@ -72,7 +72,7 @@ static void by_chunks(const RayesShaderServices *sv, const RayesShadeCtx *ctx, c
         RayesShadeCtx sub;
         shade_ctx_slice(ctx, start, n, &sub);
         RayesShadeOutputs o = {out->Ci + start, out->Oi + start,
-                               out->Irradiance ? out->Irradiance + start : NULL};
+                               out->Irradiance ? out->Irradiance + start : NULL, NULL};
         fn(sv, &sub, params, &o);
     }
     set_opacity(ctx, out);
@@ -127,7 +127,7 @@ static void plastic_chunk(const RayesShaderServices *sv, const RayesShadeCtx *ct
     float dd[SHADE_CHUNK][3], id[SHADE_CHUNK][3], ds[SHADE_CHUNK][3], rough[SHADE_CHUNK];
     for (size_t i = 0; i < ctx->n_points; i++)
         rough[i] = p->roughness;
-    sv->direct_lighting(sv, ctx, 0, rough, dd, ds);
+    sv->direct_lighting(sv, ctx, 0, NULL, rough, dd, ds);
     sv->indirect_diffuse(sv, ctx, 0, id);
     for (size_t i = 0; i < ctx->n_points; i++)
         for (int c = 0; c < 3; c++)
@@ -179,7 +179,7 @@ static void mirror_chunk(const RayesShaderServices *sv, const RayesShadeCtx *ctx
         for (int c = 0; c < 3; c++)
             dir[i][c] = I[c] - d * N[c];
     }
-    sv->indirect_specular(sv, ctx, (const float(*)[3])dir, L);
+    sv->indirect_specular(sv, ctx, (const float(*)[3])dir, NULL, 1, L);
     for (size_t i = 0; i < ctx->n_points; i++)
         for (int c = 0; c < 3; c++)
             out->Ci[i][c] = p->Kr * p->specularcolor[c] * L[i][c];

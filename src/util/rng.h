@@ -47,7 +47,8 @@ enum {
     DIM_LIGHT = 2,      /* shadow-ray positions on lights */
     DIM_DIFFUSE = 3,    /* diffuse-ray directions */
     DIM_SPECULAR = 4,   /* specular rays */
-    DIM_PATH = 5        /* child path keys */
+    DIM_PATH = 5,       /* child path keys */
+    DIM_REFRACTION = 6  /* refracted rays */
 };
 
 #endif /* RAYES_UTIL_RNG_H */

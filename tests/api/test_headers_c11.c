@@ -84,7 +84,7 @@ int main(void)
     ctx.n_points = 1;
     ctx.ray_type = RAYES_RAY_CAMERA | RAYES_RAY_SPECULAR;
     ctx.P = (const float(*)[3])P;
-    RayesShadeOutputs out = {Ci, Oi, NULL};
+    RayesShadeOutputs out = {Ci, Oi, NULL, NULL};
     flat_class.lighting(NULL, &ctx, &p, &out);
     EXPECT(Ci[0][1] == 0.25f && Oi[0][2] == 1.0f);
 

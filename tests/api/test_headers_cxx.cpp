@@ -88,7 +88,7 @@ int main()
     ctx.n_points = 1;
     ctx.ray_type = RAYES_RAY_CAMERA | RAYES_RAY_DIFFUSE;
     ctx.P = P;
-    RayesShadeOutputs out = {Ci, Oi, nullptr};
+    RayesShadeOutputs out = {Ci, Oi, nullptr, nullptr};
     flat_class.lighting(nullptr, &ctx, &p, &out);
     EXPECT(Ci[0][1] == 0.25f && Oi[0][2] == 1.0f);
 

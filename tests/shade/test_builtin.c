@@ -15,9 +15,10 @@ enum { N = 70 }; /* more than one SHADE_CHUNK */
 static int saw_I_in_specular_call;
 
 static void stub_direct(const RayesShaderServices *sv, const RayesShadeCtx *ctx, int n,
-                        const float *roughness, float (*diffuse)[3], float (*specular)[3])
+                        const char *category, const float *roughness, float (*diffuse)[3],
+                        float (*specular)[3])
 {
-    (void)sv, (void)n, (void)roughness;
+    (void)sv, (void)n, (void)category, (void)roughness;
     for (size_t i = 0; i < ctx->n_points; i++)
         for (int c = 0; c < 3; c++) {
             if (diffuse)
@@ -39,9 +40,9 @@ static void stub_indirect(const RayesShaderServices *sv, const RayesShadeCtx *ct
 }
 
 static void stub_specular(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
-                          const float (*dir)[3], float (*out)[3])
+                          const float (*dir)[3], const float *roughness, int n, float (*out)[3])
 {
-    (void)sv;
+    (void)sv, (void)roughness, (void)n;
     for (size_t i = 0; i < ctx->n_points; i++)
         for (int c = 0; c < 3; c++)
             out[i][c] = dir[i][c]; /* returns the direction, so the test can check it */
@@ -53,8 +54,14 @@ static int stub_supports(const RayesShaderServices *sv, const char *s)
     return 1;
 }
 
-static const RayesShaderServices stub = {RAYES_SHADER_ABI_VERSION, sizeof(RayesShaderServices),
-                                         stub_direct, stub_indirect, stub_specular, stub_supports};
+static const RayesShaderServices stub = {
+    .abi_version = RAYES_SHADER_ABI_VERSION,
+    .struct_size = sizeof(RayesShaderServices),
+    .direct_lighting = stub_direct,
+    .indirect_diffuse = stub_indirect,
+    .indirect_specular = stub_specular,
+    .supports = stub_supports,
+};
 
 static float P[N][3], Nn[N][3], I[N][3], Cs[N][3], Os[N][3], Ci[N][3], Oi[N][3];
 
@@ -94,7 +101,7 @@ static void test_matte(void)
     RayesParam kd = {"Kd", RAYES_PARAM_FLOAT, {0.8f, 0, 0}, NULL};
     ShaderInstance m = instance("matte", &kd, 1);
     RayesShadeCtx ctx = context();
-    RayesShadeOutputs out = {Ci, Oi, NULL};
+    RayesShadeOutputs out = {Ci, Oi, NULL, NULL};
     shade_run_lighting(&stub, &ctx, &m, &out);
     for (int i = 0; i < N; i++)
         for (int c = 0; c < 3; c++)
@@ -113,7 +120,7 @@ static void test_plastic_splits_highlight(void)
                        {"specularcolor", RAYES_PARAM_COLOR, {1, 0.5f, 0.25f}, NULL}};
     ShaderInstance m = instance("plastic", p, 2);
     RayesShadeCtx ctx = context();
-    RayesShadeOutputs out = {Ci, Oi, NULL};
+    RayesShadeOutputs out = {Ci, Oi, NULL, NULL};
     shade_run_lighting(&stub, &ctx, &m, &out);
     float lit[N][3];
     memcpy(lit, Ci, sizeof lit);
@@ -135,7 +142,7 @@ static void test_mirror_reflects(void)
     RayesParam kr = {"Kr", RAYES_PARAM_FLOAT, {0.9f, 0, 0}, NULL};
     ShaderInstance m = instance("mirror", &kr, 1);
     RayesShadeCtx ctx = context();
-    RayesShadeOutputs out = {Ci, Oi, NULL};
+    RayesShadeOutputs out = {Ci, Oi, NULL, NULL};
     shade_run_lighting(&stub, &ctx, &m, &out);
     /* The reflection of (0.6, 0, -0.8) about +z is (0.6, 0, 0.8). */
     CHECK_NEAR(Ci[3][0], 0.9 * 0.6, 1e-6);
