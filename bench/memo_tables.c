@@ -25,7 +25,7 @@
 #include <sys/stat.h>
 
 #include "io/builtin.h"
-#include "io/image.h"
+#include "image/image.h"
 #include "rayes/rayes.h"
 
 typedef struct Args {
@@ -113,7 +113,7 @@ static void save(const Args *a, const Row *r, const char *tag)
     char path[1024], err[1024];
     snprintf(path, sizeof path, "%s/%s-b%d-%s.png", a->out, tag, r->bounces,
              r->cache ? "cached" : "uncached");
-    if (io_write_image(path, r->w, r->h, r->rgba, err, sizeof err) != RAYES_OK)
+    if (image_write(path, r->w, r->h, r->rgba, err, sizeof err) != RAYES_OK)
         die(err);
 }
 

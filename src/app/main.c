@@ -15,7 +15,7 @@
 #include <unistd.h>
 
 #include "io/builtin.h"
-#include "io/image.h"
+#include "image/image.h"
 #include "io/stats_json.h"
 #include "rayes/rayes.h"
 #include "util/log.h"
@@ -194,7 +194,7 @@ static void parse_args(int argc, char **argv, Args *a)
         if (strcmp(o, "-o") == 0) {
             if (a->n_outputs == MAX_OUTPUTS)
                 die_usage("-o: at most %d outputs", MAX_OUTPUTS);
-            if (io_image_format_from_path(v) == IMAGE_FORMAT_UNKNOWN)
+            if (image_format_from_path(v) == IMAGE_FORMAT_UNKNOWN)
                 die_usage("-o %s: expected a file name ending in .exr or .png", v);
             a->outputs[a->n_outputs++] = v;
         } else if (strcmp(o, "--res") == 0)
@@ -393,7 +393,7 @@ static int cmd_render(int argc, char **argv)
     }
     int status = 0, written = 0; /* outputs written whole */
     while (written < a.n_outputs && status == 0) {
-        if (io_write_image(a.outputs[written], img->width, img->height, img->rgba, err,
+        if (image_write(a.outputs[written], img->width, img->height, img->rgba, err,
                            sizeof err) == RAYES_OK) {
             written++;
         } else {

@@ -1,5 +1,5 @@
 /*
- * io/image_png.c — PNG writing and reading through libpng.
+ * image/image_png.c — PNG writing and reading through libpng.
  *
  * Writing: 8-bit RGBA. Colour is the sRGB transfer curve applied to linear
  * values clamped to [0, 1] (NaN becomes 0); alpha is stored linearly, as
@@ -19,8 +19,8 @@
  *
  * Thread-safety: reentrant; each call has its own libpng structures.
  */
-#include "io/image.h"
-#include "io/image_internal.h"
+#include "image/image.h"
+#include "image/image_internal.h"
 
 #include <errno.h>
 #include <math.h>
@@ -83,7 +83,7 @@ static void write_png_bytes(png_structp png, png_bytep data, size_t n_bytes)
     }
 }
 
-/* io_write_via_temp flushes once at the end, which reports the error. */
+/* image_write_via_temp flushes once at the end, which reports the error. */
 static void flush_png(png_structp png)
 {
     (void)png;
@@ -106,14 +106,14 @@ static RayesError report(const PngIo *io, const char *path, const char *doing, c
                          size_t err_size)
 {
     if (io->sys_errno != 0) {
-        io_set_errno_error(err, err_size, io->sys_errno, "%s: %s", path, doing);
+        image_set_errno_error(err, err_size, io->sys_errno, "%s: %s", path, doing);
         return RAYES_ERROR_IO;
     }
     if (io->truncated) {
-        io_set_error(err, err_size, "%s: %s: the file is truncated", path, doing);
+        image_set_error(err, err_size, "%s: %s: the file is truncated", path, doing);
         return RAYES_ERROR_PARSE;
     }
-    io_set_error(err, err_size, "%s: %s: %s", path, doing,
+    image_set_error(err, err_size, "%s: %s: %s", path, doing,
                  io->message[0] ? io->message : "unknown libpng error");
     /* libpng says "Out of Memory", ours "out of memory". */
     return strcasestr(io->message, "out of memory") ? RAYES_ERROR_OUT_OF_MEMORY : RAYES_ERROR_PARSE;
@@ -162,7 +162,7 @@ static int write_png_all(png_structp png, png_infop info, const PngImage *image,
     return 0;
 }
 
-/* IoBodyWriter for io_write_via_temp; data is a PngImage. */
+/* ImageBodyWriter for image_write_via_temp; data is a PngImage. */
 static RayesError write_png_body(FILE *file, const char *path, const void *data, char *err,
                                  size_t err_size)
 {
@@ -175,7 +175,7 @@ static RayesError write_png_body(FILE *file, const char *path, const void *data,
     png_infop info = png ? png_create_info_struct(png) : NULL;
     RayesError rv = RAYES_OK;
     if (!info) {
-        io_set_error(err, err_size, "%s: out of memory", path);
+        image_set_error(err, err_size, "%s: out of memory", path);
         rv = RAYES_ERROR_OUT_OF_MEMORY;
     } else {
         png_set_write_fn(png, &io, write_png_bytes, flush_png);
@@ -189,16 +189,16 @@ static RayesError write_png_body(FILE *file, const char *path, const void *data,
     return rv;
 }
 
-RayesError io_write_png(const char *path, int width, int height, const float *rgba, char *err,
+RayesError image_write_png(const char *path, int width, int height, const float *rgba, char *err,
                         size_t err_size)
 {
     if (!path || !rgba || width <= 0 || height <= 0) {
-        io_set_error(err, err_size, "%s: cannot write PNG: invalid arguments (%d x %d pixels%s)",
+        image_set_error(err, err_size, "%s: cannot write PNG: invalid arguments (%d x %d pixels%s)",
                      path ? path : "(null)", width, height, rgba ? "" : ", no pixels");
         return RAYES_ERROR_INVALID_ARGUMENT;
     }
     PngImage image = {width, height, rgba};
-    return io_write_via_temp(path, write_png_body, &image, err, err_size);
+    return image_write_via_temp(path, write_png_body, &image, err, err_size);
 }
 
 /* -------------------------------------------------------------- reading */
@@ -273,7 +273,7 @@ static RayesError read_png_file(PngIo *io, const char *path, char *err, size_t e
     png_infop info = png ? png_create_info_struct(png) : NULL;
     if (!info) {
         png_destroy_read_struct(&png, NULL, NULL);
-        io_set_error(err, err_size, "%s: out of memory", path);
+        image_set_error(err, err_size, "%s: out of memory", path);
         return RAYES_ERROR_OUT_OF_MEMORY;
     }
     png_set_read_fn(png, io, read_png_bytes);
@@ -284,11 +284,11 @@ static RayesError read_png_file(PngIo *io, const char *path, char *err, size_t e
     return RAYES_OK;
 }
 
-RayesError io_read_png(const char *path, int *width, int *height, float **rgba, char *err,
+RayesError image_read_png(const char *path, int *width, int *height, float **rgba, char *err,
                        size_t err_size)
 {
     if (!path || !width || !height || !rgba) {
-        io_set_error(err, err_size, "%s: cannot read PNG: invalid arguments",
+        image_set_error(err, err_size, "%s: cannot read PNG: invalid arguments",
                      path ? path : "(null)");
         return RAYES_ERROR_INVALID_ARGUMENT;
     }
@@ -296,14 +296,14 @@ RayesError io_read_png(const char *path, int *width, int *height, float **rgba, 
     *width = *height = 0;
     PngIo io = {.file = fopen(path, "rbe")};
     if (!io.file) {
-        io_set_errno_error(err, err_size, errno, "%s: cannot open", path);
+        image_set_errno_error(err, err_size, errno, "%s: cannot open", path);
         return RAYES_ERROR_IO;
     }
     uint8_t signature[8];
     RayesError rv = RAYES_OK;
     if (fread(signature, 1, sizeof signature, io.file) != sizeof signature ||
         png_sig_cmp(signature, 0, sizeof signature) != 0) {
-        io_set_error(err, err_size, "%s: not a PNG file", path);
+        image_set_error(err, err_size, "%s: not a PNG file", path);
         rv = RAYES_ERROR_PARSE;
     } else {
         rv = read_png_file(&io, path, err, err_size);
@@ -312,7 +312,7 @@ RayesError io_read_png(const char *path, int *width, int *height, float **rgba, 
     if (rv == RAYES_OK) {
         *rgba = decode_pixels(&io);
         if (!*rgba) {
-            io_set_error(err, err_size, "%s: out of memory", path);
+            image_set_error(err, err_size, "%s: out of memory", path);
             rv = RAYES_ERROR_OUT_OF_MEMORY;
         } else {
             *width = (int)io.width;

@@ -1,6 +1,6 @@
 /*
- * tests/io/test_image.c — the EXR and PNG writers and readers of
- * io/image.h: round trips within the formats' precision, files of other
+ * tests/image/test_image.c — the EXR and PNG writers and readers of
+ * image/image.h: round trips within the formats' precision, files of other
  * layouts (float, uint, tiled, no alpha, grey PNG) written here with the
  * libraries directly, dispatch by extension, and failures: a missing
  * directory, garbage and truncated files, a write that runs out of room
@@ -22,7 +22,7 @@
 #include <OpenEXR/openexr.h>
 #include <png.h>
 
-#include "io/image.h"
+#include "image/image.h"
 #include "test.h"
 
 #ifndef RAYES_TEST_TMP
@@ -258,13 +258,13 @@ static void test_exr_round_trip(void)
 
     /* Writing over an existing file replaces it. */
     float zeros[W * H * 4] = {0};
-    CHECK(io_write_exr(path, W, H, zeros, err, sizeof err) == RAYES_OK);
-    CHECK(io_write_exr(path, W, H, rgba, err, sizeof err) == RAYES_OK);
+    CHECK(image_write_exr(path, W, H, zeros, err, sizeof err) == RAYES_OK);
+    CHECK(image_write_exr(path, W, H, rgba, err, sizeof err) == RAYES_OK);
     CHECK(count_leftovers(SCRATCH_DIR, "round_trip.exr") == 0);
 
     int w = 0, h = 0;
     float *back = NULL;
-    CHECK(io_read_exr(path, &w, &h, &back, err, sizeof err) == RAYES_OK);
+    CHECK(image_read_exr(path, &w, &h, &back, err, sizeof err) == RAYES_OK);
     CHECK(w == W && h == H && back != NULL);
     if (back && w == W && h == H)
         for (int i = 0; i < W * H * 4; i++)
@@ -277,7 +277,7 @@ static void test_exr_round_trip(void)
     free(back);
 }
 
-/* The header says what io_write_exr promises: half RGBA, ZIP, scanlines,
+/* The header says what image_write_exr promises: half RGBA, ZIP, scanlines,
  * renderer = "rayes". */
 static void test_exr_header(void)
 {
@@ -285,10 +285,10 @@ static void test_exr_header(void)
     scratch(path, sizeof path, "header.exr");
     /* Noise does not compress, so chunks are stored raw: read them back too. */
     float *rgba = noise_image(19, 37, 7);
-    CHECK(io_write_exr(path, 19, 37, rgba, err, sizeof err) == RAYES_OK);
+    CHECK(image_write_exr(path, 19, 37, rgba, err, sizeof err) == RAYES_OK);
     int w = 0, h = 0;
     float *back = NULL;
-    CHECK(io_read_exr(path, &w, &h, &back, err, sizeof err) == RAYES_OK);
+    CHECK(image_read_exr(path, &w, &h, &back, err, sizeof err) == RAYES_OK);
     int mismatches = 0;
     for (int i = 0; back && w == 19 && h == 37 && i < 19 * 37 * 4; i++)
         mismatches += !(fabs(back[i] - rgba[i]) <= half_tolerance(rgba[i]));
@@ -346,7 +346,7 @@ static void test_exr_reads_other_layouts(void)
         CHECK(write_test_exr(path, t, rgba));
         int w = 0, h = 0;
         float *back = NULL;
-        CHECK(io_read_exr(path, &w, &h, &back, err, sizeof err) == RAYES_OK);
+        CHECK(image_read_exr(path, &w, &h, &back, err, sizeof err) == RAYES_OK);
         if (err[0])
             fprintf(stderr, "layout %zu: %s\n", k, err);
         CHECK(w == t->width && h == t->height);
@@ -371,11 +371,11 @@ static void test_png_round_trip(void)
         rgba[i] = edges[i];
     char path[512], err[512] = "";
     scratch(path, sizeof path, "round_trip.png");
-    CHECK(io_write_png(path, W, H, rgba, err, sizeof err) == RAYES_OK);
+    CHECK(image_write_png(path, W, H, rgba, err, sizeof err) == RAYES_OK);
     CHECK(count_leftovers(SCRATCH_DIR, "round_trip.png") == 0);
     int w = 0, h = 0;
     float *back = NULL;
-    CHECK(io_read_png(path, &w, &h, &back, err, sizeof err) == RAYES_OK);
+    CHECK(image_read_png(path, &w, &h, &back, err, sizeof err) == RAYES_OK);
     CHECK(w == W && h == H && back != NULL);
     int worst = 0;
     for (int i = 0; back && w == W && h == H && i < W * H * 4; i++) {
@@ -417,7 +417,7 @@ static void test_png_reads_grey(void)
         CHECK(png_image_write_to_file(&image, path, 0, with_alpha ? grey_alpha : grey, 0, NULL));
         int w = 0, h = 0;
         float *back = NULL;
-        CHECK(io_read_png(path, &w, &h, &back, err, sizeof err) == RAYES_OK);
+        CHECK(image_read_png(path, &w, &h, &back, err, sizeof err) == RAYES_OK);
         CHECK(w == 3 && h == 2 && back != NULL);
         for (int i = 0; back && w == 3 && h == 2 && i < 6; i++) {
             int g = with_alpha ? grey_alpha[2 * i] : grey[i];
@@ -432,33 +432,33 @@ static void test_png_reads_grey(void)
 
 static void test_format_dispatch(void)
 {
-    CHECK(io_image_format_from_path("a.exr") == IMAGE_FORMAT_EXR);
-    CHECK(io_image_format_from_path("dir/B.EXR") == IMAGE_FORMAT_EXR);
-    CHECK(io_image_format_from_path("x.PnG") == IMAGE_FORMAT_PNG);
-    CHECK(io_image_format_from_path("/a.b/c.png") == IMAGE_FORMAT_PNG);
-    CHECK(io_image_format_from_path("c.png.bak") == IMAGE_FORMAT_UNKNOWN);
-    CHECK(io_image_format_from_path("dir.exr/file") == IMAGE_FORMAT_UNKNOWN);
-    CHECK(io_image_format_from_path("noext") == IMAGE_FORMAT_UNKNOWN);
-    CHECK(io_image_format_from_path(".png") == IMAGE_FORMAT_UNKNOWN);
-    CHECK(io_image_format_from_path("") == IMAGE_FORMAT_UNKNOWN);
-    CHECK(io_image_format_from_path(NULL) == IMAGE_FORMAT_UNKNOWN);
+    CHECK(image_format_from_path("a.exr") == IMAGE_FORMAT_EXR);
+    CHECK(image_format_from_path("dir/B.EXR") == IMAGE_FORMAT_EXR);
+    CHECK(image_format_from_path("x.PnG") == IMAGE_FORMAT_PNG);
+    CHECK(image_format_from_path("/a.b/c.png") == IMAGE_FORMAT_PNG);
+    CHECK(image_format_from_path("c.png.bak") == IMAGE_FORMAT_UNKNOWN);
+    CHECK(image_format_from_path("dir.exr/file") == IMAGE_FORMAT_UNKNOWN);
+    CHECK(image_format_from_path("noext") == IMAGE_FORMAT_UNKNOWN);
+    CHECK(image_format_from_path(".png") == IMAGE_FORMAT_UNKNOWN);
+    CHECK(image_format_from_path("") == IMAGE_FORMAT_UNKNOWN);
+    CHECK(image_format_from_path(NULL) == IMAGE_FORMAT_UNKNOWN);
 
     float rgba[2 * 2 * 4] = {0.25f, 0.5f, 1.0f, 1.0f, 0.0f, 0.0f, 0.0f, 0.5f};
     char path[512], err[512] = "";
     int w, h;
     float *back = NULL;
-    CHECK(io_write_image(scratch(path, sizeof path, "dispatch.EXR"), 2, 2, rgba, err, sizeof err) ==
+    CHECK(image_write(scratch(path, sizeof path, "dispatch.EXR"), 2, 2, rgba, err, sizeof err) ==
           RAYES_OK);
-    CHECK(io_read_exr(path, &w, &h, &back, err, sizeof err) == RAYES_OK);
+    CHECK(image_read_exr(path, &w, &h, &back, err, sizeof err) == RAYES_OK);
     CHECK(back && back[1] == 0.5f);
     free(back);
-    CHECK(io_write_image(scratch(path, sizeof path, "dispatch.png"), 2, 2, rgba, err, sizeof err) ==
+    CHECK(image_write(scratch(path, sizeof path, "dispatch.png"), 2, 2, rgba, err, sizeof err) ==
           RAYES_OK);
-    CHECK(io_read_png(path, &w, &h, &back, err, sizeof err) == RAYES_OK);
+    CHECK(image_read_png(path, &w, &h, &back, err, sizeof err) == RAYES_OK);
     CHECK(back && w == 2 && h == 2);
     free(back);
 
-    CHECK(io_write_image(scratch(path, sizeof path, "dispatch.tiff"), 2, 2, rgba, err,
+    CHECK(image_write(scratch(path, sizeof path, "dispatch.tiff"), 2, 2, rgba, err,
                          sizeof err) == RAYES_ERROR_INVALID_ARGUMENT);
     CHECK(good_message(err, path));
     CHECK(!file_exists(path));
@@ -469,15 +469,15 @@ static void test_bad_arguments(void)
     float rgba[4] = {0};
     char path[512], err[512] = "";
     scratch(path, sizeof path, "bad_arguments.exr");
-    CHECK(io_write_exr(path, 0, 1, rgba, err, sizeof err) == RAYES_ERROR_INVALID_ARGUMENT);
+    CHECK(image_write_exr(path, 0, 1, rgba, err, sizeof err) == RAYES_ERROR_INVALID_ARGUMENT);
     CHECK(good_message(err, path));
-    CHECK(io_write_exr(path, 1, -3, rgba, err, sizeof err) == RAYES_ERROR_INVALID_ARGUMENT);
-    CHECK(io_write_png(path, 1, 1, NULL, err, sizeof err) == RAYES_ERROR_INVALID_ARGUMENT);
-    CHECK(io_write_exr(NULL, 1, 1, rgba, err, sizeof err) == RAYES_ERROR_INVALID_ARGUMENT);
+    CHECK(image_write_exr(path, 1, -3, rgba, err, sizeof err) == RAYES_ERROR_INVALID_ARGUMENT);
+    CHECK(image_write_png(path, 1, 1, NULL, err, sizeof err) == RAYES_ERROR_INVALID_ARGUMENT);
+    CHECK(image_write_exr(NULL, 1, 1, rgba, err, sizeof err) == RAYES_ERROR_INVALID_ARGUMENT);
     CHECK(!file_exists(path));
     CHECK(count_leftovers(SCRATCH_DIR, "bad_arguments.exr") == 0);
     /* No room for a message is allowed. */
-    CHECK(io_write_png(path, 0, 0, rgba, NULL, 0) == RAYES_ERROR_INVALID_ARGUMENT);
+    CHECK(image_write_png(path, 0, 0, rgba, NULL, 0) == RAYES_ERROR_INVALID_ARGUMENT);
 }
 
 static void test_missing_directory(void)
@@ -491,7 +491,7 @@ static void test_missing_directory(void)
         char file[600];
         snprintf(file, sizeof file, "%s%s", path, exts[i]);
         err[0] = '\0';
-        RayesError rv = io_write_image(file, 1, 1, rgba, err, sizeof err);
+        RayesError rv = image_write(file, 1, 1, rgba, err, sizeof err);
         CHECK(rv == RAYES_ERROR_IO);
         CHECK(good_message(err, file));
         CHECK(strstr(err, "does not exist") != NULL);
@@ -506,8 +506,8 @@ static void check_read_fails(const char *path, int exr)
     char err[512] = "";
     int w = -1, h = -1;
     float sentinel = 0.0f, *rgba = &sentinel; /* must be replaced by NULL */
-    RayesError rv = exr ? io_read_exr(path, &w, &h, &rgba, err, sizeof err)
-                        : io_read_png(path, &w, &h, &rgba, err, sizeof err);
+    RayesError rv = exr ? image_read_exr(path, &w, &h, &rgba, err, sizeof err)
+                        : image_read_png(path, &w, &h, &rgba, err, sizeof err);
     CHECK(rv != RAYES_OK);
     CHECK(rgba == NULL && w == 0 && h == 0);
     CHECK(good_message(err, path));
@@ -536,7 +536,7 @@ static void test_read_bad_files(void)
         snprintf(name, sizeof name, "good.%s", ext);
         scratch(good, sizeof good, name);
         float *rgba = noise_image(64, 48, 3);
-        CHECK(io_write_image(good, 64, 48, rgba, err, sizeof err) == RAYES_OK);
+        CHECK(image_write(good, 64, 48, rgba, err, sizeof err) == RAYES_OK);
         free(rgba);
         size_t n = 0;
         unsigned char *bytes = slurp(good, &n);
@@ -554,7 +554,7 @@ static void test_read_bad_files(void)
     /* No room for a message is allowed. */
     int w, h;
     float *rgba;
-    CHECK(io_read_exr(path, &w, &h, &rgba, NULL, 0) != RAYES_OK);
+    CHECK(image_read_exr(path, &w, &h, &rgba, NULL, 0) != RAYES_OK);
 }
 
 /* A write that fails half-way (the file size limit stands in for a full
@@ -566,7 +566,7 @@ static void test_failed_write_keeps_target(void)
         char path[512], err[512] = "";
         scratch(path, sizeof path, names[i]);
         float small[4 * 4 * 4] = {0.5f};
-        CHECK(io_write_image(path, 4, 4, small, err, sizeof err) == RAYES_OK);
+        CHECK(image_write(path, 4, 4, small, err, sizeof err) == RAYES_OK);
         size_t n_before = 0, n_after = 0;
         unsigned char *before = slurp(path, &n_before);
 
@@ -577,7 +577,7 @@ static void test_failed_write_keeps_target(void)
         limit.rlim_cur = 2048;
         void (*old_handler)(int) = signal(SIGXFSZ, SIG_IGN);
         CHECK(setrlimit(RLIMIT_FSIZE, &limit) == 0);
-        RayesError rv = io_write_image(path, 128, 128, big, err, sizeof err);
+        RayesError rv = image_write(path, 128, 128, big, err, sizeof err);
         setrlimit(RLIMIT_FSIZE, &old_limit);
         signal(SIGXFSZ, old_handler);
         free(big);
@@ -608,7 +608,7 @@ static void *write_repeatedly(void *arg)
         rgba[i] = i % 4 == 3 ? 1.0f : writer->value;
     for (int k = 0; k < 8; k++) {
         char err[512];
-        writer->n_failures += io_write_image(writer->path, 16, 16, rgba, err, sizeof err) != 0;
+        writer->n_failures += image_write(writer->path, 16, 16, rgba, err, sizeof err) != 0;
     }
     return NULL;
 }
@@ -632,8 +632,8 @@ static void test_concurrent_writes(void)
         }
         int w = 0, h = 0;
         float *back = NULL;
-        RayesError rv = f == 0 ? io_read_exr(path, &w, &h, &back, err, sizeof err)
-                               : io_read_png(path, &w, &h, &back, err, sizeof err);
+        RayesError rv = f == 0 ? image_read_exr(path, &w, &h, &back, err, sizeof err)
+                               : image_read_png(path, &w, &h, &back, err, sizeof err);
         CHECK(rv == RAYES_OK && w == 16 && h == 16);
         int uniform = back != NULL;
         for (int i = 0; back && i < 16 * 16 * 4; i++)

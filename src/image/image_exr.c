@@ -1,12 +1,12 @@
 /*
- * io/image_exr.c — OpenEXR writing and reading through OpenEXRCore, the C
+ * image/image_exr.c — OpenEXR writing and reading through OpenEXRCore, the C
  * API of OpenEXR 3.
  *
  * Writing: one scanline part, half R, G, B, A, ZIP compression (16 lines a
  * chunk), and a "renderer" string attribute. The library converts our
  * floats to half while packing; values too large for half (65520 and up)
  * become infinity, as in any half file. The bytes go to the temporary file
- * of io_write_via_temp through our own write function, so the library
+ * of image_write_via_temp through our own write function, so the library
  * never opens a file.
  *
  * Reading: part 0 of any flat (not deep) file, scanline or tiled (level 0
@@ -36,8 +36,8 @@
  *
  * Thread-safety: reentrant; each call has its own context and file.
  */
-#include "io/image.h"
-#include "io/image_internal.h"
+#include "image/image.h"
+#include "image/image_internal.h"
 
 #include <errno.h>
 #include <fcntl.h>
@@ -166,15 +166,15 @@ static RayesError report(const ExrIo *io, exr_result_t rv, const char *path, con
     bool io_failure = rv == EXR_ERR_READ_IO || rv == EXR_ERR_WRITE_IO ||
                       rv == EXR_ERR_FILE_ACCESS || io->first_error[0] == '\0';
     if (io_failure && io->sys_errno != 0) {
-        io_set_errno_error(err, err_size, io->sys_errno, "%s: %s", path, doing);
+        image_set_errno_error(err, err_size, io->sys_errno, "%s: %s", path, doing);
         return RAYES_ERROR_IO;
     }
     if (io_failure && io->short_read) {
-        io_set_error(err, err_size, "%s: %s: the file is truncated", path, doing);
+        image_set_error(err, err_size, "%s: %s: the file is truncated", path, doing);
         return RAYES_ERROR_PARSE;
     }
     const char *why = io->first_error[0] ? io->first_error : exr_get_default_error_message(rv);
-    io_set_error(err, err_size, "%s: %s: %s", path, doing, why);
+    image_set_error(err, err_size, "%s: %s: %s", path, doing, why);
     if (rv == EXR_ERR_OUT_OF_MEMORY)
         return RAYES_ERROR_OUT_OF_MEMORY;
     if (rv == EXR_ERR_FILE_ACCESS || rv == EXR_ERR_READ_IO || rv == EXR_ERR_WRITE_IO)
@@ -257,7 +257,7 @@ static exr_result_t write_chunks(exr_context_t ctx, const ExrImage *image)
     return rv;
 }
 
-/* IoBodyWriter for io_write_via_temp; data is an ExrImage. */
+/* ImageBodyWriter for image_write_via_temp; data is an ExrImage. */
 static RayesError write_exr_body(FILE *file, const char *path, const void *data, char *err,
                                  size_t err_size)
 {
@@ -283,16 +283,16 @@ static RayesError write_exr_body(FILE *file, const char *path, const void *data,
     return RAYES_OK;
 }
 
-RayesError io_write_exr(const char *path, int width, int height, const float *rgba, char *err,
+RayesError image_write_exr(const char *path, int width, int height, const float *rgba, char *err,
                         size_t err_size)
 {
     if (!path || !rgba || width <= 0 || height <= 0 || width > MAX_SIDE) {
-        io_set_error(err, err_size, "%s: cannot write EXR: invalid arguments (%d x %d pixels%s)",
+        image_set_error(err, err_size, "%s: cannot write EXR: invalid arguments (%d x %d pixels%s)",
                      path ? path : "(null)", width, height, rgba ? "" : ", no pixels");
         return RAYES_ERROR_INVALID_ARGUMENT;
     }
     ExrImage image = {width, height, rgba};
-    return io_write_via_temp(path, write_exr_body, &image, err, err_size);
+    return image_write_via_temp(path, write_exr_body, &image, err, err_size);
 }
 
 /* -------------------------------------------------------------- reading */
@@ -485,11 +485,11 @@ static RayesError check_header(exr_const_context_t ctx, const char *path, ExrTar
     if (exr_get_storage(ctx, 0, &storage) != EXR_ERR_SUCCESS ||
         exr_get_data_window(ctx, 0, &dw) != EXR_ERR_SUCCESS ||
         exr_get_channels(ctx, 0, &channels) != EXR_ERR_SUCCESS || !channels) {
-        io_set_error(err, err_size, "%s: cannot read EXR: incomplete header", path);
+        image_set_error(err, err_size, "%s: cannot read EXR: incomplete header", path);
         return RAYES_ERROR_PARSE;
     }
     if (storage != EXR_STORAGE_SCANLINE && storage != EXR_STORAGE_TILED) {
-        io_set_error(err, err_size, "%s: cannot read EXR: deep images are not supported", path);
+        image_set_error(err, err_size, "%s: cannot read EXR: deep images are not supported", path);
         return RAYES_ERROR_PARSE;
     }
     int found = 0;
@@ -499,19 +499,19 @@ static RayesError check_header(exr_const_context_t ctx, const char *path, ExrTar
         if (slot < 0)
             continue;
         if (entry->x_sampling != 1 || entry->y_sampling != 1) {
-            io_set_error(err, err_size, "%s: cannot read EXR: channel %s is subsampled", path,
+            image_set_error(err, err_size, "%s: cannot read EXR: channel %s is subsampled", path,
                          entry->name.str);
             return RAYES_ERROR_PARSE;
         }
         found |= 1 << slot;
     }
     if ((found & 7) != 7) {
-        io_set_error(err, err_size, "%s: cannot read EXR: no R, G and B channels", path);
+        image_set_error(err, err_size, "%s: cannot read EXR: no R, G and B channels", path);
         return RAYES_ERROR_PARSE;
     }
     int64_t w = (int64_t)dw.max.x - dw.min.x + 1, h = (int64_t)dw.max.y - dw.min.y + 1;
     if (w <= 0 || h <= 0 || w > MAX_SIDE || h > MAX_SIDE || w * h > MAX_PIXELS) {
-        io_set_error(err, err_size, "%s: cannot read EXR: unsupported data window %lld x %lld",
+        image_set_error(err, err_size, "%s: cannot read EXR: unsupported data window %lld x %lld",
                      path, (long long)w, (long long)h);
         return RAYES_ERROR_PARSE;
     }
@@ -529,7 +529,7 @@ static RayesError read_part(exr_const_context_t ctx, const ExrIo *io, const char
     size_t n_pixels = (size_t)target->width * (size_t)target->height;
     target->rgba = malloc(n_pixels * 4 * sizeof(float));
     if (!target->rgba) {
-        io_set_error(err, err_size, "%s: out of memory", path);
+        image_set_error(err, err_size, "%s: out of memory", path);
         return RAYES_ERROR_OUT_OF_MEMORY;
     }
     /* Alpha defaults to 1; R, G, B are always overwritten. */
@@ -547,11 +547,11 @@ static RayesError read_part(exr_const_context_t ctx, const ExrIo *io, const char
     return RAYES_OK;
 }
 
-RayesError io_read_exr(const char *path, int *width, int *height, float **rgba, char *err,
+RayesError image_read_exr(const char *path, int *width, int *height, float **rgba, char *err,
                        size_t err_size)
 {
     if (!path || !width || !height || !rgba) {
-        io_set_error(err, err_size, "%s: cannot read EXR: invalid arguments",
+        image_set_error(err, err_size, "%s: cannot read EXR: invalid arguments",
                      path ? path : "(null)");
         return RAYES_ERROR_INVALID_ARGUMENT;
     }
@@ -559,7 +559,7 @@ RayesError io_read_exr(const char *path, int *width, int *height, float **rgba, 
     *width = *height = 0;
     ExrIo io = {.fd = open(path, O_RDONLY | O_CLOEXEC)};
     if (io.fd < 0) {
-        io_set_errno_error(err, err_size, errno, "%s: cannot open", path);
+        image_set_errno_error(err, err_size, errno, "%s: cannot open", path);
         return RAYES_ERROR_IO;
     }
     exr_context_initializer_t init = make_initializer(&io);

@@ -1,9 +1,9 @@
 /*
- * io/image.c — what the image writers share: choosing a format by the
+ * image/image.c — what the image writers share: choosing a format by the
  * file name, the error messages, and the atomic write through a temporary
  * file.
  *
- * Atomicity: a writer never opens its target. io_write_via_temp creates
+ * Atomicity: a writer never opens its target. image_write_via_temp creates
  * "PATH.tmp-<pid>-<n>" beside it (same directory, so the rename cannot
  * cross file systems), lets the format's writer fill it, and renames it
  * over the target only when every byte reached the kernel. On any failure
@@ -15,8 +15,8 @@
  * that makes temporary names unique among threads of this process (the pid
  * makes them unique among processes; O_EXCL catches anything else).
  */
-#include "io/image.h"
-#include "io/image_internal.h"
+#include "image/image.h"
+#include "image/image_internal.h"
 
 #include <errno.h>
 #include <fcntl.h>
@@ -43,7 +43,7 @@ static void flatten_line(char *s)
 }
 
 /* Fills err (if there is room) with the formatted message, on one line. */
-void io_set_error(char *err, size_t err_size, const char *fmt, ...)
+void image_set_error(char *err, size_t err_size, const char *fmt, ...)
 {
     if (!err || err_size == 0)
         return;
@@ -54,8 +54,8 @@ void io_set_error(char *err, size_t err_size, const char *fmt, ...)
     flatten_line(err);
 }
 
-/* As io_set_error, followed by ": " and the text of errnum. */
-void io_set_errno_error(char *err, size_t err_size, int errnum, const char *fmt, ...)
+/* As image_set_error, followed by ": " and the text of errnum. */
+void image_set_errno_error(char *err, size_t err_size, int errnum, const char *fmt, ...)
 {
     if (!err || err_size == 0)
         return;
@@ -73,7 +73,7 @@ void io_set_errno_error(char *err, size_t err_size, int errnum, const char *fmt,
     flatten_line(err);
 }
 
-ImageFormat io_image_format_from_path(const char *path)
+ImageFormat image_format_from_path(const char *path)
 {
     if (!path)
         return IMAGE_FORMAT_UNKNOWN;
@@ -90,18 +90,18 @@ ImageFormat io_image_format_from_path(const char *path)
     return IMAGE_FORMAT_UNKNOWN;
 }
 
-RayesError io_write_image(const char *path, int width, int height, const float *rgba, char *err,
+RayesError image_write(const char *path, int width, int height, const float *rgba, char *err,
                           size_t err_size)
 {
-    switch (io_image_format_from_path(path)) {
+    switch (image_format_from_path(path)) {
     case IMAGE_FORMAT_EXR:
-        return io_write_exr(path, width, height, rgba, err, err_size);
+        return image_write_exr(path, width, height, rgba, err, err_size);
     case IMAGE_FORMAT_PNG:
-        return io_write_png(path, width, height, rgba, err, err_size);
+        return image_write_png(path, width, height, rgba, err, err_size);
     case IMAGE_FORMAT_UNKNOWN:
         break;
     }
-    io_set_error(err, err_size, "%s: unknown image format (the name should end in .exr or .png)",
+    image_set_error(err, err_size, "%s: unknown image format (the name should end in .exr or .png)",
                  path ? path : "(null)");
     return RAYES_ERROR_INVALID_ARGUMENT;
 }
@@ -119,11 +119,11 @@ static RayesError report_create_failure(const char *path, int errnum, char *err,
     struct stat st;
     /* ENOENT also comes from directories that refuse new files (/proc). */
     if (errnum == ENOENT && stat(dir_path, &st) != 0)
-        io_set_error(err, err_size, "%s: directory %s does not exist", path, dir_path);
+        image_set_error(err, err_size, "%s: directory %s does not exist", path, dir_path);
     else if (errnum == ENOTDIR)
-        io_set_error(err, err_size, "%s: %s is not a directory", path, dir_path);
+        image_set_error(err, err_size, "%s: %s is not a directory", path, dir_path);
     else
-        io_set_errno_error(err, err_size, errnum, "%s: cannot create a file in %s", path, dir_path);
+        image_set_errno_error(err, err_size, errnum, "%s: cannot create a file in %s", path, dir_path);
     return errnum == ENOMEM ? RAYES_ERROR_OUT_OF_MEMORY : RAYES_ERROR_IO;
 }
 
@@ -133,11 +133,11 @@ static RayesError close_temp(FILE *file, const char *path, RayesError rv, char *
 {
     /* fflush, not only fclose, so that its errno is the one reported. */
     if (rv == RAYES_OK && fflush(file) != 0) {
-        io_set_errno_error(err, err_size, errno, "%s: cannot write", path);
+        image_set_errno_error(err, err_size, errno, "%s: cannot write", path);
         rv = RAYES_ERROR_IO;
     }
     if (fclose(file) != 0 && rv == RAYES_OK) {
-        io_set_errno_error(err, err_size, errno, "%s: cannot write", path);
+        image_set_errno_error(err, err_size, errno, "%s: cannot write", path);
         rv = RAYES_ERROR_IO;
     }
     return rv;
@@ -149,13 +149,13 @@ static RayesError close_temp(FILE *file, const char *path, RayesError rv, char *
  * after removing the temporary file. The file is open for writing only;
  * write_body may use stdio on it or write to fileno(file) directly, but not
  * both, and must not close it. */
-RayesError io_write_via_temp(const char *path, IoBodyWriter write_body, const void *data, char *err,
+RayesError image_write_via_temp(const char *path, ImageBodyWriter write_body, const void *data, char *err,
                              size_t err_size)
 {
     size_t tmp_bytes = strlen(path) + 64;
     char *tmp = malloc(tmp_bytes);
     if (!tmp) {
-        io_set_error(err, err_size, "%s: out of memory", path);
+        image_set_error(err, err_size, "%s: out of memory", path);
         return RAYES_ERROR_OUT_OF_MEMORY;
     }
     snprintf(tmp, tmp_bytes, "%s.tmp-%ld-%lu", path, (long)getpid(),
@@ -169,7 +169,7 @@ RayesError io_write_via_temp(const char *path, IoBodyWriter write_body, const vo
     RayesError rv = RAYES_OK;
     FILE *file = fdopen(fd, "wb");
     if (!file) {
-        io_set_errno_error(err, err_size, errno, "%s: cannot write", path);
+        image_set_errno_error(err, err_size, errno, "%s: cannot write", path);
         close(fd);
         rv = RAYES_ERROR_IO;
     } else {
@@ -177,7 +177,7 @@ RayesError io_write_via_temp(const char *path, IoBodyWriter write_body, const vo
         rv = close_temp(file, path, rv, err, err_size);
     }
     if (rv == RAYES_OK && rename(tmp, path) != 0) {
-        io_set_errno_error(err, err_size, errno, "%s: cannot replace it", path);
+        image_set_errno_error(err, err_size, errno, "%s: cannot replace it", path);
         rv = RAYES_ERROR_IO;
     }
     if (rv != RAYES_OK)

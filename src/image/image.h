@@ -1,5 +1,5 @@
 /*
- * io/image.h — writing and reading images: OpenEXR (through OpenEXRCore's
+ * image/image.h — writing and reading images: OpenEXR (through OpenEXRCore's
  * C API) and PNG (libpng).
  *
  * Pixels are RGBA floats, linear, top row first, width * height * 4.
@@ -13,8 +13,8 @@
  * to NULL and *width and *height to 0.
  * Thread-safety: all functions are reentrant.
  */
-#ifndef RAYES_IO_IMAGE_H
-#define RAYES_IO_IMAGE_H
+#ifndef RAYES_IMAGE_IMAGE_H
+#define RAYES_IMAGE_IMAGE_H
 
 #include <stddef.h>
 
@@ -27,32 +27,32 @@ typedef enum ImageFormat {
 } ImageFormat;
 
 /* The format named by a path's extension (.exr, .png, any case). */
-ImageFormat io_image_format_from_path(const char *path);
+ImageFormat image_format_from_path(const char *path);
 
 /* EXR: half-float R, G, B, A channels, ZIP compression, scanlines, with a
  * "renderer" string attribute. */
-RayesError io_write_exr(const char *path, int width, int height, const float *rgba,
+RayesError image_write_exr(const char *path, int width, int height, const float *rgba,
                         char *err, size_t err_size);
 
 /* PNG: 8-bit RGBA, sRGB-encoded (the sRGB transfer curve applied to the
  * clamped linear values, alpha linear), with an sRGB chunk. */
-RayesError io_write_png(const char *path, int width, int height, const float *rgba,
+RayesError image_write_png(const char *path, int width, int height, const float *rgba,
                         char *err, size_t err_size);
 
 /* Dispatch on the extension; an unknown extension is INVALID_ARGUMENT. */
-RayesError io_write_image(const char *path, int width, int height, const float *rgba,
+RayesError image_write(const char *path, int width, int height, const float *rgba,
                           char *err, size_t err_size);
 
 /* Reads part 0 of an EXR file with R, G, B (and optionally A; 1 if absent)
  * channels of any pixel type, scanline or tiled (a mipmap's full level);
  * the data window is the image. DWAA/DWAB files are not readable (the
  * OpenEXRCore of Debian 12 cannot decompress them). *rgba is new (free()). */
-RayesError io_read_exr(const char *path, int *width, int *height, float **rgba,
+RayesError image_read_exr(const char *path, int *width, int *height, float **rgba,
                        char *err, size_t err_size);
 
 /* Reads a PNG (any bit depth/colour type, converted to RGBA) and decodes
  * sRGB to linear. *rgba is new (free()). */
-RayesError io_read_png(const char *path, int *width, int *height, float **rgba,
+RayesError image_read_png(const char *path, int *width, int *height, float **rgba,
                        char *err, size_t err_size);
 
-#endif /* RAYES_IO_IMAGE_H */
+#endif /* RAYES_IMAGE_IMAGE_H */
