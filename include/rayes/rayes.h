@@ -104,6 +104,22 @@ typedef struct RayesParam {
 RAYES_API RayesError rayes_scene_set_shader(RayesScene *scene, const char *name,
                                             const RayesParam *params, size_t n_params);
 
+/* The displacement shader of geometry added from now on: a class with a
+ * displacement method (the built-ins "bumpy" and "fractal", or a plugin's),
+ * run on every vertex of the fine grids when the scene is prepared, before
+ * ray tracing structures are built; normals are then those of the
+ * displaced surface. NULL or "" removes it (the default: none). Parameters
+ * as for rayes_scene_set_shader. A class without a displacement method is
+ * RAYES_ERROR_INVALID_ARGUMENT. */
+RAYES_API RayesError rayes_scene_set_displacement(RayesScene *scene, const char *name,
+                                                  const RayesParam *params, size_t n_params);
+
+/* The displacement bound of geometry added from now on (RenderMan's
+ * Attribute "displacementbound" "sphere"), in world units: the promise that
+ * no point moves farther. Displacements are clamped to it, with one
+ * warning per shader. 0 (the default) means unbounded. */
+RAYES_API RayesError rayes_scene_set_displacement_bound(RayesScene *scene, float bound);
+
 /* The shading rate of geometry added from now on: the area of a
  * micropolygon in pixels (RenderMan's ShadingRate). Default 1. */
 RAYES_API RayesError rayes_scene_set_shading_rate(RayesScene *scene, float shading_rate);

@@ -80,6 +80,9 @@ void rayes_scene_release(RayesScene *s)
     for (size_t i = 0; i < s->n_objects; i++)
         if (s->objects[i].shader.cls)
             shade_instance_fini(&s->objects[i].shader);
+    for (size_t i = 0; i < s->n_displacements; i++)
+        shade_instance_fini(&s->displacements[i]);
+    free(s->displacements);
     free(s->objects);
     free(s->prims);
     free(s->lights);
@@ -182,6 +185,21 @@ static RayesError add_object(RayesScene *s, const RayesShaderClass *cls, const R
     return RAYES_OK;
 }
 
+/* Checks a shader call's parameters: named and finite. */
+static RayesError check_params(RayesScene *s, const char *what, const char *name,
+                               const RayesParam *params, size_t n_params)
+{
+    for (size_t i = 0; i < n_params; i++) {
+        if (!params[i].name)
+            return fail(s, RAYES_ERROR_INVALID_ARGUMENT, "%s \"%s\": a parameter has no name",
+                        what, name);
+        if (params[i].type != RAYES_PARAM_STRING && !finite_n(params[i].value, 3))
+            return fail(s, RAYES_ERROR_INVALID_ARGUMENT,
+                        "%s \"%s\": parameter \"%s\" is not finite", what, name, params[i].name);
+    }
+    return RAYES_OK;
+}
+
 RayesError rayes_scene_set_shader(RayesScene *s, const char *name, const RayesParam *params,
                                   size_t n_params)
 {
@@ -190,15 +208,50 @@ RayesError rayes_scene_set_shader(RayesScene *s, const char *name, const RayesPa
     const RayesShaderClass *cls = shade_find_class(name);
     if (!cls)
         return fail(s, RAYES_ERROR_INVALID_ARGUMENT, "unknown shader \"%s\"", name);
-    for (size_t i = 0; i < n_params; i++) {
-        if (!params[i].name)
-            return fail(s, RAYES_ERROR_INVALID_ARGUMENT, "shader \"%s\": a parameter has no name",
-                        name);
-        if (params[i].type != RAYES_PARAM_STRING && !finite_n(params[i].value, 3))
-            return fail(s, RAYES_ERROR_INVALID_ARGUMENT,
-                        "shader \"%s\": parameter \"%s\" is not finite", name, params[i].name);
-    }
+    RayesError e = check_params(s, "shader", name, params, n_params);
+    if (e != RAYES_OK)
+        return e;
     return add_object(s, cls, params, n_params, -1);
+}
+
+RayesError rayes_scene_set_displacement(RayesScene *s, const char *name, const RayesParam *params,
+                                        size_t n_params)
+{
+    if (!s || (n_params && !params))
+        return RAYES_ERROR_INVALID_ARGUMENT;
+    if (!name || !name[0]) {
+        s->current_displacement = 0;
+        return RAYES_OK;
+    }
+    const RayesShaderClass *cls = shade_find_class(name);
+    if (!cls)
+        return fail(s, RAYES_ERROR_INVALID_ARGUMENT, "unknown displacement shader \"%s\"", name);
+    if (!cls->displacement)
+        return fail(s, RAYES_ERROR_INVALID_ARGUMENT,
+                    "shader \"%s\" has no displacement method", name);
+    RayesError e = check_params(s, "displacement shader", name, params, n_params);
+    if (e != RAYES_OK)
+        return e;
+    if (grow((void **)&s->displacements, &s->cap_displacements, s->n_displacements,
+             sizeof *s->displacements) != 0)
+        return fail(s, RAYES_ERROR_OUT_OF_MEMORY, "out of memory");
+    char err[256];
+    if (shade_instance_init(&s->displacements[s->n_displacements], cls, params, n_params, err,
+                            sizeof err) != 0)
+        return fail(s, RAYES_ERROR_OUT_OF_MEMORY, "%s", err);
+    s->current_displacement = (uint32_t)++s->n_displacements;
+    return RAYES_OK;
+}
+
+RayesError rayes_scene_set_displacement_bound(RayesScene *s, float bound)
+{
+    if (!s)
+        return RAYES_ERROR_INVALID_ARGUMENT;
+    if (!(bound >= 0.0f) || !isfinite(bound))
+        return fail(s, RAYES_ERROR_INVALID_ARGUMENT,
+                    "displacement bound: expected a finite number >= 0");
+    s->displacement_bound = bound;
+    return RAYES_OK;
 }
 
 static RayesError add_prim(RayesScene *s, Prim *p)
@@ -212,6 +265,8 @@ static RayesError add_prim(RayesScene *s, Prim *p)
         return fail(s, RAYES_ERROR_OUT_OF_MEMORY, "out of memory");
     p->object = (uint32_t)s->current_object;
     p->shading_rate = s->shading_rate;
+    p->displacement = s->current_displacement;
+    p->displacement_bound = s->displacement_bound;
     s->prims[s->n_prims++] = *p;
     s->dirty = 1;
     return RAYES_OK;
@@ -384,8 +439,13 @@ int scene_prepare(const RayesScene *s, int height, GridSet *gs)
     cam.eye = s->eye;
     cam.pixel_angle = 2.0f * tanf(0.5f * s->fov_y * (float)(M_PI / 180.0)) / (float)height;
     cam.min_distance = 1e-3f * fmaxf(radius, 1e-6f);
-    for (size_t i = 0; i < s->n_prims; i++)
+    for (size_t i = 0; i < s->n_prims; i++) {
+        size_t first = gs->n_grids;
         if (geom_dice_prim(gs, &s->prims[i], (uint32_t)i, &cam) != 0)
             return -1;
+        /* Normals of displaced surfaces: differences over 1e-3 of the scene radius. */
+        if (s->prims[i].displacement && scene_displace(s, gs, first, 1e-3f * radius) != 0)
+            return -1;
+    }
     return 0;
 }

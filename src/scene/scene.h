@@ -42,6 +42,10 @@ struct RayesScene {
     size_t n_objects, cap_objects;
     Light *lights;
     size_t n_lights, cap_lights;
+    ShaderInstance *displacements; /* displacement shader instances, owned */
+    size_t n_displacements, cap_displacements;
+    uint32_t current_displacement; /* of geometry added next: index + 1, or 0 */
+    float displacement_bound;      /* of geometry added next; 0: unbounded */
     uint64_t timestamp;       /* commits so far */
     int dirty;                /* edited since the last commit */
 };
@@ -50,6 +54,11 @@ struct RayesScene {
  * `height` pixels over its vertical field of view. Returns 0, or -1 when
  * out of memory. */
 int scene_prepare(const RayesScene *scene, int height, GridSet *gs);
+
+/* Runs the displacement shaders of the primitives of grids [first_grid,
+ * n_grids) of gs (displace.c); normals come from differences over step
+ * (world units). Returns 0, or -1 when out of memory. */
+int scene_displace(const RayesScene *scene, GridSet *gs, size_t first_grid, float step);
 
 /* The bounds of all primitives' control points (lights included). */
 Bounds3 scene_bounds(const RayesScene *scene);

@@ -14,6 +14,7 @@
 
 static const RayesShaderClass *const builtin_classes[] = {
     &shade_class_matte, &shade_class_plastic, &shade_class_mirror, &shade_class_constant,
+    &shade_class_bumpy, &shade_class_fractal,
 };
 
 const RayesShaderClass *shade_find_class(const char *name)
