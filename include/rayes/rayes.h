@@ -169,6 +169,13 @@ typedef enum RayesFilter {
     RAYES_FILTER_GAUSSIAN = 1   /* width 2 pixels by default, alpha 2 */
 } RayesFilter;
 
+/* How camera rays are shaded at diffuse depth 0. */
+typedef enum RayesHider {
+    RAYES_HIDER_RAYTRACE = 0, /* lighting() at every camera ray hit */
+    RAYES_HIDER_GRID = 1      /* lighting() once per vertex of every visible grid; camera
+                                 hits interpolate the shaded grid (PRMan's REYES mode) */
+} RayesHider;
+
 /* Progress: fraction done in [0, 1]. Return nonzero to cancel the render.
  * Called from worker threads, one call at a time. */
 typedef int (*RayesProgressFn)(void *user, double fraction);
@@ -197,6 +204,7 @@ typedef struct RayesRenderOptions {
                                   cache_k times the ray footprint is used (default 1) */
     RayesProgressFn progress;  /* may be NULL */
     void *progress_user;
+    RayesHider hider;          /* how camera rays are shaded (default RAYES_HIDER_RAYTRACE) */
 } RayesRenderOptions;
 
 /* Fills options with the defaults of a quality preset: 512 x 512, 4 pixel

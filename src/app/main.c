@@ -75,6 +75,8 @@ static void usage(FILE *f)
           "  --cache-resolution R    auto (by ray differentials), coarse, medium or fine\n"
           "  --cache-k K             use the coarsest resolution whose micropolygons are at\n"
           "                          most K times the ray footprint (default 1)\n"
+          "  --hider raytrace|grid   shade every camera hit (default), or once per vertex of\n"
+          "                          each visible grid and interpolate (PRMan's REYES mode)\n"
           "  --data DIR              data directory (teapot.bpt); default $RAYES_DATA\n"
           "  --stats FILE.json       write statistics as JSON\n"
           "  --quiet                 no progress bar and no summary\n",
@@ -239,6 +241,11 @@ static void parse_args(int argc, char **argv, Args *a)
             opt->cache_resolution = parse_resolution(v);
         else if (strcmp(o, "--cache-k") == 0)
             opt->cache_k = parse_float(o, v, 1e-3f, 1e3f);
+        else if (strcmp(o, "--hider") == 0) {
+            if (strcmp(v, "raytrace") != 0 && strcmp(v, "grid") != 0)
+                die_usage("--hider: expected raytrace or grid, got \"%s\"", v);
+            opt->hider = strcmp(v, "grid") == 0 ? RAYES_HIDER_GRID : RAYES_HIDER_RAYTRACE;
+        }
         else if (strcmp(o, "--data") == 0)
             a->data_dir = v;
         else if (strcmp(o, "--stats") == 0)

@@ -13,6 +13,7 @@
  */
 #include "render/integrator.h"
 
+#include "render/hider.h"
 #include "render/radiosity.h"
 
 #include <math.h>
@@ -150,6 +151,8 @@ Vec3 integrator_trace(Worker *w, const Ray *ray, uint32_t kind, int diffuse_dept
     }
     if (kind == RAYES_RAY_DIFFUSE && w->set->cache)
         return radiosity_at_hit(w, ray, &hit, diffuse_depth, diff);
+    if (kind == RAYES_RAY_CAMERA && w->grid_shading)
+        return hider_camera_hit(w, ray, &hit);
     return shade_hit(w, ray, &hit, obj, kind, diffuse_depth, specular_depth, key, diff);
 }
 

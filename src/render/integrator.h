@@ -14,11 +14,14 @@ typedef struct RayDiff {
     float spread;  /* radians */
 } RayDiff;
 
+typedef struct GridShading GridShading;
+
 typedef struct Worker {
     const RenderScene *rs;
     const RenderSettings *set;
     RenderStats stats;
     CacheLocal cache;             /* this thread's part of the radiosity cache */
+    GridShading *grid_shading; /* the grid hider's shaded grids, or NULL (hider.h) */
 } Worker;
 
 /* What a shading context's `renderer` points to: per point (indexed from

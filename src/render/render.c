@@ -17,6 +17,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "render/hider.h"
 #include "render/integrator.h"
 #include "util/check.h"
 #include "util/rng.h"
@@ -163,8 +164,13 @@ int render_frame(const RenderScene *rs, const RenderSettings *set, float *rgba, 
     pthread_mutex_init(&f.progress_lock, NULL);
     f.workers = calloc((size_t)threads, sizeof *f.workers);
     RY_CHECK(f.workers != NULL);
+    GridShading *gsh = NULL;
+    if (set->hider == 1) {
+        gsh = hider_new(rs);
+        RY_CHECK(gsh != NULL);
+    }
     for (int i = 0; i < threads; i++) {
-        f.workers[i] = (Worker){.rs = rs, .set = set};
+        f.workers[i] = (Worker){.rs = rs, .set = set, .grid_shading = gsh};
         if (set->cache)
             cache_local_init(&f.workers[i].cache, set->cache);
     }
@@ -176,6 +182,7 @@ int render_frame(const RenderScene *rs, const RenderSettings *set, float *rgba, 
             cache_local_fini(&f.workers[i].cache);
     }
     free(f.workers);
+    hider_free(gsh);
     pthread_mutex_destroy(&f.progress_lock);
     return atomic_load(&f.cancelled) ? 1 : 0;
 }

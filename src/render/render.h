@@ -62,6 +62,7 @@ typedef struct RenderSettings {
     Cache *cache;                 /* the radiosity cache, or NULL: uncached */
     int cache_resolution;         /* -1: by differentials; else a forced CacheLevel */
     float cache_k;                /* resolution rule constant (DESIGN.md) */
+    int hider;                    /* 0: shade at every camera hit; 1: the grid hider (hider.h) */
 } RenderSettings;
 
 typedef struct RenderStats {

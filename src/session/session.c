@@ -102,6 +102,8 @@ static RayesError check_options(RayesScene *scene, const RayesRenderOptions *o)
     else if (!(o->filter_width > 0.0f) || o->filter_width > 16.0f ||
              (o->filter != RAYES_FILTER_BOX && o->filter != RAYES_FILTER_GAUSSIAN))
         what = "options: filter width must be in (0, 16]";
+    else if (o->hider != RAYES_HIDER_RAYTRACE && o->hider != RAYES_HIDER_GRID)
+        what = "options: hider must be RAYES_HIDER_RAYTRACE or RAYES_HIDER_GRID";
     else if (o->tile_size < 1 || o->threads < 0 || o->threads > 1024)
         what = "options: tile size must be positive and threads 0 to 1024";
     else if (!(o->cache_mb >= 0.0) || o->cache_mb > 1e7 || !(o->cache_k > 0.0f) ||
@@ -127,6 +129,7 @@ static RenderSettings settings_from(const RayesRenderOptions *o)
         .filter = o->filter == RAYES_FILTER_GAUSSIAN, .filter_width = o->filter_width,
         .seed = o->seed, .progress = o->progress, .progress_user = o->progress_user,
         .cache_resolution = o->cache_resolution, .cache_k = o->cache_k,
+        .hider = o->hider == RAYES_HIDER_GRID,
     };
     if (s.threads == 0)
         s.threads = thread_count_cores();

@@ -68,6 +68,9 @@ RayesStats *session_stats_new(const RenderSettings *set, const RenderStats *rs, 
     count(s, "bounces", (uint64_t)set->bounces);
     count(s, "shadow_rays", (uint64_t)set->shadow_rays);
     count(s, "diffuse_rays", (uint64_t)set->diffuse_rays);
+    if (s->n < MAX_STATS)
+        s->items[s->n++] = (RayesStat){.name = "hider", .kind = RAYES_STAT_STRING,
+                                       .string = set->hider ? "grid" : "raytrace"};
     return s;
 }
 
