@@ -204,7 +204,10 @@ typedef struct RayesRenderOptions {
                                   cache_k times the ray footprint is used (default 1) */
     RayesProgressFn progress;  /* may be NULL */
     void *progress_user;
-    RayesHider hider;          /* how camera rays are shaded (default RAYES_HIDER_RAYTRACE) */
+    RayesHider hider;          /* how camera rays are shaded (default RAYES_HIDER_RAYTRACE;
+                                  RAYES_HIDER_GRID for the final preset) */
+    int irradiance;            /* 1: irradiance interpolation with gradients at depth 0 over
+                                  each shaded grid (grid hider only; on for the final preset) */
 } RayesRenderOptions;
 
 /* Fills options with the defaults of a quality preset: 512 x 512, 4 pixel

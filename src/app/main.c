@@ -76,7 +76,10 @@ static void usage(FILE *f)
           "  --cache-k K             use the coarsest resolution whose micropolygons are at\n"
           "                          most K times the ray footprint (default 1)\n"
           "  --hider raytrace|grid   shade every camera hit (default), or once per vertex of\n"
-          "                          each visible grid and interpolate (PRMan's REYES mode)\n"
+          "                          each visible grid and interpolate (PRMan's REYES mode;\n"
+          "                          default for --quality final)\n"
+          "  --irradiance on|off     irradiance interpolation with gradients at depth 0 (grid\n"
+          "                          hider; on for --quality final)\n"
           "  --data DIR              data directory (teapot.bpt); default $RAYES_DATA\n"
           "  --stats FILE.json       write statistics as JSON\n"
           "  --quiet                 no progress bar and no summary\n",
@@ -245,6 +248,10 @@ static void parse_args(int argc, char **argv, Args *a)
             if (strcmp(v, "raytrace") != 0 && strcmp(v, "grid") != 0)
                 die_usage("--hider: expected raytrace or grid, got \"%s\"", v);
             opt->hider = strcmp(v, "grid") == 0 ? RAYES_HIDER_GRID : RAYES_HIDER_RAYTRACE;
+        } else if (strcmp(o, "--irradiance") == 0) {
+            if (strcmp(v, "on") != 0 && strcmp(v, "off") != 0)
+                die_usage("--irradiance: expected on or off, got \"%s\"", v);
+            opt->irradiance = strcmp(v, "on") == 0;
         }
         else if (strcmp(o, "--data") == 0)
             a->data_dir = v;

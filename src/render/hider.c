@@ -15,6 +15,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "render/irrgrid.h"
 #include "util/check.h"
 #include "util/rng.h"
 
@@ -121,7 +122,14 @@ static Rgb *shade_grid(Worker *w, uint32_t gi)
         keys[k] = hash_combine(grid_key, k);
         diff[k] = (RayDiff){pixel * dist, pixel};
     }
-    PathState ps = {w, keys, diff, curv, offset};
+    IrrGrid irr = {.grid = g, .P = (const float(*)[3])P, .N = (const float(*)[3])N};
+    float(*irr_E)[3] = NULL;
+    if (w->set->irradiance) {
+        irr_E = malloc(n * sizeof *irr_E);
+        RY_CHECK(irr_E != NULL);
+        irr.E = irr_E;
+    }
+    PathState ps = {w, keys, diff, curv, offset, w->set->irradiance ? &irr : NULL};
     RayesShadeCtx ctx = {
         .n_points = n, .ray_type = RAYES_RAY_CAMERA, .diffuse_depth = 0, .specular_depth = 0,
         .P = (const float(*)[3])P, .N = (const float(*)[3])N, .Ng = (const float(*)[3])N,
@@ -133,6 +141,7 @@ static Rgb *shade_grid(Worker *w, uint32_t gi)
     w->stats.shading_points[0] += n;
     shade_run_lighting(&render_services, &ctx, obj->shader, &out);
     memcpy(ci, Ci, n * sizeof *ci);
+    free(irr_E);
     free(f3);
     free(f1);
     free(keys);

@@ -14,6 +14,7 @@
 #include "render/integrator.h"
 
 #include "render/hider.h"
+#include "render/irrgrid.h"
 #include "render/radiosity.h"
 
 #include <math.h>
@@ -100,7 +101,7 @@ static Vec3 shade_hit(Worker *w, const Ray *ray, const Hit *hit, const RenderObj
     memcpy(hp.Os, obj->Os, sizeof hp.Os);
     hp.key = key;
     hp.diff = (RayDiff){diff.width + diff.spread * hit->t, diff.spread};
-    PathState ps = {w, &hp.key, &hp.diff, &hp.curvature, &hp.offset};
+    PathState ps = {w, &hp.key, &hp.diff, &hp.curvature, &hp.offset, NULL};
     RayesShadeCtx ctx = {
         .n_points = 1,
         .ray_type = kind,
@@ -135,13 +136,21 @@ static Vec3 shade_hit(Worker *w, const Ray *ray, const Hit *hit, const RenderObj
 Vec3 integrator_trace(Worker *w, const Ray *ray, uint32_t kind, int diffuse_depth,
                       int specular_depth, uint64_t key, RayDiff diff, float *alpha)
 {
-    Hit hit;
+    float t;
+    Vec3 L = integrator_trace_hit(w, ray, kind, diffuse_depth, specular_depth, key, diff, &t);
     if (alpha)
-        *alpha = 0.0f;
+        *alpha = isfinite(t) ? 1.0f : 0.0f;
+    return L;
+}
+
+Vec3 integrator_trace_hit(Worker *w, const Ray *ray, uint32_t kind, int diffuse_depth,
+                          int specular_depth, uint64_t key, RayDiff diff, float *t)
+{
+    Hit hit;
+    *t = INFINITY;
     if (!accel_intersect(w->rs->accel, ray, &hit))
         return v3(0, 0, 0);
-    if (alpha)
-        *alpha = 1.0f;
+    *t = hit.t;
     const RenderObject *obj = &w->rs->objects[w->rs->gs->grids[hit.grid].object];
     if (obj->light >= 0) {
         /* Emitters: seen by camera and specular rays, on their front side. */
@@ -247,6 +256,14 @@ static void svc_indirect_diffuse(const RayesShaderServices *sv, const RayesShade
     int n = n_rays > 0 ? n_rays : depth == 0 ? w->set->diffuse_rays : w->set->diffuse_rays_deep;
     if (depth >= w->set->bounces)
         n = 0;
+    IrrGrid *irr = ps->irr;
+    if (irr && n > 0 && ctx->N == irr->N + ctx->first_point) {
+        /* A grid's own points with its own normals: interpolate (irrgrid.h). */
+        if (!irr->done || irr->n_rays != n)
+            irrgrid_compute(ps, irr, n);
+        memcpy(out, irr->E + ctx->first_point, ctx->n_points * sizeof *out);
+        return;
+    }
     /* Each ray stands for 1/n of the hemisphere: its spread never shrinks. */
     float lobe_spread = n > 0 ? 1.0f / sqrtf((float)n) : 0.0f;
     for (size_t i = 0; i < ctx->n_points; i++) {

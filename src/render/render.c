@@ -147,6 +147,8 @@ static void merge_stats(RenderStats *into, const RenderStats *s)
     into->rays_shadow += s->rays_shadow;
     into->rays_diffuse += s->rays_diffuse;
     into->rays_specular += s->rays_specular;
+    into->irradiance_records += s->irradiance_records;
+    into->irradiance_interpolated += s->irradiance_interpolated;
     for (int d = 0; d <= RENDER_MAX_DEPTH; d++)
         into->shading_points[d] += s->shading_points[d];
 }

@@ -67,6 +67,8 @@ void rayes_render_options_init(RayesRenderOptions *o, RayesQuality quality)
         o->shadow_rays = o->shadow_rays_deep = 64;
         o->diffuse_rays = 1024;
         o->diffuse_rays_deep = 64;
+        o->hider = RAYES_HIDER_GRID; /* the memo's REYES-style grid shading */
+        o->irradiance = 1;
         break;
     case RAYES_QUALITY_REFERENCE:
         o->shadow_rays = 64;
@@ -129,7 +131,7 @@ static RenderSettings settings_from(const RayesRenderOptions *o)
         .filter = o->filter == RAYES_FILTER_GAUSSIAN, .filter_width = o->filter_width,
         .seed = o->seed, .progress = o->progress, .progress_user = o->progress_user,
         .cache_resolution = o->cache_resolution, .cache_k = o->cache_k,
-        .hider = o->hider == RAYES_HIDER_GRID,
+        .hider = o->hider == RAYES_HIDER_GRID, .irradiance = o->irradiance != 0,
     };
     if (s.threads == 0)
         s.threads = thread_count_cores();

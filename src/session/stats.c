@@ -68,6 +68,10 @@ RayesStats *session_stats_new(const RenderSettings *set, const RenderStats *rs, 
     count(s, "bounces", (uint64_t)set->bounces);
     count(s, "shadow_rays", (uint64_t)set->shadow_rays);
     count(s, "diffuse_rays", (uint64_t)set->diffuse_rays);
+    if (set->irradiance) {
+        count(s, "irradiance/records", rs->irradiance_records);
+        count(s, "irradiance/interpolated", rs->irradiance_interpolated);
+    }
     if (s->n < MAX_STATS)
         s->items[s->n++] = (RayesStat){.name = "hider", .kind = RAYES_STAT_STRING,
                                        .string = set->hider ? "grid" : "raytrace"};

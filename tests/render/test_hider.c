@@ -12,7 +12,8 @@
 #include "rayes/rayes.h"
 #include "test.h"
 
-static RayesImage *render(RayesHider hider, int threads, int spp, int rays, uint64_t *depth0)
+static RayesImage *render_irr(RayesHider hider, int irradiance, int threads, int spp, int rays,
+                              uint64_t *depth0, uint64_t *records)
 {
     RayesScene *s = rayes_scene_new();
     char err[512];
@@ -25,6 +26,7 @@ static RayesImage *render(RayesHider hider, int threads, int spp, int rays, uint
     o.shadow_rays = o.shadow_rays_deep = rays;
     o.diffuse_rays = rays;
     o.hider = hider;
+    o.irradiance = irradiance;
     RayesImage *img = NULL;
     RayesStats *st = NULL;
     CHECK(rayes_render(s, &o, &img, &st) == RAYES_OK);
@@ -32,9 +34,18 @@ static RayesImage *render(RayesHider hider, int threads, int spp, int rays, uint
     CHECK(sp && sp->n_counts > 0);
     if (depth0)
         *depth0 = sp && sp->n_counts ? sp->counts[0] : 0;
+    const RayesStat *rec = rayes_stats_find(st, "irradiance/records");
+    CHECK((rec != NULL) == (irradiance != 0));
+    if (records)
+        *records = rec ? rec->count : 0;
     rayes_stats_free(st);
     rayes_scene_release(s);
     return img;
+}
+
+static RayesImage *render(RayesHider hider, int threads, int spp, int rays, uint64_t *depth0)
+{
+    return render_irr(hider, 0, threads, spp, rays, depth0, NULL);
 }
 
 static double tile_mean(const RayesImage *img, int x0, int y0, int size)
@@ -47,10 +58,9 @@ static double tile_mean(const RayesImage *img, int x0, int y0, int size)
     return sum / (3.0 * size * size);
 }
 
-static void test_agrees_with_raytrace(void)
+/* Image means within 1%, 16 x 16 tile means within tile_tol. */
+static void check_agree(const RayesImage *a, const RayesImage *b, double tile_tol)
 {
-    RayesImage *a = render(RAYES_HIDER_RAYTRACE, 2, 16, 16, NULL);
-    RayesImage *b = render(RAYES_HIDER_GRID, 2, 16, 16, NULL);
     CHECK(a && b);
     if (!a || !b)
         return;
@@ -63,11 +73,36 @@ static void test_agrees_with_raytrace(void)
             if (ta > 0.02 * ma)
                 worst = fmax(worst, fabs(tb - ta) / ta);
         }
-    CHECK(worst < 0.05);
-    if (worst >= 0.05 || fabs(mb - ma) >= 0.01 * ma)
+    CHECK(worst < tile_tol);
+    if (worst >= tile_tol || fabs(mb - ma) >= 0.01 * ma)
         fprintf(stderr, "  means %g %g, worst tile %.3f\n", ma, mb, worst);
+}
+
+static void test_agrees_with_raytrace(void)
+{
+    RayesImage *a = render(RAYES_HIDER_RAYTRACE, 2, 16, 16, NULL);
+    RayesImage *b = render(RAYES_HIDER_GRID, 2, 16, 16, NULL);
+    check_agree(a, b, 0.05);
     rayes_image_free(a);
     rayes_image_free(b);
+}
+
+/* Irradiance interpolation with gradients: records at a fraction of the
+ * vertices, the same picture within noise, the same bytes for any thread
+ * count. */
+static void test_irradiance_interpolation(void)
+{
+    uint64_t d_off, d_on, records;
+    RayesImage *a = render_irr(RAYES_HIDER_GRID, 0, 2, 1, 256, &d_off, NULL);
+    RayesImage *b = render_irr(RAYES_HIDER_GRID, 1, 2, 1, 256, &d_on, &records);
+    RayesImage *c = render_irr(RAYES_HIDER_GRID, 1, 1, 1, 256, NULL, NULL);
+    check_agree(a, b, 0.03);
+    CHECK(d_on == d_off);
+    CHECK(records > 0 && records < d_on * 3 / 4);
+    CHECK(b && c && memcmp(b->rgba, c->rgba, sizeof(float) * 4 * 64 * 64) == 0);
+    rayes_image_free(a);
+    rayes_image_free(b);
+    rayes_image_free(c);
 }
 
 static void test_any_thread_count(void)
@@ -91,5 +126,6 @@ static void test_shading_follows_vertices(void)
     CHECK(grid16 < ray16 / 4);
 }
 
-TEST_MAIN(TEST(test_agrees_with_raytrace), TEST(test_any_thread_count),
+TEST_MAIN(TEST(test_agrees_with_raytrace), TEST(test_irradiance_interpolation),
+          TEST(test_any_thread_count),
           TEST(test_shading_follows_vertices))
