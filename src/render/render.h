@@ -67,6 +67,7 @@ typedef struct RenderSettings {
 typedef struct RenderStats {
     uint64_t rays_camera, rays_shadow, rays_diffuse, rays_specular;
     uint64_t shading_points[RENDER_MAX_DEPTH + 1]; /* by diffuse depth */
+    uint64_t ambient_lookups;     /* points the ambient service was asked for */
 } RenderStats;
 
 /* Camera from eye, target, up and vertical field of view in degrees. */
