@@ -338,6 +338,8 @@ int light_intersect(const Light *l, Vec3 o, Vec3 wi, LightSample *s)
             return 0;
         float sin2 = r2 / d2, cos_max = sqrtf(fmaxf(0.0f, 1.0f - sin2));
         float one_minus = sin2 / (1.0f + cos_max);
+        if (!(one_minus > 0.0f))
+            return 0; /* too small to be sampled: too small to hit */
         s->wi = wi;
         s->dist = proj - sqrtf(fmaxf(0.0f, r2 - h2));
         s->Li = l->L;
