@@ -149,6 +149,39 @@ RAYES_API RayesError rayes_scene_sphere(RayesScene *scene, float radius);
 RAYES_API RayesError rayes_scene_area_light(RayesScene *scene, const float P[4][3],
                                             const float L[3]);
 
+/* A light source of the given type, with parameters (unknown names get
+ * one warning; a wrong type is RAYES_ERROR_INVALID_ARGUMENT). Points and
+ * directions are 3-vectors given as RAYES_PARAM_COLOR and transform by the
+ * current transform. Every light takes "intensity" (FLOAT, default 1),
+ * "lightcolor" (COLOR, default 1 1 1) and "__category" (STRING, a
+ * comma-separated list the direct-lighting service's category argument
+ * selects on). Types, RenderMan's semantics (angles in degrees):
+ *   "pointlight"       "from" (default 0 0 0): irradiance intensity / d^2
+ *                      at normal incidence
+ *   "spotlight"        "from" (0 0 0), "to" (0 0 1), "coneangle" (30),
+ *                      "conedeltaangle" (5), "beamdistribution" (2): a
+ *                      point light times smoothstep(cos(cone), cos(cone -
+ *                      delta), cos a) * cos(a)^beamdistribution, a the angle
+ *                      from the axis
+ *   "distantlight"     "from" (0 0 0), "to" (0 0 1): irradiance intensity
+ *                      along to - from
+ *   "ambientlight"     adds intensity * lightcolor to the ambient service
+ *   "environmentlight" radiance intensity * lightcolor, times the
+ *                      latitude-longitude map "mapname" (EXR or PNG) if
+ *                      given, seen by camera and specular rays that miss
+ *                      everything (docs/DESIGN.md: orientation)
+ *   "arealight"        radiance intensity * lightcolor from a "shape"
+ *                      (default "quad"): "quad" the square of side
+ *                      "width" x "height" (1 x 1) about the object-space
+ *                      origin in z = 0, "disk" of "radius" (1) at the
+ *                      origin in z = 0, both emitting toward +z, or
+ *                      "sphere" of "radius" (1) emitting outward; seen by
+ *                      camera and specular rays
+ * An unknown type is RAYES_ERROR_INVALID_ARGUMENT; an unreadable map is
+ * RAYES_ERROR_IO. */
+RAYES_API RayesError rayes_scene_light(RayesScene *scene, const char *type,
+                                       const RayesParam *params, size_t n_params);
+
 /* Ends an edit: checks the scene and bumps its timestamp. Rendering an
  * uncommitted scene is RAYES_ERROR_INVALID_OPERATION. */
 RAYES_API RayesError rayes_scene_commit(RayesScene *scene);

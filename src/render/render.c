@@ -151,6 +151,7 @@ static void merge_stats(RenderStats *into, const RenderStats *s)
     into->irradiance_interpolated += s->irradiance_interpolated;
     for (int d = 0; d <= RENDER_MAX_DEPTH; d++)
         into->shading_points[d] += s->shading_points[d];
+    into->ambient_lookups += s->ambient_lookups;
 }
 
 int render_frame(const RenderScene *rs, const RenderSettings *set, float *rgba, RenderStats *stats)

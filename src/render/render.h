@@ -72,6 +72,7 @@ typedef struct RenderStats {
     uint64_t shading_points[RENDER_MAX_DEPTH + 1]; /* by diffuse depth */
     uint64_t irradiance_records;      /* irradiance interpolation: records computed */
     uint64_t irradiance_interpolated; /* and points interpolated */
+    uint64_t ambient_lookups;     /* points the ambient service was asked for */
 } RenderStats;
 
 /* Camera from eye, target, up and vertical field of view in degrees. */

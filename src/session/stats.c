@@ -54,6 +54,7 @@ RayesStats *session_stats_new(const RenderSettings *set, const RenderStats *rs, 
     count(s, "rays/shadow", rs->rays_shadow);
     count(s, "rays/diffuse", rs->rays_diffuse);
     count(s, "rays/specular", rs->rays_specular);
+    count(s, "lighting/ambient_points", rs->ambient_lookups);
     count(s, "grids", gs->n_grids);
     count(s, "grid_vertices", gs->n_vertices);
     count(s, "memory/peak_rss_bytes", mem_peak_rss_bytes());
