@@ -28,6 +28,7 @@ typedef struct Args {
     int n_outputs;
     const char *stats_path;
     const char *data_dir;
+    const char *shader_path;    /* --shader-path: put before the scene's own shader path */
     int quiet;
     RayesRenderOptions opt;
 } Args;
@@ -76,6 +77,8 @@ static void usage(FILE *f)
           "  --cache-k K             use the coarsest resolution whose micropolygons are at\n"
           "                          most K times the ray footprint (default 1)\n"
           "  --data DIR              data directory (teapot.bpt); default $RAYES_DATA\n"
+          "  --shader-path DIRS      directories of shader plugins NAME.so, ':'-separated;\n"
+          "                          searched before $RAYES_SHADER_PATH\n"
           "  --stats FILE.json       write statistics as JSON\n"
           "  --quiet                 no progress bar and no summary\n",
           f);
@@ -243,6 +246,8 @@ static void parse_args(int argc, char **argv, Args *a)
             a->data_dir = v;
         else if (strcmp(o, "--stats") == 0)
             a->stats_path = v;
+        else if (strcmp(o, "--shader-path") == 0)
+            a->shader_path = v;
         else
             die_usage("unknown option \"%s\"", o);
     }
@@ -373,7 +378,14 @@ static int cmd_render(int argc, char **argv)
         fprintf(stderr, "rayes: out of memory\n");
         return 1;
     }
-    RayesError e = io_builtin_scene(a.scene, a.data_dir, scene, err, sizeof err);
+    RayesError e = RAYES_OK;
+    /* Before the scene, so a scene file's own path can keep it with "&". */
+    if (a.shader_path && rayes_scene_set_search_path(scene, "shader", a.shader_path) != RAYES_OK) {
+        fprintf(stderr, "rayes: --shader-path: %s\n", rayes_scene_get_error(scene));
+        rayes_scene_release(scene);
+        return 2;
+    }
+    e = io_builtin_scene(a.scene, a.data_dir, scene, err, sizeof err);
     if (e != RAYES_OK) {
         fprintf(stderr, "rayes: %s\n", err);
         rayes_scene_release(scene);

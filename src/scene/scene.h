@@ -28,6 +28,13 @@ typedef struct SceneObject {
     uint32_t ray_mask;        /* RayesRayType bits of the rays that see it */
 } SceneObject;
 
+/* The kinds of rayes_scene_set_search_path, indexing RayesScene.search_paths
+ * (names in scene.c's search_path_kinds). */
+typedef enum SceneSearchPath {
+    SCENE_SEARCH_PATH_SHADER = 0,
+    SCENE_SEARCH_PATH_COUNT
+} SceneSearchPath;
+
 struct RayesScene {
     atomic_int refs;
     char error[512];          /* the first error since the last clear */
@@ -44,12 +51,18 @@ struct RayesScene {
     size_t n_lights, cap_lights;
     uint64_t timestamp;       /* commits so far */
     int dirty;                /* edited since the last commit */
+    char *search_paths[SCENE_SEARCH_PATH_COUNT]; /* colon-separated, "&" expanded; owned; NULL:
+                                                    empty */
 };
 
 /* Dices every primitive of a committed scene for a camera that sees
  * `height` pixels over its vertical field of view. Returns 0, or -1 when
  * out of memory. */
 int scene_prepare(const RayesScene *scene, int height, GridSet *gs);
+
+/* The scene's search path of that kind: colon-separated directories, ""
+ * if never set. Borrowed: valid until the next set_search_path. */
+const char *scene_search_path(const RayesScene *scene, SceneSearchPath kind);
 
 /* The bounds of all primitives' control points (lights included). */
 Bounds3 scene_bounds(const RayesScene *scene);
