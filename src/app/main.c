@@ -379,14 +379,13 @@ static int cmd_render(int argc, char **argv)
         fprintf(stderr, "rayes: out of memory\n");
         return 1;
     }
-    RayesError e = RAYES_OK;
     /* Before the scene, so a scene file's own path can keep it with "&". */
     if (a.shader_path && rayes_scene_set_search_path(scene, "shader", a.shader_path) != RAYES_OK) {
         fprintf(stderr, "rayes: --shader-path: %s\n", rayes_scene_get_error(scene));
         rayes_scene_release(scene);
         return 2;
     }
-    e = io_builtin_scene(a.scene, a.data_dir, scene, err, sizeof err);
+    RayesError e = io_builtin_scene(a.scene, a.data_dir, scene, err, sizeof err);
     if (e != RAYES_OK) {
         fprintf(stderr, "rayes: %s\n", err);
         rayes_scene_release(scene);
