@@ -99,8 +99,12 @@ typedef struct RayesParam {
 } RayesParam;
 
 /* The surface shader of geometry added from now on: a built-in class name
- * ("matte", "plastic", "mirror", "constant") with parameters. The
- * parameters are copied. An unknown class is RAYES_ERROR_INVALID_ARGUMENT. */
+ * ("matte", "plastic", "mirror", "constant"), else a plugin NAME.so found
+ * on the scene's "shader" search path, then on $RAYES_SHADER_PATH
+ * (docs/shaders.md), with parameters. The parameters are copied. An
+ * unknown class, or a plugin that fails to load or its checks, is
+ * RAYES_ERROR_INVALID_ARGUMENT; the message names the file and the
+ * problem, or the directories searched. */
 RAYES_API RayesError rayes_scene_set_shader(RayesScene *scene, const char *name,
                                             const RayesParam *params, size_t n_params);
 
@@ -119,6 +123,12 @@ RAYES_API RayesError rayes_scene_set_displacement(RayesScene *scene, const char 
  * no point moves farther. Displacements are clamped to it, with one
  * warning per shader. 0 (the default) means unbounded. */
 RAYES_API RayesError rayes_scene_set_displacement_bound(RayesScene *scene, float bound);
+/* Sets the scene's search path of a kind ("shader"): directories separated
+ * by ':', searched in order by later calls (set_shader). An entry "&" or
+ * "@" stands for the previous value (as in RenderMan), so "mine:&"
+ * prepends. Empty entries are ignored. */
+RAYES_API RayesError rayes_scene_set_search_path(RayesScene *scene, const char *kind,
+                                                 const char *path);
 
 /* The shading rate of geometry added from now on: the area of a
  * micropolygon in pixels (RenderMan's ShadingRate). Default 1. */

@@ -28,6 +28,7 @@ typedef struct Args {
     int n_outputs;
     const char *stats_path;
     const char *data_dir;
+    const char *shader_path;    /* --shader-path: put before the scene's own shader path */
     int quiet;
     RayesRenderOptions opt;
 } Args;
@@ -50,7 +51,8 @@ static void usage(FILE *f)
     fputs("usage: rayes render [SCENE] [options]\n"
           "       rayes --help | --version\n"
           "\n"
-          "SCENE is a built-in scene: cornell (default), cornell-teapots.\n"
+          "SCENE is a built-in scene: cornell (default), cornell-teapots, cornell-brick\n"
+          "(needs the plugin brick.so: --shader-path build/examples/shaders).\n"
           "\n"
           "options:\n"
           "  -o FILE                 output image, .exr or .png (repeatable; default SCENE.exr)\n"
@@ -81,6 +83,8 @@ static void usage(FILE *f)
           "  --irradiance on|off     irradiance interpolation with gradients at depth 0 (grid\n"
           "                          hider; on for --quality final)\n"
           "  --data DIR              data directory (teapot.bpt); default $RAYES_DATA\n"
+          "  --shader-path DIRS      directories of shader plugins NAME.so, ':'-separated;\n"
+          "                          searched before $RAYES_SHADER_PATH\n"
           "  --stats FILE.json       write statistics as JSON\n"
           "  --quiet                 no progress bar and no summary\n",
           f);
@@ -257,6 +261,8 @@ static void parse_args(int argc, char **argv, Args *a)
             a->data_dir = v;
         else if (strcmp(o, "--stats") == 0)
             a->stats_path = v;
+        else if (strcmp(o, "--shader-path") == 0)
+            a->shader_path = v;
         else
             die_usage("unknown option \"%s\"", o);
     }
@@ -386,6 +392,12 @@ static int cmd_render(int argc, char **argv)
     if (!scene) {
         fprintf(stderr, "rayes: out of memory\n");
         return 1;
+    }
+    /* Before the scene, so a scene file's own path can keep it with "&". */
+    if (a.shader_path && rayes_scene_set_search_path(scene, "shader", a.shader_path) != RAYES_OK) {
+        fprintf(stderr, "rayes: --shader-path: %s\n", rayes_scene_get_error(scene));
+        rayes_scene_release(scene);
+        return 2;
     }
     RayesError e = io_builtin_scene(a.scene, a.data_dir, scene, err, sizeof err);
     if (e != RAYES_OK) {

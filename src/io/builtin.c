@@ -12,8 +12,8 @@
 
 #include "io/bpt.h"
 
-const char *const io_builtin_scene_names[] = {"cornell", "cornell-teapots", "cornell-teapots-displaced",
-                                             NULL};
+const char *const io_builtin_scene_names[] = {"cornell", "cornell-teapots",
+                                              "cornell-teapots-displaced", "cornell-brick", NULL};
 
 typedef struct Quad {
     float P[4][3];
@@ -173,6 +173,31 @@ static RayesError cornell_teapots(RayesScene *s, const char *data_dir, int displ
     return e;
 }
 
+/* A wall 1.2 mm in front of the back wall, shaded by the example plugin
+ * brick (examples/shaders): bricks about 55 x 25 mm. */
+static RayesError cornell_brick(RayesScene *s, char *err, size_t err_size)
+{
+    static const Quad wall = {{{549.6f, 0, 558}, {0, 0, 558}, {0, 548.8f, 558}, {556, 548.8f, 558}}};
+    static const RayesParam p[] = {
+        {"brickwidth", RAYES_PARAM_FLOAT, {0.1f, 0, 0}, NULL},
+        {"brickheight", RAYES_PARAM_FLOAT, {0.045f, 0, 0}, NULL},
+        {"mortarthickness", RAYES_PARAM_FLOAT, {0.008f, 0, 0}, NULL},
+        {"Cbrick", RAYES_PARAM_COLOR, {0.6f, 0.16f, 0.1f}, NULL},
+        {"Cmortar", RAYES_PARAM_COLOR, {0.7f, 0.7f, 0.65f}, NULL},
+    };
+    RayesError e = rayes_scene_set_shader(s, "brick", p, sizeof p / sizeof p[0]);
+    if (e != RAYES_OK) {
+        const char *why = rayes_scene_get_error(s);
+        int missing = strncmp(why, "unknown shader", 14) == 0;
+        snprintf(err, err_size, "scene cornell-brick: %s%s", why,
+                 missing ? " (give the directory of brick.so with --shader-path DIRS or "
+                           "RAYES_SHADER_PATH)"
+                         : "");
+        return e == RAYES_ERROR_INVALID_ARGUMENT ? RAYES_ERROR_IO : e; /* missing data */
+    }
+    return quads(s, &wall, 1);
+}
+
 RayesError io_builtin_scene(const char *name, const char *data_dir, RayesScene *s, char *err,
                             size_t err_size)
 {
@@ -188,10 +213,16 @@ RayesError io_builtin_scene(const char *name, const char *data_dir, RayesScene *
         if (e == RAYES_OK)
             e = cornell_teapots(s, data_dir, strcmp(name, "cornell-teapots-displaced") == 0, err,
                                 err_size);
+    } else if (strcmp(name, "cornell-brick") == 0) {
+        e = cornell_shell(s);
+        if (e == RAYES_OK)
+            e = cornell_blocks(s);
+        if (e == RAYES_OK)
+            e = cornell_brick(s, err, err_size);
     } else {
         snprintf(err, err_size,
                  "unknown scene \"%s\" (built-in scenes: cornell, cornell-teapots, "
-                 "cornell-teapots-displaced)",
+                 "cornell-teapots-displaced, cornell-brick)",
                  name);
         return RAYES_ERROR_INVALID_ARGUMENT;
     }

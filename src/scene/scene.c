@@ -90,6 +90,8 @@ void rayes_scene_release(RayesScene *s)
     for (size_t i = 0; i < s->n_lights; i++)
         light_fini(&s->lights[i]);
     free(s->lights);
+    for (int k = 0; k < SCENE_SEARCH_PATH_COUNT; k++)
+        free(s->search_paths[k]);
     free(s);
 }
 
@@ -204,15 +206,36 @@ static RayesError check_params(RayesScene *s, const char *what, const char *name
     return RAYES_OK;
 }
 
+/* Sets *cls to a built-in class, else a plugin from the scene's shader
+ * search path and then $RAYES_SHADER_PATH. Returns RAYES_OK, or the error
+ * recorded in the scene. */
+static RayesError find_shader(RayesScene *s, const char *name, const RayesShaderClass **cls)
+{
+    *cls = shade_find_class(name);
+    if (*cls)
+        return RAYES_OK;
+    const char *mine = scene_search_path(s, SCENE_SEARCH_PATH_SHADER);
+    const char *env = getenv("RAYES_SHADER_PATH");
+    size_t len = strlen(mine) + (env ? strlen(env) : 0) + 2;
+    char *path = malloc(len), err[512];
+    if (!path)
+        return fail(s, RAYES_ERROR_OUT_OF_MEMORY, "out of memory");
+    snprintf(path, len, "%s:%s", mine, env ? env : "");
+    *cls = shade_find_class_on_path(name, path, err, sizeof err);
+    free(path);
+    return *cls ? RAYES_OK : fail(s, RAYES_ERROR_INVALID_ARGUMENT, "%s", err);
+}
+
 RayesError rayes_scene_set_shader(RayesScene *s, const char *name, const RayesParam *params,
                                   size_t n_params)
 {
     if (!s || !name || (n_params && !params))
         return RAYES_ERROR_INVALID_ARGUMENT;
-    const RayesShaderClass *cls = shade_find_class(name);
-    if (!cls)
-        return fail(s, RAYES_ERROR_INVALID_ARGUMENT, "unknown shader \"%s\"", name);
-    RayesError e = check_params(s, "shader", name, params, n_params);
+    const RayesShaderClass *cls;
+    RayesError e = find_shader(s, name, &cls);
+    if (e != RAYES_OK)
+        return e;
+    e = check_params(s, "shader", name, params, n_params);
     if (e != RAYES_OK)
         return e;
     return add_object(s, cls, params, n_params, -1);
@@ -692,4 +715,72 @@ RayesError rayes_scene_light(RayesScene *s, const char *type, const RayesParam *
     }
     return fail(s, RAYES_ERROR_INVALID_ARGUMENT,
                 "arealight: unknown shape \"%s\"; expected quad, disk or sphere", lp.shape);
+}
+
+/* ------------------------------------------------------- search paths */
+
+/* Kind names of rayes_scene_set_search_path, by SceneSearchPath. */
+static const char *const search_path_kinds[SCENE_SEARCH_PATH_COUNT] = {
+    [SCENE_SEARCH_PATH_SHADER] = "shader",
+};
+
+#define SEARCH_PATH_MAX 65536 /* characters, after expanding "&" */
+
+const char *scene_search_path(const RayesScene *s, SceneSearchPath kind)
+{
+    return s->search_paths[kind] ? s->search_paths[kind] : "";
+}
+
+/* path with each entry "&" or "@" replaced by prev, empty entries dropped;
+ * NULL when too long or out of memory (*too_long says which). */
+static char *expand_search_path(const char *path, const char *prev, int *too_long)
+{
+    size_t len = 0, cap = strlen(path) + 1;
+    for (const char *p = path; *p; p++)
+        cap += (*p == '&' || *p == '@') ? strlen(prev) : 0;
+    *too_long = cap > SEARCH_PATH_MAX;
+    char *out = *too_long ? NULL : malloc(cap);
+    if (!out)
+        return NULL;
+    out[0] = '\0';
+    for (const char *d = path; *d;) {
+        size_t n = strcspn(d, ":");
+        const char *text = d;
+        size_t tn = n;
+        if (n == 1 && (d[0] == '&' || d[0] == '@')) {
+            text = prev;
+            tn = strlen(prev);
+        }
+        if (tn > 0) {
+            if (len > 0)
+                out[len++] = ':';
+            memcpy(out + len, text, tn);
+            len += tn;
+            out[len] = '\0';
+        }
+        d += n + (d[n] == ':');
+    }
+    return out;
+}
+
+RayesError rayes_scene_set_search_path(RayesScene *s, const char *kind, const char *path)
+{
+    if (!s || !kind || !path)
+        return RAYES_ERROR_INVALID_ARGUMENT;
+    int k = 0;
+    while (k < SCENE_SEARCH_PATH_COUNT && strcmp(search_path_kinds[k], kind) != 0)
+        k++;
+    if (k == SCENE_SEARCH_PATH_COUNT)
+        return fail(s, RAYES_ERROR_INVALID_ARGUMENT,
+                    "search path: unknown kind \"%.64s\"; expected \"shader\"", kind);
+    int too_long;
+    char *expanded = expand_search_path(path, scene_search_path(s, (SceneSearchPath)k), &too_long);
+    if (!expanded)
+        return too_long ? fail(s, RAYES_ERROR_INVALID_ARGUMENT,
+                               "search path \"%s\": longer than %d characters", kind,
+                               SEARCH_PATH_MAX)
+                        : fail(s, RAYES_ERROR_OUT_OF_MEMORY, "out of memory");
+    free(s->search_paths[k]);
+    s->search_paths[k] = expanded;
+    return RAYES_OK;
 }

@@ -28,6 +28,13 @@ typedef struct SceneObject {
     uint32_t ray_mask;        /* RayesRayType bits of the rays that see it */
 } SceneObject;
 
+/* The kinds of rayes_scene_set_search_path, indexing RayesScene.search_paths
+ * (names in scene.c's search_path_kinds). */
+typedef enum SceneSearchPath {
+    SCENE_SEARCH_PATH_SHADER = 0,
+    SCENE_SEARCH_PATH_COUNT
+} SceneSearchPath;
+
 struct RayesScene {
     atomic_int refs;
     char error[512];          /* the first error since the last clear */
@@ -48,6 +55,8 @@ struct RayesScene {
     float displacement_bound;      /* of geometry added next; 0: unbounded */
     uint64_t timestamp;       /* commits so far */
     int dirty;                /* edited since the last commit */
+    char *search_paths[SCENE_SEARCH_PATH_COUNT]; /* colon-separated, "&" expanded; owned; NULL:
+                                                    empty */
 };
 
 /* Dices every primitive of a committed scene for a camera that sees
@@ -59,6 +68,9 @@ int scene_prepare(const RayesScene *scene, int height, GridSet *gs);
  * n_grids) of gs (displace.c); normals come from differences over step
  * (world units). Returns 0, or -1 when out of memory. */
 int scene_displace(const RayesScene *scene, GridSet *gs, size_t first_grid, float step);
+/* The scene's search path of that kind: colon-separated directories, ""
+ * if never set. Borrowed: valid until the next set_search_path. */
+const char *scene_search_path(const RayesScene *scene, SceneSearchPath kind);
 
 /* The bounds of all primitives' control points (lights included). */
 Bounds3 scene_bounds(const RayesScene *scene);
