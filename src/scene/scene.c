@@ -250,13 +250,14 @@ RayesError rayes_scene_set_displacement(RayesScene *s, const char *name, const R
         s->current_displacement = 0;
         return RAYES_OK;
     }
-    const RayesShaderClass *cls = shade_find_class(name);
-    if (!cls)
-        return fail(s, RAYES_ERROR_INVALID_ARGUMENT, "unknown displacement shader \"%s\"", name);
+    const RayesShaderClass *cls;
+    RayesError e = find_shader(s, name, &cls);
+    if (e != RAYES_OK)
+        return e;
     if (!cls->displacement)
         return fail(s, RAYES_ERROR_INVALID_ARGUMENT,
                     "shader \"%s\" has no displacement method", name);
-    RayesError e = check_params(s, "displacement shader", name, params, n_params);
+    e = check_params(s, "displacement shader", name, params, n_params);
     if (e != RAYES_OK)
         return e;
     if (grow((void **)&s->displacements, &s->cap_displacements, s->n_displacements,
