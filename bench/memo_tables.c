@@ -6,10 +6,15 @@
  *                      [--accuracy-size N] [--out DIR] [--data DIR] [--threads N]
  *                      [--cache-k K] [--scene cornell-teapots|cornell-teapots-displaced]
  *   memo_tables table4 [...same...] [--budgets MB,MB,...]
+ *   memo_tables table2 [...same...] [--uncached-max B]
  *
  * table1: preview quality, bounces 1..B (default 3), caching off and on:
  * shading points, rays, time, speed-up and hit rates per resolution.
  * table4: one bounce at cache budgets 0 (off), 1, 4, 16, 64, 256 MB.
+ * table2: final quality (the grid hider with irradiance interpolation),
+ * bounces 1..B, caching on, and off up to --uncached-max bounces (default
+ * 1: an uncached row costs 64 times the one before). No accuracy pass:
+ * bench/figure5 measures final against a reference.
  * Both then measure bias: the same rows at --accuracy-spp pixel samples
  * (default 64) and --accuracy-size pixels (default: half of --size), the
  * relative difference of the cached and uncached image means and the
@@ -31,6 +36,8 @@
 typedef struct Args {
     const char *mode, *data, *out, *scene;
     int size, spp, bounces_max, accuracy_spp, accuracy_size, threads;
+    int uncached_max;             /* table2: uncached rows up to this many bounces */
+    int quality;                  /* RayesQuality of the rows */
     double cache_k;
     double budgets[16];
     int n_budgets;
@@ -42,7 +49,7 @@ typedef struct Row {
     double time_s;                /* wall clock */
     double cpu_s;                 /* process CPU time (user + system), less sensitive to
                                      other tenants of a shared machine */
-    unsigned long long shading_points, rays, shadow, diffuse;
+    unsigned long long shading_points, rays, shadow, diffuse, records;
     double hit[3];
     float *rgba;
     int w, h;
@@ -74,7 +81,7 @@ static Row run(const Args *a, int size, int spp, int bounces, int cache, double 
     if (!scene || io_builtin_scene(a->scene, a->data, scene, err, sizeof err) != RAYES_OK)
         die(err);
     RayesRenderOptions o;
-    rayes_render_options_init(&o, RAYES_QUALITY_PREVIEW);
+    rayes_render_options_init(&o, (RayesQuality)a->quality);
     o.width = o.height = size;
     o.spp = spp;
     o.bounces = bounces;
@@ -98,6 +105,8 @@ static Row run(const Args *a, int size, int spp, int bounces, int cache, double 
                                       "cache/fine/hit_rate"};
     for (int l = 0; l < 3; l++)
         r.hit[l] = cache ? find(st, hr[l])->real : 0.0;
+    const RayesStat *rec = rayes_stats_find(st, "irradiance/records");
+    r.records = rec ? rec->count : 0;
     r.rgba = img->rgba;
     r.w = img->width;
     r.h = img->height;
@@ -170,6 +179,8 @@ static void parse(int argc, char **argv, Args *a)
     a->bounces_max = 3;
     a->accuracy_spp = 64;
     a->threads = 0;
+    a->uncached_max = 1;
+    a->quality = RAYES_QUALITY_PREVIEW;
     a->cache_k = 1.0;
     const double budgets[] = {0, 1, 4, 16, 64, 256};
     a->n_budgets = 6;
@@ -196,6 +207,8 @@ static void parse(int argc, char **argv, Args *a)
             a->out = v;
         else if (strcmp(o, "--scene") == 0)
             a->scene = v;
+        else if (strcmp(o, "--uncached-max") == 0)
+            a->uncached_max = atoi(v);
         else if (strcmp(o, "--budgets") == 0) {
             a->n_budgets = 0;
             for (char *s = (char *)v; *s && a->n_budgets < 16; s += strcspn(s, ",") + (s[strcspn(s, ",")] != 0))
@@ -205,8 +218,11 @@ static void parse(int argc, char **argv, Args *a)
     }
     if (a->accuracy_size == 0)
         a->accuracy_size = a->size / 2;
-    if ((strcmp(a->mode, "table1") && strcmp(a->mode, "table4")) || a->size < 32 || a->spp < 1)
-        die("usage: memo_tables table1|table4 [--size N] [--spp N] ...");
+    if (strcmp(a->mode, "table2") == 0)
+        a->quality = RAYES_QUALITY_FINAL;
+    if ((strcmp(a->mode, "table1") && strcmp(a->mode, "table2") && strcmp(a->mode, "table4")) ||
+        a->size < 32 || a->spp < 1)
+        die("usage: memo_tables table1|table2|table4 [--size N] [--spp N] ...");
     if (mkdir(a->out, 0777) != 0 && errno != EEXIST)
         die("cannot create the output directory");
 }
@@ -257,6 +273,64 @@ static void table1(const Args *a, FILE *j)
         save(a, &off, "table1");
         save(a, &on, "table1");
         free(off.rgba);
+        free(on.rgba);
+    }
+    fprintf(j, "\n  ]");
+}
+
+/* The memo's Table 2: final quality (64 shadow rays, 1024 diffuse rays at
+ * depth 0 and 64 deeper, the grid hider with irradiance interpolation),
+ * bounces 1..B, caching off (up to --uncached-max bounces: the uncached
+ * rows grow as 64^b) and on. */
+static void table2(const Args *a, FILE *j)
+{
+    printf("Table 2 (%s, final: 64 shadow, 1024/64 diffuse rays, grid hider + irradiance "
+           "interpolation, %dx%d, %d spp)\n",
+           a->scene, a->size, a->size, a->spp);
+    printf("%-3s | %9s %9s %8s %8s | %9s %9s %8s %8s %8s | %8s %8s | %s\n", "b", "sh.pts", "rays",
+           "time", "cpu", "sh.pts", "rays", "records", "time", "cpu", "speed-up", "(cpu)",
+           "hit % coarse/medium/fine");
+    fprintf(j, "{\"table\": 2, \"size\": %d, \"spp\": %d, \"rows\": [", a->size, a->spp);
+    double t1_on = 0.0, c1_on = 0.0;
+    for (int b = 1; b <= a->bounces_max; b++) {
+        Row off = {0};
+        int have_off = b <= a->uncached_max;
+        if (have_off)
+            off = run(a, a->size, a->spp, b, 0, 100);
+        Row on = run(a, a->size, a->spp, b, 1, 100);
+        char s1[32] = "-", s2[32] = "-", s3[32], s4[32], s5[32];
+        if (have_off) {
+            human(s1, sizeof s1, off.shading_points);
+            human(s2, sizeof s2, off.rays);
+        }
+        human(s3, sizeof s3, on.shading_points);
+        human(s4, sizeof s4, on.rays);
+        human(s5, sizeof s5, on.records);
+        if (have_off)
+            printf("%-3d | %9s %9s %7.1fs %7.1fs |", b, s1, s2, off.time_s, off.cpu_s);
+        else
+            printf("%-3d | %9s %9s %8s %8s |", b, s1, s2, "-", "-");
+        printf(" %9s %9s %8s %7.1fs %7.1fs |", s3, s4, s5, on.time_s, on.cpu_s);
+        if (have_off)
+            printf(" %8.1f %8.1f |", off.time_s / on.time_s, off.cpu_s / on.cpu_s);
+        else
+            printf(" %8s %8s |", "-", "-");
+        printf(" %.2f / %.2f / %.2f\n", 100 * on.hit[0], 100 * on.hit[1], 100 * on.hit[2]);
+        if (b == 1) {
+            t1_on = on.time_s;
+            c1_on = on.cpu_s;
+        } else {
+            printf("    cached time %d bounces / 1 bounce: %.2f (cpu %.2f)\n", b, on.time_s / t1_on,
+                   on.cpu_s / c1_on);
+        }
+        fflush(stdout);
+        if (have_off) {
+            json_row(j, &off, b == 1);
+            save(a, &off, "table2");
+            free(off.rgba);
+        }
+        json_row(j, &on, b == 1 && !have_off);
+        save(a, &on, "table2");
         free(on.rgba);
     }
     fprintf(j, "\n  ]");
@@ -337,9 +411,11 @@ int main(int argc, char **argv)
         die("cannot write the JSON record");
     if (strcmp(a.mode, "table1") == 0)
         table1(&a, j);
+    else if (strcmp(a.mode, "table2") == 0)
+        table2(&a, j);
     else
         table4(&a, j);
-    if (a.accuracy_spp > 0)
+    if (a.accuracy_spp > 0 && strcmp(a.mode, "table2") != 0)
         bias(&a, j);
     else
         fprintf(j, "\n}\n");
