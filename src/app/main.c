@@ -50,7 +50,7 @@ static void usage(FILE *f)
     fputs("usage: rayes render [SCENE] [options]\n"
           "       rayes --help | --version\n"
           "\n"
-          "SCENE is a built-in scene: cornell (default), cornell-teapots.\n"
+          "SCENE is a built-in scene: cornell (default), cornell-teapots, cornell-spheres.\n"
           "\n"
           "options:\n"
           "  -o FILE                 output image, .exr or .png (repeatable; default SCENE.exr)\n"

@@ -2,7 +2,8 @@
  * io/builtin.h — the built-in scenes, built through rayes.h like any scene
  * file: "cornell" (the classic Cornell box with its two blocks; the
  * default) and "cornell-teapots" (the memo's benchmark box, with the Utah
- * teapot read from data_dir/teapot.bpt). Specified in ../shared/data.
+ * teapot read from data_dir/teapot.bpt), and "cornell-spheres" (the box
+ * with a sphere per built-in shader). Specified in ../shared/data.
  */
 #ifndef RAYES_IO_BUILTIN_H
 #define RAYES_IO_BUILTIN_H
