@@ -99,7 +99,8 @@ typedef struct RayesParam {
 } RayesParam;
 
 /* The surface shader of geometry added from now on: a built-in class name
- * ("matte", "plastic", "mirror", "constant") with parameters. The
+ * ("matte", "plastic", "mirror", "constant", "metal", "shinymetal", "glass",
+ * "diffuse", "conductor", "dielectric", "coateddiffuse") with parameters. The
  * parameters are copied. An unknown class is RAYES_ERROR_INVALID_ARGUMENT. */
 RAYES_API RayesError rayes_scene_set_shader(RayesScene *scene, const char *name,
                                             const RayesParam *params, size_t n_params);
