@@ -21,6 +21,7 @@
 
 #include "shade/bsdf.h"
 #include "shade/shade.h"
+#include "util/log.h"
 
 typedef float Rgb[3];
 
@@ -428,8 +429,13 @@ typedef struct ConductorParams {
 static void conductor_index(const ConductorParams *p, Vec3 *eta, Vec3 *k)
 {
     if (p->preset[0]) {
-        if (conductor_preset(p->preset, eta, k) != 0)
+        if (conductor_preset(p->preset, eta, k) != 0) {
+            log_warning_once("conductor:preset",
+                             "conductor: unknown preset \"%s\" (expected gold, copper, "
+                             "aluminium or silver); using copper",
+                             p->preset);
             conductor_preset("copper", eta, k);
+        }
         return;
     }
     if (p->reflectance[0] >= 0.0f && p->reflectance[1] >= 0.0f && p->reflectance[2] >= 0.0f) {

@@ -449,6 +449,23 @@ static void test_metals(void)
     CHECK_NEAR(Ci[5][2], 0.5 * 0.7, 1e-5);
     CHECK_NEAR(Ci[5][0], 0.0, 1e-6);
     shade_instance_fini(&m);
+    /* The default conductor is copper, a preset gold; an unknown preset
+     * warns and is copper. Head on, the mirror ray is (0, 0, 1). */
+    const char *names[3] = {NULL, "gold", "unobtainium"};
+    float z[3];
+    for (int k = 0; k < 3; k++) {
+        RayesParam pr = {"preset", RAYES_PARAM_STRING, {0, 0, 0}, names[k]};
+        m = instance("conductor", &pr, names[k] ? 1 : 0);
+        shade_run_lighting(&stub_full, &ctx, &m, &out);
+        z[k] = Ci[5][2];
+        shade_instance_fini(&m);
+    }
+    Vec3 eta, kk;
+    conductor_preset("copper", &eta, &kk);
+    CHECK_NEAR(z[0], 0.5 * fresnel_conductor(1.0f, eta.z, kk.z), 1e-5);
+    conductor_preset("gold", &eta, &kk);
+    CHECK_NEAR(z[1], 0.5 * fresnel_conductor(1.0f, eta.z, kk.z), 1e-5);
+    CHECK(z[2] == z[0]);
 }
 
 TEST_MAIN(TEST(test_matte), TEST(test_plastic_splits_highlight), TEST(test_mirror_reflects),
