@@ -59,9 +59,9 @@ Vec3 fresnel_conductor_rgb(float cos_i, Vec3 eta, Vec3 k)
 
 float fresnel_dielectric_average(float eta)
 {
-    /* 2 * integral_0^1 F(mu) mu dmu, midpoint rule; F is smooth except at
-     * the critical angle, which 512 steps resolve to ~1e-4. */
-    enum { STEPS = 512 };
+    /* 2 * integral_0^1 F(mu) mu dmu, midpoint rule: from outside there is
+     * no critical angle and 64 steps are within 2e-5 (eta 1.1 to 2.4). */
+    enum { STEPS = 64 };
     double sum = 0.0;
     for (int i = 0; i < STEPS; i++) {
         float mu = ((float)i + 0.5f) / STEPS;
