@@ -99,11 +99,12 @@ typedef struct RayesParam {
 } RayesParam;
 
 /* The surface shader of geometry added from now on: a built-in class name
- * ("matte", "plastic", "mirror", "constant"), else a plugin NAME.so found
- * on the scene's "shader" search path, then on $RAYES_SHADER_PATH
- * (docs/shaders.md), with parameters. The parameters are copied. An
- * unknown class, or a plugin that fails to load or its checks, is
- * RAYES_ERROR_INVALID_ARGUMENT; the message names the file and the
+ * ("matte", "plastic", "mirror", "constant", "metal", "shinymetal", "glass",
+ * "diffuse", "conductor", "dielectric", "coateddiffuse"), else a plugin
+ * NAME.so found on the scene's "shader" search path, then on
+ * $RAYES_SHADER_PATH (docs/shaders.md), with parameters. The parameters are
+ * copied. An unknown class, or a plugin that fails to load or its checks,
+ * is RAYES_ERROR_INVALID_ARGUMENT; the message names the file and the
  * problem, or the directories searched. */
 RAYES_API RayesError rayes_scene_set_shader(RayesScene *scene, const char *name,
                                             const RayesParam *params, size_t n_params);

@@ -89,6 +89,10 @@ typedef struct RayesShadeCtx {
                                    methods run on these points (prelighting writes it,
                                    lighting reads it); point i at scratch + i * scratch_size;
                                    NULL when scratch_size is 0 */
+    const int *backfacing;      /* appended in ABI 2: 1 where the ray hit the back side of
+                                   the surface (against dPdu x dPdv, so N and Ng were turned
+                                   to face it; a cache fill for that side), else 0; NULL:
+                                   every point is on the front (displacement) */
 } RayesShadeCtx;
 
 /* The outputs of a method call, n_points each. Irradiance may be NULL. */

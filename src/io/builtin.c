@@ -13,7 +13,8 @@
 #include "io/bpt.h"
 
 const char *const io_builtin_scene_names[] = {"cornell", "cornell-teapots",
-                                              "cornell-teapots-displaced", "cornell-brick", NULL};
+                                              "cornell-teapots-displaced", "cornell-spheres",
+                                              "cornell-brick", NULL};
 
 typedef struct Quad {
     float P[4][3];
@@ -198,6 +199,54 @@ static RayesError cornell_brick(RayesScene *s, char *err, size_t err_size)
     return quads(s, &wall, 1);
 }
 
+/* One sphere per built-in shader, two rows of four: the back row floats
+ * (RenderMan's classics), the front row stands on the floor (the
+ * physically based family, and glass). */
+static RayesError cornell_spheres(RayesScene *s)
+{
+    typedef struct Ball {
+        const char *shader;
+        RayesParam p[3];
+        size_t n;
+    } Ball;
+    const Ball balls[8] = {
+        {"matte", {{"Cs", RAYES_PARAM_COLOR, {0.2f, 0.7f, 0.8f}, NULL}}, 1},
+        {"plastic", {{"Cs", RAYES_PARAM_COLOR, {0.8f, 0.1f, 0.1f}, NULL}}, 1},
+        {"metal",
+         {{"Cs", RAYES_PARAM_COLOR, {0.9f, 0.7f, 0.3f}, NULL},
+          {"roughness", RAYES_PARAM_FLOAT, {0.15f, 0, 0}, NULL}},
+         2},
+        {"shinymetal",
+         {{"Cs", RAYES_PARAM_COLOR, {0.8f, 0.8f, 0.85f}, NULL},
+          {"roughness", RAYES_PARAM_FLOAT, {0.05f, 0, 0}, NULL}},
+         2},
+        {"glass", {{"eta", RAYES_PARAM_FLOAT, {1.5f, 0, 0}, NULL}}, 1},
+        {"conductor",
+         {{"preset", RAYES_PARAM_STRING, {0, 0, 0}, "gold"},
+          {"roughness", RAYES_PARAM_FLOAT, {0.01f, 0, 0}, NULL}},
+         2},
+        {"dielectric", {{"eta", RAYES_PARAM_FLOAT, {1.33f, 0, 0}, NULL}}, 1},
+        {"coateddiffuse",
+         {{"reflectance", RAYES_PARAM_COLOR, {0.1f, 0.5f, 0.2f}, NULL}}, 1},
+    };
+    const float r = 55.0f, x[4] = {464, 340, 216, 92}; /* left to right as seen */
+    RayesError e = RAYES_OK;
+    for (int i = 0; i < 8 && e == RAYES_OK; i++) {
+        int back = i < 4;
+        const float m[16] = {1, 0, 0, x[i % 4], 0, 1, 0, back ? 260.0f : r,
+                             0, 0, 1, back ? 400.0f : 170.0f, 0, 0, 0, 1};
+        e = rayes_scene_set_shader(s, balls[i].shader, balls[i].p, balls[i].n);
+        if (e == RAYES_OK)
+            e = rayes_scene_set_transform(s, m);
+        if (e == RAYES_OK)
+            e = rayes_scene_sphere(s, r);
+    }
+    static const float identity[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
+    if (e == RAYES_OK)
+        e = rayes_scene_set_transform(s, identity);
+    return e;
+}
+
 RayesError io_builtin_scene(const char *name, const char *data_dir, RayesScene *s, char *err,
                             size_t err_size)
 {
@@ -213,6 +262,10 @@ RayesError io_builtin_scene(const char *name, const char *data_dir, RayesScene *
         if (e == RAYES_OK)
             e = cornell_teapots(s, data_dir, strcmp(name, "cornell-teapots-displaced") == 0, err,
                                 err_size);
+    } else if (strcmp(name, "cornell-spheres") == 0) {
+        e = cornell_shell(s);
+        if (e == RAYES_OK)
+            e = cornell_spheres(s);
     } else if (strcmp(name, "cornell-brick") == 0) {
         e = cornell_shell(s);
         if (e == RAYES_OK)
@@ -222,7 +275,7 @@ RayesError io_builtin_scene(const char *name, const char *data_dir, RayesScene *
     } else {
         snprintf(err, err_size,
                  "unknown scene \"%s\" (built-in scenes: cornell, cornell-teapots, "
-                 "cornell-teapots-displaced, cornell-brick)",
+                 "cornell-teapots-displaced, cornell-spheres, cornell-brick)",
                  name);
         return RAYES_ERROR_INVALID_ARGUMENT;
     }

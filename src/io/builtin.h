@@ -4,9 +4,9 @@
  * default), "cornell-teapots" (the memo's benchmark box, with the Utah
  * teapot read from data_dir/teapot.bpt), "cornell-teapots-displaced" (the
  * same with the memo's fractal displacement on the matte teapot), specified
- * in ../shared/data, and "cornell-brick" (the classic box with a back wall
- * shaded by the example plugin brick, found on the scene's shader search
- * path).
+ * in ../shared/data, "cornell-spheres" (the box with a sphere per built-in
+ * shader) and "cornell-brick" (the classic box with a back wall shaded by
+ * the example plugin brick, found on the scene's shader search path).
  */
 #ifndef RAYES_IO_BUILTIN_H
 #define RAYES_IO_BUILTIN_H

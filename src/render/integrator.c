@@ -97,7 +97,7 @@ static Vec3 shade_hit(Worker *w, const Ray *ray, const Hit *hit, const RenderObj
                       RayDiff diff)
 {
     HitPoint hp;
-    hit_point(w, ray, hit, &hp);
+    int backfacing = !hit_point(w, ray, hit, &hp);
     memcpy(hp.Cs, obj->Cs, sizeof hp.Cs);
     memcpy(hp.Os, obj->Os, sizeof hp.Os);
     hp.key = key;
@@ -123,6 +123,7 @@ static Vec3 shade_hit(Worker *w, const Ray *ray, const Hit *hit, const RenderObj
         .Cs = (const float(*)[3])hp.Cs,
         .Os = (const float(*)[3])hp.Os,
         .renderer = &ps,
+        .backfacing = &backfacing,
     };
     float Ci[1][3], Oi[1][3];
     RayesShadeOutputs out = {Ci, Oi, NULL, NULL};

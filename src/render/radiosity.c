@@ -239,7 +239,8 @@ static void fill_radiosity(void *user, const CacheKey *key, size_t n, float (*ou
     float *f1 = malloc(n * 6 * sizeof *f1);
     fp.keys = malloc(n * sizeof *fp.keys);
     fp.diff = malloc(n * sizeof *fp.diff);
-    RY_CHECK(f3 && f1 && fp.keys && fp.diff);
+    int *backfacing = malloc(n * sizeof *backfacing);
+    RY_CHECK(f3 && f1 && fp.keys && fp.diff && backfacing);
     fp.P = f3, fp.N = f3 + n, fp.dPdu = f3 + 2 * n, fp.dPdv = f3 + 3 * n;
     fp.Cs = f3 + 4 * n, fp.Os = f3 + 5 * n, fp.Ci = f3 + 6 * n, fp.Oi = f3 + 7 * n;
     fp.u = f1, fp.v = f1 + n, fp.du = f1 + 2 * n, fp.dv = f1 + 3 * n, fp.curv = f1 + 4 * n;
@@ -257,6 +258,7 @@ static void fill_radiosity(void *user, const CacheKey *key, size_t n, float (*ou
         fp.offset[i] = integrator_ray_offset(w, g);
         fp.keys[i] = hash_combine(fill_key, i);
         fp.diff[i] = (RayDiff){width, 0.0f};
+        backfacing[i] = key->side != 0; /* side 1: against dPdu x dPdv */
     }
     PathState ps = {w, fp.keys, fp.diff, fp.curv, fp.offset, NULL};
     RayesShadeCtx ctx = {
@@ -266,7 +268,7 @@ static void fill_radiosity(void *user, const CacheKey *key, size_t n, float (*ou
         .Ng = (const float(*)[3])fp.N, .dPdu = (const float(*)[3])fp.dPdu,
         .dPdv = (const float(*)[3])fp.dPdv, .u = fp.u, .v = fp.v, .s = fp.u, .t = fp.v,
         .du = fp.du, .dv = fp.dv, .I = NULL, .Cs = (const float(*)[3])fp.Cs,
-        .Os = (const float(*)[3])fp.Os, .renderer = &ps,
+        .Os = (const float(*)[3])fp.Os, .renderer = &ps, .backfacing = backfacing,
     };
     RayesShadeOutputs o = {fp.Ci, fp.Oi, NULL, NULL};
     w->stats.shading_points[RY_MIN(key->depth, RENDER_MAX_DEPTH)] += n;
@@ -276,6 +278,7 @@ static void fill_radiosity(void *user, const CacheKey *key, size_t n, float (*ou
     free(f1);
     free(fp.keys);
     free(fp.diff);
+    free(backfacing);
 }
 
 /* -------------------------------------------------------- interpolation */

@@ -1,6 +1,6 @@
 /*
  * shade/builtin.c — RenderMan's classic surfaces: matte, plastic, a tinted
- * mirror (shinymetal without an environment map) and constant.
+ * mirror and constant (the others are in builtin_bsdf.c).
  *
  * Each has a separate diffuselighting with exactly the view-independent
  * terms of its lighting: for matte and constant the two are the same; for
@@ -44,16 +44,21 @@ static void set_opacity(const RayesShadeCtx *ctx, RayesShadeOutputs *out)
             out->Oi[i][c] = ctx->Os ? ctx->Os[i][c] : 1.0f;
 }
 
-/* Ci = Cs Kd (direct + indirect diffuse) + emit, on one chunk. */
-static void diffuse_chunk(const RayesShaderServices *sv, const RayesShadeCtx *ctx, float Kd,
-                          const float emit[3], RayesShadeOutputs *out)
+/* Ci = Cs (Ka ambient + Kd (direct + indirect diffuse)) + emit, on one
+ * chunk (ambient is 0 when the services lack it). */
+static void diffuse_chunk(const RayesShaderServices *sv, const RayesShadeCtx *ctx, float Ka,
+                          float Kd, const float emit[3], RayesShadeOutputs *out)
 {
-    float dd[SHADE_CHUNK][3], id[SHADE_CHUNK][3];
+    float dd[SHADE_CHUNK][3], id[SHADE_CHUNK][3], am[SHADE_CHUNK][3];
     sv->direct_lighting(sv, ctx, 0, NULL, NULL, dd, NULL);
     sv->indirect_diffuse(sv, ctx, 0, id);
+    if (sv->ambient)
+        sv->ambient(sv, ctx, am);
+    else
+        memset(am, 0, sizeof am);
     for (size_t i = 0; i < ctx->n_points; i++)
         for (int c = 0; c < 3; c++)
-            out->Ci[i][c] = cs(ctx, i, c) * Kd * (dd[i][c] + id[i][c]) + emit[c];
+            out->Ci[i][c] = cs(ctx, i, c) * (Ka * am[i][c] + Kd * (dd[i][c] + id[i][c])) + emit[c];
     if (out->Irradiance)
         for (size_t i = 0; i < ctx->n_points; i++)
             for (int c = 0; c < 3; c++)
@@ -84,7 +89,7 @@ static void matte_chunk(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
                         const void *params, RayesShadeOutputs *out)
 {
     const MatteParams *p = params;
-    diffuse_chunk(sv, ctx, p->Kd, p->Ke, out);
+    diffuse_chunk(sv, ctx, p->Ka, p->Kd, p->Ke, out);
 }
 
 static void matte_lighting(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
@@ -117,21 +122,26 @@ static void plastic_diffuse_chunk(const RayesShaderServices *sv, const RayesShad
 {
     const PlasticParams *p = params;
     static const float black[3] = {0, 0, 0};
-    diffuse_chunk(sv, ctx, p->Kd, black, out);
+    diffuse_chunk(sv, ctx, p->Ka, p->Kd, black, out);
 }
 
 static void plastic_chunk(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
                           const void *params, RayesShadeOutputs *out)
 {
     const PlasticParams *p = params;
-    float dd[SHADE_CHUNK][3], id[SHADE_CHUNK][3], ds[SHADE_CHUNK][3], rough[SHADE_CHUNK];
+    float dd[SHADE_CHUNK][3], id[SHADE_CHUNK][3], ds[SHADE_CHUNK][3], am[SHADE_CHUNK][3];
+    float rough[SHADE_CHUNK];
     for (size_t i = 0; i < ctx->n_points; i++)
         rough[i] = p->roughness;
-    sv->direct_lighting(sv, ctx, 0, NULL, rough, dd, ds);
+    sv->direct_lighting(sv, ctx, 0, NULL, rough, dd, ds); /* one set of shadow rays for both */
     sv->indirect_diffuse(sv, ctx, 0, id);
+    if (sv->ambient)
+        sv->ambient(sv, ctx, am);
+    else
+        memset(am, 0, sizeof am);
     for (size_t i = 0; i < ctx->n_points; i++)
         for (int c = 0; c < 3; c++)
-            out->Ci[i][c] = cs(ctx, i, c) * p->Kd * (dd[i][c] + id[i][c]) +
+            out->Ci[i][c] = cs(ctx, i, c) * (p->Ka * am[i][c] + p->Kd * (dd[i][c] + id[i][c])) +
                             p->specularcolor[c] * p->Ks * ds[i][c];
 }
 

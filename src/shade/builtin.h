@@ -18,4 +18,14 @@ extern const RayesShaderClass shade_class_fractal;  /* displacement: the memo's 
  * lighting services are NULL; supports() says so). */
 extern const RayesShaderServices shade_dicing_services;
 
+/* builtin_bsdf.c: the rest of RenderMan's classics and the physically based
+ * family the pbrt reader maps to (README.md lists their parameters). */
+extern const RayesShaderClass shade_class_metal;         /* Ka, Ks, roughness */
+extern const RayesShaderClass shade_class_shinymetal;    /* Ka, Ks, Kr, roughness, texturename */
+extern const RayesShaderClass shade_class_glass;         /* Kr, Kt, eta, roughness, ... */
+extern const RayesShaderClass shade_class_diffuse;       /* reflectance */
+extern const RayesShaderClass shade_class_conductor;     /* eta, k, reflectance, roughness, preset */
+extern const RayesShaderClass shade_class_dielectric;    /* eta, roughness */
+extern const RayesShaderClass shade_class_coateddiffuse; /* reflectance, roughness, eta, thickness */
+
 #endif /* RAYES_SHADE_BUILTIN_H */

@@ -19,6 +19,8 @@
 static const RayesShaderClass *const builtin_classes[] = {
     &shade_class_matte, &shade_class_plastic, &shade_class_mirror, &shade_class_constant,
     &shade_class_bumpy, &shade_class_fractal,
+    &shade_class_metal, &shade_class_shinymetal, &shade_class_glass, &shade_class_diffuse,
+    &shade_class_conductor, &shade_class_dielectric, &shade_class_coateddiffuse,
 };
 
 const RayesShaderClass *shade_find_class(const char *name)
@@ -26,9 +28,6 @@ const RayesShaderClass *shade_find_class(const char *name)
     for (size_t i = 0; i < sizeof builtin_classes / sizeof builtin_classes[0]; i++)
         if (strcmp(builtin_classes[i]->name, name) == 0)
             return builtin_classes[i];
-    /* RenderMan's shinymetal is a mirror here until environment maps land. */
-    if (strcmp(name, "shinymetal") == 0)
-        return &shade_class_mirror;
     return NULL;
 }
 
@@ -110,6 +109,7 @@ void shade_ctx_slice(const RayesShadeCtx *ctx, size_t start, size_t count, Rayes
         sub->f = ctx->f + start;
     SLICE(P) SLICE(N) SLICE(Ng) SLICE(dPdu) SLICE(dPdv) SLICE(u) SLICE(v) SLICE(s) SLICE(t)
     SLICE(du) SLICE(dv) SLICE(I) SLICE(Cs) SLICE(Os)
+    SLICE(backfacing)
 #undef SLICE
 }
 

@@ -90,6 +90,12 @@ static void test_seed_changes_image(void)
     rayes_image_free(b);
 }
 
+/* Every built-in shader: glossy lobes, refraction, Fresnel. */
+static void test_spheres_any_thread_count(void)
+{
+    check_threads("cornell-spheres", RAYES_FILTER_BOX, 1);
+}
+
 TEST_MAIN(TEST(test_box_filter_any_thread_count), TEST(test_gaussian_filter_any_thread_count),
           TEST(test_teapots_any_thread_count), TEST(test_displaced_teapots),
-          TEST(test_seed_changes_image))
+          TEST(test_seed_changes_image), TEST(test_spheres_any_thread_count))

@@ -1,0 +1,552 @@
+/*
+ * shade/builtin_bsdf.c — RenderMan's metal, shinymetal and glass, and the
+ * physically based family the pbrt reader maps to: diffuse, conductor,
+ * dielectric and coateddiffuse (DESIGN.md "Built-in BSDFs and shaders").
+ *
+ * Glossy and mirror reflection come from the indirect_specular service and
+ * refraction from indirect_refraction: those rays see area lights, so the
+ * physically based shaders do not add direct_lighting's specular (that
+ * would count the lights twice). RenderMan's metal and shinymetal keep
+ * their classic specular() highlight, as their definitions say.
+ *
+ * diffuselighting is each shader's view-independent part: ambient and
+ * diffuse terms only (black for glass, dielectric and conductor). Scratch
+ * arrays live on the stack, SHADE_CHUNK points at a time.
+ */
+#include "shade/builtin.h"
+
+#include <math.h>
+#include <stddef.h>
+#include <string.h>
+
+#include "shade/bsdf.h"
+#include "shade/shade.h"
+#include "util/log.h"
+
+typedef float Rgb[3];
+
+static float cs(const RayesShadeCtx *ctx, size_t i, int c)
+{
+    return ctx->Cs ? ctx->Cs[i][c] : 1.0f;
+}
+
+static void set_opacity(const RayesShadeCtx *ctx, RayesShadeOutputs *out)
+{
+    for (size_t i = 0; i < ctx->n_points; i++)
+        for (int c = 0; c < 3; c++)
+            out->Oi[i][c] = ctx->Os ? ctx->Os[i][c] : 1.0f;
+}
+
+typedef void (*ChunkFn)(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
+                        const void *params, RayesShadeOutputs *out);
+
+/* Runs fn on SHADE_CHUNK-point slices; Irradiance, if asked for, is left
+ * to fn (zeroed first). */
+static void by_chunks(const RayesShaderServices *sv, const RayesShadeCtx *ctx, const void *params,
+                      RayesShadeOutputs *out, ChunkFn fn)
+{
+    if (out->Irradiance)
+        memset(out->Irradiance, 0, ctx->n_points * sizeof *out->Irradiance);
+    for (size_t start = 0; start < ctx->n_points; start += SHADE_CHUNK) {
+        size_t n = ctx->n_points - start < SHADE_CHUNK ? ctx->n_points - start : SHADE_CHUNK;
+        RayesShadeCtx sub;
+        shade_ctx_slice(ctx, start, n, &sub);
+        RayesShadeOutputs o = {out->Ci + start, out->Oi + start,
+                               out->Irradiance ? out->Irradiance + start : NULL, NULL};
+        fn(sv, &sub, params, &o);
+    }
+    set_opacity(ctx, out);
+}
+
+static void ambient(const RayesShaderServices *sv, const RayesShadeCtx *ctx, Rgb *out)
+{
+    if (sv->ambient)
+        sv->ambient(sv, ctx, out);
+    else
+        memset(out, 0, ctx->n_points * sizeof *out);
+}
+
+/* dd + id + ambient: what a Lambertian surface of albedo 1 reflects. */
+static void diffuse_light(const RayesShaderServices *sv, const RayesShadeCtx *ctx, Rgb *E,
+                          RayesShadeOutputs *out)
+{
+    Rgb dd[SHADE_CHUNK], id[SHADE_CHUNK], am[SHADE_CHUNK];
+    sv->direct_lighting(sv, ctx, 0, NULL, NULL, dd, NULL);
+    sv->indirect_diffuse(sv, ctx, 0, id);
+    ambient(sv, ctx, am);
+    for (size_t i = 0; i < ctx->n_points; i++)
+        for (int c = 0; c < 3; c++)
+            E[i][c] = dd[i][c] + id[i][c] + am[i][c];
+    if (out->Irradiance)
+        for (size_t i = 0; i < ctx->n_points; i++)
+            for (int c = 0; c < 3; c++)
+                out->Irradiance[i][c] = 3.14159265f * (dd[i][c] + id[i][c]);
+}
+
+static Vec3 ld(const float p[3])
+{
+    return v3(p[0], p[1], p[2]);
+}
+
+/* cos of the angle between N and the direction to the viewer, kept away
+ * from 0 (interpolated normals may turn slightly away). */
+static float cos_view(const RayesShadeCtx *ctx, size_t i)
+{
+    return fmaxf(-v3_dot(ld(ctx->I[i]), ld(ctx->N[i])), 1e-4f);
+}
+
+static void mirror_dirs(const RayesShadeCtx *ctx, Rgb *dir)
+{
+    for (size_t i = 0; i < ctx->n_points; i++) {
+        Vec3 r = bsdf_reflect(v3_neg(ld(ctx->I[i])), ld(ctx->N[i]));
+        dir[i][0] = r.x, dir[i][1] = r.y, dir[i][2] = r.z;
+    }
+}
+
+/* Radiance reflected about the mirror directions: a perfect mirror for
+ * exponent 0, else the mean over the Blinn-Phong lobe of that exponent. */
+static void reflection(const RayesShaderServices *sv, const RayesShadeCtx *ctx, float exponent,
+                       Rgb *L)
+{
+    Rgb dir[SHADE_CHUNK];
+    float rough[SHADE_CHUNK];
+    mirror_dirs(ctx, dir);
+    for (size_t i = 0; i < ctx->n_points; i++)
+        rough[i] = exponent > 0.0f ? 1.0f / exponent : 0.0f;
+    sv->indirect_specular(sv, ctx, (const float(*)[3])dir, exponent > 0.0f ? rough : NULL,
+                          exponent > 0.0f ? 0 : 1, L);
+}
+
+/* pbrt-v4's roughness (remapped: alpha = sqrt(roughness)) as a Blinn-Phong
+ * exponent; 0 for a smooth surface. */
+static float exponent_of(float roughness)
+{
+    return roughness > 0.0f ? bsdf_blinn_exponent_from_alpha(bsdf_alpha_from_roughness(roughness))
+                            : 0.0f;
+}
+
+/* ------------------------------------------------------------ metal */
+
+typedef struct MetalParams {
+    float Ka, Ks, roughness;
+} MetalParams;
+
+/* Cs (Ka ambient + Ks specular); the view-independent part is Cs Ka ambient. */
+static void metal_chunk(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
+                        const void *params, RayesShadeOutputs *out)
+{
+    const MetalParams *p = params;
+    Rgb am[SHADE_CHUNK], ds[SHADE_CHUNK];
+    float rough[SHADE_CHUNK];
+    ambient(sv, ctx, am);
+    memset(ds, 0, sizeof ds);
+    if (ctx->I) {
+        for (size_t i = 0; i < ctx->n_points; i++)
+            rough[i] = p->roughness;
+        sv->direct_lighting(sv, ctx, 0, NULL, rough, NULL, ds);
+    }
+    for (size_t i = 0; i < ctx->n_points; i++)
+        for (int c = 0; c < 3; c++)
+            out->Ci[i][c] = cs(ctx, i, c) * (p->Ka * am[i][c] + p->Ks * ds[i][c]);
+}
+
+static void metal_lighting(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
+                           const void *params, RayesShadeOutputs *out)
+{
+    by_chunks(sv, ctx, params, out, metal_chunk);
+}
+
+static const RayesShaderParamDesc metal_params[] = {
+    {"Ka", RAYES_PARAM_FLOAT, offsetof(MetalParams, Ka), {1, 0, 0}},
+    {"Ks", RAYES_PARAM_FLOAT, offsetof(MetalParams, Ks), {1, 0, 0}},
+    {"roughness", RAYES_PARAM_FLOAT, offsetof(MetalParams, roughness), {0.1f, 0, 0}},
+};
+
+const RayesShaderClass shade_class_metal = {
+    .abi_version = RAYES_SHADER_ABI_VERSION,
+    .struct_size = sizeof(RayesShaderClass),
+    .name = "metal",
+    .params_size = sizeof(MetalParams),
+    .params = metal_params,
+    .n_params = sizeof metal_params / sizeof metal_params[0],
+    .lighting = metal_lighting,
+    .diffuselighting = metal_lighting, /* without I: the specular term is left at 0 */
+};
+
+/* ------------------------------------------------------------ shinymetal */
+
+typedef struct ShinymetalParams {
+    float Ka, Ks, Kr, roughness;
+    char texturename[64];
+} ShinymetalParams;
+
+/* The environment around the mirror directions: the lat-long map
+ * texturename if it reads (s = 0.5 + atan2(x, -z) / 2 pi, t = acos(y) / pi:
+ * y up, -z at the centre), else traced. */
+static void environment(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
+                        const char *texturename, Rgb *env)
+{
+    Rgb dir[SHADE_CHUNK];
+    mirror_dirs(ctx, dir);
+    if (texturename[0] && sv->texture) {
+        float s[SHADE_CHUNK], t[SHADE_CHUNK], zero[SHADE_CHUNK];
+        for (size_t i = 0; i < ctx->n_points; i++) {
+            Vec3 d = v3_normalize(ld(dir[i]));
+            s[i] = 0.5f + atan2f(d.x, -d.z) * (0.5f / 3.14159265f);
+            t[i] = acosf(fminf(fmaxf(d.y, -1.0f), 1.0f)) * (1.0f / 3.14159265f);
+            zero[i] = 0.0f;
+        }
+        if (sv->texture(sv, ctx, texturename, s, t, zero, zero, env, NULL) == 0)
+            return;
+    }
+    sv->indirect_specular(sv, ctx, (const float(*)[3])dir, NULL, 1, env);
+}
+
+static void shinymetal_chunk(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
+                             const void *params, RayesShadeOutputs *out)
+{
+    const ShinymetalParams *p = params;
+    Rgb am[SHADE_CHUNK], ds[SHADE_CHUNK], env[SHADE_CHUNK];
+    float rough[SHADE_CHUNK];
+    ambient(sv, ctx, am);
+    memset(ds, 0, sizeof ds);
+    memset(env, 0, sizeof env);
+    if (ctx->I) {
+        for (size_t i = 0; i < ctx->n_points; i++)
+            rough[i] = p->roughness;
+        sv->direct_lighting(sv, ctx, 0, NULL, rough, NULL, ds);
+        environment(sv, ctx, p->texturename, env);
+    }
+    for (size_t i = 0; i < ctx->n_points; i++)
+        for (int c = 0; c < 3; c++)
+            out->Ci[i][c] =
+                cs(ctx, i, c) * (p->Ka * am[i][c] + p->Ks * ds[i][c] + p->Kr * env[i][c]);
+}
+
+static void shinymetal_lighting(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
+                                const void *params, RayesShadeOutputs *out)
+{
+    by_chunks(sv, ctx, params, out, shinymetal_chunk);
+}
+
+static const RayesShaderParamDesc shinymetal_params[] = {
+    {"Ka", RAYES_PARAM_FLOAT, offsetof(ShinymetalParams, Ka), {1, 0, 0}},
+    {"Ks", RAYES_PARAM_FLOAT, offsetof(ShinymetalParams, Ks), {1, 0, 0}},
+    {"Kr", RAYES_PARAM_FLOAT, offsetof(ShinymetalParams, Kr), {1, 0, 0}},
+    {"roughness", RAYES_PARAM_FLOAT, offsetof(ShinymetalParams, roughness), {0.1f, 0, 0}},
+    {"texturename", RAYES_PARAM_STRING, offsetof(ShinymetalParams, texturename), {0, 0, 0}},
+};
+
+const RayesShaderClass shade_class_shinymetal = {
+    .abi_version = RAYES_SHADER_ABI_VERSION,
+    .struct_size = sizeof(RayesShaderClass),
+    .name = "shinymetal",
+    .params_size = sizeof(ShinymetalParams),
+    .params = shinymetal_params,
+    .n_params = sizeof shinymetal_params / sizeof shinymetal_params[0],
+    .lighting = shinymetal_lighting,
+    .diffuselighting = shinymetal_lighting, /* without I: Cs Ka ambient only */
+};
+
+/* ------------------------------------------------------------ glass, dielectric */
+
+typedef struct GlassParams {
+    float Kr, Kt, eta, roughness, Ks;
+    float specularcolor[3], transmitcolor[3];
+} GlassParams;
+
+/* Fresnel-weighted reflection and refraction at a smooth boundary of
+ * relative index eta (inside over outside). A ray that hit the back side
+ * is leaving: the index is then inverted, and beyond the critical angle
+ * all light reflects. reflect_e is the exponent of the reflection lobe
+ * (0: mirror). Writes R[i] = F * reflected and T[i] = (1 - F) * refracted. */
+static void fresnel_split(const RayesShaderServices *sv, const RayesShadeCtx *ctx, float eta,
+                          float reflect_e, Rgb *R, Rgb *T)
+{
+    Rgb dir[SHADE_CHUNK], refr[SHADE_CHUNK];
+    float F[SHADE_CHUNK];
+    reflection(sv, ctx, reflect_e, R);
+    size_t n_refr = 0;
+    for (size_t i = 0; i < ctx->n_points; i++) {
+        int leaving = ctx->backfacing && ctx->backfacing[i];
+        float rel = leaving ? 1.0f / eta : eta;
+        Vec3 V = v3_neg(ld(ctx->I[i])), N = ld(ctx->N[i]), t;
+        F[i] = fresnel_dielectric(cos_view(ctx, i), rel);
+        if (!bsdf_refract(V, N, rel, &t)) {
+            F[i] = 1.0f; /* total internal reflection */
+            t = v3_neg(N);
+        }
+        dir[i][0] = t.x, dir[i][1] = t.y, dir[i][2] = t.z;
+        n_refr += F[i] < 1.0f;
+    }
+    if (n_refr > 0 && sv->indirect_refraction)
+        sv->indirect_refraction(sv, ctx, (const float(*)[3])dir, refr);
+    else
+        memset(refr, 0, sizeof refr);
+    for (size_t i = 0; i < ctx->n_points; i++)
+        for (int c = 0; c < 3; c++) {
+            R[i][c] *= F[i];
+            T[i][c] = F[i] < 1.0f ? (1.0f - F[i]) * refr[i][c] : 0.0f;
+        }
+}
+
+static void glass_chunk(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
+                        const void *params, RayesShadeOutputs *out)
+{
+    const GlassParams *p = params;
+    memset(out->Ci, 0, ctx->n_points * sizeof *out->Ci);
+    if (!ctx->I)
+        return; /* no view-independent lobe */
+    Rgb R[SHADE_CHUNK], T[SHADE_CHUNK], ds[SHADE_CHUNK];
+    fresnel_split(sv, ctx, p->eta, p->roughness > 0.0f ? 1.0f / p->roughness : 0.0f, R, T);
+    memset(ds, 0, sizeof ds);
+    if (p->Ks != 0.0f) {
+        float rough[SHADE_CHUNK];
+        for (size_t i = 0; i < ctx->n_points; i++)
+            rough[i] = p->roughness > 0.0f ? p->roughness : 0.1f;
+        sv->direct_lighting(sv, ctx, 0, NULL, rough, NULL, ds);
+    }
+    for (size_t i = 0; i < ctx->n_points; i++)
+        for (int c = 0; c < 3; c++)
+            out->Ci[i][c] = p->specularcolor[c] * (p->Kr * R[i][c] + p->Ks * ds[i][c]) +
+                            cs(ctx, i, c) * p->transmitcolor[c] * p->Kt * T[i][c];
+}
+
+static void glass_lighting(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
+                           const void *params, RayesShadeOutputs *out)
+{
+    by_chunks(sv, ctx, params, out, glass_chunk);
+}
+
+static const RayesShaderParamDesc glass_params[] = {
+    {"Kr", RAYES_PARAM_FLOAT, offsetof(GlassParams, Kr), {1, 0, 0}},
+    {"Kt", RAYES_PARAM_FLOAT, offsetof(GlassParams, Kt), {1, 0, 0}},
+    {"eta", RAYES_PARAM_FLOAT, offsetof(GlassParams, eta), {1.5f, 0, 0}},
+    {"roughness", RAYES_PARAM_FLOAT, offsetof(GlassParams, roughness), {0, 0, 0}},
+    {"Ks", RAYES_PARAM_FLOAT, offsetof(GlassParams, Ks), {0, 0, 0}},
+    {"specularcolor", RAYES_PARAM_COLOR, offsetof(GlassParams, specularcolor), {1, 1, 1}},
+    {"transmitcolor", RAYES_PARAM_COLOR, offsetof(GlassParams, transmitcolor), {1, 1, 1}},
+};
+
+const RayesShaderClass shade_class_glass = {
+    .abi_version = RAYES_SHADER_ABI_VERSION,
+    .struct_size = sizeof(RayesShaderClass),
+    .name = "glass",
+    .params_size = sizeof(GlassParams),
+    .params = glass_params,
+    .n_params = sizeof glass_params / sizeof glass_params[0],
+    .lighting = glass_lighting,
+    .diffuselighting = glass_lighting, /* without I: black */
+};
+
+typedef struct DielectricParams {
+    float eta, roughness;
+} DielectricParams;
+
+static void dielectric_chunk(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
+                             const void *params, RayesShadeOutputs *out)
+{
+    const DielectricParams *p = params;
+    memset(out->Ci, 0, ctx->n_points * sizeof *out->Ci);
+    if (!ctx->I)
+        return;
+    Rgb R[SHADE_CHUNK], T[SHADE_CHUNK];
+    fresnel_split(sv, ctx, p->eta, exponent_of(p->roughness), R, T);
+    for (size_t i = 0; i < ctx->n_points; i++)
+        for (int c = 0; c < 3; c++)
+            out->Ci[i][c] = R[i][c] + T[i][c];
+}
+
+static void dielectric_lighting(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
+                                const void *params, RayesShadeOutputs *out)
+{
+    by_chunks(sv, ctx, params, out, dielectric_chunk);
+}
+
+static const RayesShaderParamDesc dielectric_params[] = {
+    {"eta", RAYES_PARAM_FLOAT, offsetof(DielectricParams, eta), {1.5f, 0, 0}},
+    {"roughness", RAYES_PARAM_FLOAT, offsetof(DielectricParams, roughness), {0, 0, 0}},
+};
+
+const RayesShaderClass shade_class_dielectric = {
+    .abi_version = RAYES_SHADER_ABI_VERSION,
+    .struct_size = sizeof(RayesShaderClass),
+    .name = "dielectric",
+    .params_size = sizeof(DielectricParams),
+    .params = dielectric_params,
+    .n_params = sizeof dielectric_params / sizeof dielectric_params[0],
+    .lighting = dielectric_lighting,
+    .diffuselighting = dielectric_lighting, /* without I: black */
+};
+
+/* ------------------------------------------------------------ diffuse */
+
+typedef struct DiffuseParams {
+    float reflectance[3];
+} DiffuseParams;
+
+static void diffuse_chunk(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
+                          const void *params, RayesShadeOutputs *out)
+{
+    const DiffuseParams *p = params;
+    Rgb E[SHADE_CHUNK];
+    diffuse_light(sv, ctx, E, out);
+    for (size_t i = 0; i < ctx->n_points; i++)
+        for (int c = 0; c < 3; c++)
+            out->Ci[i][c] = cs(ctx, i, c) * p->reflectance[c] * E[i][c];
+}
+
+static void diffuse_lighting(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
+                             const void *params, RayesShadeOutputs *out)
+{
+    by_chunks(sv, ctx, params, out, diffuse_chunk);
+}
+
+static const RayesShaderParamDesc diffuse_params[] = {
+    {"reflectance", RAYES_PARAM_COLOR, offsetof(DiffuseParams, reflectance), {0.5f, 0.5f, 0.5f}},
+};
+
+const RayesShaderClass shade_class_diffuse = {
+    .abi_version = RAYES_SHADER_ABI_VERSION,
+    .struct_size = sizeof(RayesShaderClass),
+    .name = "diffuse",
+    .params_size = sizeof(DiffuseParams),
+    .params = diffuse_params,
+    .n_params = sizeof diffuse_params / sizeof diffuse_params[0],
+    .lighting = diffuse_lighting,
+    .diffuselighting = diffuse_lighting, /* Lambertian: view-independent throughout */
+};
+
+/* ------------------------------------------------------------ conductor */
+
+typedef struct ConductorParams {
+    float eta[3], k[3], reflectance[3], roughness;
+    char preset[64];
+} ConductorParams;
+
+/* The complex index: the preset if named (an unknown name: copper), else
+ * reflectance if given (all of it >= 0), else eta and k. */
+static void conductor_index(const ConductorParams *p, Vec3 *eta, Vec3 *k)
+{
+    if (p->preset[0]) {
+        if (conductor_preset(p->preset, eta, k) != 0) {
+            log_warning_once("conductor:preset",
+                             "conductor: unknown preset \"%s\" (expected gold, copper, "
+                             "aluminium or silver); using copper",
+                             p->preset);
+            conductor_preset("copper", eta, k);
+        }
+        return;
+    }
+    if (p->reflectance[0] >= 0.0f && p->reflectance[1] >= 0.0f && p->reflectance[2] >= 0.0f) {
+        *eta = v3(1, 1, 1);
+        *k = v3(conductor_k_from_reflectance(p->reflectance[0]),
+                conductor_k_from_reflectance(p->reflectance[1]),
+                conductor_k_from_reflectance(p->reflectance[2]));
+        return;
+    }
+    *eta = v3_load(p->eta);
+    *k = v3_load(p->k);
+}
+
+static void conductor_chunk(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
+                            const void *params, RayesShadeOutputs *out)
+{
+    const ConductorParams *p = params;
+    memset(out->Ci, 0, ctx->n_points * sizeof *out->Ci);
+    if (!ctx->I)
+        return; /* no view-independent lobe */
+    Vec3 eta, k;
+    conductor_index(p, &eta, &k);
+    Rgb L[SHADE_CHUNK];
+    reflection(sv, ctx, exponent_of(p->roughness), L);
+    for (size_t i = 0; i < ctx->n_points; i++) {
+        Vec3 F = fresnel_conductor_rgb(cos_view(ctx, i), eta, k);
+        for (int c = 0; c < 3; c++)
+            out->Ci[i][c] = cs(ctx, i, c) * v3_index(F, c) * L[i][c];
+    }
+}
+
+static void conductor_lighting(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
+                               const void *params, RayesShadeOutputs *out)
+{
+    by_chunks(sv, ctx, params, out, conductor_chunk);
+}
+
+static const RayesShaderParamDesc conductor_params[] = {
+    /* copper, pbrt-v4's default conductor */
+    {"eta", RAYES_PARAM_COLOR, offsetof(ConductorParams, eta), {0.200f, 0.924f, 1.102f}},
+    {"k", RAYES_PARAM_COLOR, offsetof(ConductorParams, k), {3.912f, 2.452f, 2.142f}},
+    {"reflectance", RAYES_PARAM_COLOR, offsetof(ConductorParams, reflectance), {-1, -1, -1}},
+    {"roughness", RAYES_PARAM_FLOAT, offsetof(ConductorParams, roughness), {0, 0, 0}},
+    {"preset", RAYES_PARAM_STRING, offsetof(ConductorParams, preset), {0, 0, 0}},
+};
+
+const RayesShaderClass shade_class_conductor = {
+    .abi_version = RAYES_SHADER_ABI_VERSION,
+    .struct_size = sizeof(RayesShaderClass),
+    .name = "conductor",
+    .params_size = sizeof(ConductorParams),
+    .params = conductor_params,
+    .n_params = sizeof conductor_params / sizeof conductor_params[0],
+    .lighting = conductor_lighting,
+    .diffuselighting = conductor_lighting, /* without I: black */
+};
+
+/* ------------------------------------------------------------ coateddiffuse */
+
+typedef struct CoatedParams {
+    float reflectance[3], roughness, eta, thickness;
+} CoatedParams;
+
+/* A Lambertian base under a smooth or glossy dielectric coat. Light reaches
+ * the base through the coat with the hemispherical average 1 - Favg and
+ * leaves toward the viewer with 1 - F(cos_v); the coat reflects
+ * F(cos_v) * the reflected radiance. diffuselighting is the average of the
+ * base term over cosine-weighted views: base (1 - Favg)^2, so lighting's
+ * base term is diffuselighting's times (1 - F(cos_v)) / (1 - Favg). The
+ * coat's absorption is exp(-2 thickness) (normal incidence, down and up). */
+static void coated_chunk(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
+                         const void *params, RayesShadeOutputs *out)
+{
+    const CoatedParams *p = params;
+    Rgb E[SHADE_CHUNK], L[SHADE_CHUNK];
+    diffuse_light(sv, ctx, E, out);
+    float favg = fresnel_dielectric_average(p->eta);
+    float base = (1.0f - favg) * (1.0f - favg) * expf(-2.0f * fmaxf(p->thickness, 0.0f));
+    if (ctx->I)
+        reflection(sv, ctx, exponent_of(p->roughness), L);
+    for (size_t i = 0; i < ctx->n_points; i++) {
+        float F = ctx->I ? fresnel_dielectric(cos_view(ctx, i), p->eta) : 0.0f;
+        float view = ctx->I ? (1.0f - F) / (1.0f - favg) : 1.0f;
+        for (int c = 0; c < 3; c++) {
+            out->Ci[i][c] = cs(ctx, i, c) * p->reflectance[c] * base * view * E[i][c];
+            if (ctx->I)
+                out->Ci[i][c] += F * L[i][c];
+        }
+    }
+}
+
+static void coated_lighting(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
+                            const void *params, RayesShadeOutputs *out)
+{
+    by_chunks(sv, ctx, params, out, coated_chunk);
+}
+
+static const RayesShaderParamDesc coated_params[] = {
+    {"reflectance", RAYES_PARAM_COLOR, offsetof(CoatedParams, reflectance), {0.5f, 0.5f, 0.5f}},
+    {"roughness", RAYES_PARAM_FLOAT, offsetof(CoatedParams, roughness), {0, 0, 0}},
+    {"eta", RAYES_PARAM_FLOAT, offsetof(CoatedParams, eta), {1.5f, 0, 0}},
+    {"thickness", RAYES_PARAM_FLOAT, offsetof(CoatedParams, thickness), {0.01f, 0, 0}},
+};
+
+const RayesShaderClass shade_class_coateddiffuse = {
+    .abi_version = RAYES_SHADER_ABI_VERSION,
+    .struct_size = sizeof(RayesShaderClass),
+    .name = "coateddiffuse",
+    .params_size = sizeof(CoatedParams),
+    .params = coated_params,
+    .n_params = sizeof coated_params / sizeof coated_params[0],
+    .lighting = coated_lighting,
+    .diffuselighting = coated_lighting, /* without I: the base's view average only */
+};
