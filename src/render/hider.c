@@ -88,7 +88,8 @@ static Rgb *shade_grid(Worker *w, uint32_t gi)
     uint64_t *keys = malloc(n * sizeof *keys);
     RayDiff *diff = malloc(n * sizeof *diff);
     Rgb *ci = malloc(n * sizeof *ci);
-    RY_CHECK(f3 && f1 && keys && diff && ci);
+    int *back = malloc(n * sizeof *back);
+    RY_CHECK(f3 && f1 && keys && diff && ci && back);
     float(*P)[3] = f3, (*N)[3] = f3 + n, (*dPdu)[3] = f3 + 2 * n, (*dPdv)[3] = f3 + 3 * n;
     float(*I)[3] = f3 + 4 * n, (*Cs)[3] = f3 + 5 * n, (*Os)[3] = f3 + 6 * n;
     float(*Ci)[3] = f3 + 7 * n, (*Oi)[3] = f3 + 8 * n;
@@ -104,7 +105,8 @@ static Rgb *shade_grid(Worker *w, uint32_t gi)
         float dist = v3_length(to);
         Vec3 d = dist > 0.0f ? v3_scale(to, 1.0f / dist) : rs->camera.forward;
         Vec3 Nk = gs->N[i];
-        if (v3_dot(Nk, d) > 0.0f) /* the side the eye sees */
+        back[k] = v3_dot(Nk, d) > 0.0f; /* the eye sees the back: shade that side */
+        if (back[k])
             Nk = v3_neg(Nk);
         put3(P[k], gs->P[i]);
         put3(N[k], Nk);
@@ -136,12 +138,14 @@ static Rgb *shade_grid(Worker *w, uint32_t gi)
         .dPdu = (const float(*)[3])dPdu, .dPdv = (const float(*)[3])dPdv, .u = u, .v = v,
         .s = u, .t = v, .du = du, .dv = dv, .I = (const float(*)[3])I,
         .Cs = (const float(*)[3])Cs, .Os = (const float(*)[3])Os, .renderer = &ps,
+        .backfacing = back,
     };
     RayesShadeOutputs out = {.Ci = Ci, .Oi = Oi};
     w->stats.shading_points[0] += n;
     shade_run_lighting(&render_services, &ctx, obj->shader, &out);
     memcpy(ci, Ci, n * sizeof *ci);
     free(irr_E);
+    free(back);
     free(f3);
     free(f1);
     free(keys);
