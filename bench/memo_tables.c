@@ -7,6 +7,7 @@
  *                      [--cache-k K] [--scene cornell-teapots|cornell-teapots-displaced]
  *   memo_tables table4 [...same...] [--budgets MB,MB,...]
  *   memo_tables table2 [...same...] [--uncached-max B]
+ *   memo_tables figure5 [--size N] [--spp N] [--out DIR] [--data DIR] [--scene S]
  *
  * table1: preview quality, bounces 1..B (default 3), caching off and on:
  * shading points, rays, time, speed-up and hit rates per resolution.
@@ -15,6 +16,9 @@
  * bounces 1..B, caching on, and off up to --uncached-max bounces (default
  * 1: an uncached row costs 64 times the one before). No accuracy pass:
  * bench/figure5 measures final against a reference.
+ * figure5: reference (4096 diffuse rays, nothing cached), preview and final
+ * images at one bounce, the relative RMSE and mean relative error of preview
+ * and final against the reference, 20x difference images, and times.
  * Both then measure bias: the same rows at --accuracy-spp pixel samples
  * (default 64) and --accuracy-size pixels (default: half of --size), the
  * relative difference of the cached and uncached image means and the
@@ -220,9 +224,10 @@ static void parse(int argc, char **argv, Args *a)
         a->accuracy_size = a->size / 2;
     if (strcmp(a->mode, "table2") == 0)
         a->quality = RAYES_QUALITY_FINAL;
-    if ((strcmp(a->mode, "table1") && strcmp(a->mode, "table2") && strcmp(a->mode, "table4")) ||
+    if ((strcmp(a->mode, "table1") && strcmp(a->mode, "table2") && strcmp(a->mode, "table4") &&
+         strcmp(a->mode, "figure5")) ||
         a->size < 32 || a->spp < 1)
-        die("usage: memo_tables table1|table2|table4 [--size N] [--spp N] ...");
+        die("usage: memo_tables table1|table2|table4|figure5 [--size N] [--spp N] ...");
     if (mkdir(a->out, 0777) != 0 && errno != EEXIST)
         die("cannot create the output directory");
 }
@@ -336,6 +341,87 @@ static void table2(const Args *a, FILE *j)
     fprintf(j, "\n  ]");
 }
 
+/* Error of image r against the reference: RMSE over pixels and channels
+ * divided by the reference's mean, and the mean relative error
+ * sum |r - ref| / sum ref; writes 20 x |r - ref| to DIR/figure5-TAG-diff.png. */
+static void against(const Args *a, const Row *r, const Row *ref, const char *tag, double *rel_rmse,
+                    double *mean_rel)
+{
+    size_t n = (size_t)r->w * r->h;
+    double se = 0.0, ae = 0.0, sum = 0.0;
+    float *diff = malloc(n * 4 * sizeof *diff);
+    if (!diff)
+        die("out of memory");
+    for (size_t i = 0; i < n; i++) {
+        for (int c = 0; c < 3; c++) {
+            double d = (double)r->rgba[4 * i + c] - ref->rgba[4 * i + c];
+            se += d * d;
+            ae += fabs(d);
+            sum += ref->rgba[4 * i + c];
+            diff[4 * i + c] = (float)(20.0 * fabs(d));
+        }
+        diff[4 * i + 3] = 1.0f;
+    }
+    double mean = sum / (3.0 * (double)n);
+    *rel_rmse = sqrt(se / (3.0 * (double)n)) / mean;
+    *mean_rel = ae / sum;
+    char path[1024], err[1024];
+    snprintf(path, sizeof path, "%s/figure5-%s-diff.png", a->out, tag);
+    if (image_write(path, r->w, r->h, diff, err, sizeof err) != RAYES_OK)
+        die(err);
+    free(diff);
+}
+
+/* The memo's Figure 5 (bottom row): preview and final images against a
+ * reference of 4096 diffuse rays per shading point and no caching of any
+ * kind, one bounce, with 20x difference images. */
+static void figure5(Args *a, FILE *j)
+{
+    static const struct {
+        const char *tag;
+        int quality;
+    } rows[3] = {{"reference", RAYES_QUALITY_REFERENCE},
+                 {"preview", RAYES_QUALITY_PREVIEW},
+                 {"final", RAYES_QUALITY_FINAL}};
+    printf("Figure 5 (%s, 1 bounce, %dx%d, %d spp): against the reference\n", a->scene, a->size,
+           a->size, a->spp);
+    printf("%-9s | %9s %9s %8s %8s | %10s %10s | %s\n", "image", "sh.pts", "rays", "time", "cpu",
+           "rel. RMSE", "mean rel.", "time / reference");
+    fprintf(j, "{\"figure\": 5, \"size\": %d, \"spp\": %d, \"rows\": [", a->size, a->spp);
+    Row ref = {0};
+    for (int i = 0; i < 3; i++) {
+        a->quality = rows[i].quality;
+        Row r = run(a, a->size, a->spp, 1, rows[i].quality != RAYES_QUALITY_REFERENCE, 100);
+        char path[1024], err[1024], s1[32], s2[32];
+        snprintf(path, sizeof path, "%s/figure5-%s.png", a->out, rows[i].tag);
+        if (image_write(path, r.w, r.h, r.rgba, err, sizeof err) != RAYES_OK)
+            die(err);
+        human(s1, sizeof s1, r.shading_points);
+        human(s2, sizeof s2, r.rays);
+        double rmse = 0.0, mrel = 0.0;
+        if (i > 0)
+            against(a, &r, &ref, rows[i].tag, &rmse, &mrel);
+        printf("%-9s | %9s %9s %7.1fs %7.1fs |", rows[i].tag, s1, s2, r.time_s, r.cpu_s);
+        if (i > 0)
+            printf(" %9.2f%% %9.2f%% | %.3f (cpu %.3f)\n", 100 * rmse, 100 * mrel,
+                   r.time_s / ref.time_s, r.cpu_s / ref.cpu_s);
+        else
+            printf(" %10s %10s |\n", "-", "-");
+        fflush(stdout);
+        fprintf(j,
+                "%s\n    {\"image\": \"%s\", \"time_s\": %.3f, \"cpu_s\": %.3f, "
+                "\"shading_points\": %llu, \"rays\": %llu, \"rel_rmse\": %.6f, "
+                "\"mean_rel\": %.6f}",
+                i ? "," : "", rows[i].tag, r.time_s, r.cpu_s, r.shading_points, r.rays, rmse, mrel);
+        if (i == 0)
+            ref = r;
+        else
+            free(r.rgba);
+    }
+    free(ref.rgba);
+    fprintf(j, "\n  ]\n}\n");
+}
+
 static void table4(const Args *a, FILE *j)
 {
     printf("Table 4 (%s, 1 bounce, preview, %dx%d, %d spp)\n", a->scene, a->size, a->size,
@@ -413,11 +499,15 @@ int main(int argc, char **argv)
         table1(&a, j);
     else if (strcmp(a.mode, "table2") == 0)
         table2(&a, j);
+    else if (strcmp(a.mode, "figure5") == 0) {
+        figure5(&a, j);
+        a.accuracy_spp = -1; /* its JSON is closed */
+    }
     else
         table4(&a, j);
     if (a.accuracy_spp > 0 && strcmp(a.mode, "table2") != 0)
         bias(&a, j);
-    else
+    else if (a.accuracy_spp == 0 || strcmp(a.mode, "table2") == 0)
         fprintf(j, "\n}\n");
     fclose(j);
     printf("wrote %s and the images beside it\n", path);
