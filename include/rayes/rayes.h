@@ -133,6 +133,14 @@ RAYES_API RayesError rayes_scene_sphere(RayesScene *scene, float radius);
 RAYES_API RayesError rayes_scene_area_light(RayesScene *scene, const float P[4][3],
                                             const float L[3]);
 
+/* A search path of the scene: kind "texture" (image files that shaders
+ * name), colon-separated directories; NULL or "" clears it. A name is
+ * tried as given first, then in each directory in order, then in those of
+ * the environment variable RAYES_TEXTURE_PATH. The path is copied. An
+ * unknown kind is RAYES_ERROR_INVALID_ARGUMENT. */
+RAYES_API RayesError rayes_scene_set_search_path(RayesScene *scene, const char *kind,
+                                                 const char *path);
+
 /* Ends an edit: checks the scene and bumps its timestamp. Rendering an
  * uncommitted scene is RAYES_ERROR_INVALID_OPERATION. */
 RAYES_API RayesError rayes_scene_commit(RayesScene *scene);
@@ -181,11 +189,14 @@ typedef struct RayesRenderOptions {
                                   cache_k times the ray footprint is used (default 1) */
     RayesProgressFn progress;  /* may be NULL */
     void *progress_user;
+    double texture_mb;         /* texture cache budget in megabytes (10^6 bytes), default 64 */
+    float texture_width;       /* multiplies every texture filter width (RenderMan's "width"):
+                                  default 1; 0 point-samples the finest MIP level */
 } RayesRenderOptions;
 
 /* Fills options with the defaults of a quality preset: 512 x 512, 4 pixel
  * samples, all cores, 1 bounce, box filter, seed 0, the radiosity cache on
- * with 100 MB. The reference preset turns the cache off (nothing cached). */
+ * with 100 MB, a texture cache of 64 MB. The reference preset turns the cache off (nothing cached). */
 RAYES_API void rayes_render_options_init(RayesRenderOptions *options, RayesQuality quality);
 
 /* ---------------------------------------------------------------- stats */

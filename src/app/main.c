@@ -75,6 +75,7 @@ static void usage(FILE *f)
           "  --cache-resolution R    auto (by ray differentials), coarse, medium or fine\n"
           "  --cache-k K             use the coarsest resolution whose micropolygons are at\n"
           "                          most K times the ray footprint (default 1)\n"
+          "  --texture-mb MB         texture cache budget in megabytes (default 64)\n"
           "  --data DIR              data directory (teapot.bpt); default $RAYES_DATA\n"
           "  --stats FILE.json       write statistics as JSON\n"
           "  --quiet                 no progress bar and no summary\n",
@@ -239,6 +240,8 @@ static void parse_args(int argc, char **argv, Args *a)
             opt->cache_resolution = parse_resolution(v);
         else if (strcmp(o, "--cache-k") == 0)
             opt->cache_k = parse_float(o, v, 1e-3f, 1e3f);
+        else if (strcmp(o, "--texture-mb") == 0)
+            opt->texture_mb = parse_float(o, v, 0.0f, 1e7f);
         else if (strcmp(o, "--data") == 0)
             a->data_dir = v;
         else if (strcmp(o, "--stats") == 0)

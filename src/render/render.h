@@ -21,6 +21,7 @@
 #include "geom/geom.h"
 #include "shade/light.h"
 #include "shade/shade.h"
+#include "shade/texture.h"
 #include "util/vec.h"
 
 #define RENDER_MAX_DEPTH 16 /* diffuse depths counted separately in statistics */
@@ -62,6 +63,7 @@ typedef struct RenderSettings {
     Cache *cache;                 /* the radiosity cache, or NULL: uncached */
     int cache_resolution;         /* -1: by differentials; else a forced CacheLevel */
     float cache_k;                /* resolution rule constant (DESIGN.md) */
+    TextureSystem *textures;      /* image textures for the texture service, or NULL */
 } RenderSettings;
 
 typedef struct RenderStats {

@@ -80,6 +80,8 @@ void rayes_scene_release(RayesScene *s)
     for (size_t i = 0; i < s->n_objects; i++)
         if (s->objects[i].shader.cls)
             shade_instance_fini(&s->objects[i].shader);
+    for (int k = 0; k < SCENE_N_PATH_KINDS; k++)
+        free(s->search_path[k]);
     free(s->objects);
     free(s->prims);
     free(s->lights);
@@ -335,6 +337,34 @@ RayesError rayes_scene_area_light(RayesScene *s, const float P[4][3], const floa
         return fail(s, RAYES_ERROR_OUT_OF_MEMORY, "out of memory");
     s->prims[s->n_prims++] = p;
     s->current_object = keep;
+    return RAYES_OK;
+}
+
+static const char *const path_kinds[SCENE_N_PATH_KINDS] = {
+    [SCENE_PATH_TEXTURE] = "texture",
+};
+
+const char *scene_path_kind_name(ScenePathKind kind)
+{
+    return kind < SCENE_N_PATH_KINDS ? path_kinds[kind] : "";
+}
+
+RayesError rayes_scene_set_search_path(RayesScene *s, const char *kind, const char *path)
+{
+    if (!s || !kind)
+        return RAYES_ERROR_INVALID_ARGUMENT;
+    int k = 0;
+    while (k < SCENE_N_PATH_KINDS && strcmp(kind, path_kinds[k]) != 0)
+        k++;
+    if (k == SCENE_N_PATH_KINDS)
+        return fail(s, RAYES_ERROR_INVALID_ARGUMENT,
+                    "search path: unknown kind \"%s\" (expected \"texture\")", kind);
+    char *copy = NULL;
+    if (path && path[0] && !(copy = strdup(path)))
+        return fail(s, RAYES_ERROR_OUT_OF_MEMORY, "search path: out of memory");
+    free(s->search_path[k]);
+    s->search_path[k] = copy;
+    s->dirty = 1;
     return RAYES_OK;
 }
 

@@ -21,6 +21,15 @@
 #include "shade/shade.h"
 #include "util/vec.h"
 
+/* The kinds of rayes_scene_set_search_path, indexing RayesScene.search_path. */
+typedef enum ScenePathKind {
+    SCENE_PATH_TEXTURE = 0,
+    SCENE_N_PATH_KINDS
+} ScenePathKind;
+
+/* The kind's name in the API ("texture"). */
+const char *scene_path_kind_name(ScenePathKind kind);
+
 typedef struct SceneObject {
     ShaderInstance shader;    /* owned; cls NULL for lights */
     float Cs[3], Os[3];       /* surface colour and opacity */
@@ -44,6 +53,7 @@ struct RayesScene {
     size_t n_lights, cap_lights;
     uint64_t timestamp;       /* commits so far */
     int dirty;                /* edited since the last commit */
+    char *search_path[SCENE_N_PATH_KINDS]; /* colon-separated directories, owned, or NULL */
 };
 
 /* Dices every primitive of a committed scene for a camera that sees

@@ -11,5 +11,7 @@ extern const RayesShaderClass shade_class_matte;    /* Lambertian: Ka, Kd, Ke */
 extern const RayesShaderClass shade_class_plastic;  /* Ka, Kd, Ks, roughness, specularcolor */
 extern const RayesShaderClass shade_class_mirror;   /* perfect specular: Kr, specularcolor */
 extern const RayesShaderClass shade_class_constant; /* Ci = Cs */
+/* plastic with a texture: Ka, Kd, Ks, roughness, specularcolor, texturename */
+extern const RayesShaderClass shade_class_paintedplastic;
 
 #endif /* RAYES_SHADE_BUILTIN_H */

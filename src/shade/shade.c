@@ -5,15 +5,19 @@
  */
 #include "shade/shade.h"
 
+#include <stddef.h>
+#include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "shade/builtin.h"
+#include "util/check.h"
 #include "util/log.h"
 
 static const RayesShaderClass *const builtin_classes[] = {
     &shade_class_matte, &shade_class_plastic, &shade_class_mirror, &shade_class_constant,
+    &shade_class_paintedplastic,
 };
 
 const RayesShaderClass *shade_find_class(const char *name)
@@ -101,27 +105,59 @@ void shade_ctx_slice(const RayesShadeCtx *ctx, size_t start, size_t count, Rayes
 #undef SLICE
 }
 
+/* Scratch for the class's methods on n points: a stack buffer when it
+ * fits (every ray hit, and grids of small scratch), else the heap. */
+#define SHADE_STACK_SCRATCH 8192
+
+typedef struct Scratch {
+    _Alignas(max_align_t) unsigned char stack[SHADE_STACK_SCRATCH];
+    void *heap;
+} Scratch;
+
+static void *scratch_get(Scratch *sc, const RayesShaderClass *cls, size_t n)
+{
+    sc->heap = NULL;
+    if (cls->scratch_size == 0 || n == 0)
+        return NULL;
+    RY_CHECK(n <= SIZE_MAX / cls->scratch_size);
+    size_t bytes = n * cls->scratch_size;
+    if (bytes <= sizeof sc->stack) {
+        memset(sc->stack, 0, bytes);
+        return sc->stack;
+    }
+    sc->heap = calloc(n, cls->scratch_size);
+    RY_CHECK(sc->heap != NULL);
+    return sc->heap;
+}
+
 void shade_run_lighting(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
                         const ShaderInstance *inst, RayesShadeOutputs *out)
 {
     const RayesShaderClass *cls = inst->cls;
+    Scratch sc;
+    RayesShadeCtx c = *ctx;
+    c.scratch = scratch_get(&sc, cls, ctx->n_points);
     if (cls->prelighting)
-        cls->prelighting(sv, ctx, inst->params, out);
-    cls->lighting(sv, ctx, inst->params, out);
+        cls->prelighting(sv, &c, inst->params, out);
+    cls->lighting(sv, &c, inst->params, out);
     if (cls->postlighting)
-        cls->postlighting(sv, ctx, inst->params, out);
+        cls->postlighting(sv, &c, inst->params, out);
+    free(sc.heap);
 }
 
 void shade_run_diffuselighting(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
                                const ShaderInstance *inst, RayesShadeOutputs *out)
 {
     const RayesShaderClass *cls = inst->cls;
+    Scratch sc;
     RayesShadeCtx c = *ctx;
     c.I = NULL; /* view independence: diffuselighting never sees I */
+    c.scratch = scratch_get(&sc, cls, ctx->n_points);
     if (cls->prelighting)
         cls->prelighting(sv, &c, inst->params, out);
     if (cls->diffuselighting) {
         cls->diffuselighting(sv, &c, inst->params, out);
+        free(sc.heap);
         return;
     }
     char key[96];
@@ -131,4 +167,5 @@ void shade_run_diffuselighting(const RayesShaderServices *sv, const RayesShadeCt
                      "its lighting method",
                      cls->name);
     cls->lighting(sv, &c, inst->params, out);
+    free(sc.heap);
 }

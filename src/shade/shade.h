@@ -34,14 +34,19 @@ void shade_instance_fini(ShaderInstance *inst);
 void shade_run_diffuselighting(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
                                const ShaderInstance *inst, RayesShadeOutputs *out);
 
-/* Runs prelighting (if any) and lighting, then postlighting (if any). */
+/* Runs prelighting (if any) and lighting, then postlighting (if any).
+ * Both runners give the methods ctx->scratch: n_points * scratch_size
+ * zeroed bytes (on the stack up to 8 kB, else the heap), shared by the
+ * methods of the one call. */
 void shade_run_lighting(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
                         const ShaderInstance *inst, RayesShadeOutputs *out);
 
 /* Points per chunk when a shader needs scratch arrays on the stack. */
 #define SHADE_CHUNK 64
 
-/* The sub-context of points [start, start + count) of ctx. */
+/* The sub-context of points [start, start + count) of ctx. Its scratch is
+ * ctx's (a slice does not know the class's scratch_size): offset it by
+ * start * scratch_size where the sub-context's methods read it. */
 void shade_ctx_slice(const RayesShadeCtx *ctx, size_t start, size_t count, RayesShadeCtx *sub);
 
 #endif /* RAYES_SHADE_SHADE_H */
