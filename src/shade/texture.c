@@ -342,7 +342,10 @@ static void acquire(TextureSystem *ts, Texture *tex, int l, LevelRef *r)
     pthread_mutex_lock(&ts->lock);
     if (!ok) {
         pthread_mutex_unlock(&ts->lock);
-        log_warning("texture \"%s\": %s could not be read again; black", tex->name, tex->path);
+        char key[64];
+        snprintf(key, sizeof key, "texture-reread:%s", tex->name);
+        log_warning_once(key, "texture \"%s\": %s could not be read again; black", tex->name,
+                         tex->path);
         return;
     }
     ts->file_reads++;
