@@ -4,7 +4,7 @@
  *
  *   memo_tables table1 [--size N] [--spp N] [--bounces-max B] [--accuracy-spp N]
  *                      [--accuracy-size N] [--out DIR] [--data DIR] [--threads N]
- *                      [--cache-k K]
+ *                      [--cache-k K] [--scene cornell-teapots|cornell-teapots-displaced]
  *   memo_tables table4 [...same...] [--budgets MB,MB,...]
  *
  * table1: preview quality, bounces 1..B (default 3), caching off and on:
@@ -29,7 +29,7 @@
 #include "rayes/rayes.h"
 
 typedef struct Args {
-    const char *mode, *data, *out;
+    const char *mode, *data, *out, *scene;
     int size, spp, bounces_max, accuracy_spp, accuracy_size, threads;
     double cache_k;
     double budgets[16];
@@ -71,7 +71,7 @@ static Row run(const Args *a, int size, int spp, int bounces, int cache, double 
 {
     RayesScene *scene = rayes_scene_new();
     char err[1024];
-    if (!scene || io_builtin_scene("cornell-teapots", a->data, scene, err, sizeof err) != RAYES_OK)
+    if (!scene || io_builtin_scene(a->scene, a->data, scene, err, sizeof err) != RAYES_OK)
         die(err);
     RayesRenderOptions o;
     rayes_render_options_init(&o, RAYES_QUALITY_PREVIEW);
@@ -164,6 +164,7 @@ static void parse(int argc, char **argv, Args *a)
 {
     a->mode = argc > 1 ? argv[1] : "";
     a->out = "bench-out";
+    a->scene = "cornell-teapots";
     a->size = 512;
     a->spp = 4;
     a->bounces_max = 3;
@@ -193,6 +194,8 @@ static void parse(int argc, char **argv, Args *a)
             a->data = v;
         else if (strcmp(o, "--out") == 0)
             a->out = v;
+        else if (strcmp(o, "--scene") == 0)
+            a->scene = v;
         else if (strcmp(o, "--budgets") == 0) {
             a->n_budgets = 0;
             for (char *s = (char *)v; *s && a->n_budgets < 16; s += strcspn(s, ",") + (s[strcspn(s, ",")] != 0))
@@ -222,7 +225,7 @@ static void json_row(FILE *j, const Row *r, int first)
 
 static void table1(const Args *a, FILE *j)
 {
-    printf("Table 1 (cornell-teapots, preview: 4 shadow + 4 diffuse rays, %dx%d, %d spp)\n",
+    printf("Table 1 (%s, preview: 4 shadow + 4 diffuse rays, %dx%d, %d spp)\n", a->scene,
            a->size, a->size, a->spp);
     printf("%-3s | %9s %9s %8s %8s | %9s %9s %8s %8s | %8s %8s | %s\n", "b", "sh.pts", "rays",
            "time", "cpu", "sh.pts", "rays", "time", "cpu", "speed-up", "(cpu)",
@@ -261,7 +264,7 @@ static void table1(const Args *a, FILE *j)
 
 static void table4(const Args *a, FILE *j)
 {
-    printf("Table 4 (cornell-teapots, 1 bounce, preview, %dx%d, %d spp)\n", a->size, a->size,
+    printf("Table 4 (%s, 1 bounce, preview, %dx%d, %d spp)\n", a->scene, a->size, a->size,
            a->spp);
     printf("%-9s | %6s %6s %6s | %9s %9s %8s %8s\n", "cache", "coarse", "medium", "fine",
            "sh.pts", "rays", "time", "cpu");

@@ -99,10 +99,38 @@ typedef struct RayesParam {
 } RayesParam;
 
 /* The surface shader of geometry added from now on: a built-in class name
- * ("matte", "plastic", "mirror", "constant") with parameters. The
- * parameters are copied. An unknown class is RAYES_ERROR_INVALID_ARGUMENT. */
+ * ("matte", "plastic", "mirror", "constant"), else a plugin NAME.so found
+ * on the scene's "shader" search path, then on $RAYES_SHADER_PATH
+ * (docs/shaders.md), with parameters. The parameters are copied. An
+ * unknown class, or a plugin that fails to load or its checks, is
+ * RAYES_ERROR_INVALID_ARGUMENT; the message names the file and the
+ * problem, or the directories searched. */
 RAYES_API RayesError rayes_scene_set_shader(RayesScene *scene, const char *name,
                                             const RayesParam *params, size_t n_params);
+
+/* The displacement shader of geometry added from now on: a class with a
+ * displacement method (the built-ins "bumpy" and "fractal", or a plugin's),
+ * run on every vertex of the fine grids when the scene is prepared, before
+ * ray tracing structures are built; normals are then those of the
+ * displaced surface. NULL or "" removes it (the default: none). Parameters
+ * as for rayes_scene_set_shader. A class without a displacement method is
+ * RAYES_ERROR_INVALID_ARGUMENT. */
+RAYES_API RayesError rayes_scene_set_displacement(RayesScene *scene, const char *name,
+                                                  const RayesParam *params, size_t n_params);
+
+/* The displacement bound of geometry added from now on (RenderMan's
+ * Attribute "displacementbound" "sphere"), in world units: the promise that
+ * no point moves farther. Displacements are clamped to it, with one
+ * warning per shader. 0 (the default) means unbounded. */
+RAYES_API RayesError rayes_scene_set_displacement_bound(RayesScene *scene, float bound);
+/* Sets the scene's search path of a kind ("shader" or "texture"):
+ * directories separated by ':', searched in order by later calls
+ * (set_shader) or, for textures, by the renders of the scene (a texture
+ * name is tried as given, then in each directory, then in those of
+ * $RAYES_TEXTURE_PATH). An entry "&" or "@" stands for the previous value
+ * (as in RenderMan), so "mine:&" prepends. Empty entries are ignored. */
+RAYES_API RayesError rayes_scene_set_search_path(RayesScene *scene, const char *kind,
+                                                 const char *path);
 
 /* The shading rate of geometry added from now on: the area of a
  * micropolygon in pixels (RenderMan's ShadingRate). Default 1. */
@@ -133,13 +161,38 @@ RAYES_API RayesError rayes_scene_sphere(RayesScene *scene, float radius);
 RAYES_API RayesError rayes_scene_area_light(RayesScene *scene, const float P[4][3],
                                             const float L[3]);
 
-/* A search path of the scene: kind "texture" (image files that shaders
- * name), colon-separated directories; NULL or "" clears it. A name is
- * tried as given first, then in each directory in order, then in those of
- * the environment variable RAYES_TEXTURE_PATH. The path is copied. An
- * unknown kind is RAYES_ERROR_INVALID_ARGUMENT. */
-RAYES_API RayesError rayes_scene_set_search_path(RayesScene *scene, const char *kind,
-                                                 const char *path);
+/* A light source of the given type, with parameters (unknown names get
+ * one warning; a wrong type is RAYES_ERROR_INVALID_ARGUMENT). Points and
+ * directions are 3-vectors given as RAYES_PARAM_COLOR and transform by the
+ * current transform. Every light takes "intensity" (FLOAT, default 1),
+ * "lightcolor" (COLOR, default 1 1 1) and "__category" (STRING, a
+ * comma-separated list the direct-lighting service's category argument
+ * selects on). Types, RenderMan's semantics (angles in degrees):
+ *   "pointlight"       "from" (default 0 0 0): irradiance intensity / d^2
+ *                      at normal incidence
+ *   "spotlight"        "from" (0 0 0), "to" (0 0 1), "coneangle" (30),
+ *                      "conedeltaangle" (5), "beamdistribution" (2): a
+ *                      point light times smoothstep(cos(cone), cos(cone -
+ *                      delta), cos a) * cos(a)^beamdistribution, a the angle
+ *                      from the axis
+ *   "distantlight"     "from" (0 0 0), "to" (0 0 1): irradiance intensity
+ *                      along to - from
+ *   "ambientlight"     adds intensity * lightcolor to the ambient service
+ *   "environmentlight" radiance intensity * lightcolor, times the
+ *                      latitude-longitude map "mapname" (EXR or PNG) if
+ *                      given, seen by camera and specular rays that miss
+ *                      everything (docs/DESIGN.md: orientation)
+ *   "arealight"        radiance intensity * lightcolor from a "shape"
+ *                      (default "quad"): "quad" the square of side
+ *                      "width" x "height" (1 x 1) about the object-space
+ *                      origin in z = 0, "disk" of "radius" (1) at the
+ *                      origin in z = 0, both emitting toward +z, or
+ *                      "sphere" of "radius" (1) emitting outward; seen by
+ *                      camera and specular rays
+ * An unknown type is RAYES_ERROR_INVALID_ARGUMENT; an unreadable map is
+ * RAYES_ERROR_IO. */
+RAYES_API RayesError rayes_scene_light(RayesScene *scene, const char *type,
+                                       const RayesParam *params, size_t n_params);
 
 /* Ends an edit: checks the scene and bumps its timestamp. Rendering an
  * uncommitted scene is RAYES_ERROR_INVALID_OPERATION. */
@@ -160,6 +213,13 @@ typedef enum RayesFilter {
     RAYES_FILTER_BOX = 0,       /* width 1 pixel by default */
     RAYES_FILTER_GAUSSIAN = 1   /* width 2 pixels by default, alpha 2 */
 } RayesFilter;
+
+/* How camera rays are shaded at diffuse depth 0. */
+typedef enum RayesHider {
+    RAYES_HIDER_RAYTRACE = 0, /* lighting() at every camera ray hit */
+    RAYES_HIDER_GRID = 1      /* lighting() once per vertex of every visible grid; camera
+                                 hits interpolate the shaded grid (PRMan's REYES mode) */
+} RayesHider;
 
 /* Progress: fraction done in [0, 1]. Return nonzero to cancel the render.
  * Called from worker threads, one call at a time. */
@@ -189,6 +249,10 @@ typedef struct RayesRenderOptions {
                                   cache_k times the ray footprint is used (default 1) */
     RayesProgressFn progress;  /* may be NULL */
     void *progress_user;
+    RayesHider hider;          /* how camera rays are shaded (default RAYES_HIDER_RAYTRACE;
+                                  RAYES_HIDER_GRID for the final preset) */
+    int irradiance;            /* 1: irradiance interpolation with gradients at depth 0 over
+                                  each shaded grid (grid hider only; on for the final preset) */
     double texture_mb;         /* texture cache budget in megabytes (10^6 bytes), default 64 */
     float texture_width;       /* multiplies every texture filter width (RenderMan's "width"):
                                   default 1; 0 point-samples the finest MIP level */

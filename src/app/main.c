@@ -28,6 +28,7 @@ typedef struct Args {
     int n_outputs;
     const char *stats_path;
     const char *data_dir;
+    const char *shader_path;    /* --shader-path: put before the scene's own shader path */
     int quiet;
     RayesRenderOptions opt;
 } Args;
@@ -50,7 +51,8 @@ static void usage(FILE *f)
     fputs("usage: rayes render [SCENE] [options]\n"
           "       rayes --help | --version\n"
           "\n"
-          "SCENE is a built-in scene: cornell (default), cornell-teapots.\n"
+          "SCENE is a built-in scene: cornell (default), cornell-teapots, cornell-brick\n"
+          "(needs the plugin brick.so: --shader-path build/examples/shaders).\n"
           "\n"
           "options:\n"
           "  -o FILE                 output image, .exr or .png (repeatable; default SCENE.exr)\n"
@@ -75,8 +77,15 @@ static void usage(FILE *f)
           "  --cache-resolution R    auto (by ray differentials), coarse, medium or fine\n"
           "  --cache-k K             use the coarsest resolution whose micropolygons are at\n"
           "                          most K times the ray footprint (default 1)\n"
+          "  --hider raytrace|grid   shade every camera hit (default), or once per vertex of\n"
+          "                          each visible grid and interpolate (PRMan's REYES mode;\n"
+          "                          default for --quality final)\n"
+          "  --irradiance on|off     irradiance interpolation with gradients at depth 0 (grid\n"
+          "                          hider; on for --quality final)\n"
           "  --texture-mb MB         texture cache budget in megabytes (default 64)\n"
           "  --data DIR              data directory (teapot.bpt); default $RAYES_DATA\n"
+          "  --shader-path DIRS      directories of shader plugins NAME.so, ':'-separated;\n"
+          "                          searched before $RAYES_SHADER_PATH\n"
           "  --stats FILE.json       write statistics as JSON\n"
           "  --quiet                 no progress bar and no summary\n",
           f);
@@ -240,12 +249,22 @@ static void parse_args(int argc, char **argv, Args *a)
             opt->cache_resolution = parse_resolution(v);
         else if (strcmp(o, "--cache-k") == 0)
             opt->cache_k = parse_float(o, v, 1e-3f, 1e3f);
-        else if (strcmp(o, "--texture-mb") == 0)
+        else if (strcmp(o, "--hider") == 0) {
+            if (strcmp(v, "raytrace") != 0 && strcmp(v, "grid") != 0)
+                die_usage("--hider: expected raytrace or grid, got \"%s\"", v);
+            opt->hider = strcmp(v, "grid") == 0 ? RAYES_HIDER_GRID : RAYES_HIDER_RAYTRACE;
+        } else if (strcmp(o, "--irradiance") == 0) {
+            if (strcmp(v, "on") != 0 && strcmp(v, "off") != 0)
+                die_usage("--irradiance: expected on or off, got \"%s\"", v);
+            opt->irradiance = strcmp(v, "on") == 0;
+        } else if (strcmp(o, "--texture-mb") == 0)
             opt->texture_mb = parse_float(o, v, 0.0f, 1e7f);
         else if (strcmp(o, "--data") == 0)
             a->data_dir = v;
         else if (strcmp(o, "--stats") == 0)
             a->stats_path = v;
+        else if (strcmp(o, "--shader-path") == 0)
+            a->shader_path = v;
         else
             die_usage("unknown option \"%s\"", o);
     }
@@ -375,6 +394,12 @@ static int cmd_render(int argc, char **argv)
     if (!scene) {
         fprintf(stderr, "rayes: out of memory\n");
         return 1;
+    }
+    /* Before the scene, so a scene file's own path can keep it with "&". */
+    if (a.shader_path && rayes_scene_set_search_path(scene, "shader", a.shader_path) != RAYES_OK) {
+        fprintf(stderr, "rayes: --shader-path: %s\n", rayes_scene_get_error(scene));
+        rayes_scene_release(scene);
+        return 2;
     }
     RayesError e = io_builtin_scene(a.scene, a.data_dir, scene, err, sizeof err);
     if (e != RAYES_OK) {

@@ -173,6 +173,38 @@ static void measure(const GridSet *gs, size_t a, size_t b, double *sum, size_t *
         *curv = fmaxf(*curv, v3_length(v3_sub(gs->N[a], gs->N[b])) / len);
 }
 
+void geom_grid_measure(GridSet *gs, Grid *g)
+{
+    size_t base = g->first_vertex;
+    double sum = 0.0;
+    size_t m = 0;
+    float curv = 0.0f;
+    for (int pass = 0; pass < 2; pass++) {
+        float *c = pass ? &curv : NULL;
+        if (g->triangular) {
+            uint32_t n = g->nu;
+            for (uint32_t j = 0; j <= n; j++)
+                for (uint32_t i = 0; i + j < n; i++) {
+                    size_t k = base + geom_tri_vertex(n, i, j);
+                    measure(gs, k, base + geom_tri_vertex(n, i + 1, j), &sum, &m, c);
+                    measure(gs, k, base + geom_tri_vertex(n, i, j + 1), &sum, &m, c);
+                }
+        } else {
+            int nu = g->nu, nv = g->nv;
+            for (int j = 0; j < nv; j++)
+                for (int i = 0; i < nu; i++) {
+                    size_t k = base + (size_t)j * nu + i;
+                    if (i + 1 < nu)
+                        measure(gs, k, k + 1, &sum, &m, c);
+                    if (j + 1 < nv)
+                        measure(gs, k, k + nu, &sum, &m, c);
+                }
+        }
+    }
+    g->edge = m ? (float)(sum / (double)m) : 0.0f;
+    g->curvature = curv;
+}
+
 static int dice_quad(GridSet *gs, const Prim *prim, uint32_t prim_index, const Domain *d, Estimate e)
 {
     int nu = RY_MIN(e.n_u, GEOM_MAX_GRID - 1) + 1, nv = RY_MIN(e.n_v, GEOM_MAX_GRID - 1) + 1;
@@ -189,21 +221,8 @@ static int dice_quad(GridSet *gs, const Prim *prim, uint32_t prim_index, const D
             domain_uv(d, (float)i / (nu - 1), (float)j / (nv - 1), &u, &v);
             put_vertex(gs, base + (size_t)j * nu + i, prim, u, v);
         }
-    double sum = 0.0;
-    size_t n = 0;
-    float curv = 0.0f;
-    for (int pass = 0; pass < 2; pass++)
-        for (int j = 0; j < nv; j++)
-            for (int i = 0; i < nu; i++) {
-                size_t k = base + (size_t)j * nu + i;
-                if (i + 1 < nu)
-                    measure(gs, k, k + 1, &sum, &n, pass ? &curv : NULL);
-                if (j + 1 < nv)
-                    measure(gs, k, k + nu, &sum, &n, pass ? &curv : NULL);
-            }
-    g->edge = n ? (float)(sum / (double)n) : 0.0f;
-    g->curvature = curv;
     gs->n_vertices += (size_t)nu * nv;
+    geom_grid_measure(gs, g);
     gs->n_grids++;
     return 0;
 }
@@ -226,19 +245,8 @@ static int dice_triangle(GridSet *gs, const Prim *prim, uint32_t prim_index, con
             domain_uv(d, (float)i / n, (float)j / n, &u, &v);
             put_vertex(gs, base + geom_tri_vertex(n, i, j), prim, u, v);
         }
-    double sum = 0.0;
-    size_t m = 0;
-    float curv = 0.0f;
-    for (int pass = 0; pass < 2; pass++)
-        for (uint32_t j = 0; j <= n; j++)
-            for (uint32_t i = 0; i + j < n; i++) {
-                size_t k = base + geom_tri_vertex(n, i, j);
-                measure(gs, k, base + geom_tri_vertex(n, i + 1, j), &sum, &m, pass ? &curv : NULL);
-                measure(gs, k, base + geom_tri_vertex(n, i, j + 1), &sum, &m, pass ? &curv : NULL);
-            }
-    g->edge = m ? (float)(sum / (double)m) : 0.0f;
-    g->curvature = curv;
     gs->n_vertices += count;
+    geom_grid_measure(gs, g);
     gs->n_grids++;
     return 0;
 }

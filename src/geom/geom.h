@@ -40,6 +40,8 @@ typedef struct Prim {
     PrimType type;
     uint32_t object;       /* the object (shader, attributes) it belongs to */
     float shading_rate;    /* micropolygon area in pixels */
+    uint32_t displacement; /* the scene's displacement shader + 1, or 0: none */
+    float displacement_bound; /* world units; 0: unbounded */
     union {
         Vec3 cp[16];       /* world-space control points */
         struct {
@@ -94,6 +96,10 @@ void geom_gridset_fini(GridSet *gs);
 /* Splits prim into patches and dices each into a grid appended to gs.
  * Returns 0, or -1 when out of memory (gs keeps what was added). */
 int geom_dice_prim(GridSet *gs, const Prim *prim, uint32_t prim_index, const DiceCamera *cam);
+
+/* Recomputes a grid's mean edge and curvature from its vertices (after
+ * displacement has moved them). */
+void geom_grid_measure(GridSet *gs, Grid *g);
 
 /* Vertex count of a grid. */
 static inline size_t geom_grid_n_vertices(const Grid *g)

@@ -3,9 +3,10 @@
  * runs the shader's lighting() at the hit; a diffuse hit reads the
  * radiosity cache (radiosity.c), or with the cache off (the memo's "without
  * caching" baseline) runs diffuselighting() at that one point (one shading
- * point, counted at its diffuse depth). Area lights are
- * seen by camera and specular rays; diffuse rays see them as black because
- * direct lighting already integrates them (no double counting).
+ * point, counted at its diffuse depth). Area lights (quads, disks,
+ * spheres) and environment lights are seen by camera and specular rays;
+ * diffuse rays see them as black because direct lighting already integrates
+ * them (no double counting).
  *
  * Every random number is a function of a key: the camera path's key, then
  * hash_combine(key, ray index) for each child ray, so images do not depend
@@ -13,6 +14,8 @@
  */
 #include "render/integrator.h"
 
+#include "render/hider.h"
+#include "render/irrgrid.h"
 #include "render/radiosity.h"
 
 #include <math.h>
@@ -130,7 +133,7 @@ static Vec3 shade_hit(Worker *w, const Ray *ray, const Hit *hit, const RenderObj
     hp.key = key;
     hp.diff = (RayDiff){diff.width + diff.spread * hit->t, diff.spread};
     hit_footprint(&hp);
-    PathState ps = {w, &hp.key, &hp.diff, &hp.curvature, &hp.offset};
+    PathState ps = {w, &hp.key, &hp.diff, &hp.curvature, &hp.offset, NULL};
     RayesShadeCtx ctx = {
         .n_points = 1,
         .ray_type = kind,
@@ -165,13 +168,28 @@ static Vec3 shade_hit(Worker *w, const Ray *ray, const Hit *hit, const RenderObj
 Vec3 integrator_trace(Worker *w, const Ray *ray, uint32_t kind, int diffuse_depth,
                       int specular_depth, uint64_t key, RayDiff diff, float *alpha)
 {
+    float t;
+    Vec3 L = integrator_trace_hit(w, ray, kind, diffuse_depth, specular_depth, key, diff, &t);
+    if (alpha)
+        *alpha = isfinite(t) ? 1.0f : 0.0f;
+    return L;
+}
+
+Vec3 integrator_trace_hit(Worker *w, const Ray *ray, uint32_t kind, int diffuse_depth,
+                          int specular_depth, uint64_t key, RayDiff diff, float *t)
+{
     Hit hit;
-    if (alpha)
-        *alpha = 0.0f;
-    if (!accel_intersect(w->rs->accel, ray, &hit))
-        return v3(0, 0, 0);
-    if (alpha)
-        *alpha = 1.0f;
+    *t = INFINITY;
+    if (!accel_intersect(w->rs->accel, ray, &hit)) {
+        /* Environment lights: seen by camera and specular rays; black to
+         * diffuse rays, as direct lighting integrates them. */
+        Vec3 L = v3(0, 0, 0);
+        for (size_t k = 0; kind != RAYES_RAY_DIFFUSE && k < w->rs->n_lights; k++)
+            if (w->rs->lights[k].type == LIGHT_ENVIRONMENT)
+                L = v3_add(L, light_env_radiance(&w->rs->lights[k], ray->d));
+        return L;
+    }
+    *t = hit.t;
     const RenderObject *obj = &w->rs->objects[w->rs->gs->grids[hit.grid].object];
     if (obj->light >= 0) {
         /* Emitters: seen by camera and specular rays, on their front side. */
@@ -181,6 +199,8 @@ Vec3 integrator_trace(Worker *w, const Ray *ray, uint32_t kind, int diffuse_dept
     }
     if (kind == RAYES_RAY_DIFFUSE && w->set->cache)
         return radiosity_at_hit(w, ray, &hit, diffuse_depth, diff);
+    if (kind == RAYES_RAY_CAMERA && w->grid_shading)
+        return hider_camera_hit(w, ray, &hit);
     return shade_hit(w, ray, &hit, obj, kind, diffuse_depth, specular_depth, key, diff);
 }
 
@@ -197,44 +217,134 @@ static size_t point(const RayesShadeCtx *ctx, size_t i)
     return ctx->first_point + i;
 }
 
-/* Direct light from one quad light at one point, n shadow rays. */
-static void light_point(Worker *w, const RayesShadeCtx *ctx, size_t i, const Light *l,
-                        uint32_t pattern, int n, float exponent, Vec3 *diffuse, Vec3 *spec)
+/* The normalised Blinn-Phong lobe of shader.h: f = (e + 8) / (8 pi) (N.H)^e. */
+static float blinn_phong(Vec3 N, Vec3 V, Vec3 wi, float e)
 {
-    const PathState *ps = ctx->renderer;
-    Vec3 P = load3(ctx->P[i]), N = load3(ctx->N[i]), Ng = load3(ctx->Ng[i]);
-    Vec3 o = v3_madd(P, Ng, ps->offset[point(ctx, i)]);
-    Vec3 V = ctx->I ? v3_neg(load3(ctx->I[i])) : v3(0, 0, 0);
-    Vec3 sum_d = v3(0, 0, 0), sum_s = v3(0, 0, 0);
-    for (int s = 0; s < n; s++) {
-        float a, b;
-        cmj_sample_2d((uint32_t)s, (uint32_t)n, pattern, &a, &b);
-        Vec3 y, ny;
-        light_quad_eval(l, a, b, &y, &ny);
-        Vec3 wi = v3_sub(y, o);
-        float d2 = v3_dot(wi, wi);
-        float cos_x = v3_dot(N, wi), cos_y = -v3_dot(ny, wi); /* both scaled by |wi| (and |ny|) */
-        if (cos_x <= 0.0f || cos_y <= 0.0f || v3_dot(Ng, wi) <= 0.0f || d2 <= 0.0f)
-            continue;
+    Vec3 H = v3_normalize(v3_add(wi, V));
+    float nh = fmaxf(v3_dot(N, H), 0.0f);
+    return (e + 8.0f) / (8.0f * (float)M_PI) * powf(nh, e);
+}
+
+/* The solid-angle pdf of drawing wi by sampling the half vector with pdf
+ * (e + 1) / (2 pi) (N.H)^e: divided by 4 V.H, the reflection's Jacobian. */
+static float blinn_phong_pdf(Vec3 N, Vec3 V, Vec3 wi, float e)
+{
+    Vec3 H = v3_normalize(v3_add(wi, V));
+    float nh = v3_dot(N, H), vh = v3_dot(V, H);
+    if (nh <= 0.0f || vh <= 0.0f)
+        return 0.0f;
+    return (e + 1.0f) / (2.0f * (float)M_PI) * powf(nh, e) / (4.0f * vh);
+}
+
+/* The power heuristic for one sample from each of two strategies. */
+static float power_heuristic(float pa, float pb)
+{
+    float a = pa * pa, b = pb * pb;
+    return a + b > 0.0f ? a / (a + b) : 0.0f;
+}
+
+/* 1 if nothing stands between o and the point dist along unit wi (INFINITY:
+ * the ray escapes); counts the shadow ray. */
+static int unoccluded(Worker *w, Vec3 o, Vec3 wi, float dist)
+{
+    Ray shadow;
+    if (isinf(dist)) {
+        shadow = (Ray){o, wi, ray_epsilon(w), INFINITY, RAYES_RAY_SHADOW};
+    } else {
         /* tnear skips surfaces through the origin itself: a grid vertex on a
          * corner line (a floor vertex against a wall) lies in the other
          * surface's plane, and would shadow itself. */
-        float near = ray_epsilon(w) / sqrtf(d2);
-        Ray shadow = {o, wi, near, 1.0f - 1e-4f, RAYES_RAY_SHADOW};
-        w->stats.rays_shadow++;
-        if (accel_occluded(w->rs->accel, &shadow))
-            continue;
-        float G = cos_x * cos_y / (d2 * d2); /* cos cos' |J| / d^2 with |ny| = |J| */
-        sum_d = v3_madd(sum_d, l->L, G);
-        if (spec) {
-            Vec3 H = v3_normalize(v3_add(v3_scale(wi, 1.0f / sqrtf(d2)), V));
-            float nh = fmaxf(v3_dot(N, H), 0.0f);
-            float f = (exponent + 8.0f) / (8.0f * (float)M_PI) * powf(nh, exponent);
-            sum_s = v3_madd(sum_s, l->L, G * f);
-        }
+        shadow = (Ray){o, v3_scale(wi, dist), ray_epsilon(w) / dist, 1.0f - 1e-4f,
+                       RAYES_RAY_SHADOW};
     }
-    *diffuse = v3_add(*diffuse, v3_scale(sum_d, 1.0f / ((float)M_PI * n)));
-    if (spec)
+    w->stats.rays_shadow++;
+    return !accel_occluded(w->rs->accel, &shadow);
+}
+
+/* What direct lighting needs of one shading point. */
+typedef struct DirectPoint {
+    Vec3 o, N, Ng, V;
+    float e;      /* Blinn-Phong exponent */
+    int spec;     /* the specular output is wanted */
+} DirectPoint;
+
+/* A delta light (point, spot, distant): one shadow ray. */
+static void light_delta(Worker *w, const DirectPoint *p, const Light *l, Vec3 *diffuse,
+                        Vec3 *spec)
+{
+    LightSample ls;
+    if (!light_sample(l, p->o, 0.5f, 0.5f, &ls))
+        return;
+    float cos_x = v3_dot(p->N, ls.wi);
+    if (cos_x <= 0.0f || v3_dot(p->Ng, ls.wi) <= 0.0f || !unoccluded(w, p->o, ls.wi, ls.dist))
+        return;
+    *diffuse = v3_madd(*diffuse, ls.Li, cos_x / (float)M_PI);
+    if (p->spec)
+        *spec = v3_madd(*spec, ls.Li, cos_x * blinn_phong(p->N, p->V, ls.wi, p->e));
+}
+
+/* An area or environment light, n samples with multiple importance
+ * sampling (power heuristic): each light sample is paired with a
+ * cosine-distributed direction for the diffuse output and, when the
+ * specular output is wanted, a Blinn-Phong direction, which count when
+ * they reach the light's emitting side unoccluded. */
+static void light_area(Worker *w, const DirectPoint *p, const Light *l, uint64_t key, int n,
+                       Vec3 *diffuse, Vec3 *spec)
+{
+    Vec3 sum_d = v3(0, 0, 0), sum_s = v3(0, 0, 0);
+    uint32_t pattern = (uint32_t)key, pat_cos = (uint32_t)hash_combine(key, 1),
+             pat_bp = (uint32_t)hash_combine(key, 2);
+    for (int s = 0; s < n; s++) {
+        float a, b;
+        LightSample ls;
+        /* The light's strategy. */
+        cmj_sample_2d((uint32_t)s, (uint32_t)n, pattern, &a, &b);
+        if (light_sample(l, p->o, a, b, &ls) && ls.pdf > 0.0f) {
+            float cos_x = v3_dot(p->N, ls.wi);
+            if (cos_x > 0.0f && v3_dot(p->Ng, ls.wi) > 0.0f && v3_max_component(ls.Li) > 0.0f &&
+                unoccluded(w, p->o, ls.wi, ls.dist)) {
+                float wd = power_heuristic(ls.pdf, cos_x / (float)M_PI);
+                sum_d = v3_madd(sum_d, ls.Li, wd * cos_x / ((float)M_PI * ls.pdf));
+                if (p->spec) {
+                    float ws = power_heuristic(ls.pdf, blinn_phong_pdf(p->N, p->V, ls.wi, p->e));
+                    float f = blinn_phong(p->N, p->V, ls.wi, p->e);
+                    sum_s = v3_madd(sum_s, ls.Li, ws * f * cos_x / ls.pdf);
+                }
+            }
+        }
+        /* The diffuse lobe's strategy: weight (cos / pi) / pdf = 1. */
+        cmj_sample_2d((uint32_t)s, (uint32_t)n, pat_cos, &a, &b);
+        Vec3 wi = sample_cosine_hemisphere(p->N, a, b);
+        float cos_x = v3_dot(p->N, wi);
+        if (cos_x > 0.0f && v3_dot(p->Ng, wi) > 0.0f && light_intersect(l, p->o, wi, &ls) &&
+            v3_max_component(ls.Li) > 0.0f && unoccluded(w, p->o, wi, ls.dist))
+            sum_d = v3_madd(sum_d, ls.Li, power_heuristic(cos_x / (float)M_PI, ls.pdf));
+        if (!p->spec)
+            continue;
+        /* The specular lobe's strategy: the half vector about N. */
+        cmj_sample_2d((uint32_t)s, (uint32_t)n, pat_bp, &a, &b);
+        float cos_h = powf(a, 1.0f / (p->e + 1.0f));
+        float sin_h = sqrtf(fmaxf(0.0f, 1.0f - cos_h * cos_h)), phi = 2.0f * (float)M_PI * b;
+        Vec3 t, bt;
+        v3_basis(p->N, &t, &bt);
+        Vec3 H = v3_add(v3_add(v3_scale(t, sin_h * cosf(phi)), v3_scale(bt, sin_h * sinf(phi))),
+                        v3_scale(p->N, cos_h));
+        float vh = v3_dot(p->V, H);
+        if (vh <= 0.0f)
+            continue;
+        wi = v3_normalize(v3_sub(v3_scale(H, 2.0f * vh), p->V));
+        cos_x = v3_dot(p->N, wi);
+        if (cos_x <= 0.0f || v3_dot(p->Ng, wi) <= 0.0f || !light_intersect(l, p->o, wi, &ls) ||
+            !(v3_max_component(ls.Li) > 0.0f))
+            continue;
+        float pdf = blinn_phong_pdf(p->N, p->V, wi, p->e);
+        if (!(pdf > 0.0f) || !unoccluded(w, p->o, wi, ls.dist))
+            continue;
+        float f = blinn_phong(p->N, p->V, wi, p->e);
+        sum_s = v3_madd(sum_s, ls.Li, power_heuristic(pdf, ls.pdf) * f * cos_x / pdf);
+    }
+    *diffuse = v3_add(*diffuse, v3_scale(sum_d, 1.0f / n));
+    if (p->spec)
         *spec = v3_add(*spec, v3_scale(sum_s, 1.0f / n));
 }
 
@@ -243,7 +353,6 @@ static void svc_direct_lighting(const RayesShaderServices *sv, const RayesShadeC
                                 float (*diffuse)[3], float (*specular)[3])
 {
     (void)sv;
-    (void)category; /* every light is an area light without categories, for now */
     const PathState *ps = ctx->renderer;
     Worker *w = ps->w;
     int n = n_shadow_rays > 0 ? n_shadow_rays
@@ -252,11 +361,23 @@ static void svc_direct_lighting(const RayesShaderServices *sv, const RayesShadeC
     int want_spec = specular && ctx->I;
     for (size_t i = 0; i < ctx->n_points; i++) {
         Vec3 d = v3(0, 0, 0), s = v3(0, 0, 0);
-        float e = 1.0f / (roughness && roughness[i] > 0.0f ? roughness[i] : 0.1f);
-        for (size_t l = 0; l < w->rs->n_lights && n > 0; l++) {
-            uint32_t pattern =
-                (uint32_t)hash_combine(hash_combine(ps->keys[point(ctx, i)], DIM_LIGHT), l);
-            light_point(w, ctx, i, &w->rs->lights[l], pattern, n, e, &d, want_spec ? &s : NULL);
+        DirectPoint p;
+        p.N = load3(ctx->N[i]);
+        p.Ng = load3(ctx->Ng[i]);
+        p.o = v3_madd(load3(ctx->P[i]), p.Ng, ps->offset[point(ctx, i)]);
+        p.V = ctx->I ? v3_neg(load3(ctx->I[i])) : v3(0, 0, 0);
+        p.e = 1.0f / (roughness && roughness[i] > 0.0f ? roughness[i] : 0.1f);
+        p.spec = want_spec;
+        for (size_t k = 0; k < w->rs->n_lights && n > 0; k++) {
+            const Light *l = &w->rs->lights[k];
+            if (l->type == LIGHT_AMBIENT || !light_category_match(l, category))
+                continue;
+            if (light_is_area(l))
+                light_area(w, &p, l,
+                           hash_combine(hash_combine(ps->keys[point(ctx, i)], DIM_LIGHT), k), n,
+                           &d, &s);
+            else
+                light_delta(w, &p, l, &d, &s);
         }
         if (diffuse)
             store3(diffuse[i], d);
@@ -275,6 +396,14 @@ static void svc_indirect_diffuse(const RayesShaderServices *sv, const RayesShade
     int n = n_rays > 0 ? n_rays : depth == 0 ? w->set->diffuse_rays : w->set->diffuse_rays_deep;
     if (depth >= w->set->bounces)
         n = 0;
+    IrrGrid *irr = ps->irr;
+    if (irr && n > 0 && ctx->N == irr->N + ctx->first_point) {
+        /* A grid's own points with its own normals: interpolate (irrgrid.h). */
+        if (!irr->done || irr->n_rays != n)
+            irrgrid_compute(ps, irr, n);
+        memcpy(out, irr->E + ctx->first_point, ctx->n_points * sizeof *out);
+        return;
+    }
     /* Each ray stands for 1/n of the hemisphere: its spread never shrinks. */
     float lobe_spread = n > 0 ? 1.0f / sqrtf((float)n) : 0.0f;
     for (size_t i = 0; i < ctx->n_points; i++) {
@@ -302,7 +431,15 @@ static void svc_indirect_diffuse(const RayesShaderServices *sv, const RayesShade
 static void svc_ambient(const RayesShaderServices *sv, const RayesShadeCtx *ctx, float (*out)[3])
 {
     (void)sv;
-    memset(out, 0, ctx->n_points * sizeof *out); /* no ambient lights yet */
+    const PathState *ps = ctx->renderer;
+    const RenderScene *rs = ps->w->rs;
+    Vec3 sum = v3(0, 0, 0);
+    for (size_t k = 0; k < rs->n_lights; k++)
+        if (rs->lights[k].type == LIGHT_AMBIENT)
+            sum = v3_add(sum, rs->lights[k].L);
+    for (size_t i = 0; i < ctx->n_points; i++)
+        store3(out[i], sum);
+    ps->w->stats.ambient_lookups += ctx->n_points;
 }
 
 /* Radiance along d from point i of ctx, a specular or refracted ray. */

@@ -14,11 +14,14 @@ typedef struct RayDiff {
     float spread;  /* radians */
 } RayDiff;
 
+typedef struct GridShading GridShading;
+
 typedef struct Worker {
     const RenderScene *rs;
     const RenderSettings *set;
     RenderStats stats;
     CacheLocal cache;             /* this thread's part of the radiosity cache */
+    GridShading *grid_shading; /* the grid hider's shaded grids, or NULL (hider.h) */
 } Worker;
 
 /* What a shading context's `renderer` points to: per point (indexed from
@@ -31,6 +34,8 @@ typedef struct PathState {
     const RayDiff *diff;
     const float *curvature;
     const float *offset;
+    struct IrrGrid *irr;          /* irradiance interpolation over this grid, or NULL
+                                     (irrgrid.h) */
 } PathState;
 
 /* How far rays leaving a point of grid g start from it, along its normal:
@@ -50,5 +55,10 @@ extern const RayesShaderServices render_services;
  * if something was hit. */
 Vec3 integrator_trace(Worker *w, const Ray *ray, uint32_t kind, int diffuse_depth,
                       int specular_depth, uint64_t key, RayDiff diff, float *alpha);
+
+/* As integrator_trace, with the distance to the hit in *t (INFINITY for a
+ * miss) instead of alpha. */
+Vec3 integrator_trace_hit(Worker *w, const Ray *ray, uint32_t kind, int diffuse_depth,
+                          int specular_depth, uint64_t key, RayDiff diff, float *t);
 
 #endif /* RAYES_RENDER_INTEGRATOR_H */

@@ -279,7 +279,7 @@ static void fill_radiosity(void *user, const CacheKey *key, size_t n, float (*ou
         fp.keys[i] = hash_combine(fill_key, i);
         fp.diff[i] = (RayDiff){width, 0.0f};
     }
-    PathState ps = {w, fp.keys, fp.diff, fp.curv, fp.offset};
+    PathState ps = {w, fp.keys, fp.diff, fp.curv, fp.offset, NULL};
     RayesShadeCtx ctx = {
         .n_points = n, .ray_type = RAYES_RAY_DIFFUSE, .diffuse_depth = key->depth,
         .specular_depth = 0,

@@ -17,6 +17,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "render/hider.h"
 #include "render/integrator.h"
 #include "util/check.h"
 #include "util/rng.h"
@@ -146,8 +147,11 @@ static void merge_stats(RenderStats *into, const RenderStats *s)
     into->rays_shadow += s->rays_shadow;
     into->rays_diffuse += s->rays_diffuse;
     into->rays_specular += s->rays_specular;
+    into->irradiance_records += s->irradiance_records;
+    into->irradiance_interpolated += s->irradiance_interpolated;
     for (int d = 0; d <= RENDER_MAX_DEPTH; d++)
         into->shading_points[d] += s->shading_points[d];
+    into->ambient_lookups += s->ambient_lookups;
 }
 
 int render_frame(const RenderScene *rs, const RenderSettings *set, float *rgba, RenderStats *stats)
@@ -163,8 +167,13 @@ int render_frame(const RenderScene *rs, const RenderSettings *set, float *rgba, 
     pthread_mutex_init(&f.progress_lock, NULL);
     f.workers = calloc((size_t)threads, sizeof *f.workers);
     RY_CHECK(f.workers != NULL);
+    GridShading *gsh = NULL;
+    if (set->hider == 1) {
+        gsh = hider_new(rs);
+        RY_CHECK(gsh != NULL);
+    }
     for (int i = 0; i < threads; i++) {
-        f.workers[i] = (Worker){.rs = rs, .set = set};
+        f.workers[i] = (Worker){.rs = rs, .set = set, .grid_shading = gsh};
         if (set->cache)
             cache_local_init(&f.workers[i].cache, set->cache);
     }
@@ -176,6 +185,7 @@ int render_frame(const RenderScene *rs, const RenderSettings *set, float *rgba, 
             cache_local_fini(&f.workers[i].cache);
     }
     free(f.workers);
+    hider_free(gsh);
     pthread_mutex_destroy(&f.progress_lock);
     return atomic_load(&f.cancelled) ? 1 : 0;
 }

@@ -63,12 +63,18 @@ typedef struct RenderSettings {
     Cache *cache;                 /* the radiosity cache, or NULL: uncached */
     int cache_resolution;         /* -1: by differentials; else a forced CacheLevel */
     float cache_k;                /* resolution rule constant (DESIGN.md) */
+    int hider;                    /* 0: shade at every camera hit; 1: the grid hider (hider.h) */
+    int irradiance;               /* 1: irradiance interpolation at depth 0 (irrgrid.h; grid
+                                     hider only) */
     TextureSystem *textures;      /* image textures for the texture service, or NULL */
 } RenderSettings;
 
 typedef struct RenderStats {
     uint64_t rays_camera, rays_shadow, rays_diffuse, rays_specular;
     uint64_t shading_points[RENDER_MAX_DEPTH + 1]; /* by diffuse depth */
+    uint64_t irradiance_records;      /* irradiance interpolation: records computed */
+    uint64_t irradiance_interpolated; /* and points interpolated */
+    uint64_t ambient_lookups;     /* points the ambient service was asked for */
 } RenderStats;
 
 /* Camera from eye, target, up and vertical field of view in degrees. */

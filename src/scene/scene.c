@@ -7,6 +7,7 @@
 
 #include <math.h>
 #include <stdarg.h>
+#include <stddef.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -14,6 +15,7 @@
 #include "rayes/rayes.h"
 #include "rayes/shader.h"
 #include "util/check.h"
+#include "util/log.h"
 
 static RayesError fail(RayesScene *s, RayesError e, const char *fmt, ...)
     __attribute__((format(printf, 3, 4)));
@@ -80,11 +82,16 @@ void rayes_scene_release(RayesScene *s)
     for (size_t i = 0; i < s->n_objects; i++)
         if (s->objects[i].shader.cls)
             shade_instance_fini(&s->objects[i].shader);
-    for (int k = 0; k < SCENE_N_PATH_KINDS; k++)
-        free(s->search_path[k]);
+    for (size_t i = 0; i < s->n_displacements; i++)
+        shade_instance_fini(&s->displacements[i]);
+    free(s->displacements);
     free(s->objects);
     free(s->prims);
+    for (size_t i = 0; i < s->n_lights; i++)
+        light_fini(&s->lights[i]);
     free(s->lights);
+    for (int k = 0; k < SCENE_SEARCH_PATH_COUNT; k++)
+        free(s->search_paths[k]);
     free(s);
 }
 
@@ -184,23 +191,95 @@ static RayesError add_object(RayesScene *s, const RayesShaderClass *cls, const R
     return RAYES_OK;
 }
 
+/* Checks a shader call's parameters: named and finite. */
+static RayesError check_params(RayesScene *s, const char *what, const char *name,
+                               const RayesParam *params, size_t n_params)
+{
+    for (size_t i = 0; i < n_params; i++) {
+        if (!params[i].name)
+            return fail(s, RAYES_ERROR_INVALID_ARGUMENT, "%s \"%s\": a parameter has no name",
+                        what, name);
+        if (params[i].type != RAYES_PARAM_STRING && !finite_n(params[i].value, 3))
+            return fail(s, RAYES_ERROR_INVALID_ARGUMENT,
+                        "%s \"%s\": parameter \"%s\" is not finite", what, name, params[i].name);
+    }
+    return RAYES_OK;
+}
+
+/* Sets *cls to a built-in class, else a plugin from the scene's shader
+ * search path and then $RAYES_SHADER_PATH. Returns RAYES_OK, or the error
+ * recorded in the scene. */
+static RayesError find_shader(RayesScene *s, const char *name, const RayesShaderClass **cls)
+{
+    *cls = shade_find_class(name);
+    if (*cls)
+        return RAYES_OK;
+    const char *mine = scene_search_path(s, SCENE_SEARCH_PATH_SHADER);
+    const char *env = getenv("RAYES_SHADER_PATH");
+    size_t len = strlen(mine) + (env ? strlen(env) : 0) + 2;
+    char *path = malloc(len), err[512];
+    if (!path)
+        return fail(s, RAYES_ERROR_OUT_OF_MEMORY, "out of memory");
+    snprintf(path, len, "%s:%s", mine, env ? env : "");
+    *cls = shade_find_class_on_path(name, path, err, sizeof err);
+    free(path);
+    return *cls ? RAYES_OK : fail(s, RAYES_ERROR_INVALID_ARGUMENT, "%s", err);
+}
+
 RayesError rayes_scene_set_shader(RayesScene *s, const char *name, const RayesParam *params,
                                   size_t n_params)
 {
     if (!s || !name || (n_params && !params))
         return RAYES_ERROR_INVALID_ARGUMENT;
-    const RayesShaderClass *cls = shade_find_class(name);
-    if (!cls)
-        return fail(s, RAYES_ERROR_INVALID_ARGUMENT, "unknown shader \"%s\"", name);
-    for (size_t i = 0; i < n_params; i++) {
-        if (!params[i].name)
-            return fail(s, RAYES_ERROR_INVALID_ARGUMENT, "shader \"%s\": a parameter has no name",
-                        name);
-        if (params[i].type != RAYES_PARAM_STRING && !finite_n(params[i].value, 3))
-            return fail(s, RAYES_ERROR_INVALID_ARGUMENT,
-                        "shader \"%s\": parameter \"%s\" is not finite", name, params[i].name);
-    }
+    const RayesShaderClass *cls;
+    RayesError e = find_shader(s, name, &cls);
+    if (e != RAYES_OK)
+        return e;
+    e = check_params(s, "shader", name, params, n_params);
+    if (e != RAYES_OK)
+        return e;
     return add_object(s, cls, params, n_params, -1);
+}
+
+RayesError rayes_scene_set_displacement(RayesScene *s, const char *name, const RayesParam *params,
+                                        size_t n_params)
+{
+    if (!s || (n_params && !params))
+        return RAYES_ERROR_INVALID_ARGUMENT;
+    if (!name || !name[0]) {
+        s->current_displacement = 0;
+        return RAYES_OK;
+    }
+    const RayesShaderClass *cls;
+    RayesError e = find_shader(s, name, &cls);
+    if (e != RAYES_OK)
+        return e;
+    if (!cls->displacement)
+        return fail(s, RAYES_ERROR_INVALID_ARGUMENT,
+                    "shader \"%s\" has no displacement method", name);
+    e = check_params(s, "displacement shader", name, params, n_params);
+    if (e != RAYES_OK)
+        return e;
+    if (grow((void **)&s->displacements, &s->cap_displacements, s->n_displacements,
+             sizeof *s->displacements) != 0)
+        return fail(s, RAYES_ERROR_OUT_OF_MEMORY, "out of memory");
+    char err[256];
+    if (shade_instance_init(&s->displacements[s->n_displacements], cls, params, n_params, err,
+                            sizeof err) != 0)
+        return fail(s, RAYES_ERROR_OUT_OF_MEMORY, "%s", err);
+    s->current_displacement = (uint32_t)++s->n_displacements;
+    return RAYES_OK;
+}
+
+RayesError rayes_scene_set_displacement_bound(RayesScene *s, float bound)
+{
+    if (!s)
+        return RAYES_ERROR_INVALID_ARGUMENT;
+    if (!(bound >= 0.0f) || !isfinite(bound))
+        return fail(s, RAYES_ERROR_INVALID_ARGUMENT,
+                    "displacement bound: expected a finite number >= 0");
+    s->displacement_bound = bound;
+    return RAYES_OK;
 }
 
 static RayesError add_prim(RayesScene *s, Prim *p)
@@ -214,6 +293,8 @@ static RayesError add_prim(RayesScene *s, Prim *p)
         return fail(s, RAYES_ERROR_OUT_OF_MEMORY, "out of memory");
     p->object = (uint32_t)s->current_object;
     p->shading_rate = s->shading_rate;
+    p->displacement = s->current_displacement;
+    p->displacement_bound = s->displacement_bound;
     s->prims[s->n_prims++] = *p;
     s->dirty = 1;
     return RAYES_OK;
@@ -313,6 +394,8 @@ RayesError rayes_scene_area_light(RayesScene *s, const float P[4][3], const floa
     if (grow((void **)&s->lights, &s->cap_lights, s->n_lights, sizeof *s->lights) != 0)
         return fail(s, RAYES_ERROR_OUT_OF_MEMORY, "out of memory");
     Light *l = &s->lights[s->n_lights];
+    memset(l, 0, sizeof *l);
+    l->type = LIGHT_QUAD;
     Vec3 v[4];
     transform_points(s, P, 4, v);
     l->P[0] = v[0];
@@ -337,34 +420,6 @@ RayesError rayes_scene_area_light(RayesScene *s, const float P[4][3], const floa
         return fail(s, RAYES_ERROR_OUT_OF_MEMORY, "out of memory");
     s->prims[s->n_prims++] = p;
     s->current_object = keep;
-    return RAYES_OK;
-}
-
-static const char *const path_kinds[SCENE_N_PATH_KINDS] = {
-    [SCENE_PATH_TEXTURE] = "texture",
-};
-
-const char *scene_path_kind_name(ScenePathKind kind)
-{
-    return kind < SCENE_N_PATH_KINDS ? path_kinds[kind] : "";
-}
-
-RayesError rayes_scene_set_search_path(RayesScene *s, const char *kind, const char *path)
-{
-    if (!s || !kind)
-        return RAYES_ERROR_INVALID_ARGUMENT;
-    int k = 0;
-    while (k < SCENE_N_PATH_KINDS && strcmp(kind, path_kinds[k]) != 0)
-        k++;
-    if (k == SCENE_N_PATH_KINDS)
-        return fail(s, RAYES_ERROR_INVALID_ARGUMENT,
-                    "search path: unknown kind \"%s\" (expected \"texture\")", kind);
-    char *copy = NULL;
-    if (path && path[0] && !(copy = strdup(path)))
-        return fail(s, RAYES_ERROR_OUT_OF_MEMORY, "search path: out of memory");
-    free(s->search_path[k]);
-    s->search_path[k] = copy;
-    s->dirty = 1;
     return RAYES_OK;
 }
 
@@ -414,8 +469,321 @@ int scene_prepare(const RayesScene *s, int height, GridSet *gs)
     cam.eye = s->eye;
     cam.pixel_angle = 2.0f * tanf(0.5f * s->fov_y * (float)(M_PI / 180.0)) / (float)height;
     cam.min_distance = 1e-3f * fmaxf(radius, 1e-6f);
-    for (size_t i = 0; i < s->n_prims; i++)
+    for (size_t i = 0; i < s->n_prims; i++) {
+        size_t first = gs->n_grids;
         if (geom_dice_prim(gs, &s->prims[i], (uint32_t)i, &cam) != 0)
             return -1;
+        /* Normals of displaced surfaces: differences over 1e-3 of the scene radius. */
+        if (s->prims[i].displacement && scene_displace(s, gs, first, 1e-3f * radius) != 0)
+            return -1;
+    }
     return 0;
+}
+
+/* ------------------------------------------------------------ lights */
+
+/* The parameters of rayes_scene_light, checked and with defaults. */
+typedef struct LightParams {
+    float intensity, color[3], from[3], to[3];
+    float coneangle, conedeltaangle, beamdistribution;
+    float radius, width, height;
+    const char *mapname, *shape, *category;
+} LightParams;
+
+typedef struct LightParamDesc {
+    const char *name;
+    RayesParamType type;
+    size_t offset;
+} LightParamDesc;
+
+static const LightParamDesc light_param_descs[] = {
+    {"intensity", RAYES_PARAM_FLOAT, offsetof(LightParams, intensity)},
+    {"lightcolor", RAYES_PARAM_COLOR, offsetof(LightParams, color)},
+    {"from", RAYES_PARAM_COLOR, offsetof(LightParams, from)},
+    {"to", RAYES_PARAM_COLOR, offsetof(LightParams, to)},
+    {"coneangle", RAYES_PARAM_FLOAT, offsetof(LightParams, coneangle)},
+    {"conedeltaangle", RAYES_PARAM_FLOAT, offsetof(LightParams, conedeltaangle)},
+    {"beamdistribution", RAYES_PARAM_FLOAT, offsetof(LightParams, beamdistribution)},
+    {"radius", RAYES_PARAM_FLOAT, offsetof(LightParams, radius)},
+    {"width", RAYES_PARAM_FLOAT, offsetof(LightParams, width)},
+    {"height", RAYES_PARAM_FLOAT, offsetof(LightParams, height)},
+    {"mapname", RAYES_PARAM_STRING, offsetof(LightParams, mapname)},
+    {"shape", RAYES_PARAM_STRING, offsetof(LightParams, shape)},
+    {"__category", RAYES_PARAM_STRING, offsetof(LightParams, category)},
+};
+
+static RayesError light_params(RayesScene *s, const char *type, const RayesParam *params,
+                               size_t n_params, LightParams *lp)
+{
+    *lp = (LightParams){.intensity = 1, .color = {1, 1, 1}, .to = {0, 0, 1}, .coneangle = 30,
+                        .conedeltaangle = 5, .beamdistribution = 2, .radius = 1, .width = 1,
+                        .height = 1, .mapname = "", .shape = "quad", .category = ""};
+    for (size_t i = 0; i < n_params; i++) {
+        const RayesParam *p = &params[i];
+        if (!p->name)
+            return fail(s, RAYES_ERROR_INVALID_ARGUMENT, "%s: a parameter has no name", type);
+        const LightParamDesc *d = NULL;
+        for (size_t k = 0; k < sizeof light_param_descs / sizeof *light_param_descs; k++)
+            if (strcmp(light_param_descs[k].name, p->name) == 0)
+                d = &light_param_descs[k];
+        if (!d) {
+            char key[128];
+            snprintf(key, sizeof key, "light:%s:%s", type, p->name);
+            log_warning_once(key, "%s has no parameter \"%s\"; ignored", type, p->name);
+            continue;
+        }
+        int ok = p->type == d->type || (d->type == RAYES_PARAM_COLOR && p->type == RAYES_PARAM_FLOAT &&
+                                        strcmp(d->name, "lightcolor") == 0);
+        if (!ok)
+            return fail(s, RAYES_ERROR_INVALID_ARGUMENT, "%s: parameter \"%s\" expects a %s", type,
+                        p->name,
+                        d->type == RAYES_PARAM_FLOAT   ? "float"
+                        : d->type == RAYES_PARAM_COLOR ? "3-vector (RAYES_PARAM_COLOR)"
+                                                       : "string");
+        char *dst = (char *)lp + d->offset;
+        if (d->type == RAYES_PARAM_STRING) {
+            if (!p->string)
+                return fail(s, RAYES_ERROR_INVALID_ARGUMENT, "%s: parameter \"%s\" has no string",
+                            type, p->name);
+            *(const char **)dst = p->string;
+            continue;
+        }
+        if (!finite_n(p->value, d->type == RAYES_PARAM_FLOAT ? 1 : 3))
+            return fail(s, RAYES_ERROR_INVALID_ARGUMENT, "%s: parameter \"%s\" is not finite",
+                        type, p->name);
+        float *f = (float *)(void *)dst;
+        if (d->type == RAYES_PARAM_FLOAT)
+            f[0] = p->value[0];
+        else
+            for (int c = 0; c < 3; c++)
+                f[c] = p->value[p->type == RAYES_PARAM_FLOAT ? 0 : c];
+    }
+    if (lp->intensity < 0 || lp->color[0] < 0 || lp->color[1] < 0 || lp->color[2] < 0)
+        return fail(s, RAYES_ERROR_INVALID_ARGUMENT,
+                    "%s: expected a non-negative intensity and lightcolor", type);
+    if (strlen(lp->category) >= LIGHT_CATEGORY_MAX)
+        return fail(s, RAYES_ERROR_INVALID_ARGUMENT, "%s: __category longer than %d characters",
+                    type, LIGHT_CATEGORY_MAX - 1);
+    return RAYES_OK;
+}
+
+/* Adds light l and, for emitters, its object and the primitives camera and
+ * specular rays see (n_prims of them). */
+static RayesError push_light(RayesScene *s, const Light *l, const Prim *prims, size_t n_prims)
+{
+    if (grow((void **)&s->lights, &s->cap_lights, s->n_lights, sizeof *s->lights) != 0)
+        return fail(s, RAYES_ERROR_OUT_OF_MEMORY, "out of memory");
+    for (size_t i = 0; i < n_prims; i++)
+        if (grow((void **)&s->prims, &s->cap_prims, s->n_prims + i, sizeof *s->prims) != 0)
+            return fail(s, RAYES_ERROR_OUT_OF_MEMORY, "out of memory");
+    if (n_prims) {
+        int64_t keep = s->current_object;
+        RayesError e = add_object(s, NULL, NULL, 0, (int)s->n_lights);
+        s->current_object = keep;
+        if (e != RAYES_OK)
+            return e;
+        for (size_t i = 0; i < n_prims; i++) {
+            Prim p = prims[i];
+            p.object = (uint32_t)(s->n_objects - 1);
+            p.shading_rate = s->shading_rate;
+            s->prims[s->n_prims++] = p;
+        }
+    }
+    s->lights[s->n_lights++] = *l;
+    s->dirty = 1;
+    return RAYES_OK;
+}
+
+#define DISK_FAN 64 /* triangles of the polygon a disk light shows the camera */
+
+RayesError rayes_scene_light(RayesScene *s, const char *type, const RayesParam *params,
+                             size_t n_params)
+{
+    if (!s || !type || (n_params && !params))
+        return RAYES_ERROR_INVALID_ARGUMENT;
+    static const char *const types[] = {"pointlight",   "spotlight",        "distantlight",
+                                        "ambientlight", "environmentlight", "arealight"};
+    int t = -1;
+    for (int k = 0; k < 6; k++)
+        if (strcmp(type, types[k]) == 0)
+            t = k;
+    if (t < 0)
+        return fail(s, RAYES_ERROR_INVALID_ARGUMENT,
+                    "unknown light type \"%s\"; expected pointlight, spotlight, distantlight, "
+                    "ambientlight, environmentlight or arealight",
+                    type);
+    LightParams lp;
+    RayesError e = light_params(s, type, params, n_params, &lp);
+    if (e != RAYES_OK)
+        return e;
+    Light l;
+    memset(&l, 0, sizeof l);
+    snprintf(l.category, sizeof l.category, "%s", lp.category);
+    l.L = v3_scale(v3_load(lp.color), lp.intensity);
+    const Mat4 *m = &s->world_from_object;
+    l.from = mat4_point(m, v3_load(lp.from));
+    Vec3 to = mat4_point(m, v3_load(lp.to));
+    switch (t) {
+    case 0:
+        l.type = LIGHT_POINT;
+        return push_light(s, &l, NULL, 0);
+    case 1:
+    case 2:
+        l.type = t == 1 ? LIGHT_SPOT : LIGHT_DISTANT;
+        l.dir = v3_normalize(v3_sub(to, l.from));
+        if (!(v3_length(v3_sub(to, l.from)) > 0.0f))
+            return fail(s, RAYES_ERROR_INVALID_ARGUMENT, "%s: \"from\" and \"to\" coincide", type);
+        if (t == 1) {
+            if (!(lp.coneangle > 0.0f && lp.coneangle <= 180.0f) || lp.conedeltaangle < 0.0f ||
+                lp.beamdistribution < 0.0f)
+                return fail(s, RAYES_ERROR_INVALID_ARGUMENT,
+                            "spotlight: expected coneangle in (0, 180], conedeltaangle >= 0 and "
+                            "beamdistribution >= 0 (degrees)");
+            float rad = (float)(M_PI / 180.0);
+            l.cos_outer = cosf(lp.coneangle * rad);
+            l.cos_inner = cosf(fmaxf(lp.coneangle - lp.conedeltaangle, 0.0f) * rad);
+            l.beam = lp.beamdistribution;
+        }
+        return push_light(s, &l, NULL, 0);
+    case 3:
+        l.type = LIGHT_AMBIENT;
+        return push_light(s, &l, NULL, 0);
+    case 4: {
+        l.type = LIGHT_ENVIRONMENT;
+        Mat4 rot = *m;
+        rot.m[0][3] = rot.m[1][3] = rot.m[2][3] = 0.0f;
+        l.world_from_light = rot;
+        mat4_invert(rot, &l.light_from_world);
+        if (lp.mapname[0]) {
+            char err[400];
+            if (light_env_load(&l, lp.mapname, err, sizeof err) != 0)
+                return fail(s, RAYES_ERROR_IO, "%s", err);
+        }
+        e = push_light(s, &l, NULL, 0);
+        if (e != RAYES_OK)
+            light_fini(&l);
+        return e;
+    }
+    default:
+        break;
+    }
+    /* arealight */
+    if (strcmp(lp.shape, "quad") == 0) {
+        if (!(lp.width > 0.0f) || !(lp.height > 0.0f))
+            return fail(s, RAYES_ERROR_INVALID_ARGUMENT, "arealight: expected a positive width and height");
+        float w = 0.5f * lp.width, h = 0.5f * lp.height;
+        const float P[4][3] = {{-w, -h, 0}, {w, -h, 0}, {w, h, 0}, {-w, h, 0}};
+        float L[3] = {l.L.x, l.L.y, l.L.z};
+        e = rayes_scene_area_light(s, P, L);
+        if (e == RAYES_OK)
+            memcpy(s->lights[s->n_lights - 1].category, l.category, sizeof l.category);
+        return e;
+    }
+    if (!(lp.radius > 0.0f))
+        return fail(s, RAYES_ERROR_INVALID_ARGUMENT, "arealight: expected a positive radius");
+    if (strcmp(lp.shape, "sphere") == 0) {
+        l.type = LIGHT_SPHERE;
+        l.from = mat4_point(m, v3(0, 0, 0));
+        l.radius = lp.radius * v3_length(mat4_vector(m, v3(1, 0, 0)));
+        Prim p = {.type = PRIM_SPHERE};
+        Mat4 inv;
+        mat4_invert(*m, &inv);
+        p.sphere.world_from_object = *m;
+        p.sphere.normal_from_object = mat4_transpose(inv);
+        p.sphere.radius = lp.radius;
+        return push_light(s, &l, &p, 1);
+    }
+    if (strcmp(lp.shape, "disk") == 0) {
+        l.type = LIGHT_DISK;
+        l.from = mat4_point(m, v3(0, 0, 0));
+        l.ex = mat4_vector(m, v3(lp.radius, 0, 0));
+        l.ey = mat4_vector(m, v3(0, lp.radius, 0));
+        Vec3 n = v3_cross(l.ex, l.ey);
+        l.area = (float)M_PI * v3_length(n);
+        l.normal = v3_normalize(n);
+        if (!(l.area > 0.0f))
+            return fail(s, RAYES_ERROR_INVALID_ARGUMENT, "arealight: the disk has no area");
+        Prim fan[DISK_FAN];
+        for (int k = 0; k < DISK_FAN; k++) {
+            float a0 = 2.0f * (float)M_PI * (float)k / DISK_FAN;
+            float a1 = 2.0f * (float)M_PI * (float)(k + 1) / DISK_FAN;
+            fan[k] = (Prim){.type = PRIM_TRIANGLE};
+            fan[k].cp[0] = l.from;
+            fan[k].cp[1] = v3_add(l.from, v3_add(v3_scale(l.ex, cosf(a0)), v3_scale(l.ey, sinf(a0))));
+            fan[k].cp[2] = v3_add(l.from, v3_add(v3_scale(l.ex, cosf(a1)), v3_scale(l.ey, sinf(a1))));
+        }
+        return push_light(s, &l, fan, DISK_FAN);
+    }
+    return fail(s, RAYES_ERROR_INVALID_ARGUMENT,
+                "arealight: unknown shape \"%s\"; expected quad, disk or sphere", lp.shape);
+}
+
+/* ------------------------------------------------------- search paths */
+
+/* Kind names of rayes_scene_set_search_path, by SceneSearchPath. */
+static const char *const search_path_kinds[SCENE_SEARCH_PATH_COUNT] = {
+    [SCENE_SEARCH_PATH_SHADER] = "shader",
+    [SCENE_SEARCH_PATH_TEXTURE] = "texture",
+};
+
+#define SEARCH_PATH_MAX 65536 /* characters, after expanding "&" */
+
+const char *scene_search_path(const RayesScene *s, SceneSearchPath kind)
+{
+    return s->search_paths[kind] ? s->search_paths[kind] : "";
+}
+
+/* path with each entry "&" or "@" replaced by prev, empty entries dropped;
+ * NULL when too long or out of memory (*too_long says which). */
+static char *expand_search_path(const char *path, const char *prev, int *too_long)
+{
+    size_t len = 0, cap = strlen(path) + 1;
+    for (const char *p = path; *p; p++)
+        cap += (*p == '&' || *p == '@') ? strlen(prev) : 0;
+    *too_long = cap > SEARCH_PATH_MAX;
+    char *out = *too_long ? NULL : malloc(cap);
+    if (!out)
+        return NULL;
+    out[0] = '\0';
+    for (const char *d = path; *d;) {
+        size_t n = strcspn(d, ":");
+        const char *text = d;
+        size_t tn = n;
+        if (n == 1 && (d[0] == '&' || d[0] == '@')) {
+            text = prev;
+            tn = strlen(prev);
+        }
+        if (tn > 0) {
+            if (len > 0)
+                out[len++] = ':';
+            memcpy(out + len, text, tn);
+            len += tn;
+            out[len] = '\0';
+        }
+        d += n + (d[n] == ':');
+    }
+    return out;
+}
+
+RayesError rayes_scene_set_search_path(RayesScene *s, const char *kind, const char *path)
+{
+    if (!s || !kind || !path)
+        return RAYES_ERROR_INVALID_ARGUMENT;
+    int k = 0;
+    while (k < SCENE_SEARCH_PATH_COUNT && strcmp(search_path_kinds[k], kind) != 0)
+        k++;
+    if (k == SCENE_SEARCH_PATH_COUNT)
+        return fail(s, RAYES_ERROR_INVALID_ARGUMENT,
+                    "search path: unknown kind \"%.64s\"; expected \"shader\" or \"texture\"",
+                    kind);
+    int too_long;
+    char *expanded = expand_search_path(path, scene_search_path(s, (SceneSearchPath)k), &too_long);
+    if (!expanded)
+        return too_long ? fail(s, RAYES_ERROR_INVALID_ARGUMENT,
+                               "search path \"%s\": longer than %d characters", kind,
+                               SEARCH_PATH_MAX)
+                        : fail(s, RAYES_ERROR_OUT_OF_MEMORY, "out of memory");
+    free(s->search_paths[k]);
+    s->search_paths[k] = expanded;
+    return RAYES_OK;
 }

@@ -21,21 +21,20 @@
 #include "shade/shade.h"
 #include "util/vec.h"
 
-/* The kinds of rayes_scene_set_search_path, indexing RayesScene.search_path. */
-typedef enum ScenePathKind {
-    SCENE_PATH_TEXTURE = 0,
-    SCENE_N_PATH_KINDS
-} ScenePathKind;
-
-/* The kind's name in the API ("texture"). */
-const char *scene_path_kind_name(ScenePathKind kind);
-
 typedef struct SceneObject {
     ShaderInstance shader;    /* owned; cls NULL for lights */
     float Cs[3], Os[3];       /* surface colour and opacity */
     int light;                /* light index, or -1 */
     uint32_t ray_mask;        /* RayesRayType bits of the rays that see it */
 } SceneObject;
+
+/* The kinds of rayes_scene_set_search_path, indexing RayesScene.search_paths
+ * (names in scene.c's search_path_kinds). */
+typedef enum SceneSearchPath {
+    SCENE_SEARCH_PATH_SHADER = 0,
+    SCENE_SEARCH_PATH_TEXTURE = 1,
+    SCENE_SEARCH_PATH_COUNT
+} SceneSearchPath;
 
 struct RayesScene {
     atomic_int refs;
@@ -51,15 +50,28 @@ struct RayesScene {
     size_t n_objects, cap_objects;
     Light *lights;
     size_t n_lights, cap_lights;
+    ShaderInstance *displacements; /* displacement shader instances, owned */
+    size_t n_displacements, cap_displacements;
+    uint32_t current_displacement; /* of geometry added next: index + 1, or 0 */
+    float displacement_bound;      /* of geometry added next; 0: unbounded */
     uint64_t timestamp;       /* commits so far */
     int dirty;                /* edited since the last commit */
-    char *search_path[SCENE_N_PATH_KINDS]; /* colon-separated directories, owned, or NULL */
+    char *search_paths[SCENE_SEARCH_PATH_COUNT]; /* colon-separated, "&" expanded; owned; NULL:
+                                                    empty */
 };
 
 /* Dices every primitive of a committed scene for a camera that sees
  * `height` pixels over its vertical field of view. Returns 0, or -1 when
  * out of memory. */
 int scene_prepare(const RayesScene *scene, int height, GridSet *gs);
+
+/* Runs the displacement shaders of the primitives of grids [first_grid,
+ * n_grids) of gs (displace.c); normals come from differences over step
+ * (world units). Returns 0, or -1 when out of memory. */
+int scene_displace(const RayesScene *scene, GridSet *gs, size_t first_grid, float step);
+/* The scene's search path of that kind: colon-separated directories, ""
+ * if never set. Borrowed: valid until the next set_search_path. */
+const char *scene_search_path(const RayesScene *scene, SceneSearchPath kind);
 
 /* The bounds of all primitives' control points (lights included). */
 Bounds3 scene_bounds(const RayesScene *scene);

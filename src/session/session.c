@@ -69,6 +69,8 @@ void rayes_render_options_init(RayesRenderOptions *o, RayesQuality quality)
         o->shadow_rays = o->shadow_rays_deep = 64;
         o->diffuse_rays = 1024;
         o->diffuse_rays_deep = 64;
+        o->hider = RAYES_HIDER_GRID; /* the memo's REYES-style grid shading */
+        o->irradiance = 1;
         break;
     case RAYES_QUALITY_REFERENCE:
         o->shadow_rays = 64;
@@ -104,6 +106,8 @@ static RayesError check_options(RayesScene *scene, const RayesRenderOptions *o)
     else if (!(o->filter_width > 0.0f) || o->filter_width > 16.0f ||
              (o->filter != RAYES_FILTER_BOX && o->filter != RAYES_FILTER_GAUSSIAN))
         what = "options: filter width must be in (0, 16]";
+    else if (o->hider != RAYES_HIDER_RAYTRACE && o->hider != RAYES_HIDER_GRID)
+        what = "options: hider must be RAYES_HIDER_RAYTRACE or RAYES_HIDER_GRID";
     else if (o->tile_size < 1 || o->threads < 0 || o->threads > 1024)
         what = "options: tile size must be positive and threads 0 to 1024";
     else if (!(o->cache_mb >= 0.0) || o->cache_mb > 1e7 || !(o->cache_k > 0.0f) ||
@@ -132,6 +136,7 @@ static RenderSettings settings_from(const RayesRenderOptions *o)
         .filter = o->filter == RAYES_FILTER_GAUSSIAN, .filter_width = o->filter_width,
         .seed = o->seed, .progress = o->progress, .progress_user = o->progress_user,
         .cache_resolution = o->cache_resolution, .cache_k = o->cache_k,
+        .hider = o->hider == RAYES_HIDER_GRID, .irradiance = o->irradiance != 0,
     };
     if (s.threads == 0)
         s.threads = thread_count_cores();
@@ -142,8 +147,8 @@ static RenderSettings settings_from(const RayesRenderOptions *o)
  * RAYES_TEXTURE_PATH's directories. NULL when out of memory. */
 static TextureSystem *render_textures(const RayesScene *scene, double mb, float width)
 {
-    const char *a = scene->search_path[SCENE_PATH_TEXTURE], *b = getenv("RAYES_TEXTURE_PATH");
-    a = a ? a : "";
+    const char *a = scene_search_path(scene, SCENE_SEARCH_PATH_TEXTURE);
+    const char *b = getenv("RAYES_TEXTURE_PATH");
     b = b ? b : "";
     size_t len = strlen(a) + strlen(b) + 2;
     char *path = malloc(len);

@@ -54,6 +54,7 @@ RayesStats *session_stats_new(const RenderSettings *set, const RenderStats *rs, 
     count(s, "rays/shadow", rs->rays_shadow);
     count(s, "rays/diffuse", rs->rays_diffuse);
     count(s, "rays/specular", rs->rays_specular);
+    count(s, "lighting/ambient_points", rs->ambient_lookups);
     count(s, "grids", gs->n_grids);
     count(s, "grid_vertices", gs->n_vertices);
     count(s, "memory/peak_rss_bytes", mem_peak_rss_bytes());
@@ -68,6 +69,13 @@ RayesStats *session_stats_new(const RenderSettings *set, const RenderStats *rs, 
     count(s, "bounces", (uint64_t)set->bounces);
     count(s, "shadow_rays", (uint64_t)set->shadow_rays);
     count(s, "diffuse_rays", (uint64_t)set->diffuse_rays);
+    if (set->irradiance) {
+        count(s, "irradiance/records", rs->irradiance_records);
+        count(s, "irradiance/interpolated", rs->irradiance_interpolated);
+    }
+    if (s->n < MAX_STATS)
+        s->items[s->n++] = (RayesStat){.name = "hider", .kind = RAYES_STAT_STRING,
+                                       .string = set->hider ? "grid" : "raytrace"};
     return s;
 }
 

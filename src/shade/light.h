@@ -1,26 +1,138 @@
 /*
- * shade/light.h — light sources. For now the emissive quad area light of
- * the Cornell box: one-sided, constant radiance, sampled by the renderer's
- * direct-lighting service over its bilinear parameterisation.
+ * shade/light.h — light sources (DESIGN.md "Lights").
+ *
+ * Area lights (one-sided quads, one-sided disks, spheres emitting outward)
+ * and the environment (dome) light have radiance and are sampled by
+ * direction with a solid-angle pdf, so the direct-lighting service can
+ * weigh their samples against BSDF samples (multiple importance sampling);
+ * light_intersect gives the radiance and pdf of a BSDF-sampled direction.
+ * Point, spot and distant lights are deltas: one direction, no pdf. Ambient
+ * lights only add to the ambient service.
+ *
+ * Radiometry (RenderMan's): a point or spot light of intensity I (times
+ * lightcolor) gives irradiance I / d^2 at normal incidence; a distant light
+ * gives I. Area and environment lights emit radiance intensity * lightcolor
+ * (times the map). Every quantity is world space.
+ *
+ * Environment maps are latitude-longitude, +y up: row 0 is straight up, the
+ * last row straight down; the map's centre (u = 1/2) is the direction +z and
+ * u grows toward -x, so a camera looking along +z with +y up sees the map
+ * unmirrored, centred. The light's transform (when it was made) rotates the
+ * map. Lookups take the nearest pixel, the same function the sampler draws.
+ *
+ * Memory: a Light owns its map (light_fini frees it). Thread-safety: every
+ * function but light_env_load and light_fini only reads the light.
  */
 #ifndef RAYES_SHADE_LIGHT_H
 #define RAYES_SHADE_LIGHT_H
 
+#include <stddef.h>
+
 #include "util/vec.h"
 
+typedef enum LightType {
+    LIGHT_QUAD = 0,
+    LIGHT_DISK = 1,
+    LIGHT_SPHERE = 2,
+    LIGHT_POINT = 3,
+    LIGHT_SPOT = 4,
+    LIGHT_DISTANT = 5,
+    LIGHT_AMBIENT = 6,
+    LIGHT_ENVIRONMENT = 7
+} LightType;
+
+#define LIGHT_CATEGORY_MAX 128
+
+/* A latitude-longitude map with its sampling distribution: pixel (x, y)
+ * weighted by its luminance times sin(theta) at its centre, drawn as a row
+ * (marginal cdf) then a column (that row's conditional cdf). */
+typedef struct LightEnvMap {
+    int width, height;
+    float *rgb;         /* width * height * 3, top row first */
+    float *row_cdf;     /* height + 1 */
+    float *col_cdf;     /* height * (width + 1) */
+    float *pixel_pdf;   /* width * height: probability of drawing the pixel */
+} LightEnvMap;
+
 typedef struct Light {
-    Vec3 P[4];   /* corners as a bilinear patch: P00, P10, P01, P11 (world) */
-    Vec3 L;      /* emitted radiance, front side only */
+    LightType type;
+    Vec3 P[4];          /* quad corners as a bilinear patch: P00, P10, P01, P11 */
+    Vec3 L;             /* radiance (area, environment) or intensity * lightcolor */
+    Vec3 from;          /* point, spot position; disk and sphere centre */
+    Vec3 dir;           /* spot axis, distant light's direction of travel (unit) */
+    Vec3 ex, ey;        /* disk: world images of the object x and y radii */
+    Vec3 normal;        /* disk: unit emitting side */
+    float radius;       /* sphere */
+    float area;         /* disk */
+    float cos_outer, cos_inner, beam; /* spot: cone edge, full beam, beamdistribution */
+    Mat4 world_from_light, light_from_world; /* environment: the map's rotation */
+    LightEnvMap *env;   /* environment: NULL for a constant one */
+    char category[LIGHT_CATEGORY_MAX]; /* comma-separated names */
 } Light;
 
+/* A direction from a point toward a light. */
+typedef struct LightSample {
+    Vec3 wi;            /* unit, from the point toward the light */
+    float dist;         /* to the light's surface or position; INFINITY for
+                           distant and environment lights */
+    Vec3 Li;            /* radiance (area, environment) or irradiance at
+                           normal incidence (delta lights) */
+    float pdf;          /* solid-angle pdf; 0 for delta lights */
+} LightSample;
+
 /* Point and unnormalised normal (dPda x dPdb, the emitting side; its length
- * is the area Jacobian) of the light at (a, b) in [0,1]^2. */
+ * is the area Jacobian) of a quad light at (a, b) in [0,1]^2. */
 static inline void light_quad_eval(const Light *l, float a, float b, Vec3 *P, Vec3 *n)
 {
     Vec3 e0 = v3_lerp(l->P[0], l->P[1], a), e1 = v3_lerp(l->P[2], l->P[3], a);
     *P = v3_lerp(e0, e1, b);
     Vec3 da = v3_lerp(v3_sub(l->P[1], l->P[0]), v3_sub(l->P[3], l->P[2]), b);
     *n = v3_cross(da, v3_sub(e1, e0));
+}
+
+/* Nonzero for lights with radiance sampled by area or direction (quad,
+ * disk, sphere, environment): the ones weighed with MIS. */
+static inline int light_is_area(const Light *l)
+{
+    return l->type == LIGHT_QUAD || l->type == LIGHT_DISK || l->type == LIGHT_SPHERE ||
+           l->type == LIGHT_ENVIRONMENT;
+}
+
+/* Nonzero if the light belongs to a selection as shader.h's direct_lighting
+ * says: NULL or "" every light; "name" lights whose category list holds
+ * name; "-name" those whose list does not. */
+int light_category_match(const Light *l, const char *category);
+
+/* Samples the light as seen from o with (a, b) in [0,1)^2. Returns 0 when
+ * the light sends nothing toward o (behind a one-sided emitter, outside a
+ * spot cone, o inside a sphere light), else fills *s. */
+int light_sample(const Light *l, Vec3 o, float a, float b, LightSample *s);
+
+/* The area or environment light along the ray o + t wi (wi unit), ignoring
+ * everything else: returns 1 and fills *s (dist the hit distance, Li the
+ * radiance, pdf what light_sample would give wi) if the ray meets its
+ * emitting side, else 0. */
+int light_intersect(const Light *l, Vec3 o, Vec3 wi, LightSample *s);
+
+/* The environment light's radiance along world direction d (unit). */
+Vec3 light_env_radiance(const Light *l, Vec3 d);
+
+/* Reads a latitude-longitude map (EXR, or PNG decoded to linear) and builds
+ * its distribution. Returns 0, or -1 with a one-line message in err. */
+int light_env_load(Light *l, const char *path, char *err, size_t err_size);
+
+/* Frees what the light owns. */
+void light_fini(Light *l);
+
+/* RenderMan's smoothstep. */
+static inline float light_smoothstep(float lo, float hi, float x)
+{
+    if (x <= lo)
+        return 0.0f;
+    if (x >= hi)
+        return 1.0f;
+    float t = (x - lo) / (hi - lo);
+    return t * t * (3.0f - 2.0f * t);
 }
 
 #endif /* RAYES_SHADE_LIGHT_H */

@@ -1,22 +1,24 @@
 /*
  * shade/shade.c — the class registry, parameter blocks and method dispatch
- * with the fallbacks of DESIGN.md. Thread-safe: the registry is a constant
- * table; instances are read-only after shade_instance_init.
+ * with the fallbacks of DESIGN.md. Thread-safe: the built-in registry is a
+ * constant table (plugins have their own, plugin.c); instances are
+ * read-only after shade_instance_init. Scratch for classes that ask for it
+ * is allocated per method run (simple; a per-thread arena would avoid the
+ * allocation, and must then nest, since lighting traces rays that shade).
  */
 #include "shade/shade.h"
 
-#include <stddef.h>
-#include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "shade/builtin.h"
-#include "util/check.h"
+#include "shade/plugin.h"
 #include "util/log.h"
 
 static const RayesShaderClass *const builtin_classes[] = {
     &shade_class_matte, &shade_class_plastic, &shade_class_mirror, &shade_class_constant,
+    &shade_class_bumpy, &shade_class_fractal,
     &shade_class_paintedplastic,
 };
 
@@ -29,6 +31,13 @@ const RayesShaderClass *shade_find_class(const char *name)
     if (strcmp(name, "shinymetal") == 0)
         return &shade_class_mirror;
     return NULL;
+}
+
+const RayesShaderClass *shade_find_class_on_path(const char *name, const char *search_path,
+                                                 char *err, size_t err_size)
+{
+    const RayesShaderClass *cls = name ? shade_find_class(name) : NULL;
+    return cls ? cls : shade_plugin_find(name, search_path, err, err_size);
 }
 
 static const RayesShaderParamDesc *find_param(const RayesShaderClass *cls, const char *name)
@@ -105,67 +114,82 @@ void shade_ctx_slice(const RayesShadeCtx *ctx, size_t start, size_t count, Rayes
 #undef SLICE
 }
 
-/* Scratch for the class's methods on n points: a stack buffer when it
- * fits (every ray hit, and grids of small scratch), else the heap. */
-#define SHADE_STACK_SCRATCH 8192
-
-typedef struct Scratch {
-    _Alignas(max_align_t) unsigned char stack[SHADE_STACK_SCRATCH];
-    void *heap;
-} Scratch;
-
-static void *scratch_get(Scratch *sc, const RayesShaderClass *cls, size_t n)
+/* Scratch for a call on ctx's points, if the class needs it and the caller
+ * gave none: n_points * scratch_size zeroed bytes, set in *c. Returns the
+ * block to free (NULL if none was made), or sets *failed when out of
+ * memory. */
+static void *scratch_begin(const RayesShaderClass *cls, RayesShadeCtx *c, int *failed)
 {
-    sc->heap = NULL;
-    if (cls->scratch_size == 0 || n == 0)
+    *failed = 0;
+    if (cls->scratch_size == 0 || c->scratch || c->n_points == 0)
         return NULL;
-    RY_CHECK(n <= SIZE_MAX / cls->scratch_size);
-    size_t bytes = n * cls->scratch_size;
-    if (bytes <= sizeof sc->stack) {
-        memset(sc->stack, 0, bytes);
-        return sc->stack;
+    void *block = calloc(c->n_points, cls->scratch_size);
+    if (!block) {
+        *failed = 1;
+        return NULL;
     }
-    sc->heap = calloc(n, cls->scratch_size);
-    RY_CHECK(sc->heap != NULL);
-    return sc->heap;
+    c->scratch = block;
+    return block;
+}
+
+/* Out of memory for scratch: the points come out black and opaque. */
+static void scratch_failed(const RayesShaderClass *cls, const RayesShadeCtx *ctx,
+                           RayesShadeOutputs *out)
+{
+    char key[96];
+    snprintf(key, sizeof key, "noscratch:%s", cls->name);
+    log_warning_once(key, "shader \"%s\": out of memory for its scratch; shading black",
+                     cls->name);
+    memset(out->Ci, 0, ctx->n_points * sizeof *out->Ci);
+    for (size_t i = 0; i < ctx->n_points; i++)
+        out->Oi[i][0] = out->Oi[i][1] = out->Oi[i][2] = 1.0f;
+    if (out->Irradiance)
+        memset(out->Irradiance, 0, ctx->n_points * sizeof *out->Irradiance);
 }
 
 void shade_run_lighting(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
                         const ShaderInstance *inst, RayesShadeOutputs *out)
 {
     const RayesShaderClass *cls = inst->cls;
-    Scratch sc;
     RayesShadeCtx c = *ctx;
-    c.scratch = scratch_get(&sc, cls, ctx->n_points);
+    int failed;
+    void *scratch = scratch_begin(cls, &c, &failed);
+    if (failed) {
+        scratch_failed(cls, ctx, out);
+        return;
+    }
     if (cls->prelighting)
         cls->prelighting(sv, &c, inst->params, out);
     cls->lighting(sv, &c, inst->params, out);
     if (cls->postlighting)
         cls->postlighting(sv, &c, inst->params, out);
-    free(sc.heap);
+    free(scratch);
 }
 
 void shade_run_diffuselighting(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
                                const ShaderInstance *inst, RayesShadeOutputs *out)
 {
     const RayesShaderClass *cls = inst->cls;
-    Scratch sc;
     RayesShadeCtx c = *ctx;
     c.I = NULL; /* view independence: diffuselighting never sees I */
-    c.scratch = scratch_get(&sc, cls, ctx->n_points);
+    int failed;
+    void *scratch = scratch_begin(cls, &c, &failed);
+    if (failed) {
+        scratch_failed(cls, ctx, out);
+        return;
+    }
     if (cls->prelighting)
         cls->prelighting(sv, &c, inst->params, out);
     if (cls->diffuselighting) {
         cls->diffuselighting(sv, &c, inst->params, out);
-        free(sc.heap);
-        return;
+    } else {
+        char key[96];
+        snprintf(key, sizeof key, "nodiffuselighting:%s", cls->name);
+        log_warning_once(key,
+                         "shader \"%s\" has no diffuselighting method; using the diffuse part "
+                         "of its lighting method",
+                         cls->name);
+        cls->lighting(sv, &c, inst->params, out);
     }
-    char key[96];
-    snprintf(key, sizeof key, "nodiffuselighting:%s", cls->name);
-    log_warning_once(key,
-                     "shader \"%s\" has no diffuselighting method; using the diffuse part of "
-                     "its lighting method",
-                     cls->name);
-    cls->lighting(sv, &c, inst->params, out);
-    free(sc.heap);
+    free(scratch);
 }

@@ -21,6 +21,13 @@ typedef struct ShaderInstance {
 /* The built-in class of that name, or NULL. */
 const RayesShaderClass *shade_find_class(const char *name);
 
+/* The built-in class of that name, else the plugin name.so from the
+ * colon-separated directories of search_path (plugin.h). Returns the class,
+ * or NULL with err filled (one line: the plugin's load error, or the
+ * unknown name and the directories searched). */
+const RayesShaderClass *shade_find_class_on_path(const char *name, const char *search_path,
+                                                 char *err, size_t err_size);
+
 /* Makes an instance: defaults, then params by name. Unknown names and type
  * mismatches get a warning naming the shader and the parameter (once per
  * class and name). Returns 0, or -1 (out of memory, err filled). */
@@ -35,9 +42,9 @@ void shade_run_diffuselighting(const RayesShaderServices *sv, const RayesShadeCt
                                const ShaderInstance *inst, RayesShadeOutputs *out);
 
 /* Runs prelighting (if any) and lighting, then postlighting (if any).
- * Both runners give the methods ctx->scratch: n_points * scratch_size
- * zeroed bytes (on the stack up to 8 kB, else the heap), shared by the
- * methods of the one call. */
+ * Both run functions give the methods scratch (the class's scratch_size
+ * bytes per point, zeroed) when the class asks for some and ctx->scratch
+ * is NULL. */
 void shade_run_lighting(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
                         const ShaderInstance *inst, RayesShadeOutputs *out);
 

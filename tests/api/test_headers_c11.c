@@ -67,6 +67,7 @@ int main(void)
     EXPECT(scene != NULL);
     RayesParam kd = {"Kd", RAYES_PARAM_FLOAT, {0.5f, 0.0f, 0.0f}, NULL};
     EXPECT(rayes_scene_set_shader(scene, "matte", &kd, 1) == RAYES_OK);
+    EXPECT(rayes_scene_set_search_path(scene, "shader", "/nonexistent:&") == RAYES_OK);
     EXPECT(rayes_scene_sphere(scene, 1.0f) == RAYES_OK);
     EXPECT(rayes_scene_commit(scene) == RAYES_OK);
     EXPECT(rayes_scene_get_timestamp(scene) == 1u);

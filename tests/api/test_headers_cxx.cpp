@@ -72,6 +72,7 @@ int main()
     EXPECT(scene != nullptr);
     RayesParam kd = {"Kd", RAYES_PARAM_FLOAT, {0.5f, 0.0f, 0.0f}, nullptr};
     EXPECT(rayes_scene_set_shader(scene, "matte", &kd, 1) == RAYES_OK);
+    EXPECT(rayes_scene_set_search_path(scene, "shader", "/nonexistent:&") == RAYES_OK);
     const float P4[4][3] = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {1, 1, 0}};
     EXPECT(rayes_scene_bilinear_patch(scene, P4) == RAYES_OK);
     EXPECT(rayes_scene_commit(scene) == RAYES_OK);

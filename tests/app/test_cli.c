@@ -3,7 +3,8 @@
  * child process: exit status 0 on success, 1 for bad input or a failed
  * write, 2 for usage errors; every error is exactly one line on stderr
  * naming what is wrong; a tiny render writes its PNG, EXR and statistics;
- * a failed write leaves nothing at the target; --quiet prints nothing.
+ * a failed write leaves nothing at the target; --quiet prints nothing;
+ * --shader-path and RAYES_SHADER_PATH find the example plugin brick.
  *
  * Each run gets its stdout and stderr in files under
  * RAYES_TEST_TMP/app_cli (our own directory: other tests share
@@ -273,6 +274,39 @@ static void test_unwritable_output(void)
     CHECK(!exists(SCRATCH_DIR "/missing-dir"));
 }
 
+/* cornell-brick needs the plugin brick.so: missing, it is a one-line error
+ * (status 1) naming the shader and --shader-path; with --shader-path (or
+ * RAYES_SHADER_PATH) the render succeeds. */
+static void test_shader_path(void)
+{
+    static Run r;
+    setup();
+    unsetenv("RAYES_SHADER_PATH");
+    remove(SCRATCH_DIR "/brick.png");
+    expect_error(1, NULL, ARGS("render", "cornell-brick", "--res", "8", "--spp", "1", "--quiet"),
+                 ARGS("unknown shader \"brick\"", "--shader-path"));
+    expect_error(1, NULL,
+                 ARGS("render", "cornell-brick", "--res", "8", "--quiet", "--shader-path",
+                      SCRATCH_DIR "/no-such-dir"),
+                 ARGS(SCRATCH_DIR "/no-such-dir"));
+    expect_error(2, NULL, ARGS("render", "--shader-path"), ARGS("--shader-path"));
+    CHECK(!exists(SCRATCH_DIR "/cornell-brick.exr"));
+    run(&r, NULL,
+        ARGS("render", "cornell-brick", "--res", "16", "--spp", "1", "--quiet", "--shader-path",
+             "/nonexistent:" RAYES_TEST_SHADERS, "-o", SCRATCH_DIR "/brick.png"));
+    CHECK(r.status == 0 && r.err[0] == '\0');
+    if (r.status != 0)
+        fprintf(stderr, "  stderr: %s", r.err);
+    CHECK(file_size(SCRATCH_DIR "/brick.png") > 8);
+    remove(SCRATCH_DIR "/brick.png");
+    setenv("RAYES_SHADER_PATH", RAYES_TEST_SHADERS, 1);
+    run(&r, NULL,
+        ARGS("render", "cornell-brick", "--res", "16", "--spp", "1", "--quiet", "-o",
+             SCRATCH_DIR "/brick.png"));
+    unsetenv("RAYES_SHADER_PATH");
+    CHECK(r.status == 0 && file_size(SCRATCH_DIR "/brick.png") > 8);
+}
+
 TEST_MAIN(TEST(test_version_and_help), TEST(test_no_arguments), TEST(test_usage_errors),
           TEST(test_missing_data), TEST(test_render_outputs), TEST(test_render_summary),
-          TEST(test_data_from_environment), TEST(test_unwritable_output))
+          TEST(test_data_from_environment), TEST(test_unwritable_output), TEST(test_shader_path))

@@ -69,6 +69,18 @@ static void test_teapots_any_thread_count(void)
     check_threads("cornell-teapots", RAYES_FILTER_BOX, 1);
 }
 
+/* Displacement runs at dicing, on every thread count the same; and it does
+ * change the picture (the matte teapot, right of centre). */
+static void test_displaced_teapots(void)
+{
+    check_threads("cornell-teapots-displaced", RAYES_FILTER_BOX, 1);
+    RayesImage *plain = render("cornell-teapots", 2, 16, RAYES_FILTER_BOX, 0, 1);
+    RayesImage *bumpy = render("cornell-teapots-displaced", 2, 16, RAYES_FILTER_BOX, 0, 1);
+    CHECK(plain && bumpy && !same(plain, bumpy));
+    rayes_image_free(plain);
+    rayes_image_free(bumpy);
+}
+
 static void test_seed_changes_image(void)
 {
     RayesImage *a = render("cornell", 2, 16, RAYES_FILTER_BOX, 0, 1);
@@ -79,4 +91,5 @@ static void test_seed_changes_image(void)
 }
 
 TEST_MAIN(TEST(test_box_filter_any_thread_count), TEST(test_gaussian_filter_any_thread_count),
-          TEST(test_teapots_any_thread_count), TEST(test_seed_changes_image))
+          TEST(test_teapots_any_thread_count), TEST(test_displaced_teapots),
+          TEST(test_seed_changes_image))

@@ -178,7 +178,7 @@ static void test_search_path_kinds(void)
 {
     RayesScene *s = rayes_scene_new();
     CHECK(rayes_scene_set_search_path(s, "texture", "a:b") == RAYES_OK);
-    CHECK(rayes_scene_set_search_path(s, "texture", NULL) == RAYES_OK);
+    CHECK(rayes_scene_set_search_path(s, "texture", "c:&") == RAYES_OK);
     CHECK(rayes_scene_set_search_path(s, "nonsense", "a") == RAYES_ERROR_INVALID_ARGUMENT);
     CHECK(strstr(rayes_scene_get_error(s), "nonsense") != NULL);
     CHECK(rayes_scene_set_search_path(s, NULL, "a") == RAYES_ERROR_INVALID_ARGUMENT);

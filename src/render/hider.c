@@ -1,0 +1,175 @@
+/*
+ * render/hider.c — the grid hider (hider.h).
+ *
+ * Each vertex is shaded on the side that faces the eye, with I from the eye
+ * to the vertex, the ray differential of a camera ray reaching it (width =
+ * pixel angle times distance), and the grid's parameter spacing as du, dv.
+ * Grids are shaded at most once: a pointer per grid, published with
+ * release semantics after its values are written; a striped lock makes the
+ * threads that want the same grid wait for the one shading it.
+ */
+#include "render/hider.h"
+
+#include <pthread.h>
+#include <stdatomic.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "render/irrgrid.h"
+#include "util/check.h"
+#include "util/rng.h"
+
+enum { STRIPES = 256 };
+
+typedef float Rgb[3];
+
+struct GridShading {
+    const RenderScene *rs;
+    _Atomic(Rgb *) *ci;          /* per grid: its vertices' radiance, NULL until shaded */
+    pthread_mutex_t locks[STRIPES];
+};
+
+GridShading *hider_new(const RenderScene *rs)
+{
+    GridShading *gsh = calloc(1, sizeof *gsh);
+    if (!gsh)
+        return NULL;
+    gsh->rs = rs;
+    gsh->ci = calloc(rs->gs->n_grids ? rs->gs->n_grids : 1, sizeof *gsh->ci);
+    if (!gsh->ci) {
+        free(gsh);
+        return NULL;
+    }
+    for (size_t i = 0; i < rs->gs->n_grids; i++)
+        atomic_init(&gsh->ci[i], NULL);
+    for (int i = 0; i < STRIPES; i++)
+        pthread_mutex_init(&gsh->locks[i], NULL);
+    return gsh;
+}
+
+void hider_free(GridShading *gsh)
+{
+    if (!gsh)
+        return;
+    for (size_t i = 0; i < gsh->rs->gs->n_grids; i++)
+        free(atomic_load_explicit(&gsh->ci[i], memory_order_relaxed));
+    for (int i = 0; i < STRIPES; i++)
+        pthread_mutex_destroy(&gsh->locks[i]);
+    free(gsh->ci);
+    free(gsh);
+}
+
+static void put3(float out[3], Vec3 v)
+{
+    out[0] = v.x, out[1] = v.y, out[2] = v.z;
+}
+
+/* Half the parameter spacing of g's vertices in u and v. */
+static void grid_spacing(const Grid *g, float *du, float *dv)
+{
+    if (g->triangular) {
+        *du = *dv = 1.0f / (float)g->nu;
+        return;
+    }
+    *du = (g->uv[1][0] - g->uv[0][0]) / (float)(g->nu - 1);
+    *dv = (g->uv[1][1] - g->uv[0][1]) / (float)(g->nv - 1);
+}
+
+/* Shades every vertex of grid gi with lighting() into a new array. */
+static Rgb *shade_grid(Worker *w, uint32_t gi)
+{
+    const RenderScene *rs = w->rs;
+    const GridSet *gs = rs->gs;
+    const Grid *g = &gs->grids[gi];
+    const RenderObject *obj = &rs->objects[g->object];
+    size_t n = geom_grid_n_vertices(g);
+    float(*f3)[3] = malloc(n * 10 * sizeof *f3);
+    float *f1 = malloc(n * 6 * sizeof *f1);
+    uint64_t *keys = malloc(n * sizeof *keys);
+    RayDiff *diff = malloc(n * sizeof *diff);
+    Rgb *ci = malloc(n * sizeof *ci);
+    RY_CHECK(f3 && f1 && keys && diff && ci);
+    float(*P)[3] = f3, (*N)[3] = f3 + n, (*dPdu)[3] = f3 + 2 * n, (*dPdv)[3] = f3 + 3 * n;
+    float(*I)[3] = f3 + 4 * n, (*Cs)[3] = f3 + 5 * n, (*Os)[3] = f3 + 6 * n;
+    float(*Ci)[3] = f3 + 7 * n, (*Oi)[3] = f3 + 8 * n;
+    float *u = f1, *v = f1 + n, *du = f1 + 2 * n, *dv = f1 + 3 * n, *curv = f1 + 4 * n;
+    float *offset = f1 + 5 * n;
+    float su, sv;
+    grid_spacing(g, &su, &sv);
+    float pixel = 2.0f * rs->camera.tan_half_fov / (float)w->set->height;
+    uint64_t grid_key = hash_combine(hash_combine(w->set->seed, 0x6772696468ull /* "gridh" */), gi);
+    for (size_t k = 0; k < n; k++) {
+        size_t i = g->first_vertex + k;
+        Vec3 to = v3_sub(gs->P[i], rs->camera.eye);
+        float dist = v3_length(to);
+        Vec3 d = dist > 0.0f ? v3_scale(to, 1.0f / dist) : rs->camera.forward;
+        Vec3 Nk = gs->N[i];
+        if (v3_dot(Nk, d) > 0.0f) /* the side the eye sees */
+            Nk = v3_neg(Nk);
+        put3(P[k], gs->P[i]);
+        put3(N[k], Nk);
+        put3(dPdu[k], gs->dPdu[i]);
+        put3(dPdv[k], gs->dPdv[i]);
+        put3(I[k], d);
+        memcpy(Cs[k], obj->Cs, sizeof Cs[k]);
+        memcpy(Os[k], obj->Os, sizeof Os[k]);
+        u[k] = gs->uv[i][0];
+        v[k] = gs->uv[i][1];
+        du[k] = su;
+        dv[k] = sv;
+        curv[k] = g->curvature;
+        offset[k] = integrator_ray_offset(w, g);
+        keys[k] = hash_combine(grid_key, k);
+        diff[k] = (RayDiff){pixel * dist, pixel};
+    }
+    IrrGrid irr = {.grid = g, .P = (const float(*)[3])P, .N = (const float(*)[3])N};
+    float(*irr_E)[3] = NULL;
+    if (w->set->irradiance) {
+        irr_E = malloc(n * sizeof *irr_E);
+        RY_CHECK(irr_E != NULL);
+        irr.E = irr_E;
+    }
+    PathState ps = {w, keys, diff, curv, offset, w->set->irradiance ? &irr : NULL};
+    RayesShadeCtx ctx = {
+        .n_points = n, .ray_type = RAYES_RAY_CAMERA, .diffuse_depth = 0, .specular_depth = 0,
+        .P = (const float(*)[3])P, .N = (const float(*)[3])N, .Ng = (const float(*)[3])N,
+        .dPdu = (const float(*)[3])dPdu, .dPdv = (const float(*)[3])dPdv, .u = u, .v = v,
+        .s = u, .t = v, .du = du, .dv = dv, .I = (const float(*)[3])I,
+        .Cs = (const float(*)[3])Cs, .Os = (const float(*)[3])Os, .renderer = &ps,
+    };
+    RayesShadeOutputs out = {.Ci = Ci, .Oi = Oi};
+    w->stats.shading_points[0] += n;
+    shade_run_lighting(&render_services, &ctx, obj->shader, &out);
+    memcpy(ci, Ci, n * sizeof *ci);
+    free(irr_E);
+    free(f3);
+    free(f1);
+    free(keys);
+    free(diff);
+    return ci;
+}
+
+Vec3 hider_camera_hit(Worker *w, const Ray *ray, const Hit *hit)
+{
+    (void)ray;
+    GridShading *gsh = w->grid_shading;
+    uint32_t gi = hit->grid;
+    Rgb *ci = atomic_load_explicit(&gsh->ci[gi], memory_order_acquire);
+    if (!ci) {
+        pthread_mutex_t *lock = &gsh->locks[gi % STRIPES];
+        pthread_mutex_lock(lock);
+        ci = atomic_load_explicit(&gsh->ci[gi], memory_order_acquire);
+        if (!ci) {
+            ci = shade_grid(w, gi);
+            atomic_store_explicit(&gsh->ci[gi], ci, memory_order_release);
+        }
+        pthread_mutex_unlock(lock);
+    }
+    uint32_t first = w->rs->gs->grids[gi].first_vertex;
+    Vec3 L = v3(0, 0, 0);
+    for (int k = 0; k < hit->n_vertex; k++) {
+        const float *c = ci[hit->vertex[k] - first];
+        L = v3_madd(L, v3(c[0], c[1], c[2]), hit->weight[k]);
+    }
+    return L;
+}

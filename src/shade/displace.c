@@ -1,0 +1,168 @@
+/*
+ * shade/displace.c — the built-in displacement shaders and the services
+ * table displacement runs with at dicing time.
+ *
+ *   bumpy    P += N * Km * noise(P * frequency), or Km * the texture's first
+ *            channel at (s, t) when texturename is given (RenderMan's bumpy
+ *            displaces by a texture map; without one, by noise)
+ *   fractal  the memo's procedural displacement: P += N * amplitude *
+ *            fbm(P * frequency, octaves, lacunarity, gain), octaves at the
+ *            digest's frequency ratio 1.99 by default
+ *
+ * Both are surfaces too (matte-like lighting from the Kd parameter is not
+ * theirs to give): they are meant for rayes_scene_set_displacement, whose
+ * instance only ever runs the displacement method, so lighting is the
+ * constant black of a class that is never shaded.
+ */
+#include <stddef.h>
+#include <string.h>
+
+#include "shade/builtin.h"
+#include "shade/noise.h"
+#include "shade/shade.h"
+
+typedef struct BumpyParams {
+    float Km, frequency;
+    char texturename[64];
+} BumpyParams;
+
+typedef struct FractalParams {
+    float amplitude, frequency, octaves, lacunarity, gain;
+} FractalParams;
+
+/* Moves out->P[i] along N[i] by h[i]. */
+static void displace_along_normal(const RayesShadeCtx *ctx, const float *h, RayesShadeOutputs *out)
+{
+    for (size_t i = 0; i < ctx->n_points; i++)
+        for (int c = 0; c < 3; c++)
+            out->P[i][c] = ctx->P[i][c] + h[i] * ctx->N[i][c];
+}
+
+static void bumpy_displacement(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
+                               const void *params, RayesShadeOutputs *out)
+{
+    const BumpyParams *p = params;
+    float h[SHADE_CHUNK], tex[SHADE_CHUNK][3];
+    for (size_t start = 0; start < ctx->n_points; start += SHADE_CHUNK) {
+        size_t n = ctx->n_points - start < SHADE_CHUNK ? ctx->n_points - start : SHADE_CHUNK;
+        RayesShadeCtx sub;
+        shade_ctx_slice(ctx, start, n, &sub);
+        if (p->texturename[0] && sv->texture &&
+            sv->texture(sv, &sub, p->texturename, sub.s, sub.t, NULL, NULL, tex, NULL) == 0) {
+            for (size_t i = 0; i < n; i++)
+                h[i] = p->Km * tex[i][0];
+        } else {
+            for (size_t i = 0; i < n; i++) {
+                const float *P = sub.P[i];
+                float q[3] = {P[0] * p->frequency, P[1] * p->frequency, P[2] * p->frequency};
+                h[i] = p->Km * sv->noise(sv, q);
+            }
+        }
+        RayesShadeOutputs o = *out;
+        o.P = out->P + start;
+        displace_along_normal(&sub, h, &o);
+    }
+}
+
+static void fractal_displacement(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
+                                 const void *params, RayesShadeOutputs *out)
+{
+    const FractalParams *p = params;
+    int octaves = p->octaves < 1.0f ? 1 : p->octaves > 16.0f ? 16 : (int)p->octaves;
+    for (size_t i = 0; i < ctx->n_points; i++) {
+        const float *P = ctx->P[i];
+        float q[3] = {P[0] * p->frequency, P[1] * p->frequency, P[2] * p->frequency};
+        float h = p->amplitude * sv->fbm(sv, q, octaves, p->lacunarity, p->gain);
+        for (int c = 0; c < 3; c++)
+            out->P[i][c] = P[c] + h * ctx->N[i][c];
+    }
+}
+
+/* A displacement-only class is never shaded; its lighting is black. */
+static void unshaded(const RayesShaderServices *sv, const RayesShadeCtx *ctx, const void *params,
+                     RayesShadeOutputs *out)
+{
+    (void)sv, (void)params;
+    memset(out->Ci, 0, ctx->n_points * sizeof *out->Ci);
+    for (size_t i = 0; i < ctx->n_points; i++)
+        out->Oi[i][0] = out->Oi[i][1] = out->Oi[i][2] = 1.0f;
+    if (out->Irradiance)
+        memset(out->Irradiance, 0, ctx->n_points * sizeof *out->Irradiance);
+}
+
+static const RayesShaderParamDesc bumpy_params[] = {
+    {"Km", RAYES_PARAM_FLOAT, offsetof(BumpyParams, Km), {1, 0, 0}},
+    {"frequency", RAYES_PARAM_FLOAT, offsetof(BumpyParams, frequency), {1, 0, 0}},
+    {"texturename", RAYES_PARAM_STRING, offsetof(BumpyParams, texturename), {0, 0, 0}},
+};
+
+const RayesShaderClass shade_class_bumpy = {
+    .abi_version = RAYES_SHADER_ABI_VERSION,
+    .struct_size = sizeof(RayesShaderClass),
+    .name = "bumpy",
+    .params_size = sizeof(BumpyParams),
+    .params = bumpy_params,
+    .n_params = sizeof bumpy_params / sizeof bumpy_params[0],
+    .displacement = bumpy_displacement,
+    .lighting = unshaded,
+    .diffuselighting = unshaded,
+};
+
+static const RayesShaderParamDesc fractal_params[] = {
+    {"amplitude", RAYES_PARAM_FLOAT, offsetof(FractalParams, amplitude), {1, 0, 0}},
+    {"frequency", RAYES_PARAM_FLOAT, offsetof(FractalParams, frequency), {1, 0, 0}},
+    {"octaves", RAYES_PARAM_FLOAT, offsetof(FractalParams, octaves), {4, 0, 0}},
+    {"lacunarity", RAYES_PARAM_FLOAT, offsetof(FractalParams, lacunarity), {NOISE_LACUNARITY, 0, 0}},
+    {"gain", RAYES_PARAM_FLOAT, offsetof(FractalParams, gain), {0.5f, 0, 0}},
+};
+
+const RayesShaderClass shade_class_fractal = {
+    .abi_version = RAYES_SHADER_ABI_VERSION,
+    .struct_size = sizeof(RayesShaderClass),
+    .name = "fractal",
+    .params_size = sizeof(FractalParams),
+    .params = fractal_params,
+    .n_params = sizeof fractal_params / sizeof fractal_params[0],
+    .displacement = fractal_displacement,
+    .lighting = unshaded,
+    .diffuselighting = unshaded,
+};
+
+/* ------------------------------------------ services at dicing time */
+
+static float dice_noise(const RayesShaderServices *sv, const float p[3])
+{
+    (void)sv;
+    return noise3(p[0], p[1], p[2]);
+}
+
+static float dice_fbm(const RayesShaderServices *sv, const float p[3], int octaves,
+                      float lacunarity, float gain)
+{
+    (void)sv;
+    return noise_fbm(p, octaves, lacunarity, gain);
+}
+
+static float dice_turbulence(const RayesShaderServices *sv, const float p[3], int octaves,
+                             float lacunarity, float gain)
+{
+    (void)sv;
+    return noise_turbulence(p, octaves, lacunarity, gain);
+}
+
+static int dice_supports(const RayesShaderServices *sv, const char *service)
+{
+    (void)sv;
+    return strcmp(service, "noise") == 0 || strcmp(service, "fbm") == 0 ||
+           strcmp(service, "turbulence") == 0;
+}
+
+/* Lighting does not exist yet when displacement runs: those members are NULL. */
+const RayesShaderServices shade_dicing_services = {
+    .abi_version = RAYES_SHADER_ABI_VERSION,
+    .struct_size = sizeof(RayesShaderServices),
+    .noise = dice_noise,
+    .fbm = dice_fbm,
+    .turbulence = dice_turbulence,
+    .supports = dice_supports,
+};

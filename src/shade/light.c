@@ -1,0 +1,452 @@
+/*
+ * shade/light.c — sampling, intersecting and looking up lights (light.h).
+ */
+#include "shade/light.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "image/image.h"
+
+static const float PI = 3.14159265358979f;
+
+int light_category_match(const Light *l, const char *category)
+{
+    if (!category || !category[0])
+        return 1;
+    int negate = category[0] == '-';
+    const char *name = category + negate;
+    size_t n = strlen(name);
+    int found = 0;
+    for (const char *c = l->category; *c;) {
+        while (*c == ',' || *c == ' ')
+            c++;
+        const char *end = c;
+        while (*end && *end != ',')
+            end++;
+        const char *last = end;
+        while (last > c && last[-1] == ' ')
+            last--;
+        if ((size_t)(last - c) == n && n > 0 && strncmp(c, name, n) == 0)
+            found = 1;
+        c = end;
+    }
+    return negate ? !found : found;
+}
+
+/* ------------------------------------------------------------ quads */
+
+/* (a, b) of the quad point nearest y, by Gauss-Newton (exact in one step
+ * for a parallelogram). */
+static void quad_invert(const Light *l, Vec3 y, float *a, float *b)
+{
+    float u = 0.5f, v = 0.5f;
+    for (int it = 0; it < 8; it++) {
+        Vec3 e0 = v3_lerp(l->P[0], l->P[1], u), e1 = v3_lerp(l->P[2], l->P[3], u);
+        Vec3 p = v3_lerp(e0, e1, v);
+        Vec3 du = v3_lerp(v3_sub(l->P[1], l->P[0]), v3_sub(l->P[3], l->P[2]), v);
+        Vec3 dv = v3_sub(e1, e0);
+        Vec3 r = v3_sub(y, p);
+        float a11 = v3_dot(du, du), a12 = v3_dot(du, dv), a22 = v3_dot(dv, dv);
+        float b1 = v3_dot(du, r), b2 = v3_dot(dv, r);
+        float det = a11 * a22 - a12 * a12;
+        if (!(fabsf(det) > 0.0f))
+            break;
+        float su = (a22 * b1 - a12 * b2) / det, sv = (a11 * b2 - a12 * b1) / det;
+        u += su;
+        v += sv;
+        if (fabsf(su) + fabsf(sv) < 1e-6f)
+            break;
+    }
+    *a = u;
+    *b = v;
+}
+
+static int ray_triangle(Vec3 o, Vec3 d, Vec3 p0, Vec3 p1, Vec3 p2, float *t)
+{
+    Vec3 e1 = v3_sub(p1, p0), e2 = v3_sub(p2, p0), pv = v3_cross(d, e2);
+    float det = v3_dot(e1, pv);
+    if (fabsf(det) < 1e-20f)
+        return 0;
+    float inv = 1.0f / det;
+    Vec3 tv = v3_sub(o, p0);
+    float u = v3_dot(tv, pv) * inv;
+    if (u < 0.0f || u > 1.0f)
+        return 0;
+    Vec3 qv = v3_cross(tv, e1);
+    float v = v3_dot(d, qv) * inv;
+    if (v < 0.0f || u + v > 1.0f)
+        return 0;
+    *t = v3_dot(e2, qv) * inv;
+    return *t > 0.0f;
+}
+
+/* Solid-angle pdf and radiance of the quad point y (normal ny, |ny| the
+ * Jacobian) seen along wi at distance d. */
+static int area_finish(const Light *l, Vec3 wi, float d, Vec3 ny, LightSample *s)
+{
+    float jac = v3_length(ny);
+    float cos_y = -v3_dot(ny, wi) / (jac > 0.0f ? jac : 1.0f);
+    if (!(cos_y > 0.0f) || !(jac > 0.0f) || !(d > 0.0f))
+        return 0;
+    s->wi = wi;
+    s->dist = d;
+    s->Li = l->L;
+    s->pdf = d * d / (cos_y * jac);
+    return 1;
+}
+
+/* ------------------------------------------------------------ disks */
+
+static void concentric_disk(float a, float b, float *x, float *y)
+{
+    float sa = 2.0f * a - 1.0f, sb = 2.0f * b - 1.0f, r, phi;
+    if (sa == 0.0f && sb == 0.0f) {
+        *x = *y = 0.0f;
+        return;
+    }
+    if (fabsf(sa) > fabsf(sb)) {
+        r = sa;
+        phi = (PI / 4.0f) * (sb / sa);
+    } else {
+        r = sb;
+        phi = PI / 2.0f - (PI / 4.0f) * (sa / sb);
+    }
+    *x = r * cosf(phi);
+    *y = r * sinf(phi);
+}
+
+/* ------------------------------------------------------ environments */
+
+static void env_dir_to_uv(const Light *l, Vec3 d, float *u, float *v)
+{
+    Vec3 ld = v3_normalize(mat4_vector(&l->light_from_world, d));
+    float phi = atan2f(-ld.x, ld.z); /* 0 at +z, growing toward -x */
+    *u = 0.5f + phi / (2.0f * PI);
+    *v = acosf(fminf(fmaxf(ld.y, -1.0f), 1.0f)) / PI;
+}
+
+static Vec3 env_uv_to_dir(const Light *l, float u, float v, float *sin_theta)
+{
+    float phi = (u - 0.5f) * 2.0f * PI, theta = v * PI;
+    float st = sinf(theta);
+    *sin_theta = st;
+    Vec3 ld = v3(-st * sinf(phi), cosf(theta), st * cosf(phi));
+    return v3_normalize(mat4_vector(&l->world_from_light, ld));
+}
+
+static int env_pixel(const LightEnvMap *m, float u, float v, int *x, int *y)
+{
+    *x = (int)floorf(u * (float)m->width);
+    *y = (int)floorf(v * (float)m->height);
+    *x = *x < 0 ? 0 : *x >= m->width ? m->width - 1 : *x;
+    *y = *y < 0 ? 0 : *y >= m->height ? m->height - 1 : *y;
+    return *y * m->width + *x;
+}
+
+Vec3 light_env_radiance(const Light *l, Vec3 d)
+{
+    if (!l->env)
+        return l->L;
+    float u, v;
+    int x, y;
+    env_dir_to_uv(l, d, &u, &v);
+    const float *c = &l->env->rgb[3 * (size_t)env_pixel(l->env, u, v, &x, &y)];
+    return v3_mul(l->L, v3(c[0], c[1], c[2]));
+}
+
+static float env_pdf(const Light *l, Vec3 d)
+{
+    if (!l->env)
+        return 1.0f / (4.0f * PI);
+    float u, v;
+    int x, y;
+    env_dir_to_uv(l, d, &u, &v);
+    float p = l->env->pixel_pdf[env_pixel(l->env, u, v, &x, &y)];
+    float st = sinf(v * PI);
+    if (!(st > 0.0f))
+        return 0.0f;
+    return p * (float)l->env->width * (float)l->env->height / (2.0f * PI * PI * st);
+}
+
+/* Index i with cdf[i] <= x < cdf[i + 1] among n intervals, skipping empty ones. */
+static int cdf_find(const float *cdf, int n, float x)
+{
+    int lo = 0, hi = n - 1;
+    while (lo < hi) {
+        int mid = (lo + hi + 1) / 2;
+        if (cdf[mid] <= x)
+            lo = mid;
+        else
+            hi = mid - 1;
+    }
+    while (lo < n - 1 && cdf[lo + 1] <= cdf[lo])
+        lo++;
+    return lo;
+}
+
+static int env_sample(const Light *l, float a, float b, LightSample *s)
+{
+    const LightEnvMap *m = l->env;
+    float u, v, st;
+    if (!m) {
+        float z = 1.0f - 2.0f * a, r = sqrtf(fmaxf(0.0f, 1.0f - z * z)), phi = 2.0f * PI * b;
+        s->wi = v3(r * cosf(phi), r * sinf(phi), z);
+        s->Li = l->L;
+        s->pdf = 1.0f / (4.0f * PI);
+        s->dist = INFINITY;
+        return 1;
+    }
+    if (!(m->row_cdf[m->height] > 0.0f))
+        return 0;
+    int y = cdf_find(m->row_cdf, m->height, a);
+    float dr = m->row_cdf[y + 1] - m->row_cdf[y];
+    float fy = dr > 0.0f ? (a - m->row_cdf[y]) / dr : 0.5f;
+    const float *cc = &m->col_cdf[(size_t)y * (m->width + 1)];
+    int x = cdf_find(cc, m->width, b);
+    float dc = cc[x + 1] - cc[x];
+    float fx = dc > 0.0f ? (b - cc[x]) / dc : 0.5f;
+    u = ((float)x + fminf(fmaxf(fx, 0.0f), 0.9999f)) / (float)m->width;
+    v = ((float)y + fminf(fmaxf(fy, 0.0f), 0.9999f)) / (float)m->height;
+    s->wi = env_uv_to_dir(l, u, v, &st);
+    float p = m->pixel_pdf[(size_t)y * m->width + x];
+    if (!(st > 0.0f) || !(p > 0.0f))
+        return 0;
+    const float *c = &m->rgb[3 * ((size_t)y * m->width + x)];
+    s->Li = v3_mul(l->L, v3(c[0], c[1], c[2]));
+    s->pdf = p * (float)m->width * (float)m->height / (2.0f * PI * PI * st);
+    s->dist = INFINITY;
+    return 1;
+}
+
+/* ---------------------------------------------------------- sampling */
+
+int light_sample(const Light *l, Vec3 o, float a, float b, LightSample *s)
+{
+    switch (l->type) {
+    case LIGHT_QUAD: {
+        Vec3 y, ny;
+        light_quad_eval(l, a, b, &y, &ny);
+        Vec3 d = v3_sub(y, o);
+        float dist = v3_length(d);
+        return dist > 0.0f && area_finish(l, v3_scale(d, 1.0f / dist), dist, ny, s);
+    }
+    case LIGHT_DISK: {
+        float x, z;
+        concentric_disk(a, b, &x, &z);
+        Vec3 y = v3_add(l->from, v3_add(v3_scale(l->ex, x), v3_scale(l->ey, z)));
+        Vec3 d = v3_sub(y, o);
+        float dist = v3_length(d);
+        return dist > 0.0f &&
+               area_finish(l, v3_scale(d, 1.0f / dist), dist, v3_scale(l->normal, l->area), s);
+    }
+    case LIGHT_SPHERE: {
+        Vec3 dc = v3_sub(l->from, o);
+        float d2 = v3_dot(dc, dc), r2 = l->radius * l->radius;
+        if (d2 <= r2 * 1.00001f)
+            return 0; /* inside: the sphere emits outward only */
+        float dlen = sqrtf(d2), sin2 = r2 / d2;
+        float cos_max = sqrtf(fmaxf(0.0f, 1.0f - sin2));
+        float one_minus = sin2 / (1.0f + cos_max); /* 1 - cos_max without cancellation */
+        float cos_t = 1.0f - a * one_minus;
+        float sin_t = sqrtf(fmaxf(0.0f, 1.0f - cos_t * cos_t)), phi = 2.0f * PI * b;
+        Vec3 w = v3_scale(dc, 1.0f / dlen), t, bt;
+        v3_basis(w, &t, &bt);
+        Vec3 wi = v3_normalize(v3_add(v3_add(v3_scale(t, sin_t * cosf(phi)),
+                                             v3_scale(bt, sin_t * sinf(phi))),
+                                      v3_scale(w, cos_t)));
+        /* The near intersection; a grazing direction touches the sphere. */
+        float proj = v3_dot(dc, wi), h2 = d2 - proj * proj;
+        float dist = proj - sqrtf(fmaxf(0.0f, r2 - h2));
+        s->wi = wi;
+        s->dist = fmaxf(dist, 0.0f);
+        s->Li = l->L;
+        s->pdf = 1.0f / (2.0f * PI * one_minus);
+        return one_minus > 0.0f;
+    }
+    case LIGHT_POINT:
+    case LIGHT_SPOT: {
+        Vec3 d = v3_sub(l->from, o);
+        float d2 = v3_dot(d, d);
+        if (!(d2 > 0.0f))
+            return 0;
+        float dist = sqrtf(d2);
+        s->wi = v3_scale(d, 1.0f / dist);
+        s->dist = dist;
+        s->pdf = 0.0f;
+        float k = 1.0f / d2;
+        if (l->type == LIGHT_SPOT) {
+            float c = -v3_dot(s->wi, l->dir);
+            k *= light_smoothstep(l->cos_outer, l->cos_inner, c) * powf(fmaxf(c, 0.0f), l->beam);
+        }
+        s->Li = v3_scale(l->L, k);
+        return k > 0.0f;
+    }
+    case LIGHT_DISTANT:
+        s->wi = v3_neg(l->dir);
+        s->dist = INFINITY;
+        s->pdf = 0.0f;
+        s->Li = l->L;
+        return 1;
+    case LIGHT_ENVIRONMENT:
+        return env_sample(l, a, b, s);
+    case LIGHT_AMBIENT:
+        return 0;
+    }
+    return 0;
+}
+
+int light_intersect(const Light *l, Vec3 o, Vec3 wi, LightSample *s)
+{
+    switch (l->type) {
+    case LIGHT_QUAD: {
+        float t;
+        if (!ray_triangle(o, wi, l->P[0], l->P[1], l->P[3], &t) &&
+            !ray_triangle(o, wi, l->P[0], l->P[3], l->P[2], &t))
+            return 0;
+        float a, b;
+        Vec3 y = v3_madd(o, wi, t), p, ny;
+        quad_invert(l, y, &a, &b);
+        light_quad_eval(l, a, b, &p, &ny);
+        return area_finish(l, wi, t, ny, s);
+    }
+    case LIGHT_DISK: {
+        float den = v3_dot(wi, l->normal);
+        if (!(den < 0.0f))
+            return 0;
+        float t = v3_dot(v3_sub(l->from, o), l->normal) / den;
+        if (!(t > 0.0f))
+            return 0;
+        Vec3 r = v3_sub(v3_madd(o, wi, t), l->from);
+        /* Coordinates in the (ex, ey) frame: the 2 x 2 Gram system. */
+        float a11 = v3_dot(l->ex, l->ex), a12 = v3_dot(l->ex, l->ey), a22 = v3_dot(l->ey, l->ey);
+        float b1 = v3_dot(l->ex, r), b2 = v3_dot(l->ey, r), det = a11 * a22 - a12 * a12;
+        float x = (a22 * b1 - a12 * b2) / det, y = (a11 * b2 - a12 * b1) / det;
+        if (x * x + y * y > 1.0f)
+            return 0;
+        return area_finish(l, wi, t, v3_scale(l->normal, l->area), s);
+    }
+    case LIGHT_SPHERE: {
+        Vec3 dc = v3_sub(l->from, o);
+        float d2 = v3_dot(dc, dc), r2 = l->radius * l->radius;
+        if (d2 <= r2 * 1.00001f)
+            return 0;
+        float proj = v3_dot(dc, wi), h2 = d2 - proj * proj;
+        if (proj <= 0.0f || h2 > r2)
+            return 0;
+        float sin2 = r2 / d2, cos_max = sqrtf(fmaxf(0.0f, 1.0f - sin2));
+        float one_minus = sin2 / (1.0f + cos_max);
+        if (!(one_minus > 0.0f))
+            return 0; /* too small to be sampled: too small to hit */
+        s->wi = wi;
+        s->dist = proj - sqrtf(fmaxf(0.0f, r2 - h2));
+        s->Li = l->L;
+        s->pdf = 1.0f / (2.0f * PI * one_minus);
+        return 1;
+    }
+    case LIGHT_ENVIRONMENT:
+        s->wi = wi;
+        s->dist = INFINITY;
+        s->Li = light_env_radiance(l, wi);
+        s->pdf = env_pdf(l, wi);
+        return 1;
+    default:
+        return 0;
+    }
+}
+
+/* ------------------------------------------------------- map loading */
+
+int light_env_load(Light *l, const char *path, char *err, size_t err_size)
+{
+    int w = 0, h = 0;
+    float *rgba = NULL;
+    char ierr[300] = "";
+    ImageFormat f = image_format_from_path(path);
+    RayesError e = f == IMAGE_FORMAT_EXR   ? image_read_exr(path, &w, &h, &rgba, ierr, sizeof ierr)
+                   : f == IMAGE_FORMAT_PNG ? image_read_png(path, &w, &h, &rgba, ierr, sizeof ierr)
+                                           : RAYES_ERROR_INVALID_ARGUMENT;
+    if (e != RAYES_OK) {
+        snprintf(err, err_size, "environment light: %s",
+                 ierr[0] ? ierr : "expected a .exr or .png latitude-longitude map");
+        free(rgba);
+        return -1;
+    }
+    LightEnvMap *m = calloc(1, sizeof *m);
+    size_t n = (size_t)w * h;
+    if (m) {
+        m->width = w;
+        m->height = h;
+        m->rgb = malloc(3 * n * sizeof *m->rgb);
+        m->row_cdf = malloc(((size_t)h + 1) * sizeof *m->row_cdf);
+        m->col_cdf = malloc((size_t)h * ((size_t)w + 1) * sizeof *m->col_cdf);
+        m->pixel_pdf = malloc(n * sizeof *m->pixel_pdf);
+    }
+    if (!m || !m->rgb || !m->row_cdf || !m->col_cdf || !m->pixel_pdf) {
+        free(rgba);
+        l->env = m;
+        light_fini(l);
+        snprintf(err, err_size, "environment light: out of memory for %s", path);
+        return -1;
+    }
+    /* Weights in double: a large map sums many small numbers. */
+    double total = 0.0;
+    double *row = calloc((size_t)h, sizeof *row);
+    if (!row) {
+        free(rgba);
+        l->env = m;
+        light_fini(l);
+        snprintf(err, err_size, "environment light: out of memory for %s", path);
+        return -1;
+    }
+    for (int y = 0; y < h; y++) {
+        double st = sin(PI * (y + 0.5) / h), acc = 0.0;
+        float *cc = &m->col_cdf[(size_t)y * (w + 1)];
+        cc[0] = 0.0f;
+        for (int x = 0; x < w; x++) {
+            const float *p = &rgba[4 * ((size_t)y * w + x)];
+            float *c = &m->rgb[3 * ((size_t)y * w + x)];
+            for (int k = 0; k < 3; k++)
+                c[k] = isfinite(p[k]) && p[k] > 0.0f ? p[k] : 0.0f;
+            double lum = 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2];
+            double wgt = lum * st;
+            m->pixel_pdf[(size_t)y * w + x] = (float)wgt;
+            acc += wgt;
+            cc[x + 1] = (float)acc;
+        }
+        for (int x = 0; x <= w; x++)
+            cc[x] = acc > 0.0 ? (float)(cc[x] / acc) : (float)x / (float)w;
+        cc[w] = 1.0f;
+        row[y] = acc;
+        total += acc;
+    }
+    double acc = 0.0;
+    m->row_cdf[0] = 0.0f;
+    for (int y = 0; y < h; y++) {
+        acc += row[y];
+        m->row_cdf[y + 1] = total > 0.0 ? (float)(acc / total) : 0.0f;
+    }
+    if (total > 0.0)
+        m->row_cdf[h] = 1.0f;
+    for (size_t i = 0; i < n; i++)
+        m->pixel_pdf[i] = total > 0.0 ? (float)(m->pixel_pdf[i] / total) : 0.0f;
+    free(row);
+    free(rgba);
+    light_fini(l);
+    l->env = m;
+    return 0;
+}
+
+void light_fini(Light *l)
+{
+    if (!l->env)
+        return;
+    free(l->env->rgb);
+    free(l->env->row_cdf);
+    free(l->env->col_cdf);
+    free(l->env->pixel_pdf);
+    free(l->env);
+    l->env = NULL;
+}

@@ -1,0 +1,131 @@
+/*
+ * The grid hider (render/hider.c): it agrees with the ray-tracing hider on
+ * a diffuse scene (image and 16 x 16 tile means, within noise), gives the
+ * same bytes for any thread count, and shades each visible grid vertex
+ * once: depth-0 shading points do not grow with pixel samples.
+ */
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "io/builtin.h"
+#include "rayes/rayes.h"
+#include "test.h"
+
+static RayesImage *render_irr(RayesHider hider, int irradiance, int threads, int spp, int rays,
+                              uint64_t *depth0, uint64_t *records)
+{
+    RayesScene *s = rayes_scene_new();
+    char err[512];
+    CHECK(io_builtin_scene("cornell", NULL, s, err, sizeof err) == RAYES_OK);
+    RayesRenderOptions o;
+    rayes_render_options_init(&o, RAYES_QUALITY_PREVIEW);
+    o.width = o.height = 64;
+    o.spp = spp;
+    o.threads = threads;
+    o.shadow_rays = o.shadow_rays_deep = rays;
+    o.diffuse_rays = rays;
+    o.hider = hider;
+    o.irradiance = irradiance;
+    RayesImage *img = NULL;
+    RayesStats *st = NULL;
+    CHECK(rayes_render(s, &o, &img, &st) == RAYES_OK);
+    const RayesStat *sp = rayes_stats_find(st, "shading_points/by_depth");
+    CHECK(sp && sp->n_counts > 0);
+    if (depth0)
+        *depth0 = sp && sp->n_counts ? sp->counts[0] : 0;
+    const RayesStat *rec = rayes_stats_find(st, "irradiance/records");
+    CHECK((rec != NULL) == (irradiance != 0));
+    if (records)
+        *records = rec ? rec->count : 0;
+    rayes_stats_free(st);
+    rayes_scene_release(s);
+    return img;
+}
+
+static RayesImage *render(RayesHider hider, int threads, int spp, int rays, uint64_t *depth0)
+{
+    return render_irr(hider, 0, threads, spp, rays, depth0, NULL);
+}
+
+static double tile_mean(const RayesImage *img, int x0, int y0, int size)
+{
+    double sum = 0.0;
+    for (int y = y0; y < y0 + size; y++)
+        for (int x = x0; x < x0 + size; x++)
+            for (int c = 0; c < 3; c++)
+                sum += img->rgba[4 * ((size_t)y * img->width + x) + c];
+    return sum / (3.0 * size * size);
+}
+
+/* Image means within 1%, 16 x 16 tile means within tile_tol. */
+static void check_agree(const RayesImage *a, const RayesImage *b, double tile_tol)
+{
+    CHECK(a && b);
+    if (!a || !b)
+        return;
+    double ma = tile_mean(a, 0, 0, 64), mb = tile_mean(b, 0, 0, 64);
+    CHECK(fabs(mb - ma) < 0.01 * ma);
+    double worst = 0.0;
+    for (int y = 0; y < 64; y += 16)
+        for (int x = 0; x < 64; x += 16) {
+            double ta = tile_mean(a, x, y, 16), tb = tile_mean(b, x, y, 16);
+            if (ta > 0.02 * ma)
+                worst = fmax(worst, fabs(tb - ta) / ta);
+        }
+    CHECK(worst < tile_tol);
+    if (worst >= tile_tol || fabs(mb - ma) >= 0.01 * ma)
+        fprintf(stderr, "  means %g %g, worst tile %.3f\n", ma, mb, worst);
+}
+
+static void test_agrees_with_raytrace(void)
+{
+    RayesImage *a = render(RAYES_HIDER_RAYTRACE, 2, 16, 16, NULL);
+    RayesImage *b = render(RAYES_HIDER_GRID, 2, 16, 16, NULL);
+    check_agree(a, b, 0.05);
+    rayes_image_free(a);
+    rayes_image_free(b);
+}
+
+/* Irradiance interpolation with gradients: records at a fraction of the
+ * vertices, the same picture within noise, the same bytes for any thread
+ * count. */
+static void test_irradiance_interpolation(void)
+{
+    uint64_t d_off, d_on, records;
+    RayesImage *a = render_irr(RAYES_HIDER_GRID, 0, 2, 1, 256, &d_off, NULL);
+    RayesImage *b = render_irr(RAYES_HIDER_GRID, 1, 2, 1, 256, &d_on, &records);
+    RayesImage *c = render_irr(RAYES_HIDER_GRID, 1, 1, 1, 256, NULL, NULL);
+    check_agree(a, b, 0.03);
+    CHECK(d_on == d_off);
+    CHECK(records > 0 && records < d_on * 3 / 4);
+    CHECK(b && c && memcmp(b->rgba, c->rgba, sizeof(float) * 4 * 64 * 64) == 0);
+    rayes_image_free(a);
+    rayes_image_free(b);
+    rayes_image_free(c);
+}
+
+static void test_any_thread_count(void)
+{
+    RayesImage *a = render(RAYES_HIDER_GRID, 1, 2, 4, NULL);
+    RayesImage *b = render(RAYES_HIDER_GRID, 3, 2, 4, NULL);
+    CHECK(a && b && memcmp(a->rgba, b->rgba, sizeof(float) * 4 * 64 * 64) == 0);
+    rayes_image_free(a);
+    rayes_image_free(b);
+}
+
+static void test_shading_follows_vertices(void)
+{
+    uint64_t grid1, grid16, ray1, ray16;
+    rayes_image_free(render(RAYES_HIDER_GRID, 2, 1, 1, &grid1));
+    rayes_image_free(render(RAYES_HIDER_GRID, 2, 16, 1, &grid16));
+    rayes_image_free(render(RAYES_HIDER_RAYTRACE, 2, 1, 1, &ray1));
+    rayes_image_free(render(RAYES_HIDER_RAYTRACE, 2, 16, 1, &ray16));
+    CHECK(ray16 > 15 * ray1 && ray16 < 17 * ray1); /* one shading point per camera hit */
+    CHECK(grid16 < grid1 + grid1 / 10);   /* a few more grids hit, no more per grid */
+    CHECK(grid16 < ray16 / 4);
+}
+
+TEST_MAIN(TEST(test_agrees_with_raytrace), TEST(test_irradiance_interpolation),
+          TEST(test_any_thread_count),
+          TEST(test_shading_follows_vertices))

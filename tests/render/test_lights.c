@@ -1,0 +1,574 @@
+/*
+ * Lights (shade/light.c, the direct-lighting and ambient services of
+ * render/integrator.c, rayes_scene_light): analytic irradiance of point,
+ * spot, distant, ambient, disk and sphere lights; multiple importance
+ * sampling against brute-force estimates of a glossy lobe under small and
+ * large quads; a constant-environment white furnace; an importance-sampled
+ * latitude-longitude map against a uniform-sphere estimate; categories;
+ * emitters seen by the camera; determinism with every light type; errors.
+ *
+ * The services are called directly on one shading point, on a scene
+ * prepared the way a render prepares it.
+ */
+#include <stdlib.h>
+#include <string.h>
+
+#include "accel/accel.h"
+#include "image/image.h"
+#include "rayes/rayes.h"
+#include "rayes/shader.h"
+#include "render/integrator.h"
+#include "scene/scene.h"
+#include "shade/light.h"
+#include "test.h"
+#include "util/rng.h"
+
+static const double PI = 3.14159265358979;
+
+/* ------------------------------------------------------------ fixture */
+
+typedef struct Fx {
+    RayesScene *s;
+    GridSet gs;
+    Accel *accel;
+    uint32_t *masks;
+    RenderObject *objs;
+    RenderScene rs;
+    RenderSettings set;
+    Worker w;
+} Fx;
+
+static void fx_init(Fx *f, RayesScene *s)
+{
+    memset(f, 0, sizeof *f);
+    f->s = s;
+    CHECK(rayes_scene_commit(s) == RAYES_OK);
+    geom_gridset_init(&f->gs);
+    CHECK(scene_prepare(s, 64, &f->gs) == 0);
+    f->masks = calloc(s->n_objects + 1, sizeof *f->masks);
+    f->objs = calloc(s->n_objects + 1, sizeof *f->objs);
+    for (size_t i = 0; i < s->n_objects; i++) {
+        f->masks[i] = s->objects[i].ray_mask;
+        f->objs[i].light = s->objects[i].light;
+        f->objs[i].shader = s->objects[i].shader.cls ? &s->objects[i].shader : NULL;
+    }
+    char err[300];
+    f->accel = accel_new(&f->gs, f->masks, s->n_objects, err, sizeof err);
+    CHECK(f->accel != NULL);
+    f->rs = (RenderScene){.gs = &f->gs, .accel = f->accel, .objects = f->objs,
+                          .n_objects = s->n_objects, .lights = s->lights,
+                          .n_lights = s->n_lights, .scene_radius = 10.0f};
+    f->set = (RenderSettings){.width = 64, .height = 64, .spp = 1, .threads = 1,
+                              .tile_size = 16, .shadow_rays = 16, .shadow_rays_deep = 16};
+    f->w = (Worker){.rs = &f->rs, .set = &f->set};
+}
+
+static void fx_fini(Fx *f)
+{
+    accel_free(f->accel);
+    geom_gridset_fini(&f->gs);
+    free(f->masks);
+    free(f->objs);
+    rayes_scene_release(f->s);
+}
+
+/* The direct-lighting service at P with normal N (viewed along I if not
+ * NULL), n samples, averaged over `keys` sample keys. */
+static void fx_direct(Fx *f, Vec3 P, Vec3 N, const Vec3 *I, int n, const char *category,
+                      float roughness, int keys, double d[3], double s[3])
+{
+    float Pa[1][3] = {{P.x, P.y, P.z}}, Na[1][3] = {{N.x, N.y, N.z}};
+    float Ia[1][3] = {{I ? I->x : 0, I ? I->y : 0, I ? I->z : 0}};
+    RayDiff diff[1] = {{0.0f, 0.0f}};
+    float curv[1] = {0.0f}, off[1] = {0.0f}; /* rays leave from P itself */
+    for (int c = 0; c < 3; c++)
+        d[c] = s[c] = 0.0;
+    for (int k = 0; k < keys; k++) {
+        uint64_t key[1] = {hash_combine(1234, (uint64_t)k)};
+        PathState ps = {&f->w, key, diff, curv, off};
+        RayesShadeCtx ctx = {.n_points = 1, .ray_type = RAYES_RAY_CAMERA,
+                             .P = (const float(*)[3])Pa, .N = (const float(*)[3])Na,
+                             .Ng = (const float(*)[3])Na,
+                             .I = I ? (const float(*)[3])Ia : NULL, .renderer = &ps};
+        float dd[1][3], ss[1][3];
+        render_services.direct_lighting(&render_services, &ctx, n, category, &roughness, dd, ss);
+        for (int c = 0; c < 3; c++) {
+            d[c] += dd[0][c] / keys;
+            s[c] += ss[0][c] / keys;
+        }
+    }
+}
+
+/* Irradiance: pi times the diffuse output. */
+static double fx_irradiance(Fx *f, Vec3 P, Vec3 N, int n, const char *category)
+{
+    double d[3], s[3];
+    fx_direct(f, P, N, NULL, n, category, 0.1f, 1, d, s);
+    return PI * d[0];
+}
+
+static RayesParam pf(const char *name, float v)
+{
+    return (RayesParam){name, RAYES_PARAM_FLOAT, {v, 0, 0}, NULL};
+}
+static RayesParam pv(const char *name, float x, float y, float z)
+{
+    return (RayesParam){name, RAYES_PARAM_COLOR, {x, y, z}, NULL};
+}
+static RayesParam ps(const char *name, const char *v)
+{
+    return (RayesParam){name, RAYES_PARAM_STRING, {0, 0, 0}, v};
+}
+
+/* ------------------------------------------------------- delta lights */
+
+static void test_point_light_inverse_square(void)
+{
+    RayesScene *s = rayes_scene_new();
+    RayesParam p[3] = {pv("from", 0, 0, 2), pf("intensity", 4), pv("lightcolor", 1, 0.5f, 0.25f)};
+    CHECK(rayes_scene_light(s, "pointlight", p, 3) == RAYES_OK);
+    Fx f;
+    fx_init(&f, s);
+    double d[3], sp[3];
+    fx_direct(&f, v3(0, 0, 0), v3(0, 0, 1), NULL, 4, NULL, 0.1f, 1, d, sp);
+    CHECK_NEAR(PI * d[0], 1.0, 1e-5); /* 4 / 2^2 */
+    CHECK_NEAR(PI * d[1], 0.5, 1e-5);
+    CHECK_NEAR(PI * d[2], 0.25, 1e-5);
+    /* 60 degrees off the normal: E = I cos / d^2. */
+    CHECK_NEAR(fx_irradiance(&f, v3(0, 0, 0), v3((float)sin(PI / 3), 0, (float)cos(PI / 3)), 4,
+                             NULL),
+               0.5, 1e-5);
+    /* From behind: nothing. */
+    CHECK_NEAR(fx_irradiance(&f, v3(0, 0, 0), v3(0, 0, -1), 4, NULL), 0.0, 0.0);
+    fx_fini(&f);
+}
+
+static void test_spot_light_cone(void)
+{
+    RayesScene *s = rayes_scene_new();
+    RayesParam p[6] = {pv("from", 0, 0, 2),      pv("to", 0, 0, 0),
+                       pf("intensity", 4),       pf("coneangle", 30),
+                       pf("conedeltaangle", 10), pf("beamdistribution", 2)};
+    CHECK(rayes_scene_light(s, "spotlight", p, 6) == RAYES_OK);
+    Fx f;
+    fx_init(&f, s);
+    const double cos30 = cos(30 * PI / 180), cos20 = cos(20 * PI / 180);
+    const double angles[3] = {10, 25, 35}; /* inside, in the falloff band, outside */
+    for (int k = 0; k < 3; k++) {
+        double a = angles[k] * PI / 180, x = 2 * tan(a), d2 = 4 + x * x, c = cos(a);
+        double t = (c - cos30) / (cos20 - cos30);
+        double smooth = c <= cos30 ? 0 : c >= cos20 ? 1 : t * t * (3 - 2 * t);
+        double expected = 4 / d2 * c /* surface cosine */ * smooth * c * c;
+        double got = fx_irradiance(&f, v3((float)x, 0, 0), v3(0, 0, 1), 4, NULL);
+        CHECK_NEAR(got, expected, 1e-5 + 1e-4 * expected);
+        if (k == 1)
+            CHECK(got > 0.05 && smooth < 0.9); /* really in the band */
+        if (k == 2)
+            CHECK(got == 0.0);
+    }
+    fx_fini(&f);
+}
+
+static void test_distant_light(void)
+{
+    RayesScene *s = rayes_scene_new();
+    RayesParam p[3] = {pv("from", 0, 0, 1), pv("to", 0, 0, 0), pf("intensity", 2)};
+    CHECK(rayes_scene_light(s, "distantlight", p, 3) == RAYES_OK);
+    Fx f;
+    fx_init(&f, s);
+    CHECK_NEAR(fx_irradiance(&f, v3(5, 7, -3), v3((float)sin(PI / 3), 0, (float)cos(PI / 3)), 4,
+                             NULL),
+               1.0, 1e-5); /* no 1/d^2 */
+    fx_fini(&f);
+}
+
+static void test_ambient_light(void)
+{
+    RayesScene *s = rayes_scene_new();
+    RayesParam a[2] = {pf("intensity", 0.5f), pv("lightcolor", 1, 0.5f, 0.25f)};
+    RayesParam b[1] = {pf("intensity", 1)};
+    CHECK(rayes_scene_light(s, "ambientlight", a, 2) == RAYES_OK);
+    CHECK(rayes_scene_light(s, "ambientlight", b, 1) == RAYES_OK);
+    Fx f;
+    fx_init(&f, s);
+    float P[1][3] = {{0, 0, 0}}, N[1][3] = {{0, 0, 1}}, out[1][3];
+    PathState st = {&f.w, (uint64_t[]){1}, (RayDiff[]){{0, 0}}, (float[]){0}, (float[]){1e-4f}};
+    RayesShadeCtx ctx = {.n_points = 1, .P = (const float(*)[3])P, .N = (const float(*)[3])N,
+                         .Ng = (const float(*)[3])N, .renderer = &st};
+    render_services.ambient(&render_services, &ctx, out);
+    CHECK_NEAR(out[0][0], 1.5, 1e-6);
+    CHECK_NEAR(out[0][1], 1.25, 1e-6);
+    CHECK_NEAR(out[0][2], 1.125, 1e-6);
+    CHECK(f.w.stats.ambient_lookups == 1);
+    /* Ambient lights are not direct light. */
+    CHECK(fx_irradiance(&f, v3(0, 0, 0), v3(0, 0, 1), 4, NULL) == 0.0);
+    fx_fini(&f);
+}
+
+/* --------------------------------------------------------- area lights */
+
+static void test_disk_light_irradiance(void)
+{
+    RayesScene *s = rayes_scene_new();
+    /* The disk's +z turned to -z, 2 above the origin. */
+    const float flip[16] = {1, 0, 0, 0, 0, -1, 0, 0, 0, 0, -1, 2, 0, 0, 0, 1};
+    CHECK(rayes_scene_set_transform(s, flip) == RAYES_OK);
+    RayesParam p[3] = {ps("shape", "disk"), pf("radius", 1), pf("intensity", 3)};
+    CHECK(rayes_scene_light(s, "arealight", p, 3) == RAYES_OK);
+    Fx f;
+    fx_init(&f, s);
+    /* A disk of radius R at height h on the axis: E = L pi R^2 / (h^2 + R^2). */
+    double E = fx_irradiance(&f, v3(0, 0, 0), v3(0, 0, 1), 64, NULL);
+    CHECK_NEAR(E / (3 * PI / 5), 1.0, 0.01);
+    /* Above the disk: its back, which does not emit. */
+    CHECK(fx_irradiance(&f, v3(0, 0, 4), v3(0, 0, -1), 64, NULL) == 0.0);
+    fx_fini(&f);
+}
+
+static void test_sphere_light_irradiance(void)
+{
+    RayesScene *s = rayes_scene_new();
+    const float move[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 3, 0, 0, 0, 1};
+    CHECK(rayes_scene_set_transform(s, move) == RAYES_OK);
+    RayesParam p[3] = {ps("shape", "sphere"), pf("radius", 1), pf("intensity", 2)};
+    CHECK(rayes_scene_light(s, "arealight", p, 3) == RAYES_OK);
+    Fx f;
+    fx_init(&f, s);
+    /* A sphere wholly above the horizon: E = L pi (R / D)^2. */
+    double E = fx_irradiance(&f, v3(0, 0, 0), v3(0, 0, 1), 64, NULL);
+    CHECK_NEAR(E / (2 * PI / 9), 1.0, 0.01);
+    /* Tilted 45 degrees the sphere (half angle 19.5) still stands above the
+     * horizon: E scales with the cosine. */
+    E = fx_irradiance(&f, v3(0, 0, 0), v3((float)sqrt(0.5), 0, (float)sqrt(0.5)), 64, NULL);
+    CHECK_NEAR(E / (2 * PI / 9 * sqrt(0.5)), 1.0, 0.01);
+    fx_fini(&f);
+}
+
+/* Irradiance from a polygon of constant radiance 1 (Lambert's formula). */
+static double polygon_irradiance(Vec3 o, Vec3 N, const Vec3 *v, int n)
+{
+    double sum = 0.0;
+    for (int i = 0; i < n; i++) {
+        Vec3 a = v3_normalize(v3_sub(v[i], o)), b = v3_normalize(v3_sub(v[(i + 1) % n], o));
+        double angle = acos(fmax(-1.0, fmin(1.0, v3_dot(a, b))));
+        sum += angle * v3_dot(N, v3_normalize(v3_cross(a, b)));
+    }
+    return 0.5 * fabs(sum);
+}
+
+/* Brute force: the specular output's integral by sampling the half vector
+ * about N (no MIS), against the light's quad intersected here. */
+static double brute_glossy(Vec3 N, Vec3 V, float e, Vec3 c, float half, int m)
+{
+    double sum = 0.0;
+    Vec3 t, b;
+    v3_basis(N, &t, &b);
+    for (int k = 0; k < m; k++) {
+        float a1, a2;
+        cmj_sample_2d((uint32_t)k, (uint32_t)m, 77u, &a1, &a2);
+        float ch = powf(a1, 1.0f / (e + 1.0f)), sh = sqrtf(fmaxf(0.0f, 1 - ch * ch));
+        float phi = 2.0f * (float)PI * a2;
+        Vec3 H = v3_add(v3_add(v3_scale(t, sh * cosf(phi)), v3_scale(b, sh * sinf(phi))),
+                        v3_scale(N, ch));
+        float vh = v3_dot(V, H);
+        if (vh <= 0)
+            continue;
+        Vec3 wi = v3_sub(v3_scale(H, 2 * vh), V);
+        if (v3_dot(N, wi) <= 0 || wi.z <= 0)
+            continue;
+        float tt = c.z / wi.z; /* the light lies in z = c.z, facing down */
+        float x = wi.x * tt - c.x, y = wi.y * tt - c.y;
+        if (fabsf(x) > half || fabsf(y) > half)
+            continue;
+        double pdf = (e + 1) / (2 * PI) * pow(ch, e) / (4 * vh);
+        double f = (e + 8) / (8 * PI) * pow(ch, e);
+        sum += f * v3_dot(N, wi) / pdf;
+    }
+    return sum / m;
+}
+
+static void check_glossy_quad(float half, float roughness)
+{
+    RayesScene *s = rayes_scene_new();
+    Vec3 c = v3(0.6f, 0.1f, 1.5f);
+    /* Turn +z to -z, centre at c. */
+    const float m[16] = {1, 0, 0, c.x, 0, -1, 0, c.y, 0, 0, -1, c.z, 0, 0, 0, 1};
+    CHECK(rayes_scene_set_transform(s, m) == RAYES_OK);
+    RayesParam p[4] = {ps("shape", "quad"), pf("width", 2 * half), pf("height", 2 * half),
+                       pf("intensity", 1)};
+    CHECK(rayes_scene_light(s, "arealight", p, 4) == RAYES_OK);
+    Fx f;
+    fx_init(&f, s);
+    Vec3 N = v3(0, 0, 1), V = v3_normalize(v3(-0.5f, -0.1f, 1.0f)), I = v3_neg(V);
+    double d[3], sp[3];
+    fx_direct(&f, v3(0, 0, 0), N, &I, 64, NULL, roughness, 16, d, sp);
+    double ref_s = brute_glossy(N, V, 1.0f / roughness, c, half, 1 << 21);
+    Vec3 quad[4] = {v3(c.x - half, c.y - half, c.z), v3(c.x + half, c.y - half, c.z),
+                    v3(c.x + half, c.y + half, c.z), v3(c.x - half, c.y + half, c.z)};
+    double ref_d = polygon_irradiance(v3(0, 0, 0), N, quad, 4) / PI;
+    CHECK(ref_s > 0.0);
+    CHECK_NEAR(d[0] / ref_d, 1.0, 0.01);
+    CHECK_NEAR(sp[0] / ref_s, 1.0, 0.02);
+    fx_fini(&f);
+}
+
+static void test_mis_glossy_small_quad(void)
+{
+    check_glossy_quad(0.1f, 0.1f);
+    check_glossy_quad(0.1f, 0.02f);
+}
+
+static void test_mis_glossy_large_quad(void)
+{
+    check_glossy_quad(2.0f, 0.1f);
+    check_glossy_quad(2.0f, 0.02f);
+}
+
+/* ------------------------------------------------------- environments */
+
+static RayesImage *render_scene(RayesScene *s, int threads, int size)
+{
+    CHECK(rayes_scene_commit(s) == RAYES_OK);
+    RayesRenderOptions o;
+    rayes_render_options_init(&o, RAYES_QUALITY_PREVIEW);
+    o.width = o.height = size;
+    o.spp = 1;
+    o.threads = threads;
+    o.shadow_rays = o.shadow_rays_deep = 16;
+    RayesImage *img = NULL;
+    CHECK(rayes_render(s, &o, &img, NULL) == RAYES_OK);
+    return img;
+}
+
+static void test_constant_environment_white_furnace(void)
+{
+    RayesScene *s = rayes_scene_new();
+    float eye[3] = {0, 0, -3}, target[3] = {0, 0, 0}, up[3] = {0, 1, 0};
+    CHECK(rayes_scene_set_camera(s, eye, target, up, 45.0f) == RAYES_OK);
+    RayesParam kd = pf("Kd", 1);
+    CHECK(rayes_scene_set_shader(s, "matte", &kd, 1) == RAYES_OK);
+    CHECK(rayes_scene_sphere(s, 1.0f) == RAYES_OK);
+    RayesParam e[1] = {pf("intensity", 0.5f)};
+    CHECK(rayes_scene_light(s, "environmentlight", e, 1) == RAYES_OK);
+    RayesImage *img = render_scene(s, 2, 32);
+    double sum = 0.0;
+    int hits = 0, background_ok = 1;
+    for (int i = 0; img && i < img->width * img->height; i++) {
+        if (img->rgba[4 * i + 3] == 1.0f) {
+            sum += img->rgba[4 * i];
+            hits++;
+        } else if (img->rgba[4 * i] != 0.5f) {
+            background_ok = 0; /* the camera sees the environment */
+        }
+    }
+    CHECK(hits > 100);
+    CHECK(background_ok);
+    /* Every point of a Lambertian of albedo 1 under L reflects L (diffuse
+     * rays that escape are black: the light is counted once). */
+    CHECK_NEAR(sum / hits / 0.5, 1.0, 0.01);
+    rayes_image_free(img);
+    rayes_scene_release(s);
+}
+
+/* A 64 x 32 map, dim everywhere but a small bright patch. */
+static void write_test_map(const char *path)
+{
+    int w = 64, h = 32;
+    float *p = malloc(sizeof(float) * 4 * w * h);
+    for (int i = 0; i < w * h; i++) {
+        int x = i % w, y = i / w;
+        int bright = x >= 40 && x < 43 && y >= 9 && y < 12;
+        p[4 * i + 0] = bright ? 200.0f : 0.02f;
+        p[4 * i + 1] = bright ? 150.0f : 0.03f;
+        p[4 * i + 2] = bright ? 100.0f : 0.05f;
+        p[4 * i + 3] = 1.0f;
+        if (x == 32 && y == 16) /* the map's centre: +z */
+            p[4 * i + 0] = 7.0f;
+        if (y == 0)
+            p[4 * i + 1] = 5.0f; /* the top row: +y */
+    }
+    CHECK(image_write_exr(path, w, h, p, NULL, 0) == RAYES_OK);
+    free(p);
+}
+
+static void test_environment_map_importance_sampling(void)
+{
+    const char *path = RAYES_TEST_TMP "/test_lights_map.exr";
+    write_test_map(path);
+    RayesScene *s = rayes_scene_new();
+    RayesParam e[2] = {ps("mapname", path), pf("intensity", 1)};
+    CHECK(rayes_scene_light(s, "environmentlight", e, 2) == RAYES_OK);
+    Fx f;
+    fx_init(&f, s);
+    const Light *l = &s->lights[0];
+    /* Orientation: the centre pixel is +z, the top row +y. */
+    CHECK(light_env_radiance(l, v3_normalize(v3(-0.03f, -0.05f, 1.0f))).x == 7.0f);
+    CHECK(light_env_radiance(l, v3(0.0f, 1.0f, 0.0f)).y == 5.0f);
+    /* The bright patch is around u = 0.66 (toward -x), v = 0.33 (above the
+     * horizon); aim a normal near it and one away from it. */
+    Vec3 normals[2] = {v3_normalize(v3(-1.0f, 0.6f, -0.4f)), v3_normalize(v3(0.3f, -0.2f, 1.0f))};
+    for (int k = 0; k < 2; k++) {
+        Vec3 N = normals[k];
+        double d[3], sp[3];
+        fx_direct(&f, v3(0, 0, 0), N, NULL, 64, NULL, 0.1f, 4, d, sp);
+        /* Brute force: stratified uniform directions over the sphere. */
+        const int m = 1500;
+        double ref = 0.0;
+        for (int i = 0; i < m; i++)
+            for (int j = 0; j < m; j++) {
+                uint64_t key = hash_combine((uint64_t)i, (uint64_t)j);
+                float z = 1.0f - 2.0f * ((float)i + rng_float(key)) / m;
+                float phi = 2.0f * (float)PI * ((float)j + rng_float(key + 1)) / m;
+                float r = sqrtf(fmaxf(0.0f, 1.0f - z * z));
+                Vec3 wi = v3(r * cosf(phi), r * sinf(phi), z);
+                float c = v3_dot(N, wi);
+                if (c > 0.0f)
+                    ref += light_env_radiance(l, wi).x * c;
+            }
+        ref *= 4.0 * PI / ((double)m * m);
+        CHECK_NEAR(PI * d[0] / ref, 1.0, 0.02);
+    }
+    fx_fini(&f);
+}
+
+/* ----------------------------------------------------------- categories */
+
+static void test_categories(void)
+{
+    RayesScene *s = rayes_scene_new();
+    RayesParam a[3] = {pv("from", 0, 0, 1), pf("intensity", 1), ps("__category", "key, fill")};
+    RayesParam b[3] = {pv("from", 0, 0, 1), pf("intensity", 10), ps("__category", "rim")};
+    RayesParam c[2] = {pv("from", 0, 0, 1), pf("intensity", 100)};
+    CHECK(rayes_scene_light(s, "pointlight", a, 3) == RAYES_OK);
+    CHECK(rayes_scene_light(s, "pointlight", b, 3) == RAYES_OK);
+    CHECK(rayes_scene_light(s, "pointlight", c, 2) == RAYES_OK);
+    Fx f;
+    fx_init(&f, s);
+    Vec3 o = v3(0, 0, 0), N = v3(0, 0, 1);
+    CHECK_NEAR(fx_irradiance(&f, o, N, 1, NULL), 111.0, 1e-3);
+    CHECK_NEAR(fx_irradiance(&f, o, N, 1, ""), 111.0, 1e-3);
+    CHECK_NEAR(fx_irradiance(&f, o, N, 1, "key"), 1.0, 1e-5);
+    CHECK_NEAR(fx_irradiance(&f, o, N, 1, "fill"), 1.0, 1e-5);
+    CHECK_NEAR(fx_irradiance(&f, o, N, 1, "rim"), 10.0, 1e-4);
+    CHECK_NEAR(fx_irradiance(&f, o, N, 1, "-key"), 110.0, 1e-3);
+    CHECK_NEAR(fx_irradiance(&f, o, N, 1, "ke"), 0.0, 0.0);
+    CHECK_NEAR(fx_irradiance(&f, o, N, 1, "none"), 0.0, 0.0);
+    fx_fini(&f);
+}
+
+/* ------------------------------------------- emitters seen by the camera */
+
+static void test_emitters_seen_by_camera(void)
+{
+    for (int shape = 0; shape < 2; shape++) {
+        RayesScene *s = rayes_scene_new();
+        float eye[3] = {0, 0, -4}, target[3] = {0, 0, 0}, up[3] = {0, 1, 0};
+        CHECK(rayes_scene_set_camera(s, eye, target, up, 30.0f) == RAYES_OK);
+        /* The disk faces the camera (-z) */
+        const float flip[16] = {1, 0, 0, 0, 0, -1, 0, 0, 0, 0, -1, 0, 0, 0, 0, 1};
+        if (shape == 0)
+            CHECK(rayes_scene_set_transform(s, flip) == RAYES_OK);
+        RayesParam p[3] = {ps("shape", shape ? "sphere" : "disk"), pf("radius", 0.5f),
+                           pv("lightcolor", 3, 2, 1)};
+        CHECK(rayes_scene_light(s, "arealight", p, 3) == RAYES_OK);
+        RayesImage *img = render_scene(s, 1, 16);
+        const float *c = img ? &img->rgba[4 * (8 * 16 + 8)] : NULL;
+        CHECK(c && c[0] == 3.0f && c[1] == 2.0f && c[2] == 1.0f && c[3] == 1.0f);
+        CHECK(img && img->rgba[3] == 0.0f); /* the corner misses */
+        rayes_image_free(img);
+        rayes_scene_release(s);
+    }
+    /* A disk seen from behind is black. */
+    RayesScene *s = rayes_scene_new();
+    float eye[3] = {0, 0, -4}, target[3] = {0, 0, 0}, up[3] = {0, 1, 0};
+    CHECK(rayes_scene_set_camera(s, eye, target, up, 30.0f) == RAYES_OK);
+    RayesParam p[2] = {ps("shape", "disk"), pf("radius", 0.5f)};
+    CHECK(rayes_scene_light(s, "arealight", p, 2) == RAYES_OK);
+    RayesImage *img = render_scene(s, 1, 16);
+    const float *c = img ? &img->rgba[4 * (8 * 16 + 8)] : NULL;
+    CHECK(c && c[0] == 0.0f && c[3] == 1.0f);
+    rayes_image_free(img);
+    rayes_scene_release(s);
+}
+
+/* ---------------------------------------------------------- determinism */
+
+static RayesScene *every_light_scene(void)
+{
+    RayesScene *s = rayes_scene_new();
+    float eye[3] = {0, 1, -4}, target[3] = {0, 0, 0}, up[3] = {0, 1, 0};
+    rayes_scene_set_camera(s, eye, target, up, 50.0f);
+    RayesParam pl[2] = {pf("Kd", 0.6f), pf("roughness", 0.05f)};
+    rayes_scene_set_shader(s, "plastic", pl, 2);
+    rayes_scene_sphere(s, 0.8f);
+    float floor[4][3] = {{-3, -0.8f, -3}, {3, -0.8f, -3}, {-3, -0.8f, 3}, {3, -0.8f, 3}};
+    rayes_scene_bilinear_patch(s, floor);
+    RayesParam sp[3] = {pv("from", 1, 3, -1), pv("to", 0, 0, 0), pf("intensity", 5)};
+    rayes_scene_light(s, "spotlight", sp, 3);
+    RayesParam pt[2] = {pv("from", -2, 2, -1), pf("intensity", 2)};
+    rayes_scene_light(s, "pointlight", pt, 2);
+    RayesParam di[2] = {pv("to", 0.3f, -1, 0.2f), pf("intensity", 0.3f)};
+    rayes_scene_light(s, "distantlight", di, 2);
+    const float m[16] = {1, 0, 0, 1.5f, 0, 1, 0, 1, 0, 0, 1, 0, 0, 0, 0, 1};
+    rayes_scene_set_transform(s, m);
+    RayesParam sph[3] = {ps("shape", "sphere"), pf("radius", 0.2f), pf("intensity", 5)};
+    rayes_scene_light(s, "arealight", sph, 3);
+    RayesParam dk[3] = {ps("shape", "disk"), pf("radius", 0.3f), pf("intensity", 5)};
+    rayes_scene_light(s, "arealight", dk, 3);
+    RayesParam env[2] = {ps("mapname", RAYES_TEST_TMP "/test_lights_map.exr"),
+                         pf("intensity", 0.2f)};
+    rayes_scene_light(s, "environmentlight", env, 2);
+    CHECK(rayes_scene_get_error(s)[0] == '\0');
+    return s;
+}
+
+static void test_every_light_any_thread_count(void)
+{
+    write_test_map(RAYES_TEST_TMP "/test_lights_map.exr");
+    RayesScene *a = every_light_scene(), *b = every_light_scene();
+    RayesImage *one = render_scene(a, 1, 24), *three = render_scene(b, 3, 24);
+    CHECK(one && three &&
+          memcmp(one->rgba, three->rgba, sizeof(float) * 4 * 24 * 24) == 0);
+    rayes_image_free(one);
+    rayes_image_free(three);
+    rayes_scene_release(a);
+    rayes_scene_release(b);
+}
+
+/* --------------------------------------------------------------- errors */
+
+static void test_bad_lights(void)
+{
+    RayesScene *s = rayes_scene_new();
+    CHECK(rayes_scene_light(s, "moonlight", NULL, 0) == RAYES_ERROR_INVALID_ARGUMENT);
+    CHECK(strstr(rayes_scene_get_error(s), "moonlight") != NULL);
+    rayes_scene_clear_error(s);
+    RayesParam bad_type = pv("intensity", 1, 2, 3);
+    CHECK(rayes_scene_light(s, "pointlight", &bad_type, 1) == RAYES_ERROR_INVALID_ARGUMENT);
+    CHECK(strstr(rayes_scene_get_error(s), "intensity") != NULL);
+    rayes_scene_clear_error(s);
+    RayesParam map = ps("mapname", "/nonexistent/sky.exr");
+    CHECK(rayes_scene_light(s, "environmentlight", &map, 1) == RAYES_ERROR_IO);
+    CHECK(strstr(rayes_scene_get_error(s), "sky.exr") != NULL);
+    rayes_scene_clear_error(s);
+    RayesParam shape = ps("shape", "torus");
+    CHECK(rayes_scene_light(s, "arealight", &shape, 1) == RAYES_ERROR_INVALID_ARGUMENT);
+    RayesParam same[2] = {pv("from", 1, 1, 1), pv("to", 1, 1, 1)};
+    CHECK(rayes_scene_light(s, "distantlight", same, 2) == RAYES_ERROR_INVALID_ARGUMENT);
+    RayesParam neg = pf("intensity", -1);
+    CHECK(rayes_scene_light(s, "ambientlight", &neg, 1) == RAYES_ERROR_INVALID_ARGUMENT);
+    RayesParam nan = pf("radius", NAN);
+    CHECK(rayes_scene_light(s, "arealight", &nan, 1) == RAYES_ERROR_INVALID_ARGUMENT);
+    CHECK(rayes_scene_light(s, NULL, NULL, 0) == RAYES_ERROR_INVALID_ARGUMENT);
+    CHECK(s->n_lights == 0); /* failed calls change nothing */
+    CHECK(s->n_objects == 0 && s->n_prims == 0);
+    rayes_scene_release(s);
+}
+
+TEST_MAIN(TEST(test_point_light_inverse_square), TEST(test_spot_light_cone),
+          TEST(test_distant_light), TEST(test_ambient_light), TEST(test_disk_light_irradiance),
+          TEST(test_sphere_light_irradiance), TEST(test_mis_glossy_small_quad),
+          TEST(test_mis_glossy_large_quad), TEST(test_constant_environment_white_furnace),
+          TEST(test_environment_map_importance_sampling), TEST(test_categories),
+          TEST(test_emitters_seen_by_camera), TEST(test_every_light_any_thread_count),
+          TEST(test_bad_lights))
