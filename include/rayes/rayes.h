@@ -260,7 +260,8 @@ typedef struct RayesRenderOptions {
 
 /* Fills options with the defaults of a quality preset: 512 x 512, 4 pixel
  * samples, all cores, 1 bounce, box filter, seed 0, the radiosity cache on
- * with 100 MB, a texture cache of 64 MB. The reference preset turns the cache off (nothing cached). */
+ * with 100 MB, a texture cache of 64 MB. The reference preset turns the
+ * radiosity cache off (nothing cached). */
 RAYES_API void rayes_render_options_init(RayesRenderOptions *options, RayesQuality quality);
 
 /* ---------------------------------------------------------------- stats */
