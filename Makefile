@@ -38,15 +38,16 @@ test-asan:
 
 # ThreadSanitizer on the threaded code of our own: the cache (its stress
 # test hammers a tiny budget from many threads), the renderer's thread
-# pool and the shader plugin registry (threads loading plugins at once;
-# the plugins are built with TSan too). Embree and TBB are not
-# instrumented, so renders are left to ASan.
+# pool, the shader plugin registry (threads loading plugins at once; the
+# plugins are built with TSan too) and the texture cache (threads loading,
+# evicting and reloading MIP levels on a tiny budget). Embree and TBB are
+# not instrumented, so renders are left to ASan.
 TSAN_TESTS = cache_test_cache cache_test_cache_stress util_test_math util_test_half \
-             shade_test_plugin
+             shade_test_plugin shade_test_texture_threads
 test-tsan:
 	@test -f build-tsan/CMakeCache.txt || cmake -S . -B build-tsan -DCMAKE_BUILD_TYPE=RelWithDebInfo -DRAYES_TSAN=ON
 	cmake --build build-tsan -j $(JOBS) --target $(TSAN_TESTS)
-	cd build-tsan && TSAN_OPTIONS=halt_on_error=1 ctest --output-on-failure -R '^(cache|util)/|^shade/test_plugin$$'
+	cd build-tsan && TSAN_OPTIONS=halt_on_error=1 ctest --output-on-failure -R '^(cache|util)/|^shade/test_plugin$$|^shade/test_texture_threads$$'
 
 bench: build
 

@@ -124,10 +124,12 @@ RAYES_API RayesError rayes_scene_set_displacement(RayesScene *scene, const char 
  * no point moves farther. Displacements are clamped to it, with one
  * warning per shader. 0 (the default) means unbounded. */
 RAYES_API RayesError rayes_scene_set_displacement_bound(RayesScene *scene, float bound);
-/* Sets the scene's search path of a kind ("shader"): directories separated
- * by ':', searched in order by later calls (set_shader). An entry "&" or
- * "@" stands for the previous value (as in RenderMan), so "mine:&"
- * prepends. Empty entries are ignored. */
+/* Sets the scene's search path of a kind ("shader" or "texture"):
+ * directories separated by ':', searched in order by later calls
+ * (set_shader) or, for textures, by the renders of the scene (a texture
+ * name is tried as given, then in each directory, then in those of
+ * $RAYES_TEXTURE_PATH). An entry "&" or "@" stands for the previous value
+ * (as in RenderMan), so "mine:&" prepends. Empty entries are ignored. */
 RAYES_API RayesError rayes_scene_set_search_path(RayesScene *scene, const char *kind,
                                                  const char *path);
 
@@ -252,11 +254,15 @@ typedef struct RayesRenderOptions {
                                   RAYES_HIDER_GRID for the final preset) */
     int irradiance;            /* 1: irradiance interpolation with gradients at depth 0 over
                                   each shaded grid (grid hider only; on for the final preset) */
+    double texture_mb;         /* texture cache budget in megabytes (10^6 bytes), default 64 */
+    float texture_width;       /* multiplies every texture filter width (RenderMan's "width"):
+                                  default 1; 0 point-samples the finest MIP level */
 } RayesRenderOptions;
 
 /* Fills options with the defaults of a quality preset: 512 x 512, 4 pixel
  * samples, all cores, 1 bounce, box filter, seed 0, the radiosity cache on
- * with 100 MB. The reference preset turns the cache off (nothing cached). */
+ * with 100 MB, a texture cache of 64 MB. The reference preset turns the
+ * radiosity cache off (nothing cached). */
 RAYES_API void rayes_render_options_init(RayesRenderOptions *options, RayesQuality quality);
 
 /* ---------------------------------------------------------------- stats */

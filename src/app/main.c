@@ -83,6 +83,7 @@ static void usage(FILE *f)
           "                          default for --quality final)\n"
           "  --irradiance on|off     irradiance interpolation with gradients at depth 0 (grid\n"
           "                          hider; on for --quality final)\n"
+          "  --texture-mb MB         texture cache budget in megabytes (default 64)\n"
           "  --data DIR              data directory (teapot.bpt); default $RAYES_DATA\n"
           "  --shader-path DIRS      directories of shader plugins NAME.so, ':'-separated;\n"
           "                          searched before $RAYES_SHADER_PATH\n"
@@ -257,7 +258,8 @@ static void parse_args(int argc, char **argv, Args *a)
             if (strcmp(v, "on") != 0 && strcmp(v, "off") != 0)
                 die_usage("--irradiance: expected on or off, got \"%s\"", v);
             opt->irradiance = strcmp(v, "on") == 0;
-        }
+        } else if (strcmp(o, "--texture-mb") == 0)
+            opt->texture_mb = parse_float(o, v, 0.0f, 1e7f);
         else if (strcmp(o, "--data") == 0)
             a->data_dir = v;
         else if (strcmp(o, "--stats") == 0)

@@ -92,6 +92,36 @@ static int hit_point(const Worker *w, const Ray *ray, const Hit *hit, HitPoint *
     return front;
 }
 
+/* The parameter footprint of a hit (the context's du, dv). The ray's
+ * footprint of width w lands on the surface as an ellipse, w across the
+ * incoming direction and w / cos(theta) along it (cos clamped at 1/64, so
+ * grazing hits stay finite); du and dv are its extents along dPdu and dPdv,
+ * divided by their lengths: the parameter ranges the point stands for. */
+static void hit_footprint(HitPoint *hp)
+{
+    Vec3 Ng = v3(hp->Ng[0], hp->Ng[1], hp->Ng[2]), I = v3(hp->I[0], hp->I[1], hp->I[2]);
+    float w = hp->diff.width, cos_i = v3_dot(Ng, I);
+    float stretch = 1.0f / fmaxf(fabsf(cos_i) / fmaxf(v3_length(I), 1e-30f), 1.0f / 64.0f);
+    Vec3 t1 = v3_sub(I, v3_scale(Ng, cos_i)), t2;
+    if (v3_length(t1) > 0.0f) {
+        t1 = v3_normalize(t1);
+        t2 = v3_cross(Ng, t1);
+    } else
+        v3_basis(Ng, &t1, &t2);
+    const float *d[2] = {hp->dPdu, hp->dPdv};
+    float *out[2] = {&hp->du, &hp->dv};
+    for (int k = 0; k < 2; k++) {
+        Vec3 e = v3(d[k][0], d[k][1], d[k][2]);
+        float len = v3_length(e);
+        if (!(len > 0.0f) || !(w > 0.0f)) {
+            *out[k] = 0.0f;
+            continue;
+        }
+        float a = w * stretch * v3_dot(t1, e) / len, b = w * v3_dot(t2, e) / len;
+        *out[k] = sqrtf(a * a + b * b) / len;
+    }
+}
+
 static Vec3 shade_hit(Worker *w, const Ray *ray, const Hit *hit, const RenderObject *obj,
                       uint32_t kind, int diffuse_depth, int specular_depth, uint64_t key,
                       RayDiff diff)
@@ -102,6 +132,7 @@ static Vec3 shade_hit(Worker *w, const Ray *ray, const Hit *hit, const RenderObj
     memcpy(hp.Os, obj->Os, sizeof hp.Os);
     hp.key = key;
     hp.diff = (RayDiff){diff.width + diff.spread * hit->t, diff.spread};
+    hit_footprint(&hp);
     PathState ps = {w, &hp.key, &hp.diff, &hp.curvature, &hp.offset, NULL};
     RayesShadeCtx ctx = {
         .n_points = 1,
@@ -514,11 +545,16 @@ static int svc_texture(const RayesShaderServices *sv, const RayesShadeCtx *ctx, 
                        const float *s, const float *t, const float *ds, const float *dt,
                        float (*rgb)[3], float *alpha)
 {
-    (void)sv, (void)name, (void)s, (void)t, (void)ds, (void)dt;
-    memset(rgb, 0, ctx->n_points * sizeof *rgb);
-    for (size_t i = 0; alpha && i < ctx->n_points; i++)
-        alpha[i] = 1.0f;
-    return -1; /* no textures yet */
+    (void)sv;
+    TextureSystem *ts = ((const PathState *)ctx->renderer)->w->set->textures;
+    if (!ts || !name || !s || !t) {
+        memset(rgb, 0, ctx->n_points * sizeof *rgb);
+        for (size_t i = 0; alpha && i < ctx->n_points; i++)
+            alpha[i] = 1.0f;
+        return -1;
+    }
+    return texture_lookup(ts, name, ctx->n_points, s, t, ds ? ds : ctx->du, dt ? dt : ctx->dv,
+                          rgb, alpha);
 }
 
 static float svc_noise(const RayesShaderServices *sv, const float p[3])
@@ -576,7 +612,7 @@ static int svc_option(const RayesShaderServices *sv, const RayesShadeCtx *ctx, c
 
 static const char *const service_names[] = {
     "direct_lighting", "ambient", "indirect_diffuse", "indirect_specular", "indirect_refraction",
-    "transmission", "noise", "fbm", "turbulence", "attribute", "option",
+    "transmission", "noise", "fbm", "turbulence", "attribute", "option", "texture",
 };
 
 static int svc_supports(const RayesShaderServices *sv, const char *service)

@@ -226,6 +226,25 @@ static void layout_points(const GridSet *gs, const Grid *g, int level, int side,
         }
 }
 
+/* The parameter footprint of a level's points: its mean knot spacing in the
+ * primitive's (u, v) (triangles: the widest extent of the patch's corners
+ * in u and in v over the level's subdivisions). */
+static void level_footprint(const Grid *g, int level, float *du, float *dv)
+{
+    if (!g->triangular) {
+        int mu = quad_level_points(level, g->nu), mv = quad_level_points(level, g->nv);
+        *du = fabsf(g->uv[1][0] - g->uv[0][0]) / (float)RY_MAX(mu - 1, 1);
+        *dv = fabsf(g->uv[1][1] - g->uv[0][1]) / (float)RY_MAX(mv - 1, 1);
+        return;
+    }
+    float m = (float)tri_level_m(level, g->nu), ext[2] = {0.0f, 0.0f};
+    for (int a = 0; a < 3; a++)
+        for (int c = 0; c < 2; c++)
+            ext[c] = fmaxf(ext[c], fabsf(g->uv[a][c] - g->uv[(a + 1) % 3][c]));
+    *du = ext[0] / m;
+    *dv = ext[1] / m;
+}
+
 /* CacheFillFn: shade every point of the level with diffuselighting. */
 static void fill_radiosity(void *user, const CacheKey *key, size_t n, float (*out)[3])
 {
@@ -249,11 +268,13 @@ static void fill_radiosity(void *user, const CacheKey *key, size_t n, float (*ou
     uint64_t fill_key = hash_combine(hash_combine(w->set->seed, 0x7261646f73ull /* "rados" */),
                                      ((uint64_t)key->patch << 32) | ((uint64_t)key->depth << 16) |
                                          ((uint64_t)key->side << 8) | key->level);
-    float width = level_edge(g, key->level);
+    float width = level_edge(g, key->level), du, dv;
+    level_footprint(g, key->level, &du, &dv);
     for (size_t i = 0; i < n; i++) {
         memcpy(fp.Cs[i], obj->Cs, sizeof fp.Cs[i]);
         memcpy(fp.Os[i], obj->Os, sizeof fp.Os[i]);
-        fp.du[i] = fp.dv[i] = 0.0f;
+        fp.du[i] = du;
+        fp.dv[i] = dv;
         fp.curv[i] = g->curvature;
         fp.offset[i] = integrator_ray_offset(w, g);
         fp.keys[i] = hash_combine(fill_key, i);

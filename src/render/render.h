@@ -21,6 +21,7 @@
 #include "geom/geom.h"
 #include "shade/light.h"
 #include "shade/shade.h"
+#include "shade/texture.h"
 #include "util/vec.h"
 
 #define RENDER_MAX_DEPTH 16 /* diffuse depths counted separately in statistics */
@@ -65,6 +66,7 @@ typedef struct RenderSettings {
     int hider;                    /* 0: shade at every camera hit; 1: the grid hider (hider.h) */
     int irradiance;               /* 1: irradiance interpolation at depth 0 (irrgrid.h; grid
                                      hider only) */
+    TextureSystem *textures;      /* image textures for the texture service, or NULL */
 } RenderSettings;
 
 typedef struct RenderStats {

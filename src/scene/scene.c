@@ -723,6 +723,7 @@ RayesError rayes_scene_light(RayesScene *s, const char *type, const RayesParam *
 /* Kind names of rayes_scene_set_search_path, by SceneSearchPath. */
 static const char *const search_path_kinds[SCENE_SEARCH_PATH_COUNT] = {
     [SCENE_SEARCH_PATH_SHADER] = "shader",
+    [SCENE_SEARCH_PATH_TEXTURE] = "texture",
 };
 
 #define SEARCH_PATH_MAX 65536 /* characters, after expanding "&" */
@@ -773,7 +774,8 @@ RayesError rayes_scene_set_search_path(RayesScene *s, const char *kind, const ch
         k++;
     if (k == SCENE_SEARCH_PATH_COUNT)
         return fail(s, RAYES_ERROR_INVALID_ARGUMENT,
-                    "search path: unknown kind \"%.64s\"; expected \"shader\"", kind);
+                    "search path: unknown kind \"%.64s\"; expected \"shader\" or \"texture\"",
+                    kind);
     int too_long;
     char *expanded = expand_search_path(path, scene_search_path(s, (SceneSearchPath)k), &too_long);
     if (!expanded)

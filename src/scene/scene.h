@@ -32,6 +32,7 @@ typedef struct SceneObject {
  * (names in scene.c's search_path_kinds). */
 typedef enum SceneSearchPath {
     SCENE_SEARCH_PATH_SHADER = 0,
+    SCENE_SEARCH_PATH_TEXTURE = 1,
     SCENE_SEARCH_PATH_COUNT
 } SceneSearchPath;
 

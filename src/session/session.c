@@ -58,6 +58,8 @@ void rayes_render_options_init(RayesRenderOptions *o, RayesQuality quality)
     o->cache_split[2] = 0.5f;
     o->cache_resolution = -1;
     o->cache_k = 1.0f;
+    o->texture_mb = 64.0;
+    o->texture_width = 1.0f;
     switch (quality) {
     case RAYES_QUALITY_PREVIEW:
         o->shadow_rays = o->shadow_rays_deep = 4;
@@ -114,6 +116,9 @@ static RayesError check_options(RayesScene *scene, const RayesRenderOptions *o)
              !(o->cache_split[0] + o->cache_split[1] + o->cache_split[2] <= 1.0001f))
         what = "options: cache budget 0 to 1e7 MB, split shares >= 0 summing to at most 1, "
                "k > 0, resolution -1 to 2";
+    else if (!(o->texture_mb >= 0.0) || o->texture_mb > 1e7 || !(o->texture_width >= 0.0f) ||
+             o->texture_width > 1e3f)
+        what = "options: texture cache budget must be 0 to 1e7 MB and texture width 0 to 1000";
     if (!what)
         return RAYES_OK;
     if (scene->error[0] == '\0')
@@ -136,6 +141,23 @@ static RenderSettings settings_from(const RayesRenderOptions *o)
     if (s.threads == 0)
         s.threads = thread_count_cores();
     return s;
+}
+
+/* The texture system of a render: the scene's texture path, then
+ * RAYES_TEXTURE_PATH's directories. NULL when out of memory. */
+static TextureSystem *render_textures(const RayesScene *scene, double mb, float width)
+{
+    const char *a = scene_search_path(scene, SCENE_SEARCH_PATH_TEXTURE);
+    const char *b = getenv("RAYES_TEXTURE_PATH");
+    b = b ? b : "";
+    size_t len = strlen(a) + strlen(b) + 2;
+    char *path = malloc(len);
+    if (!path)
+        return NULL;
+    snprintf(path, len, "%s:%s", a, b);
+    TextureSystem *ts = texture_system_new(path, (uint64_t)(mb * 1e6), width);
+    free(path);
+    return ts;
 }
 
 /* The render-side view of the scene's objects. */
@@ -193,9 +215,12 @@ RayesError rayes_render(RayesScene *scene, const RayesRenderOptions *opt, RayesI
     float *rgba = malloc(sizeof(float) * 4 * (size_t)set.width * set.height);
     Accel *accel = NULL;
     Cache *cache = NULL;
+    TextureSystem *textures = render_textures(scene, opt->texture_mb, opt->texture_width);
     RenderStats rstats = {0};
     char err[300] = "";
-    if (!objects || !masks || !img || !rgba || scene_prepare(scene, set.height, &gs) != 0) {
+    set.textures = textures;
+    if (!objects || !masks || !img || !rgba || !textures ||
+        scene_prepare(scene, set.height, &gs) != 0) {
         e = fail(scene, RAYES_ERROR_OUT_OF_MEMORY, "render: out of memory preparing the scene");
         goto done;
     }
@@ -233,6 +258,11 @@ RayesError rayes_render(RayesScene *scene, const RayesRenderOptions *opt, RayesI
             cache_get_stats(cache, &cs);
             session_stats_add_cache(*stats_out, &cs);
         }
+        if (*stats_out) {
+            TextureStats ts;
+            texture_get_stats(textures, &ts);
+            session_stats_add_textures(*stats_out, &ts);
+        }
         if (!*stats_out) {
             e = fail(scene, RAYES_ERROR_OUT_OF_MEMORY, "render: out of memory for statistics");
             goto done;
@@ -246,6 +276,7 @@ RayesError rayes_render(RayesScene *scene, const RayesRenderOptions *opt, RayesI
     rgba = NULL;
 done:
     cache_free(cache);
+    texture_system_free(textures);
     accel_free(accel);
     geom_gridset_fini(&gs);
     free(objects);

@@ -105,6 +105,19 @@ void session_stats_add_cache(RayesStats *s, const CacheStats *cs)
     }
 }
 
+void session_stats_add_textures(RayesStats *s, const TextureStats *ts)
+{
+    count(s, "textures/lookups", ts->lookups);
+    count(s, "textures/textures", ts->textures);
+    count(s, "textures/missing", ts->missing);
+    count(s, "textures/loads", ts->loads);
+    count(s, "textures/file_reads", ts->file_reads);
+    count(s, "textures/evictions", ts->evictions);
+    count(s, "textures/bytes", ts->bytes);
+    count(s, "textures/peak_bytes", ts->peak_bytes);
+    count(s, "textures/budget_bytes", ts->budget_bytes);
+}
+
 size_t rayes_stats_size(const RayesStats *s)
 {
     return s ? s->n : 0;

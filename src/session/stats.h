@@ -10,6 +10,7 @@
 #include "geom/geom.h"
 #include "rayes/rayes.h"
 #include "render/render.h"
+#include "shade/texture.h"
 
 typedef struct SessionTimes {
     double total_s, prepare_s, render_s;
@@ -23,5 +24,9 @@ RayesStats *session_stats_new(const RenderSettings *set, const RenderStats *rs, 
  * misses, fills, evictions, entries, bytes and hit_rate (radiosity only for
  * now; a later data type adds a per-type split). */
 void session_stats_add_cache(RayesStats *stats, const CacheStats *cs);
+
+/* Adds the "textures" block: lookups, textures, missing, loads (MIP levels
+ * built), file_reads, evictions, bytes, peak_bytes and budget_bytes. */
+void session_stats_add_textures(RayesStats *stats, const TextureStats *ts);
 
 #endif /* RAYES_SESSION_STATS_H */

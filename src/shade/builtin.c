@@ -1,6 +1,7 @@
 /*
- * shade/builtin.c — RenderMan's classic surfaces: matte, plastic, a tinted
- * mirror and constant (the others are in builtin_bsdf.c).
+ * shade/builtin.c — RenderMan's classic surfaces: matte, plastic,
+ * paintedplastic, a tinted mirror and constant (the others are in
+ * builtin_bsdf.c).
  *
  * Each has a separate diffuselighting with exactly the view-independent
  * terms of its lighting: for matte and constant the two are the same; for
@@ -69,18 +70,28 @@ static void diffuse_chunk(const RayesShaderServices *sv, const RayesShadeCtx *ct
 typedef void (*ChunkFn)(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
                         const void *params, RayesShadeOutputs *out);
 
-static void by_chunks(const RayesShaderServices *sv, const RayesShadeCtx *ctx, const void *params,
-                      RayesShadeOutputs *out, ChunkFn fn)
+/* The same, offsetting ctx->scratch by scratch_size bytes per point. */
+static void by_chunks_scratch(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
+                              const void *params, RayesShadeOutputs *out, ChunkFn fn,
+                              size_t scratch_size)
 {
     for (size_t start = 0; start < ctx->n_points; start += SHADE_CHUNK) {
         size_t n = ctx->n_points - start < SHADE_CHUNK ? ctx->n_points - start : SHADE_CHUNK;
         RayesShadeCtx sub;
         shade_ctx_slice(ctx, start, n, &sub);
+        if (ctx->scratch)
+            sub.scratch = (char *)ctx->scratch + start * scratch_size;
         RayesShadeOutputs o = {out->Ci + start, out->Oi + start,
                                out->Irradiance ? out->Irradiance + start : NULL, NULL};
         fn(sv, &sub, params, &o);
     }
     set_opacity(ctx, out);
+}
+
+static void by_chunks(const RayesShaderServices *sv, const RayesShadeCtx *ctx, const void *params,
+                      RayesShadeOutputs *out, ChunkFn fn)
+{
+    by_chunks_scratch(sv, ctx, params, out, fn, 0);
 }
 
 /* ---- matte */
@@ -249,4 +260,114 @@ const RayesShaderClass shade_class_constant = {
     .name = "constant",
     .lighting = constant_lighting,
     .diffuselighting = constant_lighting,
+};
+
+/* ---- paintedplastic
+ *
+ * RenderMan's paintedplastic: Ci = Cs T (Ka ambient + Kd diffuse) +
+ * Ks specularcolor specular, T the texture's colour at (s, t) (not
+ * multiplied by Os, like plastic here: surfaces are opaque for now). prelighting
+ * looks T up once into the scratch (1 without a texture name, or when the
+ * texture cannot be read: the surface is then plain plastic), which both
+ * lighting and diffuselighting read; diffuselighting drops the highlight. */
+
+typedef struct PaintedPlasticParams {
+    float Ka, Kd, Ks, roughness;
+    float specularcolor[3];
+    char texturename[64];
+} PaintedPlasticParams;
+
+typedef struct PaintedScratch {
+    float T[3];            /* the texture colour of the point */
+} PaintedScratch;
+
+static void painted_prelighting(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
+                                const void *params, RayesShadeOutputs *out)
+{
+    (void)out;
+    const PaintedPlasticParams *p = params;
+    PaintedScratch *sc = ctx->scratch;
+    int ok = -1;
+    if (p->texturename[0] && sv->texture && sv->supports(sv, "texture"))
+        ok = sv->texture(sv, ctx, p->texturename, ctx->s, ctx->t, NULL, NULL,
+                         (float(*)[3])sc, NULL);
+    if (ok != 0)
+        for (size_t i = 0; i < ctx->n_points; i++)
+            sc[i].T[0] = sc[i].T[1] = sc[i].T[2] = 1.0f;
+}
+
+/* Ci = Cs T (Ka ambient + Kd (direct + indirect diffuse)) [+ highlight]. */
+static void painted_chunk_common(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
+                                 const PaintedPlasticParams *p, int highlight,
+                                 RayesShadeOutputs *out)
+{
+    const PaintedScratch *sc = ctx->scratch;
+    float dd[SHADE_CHUNK][3], id[SHADE_CHUNK][3], ds[SHADE_CHUNK][3], am[SHADE_CHUNK][3];
+    float rough[SHADE_CHUNK];
+    for (size_t i = 0; i < ctx->n_points; i++)
+        rough[i] = p->roughness;
+    highlight = highlight && ctx->I;
+    sv->direct_lighting(sv, ctx, 0, NULL, rough, dd, highlight ? ds : NULL);
+    sv->indirect_diffuse(sv, ctx, 0, id);
+    if (sv->ambient)
+        sv->ambient(sv, ctx, am);
+    else
+        memset(am, 0, sizeof am);
+    for (size_t i = 0; i < ctx->n_points; i++)
+        for (int c = 0; c < 3; c++) {
+            float diffuse = p->Ka * am[i][c] + p->Kd * (dd[i][c] + id[i][c]);
+            float spec = highlight ? p->specularcolor[c] * p->Ks * ds[i][c] : 0.0f;
+            out->Ci[i][c] = cs(ctx, i, c) * sc[i].T[c] * diffuse + spec;
+        }
+    if (out->Irradiance)
+        for (size_t i = 0; i < ctx->n_points; i++)
+            for (int c = 0; c < 3; c++)
+                out->Irradiance[i][c] = 3.14159265f * (dd[i][c] + id[i][c]);
+}
+
+static void painted_chunk(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
+                          const void *params, RayesShadeOutputs *out)
+{
+    painted_chunk_common(sv, ctx, params, 1, out);
+}
+
+static void painted_diffuse_chunk(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
+                                  const void *params, RayesShadeOutputs *out)
+{
+    painted_chunk_common(sv, ctx, params, 0, out);
+}
+
+static void painted_lighting(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
+                             const void *params, RayesShadeOutputs *out)
+{
+    by_chunks_scratch(sv, ctx, params, out, painted_chunk, sizeof(PaintedScratch));
+}
+
+static void painted_diffuselighting(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
+                                    const void *params, RayesShadeOutputs *out)
+{
+    by_chunks_scratch(sv, ctx, params, out, painted_diffuse_chunk, sizeof(PaintedScratch));
+}
+
+static const RayesShaderParamDesc painted_params[] = {
+    {"Ka", RAYES_PARAM_FLOAT, offsetof(PaintedPlasticParams, Ka), {1, 0, 0}},
+    {"Kd", RAYES_PARAM_FLOAT, offsetof(PaintedPlasticParams, Kd), {0.5f, 0, 0}},
+    {"Ks", RAYES_PARAM_FLOAT, offsetof(PaintedPlasticParams, Ks), {0.5f, 0, 0}},
+    {"roughness", RAYES_PARAM_FLOAT, offsetof(PaintedPlasticParams, roughness), {0.1f, 0, 0}},
+    {"specularcolor", RAYES_PARAM_COLOR, offsetof(PaintedPlasticParams, specularcolor),
+     {1, 1, 1}},
+    {"texturename", RAYES_PARAM_STRING, offsetof(PaintedPlasticParams, texturename), {0, 0, 0}},
+};
+
+const RayesShaderClass shade_class_paintedplastic = {
+    .abi_version = RAYES_SHADER_ABI_VERSION,
+    .struct_size = sizeof(RayesShaderClass),
+    .name = "paintedplastic",
+    .params_size = sizeof(PaintedPlasticParams),
+    .params = painted_params,
+    .n_params = sizeof painted_params / sizeof painted_params[0],
+    .prelighting = painted_prelighting,
+    .lighting = painted_lighting,
+    .diffuselighting = painted_diffuselighting,
+    .scratch_size = sizeof(PaintedScratch),
 };

@@ -17,6 +17,8 @@ extern const RayesShaderClass shade_class_fractal;  /* displacement: the memo's 
 /* The services displacement runs with at dicing time: patterns only (the
  * lighting services are NULL; supports() says so). */
 extern const RayesShaderServices shade_dicing_services;
+/* plastic with a texture: Ka, Kd, Ks, roughness, specularcolor, texturename */
+extern const RayesShaderClass shade_class_paintedplastic;
 
 /* builtin_bsdf.c: the rest of RenderMan's classics and the physically based
  * family the pbrt reader maps to (README.md lists their parameters). */

@@ -51,7 +51,9 @@ void shade_run_lighting(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
 /* Points per chunk when a shader needs scratch arrays on the stack. */
 #define SHADE_CHUNK 64
 
-/* The sub-context of points [start, start + count) of ctx. */
+/* The sub-context of points [start, start + count) of ctx. Its scratch is
+ * ctx's (a slice does not know the class's scratch_size): offset it by
+ * start * scratch_size where the sub-context's methods read it. */
 void shade_ctx_slice(const RayesShadeCtx *ctx, size_t start, size_t count, RayesShadeCtx *sub);
 
 #endif /* RAYES_SHADE_SHADE_H */
