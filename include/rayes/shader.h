@@ -220,11 +220,13 @@ struct RayesShaderServices {
     float (*turbulence)(const RayesShaderServices *sv, const float p[3], int octaves,
                         float lacunarity, float gain);
 
-    /* Attribute of the object being shaded ("object:id", "displacementbound",
-     * "shadingrate") and option of the render ("resolution", "bounces",
-     * "samples", "shadowrays", "diffuserays", "quality"): writes up to n
-     * floats to value and returns how many the attribute has, or 0 if
-     * unknown. */
+    /* Attribute of what is being shaded ("object:id"; "patch:id";
+     * "grid:size", the grid's vertices in u and v (triangles: subdivisions
+     * and 0); "grid:edge", its mean micropolygon edge; "grid:curvature")
+     * and option of the render ("resolution", "bounces", "samples",
+     * "shadowrays", "diffuserays"): writes up to n floats to value and
+     * returns how many the attribute has, or 0 if unknown (always 0 at
+     * dicing time). */
     int (*attribute)(const RayesShaderServices *sv, const RayesShadeCtx *ctx, const char *name,
                      float *value, int n);
     int (*option)(const RayesShaderServices *sv, const RayesShadeCtx *ctx, const char *name,
@@ -233,6 +235,10 @@ struct RayesShaderServices {
     /* Nonzero if the renderer offers the named service ("direct_lighting",
      * "ambient", "texture", ...), so the table can grow. */
     int (*supports)(const RayesShaderServices *sv, const char *service);
+
+    /* A checkerboard of unit squares in (s, t): 1 where floor(s) + floor(t)
+     * is even, else 0, box-filtered over ds x dt (0: point sampled). */
+    float (*checker)(const RayesShaderServices *sv, float s, float t, float ds, float dt);
 };
 
 #ifdef __cplusplus

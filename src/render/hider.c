@@ -131,7 +131,7 @@ static Rgb *shade_grid(Worker *w, uint32_t gi)
         RY_CHECK(irr_E != NULL);
         irr.E = irr_E;
     }
-    PathState ps = {w, keys, diff, curv, offset, w->set->irradiance ? &irr : NULL};
+    PathState ps = {w, keys, diff, curv, offset, w->set->irradiance ? &irr : NULL, gi};
     RayesShadeCtx ctx = {
         .n_points = n, .ray_type = RAYES_RAY_CAMERA, .diffuse_depth = 0, .specular_depth = 0,
         .P = (const float(*)[3])P, .N = (const float(*)[3])N, .Ng = (const float(*)[3])N,

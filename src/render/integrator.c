@@ -133,7 +133,7 @@ static Vec3 shade_hit(Worker *w, const Ray *ray, const Hit *hit, const RenderObj
     hp.key = key;
     hp.diff = (RayDiff){diff.width + diff.spread * hit->t, diff.spread};
     hit_footprint(&hp);
-    PathState ps = {w, &hp.key, &hp.diff, &hp.curvature, &hp.offset, NULL};
+    PathState ps = {w, &hp.key, &hp.diff, &hp.curvature, &hp.offset, NULL, hit->grid};
     RayesShadeCtx ctx = {
         .n_points = 1,
         .ray_type = kind,
@@ -577,18 +577,36 @@ static float svc_turbulence(const RayesShaderServices *sv, const float p[3], int
     return noise_turbulence(p, octaves, lacunarity, gain);
 }
 
-static int svc_attribute(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
-                         const char *name, float *value, int n)
-{
-    (void)sv, (void)ctx, (void)name, (void)value, (void)n;
-    return 0;
-}
-
 static int put_floats(float *value, int n, const float *have, int n_have)
 {
     for (int k = 0; k < n && k < n_have; k++)
         value[k] = have[k];
     return n_have;
+}
+
+static float svc_checker(const RayesShaderServices *sv, float s, float t, float ds, float dt)
+{
+    (void)sv;
+    return pattern_checker(s, t, ds, dt);
+}
+
+static int svc_attribute(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
+                         const char *name, float *value, int n)
+{
+    (void)sv;
+    const PathState *ps = ctx->renderer;
+    const Grid *g = &ps->w->rs->gs->grids[ps->grid];
+    if (strcmp(name, "object:id") == 0)
+        return put_floats(value, n, (float[]){(float)g->object}, 1);
+    if (strcmp(name, "patch:id") == 0)
+        return put_floats(value, n, (float[]){(float)ps->grid}, 1);
+    if (strcmp(name, "grid:size") == 0)
+        return put_floats(value, n, (float[]){(float)g->nu, (float)g->nv}, 2);
+    if (strcmp(name, "grid:edge") == 0)
+        return put_floats(value, n, (float[]){g->edge}, 1);
+    if (strcmp(name, "grid:curvature") == 0)
+        return put_floats(value, n, (float[]){g->curvature}, 1);
+    return 0;
 }
 
 static int svc_option(const RayesShaderServices *sv, const RayesShadeCtx *ctx, const char *name,
@@ -612,7 +630,7 @@ static int svc_option(const RayesShaderServices *sv, const RayesShadeCtx *ctx, c
 
 static const char *const service_names[] = {
     "direct_lighting", "ambient", "indirect_diffuse", "indirect_specular", "indirect_refraction",
-    "transmission", "noise", "fbm", "turbulence", "attribute", "option", "texture",
+    "transmission", "noise", "fbm", "turbulence", "attribute", "option", "texture", "checker",
 };
 
 static int svc_supports(const RayesShaderServices *sv, const char *service)
@@ -639,5 +657,6 @@ const RayesShaderServices render_services = {
     .turbulence = svc_turbulence,
     .attribute = svc_attribute,
     .option = svc_option,
+    .checker = svc_checker,
     .supports = svc_supports,
 };

@@ -36,6 +36,7 @@ typedef struct PathState {
     const float *offset;
     struct IrrGrid *irr;          /* irradiance interpolation over this grid, or NULL
                                      (irrgrid.h) */
+    uint32_t grid;                /* the grid (patch) all the points lie on */
 } PathState;
 
 /* How far rays leaving a point of grid g start from it, along its normal:

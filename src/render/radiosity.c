@@ -281,7 +281,7 @@ static void fill_radiosity(void *user, const CacheKey *key, size_t n, float (*ou
         fp.diff[i] = (RayDiff){width, 0.0f};
         backfacing[i] = key->side != 0; /* side 1: against dPdu x dPdv */
     }
-    PathState ps = {w, fp.keys, fp.diff, fp.curv, fp.offset, NULL};
+    PathState ps = {w, fp.keys, fp.diff, fp.curv, fp.offset, NULL, key->patch};
     RayesShadeCtx ctx = {
         .n_points = n, .ray_type = RAYES_RAY_DIFFUSE, .diffuse_depth = key->depth,
         .specular_depth = 0,

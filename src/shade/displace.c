@@ -150,11 +150,17 @@ static float dice_turbulence(const RayesShaderServices *sv, const float p[3], in
     return noise_turbulence(p, octaves, lacunarity, gain);
 }
 
+static float dice_checker(const RayesShaderServices *sv, float s, float t, float ds, float dt)
+{
+    (void)sv;
+    return pattern_checker(s, t, ds, dt);
+}
+
 static int dice_supports(const RayesShaderServices *sv, const char *service)
 {
     (void)sv;
     return strcmp(service, "noise") == 0 || strcmp(service, "fbm") == 0 ||
-           strcmp(service, "turbulence") == 0;
+           strcmp(service, "turbulence") == 0 || strcmp(service, "checker") == 0;
 }
 
 /* Lighting does not exist yet when displacement runs: those members are NULL. */
@@ -165,4 +171,5 @@ const RayesShaderServices shade_dicing_services = {
     .fbm = dice_fbm,
     .turbulence = dice_turbulence,
     .supports = dice_supports,
+    .checker = dice_checker,
 };

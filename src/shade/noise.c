@@ -87,6 +87,27 @@ float noise_fbm(const float p[3], int octaves, float lacunarity, float gain)
     return octaves_sum(p, octaves, lacunarity, gain, 0);
 }
 
+/* The integral from 0 to x of the square wave that is +1 on [0,1) and -1
+ * on [1,2), period 2: a triangle wave. */
+static float tri(float x)
+{
+    float f = x - 2.0f * floorf(0.5f * x);
+    return f < 1.0f ? f : 2.0f - f;
+}
+
+/* The square wave, box-filtered over width w around x. */
+static float square_filtered(float x, float w)
+{
+    if (w <= 1e-6f)
+        return x - 2.0f * floorf(0.5f * x) < 1.0f ? 1.0f : -1.0f;
+    return (tri(x + 0.5f * w) - tri(x - 0.5f * w)) / w;
+}
+
+float pattern_checker(float s, float t, float ds, float dt)
+{
+    return 0.5f + 0.5f * square_filtered(s, fabsf(ds)) * square_filtered(t, fabsf(dt));
+}
+
 float noise_turbulence(const float p[3], int octaves, float lacunarity, float gain)
 {
     return octaves_sum(p, octaves, lacunarity, gain, 1);

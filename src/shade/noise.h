@@ -22,4 +22,10 @@ float noise_fbm(const float p[3], int octaves, float lacunarity, float gain);
 /* sum over octaves k of gain^k * |noise3(p * lacunarity^k)|. */
 float noise_turbulence(const float p[3], int octaves, float lacunarity, float gain);
 
+/* A checkerboard of unit squares, 1 where floor(s) + floor(t) is even and 0
+ * elsewhere, box-filtered over ds x dt (0: point sampled). Exact: the
+ * box filter of the separable square waves is a difference of triangle
+ * waves. */
+float pattern_checker(float s, float t, float ds, float dt);
+
 #endif /* RAYES_SHADE_NOISE_H */

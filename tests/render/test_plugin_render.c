@@ -173,4 +173,45 @@ static void test_plugin_displacement(void)
     rayes_scene_release(flat);
 }
 
-TEST_MAIN(TEST(test_search_path), TEST(test_brick_wall_renders), TEST(test_plugin_displacement))
+/* The attribute and checker services, seen by a test plugin that writes
+ * (object:id, patch:id, checker) as its colour: two quads, two objects. */
+static void test_attribute_service(void)
+{
+    RayesScene *s = rayes_scene_new();
+    CHECK(rayes_scene_set_search_path(s, "shader", RAYES_TEST_BAD_SHADERS) == RAYES_OK);
+    const float left[4][3] = {{-1, -1, 0}, {0, -1, 0}, {-1, 1, 0}, {0, 1, 0}};
+    const float right[4][3] = {{0, -1, 0}, {1, -1, 0}, {0, 1, 0}, {1, 1, 0}};
+    CHECK(rayes_scene_set_shader(s, "attributes", NULL, 0) == RAYES_OK);
+    CHECK(rayes_scene_bilinear_patch(s, left) == RAYES_OK);
+    CHECK(rayes_scene_set_shader(s, "attributes", NULL, 0) == RAYES_OK);
+    CHECK(rayes_scene_bilinear_patch(s, right) == RAYES_OK);
+    const float eye[3] = {0, 0, -3}, target[3] = {0, 0, 0}, up[3] = {0, 1, 0};
+    CHECK(rayes_scene_set_camera(s, eye, target, up, 30.0f) == RAYES_OK);
+    CHECK(rayes_scene_commit(s) == RAYES_OK);
+    RayesRenderOptions o;
+    rayes_render_options_init(&o, RAYES_QUALITY_PREVIEW);
+    o.width = o.height = 16;
+    o.spp = 1;
+    o.threads = 1;
+    RayesImage *img = NULL;
+    CHECK(rayes_render(s, &o, &img, NULL) == RAYES_OK);
+    if (img) {
+        /* Pixel (3, 8) sees the left quad (object 0), (12, 8) the right (1),
+         * the camera looking along +z with +x to the left of the image. */
+        const float *a = &img->rgba[4 * (8 * 16 + 3)], *b = &img->rgba[4 * (8 * 16 + 12)];
+        CHECK(a[0] != b[0]);
+        CHECK((a[0] == 0.0f && b[0] == 1.0f) || (a[0] == 1.0f && b[0] == 0.0f));
+        CHECK(a[1] >= 0.0f && b[1] >= 0.0f && a[1] != b[1]);
+        int zeros = 0, ones = 0;
+        for (int i = 0; i < 16 * 16; i++) {
+            zeros += img->rgba[4 * i + 2] == 0.0f;
+            ones += img->rgba[4 * i + 2] == 1.0f;
+        }
+        CHECK(zeros > 20 && ones > 20); /* the checker shows both squares */
+    }
+    rayes_image_free(img);
+    rayes_scene_release(s);
+}
+
+TEST_MAIN(TEST(test_search_path), TEST(test_brick_wall_renders), TEST(test_plugin_displacement),
+          TEST(test_attribute_service))

@@ -198,5 +198,24 @@ static void test_noise(void)
     CHECK(noise_turbulence(p, 4, NOISE_LACUNARITY, 0.5f) >= fabsf(f4) - 1e-6f);
 }
 
+static void test_checker(void)
+{
+    CHECK(pattern_checker(0.5f, 0.5f, 0, 0) == 1.0f);
+    CHECK(pattern_checker(1.5f, 0.5f, 0, 0) == 0.0f);
+    CHECK(pattern_checker(-0.5f, 0.5f, 0, 0) == 0.0f);
+    CHECK(pattern_checker(-0.5f, -0.5f, 0, 0) == 1.0f);
+    /* A footprint of whole periods averages to one half anywhere. */
+    CHECK_NEAR(pattern_checker(0.3f, 0.7f, 2.0f, 2.0f), 0.5f, 1e-5);
+    CHECK_NEAR(pattern_checker(0.3f, 0.7f, 4.0f, 0.0f), 0.5f, 1e-5);
+    /* The filter is the mean of point samples over the box. */
+    float s = 0.8f, t = 0.35f, ds = 0.7f, dt = 0.45f;
+    double mean = 0.0;
+    for (int i = 0; i < 400; i++)
+        for (int j = 0; j < 400; j++)
+            mean += pattern_checker(s + ds * ((i + 0.5f) / 400 - 0.5f),
+                                    t + dt * ((j + 0.5f) / 400 - 0.5f), 0, 0);
+    CHECK_NEAR(pattern_checker(s, t, ds, dt), mean / (400.0 * 400.0), 2e-3);
+}
+
 TEST_MAIN(TEST(test_sine_plane_is_analytic), TEST(test_neighbours_agree), TEST(test_bound_clamps),
-          TEST(test_api_errors), TEST(test_noise))
+          TEST(test_api_errors), TEST(test_noise), TEST(test_checker))

@@ -9,6 +9,8 @@
  *   badparams   a parameter beyond params_size
  *   nolighting  no lighting method
  *   nullclass   the entry returns NULL
+ *   attributes  (loads) Ci = (object:id, patch:id, checker at (u, v) x 4)
+ *               from the renderer's services, to test them
  */
 #include <stddef.h>
 #include <string.h>
@@ -33,6 +35,17 @@ static void lighting(const RayesShaderServices *sv, const RayesShadeCtx *ctx, co
             out->Ci[i][c] = p->Kd;
             out->Oi[i][c] = 1.0f;
         }
+#ifdef ATTRIBUTES
+    float object = -1.0f, patch = -1.0f;
+    int n_object = sv->attribute(sv, ctx, "object:id", &object, 1);
+    int n_patch = sv->attribute(sv, ctx, "patch:id", &patch, 1);
+    int unknown = sv->attribute(sv, ctx, "no:such", &patch, 1);
+    for (size_t i = 0; i < ctx->n_points; i++) {
+        out->Ci[i][0] = n_object == 1 && unknown == 0 ? object : -1.0f;
+        out->Ci[i][1] = n_patch == 1 ? patch : -1.0f;
+        out->Ci[i][2] = sv->checker(sv, 4.0f * ctx->u[i], 4.0f * ctx->v[i], 0.0f, 0.0f);
+    }
+#endif
 }
 
 static const RayesShaderParamDesc params[] = {
