@@ -99,7 +99,8 @@ static void half_steps(const Grid *g, float *hu, float *hv)
     }
 }
 
-static int displace_grid(const RayesScene *s, GridSet *gs, Grid *g, float step, Scratch *sc)
+static int displace_grid(const RayesScene *s, GridSet *gs, Grid *g, float step,
+                         const RayesShaderServices *sv, Scratch *sc)
 {
     const Prim *prim = &s->prims[g->prim];
     const ShaderInstance *inst = &s->displacements[prim->displacement - 1];
@@ -155,7 +156,7 @@ static int displace_grid(const RayesScene *s, GridSet *gs, Grid *g, float step, 
         .scratch = inst->cls->scratch_size ? sc->shader_scratch : NULL,
     };
     RayesShadeOutputs out = {.P = sc->out};
-    inst->cls->displacement(&shade_dicing_services, &ctx, inst->params, &out);
+    inst->cls->displacement(sv, &ctx, inst->params, &out);
     float bound = prim->displacement_bound;
     for (size_t i = 0; i < m; i++) {
         Vec3 d = v3_sub(get3(sc->out[i]), get3(sc->P[i]));
@@ -191,13 +192,14 @@ static int displace_grid(const RayesScene *s, GridSet *gs, Grid *g, float step, 
     return 0;
 }
 
-int scene_displace(const RayesScene *s, GridSet *gs, size_t first_grid, float step)
+int scene_displace(const RayesScene *s, GridSet *gs, size_t first_grid, float step,
+                   const RayesShaderServices *sv)
 {
     Scratch sc = {0};
     int status = 0;
     for (size_t i = first_grid; i < gs->n_grids && status == 0; i++)
         if (s->prims[gs->grids[i].prim].displacement)
-            status = displace_grid(s, gs, &gs->grids[i], step, &sc);
+            status = displace_grid(s, gs, &gs->grids[i], step, sv, &sc);
     scratch_free(&sc);
     return status;
 }

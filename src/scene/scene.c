@@ -14,6 +14,7 @@
 
 #include "rayes/rayes.h"
 #include "rayes/shader.h"
+#include "shade/builtin.h"
 #include "util/check.h"
 #include "util/log.h"
 
@@ -461,8 +462,10 @@ Bounds3 scene_bounds(const RayesScene *s)
     return b;
 }
 
-int scene_prepare(const RayesScene *s, int height, GridSet *gs)
+int scene_prepare(const RayesScene *s, int height, TextureSystem *textures, GridSet *gs)
 {
+    DicingServices sv;
+    shade_dicing_services_init(&sv, textures);
     DiceCamera cam;
     Bounds3 b = scene_bounds(s);
     float radius = s->n_prims ? 0.5f * v3_length(v3_sub(b.hi, b.lo)) : 1.0f;
@@ -474,7 +477,7 @@ int scene_prepare(const RayesScene *s, int height, GridSet *gs)
         if (geom_dice_prim(gs, &s->prims[i], (uint32_t)i, &cam) != 0)
             return -1;
         /* Normals of displaced surfaces: differences over 1e-3 of the scene radius. */
-        if (s->prims[i].displacement && scene_displace(s, gs, first, 1e-3f * radius) != 0)
+        if (s->prims[i].displacement && scene_displace(s, gs, first, 1e-3f * radius, &sv.sv) != 0)
             return -1;
     }
     return 0;

@@ -19,6 +19,7 @@
 #include "geom/geom.h"
 #include "shade/light.h"
 #include "shade/shade.h"
+#include "shade/texture.h"
 #include "util/vec.h"
 
 typedef struct SceneObject {
@@ -61,14 +62,16 @@ struct RayesScene {
 };
 
 /* Dices every primitive of a committed scene for a camera that sees
- * `height` pixels over its vertical field of view. Returns 0, or -1 when
- * out of memory. */
-int scene_prepare(const RayesScene *scene, int height, GridSet *gs);
+ * `height` pixels over its vertical field of view, and runs displacement
+ * shaders (whose texture lookups read from textures, which may be NULL).
+ * Returns 0, or -1 when out of memory. */
+int scene_prepare(const RayesScene *scene, int height, TextureSystem *textures, GridSet *gs);
 
 /* Runs the displacement shaders of the primitives of grids [first_grid,
  * n_grids) of gs (displace.c); normals come from differences over step
  * (world units). Returns 0, or -1 when out of memory. */
-int scene_displace(const RayesScene *scene, GridSet *gs, size_t first_grid, float step);
+int scene_displace(const RayesScene *scene, GridSet *gs, size_t first_grid, float step,
+                   const RayesShaderServices *sv);
 /* The scene's search path of that kind: colon-separated directories, ""
  * if never set. Borrowed: valid until the next set_search_path. */
 const char *scene_search_path(const RayesScene *scene, SceneSearchPath kind);

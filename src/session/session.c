@@ -220,7 +220,7 @@ RayesError rayes_render(RayesScene *scene, const RayesRenderOptions *opt, RayesI
     char err[300] = "";
     set.textures = textures;
     if (!objects || !masks || !img || !rgba || !textures ||
-        scene_prepare(scene, set.height, &gs) != 0) {
+        scene_prepare(scene, set.height, textures, &gs) != 0) {
         e = fail(scene, RAYES_ERROR_OUT_OF_MEMORY, "render: out of memory preparing the scene");
         goto done;
     }

@@ -17,6 +17,15 @@ extern const RayesShaderClass shade_class_fractal;  /* displacement: the memo's 
 /* The services displacement runs with at dicing time: patterns only (the
  * lighting services are NULL; supports() says so). */
 extern const RayesShaderServices shade_dicing_services;
+
+/* The same with the texture service reading from a texture system. */
+typedef struct TextureSystem TextureSystem;
+typedef struct DicingServices {
+    RayesShaderServices sv;   /* first, so a services pointer is a DicingServices pointer */
+    TextureSystem *textures;  /* may be NULL: the texture service then fails */
+} DicingServices;
+
+void shade_dicing_services_init(DicingServices *ds, TextureSystem *textures);
 /* plastic with a texture: Ka, Kd, Ks, roughness, specularcolor, texturename */
 extern const RayesShaderClass shade_class_paintedplastic;
 

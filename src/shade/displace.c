@@ -20,6 +20,7 @@
 #include "shade/builtin.h"
 #include "shade/noise.h"
 #include "shade/shade.h"
+#include "shade/texture.h"
 
 typedef struct BumpyParams {
     float Km, frequency;
@@ -158,9 +159,33 @@ static float dice_checker(const RayesShaderServices *sv, float s, float t, float
 
 static int dice_supports(const RayesShaderServices *sv, const char *service)
 {
-    (void)sv;
+    if (strcmp(service, "texture") == 0)
+        return sv->texture != NULL;
     return strcmp(service, "noise") == 0 || strcmp(service, "fbm") == 0 ||
            strcmp(service, "turbulence") == 0 || strcmp(service, "checker") == 0;
+}
+
+/* Texture lookups at dicing, filtered over the grid's spacing. */
+static int dice_texture(const RayesShaderServices *sv, const RayesShadeCtx *ctx, const char *name,
+                        const float *s, const float *t, const float *ds, const float *dt,
+                        float (*rgb)[3], float *alpha)
+{
+    TextureSystem *ts = ((const DicingServices *)(const void *)sv)->textures;
+    if (!ts || !name || !s || !t) {
+        memset(rgb, 0, ctx->n_points * sizeof *rgb);
+        for (size_t i = 0; alpha && i < ctx->n_points; i++)
+            alpha[i] = 1.0f;
+        return -1;
+    }
+    return texture_lookup(ts, name, ctx->n_points, s, t, ds ? ds : ctx->du, dt ? dt : ctx->dv,
+                          rgb, alpha);
+}
+
+void shade_dicing_services_init(DicingServices *ds, TextureSystem *textures)
+{
+    ds->sv = shade_dicing_services;
+    ds->sv.texture = dice_texture;
+    ds->textures = textures;
 }
 
 /* Lighting does not exist yet when displacement runs: those members are NULL. */

@@ -7,9 +7,11 @@
  * continuous.
  */
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
+#include "image/image.h"
 #include "rayes/rayes.h"
 #include "rayes/shader.h"
 #include "scene/scene.h"
@@ -71,7 +73,7 @@ static void test_sine_plane_is_analytic(void)
     RayesScene *s = plane_scene(1, rates, 1);
     GridSet gs;
     geom_gridset_init(&gs);
-    CHECK(scene_prepare(s, 200, &gs) == 0);
+    CHECK(scene_prepare(s, 200, NULL, &gs) == 0);
     CHECK(gs.n_vertices > 100);
     double worst_p = 0.0, worst_n = 0.0;
     for (size_t i = 0; i < gs.n_vertices; i++) {
@@ -103,7 +105,7 @@ static void test_neighbours_agree(void)
     RayesScene *s = plane_scene(2, rates, 0);
     GridSet gs;
     geom_gridset_init(&gs);
-    CHECK(scene_prepare(s, 20, &gs) == 0);
+    CHECK(scene_prepare(s, 20, NULL, &gs) == 0);
     CHECK(gs.n_grids == 2);
     CHECK(gs.grids[0].nu != gs.grids[1].nu);
     int matches = 0;
@@ -140,7 +142,7 @@ static void test_bound_clamps(void)
     CHECK(rayes_scene_commit(s) == RAYES_OK);
     GridSet gs;
     geom_gridset_init(&gs);
-    CHECK(scene_prepare(s, 100, &gs) == 0);
+    CHECK(scene_prepare(s, 100, NULL, &gs) == 0);
     float most = 0.0f;
     for (size_t i = 0; i < gs.n_vertices; i++)
         most = fmaxf(most, fabsf(gs.P[i].z));
@@ -198,6 +200,45 @@ static void test_noise(void)
     CHECK(noise_turbulence(p, 4, NOISE_LACUNARITY, 0.5f) >= fabsf(f4) - 1e-6f);
 }
 
+/* bumpy with a texture: displacement by Km times the texture, looked up at
+ * dicing through the texture system given to prepare. */
+static void test_bumpy_texture(void)
+{
+    const char *path = RAYES_TEST_TMP "/bumpy_half.exr";
+    float px[4 * 4 * 4];
+    for (int i = 0; i < 16; i++)
+        px[4 * i] = px[4 * i + 1] = px[4 * i + 2] = 0.5f, px[4 * i + 3] = 1.0f;
+    char err[256];
+    CHECK(image_write_exr(path, 4, 4, px, err, sizeof err) == RAYES_OK);
+    TextureSystem *ts = texture_system_new("", 1000000, 1.0f);
+    CHECK(ts != NULL);
+    RayesScene *s = rayes_scene_new();
+    const RayesParam p[] = {{"Km", RAYES_PARAM_FLOAT, {0.1f, 0, 0}, NULL},
+                            {"texturename", RAYES_PARAM_STRING, {0, 0, 0}, path}};
+    CHECK(rayes_scene_set_displacement(s, "bumpy", p, 2) == RAYES_OK);
+    const float P[4][3] = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {1, 1, 0}};
+    CHECK(rayes_scene_bilinear_patch(s, P) == RAYES_OK);
+    CHECK(rayes_scene_commit(s) == RAYES_OK);
+    for (int with = 0; with < 2; with++) {
+        GridSet gs;
+        geom_gridset_init(&gs);
+        CHECK(scene_prepare(s, 50, with ? ts : NULL, &gs) == 0);
+        float lo = INFINITY, hi = -INFINITY;
+        for (size_t i = 0; i < gs.n_vertices; i++)
+            lo = fminf(lo, gs.P[i].z), hi = fmaxf(hi, gs.P[i].z);
+        if (with) {
+            CHECK_NEAR(lo, 0.05f, 1e-6);
+            CHECK_NEAR(hi, 0.05f, 1e-6);
+        } else {
+            CHECK(hi - lo > 0.01f); /* no texture system: noise, as without a texture */
+        }
+        geom_gridset_fini(&gs);
+    }
+    rayes_scene_release(s);
+    texture_system_free(ts);
+    remove(path);
+}
+
 static void test_checker(void)
 {
     CHECK(pattern_checker(0.5f, 0.5f, 0, 0) == 1.0f);
@@ -218,4 +259,5 @@ static void test_checker(void)
 }
 
 TEST_MAIN(TEST(test_sine_plane_is_analytic), TEST(test_neighbours_agree), TEST(test_bound_clamps),
-          TEST(test_api_errors), TEST(test_noise), TEST(test_checker))
+          TEST(test_api_errors), TEST(test_noise), TEST(test_checker),
+          TEST(test_bumpy_texture))
