@@ -343,9 +343,12 @@ static void table2(const Args *a, FILE *j)
 
 /* Error of image r against the reference: RMSE over pixels and channels
  * divided by the reference's mean, and the mean relative error
- * sum |r - ref| / sum ref; writes 20 x |r - ref| to DIR/figure5-TAG-diff.png. */
-static void against(const Args *a, const Row *r, const Row *ref, const char *tag, double *rel_rmse,
-                    double *mean_rel)
+ * sum |r - ref| / sum ref, on linear values (clamp 0) or on values clamped
+ * to the displayable [0, 1] (clamp 1: a light seen directly or in a mirror
+ * is worth 1, not 17); with write, 20 x |r - ref| (linear) goes to
+ * DIR/figure5-TAG-diff.png. */
+static void against(const Args *a, const Row *r, const Row *ref, const char *tag, int clamp,
+                    int write, double *rel_rmse, double *mean_rel)
 {
     size_t n = (size_t)r->w * r->h;
     double se = 0.0, ae = 0.0, sum = 0.0;
@@ -354,11 +357,15 @@ static void against(const Args *a, const Row *r, const Row *ref, const char *tag
         die("out of memory");
     for (size_t i = 0; i < n; i++) {
         for (int c = 0; c < 3; c++) {
-            double d = (double)r->rgba[4 * i + c] - ref->rgba[4 * i + c];
-            se += d * d;
-            ae += fabs(d);
-            sum += ref->rgba[4 * i + c];
-            diff[4 * i + c] = (float)(20.0 * fabs(d));
+            double x = r->rgba[4 * i + c], y = ref->rgba[4 * i + c];
+            diff[4 * i + c] = (float)(20.0 * fabs(x - y));
+            if (clamp) {
+                x = fmin(fmax(x, 0.0), 1.0);
+                y = fmin(fmax(y, 0.0), 1.0);
+            }
+            se += (x - y) * (x - y);
+            ae += fabs(x - y);
+            sum += y;
         }
         diff[4 * i + 3] = 1.0f;
     }
@@ -367,7 +374,7 @@ static void against(const Args *a, const Row *r, const Row *ref, const char *tag
     *mean_rel = ae / sum;
     char path[1024], err[1024];
     snprintf(path, sizeof path, "%s/figure5-%s-diff.png", a->out, tag);
-    if (image_write(path, r->w, r->h, diff, err, sizeof err) != RAYES_OK)
+    if (write && image_write(path, r->w, r->h, diff, err, sizeof err) != RAYES_OK)
         die(err);
     free(diff);
 }
@@ -385,8 +392,8 @@ static void figure5(Args *a, FILE *j)
                  {"final", RAYES_QUALITY_FINAL}};
     printf("Figure 5 (%s, 1 bounce, %dx%d, %d spp): against the reference\n", a->scene, a->size,
            a->size, a->spp);
-    printf("%-9s | %9s %9s %8s %8s | %10s %10s | %s\n", "image", "sh.pts", "rays", "time", "cpu",
-           "rel. RMSE", "mean rel.", "time / reference");
+    printf("%-9s | %9s %9s %8s %8s | %10s %10s | %10s %10s | %s\n", "image", "sh.pts", "rays",
+           "time", "cpu", "rel. RMSE", "mean rel.", "(display)", "(display)", "time / reference");
     fprintf(j, "{\"figure\": 5, \"size\": %d, \"spp\": %d, \"rows\": [", a->size, a->spp);
     Row ref = {0};
     for (int i = 0; i < 3; i++) {
@@ -398,21 +405,25 @@ static void figure5(Args *a, FILE *j)
             die(err);
         human(s1, sizeof s1, r.shading_points);
         human(s2, sizeof s2, r.rays);
-        double rmse = 0.0, mrel = 0.0;
-        if (i > 0)
-            against(a, &r, &ref, rows[i].tag, &rmse, &mrel);
+        double rmse = 0.0, mrel = 0.0, drmse = 0.0, dmrel = 0.0;
+        if (i > 0) {
+            against(a, &r, &ref, rows[i].tag, 0, 1, &rmse, &mrel);
+            against(a, &r, &ref, rows[i].tag, 1, 0, &drmse, &dmrel);
+        }
         printf("%-9s | %9s %9s %7.1fs %7.1fs |", rows[i].tag, s1, s2, r.time_s, r.cpu_s);
         if (i > 0)
-            printf(" %9.2f%% %9.2f%% | %.3f (cpu %.3f)\n", 100 * rmse, 100 * mrel,
-                   r.time_s / ref.time_s, r.cpu_s / ref.cpu_s);
+            printf(" %9.2f%% %9.2f%% | %9.2f%% %9.2f%% | %.3f (cpu %.3f)\n", 100 * rmse,
+                   100 * mrel, 100 * drmse, 100 * dmrel, r.time_s / ref.time_s,
+                   r.cpu_s / ref.cpu_s);
         else
-            printf(" %10s %10s |\n", "-", "-");
+            printf(" %10s %10s | %10s %10s |\n", "-", "-", "-", "-");
         fflush(stdout);
         fprintf(j,
                 "%s\n    {\"image\": \"%s\", \"time_s\": %.3f, \"cpu_s\": %.3f, "
                 "\"shading_points\": %llu, \"rays\": %llu, \"rel_rmse\": %.6f, "
-                "\"mean_rel\": %.6f}",
-                i ? "," : "", rows[i].tag, r.time_s, r.cpu_s, r.shading_points, r.rays, rmse, mrel);
+                "\"mean_rel\": %.6f, \"display_rel_rmse\": %.6f, \"display_mean_rel\": %.6f}",
+                i ? "," : "", rows[i].tag, r.time_s, r.cpu_s, r.shading_points, r.rays, rmse, mrel,
+                drmse, dmrel);
         if (i == 0)
             ref = r;
         else
