@@ -21,6 +21,7 @@
 #include <math.h>
 #include <string.h>
 
+#include "shade/builtin.h"
 #include "shade/noise.h"
 #include "util/check.h"
 #include "util/rng.h"
@@ -547,34 +548,7 @@ static int svc_texture(const RayesShaderServices *sv, const RayesShadeCtx *ctx, 
 {
     (void)sv;
     TextureSystem *ts = ((const PathState *)ctx->renderer)->w->set->textures;
-    if (!ts || !name || !s || !t) {
-        memset(rgb, 0, ctx->n_points * sizeof *rgb);
-        for (size_t i = 0; alpha && i < ctx->n_points; i++)
-            alpha[i] = 1.0f;
-        return -1;
-    }
-    return texture_lookup(ts, name, ctx->n_points, s, t, ds ? ds : ctx->du, dt ? dt : ctx->dv,
-                          rgb, alpha);
-}
-
-static float svc_noise(const RayesShaderServices *sv, const float p[3])
-{
-    (void)sv;
-    return noise3(p[0], p[1], p[2]);
-}
-
-static float svc_fbm(const RayesShaderServices *sv, const float p[3], int octaves,
-                     float lacunarity, float gain)
-{
-    (void)sv;
-    return noise_fbm(p, octaves, lacunarity, gain);
-}
-
-static float svc_turbulence(const RayesShaderServices *sv, const float p[3], int octaves,
-                            float lacunarity, float gain)
-{
-    (void)sv;
-    return noise_turbulence(p, octaves, lacunarity, gain);
+    return shade_texture_service(ts, ctx, name, s, t, ds, dt, rgb, alpha);
 }
 
 static int put_floats(float *value, int n, const float *have, int n_have)
@@ -582,12 +556,6 @@ static int put_floats(float *value, int n, const float *have, int n_have)
     for (int k = 0; k < n && k < n_have; k++)
         value[k] = have[k];
     return n_have;
-}
-
-static float svc_checker(const RayesShaderServices *sv, float s, float t, float ds, float dt)
-{
-    (void)sv;
-    return pattern_checker(s, t, ds, dt);
 }
 
 static int svc_attribute(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
@@ -652,11 +620,11 @@ const RayesShaderServices render_services = {
     .indirect_refraction = svc_indirect_refraction,
     .transmission = svc_transmission,
     .texture = svc_texture,
-    .noise = svc_noise,
-    .fbm = svc_fbm,
-    .turbulence = svc_turbulence,
+    .noise = shade_service_noise,
+    .fbm = shade_service_fbm,
+    .turbulence = shade_service_turbulence,
     .attribute = svc_attribute,
     .option = svc_option,
-    .checker = svc_checker,
+    .checker = shade_service_checker,
     .supports = svc_supports,
 };

@@ -26,6 +26,19 @@ typedef struct DicingServices {
 } DicingServices;
 
 void shade_dicing_services_init(DicingServices *ds, TextureSystem *textures);
+
+/* Service functions that both the renderer's table and the dicing table
+ * use: patterns (noise.h), and the texture service over a texture system
+ * (NULL: -1, black, alpha 1); ds and dt NULL mean ctx->du and ctx->dv. */
+float shade_service_noise(const RayesShaderServices *sv, const float p[3]);
+float shade_service_fbm(const RayesShaderServices *sv, const float p[3], int octaves,
+                        float lacunarity, float gain);
+float shade_service_turbulence(const RayesShaderServices *sv, const float p[3], int octaves,
+                               float lacunarity, float gain);
+float shade_service_checker(const RayesShaderServices *sv, float s, float t, float ds, float dt);
+int shade_texture_service(TextureSystem *ts, const RayesShadeCtx *ctx, const char *name,
+                          const float *s, const float *t, const float *ds, const float *dt,
+                          float (*rgb)[3], float *alpha);
 /* plastic with a texture: Ka, Kd, Ks, roughness, specularcolor, texturename */
 extern const RayesShaderClass shade_class_paintedplastic;
 

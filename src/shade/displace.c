@@ -131,27 +131,27 @@ const RayesShaderClass shade_class_fractal = {
 
 /* ------------------------------------------ services at dicing time */
 
-static float dice_noise(const RayesShaderServices *sv, const float p[3])
+float shade_service_noise(const RayesShaderServices *sv, const float p[3])
 {
     (void)sv;
     return noise3(p[0], p[1], p[2]);
 }
 
-static float dice_fbm(const RayesShaderServices *sv, const float p[3], int octaves,
+float shade_service_fbm(const RayesShaderServices *sv, const float p[3], int octaves,
                       float lacunarity, float gain)
 {
     (void)sv;
     return noise_fbm(p, octaves, lacunarity, gain);
 }
 
-static float dice_turbulence(const RayesShaderServices *sv, const float p[3], int octaves,
+float shade_service_turbulence(const RayesShaderServices *sv, const float p[3], int octaves,
                              float lacunarity, float gain)
 {
     (void)sv;
     return noise_turbulence(p, octaves, lacunarity, gain);
 }
 
-static float dice_checker(const RayesShaderServices *sv, float s, float t, float ds, float dt)
+float shade_service_checker(const RayesShaderServices *sv, float s, float t, float ds, float dt)
 {
     (void)sv;
     return pattern_checker(s, t, ds, dt);
@@ -171,6 +171,13 @@ static int dice_texture(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
                         float (*rgb)[3], float *alpha)
 {
     TextureSystem *ts = ((const DicingServices *)(const void *)sv)->textures;
+    return shade_texture_service(ts, ctx, name, s, t, ds, dt, rgb, alpha);
+}
+
+int shade_texture_service(TextureSystem *ts, const RayesShadeCtx *ctx, const char *name,
+                          const float *s, const float *t, const float *ds, const float *dt,
+                          float (*rgb)[3], float *alpha)
+{
     if (!ts || !name || !s || !t) {
         memset(rgb, 0, ctx->n_points * sizeof *rgb);
         for (size_t i = 0; alpha && i < ctx->n_points; i++)
@@ -192,9 +199,9 @@ void shade_dicing_services_init(DicingServices *ds, TextureSystem *textures)
 const RayesShaderServices shade_dicing_services = {
     .abi_version = RAYES_SHADER_ABI_VERSION,
     .struct_size = sizeof(RayesShaderServices),
-    .noise = dice_noise,
-    .fbm = dice_fbm,
-    .turbulence = dice_turbulence,
+    .noise = shade_service_noise,
+    .fbm = shade_service_fbm,
+    .turbulence = shade_service_turbulence,
     .supports = dice_supports,
-    .checker = dice_checker,
+    .checker = shade_service_checker,
 };
