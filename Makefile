@@ -40,14 +40,17 @@ test-asan:
 # test hammers a tiny budget from many threads), the renderer's thread
 # pool, the shader plugin registry (threads loading plugins at once; the
 # plugins are built with TSan too) and the texture cache (threads loading,
-# evicting and reloading MIP levels on a tiny budget). Embree and TBB are
-# not instrumented, so renders are left to ASan.
+# evicting and reloading MIP levels on a tiny budget), and the grid hider
+# (threads shading grids on first sight behind striped locks), and whole
+# renders on 1 to 4 threads (the determinism tests). Embree and
+# TBB are not instrumented: tools/tsan.supp suppresses reports inside them.
 TSAN_TESTS = cache_test_cache cache_test_cache_stress util_test_math util_test_half \
-             shade_test_plugin shade_test_texture_threads
+             shade_test_plugin shade_test_texture_threads render_test_hider \
+             render_test_determinism
 test-tsan:
 	@test -f build-tsan/CMakeCache.txt || cmake -S . -B build-tsan -DCMAKE_BUILD_TYPE=RelWithDebInfo -DRAYES_TSAN=ON
 	cmake --build build-tsan -j $(JOBS) --target $(TSAN_TESTS)
-	cd build-tsan && TSAN_OPTIONS=halt_on_error=1 ctest --output-on-failure -R '^(cache|util)/|^shade/test_plugin$$|^shade/test_texture_threads$$'
+	cd build-tsan && TSAN_OPTIONS="halt_on_error=1 suppressions=$(CURDIR)/tools/tsan.supp" ctest --output-on-failure -R '^(cache|util)/|^shade/test_plugin$$|^shade/test_texture_threads$$|^render/test_(hider|determinism)$$'
 
 bench: build
 
