@@ -10,6 +10,7 @@
  */
 #include "render/hider.h"
 
+#include <math.h>
 #include <pthread.h>
 #include <stdatomic.h>
 #include <stdlib.h>
@@ -25,16 +26,19 @@ typedef float Rgb[3];
 
 struct GridShading {
     const RenderScene *rs;
+    float contrast;              /* the limit of hider_camera_hit (HIDER_CONTRAST, scaled) */
     _Atomic(Rgb *) *ci;          /* per grid: its vertices' radiance, NULL until shaded */
     pthread_mutex_t locks[STRIPES];
 };
 
-GridShading *hider_new(const RenderScene *rs)
+GridShading *hider_new(const RenderScene *rs, const RenderSettings *set)
 {
     GridShading *gsh = calloc(1, sizeof *gsh);
     if (!gsh)
         return NULL;
     gsh->rs = rs;
+    int n = set->shadow_rays < set->diffuse_rays ? set->shadow_rays : set->diffuse_rays;
+    gsh->contrast = HIDER_CONTRAST * sqrtf(fmaxf(1.0f, 64.0f / (float)(n > 1 ? n : 1)));
     gsh->ci = calloc(rs->gs->n_grids ? rs->gs->n_grids : 1, sizeof *gsh->ci);
     if (!gsh->ci) {
         free(gsh);
@@ -153,7 +157,7 @@ static Rgb *shade_grid(Worker *w, uint32_t gi)
     return ci;
 }
 
-Vec3 hider_camera_hit(Worker *w, const Ray *ray, const Hit *hit)
+int hider_camera_hit(Worker *w, const Ray *ray, const Hit *hit, Vec3 *L)
 {
     (void)ray;
     GridShading *gsh = w->grid_shading;
@@ -170,10 +174,14 @@ Vec3 hider_camera_hit(Worker *w, const Ray *ray, const Hit *hit)
         pthread_mutex_unlock(lock);
     }
     uint32_t first = w->rs->gs->grids[gi].first_vertex;
-    Vec3 L = v3(0, 0, 0);
+    Vec3 sum = v3(0, 0, 0);
+    float lo = INFINITY, hi = 0.0f, mean = 0.0f;
     for (int k = 0; k < hit->n_vertex; k++) {
         const float *c = ci[hit->vertex[k] - first];
-        L = v3_madd(L, v3(c[0], c[1], c[2]), hit->weight[k]);
+        float y = c[0] + c[1] + c[2];
+        lo = fminf(lo, y), hi = fmaxf(hi, y), mean += y / (float)hit->n_vertex;
+        sum = v3_madd(sum, v3(c[0], c[1], c[2]), hit->weight[k]);
     }
-    return L;
+    *L = sum;
+    return hi - lo <= gsh->contrast * mean;
 }

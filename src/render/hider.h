@@ -18,12 +18,23 @@
 
 
 /* For a frame of rs; NULL when out of memory. */
-GridShading *hider_new(const RenderScene *rs);
+GridShading *hider_new(const RenderScene *rs, const RenderSettings *set);
 void hider_free(GridShading *gsh);
+
+/* Relative spread of a micropolygon's shaded corners above which the grid
+ * hider does not interpolate them (see hider_camera_hit), at 64 or more
+ * shadow and diffuse rays per point; with n < 64 it grows as sqrt(64 / n),
+ * so that the noise of few rays is interpolated, not mistaken for a
+ * highlight (at 1 ray it is 4: never, for four corners). */
+#define HIDER_CONTRAST 0.5f
 
 /* The radiance toward the camera at a camera ray's hit on a surface (not an
  * emitter): the hit grid's shaded vertices, interpolated with the hit's
- * weights. Shades the grid first if nobody has. */
-Vec3 hider_camera_hit(Worker *w, const Ray *ray, const Hit *hit);
+ * weights, into *L. Shades the grid first if nobody has. Returns 0 instead
+ * when the hit micropolygon's corners disagree too much to be interpolated
+ * (max - min of their summed RGB above the contrast limit times their mean:
+ * a highlight or a sharp reflection smaller than a micropolygon); the
+ * caller then shades the sample itself, as the ray-tracing hider does. */
+int hider_camera_hit(Worker *w, const Ray *ray, const Hit *hit, Vec3 *L);
 
 #endif /* RAYES_RENDER_HIDER_H */

@@ -201,8 +201,9 @@ Vec3 integrator_trace_hit(Worker *w, const Ray *ray, uint32_t kind, int diffuse_
     }
     if (kind == RAYES_RAY_DIFFUSE && w->set->cache)
         return radiosity_at_hit(w, ray, &hit, diffuse_depth, diff);
-    if (kind == RAYES_RAY_CAMERA && w->grid_shading)
-        return hider_camera_hit(w, ray, &hit);
+    Vec3 L;
+    if (kind == RAYES_RAY_CAMERA && w->grid_shading && hider_camera_hit(w, ray, &hit, &L))
+        return L;
     return shade_hit(w, ray, &hit, obj, kind, diffuse_depth, specular_depth, key, diff);
 }
 

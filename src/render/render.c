@@ -169,7 +169,7 @@ int render_frame(const RenderScene *rs, const RenderSettings *set, float *rgba, 
     RY_CHECK(f.workers != NULL);
     GridShading *gsh = NULL;
     if (set->hider == 1) {
-        gsh = hider_new(rs);
+        gsh = hider_new(rs, set);
         RY_CHECK(gsh != NULL);
     }
     for (int i = 0; i < threads; i++) {

@@ -97,7 +97,9 @@ static void test_irradiance_interpolation(void)
     RayesImage *b = render_irr(RAYES_HIDER_GRID, 1, 2, 1, 256, &d_on, &records);
     RayesImage *c = render_irr(RAYES_HIDER_GRID, 1, 1, 1, 256, NULL, NULL);
     check_agree(a, b, 0.03);
-    CHECK(d_on == d_off);
+    /* Nearly the same shading points: the grid's vertices, plus samples on
+     * micropolygons too contrasted to interpolate, which depend on values. */
+    CHECK(d_on > d_off * 19 / 20 && d_on < d_off * 21 / 20);
     CHECK(records > 0 && records < d_on * 3 / 4);
     CHECK(b && c && memcmp(b->rgba, c->rgba, sizeof(float) * 4 * 64 * 64) == 0);
     rayes_image_free(a);
@@ -126,6 +128,41 @@ static void test_shading_follows_vertices(void)
     CHECK(grid16 < ray16 / 4);
 }
 
-TEST_MAIN(TEST(test_agrees_with_raytrace), TEST(test_irradiance_interpolation),
+/* The chrome teapot reflects the light (radiance 17) in highlights smaller
+ * than a micropolygon: the grid hider shades such micropolygons per sample
+ * (with the ray-tracing hider's keys) instead of smearing a vertex's
+ * highlight over them, so no pixel is far from the ray-traced image. */
+static void test_highlights_not_smeared(void)
+{
+    RayesImage *img[2];
+    for (int h = 0; h < 2; h++) {
+        RayesScene *s = rayes_scene_new();
+        char err[512];
+        CHECK(io_builtin_scene("cornell-teapots", RAYES_TEST_DATA, s, err, sizeof err) ==
+              RAYES_OK);
+        RayesRenderOptions o;
+        rayes_render_options_init(&o, RAYES_QUALITY_PREVIEW);
+        o.width = o.height = 96;
+        o.spp = 2;
+        o.shadow_rays = o.shadow_rays_deep = 64;
+        o.diffuse_rays = 64;
+        o.hider = h ? RAYES_HIDER_GRID : RAYES_HIDER_RAYTRACE;
+        img[h] = NULL;
+        CHECK(rayes_render(s, &o, &img[h], NULL) == RAYES_OK);
+        rayes_scene_release(s);
+    }
+    if (img[0] && img[1]) {
+        float worst = 0.0f;
+        for (int i = 0; i < 96 * 96 * 4; i++)
+            worst = fmaxf(worst, fabsf(img[0]->rgba[i] - img[1]->rgba[i]));
+        CHECK(worst < 1.0f);
+        if (worst >= 1.0f)
+            fprintf(stderr, "  largest pixel difference %g\n", worst);
+    }
+    rayes_image_free(img[0]);
+    rayes_image_free(img[1]);
+}
+
+TEST_MAIN(TEST(test_agrees_with_raytrace), TEST(test_highlights_not_smeared), TEST(test_irradiance_interpolation),
           TEST(test_any_thread_count),
           TEST(test_shading_follows_vertices))
