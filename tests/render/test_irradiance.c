@@ -6,6 +6,7 @@
  * predict E at a tilted normal, the translational one E at a moved point.
  */
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 
 #include "render/irradiance.h"
@@ -195,6 +196,74 @@ static void test_gradients_improve_interpolation(void)
     }
 }
 
+/* An open box: floor z = 0, black walls up to z = 1 around x, y in [-1, 1],
+ * open to a uniform sky of radiance 1 above. The irradiance at a floor
+ * point is the sky seen through the opening, given exactly by Lambert's
+ * formula for a polygon. */
+static Vec3 open_box(Vec3 p, Vec3 d, float *r)
+{
+    *r = INFINITY;
+    if (d.z <= 0.0f)
+        return v3(0, 0, 0);
+    float t = (1.0f - p.z) / d.z;
+    Vec3 q = v3_madd(p, d, t);
+    if (fabsf(q.x) <= 1.0f && fabsf(q.y) <= 1.0f)
+        return v3(1, 1, 1); /* out through the opening */
+    /* the first wall it meets */
+    float tw = INFINITY;
+    if (d.x > 0.0f)
+        tw = fminf(tw, (1.0f - p.x) / d.x);
+    if (d.x < 0.0f)
+        tw = fminf(tw, (-1.0f - p.x) / d.x);
+    if (d.y > 0.0f)
+        tw = fminf(tw, (1.0f - p.y) / d.y);
+    if (d.y < 0.0f)
+        tw = fminf(tw, (-1.0f - p.y) / d.y);
+    *r = tw;
+    return v3(0, 0, 0);
+}
+
+/* Lambert: E = L/2 sum over edges of angle * (n . unit normal of the edge's
+ * plane through p), for the opening seen from p with normal +z. */
+static double open_box_exact(Vec3 p)
+{
+    const double c[4][2] = {{-1, -1}, {1, -1}, {1, 1}, {-1, 1}};
+    double sum = 0.0;
+    for (int i = 0; i < 4; i++) {
+        double a[3] = {c[i][0] - p.x, c[i][1] - p.y, 1.0 - p.z};
+        double b[3] = {c[(i + 1) % 4][0] - p.x, c[(i + 1) % 4][1] - p.y, 1.0 - p.z};
+        double la = sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
+        double lb = sqrt(b[0] * b[0] + b[1] * b[1] + b[2] * b[2]);
+        double cosg = (a[0] * b[0] + a[1] * b[1] + a[2] * b[2]) / (la * lb);
+        double g = acos(fmin(1.0, fmax(-1.0, cosg)));
+        double cz = a[0] * b[1] - a[1] * b[0];
+        double cl = sqrt(pow(a[1] * b[2] - a[2] * b[1], 2) + pow(a[2] * b[0] - a[0] * b[2], 2) +
+                         cz * cz);
+        sum += g * cz / cl;
+    }
+    return 0.5 * fabs(sum);
+}
+
+static void test_open_box(void)
+{
+    enum { M = 48, N = 151 };
+    static Vec3 L[M * N];
+    static float r[M * N];
+    Vec3 n = v3(0, 0, 1), p0 = v3(0.3f, -0.2f, 0.0f), p1 = v3(0.42f, -0.12f, 0.0f);
+    for (int j = 0; j < M; j++)
+        for (int k = 0; k < N; k++)
+            L[j * N + k] = open_box(p0, irr_direction(M, N, j, k, 0.5f, 0.5f, n), &r[j * N + k]);
+    IrrRecord rec;
+    irr_record(M, N, L, r, p0, n, &rec);
+    double e0 = open_box_exact(p0), e1 = open_box_exact(p1);
+    CHECK(fabs(rec.E.x - e0) < 0.005 * e0); /* the record itself */
+    double with = irr_extrapolate(&rec, p1, n).x, without = rec.E.x;
+    CHECK(fabs(with - e1) < 0.01 * e1);
+    CHECK(fabs(without - e1) > 0.02 * e1);
+    CHECK(fabs(without - e1) > 3.0 * fabs(with - e1));
+    printf("  open box: exact %.5f, with gradients %.5f, without %.5f\n", e1, with, without);
+}
+
 static void test_weight(void)
 {
     IrrRecord rec = {.p = v3(0, 0, 0), .n = v3(0, 0, 1), .R = 1.0f};
@@ -210,4 +279,4 @@ static void test_weight(void)
 
 TEST_MAIN(TEST(test_frame_is_right_handed), TEST(test_uniform_sky), TEST(test_rotational_gradient),
           TEST(test_translational_gradient), TEST(test_gradients_improve_interpolation),
-          TEST(test_weight))
+          TEST(test_weight), TEST(test_open_box))
