@@ -6,12 +6,18 @@
  * clamps (digest 3.2): at most E / |grad_t E| per channel, then within 3 and
  * 20 times the pixel footprint at the vertex.
  *
- * A vertex off the lattice takes the records whose smooth weight
- * (irr_weight, kappa 1) is positive there; their gradient-extrapolated
- * values are averaged by weight. It computes its own record instead when
- * the weights sum to less than MIN_WEIGHT, or when the extrapolations
- * disagree by more than DISAGREE of their mean (a shadow edge or a nearby
- * occluder between records): the refinement where neighbours disagree.
+ * Quad grids: records at the lattice knots (every 4th vertex, the last row
+ * and column). A lattice cell interpolates its four corner records at its
+ * other vertices (bilinear weights times irr_weight with kappa 0.5, values
+ * extrapolated with both gradients), unless the corners' predictions for
+ * the cell's centre vertex disagree by more than max(DISAGREE, 3 /
+ * sqrt(rays)) of their mean (a shadow edge, an occluder between records),
+ * or a corner's radius is smaller than the cell: then every vertex of the
+ * cell gets its own record, the refinement where neighbours disagree.
+ *
+ * Triangular grids: in vertex order, a vertex whose earlier records' weights
+ * (kappa 1) sum to MIN_WEIGHT or more interpolates them; otherwise it gets
+ * a record.
  */
 #include "render/irrgrid.h"
 
