@@ -77,6 +77,29 @@ RAYES_API RayesError rayes_scene_set_camera(RayesScene *scene, const float eye[3
                                             const float target[3], const float up[3],
                                             float fov_y_degrees);
 
+/* Projections of rayes_scene_set_camera_matrix. */
+typedef enum RayesProjection {
+    RAYES_PROJECTION_PERSPECTIVE = 0,
+    RAYES_PROJECTION_ORTHOGRAPHIC = 1
+} RayesProjection;
+
+/* A camera given as RenderMan gives it: camera_from_world (row-major, a
+ * rigid motion possibly with a uniform scale or a mirror), in whose camera
+ * space the eye is at the origin looking down +z with +y up and +x to the
+ * right of the image (left-handed, RenderMan's and pbrt's convention; a
+ * mirror in the matrix mirrors the image). A point (x, y, z) of camera
+ * space lands at screen position (x / z, y / z) / tan(fov / 2) in
+ * perspective, (x, y) in orthographic projection (fov is then ignored).
+ * screen_window is {left, right, bottom, top} of the screen rectangle the
+ * image shows (RenderMan's ScreenWindow), or NULL for the default, which
+ * depends on the image's aspect ratio a = width / height: {-a, a, -1, 1}
+ * when a >= 1, else {-1, 1, -1/a, 1/a}, so the field of view spans the
+ * shorter side of the image. Replaces any earlier camera. */
+RAYES_API RayesError rayes_scene_set_camera_matrix(RayesScene *scene,
+                                                   const float camera_from_world[16],
+                                                   RayesProjection projection, float fov_degrees,
+                                                   const float screen_window[4]);
+
 /* The transform applied to geometry added from now on: world_from_object,
  * row-major. The identity at first. */
 RAYES_API RayesError rayes_scene_set_transform(RayesScene *scene,
@@ -155,6 +178,35 @@ RAYES_API RayesError rayes_scene_polygon_mesh(RayesScene *scene, size_t n_faces,
 
 /* A sphere of the given radius centred at the object-space origin. */
 RAYES_API RayesError rayes_scene_sphere(RayesScene *scene, float radius);
+
+/* RenderMan's quadrics, in object space (the current transform places
+ * them), swept about the z axis through thetamax degrees (0 < |thetamax|
+ * <= 360); parameters in RenderMan's order:
+ *   SPHERE       radius zmin zmax thetamax
+ *   CYLINDER     radius zmin zmax thetamax
+ *   CONE         height radius thetamax           (apex at z = height)
+ *   DISK         height radius thetamax           (in the plane z = height)
+ *   PARABOLOID   rmax zmin zmax thetamax          (r = rmax sqrt(z / zmax))
+ *   HYPERBOLOID  x1 y1 z1 x2 y2 z2 thetamax       (the line p1 p2 swept)
+ *   TORUS        rmajor rminor phimin phimax thetamax
+ * Normals point away from the z axis (up for the disk), or the other way
+ * when flags has RAYES_QUADRIC_REVERSE (RenderMan's ReverseOrientation,
+ * or a left-handed current transform). A wrong count or a degenerate
+ * shape is RAYES_ERROR_INVALID_ARGUMENT. */
+typedef enum RayesQuadric {
+    RAYES_QUADRIC_SPHERE = 0,
+    RAYES_QUADRIC_CYLINDER = 1,
+    RAYES_QUADRIC_CONE = 2,
+    RAYES_QUADRIC_DISK = 3,
+    RAYES_QUADRIC_PARABOLOID = 4,
+    RAYES_QUADRIC_HYPERBOLOID = 5,
+    RAYES_QUADRIC_TORUS = 6
+} RayesQuadric;
+
+#define RAYES_QUADRIC_REVERSE 1u
+
+RAYES_API RayesError rayes_scene_quadric(RayesScene *scene, RayesQuadric type,
+                                         const float *params, size_t n_params, unsigned flags);
 
 /* A one-sided emitting quad (an area light) with vertices P[0..3] in order
  * around the quad; it emits radiance L from the side toward which

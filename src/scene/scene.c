@@ -790,3 +790,19 @@ RayesError rayes_scene_set_search_path(RayesScene *s, const char *kind, const ch
     s->search_paths[k] = expanded;
     return RAYES_OK;
 }
+
+RayesError rayes_scene_set_camera_matrix(RayesScene *s, const float m[16], RayesProjection proj,
+                                         float fov, const float screen[4])
+{
+    (void)m, (void)proj, (void)fov, (void)screen;
+    return s ? fail(s, RAYES_ERROR_INVALID_OPERATION, "camera matrix: not built yet")
+             : RAYES_ERROR_INVALID_ARGUMENT;
+}
+
+RayesError rayes_scene_quadric(RayesScene *s, RayesQuadric type, const float *params, size_t n,
+                               unsigned flags)
+{
+    (void)type, (void)params, (void)n, (void)flags;
+    return s ? fail(s, RAYES_ERROR_INVALID_OPERATION, "quadric: not built yet")
+             : RAYES_ERROR_INVALID_ARGUMENT;
+}

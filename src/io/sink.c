@@ -1,0 +1,125 @@
+/*
+ * io/sink.c — the sink that builds a RayesScene through rayes.h, and the
+ * defaults of IoSettings.
+ */
+#include "io/sink.h"
+
+#include <string.h>
+
+static RayesError scene_set_camera(void *t, const float eye[3], const float at[3],
+                                   const float up[3], float fov)
+{
+    return rayes_scene_set_camera(t, eye, at, up, fov);
+}
+
+static RayesError scene_set_camera_matrix(void *t, const float m[16], RayesProjection proj,
+                                          float fov, const float screen[4])
+{
+    return rayes_scene_set_camera_matrix(t, m, proj, fov, screen);
+}
+
+static RayesError scene_set_transform(void *t, const float m[16])
+{
+    return rayes_scene_set_transform(t, m);
+}
+
+static RayesError scene_set_shader(void *t, const char *name, const RayesParam *p, size_t n)
+{
+    return rayes_scene_set_shader(t, name, p, n);
+}
+
+static RayesError scene_set_displacement(void *t, const char *name, const RayesParam *p,
+                                         size_t n)
+{
+    return rayes_scene_set_displacement(t, name, p, n);
+}
+
+static RayesError scene_set_displacement_bound(void *t, float bound)
+{
+    return rayes_scene_set_displacement_bound(t, bound);
+}
+
+static RayesError scene_set_search_path(void *t, const char *kind, const char *path)
+{
+    return rayes_scene_set_search_path(t, kind, path);
+}
+
+static RayesError scene_set_shading_rate(void *t, float rate)
+{
+    return rayes_scene_set_shading_rate(t, rate);
+}
+
+static RayesError scene_bilinear_patch(void *t, const float P[4][3])
+{
+    return rayes_scene_bilinear_patch(t, P);
+}
+
+static RayesError scene_bicubic_patch(void *t, const float P[16][3])
+{
+    return rayes_scene_bicubic_patch(t, P);
+}
+
+static RayesError scene_polygon_mesh(void *t, size_t n_faces, const int *n_verts,
+                                     const int *indices, size_t n_points, const float *P)
+{
+    return rayes_scene_polygon_mesh(t, n_faces, n_verts, indices, n_points, P);
+}
+
+static RayesError scene_sphere(void *t, float radius)
+{
+    return rayes_scene_sphere(t, radius);
+}
+
+static RayesError scene_quadric(void *t, RayesQuadric type, const float *params, size_t n,
+                                unsigned flags)
+{
+    return rayes_scene_quadric(t, type, params, n, flags);
+}
+
+static RayesError scene_area_light(void *t, const float P[4][3], const float L[3])
+{
+    return rayes_scene_area_light(t, P, L);
+}
+
+static RayesError scene_light(void *t, const char *type, const RayesParam *p, size_t n)
+{
+    return rayes_scene_light(t, type, p, n);
+}
+
+static const char *scene_get_error(void *t)
+{
+    return rayes_scene_get_error(t);
+}
+
+IoSink io_sink_scene(RayesScene *scene)
+{
+    return (IoSink){
+        .target = scene,
+        .set_camera = scene_set_camera,
+        .set_camera_matrix = scene_set_camera_matrix,
+        .set_transform = scene_set_transform,
+        .set_shader = scene_set_shader,
+        .set_displacement = scene_set_displacement,
+        .set_displacement_bound = scene_set_displacement_bound,
+        .set_search_path = scene_set_search_path,
+        .set_shading_rate = scene_set_shading_rate,
+        .bilinear_patch = scene_bilinear_patch,
+        .bicubic_patch = scene_bicubic_patch,
+        .polygon_mesh = scene_polygon_mesh,
+        .sphere = scene_sphere,
+        .quadric = scene_quadric,
+        .area_light = scene_area_light,
+        .light = scene_light,
+        .get_error = scene_get_error,
+    };
+}
+
+void io_settings_init(IoSettings *s)
+{
+    memset(s, 0, sizeof *s);
+    s->filter = -1;
+    s->bounces = -1;
+    s->specular_depth = -1;
+    s->crop[1] = s->crop[3] = 1.0f;
+    s->exposure_gain = s->exposure_gamma = 1.0f;
+}

@@ -1,0 +1,92 @@
+/*
+ * io/sink.h — where scene readers send what they read.
+ *
+ * Readers (RIB, pbrt, OBJ, the patch file, the built-in scenes) never call
+ * rayes.h's scene functions directly: they call the methods of an IoSink,
+ * which mirror those functions one for one (same arguments, the scene
+ * replaced by the sink's target). Three sinks exist:
+ *   - io_sink_scene (sink.c): forwards to rayes.h, building a RayesScene;
+ *   - the RIB writer (rib_write.c): writes each call as ASCII RIB, so every
+ *     reader doubles as a converter (`rayes convert`);
+ *   - a recording stub in the tests, which checks what a reader said.
+ * Render settings a file gives (image size, samples, filter, outputs) go
+ * into an IoSettings, which the caller merges with the command line (the
+ * command line wins).
+ *
+ * Errors: a method returns RayesError; a reader that gets an error stops
+ * and reports it, naming its file and line. Messages of the scene sink come
+ * from rayes_scene_get_error.
+ */
+#ifndef RAYES_IO_SINK_H
+#define RAYES_IO_SINK_H
+
+#include <stddef.h>
+
+#include "rayes/rayes.h"
+
+typedef struct IoSink {
+    void *target; /* the first argument of every method */
+    RayesError (*set_camera)(void *target, const float eye[3], const float look_at[3],
+                             const float up[3], float fov_y_degrees);
+    RayesError (*set_camera_matrix)(void *target, const float camera_from_world[16],
+                                    RayesProjection projection, float fov_degrees,
+                                    const float screen_window[4]);
+    RayesError (*set_transform)(void *target, const float world_from_object[16]);
+    RayesError (*set_shader)(void *target, const char *name, const RayesParam *params,
+                             size_t n_params);
+    RayesError (*set_displacement)(void *target, const char *name, const RayesParam *params,
+                                   size_t n_params);
+    RayesError (*set_displacement_bound)(void *target, float bound);
+    RayesError (*set_search_path)(void *target, const char *kind, const char *path);
+    RayesError (*set_shading_rate)(void *target, float shading_rate);
+    RayesError (*bilinear_patch)(void *target, const float P[4][3]);
+    RayesError (*bicubic_patch)(void *target, const float P[16][3]);
+    RayesError (*polygon_mesh)(void *target, size_t n_faces, const int *n_verts,
+                               const int *indices, size_t n_points, const float *P);
+    RayesError (*sphere)(void *target, float radius);
+    RayesError (*quadric)(void *target, RayesQuadric type, const float *params, size_t n_params,
+                          unsigned flags);
+    RayesError (*area_light)(void *target, const float P[4][3], const float L[3]);
+    RayesError (*light)(void *target, const char *type, const RayesParam *params,
+                        size_t n_params);
+    /* The last error message of the target, for reports; "" if none. */
+    const char *(*get_error)(void *target);
+} IoSink;
+
+/* A sink that builds scene through rayes.h (borrowed, not retained). */
+IoSink io_sink_scene(RayesScene *scene);
+
+#define IO_MAX_DISPLAYS 8
+
+/* One output image a file asks for (RIB's Display, pbrt's Film filename). */
+typedef struct IoDisplay {
+    char name[512];  /* file name as given ("+" of an extra RIB display removed) */
+    char type[32];   /* "file", "exr", "openexr", "png", "tiff", "framebuffer", ... */
+    char mode[32];   /* "rgb", "rgba", "z", ... ("rgba" when the file says nothing) */
+} IoDisplay;
+
+/* Render settings a scene file gives; a field the file does not set keeps
+ * the value io_settings_init gave it (0 or -1: "not given"). */
+typedef struct IoSettings {
+    int width, height;        /* pixels; 0: not given */
+    int spp;                  /* pixel samples; 0: not given */
+    int filter;               /* RayesFilter, or -1: not given */
+    float filter_width;       /* pixels; 0: not given */
+    int bounces;              /* maximum diffuse depth; -1: not given */
+    int specular_depth;       /* maximum specular depth; -1: not given */
+    float crop[4];            /* xmin xmax ymin ymax in [0, 1] (RIB CropWindow); default 0 1 0 1 */
+    float exposure_gain;      /* RIB Exposure; 1 when not given */
+    float exposure_gamma;     /* RIB Exposure; 1 when not given */
+    IoDisplay displays[IO_MAX_DISPLAYS];
+    int n_displays;
+} IoSettings;
+
+void io_settings_init(IoSettings *settings);
+
+/* What the caller tells a reader. */
+typedef struct IoReadOptions {
+    const char *data_dir;     /* where teapot.bpt lives (RIB's Geometry "teapot"); may be NULL */
+    int frame;                /* RIB: the frame to read (FrameBegin n); -1: the last frame */
+} IoReadOptions;
+
+#endif /* RAYES_IO_SINK_H */
