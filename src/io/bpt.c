@@ -68,7 +68,7 @@ static int parse(TextReader *r, Bpt *b)
     return 0;
 }
 
-RayesError io_parse_bpt(const char *name, const char *text, size_t size, RayesScene *scene,
+RayesError io_parse_bpt(const char *name, const char *text, size_t size, const IoSink *sink,
                         char *err, size_t err_size)
 {
     TextReader r;
@@ -81,9 +81,9 @@ RayesError io_parse_bpt(const char *name, const char *text, size_t size, RayesSc
         float P[16][3];
         for (int k = 0; k < 16; k++)
             memcpy(P[k], &b.points[3 * b.index[p * 16 + k]], sizeof P[k]);
-        e = rayes_scene_bicubic_patch(scene, (const float(*)[3])P);
+        e = sink->bicubic_patch(sink->target, (const float(*)[3])P);
         if (e != RAYES_OK)
-            snprintf(err, err_size, "%s: %s", name, rayes_scene_get_error(scene));
+            snprintf(err, err_size, "%s: %s", name, sink->get_error(sink->target));
     }
     free(b.index);
     free(b.line);
@@ -91,13 +91,13 @@ RayesError io_parse_bpt(const char *name, const char *text, size_t size, RayesSc
     return e;
 }
 
-RayesError io_read_bpt(const char *path, RayesScene *scene, char *err, size_t err_size)
+RayesError io_read_bpt(const char *path, const IoSink *sink, char *err, size_t err_size)
 {
     size_t size;
     char *text = text_read_file(path, &size, err, err_size);
     if (!text)
         return RAYES_ERROR_IO;
-    RayesError e = io_parse_bpt(path, text, size, scene, err, err_size);
+    RayesError e = io_parse_bpt(path, text, size, sink, err, err_size);
     free(text);
     return e;
 }

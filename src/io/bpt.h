@@ -9,17 +9,17 @@
 
 #include <stddef.h>
 
-#include "rayes/rayes.h"
+#include "io/sink.h"
 
-/* Reads the file and adds its patches to the scene (with the scene's
- * current transform and shader). On a malformed file returns nonzero, adds
+/* Reads the file and sends its patches to the sink (which places
+ * them with its current transform and shader). On a malformed file returns nonzero, adds
  * nothing, and fills err with one line "file:line:col: what was expected"
  * ("file:line:" for an index checked after reading). Running out of memory
  * while adding patches may leave the ones already added. */
-RayesError io_read_bpt(const char *path, RayesScene *scene, char *err, size_t err_size);
+RayesError io_read_bpt(const char *path, const IoSink *sink, char *err, size_t err_size);
 
 /* The same from a buffer (for tests and fuzzing); name is used in errors. */
-RayesError io_parse_bpt(const char *name, const char *text, size_t size, RayesScene *scene,
+RayesError io_parse_bpt(const char *name, const char *text, size_t size, const IoSink *sink,
                         char *err, size_t err_size);
 
 #endif /* RAYES_IO_BPT_H */

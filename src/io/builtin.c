@@ -11,6 +11,7 @@
 #include <string.h>
 
 #include "io/bpt.h"
+#include "io/sink.h"
 
 const char *const io_builtin_scene_names[] = {"cornell", "cornell-teapots",
                                               "cornell-teapots-displaced", "cornell-spheres",
@@ -130,6 +131,7 @@ static RayesError teapot_displacement(RayesScene *s)
 static RayesError cornell_teapots(RayesScene *s, const char *data_dir, int displaced, char *err,
                                   size_t err_size)
 {
+    IoSink sink = io_sink_scene(s);
     char path[4096];
     if (!data_dir) {
         snprintf(err, err_size,
@@ -155,7 +157,7 @@ static RayesError cornell_teapots(RayesScene *s, const char *data_dir, int displ
     teapot_transform(35.0f, 395.0f, 370.0f, m);
     if (e == RAYES_OK)
         e = rayes_scene_set_transform(s, m);
-    if (e == RAYES_OK && (e = io_read_bpt(path, s, err, err_size)) != RAYES_OK)
+    if (e == RAYES_OK && (e = io_read_bpt(path, &sink, err, err_size)) != RAYES_OK)
         return e;
     if (e == RAYES_OK)
         e = matte(s, grey);
@@ -164,7 +166,7 @@ static RayesError cornell_teapots(RayesScene *s, const char *data_dir, int displ
     teapot_transform(150.0f, 160.0f, 195.0f, m);
     if (e == RAYES_OK)
         e = rayes_scene_set_transform(s, m);
-    if (e == RAYES_OK && (e = io_read_bpt(path, s, err, err_size)) != RAYES_OK)
+    if (e == RAYES_OK && (e = io_read_bpt(path, &sink, err, err_size)) != RAYES_OK)
         return e;
     static const float identity[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
     if (e == RAYES_OK)

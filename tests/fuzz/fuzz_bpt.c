@@ -28,7 +28,8 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     err[0] = '\0';
     static const char empty[1] = "";
     const char *text = size ? (const char *)data : empty;
-    RayesError e = io_parse_bpt("fuzz.bpt", text, size, scene, err, sizeof err);
+    IoSink sink = io_sink_scene(scene);
+    RayesError e = io_parse_bpt("fuzz.bpt", text, size, &sink, err, sizeof err);
     if (e == RAYES_OK && err[0] != '\0')
         abort();
     if (e != RAYES_OK && (err[0] == '\0' || strchr(err, '\n') != NULL))

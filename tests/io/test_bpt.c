@@ -41,7 +41,8 @@ static RayesError parse_exact(const char *name, const char *text, size_t size, R
         return RAYES_ERROR_OUT_OF_MEMORY;
     memcpy(copy, text, size);
     err[0] = '\0';
-    RayesError e = io_parse_bpt(name, copy, size, s, err, err_size);
+    IoSink sink = io_sink_scene(s);
+    RayesError e = io_parse_bpt(name, copy, size, &sink, err, err_size);
     free(copy);
     return e;
 }
@@ -113,8 +114,9 @@ static void check_bad(const char *text, const char *where, const char *what)
 static void test_teapot_file(void)
 {
     RayesScene *s = rayes_scene_new();
+    IoSink sink = io_sink_scene(s);
     char err[512] = "";
-    CHECK(io_read_bpt(RAYES_TEST_DATA "/teapot.bpt", s, err, sizeof err) == RAYES_OK);
+    CHECK(io_read_bpt(RAYES_TEST_DATA "/teapot.bpt", &sink, err, sizeof err) == RAYES_OK);
     CHECK(err[0] == '\0');
     if (err[0] != '\0')
         fprintf(stderr, "  %s\n", err);
@@ -125,8 +127,9 @@ static void test_teapot_file(void)
 static void test_missing_file(void)
 {
     RayesScene *s = rayes_scene_new();
+    IoSink sink = io_sink_scene(s);
     char err[512] = "";
-    CHECK(io_read_bpt(RAYES_TEST_DATA "/no-such-file.bpt", s, err, sizeof err) == RAYES_ERROR_IO);
+    CHECK(io_read_bpt(RAYES_TEST_DATA "/no-such-file.bpt", &sink, err, sizeof err) == RAYES_ERROR_IO);
     CHECK(strstr(err, "no-such-file.bpt") != NULL);
     CHECK(strchr(err, '\n') == NULL);
     CHECK(count_grids(s) == 0);
