@@ -510,9 +510,11 @@ static int finish_faces(Ply *r, PlyMesh *m)
     for (size_t f = 0; f < r->n_raw; idx += r->raw_counts[f], f++) {
         int n = r->raw_counts[f];
         for (int k = 0; k < n; k++)
-            if ((size_t)idx[k] >= m->n_vertices)
+            if ((size_t)idx[k] >= m->n_vertices) {
+                r->line = 0; /* found after reading: the face's index names the place */
                 return fail(r, "face %zu uses vertex %d but the file has %zu vertices", f, idx[k],
                             m->n_vertices);
+            }
         if (n < 3) {
             m->n_skipped++;
             continue;

@@ -1,0 +1,680 @@
+/*
+ * tests/io/test_pbrt.c — the pbrt-v4 reader of io/pbrt.h against a
+ * recording IoSink: transforms and the camera matrix, the mapping of
+ * materials and lights, quadrics, instancing, plymesh and Include through
+ * files written to RAYES_TEST_TMP, the Bitterli Cornell box from the
+ * shared data (walls on the right sides as its camera sees them, the
+ * ceiling light), and bad input with "file:line:col" errors.
+ */
+#include <string.h>
+
+#include "io/pbrt.h"
+#include "rayes/rayes.h"
+#include "test.h"
+
+#ifndef RAYES_TEST_DATA
+#error "RAYES_TEST_DATA must name the shared data directory"
+#endif
+
+/* ------------------------------------------------------------- the stub */
+
+#define MAX_REC 64
+
+typedef struct Shader {
+    char name[32];
+    int n;
+    RayesParam p[8];
+    char str[8][256];
+    char names[8][32];
+} Shader;
+
+typedef struct Rec {
+    float camera[16];
+    int projection, n_camera;
+    float fov;
+    int have_screen;
+    float screen[4];
+    float xform[16];
+    Shader shader;
+    /* geometry, with the transform and shader current then */
+    int n_meshes, n_quadrics, n_patches, n_area, n_lights;
+    struct {
+        size_t n_faces, n_points;
+        float centre[3]; /* mean of the points, object space */
+        float xform[16];
+        Shader shader;
+        int first[4];    /* the first face's indices */
+    } mesh[MAX_REC];
+    struct {
+        RayesQuadric type;
+        float p[8];
+        size_t n;
+        unsigned flags;
+        float xform[16];
+    } quadric[MAX_REC];
+    struct {
+        float P[4][3], L[3], xform[16];
+    } area[MAX_REC];
+    struct {
+        char type[32];
+        Shader params; /* name unused */
+        float xform[16];
+    } light[MAX_REC];
+} Rec;
+
+static void copy_params(Shader *s, const char *name, const RayesParam *p, size_t n)
+{
+    memset(s, 0, sizeof *s);
+    snprintf(s->name, sizeof s->name, "%s", name ? name : "");
+    for (size_t i = 0; i < n && i < 8; i++) {
+        s->p[i] = p[i];
+        snprintf(s->names[i], sizeof s->names[i], "%s", p[i].name);
+        s->p[i].name = s->names[i]; /* the caller's strings are borrowed */
+        if (p[i].type == RAYES_PARAM_STRING) {
+            snprintf(s->str[i], sizeof s->str[i], "%s", p[i].string);
+            s->p[i].string = s->str[i];
+        }
+        s->n++;
+    }
+}
+
+/* A parameter of a recorded shader (its pointers re-aimed at its own
+ * copies, since the Shader may have been copied as a struct). */
+static const RayesParam *param(const Shader *cs, const char *name)
+{
+    Shader *s = (Shader *)cs;
+    for (int i = 0; i < s->n; i++) {
+        s->p[i].name = s->names[i];
+        if (s->p[i].type == RAYES_PARAM_STRING)
+            s->p[i].string = s->str[i];
+    }
+    for (int i = 0; i < s->n; i++)
+        if (strcmp(s->p[i].name, name) == 0)
+            return &s->p[i];
+    return NULL;
+}
+
+static RayesError r_camera(void *t, const float e[3], const float a[3], const float u[3], float f)
+{
+    (void)t, (void)e, (void)a, (void)u, (void)f;
+    return RAYES_ERROR_INVALID_OPERATION; /* the pbrt reader gives matrices */
+}
+
+static RayesError r_camera_matrix(void *t, const float m[16], RayesProjection proj, float fov,
+                                  const float sw[4])
+{
+    Rec *r = t;
+    memcpy(r->camera, m, sizeof r->camera);
+    r->projection = proj;
+    r->fov = fov;
+    r->have_screen = sw != NULL;
+    if (sw)
+        memcpy(r->screen, sw, sizeof r->screen);
+    r->n_camera++;
+    return RAYES_OK;
+}
+
+static RayesError r_transform(void *t, const float m[16])
+{
+    memcpy(((Rec *)t)->xform, m, 16 * sizeof(float));
+    return RAYES_OK;
+}
+
+static RayesError r_shader(void *t, const char *name, const RayesParam *p, size_t n)
+{
+    copy_params(&((Rec *)t)->shader, name, p, n);
+    return RAYES_OK;
+}
+
+static RayesError r_displacement(void *t, const char *name, const RayesParam *p, size_t n)
+{
+    (void)t, (void)name, (void)p, (void)n;
+    return RAYES_OK;
+}
+
+static RayesError r_bound(void *t, float b)
+{
+    (void)t, (void)b;
+    return RAYES_OK;
+}
+
+static RayesError r_search(void *t, const char *k, const char *p)
+{
+    (void)t, (void)k, (void)p;
+    return RAYES_OK;
+}
+
+static RayesError r_rate(void *t, float r)
+{
+    (void)t, (void)r;
+    return RAYES_OK;
+}
+
+static RayesError r_bilinear(void *t, const float P[4][3])
+{
+    (void)P;
+    ((Rec *)t)->n_patches++;
+    return RAYES_OK;
+}
+
+static RayesError r_bicubic(void *t, const float P[16][3])
+{
+    (void)t, (void)P;
+    return RAYES_OK;
+}
+
+static RayesError r_mesh(void *t, size_t n_faces, const int *nv, const int *idx, size_t n_points,
+                         const float *P)
+{
+    Rec *r = t;
+    size_t n_idx = 0;
+    for (size_t f = 0; f < n_faces; f++) {
+        if (nv[f] != 3 && nv[f] != 4)
+            return RAYES_ERROR_INVALID_ARGUMENT;
+        n_idx += (size_t)nv[f];
+    }
+    for (size_t i = 0; i < n_idx; i++)
+        if (idx[i] < 0 || (size_t)idx[i] >= n_points)
+            return RAYES_ERROR_INVALID_ARGUMENT;
+    if (r->n_meshes < MAX_REC) {
+        int k = r->n_meshes;
+        r->mesh[k].n_faces = n_faces;
+        r->mesh[k].n_points = n_points;
+        for (int c = 0; c < 3; c++) {
+            double s = 0;
+            for (size_t i = 0; i < n_points; i++)
+                s += P[3 * i + c];
+            r->mesh[k].centre[c] = (float)(s / (double)n_points);
+        }
+        memcpy(r->mesh[k].xform, r->xform, sizeof r->xform);
+        r->mesh[k].shader = r->shader;
+        for (int i = 0; i < 4; i++)
+            r->mesh[k].first[i] = i < nv[0] ? idx[i] : -1;
+    }
+    r->n_meshes++;
+    return RAYES_OK;
+}
+
+static RayesError r_sphere(void *t, float radius)
+{
+    (void)t, (void)radius;
+    return RAYES_OK;
+}
+
+static RayesError r_quadric(void *t, RayesQuadric type, const float *p, size_t n, unsigned flags)
+{
+    Rec *r = t;
+    if (r->n_quadrics < MAX_REC && n <= 8) {
+        int k = r->n_quadrics;
+        r->quadric[k].type = type;
+        memcpy(r->quadric[k].p, p, n * sizeof *p);
+        r->quadric[k].n = n;
+        r->quadric[k].flags = flags;
+        memcpy(r->quadric[k].xform, r->xform, sizeof r->xform);
+    }
+    r->n_quadrics++;
+    return RAYES_OK;
+}
+
+static RayesError r_area(void *t, const float P[4][3], const float L[3])
+{
+    Rec *r = t;
+    if (r->n_area < MAX_REC) {
+        memcpy(r->area[r->n_area].P, P, sizeof r->area[0].P);
+        memcpy(r->area[r->n_area].L, L, sizeof r->area[0].L);
+        memcpy(r->area[r->n_area].xform, r->xform, sizeof r->xform);
+    }
+    r->n_area++;
+    return RAYES_OK;
+}
+
+static RayesError r_light(void *t, const char *type, const RayesParam *p, size_t n)
+{
+    Rec *r = t;
+    if (r->n_lights < MAX_REC) {
+        snprintf(r->light[r->n_lights].type, sizeof r->light[0].type, "%s", type);
+        copy_params(&r->light[r->n_lights].params, type, p, n);
+        memcpy(r->light[r->n_lights].xform, r->xform, sizeof r->xform);
+    }
+    r->n_lights++;
+    return RAYES_OK;
+}
+
+static const char *r_error(void *t)
+{
+    (void)t;
+    return "stub error";
+}
+
+static IoSink stub(Rec *r)
+{
+    memset(r, 0, sizeof *r);
+    return (IoSink){.target = r, .set_camera = r_camera, .set_camera_matrix = r_camera_matrix,
+                    .set_transform = r_transform, .set_shader = r_shader,
+                    .set_displacement = r_displacement, .set_displacement_bound = r_bound,
+                    .set_search_path = r_search, .set_shading_rate = r_rate,
+                    .bilinear_patch = r_bilinear, .bicubic_patch = r_bicubic,
+                    .polygon_mesh = r_mesh, .sphere = r_sphere, .quadric = r_quadric,
+                    .area_light = r_area, .light = r_light, .get_error = r_error};
+}
+
+/* Parses text from an exact-size heap copy; err gets the message. */
+static RayesError parse(const char *name, const char *text, Rec *r, IoSettings *s, char *err,
+                        size_t n)
+{
+    size_t size = strlen(text);
+    unsigned char *copy = malloc(size ? size : 1);
+    memcpy(copy, text, size);
+    IoSink sink = stub(r);
+    io_settings_init(s);
+    RayesError e = io_pbrt_parse(name, copy, size, &sink, NULL, s, err, n);
+    free(copy);
+    if (e != RAYES_OK)
+        fprintf(stderr, "  (parse: %s)\n", err);
+    return e;
+}
+
+/* m p for a point p (row-major m). */
+static void xform_point(const float m[16], const float p[3], float out[3])
+{
+    for (int r = 0; r < 3; r++)
+        out[r] = m[4 * r] * p[0] + m[4 * r + 1] * p[1] + m[4 * r + 2] * p[2] + m[4 * r + 3];
+}
+
+static void write_file(const char *path, const char *text)
+{
+    FILE *f = fopen(path, "wb");
+    CHECK(f != NULL);
+    if (f) {
+        fputs(text, f);
+        fclose(f);
+    }
+}
+
+/* ------------------------------------------------------------- tests */
+
+static void test_cornell_box(void)
+{
+    Rec *r = malloc(sizeof *r);
+    IoSink sink = stub(r);
+    IoSettings s;
+    io_settings_init(&s);
+    char err[512] = "";
+    RayesError e = io_pbrt_read(RAYES_TEST_DATA "/scenes/pbrt-bitterli/cornell-box/scene-v4.pbrt",
+                                &sink, NULL, &s, err, sizeof err);
+    CHECK(e == RAYES_OK);
+    if (e != RAYES_OK) {
+        fprintf(stderr, "%s\n", err);
+        free(r);
+        return;
+    }
+    CHECK(s.width == 512 && s.height == 512 && s.spp == 1);
+    CHECK(s.bounces == 64); /* maxdepth 65 */
+    CHECK(s.n_displays == 1 && strcmp(s.displays[0].name, "cornell-box.exr") == 0);
+    CHECK(r->n_camera == 1 && r->projection == RAYES_PROJECTION_PERSPECTIVE);
+    CHECK_NEAR(r->fov, 19.5, 1e-6);
+    CHECK(!r->have_screen);
+    /* camera_from_world: the file's Transform, given column by column */
+    static const float want[16] = {1, 0, 0, 0, 0, 1, 0, -1, 0, 0, -1, 6.8f, 0, 0, 0, 1};
+    for (int i = 0; i < 16; i++)
+        CHECK_NEAR(r->camera[i], want[i], 1e-6);
+    CHECK(r->n_meshes == 7); /* floor, ceiling, back, right, left, two boxes */
+    int red = 0, green = 0, white = 0;
+    for (int k = 0; k < r->n_meshes && k < MAX_REC; k++) {
+        const RayesParam *refl = param(&r->mesh[k].shader, "reflectance");
+        CHECK(strcmp(r->mesh[k].shader.name, "diffuse") == 0 && refl);
+        if (!refl)
+            continue;
+        float world[3], cam[3];
+        xform_point(r->mesh[k].xform, r->mesh[k].centre, world);
+        xform_point(r->camera, world, cam);
+        float x_screen = cam[0] / cam[2]; /* + is the right of the image */
+        if (fabs(refl->value[0] - 0.63) < 1e-6) {
+            red++;
+            CHECK_NEAR(refl->value[1], 0.065, 1e-6);
+            CHECK_NEAR(refl->value[2], 0.05, 1e-6);
+            CHECK(x_screen < -0.1); /* the red wall is on the left */
+        } else if (fabs(refl->value[0] - 0.14) < 1e-6) {
+            green++;
+            CHECK_NEAR(refl->value[1], 0.45, 1e-6);
+            CHECK_NEAR(refl->value[2], 0.091, 1e-6);
+            CHECK(x_screen > 0.1); /* the green wall on the right */
+        } else {
+            white++;
+            CHECK_NEAR(refl->value[0], 0.725, 1e-6);
+            CHECK_NEAR(refl->value[1], 0.71, 1e-6);
+            CHECK_NEAR(refl->value[2], 0.68, 1e-6);
+        }
+    }
+    CHECK(red == 1 && green == 1 && white == 5);
+    /* the light: one quad from the two triangles, in the ceiling, emitting down */
+    CHECK(r->n_area == 1);
+    if (r->n_area == 1) {
+        CHECK_NEAR(r->area[0].L[0], 17, 0);
+        CHECK_NEAR(r->area[0].L[1], 12, 0);
+        CHECK_NEAR(r->area[0].L[2], 4, 0);
+        float(*P)[3] = r->area[0].P;
+        for (int k = 0; k < 4; k++)
+            CHECK_NEAR(P[k][1], 1.98, 1e-6);
+        float a[3], b[3];
+        for (int c = 0; c < 3; c++)
+            a[c] = P[1][c] - P[0][c], b[c] = P[2][c] - P[0][c];
+        CHECK(a[2] * b[0] - a[0] * b[2] < 0); /* (P1 - P0) x (P2 - P0) points down (-y) */
+    }
+    free(r);
+}
+
+static void test_transforms(void)
+{
+    Rec *r = malloc(sizeof *r);
+    IoSettings s;
+    char err[512] = "";
+    const char *text =
+        "LookAt 0 0 -5  0 0 0  0 1 0\n"
+        "Camera \"perspective\" \"float fov\" 45 \"float screenwindow\" [-1 1 -0.5 0.5]\n"
+        "Film \"rgb\" \"integer xresolution\" 64 \"integer yresolution\" [32]\n"
+        "WorldBegin\n"
+        "AttributeBegin\n"
+        "  Translate 1 2 3\n"
+        "  Scale 2 2 2\n"
+        "  Shape \"sphere\" \"float radius\" 0.5\n"
+        "AttributeEnd\n"
+        "AttributeBegin\n"
+        "  Rotate 90 0 0 1\n"
+        "  ReverseOrientation\n"
+        "  Shape \"disk\" \"float height\" 0.25 \"float radius\" 2 \"float phimax\" 180\n"
+        "AttributeEnd\n"
+        "Transform [1 0 0 0  0 1 0 0  0 0 1 0  5 6 7 1]\n"
+        "Shape \"cylinder\"\n"
+        "CoordSysTransform \"camera\"\n"
+        "Shape \"sphere\"\n";
+    RayesError e = parse("t.pbrt", text, r, &s, err, sizeof err);
+    CHECK(e == RAYES_OK);
+    CHECK(s.width == 64 && s.height == 32);
+    CHECK_NEAR(r->fov, 45, 1e-6);
+    CHECK(r->have_screen && r->screen[2] == -0.5f && r->screen[3] == 0.5f);
+    /* LookAt from -z toward the origin: camera z is world z, x is world -x... pbrt's
+     * left-handed convention: right = up x dir = (0,1,0) x (0,0,1) = (1,0,0) */
+    static const float cam[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 5, 0, 0, 0, 1};
+    for (int i = 0; i < 16; i++)
+        CHECK_NEAR(r->camera[i], cam[i], 1e-6);
+    CHECK(r->n_quadrics == 4);
+    if (r->n_quadrics == 4) {
+        CHECK(r->quadric[0].type == RAYES_QUADRIC_SPHERE && r->quadric[0].n == 4);
+        CHECK_NEAR(r->quadric[0].p[0], 0.5, 0);
+        CHECK_NEAR(r->quadric[0].p[1], -0.5, 0);
+        CHECK_NEAR(r->quadric[0].p[3], 360, 0);
+        CHECK(r->quadric[0].flags == 0);
+        CHECK_NEAR(r->quadric[0].xform[0], 2, 1e-6);
+        CHECK_NEAR(r->quadric[0].xform[3], 1, 1e-6);
+        CHECK_NEAR(r->quadric[0].xform[7], 2, 1e-6);
+        CHECK_NEAR(r->quadric[0].xform[11], 3, 1e-6);
+        CHECK(r->quadric[1].type == RAYES_QUADRIC_DISK && r->quadric[1].n == 3);
+        CHECK_NEAR(r->quadric[1].p[0], 0.25, 0);
+        CHECK_NEAR(r->quadric[1].p[1], 2, 0);
+        CHECK_NEAR(r->quadric[1].p[2], 180, 0);
+        CHECK(r->quadric[1].flags == RAYES_QUADRIC_REVERSE);
+        CHECK_NEAR(r->quadric[1].xform[1], -1, 1e-6); /* Rotate 90 about z: x' = -y */
+        CHECK_NEAR(r->quadric[1].xform[4], 1, 1e-6);
+        CHECK(r->quadric[2].type == RAYES_QUADRIC_CYLINDER);
+        CHECK_NEAR(r->quadric[2].xform[3], 5, 1e-6); /* Transform: column-major */
+        CHECK_NEAR(r->quadric[2].xform[7], 6, 1e-6);
+        CHECK_NEAR(r->quadric[2].xform[11], 7, 1e-6);
+        /* the camera's coordinate system: world_from_camera puts the origin at the eye */
+        CHECK_NEAR(r->quadric[3].xform[11], -5, 1e-6);
+    }
+    /* Scale -1 1 1 before LookAt mirrors: camera x is world -x then */
+    e = parse("t.pbrt", "Scale -1 1 1\nLookAt 0 0 -5 0 0 0 0 1 0\nCamera \"perspective\"\n"
+                        "WorldBegin\n", r, &s, err, sizeof err);
+    CHECK(e == RAYES_OK);
+    CHECK_NEAR(r->camera[0], -1, 1e-6);
+    CHECK_NEAR(r->fov, 90, 1e-6);
+    CHECK(s.width == 1280 && s.height == 720); /* pbrt's default film */
+    free(r);
+}
+
+static void test_materials(void)
+{
+    Rec *r = malloc(sizeof *r);
+    IoSettings s;
+    char err[512] = "";
+    const char *text =
+        "Sampler \"halton\" \"integer pixelsamples\" 8\n"
+        "Integrator \"volpath\" \"integer maxdepth\" 1\n"
+        "PixelFilter \"gaussian\" \"float xradius\" 1\n"
+        "WorldBegin\n"
+        "Texture \"grid\" \"spectrum\" \"imagemap\" \"string filename\" \"tex/grid.png\"\n"
+        "MakeNamedMaterial \"a\" \"string type\" \"diffuse\" \"rgb reflectance\" [0.2 0.4 0.6]\n"
+        "MakeNamedMaterial \"b\" \"string type\" \"diffuse\" \"float reflectance\" 1\n"
+        "Material \"conductor\" \"spectrum eta\" \"metal-Au-eta\" \"spectrum k\" \"metal-Au-k\"\n"
+        "  \"float uroughness\" 0.1 \"float vroughness\" 0.3\n"
+        "Shape \"sphere\"\n"
+        "Material \"dielectric\" \"float eta\" 1.33\n"
+        "Shape \"sphere\"\n"
+        "Material \"coateddiffuse\" \"rgb reflectance\" [0.1 0.2 0.3] \"float roughness\" 0.05\n"
+        "Shape \"sphere\"\n"
+        "Material \"mix\" \"string materials\" [\"a\" \"b\"] \"float amount\" 0.25\n"
+        "Shape \"sphere\"\n"
+        "Material \"hair\" \"float eumelanin\" 1.3\n"
+        "Shape \"sphere\"\n"
+        "Material \"diffuse\" \"texture reflectance\" \"grid\" \"float nonsense\" 3\n"
+        "Shape \"sphere\"\n"
+        "Material \"conductor\" \"rgb reflectance\" [0.9 0.8 0.7]\n"
+        "Shape \"sphere\"\n"
+        "Material \"diffuse\" \"blackbody reflectance\" 6500\n"
+        "Shape \"sphere\"\n";
+    /* a small mesh after each Material (the stub records shaders with meshes) */
+    char full[8192] = "";
+    const char *tri = "Shape \"trianglemesh\" \"point3 P\" [0 0 0 1 0 0 0 1 0]\n";
+    for (const char *p = text; *p;) {
+        const char *q = strstr(p, "Shape \"sphere\"\n");
+        if (!q) {
+            strncat(full, p, sizeof full - strlen(full) - 1);
+            break;
+        }
+        strncat(full, p, (size_t)(q - p));
+        strncat(full, tri, sizeof full - strlen(full) - 1);
+        p = q + strlen("Shape \"sphere\"\n");
+    }
+    RayesError e = parse("dir/t.pbrt", full, r, &s, err, sizeof err);
+    CHECK(e == RAYES_OK);
+    CHECK(s.spp == 8 && s.bounces == 0 && s.specular_depth == 1);
+    CHECK(s.filter == RAYES_FILTER_GAUSSIAN && s.filter_width == 2.0f);
+    CHECK(r->n_meshes == 8);
+    if (r->n_meshes != 8) {
+        free(r);
+        return;
+    }
+    const Shader *sh = &r->mesh[0].shader;
+    CHECK(strcmp(sh->name, "conductor") == 0);
+    CHECK(param(sh, "eta") && fabs(param(sh, "eta")->value[2] - 1.442) < 1e-3);
+    CHECK(param(sh, "k") && fabs(param(sh, "k")->value[0] - 3.983) < 1e-3);
+    CHECK(param(sh, "roughness") && fabs(param(sh, "roughness")->value[0] - 0.2) < 1e-6);
+    sh = &r->mesh[1].shader;
+    CHECK(strcmp(sh->name, "dielectric") == 0 && param(sh, "eta") &&
+          fabs(param(sh, "eta")->value[0] - 1.33) < 1e-6);
+    sh = &r->mesh[2].shader;
+    CHECK(strcmp(sh->name, "coateddiffuse") == 0 && param(sh, "reflectance") &&
+          fabs(param(sh, "reflectance")->value[2] - 0.3) < 1e-6);
+    sh = &r->mesh[3].shader; /* mix of two diffuse: blended, 0.75 a + 0.25 b */
+    CHECK(strcmp(sh->name, "diffuse") == 0 && param(sh, "reflectance") &&
+          fabs(param(sh, "reflectance")->value[0] - (0.75 * 0.2 + 0.25)) < 1e-6);
+    CHECK(strcmp(r->mesh[4].shader.name, "matte") == 0); /* hair: unsupported */
+    sh = &r->mesh[5].shader;
+    CHECK(strcmp(sh->name, "paintedplastic") == 0 && param(sh, "texturename") &&
+          strcmp(param(sh, "texturename")->string, "dir/tex/grid.png") == 0);
+    CHECK(param(sh, "Ks") && param(sh, "Ks")->value[0] == 0);
+    sh = &r->mesh[6].shader;
+    CHECK(strcmp(sh->name, "conductor") == 0 && param(sh, "reflectance") && !param(sh, "eta"));
+    sh = &r->mesh[7].shader; /* 6500 K: nearly white, normalised to a maximum of 1 */
+    CHECK(param(sh, "reflectance") && fabs(param(sh, "reflectance")->value[0] - 1) < 0.05 &&
+          fabs(param(sh, "reflectance")->value[2] - 1) < 0.1);
+    free(r);
+}
+
+static void test_lights(void)
+{
+    Rec *r = malloc(sizeof *r);
+    IoSettings s;
+    char err[512] = "";
+    const char *text =
+        "WorldBegin\n"
+        "LightSource \"point\" \"rgb I\" [1 2 3] \"float scale\" 4 \"point3 from\" [0 5 0]\n"
+        "LightSource \"spot\" \"point3 from\" [0 0 0] \"point3 to\" [0 -1 0] \"float coneangle\" 20\n"
+        "LightSource \"distant\" \"point3 from\" [0 1 0] \"point3 to\" [0 0 0] \"blackbody L\" 3000\n"
+        "LightSource \"infinite\" \"rgb L\" [0.1 0.2 0.3]\n"
+        "LightSource \"goniometric\" \"string filename\" \"x.exr\"\n"
+        "AttributeBegin\n"
+        "  AreaLightSource \"diffuse\" \"rgb L\" [2 2 2] \"float scale\" 3\n"
+        "  Translate 0 1 0\n"
+        "  Shape \"sphere\" \"float radius\" 0.25\n"
+        "  Shape \"disk\" \"float radius\" 0.5\n"
+        "  Shape \"bilinearmesh\" \"point3 P\" [0 0 0 1 0 0 0 1 0 1 1 0]\n"
+        "  Shape \"curve\" \"point3 P\" [0 0 0 1 1 1 2 2 2 3 3 3]\n"
+        "AttributeEnd\n"
+        "Shape \"bilinearmesh\" \"point3 P\" [0 0 0 1 0 0 0 1 0 1 1 0]\n";
+    RayesError e = parse("t.pbrt", text, r, &s, err, sizeof err);
+    CHECK(e == RAYES_OK);
+    CHECK(r->n_lights == 6);
+    if (r->n_lights == 6) {
+        CHECK(strcmp(r->light[0].type, "pointlight") == 0);
+        const Shader *p = &r->light[0].params;
+        CHECK(param(p, "intensity") && param(p, "intensity")->value[0] == 4);
+        CHECK(param(p, "lightcolor") && param(p, "lightcolor")->value[2] == 3);
+        CHECK(param(p, "from") && param(p, "from")->value[1] == 5);
+        p = &r->light[1].params;
+        CHECK(strcmp(r->light[1].type, "spotlight") == 0 && param(p, "coneangle") &&
+              param(p, "coneangle")->value[0] == 20 && param(p, "beamdistribution") &&
+              param(p, "beamdistribution")->value[0] == 0);
+        p = &r->light[2].params;
+        CHECK(strcmp(r->light[2].type, "distantlight") == 0 && param(p, "lightcolor") &&
+              param(p, "lightcolor")->value[0] == 1 && param(p, "lightcolor")->value[2] < 0.5);
+        CHECK(strcmp(r->light[3].type, "environmentlight") == 0);
+        CHECK(strcmp(r->light[4].type, "arealight") == 0); /* the sphere */
+        p = &r->light[4].params;
+        CHECK(param(p, "shape") && strcmp(param(p, "shape")->string, "sphere") == 0);
+        CHECK(param(p, "radius") && param(p, "radius")->value[0] == 0.25f);
+        CHECK(param(p, "lightcolor") && param(p, "lightcolor")->value[0] == 6);
+        CHECK_NEAR(r->light[4].xform[7], 1, 0);
+        CHECK(strcmp(r->light[5].type, "arealight") == 0 && param(&r->light[5].params, "shape") &&
+              strcmp(param(&r->light[5].params, "shape")->string, "disk") == 0);
+    }
+    CHECK(r->n_area == 1 && r->n_patches == 1); /* the emitting patch, then a plain one */
+    if (r->n_area == 1) {
+        CHECK_NEAR(r->area[0].L[1], 6, 0);
+        float(*P)[3] = r->area[0].P; /* around the patch: p00 p10 p11 p01, normal +z */
+        CHECK(P[2][0] == 1 && P[2][1] == 1 && P[3][0] == 0 && P[3][1] == 1);
+    }
+    free(r);
+}
+
+static void test_instances_include_ply(void)
+{
+    Rec *r = malloc(sizeof *r);
+    IoSettings s;
+    char err[512] = "", path[512], text[2048];
+    snprintf(path, sizeof path, "%s/test_pbrt_quad.ply", RAYES_TEST_TMP);
+    write_file(path, "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\n"
+                     "property float y\nproperty float z\nelement face 1\n"
+                     "property list uchar int vertex_indices\nend_header\n"
+                     "0 0 0\n1 0 0\n1 1 0\n0 1 0\n4 0 1 2 3\n");
+    snprintf(path, sizeof path, "%s/test_pbrt_inc.pbrt", RAYES_TEST_TMP);
+    write_file(path, "# included\nShape \"plymesh\" \"string filename\" \"test_pbrt_quad.ply\"\n");
+    snprintf(text, sizeof text,
+             "WorldBegin\n"
+             "ObjectBegin \"thing\"\n"
+             "  Translate 0 0 1\n"
+             "  Shape \"sphere\"\n"
+             "  Include \"test_pbrt_inc.pbrt\"\n"
+             "ObjectEnd\n"
+             "Translate 10 0 0\n"
+             "ObjectInstance \"thing\"\n"
+             "Translate 10 0 0\n"
+             "ObjectInstance \"thing\"\n"
+             "AttributeBegin\n"
+             "  Scale -1 1 1\n"
+             "  Include \"test_pbrt_inc.pbrt\"\n"
+             "AttributeEnd\n");
+    snprintf(path, sizeof path, "%s/test_pbrt_main.pbrt", RAYES_TEST_TMP);
+    RayesError e = parse(path, text, r, &s, err, sizeof err);
+    CHECK(e == RAYES_OK);
+    CHECK(r->n_quadrics == 2 && r->n_meshes == 3);
+    if (r->n_quadrics == 2 && r->n_meshes == 3) {
+        CHECK_NEAR(r->quadric[0].xform[3], 10, 0);
+        CHECK_NEAR(r->quadric[0].xform[11], 1, 0);
+        CHECK_NEAR(r->quadric[1].xform[3], 20, 0);
+        CHECK_NEAR(r->mesh[1].xform[3], 20, 0);
+        CHECK(r->mesh[0].n_faces == 1 && r->mesh[0].n_points == 4);
+        CHECK(r->mesh[0].first[1] == 1); /* counter-clockwise as given */
+        CHECK(r->mesh[2].first[1] == 3); /* mirrored: the winding flips, as pbrt's normal does */
+    }
+    /* an emitting plymesh quad becomes an area light */
+    snprintf(text, sizeof text,
+             "WorldBegin\nAreaLightSource \"diffuse\" \"rgb L\" [1 1 1] \"bool twosided\" true\n"
+             "Include \"test_pbrt_inc.pbrt\"\n");
+    e = parse(path, text, r, &s, err, sizeof err);
+    CHECK(e == RAYES_OK && r->n_area == 2 && r->n_meshes == 0);
+    /* an error inside an included file names that file */
+    snprintf(path, sizeof path, "%s/test_pbrt_bad.pbrt", RAYES_TEST_TMP);
+    write_file(path, "\n  Shape \"sphere\" \"float radius\" [ \"x\" ]\n");
+    snprintf(path, sizeof path, "%s/test_pbrt_main.pbrt", RAYES_TEST_TMP);
+    e = parse(path, "WorldBegin\nInclude \"test_pbrt_bad.pbrt\"\n", r, &s, err, sizeof err);
+    CHECK(e == RAYES_ERROR_PARSE && strstr(err, "test_pbrt_bad.pbrt:2:35: expected a float "
+                                                "value for \"radius\"") != NULL);
+    /* a file including itself stops at the depth limit */
+    snprintf(path, sizeof path, "%s/test_pbrt_self.pbrt", RAYES_TEST_TMP);
+    write_file(path, "Include \"test_pbrt_self.pbrt\"\nInclude \"test_pbrt_self.pbrt\"\n");
+    e = parse(path, "WorldBegin\nInclude \"test_pbrt_self.pbrt\"\n", r, &s, err, sizeof err);
+    CHECK(e == RAYES_ERROR_PARSE && strstr(err, "nested Include") != NULL);
+    free(r);
+}
+
+static void expect_error(const char *text, const char *want)
+{
+    Rec *r = malloc(sizeof *r);
+    IoSettings s;
+    char err[512] = "";
+    RayesError e = parse("t.pbrt", text, r, &s, err, sizeof err);
+    CHECK(e == RAYES_ERROR_PARSE);
+    CHECK(strstr(err, want) != NULL && !strchr(err, '\n'));
+    if (!strstr(err, want))
+        fprintf(stderr, "  got \"%s\", wanted \"%s\"\n", err, want);
+    free(r);
+}
+
+static void test_errors(void)
+{
+    expect_error("", "t.pbrt: expected WorldBegin");
+    expect_error("WorldBegin\n  Bogus 1\n", "t.pbrt:2:3: expected a directive");
+    expect_error("Translate 1 2\nWorldBegin\n", "t.pbrt:2:1: expected a number (Translate x y z)");
+    expect_error("WorldBegin\nShape \"sphere\" \"float radius [1]\n",
+                 "t.pbrt:2:16: expected a closing quote");
+    expect_error("WorldBegin\nShape \"sphere\" \"float radius\" [1\n",
+                 "t.pbrt:3:1: expected a value or \"]\"");
+    expect_error("WorldBegin\nShape \"sphere\" \"real radius\" 1\n",
+                 "t.pbrt:2:16: expected a parameter type");
+    expect_error("WorldBegin\nShape \"trianglemesh\" \"point3 P\" [0 0 0 1 0 0 0 1 0]\n"
+                 "  \"integer indices\" [0 1 3]\n",
+                 "t.pbrt:3:3: trianglemesh: index 2 is 3 but P has 3 points");
+    expect_error("WorldBegin\nShape \"trianglemesh\" \"point3 P\" [0 0 0 1 0]\n",
+                 "t.pbrt:2:22: expected a multiple of 3 values");
+    expect_error("WorldBegin\nNamedMaterial \"nope\"\n", "t.pbrt:2:15: NamedMaterial: expected a "
+                 "material defined");
+    expect_error("WorldBegin\nAttributeEnd\n", "t.pbrt:2:1: AttributeEnd without a matching");
+    expect_error("WorldBegin\nCamera \"perspective\"\n", "t.pbrt:2:1: expected this directive before "
+                 "WorldBegin");
+    expect_error("Shape \"sphere\"\n", "t.pbrt:1:1: expected WorldBegin before this directive");
+    expect_error("WorldBegin\nObjectBegin \"a\"\n", "ObjectBegin \"a\" has no ObjectEnd");
+    expect_error("WorldBegin\nObjectInstance \"b\"\n", "t.pbrt:2:16: ObjectInstance: expected an "
+                 "object");
+    expect_error("WorldBegin\nShape \"plymesh\" \"string filename\" \"/nonexistent.ply\"\n",
+                 "t.pbrt:2:1: plymesh: /nonexistent.ply: cannot open");
+    expect_error("WorldBegin\nShape \"sphere\" \"integer radius\" 1.5\n",
+                 "t.pbrt:2:33: expected an integer");
+    expect_error("WorldBegin\nShape \"sphere\" \"float radius\" 1e999\n",
+                 "t.pbrt:2:31: expected a value for \"float radius\", found \"1e999\"");
+    expect_error("WorldBegin\nRotate 90 0 0 0\n", "t.pbrt:2:1: Rotate: expected a nonzero axis");
+}
+
+TEST_MAIN(TEST(test_cornell_box), TEST(test_transforms), TEST(test_materials), TEST(test_lights),
+          TEST(test_instances_include_ply), TEST(test_errors))
