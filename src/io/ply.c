@@ -506,9 +506,14 @@ static int finish_faces(Ply *r, PlyMesh *m)
     m->n_verts = malloc((r->n_raw_indices + 1) * sizeof(int));
     if (!m->indices || !m->n_verts)
         return fail(r, "out of memory for %zu faces", r->n_raw);
-    const int *idx = r->raw_indices;
-    for (size_t f = 0; f < r->n_raw; idx += r->raw_counts[f], f++) {
+    size_t at = 0;
+    for (size_t f = 0; f < r->n_raw; at += (size_t)r->raw_counts[f], f++) {
         int n = r->raw_counts[f];
+        if (n == 0) { /* raw_indices may be NULL then */
+            m->n_skipped++;
+            continue;
+        }
+        const int *idx = r->raw_indices + at;
         for (int k = 0; k < n; k++)
             if ((size_t)idx[k] >= m->n_vertices) {
                 r->line = 0; /* found after reading: the face's index names the place */

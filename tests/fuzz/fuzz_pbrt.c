@@ -22,7 +22,7 @@
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
 
-static void finite(const float *v, size_t n)
+static void check_finite(const float *v, size_t n)
 {
     for (size_t i = 0; i < n; i++)
         if (!isfinite(v[i]))
@@ -39,17 +39,17 @@ static RayesError camera_matrix(void *t, const float m[16], RayesProjection p, f
                                 const float sw[4])
 {
     (void)t, (void)p;
-    finite(m, 16);
-    finite(&fov, 1);
+    check_finite(m, 16);
+    check_finite(&fov, 1);
     if (sw)
-        finite(sw, 4);
+        check_finite(sw, 4);
     return RAYES_OK;
 }
 
 static RayesError transform(void *t, const float m[16])
 {
     (void)t;
-    finite(m, 16);
+    check_finite(m, 16);
     return RAYES_OK;
 }
 
@@ -61,7 +61,7 @@ static RayesError shader(void *t, const char *name, const RayesParam *p, size_t 
     for (size_t i = 0; i < n; i++) {
         if (!p[i].name || (p[i].type == RAYES_PARAM_STRING && !p[i].string))
             abort();
-        finite(p[i].value, 3);
+        check_finite(p[i].value, 3);
     }
     return RAYES_OK;
 }
@@ -92,14 +92,14 @@ static RayesError rate(void *t, float r)
 static RayesError bilinear(void *t, const float P[4][3])
 {
     (void)t;
-    finite(&P[0][0], 12);
+    check_finite(&P[0][0], 12);
     return RAYES_OK;
 }
 
 static RayesError bicubic(void *t, const float P[16][3])
 {
     (void)t;
-    finite(&P[0][0], 48);
+    check_finite(&P[0][0], 48);
     return RAYES_OK;
 }
 
@@ -115,7 +115,7 @@ static RayesError mesh(void *t, size_t n_faces, const int *nv, const int *idx, s
             if (idx[k] < 0 || (size_t)idx[k] >= n_points)
                 abort();
     }
-    finite(P, 3 * n_points);
+    check_finite(P, 3 * n_points);
     return RAYES_OK;
 }
 
@@ -130,15 +130,15 @@ static RayesError quadric(void *t, RayesQuadric type, const float *p, size_t n, 
     (void)t, (void)type, (void)flags;
     if (n > 8)
         abort();
-    finite(p, n);
+    check_finite(p, n);
     return RAYES_OK;
 }
 
 static RayesError area(void *t, const float P[4][3], const float L[3])
 {
     (void)t;
-    finite(&P[0][0], 12);
-    finite(L, 3);
+    check_finite(&P[0][0], 12);
+    check_finite(L, 3);
     return RAYES_OK;
 }
 
