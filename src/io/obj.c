@@ -452,9 +452,10 @@ static int obj_mtllib(Obj *o, Lexer *L)
         char why[512];
         size_t size = 0;
         char *text = NULL;
-        if (stat(path, &st) != 0 || !S_ISREG(st.st_mode))
-            snprintf(why, sizeof why, "%s", stat(path, &st) != 0 ? strerror(errno)
-                                                                 : "not a regular file");
+        if (stat(path, &st) != 0)
+            snprintf(why, sizeof why, "%s", strerror(errno));
+        else if (!S_ISREG(st.st_mode) || st.st_size > (1 << 28))
+            snprintf(why, sizeof why, "not a regular file of at most 256 MB");
         else
             text = text_read_file(path, &size, why, sizeof why);
         if (!text) {
@@ -676,6 +677,21 @@ static double cross2(const double a[2], const double b[2], const double c[2])
     return (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]);
 }
 
+static int same(const double a[2], const double b[2])
+{
+    return a[0] == b[0] && a[1] == b[1];
+}
+
+/* Nonzero if p lies in the triangle abc (counter-clockwise) or on its
+ * edges: a vertex on the new diagonal a-c must block the ear too. Copies
+ * of the corners do not block. */
+static int inside(const double a[2], const double b[2], const double c[2], const double p[2])
+{
+    if (same(p, a) || same(p, b) || same(p, c))
+        return 0;
+    return cross2(a, b, p) >= 0.0 && cross2(b, c, p) >= 0.0 && cross2(c, a, p) >= 0.0;
+}
+
 static int mesh_face(Mesh *m, int a, int b, int c, int d)
 {
     if (ipush(&m->nv, d < 0 ? 3 : 4) != 0 || ipush(&m->idx, a) != 0 || ipush(&m->idx, b) != 0 ||
@@ -684,7 +700,8 @@ static int mesh_face(Mesh *m, int a, int b, int c, int d)
     return 0;
 }
 
-/* Ear clipping of a simple polygon (concave allowed) in its 2D projection;
+/* Ear clipping of a simple polygon (concave allowed) in its 2D projection
+ * (O(n^2) per ear at worst, so big faces are fanned instead);
  * when no ear is found (a self-intersecting or degenerate polygon) the
  * first remaining vertex is clipped anyway, so every input ends. */
 static int ear_clip(Mesh *m, const int *f, int n, double (*q)[2])
@@ -702,8 +719,7 @@ static int ear_clip(Mesh *m, const int *f, int n, double (*q)[2])
         int a = prev[cur], b = cur, c = next[cur];
         int ear = cross2(q[a], q[b], q[c]) > 0.0;
         for (int k = next[c]; ear && k != a; k = next[k])
-            ear = !(cross2(q[a], q[b], q[k]) > 0.0 && cross2(q[b], q[c], q[k]) > 0.0 &&
-                    cross2(q[c], q[a], q[k]) > 0.0);
+            ear = !inside(q[a], q[b], q[c], q[k]);
         if (ear || tried == left) {
             r = mesh_face(m, f[a], f[b], f[c], -1);
             next[a] = c;

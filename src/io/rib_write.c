@@ -30,15 +30,6 @@ struct RibWriter {
     char error[256];         /* the last error, "" if none */
 };
 
-static int stream_open(Stream *s)
-{
-    free(s->buf);
-    s->buf = NULL;
-    s->size = 0;
-    s->f = open_memstream(&s->buf, &s->size);
-    return s->f ? 0 : -1;
-}
-
 static void stream_close(Stream *s)
 {
     if (s->f)
@@ -46,6 +37,15 @@ static void stream_close(Stream *s)
     s->f = NULL;
     free(s->buf);
     s->buf = NULL;
+    s->size = 0;
+}
+
+/* Opens s empty (closing what it held). */
+static int stream_open(Stream *s)
+{
+    stream_close(s);
+    s->f = open_memstream(&s->buf, &s->size);
+    return s->f ? 0 : -1;
 }
 
 RibWriter *io_rib_writer_new(void)
@@ -92,12 +92,12 @@ static int finite_all(const float *v, size_t n)
     return 1;
 }
 
-/* "[a b c ...]" with %.9g. */
+/* "[a b c ...]" with %.9g: every float reads back exactly. */
 static void floats(FILE *f, const float *v, size_t n)
 {
     fputc('[', f);
     for (size_t i = 0; i < n; i++)
-        fprintf(f, i ? " %.9g" : "%.9g", (double)v[i]);
+        fprintf(f, i ? " %.9g" : "%.9g", v[i] == 0.0f ? 0.0 : (double)v[i]); /* no "-0" */
     fputc(']', f);
 }
 
@@ -434,7 +434,8 @@ static RayesError w_polygon_mesh(void *t, size_t n_faces, const int *nv, const i
         fprintf(f, "%s%d", i == 0 ? "" : i % 24 == 0 ? "\n   " : " ", idx[i]);
     fprintf(f, "]\n  \"P\" [");
     for (size_t i = 0; i < 3 * n_points; i++)
-        fprintf(f, "%s%.9g", i == 0 ? "" : i % 9 == 0 ? "\n   " : " ", (double)P[i]);
+        fprintf(f, "%s%.9g", i == 0 ? "" : i % 9 == 0 ? "\n   " : " ",
+                P[i] == 0.0f ? 0.0 : (double)P[i]);
     fprintf(f, "]\n");
     return RAYES_OK;
 }
@@ -453,7 +454,7 @@ static RayesError w_quadric(void *t, RayesQuadric type, const float *p, size_t n
         fprintf(f, "AttributeBegin\nReverseOrientation\n");
     fprintf(f, "%s", names[type]);
     for (size_t i = 0; i < n; i++)
-        fprintf(f, " %.9g", (double)p[i]);
+        fprintf(f, " %.9g", p[i] == 0.0f ? 0.0 : (double)p[i]);
     fprintf(f, "\n%s", reverse ? "AttributeEnd\n" : "");
     return RAYES_OK;
 }
