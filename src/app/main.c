@@ -671,7 +671,9 @@ static int cmd_convert(int argc, char **argv)
             *(in ? &out : &in) = o;
         } else if (strcmp(o, "--quiet") == 0) {
             quiet = 1;
-        } else if (strcmp(o, "--data") == 0 && v) {
+        } else if (strcmp(o, "--data") == 0) {
+            if (!v)
+                die_usage("--data: expected a value");
             data_dir = v;
             i++;
         } else if (strcmp(o, "--frame") == 0) {
