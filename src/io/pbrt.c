@@ -1445,6 +1445,9 @@ static int shape_trianglemesh(Parser *P, const Token *t, ParamList *pl)
                 "ignored", np->n_num, pp->n_num);
         np = NULL;
     }
+    if (np && !P->gs.area.on)
+        warn_at(P, np->line, np->col, "vertex data N", "trianglemesh: \"N\" is not passed on "
+                "(rayes shades meshes with their geometric normals)");
     size_t n_faces = n_idx / 3;
     float *pts = points_of(P, t, pp);
     float *N = np ? points_of(P, t, np) : NULL;
@@ -1468,9 +1471,11 @@ static int shape_trianglemesh(Parser *P, const Token *t, ParamList *pl)
 
 static int shape_bilinearmesh(Parser *P, const Token *t, ParamList *pl)
 {
-    Param *pp = find(pl, "P"), *ip = find(pl, "indices");
-    find(pl, "N");
+    Param *pp = find(pl, "P"), *ip = find(pl, "indices"), *np = find(pl, "N");
     warn_vertex_data(P, t, pl, "bilinearmesh");
+    if (np)
+        warn_at(P, np->line, np->col, "vertex data N", "bilinearmesh: \"N\" is not passed on "
+                "(rayes shades patches with their geometric normals)");
     if (!pp || pp->n_num < 12)
         return FAIL_TOK(P, t, "bilinearmesh: expected \"point3 P\" with at least 4 points");
     size_t n_points = pp->n_num / 3;
@@ -1532,6 +1537,9 @@ static int shape_plymesh(Parser *P, const Token *t, ParamList *pl)
     if (m.uv)
         warn_at(P, t->line, t->col, "vertex data uv", "plymesh: texture coordinates are not "
                 "passed on (rayes meshes carry positions only)");
+    if (m.N && !P->gs.area.on)
+        warn_at(P, t->line, t->col, "vertex data N", "plymesh: normals are not passed on (rayes "
+                "shades meshes with their geometric normals)");
     int r = shape_mesh(P, t, "plymesh", m.n_faces, m.n_verts, m.indices, m.n_vertices, m.P, m.N);
     io_ply_mesh_fini(&m);
     return r;
