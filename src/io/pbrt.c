@@ -188,6 +188,14 @@ typedef struct Parser {
 
 /* ------------------------------------------------------------ messages */
 
+/* Messages are one line: names from the file may hold escaped newlines. */
+static void one_line(char *msg)
+{
+    for (; *msg; msg++)
+        if ((unsigned char)*msg < 0x20 || *msg == 0x7f)
+            *msg = '?';
+}
+
 static int fail_at(Parser *P, long line, long col, const char *fmt, ...)
     __attribute__((format(printf, 4, 5)));
 
@@ -198,6 +206,7 @@ static int fail_at(Parser *P, long line, long col, const char *fmt, ...)
     va_start(ap, fmt);
     vsnprintf(msg, sizeof msg, fmt, ap);
     va_end(ap);
+    one_line(msg);
     snprintf(P->err, P->err_size, "%s:%ld:%ld: %s", P->lx->name, line, col, msg);
     return -1;
 }
@@ -221,6 +230,7 @@ static void warn_at(Parser *P, long line, long col, const char *key, const char 
     va_start(ap, fmt);
     vsnprintf(msg, sizeof msg, fmt, ap);
     va_end(ap);
+    one_line(msg);
     log_warning("%s:%ld:%ld: %s", P->lx->name, line, col, msg);
 }
 

@@ -673,6 +673,8 @@ static void test_errors(void)
                  "t.pbrt:2:33: expected an integer");
     expect_error("WorldBegin\nShape \"sphere\" \"float radius\" 1e999\n",
                  "t.pbrt:2:31: expected a value for \"float radius\", found \"1e999\"");
+    /* an escaped newline in a name stays out of the one-line message (fuzz finding) */
+    expect_error("WorldBegin\nNamedMaterial \"a\\nb\"\n", "found \"a?b\"");
     expect_error("WorldBegin\nRotate 90 0 0 0\n", "t.pbrt:2:1: Rotate: expected a nonzero axis");
 }
 
