@@ -4,11 +4,13 @@
 #   make test     install what is missing, build, run every test (Release, then
 #                 AddressSanitizer + UndefinedBehaviorSanitizer, then the threaded
 #                 tests under ThreadSanitizer)
+#   make fuzz     build the libFuzzer targets (clang, AddressSanitizer) into
+#                 build-fuzz/ and run each fuzz_* for FUZZ_SECONDS (default 60)
 #   make bench    build the benchmarks
 #   make format   clang-format the sources
 JOBS ?= $(shell nproc)
 
-.PHONY: all build render test test-release test-asan test-tsan deps deps-test bench format clean
+.PHONY: all build render test test-release test-asan test-tsan test-fuzz fuzz deps deps-test bench format clean
 
 all: build
 
@@ -26,7 +28,7 @@ render: deps build
 	mkdir -p out
 	build/rayes render cornell -o out/default.exr -o out/default.png
 
-test: deps-test test-release test-asan test-tsan
+test: deps-test test-release test-asan test-tsan test-fuzz
 
 test-release: build
 	cd build && ctest --output-on-failure -j $(JOBS)
@@ -52,10 +54,38 @@ test-tsan:
 	cmake --build build-tsan -j $(JOBS) --target $(TSAN_TESTS)
 	cd build-tsan && TSAN_OPTIONS="halt_on_error=1 suppressions=$(CURDIR)/tools/tsan.supp" ctest --output-on-failure -R '^(cache|util)/|^shade/test_plugin$$|^shade/test_texture_threads$$|^render/test_(hider|determinism)$$'
 
+# Fuzzing: every tests/fuzz/fuzz_NAME.c is a target, run on a scratch copy
+# of its seeds tests/fuzz/corpus_NAME/ (the repository's seeds stay as they
+# are) for FUZZ_SECONDS. A crash stops make; libFuzzer writes the input to
+# build-fuzz/artifacts/. The targets' own stderr (reader warnings) is closed.
+# Warnings are not errors there: clang warns on some code gcc accepts.
+FUZZ_SECONDS ?= 60
+FUZZ_TARGETS = $(patsubst tests/fuzz/%.c,%,$(wildcard tests/fuzz/fuzz_*.c))
+fuzz:
+	@test -f build-fuzz/Makefile || CC=clang cmake -S . -B build-fuzz -DCMAKE_BUILD_TYPE=RelWithDebInfo -DRAYES_FUZZ=ON -DRAYES_SANITIZE=ON -DRAYES_WERROR=OFF
+	cmake --build build-fuzz -j $(JOBS) --target $(FUZZ_TARGETS)
+	@mkdir -p build-fuzz/artifacts
+	@set -e; for t in $(FUZZ_TARGETS); do \
+	  name=$${t#fuzz_}; corpus=build-fuzz/corpus/$$name; \
+	  rm -rf $$corpus; mkdir -p $$corpus; \
+	  if [ -d tests/fuzz/corpus_$$name ]; then cp tests/fuzz/corpus_$$name/* $$corpus/; fi; \
+	  echo "fuzz: $$t for $(FUZZ_SECONDS) s on a copy of tests/fuzz/corpus_$$name"; \
+	  if ! build-fuzz/tests/fuzz/$$t -max_total_time=$(FUZZ_SECONDS) -timeout=20 \
+	      -rss_limit_mb=2048 -close_fd_mask=2 -print_final_stats=1 \
+	      -artifact_prefix=build-fuzz/artifacts/$$t- $$corpus > build-fuzz/$$t.log 2>&1; then \
+	    cat build-fuzz/$$t.log; echo "fuzz: $$t FAILED (log build-fuzz/$$t.log)"; exit 1; \
+	  fi; \
+	  grep -E '^stat::(number_of_executed_units|peak_rss_mb)|^#[0-9]+.*DONE' build-fuzz/$$t.log; \
+	done
+
+# make test fuzzes each target briefly.
+test-fuzz:
+	$(MAKE) fuzz FUZZ_SECONDS=20
+
 bench: build
 
 format:
 	clang-format -i $$(git ls-files '*.c' '*.h')
 
 clean:
-	rm -rf build build-asan build-tsan out
+	rm -rf build build-asan build-tsan build-fuzz out

@@ -34,6 +34,7 @@
 #include <sys/stat.h>
 
 #include "io/builtin.h"
+#include "io/sink.h"
 #include "image/image.h"
 #include "rayes/rayes.h"
 
@@ -82,8 +83,13 @@ static Row run(const Args *a, int size, int spp, int bounces, int cache, double 
 {
     RayesScene *scene = rayes_scene_new();
     char err[1024];
-    if (!scene || io_builtin_scene(a->scene, a->data, scene, err, sizeof err) != RAYES_OK)
+    if (!scene)
+        die("out of memory");
+    IoSink sink = io_sink_scene(scene);
+    if (io_builtin_scene(a->scene, a->data, &sink, err, sizeof err) != RAYES_OK)
         die(err);
+    if (rayes_scene_commit(scene) != RAYES_OK)
+        die(rayes_scene_get_error(scene));
     RayesRenderOptions o;
     rayes_render_options_init(&o, (RayesQuality)a->quality);
     o.width = o.height = size;

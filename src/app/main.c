@@ -7,25 +7,47 @@
  */
 #include <errno.h>
 #include <limits.h>
+#include <math.h>
 #include <signal.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <strings.h>
 #include <unistd.h>
 
-#include "io/builtin.h"
 #include "image/image.h"
+#include "io/builtin.h"
+#include "io/rib_write.h"
+#include "io/scene_file.h"
 #include "io/stats_json.h"
 #include "rayes/rayes.h"
 #include "util/log.h"
 
 #define MAX_OUTPUTS 8
 
+/* Options given on the command line, which win over a scene file's. */
+enum {
+    SET_RES = 1,
+    SET_SPP = 2,
+    SET_FILTER = 4,
+    SET_FILTER_WIDTH = 8,
+    SET_BOUNCES = 16,
+    SET_SPECULAR_DEPTH = 32
+};
+
+/* An image to write. */
+typedef struct Output {
+    char path[600];
+    ImageFormat format;
+} Output;
+
 typedef struct Args {
-    const char *scene;
-    const char *outputs[MAX_OUTPUTS];
+    const char *scene;          /* a built-in scene's name or a scene file */
+    Output outputs[MAX_OUTPUTS];
     int n_outputs;
+    int frame;                  /* --frame: the RIB frame to read; -1 the last */
+    unsigned set;               /* SET_*: options the command line gave */
     const char *stats_path;
     const char *data_dir;
     const char *shader_path;    /* --shader-path: put before the scene's own shader path */
@@ -49,14 +71,19 @@ static void on_sigint(int sig)
 static void usage(FILE *f)
 {
     fputs("usage: rayes render [SCENE] [options]\n"
+          "       rayes convert SCENE OUT.rib [--data DIR] [--frame N] [--quiet]\n"
           "       rayes --help | --version\n"
           "\n"
-          "SCENE is a built-in scene: cornell (default), cornell-teapots,\n"
-          "cornell-teapots-displaced, cornell-spheres, cornell-brick (needs the plugin\n"
-          "brick.so: --shader-path build/examples/shaders).\n"
+          "SCENE is a scene file (.rib, .rib.gz, .pbrt, .obj) or a built-in scene:\n"
+          "cornell (default), cornell-teapots, cornell-teapots-displaced, cornell-spheres,\n"
+          "cornell-brick (needs the plugin brick.so: --shader-path build/examples/shaders).\n"
+          "A scene file's image size, samples, filter, depths and displays are used unless\n"
+          "the command line gives them. convert writes SCENE as ASCII RIB.\n"
           "\n"
           "options:\n"
-          "  -o FILE                 output image, .exr or .png (repeatable; default SCENE.exr)\n"
+          "  -o FILE                 output image, .exr or .png (repeatable; default: the\n"
+          "                          scene file's displays, else SCENE.exr)\n"
+          "  --frame N               the frame of a RIB file to read (default: the last)\n"
           "  --res W[xH]             resolution in pixels (default 512x512)\n"
           "  --spp N                 pixel samples (default 4)\n"
           "  --threads N             worker threads (default: all cores)\n"
@@ -184,7 +211,7 @@ static void parse_args(int argc, char **argv, Args *a)
         if (strcmp(argv[i], "--quality") == 0)
             q = parse_quality(i + 1 < argc ? argv[i + 1] : NULL);
     rayes_render_options_init(&a->opt, q);
-    int filter_width_set = 0;
+    a->frame = -1;
     for (int i = 2; i < argc; i++) {
         const char *o = argv[i];
         const char *v = i + 1 < argc ? argv[i + 1] : NULL;
@@ -205,17 +232,27 @@ static void parse_args(int argc, char **argv, Args *a)
         if (strcmp(o, "-o") == 0) {
             if (a->n_outputs == MAX_OUTPUTS)
                 die_usage("-o: at most %d outputs", MAX_OUTPUTS);
-            if (image_format_from_path(v) == IMAGE_FORMAT_UNKNOWN)
+            Output *out = &a->outputs[a->n_outputs++];
+            out->format = image_format_from_path(v);
+            if (out->format == IMAGE_FORMAT_UNKNOWN)
                 die_usage("-o %s: expected a file name ending in .exr or .png", v);
-            a->outputs[a->n_outputs++] = v;
-        } else if (strcmp(o, "--res") == 0)
+            if (strlen(v) >= sizeof out->path)
+                die_usage("-o: the file name is too long");
+            snprintf(out->path, sizeof out->path, "%s", v);
+        } else if (strcmp(o, "--res") == 0) {
             parse_res(v, opt);
-        else if (strcmp(o, "--spp") == 0)
+            a->set |= SET_RES;
+        } else if (strcmp(o, "--spp") == 0) {
             opt->spp = (int)parse_long(o, v, 1, 1 << 20);
+            a->set |= SET_SPP;
+        } else if (strcmp(o, "--frame") == 0)
+            a->frame = (int)parse_long(o, v, 0, INT_MAX);
         else if (strcmp(o, "--threads") == 0)
             opt->threads = (int)parse_long(o, v, 0, 1024);
-        else if (strcmp(o, "--bounces") == 0)
+        else if (strcmp(o, "--bounces") == 0) {
             opt->bounces = (int)parse_long(o, v, 0, 64);
+            a->set |= SET_BOUNCES;
+        }
         else if (strcmp(o, "--quality") == 0)
             continue;
         else if (strcmp(o, "--shadow-rays") == 0)
@@ -224,9 +261,11 @@ static void parse_args(int argc, char **argv, Args *a)
             opt->diffuse_rays = opt->diffuse_rays_deep = (int)parse_long(o, v, 0, 1 << 20);
         else if (strcmp(o, "--diffuse-rays-deep") == 0)
             opt->diffuse_rays_deep = (int)parse_long(o, v, 0, 1 << 20);
-        else if (strcmp(o, "--specular-depth") == 0)
+        else if (strcmp(o, "--specular-depth") == 0) {
             opt->specular_depth = (int)parse_long(o, v, 0, 64);
-        else if (strcmp(o, "--filter") == 0) {
+            a->set |= SET_SPECULAR_DEPTH;
+        } else if (strcmp(o, "--filter") == 0) {
+            a->set |= SET_FILTER;
             if (strcmp(v, "box") == 0)
                 opt->filter = RAYES_FILTER_BOX;
             else if (strcmp(v, "gaussian") == 0)
@@ -235,7 +274,7 @@ static void parse_args(int argc, char **argv, Args *a)
                 die_usage("--filter: expected box or gaussian, got \"%s\"", v);
         } else if (strcmp(o, "--filter-width") == 0) {
             opt->filter_width = parse_float(o, v, 0.01f, 16.0f);
-            filter_width_set = 1;
+            a->set |= SET_FILTER_WIDTH;
         } else if (strcmp(o, "--seed") == 0)
             opt->seed = (uint64_t)parse_long(o, v, 0, LONG_MAX);
         else if (strcmp(o, "--cache") == 0) {
@@ -269,7 +308,7 @@ static void parse_args(int argc, char **argv, Args *a)
         else
             die_usage("unknown option \"%s\"", o);
     }
-    if (!filter_width_set && a->opt.filter == RAYES_FILTER_GAUSSIAN)
+    if (!(a->set & SET_FILTER_WIDTH) && a->opt.filter == RAYES_FILTER_GAUSSIAN)
         a->opt.filter_width = 2.0f;
     if (!a->scene)
         a->scene = "cornell";
@@ -376,20 +415,137 @@ static int check_output_dir(const char *path)
     return -1;
 }
 
+/* Builds the scene `scene` names (a scene file, else a built-in scene)
+ * into sink; settings receive what a file gives. */
+static RayesError load_scene(const char *scene, const char *data_dir, int frame,
+                             const IoSink *sink, IoSettings *settings, char *err, size_t err_size)
+{
+    io_settings_init(settings);
+    if (io_is_scene_file(scene)) {
+        IoReadOptions ro = {.data_dir = data_dir, .frame = frame};
+        return io_read_scene_file(scene, sink, &ro, settings, err, err_size);
+    }
+    return io_builtin_scene(scene, data_dir, sink, err, err_size);
+}
+
+/* The exit status of a failed load: an unknown built-in name is a usage
+ * error, everything else bad input. */
+static int load_status(const char *scene, RayesError e)
+{
+    return !io_is_scene_file(scene) && e == RAYES_ERROR_INVALID_ARGUMENT ? 2 : 1;
+}
+
+/* The file's settings where the command line gave none. */
+static void merge_settings(Args *a, const IoSettings *s)
+{
+    RayesRenderOptions *o = &a->opt;
+    if (!(a->set & SET_RES) && s->width > 0 && s->height > 0) {
+        o->width = s->width;
+        o->height = s->height;
+    }
+    if (!(a->set & SET_SPP) && s->spp > 0)
+        o->spp = s->spp;
+    if (!(a->set & SET_FILTER) && (s->filter == RAYES_FILTER_BOX || s->filter == RAYES_FILTER_GAUSSIAN)) {
+        o->filter = (RayesFilter)s->filter;
+        if (!(a->set & SET_FILTER_WIDTH))
+            o->filter_width = o->filter == RAYES_FILTER_GAUSSIAN ? 2.0f : 1.0f;
+    }
+    if (!(a->set & SET_FILTER_WIDTH) && s->filter_width > 0.0f)
+        o->filter_width = s->filter_width;
+    if (!(a->set & SET_BOUNCES) && s->bounces >= 0)
+        o->bounces = s->bounces < 64 ? s->bounces : 64;
+    if (!(a->set & SET_SPECULAR_DEPTH) && s->specular_depth >= 0)
+        o->specular_depth = s->specular_depth < 64 ? s->specular_depth : 64;
+    if (s->crop[0] != 0.0f || s->crop[1] != 1.0f || s->crop[2] != 0.0f || s->crop[3] != 1.0f)
+        fprintf(stderr, "rayes: warning: %s: CropWindow is not supported; the whole image is "
+                        "rendered\n", a->scene);
+}
+
+/* The scene's name without its directory and extensions, for default
+ * output names. */
+static void scene_stem(const char *scene, char *out, size_t size)
+{
+    const char *slash = strrchr(scene, '/');
+    snprintf(out, size, "%s", slash ? slash + 1 : scene);
+    if (!io_is_scene_file(scene))
+        return;
+    char *dot = strchr(out[0] == '.' ? out + 1 : out, '.');
+    if (dot)
+        *dot = '\0';
+}
+
+static void add_output(Args *a, const char *path, ImageFormat format)
+{
+    if (a->n_outputs == MAX_OUTPUTS)
+        return;
+    snprintf(a->outputs[a->n_outputs].path, sizeof a->outputs[0].path, "%s", path);
+    a->outputs[a->n_outputs++].format = format;
+}
+
+/* The images a file's displays ask for: exr/openexr and png by type,
+ * file and tiff by the name's extension, else OpenEXR (with a note);
+ * framebuffer windows write nothing; displays of other modes than rgb and
+ * rgba (AOVs) are skipped with a warning each. */
+static void outputs_from_displays(Args *a, const IoSettings *s)
+{
+    for (int i = 0; i < s->n_displays && i < IO_MAX_DISPLAYS; i++) {
+        const IoDisplay *d = &s->displays[i];
+        const char *type = d->type[0] ? d->type : "file";
+        if (d->mode[0] && strcasecmp(d->mode, "rgb") != 0 && strcasecmp(d->mode, "rgba") != 0) {
+            fprintf(stderr, "rayes: warning: display \"%s\": mode \"%s\" is not rendered (only "
+                            "rgb and rgba); skipped\n", d->name, d->mode);
+            continue;
+        }
+        if (strcasecmp(type, "framebuffer") == 0)
+            continue;
+        if (strcasecmp(type, "exr") == 0 || strcasecmp(type, "openexr") == 0) {
+            add_output(a, d->name, IMAGE_FORMAT_EXR);
+        } else if (strcasecmp(type, "png") == 0) {
+            add_output(a, d->name, IMAGE_FORMAT_PNG);
+        } else if (strcasecmp(type, "file") == 0 || strcasecmp(type, "tiff") == 0) {
+            ImageFormat f = image_format_from_path(d->name);
+            if (f != IMAGE_FORMAT_UNKNOWN) {
+                add_output(a, d->name, f);
+                continue;
+            }
+            char path[600];
+            const char *slash = strrchr(d->name, '/'), *dot = strrchr(d->name, '.');
+            int stem = dot && (!slash || dot > slash) ? (int)(dot - d->name) : (int)strlen(d->name);
+            snprintf(path, sizeof path, "%.*s.exr", stem, d->name);
+            fprintf(stderr, "rayes: note: display \"%s\" (%s): written as OpenEXR to %s\n",
+                    d->name, type, path);
+            add_output(a, path, IMAGE_FORMAT_EXR);
+        } else {
+            fprintf(stderr, "rayes: warning: display \"%s\": type \"%s\" is not supported; "
+                            "skipped\n", d->name, type);
+        }
+    }
+}
+
+/* RenderMan's Exposure: colour = (gain colour)^(1 / gamma); alpha kept. */
+static void apply_exposure(RayesImage *img, float gain, float gamma)
+{
+    if (gain == 1.0f && gamma == 1.0f)
+        return;
+    size_t n = (size_t)img->width * (size_t)img->height;
+    for (size_t i = 0; i < n; i++)
+        for (int c = 0; c < 3; c++) {
+            float v = fmaxf(img->rgba[4 * i + c] * gain, 0.0f);
+            img->rgba[4 * i + c] = gamma > 0.0f && gamma != 1.0f ? powf(v, 1.0f / gamma) : v;
+        }
+}
+
+static RayesError write_output(const Output *o, const RayesImage *img, char *err, size_t n)
+{
+    if (o->format == IMAGE_FORMAT_PNG)
+        return image_write_png(o->path, img->width, img->height, img->rgba, err, n);
+    return image_write_exr(o->path, img->width, img->height, img->rgba, err, n);
+}
+
 static int cmd_render(int argc, char **argv)
 {
     Args a = {0};
     parse_args(argc, argv, &a);
-    char default_out[512];
-    if (a.n_outputs == 0) {
-        snprintf(default_out, sizeof default_out, "%s.exr", a.scene);
-        a.outputs[a.n_outputs++] = default_out;
-    }
-    for (int i = 0; i < a.n_outputs; i++)
-        if (check_output_dir(a.outputs[i]) != 0)
-            return 1;
-    if (a.stats_path && check_output_dir(a.stats_path) != 0)
-        return 1;
     RayesScene *scene = rayes_scene_new();
     char err[1024];
     if (!scene) {
@@ -402,11 +558,39 @@ static int cmd_render(int argc, char **argv)
         rayes_scene_release(scene);
         return 2;
     }
-    RayesError e = io_builtin_scene(a.scene, a.data_dir, scene, err, sizeof err);
+    IoSettings settings;
+    IoSink sink = io_sink_scene(scene);
+    RayesError e = load_scene(a.scene, a.data_dir, a.frame, &sink, &settings, err, sizeof err);
+    if (e == RAYES_OK && rayes_scene_commit(scene) != RAYES_OK) {
+        e = RAYES_ERROR_PARSE;
+        snprintf(err, sizeof err, "%s: %s", a.scene, rayes_scene_get_error(scene));
+    }
     if (e != RAYES_OK) {
         fprintf(stderr, "rayes: %s\n", err);
         rayes_scene_release(scene);
-        return e == RAYES_ERROR_INVALID_ARGUMENT ? 2 : 1;
+        return load_status(a.scene, e);
+    }
+    merge_settings(&a, &settings);
+    if (a.n_outputs == 0) {
+        outputs_from_displays(&a, &settings);
+        if (a.n_outputs == 0) {
+            char stem[512], path[600];
+            scene_stem(a.scene, stem, sizeof stem);
+            snprintf(path, sizeof path, "%s.exr", stem);
+            if (settings.n_displays > 0)
+                fprintf(stderr, "rayes: note: %s: no display writes a file; writing %s\n",
+                        a.scene, path);
+            add_output(&a, path, IMAGE_FORMAT_EXR);
+        }
+    }
+    int status = 0;
+    for (int i = 0; i < a.n_outputs && status == 0; i++)
+        status = check_output_dir(a.outputs[i].path) != 0;
+    if (status == 0 && a.stats_path && check_output_dir(a.stats_path) != 0)
+        status = 1;
+    if (status != 0) {
+        rayes_scene_release(scene);
+        return 1;
     }
     Progress prog = {.start = time_now(), .tty = isatty(2), .last_percent = -1, .quiet = a.quiet};
     a.opt.progress = on_progress;
@@ -420,10 +604,10 @@ static int cmd_render(int argc, char **argv)
         rayes_scene_release(scene);
         return e == RAYES_ERROR_CANCELLED ? 130 : 1;
     }
-    int status = 0, written = 0; /* outputs written whole */
+    apply_exposure(img, settings.exposure_gain, settings.exposure_gamma);
+    int written = 0; /* outputs written whole */
     while (written < a.n_outputs && status == 0) {
-        if (image_write(a.outputs[written], img->width, img->height, img->rgba, err,
-                           sizeof err) == RAYES_OK) {
+        if (write_output(&a.outputs[written], img, err, sizeof err) == RAYES_OK) {
             written++;
         } else {
             fprintf(stderr, "rayes: %s\n", err);
@@ -437,15 +621,90 @@ static int cmd_render(int argc, char **argv)
     }
     /* A failed run leaves none of its outputs behind. */
     for (int i = 0; status != 0 && i < written; i++)
-        unlink(a.outputs[i]);
+        unlink(a.outputs[i].path);
     if (status == 0 && !a.quiet) {
         summary(&a, stats);
         for (int i = 0; i < a.n_outputs; i++)
-            printf("  wrote         %s\n", a.outputs[i]);
+            printf("  wrote         %s\n", a.outputs[i].path);
     }
     rayes_stats_free(stats);
     rayes_image_free(img);
     rayes_scene_release(scene);
+    return status;
+}
+
+/* Writes the RIB through a temporary file in out's directory, renamed into
+ * place once whole: an error leaves nothing behind. */
+static int write_rib(RibWriter *w, const IoSettings *settings, const char *out)
+{
+    char tmp[4200], err[512];
+    snprintf(tmp, sizeof tmp, "%s.tmp.XXXXXX", out);
+    int fd = mkstemp(tmp);
+    FILE *f = fd >= 0 ? fdopen(fd, "w") : NULL;
+    if (!f) {
+        fprintf(stderr, "rayes: %s: cannot write: %s\n", out, strerror(errno));
+        if (fd >= 0) {
+            close(fd);
+            unlink(tmp);
+        }
+        return 1;
+    }
+    RayesError e = io_rib_writer_finish(w, settings, f, err, sizeof err);
+    int bad = fclose(f) != 0;
+    if (e == RAYES_OK && !bad && rename(tmp, out) == 0)
+        return 0;
+    fprintf(stderr, "rayes: %s: cannot write: %s\n", out, e != RAYES_OK ? err : strerror(errno));
+    unlink(tmp);
+    return 1;
+}
+
+/* rayes convert IN OUT.rib [--data DIR] [--frame N] [--quiet] */
+static int cmd_convert(int argc, char **argv)
+{
+    const char *in = NULL, *out = NULL, *data_dir = getenv("RAYES_DATA");
+    int frame = -1, quiet = 0;
+    for (int i = 2; i < argc; i++) {
+        const char *o = argv[i], *v = i + 1 < argc ? argv[i + 1] : NULL;
+        if (o[0] != '-') {
+            if (out)
+                die_usage("convert: expected one scene and one output (got \"%s\" too)", o);
+            *(in ? &out : &in) = o;
+        } else if (strcmp(o, "--quiet") == 0) {
+            quiet = 1;
+        } else if (strcmp(o, "--data") == 0) {
+            if (!v)
+                die_usage("--data: expected a value");
+            data_dir = v;
+            i++;
+        } else if (strcmp(o, "--frame") == 0) {
+            frame = (int)parse_long(o, v, 0, INT_MAX);
+            i++;
+        } else {
+            die_usage("convert: unknown option \"%s\"", o);
+        }
+    }
+    size_t n = out ? strlen(out) : 0;
+    if (!in || !out)
+        die_usage("convert: expected a scene and an output file OUT.rib");
+    if (n < 4 || strcasecmp(out + n - 4, ".rib") != 0)
+        die_usage("convert %s: expected an output file name ending in .rib", out);
+    if (check_output_dir(out) != 0)
+        return 1;
+    RibWriter *w = io_rib_writer_new();
+    if (!w) {
+        fprintf(stderr, "rayes: out of memory\n");
+        return 1;
+    }
+    IoSettings settings;
+    IoSink sink = io_rib_writer_sink(w);
+    char err[1024];
+    RayesError e = load_scene(in, data_dir, frame, &sink, &settings, err, sizeof err);
+    int status = e == RAYES_OK ? write_rib(w, &settings, out) : load_status(in, e);
+    if (e != RAYES_OK)
+        fprintf(stderr, "rayes: %s\n", err);
+    io_rib_writer_free(w);
+    if (status == 0 && !quiet)
+        printf("wrote %s\n", out);
     return status;
 }
 
@@ -465,5 +724,7 @@ int main(int argc, char **argv)
     }
     if (strcmp(argv[1], "render") == 0)
         return cmd_render(argc, argv);
+    if (strcmp(argv[1], "convert") == 0)
+        return cmd_convert(argc, argv);
     die_usage("unknown command \"%s\"", argv[1]);
 }

@@ -68,7 +68,7 @@ struct Cache {
     CacheCounters counters[CACHE_N_LEVELS][CACHE_N_TYPES];
 };
 
-const int cache_local_slots[CACHE_N_LEVELS] = {256, 64, 16}; /* powers of two */
+const int cache_local_slots[CACHE_N_LEVELS] = {4096, 512, 64}; /* powers of two */
 
 /* Nominal values per entry, for sizing hash tables (memo Figure 2 sizes). */
 static const size_t nominal_values[CACHE_N_LEVELS] = {4, 25, 289};
@@ -251,13 +251,20 @@ void cache_local_init(CacheLocal *local, Cache *cache)
 {
     memset(local, 0, sizeof *local);
     local->cache = cache;
+    for (int l = 0; l < CACHE_N_LEVELS; l++) {
+        uint64_t capacity = cache->level_budget[l] / cache_entry_bytes(nominal_values[l]);
+        uint32_t n = (uint32_t)cache_local_slots[l];
+        while (n > 4 && (uint64_t)n * 32 > capacity)
+            n /= 2;
+        local->n_slots[l] = n;
+    }
 }
 
 void cache_local_fini(CacheLocal *local)
 {
     Cache *c = local->cache;
     for (int l = 0; l < CACHE_N_LEVELS; l++)
-        for (int i = 0; i < cache_local_slots[l]; i++)
+        for (uint32_t i = 0; i < local->n_slots[l]; i++)
             if (local->slots[l][i]) {
                 release(c, local->slots[l][i]);
                 local->slots[l][i] = NULL;
@@ -361,7 +368,7 @@ const uint16_t *cache_lookup(CacheLocal *local, const CacheKey *key, size_t n_va
     RY_CHECK(key->level < CACHE_N_LEVELS && key->type < CACHE_N_TYPES);
     uint64_t hash = key_hash(key);
     CacheCounters *ctr = &local->counters[key->level][key->type];
-    CacheEntry **slot = &local->slots[key->level][hash & (uint64_t)(cache_local_slots[key->level] - 1)];
+    CacheEntry **slot = &local->slots[key->level][hash & (uint64_t)(local->n_slots[key->level] - 1)];
     ctr->lookups++;
     CacheEntry *held = *slot;
     if (held && held->hash == hash && key_equal(&held->key, key) &&

@@ -100,7 +100,7 @@ static Estimate estimate(const Prim *prim, const Domain *d, const DiceCamera *ca
         for (int j = 0; j < last; j++)
             len_w += v3_length(v3_sub(p[j + 1][last - 1 - j], p[j][last - j]));
     float dist = fmaxf(bounds_distance(box, cam->eye), cam->min_distance);
-    float target = sqrtf(fmaxf(prim->shading_rate, 1e-6f)) * cam->pixel_angle * dist;
+    float target = sqrtf(fmaxf(prim->shading_rate, 1e-6f)) * (cam->pixel_width + cam->pixel_angle * dist);
     Estimate e;
     if (d->triangular) {
         float len = fmaxf(len_u, fmaxf(len_v, len_w));

@@ -33,7 +33,9 @@ typedef enum PrimType {
     PRIM_BILINEAR = 1, /* cp[0..3] = P00, P10, P01, P11 */
     PRIM_BICUBIC = 2,  /* cp[0..15] Bezier, row-major, u fastest */
     PRIM_TRIANGLE = 3, /* cp[0..2]; (u, v) are barycentrics of cp[1], cp[2] */
-    PRIM_SPHERE = 4    /* sphere.radius at the origin of sphere.world_from_object */
+    PRIM_SPHERE = 4,   /* sphere.radius at the origin of sphere.world_from_object */
+    PRIM_QUADRIC = 5   /* one of RenderMan's quadrics (quadric.kind: RayesQuadric's values),
+                          swept about object-space z; see geom_quadric_eval */
 } PrimType;
 
 typedef struct Prim {
@@ -49,8 +51,19 @@ typedef struct Prim {
             Mat4 normal_from_object; /* inverse transpose, for normals */
             float radius;
         } sphere;
+        struct {
+            Mat4 world_from_object;
+            int kind;              /* RayesQuadric's value */
+            int reverse;           /* 1: u runs backwards, so the normal turns inward */
+            float p[7];            /* RenderMan's parameters, thetamax (and phi) in radians */
+        } quadric;
     };
 } Prim;
+
+/* A quadric's object-space position and derivatives at (u, v) in [0, 1]^2:
+ * u sweeps theta from 0 to thetamax, v runs along the profile (RenderMan's
+ * parameterisation). */
+void geom_quadric_eval(const Prim *prim, float u, float v, Vec3 *P, Vec3 *dPdu, Vec3 *dPdv);
 
 /* Evaluates a primitive at parameters (u, v): position and derivatives, in
  * world space. */
@@ -86,7 +99,8 @@ typedef struct GridSet {
 /* How the camera sets dicing rates. */
 typedef struct DiceCamera {
     Vec3 eye;              /* camera position, world */
-    float pixel_angle;     /* radians subtended by one pixel */
+    float pixel_angle;     /* radians subtended by one pixel (0 in orthographic projection) */
+    float pixel_width;     /* world units of one pixel at any distance (orthographic; else 0) */
     float min_distance;    /* distances are clamped to this (the eye inside a patch) */
 } DiceCamera;
 

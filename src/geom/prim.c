@@ -56,6 +56,70 @@ static void eval_sphere(const Prim *prim, float u, float v, Vec3 *P, Vec3 *dPdu,
     *dPdv = mat4_vector(m, dv);
 }
 
+/* Quadric kinds: RayesQuadric's values (geom does not include rayes.h). */
+enum { Q_SPHERE, Q_CYLINDER, Q_CONE, Q_DISK, Q_PARABOLOID, Q_HYPERBOLOID, Q_TORUS };
+
+void geom_quadric_eval(const Prim *prim, float u, float v, Vec3 *P, Vec3 *dPdu, Vec3 *dPdv)
+{
+    const float *q = prim->quadric.p;
+    if (prim->quadric.reverse)
+        u = 1.0f - u;
+    /* Surfaces of revolution: (rho cos theta, rho sin theta, z), rho and z
+     * functions of v; the hyperboloid sweeps a line (qx, qy, qz) instead. */
+    double rho = 0, drho = 0, z = 0, dz = 0, T;
+    switch (prim->quadric.kind) {
+    case Q_SPHERE: { /* radius, phimin, phimax (latitudes from zmin, zmax), thetamax */
+        double phi = q[1] + v * (q[2] - q[1]), d = q[2] - q[1];
+        rho = q[0] * cos(phi), z = q[0] * sin(phi);
+        drho = -q[0] * sin(phi) * d, dz = q[0] * cos(phi) * d;
+        T = q[3];
+        break;
+    }
+    case Q_CYLINDER: /* radius zmin zmax thetamax */
+        rho = q[0], z = q[1] + v * (q[2] - q[1]), dz = q[2] - q[1];
+        T = q[3];
+        break;
+    case Q_CONE: /* height radius thetamax */
+        rho = q[1] * (1.0 - v), drho = -q[1], z = v * q[0], dz = q[0];
+        T = q[2];
+        break;
+    case Q_DISK: /* height radius thetamax */
+        rho = q[1] * (1.0 - v), drho = -q[1], z = q[0];
+        T = q[2];
+        break;
+    case Q_PARABOLOID: { /* rmax zmin zmax thetamax */
+        z = q[1] + v * (q[2] - q[1]), dz = q[2] - q[1];
+        double zz = fmax(z, 1e-9 * q[2]);
+        rho = q[0] * sqrt(zz / q[2]), drho = q[0] * dz / (2.0 * sqrt(zz * q[2]));
+        T = q[3];
+        break;
+    }
+    case Q_TORUS: { /* rmajor rminor phimin phimax thetamax */
+        double phi = q[2] + v * (q[3] - q[2]), d = q[3] - q[2];
+        rho = q[0] + q[1] * cos(phi), z = q[1] * sin(phi);
+        drho = -q[1] * sin(phi) * d, dz = q[1] * cos(phi) * d;
+        T = q[4];
+        break;
+    }
+    default: { /* Q_HYPERBOLOID: x1 y1 z1 x2 y2 z2 thetamax */
+        T = q[6];
+        double th = u * T, c = cos(th), sn = sin(th);
+        double dx = q[3] - q[0], dy = q[4] - q[1];
+        double x = q[0] + v * dx, y = q[1] + v * dy;
+        Vec3 p = v3((float)(x * c - y * sn), (float)(x * sn + y * c), (float)(q[2] + v * (q[5] - q[2])));
+        Vec3 du = v3((float)(T * (-x * sn - y * c)), (float)(T * (x * c - y * sn)), 0.0f);
+        Vec3 dv = v3((float)(dx * c - dy * sn), (float)(dx * sn + dy * c), q[5] - q[2]);
+        *P = p, *dPdu = prim->quadric.reverse ? v3_neg(du) : du, *dPdv = dv;
+        return;
+    }
+    }
+    double th = u * T, c = cos(th), sn = sin(th);
+    *P = v3((float)(rho * c), (float)(rho * sn), (float)z);
+    Vec3 du = v3((float)(-rho * T * sn), (float)(rho * T * c), 0.0f);
+    *dPdu = prim->quadric.reverse ? v3_neg(du) : du;
+    *dPdv = v3((float)(drho * c), (float)(drho * sn), (float)dz);
+}
+
 void geom_prim_eval(const Prim *prim, float u, float v, Vec3 *P, Vec3 *dPdu, Vec3 *dPdv)
 {
     const Vec3 *c = prim->cp;
@@ -78,6 +142,15 @@ void geom_prim_eval(const Prim *prim, float u, float v, Vec3 *P, Vec3 *dPdu, Vec
     case PRIM_SPHERE:
         eval_sphere(prim, u, v, P, dPdu, dPdv);
         break;
+    case PRIM_QUADRIC: {
+        Vec3 p, du, dv;
+        const Mat4 *m = &prim->quadric.world_from_object;
+        geom_quadric_eval(prim, u, v, &p, &du, &dv);
+        *P = mat4_point(m, p);
+        *dPdu = mat4_vector(m, du);
+        *dPdv = mat4_vector(m, dv);
+        break;
+    }
     }
 }
 

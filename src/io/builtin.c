@@ -25,13 +25,13 @@ static const float white[3] = {0.725f, 0.71f, 0.68f};
 static const float red[3] = {0.63f, 0.065f, 0.05f};
 static const float green[3] = {0.14f, 0.45f, 0.091f};
 
-static RayesError matte(RayesScene *s, const float Cs[3])
+static RayesError matte(const IoSink *s, const float Cs[3])
 {
     RayesParam p = {"Cs", RAYES_PARAM_COLOR, {Cs[0], Cs[1], Cs[2]}, NULL};
-    return rayes_scene_set_shader(s, "matte", &p, 1);
+    return s->set_shader(s->target, "matte", &p, 1);
 }
 
-static RayesError quads(RayesScene *s, const Quad *q, size_t n)
+static RayesError quads(const IoSink *s, const Quad *q, size_t n)
 {
     int nv[8], idx[32];
     RayesError e = RAYES_OK;
@@ -39,13 +39,13 @@ static RayesError quads(RayesScene *s, const Quad *q, size_t n)
         nv[0] = 4;
         for (int k = 0; k < 4; k++)
             idx[k] = k;
-        e = rayes_scene_polygon_mesh(s, 1, nv, idx, 4, &q[i].P[0][0]);
+        e = s->polygon_mesh(s->target, 1, nv, idx, 4, &q[i].P[0][0]);
     }
     return e;
 }
 
 /* The box, the light and the camera, shared by both Cornell scenes. */
-static RayesError cornell_shell(RayesScene *s)
+static RayesError cornell_shell(const IoSink *s)
 {
     static const Quad white_quads[] = {
         {{{552.8f, 0, 0}, {0, 0, 0}, {0, 0, 559.2f}, {549.6f, 0, 559.2f}}},               /* floor */
@@ -59,7 +59,7 @@ static RayesError cornell_shell(RayesScene *s)
         {343, 548.7f, 227}, {343, 548.7f, 332}, {213, 548.7f, 332}, {213, 548.7f, 227}};
     static const float L[3] = {17, 12, 4};
     static const float eye[3] = {278, 273, -800}, target[3] = {278, 273, 0}, up[3] = {0, 1, 0};
-    RayesError e = rayes_scene_set_camera(s, eye, target, up, 39.3077f);
+    RayesError e = s->set_camera(s->target, eye, target, up, 39.3077f);
     if (e == RAYES_OK)
         e = matte(s, white);
     if (e == RAYES_OK)
@@ -73,11 +73,11 @@ static RayesError cornell_shell(RayesScene *s)
     if (e == RAYES_OK)
         e = quads(s, &red_wall, 1);
     if (e == RAYES_OK)
-        e = rayes_scene_area_light(s, light, L);
+        e = s->area_light(s->target, light, L);
     return e;
 }
 
-static RayesError cornell_blocks(RayesScene *s)
+static RayesError cornell_blocks(const IoSink *s)
 {
     static const Quad blocks[] = {
         /* short block */
@@ -117,21 +117,20 @@ static void teapot_transform(float theta_degrees, float tx, float tz, float m[16
  * along the normal, 3 mm times fractal noise of 4 octaves at a base
  * frequency of 0.04 per mm. The fractal sum stays within 1.875 times the
  * amplitude, so the bound is 6 mm. */
-static RayesError teapot_displacement(RayesScene *s)
+static RayesError teapot_displacement(const IoSink *s)
 {
     const RayesParam p[] = {
         {"amplitude", RAYES_PARAM_FLOAT, {3.0f, 0, 0}, NULL},
         {"frequency", RAYES_PARAM_FLOAT, {0.04f, 0, 0}, NULL},
         {"octaves", RAYES_PARAM_FLOAT, {4.0f, 0, 0}, NULL},
     };
-    RayesError e = rayes_scene_set_displacement(s, "fractal", p, sizeof p / sizeof p[0]);
-    return e == RAYES_OK ? rayes_scene_set_displacement_bound(s, 6.0f) : e;
+    RayesError e = s->set_displacement(s->target, "fractal", p, sizeof p / sizeof p[0]);
+    return e == RAYES_OK ? s->set_displacement_bound(s->target, 6.0f) : e;
 }
 
-static RayesError cornell_teapots(RayesScene *s, const char *data_dir, int displaced, char *err,
+static RayesError cornell_teapots(const IoSink *s, const char *data_dir, int displaced, char *err,
                                   size_t err_size)
 {
-    IoSink sink = io_sink_scene(s);
     char path[4096];
     if (!data_dir) {
         snprintf(err, err_size,
@@ -153,11 +152,11 @@ static RayesError cornell_teapots(RayesScene *s, const char *data_dir, int displ
     float m[16];
     RayesParam mirror = {"specularcolor", RAYES_PARAM_COLOR, {chrome[0], chrome[1], chrome[2]},
                          NULL};
-    RayesError e = rayes_scene_set_shader(s, "mirror", &mirror, 1);
+    RayesError e = s->set_shader(s->target, "mirror", &mirror, 1);
     teapot_transform(35.0f, 395.0f, 370.0f, m);
     if (e == RAYES_OK)
-        e = rayes_scene_set_transform(s, m);
-    if (e == RAYES_OK && (e = io_read_bpt(path, &sink, err, err_size)) != RAYES_OK)
+        e = s->set_transform(s->target, m);
+    if (e == RAYES_OK && (e = io_read_bpt(path, s, err, err_size)) != RAYES_OK)
         return e;
     if (e == RAYES_OK)
         e = matte(s, grey);
@@ -165,20 +164,20 @@ static RayesError cornell_teapots(RayesScene *s, const char *data_dir, int displ
         e = teapot_displacement(s);
     teapot_transform(150.0f, 160.0f, 195.0f, m);
     if (e == RAYES_OK)
-        e = rayes_scene_set_transform(s, m);
-    if (e == RAYES_OK && (e = io_read_bpt(path, &sink, err, err_size)) != RAYES_OK)
+        e = s->set_transform(s->target, m);
+    if (e == RAYES_OK && (e = io_read_bpt(path, s, err, err_size)) != RAYES_OK)
         return e;
     static const float identity[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
     if (e == RAYES_OK)
-        e = rayes_scene_set_transform(s, identity);
+        e = s->set_transform(s->target, identity);
     if (e == RAYES_OK)
-        e = rayes_scene_set_displacement(s, NULL, NULL, 0);
+        e = s->set_displacement(s->target, NULL, NULL, 0);
     return e;
 }
 
 /* A wall 1.2 mm in front of the back wall, shaded by the example plugin
  * brick (examples/shaders): bricks about 55 x 25 mm. */
-static RayesError cornell_brick(RayesScene *s, char *err, size_t err_size)
+static RayesError cornell_brick(const IoSink *s, char *err, size_t err_size)
 {
     static const Quad wall = {{{549.6f, 0, 558}, {0, 0, 558}, {0, 548.8f, 558}, {556, 548.8f, 558}}};
     static const RayesParam p[] = {
@@ -188,9 +187,9 @@ static RayesError cornell_brick(RayesScene *s, char *err, size_t err_size)
         {"Cbrick", RAYES_PARAM_COLOR, {0.6f, 0.16f, 0.1f}, NULL},
         {"Cmortar", RAYES_PARAM_COLOR, {0.7f, 0.7f, 0.65f}, NULL},
     };
-    RayesError e = rayes_scene_set_shader(s, "brick", p, sizeof p / sizeof p[0]);
+    RayesError e = s->set_shader(s->target, "brick", p, sizeof p / sizeof p[0]);
     if (e != RAYES_OK) {
-        const char *why = rayes_scene_get_error(s);
+        const char *why = (s->get_error ? s->get_error(s->target) : "");
         int missing = strncmp(why, "unknown shader", 14) == 0;
         snprintf(err, err_size, "scene cornell-brick: %s%s", why,
                  missing ? " (give the directory of brick.so with --shader-path DIRS or "
@@ -204,7 +203,7 @@ static RayesError cornell_brick(RayesScene *s, char *err, size_t err_size)
 /* One sphere per built-in shader, two rows of four: the back row floats
  * (RenderMan's classics), the front row stands on the floor (the
  * physically based family, and glass). */
-static RayesError cornell_spheres(RayesScene *s)
+static RayesError cornell_spheres(const IoSink *s)
 {
     typedef struct Ball {
         const char *shader;
@@ -237,19 +236,19 @@ static RayesError cornell_spheres(RayesScene *s)
         int back = i < 4;
         const float m[16] = {1, 0, 0, x[i % 4], 0, 1, 0, back ? 260.0f : r,
                              0, 0, 1, back ? 400.0f : 170.0f, 0, 0, 0, 1};
-        e = rayes_scene_set_shader(s, balls[i].shader, balls[i].p, balls[i].n);
+        e = s->set_shader(s->target, balls[i].shader, balls[i].p, balls[i].n);
         if (e == RAYES_OK)
-            e = rayes_scene_set_transform(s, m);
+            e = s->set_transform(s->target, m);
         if (e == RAYES_OK)
-            e = rayes_scene_sphere(s, r);
+            e = s->sphere(s->target, r);
     }
     static const float identity[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
     if (e == RAYES_OK)
-        e = rayes_scene_set_transform(s, identity);
+        e = s->set_transform(s->target, identity);
     return e;
 }
 
-RayesError io_builtin_scene(const char *name, const char *data_dir, RayesScene *s, char *err,
+RayesError io_builtin_scene(const char *name, const char *data_dir, const IoSink *s, char *err,
                             size_t err_size)
 {
     RayesError e;
@@ -281,9 +280,7 @@ RayesError io_builtin_scene(const char *name, const char *data_dir, RayesScene *
                  name);
         return RAYES_ERROR_INVALID_ARGUMENT;
     }
-    if (e == RAYES_OK)
-        e = rayes_scene_commit(s);
     if (e != RAYES_OK && err[0] == '\0')
-        snprintf(err, err_size, "scene %s: %s", name, rayes_scene_get_error(s));
+        snprintf(err, err_size, "scene %s: %s", name, (s->get_error ? s->get_error(s->target) : ""));
     return e;
 }

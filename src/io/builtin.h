@@ -1,6 +1,7 @@
 /*
- * io/builtin.h — the built-in scenes, built through rayes.h like any scene
- * file: "cornell" (the classic Cornell box with its two blocks; the
+ * io/builtin.h — the built-in scenes, sent to an IoSink (io/sink.h) like any
+ * scene file, so they can be rendered (io_sink_scene) or written as RIB
+ * (`rayes convert`): "cornell" (the classic Cornell box with its two blocks; the
  * default), "cornell-teapots" (the memo's benchmark box, with the Utah
  * teapot read from data_dir/teapot.bpt), "cornell-teapots-displaced" (the
  * same with the memo's fractal displacement on the matte teapot), specified
@@ -13,13 +14,14 @@
 
 #include <stddef.h>
 
-#include "rayes/rayes.h"
+#include "io/sink.h"
 
-/* Adds the named scene to an empty scene and commits it. data_dir may be
+/* Sends the named scene to sink (for a RayesScene: an empty one; the caller
+ * commits it). data_dir may be
  * NULL if the scene needs no data. Errors fill err (one line) and return
  * nonzero: an unknown name is RAYES_ERROR_INVALID_ARGUMENT, missing data
  * (teapot.bpt, or a plugin not on the shader search path) RAYES_ERROR_IO. */
-RayesError io_builtin_scene(const char *name, const char *data_dir, RayesScene *scene, char *err,
+RayesError io_builtin_scene(const char *name, const char *data_dir, const IoSink *sink, char *err,
                             size_t err_size);
 
 /* The names, NULL-terminated. */

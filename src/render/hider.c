@@ -101,13 +101,15 @@ static Rgb *shade_grid(Worker *w, uint32_t gi)
     float *offset = f1 + 5 * n;
     float su, sv;
     grid_spacing(g, &su, &sv);
-    float pixel = 2.0f * rs->camera.tan_half_fov / (float)w->set->height;
+    const Camera *cam = &rs->camera;
     uint64_t grid_key = hash_combine(hash_combine(w->set->seed, 0x6772696468ull /* "gridh" */), gi);
     for (size_t k = 0; k < n; k++) {
         size_t i = g->first_vertex + k;
-        Vec3 to = v3_sub(gs->P[i], rs->camera.eye);
-        float dist = v3_length(to);
-        Vec3 d = dist > 0.0f ? v3_scale(to, 1.0f / dist) : rs->camera.forward;
+        /* The camera ray toward the vertex: from the eye in perspective,
+         * along the view in orthographic projection. */
+        Vec3 to = v3_sub(gs->P[i], cam->eye);
+        float dist = cam->tan_half_fov > 0.0f ? v3_length(to) : v3_dot(to, cam->forward);
+        Vec3 d = cam->tan_half_fov > 0.0f && dist > 0.0f ? v3_scale(to, 1.0f / dist) : cam->forward;
         Vec3 Nk = gs->N[i];
         back[k] = v3_dot(Nk, d) > 0.0f; /* the eye sees the back: shade that side */
         if (back[k])
@@ -126,7 +128,7 @@ static Rgb *shade_grid(Worker *w, uint32_t gi)
         curv[k] = g->curvature;
         offset[k] = integrator_ray_offset(w, g);
         keys[k] = hash_combine(grid_key, k);
-        diff[k] = (RayDiff){pixel * dist, pixel};
+        diff[k] = (RayDiff){cam->pixel_width + cam->pixel_spread * fmaxf(dist, 0.0f), cam->pixel_spread};
     }
     IrrGrid irr = {.grid = g, .P = (const float(*)[3])P, .N = (const float(*)[3])N};
     float(*irr_E)[3] = NULL;

@@ -23,14 +23,17 @@
 #include "util/rng.h"
 #include "util/thread.h"
 
-Camera render_camera(Vec3 eye, Vec3 target, Vec3 up, float fov_y_degrees)
+Camera render_camera(Vec3 eye, Vec3 x, Vec3 y, Vec3 z, float tan_half_fov, const float screen[4],
+                     int height)
 {
-    Camera c;
-    c.eye = eye;
-    c.forward = v3_normalize(v3_sub(target, eye));
-    c.right = v3_normalize(v3_cross(c.forward, up));
-    c.up = v3_cross(c.right, c.forward);
-    c.tan_half_fov = tanf(0.5f * fov_y_degrees * (float)(M_PI / 180.0));
+    Camera c = {.eye = eye, .forward = v3_normalize(z), .x = x, .y = y, .z = z,
+                .tan_half_fov = tan_half_fov};
+    memcpy(c.screen, screen, sizeof c.screen);
+    float pixel = fabsf(screen[3] - screen[2]) / (float)height; /* screen units */
+    if (tan_half_fov > 0.0f)
+        c.pixel_spread = pixel * tan_half_fov * v3_length(y) / v3_length(z);
+    else
+        c.pixel_width = pixel * v3_length(y);
     return c;
 }
 
@@ -62,11 +65,14 @@ static float filter_weight(const Frame *f, float dx, float dy)
 static Ray camera_ray(const RenderScene *rs, const RenderSettings *set, float x, float y)
 {
     const Camera *c = &rs->camera;
-    float aspect = (float)set->width / (float)set->height;
-    float sx = (2.0f * x / (float)set->width - 1.0f) * aspect * c->tan_half_fov;
-    float sy = (1.0f - 2.0f * y / (float)set->height) * c->tan_half_fov;
-    Vec3 d = v3_normalize(v3_add(c->forward, v3_add(v3_scale(c->right, sx), v3_scale(c->up, sy))));
-    return (Ray){c->eye, d, 0.0f, INFINITY, RAYES_RAY_CAMERA};
+    float sx = c->screen[0] + (c->screen[1] - c->screen[0]) * x / (float)set->width;
+    float sy = c->screen[3] - (c->screen[3] - c->screen[2]) * y / (float)set->height;
+    Vec3 across = v3_add(v3_scale(c->x, sx), v3_scale(c->y, sy));
+    if (c->tan_half_fov > 0.0f) {
+        Vec3 d = v3_normalize(v3_add(c->z, v3_scale(across, c->tan_half_fov)));
+        return (Ray){c->eye, d, 0.0f, INFINITY, RAYES_RAY_CAMERA};
+    }
+    return (Ray){v3_add(c->eye, across), c->forward, 0.0f, INFINITY, RAYES_RAY_CAMERA};
 }
 
 /* All samples of pixel (px, py), splatted into the tile's accumulators. */
@@ -76,7 +82,7 @@ static void render_pixel(Frame *f, Worker *w, int px, int py, int x0, int y0, in
     const RenderSettings *set = f->set;
     uint64_t pixel_key = hash_combine(hash_combine(set->seed, (uint64_t)py), (uint64_t)px);
     uint32_t pattern = (uint32_t)hash_combine(pixel_key, DIM_PIXEL);
-    RayDiff diff = {0.0f, 2.0f * f->rs->camera.tan_half_fov / (float)set->height};
+    RayDiff diff = {f->rs->camera.pixel_width, f->rs->camera.pixel_spread};
     for (int s = 0; s < set->spp; s++) {
         float jx, jy;
         cmj_sample_2d((uint32_t)s, (uint32_t)set->spp, pattern, &jx, &jy);

@@ -32,10 +32,18 @@ typedef struct RenderObject {
     int light;                    /* index of the light it emits as, or -1 */
 } RenderObject;
 
+/* The camera of a frame (rayes.h's rayes_scene_set_camera_matrix): a
+ * screen position (sx, sy) in the screen window looks along
+ * z + tan_half_fov (sx x + sy y) from eye in perspective, along z from
+ * eye + sx x + sy y in orthographic projection. */
 typedef struct Camera {
-    Vec3 eye;
-    Vec3 forward, right, up;      /* orthonormal frame */
-    float tan_half_fov;           /* tangent of half the vertical field of view */
+    Vec3 eye;                     /* world */
+    Vec3 forward;                 /* unit view direction */
+    Vec3 x, y, z;                 /* camera space's axes in world space (z = the view) */
+    float tan_half_fov;           /* perspective: tan(fov / 2); orthographic: 0 */
+    float screen[4];              /* left, right, bottom, top of the image on the screen */
+    float pixel_spread;           /* radians between neighbouring camera rays (perspective) */
+    float pixel_width;            /* world units between neighbouring rays (orthographic) */
 } Camera;
 
 typedef struct RenderScene {
@@ -77,8 +85,10 @@ typedef struct RenderStats {
     uint64_t ambient_lookups;     /* points the ambient service was asked for */
 } RenderStats;
 
-/* Camera from eye, target, up and vertical field of view in degrees. */
-Camera render_camera(Vec3 eye, Vec3 target, Vec3 up, float fov_y_degrees);
+/* The camera of an image of `height` pixels: eye, axes and tan(fov / 2)
+ * (0: orthographic) as camera_matrix gives them, and the screen window. */
+Camera render_camera(Vec3 eye, Vec3 x, Vec3 y, Vec3 z, float tan_half_fov, const float screen[4],
+                     int height);
 
 /* Renders a frame into rgba (width * height * 4 floats, top row first) and
  * adds to stats. Returns 0, or 1 if the progress callback cancelled. */

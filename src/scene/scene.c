@@ -54,16 +54,28 @@ static int grow(void **array, size_t *cap, size_t n, size_t elem)
     return 0;
 }
 
+/* The camera of rayes_scene_set_camera: an orthonormal frame looking from
+ * eye at target, the fov spanning the image height. */
+static void look_at(SceneCamera *c, const float eye[3], const float target[3], const float up[3],
+                    float fov)
+{
+    c->eye = v3_load(eye);
+    c->z = v3_normalize(v3_sub(v3_load(target), c->eye));
+    c->x = v3_normalize(v3_cross(c->z, v3_load(up)));
+    c->y = v3_cross(c->x, c->z);
+    c->tan_half_fov = tanf(0.5f * fov * (float)(M_PI / 180.0));
+    c->fov_vertical = 1;
+    c->has_screen = 0;
+}
+
 RayesScene *rayes_scene_new(void)
 {
     RayesScene *s = calloc(1, sizeof *s);
     if (!s)
         return NULL;
     atomic_init(&s->refs, 1);
-    s->eye = v3(0, 0, -5);
-    s->target = v3(0, 0, 0);
-    s->up = v3(0, 1, 0);
-    s->fov_y = 40.0f;
+    static const float eye[3] = {0, 0, -5}, target[3] = {0, 0, 0}, up[3] = {0, 1, 0};
+    look_at(&s->camera, eye, target, up, 40.0f);
     s->world_from_object = mat4_identity();
     s->shading_rate = 1.0f;
     s->current_object = -1;
@@ -120,12 +132,57 @@ RayesError rayes_scene_set_camera(RayesScene *s, const float eye[3], const float
     if (v3_length(f) <= 0.0f || v3_length(v3_cross(f, v3_load(up))) <= 0.0f)
         return fail(s, RAYES_ERROR_INVALID_ARGUMENT,
                     "camera: the eye equals the target, or up is parallel to the view");
-    s->eye = v3_load(eye);
-    s->target = v3_load(target);
-    s->up = v3_load(up);
-    s->fov_y = fov;
+    look_at(&s->camera, eye, target, up, fov);
     s->dirty = 1;
     return RAYES_OK;
+}
+
+RayesError rayes_scene_set_camera_matrix(RayesScene *s, const float m[16], RayesProjection proj,
+                                         float fov, const float screen[4])
+{
+    if (!s || !m)
+        return RAYES_ERROR_INVALID_ARGUMENT;
+    Mat4 world_from_camera;
+    if (!finite_n(m, 16) || !mat4_invert(mat4_from_array(m), &world_from_camera))
+        return fail(s, RAYES_ERROR_INVALID_ARGUMENT,
+                    "camera: expected a finite, invertible camera_from_world matrix");
+    if (proj != RAYES_PROJECTION_PERSPECTIVE && proj != RAYES_PROJECTION_ORTHOGRAPHIC)
+        return fail(s, RAYES_ERROR_INVALID_ARGUMENT,
+                    "camera: expected a perspective or orthographic projection");
+    if (proj == RAYES_PROJECTION_PERSPECTIVE && !(fov > 0.0f && fov < 180.0f))
+        return fail(s, RAYES_ERROR_INVALID_ARGUMENT,
+                    "camera: expected a field of view in (0, 180) degrees");
+    if (screen && (!finite_n(screen, 4) || !(screen[1] != screen[0]) || !(screen[3] != screen[2])))
+        return fail(s, RAYES_ERROR_INVALID_ARGUMENT,
+                    "camera: expected a screen window of nonzero width and height");
+    SceneCamera *c = &s->camera;
+    c->eye = mat4_point(&world_from_camera, v3(0, 0, 0));
+    c->x = mat4_vector(&world_from_camera, v3(1, 0, 0));
+    c->y = mat4_vector(&world_from_camera, v3(0, 1, 0));
+    c->z = mat4_vector(&world_from_camera, v3(0, 0, 1));
+    c->tan_half_fov = proj == RAYES_PROJECTION_PERSPECTIVE
+                          ? tanf(0.5f * fov * (float)(M_PI / 180.0))
+                          : 0.0f;
+    c->fov_vertical = 0;
+    c->has_screen = screen != NULL;
+    if (screen)
+        memcpy(c->screen, screen, sizeof c->screen);
+    s->dirty = 1;
+    return RAYES_OK;
+}
+
+void scene_camera_screen(const SceneCamera *c, int width, int height, float screen[4])
+{
+    if (c->has_screen) {
+        memcpy(screen, c->screen, 4 * sizeof *screen);
+        return;
+    }
+    float a = (float)width / (float)height;
+    if (a >= 1.0f || c->fov_vertical) {
+        screen[0] = -a, screen[1] = a, screen[2] = -1.0f, screen[3] = 1.0f;
+    } else {
+        screen[0] = -1.0f, screen[1] = 1.0f, screen[2] = -1.0f / a, screen[3] = 1.0f / a;
+    }
 }
 
 RayesError rayes_scene_set_transform(RayesScene *s, const float m[16])
@@ -455,6 +512,18 @@ Bounds3 scene_bounds(const RayesScene *s)
             }
             continue;
         }
+        if (p->type == PRIM_QUADRIC) { /* a lattice of surface points, widened */
+            Bounds3 q = bounds_empty();
+            for (int j = 0; j <= 16; j++)
+                for (int i = 0; i <= 16; i++) {
+                    Vec3 P, du, dv;
+                    geom_prim_eval(p, (float)i / 16.0f, (float)j / 16.0f, &P, &du, &dv);
+                    q = bounds_add(q, P);
+                }
+            Vec3 pad = v3_scale(v3_sub(q.hi, q.lo), 0.05f);
+            b = bounds_add(bounds_add(b, v3_sub(q.lo, pad)), v3_add(q.hi, pad));
+            continue;
+        }
         int n = p->type == PRIM_BICUBIC ? 16 : p->type == PRIM_TRIANGLE ? 3 : 4;
         for (int k = 0; k < n; k++)
             b = bounds_add(b, p->cp[k]);
@@ -462,15 +531,20 @@ Bounds3 scene_bounds(const RayesScene *s)
     return b;
 }
 
-int scene_prepare(const RayesScene *s, int height, TextureSystem *textures, GridSet *gs)
+int scene_prepare(const RayesScene *s, int width, int height, TextureSystem *textures,
+                  GridSet *gs)
 {
     DicingServices sv;
     shade_dicing_services_init(&sv, textures);
     DiceCamera cam;
     Bounds3 b = scene_bounds(s);
     float radius = s->n_prims ? 0.5f * v3_length(v3_sub(b.hi, b.lo)) : 1.0f;
-    cam.eye = s->eye;
-    cam.pixel_angle = 2.0f * tanf(0.5f * s->fov_y * (float)(M_PI / 180.0)) / (float)height;
+    float screen[4];
+    scene_camera_screen(&s->camera, width, height, screen);
+    float pixel = fabsf(screen[3] - screen[2]) / (float)height; /* screen units */
+    cam.eye = s->camera.eye;
+    cam.pixel_angle = s->camera.tan_half_fov * pixel;
+    cam.pixel_width = s->camera.tan_half_fov > 0.0f ? 0.0f : pixel * v3_length(s->camera.y);
     cam.min_distance = 1e-3f * fmaxf(radius, 1e-6f);
     for (size_t i = 0; i < s->n_prims; i++) {
         size_t first = gs->n_grids;
@@ -791,18 +865,81 @@ RayesError rayes_scene_set_search_path(RayesScene *s, const char *kind, const ch
     return RAYES_OK;
 }
 
-RayesError rayes_scene_set_camera_matrix(RayesScene *s, const float m[16], RayesProjection proj,
-                                         float fov, const float screen[4])
-{
-    (void)m, (void)proj, (void)fov, (void)screen;
-    return s ? fail(s, RAYES_ERROR_INVALID_OPERATION, "camera matrix: not built yet")
-             : RAYES_ERROR_INVALID_ARGUMENT;
-}
 
+
+/* RenderMan's quadrics: checks the parameters and stores them with angles
+ * in radians (the sphere's zmin, zmax as latitudes). */
 RayesError rayes_scene_quadric(RayesScene *s, RayesQuadric type, const float *params, size_t n,
                                unsigned flags)
 {
-    (void)type, (void)params, (void)n, (void)flags;
-    return s ? fail(s, RAYES_ERROR_INVALID_OPERATION, "quadric: not built yet")
-             : RAYES_ERROR_INVALID_ARGUMENT;
+    static const struct {
+        const char *name, *params;
+        size_t n;
+    } kinds[] = {
+        {"sphere", "radius zmin zmax thetamax", 4},   {"cylinder", "radius zmin zmax thetamax", 4},
+        {"cone", "height radius thetamax", 3},         {"disk", "height radius thetamax", 3},
+        {"paraboloid", "rmax zmin zmax thetamax", 4},  {"hyperboloid", "x1 y1 z1 x2 y2 z2 thetamax", 7},
+        {"torus", "rmajor rminor phimin phimax thetamax", 5},
+    };
+    if (!s || (n && !params))
+        return RAYES_ERROR_INVALID_ARGUMENT;
+    if ((unsigned)type > RAYES_QUADRIC_TORUS)
+        return fail(s, RAYES_ERROR_INVALID_ARGUMENT, "quadric: unknown type %d", (int)type);
+    const char *name = kinds[type].name;
+    if (n != kinds[type].n || !finite_n(params, n))
+        return fail(s, RAYES_ERROR_INVALID_ARGUMENT, "%s: expected %zu finite numbers (%s)", name,
+                    kinds[type].n, kinds[type].params);
+    const float deg = (float)(M_PI / 180.0);
+    float thetamax = params[n - 1];
+    if (!(thetamax != 0.0f) || fabsf(thetamax) > 360.0f)
+        return fail(s, RAYES_ERROR_INVALID_ARGUMENT, "%s: expected 0 < |thetamax| <= 360", name);
+    Prim p = {.type = PRIM_QUADRIC};
+    p.quadric.world_from_object = s->world_from_object;
+    p.quadric.kind = (int)type;
+    p.quadric.reverse = (flags & RAYES_QUADRIC_REVERSE) != 0;
+    memcpy(p.quadric.p, params, n * sizeof *params);
+    p.quadric.p[n - 1] = thetamax * deg;
+    const float *q = params;
+    const char *bad = NULL;
+    switch (type) {
+    case RAYES_QUADRIC_SPHERE: {
+        float r = q[0], lo = fmaxf(fminf(q[1], q[2]), -r), hi = fminf(fmaxf(q[1], q[2]), r);
+        if (!(r > 0.0f) || !(lo < hi))
+            bad = "a positive radius and zmin != zmax overlapping [-radius, radius]";
+        else {
+            p.quadric.p[1] = asinf(lo / r);
+            p.quadric.p[2] = asinf(hi / r);
+        }
+        break;
+    }
+    case RAYES_QUADRIC_CYLINDER:
+        if (!(q[0] > 0.0f) || !(q[1] != q[2]))
+            bad = "a positive radius and zmin != zmax";
+        break;
+    case RAYES_QUADRIC_CONE:
+    case RAYES_QUADRIC_DISK:
+        if (!(q[1] > 0.0f) || (type == RAYES_QUADRIC_CONE && !(q[0] != 0.0f)))
+            bad = "a positive radius (and a cone's nonzero height)";
+        break;
+    case RAYES_QUADRIC_PARABOLOID:
+        if (!(q[0] > 0.0f) || !(q[2] > 0.0f) || !(q[1] >= 0.0f) || !(q[1] != q[2]))
+            bad = "rmax > 0, zmax > 0 and 0 <= zmin != zmax";
+        break;
+    case RAYES_QUADRIC_HYPERBOLOID:
+        if (!(q[0] != q[3] || q[1] != q[4] || q[2] != q[5]) ||
+            (q[0] == 0 && q[1] == 0 && q[3] == 0 && q[4] == 0))
+            bad = "two different points, not both on the z axis";
+        break;
+    case RAYES_QUADRIC_TORUS:
+        if (!(q[1] > 0.0f) || !(q[2] != q[3]))
+            bad = "rminor > 0 and phimin != phimax";
+        else {
+            p.quadric.p[2] = q[2] * deg;
+            p.quadric.p[3] = q[3] * deg;
+        }
+        break;
+    }
+    if (bad)
+        return fail(s, RAYES_ERROR_INVALID_ARGUMENT, "%s: expected %s", name, bad);
+    return add_prim(s, &p);
 }

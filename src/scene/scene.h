@@ -37,11 +37,26 @@ typedef enum SceneSearchPath {
     SCENE_SEARCH_PATH_COUNT
 } SceneSearchPath;
 
+/* The camera as set through rayes.h: camera space's origin and axes in
+ * world space (x right, y up, z the view direction; of the length of a
+ * camera-space unit, so a uniform scale or a mirror in camera_from_world
+ * carries through). The screen window is resolved per image size. */
+typedef struct SceneCamera {
+    Vec3 eye;                 /* camera-space origin, world */
+    Vec3 x, y, z;             /* camera-space axes, world */
+    float tan_half_fov;       /* perspective: tan(fov / 2); orthographic: 0 */
+    int fov_vertical;         /* rayes_scene_set_camera: the fov spans the image height */
+    int has_screen;           /* screen[] given; else the default of the aspect ratio */
+    float screen[4];          /* left, right, bottom, top */
+} SceneCamera;
+
+/* The screen window of the camera for an image of width x height pixels. */
+void scene_camera_screen(const SceneCamera *camera, int width, int height, float screen[4]);
+
 struct RayesScene {
     atomic_int refs;
     char error[512];          /* the first error since the last clear */
-    Vec3 eye, target, up;     /* camera */
-    float fov_y;              /* degrees */
+    SceneCamera camera;
     Mat4 world_from_object;   /* the current transform */
     float shading_rate;       /* the current shading rate */
     int64_t current_object;   /* object of geometry added next; -1: make a default matte */
@@ -61,11 +76,12 @@ struct RayesScene {
                                                     empty */
 };
 
-/* Dices every primitive of a committed scene for a camera that sees
- * `height` pixels over its vertical field of view, and runs displacement
+/* Dices every primitive of a committed scene for its camera making an
+ * image of width x height pixels, and runs displacement
  * shaders (whose texture lookups read from textures, which may be NULL).
  * Returns 0, or -1 when out of memory. */
-int scene_prepare(const RayesScene *scene, int height, TextureSystem *textures, GridSet *gs);
+int scene_prepare(const RayesScene *scene, int width, int height, TextureSystem *textures,
+                  GridSet *gs);
 
 /* Runs the displacement shaders of the primitives of grids [first_grid,
  * n_grids) of gs (displace.c); normals come from differences over step

@@ -220,7 +220,7 @@ RayesError rayes_render(RayesScene *scene, const RayesRenderOptions *opt, RayesI
     char err[300] = "";
     set.textures = textures;
     if (!objects || !masks || !img || !rgba || !textures ||
-        scene_prepare(scene, set.height, textures, &gs) != 0) {
+        scene_prepare(scene, set.width, set.height, textures, &gs) != 0) {
         e = fail(scene, RAYES_ERROR_OUT_OF_MEMORY, "render: out of memory preparing the scene");
         goto done;
     }
@@ -239,10 +239,13 @@ RayesError rayes_render(RayesScene *scene, const RayesRenderOptions *opt, RayesI
     }
     double t1 = time_now();
     Bounds3 b = scene_bounds(scene);
+    float screen[4];
+    scene_camera_screen(&scene->camera, set.width, set.height, screen);
     RenderScene rs = {
         .gs = &gs, .accel = accel, .objects = objects, .n_objects = scene->n_objects,
         .lights = scene->lights, .n_lights = scene->n_lights,
-        .camera = render_camera(scene->eye, scene->target, scene->up, scene->fov_y),
+        .camera = render_camera(scene->camera.eye, scene->camera.x, scene->camera.y,
+                                scene->camera.z, scene->camera.tan_half_fov, screen, set.height),
         .scene_radius = scene->n_prims ? fmaxf(0.5f * v3_length(v3_sub(b.hi, b.lo)), 1e-6f) : 1.0f,
     };
     if (render_frame(&rs, &set, rgba, &rstats) != 0) {

@@ -4,7 +4,10 @@
  * write, 2 for usage errors; every error is exactly one line on stderr
  * naming what is wrong; a tiny render writes its PNG, EXR and statistics;
  * a failed write leaves nothing at the target; --quiet prints nothing;
- * --shader-path and RAYES_SHADER_PATH find the example plugin brick.
+ * --shader-path and RAYES_SHADER_PATH find the example plugin brick; an
+ * OBJ file renders (to -o, or to NAME.exr by default); convert writes a
+ * built-in scene or a file as RIB; a bad scene file is one line naming
+ * file:line:col, status 1, and leaves no output behind.
  *
  * Each run gets its stdout and stderr in files under
  * RAYES_TEST_TMP/app_cli (our own directory: other tests share
@@ -12,6 +15,7 @@
  * a default output name cannot land elsewhere, and sees RAYES_DATA only
  * when a case sets it.
  */
+#include <dirent.h>
 #include <errno.h>
 #include <string.h>
 #include <sys/stat.h>
@@ -307,6 +311,102 @@ static void test_shader_path(void)
     CHECK(r.status == 0 && file_size(SCRATCH_DIR "/brick.png") > 8);
 }
 
+static void write_text(const char *path, const char *text)
+{
+    FILE *f = fopen(path, "wb");
+    CHECK(f != NULL);
+    if (f) {
+        fputs(text, f);
+        fclose(f);
+    }
+}
+
+/* Nonzero if SCRATCH_DIR holds a file whose name contains part. */
+static int scratch_has(const char *part)
+{
+    DIR *d = opendir(SCRATCH_DIR);
+    int found = 0;
+    struct dirent *e;
+    while (d && (e = readdir(d)))
+        found |= strstr(e->d_name, part) != NULL;
+    if (d)
+        closedir(d);
+    return found;
+}
+
+#define OBJ_SCENE                                                                          \
+    "# a floor and a wall\n"                                                               \
+    "v -1 0 -1\nv 1 0 -1\nv 1 0 1\nv -1 0 1\nv -1 1 -1\nv 1 1 -1\n"                      \
+    "f 4 3 2 1\nf 1 2 6 5\n"
+
+static void test_render_obj(void)
+{
+    static Run r;
+    setup();
+    write_text(SCRATCH_DIR "/room.obj", OBJ_SCENE);
+    remove(SCRATCH_DIR "/room.png");
+    remove(SCRATCH_DIR "/room.exr");
+    run(&r, NULL,
+        ARGS("render", SCRATCH_DIR "/room.obj", "--res", "16", "--spp", "1", "--quiet", "-o",
+             SCRATCH_DIR "/room.png"));
+    CHECK(r.status == 0 && r.err[0] == '\0' && r.out[0] == '\0');
+    if (r.status != 0)
+        fprintf(stderr, "  stderr: %s", r.err);
+    CHECK(file_size(SCRATCH_DIR "/room.png") > 8);
+    /* no -o: NAME.exr in the working directory */
+    run(&r, NULL, ARGS("render", SCRATCH_DIR "/room.obj", "--res", "8", "--spp", "1", "--quiet"));
+    CHECK(r.status == 0);
+    CHECK(file_size(SCRATCH_DIR "/room.exr") > 8);
+}
+
+static void test_convert(void)
+{
+    static Run r;
+    setup();
+    remove(SCRATCH_DIR "/cornell.rib");
+    run(&r, NULL, ARGS("convert", "cornell", SCRATCH_DIR "/cornell.rib", "--quiet"));
+    CHECK(r.status == 0 && r.err[0] == '\0' && r.out[0] == '\0');
+    static char rib[65536];
+    read_file(SCRATCH_DIR "/cornell.rib", rib, sizeof rib);
+    CHECK(strncmp(rib, "##RenderMan RIB\n", 16) == 0);
+    CHECK(strstr(rib, "WorldBegin\n") && strstr(rib, "AreaLightSource") &&
+          strstr(rib, "WorldEnd\n"));
+    CHECK(!scratch_has(".tmp."));
+    /* a scene file converts too, and says what it wrote */
+    write_text(SCRATCH_DIR "/room.obj", OBJ_SCENE);
+    run(&r, NULL, ARGS("convert", SCRATCH_DIR "/room.obj", SCRATCH_DIR "/room.rib"));
+    CHECK(r.status == 0 && strstr(r.out, "room.rib") != NULL);
+    CHECK(file_size(SCRATCH_DIR "/room.rib") > 100);
+    expect_error(2, NULL, ARGS("convert", "cornell", SCRATCH_DIR "/c.txt"), ARGS(".rib"));
+    expect_error(2, NULL, ARGS("convert", "cornell"), ARGS("OUT.rib"));
+    expect_error(2, NULL, ARGS("convert", "nosuchscene", SCRATCH_DIR "/n.rib"),
+                 ARGS("nosuchscene"));
+    expect_error(1, NULL, ARGS("convert", "cornell", SCRATCH_DIR "/missing-dir/c.rib"),
+                 ARGS(SCRATCH_DIR "/missing-dir/c.rib"));
+    CHECK(!exists(SCRATCH_DIR "/n.rib") && !exists(SCRATCH_DIR "/c.txt"));
+}
+
+/* A bad scene file: one line with file:line:col, status 1, nothing left. */
+static void test_bad_scene_file(void)
+{
+    setup();
+    write_text(SCRATCH_DIR "/bad.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 4\n");
+    remove(SCRATCH_DIR "/bad.png");
+    remove(SCRATCH_DIR "/bad.rib");
+    expect_error(1, NULL,
+                 ARGS("render", SCRATCH_DIR "/bad.obj", "--res", "8", "--quiet", "-o",
+                      SCRATCH_DIR "/bad.png"),
+                 ARGS(SCRATCH_DIR "/bad.obj:4:7:", "vertex index"));
+    CHECK(!exists(SCRATCH_DIR "/bad.png") && !exists(SCRATCH_DIR "/bad.exr"));
+    expect_error(1, NULL, ARGS("convert", SCRATCH_DIR "/bad.obj", SCRATCH_DIR "/bad.rib"),
+                 ARGS(SCRATCH_DIR "/bad.obj:4:7:"));
+    CHECK(!exists(SCRATCH_DIR "/bad.rib") && !scratch_has(".tmp."));
+    expect_error(1, NULL, ARGS("render", SCRATCH_DIR "/none.obj", "--res", "8"),
+                 ARGS(SCRATCH_DIR "/none.obj"));
+    CHECK(!exists(SCRATCH_DIR "/none.exr"));
+}
+
 TEST_MAIN(TEST(test_version_and_help), TEST(test_no_arguments), TEST(test_usage_errors),
           TEST(test_missing_data), TEST(test_render_outputs), TEST(test_render_summary),
-          TEST(test_data_from_environment), TEST(test_unwritable_output), TEST(test_shader_path))
+          TEST(test_data_from_environment), TEST(test_unwritable_output), TEST(test_shader_path),
+          TEST(test_render_obj), TEST(test_convert), TEST(test_bad_scene_file))

@@ -17,6 +17,7 @@
 #include <sys/stat.h>
 
 #include "io/builtin.h"
+#include "io/sink.h"
 #include "io/stats_json.h"
 #include "rayes/rayes.h"
 #include "test.h"
@@ -292,7 +293,10 @@ static RayesStats *render_cornell(void)
 {
     RayesScene *scene = rayes_scene_new();
     char err[512];
-    RayesError e = io_builtin_scene("cornell", NULL, scene, err, sizeof err);
+    IoSink sink = io_sink_scene(scene);
+    RayesError e = io_builtin_scene("cornell", NULL, &sink, err, sizeof err);
+    if (e == RAYES_OK)
+        e = rayes_scene_commit(scene);
     CHECK(e == RAYES_OK);
     if (e != RAYES_OK) {
         fprintf(stderr, "  %s\n", err);

@@ -7,6 +7,7 @@
 #include <string.h>
 
 #include "io/builtin.h"
+#include "io/sink.h"
 #include "rayes/rayes.h"
 #include "test.h"
 
@@ -15,7 +16,10 @@ static RayesImage *render(const char *scene_name, int threads, int tile, RayesFi
 {
     RayesScene *s = rayes_scene_new();
     char err[512];
-    RayesError e = io_builtin_scene(scene_name, RAYES_TEST_DATA, s, err, sizeof err);
+    IoSink sink = io_sink_scene(s);
+    RayesError e = io_builtin_scene(scene_name, RAYES_TEST_DATA, &sink, err, sizeof err);
+    if (e == RAYES_OK)
+        e = rayes_scene_commit(s);
     CHECK(e == RAYES_OK);
     if (e != RAYES_OK)
         fprintf(stderr, "%s\n", err);

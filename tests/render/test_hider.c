@@ -9,6 +9,7 @@
 #include <string.h>
 
 #include "io/builtin.h"
+#include "io/sink.h"
 #include "rayes/rayes.h"
 #include "test.h"
 
@@ -17,7 +18,9 @@ static RayesImage *render_irr(RayesHider hider, int irradiance, int threads, int
 {
     RayesScene *s = rayes_scene_new();
     char err[512];
-    CHECK(io_builtin_scene("cornell", NULL, s, err, sizeof err) == RAYES_OK);
+    IoSink sink = io_sink_scene(s);
+    CHECK(io_builtin_scene("cornell", NULL, &sink, err, sizeof err) == RAYES_OK);
+    CHECK(rayes_scene_commit(s) == RAYES_OK);
     RayesRenderOptions o;
     rayes_render_options_init(&o, RAYES_QUALITY_PREVIEW);
     o.width = o.height = 64;
@@ -138,8 +141,9 @@ static void test_highlights_not_smeared(void)
     for (int h = 0; h < 2; h++) {
         RayesScene *s = rayes_scene_new();
         char err[512];
-        CHECK(io_builtin_scene("cornell-teapots", RAYES_TEST_DATA, s, err, sizeof err) ==
-              RAYES_OK);
+        IoSink sink = io_sink_scene(s);
+        CHECK(io_builtin_scene("cornell-teapots", RAYES_TEST_DATA, &sink, err, sizeof err) == RAYES_OK);
+        CHECK(rayes_scene_commit(s) == RAYES_OK);
         RayesRenderOptions o;
         rayes_render_options_init(&o, RAYES_QUALITY_PREVIEW);
         o.width = o.height = 96;

@@ -14,6 +14,7 @@
 
 #include "image/image.h"
 #include "io/builtin.h"
+#include "io/sink.h"
 #include "rayes/rayes.h"
 #include "test.h"
 
@@ -36,7 +37,9 @@ static RayesScene *cornell_with_wall(const char *shader, const RayesParam *p, si
     char err[512];
     RayesScene *s = rayes_scene_new();
     CHECK(rayes_scene_set_search_path(s, "shader", RAYES_TEST_SHADERS) == RAYES_OK);
-    CHECK(io_builtin_scene("cornell", NULL, s, err, sizeof err) == RAYES_OK);
+    IoSink sink = io_sink_scene(s);
+    CHECK(io_builtin_scene("cornell", NULL, &sink, err, sizeof err) == RAYES_OK);
+    CHECK(rayes_scene_commit(s) == RAYES_OK);
     static const float wall[4][3] = {
         {549.6f, 0, 558}, {0, 0, 558}, {0, 548.8f, 558}, {556, 548.8f, 558}};
     static const int nv[1] = {4}, idx[4] = {0, 1, 2, 3};
@@ -148,7 +151,9 @@ static void test_plugin_displacement(void)
     char err[512];
     RayesScene *s = rayes_scene_new();
     CHECK(rayes_scene_set_search_path(s, "shader", RAYES_TEST_SHADERS) == RAYES_OK);
-    CHECK(io_builtin_scene("cornell", NULL, s, err, sizeof err) == RAYES_OK);
+    IoSink sink = io_sink_scene(s);
+    CHECK(io_builtin_scene("cornell", NULL, &sink, err, sizeof err) == RAYES_OK);
+    CHECK(rayes_scene_commit(s) == RAYES_OK);
     const RayesParam p[] = {{"Km", RAYES_PARAM_FLOAT, {15.0f, 0, 0}, NULL},
                             {"frequency", RAYES_PARAM_FLOAT, {0.02f, 0, 0}, NULL}};
     CHECK(rayes_scene_set_displacement(s, "noisydisplace", p, 2) == RAYES_OK);

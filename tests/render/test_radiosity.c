@@ -8,6 +8,7 @@
 #include <string.h>
 
 #include "io/builtin.h"
+#include "io/sink.h"
 #include "rayes/rayes.h"
 #include "render/radiosity.h"
 #include "test.h"
@@ -118,7 +119,9 @@ static RayesImage *render(double cache_mb, int threads, int cache)
 {
     RayesScene *s = rayes_scene_new();
     char err[512];
-    CHECK(io_builtin_scene("cornell-teapots", RAYES_TEST_DATA, s, err, sizeof err) == RAYES_OK);
+    IoSink sink = io_sink_scene(s);
+    CHECK(io_builtin_scene("cornell-teapots", RAYES_TEST_DATA, &sink, err, sizeof err) == RAYES_OK);
+    CHECK(rayes_scene_commit(s) == RAYES_OK);
     RayesRenderOptions o;
     rayes_render_options_init(&o, RAYES_QUALITY_PREVIEW);
     o.width = o.height = 40;

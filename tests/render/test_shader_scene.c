@@ -8,6 +8,7 @@
 #include <string.h>
 
 #include "io/builtin.h"
+#include "io/sink.h"
 #include "rayes/rayes.h"
 #include "test.h"
 
@@ -57,7 +58,9 @@ static void test_spheres_picture(void)
 {
     RayesScene *s = rayes_scene_new();
     char err[512];
-    CHECK(io_builtin_scene("cornell-spheres", NULL, s, err, sizeof err) == RAYES_OK);
+    IoSink sink = io_sink_scene(s);
+    CHECK(io_builtin_scene("cornell-spheres", NULL, &sink, err, sizeof err) == RAYES_OK);
+    CHECK(rayes_scene_commit(s) == RAYES_OK);
     RayesRenderOptions o;
     rayes_render_options_init(&o, RAYES_QUALITY_PREVIEW);
     o.width = o.height = RES;

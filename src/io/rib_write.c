@@ -1,0 +1,617 @@
+/*
+ * io/rib_write.c — the RIB writer of rib_write.h. Three memory streams
+ * (open_memstream) hold what comes before WorldBegin (options: search
+ * paths), the camera (replaced by each camera call) and the world; finish
+ * puts them in order after the settings.
+ */
+#include "io/rib_write.h"
+
+#include <math.h>
+#include <stdarg.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* A growing text in memory. */
+typedef struct Stream {
+    char *buf;
+    size_t size;
+    FILE *f;
+} Stream;
+
+struct RibWriter {
+    Stream options;          /* before the camera: Option "searchpath" */
+    Stream camera;           /* Projection, ScreenWindow, Transform */
+    Stream world;            /* between WorldBegin and WorldEnd */
+    float fov_y;             /* set_camera's vertical fov (-1: a camera matrix, or none) */
+    int in_transform;        /* a TransformBegin is open */
+    int bezier_basis;        /* Basis "bezier" was written */
+    int opacity_set;         /* the last Opacity was not 1 1 1 */
+    int next_light;          /* the next light handle */
+    char error[256];         /* the last error, "" if none */
+};
+
+static void stream_close(Stream *s)
+{
+    if (s->f)
+        fclose(s->f);
+    s->f = NULL;
+    free(s->buf);
+    s->buf = NULL;
+    s->size = 0;
+}
+
+/* Opens s empty (closing what it held). */
+static int stream_open(Stream *s)
+{
+    stream_close(s);
+    s->f = open_memstream(&s->buf, &s->size);
+    return s->f ? 0 : -1;
+}
+
+RibWriter *io_rib_writer_new(void)
+{
+    RibWriter *w = calloc(1, sizeof *w);
+    if (!w)
+        return NULL;
+    w->next_light = 1;
+    w->fov_y = -1.0f;
+    if (stream_open(&w->options) != 0 || stream_open(&w->camera) != 0 ||
+        stream_open(&w->world) != 0) {
+        io_rib_writer_free(w);
+        return NULL;
+    }
+    return w;
+}
+
+void io_rib_writer_free(RibWriter *w)
+{
+    if (!w)
+        return;
+    stream_close(&w->options);
+    stream_close(&w->camera);
+    stream_close(&w->world);
+    free(w);
+}
+
+static RayesError fail(RibWriter *w, RayesError e, const char *fmt, ...)
+    __attribute__((format(printf, 3, 4)));
+static RayesError fail(RibWriter *w, RayesError e, const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(w->error, sizeof w->error, fmt, ap);
+    va_end(ap);
+    return e;
+}
+
+static int finite_all(const float *v, size_t n)
+{
+    for (size_t i = 0; i < n; i++)
+        if (!isfinite(v[i]))
+            return 0;
+    return 1;
+}
+
+/* "[a b c ...]" with %.9g: every float reads back exactly. */
+static void floats(FILE *f, const float *v, size_t n)
+{
+    fputc('[', f);
+    for (size_t i = 0; i < n; i++)
+        fprintf(f, i ? " %.9g" : "%.9g", v[i] == 0.0f ? 0.0 : (double)v[i]); /* no "-0" */
+    fputc(']', f);
+}
+
+/* A RIB string: quotes and backslashes escaped, control characters as
+ * octal escapes. */
+static void string(FILE *f, const char *s)
+{
+    fputc('"', f);
+    for (; s && *s; s++) {
+        unsigned char c = (unsigned char)*s;
+        if (c == '"' || c == '\\')
+            fprintf(f, "\\%c", c);
+        else if (c < 0x20 || c == 0x7f)
+            fprintf(f, "\\%03o", c);
+        else
+            fputc(c, f);
+    }
+    fputc('"', f);
+}
+
+/* The 4 x 4 matrix m (column vectors) as RIB's 16 numbers (row vectors):
+ * m transposed. */
+static void matrix(FILE *f, const float m[16])
+{
+    float t[16];
+    for (int i = 0; i < 4; i++)
+        for (int j = 0; j < 4; j++)
+            t[4 * i + j] = m[4 * j + i];
+    floats(f, t, 16);
+}
+
+/* Typed inline parameters; points names "from" and "to" of lights. */
+static RayesError params(RibWriter *w, FILE *f, const RayesParam *p, size_t n, int light)
+{
+    for (size_t i = 0; i < n; i++) {
+        if (!p[i].name || !p[i].name[0] || strpbrk(p[i].name, " \"\\"))
+            return fail(w, RAYES_ERROR_INVALID_ARGUMENT, "a parameter without a valid name");
+        int is_point = light && (!strcmp(p[i].name, "from") || !strcmp(p[i].name, "to"));
+        switch (p[i].type) {
+        case RAYES_PARAM_FLOAT:
+        case RAYES_PARAM_COLOR: {
+            size_t k = p[i].type == RAYES_PARAM_FLOAT ? 1 : 3;
+            if (!finite_all(p[i].value, k))
+                return fail(w, RAYES_ERROR_INVALID_ARGUMENT, "parameter \"%s\": not finite",
+                            p[i].name);
+            fprintf(f, " \"%s %s\" ", k == 1 ? "float" : is_point ? "point" : "color",
+                    p[i].name);
+            floats(f, p[i].value, k);
+            break;
+        }
+        case RAYES_PARAM_STRING:
+            fprintf(f, " \"string %s\" [", p[i].name);
+            string(f, p[i].string ? p[i].string : "");
+            fputc(']', f);
+            break;
+        default:
+            return fail(w, RAYES_ERROR_INVALID_ARGUMENT, "parameter \"%s\": unknown type",
+                        p[i].name);
+        }
+    }
+    return RAYES_OK;
+}
+
+/* ------------------------------------------------------------ camera */
+
+static RayesError w_set_camera(void *t, const float eye[3], const float at[3], const float up[3],
+                               float fov)
+{
+    RibWriter *w = t;
+    double fw[3], u[3], r[3], l = 0.0;
+    for (int k = 0; k < 3; k++)
+        fw[k] = (double)at[k] - eye[k];
+    for (int k = 0; k < 3; k++)
+        l += fw[k] * fw[k];
+    if (!finite_all(eye, 3) || !finite_all(at, 3) || !finite_all(up, 3) || !(l > 0.0) ||
+        !(fov > 0.0f && fov < 180.0f))
+        return fail(w, RAYES_ERROR_INVALID_ARGUMENT, "camera: degenerate or out of range");
+    for (int k = 0; k < 3; k++)
+        fw[k] /= sqrt(l);
+    /* right = forward x up, up' = right x forward: a right-handed world
+     * seen in RenderMan's left-handed camera space (a mirror). */
+    r[0] = fw[1] * up[2] - fw[2] * up[1];
+    r[1] = fw[2] * up[0] - fw[0] * up[2];
+    r[2] = fw[0] * up[1] - fw[1] * up[0];
+    l = sqrt(r[0] * r[0] + r[1] * r[1] + r[2] * r[2]);
+    if (!(l > 0.0))
+        return fail(w, RAYES_ERROR_INVALID_ARGUMENT, "camera: up is along the view direction");
+    for (int k = 0; k < 3; k++)
+        r[k] /= l;
+    u[0] = r[1] * fw[2] - r[2] * fw[1];
+    u[1] = r[2] * fw[0] - r[0] * fw[2];
+    u[2] = r[0] * fw[1] - r[1] * fw[0];
+    const double *rows[3] = {r, u, fw};
+    float m[16] = {0};
+    for (int i = 0; i < 3; i++) {
+        double d = 0.0;
+        for (int k = 0; k < 3; k++) {
+            m[4 * i + k] = (float)rows[i][k];
+            d += rows[i][k] * eye[k];
+        }
+        m[4 * i + 3] = (float)-d;
+    }
+    m[15] = 1.0f;
+    if (stream_open(&w->camera) != 0)
+        return fail(w, RAYES_ERROR_OUT_OF_MEMORY, "out of memory");
+    w->fov_y = fov;
+    fprintf(w->camera.f, "Transform ");
+    matrix(w->camera.f, m);
+    fputc('\n', w->camera.f);
+    return RAYES_OK;
+}
+
+static RayesError w_set_camera_matrix(void *t, const float m[16], RayesProjection proj, float fov,
+                                      const float screen[4])
+{
+    RibWriter *w = t;
+    if (!finite_all(m, 16) || (screen && !finite_all(screen, 4)) ||
+        (proj == RAYES_PROJECTION_PERSPECTIVE && !(fov > 0.0f && fov < 180.0f)) ||
+        (proj != RAYES_PROJECTION_PERSPECTIVE && proj != RAYES_PROJECTION_ORTHOGRAPHIC))
+        return fail(w, RAYES_ERROR_INVALID_ARGUMENT, "camera: out of range");
+    if (stream_open(&w->camera) != 0)
+        return fail(w, RAYES_ERROR_OUT_OF_MEMORY, "out of memory");
+    FILE *f = w->camera.f;
+    w->fov_y = -1.0f;
+    if (proj == RAYES_PROJECTION_PERSPECTIVE)
+        fprintf(f, "Projection \"perspective\" \"fov\" [%.9g]\n", (double)fov);
+    else
+        fprintf(f, "Projection \"orthographic\"\n");
+    if (screen)
+        fprintf(f, "ScreenWindow %.9g %.9g %.9g %.9g\n", (double)screen[0], (double)screen[1],
+                (double)screen[2], (double)screen[3]);
+    fprintf(f, "Transform ");
+    matrix(f, m);
+    fputc('\n', f);
+    return RAYES_OK;
+}
+
+/* ------------------------------------------------------- attributes */
+
+static int is_identity(const float m[16])
+{
+    for (int i = 0; i < 16; i++)
+        if (m[i] != (i % 5 == 0 ? 1.0f : 0.0f))
+            return 0;
+    return 1;
+}
+
+static RayesError w_set_transform(void *t, const float m[16])
+{
+    RibWriter *w = t;
+    if (!finite_all(m, 16))
+        return fail(w, RAYES_ERROR_INVALID_ARGUMENT, "transform: not finite");
+    FILE *f = w->world.f;
+    if (w->in_transform)
+        fprintf(f, "TransformEnd\n");
+    w->in_transform = !is_identity(m);
+    if (w->in_transform) {
+        fprintf(f, "TransformBegin\nConcatTransform ");
+        matrix(f, m);
+        fputc('\n', f);
+    }
+    return RAYES_OK;
+}
+
+/* Cs and Os from a shader's parameters (Color and Opacity in RIB). */
+static const RayesParam *find_param(const RayesParam *p, size_t n, const char *name)
+{
+    for (size_t i = 0; i < n; i++)
+        if (p[i].name && strcmp(p[i].name, name) == 0 && p[i].type != RAYES_PARAM_STRING)
+            return &p[i];
+    return NULL;
+}
+
+static void color_of(const RayesParam *p, float c[3])
+{
+    for (int k = 0; k < 3; k++)
+        c[k] = p ? p->value[p->type == RAYES_PARAM_FLOAT ? 0 : k] : 1.0f;
+}
+
+static RayesError w_set_shader(void *t, const char *name, const RayesParam *p, size_t n)
+{
+    RibWriter *w = t;
+    if (!name || !name[0])
+        return fail(w, RAYES_ERROR_INVALID_ARGUMENT, "set_shader: no name");
+    FILE *f = w->world.f;
+    float cs[3], os[3];
+    color_of(find_param(p, n, "Cs"), cs);
+    color_of(find_param(p, n, "Os"), os);
+    if (!finite_all(cs, 3) || !finite_all(os, 3))
+        return fail(w, RAYES_ERROR_INVALID_ARGUMENT, "Cs or Os: not finite");
+    int opaque = os[0] == 1.0f && os[1] == 1.0f && os[2] == 1.0f;
+    /* everything but Cs and Os, checked before anything is written */
+    RayesParam rest[64];
+    size_t n_rest = 0;
+    for (size_t i = 0; i < n; i++) {
+        if (p[i].name && (!strcmp(p[i].name, "Cs") || !strcmp(p[i].name, "Os")) &&
+            p[i].type != RAYES_PARAM_STRING)
+            continue;
+        if (n_rest == 64)
+            return fail(w, RAYES_ERROR_INVALID_ARGUMENT, "set_shader: too many parameters");
+        rest[n_rest++] = p[i];
+    }
+    char *text = NULL;
+    size_t size = 0;
+    FILE *m = open_memstream(&text, &size);
+    if (!m)
+        return fail(w, RAYES_ERROR_OUT_OF_MEMORY, "out of memory");
+    RayesError e = params(w, m, rest, n_rest, 0);
+    fclose(m);
+    if (e == RAYES_OK) {
+        fprintf(f, "Color ");
+        floats(f, cs, 3);
+        fputc('\n', f);
+        if (!opaque || w->opacity_set) {
+            fprintf(f, "Opacity ");
+            floats(f, os, 3);
+            fputc('\n', f);
+        }
+        w->opacity_set = !opaque;
+        fprintf(f, "Surface ");
+        string(f, name);
+        fprintf(f, "%s\n", text ? text : "");
+    }
+    free(text);
+    return e;
+}
+
+static RayesError w_set_displacement(void *t, const char *name, const RayesParam *p, size_t n)
+{
+    RibWriter *w = t;
+    FILE *f = w->world.f;
+    if (!name || !name[0]) {
+        fprintf(f, "Displacement \"null\"\n");
+        return RAYES_OK;
+    }
+    char *text = NULL;
+    size_t size = 0;
+    FILE *m = open_memstream(&text, &size);
+    if (!m)
+        return fail(w, RAYES_ERROR_OUT_OF_MEMORY, "out of memory");
+    RayesError e = params(w, m, p, n, 0);
+    fclose(m);
+    if (e == RAYES_OK) {
+        fprintf(f, "Displacement ");
+        string(f, name);
+        fprintf(f, "%s\n", text ? text : "");
+    }
+    free(text);
+    return e;
+}
+
+static RayesError w_set_displacement_bound(void *t, float bound)
+{
+    RibWriter *w = t;
+    if (!(bound >= 0.0f) || !isfinite(bound))
+        return fail(w, RAYES_ERROR_INVALID_ARGUMENT, "displacement bound: out of range");
+    fprintf(w->world.f,
+            "Attribute \"displacementbound\" \"float sphere\" [%.9g] "
+            "\"string coordinatesystem\" [\"world\"]\n",
+            (double)bound);
+    return RAYES_OK;
+}
+
+static RayesError w_set_search_path(void *t, const char *kind, const char *path)
+{
+    RibWriter *w = t;
+    if (!kind || !kind[0] || !path || strpbrk(kind, " \"\\"))
+        return fail(w, RAYES_ERROR_INVALID_ARGUMENT, "search path: bad kind or path");
+    fprintf(w->options.f, "Option \"searchpath\" \"string %s\" [", kind);
+    string(w->options.f, path);
+    fprintf(w->options.f, "]\n");
+    return RAYES_OK;
+}
+
+static RayesError w_set_shading_rate(void *t, float rate)
+{
+    RibWriter *w = t;
+    if (!(rate > 0.0f) || !isfinite(rate))
+        return fail(w, RAYES_ERROR_INVALID_ARGUMENT, "shading rate: out of range");
+    fprintf(w->world.f, "ShadingRate %.9g\n", (double)rate);
+    return RAYES_OK;
+}
+
+/* --------------------------------------------------------- geometry */
+
+static RayesError w_bilinear_patch(void *t, const float P[4][3])
+{
+    RibWriter *w = t;
+    if (!finite_all(&P[0][0], 12))
+        return fail(w, RAYES_ERROR_INVALID_ARGUMENT, "bilinear patch: non-finite point");
+    fprintf(w->world.f, "Patch \"bilinear\" \"P\" ");
+    floats(w->world.f, &P[0][0], 12);
+    fputc('\n', w->world.f);
+    return RAYES_OK;
+}
+
+static RayesError w_bicubic_patch(void *t, const float P[16][3])
+{
+    RibWriter *w = t;
+    if (!finite_all(&P[0][0], 48))
+        return fail(w, RAYES_ERROR_INVALID_ARGUMENT, "bicubic patch: non-finite point");
+    if (!w->bezier_basis)
+        fprintf(w->world.f, "Basis \"bezier\" 3 \"bezier\" 3\n");
+    w->bezier_basis = 1;
+    fprintf(w->world.f, "Patch \"bicubic\" \"P\" ");
+    floats(w->world.f, &P[0][0], 48);
+    fputc('\n', w->world.f);
+    return RAYES_OK;
+}
+
+static RayesError w_polygon_mesh(void *t, size_t n_faces, const int *nv, const int *idx,
+                                 size_t n_points, const float *P)
+{
+    RibWriter *w = t;
+    size_t k = 0;
+    if (n_faces == 0)
+        return RAYES_OK;
+    if (!nv || !idx || !P || !finite_all(P, 3 * n_points))
+        return fail(w, RAYES_ERROR_INVALID_ARGUMENT, "polygon mesh: missing or non-finite data");
+    for (size_t i = 0; i < n_faces; k += (size_t)nv[i], i++) {
+        if (nv[i] != 3 && nv[i] != 4)
+            return fail(w, RAYES_ERROR_INVALID_ARGUMENT,
+                        "polygon mesh: face %zu has %d vertices; expected 3 or 4", i, nv[i]);
+        for (int v = 0; v < nv[i]; v++)
+            if (idx[k + (size_t)v] < 0 || (size_t)idx[k + (size_t)v] >= n_points)
+                return fail(w, RAYES_ERROR_INVALID_ARGUMENT, "polygon mesh: index out of range");
+    }
+    FILE *f = w->world.f;
+    fprintf(f, "PointsPolygons [");
+    for (size_t i = 0; i < n_faces; i++)
+        fprintf(f, i ? " %d" : "%d", nv[i]);
+    fprintf(f, "]\n  [");
+    for (size_t i = 0; i < k; i++)
+        fprintf(f, "%s%d", i == 0 ? "" : i % 24 == 0 ? "\n   " : " ", idx[i]);
+    fprintf(f, "]\n  \"P\" [");
+    for (size_t i = 0; i < 3 * n_points; i++)
+        fprintf(f, "%s%.9g", i == 0 ? "" : i % 9 == 0 ? "\n   " : " ",
+                P[i] == 0.0f ? 0.0 : (double)P[i]);
+    fprintf(f, "]\n");
+    return RAYES_OK;
+}
+
+static RayesError w_quadric(void *t, RayesQuadric type, const float *p, size_t n, unsigned flags)
+{
+    static const char *const names[] = {"Sphere",     "Cylinder",    "Cone", "Disk",
+                                        "Paraboloid", "Hyperboloid", "Torus"};
+    static const size_t counts[] = {4, 4, 3, 3, 4, 7, 5};
+    RibWriter *w = t;
+    if ((unsigned)type > RAYES_QUADRIC_TORUS || n != counts[type] || !p || !finite_all(p, n))
+        return fail(w, RAYES_ERROR_INVALID_ARGUMENT, "quadric: wrong type or parameters");
+    FILE *f = w->world.f;
+    int reverse = (flags & RAYES_QUADRIC_REVERSE) != 0;
+    if (reverse)
+        fprintf(f, "AttributeBegin\nReverseOrientation\n");
+    fprintf(f, "%s", names[type]);
+    for (size_t i = 0; i < n; i++)
+        fprintf(f, " %.9g", p[i] == 0.0f ? 0.0 : (double)p[i]);
+    fprintf(f, "\n%s", reverse ? "AttributeEnd\n" : "");
+    return RAYES_OK;
+}
+
+static RayesError w_sphere(void *t, float r)
+{
+    const float p[4] = {r, -r, r, 360.0f};
+    if (!(r > 0.0f))
+        return fail(t, RAYES_ERROR_INVALID_ARGUMENT, "sphere: radius not positive");
+    return w_quadric(t, RAYES_QUADRIC_SPHERE, p, 4, 0);
+}
+
+/* --------------------------------------------------------------- lights */
+
+static RayesError w_area_light(void *t, const float P[4][3], const float L[3])
+{
+    RibWriter *w = t;
+    if (!finite_all(&P[0][0], 12) || !finite_all(L, 3))
+        return fail(w, RAYES_ERROR_INVALID_ARGUMENT, "area light: not finite");
+    FILE *f = w->world.f;
+    fprintf(f, "AttributeBegin\nAreaLightSource \"arealight\" %d \"color lightcolor\" ",
+            w->next_light++);
+    floats(f, L, 3);
+    fprintf(f, "\nPolygon \"P\" ");
+    floats(f, &P[0][0], 12);
+    fprintf(f, "\nAttributeEnd\n");
+    return RAYES_OK;
+}
+
+static RayesError w_light(void *t, const char *type, const RayesParam *p, size_t n)
+{
+    RibWriter *w = t;
+    if (!type || !type[0])
+        return fail(w, RAYES_ERROR_INVALID_ARGUMENT, "light: no type");
+    char *text = NULL;
+    size_t size = 0;
+    FILE *m = open_memstream(&text, &size);
+    if (!m)
+        return fail(w, RAYES_ERROR_OUT_OF_MEMORY, "out of memory");
+    RayesError e = params(w, m, p, n, 1);
+    fclose(m);
+    if (e == RAYES_OK) {
+        fprintf(w->world.f, "LightSource ");
+        string(w->world.f, type);
+        fprintf(w->world.f, " %d%s\n", w->next_light++, text ? text : "");
+    }
+    free(text);
+    return e;
+}
+
+static const char *w_get_error(void *t)
+{
+    return ((RibWriter *)t)->error;
+}
+
+IoSink io_rib_writer_sink(RibWriter *w)
+{
+    return (IoSink){
+        .target = w,
+        .set_camera = w_set_camera,
+        .set_camera_matrix = w_set_camera_matrix,
+        .set_transform = w_set_transform,
+        .set_shader = w_set_shader,
+        .set_displacement = w_set_displacement,
+        .set_displacement_bound = w_set_displacement_bound,
+        .set_search_path = w_set_search_path,
+        .set_shading_rate = w_set_shading_rate,
+        .bilinear_patch = w_bilinear_patch,
+        .bicubic_patch = w_bicubic_patch,
+        .polygon_mesh = w_polygon_mesh,
+        .sphere = w_sphere,
+        .quadric = w_quadric,
+        .area_light = w_area_light,
+        .light = w_light,
+        .get_error = w_get_error,
+    };
+}
+
+/* ------------------------------------------------------------- finish */
+
+static void settings_rib(FILE *f, const IoSettings *s)
+{
+    if (s->width > 0 && s->height > 0)
+        fprintf(f, "Format %d %d 1\n", s->width, s->height);
+    if (s->spp > 0) {
+        int r = (int)lround(sqrt((double)s->spp));
+        if (r * r == s->spp)
+            fprintf(f, "PixelSamples %d %d\n", r, r);
+        else
+            fprintf(f, "PixelSamples %d 1\n", s->spp);
+    }
+    if (s->filter == RAYES_FILTER_BOX || s->filter == RAYES_FILTER_GAUSSIAN) {
+        double fw = s->filter_width > 0.0f ? s->filter_width
+                                           : s->filter == RAYES_FILTER_BOX ? 1.0 : 2.0;
+        fprintf(f, "PixelFilter \"%s\" %.9g %.9g\n",
+                s->filter == RAYES_FILTER_BOX ? "box" : "gaussian", fw, fw);
+    }
+    if (s->exposure_gain != 1.0f || s->exposure_gamma != 1.0f)
+        fprintf(f, "Exposure %.9g %.9g\n", (double)s->exposure_gain, (double)s->exposure_gamma);
+    if (s->crop[0] != 0.0f || s->crop[1] != 1.0f || s->crop[2] != 0.0f || s->crop[3] != 1.0f)
+        fprintf(f, "CropWindow %.9g %.9g %.9g %.9g\n", (double)s->crop[0], (double)s->crop[1],
+                (double)s->crop[2], (double)s->crop[3]);
+    for (int i = 0; i < s->n_displays && i < IO_MAX_DISPLAYS; i++) {
+        char name[520];
+        snprintf(name, sizeof name, "%s%s", i ? "+" : "", s->displays[i].name);
+        fprintf(f, "Display ");
+        string(f, name);
+        fputc(' ', f);
+        string(f, s->displays[i].type[0] ? s->displays[i].type : "file");
+        fputc(' ', f);
+        string(f, s->displays[i].mode[0] ? s->displays[i].mode : "rgba");
+        fputc('\n', f);
+    }
+}
+
+/* RenderMan's fov spans the shorter side of the image; set_camera's is
+ * vertical, so a portrait image needs the horizontal angle. */
+static double rib_fov(const RibWriter *w, const IoSettings *s)
+{
+    double fov = w->fov_y;
+    if (s && s->width > 0 && s->height > s->width) {
+        double t = tan(fov * M_PI / 360.0) * s->width / s->height;
+        fov = atan(t) * 360.0 / M_PI;
+    }
+    return fov;
+}
+
+RayesError io_rib_writer_finish(RibWriter *w, const IoSettings *s, FILE *out, char *err,
+                                size_t err_size)
+{
+    if (fflush(w->options.f) != 0 || fflush(w->camera.f) != 0 || fflush(w->world.f) != 0) {
+        snprintf(err, err_size, "out of memory");
+        return RAYES_ERROR_OUT_OF_MEMORY;
+    }
+    fprintf(out, "##RenderMan RIB\n# written by rayes %s\nversion 3.04\n",
+            rayes_version_string());
+    if (s) {
+        settings_rib(out, s);
+        if (s->bounces >= 0 || s->specular_depth >= 0) {
+            fprintf(out, "Attribute \"trace\"");
+            if (s->bounces >= 0)
+                fprintf(out, " \"int maxdiffusedepth\" [%d]", s->bounces);
+            if (s->specular_depth >= 0)
+                fprintf(out, " \"int maxspeculardepth\" [%d]", s->specular_depth);
+            fputc('\n', out);
+        }
+    }
+    fwrite(w->options.buf, 1, w->options.size, out);
+    if (w->fov_y > 0.0f)
+        fprintf(out, "Projection \"perspective\" \"fov\" [%.9g]\n", rib_fov(w, s));
+    fwrite(w->camera.buf, 1, w->camera.size, out);
+    fprintf(out, "WorldBegin\n");
+    fwrite(w->world.buf, 1, w->world.size, out);
+    fprintf(out, "%sWorldEnd\n", w->in_transform ? "TransformEnd\n" : "");
+    if (fflush(out) != 0 || ferror(out)) {
+        snprintf(err, err_size, "write error");
+        return RAYES_ERROR_IO;
+    }
+    return RAYES_OK;
+}

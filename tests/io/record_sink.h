@@ -1,0 +1,240 @@
+/*
+ * tests/io/record_sink.h — a recording IoSink for the reader and writer
+ * tests: every call is kept (meshes, shaders with their parameters, lights,
+ * the camera), so a test can check what a reader said. Header-only; one
+ * Record per test, reset with record_free.
+ */
+#ifndef RAYES_TESTS_IO_RECORD_SINK_H
+#define RAYES_TESTS_IO_RECORD_SINK_H
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "io/sink.h"
+
+#define REC_MAX 64
+
+typedef struct RecMesh {
+    size_t n_faces, n_points;
+    int *nv, *idx;
+    float *P;
+    int shader;               /* index of the shader in force, -1 none */
+} RecMesh;
+
+typedef struct RecShader {
+    char name[64];
+    RayesParam p[8];
+    char pname[8][32], pstring[8][1100];
+    size_t n;
+} RecShader;
+
+typedef struct Record {
+    int calls;                /* every call */
+    int n_camera;
+    float eye[3], at[3], up[3], fov;
+    int n_transform;
+    RecMesh mesh[REC_MAX];
+    int n_mesh;
+    RecShader shader[REC_MAX];
+    int n_shader;
+    float area_P[REC_MAX][4][3], area_L[REC_MAX][3];
+    int n_area;
+    RecShader light[REC_MAX]; /* type in name */
+    int n_light;
+} Record;
+
+static RayesError rec_camera(void *t, const float eye[3], const float at[3], const float up[3],
+                             float fov)
+{
+    Record *r = t;
+    r->calls++;
+    r->n_camera++;
+    memcpy(r->eye, eye, sizeof r->eye);
+    memcpy(r->at, at, sizeof r->at);
+    memcpy(r->up, up, sizeof r->up);
+    r->fov = fov;
+    return RAYES_OK;
+}
+
+static RayesError rec_camera_matrix(void *t, const float m[16], RayesProjection p, float fov,
+                                    const float s[4])
+{
+    (void)m, (void)p, (void)fov, (void)s;
+    ((Record *)t)->calls++;
+    ((Record *)t)->n_camera++;
+    return RAYES_OK;
+}
+
+static RayesError rec_transform(void *t, const float m[16])
+{
+    (void)m;
+    ((Record *)t)->calls++;
+    ((Record *)t)->n_transform++;
+    return RAYES_OK;
+}
+
+static void rec_copy_shader(RecShader *s, const char *name, const RayesParam *p, size_t n)
+{
+    snprintf(s->name, sizeof s->name, "%s", name ? name : "");
+    s->n = n < 8 ? n : 8;
+    for (size_t i = 0; i < s->n; i++) {
+        s->p[i] = p[i];
+        snprintf(s->pname[i], sizeof s->pname[i], "%s", p[i].name);
+        s->p[i].name = s->pname[i];
+        snprintf(s->pstring[i], sizeof s->pstring[i], "%s", p[i].string ? p[i].string : "");
+        s->p[i].string = p[i].string ? s->pstring[i] : NULL;
+    }
+}
+
+static RayesError rec_shader(void *t, const char *name, const RayesParam *p, size_t n)
+{
+    Record *r = t;
+    r->calls++;
+    if (r->n_shader == REC_MAX)
+        return RAYES_ERROR_OUT_OF_MEMORY;
+    rec_copy_shader(&r->shader[r->n_shader++], name, p, n);
+    return RAYES_OK;
+}
+
+static RayesError rec_displacement(void *t, const char *name, const RayesParam *p, size_t n)
+{
+    (void)name, (void)p, (void)n;
+    ((Record *)t)->calls++;
+    return RAYES_OK;
+}
+
+static RayesError rec_float(void *t, float f)
+{
+    (void)f;
+    ((Record *)t)->calls++;
+    return RAYES_OK;
+}
+
+static RayesError rec_search_path(void *t, const char *k, const char *p)
+{
+    (void)k, (void)p;
+    ((Record *)t)->calls++;
+    return RAYES_OK;
+}
+
+static RayesError rec_bilinear(void *t, const float P[4][3])
+{
+    (void)P;
+    ((Record *)t)->calls++;
+    return RAYES_OK;
+}
+
+static RayesError rec_bicubic(void *t, const float P[16][3])
+{
+    (void)P;
+    ((Record *)t)->calls++;
+    return RAYES_OK;
+}
+
+static RayesError rec_mesh(void *t, size_t n_faces, const int *nv, const int *idx,
+                           size_t n_points, const float *P)
+{
+    Record *r = t;
+    r->calls++;
+    if (r->n_mesh == REC_MAX)
+        return RAYES_ERROR_OUT_OF_MEMORY;
+    RecMesh *m = &r->mesh[r->n_mesh++];
+    size_t k = 0;
+    for (size_t f = 0; f < n_faces; f++)
+        k += (size_t)nv[f];
+    m->n_faces = n_faces;
+    m->n_points = n_points;
+    m->nv = malloc(n_faces * sizeof *m->nv + 1);
+    m->idx = malloc(k * sizeof *m->idx + 1);
+    m->P = malloc(3 * n_points * sizeof *m->P + 1);
+    memcpy(m->nv, nv, n_faces * sizeof *nv);
+    memcpy(m->idx, idx, k * sizeof *idx);
+    memcpy(m->P, P, 3 * n_points * sizeof *P);
+    m->shader = r->n_shader - 1;
+    return RAYES_OK;
+}
+
+static RayesError rec_sphere(void *t, float radius)
+{
+    (void)radius;
+    ((Record *)t)->calls++;
+    return RAYES_OK;
+}
+
+static RayesError rec_quadric(void *t, RayesQuadric q, const float *p, size_t n, unsigned f)
+{
+    (void)q, (void)p, (void)n, (void)f;
+    ((Record *)t)->calls++;
+    return RAYES_OK;
+}
+
+static RayesError rec_area_light(void *t, const float P[4][3], const float L[3])
+{
+    Record *r = t;
+    r->calls++;
+    if (r->n_area == REC_MAX)
+        return RAYES_ERROR_OUT_OF_MEMORY;
+    memcpy(r->area_P[r->n_area], P, sizeof r->area_P[0]);
+    memcpy(r->area_L[r->n_area++], L, sizeof r->area_L[0]);
+    return RAYES_OK;
+}
+
+static RayesError rec_light(void *t, const char *type, const RayesParam *p, size_t n)
+{
+    Record *r = t;
+    r->calls++;
+    if (r->n_light == REC_MAX)
+        return RAYES_ERROR_OUT_OF_MEMORY;
+    rec_copy_shader(&r->light[r->n_light++], type, p, n);
+    return RAYES_OK;
+}
+
+static const char *rec_error(void *t)
+{
+    (void)t;
+    return "";
+}
+
+static IoSink record_sink(Record *r)
+{
+    memset(r, 0, sizeof *r);
+    return (IoSink){.target = r,
+                    .set_camera = rec_camera,
+                    .set_camera_matrix = rec_camera_matrix,
+                    .set_transform = rec_transform,
+                    .set_shader = rec_shader,
+                    .set_displacement = rec_displacement,
+                    .set_displacement_bound = rec_float,
+                    .set_search_path = rec_search_path,
+                    .set_shading_rate = rec_float,
+                    .bilinear_patch = rec_bilinear,
+                    .bicubic_patch = rec_bicubic,
+                    .polygon_mesh = rec_mesh,
+                    .sphere = rec_sphere,
+                    .quadric = rec_quadric,
+                    .area_light = rec_area_light,
+                    .light = rec_light,
+                    .get_error = rec_error};
+}
+
+static void record_free(Record *r)
+{
+    for (int i = 0; i < r->n_mesh; i++) {
+        free(r->mesh[i].nv);
+        free(r->mesh[i].idx);
+        free(r->mesh[i].P);
+    }
+    r->n_mesh = 0;
+}
+
+/* The parameter of that name, or NULL. */
+static const RayesParam *rec_param(const RecShader *s, const char *name)
+{
+    for (size_t i = 0; i < s->n; i++)
+        if (strcmp(s->p[i].name, name) == 0)
+            return &s->p[i];
+    return NULL;
+}
+
+#endif

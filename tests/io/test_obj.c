@@ -1,0 +1,289 @@
+/*
+ * tests/io/test_obj.c — the OBJ/MTL reader of io/obj.h, through a recording
+ * IoSink (io/record_sink.h): face syntaxes and relative indices, n-gon and
+ * concave triangulation (the triangles cover the polygon, all facing its
+ * way), materials from an MTL beside the file, emissive quads as area
+ * lights, the default camera and light, and bad input, whose one-line
+ * errors name "file:line:col" and leave the sink untouched. Buffers are
+ * heap copies of exactly their size, so AddressSanitizer catches reads past
+ * the end.
+ */
+#include <math.h>
+#include <string.h>
+#include <sys/stat.h>
+
+#include "io/obj.h"
+#include "io/record_sink.h"
+#include "test.h"
+
+#ifndef RAYES_TEST_TMP
+#error "RAYES_TEST_TMP must name a scratch directory"
+#endif
+
+#define DIR RAYES_TEST_TMP "/io_obj"
+
+static Record rec;
+static char err[512];
+
+static RayesError parse(const char *name, const char *text)
+{
+    size_t n = strlen(text);
+    char *copy = malloc(n ? n : 1);
+    memcpy(copy, text, n);
+    IoSink sink = record_sink(&rec);
+    IoSettings st;
+    IoReadOptions ro = {NULL, -1};
+    io_settings_init(&st);
+    RayesError e = io_obj_parse(name, (const unsigned char *)copy, n, &sink, &ro, &st, err,
+                                sizeof err);
+    free(copy);
+    CHECK(st.width == 0 && st.n_displays == 0); /* OBJ gives no settings */
+    return e;
+}
+
+static void write_file(const char *path, const char *text)
+{
+    FILE *f = fopen(path, "wb");
+    CHECK(f != NULL);
+    if (f) {
+        fputs(text, f);
+        fclose(f);
+    }
+}
+
+/* The point of corner c of face f of mesh m. */
+static const float *corner(const RecMesh *m, size_t f, int c)
+{
+    size_t k = 0;
+    for (size_t i = 0; i < f; i++)
+        k += (size_t)m->nv[i];
+    return &m->P[3 * (size_t)m->idx[k + (size_t)c]];
+}
+
+/* The z component of the total signed area of mesh m's faces (twice). */
+static double area_z(const RecMesh *m)
+{
+    double a = 0.0;
+    for (size_t f = 0; f < m->n_faces; f++)
+        for (int c = 0; c < m->nv[f]; c++) {
+            const float *p = corner(m, f, c), *q = corner(m, f, (c + 1) % m->nv[f]);
+            a += (double)p[0] * q[1] - (double)q[0] * p[1];
+        }
+    return a * 0.5;
+}
+
+/* -------------------------------------------------------------- tests */
+
+static void test_face_syntax(void)
+{
+    static const char text[] = "# a square four ways\n"
+                               "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\n"
+                               "vt 0 0\nvt 1 0\nvt 1 1\nvn 0 0 1\n"
+                               "g one two\ns 1\no obj\n"
+                               "f 1 2 3\n"
+                               "f 1/1 3/3 4/3\n"
+                               "f -4//1 -3//-1 -2//1\n"
+                               "f -4/-3/-1 -2/-1/1 -1/2/1\r\n"
+                               "f 1 2 \\\n 3 4"; /* continued, no final newline */
+    CHECK(parse("sq.obj", text) == RAYES_OK);
+    CHECK(err[0] == '\0');
+    CHECK(rec.n_mesh == 1 && rec.n_shader == 1);
+    if (rec.n_mesh == 1) {
+        const RecMesh *m = &rec.mesh[0];
+        CHECK(m->n_faces == 5 && m->n_points == 4);
+        CHECK(m->nv[0] == 3 && m->nv[4] == 4);
+        /* face 3: -4/-3/-1 -2/-1/1 -1/2/1 = vertices 1 3 4 */
+        CHECK(corner(m, 3, 0)[0] == 0 && corner(m, 3, 0)[1] == 0);
+        CHECK(corner(m, 3, 1)[0] == 1 && corner(m, 3, 1)[1] == 1);
+        CHECK(corner(m, 3, 2)[0] == 0 && corner(m, 3, 2)[1] == 1);
+        CHECK_NEAR(area_z(m), 0.5 * 4 + 1, 1e-6);
+    }
+    CHECK(strcmp(rec.shader[0].name, "matte") == 0);
+    record_free(&rec);
+}
+
+static void test_ngons(void)
+{
+    /* a convex pentagon, an L-shaped hexagon (concave), a dart (concave
+     * quad) and a convex quad */
+    static const char text[] = "v 0 0 0\nv 2 0 0\nv 3 1 0\nv 1 2 0\nv -1 1 0\n"
+                               "f 1 2 3 4 5\n"
+                               "v 0 0 1\nv 2 0 1\nv 2 1 1\nv 1 1 1\nv 1 2 1\nv 0 2 1\n"
+                               "f -6 -5 -4 -3 -2 -1\n"
+                               "v 0 0 2\nv 2 1 2\nv 0 2 2\nv 0.5 1 2\n"
+                               "f -4 -3 -2 -1\n"
+                               "v 0 0 3\nv 1 0 3\nv 1 1 3\nv 0 1 3\n"
+                               "f -4 -3 -2 -1\n";
+    CHECK(parse("ngon.obj", text) == RAYES_OK);
+    CHECK(rec.n_mesh == 1);
+    if (rec.n_mesh != 1)
+        return;
+    const RecMesh *m = &rec.mesh[0];
+    CHECK(m->n_faces == 3 + 4 + 2 + 1);
+    /* every triangle faces +z (CCW), and each polygon's area is covered */
+    double by_z[4] = {0};
+    int all_ccw = 1;
+    for (size_t f = 0; f < m->n_faces; f++) {
+        const float *a = corner(m, f, 0), *b = corner(m, f, 1), *c = corner(m, f, 2);
+        double cz = ((double)b[0] - a[0]) * ((double)c[1] - a[1]) -
+                    ((double)b[1] - a[1]) * ((double)c[0] - a[0]);
+        all_ccw &= cz > 0.0;
+        if (!(cz > 0.0))
+            fprintf(stderr, "  face %zu: (%g %g) (%g %g) (%g %g) z %g\n", f, a[0], a[1], b[0], b[1],
+                    c[0], c[1], a[2]);
+        RecMesh one = *m;
+        one.n_faces = 1;
+        size_t k = 0;
+        for (size_t i = 0; i < f; i++)
+            k += (size_t)m->nv[i];
+        one.nv = &m->nv[f];
+        one.idx = &m->idx[k];
+        by_z[(int)a[2]] += area_z(&one);
+    }
+    CHECK(all_ccw);
+    CHECK_NEAR(by_z[0], 5.0, 1e-5);  /* pentagon: shoelace */
+    CHECK_NEAR(by_z[1], 3.0, 1e-5);  /* L: 2 x 2 minus 1 x 1 */
+    CHECK_NEAR(by_z[2], 1.5, 1e-5);  /* dart */
+    CHECK_NEAR(by_z[3], 1.0, 1e-5);
+    CHECK(m->nv[m->n_faces - 1] == 4); /* the convex quad stays a quad */
+    record_free(&rec);
+}
+
+static void test_materials(void)
+{
+    mkdir(RAYES_TEST_TMP, 0777);
+    mkdir(DIR, 0777);
+    write_file(DIR "/m.mtl", "# materials\n"
+                             "newmtl red\nKd 0.6 0.1 0.05\nd 1\nillum 1\n"
+                             "newmtl shiny\nKd 0.2 0.3 0.4\nKs 0.5 0.5 0.5\nNs 40\nillum 2\n"
+                             "newmtl wood\nKd 1 1 1\nmap_Kd -s 2 2 1 wood.png\n"
+                             "newmtl lamp\nKd 0 0 0\nKe 5 4 3\n");
+    static const char text[] = "mtllib m.mtl\n"
+                               "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\n"
+                               "usemtl red\nf 1 2 3\n"
+                               "usemtl shiny\nf 1 3 4\n"
+                               "usemtl wood\nf 1 2 3 4\n"
+                               "usemtl lamp\nf 4 3 2 1\nf 1 2 3\n"
+                               "usemtl missing\nf 2 3 4\n";
+    CHECK(parse(DIR "/scene.obj", text) == RAYES_OK);
+    if (err[0])
+        fprintf(stderr, "  %s\n", err);
+    /* default (the undefined material), red, shiny, wood, the lamp's triangle */
+    CHECK(rec.n_shader == 5 && rec.n_mesh == 5);
+    if (rec.n_shader != 5)
+        return;
+    const RayesParam *p;
+    CHECK(strcmp(rec.shader[0].name, "matte") == 0);
+    CHECK(strcmp(rec.shader[1].name, "matte") == 0);
+    CHECK((p = rec_param(&rec.shader[1], "Cs")) && p->value[0] == 0.6f && p->value[2] == 0.05f);
+    CHECK(strcmp(rec.shader[2].name, "plastic") == 0);
+    CHECK((p = rec_param(&rec.shader[2], "Cs")) && p->value[1] == 0.3f);
+    CHECK((p = rec_param(&rec.shader[2], "specularcolor")) && p->value[0] == 0.5f);
+    CHECK((p = rec_param(&rec.shader[2], "roughness")) && fabsf(p->value[0] - 1.0f / 40) < 1e-7f);
+    CHECK(strcmp(rec.shader[3].name, "paintedplastic") == 0);
+    CHECK((p = rec_param(&rec.shader[3], "texturename")) &&
+          strcmp(p->string, DIR "/wood.png") == 0);
+    CHECK(strcmp(rec.shader[4].name, "constant") == 0);
+    CHECK((p = rec_param(&rec.shader[4], "Cs")) && p->value[0] == 5.0f);
+    /* the lamp's quad is an area light, in order, with L = Ke */
+    CHECK(rec.n_area == 1);
+    CHECK(rec.area_P[0][0][0] == 0 && rec.area_P[0][0][1] == 1 && rec.area_L[0][1] == 4.0f);
+    CHECK(rec.n_light == 0); /* something emits: no default light */
+    CHECK(rec.n_camera == 1);
+    record_free(&rec);
+
+    /* a missing MTL is a warning, not an error */
+    CHECK(parse(DIR "/x.obj", "mtllib nosuch.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n") ==
+          RAYES_OK);
+    CHECK(rec.n_mesh == 1);
+    record_free(&rec);
+}
+
+static void test_default_camera_and_light(void)
+{
+    CHECK(parse("c.obj", "v -1 -2 -3\nv 3 -2 -3\nv 3 4 5\nf 1 2 3\n") == RAYES_OK);
+    CHECK(rec.n_camera == 1);
+    CHECK(rec.at[0] == 1 && rec.at[1] == 1 && rec.at[2] == 1); /* the bounds' centre */
+    CHECK(rec.eye[0] == rec.at[0] && rec.eye[1] == rec.at[1] && rec.eye[2] > rec.at[2] + 5);
+    CHECK(rec.up[1] == 1 && rec.fov == 40.0f);
+    /* the bounding sphere (radius sqrt(4 + 9 + 16)) fits the field of view */
+    double d = rec.eye[2] - rec.at[2];
+    CHECK(asin(sqrt(29.0) / d) <= 20.0 * M_PI / 180.0 + 1e-6);
+    CHECK(rec.n_light == 1 && strcmp(rec.light[0].name, "distantlight") == 0);
+    const RayesParam *from = rec_param(&rec.light[0], "from");
+    CHECK(from && from->value[0] < rec.at[0] && from->value[1] > rec.at[1] &&
+          from->value[2] > rec.at[2]); /* upper left, in front */
+    record_free(&rec);
+    /* an empty file: a camera at the origin's front and a light, no geometry */
+    CHECK(parse("e.obj", "") == RAYES_OK);
+    CHECK(rec.n_camera == 1 && rec.n_mesh == 0 && rec.n_light == 1);
+}
+
+/* Bad input: the message, and nothing sent to the sink. */
+static void expect_error(const char *text, const char *where)
+{
+    RayesError e = parse("bad.obj", text);
+    CHECK(e == RAYES_ERROR_PARSE);
+    CHECK(strncmp(err, where, strlen(where)) == 0 && strchr(err, '\n') == NULL);
+    CHECK(rec.calls == 0);
+    if (e != RAYES_ERROR_PARSE || strncmp(err, where, strlen(where)) != 0)
+        fprintf(stderr, "  expected %s..., got: %s\n", where, err);
+    record_free(&rec);
+}
+
+static void test_errors(void)
+{
+    expect_error("v 1 2\n", "bad.obj:1:6: expected a vertex coordinate, found the end");
+    expect_error("v 1 2 x\n", "bad.obj:1:7: expected a vertex coordinate, found \"x\"");
+    expect_error("v 1 2 3\nv 1 2 3\nv 1 2 3\n\nf 1 2 9\n", "bad.obj:5:7: expected a vertex index from 1 to 3");
+    expect_error("v 1 2 3\nv 1 2 3\nv 1 2 3\nf 1 0 2\n", "bad.obj:4:5: expected a vertex index");
+    expect_error("v 1 2 3\nv 1 2 3\nv 1 2 3\nf -4 1 2\n", "bad.obj:4:3: expected a vertex index");
+    expect_error("v 1 2 3\nv 1 2 3\nf 1 2\n", "bad.obj:3:6: expected at least 3 vertices");
+    expect_error("v 1 2 3\nv 1 2 3\nv 1 2 3\nf 1/1 2/1 3/1\n",
+                 "bad.obj:4:5: expected a texture coordinate index, found 1 with none");
+    expect_error("v 1 2 3\nv 1 2 3\nv 1 2 3\nvn 0 0 1\nf 1//1 2//2 3//1\n",
+                 "bad.obj:5:11: expected a normal index from 1 to 1");
+    expect_error("v 1 2 3\nv 1 2 3\nv 1 2 3\nf 1 2 3x\n", "bad.obj:4:7: expected a vertex index");
+    expect_error("usemtl\n", "bad.obj:1:7: expected a material name");
+    expect_error("vn 1 2\n", "bad.obj:1:7: expected a number");
+    expect_error("v 1 2 3 1e99\n", "bad.obj:1:9: expected a number");
+    /* an MTL error names the MTL file */
+    mkdir(RAYES_TEST_TMP, 0777);
+    mkdir(DIR, 0777);
+    write_file(DIR "/bad.mtl", "newmtl a\nKd 1 0.5\n");
+    CHECK(parse(DIR "/b.obj", "mtllib bad.mtl\n") == RAYES_ERROR_PARSE);
+    CHECK(strstr(err, DIR "/bad.mtl:2:9: expected the third colour component") == err);
+    CHECK(rec.calls == 0);
+    write_file(DIR "/bad.mtl", "Kd 1 0.5 1\n");
+    CHECK(parse(DIR "/b.obj", "mtllib bad.mtl\n") == RAYES_ERROR_PARSE);
+    CHECK(strstr(err, DIR "/bad.mtl:1:1: expected newmtl") == err);
+}
+
+/* Unknown statements are skipped (with one warning each), comments and
+ * blank lines ignored. */
+static void test_unknown_statements(void)
+{
+    CHECK(parse("u.obj", "\n\n# c\ncstype bezier\ndeg 3\nv 0 0 0 # x\nv 1 0 0\nv 0 1 0\n"
+                         "l 1 2\np 1\ncstype rat\nf 1 2 3\n") == RAYES_OK);
+    CHECK(rec.n_mesh == 1 && rec.mesh[0].n_faces == 1);
+    record_free(&rec);
+}
+
+static void test_read_file(void)
+{
+    mkdir(RAYES_TEST_TMP, 0777);
+    mkdir(DIR, 0777);
+    write_file(DIR "/t.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+    IoSink sink = record_sink(&rec);
+    IoSettings st;
+    io_settings_init(&st);
+    CHECK(io_obj_read(DIR "/t.obj", &sink, NULL, &st, err, sizeof err) == RAYES_OK);
+    CHECK(rec.n_mesh == 1);
+    record_free(&rec);
+    CHECK(io_obj_read(DIR "/none.obj", &sink, NULL, &st, err, sizeof err) == RAYES_ERROR_IO);
+    CHECK(strstr(err, DIR "/none.obj") != NULL);
+}
+
+TEST_MAIN(TEST(test_face_syntax), TEST(test_ngons), TEST(test_materials),
+          TEST(test_default_camera_and_light), TEST(test_errors), TEST(test_unknown_statements),
+          TEST(test_read_file))
