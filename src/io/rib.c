@@ -30,6 +30,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <zlib.h>
 
 #include "io/bpt.h"
@@ -593,7 +594,8 @@ static int parse_decl(const char *s, Decl *d, int want_name)
     snprintf(buf, sizeof buf, "%s", s);
     char *words[4];
     int n = 0;
-    for (char *w = strtok(buf, " \t\n"); w && n < 4; w = strtok(NULL, " \t\n"))
+    char *save = NULL;
+    for (char *w = strtok_r(buf, " \t\n", &save); w && n < 4; w = strtok_r(NULL, " \t\n", &save))
         words[n++] = w;
     if (n == 0)
         return -1;
@@ -784,6 +786,19 @@ static void warn_unused(Rib *r, const Param *p, size_t n)
     }
 }
 
+/* The primitive's "Cs" when it is one colour per value; NULL otherwise. */
+static const Param *color_param(Rib *r, const Param *p, size_t n)
+{
+    const Param *cs = find_param(p, n, "Cs");
+    if (!cs || !cs->declared)
+        return NULL;
+    if (type_size(cs->d.ty) != 3 || cs->d.array != 1 || cs->d.ty == TY_STRING) {
+        warn_once(r, "Cs type", "\"Cs\" that is not one colour per value is ignored");
+        return NULL;
+    }
+    return cs;
+}
+
 /* ---------------------------------------------------------- emission */
 
 static const IoSink *out_sink(Rib *r, SinkState **st)
@@ -964,7 +979,7 @@ typedef struct Polys {
 static int emit_polys(Rib *r, const Polys *g, const float *P, size_t n_points, const Param *par,
                       size_t n_par)
 {
-    const Param *cs = find_param(par, n_par, "Cs");
+    const Param *cs = color_param(r, par, n_par);
     int per_face = cs && cs->declared && cs->d.cls != CLS_CONSTANT;
     int flip = flip_of(r);
     float L_one[3];
@@ -1641,8 +1656,7 @@ static int h_light_source(Rib *r, const Args *a)
     char handle[64];
     if (!name)
         return -1;
-    if (i < a->n && (a->v[i].kind == ARG_NUM || (a->v[i].kind == ARG_STR && i + 1 < a->n &&
-                                                  a->v[i + 1].kind == ARG_STR))) {
+    if (i < a->n && (a->n - i) % 2 == 1) { /* parameters come in pairs: the odd one out */
         if (get_handle(r, a, &i, handle) != 0)
             return -1;
     } else {
@@ -1687,14 +1701,14 @@ static int h_light_source(Rib *r, const Args *a)
     if (L && L->on && !L->used) {
         /* redefined before any geometry saw it: replace */
     } else {
+        if (L)
+            L->handle[0] = '\0'; /* the old one keeps lighting; the handle moves on */
         Light *nl = realloc(r->lights, (r->n_lights + 1) * sizeof *nl);
         if (!nl) {
             free(p);
             return rib_error(r, "out of memory");
         }
         r->lights = nl;
-        if (L)
-            L->handle[0] = '\0'; /* the old one keeps lighting; the handle moves on */
         L = &r->lights[r->n_lights++];
     }
     memset(L, 0, sizeof *L);
@@ -1744,8 +1758,7 @@ static int h_area_light(Rib *r, const Args *a)
     char handle[64];
     if (!name)
         return -1;
-    if (i < a->n && (a->v[i].kind == ARG_NUM ||
-                     (a->v[i].kind == ARG_STR && i + 1 < a->n && a->v[i + 1].kind == ARG_STR)))
+    if (i < a->n && (a->n - i) % 2 == 1)
         if (get_handle(r, a, &i, handle) != 0)
             return -1;
     Param *p;
@@ -2107,7 +2120,7 @@ static int h_patch(Rib *r, const Args *a)
         static const size_t corners[4] = {0, 1, 2, 3};
         static const size_t all[16] = {0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15};
         float col[3];
-        const float *Cs = patch_color(r, find_param(p, n, "Cs"), 0, corners, 4, all, want, col);
+        const float *Cs = patch_color(r, color_param(r, p, n), 0, corners, 4, all, want, col);
         if (cubic) {
             float B[16][3];
             rib_basis_to_bezier(r->a.ubasis, r->a.vbasis, (const float(*)[3])P, B);
@@ -2180,7 +2193,7 @@ static int h_patch_mesh(Rib *r, const Args *a)
         e = check_counts(r, p, n, &c);
     if (e == 0)
         warn_unused(r, p, n);
-    const Param *cs = find_param(p, n, "Cs");
+    const Param *cs = color_param(r, p, n);
     for (long pv = 0; e == 0 && pv < nvp; pv++)
         for (long pu = 0; e == 0 && pu < nup; pu++) {
             size_t vi[4] = {(size_t)(pv * nuvar + pu), (size_t)(pv * nuvar + (pu + 1) % nuvar),
@@ -2268,7 +2281,7 @@ static int h_quadric(Rib *r, const Args *a)
         warn_unused(r, p, n);
         static const size_t corners[4] = {0, 1, 2, 3};
         float col[3];
-        const float *Cs = patch_color(r, find_param(p, n, "Cs"), 0, corners, 4, corners, 4, col);
+        const float *Cs = patch_color(r, color_param(r, p, n), 0, corners, 4, corners, 4, col);
         e = emit_begin(r, Cs);
         if (e == 0) {
             SinkState *st;
@@ -2416,12 +2429,12 @@ static int h_object_instance(Rib *r, const Args *a)
 
 static int run(Rib *r, const char *name, const unsigned char *data, size_t size);
 
+/* Archives must be regular files (not devices or pipes, which could
+ * stream forever). */
 static int file_exists(const char *path)
 {
-    FILE *f = fopen(path, "rb");
-    if (f)
-        fclose(f);
-    return f != NULL;
+    struct stat st;
+    return stat(path, &st) == 0 && S_ISREG(st.st_mode);
 }
 
 static int read_archive(Rib *r, const char *name)
@@ -2451,6 +2464,9 @@ static int read_archive(Rib *r, const char *name)
     }
     char err[600];
     size_t size;
+    if (!file_exists(path))
+        return rib_error(r, "archive \"%s\": not found (as %s, nor on the archive search path)",
+                         name, path);
     unsigned char *data = read_gz(path, &size, err, sizeof err);
     if (!data)
         return rib_error(r, "archive \"%s\": %s", name, err);
