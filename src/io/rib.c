@@ -713,10 +713,10 @@ static int get_params(Rib *r, const Args *a, size_t start, Param **out, size_t *
         }
         int str = q->v->kind == ARG_STR || q->v->kind == ARG_STRS;
         if (q->declared && (q->d.ty == TY_STRING) != str && q->v->n > 0) {
+            arg_error(r, q->v, "the parameter \"%s\" is declared %s but has %s values", q->d.name,
+                      q->d.ty == TY_STRING ? "string" : "numeric", str ? "string" : "numeric");
             free(p);
-            return arg_error(r, q->v, "the parameter \"%s\" is declared %s but has %s values",
-                             q->d.name, q->d.ty == TY_STRING ? "string" : "numeric",
-                             str ? "string" : "numeric");
+            return -1;
         }
     }
     *out = p;
@@ -1799,6 +1799,11 @@ static int flush_lights(Rib *r)
         Light *L = &r->lights[k];
         if (!L->used && !L->on)
             continue;
+        for (size_t i = 0; i < L->n; i++) { /* the array may have moved since */
+            L->params[i].name = L->names[i];
+            if (L->params[i].type == RAYES_PARAM_STRING)
+                L->params[i].string = L->category;
+        }
         if (s->set_transform(s->target, L->M) != RAYES_OK ||
             s->light(s->target, L->type, L->params, L->n) != RAYES_OK)
             return sink_failed(r, s);
@@ -2903,6 +2908,9 @@ RayesError io_rib_parse(const char *name, const unsigned char *data, size_t size
         rib_fini(&r);
     }
     free(inflated);
+    for (char *c = err; e != 0 && *c; c++) /* names from the file may hold newlines */
+        if ((unsigned char)*c < 0x20 || *c == 0x7f)
+            *c = '?';
     return e == 0 ? RAYES_OK : RAYES_ERROR_PARSE;
 }
 
