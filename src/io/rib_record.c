@@ -1,0 +1,276 @@
+/*
+ * io/rib_record.c — the sink that records an object definition
+ * (ObjectBegin ... ObjectEnd) for replay at each ObjectInstance
+ * (rib_internal.h). Calls are kept as a list of RibCall with deep copies of
+ * their arrays and strings; replay premultiplies transforms by the
+ * instance's world_from_instance.
+ */
+#include <stdlib.h>
+#include <string.h>
+
+#include "io/rib_internal.h"
+
+typedef enum CallKind {
+    CALL_TRANSFORM,
+    CALL_SHADER,
+    CALL_DISPLACEMENT,
+    CALL_DISPLACEMENT_BOUND,
+    CALL_SHADING_RATE,
+    CALL_BILINEAR,
+    CALL_BICUBIC,
+    CALL_MESH,
+    CALL_SPHERE,
+    CALL_QUADRIC,
+    CALL_AREA_LIGHT
+} CallKind;
+
+typedef struct RibCall {
+    CallKind kind;
+    char *name;          /* shader name */
+    RayesParam *params;  /* names and strings owned */
+    size_t n_params;
+    float *f;            /* floats: matrix, points, quadric params */
+    size_t n_f;
+    int *ints;           /* mesh: n_verts then indices */
+    size_t n_faces, n_idx;
+    unsigned flags;      /* quadric type << 8 | flags */
+} RibCall;
+
+struct RibRecording {
+    RibCall *calls;
+    size_t n, cap;
+};
+
+RibRecording *rib_recording_new(void)
+{
+    return calloc(1, sizeof(RibRecording));
+}
+
+static void call_fini(RibCall *c)
+{
+    free(c->name);
+    for (size_t i = 0; i < c->n_params; i++) {
+        free((char *)c->params[i].name);
+        free((char *)c->params[i].string);
+    }
+    free(c->params);
+    free(c->f);
+    free(c->ints);
+}
+
+void rib_recording_free(RibRecording *rec)
+{
+    if (!rec)
+        return;
+    for (size_t i = 0; i < rec->n; i++)
+        call_fini(&rec->calls[i]);
+    free(rec->calls);
+    free(rec);
+}
+
+static RibCall *push(RibRecording *rec, CallKind kind)
+{
+    if (rec->n == rec->cap) {
+        size_t cap = rec->cap ? 2 * rec->cap : 16;
+        RibCall *c = realloc(rec->calls, cap * sizeof *c);
+        if (!c)
+            return NULL;
+        rec->calls = c;
+        rec->cap = cap;
+    }
+    RibCall *c = &rec->calls[rec->n++];
+    memset(c, 0, sizeof *c);
+    c->kind = kind;
+    return c;
+}
+
+static char *dup_str(const char *s)
+{
+    if (!s)
+        return NULL;
+    size_t n = strlen(s) + 1;
+    char *d = malloc(n);
+    if (d)
+        memcpy(d, s, n);
+    return d;
+}
+
+static RayesError floats(RibRecording *rec, CallKind kind, const float *f, size_t n)
+{
+    RibCall *c = push(rec, kind);
+    if (!c)
+        return RAYES_ERROR_OUT_OF_MEMORY;
+    c->f = malloc((n ? n : 1) * sizeof *f);
+    if (!c->f) {
+        rec->n--;
+        return RAYES_ERROR_OUT_OF_MEMORY;
+    }
+    if (n)
+        memcpy(c->f, f, n * sizeof *f);
+    c->n_f = n;
+    return RAYES_OK;
+}
+
+static RayesError named(RibRecording *rec, CallKind kind, const char *name, const RayesParam *p,
+                        size_t n)
+{
+    RibCall *c = push(rec, kind);
+    if (!c)
+        return RAYES_ERROR_OUT_OF_MEMORY;
+    c->name = dup_str(name ? name : "");
+    c->params = calloc(n ? n : 1, sizeof *c->params);
+    if (!c->name || !c->params)
+        return RAYES_ERROR_OUT_OF_MEMORY; /* the call stays, freed with the recording */
+    for (size_t i = 0; i < n; i++) {
+        c->params[i] = p[i];
+        c->params[i].name = dup_str(p[i].name);
+        c->params[i].string = dup_str(p[i].string);
+        c->n_params++;
+    }
+    return RAYES_OK;
+}
+
+static RayesError rec_camera(void *t, const float *e, const float *a, const float *u, float f)
+{
+    (void)t, (void)e, (void)a, (void)u, (void)f;
+    return RAYES_OK;
+}
+static RayesError rec_camera_matrix(void *t, const float m[16], RayesProjection p, float f,
+                                    const float s[4])
+{
+    (void)t, (void)m, (void)p, (void)f, (void)s;
+    return RAYES_OK;
+}
+static RayesError rec_transform(void *t, const float m[16])
+{
+    return floats(t, CALL_TRANSFORM, m, 16);
+}
+static RayesError rec_shader(void *t, const char *name, const RayesParam *p, size_t n)
+{
+    return named(t, CALL_SHADER, name, p, n);
+}
+static RayesError rec_displacement(void *t, const char *name, const RayesParam *p, size_t n)
+{
+    return named(t, CALL_DISPLACEMENT, name, p, n);
+}
+static RayesError rec_bound(void *t, float b)
+{
+    return floats(t, CALL_DISPLACEMENT_BOUND, &b, 1);
+}
+static RayesError rec_search_path(void *t, const char *kind, const char *path)
+{
+    (void)t, (void)kind, (void)path;
+    return RAYES_OK;
+}
+static RayesError rec_rate(void *t, float r)
+{
+    return floats(t, CALL_SHADING_RATE, &r, 1);
+}
+static RayesError rec_bilinear(void *t, const float P[4][3])
+{
+    return floats(t, CALL_BILINEAR, &P[0][0], 12);
+}
+static RayesError rec_bicubic(void *t, const float P[16][3])
+{
+    return floats(t, CALL_BICUBIC, &P[0][0], 48);
+}
+static RayesError rec_mesh(void *t, size_t n_faces, const int *nv, const int *idx, size_t n_points,
+                           const float *P)
+{
+    RibRecording *rec = t;
+    size_t n_idx = 0;
+    for (size_t i = 0; i < n_faces; i++)
+        n_idx += (size_t)nv[i];
+    RayesError e = floats(rec, CALL_MESH, P, 3 * n_points);
+    if (e != RAYES_OK)
+        return e;
+    RibCall *c = &rec->calls[rec->n - 1];
+    c->ints = malloc((n_faces + n_idx + 1) * sizeof *c->ints);
+    if (!c->ints)
+        return RAYES_ERROR_OUT_OF_MEMORY;
+    memcpy(c->ints, nv, n_faces * sizeof *nv);
+    memcpy(c->ints + n_faces, idx, n_idx * sizeof *idx);
+    c->n_faces = n_faces;
+    c->n_idx = n_idx;
+    return RAYES_OK;
+}
+static RayesError rec_sphere(void *t, float r)
+{
+    return floats(t, CALL_SPHERE, &r, 1);
+}
+static RayesError rec_quadric(void *t, RayesQuadric type, const float *p, size_t n, unsigned flags)
+{
+    RibRecording *rec = t;
+    RayesError e = floats(rec, CALL_QUADRIC, p, n);
+    if (e == RAYES_OK)
+        rec->calls[rec->n - 1].flags = (unsigned)type << 8 | (flags & 0xff);
+    return e;
+}
+static RayesError rec_area_light(void *t, const float P[4][3], const float L[3])
+{
+    float f[15];
+    memcpy(f, &P[0][0], 12 * sizeof *f);
+    memcpy(f + 12, L, 3 * sizeof *f);
+    return floats(t, CALL_AREA_LIGHT, f, 15);
+}
+static RayesError rec_light(void *t, const char *type, const RayesParam *p, size_t n)
+{
+    (void)t, (void)type, (void)p, (void)n;
+    return RAYES_OK;
+}
+static const char *rec_error(void *t)
+{
+    (void)t;
+    return "out of memory while recording an object";
+}
+
+IoSink rib_recording_sink(RibRecording *rec)
+{
+    IoSink s = {rec,           rec_camera,   rec_camera_matrix, rec_transform,  rec_shader,
+                rec_displacement, rec_bound, rec_search_path,  rec_rate,       rec_bilinear,
+                rec_bicubic,   rec_mesh,     rec_sphere,        rec_quadric,    rec_area_light,
+                rec_light,     rec_error};
+    return s;
+}
+
+RayesError rib_recording_replay(const RibRecording *rec, const IoSink *out,
+                                const float world_from_instance[16])
+{
+    void *t = out->target;
+    RayesError e = RAYES_OK;
+    int placed = 0;
+    for (size_t i = 0; i < rec->n && e == RAYES_OK; i++) {
+        const RibCall *c = &rec->calls[i];
+        if (!placed && c->kind != CALL_TRANSFORM && c->kind >= CALL_BILINEAR) {
+            /* geometry before any transform: the instance's own */
+            e = out->set_transform(t, world_from_instance);
+            placed = 1;
+            if (e != RAYES_OK)
+                break;
+        }
+        switch (c->kind) {
+        case CALL_TRANSFORM: {
+            float m[16];
+            rib_mat_mul(world_from_instance, c->f, m);
+            e = out->set_transform(t, m);
+            placed = 1;
+            break;
+        }
+        case CALL_SHADER: e = out->set_shader(t, c->name, c->params, c->n_params); break;
+        case CALL_DISPLACEMENT: e = out->set_displacement(t, c->name, c->params, c->n_params); break;
+        case CALL_DISPLACEMENT_BOUND: e = out->set_displacement_bound(t, c->f[0]); break;
+        case CALL_SHADING_RATE: e = out->set_shading_rate(t, c->f[0]); break;
+        case CALL_BILINEAR: e = out->bilinear_patch(t, (const float(*)[3])c->f); break;
+        case CALL_BICUBIC: e = out->bicubic_patch(t, (const float(*)[3])c->f); break;
+        case CALL_MESH:
+            e = out->polygon_mesh(t, c->n_faces, c->ints, c->ints + c->n_faces, c->n_f / 3, c->f);
+            break;
+        case CALL_SPHERE: e = out->sphere(t, c->f[0]); break;
+        case CALL_QUADRIC:
+            e = out->quadric(t, (RayesQuadric)(c->flags >> 8), c->f, c->n_f, c->flags & 0xff);
+            break;
+        case CALL_AREA_LIGHT: e = out->area_light(t, (const float(*)[3])c->f, c->f + 12); break;
+        }
+    }
+    return e;
+}

@@ -1,0 +1,653 @@
+/*
+ * tests/io/test_rib.c — the RIB reader of io/rib.h against a recording
+ * IoSink stub: transforms and the camera matrix, parameter classes and
+ * value counts, the basis change of PatchMesh, binary RIB (encoded by hand
+ * here, with encoded requests and strings), gzip, frames, objects, errors
+ * naming file:line:col, and the Aqsis files of ../shared/data/scenes.
+ * Buffers are parsed from heap copies of exactly their size so
+ * AddressSanitizer sees any read past the end.
+ */
+#include <string.h>
+#include <zlib.h>
+
+#include "io/builtin.h"
+#include "io/rib.h"
+#include "io/rib_write.h"
+#include "rayes/rayes.h"
+#include "test.h"
+
+#ifndef RAYES_TEST_DATA
+#error "RAYES_TEST_DATA must name the shared data directory"
+#endif
+
+/* ------------------------------------------------------ recording stub */
+
+#define MAX_SHADERS 64
+
+typedef struct Rec {
+    int cameras;
+    float camera[16];
+    int projection;
+    float fov;
+    int have_screen;
+    float screen[4];
+    float M[16];           /* the last transform */
+    char shader[64];       /* the last shader */
+    float Cs[3];
+    int n_shader_calls;
+    int bilinear, bicubic, meshes, faces, tris, quads, quadrics, area_lights, lights;
+    float first_bicubic[16][3];
+    float last_mesh_P0[3];
+    float area_P[4][3];
+    unsigned quadric_flags;
+    int quadric_type;
+    char light_types[16][32];
+    float light_params[16][3]; /* first param value of each light */
+    char search[256];
+    /* per mesh: its colour and the x of its first point in world space */
+    float mesh_Cs[64][3];
+    float mesh_x[64];
+    int n_mesh_rec;
+} Rec;
+
+static Rec rec;
+
+static RayesError s_camera(void *t, const float *e, const float *a, const float *u, float f)
+{
+    (void)t, (void)e, (void)a, (void)u, (void)f;
+    return RAYES_OK;
+}
+static RayesError s_camera_matrix(void *t, const float m[16], RayesProjection p, float fov,
+                                  const float s[4])
+{
+    (void)t;
+    rec.cameras++;
+    memcpy(rec.camera, m, sizeof rec.camera);
+    rec.projection = (int)p;
+    rec.fov = fov;
+    rec.have_screen = s != NULL;
+    if (s)
+        memcpy(rec.screen, s, sizeof rec.screen);
+    return RAYES_OK;
+}
+static RayesError s_transform(void *t, const float m[16])
+{
+    (void)t;
+    memcpy(rec.M, m, sizeof rec.M);
+    return RAYES_OK;
+}
+static RayesError s_shader(void *t, const char *name, const RayesParam *p, size_t n)
+{
+    (void)t;
+    snprintf(rec.shader, sizeof rec.shader, "%s", name);
+    rec.n_shader_calls++;
+    for (size_t i = 0; i < n; i++)
+        if (strcmp(p[i].name, "Cs") == 0)
+            memcpy(rec.Cs, p[i].value, sizeof rec.Cs);
+    return RAYES_OK;
+}
+static RayesError s_displacement(void *t, const char *name, const RayesParam *p, size_t n)
+{
+    (void)t, (void)name, (void)p, (void)n;
+    return RAYES_OK;
+}
+static RayesError s_float(void *t, float f)
+{
+    (void)t, (void)f;
+    return RAYES_OK;
+}
+static RayesError s_search(void *t, const char *kind, const char *path)
+{
+    (void)t;
+    snprintf(rec.search, sizeof rec.search, "%s=%s", kind, path);
+    return RAYES_OK;
+}
+static RayesError s_bilinear(void *t, const float P[4][3])
+{
+    (void)t, (void)P;
+    rec.bilinear++;
+    return RAYES_OK;
+}
+static RayesError s_bicubic(void *t, const float P[16][3])
+{
+    (void)t;
+    if (rec.bicubic++ == 0)
+        memcpy(rec.first_bicubic, P, sizeof rec.first_bicubic);
+    return RAYES_OK;
+}
+static RayesError s_mesh(void *t, size_t nf, const int *nv, const int *idx, size_t np,
+                         const float *P)
+{
+    (void)t, (void)idx;
+    rec.meshes++;
+    rec.faces += (int)nf;
+    for (size_t f = 0; f < nf; f++) {
+        rec.tris += nv[f] == 3;
+        rec.quads += nv[f] == 4;
+    }
+    if (np)
+        memcpy(rec.last_mesh_P0, P, sizeof rec.last_mesh_P0);
+    if (rec.n_mesh_rec < 64 && np) {
+        memcpy(rec.mesh_Cs[rec.n_mesh_rec], rec.Cs, sizeof rec.Cs);
+        const float *m = rec.M, *p = &P[3 * idx[0]];
+        rec.mesh_x[rec.n_mesh_rec++] = m[0] * p[0] + m[1] * p[1] + m[2] * p[2] + m[3];
+    }
+    return RAYES_OK;
+}
+static RayesError s_quadric(void *t, RayesQuadric q, const float *p, size_t n, unsigned flags)
+{
+    (void)t, (void)p, (void)n;
+    rec.quadrics++;
+    rec.quadric_type = (int)q;
+    rec.quadric_flags = flags;
+    return RAYES_OK;
+}
+static RayesError s_sphere(void *t, float r)
+{
+    (void)t, (void)r;
+    rec.quadrics++;
+    return RAYES_OK;
+}
+static RayesError s_area(void *t, const float P[4][3], const float L[3])
+{
+    (void)t, (void)L;
+    rec.area_lights++;
+    memcpy(rec.area_P, P, sizeof rec.area_P);
+    return RAYES_OK;
+}
+static RayesError s_light(void *t, const char *type, const RayesParam *p, size_t n)
+{
+    (void)t;
+    if (rec.lights < 16) {
+        snprintf(rec.light_types[rec.lights], 32, "%s", type);
+        if (n)
+            memcpy(rec.light_params[rec.lights], p[0].value, sizeof rec.light_params[0]);
+    }
+    rec.lights++;
+    return RAYES_OK;
+}
+static const char *s_error(void *t)
+{
+    (void)t;
+    return "";
+}
+
+static const IoSink stub = {NULL,      s_camera,  s_camera_matrix, s_transform, s_shader,
+                            s_displacement, s_float, s_search,     s_float,     s_bilinear,
+                            s_bicubic, s_mesh,    s_sphere,        s_quadric,   s_area,
+                            s_light,   s_error};
+
+static IoSettings settings;
+static char err[1024];
+
+static RayesError parse_n(const char *name, const void *data, size_t size, int frame)
+{
+    memset(&rec, 0, sizeof rec);
+    io_settings_init(&settings);
+    unsigned char *copy = malloc(size ? size : 1);
+    memcpy(copy, data, size);
+    IoReadOptions opt = {RAYES_TEST_DATA, frame};
+    err[0] = '\0';
+    RayesError e = io_rib_parse(name, copy, size, &stub, &opt, &settings, err, sizeof err);
+    free(copy);
+    return e;
+}
+
+static RayesError parse(const char *text)
+{
+    return parse_n("t.rib", text, strlen(text), -1);
+}
+
+static RayesError read_file(const char *rel, int frame)
+{
+    memset(&rec, 0, sizeof rec);
+    io_settings_init(&settings);
+    char path[1024];
+    snprintf(path, sizeof path, "%s/scenes/rib-aqsis/%s", RAYES_TEST_DATA, rel);
+    IoReadOptions opt = {RAYES_TEST_DATA, frame};
+    err[0] = '\0';
+    RayesError e = io_rib_read(path, &stub, &opt, &settings, err, sizeof err);
+    if (e != RAYES_OK)
+        fprintf(stderr, "%s: %s\n", rel, err);
+    return e;
+}
+
+/* --------------------------------------------------------------- tests */
+
+#define WORLD(body) "Projection \"perspective\" \"fov\" 40\nWorldBegin\n" body "\nWorldEnd\n"
+
+static void test_camera_and_transforms(void)
+{
+    CHECK(parse("Format 320 240 1\nProjection \"perspective\" \"fov\" [30]\n"
+                "Translate 0 0 5\nRotate 90 0 1 0\n"
+                "WorldBegin\nTranslate 1 2 3\nScale 2 2 2\n"
+                "Polygon \"P\" [0 0 0 1 0 0 1 1 0]\nWorldEnd\n") == RAYES_OK);
+    CHECK(rec.cameras == 1);
+    CHECK(rec.projection == RAYES_PROJECTION_PERSPECTIVE);
+    CHECK_NEAR(rec.fov, 30, 1e-6);
+    CHECK(!rec.have_screen);
+    /* camera_from_world = T(0,0,5) R_y(90): world x goes to camera -z */
+    CHECK_NEAR(rec.camera[3], 0, 1e-6);
+    CHECK_NEAR(rec.camera[11], 5, 1e-6);
+    CHECK_NEAR(rec.camera[8], -1, 1e-6); /* row z, column x */
+    CHECK_NEAR(rec.camera[2], 1, 1e-6);
+    /* world_from_object = T(1,2,3) S(2) */
+    CHECK_NEAR(rec.M[0], 2, 1e-6);
+    CHECK_NEAR(rec.M[3], 1, 1e-6);
+    CHECK_NEAR(rec.M[7], 2, 1e-6);
+    CHECK_NEAR(rec.M[11], 3, 1e-6);
+    CHECK(rec.tris == 1);
+    CHECK(settings.width == 320 && settings.height == 240);
+
+    /* ConcatTransform takes RIB's row-vector matrices (translation last) */
+    CHECK(parse(WORLD("ConcatTransform [1 0 0 0 0 1 0 0 0 0 1 0 4 5 6 1]\n"
+                      "TransformBegin\nTranslate 1 0 0\nTransformEnd\n"
+                      "Sphere 1 -1 1 360")) == RAYES_OK);
+    CHECK_NEAR(rec.M[3], 4, 1e-6);
+    CHECK_NEAR(rec.M[7], 5, 1e-6);
+    CHECK_NEAR(rec.M[11], 6, 1e-6);
+    CHECK(rec.quadrics == 1 && rec.quadric_type == RAYES_QUADRIC_SPHERE);
+    CHECK(rec.quadric_flags == 0);
+    CHECK(parse(WORLD("ReverseOrientation\nDisk 0 1 360")) == RAYES_OK);
+    CHECK(rec.quadric_flags == RAYES_QUADRIC_REVERSE);
+    CHECK(parse(WORLD("Scale -1 1 1\nCylinder 1 0 1 360")) == RAYES_OK);
+    CHECK(rec.quadric_flags == RAYES_QUADRIC_REVERSE);
+
+    CHECK(parse("ScreenWindow -1 1 -0.5 0.5\nProjection \"orthographic\"\n"
+                "WorldBegin\nWorldEnd\n") == RAYES_OK);
+    CHECK(rec.projection == RAYES_PROJECTION_ORTHOGRAPHIC && rec.have_screen);
+    CHECK_NEAR(rec.screen[2], -0.5, 1e-6);
+}
+
+static void test_settings(void)
+{
+    CHECK(parse("PixelSamples 2 3\nPixelFilter \"gaussian\" 2 2\nExposure 1.5 2.2\n"
+                "CropWindow 0 0.5 0.25 1\nDisplay \"a.exr\" \"openexr\" \"rgba\"\n"
+                "Display \"+b.png\" \"png\" \"rgb\"\nClipping 0.1 100\nQuantize \"rgba\" 255 0 255 0.5\n"
+                "PixelVariance 0.01\nWorldBegin\nWorldEnd\n") == RAYES_OK);
+    CHECK(settings.spp == 6);
+    CHECK(settings.filter == RAYES_FILTER_GAUSSIAN);
+    CHECK_NEAR(settings.filter_width, 2, 0);
+    CHECK_NEAR(settings.exposure_gamma, 2.2, 1e-6);
+    CHECK_NEAR(settings.crop[1], 0.5, 0);
+    CHECK(settings.n_displays == 2);
+    CHECK(strcmp(settings.displays[1].name, "b.png") == 0);
+    CHECK(strcmp(settings.displays[0].type, "openexr") == 0);
+    CHECK(parse("PixelFilter \"sinc\" 3 3\nWorldBegin\nWorldEnd\n") == RAYES_OK);
+    CHECK(settings.filter == RAYES_FILTER_GAUSSIAN);
+}
+
+static void test_shaders_and_lights(void)
+{
+    CHECK(parse(WORLD("LightSource \"spotlight\" 1 \"coneangle\" 0.5 \"intensity\" 3\n"
+                      "LightSource \"ambientlight\" \"amb\" \"intensity\" 0.1\n"
+                      "LightSource \"weird\" 3\n"
+                      "Color [1 0 0]\nSurface \"plastic\" \"Ks\" 0.3\n"
+                      "Polygon \"P\" [0 0 0 1 0 0 1 1 0 0 1 0]\n"
+                      "Surface \"indirect\" \"Kd\" 0.8\nPolygon \"P\" [0 0 0 1 0 0 1 1 0]")) ==
+          RAYES_OK);
+    CHECK(rec.lights == 2);
+    CHECK(strcmp(rec.light_types[0], "spotlight") == 0);
+    CHECK_NEAR(rec.light_params[0][0], 0.5 * 180 / M_PI, 1e-3); /* radians to degrees */
+    CHECK(strcmp(rec.light_types[1], "ambientlight") == 0);
+    CHECK(strcmp(rec.shader, "matte") == 0); /* the unknown shader falls back */
+    CHECK_NEAR(rec.Cs[0], 1, 0);
+    CHECK_NEAR(rec.Cs[1], 0, 0);
+    CHECK(rec.quads == 1 && rec.tris == 1);
+    /* Illuminate off before any geometry: the light is not sent */
+    CHECK(parse(WORLD("LightSource \"pointlight\" 1\nIlluminate 1 0\n"
+                      "Polygon \"P\" [0 0 0 1 0 0 1 1 0]")) == RAYES_OK);
+    CHECK(rec.lights == 0);
+    CHECK(parse(WORLD("AttributeBegin\nAreaLightSource \"arealight\" 1 \"intensity\" 2\n"
+                      "Polygon \"P\" [0 0 0 1 0 0 1 1 0 0 1 0]\nAttributeEnd\n"
+                      "Polygon \"P\" [0 0 0 1 0 0 1 1 0 0 1 0]")) == RAYES_OK);
+    CHECK(rec.area_lights == 1 && rec.quads == 1);
+    CHECK(parse("Option \"searchpath\" \"shader\" [\"mine:&\"]\nWorldBegin\nWorldEnd\n") ==
+          RAYES_OK);
+    CHECK(strcmp(rec.search, "shader=mine:&") == 0);
+}
+
+static void test_parameter_classes(void)
+{
+    /* uniform Cs: one colour per face, sent per face */
+    CHECK(parse(WORLD("PointsPolygons [3 3] [0 1 2 0 2 3] \"P\" [0 0 0 1 0 0 1 1 0 0 1 0]\n"
+                      "\"uniform color Cs\" [1 0 0 0 1 0]")) == RAYES_OK);
+    CHECK(rec.meshes == 2);
+    CHECK_NEAR(rec.mesh_Cs[0][0], 1, 0);
+    CHECK_NEAR(rec.mesh_Cs[1][1], 1, 0);
+    /* vertex Cs: averaged per face */
+    CHECK(parse(WORLD("Polygon \"P\" [0 0 0 1 0 0 1 1 0] \"vertex color Cs\" [1 0 0 0 1 0 0 0 1]")) ==
+          RAYES_OK);
+    CHECK_NEAR(rec.mesh_Cs[0][2], 1 / 3.0, 1e-6);
+    /* facevarying float[2] st: 2 values per face corner */
+    CHECK(parse(WORLD("Declare \"foo\" \"facevarying float[2]\"\n"
+                      "PointsPolygons [3] [0 1 2] \"P\" [0 0 0 1 0 0 1 1 0] \"foo\" [0 0 1 0 1 1]")) ==
+          RAYES_OK);
+    /* wrong counts are errors naming file:line:col */
+    CHECK(parse("WorldBegin\nPolygon \"P\" [0 0 0 1 0 0 1 1 0]\n  \"varying float s\" [0 1]\n"
+                "WorldEnd\n") == RAYES_ERROR_PARSE);
+    CHECK(strstr(err, "t.rib:3:21:") != NULL);
+    CHECK(strstr(err, "needs 3 values") != NULL);
+    CHECK(parse("WorldBegin\nPointsPolygons [3 3] [0 1 2 0 2 3] \"P\" [0 0 0 1 0 0 1 1 0 0 1 0] "
+                "\"uniform color Cs\" [1 0 0]\nWorldEnd\n") == RAYES_ERROR_PARSE);
+    CHECK(strstr(err, "t.rib:2:") != NULL);
+    CHECK(parse("WorldBegin\nPatch \"bilinear\" \"P\" [0 0 0 1 0 0 0 1 0]\nWorldEnd\n") ==
+          RAYES_ERROR_PARSE);
+    CHECK(strstr(err, "needs 4 points") != NULL);
+}
+
+static void test_polygons(void)
+{
+    /* a concave hexagon: ear clipped into 4 triangles; a square with a hole */
+    CHECK(parse(WORLD("Polygon \"P\" [0 0 0 4 0 0 4 4 0 2 1 0 0 4 0 0 2 0]")) == RAYES_OK);
+    CHECK(rec.tris == 4 && rec.quads == 0);
+    CHECK(parse(WORLD("GeneralPolygon [4 4] \"P\" [0 0 0 4 0 0 4 4 0 0 4 0 "
+                      "1 1 0 3 1 0 3 3 0 1 3 0]")) == RAYES_OK);
+    CHECK(rec.tris == 8);
+    /* a non-planar quad is split */
+    CHECK(parse(WORLD("Polygon \"P\" [0 0 0 1 0 0 1 1 1 0 1 0]")) == RAYES_OK);
+    CHECK(rec.tris == 2);
+    CHECK(parse(WORLD("PointsGeneralPolygons [1 2] [3 4 3] [0 1 2 3 4 5 6 7 8 9] "
+                      "\"P\" [0 0 0 1 0 0 1 1 0 0 0 1 4 0 1 4 4 1 0 4 1 1 1 1 3 1 1 2 3 1]")) ==
+          RAYES_OK);
+    CHECK(rec.tris == 1 + 7);
+}
+
+static void test_patch_mesh_bases(void)
+{
+    /* A uniform b-spline over collinear, evenly spaced points is the same
+     * line: its Bezier points are evenly spaced over the middle third. */
+    const char *bspline =
+        WORLD("Basis \"b-spline\" 1 \"b-spline\" 1\n"
+              "PatchMesh \"bicubic\" 4 \"nonperiodic\" 4 \"nonperiodic\" \"P\" ["
+              "0 0 0 3 0 0 6 0 0 9 0 0  0 3 0 3 3 0 6 3 0 9 3 0 "
+              "0 6 0 3 6 0 6 6 0 9 6 0  0 9 0 3 9 0 6 9 0 9 9 0]");
+    CHECK(parse(bspline) == RAYES_OK);
+    CHECK(rec.bicubic == 1);
+    for (int i = 0; i < 4; i++) {
+        CHECK_NEAR(rec.first_bicubic[i][0], 3 + i, 1e-5);
+        CHECK_NEAR(rec.first_bicubic[4 * i][1], 3 + i, 1e-5);
+    }
+    /* b-spline with a known non-linear window: P = 0 6 0 0 gives Bezier
+     * points (0+24+0)/6=4, (4*6+2*0)/6=4, (2*6+4*0)/6=2, (6+0+0)/6... */
+    CHECK(parse(WORLD("Basis \"b-spline\" 1 \"bezier\" 3\n"
+                      "PatchMesh \"bicubic\" 4 \"nonperiodic\" 4 \"nonperiodic\" \"P\" ["
+                      "0 0 0 1 6 0 2 0 0 3 0 0  0 0 1 1 6 1 2 0 1 3 0 1 "
+                      "0 0 2 1 6 2 2 0 2 3 0 2  0 0 3 1 6 3 2 0 3 3 0 3]")) == RAYES_OK);
+    /* B-spline points y = 0 6 0 0: b0 = (0 + 24 + 0)/6 = 4, b1 = (4*6 + 2*0)/6 = 4,
+     * b2 = (2*6 + 4*0)/6 = 2, b3 = (6 + 0 + 0)/6 = 1 */
+    CHECK_NEAR(rec.first_bicubic[0][1], 4, 1e-5);
+    CHECK_NEAR(rec.first_bicubic[1][1], 4, 1e-5);
+    CHECK_NEAR(rec.first_bicubic[2][1], 2, 1e-5);
+    CHECK_NEAR(rec.first_bicubic[3][1], 1, 1e-5);
+    /* periodic catmull-rom 4 x 4, step 1: 4 x 4 patches; bezier 7 x 4: 2 x 1 */
+    CHECK(parse(WORLD("Basis \"catmull-rom\" 1 \"catmull-rom\" 1\n"
+                      "PatchMesh \"bicubic\" 4 \"periodic\" 4 \"periodic\" \"P\" ["
+                      "0 0 0 1 0 0 1 1 0 0 1 0  0 0 1 1 0 1 1 1 1 0 1 1 "
+                      "0 0 2 1 0 2 1 1 2 0 1 2  0 0 3 1 0 3 1 1 3 0 1 3]")) == RAYES_OK);
+    CHECK(rec.bicubic == 16);
+    CHECK(parse(WORLD("PatchMesh \"bilinear\" 3 \"nonperiodic\" 2 \"nonperiodic\" \"P\" ["
+                      "0 0 0 1 0 0 2 0 0 0 1 0 1 1 0 2 1 0] \"varying color Cs\" [1 0 0 1 0 0 "
+                      "1 0 0 1 0 0 1 0 0 1 0 0]")) == RAYES_OK);
+    CHECK(rec.bilinear == 2);
+    /* an explicit matrix equal to the Bezier basis, step 3 */
+    CHECK(parse(WORLD("Basis [-1 3 -3 1 3 -6 3 0 -3 3 0 0 1 0 0 0] 3 \"bezier\" 3\n"
+                      "Patch \"bicubic\" \"P\" [0 0 0 1 0 0 2 0 0 3 0 0  0 1 0 1 1 0 2 1 0 3 1 0 "
+                      "0 2 0 1 2 0 2 2 0 3 2 0  0 3 0 1 3 0 2 3 0 3 3 0]")) == RAYES_OK);
+    CHECK_NEAR(rec.first_bicubic[5][0], 1, 1e-5);
+    CHECK_NEAR(rec.first_bicubic[5][1], 1, 1e-5);
+}
+
+static void test_objects_and_frames(void)
+{
+    CHECK(parse(WORLD("ObjectBegin \"box\"\nTranslate 1 0 0\nPolygon \"P\" [0 0 0 1 0 0 1 1 0]\n"
+                      "ObjectEnd\nTranslate 10 0 0\nObjectInstance \"box\"\n"
+                      "Translate 10 0 0\nObjectInstance \"box\"")) == RAYES_OK);
+    CHECK(rec.meshes == 2);
+    CHECK_NEAR(rec.mesh_x[0], 11, 1e-5);
+    CHECK_NEAR(rec.mesh_x[1], 21, 1e-5);
+    const char *frames = "FrameBegin 1\nDisplay \"a.shad\" \"zfile\" \"z\"\nWorldBegin\n"
+                         "Sphere 1 -1 1 360\nWorldEnd\nFrameEnd\n"
+                         "FrameBegin 2\nDisplay \"b.tif\" \"file\" \"rgb\"\nWorldBegin\n"
+                         "Polygon \"P\" [0 0 0 1 0 0 1 1 0]\nWorldEnd\nFrameEnd\n"
+                         "FrameBegin 3\nDisplay \"c.shad\" \"shadow\" \"z\"\nWorldBegin\n"
+                         "Disk 0 1 360\nWorldEnd\nFrameEnd\n";
+    CHECK(parse_n("f.rib", frames, strlen(frames), -1) == RAYES_OK);
+    CHECK(rec.meshes == 1 && rec.quadrics == 0 && rec.cameras == 1);
+    CHECK(settings.n_displays == 1 && strcmp(settings.displays[0].name, "b.tif") == 0);
+    CHECK(parse_n("f.rib", frames, strlen(frames), 3) == RAYES_OK);
+    CHECK(rec.meshes == 0 && rec.quadrics == 1);
+    CHECK(parse_n("f.rib", frames, strlen(frames), 7) == RAYES_ERROR_PARSE);
+    CHECK(strstr(err, "no frame 7") != NULL);
+}
+
+/* A small binary stream, encoded by hand (RISpec Appendix C.2). */
+static void test_binary(void)
+{
+    static const unsigned char bin[] = {
+        0314, 1, 0232, 'W', 'o', 'r', 'l', 'd', 'B', 'e', 'g', 'i', 'n', /* request 1 */
+        0314, 2, 0227, 'P', 'o', 'l', 'y', 'g', 'o', 'n',                /* request 2 */
+        0315, 7, 0221, 'P',                                               /* string 7 = "P" */
+        'F', 'o', 'r', 'm', 'a', 't', ' ', 0200, 64, 0201, 0, 48, 0204, 1, '\n', /* 64 48 1/256 */
+        0246, 1, '\n',
+        'T', 'r', 'a', 'n', 's', 'l', 'a', 't', 'e', ' ', 0244, 0x3f, 0x80, 0, 0, /* 1.0f */
+        0245, 0x40, 0, 0, 0, 0, 0, 0, 0,                                  /* 2.0 */
+        0205, 0x01, 0x80,                                                 /* 1.5 */
+        '\n', 0246, 2, 0317, 7, 0310, 9,                                  /* Polygon "P" [9 floats] */
+        0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0,
+        0x3f, 0x80, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0,
+        0x3f, 0x80, 0, 0, 0x3f, 0x80, 0, 0, 0, 0, 0, 0,
+        'W', 'o', 'r', 'l', 'd', 'E', 'n', 'd', '\n'};
+    CHECK(parse_n("b.rib", bin, sizeof bin, -1) == RAYES_OK);
+    if (err[0])
+        fprintf(stderr, "%s\n", err);
+    CHECK(settings.width == 64 && settings.height == 48);
+    CHECK(rec.tris == 1);
+    CHECK_NEAR(rec.M[3], 1, 0);
+    CHECK_NEAR(rec.M[7], 2, 0);
+    CHECK_NEAR(rec.M[11], 1.5, 0);
+    CHECK_NEAR(rec.last_mesh_P0[0], 0, 0);
+    /* reserved codes, undefined requests and truncation are errors */
+    static const unsigned char reserved[] = {'W', 'o', 'r', 'l', 'd', 'B', 'e', 'g', 'i', 'n', ' ', 0250};
+    CHECK(parse_n("b.rib", reserved, sizeof reserved, -1) == RAYES_ERROR_PARSE);
+    CHECK(strstr(err, "b.rib:1:12: reserved") != NULL);
+    static const unsigned char undefined[] = {0246, 9};
+    CHECK(parse_n("b.rib", undefined, sizeof undefined, -1) == RAYES_ERROR_PARSE);
+    CHECK(strstr(err, "not defined") != NULL);
+    static const unsigned char truncated[] = {'S', 'i', 'd', 'e', 's', ' ', 0310, 9, 0, 0};
+    CHECK(parse_n("b.rib", truncated, sizeof truncated, -1) == RAYES_ERROR_PARSE);
+    static const unsigned char nested[] = {0314, 1, 0314, 2, 0220};
+    CHECK(parse_n("b.rib", nested, sizeof nested, -1) == RAYES_ERROR_PARSE);
+}
+
+static void test_gzip(void)
+{
+    const char *text = WORLD("Patch \"bilinear\" \"P\" [0 0 0 1 0 0 0 1 0 1 1 0]");
+    char path[1024];
+    snprintf(path, sizeof path, "%s/test_rib.rib.gz", RAYES_TEST_TMP);
+    gzFile f = gzopen(path, "wb");
+    CHECK(f != NULL);
+    if (!f)
+        return;
+    gzwrite(f, text, (unsigned)strlen(text));
+    gzclose(f);
+    memset(&rec, 0, sizeof rec);
+    IoReadOptions opt = {RAYES_TEST_DATA, -1};
+    io_settings_init(&settings);
+    CHECK(io_rib_read(path, &stub, &opt, &settings, err, sizeof err) == RAYES_OK);
+    CHECK(rec.bilinear == 1);
+    /* the same bytes from a buffer */
+    FILE *g = fopen(path, "rb");
+    unsigned char buf[4096];
+    size_t n = g ? fread(buf, 1, sizeof buf, g) : 0;
+    if (g)
+        fclose(g);
+    CHECK(parse_n("x.rib.gz", buf, n, -1) == RAYES_OK && rec.bilinear == 1);
+    CHECK(parse_n("x.rib.gz", buf, n / 2, -1) == RAYES_ERROR_PARSE);
+}
+
+static void test_errors(void)
+{
+    static const struct {
+        const char *text, *want;
+    } cases[] = {
+        {"WorldBegin\nFooBar 1 2\n", "t.rib:2:1: FooBar: unknown request"},
+        {"Translate 1 2\n", "t.rib:1:1: Translate: expected dx dy dz"},
+        {"Display \"x\" \"file\" \"rgb\n", "t.rib:1:20: the string has no closing"},
+        {"Color [1 0 \"a\"]\n", "t.rib:1:12: an array mixes"},
+        {"Format [1 2 3\n", "no closing ']'"},
+        {"Sides ]", "t.rib:1:7: ']' without '['"},
+        {"1 2 3", "t.rib:1:1: expected a request name"},
+        {"WorldBegin\nPolygon \"P\" [0 0 0 1 0 0]\n", "at least 3 points"},
+        {"WorldBegin\nPointsPolygons [3] [0 1 5] \"P\" [0 0 0 1 0 0 1 1 0]\n", "vertex index 5"},
+        {"ReadArchive \"no-such-file.rib\"\n", "t.rib:1:1: ReadArchive: archive"},
+        {"ObjectInstance 4\n", "no object has the handle 4"},
+        {"Surface \"matte\" \"uniform color Kd\" [1 1]\n", "needs 3 values"},
+        {"Surface \"matte\" \"Kd\"\n", "has no value"},
+        {"Format 1e999 1\n", "t.rib:1:8: expected a number"},
+        {"Basis \"nurbs\" 1 \"bezier\" 3\n", "unknown basis"},
+        {"PatchMesh \"bicubic\" 5 \"nonperiodic\" 4 \"nonperiodic\" \"P\" [0 0 0]\n",
+         "do not make whole patches"},
+        {"Attribute \"x\" \"float[0] y\" 1\n", "inline declaration"},
+        {"ObjectBegin 1\nSphere 1 -1 1 360\n", "inside an object definition"},
+        {"Polygon \x01", "unexpected character 0x01"},
+    };
+    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+        RayesError e = parse(cases[i].text);
+        CHECK(e != RAYES_OK);
+        if (!strstr(err, cases[i].want)) {
+            fprintf(stderr, "case %zu: got \"%s\", expected \"%s\"\n", i, err, cases[i].want);
+            CHECK(0);
+        }
+        CHECK(strchr(err, '\n') == NULL);
+    }
+    /* archive recursion is bounded */
+    char path[1024];
+    snprintf(path, sizeof path, "%s/test_rib_loop.rib", RAYES_TEST_TMP);
+    FILE *f = fopen(path, "w");
+    if (f) {
+        fputs("ReadArchive \"test_rib_loop.rib\"\n", f);
+        fclose(f);
+    }
+    IoReadOptions opt = {NULL, -1};
+    CHECK(io_rib_read(path, &stub, &opt, &settings, err, sizeof err) == RAYES_ERROR_PARSE);
+    CHECK(strstr(err, "nested more than") != NULL);
+}
+
+static void test_aqsis_files(void)
+{
+    static const char *const files[] = {
+        "cornellbox/all_passes.rib", "cornellbox/beauty_pass.rib", "cornellbox/bake_pass.rib",
+        "cornellbox/shadow_pass.rib", "cornellbox/geometry.rib", "cornellbox/lights.rib",
+        "vase/vase.rib", "archives/bike.rib", "xpm/teapotgeom.rib",
+        "objectinstance/singlepolygon.rib"};
+    for (size_t i = 0; i < sizeof files / sizeof files[0]; i++)
+        CHECK(read_file(files[i], -1) == RAYES_OK);
+
+    CHECK(read_file("archives/bike.rib", -1) == RAYES_OK);
+    CHECK(rec.bicubic == 5216);
+    CHECK(rec.lights == 4);
+    CHECK_NEAR(settings.exposure_gamma, 2.2, 1e-6);
+
+    CHECK(read_file("xpm/teapotgeom.rib", -1) == RAYES_OK);
+    CHECK(rec.bicubic == 32);
+    CHECK(rec.lights == 3);
+
+    /* the vase: its beauty frame (3) with 126 patches and the PatchMesh body */
+    CHECK(read_file("vase/vase.rib", -1) == RAYES_OK);
+    CHECK(settings.width == 480 && settings.height == 360);
+    CHECK(strcmp(settings.displays[0].name, "vase.tif") == 0);
+    CHECK(rec.lights == 5);
+    CHECK(rec.cameras == 1);
+    CHECK(rec.bicubic == 42 + 12 + 8 + 4 * 2); /* Patch, then PatchMesh 13x10, 13x7, 4 x (4x7) */
+
+    CHECK(read_file("objectinstance/singlepolygon.rib", -1) == RAYES_OK);
+    CHECK(rec.meshes >= 10);
+    CHECK(rec.have_screen);
+
+    /* The Cornell box seen from its camera: green on the left, red on the
+     * right. Camera x of each wall's first point tells the side. */
+    CHECK(read_file("cornellbox/all_passes.rib", -1) == RAYES_OK);
+    CHECK(rec.cameras == 1);
+    int red = 0, green = 0;
+    for (int i = 0; i < rec.n_mesh_rec; i++) {
+        const float *c = rec.mesh_Cs[i];
+        float x = rec.camera[0] * rec.mesh_x[i]; /* approximate: the camera has no rotation */
+        if (c[0] == 1 && c[1] == 0 && c[2] == 0)
+            red += x > 0 ? 1 : -100;
+        if (c[0] == 0 && c[1] == 1 && c[2] == 0)
+            green += x < 0 ? 1 : -100;
+    }
+    CHECK(red == 1 && green == 1);
+    CHECK(strcmp(settings.displays[0].name, "cornellbox.tif") == 0);
+}
+
+/* Through the real scene sink: the files build scenes the API accepts. */
+static void test_scene_sink(void)
+{
+    static const char *const files[] = {"xpm/teapotgeom.rib", "cornellbox/all_passes.rib",
+                                        "objectinstance/singlepolygon.rib"};
+    for (size_t i = 0; i < sizeof files / sizeof files[0]; i++) {
+        RayesScene *scene = rayes_scene_new();
+        IoSink sink = io_sink_scene(scene);
+        char path[1024];
+        snprintf(path, sizeof path, "%s/scenes/rib-aqsis/%s", RAYES_TEST_DATA, files[i]);
+        IoReadOptions opt = {RAYES_TEST_DATA, -1};
+        io_settings_init(&settings);
+        RayesError e = io_rib_read(path, &sink, &opt, &settings, err, sizeof err);
+        if (e != RAYES_OK)
+            fprintf(stderr, "%s: %s\n", files[i], err);
+        CHECK(e == RAYES_OK);
+        CHECK(rayes_scene_commit(scene) == RAYES_OK);
+        rayes_scene_release(scene);
+    }
+}
+
+/* Round trip: each built-in scene, written as RIB by io/rib_write.h, reads
+ * back into the same patches, faces, quadrics and lights. */
+static void test_writer_round_trip(void)
+{
+    for (int i = 0; io_builtin_scene_names[i]; i++) {
+        const char *name = io_builtin_scene_names[i];
+        memset(&rec, 0, sizeof rec);
+        if (io_builtin_scene(name, RAYES_TEST_DATA, &stub, err, sizeof err) != RAYES_OK) {
+            fprintf(stderr, "%s: %s\n", name, err);
+            CHECK(0);
+            continue;
+        }
+        Rec direct = rec;
+        RibWriter *w = io_rib_writer_new();
+        IoSink ws = io_rib_writer_sink(w);
+        char path[1024];
+        snprintf(path, sizeof path, "%s/test_rib_%s.rib", RAYES_TEST_TMP, name);
+        FILE *f = fopen(path, "w");
+        CHECK(f != NULL);
+        if (!f) {
+            io_rib_writer_free(w);
+            continue;
+        }
+        CHECK(io_builtin_scene(name, RAYES_TEST_DATA, &ws, err, sizeof err) == RAYES_OK);
+        CHECK(io_rib_writer_finish(w, NULL, f, err, sizeof err) == RAYES_OK);
+        fclose(f);
+        io_rib_writer_free(w);
+        memset(&rec, 0, sizeof rec);
+        IoReadOptions opt = {RAYES_TEST_DATA, -1};
+        io_settings_init(&settings);
+        RayesError e = io_rib_read(path, &stub, &opt, &settings, err, sizeof err);
+        if (e != RAYES_OK)
+            fprintf(stderr, "%s: %s\n", name, err);
+        CHECK(e == RAYES_OK);
+        CHECK(rec.bicubic == direct.bicubic);
+        CHECK(rec.tris + 2 * rec.quads == direct.tris + 2 * direct.quads);
+        CHECK(rec.quadrics == direct.quadrics);
+        CHECK(rec.area_lights == direct.area_lights);
+        CHECK(rec.lights == direct.lights);
+        CHECK(rec.cameras == 1);
+    }
+}
+
+TEST_MAIN(TEST(test_camera_and_transforms), TEST(test_settings), TEST(test_shaders_and_lights),
+          TEST(test_parameter_classes), TEST(test_polygons), TEST(test_patch_mesh_bases),
+          TEST(test_objects_and_frames), TEST(test_binary), TEST(test_gzip), TEST(test_errors),
+          TEST(test_aqsis_files), TEST(test_scene_sink),
+          TEST(test_writer_round_trip))
