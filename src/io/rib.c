@@ -1865,6 +1865,15 @@ static int h_option_attribute(Rib *r, const Args *a)
         } else if (!option && strcmp(group, "displacementbound") == 0 &&
                    strcmp(q->d.name, "sphere") == 0 && is_num(q->v) && q->v->n == 1) {
             r->a.bound = (float)fabs(q->v->d[0]);
+        } else if (!option && strcmp(group, "trace") == 0 && is_num(q->v) && q->v->n == 1 &&
+                   (strcmp(q->d.name, "maxdiffusedepth") == 0 ||
+                    strcmp(q->d.name, "maxspeculardepth") == 0)) {
+            /* PRMan's ray depths; rayes has one per render, so the last wins */
+            int depth = q->v->d[0] < 0 ? 0 : q->v->d[0] > 1e6 ? 1000000 : (int)q->v->d[0];
+            if (q->d.name[3] == 'd')
+                r->settings->bounces = depth;
+            else
+                r->settings->specular_depth = depth;
         } else if (!option && strcmp(group, "identifier") == 0) {
             /* names are for messages only */
         } else if (!(!option && strcmp(group, "displacementbound") == 0)) {
