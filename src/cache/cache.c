@@ -44,8 +44,14 @@ struct CacheEntry {
     uint8_t ready;                /* values written */
     uint8_t resident;             /* in the hash table */
     uint8_t private_entry;        /* never in a table; freed by its only release */
-    uint16_t values[];            /* RGB halves, 3 * n_values */
+    /* followed by the values: RGB halves, 3 * n_values (entry_values); not a
+     * flexible array member, so that a Shard can embed its LRU sentinel */
 };
+
+static inline uint16_t *entry_values(CacheEntry *e)
+{
+    return (uint16_t *)(e + 1);
+}
 
 typedef struct Shard {
     pthread_mutex_t lock;
@@ -345,7 +351,7 @@ static void fill_entry(Cache *c, CacheEntry *e, CacheFillFn fill, void *user)
     fill(user, &e->key, n, tmp);
     for (size_t i = 0; i < n; i++)
         for (int k = 0; k < 3; k++)
-            e->values[3 * i + k] = half_from_float_clamped(tmp[i][k]);
+            entry_values(e)[3 * i + k] = half_from_float_clamped(tmp[i][k]);
     free(tmp);
     if (e->private_entry) { /* never shared: nobody can be waiting */
         e->ready = 1;
@@ -374,7 +380,7 @@ const uint16_t *cache_lookup(CacheLocal *local, const CacheKey *key, size_t n_va
     if (held && held->hash == hash && key_equal(&held->key, key) &&
         held->timestamp == cache_timestamp(c) && held->ready) {
         ctr->hits++; /* the lock-free path of coherent lookups */
-        return held->values;
+        return entry_values(held);
     }
     if (held) {
         *slot = NULL;
@@ -405,7 +411,7 @@ const uint16_t *cache_lookup(CacheLocal *local, const CacheKey *key, size_t n_va
     if (*slot)
         release(c, *slot);
     *slot = e;
-    return e->values;
+    return entry_values(e);
 }
 
 void cache_get_stats(const Cache *cc, CacheStats *st)
