@@ -146,7 +146,7 @@ typedef struct Light {
     char handle[64];
     char type[32];
     RayesParam params[RIB_LIGHT_PARAMS];
-    char names[RIB_LIGHT_PARAMS][32];
+    char names[RIB_LIGHT_PARAMS][64];
     char category[128];
     size_t n;
     float M[16];   /* world_from_light (camera_from_light before WorldBegin) */
