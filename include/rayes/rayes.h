@@ -247,6 +247,50 @@ RAYES_API RayesError rayes_scene_area_light(RayesScene *scene, const float P[4][
 RAYES_API RayesError rayes_scene_light(RayesScene *scene, const char *type,
                                        const RayesParam *params, size_t n_params);
 
+/* ---------------------------------------------------------------- edits
+ *
+ * Changes to a scene that has been rendered, for interactive preview (a
+ * progressive session, below, keeps what an edit leaves valid). Lights are
+ * numbered from 0 in the order they were made (rayes_scene_light and
+ * rayes_scene_area_light); objects likewise: every rayes_scene_set_shader
+ * makes one, and so does every light with a shape (its emitter). Edit only
+ * while no render or pass of the scene runs, then commit. */
+
+RAYES_API size_t rayes_scene_light_count(const RayesScene *scene);
+RAYES_API size_t rayes_scene_object_count(const RayesScene *scene);
+/* The surface shader class of an object ("" for a light's emitter or an
+ * index out of range); static or scene storage. */
+RAYES_API const char *rayes_scene_object_shader(const RayesScene *scene, size_t object);
+/* The light an object emits as, or -1. */
+RAYES_API int64_t rayes_scene_object_light(const RayesScene *scene, size_t object);
+
+/* Changes a light: "intensity" (FLOAT >= 0) and "lightcolor" (COLOR, or a
+ * FLOAT grey, >= 0) replace the values it was made with (a light made by
+ * rayes_scene_area_light has intensity 1 and lightcolor L); "translate"
+ * (COLOR, a world-space vector) moves it and its shape (not distant,
+ * ambient or environment lights, for which it does nothing). Any other
+ * parameter is RAYES_ERROR_INVALID_ARGUMENT, and nothing changes. */
+RAYES_API RayesError rayes_scene_edit_light(RayesScene *scene, size_t light,
+                                            const RayesParam *params, size_t n_params);
+
+/* Changes parameters of an object's surface shader (and its "Cs" and
+ * "Os"), as rayes_scene_set_shader takes them; the others keep their
+ * values. A name the shader lacks, or a wrong type, is
+ * RAYES_ERROR_INVALID_ARGUMENT, and nothing changes. */
+RAYES_API RayesError rayes_scene_edit_shader(RayesScene *scene, size_t object,
+                                             const RayesParam *params, size_t n_params);
+
+/* Where the camera is: the eye and camera space's axes x (right), y (up)
+ * and z (the view direction), in world space, each of the length of a unit
+ * of camera space. */
+RAYES_API RayesError rayes_scene_get_camera(const RayesScene *scene, float eye[3], float x[3],
+                                            float y[3], float z[3]);
+
+/* Moves the camera by a world-space motion m (row-major; rigid, possibly
+ * with a uniform scale): eye' = m eye, axes' = m axes. The projection, the
+ * field of view and the screen window stay. */
+RAYES_API RayesError rayes_scene_move_camera(RayesScene *scene, const float m[16]);
+
 /* Ends an edit: checks the scene and bumps its timestamp. Rendering an
  * uncommitted scene is RAYES_ERROR_INVALID_OPERATION. */
 RAYES_API RayesError rayes_scene_commit(RayesScene *scene);
@@ -273,6 +317,12 @@ typedef enum RayesHider {
     RAYES_HIDER_GRID = 1      /* lighting() once per vertex of every visible grid; camera
                                  hits interpolate the shaded grid (PRMan's REYES mode) */
 } RayesHider;
+
+/* A finished tile: the pixels [x, x + w) x [y, y + h) of rgba, whose rows
+ * are stride pixels apart (4 floats a pixel, linear, top row first). Called
+ * from worker threads, for different tiles at once; valid during the call. */
+typedef void (*RayesTileFn)(void *user, int x, int y, int w, int h, const float *rgba,
+                            int stride);
 
 /* Progress: fraction done in [0, 1]. Return nonzero to cancel the render.
  * Called from worker threads, one call at a time. */
@@ -309,6 +359,8 @@ typedef struct RayesRenderOptions {
     double texture_mb;         /* texture cache budget in megabytes (10^6 bytes), default 64 */
     float texture_width;       /* multiplies every texture filter width (RenderMan's "width"):
                                   default 1; 0 point-samples the finest MIP level */
+    RayesTileFn tile_done;     /* may be NULL: called as each tile of a render or pass ends */
+    void *tile_user;
 } RayesRenderOptions;
 
 /* Fills options with the defaults of a quality preset: 512 x 512, 4 pixel
@@ -362,6 +414,68 @@ RAYES_API RayesError rayes_render(RayesScene *scene, const RayesRenderOptions *o
                                   RayesImage **image, RayesStats **stats);
 
 RAYES_API void rayes_image_free(RayesImage *image);
+
+/* -------------------------------------------------- progressive session
+ *
+ * A session renders a committed scene in passes of one pixel sample each,
+ * accumulating, for interactive preview (rayes view). It keeps between
+ * passes what rayes_render rebuilds every time: the diced grids and the
+ * ray tracing structure, the radiosity cache, the texture cache and the
+ * film. Pass k takes pixel sample k of patterns of options->spp samples
+ * (then of further patterns), so with the box filter of width 1 the image
+ * after options->spp passes equals rayes_render's with options->spp
+ * samples, bit for bit.
+ *
+ * Edits: change the scene (edits above, or any other call) while no pass
+ * runs, commit, then rayes_session_update. A camera-only edit keeps the
+ * grids (diced for the camera the session was prepared with) and every
+ * cached radiosity entry, which does not depend on the view; light and
+ * shader edits keep the grids but bump the cache's timestamp, so entries
+ * filled before are never used again (they age out by LRU); anything else
+ * prepares the scene again, for its current camera. Either way the
+ * accumulation restarts.
+ *
+ * Threads: one thread drives a session; rayes_session_cancel may be called
+ * from any thread. The session holds a reference to its scene. */
+
+typedef struct RayesSession RayesSession;
+
+/* A session on a committed scene, prepared at once. options is copied
+ * (progress, if set, reports each pass's fraction). */
+RAYES_API RayesError rayes_session_new(RayesScene *scene, const RayesRenderOptions *options,
+                                       RayesSession **session);
+/* Frees a session; no pass may be running. NULL is ignored. */
+RAYES_API void rayes_session_free(RayesSession *session);
+
+/* Takes the scene's committed edits (see above) and restarts the
+ * accumulation. RAYES_ERROR_INVALID_OPERATION if the scene is uncommitted. */
+RAYES_API RayesError rayes_session_update(RayesSession *session);
+
+/* Renders one pass (one more sample in every pixel), calling
+ * options->tile_done as tiles finish. RAYES_ERROR_CANCELLED if cancelled:
+ * the accumulation is then discarded, and the next pass starts over. */
+RAYES_API RayesError rayes_session_render_pass(RayesSession *session);
+
+/* Makes the running pass, or the next one if none runs, stop as soon as
+ * its running tiles finish and return RAYES_ERROR_CANCELLED. Thread-safe. */
+RAYES_API void rayes_session_cancel(RayesSession *session);
+
+/* Pixel samples accumulated since the last restart. */
+RAYES_API int rayes_session_samples(const RayesSession *session);
+
+/* A copy of the accumulated image (free with rayes_image_free). Between
+ * passes only. */
+RAYES_API RayesError rayes_session_image(const RayesSession *session, RayesImage **image);
+
+/* The statistics of the last finished pass (rays, shading points, times,
+ * the cache's lookups and hit rates in that pass) plus "session/samples"
+ * and "session/prepare_s" (the last update's preparation time). */
+RAYES_API RayesError rayes_session_stats(const RayesSession *session, RayesStats **stats);
+
+/* The object seen through image position (x, y) (pixels, top left origin),
+ * or -1 for none, in *object. */
+RAYES_API RayesError rayes_session_pick(const RayesSession *session, float x, float y,
+                                        int64_t *object);
 
 #ifdef __cplusplus
 }

@@ -62,11 +62,11 @@ static float filter_weight(const Frame *f, float dx, float dy)
     return fmaxf(0.0f, expf(-alpha * dx * dx) - edge) * fmaxf(0.0f, expf(-alpha * dy * dy) - edge);
 }
 
-static Ray camera_ray(const RenderScene *rs, const RenderSettings *set, float x, float y)
+Ray render_camera_ray(const RenderScene *rs, int width, int height, float x, float y)
 {
     const Camera *c = &rs->camera;
-    float sx = c->screen[0] + (c->screen[1] - c->screen[0]) * x / (float)set->width;
-    float sy = c->screen[3] - (c->screen[3] - c->screen[2]) * y / (float)set->height;
+    float sx = c->screen[0] + (c->screen[1] - c->screen[0]) * x / (float)width;
+    float sy = c->screen[3] - (c->screen[3] - c->screen[2]) * y / (float)height;
     Vec3 across = v3_add(v3_scale(c->x, sx), v3_scale(c->y, sy));
     if (c->tan_half_fov > 0.0f) {
         Vec3 d = v3_normalize(v3_add(c->z, v3_scale(across, c->tan_half_fov)));
@@ -83,11 +83,13 @@ static void render_pixel(Frame *f, Worker *w, int px, int py, int x0, int y0, in
     uint64_t pixel_key = hash_combine(hash_combine(set->seed, (uint64_t)py), (uint64_t)px);
     uint32_t pattern = (uint32_t)hash_combine(pixel_key, DIM_PIXEL);
     RayDiff diff = {f->rs->camera.pixel_width, f->rs->camera.pixel_spread};
-    for (int s = 0; s < set->spp; s++) {
+    uint32_t n = (uint32_t)(set->pattern_spp > 0 ? set->pattern_spp : set->spp);
+    for (int k = 0; k < set->spp; k++) {
+        uint32_t s = (uint32_t)(set->first_sample + k), block = s / n;
         float jx, jy;
-        cmj_sample_2d((uint32_t)s, (uint32_t)set->spp, pattern, &jx, &jy);
+        cmj_sample_2d(s % n, n, block ? (uint32_t)hash_combine(pattern, block) : pattern, &jx, &jy);
         float x = (float)px + jx, y = (float)py + jy;
-        Ray ray = camera_ray(f->rs, set, x, y);
+        Ray ray = render_camera_ray(f->rs, set->width, set->height, x, y);
         float alpha;
         w->stats.rays_camera++;
         Vec3 L = integrator_trace(w, &ray, RAYES_RAY_CAMERA, 0, 0,
@@ -124,6 +126,8 @@ static void render_tile(void *ctx, size_t task, int worker)
 {
     Frame *f = ctx;
     const RenderSettings *set = f->set;
+    if (set->cancel && atomic_load(set->cancel))
+        atomic_store(&f->cancelled, 1);
     if (atomic_load(&f->cancelled))
         return;
     int ts = set->tile_size;
@@ -131,6 +135,9 @@ static void render_tile(void *ctx, size_t task, int worker)
     int tw = RY_MIN(ts, set->width - x0), th = RY_MIN(ts, set->height - y0);
     float(*acc)[5] = calloc((size_t)tw * th, sizeof *acc);
     RY_CHECK(acc != NULL);
+    if (set->accum)
+        for (int y = 0; y < th; y++)
+            memcpy(acc[y * tw], set->accum[(size_t)(y0 + y) * set->width + x0], sizeof *acc * tw);
     Worker *w = &f->workers[worker];
     for (int py = RY_MAX(y0 - f->margin, 0); py < RY_MIN(y0 + th + f->margin, set->height); py++)
         for (int px = RY_MAX(x0 - f->margin, 0); px < RY_MIN(x0 + tw + f->margin, set->width); px++)
@@ -143,7 +150,12 @@ static void render_tile(void *ctx, size_t task, int worker)
             for (int c = 0; c < 4; c++)
                 out[c] = a[c] * inv;
         }
+    if (set->accum)
+        for (int y = 0; y < th; y++)
+            memcpy(set->accum[(size_t)(y0 + y) * set->width + x0], acc[y * tw], sizeof *acc * tw);
     free(acc);
+    if (set->tile_done)
+        set->tile_done(set->tile_user, x0, y0, tw, th, f->rgba, set->width);
     report_progress(f);
 }
 
@@ -183,7 +195,8 @@ int render_frame(const RenderScene *rs, const RenderSettings *set, float *rgba, 
         if (set->cache)
             cache_local_init(&f.workers[i].cache, set->cache);
     }
-    memset(rgba, 0, sizeof(float) * 4 * (size_t)set->width * set->height);
+    if (!set->accum)
+        memset(rgba, 0, sizeof(float) * 4 * (size_t)set->width * set->height);
     thread_parallel_for(threads, (size_t)f.tiles_x * f.tiles_y, render_tile, &f);
     for (int i = 0; i < threads; i++) {
         merge_stats(stats, &f.workers[i].stats);

@@ -13,6 +13,7 @@
 #ifndef RAYES_RENDER_RENDER_H
 #define RAYES_RENDER_RENDER_H
 
+#include <stdatomic.h>
 #include <stddef.h>
 #include <stdint.h>
 
@@ -75,6 +76,15 @@ typedef struct RenderSettings {
     int irradiance;               /* 1: irradiance interpolation at depth 0 (irrgrid.h; grid
                                      hider only) */
     TextureSystem *textures;      /* image textures for the texture service, or NULL */
+    /* Progressive rendering (session/progressive.c); all zero for a one-shot frame. */
+    int first_sample;             /* the frame takes pixel samples first_sample .. + spp - 1 */
+    int pattern_spp;              /* of patterns of this many samples (0: spp); sample g is
+                                     g % pattern_spp of block g / pattern_spp's pattern */
+    float (*accum)[5];            /* width * height running sums (w r, w g, w b, w a, w) the
+                                     frame adds to, or NULL: the frame's samples alone */
+    atomic_int *cancel;           /* nonzero: stop (tiles not yet started are skipped) */
+    void (*tile_done)(void *user, int x, int y, int w, int h, const float *rgba, int stride);
+    void *tile_user;              /* tile_done gets the frame's rgba and its row stride */
 } RenderSettings;
 
 typedef struct RenderStats {
@@ -90,8 +100,16 @@ typedef struct RenderStats {
 Camera render_camera(Vec3 eye, Vec3 x, Vec3 y, Vec3 z, float tan_half_fov, const float screen[4],
                      int height);
 
+/* The camera ray through image position (x, y) of a width x height image
+ * (pixels, from the top left corner). */
+Ray render_camera_ray(const RenderScene *rs, int width, int height, float x, float y);
+
 /* Renders a frame into rgba (width * height * 4 floats, top row first) and
- * adds to stats. Returns 0, or 1 if the progress callback cancelled. */
+ * adds to stats. Returns 0, or 1 if the progress callback or set->cancel
+ * cancelled it (some tiles were then skipped; with accum, those finished
+ * have added their samples). A box filter of width 1 (no margin) adds each
+ * pixel's samples in sample order whatever the split into frames, so N
+ * frames of one sample equal one frame of N samples, bit for bit. */
 int render_frame(const RenderScene *rs, const RenderSettings *set, float *rgba, RenderStats *stats);
 
 #endif /* RAYES_RENDER_RENDER_H */

@@ -133,7 +133,7 @@ RayesError rayes_scene_set_camera(RayesScene *s, const float eye[3], const float
         return fail(s, RAYES_ERROR_INVALID_ARGUMENT,
                     "camera: the eye equals the target, or up is parallel to the view");
     look_at(&s->camera, eye, target, up, fov);
-    s->dirty = 1;
+    scene_mark(s, SCENE_CHANGE_CAMERA);
     return RAYES_OK;
 }
 
@@ -167,7 +167,7 @@ RayesError rayes_scene_set_camera_matrix(RayesScene *s, const float m[16], Rayes
     c->has_screen = screen != NULL;
     if (screen)
         memcpy(c->screen, screen, sizeof c->screen);
-    s->dirty = 1;
+    scene_mark(s, SCENE_CHANGE_CAMERA);
     return RAYES_OK;
 }
 
@@ -245,7 +245,7 @@ static RayesError add_object(RayesScene *s, const RayesShaderClass *cls, const R
     free(rest);
     s->current_object = light >= 0 ? s->current_object : (int64_t)s->n_objects;
     s->n_objects++;
-    s->dirty = 1;
+    scene_mark(s, SCENE_CHANGE_GEOMETRY);
     return RAYES_OK;
 }
 
@@ -354,7 +354,7 @@ static RayesError add_prim(RayesScene *s, Prim *p)
     p->displacement = s->current_displacement;
     p->displacement_bound = s->displacement_bound;
     s->prims[s->n_prims++] = *p;
-    s->dirty = 1;
+    scene_mark(s, SCENE_CHANGE_GEOMETRY);
     return RAYES_OK;
 }
 
@@ -460,7 +460,8 @@ RayesError rayes_scene_area_light(RayesScene *s, const float P[4][3], const floa
     l->P[1] = v[1];
     l->P[2] = v[3];
     l->P[3] = v[2];
-    l->L = v3_load(L);
+    l->L = l->color = v3_load(L);
+    l->intensity = 1.0f;
     Vec3 n;
     Vec3 c;
     light_quad_eval(l, 0.5f, 0.5f, &c, &n);
@@ -487,6 +488,13 @@ RayesError rayes_scene_commit(RayesScene *s)
         return RAYES_ERROR_INVALID_ARGUMENT;
     s->timestamp++;
     s->dirty = 0;
+    if (s->changes & SCENE_CHANGE_CAMERA)
+        s->stamp_camera = s->timestamp;
+    if (s->changes & SCENE_CHANGE_SHADING)
+        s->stamp_shading = s->timestamp;
+    if (s->changes & SCENE_CHANGE_GEOMETRY)
+        s->stamp_geometry = s->timestamp;
+    s->changes = 0;
     return RAYES_OK;
 }
 
@@ -667,7 +675,7 @@ static RayesError push_light(RayesScene *s, const Light *l, const Prim *prims, s
         }
     }
     s->lights[s->n_lights++] = *l;
-    s->dirty = 1;
+    scene_mark(s, SCENE_CHANGE_GEOMETRY);
     return RAYES_OK;
 }
 
@@ -697,6 +705,8 @@ RayesError rayes_scene_light(RayesScene *s, const char *type, const RayesParam *
     memset(&l, 0, sizeof l);
     snprintf(l.category, sizeof l.category, "%s", lp.category);
     l.L = v3_scale(v3_load(lp.color), lp.intensity);
+    l.intensity = lp.intensity;
+    l.color = v3_load(lp.color);
     const Mat4 *m = &s->world_from_object;
     l.from = mat4_point(m, v3_load(lp.from));
     Vec3 to = mat4_point(m, v3_load(lp.to));
@@ -752,8 +762,12 @@ RayesError rayes_scene_light(RayesScene *s, const char *type, const RayesParam *
         const float P[4][3] = {{-w, -h, 0}, {w, -h, 0}, {w, h, 0}, {-w, h, 0}};
         float L[3] = {l.L.x, l.L.y, l.L.z};
         e = rayes_scene_area_light(s, P, L);
-        if (e == RAYES_OK)
-            memcpy(s->lights[s->n_lights - 1].category, l.category, sizeof l.category);
+        if (e == RAYES_OK) {
+            Light *made = &s->lights[s->n_lights - 1];
+            memcpy(made->category, l.category, sizeof l.category);
+            made->intensity = l.intensity;
+            made->color = l.color;
+        }
         return e;
     }
     if (!(lp.radius > 0.0f))
@@ -793,6 +807,184 @@ RayesError rayes_scene_light(RayesScene *s, const char *type, const RayesParam *
     }
     return fail(s, RAYES_ERROR_INVALID_ARGUMENT,
                 "arealight: unknown shape \"%s\"; expected quad, disk or sphere", lp.shape);
+}
+
+/* ------------------------------------------------------------ edits */
+
+size_t rayes_scene_light_count(const RayesScene *s)
+{
+    return s ? s->n_lights : 0;
+}
+
+size_t rayes_scene_object_count(const RayesScene *s)
+{
+    return s ? s->n_objects : 0;
+}
+
+const char *rayes_scene_object_shader(const RayesScene *s, size_t object)
+{
+    if (!s || object >= s->n_objects || !s->objects[object].shader.cls)
+        return "";
+    return s->objects[object].shader.cls->name;
+}
+
+int64_t rayes_scene_object_light(const RayesScene *s, size_t object)
+{
+    if (!s || object >= s->n_objects)
+        return -1;
+    return s->objects[object].light;
+}
+
+/* Moves a primitive by d (world space). */
+static void translate_prim(Prim *p, Vec3 d)
+{
+    if (p->type == PRIM_SPHERE) {
+        for (int k = 0; k < 3; k++)
+            p->sphere.world_from_object.m[k][3] += k == 0 ? d.x : k == 1 ? d.y : d.z;
+        return;
+    }
+    for (int k = 0; k < 16; k++)
+        p->cp[k] = v3_add(p->cp[k], d);
+}
+
+RayesError rayes_scene_edit_light(RayesScene *s, size_t index, const RayesParam *params,
+                                  size_t n_params)
+{
+    if (!s || (n_params && !params))
+        return RAYES_ERROR_INVALID_ARGUMENT;
+    if (index >= s->n_lights)
+        return fail(s, RAYES_ERROR_INVALID_ARGUMENT, "edit light: no light %zu (the scene has %zu)",
+                    index, s->n_lights);
+    Light *l = &s->lights[index];
+    float intensity = l->intensity;
+    Vec3 color = l->color, d = v3(0, 0, 0);
+    for (size_t i = 0; i < n_params; i++) {
+        const RayesParam *p = &params[i];
+        const char *name = p->name ? p->name : "";
+        int is_float = p->type == RAYES_PARAM_FLOAT, is_color = p->type == RAYES_PARAM_COLOR;
+        if (!finite_n(p->value, is_color ? 3 : 1) && (is_float || is_color))
+            return fail(s, RAYES_ERROR_INVALID_ARGUMENT, "edit light: \"%s\" is not finite", name);
+        if (strcmp(name, "intensity") == 0 && is_float && p->value[0] >= 0.0f)
+            intensity = p->value[0];
+        else if (strcmp(name, "lightcolor") == 0 && (is_float || is_color) && p->value[0] >= 0.0f &&
+                 (is_float || (p->value[1] >= 0.0f && p->value[2] >= 0.0f)))
+            color = is_float ? v3(p->value[0], p->value[0], p->value[0]) : v3_load(p->value);
+        else if (strcmp(name, "translate") == 0 && is_color)
+            d = v3_add(d, v3_load(p->value));
+        else
+            return fail(s, RAYES_ERROR_INVALID_ARGUMENT,
+                        "edit light: expected \"intensity\" (a float >= 0), \"lightcolor\" (a "
+                        "colour >= 0) or \"translate\" (a vector), not \"%s\"",
+                        name);
+    }
+    l->intensity = intensity;
+    l->color = color;
+    l->L = v3_scale(color, intensity);
+    scene_mark(s, SCENE_CHANGE_SHADING);
+    if (v3_length(d) == 0.0f || l->type == LIGHT_DISTANT || l->type == LIGHT_AMBIENT ||
+        l->type == LIGHT_ENVIRONMENT)
+        return RAYES_OK;
+    for (int k = 0; k < 4; k++)
+        l->P[k] = v3_add(l->P[k], d);
+    l->from = v3_add(l->from, d);
+    for (size_t i = 0; i < s->n_prims; i++)
+        if (s->objects[s->prims[i].object].light == (int)index) {
+            translate_prim(&s->prims[i], d);
+            scene_mark(s, SCENE_CHANGE_GEOMETRY);
+        }
+    return RAYES_OK;
+}
+
+RayesError rayes_scene_edit_shader(RayesScene *s, size_t object, const RayesParam *params,
+                                   size_t n_params)
+{
+    if (!s || (n_params && !params))
+        return RAYES_ERROR_INVALID_ARGUMENT;
+    if (object >= s->n_objects)
+        return fail(s, RAYES_ERROR_INVALID_ARGUMENT,
+                    "edit shader: no object %zu (the scene has %zu)", object, s->n_objects);
+    SceneObject *o = &s->objects[object];
+    if (!o->shader.cls)
+        return fail(s, RAYES_ERROR_INVALID_ARGUMENT,
+                    "edit shader: object %zu is light %d's emitter; edit the light", object,
+                    o->light);
+    const RayesShaderClass *cls = o->shader.cls;
+    ShaderInstance trial = {cls, malloc(cls->params_size ? cls->params_size : 1)};
+    RayesParam *rest = malloc((n_params ? n_params : 1) * sizeof *rest);
+    if (!trial.params || !rest) {
+        free(trial.params);
+        free(rest);
+        return fail(s, RAYES_ERROR_OUT_OF_MEMORY, "out of memory");
+    }
+    memcpy(trial.params, o->shader.params, cls->params_size);
+    float Cs[3], Os[3];
+    memcpy(Cs, o->Cs, sizeof Cs);
+    memcpy(Os, o->Os, sizeof Os);
+    size_t n_rest = 0;
+    for (size_t i = 0; i < n_params; i++) {
+        const RayesParam *p = &params[i];
+        int n = p->type == RAYES_PARAM_COLOR ? 3 : 1;
+        if (!p->name || ((p->type == RAYES_PARAM_FLOAT || p->type == RAYES_PARAM_COLOR) &&
+                         !finite_n(p->value, (size_t)n))) {
+            free(trial.params);
+            free(rest);
+            return fail(s, RAYES_ERROR_INVALID_ARGUMENT,
+                        "edit shader: a parameter has no name or is not finite");
+        }
+        float *dst = strcmp(p->name, "Cs") == 0 ? Cs : strcmp(p->name, "Os") == 0 ? Os : NULL;
+        if (dst && (p->type == RAYES_PARAM_FLOAT || p->type == RAYES_PARAM_COLOR)) {
+            for (int c = 0; c < 3; c++)
+                dst[c] = p->value[n == 1 ? 0 : c];
+            continue;
+        }
+        rest[n_rest++] = *p;
+    }
+    char err[256];
+    if (shade_instance_apply(&trial, rest, n_rest, 1, err, sizeof err) != 0) {
+        free(trial.params);
+        free(rest);
+        return fail(s, RAYES_ERROR_INVALID_ARGUMENT, "edit shader: %s", err);
+    }
+    free(rest);
+    free(o->shader.params);
+    o->shader.params = trial.params;
+    memcpy(o->Cs, Cs, sizeof Cs);
+    memcpy(o->Os, Os, sizeof Os);
+    scene_mark(s, SCENE_CHANGE_SHADING);
+    return RAYES_OK;
+}
+
+RayesError rayes_scene_get_camera(const RayesScene *s, float eye[3], float x[3], float y[3],
+                                  float z[3])
+{
+    if (!s || !eye || !x || !y || !z)
+        return RAYES_ERROR_INVALID_ARGUMENT;
+    const SceneCamera *c = &s->camera;
+    const Vec3 *from[4] = {&c->eye, &c->x, &c->y, &c->z};
+    float *to[4] = {eye, x, y, z};
+    for (int k = 0; k < 4; k++) {
+        to[k][0] = from[k]->x;
+        to[k][1] = from[k]->y;
+        to[k][2] = from[k]->z;
+    }
+    return RAYES_OK;
+}
+
+RayesError rayes_scene_move_camera(RayesScene *s, const float m[16])
+{
+    if (!s || !m)
+        return RAYES_ERROR_INVALID_ARGUMENT;
+    Mat4 inv, M = mat4_from_array(m);
+    if (!finite_n(m, 16) || !mat4_invert(M, &inv))
+        return fail(s, RAYES_ERROR_INVALID_ARGUMENT,
+                    "move camera: expected a finite, invertible matrix");
+    SceneCamera *c = &s->camera;
+    c->eye = mat4_point(&M, c->eye);
+    c->x = mat4_vector(&M, c->x);
+    c->y = mat4_vector(&M, c->y);
+    c->z = mat4_vector(&M, c->z);
+    scene_mark(s, SCENE_CHANGE_CAMERA);
+    return RAYES_OK;
 }
 
 /* ------------------------------------------------------- search paths */

@@ -53,6 +53,16 @@ typedef struct SceneCamera {
 /* The screen window of the camera for an image of width x height pixels. */
 void scene_camera_screen(const SceneCamera *camera, int width, int height, float screen[4]);
 
+/* What an edit changed, so that a progressive session (session/progressive.c)
+ * keeps what is still valid: the camera alone keeps the diced grids and the
+ * cached radiosity (view-independent); shading parameters keep the grids
+ * but not the radiosity; anything else is prepared again. */
+typedef enum SceneChange {
+    SCENE_CHANGE_CAMERA = 1,
+    SCENE_CHANGE_SHADING = 2,
+    SCENE_CHANGE_GEOMETRY = 4
+} SceneChange;
+
 struct RayesScene {
     atomic_int refs;
     char error[512];          /* the first error since the last clear */
@@ -72,9 +82,21 @@ struct RayesScene {
     float displacement_bound;      /* of geometry added next; 0: unbounded */
     uint64_t timestamp;       /* commits so far */
     int dirty;                /* edited since the last commit */
+    unsigned changes;         /* SceneChange bits since the last commit */
+    uint64_t stamp_camera;    /* the last commit that changed the camera, */
+    uint64_t stamp_shading;   /* lights' or shaders' parameters (not the geometry), */
+    uint64_t stamp_geometry;  /* anything else (primitives, objects, lights added) */
     char *search_paths[SCENE_SEARCH_PATH_COUNT]; /* colon-separated, "&" expanded; owned; NULL:
                                                     empty */
 };
+
+/* Records an edit: the scene is uncommitted, and the change is stamped
+ * with the next commit. */
+static inline void scene_mark(RayesScene *scene, SceneChange change)
+{
+    scene->dirty = 1;
+    scene->changes |= (unsigned)change;
+}
 
 /* Dices every primitive of a committed scene for its camera making an
  * image of width x height pixels, and runs displacement

@@ -16,6 +16,7 @@
 #include "rayes/rayes.h"
 #include "render/render.h"
 #include "scene/scene.h"
+#include "session/session.h"
 #include "session/stats.h"
 #include "util/log.h"
 #include "util/thread.h"
@@ -89,7 +90,7 @@ void rayes_image_free(RayesImage *image)
     free(image);
 }
 
-static RayesError check_options(RayesScene *scene, const RayesRenderOptions *o)
+RayesError session_check_options(RayesScene *scene, const RayesRenderOptions *o)
 {
     const char *what = NULL;
     if (o->struct_size != sizeof *o)
@@ -126,7 +127,7 @@ static RayesError check_options(RayesScene *scene, const RayesRenderOptions *o)
     return RAYES_ERROR_INVALID_ARGUMENT;
 }
 
-static RenderSettings settings_from(const RayesRenderOptions *o)
+RenderSettings session_settings(const RayesRenderOptions *o)
 {
     RenderSettings s = {
         .width = o->width, .height = o->height, .spp = o->spp, .threads = o->threads,
@@ -137,6 +138,7 @@ static RenderSettings settings_from(const RayesRenderOptions *o)
         .seed = o->seed, .progress = o->progress, .progress_user = o->progress_user,
         .cache_resolution = o->cache_resolution, .cache_k = o->cache_k,
         .hider = o->hider == RAYES_HIDER_GRID, .irradiance = o->irradiance != 0,
+        .tile_done = o->tile_done, .tile_user = o->tile_user,
     };
     if (s.threads == 0)
         s.threads = thread_count_cores();
@@ -145,7 +147,7 @@ static RenderSettings settings_from(const RayesRenderOptions *o)
 
 /* The texture system of a render: the scene's texture path, then
  * RAYES_TEXTURE_PATH's directories. NULL when out of memory. */
-static TextureSystem *render_textures(const RayesScene *scene, double mb, float width)
+TextureSystem *session_textures(const RayesScene *scene, double mb, float width)
 {
     const char *a = scene_search_path(scene, SCENE_SEARCH_PATH_TEXTURE);
     const char *b = getenv("RAYES_TEXTURE_PATH");
@@ -161,7 +163,7 @@ static TextureSystem *render_textures(const RayesScene *scene, double mb, float 
 }
 
 /* The render-side view of the scene's objects. */
-static RenderObject *render_objects(const RayesScene *scene)
+RenderObject *session_render_objects(const RayesScene *scene)
 {
     RenderObject *ro = calloc(scene->n_objects + 1, sizeof *ro);
     if (!ro)
@@ -185,11 +187,58 @@ static uint32_t *object_masks(const RayesScene *scene)
     return m;
 }
 
-static RayesError fail(RayesScene *scene, RayesError e, const char *msg)
+RayesError session_fail(RayesScene *scene, RayesError e, const char *msg)
 {
     if (scene->error[0] == '\0')
         snprintf(scene->error, sizeof scene->error, "%s", msg);
     return e;
+}
+
+RayesError session_prepare(RayesScene *scene, int width, int height, TextureSystem *textures,
+                           Prepared *p)
+{
+    memset(p, 0, sizeof *p);
+    geom_gridset_init(&p->gs);
+    p->objects = session_render_objects(scene);
+    p->masks = object_masks(scene);
+    char err[300] = "";
+    if (!p->objects || !p->masks || scene_prepare(scene, width, height, textures, &p->gs) != 0) {
+        session_prepared_fini(p);
+        return session_fail(scene, RAYES_ERROR_OUT_OF_MEMORY,
+                            "render: out of memory preparing the scene");
+    }
+    p->accel = accel_new(&p->gs, p->masks, scene->n_objects, err, sizeof err);
+    if (!p->accel) {
+        session_prepared_fini(p);
+        return session_fail(scene, RAYES_ERROR_OUT_OF_MEMORY, err);
+    }
+    Bounds3 b = scene_bounds(scene);
+    p->scene_radius =
+        scene->n_prims ? fmaxf(0.5f * v3_length(v3_sub(b.hi, b.lo)), 1e-6f) : 1.0f;
+    return RAYES_OK;
+}
+
+void session_prepared_fini(Prepared *p)
+{
+    accel_free(p->accel);
+    geom_gridset_fini(&p->gs);
+    free(p->objects);
+    free(p->masks);
+    memset(p, 0, sizeof *p);
+}
+
+RenderScene session_render_scene(const RayesScene *scene, const Prepared *p, int width,
+                                 int height)
+{
+    float screen[4];
+    scene_camera_screen(&scene->camera, width, height, screen);
+    return (RenderScene){
+        .gs = &p->gs, .accel = p->accel, .objects = p->objects, .n_objects = scene->n_objects,
+        .lights = scene->lights, .n_lights = scene->n_lights,
+        .camera = render_camera(scene->camera.eye, scene->camera.x, scene->camera.y,
+                                scene->camera.z, scene->camera.tan_half_fov, screen, height),
+        .scene_radius = p->scene_radius,
+    };
 }
 
 RayesError rayes_render(RayesScene *scene, const RayesRenderOptions *opt, RayesImage **image,
@@ -201,61 +250,48 @@ RayesError rayes_render(RayesScene *scene, const RayesRenderOptions *opt, RayesI
     if (stats_out)
         *stats_out = NULL;
     if (scene->timestamp == 0 || scene->dirty)
-        return fail(scene, RAYES_ERROR_INVALID_OPERATION, "render: the scene is not committed");
-    RayesError e = check_options(scene, opt);
+        return session_fail(scene, RAYES_ERROR_INVALID_OPERATION,
+                            "render: the scene is not committed");
+    RayesError e = session_check_options(scene, opt);
     if (e != RAYES_OK)
         return e;
     double t0 = time_now();
-    RenderSettings set = settings_from(opt);
-    GridSet gs;
-    geom_gridset_init(&gs);
-    RenderObject *objects = render_objects(scene);
-    uint32_t *masks = object_masks(scene);
+    RenderSettings set = session_settings(opt);
+    Prepared prep;
+    memset(&prep, 0, sizeof prep);
     RayesImage *img = calloc(1, sizeof *img);
     float *rgba = malloc(sizeof(float) * 4 * (size_t)set.width * set.height);
-    Accel *accel = NULL;
     Cache *cache = NULL;
-    TextureSystem *textures = render_textures(scene, opt->texture_mb, opt->texture_width);
+    TextureSystem *textures = session_textures(scene, opt->texture_mb, opt->texture_width);
     RenderStats rstats = {0};
-    char err[300] = "";
     set.textures = textures;
-    if (!objects || !masks || !img || !rgba || !textures ||
-        scene_prepare(scene, set.width, set.height, textures, &gs) != 0) {
-        e = fail(scene, RAYES_ERROR_OUT_OF_MEMORY, "render: out of memory preparing the scene");
+    if (!img || !rgba || !textures) {
+        e = session_fail(scene, RAYES_ERROR_OUT_OF_MEMORY, "render: out of memory");
         goto done;
     }
-    accel = accel_new(&gs, masks, scene->n_objects, err, sizeof err);
-    if (!accel) {
-        e = fail(scene, RAYES_ERROR_OUT_OF_MEMORY, err);
+    e = session_prepare(scene, set.width, set.height, textures, &prep);
+    if (e != RAYES_OK)
         goto done;
-    }
     if (opt->cache) {
         cache = cache_new((uint64_t)(opt->cache_mb * 1e6), opt->cache_split);
         if (!cache) {
-            e = fail(scene, RAYES_ERROR_OUT_OF_MEMORY, "render: out of memory for the cache");
+            e = session_fail(scene, RAYES_ERROR_OUT_OF_MEMORY,
+                             "render: out of memory for the cache");
             goto done;
         }
         set.cache = cache;
     }
     double t1 = time_now();
-    Bounds3 b = scene_bounds(scene);
-    float screen[4];
-    scene_camera_screen(&scene->camera, set.width, set.height, screen);
-    RenderScene rs = {
-        .gs = &gs, .accel = accel, .objects = objects, .n_objects = scene->n_objects,
-        .lights = scene->lights, .n_lights = scene->n_lights,
-        .camera = render_camera(scene->camera.eye, scene->camera.x, scene->camera.y,
-                                scene->camera.z, scene->camera.tan_half_fov, screen, set.height),
-        .scene_radius = scene->n_prims ? fmaxf(0.5f * v3_length(v3_sub(b.hi, b.lo)), 1e-6f) : 1.0f,
-    };
+    RenderScene rs = session_render_scene(scene, &prep, set.width, set.height);
     if (render_frame(&rs, &set, rgba, &rstats) != 0) {
-        e = fail(scene, RAYES_ERROR_CANCELLED, "render: cancelled");
+        e = session_fail(scene, RAYES_ERROR_CANCELLED, "render: cancelled");
         goto done;
     }
     double t2 = time_now();
     if (stats_out) {
         SessionTimes times = {t2 - t0, t1 - t0, t2 - t1};
-        *stats_out = session_stats_new(&set, &rstats, &gs, &times, accel_memory_bytes(accel));
+        *stats_out = session_stats_new(&set, &rstats, &prep.gs, &times,
+                                       accel_memory_bytes(prep.accel));
         if (*stats_out && cache) {
             CacheStats cs;
             cache_get_stats(cache, &cs);
@@ -267,7 +303,8 @@ RayesError rayes_render(RayesScene *scene, const RayesRenderOptions *opt, RayesI
             session_stats_add_textures(*stats_out, &ts);
         }
         if (!*stats_out) {
-            e = fail(scene, RAYES_ERROR_OUT_OF_MEMORY, "render: out of memory for statistics");
+            e = session_fail(scene, RAYES_ERROR_OUT_OF_MEMORY,
+                             "render: out of memory for statistics");
             goto done;
         }
     }
@@ -279,11 +316,8 @@ RayesError rayes_render(RayesScene *scene, const RayesRenderOptions *opt, RayesI
     rgba = NULL;
 done:
     cache_free(cache);
+    session_prepared_fini(&prep);
     texture_system_free(textures);
-    accel_free(accel);
-    geom_gridset_fini(&gs);
-    free(objects);
-    free(masks);
     free(rgba);
     free(img);
     return e;

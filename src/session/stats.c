@@ -140,3 +140,13 @@ void rayes_stats_free(RayesStats *s)
 {
     free(s);
 }
+
+void session_stats_add_count(RayesStats *stats, const char *name, uint64_t value)
+{
+    count(stats, name, value);
+}
+
+void session_stats_add_real(RayesStats *stats, const char *name, double value)
+{
+    real(stats, name, value);
+}

@@ -29,4 +29,8 @@ void session_stats_add_cache(RayesStats *stats, const CacheStats *cs);
  * built), file_reads, evictions, bytes, peak_bytes and budget_bytes. */
 void session_stats_add_textures(RayesStats *stats, const TextureStats *ts);
 
+/* Adds one statistic; name must be static. */
+void session_stats_add_count(RayesStats *stats, const char *name, uint64_t value);
+void session_stats_add_real(RayesStats *stats, const char *name, double value);
+
 #endif /* RAYES_SESSION_STATS_H */

@@ -58,6 +58,8 @@ typedef struct Light {
     LightType type;
     Vec3 P[4];          /* quad corners as a bilinear patch: P00, P10, P01, P11 */
     Vec3 L;             /* radiance (area, environment) or intensity * lightcolor */
+    float intensity;    /* L = intensity * color, kept apart for edits */
+    Vec3 color;
     Vec3 from;          /* point, spot position; disk and sphere centre */
     Vec3 dir;           /* spot axis, distant light's direction of travel (unit) */
     Vec3 ex, ey;        /* disk: world images of the object x and y radii */

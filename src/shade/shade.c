@@ -61,6 +61,33 @@ static void set_param(void *block, const RayesShaderParamDesc *d, RayesParamType
         snprintf(at, 64, "%s", string ? string : "");
 }
 
+int shade_instance_apply(ShaderInstance *inst, const RayesParam *params, size_t n_params,
+                         int strict, char *err, size_t err_size)
+{
+    const RayesShaderClass *cls = inst->cls;
+    for (size_t i = 0; i < n_params; i++) {
+        const RayesShaderParamDesc *d = find_param(cls, params[i].name);
+        int ok = d && (d->type == params[i].type ||
+                       (d->type == RAYES_PARAM_COLOR && params[i].type == RAYES_PARAM_FLOAT));
+        if (!ok && strict) {
+            snprintf(err, err_size, d ? "shader \"%s\" parameter \"%s\" has another type"
+                                      : "shader \"%s\" has no parameter \"%s\"",
+                     cls->name, params[i].name);
+            return -1;
+        }
+        if (!ok) {
+            char key[96];
+            snprintf(key, sizeof key, "param:%s:%s", cls->name, params[i].name);
+            log_warning_once(key, d ? "shader \"%s\" parameter \"%s\" has the wrong type; ignored"
+                                    : "shader \"%s\" has no parameter \"%s\"; ignored",
+                             cls->name, params[i].name);
+            continue;
+        }
+        set_param(inst->params, d, params[i].type, params[i].value, params[i].string);
+    }
+    return 0;
+}
+
 int shade_instance_init(ShaderInstance *inst, const RayesShaderClass *cls,
                         const RayesParam *params, size_t n_params, char *err, size_t err_size)
 {
@@ -73,25 +100,7 @@ int shade_instance_init(ShaderInstance *inst, const RayesShaderClass *cls,
     for (size_t i = 0; i < cls->n_params; i++)
         set_param(inst->params, &cls->params[i], cls->params[i].type,
                   cls->params[i].default_value, "");
-    for (size_t i = 0; i < n_params; i++) {
-        const RayesShaderParamDesc *d = find_param(cls, params[i].name);
-        char key[96];
-        snprintf(key, sizeof key, "param:%s:%s", cls->name, params[i].name);
-        if (!d) {
-            log_warning_once(key, "shader \"%s\" has no parameter \"%s\"; ignored", cls->name,
-                             params[i].name);
-            continue;
-        }
-        int ok = d->type == params[i].type ||
-                 (d->type == RAYES_PARAM_COLOR && params[i].type == RAYES_PARAM_FLOAT);
-        if (!ok) {
-            log_warning_once(key, "shader \"%s\" parameter \"%s\" has the wrong type; ignored",
-                             cls->name, params[i].name);
-            continue;
-        }
-        set_param(inst->params, d, params[i].type, params[i].value, params[i].string);
-    }
-    return 0;
+    return shade_instance_apply(inst, params, n_params, 0, err, err_size);
 }
 
 void shade_instance_fini(ShaderInstance *inst)

@@ -33,6 +33,11 @@ const RayesShaderClass *shade_find_class_on_path(const char *name, const char *s
  * class and name). Returns 0, or -1 (out of memory, err filled). */
 int shade_instance_init(ShaderInstance *inst, const RayesShaderClass *cls,
                         const RayesParam *params, size_t n_params, char *err, size_t err_size);
+/* Sets params by name on an instance, over the values it has. Unknown names
+ * and wrong types get one warning each and are skipped, or, when strict,
+ * make it return -1 with err filled (nothing after the bad one is set). */
+int shade_instance_apply(ShaderInstance *inst, const RayesParam *params, size_t n_params,
+                         int strict, char *err, size_t err_size);
 void shade_instance_fini(ShaderInstance *inst);
 
 /* Runs diffuselighting, or the fallback for classes without it: lighting
