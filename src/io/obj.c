@@ -866,7 +866,8 @@ static RayesError emit_mesh(Emit *e, const Mesh *m, const char *mat)
     for (size_t i = 0; i < m->idx.n; i++)
         e->local[m->idx.a[i]] = -1;
     if (r == RAYES_OK) {
-        r = e->sink->polygon_mesh(e->sink->target, m->nv.n, m->nv.a, idx.a, e->P.n / 3, e->P.a);
+        r = e->sink->polygon_mesh(e->sink->target, m->nv.n, m->nv.a, idx.a, e->P.n / 3, e->P.a,
+                                  NULL, 0);
         if (r != RAYES_OK) {
             char what[200];
             snprintf(what, sizeof what, "the faces of material \"%s\"", mat);

@@ -60,6 +60,9 @@ typedef struct Rec {
         Shader params; /* name unused */
         float xform[16];
     } light[MAX_REC];
+    int primvars;        /* 1: an N was given, 2: an st */
+    int bad_primvars;    /* primitive variables not per point */
+    float N0[3], st0[2]; /* the last N and st call's first value */
 } Rec;
 
 static void copy_params(Shader *s, const char *name, const RayesParam *p, size_t n)
@@ -150,23 +153,37 @@ static RayesError r_rate(void *t, float r)
     return RAYES_OK;
 }
 
-static RayesError r_bilinear(void *t, const float P[4][3])
+/* Keeps the first value of N and st, and checks their counts (n). */
+static void r_primvars(Rec *r, const RayesPrimvar *pv, size_t n_pv, size_t n)
+{
+    for (size_t i = 0; i < n_pv; i++) {
+        int st = strcmp(pv[i].name, "st") == 0;
+        if (pv[i].cls != RAYES_PRIMVAR_VERTEX || pv[i].count != n)
+            r->bad_primvars++;
+        memcpy(st ? r->st0 : r->N0, pv[i].data, (st ? 2 : 3) * sizeof(float));
+        r->primvars |= st ? 2 : 1;
+    }
+}
+
+static RayesError r_bilinear(void *t, const float P[4][3], const RayesPrimvar *pv, size_t n_pv)
 {
     (void)P;
     ((Rec *)t)->n_patches++;
+    r_primvars(t, pv, n_pv, 4);
     return RAYES_OK;
 }
 
-static RayesError r_bicubic(void *t, const float P[16][3])
+static RayesError r_bicubic(void *t, const float P[16][3], const RayesPrimvar *pv, size_t n_pv)
 {
-    (void)t, (void)P;
+    (void)t, (void)P, (void)pv, (void)n_pv;
     return RAYES_OK;
 }
 
 static RayesError r_mesh(void *t, size_t n_faces, const int *nv, const int *idx, size_t n_points,
-                         const float *P)
+                         const float *P, const RayesPrimvar *pv, size_t n_pv)
 {
     Rec *r = t;
+    r_primvars(r, pv, n_pv, n_points);
     size_t n_idx = 0;
     for (size_t f = 0; f < n_faces; f++) {
         if (nv[f] != 3 && nv[f] != 4)
