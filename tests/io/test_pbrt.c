@@ -695,5 +695,41 @@ static void test_errors(void)
     expect_error("WorldBegin\nRotate 90 0 0 0\n", "t.pbrt:2:1: Rotate: expected a nonzero axis");
 }
 
+/* trianglemesh, bilinearmesh and plymesh pass N and uv per point, as
+ * vertex-class N and st with t = 1 - v; instanced meshes keep them. */
+static void test_normals_and_uv(void)
+{
+    Rec *r = malloc(sizeof *r);
+    IoSettings s;
+    char err[512] = "", path[512];
+    CHECK(parse("t.pbrt", "WorldBegin\nShape \"trianglemesh\" \"point3 P\" [0 0 0 1 0 0 0 1 0] "
+                          "\"integer indices\" [0 1 2] \"normal N\" [0 0.6 0.8 0 0 1 0 0 1] "
+                          "\"point2 uv\" [0.25 0.125 1 0 0 1]\n", r, &s, err, sizeof err) == RAYES_OK);
+    CHECK(r->primvars == 3 && r->bad_primvars == 0);
+    CHECK_NEAR(r->N0[1], 0.6, 1e-6);
+    CHECK_NEAR(r->st0[0], 0.25, 0);
+    CHECK_NEAR(r->st0[1], 0.875, 0);
+    CHECK(parse("t.pbrt", "WorldBegin\nObjectBegin \"o\"\nShape \"bilinearmesh\" \"point3 P\" "
+                          "[0 0 0 1 0 0 0 1 0 1 1 0] \"point2 uv\" [0.5 0 1 0 0 1 1 1]\n"
+                          "ObjectEnd\nObjectInstance \"o\"\n", r, &s, err, sizeof err) == RAYES_OK);
+    CHECK(r->n_patches == 1 && r->primvars == 2 && r->bad_primvars == 0);
+    CHECK_NEAR(r->st0[0], 0.5, 0);
+    CHECK_NEAR(r->st0[1], 1, 0);
+    snprintf(path, sizeof path, "%s/test_pbrt_nuv.ply", RAYES_TEST_TMP);
+    write_file(path, "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\n"
+                     "property float y\nproperty float z\nproperty float nx\nproperty float ny\n"
+                     "property float nz\nproperty float u\nproperty float v\nelement face 1\n"
+                     "property list uchar int vertex_indices\nend_header\n"
+                     "0 0 0 0 0 1 0.5 0.25\n1 0 0 0 0 1 1 0\n0 1 0 0 0 1 0 1\n3 0 1 2\n");
+    char text[1024];
+    snprintf(text, sizeof text, "WorldBegin\nShape \"plymesh\" \"string filename\" \"%s\"\n",
+             path);
+    CHECK(parse("t.pbrt", text, r, &s, err, sizeof err) == RAYES_OK);
+    CHECK(r->primvars == 3 && r->bad_primvars == 0);
+    CHECK_NEAR(r->N0[2], 1, 0);
+    CHECK_NEAR(r->st0[1], 0.75, 0);
+    free(r);
+}
+
 TEST_MAIN(TEST(test_cornell_box), TEST(test_transforms), TEST(test_materials), TEST(test_lights),
-          TEST(test_instances_include_ply), TEST(test_errors))
+          TEST(test_instances_include_ply), TEST(test_errors), TEST(test_normals_and_uv))

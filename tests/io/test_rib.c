@@ -728,8 +728,89 @@ static void test_writer_round_trip(void)
     }
 }
 
+/* Primitive variables written by the RIB writer read back as they were
+ * sent: a mesh's vertex N, facevarying st and uniform Cs, a bilinear
+ * patch's varying st, a bicubic patch's vertex Cs (16 Bezier values). */
+static void test_writer_primvars(void)
+{
+    RibWriter *w = io_rib_writer_new();
+    IoSink ws = io_rib_writer_sink(w);
+    const float P[4][3] = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}};
+    const int nv[2] = {3, 3}, idx[6] = {0, 1, 2, 0, 2, 3};
+    const float N[4][3] = {{0, 0, 1}, {0, 0.6f, 0.8f}, {0, 0, 1}, {0.6f, 0, 0.8f}};
+    const float st[6][2] = {{0, 0}, {1, 0}, {1, 1}, {0, 0.125f}, {1, 1}, {0, 1}};
+    const float Cs[2][3] = {{1, 0, 0}, {0, 0.5f, 1}};
+    const RayesPrimvar mesh_pv[3] = {{"N", RAYES_PRIMVAR_VERTEX, &N[0][0], 4},
+                                     {"st", RAYES_PRIMVAR_FACEVARYING, &st[0][0], 6},
+                                     {"Cs", RAYES_PRIMVAR_UNIFORM, &Cs[0][0], 2}};
+    CHECK(ws.polygon_mesh(ws.target, 2, nv, idx, 4, &P[0][0], mesh_pv, 3) == RAYES_OK);
+    const float Q[4][3] = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {1, 1, 0}};
+    const RayesPrimvar patch_pv = {"st", RAYES_PRIMVAR_VARYING, &st[0][0], 4};
+    CHECK(ws.bilinear_patch(ws.target, Q, &patch_pv, 1) == RAYES_OK);
+    float B[16][3], C[16][3];
+    for (int k = 0; k < 16; k++)
+        for (int c = 0; c < 3; c++)
+            B[k][c] = (float)(k % 4) + (c == 1 ? (float)(k / 4) : 0.0f), C[k][c] = 0.0625f * (float)k;
+    const RayesPrimvar cubic_pv = {"Cs", RAYES_PRIMVAR_VERTEX, &C[0][0], 16};
+    CHECK(ws.bicubic_patch(ws.target, (const float(*)[3])B, &cubic_pv, 1) == RAYES_OK);
+    const RayesPrimvar bad = {"st", RAYES_PRIMVAR_VERTEX, &st[0][0], 3};
+    CHECK(ws.polygon_mesh(ws.target, 2, nv, idx, 4, &P[0][0], &bad, 1) ==
+          RAYES_ERROR_INVALID_ARGUMENT);
+    char path[1024];
+    snprintf(path, sizeof path, "%s/test_rib_primvars.rib", RAYES_TEST_TMP);
+    FILE *f = fopen(path, "w");
+    CHECK(f != NULL);
+    if (!f) {
+        io_rib_writer_free(w);
+        return;
+    }
+    CHECK(io_rib_writer_finish(w, NULL, f, err, sizeof err) == RAYES_OK);
+    fclose(f);
+    io_rib_writer_free(w);
+    /* Read it back, checking the mesh (the first geometry) on the way. */
+    memset(&rec, 0, sizeof rec);
+    IoReadOptions opt = {NULL, -1};
+    io_settings_init(&settings);
+    CHECK(io_rib_read(path, &stub, &opt, &settings, err, sizeof err) == RAYES_OK);
+    CHECK(rec.meshes == 1 && rec.bilinear == 1 && rec.bicubic == 1);
+    const RayesPrimvar *v = last_pv("Cs"); /* the last call: the bicubic patch */
+    CHECK(v && v->cls == RAYES_PRIMVAR_VERTEX && v->count == 16);
+    CHECK(v && memcmp(v->data, C, sizeof C) == 0);
+    /* the mesh and the patch, each read alone */
+    f = fopen(path, "r");
+    char line[8192], mesh_rib[8192] = "WorldBegin\n", patch_rib[8192] = "WorldBegin\n";
+    int in_mesh = 0;
+    while (f && fgets(line, sizeof line, f)) {
+        if (strncmp(line, "PointsPolygons", 14) == 0)
+            in_mesh = 1;
+        else if (strncmp(line, "Patch \"bilinear\"", 16) == 0)
+            in_mesh = 2;
+        else if (line[0] != ' ')
+            in_mesh = 0;
+        char *to = in_mesh == 1 ? mesh_rib : patch_rib;
+        size_t have = strlen(to), add = strlen(line);
+        if (in_mesh && have + add + 16 < sizeof mesh_rib)
+            memcpy(to + have, line, add + 1);
+    }
+    if (f)
+        fclose(f);
+    strcat(mesh_rib, "WorldEnd\n");
+    strcat(patch_rib, "WorldEnd\n");
+    CHECK(parse(mesh_rib) == RAYES_OK);
+    CHECK(rec.n_pv == 3);
+    for (int i = 0; i < 3; i++) {
+        v = last_pv(mesh_pv[i].name);
+        CHECK(v && v->cls == mesh_pv[i].cls && v->count == mesh_pv[i].count);
+        CHECK(v && memcmp(v->data, mesh_pv[i].data,
+                          v->count * (i == 1 ? 2 : 3) * sizeof(float)) == 0);
+    }
+    CHECK(parse(patch_rib) == RAYES_OK);
+    v = last_pv("st");
+    CHECK(v && v->cls == RAYES_PRIMVAR_VARYING && memcmp(v->data, st, 8 * sizeof(float)) == 0);
+}
+
 TEST_MAIN(TEST(test_camera_and_transforms), TEST(test_settings), TEST(test_shaders_and_lights),
           TEST(test_parameter_classes), TEST(test_polygons), TEST(test_patch_mesh_bases),
           TEST(test_objects_and_frames), TEST(test_binary), TEST(test_gzip), TEST(test_errors),
           TEST(test_aqsis_files), TEST(test_scene_sink),
-          TEST(test_writer_round_trip))
+          TEST(test_writer_round_trip), TEST(test_writer_primvars))
