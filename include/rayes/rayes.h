@@ -176,6 +176,59 @@ RAYES_API RayesError rayes_scene_polygon_mesh(RayesScene *scene, size_t n_faces,
                                               const int *n_verts, const int *indices,
                                               size_t n_points, const float *P);
 
+/* Primitive variables: values given with a patch or mesh and interpolated
+ * over its surface, as RenderMan's. Each name has a fixed size:
+ *   "N"   3 floats: the shading normal (object space, transformed like a
+ *         normal; interpolated, then normalised). The geometric normal of
+ *         the surface still decides its front, ray offsets and shadows; a
+ *         supplied normal pointing to the back is turned to the front
+ *         side. A displacement shader replaces it with the displaced
+ *         surface's normal.
+ *   "st"  2 floats: the texture coordinates shaders get as s and t (and
+ *         texture filter widths derived from them). Default: (u, v).
+ *   "Cs"  3 floats: the surface colour, replacing the shader's Cs.
+ * A class says how many values there are (count) and how they are
+ * interpolated:
+ *   CONSTANT     1 for the whole call
+ *   UNIFORM      1 per face (patch)
+ *   VARYING      polygon mesh: 1 per point (as VERTEX); patches: 1 per
+ *                corner, in the corner order of P, interpolated bilinearly
+ *                (a bicubic patch too, as RenderMan does)
+ *   VERTEX       polygon mesh: 1 per point; bilinear patch: 1 per corner;
+ *                bicubic patch: 1 per control point (16, in P's order),
+ *                interpolated with the Bezier basis as P is
+ *   FACEVARYING  1 per face corner (polygon mesh: in the order of indices;
+ *                a patch: its 4 corners)
+ * Mesh faces interpolate point and corner values bilinearly on quads and
+ * barycentrically on triangles. The data are copied. A name not listed,
+ * a class out of range, a count that does not match, a name given twice
+ * or a non-finite value is RAYES_ERROR_INVALID_ARGUMENT. */
+typedef enum RayesPrimvarClass {
+    RAYES_PRIMVAR_CONSTANT = 0,
+    RAYES_PRIMVAR_UNIFORM = 1,
+    RAYES_PRIMVAR_VARYING = 2,
+    RAYES_PRIMVAR_VERTEX = 3,
+    RAYES_PRIMVAR_FACEVARYING = 4
+} RayesPrimvarClass;
+
+typedef struct RayesPrimvar {
+    const char *name;        /* "N", "st" or "Cs" */
+    RayesPrimvarClass cls;   /* how many values and how they are interpolated */
+    const float *data;       /* count values of the name's size, back to back */
+    size_t count;            /* values (not floats) */
+} RayesPrimvar;
+
+/* The patch and mesh calls above with primitive variables (pv may be NULL
+ * when n_pv is 0; the calls above are these with none). */
+RAYES_API RayesError rayes_scene_bilinear_patch_pv(RayesScene *scene, const float P[4][3],
+                                                   const RayesPrimvar *pv, size_t n_pv);
+RAYES_API RayesError rayes_scene_bicubic_patch_pv(RayesScene *scene, const float P[16][3],
+                                                  const RayesPrimvar *pv, size_t n_pv);
+RAYES_API RayesError rayes_scene_polygon_mesh_pv(RayesScene *scene, size_t n_faces,
+                                                 const int *n_verts, const int *indices,
+                                                 size_t n_points, const float *P,
+                                                 const RayesPrimvar *pv, size_t n_pv);
+
 /* A sphere of the given radius centred at the object-space origin. */
 RAYES_API RayesError rayes_scene_sphere(RayesScene *scene, float radius);
 

@@ -44,6 +44,10 @@ void geom_gridset_fini(GridSet *gs)
     free(gs->dPdu);
     free(gs->dPdv);
     free(gs->uv);
+    free(gs->Ns);
+    free(gs->st);
+    free(gs->dst);
+    free(gs->Cs);
     memset(gs, 0, sizeof *gs);
 }
 
@@ -114,7 +118,38 @@ static Estimate estimate(const Prim *prim, const Domain *d, const DiceCamera *ca
     return e;
 }
 
-static int reserve(GridSet *gs, size_t n_vertices)
+/* Grows (or first allocates, when a GEOM_PV_* bit of want is new) the
+ * primitive variable arrays to cap vertices. */
+static int reserve_primvars(GridSet *gs, size_t cap, unsigned want)
+{
+    unsigned have = gs->pv_arrays | want;
+    if (have & GEOM_PV_N) {
+        Vec3 *Ns = realloc(gs->Ns, cap * sizeof *Ns);
+        if (!Ns)
+            return -1;
+        gs->Ns = Ns;
+    }
+    if (have & GEOM_PV_ST) {
+        float(*st)[2] = realloc(gs->st, cap * sizeof *st);
+        if (st)
+            gs->st = st;
+        float(*dst)[4] = realloc(gs->dst, cap * sizeof *dst);
+        if (dst)
+            gs->dst = dst;
+        if (!st || !dst)
+            return -1;
+    }
+    if (have & GEOM_PV_CS) {
+        Vec3 *Cs = realloc(gs->Cs, cap * sizeof *Cs);
+        if (!Cs)
+            return -1;
+        gs->Cs = Cs;
+    }
+    gs->pv_arrays = have;
+    return 0;
+}
+
+static int reserve(GridSet *gs, size_t n_vertices, unsigned primvars)
 {
     if (gs->n_grids == gs->cap_grids) {
         size_t cap = gs->cap_grids ? 2 * gs->cap_grids : 64;
@@ -144,19 +179,39 @@ static int reserve(GridSet *gs, size_t n_vertices)
         float(*uv)[2] = realloc(gs->uv, cap * sizeof *uv);
         if (uv)
             gs->uv = uv;
-        if (!P || !N || !du || !dv || !uv)
+        if (!P || !N || !du || !dv || !uv || reserve_primvars(gs, cap, gs->pv_arrays) != 0)
             return -1;
         gs->cap_vertices = cap;
     }
+    if ((primvars & ~gs->pv_arrays) && reserve_primvars(gs, gs->cap_vertices, primvars) != 0)
+        return -1;
     return 0;
 }
 
-static void put_vertex(GridSet *gs, size_t k, const Prim *prim, float u, float v)
+static void put_vertex(GridSet *gs, size_t k, const Prim *prim, const float *pool, float u,
+                       float v)
 {
     geom_prim_eval(prim, u, v, &gs->P[k], &gs->dPdu[k], &gs->dPdv[k]);
     gs->N[k] = geom_prim_normal(prim, u, v);
     gs->uv[k][0] = u;
     gs->uv[k][1] = v;
+    if (!prim->pv)
+        return;
+    PrimvarSample s;
+    geom_prim_primvars(prim, pool, u, v, &s);
+    if (prim->pv & GEOM_PV_N) {
+        /* The front is the geometric one: a supplied normal on the back
+         * (the other winding convention, a mirror) is turned round, and
+         * one that interpolates to nothing is the geometric normal. */
+        float c = v3_dot(s.N, gs->N[k]);
+        gs->Ns[k] = v3_length(s.N) > 0.0f ? (c < 0.0f ? v3_neg(s.N) : s.N) : gs->N[k];
+    }
+    if (prim->pv & GEOM_PV_ST) {
+        memcpy(gs->st[k], s.st, sizeof gs->st[k]);
+        memcpy(gs->dst[k], s.dst, sizeof gs->dst[k]);
+    }
+    if (prim->pv & GEOM_PV_CS)
+        gs->Cs[k] = s.Cs;
 }
 
 /* One neighbour pair, in one of two passes: the first sums edge lengths;
@@ -205,21 +260,22 @@ void geom_grid_measure(GridSet *gs, Grid *g)
     g->curvature = curv;
 }
 
-static int dice_quad(GridSet *gs, const Prim *prim, uint32_t prim_index, const Domain *d, Estimate e)
+static int dice_quad(GridSet *gs, const Prim *prim, uint32_t prim_index, const float *pool,
+                     const Domain *d, Estimate e)
 {
     int nu = RY_MIN(e.n_u, GEOM_MAX_GRID - 1) + 1, nv = RY_MIN(e.n_v, GEOM_MAX_GRID - 1) + 1;
-    if (reserve(gs, (size_t)nu * nv) != 0)
+    if (reserve(gs, (size_t)nu * nv, prim->pv) != 0)
         return -1;
     Grid *g = &gs->grids[gs->n_grids];
     *g = (Grid){.prim = prim_index, .object = prim->object, .first_vertex = (uint32_t)gs->n_vertices,
-                .nu = (uint16_t)nu, .nv = (uint16_t)nv};
+                .nu = (uint16_t)nu, .nv = (uint16_t)nv, .primvars = prim->pv};
     memcpy(g->uv, d->c, sizeof g->uv);
     size_t base = gs->n_vertices;
     for (int j = 0; j < nv; j++)
         for (int i = 0; i < nu; i++) {
             float u, v;
             domain_uv(d, (float)i / (nu - 1), (float)j / (nv - 1), &u, &v);
-            put_vertex(gs, base + (size_t)j * nu + i, prim, u, v);
+            put_vertex(gs, base + (size_t)j * nu + i, prim, pool, u, v);
         }
     gs->n_vertices += (size_t)nu * nv;
     geom_grid_measure(gs, g);
@@ -227,23 +283,23 @@ static int dice_quad(GridSet *gs, const Prim *prim, uint32_t prim_index, const D
     return 0;
 }
 
-static int dice_triangle(GridSet *gs, const Prim *prim, uint32_t prim_index, const Domain *d,
-                         Estimate e)
+static int dice_triangle(GridSet *gs, const Prim *prim, uint32_t prim_index, const float *pool,
+                         const Domain *d, Estimate e)
 {
     uint32_t n = (uint32_t)RY_MIN(e.n_u, GEOM_MAX_GRID - 1);
     size_t count = (size_t)(n + 1) * (n + 2) / 2;
-    if (reserve(gs, count) != 0)
+    if (reserve(gs, count, prim->pv) != 0)
         return -1;
     Grid *g = &gs->grids[gs->n_grids];
     *g = (Grid){.prim = prim_index, .object = prim->object, .first_vertex = (uint32_t)gs->n_vertices,
-                .nu = (uint16_t)n, .nv = 0, .triangular = 1};
+                .nu = (uint16_t)n, .nv = 0, .triangular = 1, .primvars = prim->pv};
     memcpy(g->uv, d->c, sizeof g->uv);
     size_t base = gs->n_vertices;
     for (uint32_t j = 0; j <= n; j++)
         for (uint32_t i = 0; i + j <= n; i++) {
             float u, v;
             domain_uv(d, (float)i / n, (float)j / n, &u, &v);
-            put_vertex(gs, base + geom_tri_vertex(n, i, j), prim, u, v);
+            put_vertex(gs, base + geom_tri_vertex(n, i, j), prim, pool, u, v);
         }
     gs->n_vertices += count;
     geom_grid_measure(gs, g);
@@ -251,15 +307,15 @@ static int dice_triangle(GridSet *gs, const Prim *prim, uint32_t prim_index, con
     return 0;
 }
 
-static int split_dice(GridSet *gs, const Prim *prim, uint32_t prim_index, const Domain *d,
-                      const DiceCamera *cam, int depth)
+static int split_dice(GridSet *gs, const Prim *prim, uint32_t prim_index, const float *pool,
+                      const Domain *d, const DiceCamera *cam, int depth)
 {
     const int max_n = GEOM_MAX_GRID - 1;
     Estimate e = estimate(prim, d, cam);
     int split_u = e.n_u > max_n, split_v = e.n_v > max_n;
     if ((!split_u && !split_v) || depth >= MAX_SPLIT_DEPTH)
-        return d->triangular ? dice_triangle(gs, prim, prim_index, d, e)
-                             : dice_quad(gs, prim, prim_index, d, e);
+        return d->triangular ? dice_triangle(gs, prim, prim_index, pool, d, e)
+                             : dice_quad(gs, prim, prim_index, pool, d, e);
     if (d->triangular) {
         /* Four sub-triangles at the edge midpoints; corners 0, 1, 2 first,
          * the middle one last. */
@@ -275,7 +331,7 @@ static int split_dice(GridSet *gs, const Prim *prim, uint32_t prim_index, const 
             Domain sub = {.triangular = 1};
             for (int c = 0; c < 3; c++)
                 memcpy(sub.c[c], corners[s][c], sizeof sub.c[c]);
-            if (split_dice(gs, prim, prim_index, &sub, cam, depth + 1) != 0)
+            if (split_dice(gs, prim, prim_index, pool, &sub, cam, depth + 1) != 0)
                 return -1;
         }
         return 0;
@@ -294,13 +350,14 @@ static int split_dice(GridSet *gs, const Prim *prim, uint32_t prim_index, const 
             sub.c[1][0] = i + 1 == su ? d->c[1][0] : d->c[0][0] + du * (i + 1);
             sub.c[0][1] = d->c[0][1] + dv * j;
             sub.c[1][1] = j + 1 == sv ? d->c[1][1] : d->c[0][1] + dv * (j + 1);
-            if (split_dice(gs, prim, prim_index, &sub, cam, depth + 1) != 0)
+            if (split_dice(gs, prim, prim_index, pool, &sub, cam, depth + 1) != 0)
                 return -1;
         }
     return 0;
 }
 
-int geom_dice_prim(GridSet *gs, const Prim *prim, uint32_t prim_index, const DiceCamera *cam)
+int geom_dice_prim(GridSet *gs, const Prim *prim, uint32_t prim_index, const float *pv_pool,
+                   const DiceCamera *cam)
 {
     Domain d = {.triangular = prim->type == PRIM_TRIANGLE};
     if (d.triangular) {
@@ -310,5 +367,5 @@ int geom_dice_prim(GridSet *gs, const Prim *prim, uint32_t prim_index, const Dic
         const float c[3][2] = {{0, 0}, {1, 1}, {0, 0}};
         memcpy(d.c, c, sizeof c);
     }
-    return split_dice(gs, prim, prim_index, &d, cam, 0);
+    return split_dice(gs, prim, prim_index, pv_pool, &d, cam, 0);
 }

@@ -38,9 +38,22 @@ typedef enum PrimType {
                           swept about object-space z; see geom_quadric_eval */
 } PrimType;
 
+/* Primitive variables a primitive may carry (rayes.h's RayesPrimvar), as
+ * bits of Prim.pv and Grid.primvars. */
+enum {
+    GEOM_PV_N = 1u << 0,  /* shading normal, 3 floats */
+    GEOM_PV_ST = 1u << 1, /* texture coordinates, 2 floats */
+    GEOM_PV_CS = 1u << 2  /* surface colour, 3 floats */
+};
+
 typedef struct Prim {
     PrimType type;
     uint32_t object;       /* the object (shader, attributes) it belongs to */
+    uint8_t pv;            /* GEOM_PV_* bits: the primitive variables it carries */
+    uint8_t pv_cubic;      /* of those, the ones with 16 Bezier control values (a bicubic
+                              patch's vertex class); the others have one per corner */
+    size_t pv_first;       /* index of its first value in the scene's primvar pool: per
+                              variable in bit order, per control value, its floats */
     float shading_rate;    /* micropolygon area in pixels */
     uint32_t displacement; /* the scene's displacement shader + 1, or 0: none */
     float displacement_bound; /* world units; 0: unbounded */
@@ -69,6 +82,26 @@ void geom_quadric_eval(const Prim *prim, float u, float v, Vec3 *P, Vec3 *dPdu, 
  * world space. */
 void geom_prim_eval(const Prim *prim, float u, float v, Vec3 *P, Vec3 *dPdu, Vec3 *dPdv);
 
+/* Primitive variables at one point. */
+typedef struct PrimvarSample {
+    Vec3 N;                /* unit shading normal, world (GEOM_PV_N) */
+    float st[2];           /* texture coordinates (GEOM_PV_ST) */
+    float dst[4];          /* ds/du, ds/dv, dt/du, dt/dv (GEOM_PV_ST) */
+    Vec3 Cs;               /* surface colour (GEOM_PV_CS) */
+} PrimvarSample;
+
+/* The number of control values per variable of a primitive without
+ * pv_cubic: its corners (4 for patches, 3 for triangles). */
+int geom_prim_corners(const Prim *prim);
+
+/* Interpolates prim's primitive variables (those of prim->pv; the other
+ * fields of out are left alone) at (u, v) from its values in pool:
+ * bilinear over the corners of patches (bicubic ones too), barycentric on
+ * triangles, with the Bezier basis for pv_cubic values. The normal is not
+ * yet turned toward dPdu x dPdv (see geom_dice_prim). */
+void geom_prim_primvars(const Prim *prim, const float *pool, float u, float v,
+                        PrimvarSample *out);
+
 /* The unit normal at (u, v): dPdu x dPdv, or at a degenerate point (a pole,
  * a collapsed patch row) the normal a little way inside the patch. */
 Vec3 geom_prim_normal(const Prim *prim, float u, float v);
@@ -83,6 +116,8 @@ typedef struct Grid {
     float curvature;       /* largest |dN| / |dP| between neighbouring vertices, 1/units */
     float uv[3][2];        /* corners in the primitive's (u, v): quad (u0,v0), (u1,v1);
                               triangle: the three corners */
+    uint8_t primvars;      /* GEOM_PV_* bits: the GridSet's Ns, st, Cs hold its vertices'
+                              values (else: N, uv, the object's colour) */
 } Grid;
 
 typedef struct GridSet {
@@ -92,6 +127,13 @@ typedef struct GridSet {
     Vec3 *N;               /* unit normals, world (front = dPdu x dPdv) */
     Vec3 *dPdu, *dPdv;     /* derivatives with respect to the primitive's u, v */
     float (*uv)[2];        /* the primitive's (u, v) at the vertex */
+    /* Primitive variables, allocated (for every vertex) once any grid has
+     * them, valid at the vertices of grids whose primvars bit says so. */
+    Vec3 *Ns;              /* unit shading normals, on N's side (GEOM_PV_N) */
+    float (*st)[2];        /* texture coordinates (GEOM_PV_ST) */
+    float (*dst)[4];       /* their derivatives ds/du, ds/dv, dt/du, dt/dv (GEOM_PV_ST) */
+    Vec3 *Cs;              /* surface colours (GEOM_PV_CS) */
+    unsigned pv_arrays;    /* GEOM_PV_* bits of the arrays allocated */
     size_t n_vertices;
     size_t cap_grids, cap_vertices;
 } GridSet;
@@ -107,9 +149,12 @@ typedef struct DiceCamera {
 void geom_gridset_init(GridSet *gs);
 void geom_gridset_fini(GridSet *gs);
 
-/* Splits prim into patches and dices each into a grid appended to gs.
- * Returns 0, or -1 when out of memory (gs keeps what was added). */
-int geom_dice_prim(GridSet *gs, const Prim *prim, uint32_t prim_index, const DiceCamera *cam);
+/* Splits prim into patches and dices each into a grid appended to gs; its
+ * primitive variables (if any) come from pv_pool and are interpolated at
+ * every vertex, the shading normal turned to the side of N. Returns 0, or
+ * -1 when out of memory (gs keeps what was added). */
+int geom_dice_prim(GridSet *gs, const Prim *prim, uint32_t prim_index, const float *pv_pool,
+                   const DiceCamera *cam);
 
 /* Recomputes a grid's mean edge and curvature from its vertices (after
  * displacement has moved them). */
@@ -125,6 +170,32 @@ static inline size_t geom_grid_n_vertices(const Grid *g)
 static inline uint32_t geom_tri_vertex(uint32_t n, uint32_t i, uint32_t j)
 {
     return j * (n + 1) - j * (j - 1) / 2 + i;
+}
+
+/* What vertex i (of grid g) shades with: the shading normal (N without
+ * one), the texture coordinates and their derivatives with respect to
+ * (u, v) ((u, v) and the identity without), and the colour (dflt without). */
+static inline Vec3 geom_vertex_normal(const GridSet *gs, const Grid *g, size_t i)
+{
+    return (g->primvars & GEOM_PV_N) ? gs->Ns[i] : gs->N[i];
+}
+
+static inline void geom_vertex_st(const GridSet *gs, const Grid *g, size_t i, float st[2],
+                                  float dst[4])
+{
+    if (g->primvars & GEOM_PV_ST) {
+        st[0] = gs->st[i][0], st[1] = gs->st[i][1];
+        for (int k = 0; k < 4; k++)
+            dst[k] = gs->dst[i][k];
+    } else {
+        st[0] = gs->uv[i][0], st[1] = gs->uv[i][1];
+        dst[0] = 1.0f, dst[1] = 0.0f, dst[2] = 0.0f, dst[3] = 1.0f;
+    }
+}
+
+static inline Vec3 geom_vertex_color(const GridSet *gs, const Grid *g, size_t i, Vec3 dflt)
+{
+    return (g->primvars & GEOM_PV_CS) ? gs->Cs[i] : dflt;
 }
 
 /* Bernstein polynomials of degree 3 at t, and their derivatives. */

@@ -7,6 +7,7 @@
 #include "geom/geom.h"
 
 #include <math.h>
+#include <string.h>
 
 void geom_bezier_basis(float t, float b[4], float db[4])
 {
@@ -182,4 +183,67 @@ Vec3 geom_prim_normal(const Prim *prim, float u, float v)
             return v3_normalize(n);
     }
     return v3(0.0f, 0.0f, 1.0f);
+}
+
+int geom_prim_corners(const Prim *prim)
+{
+    return prim->type == PRIM_TRIANGLE ? 3 : 4;
+}
+
+/* Interpolation weights of the control values and their u and v
+ * derivatives: Bezier products (16), bilinear corners P00 P10 P01 P11 (4),
+ * or barycentric corners (3). Returns the count. */
+static int primvar_weights(const Prim *prim, int cubic, float u, float v, float w[16],
+                           float wu[16], float wv[16])
+{
+    if (cubic) {
+        float bu[4], dbu[4], bv[4], dbv[4];
+        geom_bezier_basis(u, bu, dbu);
+        geom_bezier_basis(v, bv, dbv);
+        for (int j = 0; j < 4; j++)
+            for (int i = 0; i < 4; i++) {
+                w[4 * j + i] = bu[i] * bv[j];
+                wu[4 * j + i] = dbu[i] * bv[j];
+                wv[4 * j + i] = bu[i] * dbv[j];
+            }
+        return 16;
+    }
+    if (prim->type == PRIM_TRIANGLE) {
+        const float t[3] = {1.0f - u - v, u, v}, tu[3] = {-1, 1, 0}, tv[3] = {-1, 0, 1};
+        memcpy(w, t, sizeof t), memcpy(wu, tu, sizeof tu), memcpy(wv, tv, sizeof tv);
+        return 3;
+    }
+    const float b[4] = {(1 - u) * (1 - v), u * (1 - v), (1 - u) * v, u * v};
+    const float bu[4] = {-(1 - v), 1 - v, -v, v}, bv[4] = {-(1 - u), -u, 1 - u, u};
+    memcpy(w, b, sizeof b), memcpy(wu, bu, sizeof bu), memcpy(wv, bv, sizeof bv);
+    return 4;
+}
+
+void geom_prim_primvars(const Prim *prim, const float *pool, float u, float v,
+                        PrimvarSample *out)
+{
+    static const unsigned bits[3] = {GEOM_PV_N, GEOM_PV_ST, GEOM_PV_CS};
+    static const int sizes[3] = {3, 2, 3};
+    if (!prim->pv)
+        return;
+    const float *p = pool + prim->pv_first;
+    for (int b = 0; b < 3; b++) {
+        if (!(prim->pv & bits[b]))
+            continue;
+        float w[16], wu[16], wv[16], val[3] = {0, 0, 0}, du[3] = {0, 0, 0}, dv[3] = {0, 0, 0};
+        int n = primvar_weights(prim, (prim->pv_cubic & bits[b]) != 0, u, v, w, wu, wv);
+        for (int k = 0; k < n; k++, p += sizes[b])
+            for (int c = 0; c < sizes[b]; c++) {
+                val[c] += w[k] * p[c];
+                du[c] += wu[k] * p[c];
+                dv[c] += wv[k] * p[c];
+            }
+        if (bits[b] == GEOM_PV_N)
+            out->N = v3_normalize(v3(val[0], val[1], val[2]));
+        else if (bits[b] == GEOM_PV_ST) {
+            out->st[0] = val[0], out->st[1] = val[1];
+            out->dst[0] = du[0], out->dst[1] = dv[0], out->dst[2] = du[1], out->dst[3] = dv[1];
+        } else
+            out->Cs = v3(val[0], val[1], val[2]);
+    }
 }

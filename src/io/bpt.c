@@ -81,7 +81,7 @@ RayesError io_parse_bpt(const char *name, const char *text, size_t size, const I
         float P[16][3];
         for (int k = 0; k < 16; k++)
             memcpy(P[k], &b.points[3 * b.index[p * 16 + k]], sizeof P[k]);
-        e = sink->bicubic_patch(sink->target, (const float(*)[3])P);
+        e = sink->bicubic_patch(sink->target, (const float(*)[3])P, NULL, 0);
         if (e != RAYES_OK)
             snprintf(err, err_size, "%s: %s", name, sink->get_error(sink->target));
     }

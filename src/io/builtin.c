@@ -39,7 +39,7 @@ static RayesError quads(const IoSink *s, const Quad *q, size_t n)
         nv[0] = 4;
         for (int k = 0; k < 4; k++)
             idx[k] = k;
-        e = s->polygon_mesh(s->target, 1, nv, idx, 4, &q[i].P[0][0]);
+        e = s->polygon_mesh(s->target, 1, nv, idx, 4, &q[i].P[0][0], NULL, 0);
     }
     return e;
 }

@@ -239,9 +239,11 @@ typedef struct Obj {
     const char *name;        /* the OBJ file, for messages */
     char dir[2048];          /* its directory with a final '/', or "" */
     FloatVec v;              /* x y z per vertex */
-    size_t n_vt, n_vn;       /* counts (the values cannot be passed on yet) */
+    size_t n_vt, n_vn;       /* counts */
+    FloatVec vt, vn;         /* u v per texture coordinate, x y z per normal */
     IntVec face_nv;          /* vertices per face */
-    IntVec face_idx;         /* 0-based vertex indices, face after face */
+    IntVec face_idx;         /* 0-based vertex indices, face after face (per corner) */
+    IntVec face_vt, face_vn; /* per corner: 0-based vt and vn indices, -1 none */
     IntVec face_mat;         /* material per face, -1 the default */
     Material *mats;
     size_t n_mats, cap_mats;
@@ -498,12 +500,12 @@ static int corner_index(Lexer *L, const char *tok, size_t n, size_t count, const
     return 0;
 }
 
-/* "v", "v/vt", "v//vn" or "v/vt/vn". */
-static int face_corner(Obj *o, Lexer *L, const char *tok, size_t n, int *vi)
+/* "v", "v/vt", "v//vn" or "v/vt/vn"; *ti and *ni are -1 when absent. */
+static int face_corner(Obj *o, Lexer *L, const char *tok, size_t n, int *vi, int *ti, int *ni)
 {
     const char *s1 = memchr(tok, '/', n);
     size_t n0 = s1 ? (size_t)(s1 - tok) : n;
-    int dummy;
+    *ti = *ni = -1;
     if (corner_index(L, tok, n0, o->v.n / 3, "a vertex index", vi) != 0)
         return -1;
     if (!s1)
@@ -512,12 +514,12 @@ static int face_corner(Obj *o, Lexer *L, const char *tok, size_t n, int *vi)
     const char *s2 = memchr(t, '/', (size_t)(end - t));
     size_t n1 = s2 ? (size_t)(s2 - t) : (size_t)(end - t);
     if ((n1 > 0 || !s2) && corner_index(L, t, n1, o->n_vt, "a texture coordinate index",
-                                         &dummy) != 0)
+                                         ti) != 0)
         return -1;
     if (!s2)
         return 0;
     t = s2 + 1;
-    return corner_index(L, t, (size_t)(end - t), o->n_vn, "a normal index", &dummy);
+    return corner_index(L, t, (size_t)(end - t), o->n_vn, "a normal index", ni);
 }
 
 static int obj_face(Obj *o, Lexer *L, const char *kw)
@@ -526,15 +528,18 @@ static int obj_face(Obj *o, Lexer *L, const char *kw)
     size_t n;
     int count = 0;
     while ((n = lex_token(L, &tok)) > 0) {
-        int vi;
-        if (face_corner(o, L, tok, n, &vi) != 0)
+        int vi, ti, ni;
+        if (face_corner(o, L, tok, n, &vi, &ti, &ni) != 0)
             return -1;
-        if (ipush(&o->face_idx, vi) != 0)
+        if (ipush(&o->face_idx, vi) != 0 || ipush(&o->face_vt, ti) != 0 ||
+            ipush(&o->face_vn, ni) != 0)
             return oom(L);
         count++;
     }
     if (count < 3) {
         o->face_idx.n -= (size_t)count;
+        o->face_vt.n -= (size_t)count;
+        o->face_vn.n -= (size_t)count;
         return lex_error_at(L, count ? tok : kw, "expected at least 3 vertices in a face, found %d",
                             count);
     }
@@ -568,20 +573,26 @@ static int obj_vertex(Obj *o, Lexer *L)
     return 0;
 }
 
-/* vt u [v [w]], vn x y z: checked and counted. */
-static int obj_attribute(Lexer *L, int min, int max, size_t *count)
+/* vt u [v [w]], vn x y z: checked, counted, and the first keep values
+ * (missing ones 0) pushed onto values. */
+static int obj_attribute(Lexer *L, int min, int max, int keep, size_t *count, FloatVec *values)
 {
     const char *tok;
     size_t n;
     int k = 0;
-    float f;
+    float f[3] = {0, 0, 0};
     while ((n = lex_token(L, &tok)) > 0) {
-        if (k == max || parse_float(tok, n, &f) != 0)
+        if (k == max || parse_float(tok, n, &f[k]) != 0)
             return lex_expected(L, tok, n, k == max ? "the end of the line" : "a number");
         k++;
     }
     if (k < min)
         return lex_expected(L, tok, 0, "a number");
+    if (*count >= INT_MAX - 1)
+        return lex_error_at(L, L->p, "too many vertex attributes");
+    for (int c = 0; c < keep; c++)
+        if (fpush(values, f[c]) != 0)
+            return oom(L);
     (*count)++;
     return 0;
 }
@@ -591,9 +602,9 @@ static int obj_statement(Obj *o, Lexer *L, const char *kw, size_t n)
     if (is_kw(kw, n, "v"))
         return obj_vertex(o, L);
     if (is_kw(kw, n, "vt"))
-        return obj_attribute(L, 1, 3, &o->n_vt);
+        return obj_attribute(L, 1, 3, 2, &o->n_vt, &o->vt);
     if (is_kw(kw, n, "vn"))
-        return obj_attribute(L, 3, 3, &o->n_vn);
+        return obj_attribute(L, 3, 3, 3, &o->n_vn, &o->vn);
     if (is_kw(kw, n, "f") || is_kw(kw, n, "fo"))
         return obj_face(o, L, kw);
     if (is_kw(kw, n, "g") || is_kw(kw, n, "o") || is_kw(kw, n, "s")) {
@@ -637,7 +648,7 @@ static int obj_parse_text(Obj *o, const char *text, size_t size)
 /* ------------------------------------------------------ triangulation */
 
 typedef struct Mesh {
-    IntVec nv, idx;   /* faces of 3 or 4 vertices, global vertex indices */
+    IntVec nv, idx;   /* faces of 3 or 4 corners: indices into Obj.face_idx (vt, vn) */
 } Mesh;
 
 static const float *vtx(const Obj *o, int i)
@@ -704,7 +715,7 @@ static int mesh_face(Mesh *m, int a, int b, int c, int d)
  * (O(n^2) per ear at worst, so big faces are fanned instead);
  * when no ear is found (a self-intersecting or degenerate polygon) the
  * first remaining vertex is clipped anyway, so every input ends. */
-static int ear_clip(Mesh *m, const int *f, int n, double (*q)[2])
+static int ear_clip(Mesh *m, int base, int n, double (*q)[2])
 {
     int *next = malloc((size_t)n * 2 * sizeof *next);
     if (!next)
@@ -721,7 +732,7 @@ static int ear_clip(Mesh *m, const int *f, int n, double (*q)[2])
         for (int k = next[c]; ear && k != a; k = next[k])
             ear = !inside(q[a], q[b], q[c], q[k]);
         if (ear || tried == left) {
-            r = mesh_face(m, f[a], f[b], f[c], -1);
+            r = mesh_face(m, base + a, base + b, base + c, -1);
             next[a] = c;
             prev[c] = a;
             left--;
@@ -733,14 +744,16 @@ static int ear_clip(Mesh *m, const int *f, int n, double (*q)[2])
         }
     }
     if (r == 0)
-        r = mesh_face(m, f[prev[cur]], f[cur], f[next[cur]], -1);
+        r = mesh_face(m, base + prev[cur], base + cur, base + next[cur], -1);
     free(next);
     return r;
 }
 
-/* A face into m: triangles and convex quads as they are, others split. */
-static int triangulate(Obj *o, Mesh *m, const int *f, int n)
+/* The face of n corners from corner base into m: triangles and convex
+ * quads as they are, others split. */
+static int triangulate(Obj *o, Mesh *m, int base, int n)
 {
+    const int *f = &o->face_idx.a[base];
     double N[3];
     newell(o, f, n, N);
     if (!(N[0] * N[0] + N[1] * N[1] + N[2] * N[2] > 0.0)) {
@@ -748,12 +761,12 @@ static int triangulate(Obj *o, Mesh *m, const int *f, int n)
         return 0;
     }
     if (n == 3)
-        return mesh_face(m, f[0], f[1], f[2], -1);
+        return mesh_face(m, base, base + 1, base + 2, -1);
     if (n > OBJ_MAX_EARCLIP) {
         obj_warn(o, "fan", "%s: faces of more than %d vertices are split as fans", o->name,
                  OBJ_MAX_EARCLIP);
         for (int i = 1; i + 1 < n; i++)
-            if (mesh_face(m, f[0], f[i], f[i + 1], -1) != 0)
+            if (mesh_face(m, base, base + i, base + i + 1, -1) != 0)
                 return -1;
         return 0;
     }
@@ -764,7 +777,7 @@ static int triangulate(Obj *o, Mesh *m, const int *f, int n)
     int convex = n == 4;
     for (int i = 0; convex && i < 4; i++)
         convex = cross2(q[i], q[(i + 1) % 4], q[(i + 2) % 4]) > 0.0;
-    int r = convex ? mesh_face(m, f[0], f[1], f[2], f[3]) : ear_clip(m, f, n, q);
+    int r = convex ? mesh_face(m, base, base + 1, base + 2, base + 3) : ear_clip(m, base, n, q);
     free(q);
     return r;
 }
@@ -841,6 +854,45 @@ static RayesError material_shader(Emit *e, const Material *m)
     return set_shader(e, m->map_Kd[0] ? "paintedplastic" : "plastic", p, n, m->name);
 }
 
+/* The facevarying N (vn) and st (vt: t = 1 - v, OBJ's v running up the
+ * image) of mesh m's corners into pv, when every corner has them (with
+ * one warning when only some do). Returns the count; the data are in
+ * *store (free it). */
+static size_t corner_primvars(Emit *e, const Mesh *m, RayesPrimvar pv[2], float **store)
+{
+    const Obj *o = e->o;
+    size_t n = m->idx.n, k = 0;
+    int has[2] = {1, 1}, any[2] = {0, 0};
+    for (size_t i = 0; i < n; i++) {
+        int c = m->idx.a[i], vals[2] = {o->face_vn.a[c], o->face_vt.a[c]};
+        for (int q = 0; q < 2; q++)
+            has[q] &= vals[q] >= 0, any[q] |= vals[q] >= 0;
+    }
+    for (int q = 0; q < 2; q++)
+        if (any[q] && !has[q])
+            obj_warn(e->o, q ? "some vt" : "some vn", "%s: faces of one material with and "
+                     "without %s: the %s are not used", o->name, q ? "vt" : "vn",
+                     q ? "texture coordinates" : "normals");
+    *store = has[0] || has[1] ? malloc(n * 5 * sizeof **store) : NULL;
+    if (!*store)
+        return 0;
+    float *N = *store, *st = *store + 3 * n;
+    for (size_t i = 0; i < n; i++) {
+        int c = m->idx.a[i];
+        if (has[0])
+            memcpy(N + 3 * i, &o->vn.a[3 * (size_t)o->face_vn.a[c]], 3 * sizeof *N);
+        if (has[1]) {
+            const float *t = &o->vt.a[2 * (size_t)o->face_vt.a[c]];
+            st[2 * i] = t[0], st[2 * i + 1] = 1.0f - t[1];
+        }
+    }
+    if (has[0])
+        pv[k++] = (RayesPrimvar){"N", RAYES_PRIMVAR_FACEVARYING, N, n};
+    if (has[1])
+        pv[k++] = (RayesPrimvar){"st", RAYES_PRIMVAR_FACEVARYING, st, n};
+    return k;
+}
+
 /* The faces of mesh m as one polygon mesh, with only the points they use. */
 static RayesError emit_mesh(Emit *e, const Mesh *m, const char *mat)
 {
@@ -850,7 +902,7 @@ static RayesError emit_mesh(Emit *e, const Mesh *m, const char *mat)
     e->P.n = 0;
     RayesError r = idx.a ? RAYES_OK : RAYES_ERROR_OUT_OF_MEMORY;
     for (size_t i = 0; i < m->idx.n && r == RAYES_OK; i++) {
-        int g = m->idx.a[i];
+        int g = e->o->face_idx.a[m->idx.a[i]];
         if (e->local[g] < 0) {
             const float *p = vtx(e->o, g);
             e->local[g] = (int)(e->P.n / 3);
@@ -864,9 +916,13 @@ static RayesError emit_mesh(Emit *e, const Mesh *m, const char *mat)
         idx.a[i] = e->local[g];
     }
     for (size_t i = 0; i < m->idx.n; i++)
-        e->local[m->idx.a[i]] = -1;
+        e->local[e->o->face_idx.a[m->idx.a[i]]] = -1;
+    RayesPrimvar pv[2];
+    float *store = NULL;
+    size_t n_pv = r == RAYES_OK ? corner_primvars(e, m, pv, &store) : 0;
     if (r == RAYES_OK) {
-        r = e->sink->polygon_mesh(e->sink->target, m->nv.n, m->nv.a, idx.a, e->P.n / 3, e->P.a);
+        r = e->sink->polygon_mesh(e->sink->target, m->nv.n, m->nv.a, idx.a, e->P.n / 3, e->P.a,
+                                  pv, n_pv);
         if (r != RAYES_OK) {
             char what[200];
             snprintf(what, sizeof what, "the faces of material \"%s\"", mat);
@@ -875,6 +931,7 @@ static RayesError emit_mesh(Emit *e, const Mesh *m, const char *mat)
     } else {
         snprintf(e->o->err, e->o->err_size, "%s: out of memory", e->o->name);
     }
+    free(store);
     free(idx.a);
     return r;
 }
@@ -894,7 +951,7 @@ static RayesError emit_emitter(Emit *e, const Material *mt, const Mesh *m)
         }
         float P[4][3];
         for (int c = 0; c < 4; c++) {
-            memcpy(P[c], vtx(e->o, m->idx.a[k + (size_t)c]), sizeof P[c]);
+            memcpy(P[c], vtx(e->o, e->o->face_idx.a[m->idx.a[k + (size_t)c]]), sizeof P[c]);
             for (int a = 0; a < 3; a++) {
                 e->lo[a] = fminf(e->lo[a], P[c][a]);
                 e->hi[a] = fmaxf(e->hi[a], P[c][a]);
@@ -930,7 +987,7 @@ static RayesError emit_material(Emit *e, int mi)
     RayesError r = RAYES_OK;
     size_t k = 0;
     for (size_t f = 0; f < o->face_nv.n && r == RAYES_OK; k += (size_t)o->face_nv.a[f], f++)
-        if (o->face_mat.a[f] == mi && triangulate(o, &m, &o->face_idx.a[k], o->face_nv.a[f]) != 0)
+        if (o->face_mat.a[f] == mi && triangulate(o, &m, (int)k, o->face_nv.a[f]) != 0)
             r = RAYES_ERROR_OUT_OF_MEMORY;
     if (r != RAYES_OK)
         snprintf(o->err, o->err_size, "%s: out of memory", o->name);
@@ -1023,6 +1080,10 @@ RayesError io_obj_parse(const char *name, const unsigned char *data, size_t size
     free(o.v.a);
     free(o.face_nv.a);
     free(o.face_idx.a);
+    free(o.face_vt.a);
+    free(o.face_vn.a);
+    free(o.vt.a);
+    free(o.vn.a);
     free(o.face_mat.a);
     free(o.mats);
     return r;

@@ -136,11 +136,14 @@ typedef struct Op {
     size_t n_faces, n_points;
     int *n_verts, *idx;   /* owned */
     float *pts;           /* owned */
+    float *N, *uv;        /* per point, owned; NULL when not given */
     RayesQuadric q;
     float qp[8];
     size_t n_qp;
     unsigned flags;
     float patch[4][3];
+    int patch_pv;         /* GEOM-like bits: 1 patch_N, 2 patch_uv given */
+    float patch_N[4][3], patch_uv[4][2];
 } Op;
 
 typedef struct Object {
@@ -943,8 +946,50 @@ static Op *new_op(Parser *P, const Token *t, OpKind kind)
     return op;
 }
 
+/* Vertex-class primitive variables N and st from pbrt's per-point N and
+ * uv (either may be NULL): st = (u, 1 - v), since pbrt's image textures
+ * put v = 0 at the bottom and rayes' t = 0 is the top row. st_store
+ * (2 * n floats) holds the converted values. Returns the count. */
+static size_t mesh_primvars(size_t n, const float *N, const float *uv, float *st_store,
+                            RayesPrimvar pv[2])
+{
+    size_t k = 0;
+    if (N)
+        pv[k++] = (RayesPrimvar){"N", RAYES_PRIMVAR_VERTEX, N, n};
+    if (uv && st_store) {
+        for (size_t i = 0; i < n; i++)
+            st_store[2 * i] = uv[2 * i], st_store[2 * i + 1] = 1.0f - uv[2 * i + 1];
+        pv[k++] = (RayesPrimvar){"st", RAYES_PRIMVAR_VERTEX, st_store, n};
+    }
+    return k;
+}
+
+static float *copy_floats(const float *f, size_t n)
+{
+    float *c = f ? malloc((n ? n : 1) * sizeof *c) : NULL;
+    if (c)
+        memcpy(c, f, n * sizeof *c);
+    return c;
+}
+
+/* Sends (or records) a mesh with N and uv per point (NULL: none). */
+static RayesError send_mesh(Parser *P, size_t n_faces, const int *n_verts, const int *idx,
+                            size_t n_points, const float *pts, const float *N, const float *uv)
+{
+    RayesPrimvar pv[2];
+    float *st = uv ? malloc((2 * n_points + 1) * sizeof *st) : NULL;
+    if (uv && !st)
+        return RAYES_ERROR_OUT_OF_MEMORY;
+    size_t n_pv = mesh_primvars(n_points, N, uv, st, pv);
+    RayesError e = P->sink->polygon_mesh(P->sink->target, n_faces, n_verts, idx, n_points, pts,
+                                         pv, n_pv);
+    free(st);
+    return e;
+}
+
 static int emit_mesh(Parser *P, const Token *t, size_t n_faces, const int *n_verts,
-                     const int *idx, size_t n_points, const float *pts)
+                     const int *idx, size_t n_points, const float *pts, const float *N,
+                     const float *uv)
 {
     if (n_faces == 0)
         return 0;
@@ -960,7 +1005,9 @@ static int emit_mesh(Parser *P, const Token *t, size_t n_faces, const int *n_ver
         op->n_verts = malloc(n_faces * sizeof(int));
         op->idx = malloc(n_idx * sizeof(int));
         op->pts = malloc(n_points * 3 * sizeof(float));
-        if (!op->n_verts || !op->idx || !op->pts)
+        op->N = copy_floats(N, 3 * n_points);
+        op->uv = copy_floats(uv, 2 * n_points);
+        if (!op->n_verts || !op->idx || !op->pts || (N && !op->N) || (uv && !op->uv))
             return FAIL_TOK(P, t, "out of memory");
         memcpy(op->n_verts, n_verts, n_faces * sizeof(int));
         memcpy(op->idx, idx, n_idx * sizeof(int));
@@ -969,7 +1016,7 @@ static int emit_mesh(Parser *P, const Token *t, size_t n_faces, const int *n_ver
     }
     if (send_state(P, t, P->gs.ctm, &P->gs.material) != 0)
         return -1;
-    RayesError e = P->sink->polygon_mesh(P->sink->target, n_faces, n_verts, idx, n_points, pts);
+    RayesError e = send_mesh(P, n_faces, n_verts, idx, n_points, pts, N, uv);
     return e != RAYES_OK ? sink_failed(P, t, e) : 0;
 }
 
@@ -992,18 +1039,31 @@ static int emit_quadric(Parser *P, const Token *t, RayesQuadric q, const float *
     return e != RAYES_OK ? sink_failed(P, t, e) : 0;
 }
 
-static int emit_patch(Parser *P, const Token *t, const float patch[4][3])
+/* Sends a bilinear patch with N and uv at its corners (by op's patch_pv). */
+static RayesError send_patch(Parser *P, const Op *op)
+{
+    RayesPrimvar pv[2];
+    float st[4][2];
+    size_t n_pv = mesh_primvars(4, (op->patch_pv & 1) ? &op->patch_N[0][0] : NULL,
+                                (op->patch_pv & 2) ? &op->patch_uv[0][0] : NULL, &st[0][0], pv);
+    return P->sink->bilinear_patch(P->sink->target, op->patch, pv, n_pv);
+}
+
+static int emit_patch(Parser *P, const Token *t, const Op *patch)
 {
     if (P->recording) {
         Op *op = new_op(P, t, OP_PATCH);
         if (!op)
             return -1;
-        memcpy(op->patch, patch, sizeof op->patch);
+        memcpy(op->patch, patch->patch, sizeof op->patch);
+        op->patch_pv = patch->patch_pv;
+        memcpy(op->patch_N, patch->patch_N, sizeof op->patch_N);
+        memcpy(op->patch_uv, patch->patch_uv, sizeof op->patch_uv);
         return 0;
     }
     if (send_state(P, t, P->gs.ctm, &P->gs.material) != 0)
         return -1;
-    RayesError e = P->sink->bilinear_patch(P->sink->target, patch);
+    RayesError e = send_patch(P, patch);
     return e != RAYES_OK ? sink_failed(P, t, e) : 0;
 }
 
@@ -1032,12 +1092,12 @@ static int replay(Parser *P, const Token *t, const Object *o)
             return -1;
         RayesError e = RAYES_OK;
         if (op->kind == OP_MESH)
-            e = P->sink->polygon_mesh(P->sink->target, op->n_faces, op->n_verts, op->idx,
-                                      op->n_points, op->pts);
+            e = send_mesh(P, op->n_faces, op->n_verts, op->idx, op->n_points, op->pts, op->N,
+                          op->uv);
         else if (op->kind == OP_QUADRIC)
             e = P->sink->quadric(P->sink->target, op->q, op->qp, op->n_qp, op->flags);
         else
-            e = P->sink->bilinear_patch(P->sink->target, op->patch);
+            e = send_patch(P, op);
         if (e != RAYES_OK)
             return sink_failed(P, t, e);
     }
@@ -1365,7 +1425,8 @@ static int pair_quad(const float *pts, const int *a, const int *b, int q[4])
 /* A mesh of triangles and quads (indices checked): an emitter's quads go to
  * area_light, the rest to polygon_mesh with pbrt's orientation. */
 static int shape_mesh(Parser *P, const Token *t, const char *what, size_t n_faces, int *n_verts,
-                      int *idx, size_t n_points, const float *pts, const float *N)
+                      int *idx, size_t n_points, const float *pts, const float *N,
+                      const float *uv)
 {
     if (P->gs.area.on && P->recording) {
         warn_at(P, t->line, t->col, "instanced area light", "%s: area lights inside ObjectBegin "
@@ -1401,7 +1462,7 @@ static int shape_mesh(Parser *P, const Token *t, const char *what, size_t n_face
             f[n_verts[i] - 1] = tmp;
         }
     }
-    return emit_mesh(P, t, n_faces, n_verts, idx, n_points, pts);
+    return emit_mesh(P, t, n_faces, n_verts, idx, n_points, pts, N, uv);
 }
 
 /* Points of a "point3 P" parameter as floats (new, free()). */
@@ -1419,17 +1480,32 @@ static float *points_of(Parser *P, const Token *t, const Param *p)
 
 static void warn_vertex_data(Parser *P, const Token *t, ParamList *pl, const char *what)
 {
-    static const char *names[] = {"uv", "st", "S", "faceIndices", "alpha", "emissionfilename"};
+    static const char *names[] = {"S", "faceIndices", "alpha", "emissionfilename"};
     for (size_t i = 0; i < sizeof names / sizeof names[0]; i++) {
         Param *p = find(pl, names[i]);
         if (p) {
             char key[96];
             snprintf(key, sizeof key, "vertex data %.60s", names[i]);
             warn_at(P, p->line, p->col, key, "%s: \"%s\" is not passed on (rayes meshes carry "
-                    "positions only)", what, names[i]);
+                    "positions, N and uv)", what, names[i]);
         }
     }
     (void)t;
+}
+
+/* The "point2 uv" (or "st") of a mesh of n_points points, or NULL (with
+ * a warning when its count is wrong). */
+static Param *uv_param(Parser *P, ParamList *pl, const char *what, size_t n_points)
+{
+    Param *uv = find(pl, "uv");
+    if (!uv)
+        uv = find(pl, "st");
+    if (uv && uv->n_num != 2 * n_points) {
+        warn_at(P, uv->line, uv->col, "uv count", "%s: \"uv\" has %zu values for %zu points; "
+                "ignored", what, uv->n_num, n_points);
+        return NULL;
+    }
+    return uv;
 }
 
 static int shape_trianglemesh(Parser *P, const Token *t, ParamList *pl)
@@ -1455,25 +1531,25 @@ static int shape_trianglemesh(Parser *P, const Token *t, ParamList *pl)
                 "ignored", np->n_num, pp->n_num);
         np = NULL;
     }
-    if (np && !P->gs.area.on)
-        warn_at(P, np->line, np->col, "vertex data N", "trianglemesh: \"N\" is not passed on "
-                "(rayes shades meshes with their geometric normals)");
+    Param *uvp = uv_param(P, pl, "trianglemesh", n_points);
     size_t n_faces = n_idx / 3;
     float *pts = points_of(P, t, pp);
     float *N = np ? points_of(P, t, np) : NULL;
+    float *uv = uvp ? points_of(P, t, uvp) : NULL;
     int *nv = malloc(n_faces * sizeof(int)), *idx = malloc(n_idx * sizeof(int));
     int r = -1;
-    if (!pts || (np && !N) || !nv || !idx) {
+    if (!pts || (np && !N) || (uvp && !uv) || !nv || !idx) {
         FAIL_TOK(P, t, "out of memory");
     } else {
         for (size_t f = 0; f < n_faces; f++)
             nv[f] = 3;
         for (size_t i = 0; i < n_idx; i++)
             idx[i] = ip ? (int)ip->num[i] : (int)i;
-        r = shape_mesh(P, t, "trianglemesh", n_faces, nv, idx, n_points, pts, N);
+        r = shape_mesh(P, t, "trianglemesh", n_faces, nv, idx, n_points, pts, N, uv);
     }
     free(pts);
     free(N);
+    free(uv);
     free(nv);
     free(idx);
     return r;
@@ -1483,9 +1559,6 @@ static int shape_bilinearmesh(Parser *P, const Token *t, ParamList *pl)
 {
     Param *pp = find(pl, "P"), *ip = find(pl, "indices"), *np = find(pl, "N");
     warn_vertex_data(P, t, pl, "bilinearmesh");
-    if (np)
-        warn_at(P, np->line, np->col, "vertex data N", "bilinearmesh: \"N\" is not passed on "
-                "(rayes shades patches with their geometric normals)");
     if (!pp || pp->n_num < 12)
         return FAIL_TOK(P, t, "bilinearmesh: expected \"point3 P\" with at least 4 points");
     size_t n_points = pp->n_num / 3;
@@ -1500,6 +1573,12 @@ static int shape_bilinearmesh(Parser *P, const Token *t, ParamList *pl)
         if (ip->num[i] < 0 || ip->num[i] >= (double)n_points)
             return fail_at(P, ip->line, ip->col, "bilinearmesh: index %zu is %.0f but P has %zu "
                            "points", i, ip->num[i], n_points);
+    if (np && np->n_num != pp->n_num) {
+        warn_at(P, np->line, np->col, "N count", "bilinearmesh: \"N\" has %zu values, P %zu; N "
+                "ignored", np->n_num, pp->n_num);
+        np = NULL;
+    }
+    Param *uvp = uv_param(P, pl, "bilinearmesh", n_points);
     float *pts = points_of(P, t, pp);
     if (!pts)
         return -1;
@@ -1513,11 +1592,17 @@ static int shape_bilinearmesh(Parser *P, const Token *t, ParamList *pl)
             int q[4] = {v[0], v[1], v[3], v[2]}; /* around the patch */
             r = emit_area_quad(P, t, pts, NULL, q);
         } else {
-            float patch[4][3];
+            Op patch = {.patch_pv = (np ? 1 : 0) | (uvp ? 2 : 0)};
             static const int order[2][4] = {{0, 1, 2, 3}, {1, 0, 3, 2}};
-            for (int k = 0; k < 4; k++)
-                memcpy(patch[k], &pts[3 * v[order[flip][k]]], sizeof patch[k]);
-            r = emit_patch(P, t, (const float(*)[3])patch);
+            for (int k = 0; k < 4; k++) {
+                size_t j = (size_t)v[order[flip][k]];
+                memcpy(patch.patch[k], &pts[3 * j], sizeof patch.patch[k]);
+                for (int c = 0; c < 3 && np; c++)
+                    patch.patch_N[k][c] = (float)np->num[3 * j + (size_t)c];
+                for (int c = 0; c < 2 && uvp; c++)
+                    patch.patch_uv[k][c] = (float)uvp->num[2 * j + (size_t)c];
+            }
+            r = emit_patch(P, t, &patch);
         }
         if (r != 0) {
             free(pts);
@@ -1544,13 +1629,8 @@ static int shape_plymesh(Parser *P, const Token *t, ParamList *pl)
     PlyMesh m;
     if (io_ply_read(path, &m, err, sizeof err) != RAYES_OK)
         return FAIL_TOK(P, t, "plymesh: %s", err);
-    if (m.uv)
-        warn_at(P, t->line, t->col, "vertex data uv", "plymesh: texture coordinates are not "
-                "passed on (rayes meshes carry positions only)");
-    if (m.N && !P->gs.area.on)
-        warn_at(P, t->line, t->col, "vertex data N", "plymesh: normals are not passed on (rayes "
-                "shades meshes with their geometric normals)");
-    int r = shape_mesh(P, t, "plymesh", m.n_faces, m.n_verts, m.indices, m.n_vertices, m.P, m.N);
+    int r = shape_mesh(P, t, "plymesh", m.n_faces, m.n_verts, m.indices, m.n_vertices, m.P, m.N,
+                       m.uv);
     io_ply_mesh_fini(&m);
     return r;
 }
@@ -2611,6 +2691,8 @@ static void parser_free(Parser *P)
             free(op->n_verts);
             free(op->idx);
             free(op->pts);
+            free(op->N);
+            free(op->uv);
         }
         free(P->objects[i].ops);
     }

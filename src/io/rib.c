@@ -772,7 +772,7 @@ static int check_counts(Rib *r, const Param *p, size_t n, const Counts *c)
 /* Warns once per parameter name a primitive does not use. */
 static void warn_unused(Rib *r, const Param *p, size_t n)
 {
-    static const char *const used[] = {"P", "Pw", "Cs", "Os", NULL};
+    static const char *const used[] = {"P", "Pw", "Cs", "Os", "N", "Np", "st", "s", "t", NULL};
     for (size_t i = 0; i < n; i++) {
         int u = !p[i].declared;
         for (int k = 0; used[k]; k++)
@@ -780,8 +780,8 @@ static void warn_unused(Rib *r, const Param *p, size_t n)
         if (!u) {
             char key[128];
             snprintf(key, sizeof key, "unused %s", p[i].d.name);
-            warn_once(r, key, "parameter \"%s\" is not used (rayes takes positions and one colour "
-                              "per face; normals come from the surface)", p[i].d.name);
+            warn_once(r, key, "parameter \"%s\" is not used (rayes takes P, N, st and Cs)",
+                      p[i].d.name);
         }
     }
 }
@@ -894,36 +894,204 @@ static int flip_of(Rib *r)
     return (orient_lh != cur_lh) ^ (det_wo < 0);
 }
 
-/* The colour of face f from Cs (NULL: none); averages per-vertex values. */
-static int face_color(Rib *r, const Param *cs, size_t face, const int *verts, size_t nv,
-                      size_t fv_start, float out[3])
+/* ------------------------------------------------ primitive variables */
+
+/* One of the primitive variables rayes.h takes (N, st, Cs), as a
+ * primitive gives it: values of size floats, or separate s and t. */
+typedef struct RibVar {
+    const double *d;  /* the values; s when d2 is set; NULL: not given */
+    const double *d2; /* t, when s and t are separate */
+    Cls cls;
+    int size;         /* floats per value: 3 (N, Cs), 2 (st) */
+} RibVar;
+
+static const char *const rib_var_names[3] = {"N", "st", "Cs"};
+
+/* A parameter that is a numeric declared value of size floats, or NULL
+ * (with one warning when it has the name but another type). */
+static const Param *var_param(Rib *r, const Param *p, size_t n, const char *name, int size)
 {
-    if (!cs || !cs->declared)
-        return 0;
-    const double *d = cs->v->d;
-    switch (cs->d.cls) {
-    case CLS_CONSTANT:
-        for (int c = 0; c < 3; c++)
-            out[c] = (float)d[c];
-        return 1;
-    case CLS_UNIFORM:
-        for (int c = 0; c < 3; c++)
-            out[c] = (float)d[3 * face + c];
-        return 1;
-    default:
-        break;
+    const Param *q = find_param(p, n, name);
+    if (!q || !q->declared)
+        return NULL;
+    if (q->d.ty == TY_STRING || type_size(q->d.ty) * q->d.array != size) {
+        char key[96];
+        snprintf(key, sizeof key, "type %s", name);
+        warn_once(r, key, "\"%s\" of %d numbers per value is ignored (expected %d)", name,
+                  type_size(q->d.ty) * q->d.array, size);
+        return NULL;
     }
-    warn_once(r, "vertex Cs", "per-vertex colours (Cs) are averaged per face: the API has one "
-                              "colour per object");
-    double s[3] = {0, 0, 0};
-    for (size_t k = 0; k < nv; k++) {
-        size_t j = cs->d.cls == CLS_FACEVARYING ? fv_start + k : (size_t)verts[k];
-        for (int c = 0; c < 3; c++)
-            s[c] += d[3 * j + c];
+    return q;
+}
+
+/* The primitive's N (or Np), st (or s and t) and Cs, in that order. */
+static void rib_vars(Rib *r, const Param *p, size_t n, RibVar vars[3])
+{
+    memset(vars, 0, 3 * sizeof *vars);
+    const Param *N = var_param(r, p, n, "N", 3);
+    if (!N)
+        N = var_param(r, p, n, "Np", 3);
+    if (N)
+        vars[0] = (RibVar){N->v->d, NULL, N->d.cls, 3};
+    const Param *st = var_param(r, p, n, "st", 2);
+    if (st)
+        vars[1] = (RibVar){st->v->d, NULL, st->d.cls, 2};
+    else {
+        const Param *ps = var_param(r, p, n, "s", 1), *pt = var_param(r, p, n, "t", 1);
+        if (ps && pt && ps->d.cls == pt->d.cls)
+            vars[1] = (RibVar){ps->v->d, pt->v->d, ps->d.cls, 2};
+        else if (ps || pt)
+            warn_once(r, "s t", "\"s\" and \"t\" are used only together and of one class");
     }
-    for (int c = 0; c < 3; c++)
-        out[c] = (float)(s[c] / (double)(nv ? nv : 1));
-    return 1;
+    const Param *cs = var_param(r, p, n, "Cs", 3);
+    if (cs)
+        vars[2] = (RibVar){cs->v->d, NULL, cs->d.cls, 3};
+}
+
+static void var_value(const RibVar *v, size_t j, float out[3])
+{
+    if (v->d2) {
+        out[0] = (float)v->d[j], out[1] = (float)v->d2[j];
+        return;
+    }
+    for (int c = 0; c < v->size; c++) {
+        double x = v->d[(size_t)v->size * j + c];
+        out[c] = fabs(x) < FLT_MAX ? (float)x : 0.0f;
+    }
+}
+
+/* Primitive variables for one sink call; the data are owned. */
+typedef struct PvOut {
+    RayesPrimvar pv[3];
+    float *data[3];
+    size_t n;
+} PvOut;
+
+static void pv_out_free(PvOut *o)
+{
+    for (size_t i = 0; i < o->n; i++)
+        free(o->data[i]);
+    o->n = 0;
+}
+
+/* Adds variable b of vars as class cls with count values, the k-th from
+ * source value src[k] (src NULL: k). Returns 0, or -1 out of memory. */
+static int pv_add(Rib *r, PvOut *o, const RibVar *vars, int b, RayesPrimvarClass cls,
+                  const size_t *src, size_t count)
+{
+    int size = vars[b].size;
+    float *d = malloc((count ? count : 1) * (size_t)size * sizeof *d);
+    if (!d)
+        return rib_error(r, "out of memory");
+    for (size_t k = 0; k < count; k++) {
+        float v[3];
+        var_value(&vars[b], src ? src[k] : k, v);
+        memcpy(d + k * (size_t)size, v, (size_t)size * sizeof *d);
+    }
+    o->data[o->n] = d;
+    o->pv[o->n++] = (RayesPrimvar){rib_var_names[b], cls, d, count};
+    return 0;
+}
+
+/* The primitive variables of a patch: uniform value ui, varying corners
+ * vi[4], facevarying corners fi[4], vertex values vv[n_vv] (4, or 16
+ * control points in the current basis, made Bezier), each corner (control
+ * point) order reversed along u when flip, as the patch's points are. */
+static int patch_vars(Rib *r, const RibVar *vars, size_t ui, const size_t vi[4],
+                      const size_t fi[4], const size_t *vv, int n_vv, int flip, PvOut *o)
+{
+    memset(o, 0, sizeof *o);
+    for (int b = 0; b < 3; b++) {
+        if (!vars[b].d)
+            continue;
+        size_t src[16];
+        int e = 0;
+        switch (vars[b].cls) {
+        case CLS_CONSTANT: e = pv_add(r, o, vars, b, RAYES_PRIMVAR_CONSTANT, NULL, 1); break;
+        case CLS_UNIFORM: e = pv_add(r, o, vars, b, RAYES_PRIMVAR_UNIFORM, &ui, 1); break;
+        case CLS_VARYING:
+        case CLS_FACEVARYING:
+            for (int k = 0; k < 4; k++)
+                src[k] = (vars[b].cls == CLS_VARYING ? vi : fi)[flip ? k ^ 1 : k];
+            e = pv_add(r, o, vars, b,
+                       vars[b].cls == CLS_VARYING ? RAYES_PRIMVAR_VARYING
+                                                  : RAYES_PRIMVAR_FACEVARYING,
+                       src, 4);
+            break;
+        case CLS_VERTEX:
+            if (n_vv == 4) {
+                for (int k = 0; k < 4; k++)
+                    src[k] = vv[flip ? k ^ 1 : k];
+                e = pv_add(r, o, vars, b, RAYES_PRIMVAR_VERTEX, src, 4);
+                break;
+            }
+            for (int k = 0; k < 16; k++)
+                src[k] = vv[k];
+            if ((e = pv_add(r, o, vars, b, RAYES_PRIMVAR_VERTEX, src, 16)) != 0)
+                break;
+            float G[16][3] = {{0}}, B[16][3];
+            float *d = o->data[o->n - 1];
+            int size = vars[b].size;
+            for (int k = 0; k < 16; k++)
+                memcpy(G[k], d + k * size, (size_t)size * sizeof *d);
+            rib_basis_to_bezier(r->a.ubasis, r->a.vbasis, (const float(*)[3])G, B);
+            for (int j = 0; j < 4; j++)
+                for (int k = 0; k < 4; k++)
+                    memcpy(d + (4 * j + k) * size, B[4 * j + (flip ? 3 - k : k)],
+                           (size_t)size * sizeof *d);
+            break;
+        }
+        if (e != 0) {
+            pv_out_free(o);
+            return -1;
+        }
+    }
+    return 0;
+}
+
+/* The primitive variables of polygons tessellated into faces: face f came
+ * from polygon face_poly[f], whose corners start at poly_at[p] in the
+ * polygon list g (for facevarying values: a face corner takes the value of
+ * the polygon's first corner at the same point). */
+static int poly_vars(Rib *r, const RibVar *vars, const RibFaces *faces, const size_t *face_poly,
+                     const size_t *poly_at, const int *idx, const size_t *poly_nv,
+                     size_t n_points, PvOut *o)
+{
+    memset(o, 0, sizeof *o);
+    size_t *src = malloc((faces->n_idx + faces->n_faces + 1) * sizeof *src);
+    if (!src)
+        return rib_error(r, "out of memory");
+    int e = 0;
+    for (int b = 0; b < 3 && e == 0; b++) {
+        if (!vars[b].d)
+            continue;
+        switch (vars[b].cls) {
+        case CLS_CONSTANT: e = pv_add(r, o, vars, b, RAYES_PRIMVAR_CONSTANT, NULL, 1); break;
+        case CLS_UNIFORM:
+            e = pv_add(r, o, vars, b, RAYES_PRIMVAR_UNIFORM, face_poly, faces->n_faces);
+            break;
+        case CLS_VARYING:
+        case CLS_VERTEX: e = pv_add(r, o, vars, b, RAYES_PRIMVAR_VERTEX, NULL, n_points); break;
+        case CLS_FACEVARYING: {
+            size_t k = 0;
+            for (size_t f = 0; f < faces->n_faces; f++) {
+                size_t p = face_poly[f], at = poly_at[p];
+                for (int c = 0; c < faces->n_verts[f]; c++, k++) {
+                    size_t j = 0;
+                    while (j + 1 < poly_nv[p] && idx[at + j] != faces->idx[k])
+                        j++;
+                    src[k] = at + j;
+                }
+            }
+            e = pv_add(r, o, vars, b, RAYES_PRIMVAR_FACEVARYING, src, k);
+            break;
+        }
+        }
+    }
+    free(src);
+    if (e != 0)
+        pv_out_free(o);
+    return e;
 }
 
 /* The points of a primitive from "P" or "Pw" (divided by w); new array. */
@@ -976,40 +1144,49 @@ typedef struct Polys {
     const int *idx;
 } Polys;
 
+/* Grows an array of size_t to hold n + 1. */
+static int grow_sizes(size_t **a, size_t *cap, size_t n)
+{
+    if (n < *cap)
+        return 0;
+    size_t c = *cap ? 2 * *cap : 64;
+    size_t *p = realloc(*a, c * sizeof *p);
+    if (!p)
+        return -1;
+    *a = p;
+    *cap = c;
+    return 0;
+}
+
 static int emit_polys(Rib *r, const Polys *g, const float *P, size_t n_points, const Param *par,
                       size_t n_par)
 {
-    const Param *cs = color_param(r, par, n_par);
-    int per_face = cs && cs->declared && cs->d.cls != CLS_CONSTANT;
+    RibVar vars[3];
+    rib_vars(r, par, n_par, vars);
     int flip = flip_of(r);
-    float L_one[3];
-    float color[3];
     RibFaces faces = {0};
+    size_t *face_poly = NULL, *poly_at = NULL, *poly_nv = NULL, cap_f = 0, cap_a = 0, cap_n = 0;
     size_t loop = 0, at = 0;
     int e = 0;
-    int whole = !per_face && !r->a.area;
-    if (!per_face && face_color(r, cs, 0, NULL, 0, 0, color)) {
-        e = emit_begin(r, color);
-    } else if (whole) {
-        e = emit_begin(r, NULL);
-    }
-    if (e != 0)
-        return e > 0 ? 0 : -1;
     for (size_t p = 0; p < g->n_polys && e == 0; p++) {
         size_t nl = g->n_loops ? (size_t)g->n_loops[p] : 1;
         size_t nv = 0;
         for (size_t k = 0; k < nl; k++)
             nv += (size_t)g->loop_n[loop + k];
         const int *v = &g->idx[at];
+        if (grow_sizes(&poly_at, &cap_a, p) != 0 || grow_sizes(&poly_nv, &cap_n, p) != 0) {
+            e = rib_error(r, "out of memory");
+            break;
+        }
+        poly_at[p] = at, poly_nv[p] = nv;
         if (r->a.area && nl == 1 && g->loop_n[loop] == 4) {
             float Q[4][3];
             for (int k = 0; k < 4; k++)
                 memcpy(Q[flip ? 3 - k : k], &P[3 * v[k]], sizeof Q[0]);
-            memcpy(L_one, r->a.area_L, sizeof L_one);
             SinkState *st;
             const IoSink *s = out_sink(r, &st);
             e = emit_begin(r, NULL);
-            if (e == 0 && s->area_light(s->target, (const float(*)[3])Q, L_one) != RAYES_OK)
+            if (e == 0 && s->area_light(s->target, (const float(*)[3])Q, r->a.area_L) != RAYES_OK)
                 e = sink_failed(r, s);
         } else {
             if (r->a.area)
@@ -1018,33 +1195,30 @@ static int emit_polys(Rib *r, const Polys *g, const float *P, size_t n_points, c
             size_t first_face = faces.n_faces;
             if (rib_tessellate(P, &g->loop_n[loop], nl, v, flip, &faces) != 0)
                 e = rib_error(r, "out of memory");
-            if (e == 0 && (per_face || (r->a.area))) {
-                float *Cs = face_color(r, cs, p, v, nv, at, color) ? color : NULL;
-                e = emit_begin(r, Cs);
-                if (e == 0) {
-                    SinkState *st;
-                    const IoSink *s = out_sink(r, &st);
-                    size_t first_idx = 0;
-                    for (size_t f = 0; f < first_face; f++)
-                        first_idx += (size_t)faces.n_verts[f];
-                    if (faces.n_faces > first_face &&
-                        s->polygon_mesh(s->target, faces.n_faces - first_face,
-                                        faces.n_verts + first_face, faces.idx + first_idx,
-                                        n_points, P) != RAYES_OK)
-                        e = sink_failed(r, s);
-                }
+            for (size_t f = first_face; e == 0 && f < faces.n_faces; f++) {
+                if (grow_sizes(&face_poly, &cap_f, f) != 0)
+                    e = rib_error(r, "out of memory");
+                else
+                    face_poly[f] = p;
             }
         }
         loop += nl;
         at += nv;
     }
-    if (e == 0 && !per_face && !r->a.area && faces.n_faces > 0) {
+    PvOut pv = {0};
+    if (e == 0 && faces.n_faces > 0 &&
+        (e = poly_vars(r, vars, &faces, face_poly, poly_at, g->idx, poly_nv, n_points, &pv)) == 0 &&
+        (e = emit_begin(r, NULL)) == 0) {
         SinkState *st;
         const IoSink *s = out_sink(r, &st);
-        if (s->polygon_mesh(s->target, faces.n_faces, faces.n_verts, faces.idx, n_points, P) !=
-            RAYES_OK)
+        if (s->polygon_mesh(s->target, faces.n_faces, faces.n_verts, faces.idx, n_points, P,
+                            pv.pv, pv.n) != RAYES_OK)
             e = sink_failed(r, s);
     }
+    pv_out_free(&pv);
+    free(face_poly);
+    free(poly_at);
+    free(poly_nv);
     rib_faces_fini(&faces);
     return e > 0 ? 0 : e;
 }
@@ -2040,7 +2214,7 @@ static int h_subdivision_mesh(Rib *r, const Args *a)
     return points_polygons(r, a, i, 0);
 }
 
-static int emit_bicubic(Rib *r, float B[16][3], const float *Cs)
+static int emit_bicubic(Rib *r, float B[16][3], const PvOut *pv)
 {
     if (flip_of(r))
         for (int j = 0; j < 4; j++)
@@ -2050,21 +2224,23 @@ static int emit_bicubic(Rib *r, float B[16][3], const float *Cs)
                     B[4 * j + k][c] = B[4 * j + 3 - k][c];
                     B[4 * j + 3 - k][c] = t;
                 }
-    int e = emit_begin(r, Cs);
+    int e = emit_begin(r, NULL);
     if (e != 0)
         return e > 0 ? 0 : -1;
     SinkState *st;
     const IoSink *s = out_sink(r, &st);
-    return s->bicubic_patch(s->target, (const float(*)[3])B) == RAYES_OK ? 0 : sink_failed(r, s);
+    return s->bicubic_patch(s->target, (const float(*)[3])B, pv->pv, pv->n) == RAYES_OK
+               ? 0
+               : sink_failed(r, s);
 }
 
-static int emit_bilinear(Rib *r, const float P[4][3], const float *Cs)
+static int emit_bilinear(Rib *r, const float P[4][3], const PvOut *pv)
 {
     float Q[4][3];
     int flip = flip_of(r);
     for (int k = 0; k < 4; k++)
         memcpy(Q[flip ? k ^ 1 : k], P[k], sizeof Q[0]);
-    int e = emit_begin(r, Cs);
+    int e = emit_begin(r, NULL);
     if (e != 0)
         return e > 0 ? 0 : -1;
     SinkState *st;
@@ -2079,11 +2255,14 @@ static int emit_bilinear(Rib *r, const float P[4][3], const float *Cs)
                    ? 0
                    : sink_failed(r, s);
     }
-    return s->bilinear_patch(s->target, (const float(*)[3])Q) == RAYES_OK ? 0 : sink_failed(r, s);
+    return s->bilinear_patch(s->target, (const float(*)[3])Q, pv->pv, pv->n) == RAYES_OK
+               ? 0
+               : sink_failed(r, s);
 }
 
-/* The colour of a patch: Cs constant/uniform (index u_index), or the
- * average of the given varying/vertex indices. */
+/* The colour of a quadric: Cs constant/uniform (index u_index), or the
+ * average of the given varying/vertex indices (quadrics take no primitive
+ * variables). */
 static const float *patch_color(Rib *r, const Param *cs, size_t uniform_index,
                                 const size_t *vi, size_t nvi, const size_t *vv, size_t nvv,
                                 float out[3])
@@ -2096,8 +2275,8 @@ static const float *patch_color(Rib *r, const Param *cs, size_t uniform_index,
             out[c] = (float)cs->v->d[3 * j + c];
         return out;
     }
-    warn_once(r, "vertex Cs", "per-vertex colours (Cs) are averaged per patch: the API has one "
-                              "colour per object");
+    warn_once(r, "vertex Cs", "per-vertex colours (Cs) of quadrics are averaged: quadrics take "
+                              "one colour");
     const size_t *ix = cs->d.cls == CLS_VERTEX ? vv : vi;
     size_t nx = cs->d.cls == CLS_VERTEX ? nvv : nvi;
     double s[3] = {0, 0, 0};
@@ -2129,20 +2308,25 @@ static int h_patch(Rib *r, const Args *a)
     Counts c = {1, 4, want, 4};
     if (e == 0)
         e = check_counts(r, p, n, &c);
+    RibVar vars[3];
+    PvOut pv = {0};
     if (e == 0) {
         warn_unused(r, p, n);
+        rib_vars(r, p, n, vars);
         static const size_t corners[4] = {0, 1, 2, 3};
         static const size_t all[16] = {0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15};
-        float col[3];
-        const float *Cs = patch_color(r, color_param(r, p, n), 0, corners, 4, all, want, col);
+        e = patch_vars(r, vars, 0, corners, corners, all, (int)want, flip_of(r), &pv);
+    }
+    if (e == 0) {
         if (cubic) {
             float B[16][3];
             rib_basis_to_bezier(r->a.ubasis, r->a.vbasis, (const float(*)[3])P, B);
-            e = emit_bicubic(r, B, Cs);
+            e = emit_bicubic(r, B, &pv);
         } else {
-            e = emit_bilinear(r, (const float(*)[3])P, Cs);
+            e = emit_bilinear(r, (const float(*)[3])P, &pv);
         }
     }
+    pv_out_free(&pv);
     free(P);
     free(p);
     return e;
@@ -2205,9 +2389,12 @@ static int h_patch_mesh(Rib *r, const Args *a)
     Counts c = {(size_t)(nup * nvp), (size_t)(nuvar * nvvar), np, (size_t)(nup * nvp * 4)};
     if (e == 0)
         e = check_counts(r, p, n, &c);
-    if (e == 0)
+    RibVar vars[3];
+    if (e == 0) {
         warn_unused(r, p, n);
-    const Param *cs = color_param(r, p, n);
+        rib_vars(r, p, n, vars);
+    }
+    int flip = flip_of(r);
     for (long pv = 0; e == 0 && pv < nvp; pv++)
         for (long pu = 0; e == 0 && pu < nup; pu++) {
             size_t vi[4] = {(size_t)(pv * nuvar + pu), (size_t)(pv * nuvar + (pu + 1) % nuvar),
@@ -2222,16 +2409,18 @@ static int h_patch_mesh(Rib *r, const Args *a)
                     vv[j * k + q] = idx;
                     memcpy(G[j * k + q], &P[3 * idx], sizeof G[0]);
                 }
-            float col[3];
-            const float *Cs = patch_color(r, cs, (size_t)(pv * nup + pu), vi, 4, vv,
-                                          (size_t)(k * k), col);
-            if (cubic) {
+            size_t ui = (size_t)(pv * nup + pu), fi[4] = {4 * ui, 4 * ui + 1, 4 * ui + 2, 4 * ui + 3};
+            PvOut out;
+            e = patch_vars(r, vars, ui, vi, fi, vv, k * k, flip, &out);
+            if (e == 0 && cubic) {
                 float B[16][3];
                 rib_basis_to_bezier(r->a.ubasis, r->a.vbasis, (const float(*)[3])G, B);
-                e = emit_bicubic(r, B, Cs);
-            } else {
-                e = emit_bilinear(r, (const float(*)[3])G, Cs);
+                e = emit_bicubic(r, B, &out);
+            } else if (e == 0) {
+                e = emit_bilinear(r, (const float(*)[3])G, &out);
             }
+            if (e == 0)
+                pv_out_free(&out);
         }
     free(P);
     free(p);
@@ -2318,12 +2507,15 @@ typedef struct TeapotTarget {
     int failed;
 } TeapotTarget;
 
-static RayesError teapot_patch(void *t, const float P[16][3])
+static RayesError teapot_patch(void *t, const float P[16][3], const RayesPrimvar *pv,
+                               size_t n_pv)
 {
     TeapotTarget *tt = t;
     float B[16][3];
     memcpy(B, P, sizeof B);
-    if (emit_bicubic(tt->r, B, NULL) != 0) {
+    const PvOut none = {0};
+    (void)pv, (void)n_pv; /* the patch file has none */
+    if (emit_bicubic(tt->r, B, &none) != 0) {
         tt->failed = 1;
         return RAYES_ERROR_INVALID_ARGUMENT;
     }
@@ -2781,12 +2973,20 @@ static RayesError null_path(void *t, const char *k, const char *p)
     (void)t, (void)k, (void)p;
     return RAYES_OK;
 }
-static RayesError null_p4(void *t, const float P[4][3]) { (void)t, (void)P; return RAYES_OK; }
-static RayesError null_p16(void *t, const float P[16][3]) { (void)t, (void)P; return RAYES_OK; }
-static RayesError null_mesh(void *t, size_t nf, const int *nv, const int *ix, size_t np,
-                            const float *P)
+static RayesError null_p4(void *t, const float P[4][3], const RayesPrimvar *pv, size_t n)
 {
-    (void)t, (void)nf, (void)nv, (void)ix, (void)np, (void)P;
+    (void)t, (void)P, (void)pv, (void)n;
+    return RAYES_OK;
+}
+static RayesError null_p16(void *t, const float P[16][3], const RayesPrimvar *pv, size_t n)
+{
+    (void)t, (void)P, (void)pv, (void)n;
+    return RAYES_OK;
+}
+static RayesError null_mesh(void *t, size_t nf, const int *nv, const int *ix, size_t np,
+                            const float *P, const RayesPrimvar *pv, size_t n)
+{
+    (void)t, (void)nf, (void)nv, (void)ix, (void)np, (void)P, (void)pv, (void)n;
     return RAYES_OK;
 }
 static RayesError null_quadric(void *t, RayesQuadric q, const float *p, size_t n, unsigned f)

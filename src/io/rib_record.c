@@ -34,6 +34,8 @@ typedef struct RibCall {
     int *ints;           /* mesh: n_verts then indices */
     size_t n_faces, n_idx;
     unsigned flags;      /* quadric type << 8 | flags */
+    RayesPrimvar *pv;    /* patches and meshes: primitive variables, names and data owned */
+    size_t n_pv;
 } RibCall;
 
 struct RibRecording {
@@ -56,6 +58,11 @@ static void call_fini(RibCall *c)
     free(c->params);
     free(c->f);
     free(c->ints);
+    for (size_t i = 0; i < c->n_pv; i++) {
+        free((char *)c->pv[i].name);
+        free((float *)c->pv[i].data);
+    }
+    free(c->pv);
 }
 
 void rib_recording_free(RibRecording *rec)
@@ -166,22 +173,45 @@ static RayesError rec_rate(void *t, float r)
 {
     return floats(t, CALL_SHADING_RATE, &r, 1);
 }
-static RayesError rec_bilinear(void *t, const float P[4][3])
+/* Copies primitive variables into the last call (names and data). */
+static RayesError keep_primvars(RibRecording *rec, RayesError e, const RayesPrimvar *pv,
+                                size_t n_pv)
 {
-    return floats(t, CALL_BILINEAR, &P[0][0], 12);
+    if (e != RAYES_OK || n_pv == 0)
+        return e;
+    RibCall *c = &rec->calls[rec->n - 1];
+    c->pv = calloc(n_pv, sizeof *c->pv);
+    if (!c->pv)
+        return RAYES_ERROR_OUT_OF_MEMORY;
+    for (size_t i = 0; i < n_pv; i++) {
+        size_t n = pv[i].count * (strcmp(pv[i].name, "st") == 0 ? 2u : 3u);
+        float *d = malloc((n ? n : 1) * sizeof *d);
+        c->pv[i] = pv[i];
+        c->pv[i].name = dup_str(pv[i].name);
+        c->pv[i].data = d;
+        c->n_pv++;
+        if (!d || !c->pv[i].name)
+            return RAYES_ERROR_OUT_OF_MEMORY; /* the call stays, freed with the recording */
+        memcpy(d, pv[i].data, n * sizeof *d);
+    }
+    return RAYES_OK;
 }
-static RayesError rec_bicubic(void *t, const float P[16][3])
+static RayesError rec_bilinear(void *t, const float P[4][3], const RayesPrimvar *pv, size_t n_pv)
 {
-    return floats(t, CALL_BICUBIC, &P[0][0], 48);
+    return keep_primvars(t, floats(t, CALL_BILINEAR, &P[0][0], 12), pv, n_pv);
+}
+static RayesError rec_bicubic(void *t, const float P[16][3], const RayesPrimvar *pv, size_t n_pv)
+{
+    return keep_primvars(t, floats(t, CALL_BICUBIC, &P[0][0], 48), pv, n_pv);
 }
 static RayesError rec_mesh(void *t, size_t n_faces, const int *nv, const int *idx, size_t n_points,
-                           const float *P)
+                           const float *P, const RayesPrimvar *pv, size_t n_pv)
 {
     RibRecording *rec = t;
     size_t n_idx = 0;
     for (size_t i = 0; i < n_faces; i++)
         n_idx += (size_t)nv[i];
-    RayesError e = floats(rec, CALL_MESH, P, 3 * n_points);
+    RayesError e = keep_primvars(rec, floats(rec, CALL_MESH, P, 3 * n_points), pv, n_pv);
     if (e != RAYES_OK)
         return e;
     RibCall *c = &rec->calls[rec->n - 1];
@@ -260,10 +290,15 @@ RayesError rib_recording_replay(const RibRecording *rec, const IoSink *out,
         case CALL_DISPLACEMENT: e = out->set_displacement(t, c->name, c->params, c->n_params); break;
         case CALL_DISPLACEMENT_BOUND: e = out->set_displacement_bound(t, c->f[0]); break;
         case CALL_SHADING_RATE: e = out->set_shading_rate(t, c->f[0]); break;
-        case CALL_BILINEAR: e = out->bilinear_patch(t, (const float(*)[3])c->f); break;
-        case CALL_BICUBIC: e = out->bicubic_patch(t, (const float(*)[3])c->f); break;
+        case CALL_BILINEAR:
+            e = out->bilinear_patch(t, (const float(*)[3])c->f, c->pv, c->n_pv);
+            break;
+        case CALL_BICUBIC:
+            e = out->bicubic_patch(t, (const float(*)[3])c->f, c->pv, c->n_pv);
+            break;
         case CALL_MESH:
-            e = out->polygon_mesh(t, c->n_faces, c->ints, c->ints + c->n_faces, c->n_f / 3, c->f);
+            e = out->polygon_mesh(t, c->n_faces, c->ints, c->ints + c->n_faces, c->n_f / 3, c->f,
+                                  c->pv, c->n_pv);
             break;
         case CALL_SPHERE: e = out->sphere(t, c->f[0]); break;
         case CALL_QUADRIC:

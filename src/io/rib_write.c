@@ -383,33 +383,75 @@ static RayesError w_set_shading_rate(void *t, float rate)
 
 /* --------------------------------------------------------- geometry */
 
-static RayesError w_bilinear_patch(void *t, const float P[4][3])
+/* Checks primitive variables as rayes.h does (expect[cls]: the counts of
+ * each class for the primitive); returns 0 or fails. */
+static RayesError check_primvars(RibWriter *w, const char *what, const RayesPrimvar *pv,
+                                 size_t n_pv, const size_t expect[5])
+{
+    if (n_pv && !pv)
+        return fail(w, RAYES_ERROR_INVALID_ARGUMENT, "%s: primitive variables are NULL", what);
+    for (size_t i = 0; i < n_pv; i++) {
+        int size = !pv[i].name ? 0 : strcmp(pv[i].name, "st") == 0 ? 2
+                 : strcmp(pv[i].name, "N") == 0 || strcmp(pv[i].name, "Cs") == 0 ? 3 : 0;
+        if (!size || (unsigned)pv[i].cls > RAYES_PRIMVAR_FACEVARYING ||
+            pv[i].count != expect[pv[i].cls] || (pv[i].count && !pv[i].data) ||
+            !finite_all(pv[i].data, pv[i].count * (size_t)size))
+            return fail(w, RAYES_ERROR_INVALID_ARGUMENT, "%s: bad primitive variable %s", what,
+                        pv[i].name && size ? pv[i].name : "(unknown)");
+    }
+    return RAYES_OK;
+}
+
+/* Writes primitive variables as RIB parameters, each on a line of its own. */
+static void primvars(FILE *f, const RayesPrimvar *pv, size_t n_pv)
+{
+    static const char *const cls[5] = {"constant", "uniform", "varying", "vertex", "facevarying"};
+    for (size_t i = 0; i < n_pv; i++) {
+        int st = strcmp(pv[i].name, "st") == 0;
+        const char *type = st ? "float[2]" : strcmp(pv[i].name, "N") == 0 ? "normal" : "color";
+        fprintf(f, "\n  \"%s %s %s\" ", cls[pv[i].cls], type, pv[i].name);
+        floats(f, pv[i].data, pv[i].count * (st ? 2u : 3u));
+    }
+}
+
+static RayesError w_bilinear_patch(void *t, const float P[4][3], const RayesPrimvar *pv,
+                                   size_t n_pv)
 {
     RibWriter *w = t;
+    static const size_t expect[5] = {1, 1, 4, 4, 4};
     if (!finite_all(&P[0][0], 12))
         return fail(w, RAYES_ERROR_INVALID_ARGUMENT, "bilinear patch: non-finite point");
+    if (check_primvars(w, "bilinear patch", pv, n_pv, expect) != RAYES_OK)
+        return RAYES_ERROR_INVALID_ARGUMENT;
     fprintf(w->world.f, "Patch \"bilinear\" \"P\" ");
     floats(w->world.f, &P[0][0], 12);
+    primvars(w->world.f, pv, n_pv);
     fputc('\n', w->world.f);
     return RAYES_OK;
 }
 
-static RayesError w_bicubic_patch(void *t, const float P[16][3])
+static RayesError w_bicubic_patch(void *t, const float P[16][3], const RayesPrimvar *pv,
+                                  size_t n_pv)
 {
     RibWriter *w = t;
+    static const size_t expect[5] = {1, 1, 4, 16, 4};
     if (!finite_all(&P[0][0], 48))
         return fail(w, RAYES_ERROR_INVALID_ARGUMENT, "bicubic patch: non-finite point");
+    if (check_primvars(w, "bicubic patch", pv, n_pv, expect) != RAYES_OK)
+        return RAYES_ERROR_INVALID_ARGUMENT;
     if (!w->bezier_basis)
         fprintf(w->world.f, "Basis \"bezier\" 3 \"bezier\" 3\n");
     w->bezier_basis = 1;
     fprintf(w->world.f, "Patch \"bicubic\" \"P\" ");
     floats(w->world.f, &P[0][0], 48);
+    primvars(w->world.f, pv, n_pv);
     fputc('\n', w->world.f);
     return RAYES_OK;
 }
 
 static RayesError w_polygon_mesh(void *t, size_t n_faces, const int *nv, const int *idx,
-                                 size_t n_points, const float *P)
+                                 size_t n_points, const float *P, const RayesPrimvar *pv,
+                                 size_t n_pv)
 {
     RibWriter *w = t;
     size_t k = 0;
@@ -425,6 +467,9 @@ static RayesError w_polygon_mesh(void *t, size_t n_faces, const int *nv, const i
             if (idx[k + (size_t)v] < 0 || (size_t)idx[k + (size_t)v] >= n_points)
                 return fail(w, RAYES_ERROR_INVALID_ARGUMENT, "polygon mesh: index out of range");
     }
+    const size_t expect[5] = {1, n_faces, n_points, n_points, k};
+    if (check_primvars(w, "polygon mesh", pv, n_pv, expect) != RAYES_OK)
+        return RAYES_ERROR_INVALID_ARGUMENT;
     FILE *f = w->world.f;
     fprintf(f, "PointsPolygons [");
     for (size_t i = 0; i < n_faces; i++)
@@ -436,7 +481,9 @@ static RayesError w_polygon_mesh(void *t, size_t n_faces, const int *nv, const i
     for (size_t i = 0; i < 3 * n_points; i++)
         fprintf(f, "%s%.9g", i == 0 ? "" : i % 9 == 0 ? "\n   " : " ",
                 P[i] == 0.0f ? 0.0 : (double)P[i]);
-    fprintf(f, "]\n");
+    fprintf(f, "]");
+    primvars(f, pv, n_pv);
+    fprintf(f, "\n");
     return RAYES_OK;
 }
 

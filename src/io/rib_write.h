@@ -21,6 +21,8 @@
  *   set_displacement   Displacement (NULL or "": Displacement "null")
  *   displacement bound Attribute "displacementbound" "sphere" in world space
  *   bicubic_patch      Basis "bezier" 3 "bezier" 3 (once) + Patch "bicubic"
+ *   primitive vars     after P, "<class> normal N", "<class> float[2] st",
+ *                      "<class> color Cs" with rayes.h's class names
  *   quadrics           Sphere, Cylinder, Cone, Disk, Paraboloid, Hyperboloid,
  *                      Torus (in AttributeBegin + ReverseOrientation when
  *                      flagged)

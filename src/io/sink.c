@@ -49,20 +49,23 @@ static RayesError scene_set_shading_rate(void *t, float rate)
     return rayes_scene_set_shading_rate(t, rate);
 }
 
-static RayesError scene_bilinear_patch(void *t, const float P[4][3])
+static RayesError scene_bilinear_patch(void *t, const float P[4][3], const RayesPrimvar *pv,
+                                       size_t n_pv)
 {
-    return rayes_scene_bilinear_patch(t, P);
+    return rayes_scene_bilinear_patch_pv(t, P, pv, n_pv);
 }
 
-static RayesError scene_bicubic_patch(void *t, const float P[16][3])
+static RayesError scene_bicubic_patch(void *t, const float P[16][3], const RayesPrimvar *pv,
+                                      size_t n_pv)
 {
-    return rayes_scene_bicubic_patch(t, P);
+    return rayes_scene_bicubic_patch_pv(t, P, pv, n_pv);
 }
 
 static RayesError scene_polygon_mesh(void *t, size_t n_faces, const int *n_verts,
-                                     const int *indices, size_t n_points, const float *P)
+                                     const int *indices, size_t n_points, const float *P,
+                                     const RayesPrimvar *pv, size_t n_pv)
 {
-    return rayes_scene_polygon_mesh(t, n_faces, n_verts, indices, n_points, P);
+    return rayes_scene_polygon_mesh_pv(t, n_faces, n_verts, indices, n_points, P, pv, n_pv);
 }
 
 static RayesError scene_sphere(void *t, float radius)

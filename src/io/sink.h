@@ -4,7 +4,8 @@
  * Readers (RIB, pbrt, OBJ, the patch file, the built-in scenes) never call
  * rayes.h's scene functions directly: they call the methods of an IoSink,
  * which mirror those functions one for one (same arguments, the scene
- * replaced by the sink's target). Three sinks exist:
+ * replaced by the sink's target; the patch and mesh methods are the _pv
+ * calls, with primitive variables). Three sinks exist:
  *   - io_sink_scene (sink.c): forwards to rayes.h, building a RayesScene;
  *   - the RIB writer (rib_write.c): writes each call as ASCII RIB, so every
  *     reader doubles as a converter (`rayes convert`);
@@ -39,10 +40,13 @@ typedef struct IoSink {
     RayesError (*set_displacement_bound)(void *target, float bound);
     RayesError (*set_search_path)(void *target, const char *kind, const char *path);
     RayesError (*set_shading_rate)(void *target, float shading_rate);
-    RayesError (*bilinear_patch)(void *target, const float P[4][3]);
-    RayesError (*bicubic_patch)(void *target, const float P[16][3]);
+    RayesError (*bilinear_patch)(void *target, const float P[4][3], const RayesPrimvar *pv,
+                                 size_t n_pv);
+    RayesError (*bicubic_patch)(void *target, const float P[16][3], const RayesPrimvar *pv,
+                                size_t n_pv);
     RayesError (*polygon_mesh)(void *target, size_t n_faces, const int *n_verts,
-                               const int *indices, size_t n_points, const float *P);
+                               const int *indices, size_t n_points, const float *P,
+                               const RayesPrimvar *pv, size_t n_pv);
     RayesError (*sphere)(void *target, float radius);
     RayesError (*quadric)(void *target, RayesQuadric type, const float *params, size_t n_params,
                           unsigned flags);

@@ -88,7 +88,7 @@ static Rgb *shade_grid(Worker *w, uint32_t gi)
     const RenderObject *obj = &rs->objects[g->object];
     size_t n = geom_grid_n_vertices(g);
     float(*f3)[3] = malloc(n * 10 * sizeof *f3);
-    float *f1 = malloc(n * 6 * sizeof *f1);
+    float *f1 = malloc(n * 10 * sizeof *f1);
     uint64_t *keys = malloc(n * sizeof *keys);
     RayDiff *diff = malloc(n * sizeof *diff);
     Rgb *ci = malloc(n * sizeof *ci);
@@ -96,9 +96,10 @@ static Rgb *shade_grid(Worker *w, uint32_t gi)
     RY_CHECK(f3 && f1 && keys && diff && ci && back);
     float(*P)[3] = f3, (*N)[3] = f3 + n, (*dPdu)[3] = f3 + 2 * n, (*dPdv)[3] = f3 + 3 * n;
     float(*I)[3] = f3 + 4 * n, (*Cs)[3] = f3 + 5 * n, (*Os)[3] = f3 + 6 * n;
-    float(*Ci)[3] = f3 + 7 * n, (*Oi)[3] = f3 + 8 * n;
+    float(*Ci)[3] = f3 + 7 * n, (*Oi)[3] = f3 + 8 * n, (*Ng)[3] = f3 + 9 * n;
     float *u = f1, *v = f1 + n, *du = f1 + 2 * n, *dv = f1 + 3 * n, *curv = f1 + 4 * n;
-    float *offset = f1 + 5 * n;
+    float *offset = f1 + 5 * n, *s = f1 + 6 * n, *t = f1 + 7 * n, *ds = f1 + 8 * n;
+    float *dt = f1 + 9 * n;
     float su, sv;
     grid_spacing(g, &su, &sv);
     const Camera *cam = &rs->camera;
@@ -110,21 +111,26 @@ static Rgb *shade_grid(Worker *w, uint32_t gi)
         Vec3 to = v3_sub(gs->P[i], cam->eye);
         float dist = cam->tan_half_fov > 0.0f ? v3_length(to) : v3_dot(to, cam->forward);
         Vec3 d = cam->tan_half_fov > 0.0f && dist > 0.0f ? v3_scale(to, 1.0f / dist) : cam->forward;
-        Vec3 Nk = gs->N[i];
-        back[k] = v3_dot(Nk, d) > 0.0f; /* the eye sees the back: shade that side */
+        Vec3 Ngk = gs->N[i], Nk = geom_vertex_normal(gs, g, i);
+        back[k] = v3_dot(Ngk, d) > 0.0f; /* the eye sees the back: shade that side */
         if (back[k])
-            Nk = v3_neg(Nk);
+            Nk = v3_neg(Nk), Ngk = v3_neg(Ngk);
         put3(P[k], gs->P[i]);
         put3(N[k], Nk);
+        put3(Ng[k], Ngk);
         put3(dPdu[k], gs->dPdu[i]);
         put3(dPdv[k], gs->dPdv[i]);
         put3(I[k], d);
-        memcpy(Cs[k], obj->Cs, sizeof Cs[k]);
+        put3(Cs[k], geom_vertex_color(gs, g, i, v3_load(obj->Cs)));
         memcpy(Os[k], obj->Os, sizeof Os[k]);
         u[k] = gs->uv[i][0];
         v[k] = gs->uv[i][1];
         du[k] = su;
         dv[k] = sv;
+        float st[2], dst[4];
+        geom_vertex_st(gs, g, i, st, dst);
+        s[k] = st[0], t[k] = st[1];
+        integrator_st_footprint(dst, su, sv, &ds[k], &dt[k]);
         curv[k] = g->curvature;
         offset[k] = integrator_ray_offset(w, g);
         keys[k] = hash_combine(grid_key, k);
@@ -137,12 +143,14 @@ static Rgb *shade_grid(Worker *w, uint32_t gi)
         RY_CHECK(irr_E != NULL);
         irr.E = irr_E;
     }
-    PathState ps = {w, keys, diff, curv, offset, w->set->irradiance ? &irr : NULL, gi};
+    int own_st = (g->primvars & GEOM_PV_ST) != 0;
+    PathState ps = {w, keys, diff, curv, offset, w->set->irradiance ? &irr : NULL, gi,
+                    own_st ? ds : NULL, own_st ? dt : NULL};
     RayesShadeCtx ctx = {
         .n_points = n, .ray_type = RAYES_RAY_CAMERA, .diffuse_depth = 0, .specular_depth = 0,
-        .P = (const float(*)[3])P, .N = (const float(*)[3])N, .Ng = (const float(*)[3])N,
+        .P = (const float(*)[3])P, .N = (const float(*)[3])N, .Ng = (const float(*)[3])Ng,
         .dPdu = (const float(*)[3])dPdu, .dPdv = (const float(*)[3])dPdv, .u = u, .v = v,
-        .s = u, .t = v, .du = du, .dv = dv, .I = (const float(*)[3])I,
+        .s = s, .t = t, .du = du, .dv = dv, .I = (const float(*)[3])I,
         .Cs = (const float(*)[3])Cs, .Os = (const float(*)[3])Os, .renderer = &ps,
         .backfacing = back,
     };

@@ -42,6 +42,7 @@ float integrator_ray_offset(const Worker *w, const Grid *g)
 typedef struct HitPoint {
     float P[3], N[3], Ng[3], dPdu[3], dPdv[3], I[3], Cs[3], Os[3];
     float u, v, du, dv;
+    float s, t, ds, dt, dst[4]; /* texture coordinates, filter widths, derivatives */
     uint64_t key;
     RayDiff diff;
     float curvature, offset;
@@ -54,22 +55,34 @@ static void store3(float out[3], Vec3 v)
     out[2] = v.z;
 }
 
-/* Interpolates the grid at a hit; N and Ng face the incoming ray. Returns
- * 1 if the front side (dPdu x dPdv) was hit. */
-static int hit_point(const Worker *w, const Ray *ray, const Hit *hit, HitPoint *hp)
+/* Interpolates the grid at a hit (the shading normal, texture coordinates
+ * and colour among the rest; Cs from obj without a primitive variable);
+ * N and Ng face the incoming ray. Returns 1 if the front side (dPdu x dPdv)
+ * was hit. */
+static int hit_point(const Worker *w, const Ray *ray, const Hit *hit, const RenderObject *obj,
+                     HitPoint *hp)
 {
     const GridSet *gs = w->rs->gs;
-    Vec3 N = v3(0, 0, 0), du = N, dv = N;
-    float u = 0.0f, v = 0.0f;
+    const Grid *g = &gs->grids[hit->grid];
+    Vec3 N = v3(0, 0, 0), du = N, dv = N, Cs = N, dflt = v3_load(obj->Cs);
+    float u = 0.0f, v = 0.0f, st[2] = {0, 0}, dst[4] = {0, 0, 0, 0};
     for (int k = 0; k < hit->n_vertex; k++) {
         uint32_t i = hit->vertex[k];
-        float wk = hit->weight[k];
-        N = v3_madd(N, gs->N[i], wk);
+        float wk = hit->weight[k], sti[2], dsti[4];
+        N = v3_madd(N, geom_vertex_normal(gs, g, i), wk);
         du = v3_madd(du, gs->dPdu[i], wk);
         dv = v3_madd(dv, gs->dPdv[i], wk);
         u += gs->uv[i][0] * wk;
         v += gs->uv[i][1] * wk;
+        Cs = v3_madd(Cs, geom_vertex_color(gs, g, i, dflt), wk);
+        geom_vertex_st(gs, g, i, sti, dsti);
+        for (int c = 0; c < 4; c++)
+            dst[c] += dsti[c] * wk;
+        st[0] += sti[0] * wk, st[1] += sti[1] * wk;
     }
+    store3(hp->Cs, Cs);
+    hp->s = st[0], hp->t = st[1];
+    memcpy(hp->dst, dst, sizeof dst);
     N = v3_normalize(N);
     Vec3 Ng = v3_length(hit->Ng) > 0.0f ? hit->Ng : N;
     int front = v3_dot(Ng, ray->d) < 0.0f;
@@ -128,13 +141,15 @@ static Vec3 shade_hit(Worker *w, const Ray *ray, const Hit *hit, const RenderObj
                       RayDiff diff)
 {
     HitPoint hp;
-    int backfacing = !hit_point(w, ray, hit, &hp);
-    memcpy(hp.Cs, obj->Cs, sizeof hp.Cs);
+    int backfacing = !hit_point(w, ray, hit, obj, &hp);
     memcpy(hp.Os, obj->Os, sizeof hp.Os);
     hp.key = key;
     hp.diff = (RayDiff){diff.width + diff.spread * hit->t, diff.spread};
     hit_footprint(&hp);
-    PathState ps = {w, &hp.key, &hp.diff, &hp.curvature, &hp.offset, NULL, hit->grid};
+    integrator_st_footprint(hp.dst, hp.du, hp.dv, &hp.ds, &hp.dt);
+    int own_st = (w->rs->gs->grids[hit->grid].primvars & GEOM_PV_ST) != 0;
+    PathState ps = {w, &hp.key, &hp.diff, &hp.curvature, &hp.offset, NULL, hit->grid,
+                    own_st ? &hp.ds : NULL, own_st ? &hp.dt : NULL};
     RayesShadeCtx ctx = {
         .n_points = 1,
         .ray_type = kind,
@@ -147,8 +162,8 @@ static Vec3 shade_hit(Worker *w, const Ray *ray, const Hit *hit, const RenderObj
         .dPdv = (const float(*)[3])hp.dPdv,
         .u = &hp.u,
         .v = &hp.v,
-        .s = &hp.u,
-        .t = &hp.v,
+        .s = &hp.s,
+        .t = &hp.t,
         .du = &hp.du,
         .dv = &hp.dv,
         .I = (const float(*)[3])hp.I,
@@ -548,8 +563,12 @@ static int svc_texture(const RayesShaderServices *sv, const RayesShadeCtx *ctx, 
                        float (*rgb)[3], float *alpha)
 {
     (void)sv;
-    TextureSystem *ts = ((const PathState *)ctx->renderer)->w->set->textures;
-    return shade_texture_service(ts, ctx, name, s, t, ds, dt, rgb, alpha);
+    const PathState *ps = ctx->renderer;
+    if (!ds && ps->ds)
+        ds = ps->ds + ctx->first_point;
+    if (!dt && ps->dt)
+        dt = ps->dt + ctx->first_point;
+    return shade_texture_service(ps->w->set->textures, ctx, name, s, t, ds, dt, rgb, alpha);
 }
 
 static int put_floats(float *value, int n, const float *have, int n_have)

@@ -37,7 +37,19 @@ typedef struct PathState {
     struct IrrGrid *irr;          /* irradiance interpolation over this grid, or NULL
                                      (irrgrid.h) */
     uint32_t grid;                /* the grid (patch) all the points lie on */
+    const float *ds, *dt;         /* texture filter widths in (s, t) where the points have
+                                     texture coordinates of their own (primitive variable st),
+                                     or NULL: the texture service then takes ctx->du, dv */
 } PathState;
+
+/* The texture-space footprint of a point whose parameter footprint is
+ * (du, dv), given dst = ds/du, ds/dv, dt/du, dt/dv. */
+static inline void integrator_st_footprint(const float dst[4], float du, float dv, float *ds,
+                                           float *dt)
+{
+    *ds = fabsf(dst[0]) * du + fabsf(dst[1]) * dv;
+    *dt = fabsf(dst[2]) * du + fabsf(dst[3]) * dv;
+}
 
 /* How far rays leaving a point of grid g start from it, along its normal:
  * the ray epsilon plus a bound on the sagitta of neighbouring grids' chords.

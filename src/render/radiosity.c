@@ -164,32 +164,46 @@ static void tri_cell(int n, float x, float y, int vi[3][2], float wt[3])
 }
 
 typedef struct FillPoints {
-    float (*P)[3], (*N)[3], (*dPdu)[3], (*dPdv)[3], (*Cs)[3], (*Os)[3], (*Ci)[3], (*Oi)[3];
-    float *u, *v, *du, *dv, *curv, *offset;
+    float (*P)[3], (*N)[3], (*Ng)[3], (*dPdu)[3], (*dPdv)[3], (*Cs)[3], (*Os)[3], (*Ci)[3];
+    float (*Oi)[3];
+    float *u, *v, *s, *t, (*dst)[4], *du, *dv, *ds, *dt, *curv, *offset;
     uint64_t *keys;
     RayDiff *diff;
 } FillPoints;
 
-/* Point p of the fill takes fine vertices vtx[0..n) with weights wt. */
+/* Point p of the fill takes fine vertices vtx[0..n) with weights wt; its
+ * colour is the object's dflt unless the grid has its own. */
 static void put_point(const GridSet *gs, const Grid *g, FillPoints *fp, size_t p,
-                      const uint32_t *vtx, const float *wt, int nv, int side)
+                      const uint32_t *vtx, const float *wt, int nv, int side, Vec3 dflt)
 {
-    Vec3 P = v3(0, 0, 0), N = P, du = P, dv = P;
-    float u = 0.0f, v = 0.0f;
+    Vec3 P = v3(0, 0, 0), N = P, Ng = P, du = P, dv = P, Cs = P;
+    float u = 0.0f, v = 0.0f, st[2] = {0, 0}, dst[4] = {0, 0, 0, 0};
     for (int k = 0; k < nv; k++) {
         uint32_t i = g->first_vertex + vtx[k];
+        float sti[2], dsti[4];
         P = v3_madd(P, gs->P[i], wt[k]);
-        N = v3_madd(N, gs->N[i], wt[k]);
+        N = v3_madd(N, geom_vertex_normal(gs, g, i), wt[k]);
+        Ng = v3_madd(Ng, gs->N[i], wt[k]);
         du = v3_madd(du, gs->dPdu[i], wt[k]);
         dv = v3_madd(dv, gs->dPdv[i], wt[k]);
         u += gs->uv[i][0] * wt[k];
         v += gs->uv[i][1] * wt[k];
+        Cs = v3_madd(Cs, geom_vertex_color(gs, g, i, dflt), wt[k]);
+        geom_vertex_st(gs, g, i, sti, dsti);
+        st[0] += sti[0] * wt[k], st[1] += sti[1] * wt[k];
+        for (int c = 0; c < 4; c++)
+            dst[c] += dsti[c] * wt[k];
     }
     N = v3_normalize(N);
+    Ng = v3_normalize(Ng);
     if (side)
-        N = v3_neg(N);
+        N = v3_neg(N), Ng = v3_neg(Ng);
     memcpy(fp->P[p], &P, sizeof fp->P[p]);
     memcpy(fp->N[p], &N, sizeof fp->N[p]);
+    memcpy(fp->Ng[p], &Ng, sizeof fp->Ng[p]);
+    memcpy(fp->Cs[p], &Cs, sizeof fp->Cs[p]);
+    fp->s[p] = st[0], fp->t[p] = st[1];
+    memcpy(fp->dst[p], dst, sizeof dst);
     memcpy(fp->dPdu[p], &du, sizeof fp->dPdu[p]);
     memcpy(fp->dPdv[p], &dv, sizeof fp->dPdv[p]);
     fp->u[p] = u;
@@ -197,7 +211,8 @@ static void put_point(const GridSet *gs, const Grid *g, FillPoints *fp, size_t p
 }
 
 /* Positions of the level's points on the fine grid. */
-static void layout_points(const GridSet *gs, const Grid *g, int level, int side, FillPoints *fp)
+static void layout_points(const GridSet *gs, const Grid *g, int level, int side, Vec3 dflt,
+                          FillPoints *fp)
 {
     size_t p = 0;
     if (!g->triangular) {
@@ -208,7 +223,7 @@ static void layout_points(const GridSet *gs, const Grid *g, int level, int side,
                 int fi = quad_level_index(level, i, nu), fj = quad_level_index(level, j, nv);
                 uint32_t vtx = (uint32_t)(fj * nu + fi);
                 float one = 1.0f;
-                put_point(gs, g, fp, p++, &vtx, &one, 1, side);
+                put_point(gs, g, fp, p++, &vtx, &one, 1, side, dflt);
             }
         return;
     }
@@ -222,7 +237,7 @@ static void layout_points(const GridSet *gs, const Grid *g, int level, int side,
             uint32_t vtx[3];
             for (int k = 0; k < 3; k++)
                 vtx[k] = geom_tri_vertex((uint32_t)n, (uint32_t)vi[k][0], (uint32_t)vi[k][1]);
-            put_point(gs, g, fp, p++, vtx, wt, 3, side);
+            put_point(gs, g, fp, p++, vtx, wt, 3, side, dflt);
         }
 }
 
@@ -254,40 +269,44 @@ static void fill_radiosity(void *user, const CacheKey *key, size_t n, float (*ou
     const Grid *g = &gs->grids[key->patch];
     const RenderObject *obj = &w->rs->objects[g->object];
     FillPoints fp;
-    float(*f3)[3] = malloc(n * 8 * sizeof *f3);
-    float *f1 = malloc(n * 6 * sizeof *f1);
+    float(*f3)[3] = malloc(n * 9 * sizeof *f3);
+    float *f1 = malloc(n * 14 * sizeof *f1);
     fp.keys = malloc(n * sizeof *fp.keys);
     fp.diff = malloc(n * sizeof *fp.diff);
     int *backfacing = malloc(n * sizeof *backfacing);
     RY_CHECK(f3 && f1 && fp.keys && fp.diff && backfacing);
     fp.P = f3, fp.N = f3 + n, fp.dPdu = f3 + 2 * n, fp.dPdv = f3 + 3 * n;
     fp.Cs = f3 + 4 * n, fp.Os = f3 + 5 * n, fp.Ci = f3 + 6 * n, fp.Oi = f3 + 7 * n;
+    fp.Ng = f3 + 8 * n;
     fp.u = f1, fp.v = f1 + n, fp.du = f1 + 2 * n, fp.dv = f1 + 3 * n, fp.curv = f1 + 4 * n;
-    fp.offset = f1 + 5 * n;
-    layout_points(gs, g, key->level, key->side, &fp);
+    fp.offset = f1 + 5 * n, fp.s = f1 + 6 * n, fp.t = f1 + 7 * n, fp.ds = f1 + 8 * n;
+    fp.dt = f1 + 9 * n, fp.dst = (float(*)[4])(f1 + 10 * n);
+    layout_points(gs, g, key->level, key->side, v3_load(obj->Cs), &fp);
     uint64_t fill_key = hash_combine(hash_combine(w->set->seed, 0x7261646f73ull /* "rados" */),
                                      ((uint64_t)key->patch << 32) | ((uint64_t)key->depth << 16) |
                                          ((uint64_t)key->side << 8) | key->level);
     float width = level_edge(g, key->level), du, dv;
     level_footprint(g, key->level, &du, &dv);
     for (size_t i = 0; i < n; i++) {
-        memcpy(fp.Cs[i], obj->Cs, sizeof fp.Cs[i]);
         memcpy(fp.Os[i], obj->Os, sizeof fp.Os[i]);
         fp.du[i] = du;
         fp.dv[i] = dv;
+        integrator_st_footprint(fp.dst[i], du, dv, &fp.ds[i], &fp.dt[i]);
         fp.curv[i] = g->curvature;
         fp.offset[i] = integrator_ray_offset(w, g);
         fp.keys[i] = hash_combine(fill_key, i);
         fp.diff[i] = (RayDiff){width, 0.0f};
         backfacing[i] = key->side != 0; /* side 1: against dPdu x dPdv */
     }
-    PathState ps = {w, fp.keys, fp.diff, fp.curv, fp.offset, NULL, key->patch};
+    int own_st = (g->primvars & GEOM_PV_ST) != 0;
+    PathState ps = {w, fp.keys, fp.diff, fp.curv, fp.offset, NULL, key->patch,
+                    own_st ? fp.ds : NULL, own_st ? fp.dt : NULL};
     RayesShadeCtx ctx = {
         .n_points = n, .ray_type = RAYES_RAY_DIFFUSE, .diffuse_depth = key->depth,
         .specular_depth = 0,
         .P = (const float(*)[3])fp.P, .N = (const float(*)[3])fp.N,
-        .Ng = (const float(*)[3])fp.N, .dPdu = (const float(*)[3])fp.dPdu,
-        .dPdv = (const float(*)[3])fp.dPdv, .u = fp.u, .v = fp.v, .s = fp.u, .t = fp.v,
+        .Ng = (const float(*)[3])fp.Ng, .dPdu = (const float(*)[3])fp.dPdu,
+        .dPdv = (const float(*)[3])fp.dPdv, .u = fp.u, .v = fp.v, .s = fp.s, .t = fp.t,
         .du = fp.du, .dv = fp.dv, .I = NULL, .Cs = (const float(*)[3])fp.Cs,
         .Os = (const float(*)[3])fp.Os, .renderer = &ps, .backfacing = backfacing,
     };

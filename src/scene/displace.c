@@ -31,7 +31,7 @@ enum { SAMPLES = 5 }; /* the vertex, then u - h, u + h, v - h, v + h */
 typedef struct Scratch {
     size_t cap;          /* points */
     float (*P)[3], (*N)[3], (*dPdu)[3], (*dPdv)[3], (*Cs)[3], (*Os)[3], (*out)[3];
-    float *u, *v, *du, *dv;
+    float *u, *v, *s, *t, *du, *dv;
     float *hu, *hv;      /* per vertex: the parameter steps of the differences */
     void *shader_scratch;
     size_t shader_scratch_size;
@@ -40,7 +40,8 @@ typedef struct Scratch {
 static void scratch_free(Scratch *s)
 {
     free(s->P), free(s->N), free(s->dPdu), free(s->dPdv), free(s->Cs), free(s->Os), free(s->out);
-    free(s->u), free(s->v), free(s->du), free(s->dv), free(s->hu), free(s->hv);
+    free(s->u), free(s->v), free(s->s), free(s->t), free(s->du), free(s->dv);
+    free(s->hu), free(s->hv);
     free(s->shader_scratch);
     memset(s, 0, sizeof *s);
 }
@@ -54,10 +55,11 @@ static int scratch_reserve(Scratch *s, size_t n, size_t shader_bytes)
         s->Cs = malloc(n * sizeof *s->Cs), s->Os = malloc(n * sizeof *s->Os);
         s->out = malloc(n * sizeof *s->out);
         s->u = malloc(n * sizeof *s->u), s->v = malloc(n * sizeof *s->v);
+        s->s = malloc(n * sizeof *s->s), s->t = malloc(n * sizeof *s->t);
         s->du = malloc(n * sizeof *s->du), s->dv = malloc(n * sizeof *s->dv);
         s->hu = malloc(n * sizeof *s->hu), s->hv = malloc(n * sizeof *s->hv);
         if (!s->P || !s->N || !s->dPdu || !s->dPdv || !s->Cs || !s->Os || !s->out || !s->u ||
-            !s->v || !s->du || !s->dv || !s->hu || !s->hv)
+            !s->v || !s->s || !s->t || !s->du || !s->dv || !s->hu || !s->hv)
             return -1;
         s->cap = n;
     }
@@ -127,12 +129,21 @@ static int displace_grid(const RayesScene *s, GridSet *gs, Grid *g, float step,
             Vec3 P, du, dv;
             geom_prim_eval(prim, u, v, &P, &du, &dv);
             put3(sc->P[i], q == 0 ? gs->P[vtx] : P);
-            put3(sc->N[i], q == 0 ? gs->N[vtx] : geom_prim_normal(prim, u, v));
+            Vec3 N = q == 0 ? gs->N[vtx] : geom_prim_normal(prim, u, v);
+            /* Primitive variables as the surface shader would see them:
+             * displacing along a supplied normal keeps a smooth mesh
+             * closed along its shared edges (as RenderMan's N). */
+            PrimvarSample pv = {.N = N, .st = {u, v}, .Cs = get3(obj->Cs)};
+            geom_prim_primvars(prim, s->pv, u, v, &pv);
+            if (v3_length(pv.N) > 0.0f)
+                N = v3_dot(pv.N, N) < 0.0f ? v3_neg(pv.N) : pv.N;
+            put3(sc->N[i], N);
             put3(sc->dPdu[i], du);
             put3(sc->dPdv[i], dv);
             sc->u[i] = u, sc->v[i] = v;
+            sc->s[i] = pv.st[0], sc->t[i] = pv.st[1];
             sc->du[i] = 2.0f * grid_hu, sc->dv[i] = 2.0f * grid_hv; /* the grid's spacing */
-            memcpy(sc->Cs[i], obj->Cs, sizeof obj->Cs);
+            put3(sc->Cs[i], pv.Cs);
             memcpy(sc->Os[i], obj->Os, sizeof obj->Os);
             memcpy(sc->out[i], sc->P[i], sizeof sc->out[i]);
         }
@@ -147,8 +158,8 @@ static int displace_grid(const RayesScene *s, GridSet *gs, Grid *g, float step,
         .dPdv = (const float(*)[3])sc->dPdv,
         .u = sc->u,
         .v = sc->v,
-        .s = sc->u,
-        .t = sc->v,
+        .s = sc->s,
+        .t = sc->t,
         .du = sc->du,
         .dv = sc->dv,
         .Cs = (const float(*)[3])sc->Cs,
@@ -188,6 +199,7 @@ static int displace_grid(const RayesScene *s, GridSet *gs, Grid *g, float step,
             gs->dPdv[vtx] = dv;
         } /* else a degenerate point (a pole): keep the undisplaced frame */
     }
+    g->primvars &= (uint8_t)~GEOM_PV_N; /* the displaced surface's normals replace N */
     geom_grid_measure(gs, g);
     return 0;
 }

@@ -100,6 +100,7 @@ void rayes_scene_release(RayesScene *s)
     free(s->displacements);
     free(s->objects);
     free(s->prims);
+    free(s->pv);
     for (size_t i = 0; i < s->n_lights; i++)
         light_fini(&s->lights[i]);
     free(s->lights);
@@ -364,30 +365,192 @@ static void transform_points(const RayesScene *s, const float (*P)[3], size_t n,
         out[i] = mat4_point(&s->world_from_object, v3_load(P[i]));
 }
 
+/* ------------------------------------------------- primitive variables */
+
+/* The variables rayes.h's RayesPrimvar names, in GEOM_PV_* bit order. */
+static const struct {
+    const char *name;
+    unsigned bit;
+    int size; /* floats per value */
+} primvar_names[3] = {{"N", GEOM_PV_N, 3}, {"st", GEOM_PV_ST, 2}, {"Cs", GEOM_PV_CS, 3}};
+
+static const char *const primvar_class_names[5] = {"constant", "uniform", "varying", "vertex",
+                                                   "facevarying"};
+
+/* A call's primitive variables, checked: by[b] is the one named
+ * primvar_names[b].name, or NULL. */
+typedef struct PrimvarSet {
+    const RayesPrimvar *by[3];
+    unsigned mask;            /* GEOM_PV_* bits given */
+    Mat4 normal_from_object;  /* for N: the inverse transpose of world_from_object */
+} PrimvarSet;
+
+/* Checks pv against the counts each class needs (expect[cls]) and fills
+ * set. what names the call in messages. */
+static RayesError check_primvars(RayesScene *s, const char *what, const RayesPrimvar *pv,
+                                 size_t n_pv, const size_t expect[5], PrimvarSet *set)
+{
+    memset(set, 0, sizeof *set);
+    if (n_pv && !pv)
+        return fail(s, RAYES_ERROR_INVALID_ARGUMENT, "%s: primitive variables are NULL", what);
+    for (size_t i = 0; i < n_pv; i++) {
+        int b = 0;
+        while (b < 3 && !(pv[i].name && strcmp(pv[i].name, primvar_names[b].name) == 0))
+            b++;
+        if (b == 3)
+            return fail(s, RAYES_ERROR_INVALID_ARGUMENT,
+                        "%s: unknown primitive variable \"%.64s\"; expected N, st or Cs", what,
+                        pv[i].name ? pv[i].name : "(null)");
+        if (set->by[b])
+            return fail(s, RAYES_ERROR_INVALID_ARGUMENT, "%s: primitive variable %s given twice",
+                        what, pv[i].name);
+        if ((unsigned)pv[i].cls > RAYES_PRIMVAR_FACEVARYING)
+            return fail(s, RAYES_ERROR_INVALID_ARGUMENT, "%s: primitive variable %s has class %d",
+                        what, pv[i].name, (int)pv[i].cls);
+        size_t want = expect[pv[i].cls];
+        if (pv[i].count != want)
+            return fail(s, RAYES_ERROR_INVALID_ARGUMENT,
+                        "%s: %s %s has %zu values; expected %zu", what,
+                        primvar_class_names[pv[i].cls], pv[i].name, pv[i].count, want);
+        if (want && !pv[i].data)
+            return fail(s, RAYES_ERROR_INVALID_ARGUMENT, "%s: primitive variable %s has no data",
+                        what, pv[i].name);
+        if (!finite_n(pv[i].data, want * (size_t)primvar_names[b].size))
+            return fail(s, RAYES_ERROR_INVALID_ARGUMENT,
+                        "%s: primitive variable %s has a non-finite value", what, pv[i].name);
+        set->by[b] = &pv[i];
+        set->mask |= primvar_names[b].bit;
+    }
+    Mat4 inv;
+    mat4_invert(s->world_from_object, &inv);
+    set->normal_from_object = mat4_transpose(inv);
+    return RAYES_OK;
+}
+
+/* Where one control value of a primitive comes from: its face, its corner
+ * among all face corners, its point. */
+typedef struct PrimvarSource {
+    size_t face, corner, point;
+} PrimvarSource;
+
+static size_t primvar_index(RayesPrimvarClass cls, PrimvarSource src)
+{
+    switch (cls) {
+    case RAYES_PRIMVAR_CONSTANT: return 0;
+    case RAYES_PRIMVAR_UNIFORM: return src.face;
+    case RAYES_PRIMVAR_FACEVARYING: return src.corner;
+    default: return src.point; /* varying, vertex */
+    }
+}
+
+/* Appends prim p's values to the pool: per variable of set (bit order),
+ * n values, the k-th taken from src[k] (or, when the variable is in cubic,
+ * its 16 values in order). Sets p's pv fields. */
+static RayesError push_primvars(RayesScene *s, Prim *p, const PrimvarSet *set,
+                                const PrimvarSource *src, int n, unsigned cubic)
+{
+    p->pv = (uint8_t)set->mask;
+    p->pv_cubic = (uint8_t)(set->mask & cubic);
+    p->pv_first = s->n_pv;
+    if (!set->mask)
+        return RAYES_OK;
+    size_t need = 0;
+    for (int b = 0; b < 3; b++)
+        if (set->by[b])
+            need += (size_t)((cubic & primvar_names[b].bit) ? 16 : n) * (size_t)primvar_names[b].size;
+    if (s->n_pv + need > s->cap_pv) {
+        size_t cap = s->cap_pv ? s->cap_pv : 1024;
+        while (cap < s->n_pv + need)
+            cap *= 2;
+        float *pv = realloc(s->pv, cap * sizeof *pv);
+        if (!pv)
+            return fail(s, RAYES_ERROR_OUT_OF_MEMORY, "out of memory");
+        s->pv = pv;
+        s->cap_pv = cap;
+    }
+    for (int b = 0; b < 3; b++) {
+        const RayesPrimvar *v = set->by[b];
+        if (!v)
+            continue;
+        int size = primvar_names[b].size, per_control = (cubic & primvar_names[b].bit) != 0;
+        for (int k = 0; k < (per_control ? 16 : n); k++) {
+            size_t at = per_control ? (size_t)k : primvar_index(v->cls, src[k]);
+            const float *x = v->data + at * (size_t)size;
+            float *out = s->pv + s->n_pv;
+            if (primvar_names[b].bit == GEOM_PV_N) {
+                Vec3 N = v3_normalize(mat4_vector(&set->normal_from_object, v3_load(x)));
+                out[0] = N.x, out[1] = N.y, out[2] = N.z;
+            } else
+                memcpy(out, x, (size_t)size * sizeof *out);
+            s->n_pv += (size_t)size;
+        }
+    }
+    return RAYES_OK;
+}
+
 RayesError rayes_scene_bilinear_patch(RayesScene *s, const float P[4][3])
+{
+    return rayes_scene_bilinear_patch_pv(s, P, NULL, 0);
+}
+
+RayesError rayes_scene_bilinear_patch_pv(RayesScene *s, const float P[4][3],
+                                         const RayesPrimvar *pv, size_t n_pv)
 {
     if (!s || !P)
         return RAYES_ERROR_INVALID_ARGUMENT;
     if (!finite_n(&P[0][0], 12))
         return fail(s, RAYES_ERROR_INVALID_ARGUMENT, "bilinear patch: non-finite point");
+    static const size_t expect[5] = {1, 1, 4, 4, 4};
+    PrimvarSet set;
+    RayesError e = check_primvars(s, "bilinear patch", pv, n_pv, expect, &set);
+    if (e != RAYES_OK)
+        return e;
     Prim p = {.type = PRIM_BILINEAR};
     transform_points(s, P, 4, p.cp);
+    const PrimvarSource src[4] = {{0, 0, 0}, {0, 1, 1}, {0, 2, 2}, {0, 3, 3}};
+    if ((e = push_primvars(s, &p, &set, src, 4, 0)) != RAYES_OK)
+        return e;
     return add_prim(s, &p);
 }
 
 RayesError rayes_scene_bicubic_patch(RayesScene *s, const float P[16][3])
 {
+    return rayes_scene_bicubic_patch_pv(s, P, NULL, 0);
+}
+
+RayesError rayes_scene_bicubic_patch_pv(RayesScene *s, const float P[16][3],
+                                        const RayesPrimvar *pv, size_t n_pv)
+{
     if (!s || !P)
         return RAYES_ERROR_INVALID_ARGUMENT;
     if (!finite_n(&P[0][0], 48))
         return fail(s, RAYES_ERROR_INVALID_ARGUMENT, "bicubic patch: non-finite point");
+    static const size_t expect[5] = {1, 1, 4, 16, 4};
+    PrimvarSet set;
+    RayesError e = check_primvars(s, "bicubic patch", pv, n_pv, expect, &set);
+    if (e != RAYES_OK)
+        return e;
+    unsigned cubic = 0;
+    for (int b = 0; b < 3; b++)
+        if (set.by[b] && set.by[b]->cls == RAYES_PRIMVAR_VERTEX)
+            cubic |= primvar_names[b].bit;
     Prim p = {.type = PRIM_BICUBIC};
     transform_points(s, P, 16, p.cp);
+    const PrimvarSource src[4] = {{0, 0, 0}, {0, 1, 1}, {0, 2, 2}, {0, 3, 3}};
+    if ((e = push_primvars(s, &p, &set, src, 4, cubic)) != RAYES_OK)
+        return e;
     return add_prim(s, &p);
 }
 
 RayesError rayes_scene_polygon_mesh(RayesScene *s, size_t n_faces, const int *n_verts,
                                     const int *indices, size_t n_points, const float *P)
+{
+    return rayes_scene_polygon_mesh_pv(s, n_faces, n_verts, indices, n_points, P, NULL, 0);
+}
+
+RayesError rayes_scene_polygon_mesh_pv(RayesScene *s, size_t n_faces, const int *n_verts,
+                                       const int *indices, size_t n_points, const float *P,
+                                       const RayesPrimvar *pv, size_t n_pv)
 {
     if (!s || (n_faces && (!n_verts || !indices || !P)))
         return RAYES_ERROR_INVALID_ARGUMENT;
@@ -405,22 +568,27 @@ RayesError rayes_scene_polygon_mesh(RayesScene *s, size_t n_faces, const int *n_
                             indices[k + (size_t)v], n_points ? n_points - 1 : 0);
         k += (size_t)n_verts[f];
     }
+    const size_t expect[5] = {1, n_faces, n_points, n_points, k};
+    PrimvarSet set;
+    RayesError e = check_primvars(s, "polygon mesh", pv, n_pv, expect, &set);
+    if (e != RAYES_OK)
+        return e;
     k = 0;
     for (size_t f = 0; f < n_faces; f++) {
         const float(*pts)[3] = (const float(*)[3])P;
         const int *ix = indices + k;
         Prim p = {.type = n_verts[f] == 3 ? PRIM_TRIANGLE : PRIM_BILINEAR};
-        if (n_verts[f] == 3) {
-            for (int v = 0; v < 3; v++)
-                transform_points(s, &pts[ix[v]], 1, &p.cp[v]);
-        } else {
-            /* Polygon order v0 v1 v2 v3 -> bilinear P00 = v0, P10 = v1, P01 = v3, P11 = v2. */
-            static const int order[4] = {0, 1, 3, 2};
-            for (int v = 0; v < 4; v++)
-                transform_points(s, &pts[ix[order[v]]], 1, &p.cp[v]);
+        /* Polygon order v0 v1 v2 v3 -> bilinear P00 = v0, P10 = v1, P01 = v3, P11 = v2. */
+        static const int tri[3] = {0, 1, 2}, quad[4] = {0, 1, 3, 2};
+        const int *order = n_verts[f] == 3 ? tri : quad;
+        PrimvarSource src[4];
+        for (int v = 0; v < n_verts[f]; v++) {
+            transform_points(s, &pts[ix[order[v]]], 1, &p.cp[v]);
+            src[v] = (PrimvarSource){f, k + (size_t)order[v], (size_t)ix[order[v]]};
         }
-        RayesError e = add_prim(s, &p);
-        if (e != RAYES_OK)
+        if ((e = push_primvars(s, &p, &set, src, n_verts[f], 0)) != RAYES_OK)
+            return e;
+        if ((e = add_prim(s, &p)) != RAYES_OK)
             return e;
         k += (size_t)n_verts[f];
     }
@@ -556,7 +724,7 @@ int scene_prepare(const RayesScene *s, int width, int height, TextureSystem *tex
     cam.min_distance = 1e-3f * fmaxf(radius, 1e-6f);
     for (size_t i = 0; i < s->n_prims; i++) {
         size_t first = gs->n_grids;
-        if (geom_dice_prim(gs, &s->prims[i], (uint32_t)i, &cam) != 0)
+        if (geom_dice_prim(gs, &s->prims[i], (uint32_t)i, s->pv, &cam) != 0)
             return -1;
         /* Normals of displaced surfaces: differences over 1e-3 of the scene radius. */
         if (s->prims[i].displacement && scene_displace(s, gs, first, 1e-3f * radius, &sv.sv) != 0)

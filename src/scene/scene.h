@@ -72,6 +72,8 @@ struct RayesScene {
     int64_t current_object;   /* object of geometry added next; -1: make a default matte */
     Prim *prims;
     size_t n_prims, cap_prims;
+    float *pv;                /* primitive variable values of every prim (Prim.pv_first) */
+    size_t n_pv, cap_pv;      /* floats */
     SceneObject *objects;
     size_t n_objects, cap_objects;
     Light *lights;

@@ -13,11 +13,11 @@ static GridSet scene(void)
     Prim quad = {.type = PRIM_BILINEAR, .object = 0, .shading_rate = 1.0f};
     quad.cp[0] = v3(-5, -5, 0), quad.cp[1] = v3(5, -5, 0), quad.cp[2] = v3(-5, 5, 0),
     quad.cp[3] = v3(5, 5, 0);
-    geom_dice_prim(&gs, &quad, 0, &cam);
+    geom_dice_prim(&gs, &quad, 0, NULL, &cam);
     /* Object 1: a triangle at z = 10 behind it, off to the side. */
     Prim tri = {.type = PRIM_TRIANGLE, .object = 1, .shading_rate = 1.0f};
     tri.cp[0] = v3(20, 0, 10), tri.cp[1] = v3(28, 0, 10), tri.cp[2] = v3(20, 8, 10);
-    geom_dice_prim(&gs, &tri, 1, &cam);
+    geom_dice_prim(&gs, &tri, 1, NULL, &cam);
     return gs;
 }
 

@@ -89,24 +89,36 @@ static RayesError rate(void *t, float r)
     return RAYES_OK;
 }
 
-static RayesError bilinear(void *t, const float P[4][3])
+/* Primitive variables: per point (n values), finite. */
+static void check_primvars(const RayesPrimvar *pv, size_t n_pv, size_t n)
+{
+    for (size_t i = 0; i < n_pv; i++) {
+        if (pv[i].cls != RAYES_PRIMVAR_VERTEX || pv[i].count != n)
+            abort();
+        check_finite(pv[i].data, n * (strcmp(pv[i].name, "st") == 0 ? 2 : 3));
+    }
+}
+
+static RayesError bilinear(void *t, const float P[4][3], const RayesPrimvar *pv, size_t n_pv)
 {
     (void)t;
     check_finite(&P[0][0], 12);
+    check_primvars(pv, n_pv, 4);
     return RAYES_OK;
 }
 
-static RayesError bicubic(void *t, const float P[16][3])
+static RayesError bicubic(void *t, const float P[16][3], const RayesPrimvar *pv, size_t n_pv)
 {
-    (void)t;
+    (void)t, (void)pv, (void)n_pv;
     check_finite(&P[0][0], 48);
     return RAYES_OK;
 }
 
 static RayesError mesh(void *t, size_t n_faces, const int *nv, const int *idx, size_t n_points,
-                       const float *P)
+                       const float *P, const RayesPrimvar *pv, size_t n_pv)
 {
     (void)t;
+    check_primvars(pv, n_pv, n_points);
     size_t k = 0;
     for (size_t f = 0; f < n_faces; f++) {
         if (nv[f] != 3 && nv[f] != 4)

@@ -109,7 +109,7 @@ static void test_dicing_rate_from_camera(void)
     geom_gridset_init(&gs);
     Prim p = bilinear(v3(-5, -5, 0), v3(5, -5, 0), v3(-5, 5, 0), v3(5, 5, 0));
     DiceCamera cam = camera();
-    CHECK(geom_dice_prim(&gs, &p, 0, &cam) == 0);
+    CHECK(geom_dice_prim(&gs, &p, 0, NULL, &cam) == 0);
     CHECK(gs.n_grids == 1);
     CHECK(gs.grids[0].nu == 11 && gs.grids[0].nv == 11);
     CHECK(gs.n_vertices == 121);
@@ -118,7 +118,7 @@ static void test_dicing_rate_from_camera(void)
     /* Shading rate 4 (area) halves the rate per side. */
     geom_gridset_fini(&gs);
     p.shading_rate = 4.0f;
-    CHECK(geom_dice_prim(&gs, &p, 0, &cam) == 0);
+    CHECK(geom_dice_prim(&gs, &p, 0, NULL, &cam) == 0);
     CHECK(gs.grids[0].nu == 6 && gs.grids[0].nv == 6);
     geom_gridset_fini(&gs);
 }
@@ -130,7 +130,7 @@ static void test_split_limits_grid_size(void)
     geom_gridset_init(&gs);
     Prim p = bilinear(v3(-50, -20, 0), v3(50, -20, 0), v3(-50, 20, 0), v3(50, 20, 0));
     DiceCamera cam = camera();
-    CHECK(geom_dice_prim(&gs, &p, 7, &cam) == 0);
+    CHECK(geom_dice_prim(&gs, &p, 7, NULL, &cam) == 0);
     CHECK(gs.n_grids > 1);
     double area = 0.0;
     for (size_t g = 0; g < gs.n_grids; g++) {
@@ -152,7 +152,7 @@ static void test_distance_based_rates(void)
     geom_gridset_init(&gs);
     Prim p = bilinear(v3(-20, -5, -90), v3(20, -5, -90), v3(-20, -5, 400), v3(20, -5, 400));
     DiceCamera cam = camera();
-    CHECK(geom_dice_prim(&gs, &p, 0, &cam) == 0);
+    CHECK(geom_dice_prim(&gs, &p, 0, NULL, &cam) == 0);
     float near_edge = 1e9f, far_edge = 0.0f;
     for (size_t g = 0; g < gs.n_grids; g++) {
         float z = gs.P[gs.grids[g].first_vertex].z;
@@ -172,7 +172,7 @@ static void test_triangle_grid_counts(void)
     Prim t = {.type = PRIM_TRIANGLE, .shading_rate = 1.0f};
     t.cp[0] = v3(0, 0, 0), t.cp[1] = v3(8, 0, 0), t.cp[2] = v3(0, 8, 0);
     DiceCamera cam = camera();
-    CHECK(geom_dice_prim(&gs, &t, 0, &cam) == 0);
+    CHECK(geom_dice_prim(&gs, &t, 0, NULL, &cam) == 0);
     CHECK(gs.n_grids == 1 && gs.grids[0].triangular);
     uint32_t n = gs.grids[0].nu;
     CHECK(n >= 8 && n <= 12); /* the hypotenuse is 11.3 units */
@@ -183,7 +183,7 @@ static void test_triangle_grid_counts(void)
     geom_gridset_fini(&gs);
     /* A big triangle splits into four at a time: 1 + 3k patches. */
     t.cp[1] = v3(100, 0, 0), t.cp[2] = v3(0, 100, 0);
-    CHECK(geom_dice_prim(&gs, &t, 0, &cam) == 0);
+    CHECK(geom_dice_prim(&gs, &t, 0, NULL, &cam) == 0);
     CHECK((gs.n_grids - 1) % 3 == 0 && gs.n_grids >= 16);
     for (size_t g = 0; g < gs.n_grids; g++)
         CHECK(gs.grids[g].nu <= GEOM_MAX_GRID - 1);

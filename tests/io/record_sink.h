@@ -15,12 +15,26 @@
 
 #define REC_MAX 64
 
+/* Primitive variables of one call, copied. */
+typedef struct RecPrimvars {
+    RayesPrimvar pv[3];       /* data owned */
+    char name[3][8];
+    size_t n;
+} RecPrimvars;
+
 typedef struct RecMesh {
     size_t n_faces, n_points;
     int *nv, *idx;
     float *P;
     int shader;               /* index of the shader in force, -1 none */
+    RecPrimvars pv;
 } RecMesh;
+
+typedef struct RecPatch {
+    int cubic;
+    float P[16][3];           /* 4 or 16 points */
+    RecPrimvars pv;
+} RecPatch;
 
 typedef struct RecShader {
     char name[64];
@@ -36,6 +50,8 @@ typedef struct Record {
     int n_transform;
     RecMesh mesh[REC_MAX];
     int n_mesh;
+    RecPatch patch[REC_MAX];
+    int n_patch;
     RecShader shader[REC_MAX];
     int n_shader;
     float area_P[REC_MAX][4][3], area_L[REC_MAX][3];
@@ -118,22 +134,61 @@ static RayesError rec_search_path(void *t, const char *k, const char *p)
     return RAYES_OK;
 }
 
-static RayesError rec_bilinear(void *t, const float P[4][3])
+static void rec_copy_primvars(RecPrimvars *out, const RayesPrimvar *pv, size_t n)
 {
-    (void)P;
-    ((Record *)t)->calls++;
+    out->n = n < 3 ? n : 3;
+    for (size_t i = 0; i < out->n; i++) {
+        size_t floats = pv[i].count * (strcmp(pv[i].name, "st") == 0 ? 2u : 3u);
+        float *d = malloc(floats * sizeof *d + 1);
+        memcpy(d, pv[i].data, floats * sizeof *d);
+        snprintf(out->name[i], sizeof out->name[i], "%s", pv[i].name);
+        out->pv[i] = pv[i];
+        out->pv[i].name = out->name[i];
+        out->pv[i].data = d;
+    }
+}
+
+static void rec_free_primvars(RecPrimvars *p)
+{
+    for (size_t i = 0; i < p->n; i++)
+        free((float *)p->pv[i].data);
+    p->n = 0;
+}
+
+/* The primitive variable of that name, or NULL. */
+static inline const RayesPrimvar *rec_primvar(const RecPrimvars *p, const char *name)
+{
+    for (size_t i = 0; i < p->n; i++)
+        if (strcmp(p->pv[i].name, name) == 0)
+            return &p->pv[i];
+    return NULL;
+}
+
+static RayesError rec_patch(Record *r, int cubic, const float *P, const RayesPrimvar *pv,
+                            size_t n_pv)
+{
+    r->calls++;
+    if (r->n_patch == REC_MAX)
+        return RAYES_OK; /* counted only */
+    RecPatch *p = &r->patch[r->n_patch++];
+    p->cubic = cubic;
+    memcpy(p->P, P, (cubic ? 48 : 12) * sizeof *P);
+    rec_copy_primvars(&p->pv, pv, n_pv);
     return RAYES_OK;
 }
 
-static RayesError rec_bicubic(void *t, const float P[16][3])
+static RayesError rec_bilinear(void *t, const float P[4][3], const RayesPrimvar *pv, size_t n_pv)
 {
-    (void)P;
-    ((Record *)t)->calls++;
-    return RAYES_OK;
+    return rec_patch(t, 0, &P[0][0], pv, n_pv);
+}
+
+static RayesError rec_bicubic(void *t, const float P[16][3], const RayesPrimvar *pv, size_t n_pv)
+{
+    return rec_patch(t, 1, &P[0][0], pv, n_pv);
 }
 
 static RayesError rec_mesh(void *t, size_t n_faces, const int *nv, const int *idx,
-                           size_t n_points, const float *P)
+                           size_t n_points, const float *P, const RayesPrimvar *pv, size_t n_pv)
 {
     Record *r = t;
     r->calls++;
@@ -152,6 +207,7 @@ static RayesError rec_mesh(void *t, size_t n_faces, const int *nv, const int *id
     memcpy(m->idx, idx, k * sizeof *idx);
     memcpy(m->P, P, 3 * n_points * sizeof *P);
     m->shader = r->n_shader - 1;
+    rec_copy_primvars(&m->pv, pv, n_pv);
     return RAYES_OK;
 }
 
@@ -224,8 +280,12 @@ static void record_free(Record *r)
         free(r->mesh[i].nv);
         free(r->mesh[i].idx);
         free(r->mesh[i].P);
+        rec_free_primvars(&r->mesh[i].pv);
     }
     r->n_mesh = 0;
+    for (int i = 0; i < r->n_patch; i++)
+        rec_free_primvars(&r->patch[i].pv);
+    r->n_patch = 0;
 }
 
 /* The parameter of that name, or NULL. */

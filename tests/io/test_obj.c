@@ -231,6 +231,45 @@ static void expect_error(const char *text, const char *where)
     record_free(&rec);
 }
 
+/* vn and vt reach the sink as facevarying N and st (t = 1 - v), one per
+ * corner of the faces sent, also through ear clipping; a material whose
+ * faces only partly have them gets none. */
+static void test_normals_and_texture_coordinates(void)
+{
+    CHECK(parse("n.obj", "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\n"
+                         "vt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nvn 0 0 1\nvn 0 1 1\n"
+                         "f 1/1/1 2/2/1 3/3/2 4/4/2\n") == RAYES_OK);
+    CHECK(rec.n_mesh == 1);
+    const RecMesh *m = &rec.mesh[0];
+    const RayesPrimvar *N = rec_primvar(&m->pv, "N"), *st = rec_primvar(&m->pv, "st");
+    CHECK(N && N->cls == RAYES_PRIMVAR_FACEVARYING && N->count == 4);
+    CHECK(st && st->cls == RAYES_PRIMVAR_FACEVARYING && st->count == 4);
+    for (int c = 0; N && st && c < 4; c++) {
+        const float *p = corner(m, 0, c); /* vt = the point's (x, y); vn 2 on y = 1 */
+        CHECK_NEAR(st->data[2 * c], p[0], 0);
+        CHECK_NEAR(st->data[2 * c + 1], 1 - p[1], 0);
+        CHECK_NEAR(N->data[3 * c + 1], p[1], 0);
+    }
+    record_free(&rec);
+    /* an L-shaped hexagon, ear clipped: every corner keeps its own vt */
+    CHECK(parse("l.obj", "v 0 0 0\nv 2 0 0\nv 2 1 0\nv 1 1 0\nv 1 2 0\nv 0 2 0\n"
+                         "vt 0 0\nvt 2 0\nvt 2 1\nvt 1 1\nvt 1 2\nvt 0 2\n"
+                         "f 1/1 2/2 3/3 4/4 5/5 6/6\n") == RAYES_OK);
+    m = &rec.mesh[0];
+    st = rec_primvar(&m->pv, "st");
+    CHECK(st && st->count == 3 * m->n_faces && !rec_primvar(&m->pv, "N"));
+    for (size_t f = 0; st && f < m->n_faces; f++)
+        for (int c = 0; c < 3; c++) {
+            CHECK_NEAR(st->data[2 * (3 * f + (size_t)c)], corner(m, f, c)[0], 0);
+            CHECK_NEAR(st->data[2 * (3 * f + (size_t)c) + 1], 1 - corner(m, f, c)[1], 0);
+        }
+    record_free(&rec);
+    CHECK(parse("p.obj", "v 0 0 0\nv 1 0 0\nv 1 1 0\nvn 0 0 1\nf 1//1 2//1 3//1\nf 1 2 3\n") ==
+          RAYES_OK);
+    CHECK(rec.n_mesh == 1 && rec.mesh[0].pv.n == 0);
+    record_free(&rec);
+}
+
 static void test_errors(void)
 {
     expect_error("v 1 2\n", "bad.obj:1:6: expected a vertex coordinate, found the end");
@@ -286,4 +325,4 @@ static void test_read_file(void)
 
 TEST_MAIN(TEST(test_face_syntax), TEST(test_ngons), TEST(test_materials),
           TEST(test_default_camera_and_light), TEST(test_errors), TEST(test_unknown_statements),
-          TEST(test_read_file))
+          TEST(test_read_file), TEST(test_normals_and_texture_coordinates))

@@ -60,6 +60,9 @@ typedef struct Rec {
         Shader params; /* name unused */
         float xform[16];
     } light[MAX_REC];
+    int primvars;        /* 1: an N was given, 2: an st */
+    int bad_primvars;    /* primitive variables not per point */
+    float N0[3], st0[2]; /* the last N and st call's first value */
 } Rec;
 
 static void copy_params(Shader *s, const char *name, const RayesParam *p, size_t n)
@@ -150,23 +153,37 @@ static RayesError r_rate(void *t, float r)
     return RAYES_OK;
 }
 
-static RayesError r_bilinear(void *t, const float P[4][3])
+/* Keeps the first value of N and st, and checks their counts (n). */
+static void r_primvars(Rec *r, const RayesPrimvar *pv, size_t n_pv, size_t n)
+{
+    for (size_t i = 0; i < n_pv; i++) {
+        int st = strcmp(pv[i].name, "st") == 0;
+        if (pv[i].cls != RAYES_PRIMVAR_VERTEX || pv[i].count != n)
+            r->bad_primvars++;
+        memcpy(st ? r->st0 : r->N0, pv[i].data, (st ? 2 : 3) * sizeof(float));
+        r->primvars |= st ? 2 : 1;
+    }
+}
+
+static RayesError r_bilinear(void *t, const float P[4][3], const RayesPrimvar *pv, size_t n_pv)
 {
     (void)P;
     ((Rec *)t)->n_patches++;
+    r_primvars(t, pv, n_pv, 4);
     return RAYES_OK;
 }
 
-static RayesError r_bicubic(void *t, const float P[16][3])
+static RayesError r_bicubic(void *t, const float P[16][3], const RayesPrimvar *pv, size_t n_pv)
 {
-    (void)t, (void)P;
+    (void)t, (void)P, (void)pv, (void)n_pv;
     return RAYES_OK;
 }
 
 static RayesError r_mesh(void *t, size_t n_faces, const int *nv, const int *idx, size_t n_points,
-                         const float *P)
+                         const float *P, const RayesPrimvar *pv, size_t n_pv)
 {
     Rec *r = t;
+    r_primvars(r, pv, n_pv, n_points);
     size_t n_idx = 0;
     for (size_t f = 0; f < n_faces; f++) {
         if (nv[f] != 3 && nv[f] != 4)
@@ -678,5 +695,41 @@ static void test_errors(void)
     expect_error("WorldBegin\nRotate 90 0 0 0\n", "t.pbrt:2:1: Rotate: expected a nonzero axis");
 }
 
+/* trianglemesh, bilinearmesh and plymesh pass N and uv per point, as
+ * vertex-class N and st with t = 1 - v; instanced meshes keep them. */
+static void test_normals_and_uv(void)
+{
+    Rec *r = malloc(sizeof *r);
+    IoSettings s;
+    char err[512] = "", path[512];
+    CHECK(parse("t.pbrt", "WorldBegin\nShape \"trianglemesh\" \"point3 P\" [0 0 0 1 0 0 0 1 0] "
+                          "\"integer indices\" [0 1 2] \"normal N\" [0 0.6 0.8 0 0 1 0 0 1] "
+                          "\"point2 uv\" [0.25 0.125 1 0 0 1]\n", r, &s, err, sizeof err) == RAYES_OK);
+    CHECK(r->primvars == 3 && r->bad_primvars == 0);
+    CHECK_NEAR(r->N0[1], 0.6, 1e-6);
+    CHECK_NEAR(r->st0[0], 0.25, 0);
+    CHECK_NEAR(r->st0[1], 0.875, 0);
+    CHECK(parse("t.pbrt", "WorldBegin\nObjectBegin \"o\"\nShape \"bilinearmesh\" \"point3 P\" "
+                          "[0 0 0 1 0 0 0 1 0 1 1 0] \"point2 uv\" [0.5 0 1 0 0 1 1 1]\n"
+                          "ObjectEnd\nObjectInstance \"o\"\n", r, &s, err, sizeof err) == RAYES_OK);
+    CHECK(r->n_patches == 1 && r->primvars == 2 && r->bad_primvars == 0);
+    CHECK_NEAR(r->st0[0], 0.5, 0);
+    CHECK_NEAR(r->st0[1], 1, 0);
+    snprintf(path, sizeof path, "%s/test_pbrt_nuv.ply", RAYES_TEST_TMP);
+    write_file(path, "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\n"
+                     "property float y\nproperty float z\nproperty float nx\nproperty float ny\n"
+                     "property float nz\nproperty float u\nproperty float v\nelement face 1\n"
+                     "property list uchar int vertex_indices\nend_header\n"
+                     "0 0 0 0 0 1 0.5 0.25\n1 0 0 0 0 1 1 0\n0 1 0 0 0 1 0 1\n3 0 1 2\n");
+    char text[1024];
+    snprintf(text, sizeof text, "WorldBegin\nShape \"plymesh\" \"string filename\" \"%s\"\n",
+             path);
+    CHECK(parse("t.pbrt", text, r, &s, err, sizeof err) == RAYES_OK);
+    CHECK(r->primvars == 3 && r->bad_primvars == 0);
+    CHECK_NEAR(r->N0[2], 1, 0);
+    CHECK_NEAR(r->st0[1], 0.75, 0);
+    free(r);
+}
+
 TEST_MAIN(TEST(test_cornell_box), TEST(test_transforms), TEST(test_materials), TEST(test_lights),
-          TEST(test_instances_include_ply), TEST(test_errors))
+          TEST(test_instances_include_ply), TEST(test_errors), TEST(test_normals_and_uv))

@@ -48,6 +48,11 @@ typedef struct Rec {
     float mesh_Cs[64][3];
     float mesh_x[64];
     int n_mesh_rec;
+    /* the primitive variables of the last patch or mesh (values: the first 64) */
+    RayesPrimvar pv[3];
+    float pv_data[3][64 * 3];
+    int n_pv;
+    int mesh_idx[64];      /* the last mesh's first indices */
 } Rec;
 
 static Rec rec;
@@ -102,23 +107,49 @@ static RayesError s_search(void *t, const char *kind, const char *path)
     snprintf(rec.search, sizeof rec.search, "%s=%s", kind, path);
     return RAYES_OK;
 }
-static RayesError s_bilinear(void *t, const float P[4][3])
+static void s_primvars(const RayesPrimvar *pv, size_t n)
+{
+    rec.n_pv = (int)(n < 3 ? n : 3);
+    for (int i = 0; i < rec.n_pv; i++) {
+        size_t floats = pv[i].count * (strcmp(pv[i].name, "st") == 0 ? 2u : 3u);
+        rec.pv[i] = pv[i];
+        memcpy(rec.pv_data[i], pv[i].data, (floats < 192 ? floats : 192) * sizeof(float));
+        rec.pv[i].data = rec.pv_data[i];
+    }
+}
+/* The last call's primitive variable of that name, or NULL. */
+static const RayesPrimvar *last_pv(const char *name)
+{
+    for (int i = 0; i < rec.n_pv; i++)
+        if (strcmp(rec.pv[i].name, name) == 0)
+            return &rec.pv[i];
+    return NULL;
+}
+static RayesError s_bilinear(void *t, const float P[4][3], const RayesPrimvar *pv, size_t n_pv)
 {
     (void)t, (void)P;
     rec.bilinear++;
+    s_primvars(pv, n_pv);
     return RAYES_OK;
 }
-static RayesError s_bicubic(void *t, const float P[16][3])
+static RayesError s_bicubic(void *t, const float P[16][3], const RayesPrimvar *pv, size_t n_pv)
 {
     (void)t;
     if (rec.bicubic++ == 0)
         memcpy(rec.first_bicubic, P, sizeof rec.first_bicubic);
+    s_primvars(pv, n_pv);
     return RAYES_OK;
 }
 static RayesError s_mesh(void *t, size_t nf, const int *nv, const int *idx, size_t np,
-                         const float *P)
+                         const float *P, const RayesPrimvar *pv, size_t n_pv)
 {
-    (void)t, (void)idx;
+    (void)t;
+    s_primvars(pv, n_pv);
+    size_t n_idx = 0;
+    for (size_t f = 0; f < nf; f++)
+        n_idx += (size_t)nv[f];
+    for (size_t i = 0; i < 64; i++)
+        rec.mesh_idx[i] = i < n_idx ? idx[i] : -1;
     rec.meshes++;
     rec.faces += (int)nf;
     for (size_t f = 0; f < nf; f++) {
@@ -309,20 +340,71 @@ static void test_shaders_and_lights(void)
 
 static void test_parameter_classes(void)
 {
-    /* uniform Cs: one colour per face, sent per face */
+    /* uniform Cs: one colour per face, a uniform primitive variable */
     CHECK(parse(WORLD("PointsPolygons [3 3] [0 1 2 0 2 3] \"P\" [0 0 0 1 0 0 1 1 0 0 1 0]\n"
                       "\"uniform color Cs\" [1 0 0 0 1 0]")) == RAYES_OK);
-    CHECK(rec.meshes == 2);
-    CHECK_NEAR(rec.mesh_Cs[0][0], 1, 0);
-    CHECK_NEAR(rec.mesh_Cs[1][1], 1, 0);
-    /* vertex Cs: averaged per face */
+    CHECK(rec.meshes == 1);
+    const RayesPrimvar *v = last_pv("Cs");
+    CHECK(v && v->cls == RAYES_PRIMVAR_UNIFORM && v->count == 2);
+    CHECK(v && v->data[0] == 1 && v->data[4] == 1);
+    /* vertex Cs: per point */
     CHECK(parse(WORLD("Polygon \"P\" [0 0 0 1 0 0 1 1 0] \"vertex color Cs\" [1 0 0 0 1 0 0 0 1]")) ==
           RAYES_OK);
-    CHECK_NEAR(rec.mesh_Cs[0][2], 1 / 3.0, 1e-6);
-    /* facevarying float[2] st: 2 values per face corner */
+    v = last_pv("Cs");
+    CHECK(v && v->cls == RAYES_PRIMVAR_VERTEX && v->count == 3 && v->data[8] == 1);
+    /* facevarying float[2] st: 2 values per face corner; a user variable is ignored */
     CHECK(parse(WORLD("Declare \"foo\" \"facevarying float[2]\"\n"
-                      "PointsPolygons [3] [0 1 2] \"P\" [0 0 0 1 0 0 1 1 0] \"foo\" [0 0 1 0 1 1]")) ==
+                      "PointsPolygons [3] [0 1 2] \"P\" [0 0 0 1 0 0 1 1 0] \"foo\" [0 0 1 0 1 1]"
+                      " \"facevarying float[2] st\" [0 0 1 0 1 1]")) == RAYES_OK);
+    v = last_pv("st");
+    CHECK(v && v->cls == RAYES_PRIMVAR_FACEVARYING && v->count == 3 && v->data[2] == 1);
+    CHECK(rec.n_pv == 1);
+    /* N and separate s, t (varying); Np as a uniform N */
+    CHECK(parse(WORLD("Polygon \"P\" [0 0 0 1 0 0 1 1 0] \"N\" [0 0 1 0 0 1 0 1 1] "
+                      "\"s\" [0 1 1] \"t\" [0 0 1]")) == RAYES_OK);
+    v = last_pv("N");
+    CHECK(v && v->cls == RAYES_PRIMVAR_VERTEX && v->count == 3 && v->data[7] == 1);
+    v = last_pv("st");
+    CHECK(v && v->count == 3 && v->data[2] == 1 && v->data[3] == 0 && v->data[5] == 1);
+    CHECK(parse(WORLD("Polygon \"P\" [0 0 0 1 0 0 1 1 0] \"Np\" [0 0 1]")) == RAYES_OK);
+    v = last_pv("N");
+    CHECK(v && v->cls == RAYES_PRIMVAR_UNIFORM && v->count == 1);
+    /* facevarying on an ear-clipped polygon: each corner keeps its value */
+    CHECK(parse(WORLD("Polygon \"P\" [0 0 0 4 0 0 4 4 0 2 1 0 0 4 0 0 2 0] "
+                      "\"facevarying float[2] st\" [0 0 1 0 2 0 3 0 4 0 5 0]")) == RAYES_OK);
+    v = last_pv("st");
+    CHECK(v && v->count == 12);
+    int corners_ok = v != NULL;
+    for (size_t k = 0; v && k < 12; k++)
+        corners_ok &= v->data[2 * k] == (float)rec.mesh_idx[k]; /* s = the point's index */
+    CHECK(corners_ok);
+    /* patches: varying st at the corners, reversed along u when the front flips */
+    CHECK(parse(WORLD("Patch \"bilinear\" \"P\" [0 0 0 1 0 0 0 1 0 1 1 0] "
+                      "\"st\" [0 0 1 0 0 1 1 1]")) == RAYES_OK);
+    v = last_pv("st");
+    CHECK(v && v->cls == RAYES_PRIMVAR_VARYING && v->count == 4 && v->data[2] == 1);
+    CHECK(parse(WORLD("ReverseOrientation\nPatch \"bilinear\" \"P\" [0 0 0 1 0 0 0 1 0 1 1 0] "
+                      "\"st\" [0 0 1 0 0 1 1 1]")) == RAYES_OK);
+    v = last_pv("st");
+    CHECK(v && v->data[0] == 1 && v->data[2] == 0);
+    /* bicubic vertex Cs: 16 values in the current basis, made Bezier as P is */
+    CHECK(parse(WORLD("Basis \"b-spline\" 1 \"b-spline\" 1\n"
+                      "Patch \"bicubic\" \"P\" [0 0 0 1 0 0 2 0 0 3 0 0  0 1 0 1 1 0 2 1 0 3 1 0 "
+                      "0 2 0 1 2 0 2 2 0 3 2 0  0 3 0 1 3 0 2 3 0 3 3 0] \"vertex color Cs\" ["
+                      "0 0 0 1 0 0 2 0 0 3 0 0  0 0 0 1 0 0 2 0 0 3 0 0 "
+                      "0 0 0 1 0 0 2 0 0 3 0 0  0 0 0 1 0 0 2 0 0 3 0 0]")) == RAYES_OK);
+    v = last_pv("Cs");
+    CHECK(v && v->cls == RAYES_PRIMVAR_VERTEX && v->count == 16);
+    for (int k = 0; v && k < 4; k++) /* Cs red = P x, whose Bezier points are 1, 4/3, 5/3, 2 */
+        CHECK_NEAR(v->data[3 * k], rec.first_bicubic[k][0], 1e-5);
+    /* PatchMesh: varying values at each sub-patch's corners, uniform per patch */
+    CHECK(parse(WORLD("PatchMesh \"bilinear\" 3 \"nonperiodic\" 2 \"nonperiodic\" \"P\" ["
+                      "0 0 0 1 0 0 2 0 0 0 1 0 1 1 0 2 1 0] \"varying float s\" [0 1 2 3 4 5] "
+                      "\"varying float t\" [0 0 0 1 1 1] \"uniform normal N\" [0 0 1 0 0 1]")) ==
           RAYES_OK);
+    v = last_pv("st"); /* the second patch: points 1 2 4 5 */
+    CHECK(v && v->data[0] == 1 && v->data[2] == 2 && v->data[4] == 4 && v->data[6] == 5);
+    CHECK(last_pv("N") && last_pv("N")->cls == RAYES_PRIMVAR_UNIFORM);
     /* wrong counts are errors naming file:line:col */
     CHECK(parse("WorldBegin\nPolygon \"P\" [0 0 0 1 0 0 1 1 0]\n  \"varying float s\" [0 1]\n"
                 "WorldEnd\n") == RAYES_ERROR_PARSE);
@@ -646,8 +728,89 @@ static void test_writer_round_trip(void)
     }
 }
 
+/* Primitive variables written by the RIB writer read back as they were
+ * sent: a mesh's vertex N, facevarying st and uniform Cs, a bilinear
+ * patch's varying st, a bicubic patch's vertex Cs (16 Bezier values). */
+static void test_writer_primvars(void)
+{
+    RibWriter *w = io_rib_writer_new();
+    IoSink ws = io_rib_writer_sink(w);
+    const float P[4][3] = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}};
+    const int nv[2] = {3, 3}, idx[6] = {0, 1, 2, 0, 2, 3};
+    const float N[4][3] = {{0, 0, 1}, {0, 0.6f, 0.8f}, {0, 0, 1}, {0.6f, 0, 0.8f}};
+    const float st[6][2] = {{0, 0}, {1, 0}, {1, 1}, {0, 0.125f}, {1, 1}, {0, 1}};
+    const float Cs[2][3] = {{1, 0, 0}, {0, 0.5f, 1}};
+    const RayesPrimvar mesh_pv[3] = {{"N", RAYES_PRIMVAR_VERTEX, &N[0][0], 4},
+                                     {"st", RAYES_PRIMVAR_FACEVARYING, &st[0][0], 6},
+                                     {"Cs", RAYES_PRIMVAR_UNIFORM, &Cs[0][0], 2}};
+    CHECK(ws.polygon_mesh(ws.target, 2, nv, idx, 4, &P[0][0], mesh_pv, 3) == RAYES_OK);
+    const float Q[4][3] = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {1, 1, 0}};
+    const RayesPrimvar patch_pv = {"st", RAYES_PRIMVAR_VARYING, &st[0][0], 4};
+    CHECK(ws.bilinear_patch(ws.target, Q, &patch_pv, 1) == RAYES_OK);
+    float B[16][3], C[16][3];
+    for (int k = 0; k < 16; k++)
+        for (int c = 0; c < 3; c++)
+            B[k][c] = (float)(k % 4) + (c == 1 ? (float)(k / 4) : 0.0f), C[k][c] = 0.0625f * (float)k;
+    const RayesPrimvar cubic_pv = {"Cs", RAYES_PRIMVAR_VERTEX, &C[0][0], 16};
+    CHECK(ws.bicubic_patch(ws.target, (const float(*)[3])B, &cubic_pv, 1) == RAYES_OK);
+    const RayesPrimvar bad = {"st", RAYES_PRIMVAR_VERTEX, &st[0][0], 3};
+    CHECK(ws.polygon_mesh(ws.target, 2, nv, idx, 4, &P[0][0], &bad, 1) ==
+          RAYES_ERROR_INVALID_ARGUMENT);
+    char path[1024];
+    snprintf(path, sizeof path, "%s/test_rib_primvars.rib", RAYES_TEST_TMP);
+    FILE *f = fopen(path, "w");
+    CHECK(f != NULL);
+    if (!f) {
+        io_rib_writer_free(w);
+        return;
+    }
+    CHECK(io_rib_writer_finish(w, NULL, f, err, sizeof err) == RAYES_OK);
+    fclose(f);
+    io_rib_writer_free(w);
+    /* Read it back, checking the mesh (the first geometry) on the way. */
+    memset(&rec, 0, sizeof rec);
+    IoReadOptions opt = {NULL, -1};
+    io_settings_init(&settings);
+    CHECK(io_rib_read(path, &stub, &opt, &settings, err, sizeof err) == RAYES_OK);
+    CHECK(rec.meshes == 1 && rec.bilinear == 1 && rec.bicubic == 1);
+    const RayesPrimvar *v = last_pv("Cs"); /* the last call: the bicubic patch */
+    CHECK(v && v->cls == RAYES_PRIMVAR_VERTEX && v->count == 16);
+    CHECK(v && memcmp(v->data, C, sizeof C) == 0);
+    /* the mesh and the patch, each read alone */
+    f = fopen(path, "r");
+    char line[8192], mesh_rib[8192] = "WorldBegin\n", patch_rib[8192] = "WorldBegin\n";
+    int in_mesh = 0;
+    while (f && fgets(line, sizeof line, f)) {
+        if (strncmp(line, "PointsPolygons", 14) == 0)
+            in_mesh = 1;
+        else if (strncmp(line, "Patch \"bilinear\"", 16) == 0)
+            in_mesh = 2;
+        else if (line[0] != ' ')
+            in_mesh = 0;
+        char *to = in_mesh == 1 ? mesh_rib : patch_rib;
+        size_t have = strlen(to), add = strlen(line);
+        if (in_mesh && have + add + 16 < sizeof mesh_rib)
+            memcpy(to + have, line, add + 1);
+    }
+    if (f)
+        fclose(f);
+    strcat(mesh_rib, "WorldEnd\n");
+    strcat(patch_rib, "WorldEnd\n");
+    CHECK(parse(mesh_rib) == RAYES_OK);
+    CHECK(rec.n_pv == 3);
+    for (int i = 0; i < 3; i++) {
+        v = last_pv(mesh_pv[i].name);
+        CHECK(v && v->cls == mesh_pv[i].cls && v->count == mesh_pv[i].count);
+        CHECK(v && memcmp(v->data, mesh_pv[i].data,
+                          v->count * (i == 1 ? 2 : 3) * sizeof(float)) == 0);
+    }
+    CHECK(parse(patch_rib) == RAYES_OK);
+    v = last_pv("st");
+    CHECK(v && v->cls == RAYES_PRIMVAR_VARYING && memcmp(v->data, st, 8 * sizeof(float)) == 0);
+}
+
 TEST_MAIN(TEST(test_camera_and_transforms), TEST(test_settings), TEST(test_shaders_and_lights),
           TEST(test_parameter_classes), TEST(test_polygons), TEST(test_patch_mesh_bases),
           TEST(test_objects_and_frames), TEST(test_binary), TEST(test_gzip), TEST(test_errors),
           TEST(test_aqsis_files), TEST(test_scene_sink),
-          TEST(test_writer_round_trip))
+          TEST(test_writer_round_trip), TEST(test_writer_primvars))

@@ -70,10 +70,10 @@ static void test_calls(void)
     CHECK(k.set_displacement(w, "bumpy", sp + 1, 1) == RAYES_OK);
     CHECK(k.set_displacement_bound(w, 0.5f) == RAYES_OK);
     CHECK(k.set_shading_rate(w, 2) == RAYES_OK);
-    CHECK(k.bilinear_patch(w, P4) == RAYES_OK);
-    CHECK(k.bicubic_patch(w, (const float(*)[3])P16) == RAYES_OK);
-    CHECK(k.bicubic_patch(w, (const float(*)[3])P16) == RAYES_OK);
-    CHECK(k.polygon_mesh(w, 2, nv, idx, 4, &P4[0][0]) == RAYES_OK);
+    CHECK(k.bilinear_patch(w, P4, NULL, 0) == RAYES_OK);
+    CHECK(k.bicubic_patch(w, (const float(*)[3])P16, NULL, 0) == RAYES_OK);
+    CHECK(k.bicubic_patch(w, (const float(*)[3])P16, NULL, 0) == RAYES_OK);
+    CHECK(k.polygon_mesh(w, 2, nv, idx, 4, &P4[0][0], NULL, 0) == RAYES_OK);
     CHECK(k.sphere(w, 2) == RAYES_OK);
     CHECK(k.quadric(w, RAYES_QUADRIC_TORUS, q, 5, RAYES_QUADRIC_REVERSE) == RAYES_OK);
     CHECK(k.set_transform(w, id) == RAYES_OK);
@@ -146,7 +146,7 @@ static void test_round_trip(void)
                            {16777217.0f, -2.5e-7f, 3.14159265f},
                            {1e30f, -0.0f, 7.0f / 9.0f},
                            {123456.789f, 0.3f, 2.0f / 3.0f}};
-    CHECK(k.bilinear_patch(w, v) == RAYES_OK);
+    CHECK(k.bilinear_patch(w, v, NULL, 0) == RAYES_OK);
     const float eye[3] = {1, 2, 3}, at[3] = {0, 0, 0}, up[3] = {0, 1, 0};
     CHECK(k.set_camera(w, eye, at, up, 40) == RAYES_OK);
     IoSettings s;
@@ -186,10 +186,10 @@ static void test_refused(void)
     const int three[1] = {3};
     const float P[9] = {0};
     const float q[3] = {1, 2, 3};
-    CHECK(k.bilinear_patch(w, nan4) == RAYES_ERROR_INVALID_ARGUMENT);
+    CHECK(k.bilinear_patch(w, nan4, NULL, 0) == RAYES_ERROR_INVALID_ARGUMENT);
     CHECK(strstr(k.get_error(w), "non-finite") != NULL);
-    CHECK(k.polygon_mesh(w, 1, nv, idx, 3, P) == RAYES_ERROR_INVALID_ARGUMENT);
-    CHECK(k.polygon_mesh(w, 1, three, bad, 3, P) == RAYES_ERROR_INVALID_ARGUMENT);
+    CHECK(k.polygon_mesh(w, 1, nv, idx, 3, P, NULL, 0) == RAYES_ERROR_INVALID_ARGUMENT);
+    CHECK(k.polygon_mesh(w, 1, three, bad, 3, P, NULL, 0) == RAYES_ERROR_INVALID_ARGUMENT);
     CHECK(k.quadric(w, RAYES_QUADRIC_SPHERE, q, 3, 0) == RAYES_ERROR_INVALID_ARGUMENT);
     CHECK(k.set_shading_rate(w, -1) == RAYES_ERROR_INVALID_ARGUMENT);
     char *t = finish(w, NULL);
