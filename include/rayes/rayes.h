@@ -326,6 +326,12 @@ RAYES_API int64_t rayes_scene_object_light(const RayesScene *scene, size_t objec
 RAYES_API RayesError rayes_scene_edit_light(RayesScene *scene, size_t light,
                                             const RayesParam *params, size_t n_params);
 
+/* A light's intensity and lightcolor (as rayes_scene_edit_light sets them)
+ * and its position (point, spot; the centre of an area light's shape;
+ * zero for the others); any output may be NULL. */
+RAYES_API RayesError rayes_scene_get_light(const RayesScene *scene, size_t light,
+                                           float *intensity, float color[3], float position[3]);
+
 /* Changes parameters of an object's surface shader (and its "Cs" and
  * "Os"), as rayes_scene_set_shader takes them; the others keep their
  * values. A name the shader lacks, or a wrong type, is
@@ -526,9 +532,10 @@ RAYES_API RayesError rayes_session_image(const RayesSession *session, RayesImage
 RAYES_API RayesError rayes_session_stats(const RayesSession *session, RayesStats **stats);
 
 /* The object seen through image position (x, y) (pixels, top left origin),
- * or -1 for none, in *object. */
+ * or -1 for none, in *object; and, if position is not NULL and something
+ * is seen, the world-space point seen. */
 RAYES_API RayesError rayes_session_pick(const RayesSession *session, float x, float y,
-                                        int64_t *object);
+                                        int64_t *object, float position[3]);
 
 #ifdef __cplusplus
 }

@@ -24,36 +24,7 @@
 #include "rayes/rayes.h"
 #include "util/log.h"
 
-#define MAX_OUTPUTS 8
-
-/* Options given on the command line, which win over a scene file's. */
-enum {
-    SET_RES = 1,
-    SET_SPP = 2,
-    SET_FILTER = 4,
-    SET_FILTER_WIDTH = 8,
-    SET_BOUNCES = 16,
-    SET_SPECULAR_DEPTH = 32
-};
-
-/* An image to write. */
-typedef struct Output {
-    char path[600];
-    ImageFormat format;
-} Output;
-
-typedef struct Args {
-    const char *scene;          /* a built-in scene's name or a scene file */
-    Output outputs[MAX_OUTPUTS];
-    int n_outputs;
-    int frame;                  /* --frame: the RIB frame to read; -1 the last */
-    unsigned set;               /* SET_*: options the command line gave */
-    const char *stats_path;
-    const char *data_dir;
-    const char *shader_path;    /* --shader-path: put before the scene's own shader path */
-    int quiet;
-    RayesRenderOptions opt;
-} Args;
+#include "app/app.h"
 
 typedef struct Progress {
     double start;
@@ -119,8 +90,7 @@ static void usage(FILE *f)
           f);
 }
 
-static void die_usage(const char *fmt, ...) __attribute__((noreturn, format(printf, 1, 2)));
-static void die_usage(const char *fmt, ...)
+void die_usage(const char *fmt, ...)
 {
     va_list ap;
     va_start(ap, fmt);
@@ -204,7 +174,7 @@ static RayesQuality parse_quality(const char *s)
 }
 
 /* The preset first (it sets ray counts), then every other option in order. */
-static void parse_args(int argc, char **argv, Args *a)
+void parse_args(int argc, char **argv, Args *a)
 {
     RayesQuality q = RAYES_QUALITY_PREVIEW;
     for (int i = 2; i < argc; i++)
@@ -212,6 +182,7 @@ static void parse_args(int argc, char **argv, Args *a)
             q = parse_quality(i + 1 < argc ? argv[i + 1] : NULL);
     rayes_render_options_init(&a->opt, q);
     a->frame = -1;
+    a->gamma = 1.0f;
     for (int i = 2; i < argc; i++) {
         const char *o = argv[i];
         const char *v = i + 1 < argc ? argv[i + 1] : NULL;
@@ -224,6 +195,10 @@ static void parse_args(int argc, char **argv, Args *a)
         }
         if (strcmp(o, "--quiet") == 0) {
             a->quiet = 1;
+            continue;
+        }
+        if (strcmp(o, "--headless") == 0 && a->view) {
+            a->headless = 1;
             continue;
         }
         if (!v)
@@ -305,6 +280,16 @@ static void parse_args(int argc, char **argv, Args *a)
             a->stats_path = v;
         else if (strcmp(o, "--shader-path") == 0)
             a->shader_path = v;
+        else if (a->view && strcmp(o, "--script") == 0)
+            a->script = v;
+        else if (a->view && strcmp(o, "--passes") == 0)
+            a->passes = (int)parse_long(o, v, 0, 1 << 20);
+        else if (a->view && strcmp(o, "--screenshot") == 0)
+            a->screenshot = v;
+        else if (a->view && strcmp(o, "--exposure") == 0)
+            a->exposure = parse_float(o, v, -30.0f, 30.0f);
+        else if (a->view && strcmp(o, "--gamma") == 0)
+            a->gamma = parse_float(o, v, 0.05f, 20.0f);
         else
             die_usage("unknown option \"%s\"", o);
     }
@@ -417,7 +402,7 @@ static int check_output_dir(const char *path)
 
 /* Builds the scene `scene` names (a scene file, else a built-in scene)
  * into sink; settings receive what a file gives. */
-static RayesError load_scene(const char *scene, const char *data_dir, int frame,
+RayesError load_scene(const char *scene, const char *data_dir, int frame,
                              const IoSink *sink, IoSettings *settings, char *err, size_t err_size)
 {
     io_settings_init(settings);
@@ -430,13 +415,13 @@ static RayesError load_scene(const char *scene, const char *data_dir, int frame,
 
 /* The exit status of a failed load: an unknown built-in name is a usage
  * error, everything else bad input. */
-static int load_status(const char *scene, RayesError e)
+int load_status(const char *scene, RayesError e)
 {
     return !io_is_scene_file(scene) && e == RAYES_ERROR_INVALID_ARGUMENT ? 2 : 1;
 }
 
 /* The file's settings where the command line gave none. */
-static void merge_settings(Args *a, const IoSettings *s)
+void merge_settings(Args *a, const IoSettings *s)
 {
     RayesRenderOptions *o = &a->opt;
     if (!(a->set & SET_RES) && s->width > 0 && s->height > 0) {
@@ -726,5 +711,7 @@ int main(int argc, char **argv)
         return cmd_render(argc, argv);
     if (strcmp(argv[1], "convert") == 0)
         return cmd_convert(argc, argv);
+    if (strcmp(argv[1], "view") == 0)
+        return cmd_view(argc, argv);
     die_usage("unknown command \"%s\"", argv[1]);
 }

@@ -1063,6 +1063,33 @@ RayesError rayes_scene_edit_light(RayesScene *s, size_t index, const RayesParam 
     return RAYES_OK;
 }
 
+RayesError rayes_scene_get_light(const RayesScene *s, size_t index, float *intensity,
+                                 float color[3], float position[3])
+{
+    if (!s || index >= s->n_lights)
+        return RAYES_ERROR_INVALID_ARGUMENT;
+    const Light *l = &s->lights[index];
+    Vec3 at = l->from;
+    if (l->type == LIGHT_QUAD)
+        at = v3_scale(v3_add(v3_add(l->P[0], l->P[1]), v3_add(l->P[2], l->P[3])), 0.25f);
+    else if (l->type != LIGHT_POINT && l->type != LIGHT_SPOT && l->type != LIGHT_DISK &&
+             l->type != LIGHT_SPHERE)
+        at = v3(0, 0, 0);
+    if (intensity)
+        *intensity = l->intensity;
+    if (color) {
+        color[0] = l->color.x;
+        color[1] = l->color.y;
+        color[2] = l->color.z;
+    }
+    if (position) {
+        position[0] = at.x;
+        position[1] = at.y;
+        position[2] = at.z;
+    }
+    return RAYES_OK;
+}
+
 RayesError rayes_scene_edit_shader(RayesScene *s, size_t object, const RayesParam *params,
                                    size_t n_params)
 {

@@ -265,7 +265,8 @@ RayesError rayes_session_stats(const RayesSession *s, RayesStats **out)
     return RAYES_OK;
 }
 
-RayesError rayes_session_pick(const RayesSession *s, float x, float y, int64_t *object)
+RayesError rayes_session_pick(const RayesSession *s, float x, float y, int64_t *object,
+                              float position[3])
 {
     if (!s || !object)
         return RAYES_ERROR_INVALID_ARGUMENT;
@@ -274,7 +275,14 @@ RayesError rayes_session_pick(const RayesSession *s, float x, float y, int64_t *
     RenderScene rs = session_render_scene(s->scene, s->prep, s->set.width, s->set.height);
     Ray ray = render_camera_ray(&rs, s->set.width, s->set.height, x, y);
     Hit hit;
-    if (accel_intersect(s->prep->accel, &ray, &hit))
-        *object = s->prep->gs.grids[hit.grid].object;
+    if (!accel_intersect(s->prep->accel, &ray, &hit))
+        return RAYES_OK;
+    *object = s->prep->gs.grids[hit.grid].object;
+    if (position) {
+        Vec3 P = v3_madd(ray.o, ray.d, hit.t);
+        position[0] = P.x;
+        position[1] = P.y;
+        position[2] = P.z;
+    }
     return RAYES_OK;
 }

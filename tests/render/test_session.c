@@ -155,7 +155,9 @@ static void check_edit(EditFn edit, float pick_x, float pick_y)
     RayesSession *ss = NULL;
     CHECK(rayes_session_new(s, &o, &ss) == RAYES_OK);
     int64_t object = -1;
-    CHECK(rayes_session_pick(ss, pick_x, pick_y, &object) == RAYES_OK);
+    float at[3] = {0, 0, 0};
+    CHECK(rayes_session_pick(ss, pick_x, pick_y, &object, at) == RAYES_OK);
+    CHECK(at[2] > 0.0f && at[2] < 560.0f); /* inside the box */
     CHECK(object >= 0 && rayes_scene_object_shader(s, (size_t)object)[0] != '\0');
     RayesImage *before = passes(ss, 3);
     edit(s, (size_t)object);

@@ -1,0 +1,71 @@
+/*
+ * app/app.h — what the commands of the rayes program share (main.c) and
+ * the viewer (view.c): arguments, loading a scene, usage errors.
+ */
+#ifndef RAYES_APP_APP_H
+#define RAYES_APP_APP_H
+
+#include "image/image.h"
+#include "io/sink.h"
+#include "rayes/rayes.h"
+
+#define MAX_OUTPUTS 8
+
+/* Options given on the command line, which win over a scene file's. */
+enum {
+    SET_RES = 1,
+    SET_SPP = 2,
+    SET_FILTER = 4,
+    SET_FILTER_WIDTH = 8,
+    SET_BOUNCES = 16,
+    SET_SPECULAR_DEPTH = 32
+};
+
+/* An image to write. */
+typedef struct Output {
+    char path[600];
+    ImageFormat format;
+} Output;
+
+typedef struct Args {
+    const char *scene;          /* a built-in scene's name or a scene file */
+    Output outputs[MAX_OUTPUTS];
+    int n_outputs;
+    int frame;                  /* --frame: the RIB frame to read; -1 the last */
+    unsigned set;               /* SET_*: options the command line gave */
+    const char *stats_path;
+    const char *data_dir;
+    const char *shader_path;    /* --shader-path: put before the scene's own shader path */
+    int quiet;
+    RayesRenderOptions opt;
+    /* rayes view */
+    int view;                   /* set before parse_args: the view options are accepted */
+    int headless;               /* --headless: no window */
+    const char *script;         /* --script FILE ("-": standard input) */
+    int passes;                 /* --passes N: stop after N passes (0: never, in a window) */
+    const char *screenshot;     /* --screenshot FILE: the window's pixels after --passes */
+    float exposure, gamma;      /* display: colour * 2^exposure, then ^(1 / gamma) */
+} Args;
+
+/* Parses `rayes COMMAND ...` into a (argv[2] on); dies with status 2 on a
+ * usage error. */
+void parse_args(int argc, char **argv, Args *a);
+
+/* Prints "rayes: MESSAGE" and the usage hint, exits with status 2. */
+void die_usage(const char *fmt, ...) __attribute__((noreturn, format(printf, 1, 2)));
+
+/* Builds the scene `scene` names (a scene file, else a built-in scene)
+ * into sink; settings receive what a file gives. */
+RayesError load_scene(const char *scene, const char *data_dir, int frame, const IoSink *sink,
+                      IoSettings *settings, char *err, size_t err_size);
+
+/* The exit status of a failed load (2 for an unknown built-in, else 1). */
+int load_status(const char *scene, RayesError e);
+
+/* The file's settings where the command line gave none. */
+void merge_settings(Args *a, const IoSettings *s);
+
+/* rayes view (view.c). */
+int cmd_view(int argc, char **argv);
+
+#endif /* RAYES_APP_APP_H */
