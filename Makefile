@@ -44,15 +44,18 @@ test-asan:
 # plugins are built with TSan too) and the texture cache (threads loading,
 # evicting and reloading MIP levels on a tiny budget), and the grid hider
 # (threads shading grids on first sight behind striped locks), and whole
-# renders on 1 to 4 threads (the determinism tests). Embree and
+# renders on 1 to 4 threads (the determinism tests), the progressive
+# session (passes cancelled from another thread) and rayes view (its driver
+# and window threads, headless and under SDL's dummy driver and Xvfb; Mesa's
+# software GL driver is suppressed too). Embree and
 # TBB are not instrumented: tools/tsan.supp suppresses reports inside them.
 TSAN_TESTS = cache_test_cache cache_test_cache_stress util_test_math util_test_half \
              shade_test_plugin shade_test_texture_threads render_test_hider \
-             render_test_determinism render_test_session
+             render_test_determinism render_test_session rayes_app app_test_view
 test-tsan:
 	@test -f build-tsan/Makefile || cmake -S . -B build-tsan -DCMAKE_BUILD_TYPE=RelWithDebInfo -DRAYES_TSAN=ON
 	cmake --build build-tsan -j $(JOBS) --target $(TSAN_TESTS)
-	cd build-tsan && TSAN_OPTIONS="halt_on_error=1 suppressions=$(CURDIR)/tools/tsan.supp" ctest --output-on-failure -R '^(cache|util)/|^shade/test_plugin$$|^shade/test_texture_threads$$|^render/test_(hider|determinism|session)$$'
+	cd build-tsan && TSAN_OPTIONS="halt_on_error=1 suppressions=$(CURDIR)/tools/tsan.supp" ctest --output-on-failure -R '^(cache|util)/|^shade/test_plugin$$|^shade/test_texture_threads$$|^render/test_(hider|determinism|session)$$|^app/test_view$$'
 
 # Fuzzing: every tests/fuzz/fuzz_NAME.c is a target, run on a scratch copy
 # of its seeds tests/fuzz/corpus_NAME/ (the repository's seeds stay as they
