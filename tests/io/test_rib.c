@@ -36,6 +36,8 @@ typedef struct Rec {
     float Cs[3];
     int n_shader_calls;
     int bilinear, bicubic, meshes, faces, tris, quads, quadrics, area_lights, lights;
+    int link_calls, links_mode;  /* set_light_links calls, the last one's mode */
+    size_t links[8], n_links;    /* and its lights */
     float first_bicubic[16][3];
     float last_mesh_P0[3];
     float area_P[4][3];
@@ -197,6 +199,21 @@ static RayesError s_light(void *t, const char *type, const RayesParam *p, size_t
     rec.lights++;
     return RAYES_OK;
 }
+static RayesError s_links(void *t, RayesLightLinks mode, const size_t *l, size_t n)
+{
+    (void)t;
+    rec.link_calls++;
+    rec.links_mode = (int)mode;
+    rec.n_links = n;
+    for (size_t i = 0; i < n && i < 8; i++)
+        rec.links[i] = l[i];
+    return RAYES_OK;
+}
+static size_t s_count(void *t)
+{
+    (void)t;
+    return (size_t)(rec.lights + rec.area_lights);
+}
 static const char *s_error(void *t)
 {
     (void)t;
@@ -206,7 +223,7 @@ static const char *s_error(void *t)
 static const IoSink stub = {NULL,      s_camera,  s_camera_matrix, s_transform, s_shader,
                             s_displacement, s_float, s_search,     s_float,     s_bilinear,
                             s_bicubic, s_mesh,    s_sphere,        s_quadric,   s_area,
-                            s_light,   s_error};
+                            s_light,   s_links,   s_count,   s_error};
 
 static IoSettings settings;
 static char err[1024];
