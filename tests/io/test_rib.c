@@ -346,6 +346,17 @@ static void test_shaders_and_lights(void)
     CHECK(parse(WORLD("LightSource \"pointlight\" 1\nIlluminate 1 0\n"
                       "Polygon \"P\" [0 0 0 1 0 0 1 1 0]")) == RAYES_OK);
     CHECK(rec.lights == 0);
+    /* Illuminate off in an attribute scope: the objects in it are linked
+     * EXCEPT the light; AttributeEnd turns it back on (links ALL) */
+    CHECK(parse(WORLD("LightSource \"pointlight\" 1\nPolygon \"P\" [0 0 0 1 0 0 1 1 0]\n"
+                      "AttributeBegin\nIlluminate 1 0\nPolygon \"P\" [0 0 0 1 0 0 1 1 0]\n"
+                      "AttributeEnd\nPolygon \"P\" [0 0 0 1 0 0 1 1 0]")) == RAYES_OK);
+    CHECK(rec.lights == 1 && rec.link_calls == 2 && rec.links_mode == RAYES_LIGHT_LINKS_ALL);
+    CHECK(parse(WORLD("LightSource \"pointlight\" 1\nPolygon \"P\" [0 0 0 1 0 0 1 1 0]\n"
+                      "AttributeBegin\nIlluminate 1 0\nPolygon \"P\" [0 0 0 1 0 0 1 1 0]\n"
+                      "AttributeEnd")) == RAYES_OK);
+    CHECK(rec.link_calls == 1 && rec.links_mode == RAYES_LIGHT_LINKS_EXCEPT && rec.n_links == 1 &&
+          rec.links[0] == 0);
     CHECK(parse(WORLD("AttributeBegin\nAreaLightSource \"arealight\" 1 \"intensity\" 2\n"
                       "Polygon \"P\" [0 0 0 1 0 0 1 1 0 0 1 0]\nAttributeEnd\n"
                       "Polygon \"P\" [0 0 0 1 0 0 1 1 0 0 1 0]")) == RAYES_OK);
