@@ -17,12 +17,13 @@
  * ...) is remembered in a SinkState, and resent only when it changes.
  * Lights: which are on is an attribute (a bit per light in Attr, saved by
  * AttributeBegin, not by TransformBegin; LightSource turns the new light
- * on, Illuminate on or off). A light is sent when the first geometry it is
- * on for comes (so one turned off before any geometry saw it is not sent),
- * or at WorldEnd if it is on then; each geometry's objects get the light
- * links EXCEPT the sent lights that are off for it (a light sent later
- * lights earlier geometry, as all lights did before light linking; area
- * lights light everything). Object definitions go to a recording
+ * on, Illuminate on or off). A light is sent at the first geometry after
+ * its LightSource, on or off, or at WorldEnd if it is on then (one that
+ * no geometry followed and that is off at the end lights nothing, and is
+ * not sent); each geometry's objects get the light links EXCEPT the lights
+ * that are off for it. A light still lights the geometry before its
+ * LightSource (as every light did before light linking), and area lights
+ * light everything. Object definitions go to a recording
  * sink (rib_record.c) replayed per instance.
  *
  * Limits (bad input fails cleanly): archive depth 32, attribute stack
@@ -865,7 +866,8 @@ static int send_light(Rib *r, Light *L)
 }
 
 /* Before geometry (not in an object definition) or an instance: sends the
- * lights on that were never sent, then the light links (EXCEPT the sent
+ * lights never sent, on or off (so that the links of this geometry can
+ * exclude them), then the light links (EXCEPT the sent
  * lights that are off) if they changed; new links need a new object, so
  * the shader is sent again. */
 static int send_lights(Rib *r)
@@ -875,9 +877,9 @@ static int send_lights(Rib *r)
     int changed = 0;
     for (size_t k = 0; k < r->n_lights; k++) {
         Light *L = &r->lights[k];
-        if (L->index < 0 && light_on(&r->a, k) && send_light(r, L) != 0)
+        if (L->index < 0 && send_light(r, L) != 0)
             return -1;
-        if (L->index < 0 || light_on(&r->a, k))
+        if (light_on(&r->a, k))
             continue;
         if (n >= r->n_links || r->links[n] != (size_t)L->index) {
             size_t *nl = realloc(r->links, (n + 1) * sizeof *nl);
@@ -1944,7 +1946,7 @@ static int h_light_source(Rib *r, const Args *a)
         return rib_error(r, "more than %d lights", RIB_MAX_LIGHTS);
     }
     Light *L = find_light(r, handle);
-    if (L && light_on(&r->a, (size_t)(L - r->lights)) && L->index < 0) {
+    if (L && L->index < 0) {
         /* redefined before any geometry saw it: replace */
     } else {
         if (L)

@@ -342,9 +342,14 @@ static void test_shaders_and_lights(void)
     CHECK_NEAR(rec.Cs[0], 1, 0);
     CHECK_NEAR(rec.Cs[1], 0, 0);
     CHECK(rec.quads == 1 && rec.tris == 1);
-    /* Illuminate off before any geometry: the light is not sent */
+    /* Illuminate off before any geometry: the light is sent, and the
+     * geometry is linked to every light except it */
     CHECK(parse(WORLD("LightSource \"pointlight\" 1\nIlluminate 1 0\n"
                       "Polygon \"P\" [0 0 0 1 0 0 1 1 0]")) == RAYES_OK);
+    CHECK(rec.lights == 1 && rec.links_mode == RAYES_LIGHT_LINKS_EXCEPT && rec.n_links == 1);
+    /* ... but not if no geometry follows and it is off at the end */
+    CHECK(parse(WORLD("Polygon \"P\" [0 0 0 1 0 0 1 1 0]\nLightSource \"pointlight\" 1\n"
+                      "Illuminate 1 0")) == RAYES_OK);
     CHECK(rec.lights == 0);
     /* Illuminate off in an attribute scope: the objects in it are linked
      * EXCEPT the light; AttributeEnd turns it back on (links ALL) */
