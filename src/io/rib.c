@@ -845,7 +845,8 @@ static int light_on(const Attr *a, size_t k)
 
 static void set_light_on(Attr *a, size_t k, int on)
 {
-    a->on[k / 8] = (unsigned char)((a->on[k / 8] & ~(1u << (k % 8))) | (unsigned)(on != 0) << (k % 8));
+    unsigned bit = 1u << (k % 8);
+    a->on[k / 8] = (unsigned char)(on ? a->on[k / 8] | bit : a->on[k / 8] & ~bit);
 }
 
 static int send_light(Rib *r, Light *L)
