@@ -300,6 +300,28 @@ RAYES_API RayesError rayes_scene_area_light(RayesScene *scene, const float P[4][
 RAYES_API RayesError rayes_scene_light(RayesScene *scene, const char *type,
                                        const RayesParam *params, size_t n_params);
 
+/* Light linking: which lights illuminate the objects made from now on
+ * (by rayes_scene_set_shader, or the default matte of geometry added
+ * before any shader), as RenderMan's Illuminate does for the geometry
+ * that follows it. lights are light indices as rayes_scene_light_count
+ * numbers them (from 0, in creation order, rayes_scene_light and
+ * rayes_scene_area_light alike), and may name lights made later, so a
+ * reader can link geometry to lights it sends afterwards; an index the
+ * scene has no light for at rayes_scene_commit is then
+ * RAYES_ERROR_INVALID_ARGUMENT. Direct lighting and the ambient service
+ * skip, for each shaded object, the lights not linked to it. Objects keep
+ * the links in force when they were made; an emitter's links do not
+ * matter (emitters are not shaded). The list is copied; lights may be
+ * NULL when n_lights is 0. */
+typedef enum RayesLightLinks {
+    RAYES_LIGHT_LINKS_ALL = 0,    /* every light (the default); the list is ignored */
+    RAYES_LIGHT_LINKS_ONLY = 1,   /* only the listed lights */
+    RAYES_LIGHT_LINKS_EXCEPT = 2  /* every light but the listed ones */
+} RayesLightLinks;
+
+RAYES_API RayesError rayes_scene_set_light_links(RayesScene *scene, RayesLightLinks mode,
+                                                 const size_t *lights, size_t n_lights);
+
 /* ---------------------------------------------------------------- edits
  *
  * Changes to a scene that has been rendered, for interactive preview (a

@@ -15,8 +15,15 @@
  * Shaders are immutable records (ShaderRec) owned by the reader, so the
  * copies share them. What was last sent to each sink (transform, shader,
  * ...) is remembered in a SinkState, and resent only when it changes.
- * Lights are collected and sent at WorldEnd (Illuminate may turn them off
- * before any geometry sees them). Object definitions go to a recording
+ * Lights: which are on is an attribute (a bit per light in Attr, saved by
+ * AttributeBegin, not by TransformBegin; LightSource turns the new light
+ * on, Illuminate on or off). A light is sent at the first geometry after
+ * its LightSource, on or off, or at WorldEnd if it is on then (one that
+ * no geometry followed and that is off at the end lights nothing, and is
+ * not sent); each geometry's objects get the light links EXCEPT the lights
+ * that are off for it. A light still lights the geometry before its
+ * LightSource (as every light did before light linking), and area lights
+ * light everything. Object definitions go to a recording
  * sink (rib_record.c) replayed per instance.
  *
  * Limits (bad input fails cleanly): archive depth 32, attribute stack
@@ -43,6 +50,7 @@
 #define RIB_MAX_ARGS 1000000
 #define RIB_MAX_FILE_BYTES ((size_t)1 << 30)
 #define RIB_MAX_WARNED 512
+#define RIB_MAX_LIGHTS 4096
 
 /* ----------------------------------------------------------- arguments */
 
@@ -123,6 +131,7 @@ typedef struct Attr {
     float shading_rate;
     float bound;
     int area;                  /* AreaLightSource in force */
+    unsigned char on[RIB_MAX_LIGHTS / 8]; /* bit k: Rib.lights[k] is on */
     float area_L[3];
     float ubasis[16], vbasis[16];
     int ustep, vstep;
@@ -150,7 +159,8 @@ typedef struct Light {
     char category[128];
     size_t n;
     float M[16];   /* world_from_light (camera_from_light before WorldBegin) */
-    int pre_world, on, used;
+    int pre_world;
+    long index;    /* the sink's index of the light once sent, else -1 */
 } Light;
 
 typedef struct Object {
@@ -202,6 +212,8 @@ typedef struct Rib {
     size_t n_decls;
     Light *lights;
     size_t n_lights;
+    size_t *links;             /* the light links last sent (EXCEPT these; none: ALL) */
+    size_t n_links;
     Object *objects;
     size_t n_objects;
     RibRecording *rec;         /* the object being defined */
@@ -826,6 +838,70 @@ static int send_shader(Rib *r, const IoSink *s, const float Cs[3])
     return e == RAYES_OK ? 0 : sink_failed(r, s);
 }
 
+static int light_on(const Attr *a, size_t k)
+{
+    return (a->on[k / 8] >> (k % 8)) & 1;
+}
+
+static void set_light_on(Attr *a, size_t k, int on)
+{
+    unsigned bit = 1u << (k % 8);
+    a->on[k / 8] = (unsigned char)(on ? a->on[k / 8] | bit : a->on[k / 8] & ~bit);
+}
+
+static int send_light(Rib *r, Light *L)
+{
+    const IoSink *s = r->sink;
+    size_t index = s->light_count(s->target);
+    for (size_t i = 0; i < L->n; i++) { /* the array may have moved since */
+        L->params[i].name = L->names[i];
+        if (L->params[i].type == RAYES_PARAM_STRING)
+            L->params[i].string = L->category;
+    }
+    if (s->set_transform(s->target, L->M) != RAYES_OK ||
+        s->light(s->target, L->type, L->params, L->n) != RAYES_OK)
+        return sink_failed(r, s);
+    L->index = (long)index;
+    r->real.have_M = 0;
+    return 0;
+}
+
+/* Before geometry (not in an object definition) or an instance: sends the
+ * lights never sent, on or off (so that the links of this geometry can
+ * exclude them), then the light links (EXCEPT the sent
+ * lights that are off) if they changed; new links need a new object, so
+ * the shader is sent again. */
+static int send_lights(Rib *r)
+{
+    const IoSink *s = r->sink;
+    size_t n = 0;
+    int changed = 0;
+    for (size_t k = 0; k < r->n_lights; k++) {
+        Light *L = &r->lights[k];
+        if (L->index < 0 && send_light(r, L) != 0)
+            return -1;
+        if (light_on(&r->a, k))
+            continue;
+        if (n >= r->n_links || r->links[n] != (size_t)L->index) {
+            size_t *nl = realloc(r->links, (n + 1) * sizeof *nl);
+            if (!nl)
+                return rib_error(r, "out of memory");
+            r->links = nl;
+            r->links[n] = (size_t)L->index;
+            changed = 1;
+        }
+        n++;
+    }
+    if (!changed && n == r->n_links)
+        return 0;
+    r->n_links = n;
+    if (s->set_light_links(s->target, n ? RAYES_LIGHT_LINKS_EXCEPT : RAYES_LIGHT_LINKS_ALL,
+                           r->links, n) != RAYES_OK)
+        return sink_failed(r, s);
+    r->real.have_shader = 0;
+    return 0;
+}
+
 /* Brings the sink up to date before a primitive; Cs overrides the
  * colour (a per-face colour) when not NULL. 1: skip (outside the world). */
 static int emit_begin(Rib *r, const float *Cs)
@@ -834,9 +910,8 @@ static int emit_begin(Rib *r, const float *Cs)
         warn_once(r, "outside world", "geometry outside WorldBegin/WorldEnd is ignored");
         return 1;
     }
-    for (size_t i = 0; i < r->n_lights; i++)
-        if (r->lights[i].on)
-            r->lights[i].used = 1;
+    if (!r->rec && send_lights(r) != 0)
+        return -1;
     SinkState *st;
     const IoSink *s = out_sink(r, &st);
     if (!st->have_M || memcmp(st->M, r->a.M, sizeof st->M) != 0) {
@@ -1867,12 +1942,12 @@ static int h_light_source(Rib *r, const Args *a)
         free(p);
         return 0;
     }
-    if (r->n_lights >= 4096) {
+    if (r->n_lights >= RIB_MAX_LIGHTS) {
         free(p);
-        return rib_error(r, "more than 4096 lights");
+        return rib_error(r, "more than %d lights", RIB_MAX_LIGHTS);
     }
     Light *L = find_light(r, handle);
-    if (L && L->on && !L->used) {
+    if (L && L->index < 0) {
         /* redefined before any geometry saw it: replace */
     } else {
         if (L)
@@ -1890,7 +1965,8 @@ static int h_light_source(Rib *r, const Args *a)
     snprintf(L->type, sizeof L->type, "%s", type);
     memcpy(L->M, r->a.M, sizeof L->M);
     L->pre_world = !r->in_world;
-    L->on = 1;
+    L->index = -1;
+    set_light_on(&r->a, (size_t)(L - r->lights), 1);
     static const char *const names[] = {"intensity", "lightcolor", "from", "to", "coneangle",
                                         "conedeltaangle", "beamdistribution", "__category", NULL};
     for (size_t k = 0; k < n && L->n < RIB_LIGHT_PARAMS; k++) {
@@ -1958,31 +2034,21 @@ static int h_illuminate(Rib *r, const Args *a)
     Light *L = find_light(r, handle);
     if (!L)
         return rib_error(r, "no light has the handle %s", handle[0] == '#' ? handle + 1 : handle);
-    if (!on && L->used)
-        warn_once(r, "illuminate", "Illuminate: a light lights every object once it lit one "
-                                   "(the API has no light linking)");
-    L->on = on != 0;
+    set_light_on(&r->a, (size_t)(L - r->lights), on != 0);
     return 0;
 }
 
-/* Sends the lights that lit something (or are on at the end). */
+/* At WorldEnd: sends the lights on then that were never sent, and ends
+ * the world's lights (the next world starts with none, and all links). */
 static int flush_lights(Rib *r)
 {
-    const IoSink *s = r->sink;
     for (size_t k = 0; k < r->n_lights; k++) {
         Light *L = &r->lights[k];
-        if (!L->used && !L->on)
-            continue;
-        for (size_t i = 0; i < L->n; i++) { /* the array may have moved since */
-            L->params[i].name = L->names[i];
-            if (L->params[i].type == RAYES_PARAM_STRING)
-                L->params[i].string = L->category;
-        }
-        if (s->set_transform(s->target, L->M) != RAYES_OK ||
-            s->light(s->target, L->type, L->params, L->n) != RAYES_OK)
-            return sink_failed(r, s);
+        if (L->index < 0 && light_on(&r->a, k) && send_light(r, L) != 0)
+            return -1;
     }
     r->n_lights = 0;
+    memset(r->a.on, 0, sizeof r->a.on);
     r->real.have_M = 0;
     return 0;
 }
@@ -2623,9 +2689,8 @@ static int h_object_instance(Rib *r, const Args *a)
         warn_once(r, "outside world", "geometry outside WorldBegin/WorldEnd is ignored");
         return 0;
     }
-    for (size_t k = 0; k < r->n_lights; k++)
-        if (r->lights[k].on)
-            r->lights[k].used = 1;
+    if (send_lights(r) != 0)
+        return -1;
     RayesError e = rib_recording_replay(o->rec, r->sink, r->a.M);
     memset(&r->real, 0, sizeof r->real); /* the replay changed the sink's state */
     return e == RAYES_OK ? 0 : sink_failed(r, r->sink);
@@ -2999,13 +3064,19 @@ static RayesError null_area(void *t, const float P[4][3], const float L[3])
     (void)t, (void)P, (void)L;
     return RAYES_OK;
 }
+static RayesError null_links(void *t, RayesLightLinks m, const size_t *l, size_t n)
+{
+    (void)t, (void)m, (void)l, (void)n;
+    return RAYES_OK;
+}
+static size_t null_count(void *t) { (void)t; return 0; }
 static const char *null_error(void *t) { (void)t; return ""; }
 
 static const IoSink null_sink = {NULL,        null_camera, null_camera_matrix, null_matrix,
                                  null_named,  null_named,  null_float,         null_path,
                                  null_float,  null_p4,     null_p16,           null_mesh,
                                  null_float,  null_quadric, null_area,         null_named,
-                                 null_error};
+                                 null_links,  null_count,  null_error};
 
 static void rib_init(Rib *r, int pass, const IoSink *sink, const IoReadOptions *opt,
                      IoSettings *settings, char *err, size_t err_size)
@@ -3047,6 +3118,7 @@ static void rib_fini(Rib *r)
     }
     free(r->decls);
     free(r->lights);
+    free(r->links);
     for (size_t k = 0; k < r->n_objects; k++)
         rib_recording_free(r->objects[k].rec);
     free(r->objects);

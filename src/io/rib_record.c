@@ -248,6 +248,18 @@ static RayesError rec_light(void *t, const char *type, const RayesParam *p, size
     (void)t, (void)type, (void)p, (void)n;
     return RAYES_OK;
 }
+/* The reader sends light links and lights to the real sink only, before
+ * an instance is replayed (its objects take the links in force there). */
+static RayesError rec_light_links(void *t, RayesLightLinks mode, const size_t *l, size_t n)
+{
+    (void)t, (void)mode, (void)l, (void)n;
+    return RAYES_OK;
+}
+static size_t rec_light_count(void *t)
+{
+    (void)t;
+    return 0;
+}
 static const char *rec_error(void *t)
 {
     (void)t;
@@ -259,7 +271,7 @@ IoSink rib_recording_sink(RibRecording *rec)
     IoSink s = {rec,           rec_camera,   rec_camera_matrix, rec_transform,  rec_shader,
                 rec_displacement, rec_bound, rec_search_path,  rec_rate,       rec_bilinear,
                 rec_bicubic,   rec_mesh,     rec_sphere,        rec_quadric,    rec_area_light,
-                rec_light,     rec_error};
+                rec_light,     rec_light_links, rec_light_count, rec_error};
     return s;
 }
 

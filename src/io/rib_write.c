@@ -26,7 +26,11 @@ struct RibWriter {
     int in_transform;        /* a TransformBegin is open */
     int bezier_basis;        /* Basis "bezier" was written */
     int opacity_set;         /* the last Opacity was not 1 1 1 */
-    int next_light;          /* the next light handle */
+    int next_light;          /* the next light handle (a light's index + 1) */
+    int links_mode;          /* RayesLightLinks in force */
+    size_t *links, n_links;  /* their lights; owned */
+    unsigned char off[4097]; /* by handle: turned off by an Illuminate written */
+    unsigned char area[4097]; /* by handle: an area light (not linkable in RIB) */
     char error[256];         /* the last error, "" if none */
 };
 
@@ -70,6 +74,7 @@ void io_rib_writer_free(RibWriter *w)
     stream_close(&w->options);
     stream_close(&w->camera);
     stream_close(&w->world);
+    free(w->links);
     free(w);
 }
 
@@ -516,12 +521,16 @@ static RayesError w_sphere(void *t, float r)
 
 /* --------------------------------------------------------------- lights */
 
+static int w_linked(const RibWriter *w, size_t light);
+
 static RayesError w_area_light(void *t, const float P[4][3], const float L[3])
 {
     RibWriter *w = t;
     if (!finite_all(&P[0][0], 12) || !finite_all(L, 3))
         return fail(w, RAYES_ERROR_INVALID_ARGUMENT, "area light: not finite");
     FILE *f = w->world.f;
+    if (w->next_light < 4097)
+        w->area[w->next_light] = 1;
     fprintf(f, "AttributeBegin\nAreaLightSource \"arealight\" %d \"color lightcolor\" ",
             w->next_light++);
     floats(f, L, 3);
@@ -546,10 +555,58 @@ static RayesError w_light(void *t, const char *type, const RayesParam *p, size_t
     if (e == RAYES_OK) {
         fprintf(w->world.f, "LightSource ");
         string(w->world.f, type);
-        fprintf(w->world.f, " %d%s\n", w->next_light++, text ? text : "");
+        int h = w->next_light++;
+        fprintf(w->world.f, " %d%s\n", h, text ? text : "");
+        if (h < 4097 && !w_linked(w, (size_t)h - 1)) {
+            fprintf(w->world.f, "Illuminate %d 0\n", h);
+            w->off[h] = 1;
+        }
     }
     free(text);
     return e;
+}
+
+/* Illuminate: the lights written so far are turned on or off to match the
+ * links; a light written later is turned off after its LightSource if the
+ * links in force exclude it. Links to lights not yet written, and area
+ * lights, cannot be expressed (docs/convert.md). */
+static int w_linked(const RibWriter *w, size_t light)
+{
+    int listed = 0;
+    for (size_t i = 0; i < w->n_links; i++)
+        listed |= w->links[i] == light;
+    return w->links_mode == RAYES_LIGHT_LINKS_ALL    ? 1
+           : w->links_mode == RAYES_LIGHT_LINKS_ONLY ? listed
+                                                     : !listed;
+}
+
+static RayesError w_set_light_links(void *t, RayesLightLinks mode, const size_t *l, size_t n)
+{
+    RibWriter *w = t;
+    size_t *copy = n ? malloc(n * sizeof *copy) : NULL;
+    if (n && !copy)
+        return fail(w, RAYES_ERROR_OUT_OF_MEMORY, "out of memory");
+    if (n)
+        memcpy(copy, l, n * sizeof *copy);
+    free(w->links);
+    w->links = copy;
+    w->n_links = n;
+    w->links_mode = (int)mode;
+    for (int h = 1; h < w->next_light && h < 4097; h++) {
+        if (w->area[h])
+            continue;
+        int on = w_linked(w, (size_t)h - 1);
+        if (on != !w->off[h]) {
+            fprintf(w->world.f, "Illuminate %d %d\n", h, on);
+            w->off[h] = (unsigned char)!on;
+        }
+    }
+    return RAYES_OK;
+}
+
+static size_t w_light_count(void *t)
+{
+    return (size_t)((RibWriter *)t)->next_light - 1;
 }
 
 static const char *w_get_error(void *t)
@@ -576,6 +633,8 @@ IoSink io_rib_writer_sink(RibWriter *w)
         .quadric = w_quadric,
         .area_light = w_area_light,
         .light = w_light,
+        .set_light_links = w_set_light_links,
+        .light_count = w_light_count,
         .get_error = w_get_error,
     };
 }

@@ -89,6 +89,17 @@ static RayesError scene_light(void *t, const char *type, const RayesParam *p, si
     return rayes_scene_light(t, type, p, n);
 }
 
+static RayesError scene_set_light_links(void *t, RayesLightLinks mode, const size_t *lights,
+                                        size_t n)
+{
+    return rayes_scene_set_light_links(t, mode, lights, n);
+}
+
+static size_t scene_light_count(void *t)
+{
+    return rayes_scene_light_count(t);
+}
+
 static const char *scene_get_error(void *t)
 {
     return rayes_scene_get_error(t);
@@ -113,6 +124,8 @@ IoSink io_sink_scene(RayesScene *scene)
         .quadric = scene_quadric,
         .area_light = scene_area_light,
         .light = scene_light,
+        .set_light_links = scene_set_light_links,
+        .light_count = scene_light_count,
         .get_error = scene_get_error,
     };
 }

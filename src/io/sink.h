@@ -53,6 +53,10 @@ typedef struct IoSink {
     RayesError (*area_light)(void *target, const float P[4][3], const float L[3]);
     RayesError (*light)(void *target, const char *type, const RayesParam *params,
                         size_t n_params);
+    RayesError (*set_light_links)(void *target, RayesLightLinks mode, const size_t *lights,
+                                  size_t n_lights);
+    /* rayes_scene_light_count: the index the next light will get. */
+    size_t (*light_count)(void *target);
     /* The last error message of the target, for reports; "" if none. */
     const char *(*get_error)(void *target);
 } IoSink;

@@ -366,6 +366,17 @@ static void light_area(Worker *w, const DirectPoint *p, const Light *l, uint64_t
         *spec = v3_add(*spec, v3_scale(sum_s, 1.0f / n));
 }
 
+/* The object whose light links apply to the points of ps: its grid's
+ * (every caller, camera hit, grid hider, radiosity fill, irradiance,
+ * knows the grid); a test calling services on no grid gets an object lit
+ * by every light. */
+static const RenderObject *lit_object(const PathState *ps)
+{
+    static const RenderObject every = {.light = -1};
+    const RenderScene *rs = ps->w->rs;
+    return ps->grid < rs->gs->n_grids ? &rs->objects[rs->gs->grids[ps->grid].object] : &every;
+}
+
 static void svc_direct_lighting(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
                                 int n_shadow_rays, const char *category, const float *roughness,
                                 float (*diffuse)[3], float (*specular)[3])
@@ -377,6 +388,7 @@ static void svc_direct_lighting(const RayesShaderServices *sv, const RayesShadeC
             : ctx->diffuse_depth == 0 ? w->set->shadow_rays
                                       : w->set->shadow_rays_deep;
     int want_spec = specular && ctx->I;
+    const RenderObject *obj = lit_object(ps);
     for (size_t i = 0; i < ctx->n_points; i++) {
         Vec3 d = v3(0, 0, 0), s = v3(0, 0, 0);
         DirectPoint p;
@@ -388,7 +400,8 @@ static void svc_direct_lighting(const RayesShaderServices *sv, const RayesShadeC
         p.spec = want_spec;
         for (size_t k = 0; k < w->rs->n_lights && n > 0; k++) {
             const Light *l = &w->rs->lights[k];
-            if (l->type == LIGHT_AMBIENT || !light_category_match(l, category))
+            if (l->type == LIGHT_AMBIENT || !render_lit_by(obj, k) ||
+                !light_category_match(l, category))
                 continue;
             if (light_is_area(l))
                 light_area(w, &p, l,
@@ -451,9 +464,10 @@ static void svc_ambient(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
     (void)sv;
     const PathState *ps = ctx->renderer;
     const RenderScene *rs = ps->w->rs;
+    const RenderObject *obj = lit_object(ps);
     Vec3 sum = v3(0, 0, 0);
     for (size_t k = 0; k < rs->n_lights; k++)
-        if (rs->lights[k].type == LIGHT_AMBIENT)
+        if (rs->lights[k].type == LIGHT_AMBIENT && render_lit_by(obj, k))
             sum = v3_add(sum, rs->lights[k].L);
     for (size_t i = 0; i < ctx->n_points; i++)
         store3(out[i], sum);

@@ -31,7 +31,15 @@ typedef struct RenderObject {
     const ShaderInstance *shader; /* surface shader (NULL for lights) */
     float Cs[3], Os[3];           /* surface colour and opacity */
     int light;                    /* index of the light it emits as, or -1 */
+    const unsigned char *lit;     /* n_lights flags, nonzero: that light illuminates it (its
+                                     light links); NULL: every light does */
 } RenderObject;
+
+/* Whether light k illuminates obj (direct lighting, ambient). */
+static inline int render_lit_by(const RenderObject *obj, size_t k)
+{
+    return !obj->lit || obj->lit[k];
+}
 
 /* The camera of a frame (rayes.h's rayes_scene_set_camera_matrix): a
  * screen position (sx, sy) in the screen window looks along

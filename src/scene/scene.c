@@ -98,6 +98,9 @@ void rayes_scene_release(RayesScene *s)
     for (size_t i = 0; i < s->n_displacements; i++)
         shade_instance_fini(&s->displacements[i]);
     free(s->displacements);
+    for (size_t i = 0; i < s->n_links; i++)
+        free(s->links[i].lights);
+    free(s->links);
     free(s->objects);
     free(s->prims);
     free(s->pv);
@@ -218,6 +221,7 @@ static RayesError add_object(RayesScene *s, const RayesShaderClass *cls, const R
     SceneObject *o = &s->objects[s->n_objects];
     memset(o, 0, sizeof *o);
     o->light = light;
+    o->links = s->current_links;
     o->ray_mask = RAYES_RAY_CAMERA | RAYES_RAY_DIFFUSE | RAYES_RAY_SPECULAR |
                   (light >= 0 ? 0u : (uint32_t)RAYES_RAY_SHADOW);
     for (int c = 0; c < 3; c++)
@@ -650,10 +654,76 @@ RayesError rayes_scene_area_light(RayesScene *s, const float P[4][3], const floa
     return RAYES_OK;
 }
 
+static int cmp_size(const void *a, const void *b)
+{
+    size_t x = *(const size_t *)a, y = *(const size_t *)b;
+    return x < y ? -1 : x > y;
+}
+
+RayesError rayes_scene_set_light_links(RayesScene *s, RayesLightLinks mode, const size_t *lights,
+                                       size_t n_lights)
+{
+    if (!s || (n_lights && !lights))
+        return RAYES_ERROR_INVALID_ARGUMENT;
+    if (mode != RAYES_LIGHT_LINKS_ALL && mode != RAYES_LIGHT_LINKS_ONLY &&
+        mode != RAYES_LIGHT_LINKS_EXCEPT)
+        return fail(s, RAYES_ERROR_INVALID_ARGUMENT, "light links: unknown mode %d", (int)mode);
+    if (mode == RAYES_LIGHT_LINKS_ALL) {
+        s->current_links = 0;
+        return RAYES_OK;
+    }
+    if (s->n_links >= UINT32_MAX - 1 ||
+        grow((void **)&s->links, &s->cap_links, s->n_links, sizeof *s->links) != 0)
+        return fail(s, RAYES_ERROR_OUT_OF_MEMORY, "out of memory");
+    size_t *copy = malloc((n_lights ? n_lights : 1) * sizeof *copy);
+    if (!copy)
+        return fail(s, RAYES_ERROR_OUT_OF_MEMORY, "out of memory");
+    if (n_lights)
+        memcpy(copy, lights, n_lights * sizeof *copy);
+    qsort(copy, n_lights, sizeof *copy, cmp_size);
+    size_t n = 0;
+    for (size_t i = 0; i < n_lights; i++)
+        if (n == 0 || copy[n - 1] != copy[i])
+            copy[n++] = copy[i];
+    s->links[s->n_links++] = (SceneLinks){(int)mode, copy, n};
+    s->current_links = (uint32_t)s->n_links;
+    return RAYES_OK;
+}
+
+int scene_object_lit_by(const RayesScene *s, size_t object, size_t light)
+{
+    uint32_t k = s->objects[object].links;
+    if (k == 0)
+        return 1;
+    const SceneLinks *l = &s->links[k - 1];
+    int listed = bsearch(&light, l->lights, l->n, sizeof *l->lights, cmp_size) != NULL;
+    return l->mode == RAYES_LIGHT_LINKS_ONLY ? listed : !listed;
+}
+
+/* Light links name lights that may be made after them: every light an
+ * object's links name must exist by the commit. */
+static RayesError check_links(RayesScene *s)
+{
+    for (size_t i = 0; i < s->n_objects; i++) {
+        uint32_t k = s->objects[i].links;
+        if (k == 0 || s->links[k - 1].n == 0)
+            continue;
+        size_t last = s->links[k - 1].lights[s->links[k - 1].n - 1];
+        if (last >= s->n_lights)
+            return fail(s, RAYES_ERROR_INVALID_ARGUMENT,
+                        "light links of object %zu: no light %zu (the scene has %zu)", i, last,
+                        s->n_lights);
+    }
+    return RAYES_OK;
+}
+
 RayesError rayes_scene_commit(RayesScene *s)
 {
     if (!s)
         return RAYES_ERROR_INVALID_ARGUMENT;
+    RayesError e = check_links(s);
+    if (e != RAYES_OK)
+        return e;
     s->timestamp++;
     s->dirty = 0;
     if (s->changes & SCENE_CHANGE_CAMERA)

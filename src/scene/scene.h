@@ -27,7 +27,15 @@ typedef struct SceneObject {
     float Cs[3], Os[3];       /* surface colour and opacity */
     int light;                /* light index, or -1 */
     uint32_t ray_mask;        /* RayesRayType bits of the rays that see it */
+    uint32_t links;           /* its light links: RayesScene.links index + 1, or 0: all lights */
 } SceneObject;
+
+/* A set of light links (rayes_scene_set_light_links). */
+typedef struct SceneLinks {
+    int mode;                 /* RayesLightLinks: ONLY or EXCEPT */
+    size_t *lights;           /* light indices, sorted, unique; owned */
+    size_t n;
+} SceneLinks;
 
 /* The kinds of rayes_scene_set_search_path, indexing RayesScene.search_paths
  * (names in scene.c's search_path_kinds). */
@@ -82,6 +90,9 @@ struct RayesScene {
     size_t n_displacements, cap_displacements;
     uint32_t current_displacement; /* of geometry added next: index + 1, or 0 */
     float displacement_bound;      /* of geometry added next; 0: unbounded */
+    SceneLinks *links;        /* light link sets, each made by a set_light_links call */
+    size_t n_links, cap_links;
+    uint32_t current_links;   /* of objects made next: links index + 1, or 0: all lights */
     uint64_t timestamp;       /* commits so far */
     int dirty;                /* edited since the last commit */
     unsigned changes;         /* SceneChange bits since the last commit */
@@ -115,6 +126,10 @@ int scene_displace(const RayesScene *scene, GridSet *gs, size_t first_grid, floa
 /* The scene's search path of that kind: colon-separated directories, ""
  * if never set. Borrowed: valid until the next set_search_path. */
 const char *scene_search_path(const RayesScene *scene, SceneSearchPath kind);
+
+/* Whether light `light` illuminates object `object` (its light links);
+ * 1 or 0. */
+int scene_object_lit_by(const RayesScene *scene, size_t object, size_t light);
 
 /* The bounds of all primitives' control points (lights included). */
 Bounds3 scene_bounds(const RayesScene *scene);

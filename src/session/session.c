@@ -162,18 +162,28 @@ TextureSystem *session_textures(const RayesScene *scene, double mb, float width)
     return ts;
 }
 
-/* The render-side view of the scene's objects. */
+/* The render-side view of the scene's objects, one block: the objects,
+ * then for each light link set its n_lights flags, shared by the objects
+ * made under it. */
 RenderObject *session_render_objects(const RayesScene *scene)
 {
-    RenderObject *ro = calloc(scene->n_objects + 1, sizeof *ro);
+    size_t n_ro = scene->n_objects + 1, n_lit = scene->n_links * scene->n_lights;
+    RenderObject *ro = calloc(1, n_ro * sizeof *ro + n_lit);
     if (!ro)
         return NULL;
+    unsigned char *lit = (unsigned char *)(ro + n_ro);
     for (size_t i = 0; i < scene->n_objects; i++) {
         const SceneObject *so = &scene->objects[i];
         ro[i].shader = so->shader.cls ? &so->shader : NULL;
         memcpy(ro[i].Cs, so->Cs, sizeof ro[i].Cs);
         memcpy(ro[i].Os, so->Os, sizeof ro[i].Os);
         ro[i].light = so->light;
+        if (so->links == 0)
+            continue;
+        unsigned char *mine = lit + (size_t)(so->links - 1) * scene->n_lights;
+        ro[i].lit = mine;
+        for (size_t k = 0; k < scene->n_lights; k++)
+            mine[k] = (unsigned char)scene_object_lit_by(scene, i, k);
     }
     return ro;
 }

@@ -58,6 +58,8 @@ typedef struct Record {
     int n_area;
     RecShader light[REC_MAX]; /* type in name */
     int n_light;
+    int links_mode;           /* the last set_light_links: RayesLightLinks */
+    size_t links[REC_MAX], n_links;
 } Record;
 
 static RayesError rec_camera(void *t, const float eye[3], const float at[3], const float up[3],
@@ -246,6 +248,20 @@ static RayesError rec_light(void *t, const char *type, const RayesParam *p, size
     return RAYES_OK;
 }
 
+static RayesError rec_light_links(void *t, RayesLightLinks mode, const size_t *l, size_t n)
+{
+    Record *r = t;
+    r->calls++;
+    r->links_mode = (int)mode;
+    r->n_links = n < REC_MAX ? n : REC_MAX;
+    memcpy(r->links, l, r->n_links * sizeof *l);
+    return RAYES_OK;
+}
+static size_t rec_light_count(void *t)
+{
+    Record *r = t;
+    return (size_t)(r->n_light + r->n_area);
+}
 static const char *rec_error(void *t)
 {
     (void)t;
@@ -271,6 +287,8 @@ static IoSink record_sink(Record *r)
                     .quadric = rec_quadric,
                     .area_light = rec_area_light,
                     .light = rec_light,
+                    .set_light_links = rec_light_links,
+                    .light_count = rec_light_count,
                     .get_error = rec_error};
 }
 

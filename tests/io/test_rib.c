@@ -36,6 +36,8 @@ typedef struct Rec {
     float Cs[3];
     int n_shader_calls;
     int bilinear, bicubic, meshes, faces, tris, quads, quadrics, area_lights, lights;
+    int link_calls, links_mode;  /* set_light_links calls, the last one's mode */
+    size_t links[8], n_links;    /* and its lights */
     float first_bicubic[16][3];
     float last_mesh_P0[3];
     float area_P[4][3];
@@ -197,6 +199,21 @@ static RayesError s_light(void *t, const char *type, const RayesParam *p, size_t
     rec.lights++;
     return RAYES_OK;
 }
+static RayesError s_links(void *t, RayesLightLinks mode, const size_t *l, size_t n)
+{
+    (void)t;
+    rec.link_calls++;
+    rec.links_mode = (int)mode;
+    rec.n_links = n;
+    for (size_t i = 0; i < n && i < 8; i++)
+        rec.links[i] = l[i];
+    return RAYES_OK;
+}
+static size_t s_count(void *t)
+{
+    (void)t;
+    return (size_t)(rec.lights + rec.area_lights);
+}
 static const char *s_error(void *t)
 {
     (void)t;
@@ -206,7 +223,7 @@ static const char *s_error(void *t)
 static const IoSink stub = {NULL,      s_camera,  s_camera_matrix, s_transform, s_shader,
                             s_displacement, s_float, s_search,     s_float,     s_bilinear,
                             s_bicubic, s_mesh,    s_sphere,        s_quadric,   s_area,
-                            s_light,   s_error};
+                            s_light,   s_links,   s_count,   s_error};
 
 static IoSettings settings;
 static char err[1024];
@@ -325,10 +342,26 @@ static void test_shaders_and_lights(void)
     CHECK_NEAR(rec.Cs[0], 1, 0);
     CHECK_NEAR(rec.Cs[1], 0, 0);
     CHECK(rec.quads == 1 && rec.tris == 1);
-    /* Illuminate off before any geometry: the light is not sent */
+    /* Illuminate off before any geometry: the light is sent, and the
+     * geometry is linked to every light except it */
     CHECK(parse(WORLD("LightSource \"pointlight\" 1\nIlluminate 1 0\n"
                       "Polygon \"P\" [0 0 0 1 0 0 1 1 0]")) == RAYES_OK);
+    CHECK(rec.lights == 1 && rec.links_mode == RAYES_LIGHT_LINKS_EXCEPT && rec.n_links == 1);
+    /* ... but not if no geometry follows and it is off at the end */
+    CHECK(parse(WORLD("Polygon \"P\" [0 0 0 1 0 0 1 1 0]\nLightSource \"pointlight\" 1\n"
+                      "Illuminate 1 0")) == RAYES_OK);
     CHECK(rec.lights == 0);
+    /* Illuminate off in an attribute scope: the objects in it are linked
+     * EXCEPT the light; AttributeEnd turns it back on (links ALL) */
+    CHECK(parse(WORLD("LightSource \"pointlight\" 1\nPolygon \"P\" [0 0 0 1 0 0 1 1 0]\n"
+                      "AttributeBegin\nIlluminate 1 0\nPolygon \"P\" [0 0 0 1 0 0 1 1 0]\n"
+                      "AttributeEnd\nPolygon \"P\" [0 0 0 1 0 0 1 1 0]")) == RAYES_OK);
+    CHECK(rec.lights == 1 && rec.link_calls == 2 && rec.links_mode == RAYES_LIGHT_LINKS_ALL);
+    CHECK(parse(WORLD("LightSource \"pointlight\" 1\nPolygon \"P\" [0 0 0 1 0 0 1 1 0]\n"
+                      "AttributeBegin\nIlluminate 1 0\nPolygon \"P\" [0 0 0 1 0 0 1 1 0]\n"
+                      "AttributeEnd")) == RAYES_OK);
+    CHECK(rec.link_calls == 1 && rec.links_mode == RAYES_LIGHT_LINKS_EXCEPT && rec.n_links == 1 &&
+          rec.links[0] == 0);
     CHECK(parse(WORLD("AttributeBegin\nAreaLightSource \"arealight\" 1 \"intensity\" 2\n"
                       "Polygon \"P\" [0 0 0 1 0 0 1 1 0 0 1 0]\nAttributeEnd\n"
                       "Polygon \"P\" [0 0 0 1 0 0 1 1 0 0 1 0]")) == RAYES_OK);

@@ -81,6 +81,14 @@ static void test_calls(void)
     CHECK(k.set_shader(w, "matte", NULL, 0) == RAYES_OK);
     CHECK(k.area_light(w, P4, L) == RAYES_OK);
     CHECK(k.light(w, "pointlight", lp, 2) == RAYES_OK);
+    /* light links as Illuminate: light 1 (handle 2) off, the next light
+     * off after its LightSource, then all on again; area lights untouched */
+    const size_t only0 = 0;
+    CHECK(k.light_count(w) == 2);
+    CHECK(k.set_light_links(w, RAYES_LIGHT_LINKS_ONLY, &only0, 1) == RAYES_OK);
+    CHECK(k.light(w, "ambientlight", NULL, 0) == RAYES_OK);
+    CHECK(k.set_light_links(w, RAYES_LIGHT_LINKS_ALL, NULL, 0) == RAYES_OK);
+    CHECK(k.light_count(w) == 3);
     /* the camera last: it still goes before WorldBegin */
     const float eye[3] = {0, 0, -10}, at[3] = {0, 0, 0}, up[3] = {0, 1, 0};
     CHECK(k.set_camera(w, eye, at, up, 30) == RAYES_OK);
@@ -131,6 +139,9 @@ static void test_calls(void)
     CHECK(has(t, "AttributeBegin\nAreaLightSource \"arealight\" 1 \"color lightcolor\" [17 12 4]\n"
                  "Polygon \"P\" [0 0 0 1 0 0 0 1 0 1 1 0]\nAttributeEnd\n"));
     CHECK(has(t, "LightSource \"pointlight\" 2 \"point from\" [1 2 3] \"float intensity\" [4]\n"));
+    CHECK(has(t, "[4]\nIlluminate 2 0\nLightSource \"ambientlight\" 3\nIlluminate 3 0\n"
+                 "Illuminate 2 1\nIlluminate 3 1\n"));
+    CHECK(!has(t, "Illuminate 1"));
     CHECK(has(t, "WorldEnd\n"));
     free(t);
     io_rib_writer_free(w);
