@@ -195,6 +195,13 @@ int main(int argc, char **argv)
                ph[k].n > 1 ? rest / (ph[k].n - 1) : 0.0, total, 100 * ph[k].hit[0],
                100 * ph[k].hit[1], 100 * ph[k].hit[2], ph[k].fills, ph[k].shading_points);
     }
+    printf("\npass times (s):\n");
+    for (int k = 0; k < 3; k++) {
+        printf("  %-28s", ph[k].name);
+        for (int i = 0; i < ph[k].n; i++)
+            printf(" %.3f", ph[k].pass_s[i]);
+        printf("\n");
+    }
     printf("\nfirst pass after a light edit / after a camera move: %.2f\n\n",
            ph[2].pass_s[0] / ph[1].pass_s[0]);
 

@@ -110,7 +110,9 @@ static RayesError image_of(View *v, RayesImage **img)
     RayesError e = rayes_session_image(v->session, img);
     if (e != RAYES_OK)
         return e;
+    pthread_mutex_lock(&v->lock); /* the window thread sets them */
     float gain = exp2f(v->exposure), g = v->gamma;
+    pthread_mutex_unlock(&v->lock);
     size_t n = (size_t)(*img)->width * (size_t)(*img)->height;
     if (gain != 1.0f || g != 1.0f)
         for (size_t i = 0; i < n; i++)
