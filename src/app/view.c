@@ -159,6 +159,14 @@ static int pick(View *v, const char *at, int64_t *object, char *err, size_t n)
     return 0;
 }
 
+/* The scene's error as the command's (cleared for the next edit): -1. */
+static int scene_failed(View *v, char *err, size_t n)
+{
+    snprintf(err, n, "%s", rayes_scene_get_error(v->scene));
+    rayes_scene_clear_error(v->scene);
+    return -1;
+}
+
 /* Runs one command; *edited is set when the scene changed (commit and
  * update follow). Returns 0, 1 for quit, or -1 with err filled. */
 static int run_command(View *v, const char *cmd, int *edited, char *err, size_t n)
@@ -214,8 +222,13 @@ static int run_command(View *v, const char *cmd, int *edited, char *err, size_t 
             snprintf(err, n, "light: expected an index and intensity, color, translate or scale");
             return -1;
         }
-        float f[3];
+        float f[3], now = 0.0f, c[3] = {0, 0, 0};
         int count = parse_floats(rest + k, f, 3);
+        int relative = strcmp(name, "scale") == 0 || strcmp(name, "tint") == 0;
+        if (relative && rayes_scene_get_light(v->scene, (size_t)index, &now, c, NULL) != RAYES_OK) {
+            snprintf(err, n, "light: no light %ld", index);
+            return -1;
+        }
         RayesParam p = {0};
         if (strcmp(name, "intensity") == 0 && count == 1)
             p = (RayesParam){"intensity", RAYES_PARAM_FLOAT, {f[0], 0, 0}, NULL};
@@ -226,18 +239,8 @@ static int run_command(View *v, const char *cmd, int *edited, char *err, size_t 
             Vec3 t = v3_scale(v3_add(v3_scale(x, f[0]), v3_scale(v->up, f[1])), d);
             p = (RayesParam){"translate", RAYES_PARAM_COLOR, {t.x, t.y, t.z}, NULL};
         } else if (strcmp(name, "scale") == 0 && count == 1) {
-            float now = 0.0f;
-            if (rayes_scene_get_light(v->scene, (size_t)index, &now, NULL, NULL) != RAYES_OK) {
-                snprintf(err, n, "light: no light %ld", index);
-                return -1;
-            }
             p = (RayesParam){"intensity", RAYES_PARAM_FLOAT, {now * f[0], 0, 0}, NULL};
         } else if (strcmp(name, "tint") == 0 && count == 3) {
-            float c[3];
-            if (rayes_scene_get_light(v->scene, (size_t)index, NULL, c, NULL) != RAYES_OK) {
-                snprintf(err, n, "light: no light %ld", index);
-                return -1;
-            }
             float m = fmaxf(c[0], fmaxf(c[1], c[2]));
             p = (RayesParam){"lightcolor", RAYES_PARAM_COLOR, {f[0] * m, f[1] * m, f[2] * m}, NULL};
         } else if ((strcmp(name, "color") == 0 || strcmp(name, "translate") == 0) && count == 3)
@@ -249,9 +252,7 @@ static int run_command(View *v, const char *cmd, int *edited, char *err, size_t 
             return -1;
         }
         if (rayes_scene_edit_light(v->scene, (size_t)index, &p, 1) != RAYES_OK) {
-            snprintf(err, n, "%s", rayes_scene_get_error(v->scene));
-            rayes_scene_clear_error(v->scene);
-            return -1;
+            return scene_failed(v, err, n);
         }
         *edited = 1;
         return 0;
@@ -296,9 +297,7 @@ static int run_command(View *v, const char *cmd, int *edited, char *err, size_t 
             return -1;
         }
         if (rayes_scene_edit_shader(v->scene, (size_t)object, &p, 1) != RAYES_OK) {
-            snprintf(err, n, "%s", rayes_scene_get_error(v->scene));
-            rayes_scene_clear_error(v->scene);
-            return -1;
+            return scene_failed(v, err, n);
         }
         *edited = 1;
         return 0;
@@ -329,9 +328,7 @@ static int run_command(View *v, const char *cmd, int *edited, char *err, size_t 
             return -1;
         }
         if (move_camera(v, m) != RAYES_OK) {
-            snprintf(err, n, "%s", rayes_scene_get_error(v->scene));
-            rayes_scene_clear_error(v->scene);
-            return -1;
+            return scene_failed(v, err, n);
         }
         *edited = 1;
         return 0;

@@ -113,20 +113,18 @@ RayesError rayes_session_new(RayesScene *scene, const RayesRenderOptions *option
     *out = s;
     return RAYES_OK;
 fail:
-    free(s->prep);
-    cache_free(s->cache);
-    texture_system_free(s->textures);
-    free(s->accum);
-    free(s->rgba);
-    free(s);
+    rayes_session_free(s);
     return e;
 }
 
+/* Also frees a session that rayes_session_new gave up on part way (no
+ * scene reference yet, prep NULL or emptied by a failed prepare). */
 void rayes_session_free(RayesSession *s)
 {
     if (!s)
         return;
-    session_prepared_fini(s->prep);
+    if (s->prep)
+        session_prepared_fini(s->prep);
     free(s->prep);
     cache_free(s->cache);
     texture_system_free(s->textures);
