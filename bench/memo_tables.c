@@ -227,7 +227,7 @@ static void parse(int argc, char **argv, Args *a)
             die("unknown option (see the comment at the top of bench/memo_tables.c)");
     }
     if (a->accuracy_size == 0)
-        a->accuracy_size = a->size / 2;
+        a->accuracy_size = a->size;
     if (strcmp(a->mode, "table2") == 0)
         a->quality = RAYES_QUALITY_FINAL;
     if ((strcmp(a->mode, "table1") && strcmp(a->mode, "table2") && strcmp(a->mode, "table4") &&

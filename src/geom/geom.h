@@ -3,8 +3,9 @@
  *
  * A primitive (bilinear patch, bicubic Bezier patch, triangle, sphere) is
  * split into patches small enough to dice into one grid of at most
- * GEOM_MAX_GRID x GEOM_MAX_GRID vertices (triangles: a triangular grid of at
- * most GEOM_MAX_GRID - 1 subdivisions per edge). The dicing rate comes from
+ * GEOM_GRID_SIZE micropolygons (RenderMan's "gridsize"), no side longer than
+ * GEOM_MAX_GRID vertices; triangles into triangular grids of at most
+ * GEOM_MAX_TRI subdivisions per edge. The dicing rate comes from
  * the camera: a micropolygon edge of about sqrt(shading rate) pixels at the
  * patch's distance from the eye, whether or not the patch is in view (the
  * "spherical projection" of RenderMan), at least one micropolygon per side.
@@ -27,7 +28,9 @@
 
 #include "util/vec.h"
 
-#define GEOM_MAX_GRID 17 /* vertices per side: 16 x 16 micropolygons */
+#define GEOM_GRID_SIZE 256 /* micropolygons per quad grid, at most (RenderMan's default) */
+#define GEOM_MAX_GRID 65   /* vertices per side of a quad grid, at most */
+#define GEOM_MAX_TRI 16    /* subdivisions per edge of a triangular grid, at most */
 
 typedef enum PrimType {
     PRIM_BILINEAR = 1, /* cp[0..3] = P00, P10, P01, P11 */

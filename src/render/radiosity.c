@@ -94,7 +94,14 @@ static size_t level_values(const Grid *g, int level)
     return (size_t)quad_level_points(level, g->nu) * (size_t)quad_level_points(level, g->nv);
 }
 
-/* Mean micropolygon edge of a level. */
+/* Micropolygon edge of a level: the grid's mean edge times the longer
+ * side of the level's cell in fine edges. (The longer side, not the mean
+ * of the two: grids of RenderMan's gridsize are often 2:1, and a 10 x 20
+ * grid's coarse cell spans 20 edges. Bilinear interpolation of a peaked
+ * radiosity, like the floor under the light, undershoots by about h^2/8
+ * of its curvature over a cell of side h; measured on the box at 3
+ * bounces, the worst 32 x 32 tile against the uncached image went from
+ * 2.86% with the mean to 2.23% with the longer side.) */
 static float level_edge(const Grid *g, int level)
 {
     if (level == CACHE_FINE)
@@ -105,8 +112,9 @@ static float level_edge(const Grid *g, int level)
     }
     float su = g->nu - 1, sv = g->nv - 1;
     if (level == CACHE_COARSE)
-        return g->edge * 0.5f * (su + sv);
-    return g->edge * 0.5f * (su / (medium_knots(g->nu) - 1) + sv / (medium_knots(g->nv) - 1));
+        return g->edge * fmaxf(su, sv);
+    return g->edge *
+           fmaxf(su / (float)(medium_knots(g->nu) - 1), sv / (float)(medium_knots(g->nv) - 1));
 }
 
 /* The largest angle (radians) a level's micropolygon may bend through,

@@ -123,7 +123,8 @@ static void test_dicing_rate_from_camera(void)
     geom_gridset_fini(&gs);
 }
 
-/* A large patch splits into grids of at most 17 x 17, covering it exactly. */
+/* A large patch splits into grids of at most GEOM_GRID_SIZE micropolygons,
+ * covering it exactly. */
 static void test_split_limits_grid_size(void)
 {
     GridSet gs;
@@ -136,12 +137,41 @@ static void test_split_limits_grid_size(void)
     for (size_t g = 0; g < gs.n_grids; g++) {
         const Grid *gr = &gs.grids[g];
         CHECK(gr->nu >= 2 && gr->nu <= GEOM_MAX_GRID && gr->nv >= 2 && gr->nv <= GEOM_MAX_GRID);
+        CHECK((gr->nu - 1) * (gr->nv - 1) <= GEOM_GRID_SIZE);
         CHECK(gr->prim == 7);
         area += (gr->uv[1][0] - gr->uv[0][0]) * (gr->uv[1][1] - gr->uv[0][1]);
         const Vec3 *P = &gs.P[gr->first_vertex];
         CHECK(P[0].z == 0.0f);
     }
     CHECK_NEAR(area, 1.0, 1e-6);
+    geom_gridset_fini(&gs);
+}
+
+/* RenderMan's gridsize rule: a 20 x 20 square (400 micropolygons) splits
+ * once, across u, into two 10 x 20 grids, where a rule of 16 per side
+ * would have made four 10 x 10 grids; a 40 x 2 strip (80 micropolygons)
+ * stays whole; a 100 x 1 strip splits only for the side limit. */
+static void test_split_by_area(void)
+{
+    GridSet gs;
+    geom_gridset_init(&gs);
+    DiceCamera cam = camera();
+    Prim sq = bilinear(v3(-10, -10, 0), v3(10, -10, 0), v3(-10, 10, 0), v3(10, 10, 0));
+    CHECK(geom_dice_prim(&gs, &sq, 0, NULL, &cam) == 0);
+    CHECK(gs.n_grids == 2);
+    for (size_t g = 0; g < gs.n_grids; g++)
+        CHECK(gs.grids[g].nu == 11 && gs.grids[g].nv == 21);
+    CHECK_NEAR(gs.grids[0].uv[1][0], 0.5, 1e-6);
+    geom_gridset_fini(&gs);
+    Prim strip = bilinear(v3(-20, -1, 0), v3(20, -1, 0), v3(-20, 1, 0), v3(20, 1, 0));
+    CHECK(geom_dice_prim(&gs, &strip, 0, NULL, &cam) == 0);
+    CHECK(gs.n_grids == 1 && gs.grids[0].nu == 41 && gs.grids[0].nv == 3);
+    geom_gridset_fini(&gs);
+    Prim line = bilinear(v3(-50, -0.5f, 0), v3(50, -0.5f, 0), v3(-50, 0.5f, 0), v3(50, 0.5f, 0));
+    CHECK(geom_dice_prim(&gs, &line, 0, NULL, &cam) == 0);
+    CHECK(gs.n_grids == 2);
+    for (size_t g = 0; g < gs.n_grids; g++)
+        CHECK(gs.grids[g].nu <= GEOM_MAX_GRID && gs.grids[g].nv == 2);
     geom_gridset_fini(&gs);
 }
 
@@ -186,12 +216,12 @@ static void test_triangle_grid_counts(void)
     CHECK(geom_dice_prim(&gs, &t, 0, NULL, &cam) == 0);
     CHECK((gs.n_grids - 1) % 3 == 0 && gs.n_grids >= 16);
     for (size_t g = 0; g < gs.n_grids; g++)
-        CHECK(gs.grids[g].nu <= GEOM_MAX_GRID - 1);
+        CHECK(gs.grids[g].nu <= GEOM_MAX_TRI);
     geom_gridset_fini(&gs);
 }
 
 TEST_MAIN(TEST(test_bezier_basis), TEST(test_bicubic_reproduces_bilinear),
           TEST(test_bilinear_known_values), TEST(test_sphere_eval_and_normal),
           TEST(test_degenerate_bicubic_normal), TEST(test_dicing_rate_from_camera),
-          TEST(test_split_limits_grid_size), TEST(test_distance_based_rates),
-          TEST(test_triangle_grid_counts))
+          TEST(test_split_limits_grid_size), TEST(test_split_by_area),
+          TEST(test_distance_based_rates), TEST(test_triangle_grid_counts))
