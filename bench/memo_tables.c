@@ -20,7 +20,7 @@
  * images at one bounce, the relative RMSE and mean relative error of preview
  * and final against the reference, 20x difference images, and times.
  * Both then measure bias: the same rows at --accuracy-spp pixel samples
- * (default 64) and --accuracy-size pixels (default: half of --size), the
+ * (default 64) and --accuracy-size pixels (default: --size, the table's own), the
  * relative difference of the cached and uncached image means and the
  * largest relative difference of their 32 x 32 tile means. Images (PNG) and
  * a JSON record of every row go to --out (default bench-out/).
