@@ -269,10 +269,12 @@ void geom_grid_measure(GridSet *gs, Grid *g)
 static int dice_quad(GridSet *gs, const Prim *prim, uint32_t prim_index, const float *pool,
                      const Domain *d, Estimate e)
 {
-    /* Clamped only when splitting gave up (degenerate input). */
+    /* Clamped to a square of GEOM_GRID_SIZE only when splitting gave up
+     * (degenerate input). */
     if ((int64_t)e.n_u * e.n_v > GEOM_GRID_SIZE) {
-        e.n_u = RY_MIN(e.n_u, GEOM_MAX_TRI);
-        e.n_v = RY_MIN(e.n_v, GEOM_MAX_TRI);
+        const int side = 16; /* sqrt(GEOM_GRID_SIZE) */
+        e.n_u = RY_MIN(e.n_u, side);
+        e.n_v = RY_MIN(e.n_v, side);
     }
     int nu = RY_MIN(e.n_u, GEOM_MAX_GRID - 1) + 1, nv = RY_MIN(e.n_v, GEOM_MAX_GRID - 1) + 1;
     if (reserve(gs, (size_t)nu * nv, prim->pv) != 0)
