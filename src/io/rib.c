@@ -2834,6 +2834,8 @@ static int h_frame_begin(Rib *r, const Args *a)
     float n = 0;
     if (i < a->n && get_floats(r, a, &i, &n, 1, "a frame number") != 0)
         return -1;
+    if (!(fabsf(n) <= 1e9f) || n != floorf(n))
+        return rib_error(r, "the frame number must be an integer, found %g", n);
     if (r->in_frame)
         return rib_error(r, "FrameBegin inside a frame");
     long ordinal = r->frame_ordinal++;

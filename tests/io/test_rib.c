@@ -626,6 +626,8 @@ static void test_errors(void)
         {"Attribute \"x\" \"float[0] y\" 1\n", "inline declaration"},
         {"ObjectBegin 1\nSphere 1 -1 1 360\n", "inside an object definition"},
         {"Polygon \x01", "unexpected character 0x01"},
+        {"FrameBegin -2.35e38\n", "t.rib:1:1: FrameBegin: the frame number must be an integer"},
+        {"FrameBegin 1.5\n", "must be an integer, found 1.5"},
     };
     for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
         RayesError e = parse(cases[i].text);
