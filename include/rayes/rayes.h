@@ -442,6 +442,9 @@ typedef struct RayesRenderOptions {
                                   default 1; 0 point-samples the finest MIP level */
     RayesTileFn tile_done;     /* may be NULL: called as each tile of a render or pass ends */
     void *tile_user;
+    int grid_size;             /* micropolygons per grid, at most (RenderMan's "gridsize"):
+                                  1 to 4096, default 256; smaller grids mean more, smaller
+                                  radiosity cache entries */
 } RayesRenderOptions;
 
 /* Fills options with the defaults of a quality preset: 512 x 512, 4 pixel

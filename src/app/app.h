@@ -18,7 +18,8 @@ enum {
     SET_FILTER = 4,
     SET_FILTER_WIDTH = 8,
     SET_BOUNCES = 16,
-    SET_SPECULAR_DEPTH = 32
+    SET_SPECULAR_DEPTH = 32,
+    SET_GRID_SIZE = 64
 };
 
 /* An image to write. */

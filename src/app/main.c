@@ -76,6 +76,8 @@ static void usage(FILE *f)
           "  --cache-resolution R    auto (by ray differentials), coarse, medium or fine\n"
           "  --cache-k K             use the coarsest resolution whose micropolygons are at\n"
           "                          most K times the ray footprint (default 1)\n"
+          "  --gridsize N            micropolygons per grid, at most (default 256, or the\n"
+          "                          scene file's; 1 to 4096): the size of a cache entry\n"
           "  --hider raytrace|grid   shade every camera hit (default), or once per vertex of\n"
           "                          each visible grid and interpolate (PRMan's REYES mode;\n"
           "                          default for --quality final)\n"
@@ -264,7 +266,10 @@ void parse_args(int argc, char **argv, Args *a)
             opt->cache_resolution = parse_resolution(v);
         else if (strcmp(o, "--cache-k") == 0)
             opt->cache_k = parse_float(o, v, 1e-3f, 1e3f);
-        else if (strcmp(o, "--hider") == 0) {
+        else if (strcmp(o, "--gridsize") == 0) {
+            opt->grid_size = (int)parse_long(o, v, 1, 4096);
+            a->set |= SET_GRID_SIZE;
+        } else if (strcmp(o, "--hider") == 0) {
             if (strcmp(v, "raytrace") != 0 && strcmp(v, "grid") != 0)
                 die_usage("--hider: expected raytrace or grid, got \"%s\"", v);
             opt->hider = strcmp(v, "grid") == 0 ? RAYES_HIDER_GRID : RAYES_HIDER_RAYTRACE;
@@ -441,6 +446,8 @@ void merge_settings(Args *a, const IoSettings *s)
         o->bounces = s->bounces < 64 ? s->bounces : 64;
     if (!(a->set & SET_SPECULAR_DEPTH) && s->specular_depth >= 0)
         o->specular_depth = s->specular_depth < 64 ? s->specular_depth : 64;
+    if (!(a->set & SET_GRID_SIZE) && s->grid_size > 0)
+        o->grid_size = s->grid_size;
     if (s->crop[0] != 0.0f || s->crop[1] != 1.0f || s->crop[2] != 0.0f || s->crop[3] != 1.0f)
         fprintf(stderr, "rayes: warning: %s: CropWindow is not supported; the whole image is "
                         "rendered\n", a->scene);

@@ -6,10 +6,11 @@
  * parameters, or for triangles a sub-triangle given by three barycentric
  * corners. Its size is estimated on a 5 x 5 lattice of surface points. As
  * in RenderMan, a quad domain whose grid at the camera's rate would hold
- * more than GEOM_GRID_SIZE micropolygons (or more than GEOM_MAX_GRID - 1
- * along a side) is split in two across its longer direction; a triangle
- * needing more than GEOM_MAX_TRI subdivisions per edge is split in four at
- * its edge midpoints. Each part is estimated again, nearer parts getting
+ * more than gridsize micropolygons (256 by default, or more than
+ * GEOM_MAX_GRID - 1 along a side) is split in two across its longer
+ * direction; a triangle needing more than sqrt(gridsize) subdivisions per
+ * edge (so more than gridsize micro-triangles) is split in four at its edge
+ * midpoints. Each part is estimated again, nearer parts getting
  * finer rates. The area rule gives grids of 128 to 256 micropolygons where
  * a per-side rule of 16 gave 64 to 256: on the benchmark box at 1024 x 1024,
  * 17,158 grids of 3.61 M vertices, against the memo's "approximately 18,000
@@ -266,15 +267,29 @@ void geom_grid_measure(GridSet *gs, Grid *g)
     g->curvature = curv;
 }
 
-static int dice_quad(GridSet *gs, const Prim *prim, uint32_t prim_index, const float *pool,
-                     const Domain *d, Estimate e)
+/* The limits of one grid: micropolygons, and the side of a square of
+ * that many (a triangle's subdivisions per edge). */
+typedef struct Limits {
+    int size, side;
+} Limits;
+
+static Limits limits_of(const DiceCamera *cam)
 {
-    /* Clamped to a square of GEOM_GRID_SIZE only when splitting gave up
+    Limits l = {cam->grid_size > 0 ? RY_MIN(cam->grid_size, GEOM_MAX_GRID_SIZE) : GEOM_GRID_SIZE,
+                1};
+    while ((l.side + 1) * (l.side + 1) <= l.size)
+        l.side++;
+    return l;
+}
+
+static int dice_quad(GridSet *gs, const Prim *prim, uint32_t prim_index, const float *pool,
+                     const Domain *d, Estimate e, Limits lim)
+{
+    /* Clamped to a square of lim.size only when splitting gave up
      * (degenerate input). */
-    if ((int64_t)e.n_u * e.n_v > GEOM_GRID_SIZE) {
-        const int side = 16; /* sqrt(GEOM_GRID_SIZE) */
-        e.n_u = RY_MIN(e.n_u, side);
-        e.n_v = RY_MIN(e.n_v, side);
+    if ((int64_t)e.n_u * e.n_v > lim.size) {
+        e.n_u = RY_MIN(e.n_u, lim.side);
+        e.n_v = RY_MIN(e.n_v, lim.side);
     }
     int nu = RY_MIN(e.n_u, GEOM_MAX_GRID - 1) + 1, nv = RY_MIN(e.n_v, GEOM_MAX_GRID - 1) + 1;
     if (reserve(gs, (size_t)nu * nv, prim->pv) != 0)
@@ -297,9 +312,9 @@ static int dice_quad(GridSet *gs, const Prim *prim, uint32_t prim_index, const f
 }
 
 static int dice_triangle(GridSet *gs, const Prim *prim, uint32_t prim_index, const float *pool,
-                         const Domain *d, Estimate e)
+                         const Domain *d, Estimate e, Limits lim)
 {
-    uint32_t n = (uint32_t)RY_MIN(e.n_u, GEOM_MAX_TRI);
+    uint32_t n = (uint32_t)RY_MIN(e.n_u, lim.side);
     size_t count = (size_t)(n + 1) * (n + 2) / 2;
     if (reserve(gs, count, prim->pv) != 0)
         return -1;
@@ -324,12 +339,13 @@ static int split_dice(GridSet *gs, const Prim *prim, uint32_t prim_index, const 
                       const Domain *d, const DiceCamera *cam, int depth)
 {
     Estimate e = estimate(prim, d, cam);
-    int split = d->triangular ? e.n_u > GEOM_MAX_TRI
-                              : (int64_t)e.n_u * e.n_v > GEOM_GRID_SIZE ||
+    Limits lim = limits_of(cam);
+    int split = d->triangular ? e.n_u > lim.side
+                              : (int64_t)e.n_u * e.n_v > lim.size ||
                                     e.n_u > GEOM_MAX_GRID - 1 || e.n_v > GEOM_MAX_GRID - 1;
     if (!split || depth >= MAX_SPLIT_DEPTH)
-        return d->triangular ? dice_triangle(gs, prim, prim_index, pool, d, e)
-                             : dice_quad(gs, prim, prim_index, pool, d, e);
+        return d->triangular ? dice_triangle(gs, prim, prim_index, pool, d, e, lim)
+                             : dice_quad(gs, prim, prim_index, pool, d, e, lim);
     if (d->triangular) {
         /* Four sub-triangles at the edge midpoints; corners 0, 1, 2 first,
          * the middle one last. */

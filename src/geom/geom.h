@@ -3,9 +3,10 @@
  *
  * A primitive (bilinear patch, bicubic Bezier patch, triangle, sphere) is
  * split into patches small enough to dice into one grid of at most
- * GEOM_GRID_SIZE micropolygons (RenderMan's "gridsize"), no side longer than
- * GEOM_MAX_GRID vertices; triangles into triangular grids of at most
- * GEOM_MAX_TRI subdivisions per edge. The dicing rate comes from
+ * "gridsize" micropolygons (RenderMan's limit, GEOM_GRID_SIZE unless the
+ * options say otherwise), no side longer than GEOM_MAX_GRID vertices;
+ * triangles into triangular grids of at most sqrt(gridsize) subdivisions
+ * per edge (GEOM_MAX_TRI by default). The dicing rate comes from
  * the camera: a micropolygon edge of about sqrt(shading rate) pixels at the
  * patch's distance from the eye, whether or not the patch is in view (the
  * "spherical projection" of RenderMan), at least one micropolygon per side.
@@ -28,9 +29,11 @@
 
 #include "util/vec.h"
 
-#define GEOM_GRID_SIZE 256 /* micropolygons per quad grid, at most (RenderMan's default) */
+#define GEOM_GRID_SIZE 256 /* micropolygons per grid, at most, by default (RenderMan's) */
 #define GEOM_MAX_GRID 65   /* vertices per side of a quad grid, at most */
-#define GEOM_MAX_TRI 16    /* subdivisions per edge of a triangular grid, at most */
+#define GEOM_MAX_TRI 16    /* subdivisions per edge of a triangular grid, by default
+                              (sqrt(GEOM_GRID_SIZE)); GEOM_MAX_GRID - 1 at most */
+#define GEOM_MAX_GRID_SIZE ((GEOM_MAX_GRID - 1) * (GEOM_MAX_GRID - 1)) /* largest gridsize */
 
 typedef enum PrimType {
     PRIM_BILINEAR = 1, /* cp[0..3] = P00, P10, P01, P11 */
@@ -141,12 +144,14 @@ typedef struct GridSet {
     size_t cap_grids, cap_vertices;
 } GridSet;
 
-/* How the camera sets dicing rates. */
+/* How the camera sets dicing rates, and how large a grid may be. */
 typedef struct DiceCamera {
     Vec3 eye;              /* camera position, world */
     float pixel_angle;     /* radians subtended by one pixel (0 in orthographic projection) */
     float pixel_width;     /* world units of one pixel at any distance (orthographic; else 0) */
     float min_distance;    /* distances are clamped to this (the eye inside a patch) */
+    int grid_size;         /* micropolygons per grid, at most (RenderMan's "gridsize"), 1 to
+                              GEOM_MAX_GRID_SIZE; 0: GEOM_GRID_SIZE */
 } DiceCamera;
 
 void geom_gridset_init(GridSet *gs);

@@ -2088,6 +2088,20 @@ static int search_path(Rib *r, const char *kind, const char *path)
     return 0;
 }
 
+/* Option "limits" "gridsize": RenderMan's micropolygons per grid. rayes'
+ * grids have at most 64 x 64 micropolygons, so a larger value is clamped. */
+static int set_grid_size(Rib *r, double g)
+{
+    if (!(g >= 1 && g <= 1e9) || g != floor(g))
+        return rib_error(r, "Option \"limits\" \"gridsize\": expected a positive integer, "
+                            "found %g", g);
+    if (g > 4096)
+        warn_once(r, "gridsize", "Option \"limits\" \"gridsize\" %.0f: clamped to 4096 "
+                                 "(64 x 64 micropolygons)", g);
+    r->settings->grid_size = g > 4096 ? 4096 : (int)g;
+    return 0;
+}
+
 static int h_option_attribute(Rib *r, const Args *a)
 {
     size_t i = 0;
@@ -2114,6 +2128,9 @@ static int h_option_attribute(Rib *r, const Args *a)
                 r->settings->bounces = depth;
             else
                 r->settings->specular_depth = depth;
+        } else if (option && strcmp(group, "limits") == 0 &&
+                   strcmp(q->d.name, "gridsize") == 0 && is_num(q->v) && q->v->n == 1) {
+            e = set_grid_size(r, q->v->d[0]);
         } else if (!option && strcmp(group, "identifier") == 0) {
             /* names are for messages only */
         } else if (!(!option && strcmp(group, "displacementbound") == 0)) {

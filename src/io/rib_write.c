@@ -658,6 +658,8 @@ static void settings_rib(FILE *f, const IoSettings *s)
         fprintf(f, "PixelFilter \"%s\" %.9g %.9g\n",
                 s->filter == RAYES_FILTER_BOX ? "box" : "gaussian", fw, fw);
     }
+    if (s->grid_size > 0)
+        fprintf(f, "Option \"limits\" \"int gridsize\" [%d]\n", s->grid_size);
     if (s->exposure_gain != 1.0f || s->exposure_gamma != 1.0f)
         fprintf(f, "Exposure %.9g %.9g\n", (double)s->exposure_gain, (double)s->exposure_gamma);
     if (s->crop[0] != 0.0f || s->crop[1] != 1.0f || s->crop[2] != 0.0f || s->crop[3] != 1.0f)

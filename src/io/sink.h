@@ -82,6 +82,8 @@ typedef struct IoSettings {
     float filter_width;       /* pixels; 0: not given */
     int bounces;              /* maximum diffuse depth; -1: not given */
     int specular_depth;       /* maximum specular depth; -1: not given */
+    int grid_size;            /* micropolygons per grid, at most (RIB Option "limits"
+                                 "gridsize"); 0: not given */
     float crop[4];            /* xmin xmax ymin ymax in [0, 1] (RIB CropWindow); default 0 1 0 1 */
     float exposure_gain;      /* RIB Exposure; 1 when not given */
     float exposure_gamma;     /* RIB Exposure; 1 when not given */

@@ -80,6 +80,7 @@ typedef struct RenderSettings {
     Cache *cache;                 /* the radiosity cache, or NULL: uncached */
     int cache_resolution;         /* -1: by differentials; else a forced CacheLevel */
     float cache_k;                /* resolution rule constant (DESIGN.md) */
+    int grid_size;                /* micropolygons per grid, at most (dicing; geom.h) */
     int hider;                    /* 0: shade at every camera hit; 1: the grid hider (hider.h) */
     int irradiance;               /* 1: irradiance interpolation at depth 0 (irrgrid.h; grid
                                      hider only) */

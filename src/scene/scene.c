@@ -777,8 +777,8 @@ Bounds3 scene_bounds(const RayesScene *s)
     return b;
 }
 
-int scene_prepare(const RayesScene *s, int width, int height, TextureSystem *textures,
-                  GridSet *gs)
+int scene_prepare(const RayesScene *s, int width, int height, int grid_size,
+                  TextureSystem *textures, GridSet *gs)
 {
     DicingServices sv;
     shade_dicing_services_init(&sv, textures);
@@ -792,6 +792,7 @@ int scene_prepare(const RayesScene *s, int width, int height, TextureSystem *tex
     cam.pixel_angle = s->camera.tan_half_fov * pixel;
     cam.pixel_width = s->camera.tan_half_fov > 0.0f ? 0.0f : pixel * v3_length(s->camera.y);
     cam.min_distance = 1e-3f * fmaxf(radius, 1e-6f);
+    cam.grid_size = grid_size;
     for (size_t i = 0; i < s->n_prims; i++) {
         size_t first = gs->n_grids;
         if (geom_dice_prim(gs, &s->prims[i], (uint32_t)i, s->pv, &cam) != 0)

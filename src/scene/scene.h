@@ -112,11 +112,12 @@ static inline void scene_mark(RayesScene *scene, SceneChange change)
 }
 
 /* Dices every primitive of a committed scene for its camera making an
- * image of width x height pixels, and runs displacement
- * shaders (whose texture lookups read from textures, which may be NULL).
- * Returns 0, or -1 when out of memory. */
-int scene_prepare(const RayesScene *scene, int width, int height, TextureSystem *textures,
-                  GridSet *gs);
+ * image of width x height pixels, in grids of at most grid_size
+ * micropolygons (0: GEOM_GRID_SIZE), and runs displacement shaders (whose
+ * texture lookups read from textures, which may be NULL). Returns 0, or -1
+ * when out of memory. */
+int scene_prepare(const RayesScene *scene, int width, int height, int grid_size,
+                  TextureSystem *textures, GridSet *gs);
 
 /* Runs the displacement shaders of the primitives of grids [first_grid,
  * n_grids) of gs (displace.c); normals come from differences over step

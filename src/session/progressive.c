@@ -96,7 +96,7 @@ RayesError rayes_session_new(RayesScene *scene, const RayesRenderOptions *option
         e = session_fail(scene, RAYES_ERROR_OUT_OF_MEMORY, "session: out of memory");
         goto fail;
     }
-    e = session_prepare(scene, s->set.width, s->set.height, s->textures, s->prep);
+    e = session_prepare(scene, &s->set, s->textures, s->prep);
     if (e != RAYES_OK)
         goto fail;
     rayes_scene_retain(scene);
@@ -147,7 +147,7 @@ RayesError rayes_session_update(RayesSession *s)
         Prepared *fresh = malloc(sizeof *fresh);
         if (!fresh)
             return session_fail(scene, RAYES_ERROR_OUT_OF_MEMORY, "session: out of memory");
-        RayesError e = session_prepare(scene, s->set.width, s->set.height, s->textures, fresh);
+        RayesError e = session_prepare(scene, &s->set, s->textures, fresh);
         if (e != RAYES_OK) {
             free(fresh);
             return e;

@@ -13,6 +13,7 @@
 
 #include "accel/accel.h"
 #include "cache/cache.h"
+#include "geom/geom.h"
 #include "rayes/rayes.h"
 #include "render/render.h"
 #include "scene/scene.h"
@@ -59,6 +60,7 @@ void rayes_render_options_init(RayesRenderOptions *o, RayesQuality quality)
     o->cache_split[2] = 0.5f;
     o->cache_resolution = -1;
     o->cache_k = 1.0f;
+    o->grid_size = GEOM_GRID_SIZE;
     o->texture_mb = 64.0;
     o->texture_width = 1.0f;
     switch (quality) {
@@ -117,6 +119,8 @@ RayesError session_check_options(RayesScene *scene, const RayesRenderOptions *o)
              !(o->cache_split[0] + o->cache_split[1] + o->cache_split[2] <= 1.0001f))
         what = "options: cache budget 0 to 1e7 MB, split shares >= 0 summing to at most 1, "
                "k > 0, resolution -1 to 2";
+    else if (o->grid_size < 1 || o->grid_size > GEOM_MAX_GRID_SIZE)
+        what = "options: grid size must be 1 to 4096 micropolygons";
     else if (!(o->texture_mb >= 0.0) || o->texture_mb > 1e7 || !(o->texture_width >= 0.0f) ||
              o->texture_width > 1e3f)
         what = "options: texture cache budget must be 0 to 1e7 MB and texture width 0 to 1000";
@@ -136,7 +140,7 @@ RenderSettings session_settings(const RayesRenderOptions *o)
         .diffuse_rays = o->diffuse_rays, .diffuse_rays_deep = o->diffuse_rays_deep,
         .filter = o->filter == RAYES_FILTER_GAUSSIAN, .filter_width = o->filter_width,
         .seed = o->seed, .progress = o->progress, .progress_user = o->progress_user,
-        .cache_resolution = o->cache_resolution, .cache_k = o->cache_k,
+        .cache_resolution = o->cache_resolution, .cache_k = o->cache_k, .grid_size = o->grid_size,
         .hider = o->hider == RAYES_HIDER_GRID, .irradiance = o->irradiance != 0,
         .tile_done = o->tile_done, .tile_user = o->tile_user,
     };
@@ -204,7 +208,7 @@ RayesError session_fail(RayesScene *scene, RayesError e, const char *msg)
     return e;
 }
 
-RayesError session_prepare(RayesScene *scene, int width, int height, TextureSystem *textures,
+RayesError session_prepare(RayesScene *scene, const RenderSettings *set, TextureSystem *textures,
                            Prepared *p)
 {
     memset(p, 0, sizeof *p);
@@ -212,7 +216,7 @@ RayesError session_prepare(RayesScene *scene, int width, int height, TextureSyst
     p->objects = session_render_objects(scene);
     p->masks = object_masks(scene);
     char err[300] = "";
-    if (!p->objects || !p->masks || scene_prepare(scene, width, height, textures, &p->gs) != 0) {
+    if (!p->objects || !p->masks || scene_prepare(scene, set->width, set->height, set->grid_size, textures, &p->gs) != 0) {
         session_prepared_fini(p);
         return session_fail(scene, RAYES_ERROR_OUT_OF_MEMORY,
                             "render: out of memory preparing the scene");
@@ -279,7 +283,7 @@ RayesError rayes_render(RayesScene *scene, const RayesRenderOptions *opt, RayesI
         e = session_fail(scene, RAYES_ERROR_OUT_OF_MEMORY, "render: out of memory");
         goto done;
     }
-    e = session_prepare(scene, set.width, set.height, textures, &prep);
+    e = session_prepare(scene, &set, textures, &prep);
     if (e != RAYES_OK)
         goto done;
     if (opt->cache) {

@@ -42,9 +42,10 @@ TextureSystem *session_textures(const RayesScene *scene, double mb, float width)
  * NULL when out of memory. */
 RenderObject *session_render_objects(const RayesScene *scene);
 
-/* Dices the scene for its camera at width x height and builds the ray
- * tracing structure. On failure *p is empty and the scene's error set. */
-RayesError session_prepare(RayesScene *scene, int width, int height, TextureSystem *textures,
+/* Dices the scene for its camera at set's width x height and grid size
+ * and builds the ray tracing structure. On failure *p is empty and the
+ * scene's error set. */
+RayesError session_prepare(RayesScene *scene, const RenderSettings *set, TextureSystem *textures,
                            Prepared *p);
 void session_prepared_fini(Prepared *p);
 

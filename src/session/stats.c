@@ -57,6 +57,7 @@ RayesStats *session_stats_new(const RenderSettings *set, const RenderStats *rs, 
     count(s, "lighting/ambient_points", rs->ambient_lookups);
     count(s, "grids", gs->n_grids);
     count(s, "grid_vertices", gs->n_vertices);
+    count(s, "grid_size", (uint64_t)set->grid_size);
     count(s, "memory/peak_rss_bytes", mem_peak_rss_bytes());
     count(s, "memory/accel_bytes", accel_bytes);
     size_t geom_bytes = gs->n_vertices * (4 * sizeof(Vec3) + 2 * sizeof(float)) +

@@ -189,6 +189,8 @@ static void test_usage_errors(void)
     expect_error(2, NULL, ARGS("render", "--res", "16x"), ARGS("--res"));
     expect_error(2, NULL, ARGS("render", "--quality", "best"), ARGS("--quality", "best"));
     expect_error(2, NULL, ARGS("render", "--bogus", "1"), ARGS("--bogus"));
+    expect_error(2, NULL, ARGS("render", "--gridsize", "0"), ARGS("--gridsize", "1 to 4096"));
+    expect_error(2, NULL, ARGS("render", "--gridsize", "5000"), ARGS("--gridsize"));
     expect_error(2, NULL, ARGS("render", "-o", "out.txt"), ARGS("out.txt", ".png"));
     expect_error(2, NULL, ARGS("render", "cornell", "cornell-teapots"), ARGS("one scene"));
     expect_error(2, NULL, ARGS("render", "nosuchscene", "--res", "16"), ARGS("nosuchscene"));
@@ -359,6 +361,30 @@ static void test_render_obj(void)
     CHECK(file_size(SCRATCH_DIR "/room.exr") > 8);
 }
 
+/* RIB's Option "limits" "gridsize" reaches the render unless --gridsize
+ * says otherwise; the statistics say which was used. */
+static void test_rib_grid_size(void)
+{
+    static Run r;
+    char json[8192];
+    setup();
+    write_text(SCRATCH_DIR "/grid.rib", "Option \"limits\" \"gridsize\" [32]\n"
+                                        "Projection \"perspective\" \"fov\" 40\n"
+                                        "WorldBegin\nTranslate 0 0 5\nSphere 1 -1 1 360\n"
+                                        "WorldEnd\n");
+    run(&r, NULL, ARGS("render", SCRATCH_DIR "/grid.rib", "--res", "16", "--spp", "1", "--quiet",
+                       "-o", SCRATCH_DIR "/grid.png", "--stats", SCRATCH_DIR "/grid.json"));
+    CHECK(r.status == 0 && r.err[0] == '\0');
+    read_file(SCRATCH_DIR "/grid.json", json, sizeof json);
+    CHECK(strstr(json, "\"grid_size\": 32,") != NULL);
+    run(&r, NULL, ARGS("render", SCRATCH_DIR "/grid.rib", "--res", "16", "--spp", "1", "--quiet",
+                       "--gridsize", "128", "-o", SCRATCH_DIR "/grid.png", "--stats",
+                       SCRATCH_DIR "/grid.json"));
+    CHECK(r.status == 0);
+    read_file(SCRATCH_DIR "/grid.json", json, sizeof json);
+    CHECK(strstr(json, "\"grid_size\": 128,") != NULL);
+}
+
 static void test_convert(void)
 {
     static Run r;
@@ -409,4 +435,5 @@ static void test_bad_scene_file(void)
 TEST_MAIN(TEST(test_version_and_help), TEST(test_no_arguments), TEST(test_usage_errors),
           TEST(test_missing_data), TEST(test_render_outputs), TEST(test_render_summary),
           TEST(test_data_from_environment), TEST(test_unwritable_output), TEST(test_shader_path),
-          TEST(test_render_obj), TEST(test_convert), TEST(test_bad_scene_file))
+          TEST(test_render_obj), TEST(test_rib_grid_size), TEST(test_convert),
+          TEST(test_bad_scene_file))

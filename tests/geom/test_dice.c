@@ -175,6 +175,47 @@ static void test_split_by_area(void)
     geom_gridset_fini(&gs);
 }
 
+/* The gridsize option: the 20 x 20 square of test_split_by_area in grids of
+ * at most 64 micropolygons (10 x 20, then 10 x 10, then eight 5 x 10
+ * pieces of 50), in one 20 x 20 grid at 400, and at 4096 a 64 x 64 square
+ * stays whole. A triangle then has at most sqrt(gridsize) subdivisions
+ * per edge, and an out-of-range value is clamped to 4096. */
+static void test_grid_size_option(void)
+{
+    GridSet gs;
+    geom_gridset_init(&gs);
+    DiceCamera cam = camera();
+    Prim sq = bilinear(v3(-10, -10, 0), v3(10, -10, 0), v3(-10, 10, 0), v3(10, 10, 0));
+    cam.grid_size = 64;
+    CHECK(geom_dice_prim(&gs, &sq, 0, NULL, &cam) == 0);
+    CHECK(gs.n_grids == 8);
+    for (size_t g = 0; g < gs.n_grids; g++)
+        CHECK(gs.grids[g].nu == 6 && gs.grids[g].nv == 11);
+    geom_gridset_fini(&gs);
+    cam.grid_size = 400;
+    CHECK(geom_dice_prim(&gs, &sq, 0, NULL, &cam) == 0);
+    CHECK(gs.n_grids == 1 && gs.grids[0].nu == 21 && gs.grids[0].nv == 21);
+    geom_gridset_fini(&gs);
+    Prim big = bilinear(v3(-32, -32, 0), v3(32, -32, 0), v3(-32, 32, 0), v3(32, 32, 0));
+    cam.grid_size = 1 << 20;
+    CHECK(geom_dice_prim(&gs, &big, 0, NULL, &cam) == 0);
+    CHECK(gs.n_grids == 1 && gs.grids[0].nu == 65 && gs.grids[0].nv == 65);
+    geom_gridset_fini(&gs);
+    Prim t = {.type = PRIM_TRIANGLE, .shading_rate = 1.0f};
+    t.cp[0] = v3(0, 0, 0), t.cp[1] = v3(100, 0, 0), t.cp[2] = v3(0, 100, 0);
+    for (int size = 16; size <= 4096; size *= 4) {
+        cam.grid_size = size;
+        CHECK(geom_dice_prim(&gs, &t, 0, NULL, &cam) == 0);
+        uint32_t side = 0, biggest = 0;
+        while ((side + 1) * (side + 1) <= (uint32_t)size)
+            side++;
+        for (size_t g = 0; g < gs.n_grids; g++)
+            biggest = gs.grids[g].nu > biggest ? gs.grids[g].nu : biggest;
+        CHECK(biggest <= side && 2 * biggest > side);
+        geom_gridset_fini(&gs);
+    }
+}
+
 /* Nearer parts dice finer: a floor receding from the camera. */
 static void test_distance_based_rates(void)
 {
@@ -223,5 +264,5 @@ static void test_triangle_grid_counts(void)
 TEST_MAIN(TEST(test_bezier_basis), TEST(test_bicubic_reproduces_bilinear),
           TEST(test_bilinear_known_values), TEST(test_sphere_eval_and_normal),
           TEST(test_degenerate_bicubic_normal), TEST(test_dicing_rate_from_camera),
-          TEST(test_split_limits_grid_size), TEST(test_split_by_area),
+          TEST(test_split_limits_grid_size), TEST(test_split_by_area), TEST(test_grid_size_option),
           TEST(test_distance_based_rates), TEST(test_triangle_grid_counts))

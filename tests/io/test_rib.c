@@ -323,6 +323,13 @@ static void test_settings(void)
     CHECK(strcmp(settings.displays[0].type, "openexr") == 0);
     CHECK(parse("PixelFilter \"sinc\" 3 3\nWorldBegin\nWorldEnd\n") == RAYES_OK);
     CHECK(settings.filter == RAYES_FILTER_GAUSSIAN);
+    CHECK(settings.grid_size == 0);
+    CHECK(parse("Option \"limits\" \"gridsize\" [64] \"bucketsize\" [16 16]\nWorldBegin\n"
+                "WorldEnd\n") == RAYES_OK);
+    CHECK(settings.grid_size == 64);
+    CHECK(parse("Option \"limits\" \"integer gridsize\" 100000\nWorldBegin\nWorldEnd\n") ==
+          RAYES_OK);
+    CHECK(settings.grid_size == 4096);
 }
 
 static void test_shaders_and_lights(void)
@@ -628,6 +635,9 @@ static void test_errors(void)
         {"Polygon \x01", "unexpected character 0x01"},
         {"FrameBegin -2.35e38\n", "t.rib:1:1: FrameBegin: the frame number must be an integer"},
         {"FrameBegin 1.5\n", "must be an integer, found 1.5"},
+        {"Option \"limits\" \"gridsize\" 0\n",
+         "t.rib:1:1: Option: Option \"limits\" \"gridsize\": expected a positive integer, found 0"},
+        {"Option \"limits\" \"gridsize\" [16.5]\n", "found 16.5"},
     };
     for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
         RayesError e = parse(cases[i].text);

@@ -100,6 +100,7 @@ static void test_calls(void)
     s.filter = RAYES_FILTER_GAUSSIAN;
     s.filter_width = 3;
     s.exposure_gain = 2;
+    s.grid_size = 64;
     s.n_displays = 2;
     snprintf(s.displays[0].name, sizeof s.displays[0].name, "out.exr");
     snprintf(s.displays[0].type, sizeof s.displays[0].type, "openexr");
@@ -113,6 +114,7 @@ static void test_calls(void)
     CHECK(has(t, "PixelSamples 4 4\n"));
     CHECK(has(t, "PixelFilter \"gaussian\" 3 3\n"));
     CHECK(has(t, "Exposure 2 1\n"));
+    CHECK(has(t, "Option \"limits\" \"int gridsize\" [64]\n"));
     CHECK(has(t, "Display \"out.exr\" \"openexr\" \"rgba\"\n"));
     CHECK(has(t, "Display \"+z.exr\" \"openexr\" \"z\"\n"));
     CHECK(has(t, "Option \"searchpath\" \"string shader\" [\"/a:&\"]\n"));

@@ -1,10 +1,12 @@
 /*
  * The radiosity cache in the renderer (render/): interpolation reproduces a
  * linear function exactly at every resolution, for quad grids of every size
- * and triangular grids of every subdivision; levels alias as documented;
+ * and triangular grids of every subdivision up to the default gridsize, and
+ * of the largest sizes a larger gridsize allows; levels alias as documented;
  * images do not depend on the cache budget (evicted entries refill to the
  * same bytes) nor on threads.
  */
+#include <math.h>
 #include <string.h>
 
 #include "io/builtin.h"
@@ -61,13 +63,20 @@ static size_t tri_values(const Grid *g, int level, uint16_t *v)
     return n;
 }
 
+/* Sides (vertices of a quad grid, subdivisions of a triangular one) up to
+ * GEOM_MAX_GRID: every one to 17, then some of gridsize 4096's. */
+static int next_side(int n)
+{
+    return n < 17 ? n + 1 : n < 33 ? 33 : n < 64 ? 64 : n + 1;
+}
+
 static void test_interpolation_is_exact_for_linear_functions(void)
 {
-    static uint16_t vals[3 * 17 * 17];
+    static uint16_t vals[3 * GEOM_MAX_GRID * GEOM_MAX_GRID];
     int worst_level_checks = 0;
     for (int tri = 0; tri < 2; tri++)
-        for (int nu = tri ? 1 : 2; nu <= (tri ? 16 : 17); nu++)
-            for (int nv = tri ? 0 : 2; nv <= (tri ? 0 : 17); nv++) {
+        for (int nu = tri ? 1 : 2; nu <= GEOM_MAX_GRID - tri; nu = next_side(nu))
+            for (int nv = tri ? 0 : 2; nv <= (tri ? 0 : GEOM_MAX_GRID); nv = tri ? 1 : next_side(nv)) {
                 Grid g = {.nu = (uint16_t)nu, .nv = (uint16_t)nv, .triangular = (uint8_t)tri,
                           .edge = 1.0f};
                 for (int requested = 0; requested < 3; requested++) {
@@ -158,5 +167,50 @@ static void test_same_bytes_for_any_budget_and_threads(void)
     rayes_image_free(ref);
 }
 
+/* The gridsize option: smaller grids are more grids, every size renders
+ * the same picture within the cache's bias, and sizes out of range are
+ * refused with a message. */
+static void test_grid_size(void)
+{
+    RayesScene *s = rayes_scene_new();
+    char err[512];
+    IoSink sink = io_sink_scene(s);
+    CHECK(io_builtin_scene("cornell-teapots", RAYES_TEST_DATA, &sink, err, sizeof err) == RAYES_OK);
+    CHECK(rayes_scene_commit(s) == RAYES_OK);
+    RayesRenderOptions o;
+    rayes_render_options_init(&o, RAYES_QUALITY_PREVIEW);
+    CHECK(o.grid_size == 256);
+    o.width = o.height = 48;
+    o.spp = 4;
+    o.threads = 2;
+    static const int sizes[] = {16, 256, 4096};
+    double grids[3] = {0}, mean[3] = {0};
+    for (int i = 0; i < 3; i++) {
+        o.grid_size = sizes[i];
+        RayesImage *img = NULL;
+        RayesStats *st = NULL;
+        CHECK(rayes_render(s, &o, &img, &st) == RAYES_OK);
+        const RayesStat *g = st ? rayes_stats_find(st, "grids") : NULL;
+        const RayesStat *gsz = st ? rayes_stats_find(st, "grid_size") : NULL;
+        CHECK(g && gsz && gsz->count == (uint64_t)sizes[i]);
+        grids[i] = g ? (double)g->count : 0.0;
+        for (size_t k = 0; img && k < (size_t)img->width * img->height; k++)
+            mean[i] += img->rgba[4 * k] + img->rgba[4 * k + 1] + img->rgba[4 * k + 2];
+        rayes_stats_free(st);
+        rayes_image_free(img);
+    }
+    CHECK(grids[0] > 4.0 * grids[1] && grids[1] > grids[2]);
+    CHECK(mean[0] > 0.0 && fabs(mean[0] / mean[1] - 1.0) < 0.03);
+    CHECK(fabs(mean[2] / mean[1] - 1.0) < 0.03);
+    o.grid_size = 0;
+    RayesImage *img = NULL;
+    CHECK(rayes_render(s, &o, &img, NULL) == RAYES_ERROR_INVALID_ARGUMENT && !img);
+    CHECK(strstr(rayes_scene_get_error(s), "grid size must be 1 to 4096") != NULL);
+    o.grid_size = 4097;
+    CHECK(rayes_render(s, &o, &img, NULL) == RAYES_ERROR_INVALID_ARGUMENT && !img);
+    rayes_scene_release(s);
+}
+
 TEST_MAIN(TEST(test_interpolation_is_exact_for_linear_functions), TEST(test_medium_aliasing),
-          TEST(test_level_choice), TEST(test_same_bytes_for_any_budget_and_threads))
+          TEST(test_level_choice), TEST(test_same_bytes_for_any_budget_and_threads),
+          TEST(test_grid_size))
