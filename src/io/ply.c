@@ -369,8 +369,9 @@ static int read_element(Ply *r, const PlyElement *e, PlyMesh *m, int is_vertex, 
                 if (read_value(r, pr->type, &v, e->name, i) != 0)
                     return -1;
                 if (take) {
-                    if (v < 0 || v > (double)INT32_MAX)
-                        return fail(r, "face %ld: vertex index %.0f is negative or too large", i, v);
+                    if (!(v >= 0 && v <= (double)INT32_MAX) || v != floor(v))
+                        return fail(r, "face %ld: vertex index %g is not an integer from 0 to "
+                                       "2147483647", i, v);
                     if (add_raw_index(r, (int)v) != 0)
                         return -1;
                 }

@@ -171,6 +171,13 @@ static void test_errors(void)
                  "t.ply: element \"vertex\": 1000000 of them cannot fit");
     expect_error("ply\nformat ascii 1.0\nelement face 0\nproperty list uchar int vertex_indices\n"
                  "end_header\n", "no element \"vertex\"");
+#define IHDR(type) "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\n" \
+                   "property float y\nproperty float z\nelement face 1\n" \
+                   "property list uchar " type " vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n"
+    expect_error(IHDR("float") "3 0 1 2\n", "t.ply:8:1: expected integer vertex indices");
+    expect_error(IHDR("uint") "3 0 1 3000000000\n",
+                 "face 0: vertex index 3e+09 is not an integer from 0 to 2147483647");
+    expect_error(IHDR("int") "3 0 1 -1\n", "face 0: vertex index -1 is not an integer");
 }
 
 TEST_MAIN(TEST(test_ascii), TEST(test_binary), TEST(test_errors))
