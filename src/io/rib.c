@@ -2123,7 +2123,8 @@ static int h_option_attribute(Rib *r, const Args *a)
                    (strcmp(q->d.name, "maxdiffusedepth") == 0 ||
                     strcmp(q->d.name, "maxspeculardepth") == 0)) {
             /* PRMan's ray depths; rayes has one per render, so the last wins */
-            int depth = q->v->d[0] < 0 ? 0 : q->v->d[0] > 1e6 ? 1000000 : (int)q->v->d[0];
+            double d = q->v->d[0]; /* NaN (a binary float) counts as 0 */
+            int depth = !(d > 0) ? 0 : d > 1e6 ? 1000000 : (int)d;
             if (q->d.name[3] == 'd')
                 r->settings->bounces = depth;
             else

@@ -569,6 +569,14 @@ static void test_binary(void)
     CHECK_NEAR(rec.M[7], 2, 0);
     CHECK_NEAR(rec.M[11], 1.5, 0);
     CHECK_NEAR(rec.last_mesh_P0[0], 0, 0);
+    /* binary floats that are not finite, alone or in an array, are refused
+     * where they stand (requests then only see finite numbers) */
+    static const char nan_one[] = "Attribute \"trace\" \"int maxdiffusedepth\" \244\177\300\0\0\n";
+    CHECK(parse_n("b.rib", nan_one, sizeof nan_one - 1, -1) == RAYES_ERROR_PARSE);
+    CHECK(strstr(err, "b.rib:1:41: a number out of range") != NULL);
+    static const char inf_array[] = "FrameBegin \310\1\177\200\0\0\nFrameEnd\n";
+    CHECK(parse_n("b.rib", inf_array, sizeof inf_array - 1, -1) == RAYES_ERROR_PARSE);
+    CHECK(strstr(err, "b.rib:1:12: a number out of range") != NULL);
     /* reserved codes, undefined requests and truncation are errors */
     static const unsigned char reserved[] = {'W', 'o', 'r', 'l', 'd', 'B', 'e', 'g', 'i', 'n', ' ', 0250};
     CHECK(parse_n("b.rib", reserved, sizeof reserved, -1) == RAYES_ERROR_PARSE);
