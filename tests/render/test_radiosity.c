@@ -124,13 +124,20 @@ static void test_level_choice(void)
     CHECK(radiosity_choose_level(&g, 8.0f, 2.0f, -1) == CACHE_COARSE); /* k scales the rule */
 }
 
-static RayesImage *render(double cache_mb, int threads, int cache)
+/* The benchmark scene, committed. */
+static RayesScene *teapots(void)
 {
     RayesScene *s = rayes_scene_new();
     char err[512];
     IoSink sink = io_sink_scene(s);
     CHECK(io_builtin_scene("cornell-teapots", RAYES_TEST_DATA, &sink, err, sizeof err) == RAYES_OK);
     CHECK(rayes_scene_commit(s) == RAYES_OK);
+    return s;
+}
+
+static RayesImage *render(double cache_mb, int threads, int cache)
+{
+    RayesScene *s = teapots();
     RayesRenderOptions o;
     rayes_render_options_init(&o, RAYES_QUALITY_PREVIEW);
     o.width = o.height = 40;
@@ -172,11 +179,7 @@ static void test_same_bytes_for_any_budget_and_threads(void)
  * refused with a message. */
 static void test_grid_size(void)
 {
-    RayesScene *s = rayes_scene_new();
-    char err[512];
-    IoSink sink = io_sink_scene(s);
-    CHECK(io_builtin_scene("cornell-teapots", RAYES_TEST_DATA, &sink, err, sizeof err) == RAYES_OK);
-    CHECK(rayes_scene_commit(s) == RAYES_OK);
+    RayesScene *s = teapots();
     RayesRenderOptions o;
     rayes_render_options_init(&o, RAYES_QUALITY_PREVIEW);
     CHECK(o.grid_size == 256);
