@@ -4,7 +4,8 @@
  *
  *   memo_tables table1 [--size N] [--spp N] [--bounces-max B] [--accuracy-spp N]
  *                      [--accuracy-size N] [--out DIR] [--data DIR] [--threads N]
- *                      [--cache-k K] [--scene cornell-teapots|cornell-teapots-displaced]
+ *                      [--cache-k K] [--gridsize N]
+ *                      [--scene cornell-teapots|cornell-teapots-displaced]
  *   memo_tables table4 [...same...] [--budgets MB,MB,...]
  *   memo_tables table2 [...same...] [--uncached-max B]
  *   memo_tables figure5 [--size N] [--spp N] [--out DIR] [--data DIR] [--scene S]
@@ -44,6 +45,7 @@ typedef struct Args {
     int uncached_max;             /* table2: uncached rows up to this many bounces */
     int quality;                  /* RayesQuality of the rows */
     double cache_k;
+    int grid_size;                /* micropolygons per grid, at most (0: the default) */
     double budgets[16];
     int n_budgets;
 } Args;
@@ -55,6 +57,7 @@ typedef struct Row {
     double cpu_s;                 /* process CPU time (user + system), less sensitive to
                                      other tenants of a shared machine */
     unsigned long long shading_points, rays, shadow, diffuse, records;
+    unsigned long long grids, grid_vertices, grid_size;
     double hit[3];
     float *rgba;
     int w, h;
@@ -99,6 +102,8 @@ static Row run(const Args *a, int size, int spp, int bounces, int cache, double 
     o.cache = cache;
     o.cache_mb = budget_mb;
     o.cache_k = (float)a->cache_k;
+    if (a->grid_size > 0)
+        o.grid_size = a->grid_size;
     RayesImage *img;
     RayesStats *st;
     double cpu0 = cpu_seconds();
@@ -108,6 +113,9 @@ static Row run(const Args *a, int size, int spp, int bounces, int cache, double 
     r.cpu_s = cpu_seconds() - cpu0;
     r.time_s = find(st, "time/total_s")->real;
     r.shading_points = find(st, "shading_points/total")->count;
+    r.grids = find(st, "grids")->count;
+    r.grid_vertices = find(st, "grid_vertices")->count;
+    r.grid_size = find(st, "grid_size")->count;
     r.rays = find(st, "rays/total")->count;
     r.shadow = find(st, "rays/shadow")->count;
     r.diffuse = find(st, "rays/diffuse")->count;
@@ -209,6 +217,8 @@ static void parse(int argc, char **argv, Args *a)
             a->accuracy_size = atoi(v);
         else if (strcmp(o, "--cache-k") == 0)
             a->cache_k = atof(v);
+        else if (strcmp(o, "--gridsize") == 0)
+            a->grid_size = atoi(v);
         else if (strcmp(o, "--threads") == 0)
             a->threads = atoi(v);
         else if (strcmp(o, "--data") == 0)
@@ -244,10 +254,10 @@ static void json_row(FILE *j, const Row *r, int first)
             "%s\n    {\"bounces\": %d, \"cache\": %d, \"budget_mb\": %g, \"time_s\": %.3f, \"cpu_s\": %.3f, "
             "\"shading_points\": %llu, \"rays\": %llu, \"shadow_rays\": %llu, "
             "\"diffuse_rays\": %llu, \"hit_rate\": {\"coarse\": %.5f, \"medium\": %.5f, "
-            "\"fine\": %.5f}}",
+            "\"fine\": %.5f}, \"grids\": %llu, \"grid_vertices\": %llu, \"grid_size\": %llu}",
             first ? "" : ",", r->bounces, r->cache, r->budget_mb, r->time_s, r->cpu_s,
-            r->shading_points,
-            r->rays, r->shadow, r->diffuse, r->hit[0], r->hit[1], r->hit[2]);
+            r->shading_points, r->rays, r->shadow, r->diffuse, r->hit[0], r->hit[1], r->hit[2],
+            r->grids, r->grid_vertices, r->grid_size);
 }
 
 static void table1(const Args *a, FILE *j)
@@ -275,6 +285,8 @@ static void table1(const Args *a, FILE *j)
         if (b == 1) {
             t1_on = on.time_s;
             c1_on = on.cpu_s;
+            printf("    %llu grids, %llu vertices (gridsize %llu)\n", on.grids, on.grid_vertices,
+                   on.grid_size);
         } else {
             printf("    cached time %d bounces / 1 bounce: %.2f (cpu %.2f)\n", b, on.time_s / t1_on,
                    on.cpu_s / c1_on);
