@@ -126,7 +126,7 @@ static void newell(const float *P, const int *v, size_t n, double nrm[3])
 }
 
 /* A quad is kept when it is planar (within 1e-4 of its size) and convex. */
-static int quad_ok(const float *P, const int *v)
+int rib_quad_kept(const float *P, const int *v)
 {
     double n[3];
     newell(P, v, 4, n);
@@ -270,7 +270,7 @@ int rib_tessellate(const float *P, const int *loop_n, size_t n_loops, const int 
         return 0;
     if (n_loops == 1 && n0 == 3)
         return faces_add(out, idx, 3, flip);
-    if (n_loops == 1 && n0 == 4 && quad_ok(P, idx))
+    if (n_loops == 1 && n0 == 4 && rib_quad_kept(P, idx))
         return faces_add(out, idx, 4, flip);
     double nrm[3];
     newell(P, idx, n0, nrm);

@@ -32,6 +32,12 @@ typedef struct RibFaces {
 
 void rib_faces_fini(RibFaces *f);
 
+/* Nonzero when the quad v[0..3] of P is planar (within 1e-4 of its size)
+ * and strictly convex: rib_tessellate passes it whole, where other quads
+ * are split in two triangles. The RIB writer writes the others as bilinear
+ * patches, which is what a quad of rayes_scene_polygon_mesh is. */
+int rib_quad_kept(const float *P, const int *v);
+
 /* Appends the faces of one polygon given as n_loops loops (the first the
  * outline, the others holes) of loop_n[k] indices each into P: triangles
  * and quads (a quad only when it is convex and planar, without holes),

@@ -8,8 +8,11 @@
 
 #include <math.h>
 #include <stdarg.h>
+#include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
+
+#include "io/rib_internal.h"
 
 /* A growing text in memory. */
 typedef struct Stream {
@@ -407,16 +410,22 @@ static RayesError check_primvars(RibWriter *w, const char *what, const RayesPrim
     return RAYES_OK;
 }
 
+/* Starts a primitive variable's RIB parameter on a line of its own: its
+ * inline declaration. Returns its floats per value. */
+static size_t primvar_decl(FILE *f, const RayesPrimvar *p)
+{
+    static const char *const cls[5] = {"constant", "uniform", "varying", "vertex", "facevarying"};
+    int st = strcmp(p->name, "st") == 0;
+    const char *type = st ? "float[2]" : strcmp(p->name, "N") == 0 ? "normal" : "color";
+    fprintf(f, "\n  \"%s %s %s\" ", cls[p->cls], type, p->name);
+    return st ? 2 : 3;
+}
+
 /* Writes primitive variables as RIB parameters, each on a line of its own. */
 static void primvars(FILE *f, const RayesPrimvar *pv, size_t n_pv)
 {
-    static const char *const cls[5] = {"constant", "uniform", "varying", "vertex", "facevarying"};
-    for (size_t i = 0; i < n_pv; i++) {
-        int st = strcmp(pv[i].name, "st") == 0;
-        const char *type = st ? "float[2]" : strcmp(pv[i].name, "N") == 0 ? "normal" : "color";
-        fprintf(f, "\n  \"%s %s %s\" ", cls[pv[i].cls], type, pv[i].name);
-        floats(f, pv[i].data, pv[i].count * (st ? 2u : 3u));
-    }
+    for (size_t i = 0; i < n_pv; i++)
+        floats(f, pv[i].data, pv[i].count * primvar_decl(f, &pv[i]));
 }
 
 static RayesError w_bilinear_patch(void *t, const float P[4][3], const RayesPrimvar *pv,
@@ -454,6 +463,118 @@ static RayesError w_bicubic_patch(void *t, const float P[16][3], const RayesPrim
     return RAYES_OK;
 }
 
+/* A polygon mesh being written. */
+typedef struct Mesh {
+    const int *nv, *idx;
+    size_t n_faces, n_points;
+    const float *P;
+    const RayesPrimvar *pv;
+    size_t n_pv;
+    size_t *map; /* point -> index in the run being written, or SIZE_MAX; owned */
+} Mesh;
+
+/* Nonzero if face f (its corners from k on) is a quad the reader would split. */
+static int split_quad(const Mesh *m, size_t f, size_t k)
+{
+    return m->nv[f] == 4 && !rib_quad_kept(m->P, m->idx + k);
+}
+
+/* "[...]" of the elements which[0..n) (or first.. first + n when which is
+ * NULL) of values of size floats each. */
+static void elements(FILE *f, const float *values, size_t size, const size_t *which, size_t first,
+                     size_t n)
+{
+    fputc('[', f);
+    for (size_t i = 0; i < n; i++)
+        for (size_t c = 0; c < size; c++) {
+            float v = values[size * (which ? which[i] : first + i) + c];
+            fprintf(f, "%s%.9g",
+                    i + c == 0                ? ""
+                    : (size * i + c) % 9 == 0 ? "\n   "
+                                              : " ",
+                    v == 0.0f ? 0.0 : (double)v);
+        }
+    fputc(']', f);
+}
+
+/* The primitive variables of one primitive written from the mesh: face f,
+ * the points points[0..n_points) and the corners corners[0..n_corners) (or
+ * first_corner on when corners is NULL). */
+static void mesh_primvars(FILE *f, const Mesh *m, size_t face, size_t n_faces, const size_t *points,
+                          size_t n_points, const size_t *corners, size_t first_corner,
+                          size_t n_corners)
+{
+    for (size_t i = 0; i < m->n_pv; i++) {
+        const RayesPrimvar *p = &m->pv[i];
+        size_t size = primvar_decl(f, p);
+        switch (p->cls) {
+        case RAYES_PRIMVAR_CONSTANT:
+            elements(f, p->data, size, NULL, 0, 1);
+            break;
+        case RAYES_PRIMVAR_UNIFORM:
+            elements(f, p->data, size, NULL, face, n_faces);
+            break;
+        case RAYES_PRIMVAR_VARYING:
+        case RAYES_PRIMVAR_VERTEX:
+            elements(f, p->data, size, points, 0, n_points);
+            break;
+        default:
+            elements(f, p->data, size, corners, first_corner, n_corners);
+            break;
+        }
+    }
+}
+
+/* Face f, a quad with corners from k on, as RIB's bilinear patch: P00 = v0,
+ * P10 = v1, P01 = v3, P11 = v2, as rayes_scene_polygon_mesh makes it. */
+static void quad_patch(FILE *f, const Mesh *m, size_t face, size_t k)
+{
+    static const int order[4] = {0, 1, 3, 2};
+    size_t points[4], corners[4];
+    for (int c = 0; c < 4; c++) {
+        points[c] = (size_t)m->idx[k + (size_t)order[c]];
+        corners[c] = k + (size_t)order[c];
+    }
+    fprintf(f, "Patch \"bilinear\" \"P\" ");
+    elements(f, m->P, 3, points, 0, 4);
+    mesh_primvars(f, m, face, 1, points, 4, corners, 0, 4);
+    fputc('\n', f);
+}
+
+/* Faces [a, b) (corners [k, kb)) as PointsPolygons with the points they
+ * use, in the mesh's order (all of them, as given, for a whole mesh).
+ * Returns 0, or -1 when out of memory. */
+static int polygons(FILE *f, Mesh *m, size_t a, size_t b, size_t k, size_t kb)
+{
+    if (!m->map && !(m->map = malloc((m->n_points ? m->n_points : 1) * sizeof *m->map)))
+        return -1;
+    size_t *used = malloc((m->n_points ? m->n_points : 1) * sizeof *used), n_used = 0;
+    if (!used)
+        return -1;
+    int whole = a == 0 && b == m->n_faces;
+    for (size_t i = 0; i < m->n_points; i++)
+        m->map[i] = SIZE_MAX;
+    for (size_t i = k; i < kb; i++)
+        m->map[m->idx[i]] = 0;
+    for (size_t i = 0; i < m->n_points; i++)
+        if (whole || m->map[i] != SIZE_MAX) {
+            m->map[i] = n_used;
+            used[n_used++] = i;
+        }
+    fprintf(f, "PointsPolygons [");
+    for (size_t i = a; i < b; i++)
+        fprintf(f, i > a ? " %d" : "%d", m->nv[i]);
+    fprintf(f, "]\n  [");
+    for (size_t i = k; i < kb; i++)
+        fprintf(f, "%s%zu", i == k ? "" : (i - k) % 24 == 0 ? "\n   " : " ", m->map[m->idx[i]]);
+    fprintf(f, "]\n  \"P\" ");
+    elements(f, m->P, 3, used, 0, n_used);
+    mesh_primvars(f, m, a, b - a, used, n_used, NULL, k, kb - k);
+    fprintf(f, "\n");
+    free(used);
+    return 0;
+}
+
 static RayesError w_polygon_mesh(void *t, size_t n_faces, const int *nv, const int *idx,
                                  size_t n_points, const float *P, const RayesPrimvar *pv,
                                  size_t n_pv)
@@ -475,20 +596,30 @@ static RayesError w_polygon_mesh(void *t, size_t n_faces, const int *nv, const i
     const size_t expect[5] = {1, n_faces, n_points, n_points, k};
     if (check_primvars(w, "polygon mesh", pv, n_pv, expect) != RAYES_OK)
         return RAYES_ERROR_INVALID_ARGUMENT;
-    FILE *f = w->world.f;
-    fprintf(f, "PointsPolygons [");
-    for (size_t i = 0; i < n_faces; i++)
-        fprintf(f, i ? " %d" : "%d", nv[i]);
-    fprintf(f, "]\n  [");
-    for (size_t i = 0; i < k; i++)
-        fprintf(f, "%s%d", i == 0 ? "" : i % 24 == 0 ? "\n   " : " ", idx[i]);
-    fprintf(f, "]\n  \"P\" [");
-    for (size_t i = 0; i < 3 * n_points; i++)
-        fprintf(f, "%s%.9g", i == 0 ? "" : i % 9 == 0 ? "\n   " : " ",
-                P[i] == 0.0f ? 0.0 : (double)P[i]);
-    fprintf(f, "]");
-    primvars(f, pv, n_pv);
-    fprintf(f, "\n");
+    /* Runs of faces the reader keeps as they are, in order, between the
+     * quads it would split (not planar, or not convex): those are written
+     * as the bilinear patches they are here, so that a converted scene has
+     * the same primitives in the same order. */
+    Mesh m = {nv, idx, n_faces, n_points, P, pv, n_pv, NULL};
+    k = 0;
+    for (size_t a = 0; a < n_faces;) {
+        if (split_quad(&m, a, k)) {
+            quad_patch(w->world.f, &m, a, k);
+            k += 4;
+            a++;
+            continue;
+        }
+        size_t b = a, kb = k;
+        while (b < n_faces && !split_quad(&m, b, kb))
+            kb += (size_t)nv[b++];
+        if (polygons(w->world.f, &m, a, b, k, kb) != 0) {
+            free(m.map);
+            return fail(w, RAYES_ERROR_OUT_OF_MEMORY, "polygon mesh: out of memory");
+        }
+        a = b;
+        k = kb;
+    }
+    free(m.map);
     return RAYES_OK;
 }
 

@@ -739,7 +739,9 @@ static void test_scene_sink(void)
 }
 
 /* Round trip: each built-in scene, written as RIB by io/rib_write.h, reads
- * back into the same patches, faces, quadrics and lights. */
+ * back into the same patches, faces, quadrics and lights: a mesh's quad
+ * that is not planar (the Cornell box's side walls and blocks) is a
+ * bilinear patch in rayes, and comes back as one, not as two triangles. */
 static void test_writer_round_trip(void)
 {
     for (int i = 0; io_builtin_scene_names[i]; i++) {
@@ -773,12 +775,36 @@ static void test_writer_round_trip(void)
             fprintf(stderr, "%s: %s\n", name, err);
         CHECK(e == RAYES_OK);
         CHECK(rec.bicubic == direct.bicubic);
-        CHECK(rec.tris + 2 * rec.quads == direct.tris + 2 * direct.quads);
+        CHECK(rec.tris == direct.tris);
+        CHECK(rec.quads + rec.bilinear == direct.quads + direct.bilinear);
+        CHECK(strcmp(name, "cornell") != 0 || rec.bilinear > 0);
         CHECK(rec.quadrics == direct.quadrics);
         CHECK(rec.area_lights == direct.area_lights);
         CHECK(rec.lights == direct.lights);
         CHECK(rec.cameras == 1);
     }
+}
+
+/* Finishes w into RAYES_TEST_TMP/name (path gets the full name), frees
+ * it, and reads the file back into rec. Returns -1 if the file could not
+ * be written. */
+static int write_and_read(RibWriter *w, const char *name, char *path, size_t size)
+{
+    snprintf(path, size, "%s/%s", RAYES_TEST_TMP, name);
+    FILE *f = fopen(path, "w");
+    CHECK(f != NULL);
+    if (f) {
+        CHECK(io_rib_writer_finish(w, NULL, f, err, sizeof err) == RAYES_OK);
+        fclose(f);
+    }
+    io_rib_writer_free(w);
+    if (!f)
+        return -1;
+    memset(&rec, 0, sizeof rec);
+    IoReadOptions opt = {NULL, -1};
+    io_settings_init(&settings);
+    CHECK(io_rib_read(path, &stub, &opt, &settings, err, sizeof err) == RAYES_OK);
+    return 0;
 }
 
 /* Primitive variables written by the RIB writer read back as they were
@@ -810,27 +836,15 @@ static void test_writer_primvars(void)
     CHECK(ws.polygon_mesh(ws.target, 2, nv, idx, 4, &P[0][0], &bad, 1) ==
           RAYES_ERROR_INVALID_ARGUMENT);
     char path[1024];
-    snprintf(path, sizeof path, "%s/test_rib_primvars.rib", RAYES_TEST_TMP);
-    FILE *f = fopen(path, "w");
-    CHECK(f != NULL);
-    if (!f) {
-        io_rib_writer_free(w);
-        return;
-    }
-    CHECK(io_rib_writer_finish(w, NULL, f, err, sizeof err) == RAYES_OK);
-    fclose(f);
-    io_rib_writer_free(w);
     /* Read it back, checking the mesh (the first geometry) on the way. */
-    memset(&rec, 0, sizeof rec);
-    IoReadOptions opt = {NULL, -1};
-    io_settings_init(&settings);
-    CHECK(io_rib_read(path, &stub, &opt, &settings, err, sizeof err) == RAYES_OK);
+    if (write_and_read(w, "test_rib_primvars.rib", path, sizeof path) != 0)
+        return;
     CHECK(rec.meshes == 1 && rec.bilinear == 1 && rec.bicubic == 1);
     const RayesPrimvar *v = last_pv("Cs"); /* the last call: the bicubic patch */
     CHECK(v && v->cls == RAYES_PRIMVAR_VERTEX && v->count == 16);
     CHECK(v && memcmp(v->data, C, sizeof C) == 0);
     /* the mesh and the patch, each read alone */
-    f = fopen(path, "r");
+    FILE *f = fopen(path, "r");
     char line[8192], mesh_rib[8192] = "WorldBegin\n", patch_rib[8192] = "WorldBegin\n";
     int in_mesh = 0;
     while (f && fgets(line, sizeof line, f)) {
@@ -862,8 +876,46 @@ static void test_writer_primvars(void)
     CHECK(v && v->cls == RAYES_PRIMVAR_VARYING && memcmp(v->data, st, 8 * sizeof(float)) == 0);
 }
 
+/* A mesh whose last face is a quad the reader would split (not planar) is
+ * written as a mesh of the faces before it, with only the points they use,
+ * and a bilinear patch carrying the quad's own primitive variables: vertex N
+ * and facevarying st at its corners in patch order (v0 v1 v3 v2), its
+ * uniform Cs. */
+static void test_writer_split_quad(void)
+{
+    RibWriter *w = io_rib_writer_new();
+    IoSink ws = io_rib_writer_sink(w);
+    const float P[6][3] = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}, {2, 0, 0.5f}, {2, 1, 0}};
+    const int nv[3] = {3, 3, 4}, idx[10] = {0, 1, 2, 0, 2, 3, 1, 4, 5, 2};
+    float N[6][3], st[10][2], Cs[3][3];
+    for (int i = 0; i < 6; i++)
+        N[i][0] = 0.1f * (float)i, N[i][1] = 0, N[i][2] = 1;
+    for (int i = 0; i < 10; i++)
+        st[i][0] = 0.1f * (float)i, st[i][1] = 1.0f - 0.1f * (float)i;
+    for (int i = 0; i < 3; i++)
+        Cs[i][0] = Cs[i][1] = Cs[i][2] = 0.25f * (float)(i + 1);
+    const RayesPrimvar pv[3] = {{"N", RAYES_PRIMVAR_VERTEX, &N[0][0], 6},
+                                {"st", RAYES_PRIMVAR_FACEVARYING, &st[0][0], 10},
+                                {"Cs", RAYES_PRIMVAR_UNIFORM, &Cs[0][0], 3}};
+    CHECK(ws.polygon_mesh(ws.target, 3, nv, idx, 6, &P[0][0], pv, 3) == RAYES_OK);
+    char path[1024];
+    if (write_and_read(w, "test_rib_split_quad.rib", path, sizeof path) != 0)
+        return;
+    CHECK(rec.meshes == 1 && rec.tris == 2 && rec.quads == 0 && rec.bilinear == 1);
+    static const int corner[4] = {6, 7, 9, 8}; /* v0 v1 v3 v2 of the quad */
+    const RayesPrimvar *n = last_pv("N"), *t = last_pv("st"), *c = last_pv("Cs");
+    CHECK(n && n->cls == RAYES_PRIMVAR_VERTEX && n->count == 4);
+    CHECK(t && t->cls == RAYES_PRIMVAR_FACEVARYING && t->count == 4);
+    CHECK(c && c->cls == RAYES_PRIMVAR_UNIFORM && c->count == 1 && c->data[0] == Cs[2][0]);
+    for (int k = 0; n && t && k < 4; k++) {
+        CHECK(memcmp(&n->data[3 * k], N[idx[corner[k]]], sizeof N[0]) == 0);
+        CHECK(memcmp(&t->data[2 * k], st[corner[k]], sizeof st[0]) == 0);
+    }
+}
+
 TEST_MAIN(TEST(test_camera_and_transforms), TEST(test_settings), TEST(test_shaders_and_lights),
           TEST(test_parameter_classes), TEST(test_polygons), TEST(test_patch_mesh_bases),
           TEST(test_objects_and_frames), TEST(test_binary), TEST(test_gzip), TEST(test_errors),
           TEST(test_aqsis_files), TEST(test_scene_sink),
-          TEST(test_writer_round_trip), TEST(test_writer_primvars))
+          TEST(test_writer_round_trip), TEST(test_writer_primvars),
+          TEST(test_writer_split_quad))

@@ -212,7 +212,8 @@ static void test_refused(void)
 }
 
 /* The benchmark scene, written whole: 64 bicubic patches (two teapots),
- * eleven quads, a light, the camera. */
+ * five walls (four planar polygons, and the red wall, which is not planar,
+ * a bilinear patch), a light, the camera. */
 static void test_builtin(void)
 {
     RibWriter *w = io_rib_writer_new();
@@ -220,13 +221,15 @@ static void test_builtin(void)
     char err[512];
     CHECK(io_builtin_scene("cornell-teapots", RAYES_TEST_DATA, &k, err, sizeof err) == RAYES_OK);
     char *t = finish(w, NULL);
-    int patches = 0, meshes = 0;
+    int patches = 0, meshes = 0, bilinear = 0;
     for (const char *p = t; (p = strstr(p, "Patch \"bicubic\"")); p++)
         patches++;
     for (const char *p = t; (p = strstr(p, "PointsPolygons")); p++)
         meshes++;
+    for (const char *p = t; (p = strstr(p, "Patch \"bilinear\"")); p++)
+        bilinear++;
     CHECK(patches == 64);
-    CHECK(meshes == 5);
+    CHECK(meshes == 4 && bilinear == 1);
     CHECK(has(t, "AreaLightSource") && has(t, "Surface \"mirror\""));
     CHECK(has(t, "Projection \"perspective\" \"fov\" [39.3077011]"));
     free(t);
