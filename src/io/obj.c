@@ -380,8 +380,13 @@ static int mtl_statement(Obj *o, Lexer *L, const char *mtl_dir, const char *kw, 
         return mtl_color(L, mt->Kd);
     if (is_kw(kw, n, "Ks"))
         return mtl_color(L, mt->Ks);
-    if (is_kw(kw, n, "Ke"))
-        return mtl_color(L, mt->Ke);
+    if (is_kw(kw, n, "Ke")) {
+        if (mtl_color(L, mt->Ke) != 0)
+            return -1;
+        if (mt->Ke[0] < 0 || mt->Ke[1] < 0 || mt->Ke[2] < 0)
+            return lex_error_at(L, kw, "Ke: an emission must not be negative");
+        return 0;
+    }
     if (is_kw(kw, n, "Ka") || is_kw(kw, n, "Tf")) {
         float c[3];
         return mtl_color(L, c); /* read; rayes has no ambient colour per material */

@@ -657,8 +657,9 @@ static int w_linked(const RibWriter *w, size_t light);
 static RayesError w_area_light(void *t, const float P[4][3], const float L[3])
 {
     RibWriter *w = t;
-    if (!finite_all(&P[0][0], 12) || !finite_all(L, 3))
-        return fail(w, RAYES_ERROR_INVALID_ARGUMENT, "area light: not finite");
+    if (!finite_all(&P[0][0], 12) || !finite_all(L, 3) || L[0] < 0 || L[1] < 0 || L[2] < 0)
+        return fail(w, RAYES_ERROR_INVALID_ARGUMENT,
+                    "area light: expected finite points and a non-negative radiance");
     FILE *f = w->world.f;
     if (w->next_light < 4097)
         w->area[w->next_light] = 1;

@@ -296,6 +296,10 @@ static void test_errors(void)
     write_file(DIR "/bad.mtl", "Kd 1 0.5 1\n");
     CHECK(parse(DIR "/b.obj", "mtllib bad.mtl\n") == RAYES_ERROR_PARSE);
     CHECK(strstr(err, DIR "/bad.mtl:1:1: expected newmtl") == err);
+    /* a negative emission would be a negative area light (fuzz) */
+    write_file(DIR "/bad.mtl", "newmtl a\nKe 1 -1 1\n");
+    CHECK(parse(DIR "/b.obj", "mtllib bad.mtl\n") == RAYES_ERROR_PARSE);
+    CHECK(strstr(err, DIR "/bad.mtl:2:1: Ke: an emission must not be negative") == err);
 }
 
 /* Unknown statements are skipped (with one warning each), comments and

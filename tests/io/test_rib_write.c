@@ -205,8 +205,12 @@ static void test_refused(void)
     CHECK(k.polygon_mesh(w, 1, three, bad, 3, P, NULL, 0) == RAYES_ERROR_INVALID_ARGUMENT);
     CHECK(k.quadric(w, RAYES_QUADRIC_SPHERE, q, 3, 0) == RAYES_ERROR_INVALID_ARGUMENT);
     CHECK(k.set_shading_rate(w, -1) == RAYES_ERROR_INVALID_ARGUMENT);
+    /* refused as the scene refuses it, so both sinks accept the same calls */
+    const float quad[4][3] = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {1, 1, 0}}, negative[3] = {1, -1, 1};
+    CHECK(k.area_light(w, quad, negative) == RAYES_ERROR_INVALID_ARGUMENT);
     char *t = finish(w, NULL);
     CHECK(strstr(t, "Patch") == NULL && strstr(t, "PointsPolygons") == NULL);
+    CHECK(strstr(t, "AreaLightSource") == NULL);
     free(t);
     io_rib_writer_free(w);
 }
