@@ -470,8 +470,15 @@ typedef struct Mesh {
     const float *P;
     const RayesPrimvar *pv;
     size_t n_pv;
-    size_t *map; /* point -> index in the run being written, or SIZE_MAX; owned */
+    size_t *map;  /* point -> index in the run being written, else SIZE_MAX; owned */
+    size_t *used; /* the points of that run, ascending; owned */
 } Mesh;
+
+static int ascending(const void *a, const void *b)
+{
+    size_t x = *(const size_t *)a, y = *(const size_t *)b;
+    return (x > y) - (x < y);
+}
 
 /* Nonzero if face f (its corners from k on) is a quad the reader would split. */
 static int split_quad(const Mesh *m, size_t f, size_t k)
@@ -542,25 +549,34 @@ static void quad_patch(FILE *f, const Mesh *m, size_t face, size_t k)
 }
 
 /* Faces [a, b) (corners [k, kb)) as PointsPolygons with the points they
- * use, in the mesh's order (all of them, as given, for a whole mesh).
- * Returns 0, or -1 when out of memory. */
+ * use, in the mesh's order (all of them, as given, for a whole mesh). The
+ * work is in the run's corners, not the mesh's points, so a mesh of many
+ * short runs stays linear. Returns 0, or -1 when out of memory. */
 static int polygons(FILE *f, Mesh *m, size_t a, size_t b, size_t k, size_t kb)
 {
-    if (!m->map && !(m->map = malloc((m->n_points ? m->n_points : 1) * sizeof *m->map)))
-        return -1;
-    size_t *used = malloc((m->n_points ? m->n_points : 1) * sizeof *used), n_used = 0;
-    if (!used)
-        return -1;
-    int whole = a == 0 && b == m->n_faces;
-    for (size_t i = 0; i < m->n_points; i++)
-        m->map[i] = SIZE_MAX;
-    for (size_t i = k; i < kb; i++)
-        m->map[m->idx[i]] = 0;
-    for (size_t i = 0; i < m->n_points; i++)
-        if (whole || m->map[i] != SIZE_MAX) {
-            m->map[i] = n_used;
+    size_t cap = m->n_points ? m->n_points : 1, n_used = 0;
+    if (!m->map) {
+        m->map = malloc(cap * sizeof *m->map);
+        m->used = malloc(cap * sizeof *m->used);
+        if (!m->map || !m->used)
+            return -1;
+        for (size_t i = 0; i < m->n_points; i++)
+            m->map[i] = SIZE_MAX;
+    }
+    size_t *used = m->used;
+    if (a == 0 && b == m->n_faces) {
+        for (size_t i = 0; i < m->n_points; i++)
             used[n_used++] = i;
-        }
+    } else {
+        for (size_t i = k; i < kb; i++)
+            if (m->map[m->idx[i]] == SIZE_MAX) {
+                m->map[m->idx[i]] = 0;
+                used[n_used++] = (size_t)m->idx[i];
+            }
+        qsort(used, n_used, sizeof *used, ascending);
+    }
+    for (size_t i = 0; i < n_used; i++)
+        m->map[used[i]] = i;
     fprintf(f, "PointsPolygons [");
     for (size_t i = a; i < b; i++)
         fprintf(f, i > a ? " %d" : "%d", m->nv[i]);
@@ -571,7 +587,8 @@ static int polygons(FILE *f, Mesh *m, size_t a, size_t b, size_t k, size_t kb)
     elements(f, m->P, 3, used, 0, n_used);
     mesh_primvars(f, m, a, b - a, used, n_used, NULL, k, kb - k);
     fprintf(f, "\n");
-    free(used);
+    for (size_t i = 0; i < n_used; i++)
+        m->map[used[i]] = SIZE_MAX;
     return 0;
 }
 
@@ -600,7 +617,7 @@ static RayesError w_polygon_mesh(void *t, size_t n_faces, const int *nv, const i
      * quads it would split (not planar, or not convex): those are written
      * as the bilinear patches they are here, so that a converted scene has
      * the same primitives in the same order. */
-    Mesh m = {nv, idx, n_faces, n_points, P, pv, n_pv, NULL};
+    Mesh m = {nv, idx, n_faces, n_points, P, pv, n_pv, NULL, NULL};
     k = 0;
     for (size_t a = 0; a < n_faces;) {
         if (split_quad(&m, a, k)) {
@@ -614,12 +631,14 @@ static RayesError w_polygon_mesh(void *t, size_t n_faces, const int *nv, const i
             kb += (size_t)nv[b++];
         if (polygons(w->world.f, &m, a, b, k, kb) != 0) {
             free(m.map);
+            free(m.used);
             return fail(w, RAYES_ERROR_OUT_OF_MEMORY, "polygon mesh: out of memory");
         }
         a = b;
         k = kb;
     }
     free(m.map);
+    free(m.used);
     return RAYES_OK;
 }
 

@@ -911,6 +911,17 @@ static void test_writer_split_quad(void)
         CHECK(memcmp(&n->data[3 * k], N[idx[corner[k]]], sizeof N[0]) == 0);
         CHECK(memcmp(&t->data[2 * k], st[corner[k]], sizeof st[0]) == 0);
     }
+    /* the quad between two triangles: two meshes, the second renumbered to
+     * the points it uses (3, 2, 0 -> 2, 1, 0) */
+    w = io_rib_writer_new();
+    ws = io_rib_writer_sink(w);
+    const int nv2[3] = {3, 4, 3}, idx2[10] = {0, 1, 2, 1, 4, 5, 2, 3, 2, 0};
+    CHECK(ws.polygon_mesh(ws.target, 3, nv2, idx2, 6, &P[0][0], NULL, 0) == RAYES_OK);
+    if (write_and_read(w, "test_rib_split_quad2.rib", path, sizeof path) != 0)
+        return;
+    CHECK(rec.meshes == 2 && rec.tris == 2 && rec.bilinear == 1);
+    CHECK(rec.mesh_idx[0] == 2 && rec.mesh_idx[1] == 1 && rec.mesh_idx[2] == 0);
+    CHECK(memcmp(rec.last_mesh_P0, P[0], sizeof P[0]) == 0);
 }
 
 TEST_MAIN(TEST(test_camera_and_transforms), TEST(test_settings), TEST(test_shaders_and_lights),
