@@ -132,6 +132,12 @@ typedef struct RayesParam {
 RAYES_API RayesError rayes_scene_set_shader(RayesScene *scene, const char *name,
                                             const RayesParam *params, size_t n_params);
 
+/* Nonzero if rayes_scene_set_shader would find a class of that name now (a
+ * built-in, or a plugin that loads from the search paths; loading it is
+ * kept). For readers of scene files that fall back to a built-in shader. No
+ * error is recorded in the scene. */
+RAYES_API int rayes_scene_has_shader(RayesScene *scene, const char *name);
+
 /* The displacement shader of geometry added from now on: a class with a
  * displacement method (the built-ins "bumpy" and "fractal", or a plugin's),
  * run on every vertex of the fine grids when the scene is prepared, before

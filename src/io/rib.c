@@ -1833,6 +1833,14 @@ static ShaderRec *make_shader(Rib *r, const char *name, const Param *p, size_t n
     return sh;
 }
 
+/* A built-in shader name, or one the sink knows (a plugin on its search
+ * path). */
+static int shader_known(Rib *r, const char *const *builtins, const char *name)
+{
+    return in_list(builtins, name) ||
+           (r->sink->has_shader && r->sink->has_shader(r->sink->target, name));
+}
+
 static int h_surface(Rib *r, const Args *a)
 {
     size_t i = 0;
@@ -1846,11 +1854,13 @@ static int h_surface(Rib *r, const Args *a)
         free(p);
         return -1;
     }
-    int known = in_list(builtin_surfaces, name);
+    int known = shader_known(r, builtin_surfaces, name);
     if (!known) {
         char key[128];
         snprintf(key, sizeof key, "surface %s", name);
-        warn_once(r, key, "surface shader \"%s\" is not built in: matte instead (with its Ka, Kd)",
+        warn_once(r, key,
+                  "surface shader \"%s\" is neither built in nor a plugin on the shader path: "
+                  "matte instead (with its Ka, Kd)",
                   name);
     }
     ShaderRec *sh = make_shader(r, known ? name : "matte", p, n, !known);
@@ -1874,10 +1884,13 @@ static int h_displacement(Rib *r, const Args *a)
         free(p);
         return -1;
     }
-    if (!in_list(builtin_displacements, name)) {
+    if (!shader_known(r, builtin_displacements, name)) {
         char key[128];
         snprintf(key, sizeof key, "displacement %s", name);
-        warn_once(r, key, "displacement shader \"%s\" is not built in: no displacement", name);
+        warn_once(r, key,
+                  "displacement shader \"%s\" is neither built in nor a plugin on the shader path: "
+                  "no displacement",
+                  name);
         r->a.displacement = NULL;
         free(p);
         return 0;

@@ -760,6 +760,14 @@ static size_t w_light_count(void *t)
     return (size_t)((RibWriter *)t)->next_light - 1;
 }
 
+/* RIB names any shader: a converted file keeps the names it was given,
+ * for the renderer that reads it to find (or fall back from). */
+static int w_has_shader(void *t, const char *name)
+{
+    (void)t;
+    return name && name[0];
+}
+
 static const char *w_get_error(void *t)
 {
     return ((RibWriter *)t)->error;
@@ -787,6 +795,7 @@ IoSink io_rib_writer_sink(RibWriter *w)
         .set_light_links = w_set_light_links,
         .light_count = w_light_count,
         .get_error = w_get_error,
+        .has_shader = w_has_shader,
     };
 }
 

@@ -105,6 +105,11 @@ static const char *scene_get_error(void *t)
     return rayes_scene_get_error(t);
 }
 
+static int scene_has_shader(void *t, const char *name)
+{
+    return rayes_scene_has_shader(t, name);
+}
+
 IoSink io_sink_scene(RayesScene *scene)
 {
     return (IoSink){
@@ -127,6 +132,7 @@ IoSink io_sink_scene(RayesScene *scene)
         .set_light_links = scene_set_light_links,
         .light_count = scene_light_count,
         .get_error = scene_get_error,
+        .has_shader = scene_has_shader,
     };
 }
 

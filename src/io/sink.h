@@ -59,6 +59,10 @@ typedef struct IoSink {
     size_t (*light_count)(void *target);
     /* The last error message of the target, for reports; "" if none. */
     const char *(*get_error)(void *target);
+    /* Nonzero if set_shader and set_displacement know the shader name (a
+     * plugin, say), for readers that fall back to a built-in one. May be
+     * NULL: only the built-in names are known. */
+    int (*has_shader)(void *target, const char *name);
 } IoSink;
 
 /* A sink that builds scene through rayes.h (borrowed, not retained). */

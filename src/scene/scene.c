@@ -270,9 +270,10 @@ static RayesError check_params(RayesScene *s, const char *what, const char *name
 }
 
 /* Sets *cls to a built-in class, else a plugin from the scene's shader
- * search path and then $RAYES_SHADER_PATH. Returns RAYES_OK, or the error
- * recorded in the scene. */
-static RayesError find_shader(RayesScene *s, const char *name, const RayesShaderClass **cls)
+ * search path and then $RAYES_SHADER_PATH. Returns RAYES_OK, or an error
+ * recorded in the scene when record is set. */
+static RayesError find_shader(RayesScene *s, const char *name, const RayesShaderClass **cls,
+                              int record)
 {
     *cls = shade_find_class(name);
     if (*cls)
@@ -282,11 +283,20 @@ static RayesError find_shader(RayesScene *s, const char *name, const RayesShader
     size_t len = strlen(mine) + (env ? strlen(env) : 0) + 2;
     char *path = malloc(len), err[512];
     if (!path)
-        return fail(s, RAYES_ERROR_OUT_OF_MEMORY, "out of memory");
+        return record ? fail(s, RAYES_ERROR_OUT_OF_MEMORY, "out of memory")
+                      : RAYES_ERROR_OUT_OF_MEMORY;
     snprintf(path, len, "%s:%s", mine, env ? env : "");
     *cls = shade_find_class_on_path(name, path, err, sizeof err);
     free(path);
-    return *cls ? RAYES_OK : fail(s, RAYES_ERROR_INVALID_ARGUMENT, "%s", err);
+    if (*cls)
+        return RAYES_OK;
+    return record ? fail(s, RAYES_ERROR_INVALID_ARGUMENT, "%s", err) : RAYES_ERROR_INVALID_ARGUMENT;
+}
+
+int rayes_scene_has_shader(RayesScene *s, const char *name)
+{
+    const RayesShaderClass *cls;
+    return s && name && name[0] && find_shader(s, name, &cls, 0) == RAYES_OK;
 }
 
 RayesError rayes_scene_set_shader(RayesScene *s, const char *name, const RayesParam *params,
@@ -295,7 +305,7 @@ RayesError rayes_scene_set_shader(RayesScene *s, const char *name, const RayesPa
     if (!s || !name || (n_params && !params))
         return RAYES_ERROR_INVALID_ARGUMENT;
     const RayesShaderClass *cls;
-    RayesError e = find_shader(s, name, &cls);
+    RayesError e = find_shader(s, name, &cls, 1);
     if (e != RAYES_OK)
         return e;
     e = check_params(s, "shader", name, params, n_params);
@@ -314,7 +324,7 @@ RayesError rayes_scene_set_displacement(RayesScene *s, const char *name, const R
         return RAYES_OK;
     }
     const RayesShaderClass *cls;
-    RayesError e = find_shader(s, name, &cls);
+    RayesError e = find_shader(s, name, &cls, 1);
     if (e != RAYES_OK)
         return e;
     if (!cls->displacement)

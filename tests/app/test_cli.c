@@ -283,6 +283,23 @@ static void test_unwritable_output(void)
 /* cornell-brick needs the plugin brick.so: missing, it is a one-line error
  * (status 1) naming the shader and --shader-path; with --shader-path (or
  * RAYES_SHADER_PATH) the render succeeds. */
+/* Nonzero if the two files hold the same bytes (and at most 64 KB). */
+static int same_file(const char *pa, const char *pb)
+{
+    static char a[1 << 16], b[1 << 16];
+    long na = file_size(pa), nb = file_size(pb);
+    if (!(na > 0 && na == nb && na < (long)sizeof a))
+        return 0;
+    FILE *fa = fopen(pa, "rb"), *fb = fopen(pb, "rb");
+    int same = fa && fb && fread(a, 1, (size_t)na, fa) == (size_t)na &&
+               fread(b, 1, (size_t)nb, fb) == (size_t)nb && memcmp(a, b, (size_t)na) == 0;
+    if (fa)
+        fclose(fa);
+    if (fb)
+        fclose(fb);
+    return same;
+}
+
 static void test_shader_path(void)
 {
     static Run r;
@@ -311,6 +328,24 @@ static void test_shader_path(void)
              SCRATCH_DIR "/brick.png"));
     unsetenv("RAYES_SHADER_PATH");
     CHECK(r.status == 0 && file_size(SCRATCH_DIR "/brick.png") > 8);
+    /* a RIB file names the plugin: converted (no plugin needed to write
+     * it), it renders the built-in scene's bytes when the plugin is found,
+     * and matte with a warning when it is not */
+    run(&r, NULL, ARGS("convert", "cornell-brick", SCRATCH_DIR "/brick.rib", "--quiet"));
+    CHECK(r.status == 0);
+    run(&r, NULL,
+        ARGS("render", "cornell-brick", "--res", "16", "--spp", "1", "--quiet", "--shader-path",
+             RAYES_TEST_SHADERS, "-o", SCRATCH_DIR "/brick-builtin.exr"));
+    CHECK(r.status == 0);
+    run(&r, NULL,
+        ARGS("render", SCRATCH_DIR "/brick.rib", "--res", "16", "--spp", "1", "--quiet",
+             "--shader-path", RAYES_TEST_SHADERS, "-o", SCRATCH_DIR "/brick-rib.exr"));
+    CHECK(r.status == 0 && r.err[0] == '\0');
+    CHECK(same_file(SCRATCH_DIR "/brick-builtin.exr", SCRATCH_DIR "/brick-rib.exr"));
+    run(&r, NULL,
+        ARGS("render", SCRATCH_DIR "/brick.rib", "--res", "16", "--spp", "1", "--quiet", "-o",
+             SCRATCH_DIR "/brick-rib.exr"));
+    CHECK(r.status == 0 && strstr(r.err, "\"brick\" is neither built in nor a plugin") != NULL);
 }
 
 static void write_text(const char *path, const char *text)
@@ -409,19 +444,7 @@ static void test_convert(void)
         ARGS("render", SCRATCH_DIR "/cornell.rib", "--res", "24", "--spp", "2", "--bounces", "1",
              "--threads", "2", "--quiet", "-o", SCRATCH_DIR "/converted.exr"));
     CHECK(r.status == 0);
-    static char a[1 << 16], b[1 << 16];
-    long na = file_size(SCRATCH_DIR "/builtin.exr"), nb = file_size(SCRATCH_DIR "/converted.exr");
-    CHECK(na > 100 && na == nb && na < (long)sizeof a);
-    if (na > 100 && na == nb && na < (long)sizeof a) {
-        FILE *fa = fopen(SCRATCH_DIR "/builtin.exr", "rb"),
-             *fb = fopen(SCRATCH_DIR "/converted.exr", "rb");
-        CHECK(fa && fb && fread(a, 1, (size_t)na, fa) == (size_t)na &&
-              fread(b, 1, (size_t)nb, fb) == (size_t)nb && memcmp(a, b, (size_t)na) == 0);
-        if (fa)
-            fclose(fa);
-        if (fb)
-            fclose(fb);
-    }
+    CHECK(same_file(SCRATCH_DIR "/builtin.exr", SCRATCH_DIR "/converted.exr"));
     /* a scene file converts too, and says what it wrote */
     write_text(SCRATCH_DIR "/room.obj", OBJ_SCENE);
     run(&r, NULL, ARGS("convert", SCRATCH_DIR "/room.obj", SCRATCH_DIR "/room.rib"));
