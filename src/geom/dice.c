@@ -336,10 +336,9 @@ static int dice_triangle(GridSet *gs, const Prim *prim, uint32_t prim_index, con
 }
 
 static int split_dice(GridSet *gs, const Prim *prim, uint32_t prim_index, const float *pool,
-                      const Domain *d, const DiceCamera *cam, int depth)
+                      const Domain *d, const DiceCamera *cam, Limits lim, int depth)
 {
     Estimate e = estimate(prim, d, cam);
-    Limits lim = limits_of(cam);
     int split = d->triangular ? e.n_u > lim.side
                               : (int64_t)e.n_u * e.n_v > lim.size ||
                                     e.n_u > GEOM_MAX_GRID - 1 || e.n_v > GEOM_MAX_GRID - 1;
@@ -361,7 +360,7 @@ static int split_dice(GridSet *gs, const Prim *prim, uint32_t prim_index, const 
             Domain sub = {.triangular = 1};
             for (int c = 0; c < 3; c++)
                 memcpy(sub.c[c], corners[s][c], sizeof sub.c[c]);
-            if (split_dice(gs, prim, prim_index, pool, &sub, cam, depth + 1) != 0)
+            if (split_dice(gs, prim, prim_index, pool, &sub, cam, lim, depth + 1) != 0)
                 return -1;
         }
         return 0;
@@ -376,7 +375,7 @@ static int split_dice(GridSet *gs, const Prim *prim, uint32_t prim_index, const 
             sub.c[1][0] = i + 1 == su ? d->c[1][0] : d->c[0][0] + du * (i + 1);
             sub.c[0][1] = d->c[0][1] + dv * j;
             sub.c[1][1] = j + 1 == sv ? d->c[1][1] : d->c[0][1] + dv * (j + 1);
-            if (split_dice(gs, prim, prim_index, pool, &sub, cam, depth + 1) != 0)
+            if (split_dice(gs, prim, prim_index, pool, &sub, cam, lim, depth + 1) != 0)
                 return -1;
         }
     return 0;
@@ -393,5 +392,5 @@ int geom_dice_prim(GridSet *gs, const Prim *prim, uint32_t prim_index, const flo
         const float c[3][2] = {{0, 0}, {1, 1}, {0, 0}};
         memcpy(d.c, c, sizeof c);
     }
-    return split_dice(gs, prim, prim_index, pv_pool, &d, cam, 0);
+    return split_dice(gs, prim, prim_index, pv_pool, &d, cam, limits_of(cam), 0);
 }
