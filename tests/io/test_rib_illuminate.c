@@ -1,5 +1,5 @@
 /*
- * Illuminate rendered (io/rib.c's light links through io_sink_scene): a
+ * Illuminate rendered (io/rib_shade.c's light links through io_sink_scene): a
  * light turned off around one object leaves that object lit by the other
  * lights alone, and the rest of the scene as if Illuminate were not there.
  */

@@ -1,0 +1,190 @@
+/*
+ * io/rib_frame.c — the block structure of a RIB file: frames (FrameBegin
+ * and FrameEnd: the first pass lists them, the second reads only the
+ * selected one), worlds (WorldBegin fixes the camera and turns the
+ * transform into world_from_object; WorldEnd flushes the lights) and
+ * object definitions (ObjectBegin records into a recording sink,
+ * rib_record.c, replayed per ObjectInstance with its transform). Archives
+ * are read by rib.c, which reads files.
+ */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "io/rib_reader.h"
+
+/* ------------------------------------------------------------ objects */
+
+static Object *find_object(Rib *r, const char *key)
+{
+    for (size_t k = 0; k < r->n_objects; k++)
+        if (strcmp(r->objects[k].key, key) == 0)
+            return &r->objects[k];
+    return NULL;
+}
+
+static int h_object_begin(Rib *r, const Args *a)
+{
+    size_t i = 0;
+    if (r->rec)
+        return rib_error(r, "ObjectBegin inside an object definition");
+    if (rib_get_handle(r, a, &i, r->rec_key) != 0)
+        return -1;
+    r->rec = rib_recording_new();
+    if (!r->rec)
+        return rib_error(r, "out of memory");
+    r->rec_sink = rib_recording_sink(r->rec);
+    memset(&r->recorded, 0, sizeof r->recorded);
+    memcpy(r->rec_saved_M, r->a.M, sizeof r->rec_saved_M);
+    rib_mat_identity(r->a.M);
+    return rib_push(r, 1);
+}
+
+static int h_object_end(Rib *r, const Args *a)
+{
+    (void)a;
+    if (!r->rec)
+        return rib_error(r, "ObjectEnd without ObjectBegin");
+    rib_pop(r, 1);
+    memcpy(r->a.M, r->rec_saved_M, sizeof r->a.M);
+    Object *o = find_object(r, r->rec_key);
+    if (!o) {
+        if (r->n_objects >= 65536)
+            return rib_error(r, "more than 65536 objects");
+        Object *no = realloc(r->objects, (r->n_objects + 1) * sizeof *no);
+        if (!no)
+            return rib_error(r, "out of memory");
+        r->objects = no;
+        o = &r->objects[r->n_objects++];
+        snprintf(o->key, sizeof o->key, "%s", r->rec_key);
+    } else {
+        rib_recording_free(o->rec);
+    }
+    o->rec = r->rec;
+    r->rec = NULL;
+    return 0;
+}
+
+static int h_object_instance(Rib *r, const Args *a)
+{
+    size_t i = 0;
+    char key[64];
+    if (rib_get_handle(r, a, &i, key) != 0)
+        return -1;
+    Object *o = find_object(r, key);
+    if (!o)
+        return rib_error(r, "no object has the handle %s", key[0] == '#' ? key + 1 : key);
+    if (r->rec)
+        return rib_error(r, "ObjectInstance inside an object definition");
+    if (!r->in_world) {
+        rib_warn_once(r, "outside world", "geometry outside WorldBegin/WorldEnd is ignored");
+        return 0;
+    }
+    if (rib_send_lights(r) != 0)
+        return -1;
+    RayesError e = rib_recording_replay(o->rec, r->sink, r->a.M);
+    memset(&r->real, 0, sizeof r->real); /* the replay changed the sink's state */
+    return e == RAYES_OK ? 0 : rib_sink_failed(r, r->sink);
+}
+
+/* ------------------------------------------------------ worlds, frames */
+
+static int h_world_begin(Rib *r, const Args *a)
+{
+    (void)a;
+    if (r->in_world)
+        return rib_error(r, "WorldBegin inside a world block");
+    if (r->pass == 1 && r->in_frame && r->n_frames > 0)
+        r->frames[r->n_frames - 1].renders |= !r->shadow_display;
+    if (r->worlds++ > 0 && !r->in_frame)
+        rib_warn_once(r, "worlds", "several world blocks outside frames are read into one scene");
+    memcpy(r->camera_from_world, r->a.M, sizeof r->a.M);
+    rib_mat_identity(r->a.M);
+    r->in_world = 1;
+    float sw[4];
+    const float *screen = NULL;
+    if (r->have_screen) {
+        screen = r->screen;
+    } else if (r->frame_aspect > 0) {
+        float fa = r->frame_aspect;
+        float s[4] = {-fa, fa, -1, 1}, t[4] = {-1, 1, -1 / fa, 1 / fa};
+        memcpy(sw, fa >= 1 ? s : t, sizeof sw);
+        screen = sw;
+    }
+    const IoSink *s = r->sink;
+    if (s->set_camera_matrix(s->target, r->camera_from_world, (RayesProjection)r->projection,
+                             r->fov, screen) != RAYES_OK)
+        return rib_sink_failed(r, s);
+    float wc[16];
+    rib_world_from_camera(r, wc);
+    for (size_t k = 0; k < r->n_lights; k++)
+        if (r->lights[k].pre_world) {
+            rib_mat_mul(wc, r->lights[k].M, r->lights[k].M);
+            r->lights[k].pre_world = 0;
+        }
+    memset(&r->real, 0, sizeof r->real);
+    return 0;
+}
+
+static int h_world_end(Rib *r, const Args *a)
+{
+    (void)a;
+    if (!r->in_world)
+        return rib_error(r, "WorldEnd without WorldBegin");
+    r->in_world = 0;
+    memcpy(r->a.M, r->camera_from_world, sizeof r->a.M);
+    return rib_flush_lights(r);
+}
+
+static int h_frame_begin(Rib *r, const Args *a)
+{
+    size_t i = 0;
+    float n = 0;
+    if (i < a->n && rib_get_floats(r, a, &i, &n, 1, "a frame number") != 0)
+        return -1;
+    if (!(fabsf(n) <= 1e9f) || n != floorf(n))
+        return rib_error(r, "the frame number must be an integer, found %g", n);
+    if (r->in_frame)
+        return rib_error(r, "FrameBegin inside a frame");
+    long ordinal = r->frame_ordinal++;
+    r->in_frame = 1;
+    if (r->pass == 1) {
+        Frame *f = realloc(r->frames, (r->n_frames + 1) * sizeof *f);
+        if (!f)
+            return rib_error(r, "out of memory");
+        r->frames = f;
+        r->frames[r->n_frames++] = (Frame){(long)n, 0};
+        r->frame_saved = *r->settings;
+        r->frame_saved_shadow = r->shadow_display;
+    } else if (ordinal != r->selected) {
+        r->skipping = 1;
+    }
+    return 0;
+}
+
+static int h_frame_end(Rib *r, const Args *a)
+{
+    (void)a;
+    if (!r->in_frame)
+        return rib_error(r, "FrameEnd without FrameBegin");
+    r->in_frame = 0;
+    if (r->pass == 1) { /* frames keep their options to themselves */
+        *r->settings = r->frame_saved;
+        r->shadow_display = r->frame_saved_shadow;
+    } else if (!r->skipping) {
+        r->done = 1; /* the selected frame is read */
+    }
+    r->skipping = 0;
+    return 0;
+}
+
+
+/* ------------------------------------------------------------ requests */
+
+const RibRequest rib_frame_requests[] = {
+    {"FrameBegin", h_frame_begin}, {"FrameEnd", h_frame_end}, {"WorldBegin", h_world_begin},
+    {"WorldEnd", h_world_end}, {"ObjectBegin", h_object_begin}, {"ObjectEnd", h_object_end},
+    {"ObjectInstance", h_object_instance},
+    {NULL, NULL},
+};

@@ -1,0 +1,301 @@
+/*
+ * io/rib_reader.h — the RIB reader's state and the helpers its files
+ * share. The reader (rib.h) is one file per concern:
+ *
+ *   rib.c         reading and dispatch: files and archives, a file's
+ *                 requests and their arguments, dispatch to the request
+ *                 tables, the two passes, entry points
+ *   rib_params.c  messages, and the arguments of requests: numbers,
+ *                 strings, handles, parameter lists, Declare and inline
+ *                 declarations, value counts
+ *   rib_state.c   graphics state, options and attributes: transforms,
+ *                 blocks, coordinate systems, camera and image options,
+ *                 Attribute and Option, Basis
+ *   rib_shade.c   shaders and lights, and bringing the sink up to date
+ *                 (transform, shader, light links) before a primitive
+ *   rib_prim.c    geometric primitives: polygons, patches, quadrics,
+ *                 Geometry, and their primitive variables
+ *   rib_frame.c   the block structure: frames, worlds, object definitions
+ *
+ * with rib_lex.c (tokens), rib_geom.c (tessellation, bases, matrices) and
+ * rib_record.c (object definitions) beside them (rib_internal.h). A new
+ * request goes into its concern's file, with a line in that file's table
+ * of requests (RibRequest), which rib.c's dispatch reads. The files call
+ * one way only (tools/check_deps): rib.c calls them all, rib_frame.c
+ * rib_state.c and rib_shade.c, rib_prim.c rib_shade.c, and every file
+ * rib_params.c, which calls none.
+ *
+ * State: the attribute state (transform, colour, shaders, orientation,
+ * basis) is a value copied onto a stack by AttributeBegin/TransformBegin.
+ * Shaders are immutable records (ShaderRec) owned by the reader, so the
+ * copies share them. What was last sent to each sink (transform, shader,
+ * ...) is remembered in a SinkState, and resent only when it changes.
+ * Every handler returns 0, or -1 with the message in Rib.err.
+ */
+#ifndef RAYES_IO_RIB_READER_H
+#define RAYES_IO_RIB_READER_H
+
+#include <stddef.h>
+
+#include "io/rib_internal.h"
+#include "io/rib_lex.h"
+#include "io/sink.h"
+
+#define RIB_MAX_ARCHIVE_DEPTH 32
+#define RIB_MAX_STACK 1024
+#define RIB_MAX_ARGS 1000000
+#define RIB_MAX_FILE_BYTES ((size_t)1 << 30)
+#define RIB_MAX_WARNED 512
+#define RIB_MAX_LIGHTS 4096
+
+/* ----------------------------------------------------------- arguments */
+
+typedef enum ArgKind { ARG_NUM, ARG_STR, ARG_NUMS, ARG_STRS } ArgKind;
+
+typedef struct Arg {
+    ArgKind kind;
+    double *d;   /* NUM, NUMS */
+    char **s;    /* STR, STRS */
+    size_t n;    /* values */
+    long line, col;
+} Arg;
+
+typedef struct Args {
+    Arg *v;
+    size_t n, cap;
+} Args;
+
+/* ------------------------------------------------------- declarations */
+
+typedef enum Cls { CLS_CONSTANT, CLS_UNIFORM, CLS_VARYING, CLS_VERTEX, CLS_FACEVARYING } Cls;
+typedef enum Ty { TY_FLOAT, TY_INT, TY_STRING, TY_COLOR, TY_POINT, TY_HPOINT, TY_MATRIX } Ty;
+
+typedef struct Decl {
+    char name[64];
+    Cls cls;
+    Ty ty;
+    int array; /* elements per value, >= 1 */
+} Decl;
+
+typedef struct Param {
+    Decl d;
+    int declared; /* 0: unknown name, type guessed from the values */
+    const Arg *v;
+} Param;
+
+/* ------------------------------------------------------------- state */
+
+typedef struct ShaderRec {
+    char name[64];
+    RayesParam *params; /* names and strings owned */
+    size_t n;
+    struct ShaderRec *next;
+} ShaderRec;
+
+enum { ORIENT_OUTSIDE, ORIENT_INSIDE, ORIENT_LH, ORIENT_RH };
+
+typedef struct Attr {
+    float M[16];               /* camera_from_object before WorldBegin, world_from_object after */
+    int orient;
+    float Cs[3], Os[3];
+    long color_gen;            /* changes with Cs/Os */
+    const ShaderRec *surface;  /* NULL: matte */
+    const ShaderRec *displacement;
+    float shading_rate;
+    float bound;
+    int area;                  /* AreaLightSource in force */
+    unsigned char on[RIB_MAX_LIGHTS / 8]; /* bit k: Rib.lights[k] is on */
+    float area_L[3];
+    float ubasis[16], vbasis[16];
+    int ustep, vstep;
+} Attr;
+
+typedef struct SinkState {
+    float M[16];
+    int have_M;
+    const ShaderRec *surface;
+    long color_gen;
+    int have_shader;
+    const ShaderRec *displacement;
+    int have_displacement;
+    float rate, bound;
+    int have_rate, have_bound;
+} SinkState;
+
+#define RIB_LIGHT_PARAMS 12
+
+typedef struct Light {
+    char handle[64];
+    char type[32];
+    RayesParam params[RIB_LIGHT_PARAMS];
+    char names[RIB_LIGHT_PARAMS][64];
+    char category[128];
+    size_t n;
+    float M[16];   /* world_from_light (camera_from_light before WorldBegin) */
+    int pre_world;
+    long index;    /* the sink's index of the light once sent, else -1 */
+} Light;
+
+typedef struct Object {
+    char key[64];
+    RibRecording *rec;
+} Object;
+
+typedef struct Frame {
+    long number;
+    int renders; /* a world block whose display is not a shadow map */
+} Frame;
+
+typedef struct StackEntry {
+    Attr a;
+    int attribute; /* 1: AttributeBegin, 0: TransformBegin */
+} StackEntry;
+
+typedef struct Rib {
+    int pass;                  /* 1: check and list frames, 2: read into the sink */
+    const IoSink *sink;
+    const IoReadOptions *opt;
+    IoSettings *settings;
+    char *err;
+    size_t err_size;
+    RibLexer *lx;              /* the file being read (NULL after the top file ends) */
+    const char *top_name;      /* the top file, for messages after it ends */
+    const char *file;          /* its path */
+    char req[64];              /* the current request */
+    long req_line, req_col;
+    int archive_depth;
+
+    Attr a;
+    StackEntry *stack;
+    size_t depth;
+    long next_gen;
+    ShaderRec *shaders;
+
+    int in_world;
+    int worlds;
+    float camera_from_world[16];
+    int projection;            /* RayesProjection */
+    float fov;
+    float screen[4];
+    int have_screen;
+    float frame_aspect;
+    int width, height;
+
+    Decl *decls;
+    size_t n_decls;
+    Light *lights;
+    size_t n_lights;
+    size_t *links;             /* the light links last sent (EXCEPT these; none: ALL) */
+    size_t n_links;
+    Object *objects;
+    size_t n_objects;
+    RibRecording *rec;         /* the object being defined */
+    IoSink rec_sink;
+    char rec_key[64];
+    float rec_saved_M[16];
+    SinkState real, recorded;
+
+    char archive_path[4096];
+    char *coordsys_names;      /* CoordinateSystem: n x 64 names */
+    float *coordsys_M;
+    int *coordsys_world;
+    size_t n_coordsys;
+
+    Frame *frames;
+    size_t n_frames;
+    long frame_ordinal;
+    long selected;             /* ordinal of the frame to read, -1: no frames */
+    int in_frame, skipping, done;
+    int shadow_display;
+    IoSettings frame_saved;
+    int frame_saved_shadow;
+    int motion, motion_seen;
+    int archive_block;
+
+    char *warned[RIB_MAX_WARNED];
+    size_t n_warned;
+} Rib;
+
+/* Counts of a primitive's classes, for value-count checks. */
+typedef struct Counts {
+    size_t uniform, varying, vertex, facevarying;
+} Counts;
+
+/* ------------------------------------------------------------ requests */
+
+typedef int (*Handler)(Rib *r, const Args *a);
+
+/* A request a file handles; each file's table ends with {NULL, NULL}. */
+typedef struct RibRequest {
+    const char *name;
+    Handler fn;
+} RibRequest;
+
+extern const RibRequest rib_params_requests[]; /* rib_params.c */
+extern const RibRequest rib_state_requests[];  /* rib_state.c */
+extern const RibRequest rib_shade_requests[];  /* rib_shade.c */
+extern const RibRequest rib_prim_requests[];   /* rib_prim.c */
+extern const RibRequest rib_frame_requests[];  /* rib_frame.c */
+
+/* ------------------------------------- rib_params.c: messages, arguments */
+
+/* Sets r->err to "file:line:col: Request: message" at the current
+ * request (rib_arg_error: at argument a) and returns -1. */
+int rib_error(Rib *r, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+int rib_arg_error(Rib *r, const Arg *a, const char *fmt, ...) __attribute__((format(printf, 3, 4)));
+/* One warning per key and read (the second pass only, so each is said once). */
+void rib_warn_once(Rib *r, const char *key, const char *fmt, ...) __attribute__((format(printf, 3, 4)));
+/* The sink's own message as the request's error; returns -1. */
+int rib_sink_failed(Rib *r, const IoSink *s);
+/* A copy of s (malloc), or NULL. */
+char *rib_strdup(const char *s);
+
+int rib_is_num(const Arg *g);
+/* n numbers from args *i on (scalars or arrays, an array taken whole). */
+int rib_get_floats(Rib *r, const Args *a, size_t *i, float *out, size_t n, const char *what);
+/* The string at *i (owned by a), or NULL with the error set. */
+const char *rib_get_string(Rib *r, const Args *a, size_t *i, const char *what);
+/* A handle: an integer or a string, as a key. */
+int rib_get_handle(Rib *r, const Args *a, size_t *i, char key[64]);
+/* An integer array (or one integer) with every value in [lo, hi]; *out
+ * is a new array of *n values. */
+int rib_get_ints(Rib *r, const Args *a, size_t *i, int **out, size_t *n, long lo, long hi,
+                 const char *what);
+/* Numbers per value of a type: 1, 3, 4 or 16. */
+int rib_type_size(Ty t);
+/* The parameter list of args[start..]: pairs of a name and values, as a
+ * new array of *n_out parameters (pointing into a). */
+int rib_get_params(Rib *r, const Args *a, size_t start, Param **out, size_t *n_out);
+/* The last parameter called name, or NULL. */
+const Param *rib_find_param(const Param *p, size_t n, const char *name);
+/* Checks the number of values of each declared parameter against the
+ * primitive's counts c (warning about undeclared ones). */
+int rib_check_counts(Rib *r, const Param *p, size_t n, const Counts *c);
+/* Warns once per parameter name a primitive does not use. */
+void rib_warn_unused(Rib *r, const Param *p, size_t n);
+/* The primitive's "Cs" when it is one colour per value; NULL otherwise. */
+const Param *rib_color_param(Rib *r, const Param *p, size_t n);
+
+/* --------------------------------------------------- rib_state.c: state */
+
+/* AttributeBegin (attribute 1) or TransformBegin (0), and their ends. */
+int rib_push(Rib *r, int attribute);
+int rib_pop(Rib *r, int attribute);
+/* world_from_camera, or the identity (with a warning) when singular. */
+void rib_world_from_camera(Rib *r, float m[16]);
+
+/* -------------------------------------------- rib_shade.c: the sink's state */
+
+/* The sink geometry goes to (the recording inside ObjectBegin) and what
+ * it was last sent. */
+const IoSink *rib_out_sink(Rib *r, SinkState **st);
+/* Brings the sink up to date before a primitive; Cs overrides the
+ * colour (a per-face colour) when not NULL. 1: skip (outside the world). */
+int rib_emit_begin(Rib *r, const float *Cs);
+/* Sends the lights never sent and the light links, if they changed. */
+int rib_send_lights(Rib *r);
+/* At WorldEnd: sends the lights on then that were never sent, and ends
+ * the world's lights. */
+int rib_flush_lights(Rib *r);
+
+#endif /* RAYES_IO_RIB_READER_H */

@@ -1,0 +1,474 @@
+/*
+ * io/rib_shade.c — shaders and lights of the RIB reader, and bringing the
+ * sink up to date before each primitive (rib_emit_begin: transform,
+ * shader and colour, displacement, shading rate, light links), sending
+ * only what changed since the sink last heard it (SinkState).
+ *
+ * Shaders: a name built in or known to the sink (a plugin on its search
+ * path) is kept with the parameters the API can take; another name
+ * becomes matte (with its Ka, Kd) with one warning. Lights: which are on
+ * is an attribute (a bit per light in Attr, saved by AttributeBegin, not
+ * by TransformBegin; LightSource turns the new light on, Illuminate on or
+ * off). A light is sent at the first geometry after its LightSource, on
+ * or off, or at WorldEnd if it is on then (one that no geometry followed
+ * and that is off at the end lights nothing, and is not sent); each
+ * geometry's objects get the light links EXCEPT the lights that are off
+ * for it. A light still lights the geometry before its LightSource (as
+ * every light did before light linking), and area lights light
+ * everything.
+ */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "io/rib_reader.h"
+
+/* ---------------------------------------------------------- emission */
+
+const IoSink *rib_out_sink(Rib *r, SinkState **st)
+{
+    *st = r->rec ? &r->recorded : &r->real;
+    return r->rec ? &r->rec_sink : r->sink;
+}
+
+static const float white[3] = {1, 1, 1};
+
+static int send_shader(Rib *r, const IoSink *s, const float Cs[3])
+{
+    const ShaderRec *sh = r->a.surface;
+    size_t n = sh ? sh->n : 0;
+    RayesParam *p = malloc((n + 2) * sizeof *p);
+    if (!p)
+        return rib_error(r, "out of memory");
+    if (n)
+        memcpy(p, sh->params, n * sizeof *p);
+    p[n++] = (RayesParam){"Cs", RAYES_PARAM_COLOR, {Cs[0], Cs[1], Cs[2]}, NULL};
+    if (memcmp(r->a.Os, white, sizeof white) != 0)
+        p[n++] = (RayesParam){"Os", RAYES_PARAM_COLOR, {r->a.Os[0], r->a.Os[1], r->a.Os[2]}, NULL};
+    RayesError e = s->set_shader(s->target, sh ? sh->name : "matte", p, n);
+    free(p);
+    return e == RAYES_OK ? 0 : rib_sink_failed(r, s);
+}
+
+static int light_on(const Attr *a, size_t k)
+{
+    return (a->on[k / 8] >> (k % 8)) & 1;
+}
+
+static void set_light_on(Attr *a, size_t k, int on)
+{
+    unsigned bit = 1u << (k % 8);
+    a->on[k / 8] = (unsigned char)(on ? a->on[k / 8] | bit : a->on[k / 8] & ~bit);
+}
+
+static int send_light(Rib *r, Light *L)
+{
+    const IoSink *s = r->sink;
+    size_t index = s->light_count(s->target);
+    for (size_t i = 0; i < L->n; i++) { /* the array may have moved since */
+        L->params[i].name = L->names[i];
+        if (L->params[i].type == RAYES_PARAM_STRING)
+            L->params[i].string = L->category;
+    }
+    if (s->set_transform(s->target, L->M) != RAYES_OK ||
+        s->light(s->target, L->type, L->params, L->n) != RAYES_OK)
+        return rib_sink_failed(r, s);
+    L->index = (long)index;
+    r->real.have_M = 0;
+    return 0;
+}
+
+/* Before geometry (not in an object definition) or an instance: sends the
+ * lights never sent, on or off (so that the links of this geometry can
+ * exclude them), then the light links (EXCEPT the sent
+ * lights that are off) if they changed; new links need a new object, so
+ * the shader is sent again. */
+int rib_send_lights(Rib *r)
+{
+    const IoSink *s = r->sink;
+    size_t n = 0;
+    int changed = 0;
+    for (size_t k = 0; k < r->n_lights; k++) {
+        Light *L = &r->lights[k];
+        if (L->index < 0 && send_light(r, L) != 0)
+            return -1;
+        if (light_on(&r->a, k))
+            continue;
+        if (n >= r->n_links || r->links[n] != (size_t)L->index) {
+            size_t *nl = realloc(r->links, (n + 1) * sizeof *nl);
+            if (!nl)
+                return rib_error(r, "out of memory");
+            r->links = nl;
+            r->links[n] = (size_t)L->index;
+            changed = 1;
+        }
+        n++;
+    }
+    if (!changed && n == r->n_links)
+        return 0;
+    r->n_links = n;
+    if (s->set_light_links(s->target, n ? RAYES_LIGHT_LINKS_EXCEPT : RAYES_LIGHT_LINKS_ALL,
+                           r->links, n) != RAYES_OK)
+        return rib_sink_failed(r, s);
+    r->real.have_shader = 0;
+    return 0;
+}
+
+/* Brings the sink up to date before a primitive; Cs overrides the
+ * colour (a per-face colour) when not NULL. 1: skip (outside the world). */
+int rib_emit_begin(Rib *r, const float *Cs)
+{
+    if (!r->in_world && !r->rec) {
+        rib_warn_once(r, "outside world", "geometry outside WorldBegin/WorldEnd is ignored");
+        return 1;
+    }
+    if (!r->rec && rib_send_lights(r) != 0)
+        return -1;
+    SinkState *st;
+    const IoSink *s = rib_out_sink(r, &st);
+    if (!st->have_M || memcmp(st->M, r->a.M, sizeof st->M) != 0) {
+        if (s->set_transform(s->target, r->a.M) != RAYES_OK)
+            return rib_sink_failed(r, s);
+        memcpy(st->M, r->a.M, sizeof st->M);
+        st->have_M = 1;
+    }
+    if (Cs) {
+        if (send_shader(r, s, Cs) != 0)
+            return -1;
+        st->have_shader = 0;
+    } else if (!st->have_shader || st->surface != r->a.surface || st->color_gen != r->a.color_gen) {
+        if (send_shader(r, s, r->a.Cs) != 0)
+            return -1;
+        st->surface = r->a.surface;
+        st->color_gen = r->a.color_gen;
+        st->have_shader = 1;
+    }
+    if (!st->have_displacement || st->displacement != r->a.displacement) {
+        const ShaderRec *d = r->a.displacement;
+        if (s->set_displacement(s->target, d ? d->name : NULL, d ? d->params : NULL,
+                                d ? d->n : 0) != RAYES_OK)
+            return rib_sink_failed(r, s);
+        st->displacement = d;
+        st->have_displacement = 1;
+    }
+    if (!st->have_rate || st->rate != r->a.shading_rate) {
+        if (s->set_shading_rate(s->target, r->a.shading_rate) != RAYES_OK)
+            return rib_sink_failed(r, s);
+        st->rate = r->a.shading_rate;
+        st->have_rate = 1;
+    }
+    if (!st->have_bound || st->bound != r->a.bound) {
+        if (s->set_displacement_bound(s->target, r->a.bound) != RAYES_OK)
+            return rib_sink_failed(r, s);
+        st->bound = r->a.bound;
+        st->have_bound = 1;
+    }
+    return 0;
+}
+
+/* ------------------------------------------------------------ shaders */
+
+static const char *const builtin_surfaces[] = {"matte", "plastic", "metal", "shinymetal",
+                                               "constant", "glass", "mirror", "paintedplastic",
+                                               "diffuse", "conductor", "dielectric",
+                                               "coateddiffuse", NULL};
+static const char *const builtin_displacements[] = {"bumpy", "fractal", NULL};
+
+static int in_list(const char *const *list, const char *s)
+{
+    for (int k = 0; list[k]; k++)
+        if (strcmp(list[k], s) == 0)
+            return 1;
+    return 0;
+}
+
+/* A new shader record of name with the parameters the API can take. */
+static ShaderRec *make_shader(Rib *r, const char *name, const Param *p, size_t n, int only_k)
+{
+    ShaderRec *sh = calloc(1, sizeof *sh);
+    if (sh)
+        sh->params = calloc(n + 1, sizeof *sh->params);
+    if (!sh || !sh->params) {
+        free(sh);
+        rib_error(r, "out of memory");
+        return NULL;
+    }
+    sh->next = r->shaders;
+    r->shaders = sh;
+    snprintf(sh->name, sizeof sh->name, "%s", name);
+    for (size_t i = 0; i < n; i++) {
+        const Param *q = &p[i];
+        if (only_k && strcmp(q->d.name, "Kd") != 0 && strcmp(q->d.name, "Ka") != 0)
+            continue;
+        if (!q->declared)
+            continue;
+        RayesParam o = {NULL, RAYES_PARAM_NONE, {0, 0, 0}, NULL};
+        if (q->d.ty == TY_STRING && q->v->n == 1) {
+            o.type = RAYES_PARAM_STRING;
+            o.string = rib_strdup(q->v->s[0]);
+            if (!o.string)
+                return NULL;
+        } else if ((q->d.ty == TY_FLOAT || q->d.ty == TY_INT) && q->v->n == 1) {
+            o.type = RAYES_PARAM_FLOAT;
+            o.value[0] = (float)q->v->d[0];
+        } else if (q->d.ty == TY_COLOR || q->d.ty == TY_POINT) {
+            if (q->v->n != 3)
+                continue;
+            o.type = RAYES_PARAM_COLOR;
+            for (int c = 0; c < 3; c++)
+                o.value[c] = (float)q->v->d[c];
+        } else {
+            continue;
+        }
+        o.name = rib_strdup(q->d.name);
+        if (!o.name) {
+            free((char *)o.string);
+            return NULL;
+        }
+        sh->params[sh->n++] = o;
+    }
+    return sh;
+}
+
+/* A built-in shader name, or one the sink knows (a plugin on its search
+ * path). */
+static int shader_known(Rib *r, const char *const *builtins, const char *name)
+{
+    return in_list(builtins, name) ||
+           (r->sink->has_shader && r->sink->has_shader(r->sink->target, name));
+}
+
+static int h_surface(Rib *r, const Args *a)
+{
+    size_t i = 0;
+    const char *name = rib_get_string(r, a, &i, "a shader name");
+    Param *p;
+    size_t n;
+    if (!name || rib_get_params(r, a, i, &p, &n) != 0)
+        return -1;
+    static const Counts one = {1, 1, 1, 1};
+    if (rib_check_counts(r, p, n, &one) != 0) {
+        free(p);
+        return -1;
+    }
+    int known = shader_known(r, builtin_surfaces, name);
+    if (!known) {
+        char key[128];
+        snprintf(key, sizeof key, "surface %s", name);
+        rib_warn_once(r, key,
+                  "surface shader \"%s\" is neither built in nor a plugin on the shader path: "
+                  "matte instead (with its Ka, Kd)",
+                  name);
+    }
+    ShaderRec *sh = make_shader(r, known ? name : "matte", p, n, !known);
+    free(p);
+    if (!sh)
+        return -1;
+    r->a.surface = sh;
+    return 0;
+}
+
+static int h_displacement(Rib *r, const Args *a)
+{
+    size_t i = 0;
+    const char *name = rib_get_string(r, a, &i, "a shader name");
+    Param *p;
+    size_t n;
+    if (!name || rib_get_params(r, a, i, &p, &n) != 0)
+        return -1;
+    static const Counts one = {1, 1, 1, 1};
+    if (rib_check_counts(r, p, n, &one) != 0) {
+        free(p);
+        return -1;
+    }
+    if (!shader_known(r, builtin_displacements, name)) {
+        char key[128];
+        snprintf(key, sizeof key, "displacement %s", name);
+        rib_warn_once(r, key,
+                  "displacement shader \"%s\" is neither built in nor a plugin on the shader path: "
+                  "no displacement",
+                  name);
+        r->a.displacement = NULL;
+        free(p);
+        return 0;
+    }
+    ShaderRec *sh = make_shader(r, name, p, n, 0);
+    free(p);
+    if (!sh)
+        return -1;
+    r->a.displacement = sh;
+    return 0;
+}
+
+static Light *find_light(Rib *r, const char *handle)
+{
+    for (size_t k = 0; k < r->n_lights; k++)
+        if (strcmp(r->lights[k].handle, handle) == 0)
+            return &r->lights[k];
+    return NULL;
+}
+
+static int h_light_source(Rib *r, const Args *a)
+{
+    size_t i = 0;
+    const char *name = rib_get_string(r, a, &i, "a light shader name");
+    char handle[64];
+    if (!name)
+        return -1;
+    if (i < a->n && (a->n - i) % 2 == 1) { /* parameters come in pairs: the odd one out */
+        if (rib_get_handle(r, a, &i, handle) != 0)
+            return -1;
+    } else {
+        snprintf(handle, sizeof handle, "@%zu", r->n_lights);
+    }
+    Param *p;
+    size_t n;
+    if (rib_get_params(r, a, i, &p, &n) != 0)
+        return -1;
+    static const Counts one = {1, 1, 1, 1};
+    if (rib_check_counts(r, p, n, &one) != 0) {
+        free(p);
+        return -1;
+    }
+    const char *type = NULL;
+    int spot = 0;
+    if (strcmp(name, "pointlight") == 0)
+        type = "pointlight";
+    else if (strcmp(name, "distantlight") == 0)
+        type = "distantlight";
+    else if (strcmp(name, "spotlight") == 0 || strcmp(name, "shadowspot") == 0)
+        type = "spotlight", spot = 1;
+    else if (strcmp(name, "ambientlight") == 0)
+        type = "ambientlight";
+    if (r->rec) {
+        rib_warn_once(r, "light in object", "lights inside ObjectBegin are ignored");
+        type = NULL;
+    } else if (!type) {
+        char key[128];
+        snprintf(key, sizeof key, "light %s", name);
+        rib_warn_once(r, key, "light shader \"%s\" is not built in; the light is skipped", name);
+    }
+    if (!type) {
+        free(p);
+        return 0;
+    }
+    if (r->n_lights >= RIB_MAX_LIGHTS) {
+        free(p);
+        return rib_error(r, "more than %d lights", RIB_MAX_LIGHTS);
+    }
+    Light *L = find_light(r, handle);
+    if (L && L->index < 0) {
+        /* redefined before any geometry saw it: replace */
+    } else {
+        if (L)
+            L->handle[0] = '\0'; /* the old one keeps lighting; the handle moves on */
+        Light *nl = realloc(r->lights, (r->n_lights + 1) * sizeof *nl);
+        if (!nl) {
+            free(p);
+            return rib_error(r, "out of memory");
+        }
+        r->lights = nl;
+        L = &r->lights[r->n_lights++];
+    }
+    memset(L, 0, sizeof *L);
+    snprintf(L->handle, sizeof L->handle, "%s", handle);
+    snprintf(L->type, sizeof L->type, "%s", type);
+    memcpy(L->M, r->a.M, sizeof L->M);
+    L->pre_world = !r->in_world;
+    L->index = -1;
+    set_light_on(&r->a, (size_t)(L - r->lights), 1);
+    static const char *const names[] = {"intensity", "lightcolor", "from", "to", "coneangle",
+                                        "conedeltaangle", "beamdistribution", "__category", NULL};
+    for (size_t k = 0; k < n && L->n < RIB_LIGHT_PARAMS; k++) {
+        const Param *q = &p[k];
+        if (!in_list(names, q->d.name) || !q->declared)
+            continue;
+        RayesParam *o = &L->params[L->n];
+        snprintf(L->names[L->n], sizeof L->names[0], "%s", q->d.name);
+        o->name = L->names[L->n];
+        if (q->d.ty == TY_STRING) {
+            if (q->v->n != 1)
+                continue;
+            snprintf(L->category, sizeof L->category, "%s", q->v->s[0]);
+            o->type = RAYES_PARAM_STRING;
+            o->string = L->category;
+        } else if (q->v->n == 3) {
+            o->type = RAYES_PARAM_COLOR;
+            for (int c = 0; c < 3; c++)
+                o->value[c] = (float)q->v->d[c];
+        } else if (q->v->n == 1) {
+            o->type = RAYES_PARAM_FLOAT;
+            o->value[0] = (float)q->v->d[0];
+            if (spot && (strcmp(q->d.name, "coneangle") == 0 ||
+                         strcmp(q->d.name, "conedeltaangle") == 0))
+                o->value[0] = (float)(o->value[0] * 180 / M_PI); /* RenderMan gives radians */
+        } else {
+            continue;
+        }
+        L->n++;
+    }
+    free(p);
+    return 0;
+}
+
+static int h_area_light(Rib *r, const Args *a)
+{
+    size_t i = 0;
+    const char *name = rib_get_string(r, a, &i, "a light shader name");
+    char handle[64];
+    if (!name)
+        return -1;
+    if (i < a->n && (a->n - i) % 2 == 1)
+        if (rib_get_handle(r, a, &i, handle) != 0)
+            return -1;
+    Param *p;
+    size_t n;
+    if (rib_get_params(r, a, i, &p, &n) != 0)
+        return -1;
+    const Param *in = rib_find_param(p, n, "intensity"), *lc = rib_find_param(p, n, "lightcolor");
+    float I = in && rib_is_num(in->v) && in->v->n == 1 ? (float)in->v->d[0] : 1;
+    for (int c = 0; c < 3; c++)
+        r->a.area_L[c] = I * (lc && rib_is_num(lc->v) && lc->v->n == 3 ? (float)lc->v->d[c] : 1);
+    r->a.area = 1;
+    free(p);
+    return 0;
+}
+
+static int h_illuminate(Rib *r, const Args *a)
+{
+    size_t i = 0;
+    char handle[64];
+    float on;
+    if (rib_get_handle(r, a, &i, handle) != 0 || rib_get_floats(r, a, &i, &on, 1, "0 or 1") != 0)
+        return -1;
+    Light *L = find_light(r, handle);
+    if (!L)
+        return rib_error(r, "no light has the handle %s", handle[0] == '#' ? handle + 1 : handle);
+    set_light_on(&r->a, (size_t)(L - r->lights), on != 0);
+    return 0;
+}
+
+/* At WorldEnd: sends the lights on then that were never sent, and ends
+ * the world's lights (the next world starts with none, and all links). */
+int rib_flush_lights(Rib *r)
+{
+    for (size_t k = 0; k < r->n_lights; k++) {
+        Light *L = &r->lights[k];
+        if (L->index < 0 && light_on(&r->a, k) && send_light(r, L) != 0)
+            return -1;
+    }
+    r->n_lights = 0;
+    memset(r->a.on, 0, sizeof r->a.on);
+    r->real.have_M = 0;
+    return 0;
+}
+
+
+/* ------------------------------------------------------------ requests */
+
+const RibRequest rib_shade_requests[] = {
+    {"Surface", h_surface}, {"Displacement", h_displacement}, {"LightSource", h_light_source},
+    {"AreaLightSource", h_area_light}, {"Illuminate", h_illuminate},
+    {NULL, NULL},
+};

@@ -1,0 +1,617 @@
+/*
+ * io/rib_state.c — the graphics state of the RIB reader: transforms and
+ * the AttributeBegin/TransformBegin stack, coordinate systems, the camera
+ * and image options (Format, Projection, Display, PixelSamples, ...) that
+ * go to IoSettings or to the camera at WorldBegin, the attributes that
+ * are values of Attr (colour, orientation, shading rate, Basis), and
+ * Attribute and Option. Before WorldBegin the current transform is
+ * camera_from_object, after it world_from_object (Attr.M).
+ */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "io/rib_reader.h"
+
+/* --------------------------------------------------------- transforms */
+
+static void concat(Rib *r, const float m[16])
+{
+    rib_mat_mul(r->a.M, m, r->a.M);
+}
+
+static int h_translate(Rib *r, const Args *a)
+{
+    size_t i = 0;
+    float v[3], m[16];
+    if (rib_get_floats(r, a, &i, v, 3, "dx dy dz") != 0)
+        return -1;
+    rib_mat_identity(m);
+    m[3] = v[0], m[7] = v[1], m[11] = v[2];
+    concat(r, m);
+    return 0;
+}
+
+static int h_scale(Rib *r, const Args *a)
+{
+    size_t i = 0;
+    float v[3], m[16];
+    if (rib_get_floats(r, a, &i, v, 3, "sx sy sz") != 0)
+        return -1;
+    rib_mat_identity(m);
+    m[0] = v[0], m[5] = v[1], m[10] = v[2];
+    concat(r, m);
+    return 0;
+}
+
+static int h_rotate(Rib *r, const Args *a)
+{
+    size_t i = 0;
+    float v[4], m[16];
+    if (rib_get_floats(r, a, &i, v, 4, "angle dx dy dz") != 0)
+        return -1;
+    double len = sqrt((double)v[1] * v[1] + (double)v[2] * v[2] + (double)v[3] * v[3]);
+    if (!(len > 0))
+        return rib_error(r, "the rotation axis is zero");
+    double x = v[1] / len, y = v[2] / len, z = v[3] / len;
+    double th = v[0] * M_PI / 180, c = cos(th), s = sin(th), t = 1 - c;
+    float rm[16] = {(float)(t * x * x + c), (float)(t * x * y - s * z), (float)(t * x * z + s * y), 0,
+                    (float)(t * x * y + s * z), (float)(t * y * y + c), (float)(t * y * z - s * x), 0,
+                    (float)(t * x * z - s * y), (float)(t * y * z + s * x), (float)(t * z * z + c), 0,
+                    0, 0, 0, 1};
+    memcpy(m, rm, sizeof m);
+    concat(r, m);
+    return 0;
+}
+
+static int get_matrix(Rib *r, const Args *a, float m[16])
+{
+    size_t i = 0;
+    float v[16];
+    if (rib_get_floats(r, a, &i, v, 16, "a 4 x 4 matrix") != 0)
+        return -1;
+    for (int row = 0; row < 4; row++) /* RIB matrices map row vectors: transpose */
+        for (int col = 0; col < 4; col++)
+            m[4 * row + col] = v[4 * col + row];
+    return 0;
+}
+
+static int h_transform(Rib *r, const Args *a)
+{
+    return get_matrix(r, a, r->a.M);
+}
+
+static int h_concat(Rib *r, const Args *a)
+{
+    float m[16];
+    if (get_matrix(r, a, m) != 0)
+        return -1;
+    concat(r, m);
+    return 0;
+}
+
+static int h_identity(Rib *r, const Args *a)
+{
+    (void)a;
+    rib_mat_identity(r->a.M);
+    return 0;
+}
+
+static int h_perspective(Rib *r, const Args *a)
+{
+    size_t i = 0;
+    float fov;
+    if (rib_get_floats(r, a, &i, &fov, 1, "fov") != 0)
+        return -1;
+    if (!(fov > 0 && fov < 180))
+        return rib_error(r, "fov must be in (0, 180)");
+    float t = (float)tan(fov * M_PI / 360), m[16] = {1 / t, 0, 0, 0, 0, 1 / t, 0, 0, 0, 0, 1, 0, 0, 0, 1, 0};
+    rib_warn_once(r, "Perspective", "Perspective concatenates a projective matrix; use Projection");
+    concat(r, m);
+    return 0;
+}
+
+int rib_push(Rib *r, int attribute)
+{
+    if (r->depth >= RIB_MAX_STACK)
+        return rib_error(r, "more than %d nested blocks", RIB_MAX_STACK);
+    if (!r->stack) {
+        r->stack = malloc(RIB_MAX_STACK * sizeof *r->stack);
+        if (!r->stack)
+            return rib_error(r, "out of memory");
+    }
+    r->stack[r->depth].a = r->a;
+    r->stack[r->depth++].attribute = attribute;
+    return 0;
+}
+
+int rib_pop(Rib *r, int attribute)
+{
+    if (r->depth == 0) {
+        rib_warn_once(r, attribute ? "AttributeEnd" : "TransformEnd", "%s without a matching begin",
+                  r->req);
+        return 0;
+    }
+    StackEntry *s = &r->stack[--r->depth];
+    if (s->attribute != attribute)
+        rib_warn_once(r, "unbalanced", "%s closes a %s block", r->req,
+                  s->attribute ? "AttributeBegin" : "TransformBegin");
+    if (attribute)
+        r->a = s->a;
+    else
+        memcpy(r->a.M, s->a.M, sizeof r->a.M);
+    return 0;
+}
+
+static int h_attribute_begin(Rib *r, const Args *a) { (void)a; return rib_push(r, 1); }
+static int h_attribute_end(Rib *r, const Args *a) { (void)a; return rib_pop(r, 1); }
+static int h_transform_begin(Rib *r, const Args *a) { (void)a; return rib_push(r, 0); }
+static int h_transform_end(Rib *r, const Args *a) { (void)a; return rib_pop(r, 0); }
+
+static int h_coordinate_system(Rib *r, const Args *a)
+{
+    size_t i = 0;
+    const char *name = rib_get_string(r, a, &i, "a coordinate system name");
+    if (!name)
+        return -1;
+    size_t k = 0;
+    while (k < r->n_coordsys && strncmp(&r->coordsys_names[64 * k], name, 63) != 0)
+        k++;
+    if (k == r->n_coordsys) {
+        if (k >= 4096)
+            return rib_error(r, "more than 4096 coordinate systems");
+        char *nn = realloc(r->coordsys_names, 64 * (k + 1));
+        if (nn)
+            r->coordsys_names = nn;
+        float *nm = realloc(r->coordsys_M, 16 * (k + 1) * sizeof *nm);
+        if (nm)
+            r->coordsys_M = nm;
+        int *nw = realloc(r->coordsys_world, (k + 1) * sizeof *nw);
+        if (nw)
+            r->coordsys_world = nw;
+        if (!nn || !nm || !nw)
+            return rib_error(r, "out of memory");
+        snprintf(&r->coordsys_names[64 * k], 64, "%s", name);
+        r->n_coordsys++;
+    }
+    memcpy(&r->coordsys_M[16 * k], r->a.M, 16 * sizeof(float));
+    r->coordsys_world[k] = r->in_world;
+    return 0;
+}
+
+/* world_from_camera, or the identity (with a warning) when singular. */
+void rib_world_from_camera(Rib *r, float m[16])
+{
+    if (rib_mat_inverse(r->camera_from_world, m) != 0) {
+        rib_warn_once(r, "singular camera", "the camera transform is singular");
+        rib_mat_identity(m);
+    }
+}
+
+static int h_coordsys_transform(Rib *r, const Args *a)
+{
+    size_t i = 0;
+    const char *name = rib_get_string(r, a, &i, "a coordinate system name");
+    if (!name)
+        return -1;
+    if (strcmp(name, "world") == 0) {
+        if (r->in_world)
+            rib_mat_identity(r->a.M);
+        else
+            rib_warn_once(r, "coordsys world", "CoordSysTransform \"world\" before WorldBegin ignored");
+        return 0;
+    }
+    if (strcmp(name, "camera") == 0) {
+        if (r->in_world)
+            rib_world_from_camera(r, r->a.M);
+        else
+            rib_mat_identity(r->a.M);
+        return 0;
+    }
+    for (size_t k = r->n_coordsys; k-- > 0;)
+        if (strcmp(&r->coordsys_names[64 * k], name) == 0) {
+            const float *m = &r->coordsys_M[16 * k];
+            if (r->in_world && !r->coordsys_world[k]) {
+                float wc[16];
+                rib_world_from_camera(r, wc);
+                rib_mat_mul(wc, m, r->a.M);
+            } else {
+                memcpy(r->a.M, m, 16 * sizeof *m);
+            }
+            return 0;
+        }
+    return rib_error(r, "unknown coordinate system \"%s\"", name);
+}
+
+/* ------------------------------------------------------------ options */
+
+static int h_format(Rib *r, const Args *a)
+{
+    size_t i = 0;
+    float v[3];
+    if (rib_get_floats(r, a, &i, v, 2, "width height") != 0)
+        return -1;
+    if (i < a->n && rib_get_floats(r, a, &i, v + 2, 1, "the pixel aspect ratio") != 0)
+        return -1;
+    if (!(v[0] >= 1 && v[0] <= 65536 && v[1] >= 1 && v[1] <= 65536))
+        return rib_error(r, "the image size must be 1 to 65536 pixels");
+    r->width = r->settings->width = (int)v[0];
+    r->height = r->settings->height = (int)v[1];
+    if (i == 3 && v[2] != 1 && v[2] != -1)
+        rib_warn_once(r, "pixel aspect", "pixel aspect ratio %g treated as 1", (double)v[2]);
+    return 0;
+}
+
+static int h_frame_aspect(Rib *r, const Args *a)
+{
+    size_t i = 0;
+    float v;
+    if (rib_get_floats(r, a, &i, &v, 1, "the frame aspect ratio") != 0)
+        return -1;
+    if (!(v > 0))
+        return rib_error(r, "the frame aspect ratio must be positive");
+    r->frame_aspect = v;
+    return 0;
+}
+
+static int h_screen_window(Rib *r, const Args *a)
+{
+    size_t i = 0;
+    if (rib_get_floats(r, a, &i, r->screen, 4, "left right bottom top") != 0)
+        return -1;
+    r->have_screen = 1;
+    return 0;
+}
+
+static int h_crop_window(Rib *r, const Args *a)
+{
+    size_t i = 0;
+    float v[4];
+    if (rib_get_floats(r, a, &i, v, 4, "xmin xmax ymin ymax") != 0)
+        return -1;
+    for (int k = 0; k < 4; k++)
+        r->settings->crop[k] = v[k] < 0 ? 0 : v[k] > 1 ? 1 : v[k];
+    return 0;
+}
+
+static int h_projection(Rib *r, const Args *a)
+{
+    size_t i = 0;
+    const char *name = rib_get_string(r, a, &i, "a projection name");
+    if (!name)
+        return -1;
+    Param *p;
+    size_t n;
+    if (rib_get_params(r, a, i, &p, &n) != 0)
+        return -1;
+    const Param *fov = rib_find_param(p, n, "fov");
+    int e = 0;
+    if (strcmp(name, "orthographic") == 0) {
+        r->projection = RAYES_PROJECTION_ORTHOGRAPHIC;
+    } else {
+        if (strcmp(name, "perspective") != 0)
+            rib_warn_once(r, name, "projection \"%s\" is not supported; perspective used", name);
+        r->projection = RAYES_PROJECTION_PERSPECTIVE;
+        r->fov = 90;
+        if (fov) {
+            if (!rib_is_num(fov->v) || fov->v->n != 1 || !(fov->v->d[0] > 0 && fov->v->d[0] < 180))
+                e = rib_arg_error(r, fov->v, "\"fov\" needs one angle in (0, 180) degrees");
+            else
+                r->fov = (float)fov->v->d[0];
+        }
+    }
+    free(p);
+    return e;
+}
+
+static int h_clipping(Rib *r, const Args *a)
+{
+    size_t i = 0;
+    float v[2];
+    /* Rays start at the eye and go to infinity: the clipping planes only
+     * matter to a z-buffer, and are read and ignored. */
+    return rib_get_floats(r, a, &i, v, 2, "near far");
+}
+
+static int h_pixel_samples(Rib *r, const Args *a)
+{
+    size_t i = 0;
+    float v[2];
+    if (rib_get_floats(r, a, &i, v, 2, "xsamples ysamples") != 0)
+        return -1;
+    if (!(v[0] >= 1 && v[0] <= 1024 && v[1] >= 1 && v[1] <= 1024))
+        return rib_error(r, "pixel samples must be 1 to 1024 per axis");
+    r->settings->spp = (int)roundf(v[0]) * (int)roundf(v[1]);
+    return 0;
+}
+
+static int h_pixel_filter(Rib *r, const Args *a)
+{
+    size_t i = 0;
+    const char *name = rib_get_string(r, a, &i, "a filter name");
+    float w[2];
+    if (!name || rib_get_floats(r, a, &i, w, 2, "xwidth ywidth") != 0)
+        return -1;
+    if (!(w[0] > 0 && w[0] <= 64))
+        return rib_error(r, "the filter width must be in (0, 64] pixels");
+    if (strcmp(name, "box") == 0) {
+        r->settings->filter = RAYES_FILTER_BOX;
+    } else {
+        if (strcmp(name, "gaussian") != 0)
+            rib_warn_once(r, name, "pixel filter \"%s\" is not built in; the gaussian (nearest "
+                               "smooth filter) is used with the same width", name);
+        r->settings->filter = RAYES_FILTER_GAUSSIAN;
+    }
+    r->settings->filter_width = w[0];
+    return 0;
+}
+
+static int h_one_float(Rib *r, const Args *a)
+{
+    size_t i = 0;
+    float v;
+    return rib_get_floats(r, a, &i, &v, 1, "a number");
+}
+
+static int h_exposure(Rib *r, const Args *a)
+{
+    size_t i = 0;
+    float v[2];
+    if (rib_get_floats(r, a, &i, v, 2, "gain gamma") != 0)
+        return -1;
+    if (!(v[0] > 0 && v[1] > 0))
+        return rib_error(r, "gain and gamma must be positive");
+    r->settings->exposure_gain = v[0];
+    r->settings->exposure_gamma = v[1];
+    return 0;
+}
+
+static int h_quantize(Rib *r, const Args *a)
+{
+    size_t i = 0;
+    float v[4];
+    /* Quantisation follows the output file's type (8-bit PNG, float EXR). */
+    if (!rib_get_string(r, a, &i, "the kind (\"rgba\" or \"z\")"))
+        return -1;
+    return rib_get_floats(r, a, &i, v, 4, "one min max dither");
+}
+
+static int is_shadow_display(const char *type, const char *mode)
+{
+    return strcmp(type, "zfile") == 0 || strcmp(type, "shadow") == 0 || strcmp(mode, "z") == 0;
+}
+
+static int h_display(Rib *r, const Args *a)
+{
+    size_t i = 0;
+    const char *name = rib_get_string(r, a, &i, "an image name");
+    const char *type = name ? rib_get_string(r, a, &i, "a display type") : NULL;
+    const char *mode = type ? rib_get_string(r, a, &i, "a display mode") : NULL;
+    if (!mode)
+        return -1;
+    IoSettings *s = r->settings;
+    int extra = name[0] == '+';
+    if (!extra) {
+        s->n_displays = 0;
+        r->shadow_display = is_shadow_display(type, mode);
+    }
+    if (s->n_displays >= IO_MAX_DISPLAYS) {
+        rib_warn_once(r, "displays", "more than %d displays: the others are ignored", IO_MAX_DISPLAYS);
+        return 0;
+    }
+    IoDisplay *d = &s->displays[s->n_displays++];
+    snprintf(d->name, sizeof d->name, "%s", name + extra);
+    snprintf(d->type, sizeof d->type, "%s", type);
+    snprintf(d->mode, sizeof d->mode, "%s", mode);
+    return 0;
+}
+
+static int h_hider(Rib *r, const Args *a)
+{
+    size_t i = 0;
+    const char *name = rib_get_string(r, a, &i, "a hider name");
+    if (!name)
+        return -1;
+    if (strcmp(name, "hidden") != 0 && strcmp(name, "raytrace") != 0)
+        rib_warn_once(r, name, "hider \"%s\" is not supported; rays are traced", name);
+    return 0;
+}
+
+static int h_shading_rate(Rib *r, const Args *a)
+{
+    size_t i = 0;
+    float v;
+    if (rib_get_floats(r, a, &i, &v, 1, "a shading rate") != 0)
+        return -1;
+    if (!(v > 0))
+        return rib_error(r, "the shading rate must be positive");
+    r->a.shading_rate = v;
+    return 0;
+}
+
+static int h_sides(Rib *r, const Args *a)
+{
+    size_t i = 0;
+    float v;
+    if (rib_get_floats(r, a, &i, &v, 1, "1 or 2") != 0)
+        return -1;
+    if (v != 1 && v != 2)
+        return rib_error(r, "expected 1 or 2, found %g", (double)v);
+    return 0;
+}
+
+static int h_orientation(Rib *r, const Args *a)
+{
+    size_t i = 0;
+    const char *o = rib_get_string(r, a, &i, "an orientation");
+    if (!o)
+        return -1;
+    static const char *const names[] = {"outside", "inside", "lh", "rh"};
+    for (int k = 0; k < 4; k++)
+        if (strcmp(o, names[k]) == 0) {
+            r->a.orient = k;
+            return 0;
+        }
+    return rib_error(r, "expected \"outside\", \"inside\", \"lh\" or \"rh\", found \"%s\"", o);
+}
+
+static int h_reverse_orientation(Rib *r, const Args *a)
+{
+    (void)a;
+    r->a.orient ^= 1; /* outside <-> inside, lh <-> rh */
+    return 0;
+}
+
+static int h_color(Rib *r, const Args *a)
+{
+    size_t i = 0;
+    float v[3];
+    if (rib_get_floats(r, a, &i, v, 3, "a colour") != 0)
+        return -1;
+    memcpy(strcmp(r->req, "Color") == 0 ? r->a.Cs : r->a.Os, v, sizeof v);
+    r->a.color_gen = ++r->next_gen;
+    return 0;
+}
+
+/* -------------------------------------------------- attributes, options */
+
+static int search_path(Rib *r, const char *kind, const char *path)
+{
+    if (strcmp(kind, "archive") == 0 || strcmp(kind, "resource") == 0) {
+        char out[4096] = "";
+        char buf[4096];
+        snprintf(buf, sizeof buf, "%s", path);
+        for (char *save = NULL, *e = strtok_r(buf, ":", &save); e; e = strtok_r(NULL, ":", &save)) {
+            const char *add = strcmp(e, "&") == 0 ? r->archive_path : strcmp(e, "@") == 0 ? "" : e;
+            if (!add[0])
+                continue;
+            size_t len = strlen(out), k = strlen(add);
+            if (len + k + 2 > sizeof out)
+                break;
+            if (len)
+                out[len++] = ':';
+            memcpy(out + len, add, k + 1);
+        }
+        snprintf(r->archive_path, sizeof r->archive_path, "%s", out);
+    }
+    if (strcmp(kind, "shader") == 0 || strcmp(kind, "texture") == 0 ||
+        strcmp(kind, "resource") == 0) {
+        const IoSink *s = r->sink;
+        if (strcmp(kind, "resource") == 0)
+            return (s->set_search_path(s->target, "shader", path) != RAYES_OK ||
+                    s->set_search_path(s->target, "texture", path) != RAYES_OK)
+                       ? rib_sink_failed(r, s)
+                       : 0;
+        if (s->set_search_path(s->target, kind, path) != RAYES_OK)
+            return rib_sink_failed(r, s);
+    }
+    return 0;
+}
+
+/* Option "limits" "gridsize": RenderMan's micropolygons per grid. rayes'
+ * grids have at most 64 x 64 micropolygons, so a larger value is clamped. */
+static int set_grid_size(Rib *r, double g)
+{
+    if (!(g >= 1 && g <= 1e9) || g != floor(g))
+        return rib_error(r, "Option \"limits\" \"gridsize\": expected a positive integer, "
+                            "found %g", g);
+    if (g > 4096)
+        rib_warn_once(r, "gridsize", "Option \"limits\" \"gridsize\" %.0f: clamped to 4096 "
+                                 "(64 x 64 micropolygons)", g);
+    r->settings->grid_size = g > 4096 ? 4096 : (int)g;
+    return 0;
+}
+
+static int h_option_attribute(Rib *r, const Args *a)
+{
+    size_t i = 0;
+    const char *group = rib_get_string(r, a, &i, "a name");
+    Param *p;
+    size_t n;
+    if (!group || rib_get_params(r, a, i, &p, &n) != 0)
+        return -1;
+    int option = strcmp(r->req, "Option") == 0, e = 0;
+    for (size_t k = 0; k < n && e == 0; k++) {
+        const Param *q = &p[k];
+        if (option && strcmp(group, "searchpath") == 0 && q->v->kind != ARG_NUM &&
+            q->v->kind != ARG_NUMS && q->v->n == 1) {
+            e = search_path(r, q->d.name, q->v->s[0]);
+        } else if (!option && strcmp(group, "displacementbound") == 0 &&
+                   strcmp(q->d.name, "sphere") == 0 && rib_is_num(q->v) && q->v->n == 1) {
+            r->a.bound = (float)fabs(q->v->d[0]);
+        } else if (!option && strcmp(group, "trace") == 0 && rib_is_num(q->v) && q->v->n == 1 &&
+                   (strcmp(q->d.name, "maxdiffusedepth") == 0 ||
+                    strcmp(q->d.name, "maxspeculardepth") == 0)) {
+            /* PRMan's ray depths; rayes has one per render, so the last wins */
+            double d = q->v->d[0]; /* NaN (a binary float) counts as 0 */
+            int depth = !(d > 0) ? 0 : d > 1e6 ? 1000000 : (int)d;
+            if (q->d.name[3] == 'd')
+                r->settings->bounces = depth;
+            else
+                r->settings->specular_depth = depth;
+        } else if (option && strcmp(group, "limits") == 0 &&
+                   strcmp(q->d.name, "gridsize") == 0 && rib_is_num(q->v) && q->v->n == 1) {
+            e = set_grid_size(r, q->v->d[0]);
+        } else if (!option && strcmp(group, "identifier") == 0) {
+            /* names are for messages only */
+        } else if (!(!option && strcmp(group, "displacementbound") == 0)) {
+            char key[160];
+            snprintf(key, sizeof key, "%s %s:%s", r->req, group, q->d.name);
+            rib_warn_once(r, key, "%s \"%s\" \"%s\" is not supported and ignored", r->req, group,
+                      q->d.name);
+        }
+    }
+    free(p);
+    return e;
+}
+
+static int get_basis(Rib *r, const Args *a, size_t *i, float m[16])
+{
+    if (*i < a->n && a->v[*i].kind == ARG_STR) {
+        int step;
+        const char *name = a->v[(*i)++].s[0];
+        if (rib_basis_named(name, m, &step) != 0)
+            return rib_error(r, "unknown basis \"%s\" (bezier, b-spline, catmull-rom, hermite, "
+                                "power or 16 numbers)", name);
+        return 0;
+    }
+    return rib_get_floats(r, a, i, m, 16, "a basis name or matrix");
+}
+
+static int h_basis(Rib *r, const Args *a)
+{
+    size_t i = 0;
+    float ub[16], vb[16], us, vs;
+    if (get_basis(r, a, &i, ub) != 0 || rib_get_floats(r, a, &i, &us, 1, "the u step") != 0 ||
+        get_basis(r, a, &i, vb) != 0 || rib_get_floats(r, a, &i, &vs, 1, "the v step") != 0)
+        return -1;
+    if (!(us >= 1 && us <= 4 && vs >= 1 && vs <= 4) || us != floorf(us) || vs != floorf(vs))
+        return rib_error(r, "steps must be integers from 1 to 4");
+    memcpy(r->a.ubasis, ub, sizeof ub);
+    memcpy(r->a.vbasis, vb, sizeof vb);
+    r->a.ustep = (int)us;
+    r->a.vstep = (int)vs;
+    return 0;
+}
+
+
+/* ------------------------------------------------------------ requests */
+
+const RibRequest rib_state_requests[] = {
+    {"AttributeBegin", h_attribute_begin}, {"AttributeEnd", h_attribute_end},
+    {"TransformBegin", h_transform_begin}, {"TransformEnd", h_transform_end},
+    {"Identity", h_identity}, {"Transform", h_transform}, {"ConcatTransform", h_concat},
+    {"Translate", h_translate}, {"Rotate", h_rotate}, {"Scale", h_scale},
+    {"Perspective", h_perspective}, {"CoordinateSystem", h_coordinate_system},
+    {"ScopedCoordinateSystem", h_coordinate_system}, {"CoordSysTransform", h_coordsys_transform},
+    {"Format", h_format}, {"FrameAspectRatio", h_frame_aspect}, {"ScreenWindow", h_screen_window},
+    {"CropWindow", h_crop_window}, {"Projection", h_projection}, {"Clipping", h_clipping},
+    {"PixelSamples", h_pixel_samples}, {"PixelFilter", h_pixel_filter},
+    {"PixelVariance", h_one_float}, {"Exposure", h_exposure}, {"Quantize", h_quantize},
+    {"Display", h_display}, {"Hider", h_hider}, {"ShadingRate", h_shading_rate},
+    {"Sides", h_sides}, {"Orientation", h_orientation},
+    {"ReverseOrientation", h_reverse_orientation}, {"Color", h_color}, {"Opacity", h_color},
+    {"Attribute", h_option_attribute}, {"Option", h_option_attribute}, {"Basis", h_basis},
+    {NULL, NULL},
+};
