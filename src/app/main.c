@@ -9,7 +9,6 @@
 #include <limits.h>
 #include <math.h>
 #include <signal.h>
-#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -24,7 +23,8 @@
 #include "rayes/rayes.h"
 #include "util/log.h"
 
-#include "app/app.h"
+#include "app/cli.h"
+#include "app/view.h"
 
 typedef struct Progress {
     double start;
@@ -37,273 +37,6 @@ static void on_sigint(int sig)
 {
     (void)sig;
     interrupted = 1;
-}
-
-static void usage(FILE *f)
-{
-    fputs("usage: rayes render [SCENE] [options]\n"
-          "       rayes convert SCENE OUT.rib [--data DIR] [--frame N] [--quiet]\n"
-          "       rayes --help | --version\n"
-          "\n"
-          "SCENE is a scene file (.rib, .rib.gz, .pbrt, .obj) or a built-in scene:\n"
-          "cornell (default), cornell-teapots, cornell-teapots-displaced, cornell-spheres,\n"
-          "cornell-brick (needs the plugin brick.so: --shader-path build/examples/shaders).\n"
-          "A scene file's image size, samples, filter, depths and displays are used unless\n"
-          "the command line gives them. convert writes SCENE as ASCII RIB.\n"
-          "\n"
-          "options:\n"
-          "  -o FILE                 output image, .exr or .png (repeatable; default: the\n"
-          "                          scene file's displays, else SCENE.exr)\n"
-          "  --frame N               the frame of a RIB file to read (default: the last)\n"
-          "  --res W[xH]             resolution in pixels (default 512x512)\n"
-          "  --spp N                 pixel samples (default 4)\n"
-          "  --threads N             worker threads (default: all cores)\n"
-          "  --bounces N             maximum diffuse depth (default 1)\n"
-          "  --quality Q             preview (4 shadow, 4 diffuse rays), final (64; 1024 at\n"
-          "                          depth 0, 64 deeper), reference (64 and 4096 at depth 0,\n"
-          "                          1 and 1 deeper); later options override it\n"
-          "  --shadow-rays N         shadow rays per shading point and light\n"
-          "  --diffuse-rays N        diffuse rays per shading point (all depths)\n"
-          "  --diffuse-rays-deep N   diffuse rays per shading point below depth 0\n"
-          "  --specular-depth N      maximum specular depth (default 4)\n"
-          "  --filter box|gaussian   pixel filter (default box)\n"
-          "  --filter-width W        filter width in pixels (default 1 box, 2 gaussian)\n"
-          "  --seed N                changes every random number (default 0)\n"
-          "  --cache on|off          the radiosity cache at diffuse hits (default on; off for\n"
-          "                          --quality reference)\n"
-          "  --cache-mb MB           cache budget in megabytes (default 100)\n"
-          "  --cache-split C,M,F     budget shares of coarse, medium, fine (default .25,.25,.5)\n"
-          "  --cache-resolution R    auto (by ray differentials), coarse, medium or fine\n"
-          "  --cache-k K             use the coarsest resolution whose micropolygons are at\n"
-          "                          most K times the ray footprint (default 1)\n"
-          "  --gridsize N            micropolygons per grid, at most (default 256, or the\n"
-          "                          scene file's; 1 to 4096): the size of a cache entry\n"
-          "  --hider raytrace|grid   shade every camera hit (default), or once per vertex of\n"
-          "                          each visible grid and interpolate (PRMan's REYES mode;\n"
-          "                          default for --quality final)\n"
-          "  --irradiance on|off     irradiance interpolation with gradients at depth 0 (grid\n"
-          "                          hider; on for --quality final)\n"
-          "  --texture-mb MB         texture cache budget in megabytes (default 64)\n"
-          "  --data DIR              data directory (teapot.bpt); default $RAYES_DATA\n"
-          "  --shader-path DIRS      directories of shader plugins NAME.so, ':'-separated;\n"
-          "                          searched before $RAYES_SHADER_PATH\n"
-          "  --stats FILE.json       write statistics as JSON\n"
-          "  --quiet                 no progress bar and no summary\n",
-          f);
-}
-
-void die_usage(const char *fmt, ...)
-{
-    va_list ap;
-    va_start(ap, fmt);
-    fputs("rayes: ", stderr);
-    vfprintf(stderr, fmt, ap);
-    fputs(" (rayes --help shows the usage)\n", stderr);
-    va_end(ap);
-    exit(2);
-}
-
-static long parse_long(const char *opt, const char *s, long lo, long hi)
-{
-    char *end;
-    errno = 0;
-    long v = s ? strtol(s, &end, 10) : 0;
-    if (!s || *s == '\0' || *end != '\0' || errno != 0 || v < lo || v > hi)
-        die_usage("%s: expected an integer from %ld to %ld, got \"%s\"", opt, lo, hi,
-                  s ? s : "nothing");
-    return v;
-}
-
-static float parse_float(const char *opt, const char *s, float lo, float hi)
-{
-    char *end;
-    errno = 0;
-    float v = s ? strtof(s, &end) : 0.0f;
-    if (!s || *s == '\0' || *end != '\0' || errno != 0 || !(v >= lo && v <= hi))
-        die_usage("%s: expected a number from %g to %g, got \"%s\"", opt, lo, hi,
-                  s ? s : "nothing");
-    return v;
-}
-
-static void parse_res(const char *s, RayesRenderOptions *o)
-{
-    char w[32];
-    const char *x = s ? strchr(s, 'x') : NULL;
-    if (s && x && (size_t)(x - s) < sizeof w) {
-        snprintf(w, sizeof w, "%.*s", (int)(x - s), s);
-        o->width = (int)parse_long("--res", w, 1, 65536);
-        o->height = (int)parse_long("--res", x + 1, 1, 65536);
-    } else {
-        o->width = o->height = (int)parse_long("--res", s, 1, 65536);
-    }
-}
-
-static void parse_split(const char *s, float split[3])
-{
-    char buf[128], *save = NULL;
-    snprintf(buf, sizeof buf, "%s", s);
-    float sum = 0.0f;
-    for (int i = 0; i < 3; i++) {
-        char *tok = strtok_r(i == 0 ? buf : NULL, ",", &save);
-        split[i] = parse_float("--cache-split", tok, 0.0f, 1.0f);
-        sum += split[i];
-    }
-    if (strtok_r(NULL, ",", &save) || sum > 1.0001f)
-        die_usage("--cache-split: expected three shares C,M,F summing to at most 1, got \"%s\"",
-                  s);
-}
-
-static int parse_resolution(const char *s)
-{
-    static const char *const names[] = {"coarse", "medium", "fine"};
-    if (strcmp(s, "auto") == 0)
-        return -1;
-    for (int i = 0; i < 3; i++)
-        if (strcmp(s, names[i]) == 0)
-            return i;
-    die_usage("--cache-resolution: expected auto, coarse, medium or fine, got \"%s\"", s);
-}
-
-static RayesQuality parse_quality(const char *s)
-{
-    if (s && strcmp(s, "preview") == 0)
-        return RAYES_QUALITY_PREVIEW;
-    if (s && strcmp(s, "final") == 0)
-        return RAYES_QUALITY_FINAL;
-    if (s && strcmp(s, "reference") == 0)
-        return RAYES_QUALITY_REFERENCE;
-    die_usage("--quality: expected preview, final or reference, got \"%s\"", s ? s : "nothing");
-}
-
-/* The preset first (it sets ray counts), then every other option in order. */
-void parse_args(int argc, char **argv, Args *a)
-{
-    RayesQuality q = RAYES_QUALITY_PREVIEW;
-    for (int i = 2; i < argc; i++)
-        if (strcmp(argv[i], "--quality") == 0)
-            q = parse_quality(i + 1 < argc ? argv[i + 1] : NULL);
-    rayes_render_options_init(&a->opt, q);
-    a->frame = -1;
-    a->gamma = 1.0f;
-    for (int i = 2; i < argc; i++) {
-        const char *o = argv[i];
-        const char *v = i + 1 < argc ? argv[i + 1] : NULL;
-        RayesRenderOptions *opt = &a->opt;
-        if (o[0] != '-') {
-            if (a->scene)
-                die_usage("only one scene may be given (\"%s\" and \"%s\")", a->scene, o);
-            a->scene = o;
-            continue;
-        }
-        if (strcmp(o, "--quiet") == 0) {
-            a->quiet = 1;
-            continue;
-        }
-        if (strcmp(o, "--headless") == 0 && a->view) {
-            a->headless = 1;
-            continue;
-        }
-        if (!v)
-            die_usage("%s: expected a value", o);
-        i++;
-        if (strcmp(o, "-o") == 0) {
-            if (a->n_outputs == MAX_OUTPUTS)
-                die_usage("-o: at most %d outputs", MAX_OUTPUTS);
-            Output *out = &a->outputs[a->n_outputs++];
-            out->format = image_format_from_path(v);
-            if (out->format == IMAGE_FORMAT_UNKNOWN)
-                die_usage("-o %s: expected a file name ending in .exr or .png", v);
-            if (strlen(v) >= sizeof out->path)
-                die_usage("-o: the file name is too long");
-            snprintf(out->path, sizeof out->path, "%s", v);
-        } else if (strcmp(o, "--res") == 0) {
-            parse_res(v, opt);
-            a->set |= SET_RES;
-        } else if (strcmp(o, "--spp") == 0) {
-            opt->spp = (int)parse_long(o, v, 1, 1 << 20);
-            a->set |= SET_SPP;
-        } else if (strcmp(o, "--frame") == 0)
-            a->frame = (int)parse_long(o, v, 0, INT_MAX);
-        else if (strcmp(o, "--threads") == 0)
-            opt->threads = (int)parse_long(o, v, 0, 1024);
-        else if (strcmp(o, "--bounces") == 0) {
-            opt->bounces = (int)parse_long(o, v, 0, 64);
-            a->set |= SET_BOUNCES;
-        }
-        else if (strcmp(o, "--quality") == 0)
-            continue;
-        else if (strcmp(o, "--shadow-rays") == 0)
-            opt->shadow_rays = opt->shadow_rays_deep = (int)parse_long(o, v, 0, 1 << 20);
-        else if (strcmp(o, "--diffuse-rays") == 0)
-            opt->diffuse_rays = opt->diffuse_rays_deep = (int)parse_long(o, v, 0, 1 << 20);
-        else if (strcmp(o, "--diffuse-rays-deep") == 0)
-            opt->diffuse_rays_deep = (int)parse_long(o, v, 0, 1 << 20);
-        else if (strcmp(o, "--specular-depth") == 0) {
-            opt->specular_depth = (int)parse_long(o, v, 0, 64);
-            a->set |= SET_SPECULAR_DEPTH;
-        } else if (strcmp(o, "--filter") == 0) {
-            a->set |= SET_FILTER;
-            if (strcmp(v, "box") == 0)
-                opt->filter = RAYES_FILTER_BOX;
-            else if (strcmp(v, "gaussian") == 0)
-                opt->filter = RAYES_FILTER_GAUSSIAN;
-            else
-                die_usage("--filter: expected box or gaussian, got \"%s\"", v);
-        } else if (strcmp(o, "--filter-width") == 0) {
-            opt->filter_width = parse_float(o, v, 0.01f, 16.0f);
-            a->set |= SET_FILTER_WIDTH;
-        } else if (strcmp(o, "--seed") == 0)
-            opt->seed = (uint64_t)parse_long(o, v, 0, LONG_MAX);
-        else if (strcmp(o, "--cache") == 0) {
-            if (strcmp(v, "on") != 0 && strcmp(v, "off") != 0)
-                die_usage("--cache: expected on or off, got \"%s\"", v);
-            opt->cache = strcmp(v, "on") == 0;
-        } else if (strcmp(o, "--cache-mb") == 0)
-            opt->cache_mb = parse_float(o, v, 0.0f, 1e7f);
-        else if (strcmp(o, "--cache-split") == 0)
-            parse_split(v, opt->cache_split);
-        else if (strcmp(o, "--cache-resolution") == 0)
-            opt->cache_resolution = parse_resolution(v);
-        else if (strcmp(o, "--cache-k") == 0)
-            opt->cache_k = parse_float(o, v, 1e-3f, 1e3f);
-        else if (strcmp(o, "--gridsize") == 0) {
-            opt->grid_size = (int)parse_long(o, v, 1, 4096);
-            a->set |= SET_GRID_SIZE;
-        } else if (strcmp(o, "--hider") == 0) {
-            if (strcmp(v, "raytrace") != 0 && strcmp(v, "grid") != 0)
-                die_usage("--hider: expected raytrace or grid, got \"%s\"", v);
-            opt->hider = strcmp(v, "grid") == 0 ? RAYES_HIDER_GRID : RAYES_HIDER_RAYTRACE;
-        } else if (strcmp(o, "--irradiance") == 0) {
-            if (strcmp(v, "on") != 0 && strcmp(v, "off") != 0)
-                die_usage("--irradiance: expected on or off, got \"%s\"", v);
-            opt->irradiance = strcmp(v, "on") == 0;
-        } else if (strcmp(o, "--texture-mb") == 0)
-            opt->texture_mb = parse_float(o, v, 0.0f, 1e7f);
-        else if (strcmp(o, "--data") == 0)
-            a->data_dir = v;
-        else if (strcmp(o, "--stats") == 0)
-            a->stats_path = v;
-        else if (strcmp(o, "--shader-path") == 0)
-            a->shader_path = v;
-        else if (a->view && strcmp(o, "--script") == 0)
-            a->script = v;
-        else if (a->view && strcmp(o, "--passes") == 0)
-            a->passes = (int)parse_long(o, v, 0, 1 << 20);
-        else if (a->view && strcmp(o, "--screenshot") == 0)
-            a->screenshot = v;
-        else if (a->view && strcmp(o, "--exposure") == 0)
-            a->exposure = parse_float(o, v, -30.0f, 30.0f);
-        else if (a->view && strcmp(o, "--gamma") == 0)
-            a->gamma = parse_float(o, v, 0.05f, 20.0f);
-        else
-            die_usage("unknown option \"%s\"", o);
-    }
-    if (!(a->set & SET_FILTER_WIDTH) && a->opt.filter == RAYES_FILTER_GAUSSIAN)
-        a->opt.filter_width = 2.0f;
-    if (!a->scene)
-        a->scene = "cornell";
-    if (!a->data_dir)
-        a->data_dir = getenv("RAYES_DATA");
 }
 
 static void format_time(char *buf, size_t n, double s)
@@ -403,54 +136,6 @@ static int check_output_dir(const char *path)
     fprintf(stderr, "rayes: %s: cannot write: directory %s %s\n", path, dir,
             errno == ENOENT ? "does not exist" : "is not writable");
     return -1;
-}
-
-/* Builds the scene `scene` names (a scene file, else a built-in scene)
- * into sink; settings receive what a file gives. */
-RayesError load_scene(const char *scene, const char *data_dir, int frame,
-                             const IoSink *sink, IoSettings *settings, char *err, size_t err_size)
-{
-    io_settings_init(settings);
-    if (io_is_scene_file(scene)) {
-        IoReadOptions ro = {.data_dir = data_dir, .frame = frame};
-        return io_read_scene_file(scene, sink, &ro, settings, err, err_size);
-    }
-    return io_builtin_scene(scene, data_dir, sink, err, err_size);
-}
-
-/* The exit status of a failed load: an unknown built-in name is a usage
- * error, everything else bad input. */
-int load_status(const char *scene, RayesError e)
-{
-    return !io_is_scene_file(scene) && e == RAYES_ERROR_INVALID_ARGUMENT ? 2 : 1;
-}
-
-/* The file's settings where the command line gave none. */
-void merge_settings(Args *a, const IoSettings *s)
-{
-    RayesRenderOptions *o = &a->opt;
-    if (!(a->set & SET_RES) && s->width > 0 && s->height > 0) {
-        o->width = s->width;
-        o->height = s->height;
-    }
-    if (!(a->set & SET_SPP) && s->spp > 0)
-        o->spp = s->spp;
-    if (!(a->set & SET_FILTER) && (s->filter == RAYES_FILTER_BOX || s->filter == RAYES_FILTER_GAUSSIAN)) {
-        o->filter = (RayesFilter)s->filter;
-        if (!(a->set & SET_FILTER_WIDTH))
-            o->filter_width = o->filter == RAYES_FILTER_GAUSSIAN ? 2.0f : 1.0f;
-    }
-    if (!(a->set & SET_FILTER_WIDTH) && s->filter_width > 0.0f)
-        o->filter_width = s->filter_width;
-    if (!(a->set & SET_BOUNCES) && s->bounces >= 0)
-        o->bounces = s->bounces < 64 ? s->bounces : 64;
-    if (!(a->set & SET_SPECULAR_DEPTH) && s->specular_depth >= 0)
-        o->specular_depth = s->specular_depth < 64 ? s->specular_depth : 64;
-    if (!(a->set & SET_GRID_SIZE) && s->grid_size > 0)
-        o->grid_size = s->grid_size;
-    if (s->crop[0] != 0.0f || s->crop[1] != 1.0f || s->crop[2] != 0.0f || s->crop[3] != 1.0f)
-        fprintf(stderr, "rayes: warning: %s: CropWindow is not supported; the whole image is "
-                        "rendered\n", a->scene);
 }
 
 /* The scene's name without its directory and extensions, for default
@@ -703,11 +388,11 @@ static int cmd_convert(int argc, char **argv)
 int main(int argc, char **argv)
 {
     if (argc < 2) {
-        usage(stderr);
+        print_usage(stderr);
         return 2;
     }
     if (strcmp(argv[1], "--help") == 0 || strcmp(argv[1], "-h") == 0) {
-        usage(stdout);
+        print_usage(stdout);
         return 0;
     }
     if (strcmp(argv[1], "--version") == 0) {

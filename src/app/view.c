@@ -45,7 +45,8 @@
 #include <SDL.h>
 #endif
 
-#include "app/app.h"
+#include "app/cli.h"
+#include "app/view.h"
 #include "image/image.h"
 #include "util/log.h"
 #include "util/vec.h"

@@ -1,9 +1,12 @@
 /*
- * app/app.h — what the commands of the rayes program share (main.c) and
- * the viewer (view.c): arguments, loading a scene, usage errors.
+ * app/cli.h — what the commands of the rayes program (main.c) and the
+ * viewer (view.c) share, implemented by cli.c: arguments, loading a
+ * scene, usage errors.
  */
-#ifndef RAYES_APP_APP_H
-#define RAYES_APP_APP_H
+#ifndef RAYES_APP_CLI_H
+#define RAYES_APP_CLI_H
+
+#include <stdio.h>
 
 #include "image/image.h"
 #include "io/sink.h"
@@ -52,6 +55,10 @@ typedef struct Args {
  * usage error. */
 void parse_args(int argc, char **argv, Args *a);
 
+/* The integer s, the value of option opt, in [lo, hi]; dies with a usage
+ * error otherwise. */
+long parse_long(const char *opt, const char *s, long lo, long hi);
+
 /* Prints "rayes: MESSAGE" and the usage hint, exits with status 2. */
 void die_usage(const char *fmt, ...) __attribute__((noreturn, format(printf, 1, 2)));
 
@@ -66,7 +73,7 @@ int load_status(const char *scene, RayesError e);
 /* The file's settings where the command line gave none. */
 void merge_settings(Args *a, const IoSettings *s);
 
-/* rayes view (view.c). */
-int cmd_view(int argc, char **argv);
+/* The usage text, to f. */
+void print_usage(FILE *f);
 
-#endif /* RAYES_APP_APP_H */
+#endif /* RAYES_APP_CLI_H */
