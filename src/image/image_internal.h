@@ -1,7 +1,7 @@
 /*
  * image/image_internal.h — private to src/image/: error
  * formatting and the atomic write (temporary file, then rename) that
- * image.c implements for image_exr.c and image_png.c.
+ * image_file.c implements for image_exr.c and image_png.c.
  */
 #ifndef RAYES_IMAGE_IMAGE_INTERNAL_H
 #define RAYES_IMAGE_IMAGE_INTERNAL_H
