@@ -130,9 +130,9 @@ static Rgb *shade_grid(Worker *w, uint32_t gi)
         float st[2], dst[4];
         geom_vertex_st(gs, g, i, st, dst);
         s[k] = st[0], t[k] = st[1];
-        integrator_st_footprint(dst, su, sv, &ds[k], &dt[k]);
+        path_st_footprint(dst, su, sv, &ds[k], &dt[k]);
         curv[k] = g->curvature;
-        offset[k] = integrator_ray_offset(w, g);
+        offset[k] = path_ray_offset(w, g);
         keys[k] = hash_combine(grid_key, k);
         diff[k] = (RayDiff){cam->pixel_width + cam->pixel_spread * fmaxf(dist, 0.0f), cam->pixel_spread};
     }
@@ -156,7 +156,7 @@ static Rgb *shade_grid(Worker *w, uint32_t gi)
     };
     RayesShadeOutputs out = {.Ci = Ci, .Oi = Oi};
     w->stats.shading_points[0] += n;
-    shade_run_lighting(&render_services, &ctx, obj->shader, &out);
+    shade_run_lighting(w->services, &ctx, obj->shader, &out);
     memcpy(ci, Ci, n * sizeof *ci);
     free(irr_E);
     free(back);

@@ -14,7 +14,7 @@
 #ifndef RAYES_RENDER_HIDER_H
 #define RAYES_RENDER_HIDER_H
 
-#include "render/integrator.h"
+#include "render/path.h"
 
 
 /* For a frame of rs; NULL when out of memory. */

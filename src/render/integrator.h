@@ -1,66 +1,12 @@
 /*
- * render/integrator.h — private to render/: tracing radiance along rays,
- * the per-worker state, and the services table shaders call.
+ * render/integrator.h — private to render/: tracing radiance along rays
+ * (integrator.c). The per-worker and path state are in path.h, the
+ * services table shaders call in services.h.
  */
 #ifndef RAYES_RENDER_INTEGRATOR_H
 #define RAYES_RENDER_INTEGRATOR_H
 
-#include "render/render.h"
-
-/* The simplified ray differential of DESIGN.md: the footprint at distance t
- * is width + t * spread. */
-typedef struct RayDiff {
-    float width;   /* at the origin, scene units */
-    float spread;  /* radians */
-} RayDiff;
-
-typedef struct GridShading GridShading;
-
-typedef struct Worker {
-    const RenderScene *rs;
-    const RenderSettings *set;
-    RenderStats stats;
-    CacheLocal cache;             /* this thread's part of the radiosity cache */
-    GridShading *grid_shading; /* the grid hider's shaded grids, or NULL (hider.h) */
-} Worker;
-
-/* What a shading context's `renderer` points to: per point (indexed from
- * ctx->first_point), the sample key its random numbers derive from, the ray
- * differential that arrived (width = footprint at the point), the grid's
- * curvature, and how far rays leaving the point start from it. */
-typedef struct PathState {
-    Worker *w;
-    const uint64_t *keys;
-    const RayDiff *diff;
-    const float *curvature;
-    const float *offset;
-    struct IrrGrid *irr;          /* irradiance interpolation over this grid, or NULL
-                                     (irrgrid.h) */
-    uint32_t grid;                /* the grid (patch) all the points lie on */
-    const float *ds, *dt;         /* texture filter widths in (s, t) where the points have
-                                     texture coordinates of their own (primitive variable st),
-                                     or NULL: the texture service then takes ctx->du, dv */
-} PathState;
-
-/* The texture-space footprint of a point whose parameter footprint is
- * (du, dv), given dst = ds/du, ds/dv, dt/du, dt/dv. */
-static inline void integrator_st_footprint(const float dst[4], float du, float dv, float *ds,
-                                           float *dt)
-{
-    *ds = fabsf(dst[0]) * du + fabsf(dst[1]) * dv;
-    *dt = fabsf(dst[2]) * du + fabsf(dst[3]) * dv;
-}
-
-/* How far rays leaving a point of grid g start from it, along its normal:
- * the ray epsilon plus a bound on the sagitta of neighbouring grids' chords.
- * Adjacent patches diced at different rates do not share boundary vertices,
- * and on a curved surface a neighbour's micropolygons run inside a vertex
- * on the true surface by up to edge^2 * curvature / 8; rays from a grid's
- * boundary vertex (every cache fill has them) would otherwise hit the
- * neighbour from behind. The bound allows neighbours twice as coarse. */
-float integrator_ray_offset(const Worker *w, const Grid *g);
-
-extern const RayesShaderServices render_services;
+#include "render/path.h"
 
 /* Radiance arriving at ray->o from direction ray->d (unit length), for a ray
  * of type kind (RAYES_RAY_CAMERA, _DIFFUSE or _SPECULAR) at the given

@@ -24,17 +24,13 @@
 #include <math.h>
 #include <stdlib.h>
 
+#include "render/integrator.h"
 #include "render/irradiance.h"
 #include "util/check.h"
 #include "util/rng.h"
 
 #define MIN_WEIGHT 0.1f
 #define DISAGREE 0.1f
-
-static Vec3 load3(const float p[3])
-{
-    return v3(p[0], p[1], p[2]);
-}
 
 static float comp(Vec3 v, int c)
 {
@@ -45,7 +41,7 @@ static void make_record(const PathState *ps, const IrrGrid *irr, size_t k, int M
                         float *r, IrrRecord *rec)
 {
     Worker *w = ps->w;
-    Vec3 P = load3(irr->P[k]), n = load3(irr->N[k]);
+    Vec3 P = v3_load(irr->P[k]), n = v3_load(irr->N[k]);
     Vec3 o = v3_madd(P, n, ps->offset[k]);
     uint64_t key = hash_combine(ps->keys[k], DIM_DIFFUSE);
     RayDiff diff = {ps->diff[k].width, fmaxf(ps->diff[k].spread, 1.0f / sqrtf((float)(M * N)))};
@@ -108,7 +104,7 @@ static void quad_grid(const PathState *ps, IrrGrid *irr, int M, int N, Vec3 *L, 
                                      &recs[(size_t)j1 * nu + i0], &recs[(size_t)j1 * nu + i1]};
             /* The corners' predictions for the cell's centre vertex. */
             size_t mid = (size_t)((j0 + j1) / 2) * nu + (i0 + i1) / 2;
-            Vec3 pm = load3(irr->P[mid]), nm = load3(irr->N[mid]);
+            Vec3 pm = v3_load(irr->P[mid]), nm = v3_load(irr->N[mid]);
             float lo = INFINITY, hi = 0.0f, sum = 0.0f, span = 0.0f;
             for (int q = 0; q < 4; q++) {
                 Vec3 e = irr_extrapolate(c[q], pm, nm);
@@ -132,7 +128,7 @@ static void quad_grid(const PathState *ps, IrrGrid *irr, int M, int N, Vec3 *L, 
                     /* Bilinear weights in the cell, times the corners' validity. */
                     float fx = (float)(i - i0) / (float)(i1 - i0), fy = (float)(j - j0) / (float)(j1 - j0);
                     float bw[4] = {(1 - fx) * (1 - fy), fx * (1 - fy), (1 - fx) * fy, fx * fy};
-                    Vec3 p = load3(irr->P[k]), n = load3(irr->N[k]), e = v3(0, 0, 0);
+                    Vec3 p = v3_load(irr->P[k]), n = v3_load(irr->N[k]), e = v3(0, 0, 0);
                     float wsum = 0.0f;
                     for (int q = 0; q < 4; q++) {
                         float wq = bw[q] * irr_weight(c[q], p, n, 0.5f);
@@ -163,7 +159,7 @@ static void tri_grid(const PathState *ps, IrrGrid *irr, int M, int N, Vec3 *L, f
 {
     size_t n = geom_grid_n_vertices(irr->grid), n_recs = 0;
     for (size_t k = 0; k < n; k++) {
-        Vec3 p = load3(irr->P[k]), nk = load3(irr->N[k]), sum = v3(0, 0, 0);
+        Vec3 p = v3_load(irr->P[k]), nk = v3_load(irr->N[k]), sum = v3(0, 0, 0);
         float wsum = 0.0f;
         for (size_t i = 0; i < n_recs; i++) {
             float wi = irr_weight(&recs[i], p, nk, 1.0f);

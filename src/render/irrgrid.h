@@ -17,7 +17,7 @@
 #ifndef RAYES_RENDER_IRRGRID_H
 #define RAYES_RENDER_IRRGRID_H
 
-#include "render/integrator.h"
+#include "render/path.h"
 
 typedef struct IrrGrid {
     const Grid *grid;

@@ -299,9 +299,9 @@ static void fill_radiosity(void *user, const CacheKey *key, size_t n, float (*ou
         memcpy(fp.Os[i], obj->Os, sizeof fp.Os[i]);
         fp.du[i] = du;
         fp.dv[i] = dv;
-        integrator_st_footprint(fp.dst[i], du, dv, &fp.ds[i], &fp.dt[i]);
+        path_st_footprint(fp.dst[i], du, dv, &fp.ds[i], &fp.dt[i]);
         fp.curv[i] = g->curvature;
-        fp.offset[i] = integrator_ray_offset(w, g);
+        fp.offset[i] = path_ray_offset(w, g);
         fp.keys[i] = hash_combine(fill_key, i);
         fp.diff[i] = (RayDiff){width, 0.0f};
         backfacing[i] = key->side != 0; /* side 1: against dPdu x dPdv */
@@ -320,7 +320,7 @@ static void fill_radiosity(void *user, const CacheKey *key, size_t n, float (*ou
     };
     RayesShadeOutputs o = {fp.Ci, fp.Oi, NULL, NULL};
     w->stats.shading_points[RY_MIN(key->depth, RENDER_MAX_DEPTH)] += n;
-    shade_run_diffuselighting(&render_services, &ctx, obj->shader, &o);
+    shade_run_diffuselighting(w->services, &ctx, obj->shader, &o);
     memcpy(out, fp.Ci, n * sizeof *out);
     free(f3);
     free(f1);

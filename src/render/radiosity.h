@@ -5,7 +5,7 @@
 #ifndef RAYES_RENDER_RADIOSITY_H
 #define RAYES_RENDER_RADIOSITY_H
 
-#include "render/integrator.h"
+#include "render/path.h"
 
 /* The cache level for a hit on grid g with the given ray footprint: the
  * coarsest whose micropolygon edge is at most k * footprint and whose

@@ -19,6 +19,7 @@
 
 #include "render/hider.h"
 #include "render/integrator.h"
+#include "render/services.h"
 #include "util/check.h"
 #include "util/rng.h"
 #include "util/thread.h"
@@ -191,7 +192,8 @@ int render_frame(const RenderScene *rs, const RenderSettings *set, float *rgba, 
         RY_CHECK(gsh != NULL);
     }
     for (int i = 0; i < threads; i++) {
-        f.workers[i] = (Worker){.rs = rs, .set = set, .grid_shading = gsh};
+        f.workers[i] = (Worker){.rs = rs, .set = set, .grid_shading = gsh,
+                                .services = &render_services};
         if (set->cache)
             cache_local_init(&f.workers[i].cache, set->cache);
     }

@@ -15,6 +15,7 @@
 #include "rayes/rayes.h"
 #include "rayes/shader.h"
 #include "shade/builtin.h"
+#include "shade/registry.h"
 #include "util/check.h"
 #include "util/log.h"
 

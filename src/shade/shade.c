@@ -1,8 +1,7 @@
 /*
- * shade/shade.c — the class registry, parameter blocks and method dispatch
- * with the fallbacks of DESIGN.md. Thread-safe: the built-in registry is a
- * constant table (plugins have their own, plugin.c); instances are
- * read-only after shade_instance_init. Scratch for classes that ask for it
+ * shade/shade.c — parameter blocks and method dispatch with the fallbacks
+ * of DESIGN.md (the classes are found by registry.c). Thread-safe:
+ * instances are read-only after shade_instance_init. Scratch for classes that ask for it
  * is allocated per method run (simple; a per-thread arena would avoid the
  * allocation, and must then nest, since lighting traces rays that shade).
  */
@@ -12,32 +11,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "shade/builtin.h"
-#include "shade/plugin.h"
 #include "util/log.h"
-
-static const RayesShaderClass *const builtin_classes[] = {
-    &shade_class_matte, &shade_class_plastic, &shade_class_mirror, &shade_class_constant,
-    &shade_class_bumpy, &shade_class_fractal,
-    &shade_class_metal, &shade_class_shinymetal, &shade_class_glass, &shade_class_diffuse,
-    &shade_class_conductor, &shade_class_dielectric, &shade_class_coateddiffuse,
-    &shade_class_paintedplastic,
-};
-
-const RayesShaderClass *shade_find_class(const char *name)
-{
-    for (size_t i = 0; i < sizeof builtin_classes / sizeof builtin_classes[0]; i++)
-        if (strcmp(builtin_classes[i]->name, name) == 0)
-            return builtin_classes[i];
-    return NULL;
-}
-
-const RayesShaderClass *shade_find_class_on_path(const char *name, const char *search_path,
-                                                 char *err, size_t err_size)
-{
-    const RayesShaderClass *cls = name ? shade_find_class(name) : NULL;
-    return cls ? cls : shade_plugin_find(name, search_path, err, err_size);
-}
 
 static const RayesShaderParamDesc *find_param(const RayesShaderClass *cls, const char *name)
 {

@@ -18,16 +18,6 @@ typedef struct ShaderInstance {
     void *params;               /* the parameter block, cls->params_size bytes, owned */
 } ShaderInstance;
 
-/* The built-in class of that name, or NULL. */
-const RayesShaderClass *shade_find_class(const char *name);
-
-/* The built-in class of that name, else the plugin name.so from the
- * colon-separated directories of search_path (plugin.h). Returns the class,
- * or NULL with err filled (one line: the plugin's load error, or the
- * unknown name and the directories searched). */
-const RayesShaderClass *shade_find_class_on_path(const char *name, const char *search_path,
-                                                 char *err, size_t err_size);
-
 /* Makes an instance: defaults, then params by name. Unknown names and type
  * mismatches get a warning naming the shader and the parameter (once per
  * class and name). Returns 0, or -1 (out of memory, err filled). */

@@ -24,6 +24,7 @@ typedef struct Bounds3 {
 
 static inline Vec3 v3(float x, float y, float z) { return (Vec3){x, y, z}; }
 static inline Vec3 v3_load(const float p[3]) { return (Vec3){p[0], p[1], p[2]}; }
+static inline void v3_store(float out[3], Vec3 v) { out[0] = v.x, out[1] = v.y, out[2] = v.z; }
 static inline Vec3 v3_add(Vec3 a, Vec3 b) { return v3(a.x + b.x, a.y + b.y, a.z + b.z); }
 static inline Vec3 v3_sub(Vec3 a, Vec3 b) { return v3(a.x - b.x, a.y - b.y, a.z - b.z); }
 static inline Vec3 v3_mul(Vec3 a, Vec3 b) { return v3(a.x * b.x, a.y * b.y, a.z * b.z); }

@@ -11,6 +11,7 @@
 
 #include "rayes/shader.h"
 #include "shade/bsdf.h"
+#include "shade/registry.h"
 #include "shade/shade.h"
 #include "test.h"
 #include "util/rng.h"

@@ -9,6 +9,7 @@
 #include <string.h>
 
 #include "rayes/shader.h"
+#include "shade/registry.h"
 #include "shade/shade.h"
 #include "test.h"
 

@@ -14,6 +14,7 @@
 #include "rayes/shader.h"
 #include "shade/noise.h"
 #include "shade/plugin.h"
+#include "shade/registry.h"
 #include "shade/shade.h"
 #include "test.h"
 

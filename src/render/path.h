@@ -1,0 +1,73 @@
+/*
+ * render/path.h — private to render/: what a path carries and what every
+ * file of render/ that shades points needs: the ray differential, the
+ * per-worker state (with the services table its shaders call), the path
+ * state a shading context points to, and where rays leaving a point start.
+ * It calls nothing of render/, so the files that trace (integrator.c), fill
+ * (radiosity.c, irrgrid.c), shade grids (hider.c) and serve shaders
+ * (services.c) depend on it and not on each other's circles.
+ */
+#ifndef RAYES_RENDER_PATH_H
+#define RAYES_RENDER_PATH_H
+
+#include "render/render.h"
+
+/* The simplified ray differential of DESIGN.md: the footprint at distance t
+ * is width + t * spread. */
+typedef struct RayDiff {
+    float width;   /* at the origin, scene units */
+    float spread;  /* radians */
+} RayDiff;
+
+typedef struct GridShading GridShading;
+
+typedef struct Worker {
+    const RenderScene *rs;
+    const RenderSettings *set;
+    RenderStats stats;
+    CacheLocal cache;             /* this thread's part of the radiosity cache */
+    GridShading *grid_shading; /* the grid hider's shaded grids, or NULL (hider.h) */
+    const RayesShaderServices *services; /* what shaders run here call (services.h) */
+} Worker;
+
+/* What a shading context's `renderer` points to: per point (indexed from
+ * ctx->first_point), the sample key its random numbers derive from, the ray
+ * differential that arrived (width = footprint at the point), the grid's
+ * curvature, and how far rays leaving the point start from it. */
+typedef struct PathState {
+    Worker *w;
+    const uint64_t *keys;
+    const RayDiff *diff;
+    const float *curvature;
+    const float *offset;
+    struct IrrGrid *irr;          /* irradiance interpolation over this grid, or NULL
+                                     (irrgrid.h) */
+    uint32_t grid;                /* the grid (patch) all the points lie on */
+    const float *ds, *dt;         /* texture filter widths in (s, t) where the points have
+                                     texture coordinates of their own (primitive variable st),
+                                     or NULL: the texture service then takes ctx->du, dv */
+} PathState;
+
+/* The texture-space footprint of a point whose parameter footprint is
+ * (du, dv), given dst = ds/du, ds/dv, dt/du, dt/dv. */
+static inline void path_st_footprint(const float dst[4], float du, float dv, float *ds,
+                                     float *dt)
+{
+    *ds = fabsf(dst[0]) * du + fabsf(dst[1]) * dv;
+    *dt = fabsf(dst[2]) * du + fabsf(dst[3]) * dv;
+}
+
+/* How far rays leaving a point of grid g start from it, along its normal:
+ * the ray epsilon plus a bound on the sagitta of neighbouring grids' chords.
+ * Adjacent patches diced at different rates do not share boundary vertices,
+ * and on a curved surface a neighbour's micropolygons run inside a vertex
+ * on the true surface by up to edge^2 * curvature / 8; rays from a grid's
+ * boundary vertex (every cache fill has them) would otherwise hit the
+ * neighbour from behind. The bound allows neighbours twice as coarse. */
+float path_ray_offset(const Worker *w, const Grid *g);
+
+/* The distance rays start from a point off a grid (a light, an eye) and
+ * stop short of a light: a millionth of the scene's radius times ten. */
+float path_ray_epsilon(const Worker *w);
+
+#endif /* RAYES_RENDER_PATH_H */

@@ -1,0 +1,460 @@
+/*
+ * render/services.c — the services table shaders call (rayes/shader.h):
+ * direct lighting (light sampling and BSDF sampling with multiple
+ * importance), ambient light, indirect diffuse (diffuse rays, read through
+ * the radiosity cache at their hits by integrator.c, or interpolated
+ * irradiance over a grid, irrgrid.c), indirect specular and refraction,
+ * transmission, textures, noise, attributes and options. Each renderer's
+ * worker holds a pointer to it (Worker.services), set by render.c, so the
+ * files that run shaders (integrator.c, radiosity.c, hider.c) do not call
+ * this file, which calls them.
+ *
+ * Every random number is a function of the point's key (PathState.keys)
+ * and the ray's index, so images do not depend on threads or order.
+ */
+#include "render/services.h"
+
+#include <math.h>
+#include <string.h>
+
+#include "render/integrator.h"
+#include "render/irrgrid.h"
+#include "shade/builtin.h"
+#include "shade/noise.h"
+#include "util/check.h"
+#include "util/rng.h"
+#include "util/sampling.h"
+
+/* The renderer's index of the context's point i. */
+static size_t point(const RayesShadeCtx *ctx, size_t i)
+{
+    return ctx->first_point + i;
+}
+
+/* The normalised Blinn-Phong lobe of shader.h: f = (e + 8) / (8 pi) (N.H)^e. */
+static float blinn_phong(Vec3 N, Vec3 V, Vec3 wi, float e)
+{
+    Vec3 H = v3_normalize(v3_add(wi, V));
+    float nh = fmaxf(v3_dot(N, H), 0.0f);
+    return (e + 8.0f) / (8.0f * (float)M_PI) * powf(nh, e);
+}
+
+/* The solid-angle pdf of drawing wi by sampling the half vector with pdf
+ * (e + 1) / (2 pi) (N.H)^e: divided by 4 V.H, the reflection's Jacobian. */
+static float blinn_phong_pdf(Vec3 N, Vec3 V, Vec3 wi, float e)
+{
+    Vec3 H = v3_normalize(v3_add(wi, V));
+    float nh = v3_dot(N, H), vh = v3_dot(V, H);
+    if (nh <= 0.0f || vh <= 0.0f)
+        return 0.0f;
+    return (e + 1.0f) / (2.0f * (float)M_PI) * powf(nh, e) / (4.0f * vh);
+}
+
+/* The power heuristic for one sample from each of two strategies. */
+static float power_heuristic(float pa, float pb)
+{
+    float a = pa * pa, b = pb * pb;
+    return a + b > 0.0f ? a / (a + b) : 0.0f;
+}
+
+/* 1 if nothing stands between o and the point dist along unit wi (INFINITY:
+ * the ray escapes); counts the shadow ray. */
+static int unoccluded(Worker *w, Vec3 o, Vec3 wi, float dist)
+{
+    Ray shadow;
+    if (isinf(dist)) {
+        shadow = (Ray){o, wi, path_ray_epsilon(w), INFINITY, RAYES_RAY_SHADOW};
+    } else {
+        /* tnear skips surfaces through the origin itself: a grid vertex on a
+         * corner line (a floor vertex against a wall) lies in the other
+         * surface's plane, and would shadow itself. */
+        shadow = (Ray){o, v3_scale(wi, dist), path_ray_epsilon(w) / dist, 1.0f - 1e-4f,
+                       RAYES_RAY_SHADOW};
+    }
+    w->stats.rays_shadow++;
+    return !accel_occluded(w->rs->accel, &shadow);
+}
+
+/* What direct lighting needs of one shading point. */
+typedef struct DirectPoint {
+    Vec3 o, N, Ng, V;
+    float e;      /* Blinn-Phong exponent */
+    int spec;     /* the specular output is wanted */
+} DirectPoint;
+
+/* A delta light (point, spot, distant): one shadow ray. */
+static void light_delta(Worker *w, const DirectPoint *p, const Light *l, Vec3 *diffuse,
+                        Vec3 *spec)
+{
+    LightSample ls;
+    if (!light_sample(l, p->o, 0.5f, 0.5f, &ls))
+        return;
+    float cos_x = v3_dot(p->N, ls.wi);
+    if (cos_x <= 0.0f || v3_dot(p->Ng, ls.wi) <= 0.0f || !unoccluded(w, p->o, ls.wi, ls.dist))
+        return;
+    *diffuse = v3_madd(*diffuse, ls.Li, cos_x / (float)M_PI);
+    if (p->spec)
+        *spec = v3_madd(*spec, ls.Li, cos_x * blinn_phong(p->N, p->V, ls.wi, p->e));
+}
+
+/* An area or environment light, n samples with multiple importance
+ * sampling (power heuristic): each light sample is paired with a
+ * cosine-distributed direction for the diffuse output and, when the
+ * specular output is wanted, a Blinn-Phong direction, which count when
+ * they reach the light's emitting side unoccluded. */
+static void light_area(Worker *w, const DirectPoint *p, const Light *l, uint64_t key, int n,
+                       Vec3 *diffuse, Vec3 *spec)
+{
+    Vec3 sum_d = v3(0, 0, 0), sum_s = v3(0, 0, 0);
+    uint32_t pattern = (uint32_t)key, pat_cos = (uint32_t)hash_combine(key, 1),
+             pat_bp = (uint32_t)hash_combine(key, 2);
+    for (int s = 0; s < n; s++) {
+        float a, b;
+        LightSample ls;
+        /* The light's strategy. */
+        cmj_sample_2d((uint32_t)s, (uint32_t)n, pattern, &a, &b);
+        if (light_sample(l, p->o, a, b, &ls) && ls.pdf > 0.0f) {
+            float cos_x = v3_dot(p->N, ls.wi);
+            if (cos_x > 0.0f && v3_dot(p->Ng, ls.wi) > 0.0f && v3_max_component(ls.Li) > 0.0f &&
+                unoccluded(w, p->o, ls.wi, ls.dist)) {
+                float wd = power_heuristic(ls.pdf, cos_x / (float)M_PI);
+                sum_d = v3_madd(sum_d, ls.Li, wd * cos_x / ((float)M_PI * ls.pdf));
+                if (p->spec) {
+                    float ws = power_heuristic(ls.pdf, blinn_phong_pdf(p->N, p->V, ls.wi, p->e));
+                    float f = blinn_phong(p->N, p->V, ls.wi, p->e);
+                    sum_s = v3_madd(sum_s, ls.Li, ws * f * cos_x / ls.pdf);
+                }
+            }
+        }
+        /* The diffuse lobe's strategy: weight (cos / pi) / pdf = 1. */
+        cmj_sample_2d((uint32_t)s, (uint32_t)n, pat_cos, &a, &b);
+        Vec3 wi = sample_cosine_hemisphere(p->N, a, b);
+        float cos_x = v3_dot(p->N, wi);
+        if (cos_x > 0.0f && v3_dot(p->Ng, wi) > 0.0f && light_intersect(l, p->o, wi, &ls) &&
+            v3_max_component(ls.Li) > 0.0f && unoccluded(w, p->o, wi, ls.dist))
+            sum_d = v3_madd(sum_d, ls.Li, power_heuristic(cos_x / (float)M_PI, ls.pdf));
+        if (!p->spec)
+            continue;
+        /* The specular lobe's strategy: the half vector about N. */
+        cmj_sample_2d((uint32_t)s, (uint32_t)n, pat_bp, &a, &b);
+        float cos_h = powf(a, 1.0f / (p->e + 1.0f));
+        float sin_h = sqrtf(fmaxf(0.0f, 1.0f - cos_h * cos_h)), phi = 2.0f * (float)M_PI * b;
+        Vec3 t, bt;
+        v3_basis(p->N, &t, &bt);
+        Vec3 H = v3_add(v3_add(v3_scale(t, sin_h * cosf(phi)), v3_scale(bt, sin_h * sinf(phi))),
+                        v3_scale(p->N, cos_h));
+        float vh = v3_dot(p->V, H);
+        if (vh <= 0.0f)
+            continue;
+        wi = v3_normalize(v3_sub(v3_scale(H, 2.0f * vh), p->V));
+        cos_x = v3_dot(p->N, wi);
+        if (cos_x <= 0.0f || v3_dot(p->Ng, wi) <= 0.0f || !light_intersect(l, p->o, wi, &ls) ||
+            !(v3_max_component(ls.Li) > 0.0f))
+            continue;
+        float pdf = blinn_phong_pdf(p->N, p->V, wi, p->e);
+        if (!(pdf > 0.0f) || !unoccluded(w, p->o, wi, ls.dist))
+            continue;
+        float f = blinn_phong(p->N, p->V, wi, p->e);
+        sum_s = v3_madd(sum_s, ls.Li, power_heuristic(pdf, ls.pdf) * f * cos_x / pdf);
+    }
+    *diffuse = v3_add(*diffuse, v3_scale(sum_d, 1.0f / n));
+    if (p->spec)
+        *spec = v3_add(*spec, v3_scale(sum_s, 1.0f / n));
+}
+
+/* The object whose light links apply to the points of ps: its grid's
+ * (every caller, camera hit, grid hider, radiosity fill, irradiance,
+ * knows the grid); a test calling services on no grid gets an object lit
+ * by every light. */
+static const RenderObject *lit_object(const PathState *ps)
+{
+    static const RenderObject every = {.light = -1};
+    const RenderScene *rs = ps->w->rs;
+    return ps->grid < rs->gs->n_grids ? &rs->objects[rs->gs->grids[ps->grid].object] : &every;
+}
+
+static void svc_direct_lighting(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
+                                int n_shadow_rays, const char *category, const float *roughness,
+                                float (*diffuse)[3], float (*specular)[3])
+{
+    (void)sv;
+    const PathState *ps = ctx->renderer;
+    Worker *w = ps->w;
+    int n = n_shadow_rays > 0 ? n_shadow_rays
+            : ctx->diffuse_depth == 0 ? w->set->shadow_rays
+                                      : w->set->shadow_rays_deep;
+    int want_spec = specular && ctx->I;
+    const RenderObject *obj = lit_object(ps);
+    for (size_t i = 0; i < ctx->n_points; i++) {
+        Vec3 d = v3(0, 0, 0), s = v3(0, 0, 0);
+        DirectPoint p;
+        p.N = v3_load(ctx->N[i]);
+        p.Ng = v3_load(ctx->Ng[i]);
+        p.o = v3_madd(v3_load(ctx->P[i]), p.Ng, ps->offset[point(ctx, i)]);
+        p.V = ctx->I ? v3_neg(v3_load(ctx->I[i])) : v3(0, 0, 0);
+        p.e = 1.0f / (roughness && roughness[i] > 0.0f ? roughness[i] : 0.1f);
+        p.spec = want_spec;
+        for (size_t k = 0; k < w->rs->n_lights && n > 0; k++) {
+            const Light *l = &w->rs->lights[k];
+            if (l->type == LIGHT_AMBIENT || !render_lit_by(obj, k) ||
+                !light_category_match(l, category))
+                continue;
+            if (light_is_area(l))
+                light_area(w, &p, l,
+                           hash_combine(hash_combine(ps->keys[point(ctx, i)], DIM_LIGHT), k), n,
+                           &d, &s);
+            else
+                light_delta(w, &p, l, &d, &s);
+        }
+        if (diffuse)
+            v3_store(diffuse[i], d);
+        if (specular)
+            v3_store(specular[i], s);
+    }
+}
+
+static void svc_indirect_diffuse(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
+                                 int n_rays, float (*out)[3])
+{
+    (void)sv;
+    const PathState *ps = ctx->renderer;
+    Worker *w = ps->w;
+    int depth = ctx->diffuse_depth;
+    int n = n_rays > 0 ? n_rays : depth == 0 ? w->set->diffuse_rays : w->set->diffuse_rays_deep;
+    if (depth >= w->set->bounces)
+        n = 0;
+    IrrGrid *irr = ps->irr;
+    if (irr && n > 0 && ctx->N == irr->N + ctx->first_point) {
+        /* A grid's own points with its own normals: interpolate (irrgrid.h). */
+        if (!irr->done || irr->n_rays != n)
+            irrgrid_compute(ps, irr, n);
+        memcpy(out, irr->E + ctx->first_point, ctx->n_points * sizeof *out);
+        return;
+    }
+    /* Each ray stands for 1/n of the hemisphere: its spread never shrinks. */
+    float lobe_spread = n > 0 ? 1.0f / sqrtf((float)n) : 0.0f;
+    for (size_t i = 0; i < ctx->n_points; i++) {
+        size_t j = point(ctx, i);
+        Vec3 P = v3_load(ctx->P[i]), N = v3_load(ctx->N[i]), Ng = v3_load(ctx->Ng[i]);
+        Vec3 o = v3_madd(P, Ng, ps->offset[j]), sum = v3(0, 0, 0);
+        uint64_t key = hash_combine(ps->keys[j], DIM_DIFFUSE);
+        RayDiff diff = {ps->diff[j].width, fmaxf(ps->diff[j].spread, lobe_spread)};
+        for (int s = 0; s < n; s++) {
+            float a, b;
+            cmj_sample_2d((uint32_t)s, (uint32_t)n, (uint32_t)key, &a, &b);
+            Vec3 d = sample_cosine_hemisphere(N, a, b);
+            if (v3_dot(d, Ng) <= 0.0f)
+                continue; /* below the geometric surface: no light from there */
+            Ray ray = {o, d, 0.0f, INFINITY, RAYES_RAY_DIFFUSE};
+            w->stats.rays_diffuse++;
+            Vec3 L = integrator_trace(w, &ray, RAYES_RAY_DIFFUSE, depth + 1, ctx->specular_depth,
+                                      hash_combine(key, (uint64_t)s + 1), diff, NULL);
+            sum = v3_add(sum, L);
+        }
+        v3_store(out[i], n > 0 ? v3_scale(sum, 1.0f / n) : v3(0, 0, 0));
+    }
+}
+
+static void svc_ambient(const RayesShaderServices *sv, const RayesShadeCtx *ctx, float (*out)[3])
+{
+    (void)sv;
+    const PathState *ps = ctx->renderer;
+    const RenderScene *rs = ps->w->rs;
+    const RenderObject *obj = lit_object(ps);
+    Vec3 sum = v3(0, 0, 0);
+    for (size_t k = 0; k < rs->n_lights; k++)
+        if (rs->lights[k].type == LIGHT_AMBIENT && render_lit_by(obj, k))
+            sum = v3_add(sum, rs->lights[k].L);
+    for (size_t i = 0; i < ctx->n_points; i++)
+        v3_store(out[i], sum);
+    ps->w->stats.ambient_lookups += ctx->n_points;
+}
+
+/* Radiance along d from point i of ctx, a specular or refracted ray. */
+static Vec3 trace_specular(const RayesShadeCtx *ctx, size_t i, Vec3 d, uint64_t key)
+{
+    const PathState *ps = ctx->renderer;
+    Worker *w = ps->w;
+    size_t j = point(ctx, i);
+    Vec3 Ng = v3_load(ctx->Ng[i]);
+    float off = ps->offset[j];
+    Vec3 o = v3_madd(v3_load(ctx->P[i]), Ng, v3_dot(d, Ng) >= 0.0f ? off : -off);
+    /* A mirror keeps the spread and adds the curvature's share. */
+    float width = ps->diff[j].width;
+    RayDiff diff = {width, ps->diff[j].spread + 2.0f * ps->curvature[j] * width};
+    Ray ray = {o, d, path_ray_epsilon(w), INFINITY, RAYES_RAY_SPECULAR};
+    w->stats.rays_specular++;
+    return integrator_trace(w, &ray, RAYES_RAY_SPECULAR, ctx->diffuse_depth,
+                            ctx->specular_depth + 1, key, diff, NULL);
+}
+
+static void svc_indirect_specular(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
+                                  const float (*dir)[3], const float *roughness, int n_rays,
+                                  float (*out)[3])
+{
+    (void)sv;
+    const PathState *ps = ctx->renderer;
+    Worker *w = ps->w;
+    for (size_t i = 0; i < ctx->n_points; i++) {
+        if (ctx->specular_depth >= w->set->specular_depth) {
+            v3_store(out[i], v3(0, 0, 0));
+            continue;
+        }
+        uint64_t key = hash_combine(ps->keys[point(ctx, i)], DIM_SPECULAR);
+        Vec3 d = v3_normalize(v3_load(dir[i]));
+        float r = roughness ? roughness[i] : 0.0f;
+        if (r <= 0.0f) {
+            v3_store(out[i], trace_specular(ctx, i, d, key));
+            continue;
+        }
+        /* A glossy lobe: directions with density proportional to cos^e of
+         * their angle to d; those below the surface bring nothing. */
+        int n = n_rays > 0 ? n_rays
+                : ctx->diffuse_depth == 0 ? w->set->diffuse_rays
+                                          : w->set->diffuse_rays_deep;
+        float e = 1.0f / r;
+        Vec3 Ng = v3_load(ctx->Ng[i]), sum = v3(0, 0, 0), t, b;
+        v3_basis(d, &t, &b);
+        for (int s = 0; s < n; s++) {
+            float a1, a2;
+            cmj_sample_2d((uint32_t)s, (uint32_t)n, (uint32_t)key, &a1, &a2);
+            float cos_t = powf(a1, 1.0f / (e + 1.0f)), sin_t = sqrtf(fmaxf(0.0f, 1.0f - cos_t * cos_t));
+            float phi = 2.0f * (float)M_PI * a2;
+            Vec3 wi = v3_add(v3_add(v3_scale(t, sin_t * cosf(phi)), v3_scale(b, sin_t * sinf(phi))),
+                             v3_scale(d, cos_t));
+            if (v3_dot(wi, Ng) <= 0.0f)
+                continue;
+            sum = v3_add(sum, trace_specular(ctx, i, wi, hash_combine(key, (uint64_t)s + 1)));
+        }
+        v3_store(out[i], n > 0 ? v3_scale(sum, 1.0f / n) : v3(0, 0, 0));
+    }
+}
+
+static void svc_indirect_refraction(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
+                                    const float (*dir)[3], float (*out)[3])
+{
+    (void)sv;
+    const PathState *ps = ctx->renderer;
+    for (size_t i = 0; i < ctx->n_points; i++) {
+        if (ctx->specular_depth >= ps->w->set->specular_depth) {
+            v3_store(out[i], v3(0, 0, 0));
+            continue;
+        }
+        uint64_t key = hash_combine(ps->keys[point(ctx, i)], DIM_REFRACTION);
+        v3_store(out[i], trace_specular(ctx, i, v3_normalize(v3_load(dir[i])), key));
+    }
+}
+
+static void svc_transmission(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
+                             const float (*to)[3], float (*out)[3])
+{
+    (void)sv;
+    const PathState *ps = ctx->renderer;
+    Worker *w = ps->w;
+    for (size_t i = 0; i < ctx->n_points; i++) {
+        Vec3 P = v3_load(ctx->P[i]), d = v3_sub(v3_load(to[i]), P);
+        float len = v3_length(d);
+        float vis = 1.0f;
+        if (len > 0.0f) {
+            Vec3 Ng = v3_load(ctx->Ng[i]);
+            float off = ps->offset[point(ctx, i)];
+            Vec3 o = v3_madd(P, Ng, v3_dot(d, Ng) >= 0.0f ? off : -off);
+            Vec3 wi = v3_sub(v3_load(to[i]), o);
+            Ray shadow = {o, wi, path_ray_epsilon(w) / v3_length(wi), 1.0f - 1e-4f, RAYES_RAY_SHADOW};
+            w->stats.rays_shadow++;
+            vis = accel_occluded(w->rs->accel, &shadow) ? 0.0f : 1.0f; /* all surfaces opaque */
+        }
+        v3_store(out[i], v3(vis, vis, vis));
+    }
+}
+
+static int svc_texture(const RayesShaderServices *sv, const RayesShadeCtx *ctx, const char *name,
+                       const float *s, const float *t, const float *ds, const float *dt,
+                       float (*rgb)[3], float *alpha)
+{
+    (void)sv;
+    const PathState *ps = ctx->renderer;
+    if (!ds && ps->ds)
+        ds = ps->ds + ctx->first_point;
+    if (!dt && ps->dt)
+        dt = ps->dt + ctx->first_point;
+    return shade_texture_service(ps->w->set->textures, ctx, name, s, t, ds, dt, rgb, alpha);
+}
+
+static int put_floats(float *value, int n, const float *have, int n_have)
+{
+    for (int k = 0; k < n && k < n_have; k++)
+        value[k] = have[k];
+    return n_have;
+}
+
+static int svc_attribute(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
+                         const char *name, float *value, int n)
+{
+    (void)sv;
+    const PathState *ps = ctx->renderer;
+    const Grid *g = &ps->w->rs->gs->grids[ps->grid];
+    if (strcmp(name, "object:id") == 0)
+        return put_floats(value, n, (float[]){(float)g->object}, 1);
+    if (strcmp(name, "patch:id") == 0)
+        return put_floats(value, n, (float[]){(float)ps->grid}, 1);
+    if (strcmp(name, "grid:size") == 0)
+        return put_floats(value, n, (float[]){(float)g->nu, (float)g->nv}, 2);
+    if (strcmp(name, "grid:edge") == 0)
+        return put_floats(value, n, (float[]){g->edge}, 1);
+    if (strcmp(name, "grid:curvature") == 0)
+        return put_floats(value, n, (float[]){g->curvature}, 1);
+    return 0;
+}
+
+static int svc_option(const RayesShaderServices *sv, const RayesShadeCtx *ctx, const char *name,
+                      float *value, int n)
+{
+    (void)sv;
+    const RenderSettings *set = ((const PathState *)ctx->renderer)->w->set;
+    if (strcmp(name, "resolution") == 0)
+        return put_floats(value, n, (float[]){(float)set->width, (float)set->height}, 2);
+    if (strcmp(name, "bounces") == 0)
+        return put_floats(value, n, (float[]){(float)set->bounces}, 1);
+    if (strcmp(name, "samples") == 0)
+        return put_floats(value, n, (float[]){(float)set->spp}, 1);
+    if (strcmp(name, "shadowrays") == 0)
+        return put_floats(value, n, (float[]){(float)set->shadow_rays, (float)set->shadow_rays_deep}, 2);
+    if (strcmp(name, "diffuserays") == 0)
+        return put_floats(value, n,
+                          (float[]){(float)set->diffuse_rays, (float)set->diffuse_rays_deep}, 2);
+    return 0;
+}
+
+static const char *const service_names[] = {
+    "direct_lighting", "ambient", "indirect_diffuse", "indirect_specular", "indirect_refraction",
+    "transmission", "noise", "fbm", "turbulence", "attribute", "option", "texture", "checker",
+};
+
+static int svc_supports(const RayesShaderServices *sv, const char *service)
+{
+    (void)sv;
+    for (size_t i = 0; i < sizeof service_names / sizeof service_names[0]; i++)
+        if (strcmp(service, service_names[i]) == 0)
+            return 1;
+    return 0;
+}
+
+const RayesShaderServices render_services = {
+    .abi_version = RAYES_SHADER_ABI_VERSION,
+    .struct_size = sizeof(RayesShaderServices),
+    .direct_lighting = svc_direct_lighting,
+    .ambient = svc_ambient,
+    .indirect_diffuse = svc_indirect_diffuse,
+    .indirect_specular = svc_indirect_specular,
+    .indirect_refraction = svc_indirect_refraction,
+    .transmission = svc_transmission,
+    .texture = svc_texture,
+    .noise = shade_service_noise,
+    .fbm = shade_service_fbm,
+    .turbulence = shade_service_turbulence,
+    .attribute = svc_attribute,
+    .option = svc_option,
+    .checker = shade_service_checker,
+    .supports = svc_supports,
+};
