@@ -17,57 +17,107 @@
 #include "io/builtin.h"
 #include "io/scene_file.h"
 
+static const char scene_text[] =
+    "SCENE is a scene file (.rib, .rib.gz, .pbrt, .obj) or a built-in scene:\n"
+    "cornell (default), cornell-teapots, cornell-teapots-displaced, cornell-spheres,\n"
+    "cornell-brick (needs the plugin brick.so: --shader-path build/examples/shaders).\n"
+    "A scene file's image size, samples, filter, depths and displays are used unless\n"
+    "the command line gives them.\n";
+
+static const char render_options[] =
+    "options:\n"
+    "  -o FILE                 output image, .exr or .png (repeatable; default: the\n"
+    "                          scene file's displays, else SCENE.exr)\n"
+    "  --frame N               the frame of a RIB file to read (default: the last)\n"
+    "  --res W[xH]             resolution in pixels (default 512x512)\n"
+    "  --spp N                 pixel samples (default 4)\n"
+    "  --threads N             worker threads (default: all cores)\n"
+    "  --bounces N             maximum diffuse depth (default 1)\n"
+    "  --quality Q             preview (4 shadow, 4 diffuse rays), final (64; 1024 at\n"
+    "                          depth 0, 64 deeper), reference (64 and 4096 at depth 0,\n"
+    "                          1 and 1 deeper); later options override it\n"
+    "  --shadow-rays N         shadow rays per shading point and light\n"
+    "  --diffuse-rays N        diffuse rays per shading point (all depths)\n"
+    "  --diffuse-rays-deep N   diffuse rays per shading point below depth 0\n"
+    "  --specular-depth N      maximum specular depth (default 4)\n"
+    "  --filter box|gaussian   pixel filter (default box)\n"
+    "  --filter-width W        filter width in pixels (default 1 box, 2 gaussian)\n"
+    "  --seed N                changes every random number (default 0)\n"
+    "  --cache on|off          the radiosity cache at diffuse hits (default on; off for\n"
+    "                          --quality reference)\n"
+    "  --cache-mb MB           cache budget in megabytes (default 100)\n"
+    "  --cache-split C,M,F     budget shares of coarse, medium, fine (default .25,.25,.5)\n"
+    "  --cache-resolution R    auto (by ray differentials), coarse, medium or fine\n"
+    "  --cache-k K             use the coarsest resolution whose micropolygons are at\n"
+    "                          most K times the ray footprint (default 1)\n"
+    "  --gridsize N            micropolygons per grid, at most (default 256, or the\n"
+    "                          scene file's; 1 to 4096): the size of a cache entry\n"
+    "  --hider raytrace|grid   shade every camera hit (default), or once per vertex of\n"
+    "                          each visible grid and interpolate (PRMan's REYES mode;\n"
+    "                          default for --quality final)\n"
+    "  --irradiance on|off     irradiance interpolation with gradients at depth 0 (grid\n"
+    "                          hider; on for --quality final)\n"
+    "  --texture-mb MB         texture cache budget in megabytes (default 64)\n"
+    "  --data DIR              data directory (teapot.bpt); default $RAYES_DATA\n"
+    "  --shader-path DIRS      directories of shader plugins NAME.so, ':'-separated;\n"
+    "                          searched before $RAYES_SHADER_PATH\n"
+    "  --stats FILE.json       write statistics as JSON\n"
+    "  --quiet                 no progress bar and no summary\n";
+
+static const char view_options[] =
+    "view options (and every option above; docs/view.md):\n"
+    "  --passes N              window: refine to N samples per pixel after each edit\n"
+    "                          (default 256); headless: render N passes in all\n"
+    "  --exposure E            display: colour times 2^E (default 0)\n"
+    "  --gamma G               display: colour to the power 1/G (default 1)\n"
+    "  --script FILE|-         edit commands, one per line after a pass number\n"
+    "  --headless              no window: render the passes and run the script\n"
+    "  --screenshot FILE.png   the window's pixels after --passes passes\n";
+
+static const char convert_text[] =
+    "usage: rayes convert SCENE OUT.rib [--data DIR] [--frame N] [--quiet]\n"
+    "\n"
+    "Writes SCENE (a scene file or a built-in scene, as rayes render reads it) as\n"
+    "ASCII RIB (docs/convert.md says what is kept).\n"
+    "\n"
+    "options:\n"
+    "  --data DIR              data directory (teapot.bpt); default $RAYES_DATA\n"
+    "  --frame N               the frame of a RIB file to read (default: the last)\n"
+    "  --quiet                 no \"wrote OUT.rib\" line\n";
+
 void print_usage(FILE *f)
 {
     fputs("usage: rayes render [SCENE] [options]\n"
+          "       rayes view [SCENE] [options] [view options]\n"
           "       rayes convert SCENE OUT.rib [--data DIR] [--frame N] [--quiet]\n"
           "       rayes --help | --version\n"
-          "\n"
-          "SCENE is a scene file (.rib, .rib.gz, .pbrt, .obj) or a built-in scene:\n"
-          "cornell (default), cornell-teapots, cornell-teapots-displaced, cornell-spheres,\n"
-          "cornell-brick (needs the plugin brick.so: --shader-path build/examples/shaders).\n"
-          "A scene file's image size, samples, filter, depths and displays are used unless\n"
-          "the command line gives them. convert writes SCENE as ASCII RIB.\n"
-          "\n"
-          "options:\n"
-          "  -o FILE                 output image, .exr or .png (repeatable; default: the\n"
-          "                          scene file's displays, else SCENE.exr)\n"
-          "  --frame N               the frame of a RIB file to read (default: the last)\n"
-          "  --res W[xH]             resolution in pixels (default 512x512)\n"
-          "  --spp N                 pixel samples (default 4)\n"
-          "  --threads N             worker threads (default: all cores)\n"
-          "  --bounces N             maximum diffuse depth (default 1)\n"
-          "  --quality Q             preview (4 shadow, 4 diffuse rays), final (64; 1024 at\n"
-          "                          depth 0, 64 deeper), reference (64 and 4096 at depth 0,\n"
-          "                          1 and 1 deeper); later options override it\n"
-          "  --shadow-rays N         shadow rays per shading point and light\n"
-          "  --diffuse-rays N        diffuse rays per shading point (all depths)\n"
-          "  --diffuse-rays-deep N   diffuse rays per shading point below depth 0\n"
-          "  --specular-depth N      maximum specular depth (default 4)\n"
-          "  --filter box|gaussian   pixel filter (default box)\n"
-          "  --filter-width W        filter width in pixels (default 1 box, 2 gaussian)\n"
-          "  --seed N                changes every random number (default 0)\n"
-          "  --cache on|off          the radiosity cache at diffuse hits (default on; off for\n"
-          "                          --quality reference)\n"
-          "  --cache-mb MB           cache budget in megabytes (default 100)\n"
-          "  --cache-split C,M,F     budget shares of coarse, medium, fine (default .25,.25,.5)\n"
-          "  --cache-resolution R    auto (by ray differentials), coarse, medium or fine\n"
-          "  --cache-k K             use the coarsest resolution whose micropolygons are at\n"
-          "                          most K times the ray footprint (default 1)\n"
-          "  --gridsize N            micropolygons per grid, at most (default 256, or the\n"
-          "                          scene file's; 1 to 4096): the size of a cache entry\n"
-          "  --hider raytrace|grid   shade every camera hit (default), or once per vertex of\n"
-          "                          each visible grid and interpolate (PRMan's REYES mode;\n"
-          "                          default for --quality final)\n"
-          "  --irradiance on|off     irradiance interpolation with gradients at depth 0 (grid\n"
-          "                          hider; on for --quality final)\n"
-          "  --texture-mb MB         texture cache budget in megabytes (default 64)\n"
-          "  --data DIR              data directory (teapot.bpt); default $RAYES_DATA\n"
-          "  --shader-path DIRS      directories of shader plugins NAME.so, ':'-separated;\n"
-          "                          searched before $RAYES_SHADER_PATH\n"
-          "  --stats FILE.json       write statistics as JSON\n"
-          "  --quiet                 no progress bar and no summary\n",
+          "       rayes COMMAND --help\n"
+          "\n",
           f);
+    fputs(scene_text, f);
+    fputs("convert writes SCENE as ASCII RIB.\n\n", f);
+    fputs(render_options, f);
+    fputc('\n', f);
+    fputs(view_options, f);
+}
+
+void print_command_usage(const char *command, FILE *f)
+{
+    if (strcmp(command, "convert") == 0) {
+        fputs(convert_text, f);
+        return;
+    }
+    int view = strcmp(command, "view") == 0;
+    fputs(view ? "usage: rayes view [SCENE] [options] [view options]\n\n"
+               : "usage: rayes render [SCENE] [options]\n\n",
+          f);
+    fputs(scene_text, f);
+    fputc('\n', f);
+    fputs(render_options, f);
+    if (view) {
+        fputc('\n', f);
+        fputs(view_options, f);
+    }
 }
 
 void die_usage(const char *fmt, ...)
@@ -176,6 +226,10 @@ void parse_args(int argc, char **argv, Args *a)
         if (strcmp(o, "--quiet") == 0) {
             a->quiet = 1;
             continue;
+        }
+        if (strcmp(o, "--help") == 0 || strcmp(o, "-h") == 0) {
+            print_command_usage(a->view ? "view" : "render", stdout);
+            exit(0);
         }
         if (strcmp(o, "--headless") == 0 && a->view) {
             a->headless = 1;

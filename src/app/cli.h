@@ -73,7 +73,10 @@ int load_status(const char *scene, RayesError e);
 /* The file's settings where the command line gave none. */
 void merge_settings(Args *a, const IoSettings *s);
 
-/* The usage text, to f. */
+/* The usage text of every command, to f. */
 void print_usage(FILE *f);
+
+/* The usage text of one command ("render", "view" or "convert"), to f. */
+void print_command_usage(const char *command, FILE *f);
 
 #endif /* RAYES_APP_CLI_H */

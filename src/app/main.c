@@ -348,6 +348,9 @@ static int cmd_convert(int argc, char **argv)
             *(in ? &out : &in) = o;
         } else if (strcmp(o, "--quiet") == 0) {
             quiet = 1;
+        } else if (strcmp(o, "--help") == 0 || strcmp(o, "-h") == 0) {
+            print_command_usage("convert", stdout);
+            return 0;
         } else if (strcmp(o, "--data") == 0) {
             if (!v)
                 die_usage("--data: expected a value");

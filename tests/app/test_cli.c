@@ -1,11 +1,12 @@
 /*
- * tests/app/test_cli.c — the rayes command line (src/app/main.c), run as a
- * child process: exit status 0 on success, 1 for bad input or a failed
- * write, 2 for usage errors; every error is exactly one line on stderr
- * naming what is wrong; a tiny render writes its PNG, EXR and statistics;
- * a failed write leaves nothing at the target; --quiet prints nothing;
- * --shader-path and RAYES_SHADER_PATH find the example plugin brick; an
- * OBJ file renders (to -o, or to NAME.exr by default); convert writes a
+ * tests/app/test_cli.c — the rayes command line (src/app/main.c, cli.c), run
+ * as a child process: exit status 0 on success, 1 for bad input or a
+ * failed write, 2 for usage errors; every error is exactly one line on
+ * stderr naming what is wrong; a tiny render writes its PNG, EXR and
+ * statistics; a failed write leaves nothing at the target; --quiet prints
+ * nothing; --help (alone, or after a command: that command's usage)
+ * prints on stdout with status 0; --shader-path and RAYES_SHADER_PATH
+ * find the example plugin brick; an OBJ file renders (to -o, or to NAME.exr by default); convert writes a
  * built-in scene or a file as RIB; a bad scene file is one line naming
  * file:line:col, status 1, and leaves no output behind.
  *
@@ -162,6 +163,22 @@ static void test_version_and_help(void)
     run(&r, NULL, ARGS("--help"));
     CHECK(r.status == 0);
     CHECK(strstr(r.out, "usage:") != NULL && strstr(r.out, "--spp") != NULL);
+    CHECK(r.err[0] == '\0');
+
+    /* Each command's own usage, on stdout, status 0, wherever --help is. */
+    run(&r, NULL, ARGS("render", "--help"));
+    CHECK(r.status == 0);
+    CHECK(strncmp(r.out, "usage: rayes render", 19) == 0 && strstr(r.out, "--spp") != NULL);
+    CHECK(strstr(r.out, "--screenshot") == NULL && r.err[0] == '\0');
+    run(&r, NULL, ARGS("render", "cornell", "--spp", "2", "-h"));
+    CHECK(r.status == 0 && strncmp(r.out, "usage: rayes render", 19) == 0);
+    run(&r, NULL, ARGS("view", "--help"));
+    CHECK(r.status == 0);
+    CHECK(strncmp(r.out, "usage: rayes view", 17) == 0 && strstr(r.out, "--screenshot") != NULL);
+    CHECK(strstr(r.out, "--spp") != NULL && r.err[0] == '\0');
+    run(&r, NULL, ARGS("convert", "--help"));
+    CHECK(r.status == 0);
+    CHECK(strncmp(r.out, "usage: rayes convert", 20) == 0 && strstr(r.out, "--spp") == NULL);
     CHECK(r.err[0] == '\0');
 }
 
