@@ -568,6 +568,7 @@ static void rib_fini(Rib *r)
     }
     free(r->decls);
     free(r->lights);
+    free(r->area_handles);
     free(r->links);
     for (size_t k = 0; k < r->n_objects; k++)
         rib_recording_free(r->objects[k].rec);

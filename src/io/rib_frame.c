@@ -69,12 +69,12 @@ static int h_object_end(Rib *r, const Args *a)
 static int h_object_instance(Rib *r, const Args *a)
 {
     size_t i = 0;
-    char key[64];
+    char key[RIB_MAX_HANDLE];
     if (rib_get_handle(r, a, &i, key) != 0)
         return -1;
     Object *o = find_object(r, key);
     if (!o)
-        return rib_error(r, "no object has the handle %s", key[0] == '#' ? key + 1 : key);
+        return rib_error(r, "no object has the handle %s", rib_handle_name(key));
     if (r->rec)
         return rib_error(r, "ObjectInstance inside an object definition");
     if (!r->in_world) {

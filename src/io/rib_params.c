@@ -115,17 +115,24 @@ const char *rib_get_string(Rib *r, const Args *a, size_t *i, const char *what)
 }
 
 /* A handle: an integer or a string, as a key. */
-int rib_get_handle(Rib *r, const Args *a, size_t *i, char key[64])
+int rib_get_handle(Rib *r, const Args *a, size_t *i, char key[RIB_MAX_HANDLE])
 {
     if (*i < a->n && a->v[*i].kind == ARG_NUM) {
-        snprintf(key, 64, "#%.17g", a->v[(*i)++].d[0]);
+        snprintf(key, RIB_MAX_HANDLE, "#%.17g", a->v[(*i)++].d[0]);
         return 0;
     }
     const char *s = rib_get_string(r, a, i, "a handle");
     if (!s)
         return -1;
-    snprintf(key, 64, "%s", s);
+    if (strlen(s) > RIB_MAX_HANDLE - 3)
+        return rib_error(r, "a handle longer than %d characters", RIB_MAX_HANDLE - 3);
+    snprintf(key, RIB_MAX_HANDLE, "\"%s\"", s);
     return 0;
+}
+
+const char *rib_handle_name(const char *key)
+{
+    return key[0] == '#' ? key + 1 : key;
 }
 
 /* An integer array (or one integer) with every value in [lo, hi]. */

@@ -47,6 +47,7 @@
 #define RIB_MAX_FILE_BYTES ((size_t)1 << 30)
 #define RIB_MAX_WARNED 512
 #define RIB_MAX_LIGHTS 4096
+#define RIB_MAX_HANDLE 256 /* a handle's key: "#N" for a number, "\"name\"" for a string */
 
 /* ----------------------------------------------------------- arguments */
 
@@ -125,7 +126,7 @@ typedef struct SinkState {
 #define RIB_LIGHT_PARAMS 12
 
 typedef struct Light {
-    char handle[64];
+    char handle[RIB_MAX_HANDLE]; /* "" once a later light took the handle */
     char type[32];
     RayesParam params[RIB_LIGHT_PARAMS];
     char names[RIB_LIGHT_PARAMS][64];
@@ -137,7 +138,7 @@ typedef struct Light {
 } Light;
 
 typedef struct Object {
-    char key[64];
+    char key[RIB_MAX_HANDLE];
     RibRecording *rec;
 } Object;
 
@@ -185,13 +186,15 @@ typedef struct Rib {
     size_t n_decls;
     Light *lights;
     size_t n_lights;
+    char (*area_handles)[RIB_MAX_HANDLE]; /* AreaLightSource handles, for Illuminate */
+    size_t n_area_handles;
     size_t *links;             /* the light links last sent (EXCEPT these; none: ALL) */
     size_t n_links;
     Object *objects;
     size_t n_objects;
     RibRecording *rec;         /* the object being defined */
     IoSink rec_sink;
-    char rec_key[64];
+    char rec_key[RIB_MAX_HANDLE];
     float rec_saved_M[16];
     SinkState real, recorded;
 
@@ -255,8 +258,11 @@ int rib_is_num(const Arg *g);
 int rib_get_floats(Rib *r, const Args *a, size_t *i, float *out, size_t n, const char *what);
 /* The string at *i (owned by a), or NULL with the error set. */
 const char *rib_get_string(Rib *r, const Args *a, size_t *i, const char *what);
-/* A handle: an integer or a string, as a key. */
-int rib_get_handle(Rib *r, const Args *a, size_t *i, char key[64]);
+/* A handle: an integer or a string, as a key ("#N" or "\"name\"": the
+ * two never meet); a string too long for a key is an error. */
+int rib_get_handle(Rib *r, const Args *a, size_t *i, char key[RIB_MAX_HANDLE]);
+/* The handle of key as the file wrote it, for messages. */
+const char *rib_handle_name(const char *key);
 /* An integer array (or one integer) with every value in [lo, hi]; *out
  * is a new array of *n values. */
 int rib_get_ints(Rib *r, const Args *a, size_t *i, int **out, size_t *n, long lo, long hi,

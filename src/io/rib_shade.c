@@ -313,7 +313,7 @@ static int h_light_source(Rib *r, const Args *a)
 {
     size_t i = 0;
     const char *name = rib_get_string(r, a, &i, "a light shader name");
-    char handle[64];
+    char handle[RIB_MAX_HANDLE];
     if (!name)
         return -1;
     if (i < a->n && (a->n - i) % 2 == 1) { /* parameters come in pairs: the odd one out */
@@ -357,20 +357,18 @@ static int h_light_source(Rib *r, const Args *a)
         free(p);
         return rib_error(r, "more than %d lights", RIB_MAX_LIGHTS);
     }
+    /* A handle used before: a second light; the first keeps lighting as
+     * it is, and the handle names the new one from now on. */
     Light *L = find_light(r, handle);
-    if (L && L->index < 0) {
-        /* redefined before any geometry saw it: replace */
-    } else {
-        if (L)
-            L->handle[0] = '\0'; /* the old one keeps lighting; the handle moves on */
-        Light *nl = realloc(r->lights, (r->n_lights + 1) * sizeof *nl);
-        if (!nl) {
-            free(p);
-            return rib_error(r, "out of memory");
-        }
-        r->lights = nl;
-        L = &r->lights[r->n_lights++];
+    if (L)
+        L->handle[0] = '\0';
+    Light *nl = realloc(r->lights, (r->n_lights + 1) * sizeof *nl);
+    if (!nl) {
+        free(p);
+        return rib_error(r, "out of memory");
     }
+    r->lights = nl;
+    L = &r->lights[r->n_lights++];
     memset(L, 0, sizeof *L);
     snprintf(L->handle, sizeof L->handle, "%s", handle);
     snprintf(L->type, sizeof L->type, "%s", type);
@@ -416,12 +414,21 @@ static int h_area_light(Rib *r, const Args *a)
 {
     size_t i = 0;
     const char *name = rib_get_string(r, a, &i, "a light shader name");
-    char handle[64];
+    char handle[RIB_MAX_HANDLE];
     if (!name)
         return -1;
-    if (i < a->n && (a->n - i) % 2 == 1)
+    if (i < a->n && (a->n - i) % 2 == 1) {
         if (rib_get_handle(r, a, &i, handle) != 0)
             return -1;
+        if (r->n_area_handles >= RIB_MAX_LIGHTS)
+            return rib_error(r, "more than %d area light handles", RIB_MAX_LIGHTS);
+        char(*nh)[RIB_MAX_HANDLE] =
+            realloc(r->area_handles, (r->n_area_handles + 1) * sizeof *nh);
+        if (!nh)
+            return rib_error(r, "out of memory");
+        r->area_handles = nh;
+        memcpy(nh[r->n_area_handles++], handle, sizeof handle);
+    }
     Param *p;
     size_t n;
     if (rib_get_params(r, a, i, &p, &n) != 0)
@@ -438,13 +445,21 @@ static int h_area_light(Rib *r, const Args *a)
 static int h_illuminate(Rib *r, const Args *a)
 {
     size_t i = 0;
-    char handle[64];
+    char handle[RIB_MAX_HANDLE];
     float on;
     if (rib_get_handle(r, a, &i, handle) != 0 || rib_get_floats(r, a, &i, &on, 1, "0 or 1") != 0)
         return -1;
     Light *L = find_light(r, handle);
-    if (!L)
-        return rib_error(r, "no light has the handle %s", handle[0] == '#' ? handle + 1 : handle);
+    if (!L) {
+        for (size_t k = 0; k < r->n_area_handles; k++)
+            if (strcmp(r->area_handles[k], handle) == 0) {
+                rib_warn_once(r, "Illuminate area", "Illuminate of the area light %s is ignored: "
+                                                    "area lights light everything",
+                              rib_handle_name(handle));
+                return 0;
+            }
+        return rib_error(r, "no light has the handle %s", rib_handle_name(handle));
+    }
     set_light_on(&r->a, (size_t)(L - r->lights), on != 0);
     return 0;
 }
@@ -459,6 +474,7 @@ int rib_flush_lights(Rib *r)
             return -1;
     }
     r->n_lights = 0;
+    r->n_area_handles = 0;
     memset(r->a.on, 0, sizeof r->a.on);
     r->real.have_M = 0;
     return 0;

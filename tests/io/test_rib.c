@@ -520,6 +520,67 @@ static void test_patch_mesh_bases(void)
     CHECK_NEAR(rec.first_bicubic[5][1], 1, 1e-5);
 }
 
+/* Name-keyed tables: a handle, object, coordinate system or declaration
+ * used again names the latest, and nothing earlier vanishes. */
+static void test_handles(void)
+{
+    /* Two lights with one handle: two lights, both on; Illuminate turns
+     * off only the latest (the links exclude light 1, not light 0). */
+    CHECK(parse(WORLD("LightSource \"pointlight\" 1 \"intensity\" 2\n"
+                      "LightSource \"pointlight\" 1 \"intensity\" 3\n"
+                      "Polygon \"P\" [0 0 0 1 0 0 1 1 0]\nIlluminate 1 0\n"
+                      "Polygon \"P\" [0 0 0 1 0 0 1 1 0]")) == RAYES_OK);
+    CHECK(rec.lights == 2);
+    CHECK_NEAR(rec.light_params[0][0], 2, 0);
+    CHECK_NEAR(rec.light_params[1][0], 3, 0);
+    CHECK(rec.links_mode == RAYES_LIGHT_LINKS_EXCEPT && rec.n_links == 1 && rec.links[0] == 1);
+    /* The same after geometry saw the first, and for string handles */
+    CHECK(parse(WORLD("LightSource \"pointlight\" \"key\"\nPolygon \"P\" [0 0 0 1 0 0 1 1 0]\n"
+                      "LightSource \"pointlight\" \"key\"\nIlluminate \"key\" 0\n"
+                      "Polygon \"P\" [0 0 0 1 0 0 1 1 0]")) == RAYES_OK);
+    CHECK(rec.lights == 2 && rec.n_links == 1 && rec.links[0] == 1);
+    /* The number 1 and the string "1" are different handles */
+    CHECK(parse(WORLD("LightSource \"pointlight\" 1\nLightSource \"pointlight\" \"1\"\n"
+                      "Illuminate \"1\" 0\nPolygon \"P\" [0 0 0 1 0 0 1 1 0]")) == RAYES_OK);
+    CHECK(rec.lights == 2 && rec.n_links == 1 && rec.links[0] == 1);
+    CHECK(parse(WORLD("LightSource \"pointlight\" 1\nIlluminate \"#1\" 0")) ==
+          RAYES_ERROR_PARSE);
+    CHECK(strstr(err, "no light has the handle \"#1\"") != NULL);
+    CHECK(parse(WORLD("Illuminate 7 1")) == RAYES_ERROR_PARSE);
+    CHECK(strstr(err, "no light has the handle 7") != NULL);
+    /* An area light's handle: Illuminate warns (area lights light
+     * everything) instead of failing */
+    CHECK(parse(WORLD("AttributeBegin\nAreaLightSource \"arealight\" 4\n"
+                      "Polygon \"P\" [0 0 0 1 0 0 1 1 0 0 1 0]\nAttributeEnd\nIlluminate 4 0")) ==
+          RAYES_OK);
+    CHECK(rec.area_lights == 1);
+    /* A handle too long for a key is an error, not a truncated key that
+     * could meet another */
+    char text[1024];
+    snprintf(text, sizeof text, WORLD("LightSource \"pointlight\" \"%0300d\""), 0);
+    CHECK(parse(text) == RAYES_ERROR_PARSE);
+    CHECK(strstr(err, "a handle longer than") != NULL);
+    /* An object defined again: later instances get the new definition,
+     * earlier ones keep the old */
+    CHECK(parse(WORLD("ObjectBegin \"o\"\nPolygon \"P\" [1 0 0 2 0 0 2 1 0]\nObjectEnd\n"
+                      "ObjectInstance \"o\"\n"
+                      "ObjectBegin \"o\"\nPolygon \"P\" [5 0 0 6 0 0 6 1 0]\nObjectEnd\n"
+                      "ObjectInstance \"o\"")) == RAYES_OK);
+    CHECK(rec.meshes == 2);
+    CHECK_NEAR(rec.mesh_x[0], 1, 1e-6);
+    CHECK_NEAR(rec.mesh_x[1], 5, 1e-6);
+    /* A coordinate system marked again: the latest */
+    CHECK(parse(WORLD("Translate 1 0 0\nCoordinateSystem \"c\"\nTranslate 2 0 0\n"
+                      "CoordinateSystem \"c\"\nIdentity\nCoordSysTransform \"c\"\n"
+                      "Polygon \"P\" [0 0 0 1 0 0 1 1 0]")) == RAYES_OK);
+    CHECK_NEAR(rec.mesh_x[0], 3, 1e-6);
+    /* A name declared again: the latest declaration types it */
+    CHECK(parse(WORLD("Declare \"k\" \"uniform float\"\nDeclare \"k\" \"uniform color\"\n"
+                      "Surface \"plastic\" \"k\" [1 2 3]")) == RAYES_OK);
+    CHECK(parse(WORLD("Declare \"k\" \"uniform color\"\nDeclare \"k\" \"uniform float\"\n"
+                      "Surface \"plastic\" \"k\" [1 2 3]")) == RAYES_ERROR_PARSE);
+}
+
 static void test_objects_and_frames(void)
 {
     CHECK(parse(WORLD("ObjectBegin \"box\"\nTranslate 1 0 0\nPolygon \"P\" [0 0 0 1 0 0 1 1 0]\n"
@@ -926,7 +987,8 @@ static void test_writer_split_quad(void)
 
 TEST_MAIN(TEST(test_camera_and_transforms), TEST(test_settings), TEST(test_shaders_and_lights),
           TEST(test_parameter_classes), TEST(test_polygons), TEST(test_patch_mesh_bases),
-          TEST(test_objects_and_frames), TEST(test_binary), TEST(test_gzip), TEST(test_errors),
+          TEST(test_handles), TEST(test_objects_and_frames), TEST(test_binary), TEST(test_gzip),
+          TEST(test_errors),
           TEST(test_aqsis_files), TEST(test_scene_sink),
           TEST(test_writer_round_trip), TEST(test_writer_primvars),
           TEST(test_writer_split_quad))
