@@ -1,0 +1,240 @@
+/*
+ * io/pbrt_emit.c — how the pbrt reader's geometry and lights reach the
+ * sink (pbrt_internal.h). Outside ObjectBegin ... ObjectEnd a primitive is
+ * sent at once: the current transform, the material when it differs from
+ * the last one sent, then the primitive. Inside, it is recorded instead as
+ * an Op owning copies of its arrays, its transform and its material, and
+ * ObjectInstance replays the Ops under the instance's transform (at most
+ * PBRT_MAX_REPLAYED primitives in all, so a small file cannot make a huge
+ * scene). Lights are never recorded. pbrt's uv become rayes' st with
+ * t = 1 - v.
+ */
+#include <stdlib.h>
+#include <string.h>
+
+#include "io/pbrt_internal.h"
+
+#define PBRT_MAX_REPLAYED 10000000L /* primitives emitted by ObjectInstance, in all */
+
+int pbrt_sink_failed(Parser *P, const Token *t, RayesError e)
+{
+    const char *msg = P->sink->get_error ? P->sink->get_error(P->sink->target) : "";
+    FAIL_TOK(P, t, "%s", msg && msg[0] ? msg : rayes_error_string(e));
+    return -1;
+}
+
+static void material_params(const Material *m, RayesParam out[MAT_MAX_PARAMS + 1])
+{
+    for (int i = 0; i < m->n; i++) {
+        out[i] = (RayesParam){.name = m->p[i].name, .type = m->p[i].type};
+        memcpy(out[i].value, m->p[i].v, sizeof out[i].value);
+        if (m->p[i].type == RAYES_PARAM_STRING)
+            out[i].string = m->texture;
+    }
+}
+
+static int send_state(Parser *P, const Token *t, const double m[16], const Material *mat)
+{
+    float f[16];
+    if (!pbrt_mat_finite(m))
+        return FAIL_TOK(P, t, "the current transform is not finite");
+    pbrt_mat_to_float(m, f);
+    RayesError e = P->sink->set_transform(P->sink->target, f);
+    if (e != RAYES_OK)
+        return pbrt_sink_failed(P, t, e);
+    if (!P->have_sent || memcmp(&P->sent, mat, sizeof *mat) != 0) {
+        RayesParam params[MAT_MAX_PARAMS + 1];
+        material_params(mat, params);
+        e = P->sink->set_shader(P->sink->target, mat->shader, params, (size_t)mat->n);
+        if (e != RAYES_OK)
+            return pbrt_sink_failed(P, t, e);
+        P->sent = *mat;
+        P->have_sent = 1;
+    }
+    return 0;
+}
+
+static Op *new_op(Parser *P, const Token *t, OpKind kind)
+{
+    Object *o = P->recording;
+    if (o->n_ops == o->cap_ops) {
+        size_t cap = o->cap_ops ? 2 * o->cap_ops : 8;
+        Op *n = realloc(o->ops, cap * sizeof *n);
+        if (!n) {
+            FAIL_TOK(P, t, "out of memory");
+            return NULL;
+        }
+        o->ops = n;
+        o->cap_ops = cap;
+    }
+    Op *op = &o->ops[o->n_ops];
+    memset(op, 0, sizeof *op);
+    op->mat = malloc(sizeof *op->mat);
+    if (!op->mat) {
+        FAIL_TOK(P, t, "out of memory");
+        return NULL;
+    }
+    o->n_ops++;
+    op->kind = kind;
+    memcpy(op->m, P->gs.ctm, sizeof op->m);
+    *op->mat = P->gs.material;
+    return op;
+}
+
+/* Vertex-class primitive variables N and st from pbrt's per-point N and
+ * uv (either may be NULL): st = (u, 1 - v), since pbrt's image textures
+ * put v = 0 at the bottom and rayes' t = 0 is the top row. st_store
+ * (2 * n floats) holds the converted values. Returns the count. */
+static size_t mesh_primvars(size_t n, const float *N, const float *uv, float *st_store,
+                            RayesPrimvar pv[2])
+{
+    size_t k = 0;
+    if (N)
+        pv[k++] = (RayesPrimvar){"N", RAYES_PRIMVAR_VERTEX, N, n};
+    if (uv && st_store) {
+        for (size_t i = 0; i < n; i++)
+            st_store[2 * i] = uv[2 * i], st_store[2 * i + 1] = 1.0f - uv[2 * i + 1];
+        pv[k++] = (RayesPrimvar){"st", RAYES_PRIMVAR_VERTEX, st_store, n};
+    }
+    return k;
+}
+
+static float *copy_floats(const float *f, size_t n)
+{
+    float *c = f ? malloc((n ? n : 1) * sizeof *c) : NULL;
+    if (c)
+        memcpy(c, f, n * sizeof *c);
+    return c;
+}
+
+/* Sends (or records) a mesh with N and uv per point (NULL: none). */
+static RayesError send_mesh(Parser *P, size_t n_faces, const int *n_verts, const int *idx,
+                            size_t n_points, const float *pts, const float *N, const float *uv)
+{
+    RayesPrimvar pv[2];
+    float *st = uv ? malloc((2 * n_points + 1) * sizeof *st) : NULL;
+    if (uv && !st)
+        return RAYES_ERROR_OUT_OF_MEMORY;
+    size_t n_pv = mesh_primvars(n_points, N, uv, st, pv);
+    RayesError e = P->sink->polygon_mesh(P->sink->target, n_faces, n_verts, idx, n_points, pts,
+                                         pv, n_pv);
+    free(st);
+    return e;
+}
+
+int pbrt_emit_mesh(Parser *P, const Token *t, size_t n_faces, const int *n_verts,
+                   const int *idx, size_t n_points, const float *pts, const float *N,
+                   const float *uv)
+{
+    if (n_faces == 0)
+        return 0;
+    if (P->recording) {
+        Op *op = new_op(P, t, OP_MESH);
+        if (!op)
+            return -1;
+        size_t n_idx = 0;
+        for (size_t f = 0; f < n_faces; f++)
+            n_idx += (size_t)n_verts[f];
+        op->n_faces = n_faces;
+        op->n_points = n_points;
+        op->n_verts = malloc(n_faces * sizeof(int));
+        op->idx = malloc(n_idx * sizeof(int));
+        op->pts = malloc(n_points * 3 * sizeof(float));
+        op->N = copy_floats(N, 3 * n_points);
+        op->uv = copy_floats(uv, 2 * n_points);
+        if (!op->n_verts || !op->idx || !op->pts || (N && !op->N) || (uv && !op->uv))
+            return FAIL_TOK(P, t, "out of memory");
+        memcpy(op->n_verts, n_verts, n_faces * sizeof(int));
+        memcpy(op->idx, idx, n_idx * sizeof(int));
+        memcpy(op->pts, pts, n_points * 3 * sizeof(float));
+        return 0;
+    }
+    if (send_state(P, t, P->gs.ctm, &P->gs.material) != 0)
+        return -1;
+    RayesError e = send_mesh(P, n_faces, n_verts, idx, n_points, pts, N, uv);
+    return e != RAYES_OK ? pbrt_sink_failed(P, t, e) : 0;
+}
+
+int pbrt_emit_quadric(Parser *P, const Token *t, RayesQuadric q, const float *qp, size_t n,
+                      unsigned flags)
+{
+    if (P->recording) {
+        Op *op = new_op(P, t, OP_QUADRIC);
+        if (!op)
+            return -1;
+        op->q = q;
+        memcpy(op->qp, qp, n * sizeof *qp);
+        op->n_qp = n;
+        op->flags = flags;
+        return 0;
+    }
+    if (send_state(P, t, P->gs.ctm, &P->gs.material) != 0)
+        return -1;
+    RayesError e = P->sink->quadric(P->sink->target, q, qp, n, flags);
+    return e != RAYES_OK ? pbrt_sink_failed(P, t, e) : 0;
+}
+
+/* Sends a bilinear patch with N and uv at its corners (by op's patch_pv). */
+static RayesError send_patch(Parser *P, const Op *op)
+{
+    RayesPrimvar pv[2];
+    float st[4][2];
+    size_t n_pv = mesh_primvars(4, (op->patch_pv & 1) ? &op->patch_N[0][0] : NULL,
+                                (op->patch_pv & 2) ? &op->patch_uv[0][0] : NULL, &st[0][0], pv);
+    return P->sink->bilinear_patch(P->sink->target, op->patch, pv, n_pv);
+}
+
+int pbrt_emit_patch(Parser *P, const Token *t, const Op *patch)
+{
+    if (P->recording) {
+        Op *op = new_op(P, t, OP_PATCH);
+        if (!op)
+            return -1;
+        memcpy(op->patch, patch->patch, sizeof op->patch);
+        op->patch_pv = patch->patch_pv;
+        memcpy(op->patch_N, patch->patch_N, sizeof op->patch_N);
+        memcpy(op->patch_uv, patch->patch_uv, sizeof op->patch_uv);
+        return 0;
+    }
+    if (send_state(P, t, P->gs.ctm, &P->gs.material) != 0)
+        return -1;
+    RayesError e = send_patch(P, patch);
+    return e != RAYES_OK ? pbrt_sink_failed(P, t, e) : 0;
+}
+
+int pbrt_emit_light(Parser *P, const Token *t, const double m[16], const char *type,
+                    const RayesParam *params, size_t n)
+{
+    float f[16];
+    if (!pbrt_mat_finite(m))
+        return FAIL_TOK(P, t, "the current transform is not finite");
+    pbrt_mat_to_float(m, f);
+    RayesError e = P->sink->set_transform(P->sink->target, f);
+    if (e == RAYES_OK)
+        e = P->sink->light(P->sink->target, type, params, n);
+    return e != RAYES_OK ? pbrt_sink_failed(P, t, e) : 0;
+}
+
+int pbrt_replay(Parser *P, const Token *t, const Object *o)
+{
+    for (size_t i = 0; i < o->n_ops; i++) {
+        const Op *op = &o->ops[i];
+        if (++P->replayed > PBRT_MAX_REPLAYED)
+            return FAIL_TOK(P, t, "more than %ld instanced primitives", PBRT_MAX_REPLAYED);
+        double m[16];
+        pbrt_mat_mul(P->gs.ctm, op->m, m);
+        if (send_state(P, t, m, op->mat) != 0)
+            return -1;
+        RayesError e = RAYES_OK;
+        if (op->kind == OP_MESH)
+            e = send_mesh(P, op->n_faces, op->n_verts, op->idx, op->n_points, op->pts, op->N,
+                          op->uv);
+        else if (op->kind == OP_QUADRIC)
+            e = P->sink->quadric(P->sink->target, op->q, op->qp, op->n_qp, op->flags);
+        else
+            e = send_patch(P, op);
+        if (e != RAYES_OK)
+            return pbrt_sink_failed(P, t, e);
+    }
+    return 0;
+}

@@ -1,0 +1,320 @@
+/*
+ * io/pbrt_internal.h — pieces of the pbrt-v4 reader shared by its files
+ * (the opening comment of pbrt.c describes the reader as a whole): the
+ * reader's state and types, and what one file gives the others.
+ *
+ *   pbrt.c           the graphics-state directives (transforms,
+ *                    Attribute/Transform/Object blocks, Include), the
+ *                    directive table, entry points;
+ *   pbrt_lex.c       messages, tokens, matrices, paths, named coordinate
+ *                    systems: what every file uses;
+ *   pbrt_params.c    parameter lists, colours and spectra;
+ *   pbrt_emit.c      geometry and lights to the sink, or recorded for
+ *                    ObjectInstance;
+ *   pbrt_options.c   Camera, Film, Sampler, Integrator, PixelFilter,
+ *                    ColorSpace, WorldBegin/End;
+ *   pbrt_material.c  Material, MakeNamedMaterial, NamedMaterial, Texture;
+ *   pbrt_shape.c     Shape;
+ *   pbrt_light.c     LightSource, AreaLightSource.
+ *
+ * A new directive's handler goes in the file of its concern and gets a
+ * line in pbrt.c's table. The files call one way (tools/check_deps):
+ * pbrt.c calls the others, pbrt_lex.c none, and no file calls pbrt.c. Functions taking the Parser return 0, or -1 with
+ * the message written into P->err (pbrt_fail_at). Matrices are row-major
+ * 4 x 4 doubles mapping column vectors (world_from_object), as in rayes.h.
+ * One Parser per read; nothing here is shared between threads.
+ */
+#ifndef RAYES_IO_PBRT_INTERNAL_H
+#define RAYES_IO_PBRT_INTERNAL_H
+
+#include <stddef.h>
+
+#include "io/sink.h"
+
+#define PBRT_PATH 1024
+#define PBRT_MAX_WARNED 512 /* kinds of warning said per read */
+#define MAT_MAX_PARAMS 8
+
+static const double PI = 3.14159265358979323846;
+
+/* ---------------------------------------------------------------- types */
+
+/* Tokens and the parameter list of the directive being read; the graphics
+ * state, with its material and area light; what the file defined by name
+ * (coordinate systems, materials, textures, objects); the Parser holding
+ * them all for one read. */
+
+typedef enum TokKind { TOK_END, TOK_WORD, TOK_STRING, TOK_LBRACKET, TOK_RBRACKET } TokKind;
+
+typedef struct Token {
+    TokKind kind;
+    const char *s; /* the word, or the inside of the quotes (escapes not yet resolved) */
+    size_t n;
+    long line, col;
+} Token;
+
+typedef struct Lexer {
+    const char *name; /* for messages */
+    const char *p, *end;
+    long line;
+    const char *line_start;
+    char dir[PBRT_PATH]; /* relative paths resolve here ("" = the working directory) */
+} Lexer;
+
+typedef enum ParamType {
+    PT_INTEGER, PT_FLOAT, PT_POINT2, PT_VECTOR2, PT_POINT3, PT_VECTOR3, PT_NORMAL, PT_RGB,
+    PT_SPECTRUM, PT_BLACKBODY, PT_BOOL, PT_STRING, PT_TEXTURE
+} ParamType;
+
+typedef struct Param {
+    ParamType type;
+    char type_name[32];
+    char name[96];
+    double *num;  /* numeric values (bools as 0/1) */
+    size_t n_num;
+    char **str;   /* string values */
+    size_t n_str;
+    long line, col;
+    int used;
+} Param;
+
+typedef struct ParamList {
+    Param *p;
+    size_t n, cap;
+} ParamList;
+
+/* A shader call: the built-in class and its parameters. Zeroed before it
+ * is filled, so two materials compare with memcmp. */
+typedef struct Material {
+    char shader[24];
+    int n;
+    struct {
+        char name[16];
+        RayesParamType type;
+        float v[3];
+    } p[MAT_MAX_PARAMS];
+    char texture[PBRT_PATH]; /* the value of a STRING parameter "texturename" */
+} Material;
+
+typedef struct AreaLight {
+    int on;
+    float L[3]; /* radiance, scale included */
+    int twosided;
+} AreaLight;
+
+typedef struct GState {
+    double ctm[16]; /* world_from_object, row-major */
+    int reverse;    /* ReverseOrientation */
+    int active;     /* ActiveTransform: 1 All/StartTime, 0 EndTime (transforms dropped) */
+    Material material;
+    AreaLight area;
+    int kind; /* on the stack: 'A' AttributeBegin, 'T' TransformBegin, 'O' ObjectBegin */
+} GState;
+
+typedef struct Named {
+    char name[128];
+    double m[16];
+} Named;
+
+typedef struct NamedMaterial {
+    char name[128];
+    Material m;
+} NamedMaterial;
+
+typedef struct Texture {
+    char name[128];
+    int image;               /* 1: an image file (path), 0: a constant colour */
+    float rgb[3];            /* the constant, or the image's scale */
+    char path[PBRT_PATH];
+} Texture;
+
+typedef enum OpKind { OP_MESH, OP_QUADRIC, OP_PATCH } OpKind;
+
+typedef struct Op {
+    OpKind kind;
+    double m[16];
+    Material *mat;        /* owned */
+    size_t n_faces, n_points;
+    int *n_verts, *idx;   /* owned */
+    float *pts;           /* owned */
+    float *N, *uv;        /* per point, owned; NULL when not given */
+    RayesQuadric q;
+    float qp[8];
+    size_t n_qp;
+    unsigned flags;
+    float patch[4][3];
+    int patch_pv;         /* GEOM-like bits: 1 patch_N, 2 patch_uv given */
+    float patch_N[4][3], patch_uv[4][2];
+} Op;
+
+typedef struct Object {
+    char name[128];
+    Op *ops;
+    size_t n_ops, cap_ops;
+} Object;
+
+typedef struct Parser {
+    const IoSink *sink;
+    const IoReadOptions *options;
+    IoSettings *settings;
+    char *err;
+    size_t err_size;
+    Lexer *lx;
+    Token peeked;
+    int has_peek;
+    int depth, n_files;
+    GState gs;
+    GState *stack;
+    size_t n_stack, cap_stack;
+    Named *coordsys;
+    size_t n_coordsys;
+    NamedMaterial *materials;
+    size_t n_materials;
+    Texture *textures;
+    size_t n_textures;
+    Object *objects;
+    size_t n_objects;
+    Object *recording; /* between ObjectBegin and ObjectEnd */
+    long replayed;
+    /* camera and options */
+    int world; /* after WorldBegin */
+    double camera_from_world[16];
+    RayesProjection projection;
+    float fov;
+    float screen[4];
+    int have_screen;
+    /* what the sink was last told */
+    Material sent;
+    int have_sent;
+    char (*warned)[96];
+    size_t n_warned;
+} Parser;
+
+/* ------------------------------------------------ messages (pbrt_lex.c) */
+
+/* Writes "file:line:col: message" into P->err; returns -1. */
+int pbrt_fail_at(Parser *P, long line, long col, const char *fmt, ...)
+    __attribute__((format(printf, 4, 5)));
+
+#define FAIL_TOK(P, t, ...) pbrt_fail_at((P), (t)->line, (t)->col, __VA_ARGS__)
+
+/* One warning per key and read. */
+void pbrt_warn_at(Parser *P, long line, long col, const char *key, const char *fmt, ...)
+    __attribute__((format(printf, 5, 6)));
+
+/* A printable copy of a token for messages (at most 40 characters). */
+const char *pbrt_shown(const Token *t, char buf[48]);
+
+/* --------------------------------------------------- lexer (pbrt_lex.c) */
+
+/* The next token: consumed (pbrt_next) or kept for the next read (pbrt_peek). */
+int pbrt_next(Parser *P, Token *t);
+int pbrt_peek(Parser *P, Token *t);
+/* Nonzero if t is the bare word w. */
+int pbrt_word_is(const Token *t, const char *w);
+/* The string's contents with escapes resolved, into buf (error if long). */
+int pbrt_string_value(Parser *P, const Token *t, char *buf, size_t size);
+/* A finite number of at most 1e30 in magnitude; -1 (no message) if not. */
+int pbrt_parse_number(const Token *t, double *out);
+/* A quoted string (what names it in the message), its token in *where
+ * when where is not NULL. */
+int pbrt_expect_string(Parser *P, char *buf, size_t size, const char *what, Token *where);
+/* A number, or n numbers (bare or in one bracket); what names them in the
+ * message. */
+int pbrt_expect_number(Parser *P, double *out, const char *what);
+int pbrt_expect_numbers(Parser *P, double *out, int n, const char *what);
+
+/* ------------------------------------------------ matrices (pbrt_lex.c) */
+
+void pbrt_mat_identity(double m[16]);
+void pbrt_mat_mul(const double a[16], const double b[16], double out[16]); /* out = a b */
+/* The determinant of the upper-left 3 x 3 (negative: a mirror). */
+double pbrt_mat_det3(const double m[16]);
+/* Gauss-Jordan with partial pivoting; -1 if singular. */
+int pbrt_mat_inverse(const double m[16], double out[16]);
+/* Nonzero when every element is finite and at most 1e30 in magnitude. */
+int pbrt_mat_finite(const double m[16]);
+void pbrt_mat_to_float(const double m[16], float out[16]);
+void pbrt_cross3d(const double a[3], const double b[3], double o[3]);
+double pbrt_dot3d(const double a[3], const double b[3]);
+
+/* ------------------------------------------- paths, state (pbrt_lex.c) */
+
+/* Fails unless the world has begun (inside 1) or not yet (inside 0). */
+int pbrt_need_world(Parser *P, const Token *t, int inside);
+/* file relative to the directory of the file being read (error if long). */
+int pbrt_resolve(Parser *P, const Token *t, const char *file, char *out, size_t size);
+/* Defines or redefines the named coordinate system as m. */
+int pbrt_set_coordsys(Parser *P, const Token *t, const char *name, const double m[16]);
+
+/* ------------------------------------------- parameters (pbrt_params.c) */
+
+void pbrt_params_free(ParamList *pl);
+/* Reads the "name" argument and the parameter list of a directive. */
+int pbrt_name_and_params(Parser *P, char *name, size_t size, const char *what, ParamList *pl,
+                         Token *where);
+/* Reads `"type name" value|[values]` pairs up to the first token that is
+ * not a quoted string. */
+int pbrt_parse_params(Parser *P, ParamList *pl);
+/* The last parameter of that name, marked used, or NULL. */
+Param *pbrt_find(ParamList *pl, const char *name);
+double pbrt_get_float(ParamList *pl, const char *name, double def);
+const char *pbrt_get_string(ParamList *pl, const char *name, const char *def);
+/* The first three numbers of a point parameter, or NULL (borrowed). */
+const double *pbrt_get_point(ParamList *pl, const char *name);
+/* One warning per parameter nobody asked for. */
+void pbrt_warn_unused(Parser *P, ParamList *pl, const char *directive, const char *kind);
+/* A colour parameter: rgb, spectrum (named, sampled or constant), blackbody,
+ * float (grey) or texture. Returns 0 (not given: out = def), 1 (a colour
+ * in out), 2 (an image texture in *tex, out = its scale) or -1 (error). */
+int pbrt_get_color(Parser *P, ParamList *pl, const char *name, const float def[3], float out[3],
+                   const Texture **tex);
+/* A float parameter that may be a texture (the texture's grey value then). */
+int pbrt_get_float_tex(Parser *P, ParamList *pl, const char *name, double def, double *out);
+
+/* ----------------------------------------------- emitting (pbrt_emit.c) */
+
+/* Reports the sink's error e at t; returns -1. */
+int pbrt_sink_failed(Parser *P, const Token *t, RayesError e);
+/* Geometry under the current transform and material, sent or recorded;
+ * arrays are borrowed (copied when recorded). N and uv per point or NULL. */
+int pbrt_emit_mesh(Parser *P, const Token *t, size_t n_faces, const int *n_verts,
+                   const int *idx, size_t n_points, const float *pts, const float *N,
+                   const float *uv);
+int pbrt_emit_quadric(Parser *P, const Token *t, RayesQuadric q, const float *qp, size_t n,
+                      unsigned flags);
+/* The bilinear patch of patch (its patch, patch_pv, patch_N, patch_uv). */
+int pbrt_emit_patch(Parser *P, const Token *t, const Op *patch);
+/* A light under m, sent at once (never recorded). */
+int pbrt_emit_light(Parser *P, const Token *t, const double m[16], const char *type,
+                    const RayesParam *params, size_t n);
+/* Sends the recorded object o under the current transform. */
+int pbrt_replay(Parser *P, const Token *t, const Object *o);
+
+/* ------------------------------------------ materials (pbrt_material.c) */
+
+/* A zeroed material of that shader, and a colour parameter added to it. */
+void pbrt_mat_init(Material *m, const char *shader);
+void pbrt_mat_color(Material *m, const char *name, const float c[3]);
+
+/* ----------------------------------------------------------- directives */
+
+/* The handlers of pbrt.c's table that live in the other files: each reads
+ * its directive's arguments after the directive's token t. */
+int pbrt_d_colorspace(Parser *P, const Token *t); /* pbrt_options.c */
+int pbrt_d_camera(Parser *P, const Token *t);
+int pbrt_d_film(Parser *P, const Token *t);
+int pbrt_d_sampler(Parser *P, const Token *t);
+int pbrt_d_integrator(Parser *P, const Token *t);
+int pbrt_d_filter(Parser *P, const Token *t);
+int pbrt_d_worldbegin(Parser *P, const Token *t);
+int pbrt_d_worldend(Parser *P, const Token *t);
+int pbrt_d_material(Parser *P, const Token *t); /* pbrt_material.c */
+int pbrt_d_makenamedmaterial(Parser *P, const Token *t);
+int pbrt_d_namedmaterial(Parser *P, const Token *t);
+int pbrt_d_texture(Parser *P, const Token *t);
+int pbrt_d_shape(Parser *P, const Token *t); /* pbrt_shape.c */
+int pbrt_d_arealight(Parser *P, const Token *t); /* pbrt_light.c */
+int pbrt_d_light(Parser *P, const Token *t);
+
+#endif /* RAYES_IO_PBRT_INTERNAL_H */

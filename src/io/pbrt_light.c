@@ -1,0 +1,162 @@
+/*
+ * io/pbrt_light.c — LightSource and AreaLightSource (pbrt_internal.h).
+ * LightSource maps point, spot, distant and infinite lights onto rayes'
+ * pointlight, spotlight, distantlight and environmentlight (pbrt's power
+ * and illuminance become an intensity) and sends them at once, also
+ * inside ObjectBegin. AreaLightSource only sets the graphics state's area
+ * light; the shapes that follow emit (pbrt_shape.c). Media
+ * (MakeNamedMedium, MediumInterface) are read and ignored by d_ignored
+ * (pbrt.c).
+ */
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "io/pbrt_internal.h"
+
+/* ------------------------------------------------------------ colours */
+
+static float luminance(const float c[3])
+{
+    return 0.2126f * c[0] + 0.7152f * c[1] + 0.0722f * c[2];
+}
+
+/* ------------------------------------------------------------ directives */
+
+int pbrt_d_arealight(Parser *P, const Token *t)
+{
+    char type[64];
+    ParamList pl = {0};
+    int r = pbrt_need_world(P, t, 1);
+    if (!r)
+        r = pbrt_name_and_params(P, type, sizeof type, "an area light type", &pl, NULL);
+    if (r) {
+        pbrt_params_free(&pl);
+        return -1;
+    }
+    static const float one[3] = {1, 1, 1};
+    memset(&P->gs.area, 0, sizeof P->gs.area);
+    if (strcmp(type, "diffuse") != 0) {
+        pbrt_warn_at(P, t->line, t->col, "area light type", "AreaLightSource \"%.40s\" is not "
+                     "supported; the shapes that follow do not emit", type);
+        pbrt_params_free(&pl);
+        return 0;
+    }
+    float L[3];
+    if (pbrt_get_color(P, &pl, "L", one, L, NULL) < 0) {
+        pbrt_params_free(&pl);
+        return -1;
+    }
+    double scale = pbrt_get_float(&pl, "scale", 1.0);
+    Param *tw = pbrt_find(&pl, "twosided");
+    P->gs.area.twosided = tw && tw->n_num > 0 && tw->num[0] != 0;
+    if (pbrt_find(&pl, "filename"))
+        pbrt_warn_at(P, t->line, t->col, "area filename", "AreaLightSource: image emission "
+                     "(\"filename\") is not supported; using L");
+    if (pbrt_find(&pl, "power"))
+        pbrt_warn_at(P, t->line, t->col, "area power",
+                     "AreaLightSource: \"power\" is not supported (it needs the shape's area); "
+                     "using L and scale");
+    for (int c = 0; c < 3; c++)
+        P->gs.area.L[c] = (float)(L[c] * scale);
+    P->gs.area.on = 1;
+    pbrt_warn_unused(P, &pl, "AreaLightSource", type);
+    pbrt_params_free(&pl);
+    return 0;
+}
+
+int pbrt_d_light(Parser *P, const Token *t)
+{
+    char type[64];
+    ParamList pl = {0};
+    int r = pbrt_need_world(P, t, 1);
+    if (!r)
+        r = pbrt_name_and_params(P, type, sizeof type, "a light type", &pl, NULL);
+    if (r) {
+        pbrt_params_free(&pl);
+        return -1;
+    }
+    static const float one[3] = {1, 1, 1};
+    double scale = pbrt_get_float(&pl, "scale", 1.0), power = pbrt_get_float(&pl, "power", 0.0);
+    float col[3];
+    RayesParam lp[8];
+    size_t n = 0;
+    const char *rtype = NULL;
+    double zero3[3] = {0, 0, 0}, z1[3] = {0, 0, 1};
+    if (P->recording)
+        pbrt_warn_at(P, t->line, t->col, "instanced light", "LightSource inside ObjectBegin: the "
+                     "light is added once, not per instance");
+    if (strcmp(type, "point") == 0 || strcmp(type, "spot") == 0) {
+        if (pbrt_get_color(P, &pl, "I", one, col, NULL) < 0)
+            r = -1;
+        const double *from = pbrt_get_point(&pl, "from");
+        from = from ? from : zero3;
+        lp[n++] = (RayesParam){.name = "from", .type = RAYES_PARAM_COLOR,
+                               .value = {(float)from[0], (float)from[1], (float)from[2]}};
+        double k_e = 4 * PI;
+        if (type[0] == 's') {
+            const double *to = pbrt_get_point(&pl, "to");
+            to = to ? to : z1;
+            double cone = pbrt_get_float(&pl, "coneangle", 30),
+                   delta = pbrt_get_float(&pl, "conedeltaangle", 5);
+            lp[n++] = (RayesParam){.name = "to", .type = RAYES_PARAM_COLOR,
+                                   .value = {(float)to[0], (float)to[1], (float)to[2]}};
+            lp[n++] = (RayesParam){
+                .name = "coneangle", .type = RAYES_PARAM_FLOAT, .value = {(float)cone}};
+            lp[n++] = (RayesParam){.name = "conedeltaangle", .type = RAYES_PARAM_FLOAT,
+                                   .value = {(float)delta}};
+            lp[n++] = (RayesParam){.name = "beamdistribution", .type = RAYES_PARAM_FLOAT};
+            double c0 = cos(cone * PI / 180), c1 = cos((cone - delta) * PI / 180);
+            k_e = 2 * PI * ((1 - c1) + (c1 - c0) / 2);
+        }
+        if (power > 0 && luminance(col) > 0)
+            scale *= power / (k_e * luminance(col));
+        rtype = type[0] == 's' ? "spotlight" : "pointlight";
+    } else if (strcmp(type, "distant") == 0) {
+        if (pbrt_get_color(P, &pl, "L", one, col, NULL) < 0)
+            r = -1;
+        const double *from = pbrt_get_point(&pl, "from"), *to = pbrt_get_point(&pl, "to");
+        from = from ? from : zero3;
+        to = to ? to : z1;
+        lp[n++] = (RayesParam){.name = "from", .type = RAYES_PARAM_COLOR,
+                               .value = {(float)from[0], (float)from[1], (float)from[2]}};
+        lp[n++] = (RayesParam){.name = "to", .type = RAYES_PARAM_COLOR,
+                               .value = {(float)to[0], (float)to[1], (float)to[2]}};
+        double E = pbrt_get_float(&pl, "illuminance", 0.0);
+        if (E > 0 && luminance(col) > 0)
+            scale *= E / luminance(col);
+        rtype = "distantlight";
+    } else if (strcmp(type, "infinite") == 0) {
+        if (pbrt_get_color(P, &pl, "L", one, col, NULL) < 0)
+            r = -1;
+        const char *file = pbrt_get_string(&pl, "filename", NULL);
+        if (file)
+            pbrt_warn_at(P, t->line, t->col, "infinite map",
+                         "LightSource \"infinite\": \"%.60s\" is an equal-area octahedral map, "
+                         "which rayes cannot read (it takes latitude-longitude maps); using a "
+                         "constant environment of radiance scale",
+                         file);
+        if (pbrt_get_float(&pl, "illuminance", 0.0) > 0)
+            pbrt_warn_at(P, t->line, t->col, "infinite illuminance", "LightSource \"infinite\": "
+                         "\"illuminance\" is not supported; using scale");
+        pbrt_find(&pl, "portal");
+        rtype = "environmentlight";
+    } else {
+        char key[96];
+        snprintf(key, sizeof key, "light %.60s", type);
+        pbrt_warn_at(P, t->line, t->col, key, "LightSource \"%.40s\" is not supported; skipped",
+                     type);
+        pbrt_params_free(&pl);
+        return 0;
+    }
+    if (!r) {
+        lp[n++] =
+            (RayesParam){.name = "intensity", .type = RAYES_PARAM_FLOAT, .value = {(float)scale}};
+        lp[n++] = (RayesParam){.name = "lightcolor", .type = RAYES_PARAM_COLOR,
+                               .value = {col[0], col[1], col[2]}};
+        pbrt_warn_unused(P, &pl, "LightSource", type);
+        r = pbrt_emit_light(P, t, P->gs.ctm, rtype, lp, n);
+    }
+    pbrt_params_free(&pl);
+    return r;
+}

@@ -1,0 +1,220 @@
+/*
+ * io/pbrt_options.c — the scene-wide options before WorldBegin
+ * (pbrt_internal.h): Camera, Film, Sampler, Integrator and PixelFilter
+ * fill the IoSettings and the camera (each fails after WorldBegin; values
+ * out of range are errors, unsupported types warnings), ColorSpace warns
+ * unless it is srgb, and WorldBegin sends the camera to the sink and
+ * starts the world. WorldEnd (pbrt-v3's) does nothing.
+ */
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "io/pbrt_internal.h"
+
+/* ------------------------------------------------------------ directives */
+
+int pbrt_d_colorspace(Parser *P, const Token *t)
+{
+    char name[64];
+    Token w;
+    if (pbrt_expect_string(P, name, sizeof name, "a colour space name", &w) != 0)
+        return -1;
+    if (strcmp(name, "srgb") != 0)
+        pbrt_warn_at(P, w.line, w.col, "colorspace",
+                     "ColorSpace \"%.40s\": rayes works in linear sRGB; colours are taken as "
+                     "they are", name);
+    (void)t;
+    return 0;
+}
+
+int pbrt_d_camera(Parser *P, const Token *t)
+{
+    char type[64];
+    ParamList pl = {0};
+    int r = pbrt_need_world(P, t, 0);
+    if (!r)
+        r = pbrt_name_and_params(P, type, sizeof type, "a camera type", &pl, NULL);
+    if (r) {
+        pbrt_params_free(&pl);
+        return -1;
+    }
+    memcpy(P->camera_from_world, P->gs.ctm, sizeof P->camera_from_world);
+    double inv[16];
+    if (pbrt_mat_inverse(P->gs.ctm, inv) != 0) {
+        pbrt_params_free(&pl);
+        return FAIL_TOK(P, t, "Camera: the camera transform is singular");
+    }
+    r = pbrt_set_coordsys(P, t, "camera", inv);
+    P->projection = strcmp(type, "orthographic") == 0 ? RAYES_PROJECTION_ORTHOGRAPHIC
+                                                      : RAYES_PROJECTION_PERSPECTIVE;
+    if (strcmp(type, "perspective") != 0 && strcmp(type, "orthographic") != 0)
+        pbrt_warn_at(P, t->line, t->col, "camera type",
+                     "Camera \"%.40s\" is not supported; using a perspective camera", type);
+    P->fov = (float)pbrt_get_float(&pl, "fov", 90.0);
+    if (!(P->fov > 0 && P->fov < 180)) {
+        pbrt_params_free(&pl);
+        return FAIL_TOK(P, t, "Camera: expected fov between 0 and 180 degrees");
+    }
+    Param *sw = pbrt_find(&pl, "screenwindow");
+    P->have_screen = sw && sw->n_num == 4;
+    for (int i = 0; P->have_screen && i < 4; i++)
+        P->screen[i] = (float)sw->num[i];
+    if (pbrt_get_float(&pl, "lensradius", 0.0) > 0)
+        pbrt_warn_at(P, t->line, t->col, "lensradius", "Camera: depth of field (lensradius) is not "
+                     "supported; the camera is a pinhole");
+    pbrt_find(&pl, "focaldistance");
+    pbrt_warn_unused(P, &pl, "Camera", type);
+    pbrt_params_free(&pl);
+    return r;
+}
+
+int pbrt_d_film(Parser *P, const Token *t)
+{
+    char type[64];
+    ParamList pl = {0};
+    if (pbrt_need_world(P, t, 0) ||
+        pbrt_name_and_params(P, type, sizeof type, "a film type", &pl, NULL)) {
+        pbrt_params_free(&pl);
+        return -1;
+    }
+    IoSettings *s = P->settings;
+    double w = pbrt_get_float(&pl, "xresolution", 1280),
+           h = pbrt_get_float(&pl, "yresolution", 720);
+    if (!(w >= 1 && w <= 65536 && h >= 1 && h <= 65536)) {
+        pbrt_params_free(&pl);
+        return FAIL_TOK(P, t, "Film: expected resolutions from 1 to 65536");
+    }
+    s->width = (int)w, s->height = (int)h;
+    const char *file = pbrt_get_string(&pl, "filename", NULL);
+    if (file) {
+        IoDisplay *d = &s->displays[0];
+        memset(d, 0, sizeof *d);
+        snprintf(d->name, sizeof d->name, "%s", file);
+        const char *dot = strrchr(file, '.');
+        snprintf(d->type, sizeof d->type, "%s", dot && strcmp(dot, ".exr") == 0   ? "openexr"
+                                                : dot && strcmp(dot, ".png") == 0 ? "png"
+                                                                                  : "file");
+        snprintf(d->mode, sizeof d->mode, "rgba");
+        s->n_displays = 1;
+    }
+    Param *crop = pbrt_find(&pl, "cropwindow");
+    if (crop && crop->n_num == 4)
+        for (int i = 0; i < 4; i++)
+            s->crop[i] = (float)fmin(1.0, fmax(0.0, crop->num[i]));
+    if (strcmp(type, "rgb") != 0)
+        pbrt_warn_at(P, t->line, t->col, "film type", "Film \"%.40s\": written as an rgb film",
+                     type);
+    pbrt_warn_unused(P, &pl, "Film", type);
+    pbrt_params_free(&pl);
+    return 0;
+}
+
+int pbrt_d_sampler(Parser *P, const Token *t)
+{
+    char type[64];
+    ParamList pl = {0};
+    if (pbrt_need_world(P, t, 0) ||
+        pbrt_name_and_params(P, type, sizeof type, "a sampler type", &pl, NULL)) {
+        pbrt_params_free(&pl);
+        return -1;
+    }
+    double spp = pbrt_get_float(&pl, "pixelsamples", 16);
+    if (!(spp >= 1 && spp <= 1e6)) {
+        pbrt_params_free(&pl);
+        return FAIL_TOK(P, t, "Sampler: expected pixelsamples from 1 to 1000000");
+    }
+    P->settings->spp = (int)spp;
+    pbrt_find(&pl, "seed");
+    pbrt_find(&pl, "randomization");
+    pbrt_warn_unused(P, &pl, "Sampler", type);
+    pbrt_params_free(&pl);
+    return 0;
+}
+
+int pbrt_d_integrator(Parser *P, const Token *t)
+{
+    char type[64];
+    ParamList pl = {0};
+    if (pbrt_need_world(P, t, 0) ||
+        pbrt_name_and_params(P, type, sizeof type, "an integrator type", &pl, NULL)) {
+        pbrt_params_free(&pl);
+        return -1;
+    }
+    double depth = pbrt_get_float(&pl, "maxdepth", 5);
+    if (!(depth >= 0 && depth <= 1e6)) {
+        pbrt_params_free(&pl);
+        return FAIL_TOK(P, t, "Integrator: expected maxdepth >= 0");
+    }
+    /* pbrt's maxdepth 1 is direct light only: rayes' 0 diffuse bounces */
+    P->settings->bounces = depth >= 1 ? (int)depth - 1 : 0;
+    P->settings->specular_depth = (int)depth;
+    if (strcmp(type, "ambientocclusion") == 0 || strcmp(type, "sppm") == 0 ||
+        strcmp(type, "mlt") == 0)
+        pbrt_warn_at(P, t->line, t->col, "integrator",
+                     "Integrator \"%.40s\": rayes renders with its own integrator (radiosity "
+                     "cache)", type);
+    pbrt_find(&pl, "regularize");
+    pbrt_find(&pl, "lightsampler");
+    pbrt_warn_unused(P, &pl, "Integrator", type);
+    pbrt_params_free(&pl);
+    return 0;
+}
+
+int pbrt_d_filter(Parser *P, const Token *t)
+{
+    char type[64];
+    ParamList pl = {0};
+    if (pbrt_need_world(P, t, 0) ||
+        pbrt_name_and_params(P, type, sizeof type, "a filter type", &pl, NULL)) {
+        pbrt_params_free(&pl);
+        return -1;
+    }
+    if (strcmp(type, "box") == 0 || strcmp(type, "gaussian") == 0) {
+        int box = type[0] == 'b';
+        double rx = pbrt_get_float(&pl, "xradius", box ? 0.5 : 1.5);
+        double ry = pbrt_get_float(&pl, "yradius", rx);
+        pbrt_find(&pl, "sigma");
+        P->settings->filter = box ? RAYES_FILTER_BOX : RAYES_FILTER_GAUSSIAN;
+        P->settings->filter_width = (float)fmax(0.01, rx + ry);
+        pbrt_warn_unused(P, &pl, "PixelFilter", type);
+    } else {
+        pbrt_warn_at(P, t->line, t->col, "filter",
+                     "PixelFilter \"%.40s\" is not supported; using the renderer's default filter",
+                     type);
+    }
+    pbrt_params_free(&pl);
+    return 0;
+}
+
+static int emit_camera(Parser *P, const Token *t)
+{
+    float m[16];
+    if (!pbrt_mat_finite(P->camera_from_world))
+        return FAIL_TOK(P, t, "the camera transform is not finite");
+    pbrt_mat_to_float(P->camera_from_world, m);
+    RayesError e = P->sink->set_camera_matrix(P->sink->target, m, P->projection, P->fov,
+                                              P->have_screen ? P->screen : NULL);
+    return e != RAYES_OK ? pbrt_sink_failed(P, t, e) : 0;
+}
+
+int pbrt_d_worldbegin(Parser *P, const Token *t)
+{
+    if (pbrt_need_world(P, t, 0) != 0)
+        return -1;
+    P->world = 1;
+    pbrt_mat_identity(P->gs.ctm);
+    if (pbrt_set_coordsys(P, t, "world", P->gs.ctm) != 0)
+        return -1;
+    if (P->settings->width == 0) {
+        P->settings->width = 1280; /* pbrt's default film */
+        P->settings->height = 720;
+    }
+    return emit_camera(P, t);
+}
+
+int pbrt_d_worldend(Parser *P, const Token *t)
+{
+    (void)P, (void)t; /* pbrt-v3's; the file ends the world in v4 */
+    return 0;
+}

@@ -1,0 +1,449 @@
+/*
+ * io/pbrt_shape.c — the Shape directive (pbrt_internal.h): trianglemesh,
+ * bilinearmesh, plymesh (io/ply.h), sphere, cylinder and disk. Every index
+ * is checked against the point count before it is used. Winding follows
+ * pbrt: flipped by ReverseOrientation and by a transform that swaps
+ * handedness. Under an AreaLightSource, quads (and pairs of triangles that
+ * make a planar convex quad), spheres and disks become rayes area lights;
+ * other emitters are warned about and do not emit.
+ */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "io/pbrt_internal.h"
+#include "io/ply.h"
+
+/* ------------------------------------------------------------ shapes */
+
+static int swaps_handedness(const double m[16])
+{
+    return pbrt_mat_det3(m) < 0;
+}
+
+static void sub3d(const float *a, const float *b, double o[3])
+{
+    for (int c = 0; c < 3; c++)
+        o[c] = (double)a[c] - b[c];
+}
+
+/* A quad's normal (unnormalised): the cross product of its diagonals. */
+static void quad_normal(const float *pts, const int *f, double out[3])
+{
+    double c[3], d[3];
+    sub3d(&pts[3 * f[2]], &pts[3 * f[0]], c);
+    sub3d(&pts[3 * f[3]], &pts[3 * f[1]], d);
+    pbrt_cross3d(c, d, out);
+}
+
+/* Emits one emitting quad q (indices into pts; N per vertex or NULL). */
+static int emit_area_quad(Parser *P, const Token *t, const float *pts, const float *N,
+                          const int q[4])
+{
+    double g[3], d[3];
+    quad_normal(pts, q, g);
+    memcpy(d, g, sizeof d);
+    if (N) {
+        for (int c = 0; c < 3; c++)
+            d[c] = (double)N[3 * q[0] + c] + N[3 * q[1] + c] + N[3 * q[2] + c] + N[3 * q[3] + c];
+        if (pbrt_dot3d(d, d) == 0)
+            memcpy(d, g, sizeof d);
+    }
+    if (P->gs.reverse)
+        for (int c = 0; c < 3; c++)
+            d[c] = -d[c];
+    int flip = (pbrt_dot3d(g, d) < 0) != swaps_handedness(P->gs.ctm);
+    for (int side = 0; side < 1 + P->gs.area.twosided; side++) {
+        float Q[4][3];
+        int rev = flip ^ side;
+        for (int k = 0; k < 4; k++)
+            memcpy(Q[k], &pts[3 * q[rev ? (4 - k) % 4 : k]], sizeof Q[k]);
+        float f[16];
+        if (!pbrt_mat_finite(P->gs.ctm))
+            return FAIL_TOK(P, t, "the current transform is not finite");
+        pbrt_mat_to_float(P->gs.ctm, f);
+        RayesError e = P->sink->set_transform(P->sink->target, f);
+        if (e == RAYES_OK)
+            e = P->sink->area_light(P->sink->target, (const float(*)[3])Q, P->gs.area.L);
+        if (e != RAYES_OK)
+            return pbrt_sink_failed(P, t, e);
+    }
+    return 0;
+}
+
+/* Nonzero if the triangles a and b share an edge and make a planar convex
+ * quad; q gets it in order around. */
+static int pair_quad(const float *pts, const int *a, const int *b, int q[4])
+{
+    for (int i = 0; i < 3; i++) {
+        int x = a[i], s1 = a[(i + 1) % 3], s2 = a[(i + 2) % 3];
+        for (int j = 0; j < 3; j++)
+            if (b[j] == s2 && b[(j + 1) % 3] == s1) {
+                int y = b[(j + 2) % 3];
+                if (y == x || y == s1 || y == s2)
+                    return 0;
+                q[0] = x, q[1] = s1, q[2] = y, q[3] = s2;
+                double n[4][3], len[4];
+                for (int k = 0; k < 4; k++) {
+                    double u[3], v[3];
+                    sub3d(&pts[3 * q[(k + 1) % 4]], &pts[3 * q[k]], u);
+                    sub3d(&pts[3 * q[(k + 3) % 4]], &pts[3 * q[k]], v);
+                    pbrt_cross3d(u, v, n[k]);
+                    len[k] = sqrt(pbrt_dot3d(n[k], n[k]));
+                    if (!(len[k] > 0))
+                        return 0;
+                }
+                for (int k = 1; k < 4; k++)
+                    if (pbrt_dot3d(n[0], n[k]) < 0.999 * len[0] * len[k])
+                        return 0;
+                return 1;
+            }
+    }
+    return 0;
+}
+
+/* A mesh of triangles and quads (indices checked): an emitter's quads go to
+ * area_light, the rest to polygon_mesh with pbrt's orientation. */
+static int shape_mesh(Parser *P, const Token *t, const char *what, size_t n_faces, int *n_verts,
+                      int *idx, size_t n_points, const float *pts, const float *N,
+                      const float *uv)
+{
+    if (P->gs.area.on && P->recording) {
+        pbrt_warn_at(P, t->line, t->col, "instanced area light",
+                     "%s: area lights inside ObjectBegin are not supported (as in pbrt); the shape "
+                     "is not emitting",
+                     what);
+    } else if (P->gs.area.on) {
+        size_t lone = 0;
+        const int *f = idx;
+        for (size_t i = 0; i < n_faces; f += n_verts[i], i++) {
+            int q[4];
+            if (n_verts[i] == 4) {
+                memcpy(q, f, sizeof q);
+            } else if (i + 1 < n_faces && n_verts[i + 1] == 3 && pair_quad(pts, f, f + 3, q)) {
+                f += 3;
+                i++;
+            } else {
+                lone++;
+                continue;
+            }
+            if (emit_area_quad(P, t, pts, N, q) != 0)
+                return -1;
+        }
+        if (lone)
+            pbrt_warn_at(P, t->line, t->col, "lone emitting triangle",
+                         "%s: %zu emitting triangle(s) do not pair into quads; rayes' area lights "
+                         "are quads, so they do not emit",
+                         what, lone);
+        return 0;
+    }
+    if (P->gs.reverse != swaps_handedness(P->gs.ctm)) {
+        int *f = idx;
+        for (size_t i = 0; i < n_faces; f += n_verts[i], i++) {
+            int tmp = f[1];
+            f[1] = f[n_verts[i] - 1];
+            f[n_verts[i] - 1] = tmp;
+        }
+    }
+    return pbrt_emit_mesh(P, t, n_faces, n_verts, idx, n_points, pts, N, uv);
+}
+
+/* Points of a "point3 P" parameter as floats (new, free()). */
+static float *points_of(Parser *P, const Token *t, const Param *p)
+{
+    float *pts = malloc((p->n_num ? p->n_num : 1) * sizeof(float));
+    if (!pts) {
+        FAIL_TOK(P, t, "out of memory");
+        return NULL;
+    }
+    for (size_t i = 0; i < p->n_num; i++)
+        pts[i] = (float)p->num[i];
+    return pts;
+}
+
+static void warn_vertex_data(Parser *P, const Token *t, ParamList *pl, const char *what)
+{
+    static const char *names[] = {"S", "faceIndices", "alpha", "emissionfilename"};
+    for (size_t i = 0; i < sizeof names / sizeof names[0]; i++) {
+        Param *p = pbrt_find(pl, names[i]);
+        if (p) {
+            char key[96];
+            snprintf(key, sizeof key, "vertex data %.60s", names[i]);
+            pbrt_warn_at(P, p->line, p->col, key, "%s: \"%s\" is not passed on (rayes meshes carry "
+                         "positions, N and uv)", what, names[i]);
+        }
+    }
+    (void)t;
+}
+
+/* The "point2 uv" (or "st") of a mesh of n_points points, or NULL (with
+ * a warning when its count is wrong). */
+static Param *uv_param(Parser *P, ParamList *pl, const char *what, size_t n_points)
+{
+    Param *uv = pbrt_find(pl, "uv");
+    if (!uv)
+        uv = pbrt_find(pl, "st");
+    if (uv && uv->n_num != 2 * n_points) {
+        pbrt_warn_at(P, uv->line, uv->col, "uv count", "%s: \"uv\" has %zu values for %zu points; "
+                     "ignored", what, uv->n_num, n_points);
+        return NULL;
+    }
+    return uv;
+}
+
+static int shape_trianglemesh(Parser *P, const Token *t, ParamList *pl)
+{
+    Param *pp = pbrt_find(pl, "P"), *ip = pbrt_find(pl, "indices"), *np = pbrt_find(pl, "N");
+    warn_vertex_data(P, t, pl, "trianglemesh");
+    if (!pp || pp->n_num < 9)
+        return FAIL_TOK(P, t, "trianglemesh: expected \"point3 P\" with at least 3 points");
+    size_t n_points = pp->n_num / 3;
+    if (!ip && n_points != 3)
+        return FAIL_TOK(P, t, "trianglemesh: expected \"integer indices\" (P has %zu points)",
+                        n_points);
+    size_t n_idx = ip ? ip->n_num : 3;
+    if (n_idx % 3 != 0 || n_idx == 0)
+        return pbrt_fail_at(P, ip->line, ip->col, "trianglemesh: expected a multiple of 3 indices, "
+                            "found %zu", n_idx);
+    for (size_t i = 0; ip && i < n_idx; i++)
+        if (ip->num[i] < 0 || ip->num[i] >= (double)n_points)
+            return pbrt_fail_at(P, ip->line, ip->col,
+                                "trianglemesh: index %zu is %.0f but P has %zu points", i,
+                                ip->num[i], n_points);
+    if (np && np->n_num != pp->n_num) {
+        pbrt_warn_at(P, np->line, np->col, "N count",
+                     "trianglemesh: \"N\" has %zu values, P %zu; N ignored", np->n_num, pp->n_num);
+        np = NULL;
+    }
+    Param *uvp = uv_param(P, pl, "trianglemesh", n_points);
+    size_t n_faces = n_idx / 3;
+    float *pts = points_of(P, t, pp);
+    float *N = np ? points_of(P, t, np) : NULL;
+    float *uv = uvp ? points_of(P, t, uvp) : NULL;
+    int *nv = malloc(n_faces * sizeof(int)), *idx = malloc(n_idx * sizeof(int));
+    int r = -1;
+    if (!pts || (np && !N) || (uvp && !uv) || !nv || !idx) {
+        FAIL_TOK(P, t, "out of memory");
+    } else {
+        for (size_t f = 0; f < n_faces; f++)
+            nv[f] = 3;
+        for (size_t i = 0; i < n_idx; i++)
+            idx[i] = ip ? (int)ip->num[i] : (int)i;
+        r = shape_mesh(P, t, "trianglemesh", n_faces, nv, idx, n_points, pts, N, uv);
+    }
+    free(pts);
+    free(N);
+    free(uv);
+    free(nv);
+    free(idx);
+    return r;
+}
+
+static int shape_bilinearmesh(Parser *P, const Token *t, ParamList *pl)
+{
+    Param *pp = pbrt_find(pl, "P"), *ip = pbrt_find(pl, "indices"), *np = pbrt_find(pl, "N");
+    warn_vertex_data(P, t, pl, "bilinearmesh");
+    if (!pp || pp->n_num < 12)
+        return FAIL_TOK(P, t, "bilinearmesh: expected \"point3 P\" with at least 4 points");
+    size_t n_points = pp->n_num / 3;
+    if (!ip && n_points != 4)
+        return FAIL_TOK(P, t, "bilinearmesh: expected \"integer indices\" (P has %zu points)",
+                        n_points);
+    size_t n_idx = ip ? ip->n_num : 4;
+    if (n_idx % 4 != 0)
+        return pbrt_fail_at(P, ip->line, ip->col, "bilinearmesh: expected a multiple of 4 indices, "
+                            "found %zu", n_idx);
+    for (size_t i = 0; ip && i < n_idx; i++)
+        if (ip->num[i] < 0 || ip->num[i] >= (double)n_points)
+            return pbrt_fail_at(P, ip->line, ip->col,
+                                "bilinearmesh: index %zu is %.0f but P has %zu points", i,
+                                ip->num[i], n_points);
+    if (np && np->n_num != pp->n_num) {
+        pbrt_warn_at(P, np->line, np->col, "N count",
+                     "bilinearmesh: \"N\" has %zu values, P %zu; N ignored", np->n_num, pp->n_num);
+        np = NULL;
+    }
+    Param *uvp = uv_param(P, pl, "bilinearmesh", n_points);
+    float *pts = points_of(P, t, pp);
+    if (!pts)
+        return -1;
+    int flip = P->gs.reverse != swaps_handedness(P->gs.ctm);
+    for (size_t f = 0; f < n_idx / 4; f++) {
+        int v[4];
+        for (int k = 0; k < 4; k++)
+            v[k] = ip ? (int)ip->num[4 * f + k] : k;
+        int r;
+        if (P->gs.area.on && !P->recording) {
+            int q[4] = {v[0], v[1], v[3], v[2]}; /* around the patch */
+            r = emit_area_quad(P, t, pts, NULL, q);
+        } else {
+            Op patch = {.patch_pv = (np ? 1 : 0) | (uvp ? 2 : 0)};
+            static const int order[2][4] = {{0, 1, 2, 3}, {1, 0, 3, 2}};
+            for (int k = 0; k < 4; k++) {
+                size_t j = (size_t)v[order[flip][k]];
+                memcpy(patch.patch[k], &pts[3 * j], sizeof patch.patch[k]);
+                for (int c = 0; c < 3 && np; c++)
+                    patch.patch_N[k][c] = (float)np->num[3 * j + (size_t)c];
+                for (int c = 0; c < 2 && uvp; c++)
+                    patch.patch_uv[k][c] = (float)uvp->num[2 * j + (size_t)c];
+            }
+            r = pbrt_emit_patch(P, t, &patch);
+        }
+        if (r != 0) {
+            free(pts);
+            return -1;
+        }
+    }
+    free(pts);
+    return 0;
+}
+
+static int shape_plymesh(Parser *P, const Token *t, ParamList *pl)
+{
+    const char *file = pbrt_get_string(pl, "filename", NULL);
+    if (!file)
+        return FAIL_TOK(P, t, "plymesh: expected \"string filename\"");
+    Param *d = pbrt_find(pl, "displacement");
+    if (d)
+        pbrt_warn_at(P, d->line, d->col, "ply displacement", "plymesh: \"displacement\" is not "
+                     "supported (no displacement)");
+    pbrt_find(pl, "edgelength");
+    char path[PBRT_PATH], err[600];
+    if (pbrt_resolve(P, t, file, path, sizeof path) != 0)
+        return -1;
+    PlyMesh m;
+    if (io_ply_read(path, &m, err, sizeof err) != RAYES_OK)
+        return FAIL_TOK(P, t, "plymesh: %s", err);
+    int r = shape_mesh(P, t, "plymesh", m.n_faces, m.n_verts, m.indices, m.n_vertices, m.P, m.N,
+                       m.uv);
+    io_ply_mesh_fini(&m);
+    return r;
+}
+
+/* An emitting sphere or disk: rayes' "arealight" of that shape. */
+static int quadric_light(Parser *P, const Token *t, const char *shape, float radius,
+                         const double m[16])
+{
+    RayesParam lp[4] = {
+        {.name = "shape", .type = RAYES_PARAM_STRING, .string = shape},
+        {.name = "radius", .type = RAYES_PARAM_FLOAT, .value = {radius}},
+        {.name = "lightcolor", .type = RAYES_PARAM_COLOR},
+        {.name = "intensity", .type = RAYES_PARAM_FLOAT, .value = {1}},
+    };
+    memcpy(lp[2].value, P->gs.area.L, sizeof lp[2].value);
+    return pbrt_emit_light(P, t, m, "arealight", lp, 4);
+}
+
+static int shape_quadric(Parser *P, const Token *t, const char *type, ParamList *pl)
+{
+    double radius = pbrt_get_float(pl, "radius", 1.0);
+    double phimax = pbrt_get_float(pl, "phimax", 360.0);
+    if (!(radius > 0))
+        return FAIL_TOK(P, t, "%s: expected a positive radius, found %g", type, radius);
+    if (!(phimax > 0 && phimax <= 360))
+        return FAIL_TOK(P, t, "%s: expected phimax in (0, 360], found %g", type, phimax);
+    unsigned flags = P->gs.reverse ? RAYES_QUADRIC_REVERSE : 0;
+    float qp[4];
+    size_t n;
+    RayesQuadric q;
+    double height = 0;
+    if (strcmp(type, "sphere") == 0) {
+        double zmin = pbrt_get_float(pl, "zmin", -radius),
+               zmax = pbrt_get_float(pl, "zmax", radius);
+        zmin = zmin < -radius ? -radius : zmin > radius ? radius : zmin;
+        zmax = zmax < -radius ? -radius : zmax > radius ? radius : zmax;
+        if (!(zmin < zmax))
+            return FAIL_TOK(P, t, "sphere: expected zmin < zmax");
+        q = RAYES_QUADRIC_SPHERE;
+        qp[0] = (float)radius, qp[1] = (float)zmin, qp[2] = (float)zmax, qp[3] = (float)phimax;
+        n = 4;
+        if (P->gs.area.on && (zmin > -radius || zmax < radius || phimax < 360))
+            pbrt_warn_at(P, t->line, t->col, "partial sphere light", "sphere: a partial emitting "
+                         "sphere emits as a whole sphere");
+    } else if (strcmp(type, "cylinder") == 0) {
+        double zmin = pbrt_get_float(pl, "zmin", -1), zmax = pbrt_get_float(pl, "zmax", 1);
+        if (!(zmin != zmax))
+            return FAIL_TOK(P, t, "cylinder: expected zmin != zmax");
+        q = RAYES_QUADRIC_CYLINDER;
+        qp[0] = (float)radius, qp[1] = (float)zmin, qp[2] = (float)zmax, qp[3] = (float)phimax;
+        n = 4;
+    } else {
+        height = pbrt_get_float(pl, "height", 0.0);
+        double inner = pbrt_get_float(pl, "innerradius", 0.0);
+        if (inner > 0)
+            pbrt_warn_at(P, t->line, t->col, "disk innerradius", "disk: \"innerradius\" is not "
+                         "supported; the disk is whole");
+        q = RAYES_QUADRIC_DISK;
+        qp[0] = (float)height, qp[1] = (float)radius, qp[2] = (float)phimax;
+        n = 3;
+    }
+    if (!P->gs.area.on || P->recording || q == RAYES_QUADRIC_CYLINDER) {
+        if (P->gs.area.on)
+            pbrt_warn_at(P, t->line, t->col,
+                         P->recording ? "instanced area light" : "cylinder light",
+                         "%s: this emitter is not supported (%s); the shape does not emit", type,
+                         P->recording ? "inside ObjectBegin"
+                                      : "rayes' area lights are quads, disks and spheres");
+        return pbrt_emit_quadric(P, t, q, qp, n, flags);
+    }
+    if (q == RAYES_QUADRIC_SPHERE) {
+        if (P->gs.reverse)
+            pbrt_warn_at(P, t->line, t->col, "inward sphere light", "sphere: an inward-emitting "
+                         "sphere (ReverseOrientation) emits outward in rayes");
+        return quadric_light(P, t, "sphere", (float)radius, P->gs.ctm);
+    }
+    double m[16], tr[16], flip[16];
+    pbrt_mat_identity(tr);
+    tr[11] = height;
+    pbrt_mat_mul(P->gs.ctm, tr, m);
+    pbrt_mat_identity(flip);
+    flip[5] = flip[10] = -1; /* 180 degrees about x: emits toward -z */
+    for (int side = 0; side < 1 + P->gs.area.twosided; side++) {
+        double ms[16];
+        if (P->gs.reverse ^ side)
+            pbrt_mat_mul(m, flip, ms);
+        else
+            memcpy(ms, m, sizeof ms);
+        if (quadric_light(P, t, "disk", (float)radius, ms) != 0)
+            return -1;
+    }
+    return 0;
+}
+
+/* ------------------------------------------------------------ directives */
+
+int pbrt_d_shape(Parser *P, const Token *t)
+{
+    char type[64];
+    ParamList pl = {0};
+    int r = pbrt_need_world(P, t, 1);
+    if (!r)
+        r = pbrt_name_and_params(P, type, sizeof type, "a shape type", &pl, NULL);
+    if (r) {
+        pbrt_params_free(&pl);
+        return -1;
+    }
+    if (pbrt_find(&pl, "alpha"))
+        pbrt_warn_at(P, t->line, t->col, "alpha", "Shape: \"alpha\" cut-outs are not supported");
+    if (strcmp(type, "trianglemesh") == 0)
+        r = shape_trianglemesh(P, t, &pl);
+    else if (strcmp(type, "bilinearmesh") == 0)
+        r = shape_bilinearmesh(P, t, &pl);
+    else if (strcmp(type, "plymesh") == 0)
+        r = shape_plymesh(P, t, &pl);
+    else if (strcmp(type, "sphere") == 0 || strcmp(type, "disk") == 0 ||
+             strcmp(type, "cylinder") == 0)
+        r = shape_quadric(P, t, type, &pl);
+    else {
+        char key[96];
+        snprintf(key, sizeof key, "shape %.60s", type);
+        pbrt_warn_at(P, t->line, t->col, key, "Shape \"%.40s\" is not supported; skipped", type);
+        pbrt_params_free(&pl);
+        return 0;
+    }
+    if (!r)
+        pbrt_warn_unused(P, &pl, "Shape", type);
+    pbrt_params_free(&pl);
+    return r;
+}
