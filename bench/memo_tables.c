@@ -102,6 +102,9 @@ static Row run(const Args *a, int size, int spp, int bounces, int cache, double 
     o.cache = cache;
     o.cache_mb = budget_mb;
     o.cache_k = (float)a->cache_k;
+    /* The memo's trees: every uncached diffuse hit branches into the
+     * preset's deeper rays, as its tables count them. */
+    o.branch_depth = bounces + 1;
     if (a->grid_size > 0)
         o.grid_size = a->grid_size;
     RayesImage *img;

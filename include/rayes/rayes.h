@@ -451,6 +451,13 @@ typedef struct RayesRenderOptions {
     int grid_size;             /* micropolygons per grid, at most (RenderMan's "gridsize"):
                                   1 to 4096, default 256; smaller grids mean more, smaller
                                   radiosity cache entries */
+    int branch_depth;          /* shading points whose diffuse plus specular depth is below
+                                  this branch: several glossy rays, reflection and refraction
+                                  both; deeper ones follow one lobe, chosen at random, and end
+                                  by Russian roulette; an uncached diffuse hit at a diffuse
+                                  depth of at least this traces one diffuse ray (cache fills
+                                  keep diffuse_rays_deep). Default 1: camera hits only; 1 to
+                                  129 */
 } RayesRenderOptions;
 
 /* Fills options with the defaults of a quality preset: 512 x 512, 4 pixel

@@ -224,7 +224,7 @@ struct RayesShaderServices {
      * "grid:size", the grid's vertices in u and v (triangles: subdivisions
      * and 0); "grid:edge", its mean micropolygon edge; "grid:curvature")
      * and option of the render ("resolution", "bounces", "samples",
-     * "shadowrays", "diffuserays"): writes up to n floats to value and
+     * "shadowrays", "diffuserays", "branchdepth"): writes up to n floats to value and
      * returns how many the attribute has, or 0 if unknown (always 0 at
      * dicing time). */
     int (*attribute)(const RayesShaderServices *sv, const RayesShadeCtx *ctx, const char *name,
@@ -239,6 +239,18 @@ struct RayesShaderServices {
     /* A checkerboard of unit squares in (s, t): 1 where floor(s) + floor(t)
      * is even, else 0, box-filtered over ds x dt (0: point sampled). */
     float (*checker)(const RayesShaderServices *sv, float s, float t, float ds, float dt);
+
+    /* A random number in [0, 1) for point i and a dimension of the
+     * shader's choosing: a function of the point's path, so the same
+     * render gives the same numbers whatever the threads. For choosing
+     * among lobes: a point whose diffuse plus specular depth is at least
+     * the option "branchdepth" should follow one lobe (chosen with
+     * probability p, its result divided by p) rather than call
+     * indirect_specular and indirect_refraction both, and may end by
+     * Russian roulette on the lobe's weight; the renderer then traces one
+     * ray per glossy lobe too. Older renderers lack it (supports()). */
+    float (*random)(const RayesShaderServices *sv, const RayesShadeCtx *ctx, size_t i,
+                    uint32_t dimension);
 };
 
 #ifdef __cplusplus

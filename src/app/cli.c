@@ -40,6 +40,9 @@ static const char render_options[] =
     "  --diffuse-rays N        diffuse rays per shading point (all depths)\n"
     "  --diffuse-rays-deep N   diffuse rays per shading point below depth 0\n"
     "  --specular-depth N      maximum specular depth (default 4)\n"
+    "  --branch-depth N        points shallower than N (diffuse + specular depth) trace\n"
+    "                          reflection and refraction both and several glossy rays;\n"
+    "                          deeper ones follow one lobe (default 1: camera hits)\n"
     "  --filter box|gaussian   pixel filter (default box)\n"
     "  --filter-width W        filter width in pixels (default 1 box, 2 gaussian)\n"
     "  --seed N                changes every random number (default 0)\n"
@@ -273,6 +276,8 @@ void parse_args(int argc, char **argv, Args *a)
         else if (strcmp(o, "--specular-depth") == 0) {
             opt->specular_depth = (int)parse_long(o, v, 0, 64);
             a->set |= SET_SPECULAR_DEPTH;
+        } else if (strcmp(o, "--branch-depth") == 0) {
+            opt->branch_depth = (int)parse_long(o, v, 1, 129);
         } else if (strcmp(o, "--filter") == 0) {
             a->set |= SET_FILTER;
             if (strcmp(v, "box") == 0)

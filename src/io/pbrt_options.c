@@ -146,9 +146,17 @@ int pbrt_d_integrator(Parser *P, const Token *t)
         pbrt_params_free(&pl);
         return FAIL_TOK(P, t, "Integrator: expected maxdepth >= 0");
     }
-    /* pbrt's maxdepth 1 is direct light only: rayes' 0 diffuse bounces */
+    /* pbrt's maxdepth 1 is direct light only: rayes' 0 diffuse bounces.
+     * Specular paths past the branch depth follow one lobe, so a deep
+     * specular depth is cheap; each diffuse bounce is cached apart and
+     * costs about as much as the first, which the user should know. */
     P->settings->bounces = depth >= 1 ? (int)depth - 1 : 0;
     P->settings->specular_depth = (int)depth;
+    if (depth > 9)
+        pbrt_warn_at(P, t->line, t->col, "maxdepth",
+                     "Integrator \"maxdepth\" %g: %d diffuse bounces, each costing about as "
+                     "much as the first (--bounces N for fewer)",
+                     depth, depth - 1 < 64 ? (int)depth - 1 : 64);
     if (strcmp(type, "ambientocclusion") == 0 || strcmp(type, "sppm") == 0 ||
         strcmp(type, "mlt") == 0)
         pbrt_warn_at(P, t->line, t->col, "integrator",

@@ -127,7 +127,7 @@ static Vec3 shade_hit(Worker *w, const Ray *ray, const Hit *hit, const RenderObj
     path_st_footprint(hp.dst, hp.du, hp.dv, &hp.ds, &hp.dt);
     int own_st = (w->rs->gs->grids[hit->grid].primvars & GEOM_PV_ST) != 0;
     PathState ps = {w, &hp.key, &hp.diff, &hp.curvature, &hp.offset, NULL, hit->grid,
-                    own_st ? &hp.ds : NULL, own_st ? &hp.dt : NULL};
+                    own_st ? &hp.ds : NULL, own_st ? &hp.dt : NULL, 1};
     RayesShadeCtx ctx = {
         .n_points = 1,
         .ray_type = kind,

@@ -46,6 +46,9 @@ typedef struct PathState {
     const float *ds, *dt;         /* texture filter widths in (s, t) where the points have
                                      texture coordinates of their own (primitive variable st),
                                      or NULL: the texture service then takes ctx->du, dv */
+    int path;                     /* 1: a path's own hit (integrator.c), not a grid (a cache
+                                     fill, the grid hider): past the branch depth its diffuse
+                                     rays are one */
 } PathState;
 
 /* The texture-space footprint of a point whose parameter footprint is

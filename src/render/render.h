@@ -70,6 +70,8 @@ typedef struct RenderSettings {
     int width, height, spp, threads, tile_size;
     int bounces;                  /* maximum diffuse depth */
     int specular_depth;           /* maximum specular depth */
+    int branch_depth;             /* points below this diffuse + specular depth branch
+                                     (RayesRenderOptions.branch_depth) */
     int shadow_rays, shadow_rays_deep;
     int diffuse_rays, diffuse_rays_deep;
     int filter;                   /* 0 box, 1 Gaussian */

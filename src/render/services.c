@@ -223,6 +223,8 @@ static void svc_indirect_diffuse(const RayesShaderServices *sv, const RayesShade
     int n = n_rays > 0 ? n_rays : depth == 0 ? w->set->diffuse_rays : w->set->diffuse_rays_deep;
     if (depth >= w->set->bounces)
         n = 0;
+    if (ps->path && n > 1 && depth >= w->set->branch_depth)
+        n = 1; /* an uncached hit past the branch depth: one ray follows the path */
     IrrGrid *irr = ps->irr;
     if (irr && n > 0 && ctx->N == irr->N + ctx->first_point) {
         /* A grid's own points with its own normals: interpolate (irrgrid.h). */
@@ -312,6 +314,8 @@ static void svc_indirect_specular(const RayesShaderServices *sv, const RayesShad
         int n = n_rays > 0 ? n_rays
                 : ctx->diffuse_depth == 0 ? w->set->diffuse_rays
                                           : w->set->diffuse_rays_deep;
+        if (n > 1 && ctx->diffuse_depth + ctx->specular_depth >= w->set->branch_depth)
+            n = 1; /* past the branch depth: one ray follows the lobe */
         float e = 1.0f / r;
         Vec3 Ng = v3_load(ctx->Ng[i]), sum = v3(0, 0, 0), t, b;
         v3_basis(d, &t, &b);
@@ -423,12 +427,24 @@ static int svc_option(const RayesShaderServices *sv, const RayesShadeCtx *ctx, c
     if (strcmp(name, "diffuserays") == 0)
         return put_floats(value, n,
                           (float[]){(float)set->diffuse_rays, (float)set->diffuse_rays_deep}, 2);
+    if (strcmp(name, "branchdepth") == 0)
+        return put_floats(value, n, (float[]){(float)set->branch_depth}, 1);
     return 0;
+}
+
+static float svc_random(const RayesShaderServices *sv, const RayesShadeCtx *ctx, size_t i,
+                        uint32_t dimension)
+{
+    (void)sv;
+    const PathState *ps = ctx->renderer;
+    uint64_t key = hash_combine(ps->keys[point(ctx, i)], DIM_SHADER);
+    return rng_float(hash_combine(key, dimension));
 }
 
 static const char *const service_names[] = {
     "direct_lighting", "ambient", "indirect_diffuse", "indirect_specular", "indirect_refraction",
     "transmission", "noise", "fbm", "turbulence", "attribute", "option", "texture", "checker",
+    "random",
 };
 
 static int svc_supports(const RayesShaderServices *sv, const char *service)
@@ -457,4 +473,5 @@ const RayesShaderServices render_services = {
     .option = svc_option,
     .checker = shade_service_checker,
     .supports = svc_supports,
+    .random = svc_random,
 };

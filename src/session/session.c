@@ -61,6 +61,7 @@ void rayes_render_options_init(RayesRenderOptions *o, RayesQuality quality)
     o->cache_resolution = -1;
     o->cache_k = 1.0f;
     o->grid_size = GEOM_GRID_SIZE;
+    o->branch_depth = 1;
     o->texture_mb = 64.0;
     o->texture_width = 1.0f;
     switch (quality) {
@@ -121,6 +122,8 @@ RayesError session_check_options(RayesScene *scene, const RayesRenderOptions *o)
                "k > 0, resolution -1 to 2";
     else if (o->grid_size < 1 || o->grid_size > GEOM_MAX_GRID_SIZE)
         what = "options: grid size must be 1 to 4096 micropolygons";
+    else if (o->branch_depth < 1 || o->branch_depth > 129)
+        what = "options: branch depth must be 1 to 129";
     else if (!(o->texture_mb >= 0.0) || o->texture_mb > 1e7 || !(o->texture_width >= 0.0f) ||
              o->texture_width > 1e3f)
         what = "options: texture cache budget must be 0 to 1e7 MB and texture width 0 to 1000";
@@ -141,6 +144,7 @@ RenderSettings session_settings(const RayesRenderOptions *o)
         .filter = o->filter == RAYES_FILTER_GAUSSIAN, .filter_width = o->filter_width,
         .seed = o->seed, .progress = o->progress, .progress_user = o->progress_user,
         .cache_resolution = o->cache_resolution, .cache_k = o->cache_k, .grid_size = o->grid_size,
+        .branch_depth = o->branch_depth,
         .hider = o->hider == RAYES_HIDER_GRID, .irradiance = o->irradiance != 0,
         .tile_done = o->tile_done, .tile_user = o->tile_user,
     };

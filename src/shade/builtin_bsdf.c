@@ -7,7 +7,10 @@
  * refraction from indirect_refraction: those rays see area lights, so the
  * physically based shaders do not add direct_lighting's specular (that
  * would count the lights twice). RenderMan's metal and shinymetal keep
- * their classic specular() highlight, as their definitions say.
+ * their classic specular() highlight, as their definitions say. Past the
+ * renderer's branch depth, glass and dielectric follow one of reflection
+ * and refraction (fresnel_split), so a path through nested glass is a
+ * path, not a tree.
  *
  * diffuselighting is each shader's view-independent part: ambient and
  * diffuse terms only (black for glass, dielectric and conductor). Scratch
@@ -255,17 +258,39 @@ typedef struct GlassParams {
     float specularcolor[3], transmitcolor[3];
 } GlassParams;
 
+/* Whether the context's points branch (reflection and refraction both)
+ * or follow one lobe: below the renderer's "branchdepth" they branch, and
+ * always when the renderer has no random service to choose with. */
+static int branches(const RayesShaderServices *sv, const RayesShadeCtx *ctx)
+{
+    float depth = 0.0f;
+    if (!sv->supports || !sv->supports(sv, "random") || !sv->option ||
+        sv->option(sv, ctx, "branchdepth", &depth, 1) != 1)
+        return 1;
+    return (float)(ctx->diffuse_depth + ctx->specular_depth) < depth;
+}
+
+static float max3(const float v[3])
+{
+    return fmaxf(v[0], fmaxf(v[1], v[2]));
+}
+
 /* Fresnel-weighted reflection and refraction at a smooth boundary of
  * relative index eta (inside over outside). A ray that hit the back side
  * is leaving: the index is then inverted, and beyond the critical angle
  * all light reflects. reflect_e is the exponent of the reflection lobe
- * (0: mirror). Writes R[i] = F * reflected and T[i] = (1 - F) * refracted. */
+ * (0: mirror). Writes R[i] = F * reflected and T[i] = (1 - F) * refracted,
+ * which the caller weights by wR[i] and wT[i]. Past the branch depth each
+ * point traces one of the two, chosen with probability in proportion to
+ * F max(wR) and (1 - F) max(wT), and none with probability 1 - q, q that
+ * sum at most 1 (Russian roulette on the weight the path carries on);
+ * the chosen one is divided by its probability, so the expectation is
+ * unchanged. */
 static void fresnel_split(const RayesShaderServices *sv, const RayesShadeCtx *ctx, float eta,
-                          float reflect_e, Rgb *R, Rgb *T)
+                          float reflect_e, const Rgb *wR, const Rgb *wT, Rgb *R, Rgb *T)
 {
     Rgb dir[SHADE_CHUNK], refr[SHADE_CHUNK];
     float F[SHADE_CHUNK];
-    reflection(sv, ctx, reflect_e, R);
     size_t n_refr = 0;
     for (size_t i = 0; i < ctx->n_points; i++) {
         int leaving = ctx->backfacing && ctx->backfacing[i];
@@ -279,6 +304,32 @@ static void fresnel_split(const RayesShaderServices *sv, const RayesShadeCtx *ct
         dir[i][0] = t.x, dir[i][1] = t.y, dir[i][2] = t.z;
         n_refr += F[i] < 1.0f;
     }
+    if (!branches(sv, ctx)) {
+        memset(R, 0, ctx->n_points * sizeof *R);
+        memset(T, 0, ctx->n_points * sizeof *T);
+        for (size_t i = 0; i < ctx->n_points; i++) {
+            float a = F[i] * max3(wR[i]), b = (1.0f - F[i]) * max3(wT[i]), q = fminf(a + b, 1.0f);
+            float u = sv->random(sv, ctx, i, 0);
+            if (!(a + b > 0.0f) || u >= q)
+                continue; /* ended by roulette */
+            RayesShadeCtx one;
+            shade_ctx_slice(ctx, i, 1, &one);
+            int reflect = u < q * a / (a + b);
+            float p = q * (reflect ? a : b) / (a + b);
+            Rgb L;
+            if (reflect)
+                reflection(sv, &one, reflect_e, &L);
+            else if (sv->indirect_refraction)
+                sv->indirect_refraction(sv, &one, (const float(*)[3])&dir[i], &L);
+            else
+                memset(L, 0, sizeof L);
+            float w = (reflect ? F[i] : 1.0f - F[i]) / p;
+            for (int c = 0; c < 3; c++)
+                (reflect ? R : T)[i][c] = w * L[c];
+        }
+        return;
+    }
+    reflection(sv, ctx, reflect_e, R);
     if (n_refr > 0 && sv->indirect_refraction)
         sv->indirect_refraction(sv, ctx, (const float(*)[3])dir, refr);
     else
@@ -297,8 +348,14 @@ static void glass_chunk(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
     memset(out->Ci, 0, ctx->n_points * sizeof *out->Ci);
     if (!ctx->I)
         return; /* no view-independent lobe */
-    Rgb R[SHADE_CHUNK], T[SHADE_CHUNK], ds[SHADE_CHUNK];
-    fresnel_split(sv, ctx, p->eta, p->roughness > 0.0f ? 1.0f / p->roughness : 0.0f, R, T);
+    Rgb R[SHADE_CHUNK], T[SHADE_CHUNK], ds[SHADE_CHUNK], wR[SHADE_CHUNK], wT[SHADE_CHUNK];
+    for (size_t i = 0; i < ctx->n_points; i++)
+        for (int c = 0; c < 3; c++) {
+            wR[i][c] = p->specularcolor[c] * p->Kr;
+            wT[i][c] = cs(ctx, i, c) * p->transmitcolor[c] * p->Kt;
+        }
+    fresnel_split(sv, ctx, p->eta, p->roughness > 0.0f ? 1.0f / p->roughness : 0.0f,
+                  (const Rgb *)wR, (const Rgb *)wT, R, T);
     memset(ds, 0, sizeof ds);
     if (p->Ks != 0.0f) {
         float rough[SHADE_CHUNK];
@@ -350,8 +407,11 @@ static void dielectric_chunk(const RayesShaderServices *sv, const RayesShadeCtx 
     memset(out->Ci, 0, ctx->n_points * sizeof *out->Ci);
     if (!ctx->I)
         return;
-    Rgb R[SHADE_CHUNK], T[SHADE_CHUNK];
-    fresnel_split(sv, ctx, p->eta, exponent_of(p->roughness), R, T);
+    Rgb R[SHADE_CHUNK], T[SHADE_CHUNK], one[SHADE_CHUNK];
+    for (size_t i = 0; i < ctx->n_points; i++)
+        one[i][0] = one[i][1] = one[i][2] = 1.0f;
+    fresnel_split(sv, ctx, p->eta, exponent_of(p->roughness), (const Rgb *)one,
+                  (const Rgb *)one, R, T);
     for (size_t i = 0; i < ctx->n_points; i++)
         for (int c = 0; c < 3; c++)
             out->Ci[i][c] = R[i][c] + T[i][c];

@@ -48,7 +48,8 @@ enum {
     DIM_DIFFUSE = 3,    /* diffuse-ray directions */
     DIM_SPECULAR = 4,   /* specular rays */
     DIM_PATH = 5,       /* child path keys */
-    DIM_REFRACTION = 6  /* refracted rays */
+    DIM_REFRACTION = 6, /* refracted rays */
+    DIM_SHADER = 7      /* the random service: shaders' own choices */
 };
 
 #endif /* RAYES_UTIL_RNG_H */

@@ -1,0 +1,165 @@
+/*
+ * Ray trees past the branch depth (RayesRenderOptions.branch_depth): glass
+ * nested in glass inside a white furnace (a closed sphere emitting
+ * radiance 1, no bounces), so every path that leaves the glass sees
+ * exactly 1. Past the branch depth a glass hit follows one of reflection
+ * and refraction (shade/builtin_bsdf.c), so at specular depth 64 the rays
+ * per camera ray stay bounded where branching at every hit would double
+ * them per bounce; the image keeps its expectation (1 for clear glass,
+ * and the fully branched image's for tinted glass, whose paths end by
+ * Russian roulette); a glossy lobe traces one ray past the branch
+ * depth; and so does an uncached diffuse hit (a white furnace).
+ */
+#include <string.h>
+
+#include "rayes/rayes.h"
+#include "test.h"
+
+typedef struct Result {
+    double mean;          /* red channel over the image */
+    uint64_t camera, specular;
+} Result;
+
+static void translate(RayesScene *s, float x, float y, float z)
+{
+    float m[16] = {1, 0, 0, x, 0, 1, 0, y, 0, 0, 1, z, 0, 0, 0, 1};
+    CHECK(rayes_scene_set_transform(s, m) == RAYES_OK);
+}
+
+/* tint: the glass's transmitcolor; roughness 0: smooth. */
+static Result render(int specular_depth, int branch_depth, float tint, float roughness, int spp)
+{
+    RayesScene *s = rayes_scene_new();
+    float eye[3] = {0, 0, -4}, target[3] = {0, 0, 0}, up[3] = {0, 1, 0};
+    rayes_scene_set_camera(s, eye, target, up, 30.0f);
+    RayesParam wall[3] = {
+        {"Kd", RAYES_PARAM_FLOAT, {0, 0, 0}, NULL},
+        {"Ke", RAYES_PARAM_COLOR, {1, 1, 1}, NULL},
+        {"Cs", RAYES_PARAM_COLOR, {1, 1, 1}, NULL},
+    };
+    CHECK(rayes_scene_set_shader(s, "matte", wall, 3) == RAYES_OK);
+    CHECK(rayes_scene_sphere(s, 20.0f) == RAYES_OK);
+    RayesParam glass[3] = {
+        {"eta", RAYES_PARAM_FLOAT, {1.5f, 0, 0}, NULL},
+        {"transmitcolor", RAYES_PARAM_COLOR, {tint, tint, tint}, NULL},
+        {"roughness", RAYES_PARAM_FLOAT, {roughness, 0, 0}, NULL},
+    };
+    CHECK(rayes_scene_set_shader(s, "glass", glass, 3) == RAYES_OK);
+    for (int k = 0; k < 3; k++) { /* three spheres, each inside the last */
+        translate(s, 0.05f * (float)k, 0.0f, 0.0f);
+        CHECK(rayes_scene_sphere(s, 1.0f - 0.3f * (float)k) == RAYES_OK);
+    }
+    CHECK(rayes_scene_commit(s) == RAYES_OK);
+    RayesRenderOptions o;
+    rayes_render_options_init(&o, RAYES_QUALITY_PREVIEW);
+    o.width = o.height = 16;
+    o.spp = spp;
+    o.bounces = 0;
+    o.specular_depth = specular_depth;
+    o.branch_depth = branch_depth;
+    o.threads = 2;
+    RayesImage *img = NULL;
+    RayesStats *st = NULL;
+    CHECK(rayes_render(s, &o, &img, &st) == RAYES_OK);
+    Result r = {0, 0, 0};
+    for (int i = 0; img && i < img->width * img->height; i++)
+        r.mean += img->rgba[4 * i];
+    r.mean /= img ? img->width * img->height : 1;
+    const RayesStat *cam = rayes_stats_find(st, "rays/camera");
+    const RayesStat *spec = rayes_stats_find(st, "rays/specular");
+    CHECK(cam && spec);
+    r.camera = cam ? cam->count : 0;
+    r.specular = spec ? spec->count : 0;
+    rayes_stats_free(st);
+    rayes_image_free(img);
+    rayes_scene_release(s);
+    return r;
+}
+
+static void test_deep_glass_stays_a_path(void)
+{
+    Result r = render(64, 1, 1.0f, 0.0f, 16);
+    /* depth 0 traces reflection and refraction, each a path of at most 64 */
+    CHECK(r.specular <= r.camera * (2 + 2 * 64));
+    CHECK(r.specular < r.camera * 16); /* most paths leave after a few bounces */
+    CHECK_NEAR(r.mean, 1.0, 0.01);     /* clear glass loses nothing */
+}
+
+static void test_same_expectation_as_branching(void)
+{
+    /* At specular depth 6 full branching is affordable (2^6 rays a path):
+     * the one-lobe image must agree with it, for clear glass and for
+     * tinted glass whose paths end by roulette. */
+    Result tree = render(6, 129, 1.0f, 0.0f, 4);
+    Result path = render(6, 1, 1.0f, 0.0f, 64);
+    /* the tree is several times bigger per camera ray */
+    CHECK(tree.specular * path.camera > 4 * path.specular * tree.camera);
+    CHECK_NEAR(path.mean / tree.mean, 1.0, 0.01);
+    Result ttree = render(6, 129, 0.6f, 0.0f, 4);
+    Result tpath = render(6, 1, 0.6f, 0.0f, 64);
+    CHECK(ttree.mean < 0.9 && ttree.mean > 0.2);
+    CHECK_NEAR(tpath.mean / ttree.mean, 1.0, 0.03);
+    /* A branch depth beyond the specular depth is the old full tree */
+    Result same = render(6, 7, 0.6f, 0.0f, 4);
+    CHECK(same.specular == ttree.specular && same.mean == ttree.mean);
+}
+
+static void test_glossy_lobe_one_ray_deep(void)
+{
+    /* A rough glass: at depth 0 the lobe takes the preset's 4 rays, deeper
+     * one; branching everywhere multiplies them per bounce. Same
+     * expectation; and deep enough, little is lost (the lobe's directions
+     * below the surface bring nothing: 3% here, total internal reflection
+     * at grazing angles). */
+    Result path = render(4, 1, 1.0f, 0.05f, 16);
+    Result tree = render(4, 129, 1.0f, 0.05f, 4);
+    CHECK(path.specular * 4 < tree.specular); /* for 4 times the samples */
+    CHECK_NEAR(path.mean / tree.mean, 1.0, 0.02);
+    double deep = render(32, 1, 1.0f, 0.05f, 16).mean;
+    CHECK(deep > 0.95 && deep < 1.01);
+}
+
+/* Uncached diffuse paths: a furnace of albedo a emitting 1, the cache off,
+ * 8 bounces with 4 diffuse rays a point. Past the branch depth each hit
+ * traces one ray: a path, not 4^8 rays, with the same expectation, the
+ * sum of a^k for k = 0..8. */
+static void test_uncached_diffuse_path(void)
+{
+    const float a = 0.5f;
+    RayesScene *s = rayes_scene_new();
+    float eye[3] = {0, 0, 0}, target[3] = {0, 0, 1}, up[3] = {0, 1, 0};
+    rayes_scene_set_camera(s, eye, target, up, 90.0f);
+    RayesParam p[3] = {
+        {"Kd", RAYES_PARAM_FLOAT, {a, 0, 0}, NULL},
+        {"Ke", RAYES_PARAM_COLOR, {1, 1, 1}, NULL},
+        {"Cs", RAYES_PARAM_COLOR, {1, 1, 1}, NULL},
+    };
+    CHECK(rayes_scene_set_shader(s, "matte", p, 3) == RAYES_OK);
+    CHECK(rayes_scene_sphere(s, 10.0f) == RAYES_OK);
+    CHECK(rayes_scene_commit(s) == RAYES_OK);
+    RayesRenderOptions o;
+    rayes_render_options_init(&o, RAYES_QUALITY_PREVIEW);
+    o.width = o.height = 16;
+    o.spp = 4;
+    o.bounces = 8;
+    o.cache = 0;
+    o.threads = 2;
+    RayesImage *img = NULL;
+    RayesStats *st = NULL;
+    CHECK(rayes_render(s, &o, &img, &st) == RAYES_OK);
+    double sum = 0.0, expected = 0.0, ak = 1.0;
+    for (int i = 0; img && i < img->width * img->height; i++)
+        sum += img->rgba[4 * i];
+    for (int k = 0; k <= 8; k++, ak *= a)
+        expected += ak;
+    CHECK_NEAR(sum / (16 * 16) / expected, 1.0, 0.01);
+    const RayesStat *cam = rayes_stats_find(st, "rays/camera");
+    const RayesStat *dif = rayes_stats_find(st, "rays/diffuse");
+    CHECK(cam && dif && dif->count <= cam->count * (4 + 4 * 7));
+    rayes_stats_free(st);
+    rayes_image_free(img);
+    rayes_scene_release(s);
+}
+
+TEST_MAIN(TEST(test_uncached_diffuse_path), TEST(test_deep_glass_stays_a_path), TEST(test_same_expectation_as_branching),
+          TEST(test_glossy_lobe_one_ray_deep))
