@@ -8,6 +8,7 @@
  * Textures are a constant colour or an image file with a scale. Named
  * materials and textures are found latest first, so a redefinition wins.
  */
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -61,14 +62,20 @@ static const float *mat_get(const Material *m, const char *name)
     return NULL;
 }
 
+/* rayes' roughness r is pbrt's with remapping on (alpha = sqrt(r)). pbrt's
+ * "remaproughness" false gives alpha itself, so r = alpha^2. Anisotropic
+ * roughness (uroughness, vroughness) becomes the isotropic lobe of the
+ * two alphas' geometric mean, which keeps the lobe's solid angle. */
 static double get_roughness(ParamList *pl, double def)
 {
     double r = pbrt_get_float(pl, "roughness", def);
     Param *u = pbrt_find(pl, "uroughness"), *v = pbrt_find(pl, "vroughness");
-    if (u || v)
-        r = 0.5 * (u && u->n_num ? u->num[0] : r) + 0.5 * (v && v->n_num ? v->num[0] : r);
-    pbrt_find(pl, "remaproughness"); /* rayes' roughness is pbrt's with remapping on */
-    return r;
+    Param *remap = pbrt_find(pl, "remaproughness");
+    int alpha_given = remap && remap->n_num && remap->num[0] == 0.0;
+    double ru = u && u->n_num ? u->num[0] : r, rv = v && v->n_num ? v->num[0] : r;
+    double au = alpha_given ? ru : sqrt(fmax(ru, 0.0)), av = alpha_given ? rv : sqrt(fmax(rv, 0.0));
+    double alpha = sqrt(fmax(au, 0.0) * fmax(av, 0.0));
+    return alpha * alpha;
 }
 
 static int diffuse_material(Parser *P, ParamList *pl, Material *m, const char *param)

@@ -479,6 +479,8 @@ static void test_materials(void)
         "Material \"conductor\" \"rgb reflectance\" [0.9 0.8 0.7]\n"
         "Shape \"sphere\"\n"
         "Material \"diffuse\" \"blackbody reflectance\" 6500\n"
+        "Shape \"sphere\"\n"
+        "Material \"conductor\" \"float roughness\" 0.1 \"bool remaproughness\" false\n"
         "Shape \"sphere\"\n";
     /* a small mesh after each Material (the stub records shaders with meshes) */
     char full[8192] = "";
@@ -497,8 +499,8 @@ static void test_materials(void)
     CHECK(e == RAYES_OK);
     CHECK(s.spp == 8 && s.bounces == 0 && s.specular_depth == 1);
     CHECK(s.filter == RAYES_FILTER_GAUSSIAN && s.filter_width == 2.0f);
-    CHECK(r->n_meshes == 8);
-    if (r->n_meshes != 8) {
+    CHECK(r->n_meshes == 9);
+    if (r->n_meshes != 9) {
         free(r);
         return;
     }
@@ -506,7 +508,8 @@ static void test_materials(void)
     CHECK(strcmp(sh->name, "conductor") == 0);
     CHECK(param(sh, "eta") && fabs(param(sh, "eta")->value[2] - 1.442) < 1e-3);
     CHECK(param(sh, "k") && fabs(param(sh, "k")->value[0] - 3.983) < 1e-3);
-    CHECK(param(sh, "roughness") && fabs(param(sh, "roughness")->value[0] - 0.2) < 1e-6);
+    /* anisotropic: the alphas' geometric mean, sqrt(0.1) sqrt(0.3), squared */
+    CHECK(param(sh, "roughness") && fabs(param(sh, "roughness")->value[0] - sqrt(0.03)) < 1e-6);
     sh = &r->mesh[1].shader;
     CHECK(strcmp(sh->name, "dielectric") == 0 && param(sh, "eta") &&
           fabs(param(sh, "eta")->value[0] - 1.33) < 1e-6);
@@ -526,6 +529,9 @@ static void test_materials(void)
     sh = &r->mesh[7].shader; /* 6500 K: nearly white, normalised to a maximum of 1 */
     CHECK(param(sh, "reflectance") && fabs(param(sh, "reflectance")->value[0] - 1) < 0.05 &&
           fabs(param(sh, "reflectance")->value[2] - 1) < 0.1);
+    /* remaproughness false: 0.1 is alpha itself, rayes' roughness alpha^2 */
+    sh = &r->mesh[8].shader;
+    CHECK(param(sh, "roughness") && fabs(param(sh, "roughness")->value[0] - 0.01) < 1e-7);
     free(r);
 }
 
