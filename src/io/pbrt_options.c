@@ -178,13 +178,31 @@ int pbrt_d_filter(Parser *P, const Token *t)
         pbrt_params_free(&pl);
         return -1;
     }
-    if (strcmp(type, "box") == 0 || strcmp(type, "gaussian") == 0) {
-        int box = type[0] == 'b';
-        double rx = pbrt_get_float(&pl, "xradius", box ? 0.5 : 1.5);
+    /* pbrt-v4's default radii. rayes filters with a box or a Gaussian:
+     * pbrt's triangle, Mitchell and Lanczos (windowed sinc) become the
+     * Gaussian over the same support, with one warning. */
+    static const struct {
+        const char *name;
+        double radius;
+    } filters[] = {{"box", 0.5}, {"gaussian", 1.5}, {"triangle", 2}, {"mitchell", 2},
+                   {"sinc", 4}, {"lanczos", 4}};
+    int k = 0, n = (int)(sizeof filters / sizeof filters[0]);
+    while (k < n && strcmp(type, filters[k].name) != 0)
+        k++;
+    if (k < n) {
+        int box = k == 0;
+        double rx = pbrt_get_float(&pl, "xradius", filters[k].radius);
         double ry = pbrt_get_float(&pl, "yradius", rx);
         pbrt_find(&pl, "sigma");
+        pbrt_find(&pl, "B");
+        pbrt_find(&pl, "C");
+        pbrt_find(&pl, "tau");
         P->settings->filter = box ? RAYES_FILTER_BOX : RAYES_FILTER_GAUSSIAN;
         P->settings->filter_width = (float)fmax(0.01, rx + ry);
+        if (k >= 2)
+            pbrt_warn_at(P, t->line, t->col, "filter",
+                         "PixelFilter \"%s\": filtered with the Gaussian of the same radius",
+                         filters[k].name);
         pbrt_warn_unused(P, &pl, "PixelFilter", type);
     } else {
         pbrt_warn_at(P, t->line, t->col, "filter",

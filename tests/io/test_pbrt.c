@@ -737,5 +737,33 @@ static void test_normals_and_uv(void)
     free(r);
 }
 
-TEST_MAIN(TEST(test_cornell_box), TEST(test_transforms), TEST(test_materials), TEST(test_lights),
+/* Filters: box and gaussian as given (pbrt's default radii otherwise);
+ * triangle, Mitchell and Lanczos as the Gaussian of the same radius. */
+static void test_filters(void)
+{
+    static const struct {
+        const char *text;
+        int gaussian;
+        float width;
+    } cases[] = {
+        {"PixelFilter \"box\"\n", 0, 1.0f},
+        {"PixelFilter \"gaussian\"\n", 1, 3.0f},
+        {"PixelFilter \"triangle\" \"float xradius\" 1\n", 1, 2.0f},
+        {"PixelFilter \"triangle\"\n", 1, 4.0f},
+        {"PixelFilter \"mitchell\" \"float B\" 0.3 \"float C\" 0.3\n", 1, 4.0f},
+        {"PixelFilter \"lanczos\" \"float tau\" 3\n", 1, 8.0f},
+    };
+    Rec *r = malloc(sizeof *r);
+    for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
+        char text[256], err[512] = "";
+        snprintf(text, sizeof text, "%sWorldBegin\n", cases[k].text);
+        IoSettings s;
+        CHECK(parse("t.pbrt", text, r, &s, err, sizeof err) == RAYES_OK);
+        CHECK(s.filter == (cases[k].gaussian ? RAYES_FILTER_GAUSSIAN : RAYES_FILTER_BOX));
+        CHECK_NEAR(s.filter_width, cases[k].width, 1e-6);
+    }
+    free(r);
+}
+
+TEST_MAIN(TEST(test_filters), TEST(test_cornell_box), TEST(test_transforms), TEST(test_materials), TEST(test_lights),
           TEST(test_instances_include_ply), TEST(test_errors), TEST(test_normals_and_uv))

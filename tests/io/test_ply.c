@@ -1,11 +1,12 @@
 /*
  * tests/io/test_ply.c — the PLY reader of io/ply.h: ascii and binary (both
- * byte orders) files written here, the split of quads and n-gons, and bad
+ * byte orders) files written here, plain and gzip-compressed, the split of quads and n-gons, and bad
  * input whose one-line errors name the place. Buffers are exact-size heap
  * copies so AddressSanitizer catches any read past the end.
  */
 #include <stdint.h>
 #include <string.h>
+#include <zlib.h>
 
 #include "io/ply.h"
 #include "test.h"
@@ -132,6 +133,34 @@ static void test_binary(void)
         CHECK(io_ply_read(path, &m, err, sizeof err) == RAYES_OK);
         CHECK(m.n_vertices == 4);
         io_ply_mesh_fini(&m);
+    }
+    /* gzip-compressed (pbrt-v4's .ply.gz), and a compressed stream cut
+     * short: an error naming the file, not a crash */
+    char gz_path[512];
+    snprintf(gz_path, sizeof gz_path, "%s/test_ply_le.ply.gz", RAYES_TEST_TMP);
+    gzFile g = gzopen(gz_path, "wb");
+    CHECK(g != NULL);
+    if (g) {
+        CHECK(gzwrite(g, buf, (unsigned)n) == (int)n);
+        gzclose(g);
+        PlyMesh m;
+        char err[256];
+        CHECK(io_ply_read(gz_path, &m, err, sizeof err) == RAYES_OK);
+        CHECK(m.n_vertices == 4 && m.n_faces == 2);
+        CHECK_NEAR(m.P[3 * 2 + 2], 0.5, 0);
+        io_ply_mesh_fini(&m);
+        FILE *in = fopen(gz_path, "rb");
+        unsigned char z[2048];
+        size_t zn = in ? fread(z, 1, sizeof z, in) : 0;
+        if (in)
+            fclose(in);
+        f = fopen(gz_path, "wb");
+        if (f) {
+            fwrite(z, 1, zn / 2, f);
+            fclose(f);
+        }
+        CHECK(io_ply_read(gz_path, &m, err, sizeof err) != RAYES_OK);
+        CHECK(strstr(err, "test_ply_le.ply.gz") != NULL && !strchr(err, '\n'));
     }
     PlyMesh m;
     char err[256];
