@@ -251,6 +251,18 @@ struct RayesShaderServices {
      * ray per glossy lobe too. Older renderers lack it (supports()). */
     float (*random)(const RayesShaderServices *sv, const RayesShadeCtx *ctx, size_t i,
                     uint32_t dimension);
+
+    /* Glossy reflection toward the viewer (-I) with direct_lighting's
+     * normalised Blinn-Phong lobe, e = 1 / roughness[i] (NULL: 0.1):
+     * out[i] = integral of L f(w) cos(theta) dw over all incident light,
+     * the scene's lights by multiple importance sampling against the lobe
+     * (as direct_lighting's specular) and everything else by n_rays rays
+     * drawn from the lobe (0: the renderer's setting; one past the branch
+     * depth). Unlike indirect_specular's lobe it is not divided by the
+     * lobe's albedo, and small bright lights do not make it speckle. Zero
+     * without I. Older renderers lack it (supports()). */
+    void (*glossy)(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
+                   const float *roughness, int n_rays, float (*out)[3]);
 };
 
 #ifdef __cplusplus

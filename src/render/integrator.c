@@ -130,7 +130,7 @@ static Vec3 shade_hit(Worker *w, const Ray *ray, const Hit *hit, const RenderObj
                     own_st ? &hp.ds : NULL, own_st ? &hp.dt : NULL, 1};
     RayesShadeCtx ctx = {
         .n_points = 1,
-        .ray_type = kind,
+        .ray_type = kind & ~PATH_RAY_GLOSSY,
         .diffuse_depth = diffuse_depth,
         .specular_depth = specular_depth,
         .P = (const float(*)[3])hp.P,
@@ -179,7 +179,8 @@ Vec3 integrator_trace_hit(Worker *w, const Ray *ray, uint32_t kind, int diffuse_
         /* Environment lights: seen by camera and specular rays; black to
          * diffuse rays, as direct lighting integrates them. */
         Vec3 L = v3(0, 0, 0);
-        for (size_t k = 0; kind != RAYES_RAY_DIFFUSE && k < w->rs->n_lights; k++)
+        int sees_lights = !(kind & (RAYES_RAY_DIFFUSE | PATH_RAY_GLOSSY));
+        for (size_t k = 0; sees_lights && k < w->rs->n_lights; k++)
             if (w->rs->lights[k].type == LIGHT_ENVIRONMENT)
                 L = v3_add(L, light_env_radiance(&w->rs->lights[k], ray->d));
         return L;
@@ -187,8 +188,9 @@ Vec3 integrator_trace_hit(Worker *w, const Ray *ray, uint32_t kind, int diffuse_
     *t = hit.t;
     const RenderObject *obj = &w->rs->objects[w->rs->gs->grids[hit.grid].object];
     if (obj->light >= 0) {
-        /* Emitters: seen by camera and specular rays, on their front side. */
-        if (kind == RAYES_RAY_DIFFUSE || v3_dot(hit.Ng, ray->d) >= 0.0f)
+        /* Emitters: seen by camera and specular rays, on their front side
+         * (not by glossy-lobe rays: direct lighting has them). */
+        if ((kind & (RAYES_RAY_DIFFUSE | PATH_RAY_GLOSSY)) || v3_dot(hit.Ng, ray->d) >= 0.0f)
             return v3(0, 0, 0);
         return w->rs->lights[obj->light].L;
     }

@@ -60,6 +60,12 @@ static inline void path_st_footprint(const float dst[4], float du, float dv, flo
     *dt = fabsf(dst[2]) * du + fabsf(dst[3]) * dv;
 }
 
+/* A renderer's own bit on a specular ray's kind: a ray drawn from a glossy
+ * lobe whose lights direct lighting integrates (services.c, glossy), so
+ * emitters and environment lights look black to it, as to diffuse rays.
+ * Never reaches a shader's ctx->ray_type. */
+#define PATH_RAY_GLOSSY (1u << 16)
+
 /* How far rays leaving a point of grid g start from it, along its normal:
  * the ray epsilon plus a bound on the sagitta of neighbouring grids' chords.
  * Adjacent patches diced at different rates do not share boundary vertices,

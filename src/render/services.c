@@ -79,6 +79,7 @@ static int unoccluded(Worker *w, Vec3 o, Vec3 wi, float dist)
 typedef struct DirectPoint {
     Vec3 o, N, Ng, V;
     float e;      /* Blinn-Phong exponent */
+    int diff;     /* the diffuse output is wanted */
     int spec;     /* the specular output is wanted */
 } DirectPoint;
 
@@ -118,7 +119,8 @@ static void light_area(Worker *w, const DirectPoint *p, const Light *l, uint64_t
             if (cos_x > 0.0f && v3_dot(p->Ng, ls.wi) > 0.0f && v3_max_component(ls.Li) > 0.0f &&
                 unoccluded(w, p->o, ls.wi, ls.dist)) {
                 float wd = power_heuristic(ls.pdf, cos_x / (float)M_PI);
-                sum_d = v3_madd(sum_d, ls.Li, wd * cos_x / ((float)M_PI * ls.pdf));
+                if (p->diff)
+                    sum_d = v3_madd(sum_d, ls.Li, wd * cos_x / ((float)M_PI * ls.pdf));
                 if (p->spec) {
                     float ws = power_heuristic(ls.pdf, blinn_phong_pdf(p->N, p->V, ls.wi, p->e));
                     float f = blinn_phong(p->N, p->V, ls.wi, p->e);
@@ -127,12 +129,16 @@ static void light_area(Worker *w, const DirectPoint *p, const Light *l, uint64_t
             }
         }
         /* The diffuse lobe's strategy: weight (cos / pi) / pdf = 1. */
-        cmj_sample_2d((uint32_t)s, (uint32_t)n, pat_cos, &a, &b);
-        Vec3 wi = sample_cosine_hemisphere(p->N, a, b);
-        float cos_x = v3_dot(p->N, wi);
-        if (cos_x > 0.0f && v3_dot(p->Ng, wi) > 0.0f && light_intersect(l, p->o, wi, &ls) &&
-            v3_max_component(ls.Li) > 0.0f && unoccluded(w, p->o, wi, ls.dist))
-            sum_d = v3_madd(sum_d, ls.Li, power_heuristic(cos_x / (float)M_PI, ls.pdf));
+        Vec3 wi;
+        float cos_x;
+        if (p->diff) {
+            cmj_sample_2d((uint32_t)s, (uint32_t)n, pat_cos, &a, &b);
+            wi = sample_cosine_hemisphere(p->N, a, b);
+            cos_x = v3_dot(p->N, wi);
+            if (cos_x > 0.0f && v3_dot(p->Ng, wi) > 0.0f && light_intersect(l, p->o, wi, &ls) &&
+                v3_max_component(ls.Li) > 0.0f && unoccluded(w, p->o, wi, ls.dist))
+                sum_d = v3_madd(sum_d, ls.Li, power_heuristic(cos_x / (float)M_PI, ls.pdf));
+        }
         if (!p->spec)
             continue;
         /* The specular lobe's strategy: the half vector about N. */
@@ -194,6 +200,7 @@ static void svc_direct_lighting(const RayesShaderServices *sv, const RayesShadeC
         p.V = ctx->I ? v3_neg(v3_load(ctx->I[i])) : v3(0, 0, 0);
         p.e = 1.0f / (roughness && roughness[i] > 0.0f ? roughness[i] : 0.1f);
         p.spec = want_spec;
+        p.diff = diffuse != NULL;
         for (size_t k = 0; k < w->rs->n_lights && n > 0; k++) {
             const Light *l = &w->rs->lights[k];
             if (l->type == LIGHT_AMBIENT || !render_lit_by(obj, k) ||
@@ -273,7 +280,8 @@ static void svc_ambient(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
 }
 
 /* Radiance along d from point i of ctx, a specular or refracted ray. */
-static Vec3 trace_specular(const RayesShadeCtx *ctx, size_t i, Vec3 d, uint64_t key)
+static Vec3 trace_specular(const RayesShadeCtx *ctx, size_t i, Vec3 d, uint64_t key,
+                           uint32_t kind)
 {
     const PathState *ps = ctx->renderer;
     Worker *w = ps->w;
@@ -286,8 +294,8 @@ static Vec3 trace_specular(const RayesShadeCtx *ctx, size_t i, Vec3 d, uint64_t 
     RayDiff diff = {width, ps->diff[j].spread + 2.0f * ps->curvature[j] * width};
     Ray ray = {o, d, path_ray_epsilon(w), INFINITY, RAYES_RAY_SPECULAR};
     w->stats.rays_specular++;
-    return integrator_trace(w, &ray, RAYES_RAY_SPECULAR, ctx->diffuse_depth,
-                            ctx->specular_depth + 1, key, diff, NULL);
+    return integrator_trace(w, &ray, kind, ctx->diffuse_depth, ctx->specular_depth + 1, key, diff,
+                            NULL);
 }
 
 static void svc_indirect_specular(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
@@ -306,7 +314,7 @@ static void svc_indirect_specular(const RayesShaderServices *sv, const RayesShad
         Vec3 d = v3_normalize(v3_load(dir[i]));
         float r = roughness ? roughness[i] : 0.0f;
         if (r <= 0.0f) {
-            v3_store(out[i], trace_specular(ctx, i, d, key));
+            v3_store(out[i], trace_specular(ctx, i, d, key, RAYES_RAY_SPECULAR));
             continue;
         }
         /* A glossy lobe: directions with density proportional to cos^e of
@@ -328,9 +336,62 @@ static void svc_indirect_specular(const RayesShaderServices *sv, const RayesShad
                              v3_scale(d, cos_t));
             if (v3_dot(wi, Ng) <= 0.0f)
                 continue;
-            sum = v3_add(sum, trace_specular(ctx, i, wi, hash_combine(key, (uint64_t)s + 1)));
+            sum = v3_add(sum, trace_specular(ctx, i, wi, hash_combine(key, (uint64_t)s + 1),
+                                             RAYES_RAY_SPECULAR));
         }
         v3_store(out[i], n > 0 ? v3_scale(sum, 1.0f / n) : v3(0, 0, 0));
+    }
+}
+
+/* Glossy reflection toward -I with direct lighting's normalised
+ * Blinn-Phong lobe: the lights through svc_direct_lighting's specular
+ * part (multiple importance sampling against the lobe for area and
+ * environment lights), everything else through rays drawn from the lobe
+ * (half vectors about N), to which emitters look black, each weighted by
+ * f cos / pdf. One lobe for lights and for the rest: the sum is the
+ * lobe's integral of all incident light. */
+static void svc_glossy(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
+                       const float *roughness, int n_rays, float (*out)[3])
+{
+    const PathState *ps = ctx->renderer;
+    Worker *w = ps->w;
+    if (!ctx->I) {
+        memset(out, 0, ctx->n_points * sizeof *out);
+        return;
+    }
+    svc_direct_lighting(sv, ctx, 0, NULL, roughness, NULL, out);
+    if (ctx->specular_depth >= w->set->specular_depth)
+        return;
+    int n = n_rays > 0 ? n_rays
+            : ctx->diffuse_depth == 0 ? w->set->diffuse_rays
+                                      : w->set->diffuse_rays_deep;
+    if (n > 1 && ctx->diffuse_depth + ctx->specular_depth >= w->set->branch_depth)
+        n = 1; /* past the branch depth: one ray follows the lobe */
+    for (size_t i = 0; i < ctx->n_points; i++) {
+        float e = 1.0f / (roughness && roughness[i] > 0.0f ? roughness[i] : 0.1f);
+        Vec3 N = v3_load(ctx->N[i]), Ng = v3_load(ctx->Ng[i]), V = v3_neg(v3_load(ctx->I[i]));
+        Vec3 t, b, sum = v3(0, 0, 0);
+        v3_basis(N, &t, &b);
+        uint64_t key = hash_combine(ps->keys[point(ctx, i)], DIM_SPECULAR);
+        for (int s = 0; s < n; s++) {
+            float a1, a2;
+            cmj_sample_2d((uint32_t)s, (uint32_t)n, (uint32_t)key, &a1, &a2);
+            float cos_h = powf(a1, 1.0f / (e + 1.0f));
+            float sin_h = sqrtf(fmaxf(0.0f, 1.0f - cos_h * cos_h)), phi = 2.0f * (float)M_PI * a2;
+            Vec3 H = v3_add(v3_add(v3_scale(t, sin_h * cosf(phi)), v3_scale(b, sin_h * sinf(phi))),
+                            v3_scale(N, cos_h));
+            float vh = v3_dot(V, H);
+            if (vh <= 0.0f)
+                continue;
+            Vec3 wi = v3_normalize(v3_sub(v3_scale(H, 2.0f * vh), V));
+            float cos_x = v3_dot(N, wi), pdf = blinn_phong_pdf(N, V, wi, e);
+            if (cos_x <= 0.0f || v3_dot(Ng, wi) <= 0.0f || !(pdf > 0.0f))
+                continue;
+            Vec3 L = trace_specular(ctx, i, wi, hash_combine(key, (uint64_t)s + 1),
+                                    RAYES_RAY_SPECULAR | PATH_RAY_GLOSSY);
+            sum = v3_madd(sum, L, blinn_phong(N, V, wi, e) * cos_x / pdf);
+        }
+        v3_store(out[i], v3_add(v3_load(out[i]), v3_scale(sum, 1.0f / (float)n)));
     }
 }
 
@@ -345,7 +406,8 @@ static void svc_indirect_refraction(const RayesShaderServices *sv, const RayesSh
             continue;
         }
         uint64_t key = hash_combine(ps->keys[point(ctx, i)], DIM_REFRACTION);
-        v3_store(out[i], trace_specular(ctx, i, v3_normalize(v3_load(dir[i])), key));
+        v3_store(out[i],
+                 trace_specular(ctx, i, v3_normalize(v3_load(dir[i])), key, RAYES_RAY_SPECULAR));
     }
 }
 
@@ -444,7 +506,7 @@ static float svc_random(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
 static const char *const service_names[] = {
     "direct_lighting", "ambient", "indirect_diffuse", "indirect_specular", "indirect_refraction",
     "transmission", "noise", "fbm", "turbulence", "attribute", "option", "texture", "checker",
-    "random",
+    "random", "glossy",
 };
 
 static int svc_supports(const RayesShaderServices *sv, const char *service)
@@ -474,4 +536,5 @@ const RayesShaderServices render_services = {
     .checker = shade_service_checker,
     .supports = svc_supports,
     .random = svc_random,
+    .glossy = svc_glossy,
 };

@@ -3,11 +3,14 @@
  * physically based family the pbrt reader maps to: diffuse, conductor,
  * dielectric and coateddiffuse (DESIGN.md "Built-in BSDFs and shaders").
  *
- * Glossy and mirror reflection come from the indirect_specular service and
- * refraction from indirect_refraction: those rays see area lights, so the
- * physically based shaders do not add direct_lighting's specular (that
- * would count the lights twice). RenderMan's metal and shinymetal keep
- * their classic specular() highlight, as their definitions say. Past the
+ * Mirror reflection comes from the indirect_specular service and
+ * refraction from indirect_refraction, whose rays see area lights; glossy
+ * reflection of the physically based shaders (conductor, dielectric,
+ * coateddiffuse) from the glossy service, which adds the lights by
+ * multiple importance sampling against the same lobe, so small bright
+ * lights reflect without speckle and nothing is counted twice.
+ * RenderMan's metal, shinymetal and glass keep indirect_specular's lobe
+ * and their classic specular() highlight, as their definitions say. Past the
  * renderer's branch depth, glass and dielectric follow one of reflection
  * and refraction (fresnel_split), so a path through nested glass is a
  * path, not a tree.
@@ -27,6 +30,11 @@
 #include "util/log.h"
 
 typedef float Rgb[3];
+
+/* Whether the renderer's table holds service m: within the size it was
+ * built with, and set (supports() alone trusts the renderer's word). */
+#define HAS_SERVICE(sv, m)                                                                       \
+    ((sv)->struct_size >= offsetof(RayesShaderServices, m) + sizeof((sv)->m) && (sv)->m != NULL)
 
 static float cs(const RayesShadeCtx *ctx, size_t i, int c)
 {
@@ -118,6 +126,23 @@ static void reflection(const RayesShaderServices *sv, const RayesShadeCtx *ctx, 
         rough[i] = exponent > 0.0f ? 1.0f / exponent : 0.0f;
     sv->indirect_specular(sv, ctx, (const float(*)[3])dir, exponent > 0.0f ? rough : NULL,
                           exponent > 0.0f ? 0 : 1, L);
+}
+
+/* Reflection of the physically based shaders: a mirror for exponent 0;
+ * else the glossy service's normalised Blinn-Phong lobe, whose lights come
+ * by multiple importance sampling (a renderer without it: reflection's
+ * lobe, which sees lights only through its rays). */
+static void glossy_reflection(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
+                              float exponent, Rgb *L)
+{
+    if (exponent > 0.0f && HAS_SERVICE(sv, glossy)) {
+        float rough[SHADE_CHUNK];
+        for (size_t i = 0; i < ctx->n_points; i++)
+            rough[i] = 1.0f / exponent;
+        sv->glossy(sv, ctx, rough, 0, L);
+        return;
+    }
+    reflection(sv, ctx, exponent, L);
 }
 
 /* pbrt-v4's roughness (remapped: alpha = sqrt(roughness)) as a Blinn-Phong
@@ -264,7 +289,7 @@ typedef struct GlassParams {
 static int branches(const RayesShaderServices *sv, const RayesShadeCtx *ctx)
 {
     float depth = 0.0f;
-    if (!sv->supports || !sv->supports(sv, "random") || !sv->option ||
+    if (!HAS_SERVICE(sv, random) || !HAS_SERVICE(sv, option) ||
         sv->option(sv, ctx, "branchdepth", &depth, 1) != 1)
         return 1;
     return (float)(ctx->diffuse_depth + ctx->specular_depth) < depth;
@@ -279,7 +304,8 @@ static float max3(const float v[3])
  * relative index eta (inside over outside). A ray that hit the back side
  * is leaving: the index is then inverted, and beyond the critical angle
  * all light reflects. reflect_e is the exponent of the reflection lobe
- * (0: mirror). Writes R[i] = F * reflected and T[i] = (1 - F) * refracted,
+ * (0: mirror; glossy: the glossy service's lobe, lights included, else
+ * reflection's). Writes R[i] = F * reflected and T[i] = (1 - F) * refracted,
  * which the caller weights by wR[i] and wT[i]. Past the branch depth each
  * point traces one of the two, chosen with probability in proportion to
  * F max(wR) and (1 - F) max(wT), and none with probability 1 - q, q that
@@ -287,7 +313,8 @@ static float max3(const float v[3])
  * the chosen one is divided by its probability, so the expectation is
  * unchanged. */
 static void fresnel_split(const RayesShaderServices *sv, const RayesShadeCtx *ctx, float eta,
-                          float reflect_e, const Rgb *wR, const Rgb *wT, Rgb *R, Rgb *T)
+                          float reflect_e, int glossy, const Rgb *wR, const Rgb *wT, Rgb *R,
+                          Rgb *T)
 {
     Rgb dir[SHADE_CHUNK], refr[SHADE_CHUNK];
     float F[SHADE_CHUNK];
@@ -317,7 +344,9 @@ static void fresnel_split(const RayesShaderServices *sv, const RayesShadeCtx *ct
             int reflect = u < q * a / (a + b);
             float p = q * (reflect ? a : b) / (a + b);
             Rgb L;
-            if (reflect)
+            if (reflect && glossy)
+                glossy_reflection(sv, &one, reflect_e, &L);
+            else if (reflect)
                 reflection(sv, &one, reflect_e, &L);
             else if (sv->indirect_refraction)
                 sv->indirect_refraction(sv, &one, (const float(*)[3])&dir[i], &L);
@@ -329,7 +358,10 @@ static void fresnel_split(const RayesShaderServices *sv, const RayesShadeCtx *ct
         }
         return;
     }
-    reflection(sv, ctx, reflect_e, R);
+    if (glossy)
+        glossy_reflection(sv, ctx, reflect_e, R);
+    else
+        reflection(sv, ctx, reflect_e, R);
     if (n_refr > 0 && sv->indirect_refraction)
         sv->indirect_refraction(sv, ctx, (const float(*)[3])dir, refr);
     else
@@ -354,7 +386,7 @@ static void glass_chunk(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
             wR[i][c] = p->specularcolor[c] * p->Kr;
             wT[i][c] = cs(ctx, i, c) * p->transmitcolor[c] * p->Kt;
         }
-    fresnel_split(sv, ctx, p->eta, p->roughness > 0.0f ? 1.0f / p->roughness : 0.0f,
+    fresnel_split(sv, ctx, p->eta, p->roughness > 0.0f ? 1.0f / p->roughness : 0.0f, 0,
                   (const Rgb *)wR, (const Rgb *)wT, R, T);
     memset(ds, 0, sizeof ds);
     if (p->Ks != 0.0f) {
@@ -410,7 +442,7 @@ static void dielectric_chunk(const RayesShaderServices *sv, const RayesShadeCtx 
     Rgb R[SHADE_CHUNK], T[SHADE_CHUNK], one[SHADE_CHUNK];
     for (size_t i = 0; i < ctx->n_points; i++)
         one[i][0] = one[i][1] = one[i][2] = 1.0f;
-    fresnel_split(sv, ctx, p->eta, exponent_of(p->roughness), (const Rgb *)one,
+    fresnel_split(sv, ctx, p->eta, exponent_of(p->roughness), 1, (const Rgb *)one,
                   (const Rgb *)one, R, T);
     for (size_t i = 0; i < ctx->n_points; i++)
         for (int c = 0; c < 3; c++)
@@ -519,7 +551,7 @@ static void conductor_chunk(const RayesShaderServices *sv, const RayesShadeCtx *
     Vec3 eta, k;
     conductor_index(p, &eta, &k);
     Rgb L[SHADE_CHUNK];
-    reflection(sv, ctx, exponent_of(p->roughness), L);
+    glossy_reflection(sv, ctx, exponent_of(p->roughness), L);
     for (size_t i = 0; i < ctx->n_points; i++) {
         Vec3 F = fresnel_conductor_rgb(cos_view(ctx, i), eta, k);
         for (int c = 0; c < 3; c++)
@@ -575,7 +607,7 @@ static void coated_chunk(const RayesShaderServices *sv, const RayesShadeCtx *ctx
     float favg = fresnel_dielectric_average(p->eta);
     float base = (1.0f - favg) * (1.0f - favg) * expf(-2.0f * fmaxf(p->thickness, 0.0f));
     if (ctx->I)
-        reflection(sv, ctx, exponent_of(p->roughness), L);
+        glossy_reflection(sv, ctx, exponent_of(p->roughness), L);
     for (size_t i = 0; i < ctx->n_points; i++) {
         float F = ctx->I ? fresnel_dielectric(cos_view(ctx, i), p->eta) : 0.0f;
         float view = ctx->I ? (1.0f - F) / (1.0f - favg) : 1.0f;
