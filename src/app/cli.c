@@ -64,6 +64,8 @@ static const char render_options[] =
     "  --data DIR              data directory (teapot.bpt); default $RAYES_DATA\n"
     "  --shader-path DIRS      directories of shader plugins NAME.so, ':'-separated;\n"
     "                          searched before $RAYES_SHADER_PATH\n"
+    "  --default-light         a headlight (a distant light along the view) when the\n"
+    "                          scene has no lights\n"
     "  --stats FILE.json       write statistics as JSON\n"
     "  --quiet                 no progress bar and no summary\n";
 
@@ -230,6 +232,10 @@ void parse_args(int argc, char **argv, Args *a)
             a->quiet = 1;
             continue;
         }
+        if (strcmp(o, "--default-light") == 0) {
+            a->default_light = 1;
+            continue;
+        }
         if (strcmp(o, "--help") == 0 || strcmp(o, "-h") == 0) {
             print_command_usage(a->view ? "view" : "render", stdout);
             exit(0);
@@ -389,4 +395,28 @@ void merge_settings(Args *a, const IoSettings *s)
     if (s->crop[0] != 0.0f || s->crop[1] != 1.0f || s->crop[2] != 0.0f || s->crop[3] != 1.0f)
         fprintf(stderr, "rayes: warning: %s: CropWindow is not supported; the whole image is "
                         "rendered\n", a->scene);
+}
+
+RayesError default_light(const Args *a, RayesScene *scene)
+{
+    if (rayes_scene_light_count(scene) > 0)
+        return RAYES_OK;
+    if (!a->default_light) {
+        fprintf(stderr, "rayes: warning: %s: the scene has no lights (--default-light adds a "
+                        "headlight)\n", a->scene);
+        return RAYES_OK;
+    }
+    float eye[3], x[3], y[3], z[3];
+    RayesError e = rayes_scene_get_camera(scene, eye, x, y, z);
+    if (e != RAYES_OK)
+        return e;
+    static const float identity[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
+    RayesParam p[2] = {{"from", RAYES_PARAM_COLOR, {0, 0, 0}, NULL},
+                       {"to", RAYES_PARAM_COLOR, {z[0], z[1], z[2]}, NULL}};
+    if ((e = rayes_scene_set_transform(scene, identity)) == RAYES_OK)
+        e = rayes_scene_light(scene, "distantlight", p, 2);
+    if (e == RAYES_OK && !a->quiet)
+        fprintf(stderr, "rayes: note: %s: the scene has no lights; a headlight was added\n",
+                a->scene);
+    return e;
 }

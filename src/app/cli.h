@@ -41,6 +41,7 @@ typedef struct Args {
     const char *data_dir;
     const char *shader_path;    /* --shader-path: put before the scene's own shader path */
     int quiet;
+    int default_light;          /* --default-light: a headlight for a scene without lights */
     RayesRenderOptions opt;
     /* rayes view */
     int view;                   /* set before parse_args: the view options are accepted */
@@ -72,6 +73,12 @@ int load_status(const char *scene, RayesError e);
 
 /* The file's settings where the command line gave none. */
 void merge_settings(Args *a, const IoSettings *s);
+
+/* A loaded scene without lights (before its commit): one warning, or with
+ * --default-light a headlight, a distant light of intensity 1 along the
+ * view. Returns what adding it returned (RAYES_OK when nothing was
+ * added). */
+RayesError default_light(const Args *a, RayesScene *scene);
 
 /* The usage text of every command, to f. */
 void print_usage(FILE *f);

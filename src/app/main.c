@@ -238,6 +238,8 @@ static int cmd_render(int argc, char **argv)
     IoSettings settings;
     IoSink sink = io_sink_scene(scene);
     RayesError e = load_scene(a.scene, a.data_dir, a.frame, &sink, &settings, err, sizeof err);
+    if (e == RAYES_OK && (e = default_light(&a, scene)) != RAYES_OK)
+        snprintf(err, sizeof err, "%s: %s", a.scene, rayes_scene_get_error(scene));
     if (e == RAYES_OK && rayes_scene_commit(scene) != RAYES_OK) {
         e = RAYES_ERROR_PARSE;
         snprintf(err, sizeof err, "%s: %s", a.scene, rayes_scene_get_error(scene));

@@ -792,6 +792,8 @@ int cmd_view(int argc, char **argv)
     IoSettings settings;
     IoSink sink = io_sink_scene(v.scene);
     RayesError e = load_scene(a.scene, a.data_dir, a.frame, &sink, &settings, err, sizeof err);
+    if (e == RAYES_OK && (e = default_light(&a, v.scene)) != RAYES_OK)
+        snprintf(err, sizeof err, "%s: %s", a.scene, rayes_scene_get_error(v.scene));
     if (e == RAYES_OK && rayes_scene_commit(v.scene) != RAYES_OK) {
         e = RAYES_ERROR_PARSE;
         snprintf(err, sizeof err, "%s: %s", a.scene, rayes_scene_get_error(v.scene));

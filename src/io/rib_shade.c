@@ -301,6 +301,12 @@ static int h_displacement(Rib *r, const Args *a)
     return 0;
 }
 
+/* Light shaders of other renderers that are an environment (dome) light,
+ * usually with occlusion: rayes' environmentlight stands in for them. */
+static const char *const environment_lights[] = {"envlight", "envlight2", "occlusionlight",
+                                                 "environmentlight", "domelight", "skylight",
+                                                 "ambientocclusion", NULL};
+
 static Light *find_light(Rib *r, const char *handle)
 {
     for (size_t k = 0; k < r->n_lights; k++)
@@ -341,9 +347,24 @@ static int h_light_source(Rib *r, const Args *a)
         type = "spotlight", spot = 1;
     else if (strcmp(name, "ambientlight") == 0)
         type = "ambientlight";
+    else if (in_list(environment_lights, name)) {
+        /* Production environment and occlusion lights: a constant
+         * environment light, whose shadow rays give the occlusion. */
+        type = "environmentlight";
+        char key[128];
+        snprintf(key, sizeof key, "light %s", name);
+        rib_warn_once(r, key,
+                      "light shader \"%s\" is not built in: an environmentlight of its intensity "
+                      "and lightcolor instead (ambient occlusion from its shadow rays; maps and "
+                      "other parameters are not read)",
+                      name);
+    }
     if (r->rec) {
         rib_warn_once(r, "light in object", "lights inside ObjectBegin are ignored");
         type = NULL;
+    } else if (!type && strcmp(name, "indirectlight") == 0) {
+        rib_warn_once(r, "light indirectlight", "light shader \"indirectlight\" is skipped: rayes "
+                                                "computes indirect light itself (--bounces)");
     } else if (!type) {
         char key[128];
         snprintf(key, sizeof key, "light %s", name);
@@ -378,8 +399,12 @@ static int h_light_source(Rib *r, const Args *a)
     set_light_on(&r->a, (size_t)(L - r->lights), 1);
     static const char *const names[] = {"intensity", "lightcolor", "from", "to", "coneangle",
                                         "conedeltaangle", "beamdistribution", "__category", NULL};
+    int env = strcmp(type, "environmentlight") == 0;
     for (size_t k = 0; k < n && L->n < RIB_LIGHT_PARAMS; k++) {
         const Param *q = &p[k];
+        if (env && strcmp(q->d.name, "intensity") != 0 && strcmp(q->d.name, "lightcolor") != 0 &&
+            strcmp(q->d.name, "__category") != 0)
+            continue; /* an environment light has no position, cone or map here */
         if (!in_list(names, q->d.name) || !q->declared)
             continue;
         RayesParam *o = &L->params[L->n];

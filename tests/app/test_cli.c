@@ -23,6 +23,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include "image/image.h"
 #include "test.h"
 
 #ifndef RAYES_BIN
@@ -422,7 +423,8 @@ static void test_rib_grid_size(void)
     setup();
     write_text(SCRATCH_DIR "/grid.rib", "Option \"limits\" \"gridsize\" [32]\n"
                                         "Projection \"perspective\" \"fov\" 40\n"
-                                        "WorldBegin\nTranslate 0 0 5\nSphere 1 -1 1 360\n"
+                                        "WorldBegin\nLightSource \"pointlight\" 1\n"
+                                        "Translate 0 0 5\nSphere 1 -1 1 360\n"
                                         "WorldEnd\n");
     run(&r, NULL, ARGS("render", SCRATCH_DIR "/grid.rib", "--res", "16", "--spp", "1", "--quiet",
                        "-o", SCRATCH_DIR "/grid.png", "--stats", SCRATCH_DIR "/grid.json"));
@@ -435,6 +437,44 @@ static void test_rib_grid_size(void)
     CHECK(r.status == 0);
     read_file(SCRATCH_DIR "/grid.json", json, sizeof json);
     CHECK(strstr(json, "\"grid_size\": 128,") != NULL);
+}
+
+/* A scene without lights: one warning naming the scene and the way out,
+ * and a black image; --default-light adds a headlight that lights it. */
+static void test_default_light(void)
+{
+    static Run r;
+    setup();
+    write_text(SCRATCH_DIR "/dark.rib", "Projection \"perspective\" \"fov\" 40\n"
+                                        "WorldBegin\nTranslate 0 0 5\nSphere 1 -1 1 360\n"
+                                        "WorldEnd\n");
+    float mean[2] = {-1, -1};
+    for (int lit = 0; lit < 2; lit++) {
+        const char *out = lit ? SCRATCH_DIR "/lit.exr" : SCRATCH_DIR "/dark.exr";
+        if (lit)
+            run(&r, NULL, ARGS("render", SCRATCH_DIR "/dark.rib", "--res", "16", "--spp", "1",
+                               "--quiet", "--default-light", "-o", out));
+        else
+            run(&r, NULL, ARGS("render", SCRATCH_DIR "/dark.rib", "--res", "16", "--spp", "1",
+                               "--quiet", "-o", out));
+        CHECK(r.status == 0);
+        if (lit)
+            CHECK(r.err[0] == '\0');
+        else
+            CHECK(count_char(r.err, '\n') == 1 &&
+                  strstr(r.err, "dark.rib: the scene has no lights") &&
+                  strstr(r.err, "--default-light"));
+        int w = 0, h = 0;
+        float *px = NULL;
+        char err[256];
+        CHECK(image_read_exr(out, &w, &h, &px, err, sizeof err) == RAYES_OK);
+        double sum = 0.0;
+        for (int i = 0; px && i < w * h; i++)
+            sum += px[4 * i];
+        mean[lit] = px ? (float)(sum / (w * h)) : -1.0f;
+        free(px);
+    }
+    CHECK(mean[0] == 0.0f && mean[1] > 0.02f);
 }
 
 static void test_convert(void)
@@ -499,5 +539,6 @@ static void test_bad_scene_file(void)
 TEST_MAIN(TEST(test_version_and_help), TEST(test_no_arguments), TEST(test_usage_errors),
           TEST(test_missing_data), TEST(test_render_outputs), TEST(test_render_summary),
           TEST(test_data_from_environment), TEST(test_unwritable_output), TEST(test_shader_path),
-          TEST(test_render_obj), TEST(test_rib_grid_size), TEST(test_convert),
+          TEST(test_render_obj), TEST(test_rib_grid_size), TEST(test_default_light),
+          TEST(test_convert),
           TEST(test_bad_scene_file))

@@ -373,6 +373,14 @@ static void test_shaders_and_lights(void)
                       "Polygon \"P\" [0 0 0 1 0 0 1 1 0 0 1 0]\nAttributeEnd\n"
                       "Polygon \"P\" [0 0 0 1 0 0 1 1 0 0 1 0]")) == RAYES_OK);
     CHECK(rec.area_lights == 1 && rec.quads == 1);
+    /* Production environment and occlusion lights: an environmentlight of
+     * their intensity (position, samples and maps dropped); indirectlight:
+     * skipped, rayes' own global illumination stands in */
+    CHECK(parse(WORLD("LightSource \"envlight\" 2 \"float intensity\" 0.8 \"from\" [0 1 0]\n"
+                      "LightSource \"indirectlight\" 3\nPolygon \"P\" [0 0 0 1 0 0 1 1 0]")) ==
+          RAYES_OK);
+    CHECK(rec.lights == 1 && strcmp(rec.light_types[0], "environmentlight") == 0);
+    CHECK_NEAR(rec.light_params[0][0], 0.8, 1e-6);
     CHECK(parse("Option \"searchpath\" \"shader\" [\"mine:&\"]\nWorldBegin\nWorldEnd\n") ==
           RAYES_OK);
     CHECK(strcmp(rec.search, "shader=mine:&") == 0);
