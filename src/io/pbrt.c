@@ -377,9 +377,9 @@ static int d_include(Parser *P, const Token *t)
     char *text = text_read_file(path, &n, err, sizeof err);
     if (!text)
         return FAIL_TOK(P, &w, "%s: %s", t->s[1] == 'm' ? "Import" : "Include", err);
-    char dir[PBRT_PATH];
-    dir_of(path, dir, sizeof dir);
-    int r = parse_buffer(P, path, dir, text, n);
+    /* pbrt-v4 resolves every relative path, in included files too, against
+     * the directory of the file it was given (its search directory). */
+    int r = parse_buffer(P, path, P->lx->dir, text, n);
     free(text);
     return r;
 }

@@ -7,6 +7,7 @@
  * ceiling light), and bad input with "file:line:col" errors.
  */
 #include <string.h>
+#include <sys/stat.h>
 
 #include "io/pbrt.h"
 #include "rayes/rayes.h"
@@ -644,6 +645,20 @@ static void test_instances_include_ply(void)
     e = parse(path, "WorldBegin\nInclude \"test_pbrt_bad.pbrt\"\n", r, &s, err, sizeof err);
     CHECK(e == RAYES_ERROR_PARSE && strstr(err, "test_pbrt_bad.pbrt:2:35: expected a float "
                                                 "value for \"radius\"") != NULL);
+    /* relative paths, inside included files too, are relative to the
+     * directory of the file given (pbrt-v4's search directory), not to the
+     * including file's */
+    char sub[512];
+    snprintf(sub, sizeof sub, "%s/test_pbrt_sub", RAYES_TEST_TMP);
+    mkdir(sub, 0777);
+    snprintf(path, sizeof path, "%s/test_pbrt_sub/a.pbrt", RAYES_TEST_TMP);
+    write_file(path, "Include \"test_pbrt_sub/b.pbrt\"\n"
+                     "Shape \"plymesh\" \"string filename\" \"test_pbrt_quad.ply\"\n");
+    snprintf(path, sizeof path, "%s/test_pbrt_sub/b.pbrt", RAYES_TEST_TMP);
+    write_file(path, "Shape \"plymesh\" \"string filename\" \"test_pbrt_quad.ply\"\n");
+    snprintf(path, sizeof path, "%s/test_pbrt_main.pbrt", RAYES_TEST_TMP);
+    e = parse(path, "WorldBegin\nInclude \"test_pbrt_sub/a.pbrt\"\n", r, &s, err, sizeof err);
+    CHECK(e == RAYES_OK && r->n_meshes == 2);
     /* a file including itself stops at the depth limit */
     snprintf(path, sizeof path, "%s/test_pbrt_self.pbrt", RAYES_TEST_TMP);
     write_file(path, "Include \"test_pbrt_self.pbrt\"\nInclude \"test_pbrt_self.pbrt\"\n");
