@@ -17,6 +17,7 @@
 #include <string.h>
 
 #include "io/pbrt_internal.h"
+#include "io/text.h"
 
 /* ------------------------------------------------------------ parameters */
 
@@ -296,6 +297,55 @@ static void sampled_rgb(const double *pairs, size_t n_pairs, float out[3])
     }
 }
 
+#define PBRT_MAX_SPD_PAIRS 65536
+
+/* A spectrum file (pbrt's .spd: wavelength, value pairs; '#' starts a
+ * comment) as RGB at 650, 550, 450 nm; 0, or -1 with the error set. */
+static int spd_rgb(Parser *P, const Param *p, const char *file, float out[3])
+{
+    Token at = {.line = p->line, .col = p->col};
+    char path[PBRT_PATH], err[600];
+    if (pbrt_resolve(P, &at, file, path, sizeof path) != 0)
+        return -1;
+    size_t size;
+    char *text = text_read_file(path, &size, err, sizeof err);
+    if (!text)
+        return pbrt_fail_at(P, p->line, p->col, "spectrum: %s", err);
+    double *v = malloc(2 * PBRT_MAX_SPD_PAIRS * sizeof *v);
+    size_t n = 0;
+    int bad = !v;
+    for (char *s = text; !bad && *s;) {
+        if (*s == '#') {
+            while (*s && *s != '\n')
+                s++;
+            continue;
+        }
+        if (strchr(" \t\r\n,", *s)) {
+            s++;
+            continue;
+        }
+        char *end;
+        double x = strtod(s, &end);
+        if (end == s || !isfinite(x) || n >= 2 * PBRT_MAX_SPD_PAIRS)
+            bad = 1;
+        else
+            v[n++] = x, s = end;
+    }
+    if (!bad && (n < 2 || n % 2 != 0))
+        bad = 1;
+    for (size_t i = 2; !bad && i < n; i += 2)
+        bad = !(v[i] > v[i - 2]); /* wavelengths increase */
+    if (!bad)
+        sampled_rgb(v, n / 2, out);
+    free(v);
+    free(text);
+    if (bad)
+        return pbrt_fail_at(P, p->line, p->col,
+                            "%s: expected (wavelength, value) pairs with increasing wavelengths "
+                            "(at most %d)", path, PBRT_MAX_SPD_PAIRS);
+    return 0;
+}
+
 static const Texture *find_texture(Parser *P, const char *name)
 {
     for (size_t i = P->n_textures; i-- > 0;)
@@ -333,11 +383,14 @@ int pbrt_get_color(Parser *P, ParamList *pl, const char *name, const float def[3
                     memcpy(out, named_spectra[i].rgb, sizeof named_spectra[i].rgb);
                     return 1;
                 }
+            const char *dot = strrchr(p->str[0], '.');
+            if (dot && strcmp(dot, ".spd") == 0)
+                return spd_rgb(P, p, p->str[0], out) == 0 ? 1 : -1;
             char key[96];
             snprintf(key, sizeof key, "spectrum %.60s", p->str[0]);
             pbrt_warn_at(P, p->line, p->col, key,
-                         "spectrum \"%s\" (a spectrum file or an unknown named spectrum) is not "
-                         "supported; using the default of \"%s\"", p->str[0], name);
+                         "spectrum \"%s\" (an unknown named spectrum) is not supported; using "
+                         "the default of \"%s\"", p->str[0], name);
             return 0;
         }
         if (p->n_num == 1) {

@@ -780,5 +780,44 @@ static void test_filters(void)
     free(r);
 }
 
-TEST_MAIN(TEST(test_filters), TEST(test_cornell_box), TEST(test_transforms), TEST(test_materials), TEST(test_lights),
+/* Spectrum files (.spd), relative to the scene's directory: RGB at 650,
+ * 550, 450 nm of the piecewise linear spectrum; a malformed one is an
+ * error naming the file. */
+static void test_spectrum_files(void)
+{
+    Rec *r = malloc(sizeof *r);
+    IoSettings s;
+    char err[512] = "", path[512];
+    snprintf(path, sizeof path, "%s/test_pbrt_refl.spd", RAYES_TEST_TMP);
+    write_file(path, "# reflectance\n400 0.1\n500 0.3\n600 0.5\n700 0.9 # red end\n");
+    snprintf(path, sizeof path, "%s/test_pbrt_main.pbrt", RAYES_TEST_TMP);
+    RayesError e = parse(path,
+                         "WorldBegin\nMaterial \"diffuse\" \"spectrum reflectance\" "
+                         "\"test_pbrt_refl.spd\"\nShape \"trianglemesh\" \"point3 P\" "
+                         "[0 0 0 1 0 0 0 1 0]\n",
+                         r, &s, err, sizeof err);
+    CHECK(e == RAYES_OK && r->n_meshes == 1);
+    const Shader *sh = r->n_meshes == 1 ? &r->mesh[0].shader : NULL;
+    const RayesParam *refl = sh ? param(sh, "reflectance") : NULL;
+    CHECK(refl != NULL);
+    if (refl) {
+        CHECK_NEAR(refl->value[0], 0.7, 1e-6); /* 650 nm */
+        CHECK_NEAR(refl->value[1], 0.4, 1e-6); /* 550 nm */
+        CHECK_NEAR(refl->value[2], 0.2, 1e-6); /* 450 nm */
+    }
+    snprintf(path, sizeof path, "%s/test_pbrt_bad.spd", RAYES_TEST_TMP);
+    write_file(path, "400 0.1\n500\n");
+    snprintf(path, sizeof path, "%s/test_pbrt_main.pbrt", RAYES_TEST_TMP);
+    e = parse(path,
+              "WorldBegin\nMaterial \"diffuse\" \"spectrum reflectance\" \"test_pbrt_bad.spd\"\n",
+              r, &s, err, sizeof err);
+    CHECK(e == RAYES_ERROR_PARSE && strstr(err, "test_pbrt_bad.spd: expected") != NULL);
+    e = parse(path, "WorldBegin\nMaterial \"diffuse\" \"spectrum reflectance\" \"none.spd\"\n",
+              r, &s, err, sizeof err);
+    CHECK(e == RAYES_ERROR_PARSE && strstr(err, "none.spd") != NULL);
+    free(r);
+}
+
+TEST_MAIN(TEST(test_filters), TEST(test_spectrum_files), TEST(test_cornell_box),
+          TEST(test_transforms), TEST(test_materials), TEST(test_lights),
           TEST(test_instances_include_ply), TEST(test_errors), TEST(test_normals_and_uv))
