@@ -126,7 +126,7 @@ int pbrt_emit_mesh(Parser *P, const Token *t, size_t n_faces, const int *n_verts
                    const int *idx, size_t n_points, const float *pts, const float *N,
                    const float *uv)
 {
-    if (n_faces == 0)
+    if (n_faces == 0 || strcmp(P->gs.material.shader, PBRT_INVISIBLE) == 0)
         return 0;
     if (P->recording) {
         Op *op = new_op(P, t, OP_MESH);
@@ -158,6 +158,8 @@ int pbrt_emit_mesh(Parser *P, const Token *t, size_t n_faces, const int *n_verts
 int pbrt_emit_quadric(Parser *P, const Token *t, RayesQuadric q, const float *qp, size_t n,
                       unsigned flags)
 {
+    if (strcmp(P->gs.material.shader, PBRT_INVISIBLE) == 0)
+        return 0;
     if (P->recording) {
         Op *op = new_op(P, t, OP_QUADRIC);
         if (!op)
@@ -186,6 +188,8 @@ static RayesError send_patch(Parser *P, const Op *op)
 
 int pbrt_emit_patch(Parser *P, const Token *t, const Op *patch)
 {
+    if (strcmp(P->gs.material.shader, PBRT_INVISIBLE) == 0)
+        return 0;
     if (P->recording) {
         Op *op = new_op(P, t, OP_PATCH);
         if (!op)

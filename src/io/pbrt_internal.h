@@ -34,6 +34,9 @@
 #define PBRT_PATH 1024
 #define PBRT_MAX_WARNED 512 /* kinds of warning said per read */
 #define MAT_MAX_PARAMS 8
+/* The shader name of pbrt's "interface" material: shapes with it are not
+ * emitted (they only bound media). */
+#define PBRT_INVISIBLE "(interface)"
 
 static const double PI = 3.14159265358979323846;
 

@@ -204,6 +204,15 @@ static int make_material(Parser *P, const Token *t, const char *type, ParamList 
     }
     if (strcmp(type, "mix") == 0)
         return mix_material(P, t, pl, m);
+    if (strcmp(type, "interface") == 0 || strcmp(type, "") == 0 || strcmp(type, "none") == 0) {
+        /* pbrt's "interface" (and "" or "none") marks a shape that only
+         * bounds a participating medium: it is not a surface at all. */
+        pbrt_warn_at(P, t->line, t->col, "interface",
+                     "material \"interface\": its shapes only bound media, which rayes does "
+                     "not render; they are left out");
+        pbrt_mat_init(m, PBRT_INVISIBLE);
+        return 0;
+    }
     if (strcmp(type, "diffusetransmission") == 0) {
         pbrt_warn_at(P, t->line, t->col, "diffusetransmission", "diffusetransmission: mapped to "
                      "diffuse (no transmission)");

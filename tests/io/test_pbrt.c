@@ -482,6 +482,8 @@ static void test_materials(void)
         "Material \"diffuse\" \"blackbody reflectance\" 6500\n"
         "Shape \"sphere\"\n"
         "Material \"conductor\" \"float roughness\" 0.1 \"bool remaproughness\" false\n"
+        "Shape \"sphere\"\n"
+        "Material \"interface\"\n" /* a medium's boundary: not a surface, left out */
         "Shape \"sphere\"\n";
     /* a small mesh after each Material (the stub records shaders with meshes) */
     char full[8192] = "";
