@@ -393,9 +393,16 @@ typedef enum RayesQuality {
     RAYES_QUALITY_REFERENCE = 2  /* 64 shadow and 4096 diffuse at depth 0, 1 and 1 deeper */
 } RayesQuality;
 
+/* Pixel filters, all separable (the product of one in x and one in y) and
+ * zero beyond half the width. Mitchell-Netravali, Catmull-Rom and Lanczos
+ * have negative lobes: EXR pixels may ring below zero at sharp edges. */
 typedef enum RayesFilter {
-    RAYES_FILTER_BOX = 0,       /* width 1 pixel by default */
-    RAYES_FILTER_GAUSSIAN = 1   /* width 2 pixels by default, alpha 2 */
+    RAYES_FILTER_BOX = 0,         /* width 1 pixel by default */
+    RAYES_FILTER_GAUSSIAN = 1,    /* width 2 pixels by default, alpha 2 */
+    RAYES_FILTER_TRIANGLE = 2,    /* a tent, 1 - |x| / r */
+    RAYES_FILTER_CATMULL_ROM = 3, /* the cubic B = 0, C = 1/2 over the width */
+    RAYES_FILTER_MITCHELL = 4,    /* Mitchell-Netravali, B = C = 1/3 */
+    RAYES_FILTER_LANCZOS = 5      /* sinc(x) sinc(x / 3), x in pixels (pbrt's sinc) */
 } RayesFilter;
 
 /* How camera rays are shaded at diffuse depth 0. */

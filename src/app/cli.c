@@ -43,8 +43,10 @@ static const char render_options[] =
     "  --branch-depth N        points shallower than N (diffuse + specular depth) trace\n"
     "                          reflection and refraction both and several glossy rays;\n"
     "                          deeper ones follow one lobe (default 1: camera hits)\n"
-    "  --filter box|gaussian   pixel filter (default box)\n"
-    "  --filter-width W        filter width in pixels (default 1 box, 2 gaussian)\n"
+    "  --filter F              pixel filter: box (default), gaussian, triangle,\n"
+    "                          catmull-rom, mitchell or lanczos\n"
+    "  --filter-width W        filter width in pixels (default 1 box, 2 gaussian and\n"
+    "                          triangle, 4 catmull-rom and mitchell, 6 lanczos)\n"
     "  --seed N                changes every random number (default 0)\n"
     "  --cache on|off          the radiosity cache at diffuse hits (default on; off for\n"
     "                          --quality reference)\n"
@@ -286,12 +288,11 @@ void parse_args(int argc, char **argv, Args *a)
             opt->branch_depth = (int)parse_long(o, v, 1, 129);
         } else if (strcmp(o, "--filter") == 0) {
             a->set |= SET_FILTER;
-            if (strcmp(v, "box") == 0)
-                opt->filter = RAYES_FILTER_BOX;
-            else if (strcmp(v, "gaussian") == 0)
-                opt->filter = RAYES_FILTER_GAUSSIAN;
-            else
-                die_usage("--filter: expected box or gaussian, got \"%s\"", v);
+            int k = io_filter_named(v, NULL);
+            if (k < 0)
+                die_usage("--filter: expected box, gaussian, triangle, catmull-rom, mitchell or "
+                          "lanczos, got \"%s\"", v);
+            opt->filter = (RayesFilter)k;
         } else if (strcmp(o, "--filter-width") == 0) {
             opt->filter_width = parse_float(o, v, 0.01f, 16.0f);
             a->set |= SET_FILTER_WIDTH;
@@ -341,8 +342,8 @@ void parse_args(int argc, char **argv, Args *a)
         else
             die_usage("unknown option \"%s\"", o);
     }
-    if (!(a->set & SET_FILTER_WIDTH) && a->opt.filter == RAYES_FILTER_GAUSSIAN)
-        a->opt.filter_width = 2.0f;
+    if (!(a->set & SET_FILTER_WIDTH))
+        io_filter_named(io_filter_name(a->opt.filter), &a->opt.filter_width);
     if (!a->scene)
         a->scene = "cornell";
     if (!a->data_dir)
@@ -379,10 +380,10 @@ void merge_settings(Args *a, const IoSettings *s)
     }
     if (!(a->set & SET_SPP) && s->spp > 0)
         o->spp = s->spp;
-    if (!(a->set & SET_FILTER) && (s->filter == RAYES_FILTER_BOX || s->filter == RAYES_FILTER_GAUSSIAN)) {
+    if (!(a->set & SET_FILTER) && s->filter >= RAYES_FILTER_BOX && s->filter <= RAYES_FILTER_LANCZOS) {
         o->filter = (RayesFilter)s->filter;
         if (!(a->set & SET_FILTER_WIDTH))
-            o->filter_width = o->filter == RAYES_FILTER_GAUSSIAN ? 2.0f : 1.0f;
+            io_filter_named(io_filter_name(o->filter), &o->filter_width);
     }
     if (!(a->set & SET_FILTER_WIDTH) && s->filter_width > 0.0f)
         o->filter_width = s->filter_width;

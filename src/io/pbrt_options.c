@@ -178,9 +178,7 @@ int pbrt_d_filter(Parser *P, const Token *t)
         pbrt_params_free(&pl);
         return -1;
     }
-    /* pbrt-v4's default radii. rayes filters with a box or a Gaussian:
-     * pbrt's triangle, Mitchell and Lanczos (windowed sinc) become the
-     * Gaussian over the same support, with one warning. */
+    /* pbrt-v4's filters and default radii; rayes' width is the diameter. */
     static const struct {
         const char *name;
         double radius;
@@ -190,19 +188,18 @@ int pbrt_d_filter(Parser *P, const Token *t)
     while (k < n && strcmp(type, filters[k].name) != 0)
         k++;
     if (k < n) {
-        int box = k == 0;
         double rx = pbrt_get_float(&pl, "xradius", filters[k].radius);
         double ry = pbrt_get_float(&pl, "yradius", rx);
         pbrt_find(&pl, "sigma");
-        pbrt_find(&pl, "B");
-        pbrt_find(&pl, "C");
-        pbrt_find(&pl, "tau");
-        P->settings->filter = box ? RAYES_FILTER_BOX : RAYES_FILTER_GAUSSIAN;
-        P->settings->filter_width = (float)fmax(0.01, rx + ry);
-        if (k >= 2)
-            pbrt_warn_at(P, t->line, t->col, "filter",
-                         "PixelFilter \"%s\": filtered with the Gaussian of the same radius",
+        double B = pbrt_get_float(&pl, "B", 1.0 / 3), C = pbrt_get_float(&pl, "C", 1.0 / 3);
+        double tau = pbrt_get_float(&pl, "tau", 3);
+        if (fabs(B - 1.0 / 3) > 1e-3 || fabs(C - 1.0 / 3) > 1e-3 || fabs(tau - 3) > 1e-3)
+            pbrt_warn_at(P, t->line, t->col, "filter parameters",
+                         "PixelFilter \"%s\": rayes' Mitchell has B = C = 1/3 and its sinc "
+                         "tau = 3; other values are not used",
                          filters[k].name);
+        P->settings->filter = io_filter_named(filters[k].name, NULL);
+        P->settings->filter_width = (float)fmax(0.01, rx + ry);
         pbrt_warn_unused(P, &pl, "PixelFilter", type);
     } else {
         pbrt_warn_at(P, t->line, t->col, "filter",

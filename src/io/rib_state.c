@@ -335,14 +335,13 @@ static int h_pixel_filter(Rib *r, const Args *a)
         return -1;
     if (!(w[0] > 0 && w[0] <= 64))
         return rib_error(r, "the filter width must be in (0, 64] pixels");
-    if (strcmp(name, "box") == 0) {
-        r->settings->filter = RAYES_FILTER_BOX;
-    } else {
-        if (strcmp(name, "gaussian") != 0)
-            rib_warn_once(r, name, "pixel filter \"%s\" is not built in; the gaussian (nearest "
-                               "smooth filter) is used with the same width", name);
-        r->settings->filter = RAYES_FILTER_GAUSSIAN;
+    int k = io_filter_named(name, NULL);
+    if (k < 0) {
+        rib_warn_once(r, name, "pixel filter \"%s\" is not built in; the gaussian (nearest "
+                           "smooth filter) is used with the same width", name);
+        k = RAYES_FILTER_GAUSSIAN;
     }
+    r->settings->filter = k;
     r->settings->filter_width = w[0];
     return 0;
 }

@@ -812,11 +812,11 @@ static void settings_rib(FILE *f, const IoSettings *s)
         else
             fprintf(f, "PixelSamples %d 1\n", s->spp);
     }
-    if (s->filter == RAYES_FILTER_BOX || s->filter == RAYES_FILTER_GAUSSIAN) {
-        double fw = s->filter_width > 0.0f ? s->filter_width
-                                           : s->filter == RAYES_FILTER_BOX ? 1.0 : 2.0;
-        fprintf(f, "PixelFilter \"%s\" %.9g %.9g\n",
-                s->filter == RAYES_FILTER_BOX ? "box" : "gaussian", fw, fw);
+    if (s->filter >= RAYES_FILTER_BOX && s->filter <= RAYES_FILTER_LANCZOS) {
+        float def = 1.0f;
+        io_filter_named(io_filter_name(s->filter), &def);
+        double fw = s->filter_width > 0.0f ? s->filter_width : def;
+        fprintf(f, "PixelFilter \"%s\" %.9g %.9g\n", io_filter_name(s->filter), fw, fw);
     }
     if (s->grid_size > 0)
         fprintf(f, "Option \"limits\" \"int gridsize\" [%d]\n", s->grid_size);

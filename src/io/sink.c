@@ -145,3 +145,33 @@ void io_settings_init(IoSettings *s)
     s->crop[1] = s->crop[3] = 1.0f;
     s->exposure_gain = s->exposure_gamma = 1.0f;
 }
+
+static const struct {
+    const char *name;
+    int filter;
+    float width;
+} filters[] = {
+    {"box", RAYES_FILTER_BOX, 1},           {"gaussian", RAYES_FILTER_GAUSSIAN, 2},
+    {"triangle", RAYES_FILTER_TRIANGLE, 2}, {"catmull-rom", RAYES_FILTER_CATMULL_ROM, 4},
+    {"mitchell", RAYES_FILTER_MITCHELL, 4}, {"lanczos", RAYES_FILTER_LANCZOS, 6},
+    {"sinc", RAYES_FILTER_LANCZOS, 6},
+};
+
+int io_filter_named(const char *name, float *width)
+{
+    for (size_t i = 0; i < sizeof filters / sizeof filters[0]; i++)
+        if (strcmp(filters[i].name, name) == 0) {
+            if (width)
+                *width = filters[i].width;
+            return filters[i].filter;
+        }
+    return -1;
+}
+
+const char *io_filter_name(int filter)
+{
+    for (size_t i = 0; i < sizeof filters / sizeof filters[0]; i++)
+        if (filters[i].filter == filter)
+            return filters[i].name;
+    return "box";
+}

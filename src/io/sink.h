@@ -97,6 +97,14 @@ typedef struct IoSettings {
 
 void io_settings_init(IoSettings *settings);
 
+/* Pixel filters by RenderMan's and pbrt's names: "box", "gaussian",
+ * "triangle", "catmull-rom", "mitchell", "sinc" and "lanczos" (both the
+ * Lanczos windowed sinc). Returns the RayesFilter, its default width in
+ * pixels in *width (if not NULL), or -1 for another name. */
+int io_filter_named(const char *name, float *width);
+/* The RenderMan name of a RayesFilter ("box" for an unknown one). */
+const char *io_filter_name(int filter);
+
 /* What the caller tells a reader. */
 typedef struct IoReadOptions {
     const char *data_dir;     /* where teapot.bpt lives (RIB's Geometry "teapot"); may be NULL */

@@ -51,16 +51,50 @@ typedef struct Frame {
     pthread_mutex_t progress_lock;
 } Frame;
 
+/* The Mitchell-Netravali cubic of parameters B and C at |x| in [0, 2]. */
+static float mitchell(float x, float B, float C)
+{
+    x = fabsf(x);
+    if (x < 1.0f)
+        return ((12 - 9 * B - 6 * C) * x * x * x + (-18 + 12 * B + 6 * C) * x * x + (6 - 2 * B)) /
+               6;
+    if (x < 2.0f)
+        return ((-B - 6 * C) * x * x * x + (6 * B + 30 * C) * x * x + (-12 * B - 48 * C) * x +
+                (8 * B + 24 * C)) /
+               6;
+    return 0.0f;
+}
+
+static float sinc(float x)
+{
+    x *= (float)M_PI;
+    return fabsf(x) < 1e-5f ? 1.0f : sinf(x) / x;
+}
+
+/* The filter in one dimension at offset x, |x| at most r. */
+static float filter_1d(int filter, float x, float r)
+{
+    switch (filter) {
+    case RAYES_FILTER_GAUSSIAN: {
+        const float alpha = 2.0f;
+        return fmaxf(0.0f, expf(-alpha * x * x) - expf(-alpha * r * r));
+    }
+    case RAYES_FILTER_TRIANGLE: return fmaxf(0.0f, 1.0f - fabsf(x) / r);
+    case RAYES_FILTER_CATMULL_ROM: return mitchell(2.0f * x / r, 0.0f, 0.5f);
+    case RAYES_FILTER_MITCHELL: return mitchell(2.0f * x / r, 1.0f / 3.0f, 1.0f / 3.0f);
+    case RAYES_FILTER_LANCZOS: return sinc(x) * sinc(x / 3.0f); /* x in pixels, as pbrt's */
+    default: return 1.0f;
+    }
+}
+
 static float filter_weight(const Frame *f, float dx, float dy)
 {
     float r = f->radius;
     if (fabsf(dx) > r || fabsf(dy) > r)
         return 0.0f;
-    if (f->set->filter == 0)
+    if (f->set->filter == RAYES_FILTER_BOX)
         return 1.0f;
-    const float alpha = 2.0f;
-    float edge = expf(-alpha * r * r);
-    return fmaxf(0.0f, expf(-alpha * dx * dx) - edge) * fmaxf(0.0f, expf(-alpha * dy * dy) - edge);
+    return filter_1d(f->set->filter, dx, r) * filter_1d(f->set->filter, dy, r);
 }
 
 Ray render_camera_ray(const RenderScene *rs, int width, int height, float x, float y)
@@ -99,8 +133,8 @@ static void render_pixel(Frame *f, Worker *w, int px, int py, int x0, int y0, in
             for (int qx = RY_MAX(px - f->margin, x0); qx <= RY_MIN(px + f->margin, x0 + tw - 1);
                  qx++) {
                 float wgt = filter_weight(f, x - ((float)qx + 0.5f), y - ((float)qy + 0.5f));
-                if (wgt <= 0.0f)
-                    continue;
+                if (wgt == 0.0f)
+                    continue; /* negative lobes count */
                 float *a = acc[(qy - y0) * tw + (qx - x0)];
                 a[0] += wgt * L.x;
                 a[1] += wgt * L.y;
@@ -150,6 +184,7 @@ static void render_tile(void *ctx, size_t task, int worker)
             float inv = a[4] > 0.0f ? 1.0f / a[4] : 0.0f;
             for (int c = 0; c < 4; c++)
                 out[c] = a[c] * inv;
+            out[3] = fminf(fmaxf(out[3], 0.0f), 1.0f); /* coverage, rung by negative lobes */
         }
     if (set->accum)
         for (int y = 0; y < th; y++)

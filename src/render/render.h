@@ -4,7 +4,7 @@
  * thread pool; lighting() at camera and specular hits; at diffuse hits the
  * radiosity cache, or with it off diffuselighting() at the hit (the memo's
  * "without caching" baseline);
- * services for shaders; film with box or Gaussian filtering.
+ * services for shaders; film with separable pixel filters.
  *
  * Inputs are immutable during a frame and shared by all workers; each
  * worker has its own statistics, merged at the end in worker order (sums of
@@ -74,7 +74,7 @@ typedef struct RenderSettings {
                                      (RayesRenderOptions.branch_depth) */
     int shadow_rays, shadow_rays_deep;
     int diffuse_rays, diffuse_rays_deep;
-    int filter;                   /* 0 box, 1 Gaussian */
+    int filter;                   /* RayesFilter */
     float filter_width;           /* pixels */
     uint64_t seed;
     int (*progress)(void *user, double fraction); /* nonzero: cancel */

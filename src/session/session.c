@@ -108,7 +108,7 @@ RayesError session_check_options(RayesScene *scene, const RayesRenderOptions *o)
              o->diffuse_rays_deep < 0 || o->shadow_rays > 1 << 20 || o->diffuse_rays > 1 << 20)
         what = "options: ray counts must be 0 to 1048576";
     else if (!(o->filter_width > 0.0f) || o->filter_width > 16.0f ||
-             (o->filter != RAYES_FILTER_BOX && o->filter != RAYES_FILTER_GAUSSIAN))
+             (int)o->filter < RAYES_FILTER_BOX || o->filter > RAYES_FILTER_LANCZOS)
         what = "options: filter width must be in (0, 16]";
     else if (o->hider != RAYES_HIDER_RAYTRACE && o->hider != RAYES_HIDER_GRID)
         what = "options: hider must be RAYES_HIDER_RAYTRACE or RAYES_HIDER_GRID";
@@ -141,7 +141,7 @@ RenderSettings session_settings(const RayesRenderOptions *o)
         .tile_size = o->tile_size, .bounces = o->bounces, .specular_depth = o->specular_depth,
         .shadow_rays = o->shadow_rays, .shadow_rays_deep = o->shadow_rays_deep,
         .diffuse_rays = o->diffuse_rays, .diffuse_rays_deep = o->diffuse_rays_deep,
-        .filter = o->filter == RAYES_FILTER_GAUSSIAN, .filter_width = o->filter_width,
+        .filter = (int)o->filter, .filter_width = o->filter_width,
         .seed = o->seed, .progress = o->progress, .progress_user = o->progress_user,
         .cache_resolution = o->cache_resolution, .cache_k = o->cache_k, .grid_size = o->grid_size,
         .branch_depth = o->branch_depth,

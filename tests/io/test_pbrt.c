@@ -754,21 +754,22 @@ static void test_normals_and_uv(void)
     free(r);
 }
 
-/* Filters: box and gaussian as given (pbrt's default radii otherwise);
- * triangle, Mitchell and Lanczos as the Gaussian of the same radius. */
+/* Filters: each of pbrt's, with its radius or pbrt's default radius
+ * (rayes' width is the diameter). */
 static void test_filters(void)
 {
     static const struct {
         const char *text;
-        int gaussian;
+        int filter;
         float width;
     } cases[] = {
-        {"PixelFilter \"box\"\n", 0, 1.0f},
-        {"PixelFilter \"gaussian\"\n", 1, 3.0f},
-        {"PixelFilter \"triangle\" \"float xradius\" 1\n", 1, 2.0f},
-        {"PixelFilter \"triangle\"\n", 1, 4.0f},
-        {"PixelFilter \"mitchell\" \"float B\" 0.3 \"float C\" 0.3\n", 1, 4.0f},
-        {"PixelFilter \"lanczos\" \"float tau\" 3\n", 1, 8.0f},
+        {"PixelFilter \"box\"\n", RAYES_FILTER_BOX, 1.0f},
+        {"PixelFilter \"gaussian\"\n", RAYES_FILTER_GAUSSIAN, 3.0f},
+        {"PixelFilter \"triangle\" \"float xradius\" 1\n", RAYES_FILTER_TRIANGLE, 2.0f},
+        {"PixelFilter \"triangle\"\n", RAYES_FILTER_TRIANGLE, 4.0f},
+        {"PixelFilter \"mitchell\" \"float B\" 0.3 \"float C\" 0.3\n", RAYES_FILTER_MITCHELL,
+         4.0f},
+        {"PixelFilter \"sinc\" \"float tau\" 3\n", RAYES_FILTER_LANCZOS, 8.0f},
     };
     Rec *r = malloc(sizeof *r);
     for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
@@ -776,7 +777,7 @@ static void test_filters(void)
         snprintf(text, sizeof text, "%sWorldBegin\n", cases[k].text);
         IoSettings s;
         CHECK(parse("t.pbrt", text, r, &s, err, sizeof err) == RAYES_OK);
-        CHECK(s.filter == (cases[k].gaussian ? RAYES_FILTER_GAUSSIAN : RAYES_FILTER_BOX));
+        CHECK(s.filter == cases[k].filter);
         CHECK_NEAR(s.filter_width, cases[k].width, 1e-6);
     }
     free(r);

@@ -322,7 +322,11 @@ static void test_settings(void)
     CHECK(strcmp(settings.displays[1].name, "b.png") == 0);
     CHECK(strcmp(settings.displays[0].type, "openexr") == 0);
     CHECK(parse("PixelFilter \"sinc\" 3 3\nWorldBegin\nWorldEnd\n") == RAYES_OK);
-    CHECK(settings.filter == RAYES_FILTER_GAUSSIAN);
+    CHECK(settings.filter == RAYES_FILTER_LANCZOS);
+    CHECK(parse("PixelFilter \"catmull-rom\" 4 4\nWorldBegin\nWorldEnd\n") == RAYES_OK);
+    CHECK(settings.filter == RAYES_FILTER_CATMULL_ROM && settings.filter_width == 4.0f);
+    CHECK(parse("PixelFilter \"blackman-harris\" 3 3\nWorldBegin\nWorldEnd\n") == RAYES_OK);
+    CHECK(settings.filter == RAYES_FILTER_GAUSSIAN); /* unknown: the nearest smooth filter */
     CHECK(settings.grid_size == 0);
     CHECK(parse("Option \"limits\" \"gridsize\" [64] \"bucketsize\" [16 16]\nWorldBegin\n"
                 "WorldEnd\n") == RAYES_OK);

@@ -1,8 +1,10 @@
 /*
  * Determinism (DESIGN.md): the same scene gives the same bytes whatever the
- * number of threads and the tile size, for both filters; a different seed
- * gives a different image.
+ * number of threads and the tile size, for every filter; a different seed
+ * gives a different image; and every filter, negative lobes included,
+ * keeps a constant image constant.
  */
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -31,7 +33,7 @@ static RayesImage *render(const char *scene_name, int threads, int tile, RayesFi
     o.threads = threads;
     o.tile_size = tile;
     o.filter = filter;
-    o.filter_width = filter == RAYES_FILTER_GAUSSIAN ? 2.0f : 1.0f;
+    io_filter_named(io_filter_name(filter), &o.filter_width); /* its default width */
     o.seed = seed;
     o.bounces = bounces;
     RayesImage *img = NULL;
@@ -68,6 +70,47 @@ static void test_gaussian_filter_any_thread_count(void)
     check_threads("cornell", RAYES_FILTER_GAUSSIAN, 1);
 }
 
+static void test_every_filter_any_thread_count(void)
+{
+    for (int f = RAYES_FILTER_TRIANGLE; f <= RAYES_FILTER_LANCZOS; f++)
+        check_threads("cornell", (RayesFilter)f, 0);
+}
+
+/* Inside a closed sphere emitting 1 (matte, Kd 0, Ke 1) every sample is 1:
+ * the filtered image must be 1 everywhere, whatever the filter's lobes. */
+static void test_filters_keep_a_constant_image(void)
+{
+    for (int f = RAYES_FILTER_BOX; f <= RAYES_FILTER_LANCZOS; f++) {
+        RayesScene *s = rayes_scene_new();
+        float eye[3] = {0, 0, 0}, target[3] = {0, 0, 1}, up[3] = {0, 1, 0};
+        rayes_scene_set_camera(s, eye, target, up, 60.0f);
+        RayesParam p[2] = {{"Kd", RAYES_PARAM_FLOAT, {0, 0, 0}, NULL},
+                           {"Ke", RAYES_PARAM_COLOR, {1, 1, 1}, NULL}};
+        CHECK(rayes_scene_set_shader(s, "matte", p, 2) == RAYES_OK);
+        CHECK(rayes_scene_sphere(s, 10.0f) == RAYES_OK);
+        CHECK(rayes_scene_commit(s) == RAYES_OK);
+        RayesRenderOptions o;
+        rayes_render_options_init(&o, RAYES_QUALITY_PREVIEW);
+        o.width = 24;
+        o.height = 20;
+        o.spp = 3;
+        o.threads = 2;
+        o.bounces = 0;
+        o.filter = (RayesFilter)f;
+        io_filter_named(io_filter_name(f), &o.filter_width);
+        RayesImage *img = NULL;
+        CHECK(rayes_render(s, &o, &img, NULL) == RAYES_OK);
+        float worst = 0.0f;
+        for (int i = 0; img && i < img->width * img->height; i++) {
+            worst = fmaxf(worst, fabsf(img->rgba[4 * i] - 1.0f));
+            worst = fmaxf(worst, fabsf(img->rgba[4 * i + 3] - 1.0f));
+        }
+        CHECK(img && worst < 1e-5f);
+        rayes_image_free(img);
+        rayes_scene_release(s);
+    }
+}
+
 static void test_teapots_any_thread_count(void)
 {
     check_threads("cornell-teapots", RAYES_FILTER_BOX, 1);
@@ -100,6 +143,47 @@ static void test_spheres_any_thread_count(void)
     check_threads("cornell-spheres", RAYES_FILTER_BOX, 1);
 }
 
+/* A bright edge (an emitting square filling the left half of the view,
+ * nothing on the right): the negative lobes of Catmull-Rom overshoot on
+ * the bright side (values above 1, as a film with such a filter shows),
+ * where the triangle filter, all positive, stays within [0, 1]. */
+static float edge_max(RayesFilter f)
+{
+    RayesScene *s = rayes_scene_new();
+    float eye[3] = {0, 0, -3}, target[3] = {0, 0, 0}, up[3] = {0, 1, 0};
+    rayes_scene_set_camera(s, eye, target, up, 40.0f);
+    RayesParam p[2] = {{"Kd", RAYES_PARAM_FLOAT, {0, 0, 0}, NULL},
+                       {"Ke", RAYES_PARAM_COLOR, {1, 1, 1}, NULL}};
+    CHECK(rayes_scene_set_shader(s, "matte", p, 2) == RAYES_OK);
+    float quad[4][3] = {{-5, -5, 0}, {0.013f, -5, 0}, {-5, 5, 0}, {0.013f, 5, 0}};
+    CHECK(rayes_scene_bilinear_patch(s, quad) == RAYES_OK);
+    CHECK(rayes_scene_commit(s) == RAYES_OK);
+    RayesRenderOptions o;
+    rayes_render_options_init(&o, RAYES_QUALITY_PREVIEW);
+    o.width = o.height = 16;
+    o.spp = 16;
+    o.threads = 2;
+    o.bounces = 0;
+    o.filter = f;
+    io_filter_named(io_filter_name(f), &o.filter_width);
+    RayesImage *img = NULL;
+    CHECK(rayes_render(s, &o, &img, NULL) == RAYES_OK);
+    float top = 0.0f;
+    for (int i = 0; img && i < img->width * img->height; i++)
+        top = fmaxf(top, img->rgba[4 * i]);
+    rayes_image_free(img);
+    rayes_scene_release(s);
+    return top;
+}
+
+static void test_negative_lobes_ring(void)
+{
+    CHECK(edge_max(RAYES_FILTER_TRIANGLE) <= 1.0f);
+    CHECK(edge_max(RAYES_FILTER_CATMULL_ROM) > 1.01f);
+}
+
 TEST_MAIN(TEST(test_box_filter_any_thread_count), TEST(test_gaussian_filter_any_thread_count),
+          TEST(test_every_filter_any_thread_count), TEST(test_filters_keep_a_constant_image),
+          TEST(test_negative_lobes_ring),
           TEST(test_teapots_any_thread_count), TEST(test_displaced_teapots),
           TEST(test_seed_changes_image), TEST(test_spheres_any_thread_count))
