@@ -465,6 +465,12 @@ typedef struct RayesRenderOptions {
                                   depth of at least this traces one diffuse ray (cache fills
                                   keep diffuse_rays_deep). Default 1: camera hits only; 1 to
                                   129 */
+    float dice_offscreen;      /* micropolygons of patches off screen are this much longer
+                                  (from 1 at the frame's edge to this half a frame beyond it;
+                                  Cycles' "offscreen dicing scale"): 1 to 1000, default 4 */
+    double vertex_budget;      /* grid vertices of the whole scene, at most: a scene needing
+                                  more is diced coarser, with one warning. Default 2e7 (about
+                                  1.2 to 4.4 GB of grids and ray tracing data); 0: none */
 } RayesRenderOptions;
 
 /* Fills options with the defaults of a quality preset: 512 x 512, 4 pixel

@@ -57,6 +57,10 @@ static const char render_options[] =
     "                          most K times the ray footprint (default 1)\n"
     "  --gridsize N            micropolygons per grid, at most (default 256, or the\n"
     "                          scene file's; 1 to 4096): the size of a cache entry\n"
+    "  --dice-offscreen F      micropolygons off screen up to F times longer (default 4;\n"
+    "                          1 to 1000; 1 dices them as if on screen)\n"
+    "  --vertex-budget M       grid vertices of the scene, at most, in millions (default\n"
+    "                          20; 0: none): a scene needing more is diced coarser\n"
     "  --hider raytrace|grid   shade every camera hit (default), or once per vertex of\n"
     "                          each visible grid and interpolate (PRMan's REYES mode;\n"
     "                          default for --quality final)\n"
@@ -313,7 +317,11 @@ void parse_args(int argc, char **argv, Args *a)
         else if (strcmp(o, "--gridsize") == 0) {
             opt->grid_size = (int)parse_long(o, v, 1, 4096);
             a->set |= SET_GRID_SIZE;
-        } else if (strcmp(o, "--hider") == 0) {
+        } else if (strcmp(o, "--dice-offscreen") == 0)
+            opt->dice_offscreen = parse_float(o, v, 1.0f, 1000.0f);
+        else if (strcmp(o, "--vertex-budget") == 0)
+            opt->vertex_budget = 1e6 * parse_float(o, v, 0.0f, 1e6f);
+        else if (strcmp(o, "--hider") == 0) {
             if (strcmp(v, "raytrace") != 0 && strcmp(v, "grid") != 0)
                 die_usage("--hider: expected raytrace or grid, got \"%s\"", v);
             opt->hider = strcmp(v, "grid") == 0 ? RAYES_HIDER_GRID : RAYES_HIDER_RAYTRACE;

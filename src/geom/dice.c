@@ -36,6 +36,7 @@ typedef struct Domain {
 
 typedef struct Estimate {
     int n_u, n_v;  /* micropolygons needed along u and v (triangle: n_u per edge) */
+    int thin_edge; /* triangle: the edge to bisect when split (thin_edge), or -1 */
 } Estimate;
 
 void geom_gridset_init(GridSet *gs)
@@ -81,44 +82,170 @@ static Vec3 domain_point(const Prim *prim, const Domain *d, float a, float b)
     return P;
 }
 
-static Estimate estimate(const Prim *prim, const Domain *d, const DiceCamera *cam)
+/* Where a domain's lattice lies, for choosing how it is measured. */
+typedef enum ViewPlace {
+    VIEW_NONE,     /* no view: by distance */
+    VIEW_ON,       /* may be on screen, in front of the eye: by raster size */
+    VIEW_CROSSING, /* crosses the eye plane: by distance, no off-screen factor */
+    VIEW_OFF       /* off screen: by distance, with the off-screen factor */
+} ViewPlace;
+
+/* Classifies the n lattice points p against the view; writes their screen
+ * positions (VIEW_ON) into s, and how far outside the frustum the lattice
+ * is (VIEW_OFF), as a fraction of the ramp over which the off-screen
+ * factor grows (half the frame), into outside.
+ *
+ * A lattice is off screen when all its points lie beyond one side plane
+ * of the frustum (the test is conservative: a lattice beside a corner may
+ * count as on screen). Perspective side planes pass through the eye, so
+ * points behind the eye are classified too, and how far beyond a plane a
+ * point lies is an angle (its sine: the distance to the plane over the
+ * distance from the eye); orthographic planes are parallel, and the
+ * distance is in screen units. Points behind the eye plane (orthographic)
+ * are off screen however far to the side. */
+static ViewPlace view_place(const DiceCamera *cam, const Vec3 *p, int n, float (*s)[2],
+                            float *outside)
 {
-    Vec3 p[LATTICE][LATTICE];
-    Bounds3 box = bounds_empty();
-    const float step = 1.0f / (LATTICE - 1);
-    for (int j = 0; j < LATTICE; j++)
-        for (int i = 0; i < LATTICE; i++) {
-            if (d->triangular && i + j > LATTICE - 1)
-                continue;
-            p[j][i] = domain_point(prim, d, (float)i * step, (float)j * step);
-            box = bounds_add(box, p[j][i]);
+    if (!cam->has_view)
+        return VIEW_NONE;
+    const float t = cam->tan_half_fov;
+    float lo[2] = {fminf(cam->screen[0], cam->screen[1]), fminf(cam->screen[2], cam->screen[3])};
+    float hi[2] = {fmaxf(cam->screen[0], cam->screen[1]), fmaxf(cam->screen[2], cam->screen[3])};
+    float half = 0.5f * (hi[1] - lo[1]); /* the ramp, in screen units */
+    /* beyond[side]: the smallest excess over the points, sides left,
+     * right, bottom, top. */
+    float beyond[4] = {INFINITY, INFINITY, INFINITY, INFINITY};
+    int near = 0, behind = 0;
+    for (int k = 0; k < n; k++) {
+        Vec3 c = mat4_point(&cam->camera_from_world, p[k]);
+        float xy[2] = {c.x, c.y};
+        for (int axis = 0; axis < 2; axis++) {
+            float below, above;
+            if (t > 0.0f) {
+                /* Signed distances to the planes x = lo t z and x = hi t z
+                 * (outward positive), over the distance from the eye. */
+                float r = fmaxf(v3_length(c), 1e-30f);
+                below = (lo[axis] * t * c.z - xy[axis]) /
+                        (r * sqrtf(1.0f + lo[axis] * lo[axis] * t * t));
+                above = (xy[axis] - hi[axis] * t * c.z) /
+                        (r * sqrtf(1.0f + hi[axis] * hi[axis] * t * t));
+            } else {
+                below = lo[axis] - xy[axis];
+                above = xy[axis] - hi[axis];
+            }
+            beyond[2 * axis] = fminf(beyond[2 * axis], below);
+            beyond[2 * axis + 1] = fminf(beyond[2 * axis + 1], above);
         }
-    /* Lengths of the lattice lines along u (rows) and v (columns); for
-     * triangles also along the third edge, c1 -> c2 (the diagonals). */
+        near += t > 0.0f && c.z <= cam->min_distance;
+        behind += c.z < 0.0f;
+        if (c.z > cam->min_distance || t == 0.0f) {
+            float d = t > 0.0f ? c.z * t : 1.0f;
+            s[k][0] = c.x / d, s[k][1] = c.y / d;
+        }
+    }
+    float out = fmaxf(fmaxf(beyond[0], beyond[1]), fmaxf(beyond[2], beyond[3]));
+    if (t > 0.0f) /* the sine of the angle of half the frame's height */
+        half = half * t / sqrtf(1.0f + half * half * t * t);
+    if (t == 0.0f && behind == n)
+        out = INFINITY;
+    if (out > 0.0f) {
+        *outside = out / half;
+        return VIEW_OFF;
+    }
+    return near ? VIEW_CROSSING : VIEW_ON;
+}
+
+/* Lengths of the lattice lines along u (rows) and v (columns), and for
+ * triangles along the third edge, c1 -> c2 (the diagonals): the longest
+ * line of each direction. */
+static void lattice_lengths(const Vec3 (*p)[LATTICE], int triangular, float len[3])
+{
     const int last = LATTICE - 1;
-    float len_u = 0.0f, len_v = 0.0f, len_w = 0.0f;
+    len[0] = len[1] = len[2] = 0.0f;
     for (int j = 0; j < LATTICE; j++) {
         float lu = 0.0f, lv = 0.0f;
-        int end = d->triangular ? last - j : last; /* last i (or j) of the line */
+        int end = triangular ? last - j : last; /* last i (or j) of the line */
         for (int i = 0; i < end; i++) {
             lu += v3_length(v3_sub(p[j][i + 1], p[j][i]));
             lv += v3_length(v3_sub(p[i + 1][j], p[i][j]));
         }
-        len_u = fmaxf(len_u, lu);
-        len_v = fmaxf(len_v, lv);
+        len[0] = fmaxf(len[0], lu);
+        len[1] = fmaxf(len[1], lv);
     }
-    if (d->triangular)
+    if (triangular)
         for (int j = 0; j < last; j++)
-            len_w += v3_length(v3_sub(p[j + 1][last - 1 - j], p[j][last - j]));
-    float dist = fmaxf(bounds_distance(box, cam->eye), cam->min_distance);
-    float target = sqrtf(fmaxf(prim->shading_rate, 1e-6f)) * (cam->pixel_width + cam->pixel_angle * dist);
-    Estimate e;
-    if (d->triangular) {
-        float len = fmaxf(len_u, fmaxf(len_v, len_w));
-        e.n_u = e.n_v = (int)fminf(ceilf(len / target), 1e6f);
+            len[2] += v3_length(v3_sub(p[j + 1][last - 1 - j], p[j][last - j]));
+}
+
+/* The edge of a triangle, in lattice space (0: c0-c1, 1: c1-c2, 2: c2-c0),
+ * to bisect when the triangle must split and is thin (its longest edge
+ * more than three times its height above it), else -1: split in four, a
+ * thin triangle keeps its shape, and its grids of slivers grow with the
+ * square of its length; bisected across its long edge it grows fatter
+ * (tests/geom/test_dice.c: a 1000:1 triangle dices into a fifth of the
+ * vertices). */
+static int thin_edge(const Vec3 (*p)[LATTICE])
+{
+    const int last = LATTICE - 1;
+    Vec3 c[3] = {p[0][0], p[0][last], p[last][0]};
+    float l[3], longest = 0.0f;
+    int e = 0;
+    for (int k = 0; k < 3; k++) {
+        l[k] = v3_length(v3_sub(c[(k + 1) % 3], c[k]));
+        if (l[k] > longest)
+            longest = l[k], e = k;
+    }
+    float area2 = v3_length(v3_cross(v3_sub(c[1], c[0]), v3_sub(c[2], c[0])));
+    return longest > 0.0f && longest * longest > 3.0f * area2 ? e : -1;
+}
+
+static Estimate estimate(const Prim *prim, const Domain *d, const DiceCamera *cam)
+{
+    Vec3 p[LATTICE][LATTICE];
+    float s[LATTICE * LATTICE][2];
+    Vec3 pts[LATTICE * LATTICE];
+    int n = 0;
+    Bounds3 box = bounds_empty();
+    const float step = 1.0f / (LATTICE - 1);
+    for (int j = 0; j < LATTICE; j++)
+        for (int i = 0; i < LATTICE; i++) {
+            p[j][i] = v3(0, 0, 0);
+            if (d->triangular && i + j > LATTICE - 1)
+                continue;
+            p[j][i] = domain_point(prim, d, (float)i * step, (float)j * step);
+            box = bounds_add(box, p[j][i]);
+            pts[n++] = p[j][i];
+        }
+    float outside = 0.0f, scale = cam->rate_scale > 1.0f ? cam->rate_scale : 1.0f;
+    float rate = sqrtf(fmaxf(prim->shading_rate, 1e-6f)) * scale; /* edge, in pixels */
+    ViewPlace place = view_place(cam, pts, n, s, &outside);
+    float len[3], unit;
+    if (place == VIEW_ON) {
+        /* Raster positions in the lattice's own layout, then measured as
+         * points in the plane. */
+        int k = 0;
+        for (int j = 0; j < LATTICE; j++)
+            for (int i = 0; i < LATTICE; i++)
+                if (!(d->triangular && i + j > LATTICE - 1)) {
+                    p[j][i] = v3(s[k][0] / cam->pixel, s[k][1] / cam->pixel, 0.0f);
+                    k++;
+                }
+        unit = rate;
     } else {
-        e.n_u = (int)fminf(ceilf(len_u / target), 1e6f);
-        e.n_v = (int)fminf(ceilf(len_v / target), 1e6f);
+        float dist = fmaxf(bounds_distance(box, cam->eye), cam->min_distance);
+        unit = rate * (cam->pixel_width + cam->pixel_angle * dist);
+        if (place == VIEW_OFF && cam->offscreen > 1.0f)
+            unit *= 1.0f + (cam->offscreen - 1.0f) * fminf(outside, 1.0f);
+    }
+    lattice_lengths((const Vec3(*)[LATTICE])p, d->triangular, len);
+    Estimate e = {.thin_edge = -1};
+    if (d->triangular) {
+        float l = fmaxf(len[0], fmaxf(len[1], len[2]));
+        e.n_u = e.n_v = (int)fminf(ceilf(l / unit), 1e6f);
+        e.thin_edge = thin_edge((const Vec3(*)[LATTICE])p);
+    } else {
+        e.n_u = (int)fminf(ceilf(len[0] / unit), 1e6f);
+        e.n_v = (int)fminf(ceilf(len[1] / unit), 1e6f);
     }
     e.n_u = RY_MAX(e.n_u, 1);
     e.n_v = RY_MAX(e.n_v, 1);
@@ -267,6 +394,17 @@ void geom_grid_measure(GridSet *gs, Grid *g)
     g->curvature = curv;
 }
 
+void geom_bound_sagitta(GridSet *gs, size_t first)
+{
+    float bound = 0.0f;
+    for (size_t k = first; k < gs->n_grids; k++) {
+        const Grid *g = &gs->grids[k];
+        bound = fmaxf(bound, fminf(0.5f * g->edge * g->edge * g->curvature, g->edge));
+    }
+    for (size_t k = first; k < gs->n_grids; k++)
+        gs->grids[k].sagitta = bound;
+}
+
 /* The limits of one grid: micropolygons, and the side of a square of
  * that many (a triangle's subdivisions per edge). */
 typedef struct Limits {
@@ -335,36 +473,91 @@ static int dice_triangle(GridSet *gs, const Prim *prim, uint32_t prim_index, con
     return 0;
 }
 
-static int split_dice(GridSet *gs, const Prim *prim, uint32_t prim_index, const float *pool,
-                      const Domain *d, const DiceCamera *cam, Limits lim, int depth)
+/* What a split-and-dice walk writes to: grids appended to gs, or (gs
+ * NULL) only the vertices they would hold, counted. */
+typedef struct Walk {
+    GridSet *gs;
+    const Prim *prim;
+    uint32_t prim_index;
+    const float *pool;
+    const DiceCamera *cam;
+    Limits lim;
+    size_t vertices; /* counted, when gs is NULL */
+} Walk;
+
+static int leaf(Walk *w, const Domain *d, Estimate e)
 {
-    Estimate e = estimate(prim, d, cam);
-    int split = d->triangular ? e.n_u > lim.side
-                              : (int64_t)e.n_u * e.n_v > lim.size ||
-                                    e.n_u > GEOM_MAX_GRID - 1 || e.n_v > GEOM_MAX_GRID - 1;
-    if (!split || depth >= MAX_SPLIT_DEPTH)
-        return d->triangular ? dice_triangle(gs, prim, prim_index, pool, d, e, lim)
-                             : dice_quad(gs, prim, prim_index, pool, d, e, lim);
+    if (w->gs)
+        return d->triangular ? dice_triangle(w->gs, w->prim, w->prim_index, w->pool, d, e, w->lim)
+                             : dice_quad(w->gs, w->prim, w->prim_index, w->pool, d, e, w->lim);
     if (d->triangular) {
-        /* Four sub-triangles at the edge midpoints; corners 0, 1, 2 first,
-         * the middle one last. */
-        float m01[2], m12[2], m20[2];
-        for (int k = 0; k < 2; k++) {
-            m01[k] = 0.5f * (d->c[0][k] + d->c[1][k]);
-            m12[k] = 0.5f * (d->c[1][k] + d->c[2][k]);
-            m20[k] = 0.5f * (d->c[2][k] + d->c[0][k]);
+        size_t n = (size_t)RY_MIN(e.n_u, w->lim.side);
+        w->vertices += (n + 1) * (n + 2) / 2;
+    } else {
+        if ((int64_t)e.n_u * e.n_v > w->lim.size) {
+            e.n_u = RY_MIN(e.n_u, w->lim.side);
+            e.n_v = RY_MIN(e.n_v, w->lim.side);
         }
-        const float *corners[4][3] = {{d->c[0], m01, m20}, {m01, d->c[1], m12},
-                                      {m20, m12, d->c[2]}, {m12, m20, m01}};
-        for (int s = 0; s < 4; s++) {
-            Domain sub = {.triangular = 1};
-            for (int c = 0; c < 3; c++)
-                memcpy(sub.c[c], corners[s][c], sizeof sub.c[c]);
-            if (split_dice(gs, prim, prim_index, pool, &sub, cam, lim, depth + 1) != 0)
+        w->vertices += (size_t)(RY_MIN(e.n_u, GEOM_MAX_GRID - 1) + 1) *
+                       (size_t)(RY_MIN(e.n_v, GEOM_MAX_GRID - 1) + 1);
+    }
+    return 0;
+}
+
+static int split_dice(Walk *w, const Domain *d, int depth);
+
+static int split_sub_triangle(Walk *w, const float *a, const float *b, const float *c, int depth)
+{
+    Domain sub = {.triangular = 1};
+    memcpy(sub.c[0], a, sizeof sub.c[0]);
+    memcpy(sub.c[1], b, sizeof sub.c[1]);
+    memcpy(sub.c[2], c, sizeof sub.c[2]);
+    return split_dice(w, &sub, depth + 1);
+}
+
+static int split_triangle(Walk *w, const Domain *d, int thin, int depth)
+{
+    if (thin >= 0) {
+        /* Two halves at the midpoint of the long edge (k, k+1), corners
+         * kept in order. */
+        int a = thin, b = (thin + 1) % 3;
+        float m[2] = {0.5f * (d->c[a][0] + d->c[b][0]), 0.5f * (d->c[a][1] + d->c[b][1])};
+        float half[2][3][2];
+        for (int h = 0; h < 2; h++)
+            memcpy(half[h], d->c, sizeof half[h]);
+        memcpy(half[0][b], m, sizeof m);
+        memcpy(half[1][a], m, sizeof m);
+        for (int h = 0; h < 2; h++)
+            if (split_sub_triangle(w, half[h][0], half[h][1], half[h][2], depth) != 0)
                 return -1;
-        }
         return 0;
     }
+    /* Four sub-triangles at the edge midpoints; corners 0, 1, 2 first, the
+     * middle one last. */
+    float m01[2], m12[2], m20[2];
+    for (int k = 0; k < 2; k++) {
+        m01[k] = 0.5f * (d->c[0][k] + d->c[1][k]);
+        m12[k] = 0.5f * (d->c[1][k] + d->c[2][k]);
+        m20[k] = 0.5f * (d->c[2][k] + d->c[0][k]);
+    }
+    const float *corners[4][3] = {
+        {d->c[0], m01, m20}, {m01, d->c[1], m12}, {m20, m12, d->c[2]}, {m12, m20, m01}};
+    for (int s = 0; s < 4; s++)
+        if (split_sub_triangle(w, corners[s][0], corners[s][1], corners[s][2], depth) != 0)
+            return -1;
+    return 0;
+}
+
+static int split_dice(Walk *w, const Domain *d, int depth)
+{
+    Estimate e = estimate(w->prim, d, w->cam);
+    int split = d->triangular ? e.n_u > w->lim.side
+                              : (int64_t)e.n_u * e.n_v > w->lim.size || e.n_u > GEOM_MAX_GRID - 1 ||
+                                    e.n_v > GEOM_MAX_GRID - 1;
+    if (!split || depth >= MAX_SPLIT_DEPTH)
+        return leaf(w, d, e);
+    if (d->triangular)
+        return split_triangle(w, d, e.thin_edge, depth);
     /* Across the longer direction (u on a tie). */
     int su = e.n_u >= e.n_v ? 2 : 1, sv = 3 - su;
     for (int j = 0; j < sv; j++)
@@ -375,14 +568,13 @@ static int split_dice(GridSet *gs, const Prim *prim, uint32_t prim_index, const 
             sub.c[1][0] = i + 1 == su ? d->c[1][0] : d->c[0][0] + du * (i + 1);
             sub.c[0][1] = d->c[0][1] + dv * j;
             sub.c[1][1] = j + 1 == sv ? d->c[1][1] : d->c[0][1] + dv * (j + 1);
-            if (split_dice(gs, prim, prim_index, pool, &sub, cam, lim, depth + 1) != 0)
+            if (split_dice(w, &sub, depth + 1) != 0)
                 return -1;
         }
     return 0;
 }
 
-int geom_dice_prim(GridSet *gs, const Prim *prim, uint32_t prim_index, const float *pv_pool,
-                   const DiceCamera *cam)
+static Domain whole_domain(const Prim *prim)
 {
     Domain d = {.triangular = prim->type == PRIM_TRIANGLE};
     if (d.triangular) {
@@ -392,5 +584,25 @@ int geom_dice_prim(GridSet *gs, const Prim *prim, uint32_t prim_index, const flo
         const float c[3][2] = {{0, 0}, {1, 1}, {0, 0}};
         memcpy(d.c, c, sizeof c);
     }
-    return split_dice(gs, prim, prim_index, pv_pool, &d, cam, limits_of(cam), 0);
+    return d;
+}
+
+int geom_dice_prim(GridSet *gs, const Prim *prim, uint32_t prim_index, const float *pv_pool,
+                   const DiceCamera *cam)
+{
+    Walk w = {gs, prim, prim_index, pv_pool, cam, limits_of(cam), 0};
+    Domain d = whole_domain(prim);
+    size_t first = gs->n_grids;
+    if (split_dice(&w, &d, 0) != 0)
+        return -1;
+    geom_bound_sagitta(gs, first);
+    return 0;
+}
+
+size_t geom_count_prim(const Prim *prim, const DiceCamera *cam)
+{
+    Walk w = {NULL, prim, 0, NULL, cam, limits_of(cam), 0};
+    Domain d = whole_domain(prim);
+    split_dice(&w, &d, 0);
+    return w.vertices;
 }

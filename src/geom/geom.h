@@ -120,6 +120,10 @@ typedef struct Grid {
     uint8_t triangular;    /* 1 for a triangular grid */
     float edge;            /* mean micropolygon edge length, scene units */
     float curvature;       /* largest |dN| / |dP| between neighbouring vertices, 1/units */
+    float sagitta;         /* how far a neighbouring grid's micropolygons may run inside
+                              this grid's vertices, units: the largest min(edge^2 curvature
+                              / 2, edge) over its primitive's grids (geom_bound_sagitta),
+                              since neighbours may be diced at other rates */
     float uv[3][2];        /* corners in the primitive's (u, v): quad (u0,v0), (u1,v1);
                               triangle: the three corners */
     uint8_t primvars;      /* GEOM_PV_* bits: the GridSet's Ns, st, Cs hold its vertices'
@@ -144,7 +148,18 @@ typedef struct GridSet {
     size_t cap_grids, cap_vertices;
 } GridSet;
 
-/* How the camera sets dicing rates, and how large a grid may be. */
+/* How the camera sets dicing rates, and how large a grid may be.
+ *
+ * With a view (has_view), a patch that may be on screen (its lattice is
+ * not wholly outside one side of the viewing frustum) and lies in front
+ * of the eye is diced by its projected (raster) size, as RenderMan does:
+ * micropolygon edges of sqrt(shading rate) pixels on the image, so a
+ * floor seen at a grazing angle is diced as coarsely along the view as
+ * its pixels are. Everything else (off screen, behind the eye, or
+ * crossing the eye plane, where a projection explodes) is diced by its
+ * distance from the eye ("spherical projection"), its edges longer by a
+ * factor that grows from 1 at the frustum's side to offscreen half a
+ * screen beyond it. Without a view every patch is diced by distance. */
 typedef struct DiceCamera {
     Vec3 eye;              /* camera position, world */
     float pixel_angle;     /* radians subtended by one pixel (0 in orthographic projection) */
@@ -152,6 +167,15 @@ typedef struct DiceCamera {
     float min_distance;    /* distances are clamped to this (the eye inside a patch) */
     int grid_size;         /* micropolygons per grid, at most (RenderMan's "gridsize"), 1 to
                               GEOM_MAX_GRID_SIZE; 0: GEOM_GRID_SIZE */
+    int has_view;          /* 1: the fields below describe the view */
+    Mat4 camera_from_world; /* camera space: x right, y up, z the view direction */
+    float tan_half_fov; /* perspective: tan(fov / 2), screen = (x, y) / (z tan); 0: orthographic,
+                           screen = (x, y) */
+    float screen[4];    /* screen window: left, right, bottom, top (screen units) */
+    float pixel;        /* screen units per pixel */
+    float offscreen;    /* >= 1: the edge factor of patches far off screen (1: none) */
+    float rate_scale;   /* >= 1 (0 reads as 1): every edge this much longer (the vertex
+                           budget, scene_prepare) */
 } DiceCamera;
 
 void geom_gridset_init(GridSet *gs);
@@ -164,9 +188,16 @@ void geom_gridset_fini(GridSet *gs);
 int geom_dice_prim(GridSet *gs, const Prim *prim, uint32_t prim_index, const float *pv_pool,
                    const DiceCamera *cam);
 
+/* The grid vertices geom_dice_prim would add for prim, without dicing. */
+size_t geom_count_prim(const Prim *prim, const DiceCamera *cam);
+
 /* Recomputes a grid's mean edge and curvature from its vertices (after
  * displacement has moved them). */
 void geom_grid_measure(GridSet *gs, Grid *g);
+
+/* Sets the sagitta of grids [first, n_grids) of gs, all of one primitive
+ * and measured, to the largest bound among them. */
+void geom_bound_sagitta(GridSet *gs, size_t first);
 
 /* Vertex count of a grid. */
 static inline size_t geom_grid_n_vertices(const Grid *g)

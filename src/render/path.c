@@ -12,6 +12,9 @@ float path_ray_epsilon(const Worker *w)
 
 float path_ray_offset(const Worker *w, const Grid *g)
 {
-    /* Never more than a micropolygon edge, whatever the curvature estimate. */
-    return path_ray_epsilon(w) + fminf(0.5f * g->edge * g->edge * g->curvature, g->edge);
+    /* The sagitta bound of the primitive's grids (never more than an edge,
+     * whatever the curvature estimate): neighbouring grids diced at
+     * another rate share no vertices, and a coarser one runs further
+     * inside. */
+    return path_ray_epsilon(w) + g->sagitta;
 }

@@ -83,6 +83,8 @@ typedef struct RenderSettings {
     int cache_resolution;         /* -1: by differentials; else a forced CacheLevel */
     float cache_k;                /* resolution rule constant (DESIGN.md) */
     int grid_size;                /* micropolygons per grid, at most (dicing; geom.h) */
+    float dice_offscreen;         /* off-screen dicing factor (DiceOptions) */
+    size_t vertex_budget;         /* grid vertices, at most; 0: none (DiceOptions) */
     int hider;                    /* 0: shade at every camera hit; 1: the grid hider (hider.h) */
     int irradiance;               /* 1: irradiance interpolation at depth 0 (irrgrid.h; grid
                                      hider only) */

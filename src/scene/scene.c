@@ -788,30 +788,88 @@ Bounds3 scene_bounds(const RayesScene *s)
     return b;
 }
 
-int scene_prepare(const RayesScene *s, int width, int height, int grid_size,
-                  TextureSystem *textures, GridSet *gs)
+/* The dicing camera of the scene's camera for an image of width x height. */
+static DiceCamera dice_camera(const RayesScene *s, int width, int height, const DiceOptions *dice,
+                              float radius)
+{
+    DiceCamera cam = {0};
+    const SceneCamera *c = &s->camera;
+    scene_camera_screen(c, width, height, cam.screen);
+    float pixel = fabsf(cam.screen[3] - cam.screen[2]) / (float)height; /* screen units */
+    cam.eye = c->eye;
+    cam.pixel_angle = c->tan_half_fov * pixel;
+    cam.pixel_width = c->tan_half_fov > 0.0f ? 0.0f : pixel * v3_length(c->y);
+    cam.min_distance = 1e-3f * fmaxf(radius, 1e-6f);
+    cam.grid_size = dice ? dice->grid_size : 0;
+    cam.offscreen = dice && dice->offscreen > 1.0f ? dice->offscreen : 1.0f;
+    cam.rate_scale = 1.0f;
+    Mat4 world_from_camera = {{{c->x.x, c->y.x, c->z.x, c->eye.x},
+                               {c->x.y, c->y.y, c->z.y, c->eye.y},
+                               {c->x.z, c->y.z, c->z.z, c->eye.z},
+                               {0, 0, 0, 1}}};
+    cam.has_view = mat4_invert(world_from_camera, &cam.camera_from_world);
+    cam.tan_half_fov = c->tan_half_fov;
+    cam.pixel = pixel;
+    return cam;
+}
+
+/* Dices (and displaces) every primitive into gs, or stops as soon as gs
+ * holds more than budget vertices (0: no budget) and returns the vertices
+ * all primitives would need, counted; else returns 0. -1 (as size_t)
+ * when out of memory. */
+static size_t dice_all(const RayesScene *s, const DiceCamera *cam, size_t budget,
+                       DicingServices *sv, float step, GridSet *gs)
+{
+    for (size_t i = 0; i < s->n_prims; i++) {
+        size_t first = gs->n_grids;
+        if (geom_dice_prim(gs, &s->prims[i], (uint32_t)i, s->pv, cam) != 0)
+            return (size_t)-1;
+        if (budget && gs->n_vertices > budget) {
+            size_t total = gs->n_vertices;
+            for (size_t k = i + 1; k < s->n_prims; k++)
+                total += geom_count_prim(&s->prims[k], cam);
+            return total;
+        }
+        /* Normals of displaced surfaces: differences over 1e-3 of the scene radius. */
+        if (s->prims[i].displacement) {
+            if (scene_displace(s, gs, first, step, &sv->sv) != 0)
+                return (size_t)-1;
+            geom_bound_sagitta(gs, first);
+        }
+    }
+    return 0;
+}
+
+int scene_prepare(const RayesScene *s, int width, int height, const DiceOptions *dice,
+                  TextureSystem *textures, GridSet *gs, float *coarsened)
 {
     DicingServices sv;
     shade_dicing_services_init(&sv, textures);
-    DiceCamera cam;
     Bounds3 b = scene_bounds(s);
     float radius = s->n_prims ? 0.5f * v3_length(v3_sub(b.hi, b.lo)) : 1.0f;
-    float screen[4];
-    scene_camera_screen(&s->camera, width, height, screen);
-    float pixel = fabsf(screen[3] - screen[2]) / (float)height; /* screen units */
-    cam.eye = s->camera.eye;
-    cam.pixel_angle = s->camera.tan_half_fov * pixel;
-    cam.pixel_width = s->camera.tan_half_fov > 0.0f ? 0.0f : pixel * v3_length(s->camera.y);
-    cam.min_distance = 1e-3f * fmaxf(radius, 1e-6f);
-    cam.grid_size = grid_size;
-    for (size_t i = 0; i < s->n_prims; i++) {
-        size_t first = gs->n_grids;
-        if (geom_dice_prim(gs, &s->prims[i], (uint32_t)i, s->pv, &cam) != 0)
+    DiceCamera cam = dice_camera(s, width, height, dice, radius);
+    size_t budget = dice ? dice->vertex_budget : 0;
+    /* Over the budget: vertices go as the inverse square of the edge, so
+     * edges longer by the square root of the excess (and 5%) fit, but
+     * for the grids' minimum sizes; a few rounds at most. */
+    size_t first_need = 0;
+    for (int round = 0;; round++) {
+        size_t need = dice_all(s, &cam, round < 8 ? budget : 0, &sv, 1e-3f * radius, gs);
+        if (need == (size_t)-1)
             return -1;
-        /* Normals of displaced surfaces: differences over 1e-3 of the scene radius. */
-        if (s->prims[i].displacement && scene_displace(s, gs, first, 1e-3f * radius, &sv.sv) != 0)
-            return -1;
+        if (need == 0)
+            break;
+        first_need = first_need ? first_need : need;
+        cam.rate_scale *= 1.05f * sqrtf((float)need / (float)budget);
+        geom_gridset_fini(gs);
+        geom_gridset_init(gs);
     }
+    if (first_need)
+        log_warning("dicing: the scene needs %zu grid vertices, more than the budget of %zu "
+                    "(--vertex-budget); micropolygons made %.2f times longer (%zu vertices)",
+                    first_need, budget, cam.rate_scale, gs->n_vertices);
+    if (coarsened)
+        *coarsened = cam.rate_scale;
     return 0;
 }
 

@@ -111,13 +111,24 @@ static inline void scene_mark(RayesScene *scene, SceneChange change)
     scene->changes |= (unsigned)change;
 }
 
+/* How scene_prepare dices: gridsize, the off-screen factor and the vertex
+ * budget (DESIGN.md "Splitting and dicing"). */
+typedef struct DiceOptions {
+    int grid_size;        /* micropolygons per grid, at most; 0: GEOM_GRID_SIZE */
+    float offscreen;      /* >= 1: edge factor far off screen (DiceCamera.offscreen); 0: 1 */
+    size_t vertex_budget; /* grid vertices, at most; 0: no budget */
+} DiceOptions;
+
 /* Dices every primitive of a committed scene for its camera making an
- * image of width x height pixels, in grids of at most grid_size
- * micropolygons (0: GEOM_GRID_SIZE), and runs displacement shaders (whose
- * texture lookups read from textures, which may be NULL). Returns 0, or -1
- * when out of memory. */
-int scene_prepare(const RayesScene *scene, int width, int height, int grid_size,
-                  TextureSystem *textures, GridSet *gs);
+ * image of width x height pixels (dice may be NULL: gridsize 256, no
+ * off-screen factor, no budget), and runs displacement shaders (whose
+ * texture lookups read from textures, which may be NULL). A scene that
+ * would exceed the vertex budget is diced again with every micropolygon
+ * edge longer by one factor, found by counting, with one warning; the
+ * factor is written to *coarsened when that is not NULL (1: none).
+ * Returns 0, or -1 when out of memory. */
+int scene_prepare(const RayesScene *scene, int width, int height, const DiceOptions *dice,
+                  TextureSystem *textures, GridSet *gs, float *coarsened);
 
 /* Runs the displacement shaders of the primitives of grids [first_grid,
  * n_grids) of gs (displace.c); normals come from differences over step

@@ -62,6 +62,8 @@ void rayes_render_options_init(RayesRenderOptions *o, RayesQuality quality)
     o->cache_k = 1.0f;
     o->grid_size = GEOM_GRID_SIZE;
     o->branch_depth = 1;
+    o->dice_offscreen = 4.0f;
+    o->vertex_budget = 2e7;
     o->texture_mb = 64.0;
     o->texture_width = 1.0f;
     switch (quality) {
@@ -122,6 +124,10 @@ RayesError session_check_options(RayesScene *scene, const RayesRenderOptions *o)
                "k > 0, resolution -1 to 2";
     else if (o->grid_size < 1 || o->grid_size > GEOM_MAX_GRID_SIZE)
         what = "options: grid size must be 1 to 4096 micropolygons";
+    else if (!(o->dice_offscreen >= 1.0f) || o->dice_offscreen > 1000.0f ||
+             !(o->vertex_budget >= 0.0) || o->vertex_budget > 1e12)
+        what =
+            "options: off-screen dicing factor must be 1 to 1000 and the vertex budget 0 to 1e12";
     else if (o->branch_depth < 1 || o->branch_depth > 129)
         what = "options: branch depth must be 1 to 129";
     else if (!(o->texture_mb >= 0.0) || o->texture_mb > 1e7 || !(o->texture_width >= 0.0f) ||
@@ -137,16 +143,32 @@ RayesError session_check_options(RayesScene *scene, const RayesRenderOptions *o)
 RenderSettings session_settings(const RayesRenderOptions *o)
 {
     RenderSettings s = {
-        .width = o->width, .height = o->height, .spp = o->spp, .threads = o->threads,
-        .tile_size = o->tile_size, .bounces = o->bounces, .specular_depth = o->specular_depth,
-        .shadow_rays = o->shadow_rays, .shadow_rays_deep = o->shadow_rays_deep,
-        .diffuse_rays = o->diffuse_rays, .diffuse_rays_deep = o->diffuse_rays_deep,
-        .filter = (int)o->filter, .filter_width = o->filter_width,
-        .seed = o->seed, .progress = o->progress, .progress_user = o->progress_user,
-        .cache_resolution = o->cache_resolution, .cache_k = o->cache_k, .grid_size = o->grid_size,
+        .width = o->width,
+        .height = o->height,
+        .spp = o->spp,
+        .threads = o->threads,
+        .tile_size = o->tile_size,
+        .bounces = o->bounces,
+        .specular_depth = o->specular_depth,
+        .shadow_rays = o->shadow_rays,
+        .shadow_rays_deep = o->shadow_rays_deep,
+        .diffuse_rays = o->diffuse_rays,
+        .diffuse_rays_deep = o->diffuse_rays_deep,
+        .filter = (int)o->filter,
+        .filter_width = o->filter_width,
+        .seed = o->seed,
+        .progress = o->progress,
+        .progress_user = o->progress_user,
+        .cache_resolution = o->cache_resolution,
+        .cache_k = o->cache_k,
+        .grid_size = o->grid_size,
+        .dice_offscreen = o->dice_offscreen,
+        .vertex_budget = (size_t)o->vertex_budget,
         .branch_depth = o->branch_depth,
-        .hider = o->hider == RAYES_HIDER_GRID, .irradiance = o->irradiance != 0,
-        .tile_done = o->tile_done, .tile_user = o->tile_user,
+        .hider = o->hider == RAYES_HIDER_GRID,
+        .irradiance = o->irradiance != 0,
+        .tile_done = o->tile_done,
+        .tile_user = o->tile_user,
     };
     if (s.threads == 0)
         s.threads = thread_count_cores();
@@ -220,7 +242,10 @@ RayesError session_prepare(RayesScene *scene, const RenderSettings *set, Texture
     p->objects = session_render_objects(scene);
     p->masks = object_masks(scene);
     char err[300] = "";
-    if (!p->objects || !p->masks || scene_prepare(scene, set->width, set->height, set->grid_size, textures, &p->gs) != 0) {
+    DiceOptions dice = {set->grid_size, set->dice_offscreen, set->vertex_budget};
+    if (!p->objects || !p->masks ||
+        scene_prepare(scene, set->width, set->height, &dice, textures, &p->gs, &p->coarsened) !=
+            0) {
         session_prepared_fini(p);
         return session_fail(scene, RAYES_ERROR_OUT_OF_MEMORY,
                             "render: out of memory preparing the scene");
@@ -319,6 +344,7 @@ RayesError rayes_render(RayesScene *scene, const RayesRenderOptions *opt, RayesI
             TextureStats ts;
             texture_get_stats(textures, &ts);
             session_stats_add_textures(*stats_out, &ts);
+            session_stats_add_real(*stats_out, "dicing/coarsened", prep.coarsened);
         }
         if (!*stats_out) {
             e = session_fail(scene, RAYES_ERROR_OUT_OF_MEMORY,

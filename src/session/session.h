@@ -22,6 +22,7 @@ typedef struct Prepared {
     uint32_t *masks;          /* object ray masks */
     Accel *accel;
     float scene_radius;       /* for ray offsets */
+    float coarsened;          /* >= 1: how much longer the vertex budget made micropolygons */
 } Prepared;
 
 /* Records msg as the scene's error (if it has none) and returns e. */

@@ -209,6 +209,8 @@ static void test_usage_errors(void)
     expect_error(2, NULL, ARGS("render", "--bogus", "1"), ARGS("--bogus"));
     expect_error(2, NULL, ARGS("render", "--gridsize", "0"), ARGS("--gridsize", "1 to 4096"));
     expect_error(2, NULL, ARGS("render", "--gridsize", "5000"), ARGS("--gridsize"));
+    expect_error(2, NULL, ARGS("render", "--dice-offscreen", "0.5"), ARGS("--dice-offscreen"));
+    expect_error(2, NULL, ARGS("render", "--vertex-budget", "-1"), ARGS("--vertex-budget"));
     expect_error(2, NULL, ARGS("render", "-o", "out.txt"), ARGS("out.txt", ".png"));
     expect_error(2, NULL, ARGS("render", "cornell", "cornell-teapots"), ARGS("one scene"));
     expect_error(2, NULL, ARGS("render", "nosuchscene", "--res", "16"), ARGS("nosuchscene"));
@@ -439,6 +441,31 @@ static void test_rib_grid_size(void)
     CHECK(strstr(json, "\"grid_size\": 128,") != NULL);
 }
 
+/* --vertex-budget: a scene needing more grid vertices is diced coarser,
+ * with one warning giving the need and the factor, and the statistics
+ * report the factor; --dice-offscreen is read. */
+static void test_vertex_budget(void)
+{
+    static Run r;
+    char json[8192];
+    setup();
+    write_text(SCRATCH_DIR "/budget.rib", "Projection \"perspective\" \"fov\" 40\n"
+                                          "WorldBegin\nLightSource \"pointlight\" 1\n"
+                                          "Translate 0 0 5\nSphere 1 -1 1 360\n"
+                                          "WorldEnd\n");
+    run(&r, NULL,
+        ARGS("render", SCRATCH_DIR "/budget.rib", "--res", "64", "--spp", "1", "--quiet",
+             "--vertex-budget", "0.001", "--dice-offscreen", "2", "-o", SCRATCH_DIR "/budget.png",
+             "--stats", SCRATCH_DIR "/budget.json"));
+    CHECK(r.status == 0);
+    CHECK(strstr(r.err, "more than the budget of 1000 (--vertex-budget)") != NULL);
+    CHECK(count_char(r.err, '\n') == 1);
+    read_file(SCRATCH_DIR "/budget.json", json, sizeof json);
+    const char *v = strstr(json, "\"grid_vertices\": ");
+    CHECK(v && atol(v + strlen("\"grid_vertices\": ")) <= 1000);
+    CHECK(strstr(json, "\"coarsened\": 1,") == NULL && strstr(json, "\"coarsened\"") != NULL);
+}
+
 /* A scene without lights: one warning naming the scene and the way out,
  * and a black image; --default-light adds a headlight that lights it. */
 static void test_default_light(void)
@@ -539,6 +566,5 @@ static void test_bad_scene_file(void)
 TEST_MAIN(TEST(test_version_and_help), TEST(test_no_arguments), TEST(test_usage_errors),
           TEST(test_missing_data), TEST(test_render_outputs), TEST(test_render_summary),
           TEST(test_data_from_environment), TEST(test_unwritable_output), TEST(test_shader_path),
-          TEST(test_render_obj), TEST(test_rib_grid_size), TEST(test_default_light),
-          TEST(test_convert),
-          TEST(test_bad_scene_file))
+          TEST(test_render_obj), TEST(test_rib_grid_size), TEST(test_vertex_budget),
+          TEST(test_default_light), TEST(test_convert), TEST(test_bad_scene_file))

@@ -1,3 +1,5 @@
+#include <math.h>
+#include <stdio.h>
 /* Patch evaluation and dicing (geom/). */
 #include <string.h>
 
@@ -261,8 +263,126 @@ static void test_triangle_grid_counts(void)
     geom_gridset_fini(&gs);
 }
 
+/* A camera at (0, 0, -100) looking down +z, 100 pixels over a screen of
+ * [-1, 1]^2 with tan(fov / 2) = 0.5: one pixel is 0.01 radians, as in
+ * camera(). */
+static DiceCamera view_camera(float offscreen)
+{
+    DiceCamera c = camera();
+    c.has_view = 1;
+    c.camera_from_world = mat4_translate(0, 0, 100);
+    c.tan_half_fov = 0.5f;
+    c.screen[0] = -1, c.screen[1] = 1, c.screen[2] = -1, c.screen[3] = 1;
+    c.pixel = 0.02f;
+    c.offscreen = offscreen;
+    return c;
+}
+
+static size_t dice_vertices(const Prim *p, const DiceCamera *cam, GridSet *gs)
+{
+    geom_gridset_init(gs);
+    CHECK(geom_dice_prim(gs, p, 0, NULL, cam) == 0);
+    CHECK(geom_count_prim(p, cam) == gs->n_vertices); /* counting agrees with dicing */
+    return gs->n_vertices;
+}
+
+/* On screen, dicing follows the raster: a square facing the camera gets
+ * the rate it had by distance, while a strip seen at a grazing angle is
+ * diced across at the pixel rate and along the view as coarsely as its
+ * few pixels of height (by distance it needed 10 micropolygons). */
+static void test_raster_oriented_dicing(void)
+{
+    GridSet gs;
+    DiceCamera cam = view_camera(4.0f);
+    Prim face = bilinear(v3(-5, -5, 0), v3(5, -5, 0), v3(-5, 5, 0), v3(5, 5, 0));
+    dice_vertices(&face, &cam, &gs);
+    CHECK(gs.n_grids == 1 && gs.grids[0].nu == 11 && gs.grids[0].nv == 11);
+    geom_gridset_fini(&gs);
+    Prim strip = bilinear(v3(-5, -5, 0), v3(5, -5, 0), v3(-5, -5, 10), v3(5, -5, 10));
+    dice_vertices(&strip, &cam, &gs);
+    CHECK(gs.n_grids == 1);
+    CHECK(gs.grids[0].nu == 11 && gs.grids[0].nv == 2);
+    geom_gridset_fini(&gs);
+    cam.has_view = 0; /* by distance: 10 units at 100 units away */
+    dice_vertices(&strip, &cam, &gs);
+    CHECK(gs.grids[0].nu == 11 && gs.grids[0].nv == 11);
+    geom_gridset_fini(&gs);
+}
+
+/* Off screen and behind the eye, dicing is by distance with micropolygons
+ * up to the off-screen factor longer; far beyond the frame the whole
+ * factor applies. */
+static void test_offscreen_dicing(void)
+{
+    GridSet gs;
+    DiceCamera one = view_camera(1.0f), four = view_camera(4.0f);
+    /* Beside the view: 300 units right of the axis, 100 ahead (the frame
+     * ends at 50); nearest point at 255 units from the eye. */
+    Prim side = bilinear(v3(245, -5, 0), v3(255, -5, 0), v3(245, 5, 0), v3(255, 5, 0));
+    dice_vertices(&side, &one, &gs);
+    CHECK(gs.grids[0].nu == 5 && gs.grids[0].nv == 5); /* 10 / 2.6 */
+    geom_gridset_fini(&gs);
+    dice_vertices(&side, &four, &gs);
+    CHECK(gs.grids[0].nu == 2 && gs.grids[0].nv == 2); /* 10 / 10.4 */
+    geom_gridset_fini(&gs);
+    /* Behind the eye, 100 units back. */
+    Prim back = bilinear(v3(-5, -5, -200), v3(5, -5, -200), v3(-5, 5, -200), v3(5, 5, -200));
+    dice_vertices(&back, &one, &gs);
+    CHECK(gs.grids[0].nu == 11);
+    geom_gridset_fini(&gs);
+    dice_vertices(&back, &four, &gs);
+    CHECK(gs.grids[0].nu == 4 && gs.grids[0].nv == 4);
+    geom_gridset_fini(&gs);
+    /* Just outside the frame's edge the factor has barely grown. */
+    Prim edge = bilinear(v3(52, -5, 0), v3(62, -5, 0), v3(52, 5, 0), v3(62, 5, 0));
+    dice_vertices(&edge, &four, &gs);
+    CHECK(gs.grids[0].nu >= 8);
+    geom_gridset_fini(&gs);
+}
+
+/* A floor 1 km wide passing 1 unit below the eye, through the eye plane
+ * and far behind: its vertices stay bounded (by distance near the eye
+ * plane, the off-screen factor beside and behind), where a projection
+ * would explode. */
+static void test_floor_through_eye_plane(void)
+{
+    GridSet gs;
+    DiceCamera cam = view_camera(4.0f);
+    Prim floor =
+        bilinear(v3(-500, -1, -600), v3(500, -1, -600), v3(-500, -1, 400), v3(500, -1, 400));
+    size_t n = dice_vertices(&floor, &cam, &gs);
+    CHECK(n > 1000 && n < 400000);
+    for (size_t g = 0; g < gs.n_grids; g++)
+        CHECK((int)(gs.grids[g].nu - 1) * (gs.grids[g].nv - 1) <= GEOM_GRID_SIZE);
+    geom_gridset_fini(&gs);
+}
+
+/* A long thin triangle (1000 x 1 units, one unit per micropolygon at its
+ * nearest) is bisected across its long edge while it must split: 39,687
+ * vertices, where splitting in fours (which keeps it as thin) gave
+ * 198,336. */
+static void test_thin_triangle(void)
+{
+    GridSet gs;
+    Prim t = {.type = PRIM_TRIANGLE, .shading_rate = 1.0f};
+    t.cp[0] = v3(-500, 0, 0), t.cp[1] = v3(500, 0, 0), t.cp[2] = v3(-500, 1, 0);
+    DiceCamera cam = camera();
+    size_t n = dice_vertices(&t, &cam, &gs);
+    CHECK(n > 500 && n < 50000);
+    double area = 0.0;
+    for (size_t g = 0; g < gs.n_grids; g++) {
+        const Grid *q = &gs.grids[g];
+        area += 0.5 * fabs((q->uv[1][0] - q->uv[0][0]) * (q->uv[2][1] - q->uv[0][1]) -
+                           (q->uv[2][0] - q->uv[0][0]) * (q->uv[1][1] - q->uv[0][1]));
+    }
+    CHECK_NEAR(area, 0.5, 1e-6); /* the parts tile the triangle's domain */
+    geom_gridset_fini(&gs);
+}
+
 TEST_MAIN(TEST(test_bezier_basis), TEST(test_bicubic_reproduces_bilinear),
           TEST(test_bilinear_known_values), TEST(test_sphere_eval_and_normal),
           TEST(test_degenerate_bicubic_normal), TEST(test_dicing_rate_from_camera),
           TEST(test_split_limits_grid_size), TEST(test_split_by_area), TEST(test_grid_size_option),
-          TEST(test_distance_based_rates), TEST(test_triangle_grid_counts))
+          TEST(test_distance_based_rates), TEST(test_triangle_grid_counts),
+          TEST(test_raster_oriented_dicing), TEST(test_offscreen_dicing),
+          TEST(test_floor_through_eye_plane), TEST(test_thin_triangle))
