@@ -144,6 +144,7 @@ int main(int argc, char **argv)
     o.spp = final_spp; /* the pattern the passes draw from */
     o.bounces = bounces;
     o.threads = threads;
+    o.dice_isotropic = 1; /* the memo's tessellation, as bench/memo_tables */
 
     RayesScene *s = load(data);
     Phase ph[3] = {{.name = "start"}, {.name = "camera move (orbit 10 deg)"},

@@ -468,6 +468,10 @@ typedef struct RayesRenderOptions {
     float dice_offscreen;      /* micropolygons of patches off screen are this much longer
                                   (from 1 at the frame's edge to this half a frame beyond it;
                                   Cycles' "offscreen dicing scale"): 1 to 1000, default 4 */
+    int dice_isotropic;        /* 1: patches on screen are diced by their distance from the eye
+                                  like those off screen, the same along the view as across it
+                                  (RenderMan's "rasterorient" 0); 0 (default): by their
+                                  projected size, coarser along the view where foreshortened */
     double vertex_budget;      /* grid vertices of the whole scene, at most: a scene needing
                                   more is diced coarser, with one warning. Default 2e7 (about
                                   1.2 to 4.4 GB of grids and ray tracing data); 0: none */

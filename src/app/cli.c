@@ -59,6 +59,8 @@ static const char render_options[] =
     "                          scene file's; 1 to 4096): the size of a cache entry\n"
     "  --dice-offscreen F      micropolygons off screen up to F times longer (default 4;\n"
     "                          1 to 1000; 1 dices them as if on screen)\n"
+    "  --dice-isotropic        dice on-screen patches by distance, as finely along the\n"
+    "                          view as across it (RenderMan's rasterorient 0)\n"
     "  --vertex-budget M       grid vertices of the scene, at most, in millions (default\n"
     "                          20; 0: none): a scene needing more is diced coarser\n"
     "  --hider raytrace|grid   shade every camera hit (default), or once per vertex of\n"
@@ -236,6 +238,10 @@ void parse_args(int argc, char **argv, Args *a)
         }
         if (strcmp(o, "--quiet") == 0) {
             a->quiet = 1;
+            continue;
+        }
+        if (strcmp(o, "--dice-isotropic") == 0) {
+            opt->dice_isotropic = 1;
             continue;
         }
         if (strcmp(o, "--default-light") == 0) {

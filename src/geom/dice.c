@@ -220,7 +220,7 @@ static Estimate estimate(const Prim *prim, const Domain *d, const DiceCamera *ca
     float rate = sqrtf(fmaxf(prim->shading_rate, 1e-6f)) * scale; /* edge, in pixels */
     ViewPlace place = view_place(cam, pts, n, s, &outside);
     float len[3], unit;
-    if (place == VIEW_ON) {
+    if (place == VIEW_ON && !cam->isotropic) {
         /* Raster positions in the lattice's own layout, then measured as
          * points in the plane. */
         int k = 0;

@@ -174,6 +174,7 @@ typedef struct DiceCamera {
     float screen[4];    /* screen window: left, right, bottom, top (screen units) */
     float pixel;        /* screen units per pixel */
     float offscreen;    /* >= 1: the edge factor of patches far off screen (1: none) */
+    int isotropic;      /* 1: on-screen patches by distance too (RenderMan's rasterorient 0) */
     float rate_scale;   /* >= 1 (0 reads as 1): every edge this much longer (the vertex
                            budget, scene_prepare) */
 } DiceCamera;

@@ -85,6 +85,7 @@ typedef struct RenderSettings {
     int grid_size;                /* micropolygons per grid, at most (dicing; geom.h) */
     float dice_offscreen;         /* off-screen dicing factor (DiceOptions) */
     size_t vertex_budget;         /* grid vertices, at most; 0: none (DiceOptions) */
+    int dice_isotropic;           /* on screen by distance too (DiceOptions) */
     int hider;                    /* 0: shade at every camera hit; 1: the grid hider (hider.h) */
     int irradiance;               /* 1: irradiance interpolation at depth 0 (irrgrid.h; grid
                                      hider only) */

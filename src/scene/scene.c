@@ -802,6 +802,7 @@ static DiceCamera dice_camera(const RayesScene *s, int width, int height, const 
     cam.min_distance = 1e-3f * fmaxf(radius, 1e-6f);
     cam.grid_size = dice ? dice->grid_size : 0;
     cam.offscreen = dice && dice->offscreen > 1.0f ? dice->offscreen : 1.0f;
+    cam.isotropic = dice ? dice->isotropic : 0;
     cam.rate_scale = 1.0f;
     Mat4 world_from_camera = {{{c->x.x, c->y.x, c->z.x, c->eye.x},
                                {c->x.y, c->y.y, c->z.y, c->eye.y},

@@ -117,6 +117,7 @@ typedef struct DiceOptions {
     int grid_size;        /* micropolygons per grid, at most; 0: GEOM_GRID_SIZE */
     float offscreen;      /* >= 1: edge factor far off screen (DiceCamera.offscreen); 0: 1 */
     size_t vertex_budget; /* grid vertices, at most; 0: no budget */
+    int isotropic;        /* 1: on screen by distance too (DiceCamera.isotropic) */
 } DiceOptions;
 
 /* Dices every primitive of a committed scene for its camera making an

@@ -164,6 +164,7 @@ RenderSettings session_settings(const RayesRenderOptions *o)
         .grid_size = o->grid_size,
         .dice_offscreen = o->dice_offscreen,
         .vertex_budget = (size_t)o->vertex_budget,
+        .dice_isotropic = o->dice_isotropic != 0,
         .branch_depth = o->branch_depth,
         .hider = o->hider == RAYES_HIDER_GRID,
         .irradiance = o->irradiance != 0,
@@ -242,7 +243,8 @@ RayesError session_prepare(RayesScene *scene, const RenderSettings *set, Texture
     p->objects = session_render_objects(scene);
     p->masks = object_masks(scene);
     char err[300] = "";
-    DiceOptions dice = {set->grid_size, set->dice_offscreen, set->vertex_budget};
+    DiceOptions dice = {set->grid_size, set->dice_offscreen, set->vertex_budget,
+                        set->dice_isotropic};
     if (!p->objects || !p->masks ||
         scene_prepare(scene, set->width, set->height, &dice, textures, &p->gs, &p->coarsened) !=
             0) {

@@ -61,4 +61,16 @@ static void test_offscreen_factor(void)
     rayes_scene_release(s);
 }
 
-TEST_MAIN(TEST(test_vertex_budget), TEST(test_offscreen_factor))
+/* Isotropic dicing (RenderMan's rasterorient 0) dices the floor seen at
+ * a grazing angle as finely along the view as across it: more vertices
+ * than raster-oriented dicing, with the off-screen part alike. */
+static void test_isotropic(void)
+{
+    RayesScene *s = floor_scene();
+    DiceOptions raster = {0, 4.0f, 0, 0}, iso = {0, 4.0f, 0, 1};
+    size_t nr = prepare(s, &raster, NULL), ni = prepare(s, &iso, NULL);
+    CHECK(ni > nr + nr / 4);
+    rayes_scene_release(s);
+}
+
+TEST_MAIN(TEST(test_vertex_budget), TEST(test_offscreen_factor), TEST(test_isotropic))
