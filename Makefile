@@ -65,7 +65,7 @@ test-tsan:
 FUZZ_SECONDS ?= 60
 FUZZ_TARGETS = $(patsubst tests/fuzz/%.c,%,$(wildcard tests/fuzz/fuzz_*.c))
 fuzz:
-	@test -f build-fuzz/Makefile || CC=clang cmake -S . -B build-fuzz -DCMAKE_BUILD_TYPE=RelWithDebInfo -DRAYES_FUZZ=ON -DRAYES_SANITIZE=ON -DRAYES_WERROR=OFF
+	@test -f build-fuzz/Makefile || CC=clang CXX=clang++ cmake -S . -B build-fuzz -DCMAKE_BUILD_TYPE=RelWithDebInfo -DRAYES_FUZZ=ON -DRAYES_SANITIZE=ON -DRAYES_WERROR=OFF
 	cmake --build build-fuzz -j $(JOBS) --target $(FUZZ_TARGETS)
 	@mkdir -p build-fuzz/artifacts
 	@set -e; for t in $(FUZZ_TARGETS); do \

@@ -235,6 +235,50 @@ RAYES_API RayesError rayes_scene_polygon_mesh_pv(RayesScene *scene, size_t n_fac
                                                  size_t n_points, const float *P,
                                                  const RayesPrimvar *pv, size_t n_pv);
 
+/* Subdivision surfaces: the exact limit surface of a control mesh
+ * (RenderMan's SubdivisionMesh), evaluated with OpenSubdiv. Faces are as
+ * in rayes_scene_polygon_mesh but of any size of at least 3 (Loop: 3
+ * only). Primitive variables follow the polygon mesh's counts; vertex ones
+ * are interpolated as P is (on the limit surface), varying ones linearly
+ * over each face, facevarying ones on OpenSubdiv's face-varying surface
+ * (smooth across faces where the corners agree, as tags say at
+ * boundaries). */
+typedef enum RayesSubdivScheme {
+    RAYES_SUBDIV_CATMULL_CLARK = 0,
+    RAYES_SUBDIV_LOOP = 1,
+    RAYES_SUBDIV_BILINEAR = 2
+} RayesSubdivScheme;
+
+/* Sharpness of an infinitely sharp crease or corner (OpenSubdiv's; any
+ * value at least this is infinite). */
+#define RAYES_SUBDIV_INFINITELY_SHARP 10.0f
+
+/* RenderMan's tags. interpolate_boundary: 0 leaves boundary faces out
+ * (they have no limit surface), 1 interpolates boundary edges and
+ * corners (the default of rayes_scene_subdivision_mesh with NULL tags),
+ * 2 edges only. facevarying_boundary: RenderMan's
+ * "facevaryinginterpolateboundary" 0 (smooth) to 3 (default 1). Creases
+ * are edges (pairs of point indices) with a sharpness each; corners
+ * points with a sharpness each; holes faces that are left out. */
+typedef struct RayesSubdivTags {
+    int interpolate_boundary;
+    int facevarying_boundary;
+    size_t n_creases;
+    const int *crease_edges;       /* 2 * n_creases point indices */
+    const float *crease_sharpness; /* n_creases, >= 0 */
+    size_t n_corners;
+    const int *corner_points;      /* n_corners point indices */
+    const float *corner_sharpness; /* n_corners, >= 0 */
+    size_t n_holes;
+    const int *hole_faces; /* n_holes face indices */
+} RayesSubdivTags;
+
+RAYES_API RayesError rayes_scene_subdivision_mesh(RayesScene *scene, RayesSubdivScheme scheme,
+                                                  size_t n_faces, const int *n_verts,
+                                                  const int *indices, size_t n_points,
+                                                  const float *P, const RayesSubdivTags *tags,
+                                                  const RayesPrimvar *pv, size_t n_pv);
+
 /* A sphere of the given radius centred at the object-space origin. */
 RAYES_API RayesError rayes_scene_sphere(RayesScene *scene, float radius);
 

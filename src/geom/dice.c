@@ -576,7 +576,7 @@ static int split_dice(Walk *w, const Domain *d, int depth)
 
 static Domain whole_domain(const Prim *prim)
 {
-    Domain d = {.triangular = prim->type == PRIM_TRIANGLE};
+    Domain d = {.triangular = geom_prim_triangular(prim)};
     if (d.triangular) {
         const float c[3][2] = {{0, 0}, {1, 0}, {0, 1}};
         memcpy(d.c, c, sizeof c);

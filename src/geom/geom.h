@@ -40,9 +40,13 @@ typedef enum PrimType {
     PRIM_BICUBIC = 2,  /* cp[0..15] Bezier, row-major, u fastest */
     PRIM_TRIANGLE = 3, /* cp[0..2]; (u, v) are barycentrics of cp[1], cp[2] */
     PRIM_SPHERE = 4,   /* sphere.radius at the origin of sphere.world_from_object */
-    PRIM_QUADRIC = 5   /* one of RenderMan's quadrics (quadric.kind: RayesQuadric's values),
+    PRIM_QUADRIC = 5,  /* one of RenderMan's quadrics (quadric.kind: RayesQuadric's values),
                           swept about object-space z; see geom_quadric_eval */
+    PRIM_SUBDIV = 6    /* one patch of a subdivision mesh's limit surface (subdiv.h): a quad,
+                          or a triangle (subdiv.triangular) with PRIM_TRIANGLE's (u, v) */
 } PrimType;
+
+struct SubdivMesh;
 
 /* Primitive variables a primitive may carry (rayes.h's RayesPrimvar), as
  * bits of Prim.pv and Grid.primvars. */
@@ -76,6 +80,11 @@ typedef struct Prim {
             int reverse;           /* 1: u runs backwards, so the normal turns inward */
             float p[7];            /* RenderMan's parameters, thetamax (and phi) in radians */
         } quadric;
+        struct {
+            const struct SubdivMesh *mesh; /* owned by the scene */
+            uint32_t patch;                /* its patch number in the mesh */
+            int triangular;                /* a Loop triangle */
+        } subdiv;
     };
 } Prim;
 
@@ -95,6 +104,12 @@ typedef struct PrimvarSample {
     float dst[4];          /* ds/du, ds/dv, dt/du, dt/dv (GEOM_PV_ST) */
     Vec3 Cs;               /* surface colour (GEOM_PV_CS) */
 } PrimvarSample;
+
+/* 1 if prim's (u, v) domain is a triangle (barycentric u, v). */
+static inline int geom_prim_triangular(const Prim *prim)
+{
+    return prim->type == PRIM_TRIANGLE || (prim->type == PRIM_SUBDIV && prim->subdiv.triangular);
+}
 
 /* The number of control values per variable of a primitive without
  * pv_cubic: its corners (4 for patches, 3 for triangles). */

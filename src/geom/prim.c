@@ -9,6 +9,8 @@
 #include <math.h>
 #include <string.h>
 
+#include "geom/subdiv.h"
+
 void geom_bezier_basis(float t, float b[4], float db[4])
 {
     float s = 1.0f - t;
@@ -143,6 +145,12 @@ void geom_prim_eval(const Prim *prim, float u, float v, Vec3 *P, Vec3 *dPdu, Vec
     case PRIM_SPHERE:
         eval_sphere(prim, u, v, P, dPdu, dPdv);
         break;
+    case PRIM_SUBDIV: {
+        float p[3], du[3], dv[3];
+        geom_subdiv_eval(prim->subdiv.mesh, prim->subdiv.patch, u, v, p, du, dv);
+        *P = v3(p[0], p[1], p[2]), *dPdu = v3(du[0], du[1], du[2]), *dPdv = v3(dv[0], dv[1], dv[2]);
+        break;
+    }
     case PRIM_QUADRIC: {
         Vec3 p, du, dv;
         const Mat4 *m = &prim->quadric.world_from_object;
@@ -172,7 +180,7 @@ Vec3 geom_prim_normal(const Prim *prim, float u, float v)
     /* Degenerate: step toward the middle of the parameter domain until the
      * tangent plane is defined. The first step is tiny so that the normal
      * stays the limit of the neighbouring normals. */
-    float cu = prim->type == PRIM_TRIANGLE ? 1.0f / 3.0f : 0.5f;
+    float cu = geom_prim_triangular(prim) ? 1.0f / 3.0f : 0.5f;
     float cv = cu;
     for (float e = 1e-4f; e < 0.6f; e *= 4.0f) {
         float uu = u + (cu - u) * e, vv = v + (cv - v) * e;
@@ -187,7 +195,7 @@ Vec3 geom_prim_normal(const Prim *prim, float u, float v)
 
 int geom_prim_corners(const Prim *prim)
 {
-    return prim->type == PRIM_TRIANGLE ? 3 : 4;
+    return geom_prim_triangular(prim) ? 3 : 4;
 }
 
 /* Interpolation weights of the control values and their u and v
@@ -226,6 +234,18 @@ void geom_prim_primvars(const Prim *prim, const float *pool, float u, float v,
     static const int sizes[3] = {3, 2, 3};
     if (!prim->pv)
         return;
+    if (prim->type == PRIM_SUBDIV) { /* evaluated with the surface */
+        float N[3], st[2], dst[4], Cs[3];
+        unsigned got =
+            geom_subdiv_primvars(prim->subdiv.mesh, prim->subdiv.patch, u, v, N, st, dst, Cs);
+        if (got & GEOM_PV_N)
+            out->N = v3_normalize(v3(N[0], N[1], N[2]));
+        if (got & GEOM_PV_ST)
+            memcpy(out->st, st, sizeof out->st), memcpy(out->dst, dst, sizeof out->dst);
+        if (got & GEOM_PV_CS)
+            out->Cs = v3(Cs[0], Cs[1], Cs[2]);
+        return;
+    }
     const float *p = pool + prim->pv_first;
     for (int b = 0; b < 3; b++) {
         if (!(prim->pv & bits[b]))

@@ -107,24 +107,31 @@ static float *copy_floats(const float *f, size_t n)
     return c;
 }
 
-/* Sends (or records) a mesh with N and uv per point (NULL: none). */
+/* Sends a mesh (or a Loop subdivision surface, subdiv) with N and uv per
+ * point (NULL: none). */
 static RayesError send_mesh(Parser *P, size_t n_faces, const int *n_verts, const int *idx,
-                            size_t n_points, const float *pts, const float *N, const float *uv)
+                            size_t n_points, const float *pts, const float *N, const float *uv,
+                            int subdiv)
 {
     RayesPrimvar pv[2];
     float *st = uv ? malloc((2 * n_points + 1) * sizeof *st) : NULL;
     if (uv && !st)
         return RAYES_ERROR_OUT_OF_MEMORY;
     size_t n_pv = mesh_primvars(n_points, N, uv, st, pv);
-    RayesError e = P->sink->polygon_mesh(P->sink->target, n_faces, n_verts, idx, n_points, pts,
-                                         pv, n_pv);
+    /* pbrt's Loop surfaces interpolate their boundaries. */
+    static const RayesSubdivTags tags = {.interpolate_boundary = 1, .facevarying_boundary = 1};
+    RayesError e = !subdiv ? P->sink->polygon_mesh(P->sink->target, n_faces, n_verts, idx, n_points,
+                                                   pts, pv, n_pv)
+                   : P->sink->subdivision_mesh
+                       ? P->sink->subdivision_mesh(P->sink->target, RAYES_SUBDIV_LOOP, n_faces,
+                                                   n_verts, idx, n_points, pts, &tags, pv, n_pv)
+                       : RAYES_ERROR_INVALID_ARGUMENT;
     free(st);
     return e;
 }
 
-int pbrt_emit_mesh(Parser *P, const Token *t, size_t n_faces, const int *n_verts,
-                   const int *idx, size_t n_points, const float *pts, const float *N,
-                   const float *uv)
+static int emit_mesh(Parser *P, const Token *t, size_t n_faces, const int *n_verts, const int *idx,
+                     size_t n_points, const float *pts, const float *N, const float *uv, int subdiv)
 {
     if (n_faces == 0 || strcmp(P->gs.material.shader, PBRT_INVISIBLE) == 0)
         return 0;
@@ -147,12 +154,25 @@ int pbrt_emit_mesh(Parser *P, const Token *t, size_t n_faces, const int *n_verts
         memcpy(op->n_verts, n_verts, n_faces * sizeof(int));
         memcpy(op->idx, idx, n_idx * sizeof(int));
         memcpy(op->pts, pts, n_points * 3 * sizeof(float));
+        op->subdiv = subdiv;
         return 0;
     }
     if (send_state(P, t, P->gs.ctm, &P->gs.material) != 0)
         return -1;
-    RayesError e = send_mesh(P, n_faces, n_verts, idx, n_points, pts, N, uv);
+    RayesError e = send_mesh(P, n_faces, n_verts, idx, n_points, pts, N, uv, subdiv);
     return e != RAYES_OK ? pbrt_sink_failed(P, t, e) : 0;
+}
+
+int pbrt_emit_mesh(Parser *P, const Token *t, size_t n_faces, const int *n_verts, const int *idx,
+                   size_t n_points, const float *pts, const float *N, const float *uv)
+{
+    return emit_mesh(P, t, n_faces, n_verts, idx, n_points, pts, N, uv, 0);
+}
+
+int pbrt_emit_subdiv(Parser *P, const Token *t, size_t n_faces, const int *n_verts, const int *idx,
+                     size_t n_points, const float *pts, const float *uv)
+{
+    return emit_mesh(P, t, n_faces, n_verts, idx, n_points, pts, NULL, uv, 1);
 }
 
 int pbrt_emit_quadric(Parser *P, const Token *t, RayesQuadric q, const float *qp, size_t n,
@@ -232,7 +252,7 @@ int pbrt_replay(Parser *P, const Token *t, const Object *o)
         RayesError e = RAYES_OK;
         if (op->kind == OP_MESH)
             e = send_mesh(P, op->n_faces, op->n_verts, op->idx, op->n_points, op->pts, op->N,
-                          op->uv);
+                          op->uv, op->subdiv);
         else if (op->kind == OP_QUADRIC)
             e = P->sink->quadric(P->sink->target, op->q, op->qp, op->n_qp, op->flags);
         else

@@ -148,6 +148,7 @@ typedef struct Op {
     float patch[4][3];
     int patch_pv;         /* GEOM-like bits: 1 patch_N, 2 patch_uv given */
     float patch_N[4][3], patch_uv[4][2];
+    int subdiv; /* OP_MESH: a Loop subdivision surface (loopsubdiv) */
 } Op;
 
 typedef struct Object {
@@ -284,6 +285,10 @@ int pbrt_sink_failed(Parser *P, const Token *t, RayesError e);
 int pbrt_emit_mesh(Parser *P, const Token *t, size_t n_faces, const int *n_verts,
                    const int *idx, size_t n_points, const float *pts, const float *N,
                    const float *uv);
+/* A Loop subdivision surface of triangles (loopsubdiv), sent or recorded
+ * like a mesh. */
+int pbrt_emit_subdiv(Parser *P, const Token *t, size_t n_faces, const int *n_verts, const int *idx,
+                     size_t n_points, const float *pts, const float *uv);
 int pbrt_emit_quadric(Parser *P, const Token *t, RayesQuadric q, const float *qp, size_t n,
                       unsigned flags);
 /* The bilinear patch of patch (its patch, patch_pv, patch_N, patch_uv). */

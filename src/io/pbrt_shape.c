@@ -240,6 +240,48 @@ static int shape_trianglemesh(Parser *P, const Token *t, ParamList *pl)
     return r;
 }
 
+/* loopsubdiv: the Loop limit surface of a triangle mesh, diced like every
+ * surface ("levels" is pbrt's fixed refinement, not needed). */
+static int shape_loopsubdiv(Parser *P, const Token *t, ParamList *pl)
+{
+    Param *pp = pbrt_find(pl, "P"), *ip = pbrt_find(pl, "indices"), *lv = pbrt_find(pl, "levels");
+    (void)lv; /* read, so it is not reported as unused */
+    if (!pp || pp->n_num < 9 || pp->n_num % 3 != 0)
+        return FAIL_TOK(P, t, "loopsubdiv: expected \"point3 P\" with at least 3 points");
+    size_t n_points = pp->n_num / 3;
+    if (!ip || ip->n_num == 0 || ip->n_num % 3 != 0)
+        return FAIL_TOK(P, t, "loopsubdiv: expected \"integer indices\", a multiple of 3");
+    for (size_t i = 0; i < ip->n_num; i++)
+        if (ip->num[i] < 0 || ip->num[i] >= (double)n_points)
+            return pbrt_fail_at(P, ip->line, ip->col,
+                                "loopsubdiv: index %zu is %.0f but P has %zu points", i, ip->num[i],
+                                n_points);
+    if (P->gs.area.on)
+        pbrt_warn_at(P, t->line, t->col, "loopsubdiv area",
+                     "loopsubdiv: area lights are quads in rayes; the surface does not emit");
+    size_t n_idx = ip->n_num, n_faces = n_idx / 3;
+    Param *uvp = uv_param(P, pl, "loopsubdiv", n_points);
+    float *pts = points_of(P, t, pp), *uv = uvp ? points_of(P, t, uvp) : NULL;
+    int *nv = malloc(n_faces * sizeof(int)), *idx = malloc(n_idx * sizeof(int));
+    int r = -1;
+    if (!pts || (uvp && !uv) || !nv || !idx) {
+        FAIL_TOK(P, t, "out of memory");
+    } else {
+        int flip = P->gs.reverse != swaps_handedness(P->gs.ctm);
+        for (size_t f = 0; f < n_faces; f++) {
+            nv[f] = 3;
+            for (int c = 0; c < 3; c++)
+                idx[3 * f + (size_t)(flip && c ? 3 - c : c)] = (int)ip->num[3 * f + (size_t)c];
+        }
+        r = pbrt_emit_subdiv(P, t, n_faces, nv, idx, n_points, pts, uv);
+    }
+    free(pts);
+    free(uv);
+    free(nv);
+    free(idx);
+    return r;
+}
+
 static int shape_bilinearmesh(Parser *P, const Token *t, ParamList *pl)
 {
     Param *pp = pbrt_find(pl, "P"), *ip = pbrt_find(pl, "indices"), *np = pbrt_find(pl, "N");
@@ -430,6 +472,8 @@ int pbrt_d_shape(Parser *P, const Token *t)
         r = shape_trianglemesh(P, t, &pl);
     else if (strcmp(type, "bilinearmesh") == 0)
         r = shape_bilinearmesh(P, t, &pl);
+    else if (strcmp(type, "loopsubdiv") == 0)
+        r = shape_loopsubdiv(P, t, &pl);
     else if (strcmp(type, "plymesh") == 0)
         r = shape_plymesh(P, t, &pl);
     else if (strcmp(type, "sphere") == 0 || strcmp(type, "disk") == 0 ||

@@ -373,28 +373,70 @@ static int h_archive_begin(Rib *r, const Args *a)
 /* The requests of no concern's file: version, motion blocks, and those
  * read and skipped. dispatch looks in the files' tables, then here. */
 static const RibRequest own_requests[] = {
-    {"version", h_nothing}, {"ErrorHandler", h_nothing}, {"MotionBegin", h_motion_begin},
-    {"ArchiveBegin", h_archive_begin}, {"ReadArchive", h_read_archive},
+    {"version", h_nothing},
+    {"ErrorHandler", h_nothing},
+    {"MotionBegin", h_motion_begin},
+    {"ArchiveBegin", h_archive_begin},
+    {"ReadArchive", h_read_archive},
     {"Procedural", h_procedural},
     /* tier 1 and 2: read and skipped with one warning per request name */
-    {"NuPatch", h_skip}, {"TrimCurve", h_skip}, {"Points", h_skip}, {"Curves", h_skip},
-    {"Blobby", h_skip}, {"HierarchicalSubdivisionMesh", h_skip}, {"Procedural2", h_skip},
-    {"Bxdf", h_skip}, {"Light", h_skip}, {"Pattern", h_skip}, {"Integrator", h_skip},
-    {"DisplayChannel", h_skip}, {"DisplayFilter", h_skip}, {"SampleFilter", h_skip},
-    {"Camera", h_skip}, {"Shutter", h_skip}, {"DepthOfField", h_skip}, {"MakeShadow", h_skip},
-    {"MakeTexture", h_skip}, {"MakeBump", h_skip}, {"MakeCubeFaceEnvironment", h_skip},
-    {"MakeLatLongEnvironment", h_skip}, {"MakeBrickMap", h_skip}, {"Imager", h_skip},
-    {"Atmosphere", h_skip}, {"Interior", h_skip}, {"Exterior", h_skip}, {"Deformation", h_skip},
-    {"Detail", h_skip}, {"DetailRange", h_skip}, {"RelativeDetail", h_skip},
-    {"GeometricApproximation", h_skip}, {"ShadingInterpolation", h_skip},
-    {"SolidBegin", h_skip}, {"SolidEnd", h_skip}, {"ShaderLayer", h_skip},
-    {"ConnectShaderLayers", h_skip}, {"Shader", h_skip}, {"IfBegin", h_skip},
-    {"ElseIf", h_skip}, {"Else", h_skip}, {"IfEnd", h_skip}, {"Matte", h_skip},
-    {"TextureCoordinates", h_skip}, {"Bound", h_skip}, {"ColorSamples", h_skip},
-    {"ClippingPlane", h_skip}, {"Skew", h_skip}, {"Resource", h_skip},
-    {"ResourceBegin", h_skip}, {"ResourceEnd", h_skip}, {"System", h_skip},
-    {"PixelSampleImager", h_skip}, {"ArchiveRecord", h_nothing}, {"EditBegin", h_skip},
-    {"EditEnd", h_skip}, {"CameraBegin", h_skip}, {"CameraEnd", h_skip},
+    {"NuPatch", h_skip},
+    {"TrimCurve", h_skip},
+    {"Points", h_skip},
+    {"Curves", h_skip},
+    {"Blobby", h_skip},
+    {"Procedural2", h_skip},
+    {"Bxdf", h_skip},
+    {"Light", h_skip},
+    {"Pattern", h_skip},
+    {"Integrator", h_skip},
+    {"DisplayChannel", h_skip},
+    {"DisplayFilter", h_skip},
+    {"SampleFilter", h_skip},
+    {"Camera", h_skip},
+    {"Shutter", h_skip},
+    {"DepthOfField", h_skip},
+    {"MakeShadow", h_skip},
+    {"MakeTexture", h_skip},
+    {"MakeBump", h_skip},
+    {"MakeCubeFaceEnvironment", h_skip},
+    {"MakeLatLongEnvironment", h_skip},
+    {"MakeBrickMap", h_skip},
+    {"Imager", h_skip},
+    {"Atmosphere", h_skip},
+    {"Interior", h_skip},
+    {"Exterior", h_skip},
+    {"Deformation", h_skip},
+    {"Detail", h_skip},
+    {"DetailRange", h_skip},
+    {"RelativeDetail", h_skip},
+    {"GeometricApproximation", h_skip},
+    {"ShadingInterpolation", h_skip},
+    {"SolidBegin", h_skip},
+    {"SolidEnd", h_skip},
+    {"ShaderLayer", h_skip},
+    {"ConnectShaderLayers", h_skip},
+    {"Shader", h_skip},
+    {"IfBegin", h_skip},
+    {"ElseIf", h_skip},
+    {"Else", h_skip},
+    {"IfEnd", h_skip},
+    {"Matte", h_skip},
+    {"TextureCoordinates", h_skip},
+    {"Bound", h_skip},
+    {"ColorSamples", h_skip},
+    {"ClippingPlane", h_skip},
+    {"Skew", h_skip},
+    {"Resource", h_skip},
+    {"ResourceBegin", h_skip},
+    {"ResourceEnd", h_skip},
+    {"System", h_skip},
+    {"PixelSampleImager", h_skip},
+    {"ArchiveRecord", h_nothing},
+    {"EditBegin", h_skip},
+    {"EditEnd", h_skip},
+    {"CameraBegin", h_skip},
+    {"CameraEnd", h_skip},
     {NULL, NULL},
 };
 
@@ -518,14 +560,21 @@ static RayesError null_links(void *t, RayesLightLinks m, const size_t *l, size_t
     (void)t, (void)m, (void)l, (void)n;
     return RAYES_OK;
 }
+static RayesError null_subdiv(void *t, RayesSubdivScheme s, size_t nf, const int *nv, const int *ix,
+                              size_t np, const float *P, const RayesSubdivTags *g,
+                              const RayesPrimvar *pv, size_t n)
+{
+    (void)t, (void)s, (void)nf, (void)nv, (void)ix, (void)np, (void)P, (void)g, (void)pv, (void)n;
+    return RAYES_OK;
+}
 static size_t null_count(void *t) { (void)t; return 0; }
 static const char *null_error(void *t) { (void)t; return ""; }
 
-static const IoSink null_sink = {NULL,        null_camera, null_camera_matrix, null_matrix,
-                                 null_named,  null_named,  null_float,         null_path,
-                                 null_float,  null_p4,     null_p16,           null_mesh,
-                                 null_float,  null_quadric, null_area,         null_named,
-                                 null_links,  null_count,  null_error};
+static const IoSink null_sink = {
+    NULL,       null_camera,  null_camera_matrix, null_matrix, null_named, null_named,
+    null_float, null_path,    null_float,         null_p4,     null_p16,   null_mesh,
+    null_float, null_quadric, null_area,          null_named,  null_links, null_count,
+    null_error, NULL,         null_subdiv};
 
 static void rib_init(Rib *r, int pass, const IoSink *sink, const IoReadOptions *opt,
                      IoSettings *settings, char *err, size_t err_size)

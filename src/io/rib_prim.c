@@ -1,8 +1,9 @@
 /*
  * io/rib_prim.c — the geometric primitives of the RIB reader: Polygon,
  * GeneralPolygon, PointsPolygons, PointsGeneralPolygons (tessellated into
- * triangles and convex planar quads by rib_geom.c), SubdivisionMesh (its
- * control polygons), Patch and PatchMesh in the current basis (made
+ * triangles and convex planar quads by rib_geom.c), SubdivisionMesh and
+ * HierarchicalSubdivisionMesh (schemes and tags to rayes.h's subdivision
+ * meshes), Patch and PatchMesh in the current basis (made
  * Bezier), the quadrics and Geometry "teapot"; and their primitive
  * variables (N, st or s and t, Cs) in the API's classes. Each primitive
  * checks its parameters' counts, then brings the sink up to date
@@ -445,8 +446,6 @@ static int points_polygons(Rib *r, const Args *a, size_t i, int general)
         e = rib_get_ints(r, a, &i, &nverts, &n_loops, 3, 1 << 24, "vertices per polygon");
     if (e == 0)
         e = rib_get_ints(r, a, &i, &verts, &n_idx, 0, 1 << 30, "vertex indices");
-    if (e == 0 && r->req[0] == 'S' && i < a->n && a->v[i].kind != ARG_STR)
-        i += 4; /* SubdivisionMesh: tags nargs intargs floatargs */
     if (e == 0)
         e = rib_get_params(r, a, i, &p, &n);
     if (e == 0 && !(P = get_points(r, p, n, &np)))
@@ -485,13 +484,273 @@ static int points_polygons(Rib *r, const Args *a, size_t i, int general)
 static int h_points_polygons(Rib *r, const Args *a) { return points_polygons(r, a, 0, 0); }
 static int h_points_general_polygons(Rib *r, const Args *a) { return points_polygons(r, a, 0, 1); }
 
+/* ------------------------------------------------- subdivision meshes */
+
+/* A numeric argument's values (a scalar or an array), or NULL with the
+ * error set. */
+static const double *num_array(Rib *r, const Args *a, size_t *i, size_t *n, const char *what)
+{
+    if (*i >= a->n || (a->v[*i].kind != ARG_NUMS && a->v[*i].kind != ARG_NUM)) {
+        rib_error(r, "expected %s", what);
+        return NULL;
+    }
+    const Arg *g = &a->v[(*i)++];
+    *n = g->n;
+    return g->d ? g->d : (const double *)"";
+}
+
+/* A string argument's strings (a string or an array), or NULL with the
+ * error set. */
+static char *const *str_array(Rib *r, const Args *a, size_t *i, size_t *n, const char *what)
+{
+    static char *const none[1] = {NULL};
+    const Arg *g = *i < a->n ? &a->v[*i] : NULL;
+    if (g && g->kind == ARG_NUMS && g->n == 0) { /* [] */
+        (*i)++;
+        *n = 0;
+        return none;
+    }
+    if (!g || (g->kind != ARG_STRS && g->kind != ARG_STR)) {
+        rib_error(r, "expected %s", what);
+        return NULL;
+    }
+    (*i)++;
+    *n = g->n;
+    return g->s;
+}
+
+/* The tags of a SubdivisionMesh, as rayes.h takes them; arrays owned. */
+typedef struct SubdivTags {
+    RayesSubdivTags t;
+    int *edges, *corners, *holes;
+    float *edge_sharp, *corner_sharp;
+} SubdivTags;
+
+static void subdiv_tags_free(SubdivTags *s)
+{
+    free(s->edges), free(s->corners), free(s->holes);
+    free(s->edge_sharp), free(s->corner_sharp);
+}
+
+/* Appends n ints and their sharpness (one for all, or one each) to a tag
+ * list; chain: the ints are a chain of points, each step an edge. */
+static int add_sharp(Rib *r, int **ints, float **sharp, size_t *count, const double *iv, size_t ni,
+                     const double *fv, size_t nf, int chain, const char *tag)
+{
+    size_t items = chain ? (ni >= 2 ? ni - 1 : 0) : ni;
+    if ((chain && ni < 2) || nf == 0 || (nf != 1 && nf != items))
+        return rib_error(r, "tag \"%s\": %zu points and %zu sharpnesses (expected %s)", tag, ni, nf,
+                         chain ? "at least 2 points, and 1 sharpness or one per edge"
+                               : "1 sharpness or one per point");
+    size_t per = chain ? 2 : 1;
+    int *ni_ = realloc(*ints, (*count + items) * per * sizeof **ints + sizeof **ints);
+    if (ni_)
+        *ints = ni_;
+    float *ns = realloc(*sharp, (*count + items) * sizeof **sharp + sizeof **sharp);
+    if (ns)
+        *sharp = ns;
+    if (!ni_ || !ns)
+        return rib_error(r, "out of memory");
+    for (size_t k = 0; k < items; k++) {
+        for (size_t c = 0; c < per; c++) {
+            double x = iv[k + c];
+            (*ints)[(*count + k) * per + c] = x >= 0 && x < 2147483647.0 ? (int)x : -1;
+        }
+        double s = fv[nf == 1 ? 0 : k];
+        (*sharp)[*count + k] = s >= 0 && s < 1e30 ? (float)s : -1.0f;
+    }
+    *count += items;
+    return 0;
+}
+
+/* Reads tags nargs intargs floatargs (and stringargs for the
+ * hierarchical form, per = 3) from *i on. */
+static int subdiv_tags(Rib *r, const Args *a, size_t *i, int per, SubdivTags *out)
+{
+    size_t n_tags, n_nargs, n_int, n_float, n_str = 0;
+    char *const *tags = str_array(r, a, i, &n_tags, "the tags (strings)");
+    const double *nargs = tags ? num_array(r, a, i, &n_nargs, "the tags' argument counts") : NULL;
+    const double *iv = nargs ? num_array(r, a, i, &n_int, "the tags' integer arguments") : NULL;
+    const double *fv = iv ? num_array(r, a, i, &n_float, "the tags' float arguments") : NULL;
+    if (fv && per == 3 && !str_array(r, a, i, &n_str, "the tags' string arguments"))
+        return -1;
+    if (!fv)
+        return -1;
+    if (n_nargs != (size_t)per * n_tags)
+        return rib_error(r, "%zu tags need %zu argument counts; %zu given", n_tags,
+                         (size_t)per * n_tags, n_nargs);
+    RayesSubdivTags *t = &out->t;
+    t->interpolate_boundary = 0; /* RenderMan's default: boundary faces are left out */
+    t->facevarying_boundary = 1;
+    size_t at_i = 0, at_f = 0, n_edges = 0, n_corners = 0;
+    for (size_t k = 0; k < n_tags; k++) {
+        double di = nargs[per * k], df = nargs[per * k + 1];
+        if (!(di >= 0 && df >= 0 && di <= (double)(n_int - at_i) && df <= (double)(n_float - at_f)))
+            return rib_error(r, "tag \"%s\" asks for more arguments than are given", tags[k]);
+        size_t ni = (size_t)di, nf = (size_t)df;
+        const double *ti = iv + at_i, *tf = fv + at_f;
+        at_i += ni, at_f += nf;
+        const char *tag = tags[k];
+        int e = 0;
+        if (strcmp(tag, "interpolateboundary") == 0) {
+            t->interpolate_boundary = ni ? (int)fmin(fmax(ti[0], -1.0), 3.0) : 1;
+            if (t->interpolate_boundary < 0 || t->interpolate_boundary > 2)
+                e = rib_error(r, "tag \"interpolateboundary\": expected 0, 1 or 2");
+        } else if (strcmp(tag, "facevaryinginterpolateboundary") == 0) {
+            t->facevarying_boundary = ni ? (int)fmin(fmax(ti[0], -1.0), 4.0) : 1;
+            if (t->facevarying_boundary < 0 || t->facevarying_boundary > 3)
+                e = rib_error(r, "tag \"facevaryinginterpolateboundary\": expected 0 to 3");
+        } else if (strcmp(tag, "crease") == 0)
+            e = add_sharp(r, &out->edges, &out->edge_sharp, &n_edges, ti, ni, tf, nf, 1, tag);
+        else if (strcmp(tag, "corner") == 0)
+            e = add_sharp(r, &out->corners, &out->corner_sharp, &n_corners, ti, ni, tf, nf, 0, tag);
+        else if (strcmp(tag, "hole") == 0) {
+            int *h = realloc(out->holes, (t->n_holes + ni + 1) * sizeof *h);
+            if (!h)
+                return rib_error(r, "out of memory");
+            out->holes = h;
+            for (size_t c = 0; c < ni; c++)
+                h[t->n_holes++] = ti[c] >= 0 && ti[c] < 2147483647.0 ? (int)ti[c] : -1;
+        } else {
+            char key[96];
+            snprintf(key, sizeof key, "subdiv tag %.60s", tag);
+            rib_warn_once(r, key, "tag \"%s\" is ignored", tag);
+        }
+        if (e != 0)
+            return -1;
+    }
+    t->n_creases = n_edges, t->crease_edges = out->edges, t->crease_sharpness = out->edge_sharp;
+    t->n_corners = n_corners, t->corner_points = out->corners;
+    t->corner_sharpness = out->corner_sharp;
+    t->hole_faces = out->holes;
+    return 0;
+}
+
+static int subdiv_scheme(Rib *r, const char *name, RayesSubdivScheme *scheme)
+{
+    static const char *const names[3] = {"catmull-clark", "loop", "bilinear"};
+    for (int k = 0; k < 3; k++)
+        if (strcmp(name, names[k]) == 0) {
+            *scheme = (RayesSubdivScheme)k;
+            return 0;
+        }
+    return rib_error(r, "unknown scheme \"%s\"; expected catmull-clark, loop or bilinear", name);
+}
+
+/* The primitive variables of a subdivision mesh; facevarying values
+ * follow the corners as order[] permutes them. */
+static int subdiv_vars(Rib *r, const RibVar *vars, size_t n_faces, size_t n_points,
+                       const size_t *order, size_t n_idx, PvOut *o)
+{
+    memset(o, 0, sizeof *o);
+    static const RayesPrimvarClass cls_of[] = {[CLS_CONSTANT] = RAYES_PRIMVAR_CONSTANT,
+                                               [CLS_UNIFORM] = RAYES_PRIMVAR_UNIFORM,
+                                               [CLS_VARYING] = RAYES_PRIMVAR_VARYING,
+                                               [CLS_VERTEX] = RAYES_PRIMVAR_VERTEX,
+                                               [CLS_FACEVARYING] = RAYES_PRIMVAR_FACEVARYING};
+    int e = 0;
+    for (int b = 0; b < 3 && e == 0; b++) {
+        if (!vars[b].d)
+            continue;
+        RayesPrimvarClass c = cls_of[vars[b].cls];
+        size_t count = c == RAYES_PRIMVAR_CONSTANT      ? 1
+                       : c == RAYES_PRIMVAR_UNIFORM     ? n_faces
+                       : c == RAYES_PRIMVAR_FACEVARYING ? n_idx
+                                                        : n_points;
+        e = pv_add(r, o, vars, b, c, c == RAYES_PRIMVAR_FACEVARYING ? order : NULL, count);
+    }
+    if (e != 0)
+        pv_out_free(o);
+    return e;
+}
+
+/* SubdivisionMesh (per = 2) and HierarchicalSubdivisionMesh (per = 3, its
+ * string arguments unused). */
+static int subdivision_mesh(Rib *r, const Args *a, int per)
+{
+    size_t i = 0, n_faces = 0, n_idx = 0, n = 0, np = 0;
+    const char *name = rib_get_string(r, a, &i, "a subdivision scheme");
+    RayesSubdivScheme scheme = RAYES_SUBDIV_CATMULL_CLARK;
+    if (!name || subdiv_scheme(r, name, &scheme) != 0)
+        return -1;
+    int *nverts = NULL, *verts = NULL;
+    size_t *order = NULL;
+    Param *p = NULL;
+    float *P = NULL;
+    SubdivTags tags = {0};
+    PvOut pv = {0};
+    int e = rib_get_ints(r, a, &i, &nverts, &n_faces, 3, 1 << 16, "vertices per face");
+    if (e == 0)
+        e = rib_get_ints(r, a, &i, &verts, &n_idx, 0, 1 << 30, "vertex indices");
+    if (e == 0)
+        e = subdiv_tags(r, a, &i, per, &tags);
+    if (e == 0)
+        e = rib_get_params(r, a, i, &p, &n);
+    if (e == 0 && !(P = get_points(r, p, n, &np)))
+        e = -1;
+    size_t sum = 0;
+    for (size_t k = 0; e == 0 && k < n_faces; k++)
+        sum += (size_t)nverts[k];
+    if (e == 0 && sum != n_idx)
+        e = rib_error(r, "the faces have %zu vertices but %zu indices are given", sum, n_idx);
+    for (size_t k = 0; e == 0 && k < n_idx; k++)
+        if ((size_t)verts[k] >= np)
+            e = rib_error(r, "vertex index %d is past the %zu points of \"P\"", verts[k], np);
+    Counts c = {n_faces, np, np, n_idx};
+    if (e == 0)
+        e = rib_check_counts(r, p, n, &c);
+    /* Wound as the orientation says: each face reversed after its first
+     * corner, facevarying values with it. */
+    if (e == 0 && !(order = malloc((n_idx + 1) * sizeof *order)))
+        e = rib_error(r, "out of memory");
+    int flip = e == 0 && flip_of(r);
+    for (size_t f = 0, at = 0; e == 0 && f < n_faces; at += (size_t)nverts[f++])
+        for (int k = 0; k < nverts[f]; k++)
+            order[at + (size_t)k] = at + (size_t)(flip && k ? nverts[f] - k : k);
+    int *wound = e == 0 ? malloc((n_idx + 1) * sizeof *wound) : NULL;
+    if (e == 0 && !wound)
+        e = rib_error(r, "out of memory");
+    for (size_t k = 0; e == 0 && k < n_idx; k++)
+        wound[k] = verts[order[k]];
+    RibVar vars[3];
+    if (e == 0) {
+        rib_vars(r, p, n, vars);
+        e = subdiv_vars(r, vars, n_faces, np, order, n_idx, &pv);
+    }
+    if (e == 0 && r->a.area)
+        rib_warn_once(r, "area shape",
+                      "only quads become area lights; other shapes under "
+                      "AreaLightSource are ordinary surfaces");
+    if (e == 0 && (e = rib_emit_begin(r, NULL)) == 0) {
+        SinkState *st;
+        const IoSink *s = rib_out_sink(r, &st);
+        rib_warn_unused(r, p, n);
+        if (!s->subdivision_mesh)
+            e = rib_error(r, "this sink takes no subdivision meshes");
+        else if (s->subdivision_mesh(s->target, scheme, n_faces, nverts, wound, np, P, &tags.t,
+                                     pv.pv, pv.n) != RAYES_OK)
+            e = rib_sink_failed(r, s);
+    }
+    if (e == 1) /* outside the world: nothing to draw */
+        e = 0;
+    pv_out_free(&pv);
+    subdiv_tags_free(&tags);
+    free(wound);
+    free(order);
+    free(P);
+    free(p);
+    free(nverts);
+    free(verts);
+    return e;
+}
+
 static int h_subdivision_mesh(Rib *r, const Args *a)
 {
-    size_t i = 0;
-    if (!rib_get_string(r, a, &i, "a subdivision scheme"))
-        return -1;
-    rib_warn_once(r, "SubdivisionMesh", "SubdivisionMesh is rendered as its control polygons");
-    return points_polygons(r, a, i, 0);
+    return subdivision_mesh(r, a, 2);
+}
+static int h_hierarchical_subdivision_mesh(Rib *r, const Args *a)
+{
+    return subdivision_mesh(r, a, 3);
 }
 
 static int emit_bicubic(Rib *r, float B[16][3], const PvOut *pv)
@@ -811,11 +1070,21 @@ static int h_geometry(Rib *r, const Args *a)
 /* ------------------------------------------------------------ requests */
 
 const RibRequest rib_prim_requests[] = {
-    {"Polygon", h_polygon}, {"GeneralPolygon", h_general_polygon},
-    {"PointsPolygons", h_points_polygons}, {"PointsGeneralPolygons", h_points_general_polygons},
-    {"Patch", h_patch}, {"PatchMesh", h_patch_mesh}, {"Sphere", h_quadric},
-    {"Cylinder", h_quadric}, {"Cone", h_quadric}, {"Disk", h_quadric}, {"Torus", h_quadric},
-    {"Hyperboloid", h_quadric}, {"Paraboloid", h_quadric}, {"Geometry", h_geometry},
+    {"Polygon", h_polygon},
+    {"GeneralPolygon", h_general_polygon},
+    {"PointsPolygons", h_points_polygons},
+    {"PointsGeneralPolygons", h_points_general_polygons},
+    {"Patch", h_patch},
+    {"PatchMesh", h_patch_mesh},
+    {"Sphere", h_quadric},
+    {"Cylinder", h_quadric},
+    {"Cone", h_quadric},
+    {"Disk", h_quadric},
+    {"Torus", h_quadric},
+    {"Hyperboloid", h_quadric},
+    {"Paraboloid", h_quadric},
+    {"Geometry", h_geometry},
     {"SubdivisionMesh", h_subdivision_mesh},
+    {"HierarchicalSubdivisionMesh", h_hierarchical_subdivision_mesh},
     {NULL, NULL},
 };

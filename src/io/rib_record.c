@@ -21,7 +21,8 @@ typedef enum CallKind {
     CALL_MESH,
     CALL_SPHERE,
     CALL_QUADRIC,
-    CALL_AREA_LIGHT
+    CALL_AREA_LIGHT,
+    CALL_SUBDIV
 } CallKind;
 
 typedef struct RibCall {
@@ -36,6 +37,13 @@ typedef struct RibCall {
     unsigned flags;      /* quadric type << 8 | flags */
     RayesPrimvar *pv;    /* patches and meshes: primitive variables, names and data owned */
     size_t n_pv;
+    /* Subdivision meshes: f holds P, then the crease and corner
+     * sharpnesses; ints the faces' sizes, indices, crease edges, corner
+     * points and holes; tags the counts (its pointers unset). */
+    int scheme;
+    size_t n_points;
+    RayesSubdivTags tags;
+    int has_tags;
 } RibCall;
 
 struct RibRecording {
@@ -224,6 +232,48 @@ static RayesError rec_mesh(void *t, size_t n_faces, const int *nv, const int *id
     c->n_idx = n_idx;
     return RAYES_OK;
 }
+static RayesError rec_subdivision_mesh(void *t, RayesSubdivScheme scheme, size_t n_faces,
+                                       const int *nv, const int *idx, size_t n_points,
+                                       const float *P, const RayesSubdivTags *tags,
+                                       const RayesPrimvar *pv, size_t n_pv)
+{
+    RibRecording *rec = t;
+    RayesSubdivTags none = {0};
+    const RayesSubdivTags *g = tags ? tags : &none;
+    size_t n_idx = 0;
+    for (size_t i = 0; i < n_faces; i++)
+        n_idx += (size_t)nv[i];
+    size_t n_f = 3 * n_points + g->n_creases + g->n_corners;
+    float *f = malloc((n_f + 1) * sizeof *f);
+    if (!f)
+        return RAYES_ERROR_OUT_OF_MEMORY;
+    memcpy(f, P, 3 * n_points * sizeof *f);
+    if (g->n_creases)
+        memcpy(f + 3 * n_points, g->crease_sharpness, g->n_creases * sizeof *f);
+    if (g->n_corners)
+        memcpy(f + 3 * n_points + g->n_creases, g->corner_sharpness, g->n_corners * sizeof *f);
+    RayesError e = keep_primvars(rec, floats(rec, CALL_SUBDIV, f, n_f), pv, n_pv);
+    free(f);
+    if (e != RAYES_OK)
+        return e;
+    RibCall *c = &rec->calls[rec->n - 1];
+    size_t n_ints = n_faces + n_idx + 2 * g->n_creases + g->n_corners + g->n_holes;
+    c->ints = malloc((n_ints + 1) * sizeof *c->ints);
+    if (!c->ints)
+        return RAYES_ERROR_OUT_OF_MEMORY;
+    int *at = c->ints;
+    memcpy(at, nv, n_faces * sizeof *nv), at += n_faces;
+    memcpy(at, idx, n_idx * sizeof *idx), at += n_idx;
+    if (g->n_creases)
+        memcpy(at, g->crease_edges, 2 * g->n_creases * sizeof *at), at += 2 * g->n_creases;
+    if (g->n_corners)
+        memcpy(at, g->corner_points, g->n_corners * sizeof *at), at += g->n_corners;
+    if (g->n_holes)
+        memcpy(at, g->hole_faces, g->n_holes * sizeof *at);
+    c->n_faces = n_faces, c->n_idx = n_idx, c->n_points = n_points, c->scheme = (int)scheme;
+    c->tags = *g, c->has_tags = tags != NULL;
+    return RAYES_OK;
+}
 static RayesError rec_sphere(void *t, float r)
 {
     return floats(t, CALL_SPHERE, &r, 1);
@@ -272,6 +322,7 @@ IoSink rib_recording_sink(RibRecording *rec)
                 rec_displacement, rec_bound, rec_search_path,  rec_rate,       rec_bilinear,
                 rec_bicubic,   rec_mesh,     rec_sphere,        rec_quadric,    rec_area_light,
                 rec_light,     rec_light_links, rec_light_count, rec_error};
+    s.subdivision_mesh = rec_subdivision_mesh;
     return s;
 }
 
@@ -317,6 +368,21 @@ RayesError rib_recording_replay(const RibRecording *rec, const IoSink *out,
             e = out->quadric(t, (RayesQuadric)(c->flags >> 8), c->f, c->n_f, c->flags & 0xff);
             break;
         case CALL_AREA_LIGHT: e = out->area_light(t, (const float(*)[3])c->f, c->f + 12); break;
+        case CALL_SUBDIV: {
+            RayesSubdivTags g = c->tags;
+            const int *at = c->ints + c->n_faces + c->n_idx;
+            g.crease_edges = at, at += 2 * g.n_creases;
+            g.corner_points = at, at += g.n_corners;
+            g.hole_faces = at;
+            g.crease_sharpness = c->f + 3 * c->n_points;
+            g.corner_sharpness = c->f + 3 * c->n_points + g.n_creases;
+            e = out->subdivision_mesh
+                    ? out->subdivision_mesh(t, (RayesSubdivScheme)c->scheme, c->n_faces, c->ints,
+                                            c->ints + c->n_faces, c->n_points, c->f,
+                                            c->has_tags ? &g : NULL, c->pv, c->n_pv)
+                    : RAYES_ERROR_INVALID_ARGUMENT;
+            break;
+        }
         }
     }
     return e;

@@ -642,6 +642,77 @@ static RayesError w_polygon_mesh(void *t, size_t n_faces, const int *nv, const i
     return RAYES_OK;
 }
 
+/* A subdivision mesh as RenderMan's SubdivisionMesh, every tag written
+ * (interpolateboundary too: RenderMan's default, 0, is not rayes.h's):
+ * a "crease" tag per edge, one "corner" and one "hole" tag. */
+static RayesError w_subdivision_mesh(void *t, RayesSubdivScheme scheme, size_t n_faces,
+                                     const int *nv, const int *idx, size_t n_points, const float *P,
+                                     const RayesSubdivTags *tags, const RayesPrimvar *pv,
+                                     size_t n_pv)
+{
+    static const char *const schemes[3] = {"catmull-clark", "loop", "bilinear"};
+    RibWriter *w = t;
+    FILE *f = w->world.f;
+    size_t k = 0;
+    if ((unsigned)scheme > RAYES_SUBDIV_BILINEAR || (n_faces && (!nv || !idx || !P)) ||
+        !finite_all(P, 3 * n_points))
+        return fail(w, RAYES_ERROR_INVALID_ARGUMENT, "subdivision mesh: bad scheme or data");
+    for (size_t i = 0; i < n_faces; k += (size_t)nv[i], i++) {
+        if (nv[i] < 3)
+            return fail(w, RAYES_ERROR_INVALID_ARGUMENT, "subdivision mesh: a face of %d", nv[i]);
+        for (int v = 0; v < nv[i]; v++)
+            if (idx[k + (size_t)v] < 0 || (size_t)idx[k + (size_t)v] >= n_points)
+                return fail(w, RAYES_ERROR_INVALID_ARGUMENT,
+                            "subdivision mesh: index out of range");
+    }
+    const size_t expect[5] = {1, n_faces, n_points, n_points, k};
+    if (check_primvars(w, "subdivision mesh", pv, n_pv, expect) != RAYES_OK)
+        return RAYES_ERROR_INVALID_ARGUMENT;
+    RayesSubdivTags none = {.interpolate_boundary = 1, .facevarying_boundary = 1};
+    const RayesSubdivTags *g = tags ? tags : &none;
+    if (n_faces == 0)
+        return RAYES_OK;
+    fprintf(f, "SubdivisionMesh \"%s\" [", schemes[scheme]);
+    for (size_t i = 0; i < n_faces; i++)
+        fprintf(f, i ? " %d" : "%d", nv[i]);
+    fprintf(f, "]\n  [");
+    for (size_t i = 0; i < k; i++)
+        fprintf(f, "%s%d", i == 0 ? "" : i % 24 == 0 ? "\n   " : " ", idx[i]);
+    fprintf(f, "]\n  [\"interpolateboundary\" \"facevaryinginterpolateboundary\"");
+    for (size_t i = 0; i < g->n_creases; i++)
+        fprintf(f, " \"crease\"");
+    fprintf(f, "%s%s]\n  [1 0 1 0", g->n_corners ? " \"corner\"" : "",
+            g->n_holes ? " \"hole\"" : "");
+    for (size_t i = 0; i < g->n_creases; i++)
+        fprintf(f, " 2 1");
+    if (g->n_corners)
+        fprintf(f, " %zu %zu", g->n_corners, g->n_corners);
+    if (g->n_holes)
+        fprintf(f, " %zu 0", g->n_holes);
+    fprintf(f, "]\n  [%d %d", g->interpolate_boundary, g->facevarying_boundary);
+    for (size_t i = 0; i < 2 * g->n_creases; i++)
+        fprintf(f, " %d", g->crease_edges[i]);
+    for (size_t i = 0; i < g->n_corners; i++)
+        fprintf(f, " %d", g->corner_points[i]);
+    for (size_t i = 0; i < g->n_holes; i++)
+        fprintf(f, " %d", g->hole_faces[i]);
+    fprintf(f, "]\n  ");
+    float *sharp = malloc((g->n_creases + g->n_corners + 1) * sizeof *sharp);
+    if (!sharp)
+        return fail(w, RAYES_ERROR_OUT_OF_MEMORY, "subdivision mesh: out of memory");
+    if (g->n_creases)
+        memcpy(sharp, g->crease_sharpness, g->n_creases * sizeof *sharp);
+    if (g->n_corners)
+        memcpy(sharp + g->n_creases, g->corner_sharpness, g->n_corners * sizeof *sharp);
+    floats(f, sharp, g->n_creases + g->n_corners);
+    free(sharp);
+    fprintf(f, "\n  \"P\" ");
+    floats(f, P, 3 * n_points);
+    primvars(f, pv, n_pv);
+    fputc('\n', f);
+    return RAYES_OK;
+}
+
 static RayesError w_quadric(void *t, RayesQuadric type, const float *p, size_t n, unsigned flags)
 {
     static const char *const names[] = {"Sphere",     "Cylinder",    "Cone", "Disk",
@@ -796,6 +867,7 @@ IoSink io_rib_writer_sink(RibWriter *w)
         .light_count = w_light_count,
         .get_error = w_get_error,
         .has_shader = w_has_shader,
+        .subdivision_mesh = w_subdivision_mesh,
     };
 }
 

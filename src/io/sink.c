@@ -61,6 +61,15 @@ static RayesError scene_bicubic_patch(void *t, const float P[16][3], const Rayes
     return rayes_scene_bicubic_patch_pv(t, P, pv, n_pv);
 }
 
+static RayesError scene_subdivision_mesh(void *t, RayesSubdivScheme scheme, size_t n_faces,
+                                         const int *n_verts, const int *indices, size_t n_points,
+                                         const float *P, const RayesSubdivTags *tags,
+                                         const RayesPrimvar *pv, size_t n_pv)
+{
+    return rayes_scene_subdivision_mesh(t, scheme, n_faces, n_verts, indices, n_points, P, tags, pv,
+                                        n_pv);
+}
+
 static RayesError scene_polygon_mesh(void *t, size_t n_faces, const int *n_verts,
                                      const int *indices, size_t n_points, const float *P,
                                      const RayesPrimvar *pv, size_t n_pv)
@@ -133,6 +142,7 @@ IoSink io_sink_scene(RayesScene *scene)
         .light_count = scene_light_count,
         .get_error = scene_get_error,
         .has_shader = scene_has_shader,
+        .subdivision_mesh = scene_subdivision_mesh,
     };
 }
 

@@ -63,6 +63,13 @@ typedef struct IoSink {
      * plugin, say), for readers that fall back to a built-in one. May be
      * NULL: only the built-in names are known. */
     int (*has_shader)(void *target, const char *name);
+    /* rayes_scene_subdivision_mesh (last, so positional initialisers of
+     * older sinks leave it NULL: readers then refuse subdivision meshes
+     * with an error). */
+    RayesError (*subdivision_mesh)(void *target, RayesSubdivScheme scheme, size_t n_faces,
+                                   const int *n_verts, const int *indices, size_t n_points,
+                                   const float *P, const RayesSubdivTags *tags,
+                                   const RayesPrimvar *pv, size_t n_pv);
 } IoSink;
 
 /* A sink that builds scene through rayes.h (borrowed, not retained). */

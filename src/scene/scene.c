@@ -12,6 +12,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "geom/subdiv.h"
 #include "rayes/rayes.h"
 #include "rayes/shader.h"
 #include "shade/builtin.h"
@@ -104,6 +105,9 @@ void rayes_scene_release(RayesScene *s)
     free(s->links);
     free(s->objects);
     free(s->prims);
+    for (size_t i = 0; i < s->n_subdivs; i++)
+        geom_subdiv_free(s->subdivs[i]);
+    free(s->subdivs);
     free(s->pv);
     for (size_t i = 0; i < s->n_lights; i++)
         light_fini(&s->lights[i]);
@@ -610,6 +614,139 @@ RayesError rayes_scene_polygon_mesh_pv(RayesScene *s, size_t n_faces, const int 
     return RAYES_OK;
 }
 
+/* Checks the faces and tags of a subdivision mesh. */
+static RayesError check_subdiv(RayesScene *s, RayesSubdivScheme scheme, size_t n_faces,
+                               const int *n_verts, const int *indices, size_t n_points,
+                               const RayesSubdivTags *t, size_t *n_corners)
+{
+    const char *what = "subdivision mesh";
+    if ((unsigned)scheme > RAYES_SUBDIV_BILINEAR)
+        return fail(s, RAYES_ERROR_INVALID_ARGUMENT, "%s: unknown scheme %d", what, (int)scheme);
+    if (n_faces > INT32_MAX || n_points > INT32_MAX)
+        return fail(s, RAYES_ERROR_INVALID_ARGUMENT, "%s: too many faces or points", what);
+    size_t k = 0;
+    for (size_t f = 0; f < n_faces; f++) {
+        int want3 = scheme == RAYES_SUBDIV_LOOP;
+        if (n_verts[f] < 3 || n_verts[f] > 64 || (want3 && n_verts[f] != 3))
+            return fail(s, RAYES_ERROR_INVALID_ARGUMENT,
+                        "%s: face %zu has %d vertices; expected %s", what, f, n_verts[f],
+                        want3 ? "3 (Loop takes triangles)" : "3 to 64");
+        for (int v = 0; v < n_verts[f]; v++)
+            if (indices[k + (size_t)v] < 0 || (size_t)indices[k + (size_t)v] >= n_points)
+                return fail(s, RAYES_ERROR_INVALID_ARGUMENT,
+                            "%s: face %zu uses vertex %d; expected 0 to %zu", what, f,
+                            indices[k + (size_t)v], n_points ? n_points - 1 : 0);
+        k += (size_t)n_verts[f];
+    }
+    *n_corners = k;
+    if (!t)
+        return RAYES_OK;
+    if (t->interpolate_boundary < 0 || t->interpolate_boundary > 2 || t->facevarying_boundary < 0 ||
+        t->facevarying_boundary > 3)
+        return fail(s, RAYES_ERROR_INVALID_ARGUMENT,
+                    "%s: interpolateboundary must be 0 to 2 and facevaryinginterpolateboundary 0 "
+                    "to 3",
+                    what);
+    if ((t->n_creases && (!t->crease_edges || !t->crease_sharpness)) ||
+        (t->n_corners && (!t->corner_points || !t->corner_sharpness)) ||
+        (t->n_holes && !t->hole_faces))
+        return RAYES_ERROR_INVALID_ARGUMENT;
+    for (size_t i = 0; i < 2 * t->n_creases; i++)
+        if (t->crease_edges[i] < 0 || (size_t)t->crease_edges[i] >= n_points)
+            return fail(s, RAYES_ERROR_INVALID_ARGUMENT, "%s: crease point %d; expected 0 to %zu",
+                        what, t->crease_edges[i], n_points ? n_points - 1 : 0);
+    for (size_t i = 0; i < t->n_corners; i++)
+        if (t->corner_points[i] < 0 || (size_t)t->corner_points[i] >= n_points)
+            return fail(s, RAYES_ERROR_INVALID_ARGUMENT, "%s: corner point %d; expected 0 to %zu",
+                        what, t->corner_points[i], n_points ? n_points - 1 : 0);
+    for (size_t i = 0; i < t->n_holes; i++)
+        if (t->hole_faces[i] < 0 || (size_t)t->hole_faces[i] >= n_faces)
+            return fail(s, RAYES_ERROR_INVALID_ARGUMENT, "%s: hole face %d; expected 0 to %zu",
+                        what, t->hole_faces[i], n_faces ? n_faces - 1 : 0);
+    if (!finite_n(t->crease_sharpness, t->n_creases) ||
+        !finite_n(t->corner_sharpness, t->n_corners))
+        return fail(s, RAYES_ERROR_INVALID_ARGUMENT, "%s: a sharpness is not finite", what);
+    for (size_t i = 0; i < t->n_creases; i++)
+        if (t->crease_sharpness[i] < 0.0f)
+            return fail(s, RAYES_ERROR_INVALID_ARGUMENT, "%s: a crease sharpness is negative",
+                        what);
+    for (size_t i = 0; i < t->n_corners; i++)
+        if (t->corner_sharpness[i] < 0.0f)
+            return fail(s, RAYES_ERROR_INVALID_ARGUMENT, "%s: a corner sharpness is negative",
+                        what);
+    return RAYES_OK;
+}
+
+RayesError rayes_scene_subdivision_mesh(RayesScene *s, RayesSubdivScheme scheme, size_t n_faces,
+                                        const int *n_verts, const int *indices, size_t n_points,
+                                        const float *P, const RayesSubdivTags *tags,
+                                        const RayesPrimvar *pv, size_t n_pv)
+{
+    if (!s || (n_faces && (!n_verts || !indices || !P)))
+        return RAYES_ERROR_INVALID_ARGUMENT;
+    if (!finite_n(P, 3 * n_points))
+        return fail(s, RAYES_ERROR_INVALID_ARGUMENT, "subdivision mesh: non-finite point");
+    size_t n_corners = 0;
+    RayesError e = check_subdiv(s, scheme, n_faces, n_verts, indices, n_points, tags, &n_corners);
+    if (e != RAYES_OK)
+        return e;
+    const size_t expect[5] = {1, n_faces, n_points, n_points, n_corners};
+    PrimvarSet set;
+    if ((e = check_primvars(s, "subdivision mesh", pv, n_pv, expect, &set)) != RAYES_OK)
+        return e;
+    if (n_faces == 0)
+        return RAYES_OK;
+    /* World space: points, and normals (the only variable that moves). */
+    size_t n_n = set.by[0] ? set.by[0]->count : 0;
+    float *world = malloc((3 * n_points + 3 * n_n + 1) * sizeof *world);
+    if (!world)
+        return fail(s, RAYES_ERROR_OUT_OF_MEMORY, "out of memory");
+    transform_points(s, (const float(*)[3])P, n_points, (Vec3 *)world);
+    float *N = world + 3 * n_points;
+    for (size_t i = 0; i < n_n; i++) {
+        Vec3 n = mat4_vector(&set.normal_from_object, v3_load(set.by[0]->data + 3 * i));
+        N[3 * i] = n.x, N[3 * i + 1] = n.y, N[3 * i + 2] = n.z;
+    }
+    SubdivDesc d = {.scheme = (int)scheme,
+                    .n_faces = n_faces,
+                    .n_verts = n_verts,
+                    .indices = indices,
+                    .n_points = n_points,
+                    .P = world,
+                    .interpolate_boundary = tags ? tags->interpolate_boundary : 1,
+                    .facevarying_boundary = tags ? tags->facevarying_boundary : 1};
+    if (tags) {
+        d.n_creases = tags->n_creases, d.crease_edges = tags->crease_edges;
+        d.crease_sharpness = tags->crease_sharpness;
+        d.n_corners = tags->n_corners, d.corner_points = tags->corner_points;
+        d.corner_sharpness = tags->corner_sharpness;
+        d.n_holes = tags->n_holes, d.hole_faces = tags->hole_faces;
+    }
+    for (int b = 0; b < 3; b++)
+        if (set.by[b])
+            d.pv[d.n_pv++] = (SubdivPrimvar){primvar_names[b].bit, (int)set.by[b]->cls,
+                                             primvar_names[b].size, b == 0 ? N : set.by[b]->data};
+    char err[256] = "";
+    SubdivMesh *mesh = geom_subdiv_new(&d, err, sizeof err);
+    free(world);
+    if (!mesh)
+        return fail(s, RAYES_ERROR_INVALID_ARGUMENT, "subdivision mesh: %s", err);
+    if (grow((void **)&s->subdivs, &s->cap_subdivs, s->n_subdivs, sizeof *s->subdivs) != 0) {
+        geom_subdiv_free(mesh);
+        return fail(s, RAYES_ERROR_OUT_OF_MEMORY, "out of memory");
+    }
+    s->subdivs[s->n_subdivs++] = mesh;
+    for (size_t k = 0; k < geom_subdiv_n_patches(mesh); k++) {
+        Prim p = {.type = PRIM_SUBDIV, .pv = (uint8_t)set.mask};
+        p.subdiv.mesh = mesh;
+        p.subdiv.patch = (uint32_t)k;
+        p.subdiv.triangular = geom_subdiv_patch_triangular(mesh, k);
+        if ((e = add_prim(s, &p)) != RAYES_OK)
+            return e;
+    }
+    return RAYES_OK;
+}
+
 RayesError rayes_scene_sphere(RayesScene *s, float radius)
 {
     if (!s)
@@ -767,6 +904,12 @@ Bounds3 scene_bounds(const RayesScene *s)
                 b = bounds_add(b, v3_add(c, v3(l, l, l)));
                 b = bounds_add(b, v3_sub(c, v3(l, l, l)));
             }
+            continue;
+        }
+        if (p->type == PRIM_SUBDIV) { /* the control points hold the limit surface */
+            float lo[3], hi[3];
+            geom_subdiv_patch_bounds(p->subdiv.mesh, p->subdiv.patch, lo, hi);
+            b = bounds_add(bounds_add(b, v3(lo[0], lo[1], lo[2])), v3(hi[0], hi[1], hi[2]));
             continue;
         }
         if (p->type == PRIM_QUADRIC) { /* a lattice of surface points, widened */

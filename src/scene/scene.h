@@ -80,6 +80,8 @@ struct RayesScene {
     int64_t current_object;   /* object of geometry added next; -1: make a default matte */
     Prim *prims;
     size_t n_prims, cap_prims;
+    struct SubdivMesh **subdivs; /* subdivision meshes, owned; their patches are prims */
+    size_t n_subdivs, cap_subdivs;
     float *pv;                /* primitive variable values of every prim (Prim.pv_first) */
     size_t n_pv, cap_pv;      /* floats */
     SceneObject *objects;

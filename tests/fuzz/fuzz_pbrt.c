@@ -131,6 +131,19 @@ static RayesError mesh(void *t, size_t n_faces, const int *nv, const int *idx, s
     return RAYES_OK;
 }
 
+static RayesError subdiv(void *t, RayesSubdivScheme scheme, size_t n_faces, const int *nv,
+                         const int *idx, size_t n_points, const float *P,
+                         const RayesSubdivTags *tags, const RayesPrimvar *pv, size_t n_pv)
+{
+    (void)tags;
+    if (scheme != RAYES_SUBDIV_LOOP)
+        abort();
+    for (size_t f = 0; f < n_faces; f++)
+        if (nv[f] != 3)
+            abort();
+    return mesh(t, n_faces, nv, idx, n_points, P, pv, n_pv);
+}
+
 static RayesError sphere(void *t, float r)
 {
     (void)t, (void)r;
@@ -167,12 +180,23 @@ static const char *error(void *t)
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 {
-    static const IoSink sink = {
-        .set_camera = camera, .set_camera_matrix = camera_matrix, .set_transform = transform,
-        .set_shader = shader, .set_displacement = displacement, .set_displacement_bound = bound,
-        .set_search_path = search, .set_shading_rate = rate, .bilinear_patch = bilinear,
-        .bicubic_patch = bicubic, .polygon_mesh = mesh, .sphere = sphere, .quadric = quadric,
-        .area_light = area, .light = light, .get_error = error};
+    static const IoSink sink = {.set_camera = camera,
+                                .set_camera_matrix = camera_matrix,
+                                .set_transform = transform,
+                                .set_shader = shader,
+                                .set_displacement = displacement,
+                                .set_displacement_bound = bound,
+                                .set_search_path = search,
+                                .set_shading_rate = rate,
+                                .bilinear_patch = bilinear,
+                                .bicubic_patch = bicubic,
+                                .polygon_mesh = mesh,
+                                .sphere = sphere,
+                                .quadric = quadric,
+                                .area_light = area,
+                                .light = light,
+                                .get_error = error,
+                                .subdivision_mesh = subdiv};
     IoSettings settings;
     io_settings_init(&settings);
     char err[512];

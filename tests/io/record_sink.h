@@ -28,6 +28,12 @@ typedef struct RecMesh {
     float *P;
     int shader;               /* index of the shader in force, -1 none */
     RecPrimvars pv;
+    int subdiv; /* 1: a subdivision mesh, of scheme and tags: */
+    RayesSubdivScheme scheme;
+    RayesSubdivTags tags; /* counts, and pointers into the arrays below */
+    int has_tags;
+    int tag_ints[64];     /* crease edges, corners, holes */
+    float tag_floats[32]; /* crease, then corner sharpnesses */
 } RecMesh;
 
 typedef struct RecPatch {
@@ -213,6 +219,38 @@ static RayesError rec_mesh(void *t, size_t n_faces, const int *nv, const int *id
     return RAYES_OK;
 }
 
+static RayesError rec_subdiv(void *t, RayesSubdivScheme scheme, size_t n_faces, const int *nv,
+                             const int *idx, size_t n_points, const float *P,
+                             const RayesSubdivTags *tags, const RayesPrimvar *pv, size_t n_pv)
+{
+    Record *r = t;
+    RayesError e = rec_mesh(t, n_faces, nv, idx, n_points, P, pv, n_pv);
+    if (e != RAYES_OK)
+        return e;
+    RecMesh *m = &r->mesh[r->n_mesh - 1];
+    m->subdiv = 1, m->scheme = scheme, m->has_tags = tags != NULL;
+    if (!tags)
+        return RAYES_OK;
+    m->tags = *tags;
+    size_t ni = 2 * tags->n_creases + tags->n_corners + tags->n_holes;
+    size_t nf = tags->n_creases + tags->n_corners;
+    if (ni > 64 || nf > 32)
+        return RAYES_ERROR_OUT_OF_MEMORY;
+    int *at = m->tag_ints;
+    memcpy(at, tags->crease_edges, 2 * tags->n_creases * sizeof *at);
+    m->tags.crease_edges = at, at += 2 * tags->n_creases;
+    memcpy(at, tags->corner_points, tags->n_corners * sizeof *at);
+    m->tags.corner_points = at, at += tags->n_corners;
+    memcpy(at, tags->hole_faces, tags->n_holes * sizeof *at);
+    m->tags.hole_faces = at;
+    memcpy(m->tag_floats, tags->crease_sharpness, tags->n_creases * sizeof(float));
+    memcpy(m->tag_floats + tags->n_creases, tags->corner_sharpness,
+           tags->n_corners * sizeof(float));
+    m->tags.crease_sharpness = m->tag_floats;
+    m->tags.corner_sharpness = m->tag_floats + tags->n_creases;
+    return RAYES_OK;
+}
+
 static RayesError rec_sphere(void *t, float radius)
 {
     (void)radius;
@@ -289,7 +327,8 @@ static IoSink record_sink(Record *r)
                     .light = rec_light,
                     .set_light_links = rec_light_links,
                     .light_count = rec_light_count,
-                    .get_error = rec_error};
+                    .get_error = rec_error,
+                    .subdivision_mesh = rec_subdiv};
 }
 
 static void record_free(Record *r)

@@ -19,7 +19,7 @@
  * at six bounces. The tests of energy bookkeeping use 1; one test bounds
  * the default's loss. */
 static double furnace_mean_at(float albedo, int bounces, int diffuse_rays, int threads, int cache,
-                              float offscreen)
+                              float offscreen, int subdiv)
 {
     RayesScene *s = rayes_scene_new();
     float eye[3] = {0, 0, 0}, target[3] = {0, 0, 1}, up[3] = {0, 1, 0};
@@ -30,7 +30,20 @@ static double furnace_mean_at(float albedo, int bounces, int diffuse_rays, int t
         {"Cs", RAYES_PARAM_COLOR, {1, 1, 1}, NULL},
     };
     CHECK(rayes_scene_set_shader(s, "matte", p, 3) == RAYES_OK);
-    CHECK(rayes_scene_sphere(s, 10.0f) == RAYES_OK);
+    if (subdiv) {
+        /* A Catmull-Clark cube of side 20 about the camera: its limit
+         * surface is closed, and its patches are diced at different
+         * rates on and off screen. */
+        static const float P[8][3] = {{-10, -10, -10}, {10, -10, -10}, {10, 10, -10},
+                                      {-10, 10, -10},  {-10, -10, 10}, {10, -10, 10},
+                                      {10, 10, 10},    {-10, 10, 10}};
+        static const int nv[6] = {4, 4, 4, 4, 4, 4};
+        static const int idx[24] = {0, 1, 2, 3, 7, 6, 5, 4, 4, 5, 1, 0,
+                                    5, 6, 2, 1, 6, 7, 3, 2, 7, 4, 0, 3};
+        CHECK(rayes_scene_subdivision_mesh(s, RAYES_SUBDIV_CATMULL_CLARK, 6, nv, idx, 8, &P[0][0],
+                                           NULL, NULL, 0) == RAYES_OK);
+    } else
+        CHECK(rayes_scene_sphere(s, 10.0f) == RAYES_OK);
     CHECK(rayes_scene_commit(s) == RAYES_OK);
     RayesRenderOptions o;
     rayes_render_options_init(&o, RAYES_QUALITY_PREVIEW);
@@ -57,7 +70,7 @@ static double furnace_mean_at(float albedo, int bounces, int diffuse_rays, int t
 
 static double furnace_mean(float albedo, int bounces, int diffuse_rays, int threads, int cache)
 {
-    return furnace_mean_at(albedo, bounces, diffuse_rays, threads, cache, 1.0f);
+    return furnace_mean_at(albedo, bounces, diffuse_rays, threads, cache, 1.0f, 0);
 }
 
 static void test_furnace_each_bounce_count(void)
@@ -94,9 +107,26 @@ static void test_furnace_offscreen_dicing(void)
     for (int k = 0; k <= 6; k++, ak *= a)
         finite += ak;
     for (int cache = -2; cache <= -1; cache++) {
-        double m = furnace_mean_at(a, 6, 2, 2, cache, 4.0f);
+        double m = furnace_mean_at(a, 6, 2, 2, cache, 4.0f, 0);
         CHECK_NEAR(m / finite, 1.0, 0.01);
     }
+}
+
+/* Inside a closed subdivision surface (the cube's limit, seen from
+ * inside, so its normals face away: matte shades both sides), no light
+ * leaks between patches diced at different rates: the same sums, at
+ * every cache resolution. */
+static void test_furnace_subdivision(void)
+{
+    const float a = 0.8f;
+    double finite = 0.0, ak = 1.0;
+    for (int k = 0; k <= 6; k++, ak *= a)
+        finite += ak;
+    for (int cache = -2; cache <= 2; cache++) {
+        double m = furnace_mean_at(a, 6, 2, 2, cache, 1.0f, 1);
+        CHECK_NEAR(m / finite, 1.0, 0.005);
+    }
+    CHECK_NEAR(furnace_mean_at(a, 6, 2, 2, -1, 4.0f, 1) / finite, 1.0, 0.01);
 }
 
 static void test_furnace_converges_to_infinite_sum(void)
@@ -113,4 +143,5 @@ static void test_furnace_converges_to_infinite_sum(void)
 }
 
 TEST_MAIN(TEST(test_furnace_each_bounce_count), TEST(test_furnace_each_resolution),
-          TEST(test_furnace_offscreen_dicing), TEST(test_furnace_converges_to_infinite_sum))
+          TEST(test_furnace_offscreen_dicing), TEST(test_furnace_subdivision),
+          TEST(test_furnace_converges_to_infinite_sum))
