@@ -335,9 +335,10 @@ void parse_args(int argc, char **argv, Args *a)
             if (strcmp(v, "on") != 0 && strcmp(v, "off") != 0)
                 die_usage("--irradiance: expected on or off, got \"%s\"", v);
             opt->irradiance = strcmp(v, "on") == 0;
-        } else if (strcmp(o, "--texture-mb") == 0)
+        } else if (strcmp(o, "--texture-mb") == 0) {
             opt->texture_mb = parse_float(o, v, 0.0f, 1e7f);
-        else if (strcmp(o, "--data") == 0)
+            a->set |= SET_TEXTURE_MB;
+        } else if (strcmp(o, "--data") == 0)
             a->data_dir = v;
         else if (strcmp(o, "--stats") == 0)
             a->stats_path = v;
@@ -407,6 +408,8 @@ void merge_settings(Args *a, const IoSettings *s)
         o->specular_depth = s->specular_depth < 64 ? s->specular_depth : 64;
     if (!(a->set & SET_GRID_SIZE) && s->grid_size > 0)
         o->grid_size = s->grid_size;
+    if (!(a->set & SET_TEXTURE_MB) && s->texture_mb > 0.0)
+        o->texture_mb = s->texture_mb;
     if (s->crop[0] != 0.0f || s->crop[1] != 1.0f || s->crop[2] != 0.0f || s->crop[3] != 1.0f)
         fprintf(stderr, "rayes: warning: %s: CropWindow is not supported; the whole image is "
                         "rendered\n", a->scene);

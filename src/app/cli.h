@@ -22,7 +22,8 @@ enum {
     SET_FILTER_WIDTH = 8,
     SET_BOUNCES = 16,
     SET_SPECULAR_DEPTH = 32,
-    SET_GRID_SIZE = 64
+    SET_GRID_SIZE = 64,
+    SET_TEXTURE_MB = 128
 };
 
 /* An image to write. */

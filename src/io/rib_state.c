@@ -552,6 +552,17 @@ static int h_option_attribute(Rib *r, const Args *a)
         } else if (option && strcmp(group, "limits") == 0 &&
                    strcmp(q->d.name, "gridsize") == 0 && rib_is_num(q->v) && q->v->n == 1) {
             e = set_grid_size(r, q->v->d[0]);
+        } else if (option && strcmp(group, "limits") == 0 &&
+                   strcmp(q->d.name, "texturememory") == 0 && rib_is_num(q->v) && q->v->n == 1) {
+            /* RenderMan's texture cache, in KB */
+            double kb = q->v->d[0];
+            if (!(kb > 0 && kb <= 1e10))
+                e = rib_error(r,
+                              "Option \"limits\" \"texturememory\": expected a positive "
+                              "size in KB, found %g",
+                              kb);
+            else
+                r->settings->texture_mb = kb * 1024.0 / 1e6;
         } else if (!option && strcmp(group, "identifier") == 0) {
             /* names are for messages only */
         } else if (!(!option && strcmp(group, "displacementbound") == 0)) {

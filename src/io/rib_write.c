@@ -892,6 +892,9 @@ static void settings_rib(FILE *f, const IoSettings *s)
     }
     if (s->grid_size > 0)
         fprintf(f, "Option \"limits\" \"int gridsize\" [%d]\n", s->grid_size);
+    if (s->texture_mb > 0.0)
+        fprintf(f, "Option \"limits\" \"int texturememory\" [%.0f]\n",
+                s->texture_mb * 1e6 / 1024.0);
     if (s->exposure_gain != 1.0f || s->exposure_gamma != 1.0f)
         fprintf(f, "Exposure %.9g %.9g\n", (double)s->exposure_gain, (double)s->exposure_gamma);
     if (s->crop[0] != 0.0f || s->crop[1] != 1.0f || s->crop[2] != 0.0f || s->crop[3] != 1.0f)

@@ -95,6 +95,8 @@ typedef struct IoSettings {
     int specular_depth;       /* maximum specular depth; -1: not given */
     int grid_size;            /* micropolygons per grid, at most (RIB Option "limits"
                                  "gridsize"); 0: not given */
+    double texture_mb;        /* texture cache budget in 10^6 bytes (RIB Option "limits"
+                                 "texturememory", in KB); 0: not given */
     float crop[4];            /* xmin xmax ymin ymax in [0, 1] (RIB CropWindow); default 0 1 0 1 */
     float exposure_gain;      /* RIB Exposure; 1 when not given */
     float exposure_gamma;     /* RIB Exposure; 1 when not given */

@@ -8,7 +8,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "image/image.h"
+#include "shade/texture.h"
 
 static const float PI = 3.14159265358979f;
 
@@ -364,13 +364,9 @@ int light_env_load(Light *l, const char *path, char *err, size_t err_size)
     int w = 0, h = 0;
     float *rgba = NULL;
     char ierr[300] = "";
-    ImageFormat f = image_format_from_path(path);
-    RayesError e = f == IMAGE_FORMAT_EXR   ? image_read_exr(path, &w, &h, &rgba, ierr, sizeof ierr)
-                   : f == IMAGE_FORMAT_PNG ? image_read_png(path, &w, &h, &rgba, ierr, sizeof ierr)
-                                           : RAYES_ERROR_INVALID_ARGUMENT;
-    if (e != RAYES_OK) {
+    if (texture_read_image(path, &w, &h, &rgba, ierr, sizeof ierr) != 0) {
         snprintf(err, err_size, "environment light: %s",
-                 ierr[0] ? ierr : "expected a .exr or .png latitude-longitude map");
+                 ierr[0] ? ierr : "expected a latitude-longitude map");
         free(rgba);
         return -1;
     }

@@ -1,34 +1,28 @@
 /*
- * shade/texture.h — image textures: files found on a search path, MIP-mapped
- * at load, filtered by the shading point's footprint, kept in a cache with a
- * memory budget (DESIGN.md "Decisions made in rayes", Textures).
+ * shade/texture.h — image textures: files found on a search path, read,
+ * MIP-mapped, cached within a memory budget and filtered by the shading
+ * point's footprint by OpenImageIO's TextureSystem (texture.cpp, the one
+ * C++ file of shade, behind this C interface; DESIGN.md "Textures").
  *
  * A TextureSystem belongs to one render. Textures are named as shaders name
  * them; a name is resolved once (as given, then in each directory of the
- * search path) and read with image_read_exr or image_read_png (PNG is
- * decoded from sRGB to linear). Each texture is a pyramid of MIP levels;
- * level k + 1 is the exact box-filtered average of level k (2 x 2 texels for
- * even sizes, 3 texels with fractional end weights for odd ones), so every
- * level has the mean of level 0 and texel i of a level of width w covers
- * [i / w, (i + 1) / w) in s.
+ * search path). Every format OpenImageIO reads is a texture: EXR, TIFF and
+ * maketx's tiled, MIP-mapped .tx files, PNG, JPEG, TGA, HDR, ... Untiled
+ * files get their MIP levels on first use. Integer files not marked linear
+ * are sRGB and come back linear. A lookup's result never depends on what
+ * was cached, on the budget or on threads.
  *
- * The cache: MIP levels are the unit. A level is loaded when a lookup first
- * needs it (the file is read and the pyramid reduced down to it), kept while
- * the resident bytes fit the budget, and evicted least-recently-used when a
- * new level needs the room. A level in use by a lookup is pinned. A level
- * that cannot fit is built for the lookup that needs it and freed after it.
- * A level's texels are a pure function of the file, so a lookup's result
- * never depends on what was cached, on the budget or on threads.
- *
- * Thread-safety: texture_lookup may be called from any number of threads;
- * one mutex guards the table and the LRU list, and files are read without
- * it held.
+ * Thread-safety: texture_lookup may be called from any number of threads.
  */
 #ifndef RAYES_SHADE_TEXTURE_H
 #define RAYES_SHADE_TEXTURE_H
 
 #include <stddef.h>
 #include <stdint.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
 
 typedef struct TextureSystem TextureSystem;
 
@@ -55,16 +49,26 @@ void texture_system_free(TextureSystem *ts);
 /* Looks up n points of texture `name` at (s[i], t[i]) ((0, 0) is the top
  * left corner, wrapping periodically), filtered over ds[i] x dt[i] in
  * texture space (full widths; ds or dt NULL: point sampling, bilinear on
- * level 0). The filter: ceil(major / minor) (at most 8) bilinear-trilinear
- * probes spread along the footprint's major axis, at the MIP level whose
- * texels are max(minor, major / probes) wide, blended linearly between the
- * two nearest levels. Writes linear rgb and alpha (alpha may be NULL; 1
- * when the file has none). Returns 0, or -1 when the texture cannot be
- * read: one warning naming the file per system, rgb 0 and alpha 1. */
+ * level 0) by OpenImageIO's anisotropic MIP filter. Writes linear rgb and
+ * alpha (alpha may be NULL; 1 when the file has none; grey files are grey
+ * in rgb). Returns 0, or -1 when the texture cannot be read: one warning
+ * naming the file per system, rgb 0 and alpha 1. */
 int texture_lookup(TextureSystem *ts, const char *name, size_t n, const float *s, const float *t,
                    const float *ds, const float *dt, float (*rgb)[3], float *alpha);
 
-/* The statistics so far. */
+/* The statistics so far (loads: tiles read; file_reads: files opened;
+ * evictions: tiles no longer resident; bytes: OpenImageIO's cache memory;
+ * peak_bytes: an estimate from its peak tile count). */
 void texture_get_stats(TextureSystem *ts, TextureStats *stats);
+
+/* Reads a whole image (level 0) of any format OpenImageIO knows into a new
+ * array of linear RGBA (malloc; grey as grey, alpha 1 when none, sRGB
+ * integer files decoded). Returns 0, or -1 with a message in err. For
+ * environment maps, which are sampled by their pixels. */
+int texture_read_image(const char *path, int *w, int *h, float **rgba, char *err, size_t err_size);
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif /* RAYES_SHADE_TEXTURE_H */

@@ -416,14 +416,15 @@ static void test_render_obj(void)
     CHECK(file_size(SCRATCH_DIR "/room.exr") > 8);
 }
 
-/* RIB's Option "limits" "gridsize" reaches the render unless --gridsize
- * says otherwise; the statistics say which was used. */
+/* RIB's Option "limits" "gridsize" (and "texturememory") reach the render
+ * unless --gridsize says otherwise; the statistics say which was used. */
 static void test_rib_grid_size(void)
 {
     static Run r;
     char json[8192];
     setup();
     write_text(SCRATCH_DIR "/grid.rib", "Option \"limits\" \"gridsize\" [32]\n"
+                                        "Option \"limits\" \"texturememory\" [2048]\n"
                                         "Projection \"perspective\" \"fov\" 40\n"
                                         "WorldBegin\nLightSource \"pointlight\" 1\n"
                                         "Translate 0 0 5\nSphere 1 -1 1 360\n"
@@ -433,6 +434,7 @@ static void test_rib_grid_size(void)
     CHECK(r.status == 0 && r.err[0] == '\0');
     read_file(SCRATCH_DIR "/grid.json", json, sizeof json);
     CHECK(strstr(json, "\"grid_size\": 32,") != NULL);
+    CHECK(strstr(json, "\"budget_bytes\": 2097152") != NULL); /* texturememory, KB */
     run(&r, NULL, ARGS("render", SCRATCH_DIR "/grid.rib", "--res", "16", "--spp", "1", "--quiet",
                        "--gridsize", "128", "-o", SCRATCH_DIR "/grid.png", "--stats",
                        SCRATCH_DIR "/grid.json"));

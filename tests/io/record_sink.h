@@ -237,15 +237,20 @@ static RayesError rec_subdiv(void *t, RayesSubdivScheme scheme, size_t n_faces, 
     if (ni > 64 || nf > 32)
         return RAYES_ERROR_OUT_OF_MEMORY;
     int *at = m->tag_ints;
-    memcpy(at, tags->crease_edges, 2 * tags->n_creases * sizeof *at);
+    if (tags->n_creases)
+        memcpy(at, tags->crease_edges, 2 * tags->n_creases * sizeof *at);
     m->tags.crease_edges = at, at += 2 * tags->n_creases;
-    memcpy(at, tags->corner_points, tags->n_corners * sizeof *at);
+    if (tags->n_corners)
+        memcpy(at, tags->corner_points, tags->n_corners * sizeof *at);
     m->tags.corner_points = at, at += tags->n_corners;
-    memcpy(at, tags->hole_faces, tags->n_holes * sizeof *at);
+    if (tags->n_holes)
+        memcpy(at, tags->hole_faces, tags->n_holes * sizeof *at);
     m->tags.hole_faces = at;
-    memcpy(m->tag_floats, tags->crease_sharpness, tags->n_creases * sizeof(float));
-    memcpy(m->tag_floats + tags->n_creases, tags->corner_sharpness,
-           tags->n_corners * sizeof(float));
+    if (tags->n_creases)
+        memcpy(m->tag_floats, tags->crease_sharpness, tags->n_creases * sizeof(float));
+    if (tags->n_corners)
+        memcpy(m->tag_floats + tags->n_creases, tags->corner_sharpness,
+               tags->n_corners * sizeof(float));
     m->tags.crease_sharpness = m->tag_floats;
     m->tags.corner_sharpness = m->tag_floats + tags->n_creases;
     return RAYES_OK;

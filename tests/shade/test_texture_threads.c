@@ -1,10 +1,10 @@
 /*
- * The texture cache under threads (shade/texture): eight threads look up
- * three textures with random footprints through one TextureSystem whose
- * budget holds only a few levels, so levels are loaded, pinned, evicted and
- * reloaded concurrently; every thread's results must equal the same lookups
- * made alone with an unlimited budget. Run under ThreadSanitizer by
- * `make test-tsan`.
+ * Textures under threads (shade/texture, OpenImageIO's TextureSystem):
+ * eight threads look up three textures with random footprints through one
+ * TextureSystem with the smallest budget, opening files and making their
+ * MIP levels concurrently; every thread's results must equal the same
+ * lookups made alone with an unlimited budget. Run under ThreadSanitizer
+ * by `make test-tsan` (OpenImageIO itself is not instrumented).
  */
 #include <pthread.h>
 #include <stdint.h>
@@ -92,8 +92,6 @@ static void test_threads_match_one_thread(void)
     texture_get_stats(small, &st);
     CHECK(st.lookups == (uint64_t)THREADS * N);
     CHECK(st.textures == 3 && st.missing == 0);
-    CHECK(st.evictions > 0);
-    CHECK(st.peak_bytes <= 60000);
     texture_system_free(small);
 }
 
