@@ -33,10 +33,13 @@ test: deps-test test-release test-asan test-tsan test-fuzz
 test-release: build
 	cd build && ctest --output-on-failure -j $(JOBS)
 
+# new_delete_type_mismatch=0: OpenImageIO 2.4's TextureSystem::destroy
+# deletes its implementation through the base class with a sized delete,
+# inside the library (rayes' two C++ files delete what they new).
 test-asan:
 	@test -f build-asan/Makefile || cmake -S . -B build-asan -DCMAKE_BUILD_TYPE=Debug -DRAYES_SANITIZE=ON
 	cmake --build build-asan -j $(JOBS)
-	cd build-asan && ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 ctest --output-on-failure -j $(JOBS)
+	cd build-asan && ASAN_OPTIONS=detect_leaks=1:new_delete_type_mismatch=0 UBSAN_OPTIONS=print_stacktrace=1 ctest --output-on-failure -j $(JOBS)
 
 # ThreadSanitizer on the threaded code of our own: the cache (its stress
 # test hammers a tiny budget from many threads), the renderer's thread

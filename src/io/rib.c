@@ -354,6 +354,30 @@ static int h_nothing(Rib *r, const Args *a)
     return 0;
 }
 
+/* DetailRange minvisible lowertransition uppertransition maxvisible:
+ * RenderMan's level of detail. rayes renders the most detailed
+ * representation (the one whose range is open to infinity, RenderMan's
+ * RI_INFINITY) and skips the others, instead of measuring the Detail
+ * bound's raster size: the choice RenderMan makes close up, never two
+ * representations overlapping. */
+static int h_detail_range(Rib *r, const Args *a)
+{
+    size_t i = 0;
+    float v[4];
+    if (rib_get_floats(r, a, &i, v, 4,
+                       "4 numbers (minvisible lowertransition "
+                       "uppertransition maxvisible)") != 0)
+        return -1;
+    if (!(v[0] <= v[1] && v[1] <= v[2] && v[2] <= v[3]))
+        return rib_error(r, "expected 4 numbers in order, found %g %g %g %g", v[0], v[1], v[2],
+                         v[3]);
+    r->a.lod_coarse = v[3] < 1e30f;
+    rib_warn_once(r, "DetailRange",
+                  "DetailRange: the most detailed representation (its range "
+                  "open to infinity) is rendered, the others skipped");
+    return 0;
+}
+
 static int h_skip(Rib *r, const Args *a)
 {
     (void)a;
@@ -407,8 +431,8 @@ static const RibRequest own_requests[] = {
     {"Interior", h_skip},
     {"Exterior", h_skip},
     {"Deformation", h_skip},
-    {"Detail", h_skip},
-    {"DetailRange", h_skip},
+    {"Detail", h_nothing},
+    {"DetailRange", h_detail_range},
     {"RelativeDetail", h_skip},
     {"GeometricApproximation", h_skip},
     {"ShadingInterpolation", h_skip},
@@ -469,7 +493,7 @@ static int dispatch(Rib *r, const Args *a)
     for (size_t t = 0; t < sizeof tables / sizeof tables[0]; t++)
         for (const RibRequest *k = tables[t]; k->name; k++)
             if (strcmp(k->name, q) == 0)
-                return k->fn(r, a);
+                return tables[t] == rib_prim_requests && r->a.lod_coarse ? 0 : k->fn(r, a);
     return rib_error(r, "unknown request (expected a RIB request such as WorldBegin or Polygon)");
 }
 

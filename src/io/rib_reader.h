@@ -109,6 +109,8 @@ typedef struct Attr {
     float area_L[3];
     float ubasis[16], vbasis[16];
     int ustep, vstep;
+    int lod_coarse; /* DetailRange ends before infinity: a coarser representation,
+                       whose primitives are skipped */
 } Attr;
 
 typedef struct SinkState {

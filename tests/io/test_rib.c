@@ -997,10 +997,24 @@ static void test_writer_split_quad(void)
     CHECK(memcmp(rec.last_mesh_P0, P[0], sizeof P[0]) == 0);
 }
 
+/* Level of detail: of the representations DetailRange selects, the most
+ * detailed (open to infinity) is drawn, the others skipped, within their
+ * attribute blocks only; bad ranges are errors. */
+static void test_detail_range(void)
+{
+    CHECK(parse("WorldBegin\nAttributeBegin\nDetail [-1 1 -1 1 -1 1]\n"
+                "AttributeBegin\nDetailRange [0 0 10 20]\nSphere 1 -1 1 360\n"
+                "Polygon \"P\" [0 0 0 1 0 0 1 1 0]\nAttributeEnd\n"
+                "AttributeBegin\nDetailRange [10 20 1e38 1e38]\nCylinder 1 0 1 360\n"
+                "AttributeEnd\nAttributeEnd\nDisk 0 1 360\nWorldEnd\n") == RAYES_OK);
+    CHECK(rec.quadrics == 2 && rec.meshes == 0);
+    CHECK(parse("WorldBegin\nDetailRange [0 10 5 20]\nWorldEnd\n") != RAYES_OK);
+    CHECK(strstr(err, "in order"));
+}
+
 TEST_MAIN(TEST(test_camera_and_transforms), TEST(test_settings), TEST(test_shaders_and_lights),
           TEST(test_parameter_classes), TEST(test_polygons), TEST(test_patch_mesh_bases),
           TEST(test_handles), TEST(test_objects_and_frames), TEST(test_binary), TEST(test_gzip),
-          TEST(test_errors),
-          TEST(test_aqsis_files), TEST(test_scene_sink),
-          TEST(test_writer_round_trip), TEST(test_writer_primvars),
-          TEST(test_writer_split_quad))
+          TEST(test_errors), TEST(test_aqsis_files), TEST(test_scene_sink),
+          TEST(test_writer_round_trip), TEST(test_writer_primvars), TEST(test_writer_split_quad),
+          TEST(test_detail_range))
