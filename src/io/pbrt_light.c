@@ -80,6 +80,7 @@ int pbrt_d_light(Parser *P, const Token *t)
     double scale = pbrt_get_float(&pl, "scale", 1.0), power = pbrt_get_float(&pl, "power", 0.0);
     float col[3];
     RayesParam lp[8];
+    char map_path[4096];
     size_t n = 0;
     const char *rtype = NULL;
     double zero3[3] = {0, 0, 0}, z1[3] = {0, 0, 1};
@@ -130,12 +131,14 @@ int pbrt_d_light(Parser *P, const Token *t)
         if (pbrt_get_color(P, &pl, "L", one, col, NULL) < 0)
             r = -1;
         const char *file = pbrt_get_string(&pl, "filename", NULL);
-        if (file)
-            pbrt_warn_at(P, t->line, t->col, "infinite map",
-                         "LightSource \"infinite\": \"%.60s\" is an equal-area octahedral map, "
-                         "which rayes cannot read (it takes latitude-longitude maps); using a "
-                         "constant environment of radiance scale",
-                         file);
+        if (file && !r) {
+            /* pbrt-v4's maps are equal-area octahedral squares */
+            r = pbrt_resolve(P, t, file, map_path, sizeof map_path);
+            lp[n++] =
+                (RayesParam){.name = "mapname", .type = RAYES_PARAM_STRING, .string = map_path};
+            lp[n++] =
+                (RayesParam){.name = "mapping", .type = RAYES_PARAM_STRING, .string = "octahedral"};
+        }
         if (pbrt_get_float(&pl, "illuminance", 0.0) > 0)
             pbrt_warn_at(P, t->line, t->col, "infinite illuminance", "LightSource \"infinite\": "
                          "\"illuminance\" is not supported; using scale");

@@ -1024,7 +1024,7 @@ typedef struct LightParams {
     float intensity, color[3], from[3], to[3];
     float coneangle, conedeltaangle, beamdistribution;
     float radius, width, height;
-    const char *mapname, *shape, *category;
+    const char *mapname, *mapping, *shape, *category;
 } LightParams;
 
 typedef struct LightParamDesc {
@@ -1045,6 +1045,7 @@ static const LightParamDesc light_param_descs[] = {
     {"width", RAYES_PARAM_FLOAT, offsetof(LightParams, width)},
     {"height", RAYES_PARAM_FLOAT, offsetof(LightParams, height)},
     {"mapname", RAYES_PARAM_STRING, offsetof(LightParams, mapname)},
+    {"mapping", RAYES_PARAM_STRING, offsetof(LightParams, mapping)},
     {"shape", RAYES_PARAM_STRING, offsetof(LightParams, shape)},
     {"__category", RAYES_PARAM_STRING, offsetof(LightParams, category)},
 };
@@ -1052,9 +1053,19 @@ static const LightParamDesc light_param_descs[] = {
 static RayesError light_params(RayesScene *s, const char *type, const RayesParam *params,
                                size_t n_params, LightParams *lp)
 {
-    *lp = (LightParams){.intensity = 1, .color = {1, 1, 1}, .to = {0, 0, 1}, .coneangle = 30,
-                        .conedeltaangle = 5, .beamdistribution = 2, .radius = 1, .width = 1,
-                        .height = 1, .mapname = "", .shape = "quad", .category = ""};
+    *lp = (LightParams){.intensity = 1,
+                        .color = {1, 1, 1},
+                        .to = {0, 0, 1},
+                        .coneangle = 30,
+                        .conedeltaangle = 5,
+                        .beamdistribution = 2,
+                        .radius = 1,
+                        .width = 1,
+                        .height = 1,
+                        .mapname = "",
+                        .mapping = "latlong",
+                        .shape = "quad",
+                        .category = ""};
     for (size_t i = 0; i < n_params; i++) {
         const RayesParam *p = &params[i];
         if (!p->name)
@@ -1193,9 +1204,14 @@ RayesError rayes_scene_light(RayesScene *s, const char *type, const RayesParam *
         rot.m[0][3] = rot.m[1][3] = rot.m[2][3] = 0.0f;
         l.world_from_light = rot;
         mat4_invert(rot, &l.light_from_world);
+        int octahedral = strcmp(lp.mapping, "octahedral") == 0;
+        if (!octahedral && strcmp(lp.mapping, "latlong") != 0)
+            return fail(s, RAYES_ERROR_INVALID_ARGUMENT,
+                        "environmentlight: unknown mapping \"%s\"; expected latlong or octahedral",
+                        lp.mapping);
         if (lp.mapname[0]) {
             char err[400];
-            if (light_env_load(&l, lp.mapname, err, sizeof err) != 0)
+            if (light_env_load(&l, lp.mapname, octahedral, err, sizeof err) != 0)
                 return fail(s, RAYES_ERROR_IO, "%s", err);
         }
         e = push_light(s, &l, NULL, 0);

@@ -359,7 +359,59 @@ int light_intersect(const Light *l, Vec3 o, Vec3 wi, LightSample *s)
 
 /* ------------------------------------------------------- map loading */
 
-int light_env_load(Light *l, const char *path, char *err, size_t err_size)
+/* Clarberg's equal-area map of the unit sphere onto the square [0, 1]^2
+ * (pbrt-v4's EqualAreaSphereToSquare), with the exact arctangent. */
+static void equal_area_sphere_to_square(Vec3 d, float *u, float *v)
+{
+    float x = fabsf(d.x), y = fabsf(d.y), z = fabsf(d.z);
+    float r = sqrtf(fmaxf(0.0f, 1.0f - z));
+    float a = fmaxf(x, y), b = fminf(x, y);
+    b = a == 0.0f ? 0.0f : b / a;
+    float phi = atanf(b) * 2.0f / PI;
+    if (x < y)
+        phi = 1.0f - phi;
+    float vv = phi * r, uu = r - vv;
+    if (d.z < 0.0f) {
+        float t = uu;
+        uu = 1.0f - vv, vv = 1.0f - t;
+    }
+    uu = copysignf(uu, d.x), vv = copysignf(vv, d.y);
+    *u = 0.5f * (uu + 1.0f), *v = 0.5f * (vv + 1.0f);
+}
+
+/* The octahedral map src (n x n RGBA) resampled into a latitude-longitude
+ * map of 2n x n: new array, or NULL. */
+static float *octahedral_to_latlong(const float *src, int n)
+{
+    int w = 2 * n, h = n;
+    float *out = malloc((size_t)w * h * 4 * sizeof *out);
+    if (!out)
+        return NULL;
+    for (int y = 0; y < h; y++)
+        for (int x = 0; x < w; x++) {
+            float phi = (((float)x + 0.5f) / (float)w - 0.5f) * 2.0f * PI;
+            float theta = ((float)y + 0.5f) / (float)h * PI, st = sinf(theta);
+            Vec3 ld = v3(-st * sinf(phi), cosf(theta), st * cosf(phi)); /* as env_uv_to_dir */
+            float u, v;
+            equal_area_sphere_to_square(ld, &u, &v);
+            float fx = u * (float)n - 0.5f, fy = v * (float)n - 0.5f;
+            int x0 = (int)floorf(fx), y0 = (int)floorf(fy);
+            float tx = fx - (float)x0, ty = fy - (float)y0;
+            float *o = &out[4 * ((size_t)y * w + x)];
+            memset(o, 0, 4 * sizeof *o);
+            for (int k = 0; k < 4; k++) {
+                int sx = x0 + (k & 1), sy = y0 + (k >> 1);
+                sx = sx < 0 ? 0 : sx >= n ? n - 1 : sx;
+                sy = sy < 0 ? 0 : sy >= n ? n - 1 : sy;
+                float wgt = ((k & 1) ? tx : 1.0f - tx) * ((k >> 1) ? ty : 1.0f - ty);
+                for (int c = 0; c < 4; c++)
+                    o[c] += wgt * src[4 * ((size_t)sy * n + sx) + (size_t)c];
+            }
+        }
+    return out;
+}
+
+int light_env_load(Light *l, const char *path, int octahedral, char *err, size_t err_size)
 {
     int w = 0, h = 0;
     float *rgba = NULL;
@@ -369,6 +421,24 @@ int light_env_load(Light *l, const char *path, char *err, size_t err_size)
                  ierr[0] ? ierr : "expected a latitude-longitude map");
         free(rgba);
         return -1;
+    }
+    if (octahedral) {
+        if (w != h) {
+            snprintf(err, err_size,
+                     "environment light: %s: an octahedral map must be square, "
+                     "not %d x %d",
+                     path, w, h);
+            free(rgba);
+            return -1;
+        }
+        float *ll = octahedral_to_latlong(rgba, w);
+        free(rgba);
+        if (!ll) {
+            snprintf(err, err_size, "environment light: out of memory for %s", path);
+            return -1;
+        }
+        rgba = ll;
+        w = 2 * h;
     }
     LightEnvMap *m = calloc(1, sizeof *m);
     size_t n = (size_t)w * h;

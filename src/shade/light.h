@@ -119,9 +119,14 @@ int light_intersect(const Light *l, Vec3 o, Vec3 wi, LightSample *s);
 /* The environment light's radiance along world direction d (unit). */
 Vec3 light_env_radiance(const Light *l, Vec3 d);
 
-/* Reads a latitude-longitude map (EXR, or PNG decoded to linear) and builds
- * its distribution. Returns 0, or -1 with a one-line message in err. */
-int light_env_load(Light *l, const char *path, char *err, size_t err_size);
+/* Reads an environment map (any format OpenImageIO reads, linear) and
+ * builds its distribution. A latitude-longitude map (octahedral 0) is
+ * used as it is; a square equal-area octahedral map (pbrt-v4's, octahedral
+ * 1: light-space direction d at Clarberg's EqualAreaSphereToSquare(d), its
+ * (0, 0) the top left) is resampled, bilinearly, into a latitude-longitude
+ * map of twice its width. Returns 0, or -1 with a one-line message in
+ * err. */
+int light_env_load(Light *l, const char *path, int octahedral, char *err, size_t err_size);
 
 /* Frees what the light owns. */
 void light_fini(Light *l);

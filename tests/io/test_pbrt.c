@@ -546,9 +546,11 @@ static void test_lights(void)
     const char *text =
         "WorldBegin\n"
         "LightSource \"point\" \"rgb I\" [1 2 3] \"float scale\" 4 \"point3 from\" [0 5 0]\n"
-        "LightSource \"spot\" \"point3 from\" [0 0 0] \"point3 to\" [0 -1 0] \"float coneangle\" 20\n"
-        "LightSource \"distant\" \"point3 from\" [0 1 0] \"point3 to\" [0 0 0] \"blackbody L\" 3000\n"
-        "LightSource \"infinite\" \"rgb L\" [0.1 0.2 0.3]\n"
+        "LightSource \"spot\" \"point3 from\" [0 0 0] \"point3 to\" [0 -1 0] \"float coneangle\" "
+        "20\n"
+        "LightSource \"distant\" \"point3 from\" [0 1 0] \"point3 to\" [0 0 0] \"blackbody L\" "
+        "3000\n"
+        "LightSource \"infinite\" \"rgb L\" [0.1 0.2 0.3] \"string filename\" \"sky.exr\"\n"
         "LightSource \"goniometric\" \"string filename\" \"x.exr\"\n"
         "AttributeBegin\n"
         "  AreaLightSource \"diffuse\" \"rgb L\" [2 2 2] \"float scale\" 3\n"
@@ -576,6 +578,9 @@ static void test_lights(void)
         CHECK(strcmp(r->light[2].type, "distantlight") == 0 && param(p, "lightcolor") &&
               param(p, "lightcolor")->value[0] == 1 && param(p, "lightcolor")->value[2] < 0.5);
         CHECK(strcmp(r->light[3].type, "environmentlight") == 0);
+        p = &r->light[3].params;
+        CHECK(param(p, "mapping") && strcmp(param(p, "mapping")->string, "octahedral") == 0);
+        CHECK(param(p, "mapname") && strstr(param(p, "mapname")->string, "sky.exr") != NULL);
         CHECK(strcmp(r->light[4].type, "arealight") == 0); /* the sphere */
         p = &r->light[4].params;
         CHECK(param(p, "shape") && strcmp(param(p, "shape")->string, "sphere") == 0);

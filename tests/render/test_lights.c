@@ -431,6 +431,44 @@ static void test_environment_map_importance_sampling(void)
     fx_fini(&f);
 }
 
+/* pbrt-v4's equal-area octahedral maps: the square's centre is light-space
+ * +z, its corners -z, the middle of its right edge +x and of its top row
+ * -y (pbrt's EqualAreaSphereToSquare, (0, 0) the top left). Red marks the
+ * centre, green the top rows; a map that is not square is an error. */
+static void test_octahedral_environment_map(void)
+{
+    enum { N = 32 };
+    const char *path = RAYES_TEST_TMP "/test_lights_octahedral.exr";
+    float *p = calloc((size_t)N * N * 4, sizeof *p);
+    for (int y = 0; y < N; y++)
+        for (int x = 0; x < N; x++) {
+            float *q = &p[4 * (y * N + x)];
+            q[0] = abs(2 * x + 1 - N) < 8 && abs(2 * y + 1 - N) < 8 ? 1.0f : 0.0f;
+            q[1] = y < N / 8 && abs(2 * x + 1 - N) < 8 ? 1.0f : 0.0f;
+            q[2] = 0.25f;
+            q[3] = 1.0f;
+        }
+    CHECK(image_write_exr(path, N, N, p, NULL, 0) == RAYES_OK);
+    free(p);
+    RayesScene *s = rayes_scene_new();
+    RayesParam e[2] = {ps("mapname", path), ps("mapping", "octahedral")};
+    CHECK(rayes_scene_light(s, "environmentlight", e, 2) == RAYES_OK);
+    const Light *l = &s->lights[0];
+    CHECK(light_env_radiance(l, v3(0, 0, 1)).x == 1.0f);
+    CHECK(light_env_radiance(l, v3(0, 0, -1)).x == 0.0f);
+    CHECK(light_env_radiance(l, v3(1, 0, 0)).x == 0.0f);
+    CHECK(light_env_radiance(l, v3(0, -1, 0)).y > 0.9f);
+    CHECK(light_env_radiance(l, v3(0, 1, 0)).y == 0.0f);
+    CHECK_NEAR(light_env_radiance(l, v3_normalize(v3(1, 1, 1))).z, 0.25, 1e-6);
+    RayesParam bad[2] = {ps("mapname", RAYES_TEST_TMP "/test_lights_map.exr"),
+                         ps("mapping", "octahedral")};
+    CHECK(rayes_scene_light(s, "environmentlight", bad, 2) == RAYES_ERROR_IO);
+    CHECK(strstr(rayes_scene_get_error(s), "must be square") != NULL);
+    RayesParam odd[1] = {ps("mapping", "cube")};
+    CHECK(rayes_scene_light(s, "environmentlight", odd, 1) == RAYES_ERROR_INVALID_ARGUMENT);
+    rayes_scene_release(s);
+}
+
 /* ----------------------------------------------------------- categories */
 
 static void test_categories(void)
@@ -693,6 +731,6 @@ TEST_MAIN(TEST(test_point_light_inverse_square), TEST(test_spot_light_cone),
           TEST(test_mis_glossy_large_quad), TEST(test_glossy_lights_against_brute_force),
           TEST(test_glossy_surroundings_against_brute_force),
           TEST(test_constant_environment_white_furnace),
-          TEST(test_environment_map_importance_sampling), TEST(test_categories),
-          TEST(test_emitters_seen_by_camera), TEST(test_every_light_any_thread_count),
-          TEST(test_bad_lights))
+          TEST(test_environment_map_importance_sampling), TEST(test_octahedral_environment_map),
+          TEST(test_categories), TEST(test_emitters_seen_by_camera),
+          TEST(test_every_light_any_thread_count), TEST(test_bad_lights))
