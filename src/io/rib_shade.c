@@ -282,6 +282,11 @@ static int h_displacement(Rib *r, const Args *a)
         free(p);
         return -1;
     }
+    if (strcmp(name, "null") == 0 || name[0] == '\0') { /* RenderMan's "no shader" */
+        r->a.displacement = NULL;
+        free(p);
+        return 0;
+    }
     if (!shader_known(r, builtin_displacements, name)) {
         char key[128];
         snprintf(key, sizeof key, "displacement %s", name);

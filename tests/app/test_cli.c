@@ -468,6 +468,22 @@ static void test_vertex_budget(void)
     CHECK(strstr(json, "\"coarsened\": 1,") == NULL && strstr(json, "\"coarsened\"") != NULL);
 }
 
+/* Displacement "null" (RenderMan's "no shader", which the RIB writer
+ * writes to end a displacement) is read silently. */
+static void test_null_displacement(void)
+{
+    static Run r;
+    setup();
+    write_text(SCRATCH_DIR "/null.rib", "Projection \"perspective\" \"fov\" 40\n"
+                                        "WorldBegin\nLightSource \"pointlight\" 1\n"
+                                        "Displacement \"bumpy\"\nDisplacement \"null\"\n"
+                                        "Translate 0 0 5\nSphere 1 -1 1 360\nWorldEnd\n");
+    run(&r, NULL,
+        ARGS("render", SCRATCH_DIR "/null.rib", "--res", "16", "--spp", "1", "--quiet", "-o",
+             SCRATCH_DIR "/null.png"));
+    CHECK(r.status == 0 && r.err[0] == '\0');
+}
+
 /* A scene without lights: one warning naming the scene and the way out,
  * and a black image; --default-light adds a headlight that lights it. */
 static void test_default_light(void)
@@ -569,4 +585,5 @@ TEST_MAIN(TEST(test_version_and_help), TEST(test_no_arguments), TEST(test_usage_
           TEST(test_missing_data), TEST(test_render_outputs), TEST(test_render_summary),
           TEST(test_data_from_environment), TEST(test_unwritable_output), TEST(test_shader_path),
           TEST(test_render_obj), TEST(test_rib_grid_size), TEST(test_vertex_budget),
-          TEST(test_default_light), TEST(test_convert), TEST(test_bad_scene_file))
+          TEST(test_null_displacement), TEST(test_default_light), TEST(test_convert),
+          TEST(test_bad_scene_file))
