@@ -567,6 +567,28 @@ RayesError rayes_scene_polygon_mesh(RayesScene *s, size_t n_faces, const int *n_
     return rayes_scene_polygon_mesh_pv(s, n_faces, n_verts, indices, n_points, P, NULL, 0);
 }
 
+/* Checks a mesh's faces: sizes from lo to hi vertices (hint names the rule
+ * in messages) and every index a point. Writes the corners' count. */
+static RayesError check_faces(RayesScene *s, const char *what, size_t n_faces, const int *n_verts,
+                              const int *indices, size_t n_points, int lo, int hi, const char *hint,
+                              size_t *n_corners)
+{
+    size_t k = 0;
+    for (size_t f = 0; f < n_faces; f++) {
+        if (n_verts[f] < lo || n_verts[f] > hi)
+            return fail(s, RAYES_ERROR_INVALID_ARGUMENT,
+                        "%s: face %zu has %d vertices; expected %s", what, f, n_verts[f], hint);
+        for (int v = 0; v < n_verts[f]; v++)
+            if (indices[k + (size_t)v] < 0 || (size_t)indices[k + (size_t)v] >= n_points)
+                return fail(s, RAYES_ERROR_INVALID_ARGUMENT,
+                            "%s: face %zu uses vertex %d; expected 0 to %zu", what, f,
+                            indices[k + (size_t)v], n_points ? n_points - 1 : 0);
+        k += (size_t)n_verts[f];
+    }
+    *n_corners = k;
+    return RAYES_OK;
+}
+
 RayesError rayes_scene_polygon_mesh_pv(RayesScene *s, size_t n_faces, const int *n_verts,
                                        const int *indices, size_t n_points, const float *P,
                                        const RayesPrimvar *pv, size_t n_pv)
@@ -576,20 +598,13 @@ RayesError rayes_scene_polygon_mesh_pv(RayesScene *s, size_t n_faces, const int 
     if (!finite_n(P, 3 * n_points))
         return fail(s, RAYES_ERROR_INVALID_ARGUMENT, "polygon mesh: non-finite point");
     size_t k = 0;
-    for (size_t f = 0; f < n_faces; f++) {
-        if (n_verts[f] != 3 && n_verts[f] != 4)
-            return fail(s, RAYES_ERROR_INVALID_ARGUMENT,
-                        "polygon mesh: face %zu has %d vertices; expected 3 or 4", f, n_verts[f]);
-        for (int v = 0; v < n_verts[f]; v++)
-            if (indices[k + (size_t)v] < 0 || (size_t)indices[k + (size_t)v] >= n_points)
-                return fail(s, RAYES_ERROR_INVALID_ARGUMENT,
-                            "polygon mesh: face %zu uses vertex %d; expected 0 to %zu", f,
-                            indices[k + (size_t)v], n_points ? n_points - 1 : 0);
-        k += (size_t)n_verts[f];
-    }
+    RayesError e =
+        check_faces(s, "polygon mesh", n_faces, n_verts, indices, n_points, 3, 4, "3 or 4", &k);
+    if (e != RAYES_OK)
+        return e;
     const size_t expect[5] = {1, n_faces, n_points, n_points, k};
     PrimvarSet set;
-    RayesError e = check_primvars(s, "polygon mesh", pv, n_pv, expect, &set);
+    e = check_primvars(s, "polygon mesh", pv, n_pv, expect, &set);
     if (e != RAYES_OK)
         return e;
     k = 0;
@@ -624,23 +639,11 @@ static RayesError check_subdiv(RayesScene *s, RayesSubdivScheme scheme, size_t n
         return fail(s, RAYES_ERROR_INVALID_ARGUMENT, "%s: unknown scheme %d", what, (int)scheme);
     if (n_faces > INT32_MAX || n_points > INT32_MAX)
         return fail(s, RAYES_ERROR_INVALID_ARGUMENT, "%s: too many faces or points", what);
-    size_t k = 0;
-    for (size_t f = 0; f < n_faces; f++) {
-        int want3 = scheme == RAYES_SUBDIV_LOOP;
-        if (n_verts[f] < 3 || n_verts[f] > 64 || (want3 && n_verts[f] != 3))
-            return fail(s, RAYES_ERROR_INVALID_ARGUMENT,
-                        "%s: face %zu has %d vertices; expected %s", what, f, n_verts[f],
-                        want3 ? "3 (Loop takes triangles)" : "3 to 64");
-        for (int v = 0; v < n_verts[f]; v++)
-            if (indices[k + (size_t)v] < 0 || (size_t)indices[k + (size_t)v] >= n_points)
-                return fail(s, RAYES_ERROR_INVALID_ARGUMENT,
-                            "%s: face %zu uses vertex %d; expected 0 to %zu", what, f,
-                            indices[k + (size_t)v], n_points ? n_points - 1 : 0);
-        k += (size_t)n_verts[f];
-    }
-    *n_corners = k;
-    if (!t)
-        return RAYES_OK;
+    int loop = scheme == RAYES_SUBDIV_LOOP;
+    RayesError e = check_faces(s, what, n_faces, n_verts, indices, n_points, 3, loop ? 3 : 64,
+                               loop ? "3 (Loop takes triangles)" : "3 to 64", n_corners);
+    if (e != RAYES_OK || !t)
+        return e;
     if (t->interpolate_boundary < 0 || t->interpolate_boundary > 2 || t->facevarying_boundary < 0 ||
         t->facevarying_boundary > 3)
         return fail(s, RAYES_ERROR_INVALID_ARGUMENT,

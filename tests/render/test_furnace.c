@@ -73,6 +73,15 @@ static double furnace_mean(float albedo, int bounces, int diffuse_rays, int thre
     return furnace_mean_at(albedo, bounces, diffuse_rays, threads, cache, 1.0f, 0);
 }
 
+/* sum_{k=0..n} a^k: the furnace's exact image after n bounces. */
+static double geometric_sum(float a, int n)
+{
+    double sum = 0.0, ak = 1.0;
+    for (int k = 0; k <= n; k++, ak *= a)
+        sum += ak;
+    return sum;
+}
+
 static void test_furnace_each_bounce_count(void)
 {
     const float a = 0.5f;
@@ -89,9 +98,7 @@ static void test_furnace_each_bounce_count(void)
 static void test_furnace_each_resolution(void)
 {
     const float a = 0.8f;
-    double finite = 0.0, ak = 1.0;
-    for (int k = 0; k <= 6; k++, ak *= a)
-        finite += ak;
+    double finite = geometric_sum(a, 6);
     for (int cache = -2; cache <= 2; cache++) {
         double m = furnace_mean(a, 6, 2, 2, cache);
         CHECK_NEAR(m / finite, 1.0, 0.005);
@@ -103,9 +110,7 @@ static void test_furnace_each_resolution(void)
 static void test_furnace_offscreen_dicing(void)
 {
     const float a = 0.8f;
-    double finite = 0.0, ak = 1.0;
-    for (int k = 0; k <= 6; k++, ak *= a)
-        finite += ak;
+    double finite = geometric_sum(a, 6);
     for (int cache = -2; cache <= -1; cache++) {
         double m = furnace_mean_at(a, 6, 2, 2, cache, 4.0f, 0);
         CHECK_NEAR(m / finite, 1.0, 0.01);
@@ -119,9 +124,7 @@ static void test_furnace_offscreen_dicing(void)
 static void test_furnace_subdivision(void)
 {
     const float a = 0.8f;
-    double finite = 0.0, ak = 1.0;
-    for (int k = 0; k <= 6; k++, ak *= a)
-        finite += ak;
+    double finite = geometric_sum(a, 6);
     for (int cache = -2; cache <= 2; cache++) {
         double m = furnace_mean_at(a, 6, 2, 2, cache, 1.0f, 1);
         CHECK_NEAR(m / finite, 1.0, 0.005);
@@ -134,9 +137,7 @@ static void test_furnace_converges_to_infinite_sum(void)
     /* 0.8^12 = 0.07: twelve bounces (one ray each: every path carries the same value) leave 6.9% of 1/(1-a) out,
      * which the finite sum accounts for. */
     const float a = 0.8f;
-    double finite = 0.0, ak = 1.0;
-    for (int k = 0; k <= 12; k++, ak *= a)
-        finite += ak;
+    double finite = geometric_sum(a, 12);
     double m = furnace_mean(a, 12, 1, 2, -1);
     CHECK_NEAR(m / finite, 1.0, 0.01);
     CHECK(m < 1.0 / (1.0 - a));
