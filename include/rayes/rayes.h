@@ -279,6 +279,62 @@ RAYES_API RayesError rayes_scene_subdivision_mesh(RayesScene *scene, RayesSubdiv
                                                   const float *P, const RayesSubdivTags *tags,
                                                   const RayesPrimvar *pv, size_t n_pv);
 
+/* Curves (RenderMan's Curves, pbrt-v4's curve): n_curves curves of
+ * n_verts[c] control points each, P all their points back to back.
+ * degree 1 is linear; degree 3 is cubic in RenderMan's basis matrix
+ * (RiBasis's: a segment is [t^3 t^2 t 1] basis G, G its 4 control points,
+ * the next segment step points on; Bezier has step 3, B-spline and
+ * Catmull-Rom 1). A non-periodic cubic curve has (n - 4) / step + 1
+ * segments (n - 4 a multiple of step), a periodic one n / step (n a
+ * multiple of step) and wraps; a linear one n - 1, or n when periodic.
+ *
+ * Primitive variables: "width" (1 float, object units, the diameter;
+ * default 1), "N" (3 floats: the curves become ribbons facing N, which
+ * should be across the curve), "Cs", "st". Classes: constant, uniform
+ * (one per curve), varying (one per segment end: segments + 1 per
+ * non-periodic curve, segments per periodic one; facevarying reads as
+ * varying), vertex (one per control point, interpolated with the basis).
+ * Without N, shape says how they are traced: RAYES_CURVE_ROUND tubes or
+ * RAYES_CURVE_FLAT ribbons that face each ray. They are diced into grids
+ * one micropolygon wide (cached like any surface) facing the camera. */
+typedef enum RayesCurveShape { RAYES_CURVE_ROUND = 0, RAYES_CURVE_FLAT = 1 } RayesCurveShape;
+
+typedef struct RayesCurves {
+    int degree;              /* 1 or 3 */
+    float basis[16];         /* degree 3: row-major basis matrix (RiBezierBasis, ...) */
+    int step;                /* degree 3: 1 to 4 */
+    int periodic;            /* 1: every curve wraps */
+    RayesCurveShape shape;   /* without N */
+    size_t n_curves;
+    const int *n_verts;      /* control points per curve */
+    const float *P;          /* 3 floats per control point */
+} RayesCurves;
+
+/* RenderMan's cubic bases, row-major, for RayesCurves.basis. */
+RAYES_API extern const float rayes_basis_bezier[16];
+RAYES_API extern const float rayes_basis_bspline[16];
+RAYES_API extern const float rayes_basis_catmull_rom[16];
+
+RAYES_API RayesError rayes_scene_curves(RayesScene *scene, const RayesCurves *curves,
+                                        const RayesPrimvar *pv, size_t n_pv);
+
+/* The counts primitive variables of curves must have: control points
+ * (vertex) and segment ends (varying). Returns the index of the first
+ * curve whose count makes no whole segments, or of a bad degree or step
+ * (0), as -1 - index; else 0. */
+RAYES_API long rayes_curves_counts(const RayesCurves *curves, size_t *n_points, size_t *n_varying);
+
+/* Points (RenderMan's Points): n_points spheres or disks facing each ray
+ * (shape), or with "N" disks facing N, centred at P. Primitive
+ * variables: "width" (the diameter, object units; constant, or varying or
+ * vertex: one per point; default 1), "N", "Cs", "st" (constant, uniform:
+ * 1, varying or vertex: one per point). Each point is one grid. */
+typedef enum RayesPointShape { RAYES_POINT_SPHERE = 0, RAYES_POINT_DISK = 1 } RayesPointShape;
+
+RAYES_API RayesError rayes_scene_points(RayesScene *scene, RayesPointShape shape,
+                                        size_t n_points, const float *P, const RayesPrimvar *pv,
+                                        size_t n_pv);
+
 /* A sphere of the given radius centred at the object-space origin. */
 RAYES_API RayesError rayes_scene_sphere(RayesScene *scene, float radius);
 

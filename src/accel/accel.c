@@ -5,7 +5,10 @@
  * grid buffer lists its grids (startVertexID = the grid's first vertex in
  * the shared vertex array, stride = nu); per object with triangular grids,
  * one RTC_GEOMETRY_TYPE_TRIANGLE whose index buffer lists every
- * micropolygon. Geom records map (geomID, primID) back to grids.
+ * micropolygon; per object with curves, one ROUND_ or FLAT_LINEAR_CURVE
+ * through the centre lines of their grids; per object with points, one
+ * SPHERE_ or DISC_POINT, a point per grid. Geom records map (geomID,
+ * primID) back to grids.
  *
  * Embree with TBB builds on its own threads; commit happens once, before
  * any query, and queries are concurrent (Embree's contract).
@@ -27,10 +30,19 @@ typedef struct MicroTri {
     uint8_t upper;     /* 0: (i,j),(i+1,j),(i,j+1); 1: (i+1,j),(i+1,j+1),(i,j+1) */
 } MicroTri;
 
+typedef struct CurveSeg {
+    uint32_t grid;     /* patch id */
+    uint32_t i;        /* the segment from centre-line vertex i to i + 1 */
+} CurveSeg;
+
+typedef enum GeomKind { KIND_QUADS, KIND_TRIS, KIND_CURVES, KIND_POINTS } GeomKind;
+
 typedef struct Geom {
-    int triangular;
-    uint32_t *grids;   /* quad: primID -> grid index */
-    MicroTri *tris;    /* triangle: primID -> micropolygon */
+    GeomKind kind;
+    uint8_t shape;     /* GeomShape of its grids */
+    uint32_t *grids;   /* quads, points: primID -> grid index */
+    MicroTri *tris;    /* triangles: primID -> micropolygon */
+    CurveSeg *segs;    /* curves: primID -> segment */
 } Geom;
 
 struct Accel {
@@ -76,7 +88,7 @@ static int build_quads(Accel *a, const uint32_t *idx, size_t n, uint32_t mask)
                                sizeof(Vec3), gs->n_vertices);
     struct RTCGrid *grids = rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_GRID, 0, RTC_FORMAT_GRID,
                                              sizeof(struct RTCGrid), n);
-    Geom g = {.triangular = 0, .grids = malloc(n * sizeof(uint32_t))};
+    Geom g = {.kind = KIND_QUADS, .grids = malloc(n * sizeof(uint32_t))};
     if (!grids || !g.grids) {
         free(g.grids);
         rtcReleaseGeometry(geom);
@@ -128,7 +140,7 @@ static int build_tris(Accel *a, const uint32_t *idx, size_t n, uint32_t mask)
                                sizeof(Vec3), gs->n_vertices);
     uint32_t(*tri)[3] = rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
                                                 3 * sizeof(uint32_t), n_tris);
-    Geom g = {.triangular = 1, .tris = malloc(n_tris * sizeof(MicroTri))};
+    Geom g = {.kind = KIND_TRIS, .tris = malloc(n_tris * sizeof(MicroTri))};
     if (!tri || !g.tris) {
         free(g.tris);
         rtcReleaseGeometry(geom);
@@ -157,18 +169,137 @@ static int build_tris(Accel *a, const uint32_t *idx, size_t n, uint32_t mask)
     return add_geom(a, g);
 }
 
-/* Adds the geometries of one object: its quad grids, then its triangular. */
+/* A curve grid's centre line: vertex i of its 2 rows, midway, and half
+ * the distance between them (the radius). */
+static void centre_vertex(const GridSet *gs, const Grid *g, uint32_t i, float out[4])
+{
+    Vec3 a = gs->P[g->first_vertex + i], b = gs->P[g->first_vertex + g->nu + i];
+    Vec3 c = v3_scale(v3_add(a, b), 0.5f);
+    out[0] = c.x, out[1] = c.y, out[2] = c.z;
+    out[3] = 0.5f * v3_length(v3_sub(b, a));
+}
+
+/* Curve grids (2 rows: the ribbon diced facing the eye) as Embree linear
+ * curves through their centre lines, round (tubes) or flat (ribbons that
+ * face each ray); Embree joins the segments of one grid, and ends each
+ * grid's run with a sphere (round), which fills the joint to the next. */
+static int build_curves(Accel *a, const uint32_t *idx, size_t n, uint32_t mask, int shape)
+{
+    const GridSet *gs = a->gs;
+    size_t n_vtx = 0, n_seg = 0;
+    for (size_t k = 0; k < n; k++) {
+        n_vtx += gs->grids[idx[k]].nu;
+        n_seg += gs->grids[idx[k]].nu - 1u;
+    }
+    RTCGeometry geom = rtcNewGeometry(a->device, shape == GEOM_SHAPE_ROUND_CURVE
+                                                     ? RTC_GEOMETRY_TYPE_ROUND_LINEAR_CURVE
+                                                     : RTC_GEOMETRY_TYPE_FLAT_LINEAR_CURVE);
+    float(*vtx)[4] = rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT4,
+                                             4 * sizeof(float), n_vtx);
+    uint32_t *index = rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT,
+                                              sizeof(uint32_t), n_seg);
+    Geom g = {.kind = KIND_CURVES, .shape = (uint8_t)shape, .segs = malloc(n_seg * sizeof(CurveSeg))};
+    if (!vtx || !index || !g.segs) {
+        free(g.segs);
+        rtcReleaseGeometry(geom);
+        return -1;
+    }
+    size_t v = 0, t = 0;
+    for (size_t k = 0; k < n; k++) {
+        const Grid *src = &gs->grids[idx[k]];
+        for (uint32_t i = 0; i < src->nu; i++) {
+            centre_vertex(gs, src, i, vtx[v + i]);
+            if (i + 1 < src->nu) {
+                index[t] = (uint32_t)(v + i);
+                g.segs[t++] = (CurveSeg){idx[k], i};
+            }
+        }
+        v += src->nu;
+    }
+    rtcSetGeometryMask(geom, mask);
+    rtcCommitGeometry(geom);
+    unsigned id = rtcAttachGeometry(a->scene, geom);
+    rtcReleaseGeometry(geom);
+    RY_CHECK(id == a->n_geoms);
+    return add_geom(a, g);
+}
+
+/* The corners of a point grid's square: (0,0), (1,0), (0,1). */
+static void point_square(const GridSet *gs, const Grid *g, Vec3 *o, Vec3 *x, Vec3 *y)
+{
+    uint32_t b = g->first_vertex;
+    *o = gs->P[b];
+    *x = v3_sub(gs->P[b + g->nu - 1u], *o);
+    *y = v3_sub(gs->P[b + (uint32_t)(g->nv - 1) * g->nu], *o);
+}
+
+/* Point grids as Embree spheres or ray-facing disks inscribed in their
+ * squares. */
+static int build_points(Accel *a, const uint32_t *idx, size_t n, uint32_t mask, int shape)
+{
+    const GridSet *gs = a->gs;
+    RTCGeometry geom = rtcNewGeometry(a->device, shape == GEOM_SHAPE_SPHERE
+                                                     ? RTC_GEOMETRY_TYPE_SPHERE_POINT
+                                                     : RTC_GEOMETRY_TYPE_DISC_POINT);
+    float(*vtx)[4] = rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT4,
+                                             4 * sizeof(float), n);
+    Geom g = {.kind = KIND_POINTS, .shape = (uint8_t)shape, .grids = malloc(n * sizeof(uint32_t))};
+    if (!vtx || !g.grids) {
+        free(g.grids);
+        rtcReleaseGeometry(geom);
+        return -1;
+    }
+    for (size_t k = 0; k < n; k++) {
+        Vec3 o, x, y;
+        point_square(gs, &gs->grids[idx[k]], &o, &x, &y);
+        Vec3 c = v3_add(o, v3_scale(v3_add(x, y), 0.5f));
+        vtx[k][0] = c.x, vtx[k][1] = c.y, vtx[k][2] = c.z;
+        vtx[k][3] = 0.5f * v3_length(x);
+        g.grids[k] = idx[k];
+    }
+    rtcSetGeometryMask(geom, mask);
+    rtcCommitGeometry(geom);
+    unsigned id = rtcAttachGeometry(a->scene, geom);
+    rtcReleaseGeometry(geom);
+    RY_CHECK(id == a->n_geoms);
+    return add_geom(a, g);
+}
+
+/* The kinds of grids an object may have, each one Embree geometry. */
+enum { GROUP_QUADS, GROUP_TRIS, GROUP_ROUND, GROUP_FLAT, GROUP_SPHERES, GROUP_DISKS, N_GROUPS };
+
+static int grid_group(const Grid *g)
+{
+    switch (g->shape) {
+    case GEOM_SHAPE_ROUND_CURVE: return GROUP_ROUND;
+    case GEOM_SHAPE_FLAT_CURVE: return GROUP_FLAT;
+    case GEOM_SHAPE_SPHERE: return GROUP_SPHERES;
+    case GEOM_SHAPE_DISK: return GROUP_DISKS;
+    default: return g->triangular ? GROUP_TRIS : GROUP_QUADS;
+    }
+}
+
+/* Adds the geometries of one object: its quad grids, its triangular, then
+ * its curves and points. */
 static int build_object(Accel *a, uint32_t object, uint32_t mask, uint32_t *scratch)
 {
     const GridSet *gs = a->gs;
-    for (int triangular = 0; triangular < 2; triangular++) {
+    for (int group = 0; group < N_GROUPS; group++) {
         size_t n = 0;
         for (size_t k = 0; k < gs->n_grids; k++)
-            if (gs->grids[k].object == object && gs->grids[k].triangular == triangular)
+            if (gs->grids[k].object == object && grid_group(&gs->grids[k]) == group)
                 scratch[n++] = (uint32_t)k;
         if (n == 0)
             continue;
-        int rc = triangular ? build_tris(a, scratch, n, mask) : build_quads(a, scratch, n, mask);
+        int rc;
+        switch (group) {
+        case GROUP_QUADS: rc = build_quads(a, scratch, n, mask); break;
+        case GROUP_TRIS: rc = build_tris(a, scratch, n, mask); break;
+        case GROUP_ROUND: rc = build_curves(a, scratch, n, mask, GEOM_SHAPE_ROUND_CURVE); break;
+        case GROUP_FLAT: rc = build_curves(a, scratch, n, mask, GEOM_SHAPE_FLAT_CURVE); break;
+        case GROUP_SPHERES: rc = build_points(a, scratch, n, mask, GEOM_SHAPE_SPHERE); break;
+        default: rc = build_points(a, scratch, n, mask, GEOM_SHAPE_DISK); break;
+        }
         if (rc != 0)
             return -1;
     }
@@ -221,6 +352,7 @@ void accel_free(Accel *a)
     for (size_t k = 0; k < a->n_geoms; k++) {
         free(a->geoms[k].grids);
         free(a->geoms[k].tris);
+        free(a->geoms[k].segs);
     }
     free(a->geoms);
     if (a->scene)
@@ -313,6 +445,51 @@ static void tri_hit(const Accel *a, const Geom *g, unsigned prim, float u, float
     hit->Ng = unit_or_zero(v3_cross(v3_sub(P[vtx[1]], P[vtx[0]]), v3_sub(P[vtx[2]], P[vtx[0]])));
 }
 
+/* Embree's geometric normal of a round shape's hit; a flat one faces the
+ * ray. */
+static Vec3 shape_normal(const struct RTCRayHit *rh, int shape)
+{
+    if (shape == GEOM_SHAPE_ROUND_CURVE || shape == GEOM_SHAPE_SPHERE)
+        return unit_or_zero(v3(rh->hit.Ng_x, rh->hit.Ng_y, rh->hit.Ng_z));
+    return unit_or_zero(v3(-rh->ray.dir_x, -rh->ray.dir_y, -rh->ray.dir_z));
+}
+
+/* A curve segment's hit: u along it, half way across the grid's 2 rows. */
+static void curve_hit(const Accel *a, const Geom *g, const struct RTCRayHit *rh, Hit *hit)
+{
+    const CurveSeg *seg = &g->segs[rh->hit.primID];
+    const Grid *grid = &a->gs->grids[seg->grid];
+    float u = fminf(fmaxf(rh->hit.u, 0.0f), 1.0f);
+    uint32_t b = grid->first_vertex + seg->i, w = grid->nu;
+    hit->grid = seg->grid;
+    hit->gu = ((float)seg->i + u) / (float)(w - 1u);
+    hit->gv = 0.5f;
+    hit->n_vertex = 4;
+    const uint32_t vtx[4] = {b, b + 1, b + w, b + w + 1};
+    const float wt[4] = {0.5f * (1.0f - u), 0.5f * u, 0.5f * (1.0f - u), 0.5f * u};
+    memcpy(hit->vertex, vtx, sizeof vtx);
+    memcpy(hit->weight, wt, sizeof wt);
+    hit->Ng = shape_normal(rh, g->shape);
+}
+
+/* A point's hit: where the hit projects on its square. */
+static void point_hit(const Accel *a, const Geom *g, const struct RTCRayHit *rh, Hit *hit)
+{
+    const GridSet *gs = a->gs;
+    const Grid *grid = &gs->grids[g->grids[rh->hit.primID]];
+    Vec3 o, x, y;
+    point_square(gs, grid, &o, &x, &y);
+    Vec3 p = v3(rh->ray.org_x + rh->ray.tfar * rh->ray.dir_x,
+                rh->ray.org_y + rh->ray.tfar * rh->ray.dir_y,
+                rh->ray.org_z + rh->ray.tfar * rh->ray.dir_z);
+    Vec3 d = v3_sub(p, o);
+    float xx = v3_dot(x, x), yy = v3_dot(y, y);
+    float u = xx > 0.0f ? fminf(fmaxf(v3_dot(d, x) / xx, 0.0f), 1.0f) : 0.5f;
+    float v = yy > 0.0f ? fminf(fmaxf(v3_dot(d, y) / yy, 0.0f), 1.0f) : 0.5f;
+    quad_hit(a, g, rh->hit.primID, u, v, hit);
+    hit->Ng = shape_normal(rh, g->shape);
+}
+
 int accel_intersect(const Accel *a, const Ray *ray, Hit *hit)
 {
     struct RTCIntersectContext ctx;
@@ -326,11 +503,14 @@ int accel_intersect(const Accel *a, const Ray *ray, Hit *hit)
     if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID)
         return 0;
     const Geom *g = &a->geoms[rh.hit.geomID];
-    if (g->triangular)
-        tri_hit(a, g, rh.hit.primID, rh.hit.u, rh.hit.v, hit);
-    else
-        quad_hit(a, g, rh.hit.primID, rh.hit.u, rh.hit.v, hit);
     hit->t = rh.ray.tfar;
+    hit->shape = g->shape;
+    switch (g->kind) {
+    case KIND_TRIS: tri_hit(a, g, rh.hit.primID, rh.hit.u, rh.hit.v, hit); break;
+    case KIND_QUADS: quad_hit(a, g, rh.hit.primID, rh.hit.u, rh.hit.v, hit); break;
+    case KIND_CURVES: curve_hit(a, g, &rh, hit); break;
+    case KIND_POINTS: point_hit(a, g, &rh, hit); break;
+    }
     return 1;
 }
 

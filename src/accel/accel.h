@@ -4,7 +4,11 @@
  *
  * Quad grids become Embree GRID geometry and triangular grids TRIANGLE
  * geometry, one Embree geometry of each kind per object, all sharing the
- * GridSet's vertex array (no copy). A hit leads back to its patch (the grid
+ * GridSet's vertex array (no copy). Curve grids (2 rows) become Embree's
+ * linear curves through their centre lines, with the rows' half distance
+ * as radius (round tubes, or flat ribbons facing each ray), and point
+ * grids spheres or ray-facing disks inscribed in their squares: the grid
+ * stays what is shaded and cached, Embree's shape what is hit. A hit leads back to its patch (the grid
  * index, which is the patch id), its micropolygon's vertices and the
  * interpolation weights inside it, and its position in the whole grid (the
  * coordinates the radiosity cache interpolates with).
@@ -43,6 +47,8 @@ typedef struct Hit {
     uint32_t vertex[4];  /* vertices (GridSet indices) of the micropolygon hit */
     float weight[4];     /* their interpolation weights (bilinear or barycentric) */
     int n_vertex;        /* 4 (quad cell) or 3 (triangle) */
+    int shape;           /* the grid's GeomShape: for round ones (tubes, spheres) Ng is the
+                            true surface normal at the hit, not the grid's */
 } Hit;
 
 /* Builds the acceleration structure. object_mask[o] is object o's ray

@@ -199,6 +199,14 @@ static int thin_edge(const Vec3 (*p)[LATTICE])
     return longest > 0.0f && longest * longest > 3.0f * area2 ? e : -1;
 }
 
+/* How a primitive's grids are traced (GeomShape). */
+static int prim_shape(const Prim *prim)
+{
+    return prim->type == PRIM_CURVE ? prim->curve.shape
+           : prim->type == PRIM_POINT ? prim->point.shape
+                                      : GEOM_SHAPE_SURFACE;
+}
+
 static Estimate estimate(const Prim *prim, const Domain *d, const DiceCamera *cam)
 {
     Vec3 p[LATTICE][LATTICE];
@@ -249,6 +257,8 @@ static Estimate estimate(const Prim *prim, const Domain *d, const DiceCamera *ca
     }
     e.n_u = RY_MAX(e.n_u, 1);
     e.n_v = RY_MAX(e.n_v, 1);
+    if (prim_shape(prim) == GEOM_SHAPE_ROUND_CURVE || prim_shape(prim) == GEOM_SHAPE_FLAT_CURVE)
+        e.n_v = 1; /* one micropolygon across: the tube or ribbon about the centre line */
     return e;
 }
 
@@ -400,6 +410,15 @@ void geom_bound_sagitta(GridSet *gs, size_t first)
     for (size_t k = first; k < gs->n_grids; k++) {
         const Grid *g = &gs->grids[k];
         bound = fmaxf(bound, fminf(0.5f * g->edge * g->edge * g->curvature, g->edge));
+        if (g->shape == GEOM_SHAPE_SURFACE)
+            continue;
+        /* Tubes, spheres and ray-facing disks are shaded on the square or
+         * ribbon that faces the eye, through their middle: rays leave from
+         * a little more than the radius (half of |dPdv|) off it, so that
+         * none starts inside the shape. */
+        size_t n = geom_grid_n_vertices(g);
+        for (size_t i = 0; i < n; i++)
+            bound = fmaxf(bound, 0.55f * v3_length(gs->dPdv[g->first_vertex + i]));
     }
     for (size_t k = first; k < gs->n_grids; k++)
         gs->grids[k].sagitta = bound;
@@ -434,7 +453,8 @@ static int dice_quad(GridSet *gs, const Prim *prim, uint32_t prim_index, const f
         return -1;
     Grid *g = &gs->grids[gs->n_grids];
     *g = (Grid){.prim = prim_index, .object = prim->object, .first_vertex = (uint32_t)gs->n_vertices,
-                .nu = (uint16_t)nu, .nv = (uint16_t)nv, .primvars = prim->pv};
+                .nu = (uint16_t)nu, .nv = (uint16_t)nv, .primvars = prim->pv,
+                .shape = (uint8_t)prim_shape(prim)};
     memcpy(g->uv, d->c, sizeof g->uv);
     size_t base = gs->n_vertices;
     for (int j = 0; j < nv; j++)
@@ -551,6 +571,11 @@ static int split_triangle(Walk *w, const Domain *d, int thin, int depth)
 static int split_dice(Walk *w, const Domain *d, int depth)
 {
     Estimate e = estimate(w->prim, d, w->cam);
+    if (w->prim->type == PRIM_POINT) {
+        /* One grid per point (accel.h traces it whole), square. */
+        e.n_u = e.n_v = RY_MIN(RY_MAX(e.n_u, e.n_v), w->lim.side);
+        return leaf(w, d, e);
+    }
     int split = d->triangular ? e.n_u > w->lim.side
                               : (int64_t)e.n_u * e.n_v > w->lim.size || e.n_u > GEOM_MAX_GRID - 1 ||
                                     e.n_v > GEOM_MAX_GRID - 1;
@@ -587,9 +612,25 @@ static Domain whole_domain(const Prim *prim)
     return d;
 }
 
+/* prim, or (curves and points that face the eye) a copy of it in *copy
+ * facing the camera. */
+static const Prim *facing_eye(const Prim *prim, const DiceCamera *cam, Prim *copy)
+{
+    if (prim_shape(prim) == GEOM_SHAPE_SURFACE)
+        return prim;
+    *copy = *prim;
+    if (prim->type == PRIM_CURVE)
+        copy->curve.facing = cam->eye;
+    else
+        copy->point.facing = cam->eye;
+    return copy;
+}
+
 int geom_dice_prim(GridSet *gs, const Prim *prim, uint32_t prim_index, const float *pv_pool,
                    const DiceCamera *cam)
 {
+    Prim copy;
+    prim = facing_eye(prim, cam, &copy);
     Walk w = {gs, prim, prim_index, pv_pool, cam, limits_of(cam), 0};
     Domain d = whole_domain(prim);
     size_t first = gs->n_grids;
@@ -601,6 +642,8 @@ int geom_dice_prim(GridSet *gs, const Prim *prim, uint32_t prim_index, const flo
 
 size_t geom_count_prim(const Prim *prim, const DiceCamera *cam)
 {
+    Prim copy;
+    prim = facing_eye(prim, cam, &copy);
     Walk w = {NULL, prim, 0, NULL, cam, limits_of(cam), 0};
     Domain d = whole_domain(prim);
     split_dice(&w, &d, 0);

@@ -42,9 +42,24 @@ typedef enum PrimType {
     PRIM_SPHERE = 4,   /* sphere.radius at the origin of sphere.world_from_object */
     PRIM_QUADRIC = 5,  /* one of RenderMan's quadrics (quadric.kind: RayesQuadric's values),
                           swept about object-space z; see geom_quadric_eval */
-    PRIM_SUBDIV = 6    /* one patch of a subdivision mesh's limit surface (subdiv.h): a quad,
+    PRIM_SUBDIV = 6,   /* one patch of a subdivision mesh's limit surface (subdiv.h): a quad,
                           or a triangle (subdiv.triangular) with PRIM_TRIANGLE's (u, v) */
+    PRIM_CURVE = 7,    /* one cubic Bezier segment of a curve with a width: u along it, v
+                          across, the centre line at v = 1/2 (geom_curve_frame) */
+    PRIM_POINT = 8     /* a sphere or disk: the square of its diameter facing the camera (or
+                          its normal), u and v across */
 } PrimType;
+
+/* How curves and points are traced (Grid.shape): surfaces are grids
+ * (ribbons with normals too); the others are Embree's curve and point
+ * primitives built from the grid's vertices (accel.h). */
+typedef enum GeomShape {
+    GEOM_SHAPE_SURFACE = 0,
+    GEOM_SHAPE_ROUND_CURVE = 1, /* a tube about the centre line of a 2-row grid */
+    GEOM_SHAPE_FLAT_CURVE = 2,  /* a ribbon that faces each ray */
+    GEOM_SHAPE_SPHERE = 3,      /* a sphere in a 2 x 2 grid's square */
+    GEOM_SHAPE_DISK = 4         /* a disk in the square, facing each ray */
+} GeomShape;
 
 struct SubdivMesh;
 
@@ -85,8 +100,30 @@ typedef struct Prim {
             uint32_t patch;                /* its patch number in the mesh */
             int triangular;                /* a Loop triangle */
         } subdiv;
+        struct {
+            Vec3 cp[4];      /* the centre line's Bezier control points, world */
+            float width[2];  /* world units, at u = 0 and 1 (linear between) */
+            Vec3 n[2];       /* ribbons: the normals at u = 0 and 1, world */
+            Vec3 facing;     /* round and flat: the ribbon diced faces this point (the eye:
+                                geom_dice_prim sets it) */
+            uint8_t shape;   /* GEOM_SHAPE_ROUND_CURVE, _FLAT_CURVE, or _SURFACE: a ribbon
+                                oriented by n */
+        } curve;
+        struct {
+            Vec3 centre;
+            float radius;
+            Vec3 n;          /* an oriented disk's normal (shape SURFACE), world */
+            Vec3 facing;     /* spheres and disks: the square faces this point (the eye) */
+            uint8_t shape;   /* GEOM_SHAPE_SPHERE, _DISK, or _SURFACE: an oriented disk */
+        } point;
     };
 } Prim;
+
+/* A curve segment's frame at u: the centre line C, its derivative T, the
+ * width w, and the unit direction B across the ribbon (from v = 0 to 1:
+ * n x T for ribbons, facing x T otherwise, so that dPdu x dPdv turns to
+ * n or to the facing point). */
+void geom_curve_frame(const Prim *prim, float u, Vec3 *C, Vec3 *T, float *w, Vec3 *B);
 
 /* A quadric's object-space position and derivatives at (u, v) in [0, 1]^2:
  * u sweeps theta from 0 to thetamax, v runs along the profile (RenderMan's
@@ -133,6 +170,7 @@ typedef struct Grid {
     uint32_t first_vertex; /* index of its first vertex in the GridSet */
     uint16_t nu, nv;       /* quad: vertices in u and v; triangle: nu = n subdivisions, nv = 0 */
     uint8_t triangular;    /* 1 for a triangular grid */
+    uint8_t shape;         /* GeomShape: how it is traced (curves and points: 2 rows, or 2 x 2) */
     float edge;            /* mean micropolygon edge length, scene units */
     float curvature;       /* largest |dN| / |dP| between neighbouring vertices, 1/units */
     float sagitta;         /* how far a neighbouring grid's micropolygons may run inside

@@ -123,6 +123,51 @@ void geom_quadric_eval(const Prim *prim, float u, float v, Vec3 *P, Vec3 *dPdu, 
     *dPdv = v3((float)(drho * c), (float)(drho * sn), (float)dz);
 }
 
+/* A unit vector across t (any, when t is zero). */
+static Vec3 any_perpendicular(Vec3 t)
+{
+    Vec3 a, b;
+    float l = v3_length(t);
+    v3_basis(l > 0.0f ? v3_scale(t, 1.0f / l) : v3(0, 0, 1), &a, &b);
+    return a;
+}
+
+void geom_curve_frame(const Prim *prim, float u, Vec3 *C, Vec3 *T, float *w, Vec3 *B)
+{
+    float b[4], db[4];
+    geom_bezier_basis(u, b, db);
+    Vec3 c = v3(0, 0, 0), t = c;
+    for (int k = 0; k < 4; k++) {
+        c = v3_madd(c, prim->curve.cp[k], b[k]);
+        t = v3_madd(t, prim->curve.cp[k], db[k]);
+    }
+    Vec3 toward = prim->curve.shape == GEOM_SHAPE_SURFACE
+                      ? v3_lerp(prim->curve.n[0], prim->curve.n[1], u)
+                      : v3_sub(prim->curve.facing, c);
+    Vec3 across = v3_cross(toward, t);
+    float l = v3_length(across);
+    *B = l > 1e-12f * v3_length(t) * v3_length(toward) && l > 0.0f ? v3_scale(across, 1.0f / l)
+                                                                   : any_perpendicular(t);
+    *C = c;
+    *T = t;
+    *w = prim->curve.width[0] + (prim->curve.width[1] - prim->curve.width[0]) * u;
+}
+
+/* A point's square: u along X, v along Y, X x Y its normal. */
+static void eval_point(const Prim *prim, float u, float v, Vec3 *P, Vec3 *dPdu, Vec3 *dPdv)
+{
+    Vec3 Z = prim->point.shape == GEOM_SHAPE_SURFACE ? prim->point.n
+                                                     : v3_sub(prim->point.facing, prim->point.centre);
+    float l = v3_length(Z);
+    Z = l > 0.0f ? v3_scale(Z, 1.0f / l) : v3(0, 0, 1);
+    Vec3 X = any_perpendicular(Z), Y = v3_cross(Z, X);
+    float r = prim->point.radius;
+    *P = v3_add(prim->point.centre,
+                v3_add(v3_scale(X, r * (2.0f * u - 1.0f)), v3_scale(Y, r * (2.0f * v - 1.0f))));
+    *dPdu = v3_scale(X, 2.0f * r);
+    *dPdv = v3_scale(Y, 2.0f * r);
+}
+
 void geom_prim_eval(const Prim *prim, float u, float v, Vec3 *P, Vec3 *dPdu, Vec3 *dPdv)
 {
     const Vec3 *c = prim->cp;
@@ -160,6 +205,19 @@ void geom_prim_eval(const Prim *prim, float u, float v, Vec3 *P, Vec3 *dPdu, Vec
         *dPdv = mat4_vector(m, dv);
         break;
     }
+    case PRIM_CURVE: {
+        Vec3 C, T, B;
+        float w;
+        geom_curve_frame(prim, u, &C, &T, &w, &B);
+        float dw = prim->curve.width[1] - prim->curve.width[0];
+        *P = v3_madd(C, B, (v - 0.5f) * w);
+        *dPdu = v3_madd(T, B, (v - 0.5f) * dw);
+        *dPdv = v3_scale(B, w);
+        break;
+    }
+    case PRIM_POINT:
+        eval_point(prim, u, v, P, dPdu, dPdv);
+        break;
     }
 }
 

@@ -406,8 +406,6 @@ static const RibRequest own_requests[] = {
     /* tier 1 and 2: read and skipped with one warning per request name */
     {"NuPatch", h_skip},
     {"TrimCurve", h_skip},
-    {"Points", h_skip},
-    {"Curves", h_skip},
     {"Blobby", h_skip},
     {"Procedural2", h_skip},
     {"Bxdf", h_skip},
@@ -466,7 +464,7 @@ static const RibRequest own_requests[] = {
 
 static const RibRequest *const tables[] = {rib_frame_requests, rib_state_requests,
                                            rib_params_requests, rib_shade_requests,
-                                           rib_prim_requests, own_requests};
+                                           rib_prim_requests, rib_curves_requests, own_requests};
 
 static int dispatch(Rib *r, const Args *a)
 {
@@ -493,7 +491,10 @@ static int dispatch(Rib *r, const Args *a)
     for (size_t t = 0; t < sizeof tables / sizeof tables[0]; t++)
         for (const RibRequest *k = tables[t]; k->name; k++)
             if (strcmp(k->name, q) == 0)
-                return tables[t] == rib_prim_requests && r->a.lod_coarse ? 0 : k->fn(r, a);
+                return (tables[t] == rib_prim_requests || tables[t] == rib_curves_requests) &&
+                               r->a.lod_coarse
+                           ? 0
+                           : k->fn(r, a);
     return rib_error(r, "unknown request (expected a RIB request such as WorldBegin or Polygon)");
 }
 
@@ -591,6 +592,17 @@ static RayesError null_subdiv(void *t, RayesSubdivScheme s, size_t nf, const int
     (void)t, (void)s, (void)nf, (void)nv, (void)ix, (void)np, (void)P, (void)g, (void)pv, (void)n;
     return RAYES_OK;
 }
+static RayesError null_curves(void *t, const RayesCurves *c, const RayesPrimvar *pv, size_t n)
+{
+    (void)t, (void)c, (void)pv, (void)n;
+    return RAYES_OK;
+}
+static RayesError null_points(void *t, RayesPointShape s, size_t np, const float *P,
+                              const RayesPrimvar *pv, size_t n)
+{
+    (void)t, (void)s, (void)np, (void)P, (void)pv, (void)n;
+    return RAYES_OK;
+}
 static size_t null_count(void *t) { (void)t; return 0; }
 static const char *null_error(void *t) { (void)t; return ""; }
 
@@ -598,7 +610,7 @@ static const IoSink null_sink = {
     NULL,       null_camera,  null_camera_matrix, null_matrix, null_named, null_named,
     null_float, null_path,    null_float,         null_p4,     null_p16,   null_mesh,
     null_float, null_quadric, null_area,          null_named,  null_links, null_count,
-    null_error, NULL,         null_subdiv};
+    null_error, NULL,         null_subdiv,        null_curves, null_points};
 
 static void rib_init(Rib *r, int pass, const IoSink *sink, const IoReadOptions *opt,
                      IoSettings *settings, char *err, size_t err_size)

@@ -49,7 +49,7 @@ static const char *const rib_var_names[3] = {"N", "st", "Cs"};
 
 /* A parameter that is a numeric declared value of size floats, or NULL
  * (with one warning when it has the name but another type). */
-static const Param *var_param(Rib *r, const Param *p, size_t n, const char *name, int size)
+const Param *rib_var_param(Rib *r, const Param *p, size_t n, const char *name, int size)
 {
     const Param *q = rib_find_param(p, n, name);
     if (!q || !q->declared)
@@ -68,22 +68,22 @@ static const Param *var_param(Rib *r, const Param *p, size_t n, const char *name
 static void rib_vars(Rib *r, const Param *p, size_t n, RibVar vars[3])
 {
     memset(vars, 0, 3 * sizeof *vars);
-    const Param *N = var_param(r, p, n, "N", 3);
+    const Param *N = rib_var_param(r, p, n, "N", 3);
     if (!N)
-        N = var_param(r, p, n, "Np", 3);
+        N = rib_var_param(r, p, n, "Np", 3);
     if (N)
         vars[0] = (RibVar){N->v->d, NULL, N->d.cls, 3};
-    const Param *st = var_param(r, p, n, "st", 2);
+    const Param *st = rib_var_param(r, p, n, "st", 2);
     if (st)
         vars[1] = (RibVar){st->v->d, NULL, st->d.cls, 2};
     else {
-        const Param *ps = var_param(r, p, n, "s", 1), *pt = var_param(r, p, n, "t", 1);
+        const Param *ps = rib_var_param(r, p, n, "s", 1), *pt = rib_var_param(r, p, n, "t", 1);
         if (ps && pt && ps->d.cls == pt->d.cls)
             vars[1] = (RibVar){ps->v->d, pt->v->d, ps->d.cls, 2};
         else if (ps || pt)
             rib_warn_once(r, "s t", "\"s\" and \"t\" are used only together and of one class");
     }
-    const Param *cs = var_param(r, p, n, "Cs", 3);
+    const Param *cs = rib_var_param(r, p, n, "Cs", 3);
     if (cs)
         vars[2] = (RibVar){cs->v->d, NULL, cs->d.cls, 3};
 }
@@ -235,7 +235,7 @@ static int poly_vars(Rib *r, const RibVar *vars, const RibFaces *faces, const si
 }
 
 /* The points of a primitive from "P" or "Pw" (divided by w); new array. */
-static float *get_points(Rib *r, const Param *p, size_t n_par, size_t *n_points)
+float *rib_get_points(Rib *r, const Param *p, size_t n_par, size_t *n_points)
 {
     const Param *P = rib_find_param(p, n_par, "P");
     const Param *Pw = rib_find_param(p, n_par, "Pw");
@@ -371,7 +371,7 @@ static int h_polygon(Rib *r, const Args *a)
     size_t n, np = 0;
     if (rib_get_params(r, a, 0, &p, &n) != 0)
         return -1;
-    float *P = get_points(r, p, n, &np);
+    float *P = rib_get_points(r, p, n, &np);
     int e = P ? 0 : -1;
     Counts c = {1, np, np, np};
     if (e == 0 && np < 3)
@@ -403,7 +403,7 @@ static int h_general_polygon(Rib *r, const Args *a)
     if (rib_get_ints(r, a, &i, &loops, &nl, 3, 1 << 24, "vertices per loop") != 0)
         return -1;
     int e = rib_get_params(r, a, i, &p, &n);
-    float *P = e == 0 ? get_points(r, p, n, &np) : NULL;
+    float *P = e == 0 ? rib_get_points(r, p, n, &np) : NULL;
     if (e == 0 && !P)
         e = -1;
     size_t total = 0;
@@ -448,7 +448,7 @@ static int points_polygons(Rib *r, const Args *a, size_t i, int general)
         e = rib_get_ints(r, a, &i, &verts, &n_idx, 0, 1 << 30, "vertex indices");
     if (e == 0)
         e = rib_get_params(r, a, i, &p, &n);
-    if (e == 0 && !(P = get_points(r, p, n, &np)))
+    if (e == 0 && !(P = rib_get_points(r, p, n, &np)))
         e = -1;
     if (e == 0 && !general)
         n_polys = n_loops;
@@ -686,7 +686,7 @@ static int subdivision_mesh(Rib *r, const Args *a, int per)
         e = subdiv_tags(r, a, &i, per, &tags);
     if (e == 0)
         e = rib_get_params(r, a, i, &p, &n);
-    if (e == 0 && !(P = get_points(r, p, n, &np)))
+    if (e == 0 && !(P = rib_get_points(r, p, n, &np)))
         e = -1;
     size_t sum = 0;
     for (size_t k = 0; e == 0 && k < n_faces; k++)
@@ -838,7 +838,7 @@ static int h_patch(Rib *r, const Args *a)
     int e = 0;
     if (!cubic && strcmp(type, "bilinear") != 0)
         e = rib_error(r, "expected \"bilinear\" or \"bicubic\", found \"%s\"", type);
-    float *P = e == 0 ? get_points(r, p, n, &np) : NULL;
+    float *P = e == 0 ? rib_get_points(r, p, n, &np) : NULL;
     if (e == 0 && !P)
         e = -1;
     size_t want = cubic ? 16 : 4;
@@ -920,7 +920,7 @@ static int h_patch_mesh(Rib *r, const Args *a)
     Param *p;
     if (rib_get_params(r, a, i, &p, &n) != 0)
         return -1;
-    float *P = get_points(r, p, n, &np);
+    float *P = rib_get_points(r, p, n, &np);
     int e = P ? 0 : -1;
     if (e == 0 && np != (size_t)(nu * nv))
         e = rib_error(r, "\"P\" needs %ld x %ld = %ld points, found %zu", nu, nv, nu * nv, np);

@@ -111,6 +111,7 @@ typedef struct Attr {
     int ustep, vstep;
     int lod_coarse; /* DetailRange ends before infinity: a coarser representation,
                        whose primitives are skipped */
+    int roundcurve; /* Attribute "dice" "roundcurve": curves without N are tubes */
 } Attr;
 
 typedef struct SinkState {
@@ -240,6 +241,7 @@ extern const RibRequest rib_params_requests[]; /* rib_params.c */
 extern const RibRequest rib_state_requests[];  /* rib_state.c */
 extern const RibRequest rib_shade_requests[];  /* rib_shade.c */
 extern const RibRequest rib_prim_requests[];   /* rib_prim.c */
+extern const RibRequest rib_curves_requests[]; /* rib_curves.c */
 extern const RibRequest rib_frame_requests[];  /* rib_frame.c */
 
 /* ------------------------------------- rib_params.c: messages, arguments */
@@ -283,6 +285,15 @@ int rib_check_counts(Rib *r, const Param *p, size_t n, const Counts *c);
 void rib_warn_unused(Rib *r, const Param *p, size_t n);
 /* The primitive's "Cs" when it is one colour per value; NULL otherwise. */
 const Param *rib_color_param(Rib *r, const Param *p, size_t n);
+
+/* ------------------------------------------ rib_prim.c: primitives' data */
+
+/* A parameter that is a numeric declared value of size floats, or NULL
+ * (with one warning when it has the name but another type). */
+const Param *rib_var_param(Rib *r, const Param *p, size_t n, const char *name, int size);
+/* The points of a primitive from "P" or "Pw" (divided by w); a new array
+ * of *n_points points, or NULL with the error set. */
+float *rib_get_points(Rib *r, const Param *p, size_t n_par, size_t *n_points);
 
 /* --------------------------------------------------- rib_state.c: state */
 

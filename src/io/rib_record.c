@@ -22,7 +22,9 @@ typedef enum CallKind {
     CALL_SPHERE,
     CALL_QUADRIC,
     CALL_AREA_LIGHT,
-    CALL_SUBDIV
+    CALL_SUBDIV,
+    CALL_CURVES,
+    CALL_POINTS
 } CallKind;
 
 typedef struct RibCall {
@@ -44,6 +46,10 @@ typedef struct RibCall {
     size_t n_points;
     RayesSubdivTags tags;
     int has_tags;
+    /* Curves: f holds the basis then P, ints the control point counts
+     * (n_faces of them), curves the rest (its pointers unset). Points: f
+     * holds P, flags the shape. */
+    RayesCurves curves;
 } RibCall;
 
 struct RibRecording {
@@ -192,7 +198,9 @@ static RayesError keep_primvars(RibRecording *rec, RayesError e, const RayesPrim
     if (!c->pv)
         return RAYES_ERROR_OUT_OF_MEMORY;
     for (size_t i = 0; i < n_pv; i++) {
-        size_t n = pv[i].count * (strcmp(pv[i].name, "st") == 0 ? 2u : 3u);
+        size_t n = pv[i].count * (strcmp(pv[i].name, "st") == 0      ? 2u
+                                  : strcmp(pv[i].name, "width") == 0 ? 1u
+                                                                     : 3u);
         float *d = malloc((n ? n : 1) * sizeof *d);
         c->pv[i] = pv[i];
         c->pv[i].name = dup_str(pv[i].name);
@@ -274,6 +282,42 @@ static RayesError rec_subdivision_mesh(void *t, RayesSubdivScheme scheme, size_t
     c->tags = *g, c->has_tags = tags != NULL;
     return RAYES_OK;
 }
+static RayesError rec_curves(void *t, const RayesCurves *curves, const RayesPrimvar *pv,
+                             size_t n_pv)
+{
+    RibRecording *rec = t;
+    size_t n_points, n_varying;
+    if (rayes_curves_counts(curves, &n_points, &n_varying) != 0)
+        return RAYES_ERROR_INVALID_ARGUMENT;
+    float *f = malloc((16 + 3 * n_points) * sizeof *f);
+    if (!f)
+        return RAYES_ERROR_OUT_OF_MEMORY;
+    memcpy(f, curves->basis, 16 * sizeof *f);
+    if (n_points)
+        memcpy(f + 16, curves->P, 3 * n_points * sizeof *f);
+    RayesError e = keep_primvars(rec, floats(rec, CALL_CURVES, f, 16 + 3 * n_points), pv, n_pv);
+    free(f);
+    if (e != RAYES_OK)
+        return e;
+    RibCall *c = &rec->calls[rec->n - 1];
+    c->ints = malloc((curves->n_curves + 1) * sizeof *c->ints);
+    if (!c->ints)
+        return RAYES_ERROR_OUT_OF_MEMORY;
+    if (curves->n_curves)
+        memcpy(c->ints, curves->n_verts, curves->n_curves * sizeof *c->ints);
+    c->n_faces = curves->n_curves;
+    c->curves = *curves;
+    return RAYES_OK;
+}
+static RayesError rec_points(void *t, RayesPointShape shape, size_t n, const float *P,
+                             const RayesPrimvar *pv, size_t n_pv)
+{
+    RibRecording *rec = t;
+    RayesError e = keep_primvars(rec, floats(rec, CALL_POINTS, P, 3 * n), pv, n_pv);
+    if (e == RAYES_OK)
+        rec->calls[rec->n - 1].flags = (unsigned)shape;
+    return e;
+}
 static RayesError rec_sphere(void *t, float r)
 {
     return floats(t, CALL_SPHERE, &r, 1);
@@ -323,6 +367,8 @@ IoSink rib_recording_sink(RibRecording *rec)
                 rec_bicubic,   rec_mesh,     rec_sphere,        rec_quadric,    rec_area_light,
                 rec_light,     rec_light_links, rec_light_count, rec_error};
     s.subdivision_mesh = rec_subdivision_mesh;
+    s.curves = rec_curves;
+    s.points = rec_points;
     return s;
 }
 
@@ -383,6 +429,19 @@ RayesError rib_recording_replay(const RibRecording *rec, const IoSink *out,
                     : RAYES_ERROR_INVALID_ARGUMENT;
             break;
         }
+        case CALL_CURVES: {
+            RayesCurves cv = c->curves;
+            memcpy(cv.basis, c->f, sizeof cv.basis);
+            cv.P = c->f + 16;
+            cv.n_verts = c->ints;
+            e = out->curves ? out->curves(t, &cv, c->pv, c->n_pv) : RAYES_ERROR_INVALID_ARGUMENT;
+            break;
+        }
+        case CALL_POINTS:
+            e = out->points ? out->points(t, (RayesPointShape)c->flags, c->n_f / 3, c->f, c->pv,
+                                          c->n_pv)
+                            : RAYES_ERROR_INVALID_ARGUMENT;
+            break;
         }
     }
     return e;

@@ -563,6 +563,9 @@ static int h_option_attribute(Rib *r, const Args *a)
                               kb);
             else
                 r->settings->texture_mb = kb * 1024.0 / 1e6;
+        } else if (!option && strcmp(group, "dice") == 0 && strcmp(q->d.name, "roundcurve") == 0 &&
+                   rib_is_num(q->v) && q->v->n == 1) {
+            r->a.roundcurve = q->v->d[0] != 0;
         } else if (!option && strcmp(group, "identifier") == 0) {
             /* names are for messages only */
         } else if (!(!option && strcmp(group, "displacementbound") == 0)) {

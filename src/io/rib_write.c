@@ -391,6 +391,17 @@ static RayesError w_set_shading_rate(void *t, float rate)
 
 /* --------------------------------------------------------- geometry */
 
+/* Floats per value of a primitive variable rayes.h knows ("width" is
+ * curves' and points'), or 0. */
+static int primvar_size(const char *name)
+{
+    return !name ? 0
+           : strcmp(name, "st") == 0 ? 2
+           : strcmp(name, "N") == 0 || strcmp(name, "Cs") == 0 ? 3
+           : strcmp(name, "width") == 0 ? 1
+                                        : 0;
+}
+
 /* Checks primitive variables as rayes.h does (expect[cls]: the counts of
  * each class for the primitive); returns 0 or fails. */
 static RayesError check_primvars(RibWriter *w, const char *what, const RayesPrimvar *pv,
@@ -399,8 +410,7 @@ static RayesError check_primvars(RibWriter *w, const char *what, const RayesPrim
     if (n_pv && !pv)
         return fail(w, RAYES_ERROR_INVALID_ARGUMENT, "%s: primitive variables are NULL", what);
     for (size_t i = 0; i < n_pv; i++) {
-        int size = !pv[i].name ? 0 : strcmp(pv[i].name, "st") == 0 ? 2
-                 : strcmp(pv[i].name, "N") == 0 || strcmp(pv[i].name, "Cs") == 0 ? 3 : 0;
+        int size = primvar_size(pv[i].name);
         if (!size || (unsigned)pv[i].cls > RAYES_PRIMVAR_FACEVARYING ||
             pv[i].count != expect[pv[i].cls] || (pv[i].count && !pv[i].data) ||
             !finite_all(pv[i].data, pv[i].count * (size_t)size))
@@ -415,10 +425,11 @@ static RayesError check_primvars(RibWriter *w, const char *what, const RayesPrim
 static size_t primvar_decl(FILE *f, const RayesPrimvar *p)
 {
     static const char *const cls[5] = {"constant", "uniform", "varying", "vertex", "facevarying"};
-    int st = strcmp(p->name, "st") == 0;
-    const char *type = st ? "float[2]" : strcmp(p->name, "N") == 0 ? "normal" : "color";
+    int size = primvar_size(p->name);
+    const char *type = size == 2 ? "float[2]" : size == 1 ? "float"
+                     : strcmp(p->name, "N") == 0 ? "normal" : "color";
     fprintf(f, "\n  \"%s %s %s\" ", cls[p->cls], type, p->name);
-    return st ? 2 : 3;
+    return (size_t)size;
 }
 
 /* Writes primitive variables as RIB parameters, each on a line of its own. */
@@ -713,6 +724,65 @@ static RayesError w_subdivision_mesh(void *t, RayesSubdivScheme scheme, size_t n
     return RAYES_OK;
 }
 
+/* Curves as RenderMan's Curves, in an attribute block of their own (the
+ * basis is graphics state, and round tubes are Attribute "dice"
+ * "roundcurve" 1, rib.md). */
+static RayesError w_curves(void *t, const RayesCurves *c, const RayesPrimvar *pv, size_t n_pv)
+{
+    RibWriter *w = t;
+    size_t n_points, n_varying;
+    if (rayes_curves_counts(c, &n_points, &n_varying) != 0 || !finite_all(c->P, 3 * n_points) ||
+        (c->degree == 3 && !finite_all(c->basis, 16)))
+        return fail(w, RAYES_ERROR_INVALID_ARGUMENT, "curves: bad degree, step or counts");
+    const size_t expect[5] = {1, c->n_curves, n_varying, n_points, n_varying};
+    if (check_primvars(w, "curves", pv, n_pv, expect) != RAYES_OK)
+        return RAYES_ERROR_INVALID_ARGUMENT;
+    if (c->n_curves == 0)
+        return RAYES_OK;
+    FILE *f = w->world.f;
+    fprintf(f, "AttributeBegin\nAttribute \"dice\" \"int roundcurve\" [%d]\n",
+            c->shape == RAYES_CURVE_ROUND);
+    if (c->degree == 3) {
+        for (int k = 0; k < 2; k++) {
+            fprintf(f, k ? " " : "Basis ");
+            floats(f, c->basis, 16);
+            fprintf(f, " %d", c->step);
+        }
+        fputc('\n', f);
+    }
+    fprintf(f, "Curves \"%s\" [", c->degree == 3 ? "cubic" : "linear");
+    for (size_t i = 0; i < c->n_curves; i++)
+        fprintf(f, i ? " %d" : "%d", c->n_verts[i]);
+    fprintf(f, "] \"%s\"\n  \"P\" ", c->periodic ? "periodic" : "nonperiodic");
+    floats(f, c->P, 3 * n_points);
+    primvars(f, pv, n_pv);
+    fprintf(f, "\nAttributeEnd\n");
+    return RAYES_OK;
+}
+
+/* Points as RenderMan's Points, their shape as 3Delight's "uniform string
+ * type". */
+static RayesError w_points(void *t, RayesPointShape shape, size_t n, const float *P,
+                           const RayesPrimvar *pv, size_t n_pv)
+{
+    RibWriter *w = t;
+    const size_t expect[5] = {1, 1, n, n, n};
+    if ((n && !P) || !finite_all(P, 3 * n) ||
+        (shape != RAYES_POINT_SPHERE && shape != RAYES_POINT_DISK))
+        return fail(w, RAYES_ERROR_INVALID_ARGUMENT, "points: bad shape or points");
+    if (check_primvars(w, "points", pv, n_pv, expect) != RAYES_OK)
+        return RAYES_ERROR_INVALID_ARGUMENT;
+    if (n == 0)
+        return RAYES_OK;
+    FILE *f = w->world.f;
+    fprintf(f, "Points \"uniform string type\" \"%s\"\n  \"P\" ",
+            shape == RAYES_POINT_DISK ? "disk" : "sphere");
+    floats(f, P, 3 * n);
+    primvars(f, pv, n_pv);
+    fputc('\n', f);
+    return RAYES_OK;
+}
+
 static RayesError w_quadric(void *t, RayesQuadric type, const float *p, size_t n, unsigned flags)
 {
     static const char *const names[] = {"Sphere",     "Cylinder",    "Cone", "Disk",
@@ -868,6 +938,8 @@ IoSink io_rib_writer_sink(RibWriter *w)
         .get_error = w_get_error,
         .has_shader = w_has_shader,
         .subdivision_mesh = w_subdivision_mesh,
+        .curves = w_curves,
+        .points = w_points,
     };
 }
 

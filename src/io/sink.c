@@ -70,6 +70,18 @@ static RayesError scene_subdivision_mesh(void *t, RayesSubdivScheme scheme, size
                                         n_pv);
 }
 
+static RayesError scene_curves(void *t, const RayesCurves *curves, const RayesPrimvar *pv,
+                               size_t n_pv)
+{
+    return rayes_scene_curves(t, curves, pv, n_pv);
+}
+
+static RayesError scene_points(void *t, RayesPointShape shape, size_t n_points, const float *P,
+                               const RayesPrimvar *pv, size_t n_pv)
+{
+    return rayes_scene_points(t, shape, n_points, P, pv, n_pv);
+}
+
 static RayesError scene_polygon_mesh(void *t, size_t n_faces, const int *n_verts,
                                      const int *indices, size_t n_points, const float *P,
                                      const RayesPrimvar *pv, size_t n_pv)
@@ -143,6 +155,8 @@ IoSink io_sink_scene(RayesScene *scene)
         .get_error = scene_get_error,
         .has_shader = scene_has_shader,
         .subdivision_mesh = scene_subdivision_mesh,
+        .curves = scene_curves,
+        .points = scene_points,
     };
 }
 

@@ -70,6 +70,12 @@ typedef struct IoSink {
                                    const int *n_verts, const int *indices, size_t n_points,
                                    const float *P, const RayesSubdivTags *tags,
                                    const RayesPrimvar *pv, size_t n_pv);
+    /* rayes_scene_curves and rayes_scene_points (after it for the same
+     * reason: readers refuse curves and points a sink lacks). */
+    RayesError (*curves)(void *target, const RayesCurves *curves, const RayesPrimvar *pv,
+                         size_t n_pv);
+    RayesError (*points)(void *target, RayesPointShape shape, size_t n_points, const float *P,
+                         const RayesPrimvar *pv, size_t n_pv);
 } IoSink;
 
 /* A sink that builds scene through rayes.h (borrowed, not retained). */

@@ -68,7 +68,8 @@ static int hit_point(const Worker *w, const Ray *ray, const Hit *hit, const Rend
         N = v3_neg(N);
         Ng = v3_neg(Ng);
     }
-    if (v3_dot(N, Ng) < 0.0f) /* interpolation across a silhouette */
+    if (v3_dot(N, Ng) < 0.0f || hit->shape == GEOM_SHAPE_ROUND_CURVE ||
+        hit->shape == GEOM_SHAPE_SPHERE) /* across a silhouette; round shapes' own normal */
         N = Ng;
     v3_store(hp->P, v3_madd(ray->o, ray->d, hit->t));
     v3_store(hp->N, N);

@@ -378,6 +378,43 @@ static RayesError add_prim(RayesScene *s, Prim *p)
     return RAYES_OK;
 }
 
+RayesError scene_add_prim(RayesScene *s, Prim *p)
+{
+    return add_prim(s, p);
+}
+
+RayesError scene_fail(RayesScene *s, RayesError e, const char *fmt, ...)
+{
+    if (s->error[0] == '\0') {
+        va_list ap;
+        va_start(ap, fmt);
+        vsnprintf(s->error, sizeof s->error, fmt, ap);
+        va_end(ap);
+    }
+    return e;
+}
+
+RayesError scene_push_values(RayesScene *s, Prim *p, unsigned mask, const float *values,
+                             size_t n)
+{
+    p->pv = (uint8_t)mask;
+    p->pv_cubic = 0;
+    p->pv_first = s->n_pv;
+    if (s->n_pv + n > s->cap_pv) {
+        size_t cap = s->cap_pv ? s->cap_pv : 1024;
+        while (cap < s->n_pv + n)
+            cap *= 2;
+        float *pv = realloc(s->pv, cap * sizeof *pv);
+        if (!pv)
+            return fail(s, RAYES_ERROR_OUT_OF_MEMORY, "out of memory");
+        s->pv = pv;
+        s->cap_pv = cap;
+    }
+    memcpy(s->pv + s->n_pv, values, n * sizeof *values);
+    s->n_pv += n;
+    return RAYES_OK;
+}
+
 static void transform_points(const RayesScene *s, const float (*P)[3], size_t n, Vec3 *out)
 {
     for (size_t i = 0; i < n; i++)
@@ -925,6 +962,15 @@ Bounds3 scene_bounds(const RayesScene *s)
                 }
             Vec3 pad = v3_scale(v3_sub(q.hi, q.lo), 0.05f);
             b = bounds_add(bounds_add(b, v3_sub(q.lo, pad)), v3_add(q.hi, pad));
+            continue;
+        }
+        if (p->type == PRIM_CURVE || p->type == PRIM_POINT) { /* control points, widened */
+            int n = p->type == PRIM_CURVE ? 4 : 1;
+            const Vec3 *c = p->type == PRIM_CURVE ? p->curve.cp : &p->point.centre;
+            float r = p->type == PRIM_CURVE ? 0.5f * fmaxf(p->curve.width[0], p->curve.width[1])
+                                            : p->point.radius;
+            for (int k = 0; k < n; k++)
+                b = bounds_add(bounds_add(b, v3_sub(c[k], v3(r, r, r))), v3_add(c[k], v3(r, r, r)));
             continue;
         }
         int n = p->type == PRIM_BICUBIC ? 16 : p->type == PRIM_TRIANGLE ? 3 : 4;

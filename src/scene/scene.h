@@ -146,6 +146,16 @@ const char *scene_search_path(const RayesScene *scene, SceneSearchPath kind);
  * 1 or 0. */
 int scene_object_lit_by(const RayesScene *scene, size_t object, size_t light);
 
+/* For the scene's other files (curves.c): adds a primitive to the current
+ * object; records the first error (printf-style) and returns e; appends n
+ * primitive variable floats (per GEOM_PV_* bit of mask, per corner, its
+ * floats) as p's values. */
+RayesError scene_add_prim(RayesScene *scene, Prim *p);
+RayesError scene_fail(RayesScene *scene, RayesError e, const char *fmt, ...)
+    __attribute__((format(printf, 3, 4)));
+RayesError scene_push_values(RayesScene *scene, Prim *p, unsigned mask, const float *values,
+                             size_t n);
+
 /* The bounds of all primitives' control points (lights included). */
 Bounds3 scene_bounds(const RayesScene *scene);
 

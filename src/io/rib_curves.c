@@ -1,0 +1,201 @@
+/*
+ * io/rib_curves.c — RenderMan's Curves and Points (docs/rib.md).
+ *
+ * Curves take the current v basis and step (RenderMan's rule for curves),
+ * "width" (any class) or "constantwidth", "N" (ribbons), "Cs" and "st";
+ * without N they are flat ribbons facing each ray, or tubes under
+ * Attribute "dice" "roundcurve" 1. Points take "width" or
+ * "constantwidth", "N" (oriented disks), "Cs", "st", and 3Delight's
+ * "uniform string type" "sphere" (the default) or "disk".
+ */
+#include <float.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "io/rib_internal.h"
+#include "io/rib_reader.h"
+
+/* The primitive variables of a curves or points call, converted for the
+ * sink: width, N, Cs, st in that order (those given). */
+typedef struct Vars {
+    RayesPrimvar pv[4];
+    float *data[4];
+    size_t n;
+} Vars;
+
+static void vars_free(Vars *v)
+{
+    for (size_t i = 0; i < v->n; i++)
+        free(v->data[i]);
+    v->n = 0;
+}
+
+static const RayesPrimvarClass class_of[] = {
+    [CLS_CONSTANT] = RAYES_PRIMVAR_CONSTANT, [CLS_UNIFORM] = RAYES_PRIMVAR_UNIFORM,
+    [CLS_VARYING] = RAYES_PRIMVAR_VARYING,   [CLS_VERTEX] = RAYES_PRIMVAR_VERTEX,
+    [CLS_FACEVARYING] = RAYES_PRIMVAR_FACEVARYING};
+
+/* Adds parameter q (of size floats per value) as the sink's variable name. */
+static int add_var(Rib *r, Vars *v, const Param *q, const char *name, int size)
+{
+    size_t n = q->v->n;
+    float *d = malloc((n ? n : 1) * sizeof *d);
+    if (!d)
+        return rib_error(r, "out of memory");
+    for (size_t k = 0; k < n; k++)
+        d[k] = fabs(q->v->d[k]) < FLT_MAX ? (float)q->v->d[k] : 0.0f;
+    v->data[v->n] = d;
+    v->pv[v->n++] = (RayesPrimvar){name, class_of[q->d.cls], d, n / (size_t)size};
+    return 0;
+}
+
+/* Reads the variables; warns once about parameters nothing reads. */
+static int read_vars(Rib *r, const Param *p, size_t n, Vars *v)
+{
+    memset(v, 0, sizeof *v);
+    const Param *w = rib_var_param(r, p, n, "width", 1);
+    if (!w)
+        w = rib_var_param(r, p, n, "constantwidth", 1);
+    static const struct {
+        const char *name;
+        int size;
+    } names[3] = {{"N", 3}, {"Cs", 3}, {"st", 2}};
+    int e = w ? add_var(r, v, w, "width", 1) : 0;
+    for (int k = 0; k < 3 && e == 0; k++) {
+        const Param *q = rib_var_param(r, p, n, names[k].name, names[k].size);
+        if (q)
+            e = add_var(r, v, q, names[k].name, names[k].size);
+    }
+    static const char *const used[] = {"P", "Pw", "N", "Cs", "st", "width", "constantwidth",
+                                       "type", NULL};
+    for (size_t i = 0; i < n; i++) {
+        int u = !p[i].declared;
+        for (int k = 0; used[k]; k++)
+            u |= strcmp(p[i].d.name, used[k]) == 0;
+        if (!u) {
+            char key[128];
+            snprintf(key, sizeof key, "unused %s", p[i].d.name);
+            rib_warn_once(r, key,
+                          "parameter \"%s\" is not used (rayes's curves and points take P, "
+                          "width, N, st and Cs)",
+                          p[i].d.name);
+        }
+    }
+    if (e != 0)
+        vars_free(v);
+    return e;
+}
+
+/* Sends the primitive to the sink (after the state it needs). */
+static int emit(Rib *r, const RayesCurves *c, RayesPointShape shape, size_t n_points,
+                const float *P, const Vars *v)
+{
+    int e = rib_emit_begin(r, NULL);
+    if (e == 1) /* outside the world: nothing to draw */
+        return 0;
+    if (e != 0)
+        return e;
+    SinkState *st;
+    const IoSink *s = rib_out_sink(r, &st);
+    if (c ? !s->curves : !s->points)
+        return rib_error(r, "this sink takes no %s", c ? "curves" : "points");
+    RayesError err = c ? s->curves(s->target, c, v->pv, v->n)
+                       : s->points(s->target, shape, n_points, P, v->pv, v->n);
+    return err == RAYES_OK ? 0 : rib_sink_failed(r, s);
+}
+
+static int h_curves(Rib *r, const Args *a)
+{
+    size_t i = 0, n_curves = 0, n = 0, np = 0;
+    const char *type = rib_get_string(r, a, &i, "\"linear\" or \"cubic\"");
+    if (!type)
+        return -1;
+    int cubic = strcmp(type, "cubic") == 0;
+    if (!cubic && strcmp(type, "linear") != 0)
+        return rib_error(r, "expected \"linear\" or \"cubic\", found \"%s\"", type);
+    int *nverts = NULL;
+    Param *p = NULL;
+    float *P = NULL;
+    Vars vars = {0};
+    int e = rib_get_ints(r, a, &i, &nverts, &n_curves, 1, 1 << 24, "vertices per curve");
+    const char *wrap = e == 0 ? rib_get_string(r, a, &i, "\"periodic\" or \"nonperiodic\"") : NULL;
+    if (e == 0 && !wrap)
+        e = -1;
+    int periodic = wrap && strcmp(wrap, "periodic") == 0;
+    if (e == 0 && !periodic && strcmp(wrap, "nonperiodic") != 0)
+        e = rib_error(r, "expected \"periodic\" or \"nonperiodic\", found \"%s\"", wrap);
+    if (e == 0)
+        e = rib_get_params(r, a, i, &p, &n);
+    if (e == 0 && !(P = rib_get_points(r, p, n, &np)))
+        e = -1;
+    RayesCurves c = {.degree = cubic ? 3 : 1,
+                     .step = r->a.vstep,
+                     .periodic = periodic,
+                     .shape = r->a.roundcurve ? RAYES_CURVE_ROUND : RAYES_CURVE_FLAT,
+                     .n_curves = n_curves,
+                     .n_verts = nverts,
+                     .P = P};
+    memcpy(c.basis, r->a.vbasis, sizeof c.basis);
+    size_t n_points = 0, n_varying = 0;
+    long bad = e == 0 ? rayes_curves_counts(&c, &n_points, &n_varying) : 0;
+    if (bad == -1 && n_curves == 0)
+        bad = 0;
+    if (e == 0 && bad != 0)
+        e = rib_error(r, "curve %ld has %d vertices, which make no whole %s segments (step %d)",
+                      -1 - bad, nverts[-1 - bad], type, cubic ? c.step : 1);
+    if (e == 0 && n_points != np)
+        e = rib_error(r, "the curves have %zu vertices but \"P\" has %zu points", n_points, np);
+    Counts counts = {n_curves, n_varying, n_points, n_varying};
+    if (e == 0)
+        e = rib_check_counts(r, p, n, &counts);
+    if (e == 0)
+        e = read_vars(r, p, n, &vars);
+    if (e == 0)
+        e = emit(r, &c, RAYES_POINT_SPHERE, 0, NULL, &vars);
+    vars_free(&vars);
+    free(P);
+    free(p);
+    free(nverts);
+    return e;
+}
+
+static int h_points(Rib *r, const Args *a)
+{
+    size_t n = 0, np = 0;
+    Param *p = NULL;
+    float *P = NULL;
+    Vars vars = {0};
+    int e = rib_get_params(r, a, 0, &p, &n);
+    if (e == 0 && !(P = rib_get_points(r, p, n, &np)))
+        e = -1;
+    Counts counts = {1, np, np, np};
+    if (e == 0)
+        e = rib_check_counts(r, p, n, &counts);
+    RayesPointShape shape = RAYES_POINT_SPHERE;
+    const Param *type = e == 0 ? rib_find_param(p, n, "type") : NULL;
+    if (type && (type->v->kind == ARG_STR || type->v->kind == ARG_STRS) && type->v->n == 1) {
+        if (strcmp(type->v->s[0], "disk") == 0)
+            shape = RAYES_POINT_DISK;
+        else if (strcmp(type->v->s[0], "sphere") != 0)
+            rib_warn_once(r, "points type",
+                          "Points type \"%s\" is not supported; drawn as spheres (rayes draws "
+                          "\"sphere\" and \"disk\")",
+                          type->v->s[0]);
+    }
+    if (e == 0)
+        e = read_vars(r, p, n, &vars);
+    if (e == 0)
+        e = emit(r, NULL, shape, np, P, &vars);
+    vars_free(&vars);
+    free(P);
+    free(p);
+    return e;
+}
+
+const RibRequest rib_curves_requests[] = {
+    {"Curves", h_curves},
+    {"Points", h_points},
+    {NULL, NULL},
+};
