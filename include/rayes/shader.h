@@ -263,6 +263,23 @@ struct RayesShaderServices {
      * without I. Older renderers lack it (supports()). */
     void (*glossy)(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
                    const float *roughness, int n_rays, float (*out)[3]);
+
+    /* Direct lighting of fibres (hair, fur, grass), whose shading depends
+     * on the unit tangent T[i] (the fibre's direction, e.g. dPdu), not on
+     * a normal: light from every direction counts (a fibre has no back),
+     * with direct_lighting's shadow rays and light selection. Per point,
+     * with t = T.w and (specular, needs I) v = T.V:
+     *   diffuse[i]  = (1/pi) integral of L sqrt(1 - t^2) dw (Kajiya-Kay's
+     *                 diffuse: a fibre of albedo a reflects a * diffuse[i]);
+     *   specular[i] = integral of L (e + 2) / (2 pi) max(0, sqrt(1 - t^2)
+     *                 sqrt(1 - v^2) - t v)^e dw, e = 1 / roughness[i] (NULL:
+     *                 0.1): Kajiya-Kay's highlight on the cone of mirror
+     *                 directions about the fibre.
+     * Area lights are sampled by the light only. Either output may be
+     * NULL. Older renderers lack it (supports()). */
+    void (*direct_fiber)(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
+                         int n_shadow_rays, const char *category, const float (*T)[3],
+                         const float *roughness, float (*diffuse)[3], float (*specular)[3]);
 };
 
 #ifdef __cplusplus

@@ -224,6 +224,8 @@ static int build_curves(Accel *a, const uint32_t *idx, size_t n, uint32_t mask, 
     return add_geom(a, g);
 }
 
+static Vec3 unit_or_zero(Vec3 n);
+
 /* The corners of a point grid's square: (0,0), (1,0), (0,1). */
 static void point_square(const GridSet *gs, const Grid *g, Vec3 *o, Vec3 *x, Vec3 *y)
 {
@@ -240,11 +242,17 @@ static int build_points(Accel *a, const uint32_t *idx, size_t n, uint32_t mask, 
     const GridSet *gs = a->gs;
     RTCGeometry geom = rtcNewGeometry(a->device, shape == GEOM_SHAPE_SPHERE
                                                      ? RTC_GEOMETRY_TYPE_SPHERE_POINT
-                                                     : RTC_GEOMETRY_TYPE_DISC_POINT);
+                                                 : shape == GEOM_SHAPE_DISK
+                                                     ? RTC_GEOMETRY_TYPE_DISC_POINT
+                                                     : RTC_GEOMETRY_TYPE_ORIENTED_DISC_POINT);
     float(*vtx)[4] = rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT4,
                                              4 * sizeof(float), n);
+    float(*nrm)[3] = shape == GEOM_SHAPE_ORIENTED_DISK
+                         ? rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_NORMAL, 0,
+                                                   RTC_FORMAT_FLOAT3, 3 * sizeof(float), n)
+                         : NULL;
     Geom g = {.kind = KIND_POINTS, .shape = (uint8_t)shape, .grids = malloc(n * sizeof(uint32_t))};
-    if (!vtx || !g.grids) {
+    if (!vtx || !g.grids || (shape == GEOM_SHAPE_ORIENTED_DISK && !nrm)) {
         free(g.grids);
         rtcReleaseGeometry(geom);
         return -1;
@@ -255,6 +263,10 @@ static int build_points(Accel *a, const uint32_t *idx, size_t n, uint32_t mask, 
         Vec3 c = v3_add(o, v3_scale(v3_add(x, y), 0.5f));
         vtx[k][0] = c.x, vtx[k][1] = c.y, vtx[k][2] = c.z;
         vtx[k][3] = 0.5f * v3_length(x);
+        if (nrm) {
+            Vec3 N = unit_or_zero(v3_cross(x, y));
+            nrm[k][0] = N.x, nrm[k][1] = N.y, nrm[k][2] = N.z;
+        }
         g.grids[k] = idx[k];
     }
     rtcSetGeometryMask(geom, mask);
@@ -266,7 +278,16 @@ static int build_points(Accel *a, const uint32_t *idx, size_t n, uint32_t mask, 
 }
 
 /* The kinds of grids an object may have, each one Embree geometry. */
-enum { GROUP_QUADS, GROUP_TRIS, GROUP_ROUND, GROUP_FLAT, GROUP_SPHERES, GROUP_DISKS, N_GROUPS };
+enum {
+    GROUP_QUADS,
+    GROUP_TRIS,
+    GROUP_ROUND,
+    GROUP_FLAT,
+    GROUP_SPHERES,
+    GROUP_DISKS,
+    GROUP_ORIENTED,
+    N_GROUPS
+};
 
 static int grid_group(const Grid *g)
 {
@@ -275,6 +296,7 @@ static int grid_group(const Grid *g)
     case GEOM_SHAPE_FLAT_CURVE: return GROUP_FLAT;
     case GEOM_SHAPE_SPHERE: return GROUP_SPHERES;
     case GEOM_SHAPE_DISK: return GROUP_DISKS;
+    case GEOM_SHAPE_ORIENTED_DISK: return GROUP_ORIENTED;
     default: return g->triangular ? GROUP_TRIS : GROUP_QUADS;
     }
 }
@@ -298,7 +320,8 @@ static int build_object(Accel *a, uint32_t object, uint32_t mask, uint32_t *scra
         case GROUP_ROUND: rc = build_curves(a, scratch, n, mask, GEOM_SHAPE_ROUND_CURVE); break;
         case GROUP_FLAT: rc = build_curves(a, scratch, n, mask, GEOM_SHAPE_FLAT_CURVE); break;
         case GROUP_SPHERES: rc = build_points(a, scratch, n, mask, GEOM_SHAPE_SPHERE); break;
-        default: rc = build_points(a, scratch, n, mask, GEOM_SHAPE_DISK); break;
+        case GROUP_DISKS: rc = build_points(a, scratch, n, mask, GEOM_SHAPE_DISK); break;
+        default: rc = build_points(a, scratch, n, mask, GEOM_SHAPE_ORIENTED_DISK); break;
         }
         if (rc != 0)
             return -1;
@@ -449,7 +472,8 @@ static void tri_hit(const Accel *a, const Geom *g, unsigned prim, float u, float
  * ray. */
 static Vec3 shape_normal(const struct RTCRayHit *rh, int shape)
 {
-    if (shape == GEOM_SHAPE_ROUND_CURVE || shape == GEOM_SHAPE_SPHERE)
+    if (shape == GEOM_SHAPE_ROUND_CURVE || shape == GEOM_SHAPE_SPHERE ||
+        shape == GEOM_SHAPE_ORIENTED_DISK)
         return unit_or_zero(v3(rh->hit.Ng_x, rh->hit.Ng_y, rh->hit.Ng_z));
     return unit_or_zero(v3(-rh->ray.dir_x, -rh->ray.dir_y, -rh->ray.dir_z));
 }

@@ -410,15 +410,16 @@ void geom_bound_sagitta(GridSet *gs, size_t first)
     for (size_t k = first; k < gs->n_grids; k++) {
         const Grid *g = &gs->grids[k];
         bound = fmaxf(bound, fminf(0.5f * g->edge * g->edge * g->curvature, g->edge));
-        if (g->shape == GEOM_SHAPE_SURFACE)
-            continue;
-        /* Tubes, spheres and ray-facing disks are shaded on the square or
-         * ribbon that faces the eye, through their middle: rays leave from
-         * a little more than the radius (half of |dPdv|) off it, so that
-         * none starts inside the shape. */
+        if (g->shape == GEOM_SHAPE_SURFACE || g->shape == GEOM_SHAPE_ORIENTED_DISK)
+            continue; /* flat */
+        /* Tubes, spheres and ray-facing disks are shaded on the ribbon or
+         * square that faces the eye, through their middle, or at hits on
+         * their surface: rays leave from a little more than a diameter
+         * (|dPdv|) off either side, so that none starts inside the shape
+         * or crosses it (fibres are lit from both sides). */
         size_t n = geom_grid_n_vertices(g);
         for (size_t i = 0; i < n; i++)
-            bound = fmaxf(bound, 0.55f * v3_length(gs->dPdv[g->first_vertex + i]));
+            bound = fmaxf(bound, 1.1f * v3_length(gs->dPdv[g->first_vertex + i]));
     }
     for (size_t k = first; k < gs->n_grids; k++)
         gs->grids[k].sagitta = bound;
@@ -616,7 +617,7 @@ static Domain whole_domain(const Prim *prim)
  * facing the camera. */
 static const Prim *facing_eye(const Prim *prim, const DiceCamera *cam, Prim *copy)
 {
-    if (prim_shape(prim) == GEOM_SHAPE_SURFACE)
+    if (prim_shape(prim) == GEOM_SHAPE_SURFACE || prim_shape(prim) == GEOM_SHAPE_ORIENTED_DISK)
         return prim;
     *copy = *prim;
     if (prim->type == PRIM_CURVE)

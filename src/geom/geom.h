@@ -58,7 +58,8 @@ typedef enum GeomShape {
     GEOM_SHAPE_ROUND_CURVE = 1, /* a tube about the centre line of a 2-row grid */
     GEOM_SHAPE_FLAT_CURVE = 2,  /* a ribbon that faces each ray */
     GEOM_SHAPE_SPHERE = 3,      /* a sphere in a 2 x 2 grid's square */
-    GEOM_SHAPE_DISK = 4         /* a disk in the square, facing each ray */
+    GEOM_SHAPE_DISK = 4,        /* a disk in the square, facing each ray */
+    GEOM_SHAPE_ORIENTED_DISK = 5 /* a disk in the square, in its plane */
 } GeomShape;
 
 struct SubdivMesh;
@@ -112,9 +113,9 @@ typedef struct Prim {
         struct {
             Vec3 centre;
             float radius;
-            Vec3 n;          /* an oriented disk's normal (shape SURFACE), world */
+            Vec3 n;          /* an oriented disk's normal, world */
             Vec3 facing;     /* spheres and disks: the square faces this point (the eye) */
-            uint8_t shape;   /* GEOM_SHAPE_SPHERE, _DISK, or _SURFACE: an oriented disk */
+            uint8_t shape;   /* GEOM_SHAPE_SPHERE, _DISK or _ORIENTED_DISK */
         } point;
     };
 } Prim;

@@ -156,7 +156,7 @@ void geom_curve_frame(const Prim *prim, float u, Vec3 *C, Vec3 *T, float *w, Vec
 /* A point's square: u along X, v along Y, X x Y its normal. */
 static void eval_point(const Prim *prim, float u, float v, Vec3 *P, Vec3 *dPdu, Vec3 *dPdv)
 {
-    Vec3 Z = prim->point.shape == GEOM_SHAPE_SURFACE ? prim->point.n
+    Vec3 Z = prim->point.shape == GEOM_SHAPE_ORIENTED_DISK ? prim->point.n
                                                      : v3_sub(prim->point.facing, prim->point.centre);
     float l = v3_length(Z);
     Z = l > 0.0f ? v3_scale(Z, 1.0f / l) : v3(0, 0, 1);

@@ -175,6 +175,24 @@ int pbrt_emit_subdiv(Parser *P, const Token *t, size_t n_faces, const int *n_ver
     return emit_mesh(P, t, n_faces, n_verts, idx, n_points, pts, NULL, uv, 1);
 }
 
+int pbrt_emit_curves(Parser *P, const Token *t, const RayesCurves *c, const RayesPrimvar *pv,
+                     size_t n_pv)
+{
+    if (strcmp(P->gs.material.shader, PBRT_INVISIBLE) == 0)
+        return 0;
+    if (P->recording) {
+        pbrt_warn_at(P, t->line, t->col, "curve instance",
+                     "curve: curves inside ObjectBegin are not instanced yet; skipped");
+        return 0;
+    }
+    if (send_state(P, t, P->gs.ctm, &P->gs.material) != 0)
+        return -1;
+    if (!P->sink->curves)
+        return FAIL_TOK(P, t, "curve: this sink takes no curves");
+    RayesError e = P->sink->curves(P->sink->target, c, pv, n_pv);
+    return e != RAYES_OK ? pbrt_sink_failed(P, t, e) : 0;
+}
+
 int pbrt_emit_quadric(Parser *P, const Token *t, RayesQuadric q, const float *qp, size_t n,
                       unsigned flags)
 {

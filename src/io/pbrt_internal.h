@@ -289,6 +289,10 @@ int pbrt_emit_mesh(Parser *P, const Token *t, size_t n_faces, const int *n_verts
  * like a mesh. */
 int pbrt_emit_subdiv(Parser *P, const Token *t, size_t n_faces, const int *n_verts, const int *idx,
                      size_t n_points, const float *pts, const float *uv);
+/* Curves (the curve shape) under the current transform and material;
+ * inside ObjectBegin skipped with one warning. */
+int pbrt_emit_curves(Parser *P, const Token *t, const RayesCurves *c, const RayesPrimvar *pv,
+                     size_t n_pv);
 int pbrt_emit_quadric(Parser *P, const Token *t, RayesQuadric q, const float *qp, size_t n,
                       unsigned flags);
 /* The bilinear patch of patch (its patch, patch_pv, patch_N, patch_uv). */

@@ -453,6 +453,88 @@ static int shape_quadric(Parser *P, const Token *t, const char *type, ParamList 
     return 0;
 }
 
+/* ------------------------------------------------------------------ curve */
+
+/* pbrt-v4's curve: one curve of Bezier or B-spline segments of degree 2
+ * or 3, sent as one cubic Bezier curve (quadratic segments raised to
+ * cubic, B-spline ones turned Bezier), its width from width0 to width1
+ * along the whole curve (varying), ribbons' normals (one per segment end)
+ * as varying N. "cylinder" is a round tube, "flat" a ribbon facing each
+ * ray. */
+static int shape_curve(Parser *P, const Token *t, ParamList *pl)
+{
+    Param *pp = pbrt_find(pl, "P"), *np = pbrt_find(pl, "N");
+    const char *basis = pbrt_get_string(pl, "basis", "bezier");
+    const char *type = pbrt_get_string(pl, "type", "flat");
+    int degree = (int)pbrt_get_float(pl, "degree", 3);
+    double width = pbrt_get_float(pl, "width", 1.0);
+    double w0 = pbrt_get_float(pl, "width0", width), w1 = pbrt_get_float(pl, "width1", width);
+    (void)pbrt_find(pl, "splitdepth"); /* pbrt's refinement: diced like everything else */
+    int bspline = strcmp(basis, "bspline") == 0, ribbon = strcmp(type, "ribbon") == 0;
+    if (!bspline && strcmp(basis, "bezier") != 0)
+        return FAIL_TOK(P, t, "curve: \"basis\" is \"%.40s\"; expected \"bezier\" or \"bspline\"",
+                        basis);
+    if (degree != 2 && degree != 3)
+        return FAIL_TOK(P, t, "curve: \"degree\" is %d; expected 2 or 3", degree);
+    if (!ribbon && strcmp(type, "flat") != 0 && strcmp(type, "cylinder") != 0)
+        return FAIL_TOK(P, t, "curve: \"type\" is \"%.40s\"; expected flat, cylinder or ribbon",
+                        type);
+    size_t n_cp = pp && pp->n_num % 3 == 0 ? pp->n_num / 3 : 0;
+    size_t segs = bspline ? (n_cp > (size_t)degree ? n_cp - (size_t)degree : 0)
+                          : (n_cp > 1 && (n_cp - 1) % (size_t)degree == 0 ? (n_cp - 1) / (size_t)degree
+                                                                          : 0);
+    if (segs == 0 || segs > (1u << 20))
+        return FAIL_TOK(P, t, "curve: \"point3 P\" has %zu points, which make no whole %s segments "
+                              "of degree %d",
+                        n_cp, basis, degree);
+    if (!(w0 >= 0 && w1 >= 0 && w0 < 1e30 && w1 < 1e30))
+        return FAIL_TOK(P, t, "curve: widths must be finite and >= 0");
+    if (ribbon && (!np || np->n_num != 3 * (segs + 1)))
+        return FAIL_TOK(P, t, "curve: a ribbon needs \"normal N\" with %zu normals (one per "
+                              "segment end)",
+                        segs + 1);
+    float *in = points_of(P, t, pp), *N = ribbon ? points_of(P, t, np) : NULL;
+    float *cp = malloc((3 * segs + 1) * 3 * sizeof *cp), *w = malloc((segs + 1) * sizeof *w);
+    int r = -1;
+    if (!in || (ribbon && !N) || !cp || !w) {
+        FAIL_TOK(P, t, "out of memory");
+        goto done;
+    }
+    for (size_t k = 0; k < segs; k++) {
+        const float *g = in + 3 * (bspline ? k : k * (size_t)degree);
+        float b[4][3]; /* the segment's cubic Bezier points */
+        for (int c = 0; c < 3; c++) {
+            float p0 = g[c], p1 = g[3 + c], p2 = g[6 + c], p3 = degree == 3 ? g[9 + c] : 0.0f;
+            if (degree == 3 && bspline) {
+                b[0][c] = (p0 + 4 * p1 + p2) / 6, b[1][c] = (2 * p1 + p2) / 3;
+                b[2][c] = (p1 + 2 * p2) / 3, b[3][c] = (p1 + 4 * p2 + p3) / 6;
+            } else if (degree == 3) {
+                b[0][c] = p0, b[1][c] = p1, b[2][c] = p2, b[3][c] = p3;
+            } else { /* quadratic (B-spline made Bezier first), raised to cubic */
+                float q0 = bspline ? 0.5f * (p0 + p1) : p0, q2 = bspline ? 0.5f * (p1 + p2) : p2;
+                b[0][c] = q0, b[1][c] = q0 + 2.0f / 3 * (p1 - q0);
+                b[2][c] = q2 + 2.0f / 3 * (p1 - q2), b[3][c] = q2;
+            }
+        }
+        memcpy(cp + 9 * k, b, (k + 1 == segs ? 12 : 9) * sizeof(float));
+        w[k] = (float)(w0 + (w1 - w0) * (double)k / (double)segs);
+    }
+    w[segs] = (float)w1;
+    int n_verts = (int)(3 * segs + 1);
+    RayesCurves c = {.degree = 3, .step = 3, .n_curves = 1, .n_verts = &n_verts, .P = cp,
+                     .shape = strcmp(type, "cylinder") == 0 ? RAYES_CURVE_ROUND : RAYES_CURVE_FLAT};
+    memcpy(c.basis, rayes_basis_bezier, sizeof c.basis);
+    RayesPrimvar pv[2] = {{"width", RAYES_PRIMVAR_VARYING, w, segs + 1},
+                          {"N", RAYES_PRIMVAR_VARYING, N, segs + 1}};
+    r = pbrt_emit_curves(P, t, &c, pv, ribbon ? 2 : 1);
+done:
+    free(in);
+    free(N);
+    free(cp);
+    free(w);
+    return r;
+}
+
 /* ------------------------------------------------------------ directives */
 
 int pbrt_d_shape(Parser *P, const Token *t)
@@ -476,6 +558,8 @@ int pbrt_d_shape(Parser *P, const Token *t)
         r = shape_loopsubdiv(P, t, &pl);
     else if (strcmp(type, "plymesh") == 0)
         r = shape_plymesh(P, t, &pl);
+    else if (strcmp(type, "curve") == 0)
+        r = shape_curve(P, t, &pl);
     else if (strcmp(type, "sphere") == 0 || strcmp(type, "disk") == 0 ||
              strcmp(type, "cylinder") == 0)
         r = shape_quadric(P, t, type, &pl);

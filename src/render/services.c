@@ -220,6 +220,74 @@ static void svc_direct_lighting(const RayesShaderServices *sv, const RayesShadeC
     }
 }
 
+/* Kajiya-Kay's terms for tangent T, toward the light wi and the viewer V
+ * (zero: no highlight). */
+static void fiber_terms(Vec3 T, Vec3 V, Vec3 wi, float e, float *diff, float *spec)
+{
+    float t = v3_dot(T, wi), sin_t = sqrtf(fmaxf(0.0f, 1.0f - t * t));
+    *diff = sin_t / (float)M_PI;
+    *spec = 0.0f;
+    if (v3_length(V) > 0.0f) {
+        float v = v3_dot(T, V), c = sin_t * sqrtf(fmaxf(0.0f, 1.0f - v * v)) - t * v;
+        *spec = c > 0.0f ? (e + 2.0f) / (2.0f * (float)M_PI) * powf(c, e) : 0.0f;
+    }
+}
+
+static void svc_direct_fiber(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
+                             int n_shadow_rays, const char *category, const float (*T)[3],
+                             const float *roughness, float (*diffuse)[3], float (*specular)[3])
+{
+    (void)sv;
+    const PathState *ps = ctx->renderer;
+    Worker *w = ps->w;
+    int n = n_shadow_rays > 0 ? n_shadow_rays
+            : ctx->diffuse_depth == 0 ? w->set->shadow_rays
+                                      : w->set->shadow_rays_deep;
+    const RenderObject *obj = lit_object(ps);
+    for (size_t i = 0; i < ctx->n_points; i++) {
+        Vec3 d = v3(0, 0, 0), s = d;
+        Vec3 P = v3_load(ctx->P[i]), Ng = v3_load(ctx->Ng[i]), t = v3_normalize(v3_load(T[i]));
+        Vec3 V = specular && ctx->I ? v3_normalize(v3_neg(v3_load(ctx->I[i]))) : v3(0, 0, 0);
+        float e = 1.0f / (roughness && roughness[i] > 0.0f ? roughness[i] : 0.1f);
+        float off = ps->offset[point(ctx, i)];
+        uint64_t key = hash_combine(ps->keys[point(ctx, i)], DIM_LIGHT);
+        for (size_t k = 0; k < w->rs->n_lights && n > 0; k++) {
+            const Light *l = &w->rs->lights[k];
+            if (l->type == LIGHT_AMBIENT || !render_lit_by(obj, k) ||
+                !light_category_match(l, category))
+                continue;
+            int m = light_is_area(l) ? n : 1;
+            uint32_t pattern = (uint32_t)hash_combine(key, k);
+            for (int j = 0; j < m; j++) {
+                float a = 0.5f, b = 0.5f, fd, fs;
+                if (m > 1)
+                    cmj_sample_2d((uint32_t)j, (uint32_t)m, pattern, &a, &b);
+                LightSample ls;
+                /* From the side of the grid the light is on: a fibre is lit
+                 * all round. */
+                Vec3 o = P;
+                if (!light_sample(l, o, a, b, &ls) || !(v3_max_component(ls.Li) > 0.0f))
+                    continue;
+                o = v3_madd(P, Ng, v3_dot(ls.wi, Ng) >= 0.0f ? off : -off);
+                if (!unoccluded(w, o, ls.wi, ls.dist))
+                    continue;
+                float weight = light_is_area(l) ? 1.0f / (ls.pdf * (float)m) : 1.0f;
+                if (light_is_area(l) && !(ls.pdf > 0.0f))
+                    continue;
+                fiber_terms(t, V, ls.wi, e, &fd, &fs);
+                /* Delta lights' Li is what a Lambertian cosine term scales
+                 * (direct_lighting): (1/pi) Li cos; fibres take Li the same. */
+                d = v3_madd(d, ls.Li, fd * weight);
+                s = v3_madd(s, ls.Li, fs * weight);
+            }
+        }
+        if (diffuse)
+            v3_store(diffuse[i], d);
+        if (specular)
+            v3_store(specular[i], s);
+    }
+}
+
 static void svc_indirect_diffuse(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
                                  int n_rays, float (*out)[3])
 {
@@ -506,7 +574,7 @@ static float svc_random(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
 static const char *const service_names[] = {
     "direct_lighting", "ambient", "indirect_diffuse", "indirect_specular", "indirect_refraction",
     "transmission", "noise", "fbm", "turbulence", "attribute", "option", "texture", "checker",
-    "random", "glossy",
+    "random", "glossy", "direct_fiber",
 };
 
 static int svc_supports(const RayesShaderServices *sv, const char *service)
@@ -537,4 +605,5 @@ const RayesShaderServices render_services = {
     .supports = svc_supports,
     .random = svc_random,
     .glossy = svc_glossy,
+    .direct_fiber = svc_direct_fiber,
 };

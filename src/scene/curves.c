@@ -342,7 +342,7 @@ RayesError rayes_scene_points(RayesScene *s, RayesPointShape shape, size_t n_poi
         p.point.radius = 0.5f * fmaxf(end[VAR_WIDTH][0][0], 0.0f) * scale;
         if (vars.by[VAR_N])
             p.point.n = v3_normalize(mat4_vector(&normal_from_object, v3_load(end[VAR_N][0])));
-        p.point.shape = vars.by[VAR_N]                ? GEOM_SHAPE_SURFACE
+        p.point.shape = vars.by[VAR_N]                ? GEOM_SHAPE_ORIENTED_DISK
                         : shape == RAYES_POINT_DISK ? GEOM_SHAPE_DISK
                                                     : GEOM_SHAPE_SPHERE;
         if (!(p.point.radius > 0.0f))

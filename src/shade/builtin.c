@@ -1,7 +1,7 @@
 /*
  * shade/builtin.c — RenderMan's classic surfaces: matte, plastic,
- * paintedplastic, a tinted mirror and constant (the others are in
- * builtin_bsdf.c).
+ * paintedplastic, a tinted mirror and constant, and hair, Kajiya-Kay
+ * fibres for curves (the others are in builtin_bsdf.c).
  *
  * Each has a separate diffuselighting with exactly the view-independent
  * terms of its lighting: for matte and constant the two are the same; for
@@ -370,4 +370,90 @@ const RayesShaderClass shade_class_paintedplastic = {
     .lighting = painted_lighting,
     .diffuselighting = painted_diffuselighting,
     .scratch_size = sizeof(PaintedScratch),
+};
+
+/* ---- hair: Kajiya-Kay fibres (direct_fiber), for curves */
+
+typedef struct HairParams {
+    float Ka, Kd, Ks, roughness;
+    float specularcolor[3];
+} HairParams;
+
+/* Ci = Cs (Ka ambient + Kd (fibre diffuse + indirect diffuse)), plus the
+ * highlight when spec is wanted. The tangent is dPdu (along a curve);
+ * indirect light is gathered over the hemisphere of N (on curves the
+ * side that faces the camera), an approximation of a fibre's sphere.
+ * Without direct_fiber (an older renderer) it is plastic. */
+static void hair_terms(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
+                       const HairParams *p, int spec, RayesShadeOutputs *out)
+{
+    float dd[SHADE_CHUNK][3], id[SHADE_CHUNK][3], ds[SHADE_CHUNK][3], am[SHADE_CHUNK][3];
+    float rough[SHADE_CHUNK], T[SHADE_CHUNK][3];
+    for (size_t i = 0; i < ctx->n_points; i++) {
+        rough[i] = p->roughness;
+        for (int c = 0; c < 3; c++)
+            T[i][c] = ctx->dPdu ? ctx->dPdu[i][c] : 0.0f;
+    }
+    if (sv->direct_fiber && ctx->dPdu)
+        sv->direct_fiber(sv, ctx, 0, NULL, (const float(*)[3])T, rough, dd, spec ? ds : NULL);
+    else
+        sv->direct_lighting(sv, ctx, 0, NULL, rough, dd, spec ? ds : NULL);
+    sv->indirect_diffuse(sv, ctx, 0, id);
+    if (sv->ambient)
+        sv->ambient(sv, ctx, am);
+    else
+        memset(am, 0, sizeof am);
+    for (size_t i = 0; i < ctx->n_points; i++)
+        for (int c = 0; c < 3; c++) {
+            out->Ci[i][c] = cs(ctx, i, c) * (p->Ka * am[i][c] + p->Kd * (dd[i][c] + id[i][c]));
+            if (spec)
+                out->Ci[i][c] += p->specularcolor[c] * p->Ks * ds[i][c];
+        }
+    if (out->Irradiance)
+        for (size_t i = 0; i < ctx->n_points; i++)
+            for (int c = 0; c < 3; c++)
+                out->Irradiance[i][c] = 3.14159265f * (dd[i][c] + id[i][c]);
+}
+
+static void hair_chunk(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
+                       const void *params, RayesShadeOutputs *out)
+{
+    hair_terms(sv, ctx, params, 1, out);
+}
+
+static void hair_diffuse_chunk(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
+                               const void *params, RayesShadeOutputs *out)
+{
+    hair_terms(sv, ctx, params, 0, out);
+}
+
+static void hair_lighting(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
+                          const void *params, RayesShadeOutputs *out)
+{
+    by_chunks(sv, ctx, params, out, hair_chunk);
+}
+
+static void hair_diffuselighting(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
+                                 const void *params, RayesShadeOutputs *out)
+{
+    by_chunks(sv, ctx, params, out, hair_diffuse_chunk);
+}
+
+static const RayesShaderParamDesc hair_params[] = {
+    {"Ka", RAYES_PARAM_FLOAT, offsetof(HairParams, Ka), {1, 0, 0}},
+    {"Kd", RAYES_PARAM_FLOAT, offsetof(HairParams, Kd), {0.6f, 0, 0}},
+    {"Ks", RAYES_PARAM_FLOAT, offsetof(HairParams, Ks), {0.3f, 0, 0}},
+    {"roughness", RAYES_PARAM_FLOAT, offsetof(HairParams, roughness), {0.05f, 0, 0}},
+    {"specularcolor", RAYES_PARAM_COLOR, offsetof(HairParams, specularcolor), {1, 1, 1}},
+};
+
+const RayesShaderClass shade_class_hair = {
+    .abi_version = RAYES_SHADER_ABI_VERSION,
+    .struct_size = sizeof(RayesShaderClass),
+    .name = "hair",
+    .params_size = sizeof(HairParams),
+    .params = hair_params,
+    .n_params = sizeof hair_params / sizeof hair_params[0],
+    .lighting = hair_lighting,
+    .diffuselighting = hair_diffuselighting,
 };

@@ -1,0 +1,164 @@
+/*
+ * Curves and points in scene files: RIB's Curves (the current v basis,
+ * varying widths, Attribute "dice" "roundcurve", N for ribbons) and
+ * Points ("type" "disk", constantwidth), errors naming the line, pbrt's
+ * curve shape (cylinder, bspline of degree 2 raised to cubic Bezier,
+ * width0 to width1), and the RIB writer's Curves and Points read back to
+ * the same primitives.
+ */
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "io/pbrt.h"
+#include "io/rib.h"
+#include "io/rib_write.h"
+#include "io/sink.h"
+#include "scene/scene.h"
+#include "test.h"
+
+static char err[1024];
+
+static RayesScene *read(const char *text, int pbrt, RayesError *e)
+{
+    RayesScene *s = rayes_scene_new();
+    IoSink sink = io_sink_scene(s);
+    IoSettings settings;
+    io_settings_init(&settings);
+    IoReadOptions opt = {RAYES_TEST_DATA, -1};
+    err[0] = '\0';
+    size_t n = strlen(text);
+    *e = pbrt ? io_pbrt_parse("t.pbrt", (const unsigned char *)text, n, &sink, &opt, &settings, err,
+                              sizeof err)
+              : io_rib_parse("t.rib", (const unsigned char *)text, n, &sink, &opt, &settings, err,
+                             sizeof err);
+    return s;
+}
+
+static const char *const rib_text =
+    "WorldBegin\n"
+    "Basis \"b-spline\" 1 \"b-spline\" 1\n"
+    "Curves \"cubic\" [5] \"nonperiodic\" \"P\" [0 0 0 1 0 0 2 1 0 3 1 0 4 0 0]\n"
+    "  \"width\" [0.1 0.2 0.3]\n"
+    "AttributeBegin\n"
+    "Attribute \"dice\" \"int roundcurve\" [1]\n"
+    "Curves \"linear\" [3] \"periodic\" \"P\" [0 0 0 1 0 0 0 1 0] \"constantwidth\" [0.05]\n"
+    "  \"Cs\" [1 0 0 0 1 0 0 0 1]\n"
+    "Curves \"linear\" [2] \"nonperiodic\" \"P\" [0 0 0 0 1 0] \"N\" [0 0 1 0 0 1]\n"
+    "AttributeEnd\n"
+    "Points \"P\" [0 0 0 1 1 1] \"constantwidth\" [0.5] \"uniform string type\" \"disk\"\n"
+    "WorldEnd\n";
+
+static void test_rib(void)
+{
+    RayesError e;
+    RayesScene *s = read(rib_text, 0, &e);
+    CHECK(e == RAYES_OK);
+    /* 2 B-spline segments, 3 periodic linear ones, 1 ribbon, 2 points. */
+    CHECK(s->n_prims == 8);
+    if (s->n_prims == 8) {
+        const Prim *p = s->prims;
+        CHECK(p[0].type == PRIM_CURVE && p[0].curve.shape == GEOM_SHAPE_FLAT_CURVE);
+        CHECK_NEAR(p[0].curve.width[0], 0.1, 1e-6);
+        CHECK_NEAR(p[1].curve.width[0], 0.2, 1e-6);
+        CHECK_NEAR(p[1].curve.width[1], 0.3, 1e-6);
+        /* The B-spline's first point: (P0 + 4 P1 + P2) / 6. */
+        CHECK_NEAR(p[0].curve.cp[0].x, 1.0, 1e-6);
+        CHECK_NEAR(p[0].curve.cp[0].y, 1.0 / 6.0, 1e-6);
+        CHECK(p[2].curve.shape == GEOM_SHAPE_ROUND_CURVE && p[4].curve.shape == GEOM_SHAPE_ROUND_CURVE);
+        CHECK_NEAR(p[2].curve.width[1], 0.05, 1e-6);
+        CHECK(p[2].pv == GEOM_PV_CS);
+        /* The periodic curve's last segment ends where it began. */
+        CHECK(v3_length(v3_sub(p[4].curve.cp[3], p[2].curve.cp[0])) < 1e-6f);
+        CHECK(p[5].curve.shape == GEOM_SHAPE_SURFACE && p[5].curve.n[0].z > 0.99f);
+        CHECK(p[6].type == PRIM_POINT && p[6].point.shape == GEOM_SHAPE_DISK);
+        CHECK_NEAR(p[7].point.radius, 0.25, 1e-6);
+    }
+    rayes_scene_release(s);
+}
+
+static void test_rib_errors(void)
+{
+    RayesError e;
+    RayesScene *s = read("WorldBegin\nCurves \"cubic\" [5] \"nonperiodic\"\n"
+                         "  \"P\" [0 0 0 1 0 0 2 1 0 3 1 0 4 0 0]\nWorldEnd\n",
+                         0, &e);
+    CHECK(e != RAYES_OK && strstr(err, "t.rib:2") && strstr(err, "no whole"));
+    rayes_scene_release(s);
+    s = read("WorldBegin\nCurves \"linear\" [2] \"nonperiodic\" \"P\" [0 0 0 1 0 0]\n"
+             "  \"width\" [1 2 3]\nWorldEnd\n",
+             0, &e);
+    CHECK(e != RAYES_OK && strstr(err, "t.rib:3") && strstr(err, "width"));
+    rayes_scene_release(s);
+    s = read("WorldBegin\nCurves \"quadratic\" [2] \"nonperiodic\" \"P\" [0 0 0 1 0 0]\nWorldEnd\n",
+             0, &e);
+    CHECK(e != RAYES_OK && strstr(err, "linear"));
+    rayes_scene_release(s);
+}
+
+static void test_pbrt(void)
+{
+    RayesError e;
+    RayesScene *s = read("WorldBegin\n"
+                         "Shape \"curve\" \"point3 P\" [0 0 0 1 1 0 2 0 0 3 1 0]\n"
+                         "  \"string type\" \"cylinder\" \"string basis\" \"bspline\"\n"
+                         "  \"integer degree\" 2 \"float width0\" 0.2 \"float width1\" 0.1\n"
+                         "Shape \"curve\" \"point3 P\" [0 0 0 1 1 0 2 0 0 3 1 0]\n"
+                         "  \"string type\" \"ribbon\" \"normal N\" [0 0 1 0 0 1]\n",
+                         1, &e);
+    CHECK(e == RAYES_OK);
+    CHECK(s->n_prims == 3);
+    if (s->n_prims == 3) {
+        const Prim *p = s->prims;
+        CHECK(p[0].curve.shape == GEOM_SHAPE_ROUND_CURVE && p[2].curve.shape == GEOM_SHAPE_SURFACE);
+        /* Quadratic B-spline (0 0 0, 1 1 0, 2 0 0): from (0.5, 0.5) to (1.5, 0.5). */
+        CHECK_NEAR(p[0].curve.cp[0].x, 0.5, 1e-6);
+        CHECK_NEAR(p[0].curve.cp[3].x, 1.5, 1e-6);
+        CHECK_NEAR(p[0].curve.cp[3].y, 0.5, 1e-6);
+        CHECK_NEAR(p[0].curve.width[0], 0.2, 1e-6);
+        CHECK_NEAR(p[1].curve.width[1], 0.1, 1e-6);
+    }
+    rayes_scene_release(s);
+    s = read("WorldBegin\nShape \"curve\" \"point3 P\" [0 0 0 1 1 0 2 0 0]\n", 1, &e);
+    CHECK(e != RAYES_OK && strstr(err, "t.pbrt:2") && strstr(err, "whole"));
+    rayes_scene_release(s);
+}
+
+/* The writer's RIB read again gives the same primitives. */
+static void test_write_back(void)
+{
+    RibWriter *w = io_rib_writer_new();
+    IoSink sink = io_rib_writer_sink(w);
+    IoSettings settings;
+    io_settings_init(&settings);
+    IoReadOptions opt = {RAYES_TEST_DATA, -1};
+    CHECK(io_rib_parse("t.rib", (const unsigned char *)rib_text, strlen(rib_text), &sink, &opt,
+                       &settings, err, sizeof err) == RAYES_OK);
+    char *buf = NULL;
+    size_t len = 0;
+    FILE *f = open_memstream(&buf, &len);
+    CHECK(f && io_rib_writer_finish(w, &settings, f, err, sizeof err) == RAYES_OK);
+    fclose(f);
+    io_rib_writer_free(w);
+    RayesError e1, e2;
+    RayesScene *a = read(rib_text, 0, &e1), *b = read(buf ? buf : "", 0, &e2);
+    CHECK(e1 == RAYES_OK && e2 == RAYES_OK);
+    CHECK(a->n_prims == b->n_prims);
+    for (size_t k = 0; k < a->n_prims && k < b->n_prims; k++) {
+        CHECK(a->prims[k].type == b->prims[k].type);
+        if (a->prims[k].type == PRIM_CURVE) {
+            CHECK(a->prims[k].curve.shape == b->prims[k].curve.shape);
+            for (int j = 0; j < 4; j++)
+                CHECK(v3_length(v3_sub(a->prims[k].curve.cp[j], b->prims[k].curve.cp[j])) < 1e-5f);
+            CHECK_NEAR(a->prims[k].curve.width[1], b->prims[k].curve.width[1], 1e-6);
+        } else {
+            CHECK(a->prims[k].point.shape == b->prims[k].point.shape);
+            CHECK_NEAR(a->prims[k].point.radius, b->prims[k].point.radius, 1e-6);
+        }
+    }
+    rayes_scene_release(a);
+    rayes_scene_release(b);
+    free(buf);
+}
+
+TEST_MAIN(TEST(test_rib), TEST(test_rib_errors), TEST(test_pbrt), TEST(test_write_back))
