@@ -493,6 +493,9 @@ static int shape_curve(Parser *P, const Token *t, ParamList *pl)
         return FAIL_TOK(P, t, "curve: a ribbon needs \"normal N\" with %zu normals (one per "
                               "segment end)",
                         segs + 1);
+    if (P->gs.area.on)
+        pbrt_warn_at(P, t->line, t->col, "curve area",
+                     "curve: area lights are quads in rayes; the curve does not emit");
     float *in = points_of(P, t, pp), *N = ribbon ? points_of(P, t, np) : NULL;
     float *cp = malloc((3 * segs + 1) * 3 * sizeof *cp), *w = malloc((segs + 1) * sizeof *w);
     int r = -1;

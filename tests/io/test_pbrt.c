@@ -38,7 +38,7 @@ typedef struct Rec {
     float xform[16];
     Shader shader;
     /* geometry, with the transform and shader current then */
-    int n_meshes, n_quadrics, n_patches, n_area, n_lights;
+    int n_meshes, n_quadrics, n_patches, n_area, n_lights, n_curves;
     struct {
         size_t n_faces, n_points;
         float centre[3]; /* mean of the points, object space */
@@ -264,6 +264,13 @@ static const char *r_error(void *t)
     return "stub error";
 }
 
+static RayesError r_curves(void *t, const RayesCurves *c, const RayesPrimvar *pv, size_t n_pv)
+{
+    (void)c, (void)pv, (void)n_pv;
+    ((Rec *)t)->n_curves++;
+    return RAYES_OK;
+}
+
 static IoSink stub(Rec *r)
 {
     memset(r, 0, sizeof *r);
@@ -273,7 +280,8 @@ static IoSink stub(Rec *r)
                     .set_search_path = r_search, .set_shading_rate = r_rate,
                     .bilinear_patch = r_bilinear, .bicubic_patch = r_bicubic,
                     .polygon_mesh = r_mesh, .sphere = r_sphere, .quadric = r_quadric,
-                    .area_light = r_area, .light = r_light, .get_error = r_error};
+                    .area_light = r_area, .light = r_light, .get_error = r_error,
+                    .curves = r_curves};
 }
 
 /* Parses text from an exact-size heap copy; err gets the message. */
@@ -591,6 +599,7 @@ static void test_lights(void)
               strcmp(param(&r->light[5].params, "shape")->string, "disk") == 0);
     }
     CHECK(r->n_area == 1 && r->n_patches == 1); /* the emitting patch, then a plain one */
+    CHECK(r->n_curves == 1);                     /* a curve under an area light does not emit */
     if (r->n_area == 1) {
         CHECK_NEAR(r->area[0].L[1], 6, 0);
         float(*P)[3] = r->area[0].P; /* around the patch: p00 p10 p11 p01, normal +z */
