@@ -32,6 +32,12 @@
 typedef struct Domain {
     float c[3][2]; /* quad: c[0] = (u0, v0), c[1] = (u1, v1); triangle: three corners */
     int triangular;
+    /* A quad over part of a triangle (sub_quad): c[0], c[1] bound a
+     * rectangle of the quad's own (s, t), and q holds the quad's corners
+     * (s, t) = (0,0), (1,0), (0,1), (1,1) as the triangle's barycentric
+     * (u, v), interpolated bilinearly. */
+    int sub_quad;
+    float q[4][2];
 } Domain;
 
 typedef struct Estimate {
@@ -66,6 +72,12 @@ static void domain_uv(const Domain *d, float a, float b, float *u, float *v)
     if (!d->triangular) {
         *u = d->c[0][0] + (d->c[1][0] - d->c[0][0]) * a;
         *v = d->c[0][1] + (d->c[1][1] - d->c[0][1]) * b;
+        if (d->sub_quad) {
+            float s = *u, t = *v, w[4] = {(1 - s) * (1 - t), s * (1 - t), (1 - s) * t, s * t};
+            *u = *v = 0.0f;
+            for (int k = 0; k < 4; k++)
+                *u += w[k] * d->q[k][0], *v += w[k] * d->q[k][1];
+        }
     } else {
         float w = 1.0f - a - b;
         *u = w * d->c[0][0] + a * d->c[1][0] + b * d->c[2][0];
@@ -457,6 +469,16 @@ static int dice_quad(GridSet *gs, const Prim *prim, uint32_t prim_index, const f
                 .nu = (uint16_t)nu, .nv = (uint16_t)nv, .primvars = prim->pv,
                 .shape = (uint8_t)prim_shape(prim)};
     memcpy(g->uv, d->c, sizeof g->uv);
+    if (d->sub_quad) { /* the bounds of its corners' (u, v): the spacing of its vertices */
+        float lo[2] = {INFINITY, INFINITY}, hi[2] = {-INFINITY, -INFINITY};
+        for (int k = 0; k < 4; k++) {
+            float u, v;
+            domain_uv(d, (float)(k & 1), (float)(k >> 1), &u, &v);
+            lo[0] = fminf(lo[0], u), lo[1] = fminf(lo[1], v);
+            hi[0] = fmaxf(hi[0], u), hi[1] = fmaxf(hi[1], v);
+        }
+        g->uv[0][0] = lo[0], g->uv[0][1] = lo[1], g->uv[1][0] = hi[0], g->uv[1][1] = hi[1];
+    }
     size_t base = gs->n_vertices;
     for (int j = 0; j < nv; j++)
         for (int i = 0; i < nu; i++) {
@@ -569,6 +591,35 @@ static int split_triangle(Walk *w, const Domain *d, int thin, int depth)
     return 0;
 }
 
+/* A triangle too large for one grid (and not thin: thin ones are bisected
+ * first), as three quads meeting at its centroid (each from a corner
+ * through its edges' midpoints), which dice as quads do: into grids finer
+ * along one side than the other where the view foreshortens them (a
+ * triangular grid has one rate for all its edges), traced as Embree's
+ * grids (a sixth of its triangles' bytes). */
+static int split_quads(Walk *w, const Domain *d, int depth)
+{
+    const float third = 1.0f / 3.0f;
+    float mid[3][2], centre[2] = {0, 0};
+    for (int k = 0; k < 3; k++)
+        for (int c = 0; c < 2; c++) {
+            mid[k][c] = 0.5f * (d->c[k][c] + d->c[(k + 1) % 3][c]); /* edge k, k + 1 */
+            centre[c] += third * d->c[k][c];
+        }
+    for (int k = 0; k < 3; k++) {
+        Domain sub = {.c = {{0, 0}, {1, 1}, {0, 0}}, .sub_quad = 1};
+        /* Corner k, the midpoint toward k + 1, the one toward k - 1, the
+         * centroid: (s, t) = (0,0), (1,0), (0,1), (1,1). */
+        memcpy(sub.q[0], d->c[k], sizeof sub.q[0]);
+        memcpy(sub.q[1], mid[k], sizeof sub.q[1]);
+        memcpy(sub.q[2], mid[(k + 2) % 3], sizeof sub.q[2]);
+        memcpy(sub.q[3], centre, sizeof sub.q[3]);
+        if (split_dice(w, &sub, depth + 1) != 0)
+            return -1;
+    }
+    return 0;
+}
+
 static int split_dice(Walk *w, const Domain *d, int depth)
 {
     Estimate e = estimate(w->prim, d, w->cam);
@@ -582,6 +633,8 @@ static int split_dice(Walk *w, const Domain *d, int depth)
                                     e.n_v > GEOM_MAX_GRID - 1;
     if (!split || depth >= MAX_SPLIT_DEPTH)
         return leaf(w, d, e);
+    if (d->triangular && e.thin_edge < 0)
+        return split_quads(w, d, depth);
     if (d->triangular)
         return split_triangle(w, d, e.thin_edge, depth);
     /* Across the longer direction (u on a tie). */

@@ -203,17 +203,21 @@ static void test_grid_size_option(void)
     CHECK(geom_dice_prim(&gs, &big, 0, NULL, &cam) == 0);
     CHECK(gs.n_grids == 1 && gs.grids[0].nu == 65 && gs.grids[0].nv == 65);
     geom_gridset_fini(&gs);
+    /* Triangles: one triangular grid of at most sqrt(size) subdivisions,
+     * or, too large for that, quad grids of at most size micropolygons. */
     Prim t = {.type = PRIM_TRIANGLE, .shading_rate = 1.0f};
     t.cp[0] = v3(0, 0, 0), t.cp[1] = v3(100, 0, 0), t.cp[2] = v3(0, 100, 0);
     for (int size = 16; size <= 4096; size *= 4) {
         cam.grid_size = size;
         CHECK(geom_dice_prim(&gs, &t, 0, NULL, &cam) == 0);
-        uint32_t side = 0, biggest = 0;
-        while ((side + 1) * (side + 1) <= (uint32_t)size)
-            side++;
-        for (size_t g = 0; g < gs.n_grids; g++)
-            biggest = gs.grids[g].nu > biggest ? gs.grids[g].nu : biggest;
-        CHECK(biggest <= side && 2 * biggest > side);
+        int biggest = 0;
+        for (size_t g = 0; g < gs.n_grids; g++) {
+            const Grid *q = &gs.grids[g];
+            int m = q->triangular ? q->nu * q->nu : (q->nu - 1) * (q->nv - 1);
+            CHECK(!q->triangular && m <= size);
+            biggest = m > biggest ? m : biggest;
+        }
+        CHECK(4 * biggest > size);
         geom_gridset_fini(&gs);
     }
 }
@@ -238,6 +242,42 @@ static void test_distance_based_rates(void)
     geom_gridset_fini(&gs);
 }
 
+/* Twice the area of triangle a b c projected on z. */
+static double tri_area2(Vec3 a, Vec3 b, Vec3 c)
+{
+    return v3_cross(v3_sub(b, a), v3_sub(c, a)).z;
+}
+
+/* The summed area of every grid's micropolygons (quad cells as two
+ * triangles), counted positive when it faces +z times sign. */
+static double cell_area(const GridSet *gs, float sign)
+{
+    double area = 0.0;
+    for (size_t g = 0; g < gs->n_grids; g++) {
+        const Grid *q = &gs->grids[g];
+        const Vec3 *T = gs->P + q->first_vertex;
+        uint32_t n = q->nu;
+        for (uint32_t j = 0; q->triangular && j < n; j++)
+            for (uint32_t i = 0; i + j < n; i++) {
+                area += 0.5 * sign *
+                        tri_area2(T[geom_tri_vertex(n, i, j)], T[geom_tri_vertex(n, i + 1, j)],
+                                  T[geom_tri_vertex(n, i, j + 1)]);
+                if (i + j + 1 < n)
+                    area += 0.5 * sign *
+                            tri_area2(T[geom_tri_vertex(n, i + 1, j)],
+                                      T[geom_tri_vertex(n, i + 1, j + 1)],
+                                      T[geom_tri_vertex(n, i, j + 1)]);
+            }
+        for (int j = 0; !q->triangular && j + 1 < q->nv; j++)
+            for (int i = 0; i + 1 < q->nu; i++) {
+                const Vec3 *P = gs->P + q->first_vertex + (size_t)j * q->nu + i;
+                Vec3 a = P[0], b = P[1], c = P[q->nu], d = P[q->nu + 1];
+                area += 0.5 * sign * (tri_area2(a, b, c) + tri_area2(b, d, c));
+            }
+    }
+    return area;
+}
+
 static void test_triangle_grid_counts(void)
 {
     GridSet gs;
@@ -254,12 +294,15 @@ static void test_triangle_grid_counts(void)
     Vec3 apex = gs.P[geom_tri_vertex(n, 0, n)];
     CHECK_NEAR(apex.y, 8.0, 1e-5);
     geom_gridset_fini(&gs);
-    /* A big triangle splits into four at a time: 1 + 3k patches. */
+    /* A big triangle: three quads meeting at its centroid, split as quads
+     * are; their micropolygons cover it exactly, facing its way. */
     t.cp[1] = v3(100, 0, 0), t.cp[2] = v3(0, 100, 0);
     CHECK(geom_dice_prim(&gs, &t, 0, NULL, &cam) == 0);
-    CHECK((gs.n_grids - 1) % 3 == 0 && gs.n_grids >= 16);
+    CHECK(gs.n_grids >= 3);
+    CHECK_NEAR(cell_area(&gs, 1.0f), 5000.0, 0.05);
     for (size_t g = 0; g < gs.n_grids; g++)
-        CHECK(gs.grids[g].nu <= GEOM_MAX_TRI);
+        CHECK(!gs.grids[g].triangular &&
+              (gs.grids[g].nu - 1) * (gs.grids[g].nv - 1) <= GEOM_GRID_SIZE);
     geom_gridset_fini(&gs);
 }
 
@@ -369,13 +412,7 @@ static void test_thin_triangle(void)
     DiceCamera cam = camera();
     size_t n = dice_vertices(&t, &cam, &gs);
     CHECK(n > 500 && n < 50000);
-    double area = 0.0;
-    for (size_t g = 0; g < gs.n_grids; g++) {
-        const Grid *q = &gs.grids[g];
-        area += 0.5 * fabs((q->uv[1][0] - q->uv[0][0]) * (q->uv[2][1] - q->uv[0][1]) -
-                           (q->uv[2][0] - q->uv[0][0]) * (q->uv[1][1] - q->uv[0][1]));
-    }
-    CHECK_NEAR(area, 0.5, 1e-6); /* the parts tile the triangle's domain */
+    CHECK_NEAR(cell_area(&gs, 1.0f), 500.0, 0.01); /* the parts tile the triangle */
     geom_gridset_fini(&gs);
 }
 

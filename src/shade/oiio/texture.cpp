@@ -1,6 +1,9 @@
 /*
- * shade/texture.cpp — image textures through OpenImageIO's TextureSystem
- * (texture.h): the one C++ file of shade, a C interface over the library.
+ * shade/oiio/texture.cpp — image textures through OpenImageIO's
+ * TextureSystem (texture.h): the one C++ file of shade, a C interface over
+ * the library, built as the module librayes_oiio.so that texture.c loads
+ * on first use (texture_module.h); its texture_* functions are hidden and
+ * reached through the module's table.
  *
  * Each render owns a private OIIO TextureSystem with the render's memory
  * budget (its "max_memory_MB"). OIIO reads every format it knows (EXR,
@@ -27,6 +30,7 @@
  * (OIIO's TextureSystem is thread-safe); the name table has a mutex.
  */
 #include "shade/texture.h"
+#include "shade/texture_module.h"
 
 #include <OpenImageIO/imagecache.h>
 #include <OpenImageIO/imageio.h>
@@ -35,6 +39,7 @@
 #include <atomic>
 #include <cctype>
 #include <cmath>
+#include <cstdarg>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -46,7 +51,7 @@
 #include <vector>
 
 extern "C" {
-#include "util/log.h"
+#include "util/log.h" /* log_warning: defined at the end, forwarded to the host */
 }
 
 namespace {
@@ -368,4 +373,56 @@ extern "C" int texture_read_image(const char *path, int *w, int *h, float **rgba
     *h = spec.height;
     *rgba = out;
     return 0;
+}
+
+/* ------------------------------------------------- the module's table */
+
+static void (*host_warning)(const char *message);
+
+/* util/log.h's, for this file: formatted here, said by the host. */
+extern "C" void log_warning(const char *fmt, ...)
+{
+    char buf[1024];
+    va_list ap;
+    va_start(ap, fmt);
+    std::vsnprintf(buf, sizeof buf, fmt, ap);
+    va_end(ap);
+    if (host_warning)
+        host_warning(buf);
+    else
+        std::fprintf(stderr, "rayes: warning: %s\n", buf);
+}
+
+static void set_warning(void (*warn)(const char *message))
+{
+    host_warning = warn;
+}
+
+static void *system_new(const char *search_path, uint64_t budget_bytes, float width)
+{
+    return texture_system_new(search_path, budget_bytes, width);
+}
+
+static void system_free(void *ts)
+{
+    texture_system_free(static_cast<TextureSystem *>(ts));
+}
+
+static int lookup(void *ts, const char *name, size_t n, const float *s, const float *t,
+                  const float *ds, const float *dt, float (*rgb)[3], float *alpha)
+{
+    return texture_lookup(static_cast<TextureSystem *>(ts), name, n, s, t, ds, dt, rgb, alpha);
+}
+
+static void get_stats(void *ts, TextureStats *stats)
+{
+    texture_get_stats(static_cast<TextureSystem *>(ts), stats);
+}
+
+extern "C" __attribute__((visibility("default"))) const TextureModule *rayes_texture_module(void)
+{
+    static const TextureModule table = {TEXTURE_MODULE_VERSION, set_warning, system_new,
+                                        system_free,            lookup,      get_stats,
+                                        texture_read_image};
+    return &table;
 }
