@@ -34,6 +34,8 @@
 #define GEOM_MAX_TRI 16    /* subdivisions per edge of a triangular grid, by default
                               (sqrt(GEOM_GRID_SIZE)); GEOM_MAX_GRID - 1 at most */
 #define GEOM_MAX_GRID_SIZE ((GEOM_MAX_GRID - 1) * (GEOM_MAX_GRID - 1)) /* largest gridsize */
+#define GEOM_CURVE_RUN 3   /* segments of a curve one primitive holds, at most (what fits in
+                              a Prim's control points) */
 
 typedef enum PrimType {
     PRIM_BILINEAR = 1, /* cp[0..3] = P00, P10, P01, P11 */
@@ -44,8 +46,9 @@ typedef enum PrimType {
                           swept about object-space z; see geom_quadric_eval */
     PRIM_SUBDIV = 6,   /* one patch of a subdivision mesh's limit surface (subdiv.h): a quad,
                           or a triangle (subdiv.triangular) with PRIM_TRIANGLE's (u, v) */
-    PRIM_CURVE = 7,    /* one cubic Bezier segment of a curve with a width: u along it, v
-                          across, the centre line at v = 1/2 (geom_curve_frame) */
+    PRIM_CURVE = 7,    /* a run of up to GEOM_CURVE_RUN cubic Bezier segments of a curve
+                          with a width: u along the run, v across, the centre line at
+                          v = 1/2 (geom_curve_frame) */
     PRIM_POINT = 8     /* a sphere or disk: the square of its diameter facing the camera (or
                           its normal), u and v across */
 } PrimType;
@@ -102,13 +105,16 @@ typedef struct Prim {
             int triangular;                /* a Loop triangle */
         } subdiv;
         struct {
-            Vec3 cp[4];      /* the centre line's Bezier control points, world */
-            float width[2];  /* world units, at u = 0 and 1 (linear between) */
-            Vec3 n[2];       /* ribbons: the normals at u = 0 and 1, world */
+            Vec3 cp[3 * GEOM_CURVE_RUN + 1]; /* the centre line's Bezier control points,
+                                world: segment k's are cp[3k .. 3k + 3] */
+            float width[GEOM_CURVE_RUN + 1]; /* world units, at the segments' ends (linear
+                                between) */
+            Vec3 n[2];       /* ribbons (one segment each): the normals at its ends, world */
             Vec3 facing;     /* round and flat: the ribbon diced faces this point (the eye:
                                 geom_dice_prim sets it) */
             uint8_t shape;   /* GEOM_SHAPE_ROUND_CURVE, _FLAT_CURVE, or _SURFACE: a ribbon
                                 oriented by n */
+            uint8_t n_seg;   /* segments in the run, 1 to GEOM_CURVE_RUN (1 for ribbons) */
         } curve;
         struct {
             Vec3 centre;
@@ -120,11 +126,15 @@ typedef struct Prim {
     };
 } Prim;
 
-/* A curve segment's frame at u: the centre line C, its derivative T, the
- * width w, and the unit direction B across the ribbon (from v = 0 to 1:
- * n x T for ribbons, facing x T otherwise, so that dPdu x dPdv turns to
- * n or to the facing point). */
-void geom_curve_frame(const Prim *prim, float u, Vec3 *C, Vec3 *T, float *w, Vec3 *B);
+/* A curve run's frame at u: the centre line C, its derivative T (with
+ * respect to u), the width w and its derivative dw, and the unit
+ * direction B across the ribbon (from v = 0 to 1: n x T for ribbons,
+ * facing x T otherwise, so that dPdu x dPdv turns to n or to the facing
+ * point). Segment k of n_seg covers u in [k / n_seg, (k + 1) / n_seg]. */
+void geom_curve_frame(const Prim *prim, float u, Vec3 *C, Vec3 *T, float *w, float *dw, Vec3 *B);
+
+/* The segment of a curve run at u and the parameter t in it. */
+int geom_curve_segment(const Prim *prim, float u, float *t);
 
 /* A quadric's object-space position and derivatives at (u, v) in [0, 1]^2:
  * u sweeps theta from 0 to thetamax, v runs along the profile (RenderMan's

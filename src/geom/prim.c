@@ -132,25 +132,38 @@ static Vec3 any_perpendicular(Vec3 t)
     return a;
 }
 
-void geom_curve_frame(const Prim *prim, float u, Vec3 *C, Vec3 *T, float *w, Vec3 *B)
+int geom_curve_segment(const Prim *prim, float u, float *t)
 {
-    float b[4], db[4];
-    geom_bezier_basis(u, b, db);
-    Vec3 c = v3(0, 0, 0), t = c;
-    for (int k = 0; k < 4; k++) {
-        c = v3_madd(c, prim->curve.cp[k], b[k]);
-        t = v3_madd(t, prim->curve.cp[k], db[k]);
+    int n = prim->curve.n_seg > 0 ? prim->curve.n_seg : 1;
+    float x = fminf(fmaxf(u, 0.0f), 1.0f) * (float)n;
+    int k = (int)x < n ? (int)x : n - 1;
+    *t = x - (float)k;
+    return k;
+}
+
+void geom_curve_frame(const Prim *prim, float u, Vec3 *C, Vec3 *T, float *w, float *dw, Vec3 *B)
+{
+    float b[4], db[4], t;
+    int k = geom_curve_segment(prim, u, &t), n = prim->curve.n_seg > 0 ? prim->curve.n_seg : 1;
+    const Vec3 *cp = prim->curve.cp + 3 * k;
+    geom_bezier_basis(t, b, db);
+    Vec3 c = v3(0, 0, 0), d = c;
+    for (int j = 0; j < 4; j++) {
+        c = v3_madd(c, cp[j], b[j]);
+        d = v3_madd(d, cp[j], db[j] * (float)n);
     }
     Vec3 toward = prim->curve.shape == GEOM_SHAPE_SURFACE
-                      ? v3_lerp(prim->curve.n[0], prim->curve.n[1], u)
+                      ? v3_lerp(prim->curve.n[0], prim->curve.n[1], t)
                       : v3_sub(prim->curve.facing, c);
-    Vec3 across = v3_cross(toward, t);
+    Vec3 across = v3_cross(toward, d);
     float l = v3_length(across);
-    *B = l > 1e-12f * v3_length(t) * v3_length(toward) && l > 0.0f ? v3_scale(across, 1.0f / l)
-                                                                   : any_perpendicular(t);
+    *B = l > 1e-12f * v3_length(d) * v3_length(toward) && l > 0.0f ? v3_scale(across, 1.0f / l)
+                                                                   : any_perpendicular(d);
     *C = c;
-    *T = t;
-    *w = prim->curve.width[0] + (prim->curve.width[1] - prim->curve.width[0]) * u;
+    *T = d;
+    float w0 = prim->curve.width[k], w1 = prim->curve.width[k + 1];
+    *w = w0 + (w1 - w0) * t;
+    *dw = (w1 - w0) * (float)n;
 }
 
 /* A point's square: u along X, v along Y, X x Y its normal. */
@@ -207,9 +220,8 @@ void geom_prim_eval(const Prim *prim, float u, float v, Vec3 *P, Vec3 *dPdu, Vec
     }
     case PRIM_CURVE: {
         Vec3 C, T, B;
-        float w;
-        geom_curve_frame(prim, u, &C, &T, &w, &B);
-        float dw = prim->curve.width[1] - prim->curve.width[0];
+        float w, dw;
+        geom_curve_frame(prim, u, &C, &T, &w, &dw, &B);
         *P = v3_madd(C, B, (v - 0.5f) * w);
         *dPdu = v3_madd(T, B, (v - 0.5f) * dw);
         *dPdv = v3_scale(B, w);
@@ -305,6 +317,27 @@ void geom_prim_primvars(const Prim *prim, const float *pool, float u, float v,
         return;
     }
     const float *p = pool + prim->pv_first;
+    if (prim->type == PRIM_CURVE) { /* per segment end, linear between, alike across */
+        float t;
+        int k = geom_curve_segment(prim, u, &t), n = prim->curve.n_seg > 0 ? prim->curve.n_seg : 1;
+        for (int b = 0; b < 3; b++) {
+            if (!(prim->pv & bits[b]))
+                continue;
+            const float *x0 = p + (size_t)k * (size_t)sizes[b], *x1 = x0 + sizes[b];
+            float val[3], du[3];
+            for (int c = 0; c < sizes[b]; c++)
+                val[c] = x0[c] + (x1[c] - x0[c]) * t, du[c] = (x1[c] - x0[c]) * (float)n;
+            if (bits[b] == GEOM_PV_ST) {
+                out->st[0] = val[0], out->st[1] = val[1];
+                out->dst[0] = du[0], out->dst[1] = 0.0f, out->dst[2] = du[1], out->dst[3] = 0.0f;
+            } else if (bits[b] == GEOM_PV_CS)
+                out->Cs = v3(val[0], val[1], val[2]);
+            else
+                out->N = v3_normalize(v3(val[0], val[1], val[2]));
+            p += (size_t)(n + 1) * (size_t)sizes[b];
+        }
+        return;
+    }
     for (int b = 0; b < 3; b++) {
         if (!(prim->pv & bits[b]))
             continue;

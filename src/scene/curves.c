@@ -2,12 +2,13 @@
  * scene/curves.c — rayes_scene_curves and rayes_scene_points (rayes.h):
  * RenderMan's Curves and Points as primitives of the scene.
  *
- * A curve becomes one PRIM_CURVE per segment: its four control points
- * turned into Bezier ones (B^-1 basis G, B the Bezier basis), its width
- * and primitive variables at the segment's two ends (geom interpolates
- * them linearly along it, as RenderMan does varying ones; vertex ones are
- * evaluated with the curve's basis at the ends). A point becomes one
- * PRIM_POINT. Widths are object-space diameters, scaled to world space by
+ * A curve becomes one PRIM_CURVE per run of up to GEOM_CURVE_RUN
+ * segments: each segment's four control points turned into Bezier ones
+ * (B^-1 basis G, B the Bezier basis), its width and primitive variables
+ * at the segments' ends (geom interpolates them linearly along each, as
+ * RenderMan does varying ones; vertex ones are evaluated with the curve's
+ * basis at the ends). Ribbons are one segment per primitive (their
+ * normals take the room). A point becomes one PRIM_POINT. Widths are object-space diameters, scaled to world space by
  * the cube root of the transform's determinant.
  */
 #include <math.h>
@@ -235,30 +236,40 @@ static void segment_bezier(const RayesScene *s, const RayesCurves *c, const SegS
     }
 }
 
-/* Appends Cs and st (when given) at the 4 corners of a prim whose ends
- * (u = 0, 1) have values end[var][e], across v alike. */
-static RayesError push_ends(RayesScene *s, Prim *p, const Vars *vars, float end[N_VARS][2][3])
+/* Appends Cs and st (when given) of a prim with n ends whose values are
+ * end[e][var] (pool order: GEOM_PV_* bits, st before Cs; per end). */
+static RayesError push_ends(RayesScene *s, Prim *p, const Vars *vars, float (*end)[N_VARS][3],
+                            int n)
 {
     static const unsigned bits[N_VARS] = {0, 0, GEOM_PV_CS, GEOM_PV_ST};
-    float values[4 * 5];
-    size_t n = 0;
-    unsigned mask = 0;
-    /* Pool order is GEOM_PV_* bit order: st before Cs. */
     const int order[2] = {VAR_ST, VAR_CS};
+    float values[(GEOM_CURVE_RUN + 4) * 5];
+    size_t k = 0;
+    unsigned mask = 0;
     for (int o = 0; o < 2; o++) {
         int b = order[o];
         if (!vars->by[b])
             continue;
         mask |= bits[b];
-        for (int corner = 0; corner < 4; corner++)
+        for (int e = 0; e < n; e++)
             for (int c = 0; c < var_sizes[b]; c++)
-                values[n++] = end[b][corner & 1][c];
+                values[k++] = end[e][b][c];
     }
     if (!mask) {
         p->pv = 0;
         return RAYES_OK;
     }
-    return scene_push_values(s, p, mask, values, n);
+    return scene_push_values(s, p, mask, values, k);
+}
+
+/* The values of every variable at end e (0 or 1) of a segment. */
+static void seg_ends(const Vars *vars, const SegSource *src, int e, float out[N_VARS][3])
+{
+    memset(out, 0, N_VARS * sizeof out[0]);
+    out[VAR_WIDTH][0] = 1.0f; /* RenderMan's default width */
+    for (int b = 0; b < N_VARS; b++)
+        if (vars->by[b])
+            seg_value(vars->by[b], b, src, e, out[b]);
 }
 
 RayesError rayes_scene_curves(RayesScene *s, const RayesCurves *c, const RayesPrimvar *pv,
@@ -277,32 +288,46 @@ RayesError rayes_scene_curves(RayesScene *s, const RayesCurves *c, const RayesPr
     mat4_invert(s->world_from_object, &inv);
     Mat4 normal_from_object = mat4_transpose(inv);
     float scale = width_scale(&s->world_from_object);
+    uint8_t shape = vars.by[VAR_N]                   ? GEOM_SHAPE_SURFACE
+                    : c->shape == RAYES_CURVE_FLAT ? GEOM_SHAPE_FLAT_CURVE
+                                                   : GEOM_SHAPE_ROUND_CURVE;
+    int run = shape == GEOM_SHAPE_SURFACE ? 1 : GEOM_CURVE_RUN;
     size_t first = 0, vary = 0;
     for (size_t k = 0; k < c->n_curves; k++) {
         int n = c->n_verts[k];
         size_t segs = curve_segments(c, n), n_vary = c->periodic ? segs : segs + 1;
-        for (size_t seg = 0; seg < segs; seg++) {
-            SegSource src;
-            segment_source(c, first, n, seg, &src);
-            src.uniform = k;
-            src.varying[0] = vary + seg;
-            src.varying[1] = vary + (seg + 1) % n_vary;
+        /* Runs of up to `run` segments, each one primitive; a run ends
+         * early where the curve is not continuous (a basis and step that
+         * leave gaps). */
+        for (size_t seg = 0; seg < segs;) {
             Prim p = {.type = PRIM_CURVE};
-            segment_bezier(s, c, &src, p.curve.cp);
-            float end[N_VARS][2][3] = {{{1, 0, 0}, {1, 0, 0}}};
-            for (int b = 0; b < N_VARS; b++)
-                for (int side = 0; side < 2 && vars.by[b]; side++)
-                    seg_value(vars.by[b], b, &src, side, end[b][side]);
-            for (int side = 0; side < 2; side++) {
-                p.curve.width[side] = fmaxf(end[VAR_WIDTH][side][0], 0.0f) * scale;
-                if (vars.by[VAR_N])
-                    p.curve.n[side] = v3_normalize(
-                        mat4_vector(&normal_from_object, v3_load(end[VAR_N][side])));
+            p.curve.shape = shape;
+            float end[GEOM_CURVE_RUN + 1][N_VARS][3] = {{{0}}};
+            int m = 0;
+            while (m < run && seg < segs) {
+                SegSource src;
+                segment_source(c, first, n, seg, &src);
+                src.uniform = k;
+                src.varying[0] = vary + seg;
+                src.varying[1] = vary + (seg + 1) % n_vary;
+                Vec3 cp[4];
+                segment_bezier(s, c, &src, cp);
+                if (m > 0 && v3_length(v3_sub(cp[0], p.curve.cp[3 * m])) >
+                                 1e-5f * (1.0f + v3_length(cp[0])))
+                    break;
+                memcpy(&p.curve.cp[3 * m], cp, sizeof cp);
+                if (m == 0)
+                    seg_ends(&vars, &src, 0, end[0]);
+                seg_ends(&vars, &src, 1, end[m + 1]);
+                m++, seg++;
             }
-            p.curve.shape = vars.by[VAR_N] ? GEOM_SHAPE_SURFACE
-                            : c->shape == RAYES_CURVE_FLAT ? GEOM_SHAPE_FLAT_CURVE
-                                                           : GEOM_SHAPE_ROUND_CURVE;
-            if ((e = push_ends(s, &p, &vars, end)) != RAYES_OK ||
+            p.curve.n_seg = (uint8_t)m;
+            for (int j = 0; j <= m; j++)
+                p.curve.width[j] = fmaxf(end[j][VAR_WIDTH][0], 0.0f) * scale;
+            for (int side = 0; side < 2 && vars.by[VAR_N]; side++)
+                p.curve.n[side] = v3_normalize(
+                    mat4_vector(&normal_from_object, v3_load(end[side ? m : 0][VAR_N])));
+            if ((e = push_ends(s, &p, &vars, end, m + 1)) != RAYES_OK ||
                 (e = scene_add_prim(s, &p)) != RAYES_OK)
                 return e;
         }
@@ -330,24 +355,25 @@ RayesError rayes_scene_points(RayesScene *s, RayesPointShape shape, size_t n_poi
     Mat4 normal_from_object = mat4_transpose(inv);
     float scale = width_scale(&s->world_from_object);
     for (size_t i = 0; i < n_points; i++) {
-        /* A point is a curve segment of one end, for the values. */
+        /* A point's values: a segment's first end, at all 4 corners. */
         SegSource src = {.uniform = 0, .varying = {i, i}, .vertex = {i, i, i, i},
                          .end_weight = {{1, 0, 0, 0}, {1, 0, 0, 0}}};
-        float end[N_VARS][2][3] = {{{1, 0, 0}, {1, 0, 0}}};
-        for (int b = 0; b < N_VARS; b++)
-            for (int side = 0; side < 2 && vars.by[b]; side++)
-                seg_value(vars.by[b], b, &src, side, end[b][side]);
+        float end[4][N_VARS][3];
+        seg_ends(&vars, &src, 0, end[0]);
+        for (int k = 1; k < 4; k++)
+            memcpy(end[k], end[0], sizeof end[0]);
         Prim p = {.type = PRIM_POINT};
         p.point.centre = mat4_point(&s->world_from_object, v3_load(P + 3 * i));
-        p.point.radius = 0.5f * fmaxf(end[VAR_WIDTH][0][0], 0.0f) * scale;
+        p.point.radius = 0.5f * fmaxf(end[0][VAR_WIDTH][0], 0.0f) * scale;
         if (vars.by[VAR_N])
-            p.point.n = v3_normalize(mat4_vector(&normal_from_object, v3_load(end[VAR_N][0])));
+            p.point.n = v3_normalize(mat4_vector(&normal_from_object, v3_load(end[0][VAR_N])));
         p.point.shape = vars.by[VAR_N]                ? GEOM_SHAPE_ORIENTED_DISK
                         : shape == RAYES_POINT_DISK ? GEOM_SHAPE_DISK
                                                     : GEOM_SHAPE_SPHERE;
         if (!(p.point.radius > 0.0f))
             continue; /* nothing to see */
-        if ((e = push_ends(s, &p, &vars, end)) != RAYES_OK || (e = scene_add_prim(s, &p)) != RAYES_OK)
+        if ((e = push_ends(s, &p, &vars, end, 4)) != RAYES_OK ||
+            (e = scene_add_prim(s, &p)) != RAYES_OK)
             return e;
     }
     return RAYES_OK;

@@ -965,10 +965,11 @@ Bounds3 scene_bounds(const RayesScene *s)
             continue;
         }
         if (p->type == PRIM_CURVE || p->type == PRIM_POINT) { /* control points, widened */
-            int n = p->type == PRIM_CURVE ? 4 : 1;
+            int n = p->type == PRIM_CURVE ? 3 * p->curve.n_seg + 1 : 1;
             const Vec3 *c = p->type == PRIM_CURVE ? p->curve.cp : &p->point.centre;
-            float r = p->type == PRIM_CURVE ? 0.5f * fmaxf(p->curve.width[0], p->curve.width[1])
-                                            : p->point.radius;
+            float r = p->point.radius;
+            for (int k = 0; p->type == PRIM_CURVE && k <= p->curve.n_seg; k++)
+                r = k ? fmaxf(r, 0.5f * p->curve.width[k]) : 0.5f * p->curve.width[0];
             for (int k = 0; k < n; k++)
                 b = bounds_add(bounds_add(b, v3_sub(c[k], v3(r, r, r))), v3_add(c[k], v3(r, r, r)));
             continue;
