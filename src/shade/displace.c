@@ -19,6 +19,7 @@
 
 #include "shade/builtin.h"
 #include "shade/noise.h"
+#include "shade/pattern.h"
 #include "shade/shade.h"
 #include "shade/texture.h"
 
@@ -79,6 +80,27 @@ static void fractal_displacement(const RayesShaderServices *sv, const RayesShade
     }
 }
 
+typedef struct DisplaceParams {
+    float amount;
+} DisplaceParams;
+
+/* P + amount N, amount a constant or a pattern (pbrt's "displacement"). */
+static void displace_displacement(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
+                                  const void *params, RayesShadeOutputs *out)
+{
+    const DisplaceParams *p = params;
+    float h[SHADE_CHUNK];
+    for (size_t start = 0; start < ctx->n_points; start += SHADE_CHUNK) {
+        size_t n = ctx->n_points - start < SHADE_CHUNK ? ctx->n_points - start : SHADE_CHUNK;
+        RayesShadeCtx sub;
+        shade_ctx_slice(ctx, start, n, &sub);
+        shade_param_float(sv, &sub, "amount", p->amount, h);
+        RayesShadeOutputs o = *out;
+        o.P = out->P + start;
+        displace_along_normal(&sub, h, &o);
+    }
+}
+
 /* A displacement-only class is never shaded; its lighting is black. */
 static void unshaded(const RayesShaderServices *sv, const RayesShadeCtx *ctx, const void *params,
                      RayesShadeOutputs *out)
@@ -129,6 +151,22 @@ const RayesShaderClass shade_class_fractal = {
     .diffuselighting = unshaded,
 };
 
+static const RayesShaderParamDesc displace_params[] = {
+    {"amount", RAYES_PARAM_FLOAT, offsetof(DisplaceParams, amount), {0, 0, 0}},
+};
+
+const RayesShaderClass shade_class_displace = {
+    .abi_version = RAYES_SHADER_ABI_VERSION,
+    .struct_size = sizeof(RayesShaderClass),
+    .name = "displace",
+    .params_size = sizeof(DisplaceParams),
+    .params = displace_params,
+    .n_params = sizeof displace_params / sizeof displace_params[0],
+    .displacement = displace_displacement,
+    .lighting = unshaded,
+    .diffuselighting = unshaded,
+};
+
 /* ------------------------------------------ services at dicing time */
 
 float shade_service_noise(const RayesShaderServices *sv, const float p[3])
@@ -159,7 +197,7 @@ float shade_service_checker(const RayesShaderServices *sv, float s, float t, flo
 
 static int dice_supports(const RayesShaderServices *sv, const char *service)
 {
-    if (strcmp(service, "texture") == 0)
+    if (strcmp(service, "texture") == 0 || strcmp(service, "pattern") == 0)
         return sv->texture != NULL;
     return strcmp(service, "noise") == 0 || strcmp(service, "fbm") == 0 ||
            strcmp(service, "turbulence") == 0 || strcmp(service, "checker") == 0;
@@ -172,6 +210,14 @@ static int dice_texture(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
 {
     TextureSystem *ts = ((const DicingServices *)(const void *)sv)->textures;
     return shade_texture_service(ts, ctx, name, s, t, ds, dt, rgb, alpha);
+}
+
+/* Patterns at dicing, their images filtered over the grid's spacing. */
+static int dice_pattern(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
+                        const RayesPattern *pattern, float (*out)[3])
+{
+    TextureSystem *ts = ((const DicingServices *)(const void *)sv)->textures;
+    return pattern_eval(pattern, ts, ctx, NULL, NULL, out);
 }
 
 int shade_texture_service(TextureSystem *ts, const RayesShadeCtx *ctx, const char *name,
@@ -192,6 +238,7 @@ void shade_dicing_services_init(DicingServices *ds, TextureSystem *textures)
 {
     ds->sv = shade_dicing_services;
     ds->sv.texture = dice_texture;
+    ds->sv.pattern = dice_pattern;
     ds->textures = textures;
 }
 
