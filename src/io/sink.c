@@ -114,6 +114,12 @@ static const char *scene_get_error(void *t)
     return rayes_scene_get_error(t);
 }
 
+static RayesError scene_pattern(void *t, const char *name, const char *type,
+                                const RayesParam *params, size_t n_params)
+{
+    return rayes_scene_pattern(t, name, type, params, n_params);
+}
+
 static int scene_has_shader(void *t, const char *name)
 {
     return rayes_scene_has_shader(t, name);
@@ -143,6 +149,7 @@ IoSink io_sink_scene(RayesScene *scene)
         .get_error = scene_get_error,
         .has_shader = scene_has_shader,
         .subdivision_mesh = scene_subdivision_mesh,
+        .pattern = scene_pattern,
     };
 }
 
