@@ -157,7 +157,11 @@ static RayesError params(RibWriter *w, FILE *f, const RayesParam *p, size_t n, i
             break;
         }
         case RAYES_PARAM_STRING:
-            fprintf(f, " \"string %s\" [", p[i].name);
+        case RAYES_PARAM_PATTERN: /* rayes' RIB: "reference pattern NAME" [pattern] */
+            fprintf(f,
+                    p[i].type == RAYES_PARAM_STRING ? " \"string %s\" ["
+                                                    : " \"reference pattern %s\" [",
+                    p[i].name);
             string(f, p[i].string ? p[i].string : "");
             fputc(']', f);
             break;
@@ -352,6 +356,32 @@ static RayesError w_set_displacement(void *t, const char *name, const RayesParam
         fprintf(f, "Displacement ");
         string(f, name);
         fprintf(f, "%s\n", text ? text : "");
+    }
+    free(text);
+    return e;
+}
+
+/* Pattern "type" "name" params (RenderMan's Pattern request, rayes'
+ * classes), in the current transform. */
+static RayesError w_pattern(void *t, const char *name, const char *type, const RayesParam *p,
+                            size_t n)
+{
+    RibWriter *w = t;
+    if (!name || !name[0] || !type || !type[0])
+        return fail(w, RAYES_ERROR_INVALID_ARGUMENT, "pattern: no name or type");
+    char *text = NULL;
+    size_t size = 0;
+    FILE *m = open_memstream(&text, &size);
+    if (!m)
+        return fail(w, RAYES_ERROR_OUT_OF_MEMORY, "out of memory");
+    RayesError e = params(w, m, p, n, 0);
+    fclose(m);
+    if (e == RAYES_OK) {
+        fprintf(w->world.f, "Pattern ");
+        string(w->world.f, type);
+        fputc(' ', w->world.f);
+        string(w->world.f, name);
+        fprintf(w->world.f, "%s\n", text ? text : "");
     }
     free(text);
     return e;
@@ -868,6 +898,7 @@ IoSink io_rib_writer_sink(RibWriter *w)
         .get_error = w_get_error,
         .has_shader = w_has_shader,
         .subdivision_mesh = w_subdivision_mesh,
+        .pattern = w_pattern,
     };
 }
 
