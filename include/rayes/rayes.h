@@ -367,8 +367,9 @@ RAYES_API RayesError rayes_scene_area_light(RayesScene *scene, const float P[4][
  *                      along to - from
  *   "ambientlight"     adds intensity * lightcolor to the ambient service
  *   "environmentlight" radiance intensity * lightcolor, times the
- *                      latitude-longitude map "mapname" (EXR or PNG) if
- *                      given, seen by camera and specular rays that miss
+ *                      latitude-longitude map "mapname" (any format
+ *                      OpenImageIO reads; as given, else on the texture
+ *                      search path) if given, seen by camera and specular rays that miss
  *                      everything (docs/DESIGN.md: orientation)
  *   "arealight"        radiance intensity * lightcolor from a "shape"
  *                      (default "quad"): "quad" the square of side

@@ -1,7 +1,8 @@
 /*
  * scene/patterns.c — the scene's patterns (rayes_scene_pattern) and the
  * binding of shader parameters to them (RAYES_PARAM_PATTERN values of
- * set_shader, set_displacement and edit_shader; DESIGN.md "Patterns").
+ * set_shader, set_displacement and edit_shader; DESIGN.md "Patterns"),
+ * and finding the texture files the scene reads itself (environment maps).
  *
  * Patterns are named; a name defined again is replaced for later
  * references, while instances and patterns that took the earlier one keep
@@ -14,6 +15,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 #include "scene/scene.h"
 #include "shade/pattern.h"
@@ -100,6 +102,23 @@ RayesError scene_bind_patterns(RayesScene *s, ShaderInstance *inst, const RayesP
         }
     }
     return RAYES_OK;
+}
+
+int scene_find_texture(const RayesScene *s, const char *name, char *out, size_t size)
+{
+    const char *env = getenv("RAYES_TEXTURE_PATH");
+    const char *paths[2] = {scene_search_path(s, SCENE_SEARCH_PATH_TEXTURE), env ? env : ""};
+    if (access(name, R_OK) == 0 || name[0] == '/')
+        return snprintf(out, size, "%s", name) < (int)size ? 0 : -1;
+    for (int k = 0; k < 2; k++)
+        for (const char *d = paths[k]; *d;) {
+            size_t len = strcspn(d, ":");
+            if (len > 0 && snprintf(out, size, "%.*s/%s", (int)len, d, name) < (int)size &&
+                access(out, R_OK) == 0)
+                return 0;
+            d += len + (d[len] == ':');
+        }
+    return snprintf(out, size, "%s", name) < (int)size ? 0 : -1;
 }
 
 void scene_patterns_free(RayesScene *s)

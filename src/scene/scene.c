@@ -1225,8 +1225,10 @@ RayesError rayes_scene_light(RayesScene *s, const char *type, const RayesParam *
                         "environmentlight: unknown mapping \"%s\"; expected latlong or octahedral",
                         lp.mapping);
         if (lp.mapname[0]) {
-            char err[400];
-            if (light_env_load(&l, lp.mapname, octahedral, err, sizeof err) != 0)
+            char err[400], path[1024];
+            if (scene_find_texture(s, lp.mapname, path, sizeof path) != 0)
+                return fail(s, RAYES_ERROR_INVALID_ARGUMENT, "environmentlight: map name too long");
+            if (light_env_load(&l, path, octahedral, err, sizeof err) != 0)
                 return fail(s, RAYES_ERROR_IO, "%s", err);
         }
         e = push_light(s, &l, NULL, 0);

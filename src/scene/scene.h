@@ -155,6 +155,11 @@ const char *scene_search_path(const RayesScene *scene, SceneSearchPath kind);
  * an error recorded in the scene (no such pattern or parameter). */
 RayesError scene_bind_patterns(RayesScene *scene, ShaderInstance *inst, const RayesParam *params,
                                size_t n_params);
+/* The file a texture name given to the scene stands for (an environment
+ * map's): as given if readable or absolute, else the first readable one in
+ * the scene's texture search path, then $RAYES_TEXTURE_PATH, else as given
+ * (whose reading then fails with its name). Returns 0, or -1 if too long. */
+int scene_find_texture(const RayesScene *scene, const char *name, char *out, size_t size);
 /* Frees the scene's patterns (when the scene is freed). */
 void scene_patterns_free(RayesScene *scene);
 
