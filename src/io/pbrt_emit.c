@@ -50,28 +50,32 @@ static RayesError send_displacement(Parser *P, const Material *mat)
     return P->sink->set_displacement(P->sink->target, "displace", &amount, 1);
 }
 
-int pbrt_emit_pattern(Parser *P, const Token *t, const char *name, const char *type,
-                      const RayesParam *params, size_t n)
-{
-    float f[16];
-    if (!pbrt_mat_finite(P->gs.ctm))
-        return FAIL_TOK(P, t, "the current transform is not finite");
-    pbrt_mat_to_float(P->gs.ctm, f);
-    RayesError e = P->sink->set_transform(P->sink->target, f);
-    if (e == RAYES_OK)
-        e = P->sink->pattern(P->sink->target, name, type, params, n);
-    return e != RAYES_OK ? pbrt_sink_failed(P, t, e) : 0;
-}
-
-static int send_state(Parser *P, const Token *t, const double m[16], const Material *mat)
+/* Sends m as the sink's transform; 0, or -1 when it is not finite or the
+ * sink fails. */
+static int send_transform(Parser *P, const Token *t, const double m[16])
 {
     float f[16];
     if (!pbrt_mat_finite(m))
         return FAIL_TOK(P, t, "the current transform is not finite");
     pbrt_mat_to_float(m, f);
     RayesError e = P->sink->set_transform(P->sink->target, f);
-    if (e != RAYES_OK)
-        return pbrt_sink_failed(P, t, e);
+    return e != RAYES_OK ? pbrt_sink_failed(P, t, e) : 0;
+}
+
+int pbrt_emit_pattern(Parser *P, const Token *t, const char *name, const char *type,
+                      const RayesParam *params, size_t n)
+{
+    if (send_transform(P, t, P->gs.ctm) != 0)
+        return -1;
+    RayesError e = P->sink->pattern(P->sink->target, name, type, params, n);
+    return e != RAYES_OK ? pbrt_sink_failed(P, t, e) : 0;
+}
+
+static int send_state(Parser *P, const Token *t, const double m[16], const Material *mat)
+{
+    RayesError e;
+    if (send_transform(P, t, m) != 0)
+        return -1;
     if (!P->have_sent || memcmp(&P->sent, mat, sizeof *mat) != 0) {
         RayesParam params[MAT_MAX_PARAMS + 1];
         material_params(P, mat, params);
@@ -261,13 +265,9 @@ int pbrt_emit_patch(Parser *P, const Token *t, const Op *patch)
 int pbrt_emit_light(Parser *P, const Token *t, const double m[16], const char *type,
                     const RayesParam *params, size_t n)
 {
-    float f[16];
-    if (!pbrt_mat_finite(m))
-        return FAIL_TOK(P, t, "the current transform is not finite");
-    pbrt_mat_to_float(m, f);
-    RayesError e = P->sink->set_transform(P->sink->target, f);
-    if (e == RAYES_OK)
-        e = P->sink->light(P->sink->target, type, params, n);
+    if (send_transform(P, t, m) != 0)
+        return -1;
+    RayesError e = P->sink->light(P->sink->target, type, params, n);
     return e != RAYES_OK ? pbrt_sink_failed(P, t, e) : 0;
 }
 

@@ -51,8 +51,8 @@ static long define_pattern(Parser *P, const Token *t, const char *name, int is_f
     tex.is_float = is_float;
     if (!P->sink->pattern) {
         pbrt_warn_at(P, t->line, t->col, "no patterns",
-                     "this output takes no textures; "
-                     "textured parameters become constants (the texture's mean)");
+                     "this output takes no textures; textured parameters become constants (the "
+                     "texture's mean)");
         return add_texture(P, t, &tex);
     }
     snprintf(tex.pattern, sizeof tex.pattern, "%zu:%.120s", P->n_textures,
@@ -98,9 +98,7 @@ static void tex_mapping(Parser *P, const Token *t, ParamList *pl, RayesParam *ou
     const char *mapping = pbrt_get_string(pl, "mapping", "uv");
     if (strcmp(mapping, "uv") != 0)
         pbrt_warn_at(P, t->line, t->col, "texture mapping",
-                     "Texture: mapping \"%.40s\" is not "
-                     "supported; using \"uv\"",
-                     mapping);
+                     "Texture: mapping \"%.40s\" is not supported; using \"uv\"", mapping);
 }
 
 static void mean2(const float a[3], const float b[3], float out[3])
@@ -131,10 +129,10 @@ static int imagemap_params(Parser *P, const Token *t, ParamList *pl, int is_floa
     char tail;
     if (enc && strcmp(enc, "sRGB") != 0 && strcmp(enc, "linear") != 0 &&
         !(sscanf(enc, "gamma %f%c", &g, &tail) == 1 && g > 0.0f && g < 100.0f))
-        return FAIL_TOK(P, t,
-                        "imagemap: expected encoding \"sRGB\", \"linear\" or "
-                        "\"gamma G\", found \"%.40s\"",
-                        enc);
+        return FAIL_TOK(
+            P, t,
+            "imagemap: expected encoding \"sRGB\", \"linear\" or \"gamma G\", found \"%.40s\"",
+            enc);
     if (enc)
         q[(*n)++] = (RayesParam){.name = "encoding", .type = RAYES_PARAM_STRING, .string = enc};
     if (is_float)
@@ -142,9 +140,7 @@ static int imagemap_params(Parser *P, const Token *t, ParamList *pl, int is_floa
     const char *wrap = pbrt_get_string(pl, "wrap", "repeat");
     if (strcmp(wrap, "repeat") != 0)
         pbrt_warn_at(P, t->line, t->col, "imagemap wrap",
-                     "imagemap: wrap \"%.40s\" is not "
-                     "supported; the image repeats",
-                     wrap);
+                     "imagemap: wrap \"%.40s\" is not supported; the image repeats", wrap);
     (void)pbrt_find(pl, "filter"); /* rayes always filters (OpenImageIO's anisotropic MIP) */
     (void)pbrt_find(pl, "maxanisotropy");
     float sc = (float)pbrt_get_float(pl, "scale", 1.0);
@@ -198,9 +194,7 @@ static int texture_params(Parser *P, const Token *t, const char *cls, ParamList 
         Param *dim = dots ? NULL : pbrt_find(pl, "dimension");
         if (dim && dim->n_num > 0 && dim->num[0] != 2 && dim->num[0] != 3)
             return pbrt_fail_at(P, dim->line, dim->col,
-                                "checkerboard: expected dimension 2 or "
-                                "3, found %g",
-                                dim->num[0]);
+                                "checkerboard: expected dimension 2 or 3, found %g", dim->num[0]);
         if (!dots)
             tex_number(pl, "dimension", q, n);
         tex_mapping(P, t, pl, q, n);
@@ -245,10 +239,9 @@ int pbrt_d_texture(Parser *P, const Token *t)
                                NULL);
     if (!r && strcmp(kind, "float") != 0 && strcmp(kind, "spectrum") != 0 &&
         strcmp(kind, "color") != 0)
-        r = FAIL_TOK(P, t,
-                     "Texture \"%.60s\": expected the type \"spectrum\" or \"float\", "
-                     "found \"%.40s\"",
-                     name, kind);
+        r = FAIL_TOK(
+            P, t, "Texture \"%.60s\": expected the type \"spectrum\" or \"float\", found \"%.40s\"",
+            name, kind);
     if (!r)
         r = pbrt_name_and_params(P, cls, sizeof cls, "a texture class", &pl, NULL);
     if (r) {
@@ -418,9 +411,9 @@ static int textured_roughness(Parser *P, const Token *t, ParamList *pl, Material
         return 0;
     }
     if (!same && !alpha_given)
-        pbrt_warn_at(P, t->line, t->col, "anisotropic roughness texture",
-                     "textured uroughness "
-                     "and vroughness become one isotropic roughness, their mean");
+        pbrt_warn_at(
+            P, t->line, t->col, "anisotropic roughness texture",
+            "textured uroughness and vroughness become one isotropic roughness, their mean");
     RayesParam q[3] = {rough_param(P, alpha_given ? "tex" : "tex1", tex[0], c[0][0]),
                        rough_param(P, alpha_given ? "scale" : "tex2", tex[1], c[1][0]),
                        {.name = "amount", .type = RAYES_PARAM_FLOAT, .value = {0.5f, 0, 0}}};
@@ -522,8 +515,9 @@ static int mix_material(Parser *P, const Token *t, ParamList *pl, Material *m)
         mat_get(a, "reflectance") && mat_get(b, "reflectance")) {
         q[0] = reflectance_input(P, a, "tex1");
         q[1] = reflectance_input(P, b, "tex2");
-        pbrt_warn_at(P, t->line, t->col, "mix diffuse", "mix: two diffuse materials become one "
-                     "diffuse material of the blended reflectance");
+        pbrt_warn_at(
+            P, t->line, t->col, "mix diffuse",
+            "mix: two diffuse materials become one diffuse material of the blended reflectance");
         float c[3];
         for (int k = 0; k < 3; k++) /* the constant, or the pattern's stand-in */
             c[k] = (1 - amount[0]) * mat_get(a, "reflectance")[k] +
@@ -542,8 +536,7 @@ static int mix_material(Parser *P, const Token *t, ParamList *pl, Material *m)
     }
     *m = amount[0] > 0.5f ? *b : *a;
     pbrt_warn_at(P, t->line, t->col, "mix",
-                 "mix: rayes cannot blend these materials; using the "
-                 "heavier one (\"%.60s\")",
+                 "mix: rayes cannot blend these materials; using the heavier one (\"%.60s\")",
                  amount[0] > 0.5f ? names->str[1] : names->str[0]);
     return 0;
 }
@@ -612,14 +605,14 @@ static int material_of_type(Parser *P, const Token *t, const char *type, ParamLi
         /* pbrt's "interface" (and "" or "none") marks a shape that only
          * bounds a participating medium: it is not a surface at all. */
         pbrt_warn_at(P, t->line, t->col, "interface",
-                     "material \"interface\": its shapes only bound media, which rayes does "
-                     "not render; they are left out");
+                     "material \"interface\": its shapes only bound media, which rayes does not "
+                     "render; they are left out");
         pbrt_mat_init(m, PBRT_INVISIBLE);
         return 0;
     }
     if (strcmp(type, "diffusetransmission") == 0) {
-        pbrt_warn_at(P, t->line, t->col, "diffusetransmission", "diffusetransmission: mapped to "
-                     "diffuse (no transmission)");
+        pbrt_warn_at(P, t->line, t->col, "diffusetransmission",
+                     "diffusetransmission: mapped to diffuse (no transmission)");
         return diffuse_material(P, pl, m, "reflectance");
     }
     char key[96];
@@ -698,8 +691,10 @@ int pbrt_d_namedmaterial(Parser *P, const Token *t)
         return -1;
     const Material *m = named_material(P, name);
     if (!m)
-        return FAIL_TOK(P, &w, "NamedMaterial: expected a material defined with "
-                        "MakeNamedMaterial, found \"%.60s\"", name);
+        return FAIL_TOK(
+            P, &w,
+            "NamedMaterial: expected a material defined with MakeNamedMaterial, found \"%.60s\"",
+            name);
     P->gs.material = *m;
     return 0;
 }

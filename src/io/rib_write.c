@@ -173,6 +173,20 @@ static RayesError params(RibWriter *w, FILE *f, const RayesParam *p, size_t n, i
     return RAYES_OK;
 }
 
+/* The typed inline parameters as text (params), into a new *text (free()
+ * it; NULL when there are none). */
+static RayesError params_text(RibWriter *w, const RayesParam *p, size_t n, int light, char **text)
+{
+    size_t size = 0;
+    *text = NULL;
+    FILE *m = open_memstream(text, &size);
+    if (!m)
+        return fail(w, RAYES_ERROR_OUT_OF_MEMORY, "out of memory");
+    RayesError e = params(w, m, p, n, light);
+    fclose(m);
+    return e;
+}
+
 /* ------------------------------------------------------------ camera */
 
 static RayesError w_set_camera(void *t, const float eye[3], const float at[3], const float up[3],
@@ -313,12 +327,7 @@ static RayesError w_set_shader(void *t, const char *name, const RayesParam *p, s
         rest[n_rest++] = p[i];
     }
     char *text = NULL;
-    size_t size = 0;
-    FILE *m = open_memstream(&text, &size);
-    if (!m)
-        return fail(w, RAYES_ERROR_OUT_OF_MEMORY, "out of memory");
-    RayesError e = params(w, m, rest, n_rest, 0);
-    fclose(m);
+    RayesError e = params_text(w, rest, n_rest, 0, &text);
     if (e == RAYES_OK) {
         fprintf(f, "Color ");
         floats(f, cs, 3);
@@ -346,12 +355,7 @@ static RayesError w_set_displacement(void *t, const char *name, const RayesParam
         return RAYES_OK;
     }
     char *text = NULL;
-    size_t size = 0;
-    FILE *m = open_memstream(&text, &size);
-    if (!m)
-        return fail(w, RAYES_ERROR_OUT_OF_MEMORY, "out of memory");
-    RayesError e = params(w, m, p, n, 0);
-    fclose(m);
+    RayesError e = params_text(w, p, n, 0, &text);
     if (e == RAYES_OK) {
         fprintf(f, "Displacement ");
         string(f, name);
@@ -370,12 +374,7 @@ static RayesError w_pattern(void *t, const char *name, const char *type, const R
     if (!name || !name[0] || !type || !type[0])
         return fail(w, RAYES_ERROR_INVALID_ARGUMENT, "pattern: no name or type");
     char *text = NULL;
-    size_t size = 0;
-    FILE *m = open_memstream(&text, &size);
-    if (!m)
-        return fail(w, RAYES_ERROR_OUT_OF_MEMORY, "out of memory");
-    RayesError e = params(w, m, p, n, 0);
-    fclose(m);
+    RayesError e = params_text(w, p, n, 0, &text);
     if (e == RAYES_OK) {
         fprintf(w->world.f, "Pattern ");
         string(w->world.f, type);
@@ -798,12 +797,7 @@ static RayesError w_light(void *t, const char *type, const RayesParam *p, size_t
     if (!type || !type[0])
         return fail(w, RAYES_ERROR_INVALID_ARGUMENT, "light: no type");
     char *text = NULL;
-    size_t size = 0;
-    FILE *m = open_memstream(&text, &size);
-    if (!m)
-        return fail(w, RAYES_ERROR_OUT_OF_MEMORY, "out of memory");
-    RayesError e = params(w, m, p, n, 1);
-    fclose(m);
+    RayesError e = params_text(w, p, n, 1, &text);
     if (e == RAYES_OK) {
         fprintf(w->world.f, "LightSource ");
         string(w->world.f, type);

@@ -40,30 +40,50 @@ static void displace_along_normal(const RayesShadeCtx *ctx, const float *h, Raye
             out->P[i][c] = ctx->P[i][c] + h[i] * ctx->N[i][c];
 }
 
-static void bumpy_displacement(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
-                               const void *params, RayesShadeOutputs *out)
+/* The heights of a chunk of at most SHADE_CHUNK points. */
+typedef void (*HeightFn)(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
+                         const void *params, float *h);
+
+/* Displaces ctx's points along their normals by height, SHADE_CHUNK
+ * points at a time. */
+static void displace_by_chunks(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
+                               const void *params, RayesShadeOutputs *out, HeightFn height)
 {
-    const BumpyParams *p = params;
-    float h[SHADE_CHUNK], tex[SHADE_CHUNK][3];
+    float h[SHADE_CHUNK];
     for (size_t start = 0; start < ctx->n_points; start += SHADE_CHUNK) {
         size_t n = ctx->n_points - start < SHADE_CHUNK ? ctx->n_points - start : SHADE_CHUNK;
         RayesShadeCtx sub;
         shade_ctx_slice(ctx, start, n, &sub);
-        if (p->texturename[0] && sv->texture &&
-            sv->texture(sv, &sub, p->texturename, sub.s, sub.t, NULL, NULL, tex, NULL) == 0) {
-            for (size_t i = 0; i < n; i++)
-                h[i] = p->Km * tex[i][0];
-        } else {
-            for (size_t i = 0; i < n; i++) {
-                const float *P = sub.P[i];
-                float q[3] = {P[0] * p->frequency, P[1] * p->frequency, P[2] * p->frequency};
-                h[i] = p->Km * sv->noise(sv, q);
-            }
-        }
+        height(sv, &sub, params, h);
         RayesShadeOutputs o = *out;
         o.P = out->P + start;
         displace_along_normal(&sub, h, &o);
     }
+}
+
+/* bumpy: Km times the texture's first channel, else times noise. */
+static void bumpy_height(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
+                         const void *params, float *h)
+{
+    const BumpyParams *p = params;
+    float tex[SHADE_CHUNK][3];
+    if (p->texturename[0] && sv->texture &&
+        sv->texture(sv, ctx, p->texturename, ctx->s, ctx->t, NULL, NULL, tex, NULL) == 0) {
+        for (size_t i = 0; i < ctx->n_points; i++)
+            h[i] = p->Km * tex[i][0];
+        return;
+    }
+    for (size_t i = 0; i < ctx->n_points; i++) {
+        const float *P = ctx->P[i];
+        float q[3] = {P[0] * p->frequency, P[1] * p->frequency, P[2] * p->frequency};
+        h[i] = p->Km * sv->noise(sv, q);
+    }
+}
+
+static void bumpy_displacement(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
+                               const void *params, RayesShadeOutputs *out)
+{
+    displace_by_chunks(sv, ctx, params, out, bumpy_height);
 }
 
 static void fractal_displacement(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
@@ -84,21 +104,17 @@ typedef struct DisplaceParams {
     float amount;
 } DisplaceParams;
 
-/* P + amount N, amount a constant or a pattern (pbrt's "displacement"). */
+/* displace: amount, a constant or a pattern (pbrt's "displacement"). */
+static void displace_height(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
+                            const void *params, float *h)
+{
+    shade_param_float(sv, ctx, "amount", ((const DisplaceParams *)params)->amount, h);
+}
+
 static void displace_displacement(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
                                   const void *params, RayesShadeOutputs *out)
 {
-    const DisplaceParams *p = params;
-    float h[SHADE_CHUNK];
-    for (size_t start = 0; start < ctx->n_points; start += SHADE_CHUNK) {
-        size_t n = ctx->n_points - start < SHADE_CHUNK ? ctx->n_points - start : SHADE_CHUNK;
-        RayesShadeCtx sub;
-        shade_ctx_slice(ctx, start, n, &sub);
-        shade_param_float(sv, &sub, "amount", p->amount, h);
-        RayesShadeOutputs o = *out;
-        o.P = out->P + start;
-        displace_along_normal(&sub, h, &o);
-    }
+    displace_by_chunks(sv, ctx, params, out, displace_height);
 }
 
 /* A displacement-only class is never shaded; its lighting is black. */

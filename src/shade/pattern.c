@@ -20,6 +20,7 @@
 
 #include "shade/noise.h"
 #include "shade/shade.h"
+#include "util/vec.h"
 
 #define PATTERN_CHUNK 64
 #define MAX_INPUTS 4
@@ -140,41 +141,6 @@ static const Slot *find_slot(const ClassDesc *c, const char *name)
         if (strcmp(c->slots[k].name, name) == 0)
             return &c->slots[k];
     return NULL;
-}
-
-/* Row-major 4 x 4 inverse by Gauss-Jordan with partial pivoting; -1 if
- * singular. */
-static int invert4(const float m[16], float out[16])
-{
-    double a[4][8];
-    for (int r = 0; r < 4; r++)
-        for (int c = 0; c < 8; c++)
-            a[r][c] = c < 4 ? m[4 * r + c] : (c - 4 == r);
-    for (int c = 0; c < 4; c++) {
-        int piv = c;
-        for (int r = c + 1; r < 4; r++)
-            if (fabs(a[r][c]) > fabs(a[piv][c]))
-                piv = r;
-        if (!(fabs(a[piv][c]) > 1e-12))
-            return -1;
-        for (int k = 0; k < 8; k++) {
-            double t = a[c][k];
-            a[c][k] = a[piv][k], a[piv][k] = t;
-        }
-        double d = a[c][c];
-        for (int k = 0; k < 8; k++)
-            a[c][k] /= d;
-        for (int r = 0; r < 4; r++)
-            if (r != c) {
-                double f = a[r][c];
-                for (int k = 0; k < 8; k++)
-                    a[r][k] -= f * a[c][k];
-            }
-    }
-    for (int r = 0; r < 4; r++)
-        for (int c = 0; c < 4; c++)
-            out[4 * r + c] = (float)a[r][c + 4];
-    return 0;
 }
 
 /* The values of one parameter into p; -1 with err filled if it does not
@@ -317,11 +283,13 @@ Pattern *pattern_new(const char *type, const RayesParam *params, size_t n_params
     len = sqrtf(len);
     for (int r = 0; r < 3; r++)
         p->vec[r] = len > 0.0f ? d[r] / len : 0.0f;
-    if (invert4(m, p->texture_from_world) != 0) {
+    Mat4 inv;
+    if (!mat4_invert(mat4_from_array(m), &inv)) {
         snprintf(err, err_size, "pattern \"%s\": the transform is singular", c->name);
         free(p);
         return NULL;
     }
+    memcpy(p->texture_from_world, inv.m, sizeof p->texture_from_world);
     if (check_pattern(p, c, err, err_size) != 0) {
         free(p);
         return NULL;
