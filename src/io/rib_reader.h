@@ -89,6 +89,7 @@ typedef struct Param {
 
 typedef struct ShaderRec {
     char name[64];
+    char pattern[160];  /* a Pattern's name once the sink has it, else "" */
     RayesParam *params; /* names and strings owned */
     size_t n;
     struct ShaderRec *next;

@@ -183,6 +183,10 @@ static const char *const builtin_surfaces[] = {"matte", "plastic", "metal", "shi
                                                "diffuse", "conductor", "dielectric",
                                                "coateddiffuse", NULL};
 static const char *const builtin_displacements[] = {"bumpy", "fractal", "displace", NULL};
+/* rayes' pattern classes (rayes_scene_pattern): pbrt-v4's textures. */
+static const char *const builtin_patterns[] = {
+    "constant", "scale", "mix",      "directionmix", "checkerboard", "imagemap", "bilerp",
+    "dots",     "fbm",   "wrinkled", "windy",        "marble",       NULL};
 
 static int in_list(const char *const *list, const char *s)
 {
@@ -193,6 +197,15 @@ static int in_list(const char *const *list, const char *s)
 }
 
 /* A new shader record of name with the parameters the API can take. */
+/* Whether a Pattern of that name reached the sink. */
+static int pattern_sent(const Rib *r, const char *name)
+{
+    for (const ShaderRec *s = r->shaders; s; s = s->next)
+        if (s->pattern[0] && strcmp(s->pattern, name) == 0)
+            return 1;
+    return 0;
+}
+
 static ShaderRec *make_shader(Rib *r, const char *name, const Param *p, size_t n, int only_k)
 {
     ShaderRec *sh = calloc(1, sizeof *sh);
@@ -213,6 +226,15 @@ static ShaderRec *make_shader(Rib *r, const char *name, const Param *p, size_t n
         if (!q->declared)
             continue;
         RayesParam o = {NULL, RAYES_PARAM_NONE, {0, 0, 0}, NULL};
+        if (q->d.reference && q->v->n == 1 && !pattern_sent(r, q->v->s[0])) {
+            char key[128];
+            snprintf(key, sizeof key, "reference %.100s", q->v->s[0]);
+            rib_warn_once(r, key,
+                          "\"%s\" of \"%s\" names the pattern \"%.100s\", which is "
+                          "not defined or of a class rayes has not; its default is used",
+                          q->d.name, name, q->v->s[0]);
+            continue;
+        }
         if (q->d.ty == TY_STRING && q->v->n == 1) {
             o.type = q->d.reference ? RAYES_PARAM_PATTERN : RAYES_PARAM_STRING;
             o.string = rib_strdup(q->v->s[0]);
@@ -591,18 +613,26 @@ static int h_pattern(Rib *r, const Args *a)
     size_t n;
     if (!name || rib_get_params(r, a, i, &p, &n) != 0)
         return -1;
+    const IoSink *s = r->sink;
+    if (!in_list(builtin_patterns, type) || !s->pattern) {
+        char key[128];
+        snprintf(key, sizeof key, "pattern %.100s", type);
+        rib_warn_once(r, key,
+                      "Pattern \"%s\" is not a class rayes has (RenderMan's Pxr "
+                      "patterns are not built); ignored, and parameters that reference it keep "
+                      "their defaults",
+                      type);
+        free(p);
+        return 0;
+    }
     ShaderRec *sh = make_shader(r, type, p, n, 0);
     free(p);
     if (!sh)
         return -1;
-    const IoSink *s = r->sink;
-    if (!s->pattern) {
-        rib_warn_once(r, "pattern sink", "Pattern: this output takes no patterns; ignored");
-        return 0;
-    }
     if (s->set_transform(s->target, r->a.M) != RAYES_OK ||
         s->pattern(s->target, name, type, sh->params, sh->n) != RAYES_OK)
         return rib_sink_failed(r, s);
+    snprintf(sh->pattern, sizeof sh->pattern, "%s", name);
     r->real.have_M = 0;
     return 0;
 }

@@ -107,7 +107,9 @@ RayesError scene_bind_patterns(RayesScene *s, ShaderInstance *inst, const RayesP
 int scene_find_texture(const RayesScene *s, const char *name, char *out, size_t size)
 {
     const char *env = getenv("RAYES_TEXTURE_PATH");
-    const char *paths[2] = {scene_search_path(s, SCENE_SEARCH_PATH_TEXTURE), env ? env : ""};
+    const char *mine = s->search_paths[SCENE_SEARCH_PATH_TEXTURE]; /* not scene_search_path:
+                                                                     scene.c calls this file */
+    const char *paths[2] = {mine ? mine : "", env ? env : ""};
     if (access(name, R_OK) == 0 || name[0] == '/')
         return snprintf(out, size, "%s", name) < (int)size ? 0 : -1;
     for (int k = 0; k < 2; k++)

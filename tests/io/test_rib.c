@@ -439,6 +439,14 @@ static void test_patterns(void)
     CHECK(rec.pattern_M[3] == 1 && rec.pattern_M[7] == 2 && rec.pattern_M[11] == 3);
     CHECK(strcmp(rec.shader, "diffuse") == 0 &&
           strcmp(rec.shader_pattern, "reflectance=0:checks") == 0);
+    /* RenderMan's own pattern classes are not built: skipped with a
+     * warning, and what references them keeps its default */
+    rec.pattern[0] = '\0';
+    CHECK(parse(WORLD("Pattern \"PxrTexture\" \"tex\" \"string filename\" [\"a.tex\"]\n"
+                      "Surface \"diffuse\" \"reference color reflectance\" [\"tex:resultRGB\"]\n"
+                      "Polygon \"P\" [0 0 0 1 0 0 1 1 0]")) == RAYES_OK);
+    CHECK(rec.pattern[0] == '\0' && strcmp(rec.shader, "diffuse") == 0 &&
+          rec.shader_pattern[0] == '\0');
 }
 
 static void test_parameter_classes(void)
