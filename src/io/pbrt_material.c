@@ -127,10 +127,11 @@ static int imagemap_params(Parser *P, const Token *t, ParamList *pl, int is_floa
     const char *enc = pbrt_get_string(pl, "encoding", NULL);
     float g;
     char tail;
+    const Param *ep = pbrt_find(pl, "encoding");
     if (enc && strcmp(enc, "sRGB") != 0 && strcmp(enc, "linear") != 0 &&
         !(sscanf(enc, "gamma %f%c", &g, &tail) == 1 && g > 0.0f && g < 100.0f))
-        return FAIL_TOK(
-            P, t,
+        return pbrt_fail_at(
+            P, ep->line, ep->col,
             "imagemap: expected encoding \"sRGB\", \"linear\" or \"gamma G\", found \"%.40s\"",
             enc);
     if (enc)

@@ -772,7 +772,7 @@ static void test_errors(void)
     expect_error(
         "WorldBegin\nTexture \"a\" \"spectrum\" \"imagemap\" \"string filename\" \"x.png\"\n"
         "  \"string encoding\" \"gamma\"\n",
-        "t.pbrt:2:1: imagemap: expected encoding \"sRGB\", \"linear\" or \"gamma G\"");
+        "t.pbrt:3:3: imagemap: expected encoding \"sRGB\", \"linear\" or \"gamma G\"");
     expect_error("WorldBegin\nTexture \"a\" \"spectrum\" \"scale\" \"texture tex\" \"b\"\n",
                  "t.pbrt:2:32: expected the name of a texture defined before");
     expect_error("WorldBegin\nTexture \"a\" \"float\" \"checkerboard\" \"integer dimension\" 4\n",
