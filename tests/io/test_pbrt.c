@@ -901,6 +901,9 @@ static void test_textures(void)
     int mx = pattern_index(r, "5:mx");
     CHECK(mx >= 0 && param(&r->pattern[mx].params, "amount")->type == RAYES_PARAM_PATTERN &&
           strcmp(param(&r->pattern[mx].params, "tex2")->string, "4:sc") == 0);
+    int dm = pattern_index(r, "6:dm");
+    CHECK(dm >= 0 && param(&r->pattern[dm].params, "dir") &&
+          param(&r->pattern[dm].params, "dir")->value[2] == 1);
     /* conductor: eta, k and roughness bound */
     const Shader *sh = &r->mesh[0].shader;
     CHECK(strcmp(sh->name, "conductor") == 0 && bound_pattern(r, sh, "eta") >= 0 &&

@@ -3,9 +3,9 @@
  * points — constant, scale, mix, directionmix, checkerboard in 2-D (exact
  * box filter: half a check each side of an edge is the mean) and 3-D (in
  * texture space), imagemap with uscale, vscale, udelta, vdelta, invert,
- * scale, encoding and a float's first channel (images written by the test
- * and by oiiotool), bilerp at its corners, dots (only its two values), the
- * noise patterns (deterministic; a footprint wider than the first octave
+ * scale, encoding (untiled and maketx's tiled files) and a float's first
+ * channel (images written by the test, by oiiotool and maketx), bilerp at its corners, dots (only
+ * its two values), the noise patterns (deterministic; a footprint wider than the first octave
  * leaves fbm's mean 0); more points than one chunk give what one point at
  * a time gives; and bad definitions are refused with a message.
  */
@@ -307,6 +307,14 @@ static void test_imagemap_encoding(void)
     RayesParam d[] = {STRING("filename", TMP "/grey128.png")};
     eval1(make(&m, "default", "imagemap", d, 1, NULL), ts, 0.5f, 0.5f, 0.1f, NULL, 0, v);
     CHECK_NEAR(v[0], want[0], 1e-3); /* an 8-bit PNG is sRGB */
+    /* maketx's tiled 8-bit .tx: decoded after filtering, the same here */
+    status = system("maketx " TMP "/grey128.png -o " TMP "/grey128.tx > /dev/null 2>&1");
+    CHECK(status == 0);
+    for (int k = 0; k < 3 && status == 0; k++) {
+        RayesParam q[] = {STRING("filename", TMP "/grey128.tx"), STRING("encoding", enc[k])};
+        eval1(make(&m, enc[k], "imagemap", q, 2, NULL), ts, 0.5f, 0.5f, 0.1f, NULL, 0, v);
+        CHECK_NEAR(v[0], want[k], 1e-3);
+    }
     free_made(&m);
     texture_system_free(ts);
 }
