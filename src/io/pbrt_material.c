@@ -354,17 +354,32 @@ static const float *mat_get(const Material *m, const char *name)
     return NULL;
 }
 
+/* pbrt's names of a lobe's roughness: roughness, uroughness, vroughness,
+ * after a prefix (coatedconductor's "conductor."). */
+typedef struct RoughNames {
+    char r[32], u[32], v[32];
+} RoughNames;
+
+static RoughNames rough_names(const char *prefix)
+{
+    RoughNames n;
+    snprintf(n.r, sizeof n.r, "%sroughness", prefix);
+    snprintf(n.u, sizeof n.u, "%suroughness", prefix);
+    snprintf(n.v, sizeof n.v, "%svroughness", prefix);
+    return n;
+}
+
 /* rayes' roughness r is pbrt's with remapping on (alpha = sqrt(r)). pbrt's
  * "remaproughness" false gives alpha itself, so r = alpha^2. Anisotropic
  * roughness (uroughness, vroughness) becomes the isotropic lobe of the
  * two alphas' geometric mean, which keeps the lobe's solid angle.
  * Constants only (constant textures read as their value). */
-static int get_roughness(Parser *P, ParamList *pl, double def, double *out)
+static int get_roughness(Parser *P, ParamList *pl, const RoughNames *n, double def, double *out)
 {
     double r, ru, rv;
-    if (pbrt_get_float_tex(P, pl, "roughness", def, &r) != 0 ||
-        pbrt_get_float_tex(P, pl, "uroughness", r, &ru) != 0 ||
-        pbrt_get_float_tex(P, pl, "vroughness", r, &rv) != 0)
+    if (pbrt_get_float_tex(P, pl, n->r, def, &r) != 0 ||
+        pbrt_get_float_tex(P, pl, n->u, r, &ru) != 0 ||
+        pbrt_get_float_tex(P, pl, n->v, r, &rv) != 0)
         return -1;
     Param *remap = pbrt_find(pl, "remaproughness");
     int alpha_given = remap && remap->n_num && remap->num[0] == 0.0;
@@ -390,11 +405,11 @@ static RayesParam rough_param(const Parser *P, const char *name, size_t tex, flo
  * different ones are multiplied (alpha given: the alphas' geometric mean
  * squared) or averaged (remapped: rayes' patterns take no square root, so
  * the arithmetic mean stands in for the geometric, with a warning). */
-static int textured_roughness(Parser *P, const Token *t, ParamList *pl, Material *m)
+static int textured_roughness(Parser *P, const Token *t, ParamList *pl, const RoughNames *n,
+                              Material *m)
 {
     static const float zero[3] = {0, 0, 0};
-    const char *names[2] = {pbrt_find(pl, "uroughness") ? "uroughness" : "roughness",
-                            pbrt_find(pl, "vroughness") ? "vroughness" : "roughness"};
+    const char *names[2] = {pbrt_find(pl, n->u) ? n->u : n->r, pbrt_find(pl, n->v) ? n->v : n->r};
     size_t tex[2];
     float c[2][3];
     for (int k = 0; k < 2; k++) {
@@ -430,19 +445,22 @@ static int textured_roughness(Parser *P, const Token *t, ParamList *pl, Material
 }
 
 /* rayes' "roughness" of a material: a constant, or a pattern when pbrt's
- * roughness, uroughness or vroughness is a texture that varies. */
-static int mat_roughness(Parser *P, const Token *t, ParamList *pl, Material *m, double def)
+ * roughness, uroughness or vroughness (after prefix) is a texture that
+ * varies. */
+static int mat_roughness(Parser *P, const Token *t, ParamList *pl, Material *m, double def,
+                         const char *prefix)
 {
-    static const char *const names[] = {"roughness", "uroughness", "vroughness"};
+    RoughNames n = rough_names(prefix);
+    const char *names[3] = {n.r, n.u, n.v};
     for (int k = 0; k < 3; k++) {
         Param *p = pbrt_find(pl, names[k]);
         const Texture *tx =
             p && p->type == PT_TEXTURE && p->n_str > 0 ? pbrt_find_texture(P, p->str[0]) : NULL;
         if (tx && tx->pattern[0])
-            return textured_roughness(P, t, pl, m);
+            return textured_roughness(P, t, pl, &n, m);
     }
     double r;
-    if (get_roughness(P, pl, def, &r) != 0)
+    if (get_roughness(P, pl, &n, def, &r) != 0)
         return -1;
     mat_float(m, "roughness", (float)r);
     return 0;
@@ -548,7 +566,7 @@ static int coated_material(Parser *P, const Token *t, ParamList *pl, Material *m
     static const float half[3] = {0.5f, 0.5f, 0.5f}, thin[3] = {0.01f, 0.01f, 0.01f};
     pbrt_mat_init(m, "coateddiffuse");
     if (mat_textured(P, pl, m, "reflectance", "reflectance", RAYES_PARAM_COLOR, half) != 0 ||
-        mat_roughness(P, t, pl, m, 0.0) != 0 ||
+        mat_roughness(P, t, pl, m, 0.0, "") != 0 ||
         mat_textured(P, pl, m, "thickness", "thickness", RAYES_PARAM_FLOAT, thin) != 0)
         return -1;
     mat_float(m, "eta", (float)pbrt_get_float(pl, "eta", 1.5));
@@ -572,7 +590,7 @@ static int conductor_material(Parser *P, const Token *t, const char *type, Param
                 ? mat_textured(P, pl, m, "reflectance", "reflectance", RAYES_PARAM_COLOR, cu_eta)
                 : mat_textured(P, pl, m, eta_name, "eta", RAYES_PARAM_COLOR, cu_eta) ||
                       mat_textured(P, pl, m, k_name, "k", RAYES_PARAM_COLOR, cu_k);
-    if (r != 0 || mat_roughness(P, t, pl, m, 0.0) != 0)
+    if (r != 0 || mat_roughness(P, t, pl, m, 0.0, coated ? "conductor." : "") != 0)
         return -1;
     return 0;
 }
@@ -598,7 +616,7 @@ static int material_of_type(Parser *P, const Token *t, const char *type, ParamLi
             return -1;
         pbrt_mat_init(m, "dielectric");
         mat_float(m, "eta", (c[0] + c[1] + c[2]) / 3.0f);
-        return mat_roughness(P, t, pl, m, 0.0);
+        return mat_roughness(P, t, pl, m, 0.0, "");
     }
     if (strcmp(type, "mix") == 0)
         return mix_material(P, t, pl, m);

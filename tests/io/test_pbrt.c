@@ -929,6 +929,29 @@ static void test_textures(void)
     free(r);
 }
 
+/* coatedconductor: its conductor's parameters, textures included, make the
+ * conductor it maps to. */
+static void test_coated_conductor_textures(void)
+{
+    Rec *r = malloc(sizeof *r);
+    IoSettings s;
+    char err[512] = "";
+    const char *text =
+        "WorldBegin\n"
+        "Texture \"c\" \"float\" \"checkerboard\" \"float tex1\" 0.01 \"float tex2\" 0.3\n"
+        "Material \"coatedconductor\" \"texture conductor.roughness\" \"c\"\n"
+        "  \"spectrum conductor.eta\" \"metal-Au-eta\" \"spectrum conductor.k\" \"metal-Au-k\"\n"
+        "Shape \"trianglemesh\" \"point3 P\" [0 0 0 1 0 0 0 1 0]\n";
+    CHECK(parse("t.pbrt", text, r, &s, err, sizeof err) == RAYES_OK);
+    CHECK(r->n_meshes == 1);
+    const Shader *sh = &r->mesh[0].shader;
+    CHECK(strcmp(sh->name, "conductor") == 0 && param(sh, "roughness") &&
+          param(sh, "roughness")->type == RAYES_PARAM_PATTERN &&
+          strcmp(param(sh, "roughness")->string, "0:c") == 0);
+    CHECK(param(sh, "eta") && fabs(param(sh, "eta")->value[2] - 1.442) < 1e-3);
+    free(r);
+}
+
 /* trianglemesh, bilinearmesh and plymesh pass N and uv per point, as
  * vertex-class N and st with t = 1 - v; instanced meshes keep them. */
 static void test_normals_and_uv(void)
@@ -1035,4 +1058,4 @@ static void test_spectrum_files(void)
 TEST_MAIN(TEST(test_filters), TEST(test_spectrum_files), TEST(test_cornell_box),
           TEST(test_transforms), TEST(test_materials), TEST(test_lights),
           TEST(test_instances_include_ply), TEST(test_errors), TEST(test_normals_and_uv),
-          TEST(test_textures))
+          TEST(test_textures), TEST(test_coated_conductor_textures))
