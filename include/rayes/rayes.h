@@ -111,7 +111,10 @@ typedef enum RayesParamType {
     RAYES_PARAM_NONE = 0,
     RAYES_PARAM_FLOAT = 1,  /* value[0] */
     RAYES_PARAM_COLOR = 2,  /* value[0..2], linear RGB */
-    RAYES_PARAM_STRING = 3  /* string */
+    RAYES_PARAM_STRING = 3, /* string */
+    RAYES_PARAM_PATTERN = 4 /* string: the name of a pattern (rayes_scene_pattern); given for
+                               a shader's FLOAT or COLOR parameter, the value varies over
+                               the surface as the pattern does */
 } RayesParamType;
 
 typedef struct RayesParam {
@@ -153,6 +156,35 @@ RAYES_API RayesError rayes_scene_set_displacement(RayesScene *scene, const char 
  * no point moves farther. Displacements are clamped to it, with one
  * warning per shader. 0 (the default) means unbounded. */
 RAYES_API RayesError rayes_scene_set_displacement_bound(RayesScene *scene, float bound);
+
+/* Defines the pattern `name`: one of pbrt-v4's texture classes, which
+ * shader parameters may then take (a RAYES_PARAM_PATTERN parameter of
+ * set_shader, set_displacement or edit_shader naming it). An input
+ * ("tex1", "amount", ...) is a FLOAT or COLOR constant or another pattern
+ * (RAYES_PARAM_PATTERN); the 3-D classes work in the space of the current
+ * transform (texture space = object space of the call).
+ *   "constant"      value
+ *   "scale"         tex * scale
+ *   "mix"           (1 - amount) tex1 + amount tex2
+ *   "directionmix"  tex1 weighted by |N . dir| (dir a COLOR, a direction in
+ *                   texture space), tex2 by the rest
+ *   "checkerboard"  tex1 on squares where floor(u) + floor(v) is even, tex2
+ *                   on the others, box-filtered; "dimension" 3: on cubes of
+ *                   texture space, unfiltered
+ *   "imagemap"      "filename" (STRING, on the texture search path) times
+ *                   "scale", "invert" (1: 1 - value), "encoding" (STRING:
+ *                   "sRGB", "linear" or "gamma G", for integer files; default
+ *                   the file's), "channel" (-1: RGB, else that channel grey)
+ *   "bilerp"        v00 v01 v10 v11 (constants) over (u, v)
+ *   "dots"          inside, outside: polka dots on the (u, v) cells
+ *   "fbm", "wrinkled", "windy", "marble"  pbrt's noise patterns (octaves,
+ *                   roughness; marble: scale, variation)
+ * The 2-D classes take pbrt's (u, v) = (s, 1 - t) and "uscale", "vscale",
+ * "udelta", "vdelta". A later definition of a name replaces it for later
+ * references. An unknown class, parameter or pattern name, a wrong type, or
+ * patterns nested deeper than 16 are RAYES_ERROR_INVALID_ARGUMENT. */
+RAYES_API RayesError rayes_scene_pattern(RayesScene *scene, const char *name, const char *type,
+                                         const RayesParam *params, size_t n_params);
 /* Sets the scene's search path of a kind ("shader" or "texture"):
  * directories separated by ':', searched in order by later calls
  * (set_shader) or, for textures, by the renders of the scene (a texture
@@ -391,8 +423,9 @@ RAYES_API RayesError rayes_scene_area_light(RayesScene *scene, const float P[4][
  *                      along to - from
  *   "ambientlight"     adds intensity * lightcolor to the ambient service
  *   "environmentlight" radiance intensity * lightcolor, times the
- *                      latitude-longitude map "mapname" (EXR or PNG) if
- *                      given, seen by camera and specular rays that miss
+ *                      latitude-longitude map "mapname" (any format
+ *                      OpenImageIO reads; as given, else on the texture
+ *                      search path) if given, seen by camera and specular rays that miss
  *                      everything (docs/DESIGN.md: orientation)
  *   "arealight"        radiance intensity * lightcolor from a "shape"
  *                      (default "quad"): "quad" the square of side

@@ -63,6 +63,18 @@ typedef enum RayesRayType {
     RAYES_RAY_SUBSURFACE = 1u << 5
 } RayesRayType;
 
+/* A pattern: a small graph of textures made by rayes_scene_pattern (pbrt-v4's
+ * texture classes), opaque to shaders, evaluated by the pattern service. */
+typedef struct RayesPattern RayesPattern;
+
+/* A FLOAT or COLOR parameter of the instance being shaded that the scene
+ * bound to a pattern (a RAYES_PARAM_PATTERN value): its value varies over
+ * the surface and is the pattern service's result at each point. */
+typedef struct RayesPatternBinding {
+    const char *param;           /* the parameter's name, as in the class's table */
+    const RayesPattern *pattern; /* what it is bound to; valid during the call */
+} RayesPatternBinding;
+
 /* The inputs of one method call on n_points shading points. Arrays that a
  * method may not read are NULL (I in diffuselighting). */
 typedef struct RayesShadeCtx {
@@ -93,6 +105,10 @@ typedef struct RayesShadeCtx {
                                    the surface (against dPdu x dPdv, so N and Ng were turned
                                    to face it; a cache fill for that side), else 0; NULL:
                                    every point is on the front (displacement) */
+    const RayesPatternBinding *patterns; /* appended in ABI 2: the instance's parameters
+                                   bound to patterns, n_patterns of them (NULL, 0: none); a
+                                   parameter not listed has its value in params */
+    size_t n_patterns;
 } RayesShadeCtx;
 
 /* The outputs of a method call, n_points each. Irradiance may be NULL. */
@@ -280,6 +296,15 @@ struct RayesShaderServices {
     void (*direct_fiber)(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
                          int n_shadow_rays, const char *category, const float (*T)[3],
                          const float *roughness, float (*diffuse)[3], float (*specular)[3]);
+
+    /* A pattern (one of ctx->patterns' pattern) at the points: linear RGB,
+     * a float pattern grey in all three. Image lookups are filtered over
+     * the points' texture footprint, as the texture service's with ds and
+     * dt NULL; checkerboards are box-filtered like checker. Deterministic.
+     * Returns 0, or -1 when an image cannot be read (one warning; its
+     * lookups are then 0). Older renderers lack it (supports()). */
+    int (*pattern)(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
+                   const RayesPattern *pattern, float (*out)[3]);
 };
 
 #ifdef __cplusplus

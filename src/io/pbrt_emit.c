@@ -23,29 +23,65 @@ int pbrt_sink_failed(Parser *P, const Token *t, RayesError e)
     return -1;
 }
 
-static void material_params(const Material *m, RayesParam out[MAT_MAX_PARAMS + 1])
+static void material_params(const Parser *P, const Material *m, RayesParam out[MAT_MAX_PARAMS + 1])
 {
     for (int i = 0; i < m->n; i++) {
         out[i] = (RayesParam){.name = m->p[i].name, .type = m->p[i].type};
         memcpy(out[i].value, m->p[i].v, sizeof out[i].value);
-        if (m->p[i].type == RAYES_PARAM_STRING)
-            out[i].string = m->texture;
+        if (m->p[i].type == RAYES_PARAM_PATTERN)
+            out[i].string = P->textures[m->p[i].tex].pattern;
     }
 }
 
-static int send_state(Parser *P, const Token *t, const double m[16], const Material *mat)
+/* The displacement of mat (the built-in "displace" of its amount), or
+ * none when the last material sent had one and this has not. */
+static RayesError send_displacement(Parser *P, const Material *mat)
+{
+    if (!mat->displaced)
+        return P->have_sent && P->sent.displaced
+                   ? P->sink->set_displacement(P->sink->target, "", NULL, 0)
+                   : RAYES_OK;
+    RayesParam amount = {
+        .name = "amount", .type = RAYES_PARAM_FLOAT, .value = {mat->displacement_v, 0, 0}};
+    if (mat->displaced == 2)
+        amount = (RayesParam){.name = "amount",
+                              .type = RAYES_PARAM_PATTERN,
+                              .string = P->textures[mat->displacement_tex].pattern};
+    return P->sink->set_displacement(P->sink->target, "displace", &amount, 1);
+}
+
+/* Sends m as the sink's transform; 0, or -1 when it is not finite or the
+ * sink fails. */
+static int send_transform(Parser *P, const Token *t, const double m[16])
 {
     float f[16];
     if (!pbrt_mat_finite(m))
         return FAIL_TOK(P, t, "the current transform is not finite");
     pbrt_mat_to_float(m, f);
     RayesError e = P->sink->set_transform(P->sink->target, f);
-    if (e != RAYES_OK)
-        return pbrt_sink_failed(P, t, e);
+    return e != RAYES_OK ? pbrt_sink_failed(P, t, e) : 0;
+}
+
+int pbrt_emit_pattern(Parser *P, const Token *t, const char *name, const char *type,
+                      const RayesParam *params, size_t n)
+{
+    if (send_transform(P, t, P->gs.ctm) != 0)
+        return -1;
+    RayesError e = P->sink->pattern(P->sink->target, name, type, params, n);
+    return e != RAYES_OK ? pbrt_sink_failed(P, t, e) : 0;
+}
+
+static int send_state(Parser *P, const Token *t, const double m[16], const Material *mat)
+{
+    RayesError e;
+    if (send_transform(P, t, m) != 0)
+        return -1;
     if (!P->have_sent || memcmp(&P->sent, mat, sizeof *mat) != 0) {
         RayesParam params[MAT_MAX_PARAMS + 1];
-        material_params(mat, params);
+        material_params(P, mat, params);
         e = P->sink->set_shader(P->sink->target, mat->shader, params, (size_t)mat->n);
+        if (e == RAYES_OK)
+            e = send_displacement(P, mat);
         if (e != RAYES_OK)
             return pbrt_sink_failed(P, t, e);
         P->sent = *mat;
@@ -247,13 +283,9 @@ int pbrt_emit_patch(Parser *P, const Token *t, const Op *patch)
 int pbrt_emit_light(Parser *P, const Token *t, const double m[16], const char *type,
                     const RayesParam *params, size_t n)
 {
-    float f[16];
-    if (!pbrt_mat_finite(m))
-        return FAIL_TOK(P, t, "the current transform is not finite");
-    pbrt_mat_to_float(m, f);
-    RayesError e = P->sink->set_transform(P->sink->target, f);
-    if (e == RAYES_OK)
-        e = P->sink->light(P->sink->target, type, params, n);
+    if (send_transform(P, t, m) != 0)
+        return -1;
+    RayesError e = P->sink->light(P->sink->target, type, params, n);
     return e != RAYES_OK ? pbrt_sink_failed(P, t, e) : 0;
 }
 

@@ -86,17 +86,22 @@ typedef struct ParamList {
     size_t n, cap;
 } ParamList;
 
-/* A shader call: the built-in class and its parameters. Zeroed before it
- * is filled, so two materials compare with memcmp. */
+/* A shader call: the built-in class and its parameters, and the
+ * displacement that goes with it. Zeroed before it is filled, so two
+ * materials compare with memcmp. */
 typedef struct Material {
     char shader[24];
     int n;
     struct {
         char name[16];
-        RayesParamType type;
+        RayesParamType type; /* FLOAT, COLOR, or PATTERN */
         float v[3];
+        size_t tex; /* PATTERN: the index of its Texture in Parser.textures */
     } p[MAT_MAX_PARAMS];
-    char texture[PBRT_PATH]; /* the value of a STRING parameter "texturename" */
+    int displaced; /* pbrt's "displacement": 1 a constant (displacement_v), 2 a
+                      texture (displacement_tex) */
+    float displacement_v;
+    size_t displacement_tex;
 } Material;
 
 typedef struct AreaLight {
@@ -124,11 +129,15 @@ typedef struct NamedMaterial {
     Material m;
 } NamedMaterial;
 
+/* A named texture: a pattern sent to the sink (pattern), or a constant.
+ * Textures the reader makes itself (a squared roughness, say) have a name
+ * that starts with a space, which no file's name is looked up as. */
 typedef struct Texture {
     char name[128];
-    int image;               /* 1: an image file (path), 0: a constant colour */
-    float rgb[3];            /* the constant, or the image's scale */
-    char path[PBRT_PATH];
+    char pattern[160]; /* the sink's name of its pattern; "": a constant (rgb) */
+    float rgb[3];      /* the constant, or the pattern's stand-in colour for
+                          what cannot vary (its mean where pbrt's class has one) */
+    int is_float;      /* a "float" texture (else "spectrum") */
 } Texture;
 
 typedef enum OpKind { OP_MESH, OP_QUADRIC, OP_PATCH } OpKind;
@@ -270,11 +279,14 @@ const double *pbrt_get_point(ParamList *pl, const char *name);
 void pbrt_warn_unused(Parser *P, ParamList *pl, const char *directive, const char *kind);
 /* A colour parameter: rgb, spectrum (named, sampled or constant), blackbody,
  * float (grey) or texture. Returns 0 (not given: out = def), 1 (a colour
- * in out), 2 (an image texture in *tex, out = its scale) or -1 (error). */
+ * in out; a constant texture's, or any texture's stand-in when tex is
+ * NULL), 2 (a pattern texture in *tex, out = its stand-in) or -1 (error). */
 int pbrt_get_color(Parser *P, ParamList *pl, const char *name, const float def[3], float out[3],
                    const Texture **tex);
-/* A float parameter that may be a texture (the texture's grey value then). */
+/* A float parameter that may be a texture (its stand-in's mean grey then). */
 int pbrt_get_float_tex(Parser *P, ParamList *pl, const char *name, double def, double *out);
+/* The texture defined with that name latest, or NULL. */
+const Texture *pbrt_find_texture(const Parser *P, const char *name);
 
 /* ----------------------------------------------- emitting (pbrt_emit.c) */
 
@@ -300,6 +312,10 @@ int pbrt_emit_patch(Parser *P, const Token *t, const Op *patch);
 /* A light under m, sent at once (never recorded). */
 int pbrt_emit_light(Parser *P, const Token *t, const double m[16], const char *type,
                     const RayesParam *params, size_t n);
+/* A pattern (rayes_scene_pattern) in the space of the current transform;
+ * the sink must have the pattern method. */
+int pbrt_emit_pattern(Parser *P, const Token *t, const char *name, const char *type,
+                      const RayesParam *params, size_t n);
 /* Sends the recorded object o under the current transform. */
 int pbrt_replay(Parser *P, const Token *t, const Object *o);
 

@@ -2,11 +2,15 @@
  * io/pbrt_material.c — pbrt materials and textures (pbrt_internal.h):
  * Material, MakeNamedMaterial, NamedMaterial and Texture. Each pbrt
  * material becomes one call of a built-in shader (diffuse, coateddiffuse,
- * conductor, dielectric; paintedplastic for an image-textured diffuse;
- * matte for what has no counterpart) with at most MAT_MAX_PARAMS
- * parameters; what is approximated or dropped is warned about once.
- * Textures are a constant colour or an image file with a scale. Named
- * materials and textures are found latest first, so a redefinition wins.
+ * conductor, dielectric; matte for what has no counterpart) with at most
+ * MAT_MAX_PARAMS parameters, and its "displacement" the built-in
+ * displacement shader "displace"; what is approximated or dropped is
+ * warned about once. Each Texture becomes a pattern of the sink
+ * (rayes_scene_pattern: pbrt-v4's texture classes, evaluated per shading
+ * point), named "N:name" with N its index, so a redefined name is a new
+ * pattern; a parameter pbrt lets be textured takes the pattern
+ * (RAYES_PARAM_PATTERN), every other parameter a constant. Named materials
+ * and textures are found latest first, so a redefinition wins.
  */
 #include <math.h>
 #include <stdio.h>
@@ -14,6 +18,273 @@
 #include <string.h>
 
 #include "io/pbrt_internal.h"
+
+#define TEX_MAX_PARAMS 16
+
+/* ------------------------------------------------------------ textures */
+
+/* Appends tex to the parser's textures; its index, or -1 (no memory). */
+static long add_texture(Parser *P, const Token *t, const Texture *tex)
+{
+    if ((P->n_textures & (P->n_textures - 1)) == 0) {
+        Texture *n = realloc(P->textures, (P->n_textures ? 2 * P->n_textures : 1) * sizeof *n);
+        if (!n)
+            return FAIL_TOK(P, t, "out of memory");
+        P->textures = n;
+    }
+    P->textures[P->n_textures] = *tex;
+    return (long)P->n_textures++;
+}
+
+/* A texture of pattern class cls: sent to the sink as "N:name" under the
+ * current transform (the 3-D classes' texture space), or, for a sink that
+ * takes no patterns, the constant standin with one warning. Returns its
+ * index, or -1. */
+static long define_pattern(Parser *P, const Token *t, const char *name, int is_float,
+                           const char *cls, const RayesParam *params, size_t n,
+                           const float standin[3])
+{
+    Texture tex;
+    memset(&tex, 0, sizeof tex);
+    snprintf(tex.name, sizeof tex.name, "%s", name);
+    memcpy(tex.rgb, standin, sizeof tex.rgb);
+    tex.is_float = is_float;
+    if (!P->sink->pattern) {
+        pbrt_warn_at(P, t->line, t->col, "no patterns",
+                     "this output takes no textures; textured parameters become constants (the "
+                     "texture's mean)");
+        return add_texture(P, t, &tex);
+    }
+    snprintf(tex.pattern, sizeof tex.pattern, "%zu:%.120s", P->n_textures,
+             name[0] == ' ' ? name + 1 : name);
+    if (pbrt_emit_pattern(P, t, tex.pattern, cls, params, n) != 0)
+        return -1;
+    return add_texture(P, t, &tex);
+}
+
+/* One input of a texture (tex1, amount, ...): a pattern or a constant into
+ * *out (named name), its stand-in into standin. Returns 0, or -1. */
+static int tex_input(Parser *P, ParamList *pl, const char *name, const float def[3],
+                     RayesParam *out, float standin[3])
+{
+    const Texture *tex = NULL;
+    int k = pbrt_get_color(P, pl, name, def, standin, &tex);
+    if (k < 0)
+        return -1;
+    *out = (RayesParam){.name = name, .type = RAYES_PARAM_COLOR};
+    memcpy(out->value, standin, sizeof out->value);
+    if (k == 2)
+        *out = (RayesParam){.name = name, .type = RAYES_PARAM_PATTERN, .string = tex->pattern};
+    return 0;
+}
+
+/* A number parameter passed on when given (an integer or a float). */
+static void tex_number(ParamList *pl, const char *name, RayesParam *out, size_t *n)
+{
+    Param *p = pbrt_find(pl, name);
+    if (p && (p->type == PT_FLOAT || p->type == PT_INTEGER) && p->n_num > 0)
+        out[(*n)++] = (RayesParam){
+            .name = name, .type = RAYES_PARAM_FLOAT, .value = {(float)p->num[0], 0, 0}};
+    else if (p)
+        p->used = 0; /* the wrong type: warned about as unused */
+}
+
+/* pbrt's (u, v) mapping parameters. Only "uv" mapping is built. */
+static void tex_mapping(Parser *P, const Token *t, ParamList *pl, RayesParam *out, size_t *n)
+{
+    static const char *const names[] = {"uscale", "vscale", "udelta", "vdelta"};
+    for (int k = 0; k < 4; k++)
+        tex_number(pl, names[k], out, n);
+    const char *mapping = pbrt_get_string(pl, "mapping", "uv");
+    if (strcmp(mapping, "uv") != 0)
+        pbrt_warn_at(P, t->line, t->col, "texture mapping",
+                     "Texture: mapping \"%.40s\" is not supported; using \"uv\"", mapping);
+}
+
+static void mean2(const float a[3], const float b[3], float out[3])
+{
+    for (int c = 0; c < 3; c++)
+        out[c] = 0.5f * (a[c] + b[c]);
+}
+
+/* The parameters of an imagemap: the file (resolved), its scale, invert,
+ * encoding and mapping; a float texture reads the first channel, as pbrt
+ * does. */
+static int imagemap_params(Parser *P, const Token *t, ParamList *pl, int is_float, char *path,
+                           RayesParam *q, size_t *n, float standin[3])
+{
+    const char *file = pbrt_get_string(pl, "filename", NULL);
+    if (!file)
+        return FAIL_TOK(P, t, "imagemap: expected \"string filename\"");
+    if (pbrt_resolve(P, t, file, path, PBRT_PATH) != 0)
+        return -1;
+    q[(*n)++] = (RayesParam){.name = "filename", .type = RAYES_PARAM_STRING, .string = path};
+    tex_number(pl, "scale", q, n);
+    Param *inv = pbrt_find(pl, "invert");
+    if (inv && inv->type == PT_BOOL && inv->n_num > 0)
+        q[(*n)++] = (RayesParam){
+            .name = "invert", .type = RAYES_PARAM_FLOAT, .value = {(float)inv->num[0], 0, 0}};
+    const char *enc = pbrt_get_string(pl, "encoding", NULL);
+    float g;
+    char tail;
+    const Param *ep = pbrt_find(pl, "encoding");
+    if (enc && strcmp(enc, "sRGB") != 0 && strcmp(enc, "linear") != 0 &&
+        !(sscanf(enc, "gamma %f%c", &g, &tail) == 1 && g > 0.0f && g < 100.0f))
+        return pbrt_fail_at(
+            P, ep->line, ep->col,
+            "imagemap: expected encoding \"sRGB\", \"linear\" or \"gamma G\", found \"%.40s\"",
+            enc);
+    if (enc)
+        q[(*n)++] = (RayesParam){.name = "encoding", .type = RAYES_PARAM_STRING, .string = enc};
+    if (is_float)
+        q[(*n)++] = (RayesParam){.name = "channel", .type = RAYES_PARAM_FLOAT};
+    const char *wrap = pbrt_get_string(pl, "wrap", "repeat");
+    if (strcmp(wrap, "repeat") != 0)
+        pbrt_warn_at(P, t->line, t->col, "imagemap wrap",
+                     "imagemap: wrap \"%.40s\" is not supported; the image repeats", wrap);
+    (void)pbrt_find(pl, "filter"); /* rayes always filters (OpenImageIO's anisotropic MIP) */
+    (void)pbrt_find(pl, "maxanisotropy");
+    float sc = (float)pbrt_get_float(pl, "scale", 1.0);
+    standin[0] = standin[1] = standin[2] = sc;
+    tex_mapping(P, t, pl, q, n);
+    return 0;
+}
+
+/* The pattern parameters of a pbrt texture class, and its stand-in. Returns
+ * 1 for a class rayes has, 0 for one it has not, or -1. */
+static int texture_params(Parser *P, const Token *t, const char *cls, ParamList *pl, int is_float,
+                          char *path, RayesParam *q, size_t *n, float standin[3])
+{
+    static const float one[3] = {1, 1, 1}, zero[3] = {0, 0, 0}, half[3] = {.5f, .5f, .5f};
+    float a[3], b[3], c[3], d[3];
+    if (strcmp(cls, "constant") == 0)
+        return tex_input(P, pl, "value", one, &q[(*n)++], standin) ? -1 : 1;
+    if (strcmp(cls, "scale") == 0) {
+        if (tex_input(P, pl, "tex", one, &q[0], a) || tex_input(P, pl, "scale", one, &q[1], b))
+            return -1;
+        *n = 2;
+        for (int k = 0; k < 3; k++)
+            standin[k] = a[k] * b[k];
+        return 1;
+    }
+    if (strcmp(cls, "mix") == 0 || strcmp(cls, "directionmix") == 0) {
+        if (tex_input(P, pl, "tex1", zero, &q[0], a) || tex_input(P, pl, "tex2", one, &q[1], b))
+            return -1;
+        *n = 2;
+        float w = 0.5f;
+        if (cls[0] == 'm') {
+            if (tex_input(P, pl, "amount", half, &q[(*n)++], c))
+                return -1;
+            w = c[0];
+        } else if (pbrt_get_point(pl, "dir")) {
+            const double *dir = pbrt_get_point(pl, "dir");
+            q[(*n)++] = (RayesParam){.name = "dir",
+                                     .type = RAYES_PARAM_COLOR,
+                                     .value = {(float)dir[0], (float)dir[1], (float)dir[2]}};
+        }
+        for (int k = 0; k < 3; k++)
+            standin[k] = (1 - w) * a[k] + w * b[k];
+        return 1;
+    }
+    if (strcmp(cls, "checkerboard") == 0 || strcmp(cls, "dots") == 0) {
+        int dots = cls[0] == 'd';
+        if (tex_input(P, pl, dots ? "inside" : "tex1", one, &q[0], a) ||
+            tex_input(P, pl, dots ? "outside" : "tex2", zero, &q[1], b))
+            return -1;
+        *n = 2;
+        Param *dim = dots ? NULL : pbrt_find(pl, "dimension");
+        if (dim && dim->n_num > 0 && dim->num[0] != 2 && dim->num[0] != 3)
+            return pbrt_fail_at(P, dim->line, dim->col,
+                                "checkerboard: expected dimension 2 or 3, found %g", dim->num[0]);
+        if (!dots)
+            tex_number(pl, "dimension", q, n);
+        tex_mapping(P, t, pl, q, n);
+        mean2(a, b, standin);
+        return 1;
+    }
+    if (strcmp(cls, "imagemap") == 0)
+        return imagemap_params(P, t, pl, is_float, path, q, n, standin) ? -1 : 1;
+    if (strcmp(cls, "bilerp") == 0) {
+        static const char *const v[4] = {"v00", "v01", "v10", "v11"};
+        float *vals[4] = {a, b, c, d};
+        for (int k = 0; k < 4; k++)
+            if (tex_input(P, pl, v[k], k & 1 ? one : zero, &q[k], vals[k]))
+                return -1;
+        *n = 4;
+        tex_mapping(P, t, pl, q, n);
+        for (int k = 0; k < 3; k++)
+            standin[k] = 0.25f * (a[k] + b[k] + c[k] + d[k]);
+        return 1;
+    }
+    if (strcmp(cls, "fbm") == 0 || strcmp(cls, "wrinkled") == 0 || strcmp(cls, "windy") == 0 ||
+        strcmp(cls, "marble") == 0) {
+        static const char *const nums[] = {"octaves", "roughness", "scale", "variation"};
+        int k_max = cls[0] == 'w' && cls[1] == 'i' ? 0 : cls[0] == 'm' ? 4 : 2;
+        for (int k = 0; k < k_max; k++)
+            tex_number(pl, nums[k], q, n);
+        memcpy(standin, half, sizeof half);
+        return 1;
+    }
+    return 0;
+}
+
+int pbrt_d_texture(Parser *P, const Token *t)
+{
+    char name[128], kind[32], cls[64];
+    ParamList pl = {0};
+    int r = pbrt_need_world(P, t, 1);
+    if (!r)
+        r = pbrt_expect_string(P, name, sizeof name, "a texture name", NULL);
+    if (!r)
+        r = pbrt_expect_string(P, kind, sizeof kind, "a texture type (\"spectrum\" or \"float\")",
+                               NULL);
+    if (!r && strcmp(kind, "float") != 0 && strcmp(kind, "spectrum") != 0 &&
+        strcmp(kind, "color") != 0)
+        r = FAIL_TOK(
+            P, t, "Texture \"%.60s\": expected the type \"spectrum\" or \"float\", found \"%.40s\"",
+            name, kind);
+    if (!r)
+        r = pbrt_name_and_params(P, cls, sizeof cls, "a texture class", &pl, NULL);
+    if (r) {
+        pbrt_params_free(&pl);
+        return -1;
+    }
+    int is_float = strcmp(kind, "float") == 0;
+    RayesParam q[TEX_MAX_PARAMS];
+    char *path = malloc(PBRT_PATH);
+    size_t n = 0;
+    float standin[3] = {.5f, .5f, .5f};
+    int k = path ? texture_params(P, t, cls, &pl, is_float, path, q, &n, standin)
+                 : FAIL_TOK(P, t, "out of memory");
+    if (k == 0) {
+        char key[96];
+        snprintf(key, sizeof key, "texture %.60s", cls);
+        pbrt_warn_at(P, t->line, t->col, key,
+                     "Texture \"%.40s\" is not supported; using a constant 0.5", cls);
+        for (size_t i = 0; i < pl.n; i++)
+            pl.p[i].used = 1;
+        Texture tex;
+        memset(&tex, 0, sizeof tex);
+        snprintf(tex.name, sizeof tex.name, "%s", name);
+        memcpy(tex.rgb, standin, sizeof tex.rgb);
+        tex.is_float = is_float;
+        k = add_texture(P, t, &tex) < 0 ? -1 : 1;
+    } else if (k > 0 && strcmp(cls, "constant") == 0 && q[0].type != RAYES_PARAM_PATTERN) {
+        Texture tex; /* a constant needs no pattern */
+        memset(&tex, 0, sizeof tex);
+        snprintf(tex.name, sizeof tex.name, "%s", name);
+        memcpy(tex.rgb, standin, sizeof tex.rgb);
+        tex.is_float = is_float;
+        k = add_texture(P, t, &tex) < 0 ? -1 : 1;
+    } else if (k > 0) {
+        k = define_pattern(P, t, name, is_float, cls, q, n, standin) < 0 ? -1 : 1;
+    }
+    free(path);
+    if (k > 0)
+        pbrt_warn_unused(P, &pl, "Texture", cls);
+    pbrt_params_free(&pl);
+    return k > 0 ? 0 : -1;
+}
 
 /* ------------------------------------------------------------ materials */
 
@@ -43,14 +314,35 @@ void pbrt_mat_color(Material *m, const char *name, const float c[3])
     m->n++;
 }
 
-static void mat_texture(Material *m, const char *path)
+/* The parameter name bound to texture index tex's pattern. */
+static void mat_pattern(Material *m, const char *name, size_t tex)
 {
     if (m->n >= MAT_MAX_PARAMS)
         return;
-    snprintf(m->p[m->n].name, sizeof m->p[m->n].name, "texturename");
-    m->p[m->n].type = RAYES_PARAM_STRING;
-    snprintf(m->texture, sizeof m->texture, "%s", path);
+    snprintf(m->p[m->n].name, sizeof m->p[m->n].name, "%s", name);
+    m->p[m->n].type = RAYES_PARAM_PATTERN;
+    m->p[m->n].tex = tex;
     m->n++;
+}
+
+/* A parameter pbrt lets be textured: pbrt's pname (default def) as rayes'
+ * name, a constant of that type or the texture's pattern. Returns 0, or
+ * -1. */
+static int mat_textured(Parser *P, ParamList *pl, Material *m, const char *pname, const char *name,
+                        RayesParamType type, const float def[3])
+{
+    float c[3];
+    const Texture *tex = NULL;
+    int k = pbrt_get_color(P, pl, pname, def, c, &tex);
+    if (k < 0)
+        return -1;
+    if (k == 2)
+        mat_pattern(m, name, (size_t)(tex - P->textures));
+    else if (type == RAYES_PARAM_FLOAT)
+        mat_float(m, name, (c[0] + c[1] + c[2]) / 3.0f);
+    else
+        pbrt_mat_color(m, name, c);
+    return 0;
 }
 
 /* The colour of a material's parameter, if it has one of that name. */
@@ -62,44 +354,144 @@ static const float *mat_get(const Material *m, const char *name)
     return NULL;
 }
 
+/* pbrt's names of a lobe's roughness: roughness, uroughness, vroughness,
+ * after a prefix (coatedconductor's "conductor."). */
+typedef struct RoughNames {
+    char r[32], u[32], v[32];
+} RoughNames;
+
+static RoughNames rough_names(const char *prefix)
+{
+    RoughNames n;
+    snprintf(n.r, sizeof n.r, "%sroughness", prefix);
+    snprintf(n.u, sizeof n.u, "%suroughness", prefix);
+    snprintf(n.v, sizeof n.v, "%svroughness", prefix);
+    return n;
+}
+
 /* rayes' roughness r is pbrt's with remapping on (alpha = sqrt(r)). pbrt's
  * "remaproughness" false gives alpha itself, so r = alpha^2. Anisotropic
  * roughness (uroughness, vroughness) becomes the isotropic lobe of the
- * two alphas' geometric mean, which keeps the lobe's solid angle. */
-static double get_roughness(ParamList *pl, double def)
+ * two alphas' geometric mean, which keeps the lobe's solid angle.
+ * Constants only (constant textures read as their value). */
+static int get_roughness(Parser *P, ParamList *pl, const RoughNames *n, double def, double *out)
 {
-    double r = pbrt_get_float(pl, "roughness", def);
-    Param *u = pbrt_find(pl, "uroughness"), *v = pbrt_find(pl, "vroughness");
+    double r, ru, rv;
+    if (pbrt_get_float_tex(P, pl, n->r, def, &r) != 0 ||
+        pbrt_get_float_tex(P, pl, n->u, r, &ru) != 0 ||
+        pbrt_get_float_tex(P, pl, n->v, r, &rv) != 0)
+        return -1;
     Param *remap = pbrt_find(pl, "remaproughness");
     int alpha_given = remap && remap->n_num && remap->num[0] == 0.0;
-    double ru = u && u->n_num ? u->num[0] : r, rv = v && v->n_num ? v->num[0] : r;
     double au = alpha_given ? ru : sqrt(fmax(ru, 0.0)), av = alpha_given ? rv : sqrt(fmax(rv, 0.0));
     double alpha = sqrt(fmax(au, 0.0) * fmax(av, 0.0));
-    return alpha * alpha;
+    *out = alpha * alpha;
+    return 0;
+}
+
+/* One roughness as a pattern parameter: texture index tex, or constant v
+ * when tex is (size_t)-1. */
+static RayesParam rough_param(const Parser *P, const char *name, size_t tex, float v)
+{
+    if (tex != (size_t)-1)
+        return (RayesParam){
+            .name = name, .type = RAYES_PARAM_PATTERN, .string = P->textures[tex].pattern};
+    return (RayesParam){.name = name, .type = RAYES_PARAM_FLOAT, .value = {v, 0, 0}};
+}
+
+/* The roughness of a material with a textured roughness, uroughness or
+ * vroughness: the same texture in u and v is rayes' roughness as it is
+ * (remapped) or squared (alpha given: "scale" of it by itself); two
+ * different ones are multiplied (alpha given: the alphas' geometric mean
+ * squared) or averaged (remapped: rayes' patterns take no square root, so
+ * the arithmetic mean stands in for the geometric, with a warning). */
+static int textured_roughness(Parser *P, const Token *t, ParamList *pl, const RoughNames *n,
+                              Material *m)
+{
+    static const float zero[3] = {0, 0, 0};
+    const char *names[2] = {pbrt_find(pl, n->u) ? n->u : n->r, pbrt_find(pl, n->v) ? n->v : n->r};
+    size_t tex[2];
+    float c[2][3];
+    for (int k = 0; k < 2; k++) {
+        const Texture *tx = NULL;
+        int got = pbrt_get_color(P, pl, names[k], zero, c[k], &tx);
+        if (got < 0)
+            return -1;
+        tex[k] = got == 2 ? (size_t)(tx - P->textures) : (size_t)-1;
+    }
+    Param *remap = pbrt_find(pl, "remaproughness");
+    int alpha_given = remap && remap->n_num && remap->num[0] == 0.0;
+    int same = tex[0] == tex[1] && (tex[0] != (size_t)-1 || c[0][0] == c[1][0]);
+    if (same && !alpha_given) {
+        mat_pattern(m, "roughness", tex[0]);
+        return 0;
+    }
+    if (!same && !alpha_given)
+        pbrt_warn_at(
+            P, t->line, t->col, "anisotropic roughness texture",
+            "textured uroughness and vroughness become one isotropic roughness, their mean");
+    RayesParam q[3] = {rough_param(P, alpha_given ? "tex" : "tex1", tex[0], c[0][0]),
+                       rough_param(P, alpha_given ? "scale" : "tex2", tex[1], c[1][0]),
+                       {.name = "amount", .type = RAYES_PARAM_FLOAT, .value = {0.5f, 0, 0}}};
+    float standin[3];
+    for (int k = 0; k < 3; k++)
+        standin[k] = alpha_given ? c[0][0] * c[1][0] : 0.5f * (c[0][0] + c[1][0]);
+    long i = define_pattern(P, t, " roughness", 1, alpha_given ? "scale" : "mix", q,
+                            alpha_given ? 2 : 3, standin);
+    if (i < 0)
+        return -1;
+    mat_pattern(m, "roughness", (size_t)i);
+    return 0;
+}
+
+/* rayes' "roughness" of a material: a constant, or a pattern when pbrt's
+ * roughness, uroughness or vroughness (after prefix) is a texture that
+ * varies. */
+static int mat_roughness(Parser *P, const Token *t, ParamList *pl, Material *m, double def,
+                         const char *prefix)
+{
+    RoughNames n = rough_names(prefix);
+    const char *names[3] = {n.r, n.u, n.v};
+    for (int k = 0; k < 3; k++) {
+        Param *p = pbrt_find(pl, names[k]);
+        const Texture *tx =
+            p && p->type == PT_TEXTURE && p->n_str > 0 ? pbrt_find_texture(P, p->str[0]) : NULL;
+        if (tx && tx->pattern[0])
+            return textured_roughness(P, t, pl, &n, m);
+    }
+    double r;
+    if (get_roughness(P, pl, &n, def, &r) != 0)
+        return -1;
+    mat_float(m, "roughness", (float)r);
+    return 0;
+}
+
+/* pbrt's "displacement" (a float or a float texture): the displacement
+ * shader of the material's shapes. */
+static int mat_displacement(Parser *P, ParamList *pl, Material *m)
+{
+    static const float zero[3] = {0, 0, 0};
+    float c[3];
+    const Texture *tex = NULL;
+    int k = pbrt_get_color(P, pl, "displacement", zero, c, &tex);
+    if (k < 0)
+        return -1;
+    if (k == 2) {
+        m->displaced = 2;
+        m->displacement_tex = (size_t)(tex - P->textures);
+    } else if (k == 1 && c[0] != 0.0f) {
+        m->displaced = 1;
+        m->displacement_v = c[0];
+    }
+    return 0;
 }
 
 static int diffuse_material(Parser *P, ParamList *pl, Material *m, const char *param)
 {
     static const float half[3] = {0.5f, 0.5f, 0.5f};
-    float c[3];
-    const Texture *tex = NULL;
-    int k = pbrt_get_color(P, pl, param, half, c, &tex);
-    if (k < 0)
-        return -1;
-    if (k == 2) { /* Cs T Kd (diffuse light), T the image */
-        pbrt_mat_init(m, "paintedplastic");
-        mat_float(m, "Kd", 1.0f);
-        mat_float(m, "Ks", 0.0f);
-        pbrt_mat_color(m, "Cs", c);
-        mat_texture(m, tex->path);
-        return 0;
-    }
     pbrt_mat_init(m, "diffuse");
-    pbrt_mat_color(m, "reflectance", c);
-    return 0;
+    return mat_textured(P, pl, m, param, "reflectance", RAYES_PARAM_COLOR, half);
 }
-
-static int make_material(Parser *P, const Token *t, const char *type, ParamList *pl, Material *m);
 
 static const Material *named_material(Parser *P, const char *name)
 {
@@ -109,98 +501,122 @@ static const Material *named_material(Parser *P, const char *name)
     return NULL;
 }
 
+/* The reflectance of a diffuse material as a pattern input named name. */
+static RayesParam reflectance_input(const Parser *P, const Material *m, const char *name)
+{
+    for (int i = 0; i < m->n; i++)
+        if (strcmp(m->p[i].name, "reflectance") == 0 && m->p[i].type == RAYES_PARAM_PATTERN)
+            return (RayesParam){.name = name,
+                                .type = RAYES_PARAM_PATTERN,
+                                .string = P->textures[m->p[i].tex].pattern};
+    const float *c = mat_get(m, "reflectance");
+    return (RayesParam){.name = name, .type = RAYES_PARAM_COLOR, .value = {c[0], c[1], c[2]}};
+}
+
+/* pbrt's mix of two materials: two diffuse ones are one diffuse material
+ * whose reflectance is their mix (a "mix" pattern when either reflectance
+ * or the amount is a texture); others take the heavier one. */
 static int mix_material(Parser *P, const Token *t, ParamList *pl, Material *m)
 {
+    static const float half[3] = {0.5f, 0.5f, 0.5f};
     Param *names = pbrt_find(pl, "materials");
     if (!names || names->n_str != 2)
         return FAIL_TOK(P, t, "mix: expected \"string materials\" with two material names");
-    double amount;
-    if (pbrt_get_float_tex(P, pl, "amount", 0.5, &amount) != 0)
-        return -1;
     const Material *a = named_material(P, names->str[0]), *b = named_material(P, names->str[1]);
     if (!a || !b)
         return FAIL_TOK(P, t, "mix: expected materials defined before, found \"%.60s\"",
                         !a ? names->str[0] : names->str[1]);
-    const float *ca = mat_get(a, "reflectance"), *cb = mat_get(b, "reflectance");
-    if (strcmp(a->shader, "diffuse") == 0 && strcmp(b->shader, "diffuse") == 0 && ca && cb) {
+    RayesParam q[3];
+    float amount[3];
+    if (tex_input(P, pl, "amount", half, &q[2], amount) != 0)
+        return -1;
+    if (strcmp(a->shader, "diffuse") == 0 && strcmp(b->shader, "diffuse") == 0 &&
+        mat_get(a, "reflectance") && mat_get(b, "reflectance")) {
+        q[0] = reflectance_input(P, a, "tex1");
+        q[1] = reflectance_input(P, b, "tex2");
+        pbrt_warn_at(
+            P, t->line, t->col, "mix diffuse",
+            "mix: two diffuse materials become one diffuse material of the blended reflectance");
         float c[3];
-        for (int k = 0; k < 3; k++)
-            c[k] = (float)((1 - amount) * ca[k] + amount * cb[k]);
+        for (int k = 0; k < 3; k++) /* the constant, or the pattern's stand-in */
+            c[k] = (1 - amount[0]) * mat_get(a, "reflectance")[k] +
+                   amount[0] * mat_get(b, "reflectance")[k];
         pbrt_mat_init(m, "diffuse");
-        pbrt_mat_color(m, "reflectance", c);
-        pbrt_warn_at(P, t->line, t->col, "mix diffuse", "mix: two diffuse materials become one "
-                     "diffuse material of the blended reflectance");
+        if (q[0].type != RAYES_PARAM_PATTERN && q[1].type != RAYES_PARAM_PATTERN &&
+            q[2].type != RAYES_PARAM_PATTERN) {
+            pbrt_mat_color(m, "reflectance", c);
+            return 0;
+        }
+        long i = define_pattern(P, t, " mix", 0, "mix", q, 3, c);
+        if (i < 0)
+            return -1;
+        mat_pattern(m, "reflectance", (size_t)i);
         return 0;
     }
-    *m = amount > 0.5 ? *b : *a;
-    pbrt_warn_at(P, t->line, t->col, "mix", "mix: rayes cannot blend these materials; using the "
-                 "heavier one (\"%.60s\")", amount > 0.5 ? names->str[1] : names->str[0]);
+    *m = amount[0] > 0.5f ? *b : *a;
+    pbrt_warn_at(P, t->line, t->col, "mix",
+                 "mix: rayes cannot blend these materials; using the heavier one (\"%.60s\")",
+                 amount[0] > 0.5f ? names->str[1] : names->str[0]);
     return 0;
 }
 
-static int make_material(Parser *P, const Token *t, const char *type, ParamList *pl, Material *m)
+/* coateddiffuse: reflectance, roughness and thickness may be textures. */
+static int coated_material(Parser *P, const Token *t, ParamList *pl, Material *m)
+{
+    static const float half[3] = {0.5f, 0.5f, 0.5f}, thin[3] = {0.01f, 0.01f, 0.01f};
+    pbrt_mat_init(m, "coateddiffuse");
+    if (mat_textured(P, pl, m, "reflectance", "reflectance", RAYES_PARAM_COLOR, half) != 0 ||
+        mat_roughness(P, t, pl, m, 0.0, "") != 0 ||
+        mat_textured(P, pl, m, "thickness", "thickness", RAYES_PARAM_FLOAT, thin) != 0)
+        return -1;
+    mat_float(m, "eta", (float)pbrt_get_float(pl, "eta", 1.5));
+    return 0;
+}
+
+/* conductor (and coatedconductor's conductor): reflectance if given, else
+ * eta and k (copper by default, as pbrt); each and the roughness may be
+ * textures. */
+static int conductor_material(Parser *P, const Token *t, const char *type, ParamList *pl,
+                              Material *m)
 {
     static const float cu_eta[3] = {0.200f, 0.924f, 1.102f}, cu_k[3] = {3.912f, 2.452f, 2.142f};
-    static const float half[3] = {0.5f, 0.5f, 0.5f};
-    float c[3];
-    int k;
-    if (pbrt_find(pl, "displacement"))
-        pbrt_warn_at(P, t->line, t->col, "displacement", "material \"%s\": \"displacement\" is not "
-                     "supported (no displacement)", type);
+    int coated = strcmp(type, "coatedconductor") == 0;
+    if (coated)
+        pbrt_warn_at(P, t->line, t->col, "coatedconductor",
+                     "coatedconductor: mapped to conductor (the coating is left out)");
+    pbrt_mat_init(m, "conductor");
+    const char *eta_name = coated ? "conductor.eta" : "eta", *k_name = coated ? "conductor.k" : "k";
+    int r = pbrt_find(pl, "reflectance")
+                ? mat_textured(P, pl, m, "reflectance", "reflectance", RAYES_PARAM_COLOR, cu_eta)
+                : mat_textured(P, pl, m, eta_name, "eta", RAYES_PARAM_COLOR, cu_eta) ||
+                      mat_textured(P, pl, m, k_name, "k", RAYES_PARAM_COLOR, cu_k);
+    if (r != 0 || mat_roughness(P, t, pl, m, 0.0, coated ? "conductor." : "") != 0)
+        return -1;
+    return 0;
+}
+
+static int material_of_type(Parser *P, const Token *t, const char *type, ParamList *pl, Material *m)
+{
     if (pbrt_find(pl, "normalmap"))
         pbrt_warn_at(P, t->line, t->col, "normalmap",
                      "material \"%s\": \"normalmap\" is not supported", type);
     if (strcmp(type, "diffuse") == 0)
         return diffuse_material(P, pl, m, "reflectance");
-    if (strcmp(type, "coateddiffuse") == 0) {
-        const Texture *tex = NULL;
-        if ((k = pbrt_get_color(P, pl, "reflectance", half, c, &tex)) < 0)
-            return -1;
-        if (k == 2)
-            pbrt_warn_at(P, t->line, t->col, "coateddiffuse texture", "coateddiffuse: an image "
-                         "texture as reflectance is not supported; using its scale as a colour");
-        double eta = pbrt_get_float(pl, "eta", 1.5);
-        pbrt_mat_init(m, "coateddiffuse");
-        pbrt_mat_color(m, "reflectance", c);
-        mat_float(m, "roughness", (float)get_roughness(pl, 0.0));
-        mat_float(m, "eta", (float)eta);
-        mat_float(m, "thickness", (float)pbrt_get_float(pl, "thickness", 0.01));
-        return 0;
-    }
-    if (strcmp(type, "conductor") == 0 || strcmp(type, "coatedconductor") == 0) {
-        if (strcmp(type, "coatedconductor") == 0)
-            pbrt_warn_at(P, t->line, t->col, "coatedconductor",
-                         "coatedconductor: mapped to conductor (the coating is left out)");
-        pbrt_mat_init(m, "conductor");
-        int coated = strcmp(type, "coatedconductor") == 0;
-        const char *eta_name = coated ? "conductor.eta" : "eta",
-                   *k_name = coated ? "conductor.k" : "k";
-        if ((k = pbrt_get_color(P, pl, "reflectance", half, c, NULL)) < 0)
-            return -1;
-        if (k > 0) {
-            pbrt_mat_color(m, "reflectance", c);
-        } else {
-            float eta[3], kk[3];
-            if (pbrt_get_color(P, pl, eta_name, cu_eta, eta, NULL) < 0 ||
-                pbrt_get_color(P, pl, k_name, cu_k, kk, NULL) < 0)
-                return -1;
-            pbrt_mat_color(m, "eta", eta);
-            pbrt_mat_color(m, "k", kk);
-        }
-        mat_float(m, "roughness", (float)get_roughness(pl, 0.0));
-        return 0;
-    }
+    if (strcmp(type, "coateddiffuse") == 0)
+        return coated_material(P, t, pl, m);
+    if (strcmp(type, "conductor") == 0 || strcmp(type, "coatedconductor") == 0)
+        return conductor_material(P, t, type, pl, m);
     if (strcmp(type, "dielectric") == 0 || strcmp(type, "thindielectric") == 0) {
         if (type[0] == 't')
             pbrt_warn_at(P, t->line, t->col, "thindielectric",
                          "thindielectric: mapped to dielectric");
         static const float d15[3] = {1.5f, 1.5f, 1.5f};
+        float c[3];
         if (pbrt_get_color(P, pl, "eta", d15, c, NULL) < 0)
             return -1;
         pbrt_mat_init(m, "dielectric");
         mat_float(m, "eta", (c[0] + c[1] + c[2]) / 3.0f);
-        mat_float(m, "roughness", (float)get_roughness(pl, 0.0));
-        return 0;
+        return mat_roughness(P, t, pl, m, 0.0, "");
     }
     if (strcmp(type, "mix") == 0)
         return mix_material(P, t, pl, m);
@@ -208,14 +624,14 @@ static int make_material(Parser *P, const Token *t, const char *type, ParamList 
         /* pbrt's "interface" (and "" or "none") marks a shape that only
          * bounds a participating medium: it is not a surface at all. */
         pbrt_warn_at(P, t->line, t->col, "interface",
-                     "material \"interface\": its shapes only bound media, which rayes does "
-                     "not render; they are left out");
+                     "material \"interface\": its shapes only bound media, which rayes does not "
+                     "render; they are left out");
         pbrt_mat_init(m, PBRT_INVISIBLE);
         return 0;
     }
     if (strcmp(type, "diffusetransmission") == 0) {
-        pbrt_warn_at(P, t->line, t->col, "diffusetransmission", "diffusetransmission: mapped to "
-                     "diffuse (no transmission)");
+        pbrt_warn_at(P, t->line, t->col, "diffusetransmission",
+                     "diffusetransmission: mapped to diffuse (no transmission)");
         return diffuse_material(P, pl, m, "reflectance");
     }
     char key[96];
@@ -223,8 +639,16 @@ static int make_material(Parser *P, const Token *t, const char *type, ParamList 
     pbrt_warn_at(P, t->line, t->col, key, "material \"%.40s\" is not supported; using matte", type);
     pbrt_mat_init(m, "matte");
     for (size_t i = 0; i < pl->n; i++)
-        pl->p[i].used = 1; /* one warning for the material, not one per parameter */
+        if (strcmp(pl->p[i].name, "displacement") != 0)
+            pl->p[i].used = 1; /* one warning for the material, not one per parameter */
     return 0;
+}
+
+static int make_material(Parser *P, const Token *t, const char *type, ParamList *pl, Material *m)
+{
+    if (material_of_type(P, t, type, pl, m) != 0)
+        return -1;
+    return strcmp(m->shader, PBRT_INVISIBLE) != 0 ? mat_displacement(P, pl, m) : 0;
 }
 
 /* ------------------------------------------------------------ directives */
@@ -286,94 +710,10 @@ int pbrt_d_namedmaterial(Parser *P, const Token *t)
         return -1;
     const Material *m = named_material(P, name);
     if (!m)
-        return FAIL_TOK(P, &w, "NamedMaterial: expected a material defined with "
-                        "MakeNamedMaterial, found \"%.60s\"", name);
+        return FAIL_TOK(
+            P, &w,
+            "NamedMaterial: expected a material defined with MakeNamedMaterial, found \"%.60s\"",
+            name);
     P->gs.material = *m;
     return 0;
-}
-
-int pbrt_d_texture(Parser *P, const Token *t)
-{
-    char name[128], kind[32], cls[64];
-    ParamList pl = {0};
-    int r = pbrt_need_world(P, t, 1);
-    if (!r)
-        r = pbrt_expect_string(P, name, sizeof name, "a texture name", NULL);
-    if (!r)
-        r = pbrt_expect_string(P, kind, sizeof kind, "a texture type (\"spectrum\" or \"float\")",
-                               NULL);
-    if (!r)
-        r = pbrt_name_and_params(P, cls, sizeof cls, "a texture class", &pl, NULL);
-    if (r) {
-        pbrt_params_free(&pl);
-        return -1;
-    }
-    Texture tex;
-    memset(&tex, 0, sizeof tex);
-    snprintf(tex.name, sizeof tex.name, "%s", name);
-    static const float one[3] = {1, 1, 1}, zero[3] = {0, 0, 0};
-    if (strcmp(cls, "imagemap") == 0) {
-        const char *file = pbrt_get_string(&pl, "filename", NULL);
-        if (!file)
-            r = FAIL_TOK(P, t, "imagemap: expected \"string filename\"");
-        if (!r)
-            r = pbrt_resolve(P, t, file, tex.path, sizeof tex.path);
-        double scale = pbrt_get_float(&pl, "scale", 1.0);
-        tex.rgb[0] = tex.rgb[1] = tex.rgb[2] = (float)scale;
-        tex.image = 1;
-        static const char *quiet[] = {"filter", "maxanisotropy", "wrap", "encoding", "invert",
-                                      "uscale", "vscale", "udelta", "vdelta", "mapping"};
-        for (size_t i = 0; i < sizeof quiet / sizeof quiet[0]; i++)
-            if (pbrt_find(&pl, quiet[i]) && i >= 4)
-                pbrt_warn_at(P, t->line, t->col, "imagemap mapping", "imagemap: mapping and "
-                             "encoding parameters are not supported; the image is used as it is");
-    } else if (strcmp(cls, "checkerboard") == 0) {
-        float a[3], b[3];
-        if (pbrt_get_color(P, &pl, "tex1", one, a, NULL) < 0 ||
-            pbrt_get_color(P, &pl, "tex2", zero, b, NULL) < 0)
-            r = -1;
-        for (int c = 0; c < 3; c++)
-            tex.rgb[c] = 0.5f * (a[c] + b[c]);
-        pbrt_warn_at(P, t->line, t->col, "checkerboard",
-                     "checkerboard: rayes has no built-in pattern shader for it; using the average "
-                     "of tex1 and tex2");
-        for (size_t i = 0; i < pl.n; i++)
-            pl.p[i].used = 1;
-    } else if (strcmp(cls, "constant") == 0) {
-        r = pbrt_get_color(P, &pl, "value", one, tex.rgb, NULL) < 0;
-    } else if (strcmp(cls, "scale") == 0) {
-        float a[3], b[3];
-        const Texture *img = NULL;
-        int k = pbrt_get_color(P, &pl, "tex", one, a, &img);
-        if (k < 0 || pbrt_get_color(P, &pl, "scale", one, b, NULL) < 0)
-            r = -1;
-        if (!r && k == 2) {
-            tex = *img;
-            snprintf(tex.name, sizeof tex.name, "%s", name);
-        }
-        for (int c = 0; c < 3; c++)
-            tex.rgb[c] = a[c] * b[c];
-    } else {
-        char key[96];
-        snprintf(key, sizeof key, "texture %.60s", cls);
-        pbrt_warn_at(P, t->line, t->col, key,
-                     "Texture \"%.40s\" is not supported; using a constant 0.5", cls);
-        tex.rgb[0] = tex.rgb[1] = tex.rgb[2] = 0.5f;
-        for (size_t i = 0; i < pl.n; i++)
-            pl.p[i].used = 1;
-    }
-    if (!r) {
-        pbrt_warn_unused(P, &pl, "Texture", cls);
-        if ((P->n_textures & (P->n_textures - 1)) == 0) {
-            Texture *n = realloc(P->textures, (P->n_textures ? 2 * P->n_textures : 1) * sizeof *n);
-            if (!n)
-                r = FAIL_TOK(P, t, "out of memory");
-            else
-                P->textures = n;
-        }
-        if (!r)
-            P->textures[P->n_textures++] = tex;
-    }
-    pbrt_params_free(&pl);
-    return r ? -1 : 0;
 }

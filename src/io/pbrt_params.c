@@ -346,7 +346,7 @@ static int spd_rgb(Parser *P, const Param *p, const char *file, float out[3])
     return 0;
 }
 
-static const Texture *find_texture(Parser *P, const char *name)
+const Texture *pbrt_find_texture(const Parser *P, const char *name)
 {
     for (size_t i = P->n_textures; i-- > 0;)
         if (strcmp(P->textures[i].name, name) == 0)
@@ -356,7 +356,8 @@ static const Texture *find_texture(Parser *P, const char *name)
 
 /* A colour parameter: rgb, spectrum (named, sampled or constant), blackbody,
  * float (grey) or texture. Returns 0 (not given: out = def), 1 (a colour
- * in out), 2 (an image texture in *tex, out = its scale) or -1 (error). */
+ * in out; a constant texture's, or any texture's stand-in when tex is
+ * NULL), 2 (a pattern texture in *tex, out = its stand-in) or -1 (error). */
 int pbrt_get_color(Parser *P, ParamList *pl, const char *name, const float def[3], float out[3],
                    const Texture **tex)
 {
@@ -403,13 +404,13 @@ int pbrt_get_color(Parser *P, ParamList *pl, const char *name, const float def[3
         sampled_rgb(p->num, p->n_num / 2, out);
         return 1;
     case PT_TEXTURE: {
-        const Texture *t = p->n_str > 0 ? find_texture(P, p->str[0]) : NULL;
+        const Texture *t = p->n_str > 0 ? pbrt_find_texture(P, p->str[0]) : NULL;
         if (!t)
             return pbrt_fail_at(P, p->line, p->col,
                                 "expected the name of a texture defined before, found \"%.60s\"",
                                 p->n_str > 0 ? p->str[0] : "");
         memcpy(out, t->rgb, sizeof t->rgb);
-        if (t->image && tex) {
+        if (t->pattern[0] && tex) {
             *tex = t;
             return 2;
         }
@@ -423,7 +424,7 @@ int pbrt_get_color(Parser *P, ParamList *pl, const char *name, const float def[3
     }
 }
 
-/* A float parameter that may be a texture (the texture's grey value then). */
+/* A float parameter that may be a texture (its stand-in's mean grey then). */
 int pbrt_get_float_tex(Parser *P, ParamList *pl, const char *name, double def, double *out)
 {
     Param *p = pbrt_find(pl, name);
@@ -438,12 +439,6 @@ int pbrt_get_float_tex(Parser *P, ParamList *pl, const char *name, double def, d
     p->used = 0;
     if (pbrt_get_color(P, pl, name, d, c, NULL) < 0)
         return -1;
-    if (p->type == PT_TEXTURE) {
-        char key[96];
-        snprintf(key, sizeof key, "float texture %.60s", name);
-        pbrt_warn_at(P, p->line, p->col, key, "\"%s\": float textures are not supported; using a "
-                     "constant", name);
-    }
     *out = (c[0] + c[1] + c[2]) / 3.0;
     return 0;
 }

@@ -603,6 +603,12 @@ static RayesError null_points(void *t, RayesPointShape s, size_t np, const float
     (void)t, (void)s, (void)np, (void)P, (void)pv, (void)n;
     return RAYES_OK;
 }
+static RayesError null_pattern(void *t, const char *name, const char *type, const RayesParam *p,
+                               size_t n)
+{
+    (void)t, (void)name, (void)type, (void)p, (void)n;
+    return RAYES_OK;
+}
 static size_t null_count(void *t) { (void)t; return 0; }
 static const char *null_error(void *t) { (void)t; return ""; }
 
@@ -610,7 +616,7 @@ static const IoSink null_sink = {
     NULL,       null_camera,  null_camera_matrix, null_matrix, null_named, null_named,
     null_float, null_path,    null_float,         null_p4,     null_p16,   null_mesh,
     null_float, null_quadric, null_area,          null_named,  null_links, null_count,
-    null_error, NULL,         null_subdiv,        null_curves, null_points};
+    null_error, NULL,         null_subdiv,        null_curves, null_points, null_pattern};
 
 static void rib_init(Rib *r, int pass, const IoSink *sink, const IoReadOptions *opt,
                      IoSettings *settings, char *err, size_t err_size)

@@ -213,6 +213,14 @@ static int parse_decl(const char *s, Decl *d, int want_name)
     int k = 0, have_type = 0;
     d->cls = CLS_UNIFORM;
     d->array = 1;
+    d->reference = 0;
+    if (strcmp(words[0], "reference") == 0 && n > 1) {
+        /* RenderMan's connection to a Pattern: rayes' "reference pattern
+         * NAME" (or any type there), whose value is the pattern's name */
+        d->reference = 1;
+        d->ty = TY_STRING;
+        return want_name && n == 3 ? (snprintf(d->name, sizeof d->name, "%s", words[2]), 0) : -1;
+    }
     for (int c = 0; c < 6; c++)
         if (strcmp(words[k], classes[c]) == 0) {
             d->cls = c == 5 ? CLS_FACEVARYING : (Cls)c;

@@ -76,6 +76,7 @@ typedef struct Decl {
     Cls cls;
     Ty ty;
     int array; /* elements per value, >= 1 */
+    int reference; /* "reference TYPE name": the value names a pattern (a string) */
 } Decl;
 
 typedef struct Param {
@@ -88,6 +89,7 @@ typedef struct Param {
 
 typedef struct ShaderRec {
     char name[64];
+    char pattern[160];  /* a Pattern's name once the sink has it, else "" */
     RayesParam *params; /* names and strings owned */
     size_t n;
     struct ShaderRec *next;
@@ -134,6 +136,8 @@ typedef struct Light {
     RayesParam params[RIB_LIGHT_PARAMS];
     char names[RIB_LIGHT_PARAMS][64];
     char category[128];
+    char mapname[1024]; /* an environment light's map, as given */
+    char mapping[32];   /* and its layout ("latlong", "octahedral") */
     size_t n;
     float M[16];   /* world_from_light (camera_from_light before WorldBegin) */
     int pre_world;
@@ -202,6 +206,7 @@ typedef struct Rib {
     SinkState real, recorded;
 
     char archive_path[4096];
+    char texture_path[4096];   /* the texture search path as the sink has it ("&" expanded) */
     char *coordsys_names;      /* CoordinateSystem: n x 64 names */
     float *coordsys_M;
     int *coordsys_world;

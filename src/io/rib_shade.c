@@ -21,6 +21,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 #include "io/rib_reader.h"
 
@@ -62,6 +63,14 @@ static void set_light_on(Attr *a, size_t k, int on)
     a->on[k / 8] = (unsigned char)(on ? a->on[k / 8] | bit : a->on[k / 8] & ~bit);
 }
 
+/* Where a light keeps the string parameter of that name. */
+static char *light_string(Light *L, const char *name)
+{
+    return strcmp(name, "mapname") == 0   ? L->mapname
+           : strcmp(name, "mapping") == 0 ? L->mapping
+                                          : L->category;
+}
+
 static int send_light(Rib *r, Light *L)
 {
     const IoSink *s = r->sink;
@@ -69,7 +78,7 @@ static int send_light(Rib *r, Light *L)
     for (size_t i = 0; i < L->n; i++) { /* the array may have moved since */
         L->params[i].name = L->names[i];
         if (L->params[i].type == RAYES_PARAM_STRING)
-            L->params[i].string = L->category;
+            L->params[i].string = light_string(L, L->names[i]);
     }
     if (s->set_transform(s->target, L->M) != RAYES_OK ||
         s->light(s->target, L->type, L->params, L->n) != RAYES_OK)
@@ -173,7 +182,11 @@ static const char *const builtin_surfaces[] = {"matte", "plastic", "metal", "shi
                                                "constant", "glass", "mirror", "paintedplastic",
                                                "diffuse", "conductor", "dielectric",
                                                "coateddiffuse", NULL};
-static const char *const builtin_displacements[] = {"bumpy", "fractal", NULL};
+static const char *const builtin_displacements[] = {"bumpy", "fractal", "displace", NULL};
+/* rayes' pattern classes (rayes_scene_pattern): pbrt-v4's textures. */
+static const char *const builtin_patterns[] = {
+    "constant", "scale", "mix",      "directionmix", "checkerboard", "imagemap", "bilerp",
+    "dots",     "fbm",   "wrinkled", "windy",        "marble",       NULL};
 
 static int in_list(const char *const *list, const char *s)
 {
@@ -184,6 +197,15 @@ static int in_list(const char *const *list, const char *s)
 }
 
 /* A new shader record of name with the parameters the API can take. */
+/* Whether a Pattern of that name reached the sink. */
+static int pattern_sent(const Rib *r, const char *name)
+{
+    for (const ShaderRec *s = r->shaders; s; s = s->next)
+        if (s->pattern[0] && strcmp(s->pattern, name) == 0)
+            return 1;
+    return 0;
+}
+
 static ShaderRec *make_shader(Rib *r, const char *name, const Param *p, size_t n, int only_k)
 {
     ShaderRec *sh = calloc(1, sizeof *sh);
@@ -204,8 +226,17 @@ static ShaderRec *make_shader(Rib *r, const char *name, const Param *p, size_t n
         if (!q->declared)
             continue;
         RayesParam o = {NULL, RAYES_PARAM_NONE, {0, 0, 0}, NULL};
+        if (q->d.reference && q->v->n == 1 && !pattern_sent(r, q->v->s[0])) {
+            char key[128];
+            snprintf(key, sizeof key, "reference %.100s", q->v->s[0]);
+            rib_warn_once(r, key,
+                          "\"%s\" of \"%s\" names the pattern \"%.100s\", which is "
+                          "not defined or of a class rayes has not; its default is used",
+                          q->d.name, name, q->v->s[0]);
+            continue;
+        }
         if (q->d.ty == TY_STRING && q->v->n == 1) {
-            o.type = RAYES_PARAM_STRING;
+            o.type = q->d.reference ? RAYES_PARAM_PATTERN : RAYES_PARAM_STRING;
             o.string = rib_strdup(q->v->s[0]);
             if (!o.string)
                 return NULL;
@@ -308,9 +339,51 @@ static int h_displacement(Rib *r, const Args *a)
 
 /* Light shaders of other renderers that are an environment (dome) light,
  * usually with occlusion: rayes' environmentlight stands in for them. */
-static const char *const environment_lights[] = {"envlight", "envlight2", "occlusionlight",
-                                                 "environmentlight", "domelight", "skylight",
-                                                 "ambientocclusion", NULL};
+static const char *const environment_lights[] = {"envlight",     "envlight2", "occlusionlight",
+                                                 "domelight",    "skylight",  "ambientocclusion",
+                                                 "PxrDomeLight", NULL};
+
+/* The names their environment map goes by: rayes' mapname (and mapping),
+ * then those of production light shaders and RenderMan's PxrDomeLight. */
+static const char *const environment_maps[] = {"mapname",        "envmap",      "envname",
+                                               "environmentmap", "texturename", "lightColorMap",
+                                               "filename",       NULL};
+
+/* An environment light's string parameter q as rayes' mapname or mapping
+ * into L; 0 if q is neither. */
+static int environment_map(Light *L, const Param *q, RayesParam *o, char *name, size_t size)
+{
+    int map = in_list(environment_maps, q->d.name);
+    if ((!map && strcmp(q->d.name, "mapping") != 0) || q->d.ty != TY_STRING || q->v->n != 1)
+        return 0;
+    snprintf(name, size, "%s", map ? "mapname" : "mapping");
+    char *dst = light_string(L, name);
+    snprintf(dst, map ? sizeof L->mapname : sizeof L->mapping, "%s", q->v->s[0]);
+    *o = (RayesParam){.name = name, .type = RAYES_PARAM_STRING, .string = dst};
+    return 1;
+}
+
+/* Whether a texture name is a readable file as given or on the texture
+ * search path (the file's, then $RAYES_TEXTURE_PATH), as the scene will
+ * look for it. */
+static int texture_found(const Rib *r, const char *name)
+{
+    if (access(name, R_OK) == 0)
+        return 1;
+    const char *env = getenv("RAYES_TEXTURE_PATH");
+    const char *paths[2] = {r->texture_path, env ? env : ""};
+    char path[4096];
+    for (int k = 0; k < 2 && name[0] != '/'; k++)
+        for (const char *d = paths[k]; *d;) {
+            size_t len = strcspn(d, ":");
+            if (len > 0 &&
+                (size_t)snprintf(path, sizeof path, "%.*s/%s", (int)len, d, name) < sizeof path &&
+                access(path, R_OK) == 0)
+                return 1;
+            d += len + (d[len] == ':');
+        }
+    return 0;
+}
 
 static Light *find_light(Rib *r, const char *handle)
 {
@@ -352,16 +425,19 @@ static int h_light_source(Rib *r, const Args *a)
         type = "spotlight", spot = 1;
     else if (strcmp(name, "ambientlight") == 0)
         type = "ambientlight";
+    else if (strcmp(name, "environmentlight") == 0)
+        type = "environmentlight";
     else if (in_list(environment_lights, name)) {
-        /* Production environment and occlusion lights: a constant
-         * environment light, whose shadow rays give the occlusion. */
+        /* Production environment and occlusion lights: an environment
+         * light (of their map, if given), whose shadow rays give the
+         * occlusion. */
         type = "environmentlight";
         char key[128];
         snprintf(key, sizeof key, "light %s", name);
         rib_warn_once(r, key,
-                      "light shader \"%s\" is not built in: an environmentlight of its intensity "
-                      "and lightcolor instead (ambient occlusion from its shadow rays; maps and "
-                      "other parameters are not read)",
+                      "light shader \"%s\" is not built in: an environmentlight of its intensity, "
+                      "lightcolor and map instead (ambient occlusion from its shadow rays; sample "
+                      "counts and other parameters are not read)",
                       name);
     }
     if (r->rec) {
@@ -407,9 +483,24 @@ static int h_light_source(Rib *r, const Args *a)
     int env = strcmp(type, "environmentlight") == 0;
     for (size_t k = 0; k < n && L->n < RIB_LIGHT_PARAMS; k++) {
         const Param *q = &p[k];
+        if (env && environment_map(L, q, &L->params[L->n], L->names[L->n], sizeof L->names[0])) {
+            /* a production light's map that is not there (a renderer's own
+             * format elsewhere): the constant environment, as before */
+            if (strcmp(name, "environmentlight") != 0 && L->mapname[0] &&
+                strcmp(L->names[L->n], "mapname") == 0 && !texture_found(r, L->mapname)) {
+                rib_warn_once(r, "light map",
+                              "light shader \"%s\": map \"%.200s\" is not found "
+                              "as given nor on the texture search path; a constant environment",
+                              name, L->mapname);
+                L->mapname[0] = '\0';
+                continue;
+            }
+            L->n++;
+            continue;
+        }
         if (env && strcmp(q->d.name, "intensity") != 0 && strcmp(q->d.name, "lightcolor") != 0 &&
             strcmp(q->d.name, "__category") != 0)
-            continue; /* an environment light has no position, cone or map here */
+            continue; /* an environment light has no position or cone */
         if (!in_list(names, q->d.name) || !q->declared)
             continue;
         RayesParam *o = &L->params[L->n];
@@ -510,11 +601,50 @@ int rib_flush_lights(Rib *r)
     return 0;
 }
 
+/* Pattern "type" "name" params: rayes' patterns (pbrt-v4's texture
+ * classes, rayes_scene_pattern) in the current transform, sent at once,
+ * so that shaders sent later may take them ("reference pattern NAME"). */
+static int h_pattern(Rib *r, const Args *a)
+{
+    size_t i = 0;
+    const char *type = rib_get_string(r, a, &i, "a pattern class");
+    const char *name = type ? rib_get_string(r, a, &i, "a pattern name") : NULL;
+    Param *p;
+    size_t n;
+    if (!name || rib_get_params(r, a, i, &p, &n) != 0)
+        return -1;
+    const IoSink *s = r->sink;
+    if (!in_list(builtin_patterns, type) || !s->pattern) {
+        char key[128];
+        snprintf(key, sizeof key, "pattern %.100s", type);
+        rib_warn_once(r, key,
+                      "Pattern \"%s\" is not a class rayes has (RenderMan's Pxr "
+                      "patterns are not built); ignored, and parameters that reference it keep "
+                      "their defaults",
+                      type);
+        free(p);
+        return 0;
+    }
+    ShaderRec *sh = make_shader(r, type, p, n, 0);
+    free(p);
+    if (!sh)
+        return -1;
+    if (s->set_transform(s->target, r->a.M) != RAYES_OK ||
+        s->pattern(s->target, name, type, sh->params, sh->n) != RAYES_OK)
+        return rib_sink_failed(r, s);
+    snprintf(sh->pattern, sizeof sh->pattern, "%s", name);
+    r->real.have_M = 0;
+    return 0;
+}
 
 /* ------------------------------------------------------------ requests */
 
 const RibRequest rib_shade_requests[] = {
-    {"Surface", h_surface}, {"Displacement", h_displacement}, {"LightSource", h_light_source},
-    {"AreaLightSource", h_area_light}, {"Illuminate", h_illuminate},
+    {"Surface", h_surface},
+    {"Displacement", h_displacement},
+    {"LightSource", h_light_source},
+    {"AreaLightSource", h_area_light},
+    {"Illuminate", h_illuminate},
+    {"Pattern", h_pattern},
     {NULL, NULL},
 };

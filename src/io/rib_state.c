@@ -475,24 +475,37 @@ static int h_color(Rib *r, const Args *a)
 
 /* -------------------------------------------------- attributes, options */
 
+/* A search path with "&" (the previous value, prev) expanded and "@" (the
+ * default, none) dropped, into path_out (4096 bytes, truncated at an
+ * entry). */
+static void expand_search_path(const char *prev, const char *path, char *out)
+{
+    char buf[4096];
+    out[0] = '\0';
+    snprintf(buf, sizeof buf, "%s", path);
+    for (char *save = NULL, *e = strtok_r(buf, ":", &save); e; e = strtok_r(NULL, ":", &save)) {
+        const char *add = strcmp(e, "&") == 0 ? prev : strcmp(e, "@") == 0 ? "" : e;
+        if (!add[0])
+            continue;
+        size_t len = strlen(out), k = strlen(add);
+        if (len + k + 2 > 4096)
+            break;
+        if (len)
+            out[len++] = ':';
+        memcpy(out + len, add, k + 1);
+    }
+}
+
 static int search_path(Rib *r, const char *kind, const char *path)
 {
+    char out[4096];
     if (strcmp(kind, "archive") == 0 || strcmp(kind, "resource") == 0) {
-        char out[4096] = "";
-        char buf[4096];
-        snprintf(buf, sizeof buf, "%s", path);
-        for (char *save = NULL, *e = strtok_r(buf, ":", &save); e; e = strtok_r(NULL, ":", &save)) {
-            const char *add = strcmp(e, "&") == 0 ? r->archive_path : strcmp(e, "@") == 0 ? "" : e;
-            if (!add[0])
-                continue;
-            size_t len = strlen(out), k = strlen(add);
-            if (len + k + 2 > sizeof out)
-                break;
-            if (len)
-                out[len++] = ':';
-            memcpy(out + len, add, k + 1);
-        }
+        expand_search_path(r->archive_path, path, out);
         snprintf(r->archive_path, sizeof r->archive_path, "%s", out);
+    }
+    if (strcmp(kind, "texture") == 0 || strcmp(kind, "resource") == 0) {
+        expand_search_path(r->texture_path, path, out);
+        snprintf(r->texture_path, sizeof r->texture_path, "%s", out);
     }
     if (strcmp(kind, "shader") == 0 || strcmp(kind, "texture") == 0 ||
         strcmp(kind, "resource") == 0) {

@@ -157,7 +157,11 @@ static RayesError params(RibWriter *w, FILE *f, const RayesParam *p, size_t n, i
             break;
         }
         case RAYES_PARAM_STRING:
-            fprintf(f, " \"string %s\" [", p[i].name);
+        case RAYES_PARAM_PATTERN: /* rayes' RIB: "reference pattern NAME" [pattern] */
+            fprintf(f,
+                    p[i].type == RAYES_PARAM_STRING ? " \"string %s\" ["
+                                                    : " \"reference pattern %s\" [",
+                    p[i].name);
             string(f, p[i].string ? p[i].string : "");
             fputc(']', f);
             break;
@@ -167,6 +171,20 @@ static RayesError params(RibWriter *w, FILE *f, const RayesParam *p, size_t n, i
         }
     }
     return RAYES_OK;
+}
+
+/* The typed inline parameters as text (params), into a new *text (free()
+ * it; NULL when there are none). */
+static RayesError params_text(RibWriter *w, const RayesParam *p, size_t n, int light, char **text)
+{
+    size_t size = 0;
+    *text = NULL;
+    FILE *m = open_memstream(text, &size);
+    if (!m)
+        return fail(w, RAYES_ERROR_OUT_OF_MEMORY, "out of memory");
+    RayesError e = params(w, m, p, n, light);
+    fclose(m);
+    return e;
 }
 
 /* ------------------------------------------------------------ camera */
@@ -309,12 +327,7 @@ static RayesError w_set_shader(void *t, const char *name, const RayesParam *p, s
         rest[n_rest++] = p[i];
     }
     char *text = NULL;
-    size_t size = 0;
-    FILE *m = open_memstream(&text, &size);
-    if (!m)
-        return fail(w, RAYES_ERROR_OUT_OF_MEMORY, "out of memory");
-    RayesError e = params(w, m, rest, n_rest, 0);
-    fclose(m);
+    RayesError e = params_text(w, rest, n_rest, 0, &text);
     if (e == RAYES_OK) {
         fprintf(f, "Color ");
         floats(f, cs, 3);
@@ -342,16 +355,32 @@ static RayesError w_set_displacement(void *t, const char *name, const RayesParam
         return RAYES_OK;
     }
     char *text = NULL;
-    size_t size = 0;
-    FILE *m = open_memstream(&text, &size);
-    if (!m)
-        return fail(w, RAYES_ERROR_OUT_OF_MEMORY, "out of memory");
-    RayesError e = params(w, m, p, n, 0);
-    fclose(m);
+    RayesError e = params_text(w, p, n, 0, &text);
     if (e == RAYES_OK) {
         fprintf(f, "Displacement ");
         string(f, name);
         fprintf(f, "%s\n", text ? text : "");
+    }
+    free(text);
+    return e;
+}
+
+/* Pattern "type" "name" params (RenderMan's Pattern request, rayes'
+ * classes), in the current transform. */
+static RayesError w_pattern(void *t, const char *name, const char *type, const RayesParam *p,
+                            size_t n)
+{
+    RibWriter *w = t;
+    if (!name || !name[0] || !type || !type[0])
+        return fail(w, RAYES_ERROR_INVALID_ARGUMENT, "pattern: no name or type");
+    char *text = NULL;
+    RayesError e = params_text(w, p, n, 0, &text);
+    if (e == RAYES_OK) {
+        fprintf(w->world.f, "Pattern ");
+        string(w->world.f, type);
+        fputc(' ', w->world.f);
+        string(w->world.f, name);
+        fprintf(w->world.f, "%s\n", text ? text : "");
     }
     free(text);
     return e;
@@ -838,12 +867,7 @@ static RayesError w_light(void *t, const char *type, const RayesParam *p, size_t
     if (!type || !type[0])
         return fail(w, RAYES_ERROR_INVALID_ARGUMENT, "light: no type");
     char *text = NULL;
-    size_t size = 0;
-    FILE *m = open_memstream(&text, &size);
-    if (!m)
-        return fail(w, RAYES_ERROR_OUT_OF_MEMORY, "out of memory");
-    RayesError e = params(w, m, p, n, 1);
-    fclose(m);
+    RayesError e = params_text(w, p, n, 1, &text);
     if (e == RAYES_OK) {
         fprintf(w->world.f, "LightSource ");
         string(w->world.f, type);
@@ -940,6 +964,7 @@ IoSink io_rib_writer_sink(RibWriter *w)
         .subdivision_mesh = w_subdivision_mesh,
         .curves = w_curves,
         .points = w_points,
+        .pattern = w_pattern,
     };
 }
 

@@ -126,6 +126,12 @@ static const char *scene_get_error(void *t)
     return rayes_scene_get_error(t);
 }
 
+static RayesError scene_pattern(void *t, const char *name, const char *type,
+                                const RayesParam *params, size_t n_params)
+{
+    return rayes_scene_pattern(t, name, type, params, n_params);
+}
+
 static int scene_has_shader(void *t, const char *name)
 {
     return rayes_scene_has_shader(t, name);
@@ -157,6 +163,7 @@ IoSink io_sink_scene(RayesScene *scene)
         .subdivision_mesh = scene_subdivision_mesh,
         .curves = scene_curves,
         .points = scene_points,
+        .pattern = scene_pattern,
     };
 }
 

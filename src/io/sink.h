@@ -76,6 +76,11 @@ typedef struct IoSink {
                          size_t n_pv);
     RayesError (*points)(void *target, RayesPointShape shape, size_t n_points, const float *P,
                          const RayesPrimvar *pv, size_t n_pv);
+    /* rayes_scene_pattern, in the space of the last set_transform (after
+     * subdivision_mesh, so older sinks leave it NULL: readers then use
+     * constants where textures would vary, with one warning). */
+    RayesError (*pattern)(void *target, const char *name, const char *type,
+                          const RayesParam *params, size_t n_params);
 } IoSink;
 
 /* A sink that builds scene through rayes.h (borrowed, not retained). */

@@ -21,6 +21,7 @@
 #include "render/irrgrid.h"
 #include "shade/builtin.h"
 #include "shade/noise.h"
+#include "shade/pattern.h"
 #include "util/check.h"
 #include "util/rng.h"
 #include "util/sampling.h"
@@ -515,6 +516,16 @@ static int svc_texture(const RayesShaderServices *sv, const RayesShadeCtx *ctx, 
     return shade_texture_service(ps->w->set->textures, ctx, name, s, t, ds, dt, rgb, alpha);
 }
 
+static int svc_pattern(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
+                       const RayesPattern *pattern, float (*out)[3])
+{
+    (void)sv;
+    const PathState *ps = ctx->renderer;
+    return pattern_eval(pattern, ps->w->set->textures, ctx,
+                        ps->ds ? ps->ds + ctx->first_point : NULL,
+                        ps->dt ? ps->dt + ctx->first_point : NULL, out);
+}
+
 static int put_floats(float *value, int n, const float *have, int n_have)
 {
     for (int k = 0; k < n && k < n_have; k++)
@@ -572,9 +583,23 @@ static float svc_random(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
 }
 
 static const char *const service_names[] = {
-    "direct_lighting", "ambient", "indirect_diffuse", "indirect_specular", "indirect_refraction",
-    "transmission", "noise", "fbm", "turbulence", "attribute", "option", "texture", "checker",
-    "random", "glossy", "direct_fiber",
+    "direct_lighting",
+    "ambient",
+    "indirect_diffuse",
+    "indirect_specular",
+    "indirect_refraction",
+    "transmission",
+    "noise",
+    "fbm",
+    "turbulence",
+    "attribute",
+    "option",
+    "texture",
+    "checker",
+    "random",
+    "glossy",
+    "pattern",
+    "direct_fiber",
 };
 
 static int svc_supports(const RayesShaderServices *sv, const char *service)
@@ -606,4 +631,5 @@ const RayesShaderServices render_services = {
     .random = svc_random,
     .glossy = svc_glossy,
     .direct_fiber = svc_direct_fiber,
+    .pattern = svc_pattern,
 };

@@ -165,6 +165,8 @@ static int displace_grid(const RayesScene *s, GridSet *gs, Grid *g, float step,
         .Cs = (const float(*)[3])sc->Cs,
         .Os = (const float(*)[3])sc->Os,
         .scratch = inst->cls->scratch_size ? sc->shader_scratch : NULL,
+        .patterns = inst->patterns,
+        .n_patterns = inst->n_patterns,
     };
     RayesShadeOutputs out = {.P = sc->out};
     inst->cls->displacement(sv, &ctx, inst->params, &out);

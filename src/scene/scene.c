@@ -114,6 +114,7 @@ void rayes_scene_release(RayesScene *s)
     free(s->lights);
     for (int k = 0; k < SCENE_SEARCH_PATH_COUNT; k++)
         free(s->search_paths[k]);
+    scene_patterns_free(s);
     free(s);
 }
 
@@ -252,7 +253,12 @@ static RayesError add_object(RayesScene *s, const RayesShaderClass *cls, const R
         free(rest);
         return fail(s, RAYES_ERROR_OUT_OF_MEMORY, "%s", err);
     }
+    RayesError bound = cls ? scene_bind_patterns(s, &o->shader, rest, n_rest) : RAYES_OK;
     free(rest);
+    if (bound != RAYES_OK) {
+        shade_instance_fini(&o->shader);
+        return bound;
+    }
     s->current_object = light >= 0 ? s->current_object : (int64_t)s->n_objects;
     s->n_objects++;
     scene_mark(s, SCENE_CHANGE_GEOMETRY);
@@ -267,7 +273,8 @@ static RayesError check_params(RayesScene *s, const char *what, const char *name
         if (!params[i].name)
             return fail(s, RAYES_ERROR_INVALID_ARGUMENT, "%s \"%s\": a parameter has no name",
                         what, name);
-        if (params[i].type != RAYES_PARAM_STRING && !finite_n(params[i].value, 3))
+        if (params[i].type != RAYES_PARAM_STRING && params[i].type != RAYES_PARAM_PATTERN &&
+            !finite_n(params[i].value, 3))
             return fail(s, RAYES_ERROR_INVALID_ARGUMENT,
                         "%s \"%s\": parameter \"%s\" is not finite", what, name, params[i].name);
     }
@@ -342,9 +349,14 @@ RayesError rayes_scene_set_displacement(RayesScene *s, const char *name, const R
              sizeof *s->displacements) != 0)
         return fail(s, RAYES_ERROR_OUT_OF_MEMORY, "out of memory");
     char err[256];
-    if (shade_instance_init(&s->displacements[s->n_displacements], cls, params, n_params, err,
-                            sizeof err) != 0)
+    ShaderInstance *inst = &s->displacements[s->n_displacements];
+    if (shade_instance_init(inst, cls, params, n_params, err, sizeof err) != 0)
         return fail(s, RAYES_ERROR_OUT_OF_MEMORY, "%s", err);
+    e = scene_bind_patterns(s, inst, params, n_params);
+    if (e != RAYES_OK) {
+        shade_instance_fini(inst);
+        return e;
+    }
     s->current_displacement = (uint32_t)++s->n_displacements;
     return RAYES_OK;
 }
@@ -1260,8 +1272,10 @@ RayesError rayes_scene_light(RayesScene *s, const char *type, const RayesParam *
                         "environmentlight: unknown mapping \"%s\"; expected latlong or octahedral",
                         lp.mapping);
         if (lp.mapname[0]) {
-            char err[400];
-            if (light_env_load(&l, lp.mapname, octahedral, err, sizeof err) != 0)
+            char err[400], path[1024];
+            if (scene_find_texture(s, lp.mapname, path, sizeof path) != 0)
+                return fail(s, RAYES_ERROR_INVALID_ARGUMENT, "environmentlight: map name too long");
+            if (light_env_load(&l, path, octahedral, err, sizeof err) != 0)
                 return fail(s, RAYES_ERROR_IO, "%s", err);
         }
         e = push_light(s, &l, NULL, 0);
@@ -1490,9 +1504,21 @@ RayesError rayes_scene_edit_shader(RayesScene *s, size_t object, const RayesPara
         free(rest);
         return fail(s, RAYES_ERROR_INVALID_ARGUMENT, "edit shader: %s", err);
     }
+    /* the bindings too are edited on a copy, kept only if all succeed */
+    for (size_t i = 0; i < o->shader.n_patterns; i++)
+        if (shade_instance_bind(&trial, o->shader.patterns[i].param, o->shader.patterns[i].pattern,
+                                err, sizeof err) != 0)
+            break;
+    RayesError e = trial.n_patterns == o->shader.n_patterns
+                       ? scene_bind_patterns(s, &trial, rest, n_rest)
+                       : fail(s, RAYES_ERROR_OUT_OF_MEMORY, "out of memory");
     free(rest);
-    free(o->shader.params);
-    o->shader.params = trial.params;
+    if (e != RAYES_OK) {
+        shade_instance_fini(&trial);
+        return e;
+    }
+    shade_instance_fini(&o->shader);
+    o->shader = trial;
     memcpy(o->Cs, Cs, sizeof Cs);
     memcpy(o->Os, Os, sizeof Os);
     scene_mark(s, SCENE_CHANGE_SHADING);

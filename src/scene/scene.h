@@ -30,6 +30,12 @@ typedef struct SceneObject {
     uint32_t links;           /* its light links: RayesScene.links index + 1, or 0: all lights */
 } SceneObject;
 
+/* A named pattern (rayes_scene_pattern, patterns.c). */
+typedef struct ScenePattern {
+    char *name;                   /* owned */
+    struct RayesPattern *pattern; /* owned; lives as long as the scene */
+} ScenePattern;
+
 /* A set of light links (rayes_scene_set_light_links). */
 typedef struct SceneLinks {
     int mode;                 /* RayesLightLinks: ONLY or EXCEPT */
@@ -103,6 +109,8 @@ struct RayesScene {
     uint64_t stamp_geometry;  /* anything else (primitives, objects, lights added) */
     char *search_paths[SCENE_SEARCH_PATH_COUNT]; /* colon-separated, "&" expanded; owned; NULL:
                                                     empty */
+    ScenePattern *patterns; /* in the order made; a name's latest is the one found */
+    size_t n_patterns, cap_patterns;
 };
 
 /* Records an edit: the scene is uncommitted, and the change is stamped
@@ -141,6 +149,19 @@ int scene_displace(const RayesScene *scene, GridSet *gs, size_t first_grid, floa
 /* The scene's search path of that kind: colon-separated directories, ""
  * if never set. Borrowed: valid until the next set_search_path. */
 const char *scene_search_path(const RayesScene *scene, SceneSearchPath kind);
+
+/* Binds the instance's parameters that params gives as RAYES_PARAM_PATTERN
+ * to the scene's patterns of those names (patterns.c). Returns RAYES_OK, or
+ * an error recorded in the scene (no such pattern or parameter). */
+RayesError scene_bind_patterns(RayesScene *scene, ShaderInstance *inst, const RayesParam *params,
+                               size_t n_params);
+/* The file a texture name given to the scene stands for (an environment
+ * map's): as given if readable or absolute, else the first readable one in
+ * the scene's texture search path, then $RAYES_TEXTURE_PATH, else as given
+ * (whose reading then fails with its name). Returns 0, or -1 if too long. */
+int scene_find_texture(const RayesScene *scene, const char *name, char *out, size_t size);
+/* Frees the scene's patterns (when the scene is freed). */
+void scene_patterns_free(RayesScene *scene);
 
 /* Whether light `light` illuminates object `object` (its light links);
  * 1 or 0. */

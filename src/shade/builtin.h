@@ -14,6 +14,7 @@ extern const RayesShaderClass shade_class_constant; /* Ci = Cs */
 extern const RayesShaderClass shade_class_hair;     /* fibres: Ka, Kd, Ks, roughness, specularcolor */
 extern const RayesShaderClass shade_class_bumpy;    /* displacement: Km, frequency, texturename */
 extern const RayesShaderClass shade_class_fractal;  /* displacement: the memo's fractal noise */
+extern const RayesShaderClass shade_class_displace; /* displacement: P + amount N (a pattern) */
 
 /* The services displacement runs with at dicing time: patterns only (the
  * lighting services are NULL; supports() says so). */

@@ -114,35 +114,54 @@ static void mirror_dirs(const RayesShadeCtx *ctx, Rgb *dir)
     }
 }
 
-/* Radiance reflected about the mirror directions: a perfect mirror for
- * exponent 0, else the mean over the Blinn-Phong lobe of that exponent. */
-static void reflection(const RayesShaderServices *sv, const RayesShadeCtx *ctx, float exponent,
-                       Rgb *L)
+/* How many of the points' lobe exponents are 0 (mirrors). */
+static size_t count_mirrors(const RayesShadeCtx *ctx, const float *exponent)
+{
+    size_t n = 0;
+    for (size_t i = 0; i < ctx->n_points; i++)
+        n += !(exponent[i] > 0.0f);
+    return n;
+}
+
+/* Radiance reflected about the mirror directions: a perfect mirror where
+ * exponent[i] is 0, else the mean over the Blinn-Phong lobe of that
+ * exponent. */
+static void reflection(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
+                       const float *exponent, Rgb *L)
 {
     Rgb dir[SHADE_CHUNK];
     float rough[SHADE_CHUNK];
     mirror_dirs(ctx, dir);
     for (size_t i = 0; i < ctx->n_points; i++)
-        rough[i] = exponent > 0.0f ? 1.0f / exponent : 0.0f;
-    sv->indirect_specular(sv, ctx, (const float(*)[3])dir, exponent > 0.0f ? rough : NULL,
-                          exponent > 0.0f ? 0 : 1, L);
+        rough[i] = exponent[i] > 0.0f ? 1.0f / exponent[i] : 0.0f;
+    int mirrors = count_mirrors(ctx, exponent) == ctx->n_points;
+    sv->indirect_specular(sv, ctx, (const float(*)[3])dir, mirrors ? NULL : rough, mirrors ? 1 : 0,
+                          L);
 }
 
-/* Reflection of the physically based shaders: a mirror for exponent 0;
- * else the glossy service's normalised Blinn-Phong lobe, whose lights come
- * by multiple importance sampling (a renderer without it: reflection's
- * lobe, which sees lights only through its rays). */
+/* Reflection of the physically based shaders: a mirror where exponent[i]
+ * is 0; elsewhere the glossy service's normalised Blinn-Phong lobe, whose
+ * lights come by multiple importance sampling (a renderer without it:
+ * reflection's lobe, which sees lights only through its rays). A chunk
+ * mixing both (a textured roughness reaching 0) goes point by point. */
 static void glossy_reflection(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
-                              float exponent, Rgb *L)
+                              const float *exponent, Rgb *L)
 {
-    if (exponent > 0.0f && HAS_SERVICE(sv, glossy)) {
+    size_t mirrors = count_mirrors(ctx, exponent);
+    if (mirrors == ctx->n_points || !HAS_SERVICE(sv, glossy)) {
+        reflection(sv, ctx, exponent, L);
+    } else if (mirrors == 0) {
         float rough[SHADE_CHUNK];
         for (size_t i = 0; i < ctx->n_points; i++)
-            rough[i] = 1.0f / exponent;
+            rough[i] = 1.0f / exponent[i];
         sv->glossy(sv, ctx, rough, 0, L);
-        return;
+    } else {
+        for (size_t i = 0; i < ctx->n_points; i++) {
+            RayesShadeCtx one;
+            shade_ctx_slice(ctx, i, 1, &one);
+            glossy_reflection(sv, &one, &exponent[i], &L[i]);
+        }
     }
-    reflection(sv, ctx, exponent, L);
 }
 
 /* pbrt-v4's roughness (remapped: alpha = sqrt(roughness)) as a Blinn-Phong
@@ -151,6 +170,16 @@ static float exponent_of(float roughness)
 {
     return roughness > 0.0f ? bsdf_blinn_exponent_from_alpha(bsdf_alpha_from_roughness(roughness))
                             : 0.0f;
+}
+
+/* The lobe exponents of the points: the parameter "roughness" (its
+ * constant, or the pattern bound to it) through exponent_of. */
+static void exponents(const RayesShaderServices *sv, const RayesShadeCtx *ctx, float roughness,
+                      float *e)
+{
+    shade_param_float(sv, ctx, "roughness", roughness, e);
+    for (size_t i = 0; i < ctx->n_points; i++)
+        e[i] = exponent_of(e[i]);
 }
 
 /* ------------------------------------------------------------ metal */
@@ -303,7 +332,7 @@ static float max3(const float v[3])
 /* Fresnel-weighted reflection and refraction at a smooth boundary of
  * relative index eta (inside over outside). A ray that hit the back side
  * is leaving: the index is then inverted, and beyond the critical angle
- * all light reflects. reflect_e is the exponent of the reflection lobe
+ * all light reflects. reflect_e[i] is the exponent of the reflection lobe
  * (0: mirror; glossy: the glossy service's lobe, lights included, else
  * reflection's). Writes R[i] = F * reflected and T[i] = (1 - F) * refracted,
  * which the caller weights by wR[i] and wT[i]. Past the branch depth each
@@ -313,7 +342,7 @@ static float max3(const float v[3])
  * the chosen one is divided by its probability, so the expectation is
  * unchanged. */
 static void fresnel_split(const RayesShaderServices *sv, const RayesShadeCtx *ctx, float eta,
-                          float reflect_e, int glossy, const Rgb *wR, const Rgb *wT, Rgb *R,
+                          const float *reflect_e, int glossy, const Rgb *wR, const Rgb *wT, Rgb *R,
                           Rgb *T)
 {
     Rgb dir[SHADE_CHUNK], refr[SHADE_CHUNK];
@@ -345,9 +374,9 @@ static void fresnel_split(const RayesShaderServices *sv, const RayesShadeCtx *ct
             float p = q * (reflect ? a : b) / (a + b);
             Rgb L;
             if (reflect && glossy)
-                glossy_reflection(sv, &one, reflect_e, &L);
+                glossy_reflection(sv, &one, &reflect_e[i], &L);
             else if (reflect)
-                reflection(sv, &one, reflect_e, &L);
+                reflection(sv, &one, &reflect_e[i], &L);
             else if (sv->indirect_refraction)
                 sv->indirect_refraction(sv, &one, (const float(*)[3])&dir[i], &L);
             else
@@ -381,13 +410,15 @@ static void glass_chunk(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
     if (!ctx->I)
         return; /* no view-independent lobe */
     Rgb R[SHADE_CHUNK], T[SHADE_CHUNK], ds[SHADE_CHUNK], wR[SHADE_CHUNK], wT[SHADE_CHUNK];
-    for (size_t i = 0; i < ctx->n_points; i++)
+    float e[SHADE_CHUNK];
+    for (size_t i = 0; i < ctx->n_points; i++) {
         for (int c = 0; c < 3; c++) {
             wR[i][c] = p->specularcolor[c] * p->Kr;
             wT[i][c] = cs(ctx, i, c) * p->transmitcolor[c] * p->Kt;
         }
-    fresnel_split(sv, ctx, p->eta, p->roughness > 0.0f ? 1.0f / p->roughness : 0.0f, 0,
-                  (const Rgb *)wR, (const Rgb *)wT, R, T);
+        e[i] = p->roughness > 0.0f ? 1.0f / p->roughness : 0.0f;
+    }
+    fresnel_split(sv, ctx, p->eta, e, 0, (const Rgb *)wR, (const Rgb *)wT, R, T);
     memset(ds, 0, sizeof ds);
     if (p->Ks != 0.0f) {
         float rough[SHADE_CHUNK];
@@ -440,10 +471,11 @@ static void dielectric_chunk(const RayesShaderServices *sv, const RayesShadeCtx 
     if (!ctx->I)
         return;
     Rgb R[SHADE_CHUNK], T[SHADE_CHUNK], one[SHADE_CHUNK];
+    float e[SHADE_CHUNK];
     for (size_t i = 0; i < ctx->n_points; i++)
         one[i][0] = one[i][1] = one[i][2] = 1.0f;
-    fresnel_split(sv, ctx, p->eta, exponent_of(p->roughness), 1, (const Rgb *)one,
-                  (const Rgb *)one, R, T);
+    exponents(sv, ctx, p->roughness, e);
+    fresnel_split(sv, ctx, p->eta, e, 1, (const Rgb *)one, (const Rgb *)one, R, T);
     for (size_t i = 0; i < ctx->n_points; i++)
         for (int c = 0; c < 3; c++)
             out->Ci[i][c] = R[i][c] + T[i][c];
@@ -481,11 +513,12 @@ static void diffuse_chunk(const RayesShaderServices *sv, const RayesShadeCtx *ct
                           const void *params, RayesShadeOutputs *out)
 {
     const DiffuseParams *p = params;
-    Rgb E[SHADE_CHUNK];
+    Rgb E[SHADE_CHUNK], refl[SHADE_CHUNK];
+    shade_param_color(sv, ctx, "reflectance", p->reflectance, refl);
     diffuse_light(sv, ctx, E, out);
     for (size_t i = 0; i < ctx->n_points; i++)
         for (int c = 0; c < 3; c++)
-            out->Ci[i][c] = cs(ctx, i, c) * p->reflectance[c] * E[i][c];
+            out->Ci[i][c] = cs(ctx, i, c) * refl[i][c] * E[i][c];
 }
 
 static void diffuse_lighting(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
@@ -516,29 +549,37 @@ typedef struct ConductorParams {
     char preset[64];
 } ConductorParams;
 
-/* The complex index: the preset if named (an unknown name: copper), else
- * reflectance if given (all of it >= 0), else eta and k. */
-static void conductor_index(const ConductorParams *p, Vec3 *eta, Vec3 *k)
+/* The complex index of the points: the preset if named (an unknown name:
+ * copper), else reflectance if given (bound to a pattern, or all of it >=
+ * 0), else eta and k (each a constant or a pattern). */
+static void conductor_index(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
+                            const ConductorParams *p, Rgb *eta, Rgb *k)
 {
+    Vec3 e, kk;
     if (p->preset[0]) {
-        if (conductor_preset(p->preset, eta, k) != 0) {
+        if (conductor_preset(p->preset, &e, &kk) != 0) {
             log_warning_once("conductor:preset",
                              "conductor: unknown preset \"%s\" (expected gold, copper, "
                              "aluminium or silver); using copper",
                              p->preset);
-            conductor_preset("copper", eta, k);
+            conductor_preset("copper", &e, &kk);
         }
+        for (size_t i = 0; i < ctx->n_points; i++)
+            v3_store(eta[i], e), v3_store(k[i], kk);
         return;
     }
-    if (p->reflectance[0] >= 0.0f && p->reflectance[1] >= 0.0f && p->reflectance[2] >= 0.0f) {
-        *eta = v3(1, 1, 1);
-        *k = v3(conductor_k_from_reflectance(p->reflectance[0]),
-                conductor_k_from_reflectance(p->reflectance[1]),
-                conductor_k_from_reflectance(p->reflectance[2]));
+    if (shade_param_bound(ctx, "reflectance") ||
+        (p->reflectance[0] >= 0.0f && p->reflectance[1] >= 0.0f && p->reflectance[2] >= 0.0f)) {
+        shade_param_color(sv, ctx, "reflectance", p->reflectance, k);
+        for (size_t i = 0; i < ctx->n_points; i++)
+            for (int c = 0; c < 3; c++) {
+                eta[i][c] = 1.0f;
+                k[i][c] = conductor_k_from_reflectance(fminf(fmaxf(k[i][c], 0.0f), 0.9999f));
+            }
         return;
     }
-    *eta = v3_load(p->eta);
-    *k = v3_load(p->k);
+    shade_param_color(sv, ctx, "eta", p->eta, eta);
+    shade_param_color(sv, ctx, "k", p->k, k);
 }
 
 static void conductor_chunk(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
@@ -548,12 +589,13 @@ static void conductor_chunk(const RayesShaderServices *sv, const RayesShadeCtx *
     memset(out->Ci, 0, ctx->n_points * sizeof *out->Ci);
     if (!ctx->I)
         return; /* no view-independent lobe */
-    Vec3 eta, k;
-    conductor_index(p, &eta, &k);
-    Rgb L[SHADE_CHUNK];
-    glossy_reflection(sv, ctx, exponent_of(p->roughness), L);
+    Rgb eta[SHADE_CHUNK], k[SHADE_CHUNK], L[SHADE_CHUNK];
+    float e[SHADE_CHUNK];
+    conductor_index(sv, ctx, p, eta, k);
+    exponents(sv, ctx, p->roughness, e);
+    glossy_reflection(sv, ctx, e, L);
     for (size_t i = 0; i < ctx->n_points; i++) {
-        Vec3 F = fresnel_conductor_rgb(cos_view(ctx, i), eta, k);
+        Vec3 F = fresnel_conductor_rgb(cos_view(ctx, i), v3_load(eta[i]), v3_load(k[i]));
         for (int c = 0; c < 3; c++)
             out->Ci[i][c] = cs(ctx, i, c) * v3_index(F, c) * L[i][c];
     }
@@ -602,17 +644,22 @@ static void coated_chunk(const RayesShaderServices *sv, const RayesShadeCtx *ctx
                          const void *params, RayesShadeOutputs *out)
 {
     const CoatedParams *p = params;
-    Rgb E[SHADE_CHUNK], L[SHADE_CHUNK];
+    Rgb E[SHADE_CHUNK], L[SHADE_CHUNK], refl[SHADE_CHUNK];
+    float e[SHADE_CHUNK], thick[SHADE_CHUNK];
+    shade_param_color(sv, ctx, "reflectance", p->reflectance, refl);
+    shade_param_float(sv, ctx, "thickness", p->thickness, thick);
     diffuse_light(sv, ctx, E, out);
     float favg = fresnel_dielectric_average(p->eta);
-    float base = (1.0f - favg) * (1.0f - favg) * expf(-2.0f * fmaxf(p->thickness, 0.0f));
-    if (ctx->I)
-        glossy_reflection(sv, ctx, exponent_of(p->roughness), L);
+    if (ctx->I) {
+        exponents(sv, ctx, p->roughness, e);
+        glossy_reflection(sv, ctx, e, L);
+    }
     for (size_t i = 0; i < ctx->n_points; i++) {
+        float base = (1.0f - favg) * (1.0f - favg) * expf(-2.0f * fmaxf(thick[i], 0.0f));
         float F = ctx->I ? fresnel_dielectric(cos_view(ctx, i), p->eta) : 0.0f;
         float view = ctx->I ? (1.0f - F) / (1.0f - favg) : 1.0f;
         for (int c = 0; c < 3; c++) {
-            out->Ci[i][c] = cs(ctx, i, c) * p->reflectance[c] * base * view * E[i][c];
+            out->Ci[i][c] = cs(ctx, i, c) * refl[i][c] * base * view * E[i][c];
             if (ctx->I)
                 out->Ci[i][c] += F * L[i][c];
         }

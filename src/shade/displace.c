@@ -19,6 +19,7 @@
 
 #include "shade/builtin.h"
 #include "shade/noise.h"
+#include "shade/pattern.h"
 #include "shade/shade.h"
 #include "shade/texture.h"
 
@@ -39,30 +40,50 @@ static void displace_along_normal(const RayesShadeCtx *ctx, const float *h, Raye
             out->P[i][c] = ctx->P[i][c] + h[i] * ctx->N[i][c];
 }
 
-static void bumpy_displacement(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
-                               const void *params, RayesShadeOutputs *out)
+/* The heights of a chunk of at most SHADE_CHUNK points. */
+typedef void (*HeightFn)(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
+                         const void *params, float *h);
+
+/* Displaces ctx's points along their normals by height, SHADE_CHUNK
+ * points at a time. */
+static void displace_by_chunks(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
+                               const void *params, RayesShadeOutputs *out, HeightFn height)
 {
-    const BumpyParams *p = params;
-    float h[SHADE_CHUNK], tex[SHADE_CHUNK][3];
+    float h[SHADE_CHUNK];
     for (size_t start = 0; start < ctx->n_points; start += SHADE_CHUNK) {
         size_t n = ctx->n_points - start < SHADE_CHUNK ? ctx->n_points - start : SHADE_CHUNK;
         RayesShadeCtx sub;
         shade_ctx_slice(ctx, start, n, &sub);
-        if (p->texturename[0] && sv->texture &&
-            sv->texture(sv, &sub, p->texturename, sub.s, sub.t, NULL, NULL, tex, NULL) == 0) {
-            for (size_t i = 0; i < n; i++)
-                h[i] = p->Km * tex[i][0];
-        } else {
-            for (size_t i = 0; i < n; i++) {
-                const float *P = sub.P[i];
-                float q[3] = {P[0] * p->frequency, P[1] * p->frequency, P[2] * p->frequency};
-                h[i] = p->Km * sv->noise(sv, q);
-            }
-        }
+        height(sv, &sub, params, h);
         RayesShadeOutputs o = *out;
         o.P = out->P + start;
         displace_along_normal(&sub, h, &o);
     }
+}
+
+/* bumpy: Km times the texture's first channel, else times noise. */
+static void bumpy_height(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
+                         const void *params, float *h)
+{
+    const BumpyParams *p = params;
+    float tex[SHADE_CHUNK][3];
+    if (p->texturename[0] && sv->texture &&
+        sv->texture(sv, ctx, p->texturename, ctx->s, ctx->t, NULL, NULL, tex, NULL) == 0) {
+        for (size_t i = 0; i < ctx->n_points; i++)
+            h[i] = p->Km * tex[i][0];
+        return;
+    }
+    for (size_t i = 0; i < ctx->n_points; i++) {
+        const float *P = ctx->P[i];
+        float q[3] = {P[0] * p->frequency, P[1] * p->frequency, P[2] * p->frequency};
+        h[i] = p->Km * sv->noise(sv, q);
+    }
+}
+
+static void bumpy_displacement(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
+                               const void *params, RayesShadeOutputs *out)
+{
+    displace_by_chunks(sv, ctx, params, out, bumpy_height);
 }
 
 static void fractal_displacement(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
@@ -77,6 +98,23 @@ static void fractal_displacement(const RayesShaderServices *sv, const RayesShade
         for (int c = 0; c < 3; c++)
             out->P[i][c] = P[c] + h * ctx->N[i][c];
     }
+}
+
+typedef struct DisplaceParams {
+    float amount;
+} DisplaceParams;
+
+/* displace: amount, a constant or a pattern (pbrt's "displacement"). */
+static void displace_height(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
+                            const void *params, float *h)
+{
+    shade_param_float(sv, ctx, "amount", ((const DisplaceParams *)params)->amount, h);
+}
+
+static void displace_displacement(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
+                                  const void *params, RayesShadeOutputs *out)
+{
+    displace_by_chunks(sv, ctx, params, out, displace_height);
 }
 
 /* A displacement-only class is never shaded; its lighting is black. */
@@ -129,6 +167,22 @@ const RayesShaderClass shade_class_fractal = {
     .diffuselighting = unshaded,
 };
 
+static const RayesShaderParamDesc displace_params[] = {
+    {"amount", RAYES_PARAM_FLOAT, offsetof(DisplaceParams, amount), {0, 0, 0}},
+};
+
+const RayesShaderClass shade_class_displace = {
+    .abi_version = RAYES_SHADER_ABI_VERSION,
+    .struct_size = sizeof(RayesShaderClass),
+    .name = "displace",
+    .params_size = sizeof(DisplaceParams),
+    .params = displace_params,
+    .n_params = sizeof displace_params / sizeof displace_params[0],
+    .displacement = displace_displacement,
+    .lighting = unshaded,
+    .diffuselighting = unshaded,
+};
+
 /* ------------------------------------------ services at dicing time */
 
 float shade_service_noise(const RayesShaderServices *sv, const float p[3])
@@ -159,7 +213,7 @@ float shade_service_checker(const RayesShaderServices *sv, float s, float t, flo
 
 static int dice_supports(const RayesShaderServices *sv, const char *service)
 {
-    if (strcmp(service, "texture") == 0)
+    if (strcmp(service, "texture") == 0 || strcmp(service, "pattern") == 0)
         return sv->texture != NULL;
     return strcmp(service, "noise") == 0 || strcmp(service, "fbm") == 0 ||
            strcmp(service, "turbulence") == 0 || strcmp(service, "checker") == 0;
@@ -172,6 +226,14 @@ static int dice_texture(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
 {
     TextureSystem *ts = ((const DicingServices *)(const void *)sv)->textures;
     return shade_texture_service(ts, ctx, name, s, t, ds, dt, rgb, alpha);
+}
+
+/* Patterns at dicing, their images filtered over the grid's spacing. */
+static int dice_pattern(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
+                        const RayesPattern *pattern, float (*out)[3])
+{
+    TextureSystem *ts = ((const DicingServices *)(const void *)sv)->textures;
+    return pattern_eval(pattern, ts, ctx, NULL, NULL, out);
 }
 
 int shade_texture_service(TextureSystem *ts, const RayesShadeCtx *ctx, const char *name,
@@ -192,6 +254,7 @@ void shade_dicing_services_init(DicingServices *ds, TextureSystem *textures)
 {
     ds->sv = shade_dicing_services;
     ds->sv.texture = dice_texture;
+    ds->sv.pattern = dice_pattern;
     ds->textures = textures;
 }
 

@@ -40,6 +40,8 @@ int shade_instance_apply(ShaderInstance *inst, const RayesParam *params, size_t 
 {
     const RayesShaderClass *cls = inst->cls;
     for (size_t i = 0; i < n_params; i++) {
+        if (params[i].type == RAYES_PARAM_PATTERN)
+            continue; /* bound by shade_instance_bind */
         const RayesShaderParamDesc *d = find_param(cls, params[i].name);
         int ok = d && (d->type == params[i].type ||
                        (d->type == RAYES_PARAM_COLOR && params[i].type == RAYES_PARAM_FLOAT));
@@ -66,6 +68,8 @@ int shade_instance_init(ShaderInstance *inst, const RayesShaderClass *cls,
                         const RayesParam *params, size_t n_params, char *err, size_t err_size)
 {
     inst->cls = cls;
+    inst->patterns = NULL;
+    inst->n_patterns = 0;
     inst->params = calloc(1, cls->params_size ? cls->params_size : 1);
     if (!inst->params) {
         snprintf(err, err_size, "out of memory");
@@ -81,6 +85,86 @@ void shade_instance_fini(ShaderInstance *inst)
 {
     free(inst->params);
     inst->params = NULL;
+    free(inst->patterns);
+    inst->patterns = NULL;
+    inst->n_patterns = 0;
+}
+
+int shade_instance_bind(ShaderInstance *inst, const char *name, const RayesPattern *pattern,
+                        char *err, size_t err_size)
+{
+    const RayesShaderParamDesc *d = find_param(inst->cls, name);
+    if (!d || (d->type != RAYES_PARAM_FLOAT && d->type != RAYES_PARAM_COLOR)) {
+        snprintf(err, err_size,
+                 d ? "shader \"%s\" parameter \"%s\" is not a float or colour; it cannot take "
+                     "a pattern"
+                   : "shader \"%s\" has no parameter \"%s\"",
+                 inst->cls->name, name);
+        return -1;
+    }
+    for (size_t i = 0; i < inst->n_patterns; i++)
+        if (strcmp(inst->patterns[i].param, d->name) == 0) {
+            inst->patterns[i].pattern = pattern;
+            return 0;
+        }
+    RayesPatternBinding *b = realloc(inst->patterns, (inst->n_patterns + 1) * sizeof *b);
+    if (!b) {
+        snprintf(err, err_size, "out of memory");
+        return -1;
+    }
+    inst->patterns = b;
+    b[inst->n_patterns++] = (RayesPatternBinding){d->name, pattern};
+    return 0;
+}
+
+/* Whether the renderer's table holds service m (within the size it was
+ * built with, and set). */
+#define HAS_SERVICE(sv, m)                                                                         \
+    ((sv)->struct_size >= offsetof(RayesShaderServices, m) + sizeof((sv)->m) && (sv)->m != NULL)
+
+static const RayesPattern *bound(const RayesShadeCtx *ctx, const char *name)
+{
+    for (size_t i = 0; ctx->patterns && i < ctx->n_patterns; i++)
+        if (strcmp(ctx->patterns[i].param, name) == 0)
+            return ctx->patterns[i].pattern;
+    return NULL;
+}
+
+int shade_param_bound(const RayesShadeCtx *ctx, const char *name)
+{
+    return bound(ctx, name) != NULL;
+}
+
+void shade_param_color(const RayesShaderServices *sv, const RayesShadeCtx *ctx, const char *name,
+                       const float value[3], float (*out)[3])
+{
+    const RayesPattern *p = bound(ctx, name);
+    if (p && HAS_SERVICE(sv, pattern)) {
+        sv->pattern(sv, ctx, p, out);
+        return;
+    }
+    for (size_t i = 0; i < ctx->n_points; i++)
+        memcpy(out[i], value, sizeof out[i]);
+}
+
+void shade_param_float(const RayesShaderServices *sv, const RayesShadeCtx *ctx, const char *name,
+                       float value, float *out)
+{
+    const RayesPattern *p = bound(ctx, name);
+    if (!p || !HAS_SERVICE(sv, pattern)) {
+        for (size_t i = 0; i < ctx->n_points; i++)
+            out[i] = value;
+        return;
+    }
+    for (size_t start = 0; start < ctx->n_points; start += SHADE_CHUNK) {
+        size_t n = ctx->n_points - start < SHADE_CHUNK ? ctx->n_points - start : SHADE_CHUNK;
+        RayesShadeCtx sub;
+        float rgb[SHADE_CHUNK][3];
+        shade_ctx_slice(ctx, start, n, &sub);
+        sv->pattern(sv, &sub, p, rgb);
+        for (size_t i = 0; i < n; i++)
+            out[start + i] = rgb[i][0];
+    }
 }
 
 void shade_ctx_slice(const RayesShadeCtx *ctx, size_t start, size_t count, RayesShadeCtx *sub)
@@ -135,6 +219,7 @@ void shade_run_lighting(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
 {
     const RayesShaderClass *cls = inst->cls;
     RayesShadeCtx c = *ctx;
+    c.patterns = inst->patterns, c.n_patterns = inst->n_patterns;
     int failed;
     void *scratch = scratch_begin(cls, &c, &failed);
     if (failed) {
@@ -155,6 +240,7 @@ void shade_run_diffuselighting(const RayesShaderServices *sv, const RayesShadeCt
     const RayesShaderClass *cls = inst->cls;
     RayesShadeCtx c = *ctx;
     c.I = NULL; /* view independence: diffuselighting never sees I */
+    c.patterns = inst->patterns, c.n_patterns = inst->n_patterns;
     int failed;
     void *scratch = scratch_begin(cls, &c, &failed);
     if (failed) {

@@ -16,6 +16,10 @@
 typedef struct ShaderInstance {
     const RayesShaderClass *cls;
     void *params;               /* the parameter block, cls->params_size bytes, owned */
+    RayesPatternBinding *patterns; /* parameters bound to patterns (owned array; the
+                                      patterns are the scene's), what methods see in
+                                      ctx->patterns */
+    size_t n_patterns;
 } ShaderInstance;
 
 /* Makes an instance: defaults, then params by name. Unknown names and type
@@ -29,6 +33,24 @@ int shade_instance_init(ShaderInstance *inst, const RayesShaderClass *cls,
 int shade_instance_apply(ShaderInstance *inst, const RayesParam *params, size_t n_params,
                          int strict, char *err, size_t err_size);
 void shade_instance_fini(ShaderInstance *inst);
+
+/* Binds the FLOAT or COLOR parameter `name` of the instance to pattern (a
+ * later binding of the same name replaces it). Returns 0, or -1 with err
+ * filled (no such parameter, another type, out of memory). */
+int shade_instance_bind(ShaderInstance *inst, const char *name, const RayesPattern *pattern,
+                        char *err, size_t err_size);
+
+/* The values at ctx's points of a FLOAT or COLOR parameter whose constant
+ * is value: the pattern ctx->patterns binds to name if there is one and
+ * the renderer has the pattern service, else the constant (a float reads
+ * a pattern's first channel). For shaders written against shader.h, the
+ * built-ins as plugins. */
+void shade_param_color(const RayesShaderServices *sv, const RayesShadeCtx *ctx, const char *name,
+                       const float value[3], float (*out)[3]);
+void shade_param_float(const RayesShaderServices *sv, const RayesShadeCtx *ctx, const char *name,
+                       float value, float *out);
+/* Nonzero if ctx->patterns binds name. */
+int shade_param_bound(const RayesShadeCtx *ctx, const char *name);
 
 /* Runs diffuselighting, or the fallback for classes without it: lighting
  * with I absent, whose services then return only view-independent (diffuse)

@@ -56,6 +56,15 @@ void texture_system_free(TextureSystem *ts);
 int texture_lookup(TextureSystem *ts, const char *name, size_t n, const float *s, const float *t,
                    const float *ds, const float *dt, float (*rgb)[3], float *alpha);
 
+/* texture_lookup with the texels' encoding given, as pbrt's imagemap gives
+ * it: NULL or "" the file's own (integer files sRGB unless they say they
+ * are linear), "sRGB", "linear" (integer texels as they are, over their
+ * maximum) or "gamma G" (raised to G). Float files are linear whatever it
+ * says. The same file under two encodings is two textures. */
+int texture_lookup_encoded(TextureSystem *ts, const char *name, const char *encoding, size_t n,
+                           const float *s, const float *t, const float *ds, const float *dt,
+                           float (*rgb)[3], float *alpha);
+
 /* The statistics so far (loads: tiles read; file_reads: files opened;
  * evictions: tiles no longer resident; bytes: OpenImageIO's cache memory;
  * peak_bytes: an estimate from its peak tile count). */

@@ -2,7 +2,8 @@
  * tests/fuzz/fuzz_pbrt.c — a libFuzzer target for the pbrt-v4 reader of
  * io/pbrt.h. The reader drives a checking sink that keeps nothing: meshes
  * must have faces of 3 or 4 vertices with indices in range, every number
- * it is given must be finite. The file is named inside a directory that
+ * it is given must be finite, every pattern a parameter names must have
+ * been defined before (up to the first 256). The file is named inside a directory that
  * does not exist, so Include, Import and plymesh fail cleanly instead of
  * reading whatever lies in the working directory. A failed parse must
  * leave a one-line message.
@@ -15,6 +16,7 @@
 #include <math.h>
 #include <stddef.h>
 #include <stdint.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -53,13 +55,31 @@ static RayesError transform(void *t, const float m[16])
     return RAYES_OK;
 }
 
+/* The patterns defined so far in this input (the first MAX_PATTERNS). */
+#define MAX_PATTERNS 256
+static char patterns[MAX_PATTERNS][160];
+static size_t n_patterns;
+
+static int pattern_known(const char *name)
+{
+    if (n_patterns > MAX_PATTERNS)
+        return 1; /* not tracked */
+    for (size_t i = 0; i < n_patterns; i++)
+        if (strcmp(patterns[i], name) == 0)
+            return 1;
+    return 0;
+}
+
 static RayesError shader(void *t, const char *name, const RayesParam *p, size_t n)
 {
     (void)t;
     if (!name || !name[0])
         abort();
     for (size_t i = 0; i < n; i++) {
-        if (!p[i].name || (p[i].type == RAYES_PARAM_STRING && !p[i].string))
+        int str = p[i].type == RAYES_PARAM_STRING || p[i].type == RAYES_PARAM_PATTERN;
+        if (!p[i].name || (str && !p[i].string))
+            abort();
+        if (p[i].type == RAYES_PARAM_PATTERN && !pattern_known(p[i].string))
             abort();
         check_finite(p[i].value, 3);
     }
@@ -68,7 +88,20 @@ static RayesError shader(void *t, const char *name, const RayesParam *p, size_t 
 
 static RayesError displacement(void *t, const char *name, const RayesParam *p, size_t n)
 {
+    if (name && !name[0] && n == 0)
+        return RAYES_OK; /* none */
     return shader(t, name, p, n);
+}
+
+static RayesError pattern(void *t, const char *name, const char *type, const RayesParam *p,
+                          size_t n)
+{
+    if (!name || !name[0] || shader(t, type, p, n) != RAYES_OK)
+        abort();
+    if (n_patterns < MAX_PATTERNS)
+        snprintf(patterns[n_patterns], sizeof patterns[0], "%s", name);
+    n_patterns++;
+    return RAYES_OK;
 }
 
 static RayesError bound(void *t, float b)
@@ -196,7 +229,9 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
                                 .area_light = area,
                                 .light = light,
                                 .get_error = error,
-                                .subdivision_mesh = subdiv};
+                                .subdivision_mesh = subdiv,
+                                .pattern = pattern};
+    n_patterns = 0;
     IoSettings settings;
     io_settings_init(&settings);
     char err[512];

@@ -55,6 +55,10 @@ typedef struct Rec {
     float pv_data[3][64 * 3];
     int n_pv;
     int mesh_idx[64];      /* the last mesh's first indices */
+    char light_map[16][64];  /* each light's mapname, "" if none */
+    char shader_pattern[64]; /* the last shader's first pattern parameter: "param=pattern" */
+    char pattern[64];        /* the last pattern: "type name" */
+    float pattern_M[16];     /* the transform current then */
 } Rec;
 
 static Rec rec;
@@ -88,9 +92,22 @@ static RayesError s_shader(void *t, const char *name, const RayesParam *p, size_
     (void)t;
     snprintf(rec.shader, sizeof rec.shader, "%s", name);
     rec.n_shader_calls++;
-    for (size_t i = 0; i < n; i++)
+    rec.shader_pattern[0] = '\0';
+    for (size_t i = 0; i < n; i++) {
         if (strcmp(p[i].name, "Cs") == 0)
             memcpy(rec.Cs, p[i].value, sizeof rec.Cs);
+        if (p[i].type == RAYES_PARAM_PATTERN && !rec.shader_pattern[0])
+            snprintf(rec.shader_pattern, sizeof rec.shader_pattern, "%s=%s", p[i].name,
+                     p[i].string);
+    }
+    return RAYES_OK;
+}
+static RayesError s_pattern(void *t, const char *name, const char *type, const RayesParam *p,
+                            size_t n)
+{
+    (void)t, (void)p, (void)n;
+    snprintf(rec.pattern, sizeof rec.pattern, "%s %s", type, name);
+    memcpy(rec.pattern_M, rec.M, sizeof rec.M);
     return RAYES_OK;
 }
 static RayesError s_displacement(void *t, const char *name, const RayesParam *p, size_t n)
@@ -195,6 +212,10 @@ static RayesError s_light(void *t, const char *type, const RayesParam *p, size_t
         snprintf(rec.light_types[rec.lights], 32, "%s", type);
         if (n)
             memcpy(rec.light_params[rec.lights], p[0].value, sizeof rec.light_params[0]);
+        rec.light_map[rec.lights][0] = '\0';
+        for (size_t i = 0; i < n; i++)
+            if (strcmp(p[i].name, "mapname") == 0)
+                snprintf(rec.light_map[rec.lights], 64, "%s", p[i].string);
     }
     rec.lights++;
     return RAYES_OK;
@@ -220,10 +241,10 @@ static const char *s_error(void *t)
     return "";
 }
 
-static const IoSink stub = {NULL,      s_camera,  s_camera_matrix, s_transform, s_shader,
-                            s_displacement, s_float, s_search,     s_float,     s_bilinear,
-                            s_bicubic, s_mesh,    s_sphere,        s_quadric,   s_area,
-                            s_light,   s_links,   s_count,   s_error};
+static const IoSink stub = {
+    NULL,    s_camera,   s_camera_matrix, s_transform, s_shader, s_displacement, s_float, s_search,
+    s_float, s_bilinear, s_bicubic,       s_mesh,      s_sphere, s_quadric,      s_area,  s_light,
+    s_links, s_count,    s_error,         NULL,        NULL,     NULL, NULL, s_pattern};
 
 static IoSettings settings;
 static char err[1024];
@@ -385,9 +406,47 @@ static void test_shaders_and_lights(void)
           RAYES_OK);
     CHECK(rec.lights == 1 && strcmp(rec.light_types[0], "environmentlight") == 0);
     CHECK_NEAR(rec.light_params[0][0], 0.8, 1e-6);
+    CHECK(rec.light_map[0][0] == '\0');
+    /* their map, by any of its usual names, is the environment's mapname
+     * when it is found (here on the texture search path), else dropped
+     * with a warning; rayes' own environmentlight keeps its mapname */
+    FILE *sky = fopen(RAYES_TEST_TMP "/test_rib_sky.exr", "w");
+    CHECK(sky != NULL);
+    if (sky)
+        fclose(sky);
+    CHECK(parse("Option \"searchpath\" \"texture\" [\"/nonexistent:" RAYES_TEST_TMP "\"]\n" WORLD(
+              "LightSource \"envlight\" 2 \"string envname\" \"test_rib_sky.exr\"\n"
+              "LightSource \"PxrDomeLight\" 3 \"string lightColorMap\" \"dome.tx\"\n"
+              "LightSource \"environmentlight\" 4 \"string mapname\" \"m.exr\"\n"
+              "  \"string mapping\" \"octahedral\"\n"
+              "Polygon \"P\" [0 0 0 1 0 0 1 1 0]")) == RAYES_OK);
+    CHECK(rec.lights == 3 && strcmp(rec.light_map[0], "test_rib_sky.exr") == 0 &&
+          rec.light_map[1][0] == '\0' && strcmp(rec.light_map[2], "m.exr") == 0);
     CHECK(parse("Option \"searchpath\" \"shader\" [\"mine:&\"]\nWorldBegin\nWorldEnd\n") ==
           RAYES_OK);
     CHECK(strcmp(rec.search, "shader=mine:&") == 0);
+}
+
+/* Pattern requests reach the sink at once, in the current transform, and
+ * a shader's "reference pattern NAME" parameter names one. */
+static void test_patterns(void)
+{
+    CHECK(parse(WORLD("Translate 1 2 3\n"
+                      "Pattern \"checkerboard\" \"0:checks\" \"float uscale\" [8]\n"
+                      "Surface \"diffuse\" \"reference pattern reflectance\" [\"0:checks\"]\n"
+                      "Polygon \"P\" [0 0 0 1 0 0 1 1 0]")) == RAYES_OK);
+    CHECK(strcmp(rec.pattern, "checkerboard 0:checks") == 0);
+    CHECK(rec.pattern_M[3] == 1 && rec.pattern_M[7] == 2 && rec.pattern_M[11] == 3);
+    CHECK(strcmp(rec.shader, "diffuse") == 0 &&
+          strcmp(rec.shader_pattern, "reflectance=0:checks") == 0);
+    /* RenderMan's own pattern classes are not built: skipped with a
+     * warning, and what references them keeps its default */
+    rec.pattern[0] = '\0';
+    CHECK(parse(WORLD("Pattern \"PxrTexture\" \"tex\" \"string filename\" [\"a.tex\"]\n"
+                      "Surface \"diffuse\" \"reference color reflectance\" [\"tex:resultRGB\"]\n"
+                      "Polygon \"P\" [0 0 0 1 0 0 1 1 0]")) == RAYES_OK);
+    CHECK(rec.pattern[0] == '\0' && strcmp(rec.shader, "diffuse") == 0 &&
+          rec.shader_pattern[0] == '\0');
 }
 
 static void test_parameter_classes(void)
@@ -1013,8 +1072,8 @@ static void test_detail_range(void)
 }
 
 TEST_MAIN(TEST(test_camera_and_transforms), TEST(test_settings), TEST(test_shaders_and_lights),
-          TEST(test_parameter_classes), TEST(test_polygons), TEST(test_patch_mesh_bases),
-          TEST(test_handles), TEST(test_objects_and_frames), TEST(test_binary), TEST(test_gzip),
-          TEST(test_errors), TEST(test_aqsis_files), TEST(test_scene_sink),
-          TEST(test_writer_round_trip), TEST(test_writer_primvars), TEST(test_writer_split_quad),
-          TEST(test_detail_range))
+          TEST(test_parameter_classes), TEST(test_patterns), TEST(test_polygons),
+          TEST(test_patch_mesh_bases), TEST(test_handles), TEST(test_objects_and_frames),
+          TEST(test_binary), TEST(test_gzip), TEST(test_errors), TEST(test_aqsis_files),
+          TEST(test_scene_sink), TEST(test_writer_round_trip), TEST(test_writer_primvars),
+          TEST(test_writer_split_quad), TEST(test_detail_range))

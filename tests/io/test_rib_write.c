@@ -240,4 +240,31 @@ static void test_builtin(void)
     io_rib_writer_free(w);
 }
 
-TEST_MAIN(TEST(test_calls), TEST(test_round_trip), TEST(test_refused), TEST(test_builtin))
+/* Patterns are written as RenderMan's Pattern request, and a parameter
+ * bound to one as "reference pattern NAME", which the RIB reader reads. */
+static void test_patterns(void)
+{
+    RibWriter *w = io_rib_writer_new();
+    IoSink k = io_rib_writer_sink(w);
+    const RayesParam pp[] = {{"tex1", RAYES_PARAM_COLOR, {1, 0, 0}, NULL},
+                             {"uscale", RAYES_PARAM_FLOAT, {8, 0, 0}, NULL},
+                             {"tex2", RAYES_PARAM_PATTERN, {0}, "0:img"}};
+    const RayesParam sp[] = {{"roughness", RAYES_PARAM_PATTERN, {0}, "1:checks"}};
+    CHECK(k.pattern(w, "1:checks", "checkerboard", pp, 3) == RAYES_OK);
+    CHECK(k.set_shader(w, "conductor", sp, 1) == RAYES_OK);
+    CHECK(k.set_displacement(w, "displace", sp, 1) == RAYES_OK);
+    IoSettings s;
+    io_settings_init(&s);
+    char *t = finish(w, &s);
+    CHECK(has(t,
+              "Pattern \"checkerboard\" \"1:checks\" \"color tex1\" [1 0 0] \"float uscale\" [8] "
+              "\"reference pattern tex2\" [\"0:img\"]"));
+    CHECK(has(t, "Surface \"conductor\" \"reference pattern roughness\" [\"1:checks\"]"));
+    CHECK(has(t, "Displacement \"displace\" \"reference pattern roughness\" [\"1:checks\"]"));
+    CHECK(before(t, "Pattern", "Surface"));
+    free(t);
+    io_rib_writer_free(w);
+}
+
+TEST_MAIN(TEST(test_calls), TEST(test_round_trip), TEST(test_refused), TEST(test_builtin),
+          TEST(test_patterns))

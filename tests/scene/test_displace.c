@@ -258,6 +258,57 @@ static void test_checker(void)
     CHECK_NEAR(pattern_checker(s, t, ds, dt), mean / (400.0 * 400.0), 2e-3);
 }
 
+/* pbrt's "displacement": the displace shader's amount bound to a
+ * checkerboard pattern raises the plane by 0.1 on its even checks of pbrt's
+ * (u, v) = (2 s, 2 (1 - t)) and leaves the others; the pattern and binding
+ * calls refuse what they cannot do, with a message. */
+static void test_pattern_displacement(void)
+{
+    RayesScene *s = rayes_scene_new();
+    RayesParam q[] = {{"tex1", RAYES_PARAM_FLOAT, {0.1f, 0, 0}, NULL},
+                      {"tex2", RAYES_PARAM_FLOAT, {0, 0, 0}, NULL},
+                      {"uscale", RAYES_PARAM_FLOAT, {2, 0, 0}, NULL},
+                      {"vscale", RAYES_PARAM_FLOAT, {2, 0, 0}, NULL}};
+    CHECK(rayes_scene_pattern(s, "checks", "checkerboard", q, 4) == RAYES_OK);
+    RayesParam amount = {"amount", RAYES_PARAM_PATTERN, {0, 0, 0}, "checks"};
+    CHECK(rayes_scene_set_displacement(s, "displace", &amount, 1) == RAYES_OK);
+    const float P[4][3] = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {1, 1, 0}};
+    CHECK(rayes_scene_bilinear_patch(s, P) == RAYES_OK);
+    const float eye[3] = {0.5f, 0.5f, 3}, target[3] = {0.5f, 0.5f, 0}, up[3] = {0, 1, 0};
+    CHECK(rayes_scene_set_camera(s, eye, target, up, 40.0f) == RAYES_OK);
+    CHECK(rayes_scene_commit(s) == RAYES_OK);
+    GridSet gs;
+    geom_gridset_init(&gs);
+    CHECK(scene_prepare(s, 100, 100, NULL, NULL, &gs, NULL) == 0);
+    size_t checked = 0, bad = 0;
+    for (size_t i = 0; i < gs.n_vertices; i++) {
+        float x = gs.P[i].x, y = gs.P[i].y, z = gs.P[i].z;
+        if (z < -1e-6f || z > 0.1f + 1e-6f)
+            bad++;
+        if (fabsf(x - 0.5f) < 0.1f || fabsf(y - 0.5f) < 0.1f || x < 0.1f || x > 0.9f || y < 0.1f ||
+            y > 0.9f)
+            continue; /* near an edge the filtered checker blends */
+        int even = ((int)floorf(2 * x) + (int)floorf(2 * (1 - y))) % 2 == 0;
+        bad += fabsf(z - (even ? 0.1f : 0.0f)) > 1e-4f;
+        checked++;
+    }
+    CHECK(checked > 50 && bad == 0);
+    geom_gridset_fini(&gs);
+    /* what is refused */
+    RayesParam none = {"amount", RAYES_PARAM_PATTERN, {0, 0, 0}, "nope"};
+    CHECK(rayes_scene_set_displacement(s, "displace", &none, 1) == RAYES_ERROR_INVALID_ARGUMENT);
+    CHECK(strstr(rayes_scene_get_error(s), "names no pattern (\"nope\")") != NULL);
+    rayes_scene_clear_error(s);
+    RayesParam wrong = {"preset", RAYES_PARAM_PATTERN, {0, 0, 0}, "checks"};
+    CHECK(rayes_scene_set_shader(s, "conductor", &wrong, 1) == RAYES_ERROR_INVALID_ARGUMENT);
+    CHECK(strstr(rayes_scene_get_error(s), "cannot take a pattern") != NULL);
+    rayes_scene_clear_error(s);
+    CHECK(rayes_scene_pattern(s, "x", "ptex", NULL, 0) == RAYES_ERROR_INVALID_ARGUMENT);
+    CHECK(strstr(rayes_scene_get_error(s), "pattern \"x\": unknown pattern class \"ptex\"") !=
+          NULL);
+    rayes_scene_release(s);
+}
+
 TEST_MAIN(TEST(test_sine_plane_is_analytic), TEST(test_neighbours_agree), TEST(test_bound_clamps),
-          TEST(test_api_errors), TEST(test_noise), TEST(test_checker),
-          TEST(test_bumpy_texture))
+          TEST(test_api_errors), TEST(test_noise), TEST(test_checker), TEST(test_bumpy_texture),
+          TEST(test_pattern_displacement))

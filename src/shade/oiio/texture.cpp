@@ -60,12 +60,20 @@ namespace {
 struct Entry {
     OIIO::ustring path;     /* empty: missing or unreadable */
     int channels = 0;       /* in the file */
-    bool srgb = false;      /* integer texels, not said to be linear */
+    float decode = 0.0f;    /* after filtering: 0 none, -1 sRGB, else this gamma */
 };
 
 float srgb_to_linear(float c)
 {
     return c <= 0.04045f ? c / 12.92f : std::pow((c + 0.055f) / 1.055f, 2.4f);
+}
+
+/* A texel value made linear by decode (Entry.decode). */
+float decoded(float c, float decode)
+{
+    if (decode == 0.0f)
+        return c;
+    return decode < 0.0f ? srgb_to_linear(c) : std::pow(std::fmax(c, 0.0f), decode);
 }
 
 /* sRGB for integer formats unless the file's colour space says linear. */
@@ -81,8 +89,18 @@ bool is_srgb(const OIIO::ImageSpec &spec)
     return !spec.format.is_floating_point();
 }
 
-/* The name under which the cache knows a file decoded to linear. */
-const char *const linear_suffix = "#rayes-linear";
+/* The name under which the cache knows a file decoded to linear: the
+ * path, then "#rayes-linear" (from sRGB) or "#rayes-gamma-G". */
+const char *const decode_mark = "#rayes-";
+
+std::string decoded_name(const std::string &path, float decode)
+{
+    if (decode < 0.0f)
+        return path + decode_mark + "linear";
+    char g[32];
+    std::snprintf(g, sizeof g, "gamma-%.9g", (double)decode);
+    return path + decode_mark + g;
+}
 
 /* An ImageInput over a file decoded from sRGB to linear float, whole, for
  * the cache (which reads it by scanlines and makes its MIP levels). */
@@ -91,7 +109,11 @@ class LinearInput final : public OIIO::ImageInput {
     const char *format_name() const override { return "rayes-linear"; }
     bool open(const std::string &name, OIIO::ImageSpec &newspec) override
     {
-        std::string path = name.substr(0, name.size() - std::strlen(linear_suffix));
+        size_t mark = name.rfind(decode_mark);
+        if (mark == std::string::npos)
+            return false;
+        std::string path = name.substr(0, mark), how = name.substr(mark + std::strlen(decode_mark));
+        float decode = how == "linear" ? -1.0f : std::strtof(how.c_str() + 6, nullptr);
         auto in = OIIO::ImageInput::open(path);
         if (!in)
             return false;
@@ -104,7 +126,7 @@ class LinearInput final : public OIIO::ImageInput {
         int colour = nc_ >= 3 ? 3 : 1; /* the alpha channel stays as it is */
         for (size_t i = 0; i < pixels_.size(); i += (size_t)nc_)
             for (int c = 0; c < colour; c++)
-                pixels_[i + (size_t)c] = srgb_to_linear(pixels_[i + (size_t)c]);
+                pixels_[i + (size_t)c] = decoded(pixels_[i + (size_t)c], decode);
         m_spec = OIIO::ImageSpec(spec.width, spec.height, nc_, OIIO::TypeDesc::FLOAT);
         m_spec.channelnames = spec.channelnames;
         m_spec.alpha_channel = spec.alpha_channel;
@@ -214,13 +236,29 @@ static std::string resolve(const TextureSystem *ts, const char *name)
     return "";
 }
 
-/* The entry of a name, resolved and opened on first use (one warning when
- * it cannot be read). */
-static Entry entry_of(TextureSystem *ts, const char *name)
+/* How integer texels of a file decode (Entry.decode) under an encoding:
+ * "" the file's own (sRGB unless it says linear), "sRGB", "linear",
+ * "gamma G". Float texels are linear whatever the encoding says. */
+static float decode_of(const OIIO::ImageSpec &spec, const char *encoding)
 {
+    float g = 0.0f;
+    if (!encoding || !encoding[0])
+        return is_srgb(spec) ? -1.0f : 0.0f;
+    if (spec.format.is_floating_point() || std::strcmp(encoding, "linear") == 0)
+        return 0.0f;
+    if (std::sscanf(encoding, "gamma %f", &g) == 1 && g > 0.0f)
+        return g;
+    return -1.0f;
+}
+
+/* The entry of a name under an encoding, resolved and opened on first use
+ * (one warning when it cannot be read). */
+static Entry entry_of(TextureSystem *ts, const char *name, const char *encoding)
+{
+    std::string key = std::string(name) + '\n' + (encoding ? encoding : "");
     {
         std::lock_guard<std::mutex> g(ts->lock);
-        auto it = ts->names.find(name);
+        auto it = ts->names.find(key);
         if (it != ts->names.end())
             return it->second;
     }
@@ -243,19 +281,19 @@ static Entry entry_of(TextureSystem *ts, const char *name)
         if (in) {
             e.path = OIIO::ustring(path);
             e.channels = spec.nchannels;
-            e.srgb = is_srgb(spec);
-            if (e.srgb && spec.tile_width == 0) { /* decoded before the cache filters it */
-                OIIO::ustring linear(path + linear_suffix);
+            e.decode = decode_of(spec, encoding);
+            if (e.decode != 0.0f && spec.tile_width == 0) { /* decoded before filtering */
+                OIIO::ustring linear(decoded_name(path, e.decode));
                 if (ts->oiio->imagecache()->add_file(linear, create_linear_input)) {
                     e.path = linear;
-                    e.srgb = false;
+                    e.decode = 0.0f;
                 } else
                     (void)ts->oiio->geterror();
             }
         }
     }
     std::lock_guard<std::mutex> g(ts->lock);
-    auto got = ts->names.emplace(name, e);
+    auto got = ts->names.emplace(key, e);
     if (got.second && e.path.empty()) {
         ts->missing++;
         log_warning("texture \"%s\": %s; shading continues without it", name, why.c_str());
@@ -267,8 +305,15 @@ extern "C" int texture_lookup(TextureSystem *ts, const char *name, size_t n, con
                               const float *t, const float *ds, const float *dt, float (*rgb)[3],
                               float *alpha)
 {
+    return texture_lookup_encoded(ts, name, NULL, n, s, t, ds, dt, rgb, alpha);
+}
+
+extern "C" int texture_lookup_encoded(TextureSystem *ts, const char *name, const char *encoding,
+                                      size_t n, const float *s, const float *t, const float *ds,
+                                      const float *dt, float (*rgb)[3], float *alpha)
+{
     ts->lookups.fetch_add(n, std::memory_order_relaxed);
-    Entry e = name && name[0] ? entry_of(ts, name) : Entry();
+    Entry e = name && name[0] ? entry_of(ts, name, encoding) : Entry();
     if (e.path.empty()) {
         std::memset(rgb, 0, n * sizeof *rgb);
         for (size_t i = 0; alpha && i < n; i++)
@@ -297,7 +342,7 @@ extern "C" int texture_lookup(TextureSystem *ts, const char *name, size_t n, con
         if (!has_alpha)
             v[3] = 1.0f;
         for (int c = 0; c < 3; c++)
-            rgb[i][c] = e.srgb ? srgb_to_linear(v[c]) : v[c];
+            rgb[i][c] = decoded(v[c], e.decode);
         if (alpha)
             alpha[i] = v[3];
     }
@@ -408,10 +453,11 @@ static void system_free(void *ts)
     texture_system_free(static_cast<TextureSystem *>(ts));
 }
 
-static int lookup(void *ts, const char *name, size_t n, const float *s, const float *t,
-                  const float *ds, const float *dt, float (*rgb)[3], float *alpha)
+static int lookup(void *ts, const char *name, const char *encoding, size_t n, const float *s,
+                  const float *t, const float *ds, const float *dt, float (*rgb)[3], float *alpha)
 {
-    return texture_lookup(static_cast<TextureSystem *>(ts), name, n, s, t, ds, dt, rgb, alpha);
+    return texture_lookup_encoded(static_cast<TextureSystem *>(ts), name, encoding, n, s, t, ds,
+                                  dt, rgb, alpha);
 }
 
 static void get_stats(void *ts, TextureStats *stats)
