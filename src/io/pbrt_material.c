@@ -595,6 +595,44 @@ static int conductor_material(Parser *P, const Token *t, const char *type, Param
     return 0;
 }
 
+/* pbrt-v4's hair as rayes's Kajiya-Kay `hair` (docs/pbrt.md): its colour
+ * the reflectance pbrt's SigmaAFromReflectance inverts (given, or from
+ * sigma_a, or from eumelanin and pheomelanin: pbrt's default 1.3 of
+ * eumelanin), its highlight as sharp as beta_m says (roughness beta_m^2). */
+static int hair_material(Parser *P, ParamList *pl, Material *m)
+{
+    static const float none[3] = {-1, -1, -1};
+    float refl[3], sigma[3];
+    if (pbrt_get_color(P, pl, "reflectance", none, refl, NULL) < 0 ||
+        pbrt_get_color(P, pl, "sigma_a", none, sigma, NULL) < 0)
+        return -1;
+    double bm = pbrt_get_float(pl, "beta_m", 0.3), bn = pbrt_get_float(pl, "beta_n", 0.3);
+    double eu = pbrt_get_float(pl, "eumelanin", 0.0), pheo = pbrt_get_float(pl, "pheomelanin", 0.0);
+    (void)pbrt_find(pl, "eta"), (void)pbrt_find(pl, "alpha"); /* the lobes' shape: not modelled */
+    float c[3];
+    if (refl[0] >= 0.0f) {
+        memcpy(c, refl, sizeof c);
+    } else {
+        if (sigma[0] < 0.0f) {
+            static const float eu_a[3] = {0.419f, 0.697f, 1.37f}, pheo_a[3] = {0.187f, 0.4f, 1.05f};
+            if (eu == 0.0 && pheo == 0.0)
+                eu = 1.3;
+            for (int k = 0; k < 3; k++)
+                sigma[k] = (float)(eu * eu_a[k] + pheo * pheo_a[k]);
+        }
+        double d = 5.969 - 0.215 * bn + 2.532 * bn * bn - 10.73 * pow(bn, 3) + 5.574 * pow(bn, 4) +
+                   0.245 * pow(bn, 5);
+        for (int k = 0; k < 3; k++)
+            c[k] = (float)exp(-sqrt(fmax(sigma[k], 0.0f)) * d);
+    }
+    pbrt_mat_init(m, "hair");
+    pbrt_mat_color(m, "Cs", c);
+    mat_float(m, "Kd", 1.0f);
+    mat_float(m, "Ks", 0.15f);
+    mat_float(m, "roughness", (float)fmax(bm * bm, 1e-3));
+    return 0;
+}
+
 static int material_of_type(Parser *P, const Token *t, const char *type, ParamList *pl, Material *m)
 {
     if (pbrt_find(pl, "normalmap"))
@@ -620,6 +658,8 @@ static int material_of_type(Parser *P, const Token *t, const char *type, ParamLi
     }
     if (strcmp(type, "mix") == 0)
         return mix_material(P, t, pl, m);
+    if (strcmp(type, "hair") == 0)
+        return hair_material(P, pl, m);
     if (strcmp(type, "interface") == 0 || strcmp(type, "") == 0 || strcmp(type, "none") == 0) {
         /* pbrt's "interface" (and "" or "none") marks a shape that only
          * bounds a participating medium: it is not a surface at all. */

@@ -572,7 +572,13 @@ static void test_materials(void)
     sh = &r->mesh[3].shader; /* mix of two diffuse: blended, 0.75 a + 0.25 b */
     CHECK(strcmp(sh->name, "diffuse") == 0 && param(sh, "reflectance") &&
           fabs(param(sh, "reflectance")->value[0] - (0.75 * 0.2 + 0.25)) < 1e-6);
-    CHECK(strcmp(r->mesh[4].shader.name, "matte") == 0); /* hair: unsupported */
+    /* hair: Kajiya-Kay, coloured by its melanin (pbrt's eumelanin 1.3:
+     * a dark brown, red above blue), beta_m 0.3 as roughness 0.09 */
+    CHECK(strcmp(r->mesh[4].shader.name, "hair") == 0);
+    const RayesParam *hc = param(&r->mesh[4].shader, "Cs");
+    const RayesParam *hr = param(&r->mesh[4].shader, "roughness");
+    CHECK(hc && hc->value[0] > hc->value[2] && hc->value[0] < 0.2f);
+    CHECK(hr && fabsf(hr->value[0] - 0.09f) < 1e-5f);
     sh = &r->mesh[5].shader; /* an image texture: a pattern on the reflectance */
     CHECK(strcmp(sh->name, "diffuse") == 0 && param(sh, "reflectance") &&
           param(sh, "reflectance")->type == RAYES_PARAM_PATTERN &&
