@@ -291,8 +291,10 @@ struct RayesShaderServices {
      *                 sqrt(1 - v^2) - t v)^e dw, e = 1 / roughness[i] (NULL:
      *                 0.1): Kajiya-Kay's highlight on the cone of mirror
      *                 directions about the fibre.
-     * Area lights are sampled by the light only. Either output may be
-     * NULL. Older renderers lack it (supports()). */
+     * Area and environment lights: the diffuse part by light samples, the
+     * highlight by light samples and samples of its lobe, weighed by
+     * multiple importance. Either output may be NULL. Older renderers
+     * lack it (supports()). */
     void (*direct_fiber)(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
                          int n_shadow_rays, const char *category, const float (*T)[3],
                          const float *roughness, float (*diffuse)[3], float (*specular)[3]);

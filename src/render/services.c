@@ -234,6 +234,36 @@ static void fiber_terms(Vec3 T, Vec3 V, Vec3 wi, float e, float *diff, float *sp
     }
 }
 
+/* Sampling the fibre highlight: theta (from T) drawn about the mirror
+ * cone's pi - theta_v from a Gaussian of width 1 / sqrt(e) (cos^e of the
+ * offset is about exp(-e offset^2 / 2)), phi about T uniform. The density
+ * of a direction, in solid angle, and a draw from (a, b, c). */
+static float fiber_lobe_pdf(Vec3 T, Vec3 V, Vec3 wi, float e)
+{
+    float tv = fminf(fmaxf(v3_dot(T, V), -1.0f), 1.0f);
+    float ti = fminf(fmaxf(v3_dot(T, wi), -1.0f), 1.0f), sin_t = sqrtf(1.0f - ti * ti);
+    if (sin_t < 1e-4f)
+        return 0.0f;
+    float sigma = 1.0f / sqrtf(e), x = (acosf(ti) - ((float)M_PI - acosf(tv))) / sigma;
+    return expf(-0.5f * x * x) / (sigma * sqrtf(2.0f * (float)M_PI)) /
+           (2.0f * (float)M_PI * sin_t);
+}
+
+static int fiber_lobe_sample(Vec3 T, Vec3 V, float e, float a, float b, float c, Vec3 *wi)
+{
+    float tv = fminf(fmaxf(v3_dot(T, V), -1.0f), 1.0f);
+    float gauss = sqrtf(-2.0f * logf(fmaxf(a, 1e-12f))) * cosf(2.0f * (float)M_PI * b);
+    float theta = (float)M_PI - acosf(tv) + gauss / sqrtf(e);
+    if (!(theta > 0.0f && theta < (float)M_PI))
+        return 0;
+    Vec3 X, Y;
+    v3_basis(T, &X, &Y);
+    float phi = 2.0f * (float)M_PI * c, st = sinf(theta);
+    *wi = v3_add(v3_scale(T, cosf(theta)),
+                 v3_add(v3_scale(X, st * cosf(phi)), v3_scale(Y, st * sinf(phi))));
+    return 1;
+}
+
 static void svc_direct_fiber(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
                              int n_shadow_rays, const char *category, const float (*T)[3],
                              const float *roughness, float (*diffuse)[3], float (*specular)[3])
@@ -251,6 +281,7 @@ static void svc_direct_fiber(const RayesShaderServices *sv, const RayesShadeCtx 
         Vec3 V = specular && ctx->I ? v3_normalize(v3_neg(v3_load(ctx->I[i]))) : v3(0, 0, 0);
         float e = 1.0f / (roughness && roughness[i] > 0.0f ? roughness[i] : 0.1f);
         float off = ps->offset[point(ctx, i)];
+        int spec = v3_length(V) > 0.0f;
         uint64_t key = hash_combine(ps->keys[point(ctx, i)], DIM_LIGHT);
         for (size_t k = 0; k < w->rs->n_lights && n > 0; k++) {
             const Light *l = &w->rs->lights[k];
@@ -277,9 +308,33 @@ static void svc_direct_fiber(const RayesShaderServices *sv, const RayesShadeCtx 
                     continue;
                 fiber_terms(t, V, ls.wi, e, &fd, &fs);
                 /* Delta lights' Li is what a Lambertian cosine term scales
-                 * (direct_lighting): (1/pi) Li cos; fibres take Li the same. */
+                 * (direct_lighting): (1/pi) Li cos; fibres take Li the same.
+                 * The highlight of area lights is weighed against the
+                 * lobe's own samples (power heuristic). */
+                float ws = light_is_area(l) && spec ? power_heuristic(ls.pdf, fiber_lobe_pdf(t, V, ls.wi, e))
+                                                    : 1.0f;
                 d = v3_madd(d, ls.Li, fd * weight);
-                s = v3_madd(s, ls.Li, fs * weight);
+                s = v3_madd(s, ls.Li, fs * weight * ws);
+            }
+            /* The highlight's strategy: directions from the lobe that
+             * reach the light. */
+            for (int j = 0; spec && light_is_area(l) && j < m; j++) {
+                float a, b, c, c2, fd, fs;
+                cmj_sample_2d((uint32_t)j, (uint32_t)m, (uint32_t)hash_combine(hash_combine(key, k), 1),
+                              &a, &b);
+                cmj_sample_2d((uint32_t)j, (uint32_t)m, (uint32_t)hash_combine(hash_combine(key, k), 2),
+                              &c, &c2);
+                Vec3 wi;
+                LightSample ls;
+                if (!fiber_lobe_sample(t, V, e, a, b, c, &wi) || !light_intersect(l, P, wi, &ls) ||
+                    !(v3_max_component(ls.Li) > 0.0f))
+                    continue;
+                float pdf = fiber_lobe_pdf(t, V, wi, e);
+                Vec3 o = v3_madd(P, Ng, v3_dot(wi, Ng) >= 0.0f ? off : -off);
+                if (!(pdf > 0.0f) || !unoccluded(w, o, wi, ls.dist))
+                    continue;
+                fiber_terms(t, V, wi, e, &fd, &fs);
+                s = v3_madd(s, ls.Li, fs * power_heuristic(pdf, ls.pdf) / (pdf * (float)m));
             }
         }
         if (diffuse)

@@ -299,5 +299,54 @@ static void test_hair_field_caches(void)
     rayes_scene_release(s);
 }
 
-TEST_MAIN(TEST(test_round_tube_hits), TEST(test_flat_faces_ray), TEST(test_bases),
+/* A lone hair (Kd 1, Ks 0, white) under a constant environment of
+ * radiance L: Kajiya-Kay's diffuse gathers (1/pi) L integral of sin over
+ * the sphere = pi L, from both sides of the fibre. With a highlight
+ * (Ks 1) the pixels rise above it and stay finite. */
+static void test_fiber_environment(void)
+{
+    for (int with_spec = 0; with_spec < 2; with_spec++) {
+        RayesScene *s = new_scene();
+        RayesParam hp[4] = {{"Kd", RAYES_PARAM_FLOAT, {1, 0, 0}, NULL},
+                            {"Ks", RAYES_PARAM_FLOAT, {(float)with_spec, 0, 0}, NULL},
+                            {"Ka", RAYES_PARAM_FLOAT, {0, 0, 0}, NULL},
+                            {"roughness", RAYES_PARAM_FLOAT, {0.02f, 0, 0}, NULL}};
+        CHECK(rayes_scene_set_shader(s, "hair", hp, 4) == RAYES_OK);
+        const float P[6] = {0, -2, 0, 0, 2, 0};
+        const int nv = 2;
+        RayesCurves c = {.degree = 1, .shape = RAYES_CURVE_ROUND, .n_curves = 1, .n_verts = &nv,
+                         .P = P};
+        const float w = 0.2f;
+        RayesPrimvar pv = {"width", RAYES_PRIMVAR_CONSTANT, &w, 1};
+        CHECK(rayes_scene_curves(s, &c, &pv, 1) == RAYES_OK);
+        RayesParam e = {"intensity", RAYES_PARAM_FLOAT, {0.5f, 0, 0}, NULL};
+        CHECK(rayes_scene_light(s, "environmentlight", &e, 1) == RAYES_OK);
+        CHECK(rayes_scene_commit(s) == RAYES_OK);
+        RayesRenderOptions o;
+        rayes_render_options_init(&o, RAYES_QUALITY_PREVIEW);
+        o.width = o.height = 32;
+        o.spp = 4;
+        o.shadow_rays = 64;
+        o.threads = 2;
+        RayesImage *img = NULL;
+        CHECK(rayes_render(s, &o, &img, NULL) == RAYES_OK);
+        double sum = 0.0;
+        int n = 0;
+        for (int y = 4; img && y < 28; y++) { /* the hair's middle column, lit all round */
+            const float *px = &img->rgba[4 * ((size_t)y * 32 + 16)];
+            if (px[3] == 1.0f)
+                sum += px[0], n++;
+        }
+        CHECK(n > 10);
+        double mean = n ? sum / n : 0.0;
+        if (!with_spec)
+            CHECK_NEAR(mean, 3.14159265 * 0.5, 0.03 * 3.14159265 * 0.5);
+        else
+            CHECK(mean > 3.14159265 * 0.5 && mean < 20.0); /* plus a finite highlight */
+        rayes_image_free(img);
+        rayes_scene_release(s);
+    }
+}
+
+TEST_MAIN(TEST(test_fiber_environment), TEST(test_round_tube_hits), TEST(test_flat_faces_ray), TEST(test_bases),
           TEST(test_points), TEST(test_bad_input), TEST(test_hair_field_caches))
