@@ -608,6 +608,11 @@ typedef struct RayesRenderOptions {
     double vertex_budget;      /* grid vertices of the whole scene, at most: a scene needing
                                   more is diced coarser, with one warning. Default 2e7 (about
                                   1.2 to 4.4 GB of grids and ray tracing data); 0: none */
+    float crop[4];             /* the crop window (RenderMan's CropWindow): xmin, xmax, ymin,
+                                  ymax in [0, 1] of the image, y down; pixels from ceil(W xmin)
+                                  to ceil(W xmax) - 1 (and alike in y) are rendered, each the
+                                  same bit for bit as in the whole frame, the rest are 0.
+                                  Default 0 1 0 1 */
 } RayesRenderOptions;
 
 /* Fills options with the defaults of a quality preset: 512 x 512, 4 pixel
@@ -651,6 +656,8 @@ RAYES_API void rayes_stats_free(RayesStats *stats);
 typedef struct RayesImage {
     int width, height;  /* pixels */
     float *rgba;        /* width * height * 4 floats, linear RGB and alpha, top row first */
+    int crop[4];        /* the pixels rendered: x, y, width, height (a crop window; outside
+                           it rgba is 0); width 0: all of them */
 } RayesImage;
 
 /* Renders a committed scene. On success *image (free with

@@ -52,6 +52,9 @@ static const char render_options[] =
     "                          --quality reference)\n"
     "  --cache-mb MB           cache budget in megabytes (default 100)\n"
     "  --cache-split C,M,F     budget shares of coarse, medium, fine (default .25,.25,.5)\n"
+    "  --crop X0,X1,Y0,Y1      render only this window of the image (RenderMan's CropWindow,\n"
+    "                          0 to 1, y down): the same pixels as the whole frame's; PNG\n"
+    "                          holds the window, EXR it as the data window of the frame\n"
     "  --cache-resolution R    auto (by ray differentials), coarse, medium or fine\n"
     "  --cache-k K             use the coarsest resolution whose micropolygons are at\n"
     "                          most K times the ray footprint (default 1)\n"
@@ -194,6 +197,21 @@ static void parse_split(const char *s, float split[3])
                   s);
 }
 
+/* --crop xmin,xmax,ymin,ymax in [0, 1] (RenderMan's CropWindow). */
+static void parse_crop(const char *s, float crop[4])
+{
+    char buf[128], *save = NULL;
+    snprintf(buf, sizeof buf, "%s", s);
+    for (int i = 0; i < 4; i++) {
+        char *tok = strtok_r(i == 0 ? buf : NULL, ",", &save);
+        crop[i] = parse_float("--crop", tok, 0.0f, 1.0f);
+    }
+    if (strtok_r(NULL, ",", &save) || !(crop[0] < crop[1]) || !(crop[2] < crop[3]))
+        die_usage("--crop: expected xmin,xmax,ymin,ymax in [0, 1] with xmin < xmax and ymin < "
+                  "ymax, got \"%s\"",
+                  s);
+}
+
 static int parse_resolution(const char *s)
 {
     static const char *const names[] = {"coarse", "medium", "fine"};
@@ -316,6 +334,10 @@ void parse_args(int argc, char **argv, Args *a)
             opt->cache_mb = parse_float(o, v, 0.0f, 1e7f);
         else if (strcmp(o, "--cache-split") == 0)
             parse_split(v, opt->cache_split);
+        else if (strcmp(o, "--crop") == 0) {
+            parse_crop(v, opt->crop);
+            a->set |= SET_CROP;
+        }
         else if (strcmp(o, "--cache-resolution") == 0)
             opt->cache_resolution = parse_resolution(v);
         else if (strcmp(o, "--cache-k") == 0)
@@ -410,9 +432,8 @@ void merge_settings(Args *a, const IoSettings *s)
         o->grid_size = s->grid_size;
     if (!(a->set & SET_TEXTURE_MB) && s->texture_mb > 0.0)
         o->texture_mb = s->texture_mb;
-    if (s->crop[0] != 0.0f || s->crop[1] != 1.0f || s->crop[2] != 0.0f || s->crop[3] != 1.0f)
-        fprintf(stderr, "rayes: warning: %s: CropWindow is not supported; the whole image is "
-                        "rendered\n", a->scene);
+    if (!(a->set & SET_CROP))
+        memcpy(o->crop, s->crop, sizeof o->crop);
 }
 
 RayesError default_light(const Args *a, RayesScene *scene)

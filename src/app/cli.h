@@ -23,7 +23,8 @@ enum {
     SET_BOUNCES = 16,
     SET_SPECULAR_DEPTH = 32,
     SET_GRID_SIZE = 64,
-    SET_TEXTURE_MB = 128
+    SET_TEXTURE_MB = 128,
+    SET_CROP = 256
 };
 
 /* An image to write. */

@@ -212,11 +212,29 @@ static void apply_exposure(RayesImage *img, float gain, float gamma)
         }
 }
 
+/* An image's pixels as written: a crop window's alone in a PNG; in an
+ * EXR the crop is the data window of the whole display window. */
 static RayesError write_output(const Output *o, const RayesImage *img, char *err, size_t n)
 {
-    if (o->format == IMAGE_FORMAT_PNG)
+    int win[4] = {0, 0, img->width, img->height};
+    if (img->crop[2] > 0)
+        memcpy(win, img->crop, sizeof win);
+    if (o->format != IMAGE_FORMAT_PNG)
+        return image_write_exr_window(o->path, img->width, img->height, img->rgba, win, err, n);
+    if (win[2] == img->width && win[3] == img->height)
         return image_write_png(o->path, img->width, img->height, img->rgba, err, n);
-    return image_write_exr(o->path, img->width, img->height, img->rgba, err, n);
+    float *crop = malloc(sizeof(float) * 4 * (size_t)win[2] * (size_t)win[3]);
+    if (!crop) {
+        snprintf(err, n, "%s: out of memory", o->path);
+        return RAYES_ERROR_OUT_OF_MEMORY;
+    }
+    for (int y = 0; y < win[3]; y++)
+        memcpy(crop + 4 * (size_t)y * (size_t)win[2],
+               img->rgba + 4 * ((size_t)(win[1] + y) * (size_t)img->width + (size_t)win[0]),
+               sizeof(float) * 4 * (size_t)win[2]);
+    RayesError e = image_write_png(o->path, win[2], win[3], crop, err, n);
+    free(crop);
+    return e;
 }
 
 static int cmd_render(int argc, char **argv)

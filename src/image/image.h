@@ -33,6 +33,10 @@ ImageFormat image_format_from_path(const char *path);
  * "renderer" string attribute. */
 RayesError image_write_exr(const char *path, int width, int height, const float *rgba,
                         char *err, size_t err_size);
+/* The same with the data window x, y, w, h of window[] (a crop: the
+ * display window stays width x height, as OpenEXR intends). */
+RayesError image_write_exr_window(const char *path, int width, int height, const float *rgba,
+                                  const int window[4], char *err, size_t err_size);
 
 /* PNG: 8-bit RGBA, sRGB-encoded (the sRGB transfer curve applied to the
  * clamped linear values, alpha linear), with an sRGB chunk. */

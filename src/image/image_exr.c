@@ -67,8 +67,9 @@ typedef struct ExrIo {
 } ExrIo;
 
 typedef struct ExrImage {
-    int width, height; /* pixels */
+    int width, height; /* pixels: the display window */
     const float *rgba; /* width * height * 4, top row first */
+    int x0, y0, w, h;  /* the data window written: its corner and size */
 } ExrImage;
 
 /* ------------------------------------------------------------ callbacks */
@@ -198,9 +199,16 @@ static exr_result_t define_part(exr_context_t ctx, const ExrImage *image)
 {
     int part = 0;
     exr_result_t rv = exr_add_part(ctx, NULL, EXR_STORAGE_SCANLINE, &part);
+    exr_attr_box2i_t display, data;
+    display.min.x = 0, display.min.y = 0;
+    display.max.x = image->width - 1, display.max.y = image->height - 1;
+    data.min.x = image->x0, data.min.y = image->y0;
+    data.max.x = image->x0 + image->w - 1, data.max.y = image->y0 + image->h - 1;
+    exr_attr_v2f_t centre;
+    centre.x = 0.0f, centre.y = 0.0f;
     if (rv == EXR_ERR_SUCCESS)
-        rv = exr_initialize_required_attr_simple(ctx, part, image->width, image->height,
-                                                 EXR_COMPRESSION_ZIP);
+        rv = exr_initialize_required_attr(ctx, part, &display, &data, 1.0f, &centre, 1.0f,
+                                          EXR_LINEORDER_INCREASING_Y, EXR_COMPRESSION_ZIP);
     /* Perceptual treatment only matters to lossy codecs; say it right. */
     static const char *const names[4] = {"R", "G", "B", "A"};
     for (int i = 0; i < 4 && rv == EXR_ERR_SUCCESS; i++)
@@ -234,7 +242,8 @@ static exr_result_t write_chunks(exr_context_t ctx, const ExrImage *image)
         return rv;
     exr_encode_pipeline_t encoder = EXR_ENCODE_PIPELINE_INITIALIZER;
     bool initialized = false;
-    for (int y = 0; y < image->height && rv == EXR_ERR_SUCCESS; y += lines_per_chunk) {
+    for (int y = image->y0; y < image->y0 + image->h && rv == EXR_ERR_SUCCESS;
+         y += lines_per_chunk) {
         exr_chunk_info_t cinfo;
         rv = exr_write_scanline_chunk_info(ctx, 0, y, &cinfo);
         if (rv != EXR_ERR_SUCCESS)
@@ -243,7 +252,8 @@ static exr_result_t write_chunks(exr_context_t ctx, const ExrImage *image)
                          : exr_encoding_initialize(ctx, 0, &cinfo, &encoder);
         if (rv != EXR_ERR_SUCCESS)
             break;
-        bind_encode_channels(&encoder, image->rgba + (size_t)y * (size_t)image->width * 4,
+        bind_encode_channels(&encoder,
+                             image->rgba + ((size_t)y * (size_t)image->width + (size_t)image->x0) * 4,
                              image->width);
         if (!initialized) {
             initialized = true;
@@ -286,12 +296,21 @@ static RayesError write_exr_body(FILE *file, const char *path, const void *data,
 RayesError image_write_exr(const char *path, int width, int height, const float *rgba, char *err,
                         size_t err_size)
 {
-    if (!path || !rgba || width <= 0 || height <= 0 || width > MAX_SIDE) {
+    const int all[4] = {0, 0, width, height};
+    return image_write_exr_window(path, width, height, rgba, all, err, err_size);
+}
+
+RayesError image_write_exr_window(const char *path, int width, int height, const float *rgba,
+                                  const int window[4], char *err, size_t err_size)
+{
+    if (!path || !rgba || width <= 0 || height <= 0 || width > MAX_SIDE || window[0] < 0 ||
+        window[1] < 0 || window[2] <= 0 || window[3] <= 0 || window[0] + window[2] > width ||
+        window[1] + window[3] > height) {
         image_set_error(err, err_size, "%s: cannot write EXR: invalid arguments (%d x %d pixels%s)",
                      path ? path : "(null)", width, height, rgba ? "" : ", no pixels");
         return RAYES_ERROR_INVALID_ARGUMENT;
     }
-    ExrImage image = {width, height, rgba};
+    ExrImage image = {width, height, rgba, window[0], window[1], window[2], window[3]};
     return image_write_via_temp(path, write_exr_body, &image, err, err_size);
 }
 

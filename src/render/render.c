@@ -43,7 +43,8 @@ typedef struct Frame {
     const RenderSettings *set;
     float *rgba;
     Worker *workers;
-    int tiles_x, tiles_y;
+    int tiles_x, tiles_y;     /* over crop */
+    int crop[4];              /* the pixels rendered: x0, y0, x1, y1 */
     float radius;             /* filter radius, pixels */
     int margin;               /* pixels of neighbours whose samples reach a tile */
     atomic_int cancelled;
@@ -166,8 +167,9 @@ static void render_tile(void *ctx, size_t task, int worker)
     if (atomic_load(&f->cancelled))
         return;
     int ts = set->tile_size;
-    int x0 = (int)(task % (size_t)f->tiles_x) * ts, y0 = (int)(task / (size_t)f->tiles_x) * ts;
-    int tw = RY_MIN(ts, set->width - x0), th = RY_MIN(ts, set->height - y0);
+    int x0 = f->crop[0] + (int)(task % (size_t)f->tiles_x) * ts;
+    int y0 = f->crop[1] + (int)(task / (size_t)f->tiles_x) * ts;
+    int tw = RY_MIN(ts, f->crop[2] - x0), th = RY_MIN(ts, f->crop[3] - y0);
     float(*acc)[5] = calloc((size_t)tw * th, sizeof *acc);
     RY_CHECK(acc != NULL);
     if (set->accum)
@@ -212,8 +214,13 @@ int render_frame(const RenderScene *rs, const RenderSettings *set, float *rgba, 
 {
     int threads = set->threads > 0 ? set->threads : thread_count_cores();
     Frame f = {.rs = rs, .set = set, .rgba = rgba};
-    f.tiles_x = (set->width + set->tile_size - 1) / set->tile_size;
-    f.tiles_y = (set->height + set->tile_size - 1) / set->tile_size;
+    /* Tiles over the crop window (the whole frame without one): a pixel's
+     * samples and its filter's neighbours do not depend on its tile. */
+    int whole[4] = {0, 0, set->width, set->height};
+    const int *c = set->crop[2] > set->crop[0] && set->crop[3] > set->crop[1] ? set->crop : whole;
+    memcpy(f.crop, c, sizeof f.crop);
+    f.tiles_x = (f.crop[2] - f.crop[0] + set->tile_size - 1) / set->tile_size;
+    f.tiles_y = (f.crop[3] - f.crop[1] + set->tile_size - 1) / set->tile_size;
     f.radius = 0.5f * set->filter_width;
     f.margin = RY_MAX((int)ceilf(f.radius + 0.5f) - 1, 0);
     atomic_init(&f.cancelled, 0);

@@ -68,6 +68,8 @@ typedef struct RenderScene {
 
 typedef struct RenderSettings {
     int width, height, spp, threads, tile_size;
+    int crop[4];                  /* the pixels rendered: x0, y0, x1, y1 (exclusive ends);
+                                     all zero: the whole frame */
     int bounces;                  /* maximum diffuse depth */
     int specular_depth;           /* maximum specular depth */
     int branch_depth;             /* points below this diffuse + specular depth branch

@@ -83,7 +83,7 @@ RayesError rayes_session_new(RayesScene *scene, const RayesRenderOptions *option
     atomic_init(&s->cancel, 0);
     size_t n = (size_t)s->set.width * s->set.height;
     s->accum = malloc(n * sizeof *s->accum);
-    s->rgba = malloc(n * 4 * sizeof *s->rgba);
+    s->rgba = calloc(n * 4, sizeof *s->rgba); /* 0 outside a crop window */
     s->textures = session_textures(scene, options->texture_mb, options->texture_width);
     if (options->cache)
         s->cache = cache_new((uint64_t)(options->cache_mb * 1e6), options->cache_split);

@@ -66,6 +66,7 @@ void rayes_render_options_init(RayesRenderOptions *o, RayesQuality quality)
     o->vertex_budget = 2e7;
     o->texture_mb = 64.0;
     o->texture_width = 1.0f;
+    o->crop[1] = o->crop[3] = 1.0f;
     switch (quality) {
     case RAYES_QUALITY_PREVIEW:
         o->shadow_rays = o->shadow_rays_deep = 4;
@@ -128,6 +129,11 @@ RayesError session_check_options(RayesScene *scene, const RayesRenderOptions *o)
              !(o->vertex_budget >= 0.0) || o->vertex_budget > 1e12)
         what =
             "options: off-screen dicing factor must be 1 to 1000 and the vertex budget 0 to 1e12";
+    else if (!(o->crop[0] >= 0.0f && o->crop[0] < o->crop[1] && o->crop[1] <= 1.0f &&
+               o->crop[2] >= 0.0f && o->crop[2] < o->crop[3] && o->crop[3] <= 1.0f))
+        what = "options: the crop window must be xmin < xmax and ymin < ymax within [0, 1]";
+    else if (!session_crop_pixels(o, NULL))
+        what = "options: the crop window holds no pixel";
     else if (o->branch_depth < 1 || o->branch_depth > 129)
         what = "options: branch depth must be 1 to 129";
     else if (!(o->texture_mb >= 0.0) || o->texture_mb > 1e7 || !(o->texture_width >= 0.0f) ||
@@ -138,6 +144,20 @@ RayesError session_check_options(RayesScene *scene, const RayesRenderOptions *o)
     if (scene->error[0] == '\0')
         snprintf(scene->error, sizeof scene->error, "%s", what);
     return RAYES_ERROR_INVALID_ARGUMENT;
+}
+
+int session_crop_pixels(const RayesRenderOptions *o, int rect[4])
+{
+    /* RenderMan's rule: pixels ceil(res min) to ceil(res max) - 1, less a
+     * hundredth of a pixel so that a float's rounding (0.3f is a little
+     * over 0.3) does not take a pixel away. */
+    int x0 = (int)ceil((double)o->width * o->crop[0] - 0.01);
+    int x1 = (int)ceil((double)o->width * o->crop[1] - 0.01);
+    int y0 = (int)ceil((double)o->height * o->crop[2] - 0.01);
+    int y1 = (int)ceil((double)o->height * o->crop[3] - 0.01);
+    if (rect)
+        rect[0] = x0, rect[1] = y0, rect[2] = x1, rect[3] = y1;
+    return x1 > x0 && y1 > y0;
 }
 
 RenderSettings session_settings(const RayesRenderOptions *o)
@@ -173,6 +193,7 @@ RenderSettings session_settings(const RayesRenderOptions *o)
     };
     if (s.threads == 0)
         s.threads = thread_count_cores();
+    session_crop_pixels(o, s.crop);
     return s;
 }
 
@@ -357,6 +378,10 @@ RayesError rayes_render(RayesScene *scene, const RayesRenderOptions *opt, RayesI
     img->width = set.width;
     img->height = set.height;
     img->rgba = rgba;
+    if (set.crop[0] > 0 || set.crop[1] > 0 || set.crop[2] < set.width || set.crop[3] < set.height) {
+        img->crop[0] = set.crop[0], img->crop[1] = set.crop[1];
+        img->crop[2] = set.crop[2] - set.crop[0], img->crop[3] = set.crop[3] - set.crop[1];
+    }
     *image = img;
     img = NULL;
     rgba = NULL;

@@ -35,6 +35,10 @@ RayesError session_check_options(RayesScene *scene, const RayesRenderOptions *op
  * textures yet). */
 RenderSettings session_settings(const RayesRenderOptions *options);
 
+/* The crop window's pixels, x0 y0 x1 y1 (exclusive ends), into rect (may
+ * be NULL); 1 if it holds any. */
+int session_crop_pixels(const RayesRenderOptions *options, int rect[4]);
+
 /* The texture system of a render: the scene's texture path, then
  * $RAYES_TEXTURE_PATH's. NULL when out of memory. */
 TextureSystem *session_textures(const RayesScene *scene, double mb, float width);
