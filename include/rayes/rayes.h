@@ -325,7 +325,8 @@ RAYES_API RayesError rayes_scene_subdivision_mesh(RayesScene *scene, RayesSubdiv
  * should be across the curve), "Cs", "st". Classes: constant, uniform
  * (one per curve), varying (one per segment end: segments + 1 per
  * non-periodic curve, segments per periodic one; facevarying reads as
- * varying), vertex (one per control point, interpolated with the basis).
+ * varying), vertex (one per control point, evaluated with the basis at
+ * the segment ends). Between ends every value is linear.
  * Without N, shape says how they are traced: RAYES_CURVE_ROUND tubes or
  * RAYES_CURVE_FLAT ribbons that face each ray. They are diced into grids
  * one micropolygon wide (cached like any surface) facing the camera. */
@@ -351,9 +352,9 @@ RAYES_API RayesError rayes_scene_curves(RayesScene *scene, const RayesCurves *cu
                                         const RayesPrimvar *pv, size_t n_pv);
 
 /* The counts primitive variables of curves must have: control points
- * (vertex) and segment ends (varying). Returns the index of the first
- * curve whose count makes no whole segments, or of a bad degree or step
- * (0), as -1 - index; else 0. */
+ * (vertex) and segment ends (varying). Returns 0; -1 - k when curve k's
+ * count makes no whole segments; or LONG_MIN for a bad degree or step, or
+ * missing arrays. */
 RAYES_API long rayes_curves_counts(const RayesCurves *curves, size_t *n_points, size_t *n_varying);
 
 /* Points (RenderMan's Points): n_points spheres or disks facing each ray

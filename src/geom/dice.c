@@ -9,8 +9,9 @@
  * more than gridsize micropolygons (256 by default, or more than
  * GEOM_MAX_GRID - 1 along a side) is split in two across its longer
  * direction; a triangle needing more than sqrt(gridsize) subdivisions per
- * edge (so more than gridsize micro-triangles) is split in four at its edge
- * midpoints. Each part is estimated again, nearer parts getting
+ * edge (so more than gridsize micro-triangles) is bisected across its long
+ * edge while it is thin, then made three quads. Each part is estimated
+ * again, nearer parts getting
  * finer rates. The area rule gives grids of 128 to 256 micropolygons where
  * a per-side rule of 16 gave 64 to 256: on the benchmark box at 1024 x 1024,
  * 17,158 grids of 3.61 M vertices, against the memo's "approximately 18,000
@@ -191,11 +192,11 @@ static void lattice_lengths(const Vec3 (*p)[LATTICE], int triangular, float len[
 
 /* The edge of a triangle, in lattice space (0: c0-c1, 1: c1-c2, 2: c2-c0),
  * to bisect when the triangle must split and is thin (its longest edge
- * more than three times its height above it), else -1: split in four, a
- * thin triangle keeps its shape, and its grids of slivers grow with the
- * square of its length; bisected across its long edge it grows fatter
- * (tests/geom/test_dice.c: a 1000:1 triangle dices into a fifth of the
- * vertices). */
+ * more than three times its height above it), else -1 (split_quads).
+ * Split in four, a thin triangle kept its shape and its grids of slivers
+ * grew with the square of its length; bisected across its long edge it
+ * grows fatter (tests/geom/test_dice.c: a 1000:1 triangle dices into a
+ * fifth of the vertices). */
 static int thin_edge(const Vec3 (*p)[LATTICE])
 {
     const int last = LATTICE - 1;
@@ -469,15 +470,22 @@ static int dice_quad(GridSet *gs, const Prim *prim, uint32_t prim_index, const f
                 .nu = (uint16_t)nu, .nv = (uint16_t)nv, .primvars = prim->pv,
                 .shape = (uint8_t)prim_shape(prim)};
     memcpy(g->uv, d->c, sizeof g->uv);
-    if (d->sub_quad) { /* the bounds of its corners' (u, v): the spacing of its vertices */
-        float lo[2] = {INFINITY, INFINITY}, hi[2] = {-INFINITY, -INFINITY};
-        for (int k = 0; k < 4; k++) {
-            float u, v;
-            domain_uv(d, (float)(k & 1), (float)(k >> 1), &u, &v);
-            lo[0] = fminf(lo[0], u), lo[1] = fminf(lo[1], v);
-            hi[0] = fmaxf(hi[0], u), hi[1] = fmaxf(hi[1], v);
+    if (d->sub_quad) {
+        /* Its rows and columns run askew in the triangle's (u, v): uv holds
+         * a box whose spacing, (uv[1] - uv[0]) / (n - 1), is the largest
+         * step in u and in v between neighbouring vertices along either
+         * direction (its edges bound them: the map is bilinear). */
+        float c[4][2], step[2] = {0, 0};
+        for (int k = 0; k < 4; k++)
+            domain_uv(d, (float)(k & 1), (float)(k >> 1), &c[k][0], &c[k][1]);
+        for (int a = 0; a < 2; a++) {
+            float du = fmaxf(fabsf(c[1][a] - c[0][a]), fabsf(c[3][a] - c[2][a])) / (float)(nu - 1);
+            float dv = fmaxf(fabsf(c[2][a] - c[0][a]), fabsf(c[3][a] - c[1][a])) / (float)(nv - 1);
+            step[a] = fmaxf(du, dv);
         }
-        g->uv[0][0] = lo[0], g->uv[0][1] = lo[1], g->uv[1][0] = hi[0], g->uv[1][1] = hi[1];
+        g->uv[0][0] = c[0][0], g->uv[0][1] = c[0][1];
+        g->uv[1][0] = c[0][0] + step[0] * (float)(nu - 1);
+        g->uv[1][1] = c[0][1] + step[1] * (float)(nv - 1);
     }
     size_t base = gs->n_vertices;
     for (int j = 0; j < nv; j++)
@@ -558,35 +566,19 @@ static int split_sub_triangle(Walk *w, const float *a, const float *b, const flo
     return split_dice(w, &sub, depth + 1);
 }
 
+/* A thin triangle: two halves at the midpoint of its long edge (thin:
+ * that edge's first corner, k, to k + 1), corners kept in order. */
 static int split_triangle(Walk *w, const Domain *d, int thin, int depth)
 {
-    if (thin >= 0) {
-        /* Two halves at the midpoint of the long edge (k, k+1), corners
-         * kept in order. */
-        int a = thin, b = (thin + 1) % 3;
-        float m[2] = {0.5f * (d->c[a][0] + d->c[b][0]), 0.5f * (d->c[a][1] + d->c[b][1])};
-        float half[2][3][2];
-        for (int h = 0; h < 2; h++)
-            memcpy(half[h], d->c, sizeof half[h]);
-        memcpy(half[0][b], m, sizeof m);
-        memcpy(half[1][a], m, sizeof m);
-        for (int h = 0; h < 2; h++)
-            if (split_sub_triangle(w, half[h][0], half[h][1], half[h][2], depth) != 0)
-                return -1;
-        return 0;
-    }
-    /* Four sub-triangles at the edge midpoints; corners 0, 1, 2 first, the
-     * middle one last. */
-    float m01[2], m12[2], m20[2];
-    for (int k = 0; k < 2; k++) {
-        m01[k] = 0.5f * (d->c[0][k] + d->c[1][k]);
-        m12[k] = 0.5f * (d->c[1][k] + d->c[2][k]);
-        m20[k] = 0.5f * (d->c[2][k] + d->c[0][k]);
-    }
-    const float *corners[4][3] = {
-        {d->c[0], m01, m20}, {m01, d->c[1], m12}, {m20, m12, d->c[2]}, {m12, m20, m01}};
-    for (int s = 0; s < 4; s++)
-        if (split_sub_triangle(w, corners[s][0], corners[s][1], corners[s][2], depth) != 0)
+    int a = thin, b = (thin + 1) % 3;
+    float m[2] = {0.5f * (d->c[a][0] + d->c[b][0]), 0.5f * (d->c[a][1] + d->c[b][1])};
+    float half[2][3][2];
+    for (int h = 0; h < 2; h++)
+        memcpy(half[h], d->c, sizeof half[h]);
+    memcpy(half[0][b], m, sizeof m);
+    memcpy(half[1][a], m, sizeof m);
+    for (int h = 0; h < 2; h++)
+        if (split_sub_triangle(w, half[h][0], half[h][1], half[h][2], depth) != 0)
             return -1;
     return 0;
 }

@@ -189,7 +189,9 @@ typedef struct Grid {
                               / 2, edge) over its primitive's grids (geom_bound_sagitta),
                               since neighbours may be diced at other rates */
     float uv[3][2];        /* corners in the primitive's (u, v): quad (u0,v0), (u1,v1);
-                              triangle: the three corners */
+                              triangle: the three corners; a quad over part of a triangle
+                              (dice.c's split_quads): a box whose spacing is its vertices'
+                              largest step in u and in v */
     uint8_t primvars;      /* GEOM_PV_* bits: the GridSet's Ns, st, Cs hold its vertices'
                               values (else: N, uv, the object's colour) */
 } Grid;

@@ -607,15 +607,16 @@ static int hair_material(Parser *P, ParamList *pl, Material *m)
         pbrt_get_color(P, pl, "sigma_a", none, sigma, NULL) < 0)
         return -1;
     double bm = pbrt_get_float(pl, "beta_m", 0.3), bn = pbrt_get_float(pl, "beta_n", 0.3);
+    int melanin = pbrt_find(pl, "eumelanin") || pbrt_find(pl, "pheomelanin");
     double eu = pbrt_get_float(pl, "eumelanin", 0.0), pheo = pbrt_get_float(pl, "pheomelanin", 0.0);
     (void)pbrt_find(pl, "eta"), (void)pbrt_find(pl, "alpha"); /* the lobes' shape: not modelled */
     float c[3];
-    if (refl[0] >= 0.0f) {
+    if (refl[0] >= 0.0f && sigma[0] < 0.0f) { /* pbrt: sigma_a first, then reflectance */
         memcpy(c, refl, sizeof c);
     } else {
         if (sigma[0] < 0.0f) {
             static const float eu_a[3] = {0.419f, 0.697f, 1.37f}, pheo_a[3] = {0.187f, 0.4f, 1.05f};
-            if (eu == 0.0 && pheo == 0.0)
+            if (!melanin)
                 eu = 1.3;
             for (int k = 0; k < 3; k++)
                 sigma[k] = (float)(eu * eu_a[k] + pheo * pheo_a[k]);

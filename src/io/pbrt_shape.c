@@ -466,7 +466,8 @@ static int shape_curve(Parser *P, const Token *t, ParamList *pl)
     Param *pp = pbrt_find(pl, "P"), *np = pbrt_find(pl, "N");
     const char *basis = pbrt_get_string(pl, "basis", "bezier");
     const char *type = pbrt_get_string(pl, "type", "flat");
-    int degree = (int)pbrt_get_float(pl, "degree", 3);
+    double degree_value = pbrt_get_float(pl, "degree", 3);
+    int degree = degree_value == 2.0 ? 2 : degree_value == 3.0 ? 3 : 0;
     double width = pbrt_get_float(pl, "width", 1.0);
     double w0 = pbrt_get_float(pl, "width0", width), w1 = pbrt_get_float(pl, "width1", width);
     (void)pbrt_find(pl, "splitdepth"); /* pbrt's refinement: diced like everything else */
@@ -474,8 +475,8 @@ static int shape_curve(Parser *P, const Token *t, ParamList *pl)
     if (!bspline && strcmp(basis, "bezier") != 0)
         return FAIL_TOK(P, t, "curve: \"basis\" is \"%.40s\"; expected \"bezier\" or \"bspline\"",
                         basis);
-    if (degree != 2 && degree != 3)
-        return FAIL_TOK(P, t, "curve: \"degree\" is %d; expected 2 or 3", degree);
+    if (degree == 0)
+        return FAIL_TOK(P, t, "curve: \"degree\" is %g; expected 2 or 3", degree_value);
     if (!ribbon && strcmp(type, "flat") != 0 && strcmp(type, "cylinder") != 0)
         return FAIL_TOK(P, t, "curve: \"type\" is \"%.40s\"; expected flat, cylinder or ribbon",
                         type);

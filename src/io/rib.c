@@ -410,7 +410,6 @@ static const RibRequest own_requests[] = {
     {"Procedural2", h_skip},
     {"Bxdf", h_skip},
     {"Light", h_skip},
-    {"Pattern", h_skip},
     {"Integrator", h_skip},
     {"DisplayChannel", h_skip},
     {"DisplayFilter", h_skip},

@@ -9,6 +9,7 @@
  * "uniform string type" "sphere" (the default) or "disk".
  */
 #include <float.h>
+#include <limits.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -140,8 +141,8 @@ static int h_curves(Rib *r, const Args *a)
     memcpy(c.basis, r->a.vbasis, sizeof c.basis);
     size_t n_points = 0, n_varying = 0;
     long bad = e == 0 ? rayes_curves_counts(&c, &n_points, &n_varying) : 0;
-    if (bad == -1 && n_curves == 0)
-        bad = 0;
+    if (e == 0 && bad == LONG_MIN)
+        e = rib_error(r, "the basis step %d is out of range (1 to 4)", c.step);
     if (e == 0 && bad != 0)
         e = rib_error(r, "curve %ld has %d vertices, which make no whole %s segments (step %d)",
                       -1 - bad, nverts[-1 - bad], type, cubic ? c.step : 1);

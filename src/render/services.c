@@ -264,6 +264,67 @@ static int fiber_lobe_sample(Vec3 T, Vec3 V, float e, float a, float b, float c,
     return 1;
 }
 
+/* What fibre lighting needs of one point. */
+typedef struct FiberPoint {
+    Vec3 P, Ng, T, V; /* V zero: no highlight */
+    float e, offset;
+    uint64_t key;     /* the light's sample key */
+} FiberPoint;
+
+/* A ray's origin off a fibre: on the side of Ng that wi leaves by. */
+static Vec3 fiber_origin(const FiberPoint *p, Vec3 wi)
+{
+    return v3_madd(p->P, p->Ng, v3_dot(wi, p->Ng) >= 0.0f ? p->offset : -p->offset);
+}
+
+/* One light's m samples (1 for delta lights), adding to diffuse d and
+ * highlight s; an area light's highlight is weighed against the lobe's
+ * own samples (power heuristic). Delta lights' Li is what a Lambertian
+ * cosine term scales (direct_lighting's (1/pi) Li cos); fibres take Li
+ * the same. */
+static void fiber_light_samples(Worker *w, const FiberPoint *p, const Light *l, int m,
+                                uint32_t pattern, Vec3 *d, Vec3 *s)
+{
+    int area = light_is_area(l), spec = v3_length(p->V) > 0.0f;
+    for (int j = 0; j < m; j++) {
+        float a = 0.5f, b = 0.5f, fd, fs;
+        if (area)
+            cmj_sample_2d((uint32_t)j, (uint32_t)m, pattern, &a, &b);
+        LightSample ls;
+        if (!light_sample(l, p->P, a, b, &ls) || !(v3_max_component(ls.Li) > 0.0f) ||
+            (area && !(ls.pdf > 0.0f)) || !unoccluded(w, fiber_origin(p, ls.wi), ls.wi, ls.dist))
+            continue;
+        float weight = area ? 1.0f / (ls.pdf * (float)m) : 1.0f;
+        float ws = area && spec ? power_heuristic(ls.pdf, fiber_lobe_pdf(p->T, p->V, ls.wi, p->e))
+                                : 1.0f;
+        fiber_terms(p->T, p->V, ls.wi, p->e, &fd, &fs);
+        *d = v3_madd(*d, ls.Li, fd * weight);
+        *s = v3_madd(*s, ls.Li, fs * weight * ws);
+    }
+}
+
+/* The highlight's own strategy for an area light: m directions from the
+ * lobe that reach the light. */
+static void fiber_lobe_samples(Worker *w, const FiberPoint *p, const Light *l, int m,
+                               uint64_t key, Vec3 *s)
+{
+    for (int j = 0; j < m; j++) {
+        float a, b, c, c2, fd, fs;
+        cmj_sample_2d((uint32_t)j, (uint32_t)m, (uint32_t)hash_combine(key, 1), &a, &b);
+        cmj_sample_2d((uint32_t)j, (uint32_t)m, (uint32_t)hash_combine(key, 2), &c, &c2);
+        Vec3 wi;
+        LightSample ls;
+        if (!fiber_lobe_sample(p->T, p->V, p->e, a, b, c, &wi) ||
+            !light_intersect(l, p->P, wi, &ls) || !(v3_max_component(ls.Li) > 0.0f))
+            continue;
+        float pdf = fiber_lobe_pdf(p->T, p->V, wi, p->e);
+        if (!(pdf > 0.0f) || !unoccluded(w, fiber_origin(p, wi), wi, ls.dist))
+            continue;
+        fiber_terms(p->T, p->V, wi, p->e, &fd, &fs);
+        *s = v3_madd(*s, ls.Li, fs * power_heuristic(pdf, ls.pdf) / (pdf * (float)m));
+    }
+}
+
 static void svc_direct_fiber(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
                              int n_shadow_rays, const char *category, const float (*T)[3],
                              const float *roughness, float (*diffuse)[3], float (*specular)[3])
@@ -276,66 +337,24 @@ static void svc_direct_fiber(const RayesShaderServices *sv, const RayesShadeCtx 
                                       : w->set->shadow_rays_deep;
     const RenderObject *obj = lit_object(ps);
     for (size_t i = 0; i < ctx->n_points; i++) {
-        Vec3 d = v3(0, 0, 0), s = d;
-        Vec3 P = v3_load(ctx->P[i]), Ng = v3_load(ctx->Ng[i]), t = v3_normalize(v3_load(T[i]));
-        Vec3 V = specular && ctx->I ? v3_normalize(v3_neg(v3_load(ctx->I[i]))) : v3(0, 0, 0);
-        float e = 1.0f / (roughness && roughness[i] > 0.0f ? roughness[i] : 0.1f);
-        float off = ps->offset[point(ctx, i)];
-        int spec = v3_length(V) > 0.0f;
+        FiberPoint p;
+        p.P = v3_load(ctx->P[i]);
+        p.Ng = v3_load(ctx->Ng[i]);
+        p.T = v3_normalize(v3_load(T[i]));
+        p.V = specular && ctx->I ? v3_normalize(v3_neg(v3_load(ctx->I[i]))) : v3(0, 0, 0);
+        p.e = 1.0f / (roughness && roughness[i] > 0.0f ? roughness[i] : 0.1f);
+        p.offset = ps->offset[point(ctx, i)];
         uint64_t key = hash_combine(ps->keys[point(ctx, i)], DIM_LIGHT);
+        Vec3 d = v3(0, 0, 0), s = d;
         for (size_t k = 0; k < w->rs->n_lights && n > 0; k++) {
             const Light *l = &w->rs->lights[k];
             if (l->type == LIGHT_AMBIENT || !render_lit_by(obj, k) ||
                 !light_category_match(l, category))
                 continue;
             int m = light_is_area(l) ? n : 1;
-            uint32_t pattern = (uint32_t)hash_combine(key, k);
-            for (int j = 0; j < m; j++) {
-                float a = 0.5f, b = 0.5f, fd, fs;
-                if (m > 1)
-                    cmj_sample_2d((uint32_t)j, (uint32_t)m, pattern, &a, &b);
-                LightSample ls;
-                /* From the side of the grid the light is on: a fibre is lit
-                 * all round. */
-                Vec3 o = P;
-                if (!light_sample(l, o, a, b, &ls) || !(v3_max_component(ls.Li) > 0.0f))
-                    continue;
-                o = v3_madd(P, Ng, v3_dot(ls.wi, Ng) >= 0.0f ? off : -off);
-                if (!unoccluded(w, o, ls.wi, ls.dist))
-                    continue;
-                float weight = light_is_area(l) ? 1.0f / (ls.pdf * (float)m) : 1.0f;
-                if (light_is_area(l) && !(ls.pdf > 0.0f))
-                    continue;
-                fiber_terms(t, V, ls.wi, e, &fd, &fs);
-                /* Delta lights' Li is what a Lambertian cosine term scales
-                 * (direct_lighting): (1/pi) Li cos; fibres take Li the same.
-                 * The highlight of area lights is weighed against the
-                 * lobe's own samples (power heuristic). */
-                float ws = light_is_area(l) && spec ? power_heuristic(ls.pdf, fiber_lobe_pdf(t, V, ls.wi, e))
-                                                    : 1.0f;
-                d = v3_madd(d, ls.Li, fd * weight);
-                s = v3_madd(s, ls.Li, fs * weight * ws);
-            }
-            /* The highlight's strategy: directions from the lobe that
-             * reach the light. */
-            for (int j = 0; spec && light_is_area(l) && j < m; j++) {
-                float a, b, c, c2, fd, fs;
-                cmj_sample_2d((uint32_t)j, (uint32_t)m, (uint32_t)hash_combine(hash_combine(key, k), 1),
-                              &a, &b);
-                cmj_sample_2d((uint32_t)j, (uint32_t)m, (uint32_t)hash_combine(hash_combine(key, k), 2),
-                              &c, &c2);
-                Vec3 wi;
-                LightSample ls;
-                if (!fiber_lobe_sample(t, V, e, a, b, c, &wi) || !light_intersect(l, P, wi, &ls) ||
-                    !(v3_max_component(ls.Li) > 0.0f))
-                    continue;
-                float pdf = fiber_lobe_pdf(t, V, wi, e);
-                Vec3 o = v3_madd(P, Ng, v3_dot(wi, Ng) >= 0.0f ? off : -off);
-                if (!(pdf > 0.0f) || !unoccluded(w, o, wi, ls.dist))
-                    continue;
-                fiber_terms(t, V, wi, e, &fd, &fs);
-                s = v3_madd(s, ls.Li, fs * power_heuristic(pdf, ls.pdf) / (pdf * (float)m));
-            }
+            fiber_light_samples(w, &p, l, m, (uint32_t)hash_combine(key, k), &d, &s);
+            if (light_is_area(l) && v3_length(p.V) > 0.0f)
+                fiber_lobe_samples(w, &p, l, m, hash_combine(hash_combine(key, k), 1), &s);
         }
         if (diffuse)
             v3_store(diffuse[i], d);

@@ -11,6 +11,7 @@
  * normals take the room). A point becomes one PRIM_POINT. Widths are object-space diameters, scaled to world space by
  * the cube root of the transform's determinant.
  */
+#include <limits.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -148,7 +149,7 @@ long rayes_curves_counts(const RayesCurves *c, size_t *n_points, size_t *n_varyi
     if (!c || (c->degree != 1 && c->degree != 3) ||
         (c->degree == 3 && (c->step < 1 || c->step > 4)) ||
         (c->n_curves && (!c->n_verts || !c->P)))
-        return -1;
+        return LONG_MIN;
     for (size_t k = 0; k < c->n_curves; k++) {
         size_t segs = curve_segments(c, c->n_verts[k]);
         if (segs == 0 || c->n_verts[k] > (1 << 24))
@@ -208,18 +209,23 @@ static void segment_source(const RayesCurves *c, size_t first, int n, size_t k, 
     }
 }
 
-/* Segment's Bezier control points, world space. */
+/* Segment's Bezier control points, world space. The basis works on the
+ * object-space points (a Hermite or power basis has tangents and
+ * coefficients among them, which a translation must not move); the
+ * Bezier points it gives are points, and are then transformed. */
 static void segment_bezier(const RayesScene *s, const RayesCurves *c, const SegSource *src,
                            Vec3 cp[4])
 {
     Vec3 g[4];
     int n = c->degree == 1 ? 2 : 4;
     for (int j = 0; j < n; j++)
-        g[j] = mat4_point(&s->world_from_object, v3_load(c->P + 3 * src->vertex[j]));
+        g[j] = v3_load(c->P + 3 * src->vertex[j]);
     if (c->degree == 1) {
         cp[0] = g[0], cp[3] = g[1];
         cp[1] = v3_lerp(g[0], g[1], 1.0f / 3.0f);
         cp[2] = v3_lerp(g[0], g[1], 2.0f / 3.0f);
+        for (int r = 0; r < 4; r++)
+            cp[r] = mat4_point(&s->world_from_object, cp[r]);
         return;
     }
     float m[16]; /* bezier_inverse * basis */
@@ -233,6 +239,7 @@ static void segment_bezier(const RayesScene *s, const RayesCurves *c, const SegS
         cp[r] = v3(0, 0, 0);
         for (int j = 0; j < 4; j++)
             cp[r] = v3_madd(cp[r], g[j], m[4 * r + j]);
+        cp[r] = mat4_point(&s->world_from_object, cp[r]);
     }
 }
 

@@ -1036,8 +1036,10 @@ static size_t dice_all(const RayesScene *s, const DiceCamera *cam, size_t budget
                 total += geom_count_prim(&s->prims[k], cam);
             return total;
         }
-        /* Normals of displaced surfaces: differences over 1e-3 of the scene radius. */
-        if (s->prims[i].displacement) {
+        /* Normals of displaced surfaces: differences over 1e-3 of the scene radius.
+         * Curves and points are not displaced (as in RenderMan). */
+        const Prim *p = &s->prims[i];
+        if (p->displacement && p->type != PRIM_CURVE && p->type != PRIM_POINT) {
             if (scene_displace(s, gs, first, step, &sv->sv) != 0)
                 return (size_t)-1;
             geom_bound_sagitta(gs, first);

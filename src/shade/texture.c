@@ -83,13 +83,23 @@ static void load_module(void)
     if (!h)
         h = try_open(TEXTURE_MODULE_FILE, why, sizeof why);
     TextureModuleEntry entry = NULL;
-    if (h)
+    if (h) {
         *(void **)&entry = dlsym(h, TEXTURE_MODULE_ENTRY);
+        if (!entry) {
+            const char *e = dlerror();
+            snprintf(why, sizeof why, "%s", e ? e : "no " TEXTURE_MODULE_ENTRY);
+        }
+    }
     const TextureModule *m = entry ? entry() : NULL;
-    if (!m || m->version != TEXTURE_MODULE_VERSION) {
+    if (m && m->version != TEXTURE_MODULE_VERSION) {
+        snprintf(why, sizeof why, "version %u, expected %u", (unsigned)m->version,
+                 (unsigned)TEXTURE_MODULE_VERSION);
+        m = NULL;
+    }
+    if (!m) {
         log_warning("textures: OpenImageIO's module %s cannot be loaded (%s); textures and "
                     "environment maps are unavailable",
-                    TEXTURE_MODULE_FILE, h ? "a different version" : why);
+                    TEXTURE_MODULE_FILE, why);
         return;
     }
     m->set_warning(module_warning);

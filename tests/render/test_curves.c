@@ -161,6 +161,29 @@ static void test_bases(void)
     }
 }
 
+/* A Hermite curve (RenderMan's basis: points and tangents, step 2) under
+ * a translation: the tangents are not moved, only the curve. */
+static void test_hermite_translated(void)
+{
+    static const float hermite[16] = {2, 1, -2, 1, -3, -2, 3, -1, 0, 1, 0, 0, 1, 0, 0, 0};
+    RayesScene *s = new_scene();
+    const float m[16] = {1, 0, 0, 10, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1}; /* row-major */
+    CHECK(rayes_scene_set_transform(s, m) == RAYES_OK);
+    const float P[12] = {0, 0, 0, 3, 0, 0, 1, 0, 0, 3, 0, 0}; /* P0 T0 P1 T1 */
+    const int nv = 4;
+    RayesCurves c = {.degree = 3, .step = 2, .n_curves = 1, .n_verts = &nv, .P = P};
+    memcpy(c.basis, hermite, sizeof c.basis);
+    CHECK(rayes_scene_curves(s, &c, NULL, 0) == RAYES_OK);
+    CHECK(s->n_prims == 1);
+    if (s->n_prims == 1) { /* Bezier: P0, P0 + T0 / 3, P1 - T1 / 3, P1 */
+        CHECK_NEAR(s->prims[0].curve.cp[0].x, 10.0, 1e-5);
+        CHECK_NEAR(s->prims[0].curve.cp[1].x, 11.0, 1e-5);
+        CHECK_NEAR(s->prims[0].curve.cp[2].x, 10.0, 1e-5);
+        CHECK_NEAR(s->prims[0].curve.cp[3].x, 11.0, 1e-5);
+    }
+    rayes_scene_release(s);
+}
+
 /* Spheres and disks at their analytic distance; N makes oriented disks. */
 static void test_points(void)
 {
@@ -348,5 +371,5 @@ static void test_fiber_environment(void)
     }
 }
 
-TEST_MAIN(TEST(test_fiber_environment), TEST(test_round_tube_hits), TEST(test_flat_faces_ray), TEST(test_bases),
+TEST_MAIN(TEST(test_fiber_environment), TEST(test_hermite_translated), TEST(test_round_tube_hits), TEST(test_flat_faces_ray), TEST(test_bases),
           TEST(test_points), TEST(test_bad_input), TEST(test_hair_field_caches))
