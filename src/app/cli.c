@@ -29,6 +29,9 @@ static const char render_options[] =
     "  -o FILE                 output image, .exr or .png (repeatable; default: the\n"
     "                          scene file's displays, else SCENE.exr)\n"
     "  --frame N               the frame of a RIB file to read (default: the last)\n"
+    "  --frames LIST           render these frames one after another: 1-100x2, 1,5,9-12;\n"
+    "                          '#'s in -o names become the frame number (out.####.exr)\n"
+    "  --skip-existing         skip a frame whose outputs all exist (a farm's retry)\n"
     "  --res W[xH]             resolution in pixels (default 512x512)\n"
     "  --spp N                 pixel samples (default 4)\n"
     "  --threads N             worker threads (default: all cores)\n"
@@ -258,6 +261,10 @@ void parse_args(int argc, char **argv, Args *a)
             a->quiet = 1;
             continue;
         }
+        if (strcmp(o, "--skip-existing") == 0) {
+            a->skip_existing = 1;
+            continue;
+        }
         if (strcmp(o, "--dice-isotropic") == 0) {
             opt->dice_isotropic = 1;
             continue;
@@ -295,6 +302,8 @@ void parse_args(int argc, char **argv, Args *a)
             a->set |= SET_SPP;
         } else if (strcmp(o, "--frame") == 0)
             a->frame = (int)parse_long(o, v, 0, INT_MAX);
+        else if (strcmp(o, "--frames") == 0)
+            a->frames = v;
         else if (strcmp(o, "--threads") == 0)
             opt->threads = (int)parse_long(o, v, 0, 1024);
         else if (strcmp(o, "--bounces") == 0) {

@@ -38,6 +38,8 @@ typedef struct Args {
     Output outputs[MAX_OUTPUTS];
     int n_outputs;
     int frame;                  /* --frame: the RIB frame to read; -1 the last */
+    const char *frames;         /* --frames LIST: frames to render one after another */
+    int skip_existing;          /* --skip-existing: a frame whose outputs exist is skipped */
     unsigned set;               /* SET_*: options the command line gave */
     const char *stats_path;
     const char *data_dir;

@@ -237,10 +237,98 @@ static RayesError write_output(const Output *o, const RayesImage *img, char *err
     return e;
 }
 
+/* Renders frame `frame` of a's scene (-1: as --frame says) to its outputs,
+ * whose '#' runs become the frame number `number` (zero-padded to the
+ * run's length; -1: none). Returns the exit status. */
+static int render_job(Args a, int frame, int number);
+
+/* --frames LIST: comma-separated N, N-M or N-MxS (a step), into a new
+ * array of *n frame numbers; dies with a usage error on anything else. */
+static int *parse_frames(const char *list, size_t *n)
+{
+    size_t cap = 16;
+    int *out = malloc(cap * sizeof *out);
+    char buf[4096], *save = NULL;
+    if (!out || strlen(list) >= sizeof buf)
+        die_usage("--frames: out of memory or the list is too long");
+    snprintf(buf, sizeof buf, "%s", list);
+    *n = 0;
+    for (char *tok = strtok_r(buf, ",", &save); tok; tok = strtok_r(NULL, ",", &save)) {
+        char *end;
+        long a = strtol(tok, &end, 10), b = a, step = 1;
+        if (end != tok && *end == '-')
+            b = strtol(end + 1, &end, 10);
+        if (end != tok && *end == 'x')
+            step = strtol(end + 1, &end, 10);
+        if (end == tok || *end || a < 0 || b < a || b > INT_MAX || step < 1 || step > INT_MAX)
+            die_usage("--frames: expected frames like 1-100x2 or 1,5,9-12, got \"%s\"", tok);
+        for (long f = a; f <= b; f += step) {
+            if (*n == 1000000)
+                die_usage("--frames: more than 1000000 frames");
+            if (*n == cap) {
+                int *more = realloc(out, 2 * cap * sizeof *out);
+                if (!more)
+                    die_usage("--frames: out of memory");
+                out = more, cap *= 2;
+            }
+            out[(*n)++] = (int)f;
+        }
+    }
+    if (*n == 0)
+        die_usage("--frames: no frame in \"%s\"", list);
+    return out;
+}
+
+/* path with its '#' runs replaced by number, zero-padded to each run's
+ * length; 0 if it has no '#'. */
+static int frame_path(const char *path, int number, char *out, size_t size)
+{
+    size_t k = 0;
+    int any = 0;
+    for (const char *c = path; *c && k + 1 < size;) {
+        if (*c != '#') {
+            out[k++] = *c++;
+            continue;
+        }
+        int width = 0;
+        while (c[width] == '#')
+            width++;
+        int w = snprintf(out + k, size - k, "%0*d", width, number);
+        k += w > 0 ? (size_t)w : 0;
+        c += width;
+        any = 1;
+    }
+    out[k < size ? k : size - 1] = '\0';
+    return any;
+}
+
 static int cmd_render(int argc, char **argv)
 {
     Args a = {0};
     parse_args(argc, argv, &a);
+    if (!a.frames)
+        return render_job(a, a.frame, -1);
+    size_t n;
+    int *frames = parse_frames(a.frames, &n);
+    for (int i = 0; i < a.n_outputs && n > 1; i++)
+        if (!strchr(a.outputs[i].path, '#'))
+            die_usage("--frames: -o %s needs '#'s for the frame number, or every frame would "
+                      "write it",
+                      a.outputs[i].path);
+    int status = 0;
+    for (size_t i = 0; i < n && status == 0; i++)
+        status = render_job(a, frames[i], frames[i]);
+    free(frames);
+    return status;
+}
+
+static int render_job(Args a, int frame, int number)
+{
+    for (int i = 0; i < a.n_outputs && number >= 0; i++) {
+        char path[sizeof a.outputs[i].path];
+        frame_path(a.outputs[i].path, number, path, sizeof path);
+        memcpy(a.outputs[i].path, path, sizeof path);
+    }
     RayesScene *scene = rayes_scene_new();
     char err[1024];
     if (!scene) {
@@ -255,7 +343,7 @@ static int cmd_render(int argc, char **argv)
     }
     IoSettings settings;
     IoSink sink = io_sink_scene(scene);
-    RayesError e = load_scene(a.scene, a.data_dir, a.frame, &sink, &settings, err, sizeof err);
+    RayesError e = load_scene(a.scene, a.data_dir, frame, &sink, &settings, err, sizeof err);
     if (e == RAYES_OK && (e = default_light(&a, scene)) != RAYES_OK)
         snprintf(err, sizeof err, "%s: %s", a.scene, rayes_scene_get_error(scene));
     if (e == RAYES_OK && rayes_scene_commit(scene) != RAYES_OK) {
@@ -278,6 +366,17 @@ static int cmd_render(int argc, char **argv)
                 fprintf(stderr, "rayes: note: %s: no display writes a file; writing %s\n",
                         a.scene, path);
             add_output(&a, path, IMAGE_FORMAT_EXR);
+        }
+    }
+    if (a.skip_existing) { /* a farm's retry: the frame is done when all its outputs are */
+        int all = 1;
+        for (int i = 0; i < a.n_outputs; i++)
+            all &= access(a.outputs[i].path, F_OK) == 0;
+        if (all) {
+            if (!a.quiet)
+                printf("  skipped       %s (exists)\n", a.outputs[0].path);
+            rayes_scene_release(scene);
+            return 0;
         }
     }
     int status = 0;

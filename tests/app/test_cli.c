@@ -581,9 +581,70 @@ static void test_bad_scene_file(void)
     CHECK(!exists(SCRATCH_DIR "/none.exr"));
 }
 
+/* --frames renders a RIB file's frames one after another into '#'
+ * names; --skip-existing leaves done frames alone; a list without '#'
+ * in -o, a bad list and a missing frame fail. --crop writes the window:
+ * a PNG of its size, an EXR whose data window is it. */
+static void test_frames_and_crop(void)
+{
+    static Run r;
+    setup();
+    char rib[2048] = "Format 24 16 1\n";
+    for (int f = 1; f <= 3; f++) {
+        char frame[256];
+        snprintf(frame, sizeof frame,
+                 "FrameBegin %d\nWorldBegin\nLightSource \"distantlight\" 1\n"
+                 "Translate %d 0 5\nSphere 1 -1 1 360\nWorldEnd\nFrameEnd\n",
+                 f, f - 2);
+        strcat(rib, frame);
+    }
+    write_text(SCRATCH_DIR "/frames.rib", rib);
+    for (int f = 1; f <= 3; f++) {
+        char path[256];
+        snprintf(path, sizeof path, SCRATCH_DIR "/fr.%04d.png", f);
+        unlink(path);
+    }
+    run(&r, NULL, ARGS("render", SCRATCH_DIR "/frames.rib", "--frames", "1-3", "--spp", "1",
+                       "-o", SCRATCH_DIR "/fr.####.png"));
+    CHECK(r.status == 0);
+    CHECK(exists(SCRATCH_DIR "/fr.0001.png") && exists(SCRATCH_DIR "/fr.0002.png") &&
+          exists(SCRATCH_DIR "/fr.0003.png"));
+    int w = 0, h = 0;
+    float *a = NULL, *b = NULL;
+    char err[256];
+    CHECK(image_read_png(SCRATCH_DIR "/fr.0001.png", &w, &h, &a, err, sizeof err) == RAYES_OK);
+    CHECK(image_read_png(SCRATCH_DIR "/fr.0003.png", &w, &h, &b, err, sizeof err) == RAYES_OK);
+    CHECK(a && b && w == 24 && h == 16 && memcmp(a, b, sizeof(float) * 4 * 24 * 16) != 0);
+    free(a), free(b);
+    long size = file_size(SCRATCH_DIR "/fr.0002.png");
+    run(&r, NULL, ARGS("render", SCRATCH_DIR "/frames.rib", "--frames", "1,2-3x1", "--spp", "1",
+                       "--skip-existing", "-o", SCRATCH_DIR "/fr.####.png"));
+    CHECK(r.status == 0 && strstr(r.out, "skipped") && count_char(r.out, '\n') == 3);
+    CHECK(file_size(SCRATCH_DIR "/fr.0002.png") == size);
+    expect_error(2, NULL, ARGS("render", SCRATCH_DIR "/frames.rib", "--frames", "1-3", "-o",
+                               SCRATCH_DIR "/fr.png"),
+                 ARGS("--frames", "#"));
+    expect_error(2, NULL, ARGS("render", SCRATCH_DIR "/frames.rib", "--frames", "3-1"),
+                 ARGS("--frames", "3-1"));
+    expect_error(1, NULL, ARGS("render", SCRATCH_DIR "/frames.rib", "--frames", "7", "-o",
+                               SCRATCH_DIR "/fr.#.png"),
+                 ARGS("frames.rib", "no frame 7"));
+    run(&r, NULL, ARGS("render", SCRATCH_DIR "/frames.rib", "--frame", "2", "--spp", "1",
+                       "--quiet", "--crop", "0.25,0.75,0,0.5", "-o", SCRATCH_DIR "/crop.png",
+                       "-o", SCRATCH_DIR "/crop.exr"));
+    CHECK(r.status == 0);
+    CHECK(image_read_png(SCRATCH_DIR "/crop.png", &w, &h, &a, err, sizeof err) == RAYES_OK);
+    CHECK(w == 12 && h == 8);
+    free(a);
+    CHECK(image_read_exr(SCRATCH_DIR "/crop.exr", &w, &h, &a, err, sizeof err) == RAYES_OK);
+    CHECK(w == 12 && h == 8); /* the data window */
+    free(a);
+    expect_error(2, NULL, ARGS("render", "cornell", "--crop", "0.5,0.2,0,1"), ARGS("--crop"));
+}
+
 TEST_MAIN(TEST(test_version_and_help), TEST(test_no_arguments), TEST(test_usage_errors),
           TEST(test_missing_data), TEST(test_render_outputs), TEST(test_render_summary),
           TEST(test_data_from_environment), TEST(test_unwritable_output), TEST(test_shader_path),
           TEST(test_render_obj), TEST(test_rib_grid_size), TEST(test_vertex_budget),
           TEST(test_null_displacement), TEST(test_default_light), TEST(test_convert),
-          TEST(test_bad_scene_file))
+          TEST(test_bad_scene_file), TEST(test_frames_and_crop))
