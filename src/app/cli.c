@@ -32,6 +32,8 @@ static const char render_options[] =
     "  --frames LIST           render these frames one after another: 1-100x2, 1,5,9-12;\n"
     "                          '#'s in -o names become the frame number (out.####.exr)\n"
     "  --skip-existing         skip a frame whose outputs all exist (a farm's retry)\n"
+    "  --progress json|bar     json: one JSON object per line on standard output (progress,\n"
+    "                          each frame's end) for farm managers; bar (default)\n"
     "  --res W[xH]             resolution in pixels (default 512x512)\n"
     "  --spp N                 pixel samples (default 4)\n"
     "  --threads N             worker threads (default: all cores)\n"
@@ -304,6 +306,11 @@ void parse_args(int argc, char **argv, Args *a)
             a->frame = (int)parse_long(o, v, 0, INT_MAX);
         else if (strcmp(o, "--frames") == 0)
             a->frames = v;
+        else if (strcmp(o, "--progress") == 0) {
+            if (strcmp(v, "json") != 0 && strcmp(v, "bar") != 0)
+                die_usage("--progress: expected json or bar, got \"%s\"", v);
+            a->progress_json = strcmp(v, "json") == 0;
+        }
         else if (strcmp(o, "--threads") == 0)
             opt->threads = (int)parse_long(o, v, 0, 1024);
         else if (strcmp(o, "--bounces") == 0) {

@@ -40,6 +40,7 @@ typedef struct Args {
     int frame;                  /* --frame: the RIB frame to read; -1 the last */
     const char *frames;         /* --frames LIST: frames to render one after another */
     int skip_existing;          /* --skip-existing: a frame whose outputs exist is skipped */
+    int progress_json;          /* --progress json: machine-readable lines on standard output */
     unsigned set;               /* SET_*: options the command line gave */
     const char *stats_path;
     const char *data_dir;

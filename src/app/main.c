@@ -29,6 +29,8 @@
 typedef struct Progress {
     double start;
     int tty, last_percent, quiet;
+    int json;       /* --progress json */
+    int frame;      /* the frame's number, or -1 */
 } Progress;
 
 static volatile sig_atomic_t interrupted;
@@ -45,10 +47,31 @@ static void format_time(char *buf, size_t n, double s)
     snprintf(buf, n, "%02ld:%02ld", t / 60, t % 60);
 }
 
+/* s as a JSON string on standard output (control characters as '?'). */
+static void print_json_string(const char *s)
+{
+    putchar('"');
+    for (const char *c = s; *c; c++) {
+        if (*c == '"' || *c == '\\')
+            putchar('\\');
+        putchar((unsigned char)*c < 0x20 ? '?' : *c);
+    }
+    putchar('"');
+}
+
 static int on_progress(void *user, double fraction)
 {
     Progress *p = user;
-    if (!p->quiet) {
+    if (p->json) {
+        int percent = (int)(fraction * 100.0);
+        if (percent != p->last_percent) {
+            printf("{\"event\": \"progress\", \"frame\": %d, \"fraction\": %.4f, "
+                   "\"elapsed\": %.3f}\n",
+                   p->frame, fraction, time_now() - p->start);
+            fflush(stdout);
+            p->last_percent = percent;
+        }
+    } else if (!p->quiet) {
         int percent = (int)(fraction * 100.0);
         if (p->tty || percent / 25 != p->last_percent / 25 || fraction >= 1.0) {
             double elapsed = time_now() - p->start;
@@ -388,7 +411,8 @@ static int render_job(Args a, int frame, int number)
         rayes_scene_release(scene);
         return 1;
     }
-    Progress prog = {.start = time_now(), .tty = isatty(2), .last_percent = -1, .quiet = a.quiet};
+    Progress prog = {.start = time_now(), .tty = isatty(2), .last_percent = -1, .quiet = a.quiet,
+                     .json = a.progress_json, .frame = number};
     a.opt.progress = on_progress;
     a.opt.progress_user = &prog;
     signal(SIGINT, on_sigint);
@@ -418,7 +442,17 @@ static int render_job(Args a, int frame, int number)
     /* A failed run leaves none of its outputs behind. */
     for (int i = 0; status != 0 && i < written; i++)
         unlink(a.outputs[i].path);
-    if (status == 0 && !a.quiet) {
+    if (a.progress_json) { /* the frame's end, for farm managers */
+        printf("{\"event\": \"frame\", \"frame\": %d, \"status\": %d, \"seconds\": %.3f, "
+               "\"outputs\": [",
+               number, status, time_now() - prog.start);
+        for (int i = 0; i < a.n_outputs && status == 0; i++) {
+            printf("%s", i ? ", " : "");
+            print_json_string(a.outputs[i].path);
+        }
+        printf("]}\n");
+        fflush(stdout);
+    } else if (status == 0 && !a.quiet) {
         summary(&a, stats);
         for (int i = 0; i < a.n_outputs; i++)
             printf("  wrote         %s\n", a.outputs[i].path);

@@ -629,6 +629,14 @@ static void test_frames_and_crop(void)
     expect_error(1, NULL, ARGS("render", SCRATCH_DIR "/frames.rib", "--frames", "7", "-o",
                                SCRATCH_DIR "/fr.#.png"),
                  ARGS("frames.rib", "no frame 7"));
+    run(&r, NULL, ARGS("render", SCRATCH_DIR "/frames.rib", "--frames", "2-3", "--spp", "1",
+                       "--progress", "json", "-o", SCRATCH_DIR "/js.#.png"));
+    CHECK(r.status == 0 && r.err[0] == '\0');
+    CHECK(strstr(r.out, "{\"event\": \"progress\", \"frame\": 2, \"fraction\": 1.0000,") != NULL);
+    CHECK(strstr(r.out, "{\"event\": \"frame\", \"frame\": 3, \"status\": 0,") != NULL);
+    CHECK(strstr(r.out, "js.3.png\"]}\n") != NULL);
+    CHECK(strstr(r.out, "wrote") == NULL); /* no human summary among the JSON */
+    expect_error(2, NULL, ARGS("render", "cornell", "--progress", "xml"), ARGS("--progress"));
     run(&r, NULL, ARGS("render", SCRATCH_DIR "/frames.rib", "--frame", "2", "--spp", "1",
                        "--quiet", "--crop", "0.25,0.75,0,0.5", "-o", SCRATCH_DIR "/crop.png",
                        "-o", SCRATCH_DIR "/crop.exr"));
