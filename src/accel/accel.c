@@ -80,6 +80,18 @@ static int add_geom(Accel *a, Geom g)
     return 0;
 }
 
+/* Commits geom with its ray mask into the scene as the next geometry,
+ * whose primitives map back to grids through g. */
+static int attach(Accel *a, RTCGeometry geom, uint32_t mask, Geom g)
+{
+    rtcSetGeometryMask(geom, mask);
+    rtcCommitGeometry(geom);
+    unsigned id = rtcAttachGeometry(a->scene, geom);
+    rtcReleaseGeometry(geom);
+    RY_CHECK(id == a->n_geoms);
+    return add_geom(a, g);
+}
+
 static int build_quads(Accel *a, const uint32_t *idx, size_t n, uint32_t mask)
 {
     const GridSet *gs = a->gs;
@@ -99,12 +111,7 @@ static int build_quads(Accel *a, const uint32_t *idx, size_t n, uint32_t mask)
         grids[k] = (struct RTCGrid){src->first_vertex, src->nu, src->nu, src->nv};
         g.grids[k] = idx[k];
     }
-    rtcSetGeometryMask(geom, mask);
-    rtcCommitGeometry(geom);
-    unsigned id = rtcAttachGeometry(a->scene, geom);
-    rtcReleaseGeometry(geom);
-    RY_CHECK(id == a->n_geoms);
-    return add_geom(a, g);
+    return attach(a, geom, mask, g);
 }
 
 static size_t count_tris(const GridSet *gs, const uint32_t *idx, size_t n)
@@ -161,12 +168,7 @@ static int build_tris(Accel *a, const uint32_t *idx, size_t n, uint32_t mask)
                 }
     }
     RY_CHECK(t == n_tris);
-    rtcSetGeometryMask(geom, mask);
-    rtcCommitGeometry(geom);
-    unsigned id = rtcAttachGeometry(a->scene, geom);
-    rtcReleaseGeometry(geom);
-    RY_CHECK(id == a->n_geoms);
-    return add_geom(a, g);
+    return attach(a, geom, mask, g);
 }
 
 /* A curve grid's centre line: vertex i of its 2 rows, midway, and half
@@ -216,12 +218,7 @@ static int build_curves(Accel *a, const uint32_t *idx, size_t n, uint32_t mask, 
         }
         v += src->nu;
     }
-    rtcSetGeometryMask(geom, mask);
-    rtcCommitGeometry(geom);
-    unsigned id = rtcAttachGeometry(a->scene, geom);
-    rtcReleaseGeometry(geom);
-    RY_CHECK(id == a->n_geoms);
-    return add_geom(a, g);
+    return attach(a, geom, mask, g);
 }
 
 static Vec3 unit_or_zero(Vec3 n);
@@ -269,12 +266,7 @@ static int build_points(Accel *a, const uint32_t *idx, size_t n, uint32_t mask, 
         }
         g.grids[k] = idx[k];
     }
-    rtcSetGeometryMask(geom, mask);
-    rtcCommitGeometry(geom);
-    unsigned id = rtcAttachGeometry(a->scene, geom);
-    rtcReleaseGeometry(geom);
-    RY_CHECK(id == a->n_geoms);
-    return add_geom(a, g);
+    return attach(a, geom, mask, g);
 }
 
 /* The kinds of grids an object may have, each one Embree geometry. */

@@ -20,18 +20,7 @@
 
 /* The primitive variables of a curves or points call, converted for the
  * sink: width, N, Cs, st in that order (those given). */
-typedef struct Vars {
-    RayesPrimvar pv[4];
-    float *data[4];
-    size_t n;
-} Vars;
-
-static void vars_free(Vars *v)
-{
-    for (size_t i = 0; i < v->n; i++)
-        free(v->data[i]);
-    v->n = 0;
-}
+typedef PvOut Vars;
 
 static const RayesPrimvarClass class_of[] = {
     [CLS_CONSTANT] = RAYES_PRIMVAR_CONSTANT, [CLS_UNIFORM] = RAYES_PRIMVAR_UNIFORM,
@@ -85,7 +74,7 @@ static int read_vars(Rib *r, const Param *p, size_t n, Vars *v)
         }
     }
     if (e != 0)
-        vars_free(v);
+        rib_pv_out_free(v);
     return e;
 }
 
@@ -155,7 +144,7 @@ static int h_curves(Rib *r, const Args *a)
         e = read_vars(r, p, n, &vars);
     if (e == 0)
         e = emit(r, &c, RAYES_POINT_SPHERE, 0, NULL, &vars);
-    vars_free(&vars);
+    rib_pv_out_free(&vars);
     free(P);
     free(p);
     free(nverts);
@@ -189,7 +178,7 @@ static int h_points(Rib *r, const Args *a)
         e = read_vars(r, p, n, &vars);
     if (e == 0)
         e = emit(r, NULL, shape, np, P, &vars);
-    vars_free(&vars);
+    rib_pv_out_free(&vars);
     free(P);
     free(p);
     return e;

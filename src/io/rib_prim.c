@@ -100,14 +100,7 @@ static void var_value(const RibVar *v, size_t j, float out[3])
     }
 }
 
-/* Primitive variables for one sink call; the data are owned. */
-typedef struct PvOut {
-    RayesPrimvar pv[3];
-    float *data[3];
-    size_t n;
-} PvOut;
-
-static void pv_out_free(PvOut *o)
+void rib_pv_out_free(PvOut *o)
 {
     for (size_t i = 0; i < o->n; i++)
         free(o->data[i]);
@@ -182,7 +175,7 @@ static int patch_vars(Rib *r, const RibVar *vars, size_t ui, const size_t vi[4],
             break;
         }
         if (e != 0) {
-            pv_out_free(o);
+            rib_pv_out_free(o);
             return -1;
         }
     }
@@ -230,7 +223,7 @@ static int poly_vars(Rib *r, const RibVar *vars, const RibFaces *faces, const si
     }
     free(src);
     if (e != 0)
-        pv_out_free(o);
+        rib_pv_out_free(o);
     return e;
 }
 
@@ -355,7 +348,7 @@ static int emit_polys(Rib *r, const Polys *g, const float *P, size_t n_points, c
                             pv.pv, pv.n) != RAYES_OK)
             e = rib_sink_failed(r, s);
     }
-    pv_out_free(&pv);
+    rib_pv_out_free(&pv);
     free(face_poly);
     free(poly_at);
     free(poly_nv);
@@ -660,7 +653,7 @@ static int subdiv_vars(Rib *r, const RibVar *vars, size_t n_faces, size_t n_poin
         e = pv_add(r, o, vars, b, c, c == RAYES_PRIMVAR_FACEVARYING ? order : NULL, count);
     }
     if (e != 0)
-        pv_out_free(o);
+        rib_pv_out_free(o);
     return e;
 }
 
@@ -733,7 +726,7 @@ static int subdivision_mesh(Rib *r, const Args *a, int per)
     }
     if (e == 1) /* outside the world: nothing to draw */
         e = 0;
-    pv_out_free(&pv);
+    rib_pv_out_free(&pv);
     subdiv_tags_free(&tags);
     free(wound);
     free(order);
@@ -865,7 +858,7 @@ static int h_patch(Rib *r, const Args *a)
             e = emit_bilinear(r, (const float(*)[3])P, &pv);
         }
     }
-    pv_out_free(&pv);
+    rib_pv_out_free(&pv);
     free(P);
     free(p);
     return e;
@@ -959,7 +952,7 @@ static int h_patch_mesh(Rib *r, const Args *a)
                 e = emit_bilinear(r, (const float(*)[3])G, &out);
             }
             if (e == 0)
-                pv_out_free(&out);
+                rib_pv_out_free(&out);
         }
     free(P);
     free(p);

@@ -293,6 +293,17 @@ const Param *rib_color_param(Rib *r, const Param *p, size_t n);
 
 /* ------------------------------------------ rib_prim.c: primitives' data */
 
+/* Primitive variables for one sink call (N, st, Cs; curves and points
+ * add width); the data are owned. */
+typedef struct PvOut {
+    RayesPrimvar pv[4];
+    float *data[4];
+    size_t n;
+} PvOut;
+
+/* Frees o's data; o is then empty. */
+void rib_pv_out_free(PvOut *o);
+
 /* A parameter that is a numeric declared value of size floats, or NULL
  * (with one warning when it has the name but another type). */
 const Param *rib_var_param(Rib *r, const Param *p, size_t n, const char *name, int size);

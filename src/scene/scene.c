@@ -390,6 +390,22 @@ static RayesError add_prim(RayesScene *s, Prim *p)
     return RAYES_OK;
 }
 
+/* Room for n more floats in the primitive variable pool. */
+static RayesError reserve_pv(RayesScene *s, size_t n)
+{
+    if (s->n_pv + n <= s->cap_pv)
+        return RAYES_OK;
+    size_t cap = s->cap_pv ? s->cap_pv : 1024;
+    while (cap < s->n_pv + n)
+        cap *= 2;
+    float *pv = realloc(s->pv, cap * sizeof *pv);
+    if (!pv)
+        return fail(s, RAYES_ERROR_OUT_OF_MEMORY, "out of memory");
+    s->pv = pv;
+    s->cap_pv = cap;
+    return RAYES_OK;
+}
+
 RayesError scene_add_prim(RayesScene *s, Prim *p)
 {
     return add_prim(s, p);
@@ -412,16 +428,8 @@ RayesError scene_push_values(RayesScene *s, Prim *p, unsigned mask, const float 
     p->pv = (uint8_t)mask;
     p->pv_cubic = 0;
     p->pv_first = s->n_pv;
-    if (s->n_pv + n > s->cap_pv) {
-        size_t cap = s->cap_pv ? s->cap_pv : 1024;
-        while (cap < s->n_pv + n)
-            cap *= 2;
-        float *pv = realloc(s->pv, cap * sizeof *pv);
-        if (!pv)
-            return fail(s, RAYES_ERROR_OUT_OF_MEMORY, "out of memory");
-        s->pv = pv;
-        s->cap_pv = cap;
-    }
+    if (reserve_pv(s, n) != RAYES_OK)
+        return RAYES_ERROR_OUT_OF_MEMORY;
     memcpy(s->pv + s->n_pv, values, n * sizeof *values);
     s->n_pv += n;
     return RAYES_OK;
@@ -526,16 +534,8 @@ static RayesError push_primvars(RayesScene *s, Prim *p, const PrimvarSet *set,
     for (int b = 0; b < 3; b++)
         if (set->by[b])
             need += (size_t)((cubic & primvar_names[b].bit) ? 16 : n) * (size_t)primvar_names[b].size;
-    if (s->n_pv + need > s->cap_pv) {
-        size_t cap = s->cap_pv ? s->cap_pv : 1024;
-        while (cap < s->n_pv + need)
-            cap *= 2;
-        float *pv = realloc(s->pv, cap * sizeof *pv);
-        if (!pv)
-            return fail(s, RAYES_ERROR_OUT_OF_MEMORY, "out of memory");
-        s->pv = pv;
-        s->cap_pv = cap;
-    }
+    if (reserve_pv(s, need) != RAYES_OK)
+        return RAYES_ERROR_OUT_OF_MEMORY;
     for (int b = 0; b < 3; b++) {
         const RayesPrimvar *v = set->by[b];
         if (!v)

@@ -374,10 +374,7 @@ const RayesShaderClass shade_class_paintedplastic = {
 
 /* ---- hair: Kajiya-Kay fibres (direct_fiber), for curves */
 
-typedef struct HairParams {
-    float Ka, Kd, Ks, roughness;
-    float specularcolor[3];
-} HairParams;
+typedef PlasticParams HairParams; /* the same parameters, other defaults */
 
 /* Ci = Cs (Ka ambient + Kd (fibre diffuse + indirect diffuse)), plus the
  * highlight when spec is wanted. The tangent is dPdu (along a curve);
