@@ -121,8 +121,9 @@ static void brick_chunk(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
     for (size_t i = 0; i < n; i++)
         for (int c = 0; c < 3; c++) {
             float diffuse = dd[i][c] + id[i][c];
-            out->Ci[i][c] = p->Kd * colour[i][c] * diffuse + (highlight ? p->Ks * spec[i][c] : 0.0f);
             out->Oi[i][c] = ctx->Os ? ctx->Os[i][c] : 1.0f;
+            out->Ci[i][c] = out->Oi[i][c] * (p->Kd * colour[i][c] * diffuse +
+                                             (highlight ? p->Ks * spec[i][c] : 0.0f));
             if (out->Irradiance)
                 out->Irradiance[i][c] = 3.14159265f * diffuse;
         }

@@ -56,8 +56,8 @@ static void matte_chunk(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
     for (size_t i = 0; i < ctx->n_points; i++)
         for (int c = 0; c < 3; c++) {
             float cs = ctx->Cs ? ctx->Cs[i][c] : 1.0f;
-            out->Ci[i][c] = p->Kd * cs * (dd[i][c] + id[i][c]);
             out->Oi[i][c] = ctx->Os ? ctx->Os[i][c] : 1.0f;
+            out->Ci[i][c] = out->Oi[i][c] * p->Kd * cs * (dd[i][c] + id[i][c]);
             if (out->Irradiance)
                 out->Irradiance[i][c] = 3.14159265f * (dd[i][c] + id[i][c]);
         }

@@ -196,6 +196,30 @@ RAYES_API RayesError rayes_scene_set_search_path(RayesScene *scene, const char *
 
 /* The shading rate of geometry added from now on: the area of a
  * micropolygon in pixels (RenderMan's ShadingRate). Default 1. */
+/* Visibility of the objects made from now on: the RayesRayType bits
+ * (rayes/shader.h) of the rays that see them, RenderMan's Attribute
+ * "visibility" (camera, diffuse, specular, and transmission, which is
+ * RAYES_RAY_SHADOW or RAYES_RAY_TRANSMISSION: shadow and transmission rays
+ * alike). Default: all. An object invisible to shadow rays casts no
+ * shadow. */
+RAYES_API RayesError rayes_scene_set_visibility(RayesScene *scene, uint32_t ray_types);
+
+/* How shadow and transmission rays find the opacity of the objects made
+ * from now on (RenderMan's Attribute "shade" "transmissionhitmode"). */
+typedef enum RayesTransmissionHitMode {
+    RAYES_TRANSMISSION_SHADER = 0,   /* the shader's opacity method, or Os without one
+                                        (default) */
+    RAYES_TRANSMISSION_PRIMITIVE = 1 /* Os alone (the Opacity colour, or its primitive
+                                        variable); the shader never runs */
+} RayesTransmissionHitMode;
+
+/* The transmission hit mode of the objects made from now on, and whether
+ * their opacity may be cached (memo 6.1: cache 1, the default, assumes one
+ * opacity per point whatever the side seen and the ray depth; 0 for
+ * shaders that break that assumption: they run at every hit). */
+RAYES_API RayesError rayes_scene_set_opacity_mode(RayesScene *scene, RayesTransmissionHitMode mode,
+                                                  int cache);
+
 RAYES_API RayesError rayes_scene_set_shading_rate(RayesScene *scene, float shading_rate);
 
 /* A bilinear patch with corners P[0] = (u0,v0), P[1] = (u1,v0),
@@ -589,31 +613,37 @@ typedef struct RayesRenderOptions {
                                   default 1; 0 point-samples the finest MIP level */
     RayesTileFn tile_done;     /* may be NULL: called as each tile of a render or pass ends */
     void *tile_user;
-    int grid_size;             /* micropolygons per grid, at most (RenderMan's "gridsize"):
-                                  1 to 4096, default 256; smaller grids mean more, smaller
-                                  radiosity cache entries */
-    int branch_depth;          /* shading points whose diffuse plus specular depth is below
-                                  this branch: several glossy rays, reflection and refraction
-                                  both; deeper ones follow one lobe, chosen at random, and end
-                                  by Russian roulette; an uncached diffuse hit at a diffuse
-                                  depth of at least this traces one diffuse ray (cache fills
-                                  keep diffuse_rays_deep). Default 1: camera hits only; 1 to
-                                  129 */
-    float dice_offscreen;      /* micropolygons of patches off screen are this much longer
-                                  (from 1 at the frame's edge to this half a frame beyond it;
-                                  Cycles' "offscreen dicing scale"): 1 to 1000, default 4 */
-    int dice_isotropic;        /* 1: patches on screen are diced by their distance from the eye
-                                  like those off screen, the same along the view as across it
-                                  (RenderMan's "rasterorient" 0); 0 (default): by their
-                                  projected size, coarser along the view where foreshortened */
-    double vertex_budget;      /* grid vertices of the whole scene, at most: a scene needing
-                                  more is diced coarser, with one warning. Default 2e7 (about
-                                  1.2 to 4.4 GB of grids and ray tracing data); 0: none */
-    float crop[4];             /* the crop window (RenderMan's CropWindow): xmin, xmax, ymin,
-                                  ymax in [0, 1] of the image, y down; pixels from ceil(W xmin)
-                                  to ceil(W xmax) - 1 (and alike in y) are rendered, each the
-                                  same bit for bit as in the whole frame, the rest are 0.
-                                  Default 0 1 0 1 */
+    int grid_size;           /* micropolygons per grid, at most (RenderMan's "gridsize"):
+                                1 to 4096, default 256; smaller grids mean more, smaller
+                                radiosity cache entries */
+    int branch_depth;        /* shading points whose diffuse plus specular depth is below
+                                this branch: several glossy rays, reflection and refraction
+                                both; deeper ones follow one lobe, chosen at random, and end
+                                by Russian roulette; an uncached diffuse hit at a diffuse
+                                depth of at least this traces one diffuse ray (cache fills
+                                keep diffuse_rays_deep). Default 1: camera hits only; 1 to
+                                129 */
+    float dice_offscreen;    /* micropolygons of patches off screen are this much longer
+                                (from 1 at the frame's edge to this half a frame beyond it;
+                                Cycles' "offscreen dicing scale"): 1 to 1000, default 4 */
+    int dice_isotropic;      /* 1: patches on screen are diced by their distance from the eye
+                                like those off screen, the same along the view as across it
+                                (RenderMan's "rasterorient" 0); 0 (default): by their
+                                projected size, coarser along the view where foreshortened */
+    double vertex_budget;    /* grid vertices of the whole scene, at most: a scene needing
+                                more is diced coarser, with one warning. Default 2e7 (about
+                                1.2 to 4.4 GB of grids and ray tracing data); 0: none */
+    float crop[4];           /* the crop window (RenderMan's CropWindow): xmin, xmax, ymin,
+                                ymax in [0, 1] of the image, y down; pixels from ceil(W xmin)
+                                to ceil(W xmax) - 1 (and alike in y) are rendered, each the
+                                same bit for bit as in the whole frame, the rest are 0.
+                                Default 0 1 0 1 */
+    int opacity_cache;       /* 1 (default): opacity() results are cached per grid at the
+                                three resolutions, data type opacity (memo 6.1); 0: shadow
+                                and transmission rays run the shader at every hit */
+    double opacity_cache_mb; /* the opacity entries' budget in megabytes (10^6 bytes;
+                                RenderMan's "opacitycachememory"), default 20, apart from
+                                cache_mb */
 } RayesRenderOptions;
 
 /* Fills options with the defaults of a quality preset: 512 x 512, 4 pixel

@@ -307,6 +307,16 @@ struct RayesShaderServices {
      * lookups are then 0). Older renderers lack it (supports()). */
     int (*pattern)(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
                    const RayesPattern *pattern, float (*out)[3]);
+
+    /* Ambient occlusion (RenderMan's occlusion()): the cosine-weighted
+     * fraction of the hemisphere about N from which light is blocked
+     * within maxdist (0: any distance), estimated with n_rays transmission
+     * rays (0: the renderer's diffuse ray count for this depth). Partly
+     * transparent surfaces block by their opacity (memo 6.1: read from the
+     * opacity cache), so a cut-out occludes only where it is opaque; per
+     * channel, in [0, 1]. Older renderers lack it (supports()). */
+    void (*occlusion)(const RayesShaderServices *sv, const RayesShadeCtx *ctx, int n_rays,
+                      float maxdist, float (*out)[3]);
 };
 
 #ifdef __cplusplus

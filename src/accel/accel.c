@@ -80,11 +80,15 @@ static int add_geom(Accel *a, Geom g)
     return 0;
 }
 
+static void transmission_filter(const struct RTCFilterFunctionNArguments *args);
+
 /* Commits geom with its ray mask into the scene as the next geometry,
  * whose primitives map back to grids through g. */
 static int attach(Accel *a, RTCGeometry geom, uint32_t mask, Geom g)
 {
-    rtcSetGeometryMask(geom, mask);
+    if (mask & ACCEL_MASK_TRANSPARENT)
+        rtcSetGeometryOccludedFilterFunction(geom, transmission_filter);
+    rtcSetGeometryMask(geom, mask & ~ACCEL_MASK_TRANSPARENT);
     rtcCommitGeometry(geom);
     unsigned id = rtcAttachGeometry(a->scene, geom);
     rtcReleaseGeometry(geom);
@@ -506,6 +510,28 @@ static void point_hit(const Accel *a, const Geom *g, const struct RTCRayHit *rh,
     hit->Ng = shape_normal(rh, g->shape);
 }
 
+/* The Hit of Embree's hit rh (tfar its distance). */
+static void make_hit(const Accel *a, const struct RTCRayHit *rh, Hit *hit)
+{
+    const Geom *g = &a->geoms[rh->hit.geomID];
+    hit->t = rh->ray.tfar;
+    hit->shape = g->shape;
+    switch (g->kind) {
+    case KIND_TRIS:
+        tri_hit(a, g, rh->hit.primID, rh->hit.u, rh->hit.v, hit);
+        break;
+    case KIND_QUADS:
+        quad_hit(a, g, rh->hit.primID, rh->hit.u, rh->hit.v, hit);
+        break;
+    case KIND_CURVES:
+        curve_hit(a, g, rh, hit);
+        break;
+    case KIND_POINTS:
+        point_hit(a, g, rh, hit);
+        break;
+    }
+}
+
 int accel_intersect(const Accel *a, const Ray *ray, Hit *hit)
 {
     struct RTCIntersectContext ctx;
@@ -518,16 +544,79 @@ int accel_intersect(const Accel *a, const Ray *ray, Hit *hit)
     rtcIntersect1(a->scene, &ctx, &rh);
     if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID)
         return 0;
-    const Geom *g = &a->geoms[rh.hit.geomID];
-    hit->t = rh.ray.tfar;
-    hit->shape = g->shape;
-    switch (g->kind) {
-    case KIND_TRIS: tri_hit(a, g, rh.hit.primID, rh.hit.u, rh.hit.v, hit); break;
-    case KIND_QUADS: quad_hit(a, g, rh.hit.primID, rh.hit.u, rh.hit.v, hit); break;
-    case KIND_CURVES: curve_hit(a, g, &rh, hit); break;
-    case KIND_POINTS: point_hit(a, g, &rh, hit); break;
-    }
+    make_hit(a, &rh, hit);
     return 1;
+}
+
+/* Crossings a transmission query remembers, to count each once. */
+#define TRANSMISSION_SEEN 64
+
+/* What an occlusion query through transparent objects carries: Embree
+ * hands the context to the filter, which finds the rest behind it. */
+typedef struct TransmissionCtx {
+    struct RTCIntersectContext rtc; /* first: the filter casts back */
+    const Accel *accel;
+    const Ray *ray;
+    AccelOpacityFn opacity;
+    void *user;
+    Vec3 T; /* the product so far */
+    int n_seen;
+    struct {
+        unsigned geom, prim;
+        float t;
+    } seen[TRANSMISSION_SEEN];
+} TransmissionCtx;
+
+/* Embree's occlusion filter on transparent objects: multiplies the
+ * query's transmittance by 1 - opacity and rejects the hit (traversal goes
+ * on), unless the product has reached 0 (the hit stands: occluded). A hit
+ * already seen (same primitive, same distance: a primitive referenced from
+ * two BVH leaves) is rejected without counting. */
+static void transmission_filter(const struct RTCFilterFunctionNArguments *args)
+{
+    RY_CHECK(args->N == 1);
+    if (args->valid[0] != -1)
+        return;
+    TransmissionCtx *tc = (TransmissionCtx *)args->context;
+    struct RTCRayHit rh;
+    rh.ray = *(const struct RTCRay *)args->ray;
+    rh.hit = *(const struct RTCHit *)args->hit;
+    for (int k = 0; k < tc->n_seen; k++)
+        if (tc->seen[k].geom == rh.hit.geomID && tc->seen[k].prim == rh.hit.primID &&
+            fabsf(tc->seen[k].t - rh.ray.tfar) <= 1e-6f * fmaxf(1.0f, rh.ray.tfar)) {
+            args->valid[0] = 0;
+            return;
+        }
+    if (tc->n_seen < TRANSMISSION_SEEN) {
+        tc->seen[tc->n_seen].geom = rh.hit.geomID;
+        tc->seen[tc->n_seen].prim = rh.hit.primID;
+        tc->seen[tc->n_seen].t = rh.ray.tfar;
+        tc->n_seen++;
+    }
+    Hit hit;
+    make_hit(tc->accel, &rh, &hit);
+    Vec3 op = tc->opacity(tc->user, tc->ray, &hit);
+    tc->T = v3(tc->T.x * (1.0f - fminf(fmaxf(op.x, 0.0f), 1.0f)),
+               tc->T.y * (1.0f - fminf(fmaxf(op.y, 0.0f), 1.0f)),
+               tc->T.z * (1.0f - fminf(fmaxf(op.z, 0.0f), 1.0f)));
+    if (v3_max_component(tc->T) > 0.0f)
+        args->valid[0] = 0; /* seen through: look further */
+}
+
+Vec3 accel_transmission(const Accel *a, const Ray *ray, AccelOpacityFn opacity, void *user)
+{
+    TransmissionCtx tc;
+    rtcInitIntersectContext(&tc.rtc);
+    tc.accel = a;
+    tc.ray = ray;
+    tc.opacity = opacity;
+    tc.user = user;
+    tc.T = v3(1, 1, 1);
+    tc.n_seen = 0;
+    struct RTCRay r;
+    set_ray(&r, ray);
+    rtcOccluded1(a->scene, &tc.rtc, &r);
+    return r.tfar < 0.0f ? v3(0, 0, 0) : tc.T;
 }
 
 int accel_occluded(const Accel *a, const Ray *ray)

@@ -14,7 +14,10 @@
  * coordinates the radiosity cache interpolates with).
  *
  * Each object has a ray mask: a ray hits an object only if their masks
- * share a bit (RayesRayType bits).
+ * share a bit (RayesRayType bits). An object whose mask also holds
+ * ACCEL_MASK_TRANSPARENT may be partly transparent: accel_transmission
+ * asks for the opacity of each of its hits (an Embree occlusion filter)
+ * and goes on through it; other objects stop shadow rays.
  *
  * Memory: the Accel borrows the GridSet, which must outlive it.
  * Thread-safety: queries are thread-safe after accel_new returns; threads
@@ -51,6 +54,13 @@ typedef struct Hit {
                             true surface normal at the hit, not the grid's */
 } Hit;
 
+/* In an object's mask: shadow rays may pass through it (not a ray type). */
+#define ACCEL_MASK_TRANSPARENT (1u << 31)
+
+/* The opacity (RGB, each in [0, 1]) of a transparent object's hit, asked by
+ * accel_transmission; hit is filled as accel_intersect fills it. */
+typedef Vec3 (*AccelOpacityFn)(void *user, const Ray *ray, const Hit *hit);
+
 /* Builds the acceleration structure. object_mask[o] is object o's ray
  * mask. Returns NULL and fills err on failure. */
 Accel *accel_new(const GridSet *gs, const uint32_t *object_mask, size_t n_objects,
@@ -62,6 +72,14 @@ int accel_intersect(const Accel *accel, const Ray *ray, Hit *hit);
 
 /* Returns 1 if anything lies in [tnear, tfar]. */
 int accel_occluded(const Accel *accel, const Ray *ray);
+
+/* The transmittance along the ray: the product over every surface in
+ * [tnear, tfar] of (1 - its opacity), in any order, each surface crossing
+ * counted once (Embree may report a hit twice); an opaque object's hit, or
+ * a product reaching 0, ends the query at 0. opacity is called from inside
+ * Embree's traversal, on the calling thread, for transparent objects only;
+ * it must not trace rays. */
+Vec3 accel_transmission(const Accel *accel, const Ray *ray, AccelOpacityFn opacity, void *user);
 
 /* Bytes Embree reported allocating for the structure. */
 size_t accel_memory_bytes(const Accel *accel);

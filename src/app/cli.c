@@ -57,6 +57,9 @@ static const char render_options[] =
     "                          --quality reference)\n"
     "  --cache-mb MB           cache budget in megabytes (default 100)\n"
     "  --cache-split C,M,F     budget shares of coarse, medium, fine (default .25,.25,.5)\n"
+    "  --opacity-cache on|off  cache opacity() results for shadow and transmission rays\n"
+    "                          (default on)\n"
+    "  --opacity-cache-mb MB   the opacity entries' budget in megabytes (default 20)\n"
     "  --crop X0,X1,Y0,Y1      render only this window of the image (RenderMan's CropWindow,\n"
     "                          0 to 1, y down): the same pixels as the whole frame's; PNG\n"
     "                          holds the window, EXR it as the data window of the frame\n"
@@ -348,6 +351,12 @@ void parse_args(int argc, char **argv, Args *a)
             opt->cache = strcmp(v, "on") == 0;
         } else if (strcmp(o, "--cache-mb") == 0)
             opt->cache_mb = parse_float(o, v, 0.0f, 1e7f);
+        else if (strcmp(o, "--opacity-cache") == 0) {
+            if (strcmp(v, "on") != 0 && strcmp(v, "off") != 0)
+                die_usage("--opacity-cache: expected on or off, got \"%s\"", v);
+            opt->opacity_cache = strcmp(v, "on") == 0;
+        } else if (strcmp(o, "--opacity-cache-mb") == 0)
+            opt->opacity_cache_mb = parse_float(o, v, 0.0f, 1e7f);
         else if (strcmp(o, "--cache-split") == 0)
             parse_split(v, opt->cache_split);
         else if (strcmp(o, "--crop") == 0) {

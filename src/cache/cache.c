@@ -1,7 +1,7 @@
 /*
- * cache/cache.c — the multiresolution cache (memo section 3.1 and 3.2): three
- * resolutions, each in CACHE_SHARDS shards; a shard is a mutex, a chained
- * hash table, an LRU list of unpinned entries and a byte budget.
+ * cache/cache.c — the multiresolution cache (memo section 3.1 and 3.2): per
+ * data type (memo section 6) three resolutions, each in CACHE_SHARDS shards; a shard is a mutex, a
+ * chained hash table, an LRU list of unpinned entries and a byte budget.
  *
  * Entry layout: a CacheEntry header followed by 3 * n_values half floats.
  * An entry is
@@ -66,9 +66,14 @@ typedef struct Shard {
 } Shard;
 
 struct Cache {
-    Shard shards[CACHE_N_LEVELS][CACHE_SHARDS];
-    uint64_t budget;
-    uint64_t level_budget[CACHE_N_LEVELS];
+    /* Partitions of the budget: a type's entries live in partition
+     * part_of[type] (all in 0 for cache_new, each its own for
+     * cache_new_typed), whose budget they share. */
+    Shard shards[CACHE_N_TYPES][CACHE_N_LEVELS][CACHE_SHARDS];
+    uint8_t part_of[CACHE_N_TYPES];
+    uint64_t budget;                     /* all partitions */
+    uint64_t type_budget[CACHE_N_TYPES]; /* of partition t */
+    uint64_t level_budget[CACHE_N_TYPES][CACHE_N_LEVELS];
     atomic_uint_fast64_t timestamp;
     pthread_mutex_t counters_lock;
     CacheCounters counters[CACHE_N_LEVELS][CACHE_N_TYPES];
@@ -120,22 +125,45 @@ static int shard_init(Shard *s, uint64_t budget, size_t nominal)
     return 0;
 }
 
+static Cache *cache_new_parts(const uint64_t budget_bytes[CACHE_N_TYPES],
+                              const float split[CACHE_N_LEVELS], int shared);
+
 Cache *cache_new(uint64_t budget_bytes, const float split[CACHE_N_LEVELS])
+{
+    uint64_t budgets[CACHE_N_TYPES] = {budget_bytes, 0, 0};
+    return cache_new_parts(budgets, split, 1);
+}
+
+Cache *cache_new_typed(const uint64_t budget_bytes[CACHE_N_TYPES],
+                       const float split[CACHE_N_LEVELS])
+{
+    return cache_new_parts(budget_bytes, split, 0);
+}
+
+/* shared: every type in partition 0 (budget_bytes[0]); else type t in
+ * partition t. */
+static Cache *cache_new_parts(const uint64_t budget_bytes[CACHE_N_TYPES],
+                              const float split[CACHE_N_LEVELS], int shared)
 {
     Cache *c = calloc(1, sizeof *c);
     if (!c)
         return NULL;
+    for (int t = 0; t < CACHE_N_TYPES; t++)
+        c->part_of[t] = shared ? 0 : (uint8_t)t;
     int failed = 0;
-    c->budget = budget_bytes;
     atomic_init(&c->timestamp, 1);
     pthread_mutex_init(&c->counters_lock, NULL);
-    for (int l = 0; l < CACHE_N_LEVELS; l++) {
-        float f = split[l] < 0.0f ? 0.0f : split[l];
-        c->level_budget[l] = (uint64_t)((double)budget_bytes * f);
-        for (int s = 0; s < CACHE_SHARDS; s++)
-            if (shard_init(&c->shards[l][s], c->level_budget[l] / CACHE_SHARDS,
-                           nominal_values[l]) != 0)
-                failed = 1;
+    for (int t = 0; t < CACHE_N_TYPES; t++) {
+        c->type_budget[t] = budget_bytes[t];
+        c->budget += budget_bytes[t];
+        for (int l = 0; l < CACHE_N_LEVELS; l++) {
+            float f = split[l] < 0.0f ? 0.0f : split[l];
+            c->level_budget[t][l] = (uint64_t)((double)budget_bytes[t] * f);
+            for (int s = 0; s < CACHE_SHARDS; s++)
+                if (shard_init(&c->shards[t][l][s], c->level_budget[t][l] / CACHE_SHARDS,
+                               nominal_values[l]) != 0)
+                    failed = 1;
+        }
     }
     if (failed) {
         cache_free(c);
@@ -148,19 +176,20 @@ void cache_free(Cache *c)
 {
     if (!c)
         return;
-    for (int l = 0; l < CACHE_N_LEVELS; l++)
-        for (int s = 0; s < CACHE_SHARDS; s++) {
-            Shard *sh = &c->shards[l][s];
-            for (size_t i = 0; i < sh->n_slots; i++)
-                for (CacheEntry *e = sh->table[i], *next; e; e = next) {
-                    next = e->hnext;
-                    RY_CHECK(e->refs == 0); /* nobody may hold an entry now */
-                    free(e);
-                }
-            free(sh->table);
-            pthread_mutex_destroy(&sh->lock);
-            pthread_cond_destroy(&sh->filled);
-        }
+    for (int t = 0; t < CACHE_N_TYPES; t++)
+        for (int l = 0; l < CACHE_N_LEVELS; l++)
+            for (int s = 0; s < CACHE_SHARDS; s++) {
+                Shard *sh = &c->shards[t][l][s];
+                for (size_t i = 0; i < sh->n_slots; i++)
+                    for (CacheEntry *e = sh->table[i], *next; e; e = next) {
+                        next = e->hnext;
+                        RY_CHECK(e->refs == 0); /* nobody may hold an entry now */
+                        free(e);
+                    }
+                free(sh->table);
+                pthread_mutex_destroy(&sh->lock);
+                pthread_cond_destroy(&sh->filled);
+            }
     pthread_mutex_destroy(&c->counters_lock);
     free(c);
 }
@@ -177,7 +206,7 @@ uint64_t cache_bump_timestamp(Cache *c)
 
 static Shard *shard_of(Cache *c, const CacheKey *k, uint64_t hash)
 {
-    return &c->shards[k->level][(hash >> 40) % CACHE_SHARDS];
+    return &c->shards[c->part_of[k->type]][k->level][(hash >> 40) % CACHE_SHARDS];
 }
 
 static void lru_unlink(Shard *s, CacheEntry *e)
@@ -258,7 +287,10 @@ void cache_local_init(CacheLocal *local, Cache *cache)
     memset(local, 0, sizeof *local);
     local->cache = cache;
     for (int l = 0; l < CACHE_N_LEVELS; l++) {
-        uint64_t capacity = cache->level_budget[l] / cache_entry_bytes(nominal_values[l]);
+        uint64_t level_budget = 0;
+        for (int t = 0; t < CACHE_N_TYPES; t++)
+            level_budget += cache->level_budget[t][l];
+        uint64_t capacity = level_budget / cache_entry_bytes(nominal_values[l]);
         uint32_t n = (uint32_t)cache_local_slots[l];
         while (n > 4 && (uint64_t)n * 32 > capacity)
             n /= 2;
@@ -422,17 +454,21 @@ void cache_get_stats(const Cache *cc, CacheStats *st)
     pthread_mutex_lock(&c->counters_lock);
     memcpy(st->counters, c->counters, sizeof st->counters);
     pthread_mutex_unlock(&c->counters_lock);
-    for (int l = 0; l < CACHE_N_LEVELS; l++) {
-        st->level_budget_bytes[l] = c->level_budget[l];
-        for (int s = 0; s < CACHE_SHARDS; s++) {
-            Shard *sh = &c->shards[l][s];
-            pthread_mutex_lock(&sh->lock);
-            st->entries[l] += sh->entries;
-            st->bytes[l] += sh->bytes;
-            st->peak_bytes[l] += sh->peak;
-            for (int t = 0; t < CACHE_N_TYPES; t++)
-                st->counters[l][t].evictions += sh->evictions[t];
-            pthread_mutex_unlock(&sh->lock);
+    for (int t = 0; t < CACHE_N_TYPES; t++)
+        for (int l = 0; l < CACHE_N_LEVELS; l++) {
+            st->type_budget_bytes[t] = c->type_budget[c->part_of[t]];
+            st->level_budget_bytes[l] += c->level_budget[t][l];
+            for (int s = 0; s < CACHE_SHARDS; s++) {
+                Shard *sh = &c->shards[t][l][s];
+                pthread_mutex_lock(&sh->lock);
+                st->entries[l] += sh->entries;
+                st->type_entries[t][l] += sh->entries; /* partition t's */
+                st->bytes[l] += sh->bytes;
+                st->peak_bytes[l] += sh->peak;
+                st->type_peak_bytes[t] += sh->peak;
+                for (int t = 0; t < CACHE_N_TYPES; t++)
+                    st->counters[l][t].evictions += sh->evictions[t];
+                pthread_mutex_unlock(&sh->lock);
+            }
         }
-    }
 }

@@ -4,6 +4,8 @@
  * calls the fill function it is given.
  *
  * Structure (memo 3.1, DESIGN.md "The multiresolution cache"):
+ *  - per data type (radiosity, opacity, irradiance: memo 6, one cache whose
+ *    keys carry the type) a budget of its own, and within it
  *  - three resolutions (COARSE, MEDIUM, FINE), each with its own share of the
  *    byte budget (default 25% / 25% / 50% of 100 MB) and least-recently-used
  *    replacement;
@@ -72,16 +74,28 @@ typedef struct CacheCounters {
 } CacheCounters;
 
 typedef struct CacheStats {
-    uint64_t budget_bytes;                          /* whole budget */
-    uint64_t level_budget_bytes[CACHE_N_LEVELS];
-    uint64_t entries[CACHE_N_LEVELS];               /* resident now */
-    uint64_t bytes[CACHE_N_LEVELS];                 /* counted now */
-    uint64_t peak_bytes[CACHE_N_LEVELS];
+    uint64_t budget_bytes;                                /* whole budget, all types */
+    uint64_t level_budget_bytes[CACHE_N_LEVELS];          /* these four: all types summed */
+    uint64_t entries[CACHE_N_LEVELS];                     /* resident now */
+    uint64_t bytes[CACHE_N_LEVELS];                       /* counted now */
+    uint64_t peak_bytes[CACHE_N_LEVELS];                  /* sum of the shards' peaks */
+    uint64_t type_budget_bytes[CACHE_N_TYPES];            /* the budget of the type's partition; */
+    uint64_t type_entries[CACHE_N_TYPES][CACHE_N_LEVELS]; /* these two: partition t's (the
+                                                       type's in a cache_new_typed cache) */
+    uint64_t type_peak_bytes[CACHE_N_TYPES];
     CacheCounters counters[CACHE_N_LEVELS][CACHE_N_TYPES];
 } CacheStats;
 
-/* A new cache with a byte budget split by fractions split[level] (summing to
- * at most 1). Returns NULL when out of memory. */
+/* A new cache whose data type t has budget_bytes[t], split among the
+ * resolutions by fractions split[level] (summing to at most 1): entries of
+ * one type never evict another's (the radiosity budget is the user's
+ * "cache size", the opacity budget RenderMan's "opacitycachememory"). A
+ * type of budget 0 fills a private entry at every lookup. Returns NULL
+ * when out of memory. */
+Cache *cache_new_typed(const uint64_t budget_bytes[CACHE_N_TYPES],
+                       const float split[CACHE_N_LEVELS]);
+/* A cache whose types all share one budget (entries of any type may evict
+ * any other's). */
 Cache *cache_new(uint64_t budget_bytes, const float split[CACHE_N_LEVELS]);
 /* Frees the cache; no entry may be held. */
 void cache_free(Cache *cache);

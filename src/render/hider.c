@@ -154,6 +154,7 @@ static Rgb *shade_grid(Worker *w, uint32_t gi)
         .Cs = (const float(*)[3])Cs, .Os = (const float(*)[3])Os, .renderer = &ps,
         .backfacing = back,
     };
+    path_apply_Os_pattern(w, obj, &ctx, Os);
     RayesShadeOutputs out = {.Ci = Ci, .Oi = Oi};
     w->stats.shading_points[0] += n;
     shade_run_lighting(w->services, &ctx, obj->shader, &out);

@@ -22,6 +22,7 @@
 #include <string.h>
 
 #include "util/check.h"
+#include "util/rng.h"
 
 /* The shading inputs of one hit: a 1-point context. */
 typedef struct HitPoint {
@@ -115,9 +116,12 @@ static void hit_footprint(HitPoint *hp)
     }
 }
 
+/* Shades the hit as a ray of type kind sees it (lighting, diffuselighting,
+ * or with kind RAYES_RAY_TRANSMISSION the opacity method); *Oi receives
+ * the shader's opacity. */
 static Vec3 shade_hit(Worker *w, const Ray *ray, const Hit *hit, const RenderObject *obj,
                       uint32_t kind, int diffuse_depth, int specular_depth, uint64_t key,
-                      RayDiff diff)
+                      RayDiff diff, Vec3 *Oi_out)
 {
     HitPoint hp;
     int backfacing = !hit_point(w, ray, hit, obj, &hp);
@@ -151,31 +155,75 @@ static Vec3 shade_hit(Worker *w, const Ray *ray, const Hit *hit, const RenderObj
         .renderer = &ps,
         .backfacing = &backfacing,
     };
-    float Ci[1][3], Oi[1][3];
+    path_apply_Os_pattern(w, obj, &ctx, &hp.Os);
+    float Ci[1][3] = {{0, 0, 0}}, Oi[1][3] = {{1, 1, 1}};
     RayesShadeOutputs out = {Ci, Oi, NULL, NULL};
-    w->stats.shading_points[RY_MIN(diffuse_depth, RENDER_MAX_DEPTH)]++;
-    if (kind == RAYES_RAY_DIFFUSE)
+    if (kind == RAYES_RAY_TRANSMISSION) {
+        w->stats.opacity_points++;
+        shade_run_opacity(w->services, &ctx, obj->shader, &out);
+    } else if (kind == RAYES_RAY_DIFFUSE) {
+        w->stats.shading_points[RY_MIN(diffuse_depth, RENDER_MAX_DEPTH)]++;
         shade_run_diffuselighting(w->services, &ctx, obj->shader, &out);
-    else
+    } else {
+        w->stats.shading_points[RY_MIN(diffuse_depth, RENDER_MAX_DEPTH)]++;
         shade_run_lighting(w->services, &ctx, obj->shader, &out);
+    }
+    *Oi_out = v3(Oi[0][0], Oi[0][1], Oi[0][2]);
     return v3(Ci[0][0], Ci[0][1], Ci[0][2]);
 }
 
-Vec3 integrator_trace(Worker *w, const Ray *ray, uint32_t kind, int diffuse_depth,
-                      int specular_depth, uint64_t key, RayDiff diff, float *alpha)
+Vec3 integrator_opacity(Worker *w, const Ray *ray, const Hit *hit, RayDiff diff)
 {
-    float t;
-    Vec3 L = integrator_trace_hit(w, ray, kind, diffuse_depth, specular_depth, key, diff, &t);
-    if (alpha)
-        *alpha = isfinite(t) ? 1.0f : 0.0f;
-    return L;
+    const RenderObject *obj = &w->rs->objects[w->rs->gs->grids[hit->grid].object];
+    if (!obj->transparent)
+        return v3(1, 1, 1);
+    if (!obj->opacity_shader && !obj->Os_pattern)
+        return v3_load(obj->Os); /* constant */
+    if (w->set->opacity_cache && obj->opacity_cached)
+        return radiosity_opacity_at_hit(w, hit, diff);
+    Vec3 Oi;
+    shade_hit(w, ray, hit, obj, RAYES_RAY_TRANSMISSION, 0, 0, 0, diff, &Oi);
+    return Oi;
 }
 
-Vec3 integrator_trace_hit(Worker *w, const Ray *ray, uint32_t kind, int diffuse_depth,
-                          int specular_depth, uint64_t key, RayDiff diff, float *t)
+/* AccelOpacityFn of shadow rays: the opacity at a transparent hit. */
+typedef struct ShadowRay {
+    Worker *w;
+    RayDiff diff;
+} ShadowRay;
+
+static Vec3 shadow_opacity(void *user, const Ray *ray, const Hit *hit)
+{
+    ShadowRay *sr = user;
+    sr->w->stats.transparent_hits++;
+    return integrator_opacity(sr->w, ray, hit, sr->diff);
+}
+
+Vec3 integrator_transmission(Worker *w, const Ray *ray, RayDiff diff)
+{
+    w->stats.rays_shadow++;
+    if (!w->rs->any_transparent)
+        return accel_occluded(w->rs->accel, ray) ? v3(0, 0, 0) : v3(1, 1, 1);
+    ShadowRay sr = {w, diff};
+    return accel_transmission(w->rs->accel, ray, shadow_opacity, &sr);
+}
+
+/* Surfaces a ray sees through before the next is taken as opaque. */
+#define INTEGRATOR_MAX_LAYERS 64
+
+/* integrator_trace_hit, with alpha (the coverage along the ray: 1 - the
+ * mean of the transmittance through what it hit) and the layer count of
+ * partly transparent surfaces already crossed. A transparent surface's
+ * premultiplied Ci is composited over what lies behind it, front to back:
+ * Ci + (1 - Oi) L_behind, Oi the shader's (camera, specular and uncached
+ * diffuse hits) or the opacity cache's (cached diffuse hits). */
+static Vec3 trace_layers(Worker *w, const Ray *ray, uint32_t kind, int diffuse_depth,
+                         int specular_depth, uint64_t key, RayDiff diff, float *t, float *alpha,
+                         int layer)
 {
     Hit hit;
     *t = INFINITY;
+    *alpha = 0.0f;
     if (!accel_intersect(w->rs->accel, ray, &hit)) {
         /* Environment lights: seen by camera and specular rays; black to
          * diffuse rays, as direct lighting integrates them. */
@@ -187,6 +235,7 @@ Vec3 integrator_trace_hit(Worker *w, const Ray *ray, uint32_t kind, int diffuse_
         return L;
     }
     *t = hit.t;
+    *alpha = 1.0f;
     const RenderObject *obj = &w->rs->objects[w->rs->gs->grids[hit.grid].object];
     if (obj->light >= 0) {
         /* Emitters: seen by camera and specular rays, on their front side
@@ -195,10 +244,49 @@ Vec3 integrator_trace_hit(Worker *w, const Ray *ray, uint32_t kind, int diffuse_
             return v3(0, 0, 0);
         return w->rs->lights[obj->light].L;
     }
-    if (kind == RAYES_RAY_DIFFUSE && w->set->cache)
-        return radiosity_at_hit(w, ray, &hit, diffuse_depth, diff);
-    Vec3 L;
-    if (kind == RAYES_RAY_CAMERA && w->grid_shading && hider_camera_hit(w, ray, &hit, &L))
-        return L;
-    return shade_hit(w, ray, &hit, obj, kind, diffuse_depth, specular_depth, key, diff);
+    int see_through = obj->transparent && layer < INTEGRATOR_MAX_LAYERS;
+    Vec3 Ci, Oi = v3(1, 1, 1);
+    if (kind == RAYES_RAY_DIFFUSE && w->set->radiosity_cache) {
+        Ci = radiosity_at_hit(w, ray, &hit, diffuse_depth, diff);
+        if (see_through)
+            Oi = integrator_opacity(w, ray, &hit, diff);
+    } else if (kind == RAYES_RAY_CAMERA && w->grid_shading && !obj->transparent &&
+               hider_camera_hit(w, ray, &hit, &Ci)) {
+        /* the grid hider's shaded grid (opaque objects only) */
+    } else {
+        Ci = shade_hit(w, ray, &hit, obj, kind, diffuse_depth, specular_depth, key, diff, &Oi);
+    }
+    if (!see_through)
+        return Ci;
+    Vec3 T = v3(1.0f - fminf(fmaxf(Oi.x, 0.0f), 1.0f), 1.0f - fminf(fmaxf(Oi.y, 0.0f), 1.0f),
+                1.0f - fminf(fmaxf(Oi.z, 0.0f), 1.0f));
+    if (!(v3_max_component(T) > 0.0f))
+        return Ci;
+    /* What lies behind, from just past the hit (never the same surface). */
+    Ray next = *ray;
+    next.tnear = hit.t + path_ray_epsilon(w) / fmaxf(v3_length(ray->d), 1e-30f);
+    float t_behind, a_behind;
+    Vec3 L = trace_layers(w, &next, kind, diffuse_depth, specular_depth,
+                          hash_combine(key, 0x6c61796572ull /* "layer" */), diff, &t_behind,
+                          &a_behind, layer + 1);
+    float cover = 1.0f - (T.x + T.y + T.z) / 3.0f;
+    *alpha = cover + (1.0f - cover) * a_behind;
+    return v3_add(Ci, v3_mul(T, L));
+}
+
+Vec3 integrator_trace(Worker *w, const Ray *ray, uint32_t kind, int diffuse_depth,
+                      int specular_depth, uint64_t key, RayDiff diff, float *alpha)
+{
+    float t, a;
+    Vec3 L = trace_layers(w, ray, kind, diffuse_depth, specular_depth, key, diff, &t, &a, 0);
+    if (alpha)
+        *alpha = a;
+    return L;
+}
+
+Vec3 integrator_trace_hit(Worker *w, const Ray *ray, uint32_t kind, int diffuse_depth,
+                          int specular_depth, uint64_t key, RayDiff diff, float *t)
+{
+    float a;
+    return trace_layers(w, ray, kind, diffuse_depth, specular_depth, key, diff, t, &a, 0);
 }

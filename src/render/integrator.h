@@ -20,4 +20,16 @@ Vec3 integrator_trace(Worker *w, const Ray *ray, uint32_t kind, int diffuse_dept
 Vec3 integrator_trace_hit(Worker *w, const Ray *ray, uint32_t kind, int diffuse_depth,
                           int specular_depth, uint64_t key, RayDiff diff, float *t);
 
+/* The opacity (RGB) of the surface at a hit, as shadow and transmission
+ * rays see it: 1 for opaque objects, Os where the transmission hit mode is
+ * "primitive" or the shader has no opacity method, else the opacity cache
+ * (memo 6.1) or, uncached, the shader's opacity method at the hit. diff is
+ * the ray's differential (its footprint chooses the cache resolution). */
+Vec3 integrator_opacity(Worker *w, const Ray *ray, const Hit *hit, RayDiff diff);
+
+/* The transmittance along a shadow or transmission ray: 1 where nothing is
+ * in the way, the product of (1 - opacity) through transparent surfaces, 0
+ * at an opaque one. Counts the ray. */
+Vec3 integrator_transmission(Worker *w, const Ray *ray, RayDiff diff);
+
 #endif /* RAYES_RENDER_INTEGRATOR_H */

@@ -1,9 +1,13 @@
 /*
- * render/path.c — where rays leaving a point start (path.h).
+ * render/path.c — where rays leaving a point start, and cut-out opacity
+ * patterns (path.h).
  */
 #include "render/path.h"
 
 #include <math.h>
+
+#include "shade/pattern.h"
+#include "util/check.h"
 
 float path_ray_epsilon(const Worker *w)
 {
@@ -17,4 +21,24 @@ float path_ray_offset(const Worker *w, const Grid *g)
      * another rate share no vertices, and a coarser one runs further
      * inside. */
     return path_ray_epsilon(w) + g->sagitta;
+}
+
+void path_apply_Os_pattern(const Worker *w, const RenderObject *obj, const RayesShadeCtx *ctx,
+                           float (*Os)[3])
+{
+    if (!obj->Os_pattern)
+        return;
+    const PathState *ps = ctx->renderer;
+    for (size_t start = 0; start < ctx->n_points; start += SHADE_CHUNK) {
+        size_t n = RY_MIN(ctx->n_points - start, (size_t)SHADE_CHUNK);
+        RayesShadeCtx sub;
+        float m[SHADE_CHUNK][3];
+        shade_ctx_slice(ctx, start, n, &sub);
+        pattern_eval(obj->Os_pattern, w->set->textures, &sub,
+                     ps->ds ? ps->ds + sub.first_point : NULL,
+                     ps->dt ? ps->dt + sub.first_point : NULL, m);
+        for (size_t i = 0; i < n; i++)
+            for (int c = 0; c < 3; c++)
+                Os[start + i][c] *= fminf(fmaxf(m[i][c], 0.0f), 1.0f);
+    }
 }

@@ -79,4 +79,10 @@ float path_ray_offset(const Worker *w, const Grid *g);
  * stop short of a light: a millionth of the scene's radius times ten. */
 float path_ray_epsilon(const Worker *w);
 
+/* Multiplies the Os of ctx's points (Os, the array ctx->Os points to) by
+ * obj's Os pattern, if it has one (a cut-out: pbrt's alpha texture),
+ * filtered over the points' footprints; ctx->renderer is a PathState. */
+void path_apply_Os_pattern(const Worker *w, const RenderObject *obj, const RayesShadeCtx *ctx,
+                           float (*Os)[3]);
+
 #endif /* RAYES_RENDER_PATH_H */

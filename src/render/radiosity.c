@@ -268,7 +268,9 @@ static void level_footprint(const Grid *g, int level, float *du, float *dv)
     *dv = ext[1] / m;
 }
 
-/* CacheFillFn: shade every point of the level with diffuselighting. */
+/* CacheFillFn: shade every point of the level with diffuselighting
+ * (radiosity: Ci) or the opacity method (opacity: Oi, transmission rays at
+ * depth 0, the front side). */
 static void fill_radiosity(void *user, const CacheKey *key, size_t n, float (*out)[3])
 {
     FillJob *job = user;
@@ -307,10 +309,20 @@ static void fill_radiosity(void *user, const CacheKey *key, size_t n, float (*ou
         backfacing[i] = key->side != 0; /* side 1: against dPdu x dPdv */
     }
     int own_st = (g->primvars & GEOM_PV_ST) != 0;
-    PathState ps = {w, fp.keys, fp.diff, fp.curv, fp.offset, NULL, key->patch,
-                    own_st ? fp.ds : NULL, own_st ? fp.dt : NULL};
+    PathState ps = {w,
+                    fp.keys,
+                    fp.diff,
+                    fp.curv,
+                    fp.offset,
+                    NULL,
+                    key->patch,
+                    own_st ? fp.ds : NULL,
+                    own_st ? fp.dt : NULL};
+    int opacity = key->type == CACHE_OPACITY;
     RayesShadeCtx ctx = {
-        .n_points = n, .ray_type = RAYES_RAY_DIFFUSE, .diffuse_depth = key->depth,
+        .n_points = n,
+        .ray_type = opacity ? RAYES_RAY_TRANSMISSION : RAYES_RAY_DIFFUSE,
+        .diffuse_depth = key->depth,
         .specular_depth = 0,
         .P = (const float(*)[3])fp.P, .N = (const float(*)[3])fp.N,
         .Ng = (const float(*)[3])fp.Ng, .dPdu = (const float(*)[3])fp.dPdu,
@@ -318,10 +330,17 @@ static void fill_radiosity(void *user, const CacheKey *key, size_t n, float (*ou
         .du = fp.du, .dv = fp.dv, .I = NULL, .Cs = (const float(*)[3])fp.Cs,
         .Os = (const float(*)[3])fp.Os, .renderer = &ps, .backfacing = backfacing,
     };
+    path_apply_Os_pattern(w, obj, &ctx, fp.Os);
     RayesShadeOutputs o = {fp.Ci, fp.Oi, NULL, NULL};
-    w->stats.shading_points[RY_MIN(key->depth, RENDER_MAX_DEPTH)] += n;
-    shade_run_diffuselighting(w->services, &ctx, obj->shader, &o);
-    memcpy(out, fp.Ci, n * sizeof *out);
+    if (opacity) {
+        w->stats.opacity_points += n;
+        shade_run_opacity(w->services, &ctx, obj->shader, &o);
+        memcpy(out, fp.Oi, n * sizeof *out);
+    } else {
+        w->stats.shading_points[RY_MIN(key->depth, RENDER_MAX_DEPTH)] += n;
+        shade_run_diffuselighting(w->services, &ctx, obj->shader, &o);
+        memcpy(out, fp.Ci, n * sizeof *out);
+    }
     free(f3);
     free(f1);
     free(fp.keys);
@@ -381,16 +400,33 @@ Vec3 radiosity_interpolate(const Grid *g, const Hit *hit, int level, const uint1
     return r;
 }
 
-Vec3 radiosity_at_hit(Worker *w, const Ray *ray, const Hit *hit, int diffuse_depth, RayDiff diff)
+/* The cached value of a type at a hit. */
+static Vec3 cached_at_hit(Worker *w, const Hit *hit, int type, int depth, int side, RayDiff diff)
 {
     const Grid *g = &w->rs->gs->grids[hit->grid];
     float footprint = diff.width + diff.spread * hit->t;
     int level = radiosity_choose_level(g, footprint, w->set->cache_k, w->set->cache_resolution);
-    int side = v3_dot(hit->Ng, ray->d) < 0.0f ? 0 : 1;
-    CacheKey key = {.patch = hit->grid, .depth = (uint16_t)diffuse_depth, .segment = 0,
-                    .side = (uint8_t)side, .type = CACHE_RADIOSITY, .level = (uint8_t)level};
+    CacheKey key = {.patch = hit->grid,
+                    .depth = (uint16_t)depth,
+                    .segment = 0,
+                    .side = (uint8_t)side,
+                    .type = (uint8_t)type,
+                    .level = (uint8_t)level};
     FillJob job = {w, hit->grid};
     const uint16_t *vals =
         cache_lookup(&w->cache, &key, level_values(g, level), fill_radiosity, &job);
     return radiosity_interpolate(g, hit, level, vals);
+}
+
+Vec3 radiosity_at_hit(Worker *w, const Ray *ray, const Hit *hit, int diffuse_depth, RayDiff diff)
+{
+    int side = v3_dot(hit->Ng, ray->d) < 0.0f ? 0 : 1;
+    return cached_at_hit(w, hit, CACHE_RADIOSITY, diffuse_depth, side, diff);
+}
+
+Vec3 radiosity_opacity_at_hit(Worker *w, const Hit *hit, RayDiff diff)
+{
+    /* The memo's assumption: one opacity per point, whatever the side and
+     * the depth. */
+    return cached_at_hit(w, hit, CACHE_OPACITY, 0, 0, diff);
 }

@@ -1,6 +1,6 @@
 /*
  * render/radiosity.h — private to render/: the radiosity cache at diffuse
- * hits (radiosity.c).
+ * hits, and the opacity cache at transmission hits (radiosity.c).
  */
 #ifndef RAYES_RENDER_RADIOSITY_H
 #define RAYES_RENDER_RADIOSITY_H
@@ -16,6 +16,11 @@ int radiosity_choose_level(const Grid *g, float footprint, float k, int forced);
 /* The cached radiosity leaving the hit toward the ray (filling the entry on
  * a miss). */
 Vec3 radiosity_at_hit(Worker *w, const Ray *ray, const Hit *hit, int diffuse_depth, RayDiff diff);
+
+/* The cached opacity at a hit (memo 6.1): entries of data type opacity, of
+ * the front side and depth 0 whatever the ray, filled by the shader's
+ * opacity method over the level's points. */
+Vec3 radiosity_opacity_at_hit(Worker *w, const Hit *hit, RayDiff diff);
 
 /* Interpolates a level's values at a hit. */
 Vec3 radiosity_interpolate(const Grid *g, const Hit *hit, int level, const uint16_t *values);

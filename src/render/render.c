@@ -208,6 +208,8 @@ static void merge_stats(RenderStats *into, const RenderStats *s)
     for (int d = 0; d <= RENDER_MAX_DEPTH; d++)
         into->shading_points[d] += s->shading_points[d];
     into->ambient_lookups += s->ambient_lookups;
+    into->opacity_points += s->opacity_points;
+    into->transparent_hits += s->transparent_hits;
 }
 
 int render_frame(const RenderScene *rs, const RenderSettings *set, float *rgba, RenderStats *stats)

@@ -28,11 +28,18 @@
 #define RENDER_MAX_DEPTH 16 /* diffuse depths counted separately in statistics */
 
 typedef struct RenderObject {
-    const ShaderInstance *shader; /* surface shader (NULL for lights) */
-    float Cs[3], Os[3];           /* surface colour and opacity */
-    int light;                    /* index of the light it emits as, or -1 */
-    const unsigned char *lit;     /* n_lights flags, nonzero: that light illuminates it (its
-                                     light links); NULL: every light does */
+    const ShaderInstance *shader;          /* surface shader (NULL for lights) */
+    float Cs[3], Os[3];                    /* surface colour and opacity */
+    int light;                             /* index of the light it emits as, or -1 */
+    const struct RayesPattern *Os_pattern; /* multiplies Os where not NULL (a cut-out) */
+    uint8_t transparent;                   /* 1: may be partly transparent (Os below 1, or a shader
+                                              with an opacity method): shadow rays ask its opacity and
+                                              other rays composite what lies behind it */
+    uint8_t opacity_shader;                /* 1: its opacity is its shader's opacity method's
+                                              (transmissionhitmode "shader"); 0: Os alone */
+    uint8_t opacity_cached;                /* 1: its opacity may come from the cache (memo 6.1) */
+    const unsigned char *lit; /* n_lights flags, nonzero: that light illuminates it (its
+                                 light links); NULL: every light does */
 } RenderObject;
 
 /* Whether light k illuminates obj (direct lighting, ambient). */
@@ -63,7 +70,8 @@ typedef struct RenderScene {
     const Light *lights;
     size_t n_lights;
     Camera camera;
-    float scene_radius;           /* for ray offsets */
+    float scene_radius;  /* for ray offsets */
+    int any_transparent; /* 1: some object is transparent (shadow rays filter) */
 } RenderScene;
 
 typedef struct RenderSettings {
@@ -81,17 +89,19 @@ typedef struct RenderSettings {
     uint64_t seed;
     int (*progress)(void *user, double fraction); /* nonzero: cancel */
     void *progress_user;
-    Cache *cache;                 /* the radiosity cache, or NULL: uncached */
-    int cache_resolution;         /* -1: by differentials; else a forced CacheLevel */
-    float cache_k;                /* resolution rule constant (DESIGN.md) */
-    int grid_size;                /* micropolygons per grid, at most (dicing; geom.h) */
-    float dice_offscreen;         /* off-screen dicing factor (DiceOptions) */
-    size_t vertex_budget;         /* grid vertices, at most; 0: none (DiceOptions) */
-    int dice_isotropic;           /* on screen by distance too (DiceOptions) */
-    int hider;                    /* 0: shade at every camera hit; 1: the grid hider (hider.h) */
-    int irradiance;               /* 1: irradiance interpolation at depth 0 (irrgrid.h; grid
-                                     hider only) */
-    TextureSystem *textures;      /* image textures for the texture service, or NULL */
+    Cache *cache;            /* the cache (every data type), or NULL: uncached */
+    int radiosity_cache;     /* 1: diffuse hits read radiosity from cache */
+    int opacity_cache;       /* 1: shadow and diffuse rays read opacity from cache */
+    int cache_resolution;    /* -1: by differentials; else a forced CacheLevel */
+    float cache_k;           /* resolution rule constant (DESIGN.md) */
+    int grid_size;           /* micropolygons per grid, at most (dicing; geom.h) */
+    float dice_offscreen;    /* off-screen dicing factor (DiceOptions) */
+    size_t vertex_budget;    /* grid vertices, at most; 0: none (DiceOptions) */
+    int dice_isotropic;      /* on screen by distance too (DiceOptions) */
+    int hider;               /* 0: shade at every camera hit; 1: the grid hider (hider.h) */
+    int irradiance;          /* 1: irradiance interpolation at depth 0 (irrgrid.h; grid
+                                hider only) */
+    TextureSystem *textures; /* image textures for the texture service, or NULL */
     /* Progressive rendering (session/progressive.c); all zero for a one-shot frame. */
     int first_sample;             /* the frame takes pixel samples first_sample .. + spp - 1 */
     int pattern_spp;              /* of patterns of this many samples (0: spp); sample g is
@@ -106,9 +116,13 @@ typedef struct RenderSettings {
 typedef struct RenderStats {
     uint64_t rays_camera, rays_shadow, rays_diffuse, rays_specular;
     uint64_t shading_points[RENDER_MAX_DEPTH + 1]; /* by diffuse depth */
-    uint64_t irradiance_records;      /* irradiance interpolation: records computed */
-    uint64_t irradiance_interpolated; /* and points interpolated */
-    uint64_t ambient_lookups;     /* points the ambient service was asked for */
+    uint64_t irradiance_records;                   /* irradiance interpolation: records computed */
+    uint64_t irradiance_interpolated;              /* and points interpolated */
+    uint64_t ambient_lookups;                      /* points the ambient service was asked for */
+    uint64_t opacity_points;   /* points whose opacity a shader computed (cache fills and
+                                  uncached transmission hits) */
+    uint64_t transparent_hits; /* surfaces shadow rays passed through (or stopped at) that
+                                  were partly transparent */
 } RenderStats;
 
 /* The camera of an image of `height` pixels: eye, axes and tan(fov / 2)

@@ -58,9 +58,11 @@ static float power_heuristic(float pa, float pb)
     return a + b > 0.0f ? a / (a + b) : 0.0f;
 }
 
-/* 1 if nothing stands between o and the point dist along unit wi (INFINITY:
- * the ray escapes); counts the shadow ray. */
-static int unoccluded(Worker *w, Vec3 o, Vec3 wi, float dist)
+/* The transmittance from o to the point dist along unit wi (INFINITY: the
+ * ray escapes): 1 if nothing stands between, 0 behind an opaque surface,
+ * the product of (1 - opacity) through transparent ones (memo 6.1); diff
+ * is the shadow ray's differential. Counts the shadow ray. */
+static Vec3 transmittance(Worker *w, Vec3 o, Vec3 wi, float dist, RayDiff diff)
 {
     Ray shadow;
     if (isinf(dist)) {
@@ -71,17 +73,29 @@ static int unoccluded(Worker *w, Vec3 o, Vec3 wi, float dist)
          * surface's plane, and would shadow itself. */
         shadow = (Ray){o, v3_scale(wi, dist), path_ray_epsilon(w) / dist, 1.0f - 1e-4f,
                        RAYES_RAY_SHADOW};
+        diff.spread *= dist; /* per unit of the ray's parameter, which spans dist */
     }
-    w->stats.rays_shadow++;
-    return !accel_occluded(w->rs->accel, &shadow);
+    return integrator_transmission(w, &shadow, diff);
+}
+
+/* The differential of a shadow ray from point j of ps, one of n: the
+ * point's footprint, spreading as a diffuse ray's of n (each stands for
+ * 1/n of the light's solid angle; a delta light's one ray takes the
+ * point's own spread). */
+static RayDiff shadow_diff(const PathState *ps, size_t j, int n)
+{
+    float lobe = n > 1 ? 1.0f / sqrtf((float)n) : 0.0f;
+    return (RayDiff){ps->diff[j].width, fmaxf(ps->diff[j].spread, lobe)};
 }
 
 /* What direct lighting needs of one shading point. */
 typedef struct DirectPoint {
     Vec3 o, N, Ng, V;
-    float e;      /* Blinn-Phong exponent */
-    int diff;     /* the diffuse output is wanted */
-    int spec;     /* the specular output is wanted */
+    float e;        /* Blinn-Phong exponent */
+    int diff;       /* the diffuse output is wanted */
+    int spec;       /* the specular output is wanted */
+    RayDiff shadow; /* its shadow rays' differential, for rays drawn from a lobe */
+    float spread;   /* the point's own ray spread */
 } DirectPoint;
 
 /* A delta light (point, spot, distant): one shadow ray. */
@@ -92,11 +106,14 @@ static void light_delta(Worker *w, const DirectPoint *p, const Light *l, Vec3 *d
     if (!light_sample(l, p->o, 0.5f, 0.5f, &ls))
         return;
     float cos_x = v3_dot(p->N, ls.wi);
-    if (cos_x <= 0.0f || v3_dot(p->Ng, ls.wi) <= 0.0f || !unoccluded(w, p->o, ls.wi, ls.dist))
+    if (cos_x <= 0.0f || v3_dot(p->Ng, ls.wi) <= 0.0f)
         return;
-    *diffuse = v3_madd(*diffuse, ls.Li, cos_x / (float)M_PI);
+    /* one ray, not a share of a solid angle: the point's own spread */
+    RayDiff one = {p->shadow.width, p->spread};
+    Vec3 Li = v3_mul(ls.Li, transmittance(w, p->o, ls.wi, ls.dist, one));
+    *diffuse = v3_madd(*diffuse, Li, cos_x / (float)M_PI);
     if (p->spec)
-        *spec = v3_madd(*spec, ls.Li, cos_x * blinn_phong(p->N, p->V, ls.wi, p->e));
+        *spec = v3_madd(*spec, Li, cos_x * blinn_phong(p->N, p->V, ls.wi, p->e));
 }
 
 /* An area or environment light, n samples with multiple importance
@@ -117,15 +134,18 @@ static void light_area(Worker *w, const DirectPoint *p, const Light *l, uint64_t
         cmj_sample_2d((uint32_t)s, (uint32_t)n, pattern, &a, &b);
         if (light_sample(l, p->o, a, b, &ls) && ls.pdf > 0.0f) {
             float cos_x = v3_dot(p->N, ls.wi);
-            if (cos_x > 0.0f && v3_dot(p->Ng, ls.wi) > 0.0f && v3_max_component(ls.Li) > 0.0f &&
-                unoccluded(w, p->o, ls.wi, ls.dist)) {
+            if (cos_x > 0.0f && v3_dot(p->Ng, ls.wi) > 0.0f && v3_max_component(ls.Li) > 0.0f) {
+                /* each of the n samples stands for 1 / (n pdf) of solid angle */
+                RayDiff sd = {p->shadow.width, fmaxf(p->spread, fminf(p->shadow.spread,
+                                                                      sqrtf(1.0f / (n * ls.pdf))))};
+                Vec3 Li = v3_mul(ls.Li, transmittance(w, p->o, ls.wi, ls.dist, sd));
                 float wd = power_heuristic(ls.pdf, cos_x / (float)M_PI);
                 if (p->diff)
-                    sum_d = v3_madd(sum_d, ls.Li, wd * cos_x / ((float)M_PI * ls.pdf));
+                    sum_d = v3_madd(sum_d, Li, wd * cos_x / ((float)M_PI * ls.pdf));
                 if (p->spec) {
                     float ws = power_heuristic(ls.pdf, blinn_phong_pdf(p->N, p->V, ls.wi, p->e));
                     float f = blinn_phong(p->N, p->V, ls.wi, p->e);
-                    sum_s = v3_madd(sum_s, ls.Li, ws * f * cos_x / ls.pdf);
+                    sum_s = v3_madd(sum_s, Li, ws * f * cos_x / ls.pdf);
                 }
             }
         }
@@ -137,8 +157,10 @@ static void light_area(Worker *w, const DirectPoint *p, const Light *l, uint64_t
             wi = sample_cosine_hemisphere(p->N, a, b);
             cos_x = v3_dot(p->N, wi);
             if (cos_x > 0.0f && v3_dot(p->Ng, wi) > 0.0f && light_intersect(l, p->o, wi, &ls) &&
-                v3_max_component(ls.Li) > 0.0f && unoccluded(w, p->o, wi, ls.dist))
-                sum_d = v3_madd(sum_d, ls.Li, power_heuristic(cos_x / (float)M_PI, ls.pdf));
+                v3_max_component(ls.Li) > 0.0f)
+                sum_d =
+                    v3_madd(sum_d, v3_mul(ls.Li, transmittance(w, p->o, wi, ls.dist, p->shadow)),
+                            power_heuristic(cos_x / (float)M_PI, ls.pdf));
         }
         if (!p->spec)
             continue;
@@ -159,10 +181,11 @@ static void light_area(Worker *w, const DirectPoint *p, const Light *l, uint64_t
             !(v3_max_component(ls.Li) > 0.0f))
             continue;
         float pdf = blinn_phong_pdf(p->N, p->V, wi, p->e);
-        if (!(pdf > 0.0f) || !unoccluded(w, p->o, wi, ls.dist))
+        if (!(pdf > 0.0f))
             continue;
+        Vec3 Li = v3_mul(ls.Li, transmittance(w, p->o, wi, ls.dist, p->shadow));
         float f = blinn_phong(p->N, p->V, wi, p->e);
-        sum_s = v3_madd(sum_s, ls.Li, power_heuristic(pdf, ls.pdf) * f * cos_x / pdf);
+        sum_s = v3_madd(sum_s, Li, power_heuristic(pdf, ls.pdf) * f * cos_x / pdf);
     }
     *diffuse = v3_add(*diffuse, v3_scale(sum_d, 1.0f / n));
     if (p->spec)
@@ -202,6 +225,8 @@ static void svc_direct_lighting(const RayesShaderServices *sv, const RayesShadeC
         p.e = 1.0f / (roughness && roughness[i] > 0.0f ? roughness[i] : 0.1f);
         p.spec = want_spec;
         p.diff = diffuse != NULL;
+        p.shadow = shadow_diff(ps, point(ctx, i), n);
+        p.spread = ps->diff[point(ctx, i)].spread;
         for (size_t k = 0; k < w->rs->n_lights && n > 0; k++) {
             const Light *l = &w->rs->lights[k];
             if (l->type == LIGHT_AMBIENT || !render_lit_by(obj, k) ||
@@ -268,7 +293,8 @@ static int fiber_lobe_sample(Vec3 T, Vec3 V, float e, float a, float b, float c,
 typedef struct FiberPoint {
     Vec3 P, Ng, T, V; /* V zero: no highlight */
     float e, offset;
-    uint64_t key;     /* the light's sample key */
+    uint64_t key;   /* the light's sample key */
+    RayDiff shadow; /* its shadow rays' differential */
 } FiberPoint;
 
 /* A ray's origin off a fibre: on the side of Ng that wi leaves by. */
@@ -292,8 +318,9 @@ static void fiber_light_samples(Worker *w, const FiberPoint *p, const Light *l, 
             cmj_sample_2d((uint32_t)j, (uint32_t)m, pattern, &a, &b);
         LightSample ls;
         if (!light_sample(l, p->P, a, b, &ls) || !(v3_max_component(ls.Li) > 0.0f) ||
-            (area && !(ls.pdf > 0.0f)) || !unoccluded(w, fiber_origin(p, ls.wi), ls.wi, ls.dist))
+            (area && !(ls.pdf > 0.0f)))
             continue;
+        ls.Li = v3_mul(ls.Li, transmittance(w, fiber_origin(p, ls.wi), ls.wi, ls.dist, p->shadow));
         float weight = area ? 1.0f / (ls.pdf * (float)m) : 1.0f;
         float ws = area && spec ? power_heuristic(ls.pdf, fiber_lobe_pdf(p->T, p->V, ls.wi, p->e))
                                 : 1.0f;
@@ -318,8 +345,9 @@ static void fiber_lobe_samples(Worker *w, const FiberPoint *p, const Light *l, i
             !light_intersect(l, p->P, wi, &ls) || !(v3_max_component(ls.Li) > 0.0f))
             continue;
         float pdf = fiber_lobe_pdf(p->T, p->V, wi, p->e);
-        if (!(pdf > 0.0f) || !unoccluded(w, fiber_origin(p, wi), wi, ls.dist))
+        if (!(pdf > 0.0f))
             continue;
+        ls.Li = v3_mul(ls.Li, transmittance(w, fiber_origin(p, wi), wi, ls.dist, p->shadow));
         fiber_terms(p->T, p->V, wi, p->e, &fd, &fs);
         *s = v3_madd(*s, ls.Li, fs * power_heuristic(pdf, ls.pdf) / (pdf * (float)m));
     }
@@ -344,6 +372,7 @@ static void svc_direct_fiber(const RayesShaderServices *sv, const RayesShadeCtx 
         p.V = specular && ctx->I ? v3_normalize(v3_neg(v3_load(ctx->I[i]))) : v3(0, 0, 0);
         p.e = 1.0f / (roughness && roughness[i] > 0.0f ? roughness[i] : 0.1f);
         p.offset = ps->offset[point(ctx, i)];
+        p.shadow = shadow_diff(ps, point(ctx, i), n);
         uint64_t key = hash_combine(ps->keys[point(ctx, i)], DIM_LIGHT);
         Vec3 d = v3(0, 0, 0), s = d;
         for (size_t k = 0; k < w->rs->n_lights && n > 0; k++) {
@@ -563,17 +592,51 @@ static void svc_transmission(const RayesShaderServices *sv, const RayesShadeCtx 
     for (size_t i = 0; i < ctx->n_points; i++) {
         Vec3 P = v3_load(ctx->P[i]), d = v3_sub(v3_load(to[i]), P);
         float len = v3_length(d);
-        float vis = 1.0f;
+        Vec3 vis = v3(1, 1, 1);
         if (len > 0.0f) {
             Vec3 Ng = v3_load(ctx->Ng[i]);
             float off = ps->offset[point(ctx, i)];
             Vec3 o = v3_madd(P, Ng, v3_dot(d, Ng) >= 0.0f ? off : -off);
             Vec3 wi = v3_sub(v3_load(to[i]), o);
-            Ray shadow = {o, wi, path_ray_epsilon(w) / v3_length(wi), 1.0f - 1e-4f, RAYES_RAY_SHADOW};
-            w->stats.rays_shadow++;
-            vis = accel_occluded(w->rs->accel, &shadow) ? 0.0f : 1.0f; /* all surfaces opaque */
+            float dist = v3_length(wi);
+            Ray shadow = {o, wi, path_ray_epsilon(w) / dist, 1.0f - 1e-4f, RAYES_RAY_SHADOW};
+            RayDiff diff = shadow_diff(ps, point(ctx, i), 1);
+            diff.spread *= dist;
+            vis = integrator_transmission(w, &shadow, diff);
         }
-        v3_store(out[i], v3(vis, vis, vis));
+        v3_store(out[i], vis);
+    }
+}
+
+static void svc_occlusion(const RayesShaderServices *sv, const RayesShadeCtx *ctx, int n_rays,
+                          float maxdist, float (*out)[3])
+{
+    (void)sv;
+    const PathState *ps = ctx->renderer;
+    Worker *w = ps->w;
+    int n = n_rays > 0                ? n_rays
+            : ctx->diffuse_depth == 0 ? w->set->diffuse_rays
+                                      : w->set->diffuse_rays_deep;
+    float far = maxdist > 0.0f ? maxdist : INFINITY;
+    for (size_t i = 0; i < ctx->n_points; i++) {
+        size_t j = point(ctx, i);
+        Vec3 N = v3_load(ctx->N[i]), Ng = v3_load(ctx->Ng[i]);
+        Vec3 o = v3_madd(v3_load(ctx->P[i]), Ng, ps->offset[j]), open = v3(0, 0, 0);
+        uint64_t key = hash_combine(ps->keys[j], DIM_OCCLUSION);
+        RayDiff diff = shadow_diff(ps, j, n);
+        int counted = 0;
+        for (int s = 0; s < n; s++) {
+            float a, b;
+            cmj_sample_2d((uint32_t)s, (uint32_t)n, (uint32_t)key, &a, &b);
+            Vec3 d = sample_cosine_hemisphere(N, a, b);
+            counted++;
+            if (v3_dot(d, Ng) <= 0.0f)
+                continue; /* below the geometric surface: blocked */
+            Ray ray = {o, d, 0.0f, far, RAYES_RAY_SHADOW};
+            open = v3_add(open, integrator_transmission(w, &ray, diff));
+        }
+        Vec3 occ = counted ? v3_sub(v3(1, 1, 1), v3_scale(open, 1.0f / counted)) : v3(0, 0, 0);
+        v3_store(out[i], occ);
     }
 }
 
@@ -674,6 +737,7 @@ static const char *const service_names[] = {
     "glossy",
     "pattern",
     "direct_fiber",
+    "occlusion",
 };
 
 static int svc_supports(const RayesShaderServices *sv, const char *service)
@@ -694,6 +758,7 @@ const RayesShaderServices render_services = {
     .indirect_specular = svc_indirect_specular,
     .indirect_refraction = svc_indirect_refraction,
     .transmission = svc_transmission,
+    .occlusion = svc_occlusion,
     .texture = svc_texture,
     .noise = shade_service_noise,
     .fbm = shade_service_fbm,

@@ -80,6 +80,11 @@ RayesError rayes_scene_pattern(RayesScene *s, const char *name, const char *type
     return RAYES_OK;
 }
 
+const struct RayesPattern *scene_find_pattern(const RayesScene *s, const char *name)
+{
+    return name ? find_pattern((void *)s, name) : NULL;
+}
+
 RayesError scene_bind_patterns(RayesScene *s, ShaderInstance *inst, const RayesParam *params,
                                size_t n_params)
 {

@@ -81,6 +81,9 @@ RayesScene *rayes_scene_new(void)
     s->world_from_object = mat4_identity();
     s->shading_rate = 1.0f;
     s->current_object = -1;
+    s->current_visibility =
+        RAYES_RAY_CAMERA | RAYES_RAY_DIFFUSE | RAYES_RAY_SPECULAR | RAYES_RAY_SHADOW;
+    s->current_opacity_cache = 1;
     return s;
 }
 
@@ -207,6 +210,35 @@ RayesError rayes_scene_set_transform(RayesScene *s, const float m[16])
     return RAYES_OK;
 }
 
+RayesError rayes_scene_set_visibility(RayesScene *s, uint32_t ray_types)
+{
+    const uint32_t known = RAYES_RAY_CAMERA | RAYES_RAY_SHADOW | RAYES_RAY_DIFFUSE |
+                           RAYES_RAY_SPECULAR | RAYES_RAY_TRANSMISSION;
+    if (!s)
+        return RAYES_ERROR_INVALID_ARGUMENT;
+    if (ray_types & ~known)
+        return fail(s, RAYES_ERROR_INVALID_ARGUMENT,
+                    "visibility: expected camera, shadow, diffuse, specular and transmission "
+                    "ray bits only");
+    /* Shadow and transmission rays are one kind to the tracer. */
+    if (ray_types & RAYES_RAY_TRANSMISSION)
+        ray_types = (ray_types & ~(uint32_t)RAYES_RAY_TRANSMISSION) | RAYES_RAY_SHADOW;
+    s->current_visibility = ray_types;
+    return RAYES_OK;
+}
+
+RayesError rayes_scene_set_opacity_mode(RayesScene *s, RayesTransmissionHitMode mode, int cache)
+{
+    if (!s)
+        return RAYES_ERROR_INVALID_ARGUMENT;
+    if (mode != RAYES_TRANSMISSION_SHADER && mode != RAYES_TRANSMISSION_PRIMITIVE)
+        return fail(s, RAYES_ERROR_INVALID_ARGUMENT,
+                    "opacity mode: expected RAYES_TRANSMISSION_SHADER or _PRIMITIVE");
+    s->current_hitmode = (uint8_t)mode;
+    s->current_opacity_cache = cache != 0;
+    return RAYES_OK;
+}
+
 RayesError rayes_scene_set_shading_rate(RayesScene *s, float rate)
 {
     if (!s)
@@ -228,8 +260,9 @@ static RayesError add_object(RayesScene *s, const RayesShaderClass *cls, const R
     memset(o, 0, sizeof *o);
     o->light = light;
     o->links = s->current_links;
-    o->ray_mask = RAYES_RAY_CAMERA | RAYES_RAY_DIFFUSE | RAYES_RAY_SPECULAR |
-                  (light >= 0 ? 0u : (uint32_t)RAYES_RAY_SHADOW);
+    o->ray_mask = s->current_visibility & ~(light >= 0 ? (uint32_t)RAYES_RAY_SHADOW : 0u);
+    o->transmission_hitmode = s->current_hitmode;
+    o->opacity_cache = s->current_opacity_cache;
     for (int c = 0; c < 3; c++)
         o->Cs[c] = o->Os[c] = 1.0f;
     RayesParam *rest = n_params ? malloc(n_params * sizeof *rest) : NULL;
@@ -237,6 +270,15 @@ static RayesError add_object(RayesScene *s, const RayesShaderClass *cls, const R
     if (n_params && !rest)
         return fail(s, RAYES_ERROR_OUT_OF_MEMORY, "out of memory");
     for (size_t i = 0; i < n_params; i++) {
+        if (strcmp(params[i].name, "Os") == 0 && params[i].type == RAYES_PARAM_PATTERN) {
+            o->Os_pattern = scene_find_pattern(s, params[i].string);
+            if (!o->Os_pattern) {
+                free(rest);
+                return fail(s, RAYES_ERROR_INVALID_ARGUMENT, "Os: names no pattern (\"%.64s\")",
+                            params[i].string ? params[i].string : "");
+            }
+            continue;
+        }
         float *dst = strcmp(params[i].name, "Cs") == 0   ? o->Cs
                      : strcmp(params[i].name, "Os") == 0 ? o->Os
                                                          : NULL;

@@ -23,11 +23,15 @@
 #include "util/vec.h"
 
 typedef struct SceneObject {
-    ShaderInstance shader;    /* owned; cls NULL for lights */
-    float Cs[3], Os[3];       /* surface colour and opacity */
-    int light;                /* light index, or -1 */
-    uint32_t ray_mask;        /* RayesRayType bits of the rays that see it */
-    uint32_t links;           /* its light links: RayesScene.links index + 1, or 0: all lights */
+    ShaderInstance shader; /* owned; cls NULL for lights */
+    float Cs[3], Os[3];    /* surface colour and opacity */
+    int light;             /* light index, or -1 */
+    uint32_t ray_mask;     /* RayesRayType bits of the rays that see it */
+    uint32_t links;        /* its light links: RayesScene.links index + 1, or 0: all lights */
+    const struct RayesPattern *Os_pattern; /* Os's pattern (the scene's; an "Os" parameter
+                                                naming one), multiplying Os, or NULL */
+    uint8_t transmission_hitmode;          /* RayesTransmissionHitMode */
+    uint8_t opacity_cache;                 /* 1: its opacity may be cached */
 } SceneObject;
 
 /* A named pattern (rayes_scene_pattern, patterns.c). */
@@ -100,13 +104,16 @@ struct RayesScene {
     float displacement_bound;      /* of geometry added next; 0: unbounded */
     SceneLinks *links;        /* light link sets, each made by a set_light_links call */
     size_t n_links, cap_links;
-    uint32_t current_links;   /* of objects made next: links index + 1, or 0: all lights */
-    uint64_t timestamp;       /* commits so far */
-    int dirty;                /* edited since the last commit */
-    unsigned changes;         /* SceneChange bits since the last commit */
-    uint64_t stamp_camera;    /* the last commit that changed the camera, */
-    uint64_t stamp_shading;   /* lights' or shaders' parameters (not the geometry), */
-    uint64_t stamp_geometry;  /* anything else (primitives, objects, lights added) */
+    uint32_t current_links;        /* of objects made next: links index + 1, or 0: all lights */
+    uint32_t current_visibility;   /* of objects made next: RayesRayType bits that see them */
+    uint8_t current_hitmode;       /* of objects made next: RayesTransmissionHitMode */
+    uint8_t current_opacity_cache; /* of objects made next: 1, their opacity may be cached */
+    uint64_t timestamp;            /* commits so far */
+    int dirty;                     /* edited since the last commit */
+    unsigned changes;              /* SceneChange bits since the last commit */
+    uint64_t stamp_camera;         /* the last commit that changed the camera, */
+    uint64_t stamp_shading;        /* lights' or shaders' parameters (not the geometry), */
+    uint64_t stamp_geometry;       /* anything else (primitives, objects, lights added) */
     char *search_paths[SCENE_SEARCH_PATH_COUNT]; /* colon-separated, "&" expanded; owned; NULL:
                                                     empty */
     ScenePattern *patterns; /* in the order made; a name's latest is the one found */
@@ -149,6 +156,9 @@ int scene_displace(const RayesScene *scene, GridSet *gs, size_t first_grid, floa
 /* The scene's search path of that kind: colon-separated directories, ""
  * if never set. Borrowed: valid until the next set_search_path. */
 const char *scene_search_path(const RayesScene *scene, SceneSearchPath kind);
+
+/* The latest pattern of that name, or NULL (patterns.c). */
+const struct RayesPattern *scene_find_pattern(const RayesScene *scene, const char *name);
 
 /* Binds the instance's parameters that params gives as RAYES_PARAM_PATTERN
  * to the scene's patterns of those names (patterns.c). Returns RAYES_OK, or

@@ -85,9 +85,10 @@ RayesError rayes_session_new(RayesScene *scene, const RayesRenderOptions *option
     s->accum = malloc(n * sizeof *s->accum);
     s->rgba = calloc(n * 4, sizeof *s->rgba); /* 0 outside a crop window */
     s->textures = session_textures(scene, options->texture_mb, options->texture_width);
-    if (options->cache)
-        s->cache = cache_new((uint64_t)(options->cache_mb * 1e6), options->cache_split);
-    if (!s->accum || !s->rgba || !s->textures || (options->cache && !s->cache)) {
+    int cached = options->cache || options->opacity_cache;
+    if (cached)
+        s->cache = session_cache(options);
+    if (!s->accum || !s->rgba || !s->textures || (cached && !s->cache)) {
         e = session_fail(scene, RAYES_ERROR_OUT_OF_MEMORY, "session: out of memory");
         goto fail;
     }

@@ -67,6 +67,8 @@ void rayes_render_options_init(RayesRenderOptions *o, RayesQuality quality)
     o->texture_mb = 64.0;
     o->texture_width = 1.0f;
     o->crop[1] = o->crop[3] = 1.0f;
+    o->opacity_cache = 1;
+    o->opacity_cache_mb = 20.0;
     switch (quality) {
     case RAYES_QUALITY_PREVIEW:
         o->shadow_rays = o->shadow_rays_deep = 4;
@@ -118,6 +120,7 @@ RayesError session_check_options(RayesScene *scene, const RayesRenderOptions *o)
     else if (o->tile_size < 1 || o->threads < 0 || o->threads > 1024)
         what = "options: tile size must be positive and threads 0 to 1024";
     else if (!(o->cache_mb >= 0.0) || o->cache_mb > 1e7 || !(o->cache_k > 0.0f) ||
+             !(o->opacity_cache_mb >= 0.0) || o->opacity_cache_mb > 1e7 ||
              o->cache_resolution < -1 || o->cache_resolution > 2 || o->cache_split[0] < 0.0f ||
              o->cache_split[1] < 0.0f || o->cache_split[2] < 0.0f ||
              !(o->cache_split[0] + o->cache_split[1] + o->cache_split[2] <= 1.0001f))
@@ -188,6 +191,8 @@ RenderSettings session_settings(const RayesRenderOptions *o)
         .branch_depth = o->branch_depth,
         .hider = o->hider == RAYES_HIDER_GRID,
         .irradiance = o->irradiance != 0,
+        .radiosity_cache = o->cache != 0,
+        .opacity_cache = o->opacity_cache != 0,
         .tile_done = o->tile_done,
         .tile_user = o->tile_user,
     };
@@ -195,6 +200,16 @@ RenderSettings session_settings(const RayesRenderOptions *o)
         s.threads = thread_count_cores();
     session_crop_pixels(o, s.crop);
     return s;
+}
+
+Cache *session_cache(const RayesRenderOptions *o)
+{
+    uint64_t budgets[CACHE_N_TYPES] = {0};
+    if (o->cache)
+        budgets[CACHE_RADIOSITY] = (uint64_t)(o->cache_mb * 1e6);
+    if (o->opacity_cache)
+        budgets[CACHE_OPACITY] = (uint64_t)(o->opacity_cache_mb * 1e6);
+    return cache_new_typed(budgets, o->cache_split);
 }
 
 /* The texture system of a render: the scene's texture path, then
@@ -230,6 +245,13 @@ RenderObject *session_render_objects(const RayesScene *scene)
         memcpy(ro[i].Cs, so->Cs, sizeof ro[i].Cs);
         memcpy(ro[i].Os, so->Os, sizeof ro[i].Os);
         ro[i].light = so->light;
+        ro[i].opacity_shader = so->shader.cls && so->shader.cls->opacity &&
+                               so->transmission_hitmode == RAYES_TRANSMISSION_SHADER;
+        ro[i].Os_pattern = so->Os_pattern;
+        ro[i].transparent =
+            so->light < 0 && (ro[i].opacity_shader || so->Os_pattern || so->Os[0] < 1.0f ||
+                              so->Os[1] < 1.0f || so->Os[2] < 1.0f);
+        ro[i].opacity_cached = so->opacity_cache != 0;
         if (so->links == 0)
             continue;
         unsigned char *mine = lit + (size_t)(so->links - 1) * scene->n_lights;
@@ -240,12 +262,13 @@ RenderObject *session_render_objects(const RayesScene *scene)
     return ro;
 }
 
-static uint32_t *object_masks(const RayesScene *scene)
+/* Ray masks; shadow rays pass through transparent objects (accel.h). */
+static uint32_t *object_masks(const RayesScene *scene, const RenderObject *ro)
 {
     uint32_t *m = calloc(scene->n_objects + 1, sizeof *m);
     if (m)
         for (size_t i = 0; i < scene->n_objects; i++)
-            m[i] = scene->objects[i].ray_mask;
+            m[i] = scene->objects[i].ray_mask | (ro[i].transparent ? ACCEL_MASK_TRANSPARENT : 0u);
     return m;
 }
 
@@ -262,7 +285,7 @@ RayesError session_prepare(RayesScene *scene, const RenderSettings *set, Texture
     memset(p, 0, sizeof *p);
     geom_gridset_init(&p->gs);
     p->objects = session_render_objects(scene);
-    p->masks = object_masks(scene);
+    p->masks = p->objects ? object_masks(scene, p->objects) : NULL;
     char err[300] = "";
     DiceOptions dice = {set->grid_size, set->dice_offscreen, set->vertex_budget,
                         set->dice_isotropic};
@@ -278,6 +301,8 @@ RayesError session_prepare(RayesScene *scene, const RenderSettings *set, Texture
         session_prepared_fini(p);
         return session_fail(scene, RAYES_ERROR_OUT_OF_MEMORY, err);
     }
+    for (size_t i = 0; i < scene->n_objects; i++)
+        p->any_transparent |= p->objects[i].transparent;
     Bounds3 b = scene_bounds(scene);
     p->scene_radius =
         scene->n_prims ? fmaxf(0.5f * v3_length(v3_sub(b.hi, b.lo)), 1e-6f) : 1.0f;
@@ -304,6 +329,7 @@ RenderScene session_render_scene(const RayesScene *scene, const Prepared *p, int
         .camera = render_camera(scene->camera.eye, scene->camera.x, scene->camera.y,
                                 scene->camera.z, scene->camera.tan_half_fov, screen, height),
         .scene_radius = p->scene_radius,
+        .any_transparent = p->any_transparent,
     };
 }
 
@@ -338,8 +364,8 @@ RayesError rayes_render(RayesScene *scene, const RayesRenderOptions *opt, RayesI
     e = session_prepare(scene, &set, textures, &prep);
     if (e != RAYES_OK)
         goto done;
-    if (opt->cache) {
-        cache = cache_new((uint64_t)(opt->cache_mb * 1e6), opt->cache_split);
+    if (opt->cache || opt->opacity_cache) {
+        cache = session_cache(opt);
         if (!cache) {
             e = session_fail(scene, RAYES_ERROR_OUT_OF_MEMORY,
                              "render: out of memory for the cache");

@@ -21,8 +21,9 @@ typedef struct Prepared {
     RenderObject *objects;    /* n_objects + 1 */
     uint32_t *masks;          /* object ray masks */
     Accel *accel;
-    float scene_radius;       /* for ray offsets */
-    float coarsened;          /* >= 1: how much longer the vertex budget made micropolygons */
+    float scene_radius;  /* for ray offsets */
+    int any_transparent; /* some object may be partly transparent */
+    float coarsened;     /* >= 1: how much longer the vertex budget made micropolygons */
 } Prepared;
 
 /* Records msg as the scene's error (if it has none) and returns e. */
@@ -41,6 +42,10 @@ int session_crop_pixels(const RayesRenderOptions *options, int rect[4]);
 
 /* The texture system of a render: the scene's texture path, then
  * $RAYES_TEXTURE_PATH's. NULL when out of memory. */
+/* The cache of a render: radiosity with cache_mb if o->cache, opacity with
+ * opacity_cache_mb if o->opacity_cache (one Cache, a budget per data
+ * type). NULL when out of memory. */
+Cache *session_cache(const RayesRenderOptions *o);
 TextureSystem *session_textures(const RayesScene *scene, double mb, float width);
 
 /* The render-side view of the scene's objects (shader, Cs, Os, light), or

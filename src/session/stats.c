@@ -9,7 +9,7 @@
 
 #include "util/log.h"
 
-#define MAX_STATS 128
+#define MAX_STATS 192
 
 struct RayesStats {
     RayesStat items[MAX_STATS];
@@ -55,6 +55,8 @@ RayesStats *session_stats_new(const RenderSettings *set, const RenderStats *rs, 
     count(s, "rays/diffuse", rs->rays_diffuse);
     count(s, "rays/specular", rs->rays_specular);
     count(s, "lighting/ambient_points", rs->ambient_lookups);
+    count(s, "opacity/shading_points", rs->opacity_points);
+    count(s, "opacity/transparent_hits", rs->transparent_hits);
     count(s, "grids", gs->n_grids);
     count(s, "grid_vertices", gs->n_vertices);
     count(s, "grid_size", (uint64_t)set->grid_size);
@@ -80,6 +82,8 @@ RayesStats *session_stats_new(const RenderSettings *set, const RenderStats *rs, 
     return s;
 }
 
+static void session_stats_add_cache_types(RayesStats *s, const CacheStats *cs);
+
 void session_stats_add_cache(RayesStats *s, const CacheStats *cs)
 {
     static const char *const names[CACHE_N_LEVELS][8] = {
@@ -103,6 +107,59 @@ void session_stats_add_cache(RayesStats *s, const CacheStats *cs)
         count(s, names[l][5], cs->entries[l]);
         count(s, names[l][6], cs->bytes[l]);
         real(s, names[l][7], c->lookups ? (double)c->hits / (double)c->lookups : 0.0);
+    }
+    session_stats_add_cache_types(s, cs);
+}
+
+/* Each data type's own counters (memo 6: one cache, keys with a data
+ * type): cache/radiosity/LEVEL/... and cache/opacity/LEVEL/..., for the
+ * types that had a budget or lookups. */
+static const char *const typed_names[2][CACHE_N_LEVELS][7] = {
+    {{"cache/radiosity/coarse/lookups", "cache/radiosity/coarse/hits",
+      "cache/radiosity/coarse/misses", "cache/radiosity/coarse/fills",
+      "cache/radiosity/coarse/evictions", "cache/radiosity/coarse/entries",
+      "cache/radiosity/coarse/hit_rate"},
+     {"cache/radiosity/medium/lookups", "cache/radiosity/medium/hits",
+      "cache/radiosity/medium/misses", "cache/radiosity/medium/fills",
+      "cache/radiosity/medium/evictions", "cache/radiosity/medium/entries",
+      "cache/radiosity/medium/hit_rate"},
+     {"cache/radiosity/fine/lookups", "cache/radiosity/fine/hits", "cache/radiosity/fine/misses",
+      "cache/radiosity/fine/fills", "cache/radiosity/fine/evictions",
+      "cache/radiosity/fine/entries", "cache/radiosity/fine/hit_rate"}},
+    {{"cache/opacity/coarse/lookups", "cache/opacity/coarse/hits", "cache/opacity/coarse/misses",
+      "cache/opacity/coarse/fills", "cache/opacity/coarse/evictions",
+      "cache/opacity/coarse/entries", "cache/opacity/coarse/hit_rate"},
+     {"cache/opacity/medium/lookups", "cache/opacity/medium/hits", "cache/opacity/medium/misses",
+      "cache/opacity/medium/fills", "cache/opacity/medium/evictions",
+      "cache/opacity/medium/entries", "cache/opacity/medium/hit_rate"},
+     {"cache/opacity/fine/lookups", "cache/opacity/fine/hits", "cache/opacity/fine/misses",
+      "cache/opacity/fine/fills", "cache/opacity/fine/evictions", "cache/opacity/fine/entries",
+      "cache/opacity/fine/hit_rate"}}};
+
+static void session_stats_add_cache_types(RayesStats *s, const CacheStats *cs)
+{
+    static const int types[2] = {CACHE_RADIOSITY, CACHE_OPACITY};
+    static const char *const budgets[2] = {"cache/radiosity/budget_bytes",
+                                           "cache/opacity/budget_bytes"};
+    for (int k = 0; k < 2; k++) {
+        int t = types[k];
+        uint64_t lookups = 0;
+        for (int l = 0; l < CACHE_N_LEVELS; l++)
+            lookups += cs->counters[l][t].lookups;
+        if (cs->type_budget_bytes[t] == 0 && lookups == 0)
+            continue;
+        count(s, budgets[k], cs->type_budget_bytes[t]);
+        for (int l = 0; l < CACHE_N_LEVELS; l++) {
+            const CacheCounters *c = &cs->counters[l][t];
+            const char *const *n = typed_names[k][l];
+            count(s, n[0], c->lookups);
+            count(s, n[1], c->hits);
+            count(s, n[2], c->misses);
+            count(s, n[3], c->fills);
+            count(s, n[4], c->evictions);
+            count(s, n[5], cs->type_entries[t][l]);
+            real(s, n[6], c->lookups ? (double)c->hits / (double)c->lookups : 0.0);
+        }
     }
 }
 

@@ -38,11 +38,15 @@ static float cs(const RayesShadeCtx *ctx, size_t i, int c)
     return ctx->Cs ? ctx->Cs[i][c] : 1.0f;
 }
 
+/* Oi = Os, and Ci premultiplied by it (RenderMan's Ci *= Oi: the renderer
+ * composites Ci + (1 - Oi) behind). */
 static void set_opacity(const RayesShadeCtx *ctx, RayesShadeOutputs *out)
 {
     for (size_t i = 0; i < ctx->n_points; i++)
-        for (int c = 0; c < 3; c++)
+        for (int c = 0; c < 3; c++) {
             out->Oi[i][c] = ctx->Os ? ctx->Os[i][c] : 1.0f;
+            out->Ci[i][c] *= out->Oi[i][c];
+        }
 }
 
 /* Ci = Cs (Ka ambient + Kd (direct + indirect diffuse)) + emit, on one

@@ -11,7 +11,10 @@ extern const RayesShaderClass shade_class_matte;    /* Lambertian: Ka, Kd, Ke */
 extern const RayesShaderClass shade_class_plastic;  /* Ka, Kd, Ks, roughness, specularcolor */
 extern const RayesShaderClass shade_class_mirror;   /* perfect specular: Kr, specularcolor */
 extern const RayesShaderClass shade_class_constant; /* Ci = Cs */
-extern const RayesShaderClass shade_class_hair;     /* fibres: Ka, Kd, Ks, roughness, specularcolor */
+extern const RayesShaderClass shade_class_hair; /* fibres: Ka, Kd, Ks, roughness, specularcolor */
+extern const RayesShaderClass shade_class_stainedglass; /* coloured opacity: Kd, frequency,
+                                                           leadwidth, clarity */
+extern const RayesShaderClass shade_class_occlusion;    /* ambient occlusion: samples, maxdist */
 extern const RayesShaderClass shade_class_bumpy;    /* displacement: Km, frequency, texturename */
 extern const RayesShaderClass shade_class_fractal;  /* displacement: the memo's fractal noise */
 extern const RayesShaderClass shade_class_displace; /* displacement: P + amount N (a pattern) */

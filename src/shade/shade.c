@@ -262,3 +262,25 @@ void shade_run_diffuselighting(const RayesShaderServices *sv, const RayesShadeCt
     }
     free(scratch);
 }
+
+void shade_run_opacity(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
+                       const ShaderInstance *inst, RayesShadeOutputs *out)
+{
+    const RayesShaderClass *cls = inst ? inst->cls : NULL;
+    if (!cls || !cls->opacity) {
+        for (size_t i = 0; i < ctx->n_points; i++)
+            for (int c = 0; c < 3; c++)
+                out->Oi[i][c] = ctx->Os ? ctx->Os[i][c] : 1.0f;
+        return;
+    }
+    RayesShadeCtx c = *ctx;
+    c.patterns = inst->patterns, c.n_patterns = inst->n_patterns;
+    int failed;
+    void *scratch = scratch_begin(cls, &c, &failed);
+    if (failed) {
+        scratch_failed(cls, ctx, out);
+        return;
+    }
+    cls->opacity(sv, &c, inst->params, out);
+    free(scratch);
+}

@@ -65,6 +65,13 @@ void shade_run_diffuselighting(const RayesShaderServices *sv, const RayesShadeCt
 void shade_run_lighting(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
                         const ShaderInstance *inst, RayesShadeOutputs *out);
 
+/* Runs the opacity method into out->Oi (only Oi is written), or copies
+ * ctx->Os (1 without it) for classes without one. Cache fills give no I
+ * (one opacity per point whatever the side seen, memo 6.1); uncached
+ * transmission hits do. */
+void shade_run_opacity(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
+                       const ShaderInstance *inst, RayesShadeOutputs *out);
+
 /* Points per chunk when a shader needs scratch arrays on the stack. */
 #define SHADE_CHUNK 64
 

@@ -49,7 +49,8 @@ enum {
     DIM_SPECULAR = 4,   /* specular rays */
     DIM_PATH = 5,       /* child path keys */
     DIM_REFRACTION = 6, /* refracted rays */
-    DIM_SHADER = 7      /* the random service: shaders' own choices */
+    DIM_SHADER = 7,     /* the random service: shaders' own choices */
+    DIM_OCCLUSION = 8   /* ambient occlusion rays */
 };
 
 #endif /* RAYES_UTIL_RNG_H */

@@ -51,6 +51,8 @@ static void fx_init(Fx *f, RayesScene *s)
         f->masks[i] = s->objects[i].ray_mask;
         f->objs[i].light = s->objects[i].light;
         f->objs[i].shader = s->objects[i].shader.cls ? &s->objects[i].shader : NULL;
+        memcpy(f->objs[i].Cs, s->objects[i].Cs, sizeof f->objs[i].Cs);
+        memcpy(f->objs[i].Os, s->objects[i].Os, sizeof f->objs[i].Os);
     }
     char err[300];
     f->accel = accel_new(&f->gs, f->masks, s->n_objects, err, sizeof err);

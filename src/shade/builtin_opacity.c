@@ -1,0 +1,189 @@
+/*
+ * shade/builtin_opacity.c — built-in shaders about opacity (memo 6.1):
+ * stainedglass, whose opacity method colours shadows, and occlusion,
+ * RenderMan's classic ambient occlusion shader.
+ */
+#include <math.h>
+#include <stddef.h>
+#include <string.h>
+
+#include "shade/builtin.h"
+#include "shade/shade.h"
+
+typedef float Rgb[3];
+
+/* Oi = Os times the shader's own opacity (NULL: 1), and Ci premultiplied
+ * by it (RenderMan's Ci *= Oi). */
+static void premultiply(const RayesShadeCtx *ctx, const Rgb *own, RayesShadeOutputs *out)
+{
+    for (size_t i = 0; i < ctx->n_points; i++)
+        for (int c = 0; c < 3; c++) {
+            float os = ctx->Os ? ctx->Os[i][c] : 1.0f;
+            out->Oi[i][c] = os * (own ? own[i][c] : 1.0f);
+            out->Ci[i][c] *= out->Oi[i][c];
+        }
+}
+
+/* ---- stainedglass
+ *
+ * Panes of coloured glass held by lead came, over (s, t): frequency cells
+ * per unit, their borders bent by noise; each pane has a hue of its own
+ * and a clarity that varies with five octaves of noise (bubbles and
+ * streaks in the glass). The opacity method returns 1 - the pane's
+ * transmission colour (lead: 1), so shadow rays through it are coloured;
+ * lighting reflects Kd times the pane's colour, premultiplied. */
+
+typedef struct StainedGlassParams {
+    float Kd, frequency, leadwidth, clarity;
+} StainedGlassParams;
+
+/* A hue of cell (i, j): a saturated colour. */
+static void cell_colour(int i, int j, float rgb[3])
+{
+    uint32_t h = (uint32_t)i * 73856093u ^ (uint32_t)j * 19349663u;
+    h ^= h >> 13;
+    h *= 0x5bd1e995u;
+    h ^= h >> 15;
+    float hue = (float)(h & 0xffffu) / 65536.0f * 6.0f;
+    int k = (int)hue;
+    float f = hue - (float)k;
+    float v[6][3] = {{1, f, 0}, {1 - f, 1, 0}, {0, 1, f}, {0, 1 - f, 1}, {f, 0, 1}, {1, 0, 1 - f}};
+    for (int c = 0; c < 3; c++)
+        rgb[c] = 0.15f + 0.85f * v[k % 6][c];
+}
+
+/* The transmission colour at (s, t): 0 on the lead, else the pane's hue
+ * scaled by its clarity. */
+static void glass_transmission(const RayesShaderServices *sv, const StainedGlassParams *p, float s,
+                               float t, float out[3])
+{
+    float q[3] = {s * p->frequency, t * p->frequency, 0.0f};
+    float warp[3] = {q[0] * 0.7f, q[1] * 0.7f, 3.1f};
+    float x = q[0] + 0.35f * sv->noise(sv, warp);
+    warp[2] = 7.3f;
+    float y = q[1] + 0.35f * sv->noise(sv, warp);
+    float fx = x - floorf(x), fy = y - floorf(y);
+    float edge = fminf(fminf(fx, 1.0f - fx), fminf(fy, 1.0f - fy));
+    if (edge < 0.5f * p->leadwidth * p->frequency) {
+        out[0] = out[1] = out[2] = 0.0f;
+        return;
+    }
+    float hue[3];
+    cell_colour((int)floorf(x), (int)floorf(y), hue);
+    float bubbles[3] = {q[0] * 8.0f, q[1] * 8.0f, 0.5f};
+    float streak = sv->fbm ? sv->fbm(sv, bubbles, 5, 2.0f, 0.5f) : 0.0f;
+    float clarity = fminf(fmaxf(p->clarity * (1.0f + 0.3f * streak), 0.0f), 1.0f);
+    for (int c = 0; c < 3; c++)
+        out[c] = hue[c] * clarity;
+}
+
+static void stainedglass_opacity(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
+                                 const void *params, RayesShadeOutputs *out)
+{
+    const StainedGlassParams *p = params;
+    for (size_t i = 0; i < ctx->n_points; i++) {
+        float T[3];
+        glass_transmission(sv, p, ctx->s ? ctx->s[i] : ctx->u[i], ctx->t ? ctx->t[i] : ctx->v[i],
+                           T);
+        for (int c = 0; c < 3; c++)
+            out->Oi[i][c] = (ctx->Os ? ctx->Os[i][c] : 1.0f) * (1.0f - T[c]);
+    }
+}
+
+static void stainedglass_lighting(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
+                                  const void *params, RayesShadeOutputs *out)
+{
+    const StainedGlassParams *p = params;
+    for (size_t start = 0; start < ctx->n_points; start += SHADE_CHUNK) {
+        size_t n = ctx->n_points - start < SHADE_CHUNK ? ctx->n_points - start : SHADE_CHUNK;
+        RayesShadeCtx sub;
+        shade_ctx_slice(ctx, start, n, &sub);
+        Rgb dd[SHADE_CHUNK], id[SHADE_CHUNK], own[SHADE_CHUNK];
+        sv->direct_lighting(sv, &sub, 0, NULL, NULL, dd, NULL);
+        sv->indirect_diffuse(sv, &sub, 0, id);
+        RayesShadeOutputs o = {out->Ci + start, out->Oi + start,
+                               out->Irradiance ? out->Irradiance + start : NULL, NULL};
+        for (size_t i = 0; i < n; i++) {
+            float T[3];
+            glass_transmission(sv, p, sub.s ? sub.s[i] : sub.u[i], sub.t ? sub.t[i] : sub.v[i], T);
+            for (int c = 0; c < 3; c++) {
+                /* the lead is dark grey; glass reflects a little of its hue */
+                float colour = T[c] > 0.0f ? T[c] : 0.05f;
+                own[i][c] = 1.0f - T[c];
+                o.Ci[i][c] = p->Kd * colour * (dd[i][c] + id[i][c]);
+                if (o.Irradiance)
+                    o.Irradiance[i][c] = 3.14159265f * (dd[i][c] + id[i][c]);
+            }
+        }
+        premultiply(&sub, (const Rgb *)own, &o);
+    }
+}
+
+static const RayesShaderParamDesc stainedglass_params[] = {
+    {"Kd", RAYES_PARAM_FLOAT, offsetof(StainedGlassParams, Kd), {0.5f, 0, 0}},
+    {"frequency", RAYES_PARAM_FLOAT, offsetof(StainedGlassParams, frequency), {4, 0, 0}},
+    {"leadwidth", RAYES_PARAM_FLOAT, offsetof(StainedGlassParams, leadwidth), {0.03f, 0, 0}},
+    {"clarity", RAYES_PARAM_FLOAT, offsetof(StainedGlassParams, clarity), {0.8f, 0, 0}},
+};
+
+const RayesShaderClass shade_class_stainedglass = {
+    .abi_version = RAYES_SHADER_ABI_VERSION,
+    .struct_size = sizeof(RayesShaderClass),
+    .name = "stainedglass",
+    .params_size = sizeof(StainedGlassParams),
+    .params = stainedglass_params,
+    .n_params = sizeof stainedglass_params / sizeof stainedglass_params[0],
+    .opacity = stainedglass_opacity,
+    .lighting = stainedglass_lighting,
+    .diffuselighting = stainedglass_lighting, /* view-independent throughout */
+};
+
+/* ---- occlusion
+ *
+ * RenderMan's classic ambient occlusion shader: Ci = Cs (1 - occlusion),
+ * occlusion from the occlusion service with `samples` rays (0: the
+ * renderer's diffuse ray count) within `maxdist` (0: any distance).
+ * Transparent surfaces occlude by their opacity. */
+
+typedef struct OcclusionParams {
+    float samples, maxdist;
+} OcclusionParams;
+
+static void occlusion_lighting(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
+                               const void *params, RayesShadeOutputs *out)
+{
+    const OcclusionParams *p = params;
+    for (size_t start = 0; start < ctx->n_points; start += SHADE_CHUNK) {
+        size_t n = ctx->n_points - start < SHADE_CHUNK ? ctx->n_points - start : SHADE_CHUNK;
+        RayesShadeCtx sub;
+        shade_ctx_slice(ctx, start, n, &sub);
+        Rgb occ[SHADE_CHUNK];
+        if (sv->occlusion)
+            sv->occlusion(sv, &sub, (int)p->samples, p->maxdist, occ);
+        else
+            memset(occ, 0, n * sizeof *occ);
+        for (size_t i = 0; i < n; i++)
+            for (int c = 0; c < 3; c++) {
+                out->Ci[start + i][c] = (sub.Cs ? sub.Cs[i][c] : 1.0f) * (1.0f - occ[i][c]);
+                if (out->Irradiance)
+                    out->Irradiance[start + i][c] = 0.0f;
+            }
+    }
+    premultiply(ctx, NULL, out);
+}
+
+static const RayesShaderParamDesc occlusion_params[] = {
+    {"samples", RAYES_PARAM_FLOAT, offsetof(OcclusionParams, samples), {0, 0, 0}},
+    {"maxdist", RAYES_PARAM_FLOAT, offsetof(OcclusionParams, maxdist), {0, 0, 0}},
+};
+
+const RayesShaderClass shade_class_occlusion = {
+    .abi_version = RAYES_SHADER_ABI_VERSION,
+    .struct_size = sizeof(RayesShaderClass),
+    .name = "occlusion",
+    .params_size = sizeof(OcclusionParams),
+    .params = occlusion_params,
+    .n_params = sizeof occlusion_params / sizeof occlusion_params[0],
+    .lighting = occlusion_lighting,
+    .diffuselighting = occlusion_lighting,
+};

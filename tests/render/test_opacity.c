@@ -1,0 +1,339 @@
+/*
+ * Opacity (memo 6.1) in renders: stacked coloured sheets transmit the
+ * product of (1 - Os) whatever their order; a half-transparent sheet
+ * halves a light's irradiance; ambient occlusion under a plane (with a
+ * maximum distance) and against a wall matches its closed forms; a
+ * cut-out (an Os pattern) shadows like the same cut-out made of geometry;
+ * the opacity cache gives the uncached image within noise, and images do
+ * not depend on threads or the cache budget.
+ *
+ * The scenes look down at a floor (z = 0, x and y in [-2, 2]) from above;
+ * sheets are invisible to the camera (visibility) unless a test says so,
+ * so that pixels show the floor's light.
+ */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "rayes/rayes.h"
+#include "rayes/shader.h"
+#include "test.h"
+
+enum { RES = 32 };
+
+static RayesParam pf(const char *name, float v)
+{
+    return (RayesParam){name, RAYES_PARAM_FLOAT, {v, 0, 0}, NULL};
+}
+
+static RayesParam pc(const char *name, float r, float g, float b)
+{
+    return (RayesParam){name, RAYES_PARAM_COLOR, {r, g, b}, NULL};
+}
+
+static RayesParam ps(const char *name, const char *v)
+{
+    return (RayesParam){name, RAYES_PARAM_STRING, {0, 0, 0}, v};
+}
+
+/* The camera 6 above the floor's centre, seeing [-1, 1]^2 of it. */
+static RayesScene *new_scene(void)
+{
+    RayesScene *s = rayes_scene_new();
+    static const float eye[3] = {0, 0, 6}, at[3] = {0, 0, 0}, up[3] = {0, 1, 0};
+    CHECK(rayes_scene_set_camera(s, eye, at, up, (float)(2.0 * atan(1.0 / 6.0) * 180.0 / M_PI)) ==
+          RAYES_OK);
+    return s;
+}
+
+static void quad_at(RayesScene *s, float half, float z)
+{
+    /* P00, P10, P01, P11 */
+    const float P[4][3] = {{-half, -half, z}, {half, -half, z}, {-half, half, z}, {half, half, z}};
+    CHECK(rayes_scene_bilinear_patch(s, P) == RAYES_OK);
+}
+
+/* A constant (unlit) floor is no use: a matte floor, Kd 1, no bounces. */
+static void floor_matte(RayesScene *s)
+{
+    RayesParam m[1] = {pf("Ka", 0.0f)};
+    CHECK(rayes_scene_set_shader(s, "matte", m, 1) == RAYES_OK);
+    quad_at(s, 2.0f, 0.0f);
+}
+
+static void point_light(RayesScene *s, float z)
+{
+    RayesParam p[2] = {(RayesParam){"from", RAYES_PARAM_COLOR, {0, 0, z}, NULL},
+                       pf("intensity", z * z)};
+    CHECK(rayes_scene_light(s, "pointlight", p, 2) == RAYES_OK);
+}
+
+static RayesImage *render(RayesScene *s, int threads, double cache_mb, int opacity_cache,
+                          int quality, RayesStats **stats)
+{
+    CHECK(rayes_scene_commit(s) == RAYES_OK);
+    RayesRenderOptions o;
+    rayes_render_options_init(&o, (RayesQuality)quality);
+    o.width = o.height = RES;
+    o.spp = 1;
+    o.threads = threads;
+    o.bounces = 0;
+    o.opacity_cache = opacity_cache;
+    o.opacity_cache_mb = cache_mb;
+    RayesImage *img = NULL;
+    CHECK(rayes_render(s, &o, &img, stats) == RAYES_OK);
+    return img;
+}
+
+static void mean_rgb(const RayesImage *img, double out[3])
+{
+    out[0] = out[1] = out[2] = 0.0;
+    size_t n = (size_t)img->width * img->height;
+    for (size_t i = 0; i < n; i++)
+        for (int c = 0; c < 3; c++)
+            out[c] += img->rgba[4 * i + c] / (double)n;
+}
+
+/* The floor's mean colour under sheets of opacities os[k] (in that order
+ * from the floor up), seen by shadow rays only. */
+static void floor_under_sheets(const float (*os)[3], int n, double out[3])
+{
+    RayesScene *s = new_scene();
+    floor_matte(s);
+    CHECK(rayes_scene_set_visibility(s, RAYES_RAY_SHADOW) == RAYES_OK);
+    for (int k = 0; k < n; k++) {
+        RayesParam p[1] = {pc("Os", os[k][0], os[k][1], os[k][2])};
+        CHECK(rayes_scene_set_shader(s, "matte", p, 1) == RAYES_OK);
+        quad_at(s, 3.0f, 1.0f + 0.5f * (float)k);
+    }
+    point_light(s, 5.0f);
+    RayesImage *img = render(s, 2, 20.0, 1, RAYES_QUALITY_PREVIEW, NULL);
+    if (img)
+        mean_rgb(img, out);
+    rayes_image_free(img);
+    rayes_scene_release(s);
+}
+
+static void test_stacked_sheets_multiply_in_any_order(void)
+{
+    static const float os[3][3] = {{0.5f, 0.2f, 0.1f}, {0.25f, 0.75f, 0.0f}, {0.1f, 0.1f, 0.9f}};
+    static const float rev[3][3] = {{0.1f, 0.1f, 0.9f}, {0.25f, 0.75f, 0.0f}, {0.5f, 0.2f, 0.1f}};
+    double open[3], a[3], b[3];
+    floor_under_sheets(NULL, 0, open);
+    floor_under_sheets(os, 3, a);
+    floor_under_sheets(rev, 3, b);
+    for (int c = 0; c < 3; c++) {
+        double want = open[c] * (1 - os[0][c]) * (1 - os[1][c]) * (1 - os[2][c]);
+        CHECK(open[c] > 0.1);
+        CHECK_NEAR(a[c], want, 1e-5 * open[c]);
+        CHECK_NEAR(b[c], want, 1e-5 * open[c]);
+    }
+}
+
+static void test_half_transparent_sheet_halves_irradiance(void)
+{
+    static const float half[1][3] = {{0.5f, 0.5f, 0.5f}}, opaque[1][3] = {{1, 1, 1}};
+    double open[3], got[3], none[3];
+    floor_under_sheets(NULL, 0, open);
+    floor_under_sheets(half, 1, got);
+    floor_under_sheets(opaque, 1, none);
+    for (int c = 0; c < 3; c++) {
+        CHECK_NEAR(got[c] / open[c], 0.5, 1e-5);
+        CHECK(none[c] == 0.0);
+    }
+}
+
+/* The occlusion shader on the floor, AO rays up to maxdist (0: any). */
+static double floor_occlusion(float maxdist, int wall)
+{
+    RayesScene *s = new_scene();
+    RayesParam p[2] = {pf("samples", 1024), pf("maxdist", maxdist)};
+    CHECK(rayes_scene_set_shader(s, "occlusion", p, 2) == RAYES_OK);
+    quad_at(s, 1.0f, 0.0f);
+    CHECK(rayes_scene_set_visibility(s, RAYES_RAY_SHADOW) == RAYES_OK);
+    RayesParam m[1] = {pf("Kd", 1.0f)};
+    CHECK(rayes_scene_set_shader(s, "matte", m, 1) == RAYES_OK);
+    /* Large, not huge: rays leave points a millionth of the scene's size
+     * times ten above them (path.h), 0.0007 here. */
+    if (wall) { /* the plane x = 0, its floor side: half the hemisphere */
+        const float P[4][3] = {{0, -50, -50}, {0, 50, -50}, {0, -50, 50}, {0, 50, 50}};
+        CHECK(rayes_scene_bilinear_patch(s, P) == RAYES_OK);
+    } else {
+        quad_at(s, 50.0f, 1.0f); /* a plane at height 1 */
+    }
+    RayesImage *img = render(s, 2, 20.0, 1, RAYES_QUALITY_PREVIEW, NULL);
+    double m3[3] = {0, 0, 0};
+    if (img)
+        mean_rgb(img, m3);
+    rayes_image_free(img);
+    rayes_scene_release(s);
+    return 1.0 - m3[0]; /* the occlusion */
+}
+
+static void test_ambient_occlusion_closed_forms(void)
+{
+    /* Under a plane at height h, directions within maxdist have cos >= h /
+     * maxdist: a cosine-weighted fraction 1 - (h / maxdist)^2. */
+    CHECK_NEAR(floor_occlusion(0.0f, 0), 1.0, 1e-3); /* but grazing rays past the plane's end */
+    CHECK_NEAR(floor_occlusion(2.0f, 0), 0.75, 0.01);
+    CHECK_NEAR(floor_occlusion(1.25f, 0), 1.0 - 0.64, 0.01);
+    /* Beside an infinite wall, half the hemisphere (its pixels on both
+     * sides of it, the wall's half each). */
+    CHECK_NEAR(floor_occlusion(0.0f, 1), 0.5, 0.01);
+}
+
+/* The floor's image under a square at height 1 that is a checkerboard:
+ * cut out of an opaque square by an Os pattern, or made of its opaque
+ * cells as geometry. */
+static RayesImage *checker_shadow(int as_pattern, int opacity_cache)
+{
+    RayesScene *s = new_scene();
+    floor_matte(s);
+    CHECK(rayes_scene_set_visibility(s, RAYES_RAY_SHADOW) == RAYES_OK);
+    RayesParam m[1] = {pf("Kd", 1.0f)};
+    if (as_pattern) {
+        RayesParam cb[2] = {pf("uscale", 4.0f), pf("vscale", 4.0f)};
+        CHECK(rayes_scene_pattern(s, "cells", "checkerboard", cb, 2) == RAYES_OK);
+        RayesParam p[2] = {m[0], (RayesParam){"Os", RAYES_PARAM_PATTERN, {0, 0, 0}, "cells"}};
+        CHECK(rayes_scene_set_shader(s, "matte", p, 2) == RAYES_OK);
+        quad_at(s, 1.0f, 1.0f);
+    } else {
+        CHECK(rayes_scene_set_shader(s, "matte", m, 1) == RAYES_OK);
+        for (int j = 0; j < 4; j++)
+            for (int i = 0; i < 4; i++) {
+                if ((i + j) % 2 == 0) /* tex1 (1, opaque) where floor(u) + floor(v) is even,
+                                         v = 1 - t running down y */
+                    continue;
+                float x0 = -1.0f + 0.5f * (float)i, y0 = -1.0f + 0.5f * (float)j;
+                const float P[4][3] = {
+                    {x0, y0, 1}, {x0 + 0.5f, y0, 1}, {x0, y0 + 0.5f, 1}, {x0 + 0.5f, y0 + 0.5f, 1}};
+                CHECK(rayes_scene_bilinear_patch(s, P) == RAYES_OK);
+            }
+    }
+    point_light(s, 5.0f);
+    RayesImage *img = render(s, 2, 20.0, opacity_cache, RAYES_QUALITY_PREVIEW, NULL);
+    rayes_scene_release(s);
+    return img;
+}
+
+static void test_cutout_shadow_matches_geometry(void)
+{
+    for (int cached = 0; cached < 2; cached++) {
+        RayesImage *a = checker_shadow(1, cached), *b = checker_shadow(0, cached);
+        if (!a || !b) {
+            rayes_image_free(a);
+            rayes_image_free(b);
+            continue;
+        }
+        /* Pixels differ only along the cells' edges, where the pattern is
+         * filtered over a cache level's spacing (or a shadow ray's
+         * footprint): count the pixels that disagree by more than a tenth. */
+        int differ = 0;
+        double ma[3], mb[3];
+        for (int i = 0; i < RES * RES; i++)
+            differ += fabsf(a->rgba[4 * i] - b->rgba[4 * i]) > 0.1f * fmaxf(b->rgba[4 * i], 0.05f);
+        mean_rgb(a, ma);
+        mean_rgb(b, mb);
+        fprintf(stderr, "cut-out (%s): %d of %d pixels differ, means %g and %g\n",
+                cached ? "cached" : "uncached", differ, RES * RES, ma[0], mb[0]);
+        CHECK(differ < RES * RES * 4 / 10); /* the edges of 16 cells on 32 x 32 pixels */
+        CHECK_NEAR(ma[0] / mb[0], 1.0, 0.01);
+        rayes_image_free(a);
+        rayes_image_free(b);
+    }
+}
+
+/* A curved stained-glass sheet (the stainedglass shader's opacity method,
+ * coloured) over the floor under an area light, camera-visible. */
+static RayesScene *stained_glass_scene(void)
+{
+    RayesScene *s = new_scene();
+    floor_matte(s);
+    RayesParam g[1] = {pf("frequency", 2.0f)};
+    CHECK(rayes_scene_set_shader(s, "stainedglass", g, 1) == RAYES_OK);
+    const float P[16][3] = {
+        {-1, -1, 1},    {-0.3f, -1, 1.6f},    {0.3f, -1, 1.6f},    {1, -1, 1},
+        {-1, -0.3f, 1}, {-0.3f, -0.3f, 1.6f}, {0.3f, -0.3f, 1.6f}, {1, -0.3f, 1},
+        {-1, 0.3f, 1},  {-0.3f, 0.3f, 1.6f},  {0.3f, 0.3f, 1.6f},  {1, 0.3f, 1},
+        {-1, 1, 1},     {-0.3f, 1, 1.6f},     {0.3f, 1, 1.6f},     {1, 1, 1}};
+    CHECK(rayes_scene_bicubic_patch(s, P) == RAYES_OK);
+    /* beside the view (which it would fill, seen from behind, above it) */
+    const float L[4][3] = {{1.5f, -0.5f, 4}, {1.5f, 0.5f, 4}, {2.5f, 0.5f, 4}, {2.5f, -0.5f, 4}};
+    const float Le[3] = {10, 10, 10};
+    CHECK(rayes_scene_area_light(s, L, Le) == RAYES_OK);
+    return s;
+}
+
+static void test_opacity_cache_within_noise_and_deterministic(void)
+{
+    RayesScene *s = stained_glass_scene();
+    RayesStats *st = NULL;
+    RayesImage *cached = render(s, 2, 20.0, 1, RAYES_QUALITY_FINAL, &st);
+    RayesImage *uncached = render(s, 2, 20.0, 0, RAYES_QUALITY_FINAL, NULL);
+    RayesImage *one = render(s, 1, 20.0, 1, RAYES_QUALITY_FINAL, NULL);
+    RayesImage *tiny = render(s, 3, 0.002, 1, RAYES_QUALITY_FINAL, NULL);
+    if (cached && uncached && one && tiny) {
+        double a[3], b[3];
+        mean_rgb(cached, a);
+        mean_rgb(uncached, b);
+        fprintf(stderr, "stained glass: cached %g %g %g, uncached %g %g %g\n", a[0], a[1], a[2],
+                b[0], b[1], b[2]);
+        for (int c = 0; c < 3; c++)
+            CHECK_NEAR(a[c] / b[c], 1.0, 0.01);
+        size_t bytes = sizeof(float) * 4 * RES * RES;
+        CHECK(memcmp(cached->rgba, one->rgba, bytes) == 0);
+        CHECK(memcmp(cached->rgba, tiny->rgba, bytes) == 0);
+        const RayesStat *hits = rayes_stats_find(st, "cache/opacity/fine/hits");
+        const RayesStat *coarse = rayes_stats_find(st, "cache/opacity/coarse/lookups");
+        CHECK(hits && coarse && hits->count + coarse->count > 0);
+    }
+    rayes_stats_free(st);
+    rayes_image_free(cached);
+    rayes_image_free(uncached);
+    rayes_image_free(one);
+    rayes_image_free(tiny);
+    rayes_scene_release(s);
+}
+
+/* Camera rays composite a half-transparent red sheet over a white floor. */
+static void test_camera_sees_through(void)
+{
+    RayesScene *s = new_scene();
+    RayesParam c[1] = {pc("Cs", 1, 1, 1)};
+    CHECK(rayes_scene_set_shader(s, "constant", c, 1) == RAYES_OK);
+    quad_at(s, 2.0f, 0.0f);
+    RayesParam r[2] = {pc("Cs", 1, 0, 0), pc("Os", 0.5f, 0.5f, 0.5f)};
+    CHECK(rayes_scene_set_shader(s, "constant", r, 2) == RAYES_OK);
+    quad_at(s, 3.0f, 1.0f);
+    for (int quality = 0; quality < 2; quality++) {
+        RayesImage *img = render(s, 2, 20.0, 1, quality, NULL);
+        double m[3];
+        if (!img)
+            continue;
+        mean_rgb(img, m);
+        CHECK_NEAR(m[0], 1.0, 1e-5); /* 0.5 red + 0.5 white */
+        CHECK_NEAR(m[1], 0.5, 1e-5);
+        CHECK_NEAR(m[2], 0.5, 1e-5);
+        CHECK(img->rgba[3] == 1.0f);
+        rayes_image_free(img);
+    }
+    rayes_scene_release(s);
+}
+
+static void test_bad_attributes(void)
+{
+    RayesScene *s = rayes_scene_new();
+    CHECK(rayes_scene_set_visibility(s, 1u << 20) == RAYES_ERROR_INVALID_ARGUMENT);
+    CHECK(rayes_scene_set_opacity_mode(s, (RayesTransmissionHitMode)7, 1) ==
+          RAYES_ERROR_INVALID_ARGUMENT);
+    RayesParam p[1] = {(RayesParam){"Os", RAYES_PARAM_PATTERN, {0, 0, 0}, "nothing"}};
+    CHECK(rayes_scene_set_shader(s, "matte", p, 1) != RAYES_OK);
+    (void)ps;
+    rayes_scene_release(s);
+}
+
+TEST_MAIN(TEST(test_stacked_sheets_multiply_in_any_order),
+          TEST(test_half_transparent_sheet_halves_irradiance),
+          TEST(test_ambient_occlusion_closed_forms), TEST(test_cutout_shadow_matches_geometry),
+          TEST(test_opacity_cache_within_noise_and_deterministic), TEST(test_camera_sees_through),
+          TEST(test_bad_attributes))
