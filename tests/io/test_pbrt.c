@@ -1168,6 +1168,42 @@ static void test_filter_warnings(void)
     free(r);
 }
 
+/* uroughness and vroughness become one isotropic lobe, the geometric
+ * mean of their alphas; when they differ the reader says so once, at the
+ * first material's directive, naming the file and line. */
+static void test_anisotropic_roughness(void)
+{
+    Rec *r = malloc(sizeof *r);
+    ParseRun pr = {.name = "t.pbrt", .r = r,
+                   .text = "WorldBegin\n"
+                           "Material \"conductor\" \"float uroughness\" 0.01 \"float vroughness\" 0.04\n"
+                           "Shape \"trianglemesh\" \"point3 P\" [0 0 0 1 0 0 0 1 0]\n"
+                           "Material \"conductor\" \"float uroughness\" 0.1 \"float vroughness\" 0.4\n"
+                           "  \"bool remaproughness\" false\n"
+                           "Shape \"trianglemesh\" \"point3 P\" [0 0 0 1 0 0 0 1 0]\n"
+                           "Material \"conductor\" \"float uroughness\" 0.2 \"float vroughness\" 0.2\n"
+                           "Shape \"trianglemesh\" \"point3 P\" [0 0 0 1 0 0 0 1 0]\n"};
+    const char *said = stderr_of(run_parse, &pr);
+    CHECK(pr.e == RAYES_OK && r->n_meshes == 3);
+    const char *w = strstr(said, "t.pbrt:2:1: uroughness 0.01 and vroughness 0.04 differ");
+    CHECK(w != NULL);
+    CHECK(w == NULL || strstr(strchr(w, '\n') ? strchr(w, '\n') : w, "differ") == NULL); /* once */
+    if (!w)
+        fprintf(stderr, "  got \"%s\"\n", said);
+    if (r->n_meshes == 3) {
+        const RayesParam *a = param(&r->mesh[0].shader, "roughness");
+        const RayesParam *b = param(&r->mesh[1].shader, "roughness");
+        const RayesParam *c = param(&r->mesh[2].shader, "roughness");
+        CHECK(a && b && c);
+        if (a && b && c) {
+            CHECK_NEAR(a->value[0], 0.02, 1e-6);        /* alphas 0.1, 0.2: mean sqrt(0.02) */
+            CHECK_NEAR(b->value[0], 0.1 * 0.4, 1e-6);   /* alphas given: their product */
+            CHECK_NEAR(c->value[0], 0.2, 1e-6);
+        }
+    }
+    free(r);
+}
+
 /* Spectrum files (.spd), relative to the scene's directory: RGB at 650,
  * 550, 450 nm of the piecewise linear spectrum; a malformed one is an
  * error naming the file. */
@@ -1207,7 +1243,8 @@ static void test_spectrum_files(void)
 }
 
 TEST_MAIN(TEST(test_filters), TEST(test_filter_warnings), TEST(test_import), TEST(test_film_types),
-          TEST(test_measured_material), TEST(test_spectrum_files), TEST(test_cornell_box),
+          TEST(test_measured_material), TEST(test_anisotropic_roughness),
+          TEST(test_spectrum_files), TEST(test_cornell_box),
           TEST(test_transforms), TEST(test_materials), TEST(test_lights),
           TEST(test_instances_include_ply), TEST(test_errors), TEST(test_normals_and_uv),
           TEST(test_textures), TEST(test_coated_conductor_textures))
