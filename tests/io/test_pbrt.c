@@ -378,7 +378,7 @@ static void test_cornell_box(void)
         return;
     }
     CHECK(s.width == 512 && s.height == 512 && s.spp == 1);
-    CHECK(s.bounces == 64); /* maxdepth 65 */
+    CHECK(s.bounces == 8 && s.specular_depth == 64); /* maxdepth 65: diffuse capped */
     CHECK(s.n_displays == 1 && strcmp(s.displays[0].name, "cornell-box.exr") == 0);
     CHECK(r->n_camera == 1 && r->projection == RAYES_PROJECTION_PERSPECTIVE);
     CHECK_NEAR(r->fov, 19.5, 1e-6);
@@ -1204,6 +1204,30 @@ static void test_anisotropic_roughness(void)
     free(r);
 }
 
+/* maxdepth: maxdepth - 1 diffuse bounces up to 8 and maxdepth as the
+ * specular depth up to 64; past the cap one warning at the directive. */
+static void test_maxdepth(void)
+{
+    static const struct {
+        int depth, bounces, specular, warns;
+    } cases[] = {{0, 0, 0, 0}, {1, 0, 1, 0}, {5, 4, 5, 0}, {9, 8, 9, 0},
+                 {10, 8, 10, 1}, {65, 8, 64, 1}, {1000, 8, 64, 1}};
+    Rec *r = malloc(sizeof *r);
+    for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
+        char text[128];
+        snprintf(text, sizeof text, "Integrator \"path\" \"integer maxdepth\" %d\nWorldBegin\n",
+                 cases[k].depth);
+        ParseRun pr = {.name = "t.pbrt", .text = text, .r = r};
+        const char *said = stderr_of(run_parse, &pr);
+        CHECK(pr.e == RAYES_OK);
+        CHECK(pr.s.bounces == cases[k].bounces && pr.s.specular_depth == cases[k].specular);
+        CHECK((strstr(said, "t.pbrt:1:1: Integrator \"maxdepth\"") != NULL) == cases[k].warns);
+        if (cases[k].warns)
+            CHECK(strstr(said, ": 8 diffuse bounces, not ") != NULL);
+    }
+    free(r);
+}
+
 /* Spectrum files (.spd), relative to the scene's directory: RGB at 650,
  * 550, 450 nm of the piecewise linear spectrum; a malformed one is an
  * error naming the file. */
@@ -1243,7 +1267,7 @@ static void test_spectrum_files(void)
 }
 
 TEST_MAIN(TEST(test_filters), TEST(test_filter_warnings), TEST(test_import), TEST(test_film_types),
-          TEST(test_measured_material), TEST(test_anisotropic_roughness),
+          TEST(test_measured_material), TEST(test_anisotropic_roughness), TEST(test_maxdepth),
           TEST(test_spectrum_files), TEST(test_cornell_box),
           TEST(test_transforms), TEST(test_materials), TEST(test_lights),
           TEST(test_instances_include_ply), TEST(test_errors), TEST(test_normals_and_uv),
