@@ -375,8 +375,8 @@ static RoughNames rough_names(const char *prefix)
  * two alphas' geometric mean, which keeps the lobe's solid angle; when
  * they differ that is said once, at the material's directive t.
  * Constants only (constant textures read as their value). */
-static int get_roughness(Parser *P, const Token *t, ParamList *pl, const RoughNames *n,
-                         double def, double *out)
+static int get_roughness(Parser *P, const Token *t, ParamList *pl, const RoughNames *n, double def,
+                         double *out)
 {
     double r, ru, rv;
     if (pbrt_get_float_tex(P, pl, n->r, def, &r) != 0 ||

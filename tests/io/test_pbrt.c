@@ -1017,12 +1017,11 @@ static void test_filters(void)
         {"PixelFilter \"gaussian\"\n", RAYES_FILTER_GAUSSIAN, 3.0f},
         {"PixelFilter \"triangle\" \"float xradius\" 1\n", RAYES_FILTER_TRIANGLE, 2.0f},
         {"PixelFilter \"triangle\"\n", RAYES_FILTER_TRIANGLE, 4.0f},
-        {"PixelFilter \"mitchell\" \"float B\" 0.3 \"float C\" 0.3\n", RAYES_FILTER_MITCHELL,
-         4.0f},
+        {"PixelFilter \"mitchell\" \"float B\" 0.3 \"float C\" 0.3\n", RAYES_FILTER_MITCHELL, 4.0f},
         {"PixelFilter \"sinc\" \"float tau\" 3\n", RAYES_FILTER_LANCZOS, 8.0f},
         {"PixelFilter \"lanczos\"\n", RAYES_FILTER_LANCZOS, 8.0f},
-        {"PixelFilter \"lanczos\" \"float xradius\" 2 \"float yradius\" 2\n",
-         RAYES_FILTER_LANCZOS, 4.0f},
+        {"PixelFilter \"lanczos\" \"float xradius\" 2 \"float yradius\" 2\n", RAYES_FILTER_LANCZOS,
+         4.0f},
         {"PixelFilter \"gaussian\" \"float sigma\" 0.5 \"float xradius\" 1\n",
          RAYES_FILTER_GAUSSIAN, 2.0f},
         {"PixelFilter \"mitchell\"\n", RAYES_FILTER_MITCHELL, 4.0f},
@@ -1068,7 +1067,8 @@ static void test_import(void)
     snprintf(path, sizeof path, "%s/test_pbrt_import_bad.pbrt", RAYES_TEST_TMP);
     write_file(path, "\nShape \"sphere\" \"float radius\" [ \"x\" ]\n");
     snprintf(path, sizeof path, "%s/test_pbrt_main.pbrt", RAYES_TEST_TMP);
-    ParseRun pr = {.name = path, .r = r,
+    ParseRun pr = {.name = path,
+                   .r = r,
                    .text = "WorldBegin\nTranslate 0 0 5\nImport \"test_pbrt_import.pbrt\"\n"};
     const char *said = stderr_of(run_parse, &pr);
     CHECK(pr.e == RAYES_OK && r->n_quadrics == 1 && r->n_meshes == 1);
@@ -1123,11 +1123,13 @@ static void test_film_types(void)
 static void test_measured_material(void)
 {
     Rec *r = malloc(sizeof *r);
-    ParseRun pr = {.name = "t.pbrt", .r = r,
-                   .text = "WorldBegin\n"
-                           "Material \"measured\" \"string filename\" \"bsdfs/ilm_l3_37_metallic.bsdf\"\n"
-                           "Shape \"trianglemesh\" \"point3 P\" [0 0 0 1 0 0 0 1 0]\n"
-                           "Shape \"trianglemesh\" \"point3 P\" [0 0 0 1 0 0 0 1 0]\n"};
+    ParseRun pr = {
+        .name = "t.pbrt",
+        .r = r,
+        .text = "WorldBegin\n"
+                "Material \"measured\" \"string filename\" \"bsdfs/ilm_l3_37_metallic.bsdf\"\n"
+                "Shape \"trianglemesh\" \"point3 P\" [0 0 0 1 0 0 0 1 0]\n"
+                "Shape \"trianglemesh\" \"point3 P\" [0 0 0 1 0 0 0 1 0]\n"};
     const char *said = stderr_of(run_parse, &pr);
     CHECK(pr.e == RAYES_OK && r->n_meshes == 2);
     if (r->n_meshes == 2)
@@ -1135,7 +1137,8 @@ static void test_measured_material(void)
               strcmp(r->mesh[1].shader.name, "matte") == 0);
     const char *w = strstr(said, "t.pbrt:2:1: material \"measured\" is not supported; using matte");
     CHECK(w != NULL);
-    CHECK(w == NULL || strstr(strchr(w, '\n') ? strchr(w, '\n') : w, "measured") == NULL); /* once */
+    CHECK(w == NULL ||
+          strstr(strchr(w, '\n') ? strchr(w, '\n') : w, "measured") == NULL); /* once */
     if (!w)
         fprintf(stderr, "  got \"%s\"\n", said);
     free(r);
@@ -1149,7 +1152,8 @@ static void test_filter_warnings(void)
         const char *text, *want;
     } cases[] = {
         {"PixelFilter \"lanczos\" \"float tau\" 2\nWorldBegin\n",
-         "t.pbrt:1:1: PixelFilter \"lanczos\": rayes' Mitchell has B = C = 1/3 and its sinc tau = 3"},
+         "t.pbrt:1:1: PixelFilter \"lanczos\": rayes' Mitchell has B = C = 1/3 and its sinc tau = "
+         "3"},
         {"PixelFilter \"mitchell\" \"float B\" 0\nWorldBegin\n",
          "t.pbrt:1:1: PixelFilter \"mitchell\": rayes' Mitchell has B = C = 1/3"},
         {"PixelFilter \"blackman\"\nWorldBegin\n",
@@ -1161,7 +1165,8 @@ static void test_filter_warnings(void)
         ParseRun pr = {.name = "t.pbrt", .text = cases[k].text, .r = r};
         const char *said = stderr_of(run_parse, &pr);
         CHECK(pr.e == RAYES_OK);
-        CHECK(cases[k].want ? strstr(said, cases[k].want) != NULL : strstr(said, "warning") == NULL);
+        CHECK(cases[k].want ? strstr(said, cases[k].want) != NULL
+                            : strstr(said, "warning") == NULL);
         if (cases[k].want && !strstr(said, cases[k].want))
             fprintf(stderr, "  got \"%s\"\n", said);
     }
@@ -1174,15 +1179,17 @@ static void test_filter_warnings(void)
 static void test_anisotropic_roughness(void)
 {
     Rec *r = malloc(sizeof *r);
-    ParseRun pr = {.name = "t.pbrt", .r = r,
-                   .text = "WorldBegin\n"
-                           "Material \"conductor\" \"float uroughness\" 0.01 \"float vroughness\" 0.04\n"
-                           "Shape \"trianglemesh\" \"point3 P\" [0 0 0 1 0 0 0 1 0]\n"
-                           "Material \"conductor\" \"float uroughness\" 0.1 \"float vroughness\" 0.4\n"
-                           "  \"bool remaproughness\" false\n"
-                           "Shape \"trianglemesh\" \"point3 P\" [0 0 0 1 0 0 0 1 0]\n"
-                           "Material \"conductor\" \"float uroughness\" 0.2 \"float vroughness\" 0.2\n"
-                           "Shape \"trianglemesh\" \"point3 P\" [0 0 0 1 0 0 0 1 0]\n"};
+    ParseRun pr = {
+        .name = "t.pbrt",
+        .r = r,
+        .text = "WorldBegin\n"
+                "Material \"conductor\" \"float uroughness\" 0.01 \"float vroughness\" 0.04\n"
+                "Shape \"trianglemesh\" \"point3 P\" [0 0 0 1 0 0 0 1 0]\n"
+                "Material \"conductor\" \"float uroughness\" 0.1 \"float vroughness\" 0.4\n"
+                "  \"bool remaproughness\" false\n"
+                "Shape \"trianglemesh\" \"point3 P\" [0 0 0 1 0 0 0 1 0]\n"
+                "Material \"conductor\" \"float uroughness\" 0.2 \"float vroughness\" 0.2\n"
+                "Shape \"trianglemesh\" \"point3 P\" [0 0 0 1 0 0 0 1 0]\n"};
     const char *said = stderr_of(run_parse, &pr);
     CHECK(pr.e == RAYES_OK && r->n_meshes == 3);
     const char *w = strstr(said, "t.pbrt:2:1: uroughness 0.01 and vroughness 0.04 differ");
@@ -1196,8 +1203,8 @@ static void test_anisotropic_roughness(void)
         const RayesParam *c = param(&r->mesh[2].shader, "roughness");
         CHECK(a && b && c);
         if (a && b && c) {
-            CHECK_NEAR(a->value[0], 0.02, 1e-6);        /* alphas 0.1, 0.2: mean sqrt(0.02) */
-            CHECK_NEAR(b->value[0], 0.1 * 0.4, 1e-6);   /* alphas given: their product */
+            CHECK_NEAR(a->value[0], 0.02, 1e-6);      /* alphas 0.1, 0.2: mean sqrt(0.02) */
+            CHECK_NEAR(b->value[0], 0.1 * 0.4, 1e-6); /* alphas given: their product */
             CHECK_NEAR(c->value[0], 0.2, 1e-6);
         }
     }
@@ -1210,7 +1217,7 @@ static void test_maxdepth(void)
 {
     static const struct {
         int depth, bounces, specular, warns;
-    } cases[] = {{0, 0, 0, 0}, {1, 0, 1, 0}, {5, 4, 5, 0}, {9, 8, 9, 0},
+    } cases[] = {{0, 0, 0, 0},   {1, 0, 1, 0},   {5, 4, 5, 0},    {9, 8, 9, 0},
                  {10, 8, 10, 1}, {65, 8, 64, 1}, {1000, 8, 64, 1}};
     Rec *r = malloc(sizeof *r);
     for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
@@ -1268,7 +1275,7 @@ static void test_spectrum_files(void)
 
 TEST_MAIN(TEST(test_filters), TEST(test_filter_warnings), TEST(test_import), TEST(test_film_types),
           TEST(test_measured_material), TEST(test_anisotropic_roughness), TEST(test_maxdepth),
-          TEST(test_spectrum_files), TEST(test_cornell_box),
-          TEST(test_transforms), TEST(test_materials), TEST(test_lights),
-          TEST(test_instances_include_ply), TEST(test_errors), TEST(test_normals_and_uv),
-          TEST(test_textures), TEST(test_coated_conductor_textures))
+          TEST(test_spectrum_files), TEST(test_cornell_box), TEST(test_transforms),
+          TEST(test_materials), TEST(test_lights), TEST(test_instances_include_ply),
+          TEST(test_errors), TEST(test_normals_and_uv), TEST(test_textures),
+          TEST(test_coated_conductor_textures))

@@ -31,9 +31,10 @@ typedef struct Sphere {
 } Sphere;
 
 /* Each light's reflection falls at x = C.x / 2 on the plate: two on each. */
-static const Sphere LIGHTS[4] = {
-    {{-2.4f, 3, 3}, 0.5f, 1.0f}, {{-0.8f, 3, 3}, 0.05f, 100.0f},
-    {{0.8f, 3, 3}, 0.5f, 1.0f},  {{2.4f, 3, 3}, 0.05f, 100.0f}};
+static const Sphere LIGHTS[4] = {{{-2.4f, 3, 3}, 0.5f, 1.0f},
+                                 {{-0.8f, 3, 3}, 0.05f, 100.0f},
+                                 {{0.8f, 3, 3}, 0.5f, 1.0f},
+                                 {{2.4f, 3, 3}, 0.05f, 100.0f}};
 
 static RayesParam pf(const char *name, float v)
 {

@@ -69,8 +69,7 @@ enum { THETA_BINS = 16, PHI_BINS = 32, SAMPLES = 200000, SUB = 64 };
  * over the rest of the sphere. A narrow lobe about c is thus resolved by
  * all the bins. Returns the chi-square statistic and its degrees of
  * freedom. */
-static double chi2_test_about(Lobe l, Vec3 wo, float p, Vec3 c, double tmax, int *dof,
-                              uint64_t key)
+static double chi2_test_about(Lobe l, Vec3 wo, float p, Vec3 c, double tmax, int *dof, uint64_t key)
 {
     static double observed[THETA_BINS][PHI_BINS], expected[THETA_BINS][PHI_BINS];
     memset(observed, 0, sizeof observed);
@@ -98,12 +97,12 @@ static double chi2_test_about(Lobe l, Vec3 wo, float p, Vec3 c, double tmax, int
         observed[ti][pi] += 1.0;
     }
     /* the pdf at polar angles (th, ph) about c, times the area element */
-#define PDF_AREA(th, ph)                                                                      \
-    (lobe_pdf(l, wo,                                                                          \
-              v3_add(v3_scale(c, (float)cos(th)),                                             \
-                     v3_add(v3_scale(t, (float)(sin(th) * cos(ph))),                          \
-                            v3_scale(b, (float)(sin(th) * sin(ph))))),                        \
-              p) *                                                                            \
+#define PDF_AREA(th, ph)                                                                           \
+    (lobe_pdf(                                                                                     \
+         l, wo,                                                                                    \
+         v3_add(v3_scale(c, (float)cos(th)), v3_add(v3_scale(t, (float)(sin(th) * cos(ph))),       \
+                                                    v3_scale(b, (float)(sin(th) * sin(ph))))),     \
+         p) *                                                                                      \
      sin(th))
     for (int ti = 0; ti < THETA_BINS; ti++)
         for (int pi = 0; pi < PHI_BINS; pi++) {
@@ -203,18 +202,19 @@ static void test_chi2_rough_conductor(void)
     static const float angles[] = {0.0f, 45.0f, 75.0f};
     float remapped = bsdf_alpha_from_roughness(0.005f); /* pbrt's default remapping on */
     for (size_t k = 0; k <= sizeof cases / sizeof cases[0]; k++) {
-        float alpha = k < sizeof cases / sizeof cases[0] ? sqrtf(cases[k].au * cases[k].av)
-                                                         : remapped;
+        float alpha =
+            k < sizeof cases / sizeof cases[0] ? sqrtf(cases[k].au * cases[k].av) : remapped;
         float e = bsdf_blinn_exponent_from_alpha(alpha);
         for (size_t a = 0; a < sizeof angles / sizeof angles[0]; a++) {
             Vec3 wo = from_angle(angles[a]), R = bsdf_reflect(wo, v3(0, 0, 1));
             int dof = 0;
             double tmax = fmin(PI_D, 10.0 / sqrt(e));
-            double chi2 = chi2_test_about(BLINN, wo, e, R, tmax, &dof,
-                                          hash_combine(a + 500, (uint64_t)k));
+            double chi2 =
+                chi2_test_about(BLINN, wo, e, R, tmax, &dof, hash_combine(a + 500, (uint64_t)k));
             double crit = chi2_critical(dof > 0 ? dof : 1);
             if (!(dof > 20 && chi2 < crit))
-                fprintf(stderr, "conductor alpha=%g e=%g theta_o=%g: chi2 %.1f dof %d critical %.1f\n",
+                fprintf(stderr,
+                        "conductor alpha=%g e=%g theta_o=%g: chi2 %.1f dof %d critical %.1f\n",
                         alpha, e, angles[a], chi2, dof, crit);
             CHECK(dof > 20); /* the lobe is resolved, not one bin */
             CHECK(chi2 < crit);
@@ -440,7 +440,6 @@ static void test_roughness_mappings(void)
 }
 
 TEST_MAIN(TEST(test_chi2_lambert), TEST(test_chi2_blinn), TEST(test_chi2_ggx),
-          TEST(test_chi2_rough_conductor),
-          TEST(test_chi2_detects_wrong_pdf), TEST(test_sample_weights), TEST(test_white_furnace),
-          TEST(test_reciprocity), TEST(test_fresnel_limits), TEST(test_smooth_dielectric),
-          TEST(test_roughness_mappings))
+          TEST(test_chi2_rough_conductor), TEST(test_chi2_detects_wrong_pdf),
+          TEST(test_sample_weights), TEST(test_white_furnace), TEST(test_reciprocity),
+          TEST(test_fresnel_limits), TEST(test_smooth_dielectric), TEST(test_roughness_mappings))
