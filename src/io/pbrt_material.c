@@ -372,9 +372,11 @@ static RoughNames rough_names(const char *prefix)
 /* rayes' roughness r is pbrt's with remapping on (alpha = sqrt(r)). pbrt's
  * "remaproughness" false gives alpha itself, so r = alpha^2. Anisotropic
  * roughness (uroughness, vroughness) becomes the isotropic lobe of the
- * two alphas' geometric mean, which keeps the lobe's solid angle.
+ * two alphas' geometric mean, which keeps the lobe's solid angle; when
+ * they differ that is said once, at the material's directive t.
  * Constants only (constant textures read as their value). */
-static int get_roughness(Parser *P, ParamList *pl, const RoughNames *n, double def, double *out)
+static int get_roughness(Parser *P, const Token *t, ParamList *pl, const RoughNames *n, double def,
+                         double *out)
 {
     double r, ru, rv;
     if (pbrt_get_float_tex(P, pl, n->r, def, &r) != 0 ||
@@ -385,6 +387,11 @@ static int get_roughness(Parser *P, ParamList *pl, const RoughNames *n, double d
     int alpha_given = remap && remap->n_num && remap->num[0] == 0.0;
     double au = alpha_given ? ru : sqrt(fmax(ru, 0.0)), av = alpha_given ? rv : sqrt(fmax(rv, 0.0));
     double alpha = sqrt(fmax(au, 0.0) * fmax(av, 0.0));
+    if (ru != rv)
+        pbrt_warn_at(P, t->line, t->col, "anisotropic roughness",
+                     "%s %g and %s %g differ: rayes' glossy lobes are isotropic, so the lobe "
+                     "has their alphas' geometric mean (alpha %g); highlights are not stretched",
+                     n->u, ru, n->v, rv, alpha);
     *out = alpha * alpha;
     return 0;
 }
@@ -460,7 +467,7 @@ static int mat_roughness(Parser *P, const Token *t, ParamList *pl, Material *m, 
             return textured_roughness(P, t, pl, &n, m);
     }
     double r;
-    if (get_roughness(P, pl, &n, def, &r) != 0)
+    if (get_roughness(P, t, pl, &n, def, &r) != 0)
         return -1;
     mat_float(m, "roughness", (float)r);
     return 0;

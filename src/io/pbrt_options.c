@@ -132,6 +132,9 @@ int pbrt_d_sampler(Parser *P, const Token *t)
     return 0;
 }
 
+/* The most diffuse bounces a pbrt maxdepth gives (maxdepth - 1 up to it). */
+enum { PBRT_DIFFUSE_BOUNCES = 8 };
+
 int pbrt_d_integrator(Parser *P, const Token *t)
 {
     char type[64];
@@ -148,15 +151,19 @@ int pbrt_d_integrator(Parser *P, const Token *t)
     }
     /* pbrt's maxdepth 1 is direct light only: rayes' 0 diffuse bounces.
      * Specular paths past the branch depth follow one lobe, so a deep
-     * specular depth is cheap; each diffuse bounce is cached apart and
-     * costs about as much as the first, which the user should know. */
-    P->settings->bounces = depth >= 1 ? (int)depth - 1 : 0;
-    P->settings->specular_depth = (int)depth;
-    if (depth > 9)
+     * specular depth is cheap. Each diffuse bounce is cached apart and
+     * costs about as much as the first, while the light it adds falls as
+     * the albedo's power: past PBRT_DIFFUSE_BOUNCES the bounces stop, with
+     * one warning (docs/pbrt.md: the Cornell box's figures). */
+    int bounces = depth >= 1 ? (int)fmin(depth - 1, 64) : 0;
+    P->settings->bounces = bounces < PBRT_DIFFUSE_BOUNCES ? bounces : PBRT_DIFFUSE_BOUNCES;
+    P->settings->specular_depth = (int)fmin(depth, 64);
+    if (bounces > PBRT_DIFFUSE_BOUNCES)
         pbrt_warn_at(P, t->line, t->col, "maxdepth",
-                     "Integrator \"maxdepth\" %g: %d diffuse bounces, each costing about as "
-                     "much as the first (--bounces N for fewer)",
-                     depth, depth - 1 < 64 ? (int)depth - 1 : 64);
+                     "Integrator \"maxdepth\" %g: %d diffuse bounces, not %d (each costs "
+                     "about as much as the first and adds less than the one before; "
+                     "--bounces N for more), specular depth %d",
+                     depth, PBRT_DIFFUSE_BOUNCES, bounces, P->settings->specular_depth);
     if (strcmp(type, "ambientocclusion") == 0 || strcmp(type, "sppm") == 0 ||
         strcmp(type, "mlt") == 0)
         pbrt_warn_at(P, t->line, t->col, "integrator",

@@ -1,8 +1,9 @@
 /*
  * tests/io/test_pbrt.c — the pbrt-v4 reader of io/pbrt.h against a
  * recording IoSink: transforms and the camera matrix, the mapping of
- * materials and lights, quadrics, instancing, plymesh and Include through
- * files written to RAYES_TEST_TMP, the Bitterli Cornell box from the
+ * materials and lights (measured: matte with a warning), quadrics,
+ * instancing, plymesh, Include and Import through files written to
+ * RAYES_TEST_TMP, filters and film types with their warnings, the Bitterli Cornell box from the
  * shared data (walls on the right sides as its camera sees them, the
  * ceiling light), and bad input with "file:line:col" errors.
  */
@@ -377,7 +378,7 @@ static void test_cornell_box(void)
         return;
     }
     CHECK(s.width == 512 && s.height == 512 && s.spp == 1);
-    CHECK(s.bounces == 64); /* maxdepth 65 */
+    CHECK(s.bounces == 8 && s.specular_depth == 64); /* maxdepth 65: diffuse capped */
     CHECK(s.n_displays == 1 && strcmp(s.displays[0].name, "cornell-box.exr") == 0);
     CHECK(r->n_camera == 1 && r->projection == RAYES_PROJECTION_PERSPECTIVE);
     CHECK_NEAR(r->fov, 19.5, 1e-6);
@@ -1016,9 +1017,14 @@ static void test_filters(void)
         {"PixelFilter \"gaussian\"\n", RAYES_FILTER_GAUSSIAN, 3.0f},
         {"PixelFilter \"triangle\" \"float xradius\" 1\n", RAYES_FILTER_TRIANGLE, 2.0f},
         {"PixelFilter \"triangle\"\n", RAYES_FILTER_TRIANGLE, 4.0f},
-        {"PixelFilter \"mitchell\" \"float B\" 0.3 \"float C\" 0.3\n", RAYES_FILTER_MITCHELL,
-         4.0f},
+        {"PixelFilter \"mitchell\" \"float B\" 0.3 \"float C\" 0.3\n", RAYES_FILTER_MITCHELL, 4.0f},
         {"PixelFilter \"sinc\" \"float tau\" 3\n", RAYES_FILTER_LANCZOS, 8.0f},
+        {"PixelFilter \"lanczos\"\n", RAYES_FILTER_LANCZOS, 8.0f},
+        {"PixelFilter \"lanczos\" \"float xradius\" 2 \"float yradius\" 2\n", RAYES_FILTER_LANCZOS,
+         4.0f},
+        {"PixelFilter \"gaussian\" \"float sigma\" 0.5 \"float xradius\" 1\n",
+         RAYES_FILTER_GAUSSIAN, 2.0f},
+        {"PixelFilter \"mitchell\"\n", RAYES_FILTER_MITCHELL, 4.0f},
     };
     Rec *r = malloc(sizeof *r);
     for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
@@ -1028,6 +1034,203 @@ static void test_filters(void)
         CHECK(parse("t.pbrt", text, r, &s, err, sizeof err) == RAYES_OK);
         CHECK(s.filter == cases[k].filter);
         CHECK_NEAR(s.filter_width, cases[k].width, 1e-6);
+    }
+    free(r);
+}
+
+/* A parse with standard error captured (stderr_of's argument). */
+typedef struct ParseRun {
+    const char *name, *text;
+    Rec *r;
+    IoSettings s;
+    RayesError e;
+    char err[512];
+} ParseRun;
+
+static void run_parse(void *arg)
+{
+    ParseRun *pr = arg;
+    pr->err[0] = '\0';
+    pr->e = parse(pr->name, pr->text, pr->r, &pr->s, pr->err, sizeof pr->err);
+}
+
+/* Import reads a file as Include does (pbrt-v4 allows it only for shapes
+ * and named things, which rayes does not enforce), relative to the
+ * directory of the file given, and its errors name the imported file. */
+static void test_import(void)
+{
+    Rec *r = malloc(sizeof *r);
+    char path[512];
+    snprintf(path, sizeof path, "%s/test_pbrt_import.pbrt", RAYES_TEST_TMP);
+    write_file(path, "# imported\nShape \"sphere\" \"float radius\" 2\n"
+                     "Shape \"trianglemesh\" \"point3 P\" [0 0 0 1 0 0 0 1 0]\n");
+    snprintf(path, sizeof path, "%s/test_pbrt_import_bad.pbrt", RAYES_TEST_TMP);
+    write_file(path, "\nShape \"sphere\" \"float radius\" [ \"x\" ]\n");
+    snprintf(path, sizeof path, "%s/test_pbrt_main.pbrt", RAYES_TEST_TMP);
+    ParseRun pr = {.name = path,
+                   .r = r,
+                   .text = "WorldBegin\nTranslate 0 0 5\nImport \"test_pbrt_import.pbrt\"\n"};
+    const char *said = stderr_of(run_parse, &pr);
+    CHECK(pr.e == RAYES_OK && r->n_quadrics == 1 && r->n_meshes == 1);
+    CHECK(strstr(said, "warning") == NULL);
+    if (r->n_quadrics == 1) {
+        CHECK_NEAR(r->quadric[0].p[0], 2, 0);
+        CHECK_NEAR(r->quadric[0].xform[11], 5, 0); /* the importing file's transform applies */
+    }
+    pr.text = "WorldBegin\nImport \"test_pbrt_import_bad.pbrt\"\n";
+    stderr_of(run_parse, &pr);
+    CHECK(pr.e == RAYES_ERROR_PARSE &&
+          strstr(pr.err, "test_pbrt_import_bad.pbrt:2:33: expected a float value") != NULL);
+    pr.text = "WorldBegin\nImport \"test_pbrt_none.pbrt\"\n";
+    stderr_of(run_parse, &pr);
+    CHECK(pr.e == RAYES_ERROR_PARSE && strstr(pr.err, "Import: ") != NULL &&
+          strstr(pr.err, "test_pbrt_none.pbrt") != NULL);
+    free(r);
+}
+
+/* Film "gbuffer" and "spectral" are written as rgb films: resolution,
+ * file name and crop window kept, one warning at the directive. */
+static void test_film_types(void)
+{
+    static const char *const types[] = {"gbuffer", "spectral"};
+    Rec *r = malloc(sizeof *r);
+    for (size_t k = 0; k < 2; k++) {
+        char text[512];
+        snprintf(text, sizeof text,
+                 "Sampler \"halton\"\nFilm \"%s\" \"integer xresolution\" 64 "
+                 "\"integer yresolution\" 32 \"string filename\" \"out.exr\"\n"
+                 "  \"float cropwindow\" [0 0.5 0 1]\nWorldBegin\n",
+                 types[k]);
+        ParseRun pr = {.name = "t.pbrt", .text = text, .r = r};
+        const char *said = stderr_of(run_parse, &pr);
+        CHECK(pr.e == RAYES_OK);
+        CHECK(pr.s.width == 64 && pr.s.height == 32);
+        CHECK(pr.s.n_displays == 1 && strcmp(pr.s.displays[0].name, "out.exr") == 0 &&
+              strcmp(pr.s.displays[0].type, "openexr") == 0);
+        CHECK_NEAR(pr.s.crop[1], 0.5, 0);
+        char want[128];
+        snprintf(want, sizeof want, "t.pbrt:2:1: Film \"%s\": written as an rgb film", types[k]);
+        CHECK(strstr(said, want) != NULL);
+        if (!strstr(said, want))
+            fprintf(stderr, "  got \"%s\"\n", said);
+    }
+    free(r);
+}
+
+/* measured (a tabulated BSDF file rayes does not read) becomes matte with
+ * one warning naming the type at the directive; the shape under it keeps
+ * its geometry. */
+static void test_measured_material(void)
+{
+    Rec *r = malloc(sizeof *r);
+    ParseRun pr = {
+        .name = "t.pbrt",
+        .r = r,
+        .text = "WorldBegin\n"
+                "Material \"measured\" \"string filename\" \"bsdfs/ilm_l3_37_metallic.bsdf\"\n"
+                "Shape \"trianglemesh\" \"point3 P\" [0 0 0 1 0 0 0 1 0]\n"
+                "Shape \"trianglemesh\" \"point3 P\" [0 0 0 1 0 0 0 1 0]\n"};
+    const char *said = stderr_of(run_parse, &pr);
+    CHECK(pr.e == RAYES_OK && r->n_meshes == 2);
+    if (r->n_meshes == 2)
+        CHECK(strcmp(r->mesh[0].shader.name, "matte") == 0 &&
+              strcmp(r->mesh[1].shader.name, "matte") == 0);
+    const char *w = strstr(said, "t.pbrt:2:1: material \"measured\" is not supported; using matte");
+    CHECK(w != NULL);
+    CHECK(w == NULL ||
+          strstr(strchr(w, '\n') ? strchr(w, '\n') : w, "measured") == NULL); /* once */
+    if (!w)
+        fprintf(stderr, "  got \"%s\"\n", said);
+    free(r);
+}
+
+/* Filter parameters rayes does not use are said once, at the directive;
+ * an unknown filter keeps the default with a warning. */
+static void test_filter_warnings(void)
+{
+    static const struct {
+        const char *text, *want;
+    } cases[] = {
+        {"PixelFilter \"lanczos\" \"float tau\" 2\nWorldBegin\n",
+         "t.pbrt:1:1: PixelFilter \"lanczos\": rayes' Mitchell has B = C = 1/3 and its sinc tau = "
+         "3"},
+        {"PixelFilter \"mitchell\" \"float B\" 0\nWorldBegin\n",
+         "t.pbrt:1:1: PixelFilter \"mitchell\": rayes' Mitchell has B = C = 1/3"},
+        {"PixelFilter \"blackman\"\nWorldBegin\n",
+         "t.pbrt:1:1: PixelFilter \"blackman\" is not supported; using the renderer's default"},
+        {"PixelFilter \"triangle\" \"float xradius\" 1.5\nWorldBegin\n", NULL},
+    };
+    Rec *r = malloc(sizeof *r);
+    for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
+        ParseRun pr = {.name = "t.pbrt", .text = cases[k].text, .r = r};
+        const char *said = stderr_of(run_parse, &pr);
+        CHECK(pr.e == RAYES_OK);
+        CHECK(cases[k].want ? strstr(said, cases[k].want) != NULL
+                            : strstr(said, "warning") == NULL);
+        if (cases[k].want && !strstr(said, cases[k].want))
+            fprintf(stderr, "  got \"%s\"\n", said);
+    }
+    free(r);
+}
+
+/* uroughness and vroughness become one isotropic lobe, the geometric
+ * mean of their alphas; when they differ the reader says so once, at the
+ * first material's directive, naming the file and line. */
+static void test_anisotropic_roughness(void)
+{
+    Rec *r = malloc(sizeof *r);
+    ParseRun pr = {
+        .name = "t.pbrt",
+        .r = r,
+        .text = "WorldBegin\n"
+                "Material \"conductor\" \"float uroughness\" 0.01 \"float vroughness\" 0.04\n"
+                "Shape \"trianglemesh\" \"point3 P\" [0 0 0 1 0 0 0 1 0]\n"
+                "Material \"conductor\" \"float uroughness\" 0.1 \"float vroughness\" 0.4\n"
+                "  \"bool remaproughness\" false\n"
+                "Shape \"trianglemesh\" \"point3 P\" [0 0 0 1 0 0 0 1 0]\n"
+                "Material \"conductor\" \"float uroughness\" 0.2 \"float vroughness\" 0.2\n"
+                "Shape \"trianglemesh\" \"point3 P\" [0 0 0 1 0 0 0 1 0]\n"};
+    const char *said = stderr_of(run_parse, &pr);
+    CHECK(pr.e == RAYES_OK && r->n_meshes == 3);
+    const char *w = strstr(said, "t.pbrt:2:1: uroughness 0.01 and vroughness 0.04 differ");
+    CHECK(w != NULL);
+    CHECK(w == NULL || strstr(strchr(w, '\n') ? strchr(w, '\n') : w, "differ") == NULL); /* once */
+    if (!w)
+        fprintf(stderr, "  got \"%s\"\n", said);
+    if (r->n_meshes == 3) {
+        const RayesParam *a = param(&r->mesh[0].shader, "roughness");
+        const RayesParam *b = param(&r->mesh[1].shader, "roughness");
+        const RayesParam *c = param(&r->mesh[2].shader, "roughness");
+        CHECK(a && b && c);
+        if (a && b && c) {
+            CHECK_NEAR(a->value[0], 0.02, 1e-6);      /* alphas 0.1, 0.2: mean sqrt(0.02) */
+            CHECK_NEAR(b->value[0], 0.1 * 0.4, 1e-6); /* alphas given: their product */
+            CHECK_NEAR(c->value[0], 0.2, 1e-6);
+        }
+    }
+    free(r);
+}
+
+/* maxdepth: maxdepth - 1 diffuse bounces up to 8 and maxdepth as the
+ * specular depth up to 64; past the cap one warning at the directive. */
+static void test_maxdepth(void)
+{
+    static const struct {
+        int depth, bounces, specular, warns;
+    } cases[] = {{0, 0, 0, 0},   {1, 0, 1, 0},   {5, 4, 5, 0},    {9, 8, 9, 0},
+                 {10, 8, 10, 1}, {65, 8, 64, 1}, {1000, 8, 64, 1}};
+    Rec *r = malloc(sizeof *r);
+    for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
+        char text[128];
+        snprintf(text, sizeof text, "Integrator \"path\" \"integer maxdepth\" %d\nWorldBegin\n",
+                 cases[k].depth);
+        ParseRun pr = {.name = "t.pbrt", .text = text, .r = r};
+        const char *said = stderr_of(run_parse, &pr);
+        CHECK(pr.e == RAYES_OK);
+        CHECK(pr.s.bounces == cases[k].bounces && pr.s.specular_depth == cases[k].specular);
+        CHECK((strstr(said, "t.pbrt:1:1: Integrator \"maxdepth\"") != NULL) == cases[k].warns);
+        if (cases[k].warns)
+            CHECK(strstr(said, ": 8 diffuse bounces, not ") != NULL);
     }
     free(r);
 }
@@ -1070,7 +1273,9 @@ static void test_spectrum_files(void)
     free(r);
 }
 
-TEST_MAIN(TEST(test_filters), TEST(test_spectrum_files), TEST(test_cornell_box),
-          TEST(test_transforms), TEST(test_materials), TEST(test_lights),
-          TEST(test_instances_include_ply), TEST(test_errors), TEST(test_normals_and_uv),
-          TEST(test_textures), TEST(test_coated_conductor_textures))
+TEST_MAIN(TEST(test_filters), TEST(test_filter_warnings), TEST(test_import), TEST(test_film_types),
+          TEST(test_measured_material), TEST(test_anisotropic_roughness), TEST(test_maxdepth),
+          TEST(test_spectrum_files), TEST(test_cornell_box), TEST(test_transforms),
+          TEST(test_materials), TEST(test_lights), TEST(test_instances_include_ply),
+          TEST(test_errors), TEST(test_normals_and_uv), TEST(test_textures),
+          TEST(test_coated_conductor_textures))
