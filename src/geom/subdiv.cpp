@@ -62,6 +62,7 @@ struct Face {
 struct Patch {
     uint32_t face;
     int tri;                         /* a Loop triangle */
+    int sub;                         /* its corner of a face split into sub-faces, or -1 */
     float o[2], J[2][2];             /* face (u, v) = o + J (u, v) of the patch */
 };
 
@@ -175,7 +176,7 @@ static size_t prepare(Channel *c, const Surface &s)
 static void add_patches(SubdivMesh *m, uint32_t f, const Surface &s)
 {
     Bfr::Parameterization param = s.GetParameterization();
-    Patch p = {f, param.GetType() == Bfr::Parameterization::TRI, {0, 0}, {{1, 0}, {0, 1}}};
+    Patch p = {f, param.GetType() == Bfr::Parameterization::TRI, -1, {0, 0}, {{1, 0}, {0, 1}}};
     if (!param.HasSubFaces()) {
         m->patches.push_back(p);
         return;
@@ -185,6 +186,7 @@ static void add_patches(SubdivMesh *m, uint32_t f, const Surface &s)
         param.ConvertNormalizedSubFaceToCoord(sub, c00, o);
         param.ConvertNormalizedSubFaceToCoord(sub, c10, a);
         param.ConvertNormalizedSubFaceToCoord(sub, c01, b);
+        p.sub = sub;
         p.o[0] = o[0], p.o[1] = o[1];
         p.J[0][0] = a[0] - o[0], p.J[1][0] = a[1] - o[1];
         p.J[0][1] = b[0] - o[0], p.J[1][1] = b[1] - o[1];
@@ -338,6 +340,42 @@ extern "C" size_t geom_subdiv_patch_face(const SubdivMesh *m, size_t patch)
 extern "C" int geom_subdiv_patch_triangular(const SubdivMesh *m, size_t patch)
 {
     return m->patches[patch].tri;
+}
+
+/* The curve of a mesh edge walked from point a toward point b for the
+ * fraction h of its length (1, or 1/2 to its midpoint): keyed by its
+ * points in increasing order, t running from the lower one. */
+static void edge_side(int a, int b, float h, uint64_t key[2], float t[2])
+{
+    key[0] = 1, key[1] = (uint64_t)(uint32_t)std::min(a, b) << 32 | (uint32_t)std::max(a, b);
+    t[0] = a < b ? 0.0f : 1.0f;
+    t[1] = a < b ? h : 1.0f - h;
+}
+
+extern "C" int geom_subdiv_patch_side(const SubdivMesh *m, size_t patch, int side,
+                                      uint64_t key[2], float t[2])
+{
+    const Patch &p = m->patches[patch];
+    if (p.tri)
+        return 0;
+    Far::ConstIndexArray v = m->refiner->GetLevel(0).GetFaceVertices((int)p.face);
+    int n = v.size();
+    if (p.sub < 0) { /* corners v0 (0,0), v1 (1,0), v2 (1,1), v3 (0,1) */
+        static const int from[4] = {0, 1, 3, 0}, to[4] = {1, 2, 2, 3};
+        edge_side(v[from[side]], v[to[side]], 1.0f, key, t);
+        return 1;
+    }
+    /* Ptex sub-face k: the corner k at (0,0), u toward the midpoint of
+     * edge k (to k + 1), v toward that of edge k - 1; its other two sides
+     * run from those midpoints to the face's centre, inside the face. */
+    int k = p.sub, next = (k + 1) % n, prev = (k + n - 1) % n;
+    if (side == 0 || side == 3) {
+        edge_side(v[k], v[side == 0 ? next : prev], 0.5f, key, t);
+        return 1;
+    }
+    key[0] = 2, key[1] = (uint64_t)p.face << 32 | (uint32_t)(side == 1 ? k : prev);
+    t[0] = 0.0f, t[1] = 1.0f;
+    return 1;
 }
 
 extern "C" void geom_subdiv_patch_bounds(const SubdivMesh *m, size_t patch, float lo[3],
