@@ -17,12 +17,14 @@
 #include <opensubdiv/bfr/refinerSurfaceFactory.h>
 #include <opensubdiv/bfr/surface.h>
 #include <opensubdiv/far/error.h>
+#include <opensubdiv/far/primvarRefiner.h>
 #include <opensubdiv/far/topologyDescriptor.h>
 #include <opensubdiv/far/topologyRefinerFactory.h>
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <map>
 #include <memory>
@@ -31,6 +33,8 @@
 #include <vector>
 
 using namespace OpenSubdiv;
+
+#define SUBDIV_APPROX_LEVEL 6 /* Bfr's refinement level near extraordinary vertices */
 
 namespace {
 
@@ -269,6 +273,11 @@ static int build(SubdivMesh *m, const SubdivDesc *d, char *err, size_t err_size)
     }
 
     Bfr::RefinerSurfaceFactory<>::Options options;
+    /* Near extraordinary vertices Bfr approximates the limit surface with
+     * patches of a refinement level; its default for smooth ones (2) is
+     * 5e-4 off a cube of side 2 (OpenSubdiv's own limit points,
+     * tests/scene/test_subdiv.c); 6 is within float rounding. */
+    options.SetApproxLevelSmooth(SUBDIV_APPROX_LEVEL);
     if (m->fvar.size)
         options.SetDefaultFVarID(0);
     Bfr::RefinerSurfaceFactory<> factory(*m->refiner, options);
@@ -376,6 +385,68 @@ extern "C" int geom_subdiv_patch_side(const SubdivMesh *m, size_t patch, int sid
     key[0] = 2, key[1] = (uint64_t)p.face << 32 | (uint32_t)(side == 1 ? k : prev);
     t[0] = 0.0f, t[1] = 1.0f;
     return 1;
+}
+
+namespace {
+
+/* A point for Far::PrimvarRefiner. */
+struct Point3 {
+    float p[3];
+    void Clear(void * = nullptr) { p[0] = p[1] = p[2] = 0.0f; }
+    void AddWithWeight(const Point3 &o, float w)
+    {
+        for (int k = 0; k < 3; k++)
+            p[k] += w * o.p[k];
+    }
+};
+
+} // namespace
+
+extern "C" float *geom_subdiv_refine_uniform(const SubdivDesc *d, int level, int limit, size_t *n)
+{
+    *n = 0;
+    Descriptor desc;
+    desc.numVertices = (int)d->n_points;
+    desc.numFaces = (int)d->n_faces;
+    desc.numVertsPerFace = d->n_verts;
+    desc.vertIndicesPerFace = d->indices;
+    desc.numCreases = (int)d->n_creases;
+    desc.creaseVertexIndexPairs = d->crease_edges;
+    desc.creaseWeights = d->crease_sharpness;
+    desc.numCorners = (int)d->n_corners;
+    desc.cornerVertexIndices = d->corner_points;
+    desc.cornerWeights = d->corner_sharpness;
+    desc.numHoles = (int)d->n_holes;
+    desc.holeIndices = d->hole_faces;
+    static const Sdc::SchemeType schemes[3] = {Sdc::SCHEME_CATMARK, Sdc::SCHEME_LOOP,
+                                               Sdc::SCHEME_BILINEAR};
+    std::unique_ptr<Far::TopologyRefiner> r(Far::TopologyRefinerFactory<Descriptor>::Create(
+        desc, Far::TopologyRefinerFactory<Descriptor>::Options(schemes[d->scheme], sdc_options(d))));
+    if (!r)
+        return nullptr;
+    Far::TopologyRefiner::UniformOptions uniform(level);
+    uniform.fullTopologyInLastLevel = true; /* PrimvarRefiner::Limit needs it */
+    r->RefineUniform(uniform);
+    std::vector<Point3> pts((size_t)r->GetNumVerticesTotal());
+    std::memcpy(pts.data(), d->P, d->n_points * sizeof(Point3));
+    Far::PrimvarRefiner pr(*r);
+    Point3 *src = pts.data();
+    for (int l = 1; l <= level; l++) {
+        Point3 *dst = src + r->GetLevel(l - 1).GetNumVertices();
+        pr.Interpolate(l, src, dst);
+        src = dst;
+    }
+    size_t count = (size_t)r->GetLevel(level).GetNumVertices();
+    std::vector<Point3> out(src, src + count);
+    Point3 *dst = out.data();
+    if (limit)
+        pr.Limit(src, dst);
+    float *P = (float *)std::malloc(count * sizeof(Point3));
+    if (P) {
+        std::memcpy(P, out.data(), count * sizeof(Point3));
+        *n = count;
+    }
+    return P;
 }
 
 extern "C" void geom_subdiv_patch_bounds(const SubdivMesh *m, size_t patch, float lo[3],
