@@ -349,6 +349,10 @@ Accel *accel_new(const GridSet *gs, const uint32_t *object_mask, size_t n_object
     rtcSetDeviceErrorFunction(a->device, on_error, a);
     rtcSetDeviceMemoryMonitorFunction(a->device, on_memory, a);
     a->scene = rtcNewScene(a->device);
+    /* Watertight intersection: without it Embree's fast path lets rays
+     * slip between micropolygons that share an edge, inside a grid and
+     * between stitched grids (tests/render/test_watertight.c). */
+    rtcSetSceneFlags(a->scene, RTC_SCENE_FLAG_ROBUST);
     rtcSetSceneBuildQuality(a->scene, RTC_BUILD_QUALITY_MEDIUM);
     int rc = 0;
     for (size_t o = 0; o < n_objects && rc == 0; o++)

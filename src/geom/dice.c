@@ -220,6 +220,24 @@ static int prim_shape(const Prim *prim)
                                       : GEOM_SHAPE_SURFACE;
 }
 
+/* The power of two nearest n (in ratio: up from 1.42 p). Quad patches
+ * of surfaces dice at such rates over domains halved when split, so that
+ * along any line two grids share, the coarser grid's vertices are
+ * vertices of the finer one too, which stitching (geom/stitch.c) needs. */
+static int nearest_power_of_two(int n)
+{
+    int p = 1;
+    while (p <= n / 2)
+        p *= 2;
+    return (int64_t)n * n > 2 * (int64_t)p * p ? 2 * p : p;
+}
+
+/* 1 if a domain's grid is stitched to its neighbours (geom_stitch). */
+static int stitched(const Prim *prim, const Domain *d)
+{
+    return !d->triangular && !d->sub_quad && geom_prim_stitched(prim);
+}
+
 static Estimate estimate(const Prim *prim, const Domain *d, const DiceCamera *cam)
 {
     Vec3 p[LATTICE][LATTICE];
@@ -270,6 +288,10 @@ static Estimate estimate(const Prim *prim, const Domain *d, const DiceCamera *ca
     }
     e.n_u = RY_MAX(e.n_u, 1);
     e.n_v = RY_MAX(e.n_v, 1);
+    if (cam->binary && stitched(prim, d)) {
+        e.n_u = nearest_power_of_two(e.n_u);
+        e.n_v = nearest_power_of_two(e.n_v);
+    }
     if (prim_shape(prim) == GEOM_SHAPE_ROUND_CURVE || prim_shape(prim) == GEOM_SHAPE_FLAT_CURVE)
         e.n_v = 1; /* one micropolygon across: the tube or ribbon about the centre line */
     return e;

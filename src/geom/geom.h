@@ -243,6 +243,9 @@ typedef struct DiceCamera {
     int isotropic;      /* 1: on-screen patches by distance too (RenderMan's rasterorient 0) */
     float rate_scale;   /* >= 1 (0 reads as 1): every edge this much longer (the vertex
                            budget, scene_prepare) */
+    int binary;         /* 1: quad grids of stitched primitives (geom_prim_stitched) take
+                           the power of two nearest their rate along each side (RenderMan's
+                           binary dicing), as geom_stitch needs; scene_prepare sets it */
 } DiceCamera;
 
 void geom_gridset_init(GridSet *gs);
@@ -265,6 +268,19 @@ void geom_grid_measure(GridSet *gs, Grid *g);
 /* Sets the sagitta of grids [first, n_grids) of gs, all of one primitive
  * and measured, to the largest bound among them. */
 void geom_bound_sagitta(GridSet *gs, size_t first);
+
+/* 1 if prim's quad grids are stitched to their neighbours (geom_stitch):
+ * bilinear and bicubic patches, quadrics, quad subdivision patches (with
+ * DiceCamera.binary, their quad patches dice at powers of two). */
+int geom_prim_stitched(const Prim *prim);
+
+/* Moves the vertices on the sides of gs's stitched grids (prims: the
+ * primitives they were diced from, by Grid.prim) onto the polyline of the
+ * coarsest grid along each shared line, so that neighbours diced at
+ * different rates leave no crack (geom/stitch.c). Run after dicing and
+ * displacement, before the ray tracing structure is built. Returns 0, or
+ * -1 when out of memory (gs is then partly stitched). */
+int geom_stitch(GridSet *gs, const Prim *prims);
 
 /* Vertex count of a grid. */
 static inline size_t geom_grid_n_vertices(const Grid *g)

@@ -17,12 +17,14 @@
 #include <opensubdiv/bfr/refinerSurfaceFactory.h>
 #include <opensubdiv/bfr/surface.h>
 #include <opensubdiv/far/error.h>
+#include <opensubdiv/far/primvarRefiner.h>
 #include <opensubdiv/far/topologyDescriptor.h>
 #include <opensubdiv/far/topologyRefinerFactory.h>
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <map>
 #include <memory>
@@ -31,6 +33,8 @@
 #include <vector>
 
 using namespace OpenSubdiv;
+
+#define SUBDIV_APPROX_LEVEL 6 /* Bfr's refinement level near extraordinary vertices */
 
 namespace {
 
@@ -62,6 +66,7 @@ struct Face {
 struct Patch {
     uint32_t face;
     int tri;                         /* a Loop triangle */
+    int sub;                         /* its corner of a face split into sub-faces, or -1 */
     float o[2], J[2][2];             /* face (u, v) = o + J (u, v) of the patch */
 };
 
@@ -175,7 +180,7 @@ static size_t prepare(Channel *c, const Surface &s)
 static void add_patches(SubdivMesh *m, uint32_t f, const Surface &s)
 {
     Bfr::Parameterization param = s.GetParameterization();
-    Patch p = {f, param.GetType() == Bfr::Parameterization::TRI, {0, 0}, {{1, 0}, {0, 1}}};
+    Patch p = {f, param.GetType() == Bfr::Parameterization::TRI, -1, {0, 0}, {{1, 0}, {0, 1}}};
     if (!param.HasSubFaces()) {
         m->patches.push_back(p);
         return;
@@ -185,6 +190,7 @@ static void add_patches(SubdivMesh *m, uint32_t f, const Surface &s)
         param.ConvertNormalizedSubFaceToCoord(sub, c00, o);
         param.ConvertNormalizedSubFaceToCoord(sub, c10, a);
         param.ConvertNormalizedSubFaceToCoord(sub, c01, b);
+        p.sub = sub;
         p.o[0] = o[0], p.o[1] = o[1];
         p.J[0][0] = a[0] - o[0], p.J[1][0] = a[1] - o[1];
         p.J[0][1] = b[0] - o[0], p.J[1][1] = b[1] - o[1];
@@ -267,6 +273,11 @@ static int build(SubdivMesh *m, const SubdivDesc *d, char *err, size_t err_size)
     }
 
     Bfr::RefinerSurfaceFactory<>::Options options;
+    /* Near extraordinary vertices Bfr approximates the limit surface with
+     * patches of a refinement level; its default for smooth ones (2) is
+     * 5e-4 off a cube of side 2 (OpenSubdiv's own limit points,
+     * tests/scene/test_subdiv.c); 6 is within float rounding. */
+    options.SetApproxLevelSmooth(SUBDIV_APPROX_LEVEL);
     if (m->fvar.size)
         options.SetDefaultFVarID(0);
     Bfr::RefinerSurfaceFactory<> factory(*m->refiner, options);
@@ -338,6 +349,104 @@ extern "C" size_t geom_subdiv_patch_face(const SubdivMesh *m, size_t patch)
 extern "C" int geom_subdiv_patch_triangular(const SubdivMesh *m, size_t patch)
 {
     return m->patches[patch].tri;
+}
+
+/* The curve of a mesh edge walked from point a toward point b for the
+ * fraction h of its length (1, or 1/2 to its midpoint): keyed by its
+ * points in increasing order, t running from the lower one. */
+static void edge_side(int a, int b, float h, uint64_t key[2], float t[2])
+{
+    key[0] = 1, key[1] = (uint64_t)(uint32_t)std::min(a, b) << 32 | (uint32_t)std::max(a, b);
+    t[0] = a < b ? 0.0f : 1.0f;
+    t[1] = a < b ? h : 1.0f - h;
+}
+
+extern "C" int geom_subdiv_patch_side(const SubdivMesh *m, size_t patch, int side,
+                                      uint64_t key[2], float t[2])
+{
+    const Patch &p = m->patches[patch];
+    if (p.tri)
+        return 0;
+    Far::ConstIndexArray v = m->refiner->GetLevel(0).GetFaceVertices((int)p.face);
+    int n = v.size();
+    if (p.sub < 0) { /* corners v0 (0,0), v1 (1,0), v2 (1,1), v3 (0,1) */
+        static const int from[4] = {0, 1, 3, 0}, to[4] = {1, 2, 2, 3};
+        edge_side(v[from[side]], v[to[side]], 1.0f, key, t);
+        return 1;
+    }
+    /* Ptex sub-face k: the corner k at (0,0), u toward the midpoint of
+     * edge k (to k + 1), v toward that of edge k - 1; its other two sides
+     * run from those midpoints to the face's centre, inside the face. */
+    int k = p.sub, next = (k + 1) % n, prev = (k + n - 1) % n;
+    if (side == 0 || side == 3) {
+        edge_side(v[k], v[side == 0 ? next : prev], 0.5f, key, t);
+        return 1;
+    }
+    key[0] = 2, key[1] = (uint64_t)p.face << 32 | (uint32_t)(side == 1 ? k : prev);
+    t[0] = 0.0f, t[1] = 1.0f;
+    return 1;
+}
+
+namespace {
+
+/* A point for Far::PrimvarRefiner. */
+struct Point3 {
+    float p[3];
+    void Clear(void * = nullptr) { p[0] = p[1] = p[2] = 0.0f; }
+    void AddWithWeight(const Point3 &o, float w)
+    {
+        for (int k = 0; k < 3; k++)
+            p[k] += w * o.p[k];
+    }
+};
+
+} // namespace
+
+extern "C" float *geom_subdiv_refine_uniform(const SubdivDesc *d, int level, int limit, size_t *n)
+{
+    *n = 0;
+    Descriptor desc;
+    desc.numVertices = (int)d->n_points;
+    desc.numFaces = (int)d->n_faces;
+    desc.numVertsPerFace = d->n_verts;
+    desc.vertIndicesPerFace = d->indices;
+    desc.numCreases = (int)d->n_creases;
+    desc.creaseVertexIndexPairs = d->crease_edges;
+    desc.creaseWeights = d->crease_sharpness;
+    desc.numCorners = (int)d->n_corners;
+    desc.cornerVertexIndices = d->corner_points;
+    desc.cornerWeights = d->corner_sharpness;
+    desc.numHoles = (int)d->n_holes;
+    desc.holeIndices = d->hole_faces;
+    static const Sdc::SchemeType schemes[3] = {Sdc::SCHEME_CATMARK, Sdc::SCHEME_LOOP,
+                                               Sdc::SCHEME_BILINEAR};
+    std::unique_ptr<Far::TopologyRefiner> r(Far::TopologyRefinerFactory<Descriptor>::Create(
+        desc, Far::TopologyRefinerFactory<Descriptor>::Options(schemes[d->scheme], sdc_options(d))));
+    if (!r)
+        return nullptr;
+    Far::TopologyRefiner::UniformOptions uniform(level);
+    uniform.fullTopologyInLastLevel = true; /* PrimvarRefiner::Limit needs it */
+    r->RefineUniform(uniform);
+    std::vector<Point3> pts((size_t)r->GetNumVerticesTotal());
+    std::memcpy(pts.data(), d->P, d->n_points * sizeof(Point3));
+    Far::PrimvarRefiner pr(*r);
+    Point3 *src = pts.data();
+    for (int l = 1; l <= level; l++) {
+        Point3 *dst = src + r->GetLevel(l - 1).GetNumVertices();
+        pr.Interpolate(l, src, dst);
+        src = dst;
+    }
+    size_t count = (size_t)r->GetLevel(level).GetNumVertices();
+    std::vector<Point3> out(src, src + count);
+    Point3 *dst = out.data();
+    if (limit)
+        pr.Limit(src, dst);
+    float *P = (float *)std::malloc(count * sizeof(Point3));
+    if (P) {
+        std::memcpy(P, out.data(), count * sizeof(Point3));
+        *n = count;
+    }
+    return P;
 }
 
 extern "C" void geom_subdiv_patch_bounds(const SubdivMesh *m, size_t patch, float lo[3],

@@ -80,6 +80,24 @@ size_t geom_subdiv_n_patches(const SubdivMesh *mesh);
 size_t geom_subdiv_patch_face(const SubdivMesh *mesh, size_t patch);
 int geom_subdiv_patch_triangular(const SubdivMesh *mesh, size_t patch);
 
+/* Which curve side `side` of a quad patch lies on (0: v = 0, 1: u = 1,
+ * 2: v = 1, 3: u = 0), for stitching neighbours (geom/stitch.c): key
+ * names it within the mesh (a mesh edge, or a line inside a face split
+ * into sub-faces), and the curve's parameter is t[0] + (t[1] - t[0]) s at
+ * the patch's parameter s along the side. Patches on either side of a
+ * curve agree on its key and parameter. Returns 1, or 0 for triangles. */
+int geom_subdiv_patch_side(const SubdivMesh *mesh, size_t patch, int side, uint64_t key[2],
+                           float t[2]);
+
+/* OpenSubdiv's own uniform refinement of a mesh to `level`
+ * (Far::TopologyRefiner::RefineUniform, Far::PrimvarRefiner), for
+ * checking the limit surface against (tests/scene/test_subdiv.c): the
+ * positions of the vertices of the last level, or with limit their
+ * limit positions (PrimvarRefiner::Limit), 3 floats each, in a new array
+ * the caller frees (free()), *n of them. NULL when the topology is
+ * refused or out of memory. */
+float *geom_subdiv_refine_uniform(const SubdivDesc *desc, int level, int limit, size_t *n);
+
 /* Bounds of a patch's control points, which hold its limit surface. */
 void geom_subdiv_patch_bounds(const SubdivMesh *mesh, size_t patch, float lo[3], float hi[3]);
 

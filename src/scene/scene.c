@@ -1051,6 +1051,7 @@ static DiceCamera dice_camera(const RayesScene *s, int width, int height, const 
     cam.offscreen = dice && dice->offscreen > 1.0f ? dice->offscreen : 1.0f;
     cam.isotropic = dice ? dice->isotropic : 0;
     cam.rate_scale = 1.0f;
+    cam.binary = 1; /* for geom_stitch */
     Mat4 world_from_camera = {{{c->x.x, c->y.x, c->z.x, c->eye.x},
                                {c->x.y, c->y.y, c->z.y, c->eye.y},
                                {c->x.z, c->y.z, c->z.z, c->eye.z},
@@ -1114,6 +1115,8 @@ int scene_prepare(const RayesScene *s, int width, int height, const DiceOptions 
         geom_gridset_fini(gs);
         geom_gridset_init(gs);
     }
+    if (geom_stitch(gs, s->prims) != 0)
+        return -1;
     if (first_need)
         log_warning("dicing: the scene needs %zu grid vertices, more than the budget of %zu "
                     "(--vertex-budget); micropolygons made %.2f times longer (%zu vertices)",

@@ -202,7 +202,9 @@ static void test_grid_size(void)
         rayes_stats_free(st);
         rayes_image_free(img);
     }
-    CHECK(grids[0] >= 4.0 * grids[1] && grids[1] > grids[2]); /* 340, 85, 70 */
+    /* 305, 85, 70 (binary dicing rounds rates to powers of two, so a
+     * gridsize of 16 fills its grids more than 256 does: 340 before). */
+    CHECK(grids[0] >= 3.5 * grids[1] && grids[1] > grids[2]);
     CHECK(mean[0] > 0.0 && fabs(mean[0] / mean[1] - 1.0) < 0.03);
     CHECK(fabs(mean[2] / mean[1] - 1.0) < 0.03);
     o.grid_size = 0;

@@ -1,0 +1,316 @@
+/*
+ * geom/stitch.c — closing the cracks between grids diced at different
+ * rates (DESIGN.md "Stitching").
+ *
+ * Two grids that share a line of the surface (a split inside one
+ * primitive, or an edge between primitives: subdivision faces, polygon
+ * mesh quads, bicubic patches of one mesh) are diced at their own rates,
+ * so their vertices along it differ and rays pass between them. Quad
+ * patches of surfaces dice at powers of two over domains halved when
+ * split (dice.c), so along a shared line the vertices of the coarser grid
+ * are vertices of the finer one. After dicing and displacement, every
+ * vertex on a grid's side is moved onto the polyline of the coarsest grid
+ * there: a vertex of that polyline takes one position for all grids (the
+ * least, compared x, y, z, of their copies, which neighbouring primitives
+ * evaluate a rounding apart), and a vertex between two of them is put on
+ * the segment by its parameter. Both sides of a line then have the same
+ * polyline, and grids stay regular (Embree grids, cache entries); only
+ * positions move, by at most the sagitta of the coarser side.
+ *
+ * A line is a curve with a key and a parameter t: a line u = c or v = c
+ * inside one primitive (t = the other parameter), or a side of the
+ * primitive's domain, keyed by what its neighbour shares: a subdivision
+ * mesh's edge (geom_subdiv_patch_side), the bit patterns of a bilinear
+ * patch's corners or a bicubic patch's four edge control points, in a
+ * canonical order. Lines a vertex lies on more than one of (grid
+ * corners) are settled by repeating the pass until nothing moves.
+ *
+ * Memory: one record per grid side and one position per side vertex,
+ * freed on return. Thread-safety: writes only gs->P.
+ */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "geom/geom.h"
+#include "geom/subdiv.h"
+#include "util/rng.h"
+
+#define STITCH_PASSES 6 /* corners settle in two or three; a bound for odd input */
+
+/* One grid side on a curve: its n + 1 vertices at t = lo + i (hi - lo) / n
+ * are P[first + i * stride]. */
+typedef struct Side {
+    uint64_t key[2];  /* the curve (hashed) */
+    double lo, hi;    /* its range of the curve's parameter, lo < hi */
+    size_t first;     /* the vertex at lo */
+    ptrdiff_t stride; /* to the next vertex toward hi */
+    uint32_t n;       /* segments */
+} Side;
+
+int geom_prim_stitched(const Prim *prim)
+{
+    switch (prim->type) {
+    case PRIM_BILINEAR:
+    case PRIM_BICUBIC:
+    case PRIM_SPHERE:
+    case PRIM_QUADRIC: return 1;
+    case PRIM_SUBDIV: return !prim->subdiv.triangular;
+    default: return 0;
+    }
+}
+
+static uint64_t hash_bits(uint64_t h, const Vec3 *p, int n)
+{
+    for (int k = 0; k < n; k++) {
+        uint32_t b[3];
+        memcpy(b, &p[k], sizeof b);
+        for (int c = 0; c < 3; c++)
+            h = hash_combine(h, b[c]);
+    }
+    return h;
+}
+
+/* -1, 0, 1 as the bit patterns of n points of a compare to those of b. */
+static int cmp_points(const Vec3 *a, const Vec3 *b, int n)
+{
+    for (int k = 0; k < n; k++)
+        for (int c = 0; c < 3; c++) {
+            uint32_t x, y;
+            memcpy(&x, (const float *)&a[k] + c, sizeof x);
+            memcpy(&y, (const float *)&b[k] + c, sizeof y);
+            if (x != y)
+                return x < y ? -1 : 1;
+        }
+    return 0;
+}
+
+/* A patch side given by its n control points (2 for a bilinear patch's
+ * straight edge, 4 for a Bezier curve), from s = 0 to 1: keyed in the
+ * order whose bits are less, t running that way. */
+static void points_side(const Vec3 *cp, int n, uint64_t key[2], float t[2])
+{
+    Vec3 rev[4];
+    for (int k = 0; k < n; k++)
+        rev[k] = cp[n - 1 - k];
+    int forward = cmp_points(cp, rev, n) <= 0;
+    const Vec3 *p = forward ? cp : rev;
+    key[0] = hash_bits(0x5354495443480001ull + (uint64_t)n, p, n);
+    key[1] = hash_bits(0x5354495443480002ull + (uint64_t)n, p, n);
+    t[0] = forward ? 0.0f : 1.0f;
+    t[1] = 1.0f - t[0];
+}
+
+/* The curve of side `side` of prim's domain (0: v = 0, 1: u = 1, 2: v = 1,
+ * 3: u = 0), shared with whatever neighbour shares it, and its parameter
+ * at s = 0 and 1 along the side (s: u or v). 0 if it has none. */
+static int prim_side(const Prim *prim, int side, uint64_t key[2], float t[2])
+{
+    static const int bilinear[4][2] = {{0, 1}, {1, 3}, {2, 3}, {0, 2}};
+    static const int bicubic[4][4] = {{0, 1, 2, 3}, {3, 7, 11, 15}, {12, 13, 14, 15},
+                                      {0, 4, 8, 12}};
+    Vec3 p[4];
+    switch (prim->type) {
+    case PRIM_BILINEAR:
+        p[0] = prim->cp[bilinear[side][0]], p[1] = prim->cp[bilinear[side][1]];
+        points_side(p, 2, key, t);
+        return 1;
+    case PRIM_BICUBIC:
+        for (int k = 0; k < 4; k++)
+            p[k] = prim->cp[bicubic[side][k]];
+        points_side(p, 4, key, t);
+        return 1;
+    case PRIM_SUBDIV: {
+        uint64_t k[2];
+        if (!geom_subdiv_patch_side(prim->subdiv.mesh, prim->subdiv.patch, side, k, t))
+            return 0;
+        uint64_t mesh = (uint64_t)(uintptr_t)prim->subdiv.mesh;
+        key[0] = hash_combine(hash_combine(mesh, k[0]), k[1]);
+        key[1] = hash_combine(hash_combine(k[1], mesh), k[0] + 0x9e3779b97f4a7c15ull);
+        return 1;
+    }
+    default: return 0;
+    }
+}
+
+/* The record of side `side` of grid g (of prim), or 0
+ * when the side is on no curve a neighbour can share. */
+static int grid_side(const Grid *g, const Prim *prim, int side, Side *out)
+{
+    static const int on_v[4] = {1, 0, 1, 0}; /* the side is a line of constant v */
+    int nu = g->nu, nv = g->nv;
+    float c = side == 0 ? g->uv[0][1] : side == 1 ? g->uv[1][0] : side == 2 ? g->uv[1][1]
+                                                                          : g->uv[0][0];
+    int axis = on_v[side] ? 0 : 1; /* s runs along u or v */
+    float s0 = g->uv[0][axis], s1 = g->uv[1][axis];
+    float border = side == 0 || side == 3 ? 0.0f : 1.0f;
+    float t[2] = {0.0f, 1.0f};
+    if (c == border) {
+        if (!prim_side(prim, side, out->key, t))
+            return 0;
+    } else {
+        uint32_t bits;
+        memcpy(&bits, &c, sizeof bits);
+        out->key[0] = hash_combine(hash_combine(0x494e4e4552ull, g->prim), (uint64_t)axis);
+        out->key[1] = hash_combine(out->key[0], bits);
+    }
+    size_t base = g->first_vertex;
+    size_t start = side == 0 || side == 3 ? base
+                   : side == 1            ? base + (size_t)nu - 1
+                                          : base + (size_t)(nv - 1) * (size_t)nu;
+    ptrdiff_t stride = on_v[side] ? 1 : nu;
+    out->n = (uint32_t)(on_v[side] ? nu - 1 : nv - 1);
+    double a = (double)t[0] + ((double)t[1] - t[0]) * s0, b = (double)t[0] + ((double)t[1] - t[0]) * s1;
+    if (a > b) {
+        start += (size_t)(stride * (ptrdiff_t)out->n);
+        stride = -stride;
+    }
+    out->lo = fmin(a, b), out->hi = fmax(a, b);
+    out->first = start, out->stride = stride;
+    return out->hi > out->lo;
+}
+
+static int cmp_side(const void *pa, const void *pb)
+{
+    const Side *a = pa, *b = pb;
+    for (int k = 0; k < 2; k++)
+        if (a->key[k] != b->key[k])
+            return a->key[k] < b->key[k] ? -1 : 1;
+    return a->lo < b->lo ? -1 : a->lo > b->lo;
+}
+
+static int vec_less(Vec3 a, Vec3 b)
+{
+    return a.x != b.x ? a.x < b.x : a.y != b.y ? a.y < b.y : a.z < b.z;
+}
+
+/* The sides of a curve are s[0..n), sorted by lo; the longest is len. */
+typedef struct Curve {
+    const Side *s;
+    size_t n;
+    double len;
+} Curve;
+
+/* The largest spacing among the sides covering t, and the canonical
+ * position at t (the least copy, over the sides with a vertex there) in
+ * *at when some side has one; returns that spacing. */
+static double curve_at(const Curve *c, const Vec3 *P, double t, Vec3 *at, int *found)
+{
+    double H = 0.0;
+    *found = 0;
+    /* Sides are sorted by lo, none longer than len: those covering t
+     * start in [t - len, t]. */
+    size_t hi = c->n;
+    while (hi > 0 && c->s[hi - 1].lo > t)
+        hi--;
+    for (size_t k = hi; k-- > 0 && c->s[k].lo >= t - c->len;) {
+        const Side *sd = &c->s[k];
+        if (t > sd->hi)
+            continue;
+        double h = (sd->hi - sd->lo) / sd->n, i = (t - sd->lo) / h;
+        H = fmax(H, h);
+        if (i == floor(i)) {
+            Vec3 p = P[(ptrdiff_t)sd->first + sd->stride * (ptrdiff_t)i];
+            if (!*found || vec_less(p, *at))
+                *at = p;
+            *found = 1;
+        }
+    }
+    return H;
+}
+
+/* Where vertex i of side sd belongs: on the coarsest polyline at its t.
+ * Returns 0 when that polyline has no vertex to place it by (dicing
+ * rates that are not powers of two: left alone). */
+static int settle(const Curve *c, const Vec3 *P, const Side *sd, uint32_t i, Vec3 *out)
+{
+    double t = sd->lo + (sd->hi - sd->lo) * i / sd->n;
+    int found;
+    double H = curve_at(c, P, t, out, &found);
+    double t0 = floor(t / H) * H;
+    if (t0 == t)
+        return found;
+    Vec3 a, b;
+    int fa, fb;
+    curve_at(c, P, t0, &a, &fa);
+    curve_at(c, P, t0 + H, &b, &fb);
+    if (!fa || !fb)
+        return 0;
+    *out = v3_add(a, v3_scale(v3_sub(b, a), (float)((t - t0) / H)));
+    return 1;
+}
+
+/* Settles the vertices of one curve's sides; returns how many moved, or
+ * -1 when out of memory. */
+static long stitch_curve(const Curve *c, Vec3 *P)
+{
+    size_t count = 0;
+    for (size_t k = 0; k < c->n; k++)
+        count += c->s[k].n + 1;
+    Vec3 *to = malloc(count * sizeof *to);
+    if (!to)
+        return -1;
+    size_t m = 0;
+    for (size_t k = 0; k < c->n; k++)
+        for (uint32_t i = 0; i <= c->s[k].n; i++, m++)
+            if (!settle(c, P, &c->s[k], i, &to[m]))
+                to[m] = P[(ptrdiff_t)c->s[k].first + c->s[k].stride * (ptrdiff_t)i];
+    long moved = 0;
+    m = 0;
+    for (size_t k = 0; k < c->n; k++)
+        for (uint32_t i = 0; i <= c->s[k].n; i++, m++) {
+            Vec3 *p = &P[(ptrdiff_t)c->s[k].first + c->s[k].stride * (ptrdiff_t)i];
+            moved += memcmp(p, &to[m], sizeof *p) != 0;
+            *p = to[m];
+        }
+    free(to);
+    return moved;
+}
+
+/* The sides of every stitched grid of gs, sorted by curve; NULL when out
+ * of memory (*n = 0 with none). */
+static Side *collect_sides(const GridSet *gs, const Prim *prims, size_t *n)
+{
+    Side *sides = malloc((4 * gs->n_grids + 1) * sizeof *sides);
+    *n = 0;
+    if (!sides)
+        return NULL;
+    for (size_t g = 0; g < gs->n_grids; g++) {
+        const Grid *grid = &gs->grids[g];
+        const Prim *prim = &prims[grid->prim];
+        if (grid->triangular || grid->shape != GEOM_SHAPE_SURFACE || !geom_prim_stitched(prim))
+            continue;
+        for (int side = 0; side < 4; side++)
+            *n += (size_t)grid_side(grid, prim, side, &sides[*n]);
+    }
+    qsort(sides, *n, sizeof *sides, cmp_side);
+    return sides;
+}
+
+int geom_stitch(GridSet *gs, const Prim *prims)
+{
+    size_t n;
+    Side *sides = collect_sides(gs, prims, &n);
+    if (!sides)
+        return -1;
+    long moved = 1;
+    for (int pass = 0; pass < STITCH_PASSES && moved > 0; pass++) {
+        moved = 0;
+        for (size_t a = 0, b; a < n; a = b) {
+            Curve c = {&sides[a], 0, 0.0};
+            for (b = a; b < n && !memcmp(sides[b].key, sides[a].key, sizeof sides[a].key); b++)
+                c.len = fmax(c.len, sides[b].hi - sides[b].lo);
+            c.n = b - a;
+            if (c.n < 2)
+                continue;
+            long m = stitch_curve(&c, gs->P);
+            if (m < 0) {
+                free(sides);
+                return -1;
+            }
+            moved += m;
+        }
+    }
+    free(sides);
+    return 0;
+}
