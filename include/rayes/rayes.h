@@ -424,6 +424,17 @@ typedef enum RayesQuadric {
 RAYES_API RayesError rayes_scene_quadric(RayesScene *scene, RayesQuadric type,
                                          const float *params, size_t n_params, unsigned flags);
 
+/* A volume (memo 6.1): the box bound = xmin, xmax, ymin, ymax, zmin, zmax
+ * of object space (RenderMan's Volume "box"), filled by a medium that the
+ * current shader describes: its opacity method returns the extinction
+ * coefficient per unit length (RGB; the memo's convention) and its
+ * lighting method the light the medium scatters and emits toward I per
+ * unit length (the built-in volume shaders: docs/shaders.md). With no
+ * shader set, "homogeneous". Volumes are ray marched (RayesRenderOptions'
+ * volume_step); camera and specular rays see their single scattering,
+ * shadow rays their extinction. */
+RAYES_API RayesError rayes_scene_volume(RayesScene *scene, const float bound[6]);
+
 /* A one-sided emitting quad (an area light) with vertices P[0..3] in order
  * around the quad; it emits radiance L from the side toward which
  * (P1 - P0) x (P2 - P0) points, and is seen by the camera. */
@@ -644,6 +655,10 @@ typedef struct RayesRenderOptions {
     double opacity_cache_mb; /* the opacity entries' budget in megabytes (10^6 bytes;
                                 RenderMan's "opacitycachememory"), default 20, apart from
                                 cache_mb */
+    float volume_step;         /* volumes are ray marched in steps of this many fine voxels
+                                  (a voxel projects to about a pixel at the volume's nearest
+                                  point, times the square root of its shading rate): default
+                                  1; larger is faster and coarser */
 } RayesRenderOptions;
 
 /* Fills options with the defaults of a quality preset: 512 x 512, 4 pixel

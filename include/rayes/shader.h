@@ -317,6 +317,18 @@ struct RayesShaderServices {
      * channel, in [0, 1]. Older renderers lack it (supports()). */
     void (*occlusion)(const RayesShaderServices *sv, const RayesShadeCtx *ctx, int n_rays,
                       float maxdist, float (*out)[3]);
+
+    /* Direct lighting of a medium (volume shaders' lighting method): per
+     * point, the integral of L_light(w) p(w) dw over the scene's lights,
+     * p the Henyey-Greenstein phase function of asymmetry g (0:
+     * isotropic, 1 / (4 pi)) between the light's direction and the view
+     * (ctx->I; g > 0 scatters forward, toward a viewer looking at the
+     * light). Shadow rays as direct_lighting's (n_shadow_rays, category),
+     * attenuated by surfaces' opacity and volumes' extinction. A medium of
+     * scattering coefficient sigma_s scatters sigma_s * out[i] toward the
+     * viewer per unit length. Older renderers lack it (supports()). */
+    void (*direct_volume)(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
+                          int n_shadow_rays, const char *category, float g, float (*out)[3]);
 };
 
 #ifdef __cplusplus

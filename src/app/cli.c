@@ -60,6 +60,7 @@ static const char render_options[] =
     "  --opacity-cache on|off  cache opacity() results for shadow and transmission rays\n"
     "                          (default on)\n"
     "  --opacity-cache-mb MB   the opacity entries' budget in megabytes (default 20)\n"
+    "  --volume-step S         volumes are marched in steps of S fine voxels (default 1)\n"
     "  --crop X0,X1,Y0,Y1      render only this window of the image (RenderMan's CropWindow,\n"
     "                          0 to 1, y down): the same pixels as the whole frame's; PNG\n"
     "                          holds the window, EXR it as the data window of the frame\n"
@@ -357,6 +358,8 @@ void parse_args(int argc, char **argv, Args *a)
             opt->opacity_cache = strcmp(v, "on") == 0;
         } else if (strcmp(o, "--opacity-cache-mb") == 0)
             opt->opacity_cache_mb = parse_float(o, v, 0.0f, 1e7f);
+        else if (strcmp(o, "--volume-step") == 0)
+            opt->volume_step = parse_float(o, v, 0.01f, 1000.0f);
         else if (strcmp(o, "--cache-split") == 0)
             parse_split(v, opt->cache_split);
         else if (strcmp(o, "--crop") == 0) {

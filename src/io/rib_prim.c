@@ -1002,6 +1002,41 @@ static int h_quadric(Rib *r, const Args *a)
     return e;
 }
 
+/* Volume "box" [xmin xmax ymin ymax zmin zmax] [nx ny nz]: a volume filled
+ * by the current surface shader (a volume shader: its opacity is the
+ * extinction); the voxel counts are read and unused (rayes chooses the
+ * resolution from the camera). Other types warn once and are skipped. */
+static int h_volume(Rib *r, const Args *a)
+{
+    size_t i = 0, n;
+    const char *type = rib_get_string(r, a, &i, "a volume type");
+    float b[6], dims[3];
+    Param *p;
+    if (!type || rib_get_floats(r, a, &i, b, 6, "the bound xmin xmax ymin ymax zmin zmax") != 0 ||
+        rib_get_floats(r, a, &i, dims, 3, "the voxel counts nx ny nz") != 0 ||
+        rib_get_params(r, a, i, &p, &n) != 0)
+        return -1;
+    free(p);
+    if (strcmp(type, "box") != 0) {
+        char key[128];
+        snprintf(key, sizeof key, "volume %s", type);
+        rib_warn_once(r, key, "Volume \"%s\" is not supported (only \"box\"); skipped", type);
+        return 0;
+    }
+    if (!(b[0] < b[1] && b[2] < b[3] && b[4] < b[5]))
+        return rib_error(r, "Volume: expected a bound with xmin < xmax, ymin < ymax, zmin < zmax");
+    int e = rib_emit_begin(r, NULL);
+    if (e == 0) {
+        SinkState *st;
+        const IoSink *s = rib_out_sink(r, &st);
+        if (!s->volume)
+            rib_warn_once(r, "volume sink", "Volume is not supported here; skipped");
+        else if (s->volume(s->target, b) != RAYES_OK)
+            e = rib_sink_failed(r, s);
+    }
+    return e > 0 ? 0 : e;
+}
+
 /* Geometry "teapot": io_read_bpt drives this sink, whose patches go
  * through the reader's own emission (transform, shader, orientation,
  * object recording). */
@@ -1077,6 +1112,7 @@ const RibRequest rib_prim_requests[] = {
     {"Hyperboloid", h_quadric},
     {"Paraboloid", h_quadric},
     {"Geometry", h_geometry},
+    {"Volume", h_volume},
     {"SubdivisionMesh", h_subdivision_mesh},
     {"HierarchicalSubdivisionMesh", h_hierarchical_subdivision_mesh},
     {NULL, NULL},

@@ -24,7 +24,8 @@ typedef enum CallKind {
     CALL_AREA_LIGHT,
     CALL_SUBDIV,
     CALL_CURVES,
-    CALL_POINTS
+    CALL_POINTS,
+    CALL_VOLUME
 } CallKind;
 
 typedef struct RibCall {
@@ -330,6 +331,10 @@ static RayesError rec_quadric(void *t, RayesQuadric type, const float *p, size_t
         rec->calls[rec->n - 1].flags = (unsigned)type << 8 | (flags & 0xff);
     return e;
 }
+static RayesError rec_volume(void *t, const float bound[6])
+{
+    return floats(t, CALL_VOLUME, bound, 6);
+}
 static RayesError rec_area_light(void *t, const float P[4][3], const float L[3])
 {
     float f[15];
@@ -369,6 +374,7 @@ IoSink rib_recording_sink(RibRecording *rec)
     s.subdivision_mesh = rec_subdivision_mesh;
     s.curves = rec_curves;
     s.points = rec_points;
+    s.volume = rec_volume;
     return s;
 }
 
@@ -414,6 +420,9 @@ RayesError rib_recording_replay(const RibRecording *rec, const IoSink *out,
             e = out->quadric(t, (RayesQuadric)(c->flags >> 8), c->f, c->n_f, c->flags & 0xff);
             break;
         case CALL_AREA_LIGHT: e = out->area_light(t, (const float(*)[3])c->f, c->f + 12); break;
+        case CALL_VOLUME:
+            e = out->volume ? out->volume(t, c->f) : RAYES_OK; /* the reader warned */
+            break;
         case CALL_SUBDIV: {
             RayesSubdivTags g = c->tags;
             const int *at = c->ints + c->n_faces + c->n_idx;

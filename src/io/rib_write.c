@@ -831,6 +831,16 @@ static RayesError w_quadric(void *t, RayesQuadric type, const float *p, size_t n
     return RAYES_OK;
 }
 
+static RayesError w_volume(void *t, const float b[6])
+{
+    RibWriter *w = t;
+    if (!b || !finite_all(b, 6))
+        return fail(w, RAYES_ERROR_INVALID_ARGUMENT, "volume: bound not finite");
+    fprintf(w->world.f, "Volume \"box\" [%.9g %.9g %.9g %.9g %.9g %.9g] [1 1 1]\n", (double)b[0],
+            (double)b[1], (double)b[2], (double)b[3], (double)b[4], (double)b[5]);
+    return RAYES_OK;
+}
+
 static RayesError w_sphere(void *t, float r)
 {
     const float p[4] = {r, -r, r, 360.0f};
@@ -955,6 +965,7 @@ IoSink io_rib_writer_sink(RibWriter *w)
         .polygon_mesh = w_polygon_mesh,
         .sphere = w_sphere,
         .quadric = w_quadric,
+        .volume = w_volume,
         .area_light = w_area_light,
         .light = w_light,
         .set_light_links = w_set_light_links,

@@ -94,6 +94,11 @@ static RayesError scene_sphere(void *t, float radius)
     return rayes_scene_sphere(t, radius);
 }
 
+static RayesError scene_volume(void *t, const float bound[6])
+{
+    return rayes_scene_volume(t, bound);
+}
+
 static RayesError scene_quadric(void *t, RayesQuadric type, const float *params, size_t n,
                                 unsigned flags)
 {
@@ -164,6 +169,7 @@ IoSink io_sink_scene(RayesScene *scene)
         .curves = scene_curves,
         .points = scene_points,
         .pattern = scene_pattern,
+        .volume = scene_volume,
     };
 }
 

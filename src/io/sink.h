@@ -81,6 +81,9 @@ typedef struct IoSink {
      * constants where textures would vary, with one warning). */
     RayesError (*pattern)(void *target, const char *name, const char *type,
                           const RayesParam *params, size_t n_params);
+    /* rayes_scene_volume (NULL in sinks without it: readers skip volumes
+     * with one warning). */
+    RayesError (*volume)(void *target, const float bound[6]);
 } IoSink;
 
 /* A sink that builds scene through rayes.h (borrowed, not retained). */

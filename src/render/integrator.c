@@ -17,6 +17,7 @@
 
 #include "render/hider.h"
 #include "render/radiosity.h"
+#include "render/volume.h"
 
 #include <math.h>
 #include <string.h>
@@ -202,10 +203,16 @@ static Vec3 shadow_opacity(void *user, const Ray *ray, const Hit *hit)
 Vec3 integrator_transmission(Worker *w, const Ray *ray, RayDiff diff)
 {
     w->stats.rays_shadow++;
-    if (!w->rs->any_transparent)
-        return accel_occluded(w->rs->accel, ray) ? v3(0, 0, 0) : v3(1, 1, 1);
-    ShadowRay sr = {w, diff};
-    return accel_transmission(w->rs->accel, ray, shadow_opacity, &sr);
+    Vec3 T;
+    if (!w->rs->any_transparent) {
+        T = accel_occluded(w->rs->accel, ray) ? v3(0, 0, 0) : v3(1, 1, 1);
+    } else {
+        ShadowRay sr = {w, diff};
+        T = accel_transmission(w->rs->accel, ray, shadow_opacity, &sr);
+    }
+    if (w->rs->n_volumes && v3_max_component(T) > 0.0f)
+        T = v3_mul(T, volume_transmittance(w, ray, diff));
+    return T;
 }
 
 /* Surfaces a ray sees through before the next is taken as opaque. */
@@ -274,11 +281,27 @@ static Vec3 trace_layers(Worker *w, const Ray *ray, uint32_t kind, int diffuse_d
     return v3_add(Ci, v3_mul(T, L));
 }
 
+/* trace_layers, seen through the volumes in front of what the ray hits:
+ * their light added, what lies behind attenuated (volume.h). */
+static Vec3 trace_volumes(Worker *w, const Ray *ray, uint32_t kind, int diffuse_depth,
+                          int specular_depth, uint64_t key, RayDiff diff, float *t, float *alpha)
+{
+    Vec3 L = trace_layers(w, ray, kind, diffuse_depth, specular_depth, key, diff, t, alpha, 0);
+    if (!w->rs->n_volumes)
+        return L;
+    Vec3 T;
+    float tmax = isfinite(*t) ? *t : ray->tfar;
+    Vec3 Lv = volume_radiance(w, ray, tmax, kind, diffuse_depth, specular_depth,
+                              hash_combine(key, 0x766f6c756d65ull /* "volume" */), diff, &T);
+    *alpha = 1.0f - (1.0f - *alpha) * (T.x + T.y + T.z) / 3.0f;
+    return v3_add(Lv, v3_mul(T, L));
+}
+
 Vec3 integrator_trace(Worker *w, const Ray *ray, uint32_t kind, int diffuse_depth,
                       int specular_depth, uint64_t key, RayDiff diff, float *alpha)
 {
     float t, a;
-    Vec3 L = trace_layers(w, ray, kind, diffuse_depth, specular_depth, key, diff, &t, &a, 0);
+    Vec3 L = trace_volumes(w, ray, kind, diffuse_depth, specular_depth, key, diff, &t, &a);
     if (alpha)
         *alpha = a;
     return L;
@@ -288,5 +311,5 @@ Vec3 integrator_trace_hit(Worker *w, const Ray *ray, uint32_t kind, int diffuse_
                           int specular_depth, uint64_t key, RayDiff diff, float *t)
 {
     float a;
-    return trace_layers(w, ray, kind, diffuse_depth, specular_depth, key, diff, t, &a, 0);
+    return trace_volumes(w, ray, kind, diffuse_depth, specular_depth, key, diff, t, &a);
 }

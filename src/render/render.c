@@ -210,6 +210,8 @@ static void merge_stats(RenderStats *into, const RenderStats *s)
     into->ambient_lookups += s->ambient_lookups;
     into->opacity_points += s->opacity_points;
     into->transparent_hits += s->transparent_hits;
+    into->rays_transmission += s->rays_transmission;
+    into->volume_steps += s->volume_steps;
 }
 
 int render_frame(const RenderScene *rs, const RenderSettings *set, float *rgba, RenderStats *stats)

@@ -72,6 +72,8 @@ typedef struct RenderScene {
     Camera camera;
     float scene_radius;  /* for ray offsets */
     int any_transparent; /* 1: some object is transparent (shadow rays filter) */
+    const struct RenderVolume *volumes; /* volume.h; not in the accel */
+    size_t n_volumes;
 } RenderScene;
 
 typedef struct RenderSettings {
@@ -92,6 +94,7 @@ typedef struct RenderSettings {
     Cache *cache;            /* the cache (every data type), or NULL: uncached */
     int radiosity_cache;     /* 1: diffuse hits read radiosity from cache */
     int opacity_cache;       /* 1: shadow and diffuse rays read opacity from cache */
+    float volume_step;       /* ray marching steps, in fine voxels of each volume */
     int cache_resolution;    /* -1: by differentials; else a forced CacheLevel */
     float cache_k;           /* resolution rule constant (DESIGN.md) */
     int grid_size;           /* micropolygons per grid, at most (dicing; geom.h) */
@@ -123,6 +126,9 @@ typedef struct RenderStats {
                                   uncached transmission hits) */
     uint64_t transparent_hits; /* surfaces shadow rays passed through (or stopped at) that
                                   were partly transparent */
+    uint64_t rays_transmission; /* shadow and transmission rays that marched a volume (also
+                                   counted in rays_shadow) */
+    uint64_t volume_steps;      /* ray marching steps through volumes */
 } RenderStats;
 
 /* The camera of an image of `height` pixels: eye, axes and tan(fov / 2)

@@ -640,6 +640,59 @@ static void svc_occlusion(const RayesShaderServices *sv, const RayesShadeCtx *ct
     }
 }
 
+/* The Henyey-Greenstein phase function of the angle whose cosine is c
+ * (between the light's direction and the view). */
+static float phase_hg(float g, float c)
+{
+    float d = 1.0f + g * g - 2.0f * g * c;
+    return (1.0f - g * g) / (4.0f * (float)M_PI * d * sqrtf(fmaxf(d, 1e-12f)));
+}
+
+static void svc_direct_volume(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
+                              int n_shadow_rays, const char *category, float g, float (*out)[3])
+{
+    (void)sv;
+    const PathState *ps = ctx->renderer;
+    Worker *w = ps->w;
+    int n = n_shadow_rays > 0               ? n_shadow_rays
+            : ctx->diffuse_depth == 0 ? w->set->shadow_rays
+                                            : w->set->shadow_rays_deep;
+    g = fminf(fmaxf(g, -0.99f), 0.99f);
+    for (size_t i = 0; i < ctx->n_points; i++) {
+        size_t j = point(ctx, i);
+        Vec3 P = v3_load(ctx->P[i]), I = ctx->I ? v3_load(ctx->I[i]) : v3(0, 0, 0);
+        uint64_t key = hash_combine(ps->keys[j], DIM_LIGHT);
+        Vec3 sum = v3(0, 0, 0);
+        for (size_t k = 0; k < w->rs->n_lights && n > 0; k++) {
+            const Light *l = &w->rs->lights[k];
+            if (l->type == LIGHT_AMBIENT || !light_category_match(l, category))
+                continue;
+            int m = light_is_area(l) ? n : 1;
+            uint32_t pattern = (uint32_t)hash_combine(key, k);
+            for (int s = 0; s < m; s++) {
+                float a = 0.5f, b = 0.5f;
+                if (m > 1)
+                    cmj_sample_2d((uint32_t)s, (uint32_t)m, pattern, &a, &b);
+                LightSample ls;
+                if (!light_sample(l, P, a, b, &ls) || !(v3_max_component(ls.Li) > 0.0f) ||
+                    (light_is_area(l) && !(ls.pdf > 0.0f)))
+                    continue;
+                float weight = light_is_area(l) ? 1.0f / (ls.pdf * (float)m) : 1.0f;
+                RayDiff sd = {ps->diff[j].width, ps->diff[j].spread};
+                if (light_is_area(l))
+                    sd.spread = fmaxf(sd.spread, sqrtf(1.0f / ((float)m * ls.pdf)));
+                Vec3 T = transmittance(w, P, ls.wi, ls.dist, sd);
+                float p = v3_length(I) > 0.0f ? phase_hg(g, v3_dot(ls.wi, I))
+                                              : 1.0f / (4.0f * (float)M_PI);
+                /* delta lights' Li is irradiance-like (direct_lighting's Li cos / pi for a
+                 * Lambertian): the medium takes Li p */
+                sum = v3_add(sum, v3_scale(v3_mul(ls.Li, T), p * weight));
+            }
+        }
+        v3_store(out[i], sum);
+    }
+}
+
 static int svc_texture(const RayesShaderServices *sv, const RayesShadeCtx *ctx, const char *name,
                        const float *s, const float *t, const float *ds, const float *dt,
                        float (*rgb)[3], float *alpha)
@@ -738,6 +791,7 @@ static const char *const service_names[] = {
     "pattern",
     "direct_fiber",
     "occlusion",
+    "direct_volume",
 };
 
 static int svc_supports(const RayesShaderServices *sv, const char *service)
@@ -759,6 +813,7 @@ const RayesShaderServices render_services = {
     .indirect_refraction = svc_indirect_refraction,
     .transmission = svc_transmission,
     .occlusion = svc_occlusion,
+    .direct_volume = svc_direct_volume,
     .texture = svc_texture,
     .noise = shade_service_noise,
     .fbm = shade_service_fbm,

@@ -115,6 +115,7 @@ void rayes_scene_release(RayesScene *s)
     for (size_t i = 0; i < s->n_lights; i++)
         light_fini(&s->lights[i]);
     free(s->lights);
+    free(s->volumes);
     for (int k = 0; k < SCENE_SEARCH_PATH_COUNT; k++)
         free(s->search_paths[k]);
     scene_patterns_free(s);
@@ -856,6 +857,30 @@ RayesError rayes_scene_sphere(RayesScene *s, float radius)
     return add_prim(s, &p);
 }
 
+RayesError rayes_scene_volume(RayesScene *s, const float bound[6])
+{
+    if (!s || !bound)
+        return RAYES_ERROR_INVALID_ARGUMENT;
+    if (!finite_n(bound, 6) || !(bound[0] < bound[1]) || !(bound[2] < bound[3]) ||
+        !(bound[4] < bound[5]))
+        return fail(s, RAYES_ERROR_INVALID_ARGUMENT,
+                    "volume: expected a finite box xmin < xmax, ymin < ymax, zmin < zmax");
+    if (s->current_object < 0) {
+        RayesError e = rayes_scene_set_shader(s, "homogeneous", NULL, 0);
+        if (e != RAYES_OK)
+            return e;
+    }
+    if (grow((void **)&s->volumes, &s->cap_volumes, s->n_volumes, sizeof *s->volumes) != 0)
+        return fail(s, RAYES_ERROR_OUT_OF_MEMORY, "out of memory");
+    SceneVolume *v = &s->volumes[s->n_volumes++];
+    v->object = (uint32_t)s->current_object;
+    v->world_from_object = s->world_from_object;
+    memcpy(v->bound, bound, sizeof v->bound);
+    v->shading_rate = s->shading_rate;
+    scene_mark(s, SCENE_CHANGE_GEOMETRY);
+    return RAYES_OK;
+}
+
 RayesError rayes_scene_area_light(RayesScene *s, const float P[4][3], const float L[3])
 {
     if (!s || !P || !L)
@@ -986,6 +1011,13 @@ uint64_t rayes_scene_get_timestamp(const RayesScene *s)
 Bounds3 scene_bounds(const RayesScene *s)
 {
     Bounds3 b = bounds_empty();
+    for (size_t i = 0; i < s->n_volumes; i++) {
+        const SceneVolume *v = &s->volumes[i];
+        for (int k = 0; k < 8; k++)
+            b = bounds_add(b, mat4_point(&v->world_from_object,
+                                         v3(v->bound[k & 1], v->bound[2 + (k >> 1 & 1)],
+                                            v->bound[4 + (k >> 2)])));
+    }
     for (size_t i = 0; i < s->n_prims; i++) {
         const Prim *p = &s->prims[i];
         if (p->type == PRIM_SPHERE) {

@@ -34,6 +34,15 @@ typedef struct SceneObject {
     uint8_t opacity_cache;                 /* 1: its opacity may be cached */
 } SceneObject;
 
+/* A volume (rayes_scene_volume): a box of object space under a transform,
+ * filled by its object's shader. */
+typedef struct SceneVolume {
+    uint32_t object;
+    Mat4 world_from_object;
+    float bound[6];           /* xmin, xmax, ymin, ymax, zmin, zmax */
+    float shading_rate;
+} SceneVolume;
+
 /* A named pattern (rayes_scene_pattern, patterns.c). */
 typedef struct ScenePattern {
     char *name;                   /* owned */
@@ -98,6 +107,8 @@ struct RayesScene {
     size_t n_objects, cap_objects;
     Light *lights;
     size_t n_lights, cap_lights;
+    SceneVolume *volumes;
+    size_t n_volumes, cap_volumes;
     ShaderInstance *displacements; /* displacement shader instances, owned */
     size_t n_displacements, cap_displacements;
     uint32_t current_displacement; /* of geometry added next: index + 1, or 0 */

@@ -16,6 +16,7 @@
 #include "geom/geom.h"
 #include "rayes/rayes.h"
 #include "render/render.h"
+#include "render/volume.h"
 #include "scene/scene.h"
 #include "session/session.h"
 #include "session/stats.h"
@@ -69,6 +70,7 @@ void rayes_render_options_init(RayesRenderOptions *o, RayesQuality quality)
     o->crop[1] = o->crop[3] = 1.0f;
     o->opacity_cache = 1;
     o->opacity_cache_mb = 20.0;
+    o->volume_step = 1.0f;
     switch (quality) {
     case RAYES_QUALITY_PREVIEW:
         o->shadow_rays = o->shadow_rays_deep = 4;
@@ -126,6 +128,8 @@ RayesError session_check_options(RayesScene *scene, const RayesRenderOptions *o)
              !(o->cache_split[0] + o->cache_split[1] + o->cache_split[2] <= 1.0001f))
         what = "options: cache budget 0 to 1e7 MB, split shares >= 0 summing to at most 1, "
                "k > 0, resolution -1 to 2";
+    else if (!(o->volume_step >= 0.01f) || !(o->volume_step <= 1000.0f))
+        what = "options: volume step must be 0.01 to 1000 voxels";
     else if (o->grid_size < 1 || o->grid_size > GEOM_MAX_GRID_SIZE)
         what = "options: grid size must be 1 to 4096 micropolygons";
     else if (!(o->dice_offscreen >= 1.0f) || o->dice_offscreen > 1000.0f ||
@@ -193,6 +197,7 @@ RenderSettings session_settings(const RayesRenderOptions *o)
         .irradiance = o->irradiance != 0,
         .radiosity_cache = o->cache != 0,
         .opacity_cache = o->opacity_cache != 0,
+        .volume_step = o->volume_step,
         .tile_done = o->tile_done,
         .tile_user = o->tile_user,
     };
@@ -279,6 +284,47 @@ RayesError session_fail(RayesScene *scene, RayesError e, const char *msg)
     return e;
 }
 
+/* The render form of the scene's volumes: fine voxels about a pixel wide at
+ * the box's nearest point to the eye (times the square root of its
+ * shading rate, as grids are diced), their bricks' cache keys after the
+ * grids'. Returns 0, or -1 when out of memory. */
+static int prepare_volumes(const RayesScene *scene, const RenderSettings *set, Prepared *p)
+{
+    if (!scene->n_volumes)
+        return 0;
+    p->volumes = calloc(scene->n_volumes, sizeof *p->volumes);
+    if (!p->volumes)
+        return -1;
+    float screen[4];
+    scene_camera_screen(&scene->camera, set->width, set->height, screen);
+    const SceneCamera *c = &scene->camera;
+    Camera cam = render_camera(c->eye, c->x, c->y, c->z, c->tan_half_fov, screen, set->height);
+    uint32_t base = (uint32_t)p->gs.n_grids;
+    for (size_t i = 0; i < scene->n_volumes; i++) {
+        const SceneVolume *sv = &scene->volumes[i];
+        Bounds3 wb = bounds_empty();
+        for (int k = 0; k < 8; k++)
+            wb = bounds_add(wb, mat4_point(&sv->world_from_object,
+                                           v3(sv->bound[k & 1], sv->bound[2 + (k >> 1 & 1)],
+                                              sv->bound[4 + (k >> 2)])));
+        Vec3 near = v3(fminf(fmaxf(cam.eye.x, wb.lo.x), wb.hi.x),
+                       fminf(fmaxf(cam.eye.y, wb.lo.y), wb.hi.y),
+                       fminf(fmaxf(cam.eye.z, wb.lo.z), wb.hi.z));
+        float dist =
+            fmaxf(v3_length(v3_sub(near, cam.eye)), 1e-3f * v3_length(v3_sub(wb.hi, wb.lo)));
+        float voxel = (cam.pixel_width + cam.pixel_spread * dist) * sqrtf(sv->shading_rate);
+        RenderVolume *v = &p->volumes[p->n_volumes];
+        uint32_t bricks = volume_init(v, sv->object, &sv->world_from_object,
+                                      v3(sv->bound[0], sv->bound[2], sv->bound[4]),
+                                      v3(sv->bound[1], sv->bound[3], sv->bound[5]), voxel, base);
+        if (bricks == 0)
+            continue; /* a singular transform: nothing to march */
+        base += bricks;
+        p->n_volumes++;
+    }
+    return 0;
+}
+
 RayesError session_prepare(RayesScene *scene, const RenderSettings *set, TextureSystem *textures,
                            Prepared *p)
 {
@@ -304,8 +350,14 @@ RayesError session_prepare(RayesScene *scene, const RenderSettings *set, Texture
     for (size_t i = 0; i < scene->n_objects; i++)
         p->any_transparent |= p->objects[i].transparent;
     Bounds3 b = scene_bounds(scene);
-    p->scene_radius =
-        scene->n_prims ? fmaxf(0.5f * v3_length(v3_sub(b.hi, b.lo)), 1e-6f) : 1.0f;
+    p->scene_radius = scene->n_prims || scene->n_volumes
+                          ? fmaxf(0.5f * v3_length(v3_sub(b.hi, b.lo)), 1e-6f)
+                          : 1.0f;
+    if (prepare_volumes(scene, set, p) != 0) {
+        session_prepared_fini(p);
+        return session_fail(scene, RAYES_ERROR_OUT_OF_MEMORY,
+                            "render: out of memory preparing the volumes");
+    }
     return RAYES_OK;
 }
 
@@ -315,6 +367,7 @@ void session_prepared_fini(Prepared *p)
     geom_gridset_fini(&p->gs);
     free(p->objects);
     free(p->masks);
+    free(p->volumes);
     memset(p, 0, sizeof *p);
 }
 
@@ -330,6 +383,8 @@ RenderScene session_render_scene(const RayesScene *scene, const Prepared *p, int
                                 scene->camera.z, scene->camera.tan_half_fov, screen, height),
         .scene_radius = p->scene_radius,
         .any_transparent = p->any_transparent,
+        .volumes = p->volumes,
+        .n_volumes = p->n_volumes,
     };
 }
 

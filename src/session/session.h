@@ -23,6 +23,8 @@ typedef struct Prepared {
     Accel *accel;
     float scene_radius;  /* for ray offsets */
     int any_transparent; /* some object may be partly transparent */
+    struct RenderVolume *volumes; /* n_volumes (render/volume.h) */
+    size_t n_volumes;
     float coarsened;     /* >= 1: how much longer the vertex budget made micropolygons */
 } Prepared;
 

@@ -54,9 +54,11 @@ RayesStats *session_stats_new(const RenderSettings *set, const RenderStats *rs, 
     count(s, "rays/shadow", rs->rays_shadow);
     count(s, "rays/diffuse", rs->rays_diffuse);
     count(s, "rays/specular", rs->rays_specular);
+    count(s, "rays/transmission", rs->rays_transmission); /* of rays/shadow: they marched */
     count(s, "lighting/ambient_points", rs->ambient_lookups);
     count(s, "opacity/shading_points", rs->opacity_points);
     count(s, "opacity/transparent_hits", rs->transparent_hits);
+    count(s, "volume/steps", rs->volume_steps);
     count(s, "grids", gs->n_grids);
     count(s, "grid_vertices", gs->n_vertices);
     count(s, "grid_size", (uint64_t)set->grid_size);

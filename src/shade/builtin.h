@@ -15,6 +15,10 @@ extern const RayesShaderClass shade_class_hair; /* fibres: Ka, Kd, Ks, roughness
 extern const RayesShaderClass shade_class_stainedglass; /* coloured opacity: Kd, frequency,
                                                            leadwidth, clarity */
 extern const RayesShaderClass shade_class_occlusion;    /* ambient occlusion: samples, maxdist */
+extern const RayesShaderClass shade_class_homogeneous; /* volume: density, extinction, albedo,
+                                                          g, emission */
+extern const RayesShaderClass shade_class_turbulence; /* volume: the same, frequency, octaves,
+                                                         falloff (memo Figure 9) */
 extern const RayesShaderClass shade_class_bumpy;    /* displacement: Km, frequency, texturename */
 extern const RayesShaderClass shade_class_fractal;  /* displacement: the memo's fractal noise */
 extern const RayesShaderClass shade_class_displace; /* displacement: P + amount N (a pattern) */

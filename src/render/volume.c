@@ -1,0 +1,401 @@
+/*
+ * render/volume.c — volumes by ray marching, their extinction cached in
+ * bricks (volume.h).
+ *
+ * A ray's segment inside a box is cut into n equal steps of about one fine
+ * voxel (times the volume step option), each sampled once at a jittered
+ * position (one jitter per ray, from a hash of the ray: deterministic).
+ * Extinction at the samples comes from the opacity cache (a brick entry
+ * at the resolution the ray's footprint chooses, trilinear) or, uncached,
+ * from one call of the shader's opacity method on all of a ray's samples.
+ */
+#include "render/volume.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "util/check.h"
+#include "util/half.h"
+#include "util/rng.h"
+
+/* Steps of one ray through one volume, at most. */
+#define VOLUME_MAX_STEPS 4096
+
+uint32_t volume_init(RenderVolume *v, uint32_t object, const Mat4 *world_from_object, Vec3 lo,
+                     Vec3 hi, float voxel, uint32_t key_base)
+{
+    memset(v, 0, sizeof *v);
+    v->object = object;
+    v->world_from_object = *world_from_object;
+    if (!mat4_invert(*world_from_object, &v->object_from_world))
+        return 0;
+    v->lo = v3(fminf(lo.x, hi.x), fminf(lo.y, hi.y), fminf(lo.z, hi.z));
+    v->hi = v3(fmaxf(lo.x, hi.x), fmaxf(lo.y, hi.y), fmaxf(lo.z, hi.z));
+    Vec3 ext = v3_sub(v->hi, v->lo);
+    if (!(ext.x > 0.0f && ext.y > 0.0f && ext.z > 0.0f) || !(voxel > 0.0f))
+        return 0;
+    /* world length of a unit of object space along each axis */
+    float scale[3] = {v3_length(mat4_vector(world_from_object, v3(1, 0, 0))),
+                      v3_length(mat4_vector(world_from_object, v3(0, 1, 0))),
+                      v3_length(mat4_vector(world_from_object, v3(0, 0, 1)))};
+    float e[3] = {ext.x, ext.y, ext.z}, cell[3];
+    float longest = fmaxf(e[0] * scale[0], fmaxf(e[1] * scale[1], e[2] * scale[2]));
+    voxel = fmaxf(voxel, longest / VOLUME_MAX_VOXELS);
+    uint32_t bricks = 1;
+    for (int a = 0; a < 3; a++) {
+        v->n_vox[a] = (int)fminf(fmaxf(ceilf(e[a] * scale[a] / voxel), 1.0f), VOLUME_MAX_VOXELS);
+        cell[a] = e[a] / (float)v->n_vox[a];
+        v->n_brick[a] = (v->n_vox[a] + VOLUME_BRICK - 1) / VOLUME_BRICK;
+        bricks *= (uint32_t)v->n_brick[a];
+    }
+    v->cell = v3(cell[0], cell[1], cell[2]);
+    v->voxel = voxel;
+    v->key_base = key_base;
+    return bricks;
+}
+
+/* The ray's parameter range [*t0, *t1] inside the box, within [tnear,
+ * tmax]; 0 if it misses. */
+static int clip(const RenderVolume *v, const Ray *ray, float tmax, float *t0, float *t1)
+{
+    Vec3 o = mat4_point(&v->object_from_world, ray->o);
+    Vec3 d = mat4_vector(&v->object_from_world, ray->d);
+    float lo[3] = {v->lo.x, v->lo.y, v->lo.z}, hi[3] = {v->hi.x, v->hi.y, v->hi.z};
+    float oo[3] = {o.x, o.y, o.z}, dd[3] = {d.x, d.y, d.z};
+    float a = ray->tnear, b = tmax;
+    for (int k = 0; k < 3; k++) {
+        if (dd[k] == 0.0f) {
+            if (oo[k] < lo[k] || oo[k] > hi[k])
+                return 0;
+            continue;
+        }
+        float inv = 1.0f / dd[k], ta = (lo[k] - oo[k]) * inv, tb = (hi[k] - oo[k]) * inv;
+        if (ta > tb) {
+            float s = ta;
+            ta = tb;
+            tb = s;
+        }
+        a = fmaxf(a, ta);
+        b = fminf(b, tb);
+    }
+    *t0 = a;
+    *t1 = b;
+    return b > a;
+}
+
+/* A deterministic number in [0, 1) for a ray (its origin and direction). */
+static float ray_jitter(const Ray *ray)
+{
+    uint32_t bits[6];
+    memcpy(bits, &ray->o, sizeof(float) * 3);
+    memcpy(bits + 3, &ray->d, sizeof(float) * 3);
+    uint64_t h = 0x766f6cull;
+    for (int k = 0; k < 6; k++)
+        h = hash_combine(h, bits[k]);
+    return rng_float(h);
+}
+
+/* Steps through [t0, t1]: n of them, dt apart (ray parameter), the first
+ * sample at t0 + jitter dt. */
+typedef struct March {
+    int n;
+    float t0, dt, jitter, dl; /* dl: a step's world length */
+} March;
+
+static March march(const Worker *w, const RenderVolume *v, const Ray *ray, float t0, float t1,
+                   float jitter)
+{
+    float len = v3_length(ray->d), world = (t1 - t0) * len;
+    float h = v->voxel * w->set->volume_step;
+    int n = (int)fminf(fmaxf(ceilf(world / h), 1.0f), VOLUME_MAX_STEPS);
+    March m = {n, t0, (t1 - t0) / (float)n, jitter, world / (float)n};
+    return m;
+}
+
+/* ----------------------------------------------------------- the points */
+
+/* What a shader call on n volume points needs. */
+typedef struct VolumePoints {
+    size_t n;
+    float (*P)[3], (*N)[3], (*I)[3], (*zero3)[3], (*Cs)[3], (*Os)[3], (*Ci)[3], (*Oi)[3];
+    float *u, *v, *s, *zero1;
+    uint64_t *keys;
+    RayDiff *diff;
+    int *back;
+} VolumePoints;
+
+static void points_alloc(VolumePoints *p, size_t n)
+{
+    memset(p, 0, sizeof *p);
+    p->n = n;
+    float(*f3)[3] = calloc(n * 8, sizeof *f3);
+    float *f1 = calloc(n * 4, sizeof *f1);
+    p->keys = calloc(n, sizeof *p->keys);
+    p->diff = calloc(n, sizeof *p->diff);
+    p->back = calloc(n, sizeof *p->back);
+    RY_CHECK(f3 && f1 && p->keys && p->diff && p->back);
+    p->P = f3, p->N = f3 + n, p->I = f3 + 2 * n, p->zero3 = f3 + 3 * n, p->Cs = f3 + 4 * n;
+    p->Os = f3 + 5 * n, p->Ci = f3 + 6 * n, p->Oi = f3 + 7 * n;
+    p->u = f1, p->v = f1 + n, p->s = f1 + 2 * n, p->zero1 = f1 + 3 * n;
+}
+
+static void points_free(VolumePoints *p)
+{
+    free(p->P);
+    free(p->u);
+    free(p->keys);
+    free(p->diff);
+    free(p->back);
+}
+
+/* Point i at object-space q (world P), seen along unit I (zero: none). */
+static void point_put(VolumePoints *p, size_t i, const RenderVolume *v, const RenderObject *obj,
+                      Vec3 q, Vec3 I)
+{
+    Vec3 P = mat4_point(&v->world_from_object, q), ext = v3_sub(v->hi, v->lo);
+    v3_store(p->P[i], P);
+    v3_store(p->I[i], I);
+    v3_store(p->N[i], v3_length(I) > 0.0f ? v3_neg(I) : v3(0, 0, 1));
+    memcpy(p->Cs[i], obj->Cs, sizeof p->Cs[i]);
+    memcpy(p->Os[i], obj->Os, sizeof p->Os[i]);
+    p->u[i] = (q.x - v->lo.x) / ext.x;
+    p->v[i] = (q.y - v->lo.y) / ext.y;
+    p->s[i] = (q.z - v->lo.z) / ext.z;
+}
+
+/* The context of p's n points (ray_type, I or not). */
+static RayesShadeCtx points_ctx(const VolumePoints *p, size_t n, uint32_t ray_type, int with_I,
+                                int diffuse_depth, int specular_depth, PathState *ps)
+{
+    RayesShadeCtx c = {
+        .n_points = n, .ray_type = ray_type, .diffuse_depth = diffuse_depth,
+        .specular_depth = specular_depth, .P = (const float(*)[3])p->P,
+        .N = (const float(*)[3])p->N, .Ng = (const float(*)[3])p->N,
+        .dPdu = (const float(*)[3])p->zero3, .dPdv = (const float(*)[3])p->zero3, .u = p->u,
+        .v = p->v, .s = p->s, .t = p->zero1, .du = p->zero1, .dv = p->zero1,
+        .I = with_I ? (const float(*)[3])p->I : NULL, .Cs = (const float(*)[3])p->Cs,
+        .Os = (const float(*)[3])p->Os, .renderer = ps, .backfacing = p->back,
+    };
+    return c;
+}
+
+/* Runs the opacity method on p's n points: sigma_t into p->Oi. */
+static void run_extinction(Worker *w, const RenderObject *obj, VolumePoints *p, size_t n)
+{
+    PathState ps = {w, p->keys, p->diff, p->zero1, p->zero1, NULL, UINT32_MAX, NULL, NULL, 1};
+    RayesShadeCtx ctx = points_ctx(p, n, RAYES_RAY_TRANSMISSION, 0, 0, 0, &ps);
+    RayesShadeOutputs o = {p->Ci, p->Oi, NULL, NULL};
+    w->stats.opacity_points += n;
+    shade_run_opacity(w->services, &ctx, obj->shader, &o);
+}
+
+/* ---------------------------------------------------------- the bricks */
+
+/* Points per side of a brick's level, and the fine voxels between them. */
+static int level_points(int level)
+{
+    return level == CACHE_FINE ? VOLUME_BRICK + 1 : level == CACHE_MEDIUM ? 3 : 2;
+}
+
+static int level_spacing(int level)
+{
+    return VOLUME_BRICK / (level_points(level) - 1);
+}
+
+/* The coarsest level whose spacing is at most k times the footprint. */
+static int choose_level(const Worker *w, const RenderVolume *v, float footprint)
+{
+    if (w->set->cache_resolution >= 0)
+        return w->set->cache_resolution;
+    for (int level = CACHE_COARSE; level < CACHE_FINE; level++)
+        if (v->voxel * (float)level_spacing(level) <= w->set->cache_k * footprint)
+            return level;
+    return CACHE_FINE;
+}
+
+typedef struct BrickJob {
+    Worker *w;
+    const RenderVolume *v;
+    int b[3]; /* the brick */
+} BrickJob;
+
+/* CacheFillFn: sigma_t at the brick level's lattice points. */
+static void fill_brick(void *user, const CacheKey *key, size_t n, float (*out)[3])
+{
+    BrickJob *job = user;
+    const RenderVolume *v = job->v;
+    const RenderObject *obj = &job->w->rs->objects[v->object];
+    int m = level_points(key->level), sp = level_spacing(key->level);
+    VolumePoints p;
+    points_alloc(&p, n);
+    size_t i = 0;
+    for (int z = 0; z < m; z++)
+        for (int y = 0; y < m; y++)
+            for (int x = 0; x < m; x++, i++) {
+                Vec3 q = v3(v->lo.x + v->cell.x * (float)(job->b[0] * VOLUME_BRICK + x * sp),
+                            v->lo.y + v->cell.y * (float)(job->b[1] * VOLUME_BRICK + y * sp),
+                            v->lo.z + v->cell.z * (float)(job->b[2] * VOLUME_BRICK + z * sp));
+                point_put(&p, i, v, obj, q, v3(0, 0, 0));
+                p.keys[i] = hash_combine(key->patch, i);
+                p.diff[i] = (RayDiff){v->voxel * (float)sp, 0.0f};
+            }
+    run_extinction(job->w, obj, &p, n);
+    memcpy(out, p.Oi, n * sizeof *out);
+    points_free(&p);
+}
+
+static Vec3 corner(const uint16_t *vals, int m, int x, int y, int z)
+{
+    size_t i = 3 * ((size_t)(z * m + y) * m + x);
+    return v3(half_to_float(vals[i]), half_to_float(vals[i + 1]), half_to_float(vals[i + 2]));
+}
+
+/* Cached sigma_t at object-space q for a ray of that footprint. */
+static Vec3 extinction_cached(Worker *w, const RenderVolume *v, Vec3 q, float footprint)
+{
+    float f[3] = {(q.x - v->lo.x) / v->cell.x, (q.y - v->lo.y) / v->cell.y,
+                  (q.z - v->lo.z) / v->cell.z};
+    int b[3];
+    float r[3]; /* position in the brick, fine voxels */
+    uint32_t brick = 0;
+    for (int a = 2; a >= 0; a--) {
+        float c = fminf(fmaxf(f[a], 0.0f), (float)v->n_vox[a]);
+        b[a] = RY_MIN((int)(c / VOLUME_BRICK), v->n_brick[a] - 1);
+        r[a] = c - (float)(b[a] * VOLUME_BRICK);
+        brick = brick * (uint32_t)v->n_brick[a] + (uint32_t)b[a];
+    }
+    int level = choose_level(w, v, footprint), m = level_points(level);
+    float sp = (float)level_spacing(level);
+    CacheKey key = {.patch = v->key_base + brick, .type = CACHE_OPACITY, .level = (uint8_t)level};
+    BrickJob job = {w, v, {b[0], b[1], b[2]}};
+    const uint16_t *vals = cache_lookup(&w->cache, &key, (size_t)m * m * m, fill_brick, &job);
+    int i[3];
+    float t[3];
+    for (int a = 0; a < 3; a++) {
+        float x = r[a] / sp;
+        i[a] = RY_MIN((int)x, m - 2);
+        t[a] = fminf(fmaxf(x - (float)i[a], 0.0f), 1.0f);
+    }
+    Vec3 c00 = v3_lerp(corner(vals, m, i[0], i[1], i[2]), corner(vals, m, i[0] + 1, i[1], i[2]), t[0]);
+    Vec3 c10 = v3_lerp(corner(vals, m, i[0], i[1] + 1, i[2]),
+                       corner(vals, m, i[0] + 1, i[1] + 1, i[2]), t[0]);
+    Vec3 c01 = v3_lerp(corner(vals, m, i[0], i[1], i[2] + 1),
+                       corner(vals, m, i[0] + 1, i[1], i[2] + 1), t[0]);
+    Vec3 c11 = v3_lerp(corner(vals, m, i[0], i[1] + 1, i[2] + 1),
+                       corner(vals, m, i[0] + 1, i[1] + 1, i[2] + 1), t[0]);
+    return v3_lerp(v3_lerp(c00, c10, t[1]), v3_lerp(c01, c11, t[1]), t[2]);
+}
+
+/* sigma_t at the march's samples into p->Oi (p holds the samples' points). */
+static void extinction_at(Worker *w, const RenderVolume *v, const Ray *ray, RayDiff diff,
+                          const March *m, VolumePoints *p)
+{
+    const RenderObject *obj = &w->rs->objects[v->object];
+    if (!(w->set->opacity_cache && obj->opacity_cached)) {
+        run_extinction(w, obj, p, (size_t)m->n);
+        return;
+    }
+    float len = v3_length(ray->d);
+    for (int i = 0; i < m->n; i++) {
+        float t = m->t0 + ((float)i + m->jitter) * m->dt;
+        Vec3 q = mat4_point(&v->object_from_world, v3_madd(ray->o, ray->d, t));
+        v3_store(p->Oi[i], extinction_cached(w, v, q, diff.width + diff.spread * t * len));
+    }
+}
+
+/* Fills p with the march's sample points. */
+static void march_points(const RenderVolume *v, const RenderObject *obj, const Ray *ray,
+                         const March *m, uint64_t key, RayDiff diff, VolumePoints *p)
+{
+    Vec3 I = v3_normalize(ray->d);
+    float len = v3_length(ray->d);
+    for (int i = 0; i < m->n; i++) {
+        float t = m->t0 + ((float)i + m->jitter) * m->dt;
+        Vec3 q = mat4_point(&v->object_from_world, v3_madd(ray->o, ray->d, t));
+        point_put(p, (size_t)i, v, obj, q, I);
+        p->keys[i] = hash_combine(key, (uint64_t)i);
+        p->diff[i] = (RayDiff){diff.width + diff.spread * t * len, diff.spread};
+    }
+}
+
+static Vec3 v3_exp_neg(Vec3 a)
+{
+    return v3(expf(-a.x), expf(-a.y), expf(-a.z));
+}
+
+/* ----------------------------------------------------------- the rays */
+
+Vec3 volume_transmittance(Worker *w, const Ray *ray, RayDiff diff)
+{
+    Vec3 T = v3(1, 1, 1);
+    int counted = 0;
+    for (size_t k = 0; k < w->rs->n_volumes; k++) {
+        const RenderVolume *v = &w->rs->volumes[k];
+        float t0, t1;
+        if (!clip(v, ray, ray->tfar, &t0, &t1))
+            continue;
+        if (!counted++)
+            w->stats.rays_transmission++;
+        March m = march(w, v, ray, t0, t1, ray_jitter(ray));
+        VolumePoints p;
+        points_alloc(&p, (size_t)m.n);
+        march_points(v, &w->rs->objects[v->object], ray, &m, 0, diff, &p);
+        extinction_at(w, v, ray, diff, &m, &p);
+        Vec3 tau = v3(0, 0, 0);
+        for (int i = 0; i < m.n; i++)
+            tau = v3_madd(tau, v3_load(p.Oi[i]), m.dl);
+        w->stats.volume_steps += (uint64_t)m.n;
+        points_free(&p);
+        T = v3_mul(T, v3_exp_neg(tau));
+    }
+    return T;
+}
+
+Vec3 volume_radiance(Worker *w, const Ray *ray, float tmax, uint32_t kind, int diffuse_depth,
+                     int specular_depth, uint64_t key, RayDiff diff, Vec3 *T)
+{
+    Vec3 L = v3(0, 0, 0);
+    *T = v3(1, 1, 1);
+    int scatter = (kind & (RAYES_RAY_CAMERA | RAYES_RAY_SPECULAR)) != 0;
+    for (size_t k = 0; k < w->rs->n_volumes; k++) {
+        const RenderVolume *v = &w->rs->volumes[k];
+        const RenderObject *obj = &w->rs->objects[v->object];
+        float t0, t1;
+        if (!clip(v, ray, tmax, &t0, &t1))
+            continue;
+        uint64_t vkey = hash_combine(key, 0x766f6c0000ull + k);
+        March m = march(w, v, ray, t0, t1, rng_float(vkey));
+        VolumePoints p;
+        points_alloc(&p, (size_t)m.n);
+        march_points(v, obj, ray, &m, vkey, diff, &p);
+        extinction_at(w, v, ray, diff, &m, &p);
+        w->stats.volume_steps += (uint64_t)m.n;
+        if (scatter) {
+            PathState ps = {w, p.keys, p.diff, p.zero1, p.zero1, NULL, UINT32_MAX, NULL, NULL, 1};
+            RayesShadeCtx ctx = points_ctx(&p, (size_t)m.n, kind & ~PATH_RAY_GLOSSY, 1,
+                                           diffuse_depth, specular_depth, &ps);
+            float(*Oi)[3] = malloc((size_t)m.n * sizeof *Oi);
+            RY_CHECK(Oi != NULL);
+            RayesShadeOutputs o = {p.Ci, Oi, NULL, NULL};
+            w->stats.shading_points[RY_MIN(diffuse_depth, RENDER_MAX_DEPTH)] += (uint64_t)m.n;
+            shade_run_lighting(w->services, &ctx, obj->shader, &o);
+            free(Oi);
+        }
+        /* Front to back: each step adds its source times the transmittance
+         * to its middle, then attenuates what lies behind it. */
+        Vec3 Tv = v3(1, 1, 1), Lv = v3(0, 0, 0);
+        for (int i = 0; i < m.n; i++) {
+            Vec3 step = v3_exp_neg(v3_scale(v3_load(p.Oi[i]), m.dl));
+            if (scatter) {
+                Vec3 half = v3_exp_neg(v3_scale(v3_load(p.Oi[i]), 0.5f * m.dl));
+                Lv = v3_add(Lv, v3_scale(v3_mul(v3_mul(Tv, half), v3_load(p.Ci[i])), m.dl));
+            }
+            Tv = v3_mul(Tv, step);
+        }
+        points_free(&p);
+        L = v3_add(L, v3_mul(*T, Lv));
+        *T = v3_mul(*T, Tv);
+    }
+    return L;
+}
