@@ -179,6 +179,8 @@ static const char *const predeclared[][2] = {
     {"shader", "string"}, {"texture", "string"}, {"archive", "string"},
     {"resource", "string"}, {"procedural", "string"}, {"display", "string"},
     {"bucketsize", "integer[2]"}, {"gridsize", "integer"}, {"texturememory", "integer"},
+    {"opacitycachememory", "integer"}, {"transmissionhitmode", "string"},
+    {"opacitycache", "integer"},
     {"endofframe", "integer"}, {"shadows", "string"}, {"origin", "integer[2]"},
     {"maxdistance", "float"}, {"distance", "float"}, {"background", "color"},
     {"eta", "float"}, {"Kr", "float"}, {"__category", "string"},
