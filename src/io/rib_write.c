@@ -293,11 +293,18 @@ static RayesError w_set_transform(void *t, const float m[16])
     return RAYES_OK;
 }
 
-/* Cs and Os from a shader's parameters (Color and Opacity in RIB). */
+/* Cs and Os from a shader's parameters when they are constants (Color
+ * and Opacity in RIB); bound to a pattern they stay shader parameters. */
+static int constant_color(const RayesParam *p)
+{
+    return p->name && (!strcmp(p->name, "Cs") || !strcmp(p->name, "Os")) &&
+           p->type != RAYES_PARAM_STRING && p->type != RAYES_PARAM_PATTERN;
+}
+
 static const RayesParam *find_param(const RayesParam *p, size_t n, const char *name)
 {
     for (size_t i = 0; i < n; i++)
-        if (p[i].name && strcmp(p[i].name, name) == 0 && p[i].type != RAYES_PARAM_STRING)
+        if (constant_color(&p[i]) && strcmp(p[i].name, name) == 0)
             return &p[i];
     return NULL;
 }
@@ -324,8 +331,7 @@ static RayesError w_set_shader(void *t, const char *name, const RayesParam *p, s
     RayesParam rest[64];
     size_t n_rest = 0;
     for (size_t i = 0; i < n; i++) {
-        if (p[i].name && (!strcmp(p[i].name, "Cs") || !strcmp(p[i].name, "Os")) &&
-            p[i].type != RAYES_PARAM_STRING)
+        if (constant_color(&p[i]))
             continue;
         if (n_rest == 64)
             return fail(w, RAYES_ERROR_INVALID_ARGUMENT, "set_shader: too many parameters");
