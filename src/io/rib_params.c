@@ -390,8 +390,8 @@ void rib_warn_unused(Rib *r, const Param *p, size_t n)
         if (!u) {
             char key[128];
             snprintf(key, sizeof key, "unused %s", p[i].d.name);
-            rib_warn_once(r, key, "parameter \"%s\" is not used (rayes takes P, N, st and Cs)",
-                      p[i].d.name);
+            rib_warn_once(r, key, "parameter \"%s\" is not used (rayes takes P, N, st, Cs and Os)",
+                          p[i].d.name);
         }
     }
 }

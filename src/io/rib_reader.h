@@ -301,11 +301,11 @@ const Param *rib_color_param(Rib *r, const Param *p, size_t n);
 
 /* ------------------------------------------ rib_prim.c: primitives' data */
 
-/* Primitive variables for one sink call (N, st, Cs; curves and points
- * add width); the data are owned. */
+/* Primitive variables for one sink call (N, st, Cs, Os; curves and
+ * points add width); the data are owned. */
 typedef struct PvOut {
-    RayesPrimvar pv[4];
-    float *data[4];
+    RayesPrimvar pv[5];
+    float *data[5];
     size_t n;
 } PvOut;
 

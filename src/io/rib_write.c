@@ -469,11 +469,13 @@ static RayesError w_set_opacity_mode(void *t, RayesTransmissionHitMode mode, int
  * curves' and points'), or 0. */
 static int primvar_size(const char *name)
 {
-    return !name ? 0
-           : strcmp(name, "st") == 0 ? 2
-           : strcmp(name, "N") == 0 || strcmp(name, "Cs") == 0 ? 3
-           : strcmp(name, "width") == 0 ? 1
-                                        : 0;
+    static const char *const three[] = {"N", "Cs", "Os"};
+    if (!name)
+        return 0;
+    for (size_t k = 0; k < sizeof three / sizeof three[0]; k++)
+        if (strcmp(name, three[k]) == 0)
+            return 3;
+    return strcmp(name, "st") == 0 ? 2 : strcmp(name, "width") == 0 ? 1 : 0;
 }
 
 /* Checks primitive variables as rayes.h does (expect[cls]: the counts of
