@@ -249,6 +249,9 @@ RAYES_API RayesError rayes_scene_polygon_mesh(RayesScene *scene, size_t n_faces,
  *   "st"  2 floats: the texture coordinates shaders get as s and t (and
  *         texture filter widths derived from them). Default: (u, v).
  *   "Cs"  3 floats: the surface colour, replacing the shader's Cs.
+ *   "Os"  3 floats: the surface opacity, replacing the shader's Os (an
+ *         "Os" pattern still multiplies it); an object with a value below
+ *         1 anywhere is partly transparent to every ray.
  * A class says how many values there are (count) and how they are
  * interpolated:
  *   CONSTANT     1 for the whole call
@@ -274,7 +277,7 @@ typedef enum RayesPrimvarClass {
 } RayesPrimvarClass;
 
 typedef struct RayesPrimvar {
-    const char *name;        /* "N", "st" or "Cs" */
+    const char *name;        /* "N", "st", "Cs" or "Os" */
     RayesPrimvarClass cls;   /* how many values and how they are interpolated */
     const float *data;       /* count values of the name's size, back to back */
     size_t count;            /* values (not floats) */
@@ -346,7 +349,7 @@ RAYES_API RayesError rayes_scene_subdivision_mesh(RayesScene *scene, RayesSubdiv
  *
  * Primitive variables: "width" (1 float, object units, the diameter;
  * default 1), "N" (3 floats: the curves become ribbons facing N, which
- * should be across the curve), "Cs", "st". Classes: constant, uniform
+ * should be across the curve), "Cs", "Os", "st". Classes: constant, uniform
  * (one per curve), varying (one per segment end: segments + 1 per
  * non-periodic curve, segments per periodic one; facevarying reads as
  * varying), vertex (one per control point, evaluated with the basis at
@@ -384,7 +387,7 @@ RAYES_API long rayes_curves_counts(const RayesCurves *curves, size_t *n_points, 
 /* Points (RenderMan's Points): n_points spheres or disks facing each ray
  * (shape), or with "N" disks facing N, centred at P. Primitive
  * variables: "width" (the diameter, object units; constant, or varying or
- * vertex: one per point; default 1), "N", "Cs", "st" (constant, uniform:
+ * vertex: one per point; default 1), "N", "Cs", "Os", "st" (constant, uniform:
  * 1, varying or vertex: one per point). Each point is one grid. */
 typedef enum RayesPointShape { RAYES_POINT_SPHERE = 0, RAYES_POINT_DISK = 1 } RayesPointShape;
 

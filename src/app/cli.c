@@ -356,9 +356,10 @@ void parse_args(int argc, char **argv, Args *a)
             if (strcmp(v, "on") != 0 && strcmp(v, "off") != 0)
                 die_usage("--opacity-cache: expected on or off, got \"%s\"", v);
             opt->opacity_cache = strcmp(v, "on") == 0;
-        } else if (strcmp(o, "--opacity-cache-mb") == 0)
+        } else if (strcmp(o, "--opacity-cache-mb") == 0) {
             opt->opacity_cache_mb = parse_float(o, v, 0.0f, 1e7f);
-        else if (strcmp(o, "--volume-step") == 0)
+            a->set |= SET_OPACITY_CACHE_MB;
+        } else if (strcmp(o, "--volume-step") == 0)
             opt->volume_step = parse_float(o, v, 0.01f, 1000.0f);
         else if (strcmp(o, "--cache-split") == 0)
             parse_split(v, opt->cache_split);
@@ -460,6 +461,8 @@ void merge_settings(Args *a, const IoSettings *s)
         o->grid_size = s->grid_size;
     if (!(a->set & SET_TEXTURE_MB) && s->texture_mb > 0.0)
         o->texture_mb = s->texture_mb;
+    if (!(a->set & SET_OPACITY_CACHE_MB) && s->opacity_cache_mb > 0.0)
+        o->opacity_cache_mb = s->opacity_cache_mb;
     if (!(a->set & SET_CROP))
         memcpy(o->crop, s->crop, sizeof o->crop);
 }

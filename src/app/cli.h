@@ -24,7 +24,8 @@ enum {
     SET_SPECULAR_DEPTH = 32,
     SET_GRID_SIZE = 64,
     SET_TEXTURE_MB = 128,
-    SET_CROP = 256
+    SET_CROP = 256,
+    SET_OPACITY_CACHE_MB = 512
 };
 
 /* An image to write. */

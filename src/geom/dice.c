@@ -63,6 +63,7 @@ void geom_gridset_fini(GridSet *gs)
     free(gs->st);
     free(gs->dst);
     free(gs->Cs);
+    free(gs->Os);
     memset(gs, 0, sizeof *gs);
 }
 
@@ -324,6 +325,12 @@ static int reserve_primvars(GridSet *gs, size_t cap, unsigned want)
             return -1;
         gs->Cs = Cs;
     }
+    if (have & GEOM_PV_OS) {
+        Vec3 *Os = realloc(gs->Os, cap * sizeof *Os);
+        if (!Os)
+            return -1;
+        gs->Os = Os;
+    }
     gs->pv_arrays = have;
     return 0;
 }
@@ -391,6 +398,8 @@ static void put_vertex(GridSet *gs, size_t k, const Prim *prim, const float *poo
     }
     if (prim->pv & GEOM_PV_CS)
         gs->Cs[k] = s.Cs;
+    if (prim->pv & GEOM_PV_OS)
+        gs->Os[k] = s.Os;
 }
 
 /* One neighbour pair, in one of two passes: the first sums edge lengths;

@@ -72,8 +72,10 @@ struct SubdivMesh;
 enum {
     GEOM_PV_N = 1u << 0,  /* shading normal, 3 floats */
     GEOM_PV_ST = 1u << 1, /* texture coordinates, 2 floats */
-    GEOM_PV_CS = 1u << 2  /* surface colour, 3 floats */
+    GEOM_PV_CS = 1u << 2, /* surface colour, 3 floats */
+    GEOM_PV_OS = 1u << 3  /* surface opacity, 3 floats */
 };
+#define GEOM_N_PV 4 /* the GEOM_PV_* bits */
 
 typedef struct Prim {
     PrimType type;
@@ -151,6 +153,7 @@ typedef struct PrimvarSample {
     float st[2];           /* texture coordinates (GEOM_PV_ST) */
     float dst[4];          /* ds/du, ds/dv, dt/du, dt/dv (GEOM_PV_ST) */
     Vec3 Cs;               /* surface colour (GEOM_PV_CS) */
+    Vec3 Os;               /* surface opacity (GEOM_PV_OS) */
 } PrimvarSample;
 
 /* 1 if prim's (u, v) domain is a triangle (barycentric u, v). */
@@ -192,8 +195,8 @@ typedef struct Grid {
                               triangle: the three corners; a quad over part of a triangle
                               (dice.c's split_quads): a box whose spacing is its vertices'
                               largest step in u and in v */
-    uint8_t primvars;      /* GEOM_PV_* bits: the GridSet's Ns, st, Cs hold its vertices'
-                              values (else: N, uv, the object's colour) */
+    uint8_t primvars;      /* GEOM_PV_* bits: the GridSet's Ns, st, Cs, Os hold its vertices'
+                              values (else: N, uv, the object's colour and opacity) */
 } Grid;
 
 typedef struct GridSet {
@@ -209,6 +212,7 @@ typedef struct GridSet {
     float (*st)[2];        /* texture coordinates (GEOM_PV_ST) */
     float (*dst)[4];       /* their derivatives ds/du, ds/dv, dt/du, dt/dv (GEOM_PV_ST) */
     Vec3 *Cs;              /* surface colours (GEOM_PV_CS) */
+    Vec3 *Os;              /* surface opacities (GEOM_PV_OS) */
     unsigned pv_arrays;    /* GEOM_PV_* bits of the arrays allocated */
     size_t n_vertices;
     size_t cap_grids, cap_vertices;
@@ -296,7 +300,8 @@ static inline uint32_t geom_tri_vertex(uint32_t n, uint32_t i, uint32_t j)
 
 /* What vertex i (of grid g) shades with: the shading normal (N without
  * one), the texture coordinates and their derivatives with respect to
- * (u, v) ((u, v) and the identity without), and the colour (dflt without). */
+ * (u, v) ((u, v) and the identity without), and the colour and opacity
+ * (dflt without). */
 static inline Vec3 geom_vertex_normal(const GridSet *gs, const Grid *g, size_t i)
 {
     return (g->primvars & GEOM_PV_N) ? gs->Ns[i] : gs->N[i];
@@ -318,6 +323,11 @@ static inline void geom_vertex_st(const GridSet *gs, const Grid *g, size_t i, fl
 static inline Vec3 geom_vertex_color(const GridSet *gs, const Grid *g, size_t i, Vec3 dflt)
 {
     return (g->primvars & GEOM_PV_CS) ? gs->Cs[i] : dflt;
+}
+
+static inline Vec3 geom_vertex_opacity(const GridSet *gs, const Grid *g, size_t i, Vec3 dflt)
+{
+    return (g->primvars & GEOM_PV_OS) ? gs->Os[i] : dflt;
 }
 
 /* Bernstein polynomials of degree 3 at t, and their derivatives. */

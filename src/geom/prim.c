@@ -300,27 +300,29 @@ static int primvar_weights(const Prim *prim, int cubic, float u, float v, float 
 void geom_prim_primvars(const Prim *prim, const float *pool, float u, float v,
                         PrimvarSample *out)
 {
-    static const unsigned bits[3] = {GEOM_PV_N, GEOM_PV_ST, GEOM_PV_CS};
-    static const int sizes[3] = {3, 2, 3};
+    static const unsigned bits[GEOM_N_PV] = {GEOM_PV_N, GEOM_PV_ST, GEOM_PV_CS, GEOM_PV_OS};
+    static const int sizes[GEOM_N_PV] = {3, 2, 3, 3};
     if (!prim->pv)
         return;
     if (prim->type == PRIM_SUBDIV) { /* evaluated with the surface */
-        float N[3], st[2], dst[4], Cs[3];
+        float N[3], st[2], dst[4], Cs[3], Os[3];
         unsigned got =
-            geom_subdiv_primvars(prim->subdiv.mesh, prim->subdiv.patch, u, v, N, st, dst, Cs);
+            geom_subdiv_primvars(prim->subdiv.mesh, prim->subdiv.patch, u, v, N, st, dst, Cs, Os);
         if (got & GEOM_PV_N)
             out->N = v3_normalize(v3(N[0], N[1], N[2]));
         if (got & GEOM_PV_ST)
             memcpy(out->st, st, sizeof out->st), memcpy(out->dst, dst, sizeof out->dst);
         if (got & GEOM_PV_CS)
             out->Cs = v3(Cs[0], Cs[1], Cs[2]);
+        if (got & GEOM_PV_OS)
+            out->Os = v3(Os[0], Os[1], Os[2]);
         return;
     }
     const float *p = pool + prim->pv_first;
     if (prim->type == PRIM_CURVE) { /* per segment end, linear between, alike across */
         float t;
         int k = geom_curve_segment(prim, u, &t), n = prim->curve.n_seg > 0 ? prim->curve.n_seg : 1;
-        for (int b = 0; b < 3; b++) {
+        for (int b = 0; b < GEOM_N_PV; b++) {
             if (!(prim->pv & bits[b]))
                 continue;
             const float *x0 = p + (size_t)k * (size_t)sizes[b], *x1 = x0 + sizes[b];
@@ -332,13 +334,15 @@ void geom_prim_primvars(const Prim *prim, const float *pool, float u, float v,
                 out->dst[0] = du[0], out->dst[1] = 0.0f, out->dst[2] = du[1], out->dst[3] = 0.0f;
             } else if (bits[b] == GEOM_PV_CS)
                 out->Cs = v3(val[0], val[1], val[2]);
+            else if (bits[b] == GEOM_PV_OS)
+                out->Os = v3(val[0], val[1], val[2]);
             else
                 out->N = v3_normalize(v3(val[0], val[1], val[2]));
             p += (size_t)(n + 1) * (size_t)sizes[b];
         }
         return;
     }
-    for (int b = 0; b < 3; b++) {
+    for (int b = 0; b < GEOM_N_PV; b++) {
         if (!(prim->pv & bits[b]))
             continue;
         float w[16], wu[16], wv[16], val[3] = {0, 0, 0}, du[3] = {0, 0, 0}, dv[3] = {0, 0, 0};
@@ -354,7 +358,9 @@ void geom_prim_primvars(const Prim *prim, const float *pool, float u, float v,
         else if (bits[b] == GEOM_PV_ST) {
             out->st[0] = val[0], out->st[1] = val[1];
             out->dst[0] = du[0], out->dst[1] = dv[0], out->dst[2] = du[1], out->dst[3] = dv[1];
-        } else
+        } else if (bits[b] == GEOM_PV_CS)
             out->Cs = v3(val[0], val[1], val[2]);
+        else
+            out->Os = v3(val[0], val[1], val[2]);
     }
 }

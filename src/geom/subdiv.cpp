@@ -485,7 +485,8 @@ extern "C" void geom_subdiv_eval(const SubdivMesh *m, size_t patch, float u, flo
 
 /* Writes the variables of slots from a channel's value and derivatives. */
 static unsigned put(const std::vector<Slot> &slots, const float *val, const float *du,
-                    const float *dv, float N[3], float st[2], float dst[4], float Cs[3])
+                    const float *dv, float N[3], float st[2], float dst[4], float Cs[3],
+                    float Os[3])
 {
     unsigned bits = 0;
     for (const Slot &s : slots) {
@@ -500,14 +501,15 @@ static unsigned put(const std::vector<Slot> &slots, const float *val, const floa
             } else
                 dst[0] = dst[1] = dst[2] = dst[3] = 0.0f;
         } else
-            std::memcpy(Cs, x, 3 * sizeof(float));
+            std::memcpy(s.bit == 4u ? Cs : Os, x, 3 * sizeof(float)); /* GEOM_PV_CS, _OS */
         bits |= s.bit;
     }
     return bits;
 }
 
 extern "C" unsigned geom_subdiv_primvars(const SubdivMesh *m, size_t patch, float u, float v,
-                                         float N[3], float st[2], float dst[4], float Cs[3])
+                                         float N[3], float st[2], float dst[4], float Cs[3],
+                                         float Os[3])
 {
     const Patch &p = m->patches[patch];
     const Face &f = m->faces[p.face];
@@ -515,20 +517,20 @@ extern "C" unsigned geom_subdiv_primvars(const SubdivMesh *m, size_t patch, floa
     unsigned bits = 0;
     if (m->vtx.slots.size()) {
         eval_channel(m->vtx, f.vtx, f.vtx_at, p, u, v, val, du, dv);
-        bits |= put(m->vtx.slots, val, du, dv, N, st, dst, Cs);
+        bits |= put(m->vtx.slots, val, du, dv, N, st, dst, Cs, Os);
     }
     if (m->var.size) {
         eval_channel(m->var, f.var, f.var_at, p, u, v, val, du, dv);
-        bits |= put(m->var.slots, val, du, dv, N, st, dst, Cs);
+        bits |= put(m->var.slots, val, du, dv, N, st, dst, Cs, Os);
     }
     if (m->fvar.size) {
         eval_channel(m->fvar, f.fvar, f.fvar_at, p, u, v, val, du, dv);
-        bits |= put(m->fvar.slots, val, du, dv, N, st, dst, Cs);
+        bits |= put(m->fvar.slots, val, du, dv, N, st, dst, Cs, Os);
     }
     if (m->uniform_size)
         bits |= put(m->uniform_slots, &m->uniform[p.face * (size_t)m->uniform_size], nullptr,
-                    nullptr, N, st, dst, Cs);
+                    nullptr, N, st, dst, Cs, Os);
     if (!m->constant.empty())
-        bits |= put(m->constant_slots, m->constant.data(), nullptr, nullptr, N, st, dst, Cs);
+        bits |= put(m->constant_slots, m->constant.data(), nullptr, nullptr, N, st, dst, Cs, Os);
     return bits;
 }

@@ -14,7 +14,7 @@
  * boundary faces of a mesh whose boundary is not interpolated) make no
  * patch.
  *
- * Primitive variables (N, st, Cs, the bits of GEOM_PV_*) are evaluated
+ * Primitive variables (N, st, Cs, Os, the bits of GEOM_PV_*) are evaluated
  * with the surface: vertex ones on the limit surface, varying ones
  * linearly over the face, facevarying ones on OpenSubdiv's face-varying
  * surface (values equal at a point are shared, so they are smooth across
@@ -40,9 +40,9 @@ enum { SUBDIV_CATMULL_CLARK = 0, SUBDIV_LOOP = 1, SUBDIV_BILINEAR = 2 };
 
 /* One primitive variable, already in world space (a normal transformed). */
 typedef struct SubdivPrimvar {
-    unsigned bit;          /* GEOM_PV_N, GEOM_PV_ST or GEOM_PV_CS */
+    unsigned bit;          /* GEOM_PV_N, GEOM_PV_ST, GEOM_PV_CS or GEOM_PV_OS */
     int cls;               /* RayesPrimvarClass */
-    int size;              /* floats per value: 3, 2, 3 */
+    int size;              /* floats per value: 3, 2, 3, 3 */
     const float *data;     /* values in the class's count */
 } SubdivPrimvar;
 
@@ -63,7 +63,7 @@ typedef struct SubdivDesc {
     const float *corner_sharpness;
     size_t n_holes;
     const int *hole_faces;
-    SubdivPrimvar pv[3];
+    SubdivPrimvar pv[4];
     int n_pv;
 } SubdivDesc;
 
@@ -110,7 +110,7 @@ void geom_subdiv_eval(const SubdivMesh *mesh, size_t patch, float u, float v, fl
  * GEOM_PV_* bits are written (N not normalised; dst = ds/du, ds/dv,
  * dt/du, dt/dv). */
 unsigned geom_subdiv_primvars(const SubdivMesh *mesh, size_t patch, float u, float v, float N[3],
-                              float st[2], float dst[4], float Cs[3]);
+                              float st[2], float dst[4], float Cs[3], float Os[3]);
 
 #ifdef __cplusplus
 }

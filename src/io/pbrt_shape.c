@@ -164,7 +164,7 @@ static float *points_of(Parser *P, const Token *t, const Param *p)
 
 static void warn_vertex_data(Parser *P, const Token *t, ParamList *pl, const char *what)
 {
-    static const char *names[] = {"S", "faceIndices", "alpha", "emissionfilename"};
+    static const char *names[] = {"S", "faceIndices", "emissionfilename"};
     for (size_t i = 0; i < sizeof names / sizeof names[0]; i++) {
         Param *p = pbrt_find(pl, names[i]);
         if (p) {
@@ -541,6 +541,58 @@ done:
 
 /* ------------------------------------------------------------ directives */
 
+/* pbrt-v4's "alpha" of a shape (a float, or a float texture; 0 is a
+ * cut-out) as rayes' opacity: the current material with "Os" added, in
+ * *out. pbrt cuts out stochastically where alpha is fractional; opacity is
+ * the same in expectation. Returns 1 (out set), 0 (no alpha, or 1) or -1. */
+static int shape_alpha(Parser *P, const Token *t, ParamList *pl, Material *out)
+{
+    Param *p = pbrt_find(pl, "alpha");
+    const Texture *tex = NULL;
+    float a[3];
+    static const float one[3] = {1, 1, 1};
+    int k = p ? pbrt_get_color(P, pl, "alpha", one, a, &tex) : 0;
+    if (k <= 0)
+        return k;
+    if (p->type != PT_FLOAT && p->type != PT_TEXTURE)
+        return pbrt_fail_at(P, p->line, p->col,
+                            "Shape: \"alpha\" must be a float or a float texture, found %s",
+                            p->type_name);
+    if (k == 1 && a[0] >= 1.0f)
+        return 0;
+    *out = P->gs.material;
+    if (out->n >= MAT_MAX_PARAMS)
+        return FAIL_TOK(P, t, "Shape: \"alpha\": the material has too many parameters");
+    int i = out->n++;
+    memset(&out->p[i], 0, sizeof out->p[i]);
+    snprintf(out->p[i].name, sizeof out->p[i].name, "Os");
+    out->p[i].type = k == 2 ? RAYES_PARAM_PATTERN : RAYES_PARAM_COLOR;
+    for (int c = 0; c < 3; c++)
+        out->p[i].v[c] = k == 2 ? 1.0f : fminf(fmaxf(a[0], 0.0f), 1.0f);
+    out->p[i].tex = k == 2 ? (size_t)(tex - P->textures) : 0;
+    return 1;
+}
+
+static int shape_of_type(Parser *P, const Token *t, const char *type, ParamList *pl)
+{
+    if (strcmp(type, "trianglemesh") == 0)
+        return shape_trianglemesh(P, t, pl);
+    if (strcmp(type, "bilinearmesh") == 0)
+        return shape_bilinearmesh(P, t, pl);
+    if (strcmp(type, "loopsubdiv") == 0)
+        return shape_loopsubdiv(P, t, pl);
+    if (strcmp(type, "plymesh") == 0)
+        return shape_plymesh(P, t, pl);
+    if (strcmp(type, "curve") == 0)
+        return shape_curve(P, t, pl);
+    if (strcmp(type, "sphere") == 0 || strcmp(type, "disk") == 0 || strcmp(type, "cylinder") == 0)
+        return shape_quadric(P, t, type, pl);
+    char key[96];
+    snprintf(key, sizeof key, "shape %.60s", type);
+    pbrt_warn_at(P, t->line, t->col, key, "Shape \"%.40s\" is not supported; skipped", type);
+    return 1;
+}
+
 int pbrt_d_shape(Parser *P, const Token *t)
 {
     char type[64];
@@ -552,25 +604,14 @@ int pbrt_d_shape(Parser *P, const Token *t)
         pbrt_params_free(&pl);
         return -1;
     }
-    if (pbrt_find(&pl, "alpha"))
-        pbrt_warn_at(P, t->line, t->col, "alpha", "Shape: \"alpha\" cut-outs are not supported");
-    if (strcmp(type, "trianglemesh") == 0)
-        r = shape_trianglemesh(P, t, &pl);
-    else if (strcmp(type, "bilinearmesh") == 0)
-        r = shape_bilinearmesh(P, t, &pl);
-    else if (strcmp(type, "loopsubdiv") == 0)
-        r = shape_loopsubdiv(P, t, &pl);
-    else if (strcmp(type, "plymesh") == 0)
-        r = shape_plymesh(P, t, &pl);
-    else if (strcmp(type, "curve") == 0)
-        r = shape_curve(P, t, &pl);
-    else if (strcmp(type, "sphere") == 0 || strcmp(type, "disk") == 0 ||
-             strcmp(type, "cylinder") == 0)
-        r = shape_quadric(P, t, type, &pl);
-    else {
-        char key[96];
-        snprintf(key, sizeof key, "shape %.60s", type);
-        pbrt_warn_at(P, t->line, t->col, key, "Shape \"%.40s\" is not supported; skipped", type);
+    Material saved = P->gs.material, with_alpha;
+    r = shape_alpha(P, t, &pl, &with_alpha);
+    if (r == 1)
+        P->gs.material = with_alpha; /* for this shape only */
+    if (r >= 0)
+        r = shape_of_type(P, t, type, &pl);
+    P->gs.material = saved;
+    if (r == 1) { /* skipped */
         pbrt_params_free(&pl);
         return 0;
     }

@@ -633,6 +633,8 @@ static void rib_init(Rib *r, int pass, const IoSink *sink, const IoReadOptions *
     memcpy(r->a.Cs, white, sizeof white);
     memcpy(r->a.Os, white, sizeof white);
     r->a.shading_rate = 1;
+    r->a.visibility = RAYES_RAY_CAMERA | RAYES_RAY_DIFFUSE | RAYES_RAY_SPECULAR | RAYES_RAY_SHADOW;
+    r->a.opacity_cache = 1;
     int step;
     rib_basis_named("bezier", r->a.ubasis, &step);
     rib_basis_named("bezier", r->a.vbasis, &step);

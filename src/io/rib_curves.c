@@ -2,7 +2,7 @@
  * io/rib_curves.c — RenderMan's Curves and Points (docs/rib.md).
  *
  * Curves take the current v basis and step (RenderMan's rule for curves),
- * "width" (any class) or "constantwidth", "N" (ribbons), "Cs" and "st";
+ * "width" (any class) or "constantwidth", "N" (ribbons), "Cs", "Os" and "st";
  * without N they are flat ribbons facing each ray, or tubes under
  * Attribute "dice" "roundcurve" 1. Points take "width" or
  * "constantwidth", "N" (oriented disks), "Cs", "st", and 3Delight's
@@ -51,15 +51,15 @@ static int read_vars(Rib *r, const Param *p, size_t n, Vars *v)
     static const struct {
         const char *name;
         int size;
-    } names[3] = {{"N", 3}, {"Cs", 3}, {"st", 2}};
+    } names[4] = {{"N", 3}, {"Cs", 3}, {"st", 2}, {"Os", 3}};
     int e = w ? add_var(r, v, w, "width", 1) : 0;
-    for (int k = 0; k < 3 && e == 0; k++) {
+    for (int k = 0; k < 4 && e == 0; k++) {
         const Param *q = rib_var_param(r, p, n, names[k].name, names[k].size);
         if (q)
             e = add_var(r, v, q, names[k].name, names[k].size);
     }
-    static const char *const used[] = {"P", "Pw", "N", "Cs", "st", "width", "constantwidth",
-                                       "type", NULL};
+    static const char *const used[] = {"P",    "Pw", "N", "Cs", "st", "width", "constantwidth",
+                                       "type", "Os", NULL};
     for (size_t i = 0; i < n; i++) {
         int u = !p[i].declared;
         for (int k = 0; used[k]; k++)
@@ -69,7 +69,7 @@ static int read_vars(Rib *r, const Param *p, size_t n, Vars *v)
             snprintf(key, sizeof key, "unused %s", p[i].d.name);
             rib_warn_once(r, key,
                           "parameter \"%s\" is not used (rayes's curves and points take P, "
-                          "width, N, st and Cs)",
+                          "width, N, st, Cs and Os)",
                           p[i].d.name);
         }
     }

@@ -179,6 +179,8 @@ static const char *const predeclared[][2] = {
     {"shader", "string"}, {"texture", "string"}, {"archive", "string"},
     {"resource", "string"}, {"procedural", "string"}, {"display", "string"},
     {"bucketsize", "integer[2]"}, {"gridsize", "integer"}, {"texturememory", "integer"},
+    {"opacitycachememory", "integer"}, {"transmissionhitmode", "string"},
+    {"opacitycache", "integer"},
     {"endofframe", "integer"}, {"shadows", "string"}, {"origin", "integer[2]"},
     {"maxdistance", "float"}, {"distance", "float"}, {"background", "color"},
     {"eta", "float"}, {"Kr", "float"}, {"__category", "string"},
@@ -388,8 +390,8 @@ void rib_warn_unused(Rib *r, const Param *p, size_t n)
         if (!u) {
             char key[128];
             snprintf(key, sizeof key, "unused %s", p[i].d.name);
-            rib_warn_once(r, key, "parameter \"%s\" is not used (rayes takes P, N, st and Cs)",
-                      p[i].d.name);
+            rib_warn_once(r, key, "parameter \"%s\" is not used (rayes takes P, N, st, Cs and Os)",
+                          p[i].d.name);
         }
     }
 }

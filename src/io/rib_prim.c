@@ -5,7 +5,7 @@
  * HierarchicalSubdivisionMesh (schemes and tags to rayes.h's subdivision
  * meshes), Patch and PatchMesh in the current basis (made
  * Bezier), the quadrics and Geometry "teapot"; and their primitive
- * variables (N, st or s and t, Cs) in the API's classes. Each primitive
+ * variables (N, st or s and t, Cs, Os) in the API's classes. Each primitive
  * checks its parameters' counts, then brings the sink up to date
  * (rib_emit_begin) and sends itself, wound as RenderMan's orientation and
  * the transform's handedness say (flip_of).
@@ -36,16 +36,17 @@ static int flip_of(Rib *r)
 
 /* ------------------------------------------------ primitive variables */
 
-/* One of the primitive variables rayes.h takes (N, st, Cs), as a
+/* One of the primitive variables rayes.h takes (N, st, Cs, Os), as a
  * primitive gives it: values of size floats, or separate s and t. */
 typedef struct RibVar {
     const double *d;  /* the values; s when d2 is set; NULL: not given */
     const double *d2; /* t, when s and t are separate */
     Cls cls;
-    int size;         /* floats per value: 3 (N, Cs), 2 (st) */
+    int size; /* floats per value: 3 (N, Cs, Os), 2 (st) */
 } RibVar;
 
-static const char *const rib_var_names[3] = {"N", "st", "Cs"};
+#define RIB_N_VARS 4
+static const char *const rib_var_names[RIB_N_VARS] = {"N", "st", "Cs", "Os"};
 
 /* A parameter that is a numeric declared value of size floats, or NULL
  * (with one warning when it has the name but another type). */
@@ -64,10 +65,10 @@ const Param *rib_var_param(Rib *r, const Param *p, size_t n, const char *name, i
     return q;
 }
 
-/* The primitive's N (or Np), st (or s and t) and Cs, in that order. */
-static void rib_vars(Rib *r, const Param *p, size_t n, RibVar vars[3])
+/* The primitive's N (or Np), st (or s and t), Cs and Os, in that order. */
+static void rib_vars(Rib *r, const Param *p, size_t n, RibVar vars[RIB_N_VARS])
 {
-    memset(vars, 0, 3 * sizeof *vars);
+    memset(vars, 0, RIB_N_VARS * sizeof *vars);
     const Param *N = rib_var_param(r, p, n, "N", 3);
     if (!N)
         N = rib_var_param(r, p, n, "Np", 3);
@@ -86,6 +87,9 @@ static void rib_vars(Rib *r, const Param *p, size_t n, RibVar vars[3])
     const Param *cs = rib_var_param(r, p, n, "Cs", 3);
     if (cs)
         vars[2] = (RibVar){cs->v->d, NULL, cs->d.cls, 3};
+    const Param *os = rib_var_param(r, p, n, "Os", 3);
+    if (os)
+        vars[3] = (RibVar){os->v->d, NULL, os->d.cls, 3};
 }
 
 static void var_value(const RibVar *v, size_t j, float out[3])
@@ -134,7 +138,7 @@ static int patch_vars(Rib *r, const RibVar *vars, size_t ui, const size_t vi[4],
                       const size_t fi[4], const size_t *vv, int n_vv, int flip, PvOut *o)
 {
     memset(o, 0, sizeof *o);
-    for (int b = 0; b < 3; b++) {
+    for (int b = 0; b < RIB_N_VARS; b++) {
         if (!vars[b].d)
             continue;
         size_t src[16];
@@ -195,7 +199,7 @@ static int poly_vars(Rib *r, const RibVar *vars, const RibFaces *faces, const si
     if (!src)
         return rib_error(r, "out of memory");
     int e = 0;
-    for (int b = 0; b < 3 && e == 0; b++) {
+    for (int b = 0; b < RIB_N_VARS && e == 0; b++) {
         if (!vars[b].d)
             continue;
         switch (vars[b].cls) {
@@ -294,7 +298,7 @@ static int grow_sizes(size_t **a, size_t *cap, size_t n)
 static int emit_polys(Rib *r, const Polys *g, const float *P, size_t n_points, const Param *par,
                       size_t n_par)
 {
-    RibVar vars[3];
+    RibVar vars[RIB_N_VARS];
     rib_vars(r, par, n_par, vars);
     int flip = flip_of(r);
     RibFaces faces = {0};
@@ -642,7 +646,7 @@ static int subdiv_vars(Rib *r, const RibVar *vars, size_t n_faces, size_t n_poin
                                                [CLS_VERTEX] = RAYES_PRIMVAR_VERTEX,
                                                [CLS_FACEVARYING] = RAYES_PRIMVAR_FACEVARYING};
     int e = 0;
-    for (int b = 0; b < 3 && e == 0; b++) {
+    for (int b = 0; b < RIB_N_VARS && e == 0; b++) {
         if (!vars[b].d)
             continue;
         RayesPrimvarClass c = cls_of[vars[b].cls];
@@ -705,7 +709,7 @@ static int subdivision_mesh(Rib *r, const Args *a, int per)
         e = rib_error(r, "out of memory");
     for (size_t k = 0; e == 0 && k < n_idx; k++)
         wound[k] = verts[order[k]];
-    RibVar vars[3];
+    RibVar vars[RIB_N_VARS];
     if (e == 0) {
         rib_vars(r, p, n, vars);
         e = subdiv_vars(r, vars, n_faces, np, order, n_idx, &pv);
@@ -792,9 +796,9 @@ static int emit_bilinear(Rib *r, const float P[4][3], const PvOut *pv)
                : rib_sink_failed(r, s);
 }
 
-/* The colour of a quadric: Cs constant/uniform (index u_index), or the
- * average of the given varying/vertex indices (quadrics take no primitive
- * variables). */
+/* The colour (or opacity) of a quadric: Cs (Os) constant/uniform (index
+ * u_index), or the average of the given varying/vertex indices (quadrics
+ * take no primitive variables). */
 static const float *patch_color(Rib *r, const Param *cs, size_t uniform_index,
                                 const size_t *vi, size_t nvi, const size_t *vv, size_t nvv,
                                 float out[3])
@@ -807,8 +811,14 @@ static const float *patch_color(Rib *r, const Param *cs, size_t uniform_index,
             out[c] = (float)cs->v->d[3 * j + c];
         return out;
     }
-    rib_warn_once(r, "vertex Cs", "per-vertex colours (Cs) of quadrics are averaged: quadrics take "
-                              "one colour");
+    if (strcmp(cs->d.name, "Cs") == 0)
+        rib_warn_once(r, "vertex Cs",
+                      "per-vertex colours (Cs) of quadrics are averaged: "
+                      "quadrics take one colour");
+    else
+        rib_warn_once(r, "vertex Os",
+                      "per-vertex opacities (Os) of quadrics are averaged: "
+                      "quadrics take one opacity");
     const size_t *ix = cs->d.cls == CLS_VERTEX ? vv : vi;
     size_t nx = cs->d.cls == CLS_VERTEX ? nvv : nvi;
     double s[3] = {0, 0, 0};
@@ -840,7 +850,7 @@ static int h_patch(Rib *r, const Args *a)
     Counts c = {1, 4, want, 4};
     if (e == 0)
         e = rib_check_counts(r, p, n, &c);
-    RibVar vars[3];
+    RibVar vars[RIB_N_VARS];
     PvOut pv = {0};
     if (e == 0) {
         rib_warn_unused(r, p, n);
@@ -921,7 +931,7 @@ static int h_patch_mesh(Rib *r, const Args *a)
     Counts c = {(size_t)(nup * nvp), (size_t)(nuvar * nvvar), np, (size_t)(nup * nvp * 4)};
     if (e == 0)
         e = rib_check_counts(r, p, n, &c);
-    RibVar vars[3];
+    RibVar vars[RIB_N_VARS];
     if (e == 0) {
         rib_warn_unused(r, p, n);
         rib_vars(r, p, n, vars);
@@ -986,9 +996,15 @@ static int h_quadric(Rib *r, const Args *a)
     if (e == 0) {
         rib_warn_unused(r, p, n);
         static const size_t corners[4] = {0, 1, 2, 3};
-        float col[3];
+        float col[3], op[3], saved[3];
         const float *Cs = patch_color(r, rib_color_param(r, p, n), 0, corners, 4, corners, 4, col);
-        e = rib_emit_begin(r, Cs);
+        const float *Os =
+            patch_color(r, rib_var_param(r, p, n, "Os", 3), 0, corners, 4, corners, 4, op);
+        memcpy(saved, r->a.Os, sizeof saved);
+        if (Os) /* the shader is sent with this opacity, as with a per-face colour */
+            memcpy(r->a.Os, Os, sizeof r->a.Os);
+        e = rib_emit_begin(r, Os && !Cs ? r->a.Cs : Cs);
+        memcpy(r->a.Os, saved, sizeof saved);
         if (e == 0) {
             SinkState *st;
             const IoSink *s = rib_out_sink(r, &st);

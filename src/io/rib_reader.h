@@ -36,10 +36,12 @@
 #define RAYES_IO_RIB_READER_H
 
 #include <stddef.h>
+#include <stdint.h>
 
 #include "io/rib_internal.h"
 #include "io/rib_lex.h"
 #include "io/sink.h"
+#include "rayes/shader.h"
 
 #define RIB_MAX_ARCHIVE_DEPTH 32
 #define RIB_MAX_STACK 1024
@@ -114,6 +116,9 @@ typedef struct Attr {
     int lod_coarse; /* DetailRange ends before infinity: a coarser representation,
                        whose primitives are skipped */
     int roundcurve; /* Attribute "dice" "roundcurve": curves without N are tubes */
+    uint32_t visibility; /* Attribute "visibility": RayesRayType bits of the rays that see it */
+    int hitmode;         /* Attribute "shade" "transmissionhitmode": RayesTransmissionHitMode */
+    int opacity_cache;   /* Attribute "shade" "opacitycache": 0, its opacity is never cached */
 } Attr;
 
 typedef struct SinkState {
@@ -126,6 +131,9 @@ typedef struct SinkState {
     int have_displacement;
     float rate, bound;
     int have_rate, have_bound;
+    uint32_t visibility;
+    int hitmode, opacity_cache;
+    int have_visibility, have_opacity_mode;
 } SinkState;
 
 #define RIB_LIGHT_PARAMS 12
@@ -293,11 +301,11 @@ const Param *rib_color_param(Rib *r, const Param *p, size_t n);
 
 /* ------------------------------------------ rib_prim.c: primitives' data */
 
-/* Primitive variables for one sink call (N, st, Cs; curves and points
- * add width); the data are owned. */
+/* Primitive variables for one sink call (N, st, Cs, Os; curves and
+ * points add width); the data are owned. */
 typedef struct PvOut {
-    RayesPrimvar pv[4];
-    float *data[4];
+    RayesPrimvar pv[5];
+    float *data[5];
     size_t n;
 } PvOut;
 

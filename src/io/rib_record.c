@@ -16,6 +16,8 @@ typedef enum CallKind {
     CALL_DISPLACEMENT,
     CALL_DISPLACEMENT_BOUND,
     CALL_SHADING_RATE,
+    CALL_VISIBILITY,   /* f[0]: the ray-type bits */
+    CALL_OPACITY_MODE, /* f[0]: the hit mode, f[1]: cache */
     CALL_BILINEAR,
     CALL_BICUBIC,
     CALL_MESH,
@@ -187,6 +189,16 @@ static RayesError rec_search_path(void *t, const char *kind, const char *path)
 static RayesError rec_rate(void *t, float r)
 {
     return floats(t, CALL_SHADING_RATE, &r, 1);
+}
+static RayesError rec_visibility(void *t, uint32_t ray_types)
+{
+    float f = (float)ray_types; /* a few low bits: exact */
+    return floats(t, CALL_VISIBILITY, &f, 1);
+}
+static RayesError rec_opacity_mode(void *t, RayesTransmissionHitMode mode, int cache)
+{
+    float f[2] = {(float)mode, (float)cache};
+    return floats(t, CALL_OPACITY_MODE, f, 2);
 }
 /* Copies primitive variables into the last call (names and data). */
 static RayesError keep_primvars(RibRecording *rec, RayesError e, const RayesPrimvar *pv,
@@ -375,6 +387,8 @@ IoSink rib_recording_sink(RibRecording *rec)
     s.curves = rec_curves;
     s.points = rec_points;
     s.volume = rec_volume;
+    s.set_visibility = rec_visibility;
+    s.set_opacity_mode = rec_opacity_mode;
     return s;
 }
 
@@ -405,6 +419,14 @@ RayesError rib_recording_replay(const RibRecording *rec, const IoSink *out,
         case CALL_DISPLACEMENT: e = out->set_displacement(t, c->name, c->params, c->n_params); break;
         case CALL_DISPLACEMENT_BOUND: e = out->set_displacement_bound(t, c->f[0]); break;
         case CALL_SHADING_RATE: e = out->set_shading_rate(t, c->f[0]); break;
+        case CALL_VISIBILITY:
+            e = out->set_visibility ? out->set_visibility(t, (uint32_t)c->f[0]) : RAYES_OK;
+            break;
+        case CALL_OPACITY_MODE:
+            e = out->set_opacity_mode
+                    ? out->set_opacity_mode(t, (RayesTransmissionHitMode)c->f[0], (int)c->f[1])
+                    : RAYES_OK;
+            break;
         case CALL_BILINEAR:
             e = out->bilinear_patch(t, (const float(*)[3])c->f, c->pv, c->n_pv);
             break;

@@ -1,7 +1,8 @@
 /*
  * io/rib_shade.c — shaders and lights of the RIB reader, and bringing the
  * sink up to date before each primitive (rib_emit_begin: transform,
- * shader and colour, displacement, shading rate, light links), sending
+ * visibility and opacity mode, shader and colour, displacement, shading
+ * rate, light links), sending
  * only what changed since the sink last heard it (SinkState).
  *
  * Shaders: a name built in or known to the sink (a plugin on its search
@@ -124,6 +125,33 @@ int rib_send_lights(Rib *r)
     return 0;
 }
 
+/* Sends the visibility and the opacity mode when they changed; both are
+ * properties of the objects made next, so the shader (which makes one) is
+ * sent again after them. Sinks without the methods (older ones) keep
+ * every object visible. */
+static int send_visibility(Rib *r, const IoSink *s, SinkState *st)
+{
+    const Attr *a = &r->a;
+    if (s->set_visibility && (!st->have_visibility || st->visibility != a->visibility)) {
+        if (s->set_visibility(s->target, a->visibility) != RAYES_OK)
+            return rib_sink_failed(r, s);
+        st->visibility = a->visibility;
+        st->have_visibility = 1;
+        st->have_shader = 0;
+    }
+    if (s->set_opacity_mode && (!st->have_opacity_mode || st->hitmode != a->hitmode ||
+                                st->opacity_cache != a->opacity_cache)) {
+        if (s->set_opacity_mode(s->target, (RayesTransmissionHitMode)a->hitmode,
+                                a->opacity_cache) != RAYES_OK)
+            return rib_sink_failed(r, s);
+        st->hitmode = a->hitmode;
+        st->opacity_cache = a->opacity_cache;
+        st->have_opacity_mode = 1;
+        st->have_shader = 0;
+    }
+    return 0;
+}
+
 /* Brings the sink up to date before a primitive; Cs overrides the
  * colour (a per-face colour) when not NULL. 1: skip (outside the world). */
 int rib_emit_begin(Rib *r, const float *Cs)
@@ -142,6 +170,8 @@ int rib_emit_begin(Rib *r, const float *Cs)
         memcpy(st->M, r->a.M, sizeof st->M);
         st->have_M = 1;
     }
+    if (send_visibility(r, s, st) != 0)
+        return -1;
     if (Cs) {
         if (send_shader(r, s, Cs) != 0)
             return -1;

@@ -3,9 +3,10 @@
  * the AttributeBegin/TransformBegin stack, coordinate systems, the camera
  * and image options (Format, Projection, Display, PixelSamples, ...) that
  * go to IoSettings or to the camera at WorldBegin, the attributes that
- * are values of Attr (colour, orientation, shading rate, Basis), and
- * Attribute and Option. Before WorldBegin the current transform is
- * camera_from_object, after it world_from_object (Attr.M).
+ * are values of Attr (colour, orientation, shading rate, Basis, ray
+ * visibility and opacity modes), and Attribute and Option. Before
+ * WorldBegin the current transform is camera_from_object, after it
+ * world_from_object (Attr.M).
  */
 #include <math.h>
 #include <stdio.h>
@@ -535,6 +536,91 @@ static int set_grid_size(Rib *r, double g)
     return 0;
 }
 
+/* The ray-type bits of Attribute "visibility"'s names: PRMan's "camera",
+ * "diffuse", "specular", "transmission" and the older "trace" (diffuse
+ * and specular alike); 0 for another name. */
+static uint32_t visibility_bits(const char *name)
+{
+    return strcmp(name, "camera") == 0         ? RAYES_RAY_CAMERA
+           : strcmp(name, "diffuse") == 0      ? RAYES_RAY_DIFFUSE
+           : strcmp(name, "specular") == 0     ? RAYES_RAY_SPECULAR
+           : strcmp(name, "transmission") == 0 ? RAYES_RAY_SHADOW
+           : strcmp(name, "trace") == 0        ? RAYES_RAY_DIFFUSE | RAYES_RAY_SPECULAR
+                                               : 0u;
+}
+
+/* The older "string transmission": "transparent" hides the object from
+ * shadow rays; "opaque" and "Os" use Os alone (the primitive hit mode;
+ * rayes does not force Os to 1), "shader" the shader. */
+static int visibility_string(Rib *r, const char *v)
+{
+    int mode = strcmp(v, "shader") == 0                           ? RAYES_TRANSMISSION_SHADER
+               : strcmp(v, "Os") == 0 || strcmp(v, "opaque") == 0 ? RAYES_TRANSMISSION_PRIMITIVE
+                                                                  : -1;
+    if (mode < 0 && strcmp(v, "transparent") != 0)
+        return rib_error(r,
+                         "Attribute \"visibility\" \"transmission\": expected "
+                         "\"transparent\", \"opaque\", \"Os\" or \"shader\", found \"%.64s\"",
+                         v);
+    if (mode < 0) {
+        r->a.visibility &= ~(uint32_t)RAYES_RAY_SHADOW;
+        return 0;
+    }
+    r->a.visibility |= RAYES_RAY_SHADOW;
+    r->a.hitmode = mode;
+    return 0;
+}
+
+/* One parameter of Attribute "visibility": 0 done, -1 error, 1 not ours. */
+static int attribute_visibility(Rib *r, const Param *q)
+{
+    uint32_t bits = visibility_bits(q->d.name);
+    if (!bits || q->v->n != 1)
+        return 1;
+    if (!rib_is_num(q->v))
+        return bits == RAYES_RAY_SHADOW ? visibility_string(r, q->v->s[0]) : 1;
+    if (q->v->d[0] != 0)
+        r->a.visibility |= bits;
+    else
+        r->a.visibility &= ~bits;
+    return 0;
+}
+
+/* One parameter of Attribute "shade": "string transmissionhitmode"
+ * ("primitive" or "shader") and rayes' "int opacitycache" (0: this
+ * object's opacity is never cached). 0 done, -1 error, 1 not ours. */
+static int attribute_shade(Rib *r, const Param *q)
+{
+    if (q->v->n != 1)
+        return 1;
+    if (strcmp(q->d.name, "opacitycache") == 0 && rib_is_num(q->v)) {
+        r->a.opacity_cache = q->v->d[0] != 0;
+        return 0;
+    }
+    if (strcmp(q->d.name, "transmissionhitmode") != 0 || rib_is_num(q->v))
+        return 1;
+    const char *v = q->v->s[0];
+    if (strcmp(v, "primitive") != 0 && strcmp(v, "shader") != 0)
+        return rib_error(r,
+                         "Attribute \"shade\" \"transmissionhitmode\": expected "
+                         "\"primitive\" or \"shader\", found \"%.64s\"",
+                         v);
+    r->a.hitmode = v[0] == 'p' ? RAYES_TRANSMISSION_PRIMITIVE : RAYES_TRANSMISSION_SHADER;
+    return 0;
+}
+
+/* Option "limits" "opacitycachememory": RenderMan's opacity cache, in KB. */
+static int set_opacity_cache_memory(Rib *r, double kb)
+{
+    if (!(kb > 0 && kb <= 1e10))
+        return rib_error(r,
+                         "Option \"limits\" \"opacitycachememory\": expected a positive "
+                         "size in KB, found %g",
+                         kb);
+    r->settings->opacity_cache_mb = kb * 1024.0 / 1e6;
+    return 0;
+}
+
 static int h_option_attribute(Rib *r, const Args *a)
 {
     size_t i = 0;
@@ -546,8 +632,14 @@ static int h_option_attribute(Rib *r, const Args *a)
     int option = strcmp(r->req, "Option") == 0, e = 0;
     for (size_t k = 0; k < n && e == 0; k++) {
         const Param *q = &p[k];
-        if (option && strcmp(group, "searchpath") == 0 && q->v->kind != ARG_NUM &&
-            q->v->kind != ARG_NUMS && q->v->n == 1) {
+        int mine = option                             ? 1
+                   : strcmp(group, "visibility") == 0 ? attribute_visibility(r, q)
+                   : strcmp(group, "shade") == 0      ? attribute_shade(r, q)
+                                                      : 1;
+        if (mine <= 0) {
+            e = mine;
+        } else if (option && strcmp(group, "searchpath") == 0 && q->v->kind != ARG_NUM &&
+                   q->v->kind != ARG_NUMS && q->v->n == 1) {
             e = search_path(r, q->d.name, q->v->s[0]);
         } else if (!option && strcmp(group, "displacementbound") == 0 &&
                    strcmp(q->d.name, "sphere") == 0 && rib_is_num(q->v) && q->v->n == 1) {
@@ -562,8 +654,8 @@ static int h_option_attribute(Rib *r, const Args *a)
                 r->settings->bounces = depth;
             else
                 r->settings->specular_depth = depth;
-        } else if (option && strcmp(group, "limits") == 0 &&
-                   strcmp(q->d.name, "gridsize") == 0 && rib_is_num(q->v) && q->v->n == 1) {
+        } else if (option && strcmp(group, "limits") == 0 && strcmp(q->d.name, "gridsize") == 0 &&
+                   rib_is_num(q->v) && q->v->n == 1) {
             e = set_grid_size(r, q->v->d[0]);
         } else if (option && strcmp(group, "limits") == 0 &&
                    strcmp(q->d.name, "texturememory") == 0 && rib_is_num(q->v) && q->v->n == 1) {
@@ -576,6 +668,10 @@ static int h_option_attribute(Rib *r, const Args *a)
                               kb);
             else
                 r->settings->texture_mb = kb * 1024.0 / 1e6;
+        } else if (option && strcmp(group, "limits") == 0 &&
+                   strcmp(q->d.name, "opacitycachememory") == 0 && rib_is_num(q->v) &&
+                   q->v->n == 1) {
+            e = set_opacity_cache_memory(r, q->v->d[0]);
         } else if (!option && strcmp(group, "dice") == 0 && strcmp(q->d.name, "roundcurve") == 0 &&
                    rib_is_num(q->v) && q->v->n == 1) {
             r->a.roundcurve = q->v->d[0] != 0;

@@ -13,6 +13,7 @@
 #include <string.h>
 
 #include "io/rib_internal.h"
+#include "rayes/shader.h"
 
 /* A growing text in memory. */
 typedef struct Stream {
@@ -34,6 +35,8 @@ struct RibWriter {
     size_t *links, n_links;  /* their lights; owned */
     unsigned char off[4097]; /* by handle: turned off by an Illuminate written */
     unsigned char area[4097]; /* by handle: an area light (not linkable in RIB) */
+    uint32_t visibility;      /* the RayesRayType bits written last (default: all) */
+    int hitmode, opacity_cache; /* the opacity mode written last (default: shader, 1) */
     char error[256];         /* the last error, "" if none */
 };
 
@@ -61,6 +64,8 @@ RibWriter *io_rib_writer_new(void)
     if (!w)
         return NULL;
     w->next_light = 1;
+    w->visibility = RAYES_RAY_CAMERA | RAYES_RAY_DIFFUSE | RAYES_RAY_SPECULAR | RAYES_RAY_SHADOW;
+    w->opacity_cache = 1;
     w->fov_y = -1.0f;
     if (stream_open(&w->options) != 0 || stream_open(&w->camera) != 0 ||
         stream_open(&w->world) != 0) {
@@ -288,11 +293,18 @@ static RayesError w_set_transform(void *t, const float m[16])
     return RAYES_OK;
 }
 
-/* Cs and Os from a shader's parameters (Color and Opacity in RIB). */
+/* Cs and Os from a shader's parameters when they are constants (Color
+ * and Opacity in RIB); bound to a pattern they stay shader parameters. */
+static int constant_color(const RayesParam *p)
+{
+    return p->name && (!strcmp(p->name, "Cs") || !strcmp(p->name, "Os")) &&
+           p->type != RAYES_PARAM_STRING && p->type != RAYES_PARAM_PATTERN;
+}
+
 static const RayesParam *find_param(const RayesParam *p, size_t n, const char *name)
 {
     for (size_t i = 0; i < n; i++)
-        if (p[i].name && strcmp(p[i].name, name) == 0 && p[i].type != RAYES_PARAM_STRING)
+        if (constant_color(&p[i]) && strcmp(p[i].name, name) == 0)
             return &p[i];
     return NULL;
 }
@@ -319,8 +331,7 @@ static RayesError w_set_shader(void *t, const char *name, const RayesParam *p, s
     RayesParam rest[64];
     size_t n_rest = 0;
     for (size_t i = 0; i < n; i++) {
-        if (p[i].name && (!strcmp(p[i].name, "Cs") || !strcmp(p[i].name, "Os")) &&
-            p[i].type != RAYES_PARAM_STRING)
+        if (constant_color(&p[i]))
             continue;
         if (n_rest == 64)
             return fail(w, RAYES_ERROR_INVALID_ARGUMENT, "set_shader: too many parameters");
@@ -418,17 +429,53 @@ static RayesError w_set_shading_rate(void *t, float rate)
     return RAYES_OK;
 }
 
+/* Attribute "visibility" when the bits change (transmission is shadow). */
+static RayesError w_set_visibility(void *t, uint32_t ray_types)
+{
+    RibWriter *w = t;
+    if (ray_types & RAYES_RAY_TRANSMISSION)
+        ray_types = (ray_types & ~(uint32_t)RAYES_RAY_TRANSMISSION) | RAYES_RAY_SHADOW;
+    if (ray_types == w->visibility)
+        return RAYES_OK;
+    w->visibility = ray_types;
+    fprintf(w->world.f,
+            "Attribute \"visibility\" \"int camera\" [%d] \"int diffuse\" [%d] "
+            "\"int specular\" [%d] \"int transmission\" [%d]\n",
+            !!(ray_types & RAYES_RAY_CAMERA), !!(ray_types & RAYES_RAY_DIFFUSE),
+            !!(ray_types & RAYES_RAY_SPECULAR), !!(ray_types & RAYES_RAY_SHADOW));
+    return RAYES_OK;
+}
+
+/* Attribute "shade" (transmissionhitmode, rayes' opacitycache) on change. */
+static RayesError w_set_opacity_mode(void *t, RayesTransmissionHitMode mode, int cache)
+{
+    RibWriter *w = t;
+    if (mode != RAYES_TRANSMISSION_SHADER && mode != RAYES_TRANSMISSION_PRIMITIVE)
+        return fail(w, RAYES_ERROR_INVALID_ARGUMENT, "opacity mode: out of range");
+    if ((int)mode == w->hitmode && (cache != 0) == w->opacity_cache)
+        return RAYES_OK;
+    w->hitmode = (int)mode;
+    w->opacity_cache = cache != 0;
+    fprintf(w->world.f,
+            "Attribute \"shade\" \"string transmissionhitmode\" [\"%s\"] "
+            "\"int opacitycache\" [%d]\n",
+            mode == RAYES_TRANSMISSION_PRIMITIVE ? "primitive" : "shader", w->opacity_cache);
+    return RAYES_OK;
+}
+
 /* --------------------------------------------------------- geometry */
 
 /* Floats per value of a primitive variable rayes.h knows ("width" is
  * curves' and points'), or 0. */
 static int primvar_size(const char *name)
 {
-    return !name ? 0
-           : strcmp(name, "st") == 0 ? 2
-           : strcmp(name, "N") == 0 || strcmp(name, "Cs") == 0 ? 3
-           : strcmp(name, "width") == 0 ? 1
-                                        : 0;
+    static const char *const three[] = {"N", "Cs", "Os"};
+    if (!name)
+        return 0;
+    for (size_t k = 0; k < sizeof three / sizeof three[0]; k++)
+        if (strcmp(name, three[k]) == 0)
+            return 3;
+    return strcmp(name, "st") == 0 ? 2 : strcmp(name, "width") == 0 ? 1 : 0;
 }
 
 /* Checks primitive variables as rayes.h does (expect[cls]: the counts of
@@ -976,6 +1023,8 @@ IoSink io_rib_writer_sink(RibWriter *w)
         .curves = w_curves,
         .points = w_points,
         .pattern = w_pattern,
+        .set_visibility = w_set_visibility,
+        .set_opacity_mode = w_set_opacity_mode,
     };
 }
 
@@ -1003,6 +1052,9 @@ static void settings_rib(FILE *f, const IoSettings *s)
     if (s->texture_mb > 0.0)
         fprintf(f, "Option \"limits\" \"int texturememory\" [%.0f]\n",
                 s->texture_mb * 1e6 / 1024.0);
+    if (s->opacity_cache_mb > 0.0)
+        fprintf(f, "Option \"limits\" \"int opacitycachememory\" [%.0f]\n",
+                s->opacity_cache_mb * 1e6 / 1024.0);
     if (s->exposure_gain != 1.0f || s->exposure_gamma != 1.0f)
         fprintf(f, "Exposure %.9g %.9g\n", (double)s->exposure_gain, (double)s->exposure_gamma);
     if (s->crop[0] != 0.0f || s->crop[1] != 1.0f || s->crop[2] != 0.0f || s->crop[3] != 1.0f)

@@ -49,6 +49,16 @@ static RayesError scene_set_shading_rate(void *t, float rate)
     return rayes_scene_set_shading_rate(t, rate);
 }
 
+static RayesError scene_set_visibility(void *t, uint32_t ray_types)
+{
+    return rayes_scene_set_visibility(t, ray_types);
+}
+
+static RayesError scene_set_opacity_mode(void *t, RayesTransmissionHitMode mode, int cache)
+{
+    return rayes_scene_set_opacity_mode(t, mode, cache);
+}
+
 static RayesError scene_bilinear_patch(void *t, const float P[4][3], const RayesPrimvar *pv,
                                        size_t n_pv)
 {
@@ -170,6 +180,8 @@ IoSink io_sink_scene(RayesScene *scene)
         .points = scene_points,
         .pattern = scene_pattern,
         .volume = scene_volume,
+        .set_visibility = scene_set_visibility,
+        .set_opacity_mode = scene_set_opacity_mode,
     };
 }
 

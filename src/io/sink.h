@@ -22,6 +22,7 @@
 #define RAYES_IO_SINK_H
 
 #include <stddef.h>
+#include <stdint.h>
 
 #include "rayes/rayes.h"
 
@@ -84,6 +85,11 @@ typedef struct IoSink {
     /* rayes_scene_volume (NULL in sinks without it: readers skip volumes
      * with one warning). */
     RayesError (*volume)(void *target, const float bound[6]);
+    /* rayes_scene_set_visibility and rayes_scene_set_opacity_mode (last,
+     * so older sinks leave them NULL: readers then make every object
+     * visible, with the shader's opacity, cached). */
+    RayesError (*set_visibility)(void *target, uint32_t ray_types);
+    RayesError (*set_opacity_mode)(void *target, RayesTransmissionHitMode mode, int cache);
 } IoSink;
 
 /* A sink that builds scene through rayes.h (borrowed, not retained). */
@@ -111,6 +117,8 @@ typedef struct IoSettings {
                                  "gridsize"); 0: not given */
     double texture_mb;        /* texture cache budget in 10^6 bytes (RIB Option "limits"
                                  "texturememory", in KB); 0: not given */
+    double opacity_cache_mb;  /* opacity cache budget in 10^6 bytes (RIB Option "limits"
+                                 "opacitycachememory", in KB); 0: not given */
     float crop[4];            /* xmin xmax ymin ymax in [0, 1] (RIB CropWindow); default 0 1 0 1 */
     float exposure_gain;      /* RIB Exposure; 1 when not given */
     float exposure_gamma;     /* RIB Exposure; 1 when not given */

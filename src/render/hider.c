@@ -122,7 +122,7 @@ static Rgb *shade_grid(Worker *w, uint32_t gi)
         put3(dPdv[k], gs->dPdv[i]);
         put3(I[k], d);
         put3(Cs[k], geom_vertex_color(gs, g, i, v3_load(obj->Cs)));
-        memcpy(Os[k], obj->Os, sizeof Os[k]);
+        put3(Os[k], geom_vertex_opacity(gs, g, i, v3_load(obj->Os)));
         u[k] = gs->uv[i][0];
         v[k] = gs->uv[i][1];
         du[k] = su;

@@ -35,8 +35,9 @@ typedef struct HitPoint {
     float curvature, offset;
 } HitPoint;
 
-/* Interpolates the grid at a hit (the shading normal, texture coordinates
- * and colour among the rest; Cs from obj without a primitive variable);
+/* Interpolates the grid at a hit (the shading normal, texture coordinates,
+ * colour and opacity among the rest; Cs and Os from obj without primitive
+ * variables);
  * N and Ng face the incoming ray. Returns 1 if the front side (dPdu x dPdv)
  * was hit. */
 static int hit_point(const Worker *w, const Ray *ray, const Hit *hit, const RenderObject *obj,
@@ -44,7 +45,8 @@ static int hit_point(const Worker *w, const Ray *ray, const Hit *hit, const Rend
 {
     const GridSet *gs = w->rs->gs;
     const Grid *g = &gs->grids[hit->grid];
-    Vec3 N = v3(0, 0, 0), du = N, dv = N, Cs = N, dflt = v3_load(obj->Cs);
+    Vec3 N = v3(0, 0, 0), du = N, dv = N, Cs = N, Os = N, dflt = v3_load(obj->Cs);
+    Vec3 Os_obj = v3_load(obj->Os);
     float u = 0.0f, v = 0.0f, st[2] = {0, 0}, dst[4] = {0, 0, 0, 0};
     for (int k = 0; k < hit->n_vertex; k++) {
         uint32_t i = hit->vertex[k];
@@ -55,12 +57,14 @@ static int hit_point(const Worker *w, const Ray *ray, const Hit *hit, const Rend
         u += gs->uv[i][0] * wk;
         v += gs->uv[i][1] * wk;
         Cs = v3_madd(Cs, geom_vertex_color(gs, g, i, dflt), wk);
+        Os = v3_madd(Os, geom_vertex_opacity(gs, g, i, Os_obj), wk);
         geom_vertex_st(gs, g, i, sti, dsti);
         for (int c = 0; c < 4; c++)
             dst[c] += dsti[c] * wk;
         st[0] += sti[0] * wk, st[1] += sti[1] * wk;
     }
     v3_store(hp->Cs, Cs);
+    v3_store(hp->Os, Os);
     hp->s = st[0], hp->t = st[1];
     memcpy(hp->dst, dst, sizeof dst);
     N = v3_normalize(N);
@@ -126,7 +130,6 @@ static Vec3 shade_hit(Worker *w, const Ray *ray, const Hit *hit, const RenderObj
 {
     HitPoint hp;
     int backfacing = !hit_point(w, ray, hit, obj, &hp);
-    memcpy(hp.Os, obj->Os, sizeof hp.Os);
     hp.key = key;
     hp.diff = (RayDiff){diff.width + diff.spread * hit->t, diff.spread};
     hit_footprint(&hp);
@@ -173,13 +176,25 @@ static Vec3 shade_hit(Worker *w, const Ray *ray, const Hit *hit, const RenderObj
     return v3(Ci[0][0], Ci[0][1], Ci[0][2]);
 }
 
+/* Os of the grid's primitive variable at a hit (by the hit's weights). */
+static Vec3 hit_Os(const GridSet *gs, const Hit *hit, const RenderObject *obj)
+{
+    const Grid *g = &gs->grids[hit->grid];
+    Vec3 Os = v3(0, 0, 0), Os_obj = v3_load(obj->Os);
+    for (int k = 0; k < hit->n_vertex; k++)
+        Os = v3_madd(Os, geom_vertex_opacity(gs, g, hit->vertex[k], Os_obj), hit->weight[k]);
+    return Os;
+}
+
 Vec3 integrator_opacity(Worker *w, const Ray *ray, const Hit *hit, RayDiff diff)
 {
-    const RenderObject *obj = &w->rs->objects[w->rs->gs->grids[hit->grid].object];
+    const GridSet *gs = w->rs->gs;
+    const RenderObject *obj = &w->rs->objects[gs->grids[hit->grid].object];
     if (!obj->transparent)
         return v3(1, 1, 1);
-    if (!obj->opacity_shader && !obj->Os_pattern)
-        return v3_load(obj->Os); /* constant */
+    if (!obj->opacity_shader && !obj->Os_pattern) /* Os alone: no shader runs */
+        return (gs->grids[hit->grid].primvars & GEOM_PV_OS) ? hit_Os(gs, hit, obj)
+                                                            : v3_load(obj->Os);
     if (w->set->opacity_cache && obj->opacity_cached)
         return radiosity_opacity_at_hit(w, hit, diff);
     Vec3 Oi;

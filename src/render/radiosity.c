@@ -180,11 +180,13 @@ typedef struct FillPoints {
 } FillPoints;
 
 /* Point p of the fill takes fine vertices vtx[0..n) with weights wt; its
- * colour is the object's dflt unless the grid has its own. */
+ * colour and opacity are the object's unless the grid has its own. */
 static void put_point(const GridSet *gs, const Grid *g, FillPoints *fp, size_t p,
-                      const uint32_t *vtx, const float *wt, int nv, int side, Vec3 dflt)
+                      const uint32_t *vtx, const float *wt, int nv, int side,
+                      const RenderObject *obj)
 {
-    Vec3 P = v3(0, 0, 0), N = P, Ng = P, du = P, dv = P, Cs = P;
+    Vec3 P = v3(0, 0, 0), N = P, Ng = P, du = P, dv = P, Cs = P, Os = P;
+    Vec3 Cs_obj = v3_load(obj->Cs), Os_obj = v3_load(obj->Os);
     float u = 0.0f, v = 0.0f, st[2] = {0, 0}, dst[4] = {0, 0, 0, 0};
     for (int k = 0; k < nv; k++) {
         uint32_t i = g->first_vertex + vtx[k];
@@ -196,7 +198,8 @@ static void put_point(const GridSet *gs, const Grid *g, FillPoints *fp, size_t p
         dv = v3_madd(dv, gs->dPdv[i], wt[k]);
         u += gs->uv[i][0] * wt[k];
         v += gs->uv[i][1] * wt[k];
-        Cs = v3_madd(Cs, geom_vertex_color(gs, g, i, dflt), wt[k]);
+        Cs = v3_madd(Cs, geom_vertex_color(gs, g, i, Cs_obj), wt[k]);
+        Os = v3_madd(Os, geom_vertex_opacity(gs, g, i, Os_obj), wt[k]);
         geom_vertex_st(gs, g, i, sti, dsti);
         st[0] += sti[0] * wt[k], st[1] += sti[1] * wt[k];
         for (int c = 0; c < 4; c++)
@@ -210,6 +213,7 @@ static void put_point(const GridSet *gs, const Grid *g, FillPoints *fp, size_t p
     memcpy(fp->N[p], &N, sizeof fp->N[p]);
     memcpy(fp->Ng[p], &Ng, sizeof fp->Ng[p]);
     memcpy(fp->Cs[p], &Cs, sizeof fp->Cs[p]);
+    memcpy(fp->Os[p], &Os, sizeof fp->Os[p]);
     fp->s[p] = st[0], fp->t[p] = st[1];
     memcpy(fp->dst[p], dst, sizeof dst);
     memcpy(fp->dPdu[p], &du, sizeof fp->dPdu[p]);
@@ -219,8 +223,8 @@ static void put_point(const GridSet *gs, const Grid *g, FillPoints *fp, size_t p
 }
 
 /* Positions of the level's points on the fine grid. */
-static void layout_points(const GridSet *gs, const Grid *g, int level, int side, Vec3 dflt,
-                          FillPoints *fp)
+static void layout_points(const GridSet *gs, const Grid *g, int level, int side,
+                          const RenderObject *obj, FillPoints *fp)
 {
     size_t p = 0;
     if (!g->triangular) {
@@ -231,7 +235,7 @@ static void layout_points(const GridSet *gs, const Grid *g, int level, int side,
                 int fi = quad_level_index(level, i, nu), fj = quad_level_index(level, j, nv);
                 uint32_t vtx = (uint32_t)(fj * nu + fi);
                 float one = 1.0f;
-                put_point(gs, g, fp, p++, &vtx, &one, 1, side, dflt);
+                put_point(gs, g, fp, p++, &vtx, &one, 1, side, obj);
             }
         return;
     }
@@ -245,7 +249,7 @@ static void layout_points(const GridSet *gs, const Grid *g, int level, int side,
             uint32_t vtx[3];
             for (int k = 0; k < 3; k++)
                 vtx[k] = geom_tri_vertex((uint32_t)n, (uint32_t)vi[k][0], (uint32_t)vi[k][1]);
-            put_point(gs, g, fp, p++, vtx, wt, 3, side, dflt);
+            put_point(gs, g, fp, p++, vtx, wt, 3, side, obj);
         }
 }
 
@@ -291,14 +295,13 @@ static void fill_radiosity(void *user, const CacheKey *key, size_t n, float (*ou
     fp.u = f1, fp.v = f1 + n, fp.du = f1 + 2 * n, fp.dv = f1 + 3 * n, fp.curv = f1 + 4 * n;
     fp.offset = f1 + 5 * n, fp.s = f1 + 6 * n, fp.t = f1 + 7 * n, fp.ds = f1 + 8 * n;
     fp.dt = f1 + 9 * n, fp.dst = (float(*)[4])(f1 + 10 * n);
-    layout_points(gs, g, key->level, key->side, v3_load(obj->Cs), &fp);
+    layout_points(gs, g, key->level, key->side, obj, &fp);
     uint64_t fill_key = hash_combine(hash_combine(w->set->seed, 0x7261646f73ull /* "rados" */),
                                      ((uint64_t)key->patch << 32) | ((uint64_t)key->depth << 16) |
                                          ((uint64_t)key->side << 8) | key->level);
     float width = level_edge(g, key->level), du, dv;
     level_footprint(g, key->level, &du, &dv);
     for (size_t i = 0; i < n; i++) {
-        memcpy(fp.Os[i], obj->Os, sizeof fp.Os[i]);
         fp.du[i] = du;
         fp.dv[i] = dv;
         path_st_footprint(fp.dst[i], du, dv, &fp.ds[i], &fp.dt[i]);

@@ -32,8 +32,9 @@ typedef struct RenderObject {
     float Cs[3], Os[3];                    /* surface colour and opacity */
     int light;                             /* index of the light it emits as, or -1 */
     const struct RayesPattern *Os_pattern; /* multiplies Os where not NULL (a cut-out) */
-    uint8_t transparent;                   /* 1: may be partly transparent (Os below 1, or a shader
-                                              with an opacity method): shadow rays ask its opacity and
+    uint8_t transparent;                   /* 1: may be partly transparent (Os or its primitive
+                                              variable below 1, or a shader with an opacity
+                                              method): shadow rays ask its opacity and
                                               other rays composite what lies behind it */
     uint8_t opacity_shader;                /* 1: its opacity is its shader's opacity method's
                                               (transmissionhitmode "shader"); 0: Os alone */

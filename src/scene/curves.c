@@ -32,9 +32,9 @@ static const float bezier_inverse[16] = {0, 0, 0, 1, 0, 0, 1.0f / 3, 1, 0, 1.0f 
                                          1, 1, 1, 1};
 
 /* The primitive variables curves and points read. */
-enum { VAR_WIDTH, VAR_N, VAR_CS, VAR_ST, N_VARS };
-static const char *const var_names[N_VARS] = {"width", "N", "Cs", "st"};
-static const int var_sizes[N_VARS] = {1, 3, 3, 2};
+enum { VAR_WIDTH, VAR_N, VAR_CS, VAR_ST, VAR_OS, N_VARS };
+static const char *const var_names[N_VARS] = {"width", "N", "Cs", "st", "Os"};
+static const int var_sizes[N_VARS] = {1, 3, 3, 2, 3};
 
 /* Value counts of each class, and the variables found. */
 typedef struct Vars {
@@ -62,8 +62,8 @@ static RayesError read_vars(RayesScene *s, const char *what, const RayesPrimvar 
             b++;
         if (b == N_VARS)
             return scene_fail(s, RAYES_ERROR_INVALID_ARGUMENT,
-                              "%s: unknown primitive variable \"%.64s\"; expected width, N, Cs or "
-                              "st",
+                              "%s: unknown primitive variable \"%.64s\"; expected width, N, Cs, "
+                              "st or Os",
                               what, pv[i].name ? pv[i].name : "(null)");
         if (vars->by[b])
             return scene_fail(s, RAYES_ERROR_INVALID_ARGUMENT,
@@ -88,6 +88,8 @@ static RayesError read_vars(RayesScene *s, const char *what, const RayesPrimvar 
                                       "%s: width %g is negative", what, (double)pv[i].data[k]);
         vars->by[b] = &pv[i];
     }
+    const RayesPrimvar *Os = vars->by[VAR_OS];
+    scene_note_Os(s, Os ? Os->data : NULL, Os ? Os->count : 0);
     return RAYES_OK;
 }
 
@@ -243,17 +245,18 @@ static void segment_bezier(const RayesScene *s, const RayesCurves *c, const SegS
     }
 }
 
-/* Appends Cs and st (when given) of a prim with n ends whose values are
- * end[e][var] (pool order: GEOM_PV_* bits, st before Cs; per end). */
+/* Appends st, Cs and Os (when given) of a prim with n ends whose values
+ * are end[e][var] (pool order: GEOM_PV_* bits, st before Cs before Os; per
+ * end). */
 static RayesError push_ends(RayesScene *s, Prim *p, const Vars *vars, float (*end)[N_VARS][3],
                             int n)
 {
-    static const unsigned bits[N_VARS] = {0, 0, GEOM_PV_CS, GEOM_PV_ST};
-    const int order[2] = {VAR_ST, VAR_CS};
-    float values[(GEOM_CURVE_RUN + 4) * 5];
+    static const unsigned bits[N_VARS] = {0, 0, GEOM_PV_CS, GEOM_PV_ST, GEOM_PV_OS};
+    const int order[3] = {VAR_ST, VAR_CS, VAR_OS};
+    float values[(GEOM_CURVE_RUN + 4) * 8];
     size_t k = 0;
     unsigned mask = 0;
-    for (int o = 0; o < 2; o++) {
+    for (int o = 0; o < 3; o++) {
         int b = order[o];
         if (!vars->by[b])
             continue;

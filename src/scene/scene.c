@@ -425,12 +425,22 @@ static RayesError add_prim(RayesScene *s, Prim *p)
     if (grow((void **)&s->prims, &s->cap_prims, s->n_prims, sizeof *s->prims) != 0)
         return fail(s, RAYES_ERROR_OUT_OF_MEMORY, "out of memory");
     p->object = (uint32_t)s->current_object;
+    if ((p->pv & GEOM_PV_OS) && s->pv_Os_below_1)
+        s->objects[p->object].Os_primvar_below_1 = 1;
     p->shading_rate = s->shading_rate;
     p->displacement = s->current_displacement;
     p->displacement_bound = s->displacement_bound;
     s->prims[s->n_prims++] = *p;
     scene_mark(s, SCENE_CHANGE_GEOMETRY);
     return RAYES_OK;
+}
+
+void scene_note_Os(RayesScene *s, const float *Os, size_t n)
+{
+    s->pv_Os_below_1 = 0;
+    for (size_t i = 0; Os && i < 3 * n; i++)
+        if (Os[i] < 1.0f)
+            s->pv_Os_below_1 = 1;
 }
 
 /* Room for n more floats in the primitive variable pool. */
@@ -491,7 +501,8 @@ static const struct {
     const char *name;
     unsigned bit;
     int size; /* floats per value */
-} primvar_names[3] = {{"N", GEOM_PV_N, 3}, {"st", GEOM_PV_ST, 2}, {"Cs", GEOM_PV_CS, 3}};
+} primvar_names[GEOM_N_PV] = {
+    {"N", GEOM_PV_N, 3}, {"st", GEOM_PV_ST, 2}, {"Cs", GEOM_PV_CS, 3}, {"Os", GEOM_PV_OS, 3}};
 
 static const char *const primvar_class_names[5] = {"constant", "uniform", "varying", "vertex",
                                                    "facevarying"};
@@ -499,7 +510,7 @@ static const char *const primvar_class_names[5] = {"constant", "uniform", "varyi
 /* A call's primitive variables, checked: by[b] is the one named
  * primvar_names[b].name, or NULL. */
 typedef struct PrimvarSet {
-    const RayesPrimvar *by[3];
+    const RayesPrimvar *by[GEOM_N_PV];
     unsigned mask;            /* GEOM_PV_* bits given */
     Mat4 normal_from_object;  /* for N: the inverse transpose of world_from_object */
 } PrimvarSet;
@@ -514,11 +525,11 @@ static RayesError check_primvars(RayesScene *s, const char *what, const RayesPri
         return fail(s, RAYES_ERROR_INVALID_ARGUMENT, "%s: primitive variables are NULL", what);
     for (size_t i = 0; i < n_pv; i++) {
         int b = 0;
-        while (b < 3 && !(pv[i].name && strcmp(pv[i].name, primvar_names[b].name) == 0))
+        while (b < GEOM_N_PV && !(pv[i].name && strcmp(pv[i].name, primvar_names[b].name) == 0))
             b++;
-        if (b == 3)
+        if (b == GEOM_N_PV)
             return fail(s, RAYES_ERROR_INVALID_ARGUMENT,
-                        "%s: unknown primitive variable \"%.64s\"; expected N, st or Cs", what,
+                        "%s: unknown primitive variable \"%.64s\"; expected N, st, Cs or Os", what,
                         pv[i].name ? pv[i].name : "(null)");
         if (set->by[b])
             return fail(s, RAYES_ERROR_INVALID_ARGUMENT, "%s: primitive variable %s given twice",
@@ -540,6 +551,8 @@ static RayesError check_primvars(RayesScene *s, const char *what, const RayesPri
         set->by[b] = &pv[i];
         set->mask |= primvar_names[b].bit;
     }
+    const RayesPrimvar *Os = set->by[GEOM_N_PV - 1];
+    scene_note_Os(s, Os ? Os->data : NULL, Os ? Os->count : 0);
     Mat4 inv;
     mat4_invert(s->world_from_object, &inv);
     set->normal_from_object = mat4_transpose(inv);
@@ -574,12 +587,12 @@ static RayesError push_primvars(RayesScene *s, Prim *p, const PrimvarSet *set,
     if (!set->mask)
         return RAYES_OK;
     size_t need = 0;
-    for (int b = 0; b < 3; b++)
+    for (int b = 0; b < GEOM_N_PV; b++)
         if (set->by[b])
             need += (size_t)((cubic & primvar_names[b].bit) ? 16 : n) * (size_t)primvar_names[b].size;
     if (reserve_pv(s, need) != RAYES_OK)
         return RAYES_ERROR_OUT_OF_MEMORY;
-    for (int b = 0; b < 3; b++) {
+    for (int b = 0; b < GEOM_N_PV; b++) {
         const RayesPrimvar *v = set->by[b];
         if (!v)
             continue;
@@ -642,7 +655,7 @@ RayesError rayes_scene_bicubic_patch_pv(RayesScene *s, const float P[16][3],
     if (e != RAYES_OK)
         return e;
     unsigned cubic = 0;
-    for (int b = 0; b < 3; b++)
+    for (int b = 0; b < GEOM_N_PV; b++)
         if (set.by[b] && set.by[b]->cls == RAYES_PRIMVAR_VERTEX)
             cubic |= primvar_names[b].bit;
     Prim p = {.type = PRIM_BICUBIC};
@@ -817,7 +830,7 @@ RayesError rayes_scene_subdivision_mesh(RayesScene *s, RayesSubdivScheme scheme,
         d.corner_sharpness = tags->corner_sharpness;
         d.n_holes = tags->n_holes, d.hole_faces = tags->hole_faces;
     }
-    for (int b = 0; b < 3; b++)
+    for (int b = 0; b < GEOM_N_PV; b++)
         if (set.by[b])
             d.pv[d.n_pv++] = (SubdivPrimvar){primvar_names[b].bit, (int)set.by[b]->cls,
                                              primvar_names[b].size, b == 0 ? N : set.by[b]->data};

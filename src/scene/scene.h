@@ -32,6 +32,8 @@ typedef struct SceneObject {
                                                 naming one), multiplying Os, or NULL */
     uint8_t transmission_hitmode;          /* RayesTransmissionHitMode */
     uint8_t opacity_cache;                 /* 1: its opacity may be cached */
+    uint8_t Os_primvar_below_1;            /* 1: an Os primitive variable of one of its
+                                              primitives is below 1 somewhere */
 } SceneObject;
 
 /* A volume (rayes_scene_volume): a box of object space under a transform,
@@ -119,6 +121,8 @@ struct RayesScene {
     uint32_t current_visibility;   /* of objects made next: RayesRayType bits that see them */
     uint8_t current_hitmode;       /* of objects made next: RayesTransmissionHitMode */
     uint8_t current_opacity_cache; /* of objects made next: 1, their opacity may be cached */
+    uint8_t pv_Os_below_1;         /* the primitive variables being added have an Os below 1
+                                      (scene_note_Os), for the object add_prim puts them in */
     uint64_t timestamp;            /* commits so far */
     int dirty;                     /* edited since the last commit */
     unsigned changes;              /* SceneChange bits since the last commit */
@@ -197,6 +201,10 @@ RayesError scene_fail(RayesScene *scene, RayesError e, const char *fmt, ...)
     __attribute__((format(printf, 3, 4)));
 RayesError scene_push_values(RayesScene *scene, Prim *p, unsigned mask, const float *values,
                              size_t n);
+/* Notes whether an Os primitive variable of n values (or none: NULL) has
+ * a component below 1, so that the object of the primitives added next
+ * is transparent. */
+void scene_note_Os(RayesScene *scene, const float *Os, size_t n);
 
 /* The bounds of all primitives' control points (lights included). */
 Bounds3 scene_bounds(const RayesScene *scene);

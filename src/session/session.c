@@ -255,7 +255,7 @@ RenderObject *session_render_objects(const RayesScene *scene)
         ro[i].Os_pattern = so->Os_pattern;
         ro[i].transparent =
             so->light < 0 && (ro[i].opacity_shader || so->Os_pattern || so->Os[0] < 1.0f ||
-                              so->Os[1] < 1.0f || so->Os[2] < 1.0f);
+                              so->Os[1] < 1.0f || so->Os[2] < 1.0f || so->Os_primvar_below_1);
         ro[i].opacity_cached = so->opacity_cache != 0;
         if (so->links == 0)
             continue;

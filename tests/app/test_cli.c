@@ -443,6 +443,35 @@ static void test_rib_grid_size(void)
     CHECK(strstr(json, "\"grid_size\": 128,") != NULL);
 }
 
+/* RIB's Option "limits" "opacitycachememory" (KB) sets the opacity
+ * entries' budget unless --opacity-cache-mb says otherwise. */
+static void test_rib_opacity_cache_memory(void)
+{
+    static Run r;
+    char json[8192];
+    setup();
+    write_text(SCRATCH_DIR "/ocm.rib", "Option \"limits\" \"opacitycachememory\" [2048]\n"
+                                       "Projection \"perspective\" \"fov\" 40\n"
+                                       "WorldBegin\nLightSource \"pointlight\" 1\n"
+                                       "Translate 0 0 5\nSphere 1 -1 1 360\n"
+                                       "WorldEnd\n");
+    run(&r, NULL,
+        ARGS("render", SCRATCH_DIR "/ocm.rib", "--res", "8", "--spp", "1", "--quiet", "-o",
+             SCRATCH_DIR "/ocm.png", "--stats", SCRATCH_DIR "/ocm.json"));
+    CHECK(r.status == 0 && r.err[0] == '\0');
+    read_file(SCRATCH_DIR "/ocm.json", json, sizeof json);
+    const char *o = strstr(json, "\"opacity\": {");
+    CHECK(o && strstr(o, "\"budget_bytes\": 2097152,") != NULL);
+    run(&r, NULL,
+        ARGS("render", SCRATCH_DIR "/ocm.rib", "--res", "8", "--spp", "1", "--quiet",
+             "--opacity-cache-mb", "5", "-o", SCRATCH_DIR "/ocm.png", "--stats",
+             SCRATCH_DIR "/ocm.json"));
+    CHECK(r.status == 0);
+    read_file(SCRATCH_DIR "/ocm.json", json, sizeof json);
+    o = strstr(json, "\"opacity\": {");
+    CHECK(o && strstr(o, "\"budget_bytes\": 5000000,") != NULL);
+}
+
 /* --vertex-budget: a scene needing more grid vertices is diced coarser,
  * with one warning giving the need and the factor, and the statistics
  * report the factor; --dice-offscreen is read. */
@@ -653,6 +682,6 @@ static void test_frames_and_crop(void)
 TEST_MAIN(TEST(test_version_and_help), TEST(test_no_arguments), TEST(test_usage_errors),
           TEST(test_missing_data), TEST(test_render_outputs), TEST(test_render_summary),
           TEST(test_data_from_environment), TEST(test_unwritable_output), TEST(test_shader_path),
-          TEST(test_render_obj), TEST(test_rib_grid_size), TEST(test_vertex_budget),
-          TEST(test_null_displacement), TEST(test_default_light), TEST(test_convert),
-          TEST(test_bad_scene_file), TEST(test_frames_and_crop))
+          TEST(test_render_obj), TEST(test_rib_grid_size), TEST(test_rib_opacity_cache_memory),
+          TEST(test_vertex_budget), TEST(test_null_displacement), TEST(test_default_light),
+          TEST(test_convert), TEST(test_bad_scene_file), TEST(test_frames_and_crop))

@@ -302,10 +302,10 @@ static void test_refused(void)
           RAYES_ERROR_INVALID_ARGUMENT);
     CHECK(strstr(rayes_scene_get_error(s), "polygon mesh: vertex st has 4 values; expected 5"));
     rayes_scene_clear_error(s);
-    pv = (RayesPrimvar){"Os", RAYES_PRIMVAR_CONSTANT, st, 1};
+    pv = (RayesPrimvar){"Oi", RAYES_PRIMVAR_CONSTANT, st, 1};
     CHECK(rayes_scene_polygon_mesh_pv(s, 2, mesh_nv, mesh_idx, 5, &mesh_P[0][0], &pv, 1) ==
           RAYES_ERROR_INVALID_ARGUMENT);
-    CHECK(strstr(rayes_scene_get_error(s), "unknown primitive variable \"Os\""));
+    CHECK(strstr(rayes_scene_get_error(s), "unknown primitive variable \"Oi\""));
     rayes_scene_clear_error(s);
     pv = (RayesPrimvar){"st", (RayesPrimvarClass)7, st, 1};
     CHECK(rayes_scene_polygon_mesh_pv(s, 2, mesh_nv, mesh_idx, 5, &mesh_P[0][0], &pv, 1) ==

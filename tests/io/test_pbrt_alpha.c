@@ -1,0 +1,192 @@
+/*
+ * pbrt-v4's "alpha" on shapes rendered through io_sink_scene
+ * (io/pbrt_shape.c): a constant alpha is opacity Os (0 casts no shadow,
+ * 0.5 half of one), and a float texture's alpha cuts out where it is 0 (a
+ * checkerboard's shadow is a checkerboard). pbrt cuts out stochastically
+ * where alpha is fractional; rayes' opacity is the same in expectation.
+ *
+ * The scene: the camera at z = 6 looks down at the floor (z = 0, seeing
+ * [-1, 1]^2 of it); a point light low at x = 4 is hidden from the whole
+ * visible floor by a wall at x = 2.5, out of view, which carries the
+ * alpha.
+ */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "io/pbrt.h"
+#include "io/rib.h"
+#include "io/rib_write.h"
+#include "rayes/rayes.h"
+#include "test.h"
+
+enum { SIZE = 32 };
+
+/* The scene's text with the wall's shape parameters (NULL: no wall). */
+static void scene_text(const char *wall, char *text, size_t size)
+{
+    snprintf(text, size,
+             "LookAt 0 0 6  0 0 0  0 1 0\nCamera \"perspective\" \"float fov\" 18.92\n"
+             "WorldBegin\nLightSource \"point\" \"point3 from\" [4 0 1] \"rgb I\" [10 10 10]\n"
+             "Texture \"checks\" \"float\" \"checkerboard\" \"float uscale\" 4 "
+             "\"float vscale\" 4 \"float tex1\" 0 \"float tex2\" 1\n"
+             "Material \"diffuse\"\n"
+             "Shape \"bilinearmesh\" \"point3 P\" [-4 -4 0 4 -4 0 -4 4 0 4 4 0] "
+             "\"integer indices\" [0 1 2 3]\n"
+             "%s%s\n",
+             wall ? "Shape \"bilinearmesh\" \"point3 P\" [2.5 -3 0.01 2.5 3 0.01 2.5 -3 2 2.5 3 2] "
+                    "\"integer indices\" [0 1 2 3] \"point2 uv\" [0 0 1 0 0 1 1 1] "
+                  : "",
+             wall ? wall : "");
+}
+
+/* The image of a scene read (by read, into io_sink_scene), its opacity
+ * cached or not. */
+static RayesImage *render_read(RayesError (*read)(const char *, const unsigned char *, size_t,
+                                                  const IoSink *, const IoReadOptions *,
+                                                  IoSettings *, char *, size_t),
+                               const char *text, int opacity_cache)
+{
+    RayesScene *s = rayes_scene_new();
+    IoSink sink = io_sink_scene(s);
+    IoSettings settings;
+    io_settings_init(&settings);
+    IoReadOptions opt = {NULL, -1};
+    char err[512] = "";
+    RayesImage *img = NULL;
+    RayesError e = read("alpha.pbrt", (const unsigned char *)text, strlen(text), &sink, &opt,
+                        &settings, err, sizeof err);
+    if (e != RAYES_OK)
+        fprintf(stderr, "  %s\n", err);
+    CHECK(e == RAYES_OK);
+    if (e == RAYES_OK && rayes_scene_commit(s) == RAYES_OK) {
+        RayesRenderOptions o;
+        rayes_render_options_init(&o, RAYES_QUALITY_PREVIEW);
+        o.width = o.height = SIZE;
+        o.spp = 1;
+        o.threads = 2;
+        o.bounces = 0;
+        o.opacity_cache = opacity_cache;
+        CHECK(rayes_render(s, &o, &img, NULL) == RAYES_OK);
+    }
+    rayes_scene_release(s);
+    return img;
+}
+
+/* The scene with the wall's shape parameters (NULL: no wall), its
+ * opacity cached or not. */
+static RayesImage *render_pbrt(const char *wall, int opacity_cache)
+{
+    char text[4096];
+    scene_text(wall, text, sizeof text);
+    return render_read(io_pbrt_parse, text, opacity_cache);
+}
+
+static double mean_red(const RayesImage *img)
+{
+    double t = 0;
+    for (int i = 0; i < SIZE * SIZE; i++)
+        t += img->rgba[4 * i];
+    return t / (SIZE * SIZE);
+}
+
+static void test_constant_alpha(void)
+{
+    RayesImage *open = render_pbrt(NULL, 1), *wall = render_pbrt("", 1),
+               *half = render_pbrt("\"float alpha\" 0.5", 1),
+               *gone = render_pbrt("\"float alpha\" 0", 1);
+    CHECK(open && wall && half && gone);
+    if (open && wall && half && gone) {
+        CHECK(mean_red(open) > 0.01);
+        CHECK(mean_red(wall) == 0.0);
+        CHECK_NEAR(mean_red(half) / mean_red(open), 0.5, 1e-4);
+        CHECK_NEAR(mean_red(gone) / mean_red(open), 1.0, 1e-4);
+    }
+    rayes_image_free(open);
+    rayes_image_free(wall);
+    rayes_image_free(half);
+    rayes_image_free(gone);
+}
+
+/* A checkerboard alpha (0 and 1), uncached: about half the floor lit as
+ * if the wall were not there, half dark, in cells, and half the light in
+ * all. Cached, the wall (out of view, diced coarsely) shadows with its
+ * cells' mean at a cache level's resolution: half the light too. */
+static void test_texture_alpha(void)
+{
+    RayesImage *open = render_pbrt(NULL, 0),
+               *checks = render_pbrt("\"texture alpha\" \"checks\"", 0),
+               *cached = render_pbrt("\"texture alpha\" \"checks\"", 1);
+    CHECK(open && checks && cached);
+    if (open && checks && cached) {
+        int lit = 0, dark = 0;
+        for (int i = 0; i < SIZE * SIZE; i++) {
+            float a = checks->rgba[4 * i], b = open->rgba[4 * i];
+            lit += fabsf(a - b) < 0.02f * b;
+            dark += a < 0.02f * b;
+        }
+        double ratio = mean_red(checks) / mean_red(open);
+        fprintf(stderr, "checkerboard alpha: %d lit, %d dark of %d; %g of the light (%g cached)\n",
+                lit, dark, SIZE * SIZE, ratio, mean_red(cached) / mean_red(open));
+        CHECK(lit > SIZE * SIZE / 4 && dark > SIZE * SIZE / 4);
+        CHECK(ratio > 0.4 && ratio < 0.6);
+        CHECK_NEAR(mean_red(cached) / mean_red(checks), 1.0, 0.02);
+    }
+    rayes_image_free(open);
+    rayes_image_free(checks);
+    rayes_image_free(cached);
+}
+
+/* Converted to RIB (the writer keeps Os bound to the pattern), the scene
+ * renders the same. */
+static void test_rib_round_trip(void)
+{
+    char text[4096], err[512], *rib = NULL;
+    size_t size = 0;
+    scene_text("\"texture alpha\" \"checks\"", text, sizeof text);
+    RibWriter *w = io_rib_writer_new();
+    IoSink sink = io_rib_writer_sink(w);
+    IoSettings settings;
+    io_settings_init(&settings);
+    CHECK(io_pbrt_parse("alpha.pbrt", (const unsigned char *)text, strlen(text), &sink, NULL,
+                        &settings, err, sizeof err) == RAYES_OK);
+    FILE *f = open_memstream(&rib, &size);
+    CHECK(io_rib_writer_finish(w, &settings, f, err, sizeof err) == RAYES_OK);
+    fclose(f);
+    CHECK(strstr(rib, "\"reference pattern Os\"") != NULL);
+    RayesImage *a = render_pbrt("\"texture alpha\" \"checks\"", 0),
+               *b = render_read(io_rib_parse, rib, 0);
+    CHECK(a && b);
+    if (a && b) {
+        float d = 0;
+        for (int i = 0; i < 4 * SIZE * SIZE; i++)
+            d = fmaxf(d, fabsf(a->rgba[i] - b->rgba[i]));
+        CHECK(d < 1e-4f);
+    }
+    rayes_image_free(a);
+    rayes_image_free(b);
+    io_rib_writer_free(w);
+    free(rib);
+}
+
+static void test_bad_alpha(void)
+{
+    const char *text = "WorldBegin\nShape \"sphere\" \"string alpha\" \"x\"\n";
+    RayesScene *s = rayes_scene_new();
+    IoSink sink = io_sink_scene(s);
+    IoSettings settings;
+    io_settings_init(&settings);
+    char err[512] = "";
+    CHECK(io_pbrt_parse("alpha.pbrt", (const unsigned char *)text, strlen(text), &sink, NULL,
+                        &settings, err, sizeof err) != RAYES_OK);
+    CHECK(strstr(err, "alpha.pbrt:2:") && strstr(err, "alpha") && !strchr(err, '\n'));
+    text = "WorldBegin\nShape \"sphere\" \"texture alpha\" \"nothing\"\n";
+    CHECK(io_pbrt_parse("alpha.pbrt", (const unsigned char *)text, strlen(text), &sink, NULL,
+                        &settings, err, sizeof err) != RAYES_OK);
+    CHECK(strstr(err, "alpha.pbrt:2:") != NULL);
+    rayes_scene_release(s);
+}
+
+TEST_MAIN(TEST(test_constant_alpha), TEST(test_texture_alpha), TEST(test_rib_round_trip),
+          TEST(test_bad_alpha))
