@@ -776,8 +776,31 @@ static RayesRenderOptions figure8_options(const Args *a, int size, int threads, 
     return o;
 }
 
+/* The figure's montage: a row per experiment of uncached, cached and 20x
+ * difference, each box-filtered down to at most 256 pixels a side. */
+typedef struct Montage {
+    int tile, rows; /* pixels a side of each image; experiments */
+    float *rgba;    /* 3 tile x rows tile pixels */
+} Montage;
+
+static void montage_put(Montage *m, int row, int col, const float *rgba, int size)
+{
+    int f = size / m->tile, w = 3 * m->tile;
+    for (int y = 0; y < m->tile; y++)
+        for (int x = 0; x < m->tile; x++)
+            for (int c = 0; c < 4; c++) {
+                float sum = 0.0f;
+                for (int j = 0; j < f; j++)
+                    for (int i = 0; i < f; i++)
+                        sum += rgba[4 * ((size_t)(y * f + j) * size + x * f + i) + c];
+                m->rgba[4 * ((size_t)(row * m->tile + y) * w + col * m->tile + x) + c] =
+                    c == 3 ? 1.0f : sum / (float)(f * f);
+            }
+}
+
 /* 20 |on - off| to DIR/figure8TAG-diff.png. */
-static void write_diff(const Args *a, const char *tag, const Row *on, const Row *off)
+static void write_diff(const Args *a, const char *tag, const Row *on, const Row *off, Montage *m,
+                       int row)
 {
     size_t n = (size_t)on->w * on->h;
     float *diff = malloc(n * 4 * sizeof *diff);
@@ -792,6 +815,9 @@ static void write_diff(const Args *a, const char *tag, const Row *on, const Row 
     snprintf(path, sizeof path, "%s/figure8%s-diff.png", a->out, tag);
     if (image_write(path, on->w, on->h, diff, err, sizeof err) != RAYES_OK)
         die(err);
+    montage_put(m, row, 0, off->rgba, off->w);
+    montage_put(m, row, 1, on->rgba, on->w);
+    montage_put(m, row, 2, diff, on->w);
     free(diff);
 }
 
@@ -808,7 +834,7 @@ static void write_row(const Args *a, const char *tag, const Row *r)
  * --check-size on 1 thread and with a 2 kB opacity budget against the
  * same on a->threads, bit for bit. */
 static void figure8_experiment(const Args *a, FILE *j, const char *tag, RayesScene *scene,
-                               int first)
+                               int first, Montage *m)
 {
     RayesRenderOptions o = figure8_options(a, a->size, a->threads, 0, 20.0);
     Row off = {.cache = 0}, on = {.cache = 1};
@@ -841,7 +867,7 @@ static void figure8_experiment(const Args *a, FILE *j, const char *tag, RayesSce
     accuracy(&on, &off, &mrel, &trel, where, sizeof where);
     write_row(a, tag, &off);
     write_row(a, tag, &on);
-    write_diff(a, tag, &on, &off);
+    write_diff(a, tag, &on, &off, m, first ? 0 : 1);
 
     Row base = on, one = {.cache = 1}, tiny = {.cache = 1};
     if (a->check_size != a->size) {
@@ -907,9 +933,14 @@ static void figure8(const Args *a, FILE *j)
     fprintf(j, "{\"figure\": 8, \"size\": %d, \"spp\": %d, \"threads\": %d, \"rows\": [", a->size,
             a->spp, a->threads);
     int first = 1;
+    Montage m = {a->size / ((a->size + 255) / 256), 0, NULL};
+    m.rows = (strchr(a->experiment, 'a') != NULL) + (strchr(a->experiment, 'b') != NULL);
+    m.rgba = calloc((size_t)3 * m.tile * m.tile * (m.rows ? m.rows : 1) * 4, sizeof *m.rgba);
+    if (!m.rgba)
+        die("out of memory");
     if (strchr(a->experiment, 'a')) {
         RayesScene *s = stained_glass_scene();
-        figure8_experiment(a, j, "a", s, first);
+        figure8_experiment(a, j, "a", s, first, &m);
         rayes_scene_release(s);
         first = 0;
     }
@@ -920,11 +951,17 @@ static void figure8(const Args *a, FILE *j)
         snprintf(png, sizeof png, "%s/leaf.png", dir);
         write_leaf(png, 512);
         RayesScene *s = leaf_scene(png, a->ao_samples);
-        figure8_experiment(a, j, "b", s, first);
+        figure8_experiment(a, j, "b", s, first, &m);
         rayes_scene_release(s);
         remove(png);
         rmdir(dir);
     }
+    char path[1024], err[1024];
+    snprintf(path, sizeof path, "%s/figure8.png", a->out);
+    if (m.rows && a->only < 0 &&
+        image_write(path, 3 * m.tile, m.rows * m.tile, m.rgba, err, sizeof err) != RAYES_OK)
+        die(err);
+    free(m.rgba);
     fprintf(j, "\n  ]\n}\n");
 }
 
