@@ -29,9 +29,12 @@ static void premultiply(const RayesShadeCtx *ctx, const Rgb *own, RayesShadeOutp
  * Panes of coloured glass held by lead came, over (s, t): frequency cells
  * per unit, their borders bent by noise; each pane has a hue of its own
  * and a clarity that varies with five octaves of noise (bubbles and
- * streaks in the glass). The opacity method returns 1 - the pane's
- * transmission colour (lead: 1), so shadow rays through it are coloured;
- * lighting reflects Kd times the pane's colour, premultiplied. */
+ * streaks in the glass). The lead's edges are box filtered over the
+ * point's footprint (du, dv), as a production shader antialiases them, so
+ * that the opacity cache's vertices, a level's spacing apart, average the
+ * lead instead of point-sampling it. The opacity method returns 1 - the
+ * pane's transmission colour (lead: 1), so shadow rays through it are
+ * coloured; lighting reflects Kd times the pane's colour, premultiplied. */
 
 typedef struct StainedGlassParams {
     float Kd, frequency, leadwidth, clarity;
@@ -52,19 +55,38 @@ static void cell_colour(int i, int j, float rgb[3])
         rgb[c] = 0.15f + 0.85f * v[k % 6][c];
 }
 
-/* The transmission colour at (s, t): 0 on the lead, else the pane's hue
- * scaled by its clarity. */
+/* The mean over [x - fw / 2, x + fw / 2] of a pulse train of period 1
+ * that is 1 on [k, k + w) (Apodaca and Gritz's filteredpulsetrain): box
+ * filtered, so that a grid of points spaced fw apart sees the lead's true
+ * share whatever its width. */
+static float filtered_pulse_train(float w, float x, float fw)
+{
+    if (!(fw > 1e-6f)) {
+        float f = x - floorf(x);
+        return f < w ? 1.0f : 0.0f;
+    }
+    float x0 = x - 0.5f * fw, x1 = x + 0.5f * fw;
+    float i0 = floorf(x0) * w + fminf(x0 - floorf(x0), w);
+    float i1 = floorf(x1) * w + fminf(x1 - floorf(x1), w);
+    return fminf(fmaxf((i1 - i0) / fw, 0.0f), 1.0f);
+}
+
+/* The transmission colour at (s, t), over a footprint of fw in (s, t): 0
+ * on the lead, else the pane's hue scaled by its clarity, the lead's
+ * edges box filtered over the footprint. */
 static void glass_transmission(const RayesShaderServices *sv, const StainedGlassParams *p, float s,
-                               float t, float out[3])
+                               float t, float fw, float out[3])
 {
     float q[3] = {s * p->frequency, t * p->frequency, 0.0f};
     float warp[3] = {q[0] * 0.7f, q[1] * 0.7f, 3.1f};
     float x = q[0] + 0.35f * sv->noise(sv, warp);
     warp[2] = 7.3f;
     float y = q[1] + 0.35f * sv->noise(sv, warp);
-    float fx = x - floorf(x), fy = y - floorf(y);
-    float edge = fminf(fminf(fx, 1.0f - fx), fminf(fy, 1.0f - fy));
-    if (edge < 0.5f * p->leadwidth * p->frequency) {
+    /* lead of width lw (in cells) centred on the cells' borders */
+    float lw = p->leadwidth * p->frequency, fwc = fw * p->frequency;
+    float clear = (1.0f - filtered_pulse_train(lw, x + 0.5f * lw, fwc)) *
+                  (1.0f - filtered_pulse_train(lw, y + 0.5f * lw, fwc));
+    if (!(clear > 0.0f)) {
         out[0] = out[1] = out[2] = 0.0f;
         return;
     }
@@ -72,9 +94,18 @@ static void glass_transmission(const RayesShaderServices *sv, const StainedGlass
     cell_colour((int)floorf(x), (int)floorf(y), hue);
     float bubbles[3] = {q[0] * 8.0f, q[1] * 8.0f, 0.5f};
     float streak = sv->fbm ? sv->fbm(sv, bubbles, 5, 2.0f, 0.5f) : 0.0f;
-    float clarity = fminf(fmaxf(p->clarity * (1.0f + 0.3f * streak), 0.0f), 1.0f);
+    float clarity = clear * fminf(fmaxf(p->clarity * (1.0f + 0.3f * streak), 0.0f), 1.0f);
     for (int c = 0; c < 3; c++)
         out[c] = hue[c] * clarity;
+}
+
+/* The footprint of point i, the larger of du and dv (0 without them): in
+ * (s, t) as in (u, v), as patches without their own s and t have them. */
+static float footprint(const RayesShadeCtx *ctx, size_t i)
+{
+    if (ctx->du && ctx->dv)
+        return fmaxf(ctx->du[i], ctx->dv[i]);
+    return 0.0f;
 }
 
 static void stainedglass_opacity(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
@@ -84,7 +115,7 @@ static void stainedglass_opacity(const RayesShaderServices *sv, const RayesShade
     for (size_t i = 0; i < ctx->n_points; i++) {
         float T[3];
         glass_transmission(sv, p, ctx->s ? ctx->s[i] : ctx->u[i], ctx->t ? ctx->t[i] : ctx->v[i],
-                           T);
+                           footprint(ctx, i), T);
         for (int c = 0; c < 3; c++)
             out->Oi[i][c] = (ctx->Os ? ctx->Os[i][c] : 1.0f) * (1.0f - T[c]);
     }
@@ -105,7 +136,8 @@ static void stainedglass_lighting(const RayesShaderServices *sv, const RayesShad
                                out->Irradiance ? out->Irradiance + start : NULL, NULL};
         for (size_t i = 0; i < n; i++) {
             float T[3];
-            glass_transmission(sv, p, sub.s ? sub.s[i] : sub.u[i], sub.t ? sub.t[i] : sub.v[i], T);
+            glass_transmission(sv, p, sub.s ? sub.s[i] : sub.u[i], sub.t ? sub.t[i] : sub.v[i],
+                               footprint(&sub, i), T);
             for (int c = 0; c < 3; c++) {
                 /* the lead is dark grey; glass reflects a little of its hue */
                 float colour = T[c] > 0.0f ? T[c] : 0.05f;
