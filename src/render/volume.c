@@ -22,6 +22,11 @@
 /* Steps of one ray through one volume, at most. */
 #define VOLUME_MAX_STEPS 4096
 
+/* Points of a camera or specular ray's segment through a volume where the
+ * medium's lighting (its shadow rays) is computed, at most: production
+ * renderers light volumes more coarsely than they sample extinction. */
+#define VOLUME_LIGHT_SAMPLES 16
+
 uint32_t volume_init(RenderVolume *v, uint32_t object, const Mat4 *world_from_object, Vec3 lo,
                      Vec3 hi, float voxel, uint32_t key_base)
 {
@@ -304,6 +309,13 @@ static void extinction_at(Worker *w, const RenderVolume *v, const Ray *ray, RayD
     }
 }
 
+/* The step of lighting point j of n_light on a march of n steps: the
+ * middle of its stratum. */
+static int light_step(int j, int n, int n_light)
+{
+    return (int)(((float)j + 0.5f) * (float)n / (float)n_light);
+}
+
 /* Fills p with the march's sample points. */
 static void march_points(const RenderVolume *v, const RenderObject *obj, const Ray *ray,
                          const March *m, uint64_t key, RayDiff diff, VolumePoints *p)
@@ -371,16 +383,45 @@ Vec3 volume_radiance(Worker *w, const Ray *ray, float tmax, uint32_t kind, int d
         march_points(v, obj, ray, &m, vkey, diff, &p);
         extinction_at(w, v, ray, diff, &m, &p);
         w->stats.volume_steps += (uint64_t)m.n;
+        int n_light = RY_MIN(m.n, VOLUME_LIGHT_SAMPLES);
+        VolumePoints lp;
         if (scatter) {
-            PathState ps = {w, p.keys, p.diff, p.zero1, p.zero1, NULL, UINT32_MAX, NULL, NULL, 1};
-            RayesShadeCtx ctx = points_ctx(&p, (size_t)m.n, kind & ~PATH_RAY_GLOSSY, 1,
+            /* The source at n_light of the steps, one per stratum of the
+             * segment; a step takes its stratum's. */
+            points_alloc(&lp, (size_t)n_light);
+            for (int j = 0; j < n_light; j++) {
+                int i = light_step(j, m.n, n_light);
+                memcpy(lp.P[j], p.P[i], sizeof lp.P[j]);
+                memcpy(lp.N[j], p.N[i], sizeof lp.N[j]);
+                memcpy(lp.I[j], p.I[i], sizeof lp.I[j]);
+                memcpy(lp.Cs[j], p.Cs[i], sizeof lp.Cs[j]);
+                memcpy(lp.Os[j], p.Os[i], sizeof lp.Os[j]);
+                lp.u[j] = p.u[i], lp.v[j] = p.v[i], lp.s[j] = p.s[i];
+                lp.keys[j] = p.keys[i];
+                lp.diff[j] = p.diff[i];
+            }
+            PathState ps = {w, lp.keys, lp.diff, lp.zero1, lp.zero1, NULL, UINT32_MAX, NULL, NULL, 1};
+            RayesShadeCtx ctx = points_ctx(&lp, (size_t)n_light, kind & ~PATH_RAY_GLOSSY, 1,
                                            diffuse_depth, specular_depth, &ps);
-            float(*Oi)[3] = malloc((size_t)m.n * sizeof *Oi);
-            RY_CHECK(Oi != NULL);
-            RayesShadeOutputs o = {p.Ci, Oi, NULL, NULL};
-            w->stats.shading_points[RY_MIN(diffuse_depth, RENDER_MAX_DEPTH)] += (uint64_t)m.n;
+            RayesShadeOutputs o = {lp.Ci, lp.Oi, NULL, NULL};
+            w->stats.shading_points[RY_MIN(diffuse_depth, RENDER_MAX_DEPTH)] += (uint64_t)n_light;
             shade_run_lighting(w->services, &ctx, obj->shader, &o);
-            free(Oi);
+            /* the source per unit extinction, interpolated between the
+             * lighting points (linearly: its error is second order) and
+             * times each step's own extinction */
+            for (int i = 0, j = 0; i < m.n; i++) {
+                while (j + 1 < n_light && light_step(j + 1, m.n, n_light) <= i)
+                    j++;
+                int a = light_step(j, m.n, n_light), b = j + 1 < n_light ? j + 1 : j;
+                int ib = light_step(b, m.n, n_light);
+                float f = ib > a ? fminf(fmaxf((float)(i - a) / (float)(ib - a), 0.0f), 1.0f) : 0.0f;
+                for (int c = 0; c < 3; c++) {
+                    float ra = lp.Oi[j][c] > 0.0f ? lp.Ci[j][c] / lp.Oi[j][c] : 0.0f;
+                    float rb = lp.Oi[b][c] > 0.0f ? lp.Ci[b][c] / lp.Oi[b][c] : 0.0f;
+                    p.Ci[i][c] = (ra + (rb - ra) * f) * p.Oi[i][c];
+                }
+            }
+            points_free(&lp);
         }
         /* Front to back: each step adds its source times the transmittance
          * to its middle, then attenuates what lies behind it. */

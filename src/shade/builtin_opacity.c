@@ -71,6 +71,31 @@ static float filtered_pulse_train(float w, float x, float fw)
     return fminf(fmaxf((i1 - i0) / fw, 0.0f), 1.0f);
 }
 
+/* The panes' hues box-filtered over a footprint fw cells wide about (x,
+ * y): each cell's colour weighted by its overlap (at most 8 x 8 cells;
+ * wider footprints take the hues' mean, 0.575, for the rest). */
+static void filtered_hue(float x, float y, float fw, float out[3])
+{
+    if (!(fw > 1e-3f)) {
+        cell_colour((int)floorf(x), (int)floorf(y), out);
+        return;
+    }
+    float span = fminf(fw, 8.0f), x0 = x - 0.5f * span, y0 = y - 0.5f * span;
+    float sum[3] = {0, 0, 0}, rgb[3];
+    for (float cy = floorf(y0); cy < y0 + span; cy += 1.0f) {
+        float wy = fminf(cy + 1.0f, y0 + span) - fmaxf(cy, y0);
+        for (float cx = floorf(x0); cx < x0 + span; cx += 1.0f) {
+            float wx = fminf(cx + 1.0f, x0 + span) - fmaxf(cx, x0);
+            cell_colour((int)cx, (int)cy, rgb);
+            for (int c = 0; c < 3; c++)
+                sum[c] += wx * wy * rgb[c];
+        }
+    }
+    float mix = fw > 8.0f ? 1.0f - 64.0f / (fw * fw) : 0.0f;
+    for (int c = 0; c < 3; c++)
+        out[c] = sum[c] / (span * span) * (1.0f - mix) + 0.575f * mix;
+}
+
 /* The transmission colour at (s, t), over a footprint of fw in (s, t): 0
  * on the lead, else the pane's hue scaled by its clarity, the lead's
  * edges box filtered over the footprint. */
@@ -90,10 +115,11 @@ static void glass_transmission(const RayesShaderServices *sv, const StainedGlass
         out[0] = out[1] = out[2] = 0.0f;
         return;
     }
-    float hue[3];
-    cell_colour((int)floorf(x), (int)floorf(y), hue);
+    /* Streaks finer than the footprint average out. */
+    float hue[3], fade = fmaxf(0.0f, 1.0f - 8.0f * fwc);
+    filtered_hue(x, y, fwc, hue);
     float bubbles[3] = {q[0] * 8.0f, q[1] * 8.0f, 0.5f};
-    float streak = sv->fbm ? sv->fbm(sv, bubbles, 5, 2.0f, 0.5f) : 0.0f;
+    float streak = sv->fbm && fade > 0.0f ? fade * sv->fbm(sv, bubbles, 5, 2.0f, 0.5f) : 0.0f;
     float clarity = clear * fminf(fmaxf(p->clarity * (1.0f + 0.3f * streak), 0.0f), 1.0f);
     for (int c = 0; c < 3; c++)
         out[c] = hue[c] * clarity;
