@@ -2,7 +2,9 @@
  * Watertight dicing (geom/stitch.c, DESIGN.md "Stitching"): neighbouring
  * patches diced at different rates must not crack. Closed surfaces (a
  * perturbed Catmull-Clark mesh of 96 faces, the same mesh as bilinear
- * quads, a Catmull-Clark mesh of triangles and quads) hold a marker
+ * quads, a Catmull-Clark mesh of triangles and quads, a perturbed
+ * icosahedron as a Loop mesh and as a polygon mesh of triangles, and the
+ * triangles-and-quads mesh as a displaced polygon mesh) hold a marker
  * sphere; camera rays through
  * every pixel of a 512 x 512 image (four per pixel) must all enter the
  * surface from outside: a ray that reaches the marker or first meets the
@@ -157,15 +159,14 @@ static void test_polygon_mesh_is_watertight(void)
     rayes_scene_release(s);
 }
 
-/* A closed Catmull-Clark mesh of triangles (two fans of five) and quads
- * (a ring): each triangle is three sub-face patches, whose sides meet
- * inside the face and along half edges of the mesh (10 leaked rays
- * without stitching). */
-static void test_ngon_mesh_is_watertight(void)
+enum { BARREL = 5 }; /* quads around the middle */
+
+/* The barrel: a ring of BARREL quads closed by two fans of triangles;
+ * returns the faces. */
+static int barrel(float P[2 * BARREL + 2][3], int nv[3 * BARREL], int idx[10 * BARREL])
 {
-    enum { N = 5 };
-    float P[2 * N + 2][3];
-    int nv[4 * N], idx[16 * N], f = 0, k = 0;
+    enum { N = BARREL };
+    int f = 0, k = 0;
     for (int i = 0; i < N; i++)
         for (int top = 0; top < 2; top++) {
             float a = 6.2831853f * (float)i / N;
@@ -186,13 +187,103 @@ static void test_ngon_mesh_is_watertight(void)
         nv[f++] = 3;
         memcpy(&idx[k], top, sizeof top), k += 3;
     }
+    return f;
+}
+
+/* A closed Catmull-Clark mesh of triangles (two fans of five) and quads
+ * (a ring): each triangle is three sub-face patches, whose sides meet
+ * inside the face and along half edges of the mesh (10 leaked rays
+ * without stitching). */
+static void test_ngon_mesh_is_watertight(void)
+{
+    float P[2 * BARREL + 2][3];
+    int nv[3 * BARREL], idx[10 * BARREL], f = barrel(P, nv, idx);
     RayesScene *s = scene_with_marker();
     CHECK(rayes_scene_subdivision_mesh(s, RAYES_SUBDIV_CATMULL_CLARK, (size_t)f, nv, idx,
-                                       2 * N + 2, &P[0][0], NULL, NULL, 0) == RAYES_OK);
+                                       2 * BARREL + 2, &P[0][0], NULL, NULL, 0) == RAYES_OK);
     add_marker(s);
     CHECK(rayes_scene_commit(s) == RAYES_OK);
     long n = leaks(s, 2);
     printf("n-gon mesh: %ld leaked rays of %d\n", n, 4 * IMAGE * IMAGE);
+    CHECK(n == 0);
+    rayes_scene_release(s);
+}
+
+/* A perturbed icosahedron, its 20 faces counter-clockwise from outside,
+ * scaled to hold the marker: a closed mesh of triangles only. */
+static void icosahedron(float P[12][3], int idx[60])
+{
+    static const int faces[20][3] = {
+        {0, 11, 5}, {0, 5, 1},  {0, 1, 7},   {0, 7, 10}, {0, 10, 11}, {1, 5, 9}, {5, 11, 4},
+        {11, 10, 2}, {10, 7, 6}, {7, 1, 8},  {3, 9, 4},  {3, 4, 2},   {3, 2, 6}, {3, 6, 8},
+        {3, 8, 9},  {4, 9, 5},  {2, 4, 11},  {6, 2, 10}, {8, 6, 7},   {9, 8, 1}};
+    const float g = 1.6180340f;
+    const float v[12][3] = {{-1, g, 0}, {1, g, 0}, {-1, -g, 0}, {1, -g, 0},
+                            {0, -1, g}, {0, 1, g}, {0, -1, -g}, {0, 1, -g},
+                            {g, 0, -1}, {g, 0, 1}, {-g, 0, -1}, {-g, 0, 1}};
+    for (int i = 0; i < 12; i++)
+        for (int a = 0; a < 3; a++)
+            P[i][a] = 0.8f * v[i][a] + 2.0f * jitter(i, 7, 3, a);
+    memcpy(idx, faces, sizeof faces);
+}
+
+/* A closed Loop mesh: one triangular patch per face, sharing the mesh's
+ * edges. */
+static void test_loop_mesh_is_watertight(void)
+{
+    float P[12][3];
+    int idx[60], nv[20];
+    icosahedron(P, idx);
+    for (int f = 0; f < 20; f++)
+        nv[f] = 3;
+    RayesScene *s = scene_with_marker();
+    CHECK(rayes_scene_subdivision_mesh(s, RAYES_SUBDIV_LOOP, 20, nv, idx, 12, &P[0][0], NULL,
+                                       NULL, 0) == RAYES_OK);
+    add_marker(s);
+    CHECK(rayes_scene_commit(s) == RAYES_OK);
+    long n = leaks(s, 2);
+    printf("Loop mesh: %ld leaked rays of %d\n", n, 4 * IMAGE * IMAGE);
+    CHECK(n == 0);
+    rayes_scene_release(s);
+}
+
+/* The same icosahedron as a polygon mesh of triangles: flat faces, each
+ * diced into quads (split_quads) or one triangular grid by its size. */
+static void test_triangle_mesh_is_watertight(void)
+{
+    float P[12][3];
+    int idx[60], nv[20];
+    icosahedron(P, idx);
+    for (int f = 0; f < 20; f++)
+        nv[f] = 3;
+    RayesScene *s = scene_with_marker();
+    CHECK(rayes_scene_polygon_mesh(s, 20, nv, idx, 12, &P[0][0]) == RAYES_OK);
+    add_marker(s);
+    CHECK(rayes_scene_commit(s) == RAYES_OK);
+    long n = leaks(s, 2);
+    printf("triangle mesh: %ld leaked rays of %d\n", n, 4 * IMAGE * IMAGE);
+    CHECK(n == 0);
+    rayes_scene_release(s);
+}
+
+/* The barrel as a polygon mesh, displaced: flat faces meet along straight
+ * edges, but displacement moves each face's side vertices along its own
+ * normal, so triangle-triangle and triangle-quad edges open unless
+ * stitched. */
+static void test_displaced_mixed_mesh_is_watertight(void)
+{
+    float P[2 * BARREL + 2][3];
+    int nv[3 * BARREL], idx[10 * BARREL], f = barrel(P, nv, idx);
+    RayesScene *s = scene_with_marker();
+    const RayesParam amp = {"amplitude", RAYES_PARAM_FLOAT, {0.08f, 0, 0}, NULL};
+    CHECK(rayes_scene_set_displacement(s, "fractal", &amp, 1) == RAYES_OK);
+    CHECK(rayes_scene_set_displacement_bound(s, 0.2f) == RAYES_OK);
+    CHECK(rayes_scene_polygon_mesh(s, (size_t)f, nv, idx, 2 * BARREL + 2, &P[0][0]) == RAYES_OK);
+    CHECK(rayes_scene_set_displacement(s, NULL, NULL, 0) == RAYES_OK);
+    add_marker(s);
+    CHECK(rayes_scene_commit(s) == RAYES_OK);
+    long n = leaks(s, 2);
+    printf("displaced mixed mesh: %ld leaked rays of %d\n", n, 4 * IMAGE * IMAGE);
     CHECK(n == 0);
     rayes_scene_release(s);
 }
@@ -248,4 +339,6 @@ static void test_hole_lets_rays_through(void)
 }
 
 TEST_MAIN(TEST(test_hole_lets_rays_through), TEST(test_subdivision_mesh_is_watertight), TEST(test_polygon_mesh_is_watertight),
-          TEST(test_ngon_mesh_is_watertight))
+          TEST(test_ngon_mesh_is_watertight), TEST(test_loop_mesh_is_watertight),
+          TEST(test_triangle_mesh_is_watertight),
+          TEST(test_displaced_mixed_mesh_is_watertight))
