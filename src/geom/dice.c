@@ -39,6 +39,8 @@ typedef struct Domain {
      * (u, v), interpolated bilinearly. */
     int sub_quad;
     float q[4][2];
+    float tri[3][2]; /* sub_quad: the triangle's corners, and the one q[0] is */
+    int corner;
 } Domain;
 
 typedef struct Estimate {
@@ -221,23 +223,26 @@ static int prim_shape(const Prim *prim)
                                       : GEOM_SHAPE_SURFACE;
 }
 
-/* The power of two nearest n (in ratio: up from 1.42 p). Quad patches
- * of surfaces dice at such rates over domains halved when split, so that
- * along any line two grids share, the coarser grid's vertices are
- * vertices of the finer one too, which stitching (geom/stitch.c) needs. */
-static int nearest_power_of_two(int n)
+/* The largest power of two not above n (n >= 1). */
+static int power_of_two_below(int n)
 {
     int p = 1;
     while (p <= n / 2)
         p *= 2;
+    return p;
+}
+
+/* The power of two nearest n (in ratio: up from 1.42 p). Patches of
+ * surfaces dice at such rates (triangles one for all three edges) over
+ * domains halved when split, so that along any line two grids share, the
+ * coarser grid's vertices are vertices of the finer one too, which
+ * stitching (geom/stitch.c) needs. */
+static int nearest_power_of_two(int n)
+{
+    int p = power_of_two_below(n);
     return (int64_t)n * n > 2 * (int64_t)p * p ? 2 * p : p;
 }
 
-/* 1 if a domain's grid is stitched to its neighbours (geom_stitch). */
-static int stitched(const Prim *prim, const Domain *d)
-{
-    return !d->triangular && !d->sub_quad && geom_prim_stitched(prim);
-}
 
 static Estimate estimate(const Prim *prim, const Domain *d, const DiceCamera *cam)
 {
@@ -289,7 +294,7 @@ static Estimate estimate(const Prim *prim, const Domain *d, const DiceCamera *ca
     }
     e.n_u = RY_MAX(e.n_u, 1);
     e.n_v = RY_MAX(e.n_v, 1);
-    if (cam->binary && stitched(prim, d)) {
+    if (cam->binary && geom_prim_stitched(prim)) {
         e.n_u = nearest_power_of_two(e.n_u);
         e.n_v = nearest_power_of_two(e.n_v);
     }
@@ -473,14 +478,17 @@ void geom_bound_sagitta(GridSet *gs, size_t first)
  * that many (a triangle's subdivisions per edge). */
 typedef struct Limits {
     int size, side;
+    int tri; /* subdivisions per edge of a triangular grid, at most: side, or with binary
+                dicing the power of two below it */
 } Limits;
 
 static Limits limits_of(const DiceCamera *cam)
 {
     Limits l = {cam->grid_size > 0 ? RY_MIN(cam->grid_size, GEOM_MAX_GRID_SIZE) : GEOM_GRID_SIZE,
-                1};
+                1, 1};
     while ((l.side + 1) * (l.side + 1) <= l.size)
         l.side++;
+    l.tri = cam->binary ? power_of_two_below(l.side) : l.side;
     return l;
 }
 
@@ -517,6 +525,9 @@ static int dice_quad(GridSet *gs, const Prim *prim, uint32_t prim_index, const f
         g->uv[0][0] = c[0][0], g->uv[0][1] = c[0][1];
         g->uv[1][0] = c[0][0] + step[0] * (float)(nu - 1);
         g->uv[1][1] = c[0][1] + step[1] * (float)(nv - 1);
+        g->sub_corner = (uint8_t)(1 + d->corner);
+        memcpy(g->sub, d->c, sizeof g->sub);
+        memcpy(g->tri, d->tri, sizeof g->tri);
     }
     size_t base = gs->n_vertices;
     for (int j = 0; j < nv; j++)
@@ -534,7 +545,7 @@ static int dice_quad(GridSet *gs, const Prim *prim, uint32_t prim_index, const f
 static int dice_triangle(GridSet *gs, const Prim *prim, uint32_t prim_index, const float *pool,
                          const Domain *d, Estimate e, Limits lim)
 {
-    uint32_t n = (uint32_t)RY_MIN(e.n_u, lim.side);
+    uint32_t n = (uint32_t)RY_MIN(e.n_u, lim.tri);
     size_t count = (size_t)(n + 1) * (n + 2) / 2;
     if (reserve(gs, count, prim->pv) != 0)
         return -1;
@@ -573,7 +584,7 @@ static int leaf(Walk *w, const Domain *d, Estimate e)
         return d->triangular ? dice_triangle(w->gs, w->prim, w->prim_index, w->pool, d, e, w->lim)
                              : dice_quad(w->gs, w->prim, w->prim_index, w->pool, d, e, w->lim);
     if (d->triangular) {
-        size_t n = (size_t)RY_MIN(e.n_u, w->lim.side);
+        size_t n = (size_t)RY_MIN(e.n_u, w->lim.tri);
         w->vertices += (n + 1) * (n + 2) / 2;
     } else {
         if ((int64_t)e.n_u * e.n_v > w->lim.size) {
@@ -630,7 +641,8 @@ static int split_quads(Walk *w, const Domain *d, int depth)
             centre[c] += third * d->c[k][c];
         }
     for (int k = 0; k < 3; k++) {
-        Domain sub = {.c = {{0, 0}, {1, 1}, {0, 0}}, .sub_quad = 1};
+        Domain sub = {.c = {{0, 0}, {1, 1}, {0, 0}}, .sub_quad = 1, .corner = k};
+        memcpy(sub.tri, d->c, sizeof sub.tri);
         /* Corner k, the midpoint toward k + 1, the one toward k - 1, the
          * centroid: (s, t) = (0,0), (1,0), (0,1), (1,1). */
         memcpy(sub.q[0], d->c[k], sizeof sub.q[0]);
@@ -651,7 +663,7 @@ static int split_dice(Walk *w, const Domain *d, int depth)
         e.n_u = e.n_v = RY_MIN(RY_MAX(e.n_u, e.n_v), w->lim.side);
         return leaf(w, d, e);
     }
-    int split = d->triangular ? e.n_u > w->lim.side
+    int split = d->triangular ? e.n_u > w->lim.tri
                               : (int64_t)e.n_u * e.n_v > w->lim.size || e.n_u > GEOM_MAX_GRID - 1 ||
                                     e.n_v > GEOM_MAX_GRID - 1;
     if (!split || depth >= MAX_SPLIT_DEPTH)

@@ -197,6 +197,11 @@ typedef struct Grid {
                               largest step in u and in v */
     uint8_t primvars;      /* GEOM_PV_* bits: the GridSet's Ns, st, Cs, Os hold its vertices'
                               values (else: N, uv, the object's colour and opacity) */
+    uint8_t sub_corner;    /* a quad over part of a triangle: 1 + the triangle's corner it
+                              starts at (split_quads), else 0; for stitching */
+    float sub[2][2];       /* such a quad: its rectangle of the quad's own (s, t), (s0, t0)
+                              and (s1, t1), in [0, 1] */
+    float tri[3][2];       /* such a quad: the triangle's corners, the primitive's (u, v) */
 } Grid;
 
 typedef struct GridSet {
@@ -247,9 +252,10 @@ typedef struct DiceCamera {
     int isotropic;      /* 1: on-screen patches by distance too (RenderMan's rasterorient 0) */
     float rate_scale;   /* >= 1 (0 reads as 1): every edge this much longer (the vertex
                            budget, scene_prepare) */
-    int binary;         /* 1: quad grids of stitched primitives (geom_prim_stitched) take
-                           the power of two nearest their rate along each side (RenderMan's
-                           binary dicing), as geom_stitch needs; scene_prepare sets it */
+    int binary;         /* 1: grids of stitched primitives (geom_prim_stitched) take the
+                           power of two nearest their rate along each side (RenderMan's
+                           binary dicing; triangular grids one for all three), as
+                           geom_stitch needs; scene_prepare sets it */
 } DiceCamera;
 
 void geom_gridset_init(GridSet *gs);
@@ -273,9 +279,9 @@ void geom_grid_measure(GridSet *gs, Grid *g);
  * and measured, to the largest bound among them. */
 void geom_bound_sagitta(GridSet *gs, size_t first);
 
-/* 1 if prim's quad grids are stitched to their neighbours (geom_stitch):
- * bilinear and bicubic patches, quadrics, quad subdivision patches (with
- * DiceCamera.binary, their quad patches dice at powers of two). */
+/* 1 if prim's grids are stitched to their neighbours (geom_stitch):
+ * bilinear and bicubic patches, quadrics, triangles, subdivision patches
+ * (with DiceCamera.binary, they dice at powers of two). */
 int geom_prim_stitched(const Prim *prim);
 
 /* Moves the vertices on the sides of gs's stitched grids (prims: the

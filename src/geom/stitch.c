@@ -21,8 +21,11 @@
  * inside one primitive (t = the other parameter), or a side of the
  * primitive's domain, keyed by what its neighbour shares: a subdivision
  * mesh's edge (geom_subdiv_patch_side), the bit patterns of a bilinear
- * patch's corners or a bicubic patch's four edge control points, in a
- * canonical order. Lines a vertex lies on more than one of (grid
+ * patch's or a triangle's corners or a bicubic patch's four edge control
+ * points, in a canonical order. Triangular grids (one power of two on
+ * all three edges) are stitched along their edges, and the quads a large
+ * triangle dices into along halves of its edges and the spokes between
+ * them (sub_quad_side). Lines a vertex lies on more than one of (grid
  * corners) are settled by repeating the pass until nothing moves.
  *
  * Memory: one record per grid side and one position per side vertex,
@@ -39,14 +42,28 @@
 #define STITCH_PASSES 6 /* corners settle in two or three; a bound for odd input */
 
 /* One grid side on a curve: its n + 1 vertices at t = lo + i (hi - lo) / n
- * are P[first + i * stride]. */
+ * are P[side_vertex(side, i)]: P[first + i * stride] on a quad grid. */
 typedef struct Side {
     uint64_t key[2];  /* the curve (hashed) */
     double lo, hi;    /* its range of the curve's parameter, lo < hi */
-    size_t first;     /* the vertex at lo */
-    ptrdiff_t stride; /* to the next vertex toward hi */
+    size_t first;     /* the vertex at lo; a triangular grid's edge: the grid's first */
+    ptrdiff_t stride; /* to the next vertex toward hi (quad grids) */
     uint32_t n;       /* segments */
+    uint8_t tri_edge; /* a triangular grid's edge k, from corner k to k + 1: 1 + k; else 0 */
+    uint8_t reversed; /* that edge runs from hi to lo */
 } Side;
+
+/* The index in the GridSet of vertex i (from lo) of a side. */
+static size_t side_vertex(const Side *sd, uint32_t i)
+{
+    if (!sd->tri_edge)
+        return (size_t)((ptrdiff_t)sd->first + sd->stride * (ptrdiff_t)i);
+    /* Edge 0 is row j = 0, edge 1 the diagonal i + j = n, edge 2 column i = 0. */
+    uint32_t n = sd->n, k = sd->reversed ? n - i : i;
+    uint32_t a = sd->tri_edge == 1 ? k : sd->tri_edge == 2 ? n - k : 0;
+    uint32_t b = sd->tri_edge == 1 ? 0 : sd->tri_edge == 2 ? k : n - k;
+    return sd->first + geom_tri_vertex(n, a, b);
+}
 
 int geom_prim_stitched(const Prim *prim)
 {
@@ -54,8 +71,9 @@ int geom_prim_stitched(const Prim *prim)
     case PRIM_BILINEAR:
     case PRIM_BICUBIC:
     case PRIM_SPHERE:
-    case PRIM_QUADRIC: return 1;
-    case PRIM_SUBDIV: return !prim->subdiv.triangular;
+    case PRIM_QUADRIC:
+    case PRIM_TRIANGLE:
+    case PRIM_SUBDIV: return 1;
     default: return 0;
     }
 }
@@ -67,6 +85,16 @@ static uint64_t hash_bits(uint64_t h, const Vec3 *p, int n)
         memcpy(b, &p[k], sizeof b);
         for (int c = 0; c < 3; c++)
             h = hash_combine(h, b[c]);
+    }
+    return h;
+}
+
+static uint64_t hash_floats(uint64_t h, const float *f, int n)
+{
+    for (int k = 0; k < n; k++) {
+        uint32_t b;
+        memcpy(&b, &f[k], sizeof b);
+        h = hash_combine(h, b);
     }
     return h;
 }
@@ -102,8 +130,9 @@ static void points_side(const Vec3 *cp, int n, uint64_t key[2], float t[2])
 }
 
 /* The curve of side `side` of prim's domain (0: v = 0, 1: u = 1, 2: v = 1,
- * 3: u = 0), shared with whatever neighbour shares it, and its parameter
- * at s = 0 and 1 along the side (s: u or v). 0 if it has none. */
+ * 3: u = 0; a triangle's: from corner side to side + 1), shared with
+ * whatever neighbour shares it, and its parameter at s = 0 and 1 along
+ * the side (s: u or v, or from the triangle's corner). 0 if it has none. */
 static int prim_side(const Prim *prim, int side, uint64_t key[2], float t[2])
 {
     static const int bilinear[4][2] = {{0, 1}, {1, 3}, {2, 3}, {0, 2}};
@@ -120,6 +149,12 @@ static int prim_side(const Prim *prim, int side, uint64_t key[2], float t[2])
             p[k] = prim->cp[bicubic[side][k]];
         points_side(p, 4, key, t);
         return 1;
+    case PRIM_TRIANGLE: /* a polygon mesh's edge: keyed as a bilinear patch's */
+        if (side > 2)
+            return 0;
+        p[0] = prim->cp[side], p[1] = prim->cp[(side + 1) % 3];
+        points_side(p, 2, key, t);
+        return 1;
     case PRIM_SUBDIV: {
         uint64_t k[2];
         if (!geom_subdiv_patch_side(prim->subdiv.mesh, prim->subdiv.patch, side, k, t))
@@ -133,41 +168,146 @@ static int prim_side(const Prim *prim, int side, uint64_t key[2], float t[2])
     }
 }
 
+/* Fills *out for a side of n segments whose vertices run from first by
+ * stride (a quad grid's), or along edge tri_edge - 1 of a triangular grid,
+ * on curve key from parameter a to b. Returns 0 for an empty range. */
+static int put_side(Side *out, const uint64_t key[2], double a, double b, size_t first,
+                    ptrdiff_t stride, uint32_t n, int tri_edge)
+{
+    out->key[0] = key[0], out->key[1] = key[1];
+    out->n = n;
+    out->tri_edge = (uint8_t)tri_edge;
+    out->reversed = a > b;
+    if (a > b && !tri_edge) {
+        first += (size_t)(stride * (ptrdiff_t)n);
+        stride = -stride;
+    }
+    out->lo = fmin(a, b), out->hi = fmax(a, b);
+    out->first = first, out->stride = stride;
+    return out->hi > out->lo;
+}
+
+/* The curve of a segment from a to b, corners of a triangle of a
+ * triangular primitive's domain (barycentric (u, v)), and its parameter
+ * at a and b: the primitive's edge when both lie on it (a neighbour's),
+ * else a line inside it keyed by the segment's ends (split triangles
+ * that share the whole segment). 0 if none. */
+static int tri_segment(const Prim *prim, uint32_t prim_index, const float *a, const float *b,
+                       uint64_t key[2], double t[2])
+{
+    for (int k = 0; k < 3; k++) {
+        /* Edge k from corner k; domain corners are dyadic, so these are exact. */
+        int on = k == 0   ? a[1] == 0.0f && b[1] == 0.0f
+                 : k == 1 ? a[0] + a[1] == 1.0f && b[0] + b[1] == 1.0f
+                          : a[0] == 0.0f && b[0] == 0.0f;
+        if (!on)
+            continue;
+        double pa = k == 0 ? a[0] : k == 1 ? a[1] : 1.0 - a[1];
+        double pb = k == 0 ? b[0] : k == 1 ? b[1] : 1.0 - b[1];
+        float e[2];
+        if (!prim_side(prim, k, key, e))
+            return 0;
+        t[0] = e[0] + ((double)e[1] - e[0]) * pa;
+        t[1] = e[0] + ((double)e[1] - e[0]) * pb;
+        return 1;
+    }
+    float ends[2][2] = {{a[0], a[1]}, {b[0], b[1]}};
+    int forward = memcmp(a, b, 2 * sizeof *a) <= 0 || (a[0] == b[0] && a[1] == b[1]);
+    if (!forward)
+        memcpy(ends[0], b, sizeof ends[0]), memcpy(ends[1], a, sizeof ends[1]);
+    key[0] = hash_floats(hash_combine(0x5452494c494e45ull, prim_index), &ends[0][0], 4);
+    key[1] = hash_combine(key[0], 0x9e3779b97f4a7c15ull);
+    t[0] = forward ? 0.0 : 1.0;
+    t[1] = 1.0 - t[0];
+    return 1;
+}
+
+/* The key of a line inside a quad over part of a triangle (split_quads):
+ * a line s or t = c of quad k (axis 0: t = c, 1: s = c), or (axis 2) the
+ * spoke k from the midpoint of edge k to the centroid. */
+static void sub_quad_line(const Grid *g, int axis, float c, int k, uint64_t key[2])
+{
+    uint32_t bits;
+    memcpy(&bits, &c, sizeof bits);
+    key[0] = hash_floats(hash_combine(0x5355425155414455ull, g->prim), &g->tri[0][0], 6);
+    key[0] = hash_combine(hash_combine(key[0], (uint64_t)axis * 4 + (uint64_t)k), bits);
+    key[1] = hash_combine(key[0], 0x9e3779b97f4a7c15ull);
+}
+
+/* Side `side` of a quad over part of a triangle: its outer sides (s or
+ * t = 0) lie on half of the triangle's edges (corner k to k + 1 at
+ * s / 2, corner k - 1 to k at 1 - t / 2), its sides s or t = 1 on the
+ * spokes k and k - 1 it shares with the next and previous quads. */
+static int sub_quad_side(const Grid *g, const Prim *prim, int side, double s0, double s1,
+                         double c, uint64_t key[2], double *a, double *b)
+{
+    int k = g->sub_corner - 1, prev = (k + 2) % 3;
+    double t[2];
+    if (c == 0.0 && (side == 0 || side == 3)) {
+        int e = side == 0 ? k : prev;
+        if (!tri_segment(prim, g->prim, g->tri[e], g->tri[(e + 1) % 3], key, t))
+            return 0;
+        double p0 = side == 0 ? 0.5 * s0 : 1.0 - 0.5 * s0, p1 = side == 0 ? 0.5 * s1 : 1.0 - 0.5 * s1;
+        *a = t[0] + (t[1] - t[0]) * p0, *b = t[0] + (t[1] - t[0]) * p1;
+        return 1;
+    }
+    if (c == 1.0 && (side == 1 || side == 2))
+        sub_quad_line(g, 2, 0.0f, side == 1 ? k : prev, key);
+    else
+        sub_quad_line(g, side == 0 || side == 2 ? 0 : 1, (float)c, k, key);
+    *a = s0, *b = s1;
+    return 1;
+}
+
+/* The edges of a triangular grid: edge k from its corner k to k + 1. */
+static int tri_grid_side(const Grid *g, const Prim *prim, int side, Side *out)
+{
+    uint64_t key[2];
+    double t[2];
+    if (side > 2 || !tri_segment(prim, g->prim, g->uv[side], g->uv[(side + 1) % 3], key, t))
+        return 0;
+    return put_side(out, key, t[0], t[1], g->first_vertex, 0, g->nu, 1 + side);
+}
+
 /* The record of side `side` of grid g (of prim), or 0
  * when the side is on no curve a neighbour can share. */
 static int grid_side(const Grid *g, const Prim *prim, int side, Side *out)
 {
     static const int on_v[4] = {1, 0, 1, 0}; /* the side is a line of constant v */
+    if (g->triangular)
+        return tri_grid_side(g, prim, side, out);
     int nu = g->nu, nv = g->nv;
-    float c = side == 0 ? g->uv[0][1] : side == 1 ? g->uv[1][0] : side == 2 ? g->uv[1][1]
-                                                                          : g->uv[0][0];
+    const float(*r)[2] = g->sub_corner ? g->sub : g->uv; /* the domain's rectangle */
+    float c = side == 0 ? r[0][1] : side == 1 ? r[1][0] : side == 2 ? r[1][1] : r[0][0];
     int axis = on_v[side] ? 0 : 1; /* s runs along u or v */
-    float s0 = g->uv[0][axis], s1 = g->uv[1][axis];
+    float s0 = r[0][axis], s1 = r[1][axis];
     float border = side == 0 || side == 3 ? 0.0f : 1.0f;
     float t[2] = {0.0f, 1.0f};
-    if (c == border) {
-        if (!prim_side(prim, side, out->key, t))
+    uint64_t key[2];
+    double a, b;
+    if (g->sub_corner) {
+        if (!sub_quad_side(g, prim, side, s0, s1, c, key, &a, &b))
             return 0;
     } else {
-        uint32_t bits;
-        memcpy(&bits, &c, sizeof bits);
-        out->key[0] = hash_combine(hash_combine(0x494e4e4552ull, g->prim), (uint64_t)axis);
-        out->key[1] = hash_combine(out->key[0], bits);
+        if (c == border) {
+            if (!prim_side(prim, side, key, t))
+                return 0;
+        } else {
+            uint32_t bits;
+            memcpy(&bits, &c, sizeof bits);
+            key[0] = hash_combine(hash_combine(0x494e4e4552ull, g->prim), (uint64_t)axis);
+            key[1] = hash_combine(key[0], bits);
+        }
+        a = (double)t[0] + ((double)t[1] - t[0]) * s0;
+        b = (double)t[0] + ((double)t[1] - t[0]) * s1;
     }
     size_t base = g->first_vertex;
     size_t start = side == 0 || side == 3 ? base
                    : side == 1            ? base + (size_t)nu - 1
                                           : base + (size_t)(nv - 1) * (size_t)nu;
     ptrdiff_t stride = on_v[side] ? 1 : nu;
-    out->n = (uint32_t)(on_v[side] ? nu - 1 : nv - 1);
-    double a = (double)t[0] + ((double)t[1] - t[0]) * s0, b = (double)t[0] + ((double)t[1] - t[0]) * s1;
-    if (a > b) {
-        start += (size_t)(stride * (ptrdiff_t)out->n);
-        stride = -stride;
-    }
-    out->lo = fmin(a, b), out->hi = fmax(a, b);
-    out->first = start, out->stride = stride;
-    return out->hi > out->lo;
+    uint32_t n = (uint32_t)(on_v[side] ? nu - 1 : nv - 1);
+    return put_side(out, key, a, b, start, stride, n, 0);
 }
 
 static int cmp_side(const void *pa, const void *pb)
@@ -210,7 +350,7 @@ static double curve_at(const Curve *c, const Vec3 *P, double t, Vec3 *at, int *f
         double h = (sd->hi - sd->lo) / sd->n, i = (t - sd->lo) / h;
         H = fmax(H, h);
         if (i == floor(i)) {
-            Vec3 p = P[(ptrdiff_t)sd->first + sd->stride * (ptrdiff_t)i];
+            Vec3 p = P[side_vertex(sd, (uint32_t)i)];
             if (!*found || vec_less(p, *at))
                 *at = p;
             *found = 1;
@@ -254,12 +394,12 @@ static long stitch_curve(const Curve *c, Vec3 *P)
     for (size_t k = 0; k < c->n; k++)
         for (uint32_t i = 0; i <= c->s[k].n; i++, m++)
             if (!settle(c, P, &c->s[k], i, &to[m]))
-                to[m] = P[(ptrdiff_t)c->s[k].first + c->s[k].stride * (ptrdiff_t)i];
+                to[m] = P[side_vertex(&c->s[k], i)];
     long moved = 0;
     m = 0;
     for (size_t k = 0; k < c->n; k++)
         for (uint32_t i = 0; i <= c->s[k].n; i++, m++) {
-            Vec3 *p = &P[(ptrdiff_t)c->s[k].first + c->s[k].stride * (ptrdiff_t)i];
+            Vec3 *p = &P[side_vertex(&c->s[k], i)];
             moved += memcmp(p, &to[m], sizeof *p) != 0;
             *p = to[m];
         }
@@ -278,7 +418,7 @@ static Side *collect_sides(const GridSet *gs, const Prim *prims, size_t *n)
     for (size_t g = 0; g < gs->n_grids; g++) {
         const Grid *grid = &gs->grids[g];
         const Prim *prim = &prims[grid->prim];
-        if (grid->triangular || grid->shape != GEOM_SHAPE_SURFACE || !geom_prim_stitched(prim))
+        if (grid->shape != GEOM_SHAPE_SURFACE || !geom_prim_stitched(prim))
             continue;
         for (int side = 0; side < 4; side++)
             *n += (size_t)grid_side(grid, prim, side, &sides[*n]);

@@ -365,10 +365,14 @@ extern "C" int geom_subdiv_patch_side(const SubdivMesh *m, size_t patch, int sid
                                       uint64_t key[2], float t[2])
 {
     const Patch &p = m->patches[patch];
-    if (p.tri)
-        return 0;
     Far::ConstIndexArray v = m->refiner->GetLevel(0).GetFaceVertices((int)p.face);
     int n = v.size();
+    if (p.tri) { /* corners v0 (0,0), v1 (1,0), v2 (0,1); side k from v_k to v_k+1 */
+        if (side > 2)
+            return 0;
+        edge_side(v[side], v[(side + 1) % 3], 1.0f, key, t);
+        return 1;
+    }
     if (p.sub < 0) { /* corners v0 (0,0), v1 (1,0), v2 (1,1), v3 (0,1) */
         static const int from[4] = {0, 1, 3, 0}, to[4] = {1, 2, 2, 3};
         edge_side(v[from[side]], v[to[side]], 1.0f, key, t);

@@ -80,12 +80,14 @@ size_t geom_subdiv_n_patches(const SubdivMesh *mesh);
 size_t geom_subdiv_patch_face(const SubdivMesh *mesh, size_t patch);
 int geom_subdiv_patch_triangular(const SubdivMesh *mesh, size_t patch);
 
-/* Which curve side `side` of a quad patch lies on (0: v = 0, 1: u = 1,
- * 2: v = 1, 3: u = 0), for stitching neighbours (geom/stitch.c): key
- * names it within the mesh (a mesh edge, or a line inside a face split
- * into sub-faces), and the curve's parameter is t[0] + (t[1] - t[0]) s at
- * the patch's parameter s along the side. Patches on either side of a
- * curve agree on its key and parameter. Returns 1, or 0 for triangles. */
+/* Which curve side `side` of a patch lies on (quads 0: v = 0, 1: u = 1,
+ * 2: v = 1, 3: u = 0; triangles: side k from corner k to corner k + 1,
+ * the corners at (0, 0), (1, 0), (0, 1)), for stitching neighbours
+ * (geom/stitch.c): key names it within the mesh (a mesh edge, or a line
+ * inside a face split into sub-faces), and the curve's parameter is
+ * t[0] + (t[1] - t[0]) s at the patch's parameter s along the side (for
+ * triangles, s from corner k). Patches on either side of a curve agree on
+ * its key and parameter. Returns 1, or 0 for a triangle's side 3. */
 int geom_subdiv_patch_side(const SubdivMesh *mesh, size_t patch, int side, uint64_t key[2],
                            float t[2]);
 

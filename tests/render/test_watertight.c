@@ -269,13 +269,15 @@ static void test_triangle_mesh_is_watertight(void)
 /* The barrel as a polygon mesh, displaced: flat faces meet along straight
  * edges, but displacement moves each face's side vertices along its own
  * normal, so triangle-triangle and triangle-quad edges open unless
- * stitched. */
+ * stitched (1,447 leaked rays without). An amplitude of 0.03: at 0.08 the
+ * fractal folds over itself near the silhouette, and rays meet those
+ * folds from behind without passing any crack (none reach the marker). */
 static void test_displaced_mixed_mesh_is_watertight(void)
 {
     float P[2 * BARREL + 2][3];
     int nv[3 * BARREL], idx[10 * BARREL], f = barrel(P, nv, idx);
     RayesScene *s = scene_with_marker();
-    const RayesParam amp = {"amplitude", RAYES_PARAM_FLOAT, {0.08f, 0, 0}, NULL};
+    const RayesParam amp = {"amplitude", RAYES_PARAM_FLOAT, {0.03f, 0, 0}, NULL};
     CHECK(rayes_scene_set_displacement(s, "fractal", &amp, 1) == RAYES_OK);
     CHECK(rayes_scene_set_displacement_bound(s, 0.2f) == RAYES_OK);
     CHECK(rayes_scene_polygon_mesh(s, (size_t)f, nv, idx, 2 * BARREL + 2, &P[0][0]) == RAYES_OK);
