@@ -257,7 +257,17 @@ static Vec3 corner(const uint16_t *vals, int m, int x, int y, int z)
 }
 
 /* Cached sigma_t at object-space q for a ray of that footprint. */
-static Vec3 extinction_cached(Worker *w, const RenderVolume *v, Vec3 q, float footprint)
+/* The entry a march looked up last: consecutive steps mostly stay in one
+ * brick at one level, and nothing else looks up an entry between them, so
+ * its values stay valid (cache.h) and the lookup is skipped. */
+typedef struct LastBrick {
+    uint32_t patch;
+    int level;
+    const uint16_t *vals;
+} LastBrick;
+
+static Vec3 extinction_cached(Worker *w, const RenderVolume *v, Vec3 q, float footprint,
+                              LastBrick *last)
 {
     float f[3] = {(q.x - v->lo.x) / v->cell.x, (q.y - v->lo.y) / v->cell.y,
                   (q.z - v->lo.z) / v->cell.z};
@@ -272,9 +282,14 @@ static Vec3 extinction_cached(Worker *w, const RenderVolume *v, Vec3 q, float fo
     }
     int level = choose_level(w, v, footprint), m = level_points(level);
     float sp = (float)level_spacing(level);
-    CacheKey key = {.patch = v->key_base + brick, .type = CACHE_OPACITY, .level = (uint8_t)level};
-    BrickJob job = {w, v, {b[0], b[1], b[2]}};
-    const uint16_t *vals = cache_lookup(&w->cache, &key, (size_t)m * m * m, fill_brick, &job);
+    const uint16_t *vals = last->vals;
+    if (!vals || last->patch != v->key_base + brick || last->level != level) {
+        CacheKey key = {.patch = v->key_base + brick, .type = CACHE_OPACITY,
+                        .level = (uint8_t)level};
+        BrickJob job = {w, v, {b[0], b[1], b[2]}};
+        vals = cache_lookup(&w->cache, &key, (size_t)m * m * m, fill_brick, &job);
+        *last = (LastBrick){key.patch, level, vals};
+    }
     int i[3];
     float t[3];
     for (int a = 0; a < 3; a++) {
@@ -302,10 +317,11 @@ static void extinction_at(Worker *w, const RenderVolume *v, const Ray *ray, RayD
         return;
     }
     float len = v3_length(ray->d);
+    LastBrick last = {0, -1, NULL};
     for (int i = 0; i < m->n; i++) {
         float t = m->t0 + ((float)i + m->jitter) * m->dt;
         Vec3 q = mat4_point(&v->object_from_world, v3_madd(ray->o, ray->d, t));
-        v3_store(p->Oi[i], extinction_cached(w, v, q, diff.width + diff.spread * t * len));
+        v3_store(p->Oi[i], extinction_cached(w, v, q, diff.width + diff.spread * t * len, &last));
     }
 }
 
