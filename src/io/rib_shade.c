@@ -215,8 +215,8 @@ static const char *const builtin_surfaces[] = {"matte", "plastic", "metal", "shi
 static const char *const builtin_displacements[] = {"bumpy", "fractal", "displace", NULL};
 /* rayes' pattern classes (rayes_scene_pattern): pbrt-v4's textures. */
 static const char *const builtin_patterns[] = {
-    "constant", "scale", "mix",      "directionmix", "checkerboard", "imagemap", "bilerp",
-    "dots",     "fbm",   "wrinkled", "windy",        "marble",       NULL};
+    "constant", "scale",    "mix",   "directionmix", "checkerboard", "imagemap", "bilerp", "dots",
+    "fbm",      "wrinkled", "windy", "marble",       "densitygrid",  "nanovdb",  NULL};
 
 static int in_list(const char *const *list, const char *s)
 {
@@ -273,6 +273,17 @@ static ShaderRec *make_shader(Rib *r, const char *name, const Param *p, size_t n
         } else if ((q->d.ty == TY_FLOAT || q->d.ty == TY_INT) && q->v->n == 1) {
             o.type = RAYES_PARAM_FLOAT;
             o.value[0] = (float)q->v->d[0];
+        } else if (q->d.ty == TY_FLOAT && q->v->n > 1) { /* patterns' data (densitygrid) */
+            float *v = malloc(q->v->n * sizeof *v);
+            if (!v) {
+                rib_error(r, "out of memory");
+                return NULL;
+            }
+            for (size_t k = 0; k < q->v->n; k++)
+                v[k] = (float)q->v->d[k];
+            o.type = RAYES_PARAM_FLOATS;
+            o.floats = v;
+            o.n_floats = q->v->n;
         } else if (q->d.ty == TY_COLOR || q->d.ty == TY_POINT) {
             if (q->v->n != 3)
                 continue;
@@ -285,6 +296,7 @@ static ShaderRec *make_shader(Rib *r, const char *name, const Param *p, size_t n
         o.name = rib_strdup(q->d.name);
         if (!o.name) {
             free((char *)o.string);
+            free((float *)o.floats);
             return NULL;
         }
         sh->params[sh->n++] = o;
