@@ -118,7 +118,10 @@ static int read_meta(const unsigned char *data, size_t size, size_t *at, GridMet
     size_t len = strnlen((const char *)data + *at, name_size);
     if (len >= MAX_NAME)
         len = MAX_NAME - 1;
-    memcpy(m->name, data + *at, len);
+    for (size_t k = 0; k < len; k++) { /* names reach one-line messages */
+        unsigned char ch = data[*at + k];
+        m->name[k] = ch >= 0x20 && ch < 0x7f ? (char)ch : '?';
+    }
     m->name[len] = '\0';
     *at += name_size;
     return 0;
@@ -165,6 +168,31 @@ static VoxelGrid *make_nanovdb(const unsigned char *bytes, uint64_t size, const 
     return g;
 }
 
+/* The grid m describes, whose bytes on disk start at data (size bytes to
+ * the file's end), if it is an uncompressed float grid; else NULL with
+ * err filled. */
+static VoxelGrid *open_grid(const GridMeta *m, unsigned codec, const unsigned char *data,
+                            size_t size, const char *path, char *err, size_t err_size)
+{
+    if (codec != 0) {
+        snprintf(err, err_size,
+                 "%s: grid \"%s\" is compressed (%s); rayes reads uncompressed files "
+                 "(nanovdb_convert without -z or -b)",
+                 path, m->name,
+                 codec == 1   ? "zip"
+                 : codec == 2 ? "blosc"
+                              : "unknown codec");
+    } else if (m->type != PNANOVDB_GRID_TYPE_FLOAT) {
+        snprintf(err, err_size, "%s: grid \"%s\" is not a float grid (NanoVDB type %u)", path,
+                 m->name, m->type);
+    } else if (m->file_size != m->grid_size || m->file_size > size) {
+        snprintf(err, err_size, "%s: truncated NanoVDB file (grid \"%s\")", path, m->name);
+    } else {
+        return make_nanovdb(data, m->grid_size, path, m->name, err, err_size);
+    }
+    return NULL;
+}
+
 VoxelGrid *grid_parse_nanovdb(const unsigned char *data, size_t size, const char *name,
                               const char *path, char *err, size_t err_size)
 {
@@ -201,41 +229,24 @@ VoxelGrid *grid_parse_nanovdb(const unsigned char *data, size_t size, const char
                 snprintf(err, err_size, "%s: truncated NanoVDB file (grid metadata)", path);
                 return NULL;
             }
-        for (unsigned k = 0; k < count; k++) {
+        int done = 0;
+        VoxelGrid *g = NULL;
+        for (unsigned k = 0; k < count && !done; k++) {
             const GridMeta *m = &meta[k];
-            if (strcmp(m->name, name) != 0) {
+            done = strcmp(m->name, name) == 0 || m->file_size > size - at;
+            if (strcmp(m->name, name) == 0) {
+                g = open_grid(m, codec, data + at, size - at, path, err, err_size);
+            } else if (done) {
+                snprintf(err, err_size, "%s: truncated NanoVDB file (grid \"%s\")", path, m->name);
+            } else {
                 size_t used = strlen(names);
                 snprintf(names + used, sizeof names - used, "%s\"%s\"", used ? ", " : "", m->name);
-            } else if (codec != 0) {
-                snprintf(err, err_size,
-                         "%s: grid \"%s\" is compressed (%s); rayes reads uncompressed files "
-                         "(nanovdb_convert without -z or -b)",
-                         path, name,
-                         codec == 1   ? "zip"
-                         : codec == 2 ? "blosc"
-                                      : "unknown codec");
-            } else if (m->type != PNANOVDB_GRID_TYPE_FLOAT) {
-                snprintf(err, err_size, "%s: grid \"%s\" is not a float grid (NanoVDB type %u)",
-                         path, name, m->type);
-            } else if (m->file_size != m->grid_size || m->file_size > size - at) {
-                snprintf(err, err_size, "%s: truncated NanoVDB file (grid \"%s\")", path, name);
-            } else {
-                uint64_t grid_size = m->grid_size;
-                free(meta);
-                return make_nanovdb(data + at, grid_size, path, name, err, err_size);
+                at += (size_t)m->file_size;
             }
-            if (strcmp(m->name, name) == 0) {
-                free(meta);
-                return NULL;
-            }
-            if (m->file_size > size - at) {
-                free(meta);
-                snprintf(err, err_size, "%s: truncated NanoVDB file (grid \"%s\")", path, m->name);
-                return NULL;
-            }
-            at += (size_t)m->file_size;
         }
         free(meta);
+        if (done)
+            return g;
     }
     snprintf(err, err_size, "%s: no grid \"%s\" (the file has %s)", path, name,
              names[0] ? names : "no grids");
