@@ -214,6 +214,36 @@ static const RayesParam *grid_param(const RayesParam *params, size_t n, const ch
     return NULL;
 }
 
+/* densitygrid's grid from nx ny nz, density, p0 and p1 (checked for
+ * type by make_grid); -1 with err filled. */
+static int dense_grid(Pattern *p, const RayesParam *params, size_t n, char *err, size_t err_size)
+{
+    static const char *const counts[3] = {"nx", "ny", "nz"};
+    size_t res[3] = {1, 1, 1};
+    float p0[3] = {0, 0, 0}, p1[3] = {1, 1, 1};
+    for (int k = 0; k < 3; k++) {
+        const RayesParam *q = grid_param(params, n, counts[k], RAYES_PARAM_FLOAT);
+        if (q && !(q->value[0] >= 1.0f && q->value[0] <= 1048576.0f &&
+                   q->value[0] == floorf(q->value[0]))) {
+            snprintf(err, err_size, "%s must be a count", counts[k]);
+            return -1;
+        }
+        res[k] = q ? (size_t)q->value[0] : 1;
+    }
+    const RayesParam *d = grid_param(params, n, "density", RAYES_PARAM_FLOATS);
+    const RayesParam *one = grid_param(params, n, "density", RAYES_PARAM_FLOAT);
+    const RayesParam *lo = grid_param(params, n, "p0", RAYES_PARAM_COLOR);
+    const RayesParam *hi = grid_param(params, n, "p1", RAYES_PARAM_COLOR);
+    if (lo)
+        memcpy(p0, lo->value, sizeof p0);
+    if (hi)
+        memcpy(p1, hi->value, sizeof p1);
+    const float *values = d ? d->floats : one ? one->value : NULL;
+    size_t n_values = d ? d->n_floats : one ? 1 : 0;
+    p->grid = grid_new_dense(res, values, n_values, p0, p1, err, err_size);
+    return p->grid ? 0 : -1;
+}
+
 /* The grid classes' parameters: densitygrid's nx ny nz, density, p0, p1
  * (pbrt-v4's uniformgrid medium), nanovdb's filename and grid. Unknown or
  * mistyped parameters are refused like set_slot's. */
@@ -245,28 +275,10 @@ static int make_grid(Pattern *p, const ClassDesc *c, const RayesParam *params, s
     }
     char grid_err[1200];
     if (dense) {
-        size_t res[3] = {1, 1, 1};
-        float p0[3] = {0, 0, 0}, p1[3] = {1, 1, 1};
-        for (int k = 0; k < 3; k++) {
-            const RayesParam *q = grid_param(params, n, names[k], RAYES_PARAM_FLOAT);
-            if (q && !(q->value[0] >= 1.0f && q->value[0] <= 1048576.0f &&
-                       q->value[0] == floorf(q->value[0]))) {
-                snprintf(err, err_size, "pattern \"densitygrid\": %s must be a count", names[k]);
-                return -1;
-            }
-            res[k] = q ? (size_t)q->value[0] : 1;
+        if (dense_grid(p, params, n, grid_err, sizeof grid_err) != 0) {
+            snprintf(err, err_size, "pattern \"densitygrid\": %s", grid_err);
+            return -1;
         }
-        const RayesParam *d = grid_param(params, n, "density", RAYES_PARAM_FLOATS);
-        const RayesParam *one = grid_param(params, n, "density", RAYES_PARAM_FLOAT);
-        const RayesParam *lo = grid_param(params, n, "p0", RAYES_PARAM_COLOR);
-        const RayesParam *hi = grid_param(params, n, "p1", RAYES_PARAM_COLOR);
-        if (lo)
-            memcpy(p0, lo->value, sizeof p0);
-        if (hi)
-            memcpy(p1, hi->value, sizeof p1);
-        const float *values = d ? d->floats : one ? one->value : NULL;
-        size_t n_values = d ? d->n_floats : one ? 1 : 0;
-        p->grid = grid_new_dense(res, values, n_values, p0, p1, grid_err, sizeof grid_err);
     } else {
         const RayesParam *file = grid_param(params, n, "filename", RAYES_PARAM_STRING);
         const RayesParam *name = grid_param(params, n, "grid", RAYES_PARAM_STRING);
