@@ -109,12 +109,14 @@ RAYES_API RayesError rayes_scene_set_transform(RayesScene *scene,
  * names and types it understands. Unknown names get one warning. */
 typedef enum RayesParamType {
     RAYES_PARAM_NONE = 0,
-    RAYES_PARAM_FLOAT = 1,  /* value[0] */
-    RAYES_PARAM_COLOR = 2,  /* value[0..2], linear RGB */
-    RAYES_PARAM_STRING = 3, /* string */
-    RAYES_PARAM_PATTERN = 4 /* string: the name of a pattern (rayes_scene_pattern); given for
-                               a shader's FLOAT or COLOR parameter, the value varies over
-                               the surface as the pattern does */
+    RAYES_PARAM_FLOAT = 1,   /* value[0] */
+    RAYES_PARAM_COLOR = 2,   /* value[0..2], linear RGB */
+    RAYES_PARAM_STRING = 3,  /* string */
+    RAYES_PARAM_PATTERN = 4, /* string: the name of a pattern (rayes_scene_pattern); given for
+                                a shader's FLOAT or COLOR parameter, the value varies over
+                                the surface as the pattern does */
+    RAYES_PARAM_FLOATS = 5   /* floats[0 .. n_floats - 1]: an array, for patterns' data
+                                (densitygrid's "density") */
 } RayesParamType;
 
 typedef struct RayesParam {
@@ -122,6 +124,8 @@ typedef struct RayesParam {
     RayesParamType type;
     float value[3];      /* FLOAT and COLOR values */
     const char *string;  /* STRING value, copied by the callee */
+    const float *floats; /* FLOATS values, copied by the callee */
+    size_t n_floats;
 } RayesParam;
 
 /* The surface shader of geometry added from now on: a built-in class name
@@ -179,6 +183,16 @@ RAYES_API RayesError rayes_scene_set_displacement_bound(RayesScene *scene, float
  *   "dots"          inside, outside: polka dots on the (u, v) cells
  *   "fbm", "wrinkled", "windy", "marble"  pbrt's noise patterns (octaves,
  *                   roughness; marble: scale, variation)
+ *   "densitygrid"   pbrt-v4's uniform grid: "nx", "ny", "nz" (FLOAT counts),
+ *                   "density" (FLOATS, nx ny nz values, x fastest) over the
+ *                   box "p0" to "p1" (COLORs, default 0 0 0 and 1 1 1);
+ *                   trilinear between voxel centres, 0 outside the box
+ *   "nanovdb"       a float grid of a NanoVDB file: "filename" (STRING, on
+ *                   the texture search path), "grid" (STRING, default
+ *                   "density"); the file's world space is texture space;
+ *                   read at once (a missing, damaged or compressed file, or
+ *                   no float grid of that name, is an error naming the
+ *                   file); trilinear, 0 (the background) outside the tree
  * The 2-D classes take pbrt's (u, v) = (s, 1 - t) and "uscale", "vscale",
  * "udelta", "vdelta". A later definition of a name replaces it for later
  * references. An unknown class, parameter or pattern name, a wrong type, or

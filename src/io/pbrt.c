@@ -407,9 +407,9 @@ static const struct {
     {"LightSource", pbrt_d_light},
     {"LookAt", d_lookat},
     {"MakeNamedMaterial", pbrt_d_makenamedmaterial},
-    {"MakeNamedMedium", d_ignored},
+    {"MakeNamedMedium", pbrt_d_makenamedmedium},
     {"Material", pbrt_d_material},
-    {"MediumInterface", d_ignored},
+    {"MediumInterface", pbrt_d_mediuminterface},
     {"NamedMaterial", pbrt_d_namedmaterial},
     {"ObjectBegin", d_objectbegin},
     {"ObjectEnd", d_objectend},
@@ -490,6 +490,7 @@ static void parser_free(Parser *P)
     free(P->coordsys);
     free(P->materials);
     free(P->textures);
+    pbrt_media_free(P);
     free(P->warned);
 }
 

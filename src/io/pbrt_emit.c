@@ -65,10 +65,54 @@ static int send_transform(Parser *P, const Token *t, const double m[16])
 int pbrt_emit_pattern(Parser *P, const Token *t, const char *name, const char *type,
                       const RayesParam *params, size_t n)
 {
-    if (send_transform(P, t, P->gs.ctm) != 0)
+    return pbrt_emit_pattern_in(P, t, P->gs.ctm, name, type, params, n);
+}
+
+int pbrt_emit_pattern_in(Parser *P, const Token *t, const double m[16], const char *name,
+                         const char *type, const RayesParam *params, size_t n)
+{
+    if (send_transform(P, t, m) != 0)
         return -1;
     RayesError e = P->sink->pattern(P->sink->target, name, type, params, n);
     return e != RAYES_OK ? pbrt_sink_failed(P, t, e) : 0;
+}
+
+int pbrt_emit_volume(Parser *P, const Token *t, const double m[16], const RayesParam *params,
+                     size_t n, const float bound[6])
+{
+    if (send_transform(P, t, m) != 0)
+        return -1;
+    P->have_sent = 0; /* the shader changes under the material last sent */
+    RayesError e = P->sink->set_shader(P->sink->target, "homogeneous", params, n);
+    if (e == RAYES_OK)
+        e = P->sink->volume(P->sink->target, bound);
+    return e != RAYES_OK ? pbrt_sink_failed(P, t, e) : 0;
+}
+
+/* Grows the Shape's bounds by n points (object space). */
+static void grow_bound(Parser *P, const float *pts, size_t n)
+{
+    float *b = P->shape_bound;
+    for (size_t i = 0; i < n; i++)
+        for (int k = 0; k < 3; k++) {
+            float v = pts[3 * i + k];
+            if (!P->have_shape_bound || v < b[2 * k])
+                b[2 * k] = v;
+            if (!P->have_shape_bound || v > b[2 * k + 1])
+                b[2 * k + 1] = v;
+            if (k == 2)
+                P->have_shape_bound = 1;
+        }
+}
+
+/* The corners of a quadric's bounds (pbrt's sphere, cylinder, disk). */
+static void grow_quadric(Parser *P, RayesQuadric q, const float *qp)
+{
+    float r = q == RAYES_QUADRIC_DISK ? qp[1] : qp[0];
+    float z0 = q == RAYES_QUADRIC_DISK ? qp[0] : qp[1],
+          z1 = q == RAYES_QUADRIC_DISK ? qp[0] : qp[2];
+    const float c[6] = {-r, -r, z0, r, r, z1};
+    grow_bound(P, c, 2);
 }
 
 static int send_state(Parser *P, const Token *t, const double m[16], const Material *mat)
@@ -169,6 +213,7 @@ static RayesError send_mesh(Parser *P, size_t n_faces, const int *n_verts, const
 static int emit_mesh(Parser *P, const Token *t, size_t n_faces, const int *n_verts, const int *idx,
                      size_t n_points, const float *pts, const float *N, const float *uv, int subdiv)
 {
+    grow_bound(P, pts, n_points);
     if (n_faces == 0 || strcmp(P->gs.material.shader, PBRT_INVISIBLE) == 0)
         return 0;
     if (P->recording) {
@@ -232,6 +277,8 @@ int pbrt_emit_curves(Parser *P, const Token *t, const RayesCurves *c, const Raye
 int pbrt_emit_quadric(Parser *P, const Token *t, RayesQuadric q, const float *qp, size_t n,
                       unsigned flags)
 {
+    if (q == RAYES_QUADRIC_SPHERE || q == RAYES_QUADRIC_CYLINDER || q == RAYES_QUADRIC_DISK)
+        grow_quadric(P, q, qp);
     if (strcmp(P->gs.material.shader, PBRT_INVISIBLE) == 0)
         return 0;
     if (P->recording) {
@@ -262,6 +309,7 @@ static RayesError send_patch(Parser *P, const Op *op)
 
 int pbrt_emit_patch(Parser *P, const Token *t, const Op *patch)
 {
+    grow_bound(P, &patch->patch[0][0], 4);
     if (strcmp(P->gs.material.shader, PBRT_INVISIBLE) == 0)
         return 0;
     if (P->recording) {

@@ -15,7 +15,9 @@
  *                    ColorSpace, WorldBegin/End;
  *   pbrt_material.c  Material, MakeNamedMaterial, NamedMaterial, Texture;
  *   pbrt_shape.c     Shape;
- *   pbrt_light.c     LightSource, AreaLightSource.
+ *   pbrt_light.c     LightSource, AreaLightSource;
+ *   pbrt_medium.c    MakeNamedMedium, MediumInterface, and the volume
+ *                    a shape with an inside medium bounds.
  *
  * A new directive's handler goes in the file of its concern and gets a
  * line in pbrt.c's table. The files call one way (tools/check_deps):
@@ -116,6 +118,7 @@ typedef struct GState {
     int active;     /* ActiveTransform: 1 All/StartTime, 0 EndTime (transforms dropped) */
     Material material;
     AreaLight area;
+    char inside[128], outside[128]; /* MediumInterface: media names, "" for none */
     int kind; /* on the stack: 'A' AttributeBegin, 'T' TransformBegin, 'O' ObjectBegin */
 } GState;
 
@@ -139,6 +142,25 @@ typedef struct Texture {
                           what cannot vary (its mean where pbrt's class has one) */
     int is_float;      /* a "float" texture (else "spectrum") */
 } Texture;
+
+/* A named medium (MakeNamedMedium): the homogeneous shader's parameters
+ * and, for grids, the density pattern, sent with the first shape that
+ * bounds it. */
+typedef struct Medium {
+    char name[128];
+    char type[16];       /* "homogeneous", "uniformgrid" or "nanovdb" */
+    double m[16];        /* world_from_medium: the transform at MakeNamedMedium */
+    float extinction[3]; /* (sigma_a + sigma_s) scale */
+    float albedo[3];     /* sigma_s / (sigma_a + sigma_s) */
+    float emission[3];   /* sigma_a scale Le Lescale */
+    float g;
+    size_t res[3];            /* uniformgrid: nx ny nz */
+    float *density;           /* uniformgrid: nx ny nz values, owned */
+    float p0[3], p1[3];       /* uniformgrid: the grid's box, medium space */
+    char filename[PBRT_PATH]; /* nanovdb: resolved */
+    char pattern[160];        /* the sink's pattern of the density once sent, else "" */
+    int sent;                 /* the pattern was sent */
+} Medium;
 
 typedef enum OpKind { OP_MESH, OP_QUADRIC, OP_PATCH } OpKind;
 
@@ -187,6 +209,10 @@ typedef struct Parser {
     size_t n_textures;
     Object *objects;
     size_t n_objects;
+    Medium *media;
+    size_t n_media;
+    float shape_bound[6]; /* object-space bounds of the Shape being read (x0 x1 y0 y1 z0 z1) */
+    int have_shape_bound;
     Object *recording; /* between ObjectBegin and ObjectEnd */
     long replayed;
     /* camera and options */
@@ -316,6 +342,14 @@ int pbrt_emit_light(Parser *P, const Token *t, const double m[16], const char *t
  * the sink must have the pattern method. */
 int pbrt_emit_pattern(Parser *P, const Token *t, const char *name, const char *type,
                       const RayesParam *params, size_t n);
+/* A pattern (as pbrt_emit_pattern) in the space of m. */
+int pbrt_emit_pattern_in(Parser *P, const Token *t, const double m[16], const char *name,
+                         const char *type, const RayesParam *params, size_t n);
+/* A volume (rayes_scene_volume) of the box bound in the space of m, with
+ * the built-in "homogeneous" shader of these parameters; the next shape
+ * sends its material again. The sink must have the volume method. */
+int pbrt_emit_volume(Parser *P, const Token *t, const double m[16], const RayesParam *params,
+                     size_t n, const float bound[6]);
 /* Sends the recorded object o under the current transform. */
 int pbrt_replay(Parser *P, const Token *t, const Object *o);
 
@@ -344,5 +378,12 @@ int pbrt_d_texture(Parser *P, const Token *t);
 int pbrt_d_shape(Parser *P, const Token *t); /* pbrt_shape.c */
 int pbrt_d_arealight(Parser *P, const Token *t); /* pbrt_light.c */
 int pbrt_d_light(Parser *P, const Token *t);
+int pbrt_d_makenamedmedium(Parser *P, const Token *t); /* pbrt_medium.c */
+int pbrt_d_mediuminterface(Parser *P, const Token *t);
+/* After a Shape: the volume of its inside medium, if it has one, over
+ * P->shape_bound (pbrt_emit_* grow it). */
+int pbrt_medium_shape(Parser *P, const Token *t);
+/* Frees the media's arrays. */
+void pbrt_media_free(Parser *P);
 
 #endif /* RAYES_IO_PBRT_INTERNAL_H */

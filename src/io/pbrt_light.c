@@ -4,9 +4,8 @@
  * pointlight, spotlight, distantlight and environmentlight (pbrt's power
  * and illuminance become an intensity) and sends them at once, also
  * inside ObjectBegin. AreaLightSource only sets the graphics state's area
- * light; the shapes that follow emit (pbrt_shape.c). Media
- * (MakeNamedMedium, MediumInterface) are read and ignored by d_ignored
- * (pbrt.c).
+ * light; the shapes that follow emit (pbrt_shape.c). Media are
+ * pbrt_medium.c's.
  */
 #include <math.h>
 #include <stdio.h>

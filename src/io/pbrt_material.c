@@ -670,10 +670,8 @@ static int material_of_type(Parser *P, const Token *t, const char *type, ParamLi
         return hair_material(P, pl, m);
     if (strcmp(type, "interface") == 0 || strcmp(type, "") == 0 || strcmp(type, "none") == 0) {
         /* pbrt's "interface" (and "" or "none") marks a shape that only
-         * bounds a participating medium: it is not a surface at all. */
-        pbrt_warn_at(P, t->line, t->col, "interface",
-                     "material \"interface\": its shapes only bound media, which rayes does not "
-                     "render; they are left out");
+         * bounds a participating medium: it is not a surface at all (its
+         * medium, if any, is pbrt_medium.c's). */
         pbrt_mat_init(m, PBRT_INVISIBLE);
         return 0;
     }

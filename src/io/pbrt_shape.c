@@ -604,6 +604,7 @@ int pbrt_d_shape(Parser *P, const Token *t)
         pbrt_params_free(&pl);
         return -1;
     }
+    P->have_shape_bound = 0;
     Material saved = P->gs.material, with_alpha;
     r = shape_alpha(P, t, &pl, &with_alpha);
     if (r == 1)
@@ -618,5 +619,5 @@ int pbrt_d_shape(Parser *P, const Token *t)
     if (!r)
         pbrt_warn_unused(P, &pl, "Shape", type);
     pbrt_params_free(&pl);
-    return r;
+    return r ? r : pbrt_medium_shape(P, t);
 }

@@ -654,6 +654,7 @@ static void rib_fini(Rib *r)
         for (size_t i = 0; i < s->n; i++) {
             free((char *)s->params[i].name);
             free((char *)s->params[i].string);
+            free((float *)s->params[i].floats);
         }
         free(s->params);
         free(s);

@@ -71,6 +71,7 @@ static void call_fini(RibCall *c)
     for (size_t i = 0; i < c->n_params; i++) {
         free((char *)c->params[i].name);
         free((char *)c->params[i].string);
+        free((float *)c->params[i].floats);
     }
     free(c->params);
     free(c->f);
@@ -149,6 +150,14 @@ static RayesError named(RibRecording *rec, CallKind kind, const char *name, cons
         c->params[i] = p[i];
         c->params[i].name = dup_str(p[i].name);
         c->params[i].string = dup_str(p[i].string);
+        c->params[i].floats = NULL;
+        if (p[i].type == RAYES_PARAM_FLOATS && p[i].n_floats) { /* a pattern's data */
+            float *v = malloc(p[i].n_floats * sizeof *v);
+            if (!v)
+                return RAYES_ERROR_OUT_OF_MEMORY;
+            memcpy(v, p[i].floats, p[i].n_floats * sizeof *v);
+            c->params[i].floats = v;
+        }
         c->n_params++;
     }
     return RAYES_OK;

@@ -215,8 +215,8 @@ static const char *const builtin_surfaces[] = {"matte", "plastic", "metal", "shi
 static const char *const builtin_displacements[] = {"bumpy", "fractal", "displace", NULL};
 /* rayes' pattern classes (rayes_scene_pattern): pbrt-v4's textures. */
 static const char *const builtin_patterns[] = {
-    "constant", "scale", "mix",      "directionmix", "checkerboard", "imagemap", "bilerp",
-    "dots",     "fbm",   "wrinkled", "windy",        "marble",       NULL};
+    "constant", "scale",    "mix",   "directionmix", "checkerboard", "imagemap", "bilerp", "dots",
+    "fbm",      "wrinkled", "windy", "marble",       "densitygrid",  "nanovdb",  NULL};
 
 static int in_list(const char *const *list, const char *s)
 {
@@ -236,7 +236,12 @@ static int pattern_sent(const Rib *r, const char *name)
     return 0;
 }
 
-static ShaderRec *make_shader(Rib *r, const char *name, const Param *p, size_t n, int only_k)
+/* make_shader's flags: keep only Kd and Ka (a stand-in for an unknown
+ * shader); pass float arrays (a Pattern's data, densitygrid's density). */
+#define SHADER_ONLY_K 1
+#define SHADER_ARRAYS 2
+
+static ShaderRec *make_shader(Rib *r, const char *name, const Param *p, size_t n, int flags)
 {
     ShaderRec *sh = calloc(1, sizeof *sh);
     if (sh)
@@ -251,7 +256,7 @@ static ShaderRec *make_shader(Rib *r, const char *name, const Param *p, size_t n
     snprintf(sh->name, sizeof sh->name, "%s", name);
     for (size_t i = 0; i < n; i++) {
         const Param *q = &p[i];
-        if (only_k && strcmp(q->d.name, "Kd") != 0 && strcmp(q->d.name, "Ka") != 0)
+        if ((flags & SHADER_ONLY_K) && strcmp(q->d.name, "Kd") != 0 && strcmp(q->d.name, "Ka") != 0)
             continue;
         if (!q->declared)
             continue;
@@ -273,6 +278,17 @@ static ShaderRec *make_shader(Rib *r, const char *name, const Param *p, size_t n
         } else if ((q->d.ty == TY_FLOAT || q->d.ty == TY_INT) && q->v->n == 1) {
             o.type = RAYES_PARAM_FLOAT;
             o.value[0] = (float)q->v->d[0];
+        } else if ((flags & SHADER_ARRAYS) && q->d.ty == TY_FLOAT && q->v->n > 1) {
+            float *v = malloc(q->v->n * sizeof *v);
+            if (!v) {
+                rib_error(r, "out of memory");
+                return NULL;
+            }
+            for (size_t k = 0; k < q->v->n; k++)
+                v[k] = (float)q->v->d[k];
+            o.type = RAYES_PARAM_FLOATS;
+            o.floats = v;
+            o.n_floats = q->v->n;
         } else if (q->d.ty == TY_COLOR || q->d.ty == TY_POINT) {
             if (q->v->n != 3)
                 continue;
@@ -285,6 +301,7 @@ static ShaderRec *make_shader(Rib *r, const char *name, const Param *p, size_t n
         o.name = rib_strdup(q->d.name);
         if (!o.name) {
             free((char *)o.string);
+            free((float *)o.floats);
             return NULL;
         }
         sh->params[sh->n++] = o;
@@ -322,7 +339,7 @@ static int h_surface(Rib *r, const Args *a)
                   "matte instead (with its Ka, Kd)",
                   name);
     }
-    ShaderRec *sh = make_shader(r, known ? name : "matte", p, n, !known);
+    ShaderRec *sh = make_shader(r, known ? name : "matte", p, n, known ? 0 : SHADER_ONLY_K);
     free(p);
     if (!sh)
         return -1;
@@ -655,7 +672,7 @@ static int h_pattern(Rib *r, const Args *a)
         free(p);
         return 0;
     }
-    ShaderRec *sh = make_shader(r, type, p, n, 0);
+    ShaderRec *sh = make_shader(r, type, p, n, SHADER_ARRAYS);
     free(p);
     if (!sh)
         return -1;

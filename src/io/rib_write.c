@@ -161,6 +161,13 @@ static RayesError params(RibWriter *w, FILE *f, const RayesParam *p, size_t n, i
             floats(f, p[i].value, k);
             break;
         }
+        case RAYES_PARAM_FLOATS:
+            if (!p[i].floats || !finite_all(p[i].floats, p[i].n_floats))
+                return fail(w, RAYES_ERROR_INVALID_ARGUMENT, "parameter \"%s\": not finite",
+                            p[i].name);
+            fprintf(f, " \"float %s\" ", p[i].name);
+            floats(f, p[i].floats, p[i].n_floats);
+            break;
         case RAYES_PARAM_STRING:
         case RAYES_PARAM_PATTERN: /* rayes' RIB: "reference pattern NAME" [pattern] */
             fprintf(f,

@@ -36,24 +36,55 @@ static const Pattern *find_pattern(void *data, const char *name)
     return NULL;
 }
 
+static int params_finite(const RayesParam *q)
+{
+    if (q->type == RAYES_PARAM_STRING || q->type == RAYES_PARAM_PATTERN)
+        return 1;
+    if (q->type == RAYES_PARAM_FLOATS) {
+        if (q->n_floats && !q->floats)
+            return 0;
+        for (size_t k = 0; k < q->n_floats; k++)
+            if (!isfinite(q->floats[k]))
+                return 0;
+        return 1;
+    }
+    return isfinite(q->value[0]) && isfinite(q->value[1]) && isfinite(q->value[2]);
+}
+
+/* pattern_new, with nanovdb's "filename" found on the texture search path
+ * first (as images are). */
+static Pattern *make_pattern(RayesScene *s, const char *type, const RayesParam *params,
+                             size_t n_params, const float m[16], char *err, size_t err_size)
+{
+    if (!type || strcmp(type, "nanovdb") != 0 || n_params > 16)
+        return pattern_new(type, params, n_params, m, find_pattern, s, err, err_size);
+    RayesParam copy[16];
+    char path[1024];
+    memcpy(copy, params, n_params * sizeof *params);
+    for (size_t i = 0; i < n_params; i++)
+        if (copy[i].name && strcmp(copy[i].name, "filename") == 0 &&
+            copy[i].type == RAYES_PARAM_STRING && copy[i].string &&
+            scene_find_texture(s, copy[i].string, path, sizeof path) == 0)
+            copy[i].string = path;
+    return pattern_new(type, copy, n_params, m, find_pattern, s, err, err_size);
+}
+
 RayesError rayes_scene_pattern(RayesScene *s, const char *name, const char *type,
                                const RayesParam *params, size_t n_params)
 {
     if (!s || !name || !name[0] || !type || (n_params && !params))
         return RAYES_ERROR_INVALID_ARGUMENT;
     for (size_t i = 0; i < n_params; i++)
-        if (params[i].type != RAYES_PARAM_STRING && params[i].type != RAYES_PARAM_PATTERN &&
-            !(isfinite(params[i].value[0]) && isfinite(params[i].value[1]) &&
-              isfinite(params[i].value[2]))) {
+        if (!params_finite(&params[i])) {
             set_error(s, "pattern: a parameter is not finite");
             return RAYES_ERROR_INVALID_ARGUMENT;
         }
-    char err[256], msg[400];
+    char err[512], msg[sizeof s->error];
     float m[16];
     memcpy(m, s->world_from_object.m, sizeof m);
-    Pattern *p = pattern_new(type, params, n_params, m, find_pattern, s, err, sizeof err);
+    Pattern *p = make_pattern(s, type, params, n_params, m, err, sizeof err);
     if (!p) {
-        snprintf(msg, sizeof msg, "pattern \"%.64s\": %s", name, err);
+        snprintf(msg, sizeof msg, "pattern \"%.64s\": %.420s", name, err);
         set_error(s, msg);
         return strcmp(err, "out of memory") == 0 ? RAYES_ERROR_OUT_OF_MEMORY
                                                  : RAYES_ERROR_INVALID_ARGUMENT;

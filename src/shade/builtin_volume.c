@@ -5,7 +5,9 @@
  * whose extinction is a turbulence function of five octaves of noise.
  *
  * Both: opacity() = sigma_t = density * extinction (RGB, per unit
- * length), times turbulence's pattern; lighting() = sigma_s * (the direct
+ * length), times turbulence's pattern; density may be bound to a pattern
+ * (a densitygrid or nanovdb grid, shade_param_float), negative values
+ * read as 0; lighting() = sigma_s * (the direct
  * light the phase function scatters toward the viewer, the direct_volume
  * service) + density * emission, sigma_s = albedo * sigma_t. Volume points
  * carry their position in the box in u, v and s (0 to 1).
@@ -60,13 +62,22 @@ static float turbulence_density(const RayesShaderServices *sv, const RayesShadeC
     return fmaxf(0.0f, 2.0f * turb - 0.3f) * fade;
 }
 
+/* sigma_t at ctx's points into out: density (a constant, or the pattern
+ * bound to "density") times fn's pattern times extinction. */
 static void extinction(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
                        const VolumeParams *p, DensityFn fn, Rgb *out)
 {
-    for (size_t i = 0; i < ctx->n_points; i++) {
-        float d = p->density * fn(sv, ctx, i, p);
-        for (int c = 0; c < 3; c++)
-            out[i][c] = d * p->extinction[c];
+    for (size_t start = 0; start < ctx->n_points; start += SHADE_CHUNK) {
+        size_t n = ctx->n_points - start < SHADE_CHUNK ? ctx->n_points - start : SHADE_CHUNK;
+        RayesShadeCtx sub;
+        float density[SHADE_CHUNK];
+        shade_ctx_slice(ctx, start, n, &sub);
+        shade_param_float(sv, &sub, "density", p->density, density);
+        for (size_t i = 0; i < n; i++) {
+            float d = fmaxf(density[i], 0.0f) * fn(sv, &sub, i, p);
+            for (int c = 0; c < 3; c++)
+                out[start + i][c] = d * p->extinction[c];
+        }
     }
 }
 

@@ -9,7 +9,9 @@
  * place of pbrt's and checkerboards box-filtered exactly (noise.h's
  * pattern_checker, as the checker service). pbrt's (u, v) is rayes' (s,
  * 1 - t): the pbrt reader turned v into t = 1 - v, and pbrt flips v again
- * before an image lookup, so an image lands as pbrt shows it.
+ * before an image lookup, so an image lands as pbrt shows it. The grid
+ * classes (densitygrid, nanovdb) own a VoxelGrid (grid.h), made here from
+ * their parameters and sampled in texture space.
  */
 #include "shade/pattern.h"
 
@@ -18,6 +20,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "shade/grid.h"
 #include "shade/noise.h"
 #include "shade/shade.h"
 #include "util/vec.h"
@@ -40,7 +43,9 @@ typedef enum PatternKind {
     PK_FBM,
     PK_WRINKLED,
     PK_WINDY,
-    PK_MARBLE
+    PK_MARBLE,
+    PK_DENSITYGRID,
+    PK_NANOVDB
 } PatternKind;
 
 /* One input: another pattern, or a constant when node is NULL. */
@@ -59,6 +64,7 @@ struct RayesPattern {
     float texture_from_world[16]; /* row-major; the 3-D classes' space */
     char filename[1024];          /* imagemap */
     char encoding[32];            /* imagemap: "" (the file's), "sRGB", "linear", "gamma G" */
+    VoxelGrid *grid;              /* densitygrid, nanovdb: owned */
 };
 
 /* A parameter of a class: an input ('i'), a number ('n'), a string ('s')
@@ -121,6 +127,9 @@ static const ClassDesc classes[] = {
       {"roughness", 'n', 1, {.5f}},
       {"scale", 'n', 2, {1}},
       {"variation", 'n', 3, {.2f}}}},
+    /* their parameters are read by make_grid */
+    {"densitygrid", PK_DENSITYGRID, 0, {{NULL, 0, 0, {0}}}},
+    {"nanovdb", PK_NANOVDB, 0, {{NULL, 0, 0, {0}}}},
 };
 
 static const char *const uv_names[4] = {"uscale", "vscale", "udelta", "vdelta"};
@@ -195,6 +204,98 @@ static int set_slot(Pattern *p, const ClassDesc *c, const RayesParam *q, Pattern
     return 0;
 }
 
+/* The parameter of that name and type among params, or NULL. */
+static const RayesParam *grid_param(const RayesParam *params, size_t n, const char *name,
+                                    RayesParamType type)
+{
+    for (size_t i = 0; i < n; i++)
+        if (params[i].name && strcmp(params[i].name, name) == 0 && params[i].type == type)
+            return &params[i];
+    return NULL;
+}
+
+/* densitygrid's grid from nx ny nz, density, p0 and p1 (checked for
+ * type by make_grid); -1 with err filled. */
+static int dense_grid(Pattern *p, const RayesParam *params, size_t n, char *err, size_t err_size)
+{
+    static const char *const counts[3] = {"nx", "ny", "nz"};
+    size_t res[3] = {1, 1, 1};
+    float p0[3] = {0, 0, 0}, p1[3] = {1, 1, 1};
+    for (int k = 0; k < 3; k++) {
+        const RayesParam *q = grid_param(params, n, counts[k], RAYES_PARAM_FLOAT);
+        if (q && !(q->value[0] >= 1.0f && q->value[0] <= 1048576.0f &&
+                   q->value[0] == floorf(q->value[0]))) {
+            snprintf(err, err_size, "%s must be a count", counts[k]);
+            return -1;
+        }
+        res[k] = q ? (size_t)q->value[0] : 1;
+    }
+    const RayesParam *d = grid_param(params, n, "density", RAYES_PARAM_FLOATS);
+    const RayesParam *one = grid_param(params, n, "density", RAYES_PARAM_FLOAT);
+    const RayesParam *lo = grid_param(params, n, "p0", RAYES_PARAM_COLOR);
+    const RayesParam *hi = grid_param(params, n, "p1", RAYES_PARAM_COLOR);
+    if (lo)
+        memcpy(p0, lo->value, sizeof p0);
+    if (hi)
+        memcpy(p1, hi->value, sizeof p1);
+    const float *values = d ? d->floats : one ? one->value : NULL;
+    size_t n_values = d ? d->n_floats : one ? 1 : 0;
+    p->grid = grid_new_dense(res, values, n_values, p0, p1, err, err_size);
+    return p->grid ? 0 : -1;
+}
+
+/* The grid classes' parameters: densitygrid's nx ny nz, density, p0, p1
+ * (pbrt-v4's uniformgrid medium), nanovdb's filename and grid. Unknown or
+ * mistyped parameters are refused like set_slot's. */
+static int make_grid(Pattern *p, const ClassDesc *c, const RayesParam *params, size_t n, char *err,
+                     size_t err_size)
+{
+    static const char *const dense_names[] = {"nx", "ny", "nz", "density", "p0", "p1", NULL};
+    static const RayesParamType dense_types[] = {RAYES_PARAM_FLOAT, RAYES_PARAM_FLOAT,
+                                                 RAYES_PARAM_FLOAT, RAYES_PARAM_FLOATS,
+                                                 RAYES_PARAM_COLOR, RAYES_PARAM_COLOR};
+    static const char *const vdb_names[] = {"filename", "grid", NULL};
+    static const RayesParamType vdb_types[] = {RAYES_PARAM_STRING, RAYES_PARAM_STRING};
+    int dense = p->kind == PK_DENSITYGRID;
+    const char *const *names = dense ? dense_names : vdb_names;
+    const RayesParamType *types = dense ? dense_types : vdb_types;
+    for (size_t i = 0; i < n; i++) {
+        int k = 0;
+        while (names[k] && strcmp(names[k], params[i].name) != 0)
+            k++;
+        /* one density value may come as a FLOAT */
+        int single = dense && k == 3 && params[i].type == RAYES_PARAM_FLOAT;
+        if (!names[k] || (params[i].type != types[k] && !single)) {
+            snprintf(err, err_size,
+                     names[k] ? "pattern \"%s\": parameter \"%s\" has the wrong type"
+                              : "pattern \"%s\" has no parameter \"%s\"",
+                     c->name, params[i].name);
+            return -1;
+        }
+    }
+    char grid_err[1200];
+    if (dense) {
+        if (dense_grid(p, params, n, grid_err, sizeof grid_err) != 0) {
+            snprintf(err, err_size, "pattern \"densitygrid\": %s", grid_err);
+            return -1;
+        }
+    } else {
+        const RayesParam *file = grid_param(params, n, "filename", RAYES_PARAM_STRING);
+        const RayesParam *name = grid_param(params, n, "grid", RAYES_PARAM_STRING);
+        if (!file || !file->string || !file->string[0]) {
+            snprintf(err, err_size, "pattern \"nanovdb\": no filename");
+            return -1;
+        }
+        p->grid = grid_read_nanovdb(file->string, name && name->string ? name->string : "density",
+                                    grid_err, sizeof grid_err);
+    }
+    if (!p->grid) {
+        snprintf(err, err_size, "pattern \"%s\": %s", c->name, grid_err);
+        return -1;
+    }
+    return 0;
+}
+
 /* Checks what set_slot cannot: values that only make sense together. */
 static int check_pattern(Pattern *p, const ClassDesc *c, char *err, size_t err_size)
 {
@@ -265,8 +366,10 @@ Pattern *pattern_new(const char *type, const RayesParam *params, size_t n_params
         else if (s->what == 'v')
             memcpy(p->vec, s->def, sizeof s->def);
     }
+    int grid = c->kind == PK_DENSITYGRID || c->kind == PK_NANOVDB;
     for (size_t i = 0; i < n_params; i++)
-        if (!params[i].name || set_slot(p, c, &params[i], find, find_data, err, err_size) != 0) {
+        if (!params[i].name ||
+            (!grid && set_slot(p, c, &params[i], find, find_data, err, err_size) != 0)) {
             if (!params[i].name)
                 snprintf(err, err_size, "pattern \"%s\": a parameter has no name", c->name);
             free(p);
@@ -290,8 +393,9 @@ Pattern *pattern_new(const char *type, const RayesParam *params, size_t n_params
         return NULL;
     }
     memcpy(p->texture_from_world, inv.m, sizeof p->texture_from_world);
-    if (check_pattern(p, c, err, err_size) != 0) {
-        free(p);
+    if ((grid && make_grid(p, c, params, n_params, err, err_size) != 0) ||
+        check_pattern(p, c, err, err_size) != 0) {
+        pattern_free(p);
         return NULL;
     }
     return p;
@@ -299,6 +403,8 @@ Pattern *pattern_new(const char *type, const RayesParam *params, size_t n_params
 
 void pattern_free(Pattern *p)
 {
+    if (p)
+        grid_free(p->grid);
     free(p);
 }
 
@@ -514,6 +620,19 @@ static void eval_noise(const Pattern *p, const Eval *e, Rgb *out)
     }
 }
 
+/* A grid in texture space, grey. */
+static void eval_grid(const Pattern *p, const Eval *e, Rgb *out)
+{
+    float q[PATTERN_CHUNK][3], v[PATTERN_CHUNK];
+    for (size_t i = 0; i < e->ctx->n_points; i++) {
+        float dx[3], dy[3];
+        point_at(p, e, i, q[i], dx, dy);
+    }
+    grid_sample(p->grid, e->ctx->n_points, (const float(*)[3])q, v);
+    for (size_t i = 0; i < e->ctx->n_points; i++)
+        grey(out[i], v[i]);
+}
+
 static void eval_node(const Pattern *p, Eval *e, Rgb *out)
 {
     size_t n = e->ctx->n_points;
@@ -548,6 +667,10 @@ static void eval_node(const Pattern *p, Eval *e, Rgb *out)
     case PK_WINDY:
     case PK_MARBLE:
         eval_noise(p, e, out);
+        return;
+    case PK_DENSITYGRID:
+    case PK_NANOVDB:
+        eval_grid(p, e, out);
         return;
     default: /* a weighted choice of tex1 and tex2 */
         eval_input(&p->in[0], e, in[0]);

@@ -2,7 +2,9 @@
  * shade/pattern.h — patterns: pbrt-v4's textures (constant, scale, mix,
  * directionmix, checkerboard in 2-D and 3-D, imagemap, bilerp, dots, fbm,
  * wrinkled, windy, marble) as small graphs that shaders evaluate at their
- * shading points through the `pattern` service (DESIGN.md "Patterns").
+ * shading points through the `pattern` service (DESIGN.md "Patterns"),
+ * and voxel grids of density (densitygrid, pbrt-v4's uniform grid, and
+ * nanovdb, a float grid of a NanoVDB file; grid.h) for volumes.
  *
  * A pattern is made once from a class name and RayesParams whose inputs are
  * constants or earlier patterns (found through a PatternFind), so graphs
@@ -32,7 +34,9 @@ typedef const Pattern *(*PatternFind)(void *data, const char *name);
  * with texture space given by world_from_texture (row-major 4 x 4; its
  * inverse is taken here). Returns NULL with err filled for an unknown
  * class, parameter, pattern name, wrong type, too deep a graph, a
- * singular transform or no memory. The caller owns the result. */
+ * singular transform, a grid that cannot be made or read (nanovdb's
+ * "filename" is opened as given: the scene resolves it first) or no
+ * memory. The caller owns the result. */
 Pattern *pattern_new(const char *type, const RayesParam *params, size_t n_params,
                      const float world_from_texture[16], PatternFind find, void *find_data,
                      char *err, size_t err_size);

@@ -447,6 +447,11 @@ static void test_patterns(void)
                       "Polygon \"P\" [0 0 0 1 0 0 1 1 0]")) == RAYES_OK);
     CHECK(rec.pattern[0] == '\0' && strcmp(rec.shader, "diffuse") == 0 &&
           rec.shader_pattern[0] == '\0');
+    /* the grid classes, a float array among their parameters */
+    CHECK(parse(WORLD("Pattern \"densitygrid\" \"g\" \"float nx\" 2 \"float density\" [0.5 1.5]\n"
+                      "Pattern \"nanovdb\" \"c\" \"string filename\" \"cloud.nvdb\"\n")) ==
+          RAYES_OK);
+    CHECK(strcmp(rec.pattern, "nanovdb c") == 0);
 }
 
 static void test_parameter_classes(void)

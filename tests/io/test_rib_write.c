@@ -264,6 +264,17 @@ static void test_patterns(void)
     CHECK(before(t, "Pattern", "Surface"));
     free(t);
     io_rib_writer_free(w);
+    /* an array (densitygrid's density) as a float array */
+    w = io_rib_writer_new();
+    k = io_rib_writer_sink(w);
+    const float d[3] = {0.5f, 1.5f, 2};
+    RayesParam gp[2] = {{"nx", RAYES_PARAM_FLOAT, {3, 0, 0}, NULL}};
+    gp[1] = (RayesParam){"density", RAYES_PARAM_FLOATS, {0}, NULL, d, 3};
+    CHECK(k.pattern(w, "g", "densitygrid", gp, 2) == RAYES_OK);
+    t = finish(w, &s);
+    CHECK(has(t, "Pattern \"densitygrid\" \"g\" \"float nx\" [3] \"float density\" [0.5 1.5 2]"));
+    free(t);
+    io_rib_writer_free(w);
 }
 
 TEST_MAIN(TEST(test_calls), TEST(test_round_trip), TEST(test_refused), TEST(test_builtin),

@@ -4,7 +4,9 @@
  * scatters the single-scattering closed form toward the camera; the
  * memo's turbulence medium's shadow with cached extinction agrees with
  * the uncached one within noise; images do not depend on threads or the
- * cache budget; a bad box is refused.
+ * cache budget; a bad box is refused. A slab whose density is a NanoVDB
+ * grid of one value (written by nvdb_write.h) or a densitygrid transmits
+ * exp(-sigma d) as the constant does.
  *
  * The camera looks down -z from z = 6 at [-1, 1]^2 of the plane z = 0.
  */
@@ -12,6 +14,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "nvdb_write.h"
 #include "rayes/rayes.h"
 #include "test.h"
 
@@ -88,12 +91,49 @@ static RayesImage *floor_under_slab(int slab, float sigma, int cached)
     return img;
 }
 
+/* The slab's density from a grid pattern of the single value sigma
+ * covering the slab: kind 0 a NanoVDB file (8^3 voxels of 3 units from
+ * (-10.5, -10.5, 7.5)), kind 1 a densitygrid of 2 x 2 x 2 over a box
+ * whose outer voxel centres enclose the slab. */
+static RayesImage *floor_under_grid_slab(int kind, float sigma, int cached)
+{
+    RayesScene *s = new_scene();
+    floor_matte(s);
+    RayesParam lp[2] = {pc("from", 0, 0, 20), pf("intensity", 400.0f)};
+    CHECK(rayes_scene_light(s, "pointlight", lp, 2) == RAYES_OK);
+    if (kind == 0) {
+        static float v[8][8][8];
+        for (int i = 0; i < 512; i++)
+            v[i >> 6][i >> 3 & 7][i & 7] = sigma;
+        const double o[3] = {-10.5, -10.5, 7.5};
+        const char *path = RAYES_TEST_TMP "/slab.nvdb";
+        CHECK(nvdb_write(path, "density", (const float(*)[8][8])v, 3.0, o) == 0);
+        RayesParam q[1] = {{"filename", RAYES_PARAM_STRING, {0}, path}};
+        CHECK(rayes_scene_pattern(s, "cloud", "nanovdb", q, 1) == RAYES_OK);
+    } else {
+        const float d[8] = {sigma, sigma, sigma, sigma, sigma, sigma, sigma, sigma};
+        RayesParam q[6] = {pf("nx", 2), pf("ny", 2), pf("nz", 2), pc("p0", -30, -30, 7),
+                           pc("p1", 30, 30, 10)};
+        q[5] = (RayesParam){"density", RAYES_PARAM_FLOATS, {0}, NULL, d, 8};
+        CHECK(rayes_scene_pattern(s, "cloud", "densitygrid", q, 6) == RAYES_OK);
+    }
+    RayesParam v[2] = {{"density", RAYES_PARAM_PATTERN, {0}, "cloud"}, pc("albedo", 0, 0, 0)};
+    CHECK(rayes_scene_set_shader(s, "homogeneous", v, 2) == RAYES_OK);
+    const float box[6] = {-10, 10, -10, 10, 8, 9};
+    CHECK(rayes_scene_volume(s, box) == RAYES_OK);
+    RayesImage *img = render(s, 2, 20.0, cached, NULL);
+    rayes_scene_release(s);
+    return img;
+}
+
 static void test_homogeneous_slab_transmittance(void)
 {
     const float sigma = 0.5f; /* exact in half floats */
     RayesImage *open = floor_under_slab(0, 0.0f, 1);
-    for (int cached = 0; cached < 2; cached++) {
-        RayesImage *img = floor_under_slab(1, sigma, cached);
+    for (int run = 0; run < 6; run++) {
+        int cached = run & 1, kind = run >> 1; /* the constant, a NanoVDB grid, a densitygrid */
+        RayesImage *img = kind == 0 ? floor_under_slab(1, sigma, cached)
+                                    : floor_under_grid_slab(kind - 1, sigma, cached);
         if (!open || !img) {
             rayes_image_free(img);
             continue;
@@ -109,8 +149,11 @@ static void test_homogeneous_slab_transmittance(void)
                 size_t i = 4 * ((size_t)y * RES + x);
                 worst = fmax(worst, fabs(img->rgba[i] / open->rgba[i] - want) / want);
             }
-        fprintf(stderr, "slab (%s): worst relative error %g\n", cached ? "cached" : "uncached",
-                worst);
+        fprintf(stderr, "slab of %s (%s): worst relative error %g\n",
+                kind == 0   ? "a constant"
+                : kind == 1 ? "a NanoVDB grid"
+                            : "a densitygrid",
+                cached ? "cached" : "uncached", worst);
         CHECK(worst < 2e-3); /* the pixel's sample lies within it, not at its centre */
         rayes_image_free(img);
     }

@@ -1,0 +1,258 @@
+/*
+ * io/pbrt_medium.c — pbrt-v4's participating media (pbrt_internal.h):
+ * MakeNamedMedium of type "homogeneous", "uniformgrid" and "nanovdb",
+ * MediumInterface, and the rayes volume (rayes_scene_volume with the
+ * built-in "homogeneous" shader) that a shape with an inside medium
+ * bounds. docs/pbrt.md lists the mapping:
+ *
+ *   extinction = (sigma_a + sigma_s) scale, albedo = sigma_s / (sigma_a +
+ *   sigma_s), g = g, emission = sigma_a scale Le Lescale (pbrt's source
+ *   term sigma_a Le), density = 1, or the grid: a "densitygrid" pattern
+ *   (uniformgrid, its p0 p1 in the medium's space) or a "nanovdb" pattern
+ *   (the file's "density" grid, its world space the medium's space).
+ *
+ * The volume's box is the shape's object-space bounds (the emitted
+ * primitives grow P->shape_bound), except for a uniformgrid, whose box
+ * is p0..p1 in the medium's space, where its density is. rayes' volumes
+ * are boxes: a medium inside a sphere fills the sphere's bounding box.
+ * Media only inside shapes are rendered: the camera's medium and the
+ * media outside shapes are skipped with one warning.
+ */
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "io/pbrt_internal.h"
+
+static Medium *find_medium(Parser *P, const char *name)
+{
+    for (size_t i = P->n_media; i-- > 0;)
+        if (strcmp(P->media[i].name, name) == 0)
+            return &P->media[i];
+    return NULL;
+}
+
+/* sigma_a, sigma_s, scale, g, Le and Lescale into md; pbrt's defaults
+ * for the type (homogeneous: its "default" scattering, grids: 1 and 1). */
+static int medium_coefficients(Parser *P, ParamList *pl, Medium *md)
+{
+    int homogeneous = strcmp(md->type, "homogeneous") == 0;
+    static const float one[3] = {1, 1, 1}, zero[3] = {0, 0, 0};
+    static const float sa_default[3] = {.0011f, .0024f, .014f},
+                       ss_default[3] = {2.55f, 3.21f, 3.77f};
+    float sa[3], ss[3], Le[3];
+    if (pbrt_get_color(P, pl, "sigma_a", homogeneous ? sa_default : one, sa, NULL) < 0 ||
+        pbrt_get_color(P, pl, "sigma_s", homogeneous ? ss_default : one, ss, NULL) < 0 ||
+        pbrt_get_color(P, pl, "Le", zero, Le, NULL) < 0)
+        return -1;
+    float scale = (float)pbrt_get_float(pl, "scale", 1.0);
+    float Lescale = (float)pbrt_get_float(pl, "Lescale", 1.0);
+    md->g = (float)pbrt_get_float(pl, "g", 0.0);
+    for (int c = 0; c < 3; c++) {
+        float st = sa[c] + ss[c];
+        md->extinction[c] = st * scale;
+        md->albedo[c] = st > 0.0f ? ss[c] / st : 0.0f;
+        md->emission[c] = sa[c] * scale * Le[c] * Lescale;
+    }
+    return 0;
+}
+
+/* uniformgrid's nx ny nz, density, p0 and p1. */
+static int medium_grid(Parser *P, const Token *t, ParamList *pl, Medium *md)
+{
+    static const char *const counts[3] = {"nx", "ny", "nz"};
+    size_t n = 1;
+    for (int k = 0; k < 3; k++) {
+        double v = pbrt_get_float(pl, counts[k], 1.0);
+        if (!(v >= 1 && v <= 1 << 20))
+            return FAIL_TOK(P, t, "uniformgrid: expected %s from 1 to 2^20, found %g", counts[k],
+                            v);
+        md->res[k] = (size_t)v;
+        n *= md->res[k];
+    }
+    Param *d = pbrt_find(pl, "density");
+    if (!d || d->n_num != n)
+        return FAIL_TOK(P, t, "uniformgrid: expected nx ny nz = %zu \"density\" values, found %zu",
+                        n, d ? d->n_num : 0);
+    md->density = malloc(n * sizeof *md->density);
+    if (!md->density)
+        return FAIL_TOK(P, t, "out of memory");
+    for (size_t i = 0; i < n; i++)
+        md->density[i] = (float)d->num[i];
+    const double *p0 = pbrt_get_point(pl, "p0"), *p1 = pbrt_get_point(pl, "p1");
+    for (int k = 0; k < 3; k++) {
+        md->p0[k] = p0 ? (float)p0[k] : 0.0f;
+        md->p1[k] = p1 ? (float)p1[k] : 1.0f;
+        if (!(md->p1[k] > md->p0[k]))
+            return FAIL_TOK(P, t, "uniformgrid: expected p0 below p1 on every axis");
+    }
+    return 0;
+}
+
+int pbrt_d_makenamedmedium(Parser *P, const Token *t)
+{
+    char name[128];
+    ParamList pl = {0};
+    if (pbrt_name_and_params(P, name, sizeof name, "a medium name", &pl, NULL) != 0) {
+        pbrt_params_free(&pl);
+        return -1;
+    }
+    Medium md = {0};
+    snprintf(md.name, sizeof md.name, "%s", name);
+    memcpy(md.m, P->gs.ctm, sizeof md.m);
+    const char *type = pbrt_get_string(&pl, "type", "");
+    int r = 0;
+    if (strcmp(type, "homogeneous") != 0 && strcmp(type, "uniformgrid") != 0 &&
+        strcmp(type, "nanovdb") != 0) {
+        char key[96];
+        snprintf(key, sizeof key, "medium %.60s", type);
+        pbrt_warn_at(P, t->line, t->col, key,
+                     "MakeNamedMedium: medium type \"%.40s\" is not supported; shapes filled "
+                     "with \"%.60s\" are empty",
+                     type, name);
+        for (size_t i = 0; i < pl.n; i++)
+            pl.p[i].used = 1;
+        snprintf(md.type, sizeof md.type, "none");
+    } else {
+        snprintf(md.type, sizeof md.type, "%s", type);
+        r = medium_coefficients(P, &pl, &md);
+        if (!r && strcmp(type, "uniformgrid") == 0)
+            r = medium_grid(P, t, &pl, &md);
+        if (!r && strcmp(type, "nanovdb") == 0) {
+            const char *file = pbrt_get_string(&pl, "filename", "");
+            if (!file[0])
+                r = FAIL_TOK(P, t, "nanovdb: expected a \"filename\"");
+            else
+                r = pbrt_resolve(P, t, file, md.filename, sizeof md.filename);
+        }
+    }
+    if (!r)
+        pbrt_warn_unused(P, &pl, "MakeNamedMedium", type);
+    pbrt_params_free(&pl);
+    if (r) {
+        free(md.density);
+        return -1;
+    }
+    Medium *grown = realloc(P->media, (P->n_media + 1) * sizeof *grown);
+    if (!grown) {
+        free(md.density);
+        return FAIL_TOK(P, t, "out of memory");
+    }
+    P->media = grown;
+    P->media[P->n_media++] = md;
+    return 0;
+}
+
+int pbrt_d_mediuminterface(Parser *P, const Token *t)
+{
+    char in[128], out[128];
+    Token next;
+    if (pbrt_expect_string(P, in, sizeof in, "a medium name (inside)", NULL) != 0 ||
+        pbrt_peek(P, &next) != 0)
+        return -1;
+    if (next.kind == TOK_STRING) {
+        if (pbrt_expect_string(P, out, sizeof out, "a medium name (outside)", NULL) != 0)
+            return -1;
+    } else {
+        memcpy(out, in, sizeof out); /* one name: both sides */
+    }
+    if (!P->world) {
+        if (in[0] || out[0])
+            pbrt_warn_at(P, t->line, t->col, "camera medium",
+                         "MediumInterface before WorldBegin (the camera's medium): rayes renders "
+                         "media only inside shapes; skipped");
+        return 0;
+    }
+    snprintf(P->gs.inside, sizeof P->gs.inside, "%s", in);
+    snprintf(P->gs.outside, sizeof P->gs.outside, "%s", out);
+    return 0;
+}
+
+/* The homogeneous shader's parameters for md into q; returns the count. */
+static size_t medium_params(const Medium *md, RayesParam q[5])
+{
+    size_t n = 0;
+    q[n++] = (RayesParam){.name = "extinction", .type = RAYES_PARAM_COLOR};
+    memcpy(q[0].value, md->extinction, sizeof q[0].value);
+    q[n++] = (RayesParam){.name = "albedo", .type = RAYES_PARAM_COLOR};
+    memcpy(q[1].value, md->albedo, sizeof q[1].value);
+    q[n++] = (RayesParam){.name = "g", .type = RAYES_PARAM_FLOAT, .value = {md->g, 0, 0}};
+    q[n++] = (RayesParam){.name = "emission", .type = RAYES_PARAM_COLOR};
+    memcpy(q[3].value, md->emission, sizeof q[3].value);
+    if (md->pattern[0])
+        q[n++] =
+            (RayesParam){.name = "density", .type = RAYES_PARAM_PATTERN, .string = md->pattern};
+    return n;
+}
+
+/* Sends a grid medium's density pattern, once, in the medium's space. */
+static int send_density(Parser *P, const Token *t, Medium *md)
+{
+    if (md->sent || strcmp(md->type, "homogeneous") == 0)
+        return 0;
+    snprintf(md->pattern, sizeof md->pattern, "medium %zu:%.120s", (size_t)(md - P->media),
+             md->name);
+    md->sent = 1;
+    if (strcmp(md->type, "uniformgrid") == 0) {
+        RayesParam q[6] = {
+            {.name = "nx", .type = RAYES_PARAM_FLOAT, .value = {(float)md->res[0]}},
+            {.name = "ny", .type = RAYES_PARAM_FLOAT, .value = {(float)md->res[1]}},
+            {.name = "nz", .type = RAYES_PARAM_FLOAT, .value = {(float)md->res[2]}},
+            {.name = "p0", .type = RAYES_PARAM_COLOR, .value = {md->p0[0], md->p0[1], md->p0[2]}},
+            {.name = "p1", .type = RAYES_PARAM_COLOR, .value = {md->p1[0], md->p1[1], md->p1[2]}},
+            {.name = "density",
+             .type = RAYES_PARAM_FLOATS,
+             .floats = md->density,
+             .n_floats = md->res[0] * md->res[1] * md->res[2]}};
+        return pbrt_emit_pattern_in(P, t, md->m, md->pattern, "densitygrid", q, 6);
+    }
+    RayesParam q[1] = {{.name = "filename", .type = RAYES_PARAM_STRING, .string = md->filename}};
+    return pbrt_emit_pattern_in(P, t, md->m, md->pattern, "nanovdb", q, 1);
+}
+
+int pbrt_medium_shape(Parser *P, const Token *t)
+{
+    const char *in = P->gs.inside, *out = P->gs.outside;
+    if (out[0] && strcmp(in, out) != 0)
+        pbrt_warn_at(P, t->line, t->col, "outside medium",
+                     "MediumInterface: the medium outside a shape (\"%.60s\") is not rendered; "
+                     "rayes fills only the inside of shapes",
+                     out);
+    if (!in[0] || strcmp(in, out) == 0)
+        return 0;
+    Medium *md = find_medium(P, in);
+    if (!md)
+        return FAIL_TOK(P, t,
+                        "MediumInterface names the medium \"%.60s\", which no "
+                        "MakeNamedMedium defined",
+                        in);
+    if (strcmp(md->type, "none") == 0)
+        return 0;
+    const char *skip = P->recording                            ? "inside ObjectBegin"
+                       : !P->sink->volume || !P->sink->pattern ? "this output takes no volumes"
+                                                               : NULL;
+    const float *b = P->shape_bound;
+    int uniform = strcmp(md->type, "uniformgrid") == 0;
+    if (!skip && !uniform && (!P->have_shape_bound || !(b[1] > b[0] && b[3] > b[2] && b[5] > b[4])))
+        skip = "the shape is flat";
+    if (skip) {
+        pbrt_warn_at(P, t->line, t->col, skip, "medium \"%.60s\": %s; not rendered", in, skip);
+        return 0;
+    }
+    if (send_density(P, t, md) != 0)
+        return -1;
+    RayesParam q[5];
+    size_t n = medium_params(md, q);
+    if (uniform) {
+        const float box[6] = {md->p0[0], md->p1[0], md->p0[1], md->p1[1], md->p0[2], md->p1[2]};
+        return pbrt_emit_volume(P, t, md->m, q, n, box);
+    }
+    return pbrt_emit_volume(P, t, P->gs.ctm, q, n, b);
+}
+
+void pbrt_media_free(Parser *P)
+{
+    for (size_t i = 0; i < P->n_media; i++)
+        free(P->media[i].density);
+    free(P->media);
+}

@@ -1,0 +1,182 @@
+/*
+ * pbrt-v4 media through the command line: a diffuse floor lit by a
+ * distant light straight down, seen from above through a slab z in [1, 2]
+ * (a box of material "interface") filled with an absorbing medium
+ * (sigma_s 0). Camera rays and shadow rays each cross the slab once, so
+ * the centre of the floor is exp(-2 tau) of the open floor's, tau the
+ * slab's optical depth: sigma_a for "homogeneous" and for "nanovdb" (a
+ * grid of one value written by nvdb_write.h, its voxel centres enclosing
+ * the slab), and 0.75 sigma_a for a 1 x 1 x 1 "uniformgrid" whose box is
+ * the slab in z (pbrt's grid fades to half its value at the box's faces). The
+ * box itself is invisible; the files read without a warning. A camera
+ * medium and an outside medium warn once; a shape whose medium was never
+ * defined is an error naming the line.
+ */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+
+#include "image/image.h"
+#include "nvdb_write.h"
+#include "test.h"
+
+#define TMP RAYES_TEST_TMP "/pbrt_media"
+enum { RES = 32 };
+
+/* The slab as a closed box of 12 triangles. */
+static const char *const box_shape =
+    "Shape \"trianglemesh\" \"point3 P\" [-5 -5 1  5 -5 1  5 5 1  -5 5 1  -5 -5 2  5 -5 2  5 5 2  "
+    "-5 5 2]\n"
+    "  \"integer indices\" [0 2 1 0 3 2  4 5 6 4 6 7  0 1 5 0 5 4  1 2 6 1 6 5  2 3 7 2 7 6  "
+    "3 0 4 3 4 7]\n";
+
+static void write_scene(const char *name, const char *media)
+{
+    char text[4096], path[512];
+    snprintf(
+        text, sizeof text,
+        "LookAt 0 0 6  0 0 0  0 1 0\n"
+        "Camera \"perspective\" \"float fov\" 10\n"
+        "Film \"rgb\" \"integer xresolution\" %d \"integer yresolution\" %d\n"
+        "WorldBegin\n"
+        "LightSource \"distant\" \"point3 from\" [0 0 1] \"point3 to\" [0 0 0] \"rgb L\" [3 3 3]\n"
+        "Material \"diffuse\" \"rgb reflectance\" [0.5 0.5 0.5]\n"
+        "Shape \"bilinearmesh\" \"point3 P\" [-4 -4 0 4 -4 0 -4 4 0 4 4 0]\n"
+        "  \"integer indices\" [0 1 2 3]\n"
+        "%s",
+        RES, RES, media);
+    snprintf(path, sizeof path, "%s/%s", TMP, name);
+    FILE *f = fopen(path, "w");
+    CHECK(f != NULL);
+    if (f) {
+        fputs(text, f);
+        fclose(f);
+    }
+}
+
+/* Renders a scene of TMP; its standard error into err_text, its pixels
+ * (NULL on failure). */
+static float *render(const char *name, char *err_text, size_t size)
+{
+    char cmd[2048], out[512], errpath[512], err[300];
+    snprintf(out, sizeof out, "%s/%s.exr", TMP, name);
+    snprintf(errpath, sizeof errpath, "%s/%s.err", TMP, name);
+    snprintf(cmd, sizeof cmd, "cd %s && %s render %s --spp 4 --bounces 0 --quiet -o %s 2>%s", TMP,
+             RAYES_BIN, name, out, errpath);
+    int status = system(cmd);
+    FILE *f = fopen(errpath, "r");
+    size_t n = f ? fread(err_text, 1, size - 1, f) : 0;
+    err_text[n] = '\0';
+    if (f)
+        fclose(f);
+    if (status != 0) {
+        fprintf(stderr, "  %s: %s", name, err_text);
+        return NULL;
+    }
+    int w, h;
+    float *rgba = NULL;
+    CHECK(image_read_exr(out, &w, &h, &rgba, err, sizeof err) == RAYES_OK);
+    CHECK(w == RES && h == RES);
+    return rgba;
+}
+
+/* Mean red of the 8 x 8 pixels at the centre. */
+static double centre(const float *rgba)
+{
+    double sum = 0;
+    for (int y = RES / 2 - 4; y < RES / 2 + 4; y++)
+        for (int x = RES / 2 - 4; x < RES / 2 + 4; x++)
+            sum += rgba[4 * (y * RES + x)];
+    return sum / 64.0;
+}
+
+static void test_absorbing_slabs(void)
+{
+    mkdir(TMP, 0755);
+    static float v[8][8][8];
+    for (int i = 0; i < 512; i++)
+        v[i >> 6][i >> 3 & 7][i & 7] = 1.0f;
+    const double o[3] = {-7, -7, 0};
+    CHECK(nvdb_write(TMP "/one.nvdb", "density", (const float(*)[8][8])v, 2.0, o) == 0);
+    const float sigma = 0.4f;
+    char media[4][1024];
+    snprintf(media[0], sizeof media[0], "# no medium\n");
+    const char *defs[3] = {
+        "MakeNamedMedium \"slab\" \"string type\" \"homogeneous\" \"rgb sigma_a\" [0.2 0.2 0.2]\n"
+        "  \"rgb sigma_s\" [0 0 0] \"float scale\" 2\n",
+        "MakeNamedMedium \"slab\" \"string type\" \"nanovdb\" \"string filename\" \"one.nvdb\"\n"
+        "  \"rgb sigma_a\" [0.4 0.4 0.4] \"rgb sigma_s\" [0 0 0]\n",
+        "MakeNamedMedium \"slab\" \"string type\" \"uniformgrid\" \"float density\" [2]\n"
+        "  \"point3 p0\" [-50 -50 1] \"point3 p1\" [50 50 2] \"rgb sigma_a\" [0.2 0.2 0.2]\n"
+        "  \"rgb sigma_s\" [0 0 0] \"float g\" 0.3\n"};
+    for (int k = 0; k < 3; k++)
+        snprintf(media[k + 1], sizeof media[k + 1],
+                 "%sAttributeBegin\nMediumInterface \"slab\" \"\"\nMaterial \"interface\"\n%s"
+                 "AttributeEnd\n",
+                 defs[k], box_shape);
+    const double tau[4] = {0, sigma, sigma, 0.75 * sigma};
+    const char *names[4] = {"open.pbrt", "homogeneous.pbrt", "nanovdb.pbrt", "uniformgrid.pbrt"};
+    double open = 0;
+    for (int k = 0; k < 4; k++) {
+        char err_text[4096];
+        write_scene(names[k], media[k]);
+        float *img = render(names[k], err_text, sizeof err_text);
+        CHECK(img != NULL && strstr(err_text, "warning") == NULL);
+        if (strstr(err_text, "warning"))
+            fprintf(stderr, "  %s: %s", names[k], err_text);
+        if (!img)
+            continue;
+        double c = centre(img);
+        if (k == 0)
+            open = c;
+        else {
+            double want = exp(-2.0 * tau[k]);
+            fprintf(stderr, "%s: %g of the open floor, exp(-2 tau) = %g\n", names[k], c / open,
+                    want);
+            CHECK(fabs(c / open - want) < 0.01 * want);
+        }
+        free(img);
+    }
+    CHECK(open > 0.1);
+}
+
+static void test_skipped_media_warn(void)
+{
+    mkdir(TMP, 0755);
+    char err_text[4096];
+    /* a camera medium (MediumInterface before WorldBegin), and a shape
+     * with only an outside medium */
+    char full[8192];
+    snprintf(full, sizeof full,
+             "MakeNamedMedium \"fog\" \"string type\" \"homogeneous\"\n"
+             "MediumInterface \"\" \"fog\"\n"
+             "LookAt 0 0 6  0 0 0  0 1 0\nCamera \"perspective\" \"float fov\" 10\n"
+             "Film \"rgb\" \"integer xresolution\" %d \"integer yresolution\" %d\n"
+             "WorldBegin\n"
+             "AttributeBegin\nMediumInterface \"\" \"fog\"\nMaterial \"interface\"\n%s"
+             "AttributeEnd\n",
+             RES, RES, box_shape);
+    FILE *f = fopen(TMP "/skipped.pbrt", "w");
+    if (f) {
+        fputs(full, f);
+        fclose(f);
+    }
+    float *img = render("skipped.pbrt", err_text, sizeof err_text);
+    CHECK(img != NULL);
+    free(img);
+    CHECK(strstr(err_text, "camera's medium") != NULL);
+    CHECK(strstr(err_text, "the medium outside a shape (\"fog\") is not rendered") != NULL);
+    /* an undefined medium */
+    write_scene("undefined.pbrt",
+                "AttributeBegin\nMediumInterface \"smoke\" \"\"\nMaterial \"interface\"\n"
+                "Shape \"sphere\"\nAttributeEnd\n");
+    img = render("undefined.pbrt", err_text, sizeof err_text);
+    CHECK(img == NULL);
+    free(img);
+    CHECK(strstr(err_text, "undefined.pbrt:12:") != NULL &&
+          strstr(err_text, "the medium \"smoke\", which no MakeNamedMedium defined") != NULL);
+}
+
+TEST_MAIN(TEST(test_absorbing_slabs), TEST(test_skipped_media_warn))
