@@ -48,17 +48,20 @@ test-asan:
 # evicting and reloading MIP levels on a tiny budget), and the grid hider
 # (threads shading grids on first sight behind striped locks), and whole
 # renders on 1 to 4 threads (the determinism tests), the progressive
-# session (passes cancelled from another thread) and rayes view (its driver
+# session (passes cancelled from another thread), opacity and volume renders
+# (threads filling the opacity cache's grid and brick entries from inside
+# Embree's occlusion filter) and rayes view (its driver
 # and window threads, headless and under SDL's dummy driver and Xvfb; Mesa's
 # software GL driver is suppressed too). Embree and
 # TBB are not instrumented: tools/tsan.supp suppresses reports inside them.
 TSAN_TESTS = cache_test_cache cache_test_cache_stress util_test_math util_test_half \
              shade_test_plugin shade_test_texture_threads render_test_hider \
-             render_test_determinism render_test_session rayes_app app_test_view
+             render_test_determinism render_test_session render_test_opacity render_test_volume \
+             rayes_app app_test_view
 test-tsan:
 	@test -f build-tsan/Makefile || cmake -S . -B build-tsan -DCMAKE_BUILD_TYPE=RelWithDebInfo -DRAYES_TSAN=ON
 	cmake --build build-tsan -j $(JOBS) --target $(TSAN_TESTS)
-	cd build-tsan && TSAN_OPTIONS="halt_on_error=1 suppressions=$(CURDIR)/tools/tsan.supp" ctest --output-on-failure -R '^(cache|util)/|^shade/test_plugin$$|^shade/test_texture_threads$$|^render/test_(hider|determinism|session)$$|^app/test_view$$'
+	cd build-tsan && TSAN_OPTIONS="halt_on_error=1 suppressions=$(CURDIR)/tools/tsan.supp" ctest --output-on-failure -R '^(cache|util)/|^shade/test_plugin$$|^shade/test_texture_threads$$|^render/test_(hider|determinism|session|opacity|volume)$$|^app/test_view$$'
 
 # Fuzzing: every tests/fuzz/fuzz_NAME.c is a target, run on a scratch copy
 # of its seeds tests/fuzz/corpus_NAME/ (the repository's seeds stay as they
@@ -68,7 +71,8 @@ test-tsan:
 FUZZ_SECONDS ?= 60
 FUZZ_TARGETS = $(patsubst tests/fuzz/%.c,%,$(wildcard tests/fuzz/fuzz_*.c))
 fuzz:
-	@test -f build-fuzz/Makefile || CC=clang CXX=clang++ cmake -S . -B build-fuzz -DCMAKE_BUILD_TYPE=RelWithDebInfo -DRAYES_FUZZ=ON -DRAYES_SANITIZE=ON -DRAYES_WERROR=OFF
+	@# configured every time: a target added since the last run must be known to make
+	@CC=clang CXX=clang++ cmake -S . -B build-fuzz -DCMAKE_BUILD_TYPE=RelWithDebInfo -DRAYES_FUZZ=ON -DRAYES_SANITIZE=ON -DRAYES_WERROR=OFF >/dev/null
 	cmake --build build-fuzz -j $(JOBS) --target $(FUZZ_TARGETS)
 	@mkdir -p build-fuzz/artifacts
 	@set -e; for t in $(FUZZ_TARGETS); do \

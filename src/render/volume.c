@@ -253,7 +253,8 @@ static void fill_brick(void *user, const CacheKey *key, size_t n, float (*out)[3
 static Vec3 corner(const uint16_t *vals, int m, int x, int y, int z)
 {
     size_t i = 3 * ((size_t)(z * m + y) * m + x);
-    return v3(half_to_float(vals[i]), half_to_float(vals[i + 1]), half_to_float(vals[i + 2]));
+    return v3(half_to_float_finite(vals[i]), half_to_float_finite(vals[i + 1]),
+              half_to_float_finite(vals[i + 2]));
 }
 
 /* Cached sigma_t at object-space q for a ray of that footprint. */
@@ -318,10 +319,13 @@ static void extinction_at(Worker *w, const RenderVolume *v, const Ray *ray, RayD
     }
     float len = v3_length(ray->d);
     LastBrick last = {0, -1, NULL};
+    /* object space is an affine image of world space: step along it */
+    Vec3 q0 = mat4_point(&v->object_from_world, ray->o);
+    Vec3 dq = mat4_vector(&v->object_from_world, ray->d);
     for (int i = 0; i < m->n; i++) {
         float t = m->t0 + ((float)i + m->jitter) * m->dt;
-        Vec3 q = mat4_point(&v->object_from_world, v3_madd(ray->o, ray->d, t));
-        v3_store(p->Oi[i], extinction_cached(w, v, q, diff.width + diff.spread * t * len, &last));
+        v3_store(p->Oi[i], extinction_cached(w, v, v3_madd(q0, dq, t),
+                                             diff.width + diff.spread * t * len, &last));
     }
 }
 
@@ -352,6 +356,23 @@ static Vec3 v3_exp_neg(Vec3 a)
     return v3(expf(-a.x), expf(-a.y), expf(-a.z));
 }
 
+/* The optical depth of the march from cached extinction (no points to
+ * shade: the shadow ray's own steps, nothing allocated). */
+static Vec3 optical_depth_cached(Worker *w, const RenderVolume *v, const Ray *ray, RayDiff diff,
+                                 const March *m)
+{
+    float len = v3_length(ray->d);
+    LastBrick last = {0, -1, NULL};
+    Vec3 q0 = mat4_point(&v->object_from_world, ray->o);
+    Vec3 dq = mat4_vector(&v->object_from_world, ray->d), tau = v3(0, 0, 0);
+    for (int i = 0; i < m->n; i++) {
+        float t = m->t0 + ((float)i + m->jitter) * m->dt;
+        tau = v3_add(tau, extinction_cached(w, v, v3_madd(q0, dq, t),
+                                            diff.width + diff.spread * t * len, &last));
+    }
+    return v3_scale(tau, m->dl);
+}
+
 /* ----------------------------------------------------------- the rays */
 
 Vec3 volume_transmittance(Worker *w, const Ray *ray, RayDiff diff)
@@ -366,15 +387,20 @@ Vec3 volume_transmittance(Worker *w, const Ray *ray, RayDiff diff)
         if (!counted++)
             w->stats.rays_transmission++;
         March m = march(w, v, ray, t0, t1, ray_jitter(ray));
-        VolumePoints p;
-        points_alloc(&p, (size_t)m.n);
-        march_points(v, &w->rs->objects[v->object], ray, &m, 0, diff, &p);
-        extinction_at(w, v, ray, diff, &m, &p);
+        const RenderObject *obj = &w->rs->objects[v->object];
         Vec3 tau = v3(0, 0, 0);
-        for (int i = 0; i < m.n; i++)
-            tau = v3_madd(tau, v3_load(p.Oi[i]), m.dl);
+        if (w->set->opacity_cache && obj->opacity_cached) {
+            tau = optical_depth_cached(w, v, ray, diff, &m);
+        } else {
+            VolumePoints p;
+            points_alloc(&p, (size_t)m.n);
+            march_points(v, obj, ray, &m, 0, diff, &p);
+            run_extinction(w, obj, &p, (size_t)m.n);
+            for (int i = 0; i < m.n; i++)
+                tau = v3_madd(tau, v3_load(p.Oi[i]), m.dl);
+            points_free(&p);
+        }
         w->stats.volume_steps += (uint64_t)m.n;
-        points_free(&p);
         T = v3_mul(T, v3_exp_neg(tau));
     }
     return T;

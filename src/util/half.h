@@ -40,6 +40,17 @@ static inline uint16_t half_from_float(float f)
     return (uint16_t)(sign | r);
 }
 
+/* half_to_float for finite halves (what the cache stores: it clamps),
+ * branch-free: the half's bits moved into a float's place and rescaled by
+ * 2^112, exact for normal and subnormal halves alike. */
+static inline float half_to_float_finite(uint16_t h)
+{
+    uint32_t x = ((uint32_t)(h & 0x8000u) << 16) | ((uint32_t)(h & 0x7fffu) << 13);
+    float f;
+    memcpy(&f, &x, sizeof f);
+    return f * 0x1p112f;
+}
+
 static inline float half_to_float(uint16_t h)
 {
     uint32_t sign = (uint32_t)(h & 0x8000u) << 16, e = (h >> 10) & 0x1fu, m = h & 0x3ffu, x;
