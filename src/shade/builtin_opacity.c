@@ -119,7 +119,7 @@ static void glass_transmission(const RayesShaderServices *sv, const StainedGlass
     float hue[3], fade = fmaxf(0.0f, 1.0f - 8.0f * fwc);
     filtered_hue(x, y, fwc, hue);
     float bubbles[3] = {q[0] * 8.0f, q[1] * 8.0f, 0.5f};
-    float streak = sv->fbm && fade > 0.0f ? fade * sv->fbm(sv, bubbles, 5, 2.0f, 0.5f) : 0.0f;
+    float streak = sv->fbm ? fade * sv->fbm(sv, bubbles, 5, 2.0f, 0.5f) : 0.0f;
     float clarity = clear * fminf(fmaxf(p->clarity * (1.0f + 0.3f * streak), 0.0f), 1.0f);
     for (int c = 0; c < 3; c++)
         out[c] = hue[c] * clarity;
