@@ -78,6 +78,15 @@ static Vec3 transmittance(Worker *w, Vec3 o, Vec3 wi, float dist, RayDiff diff)
     return integrator_transmission(w, &shadow, diff);
 }
 
+/* The shadow rays a service asked for n_shadow_rays traces per light and
+ * point: that many, or with 0 the renderer's setting for the depth. */
+static int shadow_ray_count(const Worker *w, const RayesShadeCtx *ctx, int n_shadow_rays)
+{
+    if (n_shadow_rays > 0)
+        return n_shadow_rays;
+    return ctx->diffuse_depth == 0 ? w->set->shadow_rays : w->set->shadow_rays_deep;
+}
+
 /* The differential of a shadow ray from point j of ps, one of n: the
  * point's footprint, spreading as a diffuse ray's of n (each stands for
  * 1/n of the light's solid angle; a delta light's one ray takes the
@@ -210,9 +219,7 @@ static void svc_direct_lighting(const RayesShaderServices *sv, const RayesShadeC
     (void)sv;
     const PathState *ps = ctx->renderer;
     Worker *w = ps->w;
-    int n = n_shadow_rays > 0 ? n_shadow_rays
-            : ctx->diffuse_depth == 0 ? w->set->shadow_rays
-                                      : w->set->shadow_rays_deep;
+    int n = shadow_ray_count(w, ctx, n_shadow_rays);
     int want_spec = specular && ctx->I;
     const RenderObject *obj = lit_object(ps);
     for (size_t i = 0; i < ctx->n_points; i++) {
@@ -360,9 +367,7 @@ static void svc_direct_fiber(const RayesShaderServices *sv, const RayesShadeCtx 
     (void)sv;
     const PathState *ps = ctx->renderer;
     Worker *w = ps->w;
-    int n = n_shadow_rays > 0 ? n_shadow_rays
-            : ctx->diffuse_depth == 0 ? w->set->shadow_rays
-                                      : w->set->shadow_rays_deep;
+    int n = shadow_ray_count(w, ctx, n_shadow_rays);
     const RenderObject *obj = lit_object(ps);
     for (size_t i = 0; i < ctx->n_points; i++) {
         FiberPoint p;
@@ -654,9 +659,7 @@ static void svc_direct_volume(const RayesShaderServices *sv, const RayesShadeCtx
     (void)sv;
     const PathState *ps = ctx->renderer;
     Worker *w = ps->w;
-    int n = n_shadow_rays > 0               ? n_shadow_rays
-            : ctx->diffuse_depth == 0 ? w->set->shadow_rays
-                                            : w->set->shadow_rays_deep;
+    int n = shadow_ray_count(w, ctx, n_shadow_rays);
     g = fminf(fmaxf(g, -0.99f), 0.99f);
     for (size_t i = 0; i < ctx->n_points; i++) {
         size_t j = point(ctx, i);
