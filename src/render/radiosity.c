@@ -355,8 +355,9 @@ static void fill_radiosity(void *user, const CacheKey *key, size_t n, float (*ou
 
 static Vec3 value(const uint16_t *vals, size_t i)
 {
-    return v3(half_to_float(vals[3 * i]), half_to_float(vals[3 * i + 1]),
-              half_to_float(vals[3 * i + 2]));
+    /* the cache stores finite halves only (it clamps, and NaN is 0) */
+    return v3(half_to_float_finite(vals[3 * i]), half_to_float_finite(vals[3 * i + 1]),
+              half_to_float_finite(vals[3 * i + 2]));
 }
 
 /* Bilinear at (x, y) in knot-grid coordinates of an mu x mv lattice. */
