@@ -41,6 +41,26 @@ namespace {
 typedef Bfr::Surface<float> Surface;
 typedef Far::TopologyDescriptor Descriptor;
 
+/* The control mesh's topology and tags as OpenSubdiv takes them (the
+ * arrays are d's, borrowed). */
+static Descriptor topology(const SubdivDesc *d)
+{
+    Descriptor desc;
+    desc.numVertices = (int)d->n_points;
+    desc.numFaces = (int)d->n_faces;
+    desc.numVertsPerFace = d->n_verts;
+    desc.vertIndicesPerFace = d->indices;
+    desc.numCreases = (int)d->n_creases;
+    desc.creaseVertexIndexPairs = d->crease_edges;
+    desc.creaseWeights = d->crease_sharpness;
+    desc.numCorners = (int)d->n_corners;
+    desc.cornerVertexIndices = d->corner_points;
+    desc.cornerWeights = d->corner_sharpness;
+    desc.numHoles = (int)d->n_holes;
+    desc.holeIndices = d->hole_faces;
+    return desc;
+}
+
 enum { CLASS_CONSTANT = 0, CLASS_UNIFORM = 1, CLASS_VARYING = 2, CLASS_VERTEX = 3, CLASS_FACEVARYING = 4 };
 
 /* Where one primitive variable sits in a channel's points. */
@@ -237,19 +257,7 @@ static int build(SubdivMesh *m, const SubdivDesc *d, char *err, size_t err_size)
                                         (size_t)s.size * sizeof(float));
     }
 
-    Descriptor desc;
-    desc.numVertices = (int)d->n_points;
-    desc.numFaces = (int)d->n_faces;
-    desc.numVertsPerFace = d->n_verts;
-    desc.vertIndicesPerFace = d->indices;
-    desc.numCreases = (int)d->n_creases;
-    desc.creaseVertexIndexPairs = d->crease_edges;
-    desc.creaseWeights = d->crease_sharpness;
-    desc.numCorners = (int)d->n_corners;
-    desc.cornerVertexIndices = d->corner_points;
-    desc.cornerWeights = d->corner_sharpness;
-    desc.numHoles = (int)d->n_holes;
-    desc.holeIndices = d->hole_faces;
+    Descriptor desc = topology(d);
     Descriptor::FVarChannel channel;
     if (m->fvar.size) {
         channel.numValues = (int)(m->fvar.points.size() / (size_t)m->fvar.size);
@@ -409,19 +417,7 @@ struct Point3 {
 extern "C" float *geom_subdiv_refine_uniform(const SubdivDesc *d, int level, int limit, size_t *n)
 {
     *n = 0;
-    Descriptor desc;
-    desc.numVertices = (int)d->n_points;
-    desc.numFaces = (int)d->n_faces;
-    desc.numVertsPerFace = d->n_verts;
-    desc.vertIndicesPerFace = d->indices;
-    desc.numCreases = (int)d->n_creases;
-    desc.creaseVertexIndexPairs = d->crease_edges;
-    desc.creaseWeights = d->crease_sharpness;
-    desc.numCorners = (int)d->n_corners;
-    desc.cornerVertexIndices = d->corner_points;
-    desc.cornerWeights = d->corner_sharpness;
-    desc.numHoles = (int)d->n_holes;
-    desc.holeIndices = d->hole_faces;
+    Descriptor desc = topology(d);
     static const Sdc::SchemeType schemes[3] = {Sdc::SCHEME_CATMARK, Sdc::SCHEME_LOOP,
                                                Sdc::SCHEME_BILINEAR};
     std::unique_ptr<Far::TopologyRefiner> r(Far::TopologyRefinerFactory<Descriptor>::Create(

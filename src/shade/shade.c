@@ -214,18 +214,30 @@ static void scratch_failed(const RayesShaderClass *cls, const RayesShadeCtx *ctx
         memset(out->Irradiance, 0, ctx->n_points * sizeof *out->Irradiance);
 }
 
+/* What a method call on inst begins with: c, ctx with the instance's
+ * pattern bindings and scratch if the class needs some (the block to free
+ * is returned); out of memory for it, *failed is set and the points come
+ * out black and opaque. */
+static void *call_begin(const ShaderInstance *inst, const RayesShadeCtx *ctx, RayesShadeCtx *c,
+                        RayesShadeOutputs *out, int *failed)
+{
+    *c = *ctx;
+    c->patterns = inst->patterns, c->n_patterns = inst->n_patterns;
+    void *scratch = scratch_begin(inst->cls, c, failed);
+    if (*failed)
+        scratch_failed(inst->cls, ctx, out);
+    return scratch;
+}
+
 void shade_run_lighting(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
                         const ShaderInstance *inst, RayesShadeOutputs *out)
 {
     const RayesShaderClass *cls = inst->cls;
-    RayesShadeCtx c = *ctx;
-    c.patterns = inst->patterns, c.n_patterns = inst->n_patterns;
+    RayesShadeCtx c;
     int failed;
-    void *scratch = scratch_begin(cls, &c, &failed);
-    if (failed) {
-        scratch_failed(cls, ctx, out);
+    void *scratch = call_begin(inst, ctx, &c, out, &failed);
+    if (failed)
         return;
-    }
     if (cls->prelighting)
         cls->prelighting(sv, &c, inst->params, out);
     cls->lighting(sv, &c, inst->params, out);
@@ -238,15 +250,12 @@ void shade_run_diffuselighting(const RayesShaderServices *sv, const RayesShadeCt
                                const ShaderInstance *inst, RayesShadeOutputs *out)
 {
     const RayesShaderClass *cls = inst->cls;
-    RayesShadeCtx c = *ctx;
-    c.I = NULL; /* view independence: diffuselighting never sees I */
-    c.patterns = inst->patterns, c.n_patterns = inst->n_patterns;
+    RayesShadeCtx c;
     int failed;
-    void *scratch = scratch_begin(cls, &c, &failed);
-    if (failed) {
-        scratch_failed(cls, ctx, out);
+    void *scratch = call_begin(inst, ctx, &c, out, &failed);
+    if (failed)
         return;
-    }
+    c.I = NULL; /* view independence: diffuselighting never sees I */
     if (cls->prelighting)
         cls->prelighting(sv, &c, inst->params, out);
     if (cls->diffuselighting) {
@@ -273,14 +282,11 @@ void shade_run_opacity(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
                 out->Oi[i][c] = ctx->Os ? ctx->Os[i][c] : 1.0f;
         return;
     }
-    RayesShadeCtx c = *ctx;
-    c.patterns = inst->patterns, c.n_patterns = inst->n_patterns;
+    RayesShadeCtx c;
     int failed;
-    void *scratch = scratch_begin(cls, &c, &failed);
-    if (failed) {
-        scratch_failed(cls, ctx, out);
+    void *scratch = call_begin(inst, ctx, &c, out, &failed);
+    if (failed)
         return;
-    }
     cls->opacity(sv, &c, inst->params, out);
     free(scratch);
 }
