@@ -250,23 +250,39 @@ static void fill_brick(void *user, const CacheKey *key, size_t n, float (*out)[3
     points_free(&p);
 }
 
-static Vec3 corner(const uint16_t *vals, int m, int x, int y, int z)
+/* x clamped to [lo, hi], NaN to lo (no libm call: fminf and fmaxf are
+ * calls without -ffinite-math-only, and this runs at every step). */
+static inline float clamp_step(float x, float lo, float hi)
 {
-    size_t i = 3 * ((size_t)(z * m + y) * m + x);
-    return v3(half_to_float_finite(vals[i]), half_to_float_finite(vals[i + 1]),
-              half_to_float_finite(vals[i + 2]));
+    return x > lo ? (x < hi ? x : hi) : lo;
 }
 
-/* Cached sigma_t at object-space q for a ray of that footprint. */
-/* The entry a march looked up last: consecutive steps mostly stay in one
- * brick at one level, and nothing else looks up an entry between them, so
- * its values stay valid (cache.h) and the lookup is skipped. */
+/* The entry a march looked up last, and the cell of it that it decoded
+ * last: consecutive steps mostly stay in one brick at one level (coarse
+ * and medium steps in one cell too), and nothing else looks up an entry
+ * between them, so its values stay valid (cache.h) and the lookup, or the
+ * decoding, is skipped. */
 typedef struct LastBrick {
     uint32_t patch;
     int level;
     const uint16_t *vals;
+    int cell;         /* the decoded cell's index in the entry, -1 none */
+    float c[4][6];    /* its corners: rows (y, z) = 00, 10, 01, 11; x, x + 1; rgb */
 } LastBrick;
 
+#define LAST_BRICK_NONE {0, -1, NULL, -1, {{0}}}
+
+/* The corners of the cell at lattice point (x, y, z) of an entry with m
+ * points a side, into last (each row's two corners lie side by side). */
+static void decode_cell(LastBrick *last, int m, int x, int y, int z)
+{
+    for (int r = 0; r < 4; r++) {
+        size_t i = 3 * ((size_t)((z + (r >> 1)) * m + y + (r & 1)) * m + x);
+        half_to_float_finite_x6(last->vals + i, last->c[r]);
+    }
+}
+
+/* Cached sigma_t at object-space q for a ray of that footprint. */
 static Vec3 extinction_cached(Worker *w, const RenderVolume *v, Vec3 q, float footprint,
                               LastBrick *last)
 {
@@ -276,36 +292,45 @@ static Vec3 extinction_cached(Worker *w, const RenderVolume *v, Vec3 q, float fo
     float r[3]; /* position in the brick, fine voxels */
     uint32_t brick = 0;
     for (int a = 2; a >= 0; a--) {
-        float c = fminf(fmaxf(f[a], 0.0f), (float)v->n_vox[a]);
+        float c = clamp_step(f[a], 0.0f, (float)v->n_vox[a]);
         b[a] = RY_MIN((int)(c / VOLUME_BRICK), v->n_brick[a] - 1);
         r[a] = c - (float)(b[a] * VOLUME_BRICK);
         brick = brick * (uint32_t)v->n_brick[a] + (uint32_t)b[a];
     }
     int level = choose_level(w, v, footprint), m = level_points(level);
     float sp = (float)level_spacing(level);
-    const uint16_t *vals = last->vals;
-    if (!vals || last->patch != v->key_base + brick || last->level != level) {
+    if (!last->vals || last->patch != v->key_base + brick || last->level != level) {
         CacheKey key = {.patch = v->key_base + brick, .type = CACHE_OPACITY,
                         .level = (uint8_t)level};
         BrickJob job = {w, v, {b[0], b[1], b[2]}};
-        vals = cache_lookup(&w->cache, &key, (size_t)m * m * m, fill_brick, &job);
-        *last = (LastBrick){key.patch, level, vals};
+        last->vals = cache_lookup(&w->cache, &key, (size_t)m * m * m, fill_brick, &job);
+        last->patch = key.patch;
+        last->level = level;
+        last->cell = -1;
     }
     int i[3];
     float t[3];
     for (int a = 0; a < 3; a++) {
         float x = r[a] / sp;
         i[a] = RY_MIN((int)x, m - 2);
-        t[a] = fminf(fmaxf(x - (float)i[a], 0.0f), 1.0f);
+        t[a] = clamp_step(x - (float)i[a], 0.0f, 1.0f);
     }
-    Vec3 c00 = v3_lerp(corner(vals, m, i[0], i[1], i[2]), corner(vals, m, i[0] + 1, i[1], i[2]), t[0]);
-    Vec3 c10 = v3_lerp(corner(vals, m, i[0], i[1] + 1, i[2]),
-                       corner(vals, m, i[0] + 1, i[1] + 1, i[2]), t[0]);
-    Vec3 c01 = v3_lerp(corner(vals, m, i[0], i[1], i[2] + 1),
-                       corner(vals, m, i[0] + 1, i[1], i[2] + 1), t[0]);
-    Vec3 c11 = v3_lerp(corner(vals, m, i[0], i[1] + 1, i[2] + 1),
-                       corner(vals, m, i[0] + 1, i[1] + 1, i[2] + 1), t[0]);
-    return v3_lerp(v3_lerp(c00, c10, t[1]), v3_lerp(c01, c11, t[1]), t[2]);
+    int cell = (i[2] * m + i[1]) * m + i[0];
+    if (cell != last->cell) {
+        decode_cell(last, m, i[0], i[1], i[2]);
+        last->cell = cell;
+    }
+    float out[3];
+    for (int k = 0; k < 3; k++) {
+        const float(*c)[6] = last->c;
+        float c00 = c[0][k] + (c[0][k + 3] - c[0][k]) * t[0];
+        float c10 = c[1][k] + (c[1][k + 3] - c[1][k]) * t[0];
+        float c01 = c[2][k] + (c[2][k + 3] - c[2][k]) * t[0];
+        float c11 = c[3][k] + (c[3][k + 3] - c[3][k]) * t[0];
+        float c0 = c00 + (c10 - c00) * t[1], c1 = c01 + (c11 - c01) * t[1];
+        out[k] = c0 + (c1 - c0) * t[2];
+    }
+    return v3(out[0], out[1], out[2]);
 }
 
 /* sigma_t at the march's samples into p->Oi (p holds the samples' points). */
@@ -318,7 +343,7 @@ static void extinction_at(Worker *w, const RenderVolume *v, const Ray *ray, RayD
         return;
     }
     float len = v3_length(ray->d);
-    LastBrick last = {0, -1, NULL};
+    LastBrick last = LAST_BRICK_NONE;
     /* object space is an affine image of world space: step along it */
     Vec3 q0 = mat4_point(&v->object_from_world, ray->o);
     Vec3 dq = mat4_vector(&v->object_from_world, ray->d);
@@ -362,7 +387,7 @@ static Vec3 optical_depth_cached(Worker *w, const RenderVolume *v, const Ray *ra
                                  const March *m)
 {
     float len = v3_length(ray->d);
-    LastBrick last = {0, -1, NULL};
+    LastBrick last = LAST_BRICK_NONE;
     Vec3 q0 = mat4_point(&v->object_from_world, ray->o);
     Vec3 dq = mat4_vector(&v->object_from_world, ray->d), tau = v3(0, 0, 0);
     for (int i = 0; i < m->n; i++) {
