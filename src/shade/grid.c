@@ -38,6 +38,7 @@ struct VoxelGrid {
     float *values;      /* nx ny nz, x fastest */
     /* NanoVDB */
     uint32_t *words; /* the grid buffer (8-byte aligned) */
+    uint32_t type;   /* PNANOVDB_GRID_TYPE_..., one grid_type_scalar accepts */
     pnanovdb_buf_t buf;
     pnanovdb_grid_handle_t grid;
     pnanovdb_root_handle_t root;
@@ -127,10 +128,27 @@ static int read_meta(const unsigned char *data, size_t size, size_t *at, GridMet
     return 0;
 }
 
-/* A grid made from the bytes of one float grid; NULL with err filled if
- * its structure cannot be a float grid's. */
-static VoxelGrid *make_nanovdb(const unsigned char *bytes, uint64_t size, const char *path,
-                               const char *name, char *err, size_t err_size)
+/* The NanoVDB grid types read as a scalar density: 1 if type is one. */
+static int grid_type_scalar(uint32_t type)
+{
+    switch (type) {
+    case PNANOVDB_GRID_TYPE_FLOAT:
+    case PNANOVDB_GRID_TYPE_DOUBLE:
+    case PNANOVDB_GRID_TYPE_HALF:
+    case PNANOVDB_GRID_TYPE_FP4:
+    case PNANOVDB_GRID_TYPE_FP8:
+    case PNANOVDB_GRID_TYPE_FP16:
+    case PNANOVDB_GRID_TYPE_FPN:
+        return 1;
+    default:
+        return 0;
+    }
+}
+
+/* A grid of that type made from the bytes of one grid; NULL with err
+ * filled if its structure cannot be that grid's. */
+static VoxelGrid *make_nanovdb(const unsigned char *bytes, uint64_t size, uint32_t type,
+                               const char *path, const char *name, char *err, size_t err_size)
 {
     if (size < PNANOVDB_GRID_SIZE + PNANOVDB_TREE_SIZE || size > ((uint64_t)1 << 40)) {
         snprintf(err, err_size, "%s: grid \"%s\" has an impossible size (%llu bytes)", path, name,
@@ -146,6 +164,7 @@ static VoxelGrid *make_nanovdb(const unsigned char *bytes, uint64_t size, const 
     }
     memcpy(aligned, bytes, (size_t)size);
     g->is_nanovdb = 1;
+    g->type = type;
     g->words = (uint32_t *)aligned;
     g->buf = pnanovdb_make_buf(g->words, size / 4);
     g->grid.address.byte_offset = 0;
@@ -156,7 +175,7 @@ static VoxelGrid *make_nanovdb(const unsigned char *bytes, uint64_t size, const 
     const char *why = NULL;
     if (pnanovdb_grid_get_magic(g->buf, g->grid) != PNANOVDB_MAGIC_NUMBER)
         why = "the grid's magic number is wrong";
-    else if (pnanovdb_grid_get_grid_type(g->buf, g->grid) != PNANOVDB_GRID_TYPE_FLOAT)
+    else if (pnanovdb_grid_get_grid_type(g->buf, g->grid) != type)
         why = "the grid's type disagrees with its metadata";
     else if (root_at >= size || tiles > (size - root_at) / PNANOVDB_ROOT_TILE_BASE_SIZE)
         why = "its root node lies beyond the grid";
@@ -169,7 +188,7 @@ static VoxelGrid *make_nanovdb(const unsigned char *bytes, uint64_t size, const 
 }
 
 /* The grid m describes, whose bytes on disk start at data (size bytes to
- * the file's end), if it is an uncompressed float grid; else NULL with
+ * the file's end), if it is an uncompressed scalar grid; else NULL with
  * err filled. */
 static VoxelGrid *open_grid(const GridMeta *m, unsigned codec, const unsigned char *data,
                             size_t size, const char *path, char *err, size_t err_size)
@@ -182,13 +201,15 @@ static VoxelGrid *open_grid(const GridMeta *m, unsigned codec, const unsigned ch
                  codec == 1   ? "zip"
                  : codec == 2 ? "blosc"
                               : "unknown codec");
-    } else if (m->type != PNANOVDB_GRID_TYPE_FLOAT) {
-        snprintf(err, err_size, "%s: grid \"%s\" is not a float grid (NanoVDB type %u)", path,
-                 m->name, m->type);
+    } else if (!grid_type_scalar(m->type)) {
+        snprintf(err, err_size,
+                 "%s: grid \"%s\" is not a scalar grid (NanoVDB type %u; rayes reads float, "
+                 "half, double, Fp4, Fp8, Fp16 and FpN)",
+                 path, m->name, m->type);
     } else if (m->file_size != m->grid_size || m->file_size > size) {
         snprintf(err, err_size, "%s: truncated NanoVDB file (grid \"%s\")", path, m->name);
     } else {
-        return make_nanovdb(data, m->grid_size, path, m->name, err, err_size);
+        return make_nanovdb(data, m->grid_size, m->type, path, m->name, err, err_size);
     }
     return NULL;
 }
@@ -303,9 +324,25 @@ static float dense_at(const VoxelGrid *g, long x, long y, long z)
 static float nano_at(const VoxelGrid *g, pnanovdb_readaccessor_t *acc, long x, long y, long z)
 {
     pnanovdb_coord_t ijk = {(int32_t)x, (int32_t)y, (int32_t)z};
+    pnanovdb_uint32_t level;
     pnanovdb_address_t a =
-        pnanovdb_readaccessor_get_value_address(PNANOVDB_GRID_TYPE_FLOAT, g->buf, acc, &ijk);
-    return pnanovdb_read_float(g->buf, a);
+        pnanovdb_readaccessor_get_value_address_and_level(g->type, g->buf, acc, &ijk, &level);
+    switch (g->type) { /* quantized leaves decode; their tiles are floats */
+    case PNANOVDB_GRID_TYPE_DOUBLE:
+        return (float)pnanovdb_read_double(g->buf, a);
+    case PNANOVDB_GRID_TYPE_HALF:
+        return pnanovdb_read_half(g->buf, a);
+    case PNANOVDB_GRID_TYPE_FP4:
+        return pnanovdb_root_fp4_read_float(g->buf, a, &ijk, level);
+    case PNANOVDB_GRID_TYPE_FP8:
+        return pnanovdb_root_fp8_read_float(g->buf, a, &ijk, level);
+    case PNANOVDB_GRID_TYPE_FP16:
+        return pnanovdb_root_fp16_read_float(g->buf, a, &ijk, level);
+    case PNANOVDB_GRID_TYPE_FPN:
+        return pnanovdb_root_fpn_read_float(g->buf, a, &ijk, level);
+    default:
+        return pnanovdb_read_float(g->buf, a);
+    }
 }
 
 /* Trilinear from the eight values around index point q (values at

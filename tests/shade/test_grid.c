@@ -3,8 +3,9 @@
  * float grid written by the test (nvdb_write.h; nanovdb_validate and
  * nanovdb_print accept it when installed) read back at its voxel centres,
  * trilinear between them and the background outside; the file's errors
- * (missing, truncated, wrong magic, no such grid, not float, compressed)
- * each one line naming the file; pbrt-v4's uniform grid at its centres,
+ * (missing, truncated, wrong magic, no such grid, not scalar, compressed)
+ * each one line naming the file; the quantized grids nanovdb_convert
+ * makes of it (Fp4, Fp8, Fp16, FpN) within their quanta; pbrt-v4's uniform grid at its centres,
  * between them, fading past the outer centres and 0 outside its box.
  */
 #include <math.h>
@@ -103,6 +104,64 @@ static void test_nanovdb_tools_agree(void)
     CHECK(strstr(out, "density") && strstr(out, "float") && strstr(out, "512"));
 }
 
+/* Runs cmd; 0 if it exits 0. */
+static int run(const char *cmd)
+{
+    int rc = system(cmd);
+    if (rc != 0)
+        fprintf(stderr, "  failed: %s\n", cmd);
+    return rc;
+}
+
+/* The test's grid through OpenVDB and back, quantized by nanovdb_convert
+ * (--fp4, --fp8, --fp16, --fpN), reads at every voxel centre within the
+ * quantum of its bits: (max - min) / (2^bits - 1) / 2 over the leaf's
+ * range, rounding to nearest (no dithering). */
+static void test_nanovdb_quantized(void)
+{
+    const char *path = grid_file();
+    if (system("command -v nanovdb_convert >/dev/null 2>&1") != 0) {
+        fprintf(stderr, "  nanovdb_convert not installed: skipped\n");
+        return;
+    }
+    char cmd[1024];
+    snprintf(cmd, sizeof cmd, "nanovdb_convert -f %s %s/grid.vdb >/dev/null", path, DIR);
+    CHECK(run(cmd) == 0);
+    float range = value_at(7, 7, 7) - value_at(0, 0, 0);
+    struct {
+        const char *flag;
+        float tol;
+    } kinds[] = {{"--fp4", range / 15.0f}, {"--fp8", range / 255.0f},
+                 {"--fp16", range / 65535.0f}, {"--fpN -a 0.002", 0.002f}};
+    for (size_t k = 0; k < sizeof kinds / sizeof kinds[0]; k++) {
+        snprintf(cmd, sizeof cmd, "nanovdb_convert -f %s %s/grid.vdb %s/grid-q.nvdb >/dev/null",
+                 kinds[k].flag, DIR, DIR);
+        CHECK(run(cmd) == 0);
+        char err[512] = "";
+        VoxelGrid *g = grid_read_nanovdb(DIR "/grid-q.nvdb", "density", err, sizeof err);
+        CHECK(g != NULL);
+        if (!g) {
+            fprintf(stderr, "  %s: %s\n", kinds[k].flag, err);
+            continue;
+        }
+        float worst = 0.0f;
+        for (int x = 0; x < 8; x++)
+            for (int y = 0; y < 8; y++)
+                for (int z = 0; z < 8; z++) {
+                    float got = sample(g, (float)(origin[0] + voxel * x),
+                                       (float)(origin[1] + voxel * y),
+                                       (float)(origin[2] + voxel * z));
+                    worst = fmaxf(worst, fabsf(got - value_at(x, y, z)));
+                }
+        CHECK(worst <= 0.5f * kinds[k].tol + 1e-5f);
+        CHECK(worst > 0.0f || k == 2); /* quantized, so not exact (Fp16 may be) */
+        if (worst > 0.5f * kinds[k].tol + 1e-5f)
+            fprintf(stderr, "  %s: worst error %g, quantum %g\n", kinds[k].flag, worst,
+                    kinds[k].tol);
+        grid_free(g);
+    }
+}
+
 static unsigned char *slurp(const char *path, size_t *size)
 {
     FILE *f = fopen(path, "rb");
@@ -146,8 +205,11 @@ static void test_nanovdb_errors(void)
     c[14] = 2; /* the segment's codec: blosc */
     check_error(c, size, "density", "compressed (blosc)");
     memcpy(c, b, size);
-    c[16 + 32] = PNANOVDB_GRID_TYPE_DOUBLE; /* metadata's grid type */
-    check_error(c, size, "density", "not a float grid");
+    c[16 + 32] = PNANOVDB_GRID_TYPE_VEC3F; /* metadata's grid type */
+    check_error(c, size, "density", "not a scalar grid (NanoVDB type 6");
+    memcpy(c, b, size);
+    c[16 + 32] = PNANOVDB_GRID_TYPE_DOUBLE; /* a scalar type, but not the grid's */
+    check_error(c, size, "density", "damaged");
     memcpy(c, b, size);
     c[16 + 176 + 8 + PNANOVDB_GRID_OFF_GRID_TYPE] = PNANOVDB_GRID_TYPE_DOUBLE; /* the grid's own */
     check_error(c, size, "density", "damaged");
@@ -232,5 +294,5 @@ static void test_densitygrid(void)
     CHECK(strstr(err, "no parameter \"sigma_a\"") != NULL);
 }
 
-TEST_MAIN(TEST(test_nanovdb_voxels), TEST(test_nanovdb_tools_agree), TEST(test_nanovdb_errors),
+TEST_MAIN(TEST(test_nanovdb_voxels), TEST(test_nanovdb_tools_agree), TEST(test_nanovdb_quantized), TEST(test_nanovdb_errors),
           TEST(test_nanovdb_pattern), TEST(test_densitygrid))
