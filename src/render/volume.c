@@ -15,6 +15,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "shade/builtin.h"
 #include "util/check.h"
 #include "util/half.h"
 #include "util/rng.h"
@@ -108,12 +109,20 @@ typedef struct March {
     float t0, dt, jitter, dl; /* dl: a step's world length */
 } March;
 
+int volume_uniform(const RenderObject *obj)
+{
+    return obj->shader && obj->shader->cls == &shade_class_homogeneous &&
+           obj->shader->n_patterns == 0;
+}
+
+/* A march of at most max_steps (a uniform volume's: its extinction needs
+ * no more). */
 static March march(const Worker *w, const RenderVolume *v, const Ray *ray, float t0, float t1,
-                   float jitter)
+                   float jitter, int max_steps)
 {
     float len = v3_length(ray->d), world = (t1 - t0) * len;
     float h = v->voxel * w->set->volume_step;
-    int n = (int)fminf(fmaxf(ceilf(world / h), 1.0f), VOLUME_MAX_STEPS);
+    int n = (int)fminf(fmaxf(ceilf(world / h), 1.0f), (float)max_steps);
     March m = {n, t0, (t1 - t0) / (float)n, jitter, world / (float)n};
     return m;
 }
@@ -411,7 +420,7 @@ Vec3 volume_transmittance(Worker *w, const Ray *ray, RayDiff diff)
             continue;
         if (!counted++)
             w->stats.rays_transmission++;
-        March m = march(w, v, ray, t0, t1, ray_jitter(ray));
+        March m = march(w, v, ray, t0, t1, ray_jitter(ray), v->uniform ? 1 : VOLUME_MAX_STEPS);
         const RenderObject *obj = &w->rs->objects[v->object];
         Vec3 tau = v3(0, 0, 0);
         if (w->set->opacity_cache && obj->opacity_cached) {
@@ -444,7 +453,8 @@ Vec3 volume_radiance(Worker *w, const Ray *ray, float tmax, uint32_t kind, int d
         if (!clip(v, ray, tmax, &t0, &t1))
             continue;
         uint64_t vkey = hash_combine(key, 0x766f6c0000ull + k);
-        March m = march(w, v, ray, t0, t1, rng_float(vkey));
+        March m = march(w, v, ray, t0, t1, rng_float(vkey),
+                        v->uniform ? VOLUME_LIGHT_SAMPLES : VOLUME_MAX_STEPS);
         VolumePoints p;
         points_alloc(&p, (size_t)m.n);
         march_points(v, obj, ray, &m, vkey, diff, &p);

@@ -33,6 +33,9 @@ typedef struct RenderVolume {
     int n_brick[3];              /* bricks along each axis */
     uint32_t key_base;           /* cache keys: patch key_base + brick index */
     float voxel;                 /* a fine voxel's size, world units (the march step) */
+    int uniform;                 /* 1: the same extinction everywhere (the homogeneous shader
+                                    without patterns): transmittance takes one step, scattering
+                                    one per lighting point */
 } RenderVolume;
 
 /* Fills v for the box [lo, hi] of object space under world_from_object,
@@ -44,6 +47,11 @@ uint32_t volume_init(RenderVolume *v, uint32_t object, const Mat4 *world_from_ob
                      Vec3 hi, float voxel, uint32_t key_base);
 
 #define VOLUME_MAX_VOXELS 512
+
+/* 1 if obj's shader gives every point of its volume the same extinction
+ * and albedo (the built-in homogeneous shader with no parameter bound to a
+ * pattern), so marching it finely gains nothing. */
+int volume_uniform(const RenderObject *obj);
 
 /* The transmittance of the volumes along ray's [tnear, tfar] (diff its
  * differential): 1 without volumes. Counts transmission rays and steps. */

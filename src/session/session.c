@@ -319,6 +319,7 @@ static int prepare_volumes(const RayesScene *scene, const RenderSettings *set, P
                                       v3(sv->bound[1], sv->bound[3], sv->bound[5]), voxel, base);
         if (bricks == 0)
             continue; /* a singular transform: nothing to march */
+        v->uniform = volume_uniform(&p->objects[sv->object]);
         base += bricks;
         p->n_volumes++;
     }

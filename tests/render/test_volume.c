@@ -160,6 +160,43 @@ static void test_homogeneous_slab_transmittance(void)
     rayes_image_free(open);
 }
 
+/* A medium of one extinction everywhere is not marched: a shadow ray
+ * takes one step through it (the slab test above shows the result
+ * exact), while the same slab from a grid takes a step per voxel. */
+static void test_uniform_volume_one_step(void)
+{
+    for (int grid = 0; grid < 2; grid++) {
+        RayesScene *s = new_scene();
+        floor_matte(s);
+        RayesParam lp[2] = {pc("from", 0, 0, 20), pf("intensity", 400.0f)};
+        CHECK(rayes_scene_light(s, "pointlight", lp, 2) == RAYES_OK);
+        const float d[8] = {0.5f, 0.5f, 0.5f, 0.5f, 0.5f, 0.5f, 0.5f, 0.5f};
+        RayesParam q[6] = {pf("nx", 2), pf("ny", 2), pf("nz", 2), pc("p0", -30, -30, 7),
+                           pc("p1", 30, 30, 10)};
+        q[5] = (RayesParam){"density", RAYES_PARAM_FLOATS, {0}, NULL, d, 8};
+        CHECK(rayes_scene_pattern(s, "cloud", "densitygrid", q, 6) == RAYES_OK);
+        RayesParam v[2] = {grid ? (RayesParam){"density", RAYES_PARAM_PATTERN, {0}, "cloud"}
+                                : pf("density", 0.5f),
+                           pc("albedo", 0, 0, 0)};
+        CHECK(rayes_scene_set_shader(s, "homogeneous", v, 2) == RAYES_OK);
+        const float box[6] = {-10, 10, -10, 10, 8, 9};
+        CHECK(rayes_scene_volume(s, box) == RAYES_OK);
+        RayesStats *st = NULL;
+        RayesImage *img = render(s, 2, 20.0, 1, &st);
+        const RayesStat *tr = rayes_stats_find(st, "rays/transmission");
+        const RayesStat *steps = rayes_stats_find(st, "volume/steps");
+        CHECK(tr && steps && tr->count > 0);
+        if (tr && steps) {
+            fprintf(stderr, "%s slab: %g steps a transmission ray\n", grid ? "grid" : "uniform",
+                    (double)steps->count / (double)tr->count);
+            CHECK(grid ? steps->count > 4 * tr->count : steps->count == tr->count);
+        }
+        rayes_stats_free(st);
+        rayes_image_free(img);
+        rayes_scene_release(s);
+    }
+}
+
 /* A slab z in [1, 2] of an isotropic medium, albedo 1, lit by a distant
  * light shining down the view: a point s deep sees the light through s
  * and the camera through s, so L = sigma E / (4 pi) (1 - e^(-2 sigma d)) /
@@ -246,5 +283,6 @@ static void test_bad_volume(void)
     rayes_scene_release(s);
 }
 
-TEST_MAIN(TEST(test_homogeneous_slab_transmittance), TEST(test_single_scattering_closed_form),
+TEST_MAIN(TEST(test_homogeneous_slab_transmittance), TEST(test_uniform_volume_one_step),
+          TEST(test_single_scattering_closed_form),
           TEST(test_cached_extinction_within_noise_and_deterministic), TEST(test_bad_volume))
