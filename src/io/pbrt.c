@@ -536,6 +536,8 @@ RayesError io_pbrt_parse(const char *name, const unsigned char *data, size_t siz
         snprintf(err, err_size, "%s: expected WorldBegin, found the end of the file", name);
         r = -1;
     }
+    if (!r)
+        r = pbrt_medium_camera(P);
     parser_free(P);
     free(P);
     return r ? RAYES_ERROR_PARSE : RAYES_OK;

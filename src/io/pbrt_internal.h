@@ -213,6 +213,10 @@ typedef struct Parser {
     size_t n_media;
     float shape_bound[6]; /* object-space bounds of the Shape being read (x0 x1 y0 y1 z0 z1) */
     int have_shape_bound;
+    float world_bound[6]; /* world-space bounds of every Shape outside ObjectBegin so far */
+    int have_world_bound;
+    char camera_medium[128]; /* the outside medium current at Camera, "" for none */
+    long camera_line, camera_col; /* where Camera was (the camera medium's messages) */
     Object *recording; /* between ObjectBegin and ObjectEnd */
     long replayed;
     /* camera and options */
@@ -383,6 +387,9 @@ int pbrt_d_mediuminterface(Parser *P, const Token *t);
 /* After a Shape: the volume of its inside medium, if it has one, over
  * P->shape_bound (pbrt_emit_* grow it). */
 int pbrt_medium_shape(Parser *P, const Token *t);
+/* At the end of the file: the camera's medium, if any, as a volume over
+ * the scene's bounds and the camera. */
+int pbrt_medium_camera(Parser *P);
 /* Frees the media's arrays. */
 void pbrt_media_free(Parser *P);
 

@@ -15,9 +15,12 @@
  * primitives grow P->shape_bound), except for a uniformgrid, whose box
  * is p0..p1 in the medium's space, where its density is. rayes' volumes
  * are boxes: a medium inside a sphere fills the sphere's bounding box.
- * Media only inside shapes are rendered: the camera's medium and the
+ * The camera's medium (the outside medium current at Camera) fills a box
+ * around every shape outside ObjectBegin and the camera, made at the end of
+ * the file; a shape whose outside medium is the camera's is in it. Other
  * media outside shapes are skipped with one warning.
  */
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -145,6 +148,7 @@ int pbrt_d_makenamedmedium(Parser *P, const Token *t)
 
 int pbrt_d_mediuminterface(Parser *P, const Token *t)
 {
+    (void)t; /* before WorldBegin too: the medium current at Camera is the camera's */
     char in[128], out[128];
     Token next;
     if (pbrt_expect_string(P, in, sizeof in, "a medium name (inside)", NULL) != 0 ||
@@ -155,13 +159,6 @@ int pbrt_d_mediuminterface(Parser *P, const Token *t)
             return -1;
     } else {
         memcpy(out, in, sizeof out); /* one name: both sides */
-    }
-    if (!P->world) {
-        if (in[0] || out[0])
-            pbrt_warn_at(P, t->line, t->col, "camera medium",
-                         "MediumInterface before WorldBegin (the camera's medium): rayes renders "
-                         "media only inside shapes; skipped");
-        return 0;
     }
     snprintf(P->gs.inside, sizeof P->gs.inside, "%s", in);
     snprintf(P->gs.outside, sizeof P->gs.outside, "%s", out);
@@ -210,10 +207,35 @@ static int send_density(Parser *P, const Token *t, Medium *md)
     return pbrt_emit_pattern_in(P, t, md->m, md->pattern, "nanovdb", q, 1);
 }
 
+/* Grows P->world_bound by the shape just read (its bounds' corners under
+ * the CTM); shapes inside ObjectBegin are placed by their instances and
+ * are not counted. */
+static void grow_world_bound(Parser *P)
+{
+    if (!P->have_shape_bound || P->recording)
+        return;
+    const double *m = P->gs.ctm;
+    const float *b = P->shape_bound;
+    float *w = P->world_bound;
+    for (int c = 0; c < 8; c++) {
+        double p[3] = {b[c & 1], b[2 + (c >> 1 & 1)], b[4 + (c >> 2)]};
+        for (int k = 0; k < 3; k++) {
+            float v = (float)(m[4 * k] * p[0] + m[4 * k + 1] * p[1] + m[4 * k + 2] * p[2] +
+                              m[4 * k + 3]);
+            if (!P->have_world_bound || v < w[2 * k])
+                w[2 * k] = v;
+            if (!P->have_world_bound || v > w[2 * k + 1])
+                w[2 * k + 1] = v;
+        }
+        P->have_world_bound = 1;
+    }
+}
+
 int pbrt_medium_shape(Parser *P, const Token *t)
 {
     const char *in = P->gs.inside, *out = P->gs.outside;
-    if (out[0] && strcmp(in, out) != 0)
+    grow_world_bound(P);
+    if (out[0] && strcmp(in, out) != 0 && strcmp(out, P->camera_medium) != 0)
         pbrt_warn_at(P, t->line, t->col, "outside medium",
                      "MediumInterface: the medium outside a shape (\"%.60s\") is not rendered; "
                      "rayes fills only the inside of shapes",
@@ -255,4 +277,48 @@ void pbrt_media_free(Parser *P)
     for (size_t i = 0; i < P->n_media; i++)
         free(P->media[i].density);
     free(P->media);
+}
+
+int pbrt_medium_camera(Parser *P)
+{
+    if (!P->camera_medium[0])
+        return 0;
+    Token t = {.line = P->camera_line, .col = P->camera_col};
+    Medium *md = find_medium(P, P->camera_medium);
+    if (!md)
+        return FAIL_TOK(P, &t,
+                        "the camera's medium \"%.60s\" (MediumInterface) was never defined by "
+                        "MakeNamedMedium",
+                        P->camera_medium);
+    if (strcmp(md->type, "none") == 0)
+        return 0;
+    if (!P->sink->volume || !P->sink->pattern) {
+        pbrt_warn_at(P, t.line, t.col, "camera medium",
+                     "the camera's medium \"%.60s\": this output takes no volumes; not rendered",
+                     md->name);
+        return 0;
+    }
+    /* the scene's bounds and the eye, widened by a thousandth of the
+     * diagonal (and at least 1e-3) so that surfaces on the bounds are in */
+    double eye_m[16];
+    if (pbrt_mat_inverse(P->camera_from_world, eye_m) != 0)
+        return 0; /* reported at Camera */
+    float eye[3] = {(float)eye_m[3], (float)eye_m[7], (float)eye_m[11]}, box[6];
+    for (int k = 0; k < 3; k++) {
+        box[2 * k] = P->have_world_bound ? fminf(P->world_bound[2 * k], eye[k]) : eye[k];
+        box[2 * k + 1] = P->have_world_bound ? fmaxf(P->world_bound[2 * k + 1], eye[k]) : eye[k];
+    }
+    float diag = 0.0f;
+    for (int k = 0; k < 3; k++)
+        diag += (box[2 * k + 1] - box[2 * k]) * (box[2 * k + 1] - box[2 * k]);
+    float pad = fmaxf(1e-3f * sqrtf(diag), 1e-3f);
+    for (int k = 0; k < 3; k++)
+        box[2 * k] -= pad, box[2 * k + 1] += pad;
+    if (send_density(P, &t, md) != 0)
+        return -1;
+    RayesParam q[5];
+    size_t n = medium_params(md, q);
+    double identity[16];
+    pbrt_mat_identity(identity);
+    return pbrt_emit_volume(P, &t, identity, q, n, box);
 }

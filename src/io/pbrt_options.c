@@ -40,6 +40,8 @@ int pbrt_d_camera(Parser *P, const Token *t)
         return -1;
     }
     memcpy(P->camera_from_world, P->gs.ctm, sizeof P->camera_from_world);
+    snprintf(P->camera_medium, sizeof P->camera_medium, "%s", P->gs.outside);
+    P->camera_line = t->line, P->camera_col = t->col;
     double inv[16];
     if (pbrt_mat_inverse(P->gs.ctm, inv) != 0) {
         pbrt_params_free(&pl);

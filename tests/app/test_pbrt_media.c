@@ -8,9 +8,10 @@
  * grid of one value written by nvdb_write.h, its voxel centres enclosing
  * the slab), and 0.75 sigma_a for a 1 x 1 x 1 "uniformgrid" whose box is
  * the slab in z (pbrt's grid fades to half its value at the box's faces). The
- * box itself is invisible; the files read without a warning. A camera
- * medium and an outside medium warn once; a shape whose medium was never
- * defined is an error naming the line.
+ * box itself is invisible; the files read without a warning. The camera's
+ * medium fills the scene's bounds (exp(-sigma d) along camera and shadow
+ * rays); another outside medium warns once; a shape whose medium was
+ * never defined is an error naming the line.
  */
 #include <math.h>
 #include <stdio.h>
@@ -142,16 +143,58 @@ static void test_absorbing_slabs(void)
     CHECK(open > 0.1);
 }
 
+/* The camera's medium (MediumInterface before Camera) fills the scene's
+ * bounds and the eye: looking straight down at the floor 6 below through
+ * absorbing fog, the camera ray crosses 6 and the shadow ray to the
+ * distant light straight up crosses the 6 to the box's top (a thousandth
+ * of its diagonal above the eye), so the centre is exp(-sigma (6 + 6 +
+ * pad)) of the open floor's. A shape in the camera's medium reads without
+ * a warning. */
+static void test_camera_medium(void)
+{
+    mkdir(TMP, 0755);
+    char text[4096], err_text[4096];
+    write_scene("cam-open.pbrt", "# no medium\n");
+    float *open = render("cam-open.pbrt", err_text, sizeof err_text);
+    snprintf(text, sizeof text,
+             "MakeNamedMedium \"fog\" \"string type\" \"homogeneous\" \"rgb sigma_a\" [0.05 0.05 "
+             "0.05]\n  \"rgb sigma_s\" [0 0 0]\n"
+             "MediumInterface \"\" \"fog\"\n"
+             "LookAt 0 0 6  0 0 0  0 1 0\nCamera \"perspective\" \"float fov\" 10\n"
+             "Film \"rgb\" \"integer xresolution\" %d \"integer yresolution\" %d\n"
+             "WorldBegin\n"
+             "LightSource \"distant\" \"point3 from\" [0 0 1] \"point3 to\" [0 0 0] \"rgb L\" [3 3 "
+             "3]\n"
+             "Material \"diffuse\" \"rgb reflectance\" [0.5 0.5 0.5]\n"
+             "Shape \"bilinearmesh\" \"point3 P\" [-4 -4 0 4 -4 0 -4 4 0 4 4 0]\n"
+             "  \"integer indices\" [0 1 2 3]\n",
+             RES, RES);
+    FILE *f = fopen(TMP "/cam-fog.pbrt", "w");
+    if (f) {
+        fputs(text, f);
+        fclose(f);
+    }
+    float *fog = render("cam-fog.pbrt", err_text, sizeof err_text);
+    CHECK(open != NULL && fog != NULL);
+    CHECK(strstr(err_text, "warning") == NULL);
+    if (open && fog) {
+        double diag = sqrt(8.0 * 8.0 * 2.0 + 6.0 * 6.0), pad = 1e-3 * diag;
+        double want = exp(-0.05 * (6.0 + 6.0 + pad)), got = centre(fog) / centre(open);
+        fprintf(stderr, "camera medium: %g of the open floor, expected %g\n", got, want);
+        CHECK(fabs(got - want) < 0.01 * want);
+    }
+    free(open);
+    free(fog);
+}
+
 static void test_skipped_media_warn(void)
 {
     mkdir(TMP, 0755);
     char err_text[4096];
-    /* a camera medium (MediumInterface before WorldBegin), and a shape
-     * with only an outside medium */
+    /* a shape with only an outside medium, not the camera's */
     char full[8192];
     snprintf(full, sizeof full,
              "MakeNamedMedium \"fog\" \"string type\" \"homogeneous\"\n"
-             "MediumInterface \"\" \"fog\"\n"
              "LookAt 0 0 6  0 0 0  0 1 0\nCamera \"perspective\" \"float fov\" 10\n"
              "Film \"rgb\" \"integer xresolution\" %d \"integer yresolution\" %d\n"
              "WorldBegin\n"
@@ -166,7 +209,6 @@ static void test_skipped_media_warn(void)
     float *img = render("skipped.pbrt", err_text, sizeof err_text);
     CHECK(img != NULL);
     free(img);
-    CHECK(strstr(err_text, "camera's medium") != NULL);
     CHECK(strstr(err_text, "the medium outside a shape (\"fog\") is not rendered") != NULL);
     /* an undefined medium */
     write_scene("undefined.pbrt",
@@ -179,4 +221,4 @@ static void test_skipped_media_warn(void)
           strstr(err_text, "the medium \"smoke\", which no MakeNamedMedium defined") != NULL);
 }
 
-TEST_MAIN(TEST(test_absorbing_slabs), TEST(test_skipped_media_warn))
+TEST_MAIN(TEST(test_absorbing_slabs), TEST(test_camera_medium), TEST(test_skipped_media_warn))
