@@ -604,6 +604,15 @@ typedef enum RayesHider {
 typedef void (*RayesTileFn)(void *user, int x, int y, int w, int h, const float *rgba,
                             int stride);
 
+/* Which tile a render thread takes next: an index into the frame's tiles
+ * (tiles_x * tiles_y of tile_size pixels over the crop window, row by
+ * row), or -1 when no tile is left for this render. Called from worker
+ * threads, one call at a time. A pixel is the same whichever tiles are
+ * rendered and in what order, so a render of some tiles (a resumed
+ * checkpoint, one machine's share of a frame) gives them the bytes of the
+ * whole render. */
+typedef int (*RayesTileSourceFn)(void *user, int tiles_x, int tiles_y);
+
 /* Progress: fraction done in [0, 1]. Return nonzero to cancel the render.
  * Called from worker threads, one call at a time. */
 typedef int (*RayesProgressFn)(void *user, double fraction);
@@ -676,6 +685,9 @@ typedef struct RayesRenderOptions {
                                   (a voxel projects to about a pixel at the volume's nearest
                                   point, times the square root of its shading rate): default
                                   1; larger is faster and coarser */
+    RayesTileSourceFn tile_source; /* may be NULL (every tile, in order): the tiles to render;
+                                      the others stay 0 in the image */
+    void *tile_source_user;
 } RayesRenderOptions;
 
 /* Fills options with the defaults of a quality preset: 512 x 512, 4 pixel

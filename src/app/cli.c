@@ -34,6 +34,10 @@ static const char render_options[] =
     "  --skip-existing         skip a frame whose outputs all exist (a farm's retry)\n"
     "  --progress json|bar     json: one JSON object per line on standard output (progress,\n"
     "                          each frame's end) for farm managers; bar (default)\n"
+    "  --checkpoint SECONDS    save the finished tiles to OUTPUT.checkpoint this often\n"
+    "                          (0: after every tile) and when interrupted\n"
+    "  --resume                render only the tiles OUTPUT.checkpoint lacks; the image is\n"
+    "                          the same bytes as an uninterrupted render's\n"
     "  --res W[xH]             resolution in pixels (default 512x512)\n"
     "  --spp N                 pixel samples (default 4)\n"
     "  --threads N             worker threads (default: all cores)\n"
@@ -252,6 +256,7 @@ void parse_args(int argc, char **argv, Args *a)
             q = parse_quality(i + 1 < argc ? argv[i + 1] : NULL);
     rayes_render_options_init(&a->opt, q);
     a->frame = -1;
+    a->checkpoint_s = -1.0;
     a->gamma = 1.0f;
     for (int i = 2; i < argc; i++) {
         const char *o = argv[i];
@@ -269,6 +274,10 @@ void parse_args(int argc, char **argv, Args *a)
         }
         if (strcmp(o, "--skip-existing") == 0) {
             a->skip_existing = 1;
+            continue;
+        }
+        if (strcmp(o, "--resume") == 0) {
+            a->resume = 1;
             continue;
         }
         if (strcmp(o, "--dice-isotropic") == 0) {
@@ -310,6 +319,8 @@ void parse_args(int argc, char **argv, Args *a)
             a->frame = (int)parse_long(o, v, 0, INT_MAX);
         else if (strcmp(o, "--frames") == 0)
             a->frames = v;
+        else if (strcmp(o, "--checkpoint") == 0)
+            a->checkpoint_s = parse_float(o, v, 0.0f, 1e7f);
         else if (strcmp(o, "--progress") == 0) {
             if (strcmp(v, "json") != 0 && strcmp(v, "bar") != 0)
                 die_usage("--progress: expected json or bar, got \"%s\"", v);

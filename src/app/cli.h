@@ -42,6 +42,8 @@ typedef struct Args {
     const char *frames;         /* --frames LIST: frames to render one after another */
     int skip_existing;          /* --skip-existing: a frame whose outputs exist is skipped */
     int progress_json;          /* --progress json: machine-readable lines on standard output */
+    double checkpoint_s;        /* --checkpoint SECONDS: save finished tiles this often; -1 never */
+    int resume;                 /* --resume: render only the tiles a checkpoint lacks */
     unsigned set;               /* SET_*: options the command line gave */
     const char *stats_path;
     const char *data_dir;

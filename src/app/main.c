@@ -3,7 +3,9 @@
  *
  * Exit status: 0 success; 1 bad input or a failed render or write (one line
  * on stderr naming the file and what is wrong); 2 a usage error; 130
- * interrupted (SIGINT), with no output written.
+ * interrupted by SIGINT, 143 by SIGTERM (a farm's pre-emption), with no
+ * output written (with --checkpoint, the finished tiles saved for
+ * --resume). docs/cli.md lists them for farm managers.
  */
 #include <errno.h>
 #include <limits.h>
@@ -23,6 +25,7 @@
 #include "rayes/rayes.h"
 #include "util/log.h"
 
+#include "app/checkpoint.h"
 #include "app/cli.h"
 #include "app/view.h"
 
@@ -33,12 +36,11 @@ typedef struct Progress {
     int frame;      /* the frame's number, or -1 */
 } Progress;
 
-static volatile sig_atomic_t interrupted;
+static volatile sig_atomic_t interrupted; /* the signal that interrupted, or 0 */
 
-static void on_sigint(int sig)
+static void on_signal(int sig)
 {
-    (void)sig;
-    interrupted = 1;
+    interrupted = sig;
 }
 
 static void format_time(char *buf, size_t n, double s)
@@ -89,7 +91,7 @@ static int on_progress(void *user, double fraction)
             p->last_percent = percent;
         }
     }
-    return interrupted;
+    return interrupted != 0;
 }
 
 static uint64_t stat_count(const RayesStats *s, const char *name)
@@ -345,6 +347,25 @@ static int cmd_render(int argc, char **argv)
     return status;
 }
 
+/* The checkpoint of a's render of frame, beside its first output, taken
+ * as done with --resume; NULL after printing why not. */
+static Checkpoint *open_checkpoint(Args *a, int frame)
+{
+    char path[4200], err[1024];
+    snprintf(path, sizeof path, "%s.checkpoint", a->outputs[0].path);
+    double every = a->checkpoint_s >= 0.0 ? a->checkpoint_s : INFINITY;
+    Checkpoint *ck = checkpoint_new(path, checkpoint_digest(a->scene, frame, &a->opt), &a->opt,
+                                    every, a->resume, err, sizeof err);
+    if (!ck) {
+        fprintf(stderr, "rayes: %s\n", err);
+        return NULL;
+    }
+    checkpoint_attach(ck, &a->opt);
+    if (checkpoint_resumed_tiles(ck) && !a->quiet && !a->progress_json)
+        printf("  resumed       %d tiles from %s\n", checkpoint_resumed_tiles(ck), path);
+    return ck;
+}
+
 static int render_job(Args a, int frame, int number)
 {
     for (int i = 0; i < a.n_outputs && number >= 0; i++) {
@@ -411,18 +432,33 @@ static int render_job(Args a, int frame, int number)
         rayes_scene_release(scene);
         return 1;
     }
+    Checkpoint *ck = NULL;
+    if ((a.checkpoint_s >= 0.0 || a.resume) && (ck = open_checkpoint(&a, frame)) == NULL) {
+        rayes_scene_release(scene);
+        return 1;
+    }
     Progress prog = {.start = time_now(), .tty = isatty(2), .last_percent = -1, .quiet = a.quiet,
                      .json = a.progress_json, .frame = number};
     a.opt.progress = on_progress;
     a.opt.progress_user = &prog;
-    signal(SIGINT, on_sigint);
+    signal(SIGINT, on_signal);
+    signal(SIGTERM, on_signal);
     RayesImage *img = NULL;
     RayesStats *stats = NULL;
     e = rayes_render(scene, &a.opt, &img, &stats);
     if (e != RAYES_OK) {
         fprintf(stderr, "rayes: %s\n", rayes_scene_get_error(scene));
+        if (ck && a.checkpoint_s >= 0.0 && e == RAYES_ERROR_CANCELLED &&
+            checkpoint_save(ck, err, sizeof err) != 0)
+            fprintf(stderr, "rayes: %s\n", err);
+        checkpoint_free(ck);
         rayes_scene_release(scene);
-        return e == RAYES_ERROR_CANCELLED ? 130 : 1;
+        return e != RAYES_ERROR_CANCELLED ? 1 : interrupted == SIGTERM ? 143 : 130;
+    }
+    if (ck) {
+        if (checkpoint_error(ck))
+            fprintf(stderr, "rayes: warning: %s\n", checkpoint_error(ck));
+        checkpoint_fill(ck, img);
     }
     apply_exposure(img, settings.exposure_gain, settings.exposure_gamma);
     int written = 0; /* outputs written whole */
@@ -439,9 +475,13 @@ static int render_job(Args a, int frame, int number)
         fprintf(stderr, "rayes: %s\n", err);
         status = 1;
     }
-    /* A failed run leaves none of its outputs behind. */
+    /* A failed run leaves none of its outputs behind; a finished one no
+     * checkpoint. */
     for (int i = 0; status != 0 && i < written; i++)
         unlink(a.outputs[i].path);
+    if (ck && status == 0)
+        checkpoint_remove(ck);
+    checkpoint_free(ck);
     if (a.progress_json) { /* the frame's end, for farm managers */
         printf("{\"event\": \"frame\", \"frame\": %d, \"status\": %d, \"seconds\": %.3f, "
                "\"outputs\": [",

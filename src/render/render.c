@@ -166,6 +166,14 @@ static void render_tile(void *ctx, size_t task, int worker)
         atomic_store(&f->cancelled, 1);
     if (atomic_load(&f->cancelled))
         return;
+    if (set->tile_source) { /* the caller's choice of tile, in place of task */
+        pthread_mutex_lock(&f->progress_lock);
+        int t = set->tile_source(set->tile_source_user, f->tiles_x, f->tiles_y);
+        pthread_mutex_unlock(&f->progress_lock);
+        if (t < 0 || (size_t)t >= (size_t)f->tiles_x * f->tiles_y)
+            return;
+        task = (size_t)t;
+    }
     int ts = set->tile_size;
     int x0 = f->crop[0] + (int)(task % (size_t)f->tiles_x) * ts;
     int y0 = f->crop[1] + (int)(task / (size_t)f->tiles_x) * ts;

@@ -115,6 +115,8 @@ typedef struct RenderSettings {
     atomic_int *cancel;           /* nonzero: stop (tiles not yet started are skipped) */
     void (*tile_done)(void *user, int x, int y, int w, int h, const float *rgba, int stride);
     void *tile_user;              /* tile_done gets the frame's rgba and its row stride */
+    int (*tile_source)(void *user, int tiles_x, int tiles_y); /* NULL: every tile */
+    void *tile_source_user;
 } RenderSettings;
 
 typedef struct RenderStats {

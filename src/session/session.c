@@ -200,6 +200,8 @@ RenderSettings session_settings(const RayesRenderOptions *o)
         .volume_step = o->volume_step,
         .tile_done = o->tile_done,
         .tile_user = o->tile_user,
+        .tile_source = o->tile_source,
+        .tile_source_user = o->tile_source_user,
     };
     if (s.threads == 0)
         s.threads = thread_count_cores();
