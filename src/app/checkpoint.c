@@ -11,13 +11,13 @@
 #include "app/checkpoint.h"
 
 #include <errno.h>
-#include <math.h>
 #include <pthread.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
 
+#include "app/tiles.h"
 #include "util/log.h"
 
 #define MAGIC "RAYESCK1"
@@ -28,9 +28,8 @@ enum { TILE_PENDING = 0, TILE_RESUMED = 1, TILE_DONE = 2 };
 struct Checkpoint {
     char path[4200], tmp[4220];
     uint64_t digest;
-    int width, height, ts;
-    int crop[4];            /* pixels x0 y0 x1 y1 (x1, y1 excluded) */
-    int tiles_x, tiles_y;
+    int width, height;
+    TileGrid g;             /* the render's tiles */
     unsigned char *state;   /* TILE_* per tile */
     float *rgba;            /* the frame, width * height * 4: finished tiles' pixels */
     int next;               /* the tile source's next candidate */
@@ -77,30 +76,9 @@ uint64_t checkpoint_digest(const char *scene, int frame, const RayesRenderOption
     return h;
 }
 
-/* ------------------------------------------------------------- tiles */
-
-/* The crop window's pixels, as the renderer takes them (session.c:
- * ceil(W xmin) to ceil(W xmax) - 1). */
-static void crop_pixels(const RayesRenderOptions *o, int crop[4])
-{
-    crop[0] = (int)ceil((double)o->width * o->crop[0] - 0.01);
-    crop[2] = (int)ceil((double)o->width * o->crop[1] - 0.01);
-    crop[1] = (int)ceil((double)o->height * o->crop[2] - 0.01);
-    crop[3] = (int)ceil((double)o->height * o->crop[3] - 0.01);
-}
-
-/* Tile t's pixels: x, y, w, h. */
-static void tile_rect(const Checkpoint *c, int t, int r[4])
-{
-    r[0] = c->crop[0] + (t % c->tiles_x) * c->ts;
-    r[1] = c->crop[1] + (t / c->tiles_x) * c->ts;
-    r[2] = (r[0] + c->ts < c->crop[2] ? r[0] + c->ts : c->crop[2]) - r[0];
-    r[3] = (r[1] + c->ts < c->crop[3] ? r[1] + c->ts : c->crop[3]) - r[1];
-}
-
 static int n_tiles(const Checkpoint *c)
 {
-    return c->tiles_x * c->tiles_y;
+    return tile_count(&c->g);
 }
 
 /* ------------------------------------------------------------- the file */
@@ -120,8 +98,9 @@ static int load(Checkpoint *c, char *err, size_t err_size)
     char magic[8];
     uint64_t digest;
     int32_t hdr[HEADER_INTS];
-    int32_t want[HEADER_INTS] = {c->width,   c->height,  c->ts,      c->crop[0], c->crop[1],
-                                 c->crop[2], c->crop[3], c->tiles_x, c->tiles_y};
+    int32_t want[HEADER_INTS] = {c->width,     c->height,    c->g.size,    c->g.crop[0],
+                                 c->g.crop[1], c->g.crop[2], c->g.crop[3], c->g.tiles_x,
+                                 c->g.tiles_y};
     int r = -1;
     if (read_exact(f, magic, 8) || memcmp(magic, MAGIC, 8) || read_exact(f, &digest, 8) ||
         read_exact(f, hdr, sizeof hdr)) {
@@ -140,7 +119,7 @@ static int load(Checkpoint *c, char *err, size_t err_size)
             c->state[t] = TILE_RESUMED;
             c->resumed++;
             int q[4];
-            tile_rect(c, t, q);
+            tile_rect(&c->g, t, q);
             for (int y = 0; y < q[3] && r == 1; y++)
                 if (read_exact(f, &c->rgba[4 * ((size_t)(q[1] + y) * c->width + q[0])],
                                sizeof(float) * 4 * (size_t)q[2])) {
@@ -164,8 +143,9 @@ int checkpoint_save(Checkpoint *c, char *err, size_t err_size)
         snprintf(err, err_size, "%s: cannot write checkpoint: %s", c->tmp, strerror(errno));
         return -1;
     }
-    int32_t hdr[HEADER_INTS] = {c->width,   c->height,  c->ts,      c->crop[0], c->crop[1],
-                                c->crop[2], c->crop[3], c->tiles_x, c->tiles_y};
+    int32_t hdr[HEADER_INTS] = {c->width,     c->height,    c->g.size,    c->g.crop[0],
+                                c->g.crop[1], c->g.crop[2], c->g.crop[3], c->g.tiles_x,
+                                c->g.tiles_y};
     int ok = fwrite(MAGIC, 1, 8, f) == 8 && fwrite(&c->digest, 8, 1, f) == 1 &&
              fwrite(hdr, sizeof hdr, 1, f) == 1;
     unsigned char *done = malloc((size_t)n_tiles(c));
@@ -177,7 +157,7 @@ int checkpoint_save(Checkpoint *c, char *err, size_t err_size)
         if (!done[t])
             continue;
         int q[4];
-        tile_rect(c, t, q);
+        tile_rect(&c->g, t, q);
         for (int y = 0; ok && y < q[3]; y++)
             ok = fwrite(&c->rgba[4 * ((size_t)(q[1] + y) * c->width + q[0])], sizeof(float) * 4,
                         (size_t)q[2], f) == (size_t)q[2];
@@ -197,7 +177,7 @@ int checkpoint_save(Checkpoint *c, char *err, size_t err_size)
 static int source(void *user, int tiles_x, int tiles_y)
 {
     Checkpoint *c = user;
-    if (tiles_x != c->tiles_x || tiles_y != c->tiles_y)
+    if (tiles_x != c->g.tiles_x || tiles_y != c->g.tiles_y)
         return c->next++ < tiles_x * tiles_y ? c->next - 1 : -1; /* not ours: every tile */
     while (c->next < n_tiles(c) && c->state[c->next] != TILE_PENDING)
         c->next++;
@@ -207,9 +187,9 @@ static int source(void *user, int tiles_x, int tiles_y)
 static void tile_done(void *user, int x, int y, int w, int h, const float *rgba, int stride)
 {
     Checkpoint *c = user;
-    if ((x - c->crop[0]) % c->ts || (y - c->crop[1]) % c->ts)
+    int t = tile_at(&c->g, x, y);
+    if (t < 0)
         return; /* cannot be one of its tiles */
-    int t = (y - c->crop[1]) / c->ts * c->tiles_x + (x - c->crop[0]) / c->ts;
     pthread_mutex_lock(&c->lock);
     for (int r = 0; r < h; r++)
         memcpy(&c->rgba[4 * ((size_t)(y + r) * c->width + x)],
@@ -236,10 +216,8 @@ Checkpoint *checkpoint_new(const char *path, uint64_t digest, const RayesRenderO
     snprintf(c->path, sizeof c->path, "%s", path);
     snprintf(c->tmp, sizeof c->tmp, "%s.tmp", path);
     c->digest = digest;
-    c->width = o->width, c->height = o->height, c->ts = o->tile_size > 0 ? o->tile_size : 1;
-    crop_pixels(o, c->crop);
-    c->tiles_x = (c->crop[2] - c->crop[0] + c->ts - 1) / c->ts;
-    c->tiles_y = (c->crop[3] - c->crop[1] + c->ts - 1) / c->ts;
+    c->width = o->width, c->height = o->height;
+    c->g = tile_grid(o);
     c->every_s = every_s;
     c->last_save = time_now();
     c->state = calloc((size_t)n_tiles(c) + 1, 1);
@@ -283,7 +261,7 @@ void checkpoint_fill(const Checkpoint *c, RayesImage *img)
         if (c->state[t] != TILE_RESUMED)
             continue;
         int q[4];
-        tile_rect(c, t, q);
+        tile_rect(&c->g, t, q);
         for (int y = 0; y < q[3]; y++) {
             size_t at = 4 * ((size_t)(q[1] + y) * c->width + q[0]);
             memcpy(&img->rgba[at], &c->rgba[at], sizeof(float) * 4 * (size_t)q[2]);
