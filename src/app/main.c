@@ -27,6 +27,7 @@
 
 #include "app/checkpoint.h"
 #include "app/cli.h"
+#include "app/distribute.h"
 #include "app/view.h"
 
 typedef struct Progress {
@@ -264,8 +265,9 @@ static RayesError write_output(const Output *o, const RayesImage *img, char *err
 
 /* Renders frame `frame` of a's scene (-1: as --frame says) to its outputs,
  * whose '#' runs become the frame number `number` (zero-padded to the
- * run's length; -1: none). Returns the exit status. */
-static int render_job(Args a, int frame, int number);
+ * run's length; -1: none), as one rank of d (NULL: one process). Returns
+ * the exit status. */
+static int render_job(Args a, int frame, int number, Distributed *d);
 
 /* --frames LIST: comma-separated N, N-M or N-MxS (a step), into a new
  * array of *n frame numbers; dies with a usage error on anything else. */
@@ -330,9 +332,17 @@ static int frame_path(const char *path, int number, char *out, size_t size)
 static int cmd_render(int argc, char **argv)
 {
     Args a = {0};
+    Distributed *d = distribute_begin(&argc, &argv);
     parse_args(argc, argv, &a);
-    if (!a.frames)
-        return render_job(a, a.frame, -1);
+    if (d && (a.checkpoint_s >= 0.0 || a.resume))
+        die_usage("--checkpoint and --resume are for one process, not an MPI job");
+    if (distribute_rank(d) != 0) /* rank 0 speaks for the job */
+        a.quiet = 1, a.progress_json = 0, a.stats_path = NULL;
+    if (!a.frames) {
+        int status = render_job(a, a.frame, -1, d);
+        distribute_end(d);
+        return status;
+    }
     size_t n;
     int *frames = parse_frames(a.frames, &n);
     for (int i = 0; i < a.n_outputs && n > 1; i++)
@@ -342,8 +352,9 @@ static int cmd_render(int argc, char **argv)
                       a.outputs[i].path);
     int status = 0;
     for (size_t i = 0; i < n && status == 0; i++)
-        status = render_job(a, frames[i], frames[i]);
+        status = render_job(a, frames[i], frames[i], d);
     free(frames);
+    distribute_end(d);
     return status;
 }
 
@@ -366,7 +377,7 @@ static Checkpoint *open_checkpoint(Args *a, int frame)
     return ck;
 }
 
-static int render_job(Args a, int frame, int number)
+static int render_job(Args a, int frame, int number, Distributed *d)
 {
     for (int i = 0; i < a.n_outputs && number >= 0; i++) {
         char path[sizeof a.outputs[i].path];
@@ -445,7 +456,23 @@ static int render_job(Args a, int frame, int number)
     signal(SIGTERM, on_signal);
     RayesImage *img = NULL;
     RayesStats *stats = NULL;
+    if (d && distribute_frame_begin(d, &a.opt, err, sizeof err) != 0) {
+        fprintf(stderr, "rayes: %s\n", err);
+        rayes_scene_release(scene);
+        return 1;
+    }
     e = rayes_render(scene, &a.opt, &img, &stats);
+    if (d && distribute_frame_end(d, e == RAYES_OK ? img : NULL, stats, err, sizeof err) != 0 &&
+        e == RAYES_OK) {
+        fprintf(stderr, "rayes: %s\n", err);
+        e = RAYES_ERROR_CANCELLED;
+    }
+    if (e == RAYES_OK && distribute_rank(d) != 0) { /* rank 0 writes the frame */
+        rayes_stats_free(stats);
+        rayes_image_free(img);
+        rayes_scene_release(scene);
+        return 0;
+    }
     if (e != RAYES_OK) {
         fprintf(stderr, "rayes: %s\n", rayes_scene_get_error(scene));
         if (ck && a.checkpoint_s >= 0.0 && e == RAYES_ERROR_CANCELLED &&
@@ -494,6 +521,7 @@ static int render_job(Args a, int frame, int number)
         fflush(stdout);
     } else if (status == 0 && !a.quiet) {
         summary(&a, stats);
+        distribute_print_summary(d, stdout);
         for (int i = 0; i < a.n_outputs; i++)
             printf("  wrote         %s\n", a.outputs[i].path);
     }
