@@ -676,6 +676,14 @@ typedef struct RayesRenderOptions {
                                   (a voxel projects to about a pixel at the volume's nearest
                                   point, times the square root of its shading rate): default
                                   1; larger is faster and coarser */
+    int subsurface_rays;       /* subsurface rays per shading point of a subsurface material
+                                  (memo 6.2): 4 in the preview preset, 64 in final and
+                                  reference */
+    int irradiance_cache;      /* 1 (default): the irradiance subsurface rays find is cached
+                                  per grid at the three resolutions, data type irradiance
+                                  (memo 6.2); 0: the shader runs at every subsurface hit */
+    double irradiance_cache_mb; /* the irradiance entries' budget in megabytes (10^6 bytes),
+                                  default 20, apart from cache_mb */
 } RayesRenderOptions;
 
 /* Fills options with the defaults of a quality preset: 512 x 512, 4 pixel
