@@ -168,8 +168,8 @@ typedef enum RayesShaderFlags {
 typedef enum RayesSubsurfaceProfile {
     RAYES_SUBSURFACE_DIPOLE = 0, /* Jensen et al. 2001, the memo's */
     RAYES_SUBSURFACE_BURLEY = 1  /* Christensen and Burley 2015's normalized diffusion,
-                                    of the dipole's total diffuse reflectance and volume
-                                    mean free path */
+                                    of the dipole's total diffuse reflectance and diffuse
+                                    mean free path 1 / sigma_tr */
 } RayesSubsurfaceProfile;
 
 /* A homogeneous scattering medium under the surface, per RGB channel. */

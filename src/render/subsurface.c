@@ -103,8 +103,8 @@ static Vec3 integrate_point(Worker *w, const Medium *m, const SubsurfacePoint *s
         w->stats.rays_subsurface++;
         if (!accel_intersect_object(w->rs->accel, sp->object, &ray, &hit))
             continue; /* an open object: the ray left it */
-        float cos_x = fmaxf(fabsf(v3_dot(hit.Ng, ray.d)), SUBSURFACE_MIN_COS);
-        float area = share * hit.t * hit.t / cos_x * mm2; /* mm^2 */
+        float cos_x = fabsf(v3_dot(hit.Ng, ray.d));
+        float area = diffusion_sample_area(n, hit.t, cos_x, SUBSURFACE_MIN_COS) * mm2; /* mm^2 */
         Vec3 E = irradiance_at(w, &ray, &hit, spread, hash_combine(sp->key, (uint64_t)s + 1));
         float r = v3_length(v3_sub(v3_madd(c, ray.d, hit.t), sp->P)) / m->scale; /* mm */
         sum.x += diffusion_profile(&m->ch[0], r) * E.x * area;

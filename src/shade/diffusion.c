@@ -55,10 +55,11 @@ void diffusion_channel(const RayesSubsurfaceParams *p, int c, DiffusionChannel *
     ch->zr = 1.0f / st;
     ch->zv = ch->zr * (1.0f + 4.0f / 3.0f * diffusion_A(eta));
     ch->Rd = diffusion_total_reflectance(ch->alpha, eta);
-    /* Burley's fit of s for the volume mean free path l = 1 / sigma_t'
-     * (Christensen and Burley 2015, eq. 6), given the dipole's albedo. */
-    float a = ch->Rd - 0.33f;
-    ch->d = ch->zr / (3.5f + 100.0f * a * a * a * a);
+    /* Burley's fit of s for the diffuse mean free path 1 / sigma_tr
+     * (Christensen and Burley 2015, eq. 5), given the dipole's albedo: the
+     * same total reflectance and the same reach as the dipole's. */
+    float a = fabsf(ch->Rd - 0.8f);
+    ch->d = 1.0f / (ch->sigma_tr * (1.85f - ch->Rd + 7.0f * a * a * a));
 }
 
 /* Jensen 2001, eq. 4: the real source at depth zr and the virtual one at

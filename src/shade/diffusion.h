@@ -21,7 +21,7 @@ typedef struct DiffusionChannel {
     float sigma_tr;  /* effective transport coefficient sqrt(3 sigma_a sigma_t'), per mm */
     float zr, zv;    /* dipole: depths of the real and virtual sources, mm */
     float Rd;        /* total diffuse reflectance (the profile's integral over the plane) */
-    float d;         /* Burley: the shape parameter l / s, mm */
+    float d;         /* Burley: the shape parameter dmfp / s, mm (dmfp = 1 / sigma_tr) */
 } DiffusionChannel;
 
 /* Donner and Jensen's fit of the diffuse Fresnel reflectance for relative
@@ -44,6 +44,15 @@ void diffusion_channel(const RayesSubsurfaceParams *p, int c, DiffusionChannel *
 /* The profile R(r) per mm^2 at distance r mm: its integral over the plane,
  * 2 pi r R(r) dr, is ch->Rd. */
 float diffusion_profile(const DiffusionChannel *ch, float r);
+
+/* The surface area (t's units squared) one of n rays cast uniformly over
+ * the sphere stands for where it hits a surface at distance t and cosine
+ * cos_x between the ray and the surface's normal (memo 6.2): 4 pi / n t^2 /
+ * cos_x, cos_x clamped below at min_cos. */
+static inline float diffusion_sample_area(int n, float t, float cos_x, float min_cos)
+{
+    return 4.0f * 3.14159265358979f / (float)n * t * t / (cos_x > min_cos ? cos_x : min_cos);
+}
 
 /* The medium of total diffuse reflectance Rd and diffuse mean free path
  * dmfp (mm, 1 / sigma_tr; RenderMan's classic "albedo" and
