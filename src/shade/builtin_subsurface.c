@@ -43,6 +43,7 @@ typedef struct SubsurfaceParams {
     float reflectance[3];      /* pbrt: total diffuse reflectance ... */
     float mfp[3];              /* ... and 1 / sigma_t', mm (0: unused) */
     float eta;                 /* index of refraction of the medium */
+    float ior;                 /* RenderMan's name for it; 0: unset, eta counts */
     float unitlength;          /* scene units per mm */
     float Kd, Ks, roughness;   /* subsurface weight, coat weight, coat roughness */
     float samples;             /* subsurface rays (0: the renderer's setting) */
@@ -51,7 +52,7 @@ typedef struct SubsurfaceParams {
 /* The service's medium of the parameters. */
 static void medium(const SubsurfaceParams *p, RayesSubsurfaceParams *m)
 {
-    m->eta = p->eta > 0.0f ? p->eta : 1.3f;
+    m->eta = p->ior > 0.0f ? p->ior : p->eta > 0.0f ? p->eta : 1.3f;
     m->scale = p->unitlength > 0.0f ? p->unitlength : 1.0f;
     m->profile = strcasecmp(p->profile, "burley") == 0 ? RAYES_SUBSURFACE_BURLEY
                                                        : RAYES_SUBSURFACE_DIPOLE;
@@ -183,6 +184,7 @@ static const RayesShaderParamDesc subsurface_params[] = {
     {"reflectance", RAYES_PARAM_COLOR, P_(reflectance), {0.8f, 0.8f, 0.8f}},
     {"mfp", RAYES_PARAM_COLOR, P_(mfp), {0, 0, 0}},
     {"eta", RAYES_PARAM_FLOAT, P_(eta), {1.3f, 0, 0}},
+    {"ior", RAYES_PARAM_FLOAT, P_(ior), {0, 0, 0}},
     {"unitlength", RAYES_PARAM_FLOAT, P_(unitlength), {1.0f, 0, 0}},
     {"Kd", RAYES_PARAM_FLOAT, P_(Kd), {1.0f, 0, 0}},
     {"Ks", RAYES_PARAM_FLOAT, P_(Ks), {1.0f, 0, 0}},

@@ -62,12 +62,9 @@ static inline float diffusion_sample_area(int n, float t, float cos_x, float min
 void diffusion_from_dmfp(float Rd, float dmfp, float eta, float *sigma_s, float *sigma_a);
 void diffusion_from_mfp(float Rd, float mfp, float eta, float *sigma_s, float *sigma_a);
 
-/* Jensen 2001's measured media (Figure 5, per mm, eta 1.3), by name
- * (case-insensitive; "skin1", "marble", "wholemilk", ...). Returns 0 and
- * fills sigma_s' and sigma_a, or -1 for an unknown name. */
+/* Jensen 2001's measured media (Figure 5, per mm, eta 1.3; util/media.h),
+ * by name (case-insensitive; "skin1", "marble", "wholemilk", ...). Returns
+ * 0 and fills sigma_s' and sigma_a, or -1 for an unknown name. */
 int diffusion_preset(const char *name, float sigma_s[3], float sigma_a[3]);
-
-/* The preset names, NULL-terminated (for messages and docs). */
-extern const char *const diffusion_preset_names[];
 
 #endif /* RAYES_SHADE_DIFFUSION_H */

@@ -154,6 +154,30 @@ static void test_thick_slab_reflects_dipole_rd(void)
     }
 }
 
+/* RenderMan's classic parameters: albedo is the total diffuse reflectance
+ * and diffusemeanfreepath 1 / sigma_tr, in mm times unitlength scene
+ * units: a thick slab lit from above reflects albedo E / pi (1 - F0),
+ * F0 of ior 1.4. */
+static void test_renderman_albedo_and_mean_free_path(void)
+{
+    RayesScene *s = new_scene();
+    RayesParam p[5] = {{"albedo", RAYES_PARAM_COLOR, {0.8f, 0.5f, 0.2f}, NULL},
+                       {"diffusemeanfreepath", RAYES_PARAM_COLOR, {4.0f, 2.0f, 1.0f}, NULL},
+                       pf("ior", 1.4f), pf("unitlength", 2.0f), pf("Ks", 0.0f)};
+    CHECK(rayes_scene_set_shader(s, "subsurface", p, 5) == RAYES_OK);
+    slab(s, 400.0f, -60.0f, 0);
+    distant_light(s, 1.0f);
+    RayesImage *img = render(s, 2, 256, 1, 20.0);
+    double got[3], f0 = pow(0.4 / 2.4, 2.0);
+    mean_rgb(img, got);
+    for (int c = 0; c < 3; c++) {
+        double want = p[0].value[c] / M_PI * (1.0 - f0);
+        CHECK_NEAR(got[c], want, 0.03 * want);
+    }
+    rayes_image_free(img);
+    rayes_scene_release(s);
+}
+
 /* Mean brightness of the top of a 6 mm marble slab lit from below. */
 static double backlit_top(int blocker)
 {
@@ -266,7 +290,7 @@ static void test_same_image_whatever_threads_and_budget(void)
     rayes_scene_release(s);
 }
 
-TEST_MAIN(TEST(test_thick_slab_reflects_dipole_rd),
+TEST_MAIN(TEST(test_thick_slab_reflects_dipole_rd), TEST(test_renderman_albedo_and_mean_free_path),
           TEST(test_light_bleeds_through_and_blockers_stop_it),
           TEST(test_rays_never_leave_their_object), TEST(test_cached_matches_uncached),
           TEST(test_same_image_whatever_threads_and_budget))

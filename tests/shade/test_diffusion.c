@@ -11,6 +11,7 @@
 #include <math.h>
 
 #include "shade/diffusion.h"
+#include "util/media.h"
 #include "test.h"
 
 /* Jensen 2001 eq. 8, written from the paper, not from diffusion.c. */
@@ -37,9 +38,9 @@ static double plane_integral(const DiffusionChannel *ch, double far)
 
 static void test_dipole_integrates_to_closed_form_rd(void)
 {
-    for (int i = 0; diffusion_preset_names[i]; i++) {
+    for (int i = 0; media_measured[i].name; i++) {
         RayesSubsurfaceParams p = {.eta = 1.3f, .scale = 1.0f, .profile = RAYES_SUBSURFACE_DIPOLE};
-        CHECK(diffusion_preset(diffusion_preset_names[i], p.sigma_s, p.sigma_a) == 0);
+        CHECK(diffusion_preset(media_measured[i].name, p.sigma_s, p.sigma_a) == 0);
         for (int c = 0; c < 3; c++) {
             if (p.sigma_a[c] <= 0.0f)
                 continue; /* spectralon: no absorption, no finite reach */
