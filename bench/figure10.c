@@ -16,9 +16,12 @@
  *
  *   figure10 [--size 256] [--final-size 192] [--spp 16] [--threads 2] [--mb 20]
  *            [--coat 1] [--data DIR] [--out DIR] [--only preview|final]
+ *            [--medium marble] [--profile dipole] [--images-only 0]
  *
  * --coat 0 takes the specular coat off (Ks 0): only the subsurface term
- * and what it costs are left on the teapot.
+ * and what it costs are left on the teapot. --medium (a preset: skin1,
+ * ketchup, ...) and --profile (burley) change the material;
+ * --images-only 1 renders the cached images alone (no timing).
  *
  * Prints, per quality: subsurface rays, shadow rays, irradiance shading
  * points, render times off and on and the speed-up, the irradiance cache's
@@ -39,9 +42,9 @@
 #include "rayes/rayes.h"
 
 typedef struct Args {
-    int size, final_size, spp, threads, coat;
+    int size, final_size, spp, threads, coat, images_only;
     double mb;
-    const char *data, *out, *only;
+    const char *data, *out, *only, *medium, *profile;
 } Args;
 
 static void die(const char *msg)
@@ -61,7 +64,7 @@ static int parse_int(const char *s, int lo, int hi)
 
 static Args parse(int argc, char **argv)
 {
-    Args a = {256, 192, 16, 2, 1, 20.0, NULL, "out/figure10", NULL};
+    Args a = {256, 192, 16, 2, 1, 0, 20.0, NULL, "out/figure10", NULL, "marble", "dipole"};
     for (int i = 1; i < argc; i++) {
         const char *o = argv[i], *v = i + 1 < argc ? argv[i + 1] : NULL;
         if (!v)
@@ -84,9 +87,16 @@ static Args parse(int argc, char **argv)
             a.out = v;
         else if (!strcmp(o, "--only"))
             a.only = v;
+        else if (!strcmp(o, "--medium"))
+            a.medium = v;
+        else if (!strcmp(o, "--profile"))
+            a.profile = v;
+        else if (!strcmp(o, "--images-only"))
+            a.images_only = parse_int(v, 0, 1);
         else
             die("usage: figure10 [--size N] [--final-size N] [--spp N] [--threads N] [--mb MB] "
-                "[--coat 0|1] [--data DIR] [--out DIR] [--only preview|final]");
+                "[--coat 0|1] [--data DIR] [--out DIR] [--only preview|final] [--medium NAME] "
+                "[--profile dipole|burley] [--images-only 1]");
         i++;
     }
     if (!a.data)
@@ -109,17 +119,19 @@ static void check(RayesScene *s, RayesError e)
 
 /* The teapot's data is z up, 6.4 units across: world = S(12) * (x, z, -y),
  * turned 30 degrees about y so the spout comes toward the camera. */
-static void teapot(RayesScene *s, const char *data, int coat)
+static void teapot(RayesScene *s, const Args *a)
 {
     double th = 30.0 * M_PI / 180.0;
     float c = (float)cos(th), sn = (float)sin(th), k = 12.0f;
     const float m[16] = {k * c, -k * sn, 0, 0, 0, 0, k, 0, -k * sn, -k * c, 0, 0, 0, 0, 0, 1};
-    RayesParam p[4] = {(RayesParam){"preset", RAYES_PARAM_STRING, {0, 0, 0}, "marble"},
-                       pf("roughness", 0.08f), pf("unitlength", 2.0f), pf("Ks", coat ? 1.0f : 0.0f)};
-    check(s, rayes_scene_set_shader(s, "subsurface", p, 4));
+    RayesParam p[5] = {(RayesParam){"preset", RAYES_PARAM_STRING, {0, 0, 0}, a->medium},
+                       (RayesParam){"profile", RAYES_PARAM_STRING, {0, 0, 0}, a->profile},
+                       pf("roughness", 0.08f), pf("unitlength", 2.0f),
+                       pf("Ks", a->coat ? 1.0f : 0.0f)};
+    check(s, rayes_scene_set_shader(s, "subsurface", p, 5));
     check(s, rayes_scene_set_transform(s, m));
     char path[4096], err[1024];
-    snprintf(path, sizeof path, "%s/teapot.bpt", data);
+    snprintf(path, sizeof path, "%s/teapot.bpt", a->data);
     IoSink sink = io_sink_scene(s);
     if (io_read_bpt(path, &sink, err, sizeof err) != RAYES_OK)
         die(err);
@@ -127,7 +139,7 @@ static void teapot(RayesScene *s, const char *data, int coat)
     check(s, rayes_scene_set_transform(s, identity));
 }
 
-static RayesScene *scene(const char *data, int coat)
+static RayesScene *scene(const Args *a)
 {
     RayesScene *s = rayes_scene_new();
     const float eye[3] = {0, 55, 130}, at[3] = {0, 17, 0}, up[3] = {0, 1, 0};
@@ -136,7 +148,7 @@ static RayesScene *scene(const char *data, int coat)
     check(s, rayes_scene_set_shader(s, "matte", m, 2));
     const float P[4][3] = {{-300, 0, -300}, {300, 0, -300}, {-300, 0, 300}, {300, 0, 300}};
     check(s, rayes_scene_bilinear_patch(s, P));
-    teapot(s, data, coat);
+    teapot(s, a);
     const float at_back[16] = {1, 0, 0, -30, 0, 1, 0, 60, 0, 0, 1, -110, 0, 0, 0, 1};
     static const float identity[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
     RayesParam back[3] = {(RayesParam){"shape", RAYES_PARAM_STRING, {0, 0, 0}, "sphere"},
@@ -297,14 +309,37 @@ static int quality(RayesScene *s, const Args *a, int final)
     return same_threads && same_budget;
 }
 
+/* --images-only: the cached render of each quality asked for, to
+ * DIR/figure10-MEDIUM-PROFILE-QUALITY.png. */
+static void images(RayesScene *s, const Args *a)
+{
+    for (int final = 0; final < 2; final++) {
+        const char *q = final ? "final" : "preview";
+        if (a->only && strcmp(a->only, q))
+            continue;
+        Run r = run(s, a, final, 1, a->threads, a->mb);
+        char name[256];
+        snprintf(name, sizeof name, "%s-%s", a->medium, a->profile);
+        write(a, q, name, r.img, r.img->rgba);
+        printf("%s %s: %.2f s\n", name, q, r.seconds);
+        rayes_image_free(r.img);
+        rayes_stats_free(r.st);
+    }
+}
+
 int main(int argc, char **argv)
 {
     Args a = parse(argc, argv);
-    RayesScene *s = scene(a.data, a.coat);
+    RayesScene *s = scene(&a);
     mkdir(a.out, 0777);
-    printf("memo Figure 10: a marble teapot lit from behind (subsurface scattering, dipole), "
-           "coat %s\n", a.coat ? "on" : "off");
+    printf("memo Figure 10: a %s teapot lit from behind (subsurface scattering, %s), coat %s\n",
+           a.medium, a.profile, a.coat ? "on" : "off");
     int ok = 1;
+    if (a.images_only) {
+        images(s, &a);
+        rayes_scene_release(s);
+        return 0;
+    }
     if (!a.only || !strcmp(a.only, "preview"))
         ok &= quality(s, &a, 0);
     if (!a.only || !strcmp(a.only, "final"))
