@@ -55,11 +55,11 @@ RayesStats *session_stats_new(const RenderSettings *set, const RenderStats *rs, 
     count(s, "rays/diffuse", rs->rays_diffuse);
     count(s, "rays/specular", rs->rays_specular);
     count(s, "rays/transmission", rs->rays_transmission); /* of rays/shadow: they marched */
+    count(s, "rays/subsurface", rs->rays_subsurface);     /* not in rays/total */
     count(s, "lighting/ambient_points", rs->ambient_lookups);
     count(s, "opacity/shading_points", rs->opacity_points);
     count(s, "opacity/transparent_hits", rs->transparent_hits);
     count(s, "volume/steps", rs->volume_steps);
-    count(s, "rays/subsurface", rs->rays_subsurface); /* not in rays/total */
     count(s, "subsurface/points", rs->subsurface_points);
     count(s, "subsurface/irradiance_points", rs->irradiance_points);
     count(s, "grids", gs->n_grids);
