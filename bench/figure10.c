@@ -249,9 +249,8 @@ static void print_cache(const RayesStats *st)
         snprintf(name, sizeof name, "cache/irradiance/%s/hit_rate", levels[l]);
         double rate = stat_real(st, name);
         snprintf(name, sizeof name, "cache/irradiance/%s/entries", levels[l]);
-        printf("  irradiance cache %-6s %12llu lookups, hit rate %.4f, %llu entries\n",
-               levels[l], (unsigned long long)lookups, rate,
-               (unsigned long long)stat_count(st, name));
+        printf("  irradiance cache %-6s %12llu lookups, hit rate %.4f, %llu entries\n", levels[l],
+               (unsigned long long)lookups, rate, (unsigned long long)stat_count(st, name));
     }
 }
 
@@ -269,8 +268,8 @@ static int quality(RayesScene *s, const Args *a, int final)
            "budget %g MB\n",
            q, on.img->width, on.img->height, a->spp, final ? 64 : 4, final ? 64 : 4, a->threads,
            a->mb);
-    printf("%-10s %14s %14s %14s %10s\n", "irradiance", "subsurface", "shadow rays",
-           "irr. points", "render s");
+    printf("%-10s %14s %14s %14s %10s\n", "irradiance", "subsurface", "shadow rays", "irr. points",
+           "render s");
     const Run *rows[2] = {&off, &on};
     for (int k = 0; k < 2; k++)
         printf("%-10s %14llu %14llu %14llu %10.2f\n", k ? "cached" : "uncached",

@@ -130,9 +130,12 @@ void subsurface_service(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
             v3_store(out[i], v3(0, 0, 0));
             continue;
         }
-        SubsurfacePoint sp = {v3_load(ctx->P[i]), v3_load(ctx->N[i]), v3_load(ctx->Ng[i]),
-                              ps->offset[j], gs->grids[ps->grid].object,
-                              hash_combine(ps->keys[j], DIM_SUBSURFACE)};
+        SubsurfacePoint sp = {.P = v3_load(ctx->P[i]),
+                              .N = v3_load(ctx->N[i]),
+                              .Ng = v3_load(ctx->Ng[i]),
+                              .offset = ps->offset[j],
+                              .object = gs->grids[ps->grid].object,
+                              .key = hash_combine(ps->keys[j], DIM_SUBSURFACE)};
         w->stats.subsurface_points++;
         v3_store(out[i], integrate_point(w, &m, &sp, n));
     }

@@ -34,19 +34,19 @@
 #include "util/log.h"
 
 typedef struct SubsurfaceParams {
-    char preset[64];           /* a measured medium's name, or "" */
-    char profile[64];          /* "dipole" or "burley" */
-    float sigma_s[3];          /* reduced scattering coefficient, per mm */
-    float sigma_a[3];          /* absorption coefficient, per mm */
-    float albedo[3];           /* RenderMan: total diffuse reflectance ... */
+    char preset[64];              /* a measured medium's name, or "" */
+    char profile[64];             /* "dipole" or "burley" */
+    float sigma_s[3];             /* reduced scattering coefficient, per mm */
+    float sigma_a[3];             /* absorption coefficient, per mm */
+    float albedo[3];              /* RenderMan: total diffuse reflectance ... */
     float diffusemeanfreepath[3]; /* ... and 1 / sigma_tr, mm (0: unused) */
-    float reflectance[3];      /* pbrt: total diffuse reflectance ... */
-    float mfp[3];              /* ... and 1 / sigma_t', mm (0: unused) */
-    float eta;                 /* index of refraction of the medium */
-    float ior;                 /* RenderMan's name for it; 0: unset, eta counts */
-    float unitlength;          /* scene units per mm */
-    float Kd, Ks, roughness;   /* subsurface weight, coat weight, coat roughness */
-    float samples;             /* subsurface rays (0: the renderer's setting) */
+    float reflectance[3];         /* pbrt: total diffuse reflectance ... */
+    float mfp[3];                 /* ... and 1 / sigma_t', mm (0: unused) */
+    float eta;                    /* index of refraction of the medium */
+    float ior;                    /* RenderMan's name for it; 0: unset, eta counts */
+    float unitlength;             /* scene units per mm */
+    float Kd, Ks, roughness;      /* subsurface weight, coat weight, coat roughness */
+    float samples;                /* subsurface rays (0: the renderer's setting) */
 } SubsurfaceParams;
 
 /* The service's medium of the parameters. */
@@ -54,8 +54,8 @@ static void medium(const SubsurfaceParams *p, RayesSubsurfaceParams *m)
 {
     m->eta = p->ior > 0.0f ? p->ior : p->eta > 0.0f ? p->eta : 1.3f;
     m->scale = p->unitlength > 0.0f ? p->unitlength : 1.0f;
-    m->profile = strcasecmp(p->profile, "burley") == 0 ? RAYES_SUBSURFACE_BURLEY
-                                                       : RAYES_SUBSURFACE_DIPOLE;
+    m->profile =
+        strcasecmp(p->profile, "burley") == 0 ? RAYES_SUBSURFACE_BURLEY : RAYES_SUBSURFACE_DIPOLE;
     if (p->preset[0] && diffusion_preset(p->preset, m->sigma_s, m->sigma_a) == 0)
         return;
     if (p->preset[0]) {
@@ -89,7 +89,7 @@ static float schlick(float cos_o, float eta)
     return f0 + (1.0f - f0) * m * m * m * m * m;
 }
 
-#define HAS(sv, m) \
+#define HAS(sv, m)                                                                                 \
     ((sv)->struct_size >= offsetof(RayesShaderServices, m) + sizeof((sv)->m) && (sv)->m != NULL)
 
 static void lighting_chunk(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
@@ -113,8 +113,7 @@ static void lighting_chunk(const RayesShaderServices *sv, const RayesShadeCtx *c
                       ctx->I[i][2] * ctx->N[i][2]);
         float F = schlick(cos_o, m.eta);
         for (int c = 0; c < 3; c++)
-            out->Ci[i][c] = cs(ctx, i, c) * p->Kd * (1.0f - F) * sss[i][c] +
-                            p->Ks * F * spec[i][c];
+            out->Ci[i][c] = cs(ctx, i, c) * p->Kd * (1.0f - F) * sss[i][c] + p->Ks * F * spec[i][c];
     }
 }
 

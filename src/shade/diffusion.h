@@ -16,12 +16,12 @@
 
 /* One channel of a medium, ready for the profile. */
 typedef struct DiffusionChannel {
-    int profile;     /* RayesSubsurfaceProfile */
-    float alpha;     /* reduced albedo alpha' = sigma_s' / sigma_t' */
-    float sigma_tr;  /* effective transport coefficient sqrt(3 sigma_a sigma_t'), per mm */
-    float zr, zv;    /* dipole: depths of the real and virtual sources, mm */
-    float Rd;        /* total diffuse reflectance (the profile's integral over the plane) */
-    float d;         /* Burley: the shape parameter dmfp / s, mm (dmfp = 1 / sigma_tr) */
+    int profile;    /* RayesSubsurfaceProfile */
+    float alpha;    /* reduced albedo alpha' = sigma_s' / sigma_t' */
+    float sigma_tr; /* effective transport coefficient sqrt(3 sigma_a sigma_t'), per mm */
+    float zr, zv;   /* dipole: depths of the real and virtual sources, mm */
+    float Rd;       /* total diffuse reflectance (the profile's integral over the plane) */
+    float d;        /* Burley: the shape parameter dmfp / s, mm (dmfp = 1 / sigma_tr) */
 } DiffusionChannel;
 
 /* Donner and Jensen's fit of the diffuse Fresnel reflectance for relative

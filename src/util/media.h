@@ -9,9 +9,9 @@
 #define RAYES_UTIL_MEDIA_H
 
 typedef struct MeasuredMedium {
-    const char *name;  /* lower case: "skin1", "marble", "wholemilk", ... */
-    float sigma_s[3];  /* reduced scattering coefficient sigma_s', per mm */
-    float sigma_a[3];  /* absorption coefficient, per mm */
+    const char *name; /* lower case: "skin1", "marble", "wholemilk", ... */
+    float sigma_s[3]; /* reduced scattering coefficient sigma_s', per mm */
+    float sigma_a[3]; /* absorption coefficient, per mm */
 } MeasuredMedium;
 
 /* The medium of that name (case-insensitive), or NULL. */

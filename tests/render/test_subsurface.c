@@ -36,8 +36,8 @@ static RayesScene *new_scene(void)
 {
     RayesScene *s = rayes_scene_new();
     static const float eye[3] = {0, 0, 400}, at[3] = {0, 0, 0}, up[3] = {0, 1, 0};
-    CHECK(rayes_scene_set_camera(s, eye, at, up, (float)(2.0 * atan(20.0 / 400.0) * 180.0 / M_PI)) ==
-          RAYES_OK);
+    CHECK(rayes_scene_set_camera(s, eye, at, up,
+                                 (float)(2.0 * atan(20.0 / 400.0) * 180.0 / M_PI)) == RAYES_OK);
     return s;
 }
 
@@ -163,7 +163,9 @@ static void test_renderman_albedo_and_mean_free_path(void)
     RayesScene *s = new_scene();
     RayesParam p[5] = {{"albedo", RAYES_PARAM_COLOR, {0.8f, 0.5f, 0.2f}, NULL},
                        {"diffusemeanfreepath", RAYES_PARAM_COLOR, {4.0f, 2.0f, 1.0f}, NULL},
-                       pf("ior", 1.4f), pf("unitlength", 2.0f), pf("Ks", 0.0f)};
+                       pf("ior", 1.4f),
+                       pf("unitlength", 2.0f),
+                       pf("Ks", 0.0f)};
     CHECK(rayes_scene_set_shader(s, "subsurface", p, 5) == RAYES_OK);
     slab(s, 400.0f, -60.0f, 0);
     distant_light(s, 1.0f);

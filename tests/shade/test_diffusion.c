@@ -11,8 +11,8 @@
 #include <math.h>
 
 #include "shade/diffusion.h"
-#include "util/media.h"
 #include "test.h"
+#include "util/media.h"
 
 /* Jensen 2001 eq. 8, written from the paper, not from diffusion.c. */
 static double closed_form(double alpha, double eta)
@@ -84,9 +84,9 @@ static void test_conversions_round_trip(void)
         diffusion_channel(&p, 0, &ch);
         CHECK_NEAR(ch.Rd, Rd[k], 1e-4);
         CHECK_NEAR(1.0 / (ss + sa), len[k], 1e-4 * len[k]);
-        CHECK_NEAR(diffusion_total_reflectance(diffusion_albedo_from_reflectance(Rd[k], 1.4f),
-                                               1.4f),
-                   Rd[k], 1e-5);
+        CHECK_NEAR(
+            diffusion_total_reflectance(diffusion_albedo_from_reflectance(Rd[k], 1.4f), 1.4f),
+            Rd[k], 1e-5);
     }
 }
 
@@ -117,7 +117,7 @@ static void test_area_estimate_integrates_a_sphere(void)
 static void test_presets_by_name(void)
 {
     float s[3], a[3];
-    static const char *const jensen[9] = {"skin1", "Skin2", "marble", "ketchup", "apple",
+    static const char *const jensen[9] = {"skin1", "Skin2",     "marble",   "ketchup", "apple",
                                           "cream", "wholemilk", "skimmilk", "potato"};
     for (int i = 0; i < 9; i++)
         CHECK(diffusion_preset(jensen[i], s, a) == 0);
