@@ -154,6 +154,32 @@ static void test_thick_slab_reflects_dipole_rd(void)
     }
 }
 
+/* A white furnace: a medium of albedo 1 (no absorption; sigma_s' 100 per
+ * mm, so the diffusion reaches about 2 mm) in uniform light of radiance 1
+ * from every direction (E = pi on the slab's top) gives back all but the
+ * dipole's own shortfall and the coat's Fresnel: Rd(alpha' -> 1) (1 -
+ * F0), Rd from the closed form at the renderer's largest albedo. */
+static void test_white_furnace_conserves_energy(void)
+{
+    RayesScene *s = new_scene();
+    RayesParam p[3] = {{"sigma_s", RAYES_PARAM_COLOR, {100, 100, 100}, NULL},
+                       {"sigma_a", RAYES_PARAM_COLOR, {0, 0, 0}, NULL},
+                       pf("Ks", 0.0f)};
+    CHECK(rayes_scene_set_shader(s, "subsurface", p, 3) == RAYES_OK);
+    slab(s, 400.0f, -60.0f, 0);
+    RayesParam env[1] = {pf("intensity", 1.0f)};
+    CHECK(rayes_scene_light(s, "environmentlight", env, 1) == RAYES_OK);
+    RayesImage *img = render(s, 2, 64, 1, 20.0);
+    double got[3], f0 = pow(0.3 / 2.3, 2.0),
+                   want = rd_closed_form(0.99999, 0.00001, 1.3) * (1 - f0);
+    mean_rgb(img, got);
+    CHECK(want > 0.95);
+    for (int c = 0; c < 3; c++)
+        CHECK_NEAR(got[c], want, 0.03 * want);
+    rayes_image_free(img);
+    rayes_scene_release(s);
+}
+
 /* RenderMan's classic parameters: albedo is the total diffuse reflectance
  * and diffusemeanfreepath 1 / sigma_tr, in mm times unitlength scene
  * units: a thick slab lit from above reflects albedo E / pi (1 - F0),
@@ -292,7 +318,8 @@ static void test_same_image_whatever_threads_and_budget(void)
     rayes_scene_release(s);
 }
 
-TEST_MAIN(TEST(test_thick_slab_reflects_dipole_rd), TEST(test_renderman_albedo_and_mean_free_path),
+TEST_MAIN(TEST(test_thick_slab_reflects_dipole_rd), TEST(test_white_furnace_conserves_energy),
+          TEST(test_renderman_albedo_and_mean_free_path),
           TEST(test_light_bleeds_through_and_blockers_stop_it),
           TEST(test_rays_never_leave_their_object), TEST(test_cached_matches_uncached),
           TEST(test_same_image_whatever_threads_and_budget))
