@@ -15,11 +15,12 @@
  * the subsurface integral.
  *
  *   figure10 [--size 256] [--final-size 192] [--spp 16] [--threads 2] [--mb 20]
- *            [--coat 1] [--data DIR] [--out DIR] [--only preview|final]
+ *            [--coat 1] [--floor 1] [--data DIR] [--out DIR] [--only preview|final]
  *            [--medium marble] [--profile dipole] [--images-only 0]
  *
- * --coat 0 takes the specular coat off (Ks 0): only the subsurface term
- * and what it costs are left on the teapot. --medium (a preset: skin1,
+ * --coat 0 takes the specular coat off (Ks 0), --floor 0 the floor: what
+ * caching cannot speed up shrinks to the camera rays and the subsurface
+ * rays themselves. --medium (a preset: skin1,
  * ketchup, ...) and --profile (burley) change the material;
  * --images-only 1 renders the cached images alone (no timing).
  *
@@ -42,7 +43,7 @@
 #include "rayes/rayes.h"
 
 typedef struct Args {
-    int size, final_size, spp, threads, coat, images_only;
+    int size, final_size, spp, threads, coat, images_only, floor;
     double mb;
     const char *data, *out, *only, *medium, *profile;
 } Args;
@@ -64,7 +65,7 @@ static int parse_int(const char *s, int lo, int hi)
 
 static Args parse(int argc, char **argv)
 {
-    Args a = {256, 192, 16, 2, 1, 0, 20.0, NULL, "out/figure10", NULL, "marble", "dipole"};
+    Args a = {256, 192, 16, 2, 1, 0, 1, 20.0, NULL, "out/figure10", NULL, "marble", "dipole"};
     for (int i = 1; i < argc; i++) {
         const char *o = argv[i], *v = i + 1 < argc ? argv[i + 1] : NULL;
         if (!v)
@@ -77,6 +78,8 @@ static Args parse(int argc, char **argv)
             a.spp = parse_int(v, 1, 1 << 16);
         else if (!strcmp(o, "--threads"))
             a.threads = parse_int(v, 0, 1024);
+        else if (!strcmp(o, "--floor"))
+            a.floor = parse_int(v, 0, 1);
         else if (!strcmp(o, "--coat"))
             a.coat = parse_int(v, 0, 1);
         else if (!strcmp(o, "--mb"))
@@ -95,7 +98,7 @@ static Args parse(int argc, char **argv)
             a.images_only = parse_int(v, 0, 1);
         else
             die("usage: figure10 [--size N] [--final-size N] [--spp N] [--threads N] [--mb MB] "
-                "[--coat 0|1] [--data DIR] [--out DIR] [--only preview|final] [--medium NAME] "
+                "[--coat 0|1] [--floor 0|1] [--data DIR] [--out DIR] [--only preview|final] [--medium NAME] "
                 "[--profile dipole|burley] [--images-only 1]");
         i++;
     }
@@ -147,7 +150,8 @@ static RayesScene *scene(const Args *a)
     RayesParam m[2] = {pf("Ka", 0.0f), pf("Kd", 0.6f)};
     check(s, rayes_scene_set_shader(s, "matte", m, 2));
     const float P[4][3] = {{-300, 0, -300}, {300, 0, -300}, {-300, 0, 300}, {300, 0, 300}};
-    check(s, rayes_scene_bilinear_patch(s, P));
+    if (a->floor)
+        check(s, rayes_scene_bilinear_patch(s, P));
     teapot(s, a);
     const float at_back[16] = {1, 0, 0, -30, 0, 1, 0, 60, 0, 0, 1, -110, 0, 0, 0, 1};
     static const float identity[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};

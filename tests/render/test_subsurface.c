@@ -90,7 +90,9 @@ static void distant_light(RayesScene *s, float dz)
     CHECK(rayes_scene_light(s, "distantlight", p, 3) == RAYES_OK);
 }
 
-static RayesImage *render_res(RayesScene *s, int res, int threads, int rays, int cached, double mb)
+/* stats (may be NULL) receives the render's statistics. */
+static RayesImage *render_res(RayesScene *s, int res, int threads, int rays, int cached, double mb,
+                              RayesStats **stats)
 {
     CHECK(rayes_scene_commit(s) == RAYES_OK);
     RayesRenderOptions o;
@@ -103,13 +105,19 @@ static RayesImage *render_res(RayesScene *s, int res, int threads, int rays, int
     o.irradiance_cache = cached;
     o.irradiance_cache_mb = mb;
     RayesImage *img = NULL;
-    CHECK(rayes_render(s, &o, &img, NULL) == RAYES_OK);
+    CHECK(rayes_render(s, &o, &img, stats) == RAYES_OK);
     return img;
 }
 
 static RayesImage *render(RayesScene *s, int threads, int rays, int cached, double mb)
 {
-    return render_res(s, RES, threads, rays, cached, mb);
+    return render_res(s, RES, threads, rays, cached, mb, NULL);
+}
+
+static uint64_t stat(const RayesStats *st, const char *name)
+{
+    const RayesStat *x = rayes_stats_find(st, name);
+    return x ? x->count : 0;
 }
 
 static void mean_rgb(const RayesImage *img, double out[3])
@@ -286,7 +294,22 @@ static void test_cached_matches_uncached(void)
     /* 96 pixels: the sphere is diced finely enough for grids to follow its
      * terminator (a 16 pixel one is a few micropolygons across, and the
      * cached irradiance, linear across each, is 4% too bright) */
-    RayesImage *on = render_res(s, 96, 2, 64, 1, 20.0), *off = render_res(s, 96, 2, 64, 0, 20.0);
+    RayesStats *st_on = NULL, *st_off = NULL;
+    RayesImage *on = render_res(s, 96, 2, 64, 1, 20.0, &st_on),
+               *off = render_res(s, 96, 2, 64, 0, 20.0, &st_off);
+    uint64_t lookups = stat(st_on, "cache/irradiance/fine/lookups") +
+                       stat(st_on, "cache/irradiance/medium/lookups") +
+                       stat(st_on, "cache/irradiance/coarse/lookups");
+    uint64_t rays = stat(st_on, "rays/subsurface"), points = stat(st_on, "subsurface/points");
+    /* every point casts a probe and 64 rays, the same with the cache off;
+     * cached, each hit is a lookup and far fewer points are shaded for
+     * irradiance than hits looked up; uncached, every hit is shaded */
+    CHECK(points > 0 && rays == 65 * points && stat(st_off, "rays/subsurface") == rays);
+    CHECK(lookups > points && stat(st_on, "subsurface/irradiance_points") < lookups / 10);
+    CHECK(stat(st_off, "cache/irradiance/fine/lookups") == 0);
+    CHECK(stat(st_off, "subsurface/irradiance_points") > lookups / 2);
+    rayes_stats_free(st_on);
+    rayes_stats_free(st_off);
     double a[3], b[3];
     mean_rgb(on, a);
     mean_rgb(off, b);
