@@ -102,8 +102,10 @@ static void lighting_chunk(const RayesShaderServices *sv, const RayesShadeCtx *c
     memset(spec, 0, sizeof spec);
     if (p->Kd > 0.0f && HAS(sv, subsurface))
         sv->subsurface(sv, ctx, &m, (int)p->samples, sss);
+    /* roughness 0 (pbrt's smooth boundary) is a sharp coat, not the
+     * service's default 0.1 */
     for (size_t i = 0; i < ctx->n_points; i++)
-        rough[i] = p->roughness;
+        rough[i] = fmaxf(p->roughness, 0.005f);
     if (p->Ks > 0.0f && ctx->I)
         sv->direct_lighting(sv, ctx, 0, NULL, rough, NULL, spec);
     for (size_t i = 0; i < ctx->n_points; i++) {
