@@ -688,6 +688,14 @@ typedef struct RayesRenderOptions {
     RayesTileSourceFn tile_source; /* may be NULL (every tile, in order): the tiles to render;
                                       the others stay 0 in the image */
     void *tile_source_user;
+    int subsurface_rays;       /* subsurface rays per shading point of a subsurface material
+                                  (memo 6.2): 4 in the preview preset, 64 in final and
+                                  reference */
+    int irradiance_cache;      /* 1 (default): the irradiance subsurface rays find is cached
+                                  per grid at the three resolutions, data type irradiance
+                                  (memo 6.2); 0: the shader runs at every subsurface hit */
+    double irradiance_cache_mb; /* the irradiance entries' budget in megabytes (10^6 bytes),
+                                  default 20, apart from cache_mb */
 } RayesRenderOptions;
 
 /* Fills options with the defaults of a quality preset: 512 x 512, 4 pixel

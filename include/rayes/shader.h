@@ -115,7 +115,12 @@ typedef struct RayesShadeCtx {
 typedef struct RayesShadeOutputs {
     float (*Ci)[3];         /* outgoing radiance toward the viewer (or radiosity) */
     float (*Oi)[3];         /* opacity */
-    float (*Irradiance)[3]; /* diffuselighting's optional irradiance (memo 6.2) */
+    float (*Irradiance)[3]; /* diffuselighting's optional irradiance (memo 6.2): the
+                               integral of incident radiance times cos over the
+                               hemisphere of N; when the renderer asks for it (subsurface
+                               rays), it holds pi times the diffuse result of the last
+                               direct_lighting call on the points (0 before any), which
+                               the shader may overwrite */
     float (*P)[3];          /* displacement: the displaced positions (input P copied in) */
 } RayesShadeOutputs;
 
@@ -148,7 +153,33 @@ typedef struct RayesShaderClass {
     RayesShaderMethod diffuselighting; /* may be NULL: the diffuse lobes of lighting */
     RayesShaderMethod postlighting;    /* may be NULL */
     size_t scratch_size;               /* bytes of scratch per point (ctx->scratch) */
+    uint32_t flags;                    /* appended in ABI 2: RayesShaderFlags (a class built
+                                          before it has struct_size short of it: none) */
 } RayesShaderClass;
+
+/* What a class tells the renderer before rendering. */
+typedef enum RayesShaderFlags {
+    RAYES_SHADER_SUBSURFACE = 1u << 0 /* its methods call the subsurface service: objects
+                                         shaded by it get an acceleration structure of
+                                         their own for subsurface rays (memo 6.2) */
+} RayesShaderFlags;
+
+/* Diffusion profiles of the subsurface service. */
+typedef enum RayesSubsurfaceProfile {
+    RAYES_SUBSURFACE_DIPOLE = 0, /* Jensen et al. 2001, the memo's */
+    RAYES_SUBSURFACE_BURLEY = 1  /* Christensen and Burley 2015's normalized diffusion,
+                                    of the dipole's total diffuse reflectance and diffuse
+                                    mean free path 1 / sigma_tr */
+} RayesSubsurfaceProfile;
+
+/* A homogeneous scattering medium under the surface, per RGB channel. */
+typedef struct RayesSubsurfaceParams {
+    float sigma_s[3]; /* reduced scattering coefficient sigma_s', per mm */
+    float sigma_a[3]; /* absorption coefficient, per mm */
+    float eta;        /* index of refraction of the medium over the outside's */
+    float scale;      /* scene units per mm */
+    int profile;      /* RayesSubsurfaceProfile */
+} RayesSubsurfaceParams;
 
 /* What a plugin exports under RAYES_SHADER_ENTRY_NAME. */
 typedef const RayesShaderClass *(*RayesShaderEntry)(void);
@@ -329,6 +360,22 @@ struct RayesShaderServices {
      * viewer per unit length. Older renderers lack it (supports()). */
     void (*direct_volume)(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
                           int n_shadow_rays, const char *category, float g, float (*out)[3]);
+
+    /* Multiple subsurface scattering by diffusion (memo 6.2): per point,
+     * out[i] = (1/pi) integral of R(|x - P[i]|) E(x) dA(x) over the surface
+     * of the object being shaded, R the medium's diffusion profile in 1/mm^2
+     * (p->profile), E the irradiance on the object's outside, which the
+     * renderer gets from the object's shader's diffuselighting (its
+     * Irradiance output; the direct_lighting service fills it) and keeps
+     * in the multiresolution cache as data type irradiance. The integral
+     * is estimated with n_rays subsurface rays (0: the renderer's setting)
+     * cast uniformly over the sphere from a probe point inside the object,
+     * which only hit its own surfaces (so surfaces inside it block). out is
+     * radiance leaving through the surface before the exit Fresnel factor,
+     * which the shader applies (it sees I). The class must have the flag
+     * RAYES_SHADER_SUBSURFACE. Older renderers lack it (supports()). */
+    void (*subsurface)(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
+                       const RayesSubsurfaceParams *p, int n_rays, float (*out)[3]);
 };
 
 #ifdef __cplusplus

@@ -8,7 +8,10 @@
  * micropolygon; per object with curves, one ROUND_ or FLAT_LINEAR_CURVE
  * through the centre lines of their grids; per object with points, one
  * SPHERE_ or DISC_POINT, a point per grid. Geom records map (geomID,
- * primID) back to grids.
+ * primID) back to grids. An object whose mask holds ACCEL_MASK_OWN_SCENE
+ * has its geometries attached to a scene of its own too, under the same
+ * geomIDs (Embree lets a geometry belong to several scenes): subsurface
+ * rays test only their object's micropolygons (memo 6.2).
  *
  * Embree with TBB builds on its own threads; commit happens once, before
  * any query, and queries are concurrent (Embree's contract).
@@ -48,6 +51,9 @@ typedef struct Geom {
 struct Accel {
     RTCDevice device;
     RTCScene scene;
+    RTCScene *object_scene; /* per object: its own scene, or NULL */
+    size_t n_objects;
+    RTCScene building;  /* the object scene geometries go to as well, or NULL */
     const GridSet *gs;
     Geom *geoms;       /* indexed by geomID */
     size_t n_geoms;
@@ -88,9 +94,11 @@ static int attach(Accel *a, RTCGeometry geom, uint32_t mask, Geom g)
 {
     if (mask & ACCEL_MASK_TRANSPARENT)
         rtcSetGeometryOccludedFilterFunction(geom, transmission_filter);
-    rtcSetGeometryMask(geom, mask & ~ACCEL_MASK_TRANSPARENT);
+    rtcSetGeometryMask(geom, mask & ~(ACCEL_MASK_TRANSPARENT | ACCEL_MASK_OWN_SCENE));
     rtcCommitGeometry(geom);
     unsigned id = rtcAttachGeometry(a->scene, geom);
+    if (a->building)
+        rtcAttachGeometryByID(a->building, geom, id);
     rtcReleaseGeometry(geom);
     RY_CHECK(id == a->n_geoms);
     return add_geom(a, g);
@@ -302,6 +310,12 @@ static int grid_group(const Grid *g)
 static int build_object(Accel *a, uint32_t object, uint32_t mask, uint32_t *scratch)
 {
     const GridSet *gs = a->gs;
+    a->building = NULL;
+    if (mask & ACCEL_MASK_OWN_SCENE) {
+        a->building = a->object_scene[object] = rtcNewScene(a->device);
+        rtcSetSceneFlags(a->building, RTC_SCENE_FLAG_ROBUST);
+        rtcSetSceneBuildQuality(a->building, RTC_BUILD_QUALITY_MEDIUM);
+    }
     for (int group = 0; group < N_GROUPS; group++) {
         size_t n = 0;
         for (size_t k = 0; k < gs->n_grids; k++)
@@ -330,18 +344,23 @@ Accel *accel_new(const GridSet *gs, const uint32_t *object_mask, size_t n_object
 {
     Accel *a = calloc(1, sizeof *a);
     uint32_t *scratch = malloc((gs->n_grids + 1) * sizeof *scratch);
-    if (!a || !scratch) {
+    RTCScene *own = calloc(n_objects + 1, sizeof *own);
+    if (!a || !scratch || !own) {
         free(a);
+        free(own);
         free(scratch);
         snprintf(err, err_size, "out of memory building the ray tracing structure");
         return NULL;
     }
     a->gs = gs;
+    a->object_scene = own;
+    a->n_objects = n_objects;
     atomic_init(&a->bytes, 0);
     a->device = rtcNewDevice("verbose=0");
     if (!a->device) {
         snprintf(err, err_size, "cannot create an Embree device (error %d)",
                  (int)rtcGetDeviceError(NULL));
+        free(own);
         free(a);
         free(scratch);
         return NULL;
@@ -360,6 +379,9 @@ Accel *accel_new(const GridSet *gs, const uint32_t *object_mask, size_t n_object
     free(scratch);
     if (rc == 0)
         rtcCommitScene(a->scene);
+    for (size_t o = 0; o < n_objects && rc == 0; o++)
+        if (a->object_scene[o])
+            rtcCommitScene(a->object_scene[o]);
     if (rc != 0 || a->error[0]) {
         snprintf(err, err_size, "%s", a->error[0] ? a->error : "out of memory in Embree");
         accel_free(a);
@@ -378,6 +400,10 @@ void accel_free(Accel *a)
         free(a->geoms[k].segs);
     }
     free(a->geoms);
+    for (size_t o = 0; o < a->n_objects; o++)
+        if (a->object_scene[o])
+            rtcReleaseScene(a->object_scene[o]);
+    free(a->object_scene);
     if (a->scene)
         rtcReleaseScene(a->scene);
     if (a->device)
@@ -536,20 +562,35 @@ static void make_hit(const Accel *a, const struct RTCRayHit *rh, Hit *hit)
     }
 }
 
-int accel_intersect(const Accel *a, const Ray *ray, Hit *hit)
+/* The nearest hit in scene (one of a's), under the ray's mask. */
+static int intersect_scene(const Accel *a, RTCScene scene, const Ray *ray, uint32_t mask,
+                           Hit *hit)
 {
     struct RTCIntersectContext ctx;
     rtcInitIntersectContext(&ctx);
     struct RTCRayHit rh;
     set_ray(&rh.ray, ray);
+    rh.ray.mask = mask;
     rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
     rh.hit.primID = RTC_INVALID_GEOMETRY_ID;
     rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
-    rtcIntersect1(a->scene, &ctx, &rh);
+    rtcIntersect1(scene, &ctx, &rh);
     if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID)
         return 0;
     make_hit(a, &rh, hit);
     return 1;
+}
+
+int accel_intersect(const Accel *a, const Ray *ray, Hit *hit)
+{
+    return intersect_scene(a, a->scene, ray, ray->mask, hit);
+}
+
+int accel_intersect_object(const Accel *a, uint32_t object, const Ray *ray, Hit *hit)
+{
+    if (object >= a->n_objects || !a->object_scene[object])
+        return 0;
+    return intersect_scene(a, a->object_scene[object], ray, ~0u, hit);
 }
 
 /* Crossings a transmission query remembers, to count each once. */

@@ -56,6 +56,10 @@ typedef struct Hit {
 
 /* In an object's mask: shadow rays may pass through it (not a ray type). */
 #define ACCEL_MASK_TRANSPARENT (1u << 31)
+/* In an object's mask: it has an Embree scene of its own as well, for rays
+ * that may hit only it (subsurface rays, memo 6.2: accel_intersect_object).
+ * Not a ray type. */
+#define ACCEL_MASK_OWN_SCENE (1u << 30)
 
 /* The opacity (RGB, each in [0, 1]) of a transparent object's hit, asked by
  * accel_transmission; hit is filled as accel_intersect fills it. */
@@ -69,6 +73,11 @@ void accel_free(Accel *accel);
 
 /* The nearest hit in [tnear, tfar]; returns 1 and fills hit, or 0. */
 int accel_intersect(const Accel *accel, const Ray *ray, Hit *hit);
+
+/* The nearest hit on object `object` alone, whatever the ray's mask (the
+ * object's own scene: its mask had ACCEL_MASK_OWN_SCENE; any other object
+ * is never hit and returns 0). */
+int accel_intersect_object(const Accel *accel, uint32_t object, const Ray *ray, Hit *hit);
 
 /* Returns 1 if anything lies in [tnear, tfar]. */
 int accel_occluded(const Accel *accel, const Ray *ray);

@@ -46,6 +46,8 @@ static const char render_options[] =
     "                          depth 0, 64 deeper), reference (64 and 4096 at depth 0,\n"
     "                          1 and 1 deeper); later options override it\n"
     "  --shadow-rays N         shadow rays per shading point and light\n"
+    "  --subsurface-rays N     subsurface rays per shading point of a subsurface material\n"
+    "                          (default 4 preview, 64 final)\n"
     "  --diffuse-rays N        diffuse rays per shading point (all depths)\n"
     "  --diffuse-rays-deep N   diffuse rays per shading point below depth 0\n"
     "  --specular-depth N      maximum specular depth (default 4)\n"
@@ -61,6 +63,8 @@ static const char render_options[] =
     "                          --quality reference)\n"
     "  --cache-mb MB           cache budget in megabytes (default 100)\n"
     "  --cache-split C,M,F     budget shares of coarse, medium, fine (default .25,.25,.5)\n"
+    "  --irradiance-cache on|off  cache the irradiance subsurface rays find (default on)\n"
+    "  --irradiance-cache-mb MB   the irradiance entries' budget in megabytes (default 20)\n"
     "  --opacity-cache on|off  cache opacity() results for shadow and transmission rays\n"
     "                          (default on)\n"
     "  --opacity-cache-mb MB   the opacity entries' budget in megabytes (default 20)\n"
@@ -336,6 +340,8 @@ void parse_args(int argc, char **argv, Args *a)
             continue;
         else if (strcmp(o, "--shadow-rays") == 0)
             opt->shadow_rays = opt->shadow_rays_deep = (int)parse_long(o, v, 0, 1 << 20);
+        else if (strcmp(o, "--subsurface-rays") == 0)
+            opt->subsurface_rays = (int)parse_long(o, v, 0, 1 << 20);
         else if (strcmp(o, "--diffuse-rays") == 0)
             opt->diffuse_rays = opt->diffuse_rays_deep = (int)parse_long(o, v, 0, 1 << 20);
         else if (strcmp(o, "--diffuse-rays-deep") == 0)
@@ -363,6 +369,12 @@ void parse_args(int argc, char **argv, Args *a)
             opt->cache = strcmp(v, "on") == 0;
         } else if (strcmp(o, "--cache-mb") == 0)
             opt->cache_mb = parse_float(o, v, 0.0f, 1e7f);
+        else if (strcmp(o, "--irradiance-cache") == 0) {
+            if (strcmp(v, "on") != 0 && strcmp(v, "off") != 0)
+                die_usage("--irradiance-cache: expected on or off, got \"%s\"", v);
+            opt->irradiance_cache = strcmp(v, "on") == 0;
+        } else if (strcmp(o, "--irradiance-cache-mb") == 0)
+            opt->irradiance_cache_mb = parse_float(o, v, 0.0f, 1e7f);
         else if (strcmp(o, "--opacity-cache") == 0) {
             if (strcmp(v, "on") != 0 && strcmp(v, "off") != 0)
                 die_usage("--opacity-cache: expected on or off, got \"%s\"", v);

@@ -18,6 +18,7 @@
 #include <string.h>
 
 #include "io/pbrt_internal.h"
+#include "util/media.h"
 
 #define TEX_MAX_PARAMS 16
 
@@ -641,6 +642,66 @@ static int hair_material(Parser *P, ParamList *pl, Material *m)
     return 0;
 }
 
+/* The medium of pbrt-v4's subsurface: a named one (Jensen 2001's), or
+ * reflectance and mfp, or sigma_a and sigma_s (pbrt's default: whole
+ * milk); g reduces sigma_s to sigma_s' = (1 - g) sigma_s. */
+static int subsurface_medium(Parser *P, const Token *t, ParamList *pl, Material *m)
+{
+    static const float milk_a[3] = {0.0011f, 0.0024f, 0.014f}, milk_s[3] = {2.55f, 3.21f, 3.77f},
+                       one[3] = {1, 1, 1};
+    const char *name = pbrt_get_string(pl, "name", NULL);
+    float a[3], b[3];
+    if (name) {
+        const MeasuredMedium *med = media_find(name);
+        if (!med)
+            return FAIL_TOK(P, t,
+                            "subsurface: unknown medium \"%.60s\" (rayes knows Jensen 2001's: "
+                            "Apple, Chicken1, Chicken2, Cream, Ketchup, Marble, Potato, "
+                            "Skimmilk, Skin1, Skin2, Spectralon, Wholemilk)",
+                            name);
+        pbrt_mat_color(m, "sigma_s", med->sigma_s);
+        pbrt_mat_color(m, "sigma_a", med->sigma_a);
+        return 0;
+    }
+    if (pbrt_find(pl, "reflectance")) {
+        if (pbrt_get_color(P, pl, "reflectance", one, a, NULL) < 0 ||
+            pbrt_get_color(P, pl, "mfp", one, b, NULL) < 0)
+            return -1;
+        pbrt_mat_color(m, "reflectance", a);
+        pbrt_mat_color(m, "mfp", b);
+        return 0;
+    }
+    if (pbrt_get_color(P, pl, "sigma_a", milk_a, a, NULL) < 0 ||
+        pbrt_get_color(P, pl, "sigma_s", milk_s, b, NULL) < 0)
+        return -1;
+    float g = (float)pbrt_get_float(pl, "g", 0.0);
+    for (int k = 0; k < 3; k++)
+        b[k] *= 1.0f - g;
+    pbrt_mat_color(m, "sigma_s", b);
+    pbrt_mat_color(m, "sigma_a", a);
+    return 0;
+}
+
+/* pbrt-v4's subsurface as rayes's `subsurface` (memo 6.2, docs/pbrt.md):
+ * pbrt's "scale" multiplies the per-mm coefficients into per-scene-unit
+ * ones, so rayes's unitlength (scene units per mm) is 1 / scale; eta
+ * (pbrt's default 1.33) and the roughness of the boundary become the
+ * coat's. */
+static int subsurface_material(Parser *P, const Token *t, ParamList *pl, Material *m)
+{
+    pbrt_mat_init(m, "subsurface");
+    if (subsurface_medium(P, t, pl, m) != 0)
+        return -1;
+    double scale = pbrt_get_float(pl, "scale", 1.0);
+    if (!(scale > 0.0))
+        return FAIL_TOK(P, t, "subsurface: \"scale\" must be positive, got %g", scale);
+    mat_float(m, "unitlength", (float)(1.0 / scale));
+    mat_float(m, "eta", (float)pbrt_get_float(pl, "eta", 1.33));
+    if (mat_roughness(P, t, pl, m, 0.0, "") != 0)
+        return -1;
+    return 0;
+}
+
 static int material_of_type(Parser *P, const Token *t, const char *type, ParamList *pl, Material *m)
 {
     if (pbrt_find(pl, "normalmap"))
@@ -668,6 +729,8 @@ static int material_of_type(Parser *P, const Token *t, const char *type, ParamLi
         return mix_material(P, t, pl, m);
     if (strcmp(type, "hair") == 0)
         return hair_material(P, pl, m);
+    if (strcmp(type, "subsurface") == 0)
+        return subsurface_material(P, t, pl, m);
     if (strcmp(type, "interface") == 0 || strcmp(type, "") == 0 || strcmp(type, "none") == 0) {
         /* pbrt's "interface" (and "" or "none") marks a shape that only
          * bounds a participating medium: it is not a surface at all (its

@@ -211,7 +211,7 @@ int rib_emit_begin(Rib *r, const float *Cs)
 static const char *const builtin_surfaces[] = {"matte", "plastic", "metal", "shinymetal",
                                                "constant", "glass", "mirror", "paintedplastic",
                                                "diffuse", "conductor", "dielectric",
-                                               "coateddiffuse", NULL};
+                                               "coateddiffuse", "subsurface", NULL};
 static const char *const builtin_displacements[] = {"bumpy", "fractal", "displace", NULL};
 /* rayes' pattern classes (rayes_scene_pattern): pbrt-v4's textures. */
 static const char *const builtin_patterns[] = {

@@ -121,15 +121,28 @@ static void hit_footprint(HitPoint *hp)
     }
 }
 
+/* Turns a hit's point to face the side the ray leaves through (a
+ * subsurface ray's hit from inside: the object's outside, memo 6.2). */
+static void face_outside(HitPoint *hp, int *backfacing)
+{
+    for (int c = 0; c < 3; c++)
+        hp->N[c] = -hp->N[c], hp->Ng[c] = -hp->Ng[c];
+    *backfacing = !*backfacing;
+}
+
 /* Shades the hit as a ray of type kind sees it (lighting, diffuselighting,
- * or with kind RAYES_RAY_TRANSMISSION the opacity method); *Oi receives
- * the shader's opacity. */
+ * or with kind RAYES_RAY_TRANSMISSION the opacity method; with
+ * RAYES_RAY_SUBSURFACE diffuselighting on the side the ray leaves through,
+ * whose Irradiance output is returned); *Oi receives the shader's
+ * opacity. */
 static Vec3 shade_hit(Worker *w, const Ray *ray, const Hit *hit, const RenderObject *obj,
                       uint32_t kind, int diffuse_depth, int specular_depth, uint64_t key,
                       RayDiff diff, Vec3 *Oi_out)
 {
     HitPoint hp;
     int backfacing = !hit_point(w, ray, hit, obj, &hp);
+    if (kind == RAYES_RAY_SUBSURFACE)
+        face_outside(&hp, &backfacing);
     hp.key = key;
     hp.diff = (RayDiff){diff.width + diff.spread * hit->t, diff.spread};
     hit_footprint(&hp);
@@ -160,8 +173,15 @@ static Vec3 shade_hit(Worker *w, const Ray *ray, const Hit *hit, const RenderObj
         .backfacing = &backfacing,
     };
     path_apply_Os_pattern(w, obj, &ctx, &hp.Os);
-    float Ci[1][3] = {{0, 0, 0}}, Oi[1][3] = {{1, 1, 1}};
+    float Ci[1][3] = {{0, 0, 0}}, Oi[1][3] = {{1, 1, 1}}, E[1][3] = {{0, 0, 0}};
     RayesShadeOutputs out = {Ci, Oi, NULL, NULL};
+    if (kind == RAYES_RAY_SUBSURFACE) {
+        w->stats.irradiance_points++;
+        out.Irradiance = ps.irradiance = E;
+        shade_run_diffuselighting(w->services, &ctx, obj->shader, &out);
+        *Oi_out = v3(1, 1, 1);
+        return v3(E[0][0], E[0][1], E[0][2]);
+    }
     if (kind == RAYES_RAY_TRANSMISSION) {
         w->stats.opacity_points++;
         shade_run_opacity(w->services, &ctx, obj->shader, &out);
@@ -184,6 +204,16 @@ static Vec3 hit_Os(const GridSet *gs, const Hit *hit, const RenderObject *obj)
     for (int k = 0; k < hit->n_vertex; k++)
         Os = v3_madd(Os, geom_vertex_opacity(gs, g, hit->vertex[k], Os_obj), hit->weight[k]);
     return Os;
+}
+
+Vec3 integrator_irradiance(Worker *w, const Ray *ray, const Hit *hit, uint64_t key,
+                           RayDiff diff)
+{
+    const RenderObject *obj = &w->rs->objects[w->rs->gs->grids[hit->grid].object];
+    if (!obj->shader)
+        return v3(0, 0, 0);
+    Vec3 Oi;
+    return shade_hit(w, ray, hit, obj, RAYES_RAY_SUBSURFACE, 0, 0, key, diff, &Oi);
 }
 
 Vec3 integrator_opacity(Worker *w, const Ray *ray, const Hit *hit, RayDiff diff)

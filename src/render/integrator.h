@@ -27,6 +27,14 @@ Vec3 integrator_trace_hit(Worker *w, const Ray *ray, uint32_t kind, int diffuse_
  * the ray's differential (its footprint chooses the cache resolution). */
 Vec3 integrator_opacity(Worker *w, const Ray *ray, const Hit *hit, RayDiff diff);
 
+/* The irradiance on the outside of the surface at a subsurface ray's hit
+ * from inside its object, uncached (memo 6.2's "without caching"): the
+ * object's diffuselighting run at the hit alone, its Irradiance output
+ * (the direct_lighting service fills it), random numbers named by key.
+ * Counts an irradiance point. */
+Vec3 integrator_irradiance(Worker *w, const Ray *ray, const Hit *hit, uint64_t key,
+                           RayDiff diff);
+
 /* The transmittance along a shadow or transmission ray: 1 where nothing is
  * in the way, the product of (1 - opacity) through transparent surfaces, 0
  * at an opaque one. Counts the ray. */

@@ -49,6 +49,9 @@ typedef struct PathState {
     int path;                     /* 1: a path's own hit (integrator.c), not a grid (a cache
                                      fill, the grid hider): past the branch depth its diffuse
                                      rays are one */
+    float (*irradiance)[3];       /* per point, where direct lighting leaves pi times its
+                                     diffuse result (the shader's Irradiance output, memo
+                                     6.2), or NULL: not asked for */
 } PathState;
 
 /* The texture-space footprint of a point whose parameter footprint is

@@ -2,6 +2,10 @@
  * render/radiosity.c — the multiresolution radiosity cache at diffuse-ray
  * hits (memo sections 3.2 and 4.3).
  *
+ * The same fills serve the irradiance cache of subsurface rays (memo 6.2,
+ * subsurface.c): entries of data type irradiance at depth 0 for the side
+ * the ray leaves through, filled by diffuselighting's Irradiance output.
+ *
  * At a diffuse hit the resolution is chosen from the ray's footprint (the
  * coarsest level whose micropolygon edge is at most k times the footprint,
  * DESIGN.md, and bends through at most RADIOSITY_MAX_BEND), the entry for (patch, diffuse depth, side, RADIOSITY, level)
@@ -272,9 +276,44 @@ static void level_footprint(const Grid *g, int level, float *du, float *dv)
     *dv = ext[1] / m;
 }
 
+/* Runs the shader's method for the fill's data type on ctx's points into
+ * out: diffuselighting's Ci (radiosity), the opacity method's Oi
+ * (opacity), or diffuselighting's Irradiance (irradiance: subsurface rays
+ * at depth 0, memo 6.2; 0 where the shader leaves it). */
+static void fill_run(Worker *w, int type, const RayesShadeCtx *ctx, const RenderObject *obj,
+                     FillPoints *fp, float (*E)[3], float (*out)[3])
+{
+    size_t n = ctx->n_points;
+    RayesShadeOutputs o = {fp->Ci, fp->Oi, NULL, NULL};
+    if (type == CACHE_OPACITY) {
+        w->stats.opacity_points += n;
+        shade_run_opacity(w->services, ctx, obj->shader, &o);
+        memcpy(out, fp->Oi, n * sizeof *out);
+    } else if (type == CACHE_IRRADIANCE) {
+        w->stats.irradiance_points += n;
+        memset(E, 0, n * sizeof *E);
+        o.Irradiance = E;
+        ((PathState *)ctx->renderer)->irradiance = E;
+        shade_run_diffuselighting(w->services, ctx, obj->shader, &o);
+        memcpy(out, E, n * sizeof *out);
+    } else {
+        w->stats.shading_points[RY_MIN(ctx->diffuse_depth, RENDER_MAX_DEPTH)] += n;
+        shade_run_diffuselighting(w->services, ctx, obj->shader, &o);
+        memcpy(out, fp->Ci, n * sizeof *out);
+    }
+}
+
+/* The ray type a fill's shader sees. */
+static uint32_t fill_ray_type(int type)
+{
+    return type == CACHE_OPACITY      ? RAYES_RAY_TRANSMISSION
+           : type == CACHE_IRRADIANCE ? RAYES_RAY_SUBSURFACE
+                                      : RAYES_RAY_DIFFUSE;
+}
+
 /* CacheFillFn: shade every point of the level with diffuselighting
- * (radiosity: Ci) or the opacity method (opacity: Oi, transmission rays at
- * depth 0, the front side). */
+ * (radiosity: Ci; irradiance: Irradiance) or the opacity method (opacity:
+ * Oi, transmission rays at depth 0, the front side). */
 static void fill_radiosity(void *user, const CacheKey *key, size_t n, float (*out)[3])
 {
     FillJob *job = user;
@@ -283,7 +322,7 @@ static void fill_radiosity(void *user, const CacheKey *key, size_t n, float (*ou
     const Grid *g = &gs->grids[key->patch];
     const RenderObject *obj = &w->rs->objects[g->object];
     FillPoints fp;
-    float(*f3)[3] = malloc(n * 9 * sizeof *f3);
+    float(*f3)[3] = malloc(n * 10 * sizeof *f3);
     float *f1 = malloc(n * 14 * sizeof *f1);
     fp.keys = malloc(n * sizeof *fp.keys);
     fp.diff = malloc(n * sizeof *fp.diff);
@@ -299,6 +338,8 @@ static void fill_radiosity(void *user, const CacheKey *key, size_t n, float (*ou
     uint64_t fill_key = hash_combine(hash_combine(w->set->seed, 0x7261646f73ull /* "rados" */),
                                      ((uint64_t)key->patch << 32) | ((uint64_t)key->depth << 16) |
                                          ((uint64_t)key->side << 8) | key->level);
+    if (key->type == CACHE_IRRADIANCE) /* apart from the radiosity fill of the same grid */
+        fill_key = hash_combine(fill_key, 0x69727261ull /* "irra" */);
     float width = level_edge(g, key->level), du, dv;
     level_footprint(g, key->level, &du, &dv);
     for (size_t i = 0; i < n; i++) {
@@ -320,11 +361,12 @@ static void fill_radiosity(void *user, const CacheKey *key, size_t n, float (*ou
                     NULL,
                     key->patch,
                     own_st ? fp.ds : NULL,
-                    own_st ? fp.dt : NULL};
-    int opacity = key->type == CACHE_OPACITY;
+                    own_st ? fp.dt : NULL,
+                    0,
+                    NULL};
     RayesShadeCtx ctx = {
         .n_points = n,
-        .ray_type = opacity ? RAYES_RAY_TRANSMISSION : RAYES_RAY_DIFFUSE,
+        .ray_type = fill_ray_type(key->type),
         .diffuse_depth = key->depth,
         .specular_depth = 0,
         .P = (const float(*)[3])fp.P, .N = (const float(*)[3])fp.N,
@@ -334,16 +376,7 @@ static void fill_radiosity(void *user, const CacheKey *key, size_t n, float (*ou
         .Os = (const float(*)[3])fp.Os, .renderer = &ps, .backfacing = backfacing,
     };
     path_apply_Os_pattern(w, obj, &ctx, fp.Os);
-    RayesShadeOutputs o = {fp.Ci, fp.Oi, NULL, NULL};
-    if (opacity) {
-        w->stats.opacity_points += n;
-        shade_run_opacity(w->services, &ctx, obj->shader, &o);
-        memcpy(out, fp.Oi, n * sizeof *out);
-    } else {
-        w->stats.shading_points[RY_MIN(key->depth, RENDER_MAX_DEPTH)] += n;
-        shade_run_diffuselighting(w->services, &ctx, obj->shader, &o);
-        memcpy(out, fp.Ci, n * sizeof *out);
-    }
+    fill_run(w, key->type, &ctx, obj, &fp, f3 + 9 * n, out);
     free(f3);
     free(f1);
     free(fp.keys);
@@ -426,6 +459,13 @@ Vec3 radiosity_at_hit(Worker *w, const Ray *ray, const Hit *hit, int diffuse_dep
 {
     int side = v3_dot(hit->Ng, ray->d) < 0.0f ? 0 : 1;
     return cached_at_hit(w, hit, CACHE_RADIOSITY, diffuse_depth, side, diff);
+}
+
+Vec3 radiosity_irradiance_at_hit(Worker *w, const Ray *ray, const Hit *hit, float footprint)
+{
+    /* The outside: the side the ray leaves the object through. */
+    int side = v3_dot(hit->Ng, ray->d) < 0.0f ? 1 : 0;
+    return cached_at_hit(w, hit, CACHE_IRRADIANCE, 0, side, (RayDiff){footprint, 0.0f});
 }
 
 Vec3 radiosity_opacity_at_hit(Worker *w, const Hit *hit, RayDiff diff)

@@ -22,6 +22,12 @@ Vec3 radiosity_at_hit(Worker *w, const Ray *ray, const Hit *hit, int diffuse_dep
  * opacity method over the level's points. */
 Vec3 radiosity_opacity_at_hit(Worker *w, const Hit *hit, RayDiff diff);
 
+/* The cached irradiance at a subsurface ray's hit from inside an object
+ * (memo 6.2): entries of data type irradiance, depth 0, of the side the ray
+ * leaves through (the object's outside), at the level the footprint
+ * (scene units) chooses, filled by diffuselighting's Irradiance output. */
+Vec3 radiosity_irradiance_at_hit(Worker *w, const Ray *ray, const Hit *hit, float footprint);
+
 /* Interpolates a level's values at a hit. */
 Vec3 radiosity_interpolate(const Grid *g, const Hit *hit, int level, const uint16_t *values);
 

@@ -220,6 +220,9 @@ static void merge_stats(RenderStats *into, const RenderStats *s)
     into->transparent_hits += s->transparent_hits;
     into->rays_transmission += s->rays_transmission;
     into->volume_steps += s->volume_steps;
+    into->rays_subsurface += s->rays_subsurface;
+    into->subsurface_points += s->subsurface_points;
+    into->irradiance_points += s->irradiance_points;
 }
 
 int render_frame(const RenderScene *rs, const RenderSettings *set, float *rgba, RenderStats *stats)

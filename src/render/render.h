@@ -95,6 +95,8 @@ typedef struct RenderSettings {
     Cache *cache;            /* the cache (every data type), or NULL: uncached */
     int radiosity_cache;     /* 1: diffuse hits read radiosity from cache */
     int opacity_cache;       /* 1: shadow and diffuse rays read opacity from cache */
+    int irradiance_cache;    /* 1: subsurface rays read irradiance from cache (memo 6.2) */
+    int subsurface_rays;     /* subsurface rays per shading point (the service's 0) */
     float volume_step;       /* ray marching steps, in fine voxels of each volume */
     int cache_resolution;    /* -1: by differentials; else a forced CacheLevel */
     float cache_k;           /* resolution rule constant (DESIGN.md) */
@@ -132,6 +134,10 @@ typedef struct RenderStats {
     uint64_t rays_transmission; /* shadow and transmission rays that marched a volume (also
                                    counted in rays_shadow) */
     uint64_t volume_steps;      /* ray marching steps through volumes */
+    uint64_t rays_subsurface;   /* subsurface rays: probes along -N and rays from probes */
+    uint64_t subsurface_points; /* points the subsurface service integrated at */
+    uint64_t irradiance_points; /* points whose irradiance a shader computed (cache fills
+                                   and uncached subsurface hits) */
 } RenderStats;
 
 /* The camera of an image of `height` pixels: eye, axes and tan(fov / 2)

@@ -19,6 +19,7 @@
 
 #include "render/integrator.h"
 #include "render/irrgrid.h"
+#include "render/subsurface.h"
 #include "shade/builtin.h"
 #include "shade/noise.h"
 #include "shade/pattern.h"
@@ -250,6 +251,8 @@ static void svc_direct_lighting(const RayesShaderServices *sv, const RayesShadeC
             v3_store(diffuse[i], d);
         if (specular)
             v3_store(specular[i], s);
+        if (ps->irradiance && diffuse) /* memo 6.2: irradiance as a side effect */
+            v3_store(ps->irradiance[point(ctx, i)], v3_scale(d, (float)M_PI));
     }
 }
 
@@ -763,6 +766,8 @@ static int svc_option(const RayesShaderServices *sv, const RayesShadeCtx *ctx, c
                           (float[]){(float)set->diffuse_rays, (float)set->diffuse_rays_deep}, 2);
     if (strcmp(name, "branchdepth") == 0)
         return put_floats(value, n, (float[]){(float)set->branch_depth}, 1);
+    if (strcmp(name, "subsurfacerays") == 0)
+        return put_floats(value, n, (float[]){(float)set->subsurface_rays}, 1);
     return 0;
 }
 
@@ -795,6 +800,7 @@ static const char *const service_names[] = {
     "direct_fiber",
     "occlusion",
     "direct_volume",
+    "subsurface",
 };
 
 static int svc_supports(const RayesShaderServices *sv, const char *service)
@@ -829,4 +835,5 @@ const RayesShaderServices render_services = {
     .glossy = svc_glossy,
     .direct_fiber = svc_direct_fiber,
     .pattern = svc_pattern,
+    .subsurface = subsurface_service,
 };

@@ -71,6 +71,9 @@ void rayes_render_options_init(RayesRenderOptions *o, RayesQuality quality)
     o->opacity_cache = 1;
     o->opacity_cache_mb = 20.0;
     o->volume_step = 1.0f;
+    o->irradiance_cache = 1;
+    o->irradiance_cache_mb = 20.0;
+    o->subsurface_rays = quality == RAYES_QUALITY_PREVIEW ? 4 : 64;
     switch (quality) {
     case RAYES_QUALITY_PREVIEW:
         o->shadow_rays = o->shadow_rays_deep = 4;
@@ -112,7 +115,8 @@ RayesError session_check_options(RayesScene *scene, const RayesRenderOptions *o)
     else if (o->bounces < 0 || o->bounces > 64 || o->specular_depth < 0 || o->specular_depth > 64)
         what = "options: depths must be 0 to 64";
     else if (o->shadow_rays < 0 || o->shadow_rays_deep < 0 || o->diffuse_rays < 0 ||
-             o->diffuse_rays_deep < 0 || o->shadow_rays > 1 << 20 || o->diffuse_rays > 1 << 20)
+             o->diffuse_rays_deep < 0 || o->shadow_rays > 1 << 20 || o->diffuse_rays > 1 << 20 ||
+             o->subsurface_rays < 0 || o->subsurface_rays > 1 << 20)
         what = "options: ray counts must be 0 to 1048576";
     else if (!(o->filter_width > 0.0f) || o->filter_width > 16.0f ||
              (int)o->filter < RAYES_FILTER_BOX || o->filter > RAYES_FILTER_LANCZOS)
@@ -123,6 +127,7 @@ RayesError session_check_options(RayesScene *scene, const RayesRenderOptions *o)
         what = "options: tile size must be positive and threads 0 to 1024";
     else if (!(o->cache_mb >= 0.0) || o->cache_mb > 1e7 || !(o->cache_k > 0.0f) ||
              !(o->opacity_cache_mb >= 0.0) || o->opacity_cache_mb > 1e7 ||
+             !(o->irradiance_cache_mb >= 0.0) || o->irradiance_cache_mb > 1e7 ||
              o->cache_resolution < -1 || o->cache_resolution > 2 || o->cache_split[0] < 0.0f ||
              o->cache_split[1] < 0.0f || o->cache_split[2] < 0.0f ||
              !(o->cache_split[0] + o->cache_split[1] + o->cache_split[2] <= 1.0001f))
@@ -197,6 +202,8 @@ RenderSettings session_settings(const RayesRenderOptions *o)
         .irradiance = o->irradiance != 0,
         .radiosity_cache = o->cache != 0,
         .opacity_cache = o->opacity_cache != 0,
+        .irradiance_cache = o->irradiance_cache != 0,
+        .subsurface_rays = o->subsurface_rays,
         .volume_step = o->volume_step,
         .tile_done = o->tile_done,
         .tile_user = o->tile_user,
@@ -216,6 +223,8 @@ Cache *session_cache(const RayesRenderOptions *o)
         budgets[CACHE_RADIOSITY] = (uint64_t)(o->cache_mb * 1e6);
     if (o->opacity_cache)
         budgets[CACHE_OPACITY] = (uint64_t)(o->opacity_cache_mb * 1e6);
+    if (o->irradiance_cache)
+        budgets[CACHE_IRRADIANCE] = (uint64_t)(o->irradiance_cache_mb * 1e6);
     return cache_new_typed(budgets, o->cache_split);
 }
 
@@ -275,7 +284,12 @@ static uint32_t *object_masks(const RayesScene *scene, const RenderObject *ro)
     uint32_t *m = calloc(scene->n_objects + 1, sizeof *m);
     if (m)
         for (size_t i = 0; i < scene->n_objects; i++)
-            m[i] = scene->objects[i].ray_mask | (ro[i].transparent ? ACCEL_MASK_TRANSPARENT : 0u);
+            m[i] = scene->objects[i].ray_mask |
+                   (ro[i].transparent ? ACCEL_MASK_TRANSPARENT : 0u) |
+                   (ro[i].shader && (shade_class_flags(ro[i].shader->cls) &
+                                     RAYES_SHADER_SUBSURFACE)
+                        ? ACCEL_MASK_OWN_SCENE
+                        : 0u);
     return m;
 }
 
@@ -422,7 +436,7 @@ RayesError rayes_render(RayesScene *scene, const RayesRenderOptions *opt, RayesI
     e = session_prepare(scene, &set, textures, &prep);
     if (e != RAYES_OK)
         goto done;
-    if (opt->cache || opt->opacity_cache) {
+    if (opt->cache || opt->opacity_cache || opt->irradiance_cache) {
         cache = session_cache(opt);
         if (!cache) {
             e = session_fail(scene, RAYES_ERROR_OUT_OF_MEMORY,

@@ -45,7 +45,8 @@ int session_crop_pixels(const RayesRenderOptions *options, int rect[4]);
 /* The texture system of a render: the scene's texture path, then
  * $RAYES_TEXTURE_PATH's. NULL when out of memory. */
 /* The cache of a render: radiosity with cache_mb if o->cache, opacity with
- * opacity_cache_mb if o->opacity_cache (one Cache, a budget per data
+ * opacity_cache_mb if o->opacity_cache, irradiance with irradiance_cache_mb
+ * if o->irradiance_cache (one Cache, a budget per data
  * type). NULL when out of memory. */
 Cache *session_cache(const RayesRenderOptions *o);
 TextureSystem *session_textures(const RayesScene *scene, double mb, float width);

@@ -9,7 +9,7 @@
 
 #include "util/log.h"
 
-#define MAX_STATS 192
+#define MAX_STATS 256
 
 struct RayesStats {
     RayesStat items[MAX_STATS];
@@ -55,10 +55,13 @@ RayesStats *session_stats_new(const RenderSettings *set, const RenderStats *rs, 
     count(s, "rays/diffuse", rs->rays_diffuse);
     count(s, "rays/specular", rs->rays_specular);
     count(s, "rays/transmission", rs->rays_transmission); /* of rays/shadow: they marched */
+    count(s, "rays/subsurface", rs->rays_subsurface);     /* not in rays/total */
     count(s, "lighting/ambient_points", rs->ambient_lookups);
     count(s, "opacity/shading_points", rs->opacity_points);
     count(s, "opacity/transparent_hits", rs->transparent_hits);
     count(s, "volume/steps", rs->volume_steps);
+    count(s, "subsurface/points", rs->subsurface_points);
+    count(s, "subsurface/irradiance_points", rs->irradiance_points);
     count(s, "grids", gs->n_grids);
     count(s, "grid_vertices", gs->n_vertices);
     count(s, "grid_size", (uint64_t)set->grid_size);
@@ -116,7 +119,7 @@ void session_stats_add_cache(RayesStats *s, const CacheStats *cs)
 /* Each data type's own counters (memo 6: one cache, keys with a data
  * type): cache/radiosity/LEVEL/... and cache/opacity/LEVEL/..., for the
  * types that had a budget or lookups. */
-static const char *const typed_names[2][CACHE_N_LEVELS][7] = {
+static const char *const typed_names[3][CACHE_N_LEVELS][7] = {
     {{"cache/radiosity/coarse/lookups", "cache/radiosity/coarse/hits",
       "cache/radiosity/coarse/misses", "cache/radiosity/coarse/fills",
       "cache/radiosity/coarse/evictions", "cache/radiosity/coarse/entries",
@@ -136,14 +139,27 @@ static const char *const typed_names[2][CACHE_N_LEVELS][7] = {
       "cache/opacity/medium/entries", "cache/opacity/medium/hit_rate"},
      {"cache/opacity/fine/lookups", "cache/opacity/fine/hits", "cache/opacity/fine/misses",
       "cache/opacity/fine/fills", "cache/opacity/fine/evictions", "cache/opacity/fine/entries",
-      "cache/opacity/fine/hit_rate"}}};
+      "cache/opacity/fine/hit_rate"}},
+    {{"cache/irradiance/coarse/lookups", "cache/irradiance/coarse/hits",
+      "cache/irradiance/coarse/misses", "cache/irradiance/coarse/fills",
+      "cache/irradiance/coarse/evictions", "cache/irradiance/coarse/entries",
+      "cache/irradiance/coarse/hit_rate"},
+     {"cache/irradiance/medium/lookups", "cache/irradiance/medium/hits",
+      "cache/irradiance/medium/misses", "cache/irradiance/medium/fills",
+      "cache/irradiance/medium/evictions", "cache/irradiance/medium/entries",
+      "cache/irradiance/medium/hit_rate"},
+     {"cache/irradiance/fine/lookups", "cache/irradiance/fine/hits",
+      "cache/irradiance/fine/misses", "cache/irradiance/fine/fills",
+      "cache/irradiance/fine/evictions", "cache/irradiance/fine/entries",
+      "cache/irradiance/fine/hit_rate"}}};
 
 static void session_stats_add_cache_types(RayesStats *s, const CacheStats *cs)
 {
-    static const int types[2] = {CACHE_RADIOSITY, CACHE_OPACITY};
-    static const char *const budgets[2] = {"cache/radiosity/budget_bytes",
-                                           "cache/opacity/budget_bytes"};
-    for (int k = 0; k < 2; k++) {
+    static const int types[3] = {CACHE_RADIOSITY, CACHE_OPACITY, CACHE_IRRADIANCE};
+    static const char *const budgets[3] = {"cache/radiosity/budget_bytes",
+                                           "cache/opacity/budget_bytes",
+                                           "cache/irradiance/budget_bytes"};
+    for (int k = 0; k < 3; k++) {
         int t = types[k];
         uint64_t lookups = 0;
         for (int l = 0; l < CACHE_N_LEVELS; l++)

@@ -72,6 +72,14 @@ void shade_run_lighting(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
 void shade_run_opacity(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
                        const ShaderInstance *inst, RayesShadeOutputs *out);
 
+/* The class's RayesShaderFlags (0 for a class built before the field). */
+static inline uint32_t shade_class_flags(const RayesShaderClass *cls)
+{
+    return cls && cls->struct_size >= offsetof(RayesShaderClass, flags) + sizeof cls->flags
+               ? cls->flags
+               : 0u;
+}
+
 /* Points per chunk when a shader needs scratch arrays on the stack. */
 #define SHADE_CHUNK 64
 

@@ -50,7 +50,8 @@ enum {
     DIM_PATH = 5,       /* child path keys */
     DIM_REFRACTION = 6, /* refracted rays */
     DIM_SHADER = 7,     /* the random service: shaders' own choices */
-    DIM_OCCLUSION = 8   /* ambient occlusion rays */
+    DIM_OCCLUSION = 8,  /* ambient occlusion rays */
+    DIM_SUBSURFACE = 9  /* subsurface rays from a probe point (memo 6.2) */
 };
 
 #endif /* RAYES_UTIL_RNG_H */

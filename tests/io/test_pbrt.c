@@ -1273,7 +1273,50 @@ static void test_spectrum_files(void)
     free(r);
 }
 
-TEST_MAIN(TEST(test_filters), TEST(test_filter_warnings), TEST(test_import), TEST(test_film_types),
+/* pbrt-v4's subsurface (memo 6.2): a named medium (Jensen's, by name in
+ * any case), reflectance and mfp, sigma_a and sigma_s reduced by g; scale
+ * becomes unitlength 1 / scale; an unknown medium is an error at its
+ * line. */
+static void test_subsurface_material(void)
+{
+    Rec *r = malloc(sizeof *r);
+    IoSettings s;
+    char err[512] = "";
+    const char *tri = "Shape \"trianglemesh\" \"point3 P\" [0 0 0 1 0 0 0 1 0]\n";
+    char text[2048];
+    snprintf(text, sizeof text,
+             "WorldBegin\n"
+             "Material \"subsurface\" \"string name\" \"Skin1\" \"float scale\" 4\n%s"
+             "Material \"subsurface\" \"rgb reflectance\" [0.8 0.5 0.3] \"rgb mfp\" [2 1 0.5]\n%s"
+             "Material \"subsurface\" \"rgb sigma_a\" [0.1 0.2 0.3] \"rgb sigma_s\" [2 2 2] "
+             "\"float g\" 0.5 \"float eta\" 1.5\n%s",
+             tri, tri, tri);
+    CHECK(parse("t.pbrt", text, r, &s, err, sizeof err) == RAYES_OK);
+    CHECK(r->n_meshes == 3);
+    if (r->n_meshes == 3) {
+        const Shader *sh = &r->mesh[0].shader;
+        CHECK(strcmp(sh->name, "subsurface") == 0);
+        CHECK(param(sh, "sigma_s") && fabsf(param(sh, "sigma_s")->value[0] - 0.74f) < 1e-6f);
+        CHECK(param(sh, "sigma_a") && fabsf(param(sh, "sigma_a")->value[2] - 0.48f) < 1e-6f);
+        CHECK(param(sh, "unitlength") && fabsf(param(sh, "unitlength")->value[0] - 0.25f) < 1e-6f);
+        CHECK(param(sh, "eta") && fabsf(param(sh, "eta")->value[0] - 1.33f) < 1e-6f);
+        sh = &r->mesh[1].shader;
+        CHECK(param(sh, "reflectance") && fabsf(param(sh, "reflectance")->value[1] - 0.5f) < 1e-6f);
+        CHECK(param(sh, "mfp") && fabsf(param(sh, "mfp")->value[2] - 0.5f) < 1e-6f);
+        CHECK(!param(sh, "sigma_s"));
+        sh = &r->mesh[2].shader;
+        CHECK(param(sh, "sigma_s") && fabsf(param(sh, "sigma_s")->value[0] - 1.0f) < 1e-6f);
+        CHECK(param(sh, "eta") && fabsf(param(sh, "eta")->value[0] - 1.5f) < 1e-6f);
+    }
+    const char *bad = "WorldBegin\n"
+                      "Material \"subsurface\" \"string name\" \"Granite\"\n";
+    CHECK(parse("bad.pbrt", bad, r, &s, err, sizeof err) == RAYES_ERROR_PARSE);
+    CHECK(strstr(err, "bad.pbrt:2:") != NULL && strstr(err, "Granite") != NULL &&
+          !strchr(err, '\n'));
+    free(r);
+}
+
+TEST_MAIN(TEST(test_filters), TEST(test_subsurface_material), TEST(test_filter_warnings), TEST(test_import), TEST(test_film_types),
           TEST(test_measured_material), TEST(test_anisotropic_roughness), TEST(test_maxdepth),
           TEST(test_spectrum_files), TEST(test_cornell_box), TEST(test_transforms),
           TEST(test_materials), TEST(test_lights), TEST(test_instances_include_ply),

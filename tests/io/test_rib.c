@@ -422,6 +422,11 @@ static void test_shaders_and_lights(void)
               "Polygon \"P\" [0 0 0 1 0 0 1 1 0]")) == RAYES_OK);
     CHECK(rec.lights == 3 && strcmp(rec.light_map[0], "test_rib_sky.exr") == 0 &&
           rec.light_map[1][0] == '\0' && strcmp(rec.light_map[2], "m.exr") == 0);
+    /* RenderMan's classic subsurface parameters: the built-in subsurface */
+    CHECK(parse(WORLD("Surface \"subsurface\" \"color albedo\" [0.8 0.6 0.5]\n"
+                      "  \"color diffusemeanfreepath\" [8 4 2] \"float ior\" 1.4\n"
+                      "  \"float unitlength\" 0.1\nPolygon \"P\" [0 0 0 1 0 0 1 1 0]")) == RAYES_OK);
+    CHECK(strcmp(rec.shader, "subsurface") == 0);
     CHECK(parse("Option \"searchpath\" \"shader\" [\"mine:&\"]\nWorldBegin\nWorldEnd\n") ==
           RAYES_OK);
     CHECK(strcmp(rec.search, "shader=mine:&") == 0);
