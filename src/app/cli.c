@@ -118,11 +118,19 @@ static const char convert_text[] =
     "  --frame N               the frame of a RIB file to read (default: the last)\n"
     "  --quiet                 no \"wrote OUT.rib\" line\n";
 
+static const char assemble_text[] =
+    "usage: rayes assemble OUT.exr PART.exr...\n"
+    "\n"
+    "Puts the crops of one frame (renders with --crop, written as EXR: each file's\n"
+    "data window is its crop) together into OUT.exr. Crops that tile the frame give\n"
+    "the bytes of the whole frame's render.\n";
+
 void print_usage(FILE *f)
 {
     fputs("usage: rayes render [SCENE] [options]\n"
           "       rayes view [SCENE] [options] [view options]\n"
           "       rayes convert SCENE OUT.rib [--data DIR] [--frame N] [--quiet]\n"
+          "       rayes assemble OUT.exr PART.exr...\n"
           "       rayes --help | --version\n"
           "       rayes COMMAND --help\n"
           "\n",
@@ -138,6 +146,10 @@ void print_command_usage(const char *command, FILE *f)
 {
     if (strcmp(command, "convert") == 0) {
         fputs(convert_text, f);
+        return;
+    }
+    if (strcmp(command, "assemble") == 0) {
+        fputs(assemble_text, f);
         return;
     }
     int view = strcmp(command, "view") == 0;

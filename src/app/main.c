@@ -25,6 +25,7 @@
 #include "rayes/rayes.h"
 #include "util/log.h"
 
+#include "app/assemble.h"
 #include "app/checkpoint.h"
 #include "app/cli.h"
 #include "app/distribute.h"
@@ -629,5 +630,7 @@ int main(int argc, char **argv)
         return cmd_convert(argc, argv);
     if (strcmp(argv[1], "view") == 0)
         return cmd_view(argc, argv);
+    if (strcmp(argv[1], "assemble") == 0)
+        return cmd_assemble(argc, argv);
     die_usage("unknown command \"%s\"", argv[1]);
 }

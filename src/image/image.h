@@ -54,6 +54,12 @@ RayesError image_write(const char *path, int width, int height, const float *rgb
 RayesError image_read_exr(const char *path, int *width, int *height, float **rgba,
                        char *err, size_t err_size);
 
+/* The same, with the file's display window size (display[0] x
+ * display[1]) and its data window within it (window: x, y, w, h; the
+ * image is the data window's pixels): a crop rendered with --crop. */
+RayesError image_read_exr_window(const char *path, int display[2], int window[4], float **rgba,
+                                 char *err, size_t err_size);
+
 /* Reads a PNG (any bit depth/colour type, converted to RGBA) and decodes
  * sRGB to linear. *rgba is new (free()). */
 RayesError image_read_png(const char *path, int *width, int *height, float **rgba,

@@ -322,6 +322,7 @@ typedef struct ExrTarget {
     int width, height; /* the data window's size */
     int x0, y0;        /* the data window's minimum corner */
     bool tiled;        /* tiles, else scanlines */
+    int display[4];    /* the display window: minimum corner, width, height */
 } ExrTarget;
 
 /* Points the decoder's channels at the chunk's first pixel in target;
@@ -534,7 +535,15 @@ static RayesError check_header(exr_const_context_t ctx, const char *path, ExrTar
                      path, (long long)w, (long long)h);
         return RAYES_ERROR_PARSE;
     }
-    *target = (ExrTarget){NULL, (int)w, (int)h, dw.min.x, dw.min.y, storage == EXR_STORAGE_TILED};
+    *target = (ExrTarget){NULL, (int)w, (int)h, dw.min.x, dw.min.y, storage == EXR_STORAGE_TILED,
+                          {dw.min.x, dw.min.y, (int)w, (int)h}};
+    exr_attr_box2i_t disp;
+    if (exr_get_display_window(ctx, 0, &disp) == EXR_ERR_SUCCESS) {
+        int64_t dw_ = (int64_t)disp.max.x - disp.min.x + 1, dh = (int64_t)disp.max.y - disp.min.y + 1;
+        if (dw_ > 0 && dh > 0 && dw_ <= MAX_SIDE && dh <= MAX_SIDE && dw_ * dh <= MAX_PIXELS)
+            memcpy(target->display, (int[4]){disp.min.x, disp.min.y, (int)dw_, (int)dh},
+                   sizeof target->display);
+    }
     return RAYES_OK;
 }
 
@@ -566,16 +575,42 @@ static RayesError read_part(exr_const_context_t ctx, const ExrIo *io, const char
     return RAYES_OK;
 }
 
+static RayesError read_exr(const char *path, ExrTarget *out, char *err, size_t err_size);
+
 RayesError image_read_exr(const char *path, int *width, int *height, float **rgba, char *err,
-                       size_t err_size)
+                          size_t err_size)
 {
     if (!path || !width || !height || !rgba) {
         image_set_error(err, err_size, "%s: cannot read EXR: invalid arguments",
-                     path ? path : "(null)");
+                        path ? path : "(null)");
         return RAYES_ERROR_INVALID_ARGUMENT;
     }
-    *rgba = NULL;
-    *width = *height = 0;
+    ExrTarget t = {0};
+    RayesError e = read_exr(path, &t, err, err_size);
+    *rgba = t.rgba;
+    *width = t.width;
+    *height = t.height;
+    return e;
+}
+
+RayesError image_read_exr_window(const char *path, int display[2], int window[4], float **rgba,
+                                 char *err, size_t err_size)
+{
+    ExrTarget t = {0};
+    RayesError e = read_exr(path, &t, err, err_size);
+    *rgba = t.rgba;
+    if (e == RAYES_OK) {
+        display[0] = t.display[2], display[1] = t.display[3];
+        window[0] = t.x0 - t.display[0], window[1] = t.y0 - t.display[1];
+        window[2] = t.width, window[3] = t.height;
+    }
+    return e;
+}
+
+/* Part 0 of the file at path into a new image in *out (out->rgba NULL on
+ * failure). */
+static RayesError read_exr(const char *path, ExrTarget *out, char *err, size_t err_size)
+{
     ExrIo io = {.fd = open(path, O_RDONLY | O_CLOEXEC)};
     if (io.fd < 0) {
         image_set_errno_error(err, err_size, errno, "%s: cannot open", path);
@@ -593,10 +628,7 @@ RayesError image_read_exr(const char *path, int *width, int *height, float **rgb
     if (ctx)
         exr_finish(&ctx);
     close(io.fd);
-    if (status == RAYES_OK) {
-        *rgba = target.rgba;
-        *width = target.width;
-        *height = target.height;
-    }
+    if (status == RAYES_OK)
+        *out = target;
     return status;
 }
