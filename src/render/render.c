@@ -212,6 +212,7 @@ static void merge_stats(RenderStats *into, const RenderStats *s)
     into->transparent_hits += s->transparent_hits;
     into->rays_transmission += s->rays_transmission;
     into->volume_steps += s->volume_steps;
+    into->instance_fills += s->instance_fills;
 }
 
 int render_frame(const RenderScene *rs, const RenderSettings *set, float *rgba, RenderStats *stats)
