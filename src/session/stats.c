@@ -52,8 +52,8 @@ static void add_instances(RayesStats *s, const RenderStats *rs, const GridSet *g
     count(s, "instances/master_grids", grids);
     count(s, "instances/master_vertices", master_vertices);
     count(s, "instances/flattened_vertices", flattened);
-    count(s, "cache/radiosity/instanced_fills", rs->instance_fills);
-    real(s, "cache/radiosity/entries_per_instance",
+    count(s, "instances/radiosity_fills", rs->instance_fills);
+    real(s, "instances/radiosity_entries_per_instance",
          (double)rs->instance_fills / (double)gs->n_instances);
 }
 
