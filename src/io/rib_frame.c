@@ -115,8 +115,8 @@ static int h_object_instance(Rib *r, const Args *a)
     Object *o = find_object(r, key);
     if (!o)
         return rib_error(r, "no object has the handle %s", rib_handle_name(key));
-    if (r->rec)
-        return rib_error(r, "ObjectInstance inside an object definition");
+    if (r->rec) /* the first pass (a sink without instances) cannot tell: the second says */
+        return r->pass == 1 ? 0 : rib_error(r, "ObjectInstance inside an object definition");
     if (r->sink->object_instance) {
         int skip = rib_emit_begin(r, NULL);
         if (skip)

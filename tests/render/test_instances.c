@@ -220,7 +220,7 @@ static void test_instances_bleed_their_own_colour(void)
     CHECK(lr > 1e-3 && rg > 1e-3);
     CHECK(lr > 3 * lg);
     CHECK(rg > 3 * rr);
-    CHECK(stat_count(st, "cache/radiosity/instanced_fills") >= 2);
+    CHECK(stat_count(st, "instances/radiosity_fills") >= 2);
     rayes_stats_free(st);
     rayes_image_free(img);
     rayes_scene_release(s);
