@@ -36,11 +36,14 @@ static void real(RayesStats *s, const char *name, double v)
 static void add_instances(RayesStats *s, const RenderStats *rs, const GridSet *gs)
 {
     uint64_t *vertices = calloc(gs->n_masters + 1, sizeof *vertices);
-    uint64_t grids = 0, master_vertices = 0, flattened = 0;
+    uint64_t grids = 0, master_vertices = 0, flattened = 0, micropolygons = 0;
     for (size_t k = 0; k < gs->n_grids; k++)
         if (gs->grids[k].master) {
+            const Grid *g = &gs->grids[k];
             grids++;
-            master_vertices += geom_grid_n_vertices(&gs->grids[k]);
+            master_vertices += geom_grid_n_vertices(g);
+            micropolygons += g->triangular ? (uint64_t)g->nu * g->nu
+                                           : (uint64_t)(g->nu - 1) * (uint64_t)(g->nv - 1);
             if (vertices)
                 vertices[gs->grids[k].master] += geom_grid_n_vertices(&gs->grids[k]);
         }
@@ -51,6 +54,7 @@ static void add_instances(RayesStats *s, const RenderStats *rs, const GridSet *g
     count(s, "instances/masters", gs->n_masters);
     count(s, "instances/master_grids", grids);
     count(s, "instances/master_vertices", master_vertices);
+    count(s, "instances/master_micropolygons", micropolygons);
     count(s, "instances/flattened_vertices", flattened);
     count(s, "instances/radiosity_fills", rs->instance_fills);
     real(s, "instances/radiosity_entries_per_instance",
