@@ -127,14 +127,18 @@ static double mean(const RayesImage *img, int c, int x0, int x1, int y0, int y1)
     return t / ((double)(x1 - x0) * (y1 - y0));
 }
 
-/* 1 ball in front, or that ball and n - 1 more behind it: the master is
- * diced once (for the nearest), so the grids do not grow with n. */
+/* 1 ball in front, or that ball and n - 1 more behind it, each with its
+ * own shader: the master is diced once (for the nearest), so the grids do
+ * not grow with n (bench/instances at test size). */
 static uint64_t grids_of(int n, uint64_t *instances)
 {
     RayesScene *s = stage();
     define_ball(s);
     for (int i = 0; i < n; i++) {
-        translate(s, (float)(i % 8) - 3.5f, 0.5f, 1.5f * (float)(i / 8) + (i ? 2.0f : -1.0f));
+        RayesParam c = color("Cs", (float)(i % 7) / 7.0f, (float)(i % 5) / 5.0f, 0.5f);
+        CHECK(rayes_scene_set_shader(s, "matte", &c, 1) == RAYES_OK); /* an object each */
+        translate(s, i ? (float)(i % 50) - 24.5f : 0.0f, 0.5f,
+                  1.5f * (float)(i / 50) + (i ? 2.0f : -1.0f));
         CHECK(rayes_scene_object_instance(s, "ball") == RAYES_OK);
     }
     identity(s);
@@ -153,9 +157,9 @@ static uint64_t grids_of(int n, uint64_t *instances)
 
 static void test_master_counted_once(void)
 {
-    uint64_t n1, n64;
-    uint64_t one = grids_of(1, &n1), many = grids_of(64, &n64);
-    CHECK(n1 == 1 && n64 == 64);
+    uint64_t n1, n_many;
+    uint64_t one = grids_of(1, &n1), many = grids_of(2500, &n_many);
+    CHECK(n1 == 1 && n_many == 2500);
     CHECK(one == many);
     CHECK(one > 10); /* the ball is diced into grids at all */
 }
