@@ -251,6 +251,7 @@ static void test_instance_renders_as_copy(void)
         identity(s);
         img[k] = render(s, 2, 1, NULL);
         dump(img[k], k ? "instances_copy" : "instances_instance");
+        rayes_scene_release(s);
     }
     for (int c = 0; c < 3; c++) {
         double a = mean(img[0], c, 0, SIZE, 0, SIZE), b = mean(img[1], c, 0, SIZE, 0, SIZE);
