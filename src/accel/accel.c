@@ -401,7 +401,7 @@ static int build_levels(Accel *a, const uint32_t *object_mask, const uint8_t *in
 
 /* One Embree instance per GeomInstance, in the world's scene, after its
  * own geometry; the masters' scenes are committed first. */
-static int build_instances(Accel *a, const uint32_t *object_mask)
+static int build_instances(Accel *a)
 {
     const GridSet *gs = a->gs;
     for (size_t m = 1; m < a->n_levels; m++)
@@ -417,7 +417,7 @@ static int build_instances(Accel *a, const uint32_t *object_mask)
         rtcSetGeometryTransform(geom, 0, RTC_FORMAT_FLOAT3X4_ROW_MAJOR,
                                 &gi->world_from_master.m[0][0]);
         Geom g = {.kind = KIND_INSTANCE, .instance = (uint32_t)i};
-        if (attach(&a->levels[0], geom, object_mask[gi->object] & ~ACCEL_MASK_TRANSPARENT, g) != 0)
+        if (attach(&a->levels[0], geom, gi->ray_mask & ~ACCEL_MASK_TRANSPARENT, g) != 0)
             return -1;
     }
     return 0;
@@ -470,7 +470,7 @@ Accel *accel_new(const GridSet *gs, const uint32_t *object_mask, size_t n_object
     a->levels[0].scene = new_scene(a);
     int rc = build_levels(a, object_mask, inherit_transparent, order);
     if (rc == 0)
-        rc = build_instances(a, object_mask);
+        rc = build_instances(a);
     free(order);
     free(inherit_transparent);
     if (rc == 0)

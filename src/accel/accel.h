@@ -23,8 +23,9 @@
  * scene of their own, in master space, and each instance one Embree
  * instance geometry of it in the world's scene (one instance level, as
  * Debian's Embree is built; nested instances are flattened before). An
- * instance's mask is its object's; a master's grids that inherit the
- * instance's object see every ray type.
+ * instance's mask is GeomInstance.ray_mask (its object's, and its
+ * enclosing instances'); a master's grids that inherit the instance's
+ * object see every ray type.
  *
  * Memory: the Accel borrows the GridSet, which must outlive it.
  * Thread-safety: queries are thread-safe after accel_new returns; threads

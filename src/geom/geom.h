@@ -225,6 +225,8 @@ typedef struct GeomInstance {
                               offsets and curvatures of master grids scale by it) */
     uint32_t master;       /* the master's index (its grids have Grid.master = master + 1) */
     uint32_t object;       /* the object its master's GEOM_OBJECT_INHERIT grids take */
+    uint32_t ray_mask;     /* RayesRayType bits that see it: those of every instance's object
+                              along its nesting (an enclosing instance's visibility holds) */
 } GeomInstance;
 
 typedef struct GridSet {

@@ -125,7 +125,8 @@ Bounds3 scene_instances_bounds(const RayesScene *s)
 
 /* The GeomInstance of master m under world_from_master; 0, or -1 if the
  * transform is singular. */
-static int make_instance(Mat4 world_from_master, uint32_t m, uint32_t object, GeomInstance *gi)
+static int make_instance(Mat4 world_from_master, uint32_t m, uint32_t object, uint32_t mask,
+                         GeomInstance *gi)
 {
     gi->world_from_master = world_from_master;
     if (!mat4_invert(world_from_master, &gi->master_from_world))
@@ -142,6 +143,7 @@ static int make_instance(Mat4 world_from_master, uint32_t m, uint32_t object, Ge
     gi->scale = cbrtf(fabsf(det));
     gi->master = m;
     gi->object = object;
+    gi->ray_mask = mask;
     return 0;
 }
 
@@ -175,18 +177,20 @@ static int children_init(const RayesScene *s, Children *c)
 }
 
 /* Appends the placements of master m under world_from_master (its own,
- * if it has primitives, then its nested instances'). */
+ * if it has primitives, then its nested instances'), seen by the rays of
+ * mask (the enclosing instances' objects' visibility, ANDed). */
 static void place(const RayesScene *s, const Children *c, uint32_t m, Mat4 world_from_master,
-                  uint32_t object, GridSet *gs)
+                  uint32_t object, uint32_t mask, GridSet *gs)
 {
     const SceneMaster *ms = &s->masters[m];
     if (ms->end_prim > ms->first_prim &&
-        make_instance(world_from_master, m, object, &gs->instances[gs->n_instances]) == 0)
+        make_instance(world_from_master, m, object, mask, &gs->instances[gs->n_instances]) == 0)
         gs->n_instances++;
     for (size_t k = c->first[m]; k < c->first[m + 1]; k++) {
         const SceneInstance *si = &s->instances[c->of[k]];
         uint32_t o = si->object == GEOM_OBJECT_INHERIT ? object : si->object;
-        place(s, c, si->master, mat4_mul(world_from_master, si->parent_from_master), o, gs);
+        place(s, c, si->master, mat4_mul(world_from_master, si->parent_from_master), o,
+              mask & s->objects[o].ray_mask, gs);
     }
 }
 
@@ -208,7 +212,8 @@ int scene_flatten_instances(const RayesScene *s, GridSet *gs)
     for (size_t i = 0; i < s->n_instances; i++) {
         const SceneInstance *si = &s->instances[i];
         if (!si->parent)
-            place(s, &c, si->master, si->parent_from_master, si->object, gs);
+            place(s, &c, si->master, si->parent_from_master, si->object,
+                  s->objects[si->object].ray_mask, gs);
     }
     free(c.first);
     free(c.of);

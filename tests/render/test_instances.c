@@ -307,6 +307,72 @@ static void test_nested_and_deterministic(void)
     rayes_image_free(img[1]);
 }
 
+/* The mean absolute difference of two images' RGB. */
+static double mean_diff(const RayesImage *a, const RayesImage *b)
+{
+    double t = 0;
+    for (int i = 0; i < SIZE * SIZE; i++)
+        for (int c = 0; c < 3; c++)
+            t += fabs(a->rgba[4 * i + c] - b->rgba[4 * i + c]);
+    return t / (3.0 * SIZE * SIZE);
+}
+
+/* Light links per instance: a ball linked to no light is dark where the
+ * other is lit. And an enclosing instance invisible to every ray hides
+ * the instances nested in it even when their block gave them a visible
+ * object of their own: the picture is the one without it (but for ray
+ * offsets, which follow the scene's bounds), unlike a visible one. */
+static void test_instance_links_and_visibility(void)
+{
+    RayesScene *s = stage();
+    define_ball(s);
+    const size_t light0 = 0;
+    RayesParam white = color("Cs", 1, 1, 1);
+    CHECK(rayes_scene_set_light_links(s, RAYES_LIGHT_LINKS_EXCEPT, &light0, 1) == RAYES_OK);
+    CHECK(rayes_scene_set_shader(s, "matte", &white, 1) == RAYES_OK);
+    translate(s, 1, 0.5f, 0); /* the image's left */
+    CHECK(rayes_scene_object_instance(s, "ball") == RAYES_OK);
+    CHECK(rayes_scene_set_light_links(s, RAYES_LIGHT_LINKS_ALL, NULL, 0) == RAYES_OK);
+    CHECK(rayes_scene_set_shader(s, "matte", &white, 1) == RAYES_OK);
+    translate(s, -1, 0.5f, 0);
+    CHECK(rayes_scene_object_instance(s, "ball") == RAYES_OK);
+    RayesImage *img = render(s, 2, 1, NULL);
+    int y0 = SIZE / 2 - 6, y1 = SIZE / 2 + 2;
+    double unlit = mean(img, 1, 16, 24, y0, y1), lit = mean(img, 1, 40, 48, y0, y1);
+    CHECK(lit > 0.05);
+    CHECK(unlit < 0.25 * lit);
+    rayes_image_free(img);
+    rayes_scene_release(s);
+
+    RayesImage *img3[3];
+    for (int k = 0; k < 3; k++) {
+        s = stage();
+        define_ball(s);
+        CHECK(rayes_scene_object_begin(s, "pair") == RAYES_OK);
+        RayesParam blue = color("Cs", 0.2f, 0.3f, 1);
+        CHECK(rayes_scene_set_shader(s, "matte", &blue, 1) == RAYES_OK); /* visible */
+        translate(s, -0.6f, 0, 0);
+        CHECK(rayes_scene_object_instance(s, "ball") == RAYES_OK);
+        translate(s, 0.6f, 0, 0);
+        CHECK(rayes_scene_object_instance(s, "ball") == RAYES_OK);
+        CHECK(rayes_scene_object_end(s) == RAYES_OK);
+        if (k < 2) {
+            if (k == 0)
+                CHECK(rayes_scene_set_visibility(s, 0) == RAYES_OK);
+            CHECK(rayes_scene_set_shader(s, "matte", &white, 1) == RAYES_OK);
+            translate(s, 0, 0.5f, 0);
+            CHECK(rayes_scene_object_instance(s, "pair") == RAYES_OK);
+        }
+        img3[k] = render(s, 2, 1, NULL);
+        rayes_scene_release(s);
+    }
+    double hidden = mean_diff(img3[0], img3[2]), shown = mean_diff(img3[1], img3[2]);
+    CHECK(hidden < 2e-3);
+    CHECK(shown > 10 * hidden && shown > 5e-3);
+    for (int k = 0; k < 3; k++)
+        rayes_image_free(img3[k]);
+}
+
 static void test_errors(void)
 {
     RayesScene *s = rayes_scene_new();
@@ -349,4 +415,5 @@ static void test_block_restores_state(void)
 
 TEST_MAIN(TEST(test_master_counted_once), TEST(test_walls_colour_instances),
           TEST(test_instances_bleed_their_own_colour), TEST(test_instance_renders_as_copy),
-          TEST(test_nested_and_deterministic), TEST(test_errors), TEST(test_block_restores_state))
+          TEST(test_nested_and_deterministic), TEST(test_instance_links_and_visibility),
+          TEST(test_errors), TEST(test_block_restores_state))
