@@ -101,8 +101,8 @@ static RayesScene *build(const Args *a)
     check(s, rayes_scene_light(s, "distantlight", dl, 2));
     RayesParam white = {"Cs", RAYES_PARAM_COLOR, {0.8f, 0.8f, 0.8f}, NULL};
     check(s, rayes_scene_set_shader(s, "matte", &white, 1));
-    const float floor[4][3] = {{-extent, 0, -4}, {extent, 0, -4}, {-extent, 0, extent},
-                               {extent, 0, extent}};
+    const float floor[4][3] = {
+        {-extent, 0, -4}, {extent, 0, -4}, {-extent, 0, extent}, {extent, 0, extent}};
     check(s, rayes_scene_bilinear_patch(s, floor));
     check(s, rayes_scene_set_shading_rate(s, a->rate));
     if (!a->flatten) {
@@ -145,19 +145,28 @@ int main(int argc, char **argv)
     if (rayes_render(s, &o, &img, &st) != RAYES_OK)
         die(rayes_scene_get_error(s));
     printf("%s: %d balls at %d x %d, %d spp, %d threads, shading rate %g\n",
-           a.flatten ? "flattened copies" : "instances", a.count, a.size, a.size, a.spp,
-           a.threads, (double)a.rate);
-    static const char *const names[] = {
-        "instances/count",        "instances/master_grids",     "instances/master_micropolygons",
-        "instances/master_vertices", "instances/flattened_vertices", "grids",
-        "grid_vertices",          "instances/radiosity_fills",  "instances/radiosity_entries_per_instance",
-        "memory/grid_bytes",      "memory/accel_bytes",         "time/prepare_s",
-        "time/render_s",          "memory/peak_rss_bytes"};
+           a.flatten ? "flattened copies" : "instances", a.count, a.size, a.size, a.spp, a.threads,
+           (double)a.rate);
+    static const char *const names[] = {"instances/count",
+                                        "instances/master_grids",
+                                        "instances/master_micropolygons",
+                                        "instances/master_vertices",
+                                        "instances/flattened_vertices",
+                                        "grids",
+                                        "grid_vertices",
+                                        "instances/radiosity_fills",
+                                        "instances/radiosity_entries_per_instance",
+                                        "memory/grid_bytes",
+                                        "memory/accel_bytes",
+                                        "time/prepare_s",
+                                        "time/render_s",
+                                        "memory/peak_rss_bytes"};
     for (size_t k = 0; k < sizeof names / sizeof *names; k++)
         printf("  %-42s %.6g\n", names[k], real_stat(st, names[k]));
     printf("  peak resident: %.1f MB\n", real_stat(st, "memory/peak_rss_bytes") / 1e6);
     char err[256];
-    if (a.out && image_write(a.out, img->width, img->height, img->rgba, err, sizeof err) != RAYES_OK)
+    if (a.out &&
+        image_write(a.out, img->width, img->height, img->rgba, err, sizeof err) != RAYES_OK)
         die(err);
     rayes_stats_free(st);
     rayes_image_free(img);

@@ -1,9 +1,11 @@
 /*
  * accel/accel.c — the Embree 3 implementation of accel.h.
  *
- * Layout (per level: the world, then each master): per object with quad grids, one RTC_GEOMETRY_TYPE_GRID whose
- * grid buffer lists its grids (startVertexID = the grid's first vertex in
- * the shared vertex array, stride = nu); per object with triangular grids,
+ * Layout, per level (the world, then each master's own Embree scene,
+ * which instance geometries in the world's place): per object with quad
+ * grids, one RTC_GEOMETRY_TYPE_GRID whose grid buffer lists its grids
+ * (startVertexID = the grid's first vertex in the shared vertex array,
+ * stride = nu); per object with triangular grids,
  * one RTC_GEOMETRY_TYPE_TRIANGLE whose index buffer lists every
  * micropolygon; per object with curves, one ROUND_ or FLAT_LINEAR_CURVE
  * through the centre lines of their grids; per object with points, one

@@ -150,8 +150,8 @@ static int make_instance(Mat4 world_from_master, uint32_t m, uint32_t object, ui
 /* The instances made inside each master's block: children[first[m] ..
  * first[m + 1]) are indices into the scene's instances, in order made. */
 typedef struct Children {
-    size_t *first;    /* n_masters + 1 */
-    uint32_t *of;     /* n_instances */
+    size_t *first; /* n_masters + 1 */
+    uint32_t *of;  /* n_instances */
 } Children;
 
 static int children_init(const RayesScene *s, Children *c)

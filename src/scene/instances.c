@@ -61,10 +61,10 @@ RayesError rayes_scene_object_begin(RayesScene *s, const char *name)
         return scene_fail(s, RAYES_ERROR_OUT_OF_MEMORY, "out of memory");
     m->first_prim = m->end_prim = s->n_prims;
     m->depth = 1;
-    s->saved = (SceneSaved){s->world_from_object, s->current_object, s->shading_rate,
-                            s->displacement_bound, s->current_displacement, s->current_links,
-                            s->current_visibility, s->current_hitmode,
-                            s->current_opacity_cache};
+    s->saved =
+        (SceneSaved){s->world_from_object,  s->current_object,       s->shading_rate,
+                     s->displacement_bound, s->current_displacement, s->current_links,
+                     s->current_visibility, s->current_hitmode,      s->current_opacity_cache};
     s->open_master = (int64_t)s->n_masters++;
     s->current_object = SCENE_OBJECT_INHERIT;
     s->world_from_object = mat4_identity();
@@ -126,8 +126,8 @@ RayesError rayes_scene_object_instance(RayesScene *s, const char *name)
         if (e != RAYES_OK)
             return e;
     }
-    if (grow_one((void **)&s->instances, &s->cap_instances, s->n_instances,
-                 sizeof *s->instances) != 0)
+    if (grow_one((void **)&s->instances, &s->cap_instances, s->n_instances, sizeof *s->instances) !=
+        0)
         return scene_fail(s, RAYES_ERROR_OUT_OF_MEMORY, "out of memory");
     s->instances[s->n_instances++] = (SceneInstance){
         .parent_from_master = s->world_from_object,

@@ -55,19 +55,19 @@ static uint64_t render_stat(RayesScene *s, const char *stat, RayesImage **keep)
     return v;
 }
 
-#define RIB_HEAD                                                                             \
-    "Projection \"perspective\" \"fov\" 40\nTranslate 0 0 6\nWorldBegin\n"                 \
+#define RIB_HEAD                                                                                   \
+    "Projection \"perspective\" \"fov\" 40\nTranslate 0 0 6\nWorldBegin\n"                         \
     "LightSource \"pointlight\" 1 \"from\" [0 0 -4] \"intensity\" [20]\n"
 
 /* A quad in a block with no Surface or Color, instanced red at x = 1 and
  * green at x = -1 (the image's right and left). */
-static const char *rib_two =
-    RIB_HEAD "ObjectBegin \"card\"\n"
-             "  Polygon \"P\" [-0.8 -0.8 0  0.8 -0.8 0  0.8 0.8 0  -0.8 0.8 0]\n"
-             "ObjectEnd\n"
-             "AttributeBegin\nColor [1 0 0]\nTranslate 1 0 0\nObjectInstance \"card\"\nAttributeEnd\n"
-             "AttributeBegin\nColor [0 1 0]\nTranslate -1 0 0\nObjectInstance \"card\"\n"
-             "AttributeEnd\nWorldEnd\n";
+static const char *rib_two = RIB_HEAD
+    "ObjectBegin \"card\"\n"
+    "  Polygon \"P\" [-0.8 -0.8 0  0.8 -0.8 0  0.8 0.8 0  -0.8 0.8 0]\n"
+    "ObjectEnd\n"
+    "AttributeBegin\nColor [1 0 0]\nTranslate 1 0 0\nObjectInstance \"card\"\nAttributeEnd\n"
+    "AttributeBegin\nColor [0 1 0]\nTranslate -1 0 0\nObjectInstance \"card\"\n"
+    "AttributeEnd\nWorldEnd\n";
 
 static void test_rib_instances_inherit_colour(void)
 {
@@ -90,8 +90,7 @@ static void test_rib_block_colour_kept(void)
     CHECK(read_into(s, "t.rib",
                     RIB_HEAD "ObjectBegin 7\nColor [0 0 1]\n"
                              "  Polygon \"P\" [-0.8 -0.8 0  0.8 -0.8 0  0.8 0.8 0  -0.8 0.8 0]\n"
-                             "ObjectEnd\nColor [1 0 0]\nObjectInstance 7\nWorldEnd\n") ==
-          RAYES_OK);
+                             "ObjectEnd\nColor [1 0 0]\nObjectInstance 7\nWorldEnd\n") == RAYES_OK);
     RayesImage *img = NULL;
     CHECK(render_stat(s, "instances/masters", &img) == 1);
     const float *mid = &img->rgba[4 * (24 * 48 + 24)];
@@ -105,16 +104,17 @@ static void test_rib_nested(void)
 {
     RayesScene *s = rayes_scene_new();
     CHECK(read_into(s, "t.rib",
-                    RIB_HEAD "ObjectBegin \"ball\"\nSphere 0.2 -0.2 0.2 360\nObjectEnd\n"
-                             "ObjectBegin \"row\"\n"
-                             "  TransformBegin\nTranslate -0.5 0 0\nObjectInstance \"ball\"\n"
-                             "  TransformEnd\n"
-                             "  ObjectInstance \"ball\"\n"
-                             "  Translate 0.5 0 0\nObjectInstance \"ball\"\n"
-                             "ObjectEnd\n"
-                             "TransformBegin\nTranslate 0 0.5 0\nObjectInstance \"row\"\nTransformEnd\n"
-                             "Translate 0 -0.5 0\nObjectInstance \"row\"\nWorldEnd\n") == RAYES_OK);
-    CHECK(rayes_scene_instance_count(s) == 5); /* made: 3 in "row", 2 of it */
+                    RIB_HEAD
+                    "ObjectBegin \"ball\"\nSphere 0.2 -0.2 0.2 360\nObjectEnd\n"
+                    "ObjectBegin \"row\"\n"
+                    "  TransformBegin\nTranslate -0.5 0 0\nObjectInstance \"ball\"\n"
+                    "  TransformEnd\n"
+                    "  ObjectInstance \"ball\"\n"
+                    "  Translate 0.5 0 0\nObjectInstance \"ball\"\n"
+                    "ObjectEnd\n"
+                    "TransformBegin\nTranslate 0 0.5 0\nObjectInstance \"row\"\nTransformEnd\n"
+                    "Translate 0 -0.5 0\nObjectInstance \"row\"\nWorldEnd\n") == RAYES_OK);
+    CHECK(rayes_scene_instance_count(s) == 5);           /* made: 3 in "row", 2 of it */
     CHECK(render_stat(s, "instances/count", NULL) == 6); /* flattened */
     rayes_scene_release(s);
 }
@@ -150,18 +150,19 @@ static void test_errors(void)
 static void test_pbrt_instances(void)
 {
     RayesScene *s = rayes_scene_new();
-    CHECK(read_into(s, "t.pbrt",
-                    "LookAt 0 0 -6  0 0 0  0 1 0\nCamera \"perspective\" \"float fov\" 40\n"
-                    "WorldBegin\n"
-                    "LightSource \"point\" \"point3 from\" [0 0 -4] \"float scale\" 20\n"
-                    "ObjectBegin \"pebble\"\n"
-                    "  Material \"diffuse\" \"rgb reflectance\" [0.8 0.4 0.2]\n"
-                    "  Shape \"sphere\" \"float radius\" 0.3\n"
-                    "ObjectEnd\n"
-                    "ObjectInstance \"pebble\"\n"
-                    "AttributeBegin\nTranslate 1 0 0\nObjectInstance \"pebble\"\nAttributeEnd\n"
-                    "AttributeBegin\nTranslate -1 0 0\nObjectInstance \"pebble\"\nAttributeEnd\n") ==
-          RAYES_OK);
+    CHECK(
+        read_into(s, "t.pbrt",
+                  "LookAt 0 0 -6  0 0 0  0 1 0\nCamera \"perspective\" \"float fov\" 40\n"
+                  "WorldBegin\n"
+                  "LightSource \"point\" \"point3 from\" [0 0 -4] \"float scale\" 20\n"
+                  "ObjectBegin \"pebble\"\n"
+                  "  Material \"diffuse\" \"rgb reflectance\" [0.8 0.4 0.2]\n"
+                  "  Shape \"sphere\" \"float radius\" 0.3\n"
+                  "ObjectEnd\n"
+                  "ObjectInstance \"pebble\"\n"
+                  "AttributeBegin\nTranslate 1 0 0\nObjectInstance \"pebble\"\nAttributeEnd\n"
+                  "AttributeBegin\nTranslate -1 0 0\nObjectInstance \"pebble\"\nAttributeEnd\n") ==
+        RAYES_OK);
     CHECK(rayes_scene_instance_count(s) == 3);
     CHECK(render_stat(s, "instances/masters", NULL) == 1);
     rayes_scene_release(s);
