@@ -97,15 +97,6 @@ Bounds3 *scene_masters_bounds(const RayesScene *s)
     return mb;
 }
 
-Bounds3 scene_master_bounds(const RayesScene *s, size_t m)
-{
-    Bounds3 *mb = scene_masters_bounds(s), b = bounds_empty();
-    if (mb && m < s->n_masters)
-        b = mb[m];
-    free(mb);
-    return b;
-}
-
 Bounds3 scene_instances_bounds(const RayesScene *s)
 {
     Bounds3 b = bounds_empty();

@@ -186,13 +186,11 @@ struct RayesScene {
  * (instances.c). Returns 0, or -1 when out of memory. */
 int scene_flatten_instances(const RayesScene *scene, GridSet *gs);
 
-/* The master-space bounds of master m's primitives and nested instances,
- * and the world bounds of every instance placed in the world
- * (flatten.c). */
-Bounds3 scene_master_bounds(const RayesScene *scene, size_t m);
+/* The world bounds of every instance placed in the world (flatten.c). */
 Bounds3 scene_instances_bounds(const RayesScene *scene);
-/* Every master's bounds, n_masters of them (malloc'd: the caller frees),
- * or NULL when out of memory. */
+/* Every master's bounds in master space (its primitives and nested
+ * instances), n_masters of them (malloc'd: the caller frees), or NULL
+ * when out of memory. */
 Bounds3 *scene_masters_bounds(const RayesScene *scene);
 
 /* The bounds of one primitive's control points (scene.c). */
