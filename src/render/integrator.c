@@ -279,9 +279,9 @@ static Vec3 trace_layers(Worker *w, const Ray *ray, uint32_t kind, int diffuse_d
         if (see_through)
             Oi = integrator_opacity(w, ray, &hit, diff);
     } else if (kind == RAYES_RAY_CAMERA && w->grid_shading && !obj->transparent &&
-               !hit.instance && hider_camera_hit(w, ray, &hit, &Ci)) {
-        /* the grid hider's shaded grid (opaque objects only; instances are
-         * shaded at their hits: a grid's shading is per instance) */
+               hider_camera_hit(w, ray, &hit, &Ci)) {
+        /* the grid hider's shaded grid (opaque objects only; a master's grid
+         * per instance) */
     } else {
         Ci = shade_hit(w, ray, &hit, obj, kind, diffuse_depth, specular_depth, key, diff, &Oi);
     }

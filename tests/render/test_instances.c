@@ -77,7 +77,8 @@ static void define_ball(RayesScene *s)
     CHECK(rayes_scene_object_end(s) == RAYES_OK);
 }
 
-static RayesImage *render(RayesScene *s, int threads, int bounces, RayesStats **stats)
+static RayesImage *render_hider(RayesScene *s, int threads, int bounces, int hider,
+                                RayesStats **stats)
 {
     CHECK(rayes_scene_commit(s) == RAYES_OK);
     RayesRenderOptions o;
@@ -86,6 +87,8 @@ static RayesImage *render(RayesScene *s, int threads, int bounces, RayesStats **
     o.spp = 4;
     o.threads = threads;
     o.bounces = bounces;
+    o.hider = hider ? RAYES_HIDER_GRID : RAYES_HIDER_RAYTRACE;
+    o.irradiance = hider;
     RayesImage *img = NULL;
     CHECK(rayes_render(s, &o, &img, stats) == RAYES_OK);
     return img;
@@ -109,6 +112,11 @@ static void dump(const RayesImage *img, const char *name)
             fputc((int)(v * 255.0f + 0.5f), f);
         }
     fclose(f);
+}
+
+static RayesImage *render(RayesScene *s, int threads, int bounces, RayesStats **stats)
+{
+    return render_hider(s, threads, bounces, 0, stats);
 }
 
 static uint64_t stat_count(const RayesStats *st, const char *name)
@@ -373,6 +381,39 @@ static void test_instance_links_and_visibility(void)
         rayes_image_free(img3[k]);
 }
 
+/* The grid hider (with irradiance interpolation) shades a master's grids
+ * once per instance: the balls of differently coloured instances keep
+ * their colours, the picture agrees with the ray-tracing hider's, and it
+ * does not depend on threads. */
+static void test_grid_hider(void)
+{
+    RayesImage *img[3];
+    for (int k = 0; k < 3; k++) {
+        RayesScene *s = stage();
+        define_ball(s);
+        RayesParam red = color("Cs", 1, 0.1f, 0.1f), green = color("Cs", 0.1f, 1, 0.1f);
+        CHECK(rayes_scene_set_shader(s, "matte", &red, 1) == RAYES_OK);
+        translate(s, 1, 0.5f, 0);
+        CHECK(rayes_scene_object_instance(s, "ball") == RAYES_OK);
+        CHECK(rayes_scene_set_shader(s, "matte", &green, 1) == RAYES_OK);
+        translate(s, -1, 0.5f, 0);
+        CHECK(rayes_scene_object_instance(s, "ball") == RAYES_OK);
+        img[k] = render_hider(s, k == 2 ? 1 : 2, 1, k != 0, NULL);
+        dump(img[k], k ? "instances_hider" : "instances_raytrace");
+        rayes_scene_release(s);
+    }
+    int y0 = SIZE / 2 - 6, y1 = SIZE / 2 + 2;
+    CHECK(mean(img[1], 0, 16, 24, y0, y1) > 4 * mean(img[1], 1, 16, 24, y0, y1)); /* red */
+    CHECK(mean(img[1], 1, 40, 48, y0, y1) > 4 * mean(img[1], 0, 40, 48, y0, y1)); /* green */
+    for (int c = 0; c < 3; c++) {
+        double a = mean(img[0], c, 8, 56, 16, 48), b = mean(img[1], c, 8, 56, 16, 48);
+        CHECK_NEAR(b / a, 1.0, 0.03);
+    }
+    CHECK(memcmp(img[1]->rgba, img[2]->rgba, sizeof(float) * 4 * SIZE * SIZE) == 0);
+    for (int k = 0; k < 3; k++)
+        rayes_image_free(img[k]);
+}
+
 static void test_errors(void)
 {
     RayesScene *s = rayes_scene_new();
@@ -416,4 +457,5 @@ static void test_block_restores_state(void)
 TEST_MAIN(TEST(test_master_counted_once), TEST(test_walls_colour_instances),
           TEST(test_instances_bleed_their_own_colour), TEST(test_instance_renders_as_copy),
           TEST(test_nested_and_deterministic), TEST(test_instance_links_and_visibility),
+          TEST(test_grid_hider),
           TEST(test_errors), TEST(test_block_restores_state))
