@@ -537,8 +537,8 @@ RAYES_API RayesError rayes_scene_set_light_links(RayesScene *scene, RayesLightLi
 RAYES_API RayesError rayes_scene_object_begin(RayesScene *scene, const char *name);
 RAYES_API RayesError rayes_scene_object_end(RayesScene *scene);
 RAYES_API RayesError rayes_scene_object_instance(RayesScene *scene, const char *name);
-/* Instances made so far (nested ones counted once per placement in their
- * master, not flattened) and masters defined. */
+/* The rayes_scene_object_instance calls made so far (one nested in a
+ * block counts once, however often the block is placed). */
 RAYES_API size_t rayes_scene_instance_count(const RayesScene *scene);
 
 /* ---------------------------------------------------------------- edits
