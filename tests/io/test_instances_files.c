@@ -203,6 +203,23 @@ static void test_rib_writer_round_trip(void)
     free(text);
 }
 
-TEST_MAIN(TEST(test_rib_instances_inherit_colour), TEST(test_rib_block_colour_kept),
+/* Aqsis's objectinstance scene: one master of one quad, twelve instances. */
+static void test_aqsis_objectinstance(void)
+{
+    char path[1024];
+    snprintf(path, sizeof path, "%s/scenes/rib-aqsis/objectinstance/singlepolygon.rib",
+             RAYES_TEST_DATA);
+    RayesScene *s = rayes_scene_new();
+    IoSettings settings;
+    io_settings_init(&settings);
+    IoSink sink = io_sink_scene(s);
+    IoReadOptions opt = {RAYES_TEST_DATA, -1};
+    CHECK(io_rib_read(path, &sink, &opt, &settings, err, sizeof err) == RAYES_OK);
+    CHECK(rayes_scene_instance_count(s) == 12);
+    CHECK(render_stat(s, "instances/masters", NULL) == 1);
+    rayes_scene_release(s);
+}
+
+TEST_MAIN(TEST(test_aqsis_objectinstance), TEST(test_rib_instances_inherit_colour), TEST(test_rib_block_colour_kept),
           TEST(test_rib_nested), TEST(test_errors), TEST(test_pbrt_instances),
           TEST(test_rib_writer_round_trip))
