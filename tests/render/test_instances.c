@@ -431,6 +431,26 @@ static void test_errors(void)
     CHECK(rayes_scene_commit(s) == RAYES_ERROR_INVALID_OPERATION);
     CHECK(rayes_scene_object_end(s) == RAYES_OK);
     CHECK(rayes_scene_commit(s) == RAYES_OK);
+    /* blocks of two instances of the one before: 2^k placements; past
+     * 2^24 flattened instances, an error instead of an explosion */
+    CHECK(rayes_scene_object_begin(s, "n0") == RAYES_OK);
+    CHECK(rayes_scene_sphere(s, 1) == RAYES_OK);
+    CHECK(rayes_scene_object_end(s) == RAYES_OK);
+    RayesError last = RAYES_OK;
+    int level = 1;
+    for (; level <= 30 && last == RAYES_OK; level++) {
+        char name[16], prev[16];
+        snprintf(name, sizeof name, "n%d", level);
+        snprintf(prev, sizeof prev, "n%d", level - 1);
+        CHECK(rayes_scene_object_begin(s, name) == RAYES_OK);
+        last = rayes_scene_object_instance(s, prev);
+        if (last == RAYES_OK)
+            last = rayes_scene_object_instance(s, prev);
+        CHECK(rayes_scene_object_end(s) == RAYES_OK);
+    }
+    CHECK(last == RAYES_ERROR_INVALID_ARGUMENT);
+    CHECK(level - 1 == 25); /* n24 holds 2^24 placements; n25 would hold 2^25 */
+    rayes_scene_clear_error(s);
     const float proj[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 1, 1};
     CHECK(rayes_scene_set_transform(s, proj) == RAYES_OK);
     CHECK(rayes_scene_object_instance(s, "a") == RAYES_ERROR_INVALID_ARGUMENT);
