@@ -514,6 +514,33 @@ typedef enum RayesLightLinks {
 RAYES_API RayesError rayes_scene_set_light_links(RayesScene *scene, RayesLightLinks mode,
                                                  const size_t *lights, size_t n_lights);
 
+/* Object instancing (RenderMan's ObjectBegin, ObjectEnd, ObjectInstance;
+ * pbrt-v4's ObjectBegin, ObjectEnd, ObjectInstance; memo 3.1). Between
+ * rayes_scene_object_begin and rayes_scene_object_end, geometry goes into
+ * a master named name instead of the world, in the master's own space
+ * (the current transform inside the block is master_from_object; the one
+ * before the block is restored by object_end, as are the shader, the
+ * displacement, the shading rate, the visibility and the light links).
+ * Geometry of the block made before any rayes_scene_set_shader inside it
+ * takes, per instance, the object (shader, colour, opacity, visibility,
+ * light links) current at rayes_scene_object_instance; geometry after a
+ * set_shader inside the block keeps that shader in every instance.
+ * rayes_scene_object_instance places the master defined last under that
+ * name with the current transform (world_from_master): one diced master
+ * is shared by all its instances (Embree instances; its grids are counted
+ * once), each instance has its own radiosity and opacity cache entries.
+ * Inside a block it nests the named master in the one being defined
+ * (flattened at render time into instances of the inner master). Lights
+ * and volumes inside a block are RAYES_ERROR_INVALID_ARGUMENT, as are
+ * a begin inside a block, an end without a begin, and an unknown name. A
+ * name defined again replaces the master for instances made afterwards. */
+RAYES_API RayesError rayes_scene_object_begin(RayesScene *scene, const char *name);
+RAYES_API RayesError rayes_scene_object_end(RayesScene *scene);
+RAYES_API RayesError rayes_scene_object_instance(RayesScene *scene, const char *name);
+/* The rayes_scene_object_instance calls made so far (one nested in a
+ * block counts once, however often the block is placed). */
+RAYES_API size_t rayes_scene_instance_count(const RayesScene *scene);
+
 /* ---------------------------------------------------------------- edits
  *
  * Changes to a scene that has been rendered, for interactive preview (a

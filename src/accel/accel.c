@@ -1,17 +1,19 @@
 /*
  * accel/accel.c — the Embree 3 implementation of accel.h.
  *
- * Layout: per object with quad grids, one RTC_GEOMETRY_TYPE_GRID whose
- * grid buffer lists its grids (startVertexID = the grid's first vertex in
- * the shared vertex array, stride = nu); per object with triangular grids,
+ * Layout, per level (the world, then each master's own Embree scene,
+ * which instance geometries in the world's place): per object with quad
+ * grids, one RTC_GEOMETRY_TYPE_GRID whose grid buffer lists its grids
+ * (startVertexID = the grid's first vertex in the shared vertex array,
+ * stride = nu); per object with triangular grids,
  * one RTC_GEOMETRY_TYPE_TRIANGLE whose index buffer lists every
  * micropolygon; per object with curves, one ROUND_ or FLAT_LINEAR_CURVE
  * through the centre lines of their grids; per object with points, one
  * SPHERE_ or DISC_POINT, a point per grid. Geom records map (geomID,
  * primID) back to grids. An object whose mask holds ACCEL_MASK_OWN_SCENE
- * has its geometries attached to a scene of its own too, under the same
- * geomIDs (Embree lets a geometry belong to several scenes): subsurface
- * rays test only their object's micropolygons (memo 6.2).
+ * has its world geometries attached to a scene of its own too, under the
+ * same geomIDs (Embree lets a geometry belong to several scenes):
+ * subsurface rays test only their object's micropolygons (memo 6.2).
  *
  * Embree with TBB builds on its own threads; commit happens once, before
  * any query, and queries are concurrent (Embree's contract).
@@ -38,25 +40,35 @@ typedef struct CurveSeg {
     uint32_t i;        /* the segment from centre-line vertex i to i + 1 */
 } CurveSeg;
 
-typedef enum GeomKind { KIND_QUADS, KIND_TRIS, KIND_CURVES, KIND_POINTS } GeomKind;
+typedef enum GeomKind { KIND_QUADS, KIND_TRIS, KIND_CURVES, KIND_POINTS, KIND_INSTANCE } GeomKind;
 
 typedef struct Geom {
     GeomKind kind;
     uint8_t shape;     /* GeomShape of its grids */
+    uint32_t instance; /* KIND_INSTANCE: the GridSet's instance index */
     uint32_t *grids;   /* quads, points: primID -> grid index */
     MicroTri *tris;    /* triangles: primID -> micropolygon */
     CurveSeg *segs;    /* curves: primID -> segment */
 } Geom;
 
-struct Accel {
-    RTCDevice device;
-    RTCScene scene;
-    RTCScene *object_scene; /* per object: its own scene, or NULL */
-    size_t n_objects;
-    RTCScene building;  /* the object scene geometries go to as well, or NULL */
-    const GridSet *gs;
+/* One Embree scene: the world's (level 0: world geometry, then one
+ * instance geometry per GeomInstance), or master m's (level m + 1, in
+ * master space, traced only through instances). */
+typedef struct Level {
+    RTCScene scene;    /* NULL: a master no instance places */
+    RTCScene also;     /* while building: an object's own scene that takes the geometries
+                          too (level 0 only), or NULL */
     Geom *geoms;       /* indexed by geomID */
     size_t n_geoms;
+} Level;
+
+struct Accel {
+    RTCDevice device;
+    const GridSet *gs;
+    Level *levels;     /* 1 + gs->n_masters */
+    size_t n_levels;
+    RTCScene *object_scene; /* per object: its own scene (ACCEL_MASK_OWN_SCENE), or NULL */
+    size_t n_objects;
     atomic_llong bytes; /* Embree's allocations, from the memory monitor */
     char error[256];   /* the first Embree error */
 };
@@ -76,35 +88,35 @@ static bool on_memory(void *user, ssize_t bytes, bool post)
     return true;
 }
 
-static int add_geom(Accel *a, Geom g)
+static int add_geom(Level *lv, Geom g)
 {
-    Geom *geoms = realloc(a->geoms, (a->n_geoms + 1) * sizeof *geoms);
+    Geom *geoms = realloc(lv->geoms, (lv->n_geoms + 1) * sizeof *geoms);
     if (!geoms)
         return -1;
-    a->geoms = geoms;
-    a->geoms[a->n_geoms++] = g;
+    lv->geoms = geoms;
+    lv->geoms[lv->n_geoms++] = g;
     return 0;
 }
 
 static void transmission_filter(const struct RTCFilterFunctionNArguments *args);
 
-/* Commits geom with its ray mask into the scene as the next geometry,
- * whose primitives map back to grids through g. */
-static int attach(Accel *a, RTCGeometry geom, uint32_t mask, Geom g)
+/* Commits geom with its ray mask into the level's scene as the next
+ * geometry, whose primitives map back to grids through g. */
+static int attach(Level *lv, RTCGeometry geom, uint32_t mask, Geom g)
 {
     if (mask & ACCEL_MASK_TRANSPARENT)
         rtcSetGeometryOccludedFilterFunction(geom, transmission_filter);
     rtcSetGeometryMask(geom, mask & ~(ACCEL_MASK_TRANSPARENT | ACCEL_MASK_OWN_SCENE));
     rtcCommitGeometry(geom);
-    unsigned id = rtcAttachGeometry(a->scene, geom);
-    if (a->building)
-        rtcAttachGeometryByID(a->building, geom, id);
+    unsigned id = rtcAttachGeometry(lv->scene, geom);
+    if (lv->also)
+        rtcAttachGeometryByID(lv->also, geom, id);
     rtcReleaseGeometry(geom);
-    RY_CHECK(id == a->n_geoms);
-    return add_geom(a, g);
+    RY_CHECK(id == lv->n_geoms);
+    return add_geom(lv, g);
 }
 
-static int build_quads(Accel *a, const uint32_t *idx, size_t n, uint32_t mask)
+static int build_quads(Accel *a, Level *lv, const uint32_t *idx, size_t n, uint32_t mask)
 {
     const GridSet *gs = a->gs;
     RTCGeometry geom = rtcNewGeometry(a->device, RTC_GEOMETRY_TYPE_GRID);
@@ -123,7 +135,7 @@ static int build_quads(Accel *a, const uint32_t *idx, size_t n, uint32_t mask)
         grids[k] = (struct RTCGrid){src->first_vertex, src->nu, src->nu, src->nv};
         g.grids[k] = idx[k];
     }
-    return attach(a, geom, mask, g);
+    return attach(lv, geom, mask, g);
 }
 
 static size_t count_tris(const GridSet *gs, const uint32_t *idx, size_t n)
@@ -150,7 +162,7 @@ static void tri_vertices(const Grid *g, const MicroTri *m, uint32_t v[3])
     }
 }
 
-static int build_tris(Accel *a, const uint32_t *idx, size_t n, uint32_t mask)
+static int build_tris(Accel *a, Level *lv, const uint32_t *idx, size_t n, uint32_t mask)
 {
     const GridSet *gs = a->gs;
     size_t n_tris = count_tris(gs, idx, n);
@@ -180,7 +192,7 @@ static int build_tris(Accel *a, const uint32_t *idx, size_t n, uint32_t mask)
                 }
     }
     RY_CHECK(t == n_tris);
-    return attach(a, geom, mask, g);
+    return attach(lv, geom, mask, g);
 }
 
 /* A curve grid's centre line: vertex i of its 2 rows, midway, and half
@@ -197,7 +209,8 @@ static void centre_vertex(const GridSet *gs, const Grid *g, uint32_t i, float ou
  * curves through their centre lines, round (tubes) or flat (ribbons that
  * face each ray); Embree joins the segments of one grid, and ends each
  * grid's run with a sphere (round), which fills the joint to the next. */
-static int build_curves(Accel *a, const uint32_t *idx, size_t n, uint32_t mask, int shape)
+static int build_curves(Accel *a, Level *lv, const uint32_t *idx, size_t n, uint32_t mask,
+                        int shape)
 {
     const GridSet *gs = a->gs;
     size_t n_vtx = 0, n_seg = 0;
@@ -230,7 +243,7 @@ static int build_curves(Accel *a, const uint32_t *idx, size_t n, uint32_t mask, 
         }
         v += src->nu;
     }
-    return attach(a, geom, mask, g);
+    return attach(lv, geom, mask, g);
 }
 
 static Vec3 unit_or_zero(Vec3 n);
@@ -246,7 +259,8 @@ static void point_square(const GridSet *gs, const Grid *g, Vec3 *o, Vec3 *x, Vec
 
 /* Point grids as Embree spheres or ray-facing disks inscribed in their
  * squares. */
-static int build_points(Accel *a, const uint32_t *idx, size_t n, uint32_t mask, int shape)
+static int build_points(Accel *a, Level *lv, const uint32_t *idx, size_t n, uint32_t mask,
+                        int shape)
 {
     const GridSet *gs = a->gs;
     RTCGeometry geom = rtcNewGeometry(a->device, shape == GEOM_SHAPE_SPHERE
@@ -278,7 +292,7 @@ static int build_points(Accel *a, const uint32_t *idx, size_t n, uint32_t mask, 
         }
         g.grids[k] = idx[k];
     }
-    return attach(a, geom, mask, g);
+    return attach(lv, geom, mask, g);
 }
 
 /* The kinds of grids an object may have, each one Embree geometry. */
@@ -305,80 +319,185 @@ static int grid_group(const Grid *g)
     }
 }
 
-/* Adds the geometries of one object: its quad grids, its triangular, then
- * its curves and points. */
-static int build_object(Accel *a, uint32_t object, uint32_t mask, uint32_t *scratch)
+/* A grid's place in the build order: by level, object, kind of geometry,
+ * then index (runs of equal level, object and kind are one geometry). */
+typedef struct GridKey {
+    uint32_t master, object, group, grid;
+} GridKey;
+
+static int cmp_keys(const void *pa, const void *pb)
+{
+    const GridKey *a = pa, *b = pb;
+    if (a->master != b->master)
+        return a->master < b->master ? -1 : 1;
+    if (a->object != b->object)
+        return a->object < b->object ? -1 : 1;
+    if (a->group != b->group)
+        return a->group < b->group ? -1 : 1;
+    return a->grid < b->grid ? -1 : a->grid > b->grid;
+}
+
+/* Adds one Embree geometry for the n grids idx (one level, object and
+ * group), in grid order. */
+static int build_run(Accel *a, Level *lv, const uint32_t *idx, size_t n, uint32_t mask)
+{
+    switch (grid_group(&a->gs->grids[idx[0]])) {
+    case GROUP_QUADS: return build_quads(a, lv, idx, n, mask);
+    case GROUP_TRIS: return build_tris(a, lv, idx, n, mask);
+    case GROUP_ROUND: return build_curves(a, lv, idx, n, mask, GEOM_SHAPE_ROUND_CURVE);
+    case GROUP_FLAT: return build_curves(a, lv, idx, n, mask, GEOM_SHAPE_FLAT_CURVE);
+    case GROUP_SPHERES: return build_points(a, lv, idx, n, mask, GEOM_SHAPE_SPHERE);
+    case GROUP_DISKS: return build_points(a, lv, idx, n, mask, GEOM_SHAPE_DISK);
+    default: return build_points(a, lv, idx, n, mask, GEOM_SHAPE_ORIENTED_DISK);
+    }
+}
+
+static RTCScene new_scene(Accel *a)
+{
+    RTCScene scene = rtcNewScene(a->device);
+    /* Watertight intersection: without it Embree's fast path lets rays
+     * slip between micropolygons that share an edge, inside a grid and
+     * between stitched grids (tests/render/test_watertight.c). */
+    rtcSetSceneFlags(scene, RTC_SCENE_FLAG_ROBUST);
+    rtcSetSceneBuildQuality(scene, RTC_BUILD_QUALITY_MEDIUM);
+    return scene;
+}
+
+/* The mask of grids of object o in a master: the object's own, or for
+ * inheriting grids every ray type (the instance's mask decides), with
+ * ACCEL_MASK_TRANSPARENT when any instance's object is transparent. */
+static uint32_t grid_mask(const Grid *g, const uint32_t *object_mask,
+                          const uint8_t *inherit_transparent)
+{
+    if (g->object != GEOM_OBJECT_INHERIT)
+        return object_mask[g->object];
+    return ~ACCEL_MASK_TRANSPARENT |
+           (inherit_transparent[g->master - 1] ? ACCEL_MASK_TRANSPARENT : 0u);
+}
+
+/* The world's and the masters' geometries: every run of grids of one
+ * level, object and kind becomes one Embree geometry. */
+static int build_levels(Accel *a, const uint32_t *object_mask, const uint8_t *inherit_transparent,
+                        uint32_t *order)
 {
     const GridSet *gs = a->gs;
-    a->building = NULL;
-    if (mask & ACCEL_MASK_OWN_SCENE) {
-        a->building = a->object_scene[object] = rtcNewScene(a->device);
-        rtcSetSceneFlags(a->building, RTC_SCENE_FLAG_ROBUST);
-        rtcSetSceneBuildQuality(a->building, RTC_BUILD_QUALITY_MEDIUM);
+    GridKey *keys = malloc((gs->n_grids + 1) * sizeof *keys);
+    if (!keys)
+        return -1;
+    for (size_t k = 0; k < gs->n_grids; k++) {
+        const Grid *g = &gs->grids[k];
+        keys[k] = (GridKey){g->master, g->object, (uint32_t)grid_group(g), (uint32_t)k};
     }
-    for (int group = 0; group < N_GROUPS; group++) {
-        size_t n = 0;
-        for (size_t k = 0; k < gs->n_grids; k++)
-            if (gs->grids[k].object == object && grid_group(&gs->grids[k]) == group)
-                scratch[n++] = (uint32_t)k;
-        if (n == 0)
-            continue;
-        int rc;
-        switch (group) {
-        case GROUP_QUADS: rc = build_quads(a, scratch, n, mask); break;
-        case GROUP_TRIS: rc = build_tris(a, scratch, n, mask); break;
-        case GROUP_ROUND: rc = build_curves(a, scratch, n, mask, GEOM_SHAPE_ROUND_CURVE); break;
-        case GROUP_FLAT: rc = build_curves(a, scratch, n, mask, GEOM_SHAPE_FLAT_CURVE); break;
-        case GROUP_SPHERES: rc = build_points(a, scratch, n, mask, GEOM_SHAPE_SPHERE); break;
-        case GROUP_DISKS: rc = build_points(a, scratch, n, mask, GEOM_SHAPE_DISK); break;
-        default: rc = build_points(a, scratch, n, mask, GEOM_SHAPE_ORIENTED_DISK); break;
+    qsort(keys, gs->n_grids, sizeof *keys, cmp_keys);
+    for (size_t k = 0; k < gs->n_grids; k++)
+        order[k] = keys[k].grid;
+    for (size_t k = 0; k < gs->n_grids;) {
+        const Grid *g = &gs->grids[order[k]];
+        size_t n = 1;
+        while (k + n < gs->n_grids && keys[k + n].master == keys[k].master &&
+               keys[k + n].object == keys[k].object && keys[k + n].group == keys[k].group)
+            n++;
+        Level *lv = &a->levels[g->master];
+        if (!lv->scene)
+            lv->scene = new_scene(a);
+        uint32_t mask = grid_mask(g, object_mask, inherit_transparent);
+        lv->also = NULL;
+        if (g->master == 0 && (mask & ACCEL_MASK_OWN_SCENE) && g->object < a->n_objects) {
+            if (!a->object_scene[g->object])
+                a->object_scene[g->object] = new_scene(a);
+            lv->also = a->object_scene[g->object];
         }
-        if (rc != 0)
+        int rc = build_run(a, lv, order + k, n, mask);
+        lv->also = NULL;
+        if (rc != 0) {
+            free(keys);
+            return -1;
+        }
+        k += n;
+    }
+    free(keys);
+    return 0;
+}
+
+/* One Embree instance per GeomInstance, in the world's scene, after its
+ * own geometry; the masters' scenes are committed first. */
+static int build_instances(Accel *a)
+{
+    const GridSet *gs = a->gs;
+    for (size_t m = 1; m < a->n_levels; m++)
+        if (a->levels[m].scene)
+            rtcCommitScene(a->levels[m].scene);
+    for (size_t i = 0; i < gs->n_instances; i++) {
+        const GeomInstance *gi = &gs->instances[i];
+        RTCScene master = a->levels[gi->master + 1].scene;
+        if (!master)
+            continue; /* a master whose grids all fell away */
+        RTCGeometry geom = rtcNewGeometry(a->device, RTC_GEOMETRY_TYPE_INSTANCE);
+        rtcSetGeometryInstancedScene(geom, master);
+        rtcSetGeometryTransform(geom, 0, RTC_FORMAT_FLOAT3X4_ROW_MAJOR,
+                                &gi->world_from_master.m[0][0]);
+        Geom g = {.kind = KIND_INSTANCE, .instance = (uint32_t)i};
+        if (attach(&a->levels[0], geom, gi->ray_mask & ~ACCEL_MASK_TRANSPARENT, g) != 0)
             return -1;
     }
     return 0;
+}
+
+/* Which masters' inheriting grids may be transparent: those placed by an
+ * instance whose object is. NULL when out of memory. */
+static uint8_t *inherit_transparency(const GridSet *gs, const uint32_t *object_mask)
+{
+    uint8_t *t = calloc(gs->n_masters + 1, 1);
+    for (size_t i = 0; t && i < gs->n_instances; i++)
+        if (object_mask[gs->instances[i].object] & ACCEL_MASK_TRANSPARENT)
+            t[gs->instances[i].master] = 1;
+    return t;
 }
 
 Accel *accel_new(const GridSet *gs, const uint32_t *object_mask, size_t n_objects, char *err,
                  size_t err_size)
 {
     Accel *a = calloc(1, sizeof *a);
-    uint32_t *scratch = malloc((gs->n_grids + 1) * sizeof *scratch);
-    RTCScene *own = calloc(n_objects + 1, sizeof *own);
-    if (!a || !scratch || !own) {
+    uint32_t *order = malloc((gs->n_grids + 1) * sizeof *order);
+    uint8_t *inherit_transparent = inherit_transparency(gs, object_mask);
+    if (a) {
+        a->levels = calloc(gs->n_masters + 1, sizeof *a->levels);
+        a->object_scene = calloc(n_objects + 1, sizeof *a->object_scene);
+        a->n_objects = n_objects;
+    }
+    if (!a || !a->levels || !a->object_scene || !order || !inherit_transparent) {
+        if (a)
+            free(a->levels), free(a->object_scene);
         free(a);
-        free(own);
-        free(scratch);
+        free(order);
+        free(inherit_transparent);
         snprintf(err, err_size, "out of memory building the ray tracing structure");
         return NULL;
     }
+    a->n_levels = gs->n_masters + 1;
     a->gs = gs;
-    a->object_scene = own;
-    a->n_objects = n_objects;
     atomic_init(&a->bytes, 0);
     a->device = rtcNewDevice("verbose=0");
     if (!a->device) {
         snprintf(err, err_size, "cannot create an Embree device (error %d)",
                  (int)rtcGetDeviceError(NULL));
-        free(own);
+        free(a->levels);
+        free(a->object_scene);
         free(a);
-        free(scratch);
+        free(order);
+        free(inherit_transparent);
         return NULL;
     }
     rtcSetDeviceErrorFunction(a->device, on_error, a);
     rtcSetDeviceMemoryMonitorFunction(a->device, on_memory, a);
-    a->scene = rtcNewScene(a->device);
-    /* Watertight intersection: without it Embree's fast path lets rays
-     * slip between micropolygons that share an edge, inside a grid and
-     * between stitched grids (tests/render/test_watertight.c). */
-    rtcSetSceneFlags(a->scene, RTC_SCENE_FLAG_ROBUST);
-    rtcSetSceneBuildQuality(a->scene, RTC_BUILD_QUALITY_MEDIUM);
-    int rc = 0;
-    for (size_t o = 0; o < n_objects && rc == 0; o++)
-        rc = build_object(a, (uint32_t)o, object_mask[o], scratch);
-    free(scratch);
+    a->levels[0].scene = new_scene(a);
+    int rc = build_levels(a, object_mask, inherit_transparent, order);
     if (rc == 0)
-        rtcCommitScene(a->scene);
+        rc = build_instances(a);
+    free(order);
+    free(inherit_transparent);
+    if (rc == 0)
+        rtcCommitScene(a->levels[0].scene);
     for (size_t o = 0; o < n_objects && rc == 0; o++)
         if (a->object_scene[o])
             rtcCommitScene(a->object_scene[o]);
@@ -394,18 +513,22 @@ void accel_free(Accel *a)
 {
     if (!a)
         return;
-    for (size_t k = 0; k < a->n_geoms; k++) {
-        free(a->geoms[k].grids);
-        free(a->geoms[k].tris);
-        free(a->geoms[k].segs);
+    for (size_t l = 0; a->levels && l < a->n_levels; l++) {
+        Level *lv = &a->levels[l];
+        for (size_t k = 0; k < lv->n_geoms; k++) {
+            free(lv->geoms[k].grids);
+            free(lv->geoms[k].tris);
+            free(lv->geoms[k].segs);
+        }
+        free(lv->geoms);
+        if (lv->scene)
+            rtcReleaseScene(lv->scene);
     }
-    free(a->geoms);
-    for (size_t o = 0; o < a->n_objects; o++)
+    free(a->levels);
+    for (size_t o = 0; a->object_scene && o < a->n_objects; o++)
         if (a->object_scene[o])
             rtcReleaseScene(a->object_scene[o]);
     free(a->object_scene);
-    if (a->scene)
-        rtcReleaseScene(a->scene);
     if (a->device)
         rtcReleaseDevice(a->device);
     free(a);
@@ -494,22 +617,28 @@ static void tri_hit(const Accel *a, const Geom *g, unsigned prim, float u, float
     hit->Ng = unit_or_zero(v3_cross(v3_sub(P[vtx[1]], P[vtx[0]]), v3_sub(P[vtx[2]], P[vtx[0]])));
 }
 
-/* Embree's geometric normal of a round shape's hit; a flat one faces the
- * ray. */
-static Vec3 shape_normal(const struct RTCRayHit *rh, int shape)
+/* Embree's geometric normal of a round shape's hit (in the space of its
+ * level); a flat one faces the ray (world). */
+static Vec3 shape_normal(const struct RTCHit *h, const Ray *ray, int shape)
 {
     if (shape == GEOM_SHAPE_ROUND_CURVE || shape == GEOM_SHAPE_SPHERE ||
         shape == GEOM_SHAPE_ORIENTED_DISK)
-        return unit_or_zero(v3(rh->hit.Ng_x, rh->hit.Ng_y, rh->hit.Ng_z));
-    return unit_or_zero(v3(-rh->ray.dir_x, -rh->ray.dir_y, -rh->ray.dir_z));
+        return unit_or_zero(v3(h->Ng_x, h->Ng_y, h->Ng_z));
+    return unit_or_zero(v3_neg(ray->d));
+}
+
+static int shape_flat(int shape)
+{
+    return shape == GEOM_SHAPE_FLAT_CURVE || shape == GEOM_SHAPE_DISK;
 }
 
 /* A curve segment's hit: u along it, half way across the grid's 2 rows. */
-static void curve_hit(const Accel *a, const Geom *g, const struct RTCRayHit *rh, Hit *hit)
+static void curve_hit(const Accel *a, const Geom *g, const struct RTCHit *h, const Ray *ray,
+                      Hit *hit)
 {
-    const CurveSeg *seg = &g->segs[rh->hit.primID];
+    const CurveSeg *seg = &g->segs[h->primID];
     const Grid *grid = &a->gs->grids[seg->grid];
-    float u = fminf(fmaxf(rh->hit.u, 0.0f), 1.0f);
+    float u = fminf(fmaxf(h->u, 0.0f), 1.0f);
     uint32_t b = grid->first_vertex + seg->i, w = grid->nu;
     hit->grid = seg->grid;
     hit->gu = ((float)seg->i + u) / (float)(w - 1u);
@@ -519,50 +648,69 @@ static void curve_hit(const Accel *a, const Geom *g, const struct RTCRayHit *rh,
     const float wt[4] = {0.5f * (1.0f - u), 0.5f * u, 0.5f * (1.0f - u), 0.5f * u};
     memcpy(hit->vertex, vtx, sizeof vtx);
     memcpy(hit->weight, wt, sizeof wt);
-    hit->Ng = shape_normal(rh, g->shape);
+    hit->Ng = shape_normal(h, ray, g->shape);
 }
 
-/* A point's hit: where the hit projects on its square. */
-static void point_hit(const Accel *a, const Geom *g, const struct RTCRayHit *rh, Hit *hit)
+/* A point's hit: where the hit (at tfar on the world ray; in master space
+ * through instance gi, when not NULL) projects on its square. */
+static void point_hit(const Accel *a, const Geom *g, const struct RTCHit *h, const Ray *ray,
+                      float tfar, const GeomInstance *gi, Hit *hit)
 {
     const GridSet *gs = a->gs;
-    const Grid *grid = &gs->grids[g->grids[rh->hit.primID]];
+    const Grid *grid = &gs->grids[g->grids[h->primID]];
     Vec3 o, x, y;
     point_square(gs, grid, &o, &x, &y);
-    Vec3 p = v3(rh->ray.org_x + rh->ray.tfar * rh->ray.dir_x,
-                rh->ray.org_y + rh->ray.tfar * rh->ray.dir_y,
-                rh->ray.org_z + rh->ray.tfar * rh->ray.dir_z);
+    Vec3 p = v3_madd(ray->o, ray->d, tfar);
+    if (gi)
+        p = mat4_point(&gi->master_from_world, p);
     Vec3 d = v3_sub(p, o);
     float xx = v3_dot(x, x), yy = v3_dot(y, y);
     float u = xx > 0.0f ? fminf(fmaxf(v3_dot(d, x) / xx, 0.0f), 1.0f) : 0.5f;
     float v = yy > 0.0f ? fminf(fmaxf(v3_dot(d, y) / yy, 0.0f), 1.0f) : 0.5f;
-    quad_hit(a, g, rh->hit.primID, u, v, hit);
-    hit->Ng = shape_normal(rh, g->shape);
+    quad_hit(a, g, h->primID, u, v, hit);
+    hit->Ng = shape_normal(h, ray, g->shape);
 }
 
-/* The Hit of Embree's hit rh (tfar its distance). */
-static void make_hit(const Accel *a, const struct RTCRayHit *rh, Hit *hit)
+/* The Hit of Embree's hit h at distance tfar along the world ray. A hit
+ * through an instance is found in its master's level; Ng is turned to
+ * world space. */
+static void make_hit(const Accel *a, const Ray *ray, const struct RTCHit *h, float tfar, Hit *hit)
 {
-    const Geom *g = &a->geoms[rh->hit.geomID];
-    hit->t = rh->ray.tfar;
+    const GeomInstance *gi = NULL;
+    const Geom *g;
+    hit->instance = 0;
+    if (h->instID[0] != RTC_INVALID_GEOMETRY_ID) {
+        uint32_t i = a->levels[0].geoms[h->instID[0]].instance;
+        gi = &a->gs->instances[i];
+        g = &a->levels[gi->master + 1].geoms[h->geomID];
+        hit->instance = i + 1;
+    } else {
+        g = &a->levels[0].geoms[h->geomID];
+    }
+    hit->t = tfar;
     hit->shape = g->shape;
     switch (g->kind) {
     case KIND_TRIS:
-        tri_hit(a, g, rh->hit.primID, rh->hit.u, rh->hit.v, hit);
+        tri_hit(a, g, h->primID, h->u, h->v, hit);
         break;
     case KIND_QUADS:
-        quad_hit(a, g, rh->hit.primID, rh->hit.u, rh->hit.v, hit);
+        quad_hit(a, g, h->primID, h->u, h->v, hit);
         break;
     case KIND_CURVES:
-        curve_hit(a, g, rh, hit);
+        curve_hit(a, g, h, ray, hit);
         break;
     case KIND_POINTS:
-        point_hit(a, g, rh, hit);
+        point_hit(a, g, h, ray, tfar, gi, hit);
+        break;
+    case KIND_INSTANCE:
+        RY_CHECK(!"an instance geometry hit as a primitive");
         break;
     }
+    if (gi && !shape_flat(g->shape))
+        hit->Ng = unit_or_zero(mat4_vector(&gi->normal_to_world, hit->Ng));
 }
 
-/* The nearest hit in scene (one of a's), under the ray's mask. */
+/* The nearest hit in scene (the world's or an object's own), under mask. */
 static int intersect_scene(const Accel *a, RTCScene scene, const Ray *ray, uint32_t mask,
                            Hit *hit)
 {
@@ -577,13 +725,13 @@ static int intersect_scene(const Accel *a, RTCScene scene, const Ray *ray, uint3
     rtcIntersect1(scene, &ctx, &rh);
     if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID)
         return 0;
-    make_hit(a, &rh, hit);
+    make_hit(a, ray, &rh.hit, rh.ray.tfar, hit);
     return 1;
 }
 
 int accel_intersect(const Accel *a, const Ray *ray, Hit *hit)
 {
-    return intersect_scene(a, a->scene, ray, ray->mask, hit);
+    return intersect_scene(a, a->levels[0].scene, ray, ray->mask, hit);
 }
 
 int accel_intersect_object(const Accel *a, uint32_t object, const Ray *ray, Hit *hit)
@@ -607,7 +755,7 @@ typedef struct TransmissionCtx {
     Vec3 T; /* the product so far */
     int n_seen;
     struct {
-        unsigned geom, prim;
+        unsigned inst, geom, prim;
         float t;
     } seen[TRANSMISSION_SEEN];
 } TransmissionCtx;
@@ -626,20 +774,24 @@ static void transmission_filter(const struct RTCFilterFunctionNArguments *args)
     struct RTCRayHit rh;
     rh.ray = *(const struct RTCRay *)args->ray;
     rh.hit = *(const struct RTCHit *)args->hit;
+    /* Inside an instance, args->ray is in master space: its tfar is the
+     * same parameter along the world ray, which make_hit uses. */
     for (int k = 0; k < tc->n_seen; k++)
-        if (tc->seen[k].geom == rh.hit.geomID && tc->seen[k].prim == rh.hit.primID &&
+        if (tc->seen[k].inst == rh.hit.instID[0] && tc->seen[k].geom == rh.hit.geomID &&
+            tc->seen[k].prim == rh.hit.primID &&
             fabsf(tc->seen[k].t - rh.ray.tfar) <= 1e-6f * fmaxf(1.0f, rh.ray.tfar)) {
             args->valid[0] = 0;
             return;
         }
     if (tc->n_seen < TRANSMISSION_SEEN) {
+        tc->seen[tc->n_seen].inst = rh.hit.instID[0];
         tc->seen[tc->n_seen].geom = rh.hit.geomID;
         tc->seen[tc->n_seen].prim = rh.hit.primID;
         tc->seen[tc->n_seen].t = rh.ray.tfar;
         tc->n_seen++;
     }
     Hit hit;
-    make_hit(tc->accel, &rh, &hit);
+    make_hit(tc->accel, tc->ray, &rh.hit, rh.ray.tfar, &hit);
     Vec3 op = tc->opacity(tc->user, tc->ray, &hit);
     tc->T = v3(tc->T.x * (1.0f - fminf(fmaxf(op.x, 0.0f), 1.0f)),
                tc->T.y * (1.0f - fminf(fmaxf(op.y, 0.0f), 1.0f)),
@@ -660,7 +812,7 @@ Vec3 accel_transmission(const Accel *a, const Ray *ray, AccelOpacityFn opacity, 
     tc.n_seen = 0;
     struct RTCRay r;
     set_ray(&r, ray);
-    rtcOccluded1(a->scene, &tc.rtc, &r);
+    rtcOccluded1(a->levels[0].scene, &tc.rtc, &r);
     return r.tfar < 0.0f ? v3(0, 0, 0) : tc.T;
 }
 
@@ -670,7 +822,7 @@ int accel_occluded(const Accel *a, const Ray *ray)
     rtcInitIntersectContext(&ctx);
     struct RTCRay r;
     set_ray(&r, ray);
-    rtcOccluded1(a->scene, &ctx, &r);
+    rtcOccluded1(a->levels[0].scene, &ctx, &r);
     return r.tfar < 0.0f;
 }
 

@@ -19,6 +19,14 @@
  * asks for the opacity of each of its hits (an Embree occlusion filter)
  * and goes on through it; other objects stop shadow rays.
  *
+ * Object instances (GridSet.instances): each master's grids are one Embree
+ * scene of their own, in master space, and each instance one Embree
+ * instance geometry of it in the world's scene (one instance level, as
+ * Debian's Embree is built; nested instances are flattened before). An
+ * instance's mask is GeomInstance.ray_mask (its object's, and its
+ * enclosing instances'); a master's grids that inherit the instance's
+ * object see every ray type.
+ *
  * Memory: the Accel borrows the GridSet, which must outlive it.
  * Thread-safety: queries are thread-safe after accel_new returns; threads
  * that trace must have FTZ/DAZ set (util/thread does).
@@ -43,8 +51,10 @@ typedef struct Ray {
 typedef struct Hit {
     float t;             /* distance along d, in units of |d| */
     uint32_t grid;       /* the patch id (index of its grid) */
-    Vec3 Ng;             /* unit geometric normal, on the side of dPdu x dPdv; zero if the
-                            micropolygon is degenerate */
+    uint32_t instance;   /* 0; or through an object instance, its GridSet index + 1: grid is
+                            its master's, vertex[] in master space (GeomInstance maps them) */
+    Vec3 Ng;             /* unit geometric normal (world), on the side of dPdu x dPdv; zero if
+                            the micropolygon is degenerate */
     float gu, gv;        /* position in the grid: quad: [0,1]^2 over the whole grid;
                             triangle: barycentrics (b1, b2) in the patch */
     uint32_t vertex[4];  /* vertices (GridSet indices) of the micropolygon hit */

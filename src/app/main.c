@@ -119,6 +119,14 @@ static void summary(const Args *a, const RayesStats *s)
     printf("  geometry      %llu grids, %llu grid vertices\n",
            (unsigned long long)stat_count(s, "grids"),
            (unsigned long long)stat_count(s, "grid_vertices"));
+    if (rayes_stats_find(s, "instances/count"))
+        printf("  instances     %llu, of %llu master(s): %llu grids, %llu micropolygons held "
+               "once; %.1f radiosity fills each\n",
+               (unsigned long long)stat_count(s, "instances/count"),
+               (unsigned long long)stat_count(s, "instances/masters"),
+               (unsigned long long)stat_count(s, "instances/master_grids"),
+               (unsigned long long)stat_count(s, "instances/master_micropolygons"),
+               stat_real(s, "instances/radiosity_entries_per_instance"));
     printf("  shading pts   %llu", (unsigned long long)stat_count(s, "shading_points/total"));
     const RayesStat *d = rayes_stats_find(s, "shading_points/by_depth");
     for (size_t i = 0; d && i < d->n_counts; i++)

@@ -93,14 +93,15 @@ static uint64_t key_hash(const CacheKey *k)
 {
     uint64_t a = (uint64_t)k->patch | (uint64_t)k->depth << 32 | (uint64_t)k->segment << 48 |
                  (uint64_t)k->side << 56;
-    uint64_t b = (uint64_t)k->type | (uint64_t)k->level << 8;
+    uint64_t b = (uint64_t)k->type | (uint64_t)k->level << 8 | (uint64_t)k->instance << 16;
     return hash_combine(hash_u64(a), b);
 }
 
 static int key_equal(const CacheKey *a, const CacheKey *b)
 {
     return a->patch == b->patch && a->depth == b->depth && a->segment == b->segment &&
-           a->side == b->side && a->type == b->type && a->level == b->level;
+           a->side == b->side && a->type == b->type && a->level == b->level &&
+           a->instance == b->instance;
 }
 
 /* Returns 0, or -1 when out of memory. */

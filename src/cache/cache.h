@@ -52,12 +52,15 @@ typedef enum CacheType {
 
 /* What an entry is for. Two keys are equal iff all fields are. */
 typedef struct CacheKey {
-    uint32_t patch;    /* patch id (instance included) */
+    uint32_t patch;    /* patch id (a master's, for instances: see instance) */
     uint16_t depth;    /* diffuse depth */
     uint8_t segment;   /* motion segment */
     uint8_t side;      /* 0: front (dPdu x dPdv), 1: back */
     uint8_t type;      /* CacheType */
     uint8_t level;     /* CacheLevel */
+    uint32_t instance; /* 0: geometry placed once; else the object instance + 1 whose
+                          master grid `patch` is (memo 3.1: each instance has its own
+                          entries, its illumination and attributes differ) */
 } CacheKey;
 
 /* Fills n_values RGB values for key (float, any finite or infinite value;

@@ -66,6 +66,7 @@ void geom_gridset_fini(GridSet *gs)
     free(gs->dst);
     free(gs->Cs);
     free(gs->Os);
+    free(gs->instances);
     memset(gs, 0, sizeof *gs);
 }
 
@@ -505,7 +506,8 @@ static int dice_quad(GridSet *gs, const Prim *prim, uint32_t prim_index, const f
     if (reserve(gs, (size_t)nu * nv, prim->pv) != 0)
         return -1;
     Grid *g = &gs->grids[gs->n_grids];
-    *g = (Grid){.prim = prim_index, .object = prim->object, .first_vertex = (uint32_t)gs->n_vertices,
+    *g = (Grid){.prim = prim_index, .object = prim->object, .master = prim->master,
+                .first_vertex = (uint32_t)gs->n_vertices,
                 .nu = (uint16_t)nu, .nv = (uint16_t)nv, .primvars = prim->pv,
                 .shape = (uint8_t)prim_shape(prim)};
     memcpy(g->uv, d->c, sizeof g->uv);
@@ -550,7 +552,8 @@ static int dice_triangle(GridSet *gs, const Prim *prim, uint32_t prim_index, con
     if (reserve(gs, count, prim->pv) != 0)
         return -1;
     Grid *g = &gs->grids[gs->n_grids];
-    *g = (Grid){.prim = prim_index, .object = prim->object, .first_vertex = (uint32_t)gs->n_vertices,
+    *g = (Grid){.prim = prim_index, .object = prim->object, .master = prim->master,
+                .first_vertex = (uint32_t)gs->n_vertices,
                 .nu = (uint16_t)n, .nv = 0, .triangular = 1, .primvars = prim->pv};
     memcpy(g->uv, d->c, sizeof g->uv);
     size_t base = gs->n_vertices;

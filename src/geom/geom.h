@@ -77,9 +77,16 @@ enum {
 };
 #define GEOM_N_PV 4 /* the GEOM_PV_* bits */
 
+/* Prim.object and Grid.object of a master's geometry made before any
+ * shader inside its block: each instance's own object applies. */
+#define GEOM_OBJECT_INHERIT UINT32_MAX
+
 typedef struct Prim {
     PrimType type;
-    uint32_t object;       /* the object (shader, attributes) it belongs to */
+    uint32_t object;       /* the object (shader, attributes) it belongs to, or
+                              GEOM_OBJECT_INHERIT (a master's: its instance's) */
+    uint32_t master;       /* 0: world geometry; else its master's index + 1: its points are
+                              in master space, and it is seen only through instances */
     uint8_t pv;            /* GEOM_PV_* bits: the primitive variables it carries */
     uint8_t pv_cubic;      /* of those, the ones with 16 Bezier control values (a bicubic
                               patch's vertex class); the others have one per corner */
@@ -180,7 +187,8 @@ Vec3 geom_prim_normal(const Prim *prim, float u, float v);
 
 typedef struct Grid {
     uint32_t prim;         /* the primitive it was diced from */
-    uint32_t object;       /* the primitive's object */
+    uint32_t object;       /* the primitive's object, or GEOM_OBJECT_INHERIT */
+    uint32_t master;       /* the primitive's master (Prim.master): 0, world geometry */
     uint32_t first_vertex; /* index of its first vertex in the GridSet */
     uint16_t nu, nv;       /* quad: vertices in u and v; triangle: nu = n subdivisions, nv = 0 */
     uint8_t triangular;    /* 1 for a triangular grid */
@@ -204,6 +212,23 @@ typedef struct Grid {
     float tri[3][2];       /* such a quad: the triangle's corners, the primitive's (u, v) */
 } Grid;
 
+/* One placement of a master (an object instance, nested ones flattened):
+ * the master's grids, diced once in master space, are traced through an
+ * Embree instance and shaded through these transforms (DESIGN.md
+ * "Instances"). */
+typedef struct GeomInstance {
+    Mat4 world_from_master;
+    Mat4 master_from_world;
+    Mat4 normal_to_world;  /* the inverse transpose, negated when the transform mirrors, so
+                              that N stays on the side of dPdu x dPdv mapped to world */
+    float scale;           /* world units per master unit: the cube root of |det| (edges,
+                              offsets and curvatures of master grids scale by it) */
+    uint32_t master;       /* the master's index (its grids have Grid.master = master + 1) */
+    uint32_t object;       /* the object its master's GEOM_OBJECT_INHERIT grids take */
+    uint32_t ray_mask;     /* RayesRayType bits that see it: those of every instance's object
+                              along its nesting (an enclosing instance's visibility holds) */
+} GeomInstance;
+
 typedef struct GridSet {
     Grid *grids;           /* one per patch; the index is the patch id */
     size_t n_grids;
@@ -221,6 +246,10 @@ typedef struct GridSet {
     unsigned pv_arrays;    /* GEOM_PV_* bits of the arrays allocated */
     size_t n_vertices;
     size_t cap_grids, cap_vertices;
+    GeomInstance *instances; /* the flattened object instances; a hit's instance is an index
+                              here + 1 (Hit.instance, CacheKey.instance); owned */
+    size_t n_instances;
+    size_t n_masters;      /* masters (grids may have master 1 .. n_masters) */
 } GridSet;
 
 /* How the camera sets dicing rates, and how large a grid may be.

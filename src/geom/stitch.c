@@ -170,11 +170,15 @@ static int prim_side(const Prim *prim, int side, uint64_t key[2], float t[2])
 
 /* Fills *out for a side of n segments whose vertices run from first by
  * stride (a quad grid's), or along edge tri_edge - 1 of a triangular grid,
- * on curve key from parameter a to b. Returns 0 for an empty range. */
-static int put_side(Side *out, const uint64_t key[2], double a, double b, size_t first,
-                    ptrdiff_t stride, uint32_t n, int tri_edge)
+ * on curve key from parameter a to b, of a grid of master `master` (its
+ * space: a master's grids meet only each other). Returns 0 for an empty
+ * range. */
+static int put_side(Side *out, const uint64_t key[2], uint32_t master, double a, double b,
+                    size_t first, ptrdiff_t stride, uint32_t n, int tri_edge)
 {
     out->key[0] = key[0], out->key[1] = key[1];
+    if (master) /* world grids keep their keys */
+        out->key[0] = hash_combine(key[0], 0x4d4153544552ull + master);
     out->n = n;
     out->tri_edge = (uint8_t)tri_edge;
     out->reversed = a > b;
@@ -266,7 +270,7 @@ static int tri_grid_side(const Grid *g, const Prim *prim, int side, Side *out)
     double t[2];
     if (side > 2 || !tri_segment(prim, g->prim, g->uv[side], g->uv[(side + 1) % 3], key, t))
         return 0;
-    return put_side(out, key, t[0], t[1], g->first_vertex, 0, g->nu, 1 + side);
+    return put_side(out, key, g->master, t[0], t[1], g->first_vertex, 0, g->nu, 1 + side);
 }
 
 /* The record of side `side` of grid g (of prim), or 0
@@ -307,7 +311,7 @@ static int grid_side(const Grid *g, const Prim *prim, int side, Side *out)
                                           : base + (size_t)(nv - 1) * (size_t)nu;
     ptrdiff_t stride = on_v[side] ? 1 : nu;
     uint32_t n = (uint32_t)(on_v[side] ? nu - 1 : nv - 1);
-    return put_side(out, key, a, b, start, stride, n, 0);
+    return put_side(out, key, g->master, a, b, start, stride, n, 0);
 }
 
 static int cmp_side(const void *pa, const void *pb)

@@ -337,14 +337,13 @@ int pbrt_emit_light(Parser *P, const Token *t, const double m[16], const char *t
     return e != RAYES_OK ? pbrt_sink_failed(P, t, e) : 0;
 }
 
-int pbrt_replay(Parser *P, const Token *t, const Object *o)
+/* Sends o's Ops, each under ctm times its own transform. */
+static int send_ops(Parser *P, const Token *t, const Object *o, const double ctm[16])
 {
     for (size_t i = 0; i < o->n_ops; i++) {
         const Op *op = &o->ops[i];
-        if (++P->replayed > PBRT_MAX_REPLAYED)
-            return FAIL_TOK(P, t, "more than %ld instanced primitives", PBRT_MAX_REPLAYED);
         double m[16];
-        pbrt_mat_mul(P->gs.ctm, op->m, m);
+        pbrt_mat_mul(ctm, op->m, m);
         if (send_state(P, t, m, op->mat) != 0)
             return -1;
         RayesError e = RAYES_OK;
@@ -359,4 +358,38 @@ int pbrt_replay(Parser *P, const Token *t, const Object *o)
             return pbrt_sink_failed(P, t, e);
     }
     return 0;
+}
+
+/* A sink with instances: o is sent once as a master (its Ops under their
+ * own transforms, which include the one current at their definition, as
+ * in pbrt-v4), then placed with the current transform. */
+static int send_instance(Parser *P, const Token *t, Object *o)
+{
+    const IoSink *s = P->sink;
+    if (!o->sent) {
+        static const double identity[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
+        if (s->object_begin(s->target, o->name) != RAYES_OK)
+            return pbrt_sink_failed(P, t, RAYES_ERROR_INVALID_ARGUMENT);
+        P->have_sent = 0; /* the block starts with no material: each Op sends its own */
+        if (send_ops(P, t, o, identity) != 0)
+            return -1;
+        if (s->object_end(s->target) != RAYES_OK)
+            return pbrt_sink_failed(P, t, RAYES_ERROR_INVALID_ARGUMENT);
+        P->have_sent = 0; /* object_end restored the material before the block */
+        o->sent = 1;
+    }
+    if (send_transform(P, t, P->gs.ctm) != 0)
+        return -1;
+    RayesError e = s->object_instance(s->target, o->name);
+    return e != RAYES_OK ? pbrt_sink_failed(P, t, e) : 0;
+}
+
+int pbrt_replay(Parser *P, const Token *t, Object *o)
+{
+    if (P->sink->object_begin && P->sink->object_end && P->sink->object_instance)
+        return send_instance(P, t, o);
+    P->replayed += (long)o->n_ops;
+    if (P->replayed > PBRT_MAX_REPLAYED)
+        return FAIL_TOK(P, t, "more than %ld instanced primitives", PBRT_MAX_REPLAYED);
+    return send_ops(P, t, o, P->gs.ctm);
 }

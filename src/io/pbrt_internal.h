@@ -184,6 +184,7 @@ typedef struct Op {
 
 typedef struct Object {
     char name[128];
+    int sent;                 /* sent to a sink with instances as a master (object_begin) */
     Op *ops;
     size_t n_ops, cap_ops;
 } Object;
@@ -355,7 +356,7 @@ int pbrt_emit_pattern_in(Parser *P, const Token *t, const double m[16], const ch
 int pbrt_emit_volume(Parser *P, const Token *t, const double m[16], const RayesParam *params,
                      size_t n, const float bound[6]);
 /* Sends the recorded object o under the current transform. */
-int pbrt_replay(Parser *P, const Token *t, const Object *o);
+int pbrt_replay(Parser *P, const Token *t, Object *o);
 
 /* ------------------------------------------ materials (pbrt_material.c) */
 

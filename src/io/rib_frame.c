@@ -24,48 +24,88 @@ static Object *find_object(Rib *r, const char *key)
     return NULL;
 }
 
+/* The object of that key, made if new (its recording, if any, freed: a
+ * handle defined again is replaced). NULL after an error. */
+static Object *define_object(Rib *r, const char *key)
+{
+    Object *o = find_object(r, key);
+    if (o) {
+        rib_recording_free(o->rec);
+        o->rec = NULL;
+        return o;
+    }
+    if (r->n_objects >= 65536) {
+        rib_error(r, "more than 65536 objects");
+        return NULL;
+    }
+    Object *no = realloc(r->objects, (r->n_objects + 1) * sizeof *no);
+    if (!no) {
+        rib_error(r, "out of memory");
+        return NULL;
+    }
+    r->objects = no;
+    o = &r->objects[r->n_objects++];
+    snprintf(o->key, sizeof o->key, "%s", key);
+    o->rec = NULL;
+    return o;
+}
+
+/* A sink with instances (object_begin) gets the block as a master; one
+ * without records it for replay as copies (rib_record.c). Either way the
+ * block starts at the identity transform and its attributes are saved. */
 static int h_object_begin(Rib *r, const Args *a)
 {
     size_t i = 0;
-    if (r->rec)
+    if (r->rec || r->in_object)
         return rib_error(r, "ObjectBegin inside an object definition");
     if (rib_get_handle(r, a, &i, r->rec_key) != 0)
         return -1;
-    r->rec = rib_recording_new();
-    if (!r->rec)
-        return rib_error(r, "out of memory");
-    r->rec_sink = rib_recording_sink(r->rec);
+    if (r->sink->object_begin) {
+        if (r->sink->object_begin(r->sink->target, r->rec_key) != RAYES_OK)
+            return rib_sink_failed(r, r->sink);
+        r->in_object = 1;
+        r->object_surface = r->a.surface;
+        r->object_color_gen = r->a.color_gen;
+    } else {
+        r->rec = rib_recording_new();
+        if (!r->rec)
+            return rib_error(r, "out of memory");
+        r->rec_sink = rib_recording_sink(r->rec);
+    }
     memset(&r->recorded, 0, sizeof r->recorded);
     memcpy(r->rec_saved_M, r->a.M, sizeof r->rec_saved_M);
     rib_mat_identity(r->a.M);
-    return rib_push(r, 1);
+    if (rib_push(r, 1) != 0)
+        return -1;
+    r->a.area = 0; /* area lights do not instance (the block's quads are geometry) */
+    return 0;
 }
 
 static int h_object_end(Rib *r, const Args *a)
 {
     (void)a;
-    if (!r->rec)
+    if (!r->rec && !r->in_object)
         return rib_error(r, "ObjectEnd without ObjectBegin");
     rib_pop(r, 1);
     memcpy(r->a.M, r->rec_saved_M, sizeof r->a.M);
-    Object *o = find_object(r, r->rec_key);
-    if (!o) {
-        if (r->n_objects >= 65536)
-            return rib_error(r, "more than 65536 objects");
-        Object *no = realloc(r->objects, (r->n_objects + 1) * sizeof *no);
-        if (!no)
-            return rib_error(r, "out of memory");
-        r->objects = no;
-        o = &r->objects[r->n_objects++];
-        snprintf(o->key, sizeof o->key, "%s", r->rec_key);
-    } else {
-        rib_recording_free(o->rec);
+    if (r->in_object) {
+        r->in_object = 0;
+        if (r->sink->object_end(r->sink->target) != RAYES_OK)
+            return rib_sink_failed(r, r->sink);
+        return define_object(r, r->rec_key) ? 0 : -1;
     }
+    Object *o = define_object(r, r->rec_key);
+    if (!o)
+        return -1;
     o->rec = r->rec;
     r->rec = NULL;
     return 0;
 }
 
+/* An instance: to a sink with instances, the current state (transform,
+ * shader and colour, light links) then object_instance; nested in a
+ * block (the sink's, RenderMan allows it) the block's state. Else the
+ * recording replayed under the current transform. */
 static int h_object_instance(Rib *r, const Args *a)
 {
     size_t i = 0;
@@ -75,8 +115,18 @@ static int h_object_instance(Rib *r, const Args *a)
     Object *o = find_object(r, key);
     if (!o)
         return rib_error(r, "no object has the handle %s", rib_handle_name(key));
-    if (r->rec)
-        return rib_error(r, "ObjectInstance inside an object definition");
+    if (r->rec) /* the first pass (a sink without instances) cannot tell: the second says */
+        return r->pass == 1 ? 0 : rib_error(r, "ObjectInstance inside an object definition");
+    if (r->sink->object_instance) {
+        int skip = rib_emit_begin(r, NULL);
+        if (skip)
+            return skip < 0 ? -1 : 0;
+        SinkState *st;
+        const IoSink *s = rib_out_sink(r, &st);
+        if (s->object_instance(s->target, key) != RAYES_OK)
+            return rib_sink_failed(r, s);
+        return 0;
+    }
     if (!r->in_world) {
         rib_warn_once(r, "outside world", "geometry outside WorldBegin/WorldEnd is ignored");
         return 0;

@@ -207,7 +207,11 @@ typedef struct Rib {
     size_t n_links;
     Object *objects;
     size_t n_objects;
-    RibRecording *rec;         /* the object being defined */
+    RibRecording *rec;         /* the object being defined, when the sink has no instances */
+    int in_object;             /* 1: inside ObjectBegin, sent to a sink with instances
+                                  (object_begin); the block's state is `recorded` */
+    const void *object_surface; /* the surface and colour generation at that ObjectBegin: */
+    long object_color_gen;     /* geometry under them inherits each instance's shader */
     IoSink rec_sink;
     char rec_key[RIB_MAX_HANDLE];
     float rec_saved_M[16];

@@ -30,7 +30,7 @@
 
 const IoSink *rib_out_sink(Rib *r, SinkState **st)
 {
-    *st = r->rec ? &r->recorded : &r->real;
+    *st = r->rec || r->in_object ? &r->recorded : &r->real;
     return r->rec ? &r->rec_sink : r->sink;
 }
 
@@ -156,11 +156,11 @@ static int send_visibility(Rib *r, const IoSink *s, SinkState *st)
  * colour (a per-face colour) when not NULL. 1: skip (outside the world). */
 int rib_emit_begin(Rib *r, const float *Cs)
 {
-    if (!r->in_world && !r->rec) {
+    if (!r->in_world && !r->rec && !r->in_object) {
         rib_warn_once(r, "outside world", "geometry outside WorldBegin/WorldEnd is ignored");
         return 1;
     }
-    if (!r->rec && rib_send_lights(r) != 0)
+    if (!r->rec && !r->in_object && rib_send_lights(r) != 0)
         return -1;
     SinkState *st;
     const IoSink *s = rib_out_sink(r, &st);
@@ -176,6 +176,9 @@ int rib_emit_begin(Rib *r, const float *Cs)
         if (send_shader(r, s, Cs) != 0)
             return -1;
         st->have_shader = 0;
+    } else if (r->in_object && !st->have_shader && r->a.surface == r->object_surface &&
+               r->a.color_gen == r->object_color_gen) {
+        /* no Surface or Color in the block yet: each instance's shader */
     } else if (!st->have_shader || st->surface != r->a.surface || st->color_gen != r->a.color_gen) {
         if (send_shader(r, s, r->a.Cs) != 0)
             return -1;
@@ -487,7 +490,7 @@ static int h_light_source(Rib *r, const Args *a)
                       "counts and other parameters are not read)",
                       name);
     }
-    if (r->rec) {
+    if (r->rec || r->in_object) {
         rib_warn_once(r, "light in object", "lights inside ObjectBegin are ignored");
         type = NULL;
     } else if (!type && strcmp(name, "indirectlight") == 0) {
@@ -605,8 +608,13 @@ static int h_area_light(Rib *r, const Args *a)
     float I = in && rib_is_num(in->v) && in->v->n == 1 ? (float)in->v->d[0] : 1;
     for (int c = 0; c < 3; c++)
         r->a.area_L[c] = I * (lc && rib_is_num(lc->v) && lc->v->n == 3 ? (float)lc->v->d[c] : 1);
-    r->a.area = 1;
     free(p);
+    if (r->in_object) {
+        rib_warn_once(r, "area light in object",
+                      "area lights inside ObjectBegin are ignored (their quads are geometry)");
+        return 0;
+    }
+    r->a.area = 1;
     return 0;
 }
 

@@ -37,6 +37,11 @@ struct RibWriter {
     unsigned char area[4097]; /* by handle: an area light (not linkable in RIB) */
     uint32_t visibility;      /* the RayesRayType bits written last (default: all) */
     int hitmode, opacity_cache; /* the opacity mode written last (default: shader, 1) */
+    int in_object;           /* inside ObjectBegin ... ObjectEnd */
+    struct {                 /* what ObjectBegin saved (ObjectEnd restores attributes) */
+        int in_transform, opacity_set, hitmode, opacity_cache;
+        uint32_t visibility;
+    } outer;
     char error[256];         /* the last error, "" if none */
 };
 
@@ -1002,6 +1007,69 @@ static const char *w_get_error(void *t)
     return ((RibWriter *)t)->error;
 }
 
+/* An object handle as the RIB reader gave it (#1 or "name", quoted), or
+ * another reader's name, written as a string. */
+static void handle(FILE *f, const char *name)
+{
+    size_t n = strlen(name);
+    if (name[0] == '#' && n > 1 && strspn(name + 1, "0123456789.-+eE") == n - 1) {
+        fprintf(f, "%s", name + 1);
+    } else if (n >= 2 && name[0] == '"' && name[n - 1] == '"') {
+        char inner[256];
+        snprintf(inner, sizeof inner, "%.*s", (int)(n - 2), name + 1);
+        string(f, inner);
+    } else {
+        string(f, name);
+    }
+}
+
+/* ObjectBegin: the block starts at the identity transform (the reader
+ * resets it) and its attributes are restored at ObjectEnd, so the
+ * writer's own record of them is saved. */
+static RayesError w_object_begin(void *t, const char *name)
+{
+    RibWriter *w = t;
+    if (w->in_object)
+        return fail(w, RAYES_ERROR_INVALID_OPERATION, "object begin: inside an object block");
+    w->outer.in_transform = w->in_transform;
+    w->outer.opacity_set = w->opacity_set;
+    w->outer.hitmode = w->hitmode;
+    w->outer.opacity_cache = w->opacity_cache;
+    w->outer.visibility = w->visibility;
+    w->in_transform = 0;
+    w->in_object = 1;
+    fprintf(w->world.f, "ObjectBegin ");
+    handle(w->world.f, name);
+    fputc('\n', w->world.f);
+    return RAYES_OK;
+}
+
+static RayesError w_object_end(void *t)
+{
+    RibWriter *w = t;
+    if (!w->in_object)
+        return fail(w, RAYES_ERROR_INVALID_OPERATION, "object end: no object block");
+    if (w->in_transform)
+        fprintf(w->world.f, "TransformEnd\n");
+    fprintf(w->world.f, "ObjectEnd\n");
+    w->in_object = 0;
+    w->in_transform = w->outer.in_transform;
+    w->opacity_set = w->outer.opacity_set;
+    w->hitmode = w->outer.hitmode;
+    w->opacity_cache = w->outer.opacity_cache;
+    w->visibility = w->outer.visibility;
+    return RAYES_OK;
+}
+
+static RayesError w_object_instance(void *t, const char *name)
+{
+    RibWriter *w = t;
+    fprintf(w->world.f, "ObjectInstance ");
+    handle(w->world.f, name);
+    fputc('\n', w->world.f);
+    return RAYES_OK;
+}
+
 IoSink io_rib_writer_sink(RibWriter *w)
 {
     return (IoSink){
@@ -1032,6 +1100,9 @@ IoSink io_rib_writer_sink(RibWriter *w)
         .pattern = w_pattern,
         .set_visibility = w_set_visibility,
         .set_opacity_mode = w_set_opacity_mode,
+        .object_begin = w_object_begin,
+        .object_end = w_object_end,
+        .object_instance = w_object_instance,
     };
 }
 

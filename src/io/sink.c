@@ -152,6 +152,21 @@ static int scene_has_shader(void *t, const char *name)
     return rayes_scene_has_shader(t, name);
 }
 
+static RayesError scene_object_begin(void *t, const char *name)
+{
+    return rayes_scene_object_begin(t, name);
+}
+
+static RayesError scene_object_end(void *t)
+{
+    return rayes_scene_object_end(t);
+}
+
+static RayesError scene_object_instance(void *t, const char *name)
+{
+    return rayes_scene_object_instance(t, name);
+}
+
 IoSink io_sink_scene(RayesScene *scene)
 {
     return (IoSink){
@@ -182,6 +197,9 @@ IoSink io_sink_scene(RayesScene *scene)
         .volume = scene_volume,
         .set_visibility = scene_set_visibility,
         .set_opacity_mode = scene_set_opacity_mode,
+        .object_begin = scene_object_begin,
+        .object_end = scene_object_end,
+        .object_instance = scene_object_instance,
     };
 }
 

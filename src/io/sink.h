@@ -90,6 +90,13 @@ typedef struct IoSink {
      * visible, with the shader's opacity, cached). */
     RayesError (*set_visibility)(void *target, uint32_t ray_types);
     RayesError (*set_opacity_mode)(void *target, RayesTransmissionHitMode mode, int cache);
+    /* rayes_scene_object_begin, _end and _instance (last, so older sinks
+     * leave them NULL: readers then record object definitions and replay
+     * them per instance, as copies). Names are the reader's: RIB passes
+     * its handle key (#1 or "name", quotes included), pbrt the name. */
+    RayesError (*object_begin)(void *target, const char *name);
+    RayesError (*object_end)(void *target);
+    RayesError (*object_instance)(void *target, const char *name);
 } IoSink;
 
 /* A sink that builds scene through rayes.h (borrowed, not retained). */

@@ -6,7 +6,10 @@
  * pixel angle times distance), and the grid's parameter spacing as du, dv.
  * Grids are shaded at most once: a pointer per grid, published with
  * release semantics after its values are written; a striped lock makes the
- * threads that want the same grid wait for the one shading it.
+ * threads that want the same grid wait for the one shading it. A master's
+ * grid is shaded once per instance that a camera ray hits (in world space,
+ * with the instance's object and random numbers): each instance has a
+ * table of its master's grids, made when the instance is first hit.
  */
 #include "render/hider.h"
 
@@ -24,10 +27,16 @@ enum { STRIPES = 256 };
 
 typedef float Rgb[3];
 
+typedef _Atomic(Rgb *) GridSlot; /* a grid's vertices' radiance, NULL until shaded */
+
 struct GridShading {
     const RenderScene *rs;
     float contrast;              /* the limit of hider_camera_hit (HIDER_CONTRAST, scaled) */
-    _Atomic(Rgb *) *ci;          /* per grid: its vertices' radiance, NULL until shaded */
+    GridSlot *ci;                /* per grid (world grids; unused for masters') */
+    _Atomic(GridSlot *) *inst;   /* per instance: a slot per grid of its master (from the
+                                    master's first grid), NULL until the instance is hit */
+    uint32_t *master_first;      /* per master: its first grid (a master's are contiguous) */
+    uint32_t *master_count;      /* and how many */
     pthread_mutex_t locks[STRIPES];
 };
 
@@ -39,13 +48,27 @@ GridShading *hider_new(const RenderScene *rs, const RenderSettings *set)
     gsh->rs = rs;
     int n = set->shadow_rays < set->diffuse_rays ? set->shadow_rays : set->diffuse_rays;
     gsh->contrast = HIDER_CONTRAST * sqrtf(fmaxf(1.0f, 64.0f / (float)(n > 1 ? n : 1)));
-    gsh->ci = calloc(rs->gs->n_grids ? rs->gs->n_grids : 1, sizeof *gsh->ci);
-    if (!gsh->ci) {
+    const GridSet *gs = rs->gs;
+    gsh->ci = calloc(gs->n_grids ? gs->n_grids : 1, sizeof *gsh->ci);
+    gsh->inst = calloc(gs->n_instances + 1, sizeof *gsh->inst);
+    gsh->master_first = calloc(gs->n_masters + 1, sizeof *gsh->master_first);
+    gsh->master_count = calloc(gs->n_masters + 1, sizeof *gsh->master_count);
+    if (!gsh->ci || !gsh->inst || !gsh->master_first || !gsh->master_count) {
+        free(gsh->ci);
+        free(gsh->inst);
+        free(gsh->master_first);
+        free(gsh->master_count);
         free(gsh);
         return NULL;
     }
-    for (size_t i = 0; i < rs->gs->n_grids; i++)
+    for (size_t i = 0; i < gs->n_grids; i++) {
         atomic_init(&gsh->ci[i], NULL);
+        uint32_t m = gs->grids[i].master;
+        if (m && gsh->master_count[m - 1]++ == 0)
+            gsh->master_first[m - 1] = (uint32_t)i;
+    }
+    for (size_t i = 0; i < gs->n_instances; i++)
+        atomic_init(&gsh->inst[i], NULL);
     for (int i = 0; i < STRIPES; i++)
         pthread_mutex_init(&gsh->locks[i], NULL);
     return gsh;
@@ -55,8 +78,18 @@ void hider_free(GridShading *gsh)
 {
     if (!gsh)
         return;
-    for (size_t i = 0; i < gsh->rs->gs->n_grids; i++)
+    const GridSet *gs = gsh->rs->gs;
+    for (size_t i = 0; i < gs->n_grids; i++)
         free(atomic_load_explicit(&gsh->ci[i], memory_order_relaxed));
+    for (size_t i = 0; i < gs->n_instances; i++) {
+        GridSlot *slots = atomic_load_explicit(&gsh->inst[i], memory_order_relaxed);
+        for (uint32_t k = 0; slots && k < gsh->master_count[gs->instances[i].master]; k++)
+            free(atomic_load_explicit(&slots[k], memory_order_relaxed));
+        free(slots);
+    }
+    free(gsh->inst);
+    free(gsh->master_first);
+    free(gsh->master_count);
     for (int i = 0; i < STRIPES; i++)
         pthread_mutex_destroy(&gsh->locks[i]);
     free(gsh->ci);
@@ -79,13 +112,29 @@ static void grid_spacing(const Grid *g, float *du, float *dv)
     *dv = (g->uv[1][1] - g->uv[0][1]) / (float)(g->nv - 1);
 }
 
-/* Shades every vertex of grid gi with lighting() into a new array. */
-static Rgb *shade_grid(Worker *w, uint32_t gi)
+/* A master's vertex i through instance gi (NULL: as it is): world P, the
+ * normals and the derivatives. */
+static void vertex_to_world(const GeomInstance *gi, Vec3 *P, Vec3 *Ng, Vec3 *N, Vec3 *du,
+                            Vec3 *dv)
+{
+    if (!gi)
+        return;
+    *P = mat4_point(&gi->world_from_master, *P);
+    *Ng = v3_normalize(mat4_vector(&gi->normal_to_world, *Ng));
+    *N = v3_normalize(mat4_vector(&gi->normal_to_world, *N));
+    *du = mat4_vector(&gi->world_from_master, *du);
+    *dv = mat4_vector(&gi->world_from_master, *dv);
+}
+
+/* Shades every vertex of grid gi, seen through instance (0: none), with
+ * lighting() into a new array. */
+static Rgb *shade_grid(Worker *w, uint32_t gi, uint32_t instance)
 {
     const RenderScene *rs = w->rs;
     const GridSet *gs = rs->gs;
     const Grid *g = &gs->grids[gi];
-    const RenderObject *obj = &rs->objects[g->object];
+    const RenderObject *obj = render_object(rs, gi, instance);
+    const GeomInstance *inst = render_instance(rs, instance);
     size_t n = geom_grid_n_vertices(g);
     float(*f3)[3] = malloc(n * 10 * sizeof *f3);
     float *f1 = malloc(n * 10 * sizeof *f1);
@@ -104,22 +153,26 @@ static Rgb *shade_grid(Worker *w, uint32_t gi)
     grid_spacing(g, &su, &sv);
     const Camera *cam = &rs->camera;
     uint64_t grid_key = hash_combine(hash_combine(w->set->seed, 0x6772696468ull /* "gridh" */), gi);
+    if (instance) /* each instance its own numbers; world grids as before */
+        grid_key = hash_combine(grid_key, instance);
     for (size_t k = 0; k < n; k++) {
         size_t i = g->first_vertex + k;
+        Vec3 Pk = gs->P[i], Ngk = gs->N[i], Nk = geom_vertex_normal(gs, g, i);
+        Vec3 duk = gs->dPdu[i], dvk = gs->dPdv[i];
+        vertex_to_world(inst, &Pk, &Ngk, &Nk, &duk, &dvk);
         /* The camera ray toward the vertex: from the eye in perspective,
          * along the view in orthographic projection. */
-        Vec3 to = v3_sub(gs->P[i], cam->eye);
+        Vec3 to = v3_sub(Pk, cam->eye);
         float dist = cam->tan_half_fov > 0.0f ? v3_length(to) : v3_dot(to, cam->forward);
         Vec3 d = cam->tan_half_fov > 0.0f && dist > 0.0f ? v3_scale(to, 1.0f / dist) : cam->forward;
-        Vec3 Ngk = gs->N[i], Nk = geom_vertex_normal(gs, g, i);
         back[k] = v3_dot(Ngk, d) > 0.0f; /* the eye sees the back: shade that side */
         if (back[k])
             Nk = v3_neg(Nk), Ngk = v3_neg(Ngk);
-        put3(P[k], gs->P[i]);
+        put3(P[k], Pk);
         put3(N[k], Nk);
         put3(Ng[k], Ngk);
-        put3(dPdu[k], gs->dPdu[i]);
-        put3(dPdv[k], gs->dPdv[i]);
+        put3(dPdu[k], duk);
+        put3(dPdv[k], dvk);
         put3(I[k], d);
         put3(Cs[k], geom_vertex_color(gs, g, i, v3_load(obj->Cs)));
         put3(Os[k], geom_vertex_opacity(gs, g, i, v3_load(obj->Os)));
@@ -131,8 +184,8 @@ static Rgb *shade_grid(Worker *w, uint32_t gi)
         geom_vertex_st(gs, g, i, st, dst);
         s[k] = st[0], t[k] = st[1];
         path_st_footprint(dst, su, sv, &ds[k], &dt[k]);
-        curv[k] = g->curvature;
-        offset[k] = path_ray_offset(w, g);
+        curv[k] = g->curvature / (inst ? inst->scale : 1.0f);
+        offset[k] = path_ray_offset_in(w, g, instance);
         keys[k] = hash_combine(grid_key, k);
         diff[k] = (RayDiff){cam->pixel_width + cam->pixel_spread * fmaxf(dist, 0.0f), cam->pixel_spread};
     }
@@ -145,7 +198,7 @@ static Rgb *shade_grid(Worker *w, uint32_t gi)
     }
     int own_st = (g->primvars & GEOM_PV_ST) != 0;
     PathState ps = {w, keys, diff, curv, offset, w->set->irradiance ? &irr : NULL, gi,
-                    own_st ? ds : NULL, own_st ? dt : NULL};
+                    own_st ? ds : NULL, own_st ? dt : NULL, 0, NULL, instance};
     RayesShadeCtx ctx = {
         .n_points = n, .ray_type = RAYES_RAY_CAMERA, .diffuse_depth = 0, .specular_depth = 0,
         .P = (const float(*)[3])P, .N = (const float(*)[3])N, .Ng = (const float(*)[3])Ng,
@@ -168,19 +221,45 @@ static Rgb *shade_grid(Worker *w, uint32_t gi)
     return ci;
 }
 
+/* The slot of grid gi as seen through instance (0: a world grid's own);
+ * an instance's table is made when first asked for (under a lock). */
+static GridSlot *grid_slot(GridShading *gsh, uint32_t gi, uint32_t instance)
+{
+    if (!instance)
+        return &gsh->ci[gi];
+    _Atomic(GridSlot *) *table = &gsh->inst[instance - 1];
+    uint32_t m = gsh->rs->gs->instances[instance - 1].master;
+    GridSlot *slots = atomic_load_explicit(table, memory_order_acquire);
+    if (!slots) {
+        pthread_mutex_t *lock = &gsh->locks[(instance * 2654435761u) % STRIPES];
+        pthread_mutex_lock(lock);
+        slots = atomic_load_explicit(table, memory_order_acquire);
+        if (!slots) {
+            slots = malloc((gsh->master_count[m] ? gsh->master_count[m] : 1) * sizeof *slots);
+            RY_CHECK(slots != NULL);
+            for (uint32_t k = 0; k < gsh->master_count[m]; k++)
+                atomic_init(&slots[k], NULL);
+            atomic_store_explicit(table, slots, memory_order_release);
+        }
+        pthread_mutex_unlock(lock);
+    }
+    return &slots[gi - gsh->master_first[m]];
+}
+
 int hider_camera_hit(Worker *w, const Ray *ray, const Hit *hit, Vec3 *L)
 {
     (void)ray;
     GridShading *gsh = w->grid_shading;
     uint32_t gi = hit->grid;
-    Rgb *ci = atomic_load_explicit(&gsh->ci[gi], memory_order_acquire);
+    GridSlot *slot = grid_slot(gsh, gi, hit->instance);
+    Rgb *ci = atomic_load_explicit(slot, memory_order_acquire);
     if (!ci) {
-        pthread_mutex_t *lock = &gsh->locks[gi % STRIPES];
+        pthread_mutex_t *lock = &gsh->locks[(gi + hit->instance * 2654435761u) % STRIPES];
         pthread_mutex_lock(lock);
-        ci = atomic_load_explicit(&gsh->ci[gi], memory_order_acquire);
+        ci = atomic_load_explicit(slot, memory_order_acquire);
         if (!ci) {
-            ci = shade_grid(w, gi);
-            atomic_store_explicit(&gsh->ci[gi], ci, memory_order_release);
+            ci = shade_grid(w, gi, hit->instance);
+            atomic_store_explicit(slot, ci, memory_order_release);
         }
         pthread_mutex_unlock(lock);
     }

@@ -67,6 +67,12 @@ static int hit_point(const Worker *w, const Ray *ray, const Hit *hit, const Rend
     v3_store(hp->Os, Os);
     hp->s = st[0], hp->t = st[1];
     memcpy(hp->dst, dst, sizeof dst);
+    const GeomInstance *gi = render_instance(w->rs, hit->instance);
+    if (gi) { /* a master's grid: its vectors to world space (hit->Ng is already) */
+        N = mat4_vector(&gi->normal_to_world, N);
+        du = mat4_vector(&gi->world_from_master, du);
+        dv = mat4_vector(&gi->world_from_master, dv);
+    }
     N = v3_normalize(N);
     Vec3 Ng = v3_length(hit->Ng) > 0.0f ? hit->Ng : N;
     int front = v3_dot(Ng, ray->d) < 0.0f;
@@ -86,8 +92,8 @@ static int hit_point(const Worker *w, const Ray *ray, const Hit *hit, const Rend
     hp->u = u;
     hp->v = v;
     hp->du = hp->dv = 0.0f;
-    hp->curvature = gs->grids[hit->grid].curvature;
-    hp->offset = path_ray_offset(w, &gs->grids[hit->grid]);
+    hp->curvature = g->curvature / (gi ? gi->scale : 1.0f);
+    hp->offset = path_ray_offset_in(w, g, hit->instance);
     return front;
 }
 
@@ -149,7 +155,8 @@ static Vec3 shade_hit(Worker *w, const Ray *ray, const Hit *hit, const RenderObj
     path_st_footprint(hp.dst, hp.du, hp.dv, &hp.ds, &hp.dt);
     int own_st = (w->rs->gs->grids[hit->grid].primvars & GEOM_PV_ST) != 0;
     PathState ps = {w, &hp.key, &hp.diff, &hp.curvature, &hp.offset, NULL, hit->grid,
-                    own_st ? &hp.ds : NULL, own_st ? &hp.dt : NULL, 1};
+                    own_st ? &hp.ds : NULL, own_st ? &hp.dt : NULL, 1, NULL,
+                    hit->instance};
     RayesShadeCtx ctx = {
         .n_points = 1,
         .ray_type = kind & ~PATH_RAY_GLOSSY,
@@ -219,7 +226,7 @@ Vec3 integrator_irradiance(Worker *w, const Ray *ray, const Hit *hit, uint64_t k
 Vec3 integrator_opacity(Worker *w, const Ray *ray, const Hit *hit, RayDiff diff)
 {
     const GridSet *gs = w->rs->gs;
-    const RenderObject *obj = &w->rs->objects[gs->grids[hit->grid].object];
+    const RenderObject *obj = render_object(w->rs, hit->grid, hit->instance);
     if (!obj->transparent)
         return v3(1, 1, 1);
     if (!obj->opacity_shader && !obj->Os_pattern) /* Os alone: no shader runs */
@@ -288,7 +295,7 @@ static Vec3 trace_layers(Worker *w, const Ray *ray, uint32_t kind, int diffuse_d
     }
     *t = hit.t;
     *alpha = 1.0f;
-    const RenderObject *obj = &w->rs->objects[w->rs->gs->grids[hit.grid].object];
+    const RenderObject *obj = render_object(w->rs, hit.grid, hit.instance);
     if (obj->light >= 0) {
         /* Emitters: seen by camera and specular rays, on their front side
          * (not by glossy-lobe rays: direct lighting has them). */
@@ -304,7 +311,8 @@ static Vec3 trace_layers(Worker *w, const Ray *ray, uint32_t kind, int diffuse_d
             Oi = integrator_opacity(w, ray, &hit, diff);
     } else if (kind == RAYES_RAY_CAMERA && w->grid_shading && !obj->transparent &&
                hider_camera_hit(w, ray, &hit, &Ci)) {
-        /* the grid hider's shaded grid (opaque objects only) */
+        /* the grid hider's shaded grid (opaque objects only; a master's grid
+         * per instance) */
     } else {
         Ci = shade_hit(w, ray, &hit, obj, kind, diffuse_depth, specular_depth, key, diff, &Oi);
     }

@@ -23,6 +23,12 @@ float path_ray_offset(const Worker *w, const Grid *g)
     return path_ray_epsilon(w) + g->sagitta;
 }
 
+float path_ray_offset_in(const Worker *w, const Grid *g, uint32_t instance)
+{
+    const GeomInstance *gi = render_instance(w->rs, instance);
+    return path_ray_epsilon(w) + g->sagitta * (gi ? gi->scale : 1.0f);
+}
+
 void path_apply_Os_pattern(const Worker *w, const RenderObject *obj, const RayesShadeCtx *ctx,
                            float (*Os)[3])
 {

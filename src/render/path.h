@@ -52,6 +52,8 @@ typedef struct PathState {
     float (*irradiance)[3];       /* per point, where direct lighting leaves pi times its
                                      diffuse result (the shader's Irradiance output, memo
                                      6.2), or NULL: not asked for */
+    uint32_t instance;            /* the object instance grid is seen through: 0, or its
+                                     GridSet index + 1 (its object's light links apply) */
 } PathState;
 
 /* The texture-space footprint of a point whose parameter footprint is
@@ -77,6 +79,9 @@ static inline void path_st_footprint(const float dst[4], float du, float dv, flo
  * boundary vertex (every cache fill has them) would otherwise hit the
  * neighbour from behind. The bound allows neighbours twice as coarse. */
 float path_ray_offset(const Worker *w, const Grid *g);
+/* The same for a master's grid seen through an instance (0: none): its
+ * sagitta in world units. */
+float path_ray_offset_in(const Worker *w, const Grid *g, uint32_t instance);
 
 /* The distance rays start from a point off a grid (a light, an eye) and
  * stop short of a light: a millionth of the scene's radius times ten. */

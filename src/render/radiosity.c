@@ -187,7 +187,7 @@ typedef struct FillPoints {
  * colour and opacity are the object's unless the grid has its own. */
 static void put_point(const GridSet *gs, const Grid *g, FillPoints *fp, size_t p,
                       const uint32_t *vtx, const float *wt, int nv, int side,
-                      const RenderObject *obj)
+                      const RenderObject *obj, const GeomInstance *gi)
 {
     Vec3 P = v3(0, 0, 0), N = P, Ng = P, du = P, dv = P, Cs = P, Os = P;
     Vec3 Cs_obj = v3_load(obj->Cs), Os_obj = v3_load(obj->Os);
@@ -209,6 +209,13 @@ static void put_point(const GridSet *gs, const Grid *g, FillPoints *fp, size_t p
         for (int c = 0; c < 4; c++)
             dst[c] += dsti[c] * wt[k];
     }
+    if (gi) { /* a master's grid through an instance: to world space */
+        P = mat4_point(&gi->world_from_master, P);
+        N = mat4_vector(&gi->normal_to_world, N);
+        Ng = mat4_vector(&gi->normal_to_world, Ng);
+        du = mat4_vector(&gi->world_from_master, du);
+        dv = mat4_vector(&gi->world_from_master, dv);
+    }
     N = v3_normalize(N);
     Ng = v3_normalize(Ng);
     if (side)
@@ -228,7 +235,7 @@ static void put_point(const GridSet *gs, const Grid *g, FillPoints *fp, size_t p
 
 /* Positions of the level's points on the fine grid. */
 static void layout_points(const GridSet *gs, const Grid *g, int level, int side,
-                          const RenderObject *obj, FillPoints *fp)
+                          const RenderObject *obj, const GeomInstance *gi, FillPoints *fp)
 {
     size_t p = 0;
     if (!g->triangular) {
@@ -239,7 +246,7 @@ static void layout_points(const GridSet *gs, const Grid *g, int level, int side,
                 int fi = quad_level_index(level, i, nu), fj = quad_level_index(level, j, nv);
                 uint32_t vtx = (uint32_t)(fj * nu + fi);
                 float one = 1.0f;
-                put_point(gs, g, fp, p++, &vtx, &one, 1, side, obj);
+                put_point(gs, g, fp, p++, &vtx, &one, 1, side, obj, gi);
             }
         return;
     }
@@ -253,7 +260,7 @@ static void layout_points(const GridSet *gs, const Grid *g, int level, int side,
             uint32_t vtx[3];
             for (int k = 0; k < 3; k++)
                 vtx[k] = geom_tri_vertex((uint32_t)n, (uint32_t)vi[k][0], (uint32_t)vi[k][1]);
-            put_point(gs, g, fp, p++, vtx, wt, 3, side, obj);
+            put_point(gs, g, fp, p++, vtx, wt, 3, side, obj, gi);
         }
 }
 
@@ -320,7 +327,9 @@ static void fill_radiosity(void *user, const CacheKey *key, size_t n, float (*ou
     Worker *w = job->w;
     const GridSet *gs = w->rs->gs;
     const Grid *g = &gs->grids[key->patch];
-    const RenderObject *obj = &w->rs->objects[g->object];
+    const RenderObject *obj = render_object(w->rs, key->patch, key->instance);
+    const GeomInstance *gi = render_instance(w->rs, key->instance);
+    float scale = gi ? gi->scale : 1.0f; /* world units per grid unit */
     FillPoints fp;
     float(*f3)[3] = malloc(n * 10 * sizeof *f3);
     float *f1 = malloc(n * 14 * sizeof *f1);
@@ -334,20 +343,22 @@ static void fill_radiosity(void *user, const CacheKey *key, size_t n, float (*ou
     fp.u = f1, fp.v = f1 + n, fp.du = f1 + 2 * n, fp.dv = f1 + 3 * n, fp.curv = f1 + 4 * n;
     fp.offset = f1 + 5 * n, fp.s = f1 + 6 * n, fp.t = f1 + 7 * n, fp.ds = f1 + 8 * n;
     fp.dt = f1 + 9 * n, fp.dst = (float(*)[4])(f1 + 10 * n);
-    layout_points(gs, g, key->level, key->side, obj, &fp);
+    layout_points(gs, g, key->level, key->side, obj, gi, &fp);
     uint64_t fill_key = hash_combine(hash_combine(w->set->seed, 0x7261646f73ull /* "rados" */),
                                      ((uint64_t)key->patch << 32) | ((uint64_t)key->depth << 16) |
                                          ((uint64_t)key->side << 8) | key->level);
     if (key->type == CACHE_IRRADIANCE) /* apart from the radiosity fill of the same grid */
         fill_key = hash_combine(fill_key, 0x69727261ull /* "irra" */);
-    float width = level_edge(g, key->level), du, dv;
+    if (key->instance) /* each instance its own numbers; uninstanced keys as before */
+        fill_key = hash_combine(fill_key, key->instance);
+    float width = level_edge(g, key->level) * scale, du, dv;
     level_footprint(g, key->level, &du, &dv);
     for (size_t i = 0; i < n; i++) {
         fp.du[i] = du;
         fp.dv[i] = dv;
         path_st_footprint(fp.dst[i], du, dv, &fp.ds[i], &fp.dt[i]);
-        fp.curv[i] = g->curvature;
-        fp.offset[i] = path_ray_offset(w, g);
+        fp.curv[i] = g->curvature / scale;
+        fp.offset[i] = path_ray_offset_in(w, g, key->instance);
         fp.keys[i] = hash_combine(fill_key, i);
         fp.diff[i] = (RayDiff){width, 0.0f};
         backfacing[i] = key->side != 0; /* side 1: against dPdu x dPdv */
@@ -363,7 +374,8 @@ static void fill_radiosity(void *user, const CacheKey *key, size_t n, float (*ou
                     own_st ? fp.ds : NULL,
                     own_st ? fp.dt : NULL,
                     0,
-                    NULL};
+                    NULL,
+                    key->instance};
     RayesShadeCtx ctx = {
         .n_points = n,
         .ray_type = fill_ray_type(key->type),
@@ -376,6 +388,7 @@ static void fill_radiosity(void *user, const CacheKey *key, size_t n, float (*ou
         .Os = (const float(*)[3])fp.Os, .renderer = &ps, .backfacing = backfacing,
     };
     path_apply_Os_pattern(w, obj, &ctx, fp.Os);
+    w->stats.instance_fills += key->instance != 0 && key->type == CACHE_RADIOSITY;
     fill_run(w, key->type, &ctx, obj, &fp, f3 + 9 * n, out);
     free(f3);
     free(f1);
@@ -441,14 +454,17 @@ Vec3 radiosity_interpolate(const Grid *g, const Hit *hit, int level, const uint1
 static Vec3 cached_at_hit(Worker *w, const Hit *hit, int type, int depth, int side, RayDiff diff)
 {
     const Grid *g = &w->rs->gs->grids[hit->grid];
-    float footprint = diff.width + diff.spread * hit->t;
+    const GeomInstance *gi = render_instance(w->rs, hit->instance);
+    /* the footprint in the grid's units (a master's, through an instance) */
+    float footprint = (diff.width + diff.spread * hit->t) / (gi ? gi->scale : 1.0f);
     int level = radiosity_choose_level(g, footprint, w->set->cache_k, w->set->cache_resolution);
     CacheKey key = {.patch = hit->grid,
                     .depth = (uint16_t)depth,
                     .segment = 0,
                     .side = (uint8_t)side,
                     .type = (uint8_t)type,
-                    .level = (uint8_t)level};
+                    .level = (uint8_t)level,
+                    .instance = hit->instance};
     FillJob job = {w, hit->grid};
     const uint16_t *vals =
         cache_lookup(&w->cache, &key, level_values(g, level), fill_radiosity, &job);

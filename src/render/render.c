@@ -223,6 +223,7 @@ static void merge_stats(RenderStats *into, const RenderStats *s)
     into->rays_subsurface += s->rays_subsurface;
     into->subsurface_points += s->subsurface_points;
     into->irradiance_points += s->irradiance_points;
+    into->instance_fills += s->instance_fills;
 }
 
 int render_frame(const RenderScene *rs, const RenderSettings *set, float *rgba, RenderStats *stats)

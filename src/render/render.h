@@ -77,6 +77,24 @@ typedef struct RenderScene {
     size_t n_volumes;
 } RenderScene;
 
+/* The object a grid is shaded with when seen through instance (Hit.instance:
+ * 0, or a GridSet instance index + 1): its own, or for a master's inheriting
+ * grid the instance's (DESIGN.md "Instances"). */
+static inline const RenderObject *render_object(const RenderScene *rs, uint32_t grid,
+                                                uint32_t instance)
+{
+    uint32_t o = rs->gs->grids[grid].object;
+    if (o == GEOM_OBJECT_INHERIT) /* never seen but through an instance; else the spare */
+        o = instance ? rs->gs->instances[instance - 1].object : (uint32_t)rs->n_objects;
+    return &rs->objects[o];
+}
+
+/* The instance of a hit or a cache key (0: none), or NULL. */
+static inline const GeomInstance *render_instance(const RenderScene *rs, uint32_t instance)
+{
+    return instance ? &rs->gs->instances[instance - 1] : (const GeomInstance *)0;
+}
+
 typedef struct RenderSettings {
     int width, height, spp, threads, tile_size;
     int crop[4];                  /* the pixels rendered: x0, y0, x1, y1 (exclusive ends);
@@ -138,6 +156,8 @@ typedef struct RenderStats {
     uint64_t subsurface_points; /* points the subsurface service integrated at */
     uint64_t irradiance_points; /* points whose irradiance a shader computed (cache fills
                                    and uncached subsurface hits) */
+    uint64_t instance_fills;    /* radiosity cache fills of grids seen through object instances
+                                   (each instance fills its own entries) */
 } RenderStats;
 
 /* The camera of an image of `height` pixels: eye, axes and tan(fov / 2)

@@ -210,7 +210,7 @@ static const RenderObject *lit_object(const PathState *ps)
 {
     static const RenderObject every = {.light = -1};
     const RenderScene *rs = ps->w->rs;
-    return ps->grid < rs->gs->n_grids ? &rs->objects[rs->gs->grids[ps->grid].object] : &every;
+    return ps->grid < rs->gs->n_grids ? render_object(rs, ps->grid, ps->instance) : &every;
 }
 
 static void svc_direct_lighting(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
@@ -735,10 +735,16 @@ static int svc_attribute(const RayesShaderServices *sv, const RayesShadeCtx *ctx
     (void)sv;
     const PathState *ps = ctx->renderer;
     const Grid *g = &ps->w->rs->gs->grids[ps->grid];
+    const RenderScene *rs = ps->w->rs;
     if (strcmp(name, "object:id") == 0)
-        return put_floats(value, n, (float[]){(float)g->object}, 1);
+        return put_floats(value, n,
+                          (float[]){(float)(render_object(rs, ps->grid, ps->instance) -
+                                            rs->objects)},
+                          1);
     if (strcmp(name, "patch:id") == 0)
         return put_floats(value, n, (float[]){(float)ps->grid}, 1);
+    if (strcmp(name, "instance:id") == 0) /* 0: not instanced; else the instance + 1 */
+        return put_floats(value, n, (float[]){(float)ps->instance}, 1);
     if (strcmp(name, "grid:size") == 0)
         return put_floats(value, n, (float[]){(float)g->nu, (float)g->nv}, 2);
     if (strcmp(name, "grid:edge") == 0)

@@ -106,7 +106,11 @@ static int displace_grid(const RayesScene *s, GridSet *gs, Grid *g, float step,
 {
     const Prim *prim = &s->prims[g->prim];
     const ShaderInstance *inst = &s->displacements[prim->displacement - 1];
-    const SceneObject *obj = &s->objects[prim->object];
+    /* A master's inheriting geometry is displaced once for every instance:
+     * it sees white Cs and Os (its instances' colours are not known here). */
+    static const SceneObject white = {.Cs = {1, 1, 1}, .Os = {1, 1, 1}};
+    const SceneObject *obj =
+        prim->object == GEOM_OBJECT_INHERIT ? &white : &s->objects[prim->object];
     size_t n = geom_grid_n_vertices(g), m = SAMPLES * n;
     if (scratch_reserve(sc, m, m * inst->cls->scratch_size) != 0)
         return -1;

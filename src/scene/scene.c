@@ -84,6 +84,7 @@ RayesScene *rayes_scene_new(void)
     s->current_visibility =
         RAYES_RAY_CAMERA | RAYES_RAY_DIFFUSE | RAYES_RAY_SPECULAR | RAYES_RAY_SHADOW;
     s->current_opacity_cache = 1;
+    s->open_master = -1;
     return s;
 }
 
@@ -119,6 +120,10 @@ void rayes_scene_release(RayesScene *s)
     for (int k = 0; k < SCENE_SEARCH_PATH_COUNT; k++)
         free(s->search_paths[k]);
     scene_patterns_free(s);
+    for (size_t i = 0; i < s->n_masters; i++)
+        free(s->masters[i].name);
+    free(s->masters);
+    free(s->instances);
     free(s);
 }
 
@@ -417,15 +422,17 @@ RayesError rayes_scene_set_displacement_bound(RayesScene *s, float bound)
 
 static RayesError add_prim(RayesScene *s, Prim *p)
 {
-    if (s->current_object < 0) {
+    if (s->current_object == -1) {
         RayesError e = rayes_scene_set_shader(s, "matte", NULL, 0);
         if (e != RAYES_OK)
             return e;
     }
     if (grow((void **)&s->prims, &s->cap_prims, s->n_prims, sizeof *s->prims) != 0)
         return fail(s, RAYES_ERROR_OUT_OF_MEMORY, "out of memory");
-    p->object = (uint32_t)s->current_object;
-    if ((p->pv & GEOM_PV_OS) && s->pv_Os_below_1)
+    p->object = s->current_object == SCENE_OBJECT_INHERIT ? GEOM_OBJECT_INHERIT
+                                                          : (uint32_t)s->current_object;
+    p->master = s->open_master >= 0 ? (uint32_t)s->open_master + 1 : 0;
+    if ((p->pv & GEOM_PV_OS) && s->pv_Os_below_1 && p->object != GEOM_OBJECT_INHERIT)
         s->objects[p->object].Os_primvar_below_1 = 1;
     p->shading_rate = s->shading_rate;
     p->displacement = s->current_displacement;
@@ -878,6 +885,8 @@ RayesError rayes_scene_volume(RayesScene *s, const float bound[6])
         !(bound[4] < bound[5]))
         return fail(s, RAYES_ERROR_INVALID_ARGUMENT,
                     "volume: expected a finite box xmin < xmax, ymin < ymax, zmin < zmax");
+    if (s->open_master >= 0)
+        return fail(s, RAYES_ERROR_INVALID_ARGUMENT, "volume: not allowed in an object block");
     if (s->current_object < 0) {
         RayesError e = rayes_scene_set_shader(s, "homogeneous", NULL, 0);
         if (e != RAYES_OK)
@@ -901,6 +910,8 @@ RayesError rayes_scene_area_light(RayesScene *s, const float P[4][3], const floa
     if (!finite_n(&P[0][0], 12) || !finite_n(L, 3) || L[0] < 0 || L[1] < 0 || L[2] < 0)
         return fail(s, RAYES_ERROR_INVALID_ARGUMENT,
                     "area light: expected finite points and a non-negative radiance");
+    if (s->open_master >= 0)
+        return fail(s, RAYES_ERROR_INVALID_ARGUMENT, "area light: not allowed in an object block");
     if (grow((void **)&s->lights, &s->cap_lights, s->n_lights, sizeof *s->lights) != 0)
         return fail(s, RAYES_ERROR_OUT_OF_MEMORY, "out of memory");
     Light *l = &s->lights[s->n_lights];
@@ -1001,6 +1012,10 @@ RayesError rayes_scene_commit(RayesScene *s)
 {
     if (!s)
         return RAYES_ERROR_INVALID_ARGUMENT;
+    if (s->open_master >= 0)
+        return fail(s, RAYES_ERROR_INVALID_OPERATION,
+                    "commit: the object block \"%.64s\" has no end (rayes_scene_object_end)",
+                    s->masters[s->open_master].name);
     RayesError e = check_links(s);
     if (e != RAYES_OK)
         return e;
@@ -1031,53 +1046,10 @@ Bounds3 scene_bounds(const RayesScene *s)
                                          v3(v->bound[k & 1], v->bound[2 + (k >> 1 & 1)],
                                             v->bound[4 + (k >> 2)])));
     }
-    for (size_t i = 0; i < s->n_prims; i++) {
-        const Prim *p = &s->prims[i];
-        if (p->type == PRIM_SPHERE) {
-            Vec3 c = mat4_point(&p->sphere.world_from_object, v3(0, 0, 0));
-            float r = p->sphere.radius;
-            for (int k = 0; k < 3; k++) {
-                Vec3 axis = mat4_vector(&p->sphere.world_from_object,
-                                        v3(k == 0 ? r : 0, k == 1 ? r : 0, k == 2 ? r : 0));
-                float l = v3_length(axis);
-                b = bounds_add(b, v3_add(c, v3(l, l, l)));
-                b = bounds_add(b, v3_sub(c, v3(l, l, l)));
-            }
-            continue;
-        }
-        if (p->type == PRIM_SUBDIV) { /* the control points hold the limit surface */
-            float lo[3], hi[3];
-            geom_subdiv_patch_bounds(p->subdiv.mesh, p->subdiv.patch, lo, hi);
-            b = bounds_add(bounds_add(b, v3(lo[0], lo[1], lo[2])), v3(hi[0], hi[1], hi[2]));
-            continue;
-        }
-        if (p->type == PRIM_QUADRIC) { /* a lattice of surface points, widened */
-            Bounds3 q = bounds_empty();
-            for (int j = 0; j <= 16; j++)
-                for (int i = 0; i <= 16; i++) {
-                    Vec3 P, du, dv;
-                    geom_prim_eval(p, (float)i / 16.0f, (float)j / 16.0f, &P, &du, &dv);
-                    q = bounds_add(q, P);
-                }
-            Vec3 pad = v3_scale(v3_sub(q.hi, q.lo), 0.05f);
-            b = bounds_add(bounds_add(b, v3_sub(q.lo, pad)), v3_add(q.hi, pad));
-            continue;
-        }
-        if (p->type == PRIM_CURVE || p->type == PRIM_POINT) { /* control points, widened */
-            int n = p->type == PRIM_CURVE ? 3 * p->curve.n_seg + 1 : 1;
-            const Vec3 *c = p->type == PRIM_CURVE ? p->curve.cp : &p->point.centre;
-            float r = p->point.radius;
-            for (int k = 0; p->type == PRIM_CURVE && k <= p->curve.n_seg; k++)
-                r = k ? fmaxf(r, 0.5f * p->curve.width[k]) : 0.5f * p->curve.width[0];
-            for (int k = 0; k < n; k++)
-                b = bounds_add(bounds_add(b, v3_sub(c[k], v3(r, r, r))), v3_add(c[k], v3(r, r, r)));
-            continue;
-        }
-        int n = p->type == PRIM_BICUBIC ? 16 : p->type == PRIM_TRIANGLE ? 3 : 4;
-        for (int k = 0; k < n; k++)
-            b = bounds_add(b, p->cp[k]);
-    }
-    return b;
+    for (size_t i = 0; i < s->n_prims; i++)
+        if (!s->prims[i].master) /* masters' are in master space: their instances' below */
+            b = bounds_union(b, scene_prim_bounds(&s->prims[i]));
+    return bounds_union(b, scene_instances_bounds(s));
 }
 
 /* The dicing camera of the scene's camera for an image of width x height. */
@@ -1107,21 +1079,68 @@ static DiceCamera dice_camera(const RayesScene *s, int width, int height, const 
     return cam;
 }
 
-/* Dices (and displaces) every primitive into gs, or stops as soon as gs
- * holds more than budget vertices (0: no budget) and returns the vertices
- * all primitives would need, counted; else returns 0. -1 (as size_t)
- * when out of memory. */
-static size_t dice_all(const RayesScene *s, const DiceCamera *cam, size_t budget,
+/* The dicing cameras of the masters: master m's (cams[m + 1]) measures
+ * by distance from the eye of its nearest instance, in master space
+ * (DESIGN.md "Instances": one tessellation serves every instance, so it
+ * is as fine as the nearest needs); cams[m + 1].grid_size is -1 for a
+ * master no instance places (not diced). Returns 0, or -1 when out of
+ * memory. */
+static int master_cameras(const RayesScene *s, const GridSet *gs, DiceCamera *cams)
+{
+    Bounds3 *mb = scene_masters_bounds(s);
+    float *best = malloc((s->n_masters + 1) * sizeof *best);
+    if (!mb || !best) {
+        free(mb);
+        free(best);
+        return -1;
+    }
+    for (size_t m = 0; m < s->n_masters; m++) {
+        best[m] = INFINITY;
+        cams[m + 1] = cams[0];
+        cams[m + 1].grid_size = -1;
+    }
+    for (size_t i = 0; i < gs->n_instances; i++) {
+        const GeomInstance *gi = &gs->instances[i];
+        Vec3 e = mat4_point(&gi->master_from_world, cams[0].eye);
+        Bounds3 b = mb[gi->master];
+        Vec3 near = v3(fminf(fmaxf(e.x, b.lo.x), b.hi.x), fminf(fmaxf(e.y, b.lo.y), b.hi.y),
+                       fminf(fmaxf(e.z, b.lo.z), b.hi.z));
+        float d = v3_length(v3_sub(near, e)); /* master units: world distance / scale */
+        if (!(d < best[gi->master]))
+            continue;
+        best[gi->master] = d;
+        DiceCamera *c = &cams[gi->master + 1];
+        *c = cams[0];
+        c->eye = e;
+        c->has_view = 0; /* by distance: the frustum is the world's, not the master's */
+        c->pixel_width = cams[0].pixel_width / gi->scale;
+        c->min_distance = cams[0].min_distance / gi->scale;
+    }
+    free(mb);
+    free(best);
+    return 0;
+}
+
+/* Dices (and displaces) every primitive into gs, world geometry with
+ * cams[0] and master m's with cams[m + 1] (skipping masters no instance
+ * places), or stops as soon as gs holds more than budget vertices (0: no
+ * budget) and returns the vertices all primitives would need, counted;
+ * else returns 0. -1 (as size_t) when out of memory. */
+static size_t dice_all(const RayesScene *s, const DiceCamera *cams, size_t budget,
                        DicingServices *sv, float step, GridSet *gs)
 {
     for (size_t i = 0; i < s->n_prims; i++) {
         size_t first = gs->n_grids;
+        const DiceCamera *cam = &cams[s->prims[i].master];
+        if (cam->grid_size < 0)
+            continue;
         if (geom_dice_prim(gs, &s->prims[i], (uint32_t)i, s->pv, cam) != 0)
             return (size_t)-1;
         if (budget && gs->n_vertices > budget) {
             size_t total = gs->n_vertices;
             for (size_t k = i + 1; k < s->n_prims; k++)
-                total += geom_count_prim(&s->prims[k], cam);
+                if (cams[s->prims[k].master].grid_size >= 0)
+                    total += geom_count_prim(&s->prims[k], &cams[s->prims[k].master]);
             return total;
         }
         /* Normals of displaced surfaces: differences over 1e-3 of the scene radius.
@@ -1143,31 +1162,51 @@ int scene_prepare(const RayesScene *s, int width, int height, const DiceOptions 
     shade_dicing_services_init(&sv, textures);
     Bounds3 b = scene_bounds(s);
     float radius = s->n_prims ? 0.5f * v3_length(v3_sub(b.hi, b.lo)) : 1.0f;
-    DiceCamera cam = dice_camera(s, width, height, dice, radius);
+    DiceCamera *cams = malloc((s->n_masters + 1) * sizeof *cams);
+    if (!cams || scene_flatten_instances(s, gs) != 0) {
+        free(cams);
+        return -1;
+    }
+    cams[0] = dice_camera(s, width, height, dice, radius);
+    if (master_cameras(s, gs, cams) != 0) {
+        free(cams);
+        return -1;
+    }
     size_t budget = dice ? dice->vertex_budget : 0;
     /* Over the budget: vertices go as the inverse square of the edge, so
      * edges longer by the square root of the excess (and 5%) fit, but
      * for the grids' minimum sizes; a few rounds at most. */
     size_t first_need = 0;
     for (int round = 0;; round++) {
-        size_t need = dice_all(s, &cam, round < 8 ? budget : 0, &sv, 1e-3f * radius, gs);
-        if (need == (size_t)-1)
+        size_t need = dice_all(s, cams, round < 8 ? budget : 0, &sv, 1e-3f * radius, gs);
+        if (need == (size_t)-1) {
+            free(cams);
             return -1;
+        }
         if (need == 0)
             break;
         first_need = first_need ? first_need : need;
-        cam.rate_scale *= 1.05f * sqrtf((float)need / (float)budget);
+        for (size_t m = 0; m <= s->n_masters; m++)
+            cams[m].rate_scale *= 1.05f * sqrtf((float)need / (float)budget);
+        GeomInstance *keep = gs->instances; /* the instances stay; the grids go */
+        size_t n_keep = gs->n_instances;
+        gs->instances = NULL;
         geom_gridset_fini(gs);
         geom_gridset_init(gs);
+        gs->instances = keep;
+        gs->n_instances = n_keep;
+        gs->n_masters = s->n_masters;
     }
+    float rate_scale = cams[0].rate_scale;
+    free(cams);
     if (geom_stitch(gs, s->prims) != 0)
         return -1;
     if (first_need)
         log_warning("dicing: the scene needs %zu grid vertices, more than the budget of %zu "
                     "(--vertex-budget); micropolygons made %.2f times longer (%zu vertices)",
-                    first_need, budget, cam.rate_scale, gs->n_vertices);
+                    first_need, budget, rate_scale, gs->n_vertices);
     if (coarsened)
-        *coarsened = cam.rate_scale;
+        *coarsened = rate_scale;
     return 0;
 }
 
@@ -1303,6 +1342,8 @@ RayesError rayes_scene_light(RayesScene *s, const char *type, const RayesParam *
 {
     if (!s || !type || (n_params && !params))
         return RAYES_ERROR_INVALID_ARGUMENT;
+    if (s->open_master >= 0)
+        return fail(s, RAYES_ERROR_INVALID_ARGUMENT, "light: not allowed in an object block");
     static const char *const types[] = {"pointlight",   "spotlight",        "distantlight",
                                         "ambientlight", "environmentlight", "arealight"};
     int t = -1;

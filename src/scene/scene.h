@@ -58,6 +58,42 @@ typedef struct SceneLinks {
     size_t n;
 } SceneLinks;
 
+/* A master (rayes_scene_object_begin ... _end): the primitives
+ * [first_prim, end_prim), in master space, and the instances made inside
+ * its block (SceneInstance.parent). */
+typedef struct SceneMaster {
+    char *name;               /* owned */
+    size_t first_prim, end_prim;
+    uint64_t leaves;          /* placements of masters with primitives one instance of it
+                                 makes when flattened (itself if it has primitives, plus its
+                                 nested instances'); caps the flattened count */
+    int depth;                /* 1 + the deepest nesting of its instances' masters */
+} SceneMaster;
+
+/* One rayes_scene_object_instance. */
+typedef struct SceneInstance {
+    Mat4 parent_from_master;  /* the current transform when it was made */
+    uint32_t master;          /* the master placed */
+    uint32_t parent;          /* 0: the world; else the master index + 1 whose block holds it */
+    uint32_t object;          /* the object its master's inheriting geometry takes, or
+                                 GEOM_OBJECT_INHERIT (inside a block before any shader: the
+                                 enclosing instance's) */
+} SceneInstance;
+
+/* What rayes_scene_object_begin saves and rayes_scene_object_end restores. */
+typedef struct SceneSaved {
+    Mat4 world_from_object;
+    int64_t current_object;
+    float shading_rate, displacement_bound;
+    uint32_t displacement, links, visibility;
+    uint8_t hitmode, opacity_cache;
+} SceneSaved;
+
+/* Flattened instances are at most this many (nested blocks multiply), and
+ * blocks nest at most SCENE_MAX_NESTING deep. */
+#define SCENE_MAX_INSTANCES (1u << 24)
+#define SCENE_MAX_NESTING 32
+
 /* The kinds of rayes_scene_set_search_path, indexing RayesScene.search_paths
  * (names in scene.c's search_path_kinds). */
 typedef enum SceneSearchPath {
@@ -133,7 +169,32 @@ struct RayesScene {
                                                     empty */
     ScenePattern *patterns; /* in the order made; a name's latest is the one found */
     size_t n_patterns, cap_patterns;
+    SceneMaster *masters;   /* in the order their blocks began; a name's latest is found */
+    size_t n_masters, cap_masters;
+    SceneInstance *instances; /* in the order made */
+    size_t n_instances, cap_instances;
+    int64_t open_master;    /* the master whose block is open, or -1 */
+    SceneSaved saved;       /* the state before that block */
+    uint64_t leaves;        /* flattened instances the world's instances make */
 };
+
+/* current_object inside a block before any shader: geometry inherits. */
+#define SCENE_OBJECT_INHERIT (-2)
+
+/* Flattens the scene's instances (nested ones into their innermost
+ * masters with primitives) into gs->instances, and sets gs->n_masters
+ * (instances.c). Returns 0, or -1 when out of memory. */
+int scene_flatten_instances(const RayesScene *scene, GridSet *gs);
+
+/* The world bounds of every instance placed in the world (flatten.c). */
+Bounds3 scene_instances_bounds(const RayesScene *scene);
+/* Every master's bounds in master space (its primitives and nested
+ * instances), n_masters of them (malloc'd: the caller frees), or NULL
+ * when out of memory. */
+Bounds3 *scene_masters_bounds(const RayesScene *scene);
+
+/* The bounds of one primitive's control points (scene.c). */
+Bounds3 scene_prim_bounds(const Prim *p);
 
 /* Records an edit: the scene is uncommitted, and the change is stamped
  * with the next commit. */

@@ -276,7 +276,7 @@ RayesError rayes_session_pick(const RayesSession *s, float x, float y, int64_t *
     Hit hit;
     if (!accel_intersect(s->prep->accel, &ray, &hit))
         return RAYES_OK;
-    *object = s->prep->gs.grids[hit.grid].object;
+    *object = render_object(&rs, hit.grid, hit.instance) - rs.objects;
     if (position) {
         Vec3 P = v3_madd(ray.o, ray.d, hit.t);
         position[0] = P.x;

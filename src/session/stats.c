@@ -29,6 +29,38 @@ static void real(RayesStats *s, const char *name, double v)
         s->items[s->n++] = (RayesStat){.name = name, .kind = RAYES_STAT_REAL, .real = v};
 }
 
+/* Object instances (DESIGN.md "Instances"): how many, the masters' grids
+ * and vertices (held once), the vertices flattened copies would hold, and
+ * the radiosity cache fills of instanced grids per instance (each
+ * instance fills its own entries; with no eviction, fills are entries). */
+static void add_instances(RayesStats *s, const RenderStats *rs, const GridSet *gs)
+{
+    uint64_t *vertices = calloc(gs->n_masters + 1, sizeof *vertices);
+    uint64_t grids = 0, master_vertices = 0, flattened = 0, micropolygons = 0;
+    for (size_t k = 0; k < gs->n_grids; k++)
+        if (gs->grids[k].master) {
+            const Grid *g = &gs->grids[k];
+            grids++;
+            master_vertices += geom_grid_n_vertices(g);
+            micropolygons += g->triangular ? (uint64_t)g->nu * g->nu
+                                           : (uint64_t)(g->nu - 1) * (uint64_t)(g->nv - 1);
+            if (vertices)
+                vertices[gs->grids[k].master] += geom_grid_n_vertices(&gs->grids[k]);
+        }
+    for (size_t i = 0; vertices && i < gs->n_instances; i++)
+        flattened += vertices[gs->instances[i].master + 1];
+    free(vertices);
+    count(s, "instances/count", gs->n_instances);
+    count(s, "instances/masters", gs->n_masters);
+    count(s, "instances/master_grids", grids);
+    count(s, "instances/master_vertices", master_vertices);
+    count(s, "instances/master_micropolygons", micropolygons);
+    count(s, "instances/flattened_vertices", flattened);
+    count(s, "instances/radiosity_fills", rs->instance_fills);
+    real(s, "instances/radiosity_entries_per_instance",
+         (double)rs->instance_fills / (double)gs->n_instances);
+}
+
 RayesStats *session_stats_new(const RenderSettings *set, const RenderStats *rs, const GridSet *gs,
                               const SessionTimes *t, size_t accel_bytes)
 {
@@ -81,6 +113,8 @@ RayesStats *session_stats_new(const RenderSettings *set, const RenderStats *rs, 
         count(s, "irradiance/records", rs->irradiance_records);
         count(s, "irradiance/interpolated", rs->irradiance_interpolated);
     }
+    if (gs->n_instances)
+        add_instances(s, rs, gs);
     if (s->n < MAX_STATS)
         s->items[s->n++] = (RayesStat){.name = "hider", .kind = RAYES_STAT_STRING,
                                        .string = set->hider ? "grid" : "raytrace"};

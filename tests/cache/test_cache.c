@@ -37,13 +37,15 @@ static uint64_t key_bits(const CacheKey *k)
 {
     uint64_t a = (uint64_t)k->patch | (uint64_t)k->depth << 32 | (uint64_t)k->segment << 48 |
                  (uint64_t)k->side << 56;
-    return hash_combine(a, (uint64_t)k->type | (uint64_t)k->level << 8);
+    return hash_combine(a, (uint64_t)k->type | (uint64_t)k->level << 8 |
+                               (uint64_t)k->instance << 16);
 }
 
 static int key_same(const CacheKey *a, const CacheKey *b)
 {
     return a->patch == b->patch && a->depth == b->depth && a->segment == b->segment &&
-           a->side == b->side && a->type == b->type && a->level == b->level;
+           a->side == b->side && a->type == b->type && a->level == b->level &&
+           a->instance == b->instance;
 }
 
 static float key_value(const CacheKey *k, uint32_t version, size_t i, int c)
@@ -273,7 +275,7 @@ static void test_keys_separate_every_field(void)
 {
     const CacheKey base = {.patch = 10, .depth = 1, .segment = 2, .side = 0,
                            .type = CACHE_RADIOSITY, .level = CACHE_MEDIUM};
-    CacheKey keys[16];
+    CacheKey keys[20];
     int n = 0;
     keys[n++] = base;
     keys[n] = base, keys[n++].patch = 11;
@@ -289,6 +291,9 @@ static void test_keys_separate_every_field(void)
     keys[n] = base, keys[n++].level = CACHE_COARSE;
     keys[n] = base, keys[n++].level = CACHE_FINE;
     keys[n] = base, keys[n].depth = 2, keys[n++].segment = 1; /* fields trading places */
+    keys[n] = base, keys[n++].instance = 1; /* an object instance's own entries (memo 3.1) */
+    keys[n] = base, keys[n++].instance = 2;
+    keys[n] = base, keys[n++].instance = 0x10000u;
     Cache *c = cache_new(4000000, split_default);
     Filler f = {0};
     for (int i = 0; i < n; i++)

@@ -1,0 +1,225 @@
+/*
+ * tests/io/test_instances_files.c — RIB and pbrt-v4 ObjectBegin, ObjectEnd
+ * and ObjectInstance read into a scene (io_sink_scene) as masters and
+ * instances, not copies: counts, the shader an instance inherits, nesting
+ * (RIB), errors naming file:line, and the RIB writer's round trip.
+ */
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "io/pbrt.h"
+#include "io/rib.h"
+#include "io/rib_write.h"
+#include "rayes/rayes.h"
+#include "test.h"
+
+static char err[1024];
+
+static RayesError read_into(RayesScene *s, const char *name, const char *text)
+{
+    IoSettings settings;
+    io_settings_init(&settings);
+    IoSink sink = io_sink_scene(s);
+    IoReadOptions opt = {RAYES_TEST_DATA, -1};
+    size_t n = strlen(text);
+    unsigned char *copy = malloc(n ? n : 1); /* exactly its size, for AddressSanitizer */
+    memcpy(copy, text, n);
+    err[0] = '\0';
+    RayesError e = strstr(name, ".pbrt")
+                       ? io_pbrt_parse(name, copy, n, &sink, &opt, &settings, err, sizeof err)
+                       : io_rib_parse(name, copy, n, &sink, &opt, &settings, err, sizeof err);
+    free(copy);
+    return e;
+}
+
+/* Renders s at 48 x 48 and returns the statistic (a count). */
+static uint64_t render_stat(RayesScene *s, const char *stat, RayesImage **keep)
+{
+    CHECK(rayes_scene_commit(s) == RAYES_OK);
+    RayesRenderOptions o;
+    rayes_render_options_init(&o, RAYES_QUALITY_PREVIEW);
+    o.width = o.height = 48;
+    o.spp = 1;
+    o.threads = 2;
+    RayesImage *img = NULL;
+    RayesStats *st = NULL;
+    CHECK(rayes_render(s, &o, &img, &st) == RAYES_OK);
+    const RayesStat *x = st ? rayes_stats_find(st, stat) : NULL;
+    uint64_t v = x ? x->count : 0;
+    rayes_stats_free(st);
+    if (keep)
+        *keep = img;
+    else
+        rayes_image_free(img);
+    return v;
+}
+
+#define RIB_HEAD                                                                                   \
+    "Projection \"perspective\" \"fov\" 40\nTranslate 0 0 6\nWorldBegin\n"                         \
+    "LightSource \"pointlight\" 1 \"from\" [0 0 -4] \"intensity\" [20]\n"
+
+/* A quad in a block with no Surface or Color, instanced red at x = 1 and
+ * green at x = -1 (the image's right and left). */
+static const char *rib_two = RIB_HEAD
+    "ObjectBegin \"card\"\n"
+    "  Polygon \"P\" [-0.8 -0.8 0  0.8 -0.8 0  0.8 0.8 0  -0.8 0.8 0]\n"
+    "ObjectEnd\n"
+    "AttributeBegin\nColor [1 0 0]\nTranslate 1 0 0\nObjectInstance \"card\"\nAttributeEnd\n"
+    "AttributeBegin\nColor [0 1 0]\nTranslate -1 0 0\nObjectInstance \"card\"\n"
+    "AttributeEnd\nWorldEnd\n";
+
+static void test_rib_instances_inherit_colour(void)
+{
+    RayesScene *s = rayes_scene_new();
+    CHECK(read_into(s, "t.rib", rib_two) == RAYES_OK);
+    CHECK(rayes_scene_instance_count(s) == 2);
+    RayesImage *img = NULL;
+    CHECK(render_stat(s, "instances/count", &img) == 2);
+    const float *left = &img->rgba[4 * (24 * 48 + 12)], *right = &img->rgba[4 * (24 * 48 + 36)];
+    CHECK(right[0] > 0.05f && right[1] < 0.2f * right[0]); /* red */
+    CHECK(left[1] > 0.05f && left[0] < 0.2f * left[1]);    /* green */
+    rayes_image_free(img);
+    rayes_scene_release(s);
+}
+
+/* A block with its own Color keeps it in every instance; numeric handles. */
+static void test_rib_block_colour_kept(void)
+{
+    RayesScene *s = rayes_scene_new();
+    CHECK(read_into(s, "t.rib",
+                    RIB_HEAD "ObjectBegin 7\nColor [0 0 1]\n"
+                             "  Polygon \"P\" [-0.8 -0.8 0  0.8 -0.8 0  0.8 0.8 0  -0.8 0.8 0]\n"
+                             "ObjectEnd\nColor [1 0 0]\nObjectInstance 7\nWorldEnd\n") == RAYES_OK);
+    RayesImage *img = NULL;
+    CHECK(render_stat(s, "instances/masters", &img) == 1);
+    const float *mid = &img->rgba[4 * (24 * 48 + 24)];
+    CHECK(mid[2] > 0.05f && mid[0] < 0.2f * mid[2]); /* blue, not red */
+    rayes_image_free(img);
+    rayes_scene_release(s);
+}
+
+/* ObjectInstance inside ObjectBegin (RenderMan allows it): 2 x 3 balls. */
+static void test_rib_nested(void)
+{
+    RayesScene *s = rayes_scene_new();
+    CHECK(read_into(s, "t.rib",
+                    RIB_HEAD
+                    "ObjectBegin \"ball\"\nSphere 0.2 -0.2 0.2 360\nObjectEnd\n"
+                    "ObjectBegin \"row\"\n"
+                    "  TransformBegin\nTranslate -0.5 0 0\nObjectInstance \"ball\"\n"
+                    "  TransformEnd\n"
+                    "  ObjectInstance \"ball\"\n"
+                    "  Translate 0.5 0 0\nObjectInstance \"ball\"\n"
+                    "ObjectEnd\n"
+                    "TransformBegin\nTranslate 0 0.5 0\nObjectInstance \"row\"\nTransformEnd\n"
+                    "Translate 0 -0.5 0\nObjectInstance \"row\"\nWorldEnd\n") == RAYES_OK);
+    CHECK(rayes_scene_instance_count(s) == 5);           /* made: 3 in "row", 2 of it */
+    CHECK(render_stat(s, "instances/count", NULL) == 6); /* flattened */
+    rayes_scene_release(s);
+}
+
+static void expect_error(const char *name, const char *text, const char *where, const char *what)
+{
+    RayesScene *s = rayes_scene_new();
+    CHECK(read_into(s, name, text) != RAYES_OK);
+    if (!strstr(err, where) || !strstr(err, what))
+        fprintf(stderr, "error was: %s\n", err);
+    CHECK(strstr(err, where) != NULL);
+    CHECK(strstr(err, what) != NULL);
+    CHECK(strchr(err, '\n') == NULL); /* one line */
+    rayes_scene_release(s);
+}
+
+static void test_errors(void)
+{
+    expect_error("t.rib", RIB_HEAD "Sphere 1 -1 1 360\nObjectInstance \"nope\"\nWorldEnd\n",
+                 "t.rib:6", "nope");
+    expect_error("t.rib", RIB_HEAD "ObjectEnd\nWorldEnd\n", "t.rib:5", "ObjectEnd without");
+    expect_error("t.rib", RIB_HEAD "ObjectBegin 1\nObjectBegin 2\nObjectEnd\nObjectEnd\n",
+                 "t.rib:6", "inside an object definition");
+    expect_error("t.pbrt", "WorldBegin\nShape \"sphere\"\nObjectInstance \"nope\"\n", "t.pbrt:3",
+                 "nope");
+    expect_error("t.pbrt",
+                 "WorldBegin\nObjectBegin \"a\"\nShape \"sphere\"\nObjectEnd\nObjectBegin \"b\"\n"
+                 "ObjectInstance \"a\"\nObjectEnd\n",
+                 "t.pbrt:6", "ObjectInstance inside ObjectBegin");
+}
+
+/* pbrt-v4: the object is sent once as a master, placed three times. */
+static void test_pbrt_instances(void)
+{
+    RayesScene *s = rayes_scene_new();
+    CHECK(
+        read_into(s, "t.pbrt",
+                  "LookAt 0 0 -6  0 0 0  0 1 0\nCamera \"perspective\" \"float fov\" 40\n"
+                  "WorldBegin\n"
+                  "LightSource \"point\" \"point3 from\" [0 0 -4] \"float scale\" 20\n"
+                  "ObjectBegin \"pebble\"\n"
+                  "  Material \"diffuse\" \"rgb reflectance\" [0.8 0.4 0.2]\n"
+                  "  Shape \"sphere\" \"float radius\" 0.3\n"
+                  "ObjectEnd\n"
+                  "ObjectInstance \"pebble\"\n"
+                  "AttributeBegin\nTranslate 1 0 0\nObjectInstance \"pebble\"\nAttributeEnd\n"
+                  "AttributeBegin\nTranslate -1 0 0\nObjectInstance \"pebble\"\nAttributeEnd\n") ==
+        RAYES_OK);
+    CHECK(rayes_scene_instance_count(s) == 3);
+    CHECK(render_stat(s, "instances/masters", NULL) == 1);
+    rayes_scene_release(s);
+}
+
+/* RIB -> RIB writer -> RIB: the blocks and instances survive, and the
+ * second file reads into the same instances. */
+static void test_rib_writer_round_trip(void)
+{
+    RibWriter *w = io_rib_writer_new();
+    IoSink sink = io_rib_writer_sink(w);
+    IoSettings settings;
+    io_settings_init(&settings);
+    IoReadOptions opt = {RAYES_TEST_DATA, -1};
+    size_t n = strlen(rib_two);
+    CHECK(io_rib_parse("t.rib", (const unsigned char *)rib_two, n, &sink, &opt, &settings, err,
+                       sizeof err) == RAYES_OK);
+    char *text = NULL;
+    size_t size = 0;
+    FILE *f = open_memstream(&text, &size);
+    CHECK(io_rib_writer_finish(w, &settings, f, err, sizeof err) == RAYES_OK);
+    fclose(f);
+    io_rib_writer_free(w);
+    CHECK(strstr(text, "ObjectBegin \"card\"") != NULL);
+    CHECK(strstr(text, "ObjectEnd") != NULL);
+    const char *first = strstr(text, "ObjectInstance \"card\"");
+    CHECK(first && strstr(first + 1, "ObjectInstance \"card\"") != NULL);
+    RayesScene *s = rayes_scene_new();
+    CHECK(read_into(s, "w.rib", text) == RAYES_OK);
+    CHECK(rayes_scene_instance_count(s) == 2);
+    RayesImage *img = NULL;
+    CHECK(render_stat(s, "instances/count", &img) == 2);
+    const float *left = &img->rgba[4 * (24 * 48 + 12)], *right = &img->rgba[4 * (24 * 48 + 36)];
+    CHECK(right[0] > 0.05f && right[1] < 0.2f * right[0]);
+    CHECK(left[1] > 0.05f && left[0] < 0.2f * left[1]);
+    rayes_image_free(img);
+    rayes_scene_release(s);
+    free(text);
+}
+
+/* Aqsis's objectinstance scene: one master of one quad, twelve instances. */
+static void test_aqsis_objectinstance(void)
+{
+    char path[1024];
+    snprintf(path, sizeof path, "%s/scenes/rib-aqsis/objectinstance/singlepolygon.rib",
+             RAYES_TEST_DATA);
+    RayesScene *s = rayes_scene_new();
+    IoSettings settings;
+    io_settings_init(&settings);
+    IoSink sink = io_sink_scene(s);
+    IoReadOptions opt = {RAYES_TEST_DATA, -1};
+    CHECK(io_rib_read(path, &sink, &opt, &settings, err, sizeof err) == RAYES_OK);
+    CHECK(rayes_scene_instance_count(s) == 12);
+    CHECK(render_stat(s, "instances/masters", NULL) == 1);
+    rayes_scene_release(s);
+}
+
+TEST_MAIN(TEST(test_aqsis_objectinstance), TEST(test_rib_instances_inherit_colour), TEST(test_rib_block_colour_kept),
+          TEST(test_rib_nested), TEST(test_errors), TEST(test_pbrt_instances),
+          TEST(test_rib_writer_round_trip))
