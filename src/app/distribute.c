@@ -22,6 +22,9 @@
 
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
+
+#include "io/stats_json.h"
 
 #ifdef RAYES_HAVE_MPI
 #include <mpi.h>
@@ -315,6 +318,62 @@ void distribute_print_summary(const Distributed *d, FILE *out)
             total[6] > 0 ? 100.0 * hits[2] / total[6] : 0.0);
 }
 
+int distribute_save_stats(const Distributed *d, const char *path, const RayesStats *stats,
+                          const char *scene, char *err, size_t err_size)
+{
+    if (!d || !d->stats)
+        return io_stats_json_save(path, stats, scene, err, err_size) == RAYES_OK ? 0 : -1;
+    /* rank 0's statistics as usual, then "mpi": every rank's and their sum */
+    char *text = NULL;
+    size_t len = 0;
+    FILE *mem = open_memstream(&text, &len);
+    if (!mem) {
+        snprintf(err, err_size, "%s: out of memory", path);
+        return -1;
+    }
+    io_stats_json_write(mem, stats, scene);
+    fclose(mem);
+    while (len > 0 && (text[len - 1] == '\n' || text[len - 1] == '}'))
+        if (text[--len] == '}')
+            break;
+    char tmp[4200];
+    snprintf(tmp, sizeof tmp, "%s.tmp", path);
+    FILE *f = fopen(tmp, "w");
+    if (!f) {
+        free(text);
+        snprintf(err, err_size, "%s: cannot write", tmp);
+        return -1;
+    }
+    fwrite(text, 1, len, f);
+    free(text);
+    double total[STAT_COUNT + 1] = {0}, hits[3] = {0};
+    fprintf(f, ",\n  \"mpi\": {\"ranks\": %d, \"per_rank\": [", d->size);
+    for (int r = 0; r < d->size; r++) {
+        const double *v = d->stats[r];
+        fprintf(f, "%s\n    {\"rank\": %d, \"tiles\": %.0f", r ? "," : "", r, v[STAT_TILES]);
+        for (int k = 0; k < STAT_COUNT; k++)
+            fprintf(f, ", \"%s\": %.17g", stat_names[k], v[k]);
+        fprintf(f, "}");
+        for (int k = 0; k <= STAT_COUNT; k++)
+            total[k] += v[k];
+        for (int l = 0; l < 3; l++)
+            hits[l] += v[7 + l] * v[4 + l];
+    }
+    fprintf(f, "],\n    \"total\": {\"tiles\": %.0f", total[STAT_TILES]);
+    for (int k = 0; k < 7; k++) /* the counts; hit rates weighted by lookups */
+        fprintf(f, ", \"%s\": %.17g", stat_names[k], total[k]);
+    for (int l = 0; l < 3; l++)
+        fprintf(f, ", \"%s\": %.17g", stat_names[7 + l],
+                total[4 + l] > 0 ? hits[l] / total[4 + l] : 0.0);
+    fprintf(f, "}}\n}\n");
+    if (fclose(f) != 0 || rename(tmp, path) != 0) {
+        unlink(tmp);
+        snprintf(err, err_size, "%s: cannot write", path);
+        return -1;
+    }
+    return 0;
+}
+
 void distribute_end(Distributed *d)
 {
     if (!d)
@@ -362,6 +421,13 @@ int distribute_frame_end(Distributed *d, RayesImage *img, const RayesStats *stat
 void distribute_print_summary(const Distributed *d, FILE *out)
 {
     (void)d, (void)out;
+}
+
+int distribute_save_stats(const Distributed *d, const char *path, const RayesStats *stats,
+                          const char *scene, char *err, size_t err_size)
+{
+    (void)d;
+    return io_stats_json_save(path, stats, scene, err, err_size) == RAYES_OK ? 0 : -1;
 }
 
 void distribute_end(Distributed *d)

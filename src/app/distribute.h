@@ -45,6 +45,13 @@ int distribute_frame_end(Distributed *d, RayesImage *img, const RayesStats *stat
  * lines. */
 void distribute_print_summary(const Distributed *d, FILE *out);
 
+/* Rank 0 (or one process, d NULL): the statistics file of the frame,
+ * stats as io_stats_json_save writes them and, in a job, an "mpi" object
+ * with every rank's tiles, rays, shading points, cache lookups and hit
+ * rates, prepare and render times, and their total. 0, or -1 with err. */
+int distribute_save_stats(const Distributed *d, const char *path, const RayesStats *stats,
+                          const char *scene, char *err, size_t err_size);
+
 void distribute_end(Distributed *d);
 
 #endif

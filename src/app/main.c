@@ -507,7 +507,7 @@ static int render_job(Args a, int frame, int number, Distributed *d)
         }
     }
     if (status == 0 && a.stats_path &&
-        io_stats_json_save(a.stats_path, stats, a.scene, err, sizeof err) != RAYES_OK) {
+        distribute_save_stats(d, a.stats_path, stats, a.scene, err, sizeof err) != 0) {
         fprintf(stderr, "rayes: %s\n", err);
         status = 1;
     }

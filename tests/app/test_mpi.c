@@ -85,8 +85,8 @@ static void test_same_bytes_as_one_process(void)
         mpirun(mpi, sizeof mpi, 3);
         snprintf(cmd, sizeof cmd,
                  "ASAN_OPTIONS=detect_leaks=0 %s %s render cornell --res 96 %s --threads 1 -o %s "
-                 ">%s 2>&1",
-                 mpi, RAYES_BIN, modes[m], many, out);
+                 "--stats %s.json >%s 2>&1",
+                 mpi, RAYES_BIN, modes[m], many, many, out);
         int rc = system(cmd);
         CHECK(rc == 0);
         CHECK(same_bytes(one, many));
@@ -100,6 +100,17 @@ static void test_same_bytes_as_one_process(void)
               strstr(text, "all ranks     3 ranks, 9 tiles"));
         if (rc != 0 || !strstr(text, "all ranks"))
             fprintf(stderr, "%s\n", text);
+        /* the statistics file: rank 0's, and every rank's with their total */
+        char json[520], jtext[16384] = "";
+        snprintf(json, sizeof json, "%s.json", many);
+        FILE *jf = fopen(json, "r");
+        size_t jn = jf ? fread(jtext, 1, sizeof jtext - 1, jf) : 0;
+        jtext[jn] = '\0';
+        if (jf)
+            fclose(jf);
+        CHECK(strstr(jtext, "\"mpi\": {\"ranks\": 3, \"per_rank\": [") &&
+              strstr(jtext, "{\"rank\": 2, \"tiles\": ") &&
+              strstr(jtext, "\"total\": {\"tiles\": 9, \"rays/total\": "));
     }
 }
 
