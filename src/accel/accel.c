@@ -10,6 +10,11 @@
  * SPHERE_ or DISC_POINT, a point per grid. Geom records map (geomID,
  * primID) back to grids.
  *
+ * Motion blur: the quad and triangle geometries of an object with a moving
+ * grid have the GridSet's n_times time steps, step k sharing its sample k
+ * vertex array (GridSet.Pt), over Embree's time range [0, 1]; a ray's
+ * time maps onto it (clamped). Curves and points stay still.
+ *
  * Embree with TBB builds on its own threads; commit happens once, before
  * any query, and queries are concurrent (Embree's contract).
  */
@@ -96,12 +101,27 @@ static int attach(Accel *a, RTCGeometry geom, uint32_t mask, Geom g)
     return add_geom(a, g);
 }
 
+/* The vertex buffers of geom, whose grids are idx[0 .. n - 1]: one, or
+ * one per time sample if any of them moves. */
+static void set_vertices(const GridSet *gs, RTCGeometry geom, const uint32_t *idx, size_t n)
+{
+    int moving = 0;
+    for (size_t k = 0; k < n && gs->n_times > 1 && !moving; k++)
+        moving = gs->grids[idx[k]].moving;
+    int steps = moving ? gs->n_times : 1;
+    if (moving)
+        rtcSetGeometryTimeStepCount(geom, (unsigned)steps);
+    for (int t = 0; t < steps; t++)
+        rtcSetSharedGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, (unsigned)t, RTC_FORMAT_FLOAT3,
+                                   geom_time_array(gs->P, gs->Pt, t), 0, sizeof(Vec3),
+                                   gs->n_vertices);
+}
+
 static int build_quads(Accel *a, const uint32_t *idx, size_t n, uint32_t mask)
 {
     const GridSet *gs = a->gs;
     RTCGeometry geom = rtcNewGeometry(a->device, RTC_GEOMETRY_TYPE_GRID);
-    rtcSetSharedGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, gs->P, 0,
-                               sizeof(Vec3), gs->n_vertices);
+    set_vertices(gs, geom, idx, n);
     struct RTCGrid *grids = rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_GRID, 0, RTC_FORMAT_GRID,
                                              sizeof(struct RTCGrid), n);
     Geom g = {.kind = KIND_QUADS, .grids = malloc(n * sizeof(uint32_t))};
@@ -147,8 +167,7 @@ static int build_tris(Accel *a, const uint32_t *idx, size_t n, uint32_t mask)
     const GridSet *gs = a->gs;
     size_t n_tris = count_tris(gs, idx, n);
     RTCGeometry geom = rtcNewGeometry(a->device, RTC_GEOMETRY_TYPE_TRIANGLE);
-    rtcSetSharedGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, gs->P, 0,
-                               sizeof(Vec3), gs->n_vertices);
+    set_vertices(gs, geom, idx, n);
     uint32_t(*tri)[3] = rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
                                                 3 * sizeof(uint32_t), n_tris);
     Geom g = {.kind = KIND_TRIS, .tris = malloc(n_tris * sizeof(MicroTri))};
@@ -385,7 +404,7 @@ void accel_free(Accel *a)
     free(a);
 }
 
-static void set_ray(struct RTCRay *r, const Ray *ray)
+static void set_ray(const Accel *a, struct RTCRay *r, const Ray *ray)
 {
     r->org_x = ray->o.x;
     r->org_y = ray->o.y;
@@ -395,7 +414,10 @@ static void set_ray(struct RTCRay *r, const Ray *ray)
     r->dir_z = ray->d.z;
     r->tnear = ray->tnear;
     r->tfar = ray->tfar;
-    r->time = 0.0f;
+    const GridSet *gs = a->gs;
+    float span = gs->time[1] - gs->time[0];
+    float t = gs->n_times > 1 && span > 0.0f ? (ray->time - gs->time[0]) / span : 0.0f;
+    r->time = t < 0.0f ? 0.0f : t > 1.0f ? 1.0f : t;
     r->mask = ray->mask;
     r->id = 0;
     r->flags = 0;
@@ -541,7 +563,7 @@ int accel_intersect(const Accel *a, const Ray *ray, Hit *hit)
     struct RTCIntersectContext ctx;
     rtcInitIntersectContext(&ctx);
     struct RTCRayHit rh;
-    set_ray(&rh.ray, ray);
+    set_ray(a, &rh.ray, ray);
     rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
     rh.hit.primID = RTC_INVALID_GEOMETRY_ID;
     rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
@@ -618,7 +640,7 @@ Vec3 accel_transmission(const Accel *a, const Ray *ray, AccelOpacityFn opacity, 
     tc.T = v3(1, 1, 1);
     tc.n_seen = 0;
     struct RTCRay r;
-    set_ray(&r, ray);
+    set_ray(a, &r, ray);
     rtcOccluded1(a->scene, &tc.rtc, &r);
     return r.tfar < 0.0f ? v3(0, 0, 0) : tc.T;
 }
@@ -628,7 +650,7 @@ int accel_occluded(const Accel *a, const Ray *ray)
     struct RTCIntersectContext ctx;
     rtcInitIntersectContext(&ctx);
     struct RTCRay r;
-    set_ray(&r, ray);
+    set_ray(a, &r, ray);
     rtcOccluded1(a->scene, &ctx, &r);
     return r.tfar < 0.0f;
 }

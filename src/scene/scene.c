@@ -108,6 +108,8 @@ void rayes_scene_release(RayesScene *s)
     free(s->links);
     free(s->objects);
     free(s->prims);
+    free(s->motions);
+    free(s->motion_prims);
     for (size_t i = 0; i < s->n_subdivs; i++)
         geom_subdiv_free(s->subdivs[i]);
     free(s->subdivs);
@@ -208,6 +210,7 @@ RayesError rayes_scene_set_transform(RayesScene *s, const float m[16])
         return fail(s, RAYES_ERROR_INVALID_ARGUMENT,
                     "transform: expected a finite, invertible matrix");
     s->world_from_object = mat4_from_array(m);
+    s->current_motion = 0;
     return RAYES_OK;
 }
 
@@ -428,6 +431,9 @@ static RayesError add_prim(RayesScene *s, Prim *p)
     if ((p->pv & GEOM_PV_OS) && s->pv_Os_below_1)
         s->objects[p->object].Os_primvar_below_1 = 1;
     p->shading_rate = s->shading_rate;
+    p->motion = s->current_motion;
+    p->motionfactor = s->motionfactor;
+    p->focusfactor = s->focusfactor;
     p->displacement = s->current_displacement;
     p->displacement_bound = s->displacement_bound;
     s->prims[s->n_prims++] = *p;
@@ -1116,12 +1122,19 @@ static size_t dice_all(const RayesScene *s, const DiceCamera *cam, size_t budget
 {
     for (size_t i = 0; i < s->n_prims; i++) {
         size_t first = gs->n_grids;
-        if (geom_dice_prim(gs, &s->prims[i], (uint32_t)i, s->pv, cam) != 0)
+        Prim blurred = s->prims[i];
+        float coarser = scene_blur_dice_factor(s, &blurred, cam);
+        blurred.shading_rate *= coarser * coarser; /* a rate is an area */
+        if (geom_dice_prim(gs, &blurred, (uint32_t)i, s->pv, cam) != 0)
             return (size_t)-1;
         if (budget && gs->n_vertices > budget) {
             size_t total = gs->n_vertices;
-            for (size_t k = i + 1; k < s->n_prims; k++)
-                total += geom_count_prim(&s->prims[k], cam);
+            for (size_t k = i + 1; k < s->n_prims; k++) {
+                Prim blurred = s->prims[k];
+                float coarser = scene_blur_dice_factor(s, &blurred, cam);
+                blurred.shading_rate *= coarser * coarser;
+                total += geom_count_prim(&blurred, cam);
+            }
             return total;
         }
         /* Normals of displaced surfaces: differences over 1e-3 of the scene radius.
@@ -1160,7 +1173,7 @@ int scene_prepare(const RayesScene *s, int width, int height, const DiceOptions 
         geom_gridset_fini(gs);
         geom_gridset_init(gs);
     }
-    if (geom_stitch(gs, s->prims) != 0)
+    if (geom_stitch(gs, s->prims) != 0 || scene_motion_prepare(s, gs) != 0)
         return -1;
     if (first_need)
         log_warning("dicing: the scene needs %zu grid vertices, more than the budget of %zu "
