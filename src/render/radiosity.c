@@ -351,6 +351,8 @@ static void fill_radiosity(void *user, const CacheKey *key, size_t n, float (*ou
         memcpy(out, fp.Oi, n * sizeof *out);
     } else {
         w->stats.shading_points[RY_MIN(key->depth, RENDER_MAX_DEPTH)] += n;
+        if (g->moving)
+            w->stats.segment_fills[key->segment]++;
         shade_run_diffuselighting(w->services, &ctx, obj->shader, &o);
         memcpy(out, fp.Ci, n * sizeof *out);
     }

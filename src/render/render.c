@@ -269,6 +269,8 @@ static void merge_stats(RenderStats *into, const RenderStats *s)
     into->transparent_hits += s->transparent_hits;
     into->rays_transmission += s->rays_transmission;
     into->volume_steps += s->volume_steps;
+    for (int k = 0; k < GEOM_MAX_TIMES - 1; k++)
+        into->segment_fills[k] += s->segment_fills[k];
 }
 
 int render_frame(const RenderScene *rs, const RenderSettings *set, float *rgba, RenderStats *stats)

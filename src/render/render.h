@@ -138,6 +138,8 @@ typedef struct RenderStats {
     uint64_t rays_transmission; /* shadow and transmission rays that marched a volume (also
                                    counted in rays_shadow) */
     uint64_t volume_steps;      /* ray marching steps through volumes */
+    uint64_t segment_fills[GEOM_MAX_TIMES - 1]; /* radiosity cache fills of moving grids, by
+                                                   motion segment (the entries each made) */
 } RenderStats;
 
 /* The camera of an image of `height` pixels: eye, axes and tan(fov / 2)
