@@ -344,13 +344,13 @@ static int h_procedural(Rib *r, const Args *a)
 static int h_motion_begin(Rib *r, const Args *a)
 {
     if (a->n < 1 || (a->v[0].kind != ARG_NUMS && a->v[0].kind != ARG_NUM))
-        return rib_error(r, "MotionBegin: expected an array of times");
+        return rib_error(r, "expected an array of times");
     const Arg *t = &a->v[0];
     if (t->n < 1 || t->n > RIB_MAX_TIMES)
-        return rib_error(r, "MotionBegin: expected 1 to %d times, found %zu", RIB_MAX_TIMES, t->n);
+        return rib_error(r, "expected 1 to %d times, found %zu", RIB_MAX_TIMES, t->n);
     for (size_t k = 0; k < t->n; k++) {
         if (!isfinite(t->d[k]) || (k > 0 && !(t->d[k] > t->d[k - 1])))
-            return rib_error(r, "MotionBegin: expected finite, increasing times");
+            return rib_error(r, "expected finite, increasing times");
         r->motion_time[k] = (float)t->d[k];
     }
     r->motion = 1;
@@ -376,7 +376,7 @@ static int motion_end(Rib *r)
 {
     r->motion = 0;
     if (r->motion_kind != 0 && (size_t)r->motion_seen != r->motion_n)
-        return rib_error(r, "MotionEnd: the block has %d requests for %zu times", r->motion_seen,
+        return rib_error(r, "the block has %d requests for %zu times", r->motion_seen,
                          r->motion_n);
     if (r->motion_kind == 1) {
         memcpy(r->a.M, r->motion_M[0], sizeof r->a.M);
@@ -399,11 +399,12 @@ static int motion_request(Rib *r, const char *q, const Args *a, int (*run)(Rib *
 {
     size_t k = (size_t)r->motion_seen++;
     if (k >= r->motion_n)
-        return rib_error(r, "%s: the motion block has more requests than its %zu times", q,
+        return rib_error(r, "the motion block has more requests than its %zu times",
                          r->motion_n);
     int transform = is_transform_request(q);
     if (r->motion_kind && r->motion_kind != (transform ? 1 : 2))
-        return rib_error(r, "%s: a motion block holds the samples of one request", q);
+        return rib_error(r, "a motion block holds the samples of one request (transforms, "
+                            "or one primitive)");
     r->motion_kind = transform ? 1 : 2;
     if (transform) {
         memcpy(r->a.M, r->motion_pre, sizeof r->a.M);

@@ -246,7 +246,7 @@ static int h_shutter(Rib *r, const Args *a)
     if (rib_get_floats(r, a, &i, v, 2, "open close") != 0)
         return -1;
     if (!isfinite(v[0]) || !isfinite(v[1]) || v[1] < v[0])
-        return rib_error(r, "Shutter: expected finite open <= close, found %g %g", v[0], v[1]);
+        return rib_error(r, "expected finite open <= close, found %g %g", v[0], v[1]);
     r->shutter[0] = v[0], r->shutter[1] = v[1];
     return 0;
 }
@@ -265,7 +265,7 @@ static int h_depth_of_field(Rib *r, const Args *a)
         return -1;
     if (!(v[0] > 0.0f) || !(v[1] >= 0.0f) || !(v[2] > 0.0f) || !isfinite(v[1]) ||
         !isfinite(v[2]))
-        return rib_error(r, "DepthOfField: expected fstop > 0, focallength >= 0 and "
+        return rib_error(r, "expected fstop > 0, focallength >= 0 and "
                             "focaldistance > 0, found %g %g %g",
                          v[0], v[1], v[2]);
     memcpy(r->dof, v, sizeof r->dof);
