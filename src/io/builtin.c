@@ -136,13 +136,13 @@ static RayesError teapot_displacement(const IoSink *s)
 
 static RayesError teapot_spin(const IoSink *s)
 {
-    if (!s->set_transform_motion || !s->set_shutter || !s->set_depth_of_field)
-        return RAYES_ERROR_INVALID_OPERATION;
     float times[MOTION_SAMPLES], m[MOTION_SAMPLES][16];
     for (int k = 0; k < MOTION_SAMPLES; k++) {
         times[k] = (float)k / (MOTION_SAMPLES - 1);
         teapot_transform(150.0f + 40.0f * times[k], 160.0f, 195.0f, m[k]);
     }
+    if (!s->set_transform_motion || !s->set_shutter || !s->set_depth_of_field)
+        return s->set_transform(s->target, m[0]); /* a sink without time: the still frame */
     RayesError e = s->set_shutter(s->target, 0.0f, 1.0f);
     if (e == RAYES_OK)
         e = s->set_depth_of_field(s->target, 20.0f, 1170.0f);

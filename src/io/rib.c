@@ -422,7 +422,13 @@ static int motion_request(Rib *r, const char *q, const Args *a, int (*run)(Rib *
                                         "sample of each motion block is used");
         return 1;
     }
-    if (k == 0 && s->motion_begin(s->target, r->motion_n, r->motion_time) != RAYES_OK)
+    if (k > 0)
+        return 0;
+    /* The state first, so that the block holds the samples alone. */
+    int skip = rib_emit_begin(r, NULL);
+    if (skip != 0)
+        return skip < 0 ? -1 : 1;
+    if (s->motion_begin(s->target, r->motion_n, r->motion_time) != RAYES_OK)
         return rib_sink_failed(r, s);
     return 0;
 }

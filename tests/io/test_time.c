@@ -257,5 +257,58 @@ static void test_pbrt_motion_and_lens(void)
     rayes_scene_release(s);
 }
 
+/* The RIB writer: what it writes of a file reads back to the same image. */
+static void round_trip(const char *text, int pbrt)
+{
+    RibWriter *wr = io_rib_writer_new();
+    IoSink sink = io_rib_writer_sink(wr);
+    IoSettings settings;
+    io_settings_init(&settings);
+    IoReadOptions opt = {NULL, -1};
+    size_t n = strlen(text);
+    RayesError e = pbrt ? io_pbrt_parse("t.pbrt", (const unsigned char *)text, n, &sink, &opt,
+                                        &settings, err, sizeof err)
+                        : io_rib_parse("t.rib", (const unsigned char *)text, n, &sink, &opt,
+                                       &settings, err, sizeof err);
+    CHECK(e == RAYES_OK);
+    char *out = NULL;
+    size_t size = 0;
+    FILE *f = open_memstream(&out, &size);
+    CHECK(io_rib_writer_finish(wr, &settings, f, err, sizeof err) == RAYES_OK);
+    fclose(f);
+    RayesImage *a = from_file(text, pbrt), *b = from_file(out, 0);
+    double d = alpha_diff(a, b);
+    CHECK(d < 1e-5);
+    CHECK(strstr(out, "MotionBegin") != NULL);
+    if (d >= 1e-5)
+        printf("  round trip differs by %g:\n%s\n", d, out);
+    rayes_image_free(a);
+    rayes_image_free(b);
+    free(out);
+    io_rib_writer_free(wr);
+}
+
+static void test_writer_round_trip(void)
+{
+    char text[4096];
+    snprintf(text, sizeof text,
+             "%sShutter 0 1\nDepthOfField 4 2 4\nMotionBegin [0 1]\nTranslate -0.5 0 5\n"
+             "Translate 0.5 0 5\nMotionEnd\nWorldBegin\n"
+             "AttributeBegin\nMotionBegin [0 0.5 1]\nTranslate -1 0 0\nTranslate 0 1 0\n"
+             "Translate 1 0 0\nMotionEnd\nSphere 1 -1 1 360\nAttributeEnd\n"
+             "MotionBegin [0 1]\nPatch \"bilinear\" \"P\" [-2 -2 1 0 -2 1 -2 -1 1 0 -1 1]\n"
+             "Patch \"bilinear\" \"P\" [-1 -2 1 1 -2 1 -1 -1 1 1 -1 1]\nMotionEnd\nWorldEnd\n",
+             "Format 48 48 1\nProjection \"perspective\" \"fov\" [60]\n");
+    round_trip(text, 0);
+    snprintf(text, sizeof text,
+             "%sTranslate 0 0 5\nCamera \"perspective\" \"float fov\" [60] "
+             "\"float lensradius\" [0.2] \"float focaldistance\" [4]\n"
+             "WorldBegin\nActiveTransform EndTime\nTranslate 1 0 0\nActiveTransform All\n"
+             "Shape \"sphere\" \"float radius\" [1]\n",
+             pbrt_ortho);
+    round_trip(text, 1);
+}
+
 TEST_MAIN(TEST(test_rib_transform_motion), TEST(test_rib_deformation_and_camera),
-          TEST(test_rib_depth_of_field), TEST(test_rib_errors), TEST(test_pbrt_motion_and_lens))
+          TEST(test_rib_depth_of_field), TEST(test_rib_errors), TEST(test_pbrt_motion_and_lens),
+          TEST(test_writer_round_trip))
