@@ -316,6 +316,41 @@ static void test_motion_determinism(void)
     rayes_image_free(d);
 }
 
-TEST_MAIN(TEST(test_moving_sphere_coverage), TEST(test_cached_segments_match_uncached),
+/* Attribute "dice" "motionfactor": a sphere blurred across 32 pixels is
+ * diced coarser (edges 1 + 32/16 = 3 times longer), covering the same. */
+static void test_motionfactor(void)
+{
+    uint64_t verts[2];
+    double cover[2];
+    for (int k = 0; k < 2; k++) {
+        RayesScene *s = rayes_scene_new();
+        ortho_camera(s);
+        CHECK(rayes_scene_set_shutter(s, 0.0f, 1.0f) == RAYES_OK);
+        CHECK(rayes_scene_set_dice_blur(s, k ? 1.0f : 0.0f, 0.0f) == RAYES_OK);
+        float m[2][16];
+        translate(m[0], -1, 0, 0);
+        translate(m[1], 1, 0, 0);
+        const float times[2] = {0, 1};
+        CHECK(rayes_scene_set_transform_motion(s, 2, times, (const float(*)[16])m) == RAYES_OK);
+        CHECK(rayes_scene_sphere(s, 1.0f) == RAYES_OK);
+        RayesStats *st = NULL;
+        RayesImage *img = render(s, 16, 2, 1, &st);
+        const RayesStat *v = rayes_stats_find(st, "grid_vertices");
+        verts[k] = v ? v->count : 0;
+        cover[k] = 0;
+        for (size_t i = 3; img && i < 4 * (size_t)W * W; i += 4)
+            cover[k] += img->rgba[i];
+        rayes_stats_free(st);
+        rayes_image_free(img);
+        rayes_scene_release(s);
+    }
+    CHECK(verts[1] * 4 < verts[0]);
+    CHECK(fabs(cover[1] / cover[0] - 1) < 0.01);
+    printf("  motionfactor 1: %llu grid vertices instead of %llu, coverage %+.2f%%\n",
+           (unsigned long long)verts[1], (unsigned long long)verts[0],
+           100 * (cover[1] / cover[0] - 1));
+}
+
+TEST_MAIN(TEST(test_moving_sphere_coverage), TEST(test_motionfactor), TEST(test_cached_segments_match_uncached),
           TEST(test_motion_determinism), TEST(test_deformation_equals_transform),
           TEST(test_bad_motion), TEST(test_camera_motion))
