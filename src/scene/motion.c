@@ -399,8 +399,9 @@ int scene_motion_prepare(const RayesScene *s, GridSet *gs)
 
 /* The primitive's centre at time t (its (1/2, 1/2), or a triangle's
  * centroid). */
-static Vec3 prim_centre(const RayesScene *s, const Prim *p, float t)
+static Vec3 prim_centre(const RayesScene *s, size_t index, float t)
 {
+    const Prim *p = &s->prims[index];
     float u = geom_prim_triangular(p) ? 1.0f / 3.0f : 0.5f, v = u;
     Vec3 P, dU, dV;
     geom_prim_eval(p, u, v, &P, &dU, &dV);
@@ -414,25 +415,26 @@ static Vec3 prim_centre(const RayesScene *s, const Prim *p, float t)
         Mat4 D = mat4_lerp(&m->delta[a], &m->delta[b], f);
         return mat4_point(&D, P);
     }
-    size_t j = (size_t)(p - s->prims) - m->first_prim;
+    size_t j = index - m->first_prim;
     Vec3 Pa, Pb;
     geom_prim_eval(deform_prim(s, m, j, a), u, v, &Pa, &dU, &dV);
     geom_prim_eval(deform_prim(s, m, j, b), u, v, &Pb, &dU, &dV);
     return v3_lerp(Pa, Pb, f);
 }
 
-float scene_blur_dice_factor(const RayesScene *s, const Prim *p, const DiceCamera *cam)
+float scene_blur_dice_factor(const RayesScene *s, size_t index, const DiceCamera *cam)
 {
+    const Prim *p = &s->prims[index];
     if (!(p->motionfactor > 0.0f) && !(p->focusfactor > 0.0f))
         return 1.0f;
-    Vec3 c0 = prim_centre(s, p, s->shutter[0]);
+    Vec3 c0 = prim_centre(s, index, s->shutter[0]);
     float dist = fmaxf(v3_length(v3_sub(c0, cam->eye)), cam->min_distance);
     float pixel = cam->pixel_angle > 0.0f ? dist * cam->pixel_angle : cam->pixel_width;
     if (!(pixel > 0.0f))
         return 1.0f;
     float blur = 0.0f;
     if (p->motionfactor > 0.0f && p->motion && s->shutter[1] > s->shutter[0]) {
-        Vec3 c1 = prim_centre(s, p, s->shutter[1]);
+        Vec3 c1 = prim_centre(s, index, s->shutter[1]);
         blur = fmaxf(blur, p->motionfactor * v3_length(v3_sub(c1, c0)) / pixel);
     }
     const SceneCamera *c = &s->camera;

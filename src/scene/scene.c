@@ -1123,7 +1123,7 @@ static size_t dice_all(const RayesScene *s, const DiceCamera *cam, size_t budget
     for (size_t i = 0; i < s->n_prims; i++) {
         size_t first = gs->n_grids;
         Prim blurred = s->prims[i];
-        float coarser = scene_blur_dice_factor(s, &blurred, cam);
+        float coarser = scene_blur_dice_factor(s, i, cam);
         blurred.shading_rate *= coarser * coarser; /* a rate is an area */
         if (geom_dice_prim(gs, &blurred, (uint32_t)i, s->pv, cam) != 0)
             return (size_t)-1;
@@ -1131,7 +1131,7 @@ static size_t dice_all(const RayesScene *s, const DiceCamera *cam, size_t budget
             size_t total = gs->n_vertices;
             for (size_t k = i + 1; k < s->n_prims; k++) {
                 Prim blurred = s->prims[k];
-                float coarser = scene_blur_dice_factor(s, &blurred, cam);
+                float coarser = scene_blur_dice_factor(s, k, cam);
                 blurred.shading_rate *= coarser * coarser;
                 total += geom_count_prim(&blurred, cam);
             }

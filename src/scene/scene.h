@@ -231,9 +231,10 @@ int scene_object_lit_by(const RayesScene *scene, size_t object, size_t light);
  * displacement and stitching. Returns 0, or -1 when out of memory. */
 int scene_motion_prepare(const RayesScene *scene, GridSet *gs);
 
-/* The factor (>= 1) by which blur lengthens a primitive's micropolygon
- * edges (motionfactor and focusfactor, motion.c); cam is the dicing camera. */
-float scene_blur_dice_factor(const RayesScene *scene, const Prim *prim, const DiceCamera *cam);
+/* The factor (>= 1) by which blur lengthens the micropolygon edges of the
+ * scene's primitive `index` (motionfactor and focusfactor, motion.c); cam
+ * is the dicing camera. */
+float scene_blur_dice_factor(const RayesScene *scene, size_t index, const DiceCamera *cam);
 
 /* For the scene's other files (curves.c): adds a primitive to the current
  * object; records the first error (printf-style) and returns e; appends n

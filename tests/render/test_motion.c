@@ -98,10 +98,11 @@ static void test_moving_sphere_coverage(void)
 
 /* A lit bilinear patch (4 x 2 units, facing the camera) moving from x = -1
  * to x = 1: by its transform, or by its two shapes. */
-static RayesScene *patch_scene(int deform)
+static RayesScene *patch_scene(int deform, float motionfactor)
 {
     RayesScene *s = rayes_scene_new();
     ortho_camera(s);
+    CHECK(rayes_scene_set_dice_blur(s, motionfactor, 0) == RAYES_OK);
     CHECK(rayes_scene_set_shutter(s, 0.0f, 1.0f) == RAYES_OK);
     RayesParam lp[2] = {{"from", RAYES_PARAM_COLOR, {0, 0, 0}, NULL},
                         {"to", RAYES_PARAM_COLOR, {0.3f, 0.2f, 1}, NULL}};
@@ -128,9 +129,9 @@ static RayesScene *patch_scene(int deform)
     return s;
 }
 
-static void test_deformation_equals_transform(void)
+static void deformation_equals_transform(float motionfactor)
 {
-    RayesScene *a = patch_scene(0), *b = patch_scene(1);
+    RayesScene *a = patch_scene(0, motionfactor), *b = patch_scene(1, motionfactor);
     RayesImage *ia = render(a, 16, 2, 1, NULL), *ib = render(b, 16, 2, 1, NULL);
     double worst = 0, mean = 0, cover = 0;
     for (size_t i = 0; ia && ib && i < 4 * (size_t)W * W; i++) {
@@ -144,11 +145,20 @@ static void test_deformation_equals_transform(void)
     float px = 2 * HALF / W;
     CHECK_NEAR(cover * px * px, 8.0, 0.08);
     CHECK(worst < 1e-5);
-    printf("  deformation vs transform: largest difference %.2g\n", worst);
+    printf("  deformation vs transform (motionfactor %g): largest difference %.2g\n",
+           motionfactor, worst);
     rayes_image_free(ia);
     rayes_image_free(ib);
     rayes_scene_release(a);
     rayes_scene_release(b);
+}
+
+/* Also with motionfactor: both blurs measure the same motion, so dice
+ * alike. */
+static void test_deformation_equals_transform(void)
+{
+    deformation_equals_transform(0.0f);
+    deformation_equals_transform(1.0f);
 }
 
 /* Bad motion calls are refused with a message. */
