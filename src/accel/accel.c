@@ -429,7 +429,20 @@ static Vec3 unit_or_zero(Vec3 n)
     return l > 0.0f && isfinite(l) ? v3_scale(n, 1.0f / l) : v3(0, 0, 0);
 }
 
-static void quad_hit(const Accel *a, const Geom *g, unsigned prim, float u, float v, Hit *hit)
+/* Vertex i of grid g where it is at Embree's ray time rt in [0, 1] (a
+ * still grid: sample 0). */
+static Vec3 vertex_at(const GridSet *gs, const Grid *g, uint32_t i, float rt)
+{
+    if (!g->moving || gs->n_times < 2)
+        return gs->P[i];
+    float x = rt * (float)(gs->n_times - 1);
+    int seg = (int)x;
+    seg = seg > gs->n_times - 2 ? gs->n_times - 2 : seg < 0 ? 0 : seg;
+    return geom_vertex_at(gs, g, i, seg, x - (float)seg).P;
+}
+
+static void quad_hit(const Accel *a, const Geom *g, unsigned prim, float u, float v, float rt,
+                     Hit *hit)
 {
     const GridSet *gs = a->gs;
     const Grid *grid = &gs->grids[g->grids[prim]];
@@ -453,13 +466,15 @@ static void quad_hit(const Accel *a, const Geom *g, unsigned prim, float u, floa
     hit->weight[1] = fu * (1.0f - fv);
     hit->weight[2] = (1.0f - fu) * fv;
     hit->weight[3] = fu * fv;
-    const Vec3 *P = gs->P;
+    Vec3 P[4];
+    for (int k = 0; k < 4; k++)
+        P[k] = vertex_at(gs, grid, hit->vertex[k], rt);
     /* The cell normal from its diagonals: 2 dPdu x dPdv for a parallelogram. */
-    hit->Ng = unit_or_zero(v3_cross(v3_sub(P[hit->vertex[3]], P[hit->vertex[0]]),
-                                    v3_sub(P[hit->vertex[2]], P[hit->vertex[1]])));
+    hit->Ng = unit_or_zero(v3_cross(v3_sub(P[3], P[0]), v3_sub(P[2], P[1])));
 }
 
-static void tri_hit(const Accel *a, const Geom *g, unsigned prim, float u, float v, Hit *hit)
+static void tri_hit(const Accel *a, const Geom *g, unsigned prim, float u, float v, float rt,
+                    Hit *hit)
 {
     const GridSet *gs = a->gs;
     const MicroTri *m = &g->tris[prim];
@@ -486,8 +501,10 @@ static void tri_hit(const Accel *a, const Geom *g, unsigned prim, float u, float
     }
     hit->vertex[3] = vtx[0];
     hit->weight[3] = 0.0f;
-    const Vec3 *P = gs->P;
-    hit->Ng = unit_or_zero(v3_cross(v3_sub(P[vtx[1]], P[vtx[0]]), v3_sub(P[vtx[2]], P[vtx[0]])));
+    Vec3 P[3];
+    for (int k = 0; k < 3; k++)
+        P[k] = vertex_at(gs, grid, vtx[k], rt);
+    hit->Ng = unit_or_zero(v3_cross(v3_sub(P[1], P[0]), v3_sub(P[2], P[0])));
 }
 
 /* Embree's geometric normal of a round shape's hit; a flat one faces the
@@ -532,7 +549,7 @@ static void point_hit(const Accel *a, const Geom *g, const struct RTCRayHit *rh,
     float xx = v3_dot(x, x), yy = v3_dot(y, y);
     float u = xx > 0.0f ? fminf(fmaxf(v3_dot(d, x) / xx, 0.0f), 1.0f) : 0.5f;
     float v = yy > 0.0f ? fminf(fmaxf(v3_dot(d, y) / yy, 0.0f), 1.0f) : 0.5f;
-    quad_hit(a, g, rh->hit.primID, u, v, hit);
+    quad_hit(a, g, rh->hit.primID, u, v, 0.0f, hit);
     hit->Ng = shape_normal(rh, g->shape);
 }
 
@@ -544,10 +561,10 @@ static void make_hit(const Accel *a, const struct RTCRayHit *rh, Hit *hit)
     hit->shape = g->shape;
     switch (g->kind) {
     case KIND_TRIS:
-        tri_hit(a, g, rh->hit.primID, rh->hit.u, rh->hit.v, hit);
+        tri_hit(a, g, rh->hit.primID, rh->hit.u, rh->hit.v, rh->ray.time, hit);
         break;
     case KIND_QUADS:
-        quad_hit(a, g, rh->hit.primID, rh->hit.u, rh->hit.v, hit);
+        quad_hit(a, g, rh->hit.primID, rh->hit.u, rh->hit.v, rh->ray.time, hit);
         break;
     case KIND_CURVES:
         curve_hit(a, g, rh, hit);
