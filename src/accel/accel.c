@@ -11,9 +11,11 @@
  * primID) back to grids.
  *
  * Motion blur: the quad and triangle geometries of an object with a moving
- * grid have the GridSet's n_times time steps, step k sharing its sample k
- * vertex array (GridSet.Pt), over Embree's time range [0, 1]; a ray's
- * time maps onto it (clamped). Curves and points stay still.
+ * grid have the GridSet's n_times time steps over Embree's time range
+ * [0, 1], each a vertex buffer of their own (Geom.steps: the grids'
+ * vertices one grid after another, still grids copied); a ray's time maps
+ * onto the range (clamped). Other geometries share GridSet.P. Curves and
+ * points stay still.
  *
  * Embree with TBB builds on its own threads; commit happens once, before
  * any query, and queries are concurrent (Embree's contract).
@@ -48,6 +50,8 @@ typedef struct Geom {
     uint32_t *grids;   /* quads, points: primID -> grid index */
     MicroTri *tris;    /* triangles: primID -> micropolygon */
     CurveSeg *segs;    /* curves: primID -> segment */
+    Vec3 *steps;       /* a moving geometry's vertices, owned: per time sample, its grids'
+                          vertices one grid after another (set_vertices) */
 } Geom;
 
 struct Accel {
@@ -101,40 +105,73 @@ static int attach(Accel *a, RTCGeometry geom, uint32_t mask, Geom g)
     return add_geom(a, g);
 }
 
-/* The vertex buffers of geom, whose grids are idx[0 .. n - 1]: one, or
- * one per time sample if any of them moves. */
-static void set_vertices(const GridSet *gs, RTCGeometry geom, const uint32_t *idx, size_t n)
+/* The vertex buffers of geom, whose grids are idx[0 .. n - 1]: the
+ * GridSet's P, shared, with base[k] = grid k's first vertex; or, if any of
+ * them moves, a buffer per time sample of their vertices one grid after
+ * another (returned, for the Geom to own; base[k] then counts in it).
+ * *failed is set when out of memory. */
+static Vec3 *set_vertices(const GridSet *gs, RTCGeometry geom, const uint32_t *idx, size_t n,
+                          uint32_t *base, int *failed)
 {
     int moving = 0;
-    for (size_t k = 0; k < n && gs->n_times > 1 && !moving; k++)
-        moving = gs->grids[idx[k]].moving;
-    int steps = moving ? gs->n_times : 1;
-    if (moving)
-        rtcSetGeometryTimeStepCount(geom, (unsigned)steps);
-    for (int t = 0; t < steps; t++)
+    size_t total = 0;
+    for (size_t k = 0; k < n; k++) {
+        const Grid *g = &gs->grids[idx[k]];
+        moving |= gs->n_times > 1 && g->moving;
+        base[k] = (uint32_t)total;
+        total += geom_grid_n_vertices(g);
+    }
+    *failed = 0;
+    if (!moving) {
+        for (size_t k = 0; k < n; k++)
+            base[k] = gs->grids[idx[k]].first_vertex;
+        rtcSetSharedGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, gs->P, 0,
+                                   sizeof(Vec3), gs->n_vertices);
+        return NULL;
+    }
+    int steps = gs->n_times;
+    Vec3 *buf = malloc(((size_t)steps * total + 1) * sizeof *buf); /* + 1: Embree reads 16 B */
+    if (!buf) {
+        *failed = 1;
+        return NULL;
+    }
+    rtcSetGeometryTimeStepCount(geom, (unsigned)steps);
+    for (int t = 0; t < steps; t++) {
+        Vec3 *out = buf + (size_t)t * total;
+        for (size_t k = 0; k < n; k++) {
+            const Grid *g = &gs->grids[idx[k]];
+            for (size_t i = 0; i < geom_grid_n_vertices(g); i++)
+                out[base[k] + i] = geom_vertex_P_at_sample(gs, g, g->first_vertex + i, t);
+        }
         rtcSetSharedGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, (unsigned)t, RTC_FORMAT_FLOAT3,
-                                   geom_time_array(gs->P, gs->Pt, t), 0, sizeof(Vec3),
-                                   gs->n_vertices);
+                                   out, 0, sizeof(Vec3), total);
+    }
+    return buf;
 }
 
 static int build_quads(Accel *a, const uint32_t *idx, size_t n, uint32_t mask)
 {
     const GridSet *gs = a->gs;
     RTCGeometry geom = rtcNewGeometry(a->device, RTC_GEOMETRY_TYPE_GRID);
-    set_vertices(gs, geom, idx, n);
+    uint32_t *base = malloc((n + 1) * sizeof *base);
+    int failed = !base;
+    Vec3 *steps = base ? set_vertices(gs, geom, idx, n, base, &failed) : NULL;
     struct RTCGrid *grids = rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_GRID, 0, RTC_FORMAT_GRID,
                                              sizeof(struct RTCGrid), n);
-    Geom g = {.kind = KIND_QUADS, .grids = malloc(n * sizeof(uint32_t))};
-    if (!grids || !g.grids) {
+    Geom g = {.kind = KIND_QUADS, .grids = malloc(n * sizeof(uint32_t)), .steps = steps};
+    if (!grids || !g.grids || failed) {
         free(g.grids);
+        free(steps);
+        free(base);
         rtcReleaseGeometry(geom);
         return -1;
     }
     for (size_t k = 0; k < n; k++) {
         const Grid *src = &gs->grids[idx[k]];
-        grids[k] = (struct RTCGrid){src->first_vertex, src->nu, src->nu, src->nv};
+        grids[k] = (struct RTCGrid){base[k], src->nu, src->nu, src->nv};
         g.grids[k] = idx[k];
     }
+    free(base);
     return attach(a, geom, mask, g);
 }
 
@@ -167,12 +204,16 @@ static int build_tris(Accel *a, const uint32_t *idx, size_t n, uint32_t mask)
     const GridSet *gs = a->gs;
     size_t n_tris = count_tris(gs, idx, n);
     RTCGeometry geom = rtcNewGeometry(a->device, RTC_GEOMETRY_TYPE_TRIANGLE);
-    set_vertices(gs, geom, idx, n);
+    uint32_t *base = malloc((n + 1) * sizeof *base);
+    int failed = !base;
+    Vec3 *steps = base ? set_vertices(gs, geom, idx, n, base, &failed) : NULL;
     uint32_t(*tri)[3] = rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
                                                 3 * sizeof(uint32_t), n_tris);
-    Geom g = {.kind = KIND_TRIS, .tris = malloc(n_tris * sizeof(MicroTri))};
-    if (!tri || !g.tris) {
+    Geom g = {.kind = KIND_TRIS, .tris = malloc(n_tris * sizeof(MicroTri)), .steps = steps};
+    if (!tri || !g.tris || failed) {
         free(g.tris);
+        free(steps);
+        free(base);
         rtcReleaseGeometry(geom);
         return -1;
     }
@@ -187,10 +228,13 @@ static int build_tris(Accel *a, const uint32_t *idx, size_t n, uint32_t mask)
                         continue;
                     g.tris[t] = (MicroTri){idx[k], (uint8_t)i, (uint8_t)j, up};
                     tri_vertices(src, &g.tris[t], tri[t]);
+                    for (int c = 0; c < 3; c++) /* into the buffer's numbering */
+                        tri[t][c] = tri[t][c] - src->first_vertex + base[k];
                     t++;
                 }
     }
     RY_CHECK(t == n_tris);
+    free(base);
     return attach(a, geom, mask, g);
 }
 
@@ -395,6 +439,7 @@ void accel_free(Accel *a)
         free(a->geoms[k].grids);
         free(a->geoms[k].tris);
         free(a->geoms[k].segs);
+        free(a->geoms[k].steps);
     }
     free(a->geoms);
     if (a->scene)

@@ -209,6 +209,7 @@ typedef struct Grid {
     float tri[3][2];       /* such a quad: the triangle's corners, the primitive's (u, v) */
     uint8_t moving;        /* 1: its vertices differ between time samples (GridSet.Pt); its
                               radiosity is cached per motion segment */
+    uint32_t motion_vertex; /* a moving grid: its first vertex in GridSet.Pt and the rest */
 } Grid;
 
 typedef struct GridSet {
@@ -228,12 +229,15 @@ typedef struct GridSet {
     unsigned pv_arrays;    /* GEOM_PV_* bits of the arrays allocated */
     size_t n_vertices;
     size_t cap_grids, cap_vertices;
-    /* Motion blur (DESIGN.md "Motion blur"): n_times uniformly spaced time
-     * samples from time[0] to time[1]; sample 0 is P, N, dPdu, dPdv above,
-     * sample k >= 1 is Pt[k - 1][i] and so on, for every vertex (still
-     * grids copy sample 0). n_times 1: nothing moves, the arrays are NULL. */
+    /* Motion blur (DESIGN.md "Motion blur and depth of field"): n_times
+     * uniformly spaced time samples from time[0] to time[1]. Sample 0 is P,
+     * N, dPdu, dPdv above; sample k >= 1 of a vertex of a moving grid g
+     * (Grid.moving) is Pt[k - 1][g->motion_vertex + (i - g->first_vertex)]
+     * and so on: only moving grids' vertices have later samples.
+     * n_times 1: nothing moves, the arrays are NULL. */
     int n_times;
     float time[2];         /* the first and last time sample, scene (shutter) time */
+    size_t n_motion_vertices; /* vertices of each later sample's arrays */
     Vec3 *Pt[GEOM_MAX_TIMES - 1], *Nt[GEOM_MAX_TIMES - 1];
     Vec3 *dPdut[GEOM_MAX_TIMES - 1], *dPdvt[GEOM_MAX_TIMES - 1];
 } GridSet;
@@ -263,11 +267,16 @@ static inline float geom_segment_mid_time(const GridSet *gs, int seg)
     return gs->time[0] + (gs->time[1] - gs->time[0]) * ((float)seg + 0.5f) / (float)(gs->n_times - 1);
 }
 
-/* A vertex array (P, N, dPdu or dPdv: base; its later samples: later) at
- * time sample k. */
-static inline const Vec3 *geom_time_array(const Vec3 *base, Vec3 *const *later, int k)
+/* Where vertex i of moving grid g is in the later samples' arrays. */
+static inline size_t geom_motion_index(const Grid *g, size_t i)
 {
-    return k == 0 ? base : later[k - 1];
+    return g->motion_vertex + (i - g->first_vertex);
+}
+
+/* Vertex i's position at time sample k (sample 0 for a still grid). */
+static inline Vec3 geom_vertex_P_at_sample(const GridSet *gs, const Grid *g, size_t i, int k)
+{
+    return k == 0 || !g->moving ? gs->P[i] : gs->Pt[k - 1][geom_motion_index(g, i)];
 }
 
 /* What a vertex of grid g is at segment seg, fraction f: the linear blend
@@ -281,12 +290,13 @@ static inline GeomVertex geom_vertex_at(const GridSet *gs, const Grid *g, size_t
 {
     if (!g->moving || gs->n_times < 2)
         return (GeomVertex){gs->P[i], gs->N[i], gs->dPdu[i], gs->dPdv[i]};
-    const Vec3 *P0 = geom_time_array(gs->P, gs->Pt, seg), *P1 = gs->Pt[seg];
-    const Vec3 *N0 = geom_time_array(gs->N, gs->Nt, seg), *N1 = gs->Nt[seg];
-    const Vec3 *U0 = geom_time_array(gs->dPdu, gs->dPdut, seg), *U1 = gs->dPdut[seg];
-    const Vec3 *V0 = geom_time_array(gs->dPdv, gs->dPdvt, seg), *V1 = gs->dPdvt[seg];
-    return (GeomVertex){v3_lerp(P0[i], P1[i], f), v3_lerp(N0[i], N1[i], f),
-                        v3_lerp(U0[i], U1[i], f), v3_lerp(V0[i], V1[i], f)};
+    size_t j = geom_motion_index(g, i);
+    GeomVertex a = seg == 0 ? (GeomVertex){gs->P[i], gs->N[i], gs->dPdu[i], gs->dPdv[i]}
+                            : (GeomVertex){gs->Pt[seg - 1][j], gs->Nt[seg - 1][j],
+                                           gs->dPdut[seg - 1][j], gs->dPdvt[seg - 1][j]};
+    GeomVertex b = {gs->Pt[seg][j], gs->Nt[seg][j], gs->dPdut[seg][j], gs->dPdvt[seg][j]};
+    return (GeomVertex){v3_lerp(a.P, b.P, f), v3_lerp(a.N, b.N, f), v3_lerp(a.dPdu, b.dPdu, f),
+                        v3_lerp(a.dPdv, b.dPdv, f)};
 }
 
 /* How the camera sets dicing rates, and how large a grid may be.

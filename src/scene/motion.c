@@ -19,7 +19,8 @@
  *    primitive's surface at (u, v) between time t and t0, so the diced,
  *    displaced and stitched vertex keeps its offset from the surface.
  * Curves and points do not move (Embree's curve and point buffers are
- * built from sample 0).
+ * built from sample 0). Only the surfaces of moving primitives have later
+ * samples (GridSet.Pt and the rest, compact: Grid.motion_vertex).
  *
  * Threading: the API calls edit one scene (one thread); prepare reads it.
  */
@@ -327,7 +328,10 @@ static void move_grid(const RayesScene *s, GridSet *gs, Grid *g, int k, float t)
     float f;
     motion_pair(m, t, &a, &b, &f);
     size_t first = g->first_vertex, n = geom_grid_n_vertices(g);
-    Vec3 *P = gs->Pt[k - 1], *N = gs->Nt[k - 1], *U = gs->dPdut[k - 1], *V = gs->dPdvt[k - 1];
+    /* The grid's slots in the later samples' arrays, indexed like gs->P. */
+    size_t off = g->motion_vertex - first;
+    Vec3 *P = gs->Pt[k - 1] + off, *N = gs->Nt[k - 1] + off, *U = gs->dPdut[k - 1] + off,
+         *V = gs->dPdvt[k - 1] + off;
     if (!m->deform) {
         Mat4 D = mat4_lerp(&m->delta[a], &m->delta[b], f), inv, nrm;
         nrm = mat4_invert(D, &inv) ? mat4_transpose(inv) : D;
@@ -369,7 +373,18 @@ int scene_motion_prepare(const RayesScene *s, GridSet *gs)
     gs->time[0] = span[0], gs->time[1] = span[1];
     if (n < 2)
         return 0;
-    size_t bytes = (gs->n_vertices + 1) * sizeof(Vec3);
+    /* Slots in the later samples for the grids that may move (surfaces of
+     * moving primitives). */
+    size_t slots = 0;
+    for (size_t gi = 0; gi < gs->n_grids; gi++) {
+        Grid *g = &gs->grids[gi];
+        if (s->prims[g->prim].motion && g->shape == GEOM_SHAPE_SURFACE) {
+            g->motion_vertex = (uint32_t)slots;
+            slots += geom_grid_n_vertices(g);
+        }
+    }
+    gs->n_motion_vertices = slots;
+    size_t bytes = (slots + 1) * sizeof(Vec3);
     for (int k = 0; k + 1 < n; k++) {
         gs->Pt[k] = malloc(bytes);
         gs->Nt[k] = malloc(bytes);
@@ -377,10 +392,6 @@ int scene_motion_prepare(const RayesScene *s, GridSet *gs)
         gs->dPdvt[k] = malloc(bytes);
         if (!gs->Pt[k] || !gs->Nt[k] || !gs->dPdut[k] || !gs->dPdvt[k])
             return -1;
-        memcpy(gs->Pt[k], gs->P, gs->n_vertices * sizeof(Vec3));
-        memcpy(gs->Nt[k], gs->N, gs->n_vertices * sizeof(Vec3));
-        memcpy(gs->dPdut[k], gs->dPdu, gs->n_vertices * sizeof(Vec3));
-        memcpy(gs->dPdvt[k], gs->dPdv, gs->n_vertices * sizeof(Vec3));
     }
     for (size_t gi = 0; gi < gs->n_grids; gi++) {
         Grid *g = &gs->grids[gi];
@@ -390,8 +401,9 @@ int scene_motion_prepare(const RayesScene *s, GridSet *gs)
             move_grid(s, gs, g, k, span[0] + (span[1] - span[0]) * (float)k / (float)(n - 1));
         size_t first = g->first_vertex, nv = geom_grid_n_vertices(g);
         for (int k = 1; k < n && !g->moving; k++)
-            for (size_t i = first; i < first + nv && !g->moving; i++)
-                if (memcmp(&gs->Pt[k - 1][i], &gs->P[i], sizeof(Vec3)) != 0)
+            for (size_t i = 0; i < nv && !g->moving; i++)
+                if (memcmp(&gs->Pt[k - 1][g->motion_vertex + i], &gs->P[first + i],
+                           sizeof(Vec3)) != 0)
                     g->moving = 1;
     }
     return 0;

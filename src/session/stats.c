@@ -80,7 +80,7 @@ RayesStats *session_stats_new(const RenderSettings *set, const RenderStats *rs, 
     count(s, "memory/accel_bytes", accel_bytes);
     size_t geom_bytes = gs->n_vertices * (4 * sizeof(Vec3) + 2 * sizeof(float)) +
                         gs->n_grids * sizeof(Grid) +
-                        (size_t)(n_times - 1) * gs->n_vertices * 4 * sizeof(Vec3);
+                        (size_t)(n_times - 1) * gs->n_motion_vertices * 4 * sizeof(Vec3);
     count(s, "memory/grid_bytes", geom_bytes);
     count(s, "resolution/width", (uint64_t)set->width);
     count(s, "resolution/height", (uint64_t)set->height);
