@@ -11,9 +11,12 @@
 #include <math.h>
 #include <string.h>
 
+#include "accel/accel.h"
+#include "geom/geom.h"
 #include "io/builtin.h"
 #include "io/sink.h"
 #include "rayes/rayes.h"
+#include "scene/scene.h"
 #include "test.h"
 
 #define W 96
@@ -361,6 +364,74 @@ static void test_motionfactor(void)
            100 * (cover[1] / cover[0] - 1));
 }
 
-TEST_MAIN(TEST(test_moving_sphere_coverage), TEST(test_motionfactor), TEST(test_cached_segments_match_uncached),
+/* The ray tracing structure of a patch turning half round about y (0, 90
+ * and 180 degrees at times 0, 0.5, 1) beside a still one: a ray at time t
+ * meets the moving patch where it is then, with the normal it has then
+ * (the side the cache keys), and the motion segment of its time; the
+ * still patch keeps segment 0 and its own vertices only. */
+static void test_moving_hits(void)
+{
+    RayesScene *s = rayes_scene_new();
+    CHECK(rayes_scene_set_shutter(s, 0.0f, 1.0f) == RAYES_OK);
+    const float times[3] = {0, 0.5f, 1};
+    float m[3][16];
+    for (int k = 0; k < 3; k++) {
+        float a = (float)M_PI * (float)k / 2, c = cosf(a), sn = sinf(a);
+        const float r[16] = {c, 0, sn, 0, 0, 1, 0, 0, -sn, 0, c, 0, 0, 0, 0, 1};
+        memcpy(m[k], r, sizeof r);
+    }
+    CHECK(rayes_scene_set_transform_motion(s, 3, times, (const float(*)[16])m) == RAYES_OK);
+    float P[4][3] = {{-1, -1, 0}, {1, -1, 0}, {-1, 1, 0}, {1, 1, 0}}; /* normal +z at t = 0 */
+    CHECK(rayes_scene_bilinear_patch(s, P) == RAYES_OK);
+    CHECK(rayes_scene_set_transform(s, identity) == RAYES_OK);
+    float Q[4][3] = {{5, -1, 0}, {7, -1, 0}, {5, 1, 0}, {7, 1, 0}};
+    CHECK(rayes_scene_bilinear_patch(s, Q) == RAYES_OK);
+    CHECK(rayes_scene_commit(s) == RAYES_OK);
+    GridSet gs;
+    geom_gridset_init(&gs);
+    CHECK(scene_prepare(s, 64, 64, NULL, NULL, &gs, NULL) == 0);
+    CHECK(gs.n_times == 3);
+    size_t moving = 0, still_vertices = 0;
+    for (size_t g = 0; g < gs.n_grids; g++) {
+        moving += gs.grids[g].moving;
+        if (!gs.grids[g].moving)
+            still_vertices += geom_grid_n_vertices(&gs.grids[g]);
+    }
+    CHECK(moving > 0 && still_vertices > 0);
+    CHECK(gs.n_motion_vertices + still_vertices == gs.n_vertices); /* only movers sampled */
+    uint32_t masks[1] = {RAYES_RAY_CAMERA};
+    char err[256];
+    Accel *a = accel_new(&gs, masks, 1, err, sizeof err);
+    CHECK(a != NULL);
+    /* Along -z through (0.3, 0.2): the patch at t = 0 faces the ray's
+     * origin with +z; at t = 1 it is turned round and faces it with -z;
+     * at t = 0.5 it is edge on (missed). */
+    const float ts[3] = {0.0f, 0.5f, 1.0f};
+    const int want_hit[3] = {1, 0, 1};
+    const float want_nz[3] = {1, 0, -1};
+    for (int k = 0; a && k < 3; k++) {
+        Ray r = {v3(0.3f, 0.2f, 5), v3(0, 0, -1), 0.0f, 1e30f, RAYES_RAY_CAMERA, ts[k]};
+        Hit h;
+        int hit = accel_intersect(a, &r, &h);
+        CHECK(hit == want_hit[k]);
+        if (hit && want_hit[k]) {
+            CHECK_NEAR(h.t, 5.0, 1e-3);
+            CHECK_NEAR(h.Ng.z, want_nz[k], 1e-3);
+            float f;
+            CHECK(geom_motion_segment(&gs, ts[k], &f) == (k == 2 ? 1 : 0));
+        }
+    }
+    /* The still patch: the same at every time. */
+    for (int k = 0; a && k < 3; k++) {
+        Ray r = {v3(6, 0, 5), v3(0, 0, -1), 0.0f, 1e30f, RAYES_RAY_CAMERA, ts[k]};
+        Hit h;
+        CHECK(accel_intersect(a, &r, &h) && !gs.grids[h.grid].moving);
+    }
+    accel_free(a);
+    geom_gridset_fini(&gs);
+    rayes_scene_release(s);
+}
+
+TEST_MAIN(TEST(test_moving_hits), TEST(test_moving_sphere_coverage), TEST(test_motionfactor), TEST(test_cached_segments_match_uncached),
           TEST(test_motion_determinism), TEST(test_deformation_equals_transform),
           TEST(test_bad_motion), TEST(test_camera_motion))
