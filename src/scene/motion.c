@@ -70,10 +70,9 @@ static RayesError check_times(RayesScene *s, const char *what, size_t n, const f
 {
     if (!times || n < 2 || n > RAYES_MAX_TIMES)
         return fail(s, RAYES_ERROR_INVALID_ARGUMENT, "%s: expected 2 to %d time samples, got %zu",
-                          what, RAYES_MAX_TIMES, n);
+                    what, RAYES_MAX_TIMES, n);
     if (!increasing(times, n))
-        return fail(s, RAYES_ERROR_INVALID_ARGUMENT,
-                          "%s: expected finite, increasing times", what);
+        return fail(s, RAYES_ERROR_INVALID_ARGUMENT, "%s: expected finite, increasing times", what);
     return RAYES_OK;
 }
 
@@ -83,7 +82,7 @@ RayesError rayes_scene_set_shutter(RayesScene *s, float open, float close)
         return RAYES_ERROR_INVALID_ARGUMENT;
     if (!isfinite(open) || !isfinite(close) || close < open)
         return fail(s, RAYES_ERROR_INVALID_ARGUMENT,
-                          "shutter: expected finite open <= close, got %g %g", open, close);
+                    "shutter: expected finite open <= close, got %g %g", open, close);
     s->shutter[0] = open, s->shutter[1] = close;
     scene_mark(s, SCENE_CHANGE_CAMERA);
     return RAYES_OK;
@@ -118,7 +117,7 @@ RayesError rayes_scene_set_transform_motion(RayesScene *s, size_t n, const float
         Mat4 inv;
         if (!finite_all(M[k], 16) || !mat4_invert(W[k], &inv))
             return fail(s, RAYES_ERROR_INVALID_ARGUMENT,
-                              "transform motion: expected finite, invertible matrices");
+                        "transform motion: expected finite, invertible matrices");
         if (k == 0)
             inv0 = inv;
     }
@@ -181,9 +180,9 @@ RayesError rayes_scene_motion_end(RayesScene *s)
     if (!same) {
         s->n_prims = s->deform_first;
         return fail(s, RAYES_ERROR_INVALID_ARGUMENT,
-                          "motion end: expected %zu primitives of the same topology, one per time "
-                          "sample",
-                          n_times);
+                    "motion end: expected %zu primitives of the same topology, one per time "
+                    "sample",
+                    n_times);
     }
     SceneMotion *m = new_motion(s);
     if (!m)
@@ -217,7 +216,7 @@ RayesError rayes_scene_set_camera_motion(RayesScene *s, size_t n, const float *t
         Mat4 wc;
         if (!finite_all(M[k], 16) || !mat4_invert(mat4_from_array(M[k]), &wc))
             return fail(s, RAYES_ERROR_INVALID_ARGUMENT,
-                              "camera motion: expected finite, invertible matrices");
+                        "camera motion: expected finite, invertible matrices");
         c->motion_time[k] = times[k];
         c->motion_eye[k] = mat4_point(&wc, v3(0, 0, 0));
         c->motion_x[k] = mat4_vector(&wc, v3(1, 0, 0));
@@ -238,9 +237,9 @@ RayesError rayes_scene_set_depth_of_field(RayesScene *s, float lens_radius, floa
     if (!(lens_radius >= 0.0f) || !isfinite(lens_radius) ||
         (lens_radius > 0.0f && !(focal_distance > 0.0f && isfinite(focal_distance))))
         return fail(s, RAYES_ERROR_INVALID_ARGUMENT,
-                          "depth of field: expected a lens radius >= 0 and a focal distance > 0, "
-                          "got %g %g",
-                          lens_radius, focal_distance);
+                    "depth of field: expected a lens radius >= 0 and a focal distance > 0, "
+                    "got %g %g",
+                    lens_radius, focal_distance);
     s->camera.lens_radius = lens_radius;
     s->camera.focal_distance = lens_radius > 0.0f ? focal_distance : 0.0f;
     scene_mark(s, SCENE_CHANGE_CAMERA);
@@ -254,7 +253,7 @@ RayesError rayes_scene_set_dice_blur(RayesScene *s, float motionfactor, float fo
     if (!(motionfactor >= 0.0f) || !(focusfactor >= 0.0f) || !isfinite(motionfactor) ||
         !isfinite(focusfactor))
         return fail(s, RAYES_ERROR_INVALID_ARGUMENT,
-                          "dice blur: expected motionfactor and focusfactor >= 0");
+                    "dice blur: expected motionfactor and focusfactor >= 0");
     s->motionfactor = motionfactor;
     s->focusfactor = focusfactor;
     return RAYES_OK;
@@ -402,8 +401,8 @@ int scene_motion_prepare(const RayesScene *s, GridSet *gs)
         size_t first = g->first_vertex, nv = geom_grid_n_vertices(g);
         for (int k = 1; k < n && !g->moving; k++)
             for (size_t i = 0; i < nv && !g->moving; i++)
-                if (memcmp(&gs->Pt[k - 1][g->motion_vertex + i], &gs->P[first + i],
-                           sizeof(Vec3)) != 0)
+                if (memcmp(&gs->Pt[k - 1][g->motion_vertex + i], &gs->P[first + i], sizeof(Vec3)) !=
+                    0)
                     g->moving = 1;
     }
     return 0;

@@ -81,9 +81,9 @@ static RayesImage *reference(float x0, float x1, float t0, float t1, float lens,
     memcpy(cam, identity, sizeof cam);
     cam[11] = 5;
     const float screen[4] = {-3, 3, -3, 3};
-    CHECK(rayes_scene_set_camera_matrix(s, cam, lens > 0 ? RAYES_PROJECTION_PERSPECTIVE
-                                                         : RAYES_PROJECTION_ORTHOGRAPHIC,
-                                        60, lens > 0 ? NULL : screen) == RAYES_OK);
+    CHECK(rayes_scene_set_camera_matrix(
+              s, cam, lens > 0 ? RAYES_PROJECTION_PERSPECTIVE : RAYES_PROJECTION_ORTHOGRAPHIC, 60,
+              lens > 0 ? NULL : screen) == RAYES_OK);
     CHECK(rayes_scene_set_shutter(s, 0, 1) == RAYES_OK);
     if (lens > 0)
         CHECK(rayes_scene_set_depth_of_field(s, lens, focus) == RAYES_OK);

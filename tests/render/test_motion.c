@@ -82,7 +82,8 @@ static void test_moving_sphere_coverage(void)
             for (int j = 0; j < 4; j++) /* the pixel's mean over 4 x 4 points */
                 for (int i = 0; i < 4; i++)
                     want += disk_time_coverage(-HALF + (x + (i + 0.5) / 4) * px,
-                                               HALF - (y + (j + 0.5) / 4) * px) / 16;
+                                               HALF - (y + (j + 0.5) / 4) * px) /
+                            16;
             double got = img->rgba[4 * (y * W + x) + 3];
             err += fabs(got - want);
             worst = fmax(worst, fabs(got - want));
@@ -148,8 +149,8 @@ static void deformation_equals_transform(float motionfactor)
     float px = 2 * HALF / W;
     CHECK_NEAR(cover * px * px, 8.0, 0.08);
     CHECK(worst < 1e-5);
-    printf("  deformation vs transform (motionfactor %g): largest difference %.2g\n",
-           motionfactor, worst);
+    printf("  deformation vs transform (motionfactor %g): largest difference %.2g\n", motionfactor,
+           worst);
     rayes_image_free(ia);
     rayes_image_free(ib);
     rayes_scene_release(a);
@@ -432,6 +433,6 @@ static void test_moving_hits(void)
     rayes_scene_release(s);
 }
 
-TEST_MAIN(TEST(test_moving_hits), TEST(test_moving_sphere_coverage), TEST(test_motionfactor), TEST(test_cached_segments_match_uncached),
-          TEST(test_motion_determinism), TEST(test_deformation_equals_transform),
-          TEST(test_bad_motion), TEST(test_camera_motion))
+TEST_MAIN(TEST(test_moving_hits), TEST(test_moving_sphere_coverage), TEST(test_motionfactor),
+          TEST(test_cached_segments_match_uncached), TEST(test_motion_determinism),
+          TEST(test_deformation_equals_transform), TEST(test_bad_motion), TEST(test_camera_motion))
