@@ -105,6 +105,53 @@ RAYES_API RayesError rayes_scene_set_camera_matrix(RayesScene *scene,
 RAYES_API RayesError rayes_scene_set_transform(RayesScene *scene,
                                                const float world_from_object[16]);
 
+/* ------------------------------------------------------------- time
+ * Motion blur and depth of field (docs/scenes.md "Time"). Times are in
+ * the scene's own units; the shutter says which of them the frame sees.
+ * At most RAYES_MAX_TIMES samples per motion. */
+#define RAYES_MAX_TIMES 16
+
+/* The shutter interval: camera rays take times in [open, close] (RenderMan's
+ * Shutter; default 0 0, no blur). open <= close. */
+RAYES_API RayesError rayes_scene_set_shutter(RayesScene *scene, float open, float close);
+
+/* A moving transform for geometry added from now on: world_from_object
+ * (row-major) at n_times increasing times (2 to RAYES_MAX_TIMES); the
+ * geometry moves linearly between samples (RenderMan's MotionBegin around
+ * transforms). set_transform ends it. */
+RAYES_API RayesError rayes_scene_set_transform_motion(RayesScene *scene, size_t n_times,
+                                                      const float *times,
+                                                      const float (*world_from_object)[16]);
+
+/* Deformation blur: the next n_times primitive calls (until motion_end)
+ * give one primitive at each of the increasing times, with the same
+ * topology (the same call with the same counts, only positions differing);
+ * their primitive variables and attributes are the first call's. */
+RAYES_API RayesError rayes_scene_motion_begin(RayesScene *scene, size_t n_times,
+                                              const float *times);
+RAYES_API RayesError rayes_scene_motion_end(RayesScene *scene);
+
+/* A moving camera: camera_from_world at n_times increasing times (2 to
+ * RAYES_MAX_TIMES), the projection of the last set_camera_matrix; the
+ * first sample also becomes the still camera (dicing uses it). */
+RAYES_API RayesError rayes_scene_set_camera_motion(RayesScene *scene, size_t n_times,
+                                                   const float *times,
+                                                   const float (*camera_from_world)[16]);
+
+/* Depth of field: a thin lens of radius lens_radius (world units; 0: a
+ * pinhole, the default) focused on the plane focal_distance along the
+ * view (RenderMan's DepthOfField gives lens_radius = focallength / (2
+ * fstop); pbrt's lensradius and focaldistance are these). */
+RAYES_API RayesError rayes_scene_set_depth_of_field(RayesScene *scene, float lens_radius,
+                                                    float focal_distance);
+
+/* Coarser dicing of blurred geometry added from now on (RenderMan's
+ * Attribute "dice" "motionfactor" and "focusfactor"; 0, the default, for
+ * none): micropolygon edges longer by 1 + factor * blur / 16, blur in
+ * pixels (the motion over the shutter, or the circle of confusion). */
+RAYES_API RayesError rayes_scene_set_dice_blur(RayesScene *scene, float motionfactor,
+                                               float focusfactor);
+
 /* Shader parameters, given by name; the shader's class table says which
  * names and types it understands. Unknown names get one warning. */
 typedef enum RayesParamType {

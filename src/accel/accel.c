@@ -15,6 +15,13 @@
  * same geomIDs (Embree lets a geometry belong to several scenes):
  * subsurface rays test only their object's micropolygons (memo 6.2).
  *
+ * Motion blur: the quad and triangle geometries of an object with a moving
+ * grid have the GridSet's n_times time steps over Embree's time range
+ * [0, 1], each a vertex buffer of their own (Geom.steps: the grids'
+ * vertices one grid after another, still grids copied); a ray's time maps
+ * onto the range (clamped). Other geometries share GridSet.P. Curves and
+ * points stay still.
+ *
  * Embree with TBB builds on its own threads; commit happens once, before
  * any query, and queries are concurrent (Embree's contract).
  */
@@ -49,6 +56,8 @@ typedef struct Geom {
     uint32_t *grids;   /* quads, points: primID -> grid index */
     MicroTri *tris;    /* triangles: primID -> micropolygon */
     CurveSeg *segs;    /* curves: primID -> segment */
+    Vec3 *steps;       /* a moving geometry's vertices, owned: per time sample, its grids'
+                          vertices one grid after another (set_vertices) */
 } Geom;
 
 /* One Embree scene: the world's (level 0: world geometry, then one
@@ -116,25 +125,73 @@ static int attach(Level *lv, RTCGeometry geom, uint32_t mask, Geom g)
     return add_geom(lv, g);
 }
 
+/* The vertex buffers of geom, whose grids are idx[0 .. n - 1]: the
+ * GridSet's P, shared, with base[k] = grid k's first vertex; or, if any of
+ * them moves, a buffer per time sample of their vertices one grid after
+ * another (returned, for the Geom to own; base[k] then counts in it).
+ * *failed is set when out of memory. */
+static Vec3 *set_vertices(const GridSet *gs, RTCGeometry geom, const uint32_t *idx, size_t n,
+                          uint32_t *base, int *failed)
+{
+    int moving = 0;
+    size_t total = 0;
+    for (size_t k = 0; k < n; k++) {
+        const Grid *g = &gs->grids[idx[k]];
+        moving |= gs->n_times > 1 && g->moving;
+        base[k] = (uint32_t)total;
+        total += geom_grid_n_vertices(g);
+    }
+    *failed = 0;
+    if (!moving) {
+        for (size_t k = 0; k < n; k++)
+            base[k] = gs->grids[idx[k]].first_vertex;
+        rtcSetSharedGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, gs->P, 0,
+                                   sizeof(Vec3), gs->n_vertices);
+        return NULL;
+    }
+    int steps = gs->n_times;
+    Vec3 *buf = malloc(((size_t)steps * total + 1) * sizeof *buf); /* + 1: Embree reads 16 B */
+    if (!buf) {
+        *failed = 1;
+        return NULL;
+    }
+    rtcSetGeometryTimeStepCount(geom, (unsigned)steps);
+    for (int t = 0; t < steps; t++) {
+        Vec3 *out = buf + (size_t)t * total;
+        for (size_t k = 0; k < n; k++) {
+            const Grid *g = &gs->grids[idx[k]];
+            for (size_t i = 0; i < geom_grid_n_vertices(g); i++)
+                out[base[k] + i] = geom_vertex_P_at_sample(gs, g, g->first_vertex + i, t);
+        }
+        rtcSetSharedGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, (unsigned)t, RTC_FORMAT_FLOAT3,
+                                   out, 0, sizeof(Vec3), total);
+    }
+    return buf;
+}
+
 static int build_quads(Accel *a, Level *lv, const uint32_t *idx, size_t n, uint32_t mask)
 {
     const GridSet *gs = a->gs;
     RTCGeometry geom = rtcNewGeometry(a->device, RTC_GEOMETRY_TYPE_GRID);
-    rtcSetSharedGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, gs->P, 0,
-                               sizeof(Vec3), gs->n_vertices);
+    uint32_t *base = malloc((n + 1) * sizeof *base);
+    int failed = !base;
+    Vec3 *steps = base ? set_vertices(gs, geom, idx, n, base, &failed) : NULL;
     struct RTCGrid *grids = rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_GRID, 0, RTC_FORMAT_GRID,
                                              sizeof(struct RTCGrid), n);
-    Geom g = {.kind = KIND_QUADS, .grids = malloc(n * sizeof(uint32_t))};
-    if (!grids || !g.grids) {
+    Geom g = {.kind = KIND_QUADS, .grids = malloc(n * sizeof(uint32_t)), .steps = steps};
+    if (!grids || !g.grids || failed) {
         free(g.grids);
+        free(steps);
+        free(base);
         rtcReleaseGeometry(geom);
         return -1;
     }
     for (size_t k = 0; k < n; k++) {
         const Grid *src = &gs->grids[idx[k]];
-        grids[k] = (struct RTCGrid){src->first_vertex, src->nu, src->nu, src->nv};
+        grids[k] = (struct RTCGrid){base[k], src->nu, src->nu, src->nv};
         g.grids[k] = idx[k];
     }
+    free(base);
     return attach(lv, geom, mask, g);
 }
 
@@ -167,13 +224,16 @@ static int build_tris(Accel *a, Level *lv, const uint32_t *idx, size_t n, uint32
     const GridSet *gs = a->gs;
     size_t n_tris = count_tris(gs, idx, n);
     RTCGeometry geom = rtcNewGeometry(a->device, RTC_GEOMETRY_TYPE_TRIANGLE);
-    rtcSetSharedGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, gs->P, 0,
-                               sizeof(Vec3), gs->n_vertices);
+    uint32_t *base = malloc((n + 1) * sizeof *base);
+    int failed = !base;
+    Vec3 *steps = base ? set_vertices(gs, geom, idx, n, base, &failed) : NULL;
     uint32_t(*tri)[3] = rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
                                                 3 * sizeof(uint32_t), n_tris);
-    Geom g = {.kind = KIND_TRIS, .tris = malloc(n_tris * sizeof(MicroTri))};
-    if (!tri || !g.tris) {
+    Geom g = {.kind = KIND_TRIS, .tris = malloc(n_tris * sizeof(MicroTri)), .steps = steps};
+    if (!tri || !g.tris || failed) {
         free(g.tris);
+        free(steps);
+        free(base);
         rtcReleaseGeometry(geom);
         return -1;
     }
@@ -188,10 +248,13 @@ static int build_tris(Accel *a, Level *lv, const uint32_t *idx, size_t n, uint32
                         continue;
                     g.tris[t] = (MicroTri){idx[k], (uint8_t)i, (uint8_t)j, up};
                     tri_vertices(src, &g.tris[t], tri[t]);
+                    for (int c = 0; c < 3; c++) /* into the buffer's numbering */
+                        tri[t][c] = tri[t][c] - src->first_vertex + base[k];
                     t++;
                 }
     }
     RY_CHECK(t == n_tris);
+    free(base);
     return attach(lv, geom, mask, g);
 }
 
@@ -519,6 +582,7 @@ void accel_free(Accel *a)
             free(lv->geoms[k].grids);
             free(lv->geoms[k].tris);
             free(lv->geoms[k].segs);
+            free(lv->geoms[k].steps);
         }
         free(lv->geoms);
         if (lv->scene)
@@ -534,7 +598,17 @@ void accel_free(Accel *a)
     free(a);
 }
 
-static void set_ray(struct RTCRay *r, const Ray *ray)
+/* The ray's time as Embree takes it: [0, 1] over the grid set's time
+ * samples (0 when nothing moves). */
+static float embree_time(const Accel *a, const Ray *ray)
+{
+    const GridSet *gs = a->gs;
+    float span = gs->time[1] - gs->time[0];
+    float t = gs->n_times > 1 && span > 0.0f ? (ray->time - gs->time[0]) / span : 0.0f;
+    return t < 0.0f ? 0.0f : t > 1.0f ? 1.0f : t;
+}
+
+static void set_ray(const Accel *a, struct RTCRay *r, const Ray *ray)
 {
     r->org_x = ray->o.x;
     r->org_y = ray->o.y;
@@ -544,7 +618,7 @@ static void set_ray(struct RTCRay *r, const Ray *ray)
     r->dir_z = ray->d.z;
     r->tnear = ray->tnear;
     r->tfar = ray->tfar;
-    r->time = 0.0f;
+    r->time = embree_time(a, ray);
     r->mask = ray->mask;
     r->id = 0;
     r->flags = 0;
@@ -556,7 +630,20 @@ static Vec3 unit_or_zero(Vec3 n)
     return l > 0.0f && isfinite(l) ? v3_scale(n, 1.0f / l) : v3(0, 0, 0);
 }
 
-static void quad_hit(const Accel *a, const Geom *g, unsigned prim, float u, float v, Hit *hit)
+/* Vertex i of grid g where it is at Embree's ray time rt in [0, 1] (a
+ * still grid: sample 0). */
+static Vec3 vertex_at(const GridSet *gs, const Grid *g, uint32_t i, float rt)
+{
+    if (!g->moving || gs->n_times < 2)
+        return gs->P[i];
+    float x = rt * (float)(gs->n_times - 1);
+    int seg = (int)x;
+    seg = seg > gs->n_times - 2 ? gs->n_times - 2 : seg < 0 ? 0 : seg;
+    return geom_vertex_at(gs, g, i, seg, x - (float)seg).P;
+}
+
+static void quad_hit(const Accel *a, const Geom *g, unsigned prim, float u, float v, float rt,
+                     Hit *hit)
 {
     const GridSet *gs = a->gs;
     const Grid *grid = &gs->grids[g->grids[prim]];
@@ -580,13 +667,15 @@ static void quad_hit(const Accel *a, const Geom *g, unsigned prim, float u, floa
     hit->weight[1] = fu * (1.0f - fv);
     hit->weight[2] = (1.0f - fu) * fv;
     hit->weight[3] = fu * fv;
-    const Vec3 *P = gs->P;
+    Vec3 P[4];
+    for (int k = 0; k < 4; k++)
+        P[k] = vertex_at(gs, grid, hit->vertex[k], rt);
     /* The cell normal from its diagonals: 2 dPdu x dPdv for a parallelogram. */
-    hit->Ng = unit_or_zero(v3_cross(v3_sub(P[hit->vertex[3]], P[hit->vertex[0]]),
-                                    v3_sub(P[hit->vertex[2]], P[hit->vertex[1]])));
+    hit->Ng = unit_or_zero(v3_cross(v3_sub(P[3], P[0]), v3_sub(P[2], P[1])));
 }
 
-static void tri_hit(const Accel *a, const Geom *g, unsigned prim, float u, float v, Hit *hit)
+static void tri_hit(const Accel *a, const Geom *g, unsigned prim, float u, float v, float rt,
+                    Hit *hit)
 {
     const GridSet *gs = a->gs;
     const MicroTri *m = &g->tris[prim];
@@ -613,8 +702,10 @@ static void tri_hit(const Accel *a, const Geom *g, unsigned prim, float u, float
     }
     hit->vertex[3] = vtx[0];
     hit->weight[3] = 0.0f;
-    const Vec3 *P = gs->P;
-    hit->Ng = unit_or_zero(v3_cross(v3_sub(P[vtx[1]], P[vtx[0]]), v3_sub(P[vtx[2]], P[vtx[0]])));
+    Vec3 P[3];
+    for (int k = 0; k < 3; k++)
+        P[k] = vertex_at(gs, grid, vtx[k], rt);
+    hit->Ng = unit_or_zero(v3_cross(v3_sub(P[1], P[0]), v3_sub(P[2], P[0])));
 }
 
 /* Embree's geometric normal of a round shape's hit (in the space of its
@@ -667,7 +758,7 @@ static void point_hit(const Accel *a, const Geom *g, const struct RTCHit *h, con
     float xx = v3_dot(x, x), yy = v3_dot(y, y);
     float u = xx > 0.0f ? fminf(fmaxf(v3_dot(d, x) / xx, 0.0f), 1.0f) : 0.5f;
     float v = yy > 0.0f ? fminf(fmaxf(v3_dot(d, y) / yy, 0.0f), 1.0f) : 0.5f;
-    quad_hit(a, g, h->primID, u, v, hit);
+    quad_hit(a, g, h->primID, u, v, embree_time(a, ray), hit);
     hit->Ng = shape_normal(h, ray, g->shape);
 }
 
@@ -691,10 +782,10 @@ static void make_hit(const Accel *a, const Ray *ray, const struct RTCHit *h, flo
     hit->shape = g->shape;
     switch (g->kind) {
     case KIND_TRIS:
-        tri_hit(a, g, h->primID, h->u, h->v, hit);
+        tri_hit(a, g, h->primID, h->u, h->v, embree_time(a, ray), hit);
         break;
     case KIND_QUADS:
-        quad_hit(a, g, h->primID, h->u, h->v, hit);
+        quad_hit(a, g, h->primID, h->u, h->v, embree_time(a, ray), hit);
         break;
     case KIND_CURVES:
         curve_hit(a, g, h, ray, hit);
@@ -717,7 +808,7 @@ static int intersect_scene(const Accel *a, RTCScene scene, const Ray *ray, uint3
     struct RTCIntersectContext ctx;
     rtcInitIntersectContext(&ctx);
     struct RTCRayHit rh;
-    set_ray(&rh.ray, ray);
+    set_ray(a, &rh.ray, ray);
     rh.ray.mask = mask;
     rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
     rh.hit.primID = RTC_INVALID_GEOMETRY_ID;
@@ -811,7 +902,7 @@ Vec3 accel_transmission(const Accel *a, const Ray *ray, AccelOpacityFn opacity, 
     tc.T = v3(1, 1, 1);
     tc.n_seen = 0;
     struct RTCRay r;
-    set_ray(&r, ray);
+    set_ray(a, &r, ray);
     rtcOccluded1(a->levels[0].scene, &tc.rtc, &r);
     return r.tfar < 0.0f ? v3(0, 0, 0) : tc.T;
 }
@@ -821,7 +912,7 @@ int accel_occluded(const Accel *a, const Ray *ray)
     struct RTCIntersectContext ctx;
     rtcInitIntersectContext(&ctx);
     struct RTCRay r;
-    set_ray(&r, ray);
+    set_ray(a, &r, ray);
     rtcOccluded1(a->levels[0].scene, &ctx, &r);
     return r.tfar < 0.0f;
 }

@@ -46,6 +46,8 @@ typedef struct Ray {
     Vec3 o, d;           /* origin and direction (need not be unit length) */
     float tnear, tfar;   /* the segment searched, in units of |d| */
     uint32_t mask;       /* RayesRayType bits */
+    float time;          /* in the shutter interval, scene time (moving geometry is where it
+                            is then; GridSet.time) */
 } Ray;
 
 typedef struct Hit {

@@ -20,7 +20,8 @@
 static const char scene_text[] =
     "SCENE is a scene file (.rib, .rib.gz, .pbrt, .obj) or a built-in scene:\n"
     "cornell (default), cornell-teapots, cornell-teapots-displaced, cornell-spheres,\n"
-    "cornell-brick (needs the plugin brick.so: --shader-path build/examples/shaders).\n"
+    "cornell-brick (needs the plugin brick.so: --shader-path build/examples/shaders),\n"
+    "cornell-teapots-motion (motion blur and depth of field).\n"
     "A scene file's image size, samples, filter, depths and displays are used unless\n"
     "the command line gives them.\n";
 

@@ -152,6 +152,15 @@ static void summary(const Args *a, const RayesStats *s)
         }
         printf("\n");
     }
+    if (stat_count(s, "motion/time_samples") > 1) {
+        printf("  motion        %llu time samples, %llu moving grids, radiosity fills by segment",
+               (unsigned long long)stat_count(s, "motion/time_samples"),
+               (unsigned long long)stat_count(s, "motion/moving_grids"));
+        const RayesStat *f = rayes_stats_find(s, "motion/fills_by_segment");
+        for (size_t i = 0; f && i < f->n_counts; i++)
+            printf("%s%llu", i ? " " : ": ", (unsigned long long)f->counts[i]);
+        printf("\n");
+    }
     printf("  memory        %.1f MB peak resident\n",
            (double)stat_count(s, "memory/peak_rss_bytes") / 1e6);
 }

@@ -67,6 +67,12 @@ void geom_gridset_fini(GridSet *gs)
     free(gs->Cs);
     free(gs->Os);
     free(gs->instances);
+    for (int k = 0; k < GEOM_MAX_TIMES - 1; k++) {
+        free(gs->Pt[k]);
+        free(gs->Nt[k]);
+        free(gs->dPdut[k]);
+        free(gs->dPdvt[k]);
+    }
     memset(gs, 0, sizeof *gs);
 }
 

@@ -34,6 +34,7 @@
 #define GEOM_MAX_TRI 16    /* subdivisions per edge of a triangular grid, by default
                               (sqrt(GEOM_GRID_SIZE)); GEOM_MAX_GRID - 1 at most */
 #define GEOM_MAX_GRID_SIZE ((GEOM_MAX_GRID - 1) * (GEOM_MAX_GRID - 1)) /* largest gridsize */
+#define GEOM_MAX_TIMES 16  /* time samples of moving geometry, at most (motion blur) */
 #define GEOM_CURVE_RUN 3   /* segments of a curve one primitive holds, at most (what fits in
                               a Prim's control points) */
 
@@ -87,12 +88,16 @@ typedef struct Prim {
                               GEOM_OBJECT_INHERIT (a master's: its instance's) */
     uint32_t master;       /* 0: world geometry; else its master's index + 1: its points are
                               in master space, and it is seen only through instances */
+    uint32_t motion;       /* its motion (the scene's SceneMotion index + 1), or 0: still */
     uint8_t pv;            /* GEOM_PV_* bits: the primitive variables it carries */
     uint8_t pv_cubic;      /* of those, the ones with 16 Bezier control values (a bicubic
                               patch's vertex class); the others have one per corner */
     size_t pv_first;       /* index of its first value in the scene's primvar pool: per
                               variable in bit order, per control value, its floats */
     float shading_rate;    /* micropolygon area in pixels */
+    float motionfactor;    /* coarser dicing when motion blurred (RenderMan's "dice"
+                              "motionfactor"; motion.c), 0: none */
+    float focusfactor;     /* coarser dicing when out of focus ("focusfactor"), 0: none */
     uint32_t displacement; /* the scene's displacement shader + 1, or 0: none */
     float displacement_bound; /* world units; 0: unbounded */
     union {
@@ -210,6 +215,9 @@ typedef struct Grid {
     float sub[2][2];       /* such a quad: its rectangle of the quad's own (s, t), (s0, t0)
                               and (s1, t1), in [0, 1] */
     float tri[3][2];       /* such a quad: the triangle's corners, the primitive's (u, v) */
+    uint8_t moving;        /* 1: its vertices differ between time samples (GridSet.Pt); its
+                              radiosity is cached per motion segment */
+    uint32_t motion_vertex; /* a moving grid: its first vertex in GridSet.Pt and the rest */
 } Grid;
 
 /* One placement of a master (an object instance, nested ones flattened):
@@ -250,7 +258,75 @@ typedef struct GridSet {
                               here + 1 (Hit.instance, CacheKey.instance); owned */
     size_t n_instances;
     size_t n_masters;      /* masters (grids may have master 1 .. n_masters) */
+    /* Motion blur (DESIGN.md "Motion blur and depth of field"): n_times
+     * uniformly spaced time samples from time[0] to time[1]. Sample 0 is P,
+     * N, dPdu, dPdv above; sample k >= 1 of a vertex of a moving grid g
+     * (Grid.moving) is Pt[k - 1][g->motion_vertex + (i - g->first_vertex)]
+     * and so on: only moving grids' vertices have later samples.
+     * n_times 1: nothing moves, the arrays are NULL. */
+    int n_times;
+    float time[2];         /* the first and last time sample, scene (shutter) time */
+    size_t n_motion_vertices; /* vertices of each later sample's arrays */
+    Vec3 *Pt[GEOM_MAX_TIMES - 1], *Nt[GEOM_MAX_TIMES - 1];
+    Vec3 *dPdut[GEOM_MAX_TIMES - 1], *dPdvt[GEOM_MAX_TIMES - 1];
 } GridSet;
+
+/* Where time t falls among gs's time samples: the motion segment (0 to
+ * n_times - 2; 0 without motion) and the fraction f in [0, 1] across it
+ * (times outside the samples clamp to the first or last). */
+static inline int geom_motion_segment(const GridSet *gs, float t, float *f)
+{
+    *f = 0.0f;
+    if (gs->n_times < 2)
+        return 0;
+    float span = gs->time[1] - gs->time[0];
+    float x = span > 0.0f ? (t - gs->time[0]) / span * (float)(gs->n_times - 1) : 0.0f;
+    x = x < 0.0f ? 0.0f : x > (float)(gs->n_times - 1) ? (float)(gs->n_times - 1) : x;
+    int seg = (int)x;
+    seg = seg > gs->n_times - 2 ? gs->n_times - 2 : seg;
+    *f = x - (float)seg;
+    return seg;
+}
+
+/* The time in the middle of motion segment seg (where a cache fill shades). */
+static inline float geom_segment_mid_time(const GridSet *gs, int seg)
+{
+    if (gs->n_times < 2)
+        return gs->time[0];
+    return gs->time[0] + (gs->time[1] - gs->time[0]) * ((float)seg + 0.5f) / (float)(gs->n_times - 1);
+}
+
+/* Where vertex i of moving grid g is in the later samples' arrays. */
+static inline size_t geom_motion_index(const Grid *g, size_t i)
+{
+    return g->motion_vertex + (i - g->first_vertex);
+}
+
+/* Vertex i's position at time sample k (sample 0 for a still grid). */
+static inline Vec3 geom_vertex_P_at_sample(const GridSet *gs, const Grid *g, size_t i, int k)
+{
+    return k == 0 || !g->moving ? gs->P[i] : gs->Pt[k - 1][geom_motion_index(g, i)];
+}
+
+/* What a vertex of grid g is at segment seg, fraction f: the linear blend
+ * of the two time samples (Embree's linear motion). A still grid's is
+ * sample 0. */
+typedef struct GeomVertex {
+    Vec3 P, N, dPdu, dPdv; /* N not renormalised */
+} GeomVertex;
+
+static inline GeomVertex geom_vertex_at(const GridSet *gs, const Grid *g, size_t i, int seg, float f)
+{
+    if (!g->moving || gs->n_times < 2)
+        return (GeomVertex){gs->P[i], gs->N[i], gs->dPdu[i], gs->dPdv[i]};
+    size_t j = geom_motion_index(g, i);
+    GeomVertex a = seg == 0 ? (GeomVertex){gs->P[i], gs->N[i], gs->dPdu[i], gs->dPdv[i]}
+                            : (GeomVertex){gs->Pt[seg - 1][j], gs->Nt[seg - 1][j],
+                                           gs->dPdut[seg - 1][j], gs->dPdvt[seg - 1][j]};
+    GeomVertex b = {gs->Pt[seg][j], gs->Nt[seg][j], gs->dPdut[seg][j], gs->dPdvt[seg][j]};
+    return (GeomVertex){v3_lerp(a.P, b.P, f), v3_lerp(a.N, b.N, f), v3_lerp(a.dPdu, b.dPdu, f),
+                        v3_lerp(a.dPdv, b.dPdv, f)};
+}
 
 /* How the camera sets dicing rates, and how large a grid may be.
  *

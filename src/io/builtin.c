@@ -15,7 +15,7 @@
 
 const char *const io_builtin_scene_names[] = {"cornell", "cornell-teapots",
                                               "cornell-teapots-displaced", "cornell-spheres",
-                                              "cornell-brick", NULL};
+                                              "cornell-brick", "cornell-teapots-motion", NULL};
 
 typedef struct Quad {
     float P[4][3];
@@ -128,8 +128,31 @@ static RayesError teapot_displacement(const IoSink *s)
     return e == RAYES_OK ? s->set_displacement_bound(s->target, 6.0f) : e;
 }
 
-static RayesError cornell_teapots(const IoSink *s, const char *data_dir, int displaced, char *err,
-                                  size_t err_size)
+/* The cornell-teapots-motion variant: the matte teapot spins 40 degrees
+ * about its axis over the shutter [0, 1] (5 samples, 10 degrees apart),
+ * and a thin lens of radius 20 mm focuses on the chrome teapot, 1170 mm
+ * along the view. */
+#define MOTION_SAMPLES 5
+
+static RayesError teapot_spin(const IoSink *s)
+{
+    float times[MOTION_SAMPLES], m[MOTION_SAMPLES][16];
+    for (int k = 0; k < MOTION_SAMPLES; k++) {
+        times[k] = (float)k / (MOTION_SAMPLES - 1);
+        teapot_transform(150.0f + 40.0f * times[k], 160.0f, 195.0f, m[k]);
+    }
+    if (!s->set_transform_motion || !s->set_shutter || !s->set_depth_of_field)
+        return s->set_transform(s->target, m[0]); /* a sink without time: the still frame */
+    RayesError e = s->set_shutter(s->target, 0.0f, 1.0f);
+    if (e == RAYES_OK)
+        e = s->set_depth_of_field(s->target, 20.0f, 1170.0f);
+    return e == RAYES_OK
+               ? s->set_transform_motion(s->target, MOTION_SAMPLES, times, (const float(*)[16])m)
+               : e;
+}
+
+static RayesError cornell_teapots(const IoSink *s, const char *data_dir, int displaced,
+                                  int motion, char *err, size_t err_size)
 {
     char path[4096];
     if (!data_dir) {
@@ -164,7 +187,7 @@ static RayesError cornell_teapots(const IoSink *s, const char *data_dir, int dis
         e = teapot_displacement(s);
     teapot_transform(150.0f, 160.0f, 195.0f, m);
     if (e == RAYES_OK)
-        e = s->set_transform(s->target, m);
+        e = motion ? teapot_spin(s) : s->set_transform(s->target, m);
     if (e == RAYES_OK && (e = io_read_bpt(path, s, err, err_size)) != RAYES_OK)
         return e;
     static const float identity[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
@@ -258,11 +281,12 @@ RayesError io_builtin_scene(const char *name, const char *data_dir, const IoSink
         if (e == RAYES_OK)
             e = cornell_blocks(s);
     } else if (strcmp(name, "cornell-teapots") == 0 ||
-               strcmp(name, "cornell-teapots-displaced") == 0) {
+               strcmp(name, "cornell-teapots-displaced") == 0 ||
+               strcmp(name, "cornell-teapots-motion") == 0) {
         e = cornell_shell(s);
         if (e == RAYES_OK)
-            e = cornell_teapots(s, data_dir, strcmp(name, "cornell-teapots-displaced") == 0, err,
-                                err_size);
+            e = cornell_teapots(s, data_dir, strcmp(name, "cornell-teapots-displaced") == 0,
+                                strcmp(name, "cornell-teapots-motion") == 0, err, err_size);
     } else if (strcmp(name, "cornell-spheres") == 0) {
         e = cornell_shell(s);
         if (e == RAYES_OK)
@@ -276,7 +300,8 @@ RayesError io_builtin_scene(const char *name, const char *data_dir, const IoSink
     } else {
         snprintf(err, err_size,
                  "unknown scene \"%s\" (built-in scenes: cornell, cornell-teapots, "
-                 "cornell-teapots-displaced, cornell-spheres, cornell-brick)",
+                 "cornell-teapots-displaced, cornell-spheres, cornell-brick, "
+                 "cornell-teapots-motion)",
                  name);
         return RAYES_ERROR_INVALID_ARGUMENT;
     }

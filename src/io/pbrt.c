@@ -59,11 +59,13 @@ static void dir_of(const char *path, char *dir, size_t size)
 typedef struct Directive Directive;
 typedef int (*Handler)(Parser *P, const Token *t);
 
+/* Concatenates m onto the active transforms (start, end, or both). */
 static void apply(Parser *P, const double m[16])
 {
-    if (!P->gs.active)
-        return;
-    pbrt_mat_mul(P->gs.ctm, m, P->gs.ctm);
+    if (P->gs.active & 1)
+        pbrt_mat_mul(P->gs.ctm, m, P->gs.ctm);
+    if (P->gs.active & 2)
+        pbrt_mat_mul(P->gs.ctm_end, m, P->gs.ctm_end);
 }
 
 static int d_translate(Parser *P, const Token *t)
@@ -162,8 +164,10 @@ static int d_transform(Parser *P, const Token *t)
     double m[16];
     if (read_matrix(P, m) != 0)
         return -1;
-    if (P->gs.active)
+    if (P->gs.active & 1)
         memcpy(P->gs.ctm, m, sizeof m);
+    if (P->gs.active & 2)
+        memcpy(P->gs.ctm_end, m, sizeof m);
     return 0;
 }
 
@@ -180,8 +184,10 @@ static int d_concat(Parser *P, const Token *t)
 static int d_identity(Parser *P, const Token *t)
 {
     (void)t;
-    if (P->gs.active)
+    if (P->gs.active & 1)
         pbrt_mat_identity(P->gs.ctm);
+    if (P->gs.active & 2)
+        pbrt_mat_identity(P->gs.ctm_end);
     return 0;
 }
 
@@ -203,6 +209,7 @@ static int d_coordsystransform(Parser *P, const Token *t)
     for (size_t i = 0; i < P->n_coordsys; i++)
         if (strcmp(P->coordsys[i].name, name) == 0) {
             memcpy(P->gs.ctm, P->coordsys[i].m, sizeof P->gs.ctm);
+            memcpy(P->gs.ctm_end, P->coordsys[i].m, sizeof P->gs.ctm_end);
             return 0;
         }
     char key[96];
@@ -216,17 +223,17 @@ static int d_active(Parser *P, const Token *t)
 {
     Token w;
     char b[48];
+    (void)t;
     if (pbrt_next(P, &w) != 0)
         return -1;
-    if (pbrt_word_is(&w, "All") || pbrt_word_is(&w, "StartTime")) {
+    if (pbrt_word_is(&w, "All"))
+        P->gs.active = 3;
+    else if (pbrt_word_is(&w, "StartTime"))
         P->gs.active = 1;
-    } else if (pbrt_word_is(&w, "EndTime")) {
-        P->gs.active = 0;
-        pbrt_warn_at(P, t->line, t->col, "motion", "ActiveTransform EndTime: motion blur is not "
-                     "supported; end-time transforms are ignored");
-    } else {
+    else if (pbrt_word_is(&w, "EndTime"))
+        P->gs.active = 2;
+    else
         return FAIL_TOK(P, &w, "expected All, StartTime or EndTime, found %s", pbrt_shown(&w, b));
-    }
     return 0;
 }
 
@@ -235,8 +242,10 @@ static int d_transformtimes(Parser *P, const Token *t)
     double v[2];
     if (pbrt_expect_number(P, &v[0], "a start time") != 0 || pbrt_expect_number(P, &v[1], "an end time") != 0)
         return -1;
-    pbrt_warn_at(P, t->line, t->col, "TransformTimes",
-                 "TransformTimes: motion blur is not supported; ignored");
+    if (!isfinite(v[0]) || !isfinite(v[1]) || !(v[1] > v[0]))
+        return FAIL_TOK(P, t, "TransformTimes: expected finite start < end, found %g %g", v[0],
+                        v[1]);
+    P->transform_times[0] = v[0], P->transform_times[1] = v[1];
     return 0;
 }
 
@@ -269,6 +278,7 @@ static int pop(Parser *P, const Token *t, int kind, const char *name)
                      s->kind == 'T' ? "Transform" : "Attribute");
     if (kind == 'T') {
         memcpy(P->gs.ctm, s->ctm, sizeof P->gs.ctm);
+        memcpy(P->gs.ctm_end, s->ctm_end, sizeof P->gs.ctm_end);
         P->gs.active = s->active;
     } else {
         P->gs = *s;
@@ -517,8 +527,12 @@ RayesError io_pbrt_parse(const char *name, const unsigned char *data, size_t siz
     if (err_size)
         err[0] = '\0';
     pbrt_mat_identity(P->gs.ctm);
+    pbrt_mat_identity(P->gs.ctm_end);
     pbrt_mat_identity(P->camera_from_world);
-    P->gs.active = 1;
+    pbrt_mat_identity(P->camera_from_world_end);
+    P->transform_times[0] = 0, P->transform_times[1] = 1;
+    P->shutter[0] = 0, P->shutter[1] = 1;
+    P->gs.active = 3;
     P->fov = 90;
     pbrt_mat_init(&P->gs.material, "diffuse"); /* pbrt's default material: diffuse 0.5 */
     static const float half[3] = {0.5f, 0.5f, 0.5f};

@@ -54,11 +54,26 @@ static RayesError send_displacement(Parser *P, const Material *mat)
  * sink fails. */
 static int send_transform(Parser *P, const Token *t, const double m[16])
 {
-    float f[16];
+    float f[2][16];
     if (!pbrt_mat_finite(m))
         return FAIL_TOK(P, t, "the current transform is not finite");
-    pbrt_mat_to_float(m, f);
-    RayesError e = P->sink->set_transform(P->sink->target, f);
+    pbrt_mat_to_float(m, f[0]);
+    /* The current transform moves when its end-time matrix differs
+     * (ActiveTransform EndTime), over TransformTimes. */
+    int moving = m == P->gs.ctm && memcmp(P->gs.ctm, P->gs.ctm_end, sizeof P->gs.ctm) != 0;
+    RayesError e;
+    if (moving && P->sink->set_transform_motion) {
+        if (!pbrt_mat_finite(P->gs.ctm_end))
+            return FAIL_TOK(P, t, "the current end-time transform is not finite");
+        pbrt_mat_to_float(P->gs.ctm_end, f[1]);
+        float times[2] = {(float)P->transform_times[0], (float)P->transform_times[1]};
+        e = P->sink->set_transform_motion(P->sink->target, 2, times, (const float(*)[16])f);
+    } else {
+        if (moving)
+            pbrt_warn_at(P, t->line, t->col, "motion",
+                         "this sink has no motion blur: the start-time transform is used");
+        e = P->sink->set_transform(P->sink->target, f[0]);
+    }
     return e != RAYES_OK ? pbrt_sink_failed(P, t, e) : 0;
 }
 

@@ -113,9 +113,10 @@ typedef struct AreaLight {
 } AreaLight;
 
 typedef struct GState {
-    double ctm[16]; /* world_from_object, row-major */
+    double ctm[16]; /* world_from_object, row-major, at the start time */
+    double ctm_end[16]; /* and at the end time (ActiveTransform EndTime's) */
     int reverse;    /* ReverseOrientation */
-    int active;     /* ActiveTransform: 1 All/StartTime, 0 EndTime (transforms dropped) */
+    int active;     /* ActiveTransform: bits 1 StartTime (ctm), 2 EndTime (ctm_end); All 3 */
     Material material;
     AreaLight area;
     char inside[128], outside[128]; /* MediumInterface: media names, "" for none */
@@ -223,6 +224,10 @@ typedef struct Parser {
     /* camera and options */
     int world; /* after WorldBegin */
     double camera_from_world[16];
+    double camera_from_world_end[16]; /* at the end time: the camera moves if it differs */
+    double transform_times[2];        /* TransformTimes (default 0 1) */
+    float shutter[2];                 /* the camera's shutteropen, shutterclose */
+    float lens_radius, focal_distance; /* the camera's lensradius, focaldistance */
     RayesProjection projection;
     float fov;
     float screen[4];

@@ -42,6 +42,7 @@ int pbrt_d_camera(Parser *P, const Token *t)
     memcpy(P->camera_from_world, P->gs.ctm, sizeof P->camera_from_world);
     snprintf(P->camera_medium, sizeof P->camera_medium, "%s", P->gs.outside);
     P->camera_line = t->line, P->camera_col = t->col;
+    memcpy(P->camera_from_world_end, P->gs.ctm_end, sizeof P->camera_from_world_end);
     double inv[16];
     if (pbrt_mat_inverse(P->gs.ctm, inv) != 0) {
         pbrt_params_free(&pl);
@@ -62,10 +63,22 @@ int pbrt_d_camera(Parser *P, const Token *t)
     P->have_screen = sw && sw->n_num == 4;
     for (int i = 0; P->have_screen && i < 4; i++)
         P->screen[i] = (float)sw->num[i];
-    if (pbrt_get_float(&pl, "lensradius", 0.0) > 0)
-        pbrt_warn_at(P, t->line, t->col, "lensradius", "Camera: depth of field (lensradius) is not "
-                     "supported; the camera is a pinhole");
-    pbrt_find(&pl, "focaldistance");
+    double open = pbrt_get_float(&pl, "shutteropen", 0.0);
+    double close = pbrt_get_float(&pl, "shutterclose", 1.0);
+    double lens = pbrt_get_float(&pl, "lensradius", 0.0);
+    double focus = pbrt_get_float(&pl, "focaldistance", 1e6);
+    if (!isfinite(open) || !isfinite(close) || close < open) {
+        pbrt_params_free(&pl);
+        return FAIL_TOK(P, t, "Camera: expected shutteropen <= shutterclose, found %g %g", open,
+                        close);
+    }
+    if (!(lens >= 0) || !isfinite(lens) || !(focus > 0) || !isfinite(focus)) {
+        pbrt_params_free(&pl);
+        return FAIL_TOK(P, t, "Camera: expected lensradius >= 0 and focaldistance > 0, found %g %g",
+                        lens, focus);
+    }
+    P->shutter[0] = (float)open, P->shutter[1] = (float)close;
+    P->lens_radius = (float)lens, P->focal_distance = (float)focus;
     pbrt_warn_unused(P, &pl, "Camera", type);
     pbrt_params_free(&pl);
     return r;
@@ -219,6 +232,34 @@ int pbrt_d_filter(Parser *P, const Token *t)
     return 0;
 }
 
+/* The shutter, the camera's motion (its transform at the end time) and
+ * the lens, after the camera. */
+static int emit_time(Parser *P, const Token *t)
+{
+    const IoSink *s = P->sink;
+    int moving = memcmp(P->camera_from_world, P->camera_from_world_end,
+                        sizeof P->camera_from_world) != 0;
+    if (!s->set_shutter || !s->set_camera_motion || !s->set_depth_of_field) {
+        if (moving || P->lens_radius > 0)
+            pbrt_warn_at(P, t->line, t->col, "time",
+                         "this sink has no motion blur or depth of field: a still pinhole "
+                         "camera is used");
+        return 0;
+    }
+    RayesError e = s->set_shutter(s->target, P->shutter[0], P->shutter[1]);
+    if (e == RAYES_OK && moving) {
+        if (!pbrt_mat_finite(P->camera_from_world_end))
+            return FAIL_TOK(P, t, "the camera's end transform is not finite");
+        float m[2][16], times[2] = {(float)P->transform_times[0], (float)P->transform_times[1]};
+        pbrt_mat_to_float(P->camera_from_world, m[0]);
+        pbrt_mat_to_float(P->camera_from_world_end, m[1]);
+        e = s->set_camera_motion(s->target, 2, times, (const float(*)[16])m);
+    }
+    if (e == RAYES_OK && P->lens_radius > 0)
+        e = s->set_depth_of_field(s->target, P->lens_radius, P->focal_distance);
+    return e != RAYES_OK ? pbrt_sink_failed(P, t, e) : 0;
+}
+
 static int emit_camera(Parser *P, const Token *t)
 {
     float m[16];
@@ -227,7 +268,9 @@ static int emit_camera(Parser *P, const Token *t)
     pbrt_mat_to_float(P->camera_from_world, m);
     RayesError e = P->sink->set_camera_matrix(P->sink->target, m, P->projection, P->fov,
                                               P->have_screen ? P->screen : NULL);
-    return e != RAYES_OK ? pbrt_sink_failed(P, t, e) : 0;
+    if (e != RAYES_OK)
+        return pbrt_sink_failed(P, t, e);
+    return emit_time(P, t);
 }
 
 int pbrt_d_worldbegin(Parser *P, const Token *t)
@@ -236,6 +279,7 @@ int pbrt_d_worldbegin(Parser *P, const Token *t)
         return -1;
     P->world = 1;
     pbrt_mat_identity(P->gs.ctm);
+    pbrt_mat_identity(P->gs.ctm_end);
     if (pbrt_set_coordsys(P, t, "world", P->gs.ctm) != 0)
         return -1;
     if (P->settings->width == 0) {

@@ -338,13 +338,98 @@ static int h_procedural(Rib *r, const Args *a)
 
 /* ----------------------------------------------------------- dispatch */
 
+/* MotionBegin [t0 t1 ...]: the requests up to MotionEnd are the samples of
+ * one transform (each applied to the transform before the block) or of one
+ * primitive (deformation, through the sink's motion_begin/end), in order. */
 static int h_motion_begin(Rib *r, const Args *a)
 {
-    (void)a;
-    rib_warn_once(r, "MotionBegin", "motion blur is not supported: the first sample of each motion "
-                                "block is used");
+    if (a->n < 1 || (a->v[0].kind != ARG_NUMS && a->v[0].kind != ARG_NUM))
+        return rib_error(r, "expected an array of times");
+    const Arg *t = &a->v[0];
+    if (t->n < 1 || t->n > RIB_MAX_TIMES)
+        return rib_error(r, "expected 1 to %d times, found %zu", RIB_MAX_TIMES, t->n);
+    for (size_t k = 0; k < t->n; k++) {
+        if (!isfinite(t->d[k]) || (k > 0 && !(t->d[k] > t->d[k - 1])))
+            return rib_error(r, "expected finite, increasing times");
+        r->motion_time[k] = (float)t->d[k];
+    }
     r->motion = 1;
     r->motion_seen = 0;
+    r->motion_n = t->n;
+    r->motion_kind = 0;
+    memcpy(r->motion_pre, r->a.M, sizeof r->motion_pre);
+    r->motion_pre_n = r->a.n_motion;
+    return 0;
+}
+
+static int is_transform_request(const char *q)
+{
+    static const char *const names[] = {"Translate", "Rotate", "Scale", "ConcatTransform",
+                                        "Transform", "Skew", "Perspective", "Identity", NULL};
+    for (int k = 0; names[k]; k++)
+        if (strcmp(q, names[k]) == 0)
+            return 1;
+    return 0;
+}
+
+static int motion_end(Rib *r)
+{
+    r->motion = 0;
+    if (r->motion_kind != 0 && (size_t)r->motion_seen != r->motion_n)
+        return rib_error(r, "the block has %d requests for %zu times", r->motion_seen,
+                         r->motion_n);
+    if (r->motion_kind == 1) {
+        memcpy(r->a.M, r->motion_M[0], sizeof r->a.M);
+        r->a.n_motion = r->motion_n > 1 ? (int)r->motion_n : 0;
+        memcpy(r->a.motion_time, r->motion_time, r->motion_n * sizeof *r->motion_time);
+        memcpy(r->a.motion_M, r->motion_M, r->motion_n * sizeof r->motion_M[0]);
+        return 0;
+    }
+    SinkState *st;
+    const IoSink *s = rib_out_sink(r, &st);
+    if (r->motion_kind == 2 && r->motion_n > 1 && s->motion_end &&
+        s->motion_end(s->target) != RAYES_OK)
+        return rib_sink_failed(r, s);
+    return 0;
+}
+
+/* One request inside a motion block (the sample motion_seen). Returns 1 if
+ * it was consumed here, else 0 (dispatch runs it), or -1. */
+static int motion_request(Rib *r, const char *q, const Args *a, int (*run)(Rib *, const Args *))
+{
+    size_t k = (size_t)r->motion_seen++;
+    if (k >= r->motion_n)
+        return rib_error(r, "the motion block has more requests than its %zu times",
+                         r->motion_n);
+    int transform = is_transform_request(q);
+    if (r->motion_kind && r->motion_kind != (transform ? 1 : 2))
+        return rib_error(r, "a motion block holds the samples of one request (transforms, "
+                            "or one primitive)");
+    r->motion_kind = transform ? 1 : 2;
+    if (transform) {
+        memcpy(r->a.M, r->motion_pre, sizeof r->a.M);
+        r->a.n_motion = 0;
+        int rc = run(r, a);
+        memcpy(r->motion_M[k], r->a.M, sizeof r->a.M);
+        return rc < 0 ? -1 : 1;
+    }
+    SinkState *st;
+    const IoSink *s = rib_out_sink(r, &st);
+    if (!s->motion_begin || r->motion_n < 2) {
+        if (k == 0)
+            return 0;
+        rib_warn_once(r, "MotionBegin", "deformation blur is not supported here: the first "
+                                        "sample of each motion block is used");
+        return 1;
+    }
+    if (k > 0)
+        return 0;
+    /* The state first, so that the block holds the samples alone. */
+    int skip = rib_emit_begin(r, NULL);
+    if (skip != 0)
+        return skip < 0 ? -1 : 1;
+    if (s->motion_begin(s->target, r->motion_n, r->motion_time) != RAYES_OK)
+        return rib_sink_failed(r, s);
     return 0;
 }
 
@@ -415,8 +500,6 @@ static const RibRequest own_requests[] = {
     {"DisplayFilter", h_skip},
     {"SampleFilter", h_skip},
     {"Camera", h_skip},
-    {"Shutter", h_skip},
-    {"DepthOfField", h_skip},
     {"MakeShadow", h_skip},
     {"MakeTexture", h_skip},
     {"MakeBump", h_skip},
@@ -477,23 +560,23 @@ static int dispatch(Rib *r, const Args *a)
     }
     if (r->skipping && strcmp(q, "FrameEnd") != 0)
         return 0;
-    if (r->motion) {
-        if (strcmp(q, "MotionEnd") == 0) {
-            r->motion = 0;
-            return 0;
-        }
-        if (r->motion_seen++ > 0)
-            return 0;
-    } else if (strcmp(q, "MotionEnd") == 0) {
+    if (r->motion && strcmp(q, "MotionEnd") == 0)
+        return motion_end(r);
+    if (!r->motion && strcmp(q, "MotionEnd") == 0)
         return rib_error(r, "MotionEnd without MotionBegin");
-    }
     for (size_t t = 0; t < sizeof tables / sizeof tables[0]; t++)
         for (const RibRequest *k = tables[t]; k->name; k++)
-            if (strcmp(k->name, q) == 0)
-                return (tables[t] == rib_prim_requests || tables[t] == rib_curves_requests) &&
-                               r->a.lod_coarse
-                           ? 0
-                           : k->fn(r, a);
+            if (strcmp(k->name, q) == 0) {
+                if ((tables[t] == rib_prim_requests || tables[t] == rib_curves_requests) &&
+                    r->a.lod_coarse)
+                    return 0;
+                if (r->motion) {
+                    int done = motion_request(r, q, a, k->fn);
+                    if (done != 0)
+                        return done < 0 ? -1 : 0;
+                }
+                return k->fn(r, a);
+            }
     return rib_error(r, "unknown request (expected a RIB request such as WorldBegin or Polygon)");
 }
 

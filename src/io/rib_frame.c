@@ -140,6 +140,28 @@ static int h_object_instance(Rib *r, const Args *a)
 
 /* ------------------------------------------------------ worlds, frames */
 
+/* The shutter, the camera's motion and the lens, at WorldBegin. */
+static int send_time(Rib *r, const IoSink *s)
+{
+    float open = r->shutter[0] + r->shutter_offset, close = r->shutter[1] + r->shutter_offset;
+    int blur = close > open || r->camera_motion > 1 || r->dof[0] > 0.0f;
+    if (blur && (!s->set_shutter || !s->set_camera_motion || !s->set_depth_of_field)) {
+        rib_warn_once(r, "time", "this sink has no motion blur or depth of field: a still "
+                                 "pinhole camera is used");
+        return 0;
+    }
+    if (close > open && s->set_shutter(s->target, open, close) != RAYES_OK)
+        return rib_sink_failed(r, s);
+    if (r->camera_motion > 1 &&
+        s->set_camera_motion(s->target, (size_t)r->camera_motion, r->camera_motion_time,
+                             (const float(*)[16])r->camera_motion_M) != RAYES_OK)
+        return rib_sink_failed(r, s);
+    if (r->dof[0] > 0.0f &&
+        s->set_depth_of_field(s->target, r->dof[1] / (2.0f * r->dof[0]), r->dof[2]) != RAYES_OK)
+        return rib_sink_failed(r, s);
+    return 0;
+}
+
 static int h_world_begin(Rib *r, const Args *a)
 {
     (void)a;
@@ -150,7 +172,11 @@ static int h_world_begin(Rib *r, const Args *a)
     if (r->worlds++ > 0 && !r->in_frame)
         rib_warn_once(r, "worlds", "several world blocks outside frames are read into one scene");
     memcpy(r->camera_from_world, r->a.M, sizeof r->a.M);
+    r->camera_motion = r->a.n_motion;
+    memcpy(r->camera_motion_time, r->a.motion_time, sizeof r->camera_motion_time);
+    memcpy(r->camera_motion_M, r->a.motion_M, sizeof r->camera_motion_M);
     rib_mat_identity(r->a.M);
+    r->a.n_motion = 0;
     r->in_world = 1;
     float sw[4];
     const float *screen = NULL;
@@ -166,6 +192,8 @@ static int h_world_begin(Rib *r, const Args *a)
     if (s->set_camera_matrix(s->target, r->camera_from_world, (RayesProjection)r->projection,
                              r->fov, screen) != RAYES_OK)
         return rib_sink_failed(r, s);
+    if (send_time(r, s) != 0)
+        return -1;
     float wc[16];
     rib_world_from_camera(r, wc);
     for (size_t k = 0; k < r->n_lights; k++)

@@ -49,6 +49,7 @@
 #define RIB_MAX_FILE_BYTES ((size_t)1 << 30)
 #define RIB_MAX_WARNED 512
 #define RIB_MAX_LIGHTS 4096
+#define RIB_MAX_TIMES 16   /* motion samples (rayes.h's RAYES_MAX_TIMES) */
 #define RIB_MAX_HANDLE 256 /* a handle's key: "#N" for a number, "\"name\"" for a string */
 
 /* ----------------------------------------------------------- arguments */
@@ -119,6 +120,10 @@ typedef struct Attr {
     uint32_t visibility; /* Attribute "visibility": RayesRayType bits of the rays that see it */
     int hitmode;         /* Attribute "shade" "transmissionhitmode": RayesTransmissionHitMode */
     int opacity_cache;   /* Attribute "shade" "opacitycache": 0, its opacity is never cached */
+    float motionfactor, focusfactor; /* Attribute "dice" "motionfactor", "focusfactor" */
+    int n_motion;        /* M moves: n_motion samples (MotionBegin around transforms), else 0 */
+    float motion_time[RIB_MAX_TIMES];
+    float motion_M[RIB_MAX_TIMES][16]; /* M at each time; M is motion_M[0] */
 } Attr;
 
 typedef struct SinkState {
@@ -134,6 +139,10 @@ typedef struct SinkState {
     uint32_t visibility;
     int hitmode, opacity_cache;
     int have_visibility, have_opacity_mode;
+    int n_motion;                      /* the motion last sent with M (0: none) */
+    float motion_M[RIB_MAX_TIMES][16];
+    float motionfactor, focusfactor;   /* the dice blur last sent */
+    int have_blur;
 } SinkState;
 
 #define RIB_LIGHT_PARAMS 12
@@ -190,6 +199,19 @@ typedef struct Rib {
     int in_world;
     int worlds;
     float camera_from_world[16];
+    int camera_motion;         /* camera_from_world moves: samples in camera_motion_M */
+    float camera_motion_time[RIB_MAX_TIMES], camera_motion_M[RIB_MAX_TIMES][16];
+    float shutter[2], shutter_offset; /* Shutter, Option "shutter" "offset" */
+    float dof[3];              /* DepthOfField fstop focallength focaldistance; fstop 0: none */
+    /* A MotionBegin block: its times, the request count so far, what it
+     * holds (1: transforms, 2: primitives, 0: nothing yet), and for
+     * transforms M before it and after each sample. */
+    int motion_kind;
+    size_t motion_n;
+    float motion_time[RIB_MAX_TIMES];
+    float motion_pre[16];
+    int motion_pre_n;
+    float motion_M[RIB_MAX_TIMES][16];
     int projection;            /* RayesProjection */
     float fov;
     float screen[4];

@@ -152,6 +152,40 @@ static int send_visibility(Rib *r, const IoSink *s, SinkState *st)
     return 0;
 }
 
+/* The current transform, moving or not, and the dice blur, if changed. */
+static int send_transform(Rib *r, const IoSink *s, SinkState *st)
+{
+    int moving = r->a.n_motion > 1 && s->set_transform_motion;
+    if (r->a.n_motion > 1 && !s->set_transform_motion)
+        rib_warn_once(r, "MotionBegin", "this sink has no motion blur: the first sample of "
+                                        "each motion block is used");
+    size_t bytes = (size_t)r->a.n_motion * sizeof r->a.motion_M[0];
+    if (!st->have_M || memcmp(st->M, r->a.M, sizeof st->M) != 0 ||
+        st->n_motion != (moving ? r->a.n_motion : 0) ||
+        (moving && memcmp(st->motion_M, r->a.motion_M, bytes) != 0)) {
+        RayesError e = moving ? s->set_transform_motion(s->target, (size_t)r->a.n_motion,
+                                                        r->a.motion_time,
+                                                        (const float(*)[16])r->a.motion_M)
+                              : s->set_transform(s->target, r->a.M);
+        if (e != RAYES_OK)
+            return rib_sink_failed(r, s);
+        memcpy(st->M, r->a.M, sizeof st->M);
+        st->n_motion = moving ? r->a.n_motion : 0;
+        if (moving)
+            memcpy(st->motion_M, r->a.motion_M, bytes);
+        st->have_M = 1;
+    }
+    if (s->set_dice_blur && (!st->have_blur || st->motionfactor != r->a.motionfactor ||
+                             st->focusfactor != r->a.focusfactor)) {
+        if (s->set_dice_blur(s->target, r->a.motionfactor, r->a.focusfactor) != RAYES_OK)
+            return rib_sink_failed(r, s);
+        st->motionfactor = r->a.motionfactor;
+        st->focusfactor = r->a.focusfactor;
+        st->have_blur = 1;
+    }
+    return 0;
+}
+
 /* Brings the sink up to date before a primitive; Cs overrides the
  * colour (a per-face colour) when not NULL. 1: skip (outside the world). */
 int rib_emit_begin(Rib *r, const float *Cs)
@@ -164,12 +198,8 @@ int rib_emit_begin(Rib *r, const float *Cs)
         return -1;
     SinkState *st;
     const IoSink *s = rib_out_sink(r, &st);
-    if (!st->have_M || memcmp(st->M, r->a.M, sizeof st->M) != 0) {
-        if (s->set_transform(s->target, r->a.M) != RAYES_OK)
-            return rib_sink_failed(r, s);
-        memcpy(st->M, r->a.M, sizeof st->M);
-        st->have_M = 1;
-    }
+    if (send_transform(r, s, st) != 0)
+        return -1;
     if (send_visibility(r, s, st) != 0)
         return -1;
     if (Cs) {

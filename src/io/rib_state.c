@@ -17,9 +17,13 @@
 
 /* --------------------------------------------------------- transforms */
 
+/* Concatenates m onto the current transform, and onto each of its motion
+ * samples when it moves. */
 static void concat(Rib *r, const float m[16])
 {
     rib_mat_mul(r->a.M, m, r->a.M);
+    for (int k = 0; k < r->a.n_motion; k++)
+        rib_mat_mul(r->a.motion_M[k], m, r->a.motion_M[k]);
 }
 
 static int h_translate(Rib *r, const Args *a)
@@ -80,6 +84,7 @@ static int get_matrix(Rib *r, const Args *a, float m[16])
 
 static int h_transform(Rib *r, const Args *a)
 {
+    r->a.n_motion = 0;
     return get_matrix(r, a, r->a.M);
 }
 
@@ -96,6 +101,7 @@ static int h_identity(Rib *r, const Args *a)
 {
     (void)a;
     rib_mat_identity(r->a.M);
+    r->a.n_motion = 0;
     return 0;
 }
 
@@ -138,10 +144,14 @@ int rib_pop(Rib *r, int attribute)
     if (s->attribute != attribute)
         rib_warn_once(r, "unbalanced", "%s closes a %s block", r->req,
                   s->attribute ? "AttributeBegin" : "TransformBegin");
-    if (attribute)
+    if (attribute) {
         r->a = s->a;
-    else
+    } else {
         memcpy(r->a.M, s->a.M, sizeof r->a.M);
+        r->a.n_motion = s->a.n_motion;
+        memcpy(r->a.motion_time, s->a.motion_time, sizeof r->a.motion_time);
+        memcpy(r->a.motion_M, s->a.motion_M, sizeof r->a.motion_M);
+    }
     return 0;
 }
 
@@ -196,6 +206,7 @@ static int h_coordsys_transform(Rib *r, const Args *a)
     const char *name = rib_get_string(r, a, &i, "a coordinate system name");
     if (!name)
         return -1;
+    r->a.n_motion = 0;
     if (strcmp(name, "world") == 0) {
         if (r->in_world)
             rib_mat_identity(r->a.M);
@@ -226,6 +237,42 @@ static int h_coordsys_transform(Rib *r, const Args *a)
 }
 
 /* ------------------------------------------------------------ options */
+
+/* Shutter open close: the interval camera rays sample (motion blur). */
+static int h_shutter(Rib *r, const Args *a)
+{
+    size_t i = 0;
+    float v[2];
+    if (rib_get_floats(r, a, &i, v, 2, "open close") != 0)
+        return -1;
+    if (!isfinite(v[0]) || !isfinite(v[1]) || v[1] < v[0])
+        return rib_error(r, "expected finite open <= close, found %g %g", v[0], v[1]);
+    r->shutter[0] = v[0], r->shutter[1] = v[1];
+    return 0;
+}
+
+/* DepthOfField fstop focallength focaldistance (no arguments: a pinhole):
+ * a thin lens of radius focallength / (2 fstop), camera-space units. */
+static int h_depth_of_field(Rib *r, const Args *a)
+{
+    if (a->n == 0) {
+        r->dof[0] = 0.0f;
+        return 0;
+    }
+    size_t i = 0;
+    float v[3];
+    if (rib_get_floats(r, a, &i, v, 3, "fstop focallength focaldistance") != 0)
+        return -1;
+    if (!(v[0] > 0.0f) || !(v[1] >= 0.0f) || !(v[2] > 0.0f) || !isfinite(v[1]) ||
+        !isfinite(v[2]))
+        return rib_error(r, "expected fstop > 0, focallength >= 0 and "
+                            "focaldistance > 0, found %g %g %g",
+                         v[0], v[1], v[2]);
+    memcpy(r->dof, v, sizeof r->dof);
+    if (isinf(v[0]))
+        r->dof[0] = 0.0f; /* RenderMan's infinite fstop: a pinhole */
+    return 0;
+}
 
 static int h_format(Rib *r, const Args *a)
 {
@@ -675,6 +722,24 @@ static int h_option_attribute(Rib *r, const Args *a)
         } else if (!option && strcmp(group, "dice") == 0 && strcmp(q->d.name, "roundcurve") == 0 &&
                    rib_is_num(q->v) && q->v->n == 1) {
             r->a.roundcurve = q->v->d[0] != 0;
+        } else if (!option && strcmp(group, "dice") == 0 &&
+                   (strcmp(q->d.name, "motionfactor") == 0 ||
+                    strcmp(q->d.name, "focusfactor") == 0) &&
+                   rib_is_num(q->v) && q->v->n == 1) {
+            double f = q->v->d[0];
+            if (!(f >= 0 && f <= 1e6))
+                e = rib_error(r, "Attribute \"dice\" \"%s\": expected a factor >= 0, found %g",
+                              q->d.name, f);
+            else if (q->d.name[0] == 'm')
+                r->a.motionfactor = (float)f;
+            else
+                r->a.focusfactor = (float)f;
+        } else if (option && strcmp(group, "shutter") == 0 && strcmp(q->d.name, "offset") == 0 &&
+                   rib_is_num(q->v) && q->v->n == 1) {
+            if (!isfinite(q->v->d[0]))
+                e = rib_error(r, "Option \"shutter\" \"offset\": expected a finite time");
+            else
+                r->shutter_offset = (float)q->v->d[0];
         } else if (!option && strcmp(group, "identifier") == 0) {
             /* names are for messages only */
         } else if (!(!option && strcmp(group, "displacementbound") == 0)) {
@@ -729,6 +794,7 @@ const RibRequest rib_state_requests[] = {
     {"ScopedCoordinateSystem", h_coordinate_system}, {"CoordSysTransform", h_coordsys_transform},
     {"Format", h_format}, {"FrameAspectRatio", h_frame_aspect}, {"ScreenWindow", h_screen_window},
     {"CropWindow", h_crop_window}, {"Projection", h_projection}, {"Clipping", h_clipping},
+    {"Shutter", h_shutter}, {"DepthOfField", h_depth_of_field},
     {"PixelSamples", h_pixel_samples}, {"PixelFilter", h_pixel_filter},
     {"PixelVariance", h_one_float}, {"Exposure", h_exposure}, {"Quantize", h_quantize},
     {"Display", h_display}, {"Hider", h_hider}, {"ShadingRate", h_shading_rate},

@@ -42,6 +42,13 @@ struct RibWriter {
         int in_transform, opacity_set, hitmode, opacity_cache;
         uint32_t visibility;
     } outer;
+    float shutter[2];        /* Shutter (written when open < close) */
+    float lens[2];           /* lens radius (0: none) and focal distance: DepthOfField */
+    float motionfactor, focusfactor; /* Attribute "dice" written last */
+    Stream motion;           /* a deformation block's samples, until motion_end */
+    FILE *world_f;           /* the world stream's FILE while motion holds the output */
+    size_t motion_n;         /* the block's time samples (0: none open) */
+    float motion_time[RAYES_MAX_TIMES];
     char error[256];         /* the last error, "" if none */
 };
 
@@ -87,6 +94,7 @@ void io_rib_writer_free(RibWriter *w)
     stream_close(&w->options);
     stream_close(&w->camera);
     stream_close(&w->world);
+    stream_close(&w->motion);
     free(w->links);
     free(w);
 }
@@ -302,6 +310,143 @@ static RayesError w_set_transform(void *t, const float m[16])
         matrix(f, m);
         fputc('\n', f);
     }
+    return RAYES_OK;
+}
+
+/* ------------------------------------------------------------- time */
+
+static void motion_times(FILE *f, size_t n, const float *times)
+{
+    fprintf(f, "MotionBegin [");
+    for (size_t k = 0; k < n; k++)
+        fprintf(f, "%s%.9g", k ? " " : "", (double)times[k]);
+    fprintf(f, "]\n");
+}
+
+static RayesError w_set_shutter(void *t, float open, float close)
+{
+    RibWriter *w = t;
+    w->shutter[0] = open, w->shutter[1] = close;
+    return RAYES_OK;
+}
+
+static RayesError w_set_depth_of_field(void *t, float lens_radius, float focal_distance)
+{
+    RibWriter *w = t;
+    w->lens[0] = lens_radius, w->lens[1] = focal_distance;
+    return RAYES_OK;
+}
+
+/* Camera motion: after the camera's Transform, a motion block of
+ * Transforms (each replaces it, RIB's sample semantics). */
+static RayesError w_set_camera_motion(void *t, size_t n, const float *times,
+                                      const float (*m)[16])
+{
+    RibWriter *w = t;
+    if (n < 2 || n > RAYES_MAX_TIMES || !finite_all(times, n) || !finite_all(m[0], 16 * n))
+        return fail(w, RAYES_ERROR_INVALID_ARGUMENT, "camera motion: out of range");
+    motion_times(w->camera.f, n, times);
+    for (size_t k = 0; k < n; k++) {
+        fprintf(w->camera.f, "Transform ");
+        matrix(w->camera.f, m[k]);
+        fputc('\n', w->camera.f);
+    }
+    fprintf(w->camera.f, "MotionEnd\n");
+    return RAYES_OK;
+}
+
+static RayesError w_set_transform_motion(void *t, size_t n, const float *times,
+                                         const float (*m)[16])
+{
+    RibWriter *w = t;
+    if (n < 2 || n > RAYES_MAX_TIMES || !finite_all(times, n) || !finite_all(m[0], 16 * n))
+        return fail(w, RAYES_ERROR_INVALID_ARGUMENT, "transform motion: out of range");
+    FILE *f = w->world.f;
+    if (w->in_transform)
+        fprintf(f, "TransformEnd\n");
+    w->in_transform = 1;
+    fprintf(f, "TransformBegin\n");
+    motion_times(f, n, times);
+    for (size_t k = 0; k < n; k++) {
+        fprintf(f, "ConcatTransform ");
+        matrix(f, m[k]);
+        fputc('\n', f);
+    }
+    fprintf(f, "MotionEnd\n");
+    return RAYES_OK;
+}
+
+static RayesError w_set_dice_blur(void *t, float motionfactor, float focusfactor)
+{
+    RibWriter *w = t;
+    if (motionfactor != w->motionfactor || focusfactor != w->focusfactor)
+        fprintf(w->world.f, "Attribute \"dice\" \"float motionfactor\" [%.9g] "
+                            "\"float focusfactor\" [%.9g]\n",
+                (double)motionfactor, (double)focusfactor);
+    w->motionfactor = motionfactor, w->focusfactor = focusfactor;
+    return RAYES_OK;
+}
+
+/* Deformation: the samples' requests go to a stream of their own; at the
+ * end, request j of every sample (the same topology writes the same
+ * requests) makes motion block j. */
+static RayesError w_motion_begin(void *t, size_t n, const float *times)
+{
+    RibWriter *w = t;
+    if (w->motion_n || n < 2 || n > RAYES_MAX_TIMES || !finite_all(times, n))
+        return fail(w, RAYES_ERROR_INVALID_ARGUMENT, "motion begin: out of range or nested");
+    if (stream_open(&w->motion) != 0)
+        return fail(w, RAYES_ERROR_OUT_OF_MEMORY, "out of memory");
+    w->motion_n = n;
+    memcpy(w->motion_time, times, n * sizeof *times);
+    w->world_f = w->world.f;
+    w->world.f = w->motion.f;
+    return RAYES_OK;
+}
+
+/* The starts of the requests in text (a request begins a line with a
+ * capital letter); returns their count, at most max. */
+static size_t request_starts(const char *text, size_t size, const char **starts, size_t max)
+{
+    size_t n = 0;
+    for (size_t i = 0; i < size; i++)
+        if ((i == 0 || text[i - 1] == '\n') && text[i] >= 'A' && text[i] <= 'Z' && n < max)
+            starts[n++] = text + i;
+    return n;
+}
+
+static RayesError w_motion_end(void *t)
+{
+    RibWriter *w = t;
+    if (!w->motion_n)
+        return fail(w, RAYES_ERROR_INVALID_OPERATION, "motion end: no motion block");
+    size_t n = w->motion_n;
+    w->motion_n = 0;
+    w->world.f = w->world_f;
+    if (fflush(w->motion.f) != 0)
+        return fail(w, RAYES_ERROR_OUT_OF_MEMORY, "out of memory");
+    const char *text = w->motion.buf, *end = text + w->motion.size;
+    size_t cap = w->motion.size / 2 + 2;
+    const char **starts = malloc((cap + 1) * sizeof *starts);
+    if (!starts)
+        return fail(w, RAYES_ERROR_OUT_OF_MEMORY, "out of memory");
+    size_t total = request_starts(text, w->motion.size, starts, cap);
+    starts[total] = end;
+    size_t per = total / n;
+    if (total == 0 || total % n != 0) {
+        free(starts);
+        return fail(w, RAYES_ERROR_INVALID_ARGUMENT,
+                    "motion end: the samples wrote %zu requests, not a multiple of %zu", total, n);
+    }
+    for (size_t j = 0; j < per; j++) {
+        motion_times(w->world.f, n, w->motion_time);
+        for (size_t k = 0; k < n; k++) {
+            const char *a = starts[k * per + j], *b = starts[k * per + j + 1];
+            fwrite(a, 1, (size_t)(b - a), w->world.f);
+        }
+        fprintf(w->world.f, "MotionEnd\n");
+    }
+    free(starts);
     return RAYES_OK;
 }
 
@@ -1103,6 +1248,13 @@ IoSink io_rib_writer_sink(RibWriter *w)
         .object_begin = w_object_begin,
         .object_end = w_object_end,
         .object_instance = w_object_instance,
+        .set_shutter = w_set_shutter,
+        .set_transform_motion = w_set_transform_motion,
+        .motion_begin = w_motion_begin,
+        .motion_end = w_motion_end,
+        .set_camera_motion = w_set_camera_motion,
+        .set_depth_of_field = w_set_depth_of_field,
+        .set_dice_blur = w_set_dice_blur,
     };
 }
 
@@ -1184,6 +1336,10 @@ RayesError io_rib_writer_finish(RibWriter *w, const IoSettings *s, FILE *out, ch
         }
     }
     fwrite(w->options.buf, 1, w->options.size, out);
+    if (w->shutter[1] > w->shutter[0])
+        fprintf(out, "Shutter %.9g %.9g\n", (double)w->shutter[0], (double)w->shutter[1]);
+    if (w->lens[0] > 0.0f) /* fstop 1: a focal length of the lens's diameter */
+        fprintf(out, "DepthOfField 1 %.9g %.9g\n", 2.0 * w->lens[0], (double)w->lens[1]);
     if (w->fov_y > 0.0f)
         fprintf(out, "Projection \"perspective\" \"fov\" [%.9g]\n", rib_fov(w, s));
     fwrite(w->camera.buf, 1, w->camera.size, out);

@@ -167,6 +167,43 @@ static RayesError scene_object_instance(void *t, const char *name)
     return rayes_scene_object_instance(t, name);
 }
 
+static RayesError scene_set_shutter(void *t, float open, float close)
+{
+    return rayes_scene_set_shutter(t, open, close);
+}
+
+static RayesError scene_set_transform_motion(void *t, size_t n, const float *times,
+                                             const float (*m)[16])
+{
+    return rayes_scene_set_transform_motion(t, n, times, m);
+}
+
+static RayesError scene_motion_begin(void *t, size_t n, const float *times)
+{
+    return rayes_scene_motion_begin(t, n, times);
+}
+
+static RayesError scene_motion_end(void *t)
+{
+    return rayes_scene_motion_end(t);
+}
+
+static RayesError scene_set_camera_motion(void *t, size_t n, const float *times,
+                                          const float (*m)[16])
+{
+    return rayes_scene_set_camera_motion(t, n, times, m);
+}
+
+static RayesError scene_set_depth_of_field(void *t, float lens_radius, float focal_distance)
+{
+    return rayes_scene_set_depth_of_field(t, lens_radius, focal_distance);
+}
+
+static RayesError scene_set_dice_blur(void *t, float motionfactor, float focusfactor)
+{
+    return rayes_scene_set_dice_blur(t, motionfactor, focusfactor);
+}
+
 IoSink io_sink_scene(RayesScene *scene)
 {
     return (IoSink){
@@ -200,6 +237,13 @@ IoSink io_sink_scene(RayesScene *scene)
         .object_begin = scene_object_begin,
         .object_end = scene_object_end,
         .object_instance = scene_object_instance,
+        .set_shutter = scene_set_shutter,
+        .set_transform_motion = scene_set_transform_motion,
+        .motion_begin = scene_motion_begin,
+        .motion_end = scene_motion_end,
+        .set_camera_motion = scene_set_camera_motion,
+        .set_depth_of_field = scene_set_depth_of_field,
+        .set_dice_blur = scene_set_dice_blur,
     };
 }
 

@@ -97,6 +97,18 @@ typedef struct IoSink {
     RayesError (*object_begin)(void *target, const char *name);
     RayesError (*object_end)(void *target);
     RayesError (*object_instance)(void *target, const char *name);
+    /* Time (rayes.h's motion blur and depth of field calls; last, so older
+     * sinks leave them NULL: readers then use the first motion sample and
+     * a pinhole, with one warning). */
+    RayesError (*set_shutter)(void *target, float open, float close);
+    RayesError (*set_transform_motion)(void *target, size_t n_times, const float *times,
+                                       const float (*world_from_object)[16]);
+    RayesError (*motion_begin)(void *target, size_t n_times, const float *times);
+    RayesError (*motion_end)(void *target);
+    RayesError (*set_camera_motion)(void *target, size_t n_times, const float *times,
+                                    const float (*camera_from_world)[16]);
+    RayesError (*set_depth_of_field)(void *target, float lens_radius, float focal_distance);
+    RayesError (*set_dice_blur)(void *target, float motionfactor, float focusfactor);
 } IoSink;
 
 /* A sink that builds scene through rayes.h (borrowed, not retained). */

@@ -251,6 +251,8 @@ int hider_camera_hit(Worker *w, const Ray *ray, const Hit *hit, Vec3 *L)
     (void)ray;
     GridShading *gsh = w->grid_shading;
     uint32_t gi = hit->grid;
+    if (w->rs->gs->grids[gi].moving)
+        return 0; /* shaded where the ray finds it, at its time */
     GridSlot *slot = grid_slot(gsh, gi, hit->instance);
     Rgb *ci = atomic_load_explicit(slot, memory_order_acquire);
     if (!ci) {
@@ -258,7 +260,12 @@ int hider_camera_hit(Worker *w, const Ray *ray, const Hit *hit, Vec3 *L)
         pthread_mutex_lock(lock);
         ci = atomic_load_explicit(slot, memory_order_acquire);
         if (!ci) {
+            /* a still grid's shading is shared by every time: its rays leave
+             * at the shutter's middle, whichever ray came first */
+            float outer = w->time;
+            w->time = 0.5f * (w->rs->camera.shutter[0] + w->rs->camera.shutter[1]);
             ci = shade_grid(w, gi, hit->instance);
+            w->time = outer;
             atomic_store_explicit(slot, ci, memory_order_release);
         }
         pthread_mutex_unlock(lock);

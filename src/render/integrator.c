@@ -47,13 +47,15 @@ static int hit_point(const Worker *w, const Ray *ray, const Hit *hit, const Rend
     const Grid *g = &gs->grids[hit->grid];
     Vec3 N = v3(0, 0, 0), du = N, dv = N, Cs = N, Os = N, dflt = v3_load(obj->Cs);
     Vec3 Os_obj = v3_load(obj->Os);
-    float u = 0.0f, v = 0.0f, st[2] = {0, 0}, dst[4] = {0, 0, 0, 0};
+    float u = 0.0f, v = 0.0f, st[2] = {0, 0}, dst[4] = {0, 0, 0, 0}, f;
+    int seg = geom_motion_segment(gs, ray->time, &f); /* a moving grid: where it is then */
     for (int k = 0; k < hit->n_vertex; k++) {
         uint32_t i = hit->vertex[k];
         float wk = hit->weight[k], sti[2], dsti[4];
-        N = v3_madd(N, geom_vertex_normal(gs, g, i), wk);
-        du = v3_madd(du, gs->dPdu[i], wk);
-        dv = v3_madd(dv, gs->dPdv[i], wk);
+        GeomVertex gv = geom_vertex_at(gs, g, i, seg, f);
+        N = v3_madd(N, (g->primvars & GEOM_PV_N) ? gs->Ns[i] : gv.N, wk);
+        du = v3_madd(du, gv.dPdu, wk);
+        dv = v3_madd(dv, gv.dPdv, wk);
         u += gs->uv[i][0] * wk;
         v += gs->uv[i][1] * wk;
         Cs = v3_madd(Cs, geom_vertex_color(gs, g, i, dflt), wk);
@@ -150,7 +152,7 @@ static Vec3 shade_hit(Worker *w, const Ray *ray, const Hit *hit, const RenderObj
     if (kind == RAYES_RAY_SUBSURFACE)
         face_outside(&hp, &backfacing);
     hp.key = key;
-    hp.diff = (RayDiff){diff.width + diff.spread * hit->t, diff.spread};
+    hp.diff = (RayDiff){path_footprint(diff, hit->t), diff.spread};
     hit_footprint(&hp);
     path_st_footprint(hp.dst, hp.du, hp.dv, &hp.ds, &hp.dt);
     int own_st = (w->rs->gs->grids[hit->grid].primvars & GEOM_PV_ST) != 0;
@@ -353,8 +355,10 @@ static Vec3 trace_volumes(Worker *w, const Ray *ray, uint32_t kind, int diffuse_
 Vec3 integrator_trace(Worker *w, const Ray *ray, uint32_t kind, int diffuse_depth,
                       int specular_depth, uint64_t key, RayDiff diff, float *alpha)
 {
-    float t, a;
+    float t, a, outer = w->time;
+    w->time = ray->time; /* what the hit's shading traces inherits */
     Vec3 L = trace_volumes(w, ray, kind, diffuse_depth, specular_depth, key, diff, &t, &a);
+    w->time = outer;
     if (alpha)
         *alpha = a;
     return L;
@@ -363,6 +367,9 @@ Vec3 integrator_trace(Worker *w, const Ray *ray, uint32_t kind, int diffuse_dept
 Vec3 integrator_trace_hit(Worker *w, const Ray *ray, uint32_t kind, int diffuse_depth,
                           int specular_depth, uint64_t key, RayDiff diff, float *t)
 {
-    float a;
-    return trace_volumes(w, ray, kind, diffuse_depth, specular_depth, key, diff, t, &a);
+    float a, outer = w->time;
+    w->time = ray->time;
+    Vec3 L = trace_volumes(w, ray, kind, diffuse_depth, specular_depth, key, diff, t, &a);
+    w->time = outer;
+    return L;
 }

@@ -51,7 +51,7 @@ static void make_record(const PathState *ps, const IrrGrid *irr, size_t k, int M
             float xi1 = rng_float(hash_combine(key, 2 * (uint64_t)c));
             float xi2 = rng_float(hash_combine(key, 2 * (uint64_t)c + 1));
             Ray ray = {o, irr_direction(M, N, j, q, xi1, xi2, n), 0.0f, INFINITY,
-                       RAYES_RAY_DIFFUSE};
+                       RAYES_RAY_DIFFUSE, w->time};
             w->stats.rays_diffuse++;
             L[c] = integrator_trace_hit(w, &ray, RAYES_RAY_DIFFUSE, 1, 0,
                                         hash_combine(key, (uint64_t)c + 1), diff, &r[c]);

@@ -17,7 +17,21 @@
 typedef struct RayDiff {
     float width;   /* at the origin, scene units */
     float spread;  /* radians */
+    float lens;    /* a camera ray through a thin lens: the lens's diameter (0: none); the
+                      beam of the pixel's rays through the whole lens is lens * |t - focus|
+                      / focus wide at t, added to the footprint (render_camera_ray_at) */
+    float focus;   /* where that beam converges, in units of the ray's |d| */
 } RayDiff;
+
+/* The footprint of a ray at distance t (units of |d|): its width plus t
+ * times its spread, plus a thin lens's defocus. */
+static inline float path_footprint(RayDiff d, float t)
+{
+    float f = d.width + d.spread * t;
+    if (d.lens > 0.0f && d.focus > 0.0f)
+        f += d.lens * fabsf(t - d.focus) / d.focus;
+    return f;
+}
 
 typedef struct GridShading GridShading;
 
@@ -28,6 +42,9 @@ typedef struct Worker {
     CacheLocal cache;             /* this thread's part of the radiosity cache */
     GridShading *grid_shading; /* the grid hider's shaded grids, or NULL (hider.h) */
     const RayesShaderServices *services; /* what shaders run here call (services.h) */
+    float time;                   /* the time of the ray being shaded (scene time): rays the
+                                     shading traces take it (integrator_trace sets and restores
+                                     it; a cache fill sets its segment's middle) */
 } Worker;
 
 /* What a shading context's `renderer` points to: per point (indexed from

@@ -187,7 +187,7 @@ typedef struct FillPoints {
  * colour and opacity are the object's unless the grid has its own. */
 static void put_point(const GridSet *gs, const Grid *g, FillPoints *fp, size_t p,
                       const uint32_t *vtx, const float *wt, int nv, int side,
-                      const RenderObject *obj, const GeomInstance *gi)
+                      const RenderObject *obj, const GeomInstance *gi, int segment)
 {
     Vec3 P = v3(0, 0, 0), N = P, Ng = P, du = P, dv = P, Cs = P, Os = P;
     Vec3 Cs_obj = v3_load(obj->Cs), Os_obj = v3_load(obj->Os);
@@ -195,11 +195,12 @@ static void put_point(const GridSet *gs, const Grid *g, FillPoints *fp, size_t p
     for (int k = 0; k < nv; k++) {
         uint32_t i = g->first_vertex + vtx[k];
         float sti[2], dsti[4];
-        P = v3_madd(P, gs->P[i], wt[k]);
-        N = v3_madd(N, geom_vertex_normal(gs, g, i), wt[k]);
-        Ng = v3_madd(Ng, gs->N[i], wt[k]);
-        du = v3_madd(du, gs->dPdu[i], wt[k]);
-        dv = v3_madd(dv, gs->dPdv[i], wt[k]);
+        GeomVertex gv = geom_vertex_at(gs, g, i, segment, 0.5f); /* the segment's middle */
+        P = v3_madd(P, gv.P, wt[k]);
+        N = v3_madd(N, (g->primvars & GEOM_PV_N) ? gs->Ns[i] : gv.N, wt[k]);
+        Ng = v3_madd(Ng, gv.N, wt[k]);
+        du = v3_madd(du, gv.dPdu, wt[k]);
+        dv = v3_madd(dv, gv.dPdv, wt[k]);
         u += gs->uv[i][0] * wt[k];
         v += gs->uv[i][1] * wt[k];
         Cs = v3_madd(Cs, geom_vertex_color(gs, g, i, Cs_obj), wt[k]);
@@ -235,7 +236,8 @@ static void put_point(const GridSet *gs, const Grid *g, FillPoints *fp, size_t p
 
 /* Positions of the level's points on the fine grid. */
 static void layout_points(const GridSet *gs, const Grid *g, int level, int side,
-                          const RenderObject *obj, const GeomInstance *gi, FillPoints *fp)
+                          const RenderObject *obj, const GeomInstance *gi, int segment,
+                          FillPoints *fp)
 {
     size_t p = 0;
     if (!g->triangular) {
@@ -246,7 +248,7 @@ static void layout_points(const GridSet *gs, const Grid *g, int level, int side,
                 int fi = quad_level_index(level, i, nu), fj = quad_level_index(level, j, nv);
                 uint32_t vtx = (uint32_t)(fj * nu + fi);
                 float one = 1.0f;
-                put_point(gs, g, fp, p++, &vtx, &one, 1, side, obj, gi);
+                put_point(gs, g, fp, p++, &vtx, &one, 1, side, obj, gi, segment);
             }
         return;
     }
@@ -260,7 +262,7 @@ static void layout_points(const GridSet *gs, const Grid *g, int level, int side,
             uint32_t vtx[3];
             for (int k = 0; k < 3; k++)
                 vtx[k] = geom_tri_vertex((uint32_t)n, (uint32_t)vi[k][0], (uint32_t)vi[k][1]);
-            put_point(gs, g, fp, p++, vtx, wt, 3, side, obj, gi);
+            put_point(gs, g, fp, p++, vtx, wt, 3, side, obj, gi, segment);
         }
 }
 
@@ -343,7 +345,7 @@ static void fill_radiosity(void *user, const CacheKey *key, size_t n, float (*ou
     fp.u = f1, fp.v = f1 + n, fp.du = f1 + 2 * n, fp.dv = f1 + 3 * n, fp.curv = f1 + 4 * n;
     fp.offset = f1 + 5 * n, fp.s = f1 + 6 * n, fp.t = f1 + 7 * n, fp.ds = f1 + 8 * n;
     fp.dt = f1 + 9 * n, fp.dst = (float(*)[4])(f1 + 10 * n);
-    layout_points(gs, g, key->level, key->side, obj, gi, &fp);
+    layout_points(gs, g, key->level, key->side, obj, gi, key->segment, &fp);
     uint64_t fill_key = hash_combine(hash_combine(w->set->seed, 0x7261646f73ull /* "rados" */),
                                      ((uint64_t)key->patch << 32) | ((uint64_t)key->depth << 16) |
                                          ((uint64_t)key->side << 8) | key->level);
@@ -351,6 +353,15 @@ static void fill_radiosity(void *user, const CacheKey *key, size_t n, float (*ou
         fill_key = hash_combine(fill_key, 0x69727261ull /* "irra" */);
     if (key->instance) /* each instance its own numbers; uninstanced keys as before */
         fill_key = hash_combine(fill_key, key->instance);
+    if (key->segment)
+        fill_key = hash_combine(fill_key, key->segment);
+    /* A moving grid is shaded at its segment's middle, a still one at the
+     * shutter's: its rays leave then, whichever ray's lookup filled it
+     * (DESIGN.md "Motion blur"). */
+    float outer_time = w->time;
+    const Camera *cam = &w->rs->camera;
+    w->time = g->moving ? geom_segment_mid_time(gs, key->segment)
+                        : 0.5f * (cam->shutter[0] + cam->shutter[1]);
     float width = level_edge(g, key->level) * scale, du, dv;
     level_footprint(g, key->level, &du, &dv);
     for (size_t i = 0; i < n; i++) {
@@ -389,7 +400,10 @@ static void fill_radiosity(void *user, const CacheKey *key, size_t n, float (*ou
     };
     path_apply_Os_pattern(w, obj, &ctx, fp.Os);
     w->stats.instance_fills += key->instance != 0 && key->type == CACHE_RADIOSITY;
+    if (g->moving && key->type == CACHE_RADIOSITY)
+        w->stats.segment_fills[key->segment]++;
     fill_run(w, key->type, &ctx, obj, &fp, f3 + 9 * n, out);
+    w->time = outer_time;
     free(f3);
     free(f1);
     free(fp.keys);
@@ -451,16 +465,20 @@ Vec3 radiosity_interpolate(const Grid *g, const Hit *hit, int level, const uint1
 }
 
 /* The cached value of a type at a hit. */
-static Vec3 cached_at_hit(Worker *w, const Hit *hit, int type, int depth, int side, RayDiff diff)
+static Vec3 cached_at_hit(Worker *w, const Hit *hit, int type, int depth, int side, RayDiff diff,
+                          float time)
 {
-    const Grid *g = &w->rs->gs->grids[hit->grid];
+    const GridSet *gs = w->rs->gs;
+    const Grid *g = &gs->grids[hit->grid];
     const GeomInstance *gi = render_instance(w->rs, hit->instance);
+    float f;
+    int segment = g->moving ? geom_motion_segment(gs, time, &f) : 0; /* memo 3.2 */
     /* the footprint in the grid's units (a master's, through an instance) */
-    float footprint = (diff.width + diff.spread * hit->t) / (gi ? gi->scale : 1.0f);
+    float footprint = path_footprint(diff, hit->t) / (gi ? gi->scale : 1.0f);
     int level = radiosity_choose_level(g, footprint, w->set->cache_k, w->set->cache_resolution);
     CacheKey key = {.patch = hit->grid,
                     .depth = (uint16_t)depth,
-                    .segment = 0,
+                    .segment = (uint8_t)segment,
                     .side = (uint8_t)side,
                     .type = (uint8_t)type,
                     .level = (uint8_t)level,
@@ -474,19 +492,20 @@ static Vec3 cached_at_hit(Worker *w, const Hit *hit, int type, int depth, int si
 Vec3 radiosity_at_hit(Worker *w, const Ray *ray, const Hit *hit, int diffuse_depth, RayDiff diff)
 {
     int side = v3_dot(hit->Ng, ray->d) < 0.0f ? 0 : 1;
-    return cached_at_hit(w, hit, CACHE_RADIOSITY, diffuse_depth, side, diff);
+    return cached_at_hit(w, hit, CACHE_RADIOSITY, diffuse_depth, side, diff, ray->time);
 }
 
 Vec3 radiosity_irradiance_at_hit(Worker *w, const Ray *ray, const Hit *hit, float footprint)
 {
     /* The outside: the side the ray leaves the object through. */
     int side = v3_dot(hit->Ng, ray->d) < 0.0f ? 1 : 0;
-    return cached_at_hit(w, hit, CACHE_IRRADIANCE, 0, side, (RayDiff){footprint, 0.0f});
+    return cached_at_hit(w, hit, CACHE_IRRADIANCE, 0, side, (RayDiff){footprint, 0.0f},
+                         ray->time);
 }
 
 Vec3 radiosity_opacity_at_hit(Worker *w, const Hit *hit, RayDiff diff)
 {
     /* The memo's assumption: one opacity per point, whatever the side and
      * the depth. */
-    return cached_at_hit(w, hit, CACHE_OPACITY, 0, 0, diff);
+    return cached_at_hit(w, hit, CACHE_OPACITY, 0, 0, diff, w->time);
 }

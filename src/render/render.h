@@ -61,6 +61,14 @@ typedef struct Camera {
     float screen[4];              /* left, right, bottom, top of the image on the screen */
     float pixel_spread;           /* radians between neighbouring camera rays (perspective) */
     float pixel_width;            /* world units between neighbouring rays (orthographic) */
+    float shutter[2];             /* open, close: camera rays' times (scene time) */
+    float lens_radius;            /* thin lens, world units; 0: a pinhole */
+    float focal_distance;         /* along z from the eye (world units: z is unit length in
+                                     focal_distance's measure, see render_camera_ray) */
+    int n_motion;                 /* camera motion: time samples (0 or 1: still) */
+    float motion_time[GEOM_MAX_TIMES];
+    Vec3 motion_eye[GEOM_MAX_TIMES], motion_x[GEOM_MAX_TIMES], motion_y[GEOM_MAX_TIMES];
+    Vec3 motion_z[GEOM_MAX_TIMES];
 } Camera;
 
 typedef struct RenderScene {
@@ -158,6 +166,8 @@ typedef struct RenderStats {
                                    and uncached subsurface hits) */
     uint64_t instance_fills;    /* radiosity cache fills of grids seen through object instances
                                    (each instance fills its own entries) */
+    uint64_t segment_fills[GEOM_MAX_TIMES - 1]; /* radiosity cache fills of moving grids, by
+                                                   motion segment (the entries each made) */
 } RenderStats;
 
 /* The camera of an image of `height` pixels: eye, axes and tan(fov / 2)
@@ -168,6 +178,15 @@ Camera render_camera(Vec3 eye, Vec3 x, Vec3 y, Vec3 z, float tan_half_fov, const
 /* The camera ray through image position (x, y) of a width x height image
  * (pixels, from the top left corner). */
 Ray render_camera_ray(const RenderScene *rs, int width, int height, float x, float y);
+
+/* The camera ray through (x, y) at a time (the camera where it is then)
+ * and lens position (lu, lv) in [0, 1)^2 (with a thin lens). *lens and
+ * *focus receive the lens's diameter and the distance along the unit ray
+ * to the plane of focus (0 for a pinhole), for RayDiff's defocus term;
+ * render_camera_ray is the ray at the shutter's opening through the lens's
+ * centre. */
+Ray render_camera_ray_at(const RenderScene *rs, int width, int height, float x, float y,
+                         float time, float lu, float lv, float *lens, float *focus);
 
 /* Renders a frame into rgba (width * height * 4 floats, top row first) and
  * adds to stats. Returns 0, or 1 if the progress callback or set->cancel

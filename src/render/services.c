@@ -67,13 +67,13 @@ static Vec3 transmittance(Worker *w, Vec3 o, Vec3 wi, float dist, RayDiff diff)
 {
     Ray shadow;
     if (isinf(dist)) {
-        shadow = (Ray){o, wi, path_ray_epsilon(w), INFINITY, RAYES_RAY_SHADOW};
+        shadow = (Ray){o, wi, path_ray_epsilon(w), INFINITY, RAYES_RAY_SHADOW, w->time};
     } else {
         /* tnear skips surfaces through the origin itself: a grid vertex on a
          * corner line (a floor vertex against a wall) lies in the other
          * surface's plane, and would shadow itself. */
         shadow = (Ray){o, v3_scale(wi, dist), path_ray_epsilon(w) / dist, 1.0f - 1e-4f,
-                       RAYES_RAY_SHADOW};
+                       RAYES_RAY_SHADOW, w->time};
         diff.spread *= dist; /* per unit of the ray's parameter, which spans dist */
     }
     return integrator_transmission(w, &shadow, diff);
@@ -434,7 +434,7 @@ static void svc_indirect_diffuse(const RayesShaderServices *sv, const RayesShade
             Vec3 d = sample_cosine_hemisphere(N, a, b);
             if (v3_dot(d, Ng) <= 0.0f)
                 continue; /* below the geometric surface: no light from there */
-            Ray ray = {o, d, 0.0f, INFINITY, RAYES_RAY_DIFFUSE};
+            Ray ray = {o, d, 0.0f, INFINITY, RAYES_RAY_DIFFUSE, w->time};
             w->stats.rays_diffuse++;
             Vec3 L = integrator_trace(w, &ray, RAYES_RAY_DIFFUSE, depth + 1, ctx->specular_depth,
                                       hash_combine(key, (uint64_t)s + 1), diff, NULL);
@@ -472,7 +472,7 @@ static Vec3 trace_specular(const RayesShadeCtx *ctx, size_t i, Vec3 d, uint64_t 
     /* A mirror keeps the spread and adds the curvature's share. */
     float width = ps->diff[j].width;
     RayDiff diff = {width, ps->diff[j].spread + 2.0f * ps->curvature[j] * width};
-    Ray ray = {o, d, path_ray_epsilon(w), INFINITY, RAYES_RAY_SPECULAR};
+    Ray ray = {o, d, path_ray_epsilon(w), INFINITY, RAYES_RAY_SPECULAR, w->time};
     w->stats.rays_specular++;
     return integrator_trace(w, &ray, kind, ctx->diffuse_depth, ctx->specular_depth + 1, key, diff,
                             NULL);
@@ -607,7 +607,8 @@ static void svc_transmission(const RayesShaderServices *sv, const RayesShadeCtx 
             Vec3 o = v3_madd(P, Ng, v3_dot(d, Ng) >= 0.0f ? off : -off);
             Vec3 wi = v3_sub(v3_load(to[i]), o);
             float dist = v3_length(wi);
-            Ray shadow = {o, wi, path_ray_epsilon(w) / dist, 1.0f - 1e-4f, RAYES_RAY_SHADOW};
+            Ray shadow = {o, wi, path_ray_epsilon(w) / dist, 1.0f - 1e-4f, RAYES_RAY_SHADOW,
+                          w->time};
             RayDiff diff = shadow_diff(ps, point(ctx, i), 1);
             diff.spread *= dist;
             vis = integrator_transmission(w, &shadow, diff);
@@ -640,7 +641,7 @@ static void svc_occlusion(const RayesShaderServices *sv, const RayesShadeCtx *ct
             counted++;
             if (v3_dot(d, Ng) <= 0.0f)
                 continue; /* below the geometric surface: blocked */
-            Ray ray = {o, d, 0.0f, far, RAYES_RAY_SHADOW};
+            Ray ray = {o, d, 0.0f, far, RAYES_RAY_SHADOW, w->time};
             open = v3_add(open, integrator_transmission(w, &ray, diff));
         }
         Vec3 occ = counted ? v3_sub(v3(1, 1, 1), v3_scale(open, 1.0f / counted)) : v3(0, 0, 0);

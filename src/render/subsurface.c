@@ -72,7 +72,7 @@ typedef struct SubsurfacePoint {
 static Vec3 probe_point(Worker *w, const Medium *m, const SubsurfacePoint *sp)
 {
     Vec3 in = v3_neg(sp->N), o = v3_madd(sp->P, sp->Ng, -sp->offset);
-    Ray ray = {o, in, 0.0f, INFINITY, RAYES_RAY_SUBSURFACE};
+    Ray ray = {o, in, 0.0f, INFINITY, RAYES_RAY_SUBSURFACE, w->time};
     Hit hit;
     w->stats.rays_subsurface++;
     float back = accel_intersect_object(w->rs->accel, sp->object, &ray, &hit) ? hit.t : INFINITY;
@@ -98,7 +98,7 @@ static Vec3 integrate_point(Worker *w, const Medium *m, const SubsurfacePoint *s
     for (int s = 0; s < n; s++) {
         float a, b;
         cmj_sample_2d((uint32_t)s, (uint32_t)n, (uint32_t)sp->key, &a, &b);
-        Ray ray = {c, sphere_direction(a, b), 0.0f, INFINITY, RAYES_RAY_SUBSURFACE};
+        Ray ray = {c, sphere_direction(a, b), 0.0f, INFINITY, RAYES_RAY_SUBSURFACE, w->time};
         Hit hit;
         w->stats.rays_subsurface++;
         if (!accel_intersect_object(w->rs->accel, sp->object, &ray, &hit))

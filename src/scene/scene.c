@@ -109,6 +109,8 @@ void rayes_scene_release(RayesScene *s)
     free(s->links);
     free(s->objects);
     free(s->prims);
+    free(s->motions);
+    free(s->motion_prims);
     for (size_t i = 0; i < s->n_subdivs; i++)
         geom_subdiv_free(s->subdivs[i]);
     free(s->subdivs);
@@ -213,6 +215,7 @@ RayesError rayes_scene_set_transform(RayesScene *s, const float m[16])
         return fail(s, RAYES_ERROR_INVALID_ARGUMENT,
                     "transform: expected a finite, invertible matrix");
     s->world_from_object = mat4_from_array(m);
+    s->current_motion = 0;
     return RAYES_OK;
 }
 
@@ -435,6 +438,9 @@ static RayesError add_prim(RayesScene *s, Prim *p)
     if ((p->pv & GEOM_PV_OS) && s->pv_Os_below_1 && p->object != GEOM_OBJECT_INHERIT)
         s->objects[p->object].Os_primvar_below_1 = 1;
     p->shading_rate = s->shading_rate;
+    p->motion = s->current_motion;
+    p->motionfactor = s->motionfactor;
+    p->focusfactor = s->focusfactor;
     p->displacement = s->current_displacement;
     p->displacement_bound = s->displacement_bound;
     s->prims[s->n_prims++] = *p;
@@ -1134,13 +1140,22 @@ static size_t dice_all(const RayesScene *s, const DiceCamera *cams, size_t budge
         const DiceCamera *cam = &cams[s->prims[i].master];
         if (cam->grid_size < 0)
             continue;
-        if (geom_dice_prim(gs, &s->prims[i], (uint32_t)i, s->pv, cam) != 0)
+        Prim blurred = s->prims[i];
+        float coarser = scene_blur_dice_factor(s, i, cam);
+        blurred.shading_rate *= coarser * coarser; /* a rate is an area */
+        if (geom_dice_prim(gs, &blurred, (uint32_t)i, s->pv, cam) != 0)
             return (size_t)-1;
         if (budget && gs->n_vertices > budget) {
             size_t total = gs->n_vertices;
-            for (size_t k = i + 1; k < s->n_prims; k++)
-                if (cams[s->prims[k].master].grid_size >= 0)
-                    total += geom_count_prim(&s->prims[k], &cams[s->prims[k].master]);
+            for (size_t k = i + 1; k < s->n_prims; k++) {
+                const DiceCamera *ck = &cams[s->prims[k].master];
+                if (ck->grid_size < 0)
+                    continue;
+                Prim later = s->prims[k];
+                float c = scene_blur_dice_factor(s, k, ck);
+                later.shading_rate *= c * c;
+                total += geom_count_prim(&later, ck);
+            }
             return total;
         }
         /* Normals of displaced surfaces: differences over 1e-3 of the scene radius.
@@ -1199,7 +1214,7 @@ int scene_prepare(const RayesScene *s, int width, int height, const DiceOptions 
     }
     float rate_scale = cams[0].rate_scale;
     free(cams);
-    if (geom_stitch(gs, s->prims) != 0)
+    if (geom_stitch(gs, s->prims) != 0 || scene_motion_prepare(s, gs) != 0)
         return -1;
     if (first_need)
         log_warning("dicing: the scene needs %zu grid vertices, more than the budget of %zu "

@@ -113,7 +113,28 @@ typedef struct SceneCamera {
     int fov_vertical;         /* rayes_scene_set_camera: the fov spans the image height */
     int has_screen;           /* screen[] given; else the default of the aspect ratio */
     float screen[4];          /* left, right, bottom, top */
+    float lens_radius;        /* depth of field: the thin lens's radius, world units; 0: pinhole */
+    float focal_distance;     /* the plane in focus, world units along z from the eye */
+    int n_motion;             /* camera motion: time samples (0 or 1: still) */
+    float motion_time[GEOM_MAX_TIMES];   /* increasing, scene time */
+    Vec3 motion_eye[GEOM_MAX_TIMES];     /* eye and axes at each time */
+    Vec3 motion_x[GEOM_MAX_TIMES], motion_y[GEOM_MAX_TIMES], motion_z[GEOM_MAX_TIMES];
 } SceneCamera;
+
+/* A primitive's motion (motion.c): its time samples and, for a moving
+ * transform, the motion of world space from the first sample to each; for
+ * deformation, its shapes at the later samples (RayesScene.motion_prims). */
+typedef struct SceneMotion {
+    int n_times;
+    float time[GEOM_MAX_TIMES];  /* increasing, scene time */
+    int deform;                  /* 1: deformation blur; 0: transform blur */
+    Mat4 delta[GEOM_MAX_TIMES];  /* transform blur: world_from_object(time k) times
+                                    object_from_world(time 0) */
+    size_t first_prim;           /* deformation: the scene's prim of time 0 first */
+    size_t n_prims;              /* deformation: prims per time sample */
+    size_t first;                /* deformation: motion_prims index of time 1's first prim;
+                                    time k's prim j is first + (k - 1) n_prims + j */
+} SceneMotion;
 
 /* The screen window of the camera for an image of width x height pixels. */
 void scene_camera_screen(const SceneCamera *camera, int width, int height, float screen[4]);
@@ -176,6 +197,19 @@ struct RayesScene {
     int64_t open_master;    /* the master whose block is open, or -1 */
     SceneSaved saved;       /* the state before that block */
     uint64_t leaves;        /* flattened instances the world's instances make */
+    /* Time (motion.c): the shutter, motions and blur attributes. */
+    float shutter[2];              /* open and close, scene time (default 0 0: no blur) */
+    SceneMotion *motions;
+    size_t n_motions, cap_motions;
+    Prim *motion_prims;            /* deformation blur: primitives of later time samples */
+    size_t n_motion_prims, cap_motion_prims;
+    uint32_t current_motion;       /* transform motion of geometry added next: motions index
+                                      + 1, or 0 */
+    int deforming;                 /* inside motion_begin: n_times of the block, else 0 */
+    size_t deform_first;           /* the prim the block's first call added first */
+    float deform_time[GEOM_MAX_TIMES];
+    float motionfactor, focusfactor; /* dicing of blurred geometry added next (RenderMan's
+                                        "dice" attributes; 0: none) */
 };
 
 /* current_object inside a block before any shader: geometry inherits. */
@@ -252,6 +286,16 @@ void scene_patterns_free(RayesScene *scene);
 /* Whether light `light` illuminates object `object` (its light links);
  * 1 or 0. */
 int scene_object_lit_by(const RayesScene *scene, size_t object, size_t light);
+
+/* Motion blur at prepare (motion.c): fills gs's time samples (GridSet.Pt
+ * and the rest) for the scene's moving primitives, after dicing,
+ * displacement and stitching. Returns 0, or -1 when out of memory. */
+int scene_motion_prepare(const RayesScene *scene, GridSet *gs);
+
+/* The factor (>= 1) by which blur lengthens the micropolygon edges of the
+ * scene's primitive `index` (motionfactor and focusfactor, motion.c); cam
+ * is the dicing camera. */
+float scene_blur_dice_factor(const RayesScene *scene, size_t index, const DiceCamera *cam);
 
 /* For the scene's other files (curves.c): adds a primitive to the current
  * object; records the first error (printf-style) and returns e; appends n

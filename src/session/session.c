@@ -388,16 +388,34 @@ void session_prepared_fini(Prepared *p)
     memset(p, 0, sizeof *p);
 }
 
+/* The frame's camera: the still one, with the shutter, the lens and the
+ * camera's motion. */
+static Camera frame_camera(const RayesScene *scene, int width, int height)
+{
+    float screen[4];
+    const SceneCamera *c = &scene->camera;
+    scene_camera_screen(c, width, height, screen);
+    Camera cam = render_camera(c->eye, c->x, c->y, c->z, c->tan_half_fov, screen, height);
+    cam.shutter[0] = scene->shutter[0], cam.shutter[1] = scene->shutter[1];
+    cam.lens_radius = c->lens_radius;
+    cam.focal_distance = c->focal_distance;
+    cam.n_motion = c->n_motion;
+    for (int k = 0; k < c->n_motion; k++) {
+        cam.motion_time[k] = c->motion_time[k];
+        cam.motion_eye[k] = c->motion_eye[k];
+        cam.motion_x[k] = c->motion_x[k], cam.motion_y[k] = c->motion_y[k];
+        cam.motion_z[k] = c->motion_z[k];
+    }
+    return cam;
+}
+
 RenderScene session_render_scene(const RayesScene *scene, const Prepared *p, int width,
                                  int height)
 {
-    float screen[4];
-    scene_camera_screen(&scene->camera, width, height, screen);
     return (RenderScene){
         .gs = &p->gs, .accel = p->accel, .objects = p->objects, .n_objects = scene->n_objects,
         .lights = scene->lights, .n_lights = scene->n_lights,
-        .camera = render_camera(scene->camera.eye, scene->camera.x, scene->camera.y,
-                                scene->camera.z, scene->camera.tan_half_fov, screen, height),
+        .camera = frame_camera(scene, width, height),
         .scene_radius = p->scene_radius,
         .any_transparent = p->any_transparent,
         .volumes = p->volumes,

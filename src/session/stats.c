@@ -15,6 +15,7 @@ struct RayesStats {
     RayesStat items[MAX_STATS];
     size_t n;
     uint64_t by_depth[RENDER_MAX_DEPTH + 1];
+    uint64_t by_segment[GEOM_MAX_TIMES - 1];
 };
 
 static void count(RayesStats *s, const char *name, uint64_t v)
@@ -96,11 +97,25 @@ RayesStats *session_stats_new(const RenderSettings *set, const RenderStats *rs, 
     count(s, "subsurface/irradiance_points", rs->irradiance_points);
     count(s, "grids", gs->n_grids);
     count(s, "grid_vertices", gs->n_vertices);
+    /* Motion blur: the geometry's time samples, its moving grids, and the
+     * radiosity entries filled for them per motion segment. */
+    uint64_t moving = 0;
+    for (size_t g = 0; g < gs->n_grids; g++)
+        moving += gs->grids[g].moving;
+    int n_times = gs->n_times > 1 ? gs->n_times : 1;
+    count(s, "motion/time_samples", (uint64_t)n_times);
+    count(s, "motion/moving_grids", moving);
+    memcpy(s->by_segment, rs->segment_fills, sizeof s->by_segment);
+    if (s->n < MAX_STATS)
+        s->items[s->n++] = (RayesStat){.name = "motion/fills_by_segment",
+                                       .kind = RAYES_STAT_COUNTS, .counts = s->by_segment,
+                                       .n_counts = (size_t)(n_times > 1 ? n_times - 1 : 1)};
     count(s, "grid_size", (uint64_t)set->grid_size);
     count(s, "memory/peak_rss_bytes", mem_peak_rss_bytes());
     count(s, "memory/accel_bytes", accel_bytes);
     size_t geom_bytes = gs->n_vertices * (4 * sizeof(Vec3) + 2 * sizeof(float)) +
-                        gs->n_grids * sizeof(Grid);
+                        gs->n_grids * sizeof(Grid) +
+                        (size_t)(n_times - 1) * gs->n_motion_vertices * 4 * sizeof(Vec3);
     count(s, "memory/grid_bytes", geom_bytes);
     count(s, "resolution/width", (uint64_t)set->width);
     count(s, "resolution/height", (uint64_t)set->height);

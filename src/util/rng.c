@@ -96,3 +96,10 @@ void cmj_sample_2d(uint32_t s, uint32_t n, uint32_t p, float *x, float *y)
     *x = fminf(fx, 0x1.fffffep-1f);
     *y = fminf(fy, 0x1.fffffep-1f);
 }
+
+float stratified_1d(uint32_t s, uint32_t n, uint32_t p)
+{
+    uint32_t stratum = permute(s % n, n, p * 0x9e3779b9u);
+    float x = ((float)stratum + randfloat(s, p * 0x85ebca6bu)) / (float)n;
+    return x < 1.0f ? x : 0x1.fffffep-1f;
+}

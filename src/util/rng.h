@@ -40,6 +40,12 @@ static inline float rng_float(uint64_t key)
  * seed p (0 <= s < n). */
 void cmj_sample_2d(uint32_t s, uint32_t n, uint32_t p, float *x, float *y);
 
+/* The s-th of n stratified samples in [0, 1) for pattern seed p: stratum
+ * permute(s) of n, jittered (the strata shuffled against cmj_sample_2d's,
+ * so a pixel's time and lens samples are stratified with its positions but
+ * not correlated with them). */
+float stratified_1d(uint32_t s, uint32_t n, uint32_t p);
+
 /* Sample dimensions: the second argument of hash_combine when a key names
  * what a sample is for. */
 enum {
@@ -51,7 +57,9 @@ enum {
     DIM_REFRACTION = 6, /* refracted rays */
     DIM_SHADER = 7,     /* the random service: shaders' own choices */
     DIM_OCCLUSION = 8,  /* ambient occlusion rays */
-    DIM_SUBSURFACE = 9  /* subsurface rays from a probe point (memo 6.2) */
+    DIM_SUBSURFACE = 9, /* subsurface rays from a probe point (memo 6.2) */
+    DIM_TIME = 10,      /* camera rays' times in the shutter */
+    DIM_LENS = 11       /* camera rays' positions on the lens */
 };
 
 #endif /* RAYES_UTIL_RNG_H */

@@ -31,4 +31,24 @@ static inline Vec3 sample_cosine_hemisphere(Vec3 n, float u1, float u2)
     return v3_add(v3_add(v3_scale(t, x), v3_scale(bt, y)), v3_scale(n, z));
 }
 
+/* A point of the unit disk from [0,1)^2, by Shirley's concentric map
+ * (keeps stratification). */
+static inline void sample_concentric_disk(float u1, float u2, float *x, float *y)
+{
+    float a = 2.0f * u1 - 1.0f, b = 2.0f * u2 - 1.0f, r, phi;
+    if (a == 0.0f && b == 0.0f) {
+        *x = *y = 0.0f;
+        return;
+    }
+    if (fabsf(a) > fabsf(b)) {
+        r = a;
+        phi = (float)(M_PI / 4.0) * (b / a);
+    } else {
+        r = b;
+        phi = (float)(M_PI / 2.0) - (float)(M_PI / 4.0) * (a / b);
+    }
+    *x = r * cosf(phi);
+    *y = r * sinf(phi);
+}
+
 #endif /* RAYES_UTIL_SAMPLING_H */

@@ -55,6 +55,33 @@ static RayesError transform(void *t, const float m[16])
     return RAYES_OK;
 }
 
+/* Time: what the reader sends is finite and ordered. */
+static RayesError shutter(void *t, float open, float close)
+{
+    (void)t;
+    if (!(open <= close))
+        abort();
+    return RAYES_OK;
+}
+
+static RayesError motion(void *t, size_t n, const float *times, const float (*m)[16])
+{
+    (void)t;
+    if (n < 2 || n > RAYES_MAX_TIMES)
+        abort();
+    check_finite(times, n);
+    check_finite(m[0], 16 * n);
+    return RAYES_OK;
+}
+
+static RayesError lens(void *t, float radius, float focus)
+{
+    (void)t;
+    if (!(radius >= 0) || !(focus > 0))
+        abort();
+    return RAYES_OK;
+}
+
 /* The patterns defined so far in this input (the first MAX_PATTERNS). */
 #define MAX_PATTERNS 256
 static char patterns[MAX_PATTERNS][160];
@@ -230,7 +257,11 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
                                 .light = light,
                                 .get_error = error,
                                 .subdivision_mesh = subdiv,
-                                .pattern = pattern};
+                                .pattern = pattern,
+                                .set_shutter = shutter,
+                                .set_transform_motion = motion,
+                                .set_camera_motion = motion,
+                                .set_depth_of_field = lens};
     n_patterns = 0;
     IoSettings settings;
     io_settings_init(&settings);

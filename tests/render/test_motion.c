@@ -1,0 +1,438 @@
+/*
+ * Motion blur (DESIGN.md "Motion blur and depth of field"): a sphere moving
+ * across an orthographic view covers each pixel for the fraction of the
+ * shutter it spends there (the analytic time average); deformation blur of
+ * a moving patch renders the same bytes as transform blur of the same
+ * motion; cached radiosity with motion segments matches uncached (1% mean,
+ * 3% per 32 x 32 tile), is deterministic across thread counts, and fills
+ * one set of entries per segment; a camera moving past a still sphere
+ * blurs it as the sphere moving the other way would.
+ */
+#include <math.h>
+#include <string.h>
+
+#include "accel/accel.h"
+#include "geom/geom.h"
+#include "io/builtin.h"
+#include "io/sink.h"
+#include "rayes/rayes.h"
+#include "scene/scene.h"
+#include "test.h"
+
+#define W 96
+#define HALF 3.0f /* the orthographic screen spans [-HALF, HALF]^2 */
+
+static const float identity[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
+
+static void translate(float m[16], float x, float y, float z)
+{
+    memcpy(m, identity, sizeof identity);
+    m[3] = x, m[7] = y, m[11] = z;
+}
+
+/* An orthographic camera on the -z side looking along +z. */
+static void ortho_camera(RayesScene *s)
+{
+    float cam[16];
+    translate(cam, 0, 0, 5);
+    const float screen[4] = {-HALF, HALF, -HALF, HALF};
+    CHECK(rayes_scene_set_camera_matrix(s, cam, RAYES_PROJECTION_ORTHOGRAPHIC, 0, screen) ==
+          RAYES_OK);
+}
+
+static RayesImage *render(RayesScene *s, int spp, int threads, int cache, RayesStats **stats)
+{
+    CHECK(rayes_scene_commit(s) == RAYES_OK);
+    RayesRenderOptions o;
+    rayes_render_options_init(&o, RAYES_QUALITY_PREVIEW);
+    o.width = W, o.height = W, o.spp = spp, o.bounces = 0, o.threads = threads;
+    o.cache = cache;
+    RayesImage *img = NULL;
+    CHECK(rayes_render(s, &o, &img, stats) == RAYES_OK);
+    return img;
+}
+
+/* The fraction of the shutter [0, 1] a unit disk whose centre runs from
+ * (-1, 0) to (1, 0) covers point (x, y). */
+static double disk_time_coverage(double x, double y)
+{
+    if (fabs(y) >= 1.0)
+        return 0.0;
+    double h = sqrt(1.0 - y * y), lo = fmax(x - h, -1.0), hi = fmin(x + h, 1.0);
+    return hi > lo ? (hi - lo) / 2.0 : 0.0;
+}
+
+static void test_moving_sphere_coverage(void)
+{
+    RayesScene *s = rayes_scene_new();
+    ortho_camera(s);
+    CHECK(rayes_scene_set_shutter(s, 0.0f, 1.0f) == RAYES_OK);
+    float m[2][16];
+    translate(m[0], -1, 0, 0);
+    translate(m[1], 1, 0, 0);
+    const float times[2] = {0, 1};
+    CHECK(rayes_scene_set_transform_motion(s, 2, times, (const float(*)[16])m) == RAYES_OK);
+    CHECK(rayes_scene_sphere(s, 1.0f) == RAYES_OK);
+    RayesImage *img = render(s, 64, 2, 1, NULL);
+    double err = 0, worst = 0, sum = 0, want_sum = 0;
+    float px = 2 * HALF / W;
+    for (int y = 0; img && y < W; y++)
+        for (int x = 0; x < W; x++) {
+            double want = 0;
+            for (int j = 0; j < 4; j++) /* the pixel's mean over 4 x 4 points */
+                for (int i = 0; i < 4; i++)
+                    want += disk_time_coverage(-HALF + (x + (i + 0.5) / 4) * px,
+                                               HALF - (y + (j + 0.5) / 4) * px) /
+                            16;
+            double got = img->rgba[4 * (y * W + x) + 3];
+            err += fabs(got - want);
+            worst = fmax(worst, fabs(got - want));
+            sum += got, want_sum += want;
+        }
+    /* Time-averaged coverage keeps the disk's area, pi. */
+    CHECK_NEAR(sum * px * px, M_PI, 0.01 * M_PI);
+    CHECK_NEAR(want_sum * px * px, M_PI, 0.01 * M_PI);
+    CHECK(err / (W * W) < 0.01);
+    CHECK(worst < 0.15); /* 64 samples: a pixel's coverage within a few strata */
+    printf("  moving sphere: coverage %.4f (pi %.4f), mean |error| %.4f, worst %.3f\n",
+           sum * px * px, M_PI, err / (W * W), worst);
+    rayes_image_free(img);
+    rayes_scene_release(s);
+}
+
+/* A lit bilinear patch (4 x 2 units, facing the camera) moving from x = -1
+ * to x = 1: by its transform, or by its two shapes. */
+static RayesScene *patch_scene(int deform, float motionfactor)
+{
+    RayesScene *s = rayes_scene_new();
+    ortho_camera(s);
+    CHECK(rayes_scene_set_dice_blur(s, motionfactor, 0) == RAYES_OK);
+    CHECK(rayes_scene_set_shutter(s, 0.0f, 1.0f) == RAYES_OK);
+    RayesParam lp[2] = {{"from", RAYES_PARAM_COLOR, {0, 0, 0}, NULL},
+                        {"to", RAYES_PARAM_COLOR, {0.3f, 0.2f, 1}, NULL}};
+    CHECK(rayes_scene_light(s, "distantlight", lp, 2) == RAYES_OK);
+    const float times[2] = {0, 1};
+    float P[4][3] = {{-2, -1, 0}, {2, -1, 0}, {-2, 1, 0.5f}, {2, 1, 0.5f}};
+    if (!deform) {
+        float m[2][16];
+        translate(m[0], -1, 0, 0);
+        translate(m[1], 1, 0, 0);
+        CHECK(rayes_scene_set_transform_motion(s, 2, times, (const float(*)[16])m) == RAYES_OK);
+        CHECK(rayes_scene_bilinear_patch(s, P) == RAYES_OK);
+        return s;
+    }
+    CHECK(rayes_scene_motion_begin(s, 2, times) == RAYES_OK);
+    for (int k = 0; k < 2; k++) {
+        float Q[4][3];
+        memcpy(Q, P, sizeof Q);
+        for (int i = 0; i < 4; i++)
+            Q[i][0] += k ? 1.0f : -1.0f;
+        CHECK(rayes_scene_bilinear_patch(s, Q) == RAYES_OK);
+    }
+    CHECK(rayes_scene_motion_end(s) == RAYES_OK);
+    return s;
+}
+
+static void deformation_equals_transform(float motionfactor)
+{
+    RayesScene *a = patch_scene(0, motionfactor), *b = patch_scene(1, motionfactor);
+    RayesImage *ia = render(a, 16, 2, 1, NULL), *ib = render(b, 16, 2, 1, NULL);
+    double worst = 0, mean = 0, cover = 0;
+    for (size_t i = 0; ia && ib && i < 4 * (size_t)W * W; i++) {
+        worst = fmax(worst, fabs(ia->rgba[i] - ib->rgba[i]));
+        mean += ia->rgba[i];
+        if (i % 4 == 3)
+            cover += ia->rgba[i];
+    }
+    CHECK(mean > 0);
+    /* The patch sweeps 4 + 2 = 6 units wide, 2 tall: area 8 times 1. */
+    float px = 2 * HALF / W;
+    CHECK_NEAR(cover * px * px, 8.0, 0.08);
+    CHECK(worst < 1e-5);
+    printf("  deformation vs transform (motionfactor %g): largest difference %.2g\n", motionfactor,
+           worst);
+    rayes_image_free(ia);
+    rayes_image_free(ib);
+    rayes_scene_release(a);
+    rayes_scene_release(b);
+}
+
+/* Also with motionfactor: both blurs measure the same motion, so dice
+ * alike. */
+static void test_deformation_equals_transform(void)
+{
+    deformation_equals_transform(0.0f);
+    deformation_equals_transform(1.0f);
+}
+
+/* Bad motion calls are refused with a message. */
+static void test_bad_motion(void)
+{
+    RayesScene *s = rayes_scene_new();
+    const float times[3] = {0, 1, 0.5f};
+    float m[3][16];
+    for (int k = 0; k < 3; k++)
+        translate(m[k], 0, 0, 0);
+    CHECK(rayes_scene_set_transform_motion(s, 3, times, (const float(*)[16])m) ==
+          RAYES_ERROR_INVALID_ARGUMENT);
+    CHECK(strstr(rayes_scene_get_error(s), "increasing") != NULL);
+    CHECK(rayes_scene_set_transform_motion(s, 1, times, (const float(*)[16])m) ==
+          RAYES_ERROR_INVALID_ARGUMENT);
+    CHECK(rayes_scene_set_shutter(s, 1, 0) == RAYES_ERROR_INVALID_ARGUMENT);
+    CHECK(rayes_scene_motion_end(s) == RAYES_ERROR_INVALID_OPERATION);
+    /* different topology: a patch, then a sphere */
+    CHECK(rayes_scene_motion_begin(s, 2, times) == RAYES_OK);
+    float P[4][3] = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {1, 1, 0}};
+    CHECK(rayes_scene_bilinear_patch(s, P) == RAYES_OK);
+    CHECK(rayes_scene_sphere(s, 1) == RAYES_OK);
+    rayes_scene_clear_error(s);
+    CHECK(rayes_scene_motion_end(s) == RAYES_ERROR_INVALID_ARGUMENT);
+    CHECK(strstr(rayes_scene_get_error(s), "same topology") != NULL);
+    CHECK(rayes_scene_set_depth_of_field(s, 1, 0) == RAYES_ERROR_INVALID_ARGUMENT);
+    CHECK(rayes_scene_set_dice_blur(s, -1, 0) == RAYES_ERROR_INVALID_ARGUMENT);
+    rayes_scene_release(s);
+}
+
+/* A moving camera: the still sphere blurs as the moving sphere did. */
+static void test_camera_motion(void)
+{
+    RayesScene *a = rayes_scene_new(), *b = rayes_scene_new();
+    ortho_camera(a);
+    ortho_camera(b);
+    CHECK(rayes_scene_set_shutter(a, 0.0f, 1.0f) == RAYES_OK);
+    CHECK(rayes_scene_set_shutter(b, 0.0f, 1.0f) == RAYES_OK);
+    const float times[2] = {0, 1};
+    float m[2][16];
+    translate(m[0], -1, 0, 0);
+    translate(m[1], 1, 0, 0);
+    CHECK(rayes_scene_set_transform_motion(a, 2, times, (const float(*)[16])m) == RAYES_OK);
+    CHECK(rayes_scene_sphere(a, 1.0f) == RAYES_OK);
+    float cam[2][16]; /* camera_from_world: the world moves by -1 .. +1 in the camera */
+    translate(cam[0], -1, 0, 5);
+    translate(cam[1], 1, 0, 5);
+    CHECK(rayes_scene_set_camera_motion(b, 2, times, (const float(*)[16])cam) == RAYES_OK);
+    CHECK(rayes_scene_sphere(b, 1.0f) == RAYES_OK);
+    RayesImage *ia = render(a, 16, 2, 1, NULL), *ib = render(b, 16, 2, 1, NULL);
+    double worst = 0;
+    for (size_t i = 3; ia && ib && i < 4 * (size_t)W * W; i += 4)
+        worst = fmax(worst, fabs(ia->rgba[i] - ib->rgba[i]));
+    CHECK(worst < 1e-4);
+    printf("  camera motion vs object motion: largest coverage difference %.2g\n", worst);
+    rayes_image_free(ia);
+    rayes_image_free(ib);
+    rayes_scene_release(a);
+    rayes_scene_release(b);
+}
+
+/* The Cornell box with a white sphere rising and swinging toward the red
+ * wall over the shutter (3 samples, 2 motion segments). */
+static RayesImage *box_render(int cache, double cache_mb, int threads, const float crop[4],
+                              RayesStats **stats)
+{
+    RayesScene *s = rayes_scene_new();
+    char err[512];
+    IoSink sink = io_sink_scene(s);
+    CHECK(io_builtin_scene("cornell", NULL, &sink, err, sizeof err) == RAYES_OK);
+    CHECK(rayes_scene_set_shutter(s, 0.0f, 1.0f) == RAYES_OK);
+    const float times[3] = {0, 0.5f, 1};
+    float m[3][16];
+    translate(m[0], 300, 100, 150);
+    translate(m[1], 380, 180, 150);
+    translate(m[2], 420, 200, 150);
+    CHECK(rayes_scene_set_shader(s, "matte", NULL, 0) == RAYES_OK);
+    CHECK(rayes_scene_set_transform_motion(s, 3, times, (const float(*)[16])m) == RAYES_OK);
+    CHECK(rayes_scene_sphere(s, 80.0f) == RAYES_OK);
+    CHECK(rayes_scene_commit(s) == RAYES_OK);
+    RayesRenderOptions o;
+    rayes_render_options_init(&o, RAYES_QUALITY_PREVIEW);
+    o.width = o.height = 128;
+    o.spp = 16;
+    o.threads = threads;
+    o.bounces = 1;
+    o.diffuse_rays = 16;
+    o.cache = cache;
+    o.cache_mb = cache_mb;
+    if (crop)
+        memcpy(o.crop, crop, sizeof o.crop);
+    RayesImage *img = NULL;
+    CHECK(rayes_render(s, &o, &img, stats) == RAYES_OK);
+    rayes_scene_release(s);
+    return img;
+}
+
+static double tile_mean(const RayesImage *img, int x0, int y0, int size)
+{
+    double sum = 0.0;
+    for (int y = y0; y < y0 + size; y++)
+        for (int x = x0; x < x0 + size; x++)
+            for (int c = 0; c < 3; c++)
+                sum += img->rgba[4 * ((size_t)y * img->width + x) + c];
+    return sum / (3.0 * size * size);
+}
+
+static void test_cached_segments_match_uncached(void)
+{
+    RayesStats *st = NULL;
+    RayesImage *a = box_render(1, 100, 2, NULL, &st), *b = box_render(0, 100, 2, NULL, NULL);
+    CHECK(a && b);
+    const RayesStat *seg = rayes_stats_find(st, "motion/fills_by_segment");
+    const RayesStat *nt = rayes_stats_find(st, "motion/time_samples");
+    CHECK(nt && nt->count == 3);
+    CHECK(seg && seg->n_counts == 2);
+    if (seg && seg->n_counts == 2) {
+        CHECK(seg->counts[0] > 0 && seg->counts[1] > 0);
+        printf("  radiosity fills by segment: %llu %llu\n", (unsigned long long)seg->counts[0],
+               (unsigned long long)seg->counts[1]);
+    }
+    if (a && b) {
+        double ma = tile_mean(a, 0, 0, 128), mb = tile_mean(b, 0, 0, 128), worst = 0;
+        for (int y = 0; y < 128; y += 32)
+            for (int x = 0; x < 128; x += 32) {
+                double ta = tile_mean(a, x, y, 32), tb = tile_mean(b, x, y, 32);
+                worst = fmax(worst, fabs(ta - tb) / tb);
+            }
+        CHECK(fabs(ma - mb) < 0.01 * mb);
+        CHECK(worst < 0.03);
+        printf("  cached vs uncached: means %.5f %.5f (%.2f%%), worst 32 x 32 tile %.2f%%\n", ma,
+               mb, 100 * fabs(ma - mb) / mb, 100 * worst);
+    }
+    rayes_stats_free(st);
+    rayes_image_free(a);
+    rayes_image_free(b);
+}
+
+/* The same bytes for 1 and 2 threads, a 0.5 MB cache, and in a crop
+ * window. */
+static void test_motion_determinism(void)
+{
+    RayesImage *a = box_render(1, 100, 2, NULL, NULL), *b = box_render(1, 100, 1, NULL, NULL);
+    RayesImage *c = box_render(1, 0.5, 2, NULL, NULL);
+    const float crop[4] = {0.3f, 0.7f, 0.4f, 0.9f};
+    RayesImage *d = box_render(1, 100, 2, crop, NULL);
+    CHECK(a && b && c && d);
+    size_t n = 4 * (size_t)128 * 128;
+    if (a && b && c)
+        CHECK(memcmp(a->rgba, b->rgba, n * sizeof *a->rgba) == 0 &&
+              memcmp(a->rgba, c->rgba, n * sizeof *a->rgba) == 0);
+    int same = 1, inside = 0;
+    for (int y = 0; a && d && y < 128; y++)
+        for (int x = 0; x < 128; x++) {
+            size_t i = 4 * ((size_t)y * 128 + x);
+            if (d->rgba[i + 3] == 0 && d->rgba[i] == 0)
+                continue; /* outside the window */
+            inside++;
+            same &= memcmp(&a->rgba[i], &d->rgba[i], 4 * sizeof *a->rgba) == 0;
+        }
+    CHECK(same && inside > 1000);
+    rayes_image_free(a);
+    rayes_image_free(b);
+    rayes_image_free(c);
+    rayes_image_free(d);
+}
+
+/* Attribute "dice" "motionfactor": a sphere blurred across 32 pixels is
+ * diced coarser (edges 1 + 32/16 = 3 times longer), covering the same. */
+static void test_motionfactor(void)
+{
+    uint64_t verts[2];
+    double cover[2];
+    for (int k = 0; k < 2; k++) {
+        RayesScene *s = rayes_scene_new();
+        ortho_camera(s);
+        CHECK(rayes_scene_set_shutter(s, 0.0f, 1.0f) == RAYES_OK);
+        CHECK(rayes_scene_set_dice_blur(s, k ? 1.0f : 0.0f, 0.0f) == RAYES_OK);
+        float m[2][16];
+        translate(m[0], -1, 0, 0);
+        translate(m[1], 1, 0, 0);
+        const float times[2] = {0, 1};
+        CHECK(rayes_scene_set_transform_motion(s, 2, times, (const float(*)[16])m) == RAYES_OK);
+        CHECK(rayes_scene_sphere(s, 1.0f) == RAYES_OK);
+        RayesStats *st = NULL;
+        RayesImage *img = render(s, 16, 2, 1, &st);
+        const RayesStat *v = rayes_stats_find(st, "grid_vertices");
+        verts[k] = v ? v->count : 0;
+        cover[k] = 0;
+        for (size_t i = 3; img && i < 4 * (size_t)W * W; i += 4)
+            cover[k] += img->rgba[i];
+        rayes_stats_free(st);
+        rayes_image_free(img);
+        rayes_scene_release(s);
+    }
+    CHECK(verts[1] * 4 < verts[0]);
+    CHECK(fabs(cover[1] / cover[0] - 1) < 0.01);
+    printf("  motionfactor 1: %llu grid vertices instead of %llu, coverage %+.2f%%\n",
+           (unsigned long long)verts[1], (unsigned long long)verts[0],
+           100 * (cover[1] / cover[0] - 1));
+}
+
+/* The ray tracing structure of a patch turning half round about y (0, 90
+ * and 180 degrees at times 0, 0.5, 1) beside a still one: a ray at time t
+ * meets the moving patch where it is then, with the normal it has then
+ * (the side the cache keys), and the motion segment of its time; the
+ * still patch keeps segment 0 and its own vertices only. */
+static void test_moving_hits(void)
+{
+    RayesScene *s = rayes_scene_new();
+    CHECK(rayes_scene_set_shutter(s, 0.0f, 1.0f) == RAYES_OK);
+    const float times[3] = {0, 0.5f, 1};
+    float m[3][16];
+    for (int k = 0; k < 3; k++) {
+        float a = (float)M_PI * (float)k / 2, c = cosf(a), sn = sinf(a);
+        const float r[16] = {c, 0, sn, 0, 0, 1, 0, 0, -sn, 0, c, 0, 0, 0, 0, 1};
+        memcpy(m[k], r, sizeof r);
+    }
+    CHECK(rayes_scene_set_transform_motion(s, 3, times, (const float(*)[16])m) == RAYES_OK);
+    float P[4][3] = {{-1, -1, 0}, {1, -1, 0}, {-1, 1, 0}, {1, 1, 0}}; /* normal +z at t = 0 */
+    CHECK(rayes_scene_bilinear_patch(s, P) == RAYES_OK);
+    CHECK(rayes_scene_set_transform(s, identity) == RAYES_OK);
+    float Q[4][3] = {{5, -1, 0}, {7, -1, 0}, {5, 1, 0}, {7, 1, 0}};
+    CHECK(rayes_scene_bilinear_patch(s, Q) == RAYES_OK);
+    CHECK(rayes_scene_commit(s) == RAYES_OK);
+    GridSet gs;
+    geom_gridset_init(&gs);
+    CHECK(scene_prepare(s, 64, 64, NULL, NULL, &gs, NULL) == 0);
+    CHECK(gs.n_times == 3);
+    size_t moving = 0, still_vertices = 0;
+    for (size_t g = 0; g < gs.n_grids; g++) {
+        moving += gs.grids[g].moving;
+        if (!gs.grids[g].moving)
+            still_vertices += geom_grid_n_vertices(&gs.grids[g]);
+    }
+    CHECK(moving > 0 && still_vertices > 0);
+    CHECK(gs.n_motion_vertices + still_vertices == gs.n_vertices); /* only movers sampled */
+    uint32_t masks[1] = {RAYES_RAY_CAMERA};
+    char err[256];
+    Accel *a = accel_new(&gs, masks, 1, err, sizeof err);
+    CHECK(a != NULL);
+    /* Along -z through (0.3, 0.2): the patch at t = 0 faces the ray's
+     * origin with +z; at t = 1 it is turned round and faces it with -z;
+     * at t = 0.5 it is edge on (missed). */
+    const float ts[3] = {0.0f, 0.5f, 1.0f};
+    const int want_hit[3] = {1, 0, 1};
+    const float want_nz[3] = {1, 0, -1};
+    for (int k = 0; a && k < 3; k++) {
+        Ray r = {v3(0.3f, 0.2f, 5), v3(0, 0, -1), 0.0f, 1e30f, RAYES_RAY_CAMERA, ts[k]};
+        Hit h;
+        int hit = accel_intersect(a, &r, &h);
+        CHECK(hit == want_hit[k]);
+        if (hit && want_hit[k]) {
+            CHECK_NEAR(h.t, 5.0, 1e-3);
+            CHECK_NEAR(h.Ng.z, want_nz[k], 1e-3);
+            float f;
+            CHECK(geom_motion_segment(&gs, ts[k], &f) == (k == 2 ? 1 : 0));
+        }
+    }
+    /* The still patch: the same at every time. */
+    for (int k = 0; a && k < 3; k++) {
+        Ray r = {v3(6, 0, 5), v3(0, 0, -1), 0.0f, 1e30f, RAYES_RAY_CAMERA, ts[k]};
+        Hit h;
+        CHECK(accel_intersect(a, &r, &h) && !gs.grids[h.grid].moving);
+    }
+    accel_free(a);
+    geom_gridset_fini(&gs);
+    rayes_scene_release(s);
+}
+
+TEST_MAIN(TEST(test_moving_hits), TEST(test_moving_sphere_coverage), TEST(test_motionfactor),
+          TEST(test_cached_segments_match_uncached), TEST(test_motion_determinism),
+          TEST(test_deformation_equals_transform), TEST(test_bad_motion), TEST(test_camera_motion))
