@@ -472,6 +472,8 @@ static int parse_buffer(Parser *P, const char *name, const char *dir, const char
         if ((r = fn(P, &t)) != 0)
             break;
     }
+    if (r == 0 && P->depth == 1 && P->world) /* the top file's end: its lexer names it */
+        r = pbrt_medium_camera(P);
     P->depth--;
     P->lx = saved; /* an error's message, written already, names the innermost file */
     P->has_peek = saved_peek;
@@ -550,8 +552,6 @@ RayesError io_pbrt_parse(const char *name, const unsigned char *data, size_t siz
         snprintf(err, err_size, "%s: expected WorldBegin, found the end of the file", name);
         r = -1;
     }
-    if (!r)
-        r = pbrt_medium_camera(P);
     parser_free(P);
     free(P);
     return r ? RAYES_ERROR_PARSE : RAYES_OK;

@@ -17,16 +17,11 @@
 #include <time.h>
 #include <unistd.h>
 
+#include "app/files.h"
 #include "test.h"
 
 #define DIR RAYES_TEST_TMP "/app_checkpoint"
 #define SCENE "cornell", "--res", "192", "--spp", "16", "--quiet" /* 36 tiles of 32 */
-
-static int exists(const char *path)
-{
-    struct stat st;
-    return stat(path, &st) == 0;
-}
 
 /* Starts rayes with args (NULL-terminated) in DIR, stdout and stderr to
  * DIR/NAME.out and .err; returns its pid. */
@@ -75,28 +70,11 @@ static void read_text(const char *name, const char *ext, char *buf, size_t size)
         fclose(f);
 }
 
-static int same_bytes(const char *a, const char *b)
-{
-    FILE *fa = fopen(a, "rb"), *fb = fopen(b, "rb");
-    int same = fa && fb;
-    while (same) {
-        int ca = fgetc(fa), cb = fgetc(fb);
-        same = ca == cb;
-        if (ca == EOF)
-            break;
-    }
-    if (fa)
-        fclose(fa);
-    if (fb)
-        fclose(fb);
-    return same;
-}
-
 /* Waits up to 60 s for path to exist. */
 static int wait_for(const char *path)
 {
     for (int i = 0; i < 60000; i++) {
-        if (exists(path))
+        if (file_exists(path))
             return 1;
         struct timespec ts = {0, 1000000};
         nanosleep(&ts, NULL);
@@ -116,10 +94,10 @@ static void test_resume_after_crash(void)
     pid_t pid = start("crash", part);
     CHECK(wait_for(DIR "/crash.exr.checkpoint"));
     kill(pid, SIGSTOP);
-    CHECK(!exists(DIR "/crash.exr")); /* stopped before the end */
+    CHECK(!file_exists(DIR "/crash.exr")); /* stopped before the end */
     kill(pid, SIGKILL);
     finish(pid);
-    CHECK(exists(DIR "/crash.exr.checkpoint") && !exists(DIR "/crash.exr"));
+    CHECK(file_exists(DIR "/crash.exr.checkpoint") && !file_exists(DIR "/crash.exr"));
     /* resumed on two threads: the rest of the tiles, the same bytes */
     const char *resume[] = {"cornell", "--res", "192", "--spp", "16", "--threads", "2",
                             "--resume", "-o", "crash.exr", NULL};
@@ -132,7 +110,7 @@ static void test_resume_after_crash(void)
     fprintf(stderr, "resumed %d of 36 tiles\n", tiles);
     CHECK(tiles >= 1 && tiles < 36);
     CHECK(same_bytes(DIR "/crash.exr", DIR "/full.exr"));
-    CHECK(!exists(DIR "/crash.exr.checkpoint")); /* removed once written */
+    CHECK(!file_exists(DIR "/crash.exr.checkpoint")); /* removed once written */
 }
 
 static void test_sigterm_saves(void)
@@ -152,8 +130,8 @@ static void test_sigterm_saves(void)
         return;
     }
     CHECK(status == 143);
-    CHECK(!exists(DIR "/term.exr"));
-    CHECK(exists(DIR "/term.exr.checkpoint"));
+    CHECK(!file_exists(DIR "/term.exr"));
+    CHECK(file_exists(DIR "/term.exr.checkpoint"));
     const char *resume[] = {SCENE, "--threads", "2", "--resume", "-o", "term.exr", NULL};
     CHECK(run("term-resume", resume) == 0);
     CHECK(same_bytes(DIR "/term.exr", DIR "/full.exr"));
@@ -188,11 +166,11 @@ static void test_other_options_and_damage(void)
     read_text("bad", "err", err, sizeof err);
     CHECK(strstr(err, "bad.exr.checkpoint: not a rayes checkpoint") != NULL);
     CHECK(strchr(err, '\n') == err + strlen(err) - 1);
-    CHECK(!exists(DIR "/bad.exr"));
+    CHECK(!file_exists(DIR "/bad.exr"));
     /* a bad value */
     const char *usage[] = {SCENE, "--checkpoint", "soon", "-o", "u.exr", NULL};
     CHECK(run("usage", usage) == 2);
-    CHECK(!exists(DIR "/u.exr"));
+    CHECK(!file_exists(DIR "/u.exr"));
 }
 
 TEST_MAIN(TEST(test_resume_after_crash), TEST(test_sigterm_saves),

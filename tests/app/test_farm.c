@@ -13,37 +13,15 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include "app/files.h"
 #include "test.h"
 
 #define SCRATCH RAYES_TEST_TMP "/app_farm"
-
-static int exists(const char *path)
-{
-    struct stat st;
-    return stat(path, &st) == 0;
-}
 
 static long mtime_ns(const char *path)
 {
     struct stat st;
     return stat(path, &st) == 0 ? (long)st.st_mtim.tv_sec * 1000000000L + st.st_mtim.tv_nsec : -1;
-}
-
-static int same_bytes(const char *a, const char *b)
-{
-    FILE *fa = fopen(a, "rb"), *fb = fopen(b, "rb");
-    int same = fa && fb;
-    while (same) {
-        int ca = fgetc(fa), cb = fgetc(fb);
-        same = ca == cb;
-        if (ca == EOF)
-            break;
-    }
-    if (fa)
-        fclose(fa);
-    if (fb)
-        fclose(fb);
-    return same;
 }
 
 /* Runs a shell command in SCRATCH, rayes being $RAYES; its status. */
@@ -91,11 +69,11 @@ static void test_slurm_array_task(void)
                  "SLURM_ARRAY_TASK_ID SLURM_CPUS_PER_TASK; %s)", id, task);
         CHECK(sh(cmd) == 0);
     }
-    CHECK(exists(SCRATCH "/renders/shot010.0001.exr") &&
-          exists(SCRATCH "/renders/shot010.0002.exr") &&
-          !exists(SCRATCH "/renders/shot010.0003.exr"));
+    CHECK(file_exists(SCRATCH "/renders/shot010.0001.exr") &&
+          file_exists(SCRATCH "/renders/shot010.0002.exr") &&
+          !file_exists(SCRATCH "/renders/shot010.0003.exr"));
     CHECK(!same_bytes(SCRATCH "/renders/shot010.0001.exr", SCRATCH "/renders/shot010.0002.exr"));
-    CHECK(!exists(SCRATCH "/renders/shot010.0001.exr.checkpoint"));
+    CHECK(!file_exists(SCRATCH "/renders/shot010.0001.exr.checkpoint"));
     long before = mtime_ns(SCRATCH "/renders/shot010.0001.exr");
     snprintf(cmd, sizeof cmd, "(SLURM_ARRAY_TASK_ID=1 SLURM_CPUS_PER_TASK=2; export "
              "SLURM_ARRAY_TASK_ID SLURM_CPUS_PER_TASK; %s)", task);
@@ -124,7 +102,7 @@ static void test_opencue_token(void)
     unlink(SCRATCH "/renders/shot010.0003.exr");
     snprintf(out, sizeof out, "%s > opencue.json", cmd);
     CHECK(sh(out) == 0);
-    CHECK(exists(SCRATCH "/renders/shot010.0003.exr"));
+    CHECK(file_exists(SCRATCH "/renders/shot010.0003.exr"));
     char text[4096] = "";
     FILE *f = fopen(SCRATCH "/opencue.json", "r");
     size_t n = f ? fread(text, 1, sizeof text - 1, f) : 0;
@@ -157,7 +135,7 @@ static void test_crops_assembled(void)
              "parts/other.exr") == 0);
     unlink(SCRATCH "/mixed.exr");
     CHECK(sh("$RAYES assemble mixed.exr parts/p0.exr parts/other.exr 2>mixed.err") == 1);
-    CHECK(!exists(SCRATCH "/mixed.exr"));
+    CHECK(!file_exists(SCRATCH "/mixed.exr"));
     char err[1024] = "";
     FILE *f = fopen(SCRATCH "/mixed.err", "r");
     size_t n = f ? fread(err, 1, sizeof err - 1, f) : 0;

@@ -16,32 +16,10 @@
 #include <time.h>
 #include <unistd.h>
 
+#include "app/files.h"
 #include "test.h"
 
 #define SCRATCH RAYES_TEST_TMP "/app_mpi"
-
-static int exists(const char *path)
-{
-    struct stat st;
-    return stat(path, &st) == 0;
-}
-
-static int same_bytes(const char *a, const char *b)
-{
-    FILE *fa = fopen(a, "rb"), *fb = fopen(b, "rb");
-    int same = fa && fb;
-    while (same) {
-        int ca = fgetc(fa), cb = fgetc(fb);
-        same = ca == cb;
-        if (ca == EOF)
-            break;
-    }
-    if (fa)
-        fclose(fa);
-    if (fb)
-        fclose(fb);
-    return same;
-}
 
 /* "mpirun ... -np N" as this user may run it (root needs its flag); leaks
  * inside Open MPI are not ours to report under AddressSanitizer. */
@@ -176,7 +154,7 @@ static void test_dead_rank_ends_the_job(void)
     int code = WIFEXITED(st) ? WEXITSTATUS(st) : -1;
     fprintf(stderr, "mpirun after a rank was killed: status %d\n", code);
     CHECK(code != 0 && code != 124); /* failed, and not by the timeout */
-    CHECK(!exists(SCRATCH "/killed.exr"));
+    CHECK(!file_exists(SCRATCH "/killed.exr"));
 }
 
 TEST_MAIN(TEST(test_same_bytes_as_one_process), TEST(test_dead_rank_ends_the_job))

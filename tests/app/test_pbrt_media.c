@@ -185,6 +185,19 @@ static void test_camera_medium(void)
     }
     free(open);
     free(fog);
+    /* a camera medium never defined: an error naming the Camera's line */
+    snprintf(text, sizeof text,
+             "MediumInterface \"\" \"nope\"\nLookAt 0 0 6  0 0 0  0 1 0\n"
+             "Camera \"perspective\" \"float fov\" 10\nWorldBegin\n");
+    f = fopen(TMP "/cam-nope.pbrt", "w");
+    if (f) {
+        fputs(text, f);
+        fclose(f);
+    }
+    float *none = render("cam-nope.pbrt", err_text, sizeof err_text);
+    CHECK(none == NULL);
+    free(none);
+    CHECK(strstr(err_text, "cam-nope.pbrt:3:1: the camera's medium \"nope\"") != NULL);
 }
 
 static void test_skipped_media_warn(void)
