@@ -83,8 +83,11 @@ static Vec3 transmittance(Worker *w, Vec3 o, Vec3 wi, float dist, RayDiff diff)
  * point: that many, or with 0 the renderer's setting for the depth. */
 static int shadow_ray_count(const Worker *w, const RayesShadeCtx *ctx, int n_shadow_rays)
 {
+    const PathState *ps = ctx->renderer;
     if (n_shadow_rays > 0)
         return n_shadow_rays;
+    if (ps && ps->shadow_rays > 0) /* an irradiance fill's own count */
+        return ps->shadow_rays;
     return ctx->diffuse_depth == 0 ? w->set->shadow_rays : w->set->shadow_rays_deep;
 }
 
