@@ -137,6 +137,10 @@ static void light_delta(Worker *w, const DirectPoint *p, const Light *l, Vec3 *d
 static void light_area(Worker *w, const DirectPoint *p, const Light *l, uint64_t key, int n,
                        Vec3 *diffuse, Vec3 *spec)
 {
+    /* wholly below the point's horizon: every strategy's sample has a
+     * cosine <= 0 and adds nothing (the same sums, without drawing them) */
+    if (light_below_plane(l, p->o, p->N))
+        return;
     Vec3 sum_d = v3(0, 0, 0), sum_s = v3(0, 0, 0);
     uint32_t pattern = (uint32_t)key, pat_cos = (uint32_t)hash_combine(key, 1),
              pat_bp = (uint32_t)hash_combine(key, 2);
