@@ -7,12 +7,15 @@
  * an internal blocker) darkens the top; subsurface rays never leave their
  * object (an unlit sphere overlapping a lit one stays black); the
  * irradiance cache gives the uncached image within noise; images do not
- * depend on threads or the irradiance cache's budget.
+ * depend on threads or the irradiance cache's budget; irradiance fills take
+ * their own shadow-ray count (uncached hits the camera's); 4 subsurface
+ * rays read cached irradiance at the resolutions 64 do.
  *
  * Units: mm. The camera looks down the z axis at the slabs' top (z = 0)
  * from 400 mm, seeing its central 40 mm.
  */
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -407,9 +410,50 @@ static void test_irradiance_fills_take_their_own_shadow_rays(void)
     rayes_scene_release(s);
 }
 
+/* The share of irradiance lookups at a level. */
+static double level_share(const RayesStats *st, const char *level)
+{
+    static const char *const all[3] = {"coarse", "medium", "fine"};
+    char name[64];
+    double sum = 0.0, mine = 0.0;
+    for (int l = 0; l < 3; l++) {
+        snprintf(name, sizeof name, "cache/irradiance/%s/lookups", all[l]);
+        double n = (double)stat(st, name);
+        sum += n;
+        if (!strcmp(all[l], level))
+            mine = n;
+    }
+    return sum > 0.0 ? mine / sum : 0.0;
+}
+
+static void test_few_rays_read_final_resolutions(void)
+{
+    /* With 4 rays a ray's own footprint would pick coarse levels, whose
+     * interpolant is biased; lookups are no coarser than 64 rays'
+     * (SUBSURFACE_LOOKUP_RAYS), so preview reads the levels final does. */
+    RayesScene *s = new_scene();
+    marble(s, "dipole");
+    slab(s, 60.0f, -6.0f, 0); /* flat, so coarse levels are allowed */
+    distant_light(s, 1.0f);
+    RayesStats *four = NULL, *sixty = NULL;
+    RayesImage *a = render_res(s, 32, 2, 4, 1, 20.0, &four),
+               *b = render_res(s, 32, 2, 64, 1, 20.0, &sixty);
+    CHECK(stat(four, "subsurface/points") > 0);
+    for (int l = 0; l < 3; l++) {
+        const char *level = l == 0 ? "coarse" : l == 1 ? "medium" : "fine";
+        CHECK_NEAR(level_share(four, level), level_share(sixty, level), 0.1);
+    }
+    rayes_image_free(a);
+    rayes_image_free(b);
+    rayes_stats_free(four);
+    rayes_stats_free(sixty);
+    rayes_scene_release(s);
+}
+
 TEST_MAIN(TEST(test_thick_slab_reflects_dipole_rd), TEST(test_white_furnace_conserves_energy),
           TEST(test_renderman_albedo_and_mean_free_path),
           TEST(test_light_bleeds_through_and_blockers_stop_it),
           TEST(test_rays_never_leave_their_object), TEST(test_cached_matches_uncached),
           TEST(test_same_image_whatever_threads_and_budget),
-          TEST(test_irradiance_fills_take_their_own_shadow_rays))
+          TEST(test_irradiance_fills_take_their_own_shadow_rays),
+          TEST(test_few_rays_read_final_resolutions))
