@@ -25,7 +25,8 @@
  * --images-only 1 renders the cached images alone (no timing).
  *
  * Prints, per quality: subsurface rays, shadow rays, irradiance shading
- * points, render times off and on and the speed-up, the irradiance cache's
+ * points, render times off and on (wall, and the process's CPU time) and
+ * the speed-ups, the irradiance cache's
  * hit rates, the image means and the worst 32 x 32 tile, whether the
  * cached image is the same with 1 thread and with a 1 MB irradiance budget
  * (evicting); the peak resident memory; writes DIR/figure10-QUALITY-{cached,
@@ -35,6 +36,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/resource.h>
 #include <sys/stat.h>
 
 #include "image/image.h"
@@ -43,7 +45,7 @@
 #include "rayes/rayes.h"
 
 typedef struct Args {
-    int size, final_size, spp, threads, coat, images_only, floor;
+    int size, final_size, spp, threads, coat, images_only, floor, resolution, irr_rays;
     double mb;
     const char *data, *out, *only, *medium, *profile;
 } Args;
@@ -65,7 +67,8 @@ static int parse_int(const char *s, int lo, int hi)
 
 static Args parse(int argc, char **argv)
 {
-    Args a = {256, 192, 16, 2, 1, 0, 1, 20.0, NULL, "out/figure10", NULL, "marble", "dipole"};
+    Args a = {256,  192,      16,      2, 1, 0, 1, -1, 0, 20.0, NULL, "out/figure10",
+              NULL, "marble", "dipole"};
     for (int i = 1; i < argc; i++) {
         const char *o = argv[i], *v = i + 1 < argc ? argv[i + 1] : NULL;
         if (!v)
@@ -80,6 +83,10 @@ static Args parse(int argc, char **argv)
             a.threads = parse_int(v, 0, 1024);
         else if (!strcmp(o, "--floor"))
             a.floor = parse_int(v, 0, 1);
+        else if (!strcmp(o, "--resolution"))
+            a.resolution = parse_int(v, -1, 2);
+        else if (!strcmp(o, "--irradiance-shadow-rays"))
+            a.irr_rays = parse_int(v, 0, 1 << 20);
         else if (!strcmp(o, "--coat"))
             a.coat = parse_int(v, 0, 1);
         else if (!strcmp(o, "--mb"))
@@ -173,8 +180,17 @@ static RayesScene *scene(const Args *a)
 typedef struct Run {
     RayesImage *img;
     RayesStats *st;
-    double seconds;
+    double seconds, cpu; /* wall time of the render, and the process's CPU time over the call
+                            (less sensitive to other jobs on a shared machine) */
 } Run;
+
+static double cpu_seconds(void)
+{
+    struct rusage ru;
+    getrusage(RUSAGE_SELF, &ru);
+    return (double)ru.ru_utime.tv_sec + 1e-6 * ru.ru_utime.tv_usec + (double)ru.ru_stime.tv_sec +
+           1e-6 * ru.ru_stime.tv_usec;
+}
 
 static uint64_t stat_count(const RayesStats *st, const char *name)
 {
@@ -198,8 +214,12 @@ static Run run(RayesScene *s, const Args *a, int final, int cached, int threads,
     o.bounces = 0;
     o.irradiance_cache = cached;
     o.irradiance_cache_mb = mb;
+    o.cache_resolution = a->resolution;
+    o.irradiance_shadow_rays = a->irr_rays;
     Run r = {0};
+    double cpu0 = cpu_seconds();
     check(s, rayes_render(s, &o, &r.img, &r.st));
+    r.cpu = cpu_seconds() - cpu0;
     r.seconds = stat_real(r.st, "time/render_s");
     return r;
 }
@@ -215,7 +235,8 @@ static double mean(const RayesImage *img)
 
 /* The largest relative difference of 32 x 32 tiles' means (tiles darker
  * than 1/100 of the image's mean are skipped: relative noise there). */
-static double worst_tile(const RayesImage *a, const RayesImage *b)
+static double worst_tile(const RayesImage *a, const RayesImage *b, int *wx, int *wy, double *wa,
+                         double *wb)
 {
     double worst = 0.0, floor = 0.01 * mean(b) * 32 * 32 * 3;
     for (int ty = 0; ty + 32 <= a->height; ty += 32)
@@ -228,8 +249,10 @@ static double worst_tile(const RayesImage *a, const RayesImage *b)
                         ma += a->rgba[i];
                         mb += b->rgba[i];
                     }
-            if (mb > floor)
-                worst = fmax(worst, fabs(ma - mb) / mb);
+            if (mb > floor && fabs(ma - mb) / mb > worst) {
+                worst = fabs(ma - mb) / mb;
+                *wx = tx, *wy = ty, *wa = ma / (32 * 32 * 3), *wb = mb / (32 * 32 * 3);
+            }
         }
     return worst;
 }
@@ -272,21 +295,23 @@ static int quality(RayesScene *s, const Args *a, int final)
            "budget %g MB\n",
            q, on.img->width, on.img->height, a->spp, final ? 64 : 4, final ? 64 : 4, a->threads,
            a->mb);
-    printf("%-10s %14s %14s %14s %10s\n", "irradiance", "subsurface", "shadow rays", "irr. points",
-           "render s");
+    printf("%-10s %14s %14s %14s %10s %10s\n", "irradiance", "subsurface", "shadow rays",
+           "irr. points", "render s", "cpu s");
     const Run *rows[2] = {&off, &on};
     for (int k = 0; k < 2; k++)
-        printf("%-10s %14llu %14llu %14llu %10.2f\n", k ? "cached" : "uncached",
+        printf("%-10s %14llu %14llu %14llu %10.2f %10.2f\n", k ? "cached" : "uncached",
                (unsigned long long)stat_count(rows[k]->st, "rays/subsurface"),
                (unsigned long long)stat_count(rows[k]->st, "rays/shadow"),
                (unsigned long long)stat_count(rows[k]->st, "subsurface/irradiance_points"),
-               rows[k]->seconds);
+               rows[k]->seconds, rows[k]->cpu);
     print_cache(on.st);
-    double ma = mean(on.img), mb = mean(off.img);
-    printf("speed-up %.2f (memo %s); means %.5f cached, %.5f uncached (%+.2f%%); worst 32x32 "
-           "tile %.2f%%\n",
-           off.seconds / on.seconds, final ? "17" : "3.4", ma, mb, 100.0 * (ma - mb) / mb,
-           100.0 * worst_tile(on.img, off.img));
+    double ma = mean(on.img), mb = mean(off.img), ta = 0.0, tb = 0.0;
+    int tx = 0, ty = 0;
+    double worst = worst_tile(on.img, off.img, &tx, &ty, &ta, &tb);
+    printf("speed-up %.2f (cpu %.2f; memo %s); means %.5f cached, %.5f uncached (%+.2f%%); worst 32x32 "
+           "tile %.2f%% (at %d,%d: %.5f cached, %.5f uncached)\n",
+           off.seconds / on.seconds, off.cpu / on.cpu, final ? "17" : "3.4", ma, mb, 100.0 * (ma - mb) / mb,
+           100.0 * worst, tx, ty, ta, tb);
     printf("cached image with 1 thread: %s; with a 1 MB irradiance budget (evicting): %s\n",
            same_threads ? "identical" : "DIFFERENT", same_budget ? "identical" : "DIFFERENT");
     float *diff = malloc(bytes);

@@ -770,6 +770,11 @@ typedef struct RayesRenderOptions {
                                   (memo 6.2); 0: the shader runs at every subsurface hit */
     double irradiance_cache_mb; /* the irradiance entries' budget in megabytes (10^6 bytes),
                                   default 20, apart from cache_mb */
+    int irradiance_shadow_rays; /* shadow rays per light at each point of an irradiance
+                                   cache fill, where the shader asks for the default: a
+                                   cached value is shared by every subsurface ray near it,
+                                   so it can afford more than a camera hit. 0 (default):
+                                   max(shadow_rays, 16) (16 in preview, 64 in final) */
 } RayesRenderOptions;
 
 /* Fills options with the defaults of a quality preset: 512 x 512, 4 pixel

@@ -49,6 +49,8 @@ static const char render_options[] =
     "  --shadow-rays N         shadow rays per shading point and light\n"
     "  --subsurface-rays N     subsurface rays per shading point of a subsurface material\n"
     "                          (default 4 preview, 64 final)\n"
+    "  --irradiance-shadow-rays N  shadow rays per light at irradiance cache fills\n"
+    "                          (default max(shadow rays, 16))\n"
     "  --diffuse-rays N        diffuse rays per shading point (all depths)\n"
     "  --diffuse-rays-deep N   diffuse rays per shading point below depth 0\n"
     "  --specular-depth N      maximum specular depth (default 4)\n"
@@ -355,6 +357,8 @@ void parse_args(int argc, char **argv, Args *a)
             opt->shadow_rays = opt->shadow_rays_deep = (int)parse_long(o, v, 0, 1 << 20);
         else if (strcmp(o, "--subsurface-rays") == 0)
             opt->subsurface_rays = (int)parse_long(o, v, 0, 1 << 20);
+        else if (strcmp(o, "--irradiance-shadow-rays") == 0)
+            opt->irradiance_shadow_rays = (int)parse_long(o, v, 0, 1 << 20);
         else if (strcmp(o, "--diffuse-rays") == 0)
             opt->diffuse_rays = opt->diffuse_rays_deep = (int)parse_long(o, v, 0, 1 << 20);
         else if (strcmp(o, "--diffuse-rays-deep") == 0)

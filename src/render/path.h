@@ -71,6 +71,9 @@ typedef struct PathState {
                                      6.2), or NULL: not asked for */
     uint32_t instance;            /* the object instance grid is seen through: 0, or its
                                      GridSet index + 1 (its object's light links apply) */
+    int shadow_rays;              /* shadow rays per light where the shader asks for the
+                                     default, or 0: the renderer's setting for the depth
+                                     (an irradiance cache fill sets its own) */
 } PathState;
 
 /* The texture-space footprint of a point whose parameter footprint is

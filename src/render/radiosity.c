@@ -375,18 +375,11 @@ static void fill_radiosity(void *user, const CacheKey *key, size_t n, float (*ou
         backfacing[i] = key->side != 0; /* side 1: against dPdu x dPdv */
     }
     int own_st = (g->primvars & GEOM_PV_ST) != 0;
-    PathState ps = {w,
-                    fp.keys,
-                    fp.diff,
-                    fp.curv,
-                    fp.offset,
-                    NULL,
-                    key->patch,
-                    own_st ? fp.ds : NULL,
-                    own_st ? fp.dt : NULL,
-                    0,
-                    NULL,
-                    key->instance};
+    PathState ps = {w, fp.keys, fp.diff, fp.curv, fp.offset, NULL, key->patch,
+                    own_st ? fp.ds : NULL, own_st ? fp.dt : NULL, 0, NULL, key->instance,
+                    /* irradiance is shared by every subsurface ray near it: more
+                     * light samples than a camera hit's (DESIGN.md) */
+                    key->type == CACHE_IRRADIANCE ? w->set->irradiance_shadow_rays : 0};
     RayesShadeCtx ctx = {
         .n_points = n,
         .ray_type = fill_ray_type(key->type),

@@ -83,8 +83,11 @@ static Vec3 transmittance(Worker *w, Vec3 o, Vec3 wi, float dist, RayDiff diff)
  * point: that many, or with 0 the renderer's setting for the depth. */
 static int shadow_ray_count(const Worker *w, const RayesShadeCtx *ctx, int n_shadow_rays)
 {
+    const PathState *ps = ctx->renderer;
     if (n_shadow_rays > 0)
         return n_shadow_rays;
+    if (ps && ps->shadow_rays > 0) /* an irradiance fill's own count */
+        return ps->shadow_rays;
     return ctx->diffuse_depth == 0 ? w->set->shadow_rays : w->set->shadow_rays_deep;
 }
 
@@ -134,6 +137,10 @@ static void light_delta(Worker *w, const DirectPoint *p, const Light *l, Vec3 *d
 static void light_area(Worker *w, const DirectPoint *p, const Light *l, uint64_t key, int n,
                        Vec3 *diffuse, Vec3 *spec)
 {
+    /* wholly below the point's horizon: every strategy's sample has a
+     * cosine <= 0 and adds nothing (the same sums, without drawing them) */
+    if (light_below_plane(l, p->o, p->N))
+        return;
     Vec3 sum_d = v3(0, 0, 0), sum_s = v3(0, 0, 0);
     uint32_t pattern = (uint32_t)key, pat_cos = (uint32_t)hash_combine(key, 1),
              pat_bp = (uint32_t)hash_combine(key, 2);

@@ -81,11 +81,12 @@ static Vec3 probe_point(Worker *w, const Medium *m, const SubsurfacePoint *sp)
 
 /* The irradiance on the outside at a subsurface hit: cached, or the
  * shader's at the hit alone; spread is the ray's share of the sphere
- * (radians). */
-static Vec3 irradiance_at(Worker *w, const Ray *ray, const Hit *hit, float spread, uint64_t key)
+ * (radians), lookup the spread that chooses the cache's resolution. */
+static Vec3 irradiance_at(Worker *w, const Ray *ray, const Hit *hit, float spread, float lookup,
+                          uint64_t key)
 {
     if (w->set->irradiance_cache && w->set->cache)
-        return radiosity_irradiance_at_hit(w, ray, hit, spread * hit->t);
+        return radiosity_irradiance_at_hit(w, ray, hit, lookup * hit->t);
     return integrator_irradiance(w, ray, hit, key, (RayDiff){0.0f, spread});
 }
 
@@ -93,8 +94,11 @@ static Vec3 irradiance_at(Worker *w, const Ray *ray, const Hit *hit, float sprea
 static Vec3 integrate_point(Worker *w, const Medium *m, const SubsurfacePoint *sp, int n)
 {
     Vec3 c = probe_point(w, m, sp), sum = v3(0, 0, 0);
-    float share = 4.0f * SUBSURFACE_PI / (float)n; /* steradians per ray */
-    float spread = sqrtf(share), mm2 = 1.0f / (m->scale * m->scale);
+    float spread = sqrtf(4.0f * SUBSURFACE_PI / (float)n), mm2 = 1.0f / (m->scale * m->scale);
+    /* the cache's resolution: no coarser than SUBSURFACE_LOOKUP_RAYS rays'
+     * footprint (DESIGN.md: a coarse level's interpolant is biased) */
+    int nl = n > SUBSURFACE_LOOKUP_RAYS ? n : SUBSURFACE_LOOKUP_RAYS;
+    float lookup = sqrtf(4.0f * SUBSURFACE_PI / (float)nl);
     for (int s = 0; s < n; s++) {
         float a, b;
         cmj_sample_2d((uint32_t)s, (uint32_t)n, (uint32_t)sp->key, &a, &b);
@@ -105,7 +109,8 @@ static Vec3 integrate_point(Worker *w, const Medium *m, const SubsurfacePoint *s
             continue; /* an open object: the ray left it */
         float cos_x = fabsf(v3_dot(hit.Ng, ray.d));
         float area = diffusion_sample_area(n, hit.t, cos_x, SUBSURFACE_MIN_COS) * mm2; /* mm^2 */
-        Vec3 E = irradiance_at(w, &ray, &hit, spread, hash_combine(sp->key, (uint64_t)s + 1));
+        Vec3 E =
+            irradiance_at(w, &ray, &hit, spread, lookup, hash_combine(sp->key, (uint64_t)s + 1));
         float r = v3_length(v3_sub(v3_madd(c, ray.d, hit.t), sp->P)) / m->scale; /* mm */
         sum.x += diffusion_profile(&m->ch[0], r) * E.x * area;
         sum.y += diffusion_profile(&m->ch[1], r) * E.y * area;

@@ -17,5 +17,10 @@ void subsurface_service(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
  * decayed (R A stays bounded), so the clamp must be small: at 0.1 a
  * marble slab lost 8% of its red (DESIGN.md, subsurface scattering). */
 #define SUBSURFACE_MIN_COS 0.001f
+/* Cached irradiance is looked up at the resolution of a subsurface ray's
+ * footprint t sqrt(4 pi / n), n at least this many (final quality's): with
+ * fewer rays the footprint would choose coarse levels whose interpolant is
+ * biased (DESIGN.md). */
+#define SUBSURFACE_LOOKUP_RAYS 64
 
 #endif /* RAYES_RENDER_SUBSURFACE_H */

@@ -20,6 +20,7 @@
 #include "scene/scene.h"
 #include "session/session.h"
 #include "session/stats.h"
+#include "util/check.h"
 #include "util/log.h"
 #include "util/thread.h"
 
@@ -116,7 +117,8 @@ RayesError session_check_options(RayesScene *scene, const RayesRenderOptions *o)
         what = "options: depths must be 0 to 64";
     else if (o->shadow_rays < 0 || o->shadow_rays_deep < 0 || o->diffuse_rays < 0 ||
              o->diffuse_rays_deep < 0 || o->shadow_rays > 1 << 20 || o->diffuse_rays > 1 << 20 ||
-             o->subsurface_rays < 0 || o->subsurface_rays > 1 << 20)
+             o->subsurface_rays < 0 || o->subsurface_rays > 1 << 20 ||
+             o->irradiance_shadow_rays < 0 || o->irradiance_shadow_rays > 1 << 20)
         what = "options: ray counts must be 0 to 1048576";
     else if (!(o->filter_width > 0.0f) || o->filter_width > 16.0f ||
              (int)o->filter < RAYES_FILTER_BOX || o->filter > RAYES_FILTER_LANCZOS)
@@ -204,6 +206,9 @@ RenderSettings session_settings(const RayesRenderOptions *o)
         .opacity_cache = o->opacity_cache != 0,
         .irradiance_cache = o->irradiance_cache != 0,
         .subsurface_rays = o->subsurface_rays,
+        .irradiance_shadow_rays = o->irradiance_shadow_rays > 0
+                                      ? o->irradiance_shadow_rays
+                                      : RY_MAX(o->shadow_rays, RENDER_IRRADIANCE_SHADOW_RAYS),
         .volume_step = o->volume_step,
         .tile_done = o->tile_done,
         .tile_user = o->tile_user,

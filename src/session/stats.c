@@ -123,6 +123,7 @@ RayesStats *session_stats_new(const RenderSettings *set, const RenderStats *rs, 
     count(s, "threads", (uint64_t)set->threads);
     count(s, "bounces", (uint64_t)set->bounces);
     count(s, "shadow_rays", (uint64_t)set->shadow_rays);
+    count(s, "irradiance_shadow_rays", (uint64_t)set->irradiance_shadow_rays);
     count(s, "diffuse_rays", (uint64_t)set->diffuse_rays);
     if (set->irradiance) {
         count(s, "irradiance/records", rs->irradiance_records);

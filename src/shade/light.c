@@ -223,6 +223,37 @@ static int env_sample(const Light *l, float a, float b, LightSample *s)
 
 /* ---------------------------------------------------------- sampling */
 
+int light_below_plane(const Light *l, Vec3 o, Vec3 n)
+{
+    float top, size; /* the light's highest point over the plane, and its scale */
+    switch (l->type) {
+    case LIGHT_SPHERE: {
+        Vec3 dc = v3_sub(l->from, o);
+        top = v3_dot(dc, n) + l->radius;
+        size = v3_length(dc) + l->radius;
+        break;
+    }
+    case LIGHT_DISK: {
+        Vec3 dc = v3_sub(l->from, o);
+        float r = fabsf(v3_dot(l->ex, n)) + fabsf(v3_dot(l->ey, n));
+        top = v3_dot(dc, n) + r;
+        size = v3_length(dc) + v3_length(l->ex) + v3_length(l->ey);
+        break;
+    }
+    case LIGHT_QUAD:
+        top = -INFINITY, size = 0.0f;
+        for (int k = 0; k < 4; k++) { /* a bilinear patch lies in its corners' hull */
+            Vec3 d = v3_sub(l->P[k], o);
+            top = fmaxf(top, v3_dot(d, n));
+            size = fmaxf(size, v3_length(d));
+        }
+        break;
+    default:
+        return 0;
+    }
+    return top < -1e-3f * size; /* the margin: sampled directions are rounded */
+}
+
 int light_sample(const Light *l, Vec3 o, float a, float b, LightSample *s)
 {
     switch (l->type) {

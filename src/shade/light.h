@@ -100,6 +100,12 @@ static inline int light_is_area(const Light *l)
            l->type == LIGHT_ENVIRONMENT;
 }
 
+/* Nonzero if every point of an area light (quad, disk, sphere) lies below
+ * the plane through o with unit normal n, by a margin: no direction from o
+ * with a positive cosine to n reaches it, so a lit point facing n gets
+ * nothing from it and its samples can be skipped. 0 for the others. */
+int light_below_plane(const Light *l, Vec3 o, Vec3 n);
+
 /* Nonzero if the light belongs to a selection as shader.h's direct_lighting
  * says: NULL or "" every light; "name" lights whose category list holds
  * name; "-name" those whose list does not. */

@@ -7,12 +7,15 @@
  * an internal blocker) darkens the top; subsurface rays never leave their
  * object (an unlit sphere overlapping a lit one stays black); the
  * irradiance cache gives the uncached image within noise; images do not
- * depend on threads or the irradiance cache's budget.
+ * depend on threads or the irradiance cache's budget; irradiance fills take
+ * their own shadow-ray count (uncached hits the camera's); 4 subsurface
+ * rays read cached irradiance at the resolutions 64 do.
  *
  * Units: mm. The camera looks down the z axis at the slabs' top (z = 0)
  * from 400 mm, seeing its central 40 mm.
  */
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -341,8 +344,116 @@ static void test_same_image_whatever_threads_and_budget(void)
     rayes_scene_release(s);
 }
 
+/* The marble sphere under a spherical area light (its shadow rays per
+ * point are the count asked for), rendered in preview (4 shadow and 4
+ * subsurface rays) with fill_rays shadow rays at irradiance fills (0: the
+ * default). */
+static RayesImage *area_render(RayesScene *s, int threads, int cached, int fill_rays,
+                               RayesStats **st)
+{
+    RayesRenderOptions o;
+    rayes_render_options_init(&o, RAYES_QUALITY_PREVIEW);
+    o.width = o.height = 32;
+    o.spp = 1;
+    o.threads = threads;
+    o.bounces = 0;
+    o.irradiance_cache = cached;
+    o.irradiance_shadow_rays = fill_rays;
+    RayesImage *img = NULL;
+    CHECK(rayes_render(s, &o, &img, st) == RAYES_OK);
+    return img;
+}
+
+static void test_irradiance_fills_take_their_own_shadow_rays(void)
+{
+    RayesScene *s = rayes_scene_new();
+    static const float eye[3] = {0, 0, 150}, at[3] = {0, 0, 0}, up[3] = {0, 1, 0};
+    static const float at_light[16] = {1, 0, 0, 80, 0, 1, 0, 30, 0, 0, 1, -40, 0, 0, 0, 1};
+    static const float identity[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
+    CHECK(rayes_scene_set_camera(s, eye, at, up, 20.0f) == RAYES_OK);
+    RayesParam lp[3] = {ps("shape", "sphere"), pf("radius", 10.0f), pf("intensity", 80.0f)};
+    CHECK(rayes_scene_set_transform(s, at_light) == RAYES_OK);
+    CHECK(rayes_scene_light(s, "arealight", lp, 3) == RAYES_OK);
+    CHECK(rayes_scene_set_transform(s, identity) == RAYES_OK);
+    marble(s, "dipole");
+    CHECK(rayes_scene_sphere(s, 10.0f) == RAYES_OK);
+    CHECK(rayes_scene_commit(s) == RAYES_OK);
+    RayesStats *def = NULL, *four = NULL, *sixty = NULL, *one = NULL, *u4 = NULL, *u64 = NULL;
+    RayesImage *a = area_render(s, 2, 1, 0, &def), *b = area_render(s, 2, 1, 4, &four),
+               *c = area_render(s, 2, 1, 64, &sixty), *d = area_render(s, 1, 1, 0, &one),
+               *e = area_render(s, 2, 0, 4, &u4), *f = area_render(s, 2, 0, 64, &u64);
+    /* the default is max(shadow rays, 16) */
+    CHECK(stat(def, "irradiance_shadow_rays") == 16 && stat(four, "irradiance_shadow_rays") == 4);
+    /* the same fills, more shadow rays at each of their points; the
+     * camera hits' rays are the same */
+    uint64_t pts = stat(def, "subsurface/irradiance_points");
+    CHECK(pts > 0 && stat(four, "subsurface/irradiance_points") == pts);
+    CHECK(stat(four, "rays/shadow") < stat(def, "rays/shadow"));
+    CHECK(stat(def, "rays/shadow") < stat(sixty, "rays/shadow"));
+    CHECK(stat(sixty, "rays/shadow") - stat(four, "rays/shadow") >= pts);
+    /* uncached, every subsurface hit takes the camera's shadow rays, the
+     * option unused */
+    CHECK(stat(u4, "rays/shadow") == stat(u64, "rays/shadow"));
+    size_t bytes = (size_t)32 * 32 * 4 * sizeof(float);
+    CHECK(a && b && d && e && f);
+    if (a && b && d && e && f) {
+        CHECK(memcmp(a->rgba, d->rgba, bytes) == 0); /* threads */
+        CHECK(memcmp(a->rgba, b->rgba, bytes) != 0);
+        CHECK(memcmp(e->rgba, f->rgba, bytes) == 0);
+    }
+    RayesImage *imgs[6] = {a, b, c, d, e, f};
+    RayesStats *sts[6] = {def, four, sixty, one, u4, u64};
+    for (int k = 0; k < 6; k++) {
+        rayes_image_free(imgs[k]);
+        rayes_stats_free(sts[k]);
+    }
+    rayes_scene_release(s);
+}
+
+/* The share of irradiance lookups at a level. */
+static double level_share(const RayesStats *st, const char *level)
+{
+    static const char *const all[3] = {"coarse", "medium", "fine"};
+    char name[64];
+    double sum = 0.0, mine = 0.0;
+    for (int l = 0; l < 3; l++) {
+        snprintf(name, sizeof name, "cache/irradiance/%s/lookups", all[l]);
+        double n = (double)stat(st, name);
+        sum += n;
+        if (!strcmp(all[l], level))
+            mine = n;
+    }
+    return sum > 0.0 ? mine / sum : 0.0;
+}
+
+static void test_few_rays_read_final_resolutions(void)
+{
+    /* With 4 rays a ray's own footprint would pick coarse levels, whose
+     * interpolant is biased; lookups are no coarser than 64 rays'
+     * (SUBSURFACE_LOOKUP_RAYS), so preview reads the levels final does. */
+    RayesScene *s = new_scene();
+    marble(s, "dipole");
+    slab(s, 60.0f, -6.0f, 0); /* flat, so coarse levels are allowed */
+    distant_light(s, 1.0f);
+    RayesStats *four = NULL, *sixty = NULL;
+    RayesImage *a = render_res(s, 32, 2, 4, 1, 20.0, &four),
+               *b = render_res(s, 32, 2, 64, 1, 20.0, &sixty);
+    CHECK(stat(four, "subsurface/points") > 0);
+    for (int l = 0; l < 3; l++) {
+        const char *level = l == 0 ? "coarse" : l == 1 ? "medium" : "fine";
+        CHECK_NEAR(level_share(four, level), level_share(sixty, level), 0.1);
+    }
+    rayes_image_free(a);
+    rayes_image_free(b);
+    rayes_stats_free(four);
+    rayes_stats_free(sixty);
+    rayes_scene_release(s);
+}
+
 TEST_MAIN(TEST(test_thick_slab_reflects_dipole_rd), TEST(test_white_furnace_conserves_energy),
           TEST(test_renderman_albedo_and_mean_free_path),
           TEST(test_light_bleeds_through_and_blockers_stop_it),
           TEST(test_rays_never_leave_their_object), TEST(test_cached_matches_uncached),
-          TEST(test_same_image_whatever_threads_and_budget))
+          TEST(test_same_image_whatever_threads_and_budget),
+          TEST(test_irradiance_fills_take_their_own_shadow_rays),
+          TEST(test_few_rays_read_final_resolutions))
