@@ -258,11 +258,22 @@ static int build_tris(Accel *a, Level *lv, const uint32_t *idx, size_t n, uint32
     return attach(lv, geom, mask, g);
 }
 
-/* A curve grid's centre line: vertex i of its 2 rows, midway, and half
- * the distance between them (the radius). */
-static void centre_vertex(const GridSet *gs, const Grid *g, uint32_t i, float out[4])
+/* Time samples a run of grids needs: the grid set's when any moves,
+ * else 1. */
+static int run_steps(const GridSet *gs, const uint32_t *idx, size_t n)
 {
-    Vec3 a = gs->P[g->first_vertex + i], b = gs->P[g->first_vertex + g->nu + i];
+    for (size_t k = 0; gs->n_times > 1 && k < n; k++)
+        if (gs->grids[idx[k]].moving)
+            return gs->n_times;
+    return 1;
+}
+
+/* A curve grid's centre line at time sample t: vertex i of its 2 rows,
+ * midway, and half the distance between them (the radius). */
+static void centre_vertex(const GridSet *gs, const Grid *g, uint32_t i, int t, float out[4])
+{
+    Vec3 a = geom_vertex_P_at_sample(gs, g, g->first_vertex + i, t);
+    Vec3 b = geom_vertex_P_at_sample(gs, g, g->first_vertex + g->nu + i, t);
     Vec3 c = v3_scale(v3_add(a, b), 0.5f);
     out[0] = c.x, out[1] = c.y, out[2] = c.z;
     out[3] = 0.5f * v3_length(v3_sub(b, a));
@@ -284,8 +295,22 @@ static int build_curves(Accel *a, Level *lv, const uint32_t *idx, size_t n, uint
     RTCGeometry geom = rtcNewGeometry(a->device, shape == GEOM_SHAPE_ROUND_CURVE
                                                      ? RTC_GEOMETRY_TYPE_ROUND_LINEAR_CURVE
                                                      : RTC_GEOMETRY_TYPE_FLAT_LINEAR_CURVE);
-    float(*vtx)[4] = rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT4,
-                                             4 * sizeof(float), n_vtx);
+    int steps = run_steps(gs, idx, n);
+    rtcSetGeometryTimeStepCount(geom, (unsigned)steps);
+    float(*vtx)[4] = NULL;
+    for (int t = 0; t < steps; t++) { /* Embree copies nothing: a buffer per sample */
+        float(*b)[4] = rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, (unsigned)t,
+                                               RTC_FORMAT_FLOAT4, 4 * sizeof(float), n_vtx);
+        if (!b) {
+            rtcReleaseGeometry(geom);
+            return -1;
+        }
+        for (size_t k = 0, v = 0; k < n; v += gs->grids[idx[k]].nu, k++)
+            for (uint32_t i = 0; i < gs->grids[idx[k]].nu; i++)
+                centre_vertex(gs, &gs->grids[idx[k]], i, t, b[v + i]);
+        if (t == 0)
+            vtx = b;
+    }
     uint32_t *index = rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT,
                                               sizeof(uint32_t), n_seg);
     Geom g = {.kind = KIND_CURVES, .shape = (uint8_t)shape, .segs = malloc(n_seg * sizeof(CurveSeg))};
@@ -298,7 +323,6 @@ static int build_curves(Accel *a, Level *lv, const uint32_t *idx, size_t n, uint
     for (size_t k = 0; k < n; k++) {
         const Grid *src = &gs->grids[idx[k]];
         for (uint32_t i = 0; i < src->nu; i++) {
-            centre_vertex(gs, src, i, vtx[v + i]);
             if (i + 1 < src->nu) {
                 index[t] = (uint32_t)(v + i);
                 g.segs[t++] = (CurveSeg){idx[k], i};
@@ -311,13 +335,14 @@ static int build_curves(Accel *a, Level *lv, const uint32_t *idx, size_t n, uint
 
 static Vec3 unit_or_zero(Vec3 n);
 
-/* The corners of a point grid's square: (0,0), (1,0), (0,1). */
-static void point_square(const GridSet *gs, const Grid *g, Vec3 *o, Vec3 *x, Vec3 *y)
+/* The corners of a point grid's square at time sample t: (0,0), (1,0),
+ * (0,1). */
+static void point_square(const GridSet *gs, const Grid *g, int t, Vec3 *o, Vec3 *x, Vec3 *y)
 {
     uint32_t b = g->first_vertex;
-    *o = gs->P[b];
-    *x = v3_sub(gs->P[b + g->nu - 1u], *o);
-    *y = v3_sub(gs->P[b + (uint32_t)(g->nv - 1) * g->nu], *o);
+    *o = geom_vertex_P_at_sample(gs, g, b, t);
+    *x = v3_sub(geom_vertex_P_at_sample(gs, g, b + g->nu - 1u, t), *o);
+    *y = v3_sub(geom_vertex_P_at_sample(gs, g, b + (uint32_t)(g->nv - 1) * g->nu, t), *o);
 }
 
 /* Point grids as Embree spheres or ray-facing disks inscribed in their
@@ -331,29 +356,37 @@ static int build_points(Accel *a, Level *lv, const uint32_t *idx, size_t n, uint
                                                  : shape == GEOM_SHAPE_DISK
                                                      ? RTC_GEOMETRY_TYPE_DISC_POINT
                                                      : RTC_GEOMETRY_TYPE_ORIENTED_DISC_POINT);
-    float(*vtx)[4] = rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT4,
-                                             4 * sizeof(float), n);
-    float(*nrm)[3] = shape == GEOM_SHAPE_ORIENTED_DISK
-                         ? rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_NORMAL, 0,
-                                                   RTC_FORMAT_FLOAT3, 3 * sizeof(float), n)
-                         : NULL;
+    int steps = run_steps(gs, idx, n);
+    rtcSetGeometryTimeStepCount(geom, (unsigned)steps);
     Geom g = {.kind = KIND_POINTS, .shape = (uint8_t)shape, .grids = malloc(n * sizeof(uint32_t))};
-    if (!vtx || !g.grids || (shape == GEOM_SHAPE_ORIENTED_DISK && !nrm)) {
-        free(g.grids);
+    for (int t = 0; g.grids && t < steps; t++) {
+        float(*vtx)[4] = rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, (unsigned)t,
+                                                 RTC_FORMAT_FLOAT4, 4 * sizeof(float), n);
+        float(*nrm)[3] = shape == GEOM_SHAPE_ORIENTED_DISK
+                             ? rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_NORMAL, (unsigned)t,
+                                                       RTC_FORMAT_FLOAT3, 3 * sizeof(float), n)
+                             : NULL;
+        if (!vtx || (shape == GEOM_SHAPE_ORIENTED_DISK && !nrm)) {
+            free(g.grids);
+            rtcReleaseGeometry(geom);
+            return -1;
+        }
+        for (size_t k = 0; k < n; k++) {
+            Vec3 o, x, y;
+            point_square(gs, &gs->grids[idx[k]], t, &o, &x, &y);
+            Vec3 c = v3_add(o, v3_scale(v3_add(x, y), 0.5f));
+            vtx[k][0] = c.x, vtx[k][1] = c.y, vtx[k][2] = c.z;
+            vtx[k][3] = 0.5f * v3_length(x);
+            if (nrm) {
+                Vec3 N = unit_or_zero(v3_cross(x, y));
+                nrm[k][0] = N.x, nrm[k][1] = N.y, nrm[k][2] = N.z;
+            }
+            g.grids[k] = idx[k];
+        }
+    }
+    if (!g.grids) {
         rtcReleaseGeometry(geom);
         return -1;
-    }
-    for (size_t k = 0; k < n; k++) {
-        Vec3 o, x, y;
-        point_square(gs, &gs->grids[idx[k]], &o, &x, &y);
-        Vec3 c = v3_add(o, v3_scale(v3_add(x, y), 0.5f));
-        vtx[k][0] = c.x, vtx[k][1] = c.y, vtx[k][2] = c.z;
-        vtx[k][3] = 0.5f * v3_length(x);
-        if (nrm) {
-            Vec3 N = unit_or_zero(v3_cross(x, y));
-            nrm[k][0] = N.x, nrm[k][1] = N.y, nrm[k][2] = N.z;
-        }
-        g.grids[k] = idx[k];
     }
     return attach(lv, geom, mask, g);
 }
@@ -749,8 +782,11 @@ static void point_hit(const Accel *a, const Geom *g, const struct RTCHit *h, con
 {
     const GridSet *gs = a->gs;
     const Grid *grid = &gs->grids[g->grids[h->primID]];
-    Vec3 o, x, y;
-    point_square(gs, grid, &o, &x, &y);
+    float rt = embree_time(a, ray); /* the square where the ray met it */
+    uint32_t b = grid->first_vertex;
+    Vec3 o = vertex_at(gs, grid, b, rt);
+    Vec3 x = v3_sub(vertex_at(gs, grid, b + grid->nu - 1u, rt), o);
+    Vec3 y = v3_sub(vertex_at(gs, grid, b + (uint32_t)(grid->nv - 1) * grid->nu, rt), o);
     Vec3 p = v3_madd(ray->o, ray->d, tfar);
     if (gi)
         p = mat4_point(&gi->master_from_world, p);
@@ -758,7 +794,7 @@ static void point_hit(const Accel *a, const Geom *g, const struct RTCHit *h, con
     float xx = v3_dot(x, x), yy = v3_dot(y, y);
     float u = xx > 0.0f ? fminf(fmaxf(v3_dot(d, x) / xx, 0.0f), 1.0f) : 0.5f;
     float v = yy > 0.0f ? fminf(fmaxf(v3_dot(d, y) / yy, 0.0f), 1.0f) : 0.5f;
-    quad_hit(a, g, h->primID, u, v, embree_time(a, ray), hit);
+    quad_hit(a, g, h->primID, u, v, rt, hit);
     hit->Ng = shape_normal(h, ray, g->shape);
 }
 

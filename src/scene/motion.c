@@ -18,9 +18,11 @@
  *  - Deformation blur: the vertex moves by the difference of the
  *    primitive's surface at (u, v) between time t and t0, so the diced,
  *    displaced and stitched vertex keeps its offset from the surface.
- * Curves and points do not move (Embree's curve and point buffers are
- * built from sample 0). Only the surfaces of moving primitives have later
- * samples (GridSet.Pt and the rest, compact: Grid.motion_vertex).
+ * Curves and points move by transform only (their grids are ribbons and
+ * squares diced for the eye, which a transform carries; a deformation
+ * block of curves or points takes its first sample's shape). Only the
+ * grids of moving primitives have later samples (GridSet.Pt and the
+ * rest, compact: Grid.motion_vertex).
  *
  * Threading: the API calls edit one scene (one thread); prepare reads it.
  */
@@ -294,6 +296,16 @@ static const Prim *deform_prim(const RayesScene *s, const SceneMotion *m, size_t
                   : &s->motion_prims[m->first + (size_t)(k - 1) * m->n_prims + j];
 }
 
+/* 1 if grid g has later time samples: a surface of a moving primitive,
+ * or a curve or point grid of one moved by its transform. */
+static int grid_moves(const RayesScene *s, const Grid *g)
+{
+    const Prim *p = &s->prims[g->prim];
+    if (!p->motion)
+        return 0;
+    return g->shape == GEOM_SHAPE_SURFACE || !s->motions[p->motion - 1].deform;
+}
+
 /* The GridSet's time samples: from the earliest to the latest motion
  * time, spaced by the finest motion's smallest spacing. Returns the count
  * (1: nothing moves). */
@@ -377,7 +389,7 @@ int scene_motion_prepare(const RayesScene *s, GridSet *gs)
     size_t slots = 0;
     for (size_t gi = 0; gi < gs->n_grids; gi++) {
         Grid *g = &gs->grids[gi];
-        if (s->prims[g->prim].motion && g->shape == GEOM_SHAPE_SURFACE) {
+        if (grid_moves(s, g)) {
             g->motion_vertex = (uint32_t)slots;
             slots += geom_grid_n_vertices(g);
         }
@@ -394,7 +406,7 @@ int scene_motion_prepare(const RayesScene *s, GridSet *gs)
     }
     for (size_t gi = 0; gi < gs->n_grids; gi++) {
         Grid *g = &gs->grids[gi];
-        if (!s->prims[g->prim].motion || g->shape != GEOM_SHAPE_SURFACE)
+        if (!grid_moves(s, g))
             continue;
         for (int k = 1; k < n; k++)
             move_grid(s, gs, g, k, span[0] + (span[1] - span[0]) * (float)k / (float)(n - 1));

@@ -100,6 +100,68 @@ static void test_moving_sphere_coverage(void)
     rayes_scene_release(s);
 }
 
+/* Points and curves move by their transform too: a sphere point of
+ * diameter 2 moving as the sphere above covers what it covers, and a
+ * vertical tube of width 0.5 moving 2 units across covers a band 2.5
+ * wide, its time-averaged area its own (length times width, and its
+ * round end caps), and the middle a quarter of the time. */
+static void test_moving_points_and_curves(void)
+{
+    for (int kind = 0; kind < 2; kind++) {
+        RayesScene *s = rayes_scene_new();
+        ortho_camera(s);
+        CHECK(rayes_scene_set_shutter(s, 0.0f, 1.0f) == RAYES_OK);
+        float m[2][16];
+        translate(m[0], -1, 0, 0);
+        translate(m[1], 1, 0, 0);
+        const float times[2] = {0, 1};
+        CHECK(rayes_scene_set_transform_motion(s, 2, times, (const float(*)[16])m) == RAYES_OK);
+        if (kind == 0) {
+            const float P[3] = {0, 0, 0}, width = 2.0f;
+            RayesPrimvar pv = {"width", RAYES_PRIMVAR_CONSTANT, &width, 1};
+            CHECK(rayes_scene_points(s, RAYES_POINT_SPHERE, 1, P, &pv, 1) == RAYES_OK);
+        } else {
+            const float P[6] = {0, -1.5f, 0, 0, 1.5f, 0}, width = 0.5f;
+            const int nv = 2;
+            RayesCurves c = {.degree = 1, .shape = RAYES_CURVE_ROUND, .n_curves = 1,
+                             .n_verts = &nv, .P = P};
+            RayesPrimvar pv = {"width", RAYES_PRIMVAR_CONSTANT, &width, 1};
+            CHECK(rayes_scene_curves(s, &c, &pv, 1) == RAYES_OK);
+        }
+        RayesStats *st = NULL;
+        RayesImage *img = render(s, 64, 2, 1, &st);
+        const RayesStat *moving = rayes_stats_find(st, "motion/moving_grids");
+        CHECK(moving && moving->count > 0);
+        rayes_stats_free(st);
+        double err = 0, sum = 0, outside = 0;
+        float px = 2 * HALF / W;
+        for (int y = 0; img && y < W; y++)
+            for (int x = 0; x < W; x++) {
+                double cx = -HALF + (x + 0.5) * px, cy = HALF - (y + 0.5) * px;
+                double got = img->rgba[4 * (y * W + x) + 3];
+                sum += got;
+                if (kind == 0)
+                    err += fabs(got - disk_time_coverage(cx, cy));
+                else if (fabs(cx) > 1.25 + px || fabs(cy) > 1.5 + 0.25 + px)
+                    outside += got;
+            }
+        double area = kind == 0 ? M_PI : 3.0 * 0.5 + M_PI * 0.25 * 0.25; /* + the end caps */
+        printf("  moving %s: coverage %.4f (%.4f)\n", kind ? "tube" : "sphere point",
+               sum * px * px, area);
+        CHECK_NEAR(sum * px * px, area, 0.03 * area);
+        if (kind == 0)
+            CHECK(err / (W * W) < 0.02);
+        else
+            CHECK(outside == 0.0);
+        if (kind == 1) { /* blurred: the middle sees the tube a quarter of the shutter */
+            double mid = img ? img->rgba[4 * ((W / 2) * W + W / 2) + 3] : 0;
+            CHECK_NEAR(mid, 0.25, 0.05);
+        }
+        rayes_image_free(img);
+        rayes_scene_release(s);
+    }
+}
+
 /* A lit bilinear patch (4 x 2 units, facing the camera) moving from x = -1
  * to x = 1: by its transform, or by its two shapes. */
 static RayesScene *patch_scene(int deform, float motionfactor)
@@ -433,6 +495,7 @@ static void test_moving_hits(void)
     rayes_scene_release(s);
 }
 
-TEST_MAIN(TEST(test_moving_hits), TEST(test_moving_sphere_coverage), TEST(test_motionfactor),
+TEST_MAIN(TEST(test_moving_hits), TEST(test_moving_sphere_coverage),
+          TEST(test_moving_points_and_curves), TEST(test_motionfactor),
           TEST(test_cached_segments_match_uncached), TEST(test_motion_determinism),
           TEST(test_deformation_equals_transform), TEST(test_bad_motion), TEST(test_camera_motion))
