@@ -42,14 +42,6 @@ typedef struct Vars {
     size_t count[5]; /* per RayesPrimvarClass */
 } Vars;
 
-static int finite_all(const float *v, size_t n)
-{
-    for (size_t i = 0; i < n; i++)
-        if (!isfinite(v[i]))
-            return 0;
-    return 1;
-}
-
 static RayesError read_vars(RayesScene *s, const char *what, const RayesPrimvar *pv, size_t n_pv,
                             Vars *vars)
 {
@@ -77,7 +69,7 @@ static RayesError read_vars(RayesScene *s, const char *what, const RayesPrimvar 
             return scene_fail(s, RAYES_ERROR_INVALID_ARGUMENT,
                               "%s: %s has %zu values; expected %zu for its class", what,
                               var_names[b], pv[i].count, want);
-        if (!pv[i].data || !finite_all(pv[i].data, want * (size_t)var_sizes[b]))
+        if (!pv[i].data || !scene_finite(pv[i].data, want * (size_t)var_sizes[b]))
             return scene_fail(s, RAYES_ERROR_INVALID_ARGUMENT,
                               "%s: primitive variable %s has no data or a non-finite value", what,
                               var_names[b]);
@@ -168,7 +160,7 @@ static RayesError check_curves(RayesScene *s, const RayesCurves *c, size_t *n_po
     if (c->degree != 1 && c->degree != 3)
         return scene_fail(s, RAYES_ERROR_INVALID_ARGUMENT, "curves: degree %d; expected 1 or 3",
                           c->degree);
-    if (c->degree == 3 && (c->step < 1 || c->step > 4 || !finite_all(c->basis, 16)))
+    if (c->degree == 3 && (c->step < 1 || c->step > 4 || !scene_finite(c->basis, 16)))
         return scene_fail(s, RAYES_ERROR_INVALID_ARGUMENT,
                           "curves: basis step %d; expected 1 to 4 and a finite basis", c->step);
     if (c->n_curves && (!c->n_verts || !c->P))
@@ -185,7 +177,7 @@ static RayesError check_curves(RayesScene *s, const RayesCurves *c, size_t *n_po
         *n_points += (size_t)c->n_verts[k];
         *n_varying += c->periodic ? segs : segs + 1;
     }
-    if (!finite_all(c->P, 3 * *n_points))
+    if (!scene_finite(c->P, 3 * *n_points))
         return scene_fail(s, RAYES_ERROR_INVALID_ARGUMENT, "curves: non-finite point");
     return RAYES_OK;
 }
@@ -354,7 +346,7 @@ RayesError rayes_scene_points(RayesScene *s, RayesPointShape shape, size_t n_poi
 {
     if (!s || (n_points && !P) || (shape != RAYES_POINT_SPHERE && shape != RAYES_POINT_DISK))
         return RAYES_ERROR_INVALID_ARGUMENT;
-    if (!finite_all(P, 3 * n_points))
+    if (!scene_finite(P, 3 * n_points))
         return scene_fail(s, RAYES_ERROR_INVALID_ARGUMENT, "points: non-finite point");
     Vars vars = {.count = {1, 1, n_points, n_points, n_points}};
     RayesError e = read_vars(s, "points", pv, n_pv, &vars);

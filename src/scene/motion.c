@@ -35,30 +35,6 @@
 #include "rayes/rayes.h"
 #include "scene/scene.h"
 
-/* Records the first error (scene.c's scene_fail, kept apart so that the
- * files do not call each other). */
-static RayesError fail(RayesScene *s, RayesError e, const char *fmt, ...)
-    __attribute__((format(printf, 3, 4)));
-
-static RayesError fail(RayesScene *s, RayesError e, const char *fmt, ...)
-{
-    if (s->error[0] == '\0') {
-        va_list ap;
-        va_start(ap, fmt);
-        vsnprintf(s->error, sizeof s->error, fmt, ap);
-        va_end(ap);
-    }
-    return e;
-}
-
-static int finite_all(const float *v, size_t n)
-{
-    for (size_t i = 0; i < n; i++)
-        if (!isfinite(v[i]))
-            return 0;
-    return 1;
-}
-
 /* 1 if times[0 .. n - 1] are finite and strictly increasing. */
 static int increasing(const float *times, size_t n)
 {
@@ -71,10 +47,11 @@ static int increasing(const float *times, size_t n)
 static RayesError check_times(RayesScene *s, const char *what, size_t n, const float *times)
 {
     if (!times || n < 2 || n > RAYES_MAX_TIMES)
-        return fail(s, RAYES_ERROR_INVALID_ARGUMENT, "%s: expected 2 to %d time samples, got %zu",
-                    what, RAYES_MAX_TIMES, n);
+        return scene_fail(s, RAYES_ERROR_INVALID_ARGUMENT,
+                          "%s: expected 2 to %d time samples, got %zu", what, RAYES_MAX_TIMES, n);
     if (!increasing(times, n))
-        return fail(s, RAYES_ERROR_INVALID_ARGUMENT, "%s: expected finite, increasing times", what);
+        return scene_fail(s, RAYES_ERROR_INVALID_ARGUMENT, "%s: expected finite, increasing times",
+                          what);
     return RAYES_OK;
 }
 
@@ -83,8 +60,8 @@ RayesError rayes_scene_set_shutter(RayesScene *s, float open, float close)
     if (!s)
         return RAYES_ERROR_INVALID_ARGUMENT;
     if (!isfinite(open) || !isfinite(close) || close < open)
-        return fail(s, RAYES_ERROR_INVALID_ARGUMENT,
-                    "shutter: expected finite open <= close, got %g %g", open, close);
+        return scene_fail(s, RAYES_ERROR_INVALID_ARGUMENT,
+                          "shutter: expected finite open <= close, got %g %g", open, close);
     s->shutter[0] = open, s->shutter[1] = close;
     scene_mark(s, SCENE_CHANGE_CAMERA);
     return RAYES_OK;
@@ -117,15 +94,15 @@ RayesError rayes_scene_set_transform_motion(RayesScene *s, size_t n, const float
     for (size_t k = 0; k < n; k++) {
         W[k] = mat4_from_array(M[k]);
         Mat4 inv;
-        if (!finite_all(M[k], 16) || !mat4_invert(W[k], &inv))
-            return fail(s, RAYES_ERROR_INVALID_ARGUMENT,
-                        "transform motion: expected finite, invertible matrices");
+        if (!scene_finite(M[k], 16) || !mat4_invert(W[k], &inv))
+            return scene_fail(s, RAYES_ERROR_INVALID_ARGUMENT,
+                              "transform motion: expected finite, invertible matrices");
         if (k == 0)
             inv0 = inv;
     }
     SceneMotion *m = new_motion(s);
     if (!m)
-        return fail(s, RAYES_ERROR_OUT_OF_MEMORY, "out of memory");
+        return scene_fail(s, RAYES_ERROR_OUT_OF_MEMORY, "out of memory");
     m->n_times = (int)n;
     for (size_t k = 0; k < n; k++) {
         m->time[k] = times[k];
@@ -141,7 +118,8 @@ RayesError rayes_scene_motion_begin(RayesScene *s, size_t n, const float *times)
     if (!s)
         return RAYES_ERROR_INVALID_ARGUMENT;
     if (s->deforming)
-        return fail(s, RAYES_ERROR_INVALID_OPERATION, "motion begin: already in a motion block");
+        return scene_fail(s, RAYES_ERROR_INVALID_OPERATION,
+                          "motion begin: already in a motion block");
     RayesError e = check_times(s, "motion begin", n, times);
     if (e != RAYES_OK)
         return e;
@@ -170,7 +148,7 @@ RayesError rayes_scene_motion_end(RayesScene *s)
     if (!s)
         return RAYES_ERROR_INVALID_ARGUMENT;
     if (!s->deforming)
-        return fail(s, RAYES_ERROR_INVALID_OPERATION, "motion end: no motion block");
+        return scene_fail(s, RAYES_ERROR_INVALID_OPERATION, "motion end: no motion block");
     size_t n_times = (size_t)s->deforming, total = s->n_prims - s->deform_first;
     s->deforming = 0;
     size_t per = total / n_times;
@@ -181,14 +159,14 @@ RayesError rayes_scene_motion_end(RayesScene *s)
                 same = 0;
     if (!same) {
         s->n_prims = s->deform_first;
-        return fail(s, RAYES_ERROR_INVALID_ARGUMENT,
-                    "motion end: expected %zu primitives of the same topology, one per time "
-                    "sample",
-                    n_times);
+        return scene_fail(s, RAYES_ERROR_INVALID_ARGUMENT,
+                          "motion end: expected %zu primitives of the same topology, one per time "
+                          "sample",
+                          n_times);
     }
     SceneMotion *m = new_motion(s);
     if (!m)
-        return fail(s, RAYES_ERROR_OUT_OF_MEMORY, "out of memory");
+        return scene_fail(s, RAYES_ERROR_OUT_OF_MEMORY, "out of memory");
     m->n_times = (int)n_times;
     memcpy(m->time, s->deform_time, n_times * sizeof *m->time);
     m->deform = 1;
@@ -197,7 +175,7 @@ RayesError rayes_scene_motion_end(RayesScene *s)
     m->first = s->n_motion_prims;
     for (size_t j = per; j < total; j++)
         if (push_motion_prim(s, &s->prims[s->deform_first + j]) != 0)
-            return fail(s, RAYES_ERROR_OUT_OF_MEMORY, "out of memory");
+            return scene_fail(s, RAYES_ERROR_OUT_OF_MEMORY, "out of memory");
     s->n_prims = s->deform_first + per;
     for (size_t j = 0; j < per; j++)
         s->prims[s->deform_first + j].motion = (uint32_t)s->n_motions;
@@ -216,9 +194,9 @@ RayesError rayes_scene_set_camera_motion(RayesScene *s, size_t n, const float *t
     SceneCamera *c = &s->camera;
     for (size_t k = 0; k < n; k++) {
         Mat4 wc;
-        if (!finite_all(M[k], 16) || !mat4_invert(mat4_from_array(M[k]), &wc))
-            return fail(s, RAYES_ERROR_INVALID_ARGUMENT,
-                        "camera motion: expected finite, invertible matrices");
+        if (!scene_finite(M[k], 16) || !mat4_invert(mat4_from_array(M[k]), &wc))
+            return scene_fail(s, RAYES_ERROR_INVALID_ARGUMENT,
+                              "camera motion: expected finite, invertible matrices");
         c->motion_time[k] = times[k];
         c->motion_eye[k] = mat4_point(&wc, v3(0, 0, 0));
         c->motion_x[k] = mat4_vector(&wc, v3(1, 0, 0));
@@ -238,10 +216,10 @@ RayesError rayes_scene_set_depth_of_field(RayesScene *s, float lens_radius, floa
         return RAYES_ERROR_INVALID_ARGUMENT;
     if (!(lens_radius >= 0.0f) || !isfinite(lens_radius) ||
         (lens_radius > 0.0f && !(focal_distance > 0.0f && isfinite(focal_distance))))
-        return fail(s, RAYES_ERROR_INVALID_ARGUMENT,
-                    "depth of field: expected a lens radius >= 0 and a focal distance > 0, "
-                    "got %g %g",
-                    lens_radius, focal_distance);
+        return scene_fail(s, RAYES_ERROR_INVALID_ARGUMENT,
+                          "depth of field: expected a lens radius >= 0 and a focal distance > 0, "
+                          "got %g %g",
+                          lens_radius, focal_distance);
     s->camera.lens_radius = lens_radius;
     s->camera.focal_distance = lens_radius > 0.0f ? focal_distance : 0.0f;
     scene_mark(s, SCENE_CHANGE_CAMERA);
@@ -254,8 +232,8 @@ RayesError rayes_scene_set_dice_blur(RayesScene *s, float motionfactor, float fo
         return RAYES_ERROR_INVALID_ARGUMENT;
     if (!(motionfactor >= 0.0f) || !(focusfactor >= 0.0f) || !isfinite(motionfactor) ||
         !isfinite(focusfactor))
-        return fail(s, RAYES_ERROR_INVALID_ARGUMENT,
-                    "dice blur: expected motionfactor and focusfactor >= 0");
+        return scene_fail(s, RAYES_ERROR_INVALID_ARGUMENT,
+                          "dice blur: expected motionfactor and focusfactor >= 0");
     s->motionfactor = motionfactor;
     s->focusfactor = focusfactor;
     return RAYES_OK;

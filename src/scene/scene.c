@@ -20,28 +20,6 @@
 #include "util/check.h"
 #include "util/log.h"
 
-static RayesError fail(RayesScene *s, RayesError e, const char *fmt, ...)
-    __attribute__((format(printf, 3, 4)));
-
-static RayesError fail(RayesScene *s, RayesError e, const char *fmt, ...)
-{
-    if (s->error[0] == '\0') {
-        va_list ap;
-        va_start(ap, fmt);
-        vsnprintf(s->error, sizeof s->error, fmt, ap);
-        va_end(ap);
-    }
-    return e;
-}
-
-static int finite_n(const float *v, size_t n)
-{
-    for (size_t i = 0; i < n; i++)
-        if (!isfinite(v[i]))
-            return 0;
-    return 1;
-}
-
 /* Grows *array (of *cap elements of size elem) to hold n + 1. */
 static int grow(void **array, size_t *cap, size_t n, size_t elem)
 {
@@ -145,14 +123,15 @@ RayesError rayes_scene_set_camera(RayesScene *s, const float eye[3], const float
 {
     if (!s || !eye || !target || !up)
         return RAYES_ERROR_INVALID_ARGUMENT;
-    if (!finite_n(eye, 3) || !finite_n(target, 3) || !finite_n(up, 3) || !(fov > 0.0f) ||
-        !(fov < 180.0f))
-        return fail(s, RAYES_ERROR_INVALID_ARGUMENT,
-                    "camera: expected finite vectors and a field of view in (0, 180) degrees");
+    if (!scene_finite(eye, 3) || !scene_finite(target, 3) || !scene_finite(up, 3) ||
+        !(fov > 0.0f) || !(fov < 180.0f))
+        return scene_fail(
+            s, RAYES_ERROR_INVALID_ARGUMENT,
+            "camera: expected finite vectors and a field of view in (0, 180) degrees");
     Vec3 f = v3_sub(v3_load(target), v3_load(eye));
     if (v3_length(f) <= 0.0f || v3_length(v3_cross(f, v3_load(up))) <= 0.0f)
-        return fail(s, RAYES_ERROR_INVALID_ARGUMENT,
-                    "camera: the eye equals the target, or up is parallel to the view");
+        return scene_fail(s, RAYES_ERROR_INVALID_ARGUMENT,
+                          "camera: the eye equals the target, or up is parallel to the view");
     look_at(&s->camera, eye, target, up, fov);
     scene_mark(s, SCENE_CHANGE_CAMERA);
     return RAYES_OK;
@@ -164,18 +143,19 @@ RayesError rayes_scene_set_camera_matrix(RayesScene *s, const float m[16], Rayes
     if (!s || !m)
         return RAYES_ERROR_INVALID_ARGUMENT;
     Mat4 world_from_camera;
-    if (!finite_n(m, 16) || !mat4_invert(mat4_from_array(m), &world_from_camera))
-        return fail(s, RAYES_ERROR_INVALID_ARGUMENT,
-                    "camera: expected a finite, invertible camera_from_world matrix");
+    if (!scene_finite(m, 16) || !mat4_invert(mat4_from_array(m), &world_from_camera))
+        return scene_fail(s, RAYES_ERROR_INVALID_ARGUMENT,
+                          "camera: expected a finite, invertible camera_from_world matrix");
     if (proj != RAYES_PROJECTION_PERSPECTIVE && proj != RAYES_PROJECTION_ORTHOGRAPHIC)
-        return fail(s, RAYES_ERROR_INVALID_ARGUMENT,
-                    "camera: expected a perspective or orthographic projection");
+        return scene_fail(s, RAYES_ERROR_INVALID_ARGUMENT,
+                          "camera: expected a perspective or orthographic projection");
     if (proj == RAYES_PROJECTION_PERSPECTIVE && !(fov > 0.0f && fov < 180.0f))
-        return fail(s, RAYES_ERROR_INVALID_ARGUMENT,
-                    "camera: expected a field of view in (0, 180) degrees");
-    if (screen && (!finite_n(screen, 4) || !(screen[1] != screen[0]) || !(screen[3] != screen[2])))
-        return fail(s, RAYES_ERROR_INVALID_ARGUMENT,
-                    "camera: expected a screen window of nonzero width and height");
+        return scene_fail(s, RAYES_ERROR_INVALID_ARGUMENT,
+                          "camera: expected a field of view in (0, 180) degrees");
+    if (screen &&
+        (!scene_finite(screen, 4) || !(screen[1] != screen[0]) || !(screen[3] != screen[2])))
+        return scene_fail(s, RAYES_ERROR_INVALID_ARGUMENT,
+                          "camera: expected a screen window of nonzero width and height");
     SceneCamera *c = &s->camera;
     c->eye = mat4_point(&world_from_camera, v3(0, 0, 0));
     c->x = mat4_vector(&world_from_camera, v3(1, 0, 0));
@@ -211,9 +191,9 @@ RayesError rayes_scene_set_transform(RayesScene *s, const float m[16])
     if (!s || !m)
         return RAYES_ERROR_INVALID_ARGUMENT;
     Mat4 inv;
-    if (!finite_n(m, 16) || !mat4_invert(mat4_from_array(m), &inv))
-        return fail(s, RAYES_ERROR_INVALID_ARGUMENT,
-                    "transform: expected a finite, invertible matrix");
+    if (!scene_finite(m, 16) || !mat4_invert(mat4_from_array(m), &inv))
+        return scene_fail(s, RAYES_ERROR_INVALID_ARGUMENT,
+                          "transform: expected a finite, invertible matrix");
     s->world_from_object = mat4_from_array(m);
     s->current_motion = 0;
     return RAYES_OK;
@@ -226,9 +206,9 @@ RayesError rayes_scene_set_visibility(RayesScene *s, uint32_t ray_types)
     if (!s)
         return RAYES_ERROR_INVALID_ARGUMENT;
     if (ray_types & ~known)
-        return fail(s, RAYES_ERROR_INVALID_ARGUMENT,
-                    "visibility: expected camera, shadow, diffuse, specular and transmission "
-                    "ray bits only");
+        return scene_fail(s, RAYES_ERROR_INVALID_ARGUMENT,
+                          "visibility: expected camera, shadow, diffuse, specular and transmission "
+                          "ray bits only");
     /* Shadow and transmission rays are one kind to the tracer. */
     if (ray_types & RAYES_RAY_TRANSMISSION)
         ray_types = (ray_types & ~(uint32_t)RAYES_RAY_TRANSMISSION) | RAYES_RAY_SHADOW;
@@ -241,8 +221,8 @@ RayesError rayes_scene_set_opacity_mode(RayesScene *s, RayesTransmissionHitMode 
     if (!s)
         return RAYES_ERROR_INVALID_ARGUMENT;
     if (mode != RAYES_TRANSMISSION_SHADER && mode != RAYES_TRANSMISSION_PRIMITIVE)
-        return fail(s, RAYES_ERROR_INVALID_ARGUMENT,
-                    "opacity mode: expected RAYES_TRANSMISSION_SHADER or _PRIMITIVE");
+        return scene_fail(s, RAYES_ERROR_INVALID_ARGUMENT,
+                          "opacity mode: expected RAYES_TRANSMISSION_SHADER or _PRIMITIVE");
     s->current_hitmode = (uint8_t)mode;
     s->current_opacity_cache = cache != 0;
     return RAYES_OK;
@@ -253,7 +233,8 @@ RayesError rayes_scene_set_shading_rate(RayesScene *s, float rate)
     if (!s)
         return RAYES_ERROR_INVALID_ARGUMENT;
     if (!(rate > 0.0f) || !isfinite(rate))
-        return fail(s, RAYES_ERROR_INVALID_ARGUMENT, "shading rate: expected a positive number");
+        return scene_fail(s, RAYES_ERROR_INVALID_ARGUMENT,
+                          "shading rate: expected a positive number");
     s->shading_rate = rate;
     return RAYES_OK;
 }
@@ -264,7 +245,7 @@ static RayesError add_object(RayesScene *s, const RayesShaderClass *cls, const R
                              size_t n_params, int light)
 {
     if (grow((void **)&s->objects, &s->cap_objects, s->n_objects, sizeof *s->objects) != 0)
-        return fail(s, RAYES_ERROR_OUT_OF_MEMORY, "out of memory");
+        return scene_fail(s, RAYES_ERROR_OUT_OF_MEMORY, "out of memory");
     SceneObject *o = &s->objects[s->n_objects];
     memset(o, 0, sizeof *o);
     o->light = light;
@@ -277,14 +258,15 @@ static RayesError add_object(RayesScene *s, const RayesShaderClass *cls, const R
     RayesParam *rest = n_params ? malloc(n_params * sizeof *rest) : NULL;
     size_t n_rest = 0;
     if (n_params && !rest)
-        return fail(s, RAYES_ERROR_OUT_OF_MEMORY, "out of memory");
+        return scene_fail(s, RAYES_ERROR_OUT_OF_MEMORY, "out of memory");
     for (size_t i = 0; i < n_params; i++) {
         if (strcmp(params[i].name, "Os") == 0 && params[i].type == RAYES_PARAM_PATTERN) {
             o->Os_pattern = scene_find_pattern(s, params[i].string);
             if (!o->Os_pattern) {
                 free(rest);
-                return fail(s, RAYES_ERROR_INVALID_ARGUMENT, "Os: names no pattern (\"%.64s\")",
-                            params[i].string ? params[i].string : "");
+                return scene_fail(s, RAYES_ERROR_INVALID_ARGUMENT,
+                                  "Os: names no pattern (\"%.64s\")",
+                                  params[i].string ? params[i].string : "");
             }
             continue;
         }
@@ -302,7 +284,7 @@ static RayesError add_object(RayesScene *s, const RayesShaderClass *cls, const R
     char err[256];
     if (cls && shade_instance_init(&o->shader, cls, rest, n_rest, err, sizeof err) != 0) {
         free(rest);
-        return fail(s, RAYES_ERROR_OUT_OF_MEMORY, "%s", err);
+        return scene_fail(s, RAYES_ERROR_OUT_OF_MEMORY, "%s", err);
     }
     RayesError bound = cls ? scene_bind_patterns(s, &o->shader, rest, n_rest) : RAYES_OK;
     free(rest);
@@ -322,12 +304,13 @@ static RayesError check_params(RayesScene *s, const char *what, const char *name
 {
     for (size_t i = 0; i < n_params; i++) {
         if (!params[i].name)
-            return fail(s, RAYES_ERROR_INVALID_ARGUMENT, "%s \"%s\": a parameter has no name",
-                        what, name);
+            return scene_fail(s, RAYES_ERROR_INVALID_ARGUMENT, "%s \"%s\": a parameter has no name",
+                              what, name);
         if (params[i].type != RAYES_PARAM_STRING && params[i].type != RAYES_PARAM_PATTERN &&
-            !finite_n(params[i].value, 3))
-            return fail(s, RAYES_ERROR_INVALID_ARGUMENT,
-                        "%s \"%s\": parameter \"%s\" is not finite", what, name, params[i].name);
+            !scene_finite(params[i].value, 3))
+            return scene_fail(s, RAYES_ERROR_INVALID_ARGUMENT,
+                              "%s \"%s\": parameter \"%s\" is not finite", what, name,
+                              params[i].name);
     }
     return RAYES_OK;
 }
@@ -346,14 +329,15 @@ static RayesError find_shader(RayesScene *s, const char *name, const RayesShader
     size_t len = strlen(mine) + (env ? strlen(env) : 0) + 2;
     char *path = malloc(len), err[512];
     if (!path)
-        return record ? fail(s, RAYES_ERROR_OUT_OF_MEMORY, "out of memory")
+        return record ? scene_fail(s, RAYES_ERROR_OUT_OF_MEMORY, "out of memory")
                       : RAYES_ERROR_OUT_OF_MEMORY;
     snprintf(path, len, "%s:%s", mine, env ? env : "");
     *cls = shade_find_class_on_path(name, path, err, sizeof err);
     free(path);
     if (*cls)
         return RAYES_OK;
-    return record ? fail(s, RAYES_ERROR_INVALID_ARGUMENT, "%s", err) : RAYES_ERROR_INVALID_ARGUMENT;
+    return record ? scene_fail(s, RAYES_ERROR_INVALID_ARGUMENT, "%s", err)
+                  : RAYES_ERROR_INVALID_ARGUMENT;
 }
 
 int rayes_scene_has_shader(RayesScene *s, const char *name)
@@ -391,18 +375,18 @@ RayesError rayes_scene_set_displacement(RayesScene *s, const char *name, const R
     if (e != RAYES_OK)
         return e;
     if (!cls->displacement)
-        return fail(s, RAYES_ERROR_INVALID_ARGUMENT,
-                    "shader \"%s\" has no displacement method", name);
+        return scene_fail(s, RAYES_ERROR_INVALID_ARGUMENT,
+                          "shader \"%s\" has no displacement method", name);
     e = check_params(s, "displacement shader", name, params, n_params);
     if (e != RAYES_OK)
         return e;
     if (grow((void **)&s->displacements, &s->cap_displacements, s->n_displacements,
              sizeof *s->displacements) != 0)
-        return fail(s, RAYES_ERROR_OUT_OF_MEMORY, "out of memory");
+        return scene_fail(s, RAYES_ERROR_OUT_OF_MEMORY, "out of memory");
     char err[256];
     ShaderInstance *inst = &s->displacements[s->n_displacements];
     if (shade_instance_init(inst, cls, params, n_params, err, sizeof err) != 0)
-        return fail(s, RAYES_ERROR_OUT_OF_MEMORY, "%s", err);
+        return scene_fail(s, RAYES_ERROR_OUT_OF_MEMORY, "%s", err);
     e = scene_bind_patterns(s, inst, params, n_params);
     if (e != RAYES_OK) {
         shade_instance_fini(inst);
@@ -417,8 +401,8 @@ RayesError rayes_scene_set_displacement_bound(RayesScene *s, float bound)
     if (!s)
         return RAYES_ERROR_INVALID_ARGUMENT;
     if (!(bound >= 0.0f) || !isfinite(bound))
-        return fail(s, RAYES_ERROR_INVALID_ARGUMENT,
-                    "displacement bound: expected a finite number >= 0");
+        return scene_fail(s, RAYES_ERROR_INVALID_ARGUMENT,
+                          "displacement bound: expected a finite number >= 0");
     s->displacement_bound = bound;
     return RAYES_OK;
 }
@@ -431,7 +415,7 @@ static RayesError add_prim(RayesScene *s, Prim *p)
             return e;
     }
     if (grow((void **)&s->prims, &s->cap_prims, s->n_prims, sizeof *s->prims) != 0)
-        return fail(s, RAYES_ERROR_OUT_OF_MEMORY, "out of memory");
+        return scene_fail(s, RAYES_ERROR_OUT_OF_MEMORY, "out of memory");
     p->object = s->current_object == SCENE_OBJECT_INHERIT ? GEOM_OBJECT_INHERIT
                                                           : (uint32_t)s->current_object;
     p->master = s->open_master >= 0 ? (uint32_t)s->open_master + 1 : 0;
@@ -466,7 +450,7 @@ static RayesError reserve_pv(RayesScene *s, size_t n)
         cap *= 2;
     float *pv = realloc(s->pv, cap * sizeof *pv);
     if (!pv)
-        return fail(s, RAYES_ERROR_OUT_OF_MEMORY, "out of memory");
+        return scene_fail(s, RAYES_ERROR_OUT_OF_MEMORY, "out of memory");
     s->pv = pv;
     s->cap_pv = cap;
     return RAYES_OK;
@@ -475,17 +459,6 @@ static RayesError reserve_pv(RayesScene *s, size_t n)
 RayesError scene_add_prim(RayesScene *s, Prim *p)
 {
     return add_prim(s, p);
-}
-
-RayesError scene_fail(RayesScene *s, RayesError e, const char *fmt, ...)
-{
-    if (s->error[0] == '\0') {
-        va_list ap;
-        va_start(ap, fmt);
-        vsnprintf(s->error, sizeof s->error, fmt, ap);
-        va_end(ap);
-    }
-    return e;
 }
 
 RayesError scene_push_values(RayesScene *s, Prim *p, unsigned mask, const float *values,
@@ -535,32 +508,34 @@ static RayesError check_primvars(RayesScene *s, const char *what, const RayesPri
 {
     memset(set, 0, sizeof *set);
     if (n_pv && !pv)
-        return fail(s, RAYES_ERROR_INVALID_ARGUMENT, "%s: primitive variables are NULL", what);
+        return scene_fail(s, RAYES_ERROR_INVALID_ARGUMENT, "%s: primitive variables are NULL",
+                          what);
     for (size_t i = 0; i < n_pv; i++) {
         int b = 0;
         while (b < GEOM_N_PV && !(pv[i].name && strcmp(pv[i].name, primvar_names[b].name) == 0))
             b++;
         if (b == GEOM_N_PV)
-            return fail(s, RAYES_ERROR_INVALID_ARGUMENT,
-                        "%s: unknown primitive variable \"%.64s\"; expected N, st, Cs or Os", what,
-                        pv[i].name ? pv[i].name : "(null)");
+            return scene_fail(s, RAYES_ERROR_INVALID_ARGUMENT,
+                              "%s: unknown primitive variable \"%.64s\"; expected N, st, Cs or Os",
+                              what, pv[i].name ? pv[i].name : "(null)");
         if (set->by[b])
-            return fail(s, RAYES_ERROR_INVALID_ARGUMENT, "%s: primitive variable %s given twice",
-                        what, pv[i].name);
+            return scene_fail(s, RAYES_ERROR_INVALID_ARGUMENT,
+                              "%s: primitive variable %s given twice", what, pv[i].name);
         if ((unsigned)pv[i].cls > RAYES_PRIMVAR_FACEVARYING)
-            return fail(s, RAYES_ERROR_INVALID_ARGUMENT, "%s: primitive variable %s has class %d",
-                        what, pv[i].name, (int)pv[i].cls);
+            return scene_fail(s, RAYES_ERROR_INVALID_ARGUMENT,
+                              "%s: primitive variable %s has class %d", what, pv[i].name,
+                              (int)pv[i].cls);
         size_t want = expect[pv[i].cls];
         if (pv[i].count != want)
-            return fail(s, RAYES_ERROR_INVALID_ARGUMENT,
-                        "%s: %s %s has %zu values; expected %zu", what,
-                        primvar_class_names[pv[i].cls], pv[i].name, pv[i].count, want);
+            return scene_fail(s, RAYES_ERROR_INVALID_ARGUMENT,
+                              "%s: %s %s has %zu values; expected %zu", what,
+                              primvar_class_names[pv[i].cls], pv[i].name, pv[i].count, want);
         if (want && !pv[i].data)
-            return fail(s, RAYES_ERROR_INVALID_ARGUMENT, "%s: primitive variable %s has no data",
-                        what, pv[i].name);
-        if (!finite_n(pv[i].data, want * (size_t)primvar_names[b].size))
-            return fail(s, RAYES_ERROR_INVALID_ARGUMENT,
-                        "%s: primitive variable %s has a non-finite value", what, pv[i].name);
+            return scene_fail(s, RAYES_ERROR_INVALID_ARGUMENT,
+                              "%s: primitive variable %s has no data", what, pv[i].name);
+        if (!scene_finite(pv[i].data, want * (size_t)primvar_names[b].size))
+            return scene_fail(s, RAYES_ERROR_INVALID_ARGUMENT,
+                              "%s: primitive variable %s has a non-finite value", what, pv[i].name);
         set->by[b] = &pv[i];
         set->mask |= primvar_names[b].bit;
     }
@@ -635,8 +610,8 @@ RayesError rayes_scene_bilinear_patch_pv(RayesScene *s, const float P[4][3],
 {
     if (!s || !P)
         return RAYES_ERROR_INVALID_ARGUMENT;
-    if (!finite_n(&P[0][0], 12))
-        return fail(s, RAYES_ERROR_INVALID_ARGUMENT, "bilinear patch: non-finite point");
+    if (!scene_finite(&P[0][0], 12))
+        return scene_fail(s, RAYES_ERROR_INVALID_ARGUMENT, "bilinear patch: non-finite point");
     static const size_t expect[5] = {1, 1, 4, 4, 4};
     PrimvarSet set;
     RayesError e = check_primvars(s, "bilinear patch", pv, n_pv, expect, &set);
@@ -660,8 +635,8 @@ RayesError rayes_scene_bicubic_patch_pv(RayesScene *s, const float P[16][3],
 {
     if (!s || !P)
         return RAYES_ERROR_INVALID_ARGUMENT;
-    if (!finite_n(&P[0][0], 48))
-        return fail(s, RAYES_ERROR_INVALID_ARGUMENT, "bicubic patch: non-finite point");
+    if (!scene_finite(&P[0][0], 48))
+        return scene_fail(s, RAYES_ERROR_INVALID_ARGUMENT, "bicubic patch: non-finite point");
     static const size_t expect[5] = {1, 1, 4, 16, 4};
     PrimvarSet set;
     RayesError e = check_primvars(s, "bicubic patch", pv, n_pv, expect, &set);
@@ -694,13 +669,14 @@ static RayesError check_faces(RayesScene *s, const char *what, size_t n_faces, c
     size_t k = 0;
     for (size_t f = 0; f < n_faces; f++) {
         if (n_verts[f] < lo || n_verts[f] > hi)
-            return fail(s, RAYES_ERROR_INVALID_ARGUMENT,
-                        "%s: face %zu has %d vertices; expected %s", what, f, n_verts[f], hint);
+            return scene_fail(s, RAYES_ERROR_INVALID_ARGUMENT,
+                              "%s: face %zu has %d vertices; expected %s", what, f, n_verts[f],
+                              hint);
         for (int v = 0; v < n_verts[f]; v++)
             if (indices[k + (size_t)v] < 0 || (size_t)indices[k + (size_t)v] >= n_points)
-                return fail(s, RAYES_ERROR_INVALID_ARGUMENT,
-                            "%s: face %zu uses vertex %d; expected 0 to %zu", what, f,
-                            indices[k + (size_t)v], n_points ? n_points - 1 : 0);
+                return scene_fail(s, RAYES_ERROR_INVALID_ARGUMENT,
+                                  "%s: face %zu uses vertex %d; expected 0 to %zu", what, f,
+                                  indices[k + (size_t)v], n_points ? n_points - 1 : 0);
         k += (size_t)n_verts[f];
     }
     *n_corners = k;
@@ -713,8 +689,8 @@ RayesError rayes_scene_polygon_mesh_pv(RayesScene *s, size_t n_faces, const int 
 {
     if (!s || (n_faces && (!n_verts || !indices || !P)))
         return RAYES_ERROR_INVALID_ARGUMENT;
-    if (!finite_n(P, 3 * n_points))
-        return fail(s, RAYES_ERROR_INVALID_ARGUMENT, "polygon mesh: non-finite point");
+    if (!scene_finite(P, 3 * n_points))
+        return scene_fail(s, RAYES_ERROR_INVALID_ARGUMENT, "polygon mesh: non-finite point");
     size_t k = 0;
     RayesError e =
         check_faces(s, "polygon mesh", n_faces, n_verts, indices, n_points, 3, 4, "3 or 4", &k);
@@ -754,9 +730,10 @@ static RayesError check_subdiv(RayesScene *s, RayesSubdivScheme scheme, size_t n
 {
     const char *what = "subdivision mesh";
     if ((unsigned)scheme > RAYES_SUBDIV_BILINEAR)
-        return fail(s, RAYES_ERROR_INVALID_ARGUMENT, "%s: unknown scheme %d", what, (int)scheme);
+        return scene_fail(s, RAYES_ERROR_INVALID_ARGUMENT, "%s: unknown scheme %d", what,
+                          (int)scheme);
     if (n_faces > INT32_MAX || n_points > INT32_MAX)
-        return fail(s, RAYES_ERROR_INVALID_ARGUMENT, "%s: too many faces or points", what);
+        return scene_fail(s, RAYES_ERROR_INVALID_ARGUMENT, "%s: too many faces or points", what);
     int loop = scheme == RAYES_SUBDIV_LOOP;
     RayesError e = check_faces(s, what, n_faces, n_verts, indices, n_points, 3, loop ? 3 : 64,
                                loop ? "3 (Loop takes triangles)" : "3 to 64", n_corners);
@@ -764,37 +741,41 @@ static RayesError check_subdiv(RayesScene *s, RayesSubdivScheme scheme, size_t n
         return e;
     if (t->interpolate_boundary < 0 || t->interpolate_boundary > 2 || t->facevarying_boundary < 0 ||
         t->facevarying_boundary > 3)
-        return fail(s, RAYES_ERROR_INVALID_ARGUMENT,
-                    "%s: interpolateboundary must be 0 to 2 and facevaryinginterpolateboundary 0 "
-                    "to 3",
-                    what);
+        return scene_fail(
+            s, RAYES_ERROR_INVALID_ARGUMENT,
+            "%s: interpolateboundary must be 0 to 2 and facevaryinginterpolateboundary 0 "
+            "to 3",
+            what);
     if ((t->n_creases && (!t->crease_edges || !t->crease_sharpness)) ||
         (t->n_corners && (!t->corner_points || !t->corner_sharpness)) ||
         (t->n_holes && !t->hole_faces))
         return RAYES_ERROR_INVALID_ARGUMENT;
     for (size_t i = 0; i < 2 * t->n_creases; i++)
         if (t->crease_edges[i] < 0 || (size_t)t->crease_edges[i] >= n_points)
-            return fail(s, RAYES_ERROR_INVALID_ARGUMENT, "%s: crease point %d; expected 0 to %zu",
-                        what, t->crease_edges[i], n_points ? n_points - 1 : 0);
+            return scene_fail(s, RAYES_ERROR_INVALID_ARGUMENT,
+                              "%s: crease point %d; expected 0 to %zu", what, t->crease_edges[i],
+                              n_points ? n_points - 1 : 0);
     for (size_t i = 0; i < t->n_corners; i++)
         if (t->corner_points[i] < 0 || (size_t)t->corner_points[i] >= n_points)
-            return fail(s, RAYES_ERROR_INVALID_ARGUMENT, "%s: corner point %d; expected 0 to %zu",
-                        what, t->corner_points[i], n_points ? n_points - 1 : 0);
+            return scene_fail(s, RAYES_ERROR_INVALID_ARGUMENT,
+                              "%s: corner point %d; expected 0 to %zu", what, t->corner_points[i],
+                              n_points ? n_points - 1 : 0);
     for (size_t i = 0; i < t->n_holes; i++)
         if (t->hole_faces[i] < 0 || (size_t)t->hole_faces[i] >= n_faces)
-            return fail(s, RAYES_ERROR_INVALID_ARGUMENT, "%s: hole face %d; expected 0 to %zu",
-                        what, t->hole_faces[i], n_faces ? n_faces - 1 : 0);
-    if (!finite_n(t->crease_sharpness, t->n_creases) ||
-        !finite_n(t->corner_sharpness, t->n_corners))
-        return fail(s, RAYES_ERROR_INVALID_ARGUMENT, "%s: a sharpness is not finite", what);
+            return scene_fail(s, RAYES_ERROR_INVALID_ARGUMENT,
+                              "%s: hole face %d; expected 0 to %zu", what, t->hole_faces[i],
+                              n_faces ? n_faces - 1 : 0);
+    if (!scene_finite(t->crease_sharpness, t->n_creases) ||
+        !scene_finite(t->corner_sharpness, t->n_corners))
+        return scene_fail(s, RAYES_ERROR_INVALID_ARGUMENT, "%s: a sharpness is not finite", what);
     for (size_t i = 0; i < t->n_creases; i++)
         if (t->crease_sharpness[i] < 0.0f)
-            return fail(s, RAYES_ERROR_INVALID_ARGUMENT, "%s: a crease sharpness is negative",
-                        what);
+            return scene_fail(s, RAYES_ERROR_INVALID_ARGUMENT, "%s: a crease sharpness is negative",
+                              what);
     for (size_t i = 0; i < t->n_corners; i++)
         if (t->corner_sharpness[i] < 0.0f)
-            return fail(s, RAYES_ERROR_INVALID_ARGUMENT, "%s: a corner sharpness is negative",
-                        what);
+            return scene_fail(s, RAYES_ERROR_INVALID_ARGUMENT, "%s: a corner sharpness is negative",
+                              what);
     return RAYES_OK;
 }
 
@@ -805,8 +786,8 @@ RayesError rayes_scene_subdivision_mesh(RayesScene *s, RayesSubdivScheme scheme,
 {
     if (!s || (n_faces && (!n_verts || !indices || !P)))
         return RAYES_ERROR_INVALID_ARGUMENT;
-    if (!finite_n(P, 3 * n_points))
-        return fail(s, RAYES_ERROR_INVALID_ARGUMENT, "subdivision mesh: non-finite point");
+    if (!scene_finite(P, 3 * n_points))
+        return scene_fail(s, RAYES_ERROR_INVALID_ARGUMENT, "subdivision mesh: non-finite point");
     size_t n_corners = 0;
     RayesError e = check_subdiv(s, scheme, n_faces, n_verts, indices, n_points, tags, &n_corners);
     if (e != RAYES_OK)
@@ -821,7 +802,7 @@ RayesError rayes_scene_subdivision_mesh(RayesScene *s, RayesSubdivScheme scheme,
     size_t n_n = set.by[0] ? set.by[0]->count : 0;
     float *world = malloc((3 * n_points + 3 * n_n + 1) * sizeof *world);
     if (!world)
-        return fail(s, RAYES_ERROR_OUT_OF_MEMORY, "out of memory");
+        return scene_fail(s, RAYES_ERROR_OUT_OF_MEMORY, "out of memory");
     transform_points(s, (const float(*)[3])P, n_points, (Vec3 *)world);
     float *N = world + 3 * n_points;
     for (size_t i = 0; i < n_n; i++) {
@@ -851,10 +832,10 @@ RayesError rayes_scene_subdivision_mesh(RayesScene *s, RayesSubdivScheme scheme,
     SubdivMesh *mesh = geom_subdiv_new(&d, err, sizeof err);
     free(world);
     if (!mesh)
-        return fail(s, RAYES_ERROR_INVALID_ARGUMENT, "subdivision mesh: %s", err);
+        return scene_fail(s, RAYES_ERROR_INVALID_ARGUMENT, "subdivision mesh: %s", err);
     if (grow((void **)&s->subdivs, &s->cap_subdivs, s->n_subdivs, sizeof *s->subdivs) != 0) {
         geom_subdiv_free(mesh);
-        return fail(s, RAYES_ERROR_OUT_OF_MEMORY, "out of memory");
+        return scene_fail(s, RAYES_ERROR_OUT_OF_MEMORY, "out of memory");
     }
     s->subdivs[s->n_subdivs++] = mesh;
     for (size_t k = 0; k < geom_subdiv_n_patches(mesh); k++) {
@@ -873,7 +854,7 @@ RayesError rayes_scene_sphere(RayesScene *s, float radius)
     if (!s)
         return RAYES_ERROR_INVALID_ARGUMENT;
     if (!(radius > 0.0f) || !isfinite(radius))
-        return fail(s, RAYES_ERROR_INVALID_ARGUMENT, "sphere: expected a positive radius");
+        return scene_fail(s, RAYES_ERROR_INVALID_ARGUMENT, "sphere: expected a positive radius");
     Prim p = {.type = PRIM_SPHERE};
     Mat4 inv;
     mat4_invert(s->world_from_object, &inv);
@@ -887,19 +868,20 @@ RayesError rayes_scene_volume(RayesScene *s, const float bound[6])
 {
     if (!s || !bound)
         return RAYES_ERROR_INVALID_ARGUMENT;
-    if (!finite_n(bound, 6) || !(bound[0] < bound[1]) || !(bound[2] < bound[3]) ||
+    if (!scene_finite(bound, 6) || !(bound[0] < bound[1]) || !(bound[2] < bound[3]) ||
         !(bound[4] < bound[5]))
-        return fail(s, RAYES_ERROR_INVALID_ARGUMENT,
-                    "volume: expected a finite box xmin < xmax, ymin < ymax, zmin < zmax");
+        return scene_fail(s, RAYES_ERROR_INVALID_ARGUMENT,
+                          "volume: expected a finite box xmin < xmax, ymin < ymax, zmin < zmax");
     if (s->open_master >= 0)
-        return fail(s, RAYES_ERROR_INVALID_ARGUMENT, "volume: not allowed in an object block");
+        return scene_fail(s, RAYES_ERROR_INVALID_ARGUMENT,
+                          "volume: not allowed in an object block");
     if (s->current_object < 0) {
         RayesError e = rayes_scene_set_shader(s, "homogeneous", NULL, 0);
         if (e != RAYES_OK)
             return e;
     }
     if (grow((void **)&s->volumes, &s->cap_volumes, s->n_volumes, sizeof *s->volumes) != 0)
-        return fail(s, RAYES_ERROR_OUT_OF_MEMORY, "out of memory");
+        return scene_fail(s, RAYES_ERROR_OUT_OF_MEMORY, "out of memory");
     SceneVolume *v = &s->volumes[s->n_volumes++];
     v->object = (uint32_t)s->current_object;
     v->world_from_object = s->world_from_object;
@@ -913,13 +895,14 @@ RayesError rayes_scene_area_light(RayesScene *s, const float P[4][3], const floa
 {
     if (!s || !P || !L)
         return RAYES_ERROR_INVALID_ARGUMENT;
-    if (!finite_n(&P[0][0], 12) || !finite_n(L, 3) || L[0] < 0 || L[1] < 0 || L[2] < 0)
-        return fail(s, RAYES_ERROR_INVALID_ARGUMENT,
-                    "area light: expected finite points and a non-negative radiance");
+    if (!scene_finite(&P[0][0], 12) || !scene_finite(L, 3) || L[0] < 0 || L[1] < 0 || L[2] < 0)
+        return scene_fail(s, RAYES_ERROR_INVALID_ARGUMENT,
+                          "area light: expected finite points and a non-negative radiance");
     if (s->open_master >= 0)
-        return fail(s, RAYES_ERROR_INVALID_ARGUMENT, "area light: not allowed in an object block");
+        return scene_fail(s, RAYES_ERROR_INVALID_ARGUMENT,
+                          "area light: not allowed in an object block");
     if (grow((void **)&s->lights, &s->cap_lights, s->n_lights, sizeof *s->lights) != 0)
-        return fail(s, RAYES_ERROR_OUT_OF_MEMORY, "out of memory");
+        return scene_fail(s, RAYES_ERROR_OUT_OF_MEMORY, "out of memory");
     Light *l = &s->lights[s->n_lights];
     memset(l, 0, sizeof *l);
     l->type = LIGHT_QUAD;
@@ -935,7 +918,7 @@ RayesError rayes_scene_area_light(RayesScene *s, const float P[4][3], const floa
     Vec3 c;
     light_quad_eval(l, 0.5f, 0.5f, &c, &n);
     if (!(v3_length(n) > 0.0f))
-        return fail(s, RAYES_ERROR_INVALID_ARGUMENT, "area light: the quad has no area");
+        return scene_fail(s, RAYES_ERROR_INVALID_ARGUMENT, "area light: the quad has no area");
     int64_t keep = s->current_object;
     RayesError e = add_object(s, NULL, NULL, 0, (int)s->n_lights);
     if (e != RAYES_OK)
@@ -945,7 +928,7 @@ RayesError rayes_scene_area_light(RayesScene *s, const float P[4][3], const floa
               .shading_rate = s->shading_rate};
     memcpy(p.cp, l->P, sizeof l->P);
     if (grow((void **)&s->prims, &s->cap_prims, s->n_prims, sizeof *s->prims) != 0)
-        return fail(s, RAYES_ERROR_OUT_OF_MEMORY, "out of memory");
+        return scene_fail(s, RAYES_ERROR_OUT_OF_MEMORY, "out of memory");
     s->prims[s->n_prims++] = p;
     s->current_object = keep;
     return RAYES_OK;
@@ -964,17 +947,18 @@ RayesError rayes_scene_set_light_links(RayesScene *s, RayesLightLinks mode, cons
         return RAYES_ERROR_INVALID_ARGUMENT;
     if (mode != RAYES_LIGHT_LINKS_ALL && mode != RAYES_LIGHT_LINKS_ONLY &&
         mode != RAYES_LIGHT_LINKS_EXCEPT)
-        return fail(s, RAYES_ERROR_INVALID_ARGUMENT, "light links: unknown mode %d", (int)mode);
+        return scene_fail(s, RAYES_ERROR_INVALID_ARGUMENT, "light links: unknown mode %d",
+                          (int)mode);
     if (mode == RAYES_LIGHT_LINKS_ALL) {
         s->current_links = 0;
         return RAYES_OK;
     }
     if (s->n_links >= UINT32_MAX - 1 ||
         grow((void **)&s->links, &s->cap_links, s->n_links, sizeof *s->links) != 0)
-        return fail(s, RAYES_ERROR_OUT_OF_MEMORY, "out of memory");
+        return scene_fail(s, RAYES_ERROR_OUT_OF_MEMORY, "out of memory");
     size_t *copy = malloc((n_lights ? n_lights : 1) * sizeof *copy);
     if (!copy)
-        return fail(s, RAYES_ERROR_OUT_OF_MEMORY, "out of memory");
+        return scene_fail(s, RAYES_ERROR_OUT_OF_MEMORY, "out of memory");
     if (n_lights)
         memcpy(copy, lights, n_lights * sizeof *copy);
     qsort(copy, n_lights, sizeof *copy, cmp_size);
@@ -1007,9 +991,9 @@ static RayesError check_links(RayesScene *s)
             continue;
         size_t last = s->links[k - 1].lights[s->links[k - 1].n - 1];
         if (last >= s->n_lights)
-            return fail(s, RAYES_ERROR_INVALID_ARGUMENT,
-                        "light links of object %zu: no light %zu (the scene has %zu)", i, last,
-                        s->n_lights);
+            return scene_fail(s, RAYES_ERROR_INVALID_ARGUMENT,
+                              "light links of object %zu: no light %zu (the scene has %zu)", i,
+                              last, s->n_lights);
     }
     return RAYES_OK;
 }
@@ -1019,9 +1003,9 @@ RayesError rayes_scene_commit(RayesScene *s)
     if (!s)
         return RAYES_ERROR_INVALID_ARGUMENT;
     if (s->open_master >= 0)
-        return fail(s, RAYES_ERROR_INVALID_OPERATION,
-                    "commit: the object block \"%.64s\" has no end (rayes_scene_object_end)",
-                    s->masters[s->open_master].name);
+        return scene_fail(s, RAYES_ERROR_INVALID_OPERATION,
+                          "commit: the object block \"%.64s\" has no end (rayes_scene_object_end)",
+                          s->masters[s->open_master].name);
     RayesError e = check_links(s);
     if (e != RAYES_OK)
         return e;
@@ -1277,7 +1261,7 @@ static RayesError light_params(RayesScene *s, const char *type, const RayesParam
     for (size_t i = 0; i < n_params; i++) {
         const RayesParam *p = &params[i];
         if (!p->name)
-            return fail(s, RAYES_ERROR_INVALID_ARGUMENT, "%s: a parameter has no name", type);
+            return scene_fail(s, RAYES_ERROR_INVALID_ARGUMENT, "%s: a parameter has no name", type);
         const LightParamDesc *d = NULL;
         for (size_t k = 0; k < sizeof light_param_descs / sizeof *light_param_descs; k++)
             if (strcmp(light_param_descs[k].name, p->name) == 0)
@@ -1291,22 +1275,22 @@ static RayesError light_params(RayesScene *s, const char *type, const RayesParam
         int ok = p->type == d->type || (d->type == RAYES_PARAM_COLOR && p->type == RAYES_PARAM_FLOAT &&
                                         strcmp(d->name, "lightcolor") == 0);
         if (!ok)
-            return fail(s, RAYES_ERROR_INVALID_ARGUMENT, "%s: parameter \"%s\" expects a %s", type,
-                        p->name,
-                        d->type == RAYES_PARAM_FLOAT   ? "float"
-                        : d->type == RAYES_PARAM_COLOR ? "3-vector (RAYES_PARAM_COLOR)"
-                                                       : "string");
+            return scene_fail(s, RAYES_ERROR_INVALID_ARGUMENT, "%s: parameter \"%s\" expects a %s",
+                              type, p->name,
+                              d->type == RAYES_PARAM_FLOAT   ? "float"
+                              : d->type == RAYES_PARAM_COLOR ? "3-vector (RAYES_PARAM_COLOR)"
+                                                             : "string");
         char *dst = (char *)lp + d->offset;
         if (d->type == RAYES_PARAM_STRING) {
             if (!p->string)
-                return fail(s, RAYES_ERROR_INVALID_ARGUMENT, "%s: parameter \"%s\" has no string",
-                            type, p->name);
+                return scene_fail(s, RAYES_ERROR_INVALID_ARGUMENT,
+                                  "%s: parameter \"%s\" has no string", type, p->name);
             *(const char **)dst = p->string;
             continue;
         }
-        if (!finite_n(p->value, d->type == RAYES_PARAM_FLOAT ? 1 : 3))
-            return fail(s, RAYES_ERROR_INVALID_ARGUMENT, "%s: parameter \"%s\" is not finite",
-                        type, p->name);
+        if (!scene_finite(p->value, d->type == RAYES_PARAM_FLOAT ? 1 : 3))
+            return scene_fail(s, RAYES_ERROR_INVALID_ARGUMENT, "%s: parameter \"%s\" is not finite",
+                              type, p->name);
         float *f = (float *)(void *)dst;
         if (d->type == RAYES_PARAM_FLOAT)
             f[0] = p->value[0];
@@ -1315,11 +1299,11 @@ static RayesError light_params(RayesScene *s, const char *type, const RayesParam
                 f[c] = p->value[p->type == RAYES_PARAM_FLOAT ? 0 : c];
     }
     if (lp->intensity < 0 || lp->color[0] < 0 || lp->color[1] < 0 || lp->color[2] < 0)
-        return fail(s, RAYES_ERROR_INVALID_ARGUMENT,
-                    "%s: expected a non-negative intensity and lightcolor", type);
+        return scene_fail(s, RAYES_ERROR_INVALID_ARGUMENT,
+                          "%s: expected a non-negative intensity and lightcolor", type);
     if (strlen(lp->category) >= LIGHT_CATEGORY_MAX)
-        return fail(s, RAYES_ERROR_INVALID_ARGUMENT, "%s: __category longer than %d characters",
-                    type, LIGHT_CATEGORY_MAX - 1);
+        return scene_fail(s, RAYES_ERROR_INVALID_ARGUMENT,
+                          "%s: __category longer than %d characters", type, LIGHT_CATEGORY_MAX - 1);
     return RAYES_OK;
 }
 
@@ -1328,10 +1312,10 @@ static RayesError light_params(RayesScene *s, const char *type, const RayesParam
 static RayesError push_light(RayesScene *s, const Light *l, const Prim *prims, size_t n_prims)
 {
     if (grow((void **)&s->lights, &s->cap_lights, s->n_lights, sizeof *s->lights) != 0)
-        return fail(s, RAYES_ERROR_OUT_OF_MEMORY, "out of memory");
+        return scene_fail(s, RAYES_ERROR_OUT_OF_MEMORY, "out of memory");
     for (size_t i = 0; i < n_prims; i++)
         if (grow((void **)&s->prims, &s->cap_prims, s->n_prims + i, sizeof *s->prims) != 0)
-            return fail(s, RAYES_ERROR_OUT_OF_MEMORY, "out of memory");
+            return scene_fail(s, RAYES_ERROR_OUT_OF_MEMORY, "out of memory");
     if (n_prims) {
         int64_t keep = s->current_object;
         RayesError e = add_object(s, NULL, NULL, 0, (int)s->n_lights);
@@ -1358,7 +1342,7 @@ RayesError rayes_scene_light(RayesScene *s, const char *type, const RayesParam *
     if (!s || !type || (n_params && !params))
         return RAYES_ERROR_INVALID_ARGUMENT;
     if (s->open_master >= 0)
-        return fail(s, RAYES_ERROR_INVALID_ARGUMENT, "light: not allowed in an object block");
+        return scene_fail(s, RAYES_ERROR_INVALID_ARGUMENT, "light: not allowed in an object block");
     static const char *const types[] = {"pointlight",   "spotlight",        "distantlight",
                                         "ambientlight", "environmentlight", "arealight"};
     int t = -1;
@@ -1366,10 +1350,11 @@ RayesError rayes_scene_light(RayesScene *s, const char *type, const RayesParam *
         if (strcmp(type, types[k]) == 0)
             t = k;
     if (t < 0)
-        return fail(s, RAYES_ERROR_INVALID_ARGUMENT,
-                    "unknown light type \"%s\"; expected pointlight, spotlight, distantlight, "
-                    "ambientlight, environmentlight or arealight",
-                    type);
+        return scene_fail(
+            s, RAYES_ERROR_INVALID_ARGUMENT,
+            "unknown light type \"%s\"; expected pointlight, spotlight, distantlight, "
+            "ambientlight, environmentlight or arealight",
+            type);
     LightParams lp;
     RayesError e = light_params(s, type, params, n_params, &lp);
     if (e != RAYES_OK)
@@ -1392,13 +1377,15 @@ RayesError rayes_scene_light(RayesScene *s, const char *type, const RayesParam *
         l.type = t == 1 ? LIGHT_SPOT : LIGHT_DISTANT;
         l.dir = v3_normalize(v3_sub(to, l.from));
         if (!(v3_length(v3_sub(to, l.from)) > 0.0f))
-            return fail(s, RAYES_ERROR_INVALID_ARGUMENT, "%s: \"from\" and \"to\" coincide", type);
+            return scene_fail(s, RAYES_ERROR_INVALID_ARGUMENT, "%s: \"from\" and \"to\" coincide",
+                              type);
         if (t == 1) {
             if (!(lp.coneangle > 0.0f && lp.coneangle <= 180.0f) || lp.conedeltaangle < 0.0f ||
                 lp.beamdistribution < 0.0f)
-                return fail(s, RAYES_ERROR_INVALID_ARGUMENT,
-                            "spotlight: expected coneangle in (0, 180], conedeltaangle >= 0 and "
-                            "beamdistribution >= 0 (degrees)");
+                return scene_fail(
+                    s, RAYES_ERROR_INVALID_ARGUMENT,
+                    "spotlight: expected coneangle in (0, 180], conedeltaangle >= 0 and "
+                    "beamdistribution >= 0 (degrees)");
             float rad = (float)(M_PI / 180.0);
             l.cos_outer = cosf(lp.coneangle * rad);
             l.cos_inner = cosf(fmaxf(lp.coneangle - lp.conedeltaangle, 0.0f) * rad);
@@ -1416,15 +1403,17 @@ RayesError rayes_scene_light(RayesScene *s, const char *type, const RayesParam *
         mat4_invert(rot, &l.light_from_world);
         int octahedral = strcmp(lp.mapping, "octahedral") == 0;
         if (!octahedral && strcmp(lp.mapping, "latlong") != 0)
-            return fail(s, RAYES_ERROR_INVALID_ARGUMENT,
-                        "environmentlight: unknown mapping \"%s\"; expected latlong or octahedral",
-                        lp.mapping);
+            return scene_fail(
+                s, RAYES_ERROR_INVALID_ARGUMENT,
+                "environmentlight: unknown mapping \"%s\"; expected latlong or octahedral",
+                lp.mapping);
         if (lp.mapname[0]) {
             char err[400], path[1024];
             if (scene_find_texture(s, lp.mapname, path, sizeof path) != 0)
-                return fail(s, RAYES_ERROR_INVALID_ARGUMENT, "environmentlight: map name too long");
+                return scene_fail(s, RAYES_ERROR_INVALID_ARGUMENT,
+                                  "environmentlight: map name too long");
             if (light_env_load(&l, path, octahedral, err, sizeof err) != 0)
-                return fail(s, RAYES_ERROR_IO, "%s", err);
+                return scene_fail(s, RAYES_ERROR_IO, "%s", err);
         }
         e = push_light(s, &l, NULL, 0);
         if (e != RAYES_OK)
@@ -1437,7 +1426,8 @@ RayesError rayes_scene_light(RayesScene *s, const char *type, const RayesParam *
     /* arealight */
     if (strcmp(lp.shape, "quad") == 0) {
         if (!(lp.width > 0.0f) || !(lp.height > 0.0f))
-            return fail(s, RAYES_ERROR_INVALID_ARGUMENT, "arealight: expected a positive width and height");
+            return scene_fail(s, RAYES_ERROR_INVALID_ARGUMENT,
+                              "arealight: expected a positive width and height");
         float w = 0.5f * lp.width, h = 0.5f * lp.height;
         const float P[4][3] = {{-w, -h, 0}, {w, -h, 0}, {w, h, 0}, {-w, h, 0}};
         float L[3] = {l.L.x, l.L.y, l.L.z};
@@ -1451,7 +1441,7 @@ RayesError rayes_scene_light(RayesScene *s, const char *type, const RayesParam *
         return e;
     }
     if (!(lp.radius > 0.0f))
-        return fail(s, RAYES_ERROR_INVALID_ARGUMENT, "arealight: expected a positive radius");
+        return scene_fail(s, RAYES_ERROR_INVALID_ARGUMENT, "arealight: expected a positive radius");
     if (strcmp(lp.shape, "sphere") == 0) {
         l.type = LIGHT_SPHERE;
         l.from = mat4_point(m, v3(0, 0, 0));
@@ -1473,7 +1463,7 @@ RayesError rayes_scene_light(RayesScene *s, const char *type, const RayesParam *
         l.area = (float)M_PI * v3_length(n);
         l.normal = v3_normalize(n);
         if (!(l.area > 0.0f))
-            return fail(s, RAYES_ERROR_INVALID_ARGUMENT, "arealight: the disk has no area");
+            return scene_fail(s, RAYES_ERROR_INVALID_ARGUMENT, "arealight: the disk has no area");
         Prim fan[DISK_FAN];
         for (int k = 0; k < DISK_FAN; k++) {
             float a0 = 2.0f * (float)M_PI * (float)k / DISK_FAN;
@@ -1485,8 +1475,8 @@ RayesError rayes_scene_light(RayesScene *s, const char *type, const RayesParam *
         }
         return push_light(s, &l, fan, DISK_FAN);
     }
-    return fail(s, RAYES_ERROR_INVALID_ARGUMENT,
-                "arealight: unknown shape \"%s\"; expected quad, disk or sphere", lp.shape);
+    return scene_fail(s, RAYES_ERROR_INVALID_ARGUMENT,
+                      "arealight: unknown shape \"%s\"; expected quad, disk or sphere", lp.shape);
 }
 
 /* ------------------------------------------------------------ edits */
@@ -1533,8 +1523,8 @@ RayesError rayes_scene_edit_light(RayesScene *s, size_t index, const RayesParam 
     if (!s || (n_params && !params))
         return RAYES_ERROR_INVALID_ARGUMENT;
     if (index >= s->n_lights)
-        return fail(s, RAYES_ERROR_INVALID_ARGUMENT, "edit light: no light %zu (the scene has %zu)",
-                    index, s->n_lights);
+        return scene_fail(s, RAYES_ERROR_INVALID_ARGUMENT,
+                          "edit light: no light %zu (the scene has %zu)", index, s->n_lights);
     Light *l = &s->lights[index];
     float intensity = l->intensity;
     Vec3 color = l->color, d = v3(0, 0, 0);
@@ -1542,8 +1532,9 @@ RayesError rayes_scene_edit_light(RayesScene *s, size_t index, const RayesParam 
         const RayesParam *p = &params[i];
         const char *name = p->name ? p->name : "";
         int is_float = p->type == RAYES_PARAM_FLOAT, is_color = p->type == RAYES_PARAM_COLOR;
-        if (!finite_n(p->value, is_color ? 3 : 1) && (is_float || is_color))
-            return fail(s, RAYES_ERROR_INVALID_ARGUMENT, "edit light: \"%s\" is not finite", name);
+        if (!scene_finite(p->value, is_color ? 3 : 1) && (is_float || is_color))
+            return scene_fail(s, RAYES_ERROR_INVALID_ARGUMENT, "edit light: \"%s\" is not finite",
+                              name);
         if (strcmp(name, "intensity") == 0 && is_float && p->value[0] >= 0.0f)
             intensity = p->value[0];
         else if (strcmp(name, "lightcolor") == 0 && (is_float || is_color) && p->value[0] >= 0.0f &&
@@ -1552,10 +1543,11 @@ RayesError rayes_scene_edit_light(RayesScene *s, size_t index, const RayesParam 
         else if (strcmp(name, "translate") == 0 && is_color)
             d = v3_add(d, v3_load(p->value));
         else
-            return fail(s, RAYES_ERROR_INVALID_ARGUMENT,
-                        "edit light: expected \"intensity\" (a float >= 0), \"lightcolor\" (a "
-                        "colour >= 0) or \"translate\" (a vector), not \"%s\"",
-                        name);
+            return scene_fail(
+                s, RAYES_ERROR_INVALID_ARGUMENT,
+                "edit light: expected \"intensity\" (a float >= 0), \"lightcolor\" (a "
+                "colour >= 0) or \"translate\" (a vector), not \"%s\"",
+                name);
     }
     l->intensity = intensity;
     l->color = color;
@@ -1608,20 +1600,20 @@ RayesError rayes_scene_edit_shader(RayesScene *s, size_t object, const RayesPara
     if (!s || (n_params && !params))
         return RAYES_ERROR_INVALID_ARGUMENT;
     if (object >= s->n_objects)
-        return fail(s, RAYES_ERROR_INVALID_ARGUMENT,
-                    "edit shader: no object %zu (the scene has %zu)", object, s->n_objects);
+        return scene_fail(s, RAYES_ERROR_INVALID_ARGUMENT,
+                          "edit shader: no object %zu (the scene has %zu)", object, s->n_objects);
     SceneObject *o = &s->objects[object];
     if (!o->shader.cls)
-        return fail(s, RAYES_ERROR_INVALID_ARGUMENT,
-                    "edit shader: object %zu is light %d's emitter; edit the light", object,
-                    o->light);
+        return scene_fail(s, RAYES_ERROR_INVALID_ARGUMENT,
+                          "edit shader: object %zu is light %d's emitter; edit the light", object,
+                          o->light);
     const RayesShaderClass *cls = o->shader.cls;
     ShaderInstance trial = {cls, malloc(cls->params_size ? cls->params_size : 1)};
     RayesParam *rest = malloc((n_params ? n_params : 1) * sizeof *rest);
     if (!trial.params || !rest) {
         free(trial.params);
         free(rest);
-        return fail(s, RAYES_ERROR_OUT_OF_MEMORY, "out of memory");
+        return scene_fail(s, RAYES_ERROR_OUT_OF_MEMORY, "out of memory");
     }
     memcpy(trial.params, o->shader.params, cls->params_size);
     float Cs[3], Os[3];
@@ -1632,11 +1624,11 @@ RayesError rayes_scene_edit_shader(RayesScene *s, size_t object, const RayesPara
         const RayesParam *p = &params[i];
         int n = p->type == RAYES_PARAM_COLOR ? 3 : 1;
         if (!p->name || ((p->type == RAYES_PARAM_FLOAT || p->type == RAYES_PARAM_COLOR) &&
-                         !finite_n(p->value, (size_t)n))) {
+                         !scene_finite(p->value, (size_t)n))) {
             free(trial.params);
             free(rest);
-            return fail(s, RAYES_ERROR_INVALID_ARGUMENT,
-                        "edit shader: a parameter has no name or is not finite");
+            return scene_fail(s, RAYES_ERROR_INVALID_ARGUMENT,
+                              "edit shader: a parameter has no name or is not finite");
         }
         float *dst = strcmp(p->name, "Cs") == 0 ? Cs : strcmp(p->name, "Os") == 0 ? Os : NULL;
         if (dst && (p->type == RAYES_PARAM_FLOAT || p->type == RAYES_PARAM_COLOR)) {
@@ -1650,7 +1642,7 @@ RayesError rayes_scene_edit_shader(RayesScene *s, size_t object, const RayesPara
     if (shade_instance_apply(&trial, rest, n_rest, 1, err, sizeof err) != 0) {
         free(trial.params);
         free(rest);
-        return fail(s, RAYES_ERROR_INVALID_ARGUMENT, "edit shader: %s", err);
+        return scene_fail(s, RAYES_ERROR_INVALID_ARGUMENT, "edit shader: %s", err);
     }
     /* the bindings too are edited on a copy, kept only if all succeed */
     for (size_t i = 0; i < o->shader.n_patterns; i++)
@@ -1659,7 +1651,7 @@ RayesError rayes_scene_edit_shader(RayesScene *s, size_t object, const RayesPara
             break;
     RayesError e = trial.n_patterns == o->shader.n_patterns
                        ? scene_bind_patterns(s, &trial, rest, n_rest)
-                       : fail(s, RAYES_ERROR_OUT_OF_MEMORY, "out of memory");
+                       : scene_fail(s, RAYES_ERROR_OUT_OF_MEMORY, "out of memory");
     free(rest);
     if (e != RAYES_OK) {
         shade_instance_fini(&trial);
@@ -1694,9 +1686,9 @@ RayesError rayes_scene_move_camera(RayesScene *s, const float m[16])
     if (!s || !m)
         return RAYES_ERROR_INVALID_ARGUMENT;
     Mat4 inv, M = mat4_from_array(m);
-    if (!finite_n(m, 16) || !mat4_invert(M, &inv))
-        return fail(s, RAYES_ERROR_INVALID_ARGUMENT,
-                    "move camera: expected a finite, invertible matrix");
+    if (!scene_finite(m, 16) || !mat4_invert(M, &inv))
+        return scene_fail(s, RAYES_ERROR_INVALID_ARGUMENT,
+                          "move camera: expected a finite, invertible matrix");
     SceneCamera *c = &s->camera;
     c->eye = mat4_point(&M, c->eye);
     c->x = mat4_vector(&M, c->x);
@@ -1761,16 +1753,16 @@ RayesError rayes_scene_set_search_path(RayesScene *s, const char *kind, const ch
     while (k < SCENE_SEARCH_PATH_COUNT && strcmp(search_path_kinds[k], kind) != 0)
         k++;
     if (k == SCENE_SEARCH_PATH_COUNT)
-        return fail(s, RAYES_ERROR_INVALID_ARGUMENT,
-                    "search path: unknown kind \"%.64s\"; expected \"shader\" or \"texture\"",
-                    kind);
+        return scene_fail(s, RAYES_ERROR_INVALID_ARGUMENT,
+                          "search path: unknown kind \"%.64s\"; expected \"shader\" or \"texture\"",
+                          kind);
     int too_long;
     char *expanded = expand_search_path(path, scene_search_path(s, (SceneSearchPath)k), &too_long);
     if (!expanded)
-        return too_long ? fail(s, RAYES_ERROR_INVALID_ARGUMENT,
-                               "search path \"%s\": longer than %d characters", kind,
-                               SEARCH_PATH_MAX)
-                        : fail(s, RAYES_ERROR_OUT_OF_MEMORY, "out of memory");
+        return too_long ? scene_fail(s, RAYES_ERROR_INVALID_ARGUMENT,
+                                     "search path \"%s\": longer than %d characters", kind,
+                                     SEARCH_PATH_MAX)
+                        : scene_fail(s, RAYES_ERROR_OUT_OF_MEMORY, "out of memory");
     free(s->search_paths[k]);
     s->search_paths[k] = expanded;
     return RAYES_OK;
@@ -1795,15 +1787,16 @@ RayesError rayes_scene_quadric(RayesScene *s, RayesQuadric type, const float *pa
     if (!s || (n && !params))
         return RAYES_ERROR_INVALID_ARGUMENT;
     if ((unsigned)type > RAYES_QUADRIC_TORUS)
-        return fail(s, RAYES_ERROR_INVALID_ARGUMENT, "quadric: unknown type %d", (int)type);
+        return scene_fail(s, RAYES_ERROR_INVALID_ARGUMENT, "quadric: unknown type %d", (int)type);
     const char *name = kinds[type].name;
-    if (n != kinds[type].n || !finite_n(params, n))
-        return fail(s, RAYES_ERROR_INVALID_ARGUMENT, "%s: expected %zu finite numbers (%s)", name,
-                    kinds[type].n, kinds[type].params);
+    if (n != kinds[type].n || !scene_finite(params, n))
+        return scene_fail(s, RAYES_ERROR_INVALID_ARGUMENT, "%s: expected %zu finite numbers (%s)",
+                          name, kinds[type].n, kinds[type].params);
     const float deg = (float)(M_PI / 180.0);
     float thetamax = params[n - 1];
     if (!(thetamax != 0.0f) || fabsf(thetamax) > 360.0f)
-        return fail(s, RAYES_ERROR_INVALID_ARGUMENT, "%s: expected 0 < |thetamax| <= 360", name);
+        return scene_fail(s, RAYES_ERROR_INVALID_ARGUMENT, "%s: expected 0 < |thetamax| <= 360",
+                          name);
     Prim p = {.type = PRIM_QUADRIC};
     p.quadric.world_from_object = s->world_from_object;
     p.quadric.kind = (int)type;
@@ -1851,6 +1844,6 @@ RayesError rayes_scene_quadric(RayesScene *s, RayesQuadric type, const float *pa
         break;
     }
     if (bad)
-        return fail(s, RAYES_ERROR_INVALID_ARGUMENT, "%s: expected %s", name, bad);
+        return scene_fail(s, RAYES_ERROR_INVALID_ARGUMENT, "%s: expected %s", name, bad);
     return add_prim(s, &p);
 }

@@ -303,7 +303,9 @@ float scene_blur_dice_factor(const RayesScene *scene, size_t index, const DiceCa
  * floats) as p's values. */
 RayesError scene_add_prim(RayesScene *scene, Prim *p);
 RayesError scene_fail(RayesScene *scene, RayesError e, const char *fmt, ...)
-    __attribute__((format(printf, 3, 4)));
+    __attribute__((format(printf, 3, 4))); /* valid.c */
+/* 1 if the n floats at v are all finite (valid.c). */
+int scene_finite(const float *v, size_t n);
 RayesError scene_push_values(RayesScene *scene, Prim *p, unsigned mask, const float *values,
                              size_t n);
 /* Notes whether an Os primitive variable of n values (or none: NULL) has
