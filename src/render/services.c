@@ -142,13 +142,17 @@ static void light_area(Worker *w, const DirectPoint *p, const Light *l, uint64_t
     if (light_below_plane(l, p->o, p->N))
         return;
     Vec3 sum_d = v3(0, 0, 0), sum_s = v3(0, 0, 0);
-    uint32_t pattern = (uint32_t)key, pat_cos = (uint32_t)hash_combine(key, 1),
-             pat_bp = (uint32_t)hash_combine(key, 2);
+    CmjPattern pattern, pat_cos, pat_bp; /* the light's, the cosine's and the lobe's */
+    cmj_pattern_init(&pattern, (uint32_t)n, (uint32_t)key);
+    if (p->diff)
+        cmj_pattern_init(&pat_cos, (uint32_t)n, (uint32_t)hash_combine(key, 1));
+    if (p->spec)
+        cmj_pattern_init(&pat_bp, (uint32_t)n, (uint32_t)hash_combine(key, 2));
     for (int s = 0; s < n; s++) {
         float a, b;
         LightSample ls;
         /* The light's strategy. */
-        cmj_sample_2d((uint32_t)s, (uint32_t)n, pattern, &a, &b);
+        cmj_pattern_sample(&pattern, (uint32_t)s, &a, &b);
         if (light_sample(l, p->o, a, b, &ls) && ls.pdf > 0.0f) {
             float cos_x = v3_dot(p->N, ls.wi);
             if (cos_x > 0.0f && v3_dot(p->Ng, ls.wi) > 0.0f && v3_max_component(ls.Li) > 0.0f) {
@@ -170,7 +174,7 @@ static void light_area(Worker *w, const DirectPoint *p, const Light *l, uint64_t
         Vec3 wi;
         float cos_x;
         if (p->diff) {
-            cmj_sample_2d((uint32_t)s, (uint32_t)n, pat_cos, &a, &b);
+            cmj_pattern_sample(&pat_cos, (uint32_t)s, &a, &b);
             wi = sample_cosine_hemisphere(p->N, a, b);
             cos_x = v3_dot(p->N, wi);
             if (cos_x > 0.0f && v3_dot(p->Ng, wi) > 0.0f && light_intersect(l, p->o, wi, &ls) &&
@@ -182,7 +186,7 @@ static void light_area(Worker *w, const DirectPoint *p, const Light *l, uint64_t
         if (!p->spec)
             continue;
         /* The specular lobe's strategy: the half vector about N. */
-        cmj_sample_2d((uint32_t)s, (uint32_t)n, pat_bp, &a, &b);
+        cmj_pattern_sample(&pat_bp, (uint32_t)s, &a, &b);
         float cos_h = powf(a, 1.0f / (p->e + 1.0f));
         float sin_h = sqrtf(fmaxf(0.0f, 1.0f - cos_h * cos_h)), phi = 2.0f * (float)M_PI * b;
         Vec3 t, bt;
@@ -329,10 +333,13 @@ static void fiber_light_samples(Worker *w, const FiberPoint *p, const Light *l, 
                                 uint32_t pattern, Vec3 *d, Vec3 *s)
 {
     int area = light_is_area(l), spec = v3_length(p->V) > 0.0f;
+    CmjPattern pat;
+    if (area)
+        cmj_pattern_init(&pat, (uint32_t)m, pattern);
     for (int j = 0; j < m; j++) {
         float a = 0.5f, b = 0.5f, fd, fs;
         if (area)
-            cmj_sample_2d((uint32_t)j, (uint32_t)m, pattern, &a, &b);
+            cmj_pattern_sample(&pat, (uint32_t)j, &a, &b);
         LightSample ls;
         if (!light_sample(l, p->P, a, b, &ls) || !(v3_max_component(ls.Li) > 0.0f) ||
             (area && !(ls.pdf > 0.0f)))
@@ -352,10 +359,13 @@ static void fiber_light_samples(Worker *w, const FiberPoint *p, const Light *l, 
 static void fiber_lobe_samples(Worker *w, const FiberPoint *p, const Light *l, int m,
                                uint64_t key, Vec3 *s)
 {
+    CmjPattern pat_ab, pat_c;
+    cmj_pattern_init(&pat_ab, (uint32_t)m, (uint32_t)hash_combine(key, 1));
+    cmj_pattern_init(&pat_c, (uint32_t)m, (uint32_t)hash_combine(key, 2));
     for (int j = 0; j < m; j++) {
         float a, b, c, c2, fd, fs;
-        cmj_sample_2d((uint32_t)j, (uint32_t)m, (uint32_t)hash_combine(key, 1), &a, &b);
-        cmj_sample_2d((uint32_t)j, (uint32_t)m, (uint32_t)hash_combine(key, 2), &c, &c2);
+        cmj_pattern_sample(&pat_ab, (uint32_t)j, &a, &b);
+        cmj_pattern_sample(&pat_c, (uint32_t)j, &c, &c2);
         Vec3 wi;
         LightSample ls;
         if (!fiber_lobe_sample(p->T, p->V, p->e, a, b, c, &wi) ||
@@ -435,9 +445,11 @@ static void svc_indirect_diffuse(const RayesShaderServices *sv, const RayesShade
         Vec3 o = v3_madd(P, Ng, ps->offset[j]), sum = v3(0, 0, 0);
         uint64_t key = hash_combine(ps->keys[j], DIM_DIFFUSE);
         RayDiff diff = {ps->diff[j].width, fmaxf(ps->diff[j].spread, lobe_spread)};
+        CmjPattern pat;
+        cmj_pattern_init(&pat, (uint32_t)n, (uint32_t)key);
         for (int s = 0; s < n; s++) {
             float a, b;
-            cmj_sample_2d((uint32_t)s, (uint32_t)n, (uint32_t)key, &a, &b);
+            cmj_pattern_sample(&pat, (uint32_t)s, &a, &b);
             Vec3 d = sample_cosine_hemisphere(N, a, b);
             if (v3_dot(d, Ng) <= 0.0f)
                 continue; /* below the geometric surface: no light from there */
@@ -514,9 +526,11 @@ static void svc_indirect_specular(const RayesShaderServices *sv, const RayesShad
         float e = 1.0f / r;
         Vec3 Ng = v3_load(ctx->Ng[i]), sum = v3(0, 0, 0), t, b;
         v3_basis(d, &t, &b);
+        CmjPattern pat;
+        cmj_pattern_init(&pat, (uint32_t)n, (uint32_t)key);
         for (int s = 0; s < n; s++) {
             float a1, a2;
-            cmj_sample_2d((uint32_t)s, (uint32_t)n, (uint32_t)key, &a1, &a2);
+            cmj_pattern_sample(&pat, (uint32_t)s, &a1, &a2);
             float cos_t = powf(a1, 1.0f / (e + 1.0f)), sin_t = sqrtf(fmaxf(0.0f, 1.0f - cos_t * cos_t));
             float phi = 2.0f * (float)M_PI * a2;
             Vec3 wi = v3_add(v3_add(v3_scale(t, sin_t * cosf(phi)), v3_scale(b, sin_t * sinf(phi))),
@@ -560,9 +574,11 @@ static void svc_glossy(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
         Vec3 t, b, sum = v3(0, 0, 0);
         v3_basis(N, &t, &b);
         uint64_t key = hash_combine(ps->keys[point(ctx, i)], DIM_SPECULAR);
+        CmjPattern pat;
+        cmj_pattern_init(&pat, (uint32_t)n, (uint32_t)key);
         for (int s = 0; s < n; s++) {
             float a1, a2;
-            cmj_sample_2d((uint32_t)s, (uint32_t)n, (uint32_t)key, &a1, &a2);
+            cmj_pattern_sample(&pat, (uint32_t)s, &a1, &a2);
             float cos_h = powf(a1, 1.0f / (e + 1.0f));
             float sin_h = sqrtf(fmaxf(0.0f, 1.0f - cos_h * cos_h)), phi = 2.0f * (float)M_PI * a2;
             Vec3 H = v3_add(v3_add(v3_scale(t, sin_h * cosf(phi)), v3_scale(b, sin_h * sinf(phi))),
@@ -641,9 +657,11 @@ static void svc_occlusion(const RayesShaderServices *sv, const RayesShadeCtx *ct
         uint64_t key = hash_combine(ps->keys[j], DIM_OCCLUSION);
         RayDiff diff = shadow_diff(ps, j, n);
         int counted = 0;
+        CmjPattern pat;
+        cmj_pattern_init(&pat, (uint32_t)n, (uint32_t)key);
         for (int s = 0; s < n; s++) {
             float a, b;
-            cmj_sample_2d((uint32_t)s, (uint32_t)n, (uint32_t)key, &a, &b);
+            cmj_pattern_sample(&pat, (uint32_t)s, &a, &b);
             Vec3 d = sample_cosine_hemisphere(N, a, b);
             counted++;
             if (v3_dot(d, Ng) <= 0.0f)
@@ -682,11 +700,13 @@ static void svc_direct_volume(const RayesShaderServices *sv, const RayesShadeCtx
             if (l->type == LIGHT_AMBIENT || !light_category_match(l, category))
                 continue;
             int m = light_is_area(l) ? n : 1;
-            uint32_t pattern = (uint32_t)hash_combine(key, k);
+            CmjPattern pattern;
+            if (m > 1)
+                cmj_pattern_init(&pattern, (uint32_t)m, (uint32_t)hash_combine(key, k));
             for (int s = 0; s < m; s++) {
                 float a = 0.5f, b = 0.5f;
                 if (m > 1)
-                    cmj_sample_2d((uint32_t)s, (uint32_t)m, pattern, &a, &b);
+                    cmj_pattern_sample(&pattern, (uint32_t)s, &a, &b);
                 LightSample ls;
                 if (!light_sample(l, P, a, b, &ls) || !(v3_max_component(ls.Li) > 0.0f) ||
                     (light_is_area(l) && !(ls.pdf > 0.0f)))

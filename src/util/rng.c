@@ -68,7 +68,8 @@ static float randfloat(uint32_t i, uint32_t p)
     return (float)(i >> 8) * (1.0f / 16777216.0f);
 }
 
-void cmj_sample_2d(uint32_t s, uint32_t n, uint32_t p, float *x, float *y)
+/* m columns and k rows of strata for n samples: m = floor(sqrt(n)), m k >= n. */
+static void cmj_shape(uint32_t n, uint32_t *m_out, uint32_t *k_out)
 {
     uint32_t m = (uint32_t)sqrtf((float)n);
     if (m * m > n)
@@ -77,24 +78,69 @@ void cmj_sample_2d(uint32_t s, uint32_t n, uint32_t p, float *x, float *y)
         m++;
     if (m == 0)
         m = 1;
-    uint32_t k = (n + m - 1) / m; /* m columns, k rows: m * k >= n strata */
-    s = permute(s, n, p * 0x51633e2du);
-    uint32_t col, row; /* s % m and s / m: a mask and a shift when m is a power of two */
-    if ((m & (m - 1)) == 0) {
-        col = s & (m - 1);
-        row = s >> __builtin_ctz(m);
-    } else {
-        col = s % m;
-        row = s / m;
-    }
-    uint32_t sx = permute(col, m, p * 0x68bc21ebu);
-    uint32_t sy = permute(row, k, p * 0x02e5be93u);
+    *m_out = m;
+    *k_out = (n + m - 1) / m;
+}
+
+/* The point of stratum s (already permuted) given its column's and row's
+ * shuffled sub-strata sx and sy. */
+static inline void cmj_point(uint32_t s, uint32_t col, uint32_t row, uint32_t sx, uint32_t sy,
+                             uint32_t m, uint32_t k, uint32_t p, float *x, float *y)
+{
     float jx = randfloat(s, p * 0x967a889bu);
     float jy = randfloat(s, p * 0x368cc8b7u);
     float fx = ((float)col + ((float)sy + jx) / (float)k) / (float)m;
     float fy = ((float)row + ((float)sx + jy) / (float)m) / (float)k;
-    *x = fminf(fx, 0x1.fffffep-1f);
-    *y = fminf(fy, 0x1.fffffep-1f);
+    *x = fx < 0x1.fffffep-1f ? fx : 0x1.fffffep-1f;
+    *y = fy < 0x1.fffffep-1f ? fy : 0x1.fffffep-1f;
+}
+
+/* s % m and s / m: a mask and a shift when m is a power of two. */
+static inline void cmj_cell(uint32_t s, uint32_t m, uint32_t *col, uint32_t *row)
+{
+    if ((m & (m - 1)) == 0) {
+        *col = s & (m - 1);
+        *row = s >> __builtin_ctz(m);
+    } else {
+        *col = s % m;
+        *row = s / m;
+    }
+}
+
+void cmj_sample_2d(uint32_t s, uint32_t n, uint32_t p, float *x, float *y)
+{
+    uint32_t m, k, col, row;
+    cmj_shape(n, &m, &k);
+    s = permute(s, n, p * 0x51633e2du);
+    cmj_cell(s, m, &col, &row);
+    cmj_point(s, col, row, permute(col, m, p * 0x68bc21ebu), permute(row, k, p * 0x02e5be93u), m,
+              k, p, x, y);
+}
+
+void cmj_pattern_init(CmjPattern *c, uint32_t n, uint32_t p)
+{
+    c->n = n;
+    c->p = p;
+    cmj_shape(n, &c->m, &c->k);
+    c->tabled = c->m <= CMJ_TABLE && c->k <= CMJ_TABLE;
+    if (!c->tabled)
+        return;
+    for (uint32_t i = 0; i < c->m; i++)
+        c->sx[i] = (uint8_t)permute(i, c->m, p * 0x68bc21ebu);
+    for (uint32_t i = 0; i < c->k; i++)
+        c->sy[i] = (uint8_t)permute(i, c->k, p * 0x02e5be93u);
+}
+
+void cmj_pattern_sample(const CmjPattern *c, uint32_t s, float *x, float *y)
+{
+    if (!c->tabled) {
+        cmj_sample_2d(s, c->n, c->p, x, y);
+        return;
+    }
+    uint32_t col, row;
+    s = permute(s, c->n, c->p * 0x51633e2du);
+    cmj_cell(s, c->m, &col, &row);
+    cmj_point(s, col, row, c->sx[col], c->sy[row], c->m, c->k, c->p, x, y);
 }
 
 float stratified_1d(uint32_t s, uint32_t n, uint32_t p)

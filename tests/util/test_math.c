@@ -75,6 +75,29 @@ static void test_cmj_deterministic_and_pattern_dependent(void)
     CHECK(x1 != x3 || y1 != y3);
 }
 
+/* A tabled pattern draws cmj_sample_2d's samples bit for bit, for counts
+ * whose shape fits the tables and for those past them (17,000 samples:
+ * 130 columns). */
+static void test_cmj_pattern_equals_samples(void)
+{
+    const uint32_t counts[] = {1, 2, 3, 4, 5, 16, 24, 63, 64, 100, 1000, 4096, 17000};
+    for (size_t c = 0; c < sizeof counts / sizeof *counts; c++) {
+        uint32_t n = counts[c], p = 0x9e3779b9u * (uint32_t)(c + 1);
+        CmjPattern pat;
+        cmj_pattern_init(&pat, n, p);
+        CHECK(pat.tabled == (n < 17000));
+        for (uint32_t s = 0; s < n; s++) {
+            float x1, y1, x2, y2;
+            cmj_sample_2d(s, n, p, &x1, &y1);
+            cmj_pattern_sample(&pat, s, &x2, &y2);
+            if (x1 != x2 || y1 != y2) {
+                CHECK(x1 == x2 && y1 == y2);
+                break;
+            }
+        }
+    }
+}
+
 static void test_hash_combine_is_ordered(void)
 {
     CHECK(hash_combine(1, 2) != hash_combine(2, 1));
@@ -112,5 +135,6 @@ static void test_bounds_distance(void)
 
 TEST_MAIN(TEST(test_matrix_inverse), TEST(test_rotation_is_right_handed),
           TEST(test_basis_is_orthonormal), TEST(test_cmj_stratified),
-          TEST(test_cmj_deterministic_and_pattern_dependent), TEST(test_hash_combine_is_ordered),
+          TEST(test_cmj_deterministic_and_pattern_dependent), TEST(test_cmj_pattern_equals_samples),
+          TEST(test_hash_combine_is_ordered),
           TEST(test_cosine_hemisphere_moments), TEST(test_bounds_distance))
