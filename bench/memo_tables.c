@@ -4,7 +4,7 @@
  * run so that ratios are taken on one machine state.
  *
  *   memo_tables table1 [--size N] [--spp N] [--bounces-max B] [--accuracy-spp N]
- *                      [--accuracy-size N] [--out DIR] [--data DIR] [--threads N]
+ *                      [--accuracy-size N] [--out DIR] [--data DIR] [--threads N] [--replay 1]
  *                      [--cache-k K] [--gridsize N] [--dice-raster 0|1]
  *                      [--scene cornell-teapots|cornell-teapots-displaced]
  *   memo_tables table4 [...same...] [--budgets MB,MB,...]
@@ -15,7 +15,9 @@
  *                       [--repeat N] [--only off|on]
  *
  * table1: preview quality, bounces 1..B (default 3), caching off and on:
- * shading points, rays, time, speed-up and hit rates per resolution.
+ * shading points, rays, time, speed-up and hit rates per resolution; with
+ * --replay 1, each render's rays traced again with no shading (issue 21's
+ * limit: the rendering CPU time over ray casting's alone).
  * table4: one bounce at cache budgets 0 (off), 1, 4, 16, 64, 256 MB.
  * table2: final quality (the grid hider with irradiance interpolation),
  * bounces 1..B, caching on, and off up to --uncached-max bounces (default
@@ -69,6 +71,8 @@ typedef struct Args {
     int repeat;                   /* figure8: renders of each mode; the shortest counts */
     int only;                     /* figure8: -1 both; 0 or 1 one render, opacity caching
                                      off or on (for a profiler), nothing compared */
+    int replay;                   /* table1: 1 traces each row's rays again unshaded
+                                     (RayesRenderOptions.replay_rays) */
 } Args;
 
 typedef struct Row {
@@ -80,6 +84,8 @@ typedef struct Row {
     unsigned long long shading_points, rays, shadow, diffuse, records;
     unsigned long long grids, grid_vertices, grid_size;
     double hit[3];
+    double render_cpu_s, replay_cpu_s; /* the render alone, and its rays traced again
+                                          unshaded (--replay 1) */
     unsigned long long opacity_points;   /* opacity() shading points (shadow-ray hits, or
                                             the points of the grids the cache filled) */
     unsigned long long transparent_hits; /* surfaces shadow rays passed through */
@@ -139,6 +145,7 @@ static Row run(const Args *a, int size, int spp, int bounces, int cache, double 
      * isotropic dicing makes (17,158 and 3.61 M); rayes's raster-oriented
      * default makes 8,113 and 1.71 M (--dice-raster). */
     o.dice_isotropic = !a->dice_raster;
+    o.replay_rays = a->replay;
     Row r = {.bounces = bounces, .cache = cache, .budget_mb = budget_mb};
     measure(scene, &o, &r);
     rayes_scene_release(scene);
@@ -163,6 +170,10 @@ static void measure(RayesScene *scene, const RayesRenderOptions *o, Row *r_out)
     r.grid_vertices = find(st, "grid_vertices")->count;
     r.grid_size = find(st, "grid_size")->count;
     r.rays = find(st, "rays/total")->count;
+    r.render_cpu_s = find(st, "time/render_cpu_s")->real;
+    const RayesStat *replay = rayes_stats_find(st, "replay/cpu_s");
+    r.replay_cpu_s = replay ? replay->real : 0.0;
+    r.cpu_s -= r.replay_cpu_s; /* the render's, not its replay's */
     r.shadow = find(st, "rays/shadow")->count;
     r.diffuse = find(st, "rays/diffuse")->count;
     static const char *const hr[3] = {"cache/coarse/hit_rate", "cache/medium/hit_rate",
@@ -300,6 +311,8 @@ static void parse(int argc, char **argv, Args *a)
             a->only = strcmp(v, "on") == 0 ? 1 : strcmp(v, "off") == 0 ? 0 : -2;
         else if (strcmp(o, "--experiment") == 0)
             a->experiment = v;
+        else if (strcmp(o, "--replay") == 0)
+            a->replay = atoi(v);
         else if (strcmp(o, "--uncached-max") == 0)
             a->uncached_max = atoi(v);
         else if (strcmp(o, "--budgets") == 0) {
@@ -330,10 +343,11 @@ static void json_row(FILE *j, const Row *r, int first)
             "%s\n    {\"bounces\": %d, \"cache\": %d, \"budget_mb\": %g, \"time_s\": %.3f, \"cpu_s\": %.3f, "
             "\"shading_points\": %llu, \"rays\": %llu, \"shadow_rays\": %llu, "
             "\"diffuse_rays\": %llu, \"hit_rate\": {\"coarse\": %.5f, \"medium\": %.5f, "
-            "\"fine\": %.5f}, \"grids\": %llu, \"grid_vertices\": %llu, \"grid_size\": %llu}",
+            "\"fine\": %.5f}, \"grids\": %llu, \"grid_vertices\": %llu, \"grid_size\": %llu, "
+            "\"render_cpu_s\": %.3f, \"replay_cpu_s\": %.3f}",
             first ? "" : ",", r->bounces, r->cache, r->budget_mb, r->time_s, r->cpu_s,
             r->shading_points, r->rays, r->shadow, r->diffuse, r->hit[0], r->hit[1], r->hit[2],
-            r->grids, r->grid_vertices, r->grid_size);
+            r->grids, r->grid_vertices, r->grid_size, r->render_cpu_s, r->replay_cpu_s);
 }
 
 static void table1(const Args *a, FILE *j)
@@ -357,6 +371,11 @@ static void table1(const Args *a, FILE *j)
                b, s1, s2, off.time_s, off.cpu_s, s3, s4, on.time_s, on.cpu_s,
                off.time_s / on.time_s, off.cpu_s / on.cpu_s, 100 * on.hit[0], 100 * on.hit[1],
                100 * on.hit[2]);
+        if (a->replay)
+            printf("    rendering cpu / the same rays traced unshaded: uncached %.2f / %.2f s = "
+                   "%.2fx, cached %.2f / %.2f s = %.2fx\n",
+                   off.render_cpu_s, off.replay_cpu_s, off.render_cpu_s / off.replay_cpu_s,
+                   on.render_cpu_s, on.replay_cpu_s, on.render_cpu_s / on.replay_cpu_s);
         fflush(stdout);
         if (b == 1) {
             t1_on = on.time_s;

@@ -26,6 +26,7 @@
  * any query, and queries are concurrent (Embree's contract).
  */
 #include "accel/accel.h"
+#include "accel/record.h"
 
 #include <embree3/rtcore.h>
 #include <math.h>
@@ -79,6 +80,7 @@ struct Accel {
     RTCScene *object_scene; /* per object: its own scene (ACCEL_MASK_OWN_SCENE), or NULL */
     size_t n_objects;
     atomic_llong bytes; /* Embree's allocations, from the memory monitor */
+    AccelRecord *record; /* NULL, or where queries are kept (record.h) */
     char error[256];   /* the first Embree error */
 };
 
@@ -856,13 +858,22 @@ static int intersect_scene(const Accel *a, RTCScene scene, const Ray *ray, uint3
     return 1;
 }
 
+void accel_attach_record(Accel *a, AccelRecord *record)
+{
+    a->record = record;
+}
+
 int accel_intersect(const Accel *a, const Ray *ray, Hit *hit)
 {
+    if (a->record)
+        accel_record_ray(a->record, ACCEL_QUERY_INTERSECT, 0, ray);
     return intersect_scene(a, a->levels[0].scene, ray, ray->mask, hit);
 }
 
 int accel_intersect_object(const Accel *a, uint32_t object, const Ray *ray, Hit *hit)
 {
+    if (a->record)
+        accel_record_ray(a->record, ACCEL_QUERY_INTERSECT_OBJECT, object, ray);
     if (object >= a->n_objects || !a->object_scene[object])
         return 0;
     return intersect_scene(a, a->object_scene[object], ray, ~0u, hit);
@@ -929,6 +940,8 @@ static void transmission_filter(const struct RTCFilterFunctionNArguments *args)
 
 Vec3 accel_transmission(const Accel *a, const Ray *ray, AccelOpacityFn opacity, void *user)
 {
+    if (a->record)
+        accel_record_ray(a->record, ACCEL_QUERY_TRANSMISSION, 0, ray);
     TransmissionCtx tc;
     rtcInitIntersectContext(&tc.rtc);
     tc.accel = a;
@@ -945,6 +958,8 @@ Vec3 accel_transmission(const Accel *a, const Ray *ray, AccelOpacityFn opacity, 
 
 int accel_occluded(const Accel *a, const Ray *ray)
 {
+    if (a->record)
+        accel_record_ray(a->record, ACCEL_QUERY_OCCLUDED, 0, ray);
     struct RTCIntersectContext ctx;
     rtcInitIntersectContext(&ctx);
     struct RTCRay r;

@@ -138,6 +138,14 @@ static void summary(const Args *a, const RayesStats *s)
            (unsigned long long)stat_count(s, "rays/shadow"),
            (unsigned long long)stat_count(s, "rays/diffuse"),
            (unsigned long long)stat_count(s, "rays/specular"));
+    if (rayes_stats_find(s, "replay/rays"))
+        printf("  replay        %llu rays (%llu dropped) traced again unshaded: %.2f s (cpu %.2f "
+               "s), the render %.2f s (cpu %.2f s), %.2fx ray casting alone\n",
+               (unsigned long long)stat_count(s, "replay/rays"),
+               (unsigned long long)stat_count(s, "replay/dropped"), stat_real(s, "replay/wall_s"),
+               stat_real(s, "replay/cpu_s"), stat_real(s, "time/render_s"),
+               stat_real(s, "time/render_cpu_s"),
+               stat_real(s, "time/render_cpu_s") / fmax(stat_real(s, "replay/cpu_s"), 1e-9));
     if (rayes_stats_find(s, "cache/budget_bytes")) {
         static const char *const lv[3] = {"coarse", "medium", "fine"};
         printf("  cache         %.0f MB:", (double)stat_count(s, "cache/budget_bytes") / 1e6);

@@ -18,11 +18,15 @@
 #include "render/render.h"
 #include "render/volume.h"
 #include "scene/scene.h"
+#include "session/replay.h"
 #include "session/session.h"
 #include "session/stats.h"
 #include "util/check.h"
 #include "util/log.h"
 #include "util/thread.h"
+
+/* RayesRenderOptions.replay_rays keeps at most this much of rays. */
+#define REPLAY_MAX_BYTES ((size_t)2000 * 1000 * 1000)
 
 const char *rayes_error_string(RayesError e)
 {
@@ -449,6 +453,7 @@ RayesError rayes_render(RayesScene *scene, const RayesRenderOptions *opt, RayesI
     RayesImage *img = calloc(1, sizeof *img);
     float *rgba = malloc(sizeof(float) * 4 * (size_t)set.width * set.height);
     Cache *cache = NULL;
+    AccelRecord *record = NULL;
     TextureSystem *textures = session_textures(scene, opt->texture_mb, opt->texture_width);
     RenderStats rstats = {0};
     set.textures = textures;
@@ -468,13 +473,28 @@ RayesError rayes_render(RayesScene *scene, const RayesRenderOptions *opt, RayesI
         }
         set.cache = cache;
     }
-    double t1 = time_now();
+    if (opt->replay_rays) {
+        record = accel_record_new(REPLAY_MAX_BYTES);
+        if (!record) {
+            e = session_fail(scene, RAYES_ERROR_OUT_OF_MEMORY, "render: out of memory");
+            goto done;
+        }
+        accel_attach_record(prep.accel, record);
+    }
+    double t1 = time_now(), cpu1 = time_cpu();
     RenderScene rs = session_render_scene(scene, &prep, set.width, set.height);
     if (render_frame(&rs, &set, rgba, &rstats) != 0) {
         e = session_fail(scene, RAYES_ERROR_CANCELLED, "render: cancelled");
         goto done;
     }
-    double t2 = time_now();
+    double t2 = time_now(), cpu2 = time_cpu(), replay_wall = 0.0, replay_cpu = 0.0;
+    if (record) {
+        accel_attach_record(prep.accel, NULL);
+        if (session_replay(prep.accel, record, set.threads, &replay_wall, &replay_cpu) != 0) {
+            e = session_fail(scene, RAYES_ERROR_OUT_OF_MEMORY, "render: cannot replay the rays");
+            goto done;
+        }
+    }
     if (stats_out) {
         SessionTimes times = {t2 - t0, t1 - t0, t2 - t1};
         *stats_out = session_stats_new(&set, &rstats, &prep.gs, &times,
@@ -489,6 +509,14 @@ RayesError rayes_render(RayesScene *scene, const RayesRenderOptions *opt, RayesI
             texture_get_stats(textures, &ts);
             session_stats_add_textures(*stats_out, &ts);
             session_stats_add_real(*stats_out, "dicing/coarsened", prep.coarsened);
+            session_stats_add_real(*stats_out, "time/render_cpu_s", cpu2 - cpu1);
+            if (record) {
+                session_stats_add_count(*stats_out, "replay/rays", accel_record_rays(record));
+                session_stats_add_count(*stats_out, "replay/dropped",
+                                        accel_record_dropped(record));
+                session_stats_add_real(*stats_out, "replay/wall_s", replay_wall);
+                session_stats_add_real(*stats_out, "replay/cpu_s", replay_cpu);
+            }
         }
         if (!*stats_out) {
             e = session_fail(scene, RAYES_ERROR_OUT_OF_MEMORY,
@@ -507,6 +535,7 @@ RayesError rayes_render(RayesScene *scene, const RayesRenderOptions *opt, RayesI
     img = NULL;
     rgba = NULL;
 done:
+    accel_record_free(record);
     cache_free(cache);
     session_prepared_fini(&prep);
     texture_system_free(textures);

@@ -17,6 +17,9 @@ void log_warning_once(const char *key, const char *fmt, ...) __attribute__((form
 /* Seconds on a monotonic clock. */
 double time_now(void);
 
+/* Seconds of CPU the process has used, all threads. */
+double time_cpu(void);
+
 /* The process's peak resident set size in bytes (0 if unknown). */
 uint64_t mem_peak_rss_bytes(void);
 

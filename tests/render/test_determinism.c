@@ -182,8 +182,51 @@ static void test_negative_lobes_ring(void)
     CHECK(edge_max(RAYES_FILTER_CATMULL_ROM) > 1.01f);
 }
 
+/* Replaying the rays (RayesRenderOptions.replay_rays) leaves the image as
+ * it was, keeps every ray the statistics count (cornell-teapots has no
+ * subsurface or volume rays beside them) and traces them again. */
+static void test_replay_rays(void)
+{
+    RayesScene *s = rayes_scene_new();
+    char err[512];
+    IoSink sink = io_sink_scene(s);
+    CHECK(io_builtin_scene("cornell-teapots", RAYES_TEST_DATA, &sink, err, sizeof err) ==
+          RAYES_OK);
+    CHECK(rayes_scene_commit(s) == RAYES_OK);
+    RayesRenderOptions o;
+    rayes_render_options_init(&o, RAYES_QUALITY_PREVIEW);
+    o.width = 48;
+    o.height = 40;
+    o.spp = 2;
+    o.threads = 2;
+    RayesImage *plain = NULL, *replayed = NULL;
+    RayesStats *st = NULL, *st_plain = NULL;
+    CHECK(rayes_render(s, &o, &plain, &st_plain) == RAYES_OK);
+    o.replay_rays = 1;
+    CHECK(rayes_render(s, &o, &replayed, &st) == RAYES_OK);
+    CHECK(same(plain, replayed));
+    const RayesStat *rays = rayes_stats_find(st, "rays/total");
+    const RayesStat *kept = rayes_stats_find(st, "replay/rays");
+    const RayesStat *dropped = rayes_stats_find(st, "replay/dropped");
+    const RayesStat *cpu = rayes_stats_find(st, "replay/cpu_s");
+    CHECK(rays && kept && dropped && cpu);
+    if (rays && kept && dropped && cpu) {
+        CHECK(rays->count > 1000);
+        CHECK(kept->count == rays->count);
+        CHECK(dropped->count == 0);
+        CHECK(cpu->real > 0.0);
+    }
+    CHECK(rayes_stats_find(st_plain, "replay/rays") == NULL);
+    rayes_stats_free(st);
+    rayes_stats_free(st_plain);
+    rayes_image_free(plain);
+    rayes_image_free(replayed);
+    rayes_scene_release(s);
+}
+
 TEST_MAIN(TEST(test_box_filter_any_thread_count), TEST(test_gaussian_filter_any_thread_count),
           TEST(test_every_filter_any_thread_count), TEST(test_filters_keep_a_constant_image),
           TEST(test_negative_lobes_ring),
           TEST(test_teapots_any_thread_count), TEST(test_displaced_teapots),
-          TEST(test_seed_changes_image), TEST(test_spheres_any_thread_count))
+          TEST(test_seed_changes_image), TEST(test_spheres_any_thread_count),
+          TEST(test_replay_rays))
