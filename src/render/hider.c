@@ -27,7 +27,8 @@ enum { STRIPES = 256 };
 
 typedef float Rgb[3];
 
-typedef _Atomic(Rgb *) GridSlot; /* a grid's vertices' radiance, NULL until shaded */
+typedef _Atomic(Rgb *) GridSlot; /* a grid's vertices' radiance (then, for a transparent
+                                     object, their opacity), NULL until shaded */
 
 struct GridShading {
     const RenderScene *rs;
@@ -127,7 +128,8 @@ static void vertex_to_world(const GeomInstance *gi, Vec3 *P, Vec3 *Ng, Vec3 *N, 
 }
 
 /* Shades every vertex of grid gi, seen through instance (0: none), with
- * lighting() into a new array. */
+ * lighting() into a new array: Ci of each vertex, followed by Oi of each if
+ * the object is transparent. */
 static Rgb *shade_grid(Worker *w, uint32_t gi, uint32_t instance)
 {
     const RenderScene *rs = w->rs;
@@ -140,7 +142,7 @@ static Rgb *shade_grid(Worker *w, uint32_t gi, uint32_t instance)
     float *f1 = malloc(n * 10 * sizeof *f1);
     uint64_t *keys = malloc(n * sizeof *keys);
     RayDiff *diff = malloc(n * sizeof *diff);
-    Rgb *ci = malloc(n * sizeof *ci);
+    Rgb *ci = malloc(n * (obj->transparent ? 2 : 1) * sizeof *ci);
     int *back = malloc(n * sizeof *back);
     RY_CHECK(f3 && f1 && keys && diff && ci && back);
     float(*P)[3] = f3, (*N)[3] = f3 + n, (*dPdu)[3] = f3 + 2 * n, (*dPdv)[3] = f3 + 3 * n;
@@ -212,6 +214,8 @@ static Rgb *shade_grid(Worker *w, uint32_t gi, uint32_t instance)
     w->stats.shading_points[0] += n;
     shade_run_lighting(w->services, &ctx, obj->shader, &out);
     memcpy(ci, Ci, n * sizeof *ci);
+    if (obj->transparent)
+        memcpy(ci + n, Oi, n * sizeof *ci);
     free(irr_E);
     free(back);
     free(f3);
@@ -246,7 +250,23 @@ static GridSlot *grid_slot(GridShading *gsh, uint32_t gi, uint32_t instance)
     return &slots[gi - gsh->master_first[m]];
 }
 
-int hider_camera_hit(Worker *w, const Ray *ray, const Hit *hit, Vec3 *L)
+/* The hit's corners of c (one RGB per grid vertex) interpolated into *out;
+ * returns whether their summed RGB spreads by at most limit times its mean. */
+static int corners(const Hit *hit, uint32_t first, const Rgb *c, float limit, Vec3 *out)
+{
+    Vec3 sum = v3(0, 0, 0);
+    float lo = INFINITY, hi = 0.0f, mean = 0.0f;
+    for (int k = 0; k < hit->n_vertex; k++) {
+        const float *ck = c[hit->vertex[k] - first];
+        float y = ck[0] + ck[1] + ck[2];
+        lo = fminf(lo, y), hi = fmaxf(hi, y), mean += y / (float)hit->n_vertex;
+        sum = v3_madd(sum, v3(ck[0], ck[1], ck[2]), hit->weight[k]);
+    }
+    *out = sum;
+    return hi - lo <= limit * mean;
+}
+
+int hider_camera_hit(Worker *w, const Ray *ray, const Hit *hit, Vec3 *L, Vec3 *Oi)
 {
     (void)ray;
     GridShading *gsh = w->grid_shading;
@@ -270,15 +290,13 @@ int hider_camera_hit(Worker *w, const Ray *ray, const Hit *hit, Vec3 *L)
         }
         pthread_mutex_unlock(lock);
     }
-    uint32_t first = w->rs->gs->grids[gi].first_vertex;
-    Vec3 sum = v3(0, 0, 0);
-    float lo = INFINITY, hi = 0.0f, mean = 0.0f;
-    for (int k = 0; k < hit->n_vertex; k++) {
-        const float *c = ci[hit->vertex[k] - first];
-        float y = c[0] + c[1] + c[2];
-        lo = fminf(lo, y), hi = fmaxf(hi, y), mean += y / (float)hit->n_vertex;
-        sum = v3_madd(sum, v3(c[0], c[1], c[2]), hit->weight[k]);
-    }
-    *L = sum;
-    return hi - lo <= gsh->contrast * mean;
+    const Grid *g = &w->rs->gs->grids[gi];
+    if (!corners(hit, g->first_vertex, ci, gsh->contrast, L))
+        return 0;
+    *Oi = v3(1, 1, 1);
+    if (!render_object(w->rs, gi, hit->instance)->transparent)
+        return 1;
+    /* Opacity is no noisy estimate: a cut-out's edge (corners of 0 and 1)
+     * or any step beyond HIDER_OPACITY_STEP is shaded where the ray hits. */
+    return corners(hit, g->first_vertex, ci + geom_grid_n_vertices(g), HIDER_OPACITY_STEP, Oi);
 }

@@ -28,13 +28,23 @@ void hider_free(GridShading *gsh);
  * highlight (at 1 ray it is 4: never, for four corners). */
 #define HIDER_CONTRAST 0.5f
 
+/* Relative spread of a micropolygon's corner opacities (summed RGB) above
+ * which a transparent object's hit is shaded where the ray hits rather
+ * than interpolated: opacity carries no noise to smooth, and a cut-out's
+ * edge drawn from the grid's corners would be as coarse as the grid. */
+#define HIDER_OPACITY_STEP 0.05f
+
 /* The radiance toward the camera at a camera ray's hit on a surface (not an
  * emitter): the hit grid's shaded vertices, interpolated with the hit's
- * weights, into *L. Shades the grid first if nobody has. Returns 0 instead
- * when the hit micropolygon's corners disagree too much to be interpolated
- * (max - min of their summed RGB above the contrast limit times their mean:
- * a highlight or a sharp reflection smaller than a micropolygon); the
- * caller then shades the sample itself, as the ray-tracing hider does. */
-int hider_camera_hit(Worker *w, const Ray *ray, const Hit *hit, Vec3 *L);
+ * weights, into *L, and its opacity into *Oi (1 for an opaque object; a
+ * transparent object's Ci is premultiplied, as the shader gave it, and the
+ * caller composites what lies behind). Shades the grid first if nobody
+ * has. Returns 0 instead when the hit micropolygon's corners disagree too
+ * much to be interpolated (max - min of their summed RGB above the
+ * contrast limit times their mean: a highlight or a sharp reflection
+ * smaller than a micropolygon; or their opacities by more than
+ * HIDER_OPACITY_STEP of their mean); the caller then shades the sample
+ * itself, as the ray-tracing hider does. */
+int hider_camera_hit(Worker *w, const Ray *ray, const Hit *hit, Vec3 *L, Vec3 *Oi);
 
 #endif /* RAYES_RENDER_HIDER_H */

@@ -311,10 +311,10 @@ static Vec3 trace_layers(Worker *w, const Ray *ray, uint32_t kind, int diffuse_d
         Ci = radiosity_at_hit(w, ray, &hit, diffuse_depth, diff);
         if (see_through)
             Oi = integrator_opacity(w, ray, &hit, diff);
-    } else if (kind == RAYES_RAY_CAMERA && w->grid_shading && !obj->transparent &&
-               hider_camera_hit(w, ray, &hit, &Ci)) {
-        /* the grid hider's shaded grid (opaque objects only; a master's grid
-         * per instance) */
+    } else if (kind == RAYES_RAY_CAMERA && w->grid_shading &&
+               hider_camera_hit(w, ray, &hit, &Ci, &Oi)) {
+        /* the grid hider's shaded grid (a master's grid per instance; Ci
+         * and Oi of a transparent one) */
     } else {
         Ci = shade_hit(w, ray, &hit, obj, kind, diffuse_depth, specular_depth, key, diff, &Oi);
     }

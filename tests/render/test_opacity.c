@@ -320,6 +320,69 @@ static void test_camera_sees_through(void)
     rayes_scene_release(s);
 }
 
+/* The grid hider shades a transparent object's grids once, Oi with Ci, and
+ * composites them as the ray-tracing hider does: a red sheet cut into a
+ * checkerboard (an Os pattern) over a white floor agrees pixel for pixel,
+ * the cells' edges shaded where the rays hit (so as sharp),
+ * while the sheet's depth-0 shading points no longer follow the pixel
+ * samples. */
+static RayesImage *checker_seen(RayesHider hider, int threads, uint64_t *depth0)
+{
+    RayesScene *s = new_scene();
+    RayesParam white[1] = {pc("Cs", 1, 1, 1)};
+    CHECK(rayes_scene_set_shader(s, "constant", white, 1) == RAYES_OK);
+    quad_at(s, 2.0f, 0.0f);
+    RayesParam cb[2] = {pf("uscale", 4.0f), pf("vscale", 4.0f)};
+    CHECK(rayes_scene_pattern(s, "cells", "checkerboard", cb, 2) == RAYES_OK);
+    RayesParam p[2] = {pc("Cs", 1, 0, 0), (RayesParam){"Os", RAYES_PARAM_PATTERN, {0, 0, 0},
+                                                       "cells"}};
+    CHECK(rayes_scene_set_shader(s, "constant", p, 2) == RAYES_OK);
+    quad_at(s, 1.0f, 1.0f);
+    CHECK(rayes_scene_commit(s) == RAYES_OK);
+    RayesRenderOptions o;
+    rayes_render_options_init(&o, RAYES_QUALITY_PREVIEW);
+    o.width = o.height = 64;
+    o.spp = 16;
+    o.threads = threads;
+    o.bounces = 0;
+    o.hider = hider;
+    RayesImage *img = NULL;
+    RayesStats *st = NULL;
+    CHECK(rayes_render(s, &o, &img, &st) == RAYES_OK);
+    const RayesStat *sp = rayes_stats_find(st, "shading_points/by_depth");
+    *depth0 = sp && sp->n_counts ? sp->counts[0] : 0;
+    rayes_stats_free(st);
+    rayes_scene_release(s);
+    return img;
+}
+
+static void test_grid_hider_transparent_grids(void)
+{
+    uint64_t n_ray, n_grid, n_one;
+    RayesImage *ray = checker_seen(RAYES_HIDER_RAYTRACE, 2, &n_ray);
+    RayesImage *grid = checker_seen(RAYES_HIDER_GRID, 2, &n_grid);
+    RayesImage *one = checker_seen(RAYES_HIDER_GRID, 1, &n_one);
+    if (ray && grid && one) {
+        int differ = 0;
+        double worst = 0.0;
+        for (int i = 0; i < 64 * 64; i++)
+            for (int c = 0; c < 4; c++) {
+                double d = fabs((double)ray->rgba[4 * i + c] - grid->rgba[4 * i + c]);
+                worst = fmax(worst, d);
+                differ += d > 0.01;
+            }
+        fprintf(stderr, "grid hider, transparent: %d values differ by > 0.01 (worst %g); depth-0 "
+                "points %llu (ray tracing %llu)\n", differ, worst, (unsigned long long)n_grid,
+                (unsigned long long)n_ray);
+        CHECK(differ < 64 * 64 * 4 / 100);
+        CHECK(n_grid < n_ray / 2);
+        CHECK(memcmp(grid->rgba, one->rgba, sizeof(float) * 4 * 64 * 64) == 0);
+    }
+    rayes_image_free(ray);
+    rayes_image_free(grid);
+    rayes_image_free(one);
+}
+
 static void test_bad_attributes(void)
 {
     RayesScene *s = rayes_scene_new();
@@ -336,4 +399,4 @@ TEST_MAIN(TEST(test_stacked_sheets_multiply_in_any_order),
           TEST(test_half_transparent_sheet_halves_irradiance),
           TEST(test_ambient_occlusion_closed_forms), TEST(test_cutout_shadow_matches_geometry),
           TEST(test_opacity_cache_within_noise_and_deterministic), TEST(test_camera_sees_through),
-          TEST(test_bad_attributes))
+          TEST(test_grid_hider_transparent_grids), TEST(test_bad_attributes))
