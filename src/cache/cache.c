@@ -29,6 +29,7 @@
 
 #include "util/check.h"
 #include "util/half.h"
+#include "util/log.h"
 #include "util/rng.h"
 
 #define CACHE_SHARDS 8
@@ -317,6 +318,9 @@ void cache_local_fini(CacheLocal *local)
             to->hits += from->hits;
             to->misses += from->misses;
             to->fills += from->fills;
+            to->waits += from->waits;
+            to->wait_ns += from->wait_ns;
+            to->contended += from->contended;
         }
     pthread_mutex_unlock(&c->counters_lock);
     memset(local->counters, 0, sizeof local->counters);
@@ -326,12 +330,15 @@ void cache_local_fini(CacheLocal *local)
  * or inserts a new pinned, unready entry for the caller to fill (*inserted =
  * 1), or returns NULL if none fits. Drops a stale entry it meets. */
 static CacheEntry *find_or_insert(Cache *c, const CacheKey *key, uint64_t hash, size_t n_values,
-                                  int *inserted)
+                                  int *inserted, CacheCounters *ctr)
 {
     Shard *s = shard_of(c, key, hash);
     uint64_t now = cache_timestamp(c);
     *inserted = 0;
-    pthread_mutex_lock(&s->lock);
+    if (pthread_mutex_trylock(&s->lock) != 0) {
+        ctr->contended++;
+        pthread_mutex_lock(&s->lock);
+    }
     CacheEntry *e = NULL;
     if (s->table) {
         for (e = s->table[hash & (s->n_slots - 1)]; e; e = e->hnext)
@@ -349,8 +356,13 @@ static CacheEntry *find_or_insert(Cache *c, const CacheKey *key, uint64_t hash, 
     if (e) {
         if (e->refs++ == 0)
             lru_unlink(s, e);
-        while (!e->ready)
-            pthread_cond_wait(&s->filled, &s->lock);
+        if (!e->ready) { /* another thread fills it: wait (what threads cost each other) */
+            double t0 = time_now();
+            while (!e->ready)
+                pthread_cond_wait(&s->filled, &s->lock);
+            ctr->waits++;
+            ctr->wait_ns += (uint64_t)(1e9 * (time_now() - t0));
+        }
         pthread_mutex_unlock(&s->lock);
         return e;
     }
@@ -420,7 +432,7 @@ const uint16_t *cache_lookup(CacheLocal *local, const CacheKey *key, size_t n_va
         release(c, held);
     }
     int inserted;
-    CacheEntry *e = find_or_insert(c, key, hash, n_values, &inserted);
+    CacheEntry *e = find_or_insert(c, key, hash, n_values, &inserted, ctr);
     if (e && !inserted) {
         ctr->hits++;
     } else {

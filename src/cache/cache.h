@@ -74,6 +74,10 @@ typedef struct CacheEntry CacheEntry;
 /* Per level and data type counters. */
 typedef struct CacheCounters {
     uint64_t lookups, hits, misses, fills, evictions;
+    uint64_t waits;     /* lookups that found their entry being filled by another
+                           thread and waited for it */
+    uint64_t wait_ns;   /* the time they waited, nanoseconds */
+    uint64_t contended; /* lookups that found their shard's lock taken */
 } CacheCounters;
 
 typedef struct CacheStats {

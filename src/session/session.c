@@ -496,7 +496,7 @@ RayesError rayes_render(RayesScene *scene, const RayesRenderOptions *opt, RayesI
         }
     }
     if (stats_out) {
-        SessionTimes times = {t2 - t0, t1 - t0, t2 - t1};
+        SessionTimes times = {t2 - t0, t1 - t0, t2 - t1, cpu2 - cpu1};
         *stats_out = session_stats_new(&set, &rstats, &prep.gs, &times,
                                        accel_memory_bytes(prep.accel));
         if (*stats_out && cache) {
@@ -509,7 +509,6 @@ RayesError rayes_render(RayesScene *scene, const RayesRenderOptions *opt, RayesI
             texture_get_stats(textures, &ts);
             session_stats_add_textures(*stats_out, &ts);
             session_stats_add_real(*stats_out, "dicing/coarsened", prep.coarsened);
-            session_stats_add_real(*stats_out, "time/render_cpu_s", cpu2 - cpu1);
             if (record) {
                 session_stats_add_count(*stats_out, "replay/rays", accel_record_rays(record));
                 session_stats_add_count(*stats_out, "replay/dropped",

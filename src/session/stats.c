@@ -71,6 +71,8 @@ RayesStats *session_stats_new(const RenderSettings *set, const RenderStats *rs, 
     real(s, "time/total_s", t->total_s);
     real(s, "time/prepare_s", t->prepare_s);
     real(s, "time/render_s", t->render_s);
+    if (t->render_cpu_s > 0.0)
+        real(s, "time/render_cpu_s", t->render_cpu_s);
     uint64_t total = 0;
     int deepest = 0;
     for (int d = 0; d <= RENDER_MAX_DEPTH; d++) {
@@ -163,6 +165,19 @@ void session_stats_add_cache(RayesStats *s, const CacheStats *cs)
         count(s, names[l][6], cs->bytes[l]);
         real(s, names[l][7], c->lookups ? (double)c->hits / (double)c->lookups : 0.0);
     }
+    /* What threads cost each other in the cache, every level and type:
+     * lookups that waited for another thread's fill of the same entry, how
+     * long, and lookups that found their shard locked. */
+    uint64_t waits = 0, wait_ns = 0, contended = 0;
+    for (int l = 0; l < CACHE_N_LEVELS; l++)
+        for (int t = 0; t < CACHE_N_TYPES; t++) {
+            waits += cs->counters[l][t].waits;
+            wait_ns += cs->counters[l][t].wait_ns;
+            contended += cs->counters[l][t].contended;
+        }
+    count(s, "cache/threads/waits", waits);
+    real(s, "cache/threads/wait_s", 1e-9 * (double)wait_ns);
+    count(s, "cache/threads/contended", contended);
     session_stats_add_cache_types(s, cs);
 }
 

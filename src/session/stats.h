@@ -14,6 +14,7 @@
 
 typedef struct SessionTimes {
     double total_s, prepare_s, render_s;
+    double render_cpu_s; /* the process's CPU time over render_s (0: not measured) */
 } SessionTimes;
 
 /* A new statistics list (free with rayes_stats_free), or NULL. */

@@ -244,15 +244,20 @@ static void run(uint64_t budget, long bump_period_us, int expect_hits)
     CHECK(stale == 0);
     CacheStats s;
     cache_get_stats(sh.cache, &s);
-    uint64_t counted = 0, hits = 0;
+    uint64_t counted = 0, hits = 0, waits = 0, contended = 0;
     for (int l = 0; l < CACHE_N_LEVELS; l++) {
         CHECK(s.bytes[l] <= s.level_budget_bytes[l]);
         CHECK(s.peak_bytes[l] <= s.level_budget_bytes[l]);
         for (int t = 0; t < CACHE_N_TYPES; t++) {
             const CacheCounters *k = &s.counters[l][t];
             CHECK(k->lookups == k->hits + k->misses && k->fills == k->misses);
+            /* a wait is a hit on an entry another thread was filling */
+            CHECK(k->waits <= k->hits && (k->waits == 0) == (k->wait_ns == 0));
+            CHECK(k->contended <= k->lookups);
             counted += k->lookups;
             hits += k->hits;
+            waits += k->waits;
+            contended += k->contended;
         }
     }
     CHECK(counted == lookups);
@@ -260,10 +265,12 @@ static void run(uint64_t budget, long bump_period_us, int expect_hits)
     for (int l = 0; l < CACHE_N_LEVELS; l++)
         for (int t = 0; t < CACHE_N_TYPES; t++)
             evictions += s.counters[l][t].evictions;
-    printf("  budget %llu: %llu lookups, %llu hits, %llu fills, %llu evictions, timestamp %llu\n",
+    printf("  budget %llu: %llu lookups, %llu hits, %llu fills, %llu evictions, timestamp %llu, "
+           "%llu waits for another's fill, %llu contended locks\n",
            (unsigned long long)budget, (unsigned long long)lookups, (unsigned long long)hits,
            (unsigned long long)fills, (unsigned long long)evictions,
-           (unsigned long long)cache_timestamp(sh.cache));
+           (unsigned long long)cache_timestamp(sh.cache), (unsigned long long)waits,
+           (unsigned long long)contended);
     if (expect_hits)
         CHECK(hits > lookups / 2);
     cache_free(sh.cache); /* aborts if any entry is still held */
