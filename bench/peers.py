@@ -7,13 +7,16 @@ Cycles"). Run through bench/peers, which builds rayes first.
     bench/peers [--size 256] [--bounces 1] [--threads 2] [--data DIR]
                 [--cycles 16,64,256,1024] [--cycles-ref 4096]
                 [--preview 4,16,64,256] [--final 4,16] [--ref-spp 1024]
-                [--out bench-out/peers]
+                [--adaptive 0.1,0.05,0.02,0.01] [--adaptive-spp 16]
+                [--adaptive-max 1024] [--reuse 0|1] [--out bench-out/peers]
 
 Cycles renders the scene of ../shared/data/cornell-teapots.md built by
 bench/peers_cycles.py with matched light transport: the same diffuse
 bounces, 4 glossy, caustics off, no clamping, no denoising, no adaptive
 sampling, a one-pixel box filter. rayes renders the built-in
-cornell-teapots in its preview and final presets. rayes's reference is the
+cornell-teapots in its preview and final presets, and the preview with
+adaptive pixel sampling (--adaptive-spp samples everywhere, up to
+--adaptive-max, at each listed --adaptive-error). rayes's reference is the
 preview's uncached estimator at --ref-spp pixel samples (4 diffuse and 4
 shadow rays a hit: 4 x ref-spp paths a pixel, nothing cached); Cycles's is
 --cycles-ref samples. Errors are relative RMSE (RMSE over RGB and pixels,
@@ -22,6 +25,8 @@ over its renders (Cycles: its render calls, every thread; rayes: the
 process, preparing included). The CPU seconds to reach 5%, 2% and 1% are
 interpolated on the log-log line between the sweep's points around the
 crossing (extrapolated as err ~ cpu^-1/2 past the last, marked '~').
+With --reuse 1, renders whose image and record are in --out already are
+not made again (rayes's beside each image, Cycles's in cycles.json).
 """
 import json
 import math
@@ -40,7 +45,9 @@ def parse(argv):
     opt = {"size": "256", "bounces": "1", "threads": "2",
            "data": os.environ.get("RAYES_DATA", os.path.join(ROOT, "..", "shared", "data")),
            "cycles": "16,64,256,1024", "cycles-ref": "4096", "preview": "4,16,64,256",
-           "final": "4,16", "ref-spp": "1024", "out": os.path.join(ROOT, "bench-out", "peers")}
+           "final": "4,16", "ref-spp": "1024", "adaptive": "0.1,0.05,0.02,0.01",
+           "adaptive-spp": "16", "adaptive-max": "1024", "reuse": "0",
+           "out": os.path.join(ROOT, "bench-out", "peers")}
     for i in range(0, len(argv), 2):
         key = argv[i].lstrip("-")
         if key not in opt or i + 1 >= len(argv):
@@ -71,16 +78,22 @@ def child_cpu():
     return r.ru_utime + r.ru_stime
 
 
-def rayes(opt, tag, spp, extra):
+def rayes(opt, tag, spp, extra, name=None):
     """Renders with rayes; returns (image path, CPU seconds of the process)."""
-    path = os.path.join(opt["out"], "rayes-%s-%d.exr" % (tag, spp))
+    path = os.path.join(opt["out"], "rayes-%s-%s.exr" % (tag, name or spp))
+    record = path + ".json"
+    if opt["reuse"] == "1" and os.path.exists(path) and os.path.exists(record):
+        with open(record) as f:
+            return path, json.load(f)["cpu_s"]
     cmd = [os.path.join(ROOT, "build", "rayes"), "render", "cornell-teapots", "--data", opt["data"],
            "--res", opt["size"], "--spp", str(spp), "--bounces", opt["bounces"],
            "--threads", opt["threads"], "--quiet", "-o", path] + extra
     c0 = child_cpu()
     subprocess.run(cmd, check=True)
     cpu = child_cpu() - c0
-    print("peers: rayes %s %d spp, %.2f s cpu" % (tag, spp, cpu), flush=True)
+    with open(record, "w") as f:
+        json.dump({"cmd": cmd[1:], "cpu_s": cpu}, f)
+    print("peers: rayes %s %s, %.2f s cpu" % (tag, name or "%d spp" % spp, cpu), flush=True)
     return path, cpu
 
 
@@ -103,13 +116,22 @@ def main():
     opt = parse(sys.argv[1:])
     os.makedirs(opt["out"], exist_ok=True)
     cyc = counts(opt["cycles"]) + [int(opt["cycles-ref"])]
-    subprocess.run(["blender", "-b", "--factory-startup", "--python",
+    done = {}
+    if opt["reuse"] == "1" and os.path.exists(os.path.join(opt["out"], "cycles.json")):
+        with open(os.path.join(opt["out"], "cycles.json")) as f:
+            done = {r["spp"]: r for r in json.load(f) if os.path.exists(r["image"])}
+    missing = [c for c in cyc if c not in done]
+    if missing:
+        subprocess.run(["blender", "-b", "--factory-startup", "--python",
                     os.path.join(ROOT, "bench", "peers_cycles.py"), "--", "--data", opt["data"],
                     "--size", opt["size"], "--bounces", opt["bounces"], "--threads",
                     opt["threads"], "--out", opt["out"], "--samples",
-                    ",".join(str(c) for c in cyc)], check=True, stdout=subprocess.DEVNULL)
-    with open(os.path.join(opt["out"], "cycles.json")) as f:
-        cycles = {r["spp"]: r for r in json.load(f)}
+                    ",".join(str(c) for c in missing)], check=True, stdout=subprocess.DEVNULL)
+        with open(os.path.join(opt["out"], "cycles.json")) as f:
+            done.update({r["spp"]: r for r in json.load(f)})
+        with open(os.path.join(opt["out"], "cycles.json"), "w") as f:
+            json.dump(list(done.values()), f, indent=1)
+    cycles = done
     ref_cycles = read(cycles[int(opt["cycles-ref"])]["image"])
     rows = []
     for spp in counts(opt["cycles"]):
@@ -121,18 +143,23 @@ def main():
         for spp in counts(opt[tag]):
             path, cpu = rayes(opt, tag, spp, ["--quality", preset])
             rows.append((tag, spp, cpu, read(path)))
+    for e in [float(x) for x in opt["adaptive"].split(",") if x]:
+        path, cpu = rayes(opt, "adaptive", int(opt["adaptive-spp"]),
+                          ["--quality", "preview", "--max-spp", opt["adaptive-max"],
+                           "--adaptive-error", "%g" % e], name="e%g" % e)
+        rows.append(("adaptive", "e%g" % e, cpu, read(path)))
 
     print()
     print("cornell-teapots %sx%s, %s diffuse bounce(s), %s threads; relative RMSE against each "
           "renderer's own reference and against the other's" % (opt["size"], opt["size"],
                                                                  opt["bounces"], opt["threads"]))
-    print("%-8s %6s %9s | %9s %9s" % ("mode", "spp", "cpu s", "own ref", "other ref"))
+    print("%-8s %6s %9s | %9s %9s" % ("mode", "spp/err", "cpu s", "own ref", "other ref"))
     record = {"size": int(opt["size"]), "bounces": int(opt["bounces"]),
               "threads": int(opt["threads"]), "rows": [], "time_to": {}}
     for tag, spp, cpu, img in rows:
         own, other = (ref_cycles, ref_rayes) if tag == "cycles" else (ref_rayes, ref_cycles)
         e_own, e_other = rel_rmse(img, own), rel_rmse(img, other)
-        print("%-8s %6d %9.2f | %8.2f%% %8.2f%%" % (tag, spp, cpu, 100 * e_own, 100 * e_other))
+        print("%-8s %6s %9.2f | %8.2f%% %8.2f%%" % (tag, spp, cpu, 100 * e_own, 100 * e_other))
         record["rows"].append({"mode": tag, "spp": spp, "cpu_s": cpu, "rmse_own": e_own,
                                "rmse_other": e_other})
     m_c, m_r = float(np.mean(ref_cycles)), float(np.mean(ref_rayes))
@@ -148,7 +175,7 @@ def main():
     print("CPU seconds to reach a relative RMSE (own reference; '~' extrapolated, '<' at the "
           "first point already)")
     print("%-8s %10s %10s %10s" % ("mode", "5%", "2%", "1%"))
-    for tag in ("cycles", "preview", "final"):
+    for tag in ("cycles", "preview", "final", "adaptive"):
         pts = [(r["cpu_s"], r["rmse_own"]) for r in record["rows"] if r["mode"] == tag]
         cells, rec = [], {}
         for target in (0.05, 0.02, 0.01):
@@ -158,7 +185,7 @@ def main():
         record["time_to"][tag] = rec
         print("%-8s %10s %10s %10s" % (tag, *cells))
     for target in ("0.05", "0.02", "0.01"):
-        best = min(record["time_to"][t][target]["cpu_s"] for t in ("preview", "final"))
+        best = min(record["time_to"][t][target]["cpu_s"] for t in ("preview", "final", "adaptive"))
         ratio = record["time_to"]["cycles"][target]["cpu_s"] / best
         print("at %s%%: Cycles / rayes's better preset = %.2f" % (float(target) * 100, ratio))
         record["time_to"]["ratio_" + target] = ratio

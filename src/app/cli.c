@@ -41,6 +41,10 @@ static const char render_options[] =
     "                          the same bytes as an uninterrupted render's\n"
     "  --res W[xH]             resolution in pixels (default 512x512)\n"
     "  --spp N                 pixel samples (default 4)\n"
+    "  --max-spp N             adaptive sampling: a noisy pixel takes further blocks of\n"
+    "                          --spp samples, up to N (default 0: off)\n"
+    "  --adaptive-error E      until its mean's relative standard error is E (default\n"
+    "                          0.02)\n"
     "  --threads N             worker threads (default: all cores)\n"
     "  --bounces N             maximum diffuse depth (default 1)\n"
     "  --quality Q             preview (4 shadow, 4 diffuse rays), final (64; 1024 at\n"
@@ -341,6 +345,12 @@ void parse_args(int argc, char **argv, Args *a)
         } else if (strcmp(o, "--spp") == 0) {
             opt->spp = (int)parse_long(o, v, 1, 1 << 20);
             a->set |= SET_SPP;
+        } else if (strcmp(o, "--max-spp") == 0) {
+            opt->max_spp = (int)parse_long(o, v, 0, 1 << 20);
+            a->set |= SET_MAX_SPP;
+        } else if (strcmp(o, "--adaptive-error") == 0) {
+            opt->adaptive_error = parse_float(o, v, 1e-6f, 1e6f);
+            a->set |= SET_ADAPTIVE_ERROR;
         } else if (strcmp(o, "--frame") == 0)
             a->frame = (int)parse_long(o, v, 0, INT_MAX);
         else if (strcmp(o, "--frames") == 0)
@@ -493,6 +503,10 @@ void merge_settings(Args *a, const IoSettings *s)
     }
     if (!(a->set & SET_SPP) && s->spp > 0)
         o->spp = s->spp;
+    if (!(a->set & SET_MAX_SPP) && s->max_spp > 0)
+        o->max_spp = s->max_spp;
+    if (!(a->set & SET_ADAPTIVE_ERROR) && s->adaptive_error > 0.0f)
+        o->adaptive_error = s->adaptive_error;
     if (!(a->set & SET_FILTER) && s->filter >= RAYES_FILTER_BOX && s->filter <= RAYES_FILTER_LANCZOS) {
         o->filter = (RayesFilter)s->filter;
         if (!(a->set & SET_FILTER_WIDTH))

@@ -25,7 +25,9 @@ enum {
     SET_GRID_SIZE = 64,
     SET_TEXTURE_MB = 128,
     SET_CROP = 256,
-    SET_OPACITY_CACHE_MB = 512
+    SET_OPACITY_CACHE_MB = 512,
+    SET_MAX_SPP = 1024,
+    SET_ADAPTIVE_ERROR = 2048
 };
 
 /* An image to write. */

@@ -394,13 +394,6 @@ static int h_pixel_filter(Rib *r, const Args *a)
     return 0;
 }
 
-static int h_one_float(Rib *r, const Args *a)
-{
-    size_t i = 0;
-    float v;
-    return rib_get_floats(r, a, &i, &v, 1, "a number");
-}
-
 static int h_exposure(Rib *r, const Args *a)
 {
     size_t i = 0;
@@ -454,6 +447,21 @@ static int h_display(Rib *r, const Args *a)
     return 0;
 }
 
+/* One positive count of a Hider parameter (RenderMan's "minsamples",
+ * "maxsamples"), or 0 if absent; -1 on error. */
+static int hider_count(Rib *r, const Param *p, size_t n, const char *name)
+{
+    const Param *q = rib_find_param(p, n, name);
+    if (!q)
+        return 0;
+    if (!rib_is_num(q->v) || q->v->n != 1 || !(q->v->d[0] >= 1 && q->v->d[0] <= 1 << 20))
+        return rib_arg_error(r, q->v, "\"%s\" needs one count from 1 to 1048576", name);
+    return (int)q->v->d[0];
+}
+
+/* Hider "raytrace" "int minsamples" m "int maxsamples" M: RenderMan RIS's
+ * adaptive pixel sampling, m samples everywhere (PixelSamples' place) and
+ * up to M where the pixel is noisy (RayesRenderOptions.max_spp). */
 static int h_hider(Rib *r, const Args *a)
 {
     size_t i = 0;
@@ -462,6 +470,29 @@ static int h_hider(Rib *r, const Args *a)
         return -1;
     if (strcmp(name, "hidden") != 0 && strcmp(name, "raytrace") != 0)
         rib_warn_once(r, name, "hider \"%s\" is not supported; rays are traced", name);
+    Param *p;
+    size_t n;
+    if (rib_get_params(r, a, i, &p, &n) != 0)
+        return -1;
+    int lo = hider_count(r, p, n, "minsamples"), hi = hider_count(r, p, n, "maxsamples");
+    if (lo < 0 || hi < 0)
+        return -1;
+    if (lo > 0)
+        r->settings->spp = lo;
+    if (hi > 0)
+        r->settings->max_spp = hi;
+    return 0;
+}
+
+static int h_pixel_variance(Rib *r, const Args *a)
+{
+    size_t i = 0;
+    float v;
+    if (rib_get_floats(r, a, &i, &v, 1, "a pixel variance") != 0)
+        return -1;
+    if (!(v > 0.0f && v < 1e6f))
+        return rib_error(r, "PixelVariance must be positive, found %g", (double)v);
+    r->settings->adaptive_error = v;
     return 0;
 }
 
@@ -796,7 +827,7 @@ const RibRequest rib_state_requests[] = {
     {"CropWindow", h_crop_window}, {"Projection", h_projection}, {"Clipping", h_clipping},
     {"Shutter", h_shutter}, {"DepthOfField", h_depth_of_field},
     {"PixelSamples", h_pixel_samples}, {"PixelFilter", h_pixel_filter},
-    {"PixelVariance", h_one_float}, {"Exposure", h_exposure}, {"Quantize", h_quantize},
+    {"PixelVariance", h_pixel_variance}, {"Exposure", h_exposure}, {"Quantize", h_quantize},
     {"Display", h_display}, {"Hider", h_hider}, {"ShadingRate", h_shading_rate},
     {"Sides", h_sides}, {"Orientation", h_orientation},
     {"ReverseOrientation", h_reverse_orientation}, {"Color", h_color}, {"Opacity", h_color},

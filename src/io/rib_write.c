@@ -1271,6 +1271,10 @@ static void settings_rib(FILE *f, const IoSettings *s)
         else
             fprintf(f, "PixelSamples %d 1\n", s->spp);
     }
+    if (s->max_spp > 0)
+        fprintf(f, "Hider \"raytrace\" \"int maxsamples\" [%d]\n", s->max_spp);
+    if (s->adaptive_error > 0.0f)
+        fprintf(f, "PixelVariance %.9g\n", (double)s->adaptive_error);
     if (s->filter >= RAYES_FILTER_BOX && s->filter <= RAYES_FILTER_LANCZOS) {
         float def = 1.0f;
         io_filter_named(io_filter_name(s->filter), &def);

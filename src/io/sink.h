@@ -128,6 +128,10 @@ typedef struct IoDisplay {
 typedef struct IoSettings {
     int width, height;        /* pixels; 0: not given */
     int spp;                  /* pixel samples; 0: not given */
+    int max_spp;              /* adaptive sampling's most pixel samples (RIB Hider
+                                 "maxsamples"); 0: not given */
+    float adaptive_error;     /* its relative standard error (RIB PixelVariance); 0: not
+                                 given */
     int filter;               /* RayesFilter, or -1: not given */
     float filter_width;       /* pixels; 0: not given */
     int bounces;              /* maximum diffuse depth; -1: not given */

@@ -158,7 +158,23 @@ Ray render_camera_ray(const RenderScene *rs, int width, int height, float x, flo
                                 &focus);
 }
 
-/* All samples of pixel (px, py), splatted into the tile's accumulators. */
+/* Adaptive pixel sampling (RenderSettings.max_spp): whether a pixel's
+ * samples so far, n of luminance sum y and sum of squares y2, estimate
+ * its mean within the relative standard error asked. A pixel's count so
+ * depends on its own samples only, whichever tile (or margin) computes
+ * them: the image stays deterministic. */
+static int pixel_converged(const RenderSettings *set, int n, double y, double y2)
+{
+    double mean = y / n, var = (y2 - y * mean) / (n > 1 ? n - 1 : 1);
+    if (!(mean > 0.0))
+        return 1; /* black (or negative-lobed) so far: nothing to refine */
+    return sqrt(fmax(var, 0.0) / n) <= (double)set->adaptive_error * mean;
+}
+
+/* All samples of pixel (px, py), splatted into the tile's accumulators:
+ * spp of them, or with adaptive sampling further blocks of spp (each its
+ * own pattern, as a progressive session's passes) until the pixel
+ * converges or has max_spp. */
 static void render_pixel(Frame *f, Worker *w, int px, int py, int x0, int y0, int tw, int th,
                          float (*acc)[5])
 {
@@ -167,7 +183,13 @@ static void render_pixel(Frame *f, Worker *w, int px, int py, int x0, int y0, in
     uint32_t pattern = (uint32_t)hash_combine(pixel_key, DIM_PIXEL);
     const Camera *cam = &f->rs->camera;
     uint32_t n = (uint32_t)(set->pattern_spp > 0 ? set->pattern_spp : set->spp);
-    for (int k = 0; k < set->spp; k++) {
+    int adaptive = set->max_spp > set->spp && !set->accum;
+    int last = adaptive ? set->max_spp : set->spp;
+    double lum = 0.0, lum2 = 0.0; /* this pixel's own samples' luminance, for adaptive */
+    for (int k = 0; k < last; k++) {
+        if (adaptive && k >= set->spp && k % set->spp == 0 &&
+            pixel_converged(set, k, lum, lum2))
+            break;
         uint32_t s = (uint32_t)(set->first_sample + k), block = s / n;
         uint32_t p = block ? (uint32_t)hash_combine(pattern, block) : pattern;
         float jx, jy, lu = 0.5f, lv = 0.5f, time = cam->shutter[0];
@@ -192,6 +214,13 @@ static void render_pixel(Frame *f, Worker *w, int px, int py, int x0, int y0, in
         w->stats.rays_camera++;
         Vec3 L = integrator_trace(w, &ray, RAYES_RAY_CAMERA, 0, 0,
                                   hash_combine(pixel_key, (uint64_t)s + 1), diff, &alpha);
+        if (adaptive) {
+            double y = 0.2126 * L.x + 0.7152 * L.y + 0.0722 * L.z;
+            lum += y;
+            lum2 += y * y;
+            if (k == last - 1 && px >= x0 && px < x0 + tw && py >= y0 && py < y0 + th)
+                w->stats.adaptive_pixels_max++; /* counted by the pixel's own tile */
+        }
         for (int qy = RY_MAX(py - f->margin, y0); qy <= RY_MIN(py + f->margin, y0 + th - 1); qy++)
             for (int qx = RY_MAX(px - f->margin, x0); qx <= RY_MIN(px + f->margin, x0 + tw - 1);
                  qx++) {
@@ -270,6 +299,7 @@ static void render_tile(void *ctx, size_t task, int worker)
 static void merge_stats(RenderStats *into, const RenderStats *s)
 {
     into->rays_camera += s->rays_camera;
+    into->adaptive_pixels_max += s->adaptive_pixels_max;
     into->rays_shadow += s->rays_shadow;
     into->rays_diffuse += s->rays_diffuse;
     into->rays_specular += s->rays_specular;

@@ -140,6 +140,11 @@ typedef struct RenderSettings {
     int irradiance;          /* 1: irradiance interpolation at depth 0 (irrgrid.h; grid
                                 hider only) */
     TextureSystem *textures; /* image textures for the texture service, or NULL */
+    int max_spp;             /* adaptive pixel sampling: above spp, a pixel takes further
+                                blocks of spp samples while its error exceeds
+                                adaptive_error, up to this many (0: off; one-shot frames) */
+    float adaptive_error;    /* the relative standard error of a pixel's mean luminance
+                                at which it stops */
     /* Progressive rendering (session/progressive.c); all zero for a one-shot frame. */
     int first_sample;             /* the frame takes pixel samples first_sample .. + spp - 1 */
     int pattern_spp;              /* of patterns of this many samples (0: spp); sample g is
@@ -155,6 +160,7 @@ typedef struct RenderSettings {
 
 typedef struct RenderStats {
     uint64_t rays_camera, rays_shadow, rays_diffuse, rays_specular;
+    uint64_t adaptive_pixels_max; /* pixels that took max_spp samples (adaptive sampling) */
     uint64_t shading_points[RENDER_MAX_DEPTH + 1]; /* by diffuse depth */
     uint64_t irradiance_records;                   /* irradiance interpolation: records computed */
     uint64_t irradiance_interpolated;              /* and points interpolated */

@@ -76,6 +76,7 @@ void rayes_render_options_init(RayesRenderOptions *o, RayesQuality quality)
     o->opacity_cache = 1;
     o->opacity_cache_mb = 20.0;
     o->volume_step = 1.0f;
+    o->adaptive_error = 0.02f;
     o->irradiance_cache = 1;
     o->irradiance_cache_mb = 20.0;
     o->subsurface_rays = quality == RAYES_QUALITY_PREVIEW ? 4 : 64;
@@ -117,6 +118,9 @@ RayesError session_check_options(RayesScene *scene, const RayesRenderOptions *o)
         what = "options: resolution must be 1 to 65536 pixels per side";
     else if (o->spp < 1 || o->spp > 1 << 20)
         what = "options: pixel samples must be 1 to 1048576";
+    else if (o->max_spp < 0 || o->max_spp > 1 << 20 ||
+             (o->max_spp > o->spp && !(o->adaptive_error > 0.0f && o->adaptive_error < 1e6f)))
+        what = "options: max_spp must be 0 to 1048576 and adaptive_error positive";
     else if (o->bounces < 0 || o->bounces > 64 || o->specular_depth < 0 || o->specular_depth > 64)
         what = "options: depths must be 0 to 64";
     else if (o->shadow_rays < 0 || o->shadow_rays_deep < 0 || o->diffuse_rays < 0 ||
@@ -214,6 +218,8 @@ RenderSettings session_settings(const RayesRenderOptions *o)
                                       ? o->irradiance_shadow_rays
                                       : RY_MAX(o->shadow_rays, RENDER_IRRADIANCE_SHADOW_RAYS),
         .volume_step = o->volume_step,
+        .max_spp = o->max_spp,
+        .adaptive_error = o->adaptive_error,
         .tile_done = o->tile_done,
         .tile_user = o->tile_user,
         .tile_source = o->tile_source,

@@ -91,6 +91,11 @@ RayesStats *session_stats_new(const RenderSettings *set, const RenderStats *rs, 
     count(s, "rays/specular", rs->rays_specular);
     count(s, "rays/transmission", rs->rays_transmission); /* of rays/shadow: they marched */
     count(s, "rays/subsurface", rs->rays_subsurface);     /* not in rays/total */
+    if (set->max_spp > set->spp) {
+        count(s, "adaptive/max_spp", (uint64_t)set->max_spp);
+        real(s, "adaptive/error", set->adaptive_error);
+        count(s, "adaptive/pixels_at_max", rs->adaptive_pixels_max);
+    }
     count(s, "lighting/ambient_points", rs->ambient_lookups);
     count(s, "opacity/shading_points", rs->opacity_points);
     count(s, "opacity/transparent_hits", rs->transparent_hits);

@@ -335,6 +335,8 @@ static void test_settings(void)
                 "Display \"+b.png\" \"png\" \"rgb\"\nClipping 0.1 100\nQuantize \"rgba\" 255 0 255 0.5\n"
                 "PixelVariance 0.01\nWorldBegin\nWorldEnd\n") == RAYES_OK);
     CHECK(settings.spp == 6);
+    CHECK_NEAR(settings.adaptive_error, 0.01, 1e-7);
+    CHECK(settings.max_spp == 0);
     CHECK(settings.filter == RAYES_FILTER_GAUSSIAN);
     CHECK_NEAR(settings.filter_width, 2, 0);
     CHECK_NEAR(settings.exposure_gamma, 2.2, 1e-6);
@@ -342,6 +344,14 @@ static void test_settings(void)
     CHECK(settings.n_displays == 2);
     CHECK(strcmp(settings.displays[1].name, "b.png") == 0);
     CHECK(strcmp(settings.displays[0].type, "openexr") == 0);
+    /* RenderMan RIS's adaptive sampling: minsamples everywhere, up to
+     * maxsamples where noisy */
+    CHECK(parse("Hider \"raytrace\" \"int minsamples\" [8] \"int maxsamples\" [256]\n"
+                "WorldBegin\nWorldEnd\n") == RAYES_OK);
+    CHECK(settings.spp == 8 && settings.max_spp == 256);
+    CHECK(parse("Hider \"raytrace\" \"int maxsamples\" [0]\nWorldBegin\nWorldEnd\n") ==
+          RAYES_ERROR_PARSE);
+    CHECK(parse("PixelVariance -1\nWorldBegin\nWorldEnd\n") == RAYES_ERROR_PARSE);
     CHECK(parse("PixelFilter \"sinc\" 3 3\nWorldBegin\nWorldEnd\n") == RAYES_OK);
     CHECK(settings.filter == RAYES_FILTER_LANCZOS);
     CHECK(parse("PixelFilter \"catmull-rom\" 4 4\nWorldBegin\nWorldEnd\n") == RAYES_OK);

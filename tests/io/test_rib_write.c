@@ -101,6 +101,8 @@ static void test_calls(void)
     s.filter_width = 3;
     s.exposure_gain = 2;
     s.grid_size = 64;
+    s.max_spp = 256;
+    s.adaptive_error = 0.01f;
     s.n_displays = 2;
     snprintf(s.displays[0].name, sizeof s.displays[0].name, "out.exr");
     snprintf(s.displays[0].type, sizeof s.displays[0].type, "openexr");
@@ -112,6 +114,8 @@ static void test_calls(void)
     CHECK(has(t, "##RenderMan RIB\n"));
     CHECK(has(t, "Format 320 240 1\n"));
     CHECK(has(t, "PixelSamples 4 4\n"));
+    CHECK(has(t, "Hider \"raytrace\" \"int maxsamples\" [256]\n"));
+    CHECK(has(t, "PixelVariance 0.00999999978\n"));
     CHECK(has(t, "PixelFilter \"gaussian\" 3 3\n"));
     CHECK(has(t, "Exposure 2 1\n"));
     CHECK(has(t, "Option \"limits\" \"int gridsize\" [64]\n"));

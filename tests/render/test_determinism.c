@@ -182,6 +182,62 @@ static void test_negative_lobes_ring(void)
     CHECK(edge_max(RAYES_FILTER_CATMULL_ROM) > 1.01f);
 }
 
+/* Adaptive pixel sampling: a pixel's count follows its own samples, so
+ * the image is the same bytes on 1, 2 and 4 threads, with tiles of other
+ * sizes and through a wide filter's margins; flat pixels stop at spp,
+ * noisy ones go on (camera rays between the two bounds, some at the
+ * most, not all). */
+static RayesImage *render_adaptive(int threads, int tile, RayesFilter filter, RayesStats **st)
+{
+    RayesScene *s = rayes_scene_new();
+    char err[512];
+    IoSink sink = io_sink_scene(s);
+    CHECK(io_builtin_scene("cornell-teapots", RAYES_TEST_DATA, &sink, err, sizeof err) ==
+          RAYES_OK);
+    CHECK(rayes_scene_commit(s) == RAYES_OK);
+    RayesRenderOptions o;
+    rayes_render_options_init(&o, RAYES_QUALITY_PREVIEW);
+    o.width = 40;
+    o.height = 32;
+    o.spp = 2;
+    o.max_spp = 32;
+    o.adaptive_error = 0.05f;
+    o.threads = threads;
+    o.tile_size = tile;
+    o.filter = filter;
+    io_filter_named(io_filter_name(filter), &o.filter_width);
+    RayesImage *img = NULL;
+    CHECK(rayes_render(s, &o, &img, st) == RAYES_OK);
+    rayes_scene_release(s);
+    return img;
+}
+
+static void test_adaptive_any_thread_count(void)
+{
+    for (int f = 0; f < 2; f++) {
+        RayesFilter filter = f ? RAYES_FILTER_GAUSSIAN : RAYES_FILTER_BOX;
+        RayesStats *st = NULL;
+        RayesImage *one = render_adaptive(1, 16, filter, &st);
+        RayesImage *two = render_adaptive(2, 16, filter, NULL);
+        RayesImage *four = render_adaptive(4, 7, filter, NULL);
+        CHECK(same(one, two));
+        CHECK(same(one, four));
+        const RayesStat *cam = rayes_stats_find(st, "rays/camera");
+        const RayesStat *at_max = rayes_stats_find(st, "adaptive/pixels_at_max");
+        CHECK(cam && at_max);
+        if (cam && at_max && f == 0) { /* the box filter has no margins: counts are exact */
+            fprintf(stderr, "adaptive: %llu camera rays for 1280 pixels, %llu at the most\n",
+                    (unsigned long long)cam->count, (unsigned long long)at_max->count);
+            CHECK(cam->count > 2 * 40 * 32 && cam->count < 32 * 40 * 32);
+            CHECK(at_max->count > 0 && at_max->count < 40 * 32);
+        }
+        rayes_stats_free(st);
+        rayes_image_free(one);
+        rayes_image_free(two);
+        rayes_image_free(four);
+    }
+}
+
 /* Replaying the rays (RayesRenderOptions.replay_rays) leaves the image as
  * it was, keeps every ray the statistics count (cornell-teapots has no
  * subsurface or volume rays beside them) and traces them again. */
@@ -229,4 +285,4 @@ TEST_MAIN(TEST(test_box_filter_any_thread_count), TEST(test_gaussian_filter_any_
           TEST(test_negative_lobes_ring),
           TEST(test_teapots_any_thread_count), TEST(test_displaced_teapots),
           TEST(test_seed_changes_image), TEST(test_spheres_any_thread_count),
-          TEST(test_replay_rays))
+          TEST(test_adaptive_any_thread_count), TEST(test_replay_rays))
