@@ -84,8 +84,8 @@ typedef struct Row {
     unsigned long long shading_points, rays, shadow, diffuse, records;
     unsigned long long grids, grid_vertices, grid_size;
     double hit[3];
-    double render_cpu_s, replay_cpu_s; /* the render alone, and its rays traced again
-                                          unshaded (--replay 1) */
+    double render_cpu_s, replay_cpu_s;   /* the render alone, and its rays traced again
+                                            unshaded (--replay 1) */
     unsigned long long opacity_points;   /* opacity() shading points (shadow-ray hits, or
                                             the points of the grids the cache filled) */
     unsigned long long transparent_hits; /* surfaces shadow rays passed through */
@@ -340,7 +340,8 @@ static void parse(int argc, char **argv, Args *a)
 static void json_row(FILE *j, const Row *r, int first)
 {
     fprintf(j,
-            "%s\n    {\"bounces\": %d, \"cache\": %d, \"budget_mb\": %g, \"time_s\": %.3f, \"cpu_s\": %.3f, "
+            "%s\n    {\"bounces\": %d, \"cache\": %d, \"budget_mb\": %g, \"time_s\": %.3f, "
+            "\"cpu_s\": %.3f, "
             "\"shading_points\": %llu, \"rays\": %llu, \"shadow_rays\": %llu, "
             "\"diffuse_rays\": %llu, \"hit_rate\": {\"coarse\": %.5f, \"medium\": %.5f, "
             "\"fine\": %.5f}, \"grids\": %llu, \"grid_vertices\": %llu, \"grid_size\": %llu, "

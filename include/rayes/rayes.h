@@ -775,18 +775,18 @@ typedef struct RayesRenderOptions {
                                    cached value is shared by every subsurface ray near it,
                                    so it can afford more than a camera hit. 0 (default):
                                    max(shadow_rays, 16) (16 in preview, 64 in final) */
-    int max_spp;               /* adaptive pixel sampling: with max_spp > spp a pixel takes
-                                  further blocks of spp samples while the relative standard
-                                  error of its mean luminance exceeds adaptive_error, up to
-                                  max_spp samples; its count depends on its own samples only,
-                                  so images stay deterministic. 0 (default): spp everywhere */
-    float adaptive_error;      /* the relative standard error at which a pixel stops
-                                  (default 0.02) */
-    int replay_rays;           /* 1: keep every ray the render traces (48 bytes each, at most
-                                  2 GB; more are dropped and counted) and, once the image is
-                                  made, trace them again with no shading on as many threads:
-                                  what ray casting alone costs of the render (the statistics'
-                                  "replay" block). The image is the same. Default 0 */
+    int max_spp;                /* adaptive pixel sampling: with max_spp > spp a pixel takes
+                                   further blocks of spp samples while the relative standard
+                                   error of its mean luminance exceeds adaptive_error, up to
+                                   max_spp samples; its count depends on its own samples only,
+                                   so images stay deterministic. 0 (default): spp everywhere */
+    float adaptive_error;       /* the relative standard error at which a pixel stops
+                                   (default 0.02) */
+    int replay_rays;            /* 1: keep every ray the render traces (48 bytes each, at most
+                                   2 GB; more are dropped and counted) and, once the image is
+                                   made, trace them again with no shading on as many threads:
+                                   what ray casting alone costs of the render (the statistics'
+                                   "replay" block). The image is the same. Default 0 */
 } RayesRenderOptions;
 
 /* Fills options with the defaults of a quality preset: 512 x 512, 4 pixel

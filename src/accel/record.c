@@ -7,7 +7,6 @@
 #include <stdatomic.h>
 #include <stdlib.h>
 
-
 /* One thread's rays, in the order it traced them. */
 #define CHUNK_RAYS 4096
 typedef struct RecordChunk {
@@ -16,7 +15,7 @@ typedef struct RecordChunk {
 } RecordChunk;
 
 struct AccelRecord {
-    pthread_mutex_t lock;  /* guards chunks, n_chunks and cap */
+    pthread_mutex_t lock; /* guards chunks, n_chunks and cap */
     RecordChunk **chunks; /* oldest first */
     size_t n_chunks, cap, max_chunks;
     uint64_t id; /* tells a thread's chunk of this record from one of a freed record */

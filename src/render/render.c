@@ -187,8 +187,7 @@ static void render_pixel(Frame *f, Worker *w, int px, int py, int x0, int y0, in
     int last = adaptive ? set->max_spp : set->spp;
     double lum = 0.0, lum2 = 0.0; /* this pixel's own samples' luminance, for adaptive */
     for (int k = 0; k < last; k++) {
-        if (adaptive && k >= set->spp && k % set->spp == 0 &&
-            pixel_converged(set, k, lum, lum2))
+        if (adaptive && k >= set->spp && k % set->spp == 0 && pixel_converged(set, k, lum, lum2))
             break;
         uint32_t s = (uint32_t)(set->first_sample + k), block = s / n;
         uint32_t p = block ? (uint32_t)hash_combine(pattern, block) : pattern;

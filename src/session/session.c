@@ -517,8 +517,7 @@ RayesError rayes_render(RayesScene *scene, const RayesRenderOptions *opt, RayesI
             session_stats_add_real(*stats_out, "dicing/coarsened", prep.coarsened);
             if (record) {
                 session_stats_add_count(*stats_out, "replay/rays", accel_record_rays(record));
-                session_stats_add_count(*stats_out, "replay/dropped",
-                                        accel_record_dropped(record));
+                session_stats_add_count(*stats_out, "replay/dropped", accel_record_dropped(record));
                 session_stats_add_real(*stats_out, "replay/wall_s", replay_wall);
                 session_stats_add_real(*stats_out, "replay/cpu_s", replay_cpu);
             }

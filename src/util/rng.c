@@ -113,8 +113,8 @@ void cmj_sample_2d(uint32_t s, uint32_t n, uint32_t p, float *x, float *y)
     cmj_shape(n, &m, &k);
     s = permute(s, n, p * 0x51633e2du);
     cmj_cell(s, m, &col, &row);
-    cmj_point(s, col, row, permute(col, m, p * 0x68bc21ebu), permute(row, k, p * 0x02e5be93u), m,
-              k, p, x, y);
+    cmj_point(s, col, row, permute(col, m, p * 0x68bc21ebu), permute(row, k, p * 0x02e5be93u), m, k,
+              p, x, y);
 }
 
 void cmj_pattern_init(CmjPattern *c, uint32_t n, uint32_t p)

@@ -192,8 +192,7 @@ static RayesImage *render_adaptive(int threads, int tile, RayesFilter filter, Ra
     RayesScene *s = rayes_scene_new();
     char err[512];
     IoSink sink = io_sink_scene(s);
-    CHECK(io_builtin_scene("cornell-teapots", RAYES_TEST_DATA, &sink, err, sizeof err) ==
-          RAYES_OK);
+    CHECK(io_builtin_scene("cornell-teapots", RAYES_TEST_DATA, &sink, err, sizeof err) == RAYES_OK);
     CHECK(rayes_scene_commit(s) == RAYES_OK);
     RayesRenderOptions o;
     rayes_render_options_init(&o, RAYES_QUALITY_PREVIEW);
@@ -246,8 +245,7 @@ static void test_replay_rays(void)
     RayesScene *s = rayes_scene_new();
     char err[512];
     IoSink sink = io_sink_scene(s);
-    CHECK(io_builtin_scene("cornell-teapots", RAYES_TEST_DATA, &sink, err, sizeof err) ==
-          RAYES_OK);
+    CHECK(io_builtin_scene("cornell-teapots", RAYES_TEST_DATA, &sink, err, sizeof err) == RAYES_OK);
     CHECK(rayes_scene_commit(s) == RAYES_OK);
     RayesRenderOptions o;
     rayes_render_options_init(&o, RAYES_QUALITY_PREVIEW);
@@ -282,7 +280,7 @@ static void test_replay_rays(void)
 
 TEST_MAIN(TEST(test_box_filter_any_thread_count), TEST(test_gaussian_filter_any_thread_count),
           TEST(test_every_filter_any_thread_count), TEST(test_filters_keep_a_constant_image),
-          TEST(test_negative_lobes_ring),
-          TEST(test_teapots_any_thread_count), TEST(test_displaced_teapots),
-          TEST(test_seed_changes_image), TEST(test_spheres_any_thread_count),
-          TEST(test_adaptive_any_thread_count), TEST(test_replay_rays))
+          TEST(test_negative_lobes_ring), TEST(test_teapots_any_thread_count),
+          TEST(test_displaced_teapots), TEST(test_seed_changes_image),
+          TEST(test_spheres_any_thread_count), TEST(test_adaptive_any_thread_count),
+          TEST(test_replay_rays))

@@ -334,8 +334,8 @@ static RayesImage *checker_seen(RayesHider hider, int threads, uint64_t *depth0)
     quad_at(s, 2.0f, 0.0f);
     RayesParam cb[2] = {pf("uscale", 4.0f), pf("vscale", 4.0f)};
     CHECK(rayes_scene_pattern(s, "cells", "checkerboard", cb, 2) == RAYES_OK);
-    RayesParam p[2] = {pc("Cs", 1, 0, 0), (RayesParam){"Os", RAYES_PARAM_PATTERN, {0, 0, 0},
-                                                       "cells"}};
+    RayesParam p[2] = {pc("Cs", 1, 0, 0),
+                       (RayesParam){"Os", RAYES_PARAM_PATTERN, {0, 0, 0}, "cells"}};
     CHECK(rayes_scene_set_shader(s, "constant", p, 2) == RAYES_OK);
     quad_at(s, 1.0f, 1.0f);
     CHECK(rayes_scene_commit(s) == RAYES_OK);
@@ -371,9 +371,10 @@ static void test_grid_hider_transparent_grids(void)
                 worst = fmax(worst, d);
                 differ += d > 0.01;
             }
-        fprintf(stderr, "grid hider, transparent: %d values differ by > 0.01 (worst %g); depth-0 "
-                "points %llu (ray tracing %llu)\n", differ, worst, (unsigned long long)n_grid,
-                (unsigned long long)n_ray);
+        fprintf(stderr,
+                "grid hider, transparent: %d values differ by > 0.01 (worst %g); depth-0 "
+                "points %llu (ray tracing %llu)\n",
+                differ, worst, (unsigned long long)n_grid, (unsigned long long)n_ray);
         CHECK(differ < 64 * 64 * 4 / 100);
         CHECK(n_grid < n_ray / 2);
         CHECK(memcmp(grid->rgba, one->rgba, sizeof(float) * 4 * 64 * 64) == 0);

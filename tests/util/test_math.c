@@ -136,5 +136,5 @@ static void test_bounds_distance(void)
 TEST_MAIN(TEST(test_matrix_inverse), TEST(test_rotation_is_right_handed),
           TEST(test_basis_is_orthonormal), TEST(test_cmj_stratified),
           TEST(test_cmj_deterministic_and_pattern_dependent), TEST(test_cmj_pattern_equals_samples),
-          TEST(test_hash_combine_is_ordered),
-          TEST(test_cosine_hemisphere_moments), TEST(test_bounds_distance))
+          TEST(test_hash_combine_is_ordered), TEST(test_cosine_hemisphere_moments),
+          TEST(test_bounds_distance))
