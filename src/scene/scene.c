@@ -1197,8 +1197,9 @@ int scene_prepare(const RayesScene *s, int width, int height, const DiceOptions 
         gs->n_masters = s->n_masters;
     }
     float rate_scale = cams[0].rate_scale;
+    int failed = geom_stitch(gs, s->prims) != 0 || scene_motion_prepare(s, cams, gs) != 0;
     free(cams);
-    if (geom_stitch(gs, s->prims) != 0 || scene_motion_prepare(s, gs) != 0)
+    if (failed)
         return -1;
     if (first_need)
         log_warning("dicing: the scene needs %zu grid vertices, more than the budget of %zu "

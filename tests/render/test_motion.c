@@ -162,6 +162,118 @@ static void test_moving_points_and_curves(void)
     }
 }
 
+/* A sphere point (diameter 2) from x = -1 to x = 1: by its transform
+ * (deform 0) or by its two positions in a motion block (deform 1). */
+static RayesScene *point_scene(int deform)
+{
+    RayesScene *s = rayes_scene_new();
+    ortho_camera(s);
+    CHECK(rayes_scene_set_shutter(s, 0.0f, 1.0f) == RAYES_OK);
+    RayesParam lp[2] = {{"from", RAYES_PARAM_COLOR, {0, 0, 0}, NULL},
+                        {"to", RAYES_PARAM_COLOR, {0.3f, 0.2f, 1}, NULL}};
+    CHECK(rayes_scene_light(s, "distantlight", lp, 2) == RAYES_OK);
+    const float times[2] = {0, 1}, width = 2.0f;
+    RayesPrimvar pv = {"width", RAYES_PRIMVAR_CONSTANT, &width, 1};
+    if (!deform) {
+        float m[2][16];
+        translate(m[0], -1, 0, 0);
+        translate(m[1], 1, 0, 0);
+        CHECK(rayes_scene_set_transform_motion(s, 2, times, (const float(*)[16])m) == RAYES_OK);
+        const float P[3] = {0, 0, 0};
+        CHECK(rayes_scene_points(s, RAYES_POINT_SPHERE, 1, P, &pv, 1) == RAYES_OK);
+        return s;
+    }
+    CHECK(rayes_scene_motion_begin(s, 2, times) == RAYES_OK);
+    for (int k = 0; k < 2; k++) {
+        const float P[3] = {k ? 1.0f : -1.0f, 0, 0};
+        CHECK(rayes_scene_points(s, RAYES_POINT_SPHERE, 1, P, &pv, 1) == RAYES_OK);
+    }
+    CHECK(rayes_scene_motion_end(s) == RAYES_OK);
+    return s;
+}
+
+/* The fraction of the shutter [0, 1] a tube whose axis runs from x = -1
+ * to x = 1 while its width grows from 0.5 to 1.5 covers abscissa x (its
+ * straight part): a midpoint sum over 4,000 times. */
+static double tube_time_coverage(double x)
+{
+    int n = 4000, in = 0;
+    for (int i = 0; i < n; i++) {
+        double t = (i + 0.5) / n;
+        in += fabs(x - (-1.0 + 2.0 * t)) < 0.5 * (0.5 + t);
+    }
+    return (double)in / n;
+}
+
+/* Deforming points and curves (a motion block around Points or Curves of
+ * the same topology): a point moved by its positions renders as the same
+ * motion by transform, and a vertical tube whose axis moves and whose
+ * width grows covers each pixel for its analytic fraction of the
+ * shutter. */
+static void test_deforming_points_and_curves(void)
+{
+    RayesScene *a = point_scene(0), *b = point_scene(1);
+    RayesImage *ia = render(a, 16, 2, 1, NULL), *ib = render(b, 16, 2, 1, NULL);
+    double worst = 0, mean = 0, cover = 0;
+    for (size_t i = 0; ia && ib && i < 4 * (size_t)W * W; i++) {
+        worst = fmax(worst, fabs(ia->rgba[i] - ib->rgba[i]));
+        mean += fabs(ia->rgba[i] - ib->rgba[i]) / (4.0 * W * W);
+        if (i % 4 == 3)
+            cover += ib->rgba[i];
+    }
+    float px = 2 * HALF / W;
+    CHECK_NEAR(cover * px * px, M_PI, 0.03 * M_PI);
+    CHECK(mean < 1e-4);
+    CHECK(worst < 0.02);
+    printf("  deforming point vs transform: mean difference %.2g, largest %.2g, coverage %.4f\n",
+           mean, worst, cover * px * px);
+    rayes_image_free(ia);
+    rayes_image_free(ib);
+    rayes_scene_release(a);
+    rayes_scene_release(b);
+
+    RayesScene *s = rayes_scene_new();
+    ortho_camera(s);
+    CHECK(rayes_scene_set_shutter(s, 0.0f, 1.0f) == RAYES_OK);
+    const float times[2] = {0, 1};
+    CHECK(rayes_scene_motion_begin(s, 2, times) == RAYES_OK);
+    for (int k = 0; k < 2; k++) {
+        float x = k ? 1.0f : -1.0f, width = k ? 1.5f : 0.5f;
+        const float P[6] = {x, -1.5f, 0, x, 1.5f, 0};
+        const int nv = 2;
+        RayesCurves c = {.degree = 1, .shape = RAYES_CURVE_ROUND, .n_curves = 1,
+                         .n_verts = &nv, .P = P};
+        RayesPrimvar pv = {"width", RAYES_PRIMVAR_CONSTANT, &width, 1};
+        CHECK(rayes_scene_curves(s, &c, &pv, 1) == RAYES_OK);
+    }
+    CHECK(rayes_scene_motion_end(s) == RAYES_OK);
+    RayesStats *st = NULL;
+    RayesImage *img = render(s, 64, 2, 1, &st);
+    const RayesStat *moving = rayes_stats_find(st, "motion/moving_grids");
+    CHECK(moving && moving->count > 0);
+    rayes_stats_free(st);
+    double err = 0, worst_px = 0;
+    int n = 0;
+    for (int y = 0; img && y < W; y++)
+        for (int x = 0; x < W; x++) {
+            double cy = HALF - (y + 0.5) * px;
+            if (fabs(cy) > 1.2) /* the straight part, away from the end caps */
+                continue;
+            double want = 0;
+            for (int i = 0; i < 4; i++) /* the pixel's mean over 4 abscissae */
+                want += tube_time_coverage(-HALF + (x + (i + 0.5) / 4) * px) / 4;
+            double got = img->rgba[4 * (y * W + x) + 3];
+            err += fabs(got - want);
+            worst_px = fmax(worst_px, fabs(got - want));
+            n++;
+        }
+    CHECK(n > 0 && err / n < 0.01);
+    CHECK(worst_px < 0.15);
+    printf("  deforming tube: mean |coverage error| %.4f, worst %.3f\n", err / n, worst_px);
+    rayes_image_free(img);
+    rayes_scene_release(s);
+}
+
 /* A lit bilinear patch (4 x 2 units, facing the camera) moving from x = -1
  * to x = 1: by its transform, or by its two shapes. */
 static RayesScene *patch_scene(int deform, float motionfactor)
@@ -496,6 +608,7 @@ static void test_moving_hits(void)
 }
 
 TEST_MAIN(TEST(test_moving_hits), TEST(test_moving_sphere_coverage),
-          TEST(test_moving_points_and_curves), TEST(test_motionfactor),
+          TEST(test_moving_points_and_curves),
+          TEST(test_deforming_points_and_curves), TEST(test_motionfactor),
           TEST(test_cached_segments_match_uncached), TEST(test_motion_determinism),
           TEST(test_deformation_equals_transform), TEST(test_bad_motion), TEST(test_camera_motion))
