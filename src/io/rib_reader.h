@@ -157,6 +157,10 @@ typedef struct Light {
     char mapping[32];   /* and its layout ("latlong", "octahedral") */
     size_t n;
     float M[16];   /* world_from_light (camera_from_light before WorldBegin) */
+    int n_motion;  /* a light moving within the frame (MotionBegin around its transform,
+                      in the world): n_motion samples, else 0 */
+    float motion_time[RIB_MAX_TIMES];
+    float motion_M[RIB_MAX_TIMES][16];
     int pre_world;
     long index;    /* the sink's index of the light once sent, else -1 */
 } Light;
