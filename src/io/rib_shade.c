@@ -192,6 +192,12 @@ static int send_transform(Rib *r, const IoSink *s, SinkState *st)
     return 0;
 }
 
+int rib_block_color_only(const Rib *r)
+{
+    return r->in_object && !r->recorded.have_shader && r->a.surface == r->object_surface &&
+           r->a.color_gen != r->object_color_gen;
+}
+
 /* Brings the sink up to date before a primitive; Cs overrides the
  * colour (a per-face colour) when not NULL. 1: skip (outside the world). */
 int rib_emit_begin(Rib *r, const float *Cs)
@@ -213,9 +219,16 @@ int rib_emit_begin(Rib *r, const float *Cs)
             return -1;
         st->have_shader = 0;
     } else if (r->in_object && !st->have_shader && r->a.surface == r->object_surface &&
-               r->a.color_gen == r->object_color_gen) {
-        /* no Surface or Color in the block yet: each instance's shader */
+               (r->a.color_gen == r->object_color_gen || r->pv_block_color)) {
+        /* no Surface in the block yet, nor a Color (or one the primitive
+         * carries as Cs): each instance's shader */
     } else if (!st->have_shader || st->surface != r->a.surface || st->color_gen != r->a.color_gen) {
+        if (rib_block_color_only(r))
+            rib_warn_once(r, "object color",
+                          "a %s in an ObjectBegin block that sets Color but no Surface takes "
+                          "the Surface current at ObjectBegin, not each instance's (it carries "
+                          "no colour of its own)",
+                          r->req);
         if (send_shader(r, s, r->a.Cs) != 0)
             return -1;
         st->surface = r->a.surface;
