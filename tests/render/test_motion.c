@@ -6,7 +6,10 @@
  * motion; cached radiosity with motion segments matches uncached (1% mean,
  * 3% per 32 x 32 tile), is deterministic across thread counts, and fills
  * one set of entries per segment; a camera moving past a still sphere
- * blurs it as the sphere moving the other way would.
+ * blurs it as the sphere moving the other way would. Deforming points and
+ * curves; a light moving within the frame (its shadow against the analytic
+ * time average, cached against uncached); the grid hider's shading per
+ * motion segment against the ray-tracing hider.
  */
 #include <math.h>
 #include <string.h>
