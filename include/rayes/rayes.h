@@ -118,7 +118,8 @@ RAYES_API RayesError rayes_scene_set_shutter(RayesScene *scene, float open, floa
 /* A moving transform for geometry added from now on: world_from_object
  * (row-major) at n_times increasing times (2 to RAYES_MAX_TIMES); the
  * geometry moves linearly between samples (RenderMan's MotionBegin around
- * transforms). set_transform ends it. */
+ * transforms). Lights made under it move with it within the frame.
+ * set_transform ends it. */
 RAYES_API RayesError rayes_scene_set_transform_motion(RayesScene *scene, size_t n_times,
                                                       const float *times,
                                                       const float (*world_from_object)[16]);
@@ -126,7 +127,8 @@ RAYES_API RayesError rayes_scene_set_transform_motion(RayesScene *scene, size_t 
 /* Deformation blur: the next n_times primitive calls (until motion_end)
  * give one primitive at each of the increasing times, with the same
  * topology (the same call with the same counts, only positions differing);
- * their primitive variables and attributes are the first call's. */
+ * their primitive variables and attributes are the first call's, but for
+ * the widths and normals that place curves and points, each sample's. */
 RAYES_API RayesError rayes_scene_motion_begin(RayesScene *scene, size_t n_times,
                                               const float *times);
 RAYES_API RayesError rayes_scene_motion_end(RayesScene *scene);

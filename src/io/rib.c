@@ -570,6 +570,7 @@ static int dispatch(Rib *r, const Args *a)
                 if ((tables[t] == rib_prim_requests || tables[t] == rib_curves_requests) &&
                     r->a.lod_coarse)
                     return 0;
+                r->pv_block_color = 0;
                 if (r->motion) {
                     int done = motion_request(r, q, a, k->fn);
                     if (done != 0)

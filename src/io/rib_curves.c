@@ -57,6 +57,18 @@ static int read_vars(Rib *r, const Param *p, size_t n, Vars *v)
         const Param *q = rib_var_param(r, p, n, names[k].name, names[k].size);
         if (q)
             e = add_var(r, v, q, names[k].name, names[k].size);
+        else if (k == 1 && rib_block_color_only(r)) { /* the block's Color as a constant Cs */
+            float *d = malloc(3 * sizeof *d);
+            if (!d) {
+                e = rib_error(r, "out of memory");
+                break;
+            }
+            for (int c = 0; c < 3; c++)
+                d[c] = r->a.Cs[c];
+            v->data[v->n] = d;
+            v->pv[v->n++] = (RayesPrimvar){"Cs", RAYES_PRIMVAR_CONSTANT, d, 1};
+            r->pv_block_color = 1;
+        }
     }
     static const char *const used[] = {"P",    "Pw", "N", "Cs", "st", "width", "constantwidth",
                                        "type", "Os", NULL};

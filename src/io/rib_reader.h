@@ -157,6 +157,10 @@ typedef struct Light {
     char mapping[32];   /* and its layout ("latlong", "octahedral") */
     size_t n;
     float M[16];   /* world_from_light (camera_from_light before WorldBegin) */
+    int n_motion;  /* a light moving within the frame (MotionBegin around its transform,
+                      in the world): n_motion samples, else 0 */
+    float motion_time[RIB_MAX_TIMES];
+    float motion_M[RIB_MAX_TIMES][16];
     int pre_world;
     long index;    /* the sink's index of the light once sent, else -1 */
 } Light;
@@ -234,6 +238,9 @@ typedef struct Rib {
                                   (object_begin); the block's state is `recorded` */
     const void *object_surface; /* the surface and colour generation at that ObjectBegin: */
     long object_color_gen;     /* geometry under them inherits each instance's shader */
+    int pv_block_color;        /* the request's primitive carries the block's Color as a
+                                  constant Cs (rib_block_color_only), so it still inherits */
+    double block_Cs[3];
     IoSink rec_sink;
     char rec_key[RIB_MAX_HANDLE];
     float rec_saved_M[16];
@@ -334,6 +341,11 @@ typedef struct PvOut {
     float *data[5];
     size_t n;
 } PvOut;
+
+/* 1 inside an ObjectBegin block (of a sink with instances) that set Color
+ * but no Surface, before any shader was sent in it: its geometry keeps
+ * each instance's shader, with the block's colour as a constant Cs. */
+int rib_block_color_only(const Rib *r);
 
 /* Frees o's data; o is then empty. */
 void rib_pv_out_free(PvOut *o);

@@ -81,7 +81,13 @@ static int send_light(Rib *r, Light *L)
         if (L->params[i].type == RAYES_PARAM_STRING)
             L->params[i].string = light_string(L, L->names[i]);
     }
-    if (s->set_transform(s->target, L->M) != RAYES_OK ||
+    int moving = L->n_motion > 1 && s->set_transform_motion;
+    if (L->n_motion > 1 && !s->set_transform_motion)
+        rib_warn_once(r, "MotionBegin", "this sink has no motion blur: the first sample of "
+                                        "each motion block is used");
+    if ((moving ? s->set_transform_motion(s->target, (size_t)L->n_motion, L->motion_time,
+                                          (const float(*)[16])L->motion_M)
+                : s->set_transform(s->target, L->M)) != RAYES_OK ||
         s->light(s->target, L->type, L->params, L->n) != RAYES_OK)
         return rib_sink_failed(r, s);
     L->index = (long)index;
@@ -186,6 +192,12 @@ static int send_transform(Rib *r, const IoSink *s, SinkState *st)
     return 0;
 }
 
+int rib_block_color_only(const Rib *r)
+{
+    return r->in_object && !r->recorded.have_shader && r->a.surface == r->object_surface &&
+           r->a.color_gen != r->object_color_gen;
+}
+
 /* Brings the sink up to date before a primitive; Cs overrides the
  * colour (a per-face colour) when not NULL. 1: skip (outside the world). */
 int rib_emit_begin(Rib *r, const float *Cs)
@@ -207,9 +219,16 @@ int rib_emit_begin(Rib *r, const float *Cs)
             return -1;
         st->have_shader = 0;
     } else if (r->in_object && !st->have_shader && r->a.surface == r->object_surface &&
-               r->a.color_gen == r->object_color_gen) {
-        /* no Surface or Color in the block yet: each instance's shader */
+               (r->a.color_gen == r->object_color_gen || r->pv_block_color)) {
+        /* no Surface in the block yet, nor a Color (or one the primitive
+         * carries as Cs): each instance's shader */
     } else if (!st->have_shader || st->surface != r->a.surface || st->color_gen != r->a.color_gen) {
+        if (rib_block_color_only(r))
+            rib_warn_once(r, "object color",
+                          "a %s in an ObjectBegin block that sets Color but no Surface takes "
+                          "the Surface current at ObjectBegin, not each instance's (it carries "
+                          "no colour of its own)",
+                          r->req);
         if (send_shader(r, s, r->a.Cs) != 0)
             return -1;
         st->surface = r->a.surface;
@@ -556,6 +575,11 @@ static int h_light_source(Rib *r, const Args *a)
     snprintf(L->type, sizeof L->type, "%s", type);
     memcpy(L->M, r->a.M, sizeof L->M);
     L->pre_world = !r->in_world;
+    if (r->in_world && r->a.n_motion > 1) { /* a light moving within the frame */
+        L->n_motion = r->a.n_motion;
+        memcpy(L->motion_time, r->a.motion_time, (size_t)L->n_motion * sizeof *L->motion_time);
+        memcpy(L->motion_M, r->a.motion_M, (size_t)L->n_motion * sizeof L->motion_M[0]);
+    }
     L->index = -1;
     set_light_on(&r->a, (size_t)(L - r->lights), 1);
     static const char *const names[] = {"intensity", "lightcolor", "from", "to", "coneangle",

@@ -388,8 +388,14 @@ static RayesError w_set_dice_blur(void *t, float motionfactor, float focusfactor
 }
 
 /* Deformation: the samples' requests go to a stream of their own; at the
- * end, request j of every sample (the same topology writes the same
- * requests) makes motion block j. */
+ * end, primitive request j of every sample (the same topology writes the
+ * same primitives) makes motion block j, written where the first sample
+ * wrote its primitive j, among the first sample's other requests (the
+ * state around its primitives: a Basis, an AttributeBegin block). The
+ * later samples' state is the first's, and is dropped: a sample ends
+ * after its last primitive once its AttributeBegin and TransformBegin
+ * blocks are closed, so a sample may write state the others do not (a
+ * Basis the first one set). */
 static RayesError w_motion_begin(void *t, size_t n, const float *times)
 {
     RibWriter *w = t;
@@ -415,6 +421,32 @@ static size_t request_starts(const char *text, size_t size, const char **starts,
     return n;
 }
 
+/* 1 if the request at r (up to end) is named name. */
+static int request_is(const char *r, const char *end, const char *name)
+{
+    size_t n = strlen(name);
+    return (size_t)(end - r) > n && strncmp(r, name, n) == 0 &&
+           (r[n] == ' ' || r[n] == '\n');
+}
+
+/* The request at r: 1 a primitive the writer writes, else 0; *depth moves
+ * with the blocks it opens and closes. */
+static int request_kind(const char *r, const char *end, int *depth)
+{
+    static const char *const prims[] = {"Patch",    "PointsPolygons", "SubdivisionMesh", "Curves",
+                                        "Points",   "Sphere",         "Cylinder",        "Cone",
+                                        "Disk",     "Paraboloid",     "Hyperboloid",     "Torus",
+                                        "Volume",   NULL};
+    for (int k = 0; prims[k]; k++)
+        if (request_is(r, end, prims[k]))
+            return 1;
+    if (request_is(r, end, "AttributeBegin") || request_is(r, end, "TransformBegin"))
+        (*depth)++;
+    else if (request_is(r, end, "AttributeEnd") || request_is(r, end, "TransformEnd"))
+        (*depth)--;
+    return 0;
+}
+
 static RayesError w_motion_end(void *t)
 {
     RibWriter *w = t;
@@ -428,25 +460,54 @@ static RayesError w_motion_end(void *t)
     const char *text = w->motion.buf, *end = text + w->motion.size;
     size_t cap = w->motion.size / 2 + 2;
     const char **starts = malloc((cap + 1) * sizeof *starts);
-    if (!starts)
+    uint8_t *prim = malloc(cap + 1);
+    if (!starts || !prim) {
+        free(starts), free(prim);
         return fail(w, RAYES_ERROR_OUT_OF_MEMORY, "out of memory");
-    size_t total = request_starts(text, w->motion.size, starts, cap);
-    starts[total] = end;
-    size_t per = total / n;
-    if (total == 0 || total % n != 0) {
-        free(starts);
-        return fail(w, RAYES_ERROR_INVALID_ARGUMENT,
-                    "motion end: the samples wrote %zu requests, not a multiple of %zu", total, n);
     }
-    for (size_t j = 0; j < per; j++) {
+    size_t total = request_starts(text, w->motion.size, starts, cap), n_prims = 0;
+    starts[total] = end;
+    int depth = 0;
+    for (size_t i = 0; i < total; i++)
+        n_prims += prim[i] = (uint8_t)request_kind(starts[i], starts[i + 1], &depth);
+    size_t per = n_prims / n;
+    /* sample k: requests first[k] .. first[k + 1] - 1; its primitives */
+    size_t first[RAYES_MAX_TIMES + 1], i = 0;
+    depth = 0;
+    for (size_t k = 0; per && n_prims % n == 0 && k < n; k++) {
+        first[k] = i;
+        for (size_t seen = 0; i < total;) {
+            seen += prim[i];
+            request_kind(starts[i], starts[i + 1], &depth);
+            i++;
+            if (seen == per && depth == 0)
+                break;
+        }
+    }
+    first[n] = total;
+    if (per == 0 || n_prims % n != 0) {
+        free(starts), free(prim);
+        return fail(w, RAYES_ERROR_INVALID_ARGUMENT,
+                    "motion end: the samples wrote %zu primitives, not a multiple of %zu",
+                    n_prims, n);
+    }
+    size_t j = 0;
+    for (size_t r = first[0]; r < first[1]; r++) {
+        if (!prim[r]) {
+            fwrite(starts[r], 1, (size_t)(starts[r + 1] - starts[r]), w->world.f);
+            continue;
+        }
         motion_times(w->world.f, n, w->motion_time);
-        for (size_t k = 0; k < n; k++) {
-            const char *a = starts[k * per + j], *b = starts[k * per + j + 1];
-            fwrite(a, 1, (size_t)(b - a), w->world.f);
+        for (size_t k = 0; k < n; k++) { /* sample k's primitive j */
+            size_t q = first[k], seen = 0;
+            while (q < first[k + 1] && !(prim[q] && seen++ == j))
+                q++;
+            fwrite(starts[q], 1, (size_t)(starts[q + 1] - starts[q]), w->world.f);
         }
         fprintf(w->world.f, "MotionEnd\n");
+        j++;
     }
-    free(starts);
+    free(starts), free(prim);
     return RAYES_OK;
 }
 

@@ -10,11 +10,21 @@
  * grid is shaded once per instance that a camera ray hits (in world space,
  * with the instance's object and random numbers): each instance has a
  * table of its master's grids, made when the instance is first hit.
+ *
+ * Motion (DESIGN.md "Motion blur and depth of field"): a moving grid is
+ * shaded once per motion segment, where it is at the segment's middle
+ * time (its rays leave then), as the radiosity cache fills it; a hit
+ * interpolates the shading of its ray's segment, as REYES interpolates a
+ * grid shaded once over its blurred micropolygons. A still grid is shaded
+ * at the shutter's middle. A grid lit by a light that moves within the
+ * frame is shaded per hit (at the ray's time), so that the light's
+ * shadows blur, and so is a moving grid of a master.
  */
 #include "render/hider.h"
 
 #include <math.h>
 #include <pthread.h>
+#include <stdint.h>
 #include <stdatomic.h>
 #include <stdlib.h>
 #include <string.h>
@@ -38,6 +48,11 @@ struct GridShading {
                                     master's first grid), NULL until the instance is hit */
     uint32_t *master_first;      /* per master: its first grid (a master's are contiguous) */
     uint32_t *master_count;      /* and how many */
+    uint32_t *moving;            /* per grid: a moving world grid's index among them, else
+                                    UINT32_MAX; NULL: nothing moves */
+    GridSlot *seg_ci;            /* per moving world grid, per motion segment */
+    int n_seg;                   /* motion segments (GridSet.n_times - 1) */
+    int moving_lights;           /* 1: some light moves within the frame */
     pthread_mutex_t locks[STRIPES];
 };
 
@@ -70,6 +85,22 @@ GridShading *hider_new(const RenderScene *rs, const RenderSettings *set)
     }
     for (size_t i = 0; i < gs->n_instances; i++)
         atomic_init(&gsh->inst[i], NULL);
+    for (size_t k = 0; k < rs->n_lights; k++)
+        gsh->moving_lights |= rs->lights[k].n_times > 1;
+    size_t n_moving = 0;
+    for (size_t i = 0; i < gs->n_grids; i++)
+        n_moving += gs->grids[i].moving && !gs->grids[i].master;
+    if (n_moving && gs->n_times > 1) {
+        gsh->n_seg = gs->n_times - 1;
+        gsh->moving = malloc(gs->n_grids * sizeof *gsh->moving);
+        gsh->seg_ci = malloc(n_moving * (size_t)gsh->n_seg * sizeof *gsh->seg_ci);
+        RY_CHECK(gsh->moving && gsh->seg_ci);
+        for (size_t i = 0, m = 0; i < gs->n_grids; i++)
+            gsh->moving[i] = gs->grids[i].moving && !gs->grids[i].master ? (uint32_t)m++
+                                                                          : UINT32_MAX;
+        for (size_t k = 0; k < n_moving * (size_t)gsh->n_seg; k++)
+            atomic_init(&gsh->seg_ci[k], NULL);
+    }
     for (int i = 0; i < STRIPES; i++)
         pthread_mutex_init(&gsh->locks[i], NULL);
     return gsh;
@@ -88,6 +119,12 @@ void hider_free(GridShading *gsh)
             free(atomic_load_explicit(&slots[k], memory_order_relaxed));
         free(slots);
     }
+    for (size_t i = 0; gsh->moving && i < gs->n_grids; i++)
+        for (int k = 0; gsh->moving[i] != UINT32_MAX && k < gsh->n_seg; k++)
+            free(atomic_load_explicit(&gsh->seg_ci[(size_t)gsh->moving[i] * gsh->n_seg + k],
+                                      memory_order_relaxed));
+    free(gsh->moving);
+    free(gsh->seg_ci);
     free(gsh->inst);
     free(gsh->master_first);
     free(gsh->master_count);
@@ -129,8 +166,9 @@ static void vertex_to_world(const GeomInstance *gi, Vec3 *P, Vec3 *Ng, Vec3 *N, 
 
 /* Shades every vertex of grid gi, seen through instance (0: none), with
  * lighting() into a new array: Ci of each vertex, followed by Oi of each if
- * the object is transparent. */
-static Rgb *shade_grid(Worker *w, uint32_t gi, uint32_t instance)
+ * the object is transparent; a moving grid where it is in the middle of
+ * motion segment seg (a still one: seg -1). */
+static Rgb *shade_grid(Worker *w, uint32_t gi, uint32_t instance, int seg)
 {
     const RenderScene *rs = w->rs;
     const GridSet *gs = rs->gs;
@@ -157,10 +195,19 @@ static Rgb *shade_grid(Worker *w, uint32_t gi, uint32_t instance)
     uint64_t grid_key = hash_combine(hash_combine(w->set->seed, 0x6772696468ull /* "gridh" */), gi);
     if (instance) /* each instance its own numbers; world grids as before */
         grid_key = hash_combine(grid_key, instance);
+    if (seg >= 0) /* each segment its own */
+        grid_key = hash_combine(grid_key, 0x736567ull + (uint64_t)seg /* "seg" */);
     for (size_t k = 0; k < n; k++) {
         size_t i = g->first_vertex + k;
         Vec3 Pk = gs->P[i], Ngk = gs->N[i], Nk = geom_vertex_normal(gs, g, i);
         Vec3 duk = gs->dPdu[i], dvk = gs->dPdv[i];
+        if (seg >= 0) { /* the segment's middle */
+            GeomVertex gv = geom_vertex_at(gs, g, i, seg, 0.5f);
+            Pk = gv.P, duk = gv.dPdu, dvk = gv.dPdv;
+            Ngk = v3_length(gv.N) > 0.0f ? v3_normalize(gv.N) : gs->N[i];
+            if (!(g->primvars & GEOM_PV_N))
+                Nk = Ngk;
+        }
         vertex_to_world(inst, &Pk, &Ngk, &Nk, &duk, &dvk);
         /* The camera ray toward the vertex: from the eye in perspective,
          * along the view in orthographic projection. */
@@ -266,25 +313,45 @@ static int corners(const Hit *hit, uint32_t first, const Rgb *c, float limit, Ve
     return hi - lo <= limit * mean;
 }
 
+/* 1 if grid gi seen through instance is lit by a light that moves. */
+static int lit_by_moving_light(const RenderScene *rs, uint32_t gi, uint32_t instance)
+{
+    const RenderObject *obj = render_object(rs, gi, instance);
+    for (size_t k = 0; k < rs->n_lights; k++)
+        if (rs->lights[k].n_times > 1 && rs->lights[k].type != LIGHT_AMBIENT &&
+            render_lit_by(obj, k))
+            return 1;
+    return 0;
+}
+
 int hider_camera_hit(Worker *w, const Ray *ray, const Hit *hit, Vec3 *L, Vec3 *Oi)
 {
-    (void)ray;
     GridShading *gsh = w->grid_shading;
     uint32_t gi = hit->grid;
-    if (w->rs->gs->grids[gi].moving)
+    const GridSet *gs = w->rs->gs;
+    int moving = gs->grids[gi].moving;
+    if ((moving && (hit->instance || !gsh->moving)) ||
+        (gsh->moving_lights && lit_by_moving_light(w->rs, gi, hit->instance)))
         return 0; /* shaded where the ray finds it, at its time */
-    GridSlot *slot = grid_slot(gsh, gi, hit->instance);
+    float f;
+    int seg = moving ? geom_motion_segment(gs, ray->time, &f) : -1;
+    GridSlot *slot = moving ? &gsh->seg_ci[(size_t)gsh->moving[gi] * gsh->n_seg + seg]
+                            : grid_slot(gsh, gi, hit->instance);
     Rgb *ci = atomic_load_explicit(slot, memory_order_acquire);
     if (!ci) {
-        pthread_mutex_t *lock = &gsh->locks[(gi + hit->instance * 2654435761u) % STRIPES];
+        pthread_mutex_t *lock =
+            &gsh->locks[(gi + hit->instance * 2654435761u + (uint32_t)(seg + 1) * 40503u) %
+                        STRIPES];
         pthread_mutex_lock(lock);
         ci = atomic_load_explicit(slot, memory_order_acquire);
         if (!ci) {
             /* a still grid's shading is shared by every time: its rays leave
-             * at the shutter's middle, whichever ray came first */
+             * at the shutter's middle, whichever ray came first; a moving
+             * grid's by every time of its segment, whose middle it takes */
             float outer = w->time;
-            w->time = 0.5f * (w->rs->camera.shutter[0] + w->rs->camera.shutter[1]);
-            ci = shade_grid(w, gi, hit->instance);
+            w->time = moving ? geom_segment_mid_time(gs, seg)
+                             : 0.5f * (w->rs->camera.shutter[0] + w->rs->camera.shutter[1]);
+            ci = shade_grid(w, gi, hit->instance, seg);
             w->time = outer;
             atomic_store_explicit(slot, ci, memory_order_release);
         }

@@ -291,8 +291,12 @@ static Vec3 trace_layers(Worker *w, const Ray *ray, uint32_t kind, int diffuse_d
         Vec3 L = v3(0, 0, 0);
         int sees_lights = !(kind & (RAYES_RAY_DIFFUSE | PATH_RAY_GLOSSY));
         for (size_t k = 0; sees_lights && k < w->rs->n_lights; k++)
-            if (w->rs->lights[k].type == LIGHT_ENVIRONMENT)
-                L = v3_add(L, light_env_radiance(&w->rs->lights[k], ray->d));
+            if (w->rs->lights[k].type == LIGHT_ENVIRONMENT) {
+                Light moved; /* a turning map: its rotation at the ray's time */
+                L = v3_add(L, light_env_radiance(light_at_time(&w->rs->lights[k], ray->time,
+                                                               &moved),
+                                                 ray->d));
+            }
         return L;
     }
     *t = hit.t;

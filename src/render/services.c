@@ -247,7 +247,8 @@ static void svc_direct_lighting(const RayesShaderServices *sv, const RayesShadeC
         p.shadow = shadow_diff(ps, point(ctx, i), n);
         p.spread = ps->diff[point(ctx, i)].spread;
         for (size_t k = 0; k < w->rs->n_lights && n > 0; k++) {
-            const Light *l = &w->rs->lights[k];
+            Light moved; /* a light moving within the frame: where it is at w->time */
+            const Light *l = light_at_time(&w->rs->lights[k], w->time, &moved);
             if (l->type == LIGHT_AMBIENT || !render_lit_by(obj, k) ||
                 !light_category_match(l, category))
                 continue;
@@ -401,7 +402,8 @@ static void svc_direct_fiber(const RayesShaderServices *sv, const RayesShadeCtx 
         uint64_t key = hash_combine(ps->keys[point(ctx, i)], DIM_LIGHT);
         Vec3 d = v3(0, 0, 0), s = d;
         for (size_t k = 0; k < w->rs->n_lights && n > 0; k++) {
-            const Light *l = &w->rs->lights[k];
+            Light moved; /* a light moving within the frame: where it is at w->time */
+            const Light *l = light_at_time(&w->rs->lights[k], w->time, &moved);
             if (l->type == LIGHT_AMBIENT || !render_lit_by(obj, k) ||
                 !light_category_match(l, category))
                 continue;
@@ -696,7 +698,8 @@ static void svc_direct_volume(const RayesShaderServices *sv, const RayesShadeCtx
         uint64_t key = hash_combine(ps->keys[j], DIM_LIGHT);
         Vec3 sum = v3(0, 0, 0);
         for (size_t k = 0; k < w->rs->n_lights && n > 0; k++) {
-            const Light *l = &w->rs->lights[k];
+            Light moved; /* a light moving within the frame: where it is at w->time */
+            const Light *l = light_at_time(&w->rs->lights[k], w->time, &moved);
             if (l->type == LIGHT_AMBIENT || !light_category_match(l, category))
                 continue;
             int m = light_is_area(l) ? n : 1;

@@ -18,11 +18,13 @@
  *  - Deformation blur: the vertex moves by the difference of the
  *    primitive's surface at (u, v) between time t and t0, so the diced,
  *    displaced and stitched vertex keeps its offset from the surface.
- * Curves and points move by transform only (their grids are ribbons and
- * squares diced for the eye, which a transform carries; a deformation
- * block of curves or points takes its first sample's shape). Only the
- * grids of moving primitives have later samples (GridSet.Pt and the
- * rest, compact: Grid.motion_vertex).
+ *    Curves and points deform the same way, their samples evaluated facing
+ *    the eye the grid was diced for (a point's square keeps its first
+ *    orientation, as a transform would carry it: it faces the eye moved
+ *    with the centre), so a tube's centre line and width, and a point's
+ *    centre and radius, are the sample's own at every time.
+ * Only the grids of moving primitives have later samples (GridSet.Pt and
+ * the rest, compact: Grid.motion_vertex).
  *
  * Threading: the API calls edit one scene (one thread); prepare reads it.
  */
@@ -143,6 +145,19 @@ static int push_motion_prim(RayesScene *s, const Prim *p)
     return 0;
 }
 
+/* 1 if a and b are samples of one primitive: of a type, and curves of as
+ * many segments and a shape, points of a shape. */
+static int same_topology(const Prim *a, const Prim *b)
+{
+    if (a->type != b->type)
+        return 0;
+    if (a->type == PRIM_CURVE)
+        return a->curve.n_seg == b->curve.n_seg && a->curve.shape == b->curve.shape;
+    if (a->type == PRIM_POINT)
+        return a->point.shape == b->point.shape;
+    return 1;
+}
+
 RayesError rayes_scene_motion_end(RayesScene *s)
 {
     if (!s)
@@ -155,7 +170,8 @@ RayesError rayes_scene_motion_end(RayesScene *s)
     int same = total > 0 && total % n_times == 0;
     for (size_t k = 1; same && k < n_times; k++)
         for (size_t j = 0; j < per; j++)
-            if (s->prims[s->deform_first + k * per + j].type != s->prims[s->deform_first + j].type)
+            if (!same_topology(&s->prims[s->deform_first + k * per + j],
+                               &s->prims[s->deform_first + j]))
                 same = 0;
     if (!same) {
         s->n_prims = s->deform_first;
@@ -274,14 +290,23 @@ static const Prim *deform_prim(const RayesScene *s, const SceneMotion *m, size_t
                   : &s->motion_prims[m->first + (size_t)(k - 1) * m->n_prims + j];
 }
 
-/* 1 if grid g has later time samples: a surface of a moving primitive,
- * or a curve or point grid of one moved by its transform. */
+/* 1 if grid g has later time samples: a grid of a moving primitive. */
 static int grid_moves(const RayesScene *s, const Grid *g)
 {
-    const Prim *p = &s->prims[g->prim];
-    if (!p->motion)
-        return 0;
-    return g->shape == GEOM_SHAPE_SURFACE || !s->motions[p->motion - 1].deform;
+    return s->prims[g->prim].motion != 0;
+}
+
+/* A curve or point sample p as diced (geom_dice_prim): facing eye (for
+ * points, moved by the centre's offset from the first sample's, first)
+ * unless it is a ribbon or an oriented disk, whose normals place it. */
+static Prim facing(const Prim *p, const Prim *first, Vec3 eye)
+{
+    Prim c = *p;
+    if (p->type == PRIM_CURVE && p->curve.shape != GEOM_SHAPE_SURFACE)
+        c.curve.facing = eye;
+    else if (p->type == PRIM_POINT && p->point.shape != GEOM_SHAPE_ORIENTED_DISK)
+        c.point.facing = v3_add(eye, v3_sub(p->point.centre, first->point.centre));
+    return c;
 }
 
 /* The GridSet's time samples: from the earliest to the latest motion
@@ -309,7 +334,7 @@ static int time_samples(const RayesScene *s, float span[2])
 }
 
 /* Moves grid g's vertices to time t (into sample k's arrays). */
-static void move_grid(const RayesScene *s, GridSet *gs, Grid *g, int k, float t)
+static void move_grid(const RayesScene *s, GridSet *gs, Grid *g, int k, float t, Vec3 eye)
 {
     const Prim *p = &s->prims[g->prim];
     const SceneMotion *m = &s->motions[p->motion - 1];
@@ -335,6 +360,8 @@ static void move_grid(const RayesScene *s, GridSet *gs, Grid *g, int k, float t)
     }
     size_t j = g->prim - m->first_prim;
     const Prim *pa = deform_prim(s, m, j, a), *pb = deform_prim(s, m, j, b);
+    Prim fp = facing(p, p, eye), fa = facing(pa, p, eye), fb = facing(pb, p, eye);
+    p = &fp, pa = &fa, pb = &fb;
     for (size_t i = first; i < first + n; i++) {
         float u = gs->uv[i][0], v = gs->uv[i][1];
         Vec3 P0, U0, V0, Pa, Ua, Va, Pb, Ub, Vb;
@@ -354,7 +381,7 @@ static void move_grid(const RayesScene *s, GridSet *gs, Grid *g, int k, float t)
     }
 }
 
-int scene_motion_prepare(const RayesScene *s, GridSet *gs)
+int scene_motion_prepare(const RayesScene *s, const DiceCamera *cams, GridSet *gs)
 {
     float span[2] = {0.0f, 0.0f};
     int n = time_samples(s, span);
@@ -362,7 +389,7 @@ int scene_motion_prepare(const RayesScene *s, GridSet *gs)
     gs->time[0] = span[0], gs->time[1] = span[1];
     if (n < 2)
         return 0;
-    /* Slots in the later samples for the grids that may move (surfaces of
+    /* Slots in the later samples for the grids that may move (those of
      * moving primitives). */
     size_t slots = 0;
     for (size_t gi = 0; gi < gs->n_grids; gi++) {
@@ -387,7 +414,8 @@ int scene_motion_prepare(const RayesScene *s, GridSet *gs)
         if (!grid_moves(s, g))
             continue;
         for (int k = 1; k < n; k++)
-            move_grid(s, gs, g, k, span[0] + (span[1] - span[0]) * (float)k / (float)(n - 1));
+            move_grid(s, gs, g, k, span[0] + (span[1] - span[0]) * (float)k / (float)(n - 1),
+                      cams[g->master].eye);
         size_t first = g->first_vertex, nv = geom_grid_n_vertices(g);
         for (int k = 1; k < n && !g->moving; k++)
             for (size_t i = 0; i < nv && !g->moving; i++)

@@ -891,6 +891,8 @@ RayesError rayes_scene_volume(RayesScene *s, const float bound[6])
     return RAYES_OK;
 }
 
+static void light_motion(const RayesScene *s, Light *l);
+
 RayesError rayes_scene_area_light(RayesScene *s, const float P[4][3], const float L[3])
 {
     if (!s || !P || !L)
@@ -919,13 +921,14 @@ RayesError rayes_scene_area_light(RayesScene *s, const float P[4][3], const floa
     light_quad_eval(l, 0.5f, 0.5f, &c, &n);
     if (!(v3_length(n) > 0.0f))
         return scene_fail(s, RAYES_ERROR_INVALID_ARGUMENT, "area light: the quad has no area");
+    light_motion(s, l);
     int64_t keep = s->current_object;
     RayesError e = add_object(s, NULL, NULL, 0, (int)s->n_lights);
     if (e != RAYES_OK)
         return e;
     s->n_lights++;
     Prim p = {.type = PRIM_BILINEAR, .object = (uint32_t)(s->n_objects - 1),
-              .shading_rate = s->shading_rate};
+              .shading_rate = s->shading_rate, .motion = s->current_motion};
     memcpy(p.cp, l->P, sizeof l->P);
     if (grow((void **)&s->prims, &s->cap_prims, s->n_prims, sizeof *s->prims) != 0)
         return scene_fail(s, RAYES_ERROR_OUT_OF_MEMORY, "out of memory");
@@ -1197,8 +1200,9 @@ int scene_prepare(const RayesScene *s, int width, int height, const DiceOptions 
         gs->n_masters = s->n_masters;
     }
     float rate_scale = cams[0].rate_scale;
+    int failed = geom_stitch(gs, s->prims) != 0 || scene_motion_prepare(s, cams, gs) != 0;
     free(cams);
-    if (geom_stitch(gs, s->prims) != 0 || scene_motion_prepare(s, gs) != 0)
+    if (failed)
         return -1;
     if (first_need)
         log_warning("dicing: the scene needs %zu grid vertices, more than the budget of %zu "
@@ -1307,6 +1311,18 @@ static RayesError light_params(RayesScene *s, const char *type, const RayesParam
     return RAYES_OK;
 }
 
+/* A light made under a moving transform moves with it (Light.time). */
+static void light_motion(const RayesScene *s, Light *l)
+{
+    l->n_times = 0;
+    if (!s->current_motion)
+        return;
+    const SceneMotion *m = &s->motions[s->current_motion - 1];
+    l->n_times = m->n_times;
+    memcpy(l->time, m->time, (size_t)m->n_times * sizeof *l->time);
+    memcpy(l->delta, m->delta, (size_t)m->n_times * sizeof *l->delta);
+}
+
 /* Adds light l and, for emitters, its object and the primitives camera and
  * specular rays see (n_prims of them). */
 static RayesError push_light(RayesScene *s, const Light *l, const Prim *prims, size_t n_prims)
@@ -1326,10 +1342,12 @@ static RayesError push_light(RayesScene *s, const Light *l, const Prim *prims, s
             Prim p = prims[i];
             p.object = (uint32_t)(s->n_objects - 1);
             p.shading_rate = s->shading_rate;
+            p.motion = s->current_motion; /* the emitter moves with the light */
             s->prims[s->n_prims++] = p;
         }
     }
-    s->lights[s->n_lights++] = *l;
+    s->lights[s->n_lights] = *l;
+    light_motion(s, &s->lights[s->n_lights++]);
     scene_mark(s, SCENE_CHANGE_GEOMETRY);
     return RAYES_OK;
 }

@@ -289,8 +289,10 @@ int scene_object_lit_by(const RayesScene *scene, size_t object, size_t light);
 
 /* Motion blur at prepare (motion.c): fills gs's time samples (GridSet.Pt
  * and the rest) for the scene's moving primitives, after dicing,
- * displacement and stitching. Returns 0, or -1 when out of memory. */
-int scene_motion_prepare(const RayesScene *scene, GridSet *gs);
+ * displacement and stitching; cams[m] is master m's dicing camera (0: the
+ * world's), whose eye deforming curves and points face. Returns 0, or -1
+ * when out of memory. */
+int scene_motion_prepare(const RayesScene *scene, const DiceCamera *cams, GridSet *gs);
 
 /* The factor (>= 1) by which blur lengthens the micropolygon edges of the
  * scene's primitive `index` (motionfactor and focusfactor, motion.c); cam

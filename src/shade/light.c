@@ -221,6 +221,50 @@ static int env_sample(const Light *l, float a, float b, LightSample *s)
     return 1;
 }
 
+/* ------------------------------------------------------------ motion */
+
+const Light *light_at_time(const Light *l, float t, Light *tmp)
+{
+    if (l->n_times < 2 || t <= l->time[0])
+        return l;
+    int k = 0;
+    float f = 1.0f;
+    while (k + 2 < l->n_times && t >= l->time[k + 1])
+        k++;
+    if (t < l->time[k + 1])
+        f = (t - l->time[k]) / (l->time[k + 1] - l->time[k]);
+    Mat4 D;
+    for (int i = 0; i < 4; i++)
+        for (int j = 0; j < 4; j++)
+            D.m[i][j] = l->delta[k].m[i][j] + (l->delta[k + 1].m[i][j] - l->delta[k].m[i][j]) * f;
+    *tmp = *l;
+    tmp->n_times = 0;
+    for (int i = 0; i < 4; i++)
+        tmp->P[i] = mat4_point(&D, l->P[i]);
+    tmp->from = mat4_point(&D, l->from);
+    Vec3 dir = mat4_vector(&D, l->dir);
+    tmp->dir = v3_length(dir) > 0.0f ? v3_normalize(dir) : l->dir;
+    tmp->ex = mat4_vector(&D, l->ex);
+    tmp->ey = mat4_vector(&D, l->ey);
+    if (l->type == LIGHT_DISK) {
+        Vec3 n = v3_cross(tmp->ex, tmp->ey);
+        tmp->area = (float)M_PI * v3_length(n);
+        tmp->normal = tmp->area > 0.0f ? v3_normalize(n) : l->normal;
+    }
+    if (l->type == LIGHT_SPHERE) { /* scaled as the object's x axis */
+        Vec3 x = mat4_vector(&D, v3(1, 0, 0));
+        tmp->radius = l->radius * v3_length(x);
+    }
+    if (l->type == LIGHT_ENVIRONMENT) { /* the rotation alone */
+        Mat4 R = D;
+        R.m[0][3] = R.m[1][3] = R.m[2][3] = 0.0f;
+        tmp->world_from_light = mat4_mul(R, l->world_from_light);
+        if (!mat4_invert(tmp->world_from_light, &tmp->light_from_world))
+            return l;
+    }
+    return tmp;
+}
+
 /* ---------------------------------------------------------- sampling */
 
 int light_below_plane(const Light *l, Vec3 o, Vec3 n)

@@ -20,6 +20,10 @@
  * unmirrored, centred. The light's transform (when it was made) rotates the
  * map. Lookups take the nearest pixel, the same function the sampler draws.
  *
+ * A light made under a moving transform moves within the frame: the
+ * lighting services take it at each ray's time (light_at_time; DESIGN.md
+ * "Motion blur and depth of field").
+ *
  * Memory: a Light owns its map (light_fini frees it). Thread-safety: every
  * function but light_env_load and light_fini only reads the light.
  */
@@ -42,6 +46,7 @@ typedef enum LightType {
 } LightType;
 
 #define LIGHT_CATEGORY_MAX 128
+#define LIGHT_MAX_TIMES 16 /* a moving light's time samples, at most (RAYES_MAX_TIMES) */
 
 /* A latitude-longitude map with its sampling distribution: pixel (x, y)
  * weighted by its luminance times sin(theta) at its centre, drawn as a row
@@ -70,6 +75,12 @@ typedef struct Light {
     Mat4 world_from_light, light_from_world; /* environment: the map's rotation */
     LightEnvMap *env;   /* environment: NULL for a constant one */
     char category[LIGHT_CATEGORY_MAX]; /* comma-separated names */
+    /* A light moving within the frame (made under a moving transform):
+     * where it is at time t is the light above (at time[0]) moved by delta
+     * blended linearly between the samples around t (light_at_time). */
+    int n_times;        /* 0: still */
+    float time[LIGHT_MAX_TIMES];
+    Mat4 delta[LIGHT_MAX_TIMES]; /* world_from_light(time k) light_from_world(time 0) */
 } Light;
 
 /* A direction from a point toward a light. */
@@ -133,6 +144,11 @@ Vec3 light_env_radiance(const Light *l, Vec3 d);
  * map of twice its width. Returns 0, or -1 with a one-line message in
  * err. */
 int light_env_load(Light *l, const char *path, int octahedral, char *err, size_t err_size);
+
+/* The light at time t: l itself when it is still, else *tmp, made from l
+ * moved to t (positions, axes, sizes; an environment map's rotation),
+ * sharing l's map. */
+const Light *light_at_time(const Light *l, float t, Light *tmp);
 
 /* Frees what the light owns. */
 void light_fini(Light *l);

@@ -99,6 +99,36 @@ static void test_rib_block_colour_kept(void)
     rayes_scene_release(s);
 }
 
+/* A block that sets Color but no Surface: its geometry keeps each
+ * instance's Surface with the block's colour (a constant shader shows the
+ * colour itself, a matte one shades it), not the Surface current at
+ * ObjectBegin. */
+static void test_rib_block_colour_instance_surface(void)
+{
+    RayesScene *s = rayes_scene_new();
+    CHECK(read_into(s, "t.rib",
+                    RIB_HEAD "ObjectBegin \"card\"\nColor [0 0 1]\n"
+                             "  Polygon \"P\" [-0.8 -0.8 0  0.8 -0.8 0  0.8 0.8 0  -0.8 0.8 0]\n"
+                             "ObjectEnd\n"
+                             "AttributeBegin\nSurface \"constant\"\nColor [1 0 0]\n"
+                             "Translate 1 0 0\nObjectInstance \"card\"\nAttributeEnd\n"
+                             "AttributeBegin\nSurface \"matte\"\nColor [0 1 0]\n"
+                             "Translate -1 0 0\nObjectInstance \"card\"\nAttributeEnd\n"
+                             "WorldEnd\n") == RAYES_OK);
+    RayesImage *img = NULL;
+    CHECK(render_stat(s, "instances/count", &img) == 2);
+    const float *left = &img->rgba[4 * (24 * 48 + 12)], *right = &img->rgba[4 * (24 * 48 + 36)];
+    /* constant: the block's blue itself */
+    CHECK(right[0] < 0.01f && right[1] < 0.01f && right[2] > 0.99f && right[2] < 1.01f);
+    /* matte: blue, lit by the point light (not 1) */
+    CHECK(left[2] > 0.05f && left[0] < 0.2f * left[2] && left[1] < 0.2f * left[2]);
+    CHECK(left[2] < 0.9f || left[2] > 1.1f);
+    printf("  Color-only block: constant instance %.3f %.3f %.3f, matte instance %.3f %.3f %.3f\n",
+           right[0], right[1], right[2], left[0], left[1], left[2]);
+    rayes_image_free(img);
+    rayes_scene_release(s);
+}
+
 /* ObjectInstance inside ObjectBegin (RenderMan allows it): 2 x 3 balls. */
 static void test_rib_nested(void)
 {
@@ -221,5 +251,6 @@ static void test_aqsis_objectinstance(void)
 }
 
 TEST_MAIN(TEST(test_aqsis_objectinstance), TEST(test_rib_instances_inherit_colour), TEST(test_rib_block_colour_kept),
+          TEST(test_rib_block_colour_instance_surface),
           TEST(test_rib_nested), TEST(test_errors), TEST(test_pbrt_instances),
           TEST(test_rib_writer_round_trip))

@@ -6,7 +6,10 @@
  * motion; cached radiosity with motion segments matches uncached (1% mean,
  * 3% per 32 x 32 tile), is deterministic across thread counts, and fills
  * one set of entries per segment; a camera moving past a still sphere
- * blurs it as the sphere moving the other way would.
+ * blurs it as the sphere moving the other way would. Deforming points and
+ * curves; a light moving within the frame (its shadow against the analytic
+ * time average, cached against uncached); the grid hider's shading per
+ * motion segment against the ray-tracing hider.
  */
 #include <math.h>
 #include <string.h>
@@ -162,6 +165,118 @@ static void test_moving_points_and_curves(void)
     }
 }
 
+/* A sphere point (diameter 2) from x = -1 to x = 1: by its transform
+ * (deform 0) or by its two positions in a motion block (deform 1). */
+static RayesScene *point_scene(int deform)
+{
+    RayesScene *s = rayes_scene_new();
+    ortho_camera(s);
+    CHECK(rayes_scene_set_shutter(s, 0.0f, 1.0f) == RAYES_OK);
+    RayesParam lp[2] = {{"from", RAYES_PARAM_COLOR, {0, 0, 0}, NULL},
+                        {"to", RAYES_PARAM_COLOR, {0.3f, 0.2f, 1}, NULL}};
+    CHECK(rayes_scene_light(s, "distantlight", lp, 2) == RAYES_OK);
+    const float times[2] = {0, 1}, width = 2.0f;
+    RayesPrimvar pv = {"width", RAYES_PRIMVAR_CONSTANT, &width, 1};
+    if (!deform) {
+        float m[2][16];
+        translate(m[0], -1, 0, 0);
+        translate(m[1], 1, 0, 0);
+        CHECK(rayes_scene_set_transform_motion(s, 2, times, (const float(*)[16])m) == RAYES_OK);
+        const float P[3] = {0, 0, 0};
+        CHECK(rayes_scene_points(s, RAYES_POINT_SPHERE, 1, P, &pv, 1) == RAYES_OK);
+        return s;
+    }
+    CHECK(rayes_scene_motion_begin(s, 2, times) == RAYES_OK);
+    for (int k = 0; k < 2; k++) {
+        const float P[3] = {k ? 1.0f : -1.0f, 0, 0};
+        CHECK(rayes_scene_points(s, RAYES_POINT_SPHERE, 1, P, &pv, 1) == RAYES_OK);
+    }
+    CHECK(rayes_scene_motion_end(s) == RAYES_OK);
+    return s;
+}
+
+/* The fraction of the shutter [0, 1] a tube whose axis runs from x = -1
+ * to x = 1 while its width grows from 0.5 to 1.5 covers abscissa x (its
+ * straight part): a midpoint sum over 4,000 times. */
+static double tube_time_coverage(double x)
+{
+    int n = 4000, in = 0;
+    for (int i = 0; i < n; i++) {
+        double t = (i + 0.5) / n;
+        in += fabs(x - (-1.0 + 2.0 * t)) < 0.5 * (0.5 + t);
+    }
+    return (double)in / n;
+}
+
+/* Deforming points and curves (a motion block around Points or Curves of
+ * the same topology): a point moved by its positions renders as the same
+ * motion by transform, and a vertical tube whose axis moves and whose
+ * width grows covers each pixel for its analytic fraction of the
+ * shutter. */
+static void test_deforming_points_and_curves(void)
+{
+    RayesScene *a = point_scene(0), *b = point_scene(1);
+    RayesImage *ia = render(a, 16, 2, 1, NULL), *ib = render(b, 16, 2, 1, NULL);
+    double worst = 0, mean = 0, cover = 0;
+    for (size_t i = 0; ia && ib && i < 4 * (size_t)W * W; i++) {
+        worst = fmax(worst, fabs(ia->rgba[i] - ib->rgba[i]));
+        mean += fabs(ia->rgba[i] - ib->rgba[i]) / (4.0 * W * W);
+        if (i % 4 == 3)
+            cover += ib->rgba[i];
+    }
+    float px = 2 * HALF / W;
+    CHECK_NEAR(cover * px * px, M_PI, 0.03 * M_PI);
+    CHECK(mean < 1e-4);
+    CHECK(worst < 0.02);
+    printf("  deforming point vs transform: mean difference %.2g, largest %.2g, coverage %.4f\n",
+           mean, worst, cover * px * px);
+    rayes_image_free(ia);
+    rayes_image_free(ib);
+    rayes_scene_release(a);
+    rayes_scene_release(b);
+
+    RayesScene *s = rayes_scene_new();
+    ortho_camera(s);
+    CHECK(rayes_scene_set_shutter(s, 0.0f, 1.0f) == RAYES_OK);
+    const float times[2] = {0, 1};
+    CHECK(rayes_scene_motion_begin(s, 2, times) == RAYES_OK);
+    for (int k = 0; k < 2; k++) {
+        float x = k ? 1.0f : -1.0f, width = k ? 1.5f : 0.5f;
+        const float P[6] = {x, -1.5f, 0, x, 1.5f, 0};
+        const int nv = 2;
+        RayesCurves c = {.degree = 1, .shape = RAYES_CURVE_ROUND, .n_curves = 1,
+                         .n_verts = &nv, .P = P};
+        RayesPrimvar pv = {"width", RAYES_PRIMVAR_CONSTANT, &width, 1};
+        CHECK(rayes_scene_curves(s, &c, &pv, 1) == RAYES_OK);
+    }
+    CHECK(rayes_scene_motion_end(s) == RAYES_OK);
+    RayesStats *st = NULL;
+    RayesImage *img = render(s, 64, 2, 1, &st);
+    const RayesStat *moving = rayes_stats_find(st, "motion/moving_grids");
+    CHECK(moving && moving->count > 0);
+    rayes_stats_free(st);
+    double err = 0, worst_px = 0;
+    int n = 0;
+    for (int y = 0; img && y < W; y++)
+        for (int x = 0; x < W; x++) {
+            double cy = HALF - (y + 0.5) * px;
+            if (fabs(cy) > 1.2) /* the straight part, away from the end caps */
+                continue;
+            double want = 0;
+            for (int i = 0; i < 4; i++) /* the pixel's mean over 4 abscissae */
+                want += tube_time_coverage(-HALF + (x + (i + 0.5) / 4) * px) / 4;
+            double got = img->rgba[4 * (y * W + x) + 3];
+            err += fabs(got - want);
+            worst_px = fmax(worst_px, fabs(got - want));
+            n++;
+        }
+    CHECK(n > 0 && err / n < 0.01);
+    CHECK(worst_px < 0.15);
+    printf("  deforming tube: mean |coverage error| %.4f, worst %.3f\n", err / n, worst_px);
+    rayes_image_free(img);
+    rayes_scene_release(s);
+}
+
 /* A lit bilinear patch (4 x 2 units, facing the camera) moving from x = -1
  * to x = 1: by its transform, or by its two shapes. */
 static RayesScene *patch_scene(int deform, float motionfactor)
@@ -287,9 +402,11 @@ static void test_camera_motion(void)
 }
 
 /* The Cornell box with a white sphere rising and swinging toward the red
- * wall over the shutter (3 samples, 2 motion segments). */
-static RayesImage *box_render(int cache, double cache_mb, int threads, const float crop[4],
-                              RayesStats **stats)
+ * wall over the shutter (3 samples, 2 motion segments); light_moves: and a
+ * point light moving 156 units (of the box's 555) above it; hider:
+ * RayesHider. */
+static RayesImage *box_render_with(int cache, double cache_mb, int threads, const float crop[4],
+                                   RayesStats **stats, int light_moves, int hider)
 {
     RayesScene *s = rayes_scene_new();
     char err[512];
@@ -304,12 +421,22 @@ static RayesImage *box_render(int cache, double cache_mb, int threads, const flo
     CHECK(rayes_scene_set_shader(s, "matte", NULL, 0) == RAYES_OK);
     CHECK(rayes_scene_set_transform_motion(s, 3, times, (const float(*)[16])m) == RAYES_OK);
     CHECK(rayes_scene_sphere(s, 80.0f) == RAYES_OK);
+    if (light_moves) {
+        float lm[2][16];
+        translate(lm[0], 210, 420, 200);
+        translate(lm[1], 330, 420, 300);
+        const float lt[2] = {0, 1};
+        CHECK(rayes_scene_set_transform_motion(s, 2, lt, (const float(*)[16])lm) == RAYES_OK);
+        RayesParam lp = {"intensity", RAYES_PARAM_FLOAT, {40000, 0, 0}, NULL};
+        CHECK(rayes_scene_light(s, "pointlight", &lp, 1) == RAYES_OK);
+    }
     CHECK(rayes_scene_commit(s) == RAYES_OK);
     RayesRenderOptions o;
     rayes_render_options_init(&o, RAYES_QUALITY_PREVIEW);
     o.width = o.height = 128;
     o.spp = 16;
     o.threads = threads;
+    o.hider = (RayesHider)hider;
     o.bounces = 1;
     o.diffuse_rays = 16;
     o.cache = cache;
@@ -320,6 +447,12 @@ static RayesImage *box_render(int cache, double cache_mb, int threads, const flo
     CHECK(rayes_render(s, &o, &img, stats) == RAYES_OK);
     rayes_scene_release(s);
     return img;
+}
+
+static RayesImage *box_render(int cache, double cache_mb, int threads, const float crop[4],
+                              RayesStats **stats)
+{
+    return box_render_with(cache, cache_mb, threads, crop, stats, 0, RAYES_HIDER_RAYTRACE);
 }
 
 static double tile_mean(const RayesImage *img, int x0, int y0, int size)
@@ -495,7 +628,217 @@ static void test_moving_hits(void)
     rayes_scene_release(s);
 }
 
+/* Means within 1%, 32 x 32 tiles (those not near black) within 3%. */
+static void check_close(const char *what, const RayesImage *a, const RayesImage *b)
+{
+    CHECK(a && b);
+    if (!a || !b)
+        return;
+    double ma = tile_mean(a, 0, 0, 128), mb = tile_mean(b, 0, 0, 128), worst = 0;
+    for (int y = 0; y < 128; y += 32)
+        for (int x = 0; x < 128; x += 32) {
+            double ta = tile_mean(a, x, y, 32), tb = tile_mean(b, x, y, 32);
+            if (tb > 0.02 * mb)
+                worst = fmax(worst, fabs(ta - tb) / tb);
+        }
+    CHECK(fabs(ma - mb) < 0.01 * mb);
+    CHECK(worst < 0.03);
+    printf("  %s: means %.5f %.5f (%.2f%%), worst 32 x 32 tile %.2f%%\n", what, ma, mb,
+           100 * fabs(ma - mb) / mb, 100 * worst);
+}
+
+/* The time average of a point light of intensity pi moving from (-1, 0,
+ * -1) to (1, 0, -1) over a matte plane z = 0 seen from -z, a sphere of
+ * radius 0.25 at (0, 0, -0.5) (seen by shadow rays only) between them:
+ * radiance h / d^3 where the light is seen, at (x, y), over 512 times. */
+static double moving_light_radiance(double x, double y)
+{
+    double sum = 0;
+    for (int i = 0; i < 512; i++) {
+        double lx = -1.0 + 2.0 * (i + 0.5) / 512, dx = lx - x, dy = -y, dz = -1.0;
+        double d = sqrt(dx * dx + dy * dy + dz * dz);
+        /* the segment from (x, y, 0) to the light against the sphere */
+        double cx = -x, cy = -y, cz = -0.5; /* the centre from the point */
+        double s = (cx * dx + cy * dy + cz * dz) / (d * d);
+        s = s < 0 ? 0 : s > 1 ? 1 : s;
+        double ex = cx - s * dx, ey = cy - s * dy, ez = cz - s * dz;
+        if (ex * ex + ey * ey + ez * ez >= 0.25 * 0.25)
+            sum += 1.0 / (d * d * d);
+    }
+    return sum / 512;
+}
+
+/* A light moving within the frame (rayes_scene_light under a moving
+ * transform): each ray sees it where it is at the ray's time, so a matte
+ * plane's light and the shadow of a sphere blur as the analytic time
+ * average; the light still at its middle position differs. */
+static void test_moving_light_shadow(void)
+{
+    RayesImage *img[2];
+    for (int still = 0; still < 2; still++) {
+        RayesScene *s = rayes_scene_new();
+        ortho_camera(s);
+        CHECK(rayes_scene_set_shutter(s, 0.0f, 1.0f) == RAYES_OK);
+        float m[2][16];
+        translate(m[0], 0, 0, -0.5f);
+        CHECK(rayes_scene_set_transform(s, m[0]) == RAYES_OK);
+        CHECK(rayes_scene_set_visibility(s, RAYES_RAY_SHADOW) == RAYES_OK);
+        CHECK(rayes_scene_sphere(s, 0.25f) == RAYES_OK);
+        CHECK(rayes_scene_set_visibility(s, 0x1fu /* every ray */) == RAYES_OK);
+        translate(m[0], still ? 0.0f : -1.0f, 0, -1);
+        translate(m[1], still ? 0.0f : 1.0f, 0, -1);
+        const float times[2] = {0, 1};
+        CHECK(rayes_scene_set_transform_motion(s, 2, times, (const float(*)[16])m) == RAYES_OK);
+        RayesParam lp = {"intensity", RAYES_PARAM_FLOAT, {(float)M_PI, 0, 0}, NULL};
+        CHECK(rayes_scene_light(s, "pointlight", &lp, 1) == RAYES_OK);
+        CHECK(rayes_scene_set_transform(s, identity) == RAYES_OK);
+        CHECK(rayes_scene_set_shader(s, "matte", NULL, 0) == RAYES_OK);
+        float P[4][3] = {{-4, -4, 0}, {4, -4, 0}, {-4, 4, 0}, {4, 4, 0}};
+        CHECK(rayes_scene_bilinear_patch(s, P) == RAYES_OK);
+        img[still] = render(s, 64, 2, 0, NULL);
+        rayes_scene_release(s);
+    }
+    double err = 0, worst = 0, off = 0;
+    float px = 2 * HALF / W;
+    for (int y = 0; img[0] && img[1] && y < W; y++)
+        for (int x = 0; x < W; x++) {
+            double want = 0;
+            for (int j = 0; j < 2; j++)
+                for (int i = 0; i < 2; i++)
+                    want += moving_light_radiance(-HALF + (x + (i + 0.5) / 2) * px,
+                                                  HALF - (y + (j + 0.5) / 2) * px) / 4;
+            double got = img[0]->rgba[4 * (y * W + x)];
+            err += fabs(got - want);
+            worst = fmax(worst, fabs(got - want));
+            off = fmax(off, fabs(img[1]->rgba[4 * (y * W + x)] - want));
+        }
+    err /= W * W;
+    CHECK(err < 0.01);
+    CHECK(worst < 0.1);
+    CHECK(off > 0.2); /* the light held still at its middle is another picture */
+    printf("  moving light: mean |error| %.4f, worst %.3f (still light: worst %.3f)\n", err, worst,
+           off);
+    rayes_image_free(img[0]);
+    rayes_image_free(img[1]);
+}
+
+/* A light moving through the box: cached radiosity (fills at the shutter's
+ * middle for still grids, the segment's for moving ones) against uncached
+ * (every ray at its own time), and the grid hider (which shades grids lit
+ * by a moving light per hit) against the ray-tracing hider. */
+static void test_moving_light_cached(void)
+{
+    RayesImage *a = box_render_with(1, 100, 2, NULL, NULL, 1, RAYES_HIDER_RAYTRACE);
+    RayesImage *b = box_render_with(0, 100, 2, NULL, NULL, 1, RAYES_HIDER_RAYTRACE);
+    RayesImage *c = box_render_with(1, 100, 2, NULL, NULL, 1, RAYES_HIDER_GRID);
+    check_close("moving light, cached vs uncached", a, b);
+    check_close("moving light, grid hider vs ray tracing", c, a);
+    rayes_image_free(a);
+    rayes_image_free(b);
+    rayes_image_free(c);
+}
+
+/* A matte sphere moving from x = -1 through (0, 0.3) to x = 1 (3 samples,
+ * 2 motion segments, or with fine 5: the same path in 4 segments) under a
+ * point light, rendered with a hider. */
+static RayesImage *hider_sphere(int hider, int threads, int fine, RayesStats **stats)
+{
+    RayesScene *s = rayes_scene_new();
+    ortho_camera(s);
+    CHECK(rayes_scene_set_shutter(s, 0.0f, 1.0f) == RAYES_OK);
+    RayesParam lp[2] = {{"from", RAYES_PARAM_COLOR, {0, 3, -6}, NULL},
+                        {"intensity", RAYES_PARAM_FLOAT, {150, 0, 0}, NULL}};
+    CHECK(rayes_scene_light(s, "pointlight", lp, 2) == RAYES_OK);
+    int n = fine ? 5 : 3;
+    float times[5], m[5][16];
+    for (int k = 0; k < n; k++) {
+        times[k] = (float)k / (float)(n - 1);
+        float x = 2.0f * times[k] - 1.0f;
+        translate(m[k], x, 0.3f * (1.0f - fabsf(x)), 0);
+    }
+    CHECK(rayes_scene_set_shader(s, "matte", NULL, 0) == RAYES_OK);
+    CHECK(rayes_scene_set_transform_motion(s, (size_t)n, times, (const float(*)[16])m) ==
+          RAYES_OK);
+    CHECK(rayes_scene_sphere(s, 1.0f) == RAYES_OK);
+    CHECK(rayes_scene_commit(s) == RAYES_OK);
+    RayesRenderOptions o;
+    rayes_render_options_init(&o, RAYES_QUALITY_PREVIEW);
+    o.width = o.height = W;
+    o.spp = 16;
+    o.threads = threads;
+    o.bounces = 0;
+    o.hider = (RayesHider)hider;
+    RayesImage *img = NULL;
+    CHECK(rayes_render(s, &o, &img, stats) == RAYES_OK);
+    rayes_scene_release(s);
+    return img;
+}
+
+/* Mean relative difference of a and b (RGB), and the worst over 16 x 16
+ * tiles the sphere mostly covers, into *worst. */
+static double hider_diff(const RayesImage *a, const RayesImage *b, double *worst)
+{
+    double ma = 0, mb = 0;
+    *worst = 0;
+    for (int ty = 0; a && b && ty < W; ty += 16)
+        for (int tx = 0; tx < W; tx += 16) {
+            double ta = 0, tb = 0;
+            for (int y = ty; y < ty + 16; y++)
+                for (int x = tx; x < tx + 16; x++)
+                    for (int c = 0; c < 3; c++) {
+                        ta += a->rgba[4 * (y * W + x) + c];
+                        tb += b->rgba[4 * (y * W + x) + c];
+                    }
+            ma += ta, mb += tb;
+            if (tb > 0.2 * 16 * 16)
+                *worst = fmax(*worst, fabs(ta - tb) / tb);
+        }
+    return mb > 0 ? fabs(ma - mb) / mb : 1.0;
+}
+
+/* The grid hider on moving grids: each is shaded once per motion segment
+ * (where it is at the segment's middle time), and hits interpolate their
+ * segment's shading. Against the ray-tracing hider (every hit shaded at
+ * its own time) the means agree within 1%; the tiles differ by the
+ * lighting's change within a segment, so less with more segments along
+ * the same path; far fewer camera shading points; the same bytes for 1
+ * and 2 threads. */
+static void test_grid_hider_motion(void)
+{
+    RayesStats *sa = NULL, *sb = NULL;
+    RayesImage *a = hider_sphere(RAYES_HIDER_GRID, 2, 0, &sa);
+    RayesImage *b = hider_sphere(RAYES_HIDER_RAYTRACE, 2, 0, &sb);
+    RayesImage *af = hider_sphere(RAYES_HIDER_GRID, 2, 1, NULL);
+    RayesImage *bf = hider_sphere(RAYES_HIDER_RAYTRACE, 2, 1, NULL);
+    CHECK(a && b && af && bf);
+    double worst, worst_f, mean = hider_diff(a, b, &worst), mean_f = hider_diff(af, bf, &worst_f);
+    CHECK(mean < 0.01 && mean_f < 0.01);
+    CHECK(worst > 0 && worst < 0.08 && worst_f < 0.75 * worst);
+    printf("  moving sphere, grid hider vs ray tracing: 2 segments: means %.2f%%, worst 16 x 16 "
+           "tile %.2f%%; 4 segments: %.2f%%, %.2f%%\n",
+           100 * mean, 100 * worst, 100 * mean_f, 100 * worst_f);
+    const RayesStat *pa = rayes_stats_find(sa, "shading_points/by_depth");
+    const RayesStat *pb = rayes_stats_find(sb, "shading_points/by_depth");
+    CHECK(pa && pb && pa->n_counts > 0 && pb->n_counts > 0);
+    if (pa && pb && pa->n_counts > 0 && pb->n_counts > 0) {
+        CHECK(pa->counts[0] * 2 < pb->counts[0]);
+        printf("  depth-0 shading points: grid hider %llu, ray tracing %llu\n",
+               (unsigned long long)pa->counts[0], (unsigned long long)pb->counts[0]);
+    }
+    rayes_stats_free(sa);
+    rayes_stats_free(sb);
+    RayesImage *c = hider_sphere(RAYES_HIDER_GRID, 1, 0, NULL);
+    CHECK(a && c && memcmp(a->rgba, c->rgba, 4 * sizeof *a->rgba * W * W) == 0);
+    rayes_image_free(a);
+    rayes_image_free(b);
+    rayes_image_free(af);
+    rayes_image_free(bf);
+    rayes_image_free(c);
+}
+
 TEST_MAIN(TEST(test_moving_hits), TEST(test_moving_sphere_coverage),
-          TEST(test_moving_points_and_curves), TEST(test_motionfactor),
+          TEST(test_moving_points_and_curves),
+          TEST(test_deforming_points_and_curves), TEST(test_moving_light_shadow),
+          TEST(test_moving_light_cached), TEST(test_grid_hider_motion), TEST(test_motionfactor),
           TEST(test_cached_segments_match_uncached), TEST(test_motion_determinism),
           TEST(test_deformation_equals_transform), TEST(test_bad_motion), TEST(test_camera_motion))
