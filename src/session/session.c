@@ -208,7 +208,7 @@ RenderSettings session_settings(const RayesRenderOptions *o)
         .subsurface_rays = o->subsurface_rays,
         .irradiance_shadow_rays = o->irradiance_shadow_rays > 0
                                       ? o->irradiance_shadow_rays
-                                      : RY_MAX(o->shadow_rays, RENDER_IRRADIANCE_SHADOW_RAYS),
+                                      : RENDER_IRRADIANCE_SHADOW_RAYS,
         .volume_step = o->volume_step,
         .tile_done = o->tile_done,
         .tile_user = o->tile_user,
