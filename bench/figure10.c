@@ -16,12 +16,14 @@
  *
  *   figure10 [--size 256] [--final-size 192] [--spp 16] [--threads 2] [--mb 20]
  *            [--coat 1] [--floor 1] [--data DIR] [--out DIR] [--only preview|final]
- *            [--medium marble] [--profile dipole] [--images-only 0]
+ *            [--medium marble] [--profile dipole] [--images-only 0] [--alone 1]
  *
  * --coat 0 takes the specular coat off (Ks 0), --floor 0 the floor: what
  * caching cannot speed up shrinks to the camera rays and the subsurface
- * rays themselves. --medium (a preset: skin1,
- * ketchup, ...) and --profile (burley) change the material;
+ * rays themselves. Unless --alone 0 (or the floor and coat are already
+ * off), the run ends with that second row: both qualities again on the
+ * teapot alone, images DIR/figure10-QUALITY-alone-*.png. --medium (a
+ * preset: skin1, ketchup, ...) and --profile (burley) change the material;
  * --images-only 1 renders the cached images alone (no timing).
  *
  * Prints, per quality: subsurface rays, shadow rays, irradiance shading
@@ -45,7 +47,7 @@
 #include "rayes/rayes.h"
 
 typedef struct Args {
-    int size, final_size, spp, threads, coat, images_only, floor, resolution, irr_rays;
+    int size, final_size, spp, threads, coat, images_only, floor, resolution, irr_rays, alone;
     double mb;
     const char *data, *out, *only, *medium, *profile;
 } Args;
@@ -67,7 +69,7 @@ static int parse_int(const char *s, int lo, int hi)
 
 static Args parse(int argc, char **argv)
 {
-    Args a = {256,  192,      16,      2, 1, 0, 1, -1, 0, 20.0, NULL, "out/figure10",
+    Args a = {256,  192,      16,      2, 1, 0, 1, -1, 0, 1, 20.0, NULL, "out/figure10",
               NULL, "marble", "dipole"};
     for (int i = 1; i < argc; i++) {
         const char *o = argv[i], *v = i + 1 < argc ? argv[i + 1] : NULL;
@@ -101,12 +103,14 @@ static Args parse(int argc, char **argv)
             a.medium = v;
         else if (!strcmp(o, "--profile"))
             a.profile = v;
+        else if (!strcmp(o, "--alone"))
+            a.alone = parse_int(v, 0, 1);
         else if (!strcmp(o, "--images-only"))
             a.images_only = parse_int(v, 0, 1);
         else
             die("usage: figure10 [--size N] [--final-size N] [--spp N] [--threads N] [--mb MB] "
                 "[--coat 0|1] [--floor 0|1] [--data DIR] [--out DIR] [--only preview|final] [--medium NAME] "
-                "[--profile dipole|burley] [--images-only 1]");
+                "[--profile dipole|burley] [--images-only 1] [--alone 0|1]");
         i++;
     }
     if (!a.data)
@@ -283,18 +287,17 @@ static void print_cache(const RayesStats *st)
 
 /* One quality: off and on, then the determinism renders. Returns 1 if
  * the cached image is the same with 1 thread and a 1 MB budget. */
-static int quality(RayesScene *s, const Args *a, int final)
+static int quality(RayesScene *s, const Args *a, int final, const char *q)
 {
-    const char *q = final ? "final" : "preview";
     Run off = run(s, a, final, 0, a->threads, a->mb), on = run(s, a, final, 1, a->threads, a->mb);
     Run one = run(s, a, final, 1, 1, a->mb), tiny = run(s, a, final, 1, a->threads, 1.0);
     size_t n = (size_t)on.img->width * on.img->height, bytes = n * 4 * sizeof(float);
     int same_threads = memcmp(on.img->rgba, one.img->rgba, bytes) == 0;
     int same_budget = memcmp(on.img->rgba, tiny.img->rgba, bytes) == 0;
     printf("\n%s: %d x %d, %d spp, %d shadow and %d subsurface rays, %d threads, irradiance "
-           "budget %g MB\n",
+           "budget %g MB, floor %s, coat %s\n",
            q, on.img->width, on.img->height, a->spp, final ? 64 : 4, final ? 64 : 4, a->threads,
-           a->mb);
+           a->mb, a->floor ? "on" : "off", a->coat ? "on" : "off");
     printf("%-10s %14s %14s %14s %10s %10s\n", "irradiance", "subsurface", "shadow rays",
            "irr. points", "render s", "cpu s");
     const Run *rows[2] = {&off, &on};
@@ -369,10 +372,24 @@ int main(int argc, char **argv)
         return 0;
     }
     if (!a.only || !strcmp(a.only, "preview"))
-        ok &= quality(s, &a, 0);
+        ok &= quality(s, &a, 0, "preview");
     if (!a.only || !strcmp(a.only, "final"))
-        ok &= quality(s, &a, 1);
-    printf("images in %s\n", a.out);
+        ok &= quality(s, &a, 1, "final");
     rayes_scene_release(s);
+    if (a.alone && (a.floor || a.coat)) {
+        /* The second row: the translucent object alone (the memo's Figure
+         * 10 is a candle face), without what caching cannot touch, the
+         * floor's direct lighting and the coat's highlights. */
+        Args b = a;
+        b.floor = b.coat = 0;
+        s = scene(&b);
+        printf("\nthe teapot alone (no floor, no coat):\n");
+        if (!a.only || !strcmp(a.only, "preview"))
+            ok &= quality(s, &b, 0, "preview-alone");
+        if (!a.only || !strcmp(a.only, "final"))
+            ok &= quality(s, &b, 1, "final-alone");
+        rayes_scene_release(s);
+    }
+    printf("images in %s\n", a.out);
     return ok ? 0 : 1;
 }

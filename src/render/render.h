@@ -26,8 +26,8 @@
 #include "util/vec.h"
 
 #define RENDER_MAX_DEPTH 16 /* diffuse depths counted separately in statistics */
-/* The least shadow rays per light at irradiance cache fills (memo 6.2;
- * DESIGN.md, subsurface scattering). */
+/* The shadow rays per light at irradiance cache fills by default, in
+ * every quality (memo 6.2; DESIGN.md, subsurface scattering). */
 #define RENDER_IRRADIANCE_SHADOW_RAYS 16
 
 typedef struct RenderObject {
@@ -127,8 +127,8 @@ typedef struct RenderSettings {
     int irradiance_cache;    /* 1: subsurface rays read irradiance from cache (memo 6.2) */
     int subsurface_rays;     /* subsurface rays per shading point (the service's 0) */
     int irradiance_shadow_rays; /* shadow rays per light at irradiance cache fills' points
-                                   (the shader's 0): the option, or max(shadow_rays,
-                                   RENDER_IRRADIANCE_SHADOW_RAYS) */
+                                   (the shader's 0): the option, or
+                                   RENDER_IRRADIANCE_SHADOW_RAYS */
     float volume_step;       /* ray marching steps, in fine voxels of each volume */
     int cache_resolution;    /* -1: by differentials; else a forced CacheLevel */
     float cache_k;           /* resolution rule constant (DESIGN.md) */

@@ -216,7 +216,7 @@ RenderSettings session_settings(const RayesRenderOptions *o)
         .subsurface_rays = o->subsurface_rays,
         .irradiance_shadow_rays = o->irradiance_shadow_rays > 0
                                       ? o->irradiance_shadow_rays
-                                      : RY_MAX(o->shadow_rays, RENDER_IRRADIANCE_SHADOW_RAYS),
+                                      : RENDER_IRRADIANCE_SHADOW_RAYS,
         .volume_step = o->volume_step,
         .max_spp = o->max_spp,
         .adaptive_error = o->adaptive_error,

@@ -56,11 +56,13 @@ void diffusion_channel(const RayesSubsurfaceParams *p, int c, DiffusionChannel *
     ch->zr = 1.0f / st;
     ch->zv = ch->zr * (1.0f + 4.0f / 3.0f * diffusion_A(eta));
     ch->Rd = diffusion_total_reflectance(ch->alpha, eta);
-    /* Burley's fit of s for the diffuse mean free path 1 / sigma_tr
-     * (Christensen and Burley 2015, eq. 5), given the dipole's albedo: the
-     * same total reflectance and the same reach as the dipole's. */
-    float a = fabsf(ch->Rd - 0.8f);
-    ch->d = 1.0f / (ch->sigma_tr * (1.85f - ch->Rd + 7.0f * a * a * a));
+    /* Burley's d = l / s for the diffuse mean free path l = 1 / sigma_tr,
+     * with the paper's fit of s for that length, s = 3.5 + 100 (A - 0.33)^4
+     * (Christensen and Burley 2015, section 5; the searchlight fit
+     * 1.85 - A + 7 |A - 0.8|^3 is for the mean free path 1 / sigma_t), and
+     * A the dipole's total reflectance: the same total as the dipole. */
+    float a = ch->Rd - 0.33f;
+    ch->d = 1.0f / (ch->sigma_tr * (3.5f + 100.0f * a * a * a * a));
 }
 
 /* Jensen 2001, eq. 4: the real source at depth zr and the virtual one at

@@ -382,7 +382,7 @@ static void test_irradiance_fills_take_their_own_shadow_rays(void)
     RayesImage *a = area_render(s, 2, 1, 0, &def), *b = area_render(s, 2, 1, 4, &four),
                *c = area_render(s, 2, 1, 64, &sixty), *d = area_render(s, 1, 1, 0, &one),
                *e = area_render(s, 2, 0, 4, &u4), *f = area_render(s, 2, 0, 64, &u64);
-    /* the default is max(shadow rays, 16) */
+    /* the default is 16, here more than the camera's 4 */
     CHECK(stat(def, "irradiance_shadow_rays") == 16 && stat(four, "irradiance_shadow_rays") == 4);
     /* the same fills, more shadow rays at each of their points; the
      * camera hits' rays are the same */
@@ -401,6 +401,18 @@ static void test_irradiance_fills_take_their_own_shadow_rays(void)
         CHECK(memcmp(a->rgba, b->rgba, bytes) != 0);
         CHECK(memcmp(e->rgba, f->rgba, bytes) == 0);
     }
+    /* and 16 in final too, fewer than the camera's 64 (DESIGN.md) */
+    RayesRenderOptions o;
+    rayes_render_options_init(&o, RAYES_QUALITY_FINAL);
+    o.width = o.height = 16;
+    o.spp = 1;
+    o.bounces = 0;
+    RayesImage *fin = NULL;
+    RayesStats *fst = NULL;
+    CHECK(rayes_render(s, &o, &fin, &fst) == RAYES_OK);
+    CHECK(stat(fst, "shadow_rays") == 64 && stat(fst, "irradiance_shadow_rays") == 16);
+    rayes_image_free(fin);
+    rayes_stats_free(fst);
     RayesImage *imgs[6] = {a, b, c, d, e, f};
     RayesStats *sts[6] = {def, four, sixty, one, u4, u64};
     for (int k = 0; k < 6; k++) {

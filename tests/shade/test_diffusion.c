@@ -2,7 +2,8 @@
  * Diffusion profiles (shade/diffusion.h, memo 6.2) against analytic
  * answers: the dipole's integral over the plane is Jensen 2001's closed
  * form of the total diffuse reflectance (computed here on its own) for
- * every measured medium; Burley's profile integrates to the same Rd; the
+ * every measured medium; Burley's profile is the paper's closed form for
+ * the diffuse mean free path and integrates to the same Rd; the
  * conversions from RenderMan's albedo and diffuse mean free path and from
  * pbrt's reflectance and mean free path give back what they were given;
  * the 4 pi / N area estimate of rays cast from points inside a sphere sums
@@ -68,6 +69,34 @@ static void test_burley_integrates_to_the_same_rd(void)
     }
 }
 
+/* Burley's profile is the paper's closed form, written here from
+ * Christensen and Burley 2015 (eq. 2 with their fit of s for the diffuse
+ * mean free path, section 5), with A the dipole's Rd and l = 1 / sigma_tr:
+ * R(r) = A s (e^{-s r / l} + e^{-s r / 3l}) / (8 pi l r), s = 3.5 + 100
+ * (A - 0.33)^4. */
+static void test_burley_is_the_papers_dmfp_fit(void)
+{
+    static const char *const media[4] = {"marble", "skin1", "ketchup", "cream"};
+    for (int i = 0; i < 4; i++) {
+        RayesSubsurfaceParams p = {.eta = 1.3f, .scale = 1.0f, .profile = RAYES_SUBSURFACE_BURLEY};
+        CHECK(diffusion_preset(media[i], p.sigma_s, p.sigma_a) == 0);
+        for (int c = 0; c < 3; c++) {
+            DiffusionChannel ch;
+            diffusion_channel(&p, c, &ch);
+            double st = (double)p.sigma_s[c] + p.sigma_a[c];
+            double A = closed_form(p.sigma_s[c] / st, 1.3), l = 1.0 / sqrt(3.0 * p.sigma_a[c] * st);
+            double sc = 3.5 + 100.0 * pow(A - 0.33, 4.0);
+            for (int k = 0; k < 5; k++) {
+                double r = l * (0.05 + 0.6 * k);
+                double want = A * sc * (exp(-sc * r / l) + exp(-sc * r / (3.0 * l))) /
+                              (8.0 * M_PI * l * r);
+                /* float against double: A (1e-4) enters s, amplified by s r / l */
+                CHECK_NEAR(diffusion_profile(&ch, (float)r), want, 5e-3 * want);
+            }
+        }
+    }
+}
+
 static void test_conversions_round_trip(void)
 {
     const float Rd[3] = {0.1f, 0.5f, 0.85f}, len[3] = {0.2f, 1.0f, 7.0f};
@@ -127,5 +156,6 @@ static void test_presets_by_name(void)
 }
 
 TEST_MAIN(TEST(test_dipole_integrates_to_closed_form_rd),
-          TEST(test_burley_integrates_to_the_same_rd), TEST(test_conversions_round_trip),
+          TEST(test_burley_integrates_to_the_same_rd), TEST(test_burley_is_the_papers_dmfp_fit),
+          TEST(test_conversions_round_trip),
           TEST(test_area_estimate_integrates_a_sphere), TEST(test_presets_by_name))
