@@ -15,7 +15,9 @@
 #include "cache/cache.h"
 #include "geom/geom.h"
 #include "rayes/rayes.h"
+#include "render/pbgi.h"
 #include "render/render.h"
+#include "render/services.h"
 #include "render/volume.h"
 #include "scene/scene.h"
 #include "session/session.h"
@@ -75,6 +77,8 @@ void rayes_render_options_init(RayesRenderOptions *o, RayesQuality quality)
     o->irradiance_cache = 1;
     o->irradiance_cache_mb = 20.0;
     o->subsurface_rays = quality == RAYES_QUALITY_PREVIEW ? 4 : 64;
+    o->pbgi_max_solid_angle = 0.05f;
+    o->pbgi_raster = 8;
     switch (quality) {
     case RAYES_QUALITY_PREVIEW:
         o->shadow_rays = o->shadow_rays_deep = 4;
@@ -123,6 +127,11 @@ RayesError session_check_options(RayesScene *scene, const RayesRenderOptions *o)
     else if (!(o->filter_width > 0.0f) || o->filter_width > 16.0f ||
              (int)o->filter < RAYES_FILTER_BOX || o->filter > RAYES_FILTER_LANCZOS)
         what = "options: filter width must be in (0, 16]";
+    else if ((o->gi != RAYES_GI_RAYTRACE && o->gi != RAYES_GI_POINTBASED) ||
+             !(o->pbgi_max_solid_angle > 0.0f) || o->pbgi_max_solid_angle > 12.57f ||
+             o->pbgi_raster < 2 || o->pbgi_raster > 64 || o->pbgi_raster % 2)
+        what = "options: gi must be RAYES_GI_RAYTRACE or RAYES_GI_POINTBASED, the point-based "
+               "solid angle in (0, 12.57] and its raster even, 2 to 64";
     else if (o->hider != RAYES_HIDER_RAYTRACE && o->hider != RAYES_HIDER_GRID)
         what = "options: hider must be RAYES_HIDER_RAYTRACE or RAYES_HIDER_GRID";
     else if (o->tile_size < 1 || o->threads < 0 || o->threads > 1024)
@@ -210,6 +219,8 @@ RenderSettings session_settings(const RayesRenderOptions *o)
                                       ? o->irradiance_shadow_rays
                                       : RY_MAX(o->shadow_rays, RENDER_IRRADIANCE_SHADOW_RAYS),
         .volume_step = o->volume_step,
+        .pbgi_max_solid_angle = o->pbgi_max_solid_angle,
+        .pbgi_raster = o->pbgi_raster,
         .tile_done = o->tile_done,
         .tile_user = o->tile_user,
         .tile_source = o->tile_source,
@@ -428,6 +439,24 @@ RenderScene session_render_scene(const RayesScene *scene, const Prepared *p, int
     };
 }
 
+/* Point-based GI's passes 1 and 2 (render/pbgi.h): the cloud into *cloud
+ * (owned by the caller) and set->pbgi, written to opt->pointcloud_out if
+ * given. */
+static RayesError session_point_cloud(RayesScene *scene, const RayesRenderOptions *opt,
+                                      const RenderScene *rs, RenderSettings *set,
+                                      RenderStats *stats, PbgiCloud **cloud, PbgiTimes *times)
+{
+    *cloud = pbgi_build(rs, set, &render_services, stats, times);
+    if (!*cloud)
+        return session_fail(scene, RAYES_ERROR_OUT_OF_MEMORY,
+                            "render: out of memory for the point cloud");
+    set->pbgi = *cloud;
+    char err[400];
+    if (opt->pointcloud_out && pbgi_write_ply(*cloud, opt->pointcloud_out, err, sizeof err) != 0)
+        return session_fail(scene, RAYES_ERROR_IO, err);
+    return RAYES_OK;
+}
+
 RayesError rayes_render(RayesScene *scene, const RayesRenderOptions *opt, RayesImage **image,
                         RayesStats **stats_out)
 {
@@ -451,6 +480,8 @@ RayesError rayes_render(RayesScene *scene, const RayesRenderOptions *opt, RayesI
     Cache *cache = NULL;
     TextureSystem *textures = session_textures(scene, opt->texture_mb, opt->texture_width);
     RenderStats rstats = {0};
+    PbgiCloud *cloud = NULL;
+    PbgiTimes pbgi_times = {0};
     set.textures = textures;
     if (!img || !rgba || !textures) {
         e = session_fail(scene, RAYES_ERROR_OUT_OF_MEMORY, "render: out of memory");
@@ -470,13 +501,19 @@ RayesError rayes_render(RayesScene *scene, const RayesRenderOptions *opt, RayesI
     }
     double t1 = time_now();
     RenderScene rs = session_render_scene(scene, &prep, set.width, set.height);
+    if (opt->gi == RAYES_GI_POINTBASED) {
+        e = session_point_cloud(scene, opt, &rs, &set, &rstats, &cloud, &pbgi_times);
+        if (e != RAYES_OK)
+            goto done;
+    }
+    double t1b = time_now();
     if (render_frame(&rs, &set, rgba, &rstats) != 0) {
         e = session_fail(scene, RAYES_ERROR_CANCELLED, "render: cancelled");
         goto done;
     }
     double t2 = time_now();
     if (stats_out) {
-        SessionTimes times = {t2 - t0, t1 - t0, t2 - t1};
+        SessionTimes times = {t2 - t0, t1 - t0, t2 - t1b};
         *stats_out = session_stats_new(&set, &rstats, &prep.gs, &times,
                                        accel_memory_bytes(prep.accel));
         if (*stats_out && cache) {
@@ -489,6 +526,14 @@ RayesError rayes_render(RayesScene *scene, const RayesRenderOptions *opt, RayesI
             texture_get_stats(textures, &ts);
             session_stats_add_textures(*stats_out, &ts);
             session_stats_add_real(*stats_out, "dicing/coarsened", prep.coarsened);
+        }
+        if (*stats_out && cloud) {
+            session_stats_add_count(*stats_out, "pbgi/points", cloud->n_disks);
+            session_stats_add_count(*stats_out, "pbgi/nodes", cloud->n_nodes);
+            session_stats_add_count(*stats_out, "pbgi/gathers", rstats.pbgi_gathers);
+            session_stats_add_real(*stats_out, "time/pbgi_cloud_s", pbgi_times.cloud_s);
+            session_stats_add_real(*stats_out, "time/pbgi_bounces_s", pbgi_times.bounces_s);
+            session_stats_add_real(*stats_out, "time/pbgi_octree_s", pbgi_times.octree_s);
         }
         if (!*stats_out) {
             e = session_fail(scene, RAYES_ERROR_OUT_OF_MEMORY,
@@ -507,6 +552,7 @@ RayesError rayes_render(RayesScene *scene, const RayesRenderOptions *opt, RayesI
     img = NULL;
     rgba = NULL;
 done:
+    pbgi_cloud_free(cloud);
     cache_free(cache);
     session_prepared_fini(&prep);
     texture_system_free(textures);
