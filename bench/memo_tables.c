@@ -10,6 +10,7 @@
  *   memo_tables table4 [...same...] [--budgets MB,MB,...]
  *   memo_tables table2 [...same...] [--uncached-max B]
  *   memo_tables figure5 [--size N] [--spp N] [--out DIR] [--data DIR] [--scene S]
+ *                       [--pbgi-solid-angle SR] [--pbgi-raster N]
  *   memo_tables figure8 [--size N] [--spp N] [--threads N] [--shadow-rays N]
  *                       [--ao-samples N] [--check-size N] [--experiment a|b|ab] [--out DIR]
  *                       [--repeat N] [--only off|on]
@@ -22,8 +23,11 @@
  * 1: an uncached row costs 64 times the one before). No accuracy pass:
  * bench/figure5 measures final against a reference.
  * figure5: reference (4096 diffuse rays, nothing cached), preview and final
- * images at one bounce, the relative RMSE and mean relative error of preview
- * and final against the reference, 20x difference images, and times.
+ * images at one bounce, and point-based GI (the final preset's lighting
+ * and grid hider, indirect diffuse gathered from a point cloud: memo 5.3),
+ * the relative RMSE and mean relative error of each against the reference,
+ * 20x difference images, times (point-based: of each pass) and the point
+ * count.
  * Both then measure bias: the same rows at --accuracy-spp pixel samples
  * (default 64) and --accuracy-size pixels (default: --size, the table's own), the
  * relative difference of the cached and uncached image means and the
@@ -69,6 +73,9 @@ typedef struct Args {
     int repeat;                   /* figure8: renders of each mode; the shortest counts */
     int only;                     /* figure8: -1 both; 0 or 1 one render, opacity caching
                                      off or on (for a profiler), nothing compared */
+    int gi;                       /* RayesGi of the rows */
+    float pbgi_solid_angle;       /* figure5: point-based GI's knobs */
+    int pbgi_raster;
 } Args;
 
 typedef struct Row {
@@ -80,6 +87,8 @@ typedef struct Row {
     unsigned long long shading_points, rays, shadow, diffuse, records;
     unsigned long long grids, grid_vertices, grid_size;
     double hit[3];
+    unsigned long long pbgi_points;       /* point-based GI: disks in the point cloud */
+    double pbgi_cloud_s, pbgi_bounces_s, pbgi_octree_s, render_s; /* its passes, wall */
     unsigned long long opacity_points;   /* opacity() shading points (shadow-ray hits, or
                                             the points of the grids the cache filled) */
     unsigned long long transparent_hits; /* surfaces shadow rays passed through */
@@ -139,6 +148,9 @@ static Row run(const Args *a, int size, int spp, int bounces, int cache, double 
      * isotropic dicing makes (17,158 and 3.61 M); rayes's raster-oriented
      * default makes 8,113 and 1.71 M (--dice-raster). */
     o.dice_isotropic = !a->dice_raster;
+    o.gi = (RayesGi)a->gi;
+    o.pbgi_max_solid_angle = a->pbgi_solid_angle;
+    o.pbgi_raster = a->pbgi_raster;
     Row r = {.bounces = bounces, .cache = cache, .budget_mb = budget_mb};
     measure(scene, &o, &r);
     rayes_scene_release(scene);
@@ -171,6 +183,14 @@ static void measure(RayesScene *scene, const RayesRenderOptions *o, Row *r_out)
         r.hit[l] = cache ? find(st, hr[l])->real : 0.0;
     const RayesStat *rec = rayes_stats_find(st, "irradiance/records");
     r.records = rec ? rec->count : 0;
+    const RayesStat *pts = rayes_stats_find(st, "pbgi/points");
+    r.pbgi_points = pts ? pts->count : 0;
+    if (pts) {
+        r.pbgi_cloud_s = find(st, "time/pbgi_cloud_s")->real;
+        r.pbgi_bounces_s = find(st, "time/pbgi_bounces_s")->real;
+        r.pbgi_octree_s = find(st, "time/pbgi_octree_s")->real;
+    }
+    r.render_s = find(st, "time/render_s")->real;
     r.rgba = img->rgba;
     r.w = img->width;
     r.h = img->height;
@@ -259,6 +279,8 @@ static void parse(int argc, char **argv, Args *a)
     a->experiment = "ab";
     a->only = -1;
     a->repeat = 2;
+    a->pbgi_solid_angle = 0.05f;
+    a->pbgi_raster = 8;
     const double budgets[] = {0, 1, 4, 16, 64, 256};
     a->n_budgets = 6;
     memcpy(a->budgets, budgets, sizeof budgets);
@@ -300,6 +322,10 @@ static void parse(int argc, char **argv, Args *a)
             a->only = strcmp(v, "on") == 0 ? 1 : strcmp(v, "off") == 0 ? 0 : -2;
         else if (strcmp(o, "--experiment") == 0)
             a->experiment = v;
+        else if (strcmp(o, "--pbgi-solid-angle") == 0)
+            a->pbgi_solid_angle = (float)atof(v);
+        else if (strcmp(o, "--pbgi-raster") == 0)
+            a->pbgi_raster = atoi(v);
         else if (strcmp(o, "--uncached-max") == 0)
             a->uncached_max = atoi(v);
         else if (strcmp(o, "--budgets") == 0) {
@@ -473,25 +499,28 @@ static void against(const Args *a, const Row *r, const Row *ref, const char *tag
     free(diff);
 }
 
-/* The memo's Figure 5 (bottom row): preview and final images against a
- * reference of 4096 diffuse rays per shading point and no caching of any
- * kind, one bounce, with 20x difference images. */
+/* The memo's Figure 5: preview and final images (its bottom row) and
+ * point-based GI (its top row) against a reference of 4096 diffuse rays
+ * per shading point and no caching of any kind, one bounce, with 20x
+ * difference images. */
 static void figure5(Args *a, FILE *j)
 {
     static const struct {
         const char *tag;
-        int quality;
-    } rows[3] = {{"reference", RAYES_QUALITY_REFERENCE},
-                 {"preview", RAYES_QUALITY_PREVIEW},
-                 {"final", RAYES_QUALITY_FINAL}};
+        int quality, gi;
+    } rows[4] = {{"reference", RAYES_QUALITY_REFERENCE, RAYES_GI_RAYTRACE},
+                 {"preview", RAYES_QUALITY_PREVIEW, RAYES_GI_RAYTRACE},
+                 {"final", RAYES_QUALITY_FINAL, RAYES_GI_RAYTRACE},
+                 {"pointbased", RAYES_QUALITY_FINAL, RAYES_GI_POINTBASED}};
     printf("Figure 5 (%s, 1 bounce, %dx%d, %d spp): against the reference\n", a->scene, a->size,
            a->size, a->spp);
-    printf("%-9s | %9s %9s %8s %8s | %10s %10s | %10s %10s | %s\n", "image", "sh.pts", "rays",
+    printf("%-10s | %9s %9s %8s %8s | %10s %10s | %10s %10s | %s\n", "image", "sh.pts", "rays",
            "time", "cpu", "rel. RMSE", "mean rel.", "(display)", "(display)", "time / reference");
     fprintf(j, "{\"figure\": 5, \"size\": %d, \"spp\": %d, \"rows\": [", a->size, a->spp);
     Row ref = {0};
-    for (int i = 0; i < 3; i++) {
+    for (int i = 0; i < 4; i++) {
         a->quality = rows[i].quality;
+        a->gi = rows[i].gi;
         Row r = run(a, a->size, a->spp, 1, rows[i].quality != RAYES_QUALITY_REFERENCE, 100);
         char path[1024], err[1024], s1[32], s2[32];
         snprintf(path, sizeof path, "%s/figure5-%s.png", a->out, rows[i].tag);
@@ -504,20 +533,27 @@ static void figure5(Args *a, FILE *j)
             against(a, &r, &ref, rows[i].tag, 0, 1, &rmse, &mrel);
             against(a, &r, &ref, rows[i].tag, 1, 0, &drmse, &dmrel);
         }
-        printf("%-9s | %9s %9s %7.1fs %7.1fs |", rows[i].tag, s1, s2, r.time_s, r.cpu_s);
+        printf("%-10s | %9s %9s %7.1fs %7.1fs |", rows[i].tag, s1, s2, r.time_s, r.cpu_s);
         if (i > 0)
             printf(" %9.2f%% %9.2f%% | %9.2f%% %9.2f%% | %.3f (cpu %.3f)\n", 100 * rmse,
                    100 * mrel, 100 * drmse, 100 * dmrel, r.time_s / ref.time_s,
                    r.cpu_s / ref.cpu_s);
         else
             printf(" %10s %10s | %10s %10s |\n", "-", "-", "-", "-");
+        if (r.pbgi_points)
+            printf("    point cloud: %llu points, pass 1 (shading the cloud) %.2fs, octree %.2fs, "
+                   "pass 2 (bounces) %.2fs, render %.1fs\n",
+                   r.pbgi_points, r.pbgi_cloud_s, r.pbgi_octree_s, r.pbgi_bounces_s, r.render_s);
         fflush(stdout);
         fprintf(j,
                 "%s\n    {\"image\": \"%s\", \"time_s\": %.3f, \"cpu_s\": %.3f, "
                 "\"shading_points\": %llu, \"rays\": %llu, \"rel_rmse\": %.6f, "
-                "\"mean_rel\": %.6f, \"display_rel_rmse\": %.6f, \"display_mean_rel\": %.6f}",
+                "\"mean_rel\": %.6f, \"display_rel_rmse\": %.6f, \"display_mean_rel\": %.6f, "
+                "\"render_s\": %.3f, \"pbgi_points\": %llu, \"pbgi_cloud_s\": %.3f, "
+                "\"pbgi_octree_s\": %.3f, \"pbgi_bounces_s\": %.3f}",
                 i ? "," : "", rows[i].tag, r.time_s, r.cpu_s, r.shading_points, r.rays, rmse, mrel,
-                drmse, dmrel);
+                drmse, dmrel, r.render_s, r.pbgi_points, r.pbgi_cloud_s, r.pbgi_octree_s,
+                r.pbgi_bounces_s);
         if (i == 0)
             ref = r;
         else

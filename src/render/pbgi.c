@@ -69,7 +69,7 @@ static int sh_band(int k)
     return k == 0 ? 0 : k < 4 ? 1 : 2;
 }
 
-static void node_add_disk(PbgiNode *n, const PbgiDisk *d)
+static void node_add_disk(PbgiCluster *n, const PbgiDisk *d)
 {
     static const float clamped[3] = {(float)M_PI, 2.0f * (float)M_PI / 3.0f, (float)M_PI / 4.0f};
     float y[PBGI_SH];
@@ -79,6 +79,15 @@ static void node_add_disk(PbgiNode *n, const PbgiDisk *d)
         for (int c = 0; c < 3; c++)
             n->power[k][c] += p * d->L[c];
         n->area[k] += d->area * clamped[sh_band(k)] * y[k];
+    }
+}
+
+static void cluster_add(PbgiCluster *into, const PbgiCluster *ch)
+{
+    for (int q = 0; q < PBGI_SH; q++) {
+        for (int col = 0; col < 3; col++)
+            into->power[q][col] += ch->power[q][col];
+        into->area[q] += ch->area[q];
     }
 }
 
@@ -103,15 +112,19 @@ static size_t new_nodes(Build *b, size_t n)
     if (c->n_nodes + n > b->cap_nodes) {
         size_t cap = RY_MAX(2 * b->cap_nodes, c->n_nodes + n);
         PbgiNode *nodes = realloc(c->nodes, cap * sizeof *nodes);
-        if (!nodes) {
+        if (nodes)
+            c->nodes = nodes;
+        PbgiCluster *cl = nodes ? realloc(c->clusters, cap * sizeof *cl) : NULL;
+        if (!cl) {
             b->failed = 1;
             return (size_t)-1;
         }
-        c->nodes = nodes;
+        c->clusters = cl;
         b->cap_nodes = cap;
     }
     size_t first = c->n_nodes;
     memset(&c->nodes[first], 0, n * sizeof *c->nodes);
+    memset(&c->clusters[first], 0, n * sizeof *c->clusters);
     c->n_nodes += n;
     return first;
 }
@@ -135,7 +148,7 @@ static void build_node(Build *b, size_t at, size_t lo, size_t hi, int depth)
         float r = 0.0f;
         for (size_t i = lo; i < lo + n->count; i++) {
             const PbgiDisk *d = &c->disks[i];
-            node_add_disk(n, d);
+            node_add_disk(&c->clusters[at], d);
             r = fmaxf(r, v3_length(v3_sub(v3_load(d->P), mid)) + sqrtf(d->area / (float)M_PI));
         }
         n->r = r;
@@ -175,13 +188,8 @@ static void build_node(Build *b, size_t at, size_t lo, size_t hi, int depth)
     n = &c->nodes[at];
     float r = 0.0f;
     for (size_t j = first; j < first + (size_t)children; j++) {
-        const PbgiNode *ch = &c->nodes[j];
-        for (int q = 0; q < PBGI_SH; q++) {
-            for (int col = 0; col < 3; col++)
-                n->power[q][col] += ch->power[q][col];
-            n->area[q] += ch->area[q];
-        }
-        r = fmaxf(r, v3_length(v3_sub(v3_load(ch->c), mid)) + ch->r);
+        cluster_add(&c->clusters[at], &c->clusters[j]);
+        r = fmaxf(r, v3_length(v3_sub(v3_load(c->nodes[j].c), mid)) + c->nodes[j].r);
     }
     n->r = r;
 }
@@ -189,22 +197,16 @@ static void build_node(Build *b, size_t at, size_t lo, size_t hi, int depth)
 /* The harmonics of node `at` and below from its disks' radiosities. */
 static void relight_node(PbgiCloud *c, size_t at)
 {
-    PbgiNode *n = &c->nodes[at];
-    memset(n->power, 0, sizeof n->power);
-    memset(n->area, 0, sizeof n->area);
+    const PbgiNode *n = &c->nodes[at];
+    memset(&c->clusters[at], 0, sizeof c->clusters[at]);
     if (n->leaf) {
         for (size_t i = n->first; i < n->first + n->count; i++)
-            node_add_disk(n, &c->disks[i]);
+            node_add_disk(&c->clusters[at], &c->disks[i]);
         return;
     }
     for (size_t j = n->first; j < n->first + n->count; j++) {
         relight_node(c, j);
-        const PbgiNode *ch = &c->nodes[j];
-        for (int q = 0; q < PBGI_SH; q++) {
-            for (int col = 0; col < 3; col++)
-                n->power[q][col] += ch->power[q][col];
-            n->area[q] += ch->area[q];
-        }
+        cluster_add(&c->clusters[at], &c->clusters[j]);
     }
 }
 
@@ -352,6 +354,7 @@ void pbgi_cloud_free(PbgiCloud *c)
     free(c->disks);
     free(c->perm);
     free(c->nodes);
+    free(c->clusters);
     free(c->pix_of);
     free(c->pix_dir);
     free(c->pix_weight);
@@ -466,7 +469,7 @@ static void splat_disk(Gather *g, const PbgiDisk *k)
 }
 
 /* A node as one cluster, seen from P along -d. */
-static void splat_cluster(Gather *g, const PbgiNode *n, Vec3 d, float dist)
+static void splat_cluster(Gather *g, const PbgiCluster *n, Vec3 d, float dist)
 {
     float y[PBGI_SH];
     sh_eval(v3_neg(d), y); /* toward P */
@@ -488,9 +491,11 @@ static void splat_cluster(Gather *g, const PbgiNode *n, Vec3 d, float dist)
     splat(g, d, area / (dist * dist), L, g->T, 1.0f);
 }
 
-static float node_distance(const Gather *g, const PbgiNode *n)
+/* Squared distance from P: the order of the walk. */
+static float node_distance2(const Gather *g, const PbgiNode *n)
 {
-    return v3_length(v3_sub(v3_load(n->c), g->P));
+    Vec3 v = v3_sub(v3_load(n->c), g->P);
+    return v3_dot(v, v);
 }
 
 static void traverse(Gather *g, const PbgiNode *n)
@@ -503,7 +508,7 @@ static void traverse(Gather *g, const PbgiNode *n)
     if (v3_dot(v, g->N) < -n->r)
         return; /* below the horizon */
     if (dist > n->r && (float)M_PI * n->r * n->r < c->max_solid_angle * dist * dist) {
-        splat_cluster(g, n, v3_scale(v, 1.0f / dist), dist);
+        splat_cluster(g, &c->clusters[n - c->nodes], v3_scale(v, 1.0f / dist), dist);
         return;
     }
     if (n->leaf) {
@@ -516,7 +521,8 @@ static void traverse(Gather *g, const PbgiNode *n)
             return;
         }
         for (int i = 0; i < m; i++) { /* insertion sort, nearest first */
-            float k = v3_length(v3_sub(v3_load(c->disks[n->first + i].P), g->P));
+            Vec3 v = v3_sub(v3_load(c->disks[n->first + i].P), g->P);
+            float k = v3_dot(v, v);
             int j = i;
             for (; j > 0 && key[j - 1] > k; j--) {
                 key[j] = key[j - 1];
@@ -533,7 +539,7 @@ static void traverse(Gather *g, const PbgiNode *n)
     float key[8];
     int m = n->count;
     for (int i = 0; i < m; i++) {
-        float k = node_distance(g, &c->nodes[n->first + i]);
+        float k = node_distance2(g, &c->nodes[n->first + i]);
         int j = i;
         for (; j > 0 && key[j - 1] > k; j--) {
             key[j] = key[j - 1];

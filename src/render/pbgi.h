@@ -41,15 +41,21 @@ typedef struct PbgiNode {
     uint32_t first;            /* leaf: its first disk; else its first child node */
     uint16_t count;            /* leaf: disks; else children (contiguous) */
     uint8_t leaf;              /* 1: a leaf */
+} PbgiNode;
+
+/* A node's harmonics, apart from the nodes the traversal reads (24 bytes
+ * each, a cache line for three): read only where a node is a cluster. */
+typedef struct PbgiCluster {
     float power[PBGI_SH][3];   /* SH of the power toward w: sum L A max(0, N.w), RGB */
     float area[PBGI_SH];       /* SH of the projected area facing w: sum A max(0, N.w) */
-} PbgiNode;
+} PbgiCluster;
 
 typedef struct PbgiCloud {
     PbgiDisk *disks;           /* in octree order; owned */
     uint32_t *perm;            /* disk k was disk perm[k] of the order given to _new */
     size_t n_disks;
     PbgiNode *nodes;           /* nodes[0] is the root; owned */
+    PbgiCluster *clusters;     /* per node: its harmonics; owned */
     size_t n_nodes;
     float max_solid_angle;     /* a node smaller than this (steradians) is one cluster */
     int raster;                /* cube raster: raster x raster pixels a face */
