@@ -10,7 +10,7 @@
  *   memo_tables table4 [...same...] [--budgets MB,MB,...]
  *   memo_tables table2 [...same...] [--uncached-max B]
  *   memo_tables figure5 [--size N] [--spp N] [--out DIR] [--data DIR] [--scene S]
- *                       [--pbgi-solid-angle SR] [--pbgi-raster N]
+ *                       [--pbgi-solid-angle SR[,SR...]] [--pbgi-raster N]
  *   memo_tables figure8 [--size N] [--spp N] [--threads N] [--shadow-rays N]
  *                       [--ao-samples N] [--check-size N] [--experiment a|b|ab] [--out DIR]
  *                       [--repeat N] [--only off|on]
@@ -27,7 +27,7 @@
  * and grid hider, indirect diffuse gathered from a point cloud: memo 5.3),
  * the relative RMSE and mean relative error of each against the reference,
  * 20x difference images, times (point-based: of each pass) and the point
- * count.
+ * count; a point-based row for each of the --pbgi-solid-angle values.
  * Both then measure bias: the same rows at --accuracy-spp pixel samples
  * (default 64) and --accuracy-size pixels (default: --size, the table's own), the
  * relative difference of the cached and uncached image means and the
@@ -74,8 +74,10 @@ typedef struct Args {
     int only;                     /* figure8: -1 both; 0 or 1 one render, opacity caching
                                      off or on (for a profiler), nothing compared */
     int gi;                       /* RayesGi of the rows */
-    float pbgi_solid_angle;       /* figure5: point-based GI's knobs */
+    float pbgi_solid_angle;       /* figure5: point-based GI's knobs (the row's) */
     int pbgi_raster;
+    float pbgi_solid_angles[8];   /* figure5: a point-based row for each */
+    int n_pbgi;
 } Args;
 
 typedef struct Row {
@@ -280,6 +282,8 @@ static void parse(int argc, char **argv, Args *a)
     a->only = -1;
     a->repeat = 2;
     a->pbgi_solid_angle = 0.05f;
+    a->pbgi_solid_angles[0] = 0.05f;
+    a->n_pbgi = 1;
     a->pbgi_raster = 8;
     const double budgets[] = {0, 1, 4, 16, 64, 256};
     a->n_budgets = 6;
@@ -322,8 +326,11 @@ static void parse(int argc, char **argv, Args *a)
             a->only = strcmp(v, "on") == 0 ? 1 : strcmp(v, "off") == 0 ? 0 : -2;
         else if (strcmp(o, "--experiment") == 0)
             a->experiment = v;
-        else if (strcmp(o, "--pbgi-solid-angle") == 0)
-            a->pbgi_solid_angle = (float)atof(v);
+        else if (strcmp(o, "--pbgi-solid-angle") == 0) {
+            a->n_pbgi = 0;
+            for (char *p = (char *)v; *p && a->n_pbgi < 8; p += strcspn(p, ",") + (p[strcspn(p, ",")] != 0))
+                a->pbgi_solid_angles[a->n_pbgi++] = (float)atof(p);
+        }
         else if (strcmp(o, "--pbgi-raster") == 0)
             a->pbgi_raster = atoi(v);
         else if (strcmp(o, "--uncached-max") == 0)
@@ -505,22 +512,34 @@ static void against(const Args *a, const Row *r, const Row *ref, const char *tag
  * difference images. */
 static void figure5(Args *a, FILE *j)
 {
-    static const struct {
-        const char *tag;
+    struct {
+        char tag[32];
         int quality, gi;
-    } rows[4] = {{"reference", RAYES_QUALITY_REFERENCE, RAYES_GI_RAYTRACE},
-                 {"preview", RAYES_QUALITY_PREVIEW, RAYES_GI_RAYTRACE},
-                 {"final", RAYES_QUALITY_FINAL, RAYES_GI_RAYTRACE},
-                 {"pointbased", RAYES_QUALITY_FINAL, RAYES_GI_POINTBASED}};
+        float solid_angle;
+    } rows[3 + 8] = {{"reference", RAYES_QUALITY_REFERENCE, RAYES_GI_RAYTRACE, 0},
+                     {"preview", RAYES_QUALITY_PREVIEW, RAYES_GI_RAYTRACE, 0},
+                     {"final", RAYES_QUALITY_FINAL, RAYES_GI_RAYTRACE, 0}};
+    int n_rows = 3;
+    for (int k = 0; k < a->n_pbgi; k++, n_rows++) {
+        rows[n_rows].quality = RAYES_QUALITY_FINAL;
+        rows[n_rows].gi = RAYES_GI_POINTBASED;
+        rows[n_rows].solid_angle = a->pbgi_solid_angles[k];
+        if (a->n_pbgi == 1)
+            snprintf(rows[n_rows].tag, sizeof rows[n_rows].tag, "pointbased");
+        else
+            snprintf(rows[n_rows].tag, sizeof rows[n_rows].tag, "pointbased-%g", rows[n_rows].solid_angle);
+    }
     printf("Figure 5 (%s, 1 bounce, %dx%d, %d spp): against the reference\n", a->scene, a->size,
            a->size, a->spp);
-    printf("%-10s | %9s %9s %8s %8s | %10s %10s | %10s %10s | %s\n", "image", "sh.pts", "rays",
+    printf("%-15s | %9s %9s %8s %8s | %10s %10s | %10s %10s | %s\n", "image", "sh.pts", "rays",
            "time", "cpu", "rel. RMSE", "mean rel.", "(display)", "(display)", "time / reference");
     fprintf(j, "{\"figure\": 5, \"size\": %d, \"spp\": %d, \"rows\": [", a->size, a->spp);
     Row ref = {0};
-    for (int i = 0; i < 4; i++) {
+    for (int i = 0; i < n_rows; i++) {
         a->quality = rows[i].quality;
         a->gi = rows[i].gi;
+        if (rows[i].gi == RAYES_GI_POINTBASED)
+            a->pbgi_solid_angle = rows[i].solid_angle;
         Row r = run(a, a->size, a->spp, 1, rows[i].quality != RAYES_QUALITY_REFERENCE, 100);
         char path[1024], err[1024], s1[32], s2[32];
         snprintf(path, sizeof path, "%s/figure5-%s.png", a->out, rows[i].tag);
@@ -533,7 +552,7 @@ static void figure5(Args *a, FILE *j)
             against(a, &r, &ref, rows[i].tag, 0, 1, &rmse, &mrel);
             against(a, &r, &ref, rows[i].tag, 1, 0, &drmse, &dmrel);
         }
-        printf("%-10s | %9s %9s %7.1fs %7.1fs |", rows[i].tag, s1, s2, r.time_s, r.cpu_s);
+        printf("%-15s | %9s %9s %7.1fs %7.1fs |", rows[i].tag, s1, s2, r.time_s, r.cpu_s);
         if (i > 0)
             printf(" %9.2f%% %9.2f%% | %9.2f%% %9.2f%% | %.3f (cpu %.3f)\n", 100 * rmse,
                    100 * mrel, 100 * drmse, 100 * dmrel, r.time_s / ref.time_s,
@@ -541,9 +560,10 @@ static void figure5(Args *a, FILE *j)
         else
             printf(" %10s %10s | %10s %10s |\n", "-", "-", "-", "-");
         if (r.pbgi_points)
-            printf("    point cloud: %llu points, pass 1 (shading the cloud) %.2fs, octree %.2fs, "
-                   "pass 2 (bounces) %.2fs, render %.1fs\n",
-                   r.pbgi_points, r.pbgi_cloud_s, r.pbgi_octree_s, r.pbgi_bounces_s, r.render_s);
+            printf("    point cloud (solid angle %g sr, raster %d): %llu points, pass 1 (shading the "
+                   "cloud) %.2fs, octree %.2fs, pass 2 (bounces) %.2fs, render %.1fs\n",
+                   rows[i].solid_angle, a->pbgi_raster, r.pbgi_points, r.pbgi_cloud_s,
+                   r.pbgi_octree_s, r.pbgi_bounces_s, r.render_s);
         fflush(stdout);
         fprintf(j,
                 "%s\n    {\"image\": \"%s\", \"time_s\": %.3f, \"cpu_s\": %.3f, "
