@@ -27,7 +27,9 @@
  * and grid hider, indirect diffuse gathered from a point cloud: memo 5.3),
  * the relative RMSE and mean relative error of each against the reference,
  * 20x difference images, times (point-based: of each pass) and the point
- * count; a point-based row for each of the --pbgi-solid-angle values.
+ * count; a point-based row for each of the --pbgi-solid-angle values. The
+ * first point-based row's cloud goes to figure5-pointcloud.ply and, its
+ * disks splatted from the camera, to figure5-pointcloud.png.
  * Both then measure bias: the same rows at --accuracy-spp pixel samples
  * (default 64) and --accuracy-size pixels (default: --size, the table's own), the
  * relative difference of the cached and uncached image means and the
@@ -153,6 +155,10 @@ static Row run(const Args *a, int size, int spp, int bounces, int cache, double 
     o.gi = (RayesGi)a->gi;
     o.pbgi_max_solid_angle = a->pbgi_solid_angle;
     o.pbgi_raster = a->pbgi_raster;
+    char cloud[1024];
+    snprintf(cloud, sizeof cloud, "%s/figure5-pointcloud.ply", a->out);
+    if (o.gi == RAYES_GI_POINTBASED)
+        o.pointcloud_out = cloud;
     Row r = {.bounces = bounces, .cache = cache, .budget_mb = budget_mb};
     measure(scene, &o, &r);
     rayes_scene_release(scene);
@@ -506,6 +512,61 @@ static void against(const Args *a, const Row *r, const Row *ref, const char *tag
     free(diff);
 }
 
+/* The point cloud a point-based row wrote (DIR/figure5-pointcloud.ply),
+ * its disks splatted nearest first as seen by the box's camera (eye 278
+ * 273 -800 looking along +z, 39.3 degrees: the built-in Cornell scenes'),
+ * to DIR/figure5-pointcloud.png: radiosity on the side that faces the
+ * eye, dark purple where a disk is seen from behind. shrink scales the
+ * disks' radii (below 1 they show one by one). */
+static void pointcloud_view(const Args *a, int size, float shrink)
+{
+    char path[1024], err[1024], line[256];
+    snprintf(path, sizeof path, "%s/figure5-pointcloud.ply", a->out);
+    FILE *f = fopen(path, "rb");
+    size_t n = 0;
+    if (!f)
+        die("cannot read the point cloud back");
+    while (fgets(line, sizeof line, f) && strcmp(line, "end_header\n") != 0)
+        sscanf(line, "element vertex %zu", &n);
+    float *rgba = calloc((size_t)size * size * 4, sizeof *rgba);
+    float *depth = malloc((size_t)size * size * sizeof *depth);
+    if (!rgba || !depth)
+        die("out of memory");
+    for (int i = 0; i < size * size; i++)
+        depth[i] = INFINITY, rgba[4 * i + 3] = 1.0f;
+    const float t = tanf(0.5f * 39.3077f * (float)M_PI / 180.0f);
+    for (size_t i = 0; i < n; i++) {
+        float d[10]; /* x y z nx ny nz area r g b, little-endian like this machine */
+        if (fread(d, sizeof d, 1, f) != 1)
+            die("short point cloud");
+        float dz = d[2] + 800.0f;
+        if (dz <= 1.0f)
+            continue;
+        float px = (1.0f - (d[0] - 278.0f) / dz / t) * 0.5f * (float)size;
+        float py = (1.0f - (d[1] - 273.0f) / dz / t) * 0.5f * (float)size;
+        float rad = shrink * sqrtf(d[6] / (float)M_PI) / dz / t * 0.5f * (float)size;
+        rad = fmaxf(rad, 0.5f);
+        int facing = d[3] * (278.0f - d[0]) + d[4] * (273.0f - d[1]) + d[5] * (-800.0f - d[2]) > 0;
+        for (int y = (int)fmaxf(py - rad, 0); y <= (int)fminf(py + rad, size - 1); y++)
+            for (int x = (int)fmaxf(px - rad, 0); x <= (int)fminf(px + rad, size - 1); x++) {
+                float ex = (float)x + 0.5f - px, ey = (float)y + 0.5f - py;
+                size_t k = (size_t)y * size + x;
+                if (ex * ex + ey * ey > rad * rad || dz >= depth[k])
+                    continue;
+                depth[k] = dz;
+                rgba[4 * k] = facing ? d[7] : 0.04f;
+                rgba[4 * k + 1] = facing ? d[8] : 0.0f;
+                rgba[4 * k + 2] = facing ? d[9] : 0.04f;
+            }
+    }
+    fclose(f);
+    snprintf(path, sizeof path, "%s/figure5-pointcloud.png", a->out);
+    if (image_write(path, size, size, rgba, err, sizeof err) != RAYES_OK)
+        die(err);
+    free(rgba);
+    free(depth);
+}
+
 /* The memo's Figure 5: preview and final images (its bottom row) and
  * point-based GI (its top row) against a reference of 4096 diffuse rays
  * per shading point and no caching of any kind, one bounce, with 20x
@@ -559,6 +620,8 @@ static void figure5(Args *a, FILE *j)
                    r.cpu_s / ref.cpu_s);
         else
             printf(" %10s %10s | %10s %10s |\n", "-", "-", "-", "-");
+        if (r.pbgi_points && i == 3)
+            pointcloud_view(a, a->size, 0.7f);
         if (r.pbgi_points)
             printf("    point cloud (solid angle %g sr, raster %d): %llu points, pass 1 (shading the "
                    "cloud) %.2fs, octree %.2fs, pass 2 (bounces) %.2fs, render %.1fs\n",
