@@ -293,6 +293,26 @@ static int face_pixel(const PbgiCloud *c, int f, int i, int j)
     return c->pix_of[(f * R + j) * R + i];
 }
 
+/* The pixel of a bilinear tap (i, j) of face f: itself inside the face;
+ * beyond an edge, the pixel of the adjacent face that the tap's centre,
+ * on the face's plane extended, falls in (clamping into the face would
+ * pile a fragment near an edge onto one face's edge pixel and starve the
+ * other face's). */
+static int tap_pixel(const PbgiCloud *c, int f, int i, int j)
+{
+    int R = c->raster;
+    if (i >= 0 && i < R && j >= 0 && j < R)
+        return c->pix_of[(f * R + j) * R + i];
+    int a, u, v;
+    face_axes(f, &a, &u, &v);
+    float d[3], x, y;
+    d[a] = f % 2 ? -1.0f : 1.0f;
+    d[u] = -1.0f + (2.0f * (float)i + 1.0f) / (float)R;
+    d[v] = -1.0f + (2.0f * (float)j + 1.0f) / (float)R;
+    int g = face_coords(c, v3_load(d), &x, &y);
+    return face_pixel(c, g, (int)floorf(x + 0.5f), (int)floorf(y + 0.5f));
+}
+
 int pbgi_raster_init(PbgiRaster *r, const PbgiCloud *cloud)
 {
     r->cov = malloc((size_t)cloud->n_pix * sizeof *r->cov);
@@ -413,7 +433,7 @@ static void splat(Gather *g, Vec3 d, float omega, Vec3 L, Vec3 minor, float squa
             return; /* its pixels are all below the horizon */
         const float w[4] = {(1 - fx) * (1 - fy), fx * (1 - fy), (1 - fx) * fy, fx * fy};
         for (int k = 0; k < 4; k++) {
-            int p = face_pixel(c, f, i + (k & 1), j + (k >> 1));
+            int p = tap_pixel(c, f, i + (k & 1), j + (k >> 1));
             if (w[k] > 0.0f)
                 cover(g, p, w[k] * omega / c->pix_omega[p], L);
         }
