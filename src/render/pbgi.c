@@ -14,19 +14,19 @@
  *
  * A gather at P, N: a cube raster in the frame of N (faces raster^2
  * pixels; those below the horizon weigh nothing but keep the shares of
- * fragments across it). The
- * octree is traversed front to back (children by distance from P, leaf
- * disks likewise); a node whose bounding sphere subtends less than
- * max_solid_angle is splatted as one cluster (its power and projected area
- * toward P from the harmonics, splat_cluster), a leaf's disks one by one
- * (a disk's solid angle is that of a disk of its area seen face on, times
- * |cos| of its tilt: right near P too). A
- * fragment smaller than a pixel adds its coverage to the pixel it falls
- * in; a larger one covers the pixels whose centres lie within its cone.
- * Coverage adds up to 1 and no further: nearer fragments, rasterised
- * first, hide farther ones. The result is the sum over pixels of radiance
- * times cos d(omega), over pi; uncovered pixels are black, as the sky is
- * to diffuse rays.
+ * fragments across it). The octree is traversed front to back (children
+ * by distance from P, leaf disks likewise); a node whose bounding sphere
+ * subtends less than max_solid_angle is splatted as one cluster (its power
+ * and projected area toward P from the harmonics, splat_cluster), a
+ * leaf's disks one by one (a disk's solid angle is that of a disk of its
+ * area seen face on, times |cos| of its tilt: right near P too). Splats
+ * are anti-aliased (splat): a fragment smaller than a pixel shares its
+ * coverage bilinearly between four pixels (across a face's edge too), a
+ * larger one covers the pixels inside its outline with a ramp at the
+ * edge. Coverage adds up to 1 and no further: nearer fragments,
+ * rasterised first, hide farther ones. The result is the sum over pixels
+ * of radiance times cos d(omega), over pi; uncovered pixels are black, as
+ * the sky is to diffuse rays.
  *
  * The passes shade whole grids through radiosity_shade_grid (the cache's
  * fill, FINE level, front side), on threads, each grid into its own slots:
