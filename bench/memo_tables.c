@@ -10,6 +10,7 @@
  *   memo_tables table4 [...same...] [--budgets MB,MB,...]
  *   memo_tables table2 [...same...] [--uncached-max B]
  *   memo_tables figure5 [--size N] [--spp N] [--out DIR] [--data DIR] [--scene S]
+ *                       [--pbgi-solid-angle SR[,SR...]] [--pbgi-raster N]
  *   memo_tables figure8 [--size N] [--spp N] [--threads N] [--shadow-rays N]
  *                       [--ao-samples N] [--check-size N] [--experiment a|b|ab] [--out DIR]
  *                       [--repeat N] [--only off|on]
@@ -24,8 +25,13 @@
  * 1: an uncached row costs 64 times the one before). No accuracy pass:
  * bench/figure5 measures final against a reference.
  * figure5: reference (4096 diffuse rays, nothing cached), preview and final
- * images at one bounce, the relative RMSE and mean relative error of preview
- * and final against the reference, 20x difference images, and times.
+ * images at one bounce, and point-based GI (the final preset's lighting
+ * and grid hider, indirect diffuse gathered from a point cloud: memo 5.3),
+ * the relative RMSE and mean relative error of each against the reference,
+ * 20x difference images, times (point-based: of each pass) and the point
+ * count; a point-based row for each of the --pbgi-solid-angle values. The
+ * first point-based row's cloud goes to figure5-pointcloud.ply and, its
+ * disks splatted from the camera, to figure5-pointcloud.png.
  * Both then measure bias: the same rows at --accuracy-spp pixel samples
  * (default 64) and --accuracy-size pixels (default: --size, the table's own), the
  * relative difference of the cached and uncached image means and the
@@ -73,6 +79,11 @@ typedef struct Args {
                                      off or on (for a profiler), nothing compared */
     int replay;                   /* table1: 1 traces each row's rays again unshaded
                                      (RayesRenderOptions.replay_rays) */
+    int gi;                       /* RayesGi of the rows */
+    float pbgi_solid_angle;       /* figure5: point-based GI's knobs (the row's) */
+    int pbgi_raster;
+    float pbgi_solid_angles[8];   /* figure5: a point-based row for each */
+    int n_pbgi;
 } Args;
 
 typedef struct Row {
@@ -86,6 +97,8 @@ typedef struct Row {
     double hit[3];
     double render_cpu_s, replay_cpu_s;   /* the render alone, and its rays traced again
                                             unshaded (--replay 1) */
+    unsigned long long pbgi_points;       /* point-based GI: disks in the point cloud */
+    double pbgi_cloud_s, pbgi_bounces_s, pbgi_octree_s, render_s; /* its passes, wall */
     unsigned long long opacity_points;   /* opacity() shading points (shadow-ray hits, or
                                             the points of the grids the cache filled) */
     unsigned long long transparent_hits; /* surfaces shadow rays passed through */
@@ -146,6 +159,13 @@ static Row run(const Args *a, int size, int spp, int bounces, int cache, double 
      * default makes 8,113 and 1.71 M (--dice-raster). */
     o.dice_isotropic = !a->dice_raster;
     o.replay_rays = a->replay;
+    o.gi = (RayesGi)a->gi;
+    o.pbgi_max_solid_angle = a->pbgi_solid_angle;
+    o.pbgi_raster = a->pbgi_raster;
+    char cloud[1024];
+    snprintf(cloud, sizeof cloud, "%s/figure5-pointcloud.ply", a->out);
+    if (o.gi == RAYES_GI_POINTBASED)
+        o.pointcloud_out = cloud;
     Row r = {.bounces = bounces, .cache = cache, .budget_mb = budget_mb};
     measure(scene, &o, &r);
     rayes_scene_release(scene);
@@ -182,6 +202,14 @@ static void measure(RayesScene *scene, const RayesRenderOptions *o, Row *r_out)
         r.hit[l] = cache ? find(st, hr[l])->real : 0.0;
     const RayesStat *rec = rayes_stats_find(st, "irradiance/records");
     r.records = rec ? rec->count : 0;
+    const RayesStat *pts = rayes_stats_find(st, "pbgi/points");
+    r.pbgi_points = pts ? pts->count : 0;
+    if (pts) {
+        r.pbgi_cloud_s = find(st, "time/pbgi_cloud_s")->real;
+        r.pbgi_bounces_s = find(st, "time/pbgi_bounces_s")->real;
+        r.pbgi_octree_s = find(st, "time/pbgi_octree_s")->real;
+    }
+    r.render_s = find(st, "time/render_s")->real;
     r.rgba = img->rgba;
     r.w = img->width;
     r.h = img->height;
@@ -270,6 +298,10 @@ static void parse(int argc, char **argv, Args *a)
     a->experiment = "ab";
     a->only = -1;
     a->repeat = 2;
+    a->pbgi_solid_angle = 0.05f;
+    a->pbgi_solid_angles[0] = 0.05f;
+    a->n_pbgi = 1;
+    a->pbgi_raster = 8;
     const double budgets[] = {0, 1, 4, 16, 64, 256};
     a->n_budgets = 6;
     memcpy(a->budgets, budgets, sizeof budgets);
@@ -313,6 +345,13 @@ static void parse(int argc, char **argv, Args *a)
             a->experiment = v;
         else if (strcmp(o, "--replay") == 0)
             a->replay = atoi(v);
+        else if (strcmp(o, "--pbgi-solid-angle") == 0) {
+            a->n_pbgi = 0;
+            for (char *p = (char *)v; *p && a->n_pbgi < 8; p += strcspn(p, ",") + (p[strcspn(p, ",")] != 0))
+                a->pbgi_solid_angles[a->n_pbgi++] = (float)atof(p);
+        }
+        else if (strcmp(o, "--pbgi-raster") == 0)
+            a->pbgi_raster = atoi(v);
         else if (strcmp(o, "--uncached-max") == 0)
             a->uncached_max = atoi(v);
         else if (strcmp(o, "--budgets") == 0) {
@@ -493,25 +532,95 @@ static void against(const Args *a, const Row *r, const Row *ref, const char *tag
     free(diff);
 }
 
-/* The memo's Figure 5 (bottom row): preview and final images against a
- * reference of 4096 diffuse rays per shading point and no caching of any
- * kind, one bounce, with 20x difference images. */
+/* The point cloud a point-based row wrote (DIR/figure5-pointcloud.ply),
+ * its disks splatted nearest first as seen by the box's camera (eye 278
+ * 273 -800 looking along +z, 39.3 degrees: the built-in Cornell scenes'),
+ * to DIR/figure5-pointcloud.png: radiosity on the side that faces the
+ * eye, dark purple where a disk is seen from behind. shrink scales the
+ * disks' radii (below 1 they show one by one). */
+static void pointcloud_view(const Args *a, int size, float shrink)
+{
+    char path[1024], err[1024], line[256];
+    snprintf(path, sizeof path, "%s/figure5-pointcloud.ply", a->out);
+    FILE *f = fopen(path, "rb");
+    size_t n = 0;
+    if (!f)
+        die("cannot read the point cloud back");
+    while (fgets(line, sizeof line, f) && strcmp(line, "end_header\n") != 0)
+        sscanf(line, "element vertex %zu", &n);
+    float *rgba = calloc((size_t)size * size * 4, sizeof *rgba);
+    float *depth = malloc((size_t)size * size * sizeof *depth);
+    if (!rgba || !depth)
+        die("out of memory");
+    for (int i = 0; i < size * size; i++)
+        depth[i] = INFINITY, rgba[4 * i + 3] = 1.0f;
+    const float t = tanf(0.5f * 39.3077f * (float)M_PI / 180.0f);
+    for (size_t i = 0; i < n; i++) {
+        float d[10]; /* x y z nx ny nz area r g b, little-endian like this machine */
+        if (fread(d, sizeof d, 1, f) != 1)
+            die("short point cloud");
+        float dz = d[2] + 800.0f;
+        if (dz <= 1.0f)
+            continue;
+        float px = (1.0f - (d[0] - 278.0f) / dz / t) * 0.5f * (float)size;
+        float py = (1.0f - (d[1] - 273.0f) / dz / t) * 0.5f * (float)size;
+        float rad = shrink * sqrtf(d[6] / (float)M_PI) / dz / t * 0.5f * (float)size;
+        rad = fmaxf(rad, 0.5f);
+        int facing = d[3] * (278.0f - d[0]) + d[4] * (273.0f - d[1]) + d[5] * (-800.0f - d[2]) > 0;
+        for (int y = (int)fmaxf(py - rad, 0); y <= (int)fminf(py + rad, size - 1); y++)
+            for (int x = (int)fmaxf(px - rad, 0); x <= (int)fminf(px + rad, size - 1); x++) {
+                float ex = (float)x + 0.5f - px, ey = (float)y + 0.5f - py;
+                size_t k = (size_t)y * size + x;
+                if (ex * ex + ey * ey > rad * rad || dz >= depth[k])
+                    continue;
+                depth[k] = dz;
+                rgba[4 * k] = facing ? d[7] : 0.04f;
+                rgba[4 * k + 1] = facing ? d[8] : 0.0f;
+                rgba[4 * k + 2] = facing ? d[9] : 0.04f;
+            }
+    }
+    fclose(f);
+    snprintf(path, sizeof path, "%s/figure5-pointcloud.png", a->out);
+    if (image_write(path, size, size, rgba, err, sizeof err) != RAYES_OK)
+        die(err);
+    free(rgba);
+    free(depth);
+}
+
+/* The memo's Figure 5: preview and final images (its bottom row) and
+ * point-based GI (its top row) against a reference of 4096 diffuse rays
+ * per shading point and no caching of any kind, one bounce, with 20x
+ * difference images. */
 static void figure5(Args *a, FILE *j)
 {
-    static const struct {
-        const char *tag;
-        int quality;
-    } rows[3] = {{"reference", RAYES_QUALITY_REFERENCE},
-                 {"preview", RAYES_QUALITY_PREVIEW},
-                 {"final", RAYES_QUALITY_FINAL}};
+    struct {
+        char tag[32];
+        int quality, gi;
+        float solid_angle;
+    } rows[3 + 8] = {{"reference", RAYES_QUALITY_REFERENCE, RAYES_GI_RAYTRACE, 0},
+                     {"preview", RAYES_QUALITY_PREVIEW, RAYES_GI_RAYTRACE, 0},
+                     {"final", RAYES_QUALITY_FINAL, RAYES_GI_RAYTRACE, 0}};
+    int n_rows = 3;
+    for (int k = 0; k < a->n_pbgi; k++, n_rows++) {
+        rows[n_rows].quality = RAYES_QUALITY_FINAL;
+        rows[n_rows].gi = RAYES_GI_POINTBASED;
+        rows[n_rows].solid_angle = a->pbgi_solid_angles[k];
+        if (a->n_pbgi == 1)
+            snprintf(rows[n_rows].tag, sizeof rows[n_rows].tag, "pointbased");
+        else
+            snprintf(rows[n_rows].tag, sizeof rows[n_rows].tag, "pointbased-%g", rows[n_rows].solid_angle);
+    }
     printf("Figure 5 (%s, 1 bounce, %dx%d, %d spp): against the reference\n", a->scene, a->size,
            a->size, a->spp);
-    printf("%-9s | %9s %9s %8s %8s | %10s %10s | %10s %10s | %s\n", "image", "sh.pts", "rays",
+    printf("%-15s | %9s %9s %8s %8s | %10s %10s | %10s %10s | %s\n", "image", "sh.pts", "rays",
            "time", "cpu", "rel. RMSE", "mean rel.", "(display)", "(display)", "time / reference");
     fprintf(j, "{\"figure\": 5, \"size\": %d, \"spp\": %d, \"rows\": [", a->size, a->spp);
     Row ref = {0};
-    for (int i = 0; i < 3; i++) {
+    for (int i = 0; i < n_rows; i++) {
         a->quality = rows[i].quality;
+        a->gi = rows[i].gi;
+        if (rows[i].gi == RAYES_GI_POINTBASED)
+            a->pbgi_solid_angle = rows[i].solid_angle;
         Row r = run(a, a->size, a->spp, 1, rows[i].quality != RAYES_QUALITY_REFERENCE, 100);
         char path[1024], err[1024], s1[32], s2[32];
         snprintf(path, sizeof path, "%s/figure5-%s.png", a->out, rows[i].tag);
@@ -524,20 +633,30 @@ static void figure5(Args *a, FILE *j)
             against(a, &r, &ref, rows[i].tag, 0, 1, &rmse, &mrel);
             against(a, &r, &ref, rows[i].tag, 1, 0, &drmse, &dmrel);
         }
-        printf("%-9s | %9s %9s %7.1fs %7.1fs |", rows[i].tag, s1, s2, r.time_s, r.cpu_s);
+        printf("%-15s | %9s %9s %7.1fs %7.1fs |", rows[i].tag, s1, s2, r.time_s, r.cpu_s);
         if (i > 0)
             printf(" %9.2f%% %9.2f%% | %9.2f%% %9.2f%% | %.3f (cpu %.3f)\n", 100 * rmse,
                    100 * mrel, 100 * drmse, 100 * dmrel, r.time_s / ref.time_s,
                    r.cpu_s / ref.cpu_s);
         else
             printf(" %10s %10s | %10s %10s |\n", "-", "-", "-", "-");
+        if (r.pbgi_points && i == 3)
+            pointcloud_view(a, a->size, 0.7f);
+        if (r.pbgi_points)
+            printf("    point cloud (solid angle %g sr, raster %d): %llu points, pass 1 (shading the "
+                   "cloud) %.2fs, octree %.2fs, pass 2 (bounces) %.2fs, render %.1fs\n",
+                   rows[i].solid_angle, a->pbgi_raster, r.pbgi_points, r.pbgi_cloud_s,
+                   r.pbgi_octree_s, r.pbgi_bounces_s, r.render_s);
         fflush(stdout);
         fprintf(j,
                 "%s\n    {\"image\": \"%s\", \"time_s\": %.3f, \"cpu_s\": %.3f, "
                 "\"shading_points\": %llu, \"rays\": %llu, \"rel_rmse\": %.6f, "
-                "\"mean_rel\": %.6f, \"display_rel_rmse\": %.6f, \"display_mean_rel\": %.6f}",
+                "\"mean_rel\": %.6f, \"display_rel_rmse\": %.6f, \"display_mean_rel\": %.6f, "
+                "\"render_s\": %.3f, \"pbgi_points\": %llu, \"pbgi_cloud_s\": %.3f, "
+                "\"pbgi_octree_s\": %.3f, \"pbgi_bounces_s\": %.3f}",
                 i ? "," : "", rows[i].tag, r.time_s, r.cpu_s, r.shading_points, r.rays, rmse, mrel,
-                drmse, dmrel);
+                drmse, dmrel, r.render_s, r.pbgi_points, r.pbgi_cloud_s, r.pbgi_octree_s,
+                r.pbgi_bounces_s);
         if (i == 0)
             ref = r;
         else

@@ -674,6 +674,15 @@ typedef enum RayesHider {
                                  hits interpolate the shaded grid (PRMan's REYES mode) */
 } RayesHider;
 
+/* How indirect diffuse light is computed (DESIGN.md "Point-based global
+ * illumination"). */
+typedef enum RayesGi {
+    RAYES_GI_RAYTRACE = 0,   /* diffuse rays, their hits read the radiosity cache (default) */
+    RAYES_GI_POINTBASED = 1  /* point-based GI (Christensen 2008): a point cloud of every
+                                grid's direct radiosity, bounces on it, and gathers from an
+                                octree of its disks at shading points */
+} RayesGi;
+
 /* A finished tile: the pixels [x, x + w) x [y, y + h) of rgba, whose rows
  * are stride pixels apart (4 floats a pixel, linear, top row first). Called
  * from worker threads, for different tiles at once; valid during the call. */
@@ -790,6 +799,15 @@ typedef struct RayesRenderOptions {
                                    made, trace them again with no shading on as many threads:
                                    what ray casting alone costs of the render (the statistics'
                                    "replay" block). The image is the same. Default 0 */
+    RayesGi gi;                /* RAYES_GI_RAYTRACE (default) or RAYES_GI_POINTBASED; the
+                                  progressive session renders the latter as the former */
+    float pbgi_max_solid_angle; /* point-based GI: octree nodes subtending less than this
+                                   (steradians) are gathered as one cluster: default 0.05,
+                                   (0, 12.57] */
+    int pbgi_raster;           /* point-based GI: the gather's cube raster, pixels a face
+                                  side: default 8, even, 2 to 64 */
+    const char *pointcloud_out; /* point-based GI: NULL, or a file the point cloud is written
+                                   to (binary PLY: x y z nx ny nz area r g b, docs/cli.md) */
 } RayesRenderOptions;
 
 /* Fills options with the defaults of a quality preset: 512 x 512, 4 pixel

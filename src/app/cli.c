@@ -95,6 +95,13 @@ static const char render_options[] =
     "                          default for --quality final)\n"
     "  --irradiance on|off     irradiance interpolation with gradients at depth 0 (grid\n"
     "                          hider; on for --quality final)\n"
+    "  --gi raytrace|pointbased  indirect diffuse by diffuse rays and the radiosity cache\n"
+    "                          (default), or point-based GI from a point cloud of disks\n"
+    "  --pbgi-solid-angle SR   point-based GI: octree nodes under SR steradians gather as\n"
+    "                          one cluster (default 0.05)\n"
+    "  --pbgi-raster N         point-based GI: cube raster of N x N pixels a face (default\n"
+    "                          8; even, 2 to 64)\n"
+    "  --pointcloud-out FILE.ply  point-based GI: write the point cloud (binary PLY)\n"
     "  --texture-mb MB         texture cache budget in megabytes (default 64)\n"
     "  --data DIR              data directory (teapot.bpt); default $RAYES_DATA\n"
     "  --shader-path DIRS      directories of shader plugins NAME.so, ':'-separated;\n"
@@ -443,7 +450,19 @@ void parse_args(int argc, char **argv, Args *a)
             if (strcmp(v, "on") != 0 && strcmp(v, "off") != 0)
                 die_usage("--irradiance: expected on or off, got \"%s\"", v);
             opt->irradiance = strcmp(v, "on") == 0;
-        } else if (strcmp(o, "--texture-mb") == 0) {
+        } else if (strcmp(o, "--gi") == 0) {
+            if (strcmp(v, "raytrace") != 0 && strcmp(v, "pointbased") != 0)
+                die_usage("--gi: expected raytrace or pointbased, got \"%s\"", v);
+            opt->gi = strcmp(v, "pointbased") == 0 ? RAYES_GI_POINTBASED : RAYES_GI_RAYTRACE;
+        } else if (strcmp(o, "--pbgi-solid-angle") == 0)
+            opt->pbgi_max_solid_angle = parse_float(o, v, 1e-6f, 12.57f);
+        else if (strcmp(o, "--pbgi-raster") == 0) {
+            opt->pbgi_raster = (int)parse_long(o, v, 2, 64);
+            if (opt->pbgi_raster % 2)
+                die_usage("--pbgi-raster: expected an even number, got \"%s\"", v);
+        } else if (strcmp(o, "--pointcloud-out") == 0)
+            opt->pointcloud_out = v;
+        else if (strcmp(o, "--texture-mb") == 0) {
             opt->texture_mb = parse_float(o, v, 0.0f, 1e7f);
             a->set |= SET_TEXTURE_MB;
         } else if (strcmp(o, "--data") == 0)

@@ -139,6 +139,10 @@ typedef struct RenderSettings {
     int hider;               /* 0: shade at every camera hit; 1: the grid hider (hider.h) */
     int irradiance;          /* 1: irradiance interpolation at depth 0 (irrgrid.h; grid
                                 hider only) */
+    const struct PbgiCloud *pbgi; /* point-based GI: the indirect-diffuse service gathers
+                                     from this cloud (pbgi.h), or NULL: diffuse rays */
+    float pbgi_max_solid_angle;   /* its clusters' largest solid angle, steradians */
+    int pbgi_raster;              /* its gathers' cube raster, pixels a face side */
     TextureSystem *textures; /* image textures for the texture service, or NULL */
     int max_spp;             /* adaptive pixel sampling: above spp, a pixel takes further
                                 blocks of spp samples while its error exceeds
@@ -178,6 +182,7 @@ typedef struct RenderStats {
                                    and uncached subsurface hits) */
     uint64_t instance_fills;    /* radiosity cache fills of grids seen through object instances
                                    (each instance fills its own entries) */
+    uint64_t pbgi_gathers;      /* point-based GI: points gathered from the cloud */
     uint64_t segment_fills[GEOM_MAX_TIMES - 1]; /* radiosity cache fills of moving grids, by
                                                    motion segment (the entries each made) */
 } RenderStats;

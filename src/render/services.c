@@ -19,6 +19,7 @@
 
 #include "render/integrator.h"
 #include "render/irrgrid.h"
+#include "render/pbgi.h"
 #include "render/subsurface.h"
 #include "shade/builtin.h"
 #include "shade/noise.h"
@@ -431,6 +432,15 @@ static void svc_indirect_diffuse(const RayesShaderServices *sv, const RayesShade
         n = 0;
     if (ps->path && n > 1 && depth >= w->set->branch_depth)
         n = 1; /* an uncached hit past the branch depth: one ray follows the path */
+    if (w->set->pbgi && n > 0) { /* point-based GI: gather from the cloud (pbgi.h) */
+        PbgiRaster r;
+        RY_CHECK(pbgi_raster_init(&r, w->set->pbgi) == 0);
+        for (size_t i = 0; i < ctx->n_points; i++)
+            v3_store(out[i], pbgi_gather(w->set->pbgi, &r, v3_load(ctx->P[i]), v3_load(ctx->N[i])));
+        w->stats.pbgi_gathers += ctx->n_points;
+        pbgi_raster_fini(&r);
+        return;
+    }
     IrrGrid *irr = ps->irr;
     if (irr && n > 0 && ctx->N == irr->N + ctx->first_point) {
         /* A grid's own points with its own normals: interpolate (irrgrid.h). */

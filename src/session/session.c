@@ -15,7 +15,9 @@
 #include "cache/cache.h"
 #include "geom/geom.h"
 #include "rayes/rayes.h"
+#include "render/pbgi.h"
 #include "render/render.h"
+#include "render/services.h"
 #include "render/volume.h"
 #include "scene/scene.h"
 #include "session/replay.h"
@@ -80,6 +82,8 @@ void rayes_render_options_init(RayesRenderOptions *o, RayesQuality quality)
     o->irradiance_cache = 1;
     o->irradiance_cache_mb = 20.0;
     o->subsurface_rays = quality == RAYES_QUALITY_PREVIEW ? 4 : 64;
+    o->pbgi_max_solid_angle = 0.05f;
+    o->pbgi_raster = 8;
     switch (quality) {
     case RAYES_QUALITY_PREVIEW:
         o->shadow_rays = o->shadow_rays_deep = 4;
@@ -131,6 +135,11 @@ RayesError session_check_options(RayesScene *scene, const RayesRenderOptions *o)
     else if (!(o->filter_width > 0.0f) || o->filter_width > 16.0f ||
              (int)o->filter < RAYES_FILTER_BOX || o->filter > RAYES_FILTER_LANCZOS)
         what = "options: filter width must be in (0, 16]";
+    else if ((o->gi != RAYES_GI_RAYTRACE && o->gi != RAYES_GI_POINTBASED) ||
+             !(o->pbgi_max_solid_angle > 0.0f) || o->pbgi_max_solid_angle > 12.57f ||
+             o->pbgi_raster < 2 || o->pbgi_raster > 64 || o->pbgi_raster % 2)
+        what = "options: gi must be RAYES_GI_RAYTRACE or RAYES_GI_POINTBASED, the point-based "
+               "solid angle in (0, 12.57] and its raster even, 2 to 64";
     else if (o->hider != RAYES_HIDER_RAYTRACE && o->hider != RAYES_HIDER_GRID)
         what = "options: hider must be RAYES_HIDER_RAYTRACE or RAYES_HIDER_GRID";
     else if (o->tile_size < 1 || o->threads < 0 || o->threads > 1024)
@@ -220,6 +229,8 @@ RenderSettings session_settings(const RayesRenderOptions *o)
         .volume_step = o->volume_step,
         .max_spp = o->max_spp,
         .adaptive_error = o->adaptive_error,
+        .pbgi_max_solid_angle = o->pbgi_max_solid_angle,
+        .pbgi_raster = o->pbgi_raster,
         .tile_done = o->tile_done,
         .tile_user = o->tile_user,
         .tile_source = o->tile_source,
@@ -438,6 +449,27 @@ RenderScene session_render_scene(const RayesScene *scene, const Prepared *p, int
     };
 }
 
+/* Point-based GI's passes 1 and 2 (render/pbgi.h): the cloud into *cloud
+ * (owned by the caller) and set->pbgi, written to opt->pointcloud_out if
+ * given. */
+static RayesError session_point_cloud(RayesScene *scene, const RayesRenderOptions *opt,
+                                      const RenderScene *rs, RenderSettings *set,
+                                      RenderStats *stats, PbgiCloud **cloud, PbgiTimes *times)
+{
+    if (rs->gs->n_instances > 0)
+        log_warning_once("pbgi-instances", "point-based GI: object instances are not in the "
+                                            "point cloud (they neither bleed light nor occlude)");
+    *cloud = pbgi_build(rs, set, &render_services, stats, times);
+    if (!*cloud)
+        return session_fail(scene, RAYES_ERROR_OUT_OF_MEMORY,
+                            "render: out of memory for the point cloud");
+    set->pbgi = *cloud;
+    char err[400];
+    if (opt->pointcloud_out && pbgi_write_ply(*cloud, opt->pointcloud_out, err, sizeof err) != 0)
+        return session_fail(scene, RAYES_ERROR_IO, err);
+    return RAYES_OK;
+}
+
 RayesError rayes_render(RayesScene *scene, const RayesRenderOptions *opt, RayesImage **image,
                         RayesStats **stats_out)
 {
@@ -462,6 +494,8 @@ RayesError rayes_render(RayesScene *scene, const RayesRenderOptions *opt, RayesI
     AccelRecord *record = NULL;
     TextureSystem *textures = session_textures(scene, opt->texture_mb, opt->texture_width);
     RenderStats rstats = {0};
+    PbgiCloud *cloud = NULL;
+    PbgiTimes pbgi_times = {0};
     set.textures = textures;
     if (!img || !rgba || !textures) {
         e = session_fail(scene, RAYES_ERROR_OUT_OF_MEMORY, "render: out of memory");
@@ -487,8 +521,14 @@ RayesError rayes_render(RayesScene *scene, const RayesRenderOptions *opt, RayesI
         }
         accel_attach_record(prep.accel, record);
     }
-    double t1 = time_now(), cpu1 = time_cpu();
+    double t1 = time_now();
     RenderScene rs = session_render_scene(scene, &prep, set.width, set.height);
+    if (opt->gi == RAYES_GI_POINTBASED) {
+        e = session_point_cloud(scene, opt, &rs, &set, &rstats, &cloud, &pbgi_times);
+        if (e != RAYES_OK)
+            goto done;
+    }
+    double t1b = time_now(), cpu1 = time_cpu();
     if (render_frame(&rs, &set, rgba, &rstats) != 0) {
         e = session_fail(scene, RAYES_ERROR_CANCELLED, "render: cancelled");
         goto done;
@@ -502,7 +542,8 @@ RayesError rayes_render(RayesScene *scene, const RayesRenderOptions *opt, RayesI
         }
     }
     if (stats_out) {
-        SessionTimes times = {t2 - t0, t1 - t0, t2 - t1, cpu2 - cpu1};
+        SessionTimes times = {t2 - t0, t1 - t0, t2 - t1b, cpu2 - cpu1, cloud != NULL,
+                              pbgi_times.cloud_s, pbgi_times.bounces_s, pbgi_times.octree_s};
         *stats_out = session_stats_new(&set, &rstats, &prep.gs, &times,
                                        accel_memory_bytes(prep.accel));
         if (*stats_out && cache) {
@@ -522,6 +563,11 @@ RayesError rayes_render(RayesScene *scene, const RayesRenderOptions *opt, RayesI
                 session_stats_add_real(*stats_out, "replay/cpu_s", replay_cpu);
             }
         }
+        if (*stats_out && cloud) {
+            session_stats_add_count(*stats_out, "pbgi/points", cloud->n_disks);
+            session_stats_add_count(*stats_out, "pbgi/nodes", cloud->n_nodes);
+            session_stats_add_count(*stats_out, "pbgi/gathers", rstats.pbgi_gathers);
+        }
         if (!*stats_out) {
             e = session_fail(scene, RAYES_ERROR_OUT_OF_MEMORY,
                              "render: out of memory for statistics");
@@ -540,6 +586,7 @@ RayesError rayes_render(RayesScene *scene, const RayesRenderOptions *opt, RayesI
     rgba = NULL;
 done:
     accel_record_free(record);
+    pbgi_cloud_free(cloud);
     cache_free(cache);
     session_prepared_fini(&prep);
     texture_system_free(textures);

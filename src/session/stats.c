@@ -73,6 +73,11 @@ RayesStats *session_stats_new(const RenderSettings *set, const RenderStats *rs, 
     real(s, "time/render_s", t->render_s);
     if (t->render_cpu_s > 0.0)
         real(s, "time/render_cpu_s", t->render_cpu_s);
+    if (t->pbgi) { /* in the time block: the JSON nests consecutive names */
+        real(s, "time/pbgi_cloud_s", t->pbgi_cloud_s);
+        real(s, "time/pbgi_bounces_s", t->pbgi_bounces_s);
+        real(s, "time/pbgi_octree_s", t->pbgi_octree_s);
+    }
     uint64_t total = 0;
     int deepest = 0;
     for (int d = 0; d <= RENDER_MAX_DEPTH; d++) {

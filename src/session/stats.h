@@ -15,6 +15,8 @@
 typedef struct SessionTimes {
     double total_s, prepare_s, render_s;
     double render_cpu_s; /* the process's CPU time over render_s (0: not measured) */
+    int pbgi;            /* point-based GI ran its passes before render_s: */
+    double pbgi_cloud_s, pbgi_bounces_s, pbgi_octree_s;
 } SessionTimes;
 
 /* A new statistics list (free with rayes_stats_free), or NULL. */

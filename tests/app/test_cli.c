@@ -211,6 +211,9 @@ static void test_usage_errors(void)
     expect_error(2, NULL, ARGS("render", "--gridsize", "5000"), ARGS("--gridsize"));
     expect_error(2, NULL, ARGS("render", "--dice-offscreen", "0.5"), ARGS("--dice-offscreen"));
     expect_error(2, NULL, ARGS("render", "--vertex-budget", "-1"), ARGS("--vertex-budget"));
+    expect_error(2, NULL, ARGS("render", "--gi", "photons"), ARGS("--gi", "photons"));
+    expect_error(2, NULL, ARGS("render", "--pbgi-raster", "7"), ARGS("--pbgi-raster", "even"));
+    expect_error(2, NULL, ARGS("render", "--pbgi-solid-angle", "0"), ARGS("--pbgi-solid-angle"));
     expect_error(2, NULL, ARGS("render", "-o", "out.txt"), ARGS("out.txt", ".png"));
     expect_error(2, NULL, ARGS("render", "cornell", "cornell-teapots"), ARGS("one scene"));
     expect_error(2, NULL, ARGS("render", "nosuchscene", "--res", "16"), ARGS("nosuchscene"));
