@@ -148,6 +148,13 @@ static Row run(const Args *a, int size, int spp, int bounces, int cache, double 
     o.cache = cache;
     o.cache_mb = budget_mb;
     o.cache_k = (float)a->cache_k;
+    if (a->quality == RAYES_QUALITY_REFERENCE) {
+        /* The memo's reference (Figure 5): 4096 diffuse and 64 shadow rays at
+         * every camera hit, at the bench's pixel samples (the preset itself
+         * spreads its rays over 64 pixel samples instead). */
+        o.diffuse_rays = 4096;
+        o.shadow_rays = 64;
+    }
     /* The memo's trees: every uncached diffuse hit branches into the
      * preset's deeper rays, as its tables count them. */
     o.branch_depth = bounces + 1;

@@ -175,7 +175,10 @@ teapot("matte-teapot", grey, 150.0, 160.0, 195.0, patches, points)
 # The camera at (278, 273, -800) looking along +z, up +y: its local -Z is
 # the view, +Y up, so +X (the image's right) is world -x.
 cam_data = bpy.data.cameras.new("camera")
-cam_data.sensor_fit = "VERTICAL"
+# A square sensor: the field of view is the same across and up (Blender's
+# angle setter works on the sensor's width whatever the fit).
+cam_data.sensor_fit = "AUTO"
+cam_data.sensor_width = cam_data.sensor_height = 36.0
 cam_data.angle = math.radians(39.3077)
 cam_data.clip_start = 1.0
 cam_data.clip_end = 10000.0

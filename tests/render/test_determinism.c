@@ -237,6 +237,31 @@ static void test_adaptive_any_thread_count(void)
     }
 }
 
+/* The reference preset converges in pixels too (64 samples a pixel) and
+ * caches nothing: no cache at all is made. */
+static void test_reference_preset(void)
+{
+    RayesScene *s = rayes_scene_new();
+    char err[512];
+    IoSink sink = io_sink_scene(s);
+    CHECK(io_builtin_scene("cornell", NULL, &sink, err, sizeof err) == RAYES_OK);
+    CHECK(rayes_scene_commit(s) == RAYES_OK);
+    RayesRenderOptions o;
+    rayes_render_options_init(&o, RAYES_QUALITY_REFERENCE);
+    CHECK(o.spp == 64 && !o.cache && !o.opacity_cache && !o.irradiance_cache);
+    o.width = o.height = 8;
+    o.threads = 2;
+    RayesImage *img = NULL;
+    RayesStats *st = NULL;
+    CHECK(rayes_render(s, &o, &img, &st) == RAYES_OK);
+    const RayesStat *cam = rayes_stats_find(st, "rays/camera");
+    CHECK(cam && cam->count == 8 * 8 * 64);
+    CHECK(rayes_stats_find(st, "cache/budget_bytes") == NULL);
+    rayes_stats_free(st);
+    rayes_image_free(img);
+    rayes_scene_release(s);
+}
+
 /* Replaying the rays (RayesRenderOptions.replay_rays) leaves the image as
  * it was, keeps every ray the statistics count (cornell-teapots has no
  * subsurface or volume rays beside them) and traces them again. */
@@ -283,4 +308,4 @@ TEST_MAIN(TEST(test_box_filter_any_thread_count), TEST(test_gaussian_filter_any_
           TEST(test_negative_lobes_ring), TEST(test_teapots_any_thread_count),
           TEST(test_displaced_teapots), TEST(test_seed_changes_image),
           TEST(test_spheres_any_thread_count), TEST(test_adaptive_any_thread_count),
-          TEST(test_replay_rays))
+          TEST(test_reference_preset), TEST(test_replay_rays))
