@@ -7,6 +7,7 @@ Cycles"). Run through bench/peers, which builds rayes first.
     bench/peers [--size 256] [--bounces 1] [--threads 2] [--data DIR]
                 [--cycles 16,64,256,1024] [--cycles-ref 4096]
                 [--preview 4,16,64,256] [--final 4,16] [--ref-spp 1024]
+                [--one-ray 64,256]
                 [--adaptive 0.1,0.05,0.02,0.01] [--adaptive-spp 16]
                 [--adaptive-max 1024] [--reuse 0|1] [--out bench-out/peers]
 
@@ -14,7 +15,8 @@ Cycles renders the scene of ../shared/data/cornell-teapots.md built by
 bench/peers_cycles.py with matched light transport: the same diffuse
 bounces, 4 glossy, caustics off, no clamping, no denoising, no adaptive
 sampling, a one-pixel box filter. rayes renders the built-in
-cornell-teapots in its preview and final presets, and the preview with
+cornell-teapots in its preview and final presets, the preview with one
+shadow and one diffuse ray a camera hit (--one-ray), and the preview with
 adaptive pixel sampling (--adaptive-spp samples everywhere, up to
 --adaptive-max, at each listed --adaptive-error). rayes's reference is the
 preview's uncached estimator at --ref-spp pixel samples (4 diffuse and 4
@@ -45,7 +47,7 @@ def parse(argv):
     opt = {"size": "256", "bounces": "1", "threads": "2",
            "data": os.environ.get("RAYES_DATA", os.path.join(ROOT, "..", "shared", "data")),
            "cycles": "16,64,256,1024", "cycles-ref": "4096", "preview": "4,16,64,256",
-           "final": "4,16", "ref-spp": "1024", "adaptive": "0.1,0.05,0.02,0.01",
+           "final": "4,16", "ref-spp": "1024", "one-ray": "64,256", "adaptive": "0.1,0.05,0.02,0.01",
            "adaptive-spp": "16", "adaptive-max": "1024", "reuse": "0",
            "out": os.path.join(ROOT, "bench-out", "peers")}
     for i in range(0, len(argv), 2):
@@ -143,6 +145,10 @@ def main():
         for spp in counts(opt[tag]):
             path, cpu = rayes(opt, tag, spp, ["--quality", preset])
             rows.append((tag, spp, cpu, read(path)))
+    for spp in counts(opt["one-ray"]):
+        path, cpu = rayes(opt, "one-ray", spp, ["--quality", "preview", "--shadow-rays", "1",
+                                                "--diffuse-rays", "1"])
+        rows.append(("one-ray", spp, cpu, read(path)))
     for e in [float(x) for x in opt["adaptive"].split(",") if x]:
         path, cpu = rayes(opt, "adaptive", int(opt["adaptive-spp"]),
                           ["--quality", "preview", "--max-spp", opt["adaptive-max"],
@@ -175,7 +181,7 @@ def main():
     print("CPU seconds to reach a relative RMSE (own reference; '~' extrapolated, '<' at the "
           "first point already)")
     print("%-8s %10s %10s %10s" % ("mode", "5%", "2%", "1%"))
-    for tag in ("cycles", "preview", "final", "adaptive"):
+    for tag in ("cycles", "preview", "final", "one-ray", "adaptive"):
         pts = [(r["cpu_s"], r["rmse_own"]) for r in record["rows"] if r["mode"] == tag]
         cells, rec = [], {}
         for target in (0.05, 0.02, 0.01):
@@ -185,7 +191,8 @@ def main():
         record["time_to"][tag] = rec
         print("%-8s %10s %10s %10s" % (tag, *cells))
     for target in ("0.05", "0.02", "0.01"):
-        best = min(record["time_to"][t][target]["cpu_s"] for t in ("preview", "final", "adaptive"))
+        best = min(record["time_to"][t][target]["cpu_s"]
+                   for t in ("preview", "final", "one-ray", "adaptive"))
         ratio = record["time_to"]["cycles"][target]["cpu_s"] / best
         print("at %s%%: Cycles / rayes's better preset = %.2f" % (float(target) * 100, ratio))
         record["time_to"]["ratio_" + target] = ratio
