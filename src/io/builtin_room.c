@@ -440,7 +440,7 @@ static void table_and_chairs(Room *r)
     pattern(r, "chairgrain", "marble", chairpat, 3);
     const RayesParam tint[] = {cp("tex", 0.18f, 0.32f, 0.3f), pat("scale", "chairgrain")};
     pattern(r, "chaircolour", "scale", tint, 2);
-    const RayesParam coat[] = {pat("reflectance", "chaircolour"), fp("roughness", 0.02f)};
+    const RayesParam coat[] = {pat("reflectance", "chaircolour"), fp("roughness", 0.0f)};
     shader(r, "coateddiffuse", coat, 2);
     const float cx[3] = {tx - 0.35f, tx + 0.4f, tx + 1.1f}, cz[3] = {tz + 0.75f, tz + 0.8f, tz};
     for (int c = 0; c < 3; c++) {
