@@ -23,7 +23,7 @@
 #error "RAYES_TEST_TMP must name a scratch directory"
 #endif
 
-enum { W = 96, H = 54 };
+enum { W = 64, H = 36 };
 
 static RayesScene *built(void)
 {
