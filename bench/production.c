@@ -238,9 +238,13 @@ static void save(const Args *a, const Row *r)
 static const char *label(const Row *r)
 {
     static char buf[32];
-    snprintf(buf, sizeof buf, "%s %s", r->bounces == 0 ? "direct" : r->bounces == 1 ? "1 bounce"
-                                                                                   : "2 bounces",
-             r->bounces == 0 ? "" : r->cache ? "on" : "off");
+    snprintf(buf, sizeof buf, "%s %s",
+             r->bounces == 0   ? "direct"
+             : r->bounces == 1 ? "1 bounce"
+                               : "2 bounces",
+             r->bounces == 0 ? ""
+             : r->cache      ? "on"
+                             : "off");
     return buf;
 }
 
@@ -272,8 +276,8 @@ static void json_row(FILE *j, const Row *r, int first)
             "\"grid_vertices\": %llu, \"hit_rate\": {\"coarse\": %.5f, \"medium\": %.5f, "
             "\"fine\": %.5f}}",
             first ? "" : ",", r->bounces, r->cache, r->subset, r->time_s, r->cpu_s, r->peak_mb,
-            r->grid_mb, r->accel_mb, r->shading_points, r->rays, r->shadow, r->diffuse,
-            r->specular, r->grids, r->vertices, r->hit[0], r->hit[1], r->hit[2]);
+            r->grid_mb, r->accel_mb, r->shading_points, r->rays, r->shadow, r->diffuse, r->specular,
+            r->grids, r->vertices, r->hit[0], r->hit[1], r->hit[2]);
 }
 
 static int parse_size(const char *v, int *w, int *h)
@@ -331,12 +335,11 @@ int main(int argc, char **argv)
         die("cannot write the JSON record");
     printf("production-room, %dx%d, %d spp, %d shadow rays per area light, %d diffuse rays (%d "
            "deeper), %d threads\n",
-           a.width, a.height, a.spp, a.shadow_rays, a.diffuse_rays, a.diffuse_rays_deep,
-           a.threads);
+           a.width, a.height, a.spp, a.shadow_rays, a.diffuse_rays, a.diffuse_rays_deep, a.threads);
     printf("%s%s\n\n", a.tiles > 1 ? "one 32x32 tile in --tiles of the frame" : "the whole frame",
            a.uncached ? "" : ", cached rows only");
-    printf("%-14s | %8s %8s %7s | %8s | %10s | %9s %9s | %s\n", "illumination", "shadow",
-           "diffuse", "spec", "sh.pts", "peak mem", "time", "cpu", "hit % coarse/medium/fine");
+    printf("%-14s | %8s %8s %7s | %8s | %10s | %9s %9s | %s\n", "illumination", "shadow", "diffuse",
+           "spec", "sh.pts", "peak mem", "time", "cpu", "hit % coarse/medium/fine");
     fprintf(j,
             "{\"scene\": \"production-room\", \"width\": %d, \"height\": %d, \"spp\": %d, "
             "\"shadow_rays\": %d, \"diffuse_rays\": %d, \"diffuse_rays_deep\": %d, \"tiles\": %d, "
@@ -372,8 +375,9 @@ int main(int argc, char **argv)
                    "worst 32x32 tile %.3f%% (%s)\n",
                    b, b > 1 ? "s" : "", off[b].time_s / on[b].time_s, off[b].cpu_s / on[b].cpu_s,
                    100 * mrel, 100 * trel, where);
-            fprintf(j, ",\n    {\"bias_bounces\": %d, \"mean_rel\": %.6f, \"max_tile_rel\": %.6f, "
-                       "\"speedup\": %.3f, \"speedup_cpu\": %.3f}",
+            fprintf(j,
+                    ",\n    {\"bias_bounces\": %d, \"mean_rel\": %.6f, \"max_tile_rel\": %.6f, "
+                    "\"speedup\": %.3f, \"speedup_cpu\": %.3f}",
                     b, mrel, trel, off[b].time_s / on[b].time_s, off[b].cpu_s / on[b].cpu_s);
         }
         if (b > 1) {

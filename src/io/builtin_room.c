@@ -160,13 +160,13 @@ static void box(Room *r, float x0, float x1, float y0, float y1, float z0, float
  * approximation). */
 static void revolve(Room *r, float cx, float cy, float cz, const float prof[4][2])
 {
-    static const float ring[13][2] = {{1, 0}, {1, 0.5522847f}, {0.5522847f, 1}, {0, 1},
-                                      {-0.5522847f, 1}, {-1, 0.5522847f}, {-1, 0},
-                                      {-1, -0.5522847f}, {-0.5522847f, -1}, {0, -1},
-                                      {0.5522847f, -1}, {1, -0.5522847f}, {1, 0}};
+    static const float ring[13][2] = {
+        {1, 0},  {1, 0.5522847f},   {0.5522847f, 1},   {0, 1},  {-0.5522847f, 1}, {-1, 0.5522847f},
+        {-1, 0}, {-1, -0.5522847f}, {-0.5522847f, -1}, {0, -1}, {0.5522847f, -1}, {1, -0.5522847f},
+        {1, 0}};
     for (int q = 0; q < 4 && r->e == RAYES_OK; q++) {
         float P[16][3];
-        for (int j = 0; j < 4; j++)     /* along the profile */
+        for (int j = 0; j < 4; j++)       /* along the profile */
             for (int i = 0; i < 4; i++) { /* around */
                 const float *c = ring[3 * q + i];
                 P[4 * j + i][0] = cx + prof[j][0] * c[0];
@@ -356,11 +356,16 @@ static RayesError make_textures(char *dir, size_t dir_size, char *err, size_t er
 static void walls(Room *r)
 {
     /* floor: oak planks along x, displaced a little */
-    const RayesParam floorwood[] = {fp("plankwidth", 0.16f), fp("planklength", 1.9f),
-                                    fp("axis", 0), fp("Ks", 0.25f), fp("roughness", 0.04f),
+    const RayesParam floorwood[] = {fp("plankwidth", 0.16f),
+                                    fp("planklength", 1.9f),
+                                    fp("axis", 0),
+                                    fp("Ks", 0.25f),
+                                    fp("roughness", 0.04f),
                                     cp("Clight", 0.78f, 0.55f, 0.32f),
-                                    cp("Cdark", 0.5f, 0.3f, 0.14f), fp("ringscale", 25),
-                                    fp("grainamp", 0.7f), fp("gapwidth", 0.006f)};
+                                    cp("Cdark", 0.5f, 0.3f, 0.14f),
+                                    fp("ringscale", 25),
+                                    fp("grainamp", 0.7f),
+                                    fp("gapwidth", 0.006f)};
     shader(r, "wood", floorwood, 10);
     const RayesParam fl[] = {fp("amplitude", 0.0015f), fp("frequency", 6), fp("octaves", 4)};
     displacement(r, "fractal", fl, 3, 0.003f);
@@ -393,7 +398,8 @@ static void walls(Room *r)
     shader(r, "paintedplastic", wp, 4);
     rect(r, (float[3]){3, 0, 3}, (float[3]){0, 0, -7}, (float[3]){0, 2.8f, 0}, 7, 3, 14, 5.6f);
     /* skirting boards */
-    const RayesParam paint[] = {cp("Cs", 0.85f, 0.84f, 0.8f), fp("Ks", 0.3f), fp("roughness", 0.05f)};
+    const RayesParam paint[] = {cp("Cs", 0.85f, 0.84f, 0.8f), fp("Ks", 0.3f),
+                                fp("roughness", 0.05f)};
     shader(r, "plastic", paint, 3);
     box(r, -3, 3, 0, 0.12f, -4, -3.98f, 3);
     box(r, 2.98f, 3, 0, 0.12f, -4, 3, 3);
@@ -403,12 +409,13 @@ static void walls(Room *r)
 /* The window's frame and cross bars, in wood painted white. */
 static void window(Room *r)
 {
-    const RayesParam paint[] = {cp("Cs", 0.9f, 0.9f, 0.88f), fp("Ks", 0.4f), fp("roughness", 0.04f)};
+    const RayesParam paint[] = {cp("Cs", 0.9f, 0.9f, 0.88f), fp("Ks", 0.4f),
+                                fp("roughness", 0.04f)};
     shader(r, "plastic", paint, 3);
     const float x0 = -3.08f, x1 = -2.92f;
-    box(r, x0, x1, 0.84f, 0.9f, -2.76f, -0.64f, 3);  /* sill */
-    box(r, x0, x1, 2.3f, 2.36f, -2.76f, -0.64f, 3);  /* head */
-    box(r, x0, x1, 0.9f, 2.3f, -2.76f, -2.7f, 3);    /* jambs */
+    box(r, x0, x1, 0.84f, 0.9f, -2.76f, -0.64f, 3); /* sill */
+    box(r, x0, x1, 2.3f, 2.36f, -2.76f, -0.64f, 3); /* head */
+    box(r, x0, x1, 0.9f, 2.3f, -2.76f, -2.7f, 3);   /* jambs */
     box(r, x0, x1, 0.9f, 2.3f, -0.7f, -0.64f, 3);
     box(r, -3.04f, -2.96f, 0.9f, 2.3f, -1.72f, -1.68f, 3); /* mullion */
     box(r, -3.04f, -2.96f, 1.58f, 1.62f, -2.7f, -0.7f, 3); /* transom */
@@ -419,9 +426,12 @@ static void window(Room *r)
 
 static void table_and_chairs(Room *r)
 {
-    const RayesParam walnut[] = {fp("axis", 0), cp("Clight", 0.45f, 0.28f, 0.15f),
-                                 cp("Cdark", 0.24f, 0.13f, 0.06f), fp("Ks", 0.5f),
-                                 fp("roughness", 0.03f), fp("ringscale", 60)};
+    const RayesParam walnut[] = {fp("axis", 0),
+                                 cp("Clight", 0.45f, 0.28f, 0.15f),
+                                 cp("Cdark", 0.24f, 0.13f, 0.06f),
+                                 fp("Ks", 0.5f),
+                                 fp("roughness", 0.03f),
+                                 fp("ringscale", 60)};
     shader(r, "wood", walnut, 6);
     const float tx = -0.7f, tz = -1.7f;
     box(r, tx - 0.85f, tx + 0.85f, 0.72f, 0.77f, tz - 0.48f, tz + 0.48f, 2.5f);
@@ -474,9 +484,9 @@ static void sofa(Room *r)
     const RayesParam fabric[] = {pat("reflectance", "fabric")};
     shader(r, "diffuse", fabric, 1);
     const float x0 = 0.6f, x1 = 2.7f, z0 = -3.85f, z1 = -2.95f;
-    box(r, x0 + 0.2f, x1 - 0.2f, 0.12f, 0.4f, z0, z1, 1.5f);           /* base */
-    box(r, x0 + 0.2f, x1 - 0.2f, 0.4f, 0.95f, z0, z0 + 0.25f, 1.0f);   /* back */
-    box(r, x0, x0 + 0.22f, 0.12f, 0.68f, z0, z1, 1.5f);                /* arms */
+    box(r, x0 + 0.2f, x1 - 0.2f, 0.12f, 0.4f, z0, z1, 1.5f);         /* base */
+    box(r, x0 + 0.2f, x1 - 0.2f, 0.4f, 0.95f, z0, z0 + 0.25f, 1.0f); /* back */
+    box(r, x0, x0 + 0.22f, 0.12f, 0.68f, z0, z1, 1.5f);              /* arms */
     box(r, x1 - 0.22f, x1, 0.12f, 0.68f, z0, z1, 1.5f);
     for (int k = 0; k < 3; k++) { /* seat cushions, soft */
         float a = x0 + 0.22f + (x1 - x0 - 0.44f) * k / 3.0f, b = a + (x1 - x0 - 0.44f) / 3.0f;
@@ -507,7 +517,7 @@ static void shelves(Room *r)
     for (int b = 0; b < 5; b++)
         box(r, x0, x1 - 0.02f, boards[b], boards[b] + 0.03f, z0 + 0.03f, z1 - 0.03f, 3);
     /* books: plastic covers, colours and sizes from a hash */
-    static const float covers[6][3] = {{0.5f, 0.08f, 0.06f}, {0.1f, 0.2f, 0.45f},
+    static const float covers[6][3] = {{0.5f, 0.08f, 0.06f},  {0.1f, 0.2f, 0.45f},
                                        {0.12f, 0.35f, 0.15f}, {0.7f, 0.6f, 0.35f},
                                        {0.3f, 0.12f, 0.3f},   {0.15f, 0.15f, 0.15f}};
     for (int b = 0; b < 3 && r->e == RAYES_OK; b++) {
@@ -551,11 +561,16 @@ static void objects(Room *r)
     revolve(r, -0.95f, 0.77f, -1.75f, bowl);
     const float inner[4][2] = {{0.19f, 0.11f}, {0.19f, 0.06f}, {0.17f, 0.01f}, {0.001f, 0.01f}};
     revolve(r, -0.95f, 0.77f, -1.75f, inner);
-    static const float fruit[5][4] = {{-1.0f, 0.84f, -1.75f, 0.06f}, {-0.88f, 0.84f, -1.72f, 0.055f},
-                                      {-0.95f, 0.84f, -1.84f, 0.06f}, {-0.93f, 0.92f, -1.76f, 0.05f},
+    static const float fruit[5][4] = {{-1.0f, 0.84f, -1.75f, 0.06f},
+                                      {-0.88f, 0.84f, -1.72f, 0.055f},
+                                      {-0.95f, 0.84f, -1.84f, 0.06f},
+                                      {-0.93f, 0.92f, -1.76f, 0.05f},
                                       {-1.04f, 0.83f, -1.85f, 0.05f}};
-    static const float fc[5][3] = {{0.7f, 0.1f, 0.05f}, {0.8f, 0.55f, 0.05f}, {0.25f, 0.5f, 0.1f},
-                                   {0.75f, 0.2f, 0.05f}, {0.8f, 0.6f, 0.1f}};
+    static const float fc[5][3] = {{0.7f, 0.1f, 0.05f},
+                                   {0.8f, 0.55f, 0.05f},
+                                   {0.25f, 0.5f, 0.1f},
+                                   {0.75f, 0.2f, 0.05f},
+                                   {0.8f, 0.6f, 0.1f}};
     for (int k = 0; k < 5 && r->e == RAYES_OK; k++) {
         const RayesParam skin[] = {cp("Cs", fc[k][0], fc[k][1], fc[k][2]), fp("Ks", 0.4f),
                                    fp("roughness", 0.06f)};
@@ -567,7 +582,8 @@ static void objects(Room *r)
             sphere_quadric(r, fruit[k][3]);
     }
     transform(r, identity);
-    const RayesParam blue[] = {cp("Cs", 0.12f, 0.22f, 0.5f), fp("Ks", 0.7f), fp("roughness", 0.02f)};
+    const RayesParam blue[] = {cp("Cs", 0.12f, 0.22f, 0.5f), fp("Ks", 0.7f),
+                               fp("roughness", 0.02f)};
     shader(r, "plastic", blue, 3);
     const float vase[4][2] = {{0.05f, 0}, {0.14f, 0.12f}, {0.03f, 0.26f}, {0.06f, 0.4f}};
     revolve(r, -0.25f, 0.77f, -1.6f, vase);
@@ -656,8 +672,8 @@ static void frame_toward(float m[16], const float o[3], const float dir[3])
 /* A quad area light a x b centred on o, emitting toward dir, of radiance
  * intensity times colour (a quad, as RIB's AreaLightSource writes and
  * reads them). */
-static void area(Room *r, const float o[3], const float dir[3], float a, float b,
-                 float intensity, const float colour[3])
+static void area(Room *r, const float o[3], const float dir[3], float a, float b, float intensity,
+                 const float colour[3])
 {
     float m[16], P[4][3];
     frame_toward(m, o, dir);
@@ -673,8 +689,10 @@ static void area(Room *r, const float o[3], const float dir[3], float a, float b
 static void spot(Room *r, const float from[3], const float to[3], float cone, float delta,
                  float intensity, const float colour[3])
 {
-    const RayesParam p[] = {cp("from", from[0], from[1], from[2]), cp("to", to[0], to[1], to[2]),
-                            fp("coneangle", cone), fp("conedeltaangle", delta),
+    const RayesParam p[] = {cp("from", from[0], from[1], from[2]),
+                            cp("to", to[0], to[1], to[2]),
+                            fp("coneangle", cone),
+                            fp("conedeltaangle", delta),
                             fp("intensity", intensity),
                             cp("lightcolor", colour[0], colour[1], colour[2])};
     light(r, "spotlight", p, 6);
@@ -705,8 +723,7 @@ static void lights(Room *r)
                               fp("intensity", 8.0f), cp("lightcolor", 1.0f, 0.92f, 0.8f)};
     light(r, "distantlight", sun, 4);
     /* 3-5: ceiling panels facing down */
-    area(r, (float[3]){-0.7f, 2.78f, -1.7f}, (float[3]){0, -1, 0}, 1.0f, 0.5f, 7.0f,
-         white);
+    area(r, (float[3]){-0.7f, 2.78f, -1.7f}, (float[3]){0, -1, 0}, 1.0f, 0.5f, 7.0f, white);
     area(r, (float[3]){1.5f, 2.78f, -2.8f}, (float[3]){0, -1, 0}, 1.0f, 0.5f, 6.0f, white);
     /* the window's portal: the sky's light through the opening, which the
      * environment light alone gives only as the speckle of its few samples

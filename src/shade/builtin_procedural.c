@@ -44,9 +44,9 @@ typedef struct BrickParams {
     float Ka, Kd, Ks, roughness;
     float Cbrick[3], Cmortar[3];
     float brickwidth, brickheight, mortarthickness; /* world units */
-    float variation;           /* spread of the brick colours, 0..1 */
-    float mortardepth;         /* displacement: how far the mortar is recessed */
-    float roughnessamp;        /* displacement: fbm roughness of the faces */
+    float variation;                                /* spread of the brick colours, 0..1 */
+    float mortardepth;  /* displacement: how far the mortar is recessed */
+    float roughnessamp; /* displacement: fbm roughness of the faces */
 } BrickParams;
 
 typedef struct ColourScratch {
@@ -78,8 +78,8 @@ static float cell_hash(int a, int b)
 
 /* ---- the lighting both share: C (Ka ambient + Kd diffuse) + Ks F spec */
 
-static void coat_chunk(const RayesShaderServices *sv, const RayesShadeCtx *ctx, float Ka,
-                       float Kd, float Ks, float roughness, int highlight, RayesShadeOutputs *out)
+static void coat_chunk(const RayesShaderServices *sv, const RayesShadeCtx *ctx, float Ka, float Kd,
+                       float Ks, float roughness, int highlight, RayesShadeOutputs *out)
 {
     const ColourScratch *sc = ctx->scratch;
     float dd[SHADE_CHUNK][3], id[SHADE_CHUNK][3], ds[SHADE_CHUNK][3], am[SHADE_CHUNK][3];
@@ -105,7 +105,8 @@ static void coat_chunk(const RayesShaderServices *sv, const RayesShadeCtx *ctx, 
         for (int c = 0; c < 3; c++) {
             float base = (ctx->Cs ? ctx->Cs[i][c] : 1.0f) * sc[i].C[c] *
                          (Ka * am[i][c] + Kd * (dd[i][c] + id[i][c]));
-            out->Ci[i][c] = base + (highlight ? Ks * (1.0f + 3.0f * (F - 0.04f) / 0.96f) * ds[i][c] : 0.0f);
+            out->Ci[i][c] =
+                base + (highlight ? Ks * (1.0f + 3.0f * (F - 0.04f) / 0.96f) * ds[i][c] : 0.0f);
         }
     }
     if (out->Irradiance)
@@ -114,8 +115,8 @@ static void coat_chunk(const RayesShaderServices *sv, const RayesShadeCtx *ctx, 
                 out->Irradiance[i][c] = 3.14159265f * (dd[i][c] + id[i][c]);
 }
 
-typedef void (*ChunkFn)(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
-                        const void *params, RayesShadeOutputs *out);
+typedef void (*ChunkFn)(const RayesShaderServices *sv, const RayesShadeCtx *ctx, const void *params,
+                        RayesShadeOutputs *out);
 
 /* Calls fn on SHADE_CHUNK-point slices of ctx, the scratch sliced along;
  * then Oi = Os and Ci premultiplied by it. */
@@ -191,8 +192,8 @@ static void wood_prelighting(const RayesShaderServices *sv, const RayesShadeCtx 
         wood_colour(sv, params, ctx->P[i], sc[i].C);
 }
 
-static void wood_chunk(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
-                       const void *params, RayesShadeOutputs *out)
+static void wood_chunk(const RayesShaderServices *sv, const RayesShadeCtx *ctx, const void *params,
+                       RayesShadeOutputs *out)
 {
     const WoodParams *p = params;
     coat_chunk(sv, ctx, p->Ka, p->Kd, p->Ks, p->roughness, 1, out);
@@ -291,8 +292,8 @@ static void brick_prelighting(const RayesShaderServices *sv, const RayesShadeCtx
         brick_colour(sv, params, ctx->P[i], sc[i].C);
 }
 
-static void brick_chunk(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
-                        const void *params, RayesShadeOutputs *out)
+static void brick_chunk(const RayesShaderServices *sv, const RayesShadeCtx *ctx, const void *params,
+                        RayesShadeOutputs *out)
 {
     const BrickParams *p = params;
     coat_chunk(sv, ctx, p->Ka, p->Kd, p->Ks, p->roughness, 1, out);

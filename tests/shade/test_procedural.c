@@ -77,9 +77,12 @@ static RayesShadeCtx context(void)
         I[i][1] = 0.0f;
         I[i][2] = -0.8f;
     }
-    return (RayesShadeCtx){.n_points = N, .ray_type = RAYES_RAY_CAMERA,
-                           .P = (const float(*)[3])P, .N = (const float(*)[3])Nn,
-                           .Ng = (const float(*)[3])Nn, .I = (const float(*)[3])I};
+    return (RayesShadeCtx){.n_points = N,
+                           .ray_type = RAYES_RAY_CAMERA,
+                           .P = (const float(*)[3])P,
+                           .N = (const float(*)[3])Nn,
+                           .Ng = (const float(*)[3])Nn,
+                           .I = (const float(*)[3])I};
 }
 
 static ShaderInstance instance(const char *name, const RayesParam *p, size_t n)
@@ -119,8 +122,8 @@ static void test_brick_displacement_recesses_the_mortar(void)
     ShaderInstance inst = instance("brickwall", p, 2);
     CHECK(inst.cls->displacement != NULL);
     /* bricks 0.215 x 0.075 (the defaults), a joint at y = 0 and x = 0 */
-    const float at[N][3] = {{0.1075f, 0.0375f, 0}, {0.0f, 0.0375f, 0},
-                            {0.05f, 0.0f, 0}, {0.2f, 0.1125f, 0}};
+    const float at[N][3] = {
+        {0.1075f, 0.0375f, 0}, {0.0f, 0.0375f, 0}, {0.05f, 0.0f, 0}, {0.2f, 0.1125f, 0}};
     memcpy(P, at, sizeof P);
     RayesShadeCtx ctx = context();
     ctx.I = NULL;
@@ -142,8 +145,8 @@ static void test_brick_colours(void)
                             {"Cbrick", RAYES_PARAM_COLOR, {0.6f, 0.2f, 0.1f}, NULL},
                             {"Cmortar", RAYES_PARAM_COLOR, {0.6f, 0.6f, 0.6f}, NULL}};
     ShaderInstance inst = instance("brickwall", p, 3);
-    const float at[N][3] = {{0.1075f, 0.0375f, 0}, {0.0f, 0.0375f, 0},
-                            {0.05f, 0.0f, 0}, {0.2f, 0.1125f, 0}};
+    const float at[N][3] = {
+        {0.1075f, 0.0375f, 0}, {0.0f, 0.0375f, 0}, {0.05f, 0.0f, 0}, {0.2f, 0.1125f, 0}};
     memcpy(P, at, sizeof P);
     shade_both(&inst, 0.4f);
     for (int i = 0; i < N; i++) {
@@ -167,8 +170,8 @@ static void test_wood_planks_and_grain(void)
                             {"Ks", RAYES_PARAM_FLOAT, {0.25f, 0, 0}, NULL}};
     ShaderInstance inst = instance("wood", p, 4);
     /* planks run along x, side by side along y (axis 0: a = y) */
-    const float at[N][3] = {{0.3f, 0.08f, 0}, {0.3f, 0.16f, 0}, {0.31f, 0.24f, 0},
-                            {0.3f, 0.08f, 0}};
+    const float at[N][3] = {
+        {0.3f, 0.08f, 0}, {0.3f, 0.16f, 0}, {0.31f, 0.24f, 0}, {0.3f, 0.08f, 0}};
     memcpy(P, at, sizeof P);
     shade_both(&inst, 0.25f);
     const float light[3] = {0.62f, 0.42f, 0.24f}, dark[3] = {0.36f, 0.2f, 0.09f};
