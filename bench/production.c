@@ -20,7 +20,7 @@
  *
  * Rows: direct illumination (0 bounces), then 1..B bounces with caching
  * off and on, each a whole frame of --size. An uncached frame at these
- * settings costs about 12 ms of CPU per pixel on this machine (hours at
+ * settings costs about 8 ms of CPU per pixel on this machine (hours at
  * 1280 x 720), so docs/performance.md measures the pairs at a reduced
  * --size and the cached rows alone (--uncached 0) at 1280 x 720.
  * --tiles K renders one 32 x 32 tile in K, spread over the frame by a
