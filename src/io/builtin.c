@@ -15,7 +15,8 @@
 
 const char *const io_builtin_scene_names[] = {"cornell", "cornell-teapots",
                                               "cornell-teapots-displaced", "cornell-spheres",
-                                              "cornell-brick", "cornell-teapots-motion", NULL};
+                                              "cornell-brick", "cornell-teapots-motion",
+                                              "production-room", NULL};
 
 typedef struct Quad {
     float P[4][3];
@@ -297,11 +298,13 @@ RayesError io_builtin_scene(const char *name, const char *data_dir, const IoSink
             e = cornell_blocks(s);
         if (e == RAYES_OK)
             e = cornell_brick(s, err, err_size);
+    } else if (strcmp(name, "production-room") == 0) {
+        e = io_builtin_production_room(s, err, err_size);
     } else {
         snprintf(err, err_size,
                  "unknown scene \"%s\" (built-in scenes: cornell, cornell-teapots, "
                  "cornell-teapots-displaced, cornell-spheres, cornell-brick, "
-                 "cornell-teapots-motion)",
+                 "cornell-teapots-motion, production-room)",
                  name);
         return RAYES_ERROR_INVALID_ARGUMENT;
     }

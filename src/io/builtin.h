@@ -24,6 +24,11 @@
 RayesError io_builtin_scene(const char *name, const char *data_dir, const IoSink *sink, char *err,
                             size_t err_size);
 
+/* "production-room" (builtin_room.c): the furnished interior of the
+ * production benchmark (bench/production), 20 lights, textures made at
+ * build time into $TMPDIR/rayes-production-room-N. */
+RayesError io_builtin_production_room(const IoSink *sink, char *err, size_t err_size);
+
 /* The names, NULL-terminated. */
 extern const char *const io_builtin_scene_names[];
 

@@ -1141,13 +1141,37 @@ static RayesError w_light(void *t, const char *type, const RayesParam *p, size_t
     RibWriter *w = t;
     if (!type || !type[0])
         return fail(w, RAYES_ERROR_INVALID_ARGUMENT, "light: no type");
+    /* RenderMan's spotlight takes its angles in radians, rayes's in
+     * degrees: they are written apart, in radians to 17 digits, so the
+     * reader's conversion back gives the same float. */
+    int spot = strcmp(type, "spotlight") == 0;
+    RayesParam rest[64];
+    double angle[2] = {-1.0, -1.0};
+    size_t n_rest = 0;
+    for (size_t i = 0; i < n; i++) {
+        int k = !spot || p[i].type != RAYES_PARAM_FLOAT || !p[i].name ? -1
+                : strcmp(p[i].name, "coneangle") == 0                 ? 0
+                : strcmp(p[i].name, "conedeltaangle") == 0            ? 1
+                                                                      : -1;
+        if (k >= 0)
+            angle[k] = (double)p[i].value[0] * M_PI / 180.0;
+        else if (n_rest < sizeof rest / sizeof rest[0])
+            rest[n_rest++] = p[i];
+        else
+            return fail(w, RAYES_ERROR_INVALID_ARGUMENT, "light: too many parameters");
+    }
     char *text = NULL;
-    RayesError e = params_text(w, p, n, 1, &text);
+    RayesError e = params_text(w, rest, n_rest, 1, &text);
     if (e == RAYES_OK) {
         fprintf(w->world.f, "LightSource ");
         string(w->world.f, type);
         int h = w->next_light++;
-        fprintf(w->world.f, " %d%s\n", h, text ? text : "");
+        fprintf(w->world.f, " %d%s", h, text ? text : "");
+        static const char *const angle_names[2] = {"coneangle", "conedeltaangle"};
+        for (int k = 0; k < 2; k++)
+            if (angle[k] >= 0.0)
+                fprintf(w->world.f, " \"float %s\" [%.17g]", angle_names[k], angle[k]);
+        fprintf(w->world.f, "\n");
         if (h < 4097 && !w_linked(w, (size_t)h - 1)) {
             fprintf(w->world.f, "Illuminate %d 0\n", h);
             w->off[h] = 1;

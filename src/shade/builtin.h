@@ -54,6 +54,11 @@ int shade_texture_service(TextureSystem *ts, const RayesShadeCtx *ctx, const cha
 /* plastic with a texture: Ka, Kd, Ks, roughness, specularcolor, texturename */
 extern const RayesShaderClass shade_class_paintedplastic;
 
+/* builtin_procedural.c: wood grain under a varnish (planks optional) and a
+ * brick wall whose displacement recesses its mortar (docs/shaders.md). */
+extern const RayesShaderClass shade_class_wood;
+extern const RayesShaderClass shade_class_brickwall;
+
 /* builtin_bsdf.c: the rest of RenderMan's classics and the physically based
  * family the pbrt reader maps to (README.md lists their parameters). */
 extern const RayesShaderClass shade_class_metal;         /* Ka, Ks, roughness */

@@ -18,6 +18,7 @@ static const RayesShaderClass *const builtin_classes[] = {
     &shade_class_dielectric, &shade_class_coateddiffuse, &shade_class_paintedplastic,
     &shade_class_hair,       &shade_class_stainedglass,  &shade_class_occlusion,
     &shade_class_homogeneous, &shade_class_turbulence,   &shade_class_subsurface,
+    &shade_class_wood,       &shade_class_brickwall,
 };
 
 const RayesShaderClass *shade_find_class(const char *name)

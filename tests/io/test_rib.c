@@ -36,6 +36,7 @@ typedef struct Rec {
     float Cs[3];
     int n_shader_calls;
     int bilinear, bicubic, meshes, faces, tris, quads, quadrics, area_lights, lights;
+    int subdivs;           /* subdivision meshes */
     int link_calls, links_mode;  /* set_light_links calls, the last one's mode */
     size_t links[8], n_links;    /* and its lights */
     float first_bicubic[16][3];
@@ -205,6 +206,15 @@ static RayesError s_area(void *t, const float P[4][3], const float L[3])
     memcpy(rec.area_P, P, sizeof rec.area_P);
     return RAYES_OK;
 }
+static RayesError s_subdiv(void *t, RayesSubdivScheme scheme, size_t n_faces, const int *n_verts,
+                           const int *indices, size_t n_points, const float *P,
+                           const RayesSubdivTags *tags, const RayesPrimvar *pv, size_t n_pv)
+{
+    (void)t, (void)scheme, (void)n_faces, (void)n_verts, (void)indices, (void)n_points, (void)P;
+    (void)tags, (void)pv, (void)n_pv;
+    rec.subdivs++;
+    return RAYES_OK;
+}
 static RayesError s_light(void *t, const char *type, const RayesParam *p, size_t n)
 {
     (void)t;
@@ -244,7 +254,7 @@ static const char *s_error(void *t)
 static const IoSink stub = {
     NULL,    s_camera,   s_camera_matrix, s_transform, s_shader, s_displacement, s_float, s_search,
     s_float, s_bilinear, s_bicubic,       s_mesh,      s_sphere, s_quadric,      s_area,  s_light,
-    s_links, s_count,    s_error,         NULL,        NULL,     NULL, NULL, s_pattern};
+    s_links, s_count,    s_error,         NULL,        s_subdiv, NULL, NULL, s_pattern};
 
 static IoSettings settings;
 static char err[1024];
@@ -931,6 +941,7 @@ static void test_writer_round_trip(void)
         CHECK(rec.quads + rec.bilinear == direct.quads + direct.bilinear);
         CHECK(strcmp(name, "cornell") != 0 || rec.bilinear > 0);
         CHECK(rec.quadrics == direct.quadrics);
+        CHECK(rec.subdivs == direct.subdivs);
         CHECK(rec.area_lights == direct.area_lights);
         CHECK(rec.lights == direct.lights);
         CHECK(rec.cameras == 1);
