@@ -367,7 +367,7 @@ static void fill_radiosity(void *user, const CacheKey *key, size_t n, float (*ou
     float outer_time = w->time;
     const Camera *cam = &w->rs->camera;
     w->time = moves ? geom_segment_mid_time(gs, key->segment)
-                        : 0.5f * (cam->shutter[0] + cam->shutter[1]);
+                    : 0.5f * (cam->shutter[0] + cam->shutter[1]);
     float width = level_edge(g, key->level) * scale, du, dv;
     level_footprint(g, key->level, &du, &dv);
     for (size_t i = 0; i < n; i++) {

@@ -184,8 +184,8 @@ typedef struct Flatten {
  * primitives, then its nested instances', seen by the rays of mask (the
  * enclosing instances' objects' visibility, ANDed). Motion at any level
  * composes sample by sample (DESIGN.md "Instances": instance motion). */
-static void place(const RayesScene *s, const Children *c, Flatten *fl, uint32_t m,
-                  const Mat4 *W, int moving, uint32_t object, uint32_t mask, GridSet *gs)
+static void place(const RayesScene *s, const Children *c, Flatten *fl, uint32_t m, const Mat4 *W,
+                  int moving, uint32_t object, uint32_t mask, GridSet *gs)
 {
     const SceneMaster *ms = &s->masters[m];
     GeomInstance *gi = &gs->instances[gs->n_instances];
@@ -240,9 +240,9 @@ int scene_flatten_instances(const RayesScene *s, GridSet *gs)
     float span[2];
     fl.n_times = scene_time_samples(s, span);
     for (int j = 0; j < fl.n_times; j++)
-        fl.time[j] = fl.n_times > 1 ? span[0] + (span[1] - span[0]) * (float)j /
-                                                    (float)(fl.n_times - 1)
-                                    : span[0];
+        fl.time[j] = fl.n_times > 1
+                         ? span[0] + (span[1] - span[0]) * (float)j / (float)(fl.n_times - 1)
+                         : span[0];
     Mat4 W[GEOM_MAX_TIMES];
     for (size_t i = 0; i < s->n_instances && !fl.failed; i++) {
         const SceneInstance *si = &s->instances[i];

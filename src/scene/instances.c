@@ -9,8 +9,9 @@
  * SCENE_OBJECT_INHERIT and its primitives take each instance's object.
  * object_end restores what object_begin saved (SceneSaved), so attributes
  * set inside a block do not leak out. Each instance records the current
- * transform (moving: its motion, SceneInstance.motion) and object; nesting and the flattened count are bounded here
- * (SCENE_MAX_NESTING, SCENE_MAX_INSTANCES), so prepare cannot explode.
+ * transform (moving: its motion, SceneInstance.motion) and object;
+ * nesting and the flattened count are bounded here (SCENE_MAX_NESTING,
+ * SCENE_MAX_INSTANCES), so prepare cannot explode.
  */
 #include <stdlib.h>
 #include <string.h>
@@ -61,11 +62,10 @@ RayesError rayes_scene_object_begin(RayesScene *s, const char *name)
         return scene_fail(s, RAYES_ERROR_OUT_OF_MEMORY, "out of memory");
     m->first_prim = m->end_prim = s->n_prims;
     m->depth = 1;
-    s->saved =
-        (SceneSaved){s->world_from_object,  s->current_object,       s->shading_rate,
-                     s->displacement_bound, s->current_displacement, s->current_links,
-                     s->current_visibility, s->current_hitmode,      s->current_opacity_cache,
-                     s->current_motion};
+    s->saved = (SceneSaved){
+        s->world_from_object,     s->current_object, s->shading_rate,       s->displacement_bound,
+        s->current_displacement,  s->current_links,  s->current_visibility, s->current_hitmode,
+        s->current_opacity_cache, s->current_motion};
     s->open_master = (int64_t)s->n_masters++;
     s->current_object = SCENE_OBJECT_INHERIT;
     s->world_from_object = mat4_identity();

@@ -443,8 +443,8 @@ static void test_moving_instance(void)
     IoSettings settings;
     io_settings_init(&settings);
     IoReadOptions opt = {NULL, -1};
-    CHECK(io_rib_parse("t.rib", (const unsigned char *)text, strlen(text), &sink, &opt,
-                       &settings, err, sizeof err) == RAYES_OK);
+    CHECK(io_rib_parse("t.rib", (const unsigned char *)text, strlen(text), &sink, &opt, &settings,
+                       err, sizeof err) == RAYES_OK);
     char *out = NULL;
     size_t size = 0;
     FILE *f = open_memstream(&out, &size);
