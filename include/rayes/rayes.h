@@ -118,8 +118,8 @@ RAYES_API RayesError rayes_scene_set_shutter(RayesScene *scene, float open, floa
 /* A moving transform for geometry added from now on: world_from_object
  * (row-major) at n_times increasing times (2 to RAYES_MAX_TIMES); the
  * geometry moves linearly between samples (RenderMan's MotionBegin around
- * transforms). Lights made under it move with it within the frame.
- * set_transform ends it. */
+ * transforms). Lights made under it move with it within the frame, and
+ * so do object instances placed under it. set_transform ends it. */
 RAYES_API RayesError rayes_scene_set_transform_motion(RayesScene *scene, size_t n_times,
                                                       const float *times,
                                                       const float (*world_from_object)[16]);
@@ -567,15 +567,17 @@ RAYES_API RayesError rayes_scene_set_light_links(RayesScene *scene, RayesLightLi
  * pbrt-v4's ObjectBegin, ObjectEnd, ObjectInstance; memo 3.1). Between
  * rayes_scene_object_begin and rayes_scene_object_end, geometry goes into
  * a master named name instead of the world, in the master's own space
- * (the current transform inside the block is master_from_object; the one
- * before the block is restored by object_end, as are the shader, the
+ * (the current transform inside the block is master_from_object, still
+ * until a motion inside; the one before the block, moving or not, is
+ * restored by object_end, as are the shader, the
  * displacement, the shading rate, the visibility and the light links).
  * Geometry of the block made before any rayes_scene_set_shader inside it
  * takes, per instance, the object (shader, colour, opacity, visibility,
  * light links) current at rayes_scene_object_instance; geometry after a
  * set_shader inside the block keeps that shader in every instance.
  * rayes_scene_object_instance places the master defined last under that
- * name with the current transform (world_from_master): one diced master
+ * name with the current transform (world_from_master; a moving one,
+ * rayes_scene_set_transform_motion, moves the instance): one diced master
  * is shared by all its instances (Embree instances; its grids are counted
  * once), each instance has its own radiosity and opacity cache entries.
  * Inside a block it nests the named master in the one being defined

@@ -20,7 +20,10 @@
  * [0, 1], each a vertex buffer of their own (Geom.steps: the grids'
  * vertices one grid after another, still grids copied); a ray's time maps
  * onto the range (clamped). Other geometries share GridSet.P. Curves and
- * points stay still.
+ * points stay still. A moving instance (GeomInstance.motion) has as many
+ * time steps, each its world_from_master at that sample; Embree blends the
+ * matrices linearly (no quaternion form), and make_hit maps a hit's
+ * points with the same blend (geom_instance_at).
  *
  * Embree with TBB builds on its own threads; commit happens once, before
  * any query, and queries are concurrent (Embree's contract).
@@ -532,8 +535,16 @@ static int build_instances(Accel *a)
             continue; /* a master whose grids all fell away */
         RTCGeometry geom = rtcNewGeometry(a->device, RTC_GEOMETRY_TYPE_INSTANCE);
         rtcSetGeometryInstancedScene(geom, master);
-        rtcSetGeometryTransform(geom, 0, RTC_FORMAT_FLOAT3X4_ROW_MAJOR,
-                                &gi->world_from_master.m[0][0]);
+        if (gi->motion && gs->n_times > 1) { /* instance motion: a transform per time step */
+            const Mat4 *W = &gs->instance_motion[(size_t)(gi->motion - 1) * (size_t)gs->n_times];
+            rtcSetGeometryTimeStepCount(geom, (unsigned)gs->n_times);
+            for (int k = 0; k < gs->n_times; k++)
+                rtcSetGeometryTransform(geom, (unsigned)k, RTC_FORMAT_FLOAT3X4_ROW_MAJOR,
+                                        &W[k].m[0][0]);
+        } else {
+            rtcSetGeometryTransform(geom, 0, RTC_FORMAT_FLOAT3X4_ROW_MAJOR,
+                                    &gi->world_from_master.m[0][0]);
+        }
         Geom g = {.kind = KIND_INSTANCE, .instance = (uint32_t)i};
         if (attach(&a->levels[0], geom, gi->ray_mask & ~ACCEL_MASK_TRANSPARENT, g) != 0)
             return -1;
@@ -806,11 +817,13 @@ static void point_hit(const Accel *a, const Geom *g, const struct RTCHit *h, con
 static void make_hit(const Accel *a, const Ray *ray, const struct RTCHit *h, float tfar, Hit *hit)
 {
     const GeomInstance *gi = NULL;
+    GeomInstance moved;
     const Geom *g;
     hit->instance = 0;
     if (h->instID[0] != RTC_INVALID_GEOMETRY_ID) {
         uint32_t i = a->levels[0].geoms[h->instID[0]].instance;
-        gi = &a->gs->instances[i];
+        /* a moving instance at the ray's time, blended as Embree blends it */
+        gi = geom_instance_at(a->gs, &a->gs->instances[i], ray->time, &moved);
         g = &a->levels[gi->master + 1].geoms[h->geomID];
         hit->instance = i + 1;
     } else {

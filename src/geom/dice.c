@@ -67,6 +67,7 @@ void geom_gridset_fini(GridSet *gs)
     free(gs->Cs);
     free(gs->Os);
     free(gs->instances);
+    free(gs->instance_motion);
     for (int k = 0; k < GEOM_MAX_TIMES - 1; k++) {
         free(gs->Pt[k]);
         free(gs->Nt[k]);
@@ -74,6 +75,42 @@ void geom_gridset_fini(GridSet *gs)
         free(gs->dPdvt[k]);
     }
     memset(gs, 0, sizeof *gs);
+}
+
+int geom_instance_set(GeomInstance *gi, Mat4 world_from_master)
+{
+    gi->world_from_master = world_from_master;
+    if (!mat4_invert(world_from_master, &gi->master_from_world))
+        return -1;
+    const float(*a)[4] = world_from_master.m;
+    float det = a[0][0] * (a[1][1] * a[2][2] - a[1][2] * a[2][1]) -
+                a[0][1] * (a[1][0] * a[2][2] - a[1][2] * a[2][0]) +
+                a[0][2] * (a[1][0] * a[2][1] - a[1][1] * a[2][0]);
+    gi->normal_to_world = mat4_transpose(gi->master_from_world);
+    if (det < 0.0f) /* mirrored: keep N on the side of dPdu x dPdv */
+        for (int r = 0; r < 3; r++)
+            for (int c = 0; c < 3; c++)
+                gi->normal_to_world.m[r][c] = -gi->normal_to_world.m[r][c];
+    gi->scale = cbrtf(fabsf(det));
+    return 0;
+}
+
+const GeomInstance *geom_instance_at(const GridSet *gs, const GeomInstance *gi, float t,
+                                     GeomInstance *tmp)
+{
+    if (!gi || !gi->motion || gs->n_times < 2)
+        return gi;
+    float f;
+    int seg = geom_motion_segment(gs, t, &f);
+    const Mat4 *M = &gs->instance_motion[(size_t)(gi->motion - 1) * (size_t)gs->n_times];
+    Mat4 m;
+    for (int i = 0; i < 4; i++)
+        for (int j = 0; j < 4; j++)
+            m.m[i][j] = M[seg].m[i][j] + (M[seg + 1].m[i][j] - M[seg].m[i][j]) * f;
+    *tmp = *gi;
+    if (geom_instance_set(tmp, m) != 0)
+        return gi; /* a blend that is singular (a flip through zero): the first sample */
+    return tmp;
 }
 
 /* The primitive's (u, v) at lattice position (a, b) in [0,1]^2 of a domain

@@ -235,6 +235,9 @@ typedef struct GeomInstance {
     uint32_t object;       /* the object its master's GEOM_OBJECT_INHERIT grids take */
     uint32_t ray_mask;     /* RayesRayType bits that see it: those of every instance's object
                               along its nesting (an enclosing instance's visibility holds) */
+    uint32_t motion;       /* 0: still; else 1 + the index in GridSet.instance_motion of its
+                              world_from_master at each of the GridSet's n_times samples (the
+                              fields above are sample 0's); geom_instance_at blends them */
 } GeomInstance;
 
 typedef struct GridSet {
@@ -258,6 +261,9 @@ typedef struct GridSet {
                               here + 1 (Hit.instance, CacheKey.instance); owned */
     size_t n_instances;
     size_t n_masters;      /* masters (grids may have master 1 .. n_masters) */
+    Mat4 *instance_motion; /* moving instances' world_from_master, n_times per instance
+                              (GeomInstance.motion); owned, NULL if none moves */
+    size_t n_moving_instances;
     /* Motion blur (DESIGN.md "Motion blur and depth of field"): n_times
      * uniformly spaced time samples from time[0] to time[1]. Sample 0 is P,
      * N, dPdu, dPdv above; sample k >= 1 of a vertex of a moving grid g
@@ -295,6 +301,17 @@ static inline float geom_segment_mid_time(const GridSet *gs, int seg)
         return gs->time[0];
     return gs->time[0] + (gs->time[1] - gs->time[0]) * ((float)seg + 0.5f) / (float)(gs->n_times - 1);
 }
+
+/* Sets gi's world_from_master, its inverse, normal_to_world and scale
+ * (the other fields are left alone). 0, or -1 if m is singular. */
+int geom_instance_set(GeomInstance *gi, Mat4 world_from_master);
+
+/* Instance gi at time t: gi itself if it is still, else *tmp, a copy whose
+ * transforms are the linear blend of its world_from_master at the two
+ * GridSet time samples about t (the matrices blended entry by entry, as
+ * Embree blends an instance's FLOAT3X4 transforms; clamped outside). */
+const GeomInstance *geom_instance_at(const GridSet *gs, const GeomInstance *gi, float t,
+                                     GeomInstance *tmp);
 
 /* Where vertex i of moving grid g is in the later samples' arrays. */
 static inline size_t geom_motion_index(const Grid *g, size_t i)

@@ -331,6 +331,7 @@ int hider_camera_hit(Worker *w, const Ray *ray, const Hit *hit, Vec3 *L, Vec3 *O
     const GridSet *gs = w->rs->gs;
     int moving = gs->grids[gi].moving;
     if ((moving && (hit->instance || !gsh->moving)) ||
+        (hit->instance && gs->instances[hit->instance - 1].motion) || /* instance motion */
         (gsh->moving_lights && lit_by_moving_light(w->rs, gi, hit->instance)))
         return 0; /* shaded where the ray finds it, at its time */
     float f;

@@ -69,7 +69,9 @@ static int hit_point(const Worker *w, const Ray *ray, const Hit *hit, const Rend
     v3_store(hp->Os, Os);
     hp->s = st[0], hp->t = st[1];
     memcpy(hp->dst, dst, sizeof dst);
-    const GeomInstance *gi = render_instance(w->rs, hit->instance);
+    GeomInstance moved; /* a moving instance where it is at the ray's time */
+    const GeomInstance *gi =
+        geom_instance_at(w->rs->gs, render_instance(w->rs, hit->instance), ray->time, &moved);
     if (gi) { /* a master's grid: its vectors to world space (hit->Ng is already) */
         N = mat4_vector(&gi->normal_to_world, N);
         du = mat4_vector(&gi->world_from_master, du);

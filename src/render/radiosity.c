@@ -331,6 +331,12 @@ static void fill_radiosity(void *user, const CacheKey *key, size_t n, float (*ou
     const Grid *g = &gs->grids[key->patch];
     const RenderObject *obj = render_object(w->rs, key->patch, key->instance);
     const GeomInstance *gi = render_instance(w->rs, key->instance);
+    /* A grid seen through a moving instance moves too: filled per segment,
+     * at the segment's middle, the instance where it is then. */
+    int moves = g->moving || (gi && gi->motion && gs->n_times > 1);
+    GeomInstance moved;
+    if (gi && gi->motion)
+        gi = geom_instance_at(gs, gi, geom_segment_mid_time(gs, key->segment), &moved);
     float scale = gi ? gi->scale : 1.0f; /* world units per grid unit */
     FillPoints fp;
     float(*f3)[3] = malloc(n * 10 * sizeof *f3);
@@ -360,8 +366,8 @@ static void fill_radiosity(void *user, const CacheKey *key, size_t n, float (*ou
      * (DESIGN.md "Motion blur"). */
     float outer_time = w->time;
     const Camera *cam = &w->rs->camera;
-    w->time = g->moving ? geom_segment_mid_time(gs, key->segment)
-                        : 0.5f * (cam->shutter[0] + cam->shutter[1]);
+    w->time = moves ? geom_segment_mid_time(gs, key->segment)
+                    : 0.5f * (cam->shutter[0] + cam->shutter[1]);
     float width = level_edge(g, key->level) * scale, du, dv;
     level_footprint(g, key->level, &du, &dv);
     for (size_t i = 0; i < n; i++) {
@@ -393,7 +399,7 @@ static void fill_radiosity(void *user, const CacheKey *key, size_t n, float (*ou
     };
     path_apply_Os_pattern(w, obj, &ctx, fp.Os);
     w->stats.instance_fills += key->instance != 0 && key->type == CACHE_RADIOSITY;
-    if (g->moving && key->type == CACHE_RADIOSITY)
+    if (moves && key->type == CACHE_RADIOSITY)
         w->stats.segment_fills[key->segment]++;
     fill_run(w, key->type, &ctx, obj, &fp, f3 + 9 * n, out);
     w->time = outer_time;
@@ -474,7 +480,8 @@ static Vec3 cached_at_hit(Worker *w, const Hit *hit, int type, int depth, int si
     const Grid *g = &gs->grids[hit->grid];
     const GeomInstance *gi = render_instance(w->rs, hit->instance);
     float f;
-    int segment = g->moving ? geom_motion_segment(gs, time, &f) : 0; /* memo 3.2 */
+    int moves = g->moving || (gi && gi->motion && gs->n_times > 1); /* memo 3.2 */
+    int segment = moves ? geom_motion_segment(gs, time, &f) : 0;
     /* the footprint in the grid's units (a master's, through an instance) */
     float footprint = path_footprint(diff, hit->t) / (gi ? gi->scale : 1.0f);
     int level = radiosity_choose_level(g, footprint, w->set->cache_k, w->set->cache_resolution);

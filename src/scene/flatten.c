@@ -78,6 +78,21 @@ static Bounds3 bounds_transform(const Mat4 *m, Bounds3 b)
     return r;
 }
 
+/* Master bounds b placed by instance si: under each of its motion's
+ * samples (the blend between two samples of an affine map keeps a box's
+ * corners within the samples' boxes' hull only approximately; Embree
+ * bounds the motion itself, this is for the scene's extent). */
+static Bounds3 instance_bounds(const RayesScene *s, const SceneInstance *si, Bounds3 b)
+{
+    Bounds3 r = bounds_transform(&si->parent_from_master, b);
+    const SceneMotion *m = si->motion ? &s->motions[si->motion - 1] : NULL;
+    for (int k = 1; m && k < m->n_times; k++) {
+        Mat4 M = scene_instance_at(s, si, m->time[k]);
+        r = bounds_union(r, bounds_transform(&M, b));
+    }
+    return r;
+}
+
 Bounds3 *scene_masters_bounds(const RayesScene *s)
 {
     Bounds3 *mb = malloc((s->n_masters ? s->n_masters : 1) * sizeof *mb);
@@ -91,8 +106,8 @@ Bounds3 *scene_masters_bounds(const RayesScene *s)
     for (size_t i = 0; i < s->n_instances; i++) {
         const SceneInstance *si = &s->instances[i];
         if (si->parent)
-            mb[si->parent - 1] = bounds_union(
-                mb[si->parent - 1], bounds_transform(&si->parent_from_master, mb[si->master]));
+            mb[si->parent - 1] =
+                bounds_union(mb[si->parent - 1], instance_bounds(s, si, mb[si->master]));
     }
     return mb;
 }
@@ -108,7 +123,7 @@ Bounds3 scene_instances_bounds(const RayesScene *s)
     for (size_t i = 0; i < s->n_instances; i++) {
         const SceneInstance *si = &s->instances[i];
         if (!si->parent)
-            b = bounds_union(b, bounds_transform(&si->parent_from_master, mb[si->master]));
+            b = bounds_union(b, instance_bounds(s, si, mb[si->master]));
     }
     free(mb);
     return b;
@@ -119,23 +134,11 @@ Bounds3 scene_instances_bounds(const RayesScene *s)
 static int make_instance(Mat4 world_from_master, uint32_t m, uint32_t object, uint32_t mask,
                          GeomInstance *gi)
 {
-    gi->world_from_master = world_from_master;
-    if (!mat4_invert(world_from_master, &gi->master_from_world))
-        return -1;
-    const float(*a)[4] = world_from_master.m;
-    float det = a[0][0] * (a[1][1] * a[2][2] - a[1][2] * a[2][1]) -
-                a[0][1] * (a[1][0] * a[2][2] - a[1][2] * a[2][0]) +
-                a[0][2] * (a[1][0] * a[2][1] - a[1][1] * a[2][0]);
-    gi->normal_to_world = mat4_transpose(gi->master_from_world);
-    if (det < 0.0f) /* mirrored: keep N on the side of dPdu x dPdv */
-        for (int r = 0; r < 3; r++)
-            for (int c = 0; c < 3; c++)
-                gi->normal_to_world.m[r][c] = -gi->normal_to_world.m[r][c];
-    gi->scale = cbrtf(fabsf(det));
     gi->master = m;
     gi->object = object;
     gi->ray_mask = mask;
-    return 0;
+    gi->motion = 0;
+    return geom_instance_set(gi, world_from_master);
 }
 
 /* The instances made inside each master's block: children[first[m] ..
@@ -167,29 +170,62 @@ static int children_init(const RayesScene *s, Children *c)
     return 0;
 }
 
-/* Appends the placements of master m under world_from_master (its own,
- * if it has primitives, then its nested instances'), seen by the rays of
- * mask (the enclosing instances' objects' visibility, ANDed). */
-static void place(const RayesScene *s, const Children *c, uint32_t m, Mat4 world_from_master,
-                  uint32_t object, uint32_t mask, GridSet *gs)
+/* What flattening carries down: the GridSet's time samples and where the
+ * moving instances' matrices go. */
+typedef struct Flatten {
+    int n_times;
+    float time[GEOM_MAX_TIMES]; /* the GridSet's samples, scene time */
+    size_t cap_motion;          /* matrices room in gs->instance_motion */
+    int failed;                 /* out of memory */
+} Flatten;
+
+/* Appends the placements of master m under W (world_from_master at each of
+ * fl's time samples: W[0] only, if moving is 0), its own if it has
+ * primitives, then its nested instances', seen by the rays of mask (the
+ * enclosing instances' objects' visibility, ANDed). Motion at any level
+ * composes sample by sample (DESIGN.md "Instances": instance motion). */
+static void place(const RayesScene *s, const Children *c, Flatten *fl, uint32_t m, const Mat4 *W,
+                  int moving, uint32_t object, uint32_t mask, GridSet *gs)
 {
     const SceneMaster *ms = &s->masters[m];
-    if (ms->end_prim > ms->first_prim &&
-        make_instance(world_from_master, m, object, mask, &gs->instances[gs->n_instances]) == 0)
+    GeomInstance *gi = &gs->instances[gs->n_instances];
+    if (ms->end_prim > ms->first_prim && make_instance(W[0], m, object, mask, gi) == 0) {
         gs->n_instances++;
+        if (moving) {
+            size_t n = (size_t)fl->n_times, need = (gs->n_moving_instances + 1) * n;
+            if (need > fl->cap_motion) {
+                size_t cap = fl->cap_motion ? 2 * fl->cap_motion : 16 * n;
+                Mat4 *a = realloc(gs->instance_motion, (cap > need ? cap : need) * sizeof *a);
+                if (!a) {
+                    fl->failed = 1;
+                    return;
+                }
+                gs->instance_motion = a;
+                fl->cap_motion = cap > need ? cap : need;
+            }
+            memcpy(&gs->instance_motion[gs->n_moving_instances * n], W, n * sizeof *W);
+            gi->motion = (uint32_t)++gs->n_moving_instances;
+        }
+    }
+    Mat4 Wc[GEOM_MAX_TIMES];
     for (size_t k = c->first[m]; k < c->first[m + 1]; k++) {
         const SceneInstance *si = &s->instances[c->of[k]];
         uint32_t o = si->object == GEOM_OBJECT_INHERIT ? object : si->object;
-        place(s, c, si->master, mat4_mul(world_from_master, si->parent_from_master), o,
-              mask & s->objects[o].ray_mask, gs);
+        int mv = moving || si->motion;
+        for (int j = 0; j < (mv ? fl->n_times : 1); j++)
+            Wc[j] = mat4_mul(W[moving ? j : 0], scene_instance_at(s, si, fl->time[j]));
+        place(s, c, fl, si->master, Wc, mv, o, mask & s->objects[o].ray_mask, gs);
     }
 }
 
 int scene_flatten_instances(const RayesScene *s, GridSet *gs)
 {
     free(gs->instances);
+    free(gs->instance_motion);
     gs->instances = NULL;
+    gs->instance_motion = NULL;
     gs->n_instances = 0;
+    gs->n_moving_instances = 0;
     gs->n_masters = s->n_masters;
     if (!s->leaves)
         return 0;
@@ -200,13 +236,24 @@ int scene_flatten_instances(const RayesScene *s, GridSet *gs)
         free(c.of);
         return -1;
     }
-    for (size_t i = 0; i < s->n_instances; i++) {
+    Flatten fl = {0};
+    float span[2];
+    fl.n_times = scene_time_samples(s, span);
+    for (int j = 0; j < fl.n_times; j++)
+        fl.time[j] = fl.n_times > 1
+                         ? span[0] + (span[1] - span[0]) * (float)j / (float)(fl.n_times - 1)
+                         : span[0];
+    Mat4 W[GEOM_MAX_TIMES];
+    for (size_t i = 0; i < s->n_instances && !fl.failed; i++) {
         const SceneInstance *si = &s->instances[i];
-        if (!si->parent)
-            place(s, &c, si->master, si->parent_from_master, si->object,
-                  s->objects[si->object].ray_mask, gs);
+        if (si->parent)
+            continue;
+        int mv = si->motion != 0 && fl.n_times > 1;
+        for (int j = 0; j < (mv ? fl.n_times : 1); j++)
+            W[j] = scene_instance_at(s, si, fl.time[j]);
+        place(s, &c, &fl, si->master, W, mv, si->object, s->objects[si->object].ray_mask, gs);
     }
     free(c.first);
     free(c.of);
-    return 0;
+    return fl.failed ? -1 : 0;
 }

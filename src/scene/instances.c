@@ -9,8 +9,9 @@
  * SCENE_OBJECT_INHERIT and its primitives take each instance's object.
  * object_end restores what object_begin saved (SceneSaved), so attributes
  * set inside a block do not leak out. Each instance records the current
- * transform and object; nesting and the flattened count are bounded here
- * (SCENE_MAX_NESTING, SCENE_MAX_INSTANCES), so prepare cannot explode.
+ * transform (moving: its motion, SceneInstance.motion) and object;
+ * nesting and the flattened count are bounded here (SCENE_MAX_NESTING,
+ * SCENE_MAX_INSTANCES), so prepare cannot explode.
  */
 #include <stdlib.h>
 #include <string.h>
@@ -61,13 +62,14 @@ RayesError rayes_scene_object_begin(RayesScene *s, const char *name)
         return scene_fail(s, RAYES_ERROR_OUT_OF_MEMORY, "out of memory");
     m->first_prim = m->end_prim = s->n_prims;
     m->depth = 1;
-    s->saved =
-        (SceneSaved){s->world_from_object,  s->current_object,       s->shading_rate,
-                     s->displacement_bound, s->current_displacement, s->current_links,
-                     s->current_visibility, s->current_hitmode,      s->current_opacity_cache};
+    s->saved = (SceneSaved){
+        s->world_from_object,     s->current_object, s->shading_rate,       s->displacement_bound,
+        s->current_displacement,  s->current_links,  s->current_visibility, s->current_hitmode,
+        s->current_opacity_cache, s->current_motion};
     s->open_master = (int64_t)s->n_masters++;
     s->current_object = SCENE_OBJECT_INHERIT;
     s->world_from_object = mat4_identity();
+    s->current_motion = 0;
     return RAYES_OK;
 }
 
@@ -91,6 +93,7 @@ RayesError rayes_scene_object_end(RayesScene *s)
     s->current_visibility = v->visibility;
     s->current_hitmode = v->hitmode;
     s->current_opacity_cache = v->opacity_cache;
+    s->current_motion = v->motion;
     s->open_master = -1;
     scene_mark(s, SCENE_CHANGE_GEOMETRY);
     return RAYES_OK;
@@ -132,6 +135,7 @@ RayesError rayes_scene_object_instance(RayesScene *s, const char *name)
     s->instances[s->n_instances++] = (SceneInstance){
         .parent_from_master = s->world_from_object,
         .master = (uint32_t)m,
+        .motion = s->current_motion,
         .parent = parent ? (uint32_t)s->open_master + 1 : 0,
         .object = s->current_object == SCENE_OBJECT_INHERIT ? GEOM_OBJECT_INHERIT
                                                             : (uint32_t)s->current_object,

@@ -309,28 +309,49 @@ static Prim facing(const Prim *p, const Prim *first, Vec3 eye)
     return c;
 }
 
-/* The GridSet's time samples: from the earliest to the latest motion
- * time, spaced by the finest motion's smallest spacing. Returns the count
- * (1: nothing moves). */
-static int time_samples(const RayesScene *s, float span[2])
+/* Widens lo, hi, step by motion m's times. */
+static void add_times(const SceneMotion *m, float *lo, float *hi, float *step)
+{
+    *lo = fminf(*lo, m->time[0]);
+    *hi = fmaxf(*hi, m->time[m->n_times - 1]);
+    for (int k = 1; k < m->n_times; k++)
+        *step = fminf(*step, m->time[k] - m->time[k - 1]);
+}
+
+int scene_time_samples(const RayesScene *s, float span[2])
 {
     int any = 0;
     float lo = INFINITY, hi = -INFINITY, step = INFINITY;
+    span[0] = span[1] = 0.0f;
     for (size_t i = 0; i < s->n_prims; i++) {
         if (!s->prims[i].motion)
             continue;
-        const SceneMotion *m = &s->motions[s->prims[i].motion - 1];
         any = 1;
-        lo = fminf(lo, m->time[0]);
-        hi = fmaxf(hi, m->time[m->n_times - 1]);
-        for (int k = 1; k < m->n_times; k++)
-            step = fminf(step, m->time[k] - m->time[k - 1]);
+        add_times(&s->motions[s->prims[i].motion - 1], &lo, &hi, &step);
+    }
+    for (size_t i = 0; i < s->n_instances; i++) {
+        if (!s->instances[i].motion)
+            continue;
+        any = 1;
+        add_times(&s->motions[s->instances[i].motion - 1], &lo, &hi, &step);
     }
     if (!any)
         return 1;
     span[0] = lo, span[1] = hi;
     double n = ceil((double)(hi - lo) / (double)step - 1e-3) + 1.0;
     return n > GEOM_MAX_TIMES ? GEOM_MAX_TIMES : n < 2 ? 2 : (int)n;
+}
+
+Mat4 scene_instance_at(const RayesScene *s, const SceneInstance *si, float t)
+{
+    if (!si->motion)
+        return si->parent_from_master;
+    const SceneMotion *m = &s->motions[si->motion - 1];
+    int a, b;
+    float f;
+    motion_pair(m, t, &a, &b, &f);
+    Mat4 D = mat4_lerp(&m->delta[a], &m->delta[b], f);
+    return mat4_mul(D, si->parent_from_master);
 }
 
 /* Moves grid g's vertices to time t (into sample k's arrays). */
@@ -384,7 +405,7 @@ static void move_grid(const RayesScene *s, GridSet *gs, Grid *g, int k, float t,
 int scene_motion_prepare(const RayesScene *s, const DiceCamera *cams, GridSet *gs)
 {
     float span[2] = {0.0f, 0.0f};
-    int n = time_samples(s, span);
+    int n = scene_time_samples(s, span);
     gs->n_times = n;
     gs->time[0] = span[0], gs->time[1] = span[1];
     if (n < 2)

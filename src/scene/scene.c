@@ -1191,12 +1191,16 @@ int scene_prepare(const RayesScene *s, int width, int height, const DiceOptions 
         for (size_t m = 0; m <= s->n_masters; m++)
             cams[m].rate_scale *= 1.05f * sqrtf((float)need / (float)budget);
         GeomInstance *keep = gs->instances; /* the instances stay; the grids go */
-        size_t n_keep = gs->n_instances;
+        size_t n_keep = gs->n_instances, n_moving = gs->n_moving_instances;
+        Mat4 *keep_motion = gs->instance_motion;
         gs->instances = NULL;
+        gs->instance_motion = NULL;
         geom_gridset_fini(gs);
         geom_gridset_init(gs);
         gs->instances = keep;
         gs->n_instances = n_keep;
+        gs->instance_motion = keep_motion;
+        gs->n_moving_instances = n_moving;
         gs->n_masters = s->n_masters;
     }
     float rate_scale = cams[0].rate_scale;

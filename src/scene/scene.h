@@ -78,6 +78,8 @@ typedef struct SceneInstance {
     uint32_t object;          /* the object its master's inheriting geometry takes, or
                                  GEOM_OBJECT_INHERIT (inside a block before any shader: the
                                  enclosing instance's) */
+    uint32_t motion;          /* 0: still; else the motions index + 1 of its moving transform
+                                 (parent_from_master at time k: delta[k] parent_from_master) */
 } SceneInstance;
 
 /* What rayes_scene_object_begin saves and rayes_scene_object_end restores. */
@@ -87,6 +89,7 @@ typedef struct SceneSaved {
     float shading_rate, displacement_bound;
     uint32_t displacement, links, visibility;
     uint8_t hitmode, opacity_cache;
+    uint32_t motion; /* current_motion (a block starts still, in master space) */
 } SceneSaved;
 
 /* Flattened instances are at most this many (nested blocks multiply), and
@@ -286,6 +289,16 @@ void scene_patterns_free(RayesScene *scene);
 /* Whether light `light` illuminates object `object` (its light links);
  * 1 or 0. */
 int scene_object_lit_by(const RayesScene *scene, size_t object, size_t light);
+
+/* The GridSet's time samples (motion.c): uniformly spaced from the
+ * earliest to the latest time of any primitive's or instance's motion, as
+ * many as the finest spacing asks (at most GEOM_MAX_TIMES); the count (1:
+ * nothing moves) and, in span, the first and last. */
+int scene_time_samples(const RayesScene *s, float span[2]);
+
+/* Instance si's parent_from_master at time t: its motion's delta, blended
+ * linearly between the motion's samples, times its transform (motion.c). */
+Mat4 scene_instance_at(const RayesScene *s, const SceneInstance *si, float t);
 
 /* Motion blur at prepare (motion.c): fills gs's time samples (GridSet.Pt
  * and the rest) for the scene's moving primitives, after dicing,
