@@ -475,6 +475,7 @@ static int h_hider(Rib *r, const Args *a)
     if (rib_get_params(r, a, i, &p, &n) != 0)
         return -1;
     int lo = hider_count(r, p, n, "minsamples"), hi = hider_count(r, p, n, "maxsamples");
+    free(p);
     if (lo < 0 || hi < 0)
         return -1;
     if (lo > 0)

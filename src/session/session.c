@@ -518,20 +518,20 @@ RayesError rayes_render(RayesScene *scene, const RayesRenderOptions *opt, RayesI
         }
         set.cache = cache;
     }
-    if (opt->replay_rays) {
-        record = accel_record_new(REPLAY_MAX_BYTES);
-        if (!record) {
-            e = session_fail(scene, RAYES_ERROR_OUT_OF_MEMORY, "render: out of memory");
-            goto done;
-        }
-        accel_attach_record(prep.accel, record);
-    }
     double t1 = time_now();
     RenderScene rs = session_render_scene(scene, &prep, set.width, set.height);
     if (opt->gi == RAYES_GI_POINTBASED) {
         e = session_point_cloud(scene, opt, &rs, &set, &rstats, &cloud, &pbgi_times);
         if (e != RAYES_OK)
             goto done;
+    }
+    if (opt->replay_rays) { /* the frame's rays, not the point cloud's */
+        record = accel_record_new(REPLAY_MAX_BYTES);
+        if (!record) {
+            e = session_fail(scene, RAYES_ERROR_OUT_OF_MEMORY, "render: out of memory");
+            goto done;
+        }
+        accel_attach_record(prep.accel, record);
     }
     double t1b = time_now(), cpu1 = time_cpu();
     if (render_frame(&rs, &set, rgba, &rstats) != 0) {
