@@ -13,8 +13,8 @@
 #include "rayes/rayes.h"
 #include "test.h"
 
-static RayesImage *render(const char *scene_name, int threads, int tile, RayesFilter filter,
-                          uint64_t seed, int bounces)
+/* A built-in scene, committed. */
+static RayesScene *builtin(const char *scene_name)
 {
     RayesScene *s = rayes_scene_new();
     char err[512];
@@ -25,6 +25,13 @@ static RayesImage *render(const char *scene_name, int threads, int tile, RayesFi
     CHECK(e == RAYES_OK);
     if (e != RAYES_OK)
         fprintf(stderr, "%s\n", err);
+    return s;
+}
+
+static RayesImage *render(const char *scene_name, int threads, int tile, RayesFilter filter,
+                          uint64_t seed, int bounces)
+{
+    RayesScene *s = builtin(scene_name);
     RayesRenderOptions o;
     rayes_render_options_init(&o, RAYES_QUALITY_PREVIEW);
     o.width = 48;
@@ -189,11 +196,7 @@ static void test_negative_lobes_ring(void)
  * most, not all). */
 static RayesImage *render_adaptive(int threads, int tile, RayesFilter filter, RayesStats **st)
 {
-    RayesScene *s = rayes_scene_new();
-    char err[512];
-    IoSink sink = io_sink_scene(s);
-    CHECK(io_builtin_scene("cornell-teapots", RAYES_TEST_DATA, &sink, err, sizeof err) == RAYES_OK);
-    CHECK(rayes_scene_commit(s) == RAYES_OK);
+    RayesScene *s = builtin("cornell-teapots");
     RayesRenderOptions o;
     rayes_render_options_init(&o, RAYES_QUALITY_PREVIEW);
     o.width = 40;
@@ -241,11 +244,7 @@ static void test_adaptive_any_thread_count(void)
  * caches nothing: no cache at all is made. */
 static void test_reference_preset(void)
 {
-    RayesScene *s = rayes_scene_new();
-    char err[512];
-    IoSink sink = io_sink_scene(s);
-    CHECK(io_builtin_scene("cornell", NULL, &sink, err, sizeof err) == RAYES_OK);
-    CHECK(rayes_scene_commit(s) == RAYES_OK);
+    RayesScene *s = builtin("cornell");
     RayesRenderOptions o;
     rayes_render_options_init(&o, RAYES_QUALITY_REFERENCE);
     CHECK(o.spp == 64 && !o.cache && !o.opacity_cache && !o.irradiance_cache);
@@ -267,11 +266,7 @@ static void test_reference_preset(void)
  * subsurface or volume rays beside them) and traces them again. */
 static void test_replay_rays(void)
 {
-    RayesScene *s = rayes_scene_new();
-    char err[512];
-    IoSink sink = io_sink_scene(s);
-    CHECK(io_builtin_scene("cornell-teapots", RAYES_TEST_DATA, &sink, err, sizeof err) == RAYES_OK);
-    CHECK(rayes_scene_commit(s) == RAYES_OK);
+    RayesScene *s = builtin("cornell-teapots");
     RayesRenderOptions o;
     rayes_render_options_init(&o, RAYES_QUALITY_PREVIEW);
     o.width = 48;
