@@ -55,7 +55,7 @@ static const char render_options[] =
     "  --subsurface-rays N     subsurface rays per shading point of a subsurface material\n"
     "                          (default 4 preview, 64 final)\n"
     "  --irradiance-shadow-rays N  shadow rays per light at irradiance cache fills\n"
-    "                          (default 16)\n"
+    "                          (default: --shadow-rays, at most 16)\n"
     "  --diffuse-rays N        diffuse rays per shading point (all depths)\n"
     "  --diffuse-rays-deep N   diffuse rays per shading point below depth 0\n"
     "  --specular-depth N      maximum specular depth (default 4)\n"

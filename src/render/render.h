@@ -26,8 +26,9 @@
 #include "util/vec.h"
 
 #define RENDER_MAX_DEPTH 16 /* diffuse depths counted separately in statistics */
-/* The shadow rays per light at irradiance cache fills by default, in
- * every quality (memo 6.2; DESIGN.md, subsurface scattering). */
+/* The most shadow rays per light irradiance cache fills take by default:
+ * they take the camera hits' count up to this (memo 6.2; DESIGN.md,
+ * subsurface scattering). */
 #define RENDER_IRRADIANCE_SHADOW_RAYS 16
 
 typedef struct RenderObject {
@@ -128,7 +129,7 @@ typedef struct RenderSettings {
     int subsurface_rays;     /* subsurface rays per shading point (the service's 0) */
     int irradiance_shadow_rays; /* shadow rays per light at irradiance cache fills' points
                                    (the shader's 0): the option, or
-                                   RENDER_IRRADIANCE_SHADOW_RAYS */
+                                   min(shadow_rays, RENDER_IRRADIANCE_SHADOW_RAYS) */
     float volume_step;       /* ray marching steps, in fine voxels of each volume */
     int cache_resolution;    /* -1: by differentials; else a forced CacheLevel */
     float cache_k;           /* resolution rule constant (DESIGN.md) */

@@ -72,7 +72,9 @@ typedef struct SubsurfacePoint {
 static Vec3 probe_point(Worker *w, const Medium *m, const SubsurfacePoint *sp)
 {
     Vec3 in = v3_neg(sp->N), o = v3_madd(sp->P, sp->Ng, -sp->offset);
-    Ray ray = {o, in, 0.0f, INFINITY, RAYES_RAY_SUBSURFACE, w->time};
+    /* A back side beyond 2 mfp leaves the probe at 1 mfp: the ray need not
+     * look further (a short ray is cheaper to trace; the same point). */
+    Ray ray = {o, in, 0.0f, 2.0f * m->mfp, RAYES_RAY_SUBSURFACE, w->time};
     Hit hit;
     w->stats.rays_subsurface++;
     float back = accel_intersect_object(w->rs->accel, sp->object, &ray, &hit) ? hit.t : INFINITY;
@@ -99,9 +101,11 @@ static Vec3 integrate_point(Worker *w, const Medium *m, const SubsurfacePoint *s
      * footprint (DESIGN.md: a coarse level's interpolant is biased) */
     int nl = n > SUBSURFACE_LOOKUP_RAYS ? n : SUBSURFACE_LOOKUP_RAYS;
     float lookup = sqrtf(4.0f * SUBSURFACE_PI / (float)nl);
+    CmjPattern pattern; /* cmj_sample_2d's points, its shuffles tabled once */
+    cmj_pattern_init(&pattern, (uint32_t)n, (uint32_t)sp->key);
     for (int s = 0; s < n; s++) {
         float a, b;
-        cmj_sample_2d((uint32_t)s, (uint32_t)n, (uint32_t)sp->key, &a, &b);
+        cmj_pattern_sample(&pattern, (uint32_t)s, &a, &b);
         Ray ray = {c, sphere_direction(a, b), 0.0f, INFINITY, RAYES_RAY_SUBSURFACE, w->time};
         Hit hit;
         w->stats.rays_subsurface++;

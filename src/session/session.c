@@ -228,8 +228,10 @@ RenderSettings session_settings(const RayesRenderOptions *o)
         .opacity_cache = o->opacity_cache != 0,
         .irradiance_cache = o->irradiance_cache != 0,
         .subsurface_rays = o->subsurface_rays,
-        .irradiance_shadow_rays = o->irradiance_shadow_rays > 0
-                                      ? o->irradiance_shadow_rays
+        /* the camera's count, at most RENDER_IRRADIANCE_SHADOW_RAYS (DESIGN.md) */
+        .irradiance_shadow_rays = o->irradiance_shadow_rays > 0 ? o->irradiance_shadow_rays
+                                  : o->shadow_rays < RENDER_IRRADIANCE_SHADOW_RAYS
+                                      ? o->shadow_rays
                                       : RENDER_IRRADIANCE_SHADOW_RAYS,
         .volume_step = o->volume_step,
         .max_spp = o->max_spp,

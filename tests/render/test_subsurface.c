@@ -378,19 +378,20 @@ static void test_irradiance_fills_take_their_own_shadow_rays(void)
     marble(s, "dipole");
     CHECK(rayes_scene_sphere(s, 10.0f) == RAYES_OK);
     CHECK(rayes_scene_commit(s) == RAYES_OK);
-    RayesStats *def = NULL, *four = NULL, *sixty = NULL, *one = NULL, *u4 = NULL, *u64 = NULL;
-    RayesImage *a = area_render(s, 2, 1, 0, &def), *b = area_render(s, 2, 1, 4, &four),
+    RayesStats *def = NULL, *sixteen = NULL, *sixty = NULL, *one = NULL, *u4 = NULL, *u64 = NULL;
+    RayesImage *a = area_render(s, 2, 1, 0, &def), *b = area_render(s, 2, 1, 16, &sixteen),
                *c = area_render(s, 2, 1, 64, &sixty), *d = area_render(s, 1, 1, 0, &one),
                *e = area_render(s, 2, 0, 4, &u4), *f = area_render(s, 2, 0, 64, &u64);
-    /* the default is 16, here more than the camera's 4 */
-    CHECK(stat(def, "irradiance_shadow_rays") == 16 && stat(four, "irradiance_shadow_rays") == 4);
+    /* the default is the camera's count, 4 in preview */
+    CHECK(stat(def, "irradiance_shadow_rays") == 4 &&
+          stat(sixteen, "irradiance_shadow_rays") == 16);
     /* the same fills, more shadow rays at each of their points; the
      * camera hits' rays are the same */
     uint64_t pts = stat(def, "subsurface/irradiance_points");
-    CHECK(pts > 0 && stat(four, "subsurface/irradiance_points") == pts);
-    CHECK(stat(four, "rays/shadow") < stat(def, "rays/shadow"));
-    CHECK(stat(def, "rays/shadow") < stat(sixty, "rays/shadow"));
-    CHECK(stat(sixty, "rays/shadow") - stat(four, "rays/shadow") >= pts);
+    CHECK(pts > 0 && stat(sixteen, "subsurface/irradiance_points") == pts);
+    CHECK(stat(def, "rays/shadow") < stat(sixteen, "rays/shadow"));
+    CHECK(stat(sixteen, "rays/shadow") < stat(sixty, "rays/shadow"));
+    CHECK(stat(sixty, "rays/shadow") - stat(def, "rays/shadow") >= pts);
     /* uncached, every subsurface hit takes the camera's shadow rays, the
      * option unused */
     CHECK(stat(u4, "rays/shadow") == stat(u64, "rays/shadow"));
@@ -401,20 +402,25 @@ static void test_irradiance_fills_take_their_own_shadow_rays(void)
         CHECK(memcmp(a->rgba, b->rgba, bytes) != 0);
         CHECK(memcmp(e->rgba, f->rgba, bytes) == 0);
     }
-    /* and 16 in final too, fewer than the camera's 64 (DESIGN.md) */
-    RayesRenderOptions o;
-    rayes_render_options_init(&o, RAYES_QUALITY_FINAL);
-    o.width = o.height = 16;
-    o.spp = 1;
-    o.bounces = 0;
-    RayesImage *fin = NULL;
-    RayesStats *fst = NULL;
-    CHECK(rayes_render(s, &o, &fin, &fst) == RAYES_OK);
-    CHECK(stat(fst, "shadow_rays") == 64 && stat(fst, "irradiance_shadow_rays") == 16);
-    rayes_image_free(fin);
-    rayes_stats_free(fst);
+    /* the camera's 8 with 8, and at most 16: final's 64 give 16 (DESIGN.md) */
+    for (int k = 0; k < 2; k++) {
+        RayesRenderOptions o;
+        rayes_render_options_init(&o, k ? RAYES_QUALITY_FINAL : RAYES_QUALITY_PREVIEW);
+        o.width = o.height = 16;
+        o.spp = 1;
+        o.bounces = 0;
+        if (!k)
+            o.shadow_rays = o.shadow_rays_deep = 8;
+        RayesImage *fin = NULL;
+        RayesStats *fst = NULL;
+        CHECK(rayes_render(s, &o, &fin, &fst) == RAYES_OK);
+        CHECK(stat(fst, "shadow_rays") == (k ? 64u : 8u) &&
+              stat(fst, "irradiance_shadow_rays") == (k ? 16u : 8u));
+        rayes_image_free(fin);
+        rayes_stats_free(fst);
+    }
     RayesImage *imgs[6] = {a, b, c, d, e, f};
-    RayesStats *sts[6] = {def, four, sixty, one, u4, u64};
+    RayesStats *sts[6] = {def, sixteen, sixty, one, u4, u64};
     for (int k = 0; k < 6; k++) {
         rayes_image_free(imgs[k]);
         rayes_stats_free(sts[k]);
