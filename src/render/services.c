@@ -130,11 +130,35 @@ static void light_delta(Worker *w, const DirectPoint *p, const Light *l, Vec3 *d
         *spec = v3_madd(*spec, Li, cos_x * blinn_phong(p->N, p->V, ls.wi, p->e));
 }
 
+/* The cosine-distributed direction of sample_cosine_hemisphere(N, a, b),
+ * bit for bit, in the point's frame (t, bt, N) made once for its samples. */
+static Vec3 cosine_dir(Vec3 t, Vec3 bt, Vec3 N, float u1, float u2)
+{
+    float a = 2.0f * u1 - 1.0f, b = 2.0f * u2 - 1.0f, r, phi;
+    if (a == 0.0f && b == 0.0f) {
+        r = 0.0f;
+        phi = 0.0f;
+    } else if (fabsf(a) > fabsf(b)) {
+        r = a;
+        phi = (float)(M_PI / 4.0) * (b / a);
+    } else {
+        r = b;
+        phi = (float)(M_PI / 2.0) - (float)(M_PI / 4.0) * (a / b);
+    }
+    float x = r * cosf(phi), y = r * sinf(phi);
+    float z2 = 1.0f - x * x - y * y; /* fmaxf(0, z2) without libm's call */
+    float z = sqrtf(z2 > 0.0f ? z2 : 0.0f);
+    return v3_add(v3_add(v3_scale(t, x), v3_scale(bt, y)), v3_scale(N, z));
+}
+
 /* An area or environment light, n samples with multiple importance
  * sampling (power heuristic): each light sample is paired with a
  * cosine-distributed direction for the diffuse output and, when the
  * specular output is wanted, a Blinn-Phong direction, which count when
- * they reach the light's emitting side unoccluded. */
+ * they reach the light's emitting side unoccluded. The samples are drawn
+ * CMJ_BATCH at a time (cmj_pattern_samples) and the lobes' directions
+ * first tested against a ball around the light (LightBound); the sums are
+ * the same, in the same order, as drawing each sample on its own. */
 static void light_area(Worker *w, const DirectPoint *p, const Light *l, uint64_t key, int n,
                        Vec3 *diffuse, Vec3 *spec)
 {
@@ -149,65 +173,77 @@ static void light_area(Worker *w, const DirectPoint *p, const Light *l, uint64_t
         cmj_pattern_init(&pat_cos, (uint32_t)n, (uint32_t)hash_combine(key, 1));
     if (p->spec)
         cmj_pattern_init(&pat_bp, (uint32_t)n, (uint32_t)hash_combine(key, 2));
-    for (int s = 0; s < n; s++) {
-        float a, b;
-        LightSample ls;
-        /* The light's strategy. */
-        cmj_pattern_sample(&pattern, (uint32_t)s, &a, &b);
-        if (light_sample(l, p->o, a, b, &ls) && ls.pdf > 0.0f) {
-            float cos_x = v3_dot(p->N, ls.wi);
-            if (cos_x > 0.0f && v3_dot(p->Ng, ls.wi) > 0.0f && v3_max_component(ls.Li) > 0.0f) {
-                /* each of the n samples stands for 1 / (n pdf) of solid angle */
-                RayDiff sd = {p->shadow.width, fmaxf(p->spread, fminf(p->shadow.spread,
-                                                                      sqrtf(1.0f / (n * ls.pdf))))};
-                Vec3 Li = v3_mul(ls.Li, transmittance(w, p->o, ls.wi, ls.dist, sd));
-                float wd = power_heuristic(ls.pdf, cos_x / (float)M_PI);
-                if (p->diff)
-                    sum_d = v3_madd(sum_d, Li, wd * cos_x / ((float)M_PI * ls.pdf));
-                if (p->spec) {
-                    float ws = power_heuristic(ls.pdf, blinn_phong_pdf(p->N, p->V, ls.wi, p->e));
-                    float f = blinn_phong(p->N, p->V, ls.wi, p->e);
-                    sum_s = v3_madd(sum_s, Li, ws * f * cos_x / ls.pdf);
+    Vec3 t, bt; /* the point's frame about N, for both lobes */
+    v3_basis(p->N, &t, &bt);
+    LightBound bound;
+    light_bound_init(l, p->o, &bound);
+    float la[CMJ_BATCH], lb[CMJ_BATCH], ca[CMJ_BATCH], cb[CMJ_BATCH], ba[CMJ_BATCH], bb[CMJ_BATCH];
+    for (int s0 = 0; s0 < n; s0 += CMJ_BATCH) {
+        int nb = n - s0 < CMJ_BATCH ? n - s0 : CMJ_BATCH;
+        cmj_pattern_samples(&pattern, (uint32_t)s0, (uint32_t)nb, la, lb);
+        if (p->diff)
+            cmj_pattern_samples(&pat_cos, (uint32_t)s0, (uint32_t)nb, ca, cb);
+        if (p->spec)
+            cmj_pattern_samples(&pat_bp, (uint32_t)s0, (uint32_t)nb, ba, bb);
+        for (int j = 0; j < nb; j++) {
+            LightSample ls;
+            /* The light's strategy. */
+            if (light_sample(l, p->o, la[j], lb[j], &ls) && ls.pdf > 0.0f) {
+                float cos_x = v3_dot(p->N, ls.wi);
+                if (cos_x > 0.0f && v3_dot(p->Ng, ls.wi) > 0.0f &&
+                    v3_max_component(ls.Li) > 0.0f) {
+                    /* each of the n samples stands for 1 / (n pdf) of solid angle */
+                    float lobe = sqrtf(1.0f / (n * ls.pdf));
+                    lobe = p->shadow.spread < lobe ? p->shadow.spread : lobe;
+                    RayDiff sd = {p->shadow.width, p->spread > lobe ? p->spread : lobe};
+                    Vec3 Li = v3_mul(ls.Li, transmittance(w, p->o, ls.wi, ls.dist, sd));
+                    float wd = power_heuristic(ls.pdf, cos_x / (float)M_PI);
+                    if (p->diff)
+                        sum_d = v3_madd(sum_d, Li, wd * cos_x / ((float)M_PI * ls.pdf));
+                    if (p->spec) {
+                        float ws =
+                            power_heuristic(ls.pdf, blinn_phong_pdf(p->N, p->V, ls.wi, p->e));
+                        float f = blinn_phong(p->N, p->V, ls.wi, p->e);
+                        sum_s = v3_madd(sum_s, Li, ws * f * cos_x / ls.pdf);
+                    }
                 }
             }
-        }
-        /* The diffuse lobe's strategy: weight (cos / pi) / pdf = 1. */
-        Vec3 wi;
-        float cos_x;
-        if (p->diff) {
-            cmj_pattern_sample(&pat_cos, (uint32_t)s, &a, &b);
-            wi = sample_cosine_hemisphere(p->N, a, b);
+            /* The diffuse lobe's strategy: weight (cos / pi) / pdf = 1. */
+            Vec3 wi;
+            float cos_x;
+            if (p->diff) {
+                wi = cosine_dir(t, bt, p->N, ca[j], cb[j]);
+                cos_x = v3_dot(p->N, wi);
+                if (cos_x > 0.0f && v3_dot(p->Ng, wi) > 0.0f && light_bound_may_hit(&bound, wi) &&
+                    light_intersect(l, p->o, wi, &ls) && v3_max_component(ls.Li) > 0.0f)
+                    sum_d = v3_madd(sum_d,
+                                    v3_mul(ls.Li, transmittance(w, p->o, wi, ls.dist, p->shadow)),
+                                    power_heuristic(cos_x / (float)M_PI, ls.pdf));
+            }
+            if (!p->spec)
+                continue;
+            /* The specular lobe's strategy: the half vector about N. */
+            float cos_h = powf(ba[j], 1.0f / (p->e + 1.0f));
+            float sin_h = sqrtf(fmaxf(0.0f, 1.0f - cos_h * cos_h)),
+                  phi = 2.0f * (float)M_PI * bb[j];
+            Vec3 H = v3_add(
+                v3_add(v3_scale(t, sin_h * cosf(phi)), v3_scale(bt, sin_h * sinf(phi))),
+                v3_scale(p->N, cos_h));
+            float vh = v3_dot(p->V, H);
+            if (vh <= 0.0f)
+                continue;
+            wi = v3_normalize(v3_sub(v3_scale(H, 2.0f * vh), p->V));
             cos_x = v3_dot(p->N, wi);
-            if (cos_x > 0.0f && v3_dot(p->Ng, wi) > 0.0f && light_intersect(l, p->o, wi, &ls) &&
-                v3_max_component(ls.Li) > 0.0f)
-                sum_d =
-                    v3_madd(sum_d, v3_mul(ls.Li, transmittance(w, p->o, wi, ls.dist, p->shadow)),
-                            power_heuristic(cos_x / (float)M_PI, ls.pdf));
+            if (cos_x <= 0.0f || v3_dot(p->Ng, wi) <= 0.0f || !light_bound_may_hit(&bound, wi) ||
+                !light_intersect(l, p->o, wi, &ls) || !(v3_max_component(ls.Li) > 0.0f))
+                continue;
+            float pdf = blinn_phong_pdf(p->N, p->V, wi, p->e);
+            if (!(pdf > 0.0f))
+                continue;
+            Vec3 Li = v3_mul(ls.Li, transmittance(w, p->o, wi, ls.dist, p->shadow));
+            float f = blinn_phong(p->N, p->V, wi, p->e);
+            sum_s = v3_madd(sum_s, Li, power_heuristic(pdf, ls.pdf) * f * cos_x / pdf);
         }
-        if (!p->spec)
-            continue;
-        /* The specular lobe's strategy: the half vector about N. */
-        cmj_pattern_sample(&pat_bp, (uint32_t)s, &a, &b);
-        float cos_h = powf(a, 1.0f / (p->e + 1.0f));
-        float sin_h = sqrtf(fmaxf(0.0f, 1.0f - cos_h * cos_h)), phi = 2.0f * (float)M_PI * b;
-        Vec3 t, bt;
-        v3_basis(p->N, &t, &bt);
-        Vec3 H = v3_add(v3_add(v3_scale(t, sin_h * cosf(phi)), v3_scale(bt, sin_h * sinf(phi))),
-                        v3_scale(p->N, cos_h));
-        float vh = v3_dot(p->V, H);
-        if (vh <= 0.0f)
-            continue;
-        wi = v3_normalize(v3_sub(v3_scale(H, 2.0f * vh), p->V));
-        cos_x = v3_dot(p->N, wi);
-        if (cos_x <= 0.0f || v3_dot(p->Ng, wi) <= 0.0f || !light_intersect(l, p->o, wi, &ls) ||
-            !(v3_max_component(ls.Li) > 0.0f))
-            continue;
-        float pdf = blinn_phong_pdf(p->N, p->V, wi, p->e);
-        if (!(pdf > 0.0f))
-            continue;
-        Vec3 Li = v3_mul(ls.Li, transmittance(w, p->o, wi, ls.dist, p->shadow));
-        float f = blinn_phong(p->N, p->V, wi, p->e);
-        sum_s = v3_madd(sum_s, Li, power_heuristic(pdf, ls.pdf) * f * cos_x / pdf);
     }
     *diffuse = v3_add(*diffuse, v3_scale(sum_d, 1.0f / n));
     if (p->spec)
