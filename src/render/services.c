@@ -151,11 +151,29 @@ static Vec3 cosine_dir(Vec3 t, Vec3 bt, Vec3 N, float u1, float u2)
     return v3_add(v3_add(v3_scale(t, x), v3_scale(bt, y)), v3_scale(N, z));
 }
 
+/* Nonzero if the diffuse lobe's strategy is worth its samples for a light
+ * in the ball of bound b: not where the light is far for its size. From
+ * d >= 5 r (d the distance to the ball's centre, r its radius), the light
+ * strategy's pdf is at least (d - r)^2 / (pi r^2) everywhere on the light
+ * (a quad or disk in the ball has area below pi r^2 and faces the point at
+ * a cosine of at most 1; a sphere's cone is narrower still), at least 16
+ * / pi, so the lobe's pdf, at most 1 / pi, is below 1/16 of it and the
+ * power heuristic gives the lobe's samples weights below 1/257: they hit
+ * the light rarely (its solid angle times the lobe's pdf) and count for
+ * almost nothing when they do, and the light's samples alone (weight 1)
+ * are as good an estimate, at half the samples. */
+static int lobe_strategy_useful(const LightBound *b)
+{
+    return b->all || b->d2 < 25.0f * b->r2;
+}
+
 /* An area or environment light, n samples with multiple importance
  * sampling (power heuristic): each light sample is paired with a
  * cosine-distributed direction for the diffuse output and, when the
  * specular output is wanted, a Blinn-Phong direction, which count when
- * they reach the light's emitting side unoccluded. The samples are drawn
+ * they reach the light's emitting side unoccluded; the cosine directions
+ * only where the light is near for its size (lobe_strategy_useful: far
+ * off, the light's samples alone). The samples are drawn
  * CMJ_BATCH at a time (cmj_pattern_samples) and the lobes' directions
  * first tested against a ball around the light (LightBound); the sums are
  * the same, in the same order, as drawing each sample on its own. */
@@ -167,21 +185,22 @@ static void light_area(Worker *w, const DirectPoint *p, const Light *l, uint64_t
     if (light_below_plane(l, p->o, p->N))
         return;
     Vec3 sum_d = v3(0, 0, 0), sum_s = v3(0, 0, 0);
+    LightBound bound;
+    light_bound_init(l, p->o, &bound);
+    int lobe = p->diff && lobe_strategy_useful(&bound); /* the cosine strategy */
     CmjPattern pattern, pat_cos, pat_bp; /* the light's, the cosine's and the lobe's */
     cmj_pattern_init(&pattern, (uint32_t)n, (uint32_t)key);
-    if (p->diff)
+    if (lobe)
         cmj_pattern_init(&pat_cos, (uint32_t)n, (uint32_t)hash_combine(key, 1));
     if (p->spec)
         cmj_pattern_init(&pat_bp, (uint32_t)n, (uint32_t)hash_combine(key, 2));
     Vec3 t, bt; /* the point's frame about N, for both lobes */
     v3_basis(p->N, &t, &bt);
-    LightBound bound;
-    light_bound_init(l, p->o, &bound);
     float la[CMJ_BATCH], lb[CMJ_BATCH], ca[CMJ_BATCH], cb[CMJ_BATCH], ba[CMJ_BATCH], bb[CMJ_BATCH];
     for (int s0 = 0; s0 < n; s0 += CMJ_BATCH) {
         int nb = n - s0 < CMJ_BATCH ? n - s0 : CMJ_BATCH;
         cmj_pattern_samples(&pattern, (uint32_t)s0, (uint32_t)nb, la, lb);
-        if (p->diff)
+        if (lobe)
             cmj_pattern_samples(&pat_cos, (uint32_t)s0, (uint32_t)nb, ca, cb);
         if (p->spec)
             cmj_pattern_samples(&pat_bp, (uint32_t)s0, (uint32_t)nb, ba, bb);
@@ -197,7 +216,7 @@ static void light_area(Worker *w, const DirectPoint *p, const Light *l, uint64_t
                     lobe = p->shadow.spread < lobe ? p->shadow.spread : lobe;
                     RayDiff sd = {p->shadow.width, p->spread > lobe ? p->spread : lobe};
                     Vec3 Li = v3_mul(ls.Li, transmittance(w, p->o, ls.wi, ls.dist, sd));
-                    float wd = power_heuristic(ls.pdf, cos_x / (float)M_PI);
+                    float wd = lobe ? power_heuristic(ls.pdf, cos_x / (float)M_PI) : 1.0f;
                     if (p->diff)
                         sum_d = v3_madd(sum_d, Li, wd * cos_x / ((float)M_PI * ls.pdf));
                     if (p->spec) {
@@ -211,7 +230,7 @@ static void light_area(Worker *w, const DirectPoint *p, const Light *l, uint64_t
             /* The diffuse lobe's strategy: weight (cos / pi) / pdf = 1. */
             Vec3 wi;
             float cos_x;
-            if (p->diff) {
+            if (lobe) {
                 wi = cosine_dir(t, bt, p->N, ca[j], cb[j]);
                 cos_x = v3_dot(p->N, wi);
                 if (cos_x > 0.0f && v3_dot(p->Ng, wi) > 0.0f && light_bound_may_hit(&bound, wi) &&
