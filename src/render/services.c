@@ -204,10 +204,16 @@ static void light_area(Worker *w, const DirectPoint *p, const Light *l, uint64_t
             cmj_pattern_samples(&pat_cos, (uint32_t)s0, (uint32_t)nb, ca, cb);
         if (p->spec)
             cmj_pattern_samples(&pat_bp, (uint32_t)s0, (uint32_t)nb, ba, bb);
+        /* The light's samples of the batch first, independent of each
+         * other (their square roots and divisions overlap), then the rays. */
+        LightSample lsb[CMJ_BATCH];
+        unsigned char got[CMJ_BATCH];
+        for (int j = 0; j < nb; j++)
+            got[j] = light_sample(l, p->o, la[j], lb[j], &lsb[j]) && lsb[j].pdf > 0.0f;
         for (int j = 0; j < nb; j++) {
-            LightSample ls;
+            LightSample ls = lsb[j];
             /* The light's strategy. */
-            if (light_sample(l, p->o, la[j], lb[j], &ls) && ls.pdf > 0.0f) {
+            if (got[j]) {
                 float cos_x = v3_dot(p->N, ls.wi);
                 if (cos_x > 0.0f && v3_dot(p->Ng, ls.wi) > 0.0f &&
                     v3_max_component(ls.Li) > 0.0f) {
