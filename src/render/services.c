@@ -152,16 +152,15 @@ static Vec3 cosine_dir(Vec3 t, Vec3 bt, Vec3 N, float u1, float u2)
 }
 
 /* Nonzero if the diffuse lobe's strategy is worth its samples for a light
- * in the ball of bound b: not where the light is far for its size. From
- * d >= 5 r (d the distance to the ball's centre, r its radius), the light
- * strategy's pdf is at least (d - r)^2 / (pi r^2) everywhere on the light
- * (a quad or disk in the ball has area below pi r^2 and faces the point at
- * a cosine of at most 1; a sphere's cone is narrower still), at least 16
- * / pi, so the lobe's pdf, at most 1 / pi, is below 1/16 of it and the
- * power heuristic gives the lobe's samples weights below 1/257: they hit
- * the light rarely (its solid angle times the lobe's pdf) and count for
- * almost nothing when they do, and the light's samples alone (weight 1)
- * are as good an estimate, at half the samples. */
+ * in the ball of bound b: not where the light is far for its size, d >= 5 r
+ * (d the distance to the ball's centre, r its radius). There the light
+ * strategy's solid-angle pdf, d'^2 / (A cos) on a flat light of area A
+ * (below pi r^2) at distance d' (above d - r = 4 r), is at least 16 / pi
+ * (a sphere's cone: more), 16 times the lobe's largest, 1 / pi: the power
+ * heuristic gives the lobe's samples weights below 1/257, and they hit the
+ * light rarely (the light's solid angle, below pi / 16, times the lobe's
+ * pdf). The light's samples alone, weight 1, are as good an estimate with
+ * half the samples; unbiased either way (DESIGN.md "Lights"). */
 static int lobe_strategy_useful(const LightBound *b)
 {
     return b->all || b->d2 < 25.0f * b->r2;
@@ -520,17 +519,23 @@ static void svc_indirect_diffuse(const RayesShaderServices *sv, const RayesShade
         RayDiff diff = {ps->diff[j].width, fmaxf(ps->diff[j].spread, lobe_spread)};
         CmjPattern pat;
         cmj_pattern_init(&pat, (uint32_t)n, (uint32_t)key);
-        for (int s = 0; s < n; s++) {
-            float a, b;
-            cmj_pattern_sample(&pat, (uint32_t)s, &a, &b);
-            Vec3 d = sample_cosine_hemisphere(N, a, b);
-            if (v3_dot(d, Ng) <= 0.0f)
-                continue; /* below the geometric surface: no light from there */
-            Ray ray = {o, d, 0.0f, INFINITY, RAYES_RAY_DIFFUSE, w->time};
-            w->stats.rays_diffuse++;
-            Vec3 L = integrator_trace(w, &ray, RAYES_RAY_DIFFUSE, depth + 1, ctx->specular_depth,
-                                      hash_combine(key, (uint64_t)s + 1), diff, NULL);
-            sum = v3_add(sum, L);
+        Vec3 t, bt; /* the point's frame, made once for its rays */
+        v3_basis(N, &t, &bt);
+        float ua[CMJ_BATCH], ub[CMJ_BATCH];
+        for (int s0 = 0; s0 < n; s0 += CMJ_BATCH) {
+            int nb = n - s0 < CMJ_BATCH ? n - s0 : CMJ_BATCH;
+            cmj_pattern_samples(&pat, (uint32_t)s0, (uint32_t)nb, ua, ub);
+            for (int s = s0; s < s0 + nb; s++) {
+                Vec3 d = cosine_dir(t, bt, N, ua[s - s0], ub[s - s0]);
+                if (v3_dot(d, Ng) <= 0.0f)
+                    continue; /* below the geometric surface: no light from there */
+                Ray ray = {o, d, 0.0f, INFINITY, RAYES_RAY_DIFFUSE, w->time};
+                w->stats.rays_diffuse++;
+                Vec3 L = integrator_trace(w, &ray, RAYES_RAY_DIFFUSE, depth + 1,
+                                          ctx->specular_depth, hash_combine(key, (uint64_t)s + 1),
+                                          diff, NULL);
+                sum = v3_add(sum, L);
+            }
         }
         v3_store(out[i], n > 0 ? v3_scale(sum, 1.0f / n) : v3(0, 0, 0));
     }

@@ -73,8 +73,9 @@ static void permutation_init(Permutation *pm, uint32_t l, uint32_t p)
     pm->l = l;
     pm->w = w;
     pm->p = p;
-    pm->p_mod = l > 1 ? p % l : 0;
-    pm->wrap = l > 1 ? l - (uint32_t)((1ull << 32) % l) : 0;
+    int general = l > 1 && (l & (l - 1)) != 0; /* not a power of two: the cycle walk */
+    pm->p_mod = general ? p % l : 0;
+    pm->wrap = general ? l - (uint32_t)((1ull << 32) % l) : 0;
 }
 
 /* permute(i, l, p), bit for bit. */
