@@ -130,27 +130,6 @@ static void light_delta(Worker *w, const DirectPoint *p, const Light *l, Vec3 *d
         *spec = v3_madd(*spec, Li, cos_x * blinn_phong(p->N, p->V, ls.wi, p->e));
 }
 
-/* The cosine-distributed direction of sample_cosine_hemisphere(N, a, b),
- * bit for bit, in the point's frame (t, bt, N) made once for its samples. */
-static Vec3 cosine_dir(Vec3 t, Vec3 bt, Vec3 N, float u1, float u2)
-{
-    float a = 2.0f * u1 - 1.0f, b = 2.0f * u2 - 1.0f, r, phi;
-    if (a == 0.0f && b == 0.0f) {
-        r = 0.0f;
-        phi = 0.0f;
-    } else if (fabsf(a) > fabsf(b)) {
-        r = a;
-        phi = (float)(M_PI / 4.0) * (b / a);
-    } else {
-        r = b;
-        phi = (float)(M_PI / 2.0) - (float)(M_PI / 4.0) * (a / b);
-    }
-    float x = r * cosf(phi), y = r * sinf(phi);
-    float z2 = 1.0f - x * x - y * y; /* fmaxf(0, z2) without libm's call */
-    float z = sqrtf(z2 > 0.0f ? z2 : 0.0f);
-    return v3_add(v3_add(v3_scale(t, x), v3_scale(bt, y)), v3_scale(N, z));
-}
-
 /* Nonzero if the diffuse lobe's strategy is worth its samples for a light
  * in the ball of bound b: not where the light is far for its size, d >= 5 r
  * (d the distance to the ball's centre, r its radius). There the light
@@ -236,7 +215,7 @@ static void light_area(Worker *w, const DirectPoint *p, const Light *l, uint64_t
             Vec3 wi;
             float cos_x;
             if (lobe) {
-                wi = cosine_dir(t, bt, p->N, ca[j], cb[j]);
+                wi = sample_cosine_frame(t, bt, p->N, ca[j], cb[j]);
                 cos_x = v3_dot(p->N, wi);
                 if (cos_x > 0.0f && v3_dot(p->Ng, wi) > 0.0f && light_bound_may_hit(&bound, wi) &&
                     light_intersect(l, p->o, wi, &ls) && v3_max_component(ls.Li) > 0.0f)
@@ -526,7 +505,7 @@ static void svc_indirect_diffuse(const RayesShaderServices *sv, const RayesShade
             int nb = n - s0 < CMJ_BATCH ? n - s0 : CMJ_BATCH;
             cmj_pattern_samples(&pat, (uint32_t)s0, (uint32_t)nb, ua, ub);
             for (int s = s0; s < s0 + nb; s++) {
-                Vec3 d = cosine_dir(t, bt, N, ua[s - s0], ub[s - s0]);
+                Vec3 d = sample_cosine_frame(t, bt, N, ua[s - s0], ub[s - s0]);
                 if (v3_dot(d, Ng) <= 0.0f)
                     continue; /* below the geometric surface: no light from there */
                 Ray ray = {o, d, 0.0f, INFINITY, RAYES_RAY_DIFFUSE, w->time};
