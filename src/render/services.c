@@ -130,11 +130,31 @@ static void light_delta(Worker *w, const DirectPoint *p, const Light *l, Vec3 *d
         *spec = v3_madd(*spec, Li, cos_x * blinn_phong(p->N, p->V, ls.wi, p->e));
 }
 
+/* Nonzero if the diffuse lobe's strategy is worth its samples for a light
+ * in the ball of bound b: not where the light is far for its size, d >= 5 r
+ * (d the distance to the ball's centre, r its radius). There the light
+ * strategy's solid-angle pdf, d'^2 / (A cos) on a flat light of area A
+ * (below pi r^2) at distance d' (above d - r = 4 r), is at least 16 / pi
+ * (a sphere's cone: more), 16 times the lobe's largest, 1 / pi: the power
+ * heuristic gives the lobe's samples weights below 1/257, and they hit the
+ * light rarely (the light's solid angle, below pi / 16, times the lobe's
+ * pdf). The light's samples alone, weight 1, are as good an estimate with
+ * half the samples; unbiased either way (DESIGN.md "Lights"). */
+static int lobe_strategy_useful(const LightBound *b)
+{
+    return b->all || b->d2 < 25.0f * b->r2;
+}
+
 /* An area or environment light, n samples with multiple importance
  * sampling (power heuristic): each light sample is paired with a
  * cosine-distributed direction for the diffuse output and, when the
  * specular output is wanted, a Blinn-Phong direction, which count when
- * they reach the light's emitting side unoccluded. */
+ * they reach the light's emitting side unoccluded; the cosine directions
+ * only where the light is near for its size (lobe_strategy_useful: far
+ * off, the light's samples alone). The samples are drawn
+ * CMJ_BATCH at a time (cmj_pattern_samples) and the lobes' directions
+ * first tested against a ball around the light (LightBound); the sums are
+ * the same, in the same order, as drawing each sample on its own. */
 static void light_area(Worker *w, const DirectPoint *p, const Light *l, uint64_t key, int n,
                        Vec3 *diffuse, Vec3 *spec)
 {
@@ -143,71 +163,90 @@ static void light_area(Worker *w, const DirectPoint *p, const Light *l, uint64_t
     if (light_below_plane(l, p->o, p->N))
         return;
     Vec3 sum_d = v3(0, 0, 0), sum_s = v3(0, 0, 0);
+    LightBound bound;
+    light_bound_init(l, p->o, &bound);
+    int lobe = p->diff && lobe_strategy_useful(&bound); /* the cosine strategy */
     CmjPattern pattern, pat_cos, pat_bp; /* the light's, the cosine's and the lobe's */
     cmj_pattern_init(&pattern, (uint32_t)n, (uint32_t)key);
-    if (p->diff)
+    if (lobe)
         cmj_pattern_init(&pat_cos, (uint32_t)n, (uint32_t)hash_combine(key, 1));
     if (p->spec)
         cmj_pattern_init(&pat_bp, (uint32_t)n, (uint32_t)hash_combine(key, 2));
-    for (int s = 0; s < n; s++) {
-        float a, b;
-        LightSample ls;
-        /* The light's strategy. */
-        cmj_pattern_sample(&pattern, (uint32_t)s, &a, &b);
-        if (light_sample(l, p->o, a, b, &ls) && ls.pdf > 0.0f) {
-            float cos_x = v3_dot(p->N, ls.wi);
-            if (cos_x > 0.0f && v3_dot(p->Ng, ls.wi) > 0.0f && v3_max_component(ls.Li) > 0.0f) {
-                /* each of the n samples stands for 1 / (n pdf) of solid angle */
-                RayDiff sd = {p->shadow.width, fmaxf(p->spread, fminf(p->shadow.spread,
-                                                                      sqrtf(1.0f / (n * ls.pdf))))};
-                Vec3 Li = v3_mul(ls.Li, transmittance(w, p->o, ls.wi, ls.dist, sd));
-                float wd = power_heuristic(ls.pdf, cos_x / (float)M_PI);
-                if (p->diff)
-                    sum_d = v3_madd(sum_d, Li, wd * cos_x / ((float)M_PI * ls.pdf));
-                if (p->spec) {
-                    float ws = power_heuristic(ls.pdf, blinn_phong_pdf(p->N, p->V, ls.wi, p->e));
-                    float f = blinn_phong(p->N, p->V, ls.wi, p->e);
-                    sum_s = v3_madd(sum_s, Li, ws * f * cos_x / ls.pdf);
+    Vec3 t, bt; /* the point's frame about N, for both lobes */
+    v3_basis(p->N, &t, &bt);
+    float la[CMJ_BATCH], lb[CMJ_BATCH], ca[CMJ_BATCH], cb[CMJ_BATCH], ba[CMJ_BATCH], bb[CMJ_BATCH];
+    for (int s0 = 0; s0 < n; s0 += CMJ_BATCH) {
+        int nb = n - s0 < CMJ_BATCH ? n - s0 : CMJ_BATCH;
+        cmj_pattern_samples(&pattern, (uint32_t)s0, (uint32_t)nb, la, lb);
+        if (lobe)
+            cmj_pattern_samples(&pat_cos, (uint32_t)s0, (uint32_t)nb, ca, cb);
+        if (p->spec)
+            cmj_pattern_samples(&pat_bp, (uint32_t)s0, (uint32_t)nb, ba, bb);
+        /* The light's samples of the batch first, independent of each
+         * other (their square roots and divisions overlap), then the rays. */
+        LightSample lsb[CMJ_BATCH];
+        unsigned char got[CMJ_BATCH];
+        for (int j = 0; j < nb; j++)
+            got[j] = light_sample(l, p->o, la[j], lb[j], &lsb[j]) && lsb[j].pdf > 0.0f;
+        for (int j = 0; j < nb; j++) {
+            LightSample ls = lsb[j];
+            /* The light's strategy. */
+            if (got[j]) {
+                float cos_x = v3_dot(p->N, ls.wi);
+                if (cos_x > 0.0f && v3_dot(p->Ng, ls.wi) > 0.0f &&
+                    v3_max_component(ls.Li) > 0.0f) {
+                    /* each of the n samples stands for 1 / (n pdf) of solid angle */
+                    float lobe = sqrtf(1.0f / (n * ls.pdf));
+                    lobe = p->shadow.spread < lobe ? p->shadow.spread : lobe;
+                    RayDiff sd = {p->shadow.width, p->spread > lobe ? p->spread : lobe};
+                    Vec3 Li = v3_mul(ls.Li, transmittance(w, p->o, ls.wi, ls.dist, sd));
+                    float wd = lobe ? power_heuristic(ls.pdf, cos_x / (float)M_PI) : 1.0f;
+                    if (p->diff)
+                        sum_d = v3_madd(sum_d, Li, wd * cos_x / ((float)M_PI * ls.pdf));
+                    if (p->spec) {
+                        float ws =
+                            power_heuristic(ls.pdf, blinn_phong_pdf(p->N, p->V, ls.wi, p->e));
+                        float f = blinn_phong(p->N, p->V, ls.wi, p->e);
+                        sum_s = v3_madd(sum_s, Li, ws * f * cos_x / ls.pdf);
+                    }
                 }
             }
-        }
-        /* The diffuse lobe's strategy: weight (cos / pi) / pdf = 1. */
-        Vec3 wi;
-        float cos_x;
-        if (p->diff) {
-            cmj_pattern_sample(&pat_cos, (uint32_t)s, &a, &b);
-            wi = sample_cosine_hemisphere(p->N, a, b);
+            /* The diffuse lobe's strategy: weight (cos / pi) / pdf = 1. */
+            Vec3 wi;
+            float cos_x;
+            if (lobe) {
+                wi = sample_cosine_frame(t, bt, p->N, ca[j], cb[j]);
+                cos_x = v3_dot(p->N, wi);
+                if (cos_x > 0.0f && v3_dot(p->Ng, wi) > 0.0f && light_bound_may_hit(&bound, wi) &&
+                    light_intersect(l, p->o, wi, &ls) && v3_max_component(ls.Li) > 0.0f)
+                    sum_d = v3_madd(sum_d,
+                                    v3_mul(ls.Li, transmittance(w, p->o, wi, ls.dist, p->shadow)),
+                                    power_heuristic(cos_x / (float)M_PI, ls.pdf));
+            }
+            if (!p->spec)
+                continue;
+            /* The specular lobe's strategy: the half vector about N. */
+            float cos_h = powf(ba[j], 1.0f / (p->e + 1.0f));
+            float sin_h = sqrtf(fmaxf(0.0f, 1.0f - cos_h * cos_h)),
+                  phi = 2.0f * (float)M_PI * bb[j];
+            Vec3 H = v3_add(
+                v3_add(v3_scale(t, sin_h * cosf(phi)), v3_scale(bt, sin_h * sinf(phi))),
+                v3_scale(p->N, cos_h));
+            float vh = v3_dot(p->V, H);
+            if (vh <= 0.0f)
+                continue;
+            wi = v3_normalize(v3_sub(v3_scale(H, 2.0f * vh), p->V));
             cos_x = v3_dot(p->N, wi);
-            if (cos_x > 0.0f && v3_dot(p->Ng, wi) > 0.0f && light_intersect(l, p->o, wi, &ls) &&
-                v3_max_component(ls.Li) > 0.0f)
-                sum_d =
-                    v3_madd(sum_d, v3_mul(ls.Li, transmittance(w, p->o, wi, ls.dist, p->shadow)),
-                            power_heuristic(cos_x / (float)M_PI, ls.pdf));
+            if (cos_x <= 0.0f || v3_dot(p->Ng, wi) <= 0.0f || !light_bound_may_hit(&bound, wi) ||
+                !light_intersect(l, p->o, wi, &ls) || !(v3_max_component(ls.Li) > 0.0f))
+                continue;
+            float pdf = blinn_phong_pdf(p->N, p->V, wi, p->e);
+            if (!(pdf > 0.0f))
+                continue;
+            Vec3 Li = v3_mul(ls.Li, transmittance(w, p->o, wi, ls.dist, p->shadow));
+            float f = blinn_phong(p->N, p->V, wi, p->e);
+            sum_s = v3_madd(sum_s, Li, power_heuristic(pdf, ls.pdf) * f * cos_x / pdf);
         }
-        if (!p->spec)
-            continue;
-        /* The specular lobe's strategy: the half vector about N. */
-        cmj_pattern_sample(&pat_bp, (uint32_t)s, &a, &b);
-        float cos_h = powf(a, 1.0f / (p->e + 1.0f));
-        float sin_h = sqrtf(fmaxf(0.0f, 1.0f - cos_h * cos_h)), phi = 2.0f * (float)M_PI * b;
-        Vec3 t, bt;
-        v3_basis(p->N, &t, &bt);
-        Vec3 H = v3_add(v3_add(v3_scale(t, sin_h * cosf(phi)), v3_scale(bt, sin_h * sinf(phi))),
-                        v3_scale(p->N, cos_h));
-        float vh = v3_dot(p->V, H);
-        if (vh <= 0.0f)
-            continue;
-        wi = v3_normalize(v3_sub(v3_scale(H, 2.0f * vh), p->V));
-        cos_x = v3_dot(p->N, wi);
-        if (cos_x <= 0.0f || v3_dot(p->Ng, wi) <= 0.0f || !light_intersect(l, p->o, wi, &ls) ||
-            !(v3_max_component(ls.Li) > 0.0f))
-            continue;
-        float pdf = blinn_phong_pdf(p->N, p->V, wi, p->e);
-        if (!(pdf > 0.0f))
-            continue;
-        Vec3 Li = v3_mul(ls.Li, transmittance(w, p->o, wi, ls.dist, p->shadow));
-        float f = blinn_phong(p->N, p->V, wi, p->e);
-        sum_s = v3_madd(sum_s, Li, power_heuristic(pdf, ls.pdf) * f * cos_x / pdf);
     }
     *diffuse = v3_add(*diffuse, v3_scale(sum_d, 1.0f / n));
     if (p->spec)
@@ -459,17 +498,23 @@ static void svc_indirect_diffuse(const RayesShaderServices *sv, const RayesShade
         RayDiff diff = {ps->diff[j].width, fmaxf(ps->diff[j].spread, lobe_spread)};
         CmjPattern pat;
         cmj_pattern_init(&pat, (uint32_t)n, (uint32_t)key);
-        for (int s = 0; s < n; s++) {
-            float a, b;
-            cmj_pattern_sample(&pat, (uint32_t)s, &a, &b);
-            Vec3 d = sample_cosine_hemisphere(N, a, b);
-            if (v3_dot(d, Ng) <= 0.0f)
-                continue; /* below the geometric surface: no light from there */
-            Ray ray = {o, d, 0.0f, INFINITY, RAYES_RAY_DIFFUSE, w->time};
-            w->stats.rays_diffuse++;
-            Vec3 L = integrator_trace(w, &ray, RAYES_RAY_DIFFUSE, depth + 1, ctx->specular_depth,
-                                      hash_combine(key, (uint64_t)s + 1), diff, NULL);
-            sum = v3_add(sum, L);
+        Vec3 t, bt; /* the point's frame, made once for its rays */
+        v3_basis(N, &t, &bt);
+        float ua[CMJ_BATCH], ub[CMJ_BATCH];
+        for (int s0 = 0; s0 < n; s0 += CMJ_BATCH) {
+            int nb = n - s0 < CMJ_BATCH ? n - s0 : CMJ_BATCH;
+            cmj_pattern_samples(&pat, (uint32_t)s0, (uint32_t)nb, ua, ub);
+            for (int s = s0; s < s0 + nb; s++) {
+                Vec3 d = sample_cosine_frame(t, bt, N, ua[s - s0], ub[s - s0]);
+                if (v3_dot(d, Ng) <= 0.0f)
+                    continue; /* below the geometric surface: no light from there */
+                Ray ray = {o, d, 0.0f, INFINITY, RAYES_RAY_DIFFUSE, w->time};
+                w->stats.rays_diffuse++;
+                Vec3 L = integrator_trace(w, &ray, RAYES_RAY_DIFFUSE, depth + 1,
+                                          ctx->specular_depth, hash_combine(key, (uint64_t)s + 1),
+                                          diff, NULL);
+                sum = v3_add(sum, L);
+            }
         }
         v3_store(out[i], n > 0 ? v3_scale(sum, 1.0f / n) : v3(0, 0, 0));
     }

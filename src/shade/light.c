@@ -298,6 +298,40 @@ int light_below_plane(const Light *l, Vec3 o, Vec3 n)
     return top < -1e-3f * size; /* the margin: sampled directions are rounded */
 }
 
+void light_bound_init(const Light *l, Vec3 o, LightBound *b)
+{
+    Vec3 c;
+    float r2;
+    switch (l->type) {
+    case LIGHT_QUAD: /* a bilinear patch lies in its corners' hull */
+        c = v3_scale(v3_add(v3_add(l->P[0], l->P[1]), v3_add(l->P[2], l->P[3])), 0.25f);
+        r2 = 0.0f;
+        for (int k = 0; k < 4; k++) {
+            Vec3 d = v3_sub(l->P[k], c);
+            float d2 = v3_dot(d, d);
+            r2 = d2 > r2 ? d2 : r2;
+        }
+        break;
+    case LIGHT_DISK: /* |x ex + y ey| <= sqrt(|ex|^2 + |ey|^2) for x^2 + y^2 <= 1 */
+        c = l->from;
+        r2 = v3_dot(l->ex, l->ex) + v3_dot(l->ey, l->ey);
+        break;
+    case LIGHT_SPHERE:
+        c = l->from;
+        r2 = l->radius * l->radius;
+        break;
+    default:
+        *b = (LightBound){.all = 1};
+        return;
+    }
+    b->dc = v3_sub(c, o);
+    b->d2 = v3_dot(b->dc, b->dc);
+    /* 2% on the radius, and 1e-4 of the distance squared for the
+     * cancellation in d2 - proj^2 and a direction's rounded length */
+    b->r2 = r2 * 1.0404f + 1e-4f * b->d2;
+    b->all = !(b->d2 > b->r2) || !(b->r2 < INFINITY);
+}
+
 int light_sample(const Light *l, Vec3 o, float a, float b, LightSample *s)
 {
     switch (l->type) {

@@ -117,6 +117,31 @@ static inline int light_is_area(const Light *l)
  * nothing from it and its samples can be skipped. 0 for the others. */
 int light_below_plane(const Light *l, Vec3 o, Vec3 n);
 
+/* A ball holding an area light (quad, disk, sphere), as seen from one
+ * point o: a direction from o that misses the ball misses the light, and
+ * costs one dot product to reject instead of light_intersect's tests (the
+ * BSDF strategies' directions, most of which miss a small light). The
+ * ball is a little larger than the light, for rounding: it never rejects
+ * a direction light_intersect would take. */
+typedef struct LightBound {
+    Vec3 dc;            /* from o to the ball's centre */
+    float d2;           /* |dc|^2 */
+    float r2;           /* the ball's radius squared, margin included */
+    int all;            /* o inside the ball, or an unbounded light: no rejection */
+} LightBound;
+
+void light_bound_init(const Light *l, Vec3 o, LightBound *b);
+
+/* 0 if the ray from the bound's point along unit wi misses the ball (so
+ * light_intersect would return 0), else 1. */
+static inline int light_bound_may_hit(const LightBound *b, Vec3 wi)
+{
+    if (b->all)
+        return 1;
+    float proj = v3_dot(b->dc, wi);
+    return proj > 0.0f && b->d2 - proj * proj <= b->r2;
+}
+
 /* Nonzero if the light belongs to a selection as shader.h's direct_lighting
  * says: NULL or "" every light; "name" lights whose category list holds
  * name; "-name" those whose list does not. */

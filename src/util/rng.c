@@ -53,6 +53,49 @@ static uint32_t permute(uint32_t i, uint32_t l, uint32_t p)
     return (i + p) % l;
 }
 
+/* permute(., l, p) set up once for many indices: the mask, and the final
+ * (i + p) % l done without a division (i < l, so only p mod l and whether
+ * i + p wraps past 2^32 matter). */
+typedef struct Permutation {
+    uint32_t l, w, p;
+    uint32_t p_mod;     /* p % l */
+    uint32_t wrap;      /* l - 2^32 % l: what a wrapped sum i + p gains mod l */
+} Permutation;
+
+static void permutation_init(Permutation *pm, uint32_t l, uint32_t p)
+{
+    uint32_t w = l > 0 ? l - 1 : 0;
+    w |= w >> 1;
+    w |= w >> 2;
+    w |= w >> 4;
+    w |= w >> 8;
+    w |= w >> 16;
+    pm->l = l;
+    pm->w = w;
+    pm->p = p;
+    int general = l > 1 && (l & (l - 1)) != 0; /* not a power of two: the cycle walk */
+    pm->p_mod = general ? p % l : 0;
+    pm->wrap = general ? l - (uint32_t)((1ull << 32) % l) : 0;
+}
+
+/* permute(i, l, p), bit for bit. */
+static inline uint32_t permutation_at(const Permutation *pm, uint32_t i)
+{
+    uint32_t l = pm->l;
+    if (l <= 1)
+        return 0;
+    if ((l & (l - 1)) == 0)
+        return (permute_round(i, pm->w, pm->p) + pm->p) & pm->w;
+    do {
+        i = permute_round(i, pm->w, pm->p);
+    } while (i >= l);
+    uint32_t r = i + pm->p_mod; /* (i + p) mod l, from below 3 l */
+    if (i + pm->p < i)
+        r += pm->wrap;
+    r = r >= l ? r - l : r;
+    return r >= l ? r - l : r;
+}
+
 static float randfloat(uint32_t i, uint32_t p)
 {
     i ^= p;
@@ -125,10 +168,13 @@ void cmj_pattern_init(CmjPattern *c, uint32_t n, uint32_t p)
     c->tabled = c->m <= CMJ_TABLE && c->k <= CMJ_TABLE;
     if (!c->tabled)
         return;
+    Permutation px, py;
+    permutation_init(&px, c->m, p * 0x68bc21ebu);
+    permutation_init(&py, c->k, p * 0x02e5be93u);
     for (uint32_t i = 0; i < c->m; i++)
-        c->sx[i] = (uint8_t)permute(i, c->m, p * 0x68bc21ebu);
+        c->sx[i] = (uint8_t)permutation_at(&px, i);
     for (uint32_t i = 0; i < c->k; i++)
-        c->sy[i] = (uint8_t)permute(i, c->k, p * 0x02e5be93u);
+        c->sy[i] = (uint8_t)permutation_at(&py, i);
 }
 
 void cmj_pattern_sample(const CmjPattern *c, uint32_t s, float *x, float *y)
@@ -141,6 +187,32 @@ void cmj_pattern_sample(const CmjPattern *c, uint32_t s, float *x, float *y)
     s = permute(s, c->n, c->p * 0x51633e2du);
     cmj_cell(s, c->m, &col, &row);
     cmj_point(s, col, row, c->sx[col], c->sy[row], c->m, c->k, c->p, x, y);
+}
+
+void cmj_pattern_samples(const CmjPattern *c, uint32_t first, uint32_t count, float *x, float *y)
+{
+    if (!c->tabled) {
+        for (uint32_t i = 0; i < count; i++)
+            cmj_sample_2d(first + i, c->n, c->p, &x[i], &y[i]);
+        return;
+    }
+    /* Two passes: the permutations first, each independent of the others,
+     * so that their hash chains overlap in the processor instead of
+     * waiting, one at a time, behind the caller's work between samples. */
+    uint32_t idx[CMJ_BATCH];
+    Permutation ps;
+    permutation_init(&ps, c->n, c->p * 0x51633e2du);
+    for (uint32_t done = 0; done < count; done += CMJ_BATCH) {
+        uint32_t nb = count - done < CMJ_BATCH ? count - done : CMJ_BATCH;
+        for (uint32_t i = 0; i < nb; i++)
+            idx[i] = permutation_at(&ps, first + done + i);
+        for (uint32_t i = 0; i < nb; i++) {
+            uint32_t col, row, s = idx[i];
+            cmj_cell(s, c->m, &col, &row);
+            cmj_point(s, col, row, c->sx[col], c->sy[row], c->m, c->k, c->p, &x[done + i],
+                      &y[done + i]);
+        }
+    }
 }
 
 float stratified_1d(uint32_t s, uint32_t n, uint32_t p)

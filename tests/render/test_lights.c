@@ -222,9 +222,66 @@ static void test_disk_light_irradiance(void)
     /* A disk of radius R at height h on the axis: E = L pi R^2 / (h^2 + R^2). */
     double E = fx_irradiance(&f, v3(0, 0, 0), v3(0, 0, 1), 64, NULL);
     CHECK_NEAR(E / (3 * PI / 5), 1.0, 0.01);
+    /* Far below (h = 12 >= 5 R): the light's samples alone, no cosine
+     * strategy; the same closed form. */
+    E = fx_irradiance(&f, v3(0, 0, -10), v3(0, 0, 1), 64, NULL);
+    CHECK_NEAR(E / (3 * PI / 145), 1.0, 0.01);
     /* Above the disk: its back, which does not emit. */
     CHECK(fx_irradiance(&f, v3(0, 0, 4), v3(0, 0, -1), 64, NULL) == 0.0);
     fx_fini(&f);
+}
+
+/* The ball around a light (LightBound) never rejects a direction that
+ * light_intersect takes, from points near and far, including directions
+ * aimed exactly at a quad's corners and edges; and it rejects most
+ * directions from far points (else it would save nothing). */
+static void test_light_bound_keeps_every_hit(void)
+{
+    Light q = {.type = LIGHT_QUAD, .L = {1, 1, 1}};
+    q.P[0] = v3(-0.75f, -4.5f, 5.5f), q.P[1] = v3(0.8f, -4.6f, 5.4f);
+    q.P[2] = v3(-0.7f, -3.9f, 4.9f), q.P[3] = v3(0.75f, -4.0f, 4.95f); /* not a parallelogram */
+    Light d = {.type = LIGHT_DISK, .L = {1, 1, 1}, .from = {0, 0, 3}, .ex = {1.5f, 0, 0},
+               .ey = {0, 0.4f, 0.3f}};
+    d.normal = v3_normalize(v3_neg(v3_cross(d.ex, d.ey)));
+    d.area = (float)PI * v3_length(v3_cross(d.ex, d.ey));
+    Light sp = {.type = LIGHT_SPHERE, .L = {1, 1, 1}, .from = {1, 2, 3}, .radius = 0.5f};
+    const Light *lights[3] = {&q, &d, &sp};
+    long hits = 0, rejected = 0, far = 0;
+    for (int k = 0; k < 3; k++)
+        for (int i = 0; i < 200; i++) {
+            float scale = i < 100 ? 2.0f : 40.0f; /* near, then far */
+            Vec3 o = v3(scale * (rng_float(hash_combine(i, 1)) - 0.5f),
+                        scale * (rng_float(hash_combine(i, 2)) - 0.5f),
+                        scale * (rng_float(hash_combine(i, 3)) - 0.5f));
+            LightBound b;
+            light_bound_init(lights[k], o, &b);
+            for (int j = 0; j < 2000; j++) {
+                Vec3 wi;
+                if (k == 0 && j < 8) { /* a corner, or an edge's midpoint */
+                    Vec3 y = j < 4 ? q.P[j] : v3_scale(v3_add(q.P[j - 4], q.P[(j - 3) % 4]), 0.5f);
+                    wi = v3_normalize(v3_sub(y, o));
+                } else {
+                    float z = 1.0f - 2.0f * rng_float(hash_combine(hash_combine(i, j), 4));
+                    float phi = 2.0f * (float)PI * rng_float(hash_combine(hash_combine(i, j), 5));
+                    float r = sqrtf(fmaxf(0.0f, 1.0f - z * z));
+                    wi = v3(r * cosf(phi), r * sinf(phi), z);
+                }
+                LightSample ls;
+                int hit = light_intersect(lights[k], o, wi, &ls);
+                int may = light_bound_may_hit(&b, wi);
+                hits += hit;
+                if (hit && !may) {
+                    CHECK(!"the bound rejected a hit");
+                    return;
+                }
+                if (i >= 100) {
+                    far++;
+                    rejected += !may;
+                }
+            }
+        }
+    CHECK(hits > 1000);
+    CHECK(rejected > far * 9 / 10);
 }
 
 static void test_sphere_light_irradiance(void)
@@ -729,7 +786,8 @@ static void test_bad_lights(void)
 
 TEST_MAIN(TEST(test_point_light_inverse_square), TEST(test_spot_light_cone),
           TEST(test_distant_light), TEST(test_ambient_light), TEST(test_disk_light_irradiance),
-          TEST(test_sphere_light_irradiance), TEST(test_mis_glossy_small_quad),
+          TEST(test_sphere_light_irradiance), TEST(test_light_bound_keeps_every_hit),
+          TEST(test_mis_glossy_small_quad),
           TEST(test_mis_glossy_large_quad), TEST(test_glossy_lights_against_brute_force),
           TEST(test_glossy_surroundings_against_brute_force),
           TEST(test_constant_environment_white_furnace),

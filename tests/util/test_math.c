@@ -75,7 +75,8 @@ static void test_cmj_deterministic_and_pattern_dependent(void)
     CHECK(x1 != x3 || y1 != y3);
 }
 
-/* A tabled pattern draws cmj_sample_2d's samples bit for bit, for counts
+/* A tabled pattern draws cmj_sample_2d's samples bit for bit, one at a
+ * time and in batches (from an odd start, past CMJ_BATCH), for counts
  * whose shape fits the tables and for those past them (17,000 samples:
  * 130 columns). */
 static void test_cmj_pattern_equals_samples(void)
@@ -92,6 +93,17 @@ static void test_cmj_pattern_equals_samples(void)
             cmj_pattern_sample(&pat, s, &x2, &y2);
             if (x1 != x2 || y1 != y2) {
                 CHECK(x1 == x2 && y1 == y2);
+                break;
+            }
+        }
+        static float xs[17000], ys[17000];
+        uint32_t first = n > 3 ? 3 : 0;
+        cmj_pattern_samples(&pat, first, n - first, xs, ys);
+        for (uint32_t s = first; s < n; s++) {
+            float x1, y1;
+            cmj_sample_2d(s, n, p, &x1, &y1);
+            if (x1 != xs[s - first] || y1 != ys[s - first]) {
+                CHECK(x1 == xs[s - first] && y1 == ys[s - first]);
                 break;
             }
         }
