@@ -8,7 +8,7 @@ Cycles"). Run through bench/peers, which builds rayes first.
                 [--cycles 16,64,256,1024] [--cycles-ref 4096]
                 [--preview 4,16,64,256] [--final 4,16] [--ref-spp 1024]
                 [--one-ray 64,256]
-                [--adaptive 0.1,0.05,0.02,0.01] [--adaptive-spp 16]
+                [--adaptive 0.1,0.05,0.02] [--adaptive-spp 16]
                 [--adaptive-max 1024] [--reuse 0|1] [--out bench-out/peers]
 
 Cycles renders the scene of ../shared/data/cornell-teapots.md built by
@@ -18,7 +18,12 @@ sampling, a one-pixel box filter. rayes renders the built-in
 cornell-teapots in its preview and final presets, the preview with one
 shadow and one diffuse ray a camera hit (--one-ray), and the preview with
 adaptive pixel sampling (--adaptive-spp samples everywhere, up to
---adaptive-max, at each listed --adaptive-error). rayes's reference is the
+--adaptive-max, at each listed --adaptive-error: a pixel stops when its
+standard error is the error asked times the lesser of its mean and the
+frame's, its variance at least its 3 x 3 neighbourhood's first block's,
+its positions one Owen-scrambled Sobol sequence; DESIGN.md "Adaptive pixel
+sampling"). Non-adaptive rows are unchanged by that rule (the same bytes),
+so --reuse 1 keeps them. rayes's reference is the
 preview's uncached estimator at --ref-spp pixel samples (4 diffuse and 4
 shadow rays a hit: 4 x ref-spp paths a pixel, nothing cached); Cycles's is
 --cycles-ref samples. Errors are relative RMSE (RMSE over RGB and pixels,
@@ -47,7 +52,7 @@ def parse(argv):
     opt = {"size": "256", "bounces": "1", "threads": "2",
            "data": os.environ.get("RAYES_DATA", os.path.join(ROOT, "..", "shared", "data")),
            "cycles": "16,64,256,1024", "cycles-ref": "4096", "preview": "4,16,64,256",
-           "final": "4,16", "ref-spp": "1024", "one-ray": "64,256", "adaptive": "0.1,0.05,0.02,0.01",
+           "final": "4,16", "ref-spp": "1024", "one-ray": "64,256", "adaptive": "0.1,0.05,0.02",
            "adaptive-spp": "16", "adaptive-max": "1024", "reuse": "0",
            "out": os.path.join(ROOT, "bench-out", "peers")}
     for i in range(0, len(argv), 2):
