@@ -8,7 +8,7 @@ Cycles"). Run through bench/peers, which builds rayes first.
                 [--cycles 16,64,256,1024] [--cycles-ref 4096]
                 [--preview 4,16,64,256] [--final 4,16] [--ref-spp 1024]
                 [--one-ray 64,256]
-                [--adaptive 0.1,0.05,0.02] [--adaptive-spp 16]
+                [--adaptive 0.1,0.05,0.02,0.01] [--adaptive-spp 16]
                 [--adaptive-max 1024] [--reuse 0|1] [--out bench-out/peers]
 
 Cycles renders the scene of ../shared/data/cornell-teapots.md built by
@@ -52,7 +52,7 @@ def parse(argv):
     opt = {"size": "256", "bounces": "1", "threads": "2",
            "data": os.environ.get("RAYES_DATA", os.path.join(ROOT, "..", "shared", "data")),
            "cycles": "16,64,256,1024", "cycles-ref": "4096", "preview": "4,16,64,256",
-           "final": "4,16", "ref-spp": "1024", "one-ray": "64,256", "adaptive": "0.1,0.05,0.02",
+           "final": "4,16", "ref-spp": "1024", "one-ray": "64,256", "adaptive": "0.1,0.05,0.02,0.01",
            "adaptive-spp": "16", "adaptive-max": "1024", "reuse": "0",
            "out": os.path.join(ROOT, "bench-out", "peers")}
     for i in range(0, len(argv), 2):

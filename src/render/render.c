@@ -198,8 +198,10 @@ static double relative_variance(int n, double y, double y2)
  * accumulators when splat is set (with adaptive sampling, the first block
  * of a pixel just outside the filter's reach is taken for its variance
  * only), their luminance added to *lum and *lum2. Sample s of a pixel is
- * in block s / spp, each block its own pattern (as a progressive
- * session's passes). */
+ * in block s / spp, each block its own CMJ pattern (as a progressive
+ * session's passes); with adaptive sampling its position is the s-th of
+ * the pixel's one Sobol sequence instead (its time and lens position
+ * keep the block's patterns). */
 static void render_samples(Frame *f, Worker *w, int px, int py, int x0, int y0, int tw, int th,
                            float (*acc)[5], int k0, int k1, int splat, double *lum, double *lum2)
 {
