@@ -18,7 +18,12 @@ sampling, a one-pixel box filter. rayes renders the built-in
 cornell-teapots in its preview and final presets, the preview with one
 shadow and one diffuse ray a camera hit (--one-ray), and the preview with
 adaptive pixel sampling (--adaptive-spp samples everywhere, up to
---adaptive-max, at each listed --adaptive-error). rayes's reference is the
+--adaptive-max, at each listed --adaptive-error: a pixel stops when its
+standard error is the error asked times the lesser of its mean and the
+frame's, its variance at least its 3 x 3 neighbourhood's first block's,
+its positions one Owen-scrambled Sobol sequence; DESIGN.md "Adaptive pixel
+sampling"). Non-adaptive rows are unchanged by that rule (the same bytes),
+so --reuse 1 keeps them. rayes's reference is the
 preview's uncached estimator at --ref-spp pixel samples (4 diffuse and 4
 shadow rays a hit: 4 x ref-spp paths a pixel, nothing cached); Cycles's is
 --cycles-ref samples. Errors are relative RMSE (RMSE over RGB and pixels,

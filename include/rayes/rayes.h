@@ -790,10 +790,14 @@ typedef struct RayesRenderOptions {
                                    shadow_rays, nor 64 in final (measured: 16 is as close).
                                    0 (default): shadow_rays, at most 16 (4 in preview) */
     int max_spp;                /* adaptive pixel sampling: with max_spp > spp a pixel takes
-                                   further blocks of spp samples while the relative standard
-                                   error of its mean luminance exceeds adaptive_error, up to
-                                   max_spp samples; its count depends on its own samples only,
-                                   so images stay deterministic. 0 (default): spp everywhere */
+                                   further blocks of spp samples while the standard error of
+                                   its mean luminance exceeds adaptive_error times the lesser
+                                   of its mean and the frame's, its variance taken at least
+                                   its 3 x 3 neighbourhood's first blocks' (relative), up to
+                                   max_spp samples; its positions are one stratified (0, 2)
+                                   sequence over all its blocks. Its count depends on fixed
+                                   pixels' samples only, so images stay deterministic.
+                                   0 (default): spp everywhere */
     float adaptive_error;       /* the relative standard error at which a pixel stops
                                    (default 0.02) */
     int replay_rays;            /* 1: keep every ray the render traces (48 bytes each, at most

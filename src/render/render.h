@@ -147,7 +147,8 @@ typedef struct RenderSettings {
     TextureSystem *textures; /* image textures for the texture service, or NULL */
     int max_spp;             /* adaptive pixel sampling: above spp, a pixel takes further
                                 blocks of spp samples while its error exceeds
-                                adaptive_error, up to this many (0: off; one-shot frames) */
+                                adaptive_error, up to this many (0: off; one-shot frames;
+                                render.c's pixel_converged) */
     float adaptive_error;    /* the relative standard error of a pixel's mean luminance
                                 at which it stops */
     /* Progressive rendering (session/progressive.c); all zero for a one-shot frame. */

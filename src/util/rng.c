@@ -215,6 +215,42 @@ void cmj_pattern_samples(const CmjPattern *c, uint32_t first, uint32_t count, fl
     }
 }
 
+static uint32_t reverse_bits(uint32_t x)
+{
+    x = ((x >> 1) & 0x55555555u) | ((x & 0x55555555u) << 1);
+    x = ((x >> 2) & 0x33333333u) | ((x & 0x33333333u) << 2);
+    x = ((x >> 4) & 0x0f0f0f0fu) | ((x & 0x0f0f0f0fu) << 4);
+    x = ((x >> 8) & 0x00ff00ffu) | ((x & 0x00ff00ffu) << 8);
+    return (x >> 16) | (x << 16);
+}
+
+/* Burley's nested uniform scramble of x's bits (Laine and Karras's hash
+ * on the reversed bits: each bit flipped by a hash of the bits above it). */
+static uint32_t owen_scramble(uint32_t x, uint32_t seed)
+{
+    x = reverse_bits(x);
+    x += seed;
+    x ^= x * 0x6c50b47cu;
+    x ^= x * 0xb82f1e52u;
+    x ^= x * 0xc7afe638u;
+    x ^= x * 0x8d22f6e6u;
+    return reverse_bits(x);
+}
+
+void sobol_owen_2d(uint32_t s, uint32_t p, float *x, float *y)
+{
+    /* dimension 0: the van der Corput sequence; dimension 1: direction
+     * numbers of the polynomial x + 1, v_i = v_{i-1} ^ (v_{i-1} >> 1) */
+    uint32_t a = reverse_bits(s), b = 0, v = 0x80000000u;
+    for (uint32_t i = s; i; i >>= 1, v ^= v >> 1)
+        if (i & 1)
+            b ^= v;
+    a = owen_scramble(a, (uint32_t)hash_combine(p, 1));
+    b = owen_scramble(b, (uint32_t)hash_combine(p, 2));
+    *x = (float)(a >> 8) * (1.0f / 16777216.0f);
+    *y = (float)(b >> 8) * (1.0f / 16777216.0f);
+}
+
 float stratified_1d(uint32_t s, uint32_t n, uint32_t p)
 {
     uint32_t stratum = permute(s % n, n, p * 0x9e3779b9u);

@@ -46,6 +46,15 @@ void cmj_sample_2d(uint32_t s, uint32_t n, uint32_t p, float *x, float *y);
  * not correlated with them). */
 float stratified_1d(uint32_t s, uint32_t n, uint32_t p);
 
+/* The s-th point of the first two dimensions of Sobol's sequence, a
+ * (0, 2)-sequence in base 2, Owen-scrambled with seed p (Burley 2020's
+ * hashed nested uniform scramble): every prefix of 2^k points is
+ * stratified in every 2^k elementary interval of [0,1)^2 (n-rooks and
+ * jittered at once), so a pixel taking samples a block at a time stays
+ * stratified over all it took (adaptive sampling), where separate CMJ
+ * patterns per block are stratified within each block only. */
+void sobol_owen_2d(uint32_t s, uint32_t p, float *x, float *y);
+
 /* A pattern whose samples are drawn many times over (a light's n shadow
  * rays at a point): the column and row shuffles tabled once, so each
  * sample costs one permutation instead of three. Its samples are
@@ -81,7 +90,8 @@ enum {
     DIM_OCCLUSION = 8,  /* ambient occlusion rays */
     DIM_SUBSURFACE = 9, /* subsurface rays from a probe point (memo 6.2) */
     DIM_TIME = 10,      /* camera rays' times in the shutter */
-    DIM_LENS = 11       /* camera rays' positions on the lens */
+    DIM_LENS = 11,      /* camera rays' positions on the lens */
+    DIM_FRAME = 12      /* adaptive sampling's estimate of the frame's mean */
 };
 
 #endif /* RAYES_UTIL_RNG_H */

@@ -189,9 +189,10 @@ static void test_negative_lobes_ring(void)
     CHECK(edge_max(RAYES_FILTER_CATMULL_ROM) > 1.01f);
 }
 
-/* Adaptive pixel sampling: a pixel's count follows its own samples, so
- * the image is the same bytes on 1, 2 and 4 threads, with tiles of other
- * sizes and through a wide filter's margins; flat pixels stop at spp,
+/* Adaptive pixel sampling: a pixel's count follows the samples of fixed
+ * pixels (its own, its 3 x 3 neighbourhood's first block) and the frame's
+ * mean, so the image is the same bytes on 1, 2 and 4 threads, with tiles
+ * of other sizes and through a wide filter's margins; flat pixels stop at spp,
  * noisy ones go on (camera rays between the two bounds, some at the
  * most, not all). */
 static RayesImage *render_adaptive(int threads, int tile, RayesFilter filter, RayesStats **st)
