@@ -93,9 +93,10 @@ static int subset_tile(int tx, int ty, int k)
 }
 
 /* The tiles a render takes, in order, and (--uncached-sample) the CPU
- * time of each: the callback runs on the worker thread that will render
- * the tile it returns (render.c), so the thread's CPU clock between two
- * of its calls is the tile it rendered in between. */
+ * time of each: the source callback runs on the worker thread that will
+ * render the tile it returns (render.c), and tile_done on the same
+ * thread as that tile ends, so the thread's CPU clock between the two is
+ * the tile's. */
 typedef struct Sample {
     int k;             /* --tiles K; 0 with a list */
     int *tiles, count; /* --uncached-sample: tile indices, ascending */
@@ -117,12 +118,9 @@ static double thread_cpu_seconds(void)
 static int sample_source(void *user, int tiles_x, int tiles_y)
 {
     Sample *s = user;
-    double now = thread_cpu_seconds();
-    if (clock_generation == s->generation && clock_tile >= 0 && s->cpu_s)
-        s->cpu_s[clock_tile] += now - clock_start;
     clock_generation = s->generation;
     clock_tile = -1;
-    clock_start = now;
+    clock_start = thread_cpu_seconds();
     if (s->tiles) {
         if (s->next >= s->count)
             return -1;
@@ -135,6 +133,17 @@ static int sample_source(void *user, int tiles_x, int tiles_y)
             return i;
     }
     return -1;
+}
+
+/* Called by the render as each tile ends, on its thread (several tiles
+ * at once, each thread writing its own tile's entry). */
+static void sample_tile_done(void *user, int x, int y, int w, int h, const float *rgba, int stride)
+{
+    (void)x, (void)y, (void)w, (void)h, (void)rgba, (void)stride;
+    Sample *s = user;
+    if (clock_generation == s->generation && clock_tile >= 0 && s->cpu_s)
+        s->cpu_s[clock_tile] += thread_cpu_seconds() - clock_start;
+    clock_tile = -1;
 }
 
 /* --uncached-sample F: a stratified random sample of the frame's
@@ -215,6 +224,9 @@ static void estimate(const Args *a, const Sample *s, int tiles_x, Row *r)
     int n = s->count;
     double tiles = (double)tiles_x * ((a->height + TILE - 1) / TILE), mean_p = p / n;
     double var = n > 1 ? (1.0 - n / tiles) * ss / (n - 1) / n / (mean_p * mean_p) : 0.0;
+    for (int i = 0; i < s->count; i++)
+        if (!(s->cpu_s[i] > 0.0))
+            die("a sampled tile was not timed");
     r->fixed_cpu_s = r->cpu_s - t;
     r->est_cpu_s = r->fixed_cpu_s + rate * pixels;
     r->est_se_s = sqrt(var) * pixels;
@@ -258,6 +270,8 @@ static Row run(const Args *a, int bounces, int cache, int subset)
     if (subset == 2 || (subset && a->tiles > 1)) {
         o.tile_source = sample_source;
         o.tile_source_user = &sample;
+        o.tile_done = sample_tile_done;
+        o.tile_user = &sample;
     }
     RayesImage *img;
     RayesStats *st;
