@@ -8,7 +8,8 @@
  *
  *   production [--size WxH] [--spp N] [--shadow-rays N] [--diffuse-rays N]
  *              [--diffuse-rays-deep N] [--bounces-max B] [--uncached 0|1]
- *              [--tiles K] [--threads N] [--cache-mb MB] [--out DIR]
+ *              [--tiles K | --uncached-sample F] [--threads N] [--cache-mb MB]
+ *              [--out DIR]
  *
  * Defaults: 1280 x 720, 1 pixel sample, 8 shadow rays per area light and
  * point (delta lights take one; the environment light counts as an area
@@ -29,6 +30,15 @@
  * grids those tiles' rays reach for fewer pixels, so a subset's speed-up
  * understates the whole frame's. Pictures go to DIR/production-bB-*.png.
  *
+ * --uncached-sample F (0 < F < 1) renders the cached rows whole and the
+ * uncached ones on a stratified random sample of about F of the 32 x 32
+ * tiles (one drawn in each of as many blocks of the frame), timing each
+ * tile by its thread's CPU clock; an uncached pixel does not depend on
+ * any other (there is no cache), so the whole frame's CPU time is
+ * estimated as the render's CPU outside the tiles (scene, dicing) plus
+ * the tiles' CPU per pixel times the frame's pixels, with the standard
+ * error of that estimate (docs/performance.md, "Production scene").
+ *
  * Bias: the cached and uncached frames (or subsets) compared as the other benches
  * compare whole images: the relative difference of their means, and the
  * largest relative difference of the means of one 32 x 32 tile.
@@ -37,6 +47,7 @@
  */
 #define _POSIX_C_SOURCE 200809L
 #include <errno.h>
+#include <time.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -54,7 +65,7 @@
 typedef struct Args {
     int width, height, spp, shadow_rays, diffuse_rays, diffuse_rays_deep, tiles, bounces_max;
     int uncached, threads;
-    double cache_mb;
+    double cache_mb, uncached_sample;
     const char *out;
 } Args;
 
@@ -65,22 +76,57 @@ typedef struct Row {
     double hit[3];
     float *rgba;
     int w, h;
+    double fixed_cpu_s, est_cpu_s, est_se_s; /* --uncached-sample: outside the tiles, frame */
 } Row;
 
-/* The stratified subset: tile (x, y) when (x + 5 y) mod K is 0, for
- * K > 1: one tile in K of every row, shifted from row to row. */
-typedef struct Subset {
-    int k, next;
-} Subset;
+static void die(const char *msg)
+{
+    fprintf(stderr, "production: %s\n", msg);
+    exit(1);
+}
 
+/* The stratified subset of --tiles K: tile (x, y) when (x + 5 y) mod K
+ * is 0, for K > 1: one tile in K of every row, shifted from row to row. */
 static int subset_tile(int tx, int ty, int k)
 {
     return k <= 1 || (tx + 5 * ty) % k == 0;
 }
 
-static int subset_source(void *user, int tiles_x, int tiles_y)
+/* The tiles a render takes, in order, and (--uncached-sample) the CPU
+ * time of each: the source callback runs on the worker thread that will
+ * render the tile it returns (render.c), and tile_done on the same
+ * thread as that tile ends, so the thread's CPU clock between the two is
+ * the tile's. */
+typedef struct Sample {
+    int k;             /* --tiles K; 0 with a list */
+    int *tiles, count; /* --uncached-sample: tile indices, ascending */
+    int next;          /* the next tile of the list or the frame */
+    int generation;    /* this render's, to reset the threads' clocks */
+    double *cpu_s;     /* per tile of the list: thread CPU seconds */
+} Sample;
+
+static _Thread_local int clock_generation = -1, clock_tile = -1;
+static _Thread_local double clock_start;
+
+static double thread_cpu_seconds(void)
 {
-    Subset *s = user;
+    struct timespec t;
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+    return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
+}
+
+static int sample_source(void *user, int tiles_x, int tiles_y)
+{
+    Sample *s = user;
+    clock_generation = s->generation;
+    clock_tile = -1;
+    clock_start = thread_cpu_seconds();
+    if (s->tiles) {
+        if (s->next >= s->count)
+            return -1;
+        clock_tile = s->next++;
+        return s->tiles[clock_tile];
+    }
     while (s->next < tiles_x * tiles_y) {
         int i = s->next++;
         if (subset_tile(i % tiles_x, i / tiles_x, s->k))
@@ -89,10 +135,51 @@ static int subset_source(void *user, int tiles_x, int tiles_y)
     return -1;
 }
 
-static void die(const char *msg)
+/* Called by the render as each tile ends, on its thread (several tiles
+ * at once, each thread writing its own tile's entry). */
+static void sample_tile_done(void *user, int x, int y, int w, int h, const float *rgba, int stride)
 {
-    fprintf(stderr, "production: %s\n", msg);
-    exit(1);
+    (void)x, (void)y, (void)w, (void)h, (void)rgba, (void)stride;
+    Sample *s = user;
+    if (clock_generation == s->generation && clock_tile >= 0 && s->cpu_s)
+        s->cpu_s[clock_tile] += thread_cpu_seconds() - clock_start;
+    clock_tile = -1;
+}
+
+/* --uncached-sample F: a stratified random sample of the frame's
+ * TILE x TILE tiles, about F of them: the tile grid cut into as many
+ * nearly square blocks (strata), one tile drawn in each by a fixed
+ * seed. Returns the count; *tiles (ascending) is the caller's. */
+static int sample_tiles(int tiles_x, int tiles_y, double fraction, int **tiles)
+{
+    int n = (int)lround(fraction * tiles_x * tiles_y);
+    n = n < 2 ? 2 : n > tiles_x * tiles_y ? tiles_x * tiles_y : n;
+    int sy = (int)lround(sqrt((double)n * tiles_y / tiles_x));
+    sy = sy < 1 ? 1 : sy > tiles_y ? tiles_y : sy;
+    int sx = (n + sy - 1) / sy;
+    sx = sx > tiles_x ? tiles_x : sx;
+    *tiles = malloc(sizeof **tiles * (size_t)sx * sy);
+    if (!*tiles)
+        die("out of memory");
+    unsigned long long seed = 0x9e3779b97f4a7c15ull;
+    int count = 0;
+    for (int by = 0; by < sy; by++)
+        for (int bx = 0; bx < sx; bx++) {
+            int x0 = bx * tiles_x / sx, x1 = (bx + 1) * tiles_x / sx;
+            int y0 = by * tiles_y / sy, y1 = (by + 1) * tiles_y / sy;
+            seed = seed * 6364136223846793005ull + 1442695040888963407ull;
+            int x = x0 + (int)((seed >> 33) % (unsigned long long)(x1 - x0));
+            seed = seed * 6364136223846793005ull + 1442695040888963407ull;
+            int y = y0 + (int)((seed >> 33) % (unsigned long long)(y1 - y0));
+            (*tiles)[count++] = y * tiles_x + x;
+        }
+    for (int i = 1; i < count; i++) /* insertion sort: the frame's order */
+        for (int j = i; j > 0 && (*tiles)[j - 1] > (*tiles)[j]; j--) {
+            int t = (*tiles)[j];
+            (*tiles)[j] = (*tiles)[j - 1];
+            (*tiles)[j - 1] = t;
+        }
+    return count;
 }
 
 static double cpu_seconds(void)
@@ -115,8 +202,41 @@ static double real(const RayesStats *st, const char *name)
     return s ? s->real : 0.0;
 }
 
+/* The whole frame's CPU time from the sample's (a ratio estimator): the
+ * render's CPU outside the tiles (scene, dicing, threads) is paid once,
+ * a tile's in proportion to its pixels. The standard error is simple
+ * random sampling's, without replacement; one tile drawn per stratum
+ * has at most that variance when neighbouring tiles cost alike. */
+static void estimate(const Args *a, const Sample *s, int tiles_x, Row *r)
+{
+    double t = 0.0, p = 0.0;
+    for (int i = 0; i < s->count; i++) {
+        int x0 = s->tiles[i] % tiles_x * TILE, y0 = s->tiles[i] / tiles_x * TILE;
+        t += s->cpu_s[i];
+        p += (double)(fmin(x0 + TILE, a->width) - x0) * (fmin(y0 + TILE, a->height) - y0);
+    }
+    double rate = t / p, ss = 0.0, pixels = (double)a->width * a->height;
+    for (int i = 0; i < s->count; i++) {
+        int x0 = s->tiles[i] % tiles_x * TILE, y0 = s->tiles[i] / tiles_x * TILE;
+        double pi = (fmin(x0 + TILE, a->width) - x0) * (fmin(y0 + TILE, a->height) - y0);
+        ss += (s->cpu_s[i] - rate * pi) * (s->cpu_s[i] - rate * pi);
+    }
+    int n = s->count;
+    double tiles = (double)tiles_x * ((a->height + TILE - 1) / TILE), mean_p = p / n;
+    double var = n > 1 ? (1.0 - n / tiles) * ss / (n - 1) / n / (mean_p * mean_p) : 0.0;
+    for (int i = 0; i < s->count; i++)
+        if (!(s->cpu_s[i] > 0.0))
+            die("a sampled tile was not timed");
+    r->fixed_cpu_s = r->cpu_s - t;
+    r->est_cpu_s = r->fixed_cpu_s + rate * pixels;
+    r->est_se_s = sqrt(var) * pixels;
+}
+
+/* subset: 0 the whole frame, 1 --tiles K's tiles, 2 --uncached-sample's
+ * (the frame's CPU time then estimated from theirs: fixed_cpu_s, est_*). */
 static Row run(const Args *a, int bounces, int cache, int subset)
 {
+    static int generation;
     RayesScene *scene = rayes_scene_new();
     char err[1024];
     if (!scene)
@@ -139,18 +259,31 @@ static Row run(const Args *a, int bounces, int cache, int subset)
     o.cache = cache;
     o.cache_mb = a->cache_mb;
     o.tile_size = TILE;
-    Subset sub = {a->tiles, 0};
-    if (subset && a->tiles > 1) {
-        o.tile_source = subset_source;
-        o.tile_source_user = &sub;
+    int tiles_x = (a->width + TILE - 1) / TILE, tiles_y = (a->height + TILE - 1) / TILE;
+    Sample sample = {.k = a->tiles, .generation = ++generation};
+    if (subset == 2) {
+        sample.count = sample_tiles(tiles_x, tiles_y, a->uncached_sample, &sample.tiles);
+        sample.cpu_s = calloc((size_t)sample.count, sizeof *sample.cpu_s);
+        if (!sample.cpu_s)
+            die("out of memory");
+    }
+    if (subset == 2 || (subset && a->tiles > 1)) {
+        o.tile_source = sample_source;
+        o.tile_source_user = &sample;
+        o.tile_done = sample_tile_done;
+        o.tile_user = &sample;
     }
     RayesImage *img;
     RayesStats *st;
     double cpu0 = cpu_seconds();
     if (rayes_render(scene, &o, &img, &st) != RAYES_OK)
         die(rayes_scene_get_error(scene));
-    Row r = {.bounces = bounces, .cache = cache, .subset = subset && a->tiles > 1};
+    Row r = {.bounces = bounces, .cache = cache, .subset = subset == 2 ? 2 : subset && a->tiles > 1};
     r.cpu_s = cpu_seconds() - cpu0;
+    if (subset == 2)
+        estimate(a, &sample, tiles_x, &r);
+    free(sample.tiles);
+    free(sample.cpu_s);
     r.time_s = real(st, "time/total_s");
     r.peak_mb = 1e-6 * (double)count(st, "memory/peak_rss_bytes");
     r.grid_mb = 1e-6 * (double)count(st, "memory/grid_bytes");
@@ -199,18 +332,25 @@ static double region_mean(const Row *r, int x0, int y0, int w, int h)
     return s / ((double)w * h);
 }
 
-/* Bias of on against off over the tiles of the subset (whole 32 x 32
+/* Bias of on against off over the tiles both rendered (whole 32 x 32
  * tiles only): the relative difference of the means, and the largest of
  * one tile's (black tiles have no relative error). */
 static void bias(const Args *a, const Row *on, const Row *off, double *mean_rel, double *tile_rel,
                  char *where, size_t where_size)
 {
+    int tiles_x = (a->width + TILE - 1) / TILE, tiles_y = (a->height + TILE - 1) / TILE;
+    int *list = NULL, count = 0;
+    if (off->subset == 2)
+        count = sample_tiles(tiles_x, tiles_y, a->uncached_sample, &list);
     double s_on = 0.0, s_off = 0.0;
     *tile_rel = 0.0;
     int n = 0;
     for (int ty = 0; (ty + 1) * TILE <= on->h; ty++)
         for (int tx = 0; (tx + 1) * TILE <= on->w; tx++) {
-            if (!subset_tile(tx, ty, a->tiles))
+            int in = !list && subset_tile(tx, ty, a->tiles);
+            for (int i = 0; i < count; i++)
+                in |= list[i] == ty * tiles_x + tx;
+            if (!in)
                 continue;
             double x = region_mean(on, tx * TILE, ty * TILE, TILE, TILE);
             double y = region_mean(off, tx * TILE, ty * TILE, TILE, TILE);
@@ -223,6 +363,7 @@ static void bias(const Args *a, const Row *on, const Row *off, double *mean_rel,
                          tx * TILE, ty * TILE, x, y);
             }
         }
+    free(list);
     *mean_rel = n && s_off > 0.0 ? fabs(s_on - s_off) / s_off : 0.0;
 }
 
@@ -230,7 +371,7 @@ static void save(const Args *a, const Row *r)
 {
     char path[1024], err[1024];
     snprintf(path, sizeof path, "%s/production-b%d%s-%s.png", a->out, r->bounces,
-             r->subset ? "-tiles" : "", r->cache ? "cached" : "uncached");
+             r->subset == 2 ? "-sample" : r->subset ? "-tiles" : "", r->cache ? "cached" : "uncached");
     if (image_write(path, r->w, r->h, r->rgba, err, sizeof err) != RAYES_OK)
         die(err);
 }
@@ -274,10 +415,12 @@ static void json_row(FILE *j, const Row *r, int first)
             "\"shading_points\": %llu, \"rays\": %llu, \"shadow_rays\": %llu, "
             "\"diffuse_rays\": %llu, \"specular_rays\": %llu, \"grids\": %llu, "
             "\"grid_vertices\": %llu, \"hit_rate\": {\"coarse\": %.5f, \"medium\": %.5f, "
-            "\"fine\": %.5f}}",
+            "\"fine\": %.5f}, \"frame_cpu_estimate_s\": %.3f, \"frame_cpu_se_s\": %.3f, "
+            "\"outside_tiles_cpu_s\": %.3f}",
             first ? "" : ",", r->bounces, r->cache, r->subset, r->time_s, r->cpu_s, r->peak_mb,
             r->grid_mb, r->accel_mb, r->shading_points, r->rays, r->shadow, r->diffuse, r->specular,
-            r->grids, r->vertices, r->hit[0], r->hit[1], r->hit[2]);
+            r->grids, r->vertices, r->hit[0], r->hit[1], r->hit[2],
+            r->subset == 2 ? r->est_cpu_s : r->cpu_s, r->est_se_s, r->fixed_cpu_s);
 }
 
 static int parse_size(const char *v, int *w, int *h)
@@ -287,7 +430,7 @@ static int parse_size(const char *v, int *w, int *h)
 
 static void parse(int argc, char **argv, Args *a)
 {
-    *a = (Args){1280, 720, 1, 8, 256, 16, 1, 2, 1, 0, 100.0, "bench-out"};
+    *a = (Args){1280, 720, 1, 8, 256, 16, 1, 2, 1, 0, 100.0, 0.0, "bench-out"};
     for (int i = 1; i + 1 < argc; i += 2) {
         const char *o = argv[i], *v = argv[i + 1];
         if (strcmp(o, "--size") == 0) {
@@ -309,6 +452,8 @@ static void parse(int argc, char **argv, Args *a)
             a->uncached = atoi(v);
         else if (strcmp(o, "--threads") == 0)
             a->threads = atoi(v);
+        else if (strcmp(o, "--uncached-sample") == 0)
+            a->uncached_sample = atof(v);
         else if (strcmp(o, "--cache-mb") == 0)
             a->cache_mb = atof(v);
         else if (strcmp(o, "--out") == 0)
@@ -318,7 +463,8 @@ static void parse(int argc, char **argv, Args *a)
     }
     if (argc % 2 == 0 || a->spp < 1 || a->shadow_rays < 1 || a->diffuse_rays < 1 ||
         a->diffuse_rays_deep < 1 || a->tiles < 1 || a->bounces_max < 1 || a->bounces_max > 4 ||
-        a->cache_mb <= 0.0)
+        a->cache_mb <= 0.0 || !(a->uncached_sample >= 0.0 && a->uncached_sample < 1.0) ||
+        (a->uncached_sample > 0.0 && a->tiles > 1))
         die("usage: production [--size WxH] [--spp N] [--tiles K] ... (see bench/production.c)");
     if (mkdir(a->out, 0777) != 0 && errno != EEXIST)
         die("cannot create the output directory");
@@ -355,8 +501,12 @@ int main(int argc, char **argv)
     Row off[5] = {{0}}, on[5] = {{0}};
     for (int b = 1; b <= a.bounces_max; b++) {
         if (a.uncached) {
-            off[b] = run(&a, b, 0, 1);
+            off[b] = run(&a, b, 0, a.uncached_sample > 0.0 ? 2 : 1);
             print_row(&off[b]);
+            if (off[b].subset == 2)
+                printf("%-14s   whole frame estimated from the sample: %.1fs cpu +- %.1fs (one "
+                       "standard error; %.1fs outside the tiles)\n",
+                       "", off[b].est_cpu_s, off[b].est_se_s, off[b].fixed_cpu_s);
             save(&a, &off[b]);
             json_row(j, &off[b], 0);
         }
@@ -371,19 +521,31 @@ int main(int argc, char **argv)
             double mrel, trel;
             char where[160] = "";
             bias(&a, &on[b], &off[b], &mrel, &trel, where, sizeof where);
-            printf("%d bounce%s: speed-up %.1f (cpu %.1f); cached vs uncached: mean %.3f%%, "
-                   "worst 32x32 tile %.3f%% (%s)\n",
-                   b, b > 1 ? "s" : "", off[b].time_s / on[b].time_s, off[b].cpu_s / on[b].cpu_s,
-                   100 * mrel, 100 * trel, where);
+            if (off[b].subset == 2) {
+                double x = off[b].est_cpu_s / on[b].cpu_s, e = off[b].est_se_s / on[b].cpu_s;
+                printf("%d bounce%s: speed-up (cpu, uncached frame estimated) %.1f +- %.1f; "
+                       "cached vs uncached on the sample's tiles: mean %.3f%%, worst 32x32 tile "
+                       "%.3f%% (%s)\n",
+                       b, b > 1 ? "s" : "", x, e, 100 * mrel, 100 * trel, where);
+            } else
+                printf("%d bounce%s: speed-up %.1f (cpu %.1f); cached vs uncached: mean %.3f%%, "
+                       "worst 32x32 tile %.3f%% (%s)\n",
+                       b, b > 1 ? "s" : "", off[b].time_s / on[b].time_s,
+                       off[b].cpu_s / on[b].cpu_s, 100 * mrel, 100 * trel, where);
+            double off_cpu = off[b].subset == 2 ? off[b].est_cpu_s : off[b].cpu_s;
             fprintf(j,
                     ",\n    {\"bias_bounces\": %d, \"mean_rel\": %.6f, \"max_tile_rel\": %.6f, "
-                    "\"speedup\": %.3f, \"speedup_cpu\": %.3f}",
-                    b, mrel, trel, off[b].time_s / on[b].time_s, off[b].cpu_s / on[b].cpu_s);
+                    "\"speedup\": %.3f, \"speedup_cpu\": %.3f, \"speedup_cpu_se\": %.3f}",
+                    b, mrel, trel, off[b].time_s / on[b].time_s, off_cpu / on[b].cpu_s,
+                    off[b].est_se_s / on[b].cpu_s);
         }
         if (b > 1) {
             printf("    cached %d bounces / 1 bounce: %.2f (cpu %.2f)", b,
                    on[b].time_s / on[1].time_s, on[b].cpu_s / on[1].cpu_s);
-            if (a.uncached)
+            if (a.uncached && off[b].subset == 2)
+                printf("; uncached (cpu, frames estimated) %.2f",
+                       off[b].est_cpu_s / off[1].est_cpu_s);
+            else if (a.uncached)
                 printf("; uncached %.2f (cpu %.2f)", off[b].time_s / off[1].time_s,
                        off[b].cpu_s / off[1].cpu_s);
             printf("\n");

@@ -146,24 +146,17 @@ static int env_pixel(const LightEnvMap *m, float u, float v, int *x, int *y)
     return *y * m->width + *x;
 }
 
-Vec3 light_env_radiance(const Light *l, Vec3 d)
+static Vec3 env_texel(const Light *l, float u, float v)
 {
-    if (!l->env)
-        return l->L;
-    float u, v;
     int x, y;
-    env_dir_to_uv(l, d, &u, &v);
     const float *c = &l->env->rgb[3 * (size_t)env_pixel(l->env, u, v, &x, &y)];
     return v3_mul(l->L, v3(c[0], c[1], c[2]));
 }
 
-static float env_pdf(const Light *l, Vec3 d)
+/* The pdf (solid angle) of drawing the direction at (u, v) of the map. */
+static float env_pdf_uv(const Light *l, float u, float v)
 {
-    if (!l->env)
-        return 1.0f / (4.0f * PI);
-    float u, v;
     int x, y;
-    env_dir_to_uv(l, d, &u, &v);
     float p = l->env->pixel_pdf[env_pixel(l->env, u, v, &x, &y)];
     float st = sinf(v * PI);
     if (!(st > 0.0f))
@@ -171,20 +164,41 @@ static float env_pdf(const Light *l, Vec3 d)
     return p * (float)l->env->width * (float)l->env->height / (2.0f * PI * PI * st);
 }
 
-/* Index i with cdf[i] <= x < cdf[i + 1] among n intervals, skipping empty ones. */
-static int cdf_find(const float *cdf, int n, float x)
+Vec3 light_env_radiance(const Light *l, Vec3 d)
 {
-    int lo = 0, hi = n - 1;
-    while (lo < hi) {
-        int mid = (lo + hi + 1) / 2;
-        if (cdf[mid] <= x)
-            lo = mid;
-        else
-            hi = mid - 1;
-    }
+    if (!l->env)
+        return l->L;
+    float u, v;
+    env_dir_to_uv(l, d, &u, &v);
+    return env_texel(l, u, v);
+}
+
+/* Index i with cdf[i] <= x < cdf[i + 1] among n intervals, skipping empty
+ * ones: the largest i < n with cdf[i] <= x, the binary search's answer
+ * exactly, found from the guide table's start for x (guide: n entries). */
+static int cdf_find(const float *cdf, const int *guide, int n, float x)
+{
+    int k = (int)(x * (float)n);
+    int lo = guide[k < 0 ? 0 : k >= n ? n - 1 : k];
+    while (lo > 0 && cdf[lo] > x) /* x * n rounded up into the next bucket */
+        lo--;
+    while (lo < n - 1 && cdf[lo + 1] <= x)
+        lo++;
     while (lo < n - 1 && cdf[lo + 1] <= cdf[lo])
         lo++;
     return lo;
+}
+
+/* guide[k] for k < n: the largest i < n with cdf[i] <= k / n. */
+static void cdf_guide(const float *cdf, int n, int *guide)
+{
+    int i = 0;
+    for (int k = 0; k < n; k++) {
+        float x = (float)k / (float)n;
+        while (i < n - 1 && cdf[i + 1] <= x)
+            i++;
+        guide[k] = i;
+    }
 }
 
 static int env_sample(const Light *l, float a, float b, LightSample *s)
@@ -201,11 +215,11 @@ static int env_sample(const Light *l, float a, float b, LightSample *s)
     }
     if (!(m->row_cdf[m->height] > 0.0f))
         return 0;
-    int y = cdf_find(m->row_cdf, m->height, a);
+    int y = cdf_find(m->row_cdf, m->row_guide, m->height, a);
     float dr = m->row_cdf[y + 1] - m->row_cdf[y];
     float fy = dr > 0.0f ? (a - m->row_cdf[y]) / dr : 0.5f;
     const float *cc = &m->col_cdf[(size_t)y * (m->width + 1)];
-    int x = cdf_find(cc, m->width, b);
+    int x = cdf_find(cc, &m->col_guide[(size_t)y * m->width], m->width, b);
     float dc = cc[x + 1] - cc[x];
     float fx = dc > 0.0f ? (b - cc[x]) / dc : 0.5f;
     u = ((float)x + fminf(fmaxf(fx, 0.0f), 0.9999f)) / (float)m->width;
@@ -458,8 +472,15 @@ int light_intersect(const Light *l, Vec3 o, Vec3 wi, LightSample *s)
     case LIGHT_ENVIRONMENT:
         s->wi = wi;
         s->dist = INFINITY;
-        s->Li = light_env_radiance(l, wi);
-        s->pdf = env_pdf(l, wi);
+        if (!l->env) {
+            s->Li = l->L;
+            s->pdf = 1.0f / (4.0f * PI);
+            return 1;
+        }
+        float u, v; /* one look-up of the map for its radiance and pdf */
+        env_dir_to_uv(l, wi, &u, &v);
+        s->Li = env_texel(l, u, v);
+        s->pdf = env_pdf_uv(l, u, v);
         return 1;
     default:
         return 0;
@@ -558,8 +579,11 @@ int light_env_load(Light *l, const char *path, int octahedral, char *err, size_t
         m->row_cdf = malloc(((size_t)h + 1) * sizeof *m->row_cdf);
         m->col_cdf = malloc((size_t)h * ((size_t)w + 1) * sizeof *m->col_cdf);
         m->pixel_pdf = malloc(n * sizeof *m->pixel_pdf);
+        m->row_guide = malloc((size_t)h * sizeof *m->row_guide);
+        m->col_guide = malloc(n * sizeof *m->col_guide);
     }
-    if (!m || !m->rgb || !m->row_cdf || !m->col_cdf || !m->pixel_pdf) {
+    if (!m || !m->rgb || !m->row_cdf || !m->col_cdf || !m->pixel_pdf || !m->row_guide ||
+        !m->col_guide) {
         free(rgba);
         l->env = m;
         light_fini(l);
@@ -607,6 +631,9 @@ int light_env_load(Light *l, const char *path, int octahedral, char *err, size_t
         m->row_cdf[h] = 1.0f;
     for (size_t i = 0; i < n; i++)
         m->pixel_pdf[i] = total > 0.0 ? (float)(m->pixel_pdf[i] / total) : 0.0f;
+    cdf_guide(m->row_cdf, h, m->row_guide);
+    for (int y = 0; y < h; y++)
+        cdf_guide(&m->col_cdf[(size_t)y * (w + 1)], w, &m->col_guide[(size_t)y * w]);
     free(row);
     free(rgba);
     light_fini(l);
@@ -622,6 +649,8 @@ void light_fini(Light *l)
     free(l->env->row_cdf);
     free(l->env->col_cdf);
     free(l->env->pixel_pdf);
+    free(l->env->row_guide);
+    free(l->env->col_guide);
     free(l->env);
     l->env = NULL;
 }

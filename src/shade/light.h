@@ -50,13 +50,18 @@ typedef enum LightType {
 
 /* A latitude-longitude map with its sampling distribution: pixel (x, y)
  * weighted by its luminance times sin(theta) at its centre, drawn as a row
- * (marginal cdf) then a column (that row's conditional cdf). */
+ * (marginal cdf) then a column (that row's conditional cdf). Each cdf has
+ * a guide table (Chen's cutpoints): guide[k] is the interval holding k / n
+ * of n, where the search for a number of [k / n, (k + 1) / n) starts, so
+ * that inverting takes a step or two on average, not log2(n). */
 typedef struct LightEnvMap {
     int width, height;
     float *rgb;         /* width * height * 3, top row first */
     float *row_cdf;     /* height + 1 */
     float *col_cdf;     /* height * (width + 1) */
     float *pixel_pdf;   /* width * height: probability of drawing the pixel */
+    int *row_guide;     /* height: row_cdf's */
+    int *col_guide;     /* height * width: each row's col_cdf's */
 } LightEnvMap;
 
 typedef struct Light {

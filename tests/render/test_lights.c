@@ -4,7 +4,8 @@
  * spot, distant, ambient, disk and sphere lights; multiple importance
  * sampling against brute-force estimates of a glossy lobe under small and
  * large quads; a constant-environment white furnace; an importance-sampled
- * latitude-longitude map against a uniform-sphere estimate; categories;
+ * latitude-longitude map against a uniform-sphere estimate, its sampling
+ * against a binary search and pixel_pdf (chi-square); categories;
  * emitters seen by the camera; determinism with every light type; errors.
  *
  * The services are called directly on one shading point, on a scene
@@ -490,6 +491,118 @@ static void test_environment_map_importance_sampling(void)
     fx_fini(&f);
 }
 
+/* The binary search the guide tables replaced: the largest i < n with
+ * cdf[i] <= x, then past empty intervals. */
+static int reference_find(const float *cdf, int n, float x)
+{
+    int lo = 0, hi = n - 1;
+    while (lo < hi) {
+        int mid = (lo + hi + 1) / 2;
+        if (cdf[mid] <= x)
+            lo = mid;
+        else
+            hi = mid - 1;
+    }
+    while (lo < n - 1 && cdf[lo + 1] <= cdf[lo])
+        lo++;
+    return lo;
+}
+
+/* A 64 x 32 map with empty intervals in both cdfs: the bottom rows and a
+ * band of columns black, a bright patch, a gradient elsewhere. */
+static void write_holed_map(const char *path)
+{
+    int w = 64, h = 32;
+    float *p = malloc(sizeof(float) * 4 * w * h);
+    for (int i = 0; i < w * h; i++) {
+        int x = i % w, y = i / w;
+        float v = y >= 24 || (x >= 10 && x < 20) ? 0.0f
+                  : x >= 40 && x < 43 && y >= 9 && y < 12 ? 300.0f
+                                                           : 0.05f + 0.01f * (float)(x + y);
+        p[4 * i + 0] = p[4 * i + 1] = p[4 * i + 2] = v;
+        p[4 * i + 3] = 1.0f;
+    }
+    CHECK(image_write_exr(path, w, h, p, NULL, 0) == RAYES_OK);
+    free(p);
+}
+
+/* The map's sampling (shade/light.c's guide tables): each (a, b) draws the
+ * pixel the binary search draws, with the same pdf bit for bit, at random
+ * numbers and at every bucket's edge and its neighbours; black pixels are
+ * never drawn; the drawn pixels follow pixel_pdf (chi-square); and the pdf
+ * of a drawn direction, looked up again (light_intersect, what multiple
+ * importance sampling uses), is the sample's. */
+static void test_environment_map_sampling_consistency(void)
+{
+    const char *path = RAYES_TEST_TMP "/test_lights_holed.exr";
+    write_holed_map(path);
+    RayesScene *s = rayes_scene_new();
+    RayesParam e[2] = {ps("mapname", path), pf("intensity", 1)};
+    CHECK(rayes_scene_light(s, "environmentlight", e, 2) == RAYES_OK);
+    Fx f;
+    fx_init(&f, s);
+    const Light *l = &s->lights[0];
+    const LightEnvMap *m = l->env;
+    CHECK(m != NULL);
+    int w = m->width, h = m->height, n = 400000, edges = 0;
+    int *count = calloc((size_t)w * h, sizeof *count);
+    int wrong = 0, black = 0, pdf_far = 0, failed = 0;
+    for (int i = 0; i < n + 4 * (w + h); i++) {
+        float a = rng_float(hash_combine(11, (uint64_t)i));
+        float b = rng_float(hash_combine(12, (uint64_t)i));
+        if (i >= n) { /* bucket edges k / n and the floats beside them */
+            int j = (i - n) / 4, side = (i - n) % 4;
+            float ea = (float)(j % h) / (float)h, eb = (float)(j % w) / (float)w;
+            a = side == 1 ? nextafterf(ea, 0.0f) : side == 2 ? nextafterf(ea, 1.0f) : ea;
+            b = side == 3 ? nextafterf(eb, 0.0f) : side == 2 ? nextafterf(eb, 1.0f) : eb;
+            a = fminf(fmaxf(a, 0.0f), nextafterf(1.0f, 0.0f));
+            b = fminf(fmaxf(b, 0.0f), nextafterf(1.0f, 0.0f));
+            edges++;
+        }
+        int y = reference_find(m->row_cdf, h, a);
+        const float *cc = &m->col_cdf[(size_t)y * (w + 1)];
+        int x = reference_find(cc, w, b);
+        float dr = m->row_cdf[y + 1] - m->row_cdf[y];
+        float fy = dr > 0.0f ? (a - m->row_cdf[y]) / dr : 0.5f;
+        float v = ((float)y + fminf(fmaxf(fy, 0.0f), 0.9999f)) / (float)h;
+        float pdf = m->pixel_pdf[(size_t)y * w + x] * (float)w * (float)h /
+                    (2.0f * (float)PI * (float)PI * sinf(v * (float)PI));
+        LightSample ls;
+        if (!light_sample(l, v3(0, 0, 0), a, b, &ls)) {
+            failed += sinf(v * (float)PI) > 0.0f; /* only at the pole, a = 0 */
+            continue;
+        }
+        wrong += ls.pdf != pdf;
+        black += !(m->pixel_pdf[(size_t)y * w + x] > 0.0f);
+        if (i < n)
+            count[y * w + x]++;
+        LightSample back;
+        CHECK(light_intersect(l, v3(0, 0, 0), ls.wi, &back));
+        pdf_far += fabsf(back.pdf - ls.pdf) > 1e-3f * ls.pdf;
+    }
+    CHECK(edges == 4 * (w + h));
+    CHECK(failed == 0);
+    CHECK(wrong == 0);
+    CHECK(black == 0);
+    /* a direction on a pixel's edge may look up its neighbour */
+    CHECK(pdf_far < n / 100);
+    double chi2 = 0.0;
+    int dof = -1;
+    for (int i = 0; i < w * h; i++) {
+        double expect = (double)m->pixel_pdf[i] * n;
+        if (expect >= 5.0) {
+            chi2 += (count[i] - expect) * (count[i] - expect) / expect;
+            dof++;
+        } else
+            CHECK(m->pixel_pdf[i] > 0.0f || count[i] == 0);
+    }
+    /* chi-square of dof degrees: mean dof, deviation sqrt(2 dof); 5 of them */
+    CHECK(dof > 500);
+    CHECK(chi2 < dof + 5.0 * sqrt(2.0 * dof));
+    free(count);
+    fx_fini(&f);
+}
+
 /* pbrt-v4's equal-area octahedral maps: the square's centre is light-space
  * +z, its corners -z, the middle of its right edge +x and of its top row
  * -y (pbrt's EqualAreaSphereToSquare, (0, 0) the top left). Red marks the
@@ -791,6 +904,7 @@ TEST_MAIN(TEST(test_point_light_inverse_square), TEST(test_spot_light_cone),
           TEST(test_mis_glossy_large_quad), TEST(test_glossy_lights_against_brute_force),
           TEST(test_glossy_surroundings_against_brute_force),
           TEST(test_constant_environment_white_furnace),
-          TEST(test_environment_map_importance_sampling), TEST(test_octahedral_environment_map),
+          TEST(test_environment_map_importance_sampling),
+          TEST(test_environment_map_sampling_consistency), TEST(test_octahedral_environment_map),
           TEST(test_categories), TEST(test_emitters_seen_by_camera),
           TEST(test_every_light_any_thread_count), TEST(test_bad_lights))
