@@ -154,6 +154,7 @@ static Row run(const Args *a, int size, int spp, int bounces, int cache, double 
          * spreads its rays over 64 pixel samples instead). */
         o.diffuse_rays = 4096;
         o.shadow_rays = 64;
+        o.max_spp = 0; /* the memo's reference: no adaptive pixel samples */
     }
     /* The memo's trees: every uncached diffuse hit branches into the
      * preset's deeper rays, as its tables count them. */

@@ -654,7 +654,8 @@ RAYES_API uint64_t rayes_scene_get_timestamp(const RayesScene *scene);
 typedef enum RayesQuality {
     RAYES_QUALITY_PREVIEW = 0,   /* 4 shadow rays, 4 diffuse rays */
     RAYES_QUALITY_FINAL = 1,     /* 64 shadow; 1024 diffuse at depth 0, 64 deeper */
-    RAYES_QUALITY_REFERENCE = 2  /* 64 shadow and 4096 diffuse at depth 0, 1 and 1 deeper */
+    RAYES_QUALITY_REFERENCE = 2  /* uncached; 64-1024 adaptive pixel samples, each 16 shadow
+                                    and 256 diffuse at depth 0, 1 and 1 deeper */
 } RayesQuality;
 
 /* Pixel filters, all separable (the product of one in x and one in y) and

@@ -97,11 +97,13 @@ void rayes_render_options_init(RayesRenderOptions *o, RayesQuality quality)
         o->irradiance = 1;
         break;
     case RAYES_QUALITY_REFERENCE:
-        /* Converged in pixels as well as in light: 64 pixel samples (edges,
-         * reflections, the light's outline), each with 256 diffuse and 16
-         * shadow rays, 16,384 diffuse paths a pixel as the memo's 4096 rays
-         * at 4 samples gave, for about the same rays. */
+        /* Converged in pixels as well as in light: at least 64 pixel
+         * samples, each with 256 diffuse and 16 shadow rays (16,384 diffuse
+         * paths a pixel, as the memo's 4096 rays at 4 samples gave), and up
+         * to 1024 where the adaptive test finds a pixel short of 2% (edges,
+         * reflections, the light's outline: docs/performance.md). */
         o->spp = 64;
+        o->max_spp = 1024;
         o->shadow_rays = 16;
         o->shadow_rays_deep = 1;
         o->diffuse_rays = 256;

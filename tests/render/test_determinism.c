@@ -248,17 +248,26 @@ static void test_reference_preset(void)
     RayesScene *s = builtin("cornell");
     RayesRenderOptions o;
     rayes_render_options_init(&o, RAYES_QUALITY_REFERENCE);
-    CHECK(o.spp == 64 && !o.cache && !o.opacity_cache && !o.irradiance_cache);
+    CHECK(o.spp == 64 && o.max_spp == 1024 && o.adaptive_error > 0.0f && !o.cache &&
+          !o.opacity_cache && !o.irradiance_cache);
     o.width = o.height = 8;
     o.threads = 2;
-    RayesImage *img = NULL;
-    RayesStats *st = NULL;
+    o.diffuse_rays = 16; /* the pixel samples are what is tested */
+    RayesImage *img = NULL, *uniform = NULL;
+    RayesStats *st = NULL, *st_uniform = NULL;
     CHECK(rayes_render(s, &o, &img, &st) == RAYES_OK);
+    /* adaptive: at least the 64 first samples a pixel, more where needed */
     const RayesStat *cam = rayes_stats_find(st, "rays/camera");
-    CHECK(cam && cam->count == 8 * 8 * 64);
+    CHECK(cam && cam->count > 8 * 8 * 64 && cam->count < 8 * 8 * 1024);
     CHECK(rayes_stats_find(st, "cache/budget_bytes") == NULL);
+    o.max_spp = 0;
+    CHECK(rayes_render(s, &o, &uniform, &st_uniform) == RAYES_OK);
+    cam = rayes_stats_find(st_uniform, "rays/camera");
+    CHECK(cam && cam->count == 8 * 8 * 64);
     rayes_stats_free(st);
+    rayes_stats_free(st_uniform);
     rayes_image_free(img);
+    rayes_image_free(uniform);
     rayes_scene_release(s);
 }
 
