@@ -313,12 +313,60 @@ static int tap_pixel(const PbgiCloud *c, int f, int i, int j)
     return face_pixel(c, g, (int)floorf(x + 0.5f), (int)floorf(y + 0.5f));
 }
 
+/* The walls between adjacent upper pixels, across the faces' edges too,
+ * for the translational gradient (pbgi_record). A wall is an arc of a
+ * great circle (a cube edge's or a pixel edge's image on the sphere): its
+ * normal on the sphere is constant along it, the normal of the circle's
+ * plane, and the integral of the unit direction along an arc from w0 to
+ * w1 is (w0 + w1) tan(gamma / 2), gamma the arc's angle. */
+static int wall_tables(PbgiCloud *c)
+{
+    int R = c->raster;
+    c->wall_pix = malloc((size_t)12 * R * R * sizeof *c->wall_pix);
+    c->wall_vec = malloc((size_t)12 * R * R * sizeof *c->wall_vec);
+    if (!c->wall_pix || !c->wall_vec)
+        return -1;
+    c->n_walls = 0;
+    for (int f = 0; f < 6; f++) {
+        int a, u, v;
+        face_axes(f, &a, &u, &v);
+        for (int j = 0; j < R; j++)
+            for (int i = 0; i < R; i++)
+                for (int e = 0; e < 4; e++) { /* the pixel's left, right, lower, upper edge */
+                    int di = e == 0 ? -1 : e == 1 ? 1 : 0, dj = e == 2 ? -1 : e == 3 ? 1 : 0;
+                    int p = c->pix_of[(f * R + j) * R + i], q = tap_pixel(c, f, i + di, j + dj);
+                    if (q <= p || q >= c->n_upper) /* once a wall, upper pixels only */
+                        continue;
+                    float w[2][3];
+                    for (int k = 0; k < 2; k++) { /* the edge's ends on the face */
+                        int ci = di ? i + (di > 0) : i + k, cj = dj ? j + (dj > 0) : j + k;
+                        w[k][a] = f % 2 ? -1.0f : 1.0f;
+                        w[k][u] = -1.0f + 2.0f * (float)ci / (float)R;
+                        w[k][v] = -1.0f + 2.0f * (float)cj / (float)R;
+                    }
+                    Vec3 w0 = v3_normalize(v3_load(w[0])), w1 = v3_normalize(v3_load(w[1]));
+                    Vec3 m = v3_normalize(v3_cross(w0, w1));
+                    if (v3_dot(m, v3_load(c->pix_dir[q])) < 0.0f)
+                        m = v3_neg(m);
+                    float along = v3_length(v3_cross(w0, w1)) / (1.0f + v3_dot(w0, w1));
+                    float cos_len = (w0.z + w1.z) * along; /* the integral of cos(theta) */
+                    if (!(cos_len > 0.0f))
+                        continue; /* on the horizon */
+                    c->wall_pix[c->n_walls][0] = p;
+                    c->wall_pix[c->n_walls][1] = q;
+                    v3_store(c->wall_vec[c->n_walls++], v3_scale(m, cos_len));
+                }
+    }
+    return 0;
+}
+
 int pbgi_raster_init(PbgiRaster *r, const PbgiCloud *cloud)
 {
     r->cov = malloc((size_t)cloud->n_pix * sizeof *r->cov);
     r->col = malloc((size_t)cloud->n_pix * sizeof *r->col);
     r->tmp = malloc((size_t)cloud->n_pix * sizeof *r->tmp);
-    if (!r->cov || !r->col || !r->tmp) {
+    r->dist = malloc((size_t)cloud->n_pix * sizeof *r->dist);
+    if (!r->cov || !r->col || !r->tmp || !r->dist) {
         pbgi_raster_fini(r);
         return -1;
     }
@@ -330,9 +378,11 @@ void pbgi_raster_fini(PbgiRaster *r)
     free(r->cov);
     free(r->col);
     free(r->tmp);
+    free(r->dist);
     r->cov = NULL;
     r->col = NULL;
     r->tmp = NULL;
+    r->dist = NULL;
 }
 
 PbgiCloud *pbgi_cloud_new(PbgiDisk *disks, size_t n, float max_solid_angle, int raster)
@@ -350,7 +400,7 @@ PbgiCloud *pbgi_cloud_new(PbgiDisk *disks, size_t n, float max_solid_angle, int 
     Build b = {.cloud = c};
     b.tmp = malloc(RY_MAX(n, 1) * sizeof *b.tmp);
     b.tmp_perm = malloc(RY_MAX(n, 1) * sizeof *b.tmp_perm);
-    int ok = c->perm && b.tmp && b.tmp_perm && raster_tables(c) == 0;
+    int ok = c->perm && b.tmp && b.tmp_perm && raster_tables(c) == 0 && wall_tables(c) == 0;
     if (ok) {
         for (size_t i = 0; i < n; i++)
             c->perm[i] = (uint32_t)i;
@@ -379,6 +429,8 @@ void pbgi_cloud_free(PbgiCloud *c)
     free(c->pix_dir);
     free(c->pix_weight);
     free(c->pix_omega);
+    free(c->wall_pix);
+    free(c->wall_vec);
     free(c);
 }
 
@@ -391,7 +443,7 @@ typedef struct Gather {
     int full;                  /* pixels fully covered */
 } Gather;
 
-static void cover(Gather *g, int p, float cov, Vec3 L)
+static void cover(Gather *g, int p, float cov, Vec3 L, float dist)
 {
     float have = g->r->cov[p];
     if (have >= 1.0f)
@@ -401,6 +453,7 @@ static void cover(Gather *g, int p, float cov, Vec3 L)
     g->r->col[p][0] += a * L.x;
     g->r->col[p][1] += a * L.y;
     g->r->col[p][2] += a * L.z;
+    g->r->dist[p] += a * dist;
     if (have + a >= 1.0f - 1e-6f) {
         g->r->cov[p] = 1.0f;
         g->full += p < g->c->n_upper;
@@ -408,7 +461,7 @@ static void cover(Gather *g, int p, float cov, Vec3 L)
 }
 
 /* A fragment of solid angle omega and radiance L in unit world direction
- * d, anti-aliased: one smaller than a pixel shares its coverage between
+ * d at distance dist, anti-aliased: one smaller than a pixel shares its coverage between
  * the four pixels about it (bilinear), a larger one covers the pixels
  * within its outline with a ramp a pixel wide at the edge, scaled so that
  * its coverages times the pixels' solid angles add up to omega. The
@@ -417,7 +470,7 @@ static void cover(Gather *g, int p, float cov, Vec3 L)
  * tilted disk's. Then fragments that tile a surface cover the raster
  * evenly, without the gaps and overlaps of whole pixels or of circles
  * (with those, a furnace lost 10-20%, and 3-7% near its wall). */
-static void splat(Gather *g, Vec3 d, float omega, Vec3 L, Vec3 minor, float squash)
+static void splat(Gather *g, Vec3 d, float dist, float omega, Vec3 L, Vec3 minor, float squash)
 {
     const PbgiCloud *c = g->c;
     Vec3 l = v3(v3_dot(d, g->T), v3_dot(d, g->B), v3_dot(d, g->N));
@@ -435,7 +488,7 @@ static void splat(Gather *g, Vec3 d, float omega, Vec3 L, Vec3 minor, float squa
         for (int k = 0; k < 4; k++) {
             int p = tap_pixel(c, f, i + (k & 1), j + (k >> 1));
             if (w[k] > 0.0f)
-                cover(g, p, w[k] * omega / c->pix_omega[p], L);
+                cover(g, p, w[k] * omega / c->pix_omega[p], L, dist);
         }
         return;
     }
@@ -467,7 +520,7 @@ static void splat(Gather *g, Vec3 d, float omega, Vec3 L, Vec3 minor, float squa
     float scale = fminf(omega, 2.0f * (float)M_PI) / sum;
     for (int q = 0; q < c->n_pix; q++)
         if (t[q] > 0.0f)
-            cover(g, q, t[q] * scale, L);
+            cover(g, q, t[q] * scale, L, dist);
 }
 
 static void splat_disk(Gather *g, const PbgiDisk *k)
@@ -485,7 +538,7 @@ static void splat_disk(Gather *g, const PbgiDisk *k)
     Vec3 across = v3_sub(n, v3_scale(d, cosk)); /* the normal across d: the outline's minor axis */
     float s = v3_length(across);
     Vec3 minor = s > 1e-6f ? v3_scale(across, 1.0f / s) : g->T;
-    splat(g, d, omega, L, minor, fabsf(cosk));
+    splat(g, d, dist, omega, L, minor, fabsf(cosk));
 }
 
 /* A node as one cluster, seen from P along -d. */
@@ -508,7 +561,7 @@ static void splat_cluster(Gather *g, const PbgiCluster *n, Vec3 d, float dist)
     if (!(area > 0.0f))
         return;
     Vec3 L = v3(fmaxf(pw[0], 0.0f) / area, fmaxf(pw[1], 0.0f) / area, fmaxf(pw[2], 0.0f) / area);
-    splat(g, d, area / (dist * dist), L, g->T, 1.0f);
+    splat(g, d, dist, area / (dist * dist), L, g->T, 1.0f);
 }
 
 /* Squared distance from P: the order of the walk. */
@@ -572,19 +625,76 @@ static void traverse(Gather *g, const PbgiNode *n)
         traverse(g, &c->nodes[order[i]]);
 }
 
-Vec3 pbgi_gather(const PbgiCloud *c, PbgiRaster *r, Vec3 P, Vec3 N)
+/* Rasterises the cloud as seen from P, N into r; g is the gather's frame. */
+static void rasterise(const PbgiCloud *c, PbgiRaster *r, Vec3 P, Vec3 N, Gather *g)
 {
-    Gather g = {.c = c, .r = r, .P = P, .N = N};
-    v3_basis(N, &g.T, &g.B);
+    *g = (Gather){.c = c, .r = r, .P = P, .N = N};
+    v3_basis(N, &g->T, &g->B);
     memset(r->cov, 0, (size_t)c->n_pix * sizeof *r->cov);
     memset(r->col, 0, (size_t)c->n_pix * sizeof *r->col);
+    memset(r->dist, 0, (size_t)c->n_pix * sizeof *r->dist);
     if (c->n_nodes)
-        traverse(&g, &c->nodes[0]);
+        traverse(g, &c->nodes[0]);
+}
+
+Vec3 pbgi_gather(const PbgiCloud *c, PbgiRaster *r, Vec3 P, Vec3 N)
+{
+    Gather g;
+    rasterise(c, r, P, N, &g);
     double s[3] = {0, 0, 0};
     for (int p = 0; p < c->n_upper; p++)
         for (int k = 0; k < 3; k++)
             s[k] += (double)c->pix_weight[p] * r->col[p][k];
     return v3((float)(s[0] / M_PI), (float)(s[1] / M_PI), (float)(s[2] / M_PI));
+}
+
+/* The gather's record. Rotational gradient: turning the normal by a small
+ * rotation vector alpha changes each direction's cosine by alpha . (N x
+ * w), so grad_r = sum over upper pixels of L_p omega_p (N x w_p) (the
+ * tan(theta) v_k sum of Ward and Heckbert on their strata). Translational
+ * gradient: moving P by dx moves the outline of the nearer surface at a
+ * wall between pixels p and q by -dx across w over its distance, trading
+ * solid angle between them: grad_t = sum over walls of (L_q - L_p) m
+ * (integral of cos(theta) along it) / min(r_p, r_q), m its normal into q,
+ * Ward and Heckbert's formula with the raster's walls for their strata's
+ * (DESIGN.md, "Point-based global illumination"); in the tangent plane, as
+ * theirs. Pixel depths are their fragments' coverage-weighted distances. */
+void pbgi_record(const PbgiCloud *c, PbgiRaster *r, Vec3 P, Vec3 N, IrrRecord *rec)
+{
+    Gather g;
+    rasterise(c, r, P, N, &g);
+    double E[3] = {0, 0, 0}, rot[3][2] = {{0, 0}, {0, 0}, {0, 0}}, tr[3][2] = {{0, 0}, {0, 0}, {0, 0}};
+    IrrRadius radius = IRR_RADIUS_INIT;
+    for (int p = 0; p < c->n_upper; p++) {
+        const float *w = c->pix_dir[p], *L = r->col[p];
+        float omega = c->pix_weight[p] / w[2]; /* the solid angle, normalised as the weights */
+        for (int k = 0; k < 3; k++) {
+            E[k] += (double)c->pix_weight[p] * L[k];
+            rot[k][0] -= (double)(omega * w[1] * L[k]); /* N x w = (-w.y, w.x, 0) */
+            rot[k][1] += (double)(omega * w[0] * L[k]);
+        }
+        r->dist[p] = r->cov[p] > 0.0f ? r->dist[p] / r->cov[p] : INFINITY;
+        irr_radius_add(&radius, r->dist[p], w[2]);
+    }
+    for (int k = 0; k < c->n_walls; k++) {
+        int p = c->wall_pix[k][0], q = c->wall_pix[k][1];
+        float rr = fminf(r->dist[p], r->dist[q]);
+        if (!isfinite(rr) || !(rr > 0.0f))
+            continue;
+        for (int ch = 0; ch < 3; ch++) {
+            double d = (double)(r->col[q][ch] - r->col[p][ch]) / rr;
+            tr[ch][0] += d * c->wall_vec[k][0];
+            tr[ch][1] += d * c->wall_vec[k][1];
+        }
+    }
+    rec->p = P;
+    rec->n = N;
+    rec->E = v3((float)E[0], (float)E[1], (float)E[2]);
+    for (int k = 0; k < 3; k++) {
+        rec->grad_r[k] = v3_add(v3_scale(g.T, (float)rot[k][0]), v3_scale(g.B, (float)rot[k][1]));
+        rec->grad_t[k] = v3_add(v3_scale(g.T, (float)tr[k][0]), v3_scale(g.B, (float)tr[k][1]));
+    }
+    rec->R = irr_radius(&radius);
 }
 
 /* --------------------------------------------------------------- passes */
