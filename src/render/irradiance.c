@@ -110,7 +110,9 @@ void irr_radius_add(IrrRadius *acc, float r, float cos_theta)
 
 float irr_radius(const IrrRadius *acc)
 {
-    return isfinite(acc->r_min) ? acc->r_min : acc->inv_r > 0.0 ? (float)(acc->n / acc->inv_r) : INFINITY;
+    if (isfinite(acc->r_min))
+        return acc->r_min;
+    return acc->inv_r > 0.0 ? (float)(acc->n / acc->inv_r) : INFINITY;
 }
 
 Vec3 irr_extrapolate(const IrrRecord *rec, Vec3 p, Vec3 n)

@@ -48,7 +48,8 @@ void irr_record(int M, int N, const Vec3 *L, const float *r, Vec3 p, Vec3 n, Irr
 /* A record's validity radius from the hit distances of its samples: the
  * smallest distance of those more than ~10 degrees above the tangent plane
  * (cos theta > 0.173), else the harmonic mean of all (a miss, r INFINITY,
- * counts as infinitely far), else INFINITY. Start from IRR_RADIUS_INIT, irr_radius_add each sample. */
+ * counts as infinitely far), else INFINITY. Start from IRR_RADIUS_INIT,
+ * irr_radius_add each sample. */
 typedef struct IrrRadius {
     double inv_r;
     int n;

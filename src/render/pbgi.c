@@ -663,7 +663,8 @@ void pbgi_record(const PbgiCloud *c, PbgiRaster *r, Vec3 P, Vec3 N, IrrRecord *r
 {
     Gather g;
     rasterise(c, r, P, N, &g);
-    double E[3] = {0, 0, 0}, rot[3][2] = {{0, 0}, {0, 0}, {0, 0}}, tr[3][2] = {{0, 0}, {0, 0}, {0, 0}};
+    double E[3] = {0, 0, 0}, rot[3][2] = {{0, 0}, {0, 0}, {0, 0}};
+    double tr[3][2] = {{0, 0}, {0, 0}, {0, 0}};
     IrrRadius radius = IRR_RADIUS_INIT;
     for (int p = 0; p < c->n_upper; p++) {
         const float *w = c->pix_dir[p], *L = r->col[p];

@@ -475,5 +475,6 @@ static void test_bad_options(void)
     rayes_scene_release(s);
 }
 
-TEST_MAIN(TEST(test_gradients), TEST(test_furnace), TEST(test_furnace_cube), TEST(test_occlusion), TEST(test_back_faces_occlude),
-          TEST(test_lit_plane_power), TEST(test_threads_and_bounces), TEST(test_interpolation), TEST(test_bad_options))
+TEST_MAIN(TEST(test_gradients), TEST(test_furnace), TEST(test_furnace_cube), TEST(test_occlusion),
+          TEST(test_back_faces_occlude), TEST(test_lit_plane_power), TEST(test_threads_and_bounces),
+          TEST(test_interpolation), TEST(test_bad_options))
