@@ -10,7 +10,7 @@
  *   memo_tables table4 [...same...] [--budgets MB,MB,...]
  *   memo_tables table2 [...same...] [--uncached-max B]
  *   memo_tables figure5 [--size N] [--spp N] [--out DIR] [--data DIR] [--scene S]
- *                       [--pbgi-solid-angle SR[,SR...]] [--pbgi-raster N]
+ *                       [--pbgi-solid-angle SR[,SR...]] [--pbgi-raster N] [--final-rays N[,N...]]
  *   memo_tables figure8 [--size N] [--spp N] [--threads N] [--shadow-rays N]
  *                       [--ao-samples N] [--check-size N] [--experiment a|b|ab] [--out DIR]
  *                       [--repeat N] [--only off|on]
@@ -31,7 +31,8 @@
  * 20x difference images, times (point-based: of each pass) and the point
  * count; a point-based row for each of the --pbgi-solid-angle values (with
  * the final preset's irradiance interpolation) and one for the first
- * without (a gather at every shaded vertex). The
+ * without (a gather at every shaded vertex); with --final-rays, final rows
+ * at those depth-0 diffuse ray counts (final at point-based GI's time). The
  * first point-based row's cloud goes to figure5-pointcloud.ply and, its
  * disks splatted from the camera, to figure5-pointcloud.png.
  * Both then measure bias: the same rows at --accuracy-spp pixel samples
@@ -88,6 +89,9 @@ typedef struct Args {
     int n_pbgi;
     int irradiance;               /* the rows' irradiance interpolation: -1 the preset's,
                                      0 off, 1 on */
+    int diffuse_rays;             /* the rows' depth-0 diffuse rays, 0: the preset's */
+    int final_rays[4];            /* figure5: a final row at each of these depth-0 rays */
+    int n_final_rays;
 } Args;
 
 typedef struct Row {
@@ -174,6 +178,8 @@ static Row run(const Args *a, int size, int spp, int bounces, int cache, double 
     o.gi = (RayesGi)a->gi;
     if (a->irradiance >= 0)
         o.irradiance = a->irradiance;
+    if (a->diffuse_rays > 0)
+        o.diffuse_rays = a->diffuse_rays;
     o.pbgi_max_solid_angle = a->pbgi_solid_angle;
     o.pbgi_raster = a->pbgi_raster;
     char cloud[1024];
@@ -368,7 +374,11 @@ static void parse(int argc, char **argv, Args *a)
             for (char *p = (char *)v; *p && a->n_pbgi < 8; p += strcspn(p, ",") + (p[strcspn(p, ",")] != 0))
                 a->pbgi_solid_angles[a->n_pbgi++] = (float)atof(p);
         }
-        else if (strcmp(o, "--pbgi-raster") == 0)
+        else if (strcmp(o, "--final-rays") == 0) {
+            a->n_final_rays = 0;
+            for (char *p = (char *)v; *p && a->n_final_rays < 4; p += strcspn(p, ",") + (p[strcspn(p, ",")] != 0))
+                a->final_rays[a->n_final_rays++] = atoi(p);
+        } else if (strcmp(o, "--pbgi-raster") == 0)
             a->pbgi_raster = atoi(v);
         else if (strcmp(o, "--uncached-max") == 0)
             a->uncached_max = atoi(v);
@@ -615,11 +625,18 @@ static void figure5(Args *a, FILE *j)
         char tag[48];
         int quality, gi;
         float solid_angle;
-        int irradiance;
-    } rows[3 + 9] = {{"reference", RAYES_QUALITY_REFERENCE, RAYES_GI_RAYTRACE, 0, -1},
-                     {"preview", RAYES_QUALITY_PREVIEW, RAYES_GI_RAYTRACE, 0, -1},
-                     {"final", RAYES_QUALITY_FINAL, RAYES_GI_RAYTRACE, 0, -1}};
+        int irradiance, diffuse_rays;
+    } rows[3 + 4 + 9] = {{"reference", RAYES_QUALITY_REFERENCE, RAYES_GI_RAYTRACE, 0, -1, 0},
+                         {"preview", RAYES_QUALITY_PREVIEW, RAYES_GI_RAYTRACE, 0, -1, 0},
+                         {"final", RAYES_QUALITY_FINAL, RAYES_GI_RAYTRACE, 0, -1, 0}};
     int n_rows = 3;
+    /* Final at fewer depth-0 rays (--final-rays): its error at point-based
+     * GI's time. */
+    for (int k = 0; k < a->n_final_rays; k++, n_rows++) {
+        rows[n_rows] = rows[2];
+        rows[n_rows].diffuse_rays = a->final_rays[k];
+        snprintf(rows[n_rows].tag, sizeof rows[n_rows].tag, "final-%d", a->final_rays[k]);
+    }
     /* A row for each solid angle, with irradiance interpolation (the final
      * preset's), and the first's without: a gather at every vertex. */
     for (int k = 0; k <= a->n_pbgi; k++, n_rows++) {
@@ -647,8 +664,9 @@ static void figure5(Args *a, FILE *j)
         if (rows[i].gi == RAYES_GI_POINTBASED)
             a->pbgi_solid_angle = rows[i].solid_angle;
         a->irradiance = rows[i].irradiance;
+        a->diffuse_rays = rows[i].diffuse_rays;
         Row r = run(a, a->size, a->spp, 1, rows[i].quality != RAYES_QUALITY_REFERENCE, 100);
-        char path[1024], err[1024], s1[32], s2[32];
+        char path[1200], err[1024], s1[32], s2[32];
         snprintf(path, sizeof path, "%s/figure5-%s.png", a->out, rows[i].tag);
         if (image_write(path, r.w, r.h, r.rgba, err, sizeof err) != RAYES_OK)
             die(err);
@@ -666,7 +684,7 @@ static void figure5(Args *a, FILE *j)
                    r.cpu_s / ref.cpu_s);
         else
             printf(" %10s %10s | %10s %10s |\n", "-", "-", "-", "-");
-        if (r.pbgi_points && i == 3)
+        if (r.pbgi_points && i == 3 + a->n_final_rays)
             pointcloud_view(a, a->size, 0.7f);
         if (r.pbgi_points)
             printf("    point cloud (solid angle %g sr, raster %d): %llu points, pass 1 (shading the "

@@ -700,16 +700,57 @@ void pbgi_record(const PbgiCloud *c, PbgiRaster *r, Vec3 P, Vec3 N, IrrRecord *r
 
 /* --------------------------------------------------------------- passes */
 
-/* Whether grid g goes into the cloud: a surface of world geometry (not an
- * instance's master: see DESIGN.md) whose object has a shader (lights do
- * not: diffuse rays see them black, direct lighting counts them). */
-static int cloud_grid(const RenderScene *rs, uint32_t g)
+/* A grid of the cloud: grid `grid` seen through `instance` (0: world
+ * geometry; else an object instance + 1 of the grid's master). */
+typedef struct CloudGrid {
+    uint32_t grid, instance;
+} CloudGrid;
+
+/* Whether grid g seen through instance goes into the cloud: a surface
+ * (world geometry, or a master's grid through an instance of it) whose
+ * object has a shader (lights do not: diffuse rays see them black, direct
+ * lighting counts them). */
+static int cloud_grid(const RenderScene *rs, uint32_t g, uint32_t instance)
 {
     const Grid *grid = &rs->gs->grids[g];
-    if (grid->shape != GEOM_SHAPE_SURFACE || grid->master != 0 ||
-        grid->object == GEOM_OBJECT_INHERIT)
+    if (grid->shape != GEOM_SHAPE_SURFACE || (grid->master != 0) != (instance != 0) ||
+        (!instance && grid->object == GEOM_OBJECT_INHERIT))
         return 0;
-    return render_object(rs, g, 0)->shader != NULL;
+    return render_object(rs, g, instance)->shader != NULL;
+}
+
+/* The cloud's grids: world geometry's in grid order, then each instance's
+ * master grids, instances in order. *n gets their count; NULL when out of
+ * memory. */
+static CloudGrid *cloud_grids(const RenderScene *rs, size_t *n)
+{
+    const GridSet *gs = rs->gs;
+    uint32_t *mfirst = calloc(gs->n_masters + 1, sizeof *mfirst);
+    uint32_t *mcount = calloc(gs->n_masters + 1, sizeof *mcount);
+    size_t cap = gs->n_grids;
+    for (uint32_t g = 0; mfirst && mcount && g < gs->n_grids; g++) {
+        uint32_t m = gs->grids[g].master; /* a master's grids are contiguous */
+        if (m && mcount[m - 1]++ == 0)
+            mfirst[m - 1] = g;
+    }
+    for (size_t i = 0; mcount && i < gs->n_instances; i++)
+        cap += mcount[gs->instances[i].master];
+    CloudGrid *out = mfirst && mcount ? malloc(RY_MAX(cap, 1) * sizeof *out) : NULL;
+    *n = 0;
+    if (out) {
+        for (uint32_t g = 0; g < gs->n_grids; g++)
+            if (cloud_grid(rs, g, 0))
+                out[(*n)++] = (CloudGrid){g, 0};
+        for (size_t i = 0; i < gs->n_instances; i++) {
+            uint32_t m = gs->instances[i].master;
+            for (uint32_t g = mfirst[m]; g < mfirst[m] + mcount[m]; g++)
+                if (cloud_grid(rs, g, (uint32_t)i + 1))
+                    out[(*n)++] = (CloudGrid){g, (uint32_t)i + 1};
+        }
+    }
+    free(mfirst);
+    free(mcount);
+    return out;
 }
 
 /* Disks of grid g: its micropolygons (quads; a triangular grid's lattice
@@ -734,16 +775,18 @@ static size_t tri_value(int n, int i, int j)
 }
 
 /* One disk over the polygon of k vertices (grid vertex vi[], fill value
- * ki[]), facing the vertices' normals. */
-static void polygon_disk(const GridSet *gs, const Grid *g, const uint32_t *vi,
-                         const size_t *ki, int k, const float (*val)[3], PbgiDisk *out)
+ * ki[]), facing the vertices' normals; in world space through inst (or
+ * NULL). */
+static void polygon_disk(const GridSet *gs, const Grid *g, const GeomInstance *inst,
+                         const uint32_t *vi, const size_t *ki, int k, const float (*val)[3],
+                         PbgiDisk *out)
 {
     Vec3 P = v3(0, 0, 0), N = P, L = P, p[4];
     for (int a = 0; a < k; a++) {
         uint32_t v = g->first_vertex + vi[a];
-        p[a] = gs->P[v];
+        p[a] = inst ? mat4_point(&inst->world_from_master, gs->P[v]) : gs->P[v];
         P = v3_add(P, p[a]);
-        N = v3_add(N, gs->N[v]);
+        N = v3_add(N, inst ? mat4_vector(&inst->normal_to_world, gs->N[v]) : gs->N[v]);
         L = v3_add(L, v3_load(val[ki[a]]));
     }
     Vec3 x = k == 4 ? v3_cross(v3_sub(p[2], p[0]), v3_sub(p[3], p[1]))
@@ -759,7 +802,8 @@ static void polygon_disk(const GridSet *gs, const Grid *g, const uint32_t *vi,
 }
 
 /* The disks of grid g from its vertices' values. */
-static void grid_disks(const GridSet *gs, const Grid *g, const float (*val)[3], PbgiDisk *out)
+static void grid_disks(const GridSet *gs, const Grid *g, const GeomInstance *inst,
+                       const float (*val)[3], PbgiDisk *out)
 {
     if (!g->triangular) {
         int nu = g->nu;
@@ -769,7 +813,7 @@ static void grid_disks(const GridSet *gs, const Grid *g, const float (*val)[3], 
                 uint32_t vi[4] = {(uint32_t)(j * nu + i), (uint32_t)(j * nu + i + 1),
                                   (uint32_t)((j + 1) * nu + i + 1), (uint32_t)((j + 1) * nu + i)};
                 size_t ki[4] = {vi[0], vi[1], vi[2], vi[3]};
-                polygon_disk(gs, g, vi, ki, 4, val, out++);
+                polygon_disk(gs, g, inst, vi, ki, 4, val, out++);
             }
         return;
     }
@@ -788,7 +832,7 @@ static void grid_disks(const GridSet *gs, const Grid *g, const float (*val)[3], 
                                             (uint32_t)tri[t][a][1]);
                     ki[a] = tri_value(n, tri[t][a][0], tri[t][a][1]);
                 }
-                polygon_disk(gs, g, vi, ki, 3, val, out++);
+                polygon_disk(gs, g, inst, vi, ki, 3, val, out++);
             }
         }
 }
@@ -797,7 +841,9 @@ typedef struct Pass {
     const RenderScene *rs;
     const RenderSettings *set;
     Worker *workers;
-    const size_t *first;       /* per grid: its first disk; first[n_grids]: all */
+    const CloudGrid *grids;    /* the cloud's grids */
+    size_t n_grids;
+    const size_t *first;       /* per cloud grid: its first disk; first[n_grids]: all */
     PbgiDisk *disks;           /* pass 1: geometry and radiosity */
     float (*L)[3];             /* pass 2: radiosity alone, per disk in grid order */
     int depth;                 /* the diffuse depth the grids are shaded at */
@@ -806,22 +852,21 @@ typedef struct Pass {
 static void pass_grid(void *ctx, size_t task, int worker)
 {
     Pass *p = ctx;
-    uint32_t gi = (uint32_t)task;
-    if (p->first[gi + 1] == p->first[gi])
-        return;
     const GridSet *gs = p->rs->gs;
-    const Grid *g = &gs->grids[gi];
+    const CloudGrid *cg = &p->grids[task];
+    const Grid *g = &gs->grids[cg->grid];
+    const GeomInstance *inst = render_instance(p->rs, cg->instance);
     size_t nd = grid_disk_count(g);
     float(*val)[3] = malloc(grid_values(g) * sizeof *val);
     PbgiDisk *tmp = p->disks ? NULL : malloc(nd * sizeof *tmp);
     RY_CHECK(val && (p->disks || tmp));
-    radiosity_shade_grid(&p->workers[worker], gi, p->depth, val);
+    radiosity_shade_grid(&p->workers[worker], cg->grid, cg->instance, p->depth, val);
     if (p->disks) {
-        grid_disks(gs, g, (const float(*)[3])val, &p->disks[p->first[gi]]);
+        grid_disks(gs, g, inst, (const float(*)[3])val, &p->disks[p->first[task]]);
     } else {
-        grid_disks(gs, g, (const float(*)[3])val, tmp);
+        grid_disks(gs, g, inst, (const float(*)[3])val, tmp);
         for (size_t k = 0; k < nd; k++)
-            memcpy(p->L[p->first[gi] + k], tmp[k].L, sizeof *p->L);
+            memcpy(p->L[p->first[task] + k], tmp[k].L, sizeof *p->L);
         free(tmp);
     }
     free(val);
@@ -838,7 +883,7 @@ static void run_pass(Pass *p, const RayesShaderServices *services, RenderStats *
         if (p->set->cache)
             cache_local_init(&p->workers[i].cache, p->set->cache);
     }
-    thread_parallel_for(threads, p->rs->gs->n_grids, pass_grid, p);
+    thread_parallel_for(threads, p->n_grids, pass_grid, p);
     for (int i = 0; i < threads; i++) {
         const RenderStats *s = &p->workers[i].stats;
         stats->rays_shadow += s->rays_shadow;
@@ -859,16 +904,21 @@ PbgiCloud *pbgi_build(const RenderScene *rs, const RenderSettings *set,
                       const RayesShaderServices *services, RenderStats *stats, PbgiTimes *times)
 {
     const GridSet *gs = rs->gs;
-    size_t *first = malloc((gs->n_grids + 1) * sizeof *first);
-    if (!first)
+    size_t n_grids;
+    CloudGrid *grids = cloud_grids(rs, &n_grids);
+    size_t *first = grids ? malloc((n_grids + 1) * sizeof *first) : NULL;
+    if (!first) {
+        free(grids);
         return NULL;
+    }
     first[0] = 0;
-    for (uint32_t g = 0; g < gs->n_grids; g++)
-        first[g + 1] = first[g] + (cloud_grid(rs, g) ? grid_disk_count(&gs->grids[g]) : 0);
-    size_t n = first[gs->n_grids];
+    for (size_t k = 0; k < n_grids; k++)
+        first[k + 1] = first[k] + grid_disk_count(&gs->grids[grids[k].grid]);
+    size_t n = first[n_grids];
     PbgiDisk *disks = malloc(RY_MAX(n, 1) * sizeof *disks);
     if (!disks) {
         free(first);
+        free(grids);
         return NULL;
     }
     /* Pass 1: direct lighting only (shaded at the last depth, where the
@@ -876,7 +926,8 @@ PbgiCloud *pbgi_build(const RenderScene *rs, const RenderSettings *set,
     RenderSettings direct = *set;
     direct.pbgi = NULL;
     double t0 = time_now();
-    Pass p = {.rs = rs, .set = &direct, .first = first, .disks = disks, .depth = set->bounces};
+    Pass p = {.rs = rs, .set = &direct, .grids = grids, .n_grids = n_grids, .first = first,
+              .disks = disks, .depth = set->bounces};
     run_pass(&p, services, stats);
     double t1 = time_now();
     PbgiCloud *cloud = pbgi_cloud_new(disks, n, set->pbgi_max_solid_angle, set->pbgi_raster);
@@ -885,6 +936,7 @@ PbgiCloud *pbgi_build(const RenderScene *rs, const RenderSettings *set,
     times->octree_s += t2 - t1;
     if (!cloud || set->bounces < 2) {
         free(first);
+        free(grids);
         return cloud;
     }
     /* Pass 2: bounce k reshades the grids at depth bounces - k, their
@@ -892,6 +944,7 @@ PbgiCloud *pbgi_build(const RenderScene *rs, const RenderSettings *set,
     float(*L)[3] = malloc(RY_MAX(n, 1) * sizeof *L);
     if (!L) {
         free(first);
+        free(grids);
         pbgi_cloud_free(cloud);
         return NULL;
     }
@@ -899,7 +952,8 @@ PbgiCloud *pbgi_build(const RenderScene *rs, const RenderSettings *set,
         RenderSettings bounce = *set;
         bounce.pbgi = cloud;
         double t3 = time_now();
-        Pass q = {.rs = rs, .set = &bounce, .first = first, .L = L, .depth = set->bounces - k};
+        Pass q = {.rs = rs, .set = &bounce, .grids = grids, .n_grids = n_grids, .first = first,
+                  .L = L, .depth = set->bounces - k};
         run_pass(&q, services, stats);
         double t4 = time_now();
         pbgi_cloud_relight(cloud, (const float(*)[3])L);
@@ -908,6 +962,7 @@ PbgiCloud *pbgi_build(const RenderScene *rs, const RenderSettings *set,
     }
     free(L);
     free(first);
+    free(grids);
     return cloud;
 }
 

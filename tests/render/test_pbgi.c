@@ -249,7 +249,16 @@ static void test_back_faces_occlude(void)
 
 /* The disks of a PLY the renderer wrote: count and sum of L A per channel
  * (0 on a malformed file). */
+static size_t read_ply_x(const char *path, double power[3], double *x_max);
+
 static size_t read_ply(const char *path, double power[3])
+{
+    double x;
+    return read_ply_x(path, power, &x);
+}
+
+/* The same, and the largest x of a disk's centre in *x_max. */
+static size_t read_ply_x(const char *path, double power[3], double *x_max)
 {
     FILE *f = fopen(path, "rb");
     char line[256];
@@ -273,6 +282,7 @@ static size_t read_ply(const char *path, double power[3])
         }
         for (int c = 0; c < 3; c++)
             power[c] += (double)rec[6] * rec[7 + c];
+        *x_max = i == 0 ? rec[0] : fmax(*x_max, rec[0]);
     }
     fclose(f);
     return n;
@@ -289,10 +299,11 @@ static RayesParam pc(const char *name, float a, float b, float c)
 }
 
 /* A 4 x 3 matte plane (Kd 0.6, Cs 1 0.5 0.25) under a distant light of
- * irradiance 2 at 60 degrees: its point cloud's power, sum pi L A, is Kd
- * Cs E A with E = 2 cos 60 = 1 (the plane is off camera: the cloud has it
- * all the same). */
-static void test_lit_plane_power(void)
+ * irradiance 2 at 60 degrees, off camera; instanced: an object instanced
+ * twice, the second moved 10 along x and stretched 2 times along it.
+ * Rendered with point-based GI, its cloud written to ply; its statistics
+ * into *st. */
+static void render_lit_plane(int instanced, const char *ply, RayesStats **st)
 {
     RayesScene *s = rayes_scene_new();
     float eye[3] = {0, 0, 10}, target[3] = {0, 0, 11}, up[3] = {0, 1, 0};
@@ -303,7 +314,17 @@ static void test_lit_plane_power(void)
     RayesParam m[2] = {pf("Kd", 0.6f), pc("Cs", 1.0f, 0.5f, 0.25f)};
     CHECK(rayes_scene_set_shader(s, "matte", m, 2) == RAYES_OK);
     const float P[4][3] = {{-2, -1.5f, 0}, {2, -1.5f, 0}, {-2, 1.5f, 0}, {2, 1.5f, 0}};
-    CHECK(rayes_scene_bilinear_patch(s, P) == RAYES_OK);
+    if (instanced) {
+        const float moved[16] = {2, 0, 0, 10, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
+        CHECK(rayes_scene_object_begin(s, "plane") == RAYES_OK);
+        CHECK(rayes_scene_bilinear_patch(s, P) == RAYES_OK);
+        CHECK(rayes_scene_object_end(s) == RAYES_OK);
+        CHECK(rayes_scene_object_instance(s, "plane") == RAYES_OK);
+        CHECK(rayes_scene_set_transform(s, moved) == RAYES_OK);
+        CHECK(rayes_scene_object_instance(s, "plane") == RAYES_OK);
+    } else {
+        CHECK(rayes_scene_bilinear_patch(s, P) == RAYES_OK);
+    }
     CHECK(rayes_scene_commit(s) == RAYES_OK);
     RayesRenderOptions o;
     rayes_render_options_init(&o, RAYES_QUALITY_PREVIEW);
@@ -311,25 +332,46 @@ static void test_lit_plane_power(void)
     o.spp = 1;
     o.threads = 2;
     o.gi = RAYES_GI_POINTBASED;
-    o.pointcloud_out = RAYES_TEST_TMP "/test_pbgi_plane.ply";
+    o.pointcloud_out = ply;
     RayesImage *img = NULL;
+    CHECK(rayes_render(s, &o, &img, st) == RAYES_OK);
+    rayes_image_free(img);
+    rayes_scene_release(s);
+}
+
+/* The lit plane's point cloud: its power, sum pi L A, is Kd Cs E A with E
+ * = 2 cos 60 = 1 (the plane is off camera: the cloud has it all the
+ * same). */
+static void test_lit_plane_power(void)
+{
+    const char *ply = RAYES_TEST_TMP "/test_pbgi_plane.ply";
     RayesStats *st = NULL;
-    CHECK(rayes_render(s, &o, &img, &st) == RAYES_OK);
+    render_lit_plane(0, ply, &st);
     double power[3];
-    size_t n = read_ply(o.pointcloud_out, power);
+    size_t n = read_ply(ply, power);
     const RayesStat *pts = st ? rayes_stats_find(st, "pbgi/points") : NULL;
     CHECK(n >= 16 && pts && pts->count == n);
     const double cs[3] = {1.0, 0.5, 0.25};
     for (int c = 0; c < 3; c++)
         CHECK_NEAR(PI * power[c] / (0.6 * cs[c] * 1.0 * 12.0), 1.0, 1e-3);
     rayes_stats_free(st);
-    rayes_image_free(img);
-    rayes_scene_release(s);
 }
 
-/* cornell-teapots at 40 x 32 times scale by the grid hider with
- * point-based GI, with irradiance interpolation or a gather at every
- * vertex; *gathers, if not NULL, gets the gathers' count. */
+/* The plane instanced twice: the cloud has both instances' disks, in
+ * world space, carrying Kd Cs E times 12 + 24. */
+static void test_instances_in_cloud(void)
+{
+    const char *ply = RAYES_TEST_TMP "/test_pbgi_instances.ply";
+    render_lit_plane(1, ply, NULL);
+    double power[3], x_max = 0.0;
+    size_t n = read_ply_x(ply, power, &x_max);
+    CHECK(n >= 32 && n % 2 == 0);
+    CHECK(x_max > 13.0 && x_max < 14.0); /* the second instance spans x in [6, 14] */
+    const double cs[3] = {1.0, 0.5, 0.25};
+    for (int c = 0; c < 3; c++)
+        CHECK_NEAR(PI * power[c] / (0.6 * cs[c] * 1.0 * 36.0), 1.0, 1e-3);
+}
+
 static RayesImage *render_box_irr(int threads, int bounces, const char *ply, int irradiance,
                                   int scale, uint64_t *gathers)
 {
@@ -476,5 +518,5 @@ static void test_bad_options(void)
 }
 
 TEST_MAIN(TEST(test_gradients), TEST(test_furnace), TEST(test_furnace_cube), TEST(test_occlusion),
-          TEST(test_back_faces_occlude), TEST(test_lit_plane_power), TEST(test_threads_and_bounces),
+          TEST(test_back_faces_occlude), TEST(test_lit_plane_power), TEST(test_instances_in_cloud), TEST(test_threads_and_bounces),
           TEST(test_interpolation), TEST(test_bad_options))
