@@ -28,9 +28,14 @@
  * of radiance times cos d(omega), over pi; uncovered pixels are black, as
  * the sky is to diffuse rays.
  *
+ * A record (pbgi_record, for irradiance interpolation) is the same gather
+ * with each pixel's coverage-weighted fragment distance kept: its
+ * gradients are sums over the pixels and over the walls between them.
+ *
  * The passes shade whole grids through radiosity_shade_grid (the cache's
- * fill, FINE level, front side), on threads, each grid into its own slots:
- * disks do not depend on threads, and the octree is built on one thread.
+ * fill, FINE level, front side; a master's grids once per instance), on
+ * threads, each grid into its own slots: disks do not depend on threads,
+ * and the octree is built on one thread.
  */
 #include "render/pbgi.h"
 

@@ -12,7 +12,9 @@
  * octree over the disks, whose nodes carry order-2 spherical harmonics (9
  * coefficients) of their emitted power and projected area, by rasterising
  * near disks and far clusters front to back into a small cube raster
- * around the shading point, where nearer surfaces cover farther ones.
+ * around the shading point, where nearer surfaces cover farther ones; with
+ * irradiance interpolation the grid hider's records are such gathers with
+ * gradients (pbgi_record, irrgrid.h).
  *
  * A cloud is immutable once built and read by every thread; a gather is a
  * pure function of the cloud and the point, so images do not depend on
