@@ -10,7 +10,7 @@
  *   memo_tables table4 [...same...] [--budgets MB,MB,...]
  *   memo_tables table2 [...same...] [--uncached-max B]
  *   memo_tables figure5 [--size N] [--spp N] [--out DIR] [--data DIR] [--scene S]
- *                       [--pbgi-solid-angle SR[,SR...]] [--pbgi-raster N]
+ *                       [--pbgi-solid-angle SR[,SR...]] [--pbgi-raster N] [--final-rays N[,N...]]
  *   memo_tables figure8 [--size N] [--spp N] [--threads N] [--shadow-rays N]
  *                       [--ao-samples N] [--check-size N] [--experiment a|b|ab] [--out DIR]
  *                       [--repeat N] [--only off|on]
@@ -29,7 +29,10 @@
  * and grid hider, indirect diffuse gathered from a point cloud: memo 5.3),
  * the relative RMSE and mean relative error of each against the reference,
  * 20x difference images, times (point-based: of each pass) and the point
- * count; a point-based row for each of the --pbgi-solid-angle values. The
+ * count; a point-based row for each of the --pbgi-solid-angle values (with
+ * the final preset's irradiance interpolation) and one for the first
+ * without (a gather at every shaded vertex); with --final-rays, final rows
+ * at those depth-0 diffuse ray counts (final at point-based GI's time). The
  * first point-based row's cloud goes to figure5-pointcloud.ply and, its
  * disks splatted from the camera, to figure5-pointcloud.png.
  * Both then measure bias: the same rows at --accuracy-spp pixel samples
@@ -84,6 +87,11 @@ typedef struct Args {
     int pbgi_raster;
     float pbgi_solid_angles[8];   /* figure5: a point-based row for each */
     int n_pbgi;
+    int irradiance;               /* the rows' irradiance interpolation: -1 the preset's,
+                                     0 off, 1 on */
+    int diffuse_rays;             /* the rows' depth-0 diffuse rays, 0: the preset's */
+    int final_rays[4];            /* figure5: a final row at each of these depth-0 rays */
+    int n_final_rays;
 } Args;
 
 typedef struct Row {
@@ -92,12 +100,13 @@ typedef struct Row {
     double time_s;                /* wall clock */
     double cpu_s;                 /* process CPU time (user + system), less sensitive to
                                      other tenants of a shared machine */
-    unsigned long long shading_points, rays, shadow, diffuse, records;
+    unsigned long long shading_points, rays, shadow, diffuse, records, interpolated;
     unsigned long long grids, grid_vertices, grid_size;
     double hit[3];
     double render_cpu_s, replay_cpu_s;   /* the render alone, and its rays traced again
                                             unshaded (--replay 1) */
     unsigned long long pbgi_points;       /* point-based GI: disks in the point cloud */
+    unsigned long long pbgi_gathers;      /* and gathers from it */
     double pbgi_cloud_s, pbgi_bounces_s, pbgi_octree_s, render_s; /* its passes, wall */
     unsigned long long opacity_points;   /* opacity() shading points (shadow-ray hits, or
                                             the points of the grids the cache filled) */
@@ -168,6 +177,10 @@ static Row run(const Args *a, int size, int spp, int bounces, int cache, double 
     o.dice_isotropic = !a->dice_raster;
     o.replay_rays = a->replay;
     o.gi = (RayesGi)a->gi;
+    if (a->irradiance >= 0)
+        o.irradiance = a->irradiance;
+    if (a->diffuse_rays > 0)
+        o.diffuse_rays = a->diffuse_rays;
     o.pbgi_max_solid_angle = a->pbgi_solid_angle;
     o.pbgi_raster = a->pbgi_raster;
     char cloud[1024];
@@ -210,9 +223,12 @@ static void measure(RayesScene *scene, const RayesRenderOptions *o, Row *r_out)
         r.hit[l] = cache ? find(st, hr[l])->real : 0.0;
     const RayesStat *rec = rayes_stats_find(st, "irradiance/records");
     r.records = rec ? rec->count : 0;
+    const RayesStat *interp = rayes_stats_find(st, "irradiance/interpolated");
+    r.interpolated = interp ? interp->count : 0;
     const RayesStat *pts = rayes_stats_find(st, "pbgi/points");
     r.pbgi_points = pts ? pts->count : 0;
     if (pts) {
+        r.pbgi_gathers = find(st, "pbgi/gathers")->count;
         r.pbgi_cloud_s = find(st, "time/pbgi_cloud_s")->real;
         r.pbgi_bounces_s = find(st, "time/pbgi_bounces_s")->real;
         r.pbgi_octree_s = find(st, "time/pbgi_octree_s")->real;
@@ -310,6 +326,7 @@ static void parse(int argc, char **argv, Args *a)
     a->pbgi_solid_angles[0] = 0.05f;
     a->n_pbgi = 1;
     a->pbgi_raster = 8;
+    a->irradiance = -1;
     const double budgets[] = {0, 1, 4, 16, 64, 256};
     a->n_budgets = 6;
     memcpy(a->budgets, budgets, sizeof budgets);
@@ -358,7 +375,11 @@ static void parse(int argc, char **argv, Args *a)
             for (char *p = (char *)v; *p && a->n_pbgi < 8; p += strcspn(p, ",") + (p[strcspn(p, ",")] != 0))
                 a->pbgi_solid_angles[a->n_pbgi++] = (float)atof(p);
         }
-        else if (strcmp(o, "--pbgi-raster") == 0)
+        else if (strcmp(o, "--final-rays") == 0) {
+            a->n_final_rays = 0;
+            for (char *p = (char *)v; *p && a->n_final_rays < 4; p += strcspn(p, ",") + (p[strcspn(p, ",")] != 0))
+                a->final_rays[a->n_final_rays++] = atoi(p);
+        } else if (strcmp(o, "--pbgi-raster") == 0)
             a->pbgi_raster = atoi(v);
         else if (strcmp(o, "--uncached-max") == 0)
             a->uncached_max = atoi(v);
@@ -602,21 +623,35 @@ static void pointcloud_view(const Args *a, int size, float shrink)
 static void figure5(Args *a, FILE *j)
 {
     struct {
-        char tag[32];
+        char tag[48];
         int quality, gi;
         float solid_angle;
-    } rows[3 + 8] = {{"reference", RAYES_QUALITY_REFERENCE, RAYES_GI_RAYTRACE, 0},
-                     {"preview", RAYES_QUALITY_PREVIEW, RAYES_GI_RAYTRACE, 0},
-                     {"final", RAYES_QUALITY_FINAL, RAYES_GI_RAYTRACE, 0}};
+        int irradiance, diffuse_rays;
+    } rows[3 + 4 + 9] = {{"reference", RAYES_QUALITY_REFERENCE, RAYES_GI_RAYTRACE, 0, -1, 0},
+                         {"preview", RAYES_QUALITY_PREVIEW, RAYES_GI_RAYTRACE, 0, -1, 0},
+                         {"final", RAYES_QUALITY_FINAL, RAYES_GI_RAYTRACE, 0, -1, 0}};
     int n_rows = 3;
-    for (int k = 0; k < a->n_pbgi; k++, n_rows++) {
+    /* Final at fewer depth-0 rays (--final-rays): its error at point-based
+     * GI's time. */
+    for (int k = 0; k < a->n_final_rays; k++, n_rows++) {
+        rows[n_rows] = rows[2];
+        rows[n_rows].diffuse_rays = a->final_rays[k];
+        snprintf(rows[n_rows].tag, sizeof rows[n_rows].tag, "final-%d", a->final_rays[k]);
+    }
+    /* A row for each solid angle, with irradiance interpolation (the final
+     * preset's), and the first's without: a gather at every vertex. */
+    for (int k = 0; k <= a->n_pbgi; k++, n_rows++) {
+        float sr = a->pbgi_solid_angles[k < a->n_pbgi ? k : 0];
         rows[n_rows].quality = RAYES_QUALITY_FINAL;
         rows[n_rows].gi = RAYES_GI_POINTBASED;
-        rows[n_rows].solid_angle = a->pbgi_solid_angles[k];
-        if (a->n_pbgi == 1)
+        rows[n_rows].solid_angle = sr;
+        rows[n_rows].irradiance = k < a->n_pbgi ? -1 : 0;
+        if (k == a->n_pbgi)
+            snprintf(rows[n_rows].tag, sizeof rows[n_rows].tag, "pointbased-%g-nointerp", sr);
+        else if (a->n_pbgi == 1)
             snprintf(rows[n_rows].tag, sizeof rows[n_rows].tag, "pointbased");
         else
-            snprintf(rows[n_rows].tag, sizeof rows[n_rows].tag, "pointbased-%g", rows[n_rows].solid_angle);
+            snprintf(rows[n_rows].tag, sizeof rows[n_rows].tag, "pointbased-%g", sr);
     }
     printf("Figure 5 (%s, 1 bounce, %dx%d, %d spp): against the reference\n", a->scene, a->size,
            a->size, a->spp);
@@ -629,8 +664,10 @@ static void figure5(Args *a, FILE *j)
         a->gi = rows[i].gi;
         if (rows[i].gi == RAYES_GI_POINTBASED)
             a->pbgi_solid_angle = rows[i].solid_angle;
+        a->irradiance = rows[i].irradiance;
+        a->diffuse_rays = rows[i].diffuse_rays;
         Row r = run(a, a->size, a->spp, 1, rows[i].quality != RAYES_QUALITY_REFERENCE, 100);
-        char path[1024], err[1024], s1[32], s2[32];
+        char path[1200], err[1024], s1[32], s2[32];
         snprintf(path, sizeof path, "%s/figure5-%s.png", a->out, rows[i].tag);
         if (image_write(path, r.w, r.h, r.rgba, err, sizeof err) != RAYES_OK)
             die(err);
@@ -648,23 +685,26 @@ static void figure5(Args *a, FILE *j)
                    r.cpu_s / ref.cpu_s);
         else
             printf(" %10s %10s | %10s %10s |\n", "-", "-", "-", "-");
-        if (r.pbgi_points && i == 3)
+        if (r.pbgi_points && i == 3 + a->n_final_rays)
             pointcloud_view(a, a->size, 0.7f);
         if (r.pbgi_points)
             printf("    point cloud (solid angle %g sr, raster %d): %llu points, pass 1 (shading the "
-                   "cloud) %.2fs, octree %.2fs, pass 2 (bounces) %.2fs, render %.1fs\n",
+                   "cloud) %.2fs, octree %.2fs, pass 2 (bounces) %.2fs, render %.1fs (cpu %.1fs), "
+                   "%llu gathers (%llu interpolated)\n",
                    rows[i].solid_angle, a->pbgi_raster, r.pbgi_points, r.pbgi_cloud_s,
-                   r.pbgi_octree_s, r.pbgi_bounces_s, r.render_s);
+                   r.pbgi_octree_s, r.pbgi_bounces_s, r.render_s, r.render_cpu_s, r.pbgi_gathers,
+                   r.interpolated);
         fflush(stdout);
         fprintf(j,
                 "%s\n    {\"image\": \"%s\", \"time_s\": %.3f, \"cpu_s\": %.3f, "
                 "\"shading_points\": %llu, \"rays\": %llu, \"rel_rmse\": %.6f, "
                 "\"mean_rel\": %.6f, \"display_rel_rmse\": %.6f, \"display_mean_rel\": %.6f, "
                 "\"render_s\": %.3f, \"pbgi_points\": %llu, \"pbgi_cloud_s\": %.3f, "
-                "\"pbgi_octree_s\": %.3f, \"pbgi_bounces_s\": %.3f}",
+                "\"pbgi_octree_s\": %.3f, \"pbgi_bounces_s\": %.3f, \"pbgi_gathers\": %llu, "
+                "\"render_cpu_s\": %.3f}",
                 i ? "," : "", rows[i].tag, r.time_s, r.cpu_s, r.shading_points, r.rays, rmse, mrel,
                 drmse, dmrel, r.render_s, r.pbgi_points, r.pbgi_cloud_s, r.pbgi_octree_s,
-                r.pbgi_bounces_s);
+                r.pbgi_bounces_s, r.pbgi_gathers, r.render_cpu_s);
         if (i == 0)
             ref = r;
         else

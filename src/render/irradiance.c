@@ -51,9 +51,7 @@ void irr_record(int M, int N, const Vec3 *L, const float *r, Vec3 p, Vec3 n, Irr
     Vec3 t, b;
     irr_frame(n, &t, &b);
     Vec3 zero = v3(0, 0, 0), sum = zero;
-    double inv_r = 0.0;
-    float r_min = INFINITY;
-    const float cos_min = 0.173f; /* rays within ~10 degrees of the tangent plane do not set R */
+    IrrRadius radius = IRR_RADIUS_INIT;
     rec->p = p;
     rec->n = n;
     for (int c = 0; c < 3; c++)
@@ -70,11 +68,7 @@ void irr_record(int M, int N, const Vec3 *L, const float *r, Vec3 p, Vec3 n, Irr
             sum = v3_add(sum, L[i]);
             float s2 = ((float)j + 0.5f) / (float)M;
             float cos_c = sqrtf(1.0f - s2), tan_c = sqrtf(s2) / cos_c;
-            if (isfinite(r[i]) && r[i] > 0.0f) {
-                inv_r += 1.0 / r[i];
-                if (cos_c > cos_min)
-                    r_min = fminf(r_min, r[i]);
-            }
+            irr_radius_add(&radius, r[i], cos_c);
             float sin_lo = sqrtf((float)j / (float)M), sin_hi = sqrtf((float)(j + 1) / (float)M);
             float cos2_lo = 1.0f - (float)j / (float)M;
             for (int c = 0; c < 3; c++) {
@@ -101,7 +95,24 @@ void irr_record(int M, int N, const Vec3 *L, const float *r, Vec3 p, Vec3 n, Irr
     rec->E = v3_scale(sum, cell);
     for (int c = 0; c < 3; c++)
         rec->grad_r[c] = v3_scale(rec->grad_r[c], cell);
-    rec->R = isfinite(r_min) ? r_min : inv_r > 0.0 ? (float)((double)(M * N) / inv_r) : INFINITY;
+    rec->R = irr_radius(&radius);
+}
+
+void irr_radius_add(IrrRadius *acc, float r, float cos_theta)
+{
+    acc->n++;
+    if (!isfinite(r) || !(r > 0.0f))
+        return;
+    acc->inv_r += 1.0 / r;
+    if (cos_theta > 0.173f) /* samples within ~10 degrees of the tangent plane do not set R */
+        acc->r_min = fminf(acc->r_min, r);
+}
+
+float irr_radius(const IrrRadius *acc)
+{
+    if (isfinite(acc->r_min))
+        return acc->r_min;
+    return acc->inv_r > 0.0 ? (float)(acc->n / acc->inv_r) : INFINITY;
 }
 
 Vec3 irr_extrapolate(const IrrRecord *rec, Vec3 p, Vec3 n)

@@ -21,6 +21,8 @@
 #ifndef RAYES_RENDER_IRRADIANCE_H
 #define RAYES_RENDER_IRRADIANCE_H
 
+#include <math.h>
+
 #include "util/vec.h"
 
 typedef struct IrrRecord {
@@ -42,6 +44,20 @@ Vec3 irr_direction(int M, int N, int j, int k, float xi1, float xi2, Vec3 n);
  * distance r[j * N + k] (INFINITY for a miss) of each cell, at p with
  * normal n. M >= 1, N >= 3. */
 void irr_record(int M, int N, const Vec3 *L, const float *r, Vec3 p, Vec3 n, IrrRecord *rec);
+
+/* A record's validity radius from the hit distances of its samples: the
+ * smallest distance of those more than ~10 degrees above the tangent plane
+ * (cos theta > 0.173), else the harmonic mean of all (a miss, r INFINITY,
+ * counts as infinitely far), else INFINITY. Start from IRR_RADIUS_INIT,
+ * irr_radius_add each sample. */
+typedef struct IrrRadius {
+    double inv_r;
+    int n;
+    float r_min;
+} IrrRadius;
+#define IRR_RADIUS_INIT ((IrrRadius){0.0, 0, INFINITY})
+void irr_radius_add(IrrRadius *acc, float r, float cos_theta);
+float irr_radius(const IrrRadius *acc);
 
 /* The record's value extrapolated to (p, n) with its gradients. */
 Vec3 irr_extrapolate(const IrrRecord *rec, Vec3 p, Vec3 n);

@@ -18,6 +18,11 @@
  * Triangular grids: in vertex order, a vertex whose earlier records' weights
  * (kappa 1) sum to MIN_WEIGHT or more interpolates them; otherwise it gets
  * a record.
+ *
+ * With point-based GI (set->pbgi) a record is a gather from the cloud
+ * instead of rays (pbgi_record: its gradients come from the cube raster),
+ * with the same lattice, clamps and criteria; a gather has no noise, so
+ * the disagreement tolerance is DISAGREE.
  */
 #include "render/irrgrid.h"
 
@@ -26,6 +31,7 @@
 
 #include "render/integrator.h"
 #include "render/irradiance.h"
+#include "render/pbgi.h"
 #include "util/check.h"
 #include "util/rng.h"
 
@@ -37,11 +43,22 @@ static float comp(Vec3 v, int c)
     return c == 0 ? v.x : c == 1 ? v.y : v.z;
 }
 
-static void make_record(const PathState *ps, const IrrGrid *irr, size_t k, int M, int N, Vec3 *L,
-                        float *r, IrrRecord *rec)
+/* How records are made: M x N rays into L and r, or, with point-based
+ * GI, gathers from cloud into raster. */
+typedef struct Sampler {
+    int M, N;
+    Vec3 *L;
+    float *r;
+    const PbgiCloud *cloud;
+    PbgiRaster raster;
+} Sampler;
+
+/* The record of vertex k from the sampler's rays. */
+static void trace_record(const PathState *ps, size_t k, Vec3 P, Vec3 n, Sampler *s,
+                         IrrRecord *rec)
 {
     Worker *w = ps->w;
-    Vec3 P = v3_load(irr->P[k]), n = v3_load(irr->N[k]);
+    int M = s->M, N = s->N;
     Vec3 o = v3_madd(P, n, ps->offset[k]);
     uint64_t key = hash_combine(ps->keys[k], DIM_DIFFUSE);
     RayDiff diff = {ps->diff[k].width, fmaxf(ps->diff[k].spread, 1.0f / sqrtf((float)(M * N)))};
@@ -53,10 +70,23 @@ static void make_record(const PathState *ps, const IrrGrid *irr, size_t k, int M
             Ray ray = {o, irr_direction(M, N, j, q, xi1, xi2, n), 0.0f, INFINITY,
                        RAYES_RAY_DIFFUSE, w->time};
             w->stats.rays_diffuse++;
-            L[c] = integrator_trace_hit(w, &ray, RAYES_RAY_DIFFUSE, 1, 0,
-                                        hash_combine(key, (uint64_t)c + 1), diff, &r[c]);
+            s->L[c] = integrator_trace_hit(w, &ray, RAYES_RAY_DIFFUSE, 1, 0,
+                                           hash_combine(key, (uint64_t)c + 1), diff, &s->r[c]);
         }
-    irr_record(M, N, L, r, P, n, rec);
+    irr_record(M, N, s->L, s->r, P, n, rec);
+}
+
+static void make_record(const PathState *ps, const IrrGrid *irr, size_t k, Sampler *s,
+                        IrrRecord *rec)
+{
+    Worker *w = ps->w;
+    Vec3 P = v3_load(irr->P[k]), n = v3_load(irr->N[k]);
+    if (s->cloud) {
+        pbgi_record(s->cloud, &s->raster, P, n, rec);
+        w->stats.pbgi_gathers++;
+    } else {
+        trace_record(ps, k, P, n, s, rec);
+    }
     float R = rec->R;
     for (int c = 0; c < 3; c++) {
         float g = v3_length(rec->grad_t[c]);
@@ -82,7 +112,7 @@ static int knots(int n, int *at)
  * knots; each lattice cell either interpolates its four corner records or,
  * where they disagree or see geometry closer than the cell is wide, gets a
  * record at every vertex. */
-static void quad_grid(const PathState *ps, IrrGrid *irr, int M, int N, Vec3 *L, float *r,
+static void quad_grid(const PathState *ps, IrrGrid *irr, Sampler *s,
                       IrrRecord *recs, float tol)
 {
     const Grid *g = irr->grid;
@@ -94,7 +124,7 @@ static void quad_grid(const PathState *ps, IrrGrid *irr, int M, int N, Vec3 *L, 
     for (int b = 0; b < mv; b++)
         for (int a = 0; a < mu; a++) {
             size_t k = (size_t)kv[b] * nu + ku[a];
-            make_record(ps, irr, k, M, N, L, r, &recs[k]);
+            make_record(ps, irr, k, s, &recs[k]);
             done[k] = 1;
         }
     for (int b = 0; b + 1 < mv; b++)
@@ -121,7 +151,7 @@ static void quad_grid(const PathState *ps, IrrGrid *irr, int M, int N, Vec3 *L, 
                     if (done[k])
                         continue;
                     if (refine) {
-                        make_record(ps, irr, k, M, N, L, r, &recs[k]);
+                        make_record(ps, irr, k, s, &recs[k]);
                         done[k] = 1;
                         continue;
                     }
@@ -136,7 +166,7 @@ static void quad_grid(const PathState *ps, IrrGrid *irr, int M, int N, Vec3 *L, 
                         wsum += wq;
                     }
                     if (wsum < 1e-3f) {
-                        make_record(ps, irr, k, M, N, L, r, &recs[k]);
+                        make_record(ps, irr, k, s, &recs[k]);
                         done[k] = 1;
                         continue;
                     }
@@ -154,7 +184,7 @@ static void quad_grid(const PathState *ps, IrrGrid *irr, int M, int N, Vec3 *L, 
 }
 
 /* Triangular grids: records where no earlier record covers a vertex. */
-static void tri_grid(const PathState *ps, IrrGrid *irr, int M, int N, Vec3 *L, float *r,
+static void tri_grid(const PathState *ps, IrrGrid *irr, Sampler *s,
                      IrrRecord *recs)
 {
     size_t n = geom_grid_n_vertices(irr->grid), n_recs = 0;
@@ -170,7 +200,7 @@ static void tri_grid(const PathState *ps, IrrGrid *irr, int M, int N, Vec3 *L, f
         }
         Vec3 E;
         if (wsum < MIN_WEIGHT) {
-            make_record(ps, irr, k, M, N, L, r, &recs[n_recs]);
+            make_record(ps, irr, k, s, &recs[n_recs]);
             E = recs[n_recs++].E;
         } else {
             E = v3_scale(sum, 1.0f / wsum);
@@ -184,19 +214,27 @@ void irrgrid_compute(const PathState *ps, IrrGrid *irr, int n_rays)
 {
     const Grid *g = irr->grid;
     size_t n = geom_grid_n_vertices(g);
-    int M = (int)lroundf(sqrtf((float)n_rays / (float)M_PI));
-    M = M < 1 ? 1 : M;
-    int N = n_rays / M < 3 ? 3 : n_rays / M;
+    Sampler s = {.cloud = ps->w->set->pbgi};
     IrrRecord *recs = malloc(n * sizeof *recs);
-    Vec3 *L = malloc((size_t)(M * N) * sizeof *L);
-    float *r = malloc((size_t)(M * N) * sizeof *r);
-    RY_CHECK(recs && L && r);
-    /* Noise of a record's E is about 1/sqrt(rays): disagreement must exceed it. */
-    float tol = fmaxf(DISAGREE, 3.0f / sqrtf((float)(M * N)));
+    RY_CHECK(recs != NULL);
+    /* Noise of a record's E is about 1/sqrt(rays): disagreement must exceed
+     * it. A gather has no noise. */
+    float tol = DISAGREE;
+    if (s.cloud) {
+        RY_CHECK(pbgi_raster_init(&s.raster, s.cloud) == 0);
+    } else {
+        s.M = (int)lroundf(sqrtf((float)n_rays / (float)M_PI));
+        s.M = s.M < 1 ? 1 : s.M;
+        s.N = n_rays / s.M < 3 ? 3 : n_rays / s.M;
+        s.L = malloc((size_t)(s.M * s.N) * sizeof *s.L);
+        s.r = malloc((size_t)(s.M * s.N) * sizeof *s.r);
+        RY_CHECK(s.L && s.r);
+        tol = fmaxf(DISAGREE, 3.0f / sqrtf((float)(s.M * s.N)));
+    }
     if (g->triangular)
-        tri_grid(ps, irr, M, N, L, r, recs);
+        tri_grid(ps, irr, &s, recs);
     else
-        quad_grid(ps, irr, M, N, L, r, recs, tol);
+        quad_grid(ps, irr, &s, recs, tol);
     /* The service's indirect diffuse is irradiance / pi. */
     for (size_t k = 0; k < n; k++)
         for (int c = 0; c < 3; c++)
@@ -204,6 +242,8 @@ void irrgrid_compute(const PathState *ps, IrrGrid *irr, int n_rays)
     irr->done = 1;
     irr->n_rays = n_rays;
     free(recs);
-    free(L);
-    free(r);
+    free(s.L);
+    free(s.r);
+    if (s.cloud)
+        pbgi_raster_fini(&s.raster);
 }

@@ -12,7 +12,8 @@
  * cover it or, where none covers it or the covering records disagree, gets
  * a record of its own. Records never leave their grid, so light cannot
  * leak across patch boundaries, and one thread does a grid in a fixed
- * order, so images do not depend on threads.
+ * order, so images do not depend on threads. With point-based GI the
+ * records are gathers from the point cloud (pbgi.h), not rays.
  */
 #ifndef RAYES_RENDER_IRRGRID_H
 #define RAYES_RENDER_IRRGRID_H

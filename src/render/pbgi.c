@@ -28,9 +28,14 @@
  * of radiance times cos d(omega), over pi; uncovered pixels are black, as
  * the sky is to diffuse rays.
  *
+ * A record (pbgi_record, for irradiance interpolation) is the same gather
+ * with each pixel's coverage-weighted fragment distance kept: its
+ * gradients are sums over the pixels and over the walls between them.
+ *
  * The passes shade whole grids through radiosity_shade_grid (the cache's
- * fill, FINE level, front side), on threads, each grid into its own slots:
- * disks do not depend on threads, and the octree is built on one thread.
+ * fill, FINE level, front side; a master's grids once per instance), on
+ * threads, each grid into its own slots: disks do not depend on threads,
+ * and the octree is built on one thread.
  */
 #include "render/pbgi.h"
 
@@ -313,12 +318,60 @@ static int tap_pixel(const PbgiCloud *c, int f, int i, int j)
     return face_pixel(c, g, (int)floorf(x + 0.5f), (int)floorf(y + 0.5f));
 }
 
+/* The walls between adjacent upper pixels, across the faces' edges too,
+ * for the translational gradient (pbgi_record). A wall is an arc of a
+ * great circle (a cube edge's or a pixel edge's image on the sphere): its
+ * normal on the sphere is constant along it, the normal of the circle's
+ * plane, and the integral of the unit direction along an arc from w0 to
+ * w1 is (w0 + w1) tan(gamma / 2), gamma the arc's angle. */
+static int wall_tables(PbgiCloud *c)
+{
+    int R = c->raster;
+    c->wall_pix = malloc((size_t)12 * R * R * sizeof *c->wall_pix);
+    c->wall_vec = malloc((size_t)12 * R * R * sizeof *c->wall_vec);
+    if (!c->wall_pix || !c->wall_vec)
+        return -1;
+    c->n_walls = 0;
+    for (int f = 0; f < 6; f++) {
+        int a, u, v;
+        face_axes(f, &a, &u, &v);
+        for (int j = 0; j < R; j++)
+            for (int i = 0; i < R; i++)
+                for (int e = 0; e < 4; e++) { /* the pixel's left, right, lower, upper edge */
+                    int di = e == 0 ? -1 : e == 1 ? 1 : 0, dj = e == 2 ? -1 : e == 3 ? 1 : 0;
+                    int p = c->pix_of[(f * R + j) * R + i], q = tap_pixel(c, f, i + di, j + dj);
+                    if (q <= p || q >= c->n_upper) /* once a wall, upper pixels only */
+                        continue;
+                    float w[2][3];
+                    for (int k = 0; k < 2; k++) { /* the edge's ends on the face */
+                        int ci = di ? i + (di > 0) : i + k, cj = dj ? j + (dj > 0) : j + k;
+                        w[k][a] = f % 2 ? -1.0f : 1.0f;
+                        w[k][u] = -1.0f + 2.0f * (float)ci / (float)R;
+                        w[k][v] = -1.0f + 2.0f * (float)cj / (float)R;
+                    }
+                    Vec3 w0 = v3_normalize(v3_load(w[0])), w1 = v3_normalize(v3_load(w[1]));
+                    Vec3 m = v3_normalize(v3_cross(w0, w1));
+                    if (v3_dot(m, v3_load(c->pix_dir[q])) < 0.0f)
+                        m = v3_neg(m);
+                    float along = v3_length(v3_cross(w0, w1)) / (1.0f + v3_dot(w0, w1));
+                    float cos_len = (w0.z + w1.z) * along; /* the integral of cos(theta) */
+                    if (!(cos_len > 0.0f))
+                        continue; /* on the horizon */
+                    c->wall_pix[c->n_walls][0] = p;
+                    c->wall_pix[c->n_walls][1] = q;
+                    v3_store(c->wall_vec[c->n_walls++], v3_scale(m, cos_len));
+                }
+    }
+    return 0;
+}
+
 int pbgi_raster_init(PbgiRaster *r, const PbgiCloud *cloud)
 {
     r->cov = malloc((size_t)cloud->n_pix * sizeof *r->cov);
     r->col = malloc((size_t)cloud->n_pix * sizeof *r->col);
     r->tmp = malloc((size_t)cloud->n_pix * sizeof *r->tmp);
-    if (!r->cov || !r->col || !r->tmp) {
+    r->dist = malloc((size_t)cloud->n_pix * sizeof *r->dist);
+    if (!r->cov || !r->col || !r->tmp || !r->dist) {
         pbgi_raster_fini(r);
         return -1;
     }
@@ -330,9 +383,11 @@ void pbgi_raster_fini(PbgiRaster *r)
     free(r->cov);
     free(r->col);
     free(r->tmp);
+    free(r->dist);
     r->cov = NULL;
     r->col = NULL;
     r->tmp = NULL;
+    r->dist = NULL;
 }
 
 PbgiCloud *pbgi_cloud_new(PbgiDisk *disks, size_t n, float max_solid_angle, int raster)
@@ -350,7 +405,7 @@ PbgiCloud *pbgi_cloud_new(PbgiDisk *disks, size_t n, float max_solid_angle, int 
     Build b = {.cloud = c};
     b.tmp = malloc(RY_MAX(n, 1) * sizeof *b.tmp);
     b.tmp_perm = malloc(RY_MAX(n, 1) * sizeof *b.tmp_perm);
-    int ok = c->perm && b.tmp && b.tmp_perm && raster_tables(c) == 0;
+    int ok = c->perm && b.tmp && b.tmp_perm && raster_tables(c) == 0 && wall_tables(c) == 0;
     if (ok) {
         for (size_t i = 0; i < n; i++)
             c->perm[i] = (uint32_t)i;
@@ -379,6 +434,8 @@ void pbgi_cloud_free(PbgiCloud *c)
     free(c->pix_dir);
     free(c->pix_weight);
     free(c->pix_omega);
+    free(c->wall_pix);
+    free(c->wall_vec);
     free(c);
 }
 
@@ -391,7 +448,7 @@ typedef struct Gather {
     int full;                  /* pixels fully covered */
 } Gather;
 
-static void cover(Gather *g, int p, float cov, Vec3 L)
+static void cover(Gather *g, int p, float cov, Vec3 L, float dist)
 {
     float have = g->r->cov[p];
     if (have >= 1.0f)
@@ -401,6 +458,7 @@ static void cover(Gather *g, int p, float cov, Vec3 L)
     g->r->col[p][0] += a * L.x;
     g->r->col[p][1] += a * L.y;
     g->r->col[p][2] += a * L.z;
+    g->r->dist[p] += a * dist;
     if (have + a >= 1.0f - 1e-6f) {
         g->r->cov[p] = 1.0f;
         g->full += p < g->c->n_upper;
@@ -408,7 +466,7 @@ static void cover(Gather *g, int p, float cov, Vec3 L)
 }
 
 /* A fragment of solid angle omega and radiance L in unit world direction
- * d, anti-aliased: one smaller than a pixel shares its coverage between
+ * d at distance dist, anti-aliased: one smaller than a pixel shares its coverage between
  * the four pixels about it (bilinear), a larger one covers the pixels
  * within its outline with a ramp a pixel wide at the edge, scaled so that
  * its coverages times the pixels' solid angles add up to omega. The
@@ -417,7 +475,7 @@ static void cover(Gather *g, int p, float cov, Vec3 L)
  * tilted disk's. Then fragments that tile a surface cover the raster
  * evenly, without the gaps and overlaps of whole pixels or of circles
  * (with those, a furnace lost 10-20%, and 3-7% near its wall). */
-static void splat(Gather *g, Vec3 d, float omega, Vec3 L, Vec3 minor, float squash)
+static void splat(Gather *g, Vec3 d, float dist, float omega, Vec3 L, Vec3 minor, float squash)
 {
     const PbgiCloud *c = g->c;
     Vec3 l = v3(v3_dot(d, g->T), v3_dot(d, g->B), v3_dot(d, g->N));
@@ -435,7 +493,7 @@ static void splat(Gather *g, Vec3 d, float omega, Vec3 L, Vec3 minor, float squa
         for (int k = 0; k < 4; k++) {
             int p = tap_pixel(c, f, i + (k & 1), j + (k >> 1));
             if (w[k] > 0.0f)
-                cover(g, p, w[k] * omega / c->pix_omega[p], L);
+                cover(g, p, w[k] * omega / c->pix_omega[p], L, dist);
         }
         return;
     }
@@ -467,7 +525,7 @@ static void splat(Gather *g, Vec3 d, float omega, Vec3 L, Vec3 minor, float squa
     float scale = fminf(omega, 2.0f * (float)M_PI) / sum;
     for (int q = 0; q < c->n_pix; q++)
         if (t[q] > 0.0f)
-            cover(g, q, t[q] * scale, L);
+            cover(g, q, t[q] * scale, L, dist);
 }
 
 static void splat_disk(Gather *g, const PbgiDisk *k)
@@ -485,7 +543,7 @@ static void splat_disk(Gather *g, const PbgiDisk *k)
     Vec3 across = v3_sub(n, v3_scale(d, cosk)); /* the normal across d: the outline's minor axis */
     float s = v3_length(across);
     Vec3 minor = s > 1e-6f ? v3_scale(across, 1.0f / s) : g->T;
-    splat(g, d, omega, L, minor, fabsf(cosk));
+    splat(g, d, dist, omega, L, minor, fabsf(cosk));
 }
 
 /* A node as one cluster, seen from P along -d. */
@@ -508,7 +566,7 @@ static void splat_cluster(Gather *g, const PbgiCluster *n, Vec3 d, float dist)
     if (!(area > 0.0f))
         return;
     Vec3 L = v3(fmaxf(pw[0], 0.0f) / area, fmaxf(pw[1], 0.0f) / area, fmaxf(pw[2], 0.0f) / area);
-    splat(g, d, area / (dist * dist), L, g->T, 1.0f);
+    splat(g, d, dist, area / (dist * dist), L, g->T, 1.0f);
 }
 
 /* Squared distance from P: the order of the walk. */
@@ -572,14 +630,22 @@ static void traverse(Gather *g, const PbgiNode *n)
         traverse(g, &c->nodes[order[i]]);
 }
 
-Vec3 pbgi_gather(const PbgiCloud *c, PbgiRaster *r, Vec3 P, Vec3 N)
+/* Rasterises the cloud as seen from P, N into r; g is the gather's frame. */
+static void rasterise(const PbgiCloud *c, PbgiRaster *r, Vec3 P, Vec3 N, Gather *g)
 {
-    Gather g = {.c = c, .r = r, .P = P, .N = N};
-    v3_basis(N, &g.T, &g.B);
+    *g = (Gather){.c = c, .r = r, .P = P, .N = N};
+    v3_basis(N, &g->T, &g->B);
     memset(r->cov, 0, (size_t)c->n_pix * sizeof *r->cov);
     memset(r->col, 0, (size_t)c->n_pix * sizeof *r->col);
+    memset(r->dist, 0, (size_t)c->n_pix * sizeof *r->dist);
     if (c->n_nodes)
-        traverse(&g, &c->nodes[0]);
+        traverse(g, &c->nodes[0]);
+}
+
+Vec3 pbgi_gather(const PbgiCloud *c, PbgiRaster *r, Vec3 P, Vec3 N)
+{
+    Gather g;
+    rasterise(c, r, P, N, &g);
     double s[3] = {0, 0, 0};
     for (int p = 0; p < c->n_upper; p++)
         for (int k = 0; k < 3; k++)
@@ -587,18 +653,109 @@ Vec3 pbgi_gather(const PbgiCloud *c, PbgiRaster *r, Vec3 P, Vec3 N)
     return v3((float)(s[0] / M_PI), (float)(s[1] / M_PI), (float)(s[2] / M_PI));
 }
 
+/* The gather's record. Rotational gradient: turning the normal by a small
+ * rotation vector alpha changes each direction's cosine by alpha . (N x
+ * w), so grad_r = sum over upper pixels of L_p omega_p (N x w_p) (the
+ * tan(theta) v_k sum of Ward and Heckbert on their strata). Translational
+ * gradient: moving P by dx moves the outline of the nearer surface at a
+ * wall between pixels p and q by -dx across w over its distance, trading
+ * solid angle between them: grad_t = sum over walls of (L_q - L_p) m
+ * (integral of cos(theta) along it) / min(r_p, r_q), m its normal into q,
+ * Ward and Heckbert's formula with the raster's walls for their strata's
+ * (DESIGN.md, "Point-based global illumination"); in the tangent plane, as
+ * theirs. Pixel depths are their fragments' coverage-weighted distances. */
+void pbgi_record(const PbgiCloud *c, PbgiRaster *r, Vec3 P, Vec3 N, IrrRecord *rec)
+{
+    Gather g;
+    rasterise(c, r, P, N, &g);
+    double E[3] = {0, 0, 0}, rot[3][2] = {{0, 0}, {0, 0}, {0, 0}};
+    double tr[3][2] = {{0, 0}, {0, 0}, {0, 0}};
+    IrrRadius radius = IRR_RADIUS_INIT;
+    for (int p = 0; p < c->n_upper; p++) {
+        const float *w = c->pix_dir[p], *L = r->col[p];
+        float omega = c->pix_weight[p] / w[2]; /* the solid angle, normalised as the weights */
+        for (int k = 0; k < 3; k++) {
+            E[k] += (double)c->pix_weight[p] * L[k];
+            rot[k][0] -= (double)(omega * w[1] * L[k]); /* N x w = (-w.y, w.x, 0) */
+            rot[k][1] += (double)(omega * w[0] * L[k]);
+        }
+        r->dist[p] = r->cov[p] > 0.0f ? r->dist[p] / r->cov[p] : INFINITY;
+        irr_radius_add(&radius, r->dist[p], w[2]);
+    }
+    for (int k = 0; k < c->n_walls; k++) {
+        int p = c->wall_pix[k][0], q = c->wall_pix[k][1];
+        float rr = fminf(r->dist[p], r->dist[q]);
+        if (!isfinite(rr) || !(rr > 0.0f))
+            continue;
+        for (int ch = 0; ch < 3; ch++) {
+            double d = (double)(r->col[q][ch] - r->col[p][ch]) / rr;
+            tr[ch][0] += d * c->wall_vec[k][0];
+            tr[ch][1] += d * c->wall_vec[k][1];
+        }
+    }
+    rec->p = P;
+    rec->n = N;
+    rec->E = v3((float)E[0], (float)E[1], (float)E[2]);
+    for (int k = 0; k < 3; k++) {
+        rec->grad_r[k] = v3_add(v3_scale(g.T, (float)rot[k][0]), v3_scale(g.B, (float)rot[k][1]));
+        rec->grad_t[k] = v3_add(v3_scale(g.T, (float)tr[k][0]), v3_scale(g.B, (float)tr[k][1]));
+    }
+    rec->R = irr_radius(&radius);
+}
+
 /* --------------------------------------------------------------- passes */
 
-/* Whether grid g goes into the cloud: a surface of world geometry (not an
- * instance's master: see DESIGN.md) whose object has a shader (lights do
- * not: diffuse rays see them black, direct lighting counts them). */
-static int cloud_grid(const RenderScene *rs, uint32_t g)
+/* A grid of the cloud: grid `grid` seen through `instance` (0: world
+ * geometry; else an object instance + 1 of the grid's master). */
+typedef struct CloudGrid {
+    uint32_t grid, instance;
+} CloudGrid;
+
+/* Whether grid g seen through instance goes into the cloud: a surface
+ * (world geometry, or a master's grid through an instance of it) whose
+ * object has a shader (lights do not: diffuse rays see them black, direct
+ * lighting counts them). */
+static int cloud_grid(const RenderScene *rs, uint32_t g, uint32_t instance)
 {
     const Grid *grid = &rs->gs->grids[g];
-    if (grid->shape != GEOM_SHAPE_SURFACE || grid->master != 0 ||
-        grid->object == GEOM_OBJECT_INHERIT)
+    if (grid->shape != GEOM_SHAPE_SURFACE || (grid->master != 0) != (instance != 0) ||
+        (!instance && grid->object == GEOM_OBJECT_INHERIT))
         return 0;
-    return render_object(rs, g, 0)->shader != NULL;
+    return render_object(rs, g, instance)->shader != NULL;
+}
+
+/* The cloud's grids: world geometry's in grid order, then each instance's
+ * master grids, instances in order. *n gets their count; NULL when out of
+ * memory. */
+static CloudGrid *cloud_grids(const RenderScene *rs, size_t *n)
+{
+    const GridSet *gs = rs->gs;
+    uint32_t *mfirst = calloc(gs->n_masters + 1, sizeof *mfirst);
+    uint32_t *mcount = calloc(gs->n_masters + 1, sizeof *mcount);
+    size_t cap = gs->n_grids;
+    for (uint32_t g = 0; mfirst && mcount && g < gs->n_grids; g++) {
+        uint32_t m = gs->grids[g].master; /* a master's grids are contiguous */
+        if (m && mcount[m - 1]++ == 0)
+            mfirst[m - 1] = g;
+    }
+    for (size_t i = 0; mcount && i < gs->n_instances; i++)
+        cap += mcount[gs->instances[i].master];
+    CloudGrid *out = mfirst && mcount ? malloc(RY_MAX(cap, 1) * sizeof *out) : NULL;
+    *n = 0;
+    if (out) {
+        for (uint32_t g = 0; g < gs->n_grids; g++)
+            if (cloud_grid(rs, g, 0))
+                out[(*n)++] = (CloudGrid){g, 0};
+        for (size_t i = 0; i < gs->n_instances; i++) {
+            uint32_t m = gs->instances[i].master;
+            for (uint32_t g = mfirst[m]; g < mfirst[m] + mcount[m]; g++)
+                if (cloud_grid(rs, g, (uint32_t)i + 1))
+                    out[(*n)++] = (CloudGrid){g, (uint32_t)i + 1};
+        }
+    }
+    free(mfirst);
+    free(mcount);
+    return out;
 }
 
 /* Disks of grid g: its micropolygons (quads; a triangular grid's lattice
@@ -623,16 +780,18 @@ static size_t tri_value(int n, int i, int j)
 }
 
 /* One disk over the polygon of k vertices (grid vertex vi[], fill value
- * ki[]), facing the vertices' normals. */
-static void polygon_disk(const GridSet *gs, const Grid *g, const uint32_t *vi,
-                         const size_t *ki, int k, const float (*val)[3], PbgiDisk *out)
+ * ki[]), facing the vertices' normals; in world space through inst (or
+ * NULL). */
+static void polygon_disk(const GridSet *gs, const Grid *g, const GeomInstance *inst,
+                         const uint32_t *vi, const size_t *ki, int k, const float (*val)[3],
+                         PbgiDisk *out)
 {
     Vec3 P = v3(0, 0, 0), N = P, L = P, p[4];
     for (int a = 0; a < k; a++) {
         uint32_t v = g->first_vertex + vi[a];
-        p[a] = gs->P[v];
+        p[a] = inst ? mat4_point(&inst->world_from_master, gs->P[v]) : gs->P[v];
         P = v3_add(P, p[a]);
-        N = v3_add(N, gs->N[v]);
+        N = v3_add(N, inst ? mat4_vector(&inst->normal_to_world, gs->N[v]) : gs->N[v]);
         L = v3_add(L, v3_load(val[ki[a]]));
     }
     Vec3 x = k == 4 ? v3_cross(v3_sub(p[2], p[0]), v3_sub(p[3], p[1]))
@@ -648,7 +807,8 @@ static void polygon_disk(const GridSet *gs, const Grid *g, const uint32_t *vi,
 }
 
 /* The disks of grid g from its vertices' values. */
-static void grid_disks(const GridSet *gs, const Grid *g, const float (*val)[3], PbgiDisk *out)
+static void grid_disks(const GridSet *gs, const Grid *g, const GeomInstance *inst,
+                       const float (*val)[3], PbgiDisk *out)
 {
     if (!g->triangular) {
         int nu = g->nu;
@@ -658,7 +818,7 @@ static void grid_disks(const GridSet *gs, const Grid *g, const float (*val)[3], 
                 uint32_t vi[4] = {(uint32_t)(j * nu + i), (uint32_t)(j * nu + i + 1),
                                   (uint32_t)((j + 1) * nu + i + 1), (uint32_t)((j + 1) * nu + i)};
                 size_t ki[4] = {vi[0], vi[1], vi[2], vi[3]};
-                polygon_disk(gs, g, vi, ki, 4, val, out++);
+                polygon_disk(gs, g, inst, vi, ki, 4, val, out++);
             }
         return;
     }
@@ -677,7 +837,7 @@ static void grid_disks(const GridSet *gs, const Grid *g, const float (*val)[3], 
                                             (uint32_t)tri[t][a][1]);
                     ki[a] = tri_value(n, tri[t][a][0], tri[t][a][1]);
                 }
-                polygon_disk(gs, g, vi, ki, 3, val, out++);
+                polygon_disk(gs, g, inst, vi, ki, 3, val, out++);
             }
         }
 }
@@ -686,7 +846,9 @@ typedef struct Pass {
     const RenderScene *rs;
     const RenderSettings *set;
     Worker *workers;
-    const size_t *first;       /* per grid: its first disk; first[n_grids]: all */
+    const CloudGrid *grids;    /* the cloud's grids */
+    size_t n_grids;
+    const size_t *first;       /* per cloud grid: its first disk; first[n_grids]: all */
     PbgiDisk *disks;           /* pass 1: geometry and radiosity */
     float (*L)[3];             /* pass 2: radiosity alone, per disk in grid order */
     int depth;                 /* the diffuse depth the grids are shaded at */
@@ -695,22 +857,21 @@ typedef struct Pass {
 static void pass_grid(void *ctx, size_t task, int worker)
 {
     Pass *p = ctx;
-    uint32_t gi = (uint32_t)task;
-    if (p->first[gi + 1] == p->first[gi])
-        return;
     const GridSet *gs = p->rs->gs;
-    const Grid *g = &gs->grids[gi];
+    const CloudGrid *cg = &p->grids[task];
+    const Grid *g = &gs->grids[cg->grid];
+    const GeomInstance *inst = render_instance(p->rs, cg->instance);
     size_t nd = grid_disk_count(g);
     float(*val)[3] = malloc(grid_values(g) * sizeof *val);
     PbgiDisk *tmp = p->disks ? NULL : malloc(nd * sizeof *tmp);
     RY_CHECK(val && (p->disks || tmp));
-    radiosity_shade_grid(&p->workers[worker], gi, p->depth, val);
+    radiosity_shade_grid(&p->workers[worker], cg->grid, cg->instance, p->depth, val);
     if (p->disks) {
-        grid_disks(gs, g, (const float(*)[3])val, &p->disks[p->first[gi]]);
+        grid_disks(gs, g, inst, (const float(*)[3])val, &p->disks[p->first[task]]);
     } else {
-        grid_disks(gs, g, (const float(*)[3])val, tmp);
+        grid_disks(gs, g, inst, (const float(*)[3])val, tmp);
         for (size_t k = 0; k < nd; k++)
-            memcpy(p->L[p->first[gi] + k], tmp[k].L, sizeof *p->L);
+            memcpy(p->L[p->first[task] + k], tmp[k].L, sizeof *p->L);
         free(tmp);
     }
     free(val);
@@ -727,7 +888,7 @@ static void run_pass(Pass *p, const RayesShaderServices *services, RenderStats *
         if (p->set->cache)
             cache_local_init(&p->workers[i].cache, p->set->cache);
     }
-    thread_parallel_for(threads, p->rs->gs->n_grids, pass_grid, p);
+    thread_parallel_for(threads, p->n_grids, pass_grid, p);
     for (int i = 0; i < threads; i++) {
         const RenderStats *s = &p->workers[i].stats;
         stats->rays_shadow += s->rays_shadow;
@@ -748,16 +909,21 @@ PbgiCloud *pbgi_build(const RenderScene *rs, const RenderSettings *set,
                       const RayesShaderServices *services, RenderStats *stats, PbgiTimes *times)
 {
     const GridSet *gs = rs->gs;
-    size_t *first = malloc((gs->n_grids + 1) * sizeof *first);
-    if (!first)
+    size_t n_grids;
+    CloudGrid *grids = cloud_grids(rs, &n_grids);
+    size_t *first = grids ? malloc((n_grids + 1) * sizeof *first) : NULL;
+    if (!first) {
+        free(grids);
         return NULL;
+    }
     first[0] = 0;
-    for (uint32_t g = 0; g < gs->n_grids; g++)
-        first[g + 1] = first[g] + (cloud_grid(rs, g) ? grid_disk_count(&gs->grids[g]) : 0);
-    size_t n = first[gs->n_grids];
+    for (size_t k = 0; k < n_grids; k++)
+        first[k + 1] = first[k] + grid_disk_count(&gs->grids[grids[k].grid]);
+    size_t n = first[n_grids];
     PbgiDisk *disks = malloc(RY_MAX(n, 1) * sizeof *disks);
     if (!disks) {
         free(first);
+        free(grids);
         return NULL;
     }
     /* Pass 1: direct lighting only (shaded at the last depth, where the
@@ -765,7 +931,8 @@ PbgiCloud *pbgi_build(const RenderScene *rs, const RenderSettings *set,
     RenderSettings direct = *set;
     direct.pbgi = NULL;
     double t0 = time_now();
-    Pass p = {.rs = rs, .set = &direct, .first = first, .disks = disks, .depth = set->bounces};
+    Pass p = {.rs = rs, .set = &direct, .grids = grids, .n_grids = n_grids, .first = first,
+              .disks = disks, .depth = set->bounces};
     run_pass(&p, services, stats);
     double t1 = time_now();
     PbgiCloud *cloud = pbgi_cloud_new(disks, n, set->pbgi_max_solid_angle, set->pbgi_raster);
@@ -774,6 +941,7 @@ PbgiCloud *pbgi_build(const RenderScene *rs, const RenderSettings *set,
     times->octree_s += t2 - t1;
     if (!cloud || set->bounces < 2) {
         free(first);
+        free(grids);
         return cloud;
     }
     /* Pass 2: bounce k reshades the grids at depth bounces - k, their
@@ -781,6 +949,7 @@ PbgiCloud *pbgi_build(const RenderScene *rs, const RenderSettings *set,
     float(*L)[3] = malloc(RY_MAX(n, 1) * sizeof *L);
     if (!L) {
         free(first);
+        free(grids);
         pbgi_cloud_free(cloud);
         return NULL;
     }
@@ -788,7 +957,8 @@ PbgiCloud *pbgi_build(const RenderScene *rs, const RenderSettings *set,
         RenderSettings bounce = *set;
         bounce.pbgi = cloud;
         double t3 = time_now();
-        Pass q = {.rs = rs, .set = &bounce, .first = first, .L = L, .depth = set->bounces - k};
+        Pass q = {.rs = rs, .set = &bounce, .grids = grids, .n_grids = n_grids, .first = first,
+                  .L = L, .depth = set->bounces - k};
         run_pass(&q, services, stats);
         double t4 = time_now();
         pbgi_cloud_relight(cloud, (const float(*)[3])L);
@@ -797,6 +967,7 @@ PbgiCloud *pbgi_build(const RenderScene *rs, const RenderSettings *set,
     }
     free(L);
     free(first);
+    free(grids);
     return cloud;
 }
 

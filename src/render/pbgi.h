@@ -12,7 +12,9 @@
  * octree over the disks, whose nodes carry order-2 spherical harmonics (9
  * coefficients) of their emitted power and projected area, by rasterising
  * near disks and far clusters front to back into a small cube raster
- * around the shading point, where nearer surfaces cover farther ones.
+ * around the shading point, where nearer surfaces cover farther ones; with
+ * irradiance interpolation the grid hider's records are such gathers with
+ * gradients (pbgi_record, irrgrid.h).
  *
  * A cloud is immutable once built and read by every thread; a gather is a
  * pure function of the cloud and the point, so images do not depend on
@@ -24,6 +26,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "render/irradiance.h"
 #include "render/path.h"
 
 #define PBGI_SH 9 /* spherical-harmonic coefficients, order 2 */
@@ -69,6 +72,10 @@ typedef struct PbgiCloud {
     int n_pix;                 /* pixels: 6 raster^2 (below the horizon too, so that
                                   fragments across it keep their shares) */
     int n_upper;               /* those above the horizon, first: 3 raster^2 */
+    int (*wall_pix)[2];        /* per wall between two upper pixels (p, q): their indices */
+    float (*wall_vec)[3];      /* its unit normal into q on the sphere (local frame) times
+                                  the integral of cos(theta) along it */
+    int n_walls;
 } PbgiCloud;
 
 /* A thread's scratch raster for gathers. */
@@ -76,6 +83,7 @@ typedef struct PbgiRaster {
     float *cov;                /* n_pix coverages in [0, 1] */
     float (*col)[3];           /* n_pix coverage-weighted radiances */
     float *tmp;                /* n_pix: a large fragment's coverages */
+    float *dist;               /* n_pix coverage-weighted distances of the fragments */
 } PbgiRaster;
 
 /* Seconds of each pass and what it made. */
@@ -104,6 +112,12 @@ void pbgi_raster_fini(PbgiRaster *r);
  * cosine-weighted mean of the radiance arriving over the hemisphere (the
  * irradiance over pi, as the indirect-diffuse service defines it). */
 Vec3 pbgi_gather(const PbgiCloud *cloud, PbgiRaster *r, Vec3 P, Vec3 N);
+
+/* The same gather as an irradiance record (irradiance.h) at P, N: its
+ * irradiance (pi times pbgi_gather's), rotational and translational
+ * gradients from the raster's pixels and their depths, and validity
+ * radius (irradiance interpolation over grids, irrgrid.h). */
+void pbgi_record(const PbgiCloud *cloud, PbgiRaster *r, Vec3 P, Vec3 N, IrrRecord *rec);
 
 /* Passes 1 and 2 over the render scene: a cloud with set's quality knobs
  * (set->pbgi_max_solid_angle, set->pbgi_raster) of every surface grid with

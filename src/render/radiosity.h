@@ -28,11 +28,13 @@ Vec3 radiosity_opacity_at_hit(Worker *w, const Hit *hit, RayDiff diff);
  * (scene units) chooses, filled by diffuselighting's Irradiance output. */
 Vec3 radiosity_irradiance_at_hit(Worker *w, const Ray *ray, const Hit *hit, float footprint);
 
-/* Shades every vertex of grid `grid` (world geometry, its front side, the
- * FINE level) with diffuselighting at diffuse depth `depth`, as a cache fill
+/* Shades every vertex of grid `grid` (world geometry, or a master's grid
+ * seen through object instance `instance` - 1; its front side, the FINE
+ * level) with diffuselighting at diffuse depth `depth`, as a cache fill
  * would, into out (the fill's order: vertex order; triangles row by row):
  * point-based GI's passes (pbgi.c). */
-void radiosity_shade_grid(Worker *w, uint32_t grid, int depth, float (*out)[3]);
+void radiosity_shade_grid(Worker *w, uint32_t grid, uint32_t instance, int depth,
+                          float (*out)[3]);
 
 /* Interpolates a level's values at a hit. */
 Vec3 radiosity_interpolate(const Grid *g, const Hit *hit, int level, const uint16_t *values);

@@ -471,6 +471,15 @@ static void svc_indirect_diffuse(const RayesShaderServices *sv, const RayesShade
         n = 0;
     if (ps->path && n > 1 && depth >= w->set->branch_depth)
         n = 1; /* an uncached hit past the branch depth: one ray follows the path */
+    IrrGrid *irr = ps->irr;
+    if (irr && n > 0 && ctx->N == irr->N + ctx->first_point) {
+        /* A grid's own points with its own normals: interpolate (irrgrid.h),
+         * records from rays or, with point-based GI, from gathers. */
+        if (!irr->done || irr->n_rays != n)
+            irrgrid_compute(ps, irr, n);
+        memcpy(out, irr->E + ctx->first_point, ctx->n_points * sizeof *out);
+        return;
+    }
     if (w->set->pbgi && n > 0) { /* point-based GI: gather from the cloud (pbgi.h) */
         PbgiRaster r;
         RY_CHECK(pbgi_raster_init(&r, w->set->pbgi) == 0);
@@ -478,14 +487,6 @@ static void svc_indirect_diffuse(const RayesShaderServices *sv, const RayesShade
             v3_store(out[i], pbgi_gather(w->set->pbgi, &r, v3_load(ctx->P[i]), v3_load(ctx->N[i])));
         w->stats.pbgi_gathers += ctx->n_points;
         pbgi_raster_fini(&r);
-        return;
-    }
-    IrrGrid *irr = ps->irr;
-    if (irr && n > 0 && ctx->N == irr->N + ctx->first_point) {
-        /* A grid's own points with its own normals: interpolate (irrgrid.h). */
-        if (!irr->done || irr->n_rays != n)
-            irrgrid_compute(ps, irr, n);
-        memcpy(out, irr->E + ctx->first_point, ctx->n_points * sizeof *out);
         return;
     }
     /* Each ray stands for 1/n of the hemisphere: its spread never shrinks. */

@@ -465,9 +465,6 @@ static RayesError session_point_cloud(RayesScene *scene, const RayesRenderOption
                                       const RenderScene *rs, RenderSettings *set,
                                       RenderStats *stats, PbgiCloud **cloud, PbgiTimes *times)
 {
-    if (rs->gs->n_instances > 0)
-        log_warning_once("pbgi-instances", "point-based GI: object instances are not in the "
-                                            "point cloud (they neither bleed light nor occlude)");
     *cloud = pbgi_build(rs, set, &render_services, stats, times);
     if (!*cloud)
         return session_fail(scene, RAYES_ERROR_OUT_OF_MEMORY,
