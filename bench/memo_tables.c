@@ -565,7 +565,7 @@ static void against(const Args *a, const Row *r, const Row *ref, const char *tag
  * its disks splatted nearest first as seen by the box's camera (eye 278
  * 273 -800 looking along +z, 39.3 degrees: the built-in Cornell scenes'),
  * to DIR/figure5-pointcloud.png: radiosity on the side that faces the
- * eye, dark purple where a disk is seen from behind. shrink scales the
+ * eye, dark purple where a disk is seen from behind and black there. shrink scales the
  * disks' radii (below 1 they show one by one). */
 static void pointcloud_view(const Args *a, int size, float shrink)
 {
@@ -585,7 +585,8 @@ static void pointcloud_view(const Args *a, int size, float shrink)
         depth[i] = INFINITY, rgba[4 * i + 3] = 1.0f;
     const float t = tanf(0.5f * 39.3077f * (float)M_PI / 180.0f);
     for (size_t i = 0; i < n; i++) {
-        float d[10]; /* x y z nx ny nz area r g b, little-endian like this machine */
+        float d[13]; /* x y z nx ny nz area r g b back_r back_g back_b, little-endian
+                        like this machine */
         if (fread(d, sizeof d, 1, f) != 1)
             die("short point cloud");
         float dz = d[2] + 800.0f;
@@ -603,9 +604,10 @@ static void pointcloud_view(const Args *a, int size, float shrink)
                 if (ex * ex + ey * ey > rad * rad || dz >= depth[k])
                     continue;
                 depth[k] = dz;
-                rgba[4 * k] = facing ? d[7] : 0.04f;
-                rgba[4 * k + 1] = facing ? d[8] : 0.0f;
-                rgba[4 * k + 2] = facing ? d[9] : 0.04f;
+                int black = !facing && d[10] + d[11] + d[12] <= 0.0f;
+                rgba[4 * k] = facing ? d[7] : black ? 0.04f : d[10];
+                rgba[4 * k + 1] = facing ? d[8] : black ? 0.0f : d[11];
+                rgba[4 * k + 2] = facing ? d[9] : black ? 0.04f : d[12];
             }
     }
     fclose(f);

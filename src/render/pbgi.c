@@ -33,7 +33,7 @@
  * gradients are sums over the pixels and over the walls between them.
  *
  * The passes shade whole grids through radiosity_shade_grid (the cache's
- * fill, FINE level, front side; a master's grids once per instance), on
+ * fill, FINE level, both sides; a master's grids once per instance), on
  * threads, each grid into its own slots: disks do not depend on threads,
  * and the octree is built on one thread.
  */
@@ -74,15 +74,19 @@ static int sh_band(int k)
     return k == 0 ? 0 : k < 4 ? 1 : 2;
 }
 
+/* A disk's power toward w is A (L max(0, N.w) + Lb max(0, -N.w)): the
+ * back side is a disk facing -N, whose harmonics are the front's with band
+ * 1 negated. The area stays the front's (splat_cluster takes the larger of
+ * it at w and -w). */
 static void node_add_disk(PbgiCluster *n, const PbgiDisk *d)
 {
     static const float clamped[3] = {(float)M_PI, 2.0f * (float)M_PI / 3.0f, (float)M_PI / 4.0f};
     float y[PBGI_SH];
     sh_eval(v3_load(d->N), y);
     for (int k = 0; k < PBGI_SH; k++) {
-        float p = d->area * clamped[sh_band(k)] * y[k];
+        float p = d->area * clamped[sh_band(k)] * y[k], pb = sh_band(k) == 1 ? -p : p;
         for (int c = 0; c < 3; c++)
-            n->power[k][c] += p * d->L[c];
+            n->power[k][c] += p * d->L[c] + pb * d->Lb[c];
         n->area[k] += d->area * clamped[sh_band(k)] * y[k];
     }
 }
@@ -215,10 +219,12 @@ static void relight_node(PbgiCloud *c, size_t at)
     }
 }
 
-void pbgi_cloud_relight(PbgiCloud *cloud, const float (*L)[3])
+void pbgi_cloud_relight(PbgiCloud *cloud, const float (*L)[3], const float (*Lb)[3])
 {
-    for (size_t k = 0; k < cloud->n_disks; k++)
+    for (size_t k = 0; k < cloud->n_disks; k++) {
         memcpy(cloud->disks[k].L, L[cloud->perm[k]], sizeof cloud->disks[k].L);
+        memcpy(cloud->disks[k].Lb, Lb[cloud->perm[k]], sizeof cloud->disks[k].Lb);
+    }
     if (cloud->n_nodes)
         relight_node(cloud, 0);
 }
@@ -539,7 +545,7 @@ static void splat_disk(Gather *g, const PbgiDisk *k)
     float cosk = v3_dot(n, d); /* < 0: the disk faces P */
     float r2 = k->area / (float)M_PI;
     float omega = 2.0f * (float)M_PI * (1.0f - dist / sqrtf(dist2 + r2)) * fabsf(cosk);
-    Vec3 L = cosk < 0.0f ? v3_load(k->L) : v3(0, 0, 0); /* seen from behind: black */
+    Vec3 L = v3_load(cosk < 0.0f ? k->L : k->Lb); /* seen from behind: the back side's */
     Vec3 across = v3_sub(n, v3_scale(d, cosk)); /* the normal across d: the outline's minor axis */
     float s = v3_length(across);
     Vec3 minor = s > 1e-6f ? v3_scale(across, 1.0f / s) : g->T;
@@ -784,15 +790,16 @@ static size_t tri_value(int n, int i, int j)
  * NULL). */
 static void polygon_disk(const GridSet *gs, const Grid *g, const GeomInstance *inst,
                          const uint32_t *vi, const size_t *ki, int k, const float (*val)[3],
-                         PbgiDisk *out)
+                         const float (*valb)[3], PbgiDisk *out)
 {
-    Vec3 P = v3(0, 0, 0), N = P, L = P, p[4];
+    Vec3 P = v3(0, 0, 0), N = P, L = P, Lb = P, p[4];
     for (int a = 0; a < k; a++) {
         uint32_t v = g->first_vertex + vi[a];
         p[a] = inst ? mat4_point(&inst->world_from_master, gs->P[v]) : gs->P[v];
         P = v3_add(P, p[a]);
         N = v3_add(N, inst ? mat4_vector(&inst->normal_to_world, gs->N[v]) : gs->N[v]);
         L = v3_add(L, v3_load(val[ki[a]]));
+        Lb = v3_add(Lb, v3_load(valb[ki[a]]));
     }
     Vec3 x = k == 4 ? v3_cross(v3_sub(p[2], p[0]), v3_sub(p[3], p[1]))
                     : v3_cross(v3_sub(p[1], p[0]), v3_sub(p[2], p[0]));
@@ -804,11 +811,13 @@ static void polygon_disk(const GridSet *gs, const Grid *g, const GeomInstance *i
     v3_store(out->N, n);
     out->area = 0.5f * len;
     v3_store(out->L, v3_scale(L, 1.0f / (float)k));
+    v3_store(out->Lb, v3_scale(Lb, 1.0f / (float)k));
 }
 
-/* The disks of grid g from its vertices' values. */
+/* The disks of grid g from its vertices' values, front (val) and back
+ * (valb). */
 static void grid_disks(const GridSet *gs, const Grid *g, const GeomInstance *inst,
-                       const float (*val)[3], PbgiDisk *out)
+                       const float (*val)[3], const float (*valb)[3], PbgiDisk *out)
 {
     if (!g->triangular) {
         int nu = g->nu;
@@ -818,7 +827,7 @@ static void grid_disks(const GridSet *gs, const Grid *g, const GeomInstance *ins
                 uint32_t vi[4] = {(uint32_t)(j * nu + i), (uint32_t)(j * nu + i + 1),
                                   (uint32_t)((j + 1) * nu + i + 1), (uint32_t)((j + 1) * nu + i)};
                 size_t ki[4] = {vi[0], vi[1], vi[2], vi[3]};
-                polygon_disk(gs, g, inst, vi, ki, 4, val, out++);
+                polygon_disk(gs, g, inst, vi, ki, 4, val, valb, out++);
             }
         return;
     }
@@ -837,7 +846,7 @@ static void grid_disks(const GridSet *gs, const Grid *g, const GeomInstance *ins
                                             (uint32_t)tri[t][a][1]);
                     ki[a] = tri_value(n, tri[t][a][0], tri[t][a][1]);
                 }
-                polygon_disk(gs, g, inst, vi, ki, 3, val, out++);
+                polygon_disk(gs, g, inst, vi, ki, 3, val, valb, out++);
             }
         }
 }
@@ -850,7 +859,7 @@ typedef struct Pass {
     size_t n_grids;
     const size_t *first;       /* per cloud grid: its first disk; first[n_grids]: all */
     PbgiDisk *disks;           /* pass 1: geometry and radiosity */
-    float (*L)[3];             /* pass 2: radiosity alone, per disk in grid order */
+    float (*L)[3], (*Lb)[3];   /* pass 2: radiosity alone, per disk in grid order */
     int depth;                 /* the diffuse depth the grids are shaded at */
 } Pass;
 
@@ -862,16 +871,22 @@ static void pass_grid(void *ctx, size_t task, int worker)
     const Grid *g = &gs->grids[cg->grid];
     const GeomInstance *inst = render_instance(p->rs, cg->instance);
     size_t nd = grid_disk_count(g);
-    float(*val)[3] = malloc(grid_values(g) * sizeof *val);
+    size_t nv = grid_values(g);
+    float(*val)[3] = malloc(2 * nv * sizeof *val), (*valb)[3] = val + nv;
     PbgiDisk *tmp = p->disks ? NULL : malloc(nd * sizeof *tmp);
     RY_CHECK(val && (p->disks || tmp));
-    radiosity_shade_grid(&p->workers[worker], cg->grid, cg->instance, p->depth, val);
+    /* both sides, as the ray-traced cache keeps an entry for each */
+    radiosity_shade_grid(&p->workers[worker], cg->grid, cg->instance, p->depth, 0, val);
+    radiosity_shade_grid(&p->workers[worker], cg->grid, cg->instance, p->depth, 1, valb);
+    const float(*cv)[3] = (const float(*)[3])val, (*cvb)[3] = (const float(*)[3])valb;
     if (p->disks) {
-        grid_disks(gs, g, inst, (const float(*)[3])val, &p->disks[p->first[task]]);
+        grid_disks(gs, g, inst, cv, cvb, &p->disks[p->first[task]]);
     } else {
-        grid_disks(gs, g, inst, (const float(*)[3])val, tmp);
-        for (size_t k = 0; k < nd; k++)
+        grid_disks(gs, g, inst, cv, cvb, tmp);
+        for (size_t k = 0; k < nd; k++) {
             memcpy(p->L[p->first[task] + k], tmp[k].L, sizeof *p->L);
+            memcpy(p->Lb[p->first[task] + k], tmp[k].Lb, sizeof *p->Lb);
+        }
         free(tmp);
     }
     free(val);
@@ -946,7 +961,7 @@ PbgiCloud *pbgi_build(const RenderScene *rs, const RenderSettings *set,
     }
     /* Pass 2: bounce k reshades the grids at depth bounces - k, their
      * indirect diffuse gathered from the cloud of k - 1 bounces. */
-    float(*L)[3] = malloc(RY_MAX(n, 1) * sizeof *L);
+    float(*L)[3] = malloc(2 * RY_MAX(n, 1) * sizeof *L), (*Lb)[3] = L + RY_MAX(n, 1);
     if (!L) {
         free(first);
         free(grids);
@@ -958,10 +973,10 @@ PbgiCloud *pbgi_build(const RenderScene *rs, const RenderSettings *set,
         bounce.pbgi = cloud;
         double t3 = time_now();
         Pass q = {.rs = rs, .set = &bounce, .grids = grids, .n_grids = n_grids, .first = first,
-                  .L = L, .depth = set->bounces - k};
+                  .L = L, .Lb = Lb, .depth = set->bounces - k};
         run_pass(&q, services, stats);
         double t4 = time_now();
-        pbgi_cloud_relight(cloud, (const float(*)[3])L);
+        pbgi_cloud_relight(cloud, (const float(*)[3])L, (const float(*)[3])Lb);
         times->bounces_s += t4 - t3;
         times->octree_s += time_now() - t4;
     }
@@ -982,19 +997,21 @@ int pbgi_write_ply(const PbgiCloud *c, const char *path, char *err, size_t err_s
     }
     fprintf(f,
             "ply\nformat binary_little_endian 1.0\ncomment rayes point cloud (docs/cli.md): "
-            "disks, radiosity r g b as outgoing radiance\nelement vertex %zu\n"
+            "disks, radiosity r g b as outgoing radiance toward n, back_r back_g back_b "
+            "against it\nelement vertex %zu\n"
             "property float x\nproperty float y\nproperty float z\n"
             "property float nx\nproperty float ny\nproperty float nz\n"
             "property float area\nproperty float r\nproperty float g\nproperty float b\n"
+            "property float back_r\nproperty float back_g\nproperty float back_b\n"
             "end_header\n",
             c->n_disks);
     int ok = 1;
     for (size_t i = 0; i < c->n_disks && ok; i++) {
         const PbgiDisk *d = &c->disks[i];
-        float rec[10] = {d->P[0], d->P[1], d->P[2], d->N[0], d->N[1],
-                         d->N[2], d->area, d->L[0], d->L[1], d->L[2]};
-        unsigned char b[40];
-        for (int k = 0; k < 10; k++) { /* little-endian whatever the host */
+        float rec[13] = {d->P[0], d->P[1], d->P[2], d->N[0],  d->N[1],  d->N[2], d->area,
+                         d->L[0], d->L[1], d->L[2], d->Lb[0], d->Lb[1], d->Lb[2]};
+        unsigned char b[52];
+        for (int k = 0; k < 13; k++) { /* little-endian whatever the host */
             uint32_t u;
             memcpy(&u, &rec[k], 4);
             for (int q = 0; q < 4; q++)

@@ -4,9 +4,9 @@
  * pointbased`, DESIGN.md "Point-based global illumination").
  *
  * Pass 1 shades every grid of the diced scene, on and off camera, at its
- * vertices with diffuselighting (direct lighting only) and turns each
- * micropolygon into a disk: position, normal, area, radiosity (outgoing
- * radiance, as the radiosity cache holds it). Pass 2 (bounces > 1) reshades
+ * vertices with diffuselighting (direct lighting only), both sides, and
+ * turns each micropolygon into a disk: position, normal, area, radiosity of
+ * either side (outgoing radiance, as the radiosity cache holds it). Pass 2 (bounces > 1) reshades
  * the grids with the indirect-diffuse service answered by the cloud itself.
  * Pass 3 is the render: the indirect-diffuse service gathers from an
  * octree over the disks, whose nodes carry order-2 spherical harmonics (9
@@ -36,6 +36,7 @@ typedef struct PbgiDisk {
     float N[3];    /* unit normal: the side that emits */
     float area;    /* scene units^2 */
     float L[3];    /* radiosity: outgoing radiance on the normal's side (as the cache's) */
+    float Lb[3];   /* the back side's (against the normal); 0: black from behind */
 } PbgiDisk;
 
 typedef struct PbgiNode {
@@ -99,9 +100,9 @@ typedef struct PbgiTimes {
 PbgiCloud *pbgi_cloud_new(PbgiDisk *disks, size_t n, float max_solid_angle, int raster);
 void pbgi_cloud_free(PbgiCloud *cloud);
 
-/* Replaces the disks' radiosities (L[i] for the disk given i-th to _new)
- * and recomputes the nodes' harmonics. */
-void pbgi_cloud_relight(PbgiCloud *cloud, const float (*L)[3]);
+/* Replaces the disks' radiosities (L[i] and back side's Lb[i] for the disk
+ * given i-th to _new) and recomputes the nodes' harmonics. */
+void pbgi_cloud_relight(PbgiCloud *cloud, const float (*L)[3], const float (*Lb)[3]);
 
 /* A scratch raster for cloud's gathers, and its release. 0: done; -1: out
  * of memory. */
@@ -128,7 +129,8 @@ PbgiCloud *pbgi_build(const RenderScene *rs, const RenderSettings *set,
                       const RayesShaderServices *services, RenderStats *stats, PbgiTimes *times);
 
 /* Writes the cloud as binary little-endian PLY: a vertex element of float
- * x y z nx ny nz area r g b (radiosity). 0, or -1 with a one-line message
+ * x y z nx ny nz area r g b (radiosity) back_r back_g back_b (the back
+ * side's). 0, or -1 with a one-line message
  * in err. */
 int pbgi_write_ply(const PbgiCloud *cloud, const char *path, char *err, size_t err_size);
 

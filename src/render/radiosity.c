@@ -410,12 +410,12 @@ static void fill_radiosity(void *user, const CacheKey *key, size_t n, float (*ou
     free(backfacing);
 }
 
-void radiosity_shade_grid(Worker *w, uint32_t grid, uint32_t instance, int depth,
+void radiosity_shade_grid(Worker *w, uint32_t grid, uint32_t instance, int depth, int side,
                           float (*out)[3])
 {
     const Grid *g = &w->rs->gs->grids[grid];
     CacheKey key = {.patch = grid, .instance = instance, .depth = (uint16_t)depth,
-                    .type = CACHE_RADIOSITY, .level = CACHE_FINE};
+                    .side = (uint8_t)side, .type = CACHE_RADIOSITY, .level = CACHE_FINE};
     FillJob job = {w, grid};
     fill_radiosity(&job, &key, level_values(g, CACHE_FINE), out);
 }

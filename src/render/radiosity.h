@@ -29,11 +29,11 @@ Vec3 radiosity_opacity_at_hit(Worker *w, const Hit *hit, RayDiff diff);
 Vec3 radiosity_irradiance_at_hit(Worker *w, const Ray *ray, const Hit *hit, float footprint);
 
 /* Shades every vertex of grid `grid` (world geometry, or a master's grid
- * seen through object instance `instance` - 1; its front side, the FINE
- * level) with diffuselighting at diffuse depth `depth`, as a cache fill
- * would, into out (the fill's order: vertex order; triangles row by row):
+ * seen through object instance `instance` - 1; its side `side`, 0 front, 1
+ * back, as a cache entry's; the FINE level) with diffuselighting at
+ * diffuse depth `depth`, as a cache fill would, into out (the fill's order: vertex order; triangles row by row):
  * point-based GI's passes (pbgi.c). */
-void radiosity_shade_grid(Worker *w, uint32_t grid, uint32_t instance, int depth,
+void radiosity_shade_grid(Worker *w, uint32_t grid, uint32_t instance, int depth, int side,
                           float (*out)[3]);
 
 /* Interpolates a level's values at a hit. */
