@@ -717,14 +717,15 @@ typedef struct CloudGrid {
     uint32_t grid, instance;
 } CloudGrid;
 
-/* Whether grid g seen through instance goes into the cloud: a surface
- * (world geometry, or a master's grid through an instance of it) whose
- * object has a shader (lights do not: diffuse rays see them black, direct
+/* Whether grid g seen through instance goes into the cloud: a surface,
+ * curve or point grid (world geometry, or a master's grid through an
+ * instance of it; curves and points as diced, facing the eye: a ribbon's
+ * quads, a point's square) whose object has a shader (lights do not: diffuse rays see them black, direct
  * lighting counts them). */
 static int cloud_grid(const RenderScene *rs, uint32_t g, uint32_t instance)
 {
     const Grid *grid = &rs->gs->grids[g];
-    if (grid->shape != GEOM_SHAPE_SURFACE || (grid->master != 0) != (instance != 0) ||
+    if ((grid->master != 0) != (instance != 0) ||
         (!instance && grid->object == GEOM_OBJECT_INHERIT))
         return 0;
     return render_object(rs, g, instance)->shader != NULL;

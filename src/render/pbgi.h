@@ -121,8 +121,8 @@ Vec3 pbgi_gather(const PbgiCloud *cloud, PbgiRaster *r, Vec3 P, Vec3 N);
 void pbgi_record(const PbgiCloud *cloud, PbgiRaster *r, Vec3 P, Vec3 N, IrrRecord *rec);
 
 /* Passes 1 and 2 over the render scene: a cloud with set's quality knobs
- * (set->pbgi_max_solid_angle, set->pbgi_raster) of every surface grid with
- * a shader, bounces - 1 further bounces computed on it. Shaders call
+ * (set->pbgi_max_solid_angle, set->pbgi_raster) of every grid (surfaces,
+ * curves, points) with a shader, bounces - 1 further bounces computed on it. Shaders call
  * `services` (render_services). Adds the passes' shading points and rays to
  * stats and their times to *times. NULL when out of memory. */
 PbgiCloud *pbgi_build(const RenderScene *rs, const RenderSettings *set,

@@ -417,6 +417,64 @@ static void test_instances_in_cloud(void)
         CHECK_NEAR(PI * power[c] / (0.6 * cs[c] * 1.0 * 36.0), 1.0, 1e-3);
 }
 
+/* Hair and particles in the cloud: a sphere point of width 0.5 at the
+ * origin and a linear round curve of width 0.1 from (-1, 0.3, 0) to (1,
+ * 0.3, 0), off camera (the eye at z = 10 looks away), both facing the eye
+ * as diced and lit head-on by a distant light of irradiance 2: their disks
+ * cover the point's square and the ribbon, 0.25 + 0.2 (to 0.1%), and carry
+ * pi L A = Kd E A (Kd 0.6; within 2%) on their front side, none on their
+ * back. */
+static void test_curves_points(void)
+{
+    const char *ply = RAYES_TEST_TMP "/test_pbgi_hair.ply";
+    RayesScene *s = rayes_scene_new();
+    float eye[3] = {0, 0, 10}, target[3] = {0, 0, 11}, up[3] = {0, 1, 0};
+    rayes_scene_set_camera(s, eye, target, up, 40.0f);
+    RayesParam light[3] = {pf("intensity", 2.0f), pc("from", 0, 0, 1), pc("to", 0, 0, 0)};
+    CHECK(rayes_scene_light(s, "distantlight", light, 3) == RAYES_OK);
+    RayesParam m[2] = {pf("Kd", 0.6f), pc("Cs", 1.0f, 1.0f, 1.0f)};
+    CHECK(rayes_scene_set_shader(s, "matte", m, 2) == RAYES_OK);
+    const float pw = 0.5f, cw = 0.1f, pp[3] = {0, 0, 0}, cp[6] = {-1, 0.3f, 0, 1, 0.3f, 0};
+    RayesPrimvar pwv = {"width", RAYES_PRIMVAR_CONSTANT, &pw, 1};
+    RayesPrimvar cwv = {"width", RAYES_PRIMVAR_CONSTANT, &cw, 1};
+    CHECK(rayes_scene_points(s, RAYES_POINT_SPHERE, 1, pp, &pwv, 1) == RAYES_OK);
+    const int nv = 2;
+    RayesCurves c = {.degree = 1, .shape = RAYES_CURVE_ROUND, .n_curves = 1, .n_verts = &nv,
+                     .P = cp};
+    CHECK(rayes_scene_curves(s, &c, &cwv, 1) == RAYES_OK);
+    CHECK(rayes_scene_commit(s) == RAYES_OK);
+    RayesRenderOptions o;
+    rayes_render_options_init(&o, RAYES_QUALITY_PREVIEW);
+    o.width = o.height = 16;
+    o.spp = 1;
+    o.threads = 2;
+    o.gi = RAYES_GI_POINTBASED;
+    o.pointcloud_out = ply;
+    RayesImage *img = NULL;
+    CHECK(rayes_render(s, &o, &img, NULL) == RAYES_OK);
+    rayes_image_free(img);
+    rayes_scene_release(s);
+    double power[3], x_max = 0.0, back[3], area = 0.0;
+    size_t n = read_ply_x(ply, power, &x_max, back);
+    FILE *f = fopen(ply, "rb");
+    char line[256];
+    while (f && fgets(line, sizeof line, f) && strcmp(line, "end_header\n") != 0)
+        ;
+    for (size_t i = 0; f && i < n; i++) {
+        float rec[13];
+        if (fread(rec, sizeof rec, 1, f) == 1) /* little-endian, like the test machines */
+            area += rec[6];
+    }
+    if (f)
+        fclose(f);
+    printf("curves and points: %zu disks, area %.5f, pi L A %.4f, back %.4f\n", n, area,
+           PI * power[0], PI * back[0]);
+    CHECK(n >= 2);
+    CHECK_NEAR(area / 0.45, 1.0, 1e-3);
+    CHECK_NEAR(PI * power[0] / (0.6 * 2.0 * 0.45), 1.0, 0.02);
+    CHECK(back[0] < 1e-3 * power[0]);
+}
+
 static RayesImage *render_box_irr(int threads, int bounces, const char *ply, int irradiance,
                                   int scale, uint64_t *gathers)
 {
@@ -618,5 +676,5 @@ static void test_bad_options(void)
 
 TEST_MAIN(TEST(test_gradients), TEST(test_furnace), TEST(test_furnace_cube), TEST(test_occlusion),
           TEST(test_back_faces_occlude), TEST(test_back_sides), TEST(test_lit_plane_power),
-          TEST(test_flipped_floor), TEST(test_instances_in_cloud), TEST(test_threads_and_bounces),
+          TEST(test_flipped_floor), TEST(test_curves_points), TEST(test_instances_in_cloud), TEST(test_threads_and_bounces),
           TEST(test_interpolation), TEST(test_bad_options))
