@@ -64,7 +64,7 @@ test-tsan:
 	@# configured every time: the targets below must be known to make even if added since
 	@cmake -S . -B build-tsan -DCMAKE_BUILD_TYPE=RelWithDebInfo -DRAYES_TSAN=ON >/dev/null
 	cmake --build build-tsan -j $(JOBS) --target $(TSAN_TESTS)
-	cd build-tsan && TSAN_OPTIONS="halt_on_error=1 suppressions=$(CURDIR)/tools/tsan.supp" ctest --output-on-failure -R '^(cache|util)/|^shade/test_plugin$$|^shade/test_texture_threads$$|^render/test_(hider|determinism|adaptive|session|opacity|volume|subsurface|instances|motion|dof|pbgi)$$|^app/test_(view|checkpoint)$$'
+	cd build-tsan && TSAN_OPTIONS="halt_on_error=1 suppressions=$(CURDIR)/tools/tsan.supp" ctest --output-on-failure -j $(JOBS) -R '^(cache|util)/|^shade/test_plugin$$|^shade/test_texture_threads$$|^render/test_(hider|determinism|adaptive|session|opacity|volume|subsurface|instances|motion|dof|pbgi)$$|^app/test_(view|checkpoint)$$'
 
 # Fuzzing: every tests/fuzz/fuzz_NAME.c is a target, run on a scratch copy
 # of its seeds tests/fuzz/corpus_NAME/ (the repository's seeds stay as they
