@@ -688,8 +688,23 @@ static Vec3 vertex_at(const GridSet *gs, const Grid *g, uint32_t i, float rt)
     return geom_vertex_at(gs, g, i, seg, x - (float)seg).P;
 }
 
+/* The unit normal of the micropolygon a quad or triangle hit names, at
+ * Embree's ray time rt (object space): a cell's from its diagonals (2 dPdu
+ * x dPdv for a parallelogram), a triangle's from its edges. */
+static Vec3 mesh_normal(const GridSet *gs, const Hit *hit, float rt)
+{
+    const Grid *grid = &gs->grids[hit->grid];
+    Vec3 P[4];
+    for (int k = 0; k < hit->n_vertex; k++)
+        P[k] = vertex_at(gs, grid, hit->vertex[k], rt);
+    if (hit->n_vertex == 4)
+        return unit_or_zero(v3_cross(v3_sub(P[3], P[0]), v3_sub(P[2], P[1])));
+    return unit_or_zero(v3_cross(v3_sub(P[1], P[0]), v3_sub(P[2], P[0])));
+}
+
+/* A quad cell's hit; its Ng only when normal is set (zero otherwise). */
 static void quad_hit(const Accel *a, const Geom *g, unsigned prim, float u, float v, float rt,
-                     Hit *hit)
+                     int normal, Hit *hit)
 {
     const GridSet *gs = a->gs;
     const Grid *grid = &gs->grids[g->grids[prim]];
@@ -713,15 +728,11 @@ static void quad_hit(const Accel *a, const Geom *g, unsigned prim, float u, floa
     hit->weight[1] = fu * (1.0f - fv);
     hit->weight[2] = (1.0f - fu) * fv;
     hit->weight[3] = fu * fv;
-    Vec3 P[4];
-    for (int k = 0; k < 4; k++)
-        P[k] = vertex_at(gs, grid, hit->vertex[k], rt);
-    /* The cell normal from its diagonals: 2 dPdu x dPdv for a parallelogram. */
-    hit->Ng = unit_or_zero(v3_cross(v3_sub(P[3], P[0]), v3_sub(P[2], P[1])));
+    hit->Ng = normal ? mesh_normal(gs, hit, rt) : v3(0, 0, 0);
 }
 
 static void tri_hit(const Accel *a, const Geom *g, unsigned prim, float u, float v, float rt,
-                    Hit *hit)
+                    int normal, Hit *hit)
 {
     const GridSet *gs = a->gs;
     const MicroTri *m = &g->tris[prim];
@@ -748,10 +759,7 @@ static void tri_hit(const Accel *a, const Geom *g, unsigned prim, float u, float
     }
     hit->vertex[3] = vtx[0];
     hit->weight[3] = 0.0f;
-    Vec3 P[3];
-    for (int k = 0; k < 3; k++)
-        P[k] = vertex_at(gs, grid, vtx[k], rt);
-    hit->Ng = unit_or_zero(v3_cross(v3_sub(P[1], P[0]), v3_sub(P[2], P[0])));
+    hit->Ng = normal ? mesh_normal(gs, hit, rt) : v3(0, 0, 0);
 }
 
 /* Embree's geometric normal of a round shape's hit (in the space of its
@@ -807,14 +815,16 @@ static void point_hit(const Accel *a, const Geom *g, const struct RTCHit *h, con
     float xx = v3_dot(x, x), yy = v3_dot(y, y);
     float u = xx > 0.0f ? fminf(fmaxf(v3_dot(d, x) / xx, 0.0f), 1.0f) : 0.5f;
     float v = yy > 0.0f ? fminf(fmaxf(v3_dot(d, y) / yy, 0.0f), 1.0f) : 0.5f;
-    quad_hit(a, g, h->primID, u, v, rt, hit);
+    quad_hit(a, g, h->primID, u, v, rt, 0, hit);
     hit->Ng = shape_normal(h, ray, g->shape);
 }
 
 /* The Hit of Embree's hit h at distance tfar along the world ray. A hit
  * through an instance is found in its master's level; Ng is turned to
- * world space. */
-static void make_hit(const Accel *a, const Ray *ray, const struct RTCHit *h, float tfar, Hit *hit)
+ * world space. Without normal, a quad's or triangle's Ng is left zero (its
+ * vertices' positions are not read; returns 1): hit_normal adds it. */
+static int make_hit(const Accel *a, const Ray *ray, const struct RTCHit *h, float tfar,
+                    int normal, Hit *hit)
 {
     const GeomInstance *gi = NULL;
     GeomInstance moved;
@@ -833,10 +843,10 @@ static void make_hit(const Accel *a, const Ray *ray, const struct RTCHit *h, flo
     hit->shape = g->shape;
     switch (g->kind) {
     case KIND_TRIS:
-        tri_hit(a, g, h->primID, h->u, h->v, embree_time(a, ray), hit);
+        tri_hit(a, g, h->primID, h->u, h->v, embree_time(a, ray), normal, hit);
         break;
     case KIND_QUADS:
-        quad_hit(a, g, h->primID, h->u, h->v, embree_time(a, ray), hit);
+        quad_hit(a, g, h->primID, h->u, h->v, embree_time(a, ray), normal, hit);
         break;
     case KIND_CURVES:
         curve_hit(a, g, h, ray, hit);
@@ -850,6 +860,19 @@ static void make_hit(const Accel *a, const Ray *ray, const struct RTCHit *h, flo
     }
     if (gi && !shape_flat(g->shape))
         hit->Ng = unit_or_zero(mat4_vector(&gi->normal_to_world, hit->Ng));
+    return !normal && (g->kind == KIND_TRIS || g->kind == KIND_QUADS);
+}
+
+/* The Ng make_hit left out of a quad's or triangle's hit. */
+static void hit_normal(const Accel *a, const Ray *ray, Hit *hit)
+{
+    hit->Ng = mesh_normal(a->gs, hit, embree_time(a, ray));
+    if (hit->instance) {
+        GeomInstance moved;
+        const GeomInstance *gi =
+            geom_instance_at(a->gs, &a->gs->instances[hit->instance - 1], ray->time, &moved);
+        hit->Ng = unit_or_zero(mat4_vector(&gi->normal_to_world, hit->Ng));
+    }
 }
 
 /* The nearest hit in scene (the world's or an object's own), under mask. */
@@ -867,7 +890,7 @@ static int intersect_scene(const Accel *a, RTCScene scene, const Ray *ray, uint3
     rtcIntersect1(scene, &ctx, &rh);
     if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID)
         return 0;
-    make_hit(a, ray, &rh.hit, rh.ray.tfar, hit);
+    make_hit(a, ray, &rh.hit, rh.ray.tfar, 1, hit);
     return 1;
 }
 
@@ -890,6 +913,18 @@ int accel_intersect_object(const Accel *a, uint32_t object, const Ray *ray, Hit 
     if (object >= a->n_objects || !a->object_scene[object])
         return 0;
     return intersect_scene(a, a->object_scene[object], ray, ~0u, hit);
+}
+
+struct AccelCrossing {
+    const Accel *accel;
+    const Ray *ray;
+    int no_normal; /* make_hit left the hit's Ng out */
+};
+
+void accel_crossing_normal(const AccelCrossing *c, Hit *hit)
+{
+    if (c && c->no_normal)
+        hit_normal(c->accel, c->ray, hit);
 }
 
 /* Crossings a transmission query remembers, to count each once. */
@@ -922,28 +957,28 @@ static void transmission_filter(const struct RTCFilterFunctionNArguments *args)
     if (args->valid[0] != -1)
         return;
     TransmissionCtx *tc = (TransmissionCtx *)args->context;
-    struct RTCRayHit rh;
-    rh.ray = *(const struct RTCRay *)args->ray;
-    rh.hit = *(const struct RTCHit *)args->hit;
+    const struct RTCHit *h = (const struct RTCHit *)args->hit;
     /* Inside an instance, args->ray is in master space: its tfar is the
      * same parameter along the world ray, which make_hit uses. */
+    float tfar = ((const struct RTCRay *)args->ray)->tfar;
     for (int k = 0; k < tc->n_seen; k++)
-        if (tc->seen[k].inst == rh.hit.instID[0] && tc->seen[k].geom == rh.hit.geomID &&
-            tc->seen[k].prim == rh.hit.primID &&
-            fabsf(tc->seen[k].t - rh.ray.tfar) <= 1e-6f * fmaxf(1.0f, rh.ray.tfar)) {
+        if (tc->seen[k].inst == h->instID[0] && tc->seen[k].geom == h->geomID &&
+            tc->seen[k].prim == h->primID &&
+            fabsf(tc->seen[k].t - tfar) <= 1e-6f * fmaxf(1.0f, tfar)) {
             args->valid[0] = 0;
             return;
         }
     if (tc->n_seen < TRANSMISSION_SEEN) {
-        tc->seen[tc->n_seen].inst = rh.hit.instID[0];
-        tc->seen[tc->n_seen].geom = rh.hit.geomID;
-        tc->seen[tc->n_seen].prim = rh.hit.primID;
-        tc->seen[tc->n_seen].t = rh.ray.tfar;
+        tc->seen[tc->n_seen].inst = h->instID[0];
+        tc->seen[tc->n_seen].geom = h->geomID;
+        tc->seen[tc->n_seen].prim = h->primID;
+        tc->seen[tc->n_seen].t = tfar;
         tc->n_seen++;
     }
     Hit hit;
-    make_hit(tc->accel, tc->ray, &rh.hit, rh.ray.tfar, &hit);
-    Vec3 op = tc->opacity(tc->user, tc->ray, &hit);
+    AccelCrossing crossing = {tc->accel, tc->ray, 0};
+    crossing.no_normal = make_hit(tc->accel, tc->ray, h, tfar, 0, &hit);
+    Vec3 op = tc->opacity(tc->user, tc->ray, &hit, &crossing);
     tc->T = v3(tc->T.x * (1.0f - fminf(fmaxf(op.x, 0.0f), 1.0f)),
                tc->T.y * (1.0f - fminf(fmaxf(op.y, 0.0f), 1.0f)),
                tc->T.z * (1.0f - fminf(fmaxf(op.z, 0.0f), 1.0f)));

@@ -73,9 +73,20 @@ typedef struct Hit {
  * Not a ray type. */
 #define ACCEL_MASK_OWN_SCENE (1u << 30)
 
+/* A transparent surface a transmission query crosses. */
+typedef struct AccelCrossing AccelCrossing;
+
 /* The opacity (RGB, each in [0, 1]) of a transparent object's hit, asked by
- * accel_transmission; hit is filled as accel_intersect fills it. */
-typedef Vec3 (*AccelOpacityFn)(void *user, const Ray *ray, const Hit *hit);
+ * accel_transmission. hit is filled as accel_intersect fills it, but a
+ * micropolygon's Ng may be left zero (its vertices unread: an opacity
+ * cache lookup needs grid, gu, gv, t and instance alone);
+ * accel_crossing_normal adds it, for a shader that runs. */
+typedef Vec3 (*AccelOpacityFn)(void *user, const Ray *ray, Hit *hit,
+                               const AccelCrossing *crossing);
+
+/* Fills in the Ng of the crossing's hit if it was left out; a NULL crossing
+ * (a hit from accel_intersect) is left as it is. */
+void accel_crossing_normal(const AccelCrossing *crossing, Hit *hit);
 
 /* Builds the acceleration structure. object_mask[o] is object o's ray
  * mask. Returns NULL and fills err on failure. */

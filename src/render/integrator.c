@@ -227,7 +227,8 @@ Vec3 integrator_irradiance(Worker *w, const Ray *ray, const Hit *hit, uint64_t k
     return shade_hit(w, ray, hit, obj, RAYES_RAY_SUBSURFACE, 0, 0, key, diff, &Oi);
 }
 
-Vec3 integrator_opacity(Worker *w, const Ray *ray, const Hit *hit, RayDiff diff)
+Vec3 integrator_opacity(Worker *w, const Ray *ray, Hit *hit, const AccelCrossing *crossing,
+                        RayDiff diff)
 {
     const GridSet *gs = w->rs->gs;
     const RenderObject *obj = render_object(w->rs, hit->grid, hit->instance);
@@ -239,6 +240,7 @@ Vec3 integrator_opacity(Worker *w, const Ray *ray, const Hit *hit, RayDiff diff)
     if (w->set->opacity_cache && obj->opacity_cached)
         return radiosity_opacity_at_hit(w, hit, diff);
     Vec3 Oi;
+    accel_crossing_normal(crossing, hit);
     shade_hit(w, ray, hit, obj, RAYES_RAY_TRANSMISSION, 0, 0, 0, diff, &Oi);
     return Oi;
 }
@@ -249,11 +251,11 @@ typedef struct ShadowRay {
     RayDiff diff;
 } ShadowRay;
 
-static Vec3 shadow_opacity(void *user, const Ray *ray, const Hit *hit)
+static Vec3 shadow_opacity(void *user, const Ray *ray, Hit *hit, const AccelCrossing *crossing)
 {
     ShadowRay *sr = user;
     sr->w->stats.transparent_hits++;
-    return integrator_opacity(sr->w, ray, hit, sr->diff);
+    return integrator_opacity(sr->w, ray, hit, crossing, sr->diff);
 }
 
 Vec3 integrator_transmission(Worker *w, const Ray *ray, RayDiff diff)
@@ -316,7 +318,7 @@ static Vec3 trace_layers(Worker *w, const Ray *ray, uint32_t kind, int diffuse_d
     if (kind == RAYES_RAY_DIFFUSE && w->set->radiosity_cache) {
         Ci = radiosity_at_hit(w, ray, &hit, diffuse_depth, diff);
         if (see_through)
-            Oi = integrator_opacity(w, ray, &hit, diff);
+            Oi = integrator_opacity(w, ray, &hit, NULL, diff);
     } else if (kind == RAYES_RAY_CAMERA && w->grid_shading &&
                hider_camera_hit(w, ray, &hit, &Ci, &Oi)) {
         /* the grid hider's shaded grid (a master's grid per instance; Ci

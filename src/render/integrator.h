@@ -24,8 +24,11 @@ Vec3 integrator_trace_hit(Worker *w, const Ray *ray, uint32_t kind, int diffuse_
  * rays see it: 1 for opaque objects, Os where the transmission hit mode is
  * "primitive" or the shader has no opacity method, else the opacity cache
  * (memo 6.1) or, uncached, the shader's opacity method at the hit. diff is
- * the ray's differential (its footprint chooses the cache resolution). */
-Vec3 integrator_opacity(Worker *w, const Ray *ray, const Hit *hit, RayDiff diff);
+ * the ray's differential (its footprint chooses the cache resolution).
+ * crossing: a transmission query's (whose hit may lack Ng until a shader
+ * runs), or NULL for a hit with Ng. */
+Vec3 integrator_opacity(Worker *w, const Ray *ray, Hit *hit, const AccelCrossing *crossing,
+                        RayDiff diff);
 
 /* The irradiance on the outside of the surface at a subsurface ray's hit
  * from inside its object, uncached (memo 6.2's "without caching"): the

@@ -434,9 +434,11 @@ static Vec3 bilinear(const uint16_t *vals, int mu, int mv, float x, float y)
 {
     int i = RY_MAX(RY_MIN((int)x, mu - 2), 0), j = RY_MAX(RY_MIN((int)y, mv - 2), 0);
     float fx = fminf(fmaxf(x - i, 0.0f), 1.0f), fy = fminf(fmaxf(y - j, 0.0f), 1.0f);
-    Vec3 a = v3_lerp(value(vals, (size_t)j * mu + i), value(vals, (size_t)j * mu + i + 1), fx);
-    Vec3 b = v3_lerp(value(vals, (size_t)(j + 1) * mu + i),
-                     value(vals, (size_t)(j + 1) * mu + i + 1), fx);
+    float lo[6], hi[6]; /* knots i and i + 1 of rows j and j + 1: adjacent values */
+    half_to_float_finite_x6(vals + 3 * ((size_t)j * mu + i), lo);
+    half_to_float_finite_x6(vals + 3 * ((size_t)(j + 1) * mu + i), hi);
+    Vec3 a = v3_lerp(v3(lo[0], lo[1], lo[2]), v3(lo[3], lo[4], lo[5]), fx);
+    Vec3 b = v3_lerp(v3(hi[0], hi[1], hi[2]), v3(hi[3], hi[4], hi[5]), fx);
     return v3_lerp(a, b, fy);
 }
 

@@ -14,9 +14,9 @@
 #include "util/thread.h"
 
 /* Transparent surfaces let a replayed transmission ray through. */
-static Vec3 clear(void *user, const Ray *ray, const Hit *hit)
+static Vec3 clear(void *user, const Ray *ray, Hit *hit, const AccelCrossing *crossing)
 {
-    (void)user, (void)ray, (void)hit;
+    (void)user, (void)ray, (void)hit, (void)crossing;
     return v3(0, 0, 0);
 }
 
