@@ -1,5 +1,8 @@
 /* Embree hits on known geometry (accel/). */
 #include "accel/accel.h"
+
+#include <string.h>
+
 #include "rayes/shader.h"
 #include "test.h"
 #include "util/thread.h"
@@ -121,4 +124,61 @@ static void test_concurrent_queries(void)
     geom_gridset_fini(&gs);
 }
 
-TEST_MAIN(TEST(test_quad_grid_hit), TEST(test_triangle_grid_hit), TEST(test_concurrent_queries))
+/* A transmission query's crossings: each hit as accel_intersect finds it,
+ * but for Ng, which accel_crossing_normal adds; each opacity multiplies. */
+typedef struct Crossings {
+    int n, no_normal;
+    Hit hit[2];
+} Crossings;
+
+static Vec3 half_clear(void *user, const Ray *ray, Hit *hit, const AccelCrossing *crossing)
+{
+    Crossings *c = user;
+    if (hit->Ng.x == 0.0f && hit->Ng.y == 0.0f && hit->Ng.z == 0.0f)
+        c->no_normal++; /* left out: nothing but the opacity lookup's fields */
+    accel_crossing_normal(crossing, hit);
+    if (c->n < 2)
+        c->hit[c->n] = *hit;
+    c->n++;
+    (void)ray;
+    return v3(0.5f, 0.25f, 0.0f);
+}
+
+static void test_transmission_crossings(void)
+{
+    GridSet gs = scene();
+    uint32_t m = RAYES_RAY_SHADOW | RAYES_RAY_CAMERA | ACCEL_MASK_TRANSPARENT;
+    uint32_t masks[2] = {m, m};
+    char err[256];
+    Accel *a = accel_new(&gs, masks, 2, err, sizeof err);
+    CHECK(a != NULL);
+    if (!a)
+        return;
+    /* the square (grid 0) at t = 10, then a miss of the triangle; and
+     * the triangle (grid 1) alone */
+    const Ray rays[2] = {{v3(2.5f, -1.25f, -10), v3(0, 0, 1), 0.0f, 1e9f, RAYES_RAY_SHADOW},
+                         {v3(22, 2, 0), v3(0, 0, 1), 0.0f, 1e9f, RAYES_RAY_SHADOW}};
+    for (int k = 0; k < 2; k++) {
+        Crossings c = {0};
+        Vec3 T = accel_transmission(a, &rays[k], half_clear, &c);
+        CHECK(c.n == 1);
+        CHECK(c.no_normal == 1);
+        CHECK_NEAR(T.x, 0.5, 1e-6);
+        CHECK_NEAR(T.y, 0.75, 1e-6);
+        CHECK_NEAR(T.z, 1.0, 1e-6);
+        Ray camera = rays[k];
+        camera.mask = RAYES_RAY_CAMERA;
+        Hit h;
+        CHECK(accel_intersect(a, &camera, &h));
+        CHECK(c.hit[0].grid == h.grid && c.hit[0].n_vertex == h.n_vertex);
+        CHECK(c.hit[0].t == h.t && c.hit[0].gu == h.gu && c.hit[0].gv == h.gv);
+        CHECK(c.hit[0].Ng.x == h.Ng.x && c.hit[0].Ng.y == h.Ng.y && c.hit[0].Ng.z == h.Ng.z);
+        CHECK(memcmp(c.hit[0].vertex, h.vertex, sizeof h.vertex) == 0);
+        CHECK(memcmp(c.hit[0].weight, h.weight, sizeof h.weight) == 0);
+    }
+    accel_free(a);
+    geom_gridset_fini(&gs);
+}
+
+TEST_MAIN(TEST(test_quad_grid_hit), TEST(test_triangle_grid_hit), TEST(test_concurrent_queries),
+          TEST(test_transmission_crossings))
