@@ -315,6 +315,8 @@ static int quality(RayesScene *s, const Args *a, int final, const char *q)
            "tile %.2f%% (at %d,%d: %.5f cached, %.5f uncached)\n",
            off.seconds / on.seconds, off.cpu / on.cpu, final ? "17" : "3.4", ma, mb, 100.0 * (ma - mb) / mb,
            100.0 * worst, tx, ty, ta, tb);
+    printf("of which preparing the scene (wall): %.2f s uncached, %.2f s cached\n",
+           stat_real(off.st, "time/prepare_s"), stat_real(on.st, "time/prepare_s"));
     printf("cached image with 1 thread: %s; with a 1 MB irradiance budget (evicting): %s\n",
            same_threads ? "identical" : "DIFFERENT", same_budget ? "identical" : "DIFFERENT");
     float *diff = malloc(bytes);

@@ -453,13 +453,15 @@ static int build_run(Accel *a, Level *lv, const uint32_t *idx, size_t n, uint32_
     }
 }
 
-static RTCScene new_scene(Accel *a)
+static RTCScene new_scene(Accel *a, int robust)
 {
     RTCScene scene = rtcNewScene(a->device);
     /* Watertight intersection: without it Embree's fast path lets rays
      * slip between micropolygons that share an edge, inside a grid and
-     * between stitched grids (tests/render/test_watertight.c). */
-    rtcSetSceneFlags(scene, RTC_SCENE_FLAG_ROBUST);
+     * between stitched grids (tests/render/test_watertight.c). An
+     * object's own scene does without (a subsurface ray that slips is one
+     * sample lost; DESIGN.md). */
+    rtcSetSceneFlags(scene, robust ? RTC_SCENE_FLAG_ROBUST : RTC_SCENE_FLAG_NONE);
     rtcSetSceneBuildQuality(scene, RTC_BUILD_QUALITY_MEDIUM);
     return scene;
 }
@@ -500,12 +502,12 @@ static int build_levels(Accel *a, const uint32_t *object_mask, const uint8_t *in
             n++;
         Level *lv = &a->levels[g->master];
         if (!lv->scene)
-            lv->scene = new_scene(a);
+            lv->scene = new_scene(a, 1);
         uint32_t mask = grid_mask(g, object_mask, inherit_transparent);
         lv->also = NULL;
         if (g->master == 0 && (mask & ACCEL_MASK_OWN_SCENE) && g->object < a->n_objects) {
             if (!a->object_scene[g->object])
-                a->object_scene[g->object] = new_scene(a);
+                a->object_scene[g->object] = new_scene(a, 0);
             lv->also = a->object_scene[g->object];
         }
         int rc = build_run(a, lv, order + k, n, mask);
@@ -599,7 +601,7 @@ Accel *accel_new(const GridSet *gs, const uint32_t *object_mask, size_t n_object
     }
     rtcSetDeviceErrorFunction(a->device, on_error, a);
     rtcSetDeviceMemoryMonitorFunction(a->device, on_memory, a);
-    a->levels[0].scene = new_scene(a);
+    a->levels[0].scene = new_scene(a, 1);
     int rc = build_levels(a, object_mask, inherit_transparent, order);
     if (rc == 0)
         rc = build_instances(a);
