@@ -877,9 +877,12 @@ static void hit_normal(const Accel *a, const Ray *ray, Hit *hit)
     }
 }
 
-/* The nearest hit in scene (the world's or an object's own), under mask. */
+/* The nearest hit in scene (the world's or an object's own), under mask.
+ * With embree_ng, a quad's or triangle's Ng is the one Embree found (of
+ * the triangle of the cell it hit: the cell's own for a flat one, facing
+ * the same way), and the micropolygon's vertices are not read. */
 static int intersect_scene(const Accel *a, RTCScene scene, const Ray *ray, uint32_t mask,
-                           Hit *hit)
+                           int embree_ng, Hit *hit)
 {
     struct RTCIntersectContext ctx;
     rtcInitIntersectContext(&ctx);
@@ -892,7 +895,10 @@ static int intersect_scene(const Accel *a, RTCScene scene, const Ray *ray, uint3
     rtcIntersect1(scene, &ctx, &rh);
     if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID)
         return 0;
-    make_hit(a, ray, &rh.hit, rh.ray.tfar, 1, hit);
+    if (!embree_ng)
+        make_hit(a, ray, &rh.hit, rh.ray.tfar, 1, hit);
+    else if (make_hit(a, ray, &rh.hit, rh.ray.tfar, 0, hit))
+        hit->Ng = unit_or_zero(v3(rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z));
     return 1;
 }
 
@@ -905,7 +911,7 @@ int accel_intersect(const Accel *a, const Ray *ray, Hit *hit)
 {
     if (a->record)
         accel_record_ray(a->record, ACCEL_QUERY_INTERSECT, 0, ray);
-    return intersect_scene(a, a->levels[0].scene, ray, ray->mask, hit);
+    return intersect_scene(a, a->levels[0].scene, ray, ray->mask, 0, hit);
 }
 
 int accel_intersect_object(const Accel *a, uint32_t object, const Ray *ray, Hit *hit)
@@ -914,7 +920,7 @@ int accel_intersect_object(const Accel *a, uint32_t object, const Ray *ray, Hit 
         accel_record_ray(a->record, ACCEL_QUERY_INTERSECT_OBJECT, object, ray);
     if (object >= a->n_objects || !a->object_scene[object])
         return 0;
-    return intersect_scene(a, a->object_scene[object], ray, ~0u, hit);
+    return intersect_scene(a, a->object_scene[object], ray, ~0u, 1, hit);
 }
 
 struct AccelCrossing {

@@ -99,7 +99,8 @@ int accel_intersect(const Accel *accel, const Ray *ray, Hit *hit);
 
 /* The nearest hit on object `object` alone, whatever the ray's mask (the
  * object's own scene: its mask had ACCEL_MASK_OWN_SCENE; any other object
- * is never hit and returns 0). */
+ * is never hit and returns 0). A micropolygon's Ng is Embree's, of the
+ * triangle hit (facing as accel_intersect's: the same for a flat cell). */
 int accel_intersect_object(const Accel *accel, uint32_t object, const Ray *ray, Hit *hit);
 
 /* Returns 1 if anything lies in [tnear, tfar]. */

@@ -180,5 +180,34 @@ static void test_transmission_crossings(void)
     geom_gridset_fini(&gs);
 }
 
+/* A hit in an object's own scene is the world's, its Ng Embree's. */
+static void test_own_scene_hits(void)
+{
+    GridSet gs = scene();
+    uint32_t m = RAYES_RAY_CAMERA | RAYES_RAY_SUBSURFACE | ACCEL_MASK_OWN_SCENE;
+    uint32_t masks[2] = {m, m};
+    char err[256];
+    Accel *a = accel_new(&gs, masks, 2, err, sizeof err);
+    CHECK(a != NULL);
+    if (!a)
+        return;
+    const Ray rays[4] = {{v3(2.5f, -1.25f, -10), v3(0, 0, 1), 0.0f, 1e9f, RAYES_RAY_SUBSURFACE},
+                         {v3(2.5f, -1.25f, 10), v3(0.1f, 0, -1), 0.0f, 1e9f, RAYES_RAY_SUBSURFACE},
+                         {v3(22, 2, 0), v3(0, 0, 1), 0.0f, 1e9f, RAYES_RAY_SUBSURFACE},
+                         {v3(22, 2, 20), v3(0, 0.1f, -1), 0.0f, 1e9f, RAYES_RAY_SUBSURFACE}};
+    for (int k = 0; k < 4; k++) {
+        Hit own, world;
+        uint32_t object = k < 2 ? 0 : 1;
+        CHECK(accel_intersect_object(a, object, &rays[k], &own));
+        CHECK(!accel_intersect_object(a, 1 - object, &rays[k], &world)); /* the other's */
+        CHECK(accel_intersect(a, &rays[k], &world));
+        CHECK(own.grid == world.grid && own.n_vertex == world.n_vertex && own.t == world.t);
+        CHECK(own.gu == world.gu && own.gv == world.gv);
+        CHECK(v3_dot(own.Ng, world.Ng) > 0.9999f);
+    }
+    accel_free(a);
+    geom_gridset_fini(&gs);
+}
+
 TEST_MAIN(TEST(test_quad_grid_hit), TEST(test_triangle_grid_hit), TEST(test_concurrent_queries),
-          TEST(test_transmission_crossings))
+          TEST(test_transmission_crossings), TEST(test_own_scene_hits))
