@@ -200,6 +200,40 @@ static int build_quads(Accel *a, Level *lv, const uint32_t *idx, size_t n, uint3
     return attach(lv, geom, mask, g);
 }
 
+/* Planar grids (grid_planar) as one Embree cell each, between their four
+ * corners: the same surface, the same (u, v) over the grid (an affine map
+ * on both of the cell's triangles), so hits map back as build_quads's do,
+ * at a fraction of the primitives. */
+static int build_planar_quads(Accel *a, Level *lv, const uint32_t *idx, size_t n, uint32_t mask)
+{
+    const GridSet *gs = a->gs;
+    RTCGeometry geom = rtcNewGeometry(a->device, RTC_GEOMETRY_TYPE_GRID);
+    Vec3 *corners = malloc((4 * n + 1) * sizeof *corners); /* + 1: Embree reads 16 B */
+    struct RTCGrid *grids = rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_GRID, 0, RTC_FORMAT_GRID,
+                                                    sizeof(struct RTCGrid), n);
+    Geom g = {.kind = KIND_QUADS, .grids = malloc(n * sizeof(uint32_t)), .steps = corners};
+    if (!grids || !g.grids || !corners) {
+        free(g.grids);
+        free(corners);
+        rtcReleaseGeometry(geom);
+        return -1;
+    }
+    for (size_t k = 0; k < n; k++) {
+        const Grid *src = &gs->grids[idx[k]];
+        const Vec3 *P = gs->P + src->first_vertex;
+        size_t w = src->nu, h = src->nv;
+        corners[4 * k] = P[0];
+        corners[4 * k + 1] = P[w - 1];
+        corners[4 * k + 2] = P[(h - 1) * w];
+        corners[4 * k + 3] = P[h * w - 1];
+        grids[k] = (struct RTCGrid){(unsigned)(4 * k), 2, 2, 2};
+        g.grids[k] = idx[k];
+    }
+    rtcSetSharedGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, corners, 0,
+                               sizeof(Vec3), 4 * n);
+    return attach(lv, geom, mask, g);
+}
+
 static size_t count_tris(const GridSet *gs, const uint32_t *idx, size_t n)
 {
     size_t t = 0;
@@ -399,6 +433,7 @@ static int build_points(Accel *a, Level *lv, const uint32_t *idx, size_t n, uint
 /* The kinds of grids an object may have, each one Embree geometry. */
 enum {
     GROUP_QUADS,
+    GROUP_PLANAR_QUADS,
     GROUP_TRIS,
     GROUP_ROUND,
     GROUP_FLAT,
@@ -408,7 +443,35 @@ enum {
     N_GROUPS
 };
 
-static int grid_group(const Grid *g)
+static float max_abs(Vec3 v)
+{
+    return fmaxf(fabsf(v.x), fmaxf(fabsf(v.y), fabsf(v.z)));
+}
+
+/* Whether a still quad grid is a parallelogram diced evenly: every vertex
+ * where the corners' affine map puts it (within float rounding of the
+ * coordinates' size, far below a ray's offset from its surface). A flat
+ * floor or wall, undisplaced. */
+static int grid_planar(const GridSet *gs, const Grid *g)
+{
+    if (g->triangular || (g->moving && gs->n_times > 1) || g->nu < 2 || g->nv < 2)
+        return 0;
+    const Vec3 *P = gs->P + g->first_vertex;
+    int w = g->nu, h = g->nv;
+    Vec3 o = P[0], du = v3_scale(v3_sub(P[w - 1], o), 1.0f / (float)(w - 1)),
+         dv = v3_scale(v3_sub(P[(size_t)(h - 1) * w], o), 1.0f / (float)(h - 1));
+    float size = fmaxf(max_abs(o), v3_length(v3_sub(P[(size_t)h * w - 1], o)));
+    float tol = 4e-6f * size;
+    for (int j = 0; j < h; j++)
+        for (int i = 0; i < w; i++) {
+            Vec3 d = v3_sub(P[(size_t)j * w + i], v3_madd(v3_madd(o, du, (float)i), dv, (float)j));
+            if (max_abs(d) > tol)
+                return 0;
+        }
+    return 1;
+}
+
+static int grid_group(const GridSet *gs, const Grid *g)
 {
     switch (g->shape) {
     case GEOM_SHAPE_ROUND_CURVE: return GROUP_ROUND;
@@ -416,7 +479,8 @@ static int grid_group(const Grid *g)
     case GEOM_SHAPE_SPHERE: return GROUP_SPHERES;
     case GEOM_SHAPE_DISK: return GROUP_DISKS;
     case GEOM_SHAPE_ORIENTED_DISK: return GROUP_ORIENTED;
-    default: return g->triangular ? GROUP_TRIS : GROUP_QUADS;
+    default:
+        return g->triangular ? GROUP_TRIS : grid_planar(gs, g) ? GROUP_PLANAR_QUADS : GROUP_QUADS;
     }
 }
 
@@ -442,8 +506,9 @@ static int cmp_keys(const void *pa, const void *pb)
  * group), in grid order. */
 static int build_run(Accel *a, Level *lv, const uint32_t *idx, size_t n, uint32_t mask)
 {
-    switch (grid_group(&a->gs->grids[idx[0]])) {
+    switch (grid_group(a->gs, &a->gs->grids[idx[0]])) {
     case GROUP_QUADS: return build_quads(a, lv, idx, n, mask);
+    case GROUP_PLANAR_QUADS: return build_planar_quads(a, lv, idx, n, mask);
     case GROUP_TRIS: return build_tris(a, lv, idx, n, mask);
     case GROUP_ROUND: return build_curves(a, lv, idx, n, mask, GEOM_SHAPE_ROUND_CURVE);
     case GROUP_FLAT: return build_curves(a, lv, idx, n, mask, GEOM_SHAPE_FLAT_CURVE);
@@ -489,7 +554,7 @@ static int build_levels(Accel *a, const uint32_t *object_mask, const uint8_t *in
         return -1;
     for (size_t k = 0; k < gs->n_grids; k++) {
         const Grid *g = &gs->grids[k];
-        keys[k] = (GridKey){g->master, g->object, (uint32_t)grid_group(g), (uint32_t)k};
+        keys[k] = (GridKey){g->master, g->object, (uint32_t)grid_group(gs, g), (uint32_t)k};
     }
     qsort(keys, gs->n_grids, sizeof *keys, cmp_keys);
     for (size_t k = 0; k < gs->n_grids; k++)
