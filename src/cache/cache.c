@@ -80,7 +80,7 @@ struct Cache {
     CacheCounters counters[CACHE_N_LEVELS][CACHE_N_TYPES];
 };
 
-const int cache_local_slots[CACHE_N_LEVELS] = {4096, 512, 64}; /* powers of two */
+const int cache_local_slots[CACHE_N_LEVELS] = {4096, 512, 1024}; /* powers of two */
 
 /* Nominal values per entry, for sizing hash tables (memo Figure 2 sizes). */
 static const size_t nominal_values[CACHE_N_LEVELS] = {4, 25, 289};

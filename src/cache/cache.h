@@ -114,7 +114,8 @@ uint64_t cache_bump_timestamp(Cache *cache);
 
 /* A thread's local part: a direct-mapped table of held entries per level,
  * largest for COARSE, whose lookups are the least coherent and whose entries
- * are the smallest (at most cache_local_slots[level] slots, at most
+ * are the smallest, and large for FINE, whose entries a volume's march
+ * walks through by the hundred (at most cache_local_slots[level] slots, at most
  * CACHE_LOCAL_SLOTS; fewer when the level's budget is small, so that one
  * thread never pins more than 1/32 of the entries a level can hold). A
  * lookup found here takes no lock; the tables are large because diffuse

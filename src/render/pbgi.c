@@ -897,8 +897,9 @@ static void pass_grid(void *ctx, size_t task, int worker)
 static void run_pass(Pass *p, const RayesShaderServices *services, RenderStats *stats)
 {
     int threads = p->set->threads > 0 ? p->set->threads : thread_count_cores();
-    p->workers = calloc((size_t)threads, sizeof *p->workers);
+    p->workers = aligned_alloc(WORKER_ALIGN, (size_t)threads * sizeof *p->workers);
     RY_CHECK(p->workers != NULL);
+    memset(p->workers, 0, (size_t)threads * sizeof *p->workers);
     for (int i = 0; i < threads; i++) {
         p->workers[i] = (Worker){.rs = p->rs, .set = p->set, .services = services};
         if (p->set->cache)

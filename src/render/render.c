@@ -440,8 +440,9 @@ int render_frame(const RenderScene *rs, const RenderSettings *set, float *rgba, 
     atomic_init(&f.cancelled, 0);
     atomic_init(&f.tiles_done, 0);
     pthread_mutex_init(&f.progress_lock, NULL);
-    f.workers = calloc((size_t)threads, sizeof *f.workers);
+    f.workers = aligned_alloc(WORKER_ALIGN, (size_t)threads * sizeof *f.workers);
     RY_CHECK(f.workers != NULL);
+    memset(f.workers, 0, (size_t)threads * sizeof *f.workers);
     GridShading *gsh = NULL;
     if (set->hider == 1) {
         gsh = hider_new(rs, set);
