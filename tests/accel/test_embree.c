@@ -144,14 +144,20 @@ static Vec3 half_clear(void *user, const Ray *ray, Hit *hit, const AccelCrossing
     return v3(0.5f, 0.25f, 0.0f);
 }
 
+/* The scene's two objects under one mask. */
+static Accel *both_with_mask(const GridSet *gs, uint32_t mask)
+{
+    uint32_t masks[2] = {mask, mask};
+    char err[256];
+    Accel *a = accel_new(gs, masks, 2, err, sizeof err);
+    CHECK(a != NULL);
+    return a;
+}
+
 static void test_transmission_crossings(void)
 {
     GridSet gs = scene();
-    uint32_t m = RAYES_RAY_SHADOW | RAYES_RAY_CAMERA | ACCEL_MASK_TRANSPARENT;
-    uint32_t masks[2] = {m, m};
-    char err[256];
-    Accel *a = accel_new(&gs, masks, 2, err, sizeof err);
-    CHECK(a != NULL);
+    Accel *a = both_with_mask(&gs, RAYES_RAY_SHADOW | RAYES_RAY_CAMERA | ACCEL_MASK_TRANSPARENT);
     if (!a)
         return;
     /* the square (grid 0) at t = 10, then a miss of the triangle; and
@@ -184,11 +190,7 @@ static void test_transmission_crossings(void)
 static void test_own_scene_hits(void)
 {
     GridSet gs = scene();
-    uint32_t m = RAYES_RAY_CAMERA | RAYES_RAY_SUBSURFACE | ACCEL_MASK_OWN_SCENE;
-    uint32_t masks[2] = {m, m};
-    char err[256];
-    Accel *a = accel_new(&gs, masks, 2, err, sizeof err);
-    CHECK(a != NULL);
+    Accel *a = both_with_mask(&gs, RAYES_RAY_CAMERA | RAYES_RAY_SUBSURFACE | ACCEL_MASK_OWN_SCENE);
     if (!a)
         return;
     const Ray rays[4] = {{v3(2.5f, -1.25f, -10), v3(0, 0, 1), 0.0f, 1e9f, RAYES_RAY_SUBSURFACE},
