@@ -51,7 +51,14 @@ typedef struct CurveSeg {
     uint32_t i;        /* the segment from centre-line vertex i to i + 1 */
 } CurveSeg;
 
-typedef enum GeomKind { KIND_QUADS, KIND_TRIS, KIND_CURVES, KIND_POINTS, KIND_INSTANCE } GeomKind;
+typedef enum GeomKind {
+    KIND_QUADS,
+    KIND_TRIS,
+    KIND_PLANAR_TRIS, /* a planar triangular grid as one triangle (build_planar_tris) */
+    KIND_CURVES,
+    KIND_POINTS,
+    KIND_INSTANCE
+} GeomKind;
 
 typedef struct Geom {
     GeomKind kind;
@@ -258,6 +265,40 @@ static void tri_vertices(const Grid *g, const MicroTri *m, uint32_t v[3])
     }
 }
 
+/* Planar triangular grids (tri_grid_planar) as one Embree triangle each,
+ * between their corners (0, 0), (n, 0) and (0, n): Embree's barycentrics
+ * are the patch's (gu, gv), from which planar_tri_hit finds the
+ * micro-triangle. */
+static int build_planar_tris(Accel *a, Level *lv, const uint32_t *idx, size_t n, uint32_t mask)
+{
+    const GridSet *gs = a->gs;
+    RTCGeometry geom = rtcNewGeometry(a->device, RTC_GEOMETRY_TYPE_TRIANGLE);
+    Vec3 *corners = malloc((3 * n + 1) * sizeof *corners); /* + 1: Embree reads 16 B */
+    uint32_t(*tri)[3] = rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
+                                                3 * sizeof(uint32_t), n);
+    Geom g = {.kind = KIND_PLANAR_TRIS, .grids = malloc(n * sizeof(uint32_t)), .steps = corners};
+    if (!tri || !g.grids || !corners) {
+        free(g.grids);
+        free(corners);
+        rtcReleaseGeometry(geom);
+        return -1;
+    }
+    for (size_t k = 0; k < n; k++) {
+        const Grid *src = &gs->grids[idx[k]];
+        const Vec3 *P = gs->P + src->first_vertex;
+        uint32_t s = src->nu;
+        corners[3 * k] = P[0];
+        corners[3 * k + 1] = P[geom_tri_vertex(s, s, 0)];
+        corners[3 * k + 2] = P[geom_tri_vertex(s, 0, s)];
+        for (int c = 0; c < 3; c++)
+            tri[k][c] = (uint32_t)(3 * k) + (uint32_t)c;
+        g.grids[k] = idx[k];
+    }
+    rtcSetSharedGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, corners, 0,
+                               sizeof(Vec3), 3 * n);
+    return attach(lv, geom, mask, g);
+}
+
 static int build_tris(Accel *a, Level *lv, const uint32_t *idx, size_t n, uint32_t mask)
 {
     const GridSet *gs = a->gs;
@@ -435,6 +476,7 @@ enum {
     GROUP_QUADS,
     GROUP_PLANAR_QUADS,
     GROUP_TRIS,
+    GROUP_PLANAR_TRIS,
     GROUP_ROUND,
     GROUP_FLAT,
     GROUP_SPHERES,
@@ -471,6 +513,29 @@ static int grid_planar(const GridSet *gs, const Grid *g)
     return 1;
 }
 
+/* grid_planar for a triangular grid of n subdivisions: every vertex (i, j)
+ * where the corners' affine map puts it. */
+static int tri_grid_planar(const GridSet *gs, const Grid *g)
+{
+    if (!g->triangular || (g->moving && gs->n_times > 1) || g->nu < 1)
+        return 0;
+    const Vec3 *P = gs->P + g->first_vertex;
+    uint32_t n = g->nu;
+    Vec3 o = P[0], du = v3_scale(v3_sub(P[geom_tri_vertex(n, n, 0)], o), 1.0f / (float)n),
+         dv = v3_scale(v3_sub(P[geom_tri_vertex(n, 0, n)], o), 1.0f / (float)n);
+    float size = fmaxf(max_abs(o), fmaxf(v3_length(v3_scale(du, (float)n)),
+                                         v3_length(v3_scale(dv, (float)n))));
+    float tol = 4e-6f * size;
+    for (uint32_t j = 0; j <= n; j++)
+        for (uint32_t i = 0; i + j <= n; i++) {
+            Vec3 d = v3_sub(P[geom_tri_vertex(n, i, j)],
+                            v3_madd(v3_madd(o, du, (float)i), dv, (float)j));
+            if (max_abs(d) > tol)
+                return 0;
+        }
+    return 1;
+}
+
 static int grid_group(const GridSet *gs, const Grid *g)
 {
     switch (g->shape) {
@@ -480,7 +545,9 @@ static int grid_group(const GridSet *gs, const Grid *g)
     case GEOM_SHAPE_DISK: return GROUP_DISKS;
     case GEOM_SHAPE_ORIENTED_DISK: return GROUP_ORIENTED;
     default:
-        return g->triangular ? GROUP_TRIS : grid_planar(gs, g) ? GROUP_PLANAR_QUADS : GROUP_QUADS;
+        if (g->triangular)
+            return tri_grid_planar(gs, g) ? GROUP_PLANAR_TRIS : GROUP_TRIS;
+        return grid_planar(gs, g) ? GROUP_PLANAR_QUADS : GROUP_QUADS;
     }
 }
 
@@ -510,6 +577,7 @@ static int build_run(Accel *a, Level *lv, const uint32_t *idx, size_t n, uint32_
     case GROUP_QUADS: return build_quads(a, lv, idx, n, mask);
     case GROUP_PLANAR_QUADS: return build_planar_quads(a, lv, idx, n, mask);
     case GROUP_TRIS: return build_tris(a, lv, idx, n, mask);
+    case GROUP_PLANAR_TRIS: return build_planar_tris(a, lv, idx, n, mask);
     case GROUP_ROUND: return build_curves(a, lv, idx, n, mask, GEOM_SHAPE_ROUND_CURVE);
     case GROUP_FLAT: return build_curves(a, lv, idx, n, mask, GEOM_SHAPE_FLAT_CURVE);
     case GROUP_SPHERES: return build_points(a, lv, idx, n, mask, GEOM_SHAPE_SPHERE);
@@ -829,6 +897,47 @@ static void tri_hit(const Accel *a, const Geom *g, unsigned prim, float u, float
     hit->Ng = normal ? mesh_normal(gs, hit, rt) : v3(0, 0, 0);
 }
 
+/* A hit (u, v) on a planar triangular grid's one triangle: the patch's
+ * barycentrics, and the micro-triangle of the lattice that holds them,
+ * with its vertices and weights as tri_hit gives them. */
+static void planar_tri_hit(const Accel *a, const Geom *g, unsigned prim, float u, float v,
+                           float rt, int normal, Hit *hit)
+{
+    const GridSet *gs = a->gs;
+    uint32_t gi = g->grids[prim];
+    const Grid *grid = &gs->grids[gi];
+    int n = grid->nu;
+    float x = fmaxf(u, 0.0f) * (float)n, y = fmaxf(v, 0.0f) * (float)n;
+    int i = RY_MAX(RY_MIN((int)x, n - 1), 0);
+    int j = RY_MAX(RY_MIN((int)y, n - 1 - i), 0);
+    float fx = fminf(fmaxf(x - (float)i, 0.0f), 1.0f), fy = fminf(fmaxf(y - (float)j, 0.0f), 1.0f);
+    uint32_t b = grid->first_vertex, un = (uint32_t)n, ui = (uint32_t)i, uj = (uint32_t)j;
+    hit->grid = gi;
+    hit->gu = u;
+    hit->gv = v;
+    hit->n_vertex = 3;
+    if (fx + fy <= 1.0f || i + j + 1 >= n) { /* the lower triangle (the only one at the edge) */
+        float s = fx + fy > 1.0f ? fx + fy : 1.0f;
+        fx /= s, fy /= s;
+        hit->vertex[0] = b + geom_tri_vertex(un, ui, uj);
+        hit->vertex[1] = b + geom_tri_vertex(un, ui + 1, uj);
+        hit->vertex[2] = b + geom_tri_vertex(un, ui, uj + 1);
+        hit->weight[0] = 1.0f - fx - fy;
+        hit->weight[1] = fx;
+        hit->weight[2] = fy;
+    } else {
+        hit->vertex[0] = b + geom_tri_vertex(un, ui + 1, uj);
+        hit->vertex[1] = b + geom_tri_vertex(un, ui + 1, uj + 1);
+        hit->vertex[2] = b + geom_tri_vertex(un, ui, uj + 1);
+        hit->weight[0] = 1.0f - fy;
+        hit->weight[1] = fx + fy - 1.0f;
+        hit->weight[2] = 1.0f - fx;
+    }
+    hit->vertex[3] = hit->vertex[0];
+    hit->weight[3] = 0.0f;
+    hit->Ng = normal ? mesh_normal(gs, hit, rt) : v3(0, 0, 0);
+}
+
 /* Embree's geometric normal of a round shape's hit (in the space of its
  * level); a flat one faces the ray (world). */
 static Vec3 shape_normal(const struct RTCHit *h, const Ray *ray, int shape)
@@ -915,6 +1024,9 @@ static int make_hit(const Accel *a, const Ray *ray, const struct RTCHit *h, floa
     case KIND_QUADS:
         quad_hit(a, g, h->primID, h->u, h->v, embree_time(a, ray), normal, hit);
         break;
+    case KIND_PLANAR_TRIS:
+        planar_tri_hit(a, g, h->primID, h->u, h->v, embree_time(a, ray), normal, hit);
+        break;
     case KIND_CURVES:
         curve_hit(a, g, h, ray, hit);
         break;
@@ -927,7 +1039,8 @@ static int make_hit(const Accel *a, const Ray *ray, const struct RTCHit *h, floa
     }
     if (gi && !shape_flat(g->shape))
         hit->Ng = unit_or_zero(mat4_vector(&gi->normal_to_world, hit->Ng));
-    return !normal && (g->kind == KIND_TRIS || g->kind == KIND_QUADS);
+    return !normal &&
+           (g->kind == KIND_TRIS || g->kind == KIND_QUADS || g->kind == KIND_PLANAR_TRIS);
 }
 
 /* The Ng make_hit left out of a quad's or triangle's hit. */

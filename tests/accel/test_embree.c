@@ -89,6 +89,31 @@ static void test_triangle_grid_hit(void)
     CHECK_NEAR(P.x, 22.0, 1e-4);
     CHECK_NEAR(P.y, 2.0, 1e-4);
     CHECK(h.Ng.z > 0.99f);
+    /* The flat triangle is traced as one (its micro-triangles found from
+     * the barycentrics): lower and upper ones, and along the hypotenuse,
+     * each hit's weights reproduce it. */
+    for (int k = 0; k < 64; k++) {
+        float x = 20.0f + 7.99f * (float)(k % 8) / 7.0f, y = 0.01f + 7.9f * (float)(k / 8) / 8.0f;
+        if (x - 20.0f + y > 7.99f)
+            y = 7.99f - (x - 20.0f);
+        Ray rk = {v3(x, y, 0), v3(0, 0, 1), 0.0f, 1e9f, RAYES_RAY_CAMERA};
+        if (!accel_intersect(a, &rk, &h)) {
+            CHECK(!"a hit inside the triangle");
+            continue;
+        }
+        Vec3 Pk = v3(0, 0, 0);
+        float wsum = 0.0f;
+        for (int c = 0; c < 3; c++) {
+            Pk = v3_madd(Pk, gs.P[h.vertex[c]], h.weight[c]);
+            wsum += h.weight[c];
+            CHECK(h.weight[c] >= -1e-5f);
+        }
+        CHECK_NEAR(wsum, 1.0, 1e-5);
+        CHECK_NEAR(Pk.x, x, 1e-4);
+        CHECK_NEAR(Pk.y, y, 1e-4);
+        CHECK_NEAR(h.gu, (x - 20.0f) / 8.0f, 1e-4);
+        CHECK_NEAR(h.gv, y / 8.0f, 1e-4);
+    }
     accel_free(a);
     geom_gridset_fini(&gs);
 }
