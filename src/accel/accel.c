@@ -54,7 +54,7 @@ typedef struct CurveSeg {
 typedef enum GeomKind {
     KIND_QUADS,
     KIND_TRIS,
-    KIND_PLANAR_TRIS, /* a planar triangular grid as one triangle (build_planar_tris) */
+    KIND_PLANAR_TRIS, /* a planar triangular grid as one triangle (build_planar) */
     KIND_CURVES,
     KIND_POINTS,
     KIND_INSTANCE
@@ -207,40 +207,6 @@ static int build_quads(Accel *a, Level *lv, const uint32_t *idx, size_t n, uint3
     return attach(lv, geom, mask, g);
 }
 
-/* Planar grids (grid_planar) as one Embree cell each, between their four
- * corners: the same surface, the same (u, v) over the grid (an affine map
- * on both of the cell's triangles), so hits map back as build_quads's do,
- * at a fraction of the primitives. */
-static int build_planar_quads(Accel *a, Level *lv, const uint32_t *idx, size_t n, uint32_t mask)
-{
-    const GridSet *gs = a->gs;
-    RTCGeometry geom = rtcNewGeometry(a->device, RTC_GEOMETRY_TYPE_GRID);
-    Vec3 *corners = malloc((4 * n + 1) * sizeof *corners); /* + 1: Embree reads 16 B */
-    struct RTCGrid *grids = rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_GRID, 0, RTC_FORMAT_GRID,
-                                                    sizeof(struct RTCGrid), n);
-    Geom g = {.kind = KIND_QUADS, .grids = malloc(n * sizeof(uint32_t)), .steps = corners};
-    if (!grids || !g.grids || !corners) {
-        free(g.grids);
-        free(corners);
-        rtcReleaseGeometry(geom);
-        return -1;
-    }
-    for (size_t k = 0; k < n; k++) {
-        const Grid *src = &gs->grids[idx[k]];
-        const Vec3 *P = gs->P + src->first_vertex;
-        size_t w = src->nu, h = src->nv;
-        corners[4 * k] = P[0];
-        corners[4 * k + 1] = P[w - 1];
-        corners[4 * k + 2] = P[(h - 1) * w];
-        corners[4 * k + 3] = P[h * w - 1];
-        grids[k] = (struct RTCGrid){(unsigned)(4 * k), 2, 2, 2};
-        g.grids[k] = idx[k];
-    }
-    rtcSetSharedGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, corners, 0,
-                               sizeof(Vec3), 4 * n);
-    return attach(lv, geom, mask, g);
-}
-
 static size_t count_tris(const GridSet *gs, const uint32_t *idx, size_t n)
 {
     size_t t = 0;
@@ -265,19 +231,29 @@ static void tri_vertices(const Grid *g, const MicroTri *m, uint32_t v[3])
     }
 }
 
-/* Planar triangular grids (tri_grid_planar) as one Embree triangle each,
- * between their corners (0, 0), (n, 0) and (0, n): Embree's barycentrics
+/* Planar grids (grid_planar, tri_grid_planar) as one Embree primitive
+ * each between their corners: a quad grid as a 2 x 2 grid cell, whose
+ * (u, v) over the grid is the same affine coordinate as over the fine
+ * cells (so hits map back as build_quads's do); a triangular grid of n
+ * subdivisions as the triangle (0, 0), (n, 0), (0, n), whose barycentrics
  * are the patch's (gu, gv), from which planar_tri_hit finds the
- * micro-triangle. */
-static int build_planar_tris(Accel *a, Level *lv, const uint32_t *idx, size_t n, uint32_t mask)
+ * micro-triangle. A fraction of the primitives for the same surface. */
+static int build_planar(Accel *a, Level *lv, const uint32_t *idx, size_t n, uint32_t mask,
+                        int tris)
 {
     const GridSet *gs = a->gs;
-    RTCGeometry geom = rtcNewGeometry(a->device, RTC_GEOMETRY_TYPE_TRIANGLE);
-    Vec3 *corners = malloc((3 * n + 1) * sizeof *corners); /* + 1: Embree reads 16 B */
-    uint32_t(*tri)[3] = rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
-                                                3 * sizeof(uint32_t), n);
-    Geom g = {.kind = KIND_PLANAR_TRIS, .grids = malloc(n * sizeof(uint32_t)), .steps = corners};
-    if (!tri || !g.grids || !corners) {
+    size_t per = tris ? 3 : 4;
+    RTCGeometry geom =
+        rtcNewGeometry(a->device, tris ? RTC_GEOMETRY_TYPE_TRIANGLE : RTC_GEOMETRY_TYPE_GRID);
+    Vec3 *corners = malloc((per * n + 1) * sizeof *corners); /* + 1: Embree reads 16 B */
+    void *prims = tris ? rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
+                                                 3 * sizeof(uint32_t), n)
+                       : rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_GRID, 0, RTC_FORMAT_GRID,
+                                                 sizeof(struct RTCGrid), n);
+    Geom g = {.kind = tris ? KIND_PLANAR_TRIS : KIND_QUADS,
+              .grids = malloc(n * sizeof(uint32_t)),
+              .steps = corners};
+    if (!prims || !g.grids || !corners) {
         free(g.grids);
         free(corners);
         rtcReleaseGeometry(geom);
@@ -286,16 +262,27 @@ static int build_planar_tris(Accel *a, Level *lv, const uint32_t *idx, size_t n,
     for (size_t k = 0; k < n; k++) {
         const Grid *src = &gs->grids[idx[k]];
         const Vec3 *P = gs->P + src->first_vertex;
-        uint32_t s = src->nu;
-        corners[3 * k] = P[0];
-        corners[3 * k + 1] = P[geom_tri_vertex(s, s, 0)];
-        corners[3 * k + 2] = P[geom_tri_vertex(s, 0, s)];
-        for (int c = 0; c < 3; c++)
-            tri[k][c] = (uint32_t)(3 * k) + (uint32_t)c;
+        Vec3 *c = corners + per * k;
+        uint32_t first = (uint32_t)(per * k);
+        if (tris) {
+            uint32_t sub = src->nu;
+            c[0] = P[0];
+            c[1] = P[geom_tri_vertex(sub, sub, 0)];
+            c[2] = P[geom_tri_vertex(sub, 0, sub)];
+            uint32_t *t = (uint32_t *)prims + 3 * k;
+            t[0] = first, t[1] = first + 1, t[2] = first + 2;
+        } else {
+            size_t w = src->nu, h = src->nv;
+            c[0] = P[0];
+            c[1] = P[w - 1];
+            c[2] = P[(h - 1) * w];
+            c[3] = P[h * w - 1];
+            ((struct RTCGrid *)prims)[k] = (struct RTCGrid){first, 2, 2, 2};
+        }
         g.grids[k] = idx[k];
     }
     rtcSetSharedGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, corners, 0,
-                               sizeof(Vec3), 3 * n);
+                               sizeof(Vec3), per * n);
     return attach(lv, geom, mask, g);
 }
 
@@ -571,13 +558,14 @@ static int cmp_keys(const void *pa, const void *pb)
 
 /* Adds one Embree geometry for the n grids idx (one level, object and
  * group), in grid order. */
-static int build_run(Accel *a, Level *lv, const uint32_t *idx, size_t n, uint32_t mask)
+static int build_run(Accel *a, Level *lv, const uint32_t *idx, size_t n, uint32_t mask,
+                     int group)
 {
-    switch (grid_group(a->gs, &a->gs->grids[idx[0]])) {
+    switch (group) {
     case GROUP_QUADS: return build_quads(a, lv, idx, n, mask);
-    case GROUP_PLANAR_QUADS: return build_planar_quads(a, lv, idx, n, mask);
+    case GROUP_PLANAR_QUADS: return build_planar(a, lv, idx, n, mask, 0);
     case GROUP_TRIS: return build_tris(a, lv, idx, n, mask);
-    case GROUP_PLANAR_TRIS: return build_planar_tris(a, lv, idx, n, mask);
+    case GROUP_PLANAR_TRIS: return build_planar(a, lv, idx, n, mask, 1);
     case GROUP_ROUND: return build_curves(a, lv, idx, n, mask, GEOM_SHAPE_ROUND_CURVE);
     case GROUP_FLAT: return build_curves(a, lv, idx, n, mask, GEOM_SHAPE_FLAT_CURVE);
     case GROUP_SPHERES: return build_points(a, lv, idx, n, mask, GEOM_SHAPE_SPHERE);
@@ -643,7 +631,7 @@ static int build_levels(Accel *a, const uint32_t *object_mask, const uint8_t *in
                 a->object_scene[g->object] = new_scene(a, 0);
             lv->also = a->object_scene[g->object];
         }
-        int rc = build_run(a, lv, order + k, n, mask);
+        int rc = build_run(a, lv, order + k, n, mask, (int)keys[k].group);
         lv->also = NULL;
         if (rc != 0) {
             free(keys);

@@ -430,6 +430,17 @@ static void test_constant_environment_white_furnace(void)
     rayes_scene_release(s);
 }
 
+/* A scene of one environment light of the map at path, intensity 1, set
+ * up in f. */
+static RayesScene *env_fixture(Fx *f, const char *path)
+{
+    RayesScene *s = rayes_scene_new();
+    RayesParam e[2] = {ps("mapname", path), pf("intensity", 1)};
+    CHECK(rayes_scene_light(s, "environmentlight", e, 2) == RAYES_OK);
+    fx_init(f, s);
+    return s;
+}
+
 /* A 64 x 32 map, dim everywhere but a small bright patch. */
 static void write_test_map(const char *path)
 {
@@ -455,11 +466,8 @@ static void test_environment_map_importance_sampling(void)
 {
     const char *path = RAYES_TEST_TMP "/test_lights_map.exr";
     write_test_map(path);
-    RayesScene *s = rayes_scene_new();
-    RayesParam e[2] = {ps("mapname", path), pf("intensity", 1)};
-    CHECK(rayes_scene_light(s, "environmentlight", e, 2) == RAYES_OK);
     Fx f;
-    fx_init(&f, s);
+    RayesScene *s = env_fixture(&f, path);
     const Light *l = &s->lights[0];
     /* Orientation: the centre pixel is +z, the top row +y. */
     CHECK(light_env_radiance(l, v3_normalize(v3(-0.03f, -0.05f, 1.0f))).x == 7.0f);
@@ -536,11 +544,8 @@ static void test_environment_map_sampling_consistency(void)
 {
     const char *path = RAYES_TEST_TMP "/test_lights_holed.exr";
     write_holed_map(path);
-    RayesScene *s = rayes_scene_new();
-    RayesParam e[2] = {ps("mapname", path), pf("intensity", 1)};
-    CHECK(rayes_scene_light(s, "environmentlight", e, 2) == RAYES_OK);
     Fx f;
-    fx_init(&f, s);
+    RayesScene *s = env_fixture(&f, path);
     const Light *l = &s->lights[0];
     const LightEnvMap *m = l->env;
     CHECK(m != NULL);

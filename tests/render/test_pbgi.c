@@ -343,6 +343,24 @@ static RayesParam pc(const char *name, float a, float b, float c)
     return (RayesParam){name, RAYES_PARAM_COLOR, {a, b, c}, NULL};
 }
 
+/* Commits and renders s (16 x 16, preview, point-based GI) to write its
+ * cloud to ply, its statistics into *st (st may be NULL); releases s. */
+static void write_cloud(RayesScene *s, const char *ply, RayesStats **st)
+{
+    CHECK(rayes_scene_commit(s) == RAYES_OK);
+    RayesRenderOptions o;
+    rayes_render_options_init(&o, RAYES_QUALITY_PREVIEW);
+    o.width = o.height = 16;
+    o.spp = 1;
+    o.threads = 2;
+    o.gi = RAYES_GI_POINTBASED;
+    o.pointcloud_out = ply;
+    RayesImage *img = NULL;
+    CHECK(rayes_render(s, &o, &img, st) == RAYES_OK);
+    rayes_image_free(img);
+    rayes_scene_release(s);
+}
+
 /* A 4 x 3 matte plane (Kd 0.6, Cs 1 0.5 0.25) under a distant light of
  * irradiance 2 at 60 degrees, off camera; instanced: an object instanced
  * twice, the second moved 10 along x and stretched 2 times along it.
@@ -370,18 +388,7 @@ static void render_lit_plane(int instanced, const char *ply, RayesStats **st)
     } else {
         CHECK(rayes_scene_bilinear_patch(s, P) == RAYES_OK);
     }
-    CHECK(rayes_scene_commit(s) == RAYES_OK);
-    RayesRenderOptions o;
-    rayes_render_options_init(&o, RAYES_QUALITY_PREVIEW);
-    o.width = o.height = 16;
-    o.spp = 1;
-    o.threads = 2;
-    o.gi = RAYES_GI_POINTBASED;
-    o.pointcloud_out = ply;
-    RayesImage *img = NULL;
-    CHECK(rayes_render(s, &o, &img, st) == RAYES_OK);
-    rayes_image_free(img);
-    rayes_scene_release(s);
+    write_cloud(s, ply, st);
 }
 
 /* The lit plane's point cloud: its power, sum pi L A, is Kd Cs E A with E
@@ -442,18 +449,7 @@ static void test_curves_points(void)
     RayesCurves c = {.degree = 1, .shape = RAYES_CURVE_ROUND, .n_curves = 1, .n_verts = &nv,
                      .P = cp};
     CHECK(rayes_scene_curves(s, &c, &cwv, 1) == RAYES_OK);
-    CHECK(rayes_scene_commit(s) == RAYES_OK);
-    RayesRenderOptions o;
-    rayes_render_options_init(&o, RAYES_QUALITY_PREVIEW);
-    o.width = o.height = 16;
-    o.spp = 1;
-    o.threads = 2;
-    o.gi = RAYES_GI_POINTBASED;
-    o.pointcloud_out = ply;
-    RayesImage *img = NULL;
-    CHECK(rayes_render(s, &o, &img, NULL) == RAYES_OK);
-    rayes_image_free(img);
-    rayes_scene_release(s);
+    write_cloud(s, ply, NULL);
     double power[3], x_max = 0.0, back[3], area = 0.0;
     size_t n = read_ply_x(ply, power, &x_max, back);
     FILE *f = fopen(ply, "rb");
