@@ -111,8 +111,16 @@ static float randfloat(uint32_t i, uint32_t p)
     return (float)(i >> 8) * (1.0f / 16777216.0f);
 }
 
-/* m columns and k rows of strata for n samples: m = floor(sqrt(n)), m k >= n. */
-static void cmj_shape(uint32_t n, uint32_t *m_out, uint32_t *k_out)
+/* m columns and k rows of strata for n samples. Where n has a divisor m
+ * <= sqrt(n) of at least half floor(sqrt(n)) (the strata no more than
+ * about 4 times taller than wide), n = m k and every stratum holds a
+ * sample. Otherwise (a prime n, say) m = floor(sqrt(n)), k = ceil(n / m),
+ * and the n samples take n of the m k strata, the ones the pattern's
+ * permutation of all m k picks: which strata stay empty changes from
+ * pattern to pattern, so the points are uniform on average. (Taking the
+ * first n strata, as Kensler's arbitrary-n variant does, always left the
+ * top row's end empty: an estimate with n = 32 came out 0.7% dark.) */
+void cmj_strata(uint32_t n, uint32_t *m_out, uint32_t *k_out)
 {
     uint32_t m = (uint32_t)sqrtf((float)n);
     if (m * m > n)
@@ -121,6 +129,12 @@ static void cmj_shape(uint32_t n, uint32_t *m_out, uint32_t *k_out)
         m++;
     if (m == 0)
         m = 1;
+    for (uint32_t d = m; 2 * d >= m; d--)
+        if (n % d == 0) {
+            *m_out = d;
+            *k_out = n / d;
+            return;
+        }
     *m_out = m;
     *k_out = (n + m - 1) / m;
 }
@@ -153,8 +167,8 @@ static inline void cmj_cell(uint32_t s, uint32_t m, uint32_t *col, uint32_t *row
 void cmj_sample_2d(uint32_t s, uint32_t n, uint32_t p, float *x, float *y)
 {
     uint32_t m, k, col, row;
-    cmj_shape(n, &m, &k);
-    s = permute(s, n, p * 0x51633e2du);
+    cmj_strata(n, &m, &k);
+    s = permute(s, m * k, p * 0x51633e2du); /* m k = n, or n of the strata */
     cmj_cell(s, m, &col, &row);
     cmj_point(s, col, row, permute(col, m, p * 0x68bc21ebu), permute(row, k, p * 0x02e5be93u), m, k,
               p, x, y);
@@ -164,7 +178,7 @@ void cmj_pattern_init(CmjPattern *c, uint32_t n, uint32_t p)
 {
     c->n = n;
     c->p = p;
-    cmj_shape(n, &c->m, &c->k);
+    cmj_strata(n, &c->m, &c->k);
     c->tabled = c->m <= CMJ_TABLE && c->k <= CMJ_TABLE;
     if (!c->tabled)
         return;
@@ -184,7 +198,7 @@ void cmj_pattern_sample(const CmjPattern *c, uint32_t s, float *x, float *y)
         return;
     }
     uint32_t col, row;
-    s = permute(s, c->n, c->p * 0x51633e2du);
+    s = permute(s, c->m * c->k, c->p * 0x51633e2du);
     cmj_cell(s, c->m, &col, &row);
     cmj_point(s, col, row, c->sx[col], c->sy[row], c->m, c->k, c->p, x, y);
 }
@@ -201,7 +215,7 @@ void cmj_pattern_samples(const CmjPattern *c, uint32_t first, uint32_t count, fl
      * waiting, one at a time, behind the caller's work between samples. */
     uint32_t idx[CMJ_BATCH];
     Permutation ps;
-    permutation_init(&ps, c->n, c->p * 0x51633e2du);
+    permutation_init(&ps, c->m * c->k, c->p * 0x51633e2du);
     for (uint32_t done = 0; done < count; done += CMJ_BATCH) {
         uint32_t nb = count - done < CMJ_BATCH ? count - done : CMJ_BATCH;
         for (uint32_t i = 0; i < nb; i++)

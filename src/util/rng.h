@@ -40,6 +40,12 @@ static inline float rng_float(uint64_t key)
  * seed p (0 <= s < n). */
 void cmj_sample_2d(uint32_t s, uint32_t n, uint32_t p, float *x, float *y);
 
+/* The m columns and k rows of strata of n points: n = m k where n has a
+ * divisor m near sqrt(n) (at least half of floor(sqrt(n))), else m =
+ * floor(sqrt(n)), k = ceil(n / m) and each pattern leaves its own m k - n
+ * strata empty (uniform on average). */
+void cmj_strata(uint32_t n, uint32_t *m, uint32_t *k);
+
 /* The s-th of n stratified samples in [0, 1) for pattern seed p: stratum
  * permute(s) of n, jittered (the strata shuffled against cmj_sample_2d's,
  * so a pixel's time and lens samples are stratified with its positions but
