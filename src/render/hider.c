@@ -180,7 +180,8 @@ static Rgb *shade_grid(Worker *w, uint32_t gi, uint32_t instance, int seg)
     float *f1 = malloc(n * 10 * sizeof *f1);
     uint64_t *keys = malloc(n * sizeof *keys);
     RayDiff *diff = malloc(n * sizeof *diff);
-    Rgb *ci = malloc(n * (obj->transparent ? 2 : 1) * sizeof *ci);
+    size_t n_ci = n * (obj->transparent ? 2 : 1);
+    Rgb *ci = malloc((n_ci + 1) * sizeof *ci);
     int *back = malloc(n * sizeof *back);
     RY_CHECK(f3 && f1 && keys && diff && ci && back);
     float(*P)[3] = f3, (*N)[3] = f3 + n, (*dPdu)[3] = f3 + 2 * n, (*dPdv)[3] = f3 + 3 * n;
@@ -259,10 +260,14 @@ static Rgb *shade_grid(Worker *w, uint32_t gi, uint32_t instance, int seg)
     path_apply_Os_pattern(w, obj, &ctx, Os);
     RayesShadeOutputs out = {.Ci = Ci, .Oi = Oi};
     w->stats.shading_points[0] += n;
+    uint64_t sharp = w->sharp_rays;
     shade_run_lighting(w->services, &ctx, obj->shader, &out);
     memcpy(ci, Ci, n * sizeof *ci);
     if (obj->transparent)
         memcpy(ci + n, Oi, n * sizeof *ci);
+    /* the trailer: 1 if the grid reflects or refracts sharply (hider_camera_hit) */
+    ci[n_ci][0] = w->sharp_rays != sharp ? 1.0f : 0.0f;
+    ci[n_ci][1] = ci[n_ci][2] = 0.0f;
     free(irr_E);
     free(back);
     free(f3);
@@ -359,10 +364,13 @@ int hider_camera_hit(Worker *w, const Ray *ray, const Hit *hit, Vec3 *L, Vec3 *O
         pthread_mutex_unlock(lock);
     }
     const Grid *g = &w->rs->gs->grids[gi];
+    int transparent = render_object(w->rs, gi, hit->instance)->transparent;
+    if (ci[geom_grid_n_vertices(g) * (transparent ? 2 : 1)][0] != 0.0f)
+        return 0; /* a sharp reflection or refraction: shaded where the ray hits */
     if (!corners(hit, g->first_vertex, ci, gsh->contrast, L))
         return 0;
     *Oi = v3(1, 1, 1);
-    if (!render_object(w->rs, gi, hit->instance)->transparent)
+    if (!transparent)
         return 1;
     /* Opacity is no noisy estimate: a cut-out's edge (corners of 0 and 1)
      * or any step beyond HIDER_OPACITY_STEP is shaded where the ray hits. */

@@ -47,6 +47,9 @@ typedef struct Worker {
     CacheLocal cache;             /* this thread's part of the radiosity cache */
     GridShading *grid_shading; /* the grid hider's shaded grids, or NULL (hider.h) */
     const RayesShaderServices *services; /* what shaders run here call (services.h) */
+    uint64_t sharp_rays;          /* perfect mirror and refraction rays traced from points at
+                                     depth 0 (the grid hider asks whether a grid's shading
+                                     traced any: hider.c) */
     float time;                   /* the time of the ray being shaded (scene time): rays the
                                      shading traces take it (integrator_trace sets and restores
                                      it; a cache fill sets its segment's middle) */

@@ -571,6 +571,7 @@ static void svc_indirect_specular(const RayesShaderServices *sv, const RayesShad
         Vec3 d = v3_normalize(v3_load(dir[i]));
         float r = roughness ? roughness[i] : 0.0f;
         if (r <= 0.0f) {
+            w->sharp_rays += ctx->diffuse_depth == 0 && ctx->specular_depth == 0;
             v3_store(out[i], trace_specular(ctx, i, d, key, RAYES_RAY_SPECULAR));
             continue;
         }
@@ -667,6 +668,7 @@ static void svc_indirect_refraction(const RayesShaderServices *sv, const RayesSh
             continue;
         }
         uint64_t key = hash_combine(ps->keys[point(ctx, i)], DIM_REFRACTION);
+        ps->w->sharp_rays += ctx->diffuse_depth == 0 && ctx->specular_depth == 0;
         v3_store(out[i],
                  trace_specular(ctx, i, v3_normalize(v3_load(dir[i])), key, RAYES_RAY_SPECULAR));
     }

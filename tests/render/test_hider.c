@@ -1,8 +1,9 @@
 /*
  * The grid hider (render/hider.c): it agrees with the ray-tracing hider on
  * a diffuse scene (image and 16 x 16 tile means, within noise), gives the
- * same bytes for any thread count, and shades each visible grid vertex
- * once: depth-0 shading points do not grow with pixel samples.
+ * same bytes for any thread count, shades each visible grid vertex once
+ * (depth-0 shading points do not grow with pixel samples), and shades
+ * sharp mirrors where the camera rays hit them.
  */
 #include <math.h>
 #include <stdio.h>
@@ -167,6 +168,67 @@ static void test_highlights_not_smeared(void)
     rayes_image_free(img[1]);
 }
 
+/* A chrome ball (the only thing the camera sees) reflects a small light
+ * and a diffuse wall behind the camera: the light's image in it is far
+ * smaller than a micropolygon. A grid whose shading traces perfect mirror
+ * or refraction rays is shaded where each camera ray hits it, as the
+ * ray-tracing hider shades it, so both hiders give the same bytes (shaded
+ * at its vertices and interpolated, every pixel of the ball would differ
+ * and the light's image would be lost or smeared). */
+static RayesImage *render_chrome_ball(RayesHider hider)
+{
+    RayesScene *s = rayes_scene_new();
+    const float eye[3] = {0, 0, 6}, at[3] = {0, 0, 0}, up[3] = {0, 1, 0};
+    static const float identity[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
+    static const float at_light[16] = {1, 0, 0, 3, 0, 1, 0, 4, 0, 0, 1, 5, 0, 0, 0, 1};
+    CHECK(rayes_scene_set_camera(s, eye, at, up, 25.0f) == RAYES_OK);
+    RayesParam chrome = {"specularcolor", RAYES_PARAM_COLOR, {0.9f, 0.9f, 0.9f}, NULL};
+    CHECK(rayes_scene_set_shader(s, "mirror", &chrome, 1) == RAYES_OK);
+    CHECK(rayes_scene_sphere(s, 1.0f) == RAYES_OK);
+    RayesParam kd = {"Kd", RAYES_PARAM_FLOAT, {0.8f, 0, 0}, NULL};
+    CHECK(rayes_scene_set_shader(s, "matte", &kd, 1) == RAYES_OK);
+    const float wall[4][3] = {{-20, -20, 12}, {20, -20, 12}, {-20, 20, 12}, {20, 20, 12}};
+    CHECK(rayes_scene_bilinear_patch(s, wall) == RAYES_OK);
+    RayesParam light[3] = {{"shape", RAYES_PARAM_STRING, {0, 0, 0}, "sphere"},
+                           {"radius", RAYES_PARAM_FLOAT, {0.3f, 0, 0}, NULL},
+                           {"intensity", RAYES_PARAM_FLOAT, {400.0f, 0, 0}, NULL}};
+    CHECK(rayes_scene_set_transform(s, at_light) == RAYES_OK);
+    CHECK(rayes_scene_light(s, "arealight", light, 3) == RAYES_OK);
+    CHECK(rayes_scene_set_transform(s, identity) == RAYES_OK);
+    CHECK(rayes_scene_commit(s) == RAYES_OK);
+    RayesRenderOptions o;
+    rayes_render_options_init(&o, RAYES_QUALITY_PREVIEW);
+    o.width = o.height = 48;
+    o.spp = 4;
+    o.threads = 2;
+    o.bounces = 0;
+    o.hider = hider;
+    RayesImage *img = NULL;
+    CHECK(rayes_render(s, &o, &img, NULL) == RAYES_OK);
+    rayes_scene_release(s);
+    return img;
+}
+
+static void test_sharp_reflections_per_sample(void)
+{
+    RayesImage *a = render_chrome_ball(RAYES_HIDER_RAYTRACE), *b = render_chrome_ball(RAYES_HIDER_GRID);
+    CHECK(a && b);
+    if (a && b) {
+        size_t n = (size_t)48 * 48, differ = 0;
+        float brightest = 0.0f;
+        for (size_t i = 0; i < n; i++) {
+            differ += memcmp(a->rgba + 4 * i, b->rgba + 4 * i, 3 * sizeof(float)) != 0;
+            brightest = fmaxf(brightest, a->rgba[4 * i]);
+        }
+        CHECK(differ == 0);
+        CHECK(brightest > 1.0f); /* the light's image is in the picture */
+        if (differ)
+            fprintf(stderr, "  %zu of %zu pixels differ between the hiders\n", differ, n);
+    }
+    rayes_image_free(a);
+    rayes_image_free(b);
+}
+
 TEST_MAIN(TEST(test_agrees_with_raytrace), TEST(test_highlights_not_smeared), TEST(test_irradiance_interpolation),
-          TEST(test_any_thread_count),
+          TEST(test_any_thread_count), TEST(test_sharp_reflections_per_sample),
           TEST(test_shading_follows_vertices))
