@@ -9,7 +9,8 @@ Cycles"). Run through bench/peers, which builds rayes first.
                 [--preview 4,16,64,256] [--final 4,16] [--ref-spp 1024]
                 [--one-ray 64,256]
                 [--adaptive 0.1,0.05,0.02,0.01] [--adaptive-spp 16]
-                [--adaptive-max 1024] [--reuse 0|1] [--out bench-out/peers]
+                [--adaptive-max 1024] [--grid 0.4,0.3,0.2,0.1] [--grid-rays 8,24,4]
+                [--reuse 0|1] [--out bench-out/peers]
 
 Cycles renders the scene of ../shared/data/cornell-teapots.md built by
 bench/peers_cycles.py with matched light transport: the same diffuse
@@ -22,7 +23,12 @@ adaptive pixel sampling (--adaptive-spp samples everywhere, up to
 standard error is the error asked times the lesser of its mean and the
 frame's, its variance at least its 3 x 3 neighbourhood's first block's,
 its positions one Owen-scrambled Sobol sequence; DESIGN.md "Adaptive pixel
-sampling"). Non-adaptive rows are unchanged by that rule (the same bytes),
+sampling"), and the grid hider (REYES: every grid shaded once at its
+vertices, with --grid-rays shadow and diffuse rays a vertex and diffuse
+rays a deeper hit (the preview's 4); sharp mirrors
+and highlights shaded per sample; DESIGN.md "The grid hider") with the
+same adaptive sampling at each --grid error. Non-adaptive rows are
+unchanged by that rule (the same bytes),
 so --reuse 1 keeps them. rayes's reference is the
 preview's uncached estimator at --ref-spp pixel samples (4 diffuse and 4
 shadow rays a hit: 4 x ref-spp paths a pixel, nothing cached); Cycles's is
@@ -53,7 +59,8 @@ def parse(argv):
            "data": os.environ.get("RAYES_DATA", os.path.join(ROOT, "..", "shared", "data")),
            "cycles": "16,64,256,1024", "cycles-ref": "4096", "preview": "4,16,64,256",
            "final": "4,16", "ref-spp": "1024", "one-ray": "64,256", "adaptive": "0.1,0.05,0.02,0.01",
-           "adaptive-spp": "16", "adaptive-max": "1024", "reuse": "0",
+           "adaptive-spp": "16", "adaptive-max": "1024", "grid": "0.4,0.3,0.2,0.1",
+           "grid-rays": "8,24,4", "reuse": "0",
            "out": os.path.join(ROOT, "bench-out", "peers")}
     for i in range(0, len(argv), 2):
         key = argv[i].lstrip("-")
@@ -159,6 +166,14 @@ def main():
                           ["--quality", "preview", "--max-spp", opt["adaptive-max"],
                            "--adaptive-error", "%g" % e], name="e%g" % e)
         rows.append(("adaptive", "e%g" % e, cpu, read(path)))
+    shadow, diffuse, deep = counts(opt["grid-rays"])
+    for e in [float(x) for x in opt["grid"].split(",") if x]:
+        path, cpu = rayes(opt, "grid", int(opt["adaptive-spp"]),
+                          ["--quality", "preview", "--hider", "grid", "--shadow-rays", str(shadow),
+                           "--diffuse-rays", str(diffuse), "--diffuse-rays-deep", str(deep),
+                           "--max-spp", opt["adaptive-max"],
+                           "--adaptive-error", "%g" % e], name="s%dd%de%g" % (shadow, diffuse, e))
+        rows.append(("grid", "e%g" % e, cpu, read(path)))
 
     print()
     print("cornell-teapots %sx%s, %s diffuse bounce(s), %s threads; relative RMSE against each "
@@ -186,7 +201,7 @@ def main():
     print("CPU seconds to reach a relative RMSE (own reference; '~' extrapolated, '<' at the "
           "first point already)")
     print("%-8s %10s %10s %10s" % ("mode", "5%", "2%", "1%"))
-    for tag in ("cycles", "preview", "final", "one-ray", "adaptive"):
+    for tag in ("cycles", "preview", "final", "one-ray", "adaptive", "grid"):
         pts = [(r["cpu_s"], r["rmse_own"]) for r in record["rows"] if r["mode"] == tag]
         cells, rec = [], {}
         for target in (0.05, 0.02, 0.01):
@@ -197,7 +212,7 @@ def main():
         print("%-8s %10s %10s %10s" % (tag, *cells))
     for target in ("0.05", "0.02", "0.01"):
         best = min(record["time_to"][t][target]["cpu_s"]
-                   for t in ("preview", "final", "one-ray", "adaptive"))
+                   for t in ("preview", "final", "one-ray", "adaptive", "grid"))
         ratio = record["time_to"]["cycles"][target]["cpu_s"] / best
         print("at %s%%: Cycles / rayes's better preset = %.2f" % (float(target) * 100, ratio))
         record["time_to"]["ratio_" + target] = ratio
