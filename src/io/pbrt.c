@@ -368,9 +368,11 @@ static int d_objectinstance(Parser *P, const Token *t)
                     "\"%.60s\"", name);
 }
 
-static int parse_buffer(Parser *P, const char *name, const char *dir, const char *data,
-                        size_t size);
-
+/* Include and Import: the file's tokens come next, then the rest of this
+ * file's (pbrt-v4 reads one stream of tokens, so a directive that ends an
+ * included file may take parameters that follow the Include: pbrt-v4's
+ * smoke-plume scene names a medium's type in one and its coefficients
+ * after). The lexer returns to this file at the included one's end. */
 static int d_include(Parser *P, const Token *t)
 {
     char file[PBRT_PATH], path[PBRT_PATH];
@@ -384,14 +386,32 @@ static int d_include(Parser *P, const Token *t)
         return FAIL_TOK(P, &w, "more than %d included files", PBRT_MAX_FILES);
     size_t n;
     char err[600];
-    char *text = text_read_file(path, &n, err, sizeof err);
-    if (!text)
+    Lexer *lx = calloc(1, sizeof *lx);
+    if (!lx)
+        return FAIL_TOK(P, &w, "out of memory");
+    lx->text = text_read_file(path, &n, err, sizeof err);
+    if (!lx->text) {
+        free(lx);
         return FAIL_TOK(P, &w, "%s: %s", t->s[1] == 'm' ? "Import" : "Include", err);
+    }
+    lx->next = P->included;
+    P->included = lx;
+    size_t len = strlen(path) + 1;
+    char *name = malloc(len);
+    if (!name)
+        return FAIL_TOK(P, &w, "out of memory");
+    memcpy(name, path, len);
+    lx->name = name;
+    lx->p = lx->line_start = lx->text;
+    lx->end = lx->text + n;
+    lx->line = 1;
     /* pbrt-v4 resolves every relative path, in included files too, against
      * the directory of the file it was given (its search directory). */
-    int r = parse_buffer(P, path, P->lx->dir, text, n);
-    free(text);
-    return r;
+    snprintf(lx->dir, sizeof lx->dir, "%s", P->lx->dir);
+    lx->parent = P->lx;
+    P->lx = lx;
+    P->depth++;
+    return 0;
 }
 
 static const struct {
@@ -485,6 +505,13 @@ static int parse_buffer(Parser *P, const char *name, const char *dir, const char
 
 static void parser_free(Parser *P)
 {
+    while (P->included) {
+        Lexer *lx = P->included;
+        P->included = lx->next;
+        free((char *)lx->name);
+        free(lx->text);
+        free(lx);
+    }
     for (size_t i = 0; i < P->n_objects; i++) {
         for (size_t k = 0; k < P->objects[i].n_ops; k++) {
             Op *op = &P->objects[i].ops[k];
@@ -534,6 +561,7 @@ RayesError io_pbrt_parse(const char *name, const unsigned char *data, size_t siz
     pbrt_mat_identity(P->camera_from_world_end);
     P->transform_times[0] = 0, P->transform_times[1] = 1;
     P->shutter[0] = 0, P->shutter[1] = 1;
+    P->iso = 100;
     P->gs.active = 3;
     P->fov = 90;
     pbrt_mat_init(&P->gs.material, "diffuse"); /* pbrt's default material: diffuse 0.5 */
@@ -552,6 +580,10 @@ RayesError io_pbrt_parse(const char *name, const unsigned char *data, size_t siz
         snprintf(err, err_size, "%s: expected WorldBegin, found the end of the file", name);
         r = -1;
     }
+    /* pbrt-v4's imaging ratio: the exposure time times iso / 100 (1 by
+     * default: shutter 0 to 1, iso 100) scales every pixel */
+    if (!r && settings)
+        settings->exposure_gain *= (P->shutter[1] - P->shutter[0]) * P->iso / 100.0f;
     parser_free(P);
     free(P);
     return r ? RAYES_ERROR_PARSE : RAYES_OK;

@@ -64,6 +64,10 @@ typedef struct Lexer {
     long line;
     const char *line_start;
     char dir[PBRT_PATH]; /* relative paths resolve here ("" = the working directory) */
+    struct Lexer *parent; /* an included file's: the file that included it, whose tokens
+                             follow its own (pbrt-v4 reads one stream of tokens), or NULL */
+    char *text;           /* an included file's text, owned (freed with the parser) */
+    struct Lexer *next;   /* the parser's list of included files' lexers */
 } Lexer;
 
 typedef enum ParamType {
@@ -197,6 +201,7 @@ typedef struct Parser {
     char *err;
     size_t err_size;
     Lexer *lx;
+    Lexer *included; /* every included file's lexer and text, kept to the parse's end */
     Token peeked;
     int has_peek;
     int depth, n_files;
@@ -227,6 +232,7 @@ typedef struct Parser {
     double camera_from_world_end[16]; /* at the end time: the camera moves if it differs */
     double transform_times[2];        /* TransformTimes (default 0 1) */
     float shutter[2];                 /* the camera's shutteropen, shutterclose */
+    float iso;                        /* the film's iso (100: pbrt's default) */
     float lens_radius, focal_distance; /* the camera's lensradius, focaldistance */
     RayesProjection projection;
     float fov;

@@ -102,6 +102,13 @@ static int lex(Parser *P, Token *t)
     t->s = l->p;
     t->n = 0;
     if (l->p >= l->end) {
+        if (l->parent) {
+            /* an included file ends: the tokens go on in the file that
+             * included it, the last directive's parameters too */
+            P->lx = l->parent;
+            P->depth--;
+            return lex(P, t);
+        }
         t->kind = TOK_END;
         return 0;
     }

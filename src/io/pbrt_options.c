@@ -67,10 +67,11 @@ int pbrt_d_camera(Parser *P, const Token *t)
     double close = pbrt_get_float(&pl, "shutterclose", 1.0);
     double lens = pbrt_get_float(&pl, "lensradius", 0.0);
     double focus = pbrt_get_float(&pl, "focaldistance", 1e6);
-    if (!isfinite(open) || !isfinite(close) || close < open) {
+    if (!isfinite(open) || !isfinite(close) || close <= open) {
+        /* pbrt-v4 refuses it too: the image is scaled by the exposure time */
         pbrt_params_free(&pl);
-        return FAIL_TOK(P, t, "Camera: expected shutteropen <= shutterclose, found %g %g", open,
-                        close);
+        return FAIL_TOK(P, t, "Camera: expected shutteropen < shutterclose (the shutter must "
+                        "open), found %g %g", open, close);
     }
     if (!(lens >= 0) || !isfinite(lens) || !(focus > 0) || !isfinite(focus)) {
         pbrt_params_free(&pl);
@@ -117,6 +118,15 @@ int pbrt_d_film(Parser *P, const Token *t)
     if (crop && crop->n_num == 4)
         for (int i = 0; i < 4; i++)
             s->crop[i] = (float)fmin(1.0, fmax(0.0, crop->num[i]));
+    /* pbrt-v4's imaging ratio, the exposure time (the camera's shutter)
+     * times iso / 100, scales the image (pbrt_exposure); a sensor's
+     * spectral response and white balance are not modelled (warned) */
+    double iso = pbrt_get_float(&pl, "iso", 100.0);
+    if (!(iso > 0) || !isfinite(iso)) {
+        pbrt_params_free(&pl);
+        return FAIL_TOK(P, t, "Film: expected iso > 0, found %g", iso);
+    }
+    P->iso = (float)iso;
     if (strcmp(type, "rgb") != 0)
         pbrt_warn_at(P, t->line, t->col, "film type", "Film \"%.40s\": written as an rgb film",
                      type);

@@ -714,6 +714,22 @@ static void test_instances_include_ply(void)
     e = parse(path, "WorldBegin\nInclude \"test_pbrt_bad.pbrt\"\n", r, &s, err, sizeof err);
     CHECK(e == RAYES_ERROR_PARSE && strstr(err, "test_pbrt_bad.pbrt:2:35: expected a float "
                                                 "value for \"radius\"") != NULL);
+    /* pbrt-v4 reads one stream of tokens: a directive that ends an
+     * included file takes the parameters that follow the Include, and an
+     * error after it names the including file again */
+    snprintf(path, sizeof path, "%s/test_pbrt_tail.pbrt", RAYES_TEST_TMP);
+    write_file(path, "Shape \"sphere\"");
+    snprintf(path, sizeof path, "%s/test_pbrt_main.pbrt", RAYES_TEST_TMP);
+    e = parse(path, "WorldBegin\nInclude \"test_pbrt_tail.pbrt\"\n  \"float radius\" 3\n"
+                    "Shape \"sphere\"\n", r, &s, err, sizeof err);
+    CHECK(e == RAYES_OK && r->n_quadrics == 2);
+    if (e == RAYES_OK && r->n_quadrics == 2) {
+        CHECK_NEAR(r->quadric[0].p[0], 3, 0);
+        CHECK_NEAR(r->quadric[1].p[0], 1, 0);
+    }
+    e = parse(path, "WorldBegin\nInclude \"test_pbrt_tail.pbrt\"\n  \"float radius\" [ \"x\" ]\n",
+              r, &s, err, sizeof err);
+    CHECK(e == RAYES_ERROR_PARSE && strstr(err, "test_pbrt_main.pbrt:3:") != NULL);
     /* relative paths, inside included files too, are relative to the
      * directory of the file given (pbrt-v4's search directory), not to the
      * including file's */
@@ -1316,7 +1332,30 @@ static void test_subsurface_material(void)
     free(r);
 }
 
-TEST_MAIN(TEST(test_filters), TEST(test_subsurface_material), TEST(test_filter_warnings), TEST(test_import), TEST(test_film_types),
+/* pbrt-v4's imaging ratio: the exposure time times iso / 100 scales the
+ * image (1 by default); a shutter that never opens is an error, as in
+ * pbrt-v4. */
+static void test_exposure(void)
+{
+    Rec *r = malloc(sizeof *r);
+    IoSettings s;
+    char err[512] = "";
+    CHECK(parse("t.pbrt", "Camera \"perspective\"\nWorldBegin\n", r, &s, err, sizeof err) ==
+          RAYES_OK);
+    CHECK_NEAR(s.exposure_gain, 1, 0);
+    CHECK(parse("t.pbrt",
+                "Film \"rgb\" \"float iso\" 400\nCamera \"perspective\" \"float shutteropen\" 0.25 "
+                "\"float shutterclose\" 0.75\nWorldBegin\n",
+                r, &s, err, sizeof err) == RAYES_OK);
+    CHECK_NEAR(s.exposure_gain, 2, 1e-6);
+    free(r);
+    expect_error("Camera \"perspective\" \"float shutteropen\" 0.5 \"float shutterclose\" 0.5\n"
+                 "WorldBegin\n",
+                 "t.pbrt:1:1: Camera: expected shutteropen < shutterclose");
+    expect_error("Film \"rgb\" \"float iso\" 0\nWorldBegin\n", "t.pbrt:1:1: Film: expected iso > 0");
+}
+
+TEST_MAIN(TEST(test_filters), TEST(test_exposure), TEST(test_subsurface_material), TEST(test_filter_warnings), TEST(test_import), TEST(test_film_types),
           TEST(test_measured_material), TEST(test_anisotropic_roughness), TEST(test_maxdepth),
           TEST(test_spectrum_files), TEST(test_cornell_box), TEST(test_transforms),
           TEST(test_materials), TEST(test_lights), TEST(test_instances_include_ply),
