@@ -536,6 +536,22 @@ static void svc_ambient(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
     ps->w->stats.ambient_lookups += ctx->n_points;
 }
 
+/* A reflected direction d that leaves above the smooth surface (N) but
+ * below the micropolygon's own plane (Ng), as grazing reflections off a
+ * coarsely diced curve do, bent to leave just above that plane: traced as
+ * it is, it would start inside the object and bounce about in it until
+ * the specular depth ran out, black (a chrome ball in a white furnace lost
+ * 6% at normal view, more at its rim). Directions below N are the lobe's
+ * own horizon and stay as they are. */
+#define SPECULAR_ABOVE 1e-3f
+static Vec3 above_facet(Vec3 d, Vec3 N, Vec3 Ng)
+{
+    float dn = v3_dot(d, Ng);
+    if (dn >= SPECULAR_ABOVE || v3_dot(d, N) <= 0.0f)
+        return d;
+    return v3_normalize(v3_madd(d, Ng, SPECULAR_ABOVE - dn));
+}
+
 /* Radiance along d from point i of ctx, a specular or refracted ray. */
 static Vec3 trace_specular(const RayesShadeCtx *ctx, size_t i, Vec3 d, uint64_t key,
                            uint32_t kind)
@@ -569,9 +585,11 @@ static void svc_indirect_specular(const RayesShaderServices *sv, const RayesShad
         }
         uint64_t key = hash_combine(ps->keys[point(ctx, i)], DIM_SPECULAR);
         Vec3 d = v3_normalize(v3_load(dir[i]));
+        Vec3 N = v3_load(ctx->N[i]);
         float r = roughness ? roughness[i] : 0.0f;
         if (r <= 0.0f) {
             w->sharp_rays += ctx->diffuse_depth == 0 && ctx->specular_depth == 0;
+            d = above_facet(d, N, v3_load(ctx->Ng[i]));
             v3_store(out[i], trace_specular(ctx, i, d, key, RAYES_RAY_SPECULAR));
             continue;
         }
@@ -594,6 +612,7 @@ static void svc_indirect_specular(const RayesShaderServices *sv, const RayesShad
             float phi = 2.0f * (float)M_PI * a2;
             Vec3 wi = v3_add(v3_add(v3_scale(t, sin_t * cosf(phi)), v3_scale(b, sin_t * sinf(phi))),
                              v3_scale(d, cos_t));
+            wi = above_facet(wi, N, Ng);
             if (v3_dot(wi, Ng) <= 0.0f)
                 continue;
             sum = v3_add(sum, trace_specular(ctx, i, wi, hash_combine(key, (uint64_t)s + 1),
