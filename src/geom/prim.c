@@ -72,7 +72,11 @@ void geom_quadric_eval(const Prim *prim, float u, float v, Vec3 *P, Vec3 *dPdu, 
     double rho = 0, drho = 0, z = 0, dz = 0, T;
     switch (prim->quadric.kind) {
     case Q_SPHERE: { /* radius, phimin, phimax (latitudes from zmin, zmax), thetamax */
-        double phi = q[1] + v * (q[2] - q[1]), d = q[2] - q[1];
+        /* within the poles: -pi/2 as a float lies just beyond -pi/2, where
+         * rho = r cos(phi) < 0 turned the pole's normal inward (and the
+         * normals interpolated around it sideways: a mirror ball seen along
+         * its axis reflected the wrong way at its centre) */
+        double phi = fmax(-M_PI / 2, fmin(M_PI / 2, q[1] + v * (q[2] - q[1]))), d = q[2] - q[1];
         rho = q[0] * cos(phi), z = q[0] * sin(phi);
         drho = -q[0] * sin(phi) * d, dz = q[0] * cos(phi) * d;
         T = q[3];

@@ -435,14 +435,18 @@ static void test_constant_environment_white_furnace(void)
  * micropolygon's plane would turn back into the ball is bent out above that
  * plane (services.c, above_facet), not lost inside the ball (before: 0.47
  * instead of 0.5 on some pixels, 1 sample in 16 black). */
-static void test_chrome_ball_white_furnace(void)
+static void chrome_ball_white_furnace(int quadric)
 {
     RayesScene *s = rayes_scene_new();
-    float eye[3] = {-6, 0, 0}, target[3] = {0, 0, 0}, up[3] = {0, 0, 1};
+    /* the sphere from its side; RenderMan's and pbrt's along its axis */
+    float eye[3] = {quadric ? 0.0f : -6.0f, 0, quadric ? -6.0f : 0.0f}, target[3] = {0, 0, 0},
+          up[3] = {0, quadric ? 1.0f : 0.0f, quadric ? 0.0f : 1.0f};
     CHECK(rayes_scene_set_camera(s, eye, target, up, 30.0f) == RAYES_OK);
     RayesParam chrome[2] = {pf("Kr", 1), {"specularcolor", RAYES_PARAM_COLOR, {1, 1, 1}, NULL}};
     CHECK(rayes_scene_set_shader(s, "mirror", chrome, 2) == RAYES_OK);
-    CHECK(rayes_scene_sphere(s, 1.0f) == RAYES_OK);
+    const float q[4] = {1, -1, 1, 360};
+    CHECK((quadric ? rayes_scene_quadric(s, RAYES_QUADRIC_SPHERE, q, 4, 0)
+                   : rayes_scene_sphere(s, 1.0f)) == RAYES_OK);
     RayesParam e[1] = {pf("intensity", 0.5f)};
     CHECK(rayes_scene_light(s, "environmentlight", e, 1) == RAYES_OK);
     CHECK(rayes_scene_commit(s) == RAYES_OK);
@@ -465,6 +469,17 @@ static void test_chrome_ball_white_furnace(void)
         fprintf(stderr, "  %d of %d pixels of the ball lost light\n", dark, hits);
     rayes_image_free(img);
     rayes_scene_release(s);
+}
+
+/* ... and a quadric sphere seen along its axis: its pole faces the camera,
+ * where a latitude of -pi/2 rounded to a float once turned the normal
+ * inward and its neighbours' sideways (geom/prim.c): the middle of the
+ * ball reflected the wrong way (and a small light behind the camera was
+ * never seen in it). */
+static void test_chrome_ball_white_furnace(void)
+{
+    chrome_ball_white_furnace(0);
+    chrome_ball_white_furnace(1);
 }
 
 /* A scene of one environment light of the map at path, intensity 1, set
