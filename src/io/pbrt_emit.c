@@ -105,7 +105,7 @@ int pbrt_emit_volume(Parser *P, const Token *t, const double m[16], const RayesP
 }
 
 /* Grows the Shape's bounds by n points (object space). */
-static void grow_bound(Parser *P, const float *pts, size_t n)
+void pbrt_grow_bound(Parser *P, const float *pts, size_t n)
 {
     float *b = P->shape_bound;
     for (size_t i = 0; i < n; i++)
@@ -121,13 +121,13 @@ static void grow_bound(Parser *P, const float *pts, size_t n)
 }
 
 /* The corners of a quadric's bounds (pbrt's sphere, cylinder, disk). */
-static void grow_quadric(Parser *P, RayesQuadric q, const float *qp)
+void pbrt_grow_quadric(Parser *P, RayesQuadric q, const float *qp)
 {
     float r = q == RAYES_QUADRIC_DISK ? qp[1] : qp[0];
     float z0 = q == RAYES_QUADRIC_DISK ? qp[0] : qp[1],
           z1 = q == RAYES_QUADRIC_DISK ? qp[0] : qp[2];
     const float c[6] = {-r, -r, z0, r, r, z1};
-    grow_bound(P, c, 2);
+    pbrt_grow_bound(P, c, 2);
 }
 
 static int send_state(Parser *P, const Token *t, const double m[16], const Material *mat)
@@ -228,7 +228,7 @@ static RayesError send_mesh(Parser *P, size_t n_faces, const int *n_verts, const
 static int emit_mesh(Parser *P, const Token *t, size_t n_faces, const int *n_verts, const int *idx,
                      size_t n_points, const float *pts, const float *N, const float *uv, int subdiv)
 {
-    grow_bound(P, pts, n_points);
+    pbrt_grow_bound(P, pts, n_points);
     if (n_faces == 0 || strcmp(P->gs.material.shader, PBRT_INVISIBLE) == 0)
         return 0;
     if (P->recording) {
@@ -293,7 +293,7 @@ int pbrt_emit_quadric(Parser *P, const Token *t, RayesQuadric q, const float *qp
                       unsigned flags)
 {
     if (q == RAYES_QUADRIC_SPHERE || q == RAYES_QUADRIC_CYLINDER || q == RAYES_QUADRIC_DISK)
-        grow_quadric(P, q, qp);
+        pbrt_grow_quadric(P, q, qp);
     if (strcmp(P->gs.material.shader, PBRT_INVISIBLE) == 0)
         return 0;
     if (P->recording) {
@@ -324,7 +324,7 @@ static RayesError send_patch(Parser *P, const Op *op)
 
 int pbrt_emit_patch(Parser *P, const Token *t, const Op *patch)
 {
-    grow_bound(P, &patch->patch[0][0], 4);
+    pbrt_grow_bound(P, &patch->patch[0][0], 4);
     if (strcmp(P->gs.material.shader, PBRT_INVISIBLE) == 0)
         return 0;
     if (P->recording) {

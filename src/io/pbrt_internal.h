@@ -347,6 +347,10 @@ int pbrt_emit_subdiv(Parser *P, const Token *t, size_t n_faces, const int *n_ver
  * inside ObjectBegin skipped with one warning. */
 int pbrt_emit_curves(Parser *P, const Token *t, const RayesCurves *c, const RayesPrimvar *pv,
                      size_t n_pv);
+/* Grow the current Shape's bounds (object space; the world bound that a
+ * camera's medium fills, pbrt_medium.c): by n points, by a quadric. */
+void pbrt_grow_bound(Parser *P, const float *pts, size_t n);
+void pbrt_grow_quadric(Parser *P, RayesQuadric q, const float *qp);
 int pbrt_emit_quadric(Parser *P, const Token *t, RayesQuadric q, const float *qp, size_t n,
                       unsigned flags);
 /* The bilinear patch of patch (its patch, patch_pv, patch_N, patch_uv). */

@@ -42,6 +42,8 @@ static int emit_area_quad(Parser *P, const Token *t, const float *pts, const flo
                           const int q[4])
 {
     double g[3], d[3];
+    for (int k = 0; k < 4; k++) /* emitters count in the world's bound too */
+        pbrt_grow_bound(P, &pts[3 * q[k]], 1);
     quad_normal(pts, q, g);
     memcpy(d, g, sizeof d);
     if (N) {
@@ -429,6 +431,7 @@ static int shape_quadric(Parser *P, const Token *t, const char *type, ParamList 
                                       : "rayes' area lights are quads, disks and spheres");
         return pbrt_emit_quadric(P, t, q, qp, n, flags);
     }
+    pbrt_grow_quadric(P, q, qp); /* emitters count in the world's bound too */
     if (q == RAYES_QUADRIC_SPHERE) {
         if (P->gs.reverse)
             pbrt_warn_at(P, t->line, t->col, "inward sphere light", "sphere: an inward-emitting "

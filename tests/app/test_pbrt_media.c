@@ -185,6 +185,40 @@ static void test_camera_medium(void)
     }
     free(open);
     free(fog);
+    /* emitters are shapes too: the camera's medium spans a scene of one
+     * emitting floor (before, only the eye: no fog at all) */
+    const char *emit_scene =
+        "LookAt 0 0 6  0 0 0  0 1 0\nCamera \"perspective\" \"float fov\" 10\n"
+        "Film \"rgb\" \"integer xresolution\" %d \"integer yresolution\" %d\n"
+        "WorldBegin\nAreaLightSource \"diffuse\" \"rgb L\" [1 1 1]\n"
+        "Shape \"bilinearmesh\" \"point3 P\" [-4 -4 0 4 -4 0 -4 4 0 4 4 0]\n"
+        "  \"integer indices\" [0 1 2 3]\n";
+    for (int fogged = 0; fogged < 2; fogged++) {
+        char body[2048];
+        snprintf(body, sizeof body, emit_scene, RES, RES);
+        snprintf(text, sizeof text, "%s%s",
+                 fogged ? "MakeNamedMedium \"fog\" \"string type\" \"homogeneous\" \"rgb sigma_a\" "
+                          "[0.05 0.05 0.05] \"rgb sigma_s\" [0 0 0]\nMediumInterface \"\" \"fog\"\n"
+                        : "",
+                 body);
+        f = fopen(fogged ? TMP "/cam-emit-fog.pbrt" : TMP "/cam-emit.pbrt", "w");
+        if (f) {
+            fputs(text, f);
+            fclose(f);
+        }
+    }
+    float *lit = render("cam-emit.pbrt", err_text, sizeof err_text);
+    float *lit_fog = render("cam-emit-fog.pbrt", err_text, sizeof err_text);
+    CHECK(lit != NULL && lit_fog != NULL);
+    if (lit && lit_fog) {
+        double pad = 1e-3 * sqrt(8.0 * 8.0 * 2.0 + 6.0 * 6.0);
+        double want = exp(-0.05 * (6.0 + pad)), got = centre(lit_fog) / centre(lit);
+        CHECK(fabs(got - want) < 0.01 * want);
+        if (fabs(got - want) >= 0.01 * want)
+            fprintf(stderr, "emitter in fog: %g of the open one, expected %g\n", got, want);
+    }
+    free(lit);
+    free(lit_fog);
     /* a camera medium never defined: an error naming the Camera's line */
     snprintf(text, sizeof text,
              "MediumInterface \"\" \"nope\"\nLookAt 0 0 6  0 0 0  0 1 0\n"
