@@ -514,6 +514,8 @@ static int render_job(Args a, int frame, int number, Distributed *d)
         checkpoint_fill(ck, img);
     }
     apply_exposure(img, settings.exposure_gain, settings.exposure_gamma);
+    for (size_t i = 0; settings.opaque && i < (size_t)img->width * (size_t)img->height; i++)
+        img->rgba[4 * i + 3] = 1.0f; /* a pbrt film: no alpha, the environment opaque */
     int written = 0; /* outputs written whole */
     while (written < a.n_outputs && status == 0) {
         if (write_output(&a.outputs[written], img, err, sizeof err) == RAYES_OK) {

@@ -582,8 +582,10 @@ RayesError io_pbrt_parse(const char *name, const unsigned char *data, size_t siz
     }
     /* pbrt-v4's imaging ratio: the exposure time times iso / 100 (1 by
      * default: shutter 0 to 1, iso 100) scales every pixel */
-    if (!r && settings)
+    if (!r && settings) {
         settings->exposure_gain *= (P->shutter[1] - P->shutter[0]) * P->iso / 100.0f;
+        settings->opaque = 1; /* pbrt's films write no alpha */
+    }
     parser_free(P);
     free(P);
     return r ? RAYES_ERROR_PARSE : RAYES_OK;

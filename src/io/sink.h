@@ -145,6 +145,8 @@ typedef struct IoSettings {
     float crop[4];            /* xmin xmax ymin ymax in [0, 1] (RIB CropWindow); default 0 1 0 1 */
     float exposure_gain;      /* RIB Exposure; 1 when not given */
     float exposure_gamma;     /* RIB Exposure; 1 when not given */
+    int opaque;               /* 1: the format's films have no alpha (pbrt): images are
+                                 written with alpha 1, the environment seen as pbrt shows it */
     IoDisplay displays[IO_MAX_DISPLAYS];
     int n_displays;
 } IoSettings;

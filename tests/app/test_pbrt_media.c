@@ -219,6 +219,26 @@ static void test_camera_medium(void)
     }
     free(lit);
     free(lit_fog);
+    /* pbrt's films have no alpha: the environment is written opaque, as
+     * pbrt shows it (before, alpha 0 there: viewers showed a checkerboard) */
+    snprintf(text, sizeof text,
+             "LookAt 0 0 6  0 0 0  0 1 0\nCamera \"perspective\" \"float fov\" 10\n"
+             "Film \"rgb\" \"integer xresolution\" %d \"integer yresolution\" %d\n"
+             "WorldBegin\nLightSource \"infinite\" \"rgb L\" [0.5 0.5 0.5]\n"
+             "Shape \"sphere\" \"float radius\" 0.1\n",
+             RES, RES);
+    f = fopen(TMP "/env-alpha.pbrt", "w");
+    if (f) {
+        fputs(text, f);
+        fclose(f);
+    }
+    float *env = render("env-alpha.pbrt", err_text, sizeof err_text);
+    CHECK(env != NULL);
+    if (env) {
+        CHECK(env[3] == 1.0f && fabsf(env[0] - 0.5f) < 1e-3f); /* a corner: the environment */
+        CHECK(env[4 * (RES / 2 * RES + RES / 2) + 3] == 1.0f);  /* the sphere */
+    }
+    free(env);
     /* a camera medium never defined: an error naming the Camera's line */
     snprintf(text, sizeof text,
              "MediumInterface \"\" \"nope\"\nLookAt 0 0 6  0 0 0  0 1 0\n"
