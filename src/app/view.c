@@ -805,6 +805,12 @@ int cmd_view(int argc, char **argv)
         return load_status(a.scene, e);
     }
     merge_settings(&a, &settings);
+    /* the scene's own exposure (RIB Exposure, pbrt's iso and shutter), as
+     * rayes render applies it, under the viewer's */
+    if (settings.exposure_gain > 0.0f && settings.exposure_gain != 1.0f)
+        v.exposure += log2f(settings.exposure_gain);
+    if (settings.exposure_gamma > 0.0f)
+        v.gamma *= settings.exposure_gamma;
     v.width = a.opt.width;
     v.height = a.opt.height;
     a.opt.tile_done = on_tile;

@@ -94,6 +94,36 @@ static void test_edits_after_passes_equal_edits_before(void)
     CHECK(!same_exr("late.exr", "none.exr"));
 }
 
+/* The scene's exposure applies in the viewer as in rayes render: a pbrt
+ * film at iso 400 shows (and writes) 4 times the light of one at 100. */
+static void test_scene_exposure(void)
+{
+    for (int k = 0; k < 2; k++) {
+        char text[600], name[32];
+        snprintf(text, sizeof text,
+                 "LookAt 0 0 5  0 0 0  0 1 0\nCamera \"perspective\" \"float fov\" 20\n"
+                 "Film \"rgb\" \"float iso\" %d\nWorldBegin\n"
+                 "LightSource \"distant\" \"point3 from\" [0 0 1] \"point3 to\" [0 0 0] "
+                 "\"rgb L\" [0.2 0.2 0.2]\nShape \"sphere\" \"float radius\" 1\n",
+                 k ? 400 : 100);
+        snprintf(name, sizeof name, "iso%d.pbrt", k ? 400 : 100);
+        write_text(name, text);
+        snprintf(text, sizeof text, "1 write iso%d.exr\n", k ? 400 : 100);
+        write_text(k ? "iso400.txt" : "iso100.txt", text);
+        snprintf(text, sizeof text, "%s --headless --quiet --res 16x16 --spp 1 --threads 1 --script %s",
+                 name, k ? "iso400.txt" : "iso100.txt");
+        CHECK(view("", text) == 0);
+    }
+    int w, h, w2, h2;
+    float *a = read_exr("iso100.exr", &w, &h), *b = read_exr("iso400.exr", &w2, &h2);
+    if (a && b) {
+        size_t c = 4 * (size_t)(h / 2 * w + w / 2);
+        CHECK(a[c] > 0.01f && fabsf(b[c] / a[c] - 4.0f) < 0.01f);
+    }
+    free(a);
+    free(b);
+}
+
 static void test_camera_move_reuses_cache_to_the_same_bytes(void)
 {
     write_text("cam_late.txt", "3 camera orbit 12 4\n3 camera dolly 0.2\n7 write cam_late.exr\n");
@@ -178,7 +208,7 @@ int main(void)
 {
     mkdir(DIR, 0755);
     static const TestCase tests[] = {
-        TEST(test_edits_after_passes_equal_edits_before),
+        TEST(test_edits_after_passes_equal_edits_before), TEST(test_scene_exposure),
         TEST(test_camera_move_reuses_cache_to_the_same_bytes), TEST(test_script_errors),
         TEST(test_window_shows_the_image)};
     return test_run(tests, sizeof tests / sizeof tests[0]);
