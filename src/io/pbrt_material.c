@@ -589,10 +589,17 @@ static int conductor_material(Parser *P, const Token *t, const char *type, Param
 {
     static const float cu_eta[3] = {0.200f, 0.924f, 1.102f}, cu_k[3] = {3.912f, 2.452f, 2.142f};
     int coated = strcmp(type, "coatedconductor") == 0;
-    if (coated)
-        pbrt_warn_at(P, t->line, t->col, "coatedconductor",
-                     "coatedconductor: mapped to conductor (the coating is left out)");
     pbrt_mat_init(m, "conductor");
+    if (coated) { /* the coat in closed form (conductor's "coat"; docs/pbrt.md) */
+        RoughNames n = rough_names("interface.");
+        double r;
+        if (get_roughness(P, t, pl, &n, 0.0, &r) != 0)
+            return -1;
+        mat_float(m, "coat", 1.0f);
+        mat_float(m, "coat_roughness", (float)r);
+        mat_float(m, "coat_eta", (float)pbrt_get_float(pl, "interface.eta", 1.5));
+        (void)pbrt_find(pl, "thickness"); /* a clear layer's (albedo 0): a per cent or so */
+    }
     const char *eta_name = coated ? "conductor.eta" : "eta", *k_name = coated ? "conductor.k" : "k";
     int r = pbrt_find(pl, "reflectance")
                 ? mat_textured(P, pl, m, "reflectance", "reflectance", RAYES_PARAM_COLOR, cu_eta)

@@ -551,6 +551,7 @@ const RayesShaderClass shade_class_diffuse = {
 typedef struct ConductorParams {
     float eta[3], k[3], reflectance[3], roughness;
     char preset[64];
+    float coat, coat_roughness, coat_eta; /* a dielectric coat (pbrt's coatedconductor) */
 } ConductorParams;
 
 /* The complex index of the points: the preset if named (an unknown name:
@@ -598,10 +599,30 @@ static void conductor_chunk(const RayesShaderServices *sv, const RayesShadeCtx *
     conductor_index(sv, ctx, p, eta, k);
     exponents(sv, ctx, p->roughness, e);
     glossy_reflection(sv, ctx, e, L);
+    /* Under a coat (pbrt's coatedconductor, whose layers pbrt walks
+     * stochastically; here in closed form): the coat reflects its
+     * dielectric Fresnel F_c through its own lobe, and the metal what
+     * crosses the coat twice and bounces between metal and coat,
+     * (1 - F_c)^2 F / (1 - F_c F) (the layer's absorption and the lobe's
+     * narrowing by refraction left out). A white metal under a clear coat
+     * reflects F_c + (1 - F_c) = 1: no energy lost or made. */
+    Rgb Lc[SHADE_CHUNK];
+    float ec[SHADE_CHUNK];
+    if (p->coat > 0.0f) {
+        for (size_t i = 0; i < ctx->n_points; i++)
+            ec[i] = exponent_of(p->coat_roughness);
+        glossy_reflection(sv, ctx, ec, Lc);
+    }
     for (size_t i = 0; i < ctx->n_points; i++) {
-        Vec3 F = fresnel_conductor_rgb(cos_view(ctx, i), v3_load(eta[i]), v3_load(k[i]));
-        for (int c = 0; c < 3; c++)
-            out->Ci[i][c] = cs(ctx, i, c) * v3_index(F, c) * L[i][c];
+        float cv = cos_view(ctx, i);
+        Vec3 F = fresnel_conductor_rgb(cv, v3_load(eta[i]), v3_load(k[i]));
+        float Fc = p->coat > 0.0f ? fminf(p->coat, 1.0f) * fresnel_dielectric(cv, p->coat_eta) : 0.0f;
+        for (int c = 0; c < 3; c++) {
+            float Fm = v3_index(F, c);
+            out->Ci[i][c] = cs(ctx, i, c) * (1.0f - Fc) * (1.0f - Fc) * Fm / (1.0f - Fc * Fm) * L[i][c];
+            if (Fc > 0.0f)
+                out->Ci[i][c] += Fc * Lc[i][c];
+        }
     }
 }
 
@@ -618,6 +639,9 @@ static const RayesShaderParamDesc conductor_params[] = {
     {"reflectance", RAYES_PARAM_COLOR, offsetof(ConductorParams, reflectance), {-1, -1, -1}},
     {"roughness", RAYES_PARAM_FLOAT, offsetof(ConductorParams, roughness), {0, 0, 0}},
     {"preset", RAYES_PARAM_STRING, offsetof(ConductorParams, preset), {0, 0, 0}},
+    {"coat", RAYES_PARAM_FLOAT, offsetof(ConductorParams, coat), {0, 0, 0}},
+    {"coat_roughness", RAYES_PARAM_FLOAT, offsetof(ConductorParams, coat_roughness), {0, 0, 0}},
+    {"coat_eta", RAYES_PARAM_FLOAT, offsetof(ConductorParams, coat_eta), {1.5f, 0, 0}},
 };
 
 const RayesShaderClass shade_class_conductor = {

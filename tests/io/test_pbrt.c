@@ -962,7 +962,7 @@ static void test_textures(void)
 }
 
 /* coatedconductor: its conductor's parameters, textures included, make the
- * conductor it maps to. */
+ * conductor it maps to, under its coat. */
 static void test_coated_conductor_textures(void)
 {
     Rec *r = malloc(sizeof *r);
@@ -981,6 +981,16 @@ static void test_coated_conductor_textures(void)
           param(sh, "roughness")->type == RAYES_PARAM_PATTERN &&
           strcmp(param(sh, "roughness")->string, "0:c") == 0);
     CHECK(param(sh, "eta") && fabs(param(sh, "eta")->value[2] - 1.442) < 1e-3);
+    /* the coat: pbrt's interface roughness (0 by default) and eta (1.5) */
+    CHECK(param(sh, "coat") && param(sh, "coat")->value[0] == 1.0f);
+    CHECK(param(sh, "coat_roughness") && param(sh, "coat_roughness")->value[0] == 0.0f);
+    CHECK(param(sh, "coat_eta") && param(sh, "coat_eta")->value[0] == 1.5f);
+    text = "WorldBegin\nMaterial \"coatedconductor\" \"float interface.roughness\" 0.1 "
+           "\"float interface.eta\" 1.6\nShape \"trianglemesh\" \"point3 P\" [0 0 0 1 0 0 0 1 0]\n";
+    CHECK(parse("t.pbrt", text, r, &s, err, sizeof err) == RAYES_OK && r->n_meshes == 1);
+    sh = &r->mesh[0].shader;
+    CHECK(param(sh, "coat_roughness") && fabsf(param(sh, "coat_roughness")->value[0] - 0.1f) < 1e-6f);
+    CHECK(param(sh, "coat_eta") && fabsf(param(sh, "coat_eta")->value[0] - 1.6f) < 1e-6f);
     free(r);
 }
 
