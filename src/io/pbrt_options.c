@@ -119,7 +119,7 @@ int pbrt_d_film(Parser *P, const Token *t)
         for (int i = 0; i < 4; i++)
             s->crop[i] = (float)fmin(1.0, fmax(0.0, crop->num[i]));
     /* pbrt-v4's imaging ratio, the exposure time (the camera's shutter)
-     * times iso / 100, scales the image (pbrt_exposure); a sensor's
+     * times iso / 100, scales the image (io_pbrt_parse); a sensor's
      * spectral response and white balance are not modelled (warned) */
     double iso = pbrt_get_float(&pl, "iso", 100.0);
     if (!(iso > 0) || !isfinite(iso)) {
