@@ -801,6 +801,10 @@ typedef struct RayesRenderOptions {
                                    0 (default): spp everywhere */
     float adaptive_error;       /* the relative standard error at which a pixel stops
                                    (default 0.02) */
+    float sample_clamp;         /* each camera sample's radiance scaled down so that no
+                                   component exceeds it (pbrt-v4's Film "maxcomponentvalue",
+                                   Cycles' clamp): fewer fireflies, for a biased, darker
+                                   image. 0 (default): off */
     int replay_rays;            /* 1: keep every ray the render traces (48 bytes each, at most
                                    2 GB; more are dropped and counted) and, once the image is
                                    made, trace them again with no shading on as many threads:

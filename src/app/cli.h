@@ -27,7 +27,8 @@ enum {
     SET_CROP = 256,
     SET_OPACITY_CACHE_MB = 512,
     SET_MAX_SPP = 1024,
-    SET_ADAPTIVE_ERROR = 2048
+    SET_ADAPTIVE_ERROR = 2048,
+    SET_CLAMP = 4096
 };
 
 /* An image to write. */

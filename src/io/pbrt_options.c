@@ -127,6 +127,15 @@ int pbrt_d_film(Parser *P, const Token *t)
         return FAIL_TOK(P, t, "Film: expected iso > 0, found %g", iso);
     }
     P->iso = (float)iso;
+    /* pbrt-v4 clamps each sample's largest component to this (infinite by
+     * default): rayes's sample clamp */
+    double mcv = pbrt_get_float(&pl, "maxcomponentvalue", INFINITY);
+    if (!(mcv > 0)) {
+        pbrt_params_free(&pl);
+        return FAIL_TOK(P, t, "Film: expected maxcomponentvalue > 0, found %g", mcv);
+    }
+    if (isfinite(mcv))
+        s->sample_clamp = (float)mcv;
     if (strcmp(type, "rgb") != 0)
         pbrt_warn_at(P, t->line, t->col, "film type", "Film \"%.40s\": written as an rgb film",
                      type);

@@ -132,6 +132,8 @@ typedef struct IoSettings {
                                  "maxsamples"); 0: not given */
     float adaptive_error;     /* its relative standard error (RIB PixelVariance); 0: not
                                  given */
+    float sample_clamp;       /* a camera sample's largest component (pbrt's Film
+                                 "maxcomponentvalue"); 0: not given */
     int filter;               /* RayesFilter, or -1: not given */
     float filter_width;       /* pixels; 0: not given */
     int bounces;              /* maximum diffuse depth; -1: not given */

@@ -238,6 +238,9 @@ static void render_samples(Frame *f, Worker *w, int px, int py, int x0, int y0, 
         w->stats.rays_camera++;
         Vec3 L = integrator_trace(w, &ray, RAYES_RAY_CAMERA, 0, 0,
                                   hash_combine(pixel_key, (uint64_t)s + 1), diff, &alpha);
+        float top = fmaxf(L.x, fmaxf(L.y, L.z));
+        if (set->sample_clamp > 0.0f && top > set->sample_clamp) /* as pbrt-v4's film does */
+            L = v3_scale(L, set->sample_clamp / top);
         double yl = 0.2126 * L.x + 0.7152 * L.y + 0.0722 * L.z;
         *lum += yl;
         *lum2 += yl * yl;

@@ -151,6 +151,7 @@ typedef struct RenderSettings {
                                 render.c's pixel_converged) */
     float adaptive_error;    /* the relative standard error of a pixel's mean luminance
                                 at which it stops */
+    float sample_clamp;      /* a camera sample's largest component, or 0: no clamp */
     /* Progressive rendering (session/progressive.c); all zero for a one-shot frame. */
     int first_sample;             /* the frame takes pixel samples first_sample .. + spp - 1 */
     int pattern_spp;              /* of patterns of this many samples (0: spp); sample g is

@@ -132,6 +132,8 @@ RayesError session_check_options(RayesScene *scene, const RayesRenderOptions *o)
     else if (o->max_spp < 0 || o->max_spp > 1 << 20 ||
              (o->max_spp > o->spp && !(o->adaptive_error > 0.0f && o->adaptive_error < 1e6f)))
         what = "options: max_spp must be 0 to 1048576 and adaptive_error positive";
+    else if (!(o->sample_clamp >= 0.0f) || isinf(o->sample_clamp))
+        what = "options: sample_clamp must be 0 (off) or positive";
     else if (o->bounces < 0 || o->bounces > 64 || o->specular_depth < 0 || o->specular_depth > 64)
         what = "options: depths must be 0 to 64";
     else if (o->shadow_rays < 0 || o->shadow_rays_deep < 0 || o->diffuse_rays < 0 ||
@@ -238,6 +240,7 @@ RenderSettings session_settings(const RayesRenderOptions *o)
         .volume_step = o->volume_step,
         .max_spp = o->max_spp,
         .adaptive_error = o->adaptive_error,
+        .sample_clamp = o->sample_clamp,
         .pbgi_max_solid_angle = o->pbgi_max_solid_angle,
         .pbgi_raster = o->pbgi_raster,
         .tile_done = o->tile_done,

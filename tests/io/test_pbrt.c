@@ -1363,6 +1363,15 @@ static void test_exposure(void)
                  "WorldBegin\n",
                  "t.pbrt:1:1: Camera: expected shutteropen < shutterclose");
     expect_error("Film \"rgb\" \"float iso\" 0\nWorldBegin\n", "t.pbrt:1:1: Film: expected iso > 0");
+    /* pbrt's maxcomponentvalue is the sample clamp (infinite: none) */
+    r = malloc(sizeof *r);
+    CHECK(parse("t.pbrt", "Film \"rgb\" \"float maxcomponentvalue\" 10\nWorldBegin\n", r, &s, err,
+                sizeof err) == RAYES_OK);
+    CHECK_NEAR(s.sample_clamp, 10, 0);
+    CHECK(parse("t.pbrt", "WorldBegin\n", r, &s, err, sizeof err) == RAYES_OK && s.sample_clamp == 0);
+    free(r);
+    expect_error("Film \"rgb\" \"float maxcomponentvalue\" 0\nWorldBegin\n",
+                 "t.pbrt:1:1: Film: expected maxcomponentvalue > 0");
 }
 
 TEST_MAIN(TEST(test_filters), TEST(test_exposure), TEST(test_subsurface_material), TEST(test_filter_warnings), TEST(test_import), TEST(test_film_types),

@@ -489,6 +489,36 @@ static void test_chrome_ball_white_furnace(void)
     chrome_ball_white_furnace(2);
 }
 
+/* The sample clamp (pbrt's Film "maxcomponentvalue"): each camera
+ * sample's largest component is at most the clamp, its colour's ratios
+ * kept; 0 is off; a negative clamp is refused. */
+static void test_sample_clamp(void)
+{
+    RayesScene *s = rayes_scene_new();
+    float eye[3] = {0, 0, -3}, target[3] = {0, 0, 0}, up[3] = {0, 1, 0};
+    CHECK(rayes_scene_set_camera(s, eye, target, up, 45.0f) == RAYES_OK);
+    RayesParam e[2] = {pf("intensity", 4.0f), {"lightcolor", RAYES_PARAM_COLOR, {1, 0.5f, 0.25f}, NULL}};
+    CHECK(rayes_scene_light(s, "environmentlight", e, 2) == RAYES_OK);
+    CHECK(rayes_scene_commit(s) == RAYES_OK);
+    RayesRenderOptions o;
+    rayes_render_options_init(&o, RAYES_QUALITY_PREVIEW);
+    o.width = o.height = 8;
+    o.threads = 1;
+    for (int k = 0; k < 3; k++) {
+        o.sample_clamp = k == 0 ? 0.0f : k == 1 ? 2.0f : -1.0f;
+        RayesImage *img = NULL;
+        RayesError err = rayes_render(s, &o, &img, NULL);
+        CHECK((err == RAYES_OK) == (k < 2));
+        if (img) { /* the environment everywhere: (4, 2, 1), or (2, 1, 0.5) clamped */
+            CHECK_NEAR(img->rgba[0], k ? 2.0 : 4.0, 1e-5);
+            CHECK_NEAR(img->rgba[1], k ? 1.0 : 2.0, 1e-5);
+            CHECK_NEAR(img->rgba[2], k ? 0.5 : 1.0, 1e-5);
+        }
+        rayes_image_free(img);
+    }
+    rayes_scene_release(s);
+}
+
 /* A scene of one environment light of the map at path, intensity 1, set
  * up in f. */
 static RayesScene *env_fixture(Fx *f, const char *path)
@@ -967,7 +997,7 @@ TEST_MAIN(TEST(test_point_light_inverse_square), TEST(test_spot_light_cone),
           TEST(test_mis_glossy_small_quad),
           TEST(test_mis_glossy_large_quad), TEST(test_glossy_lights_against_brute_force),
           TEST(test_glossy_surroundings_against_brute_force),
-          TEST(test_constant_environment_white_furnace), TEST(test_chrome_ball_white_furnace),
+          TEST(test_constant_environment_white_furnace), TEST(test_sample_clamp), TEST(test_chrome_ball_white_furnace),
           TEST(test_environment_map_importance_sampling),
           TEST(test_environment_map_sampling_consistency), TEST(test_octahedral_environment_map),
           TEST(test_categories), TEST(test_emitters_seen_by_camera),
