@@ -164,6 +164,13 @@ static void vertex_to_world(const GeomInstance *gi, Vec3 *P, Vec3 *Ng, Vec3 *N, 
     *dv = mat4_vector(&gi->world_from_master, *dv);
 }
 
+/* How many RGB values a shaded grid holds before its trailer: Ci of each
+ * vertex, then Oi of each for a transparent object. */
+static size_t grid_values(const Grid *g, int transparent)
+{
+    return geom_grid_n_vertices(g) * (transparent ? 2 : 1);
+}
+
 /* Shades every vertex of grid gi, seen through instance (0: none), with
  * lighting() into a new array: Ci of each vertex, followed by Oi of each if
  * the object is transparent; a moving grid where it is in the middle of
@@ -180,7 +187,7 @@ static Rgb *shade_grid(Worker *w, uint32_t gi, uint32_t instance, int seg)
     float *f1 = malloc(n * 10 * sizeof *f1);
     uint64_t *keys = malloc(n * sizeof *keys);
     RayDiff *diff = malloc(n * sizeof *diff);
-    size_t n_ci = n * (obj->transparent ? 2 : 1);
+    size_t n_ci = grid_values(g, obj->transparent);
     Rgb *ci = malloc((n_ci + 1) * sizeof *ci);
     int *back = malloc(n * sizeof *back);
     RY_CHECK(f3 && f1 && keys && diff && ci && back);
@@ -365,7 +372,7 @@ int hider_camera_hit(Worker *w, const Ray *ray, const Hit *hit, Vec3 *L, Vec3 *O
     }
     const Grid *g = &w->rs->gs->grids[gi];
     int transparent = render_object(w->rs, gi, hit->instance)->transparent;
-    if (ci[geom_grid_n_vertices(g) * (transparent ? 2 : 1)][0] != 0.0f)
+    if (ci[grid_values(g, transparent)][0] != 0.0f)
         return 0; /* a sharp reflection or refraction: shaded where the ray hits */
     if (!corners(hit, g->first_vertex, ci, gsh->contrast, L))
         return 0;

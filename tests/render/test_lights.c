@@ -386,14 +386,21 @@ static void test_mis_glossy_large_quad(void)
 
 /* ------------------------------------------------------- environments */
 
-static RayesImage *render_scene(RayesScene *s, int threads, int size)
+/* The preview preset at size x size pixels, spp samples, on threads. */
+static RayesRenderOptions preview_options(int size, int spp, int threads)
 {
-    CHECK(rayes_scene_commit(s) == RAYES_OK);
     RayesRenderOptions o;
     rayes_render_options_init(&o, RAYES_QUALITY_PREVIEW);
     o.width = o.height = size;
-    o.spp = 1;
+    o.spp = spp;
     o.threads = threads;
+    return o;
+}
+
+static RayesImage *render_scene(RayesScene *s, int threads, int size)
+{
+    CHECK(rayes_scene_commit(s) == RAYES_OK);
+    RayesRenderOptions o = preview_options(size, 1, threads);
     o.shadow_rays = o.shadow_rays_deep = 16;
     RayesImage *img = NULL;
     CHECK(rayes_render(s, &o, &img, NULL) == RAYES_OK);
@@ -455,11 +462,7 @@ static void chrome_ball_white_furnace(int quadric)
     RayesParam e[1] = {pf("intensity", 0.5f)};
     CHECK(rayes_scene_light(s, "environmentlight", e, 1) == RAYES_OK);
     CHECK(rayes_scene_commit(s) == RAYES_OK);
-    RayesRenderOptions o;
-    rayes_render_options_init(&o, RAYES_QUALITY_PREVIEW);
-    o.width = o.height = 32;
-    o.spp = 16;
-    o.threads = 2;
+    RayesRenderOptions o = preview_options(32, 16, 2);
     RayesImage *img = NULL;
     CHECK(rayes_render(s, &o, &img, NULL) == RAYES_OK);
     int hits = 0, dark = 0;
@@ -500,10 +503,7 @@ static void test_sample_clamp(void)
     RayesParam e[2] = {pf("intensity", 4.0f), {"lightcolor", RAYES_PARAM_COLOR, {1, 0.5f, 0.25f}, NULL}};
     CHECK(rayes_scene_light(s, "environmentlight", e, 2) == RAYES_OK);
     CHECK(rayes_scene_commit(s) == RAYES_OK);
-    RayesRenderOptions o;
-    rayes_render_options_init(&o, RAYES_QUALITY_PREVIEW);
-    o.width = o.height = 8;
-    o.threads = 1;
+    RayesRenderOptions o = preview_options(8, 4, 1);
     for (int k = 0; k < 3; k++) {
         o.sample_clamp = k == 0 ? 0.0f : k == 1 ? 2.0f : -1.0f;
         RayesImage *img = NULL;
