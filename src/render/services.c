@@ -21,6 +21,7 @@
 #include "render/irrgrid.h"
 #include "render/pbgi.h"
 #include "render/subsurface.h"
+#include "shade/bsdf.h"
 #include "shade/builtin.h"
 #include "shade/noise.h"
 #include "shade/pattern.h"
@@ -34,23 +35,92 @@ static size_t point(const RayesShadeCtx *ctx, size_t i)
     return ctx->first_point + i;
 }
 
-/* The normalised Blinn-Phong lobe of shader.h: f = (e + 8) / (8 pi) (N.H)^e. */
-static float blinn_phong(Vec3 N, Vec3 V, Vec3 wi, float e)
+/* The reflection lobe of direct lighting's specular output and of the
+ * glossy services (shader.h), with its frame: the normalised Blinn-Phong
+ * f = (e + 8) / (8 pi) (N.H)^e (alpha 0), or GGX, Trowbridge-Reitz of
+ * width alpha with the height-correlated Smith G, f = D G / (4 N.V N.L) (the
+ * microfacet service; shade/bsdf.h evaluates it in the frame). Both are
+ * sampled by their half vector about N. */
+typedef struct Lobe {
+    Vec3 N, t, b; /* the frame about N */
+    Vec3 V;       /* toward the viewer */
+    float e;      /* Blinn-Phong's exponent */
+    float alpha;  /* GGX's width; 0: Blinn-Phong */
+} Lobe;
+
+/* GGX's narrowest lobe: a smaller width is taken as this one (a mirror is
+ * indirect_specular's). */
+#define LOBE_MIN_ALPHA 1e-3f
+
+static Lobe lobe_blinn(Vec3 N, Vec3 V, float e)
 {
-    Vec3 H = v3_normalize(v3_add(wi, V));
-    float nh = fmaxf(v3_dot(N, H), 0.0f);
-    return (e + 8.0f) / (8.0f * (float)M_PI) * powf(nh, e);
+    Lobe l = {N, N, N, V, e, 0.0f};
+    v3_basis(N, &l.t, &l.b);
+    return l;
 }
 
-/* The solid-angle pdf of drawing wi by sampling the half vector with pdf
- * (e + 1) / (2 pi) (N.H)^e: divided by 4 V.H, the reflection's Jacobian. */
-static float blinn_phong_pdf(Vec3 N, Vec3 V, Vec3 wi, float e)
+static Lobe lobe_ggx(Vec3 N, Vec3 V, float alpha)
 {
-    Vec3 H = v3_normalize(v3_add(wi, V));
-    float nh = v3_dot(N, H), vh = v3_dot(V, H);
+    Lobe l = lobe_blinn(N, V, 0.0f);
+    l.alpha = fmaxf(alpha, LOBE_MIN_ALPHA);
+    return l;
+}
+
+/* A direction in the lobe's frame. The view is kept just above the
+ * surface: an interpolated normal may turn a little away from it, where
+ * Smith's G would otherwise black the lobe out. */
+static Vec3 lobe_local(const Lobe *l, Vec3 d, int view)
+{
+    Vec3 o = v3(v3_dot(d, l->t), v3_dot(d, l->b), v3_dot(d, l->N));
+    if (view && o.z < 1e-4f)
+        o.z = 1e-4f;
+    return o;
+}
+
+/* The lobe's value f toward wi (no cosine). */
+static float lobe_f(const Lobe *l, Vec3 wi)
+{
+    if (l->alpha > 0.0f) {
+        Vec3 o = lobe_local(l, l->V, 1), i = lobe_local(l, wi, 0);
+        return i.z > 0.0f ? bsdf_ggx_eval(o, i, l->alpha) / i.z : 0.0f;
+    }
+    Vec3 H = v3_normalize(v3_add(wi, l->V));
+    float nh = fmaxf(v3_dot(l->N, H), 0.0f);
+    return (l->e + 8.0f) / (8.0f * (float)M_PI) * powf(nh, l->e);
+}
+
+/* The solid-angle pdf of drawing wi by lobe_sample: the half vector's
+ * density divided by 4 V.H, the reflection's Jacobian (Blinn-Phong's
+ * half vector has (e + 1) / (2 pi) (N.H)^e, GGX's D(H) N.H). */
+static float lobe_pdf(const Lobe *l, Vec3 wi)
+{
+    if (l->alpha > 0.0f)
+        return bsdf_ggx_pdf(lobe_local(l, l->V, 1), lobe_local(l, wi, 0), l->alpha);
+    Vec3 H = v3_normalize(v3_add(wi, l->V));
+    float nh = v3_dot(l->N, H), vh = v3_dot(l->V, H);
     if (nh <= 0.0f || vh <= 0.0f)
         return 0.0f;
-    return (e + 1.0f) / (2.0f * (float)M_PI) * powf(nh, e) / (4.0f * vh);
+    return (l->e + 1.0f) / (2.0f * (float)M_PI) * powf(nh, l->e) / (4.0f * vh);
+}
+
+/* A direction drawn from the lobe with (u1, u2): its half vector about N,
+ * the view reflected about it. Returns 0 when the half vector faces away
+ * from the view (no direction). */
+static int lobe_sample(const Lobe *l, float u1, float u2, Vec3 *wi)
+{
+    float cos_h;
+    if (l->alpha > 0.0f) /* tan^2 = alpha^2 u1 / (1 - u1) (shade/bsdf.c) */
+        cos_h = 1.0f / sqrtf(1.0f + l->alpha * l->alpha * u1 / fmaxf(1.0f - u1, 1e-7f));
+    else
+        cos_h = powf(u1, 1.0f / (l->e + 1.0f));
+    float sin_h = sqrtf(fmaxf(0.0f, 1.0f - cos_h * cos_h)), phi = 2.0f * (float)M_PI * u2;
+    Vec3 H = v3_add(v3_add(v3_scale(l->t, sin_h * cosf(phi)), v3_scale(l->b, sin_h * sinf(phi))),
+                    v3_scale(l->N, cos_h));
+    float vh = v3_dot(l->V, H);
+    if (vh <= 0.0f)
+        return 0;
+    *wi = v3_normalize(v3_sub(v3_scale(H, 2.0f * vh), l->V));
+    return 1;
 }
 
 /* The power heuristic for one sample from each of two strategies. */
@@ -105,7 +175,7 @@ static RayDiff shadow_diff(const PathState *ps, size_t j, int n)
 /* What direct lighting needs of one shading point. */
 typedef struct DirectPoint {
     Vec3 o, N, Ng, V;
-    float e;        /* Blinn-Phong exponent */
+    Lobe lobe;      /* the specular output's */
     int diff;       /* the diffuse output is wanted */
     int spec;       /* the specular output is wanted */
     RayDiff shadow; /* its shadow rays' differential, for rays drawn from a lobe */
@@ -127,7 +197,7 @@ static void light_delta(Worker *w, const DirectPoint *p, const Light *l, Vec3 *d
     Vec3 Li = v3_mul(ls.Li, transmittance(w, p->o, ls.wi, ls.dist, one));
     *diffuse = v3_madd(*diffuse, Li, cos_x / (float)M_PI);
     if (p->spec)
-        *spec = v3_madd(*spec, Li, cos_x * blinn_phong(p->N, p->V, ls.wi, p->e));
+        *spec = v3_madd(*spec, Li, cos_x * lobe_f(&p->lobe, ls.wi));
 }
 
 /* Nonzero if the diffuse lobe's strategy is worth its samples for a light
@@ -172,8 +242,6 @@ static void light_area(Worker *w, const DirectPoint *p, const Light *l, uint64_t
         cmj_pattern_init(&pat_cos, (uint32_t)n, (uint32_t)hash_combine(key, 1));
     if (p->spec)
         cmj_pattern_init(&pat_bp, (uint32_t)n, (uint32_t)hash_combine(key, 2));
-    Vec3 t, bt; /* the point's frame about N, for both lobes */
-    v3_basis(p->N, &t, &bt);
     float la[CMJ_BATCH], lb[CMJ_BATCH], ca[CMJ_BATCH], cb[CMJ_BATCH], ba[CMJ_BATCH], bb[CMJ_BATCH];
     for (int s0 = 0; s0 < n; s0 += CMJ_BATCH) {
         int nb = n - s0 < CMJ_BATCH ? n - s0 : CMJ_BATCH;
@@ -204,9 +272,8 @@ static void light_area(Worker *w, const DirectPoint *p, const Light *l, uint64_t
                     if (p->diff)
                         sum_d = v3_madd(sum_d, Li, wd * cos_x / ((float)M_PI * ls.pdf));
                     if (p->spec) {
-                        float ws =
-                            power_heuristic(ls.pdf, blinn_phong_pdf(p->N, p->V, ls.wi, p->e));
-                        float f = blinn_phong(p->N, p->V, ls.wi, p->e);
+                        float ws = power_heuristic(ls.pdf, lobe_pdf(&p->lobe, ls.wi));
+                        float f = lobe_f(&p->lobe, ls.wi);
                         sum_s = v3_madd(sum_s, Li, ws * f * cos_x / ls.pdf);
                     }
                 }
@@ -215,7 +282,7 @@ static void light_area(Worker *w, const DirectPoint *p, const Light *l, uint64_t
             Vec3 wi;
             float cos_x;
             if (lobe) {
-                wi = sample_cosine_frame(t, bt, p->N, ca[j], cb[j]);
+                wi = sample_cosine_frame(p->lobe.t, p->lobe.b, p->N, ca[j], cb[j]);
                 cos_x = v3_dot(p->N, wi);
                 if (cos_x > 0.0f && v3_dot(p->Ng, wi) > 0.0f && light_bound_may_hit(&bound, wi) &&
                     light_intersect(l, p->o, wi, &ls) && v3_max_component(ls.Li) > 0.0f)
@@ -226,25 +293,17 @@ static void light_area(Worker *w, const DirectPoint *p, const Light *l, uint64_t
             if (!p->spec)
                 continue;
             /* The specular lobe's strategy: the half vector about N. */
-            float cos_h = powf(ba[j], 1.0f / (p->e + 1.0f));
-            float sin_h = sqrtf(fmaxf(0.0f, 1.0f - cos_h * cos_h)),
-                  phi = 2.0f * (float)M_PI * bb[j];
-            Vec3 H = v3_add(
-                v3_add(v3_scale(t, sin_h * cosf(phi)), v3_scale(bt, sin_h * sinf(phi))),
-                v3_scale(p->N, cos_h));
-            float vh = v3_dot(p->V, H);
-            if (vh <= 0.0f)
+            if (!lobe_sample(&p->lobe, ba[j], bb[j], &wi))
                 continue;
-            wi = v3_normalize(v3_sub(v3_scale(H, 2.0f * vh), p->V));
             cos_x = v3_dot(p->N, wi);
             if (cos_x <= 0.0f || v3_dot(p->Ng, wi) <= 0.0f || !light_bound_may_hit(&bound, wi) ||
                 !light_intersect(l, p->o, wi, &ls) || !(v3_max_component(ls.Li) > 0.0f))
                 continue;
-            float pdf = blinn_phong_pdf(p->N, p->V, wi, p->e);
+            float pdf = lobe_pdf(&p->lobe, wi);
             if (!(pdf > 0.0f))
                 continue;
             Vec3 Li = v3_mul(ls.Li, transmittance(w, p->o, wi, ls.dist, p->shadow));
-            float f = blinn_phong(p->N, p->V, wi, p->e);
+            float f = lobe_f(&p->lobe, wi);
             sum_s = v3_madd(sum_s, Li, power_heuristic(pdf, ls.pdf) * f * cos_x / pdf);
         }
     }
@@ -264,11 +323,19 @@ static const RenderObject *lit_object(const PathState *ps)
     return ps->grid < rs->gs->n_grids ? render_object(rs, ps->grid, ps->instance) : &every;
 }
 
-static void svc_direct_lighting(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
-                                int n_shadow_rays, const char *category, const float *roughness,
-                                float (*diffuse)[3], float (*specular)[3])
+/* The specular lobe of point i: GGX of width[i] (ggx), else Blinn-Phong
+ * of exponent 1 / width[i], a roughness (NULL or not above 0: 0.1). */
+static Lobe point_lobe(Vec3 N, Vec3 V, const float *width, size_t i, int ggx)
 {
-    (void)sv;
+    if (ggx)
+        return lobe_ggx(N, V, width ? width[i] : 0.0f);
+    return lobe_blinn(N, V, 1.0f / (width && width[i] > 0.0f ? width[i] : 0.1f));
+}
+
+/* direct_lighting with the lobe of point_lobe. */
+static void direct_lighting(const RayesShadeCtx *ctx, int n_shadow_rays, const char *category,
+                            const float *width, int ggx, float (*diffuse)[3], float (*specular)[3])
+{
     const PathState *ps = ctx->renderer;
     Worker *w = ps->w;
     int n = shadow_ray_count(w, ctx, n_shadow_rays);
@@ -281,7 +348,7 @@ static void svc_direct_lighting(const RayesShaderServices *sv, const RayesShadeC
         p.Ng = v3_load(ctx->Ng[i]);
         p.o = v3_madd(v3_load(ctx->P[i]), p.Ng, ps->offset[point(ctx, i)]);
         p.V = ctx->I ? v3_neg(v3_load(ctx->I[i])) : v3(0, 0, 0);
-        p.e = 1.0f / (roughness && roughness[i] > 0.0f ? roughness[i] : 0.1f);
+        p.lobe = point_lobe(p.N, p.V, width, i, ggx);
         p.spec = want_spec;
         p.diff = diffuse != NULL;
         p.shadow = shadow_diff(ps, point(ctx, i), n);
@@ -306,6 +373,14 @@ static void svc_direct_lighting(const RayesShaderServices *sv, const RayesShadeC
         if (ps->irradiance && diffuse) /* memo 6.2: irradiance as a side effect */
             v3_store(ps->irradiance[point(ctx, i)], v3_scale(d, (float)M_PI));
     }
+}
+
+static void svc_direct_lighting(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
+                                int n_shadow_rays, const char *category, const float *roughness,
+                                float (*diffuse)[3], float (*specular)[3])
+{
+    (void)sv;
+    direct_lighting(ctx, n_shadow_rays, category, roughness, 0, diffuse, specular);
 }
 
 /* Kajiya-Kay's terms for tangent T, toward the light wi and the viewer V
@@ -622,15 +697,15 @@ static void svc_indirect_specular(const RayesShaderServices *sv, const RayesShad
     }
 }
 
-/* Glossy reflection toward -I with direct lighting's normalised
- * Blinn-Phong lobe: the lights through svc_direct_lighting's specular
- * part (multiple importance sampling against the lobe for area and
- * environment lights), everything else through rays drawn from the lobe
- * (half vectors about N), to which emitters look black, each weighted by
- * f cos / pdf. One lobe for lights and for the rest: the sum is the
- * lobe's integral of all incident light. */
-static void svc_glossy(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
-                       const float *roughness, int n_rays, float (*out)[3])
+/* Glossy reflection toward -I with a lobe of point_lobe's (Blinn-Phong,
+ * direct lighting's, or GGX): the lights through direct lighting's
+ * specular part (multiple importance sampling against the lobe for area
+ * and environment lights), everything else through rays drawn from the
+ * lobe (half vectors about N), to which emitters look black, each
+ * weighted by f cos / pdf. One lobe for lights and for the rest: the sum
+ * is the lobe's integral of all incident light. */
+static void glossy(const RayesShadeCtx *ctx, const float *width, int ggx, int n_rays,
+                   float (*out)[3])
 {
     const PathState *ps = ctx->renderer;
     Worker *w = ps->w;
@@ -638,7 +713,7 @@ static void svc_glossy(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
         memset(out, 0, ctx->n_points * sizeof *out);
         return;
     }
-    svc_direct_lighting(sv, ctx, 0, NULL, roughness, NULL, out);
+    direct_lighting(ctx, 0, NULL, width, ggx, NULL, out);
     if (ctx->specular_depth >= w->set->specular_depth)
         return;
     int n = n_rays > 0 ? n_rays
@@ -647,33 +722,40 @@ static void svc_glossy(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
     if (n > 1 && ctx->diffuse_depth + ctx->specular_depth >= w->set->branch_depth)
         n = 1; /* past the branch depth: one ray follows the lobe */
     for (size_t i = 0; i < ctx->n_points; i++) {
-        float e = 1.0f / (roughness && roughness[i] > 0.0f ? roughness[i] : 0.1f);
-        Vec3 N = v3_load(ctx->N[i]), Ng = v3_load(ctx->Ng[i]), V = v3_neg(v3_load(ctx->I[i]));
-        Vec3 t, b, sum = v3(0, 0, 0);
-        v3_basis(N, &t, &b);
+        Vec3 N = v3_load(ctx->N[i]), Ng = v3_load(ctx->Ng[i]), sum = v3(0, 0, 0);
+        Lobe lobe = point_lobe(N, v3_neg(v3_load(ctx->I[i])), width, i, ggx);
         uint64_t key = hash_combine(ps->keys[point(ctx, i)], DIM_SPECULAR);
         CmjPattern pat;
         cmj_pattern_init(&pat, (uint32_t)n, (uint32_t)key);
         for (int s = 0; s < n; s++) {
             float a1, a2;
+            Vec3 wi;
             cmj_pattern_sample(&pat, (uint32_t)s, &a1, &a2);
-            float cos_h = powf(a1, 1.0f / (e + 1.0f));
-            float sin_h = sqrtf(fmaxf(0.0f, 1.0f - cos_h * cos_h)), phi = 2.0f * (float)M_PI * a2;
-            Vec3 H = v3_add(v3_add(v3_scale(t, sin_h * cosf(phi)), v3_scale(b, sin_h * sinf(phi))),
-                            v3_scale(N, cos_h));
-            float vh = v3_dot(V, H);
-            if (vh <= 0.0f)
+            if (!lobe_sample(&lobe, a1, a2, &wi))
                 continue;
-            Vec3 wi = v3_normalize(v3_sub(v3_scale(H, 2.0f * vh), V));
-            float cos_x = v3_dot(N, wi), pdf = blinn_phong_pdf(N, V, wi, e);
+            float cos_x = v3_dot(N, wi), pdf = lobe_pdf(&lobe, wi);
             if (cos_x <= 0.0f || v3_dot(Ng, wi) <= 0.0f || !(pdf > 0.0f))
                 continue;
             Vec3 L = trace_specular(ctx, i, wi, hash_combine(key, (uint64_t)s + 1),
                                     RAYES_RAY_SPECULAR | PATH_RAY_GLOSSY);
-            sum = v3_madd(sum, L, blinn_phong(N, V, wi, e) * cos_x / pdf);
+            sum = v3_madd(sum, L, lobe_f(&lobe, wi) * cos_x / pdf);
         }
         v3_store(out[i], v3_add(v3_load(out[i]), v3_scale(sum, 1.0f / (float)n)));
     }
+}
+
+static void svc_glossy(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
+                       const float *roughness, int n_rays, float (*out)[3])
+{
+    (void)sv;
+    glossy(ctx, roughness, 0, n_rays, out);
+}
+
+static void svc_microfacet(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
+                           const float *alpha, int n_rays, float (*out)[3])
+{
+    (void)sv;
+    glossy(ctx, alpha, 1, n_rays, out);
 }
 
 static void svc_indirect_refraction(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
@@ -915,6 +997,7 @@ static const char *const service_names[] = {
     "occlusion",
     "direct_volume",
     "subsurface",
+    "microfacet",
 };
 
 static int svc_supports(const RayesShaderServices *sv, const char *service)
@@ -950,4 +1033,5 @@ const RayesShaderServices render_services = {
     .direct_fiber = svc_direct_fiber,
     .pattern = svc_pattern,
     .subsurface = subsurface_service,
+    .microfacet = svc_microfacet,
 };

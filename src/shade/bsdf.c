@@ -224,13 +224,21 @@ float bsdf_ggx_G1(Vec3 w, float alpha)
     return 2.0f / (1.0f + sqrtf(1.0f + alpha * alpha * tan2));
 }
 
+/* Smith's Lambda for GGX (G1 = 1 / (1 + Lambda)); w above the surface. */
+static float ggx_lambda(Vec3 w, float alpha)
+{
+    float c2 = w.z * w.z, tan2 = (1.0f - c2) / c2;
+    return 0.5f * (sqrtf(1.0f + alpha * alpha * tan2) - 1.0f);
+}
+
 float bsdf_ggx_eval(Vec3 wo, Vec3 wi, float alpha)
 {
     Vec3 h;
     if (wo.z <= 0.0f || wi.z <= 0.0f || !half_vector(wo, wi, &h))
         return 0.0f;
-    return bsdf_ggx_D(h, alpha) * bsdf_ggx_G1(wo, alpha) * bsdf_ggx_G1(wi, alpha) /
-           (4.0f * wo.z);
+    /* the height-correlated G = 1 / (1 + Lambda(wo) + Lambda(wi)), pbrt-v4's */
+    return bsdf_ggx_D(h, alpha) / ((1.0f + ggx_lambda(wo, alpha) + ggx_lambda(wi, alpha)) *
+                                   (4.0f * wo.z));
 }
 
 float bsdf_ggx_pdf(Vec3 wo, Vec3 wi, float alpha)

@@ -12,7 +12,8 @@
  *   Blinn-Phong        f = (e + 8) / (8 pi) (N.H)^e, the lobe of the
  *                      renderer's direct_lighting service; sampled by the
  *                      half vector, pdf_h = (e + 1) / (2 pi) (N.H)^e
- *   GGX                Trowbridge-Reitz D with the separable Smith G,
+ *   GGX                Trowbridge-Reitz D with Smith's height-correlated
+ *                      G = 1 / (1 + Lambda(wo) + Lambda(wi)) (pbrt-v4's),
  *                      f = D G / (4 cos_o cos_i); sampled by D(h) cos(h)
  *   smooth dielectric  delta reflection and refraction, chosen by Fresnel
  *

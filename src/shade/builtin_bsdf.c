@@ -6,9 +6,10 @@
  * Mirror reflection comes from the indirect_specular service and
  * refraction from indirect_refraction, whose rays see area lights; glossy
  * reflection of the physically based shaders (conductor, dielectric,
- * coateddiffuse) from the glossy service, which adds the lights by
- * multiple importance sampling against the same lobe, so small bright
- * lights reflect without speckle and nothing is counted twice.
+ * coateddiffuse) from the microfacet service (GGX, as pbrt's and Cycles's
+ * rough surfaces), which adds the lights by multiple importance sampling
+ * against the same lobe, so small bright lights reflect without speckle
+ * and nothing is counted twice.
  * RenderMan's metal, shinymetal and glass keep indirect_specular's lobe
  * and their classic specular() highlight, as their definitions say. Past the
  * renderer's branch depth, glass and dielectric follow one of reflection
@@ -118,12 +119,13 @@ static void mirror_dirs(const RayesShadeCtx *ctx, Rgb *dir)
     }
 }
 
-/* How many of the points' lobe exponents are 0 (mirrors). */
-static size_t count_mirrors(const RayesShadeCtx *ctx, const float *exponent)
+/* How many of the points' lobe widths (exponents or alphas) are 0
+ * (mirrors). */
+static size_t count_mirrors(const RayesShadeCtx *ctx, const float *width)
 {
     size_t n = 0;
     for (size_t i = 0; i < ctx->n_points; i++)
-        n += !(exponent[i] > 0.0f);
+        n += !(width[i] > 0.0f);
     return n;
 }
 
@@ -143,47 +145,54 @@ static void reflection(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
                           L);
 }
 
-/* Reflection of the physically based shaders: a mirror where exponent[i]
- * is 0; elsewhere the glossy service's normalised Blinn-Phong lobe, whose
- * lights come by multiple importance sampling (a renderer without it:
- * reflection's lobe, which sees lights only through its rays). A chunk
- * mixing both (a textured roughness reaching 0) goes point by point. */
+/* Reflection of the physically based shaders: a mirror where alpha[i] is
+ * 0; elsewhere the microfacet service's GGX lobe of width alpha[i], whose
+ * lights come by multiple importance sampling. A renderer without it: the
+ * glossy service's Blinn-Phong lobe of the same width (Walter et al.'s
+ * exponent), or without that reflection's lobe, which sees lights only
+ * through its rays. A chunk mixing mirrors and lobes (a textured
+ * roughness reaching 0) goes point by point. */
 static void glossy_reflection(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
-                              const float *exponent, Rgb *L)
+                              const float *alpha, Rgb *L)
 {
-    size_t mirrors = count_mirrors(ctx, exponent);
-    if (mirrors == ctx->n_points || !HAS_SERVICE(sv, glossy)) {
-        reflection(sv, ctx, exponent, L);
-    } else if (mirrors == 0) {
-        float rough[SHADE_CHUNK];
-        for (size_t i = 0; i < ctx->n_points; i++)
-            rough[i] = 1.0f / exponent[i];
-        sv->glossy(sv, ctx, rough, 0, L);
-    } else {
+    size_t mirrors = count_mirrors(ctx, alpha);
+    float w[SHADE_CHUNK];
+    if (mirrors != ctx->n_points && mirrors != 0) {
         for (size_t i = 0; i < ctx->n_points; i++) {
             RayesShadeCtx one;
             shade_ctx_slice(ctx, i, 1, &one);
-            glossy_reflection(sv, &one, &exponent[i], &L[i]);
+            glossy_reflection(sv, &one, &alpha[i], &L[i]);
         }
+    } else if (mirrors == 0 && HAS_SERVICE(sv, microfacet)) {
+        sv->microfacet(sv, ctx, alpha, 0, L);
+    } else {
+        for (size_t i = 0; i < ctx->n_points; i++)
+            w[i] = alpha[i] > 0.0f ? bsdf_blinn_exponent_from_alpha(alpha[i]) : 0.0f;
+        if (mirrors == ctx->n_points || !HAS_SERVICE(sv, glossy)) {
+            reflection(sv, ctx, w, L);
+            return;
+        }
+        for (size_t i = 0; i < ctx->n_points; i++)
+            w[i] = 1.0f / w[i]; /* the glossy service's roughness */
+        sv->glossy(sv, ctx, w, 0, L);
     }
 }
 
-/* pbrt-v4's roughness (remapped: alpha = sqrt(roughness)) as a Blinn-Phong
- * exponent; 0 for a smooth surface. */
-static float exponent_of(float roughness)
+/* pbrt-v4's roughness (remapped: alpha = sqrt(roughness)) as the GGX
+ * width; 0 for a smooth surface. */
+static float alpha_of(float roughness)
 {
-    return roughness > 0.0f ? bsdf_blinn_exponent_from_alpha(bsdf_alpha_from_roughness(roughness))
-                            : 0.0f;
+    return roughness > 0.0f ? bsdf_alpha_from_roughness(roughness) : 0.0f;
 }
 
-/* The lobe exponents of the points: the parameter "roughness" (its
- * constant, or the pattern bound to it) through exponent_of. */
-static void exponents(const RayesShaderServices *sv, const RayesShadeCtx *ctx, float roughness,
-                      float *e)
+/* The lobe widths of the points: the parameter "roughness" (its constant,
+ * or the pattern bound to it) through alpha_of. */
+static void alphas(const RayesShaderServices *sv, const RayesShadeCtx *ctx, float roughness,
+                   float *alpha)
 {
-    shade_param_float(sv, ctx, "roughness", roughness, e);
+    shade_param_float(sv, ctx, "roughness", roughness, alpha);
     for (size_t i = 0; i < ctx->n_points; i++)
-        e[i] = exponent_of(e[i]);
+        alpha[i] = alpha_of(alpha[i]);
 }
 
 /* ------------------------------------------------------------ metal */
@@ -336,9 +345,9 @@ static float max3(const float v[3])
 /* Fresnel-weighted reflection and refraction at a smooth boundary of
  * relative index eta (inside over outside). A ray that hit the back side
  * is leaving: the index is then inverted, and beyond the critical angle
- * all light reflects. reflect_e[i] is the exponent of the reflection lobe
- * (0: mirror; glossy: the glossy service's lobe, lights included, else
- * reflection's). Writes R[i] = F * reflected and T[i] = (1 - F) * refracted,
+ * all light reflects. width[i] is the reflection lobe's (0: a mirror):
+ * with glossy, the GGX alpha of glossy_reflection, lights included; else
+ * the Blinn-Phong exponent of reflection's lobe. Writes R[i] = F * reflected and T[i] = (1 - F) * refracted,
  * which the caller weights by wR[i] and wT[i]. Past the branch depth each
  * point traces one of the two, chosen with probability in proportion to
  * F max(wR) and (1 - F) max(wT), and none with probability 1 - q, q that
@@ -346,7 +355,7 @@ static float max3(const float v[3])
  * the chosen one is divided by its probability, so the expectation is
  * unchanged. */
 static void fresnel_split(const RayesShaderServices *sv, const RayesShadeCtx *ctx, float eta,
-                          const float *reflect_e, int glossy, const Rgb *wR, const Rgb *wT, Rgb *R,
+                          const float *width, int glossy, const Rgb *wR, const Rgb *wT, Rgb *R,
                           Rgb *T)
 {
     Rgb dir[SHADE_CHUNK], refr[SHADE_CHUNK];
@@ -378,9 +387,9 @@ static void fresnel_split(const RayesShaderServices *sv, const RayesShadeCtx *ct
             float p = q * (reflect ? a : b) / (a + b);
             Rgb L;
             if (reflect && glossy)
-                glossy_reflection(sv, &one, &reflect_e[i], &L);
+                glossy_reflection(sv, &one, &width[i], &L);
             else if (reflect)
-                reflection(sv, &one, &reflect_e[i], &L);
+                reflection(sv, &one, &width[i], &L);
             else if (sv->indirect_refraction)
                 sv->indirect_refraction(sv, &one, (const float(*)[3])&dir[i], &L);
             else
@@ -392,9 +401,9 @@ static void fresnel_split(const RayesShaderServices *sv, const RayesShadeCtx *ct
         return;
     }
     if (glossy)
-        glossy_reflection(sv, ctx, reflect_e, R);
+        glossy_reflection(sv, ctx, width, R);
     else
-        reflection(sv, ctx, reflect_e, R);
+        reflection(sv, ctx, width, R);
     if (n_refr > 0 && sv->indirect_refraction)
         sv->indirect_refraction(sv, ctx, (const float(*)[3])dir, refr);
     else
@@ -475,11 +484,11 @@ static void dielectric_chunk(const RayesShaderServices *sv, const RayesShadeCtx 
     if (!ctx->I)
         return;
     Rgb R[SHADE_CHUNK], T[SHADE_CHUNK], one[SHADE_CHUNK];
-    float e[SHADE_CHUNK];
+    float alpha[SHADE_CHUNK];
     for (size_t i = 0; i < ctx->n_points; i++)
         one[i][0] = one[i][1] = one[i][2] = 1.0f;
-    exponents(sv, ctx, p->roughness, e);
-    fresnel_split(sv, ctx, p->eta, e, 1, (const Rgb *)one, (const Rgb *)one, R, T);
+    alphas(sv, ctx, p->roughness, alpha);
+    fresnel_split(sv, ctx, p->eta, alpha, 1, (const Rgb *)one, (const Rgb *)one, R, T);
     for (size_t i = 0; i < ctx->n_points; i++)
         for (int c = 0; c < 3; c++)
             out->Ci[i][c] = R[i][c] + T[i][c];
@@ -595,10 +604,10 @@ static void conductor_chunk(const RayesShaderServices *sv, const RayesShadeCtx *
     if (!ctx->I)
         return; /* no view-independent lobe */
     Rgb eta[SHADE_CHUNK], k[SHADE_CHUNK], L[SHADE_CHUNK];
-    float e[SHADE_CHUNK];
+    float alpha[SHADE_CHUNK];
     conductor_index(sv, ctx, p, eta, k);
-    exponents(sv, ctx, p->roughness, e);
-    glossy_reflection(sv, ctx, e, L);
+    alphas(sv, ctx, p->roughness, alpha);
+    glossy_reflection(sv, ctx, alpha, L);
     /* Under a coat (pbrt's coatedconductor, whose layers pbrt walks
      * stochastically; here in closed form): the coat reflects its
      * dielectric Fresnel F_c through its own lobe, and the metal what
@@ -607,11 +616,11 @@ static void conductor_chunk(const RayesShaderServices *sv, const RayesShadeCtx *
      * narrowing by refraction left out). A white metal under a clear coat
      * reflects F_c + (1 - F_c) = 1: no energy lost or made. */
     Rgb Lc[SHADE_CHUNK];
-    float ec[SHADE_CHUNK];
+    float ac[SHADE_CHUNK];
     if (p->coat > 0.0f) {
         for (size_t i = 0; i < ctx->n_points; i++)
-            ec[i] = exponent_of(p->coat_roughness);
-        glossy_reflection(sv, ctx, ec, Lc);
+            ac[i] = alpha_of(p->coat_roughness);
+        glossy_reflection(sv, ctx, ac, Lc);
     }
     for (size_t i = 0; i < ctx->n_points; i++) {
         float cv = cos_view(ctx, i);
@@ -673,14 +682,14 @@ static void coated_chunk(const RayesShaderServices *sv, const RayesShadeCtx *ctx
 {
     const CoatedParams *p = params;
     Rgb E[SHADE_CHUNK], L[SHADE_CHUNK], refl[SHADE_CHUNK];
-    float e[SHADE_CHUNK], thick[SHADE_CHUNK];
+    float alpha[SHADE_CHUNK], thick[SHADE_CHUNK];
     shade_param_color(sv, ctx, "reflectance", p->reflectance, refl);
     shade_param_float(sv, ctx, "thickness", p->thickness, thick);
     diffuse_light(sv, ctx, E, out);
     float favg = fresnel_dielectric_average(p->eta);
     if (ctx->I) {
-        exponents(sv, ctx, p->roughness, e);
-        glossy_reflection(sv, ctx, e, L);
+        alphas(sv, ctx, p->roughness, alpha);
+        glossy_reflection(sv, ctx, alpha, L);
     }
     for (size_t i = 0; i < ctx->n_points; i++) {
         float base = (1.0f - favg) * (1.0f - favg) * expf(-2.0f * fmaxf(thick[i], 0.0f));

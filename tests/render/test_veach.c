@@ -4,8 +4,8 @@
  * rough, each reflecting a small bright and a large dim spherical area
  * light of equal power. The whole image is plate; each plate's image
  * half (less the columns beside the seam) is compared with a brute-force
- * estimate made here, by many samples of the conductor's lobe (the glossy
- * service's normalised Blinn-Phong, shade/bsdf.h) traced against the
+ * estimate made here, by many samples of the conductor's lobe (the
+ * microfacet service's GGX, shade/bsdf.h) traced against the
  * spheres analytically, with no light sampling at all.
  *
  * The defect this would have caught: plates glowing copper all over
@@ -110,11 +110,11 @@ static double brute_force_mean(int x0, int x1, int n_pos, int n_lobe)
         if (!(d.z < 0.0f))
             continue;
         Vec3 P = v3_madd(eye, d, -eye.z / d.z), V = v3_neg(d); /* plate z = 0, N = +z */
-        float e = bsdf_blinn_exponent_from_alpha(bsdf_alpha_from_roughness(ROUGHNESS[P.x > 0]));
+        float alpha = bsdf_alpha_from_roughness(ROUGHNESS[P.x > 0]);
         double F = v3_index(fresnel_conductor_rgb(V.z, eta, k), 0), Li = 0.0;
         for (int j = 0; j < n_lobe; j++) {
-            BsdfSample b = bsdf_blinn_sample(V, rng_float(hash_combine(key, 3 + 2 * (uint64_t)j)),
-                                             rng_float(hash_combine(key, 4 + 2 * (uint64_t)j)), e);
+            BsdfSample b = bsdf_ggx_sample(V, rng_float(hash_combine(key, 3 + 2 * (uint64_t)j)),
+                                           rng_float(hash_combine(key, 4 + 2 * (uint64_t)j)), alpha);
             if (b.weight > 0.0f && b.wi.z > 0.0f)
                 Li += b.weight * sphere_radiance(P, b.wi);
         }
