@@ -263,6 +263,28 @@ BsdfSample bsdf_ggx_sample(Vec3 wo, float u1, float u2, float alpha)
     return s;
 }
 
+float bsdf_ggx_refract_sample(Vec3 wo, float u1, float u2, float alpha, float eta, Vec3 *wt)
+{
+    float tan2 = alpha * alpha * u1 / fmaxf(1.0f - u1, 1e-7f);
+    float cos_h = 1.0f / sqrtf(1.0f + tan2);
+    Vec3 h = local_dir(cos_h, 2.0f * PI_F * u2);
+    float oh = v3_dot(wo, h);
+    if (wo.z <= 0.0f || oh <= 0.0f)
+        return 0.0f;
+    if (bsdf_refract(wo, h, eta, wt)) {
+        if (wt->z >= 0.0f)
+            return 0.0f; /* refracted back to wo's side */
+    } else {
+        *wt = bsdf_reflect(wo, h); /* total internal reflection at h */
+        if (wt->z <= 0.0f)
+            return 0.0f; /* reflected into the surface */
+    }
+    /* D(h) cos_h sampling: f |cos| / pdf, Fresnel left out, is
+     * |wo.h| G / (wo.z h.z) either way (Walter et al. 2007, eq. 41) */
+    Vec3 away = v3(wt->x, wt->y, fabsf(wt->z));
+    return oh / ((1.0f + ggx_lambda(wo, alpha) + ggx_lambda(away, alpha)) * wo.z * cos_h);
+}
+
 /* ------------------------------------------------------------ smooth dielectric */
 
 BsdfSample bsdf_dielectric_sample(Vec3 wo, float u1, float eta)

@@ -93,6 +93,17 @@ float bsdf_ggx_eval(Vec3 wo, Vec3 wi, float alpha);
 float bsdf_ggx_pdf(Vec3 wo, Vec3 wi, float alpha);
 BsdfSample bsdf_ggx_sample(Vec3 wo, float u1, float u2, float alpha);
 
+/* Rough refraction through a GGX surface of width alpha and relative
+ * index eta (the far side's over wo's; wo.z > 0): a microfacet normal h
+ * drawn as bsdf_ggx_sample draws it, wo refracted through it into *wt
+ * (wt.z < 0), or where h reflects totally, wo reflected about it (wt.z >
+ * 0: light leaving glass at a steep microfacet stays inside). Returns the
+ * sample's weight without Fresnel, |wo.h| G / (wo.z h.z) (Walter et al.
+ * 2007), whose mean is the share of light the lobe passes on (below 1 by
+ * what Smith's G loses), or 0 when h gives nothing (a refraction back to
+ * wo's side). */
+float bsdf_ggx_refract_sample(Vec3 wo, float u1, float u2, float alpha, float eta, Vec3 *wt);
+
 /* ---- smooth dielectric, eta = n_inside / n_outside; wo on either side
  * (wo.z < 0: from the inside). u1 picks reflection with probability F;
  * weight is 1 (radiance is not scaled by eta^2: closed objects). */

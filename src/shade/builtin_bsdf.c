@@ -337,9 +337,60 @@ static int branches(const RayesShaderServices *sv, const RayesShadeCtx *ctx)
     return (float)(ctx->diffuse_depth + ctx->specular_depth) < depth;
 }
 
+/* Whether point i's ray hit the back side (it is leaving the medium). */
+static int leaving(const RayesShadeCtx *ctx, size_t i)
+{
+    return ctx->backfacing && ctx->backfacing[i];
+}
+
 static float max3(const float v[3])
 {
     return fmaxf(v[0], fmaxf(v[1], v[2]));
+}
+
+/* How many rays a glossy lobe of the context's points traces: the
+ * renderer's diffuse ray count for their depth, one past the branch depth
+ * (the glossy service's rule). */
+static int lobe_rays(const RayesShaderServices *sv, const RayesShadeCtx *ctx)
+{
+    float n[2] = {1.0f, 1.0f};
+    if (!branches(sv, ctx) || !HAS_SERVICE(sv, option) ||
+        sv->option(sv, ctx, "diffuserays", n, 2) < 1)
+        return 1;
+    int k = (int)n[ctx->diffuse_depth > 0];
+    return k > 1 ? k : 1;
+}
+
+/* Radiance refracted through a rough boundary (relative index rel) at
+ * the one point of ctx: the mean over n rays, each refracted through a
+ * microfacet normal drawn from GGX of width alpha and weighted as
+ * bsdf_ggx_refract_sample says, or reflected about it where it reflects
+ * totally (pbrt-v4's rough dielectric, Fresnel left to the caller, taken
+ * at N); the normals' random numbers from the random service
+ * (dimensions 1 and up), the first stratified over the n rays. */
+static void rough_refraction(const RayesShaderServices *sv, const RayesShadeCtx *one, float alpha,
+                             float rel, int n, float L[3])
+{
+    Vec3 V = v3_neg(ld(one->I[0])), N = ld(one->N[0]), t, b;
+    v3_basis(N, &t, &b);
+    Vec3 wo = v3(v3_dot(V, t), v3_dot(V, b), fmaxf(v3_dot(V, N), 1e-4f));
+    L[0] = L[1] = L[2] = 0.0f;
+    for (int s = 0; s < n; s++) {
+        float u1 = ((float)s + sv->random(sv, one, 0, 1u + 2u * (uint32_t)s)) / (float)n;
+        float u2 = sv->random(sv, one, 0, 2u + 2u * (uint32_t)s);
+        Vec3 w;
+        float weight = bsdf_ggx_refract_sample(wo, fminf(u1, 0.99999994f), u2, alpha, rel, &w);
+        if (!(weight > 0.0f))
+            continue;
+        Vec3 d = v3_add(v3_add(v3_scale(t, w.x), v3_scale(b, w.y)), v3_scale(N, w.z));
+        Rgb dir = {d.x, d.y, d.z}, Ls;
+        if (w.z < 0.0f)
+            sv->indirect_refraction(sv, one, (const float(*)[3])&dir, &Ls);
+        else /* the microfacet reflects totally: a mirror ray about it */
+            sv->indirect_specular(sv, one, (const float(*)[3])&dir, NULL, 1, &Ls);
+        for (int c = 0; c < 3; c++)
+            L[c] += weight * Ls[c] / (float)n;
+    }
 }
 
 /* Fresnel-weighted reflection and refraction at a smooth boundary of
@@ -347,7 +398,9 @@ static float max3(const float v[3])
  * is leaving: the index is then inverted, and beyond the critical angle
  * all light reflects. width[i] is the reflection lobe's (0: a mirror):
  * with glossy, the GGX alpha of glossy_reflection, lights included; else
- * the Blinn-Phong exponent of reflection's lobe. Writes R[i] = F * reflected and T[i] = (1 - F) * refracted,
+ * the Blinn-Phong exponent of reflection's lobe; with glossy, refraction
+ * is rough through the same width (rough_refraction; sharp at 0). Writes
+ * R[i] = F * reflected and T[i] = (1 - F) * refracted,
  * which the caller weights by wR[i] and wT[i]. Past the branch depth each
  * point traces one of the two, chosen with probability in proportion to
  * F max(wR) and (1 - F) max(wT), and none with probability 1 - q, q that
@@ -362,8 +415,7 @@ static void fresnel_split(const RayesShaderServices *sv, const RayesShadeCtx *ct
     float F[SHADE_CHUNK];
     size_t n_refr = 0;
     for (size_t i = 0; i < ctx->n_points; i++) {
-        int leaving = ctx->backfacing && ctx->backfacing[i];
-        float rel = leaving ? 1.0f / eta : eta;
+        float rel = leaving(ctx, i) ? 1.0f / eta : eta;
         Vec3 V = v3_neg(ld(ctx->I[i])), N = ld(ctx->N[i]), t;
         F[i] = fresnel_dielectric(cos_view(ctx, i), rel);
         if (!bsdf_refract(V, N, rel, &t)) {
@@ -390,6 +442,8 @@ static void fresnel_split(const RayesShaderServices *sv, const RayesShadeCtx *ct
                 glossy_reflection(sv, &one, &width[i], &L);
             else if (reflect)
                 reflection(sv, &one, &width[i], &L);
+            else if (sv->indirect_refraction && glossy && width[i] > 0.0f)
+                rough_refraction(sv, &one, width[i], leaving(ctx, i) ? 1.0f / eta : eta, 1, L);
             else if (sv->indirect_refraction)
                 sv->indirect_refraction(sv, &one, (const float(*)[3])&dir[i], &L);
             else
@@ -404,10 +458,25 @@ static void fresnel_split(const RayesShaderServices *sv, const RayesShadeCtx *ct
         glossy_reflection(sv, ctx, width, R);
     else
         reflection(sv, ctx, width, R);
-    if (n_refr > 0 && sv->indirect_refraction)
+    memset(refr, 0, sizeof refr);
+    size_t n_rough = 0;
+    for (size_t i = 0; glossy && i < ctx->n_points; i++)
+        n_rough += width[i] > 0.0f && F[i] < 1.0f;
+    if (n_refr > 0 && sv->indirect_refraction && n_rough == 0) {
         sv->indirect_refraction(sv, ctx, (const float(*)[3])dir, refr);
-    else
-        memset(refr, 0, sizeof refr);
+    } else if (n_refr > 0 && sv->indirect_refraction) { /* point by point */
+        for (size_t i = 0; i < ctx->n_points; i++) {
+            RayesShadeCtx one;
+            shade_ctx_slice(ctx, i, 1, &one);
+            if (F[i] >= 1.0f)
+                continue;
+            if (glossy && width[i] > 0.0f)
+                rough_refraction(sv, &one, width[i], leaving(ctx, i) ? 1.0f / eta : eta,
+                                 lobe_rays(sv, ctx), refr[i]);
+            else
+                sv->indirect_refraction(sv, &one, (const float(*)[3])&dir[i], &refr[i]);
+        }
+    }
     for (size_t i = 0; i < ctx->n_points; i++)
         for (int c = 0; c < 3; c++) {
             R[i][c] *= F[i];

@@ -492,6 +492,53 @@ static void test_chrome_ball_white_furnace(void)
     chrome_ball_white_furnace(2);
 }
 
+/* Glass balls in a constant environment, smooth and rough (pbrt's
+ * dielectric, roughness 0.02 and 0.1: GGX of alpha 0.14 and 0.32, rough
+ * refraction as well as reflection; builtin_bsdf.c rough_refraction). A
+ * smooth ball keeps the environment's radiance; a rough one loses what a
+ * single-scattering microfacet model loses (Smith's G; refractions
+ * through steep microfacets that point back inside), most where light
+ * leaves the glass, but never makes light. Index-matched (eta 1.0001),
+ * where nothing reflects or bends, a rough ball all but vanishes: its
+ * refraction's weights are right. */
+static double glass_ball_mean(float eta, float roughness)
+{
+    RayesScene *s = rayes_scene_new();
+    float eye[3] = {0, 0, -6}, target[3] = {0, 0, 0}, up[3] = {0, 1, 0};
+    CHECK(rayes_scene_set_camera(s, eye, target, up, 30.0f) == RAYES_OK);
+    RayesParam g[2] = {pf("eta", eta), pf("roughness", roughness)};
+    CHECK(rayes_scene_set_shader(s, "dielectric", g, 2) == RAYES_OK);
+    CHECK(rayes_scene_sphere(s, 1.0f) == RAYES_OK);
+    RayesParam e[1] = {pf("intensity", 0.5f)};
+    CHECK(rayes_scene_light(s, "environmentlight", e, 1) == RAYES_OK);
+    CHECK(rayes_scene_commit(s) == RAYES_OK);
+    RayesRenderOptions o = preview_options(32, 16, 2);
+    o.specular_depth = 16;
+    RayesImage *img = NULL;
+    CHECK(rayes_render(s, &o, &img, NULL) == RAYES_OK);
+    double sum = 0.0;
+    int hits = 0;
+    for (int i = 0; img && i < img->width * img->height; i++)
+        if (img->rgba[4 * i + 3] == 1.0f)
+            hits++, sum += img->rgba[4 * i];
+    CHECK(hits > 100);
+    rayes_image_free(img);
+    rayes_scene_release(s);
+    return hits ? sum / hits : 0.0;
+}
+
+static void test_glass_ball_white_furnace(void)
+{
+    double smooth = glass_ball_mean(1.5f, 0.0f);
+    CHECK(smooth > 0.49 && smooth <= 0.5);
+    CHECK_NEAR(glass_ball_mean(1.0001f, 0.02f), 0.5, 0.02);
+    CHECK_NEAR(glass_ball_mean(1.0001f, 0.1f), 0.5, 0.05);
+    for (int k = 0; k < 2; k++) {
+        double rough = glass_ball_mean(1.5f, k ? 0.1f : 0.02f);
+        CHECK(rough > 0.3 && rough < 0.5);
+    }
+}
+
 /* The sample clamp (pbrt's Film "maxcomponentvalue"): each camera
  * sample's largest component is at most the clamp, its colour's ratios
  * kept; 0 is off; a negative clamp is refused. */
@@ -1096,6 +1143,7 @@ TEST_MAIN(TEST(test_point_light_inverse_square), TEST(test_spot_light_cone),
           TEST(test_glossy_surroundings_against_brute_force),
           TEST(test_microfacet_against_brute_force),
           TEST(test_constant_environment_white_furnace), TEST(test_sample_clamp), TEST(test_chrome_ball_white_furnace),
+          TEST(test_glass_ball_white_furnace),
           TEST(test_environment_map_importance_sampling),
           TEST(test_environment_map_sampling_consistency), TEST(test_octahedral_environment_map),
           TEST(test_categories), TEST(test_emitters_seen_by_camera),

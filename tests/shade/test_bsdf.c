@@ -439,7 +439,87 @@ static void test_roughness_mappings(void)
     CHECK_NEAR(bsdf_alpha_from_roughness(0.01f), 0.1, 1e-6);
 }
 
+/* Walter et al.'s rough transmission without Fresnel, f_t |cos_t|, for
+ * wo above (index 1) and wt below (index eta), in double: the integral
+ * over wt of it is the share of light the lobe transmits. */
+static double walter_ft_cos(Vec3 wo, Vec3 wt, double alpha, double eta)
+{
+    if (wo.z <= 0.0f || wt.z >= 0.0f)
+        return 0.0;
+    double hx = -(wo.x + eta * wt.x), hy = -(wo.y + eta * wt.y), hz = -(wo.z + eta * wt.z);
+    double len = sqrt(hx * hx + hy * hy + hz * hz);
+    if (len <= 0.0)
+        return 0.0;
+    if (hz < 0.0)
+        len = -len;
+    hx /= len, hy /= len, hz /= len;
+    double ih = wo.x * hx + wo.y * hy + wo.z * hz, oh = wt.x * hx + wt.y * hy + wt.z * hz;
+    if (ih <= 0.0 || oh >= 0.0)
+        return 0.0; /* not a refraction through h */
+    double a2 = alpha * alpha, d = hz * hz * (a2 - 1.0) + 1.0, D = a2 / (PI_D * d * d);
+    double ci = wo.z, co = -wt.z;
+    double Li = (sqrt(1.0 + a2 * (1.0 - ci * ci) / (ci * ci)) - 1.0) / 2.0;
+    double Lo = (sqrt(1.0 + a2 * (1.0 - co * co) / (co * co)) - 1.0) / 2.0;
+    double den = ih + eta * oh;
+    return ih * -oh * eta * eta * D / ((1.0 + Li + Lo) * ci * co * den * den) * co;
+}
+
+/* Rough refraction's samples (bsdf_ggx_refract_sample): their mean
+ * weight equals the integral of Walter's f_t |cos_t| over the far side
+ * (brute force, directions uniform over it), entering (eta 1.5) and
+ * leaving (1 / 1.5) glass, narrow to broad lobes, head on and 50 degrees
+ * off; a narrow lobe refracts almost where the smooth surface does, with
+ * weights near 1. */
+static void test_rough_refraction(void)
+{
+    static const float alphas[] = {0.1f, 0.3f, 0.6f}, views[] = {0.0f, 50.0f},
+                       etas[] = {1.5f, 1.0f / 1.5f};
+    for (int a = 0; a < 3; a++)
+        for (int v = 0; v < 2; v++)
+            for (int e = 0; e < 2; e++) {
+                Vec3 wo = from_angle(views[v]);
+                double mean = 0.0, brute = 0.0, tir = 0.0;
+                const int n = 1 << 20;
+                for (int i = 0; i < n; i++) {
+                    float u1, u2;
+                    uniform2(71, (uint64_t)i, &u1, &u2);
+                    Vec3 wt = v3(0, 0, 0);
+                    float w = bsdf_ggx_refract_sample(wo, u1, u2, alphas[a], etas[e], &wt);
+                    CHECK(w >= 0.0f);
+                    if (w > 0.0f)
+                        CHECK(fabsf(v3_length(wt) - 1.0f) < 1e-4f);
+                    CHECK(wt.z < 0.0f || etas[e] < 1.0f || w == 0.0f); /* no TIR into glass */
+                    if (w > 0.0f && wt.z < 0.0f)
+                        mean += w / n;
+                    else if (w > 0.0f)
+                        tir += w / n;
+                    /* uniform over the lower hemisphere: pdf 1 / (2 pi) */
+                    uniform2(72, (uint64_t)i, &u1, &u2);
+                    float ct = u1, st = sqrtf(fmaxf(0.0f, 1.0f - ct * ct));
+                    Vec3 d = v3(st * cosf(2.0f * (float)PI_D * u2),
+                                st * sinf(2.0f * (float)PI_D * u2), -ct);
+                    brute += walter_ft_cos(wo, d, alphas[a], etas[e]) * 2.0 * PI_D / n;
+                }
+                /* into glass nearly all passes (Smith's G loses a few
+                 * per cent); out of it microfacets beyond the critical
+                 * angle reflect (50 degrees is beyond it: 0.09 to 0.38) */
+                CHECK(mean <= 1.0 && (etas[e] < 1.0f || mean > 0.9));
+                /* microfacets that reflect totally carry on what does not
+                 * pass; refractions back inside are lost (single
+                 * scattering: 31% at alpha 0.6 head on) */
+                CHECK(mean + tir <= 1.0 && mean + tir > (alphas[a] < 0.5f ? 0.78 : 0.6));
+                CHECK_NEAR(mean / brute, 1.0, 0.02);
+            }
+    /* narrow: the smooth surface's direction, weight about 1 */
+    Vec3 wo = from_angle(40.0f), sharp, wt;
+    CHECK(bsdf_refract(wo, v3(0, 0, 1), 1.5f, &sharp));
+    float w = bsdf_ggx_refract_sample(wo, 0.3f, 0.7f, 0.001f, 1.5f, &wt);
+    CHECK_NEAR(w, 1.0, 0.01);
+    CHECK(v3_dot(wt, sharp) > 0.9999f);
+}
+
 TEST_MAIN(TEST(test_chi2_lambert), TEST(test_chi2_blinn), TEST(test_chi2_ggx),
           TEST(test_chi2_rough_conductor), TEST(test_chi2_detects_wrong_pdf),
           TEST(test_sample_weights), TEST(test_white_furnace), TEST(test_reciprocity),
-          TEST(test_fresnel_limits), TEST(test_smooth_dielectric), TEST(test_roughness_mappings))
+          TEST(test_fresnel_limits), TEST(test_smooth_dielectric), TEST(test_roughness_mappings),
+          TEST(test_rough_refraction))
