@@ -375,9 +375,12 @@ static void rough_refraction(const RayesShaderServices *sv, const RayesShadeCtx 
     v3_basis(N, &t, &b);
     Vec3 wo = v3(v3_dot(V, t), v3_dot(V, b), fmaxf(v3_dot(V, N), 1e-4f));
     L[0] = L[1] = L[2] = 0.0f;
+    int rnd = HAS_SERVICE(sv, random); /* else the strata's middles, a golden-ratio walk */
     for (int s = 0; s < n; s++) {
-        float u1 = ((float)s + sv->random(sv, one, 0, 1u + 2u * (uint32_t)s)) / (float)n;
-        float u2 = sv->random(sv, one, 0, 2u + 2u * (uint32_t)s);
+        float u1 =
+            ((float)s + (rnd ? sv->random(sv, one, 0, 1u + 2u * (uint32_t)s) : 0.5f)) / (float)n;
+        float u2 = rnd ? sv->random(sv, one, 0, 2u + 2u * (uint32_t)s)
+                       : fmodf(0.5f + 0.618034f * (float)s, 1.0f);
         Vec3 w;
         float weight = bsdf_ggx_refract_sample(wo, fminf(u1, 0.99999994f), u2, alpha, rel, &w);
         if (!(weight > 0.0f))
@@ -386,8 +389,10 @@ static void rough_refraction(const RayesShaderServices *sv, const RayesShadeCtx 
         Rgb dir = {d.x, d.y, d.z}, Ls;
         if (w.z < 0.0f)
             sv->indirect_refraction(sv, one, (const float(*)[3])&dir, &Ls);
-        else /* the microfacet reflects totally: a mirror ray about it */
+        else if (sv->indirect_specular) /* the microfacet reflects totally: a mirror ray about it */
             sv->indirect_specular(sv, one, (const float(*)[3])&dir, NULL, 1, &Ls);
+        else
+            continue;
         for (int c = 0; c < 3; c++)
             L[c] += weight * Ls[c] / (float)n;
     }
