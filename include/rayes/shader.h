@@ -392,8 +392,8 @@ struct RayesShaderServices {
      * n_rays rays drawn from D(H) N.H (0: the renderer's setting; one past
      * the branch depth). Zero without I. Older renderers lack it
      * (supports()). */
-    void (*microfacet)(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
-                       const float *alpha, int n_rays, float (*out)[3]);
+    void (*microfacet)(const RayesShaderServices *sv, const RayesShadeCtx *ctx, const float *alpha,
+                       int n_rays, float (*out)[3]);
 };
 
 #ifdef __cplusplus

@@ -237,8 +237,8 @@ float bsdf_ggx_eval(Vec3 wo, Vec3 wi, float alpha)
     if (wo.z <= 0.0f || wi.z <= 0.0f || !half_vector(wo, wi, &h))
         return 0.0f;
     /* the height-correlated G = 1 / (1 + Lambda(wo) + Lambda(wi)), pbrt-v4's */
-    return bsdf_ggx_D(h, alpha) / ((1.0f + ggx_lambda(wo, alpha) + ggx_lambda(wi, alpha)) *
-                                   (4.0f * wo.z));
+    return bsdf_ggx_D(h, alpha) /
+           ((1.0f + ggx_lambda(wo, alpha) + ggx_lambda(wi, alpha)) * (4.0f * wo.z));
 }
 
 float bsdf_ggx_pdf(Vec3 wo, Vec3 wi, float alpha)

@@ -912,8 +912,8 @@ static void test_glossy_lights_against_brute_force(void)
         Vec3 N = v3(0, 0, 1), R = v3_normalize(v3(1, 0, 3)), I = v3(R.x, 0, -R.z);
         double got[3];
         fx_glossy(&f, v3(0, 0, 0), N, I, 1.0f / cases[k].e, 256, got);
-        double want = brute_sphere(C, cases[k].radius, 1.0 / (cases[k].radius * cases[k].radius),
-                                   N, v3_neg(I), cases[k].e, lobe_cos);
+        double want = brute_sphere(C, cases[k].radius, 1.0 / (cases[k].radius * cases[k].radius), N,
+                                   v3_neg(I), cases[k].e, lobe_cos);
         CHECK(want > 0.0);
         CHECK_NEAR(got[0] / want, 1.0, 0.03);
         fx_fini(&f);
@@ -985,8 +985,8 @@ static void test_microfacet_against_brute_force(void)
         Vec3 N = v3(0, 0, 1), R = v3_normalize(v3(1, 0, 3)), I = v3(R.x, 0, -R.z);
         double got[3];
         fx_lobe(&f, 1, v3(0, 0, 0), N, I, cases[k].alpha, 256, got);
-        double want = brute_sphere(C, cases[k].radius, 1.0 / (cases[k].radius * cases[k].radius),
-                                   N, v3_neg(I), cases[k].alpha, ggx_cos);
+        double want = brute_sphere(C, cases[k].radius, 1.0 / (cases[k].radius * cases[k].radius), N,
+                                   v3_neg(I), cases[k].alpha, ggx_cos);
         CHECK(want > 0.0);
         CHECK_NEAR(got[0] / want, 1.0, 0.03);
         fx_fini(&f);
@@ -1138,13 +1138,12 @@ static void test_bad_lights(void)
 TEST_MAIN(TEST(test_point_light_inverse_square), TEST(test_spot_light_cone),
           TEST(test_distant_light), TEST(test_ambient_light), TEST(test_disk_light_irradiance),
           TEST(test_sphere_light_irradiance), TEST(test_light_bound_keeps_every_hit),
-          TEST(test_mis_glossy_small_quad),
-          TEST(test_mis_glossy_large_quad), TEST(test_glossy_lights_against_brute_force),
+          TEST(test_mis_glossy_small_quad), TEST(test_mis_glossy_large_quad),
+          TEST(test_glossy_lights_against_brute_force),
           TEST(test_glossy_surroundings_against_brute_force),
-          TEST(test_microfacet_against_brute_force),
-          TEST(test_constant_environment_white_furnace), TEST(test_sample_clamp), TEST(test_chrome_ball_white_furnace),
-          TEST(test_glass_ball_white_furnace),
-          TEST(test_environment_map_importance_sampling),
+          TEST(test_microfacet_against_brute_force), TEST(test_constant_environment_white_furnace),
+          TEST(test_sample_clamp), TEST(test_chrome_ball_white_furnace),
+          TEST(test_glass_ball_white_furnace), TEST(test_environment_map_importance_sampling),
           TEST(test_environment_map_sampling_consistency), TEST(test_octahedral_environment_map),
           TEST(test_categories), TEST(test_emitters_seen_by_camera),
           TEST(test_every_light_any_thread_count), TEST(test_bad_lights))

@@ -113,8 +113,9 @@ static double brute_force_mean(int x0, int x1, int n_pos, int n_lobe)
         float alpha = bsdf_alpha_from_roughness(ROUGHNESS[P.x > 0]);
         double F = v3_index(fresnel_conductor_rgb(V.z, eta, k), 0), Li = 0.0;
         for (int j = 0; j < n_lobe; j++) {
-            BsdfSample b = bsdf_ggx_sample(V, rng_float(hash_combine(key, 3 + 2 * (uint64_t)j)),
-                                           rng_float(hash_combine(key, 4 + 2 * (uint64_t)j)), alpha);
+            BsdfSample b =
+                bsdf_ggx_sample(V, rng_float(hash_combine(key, 3 + 2 * (uint64_t)j)),
+                                rng_float(hash_combine(key, 4 + 2 * (uint64_t)j)), alpha);
             if (b.weight > 0.0f && b.wi.z > 0.0f)
                 Li += b.weight * sphere_radiance(P, b.wi);
         }
