@@ -834,11 +834,6 @@ static void fx_lobe(Fx *f, int microfacet, Vec3 P, Vec3 N, Vec3 I, float width, 
     }
 }
 
-static void fx_glossy(Fx *f, Vec3 P, Vec3 N, Vec3 I, float roughness, int keys, double out[3])
-{
-    fx_lobe(f, 0, P, N, I, roughness, keys, out);
-}
-
 /* The normalised Blinn-Phong lobe times the cosine, as shader.h defines it. */
 static double lobe_cos(Vec3 N, Vec3 V, Vec3 wi, double e)
 {
@@ -884,6 +879,66 @@ static double brute_sphere(Vec3 C, double R, double L, Vec3 N, Vec3 V, double w,
     return sum / n * 2 * PI * (1 - cos_max);
 }
 
+/* One light through a lobe (microfacet: GGX of width w, else the glossy
+ * service's roughness 1 / w) against lobe's brute-force integral over the
+ * light's cone: a sphere of the radius at (x, 0, 3), viewed so that the
+ * mirror direction points at x = 1. */
+static void check_sphere_light(int microfacet, float radius, float x, float w, LobeCos lobe)
+{
+    RayesScene *s = rayes_scene_new();
+    Vec3 C = v3(x, 0, 3);
+    const float move[16] = {1, 0, 0, C.x, 0, 1, 0, C.y, 0, 0, 1, C.z, 0, 0, 0, 1};
+    CHECK(rayes_scene_set_transform(s, move) == RAYES_OK);
+    RayesParam p[3] = {ps("shape", "sphere"), pf("radius", radius),
+                       pf("intensity", 1.0f / (radius * radius))};
+    CHECK(rayes_scene_light(s, "arealight", p, 3) == RAYES_OK);
+    Fx f;
+    fx_init(&f, s);
+    f.set.specular_depth = 4;
+    f.set.branch_depth = 1;
+    f.set.diffuse_rays = 4;
+    Vec3 N = v3(0, 0, 1), R = v3_normalize(v3(1, 0, 3)), I = v3(R.x, 0, -R.z);
+    double got[3];
+    fx_lobe(&f, microfacet, v3(0, 0, 0), N, I, microfacet ? w : 1.0f / w, 256, got);
+    double want = brute_sphere(C, radius, 1.0 / (radius * radius), N, v3_neg(I), w, lobe);
+    CHECK(want > 0.0);
+    CHECK_NEAR(got[0] / want, 1.0, 0.03);
+    fx_fini(&f);
+}
+
+/* Inside an incandescent sphere (matte, Kd 0, Ke 1: radiance 1, not a
+ * light) a lobe (as check_sphere_light's) viewed at theta degrees off
+ * the normal gives its directional albedo, estimated here by brute force
+ * with uniform directions over the hemisphere; returns it. */
+static double check_surroundings(int microfacet, float theta, float w, LobeCos lobe)
+{
+    RayesScene *s = rayes_scene_new();
+    RayesParam m[2] = {pf("Kd", 0.0f), pv("Ke", 1, 1, 1)};
+    CHECK(rayes_scene_set_shader(s, "matte", m, 2) == RAYES_OK);
+    CHECK(rayes_scene_sphere(s, 5.0f) == RAYES_OK);
+    Fx f;
+    fx_init(&f, s);
+    f.set.specular_depth = 4;
+    f.set.branch_depth = 1;
+    f.set.diffuse_rays = 16;
+    float th = theta * (float)PI / 180.0f;
+    Vec3 N = v3(0, 0, 1), I = v3(sinf(th), 0, -cosf(th));
+    double got[3], sum = 0.0;
+    fx_lobe(&f, microfacet, v3(0, 0, 0), N, I, microfacet ? w : 1.0f / w, 256, got);
+    const int n = 1 << 21;
+    for (int j = 0; j < n; j++) {
+        double u1 = rng_float(hash_combine(99, 2 * (uint64_t)j));
+        double u2 = rng_float(hash_combine(99, 2 * (uint64_t)j + 1));
+        double ct = u1, st = sqrt(fmax(0, 1 - ct * ct)), ph = 2 * PI * u2;
+        Vec3 wi = v3((float)(st * cos(ph)), (float)(st * sin(ph)), (float)ct);
+        sum += lobe(N, v3_neg(I), wi, w);
+    }
+    double want = sum / n * 2 * PI;
+    CHECK_NEAR(got[0] / want, 1.0, 0.02);
+    fx_fini(&f);
+    return want;
+}
+
 /* Lights through a glossy lobe (multiple importance sampling) against the
  * brute-force integral over the light's cone: small and large spheres,
  * sharp and broad lobes, the light at and off the mirror direction. The
@@ -895,135 +950,45 @@ static void test_glossy_lights_against_brute_force(void)
         float radius, x, e;
     } cases[] = {{0.05f, 1.0f, 200}, {0.05f, 1.0f, 20}, {1.0f, 1.0f, 200},
                  {1.0f, 1.0f, 20},   {0.3f, 2.5f, 50},  {0.05f, 1.0f, 2000}};
-    for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
-        RayesScene *s = rayes_scene_new();
-        Vec3 C = v3(cases[k].x, 0, 3);
-        const float move[16] = {1, 0, 0, C.x, 0, 1, 0, C.y, 0, 0, 1, C.z, 0, 0, 0, 1};
-        CHECK(rayes_scene_set_transform(s, move) == RAYES_OK);
-        RayesParam p[3] = {ps("shape", "sphere"), pf("radius", cases[k].radius),
-                           pf("intensity", 1.0f / (cases[k].radius * cases[k].radius))};
-        CHECK(rayes_scene_light(s, "arealight", p, 3) == RAYES_OK);
-        Fx f;
-        fx_init(&f, s);
-        f.set.specular_depth = 4;
-        f.set.branch_depth = 1;
-        f.set.diffuse_rays = 4;
-        /* viewed so that the mirror direction points at x = 1 */
-        Vec3 N = v3(0, 0, 1), R = v3_normalize(v3(1, 0, 3)), I = v3(R.x, 0, -R.z);
-        double got[3];
-        fx_glossy(&f, v3(0, 0, 0), N, I, 1.0f / cases[k].e, 256, got);
-        double want = brute_sphere(C, cases[k].radius, 1.0 / (cases[k].radius * cases[k].radius), N,
-                                   v3_neg(I), cases[k].e, lobe_cos);
-        CHECK(want > 0.0);
-        CHECK_NEAR(got[0] / want, 1.0, 0.03);
-        fx_fini(&f);
-    }
+    for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++)
+        check_sphere_light(0, cases[k].radius, cases[k].x, cases[k].e, lobe_cos);
 }
 
-/* What is not a light comes through the lobe's rays: inside an enclosing
- * incandescent sphere (matte, Kd 0, Ke 1: radiance 1, not a light) the
- * glossy service gives the lobe's directional albedo, estimated here by
- * brute force with uniform directions over the hemisphere. */
+/* What is not a light comes through the lobe's rays: the glossy service's
+ * directional albedo, 37 degrees off the normal. */
 static void test_glossy_surroundings_against_brute_force(void)
 {
-    RayesScene *s = rayes_scene_new();
-    RayesParam m[2] = {pf("Kd", 0.0f), pv("Ke", 1, 1, 1)};
-    CHECK(rayes_scene_set_shader(s, "matte", m, 2) == RAYES_OK);
-    CHECK(rayes_scene_sphere(s, 5.0f) == RAYES_OK);
-    Fx f;
-    fx_init(&f, s);
-    f.set.specular_depth = 4;
-    f.set.branch_depth = 1;
-    f.set.diffuse_rays = 16;
     static const float es[] = {20, 100};
     for (int k = 0; k < 2; k++) {
-        Vec3 N = v3(0, 0, 1), I = v3_normalize(v3(0.6f, 0, -0.8f));
-        double got[3];
-        fx_glossy(&f, v3(0, 0, 0), N, I, 1.0f / es[k], 256, got);
-        double sum = 0.0;
-        const int n = 1 << 21;
-        for (int j = 0; j < n; j++) {
-            double u1 = rng_float(hash_combine(99, 2 * (uint64_t)j));
-            double u2 = rng_float(hash_combine(99, 2 * (uint64_t)j + 1));
-            double ct = u1, st = sqrt(fmax(0, 1 - ct * ct)), ph = 2 * PI * u2;
-            Vec3 wi = v3((float)(st * cos(ph)), (float)(st * sin(ph)), (float)ct);
-            sum += lobe_cos(N, v3_neg(I), wi, es[k]);
-        }
-        double want = sum / n * 2 * PI;
+        double want = check_surroundings(0, 36.87f, es[k], lobe_cos);
         CHECK(want > 0.5 && want < 1.1);
-        CHECK_NEAR(got[0] / want, 1.0, 0.02);
     }
-    fx_fini(&f);
 }
 
 /* The microfacet service (GGX) against brute force, as the glossy
- * service's tests: lights (small and large spheres, narrow and broad
- * lobes, at and off the mirror direction), and what is not a light
- * (inside an incandescent sphere of radiance 1, the lobe's directional
- * albedo) at the normal, 60 and 80 degrees off it. Unlike Blinn-Phong's,
- * the albedo stays near 1 off the normal (the reason the physically based
- * shaders use it: pbrt's rough metals were dark toward their rims). */
+ * service's tests: lights, and the lobe's directional albedo at the
+ * normal, 60 and 80 degrees off it. Unlike Blinn-Phong's, the albedo
+ * changes little off the normal (the reason the physically based shaders
+ * use it: pbrt's rough metals were dark toward their rims). */
 static void test_microfacet_against_brute_force(void)
 {
     static const struct {
         float radius, x, alpha;
     } cases[] = {{0.05f, 1.0f, 0.05f}, {0.05f, 1.0f, 0.3f}, {1.0f, 1.0f, 0.05f},
                  {1.0f, 1.0f, 0.3f},   {0.3f, 2.5f, 0.15f}, {0.3f, 1.0f, 0.6f}};
-    for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
-        RayesScene *s = rayes_scene_new();
-        Vec3 C = v3(cases[k].x, 0, 3);
-        const float move[16] = {1, 0, 0, C.x, 0, 1, 0, C.y, 0, 0, 1, C.z, 0, 0, 0, 1};
-        CHECK(rayes_scene_set_transform(s, move) == RAYES_OK);
-        RayesParam p[3] = {ps("shape", "sphere"), pf("radius", cases[k].radius),
-                           pf("intensity", 1.0f / (cases[k].radius * cases[k].radius))};
-        CHECK(rayes_scene_light(s, "arealight", p, 3) == RAYES_OK);
-        Fx f;
-        fx_init(&f, s);
-        f.set.specular_depth = 4;
-        f.set.branch_depth = 1;
-        f.set.diffuse_rays = 4;
-        Vec3 N = v3(0, 0, 1), R = v3_normalize(v3(1, 0, 3)), I = v3(R.x, 0, -R.z);
-        double got[3];
-        fx_lobe(&f, 1, v3(0, 0, 0), N, I, cases[k].alpha, 256, got);
-        double want = brute_sphere(C, cases[k].radius, 1.0 / (cases[k].radius * cases[k].radius), N,
-                                   v3_neg(I), cases[k].alpha, ggx_cos);
-        CHECK(want > 0.0);
-        CHECK_NEAR(got[0] / want, 1.0, 0.03);
-        fx_fini(&f);
-    }
-    RayesScene *s = rayes_scene_new();
-    RayesParam m[2] = {pf("Kd", 0.0f), pv("Ke", 1, 1, 1)};
-    CHECK(rayes_scene_set_shader(s, "matte", m, 2) == RAYES_OK);
-    CHECK(rayes_scene_sphere(s, 5.0f) == RAYES_OK);
-    Fx f;
-    fx_init(&f, s);
-    f.set.specular_depth = 4;
-    f.set.branch_depth = 1;
-    f.set.diffuse_rays = 16;
+    for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++)
+        check_sphere_light(1, cases[k].radius, cases[k].x, cases[k].alpha, ggx_cos);
     static const float alphas[] = {0.2f, 0.5f}, views[] = {0.0f, 60.0f, 80.0f};
-    double w0 = 1.0;
-    for (int k = 0; k < 2; k++)
+    for (int k = 0; k < 2; k++) {
+        double w0 = 1.0; /* along the normal */
         for (int v = 0; v < 3; v++) {
-            float th = views[v] * (float)PI / 180.0f;
-            Vec3 N = v3(0, 0, 1), I = v3(sinf(th), 0, -cosf(th));
-            double got[3], sum = 0.0;
-            fx_lobe(&f, 1, v3(0, 0, 0), N, I, alphas[k], 256, got);
-            const int n = 1 << 21;
-            for (int j = 0; j < n; j++) {
-                double u1 = rng_float(hash_combine(99, 2 * (uint64_t)j));
-                double u2 = rng_float(hash_combine(99, 2 * (uint64_t)j + 1));
-                double ct = u1, st = sqrt(fmax(0, 1 - ct * ct)), ph = 2 * PI * u2;
-                Vec3 wi = v3((float)(st * cos(ph)), (float)(st * sin(ph)), (float)ct);
-                sum += ggx_cos(N, v3_neg(I), wi, alphas[k]);
-            }
-            double want = sum / n * 2 * PI;
+            double want = check_surroundings(1, views[v], alphas[k], ggx_cos);
             if (v == 0)
-                w0 = want; /* along the normal */
+                w0 = want;
             CHECK(want > 0.6 && want < 1.0);
             CHECK(want > 0.85 * w0); /* Blinn-Phong's: (N.V)^2, 0.25 and 0.03 */
-            CHECK_NEAR(got[0] / want, 1.0, 0.02);
         }
-    fx_fini(&f);
+    }
 }
 
 /* ------------------------------------------- emitters seen by the camera */
