@@ -44,6 +44,7 @@ static size_t point(const RayesShadeCtx *ctx, size_t i)
 typedef struct Lobe {
     Vec3 N, t, b; /* the frame about N */
     Vec3 V;       /* toward the viewer */
+    Vec3 Vl;      /* GGX's: V in the frame, kept just above the surface */
     float e;      /* Blinn-Phong's exponent */
     float alpha;  /* GGX's width; 0: Blinn-Phong */
 } Lobe;
@@ -54,35 +55,35 @@ typedef struct Lobe {
 
 static Lobe lobe_blinn(Vec3 N, Vec3 V, float e)
 {
-    Lobe l = {N, N, N, V, e, 0.0f};
+    Lobe l = {N, N, N, V, V, e, 0.0f};
     v3_basis(N, &l.t, &l.b);
     return l;
 }
 
+/* A direction in the lobe's frame. */
+static Vec3 lobe_local(const Lobe *l, Vec3 d)
+{
+    return v3(v3_dot(d, l->t), v3_dot(d, l->b), v3_dot(d, l->N));
+}
+
+/* The view is kept just above the surface: an interpolated normal may
+ * turn a little away from it, where Smith's G would otherwise black the
+ * lobe out. */
 static Lobe lobe_ggx(Vec3 N, Vec3 V, float alpha)
 {
     Lobe l = lobe_blinn(N, V, 0.0f);
     l.alpha = fmaxf(alpha, LOBE_MIN_ALPHA);
+    l.Vl = lobe_local(&l, V);
+    l.Vl.z = fmaxf(l.Vl.z, 1e-4f);
     return l;
-}
-
-/* A direction in the lobe's frame. The view is kept just above the
- * surface: an interpolated normal may turn a little away from it, where
- * Smith's G would otherwise black the lobe out. */
-static Vec3 lobe_local(const Lobe *l, Vec3 d, int view)
-{
-    Vec3 o = v3(v3_dot(d, l->t), v3_dot(d, l->b), v3_dot(d, l->N));
-    if (view && o.z < 1e-4f)
-        o.z = 1e-4f;
-    return o;
 }
 
 /* The lobe's value f toward wi (no cosine). */
 static float lobe_f(const Lobe *l, Vec3 wi)
 {
     if (l->alpha > 0.0f) {
-        Vec3 o = lobe_local(l, l->V, 1), i = lobe_local(l, wi, 0);
-        return i.z > 0.0f ? bsdf_ggx_eval(o, i, l->alpha) / i.z : 0.0f;
+        Vec3 i = lobe_local(l, wi);
+        return i.z > 0.0f ? bsdf_ggx_eval(l->Vl, i, l->alpha) / i.z : 0.0f;
     }
     Vec3 H = v3_normalize(v3_add(wi, l->V));
     float nh = fmaxf(v3_dot(l->N, H), 0.0f);
@@ -95,7 +96,7 @@ static float lobe_f(const Lobe *l, Vec3 wi)
 static float lobe_pdf(const Lobe *l, Vec3 wi)
 {
     if (l->alpha > 0.0f)
-        return bsdf_ggx_pdf(lobe_local(l, l->V, 1), lobe_local(l, wi, 0), l->alpha);
+        return bsdf_ggx_pdf(l->Vl, lobe_local(l, wi), l->alpha);
     Vec3 H = v3_normalize(v3_add(wi, l->V));
     float nh = v3_dot(l->N, H), vh = v3_dot(l->V, H);
     if (nh <= 0.0f || vh <= 0.0f)

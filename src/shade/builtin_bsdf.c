@@ -470,14 +470,15 @@ static void fresnel_split(const RayesShaderServices *sv, const RayesShadeCtx *ct
     if (n_refr > 0 && sv->indirect_refraction && n_rough == 0) {
         sv->indirect_refraction(sv, ctx, (const float(*)[3])dir, refr);
     } else if (n_refr > 0 && sv->indirect_refraction) { /* point by point */
+        int rays = lobe_rays(sv, ctx);
         for (size_t i = 0; i < ctx->n_points; i++) {
             RayesShadeCtx one;
             shade_ctx_slice(ctx, i, 1, &one);
             if (F[i] >= 1.0f)
                 continue;
             if (glossy && width[i] > 0.0f)
-                rough_refraction(sv, &one, width[i], leaving(ctx, i) ? 1.0f / eta : eta,
-                                 lobe_rays(sv, ctx), refr[i]);
+                rough_refraction(sv, &one, width[i], leaving(ctx, i) ? 1.0f / eta : eta, rays,
+                                 refr[i]);
             else
                 sv->indirect_refraction(sv, &one, (const float(*)[3])&dir[i], &refr[i]);
         }
