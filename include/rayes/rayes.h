@@ -458,6 +458,38 @@ RAYES_API RayesError rayes_scene_points(RayesScene *scene, RayesPointShape shape
                                         size_t n_points, const float *P, const RayesPrimvar *pv,
                                         size_t n_pv);
 
+/* Blobby implicit surfaces (RenderMan's RiBlobby): primitive fields
+ * combined by a small program; the surface is where the field reaches
+ * 0.421875 (a lone blob's surface at half its unit sphere), made polygons
+ * with normals from the field (docs/scenes.md "Blobby"). code, floats and
+ * strings are RiBlobby's arrays: opcodes 1000 constant (1 float), 1001
+ * ellipsoid (16 floats: the matrix from its unit sphere to object space,
+ * row vectors as RIB writes it), 1002 segment (two ends, a radius and such
+ * a matrix: 23 floats), 1003 repelling plane and 1004 field plugin (read,
+ * and taken as 0); 0 add, 1 multiply, 2 maximum, 3 minimum (a count, then
+ * that many operands), 4 subtract, 5 divide (two operands: first minus, or
+ * over, second), 6 negate, 7 identity (one); an operand is the index of an
+ * earlier instruction, and the last instruction is the field. n_leaf
+ * counts the primitive fields (opcodes 1000 and more) as RiBlobby's nleaf.
+ * Primitive variables "Cs", "Os" and "st": constant or uniform (1 value),
+ * or varying or vertex (n_leaf values, one per primitive field in code
+ * order), blended at each point by the fields' values there. A bad program
+ * is RAYES_ERROR_INVALID_ARGUMENT naming the instruction. */
+typedef struct RayesBlobby {
+    size_t n_leaf;   /* primitive fields, for vertex values */
+    const int *code; /* n_code opcodes and operands */
+    size_t n_code;
+    const float *floats; /* n_floats values the operands index */
+    size_t n_floats;
+    const char *const *strings; /* n_strings names the operands may index (depth maps
+                                   and plugins; unused in rendering, kept by the RIB
+                                   writer) */
+    size_t n_strings;
+} RayesBlobby;
+
+RAYES_API RayesError rayes_scene_blobby(RayesScene *scene, const RayesBlobby *blobby,
+                                        const RayesPrimvar *pv, size_t n_pv);
+
 /* A sphere of the given radius centred at the object-space origin. */
 RAYES_API RayesError rayes_scene_sphere(RayesScene *scene, float radius);
 

@@ -513,6 +513,13 @@ static int render_job(Args a, int frame, int number, Distributed *d)
             fprintf(stderr, "rayes: warning: %s\n", checkpoint_error(ck));
         checkpoint_fill(ck, img);
     }
+    if (settings.background[3] > 0.0f) /* over the background imager's colour */
+        for (size_t i = 0; i < (size_t)img->width * (size_t)img->height; i++) {
+            float *px = img->rgba + 4 * i;
+            for (int c = 0; c < 3; c++)
+                px[c] += (1.0f - px[3]) * settings.background[c];
+            px[3] = 1.0f;
+        }
     apply_exposure(img, settings.exposure_gain, settings.exposure_gamma);
     for (size_t i = 0; settings.opaque && i < (size_t)img->width * (size_t)img->height; i++)
         img->rgba[4 * i + 3] = 1.0f; /* a pbrt film: no alpha, the environment opaque */

@@ -491,7 +491,6 @@ static const RibRequest own_requests[] = {
     /* tier 1 and 2: read and skipped with one warning per request name */
     {"NuPatch", h_skip},
     {"TrimCurve", h_skip},
-    {"Blobby", h_skip},
     {"Procedural2", h_skip},
     {"Bxdf", h_skip},
     {"Light", h_skip},
@@ -506,7 +505,6 @@ static const RibRequest own_requests[] = {
     {"MakeCubeFaceEnvironment", h_skip},
     {"MakeLatLongEnvironment", h_skip},
     {"MakeBrickMap", h_skip},
-    {"Imager", h_skip},
     {"Atmosphere", h_skip},
     {"Interior", h_skip},
     {"Exterior", h_skip},

@@ -1,16 +1,19 @@
 /*
- * io/rib_curves.c — RenderMan's Curves and Points (docs/rib.md).
+ * io/rib_curves.c — RenderMan's Curves, Points and Blobby (docs/rib.md).
  *
  * Curves take the current v basis and step (RenderMan's rule for curves),
  * "width" (any class) or "constantwidth", "N" (ribbons), "Cs", "Os" and "st";
  * without N they are flat ribbons facing each ray, or tubes under
  * Attribute "dice" "roundcurve" 1. Points take "width" or
  * "constantwidth", "N" (oriented disks), "Cs", "st", and 3Delight's
- * "uniform string type" "sphere" (the default) or "disk".
+ * "uniform string type" "sphere" (the default) or "disk". Blobby passes
+ * its program's arrays as read, with "Cs", "Os" and "st" (one value, or
+ * one per primitive field).
  */
 #include <float.h>
 #include <limits.h>
 #include <math.h>
+#include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -196,8 +199,91 @@ static int h_points(Rib *r, const Args *a)
     return e;
 }
 
+/* Blobby nleaf [code] [floats] [strings] parameters. */
+static int h_blobby(Rib *r, const Args *a)
+{
+    size_t i = 0, n_nleaf = 0, n_code = 0, n = 0;
+    int *nleaf = NULL, *code = NULL;
+    float *floats = NULL;
+    Param *p = NULL;
+    Vars vars = {0};
+    int e = rib_get_ints(r, a, &i, &nleaf, &n_nleaf, 0, 1 << 24, "the number of blobs");
+    if (e == 0 && n_nleaf != 1)
+        e = rib_error(r, "expected one number of blobs, found %zu numbers", n_nleaf);
+    if (e == 0)
+        e = rib_get_ints(r, a, &i, &code, &n_code, INT32_MIN, INT32_MAX, "the code array");
+    const Arg *fa = e == 0 && i < a->n ? &a->v[i] : NULL;
+    if (e == 0 && (!fa || !rib_is_num(fa)))
+        e = rib_error(r, "expected the float array");
+    size_t n_floats = fa && e == 0 ? fa->n : 0;
+    if (e == 0 && !(floats = malloc((n_floats ? n_floats : 1) * sizeof *floats)))
+        e = rib_error(r, "out of memory");
+    for (size_t k = 0; e == 0 && k < n_floats; k++) {
+        if (!(fabs(fa->d[k]) <= FLT_MAX))
+            e = rib_arg_error(r, fa, "float %zu (%g) is not a finite float", k + 1, fa->d[k]);
+        floats[k] = (float)fa->d[k];
+    }
+    i += e == 0;
+    const Arg *sa = e == 0 && i < a->n ? &a->v[i] : NULL;
+    size_t n_strings = 0;
+    if (e == 0 && sa && (sa->kind == ARG_STR || sa->kind == ARG_STRS))
+        n_strings = sa->n;
+    else if (e == 0 && !(sa && sa->kind == ARG_NUMS && sa->n == 0)) /* [] */
+        e = rib_error(r, "expected the string array");
+    i += e == 0;
+    if (e == 0)
+        e = rib_get_params(r, a, i, &p, &n);
+    size_t leaves = nleaf ? (size_t)nleaf[0] : 0;
+    Counts counts = {1, leaves, leaves, leaves};
+    if (e == 0)
+        e = rib_check_counts(r, p, n, &counts);
+    static const struct {
+        const char *name;
+        int size;
+    } names[3] = {{"Cs", 3}, {"Os", 3}, {"st", 2}};
+    for (int k = 0; k < 3 && e == 0; k++) {
+        const Param *q = rib_var_param(r, p, n, names[k].name, names[k].size);
+        if (q && q->d.cls == CLS_FACEVARYING)
+            e = rib_error(r, "\"%s\" cannot be facevarying on a blobby", names[k].name);
+        else if (q)
+            e = add_var(r, &vars, q, names[k].name, names[k].size);
+    }
+    for (size_t k = 0; e == 0 && k < n; k++)
+        if (p[k].declared && strcmp(p[k].d.name, "Cs") != 0 && strcmp(p[k].d.name, "Os") != 0 &&
+            strcmp(p[k].d.name, "st") != 0) {
+            char key[128];
+            snprintf(key, sizeof key, "unused %s", p[k].d.name);
+            rib_warn_once(r, key, "parameter \"%s\" is not used (a blobby takes Cs, Os and st)",
+                          p[k].d.name);
+        }
+    if (e == 0 && r->a.area)
+        rib_warn_once(r, "area shape",
+                      "only quads become area lights; other shapes under "
+                      "AreaLightSource are ordinary surfaces");
+    int begun = e == 0 ? rib_emit_begin(r, NULL) : e;
+    if (begun == 0) {
+        SinkState *st;
+        const IoSink *s = rib_out_sink(r, &st);
+        RayesBlobby b = {leaves,   code,     n_code,
+                         floats,   n_floats, (const char *const *)(n_strings ? sa->s : NULL),
+                         n_strings};
+        if (!s->blobby)
+            rib_warn_once(r, "blobby sink", "this sink takes no blobbies; skipped");
+        else if (s->blobby(s->target, &b, vars.pv, vars.n) != RAYES_OK)
+            e = rib_sink_failed(r, s);
+    } else if (begun != 1) /* 1: outside the world, nothing to draw */
+        e = begun;
+    rib_pv_out_free(&vars);
+    free(p);
+    free(floats);
+    free(code);
+    free(nleaf);
+    return e;
+}
+
 const RibRequest rib_curves_requests[] = {
     {"Curves", h_curves},
     {"Points", h_points},
+    {"Blobby", h_blobby},
     {NULL, NULL},
 };

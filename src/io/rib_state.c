@@ -8,6 +8,7 @@
  * WorldBegin the current transform is camera_from_object, after it
  * world_from_object (Attr.M).
  */
+#include <float.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -404,6 +405,47 @@ static int h_exposure(Rib *r, const Args *a)
         return rib_error(r, "gain and gamma must be positive");
     r->settings->exposure_gain = v[0];
     r->settings->exposure_gamma = v[1];
+    return 0;
+}
+
+/* Imager "background": the image composited over a colour (the
+ * "bgcolor", "background" or "color" parameter; white by default), as
+ * RenderMan's background imager shader does; other imagers are warned. */
+static int h_imager(Rib *r, const Args *a)
+{
+    size_t i = 0, n = 0;
+    const char *name = rib_get_string(r, a, &i, "an imager shader name");
+    if (!name)
+        return -1;
+    if (strcmp(name, "background") != 0) {
+        rib_warn_once(r, "imager",
+                      "Imager \"%s\" is not supported; ignored (rayes has "
+                      "\"background\")",
+                      name);
+        return 0;
+    }
+    Param *p = NULL;
+    if (rib_get_params(r, a, i, &p, &n) != 0)
+        return -1;
+    float bg[3] = {1.0f, 1.0f, 1.0f};
+    static const char *const names[] = {"bgcolor", "background", "color"};
+    for (int k = 0; k < 3; k++) {
+        const Param *q = rib_find_param(p, n, names[k]);
+        if (!q)
+            continue;
+        if (q->v->kind != ARG_NUMS || q->v->n != 3) {
+            free(p);
+            return rib_error(r, "\"%s\" needs one colour (3 numbers), found %zu", names[k],
+                             q->v->n);
+        }
+        for (int c = 0; c < 3; c++)
+            bg[c] = fabs(q->v->d[c]) <= FLT_MAX ? (float)q->v->d[c] : 0.0f;
+        break;
+    }
+    free(p);
+    for (int c = 0; c < 3; c++)
+        r->settings->background[c] = bg[c];
+    r->settings->background[3] = 1.0f;
     return 0;
 }
 
@@ -829,8 +871,8 @@ const RibRequest rib_state_requests[] = {
     {"Shutter", h_shutter}, {"DepthOfField", h_depth_of_field},
     {"PixelSamples", h_pixel_samples}, {"PixelFilter", h_pixel_filter},
     {"PixelVariance", h_pixel_variance}, {"Exposure", h_exposure}, {"Quantize", h_quantize},
-    {"Display", h_display}, {"Hider", h_hider}, {"ShadingRate", h_shading_rate},
-    {"Sides", h_sides}, {"Orientation", h_orientation},
+    {"Imager", h_imager}, {"Display", h_display}, {"Hider", h_hider},
+    {"ShadingRate", h_shading_rate}, {"Sides", h_sides}, {"Orientation", h_orientation},
     {"ReverseOrientation", h_reverse_orientation}, {"Color", h_color}, {"Opacity", h_color},
     {"Attribute", h_option_attribute}, {"Option", h_option_attribute}, {"Basis", h_basis},
     {NULL, NULL},

@@ -1077,6 +1077,33 @@ static RayesError w_points(void *t, RayesPointShape shape, size_t n, const float
     return RAYES_OK;
 }
 
+static RayesError w_blobby(void *t, const RayesBlobby *b, const RayesPrimvar *pv, size_t n_pv)
+{
+    RibWriter *w = t;
+    const size_t expect[5] = {1, 1, b ? b->n_leaf : 0, b ? b->n_leaf : 0, (size_t)-1};
+    if (!b || (b->n_code && !b->code) || (b->n_floats && !b->floats) ||
+        (b->n_strings && !b->strings) || !finite_all(b->floats, b->n_floats))
+        return fail(w, RAYES_ERROR_INVALID_ARGUMENT, "blobby: missing or non-finite arrays");
+    if (check_primvars(w, "blobby", pv, n_pv, expect) != RAYES_OK)
+        return RAYES_ERROR_INVALID_ARGUMENT;
+    FILE *f = w->world.f;
+    fprintf(f, "Blobby %zu [", b->n_leaf);
+    for (size_t i = 0; i < b->n_code; i++)
+        fprintf(f, i ? " %d" : "%d", b->code[i]);
+    fputs("]\n  ", f);
+    floats(f, b->floats, b->n_floats);
+    fputs("\n  [", f);
+    for (size_t i = 0; i < b->n_strings; i++) {
+        if (i)
+            fputc(' ', f);
+        string(f, b->strings[i]);
+    }
+    fputc(']', f);
+    primvars(f, pv, n_pv);
+    fputc('\n', f);
+    return RAYES_OK;
+}
+
 static RayesError w_quadric(void *t, RayesQuadric type, const float *p, size_t n, unsigned flags)
 {
     static const char *const names[] = {"Sphere",     "Cylinder",    "Cone", "Disk",
@@ -1340,6 +1367,7 @@ IoSink io_rib_writer_sink(RibWriter *w)
         .set_camera_motion = w_set_camera_motion,
         .set_depth_of_field = w_set_depth_of_field,
         .set_dice_blur = w_set_dice_blur,
+        .blobby = w_blobby,
     };
 }
 
@@ -1374,6 +1402,9 @@ static void settings_rib(FILE *f, const IoSettings *s)
     if (s->opacity_cache_mb > 0.0)
         fprintf(f, "Option \"limits\" \"int opacitycachememory\" [%.0f]\n",
                 s->opacity_cache_mb * 1e6 / 1024.0);
+    if (s->background[3] > 0.0f)
+        fprintf(f, "Imager \"background\" \"color bgcolor\" [%.9g %.9g %.9g]\n",
+                (double)s->background[0], (double)s->background[1], (double)s->background[2]);
     if (s->exposure_gain != 1.0f || s->exposure_gamma != 1.0f)
         fprintf(f, "Exposure %.9g %.9g\n", (double)s->exposure_gain, (double)s->exposure_gamma);
     if (s->crop[0] != 0.0f || s->crop[1] != 1.0f || s->crop[2] != 0.0f || s->crop[3] != 1.0f)

@@ -29,6 +29,7 @@
  *   area_light         AttributeBegin, AreaLightSource "arealight" N
  *                      "color lightcolor" L, Polygon, AttributeEnd
  *   light              LightSource with parameters ("from"/"to" as points)
+ *   blobby             Blobby with its arrays as given
  *
  * Not thread-safe; one writer per file.
  */

@@ -92,6 +92,11 @@ static RayesError scene_points(void *t, RayesPointShape shape, size_t n_points, 
     return rayes_scene_points(t, shape, n_points, P, pv, n_pv);
 }
 
+static RayesError scene_blobby(void *t, const RayesBlobby *b, const RayesPrimvar *pv, size_t n_pv)
+{
+    return rayes_scene_blobby(t, b, pv, n_pv);
+}
+
 static RayesError scene_polygon_mesh(void *t, size_t n_faces, const int *n_verts,
                                      const int *indices, size_t n_points, const float *P,
                                      const RayesPrimvar *pv, size_t n_pv)
@@ -244,6 +249,7 @@ IoSink io_sink_scene(RayesScene *scene)
         .set_camera_motion = scene_set_camera_motion,
         .set_depth_of_field = scene_set_depth_of_field,
         .set_dice_blur = scene_set_dice_blur,
+        .blobby = scene_blobby,
     };
 }
 

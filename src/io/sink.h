@@ -109,6 +109,10 @@ typedef struct IoSink {
                                     const float (*camera_from_world)[16]);
     RayesError (*set_depth_of_field)(void *target, float lens_radius, float focal_distance);
     RayesError (*set_dice_blur)(void *target, float motionfactor, float focusfactor);
+    /* rayes_scene_blobby (last, so older sinks leave it NULL: readers then
+     * skip blobbies with one warning). */
+    RayesError (*blobby)(void *target, const RayesBlobby *blobby, const RayesPrimvar *pv,
+                         size_t n_pv);
 } IoSink;
 
 /* A sink that builds scene through rayes.h (borrowed, not retained). */
@@ -147,6 +151,8 @@ typedef struct IoSettings {
     float crop[4];            /* xmin xmax ymin ymax in [0, 1] (RIB CropWindow); default 0 1 0 1 */
     float exposure_gain;      /* RIB Exposure; 1 when not given */
     float exposure_gamma;     /* RIB Exposure; 1 when not given */
+    float background[4];      /* RIB Imager "background": the colour the image is
+                                 composited over, before exposure; [3] 1 when given */
     int opaque;               /* 1: the format's films have no alpha (pbrt): images are
                                  written with alpha 1, the environment seen as pbrt shows it */
     IoDisplay displays[IO_MAX_DISPLAYS];

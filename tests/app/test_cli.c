@@ -682,9 +682,39 @@ static void test_frames_and_crop(void)
     expect_error(2, NULL, ARGS("render", "cornell", "--crop", "0.5,0.2,0,1"), ARGS("--crop"));
 }
 
+/* Imager "background": the image over its colour, before the exposure;
+ * the sphere keeps its own colour. */
+static void test_background_imager(void)
+{
+    static Run r;
+    setup();
+    write_text(SCRATCH_DIR "/bg.rib",
+               "Format 16 16 1\nExposure 1 2\nImager \"background\" \"color bgcolor\" [0.25 0 1]\n"
+               "WorldBegin\nSurface \"constant\"\nColor [0 1 0]\nTranslate 0 0 5\n"
+               "Sphere 0.5 -0.5 0.5 360\nWorldEnd\n");
+    run(&r, NULL,
+        ARGS("render", SCRATCH_DIR "/bg.rib", "--spp", "4", "--quiet", "-o",
+             SCRATCH_DIR "/bg.exr"));
+    CHECK(r.status == 0);
+    int w = 0, h = 0;
+    float *px = NULL;
+    char err[256];
+    CHECK(image_read_exr(SCRATCH_DIR "/bg.exr", &w, &h, &px, err, sizeof err) == RAYES_OK);
+    if (px && w == 16 && h == 16) {
+        const float *corner = px, *mid = px + 4 * (8 * 16 + 8);
+        CHECK_NEAR(corner[0], 0.5, 1e-4); /* 0.25 ^ (1 / 2) */
+        CHECK_NEAR(corner[1], 0.0, 1e-6);
+        CHECK_NEAR(corner[2], 1.0, 1e-4);
+        CHECK_NEAR(corner[3], 1.0, 0);
+        CHECK(mid[1] > 0.99f && mid[0] < 0.01f && mid[3] == 1.0f);
+    }
+    free(px);
+}
+
 TEST_MAIN(TEST(test_version_and_help), TEST(test_no_arguments), TEST(test_usage_errors),
           TEST(test_missing_data), TEST(test_render_outputs), TEST(test_render_summary),
           TEST(test_data_from_environment), TEST(test_unwritable_output), TEST(test_shader_path),
           TEST(test_render_obj), TEST(test_rib_grid_size), TEST(test_rib_opacity_cache_memory),
           TEST(test_vertex_budget), TEST(test_null_displacement), TEST(test_default_light),
-          TEST(test_convert), TEST(test_bad_scene_file), TEST(test_frames_and_crop))
+          TEST(test_convert), TEST(test_bad_scene_file), TEST(test_frames_and_crop),
+          TEST(test_background_imager))

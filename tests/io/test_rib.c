@@ -350,10 +350,25 @@ static void test_settings(void)
     CHECK(settings.filter == RAYES_FILTER_GAUSSIAN);
     CHECK_NEAR(settings.filter_width, 2, 0);
     CHECK_NEAR(settings.exposure_gamma, 2.2, 1e-6);
+    CHECK(settings.background[3] == 0.0f); /* no Imager */
     CHECK_NEAR(settings.crop[1], 0.5, 0);
     CHECK(settings.n_displays == 2);
     CHECK(strcmp(settings.displays[1].name, "b.png") == 0);
     CHECK(strcmp(settings.displays[0].type, "openexr") == 0);
+    /* Imager "background": its colour (bgcolor, or Aqsis files' "color"),
+     * white by default; other imagers are ignored. */
+    CHECK(parse("Imager \"background\" \"color bgcolor\" [0.5 0.25 0]\nWorldBegin\nWorldEnd\n") ==
+          RAYES_OK);
+    CHECK(settings.background[3] == 1.0f && settings.background[0] == 0.5f &&
+          settings.background[1] == 0.25f && settings.background[2] == 0.0f);
+    CHECK(parse("WorldBegin\nImager \"background\" \"color\" [0 1 0]\nWorldEnd\n") == RAYES_OK);
+    CHECK(settings.background[1] == 1.0f && settings.background[0] == 0.0f);
+    CHECK(parse("Imager \"background\"\nWorldBegin\nWorldEnd\n") == RAYES_OK);
+    CHECK(settings.background[3] == 1.0f && settings.background[2] == 1.0f);
+    CHECK(parse("Imager \"sepia\"\nWorldBegin\nWorldEnd\n") == RAYES_OK);
+    CHECK(settings.background[3] == 0.0f);
+    CHECK(parse("Imager \"background\" \"color bgcolor\" [1 2]\nWorldBegin\nWorldEnd\n") !=
+          RAYES_OK);
     /* RenderMan RIS's adaptive sampling: minsamples everywhere, up to
      * maxsamples where noisy */
     CHECK(parse("Hider \"raytrace\" \"int minsamples\" [8] \"int maxsamples\" [256]\n"

@@ -100,6 +100,7 @@ static void test_calls(void)
     s.filter = RAYES_FILTER_GAUSSIAN;
     s.filter_width = 3;
     s.exposure_gain = 2;
+    s.background[0] = 0.5f, s.background[3] = 1.0f;
     s.grid_size = 64;
     s.max_spp = 256;
     s.adaptive_error = 0.01f;
@@ -118,6 +119,7 @@ static void test_calls(void)
     CHECK(has(t, "PixelVariance 0.00999999978\n"));
     CHECK(has(t, "PixelFilter \"gaussian\" 3 3\n"));
     CHECK(has(t, "Exposure 2 1\n"));
+    CHECK(has(t, "Imager \"background\" \"color bgcolor\" [0.5 0 0]\n"));
     CHECK(has(t, "Option \"limits\" \"int gridsize\" [64]\n"));
     CHECK(has(t, "Display \"out.exr\" \"openexr\" \"rgba\"\n"));
     CHECK(has(t, "Display \"+z.exr\" \"openexr\" \"z\"\n"));
