@@ -464,9 +464,11 @@ RAYES_API RayesError rayes_scene_points(RayesScene *scene, RayesPointShape shape
  * with normals from the field (docs/scenes.md "Blobby"). code, floats and
  * strings are RiBlobby's arrays: opcodes 1000 constant (1 float), 1001
  * ellipsoid (16 floats: the matrix from its unit sphere to object space,
- * row vectors as RIB writes it), 1002 segment (two ends, a radius and such
- * a matrix: 23 floats), 1003 repelling plane and 1004 field plugin (read,
- * and taken as 0); 0 add, 1 multiply, 2 maximum, 3 minimum (a count, then
+ * row vectors as RIB writes it; its field (1 - r^2)^3), 1002 segment (two
+ * ends, a radius and such a matrix: 23 floats; the ellipsoid's field
+ * convolved along it, so that segments end to end make one tube), 1003
+ * repelling plane, 1004 field plugin and 9000 (AIR's plugin blob: a
+ * count, then operands) (read, and taken as 0); 0 add, 1 multiply, 2 maximum, 3 minimum (a count, then
  * that many operands), 4 subtract, 5 divide (two operands: first minus, or
  * over, second), 6 negate, 7 identity (one); an operand is the index of an
  * earlier instruction, and the last instruction is the field. n_leaf

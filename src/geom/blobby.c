@@ -19,7 +19,8 @@ enum {
     LEAF_ELLIPSOID = 1001,
     LEAF_SEGMENT = 1002,
     LEAF_PLANE = 1003,
-    LEAF_PLUGIN = 1004
+    LEAF_PLUGIN = 1004,
+    LEAF_AIR_DBO = 9000
 };
 
 #define BRICK 8      /* cubes per side of the lattice blocks visited whole */
@@ -164,27 +165,80 @@ static int make_leaf(Leaf *l, int kind, const float *f, char *msg, size_t n_msg,
         for (int c = 0; c < 3; c++)
             frob += l->blob_from_object.m[r][c] * l->blob_from_object.m[r][c];
     l->stretch = sqrtf(frob) * l->inv_radius;
+    /* A long segment's tube: (1 - d^2)^(7/2) = T. */
+    float r_t = kind == LEAF_SEGMENT ? sqrtf(1.0f - powf(BLOBBY_THRESHOLD, 2.0f / 7.0f))
+                                     : surface_radius();
     float s = largest_stretch(&l->blob_from_object) * l->inv_radius;
-    l->radius = s > 0.0f ? surface_radius() / s : 0.0f;
-    float reach = surface_radius() * radius * largest_stretch(&ob);
+    l->radius = s > 0.0f ? r_t / s : 0.0f;
+    float reach = r_t * radius * largest_stretch(&ob);
     float length = v3_length(mat4_vector(&ob, v3_sub(l->b, l->a)));
     l->area = 4.0f * (float)M_PI * reach * reach + 2.0f * (float)M_PI * reach * length;
     return 0;
 }
 
-/* The squared distance, in the leaf's unit, from blob-space q to the leaf;
- * d receives q minus its nearest point. */
-static float leaf_r2(const Leaf *l, Vec3 q, Vec3 *d)
+/* The bump's integral along a line, in units of the radius: with
+ * a = 1 - d^2 (d the distance to the line), the antiderivative of
+ * (a - u^2)^3 in u, and its derivative in a. */
+static inline double conv_g(double a, double u)
 {
-    if (l->kind == LEAF_SEGMENT) {
-        Vec3 ab = v3_sub(l->b, l->a);
-        float len2 = v3_dot(ab, ab);
-        float t = len2 > 0.0f ? v3_dot(v3_sub(q, l->a), ab) / len2 : 0.0f;
-        t = fminf(fmaxf(t, 0.0f), 1.0f);
-        q = v3_sub(q, v3_madd(l->a, ab, t));
+    double u2 = u * u;
+    return u * (a * a * a - a * a * u2 + 0.6 * a * u2 * u2 - u2 * u2 * u2 / 7.0);
+}
+static inline double conv_ga(double a, double u)
+{
+    double u2 = u * u;
+    return u * (3.0 * a * a - 2.0 * a * u2 + 0.6 * u2 * u2);
+}
+
+/* A segment's field at blob-space q: the bump convolved along the segment,
+ * scaled so that a long segment's axis has 1 (35/32 is 1 over the bump's
+ * integral across the line); its gradient in blob space to *dq when dq is
+ * not NULL. A chain of segments thus sums to a smooth tube. */
+static float segment_field(const Leaf *l, Vec3 q, Vec3 *dq)
+{
+    const double k = 35.0 / 32.0;
+    double ir = l->inv_radius;
+    Vec3 ab = v3_sub(l->b, l->a), aq = v3_sub(q, l->a);
+    double len = v3_length(ab);
+    if (dq)
+        *dq = v3(0, 0, 0);
+    if (!(len * ir > 1e-6)) { /* a point: the bump of its distance */
+        double r2 = v3_dot(aq, aq) * ir * ir;
+        if (!(r2 < 1.0))
+            return 0.0f;
+        double t = 1.0 - r2;
+        if (dq)
+            *dq = v3_scale(aq, (float)(-6.0 * t * t * ir * ir));
+        return (float)(t * t * t);
     }
-    *d = q;
-    return v3_dot(q, q) * l->inv_radius * l->inv_radius;
+    Vec3 e = v3_scale(ab, (float)(1.0 / len));
+    double t = v3_dot(aq, e);
+    Vec3 perp = v3_madd(aq, e, (float)-t);
+    double a = 1.0 - v3_dot(perp, perp) * ir * ir;
+    if (!(a > 0.0))
+        return 0.0f;
+    double w = sqrt(a), u0 = -t * ir, u1 = (len - t) * ir;
+    double lo = u0 > -w ? u0 : -w, hi = u1 < w ? u1 : w;
+    if (!(lo < hi))
+        return 0.0f;
+    double f = k * (conv_g(a, hi) - conv_g(a, lo));
+    if (dq) {
+        /* Through a (the distance to the line), and through an end that is
+         * the segment's own (a clamped one has a zero bump). */
+        double da = k * (conv_ga(a, hi) - conv_ga(a, lo)) * -2.0 * ir * ir;
+        Vec3 g = v3_scale(perp, (float)da);
+        double dt = 0.0;
+        if (hi == u1) {
+            double b = a - u1 * u1;
+            dt += k * b * b * b * -ir;
+        }
+        if (lo == u0) {
+            double b = a - u0 * u0;
+            dt -= k * b * b * b * -ir;
+        }
+        *dq = v3_madd(g, e, (float)dt);
+    }
+    return (float)f;
 }
 
 /* A leaf's field at p, and its gradient when g is not NULL. */
@@ -196,22 +250,31 @@ static float leaf_field(const Leaf *l, Vec3 p, Vec3 *g)
         return l->value;
     if (l->kind != LEAF_ELLIPSOID && l->kind != LEAF_SEGMENT)
         return 0.0f;
-    Vec3 d;
-    float r2 = leaf_r2(l, mat4_point(&l->blob_from_object, p), &d);
-    if (!(r2 < 1.0f))
-        return 0.0f;
-    float t = 1.0f - r2;
-    if (g) { /* dF/dq = -6 t^2 d / radius^2, then through the linear part (transposed) */
-        Vec3 v = v3_scale(d, -6.0f * t * t * l->inv_radius * l->inv_radius);
+    Vec3 q = mat4_point(&l->blob_from_object, p), v;
+    float f;
+    if (l->kind == LEAF_SEGMENT) {
+        f = segment_field(l, q, g ? &v : NULL);
+    } else {
+        float r2 = v3_dot(q, q);
+        if (!(r2 < 1.0f))
+            return 0.0f;
+        float t = 1.0f - r2;
+        f = t * t * t;
+        v = v3_scale(q, -6.0f * t * t); /* dF/dq */
+    }
+    if (g) { /* through the linear part, transposed */
         const float(*m)[4] = l->blob_from_object.m;
         *g = v3(m[0][0] * v.x + m[1][0] * v.y + m[2][0] * v.z,
                 m[0][1] * v.x + m[1][1] * v.y + m[2][1] * v.z,
                 m[0][2] * v.x + m[1][2] * v.y + m[2][2] * v.z);
     }
-    return t * t * t;
+    return f;
 }
 
-/* The range of a leaf's field over the ball of centre c and radius rho. */
+/* The range of a leaf's field over the ball of centre c and radius rho.
+ * An ellipsoid's bump falls with the distance; a segment's field is at
+ * most (1 - d^2)^(7/2) at distance d (in radii) from the segment, at
+ * least 0, and changes by at most 2.2 per radius. */
 static void leaf_range(const Leaf *l, Vec3 c, float rho, float *lo, float *hi)
 {
     if (l->kind == LEAF_CONSTANT) {
@@ -222,12 +285,26 @@ static void leaf_range(const Leaf *l, Vec3 c, float rho, float *lo, float *hi)
         *lo = *hi = 0.0f;
         return;
     }
-    Vec3 d;
-    float r = sqrtf(leaf_r2(l, mat4_point(&l->blob_from_object, c), &d));
+    Vec3 q = mat4_point(&l->blob_from_object, c);
     float s = rho * l->stretch;
-    float rlo = fmaxf(r - s, 0.0f), rhi = r + s;
-    *lo = bump(rhi * rhi);
-    *hi = bump(rlo * rlo);
+    if (l->kind == LEAF_ELLIPSOID) {
+        float r = v3_length(q);
+        float rlo = fmaxf(r - s, 0.0f), rhi = r + s;
+        *lo = bump(rhi * rhi);
+        *hi = bump(rlo * rlo);
+        return;
+    }
+    Vec3 ab = v3_sub(l->b, l->a);
+    float len2 = v3_dot(ab, ab);
+    float t = len2 > 0.0f ? fminf(fmaxf(v3_dot(v3_sub(q, l->a), ab) / len2, 0.0f), 1.0f) : 0.0f;
+    float d = v3_length(v3_sub(q, v3_madd(l->a, ab, t))) * l->inv_radius;
+    float dlo = fmaxf(d - s, 0.0f);
+    float top = dlo < 1.0f ? powf(1.0f - dlo * dlo, 3.5f) : 0.0f;
+    float f = segment_field(l, q, NULL);
+    *lo = fmaxf(f - 2.2f * s, 0.0f);
+    *hi = fminf(top, f + 2.2f * s);
+    if (*hi < *lo)
+        *hi = *lo;
 }
 
 /* ----------------------------------------------------------- compiling */
@@ -324,10 +401,23 @@ Blobby *blobby_compile(const int *code, size_t n_code, const float *floats, size
                 b->args[b->n_args++] = a;
             }
             in->n_args = (int)n;
+        } else if (op == LEAF_AIR_DBO) { /* AIR's plugin blob: a count, then operands */
+            if (rest < 1 || code[c] < 0 || (size_t)code[c] > rest - 1) {
+                bad = failf(msg, n_msg,
+                            "instruction %zu (opcode 9000): expected a count and that many "
+                            "operands",
+                            at);
+                break;
+            }
+            c += 1 + (size_t)code[c];
+            in->leaf = (int)b->n_leaves;
+            make_leaf(&b->leaves[b->n_leaves++], op, NULL, msg, n_msg, at);
+            b->n_unsupported++;
         } else {
             bad = failf(msg, n_msg,
-                        "instruction %zu: unknown opcode %d (expected 0 to 7 or 1000 to 1004)", at,
-                        op);
+                        "instruction %zu: unknown opcode %d (expected 0 to 7, 1000 to 1004 or "
+                        "9000)",
+                        at, op);
             break;
         }
         b->n_instr++;

@@ -3,15 +3,18 @@
  * polygons (DESIGN.md "Blobby implicit surfaces").
  *
  * A blobby is a program: primitive fields (the leaves: opcode 1000 a
- * constant, 1001 an ellipsoid, 1002 a segment, 1003 a repelling plane and
- * 1004 a field plugin, the last two read and taken as 0) combined by
+ * constant, 1001 an ellipsoid, 1002 a segment, 1003 a repelling plane,
+ * 1004 a field plugin and AIR's 9000 plugin blob (a count, then its
+ * operands), the last three read and taken as 0) combined by
  * operators (0 add, 1 multiply, 2 maximum, 3 minimum, 4 subtract, 5
  * divide, 6 negate, 7 identity) whose operands are earlier instructions;
  * the last instruction is the field. An ellipsoid's field is
  * (1 - r^2)^3 for r < 1, r the distance from its centre in the unit
- * sphere its matrix maps to object space; a segment's the same of the
- * distance to the segment over its radius. The surface is the field's
- * level set at BLOBBY_THRESHOLD, inside where the field is larger.
+ * sphere its matrix maps to object space; a segment's is that bump
+ * convolved along the segment (distances over its radius), scaled to 1 on
+ * a long segment's axis, so that segments end to end make one smooth tube
+ * (of radius 0.4675 times theirs). The surface is the field's level set at
+ * BLOBBY_THRESHOLD, inside where the field is larger.
  *
  * blobby_polygonize finds the surface on a lattice of cubes (dual
  * contouring's surface nets): only cubes an interval bound of the field

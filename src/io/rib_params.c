@@ -208,10 +208,12 @@ static int parse_decl(const char *s, Decl *d, int want_name)
         return -1;
     static const char *const classes[] = {"constant", "uniform", "varying", "vertex", "facevarying",
                                           "facevertex"};
-    static const char *const types[] = {"float", "integer", "string", "color", "point", "hpoint",
-                                        "matrix", "int", "vector", "normal", "bool"};
-    static const Ty type_of[] = {TY_FLOAT, TY_INT, TY_STRING, TY_COLOR, TY_POINT, TY_HPOINT,
-                                 TY_MATRIX, TY_INT, TY_POINT, TY_POINT, TY_INT};
+    /* mpoint: RenderMan's blob reference frame, a matrix per blob */
+    static const char *const types[] = {"float",  "integer", "string", "color",
+                                        "point",  "hpoint",  "matrix", "int",
+                                        "vector", "normal",  "bool",   "mpoint"};
+    static const Ty type_of[] = {TY_FLOAT, TY_INT,   TY_STRING, TY_COLOR, TY_POINT, TY_HPOINT,
+                                 TY_MATRIX, TY_INT,  TY_POINT,  TY_POINT, TY_INT,   TY_MATRIX};
     int k = 0, have_type = 0;
     d->cls = CLS_UNIFORM;
     d->array = 1;
@@ -233,7 +235,7 @@ static int parse_decl(const char *s, Decl *d, int want_name)
         char *br = strchr(words[k], '[');
         if (br)
             *br = '\0';
-        for (int t = 0; t < 11; t++)
+        for (int t = 0; t < (int)(sizeof types / sizeof *types); t++)
             if (strcmp(words[k], types[t]) == 0) {
                 d->ty = type_of[t];
                 have_type = 1;

@@ -84,7 +84,9 @@ static float filter_1d(int filter, float x, float r)
         return fmaxf(0.0f, expf(-alpha * x * x) - expf(-alpha * r * r));
     }
     case RAYES_FILTER_TRIANGLE: return fmaxf(0.0f, 1.0f - fabsf(x) / r);
-    case RAYES_FILTER_CATMULL_ROM: return mitchell(2.0f * x / r, 0.0f, 0.5f);
+    case RAYES_FILTER_CATMULL_ROM: /* RenderMan's: the cubic in pixels, windowed by the width
+                                      (not stretched to it: a width of 1 keeps its middle) */
+        return mitchell(x, 0.0f, 0.5f);
     case RAYES_FILTER_MITCHELL: return mitchell(2.0f * x / r, 1.0f / 3.0f, 1.0f / 3.0f);
     case RAYES_FILTER_LANCZOS: return sinc(x) * sinc(x / 3.0f); /* x in pixels, as pbrt's */
     default: return 1.0f;

@@ -1,7 +1,8 @@
 /*
  * Blobby implicit surfaces made polygons (geom/blobby.h): a lone blob is a
  * sphere of half its unit radius, closed and wound outward, with the
- * enclosed volume; ellipsoids and segments keep their shapes; adding
+ * enclosed volume; ellipsoids keep their shapes; a segment is a tube,
+ * and two end to end the same tube (a convolution); adding
  * blends two blobs into one piece where the maximum keeps them apart;
  * subtraction dents; the gradient is the field's; bad programs are
  * refused with the instruction named; a mesh over budget is refused.
@@ -183,6 +184,12 @@ static void test_subtract(void)
     blobby_mesh_free(&m);
 }
 
+/* A segment's tube: (1 - d^2)^(7/2) = T, d in radii. */
+static double tube_radius(double radius)
+{
+    return radius * sqrt(1.0 - pow(BLOBBY_THRESHOLD, 2.0 / 7.0));
+}
+
 static void test_segment(void)
 {
     float f[23] = {-1, 0, 0, 1, 0, 0, 0.5f};
@@ -195,13 +202,41 @@ static void test_segment(void)
         Vec3 p = point(&m, (int)i);
         if (fabsf(p.x) < 0.5f) {
             middle++;
-            worst = fmax(worst, fabs(hypot(p.y, p.z) - 0.25));
+            worst = fmax(worst, fabs(hypot(p.y, p.z) - tube_radius(0.5)));
         }
         CHECK(fabsf(p.x) < 1.26f);
     }
     CHECK(middle > 100 && worst < 1e-4);
     CHECK(closed(&m));
     blobby_mesh_free(&m);
+    /* Two segments end to end convolve to the one they make: the same
+     * field everywhere, so no bead at the joint. */
+    float g[46] = {-1, 0, 0, 0, 0, 0, 0.5f};
+    blob(g + 7, 1, 1, 1, 0, 0, 0);
+    const float second[7] = {0, 0, 0, 1, 0, 0, 0.5f};
+    memcpy(g + 23, second, sizeof second);
+    blob(g + 30, 1, 1, 1, 0, 0, 0);
+    const int chain[] = {1002, 0, 1002, 23, 0, 2, 0, 1};
+    Blobby *one = blobby_compile(code, 2, f, 23, 0, msg, sizeof msg);
+    Blobby *two = blobby_compile(chain, 8, g, 46, 0, msg, sizeof msg);
+    CHECK(one && two);
+    const Vec3 at[4] = {{0, 0.2f, 0}, {0.05f, 0.1f, 0.15f}, {-0.7f, 0, 0.3f}, {1.1f, 0.1f, 0}};
+    for (int i = 0; one && two && i < 4; i++) {
+        Vec3 ga, gb;
+        CHECK_NEAR(blobby_field(one, at[i], &ga), blobby_field(two, at[i], &gb), 1e-5);
+        CHECK(v3_length(v3_sub(ga, gb)) < 1e-4f);
+        /* and the gradient is the field's */
+        const float e = 1e-3f;
+        for (int a = 0; a < 3; a++) {
+            Vec3 d = v3(a == 0 ? e : 0, a == 1 ? e : 0, a == 2 ? e : 0);
+            float fd = (blobby_field(one, v3_add(at[i], d), NULL) -
+                        blobby_field(one, v3_sub(at[i], d), NULL)) /
+                       (2 * e);
+            CHECK_NEAR(v3_index(ga, a), fd, 2e-3 * (1 + fabs(fd)));
+        }
+    }
+    blobby_free(one);
+    blobby_free(two);
 }
 
 static void test_gradient(void)
