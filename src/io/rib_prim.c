@@ -568,9 +568,38 @@ static int add_sharp(Rib *r, int **ints, float **sharp, size_t *count, const dou
 
 /* Reads tags nargs intargs floatargs (and stringargs for the
  * hierarchical form, per = 3) from *i on. */
+/* Whether a bare string after a mesh's indices names a tag (some writers
+ * leave out the brackets of a one-tag array) rather than a parameter. */
+static int is_tag_name(const char *s)
+{
+    static const char *const tags[] = {"interpolateboundary",
+                                       "facevaryinginterpolateboundary",
+                                       "crease",
+                                       "corner",
+                                       "hole",
+                                       "creasemethod",
+                                       "facevaryingpropagatecorners",
+                                       "smoothtriangles",
+                                       "vertexedit",
+                                       "edgeedit",
+                                       "faceedit",
+                                       NULL};
+    for (int k = 0; tags[k]; k++)
+        if (strcmp(s, tags[k]) == 0)
+            return 1;
+    return 0;
+}
+
 static int subdiv_tags(Rib *r, const Args *a, size_t *i, int per, SubdivTags *out)
 {
     size_t n_tags, n_nargs, n_int, n_float, n_str = 0;
+    /* The tag arrays may be left out altogether (no tags): the parameters
+     * follow the indices. */
+    if (*i >= a->n || (a->v[*i].kind == ARG_STR && !is_tag_name(a->v[*i].s[0]))) {
+        out->t.interpolate_boundary = 0; /* RenderMan's default */
+        out->t.facevarying_boundary = 1;
+        return 0;
+    }
     char *const *tags = str_array(r, a, i, &n_tags, "the tags (strings)");
     const double *nargs = tags ? num_array(r, a, i, &n_nargs, "the tags' argument counts") : NULL;
     const double *iv = nargs ? num_array(r, a, i, &n_int, "the tags' integer arguments") : NULL;

@@ -66,6 +66,18 @@ static void test_rib_tags(void)
     CHECK(rec.n_mesh == 1 && rec.mesh[0].scheme == RAYES_SUBDIV_LOOP);
     CHECK(rec.mesh[0].tags.interpolate_boundary == 0 && rec.mesh[0].tags.facevarying_boundary == 1);
     record_free(&rec);
+    /* The tag arrays left out altogether (Aqsis's motion blur example);
+     * a bare tag name still reads as a one-tag array. */
+    CHECK(rib("WorldBegin\nSubdivisionMesh \"catmull-clark\" [3 3 3 3] [0 1 3 1 2 3 2 0 3 2 1 0]\n"
+              "\"P\" [1 0 0 -0.5 1 0 -0.5 -1 0 0 0 1]\nWorldEnd\n") == RAYES_OK);
+    CHECK(rec.n_mesh == 1 && rec.mesh[0].n_faces == 4 && rec.mesh[0].n_points == 4);
+    CHECK(rec.mesh[0].tags.interpolate_boundary == 0);
+    record_free(&rec);
+    CHECK(rib("WorldBegin\nSubdivisionMesh \"catmull-clark\" [3] [0 1 2] \"interpolateboundary\" "
+              "[0 0] "
+              "[] []\n\"P\" [0 0 0 1 0 0 0 1 0]\nWorldEnd\n") == RAYES_OK);
+    CHECK(rec.n_mesh == 1 && rec.mesh[0].tags.interpolate_boundary == 1);
+    record_free(&rec);
     /* HierarchicalSubdivisionMesh: three counts per tag and string
      * arguments. */
     CHECK(rib("WorldBegin\nHierarchicalSubdivisionMesh \"bilinear\" [4] [0 1 2 3]\n"
