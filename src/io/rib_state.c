@@ -434,9 +434,10 @@ static int h_imager(Rib *r, const Args *a)
         if (!q)
             continue;
         if (q->v->kind != ARG_NUMS || q->v->n != 3) {
+            size_t got = q->v->n;
             free(p);
             return rib_error(r, "\"%s\" needs one colour (3 numbers), found %zu", names[k],
-                             q->v->n);
+                             got);
         }
         for (int c = 0; c < 3; c++)
             bg[c] = fabs(q->v->d[c]) <= FLT_MAX ? (float)q->v->d[c] : 0.0f;
