@@ -492,6 +492,28 @@ typedef struct RayesBlobby {
 RAYES_API RayesError rayes_scene_blobby(RayesScene *scene, const RayesBlobby *blobby,
                                         const RayesPrimvar *pv, size_t n_pv);
 
+/* Constructive solid geometry (RenderMan's SolidBegin/SolidEnd): blocks
+ * nest into a tree of solids. The primitives given inside a primitive
+ * solid's block are its closed surface, its inside behind their fronts
+ * (counter-clockwise seen from outside; quadrics unless reversed); union,
+ * intersection and difference (the first child less the others) combine
+ * the solids given in their blocks. A ray sees a surface of a solid where
+ * it bounds its tree's result: a difference's holes are open, their walls
+ * the subtracted solids' surfaces. Geometry in a boolean block but no
+ * primitive one, and solids in object definitions, are drawn as they are
+ * (one warning). A primitive solid inside a primitive solid, or an end
+ * without a begin, is RAYES_ERROR_INVALID_ARGUMENT; blocks left open end
+ * with the scene. */
+typedef enum RayesSolidOp {
+    RAYES_SOLID_PRIMITIVE = 0,
+    RAYES_SOLID_UNION = 1,
+    RAYES_SOLID_INTERSECTION = 2,
+    RAYES_SOLID_DIFFERENCE = 3
+} RayesSolidOp;
+
+RAYES_API RayesError rayes_scene_solid_begin(RayesScene *scene, RayesSolidOp op);
+RAYES_API RayesError rayes_scene_solid_end(RayesScene *scene);
+
 /* A sphere of the given radius centred at the object-space origin. */
 RAYES_API RayesError rayes_scene_sphere(RayesScene *scene, float radius);
 

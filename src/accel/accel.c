@@ -76,8 +76,9 @@ typedef struct Geom {
  * master space, traced only through instances). */
 typedef struct Level {
     RTCScene scene;    /* NULL: a master no instance places */
-    RTCScene also;     /* while building: an object's own scene that takes the geometries
-                          too (level 0 only), or NULL */
+    RTCScene also[3];  /* while building: an object's own scene, a primitive solid's and all
+                          solids' that take the geometries too (level 0 only), or NULL */
+    int only_also;     /* while building: the level's scene does not take them (solids) */
     Geom *geoms;       /* indexed by geomID */
     size_t n_geoms;
 } Level;
@@ -89,6 +90,13 @@ struct Accel {
     size_t n_levels;
     RTCScene *object_scene; /* per object: its own scene (ACCEL_MASK_OWN_SCENE), or NULL */
     size_t n_objects;
+    uint32_t *object_mask;  /* per object: its ray mask (solids' geometries have
+                               ACCEL_MASK_SOLID instead; queries check this) */
+    RTCScene *solid_scene;  /* per node of the solids' tree: a primitive solid's surfaces
+                               alone, or NULL */
+    Bounds3 *solid_bound;   /* per node: a primitive solid's bound (its grids' vertices) */
+    RTCScene solids;        /* every primitive solid's surfaces (not in the world's scene:
+                               intersect_solids finds them), or NULL */
     atomic_llong bytes; /* Embree's allocations, from the memory monitor */
     AccelRecord *record; /* NULL, or where queries are kept (record.h) */
     char error[256];   /* the first Embree error */
@@ -129,9 +137,12 @@ static int attach(Level *lv, RTCGeometry geom, uint32_t mask, Geom g)
         rtcSetGeometryOccludedFilterFunction(geom, transmission_filter);
     rtcSetGeometryMask(geom, mask & ~(ACCEL_MASK_TRANSPARENT | ACCEL_MASK_OWN_SCENE));
     rtcCommitGeometry(geom);
-    unsigned id = rtcAttachGeometry(lv->scene, geom);
-    if (lv->also)
-        rtcAttachGeometryByID(lv->also, geom, id);
+    unsigned id = (unsigned)lv->n_geoms;
+    if (!lv->only_also)
+        id = rtcAttachGeometry(lv->scene, geom);
+    for (int k = 0; k < 3; k++)
+        if (lv->also[k])
+            rtcAttachGeometryByID(lv->also[k], geom, id);
     rtcReleaseGeometry(geom);
     RY_CHECK(id == lv->n_geoms);
     return add_geom(lv, g);
@@ -541,7 +552,7 @@ static int grid_group(const GridSet *gs, const Grid *g)
 /* A grid's place in the build order: by level, object, kind of geometry,
  * then index (runs of equal level, object and kind are one geometry). */
 typedef struct GridKey {
-    uint32_t master, object, group, grid;
+    uint32_t master, object, solid, group, grid;
 } GridKey;
 
 static int cmp_keys(const void *pa, const void *pb)
@@ -551,6 +562,8 @@ static int cmp_keys(const void *pa, const void *pb)
         return a->master < b->master ? -1 : 1;
     if (a->object != b->object)
         return a->object < b->object ? -1 : 1;
+    if (a->solid != b->solid)
+        return a->solid < b->solid ? -1 : 1;
     if (a->group != b->group)
         return a->group < b->group ? -1 : 1;
     return a->grid < b->grid ? -1 : a->grid > b->grid;
@@ -610,7 +623,8 @@ static int build_levels(Accel *a, const uint32_t *object_mask, const uint8_t *in
         return -1;
     for (size_t k = 0; k < gs->n_grids; k++) {
         const Grid *g = &gs->grids[k];
-        keys[k] = (GridKey){g->master, g->object, (uint32_t)grid_group(gs, g), (uint32_t)k};
+        uint32_t solid = g->master == 0 && g->solid <= gs->n_solids ? g->solid : 0;
+        keys[k] = (GridKey){g->master, g->object, solid, (uint32_t)grid_group(gs, g), (uint32_t)k};
     }
     qsort(keys, gs->n_grids, sizeof *keys, cmp_keys);
     for (size_t k = 0; k < gs->n_grids; k++)
@@ -619,20 +633,34 @@ static int build_levels(Accel *a, const uint32_t *object_mask, const uint8_t *in
         const Grid *g = &gs->grids[order[k]];
         size_t n = 1;
         while (k + n < gs->n_grids && keys[k + n].master == keys[k].master &&
-               keys[k + n].object == keys[k].object && keys[k + n].group == keys[k].group)
+               keys[k + n].object == keys[k].object && keys[k + n].solid == keys[k].solid &&
+               keys[k + n].group == keys[k].group)
             n++;
         Level *lv = &a->levels[g->master];
         if (!lv->scene)
             lv->scene = new_scene(a, 1);
         uint32_t mask = grid_mask(g, object_mask, inherit_transparent);
-        lv->also = NULL;
+        lv->also[0] = lv->also[1] = lv->also[2] = NULL;
+        lv->only_also = 0;
         if (g->master == 0 && (mask & ACCEL_MASK_OWN_SCENE) && g->object < a->n_objects) {
             if (!a->object_scene[g->object])
                 a->object_scene[g->object] = new_scene(a, 0);
-            lv->also = a->object_scene[g->object];
+            lv->also[0] = a->object_scene[g->object];
+        }
+        uint32_t solid = keys[k].solid;
+        if (solid) { /* a primitive solid's surface: found by solid queries alone, opaque */
+            if (!a->solid_scene[solid - 1])
+                a->solid_scene[solid - 1] = new_scene(a, 1);
+            lv->also[1] = a->solid_scene[solid - 1];
+            if (!a->solids)
+                a->solids = new_scene(a, 1);
+            lv->also[2] = a->solids;
+            lv->only_also = 1;
+            mask = ACCEL_MASK_SOLID | (mask & ACCEL_MASK_OWN_SCENE);
         }
         int rc = build_run(a, lv, order + k, n, mask, (int)keys[k].group);
-        lv->also = NULL;
+        lv->also[0] = lv->also[1] = lv->also[2] = NULL;
+        lv->only_also = 0;
         if (rc != 0) {
             free(keys);
             return -1;
@@ -696,10 +724,15 @@ Accel *accel_new(const GridSet *gs, const uint32_t *object_mask, size_t n_object
         a->levels = calloc(gs->n_masters + 1, sizeof *a->levels);
         a->object_scene = calloc(n_objects + 1, sizeof *a->object_scene);
         a->n_objects = n_objects;
+        a->object_mask = malloc((n_objects + 1) * sizeof *a->object_mask);
+        a->solid_scene = calloc(gs->n_solids + 1, sizeof *a->solid_scene);
+        a->solid_bound = malloc((gs->n_solids + 1) * sizeof *a->solid_bound);
     }
-    if (!a || !a->levels || !a->object_scene || !order || !inherit_transparent) {
+    if (!a || !a->levels || !a->object_scene || !a->object_mask || !a->solid_scene ||
+        !a->solid_bound || !order || !inherit_transparent) {
         if (a)
-            free(a->levels), free(a->object_scene);
+            free(a->levels), free(a->object_scene), free(a->object_mask), free(a->solid_scene),
+                free(a->solid_bound);
         free(a);
         free(order);
         free(inherit_transparent);
@@ -708,6 +741,24 @@ Accel *accel_new(const GridSet *gs, const uint32_t *object_mask, size_t n_object
     }
     a->n_levels = gs->n_masters + 1;
     a->gs = gs;
+    if (n_objects)
+        memcpy(a->object_mask, object_mask, n_objects * sizeof *object_mask);
+    for (size_t k = 0; k < gs->n_solids; k++)
+        a->solid_bound[k] = bounds_empty();
+    for (size_t k = 0; k < gs->n_grids; k++) { /* primitive solids' bounds, a little wider */
+        const Grid *g = &gs->grids[k];
+        if (g->master || !g->solid || g->solid > gs->n_solids)
+            continue;
+        Bounds3 *b = &a->solid_bound[g->solid - 1];
+        for (size_t i = 0; i < geom_grid_n_vertices(g); i++)
+            for (int t = 0; t < (g->moving ? gs->n_times : 1); t++)
+                *b = bounds_add(*b, geom_vertex_P_at_sample(gs, g, g->first_vertex + i, t));
+    }
+    for (size_t k = 0; k < gs->n_solids; k++) {
+        Bounds3 *b = &a->solid_bound[k];
+        Vec3 m = v3_scale(v3_sub(b->hi, b->lo), 1e-3f);
+        b->lo = v3_sub(b->lo, m), b->hi = v3_add(b->hi, m);
+    }
     atomic_init(&a->bytes, 0);
     a->device = rtcNewDevice("verbose=0");
     if (!a->device) {
@@ -715,6 +766,9 @@ Accel *accel_new(const GridSet *gs, const uint32_t *object_mask, size_t n_object
                  (int)rtcGetDeviceError(NULL));
         free(a->levels);
         free(a->object_scene);
+        free(a->object_mask);
+        free(a->solid_scene);
+        free(a->solid_bound);
         free(a);
         free(order);
         free(inherit_transparent);
@@ -733,6 +787,11 @@ Accel *accel_new(const GridSet *gs, const uint32_t *object_mask, size_t n_object
     for (size_t o = 0; o < n_objects && rc == 0; o++)
         if (a->object_scene[o])
             rtcCommitScene(a->object_scene[o]);
+    for (size_t k = 0; k < gs->n_solids && rc == 0; k++)
+        if (a->solid_scene[k])
+            rtcCommitScene(a->solid_scene[k]);
+    if (a->solids && rc == 0)
+        rtcCommitScene(a->solids);
     if (rc != 0 || a->error[0]) {
         snprintf(err, err_size, "%s", a->error[0] ? a->error : "out of memory in Embree");
         accel_free(a);
@@ -762,6 +821,14 @@ void accel_free(Accel *a)
         if (a->object_scene[o])
             rtcReleaseScene(a->object_scene[o]);
     free(a->object_scene);
+    for (size_t k = 0; a->solid_scene && k < a->gs->n_solids; k++)
+        if (a->solid_scene[k])
+            rtcReleaseScene(a->solid_scene[k]);
+    free(a->solid_scene);
+    free(a->solid_bound);
+    free(a->object_mask);
+    if (a->solids)
+        rtcReleaseScene(a->solids);
     if (a->device)
         rtcReleaseDevice(a->device);
     free(a);
@@ -788,7 +855,7 @@ static void set_ray(const Accel *a, struct RTCRay *r, const Ray *ray)
     r->tnear = ray->tnear;
     r->tfar = ray->tfar;
     r->time = embree_time(a, ray);
-    r->mask = ray->mask;
+    r->mask = ray->mask & ~ACCEL_MASK_SOLID; /* solids' surfaces: intersect_solids */
     r->id = 0;
     r->flags = 0;
 }
@@ -1073,11 +1140,121 @@ void accel_attach_record(Accel *a, AccelRecord *record)
     a->record = record;
 }
 
+/* ------------------------------------------------------------ solids */
+
+/* Whether point x is inside primitive solid k: within its bound, and the
+ * nearest of its surfaces along d from x is met from behind (the solid's
+ * inside lies behind its surfaces' fronts). */
+static int inside_solid(const Accel *a, size_t k, Vec3 x, Vec3 d, float time)
+{
+    const Bounds3 *b = &a->solid_bound[k];
+    if (!a->solid_scene[k] || x.x < b->lo.x || x.y < b->lo.y || x.z < b->lo.z ||
+        x.x > b->hi.x || x.y > b->hi.y || x.z > b->hi.z)
+        return 0;
+    Ray r = {x, d, 0.0f, INFINITY, ~0u, time};
+    Hit h;
+    return intersect_scene(a, a->solid_scene[k], &r, ~0u, 1, &h) && v3_dot(h.Ng, d) > 0.0f;
+}
+
+/* Whether node k of a tree (indices from its root, 0) holds a point, the
+ * primitive solids' states given (in[], per node). */
+static int solid_holds(const GeomSolid *s, size_t k, size_t root, const uint8_t *in)
+{
+    if (s[k].op == GEOM_SOLID_PRIMITIVE)
+        return in[k - root];
+    int any = 0, all = 1, first = -1, rest = 0;
+    for (size_t c = k + 1; c < s[k].end; c = s[c].end) {
+        int h = solid_holds(s, c, root, in);
+        any |= h, all &= h;
+        if (first < 0)
+            first = h;
+        else
+            rest |= h;
+    }
+    switch (s[k].op) {
+    case GEOM_SOLID_UNION: return any;
+    case GEOM_SOLID_INTERSECTION: return first >= 0 && all;
+    default: return first > 0 && !rest; /* difference */
+    }
+}
+
+#define SOLID_MAX_NODES 256 /* nodes of one tree a query classifies, at most */
+#define SOLID_TREES 4       /* trees a query follows along the ray, at most */
+
+/* Along one ray, a tree's primitive solids' states: found at the first
+ * hit on the tree (a query per primitive solid), then changed at each of
+ * its surfaces the ray crosses. */
+typedef struct SolidWalk {
+    size_t root, n;
+    uint8_t in[SOLID_MAX_NODES];
+} SolidWalk;
+
+/* The nearest hit on the surface of a solid in [tnear, tfar]: the
+ * solids' surfaces are found one after another (queries with
+ * ACCEL_MASK_SOLID) until one lies on its tree's surface (the tree holds
+ * the points just before and just after it differently) and is seen by
+ * the ray's type. */
+static int intersect_solids(const Accel *a, const Ray *ray, Hit *hit)
+{
+    const GeomSolid *s = a->gs->solids;
+    SolidWalk walk[SOLID_TREES], spare;
+    int n_walk = 0;
+    Vec3 d = v3_normalize(ray->d);
+    Ray r = *ray;
+    for (int step = 0; step < 1024 && r.tnear <= r.tfar; step++) {
+        if (!a->solids || !intersect_scene(a, a->solids, &r, ~0u, 0, hit))
+            return 0;
+        const Grid *g = &a->gs->grids[hit->grid];
+        uint32_t mask = g->object < a->n_objects ? a->object_mask[g->object] : ~0u;
+        size_t leaf = g->solid ? g->solid - 1 : 0, root = leaf;
+        while (g->solid && s[root].parent)
+            root = s[root].parent - 1;
+        size_t n = s[root].end - root;
+        if (!g->solid || n > SOLID_MAX_NODES) { /* too large to classify: drawn whole */
+            if (mask & ray->mask)
+                return 1;
+        } else {
+            SolidWalk *w = NULL;
+            for (int k = 0; k < n_walk && !w; k++)
+                if (walk[k].root == root)
+                    w = &walk[k];
+            if (!w) { /* the first hit on this tree: classify at the hit */
+                w = n_walk < SOLID_TREES ? &walk[n_walk++] : &spare;
+                w->root = root, w->n = n;
+                Vec3 x = v3_madd(ray->o, ray->d, hit->t);
+                for (size_t k = root; k < root + n; k++)
+                    w->in[k - root] = s[k].op == GEOM_SOLID_PRIMITIVE && k != leaf &&
+                                      inside_solid(a, k, x, d, ray->time);
+            }
+            int entering = v3_dot(hit->Ng, d) < 0.0f;
+            w->in[leaf - root] = (uint8_t)!entering;
+            int before = solid_holds(s, root, root, w->in);
+            w->in[leaf - root] = (uint8_t)entering;
+            if (solid_holds(s, root, root, w->in) != before && (mask & ray->mask))
+                return 1;
+        }
+        r.tnear = nextafterf(hit->t, INFINITY) + 1e-6f * hit->t;
+    }
+    return 0;
+}
+
 int accel_intersect(const Accel *a, const Ray *ray, Hit *hit)
 {
     if (a->record)
         accel_record_ray(a->record, ACCEL_QUERY_INTERSECT, 0, ray);
-    return intersect_scene(a, a->levels[0].scene, ray, ray->mask, 0, hit);
+    int found =
+        intersect_scene(a, a->levels[0].scene, ray, ray->mask & ~ACCEL_MASK_SOLID, 0, hit);
+    if (!a->gs->n_solids)
+        return found;
+    Ray r = *ray;
+    if (found)
+        r.tfar = hit->t;
+    Hit h;
+    if (intersect_solids(a, &r, &h)) {
+        *hit = h;
+        return 1;
+    }
+    return found;
 }
 
 int accel_intersect_object(const Accel *a, uint32_t object, const Ray *ray, Hit *hit)
@@ -1172,6 +1349,9 @@ Vec3 accel_transmission(const Accel *a, const Ray *ray, AccelOpacityFn opacity, 
     tc.user = user;
     tc.T = v3(1, 1, 1);
     tc.n_seen = 0;
+    Hit h;
+    if (a->gs->n_solids && intersect_solids(a, ray, &h))
+        return v3(0, 0, 0);
     struct RTCRay r;
     set_ray(a, &r, ray);
     rtcOccluded1(a->levels[0].scene, &tc.rtc, &r);
@@ -1187,7 +1367,10 @@ int accel_occluded(const Accel *a, const Ray *ray)
     struct RTCRay r;
     set_ray(a, &r, ray);
     rtcOccluded1(a->levels[0].scene, &ctx, &r);
-    return r.tfar < 0.0f;
+    if (r.tfar < 0.0f)
+        return 1;
+    Hit h;
+    return a->gs->n_solids && intersect_solids(a, ray, &h);
 }
 
 size_t accel_memory_bytes(const Accel *a)

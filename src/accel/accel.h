@@ -72,6 +72,12 @@ typedef struct Hit {
  * that may hit only it (subsurface rays, memo 6.2: accel_intersect_object).
  * Not a ray type. */
 #define ACCEL_MASK_OWN_SCENE (1u << 30)
+/* The mask of the surfaces of primitive solids (GridSet.solids): ordinary
+ * queries miss them; accel_intersect, accel_occluded and
+ * accel_transmission find them one by one and keep a hit only where it
+ * lies on its tree's solid (RenderMan's CSG; DESIGN.md "Solids"). Set by
+ * accel_new itself. */
+#define ACCEL_MASK_SOLID (1u << 29)
 
 /* A transparent surface a transmission query crosses. */
 typedef struct AccelCrossing AccelCrossing;

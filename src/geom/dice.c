@@ -68,6 +68,7 @@ void geom_gridset_fini(GridSet *gs)
     free(gs->Os);
     free(gs->instances);
     free(gs->instance_motion);
+    free(gs->solids);
     for (int k = 0; k < GEOM_MAX_TIMES - 1; k++) {
         free(gs->Pt[k]);
         free(gs->Nt[k]);
@@ -550,6 +551,7 @@ static int dice_quad(GridSet *gs, const Prim *prim, uint32_t prim_index, const f
         return -1;
     Grid *g = &gs->grids[gs->n_grids];
     *g = (Grid){.prim = prim_index, .object = prim->object, .master = prim->master,
+                .solid = prim->solid,
                 .first_vertex = (uint32_t)gs->n_vertices,
                 .nu = (uint16_t)nu, .nv = (uint16_t)nv, .primvars = prim->pv,
                 .shape = (uint8_t)prim_shape(prim)};
@@ -596,6 +598,7 @@ static int dice_triangle(GridSet *gs, const Prim *prim, uint32_t prim_index, con
         return -1;
     Grid *g = &gs->grids[gs->n_grids];
     *g = (Grid){.prim = prim_index, .object = prim->object, .master = prim->master,
+                .solid = prim->solid,
                 .first_vertex = (uint32_t)gs->n_vertices,
                 .nu = (uint16_t)n, .nv = 0, .triangular = 1, .primvars = prim->pv};
     memcpy(g->uv, d->c, sizeof g->uv);

@@ -82,6 +82,23 @@ enum {
  * shader inside its block: each instance's own object applies. */
 #define GEOM_OBJECT_INHERIT UINT32_MAX
 
+/* Constructive solid geometry (RenderMan's SolidBegin, DESIGN.md
+ * "Solids"): a tree of solids, nodes in the order their blocks open, a
+ * node's subtree the nodes [its index, end). A primitive solid is a leaf:
+ * the closed surface of its primitives, inside behind their fronts. */
+typedef enum GeomSolidOp {
+    GEOM_SOLID_PRIMITIVE = 0,
+    GEOM_SOLID_UNION = 1,
+    GEOM_SOLID_INTERSECTION = 2,
+    GEOM_SOLID_DIFFERENCE = 3 /* the first child less the others */
+} GeomSolidOp;
+
+typedef struct GeomSolid {
+    uint32_t op;     /* GeomSolidOp */
+    uint32_t parent; /* the enclosing solid's index + 1; 0: a root */
+    uint32_t end;    /* one past the last node of its subtree */
+} GeomSolid;
+
 typedef struct Prim {
     PrimType type;
     uint32_t object;       /* the object (shader, attributes) it belongs to, or
@@ -89,6 +106,7 @@ typedef struct Prim {
     uint32_t master;       /* 0: world geometry; else its master's index + 1: its points are
                               in master space, and it is seen only through instances */
     uint32_t motion;       /* its motion (the scene's SceneMotion index + 1), or 0: still */
+    uint32_t solid;        /* its primitive solid (GeomSolid index + 1), or 0: none */
     uint8_t pv;            /* GEOM_PV_* bits: the primitive variables it carries */
     uint8_t pv_cubic;      /* of those, the ones with 16 Bezier control values (a bicubic
                               patch's vertex class); the others have one per corner */
@@ -194,6 +212,7 @@ typedef struct Grid {
     uint32_t prim;         /* the primitive it was diced from */
     uint32_t object;       /* the primitive's object, or GEOM_OBJECT_INHERIT */
     uint32_t master;       /* the primitive's master (Prim.master): 0, world geometry */
+    uint32_t solid;        /* the primitive's solid (Prim.solid): 0, none */
     uint32_t first_vertex; /* index of its first vertex in the GridSet */
     uint16_t nu, nv;       /* quad: vertices in u and v; triangle: nu = n subdivisions, nv = 0 */
     uint8_t triangular;    /* 1 for a triangular grid */
@@ -264,6 +283,8 @@ typedef struct GridSet {
     Mat4 *instance_motion; /* moving instances' world_from_master, n_times per instance
                               (GeomInstance.motion); owned, NULL if none moves */
     size_t n_moving_instances;
+    GeomSolid *solids;     /* the solids' tree (Grid.solid indexes it, + 1); owned */
+    size_t n_solids;
     /* Motion blur (DESIGN.md "Motion blur and depth of field"): n_times
      * uniformly spaced time samples from time[0] to time[1]. Sample 0 is P,
      * N, dPdu, dPdv above; sample k >= 1 of a vertex of a moving grid g

@@ -514,8 +514,6 @@ static const RibRequest own_requests[] = {
     {"RelativeDetail", h_skip},
     {"GeometricApproximation", h_skip},
     {"ShadingInterpolation", h_skip},
-    {"SolidBegin", h_skip},
-    {"SolidEnd", h_skip},
     {"ShaderLayer", h_skip},
     {"ConnectShaderLayers", h_skip},
     {"Shader", h_skip},

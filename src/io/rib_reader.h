@@ -177,7 +177,9 @@ typedef struct Frame {
 
 typedef struct StackEntry {
     Attr a;
-    int attribute; /* 1: AttributeBegin, 0: TransformBegin */
+    int attribute; /* 1: AttributeBegin, 0: TransformBegin, 2: SolidBegin */
+    int solid_op;  /* SolidBegin: its RayesSolidOp */
+    int solid_sent; /* SolidBegin: the sink was told (solid_begin) */
 } StackEntry;
 
 typedef struct Rib {

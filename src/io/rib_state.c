@@ -130,6 +130,8 @@ int rib_push(Rib *r, int attribute)
             return rib_error(r, "out of memory");
     }
     r->stack[r->depth].a = r->a;
+    r->stack[r->depth].solid_op = -1;
+    r->stack[r->depth].solid_sent = 0;
     r->stack[r->depth++].attribute = attribute;
     return 0;
 }
@@ -142,9 +144,9 @@ int rib_pop(Rib *r, int attribute)
         return 0;
     }
     StackEntry *s = &r->stack[--r->depth];
+    static const char *const block[3] = {"TransformBegin", "AttributeBegin", "SolidBegin"};
     if (s->attribute != attribute)
-        rib_warn_once(r, "unbalanced", "%s closes a %s block", r->req,
-                  s->attribute ? "AttributeBegin" : "TransformBegin");
+        rib_warn_once(r, "unbalanced", "%s closes a %s block", r->req, block[s->attribute]);
     if (attribute) {
         r->a = s->a;
     } else {
@@ -154,6 +156,75 @@ int rib_pop(Rib *r, int attribute)
         memcpy(r->a.motion_M, s->a.motion_M, sizeof r->a.motion_M);
     }
     return 0;
+}
+
+/* SolidBegin "primitive" | "union" | "intersection" | "difference":
+ * RenderMan's CSG (rayes_scene_solid_begin). The block saves the
+ * attributes and the transform as AttributeBegin does (as Aqsis's and
+ * PRMan's do). A solid inside a primitive solid is left out of the tree
+ * (one warning), as Aqsis does; a sink without solids draws their
+ * primitives (one warning). */
+static int h_solid_begin(Rib *r, const Args *a)
+{
+    static const char *const names[] = {"primitive", "union", "intersection", "difference"};
+    size_t i = 0;
+    const char *op = rib_get_string(r, a, &i, "a solid operation");
+    if (!op)
+        return -1;
+    int k = 0;
+    while (k < 4 && strcmp(op, names[k]) != 0)
+        k++;
+    if (k == 4)
+        return rib_error(r, "unknown solid operation \"%s\"; expected primitive, union, "
+                            "intersection or difference",
+                         op);
+    int inner = -1, sent = 1; /* the innermost open solid's operation; all sent */
+    for (size_t d = r->depth; d-- > 0;)
+        if (r->stack[d].attribute == 2) {
+            inner = r->stack[d].solid_op;
+            sent = r->stack[d].solid_sent;
+            break;
+        }
+    if (rib_push(r, 2) != 0)
+        return -1;
+    StackEntry *e = &r->stack[r->depth - 1];
+    e->solid_op = k;
+    if (inner == RAYES_SOLID_PRIMITIVE || !sent) {
+        rib_warn_once(r, "solid in primitive",
+                      "a solid inside a primitive solid is left out of the CSG tree (its "
+                      "primitives belong to the primitive solid)");
+        e->solid_op = RAYES_SOLID_PRIMITIVE;
+        return 0;
+    }
+    if (!r->in_world && !r->rec && !r->in_object)
+        return 0;
+    SinkState *st;
+    const IoSink *s = rib_out_sink(r, &st);
+    if (!s->solid_begin || !s->solid_end) {
+        rib_warn_once(r, "solid sink",
+                      "this sink has no solids: they are drawn as the union of their primitives");
+        return 0;
+    }
+    if (s->solid_begin(s->target, (RayesSolidOp)k) != RAYES_OK)
+        return rib_sink_failed(r, s);
+    e->solid_sent = 1;
+    return 0;
+}
+
+static int h_solid_end(Rib *r, const Args *a)
+{
+    (void)a;
+    if (r->depth == 0 || r->stack[r->depth - 1].attribute != 2) {
+        rib_warn_once(r, "SolidEnd", "SolidEnd without a matching SolidBegin");
+        return r->depth ? rib_pop(r, 2) : 0;
+    }
+    if (r->stack[r->depth - 1].solid_sent) {
+        SinkState *st;
+        const IoSink *s = rib_out_sink(r, &st);
+        if (s->solid_end && s->solid_end(s->target) != RAYES_OK)
+            return rib_sink_failed(r, s);
+    }
+    return rib_pop(r, 2);
 }
 
 static int h_attribute_begin(Rib *r, const Args *a) { (void)a; return rib_push(r, 1); }
@@ -862,6 +933,7 @@ static int h_basis(Rib *r, const Args *a)
 
 const RibRequest rib_state_requests[] = {
     {"AttributeBegin", h_attribute_begin}, {"AttributeEnd", h_attribute_end},
+    {"SolidBegin", h_solid_begin}, {"SolidEnd", h_solid_end},
     {"TransformBegin", h_transform_begin}, {"TransformEnd", h_transform_end},
     {"Identity", h_identity}, {"Transform", h_transform}, {"ConcatTransform", h_concat},
     {"Translate", h_translate}, {"Rotate", h_rotate}, {"Scale", h_scale},

@@ -1077,6 +1077,31 @@ static RayesError w_points(void *t, RayesPointShape shape, size_t n, const float
     return RAYES_OK;
 }
 
+static RayesError w_solid_begin(void *t, RayesSolidOp op)
+{
+    static const char *const names[] = {"primitive", "union", "intersection", "difference"};
+    RibWriter *w = t;
+    if ((unsigned)op > RAYES_SOLID_DIFFERENCE)
+        return fail(w, RAYES_ERROR_INVALID_ARGUMENT, "solid: unknown operation");
+    /* The block saves attributes and transform: no TransformBegin of the
+     * writer's may straddle it. */
+    if (w->in_transform)
+        fprintf(w->world.f, "TransformEnd\n");
+    w->in_transform = 0;
+    fprintf(w->world.f, "SolidBegin \"%s\"\n", names[op]);
+    return RAYES_OK;
+}
+
+static RayesError w_solid_end(void *t)
+{
+    RibWriter *w = t;
+    if (w->in_transform)
+        fprintf(w->world.f, "TransformEnd\n");
+    w->in_transform = 0;
+    fprintf(w->world.f, "SolidEnd\n");
+    return RAYES_OK;
+}
+
 static RayesError w_blobby(void *t, const RayesBlobby *b, const RayesPrimvar *pv, size_t n_pv)
 {
     RibWriter *w = t;
@@ -1368,6 +1393,8 @@ IoSink io_rib_writer_sink(RibWriter *w)
         .set_depth_of_field = w_set_depth_of_field,
         .set_dice_blur = w_set_dice_blur,
         .blobby = w_blobby,
+        .solid_begin = w_solid_begin,
+        .solid_end = w_solid_end,
     };
 }
 

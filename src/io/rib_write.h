@@ -30,6 +30,8 @@
  *                      "color lightcolor" L, Polygon, AttributeEnd
  *   light              LightSource with parameters ("from"/"to" as points)
  *   blobby             Blobby with its arrays as given
+ *   solids             SolidBegin "op" ... SolidEnd (no TransformBegin of the writer's
+ *                      straddles a block)
  *
  * Not thread-safe; one writer per file.
  */

@@ -92,6 +92,13 @@ static RayesError scene_points(void *t, RayesPointShape shape, size_t n_points, 
     return rayes_scene_points(t, shape, n_points, P, pv, n_pv);
 }
 
+static RayesError scene_solid_begin(void *t, RayesSolidOp op)
+{
+    return rayes_scene_solid_begin(t, op);
+}
+
+static RayesError scene_solid_end(void *t) { return rayes_scene_solid_end(t); }
+
 static RayesError scene_blobby(void *t, const RayesBlobby *b, const RayesPrimvar *pv, size_t n_pv)
 {
     return rayes_scene_blobby(t, b, pv, n_pv);
@@ -250,6 +257,8 @@ IoSink io_sink_scene(RayesScene *scene)
         .set_depth_of_field = scene_set_depth_of_field,
         .set_dice_blur = scene_set_dice_blur,
         .blobby = scene_blobby,
+        .solid_begin = scene_solid_begin,
+        .solid_end = scene_solid_end,
     };
 }
 

@@ -113,6 +113,10 @@ typedef struct IoSink {
      * skip blobbies with one warning). */
     RayesError (*blobby)(void *target, const RayesBlobby *blobby, const RayesPrimvar *pv,
                          size_t n_pv);
+    /* rayes_scene_solid_begin and _end (last: readers draw solids as the
+     * union of their primitives, with one warning, for sinks without). */
+    RayesError (*solid_begin)(void *target, RayesSolidOp op);
+    RayesError (*solid_end)(void *target);
 } IoSink;
 
 /* A sink that builds scene through rayes.h (borrowed, not retained). */

@@ -63,6 +63,7 @@ RayesScene *rayes_scene_new(void)
         RAYES_RAY_CAMERA | RAYES_RAY_DIFFUSE | RAYES_RAY_SPECULAR | RAYES_RAY_SHADOW;
     s->current_opacity_cache = 1;
     s->open_master = -1;
+    s->open_solid = -1;
     return s;
 }
 
@@ -86,6 +87,7 @@ void rayes_scene_release(RayesScene *s)
         free(s->links[i].lights);
     free(s->links);
     free(s->objects);
+    free(s->solids);
     free(s->prims);
     free(s->motions);
     free(s->motion_prims);
@@ -407,6 +409,37 @@ RayesError rayes_scene_set_displacement_bound(RayesScene *s, float bound)
     return RAYES_OK;
 }
 
+RayesError rayes_scene_solid_begin(RayesScene *s, RayesSolidOp op)
+{
+    if (!s)
+        return RAYES_ERROR_INVALID_ARGUMENT;
+    if ((unsigned)op > RAYES_SOLID_DIFFERENCE)
+        return scene_fail(s, RAYES_ERROR_INVALID_ARGUMENT, "solid: unknown operation %d", (int)op);
+    if (s->open_solid >= 0 && s->solids[s->open_solid].op == GEOM_SOLID_PRIMITIVE)
+        return scene_fail(s, RAYES_ERROR_INVALID_ARGUMENT,
+                          "solid: a solid inside a primitive solid (only primitives may be)");
+    if (s->n_solids >= UINT32_MAX - 1)
+        return scene_fail(s, RAYES_ERROR_INVALID_ARGUMENT, "solid: too many solids");
+    if (grow((void **)&s->solids, &s->cap_solids, s->n_solids, sizeof *s->solids) != 0)
+        return scene_fail(s, RAYES_ERROR_OUT_OF_MEMORY, "out of memory");
+    s->solids[s->n_solids] = (GeomSolid){(uint32_t)op, (uint32_t)(s->open_solid + 1), 0};
+    s->open_solid = (int64_t)s->n_solids++;
+    scene_mark(s, SCENE_CHANGE_GEOMETRY);
+    return RAYES_OK;
+}
+
+RayesError rayes_scene_solid_end(RayesScene *s)
+{
+    if (!s)
+        return RAYES_ERROR_INVALID_ARGUMENT;
+    if (s->open_solid < 0)
+        return scene_fail(s, RAYES_ERROR_INVALID_ARGUMENT, "solid: an end without a begin");
+    GeomSolid *g = &s->solids[s->open_solid];
+    g->end = (uint32_t)s->n_solids;
+    s->open_solid = (int64_t)g->parent - 1;
+    return RAYES_OK;
+}
+
 static RayesError add_prim(RayesScene *s, Prim *p)
 {
     if (s->current_object == -1) {
@@ -419,6 +452,17 @@ static RayesError add_prim(RayesScene *s, Prim *p)
     p->object = s->current_object == SCENE_OBJECT_INHERIT ? GEOM_OBJECT_INHERIT
                                                           : (uint32_t)s->current_object;
     p->master = s->open_master >= 0 ? (uint32_t)s->open_master + 1 : 0;
+    p->solid = 0;
+    if (s->open_solid >= 0 && p->master == 0) {
+        if (s->solids[s->open_solid].op == GEOM_SOLID_PRIMITIVE)
+            p->solid = (uint32_t)s->open_solid + 1;
+        else
+            log_warning_once("solid loose", "a primitive in a boolean solid but in no primitive "
+                                            "solid is drawn as it is (not part of the solid)");
+    } else if (s->open_solid >= 0) {
+        log_warning_once("solid master", "solids inside object definitions are drawn as their "
+                                         "primitives (not combined)");
+    }
     if ((p->pv & GEOM_PV_OS) && s->pv_Os_below_1 && p->object != GEOM_OBJECT_INHERIT)
         s->objects[p->object].Os_primvar_below_1 = 1;
     p->shading_rate = s->shading_rate;
@@ -1212,6 +1256,15 @@ int scene_prepare(const RayesScene *s, int width, int height, const DiceOptions 
         log_warning("dicing: the scene needs %zu grid vertices, more than the budget of %zu "
                     "(--vertex-budget); micropolygons made %.2f times longer (%zu vertices)",
                     first_need, budget, rate_scale, gs->n_vertices);
+    if (s->n_solids) { /* the solids' tree, blocks still open closed at the end */
+        if (!(gs->solids = malloc(s->n_solids * sizeof *gs->solids)))
+            return -1;
+        memcpy(gs->solids, s->solids, s->n_solids * sizeof *gs->solids);
+        gs->n_solids = s->n_solids;
+        for (size_t k = 0; k < s->n_solids; k++)
+            if (gs->solids[k].end <= k)
+                gs->solids[k].end = (uint32_t)s->n_solids;
+    }
     if (coarsened)
         *coarsened = rate_scale;
     return 0;

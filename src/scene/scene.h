@@ -198,6 +198,9 @@ struct RayesScene {
     SceneInstance *instances; /* in the order made */
     size_t n_instances, cap_instances;
     int64_t open_master;    /* the master whose block is open, or -1 */
+    GeomSolid *solids;      /* the solids' tree (rayes_scene_solid_begin), in block order */
+    size_t n_solids, cap_solids;
+    int64_t open_solid;     /* the innermost solid whose block is open, or -1 */
     SceneSaved saved;       /* the state before that block */
     uint64_t leaves;        /* flattened instances the world's instances make */
     /* Time (motion.c): the shutter, motions and blur attributes. */
