@@ -720,10 +720,16 @@ static int material_of_type(Parser *P, const Token *t, const char *type, ParamLi
         return coated_material(P, t, pl, m);
     if (strcmp(type, "conductor") == 0 || strcmp(type, "coatedconductor") == 0)
         return conductor_material(P, t, type, pl, m);
-    if (strcmp(type, "dielectric") == 0 || strcmp(type, "thindielectric") == 0) {
-        if (type[0] == 't')
-            pbrt_warn_at(P, t->line, t->col, "thindielectric",
-                         "thindielectric: mapped to dielectric");
+    if (strcmp(type, "thindielectric") == 0) { /* a sheet: light through it unbent */
+        static const float d15[3] = {1.5f, 1.5f, 1.5f};
+        float c[3];
+        if (pbrt_get_color(P, pl, "eta", d15, c, NULL) < 0)
+            return -1;
+        pbrt_mat_init(m, "thindielectric");
+        mat_float(m, "eta", (c[0] + c[1] + c[2]) / 3.0f);
+        return 0;
+    }
+    if (strcmp(type, "dielectric") == 0) {
         static const float d15[3] = {1.5f, 1.5f, 1.5f};
         float c[3];
         if (pbrt_get_color(P, pl, "eta", d15, c, NULL) < 0)

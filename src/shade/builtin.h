@@ -15,6 +15,8 @@ extern const RayesShaderClass shade_class_hair; /* fibres: Ka, Kd, Ks, roughness
 extern const RayesShaderClass shade_class_stainedglass; /* coloured opacity: Kd, frequency,
                                                            leadwidth, clarity */
 extern const RayesShaderClass shade_class_occlusion;    /* ambient occlusion: samples, maxdist */
+extern const RayesShaderClass shade_class_thindielectric; /* a glass sheet, light through it
+                                                             unbent: eta */
 extern const RayesShaderClass shade_class_homogeneous; /* volume: density, extinction, albedo,
                                                           g, emission */
 extern const RayesShaderClass shade_class_turbulence; /* volume: the same, frequency, octaves,

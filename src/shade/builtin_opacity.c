@@ -1,12 +1,14 @@
 /*
  * shade/builtin_opacity.c — built-in shaders about opacity (memo 6.1):
- * stainedglass, whose opacity method colours shadows, and occlusion,
- * RenderMan's classic ambient occlusion shader.
+ * stainedglass, whose opacity method colours shadows, thindielectric
+ * (pbrt-v4's thin glass: a sheet light passes straight through), and
+ * occlusion, RenderMan's classic ambient occlusion shader.
  */
 #include <math.h>
 #include <stddef.h>
 #include <string.h>
 
+#include "shade/bsdf.h"
 #include "shade/builtin.h"
 #include "shade/shade.h"
 
@@ -194,6 +196,91 @@ const RayesShaderClass shade_class_stainedglass = {
     .opacity = stainedglass_opacity,
     .lighting = stainedglass_lighting,
     .diffuselighting = stainedglass_lighting, /* view-independent throughout */
+};
+
+/* ---- thindielectric
+ *
+ * pbrt-v4's thin dielectric: a sheet of glass of index eta (a window) that
+ * light crosses unbent. Its two faces reflect R' = R + T^2 R / (1 - R^2)
+ * = 2 R / (1 + R) in all (R Fresnel's reflectance at the view angle, T =
+ * 1 - R), and the rest passes straight on. So it is a partly transparent
+ * surface: Oi = R', Ci = R' times the mirrored radiance, and the renderer
+ * composites what lies behind by 1 - R'. Shadow rays and cached diffuse
+ * rays take the opacity method's R' at normal incidence (view-independent:
+ * 0.077 for eta 1.5): sunlight and skylight come in through windows. */
+
+typedef struct ThinDielectricParams {
+    float eta;
+} ThinDielectricParams;
+
+static float thin_reflectance(float cos_i, float eta)
+{
+    float R = fresnel_dielectric(fminf(fmaxf(cos_i, 1e-4f), 1.0f), eta);
+    return 2.0f * R / (1.0f + R);
+}
+
+static void thindielectric_opacity(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
+                                   const void *params, RayesShadeOutputs *out)
+{
+    (void)sv;
+    const ThinDielectricParams *p = params;
+    float R = thin_reflectance(1.0f, p->eta);
+    for (size_t i = 0; i < ctx->n_points; i++)
+        for (int c = 0; c < 3; c++)
+            out->Oi[i][c] = (ctx->Os ? ctx->Os[i][c] : 1.0f) * R;
+}
+
+static void thindielectric_lighting(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
+                                    const void *params, RayesShadeOutputs *out)
+{
+    const ThinDielectricParams *p = params;
+    for (size_t start = 0; start < ctx->n_points; start += SHADE_CHUNK) {
+        size_t n = ctx->n_points - start < SHADE_CHUNK ? ctx->n_points - start : SHADE_CHUNK;
+        RayesShadeCtx sub;
+        shade_ctx_slice(ctx, start, n, &sub);
+        Rgb own[SHADE_CHUNK], dir[SHADE_CHUNK], L[SHADE_CHUNK];
+        for (size_t i = 0; i < n; i++) {
+            float R = thin_reflectance(1.0f, p->eta);
+            if (sub.I) { /* the mirror direction and Fresnel at the view angle */
+                Vec3 V = v3(-sub.I[i][0], -sub.I[i][1], -sub.I[i][2]);
+                Vec3 N = v3(sub.N[i][0], sub.N[i][1], sub.N[i][2]);
+                float c = v3_dot(V, N);
+                Vec3 r = v3_sub(v3_scale(N, 2.0f * c), V);
+                dir[i][0] = r.x, dir[i][1] = r.y, dir[i][2] = r.z;
+                R = thin_reflectance(c, p->eta);
+            }
+            own[i][0] = own[i][1] = own[i][2] = R;
+        }
+        if (sub.I && sv->indirect_specular)
+            sv->indirect_specular(sv, &sub, (const float(*)[3])dir, NULL, 1, L);
+        else
+            memset(L, 0, n * sizeof *L);
+        RayesShadeOutputs o = {out->Ci + start, out->Oi + start,
+                               out->Irradiance ? out->Irradiance + start : NULL, NULL};
+        for (size_t i = 0; i < n; i++)
+            for (int c = 0; c < 3; c++) {
+                o.Ci[i][c] = L[i][c];
+                if (o.Irradiance)
+                    o.Irradiance[i][c] = 0.0f;
+            }
+        premultiply(&sub, (const Rgb *)own, &o);
+    }
+}
+
+static const RayesShaderParamDesc thindielectric_params[] = {
+    {"eta", RAYES_PARAM_FLOAT, offsetof(ThinDielectricParams, eta), {1.5f, 0, 0}},
+};
+
+const RayesShaderClass shade_class_thindielectric = {
+    .abi_version = RAYES_SHADER_ABI_VERSION,
+    .struct_size = sizeof(RayesShaderClass),
+    .name = "thindielectric",
+    .params_size = sizeof(ThinDielectricParams),
+    .params = thindielectric_params,
+    .n_params = sizeof thindielectric_params / sizeof thindielectric_params[0],
+    .opacity = thindielectric_opacity,
+    .lighting = thindielectric_lighting,
+    .diffuselighting = thindielectric_lighting, /* no I: no reflection, R' at normal incidence */
 };
 
 /* ---- occlusion

@@ -1170,6 +1170,26 @@ static void test_measured_material(void)
     free(r);
 }
 
+/* thindielectric: rayes's thin glass sheet, its eta, and no warning. */
+static void test_thin_dielectric(void)
+{
+    Rec *r = malloc(sizeof *r);
+    ParseRun pr = {.name = "t.pbrt",
+                   .r = r,
+                   .text = "WorldBegin\n"
+                           "Material \"thindielectric\" \"float eta\" 1.4\n"
+                           "Shape \"trianglemesh\" \"point3 P\" [0 0 0 1 0 0 0 1 0]\n"};
+    const char *said = stderr_of(run_parse, &pr);
+    CHECK(pr.e == RAYES_OK && r->n_meshes == 1);
+    if (r->n_meshes == 1) {
+        const Shader *sh = &r->mesh[0].shader;
+        CHECK(strcmp(sh->name, "thindielectric") == 0 && param(sh, "eta") &&
+              fabs(param(sh, "eta")->value[0] - 1.4) < 1e-6);
+    }
+    CHECK(strstr(said, "thindielectric") == NULL);
+    free(r);
+}
+
 /* Filter parameters rayes does not use are said once, at the directive;
  * an unknown filter keeps the default with a warning. */
 static void test_filter_warnings(void)
@@ -1374,9 +1394,10 @@ static void test_exposure(void)
                  "t.pbrt:1:1: Film: expected maxcomponentvalue > 0");
 }
 
-TEST_MAIN(TEST(test_filters), TEST(test_exposure), TEST(test_subsurface_material), TEST(test_filter_warnings), TEST(test_import), TEST(test_film_types),
-          TEST(test_measured_material), TEST(test_anisotropic_roughness), TEST(test_maxdepth),
-          TEST(test_spectrum_files), TEST(test_cornell_box), TEST(test_transforms),
-          TEST(test_materials), TEST(test_lights), TEST(test_instances_include_ply),
-          TEST(test_errors), TEST(test_normals_and_uv), TEST(test_textures),
-          TEST(test_coated_conductor_textures))
+TEST_MAIN(TEST(test_filters), TEST(test_exposure), TEST(test_subsurface_material),
+          TEST(test_filter_warnings), TEST(test_import), TEST(test_film_types),
+          TEST(test_measured_material), TEST(test_thin_dielectric),
+          TEST(test_anisotropic_roughness), TEST(test_maxdepth), TEST(test_spectrum_files),
+          TEST(test_cornell_box), TEST(test_transforms), TEST(test_materials), TEST(test_lights),
+          TEST(test_instances_include_ply), TEST(test_errors), TEST(test_normals_and_uv),
+          TEST(test_textures), TEST(test_coated_conductor_textures))

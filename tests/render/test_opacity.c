@@ -396,8 +396,59 @@ static void test_bad_attributes(void)
     rayes_scene_release(s);
 }
 
+/* A thin dielectric window (pbrt-v4's thindielectric): shadow rays pass
+ * with 1 - R', R' = 2R / (1 + R) of Fresnel's R at normal incidence; the
+ * camera sees the floor through it unbent, dimmed by its R' at the view
+ * angle (here head on), the floor's pattern not shifted. */
+static void test_thin_glass(void)
+{
+    const double R0 = 0.04, Rt = 2 * R0 / (1 + R0); /* eta 1.5 */
+    double open[3], through[3];
+    floor_under_sheets(NULL, 0, open);
+    RayesScene *s = new_scene();
+    floor_matte(s);
+    CHECK(rayes_scene_set_visibility(s, RAYES_RAY_SHADOW) == RAYES_OK);
+    RayesParam eta[1] = {pf("eta", 1.5f)};
+    CHECK(rayes_scene_set_shader(s, "thindielectric", eta, 1) == RAYES_OK);
+    quad_at(s, 3.0f, 1.0f);
+    point_light(s, 5.0f);
+    RayesImage *img = render(s, 2, 20.0, 1, RAYES_QUALITY_PREVIEW, NULL);
+    if (img)
+        mean_rgb(img, through);
+    rayes_image_free(img);
+    rayes_scene_release(s);
+    for (int c = 0; c < 3; c++)
+        CHECK_NEAR(through[c] / open[c], 1.0 - Rt, 1e-4);
+    /* Seen by the camera too: a checkered floor through the window, the
+     * same picture as without it times about 1 - R' (the camera's rays
+     * are within 10 degrees of the normal; nothing to reflect but black). */
+    RayesImage *pair[2];
+    for (int k = 0; k < 2; k++) {
+        s = new_scene();
+        RayesParam cb[2] = {pf("uscale", 4.0f), pf("vscale", 4.0f)};
+        CHECK(rayes_scene_pattern(s, "cells", "checkerboard", cb, 2) == RAYES_OK);
+        RayesParam p[1] = {(RayesParam){"Cs", RAYES_PARAM_PATTERN, {0, 0, 0}, "cells"}};
+        CHECK(rayes_scene_set_shader(s, "constant", p, 1) == RAYES_OK);
+        quad_at(s, 2.0f, 0.0f);
+        if (k) {
+            CHECK(rayes_scene_set_shader(s, "thindielectric", eta, 1) == RAYES_OK);
+            quad_at(s, 3.0f, 1.0f);
+        }
+        pair[k] = render(s, 2, 20.0, 1, RAYES_QUALITY_PREVIEW, NULL);
+        rayes_scene_release(s);
+    }
+    double worst = 0.0;
+    for (size_t i = 0; pair[0] && pair[1] && i < (size_t)RES * RES; i++) {
+        double a = pair[0]->rgba[4 * i], b = pair[1]->rgba[4 * i];
+        worst = fmax(worst, fabs(b - (1.0 - Rt) * a));
+    }
+    CHECK(pair[0] && pair[1] && worst < 0.01);
+    rayes_image_free(pair[0]);
+    rayes_image_free(pair[1]);
+}
+
 TEST_MAIN(TEST(test_stacked_sheets_multiply_in_any_order),
           TEST(test_half_transparent_sheet_halves_irradiance),
           TEST(test_ambient_occlusion_closed_forms), TEST(test_cutout_shadow_matches_geometry),
           TEST(test_opacity_cache_within_noise_and_deterministic), TEST(test_camera_sees_through),
-          TEST(test_grid_hider_transparent_grids), TEST(test_bad_attributes))
+          TEST(test_grid_hider_transparent_grids), TEST(test_bad_attributes), TEST(test_thin_glass))
