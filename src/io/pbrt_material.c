@@ -751,10 +751,15 @@ static int material_of_type(Parser *P, const Token *t, const char *type, ParamLi
         pbrt_mat_init(m, PBRT_INVISIBLE);
         return 0;
     }
-    if (strcmp(type, "diffusetransmission") == 0) {
-        pbrt_warn_at(P, t->line, t->col, "diffusetransmission",
-                     "diffusetransmission: mapped to diffuse (no transmission)");
-        return diffuse_material(P, pl, m, "reflectance");
+    if (strcmp(type, "diffusetransmission") == 0) { /* reflects and transmits diffusely */
+        static const float quarter[3] = {0.25f, 0.25f, 0.25f};
+        pbrt_mat_init(m, "diffusetransmission");
+        if (mat_textured(P, pl, m, "reflectance", "reflectance", RAYES_PARAM_COLOR, quarter) != 0 ||
+            mat_textured(P, pl, m, "transmittance", "transmittance", RAYES_PARAM_COLOR, quarter) !=
+                0)
+            return -1;
+        mat_float(m, "scale", (float)pbrt_get_float(pl, "scale", 1.0));
+        return 0;
     }
     char key[96];
     snprintf(key, sizeof key, "material %.60s", type);

@@ -15,6 +15,9 @@ extern const RayesShaderClass shade_class_hair; /* fibres: Ka, Kd, Ks, roughness
 extern const RayesShaderClass shade_class_stainedglass; /* coloured opacity: Kd, frequency,
                                                            leadwidth, clarity */
 extern const RayesShaderClass shade_class_occlusion;    /* ambient occlusion: samples, maxdist */
+extern const RayesShaderClass shade_class_diffusetransmission; /* Lambertian reflection and
+                                                                  transmission: reflectance,
+                                                                  transmittance, scale */
 extern const RayesShaderClass shade_class_thindielectric; /* a glass sheet, light through it
                                                              unbent: eta */
 extern const RayesShaderClass shade_class_homogeneous; /* volume: density, extinction, albedo,

@@ -630,6 +630,71 @@ const RayesShaderClass shade_class_diffuse = {
     .diffuselighting = diffuse_lighting, /* Lambertian: view-independent throughout */
 };
 
+/* ------------------------------------------------- diffusetransmission */
+
+/* pbrt-v4's diffusetransmission (leaves, paper, lamp shades): Lambertian
+ * reflection of the light on the shaded side and Lambertian transmission
+ * of the light on the other, each scaled by `scale`. The other side's
+ * light is the same services' with the normals turned over (its rays leave
+ * from that side). View-independent, so cached as diffuse light. */
+typedef struct DiffuseTransmissionParams {
+    float reflectance[3], transmittance[3], scale;
+} DiffuseTransmissionParams;
+
+static void diffusetransmission_chunk(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
+                                      const void *params, RayesShadeOutputs *out)
+{
+    const DiffuseTransmissionParams *p = params;
+    Rgb E[SHADE_CHUNK], Eb[SHADE_CHUNK], refl[SHADE_CHUNK], tran[SHADE_CHUNK];
+    Rgb Nb[SHADE_CHUNK], Ngb[SHADE_CHUNK];
+    shade_param_color(sv, ctx, "reflectance", p->reflectance, refl);
+    shade_param_color(sv, ctx, "transmittance", p->transmittance, tran);
+    diffuse_light(sv, ctx, E, out);
+    RayesShadeCtx back = *ctx; /* the other side */
+    for (size_t i = 0; i < ctx->n_points; i++)
+        for (int c = 0; c < 3; c++) {
+            Nb[i][c] = -ctx->N[i][c];
+            Ngb[i][c] = -(ctx->Ng ? ctx->Ng : ctx->N)[i][c];
+        }
+    back.N = (const float(*)[3])Nb;
+    back.Ng = (const float(*)[3])Ngb;
+    RayesShadeOutputs ob = {NULL, NULL, NULL, NULL};
+    diffuse_light(sv, &back, Eb, &ob);
+    for (size_t i = 0; i < ctx->n_points; i++)
+        for (int c = 0; c < 3; c++)
+            out->Ci[i][c] =
+                cs(ctx, i, c) * p->scale * (refl[i][c] * E[i][c] + tran[i][c] * Eb[i][c]);
+}
+
+static void diffusetransmission_lighting(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
+                                         const void *params, RayesShadeOutputs *out)
+{
+    by_chunks(sv, ctx, params, out, diffusetransmission_chunk);
+}
+
+static const RayesShaderParamDesc diffusetransmission_params[] = {
+    {"reflectance",
+     RAYES_PARAM_COLOR,
+     offsetof(DiffuseTransmissionParams, reflectance),
+     {0.25f, 0.25f, 0.25f}},
+    {"transmittance",
+     RAYES_PARAM_COLOR,
+     offsetof(DiffuseTransmissionParams, transmittance),
+     {0.25f, 0.25f, 0.25f}},
+    {"scale", RAYES_PARAM_FLOAT, offsetof(DiffuseTransmissionParams, scale), {1, 0, 0}},
+};
+
+const RayesShaderClass shade_class_diffusetransmission = {
+    .abi_version = RAYES_SHADER_ABI_VERSION,
+    .struct_size = sizeof(RayesShaderClass),
+    .name = "diffusetransmission",
+    .params_size = sizeof(DiffuseTransmissionParams),
+    .params = diffusetransmission_params,
+    .n_params = sizeof diffusetransmission_params / sizeof diffusetransmission_params[0],
+    .lighting = diffusetransmission_lighting,
+    .diffuselighting = diffusetransmission_lighting, /* view-independent throughout */
+};
+
 /* ------------------------------------------------------------ conductor */
 
 typedef struct ConductorParams {

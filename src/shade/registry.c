@@ -11,14 +11,19 @@
 #include "shade/plugin.h"
 
 static const RayesShaderClass *const builtin_classes[] = {
-    &shade_class_matte,          &shade_class_plastic,       &shade_class_mirror,
-    &shade_class_constant,       &shade_class_bumpy,         &shade_class_fractal,
-    &shade_class_displace,       &shade_class_metal,         &shade_class_shinymetal,
-    &shade_class_glass,          &shade_class_diffuse,       &shade_class_conductor,
-    &shade_class_dielectric,     &shade_class_coateddiffuse, &shade_class_paintedplastic,
-    &shade_class_hair,           &shade_class_stainedglass,  &shade_class_occlusion,
-    &shade_class_thindielectric, &shade_class_homogeneous,   &shade_class_turbulence,
-    &shade_class_subsurface,     &shade_class_wood,          &shade_class_brickwall,
+    &shade_class_matte,          &shade_class_plastic,
+    &shade_class_mirror,         &shade_class_constant,
+    &shade_class_bumpy,          &shade_class_fractal,
+    &shade_class_displace,       &shade_class_metal,
+    &shade_class_shinymetal,     &shade_class_glass,
+    &shade_class_diffuse,        &shade_class_conductor,
+    &shade_class_dielectric,     &shade_class_coateddiffuse,
+    &shade_class_paintedplastic, &shade_class_hair,
+    &shade_class_stainedglass,   &shade_class_occlusion,
+    &shade_class_thindielectric, &shade_class_diffusetransmission,
+    &shade_class_homogeneous,    &shade_class_turbulence,
+    &shade_class_subsurface,     &shade_class_wood,
+    &shade_class_brickwall,
 };
 
 const RayesShaderClass *shade_find_class(const char *name)

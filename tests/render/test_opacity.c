@@ -5,7 +5,8 @@
  * maximum distance) and against a wall matches its closed forms; a
  * cut-out (an Os pattern) shadows like the same cut-out made of geometry;
  * the opacity cache gives the uncached image within noise, and images do
- * not depend on threads or the cache budget.
+ * not depend on threads or the cache budget. Also thin glass and
+ * diffuse transmission (pbrt-v4's thindielectric, diffusetransmission).
  *
  * The scenes look down at a floor (z = 0, x and y in [-2, 2]) from above;
  * sheets are invisible to the camera (visibility) unless a test says so,
@@ -447,8 +448,38 @@ static void test_thin_glass(void)
     rayes_image_free(pair[1]);
 }
 
+/* pbrt-v4's diffusetransmission: a sheet lit from behind shows its
+ * transmittance times that light, as a diffuse sheet of that reflectance
+ * lit from the front would; lit from the front, its reflectance. */
+static double sheet(const char *shader, float refl, float tran, float light_z)
+{
+    RayesScene *s = new_scene();
+    RayesParam p[2] = {pc("reflectance", refl, refl, refl), pc("transmittance", tran, tran, tran)};
+    CHECK(rayes_scene_set_shader(s, shader, p, strcmp(shader, "diffuse") ? 2 : 1) == RAYES_OK);
+    quad_at(s, 2.0f, 0.0f);
+    point_light(s, light_z);
+    RayesImage *img = render(s, 2, 20.0, 1, RAYES_QUALITY_PREVIEW, NULL);
+    double m[3] = {0, 0, 0};
+    if (img)
+        mean_rgb(img, m);
+    rayes_image_free(img);
+    rayes_scene_release(s);
+    return m[1];
+}
+
+static void test_diffuse_transmission(void)
+{
+    double lit = sheet("diffuse", 1.0f, 0.0f, 5.0f);
+    CHECK(lit > 0.05);
+    CHECK_NEAR(sheet("diffusetransmission", 0.0f, 1.0f, -5.0f), lit, 1e-4 * lit);
+    CHECK_NEAR(sheet("diffusetransmission", 0.0f, 1.0f, 5.0f), 0.0, 1e-6);
+    CHECK_NEAR(sheet("diffusetransmission", 0.25f, 0.5f, 5.0f), 0.25 * lit, 1e-4 * lit);
+    CHECK_NEAR(sheet("diffusetransmission", 0.25f, 0.5f, -5.0f), 0.5 * lit, 1e-4 * lit);
+}
+
 TEST_MAIN(TEST(test_stacked_sheets_multiply_in_any_order),
           TEST(test_half_transparent_sheet_halves_irradiance),
           TEST(test_ambient_occlusion_closed_forms), TEST(test_cutout_shadow_matches_geometry),
           TEST(test_opacity_cache_within_noise_and_deterministic), TEST(test_camera_sees_through),
-          TEST(test_grid_hider_transparent_grids), TEST(test_bad_attributes), TEST(test_thin_glass))
+          TEST(test_grid_hider_transparent_grids), TEST(test_bad_attributes), TEST(test_thin_glass),
+          TEST(test_diffuse_transmission))
