@@ -120,12 +120,14 @@ void pbrt_grow_bound(Parser *P, const float *pts, size_t n)
         }
 }
 
-/* The corners of a quadric's bounds (pbrt's sphere, cylinder, disk). */
+/* The corners of a quadric's bounds (pbrt's sphere, cylinder, disk, and
+ * the annulus: a flat hyperboloid from the rim). */
 void pbrt_grow_quadric(Parser *P, RayesQuadric q, const float *qp)
 {
+    int flat = q == RAYES_QUADRIC_DISK || q == RAYES_QUADRIC_HYPERBOLOID;
     float r = q == RAYES_QUADRIC_DISK ? qp[1] : qp[0];
-    float z0 = q == RAYES_QUADRIC_DISK ? qp[0] : qp[1],
-          z1 = q == RAYES_QUADRIC_DISK ? qp[0] : qp[2];
+    float h = q == RAYES_QUADRIC_DISK ? qp[0] : qp[2];
+    float z0 = flat ? h : qp[1], z1 = flat ? h : qp[2];
     const float c[6] = {-r, -r, z0, r, r, z1};
     pbrt_grow_bound(P, c, 2);
 }
@@ -292,7 +294,8 @@ int pbrt_emit_curves(Parser *P, const Token *t, const RayesCurves *c, const Raye
 int pbrt_emit_quadric(Parser *P, const Token *t, RayesQuadric q, const float *qp, size_t n,
                       unsigned flags)
 {
-    if (q == RAYES_QUADRIC_SPHERE || q == RAYES_QUADRIC_CYLINDER || q == RAYES_QUADRIC_DISK)
+    if (q == RAYES_QUADRIC_SPHERE || q == RAYES_QUADRIC_CYLINDER || q == RAYES_QUADRIC_DISK ||
+        q == RAYES_QUADRIC_HYPERBOLOID)
         pbrt_grow_quadric(P, q, qp);
     if (strcmp(P->gs.material.shader, PBRT_INVISIBLE) == 0)
         return 0;

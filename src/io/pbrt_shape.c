@@ -388,7 +388,7 @@ static int shape_quadric(Parser *P, const Token *t, const char *type, ParamList 
     if (!(phimax > 0 && phimax <= 360))
         return FAIL_TOK(P, t, "%s: expected phimax in (0, 360], found %g", type, phimax);
     unsigned flags = P->gs.reverse ? RAYES_QUADRIC_REVERSE : 0;
-    float qp[4];
+    float qp[7];
     size_t n;
     RayesQuadric q;
     double height = 0;
@@ -415,12 +415,24 @@ static int shape_quadric(Parser *P, const Token *t, const char *type, ParamList 
     } else {
         height = pbrt_get_float(pl, "height", 0.0);
         double inner = pbrt_get_float(pl, "innerradius", 0.0);
-        if (inner > 0)
-            pbrt_warn_at(P, t->line, t->col, "disk innerradius", "disk: \"innerradius\" is not "
-                         "supported; the disk is whole");
-        q = RAYES_QUADRIC_DISK;
-        qp[0] = (float)height, qp[1] = (float)radius, qp[2] = (float)phimax;
-        n = 3;
+        if (inner > 0 && inner < radius && !P->gs.area.on) {
+            /* an annulus: RenderMan's hyperboloid of the line from the rim
+             * in to the inner radius, parameterised (and facing) as the
+             * disk is */
+            q = RAYES_QUADRIC_HYPERBOLOID;
+            const float line[7] = {(float)radius, 0, (float)height, (float)inner, 0, (float)height,
+                                   (float)phimax};
+            memcpy(qp, line, sizeof line);
+            n = 7;
+        } else {
+            if (inner > 0)
+                pbrt_warn_at(P, t->line, t->col, "disk innerradius",
+                             "disk: \"innerradius\" %s; the disk is whole",
+                             inner >= radius ? "is not below the radius" : "on an emitter");
+            q = RAYES_QUADRIC_DISK;
+            qp[0] = (float)height, qp[1] = (float)radius, qp[2] = (float)phimax;
+            n = 3;
+        }
     }
     if (!P->gs.area.on || P->recording || q == RAYES_QUADRIC_CYLINDER) {
         if (P->gs.area.on)

@@ -1170,6 +1170,28 @@ static void test_measured_material(void)
     free(r);
 }
 
+/* A disk with an inner radius: an annulus, RenderMan's hyperboloid of the
+ * line from the rim in (facing as the disk); without, a disk. */
+static void test_annulus(void)
+{
+    Rec *r = malloc(sizeof *r);
+    IoSettings s;
+    char err[256];
+    CHECK(parse("t.pbrt",
+                "WorldBegin\nShape \"disk\" \"float radius\" 2 \"float innerradius\" 0.5 "
+                "\"float height\" 0.25\nShape \"disk\" \"float radius\" 2\n",
+                r, &s, err, sizeof err) == RAYES_OK);
+    CHECK(r->n_quadrics == 2);
+    if (r->n_quadrics == 2) {
+        CHECK(r->quadric[0].type == RAYES_QUADRIC_HYPERBOLOID && r->quadric[0].n == 7);
+        const float want[7] = {2, 0, 0.25f, 0.5f, 0, 0.25f, 360};
+        for (int k = 0; k < 7; k++)
+            CHECK(r->quadric[0].p[k] == want[k]);
+        CHECK(r->quadric[1].type == RAYES_QUADRIC_DISK);
+    }
+    free(r);
+}
+
 /* thindielectric: rayes's thin glass sheet, its eta, and no warning. */
 static void test_thin_dielectric(void)
 {
@@ -1396,7 +1418,7 @@ static void test_exposure(void)
 
 TEST_MAIN(TEST(test_filters), TEST(test_exposure), TEST(test_subsurface_material),
           TEST(test_filter_warnings), TEST(test_import), TEST(test_film_types),
-          TEST(test_measured_material), TEST(test_thin_dielectric),
+          TEST(test_measured_material), TEST(test_thin_dielectric), TEST(test_annulus),
           TEST(test_anisotropic_roughness), TEST(test_maxdepth), TEST(test_spectrum_files),
           TEST(test_cornell_box), TEST(test_transforms), TEST(test_materials), TEST(test_lights),
           TEST(test_instances_include_ply), TEST(test_errors), TEST(test_normals_and_uv),
