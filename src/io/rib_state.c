@@ -847,6 +847,12 @@ static int h_option_attribute(Rib *r, const Args *a)
                 r->settings->bounces = depth;
             else
                 r->settings->specular_depth = depth;
+        } else if (option && strcmp(group, "trace") == 0 && strcmp(q->d.name, "maxdepth") == 0 &&
+                   rib_is_num(q->v) && q->v->n == 1) {
+            /* the older RenderMans' (and Aqsis's, 3Delight's) depth of traced
+             * rays: rayes's specular depth (its diffuse bounces are its own) */
+            double d = q->v->d[0];
+            r->settings->specular_depth = !(d > 0) ? 0 : d > 1e6 ? 1000000 : (int)d;
         } else if (option && strcmp(group, "limits") == 0 && strcmp(q->d.name, "gridsize") == 0 &&
                    rib_is_num(q->v) && q->v->n == 1) {
             e = set_grid_size(r, q->v->d[0]);

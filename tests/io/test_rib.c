@@ -355,6 +355,9 @@ static void test_settings(void)
     CHECK(settings.n_displays == 2);
     CHECK(strcmp(settings.displays[1].name, "b.png") == 0);
     CHECK(strcmp(settings.displays[0].type, "openexr") == 0);
+    /* Option "trace" "maxdepth": the specular depth. */
+    CHECK(parse("Option \"trace\" \"int maxdepth\" [4]\nWorldBegin\nWorldEnd\n") == RAYES_OK);
+    CHECK(settings.specular_depth == 4 && settings.bounces == -1);
     /* Imager "background": its colour (bgcolor, or Aqsis files' "color"),
      * white by default; other imagers are ignored. */
     CHECK(parse("Imager \"background\" \"color bgcolor\" [0.5 0.25 0]\nWorldBegin\nWorldEnd\n") ==
