@@ -109,6 +109,9 @@ typedef struct RayesShadeCtx {
                                    bound to patterns, n_patterns of them (NULL, 0: none); a
                                    parameter not listed has its value in params */
     size_t n_patterns;
+    const float (*dst)[4]; /* appended after ABI 2 (a renderer that predates it leaves
+                              it NULL): per point ds/du, ds/dv, dt/du, dt/dv, the texture
+                              coordinates' derivatives (NULL: s and t are u and v) */
 } RayesShadeCtx;
 
 /* The outputs of a method call, n_points each. Irradiance may be NULL. */

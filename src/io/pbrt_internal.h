@@ -35,7 +35,7 @@
 
 #define PBRT_PATH 1024
 #define PBRT_MAX_WARNED 512 /* kinds of warning said per read */
-#define MAT_MAX_PARAMS 8
+#define MAT_MAX_PARAMS 10
 /* The shader name of pbrt's "interface" material: shapes with it are not
  * emitted (they only bound media). */
 #define PBRT_INVISIBLE "(interface)"

@@ -711,9 +711,6 @@ static int subsurface_material(Parser *P, const Token *t, ParamList *pl, Materia
 
 static int material_of_type(Parser *P, const Token *t, const char *type, ParamList *pl, Material *m)
 {
-    if (pbrt_find(pl, "normalmap"))
-        pbrt_warn_at(P, t->line, t->col, "normalmap",
-                     "material \"%s\": \"normalmap\" is not supported", type);
     if (strcmp(type, "diffuse") == 0)
         return diffuse_material(P, pl, m, "reflectance");
     if (strcmp(type, "coateddiffuse") == 0)
@@ -771,9 +768,41 @@ static int material_of_type(Parser *P, const Token *t, const char *type, ParamLi
     return 0;
 }
 
+/* pbrt-v4's "normalmap": a linear image of tangent-space normals, as a
+ * pattern the shader's "normalmap" parameter is bound to (the shaders
+ * rayes maps pbrt's materials to read it; others warn). */
+static int mat_normal_map(Parser *P, const Token *t, ParamList *pl, Material *m)
+{
+    const char *file = pbrt_get_string(pl, "normalmap", NULL);
+    if (!file || !file[0])
+        return 0;
+    static const char *const takes[] = {"diffuse",       "dielectric",          "conductor",
+                                        "coateddiffuse", "diffusetransmission", NULL};
+    int k = 0;
+    while (takes[k] && strcmp(m->shader, takes[k]) != 0)
+        k++;
+    if (!takes[k]) {
+        pbrt_warn_at(P, t->line, t->col, "normalmap",
+                     "\"normalmap\" on a material rayes draws as \"%s\" is not used", m->shader);
+        return 0;
+    }
+    char path[PBRT_PATH];
+    if (pbrt_resolve(P, t, file, path, sizeof path) != 0)
+        return -1;
+    const RayesParam q[2] = {{.name = "filename", .type = RAYES_PARAM_STRING, .string = path},
+                             {.name = "encoding", .type = RAYES_PARAM_STRING, .string = "linear"}};
+    static const float flat[3] = {0.5f, 0.5f, 1.0f};
+    long idx = define_pattern(P, t, " normalmap", 0, "imagemap", q, 2, flat);
+    if (idx < 0)
+        return -1;
+    if (P->textures[idx].pattern[0])
+        mat_pattern(m, "normalmap", (size_t)idx);
+    return 0;
+}
+
 static int make_material(Parser *P, const Token *t, const char *type, ParamList *pl, Material *m)
 {
-    if (material_of_type(P, t, type, pl, m) != 0)
+    if (material_of_type(P, t, type, pl, m) != 0 || mat_normal_map(P, t, pl, m) != 0)
         return -1;
     return strcmp(m->shader, PBRT_INVISIBLE) != 0 ? mat_displacement(P, pl, m) : 0;
 }

@@ -185,12 +185,13 @@ static Rgb *shade_grid(Worker *w, uint32_t gi, uint32_t instance, int seg)
     size_t n = geom_grid_n_vertices(g);
     float(*f3)[3] = malloc(n * 10 * sizeof *f3);
     float *f1 = malloc(n * 10 * sizeof *f1);
+    float(*dsts)[4] = malloc(n * sizeof *dsts);
     uint64_t *keys = malloc(n * sizeof *keys);
     RayDiff *diff = malloc(n * sizeof *diff);
     size_t n_ci = grid_values(g, obj->transparent);
     Rgb *ci = malloc((n_ci + 1) * sizeof *ci);
     int *back = malloc(n * sizeof *back);
-    RY_CHECK(f3 && f1 && keys && diff && ci && back);
+    RY_CHECK(f3 && f1 && dsts && keys && diff && ci && back);
     float(*P)[3] = f3, (*N)[3] = f3 + n, (*dPdu)[3] = f3 + 2 * n, (*dPdv)[3] = f3 + 3 * n;
     float(*I)[3] = f3 + 4 * n, (*Cs)[3] = f3 + 5 * n, (*Os)[3] = f3 + 6 * n;
     float(*Ci)[3] = f3 + 7 * n, (*Oi)[3] = f3 + 8 * n, (*Ng)[3] = f3 + 9 * n;
@@ -237,7 +238,7 @@ static Rgb *shade_grid(Worker *w, uint32_t gi, uint32_t instance, int seg)
         v[k] = gs->uv[i][1];
         du[k] = su;
         dv[k] = sv;
-        float st[2], dst[4];
+        float st[2], *dst = dsts[k];
         geom_vertex_st(gs, g, i, st, dst);
         s[k] = st[0], t[k] = st[1];
         path_st_footprint(dst, su, sv, &ds[k], &dt[k]);
@@ -257,12 +258,27 @@ static Rgb *shade_grid(Worker *w, uint32_t gi, uint32_t instance, int seg)
     PathState ps = {w, keys, diff, curv, offset, w->set->irradiance ? &irr : NULL, gi,
                     own_st ? ds : NULL, own_st ? dt : NULL, 0, NULL, instance};
     RayesShadeCtx ctx = {
-        .n_points = n, .ray_type = RAYES_RAY_CAMERA, .diffuse_depth = 0, .specular_depth = 0,
-        .P = (const float(*)[3])P, .N = (const float(*)[3])N, .Ng = (const float(*)[3])Ng,
-        .dPdu = (const float(*)[3])dPdu, .dPdv = (const float(*)[3])dPdv, .u = u, .v = v,
-        .s = s, .t = t, .du = du, .dv = dv, .I = (const float(*)[3])I,
-        .Cs = (const float(*)[3])Cs, .Os = (const float(*)[3])Os, .renderer = &ps,
+        .n_points = n,
+        .ray_type = RAYES_RAY_CAMERA,
+        .diffuse_depth = 0,
+        .specular_depth = 0,
+        .P = (const float(*)[3])P,
+        .N = (const float(*)[3])N,
+        .Ng = (const float(*)[3])Ng,
+        .dPdu = (const float(*)[3])dPdu,
+        .dPdv = (const float(*)[3])dPdv,
+        .u = u,
+        .v = v,
+        .s = s,
+        .t = t,
+        .du = du,
+        .dv = dv,
+        .I = (const float(*)[3])I,
+        .Cs = (const float(*)[3])Cs,
+        .Os = (const float(*)[3])Os,
+        .renderer = &ps,
         .backfacing = back,
+        .dst = own_st ? (const float(*)[4])dsts : NULL,
     };
     path_apply_Os_pattern(w, obj, &ctx, Os);
     RayesShadeOutputs out = {.Ci = Ci, .Oi = Oi};
@@ -279,6 +295,7 @@ static Rgb *shade_grid(Worker *w, uint32_t gi, uint32_t instance, int seg)
     free(back);
     free(f3);
     free(f1);
+    free(dsts);
     free(keys);
     free(diff);
     return ci;

@@ -182,6 +182,7 @@ static Vec3 shade_hit(Worker *w, const Ray *ray, const Hit *hit, const RenderObj
         .Os = (const float(*)[3])hp.Os,
         .renderer = &ps,
         .backfacing = &backfacing,
+        .dst = own_st ? (const float(*)[4]) & hp.dst : NULL,
     };
     path_apply_Os_pattern(w, obj, &ctx, &hp.Os);
     float Ci[1][3] = {{0, 0, 0}}, Oi[1][3] = {{1, 1, 1}}, E[1][3] = {{0, 0, 0}};

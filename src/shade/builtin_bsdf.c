@@ -56,6 +56,43 @@ static void set_opacity(const RayesShadeCtx *ctx, RayesShadeOutputs *out)
 typedef void (*ChunkFn)(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
                         const void *params, RayesShadeOutputs *out);
 
+/* The shading normals of a normal map (pbrt-v4's "normalmap": a linear
+ * image whose texel n = 2 rgb - 1 is in the frame of x = dP/ds, z = N,
+ * y = z cross x; the pattern "normalmap" holds it): dP/ds from dPdu, dPdv
+ * and the texture coordinates' derivatives (ctx->dst; without them s is u),
+ * made perpendicular to N. A mapped normal that turns away from the
+ * geometric normal keeps N. */
+static Vec3 ld(const float p[3]);
+
+static void normal_map(const RayesShaderServices *sv, const RayesShadeCtx *ctx, Rgb *out)
+{
+    static const float flat[3] = {0.5f, 0.5f, 1.0f};
+    Rgb tex[SHADE_CHUNK];
+    shade_param_color(sv, ctx, "normalmap", flat, tex);
+    for (size_t i = 0; i < ctx->n_points; i++) {
+        Vec3 N = ld(ctx->N[i]), du = ld(ctx->dPdu[i]), dv = ld(ctx->dPdv[i]), dPds = du;
+        if (ctx->dst) { /* [ds dt] = J [du dv]: dP/ds = (dt/dv dPdu - dt/du dPdv) / det J */
+            const float *j = ctx->dst[i];
+            float det = j[0] * j[3] - j[1] * j[2];
+            if (fabsf(det) > 1e-20f)
+                dPds = v3_scale(v3_sub(v3_scale(du, j[3]), v3_scale(dv, j[2])), 1.0f / det);
+        }
+        Vec3 T = v3_sub(dPds, v3_scale(N, v3_dot(N, dPds)));
+        float len = v3_length(T);
+        Vec3 m = N;
+        if (len > 0.0f && isfinite(len)) {
+            T = v3_scale(T, 1.0f / len);
+            Vec3 B = v3_cross(N, T);
+            Vec3 n = v3(2.0f * tex[i][0] - 1.0f, 2.0f * tex[i][1] - 1.0f, 2.0f * tex[i][2] - 1.0f);
+            m = v3_normalize(v3_add(v3_add(v3_scale(T, n.x), v3_scale(B, n.y)), v3_scale(N, n.z)));
+            Vec3 Ng = ctx->Ng ? ld(ctx->Ng[i]) : N;
+            if (!(v3_dot(m, Ng) > 0.0f) || !isfinite(m.x + m.y + m.z))
+                m = N;
+        }
+        out[i][0] = m.x, out[i][1] = m.y, out[i][2] = m.z;
+    }
+}
+
 /* Runs fn on SHADE_CHUNK-point slices; Irradiance, if asked for, is left
  * to fn (zeroed first). */
 static void by_chunks(const RayesShaderServices *sv, const RayesShadeCtx *ctx, const void *params,
@@ -69,6 +106,11 @@ static void by_chunks(const RayesShaderServices *sv, const RayesShadeCtx *ctx, c
         shade_ctx_slice(ctx, start, n, &sub);
         RayesShadeOutputs o = {out->Ci + start, out->Oi + start,
                                out->Irradiance ? out->Irradiance + start : NULL, NULL};
+        Rgb mapped[SHADE_CHUNK];
+        if (shade_param_bound(&sub, "normalmap")) {
+            normal_map(sv, &sub, mapped);
+            sub.N = (const float(*)[3])mapped;
+        }
         fn(sv, &sub, params, &o);
     }
     set_opacity(ctx, out);
@@ -548,7 +590,7 @@ const RayesShaderClass shade_class_glass = {
 };
 
 typedef struct DielectricParams {
-    float eta, roughness;
+    float eta, roughness, normalmap[3];
 } DielectricParams;
 
 static void dielectric_chunk(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
@@ -578,6 +620,7 @@ static void dielectric_lighting(const RayesShaderServices *sv, const RayesShadeC
 static const RayesShaderParamDesc dielectric_params[] = {
     {"eta", RAYES_PARAM_FLOAT, offsetof(DielectricParams, eta), {1.5f, 0, 0}},
     {"roughness", RAYES_PARAM_FLOAT, offsetof(DielectricParams, roughness), {0, 0, 0}},
+    {"normalmap", RAYES_PARAM_COLOR, offsetof(DielectricParams, normalmap), {0.5f, 0.5f, 1.0f}},
 };
 
 const RayesShaderClass shade_class_dielectric = {
@@ -594,7 +637,7 @@ const RayesShaderClass shade_class_dielectric = {
 /* ------------------------------------------------------------ diffuse */
 
 typedef struct DiffuseParams {
-    float reflectance[3];
+    float reflectance[3], normalmap[3];
 } DiffuseParams;
 
 static void diffuse_chunk(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
@@ -617,6 +660,7 @@ static void diffuse_lighting(const RayesShaderServices *sv, const RayesShadeCtx 
 
 static const RayesShaderParamDesc diffuse_params[] = {
     {"reflectance", RAYES_PARAM_COLOR, offsetof(DiffuseParams, reflectance), {0.5f, 0.5f, 0.5f}},
+    {"normalmap", RAYES_PARAM_COLOR, offsetof(DiffuseParams, normalmap), {0.5f, 0.5f, 1.0f}},
 };
 
 const RayesShaderClass shade_class_diffuse = {
@@ -638,7 +682,7 @@ const RayesShaderClass shade_class_diffuse = {
  * light is the same services' with the normals turned over (its rays leave
  * from that side). View-independent, so cached as diffuse light. */
 typedef struct DiffuseTransmissionParams {
-    float reflectance[3], transmittance[3], scale;
+    float reflectance[3], transmittance[3], scale, normalmap[3];
 } DiffuseTransmissionParams;
 
 static void diffusetransmission_chunk(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
@@ -682,6 +726,10 @@ static const RayesShaderParamDesc diffusetransmission_params[] = {
      offsetof(DiffuseTransmissionParams, transmittance),
      {0.25f, 0.25f, 0.25f}},
     {"scale", RAYES_PARAM_FLOAT, offsetof(DiffuseTransmissionParams, scale), {1, 0, 0}},
+    {"normalmap",
+     RAYES_PARAM_COLOR,
+     offsetof(DiffuseTransmissionParams, normalmap),
+     {0.5f, 0.5f, 1.0f}},
 };
 
 const RayesShaderClass shade_class_diffusetransmission = {
@@ -701,6 +749,7 @@ typedef struct ConductorParams {
     float eta[3], k[3], reflectance[3], roughness;
     char preset[64];
     float coat, coat_roughness, coat_eta; /* a dielectric coat (pbrt's coatedconductor) */
+    float normalmap[3];
 } ConductorParams;
 
 /* The complex index of the points: the preset if named (an unknown name:
@@ -791,6 +840,7 @@ static const RayesShaderParamDesc conductor_params[] = {
     {"coat", RAYES_PARAM_FLOAT, offsetof(ConductorParams, coat), {0, 0, 0}},
     {"coat_roughness", RAYES_PARAM_FLOAT, offsetof(ConductorParams, coat_roughness), {0, 0, 0}},
     {"coat_eta", RAYES_PARAM_FLOAT, offsetof(ConductorParams, coat_eta), {1.5f, 0, 0}},
+    {"normalmap", RAYES_PARAM_COLOR, offsetof(ConductorParams, normalmap), {0.5f, 0.5f, 1.0f}},
 };
 
 const RayesShaderClass shade_class_conductor = {
@@ -807,7 +857,7 @@ const RayesShaderClass shade_class_conductor = {
 /* ------------------------------------------------------------ coateddiffuse */
 
 typedef struct CoatedParams {
-    float reflectance[3], roughness, eta, thickness;
+    float reflectance[3], roughness, eta, thickness, normalmap[3];
 } CoatedParams;
 
 /* A Lambertian base under a smooth or glossy dielectric coat. Light reaches
@@ -854,6 +904,7 @@ static const RayesShaderParamDesc coated_params[] = {
     {"roughness", RAYES_PARAM_FLOAT, offsetof(CoatedParams, roughness), {0, 0, 0}},
     {"eta", RAYES_PARAM_FLOAT, offsetof(CoatedParams, eta), {1.5f, 0, 0}},
     {"thickness", RAYES_PARAM_FLOAT, offsetof(CoatedParams, thickness), {0.01f, 0, 0}},
+    {"normalmap", RAYES_PARAM_COLOR, offsetof(CoatedParams, normalmap), {0.5f, 0.5f, 1.0f}},
 };
 
 const RayesShaderClass shade_class_coateddiffuse = {

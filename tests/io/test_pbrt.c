@@ -1170,6 +1170,29 @@ static void test_measured_material(void)
     free(r);
 }
 
+/* "normalmap": a linear imagemap pattern bound to the shader's
+ * "normalmap"; a material drawn by a shader without one warns. */
+static void test_normal_map(void)
+{
+    Rec *r = malloc(sizeof *r);
+    ParseRun pr = {.name = "t.pbrt",
+                   .r = r,
+                   .text = "WorldBegin\n"
+                           "Material \"coateddiffuse\" \"string normalmap\" \"nm.png\"\n"
+                           "Shape \"trianglemesh\" \"point3 P\" [0 0 0 1 0 0 0 1 0]\n"
+                           "Material \"hair\" \"string normalmap\" \"nm.png\"\n"
+                           "Shape \"trianglemesh\" \"point3 P\" [0 0 0 1 0 0 0 1 0]\n"};
+    const char *said = stderr_of(run_parse, &pr);
+    CHECK(pr.e == RAYES_OK && r->n_meshes == 2);
+    if (r->n_meshes == 2) {
+        const RayesParam *nm = param(&r->mesh[0].shader, "normalmap");
+        CHECK(nm && nm->type == RAYES_PARAM_PATTERN);
+        CHECK(param(&r->mesh[1].shader, "normalmap") == NULL);
+    }
+    CHECK(strstr(said, "t.pbrt:4:1: \"normalmap\" on a material rayes draws as \"hair\"") != NULL);
+    free(r);
+}
+
 /* A disk with an inner radius: an annulus, RenderMan's hyperboloid of the
  * line from the rim in (facing as the disk); without, a disk. */
 static void test_annulus(void)
@@ -1419,7 +1442,8 @@ static void test_exposure(void)
 TEST_MAIN(TEST(test_filters), TEST(test_exposure), TEST(test_subsurface_material),
           TEST(test_filter_warnings), TEST(test_import), TEST(test_film_types),
           TEST(test_measured_material), TEST(test_thin_dielectric), TEST(test_annulus),
-          TEST(test_anisotropic_roughness), TEST(test_maxdepth), TEST(test_spectrum_files),
-          TEST(test_cornell_box), TEST(test_transforms), TEST(test_materials), TEST(test_lights),
-          TEST(test_instances_include_ply), TEST(test_errors), TEST(test_normals_and_uv),
-          TEST(test_textures), TEST(test_coated_conductor_textures))
+          TEST(test_normal_map), TEST(test_anisotropic_roughness), TEST(test_maxdepth),
+          TEST(test_spectrum_files), TEST(test_cornell_box), TEST(test_transforms),
+          TEST(test_materials), TEST(test_lights), TEST(test_instances_include_ply),
+          TEST(test_errors), TEST(test_normals_and_uv), TEST(test_textures),
+          TEST(test_coated_conductor_textures))
