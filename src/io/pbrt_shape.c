@@ -117,27 +117,38 @@ static int shape_mesh(Parser *P, const Token *t, const char *what, size_t n_face
                      "is not emitting",
                      what);
     } else if (P->gs.area.on) {
+        /* Quads, and triangles paired into planar convex quads, are quad
+         * lights; the other triangles are quads with a corner twice (the
+         * top edge collapsed: a bilinear patch that is the triangle), each
+         * a light of its own, so a mesh keeps at most LONE_LIGHTS of them. */
+        enum { LONE_LIGHTS = 32 };
         size_t lone = 0;
         const int *f = idx;
-        for (size_t i = 0; i < n_faces; f += n_verts[i], i++) {
-            int q[4];
-            if (n_verts[i] == 4) {
-                memcpy(q, f, sizeof q);
-            } else if (i + 1 < n_faces && n_verts[i + 1] == 3 && pair_quad(pts, f, f + 3, q)) {
-                f += 3;
-                i++;
-            } else {
-                lone++;
-                continue;
+        for (size_t pass = 0; pass < 2; pass++) {
+            f = idx;
+            for (size_t i = 0; i < n_faces; f += n_verts[i], i++) {
+                int q[4];
+                if (n_verts[i] == 4) {
+                    memcpy(q, f, sizeof q);
+                } else if (i + 1 < n_faces && n_verts[i + 1] == 3 && pair_quad(pts, f, f + 3, q)) {
+                    f += 3;
+                    i++;
+                } else {
+                    lone += pass == 0;
+                    if (pass == 0 || lone > LONE_LIGHTS)
+                        continue;
+                    const int tri[4] = {f[0], f[1], f[2], f[2]};
+                    memcpy(q, tri, sizeof q);
+                }
+                if (pass == 1 && emit_area_quad(P, t, pts, N, q) != 0)
+                    return -1;
             }
-            if (emit_area_quad(P, t, pts, N, q) != 0)
-                return -1;
         }
-        if (lone)
+        if (lone > LONE_LIGHTS)
             pbrt_warn_at(P, t->line, t->col, "lone emitting triangle",
-                         "%s: %zu emitting triangle(s) do not pair into quads; rayes' area lights "
-                         "are quads, so they do not emit",
-                         what, lone);
+                         "%s: %zu emitting triangles do not pair into quads; more than %d would "
+                         "be as many lights, so they do not emit",
+                         what, lone, (int)LONE_LIGHTS);
         return 0;
     }
     if (P->gs.reverse != swaps_handedness(P->gs.ctm)) {

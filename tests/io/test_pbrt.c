@@ -1193,6 +1193,28 @@ static void test_normal_map(void)
     free(r);
 }
 
+/* An emitting triangle that pairs with no other: a quad light with its
+ * third corner twice (the triangle); a square of two triangles: one quad. */
+static void test_triangle_light(void)
+{
+    Rec *r = malloc(sizeof *r);
+    IoSettings s;
+    char err[256];
+    CHECK(parse("t.pbrt",
+                "WorldBegin\nAreaLightSource \"diffuse\" \"rgb L\" [2 2 2]\n"
+                "Shape \"trianglemesh\" \"point3 P\" [0 0 0 1 0 0 0 1 0]\n"
+                "Shape \"trianglemesh\" \"point3 P\" [0 0 0 1 0 0 1 1 0 0 1 0] "
+                "\"integer indices\" [0 1 2 0 2 3]\n",
+                r, &s, err, sizeof err) == RAYES_OK);
+    CHECK(r->n_area == 2);
+    if (r->n_area == 2) {
+        const float want[4][3] = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 1, 0}};
+        CHECK(memcmp(r->area[0].P, want, sizeof want) == 0);
+        CHECK(r->area[0].L[0] == 2.0f);
+    }
+    free(r);
+}
+
 /* A disk with an inner radius: an annulus, RenderMan's hyperboloid of the
  * line from the rim in (facing as the disk); without, a disk. */
 static void test_annulus(void)
@@ -1442,8 +1464,8 @@ static void test_exposure(void)
 TEST_MAIN(TEST(test_filters), TEST(test_exposure), TEST(test_subsurface_material),
           TEST(test_filter_warnings), TEST(test_import), TEST(test_film_types),
           TEST(test_measured_material), TEST(test_thin_dielectric), TEST(test_annulus),
-          TEST(test_normal_map), TEST(test_anisotropic_roughness), TEST(test_maxdepth),
-          TEST(test_spectrum_files), TEST(test_cornell_box), TEST(test_transforms),
-          TEST(test_materials), TEST(test_lights), TEST(test_instances_include_ply),
-          TEST(test_errors), TEST(test_normals_and_uv), TEST(test_textures),
-          TEST(test_coated_conductor_textures))
+          TEST(test_triangle_light), TEST(test_normal_map), TEST(test_anisotropic_roughness),
+          TEST(test_maxdepth), TEST(test_spectrum_files), TEST(test_cornell_box),
+          TEST(test_transforms), TEST(test_materials), TEST(test_lights),
+          TEST(test_instances_include_ply), TEST(test_errors), TEST(test_normals_and_uv),
+          TEST(test_textures), TEST(test_coated_conductor_textures))
