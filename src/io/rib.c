@@ -472,6 +472,17 @@ static int h_skip(Rib *r, const Args *a)
     return 0;
 }
 
+/* Matte 0 is every surface's default: nothing to say; Matte 1 (a holdout)
+ * is drawn as an ordinary surface, with one warning. */
+static int h_matte(Rib *r, const Args *a)
+{
+    if (a->n == 1 && rib_is_num(&a->v[0]) && a->v[0].n == 1 && a->v[0].d[0] == 0.0)
+        return 0;
+    rib_warn_once(r, "request Matte",
+                  "Matte 1 (a holdout) is not supported; the surface is drawn as any other");
+    return 0;
+}
+
 static int h_archive_begin(Rib *r, const Args *a)
 {
     h_skip(r, a);
@@ -521,7 +532,7 @@ static const RibRequest own_requests[] = {
     {"ElseIf", h_skip},
     {"Else", h_skip},
     {"IfEnd", h_skip},
-    {"Matte", h_skip},
+    {"Matte", h_matte},
     {"TextureCoordinates", h_skip},
     {"Bound", h_skip},
     {"ColorSamples", h_skip},

@@ -730,8 +730,9 @@ static int set_grid_size(Rib *r, double g)
 }
 
 /* The ray-type bits of Attribute "visibility"'s names: PRMan's "camera",
- * "diffuse", "specular", "transmission" and the older "trace" (diffuse
- * and specular alike); 0 for another name. */
+ * "diffuse", "specular", "transmission", the older "trace" (diffuse and
+ * specular alike) and "indirect" (PRMan 13's indirect, diffuse rays); 0
+ * for another name. */
 static uint32_t visibility_bits(const char *name)
 {
     return strcmp(name, "camera") == 0         ? RAYES_RAY_CAMERA
@@ -739,6 +740,7 @@ static uint32_t visibility_bits(const char *name)
            : strcmp(name, "specular") == 0     ? RAYES_RAY_SPECULAR
            : strcmp(name, "transmission") == 0 ? RAYES_RAY_SHADOW
            : strcmp(name, "trace") == 0        ? RAYES_RAY_DIFFUSE | RAYES_RAY_SPECULAR
+           : strcmp(name, "indirect") == 0     ? RAYES_RAY_DIFFUSE
                                                : 0u;
 }
 

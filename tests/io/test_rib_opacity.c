@@ -21,6 +21,7 @@
 #include "io/rib.h"
 #include "io/rib_write.h"
 #include "rayes/rayes.h"
+#include "scene/scene.h"
 #include "test.h"
 
 enum { SIZE = 24 };
@@ -89,8 +90,32 @@ static int same(const RayesImage *a, const RayesImage *b)
 
 #define BLOCKER "Polygon \"P\" [-0.5 -0.5 3  0.5 -0.5 3  0.5 0.5 3  -0.5 0.5 3]\n"
 
+/* The ray mask of the object of the last primitive of a RIB text. */
+static uint32_t last_mask(const char *text)
+{
+    RayesScene *s = rayes_scene_new();
+    IoSink sink = io_sink_scene(s);
+    IoSettings settings;
+    io_settings_init(&settings);
+    IoReadOptions opt = {NULL, -1};
+    char err[512] = "";
+    CHECK(io_rib_parse("v.rib", (const unsigned char *)text, strlen(text), &sink, &opt, &settings,
+                       err, sizeof err) == RAYES_OK);
+    uint32_t m = s->n_prims ? s->objects[s->prims[s->n_prims - 1].object].ray_mask : 0;
+    rayes_scene_release(s);
+    return m;
+}
+
 static void test_visibility(void)
 {
+    /* The older names: "trace" is diffuse and specular, PRMan 13's
+     * "indirect" diffuse alone. */
+    uint32_t m = last_mask("WorldBegin\nAttribute \"visibility\" \"int indirect\" [0]\n"
+                           "Sphere 1 -1 1 360\nWorldEnd\n");
+    CHECK(!(m & RAYES_RAY_DIFFUSE) && (m & RAYES_RAY_SPECULAR) && (m & RAYES_RAY_CAMERA));
+    m = last_mask("WorldBegin\nAttribute \"visibility\" \"int trace\" [0]\n"
+                  "Sphere 1 -1 1 360\nWorldEnd\n");
+    CHECK(!(m & (RAYES_RAY_DIFFUSE | RAYES_RAY_SPECULAR)) && (m & RAYES_RAY_SHADOW));
     RayesImage *open = render_rib("", NULL);
     RayesImage *shadow = render_rib("AttributeBegin\nAttribute \"visibility\" \"int camera\" [0]\n"
                                     "Color [1 0 0]\n" BLOCKER "AttributeEnd\n",
