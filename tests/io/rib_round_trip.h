@@ -1,7 +1,7 @@
 /*
- * tests/io/rib_round_trip.h — the RIB writer's text for a RIB text: read
- * into the writer's sink, written out whole. Header-only, for the tests
- * that read a writer's RIB back (curves, blobbies, solids).
+ * tests/io/rib_round_trip.h — RIB texts for the tests that read a
+ * writer's RIB back (curves, blobbies, solids): the writer's text for a
+ * RIB text, and a RIB text read into a new scene. Header-only.
  */
 #ifndef RAYES_TESTS_IO_RIB_ROUND_TRIP_H
 #define RAYES_TESTS_IO_RIB_ROUND_TRIP_H
@@ -13,6 +13,22 @@
 #include "io/rib.h"
 #include "io/rib_write.h"
 #include "io/sink.h"
+#include "rayes/rayes.h"
+
+/* A new scene (release it) of a RIB text named t.rib; *e the reader's
+ * result, err its message. */
+static RayesScene *rib_read_scene(const char *text, RayesError *e, char *err, size_t n)
+{
+    RayesScene *s = rayes_scene_new();
+    IoSink sink = io_sink_scene(s);
+    IoSettings settings;
+    io_settings_init(&settings);
+    IoReadOptions opt = {RAYES_TEST_DATA, -1};
+    err[0] = '\0';
+    *e = io_rib_parse("t.rib", (const unsigned char *)text, strlen(text), &sink, &opt, &settings,
+                      err, n);
+    return s;
+}
 
 /* The written RIB (malloc'd; free it), or NULL if reading or writing
  * failed (err says why). */

@@ -21,17 +21,16 @@ static char err[1024];
 
 static RayesScene *read(const char *text, int pbrt, RayesError *e)
 {
+    if (!pbrt)
+        return rib_read_scene(text, e, err, sizeof err);
     RayesScene *s = rayes_scene_new();
     IoSink sink = io_sink_scene(s);
     IoSettings settings;
     io_settings_init(&settings);
     IoReadOptions opt = {RAYES_TEST_DATA, -1};
     err[0] = '\0';
-    size_t n = strlen(text);
-    *e = pbrt ? io_pbrt_parse("t.pbrt", (const unsigned char *)text, n, &sink, &opt, &settings, err,
-                              sizeof err)
-              : io_rib_parse("t.rib", (const unsigned char *)text, n, &sink, &opt, &settings, err,
-                             sizeof err);
+    *e = io_pbrt_parse("t.pbrt", (const unsigned char *)text, strlen(text), &sink, &opt, &settings,
+                       err, sizeof err);
     return s;
 }
 

@@ -173,14 +173,7 @@ static char err[1024];
 
 static RayesScene *read_rib(const char *text, RayesError *e)
 {
-    RayesScene *s = rayes_scene_new();
-    IoSink sink = io_sink_scene(s);
-    IoSettings settings;
-    io_settings_init(&settings);
-    IoReadOptions opt = {RAYES_TEST_DATA, -1};
-    *e = io_rib_parse("t.rib", (const unsigned char *)text, strlen(text), &sink, &opt, &settings,
-                      err, sizeof err);
-    return s;
+    return rib_read_scene(text, e, err, sizeof err);
 }
 
 static const char *const rib_text =
