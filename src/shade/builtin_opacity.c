@@ -149,34 +149,35 @@ static void stainedglass_opacity(const RayesShaderServices *sv, const RayesShade
     }
 }
 
+/* One chunk of stainedglass's lighting (points of ctx, at most
+ * SHADE_CHUNK). */
+static void stainedglass_chunk(const RayesShaderServices *sv, const RayesShadeCtx *sub,
+                               const void *params, RayesShadeOutputs *o)
+{
+    const StainedGlassParams *p = params;
+    Rgb dd[SHADE_CHUNK], id[SHADE_CHUNK], own[SHADE_CHUNK];
+    sv->direct_lighting(sv, sub, 0, NULL, NULL, dd, NULL);
+    sv->indirect_diffuse(sv, sub, 0, id);
+    for (size_t i = 0; i < sub->n_points; i++) {
+        float T[3];
+        glass_transmission(sv, p, sub->s ? sub->s[i] : sub->u[i], sub->t ? sub->t[i] : sub->v[i],
+                           footprint(sub, i), T);
+        for (int c = 0; c < 3; c++) {
+            /* the lead is dark grey; glass reflects a little of its hue */
+            float colour = T[c] > 0.0f ? T[c] : 0.05f;
+            own[i][c] = 1.0f - T[c];
+            o->Ci[i][c] = p->Kd * colour * (dd[i][c] + id[i][c]);
+            if (o->Irradiance)
+                o->Irradiance[i][c] = 3.14159265f * (dd[i][c] + id[i][c]);
+        }
+    }
+    premultiply(sub, (const Rgb *)own, o);
+}
+
 static void stainedglass_lighting(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
                                   const void *params, RayesShadeOutputs *out)
 {
-    const StainedGlassParams *p = params;
-    for (size_t start = 0; start < ctx->n_points; start += SHADE_CHUNK) {
-        size_t n = ctx->n_points - start < SHADE_CHUNK ? ctx->n_points - start : SHADE_CHUNK;
-        RayesShadeCtx sub;
-        shade_ctx_slice(ctx, start, n, &sub);
-        Rgb dd[SHADE_CHUNK], id[SHADE_CHUNK], own[SHADE_CHUNK];
-        sv->direct_lighting(sv, &sub, 0, NULL, NULL, dd, NULL);
-        sv->indirect_diffuse(sv, &sub, 0, id);
-        RayesShadeOutputs o = {out->Ci + start, out->Oi + start,
-                               out->Irradiance ? out->Irradiance + start : NULL, NULL};
-        for (size_t i = 0; i < n; i++) {
-            float T[3];
-            glass_transmission(sv, p, sub.s ? sub.s[i] : sub.u[i], sub.t ? sub.t[i] : sub.v[i],
-                               footprint(&sub, i), T);
-            for (int c = 0; c < 3; c++) {
-                /* the lead is dark grey; glass reflects a little of its hue */
-                float colour = T[c] > 0.0f ? T[c] : 0.05f;
-                own[i][c] = 1.0f - T[c];
-                o.Ci[i][c] = p->Kd * colour * (dd[i][c] + id[i][c]);
-                if (o.Irradiance)
-                    o.Irradiance[i][c] = 3.14159265f * (dd[i][c] + id[i][c]);
-            }
-        }
-        premultiply(&sub, (const Rgb *)own, &o);
-    }
+    shade_chunks(sv, ctx, params, out, stainedglass_chunk);
 }
 
 static const RayesShaderParamDesc stainedglass_params[] = {
@@ -230,41 +231,43 @@ static void thindielectric_opacity(const RayesShaderServices *sv, const RayesSha
             out->Oi[i][c] = (ctx->Os ? ctx->Os[i][c] : 1.0f) * R;
 }
 
+/* One chunk of thindielectric's lighting. */
+static void thindielectric_chunk(const RayesShaderServices *sv, const RayesShadeCtx *sub,
+                                 const void *params, RayesShadeOutputs *o)
+{
+    const ThinDielectricParams *p = params;
+    size_t n = sub->n_points;
+    Rgb own[SHADE_CHUNK], dir[SHADE_CHUNK], L[SHADE_CHUNK];
+    float R0 = thin_reflectance(1.0f, p->eta);
+    for (size_t i = 0; i < n; i++) {
+        float R = R0;
+        if (sub->I) { /* the mirror direction and Fresnel at the view angle */
+            Vec3 V = v3(-sub->I[i][0], -sub->I[i][1], -sub->I[i][2]);
+            Vec3 N = v3(sub->N[i][0], sub->N[i][1], sub->N[i][2]);
+            float c = v3_dot(V, N);
+            Vec3 r = v3_sub(v3_scale(N, 2.0f * c), V);
+            dir[i][0] = r.x, dir[i][1] = r.y, dir[i][2] = r.z;
+            R = thin_reflectance(c, p->eta);
+        }
+        own[i][0] = own[i][1] = own[i][2] = R;
+    }
+    if (sub->I && sv->indirect_specular)
+        sv->indirect_specular(sv, sub, (const float(*)[3])dir, NULL, 1, L);
+    else
+        memset(L, 0, n * sizeof *L);
+    for (size_t i = 0; i < n; i++)
+        for (int c = 0; c < 3; c++) {
+            o->Ci[i][c] = L[i][c];
+            if (o->Irradiance)
+                o->Irradiance[i][c] = 0.0f;
+        }
+    premultiply(sub, (const Rgb *)own, o);
+}
+
 static void thindielectric_lighting(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
                                     const void *params, RayesShadeOutputs *out)
 {
-    const ThinDielectricParams *p = params;
-    for (size_t start = 0; start < ctx->n_points; start += SHADE_CHUNK) {
-        size_t n = ctx->n_points - start < SHADE_CHUNK ? ctx->n_points - start : SHADE_CHUNK;
-        RayesShadeCtx sub;
-        shade_ctx_slice(ctx, start, n, &sub);
-        Rgb own[SHADE_CHUNK], dir[SHADE_CHUNK], L[SHADE_CHUNK];
-        for (size_t i = 0; i < n; i++) {
-            float R = thin_reflectance(1.0f, p->eta);
-            if (sub.I) { /* the mirror direction and Fresnel at the view angle */
-                Vec3 V = v3(-sub.I[i][0], -sub.I[i][1], -sub.I[i][2]);
-                Vec3 N = v3(sub.N[i][0], sub.N[i][1], sub.N[i][2]);
-                float c = v3_dot(V, N);
-                Vec3 r = v3_sub(v3_scale(N, 2.0f * c), V);
-                dir[i][0] = r.x, dir[i][1] = r.y, dir[i][2] = r.z;
-                R = thin_reflectance(c, p->eta);
-            }
-            own[i][0] = own[i][1] = own[i][2] = R;
-        }
-        if (sub.I && sv->indirect_specular)
-            sv->indirect_specular(sv, &sub, (const float(*)[3])dir, NULL, 1, L);
-        else
-            memset(L, 0, n * sizeof *L);
-        RayesShadeOutputs o = {out->Ci + start, out->Oi + start,
-                               out->Irradiance ? out->Irradiance + start : NULL, NULL};
-        for (size_t i = 0; i < n; i++)
-            for (int c = 0; c < 3; c++) {
-                o.Ci[i][c] = L[i][c];
-                if (o.Irradiance)
-                    o.Irradiance[i][c] = 0.0f;
-            }
-        premultiply(&sub, (const Rgb *)own, &o);
-    }
+    shade_chunks(sv, ctx, params, out, thindielectric_chunk);
 }
 
 static const RayesShaderParamDesc thindielectric_params[] = {

@@ -93,8 +93,9 @@ static float schlick(float cos_o, float eta)
     ((sv)->struct_size >= offsetof(RayesShaderServices, m) + sizeof((sv)->m) && (sv)->m != NULL)
 
 static void lighting_chunk(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
-                           const SubsurfaceParams *p, RayesShadeOutputs *out)
+                           const void *params, RayesShadeOutputs *out)
 {
+    const SubsurfaceParams *p = params;
     RayesSubsurfaceParams m;
     medium(p, &m);
     float sss[SHADE_CHUNK][3], spec[SHADE_CHUNK][3], rough[SHADE_CHUNK];
@@ -120,8 +121,9 @@ static void lighting_chunk(const RayesShaderServices *sv, const RayesShadeCtx *c
 }
 
 static void diffuse_chunk(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
-                          const SubsurfaceParams *p, RayesShadeOutputs *out)
+                          const void *params, RayesShadeOutputs *out)
 {
+    const SubsurfaceParams *p = params;
     RayesSubsurfaceParams m;
     medium(p, &m);
     float dd[SHADE_CHUNK][3], id[SHADE_CHUNK][3], Rd[3];
@@ -139,21 +141,11 @@ static void diffuse_chunk(const RayesShaderServices *sv, const RayesShadeCtx *ct
             out->Ci[i][c] = cs(ctx, i, c) * p->Kd * Rd[c] * (dd[i][c] + id[i][c]);
 }
 
-typedef void (*ChunkFn)(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
-                        const SubsurfaceParams *p, RayesShadeOutputs *out);
-
 /* Runs fn on SHADE_CHUNK-point slices, then Oi = Os and Ci *= Oi. */
 static void by_chunks(const RayesShaderServices *sv, const RayesShadeCtx *ctx, const void *params,
-                      RayesShadeOutputs *out, ChunkFn fn)
+                      RayesShadeOutputs *out, ShadeChunkFn fn)
 {
-    for (size_t start = 0; start < ctx->n_points; start += SHADE_CHUNK) {
-        size_t n = ctx->n_points - start < SHADE_CHUNK ? ctx->n_points - start : SHADE_CHUNK;
-        RayesShadeCtx sub;
-        shade_ctx_slice(ctx, start, n, &sub);
-        RayesShadeOutputs o = {out->Ci + start, out->Oi + start,
-                               out->Irradiance ? out->Irradiance + start : NULL, NULL};
-        fn(sv, &sub, params, &o);
-    }
+    shade_chunks(sv, ctx, params, out, fn);
     for (size_t i = 0; i < ctx->n_points; i++)
         for (int c = 0; c < 3; c++) {
             out->Oi[i][c] = ctx->Os ? ctx->Os[i][c] : 1.0f;

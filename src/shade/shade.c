@@ -175,10 +175,23 @@ void shade_ctx_slice(const RayesShadeCtx *ctx, size_t start, size_t count, Rayes
 #define SLICE(f)                                  \
     if (ctx->f)                                   \
         sub->f = ctx->f + start;
-    SLICE(P) SLICE(N) SLICE(Ng) SLICE(dPdu) SLICE(dPdv) SLICE(u) SLICE(v) SLICE(s) SLICE(t)
-    SLICE(du) SLICE(dv) SLICE(I) SLICE(Cs) SLICE(Os)
-    SLICE(backfacing)
+    SLICE(P)
+    SLICE(N) SLICE(Ng) SLICE(dPdu) SLICE(dPdv) SLICE(u) SLICE(v) SLICE(s) SLICE(t) SLICE(du)
+        SLICE(dv) SLICE(I) SLICE(Cs) SLICE(Os) SLICE(backfacing) SLICE(dst)
 #undef SLICE
+}
+
+void shade_chunks(const RayesShaderServices *sv, const RayesShadeCtx *ctx, const void *params,
+                  RayesShadeOutputs *out, ShadeChunkFn fn)
+{
+    for (size_t start = 0; start < ctx->n_points; start += SHADE_CHUNK) {
+        size_t n = ctx->n_points - start < SHADE_CHUNK ? ctx->n_points - start : SHADE_CHUNK;
+        RayesShadeCtx sub;
+        shade_ctx_slice(ctx, start, n, &sub);
+        RayesShadeOutputs o = {out->Ci + start, out->Oi + start,
+                               out->Irradiance ? out->Irradiance + start : NULL, NULL};
+        fn(sv, &sub, params, &o);
+    }
 }
 
 /* Scratch for a call on ctx's points, if the class needs it and the caller

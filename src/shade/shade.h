@@ -88,4 +88,11 @@ static inline uint32_t shade_class_flags(const RayesShaderClass *cls)
  * start * scratch_size where the sub-context's methods read it. */
 void shade_ctx_slice(const RayesShadeCtx *ctx, size_t start, size_t count, RayesShadeCtx *sub);
 
+/* Runs fn on ctx's points SHADE_CHUNK at a time, each slice with its part
+ * of out (Ci, Oi, Irradiance). */
+typedef void (*ShadeChunkFn)(const RayesShaderServices *sv, const RayesShadeCtx *sub,
+                             const void *params, RayesShadeOutputs *out);
+void shade_chunks(const RayesShaderServices *sv, const RayesShadeCtx *ctx, const void *params,
+                  RayesShadeOutputs *out, ShadeChunkFn fn);
+
 #endif /* RAYES_SHADE_SHADE_H */

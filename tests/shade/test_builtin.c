@@ -469,6 +469,29 @@ static void test_metals(void)
     CHECK(z[2] == z[0]);
 }
 
+/* A slice of a context starts every per-point array at its first point,
+ * the texture coordinates' derivatives (dst) and backfacing included. */
+static void test_ctx_slice(void)
+{
+    float P[8][3] = {{0}}, st[8], dst[8][4];
+    int back[8];
+    for (int i = 0; i < 8; i++)
+        P[i][0] = st[i] = dst[i][0] = (float)i, back[i] = i;
+    RayesShadeCtx ctx = {.n_points = 8,
+                         .P = (const float(*)[3])P,
+                         .s = st,
+                         .t = st,
+                         .backfacing = back,
+                         .dst = (const float(*)[4])dst};
+    RayesShadeCtx sub;
+    shade_ctx_slice(&ctx, 5, 3, &sub);
+    CHECK(sub.n_points == 3 && sub.first_point == 5);
+    CHECK(sub.P[0][0] == 5.0f && sub.s[0] == 5.0f && sub.t[1] == 6.0f);
+    CHECK(sub.backfacing[2] == 7 && sub.dst[0][0] == 5.0f);
+    CHECK(sub.u == NULL && sub.Cs == NULL);
+}
+
 TEST_MAIN(TEST(test_matte), TEST(test_plastic_splits_highlight), TEST(test_mirror_reflects),
           TEST(test_params_and_lookup), TEST(test_diffuselighting_is_view_independent_part),
-          TEST(test_shader_furnace), TEST(test_glass_fresnel_and_sides), TEST(test_metals))
+          TEST(test_shader_furnace), TEST(test_glass_fresnel_and_sides), TEST(test_metals),
+          TEST(test_ctx_slice))
