@@ -563,6 +563,19 @@ RAYES_API RayesError rayes_scene_volume(RayesScene *scene, const float bound[6])
 RAYES_API RayesError rayes_scene_area_light(RayesScene *scene, const float P[4][3],
                                             const float L[3]);
 
+/* An emitting polygon mesh (an area light of any shape): n_faces faces,
+ * face f of n_verts[f] >= 3 vertices (convex, counter-clockwise seen from
+ * the front; fanned into triangles), indices into P (n_points points),
+ * radiance L from each face's front, or from both sides if two_sided. One
+ * light however many faces: its shadow rays draw points over the whole
+ * mesh by area. Seen by camera and specular rays; it does not move within
+ * the frame (under a moving transform it stays where the shutter opens,
+ * with one warning). */
+RAYES_API RayesError rayes_scene_area_light_mesh(RayesScene *scene, size_t n_faces,
+                                                 const int *n_verts, const int *indices,
+                                                 size_t n_points, const float *P, const float L[3],
+                                                 int two_sided);
+
 /* A light source of the given type, with parameters (unknown names get
  * one warning; a wrong type is RAYES_ERROR_INVALID_ARGUMENT). Points and
  * directions are 3-vectors given as RAYES_PARAM_COLOR and transform by the

@@ -941,10 +941,50 @@ static RayesError emit_mesh(Emit *e, const Mesh *m, const char *mat)
     return r;
 }
 
-/* The faces of an emissive material: quads as area lights, the rest as
- * constant-shaded polygons (seen, but lighting nothing), with a warning. */
+/* The faces of an emissive material as one mesh light (its corners' points
+ * in file order). */
+static RayesError emit_light_mesh(Emit *e, const Material *mt, const Mesh *m)
+{
+    size_t n_corners = 0;
+    for (size_t f = 0; f < m->nv.n; f++)
+        n_corners += (size_t)m->nv.a[f];
+    float *P = malloc(3 * n_corners * sizeof *P);
+    int *idx = malloc(n_corners * sizeof *idx);
+    RayesError r = RAYES_ERROR_OUT_OF_MEMORY;
+    if (P && idx) {
+        for (size_t k = 0; k < n_corners; k++) {
+            memcpy(&P[3 * k], vtx(e->o, e->o->face_idx.a[m->idx.a[k]]), 3 * sizeof *P);
+            for (int a = 0; a < 3; a++) {
+                e->lo[a] = fminf(e->lo[a], P[3 * k + (size_t)a]);
+                e->hi[a] = fmaxf(e->hi[a], P[3 * k + (size_t)a]);
+            }
+            idx[k] = (int)k;
+        }
+        r = e->sink->area_light_mesh(e->sink->target, m->nv.n, m->nv.a, idx, n_corners, P, mt->Ke,
+                                     0);
+        if (r != RAYES_OK)
+            r = sink_fail(e, r, "an emissive mesh");
+        e->n_area_lights++;
+    } else {
+        snprintf(e->o->err, e->o->err_size, "%s: out of memory", e->o->name);
+    }
+    free(P);
+    free(idx);
+    return r;
+}
+
+/* The faces of an emissive material: at most AREA_QUADS quads are quad
+ * lights, other faces one mesh light; for a sink without mesh lights,
+ * the faces but quads are constant-shaded polygons (seen, but lighting
+ * nothing), with a warning. */
+#define AREA_QUADS 4
 static RayesError emit_emitter(Emit *e, const Material *mt, const Mesh *m)
 {
+    int few_quads = m->nv.n <= AREA_QUADS;
+    for (size_t f = 0; f < m->nv.n && few_quads; f++)
+        few_quads = m->nv.a[f] == 4;
+    if (!few_quads && e->sink->area_light_mesh)
+        return emit_light_mesh(e, mt, m);
     Mesh rest = {{0}, {0}};
     RayesError r = RAYES_OK;
     size_t k = 0;

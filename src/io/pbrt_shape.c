@@ -3,9 +3,10 @@
  * bilinearmesh, plymesh (io/ply.h), sphere, cylinder and disk. Every index
  * is checked against the point count before it is used. Winding follows
  * pbrt: flipped by ReverseOrientation and by a transform that swaps
- * handedness. Under an AreaLightSource, quads (and pairs of triangles that
- * make a planar convex quad), spheres and disks become rayes area lights;
- * other emitters are warned about and do not emit.
+ * handedness. Under an AreaLightSource, up to four quads (or pairs of
+ * triangles that make planar convex quads), spheres and disks become rayes
+ * area lights of those shapes, other meshes one mesh light each; other
+ * emitters are warned about and do not emit.
  */
 #include <math.h>
 #include <stdio.h>
@@ -105,8 +106,62 @@ static int pair_quad(const float *pts, const int *a, const int *b, int q[4])
     return 0;
 }
 
-/* A mesh of triangles and quads (indices checked): an emitter's quads go to
- * area_light, the rest to polygon_mesh with pbrt's orientation. */
+/* The most quads an emitter makes quad lights of; more, one mesh light. */
+enum { AREA_QUADS = 4 };
+
+/* Emits a mesh's faces as one mesh light: each face wound so that its
+ * front is pbrt's (the object-space winding's normal, turned toward the
+ * face's N when given, reversed by ReverseOrientation and by a transform
+ * that swaps handedness, as emit_area_quad's). idx is rewritten. */
+static int emit_area_mesh(Parser *P, const Token *t, size_t n_faces, const int *n_verts, int *idx,
+                          size_t n_points, const float *pts, const float *N)
+{
+    pbrt_grow_bound(P, pts, n_points); /* emitters count in the world's bound too */
+    int swaps = swaps_handedness(P->gs.ctm);
+    int *f = idx;
+    for (size_t i = 0; i < n_faces; f += n_verts[i], i++) {
+        double g[3] = {0, 0, 0}, d[3];
+        for (int k = 1; k + 1 < n_verts[i]; k++) { /* the fan's normals, summed */
+            double u[3], v[3], c[3];
+            sub3d(&pts[3 * f[k]], &pts[3 * f[0]], u);
+            sub3d(&pts[3 * f[k + 1]], &pts[3 * f[0]], v);
+            pbrt_cross3d(u, v, c);
+            for (int j = 0; j < 3; j++)
+                g[j] += c[j];
+        }
+        memcpy(d, g, sizeof d);
+        if (N) {
+            for (int j = 0; j < 3; j++) {
+                d[j] = 0;
+                for (int k = 0; k < n_verts[i]; k++)
+                    d[j] += N[3 * f[k] + j];
+            }
+            if (pbrt_dot3d(d, d) == 0)
+                memcpy(d, g, sizeof d);
+        }
+        int flip = ((pbrt_dot3d(g, d) < 0) != P->gs.reverse) != swaps;
+        for (int k = 1; flip && k < n_verts[i] - k; k++) { /* reverse after the first corner */
+            int tmp = f[k];
+            f[k] = f[n_verts[i] - k];
+            f[n_verts[i] - k] = tmp;
+        }
+    }
+    float m[16];
+    if (!pbrt_mat_finite(P->gs.ctm))
+        return FAIL_TOK(P, t, "the current transform is not finite");
+    pbrt_mat_to_float(P->gs.ctm, m);
+    RayesError e = P->sink->set_transform(P->sink->target, m);
+    if (e == RAYES_OK)
+        e = P->sink->area_light_mesh(P->sink->target, n_faces, n_verts, idx, n_points, pts,
+                                     P->gs.area.L, P->gs.area.twosided);
+    return e == RAYES_OK ? 0 : pbrt_sink_failed(P, t, e);
+}
+
+/* A mesh of triangles and quads (indices checked): an emitter is a few
+ * quad lights when its faces are at most AREA_QUADS quads (or triangle
+ * pairs that make planar convex quads: sampled as quads, exactly), else
+ * one mesh light; other meshes go to polygon_mesh with pbrt's
+ * orientation. */
 static int shape_mesh(Parser *P, const Token *t, const char *what, size_t n_faces, int *n_verts,
                       int *idx, size_t n_points, const float *pts, const float *N,
                       const float *uv)
@@ -117,38 +172,29 @@ static int shape_mesh(Parser *P, const Token *t, const char *what, size_t n_face
                      "is not emitting",
                      what);
     } else if (P->gs.area.on) {
-        /* Quads, and triangles paired into planar convex quads, are quad
-         * lights; the other triangles are quads with a corner twice (the
-         * top edge collapsed: a bilinear patch that is the triangle), each
-         * a light of its own, so a mesh keeps at most LONE_LIGHTS of them. */
-        enum { LONE_LIGHTS = 32 };
-        size_t lone = 0;
+        int q[AREA_QUADS][4];
+        size_t n_quads = 0, i = 0;
         const int *f = idx;
-        for (size_t pass = 0; pass < 2; pass++) {
-            f = idx;
-            for (size_t i = 0; i < n_faces; f += n_verts[i], i++) {
-                int q[4];
-                if (n_verts[i] == 4) {
-                    memcpy(q, f, sizeof q);
-                } else if (i + 1 < n_faces && n_verts[i + 1] == 3 && pair_quad(pts, f, f + 3, q)) {
-                    f += 3;
-                    i++;
-                } else {
-                    lone += pass == 0;
-                    if (pass == 0 || lone > LONE_LIGHTS)
-                        continue;
-                    const int tri[4] = {f[0], f[1], f[2], f[2]};
-                    memcpy(q, tri, sizeof q);
-                }
-                if (pass == 1 && emit_area_quad(P, t, pts, N, q) != 0)
-                    return -1;
+        for (; i < n_faces && n_quads < AREA_QUADS; f += n_verts[i], i++, n_quads++) {
+            if (n_verts[i] == 4) {
+                memcpy(q[n_quads], f, sizeof q[n_quads]);
+            } else if (i + 1 < n_faces && n_verts[i + 1] == 3 &&
+                       pair_quad(pts, f, f + 3, q[n_quads])) {
+                f += 3;
+                i++;
+            } else {
+                break;
             }
         }
-        if (lone > LONE_LIGHTS)
-            pbrt_warn_at(P, t->line, t->col, "lone emitting triangle",
-                         "%s: %zu emitting triangles do not pair into quads; more than %d would "
-                         "be as many lights, so they do not emit",
-                         what, lone, (int)LONE_LIGHTS);
+        if (i < n_faces && P->sink->area_light_mesh)
+            return emit_area_mesh(P, t, n_faces, n_verts, idx, n_points, pts, N);
+        if (i < n_faces)
+            pbrt_warn_at(P, t->line, t->col, "emitting mesh",
+                         "%s: only its first %zu quads emit (the scene takes no mesh lights)", what,
+                         n_quads);
+        for (size_t k = 0; k < n_quads; k++)
+            if (emit_area_quad(P, t, pts, N, q[k]) != 0)
+                return -1;
         return 0;
     }
     if (P->gs.reverse != swaps_handedness(P->gs.ctm)) {
@@ -323,6 +369,29 @@ static int shape_bilinearmesh(Parser *P, const Token *t, ParamList *pl)
     float *pts = points_of(P, t, pp);
     if (!pts)
         return -1;
+    if (P->gs.area.on && !P->recording && n_idx / 4 > AREA_QUADS && P->sink->area_light_mesh) {
+        /* many emitting patches: one mesh light of their corners, around */
+        size_t n_faces = n_idx / 4;
+        int *nv = malloc(n_faces * sizeof *nv), *idx = malloc(n_idx * sizeof *idx);
+        float *N = np ? points_of(P, t, np) : NULL;
+        int r = -1;
+        if (!nv || !idx || (np && !N)) {
+            FAIL_TOK(P, t, "out of memory");
+        } else {
+            static const int around[4] = {0, 1, 3, 2};
+            for (size_t f = 0; f < n_faces; f++) {
+                nv[f] = 4;
+                for (int k = 0; k < 4; k++)
+                    idx[4 * f + (size_t)k] = (int)ip->num[4 * f + (size_t)around[k]];
+            }
+            r = emit_area_mesh(P, t, n_faces, nv, idx, n_points, pts, N);
+        }
+        free(nv);
+        free(idx);
+        free(N);
+        free(pts);
+        return r;
+    }
     int flip = P->gs.reverse != swaps_handedness(P->gs.ctm);
     for (size_t f = 0; f < n_idx / 4; f++) {
         int v[4];

@@ -301,9 +301,55 @@ static int grow_sizes(size_t **a, size_t *cap, size_t n)
     return 0;
 }
 
+/* Nonzero when the polygons of g are at most AREA_QUADS quads of one loop
+ * each: under an area light, quad lights (sampled exactly as quads). */
+#define AREA_QUADS 4
+static int few_quads(const Polys *g)
+{
+    if (g->n_polys > AREA_QUADS)
+        return 0;
+    for (size_t p = 0, loop = 0; p < g->n_polys; p++) {
+        size_t nl = g->n_loops ? (size_t)g->n_loops[p] : 1;
+        if (nl != 1 || g->loop_n[loop] != 4)
+            return 0;
+        loop += nl;
+    }
+    return 1;
+}
+
+/* The polygons of g as one mesh light (tessellated as surfaces are). */
+static int emit_area_mesh(Rib *r, const Polys *g, const float *P, size_t n_points)
+{
+    int flip = flip_of(r), e = 0;
+    RibFaces faces = {0};
+    for (size_t p = 0, loop = 0, at = 0; p < g->n_polys && e == 0; p++) {
+        size_t nl = g->n_loops ? (size_t)g->n_loops[p] : 1, nv = 0;
+        for (size_t k = 0; k < nl; k++)
+            nv += (size_t)g->loop_n[loop + k];
+        if (rib_tessellate(P, &g->loop_n[loop], nl, &g->idx[at], flip, &faces) != 0)
+            e = rib_error(r, "out of memory");
+        loop += nl;
+        at += nv;
+    }
+    if (e == 0 && faces.n_faces > 0 && (e = rib_emit_begin(r, NULL)) == 0) {
+        SinkState *st;
+        const IoSink *s = rib_out_sink(r, &st);
+        if (s->area_light_mesh(s->target, faces.n_faces, faces.n_verts, faces.idx, n_points, P,
+                               r->a.area_L, r->a.area_twosided) != RAYES_OK)
+            e = rib_sink_failed(r, s);
+    }
+    rib_faces_fini(&faces);
+    return e > 0 ? 0 : e;
+}
+
 static int emit_polys(Rib *r, const Polys *g, const float *P, size_t n_points, const Param *par,
                       size_t n_par)
 {
+    if (r->a.area && !few_quads(g)) {
+        SinkState *st;
+        if (rib_out_sink(r, &st)->area_light_mesh)
+            return emit_area_mesh(r, g, P, n_points);
+    }
     RibVar vars[RIB_N_VARS];
     rib_vars(r, par, n_par, vars);
     int flip = flip_of(r);
@@ -333,8 +379,9 @@ static int emit_polys(Rib *r, const Polys *g, const float *P, size_t n_points, c
                 e = rib_sink_failed(r, s);
         } else {
             if (r->a.area)
-                rib_warn_once(r, "area shape", "only quads become area lights; other shapes under "
-                                           "AreaLightSource are ordinary surfaces");
+                rib_warn_once(r, "area shape",
+                              "this scene takes no mesh lights: only quads "
+                              "become area lights, other polygons are surfaces");
             size_t first_face = faces.n_faces;
             if (rib_tessellate(P, &g->loop_n[loop], nl, v, flip, &faces) != 0)
                 e = rib_error(r, "out of memory");

@@ -110,6 +110,7 @@ typedef struct Attr {
     float shading_rate;
     float bound;
     int area;                  /* AreaLightSource in force */
+    int area_twosided;         /* its "twosided" (rayes's own parameter; default 0) */
     unsigned char on[RIB_MAX_LIGHTS / 8]; /* bit k: Rib.lights[k] is on */
     float area_L[3];
     float ubasis[16], vbasis[16];

@@ -662,6 +662,8 @@ static int h_area_light(Rib *r, const Args *a)
     float I = in && rib_is_num(in->v) && in->v->n == 1 ? (float)in->v->d[0] : 1;
     for (int c = 0; c < 3; c++)
         r->a.area_L[c] = I * (lc && rib_is_num(lc->v) && lc->v->n == 3 ? (float)lc->v->d[c] : 1);
+    const Param *ts = rib_find_param(p, n, "twosided");
+    r->a.area_twosided = ts && rib_is_num(ts->v) && ts->v->n == 1 && ts->v->d[0] != 0;
     free(p);
     if (r->in_object) {
         rib_warn_once(r, "area light in object",

@@ -1170,20 +1170,71 @@ static RayesError w_sphere(void *t, float r)
 
 static int w_linked(const RibWriter *w, size_t light);
 
-static RayesError w_area_light(void *t, const float P[4][3], const float L[3])
+/* An area light's block opened, its shader's lightcolor written (the line
+ * goes on); returns the world's file. */
+static FILE *area_light_begin(RibWriter *w, const float L[3])
 {
-    RibWriter *w = t;
-    if (!finite_all(&P[0][0], 12) || !finite_all(L, 3) || L[0] < 0 || L[1] < 0 || L[2] < 0)
-        return fail(w, RAYES_ERROR_INVALID_ARGUMENT,
-                    "area light: expected finite points and a non-negative radiance");
     FILE *f = w->world.f;
     if (w->next_light < 4097)
         w->area[w->next_light] = 1;
     fprintf(f, "AttributeBegin\nAreaLightSource \"arealight\" %d \"color lightcolor\" ",
             w->next_light++);
     floats(f, L, 3);
+    return f;
+}
+
+static RayesError w_area_light(void *t, const float P[4][3], const float L[3])
+{
+    RibWriter *w = t;
+    if (!finite_all(&P[0][0], 12) || !finite_all(L, 3) || L[0] < 0 || L[1] < 0 || L[2] < 0)
+        return fail(w, RAYES_ERROR_INVALID_ARGUMENT,
+                    "area light: expected finite points and a non-negative radiance");
+    FILE *f = area_light_begin(w, L);
     fprintf(f, "\nPolygon \"P\" ");
     floats(f, &P[0][0], 12);
+    fprintf(f, "\nAttributeEnd\n");
+    return RAYES_OK;
+}
+
+static RayesError w_area_light_mesh(void *t, size_t n_faces, const int *nv, const int *idx,
+                                    size_t n_points, const float *P, const float L[3],
+                                    int two_sided)
+{
+    RibWriter *w = t;
+    if (!n_faces || !nv || !idx || !P || !finite_all(P, 3 * n_points) || !finite_all(L, 3) ||
+        L[0] < 0 || L[1] < 0 || L[2] < 0)
+        return fail(w, RAYES_ERROR_INVALID_ARGUMENT,
+                    "area light mesh: expected faces, finite points and a non-negative radiance");
+    size_t k = 0;
+    for (size_t i = 0; i < n_faces; k += (size_t)nv[i], i++) {
+        if (nv[i] < 3)
+            return fail(w, RAYES_ERROR_INVALID_ARGUMENT,
+                        "area light mesh: face %zu has %d vertices; expected 3 or more", i, nv[i]);
+        for (int v = 0; v < nv[i]; v++)
+            if (idx[k + (size_t)v] < 0 || (size_t)idx[k + (size_t)v] >= n_points)
+                return fail(w, RAYES_ERROR_INVALID_ARGUMENT, "area light mesh: index out of range");
+    }
+    FILE *f = area_light_begin(w, L);
+    if (two_sided)
+        fprintf(f, " \"float twosided\" [1]");
+    /* Written as the triangles the scene keeps, so that a mesh of a few
+     * quads reads back as the same one light, not as quad lights. */
+    size_t n_tris = k - 2 * n_faces;
+    fprintf(f, "\nPointsPolygons [");
+    for (size_t i = 0; i < n_tris; i++)
+        fprintf(f, i ? (i % 40 == 0 ? "\n   3" : " 3") : "3");
+    fprintf(f, "]\n  [");
+    k = 0;
+    size_t out = 0;
+    for (size_t i = 0; i < n_faces; k += (size_t)nv[i], i++)
+        for (int c = 1; c + 1 < nv[i]; c++, out++)
+            fprintf(f, "%s%d %d %d",
+                    out == 0       ? ""
+                    : out % 8 == 0 ? "\n   "
+                                   : " ",
+                    idx[k], idx[k + (size_t)c], idx[k + (size_t)c + 1]);
+    fprintf(f, "]\n  \"P\" ");
+    floats(f, P, 3 * n_points);
     fprintf(f, "\nAttributeEnd\n");
     return RAYES_OK;
 }
@@ -1395,6 +1446,7 @@ IoSink io_rib_writer_sink(RibWriter *w)
         .blobby = w_blobby,
         .solid_begin = w_solid_begin,
         .solid_end = w_solid_end,
+        .area_light_mesh = w_area_light_mesh,
     };
 }
 

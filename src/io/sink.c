@@ -132,6 +132,13 @@ static RayesError scene_area_light(void *t, const float P[4][3], const float L[3
     return rayes_scene_area_light(t, P, L);
 }
 
+static RayesError scene_area_light_mesh(void *t, size_t n_faces, const int *n_verts,
+                                        const int *indices, size_t n_points, const float *P,
+                                        const float L[3], int two_sided)
+{
+    return rayes_scene_area_light_mesh(t, n_faces, n_verts, indices, n_points, P, L, two_sided);
+}
+
 static RayesError scene_light(void *t, const char *type, const RayesParam *p, size_t n)
 {
     return rayes_scene_light(t, type, p, n);
@@ -259,6 +266,7 @@ IoSink io_sink_scene(RayesScene *scene)
         .blobby = scene_blobby,
         .solid_begin = scene_solid_begin,
         .solid_end = scene_solid_end,
+        .area_light_mesh = scene_area_light_mesh,
     };
 }
 

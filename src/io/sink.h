@@ -117,6 +117,11 @@ typedef struct IoSink {
      * union of their primitives, with one warning, for sinks without). */
     RayesError (*solid_begin)(void *target, RayesSolidOp op);
     RayesError (*solid_end)(void *target);
+    /* rayes_scene_area_light_mesh (last: readers make quad lights of an
+     * emitter's quads alone, with one warning, for sinks without). */
+    RayesError (*area_light_mesh)(void *target, size_t n_faces, const int *n_verts,
+                                  const int *indices, size_t n_points, const float *P,
+                                  const float L[3], int two_sided);
 } IoSink;
 
 /* A sink that builds scene through rayes.h (borrowed, not retained). */

@@ -309,10 +309,12 @@ static Vec3 trace_layers(Worker *w, const Ray *ray, uint32_t kind, int diffuse_d
     const RenderObject *obj = render_object(w->rs, hit.grid, hit.instance);
     if (obj->light >= 0) {
         /* Emitters: seen by camera and specular rays, on their front side
-         * (not by glossy-lobe rays: direct lighting has them). */
-        if ((kind & (RAYES_RAY_DIFFUSE | PATH_RAY_GLOSSY)) || v3_dot(hit.Ng, ray->d) >= 0.0f)
+         * or both (not by glossy-lobe rays: direct lighting has them). */
+        const Light *l = &w->rs->lights[obj->light];
+        if ((kind & (RAYES_RAY_DIFFUSE | PATH_RAY_GLOSSY)) ||
+            (!l->two_sided && v3_dot(hit.Ng, ray->d) >= 0.0f))
             return v3(0, 0, 0);
-        return w->rs->lights[obj->light].L;
+        return l->L;
     }
     int see_through = obj->transparent && layer < INTEGRATOR_MAX_LAYERS;
     Vec3 Ci, Oi = v3(1, 1, 1);

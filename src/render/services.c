@@ -151,6 +151,19 @@ static Vec3 transmittance(Worker *w, Vec3 o, Vec3 wi, float dist, RayDiff diff)
     return integrator_transmission(w, &shadow, diff);
 }
 
+/* light_intersect, and for a mesh light its emitter's own Embree scene:
+ * the nearest face along wi, whatever else lies between (transmittance
+ * asks that). */
+static int light_hit(Worker *w, const Light *l, Vec3 o, Vec3 wi, LightSample *s)
+{
+    if (l->type != LIGHT_MESH)
+        return light_intersect(l, o, wi, s);
+    Ray ray = {o, wi, 0.0f, INFINITY, RAYES_RAY_SHADOW, w->time};
+    Hit hit;
+    return accel_intersect_object(w->rs->accel, (uint32_t)l->emitter, &ray, &hit) &&
+           light_mesh_finish(l, wi, hit.t, hit.Ng, s);
+}
+
 /* The shadow rays a service asked for n_shadow_rays traces per light and
  * point: that many, or with 0 the renderer's setting for the depth. */
 static int shadow_ray_count(const Worker *w, const RayesShadeCtx *ctx, int n_shadow_rays)
@@ -286,7 +299,7 @@ static void light_area(Worker *w, const DirectPoint *p, const Light *l, uint64_t
                 wi = sample_cosine_frame(p->lobe.t, p->lobe.b, p->N, ca[j], cb[j]);
                 cos_x = v3_dot(p->N, wi);
                 if (cos_x > 0.0f && v3_dot(p->Ng, wi) > 0.0f && light_bound_may_hit(&bound, wi) &&
-                    light_intersect(l, p->o, wi, &ls) && v3_max_component(ls.Li) > 0.0f)
+                    light_hit(w, l, p->o, wi, &ls) && v3_max_component(ls.Li) > 0.0f)
                     sum_d = v3_madd(sum_d,
                                     v3_mul(ls.Li, transmittance(w, p->o, wi, ls.dist, p->shadow)),
                                     power_heuristic(cos_x / (float)M_PI, ls.pdf));
@@ -298,7 +311,7 @@ static void light_area(Worker *w, const DirectPoint *p, const Light *l, uint64_t
                 continue;
             cos_x = v3_dot(p->N, wi);
             if (cos_x <= 0.0f || v3_dot(p->Ng, wi) <= 0.0f || !light_bound_may_hit(&bound, wi) ||
-                !light_intersect(l, p->o, wi, &ls) || !(v3_max_component(ls.Li) > 0.0f))
+                !light_hit(w, l, p->o, wi, &ls) || !(v3_max_component(ls.Li) > 0.0f))
                 continue;
             float pdf = lobe_pdf(&p->lobe, wi);
             if (!(pdf > 0.0f))
@@ -485,8 +498,8 @@ static void fiber_lobe_samples(Worker *w, const FiberPoint *p, const Light *l, i
         cmj_pattern_sample(&pat_c, (uint32_t)j, &c, &c2);
         Vec3 wi;
         LightSample ls;
-        if (!fiber_lobe_sample(p->T, p->V, p->e, a, b, c, &wi) ||
-            !light_intersect(l, p->P, wi, &ls) || !(v3_max_component(ls.Li) > 0.0f))
+        if (!fiber_lobe_sample(p->T, p->V, p->e, a, b, c, &wi) || !light_hit(w, l, p->P, wi, &ls) ||
+            !(v3_max_component(ls.Li) > 0.0f))
             continue;
         float pdf = fiber_lobe_pdf(p->T, p->V, wi, p->e);
         if (!(pdf > 0.0f))

@@ -936,6 +936,7 @@ RayesError rayes_scene_volume(RayesScene *s, const float bound[6])
 }
 
 static void light_motion(const RayesScene *s, Light *l);
+static RayesError push_light(RayesScene *s, const Light *l, const Prim *prims, size_t n_prims);
 
 RayesError rayes_scene_area_light(RayesScene *s, const float P[4][3], const float L[3])
 {
@@ -979,6 +980,69 @@ RayesError rayes_scene_area_light(RayesScene *s, const float P[4][3], const floa
     s->prims[s->n_prims++] = p;
     s->current_object = keep;
     return RAYES_OK;
+}
+
+/* The emitter's geometry is the light's triangles; a moving transform is
+ * taken at its first time (mesh lights are still: light.h). */
+RayesError rayes_scene_area_light_mesh(RayesScene *s, size_t n_faces, const int *n_verts,
+                                       const int *indices, size_t n_points, const float *P,
+                                       const float L[3], int two_sided)
+{
+    if (!s || !L || !n_faces || !n_verts || !indices || !P)
+        return RAYES_ERROR_INVALID_ARGUMENT;
+    if (!scene_finite(P, 3 * n_points) || !scene_finite(L, 3) || L[0] < 0 || L[1] < 0 || L[2] < 0)
+        return scene_fail(s, RAYES_ERROR_INVALID_ARGUMENT,
+                          "area light mesh: expected finite points and a non-negative radiance");
+    if (s->open_master >= 0)
+        return scene_fail(s, RAYES_ERROR_INVALID_ARGUMENT,
+                          "area light mesh: not allowed in an object block");
+    size_t n_corners = 0;
+    RayesError e = check_faces(s, "area light mesh", n_faces, n_verts, indices, n_points, 3,
+                               INT32_MAX, "3 or more", &n_corners);
+    if (e != RAYES_OK)
+        return e;
+    size_t n_tris = n_corners - 2 * n_faces; /* each face a fan */
+    Vec3 *v = malloc(3 * n_tris * sizeof *v);
+    Prim *prims = malloc(n_tris * sizeof *prims);
+    if (!v || !prims) {
+        free(v);
+        free(prims);
+        return scene_fail(s, RAYES_ERROR_OUT_OF_MEMORY, "out of memory");
+    }
+    const float(*pts)[3] = (const float(*)[3])P;
+    size_t t = 0, k = 0;
+    for (size_t f = 0; f < n_faces; k += (size_t)n_verts[f], f++)
+        for (int c = 1; c + 1 < n_verts[f]; c++, t++) {
+            const int corner[3] = {indices[k], indices[k + (size_t)c], indices[k + (size_t)c + 1]};
+            prims[t] = (Prim){.type = PRIM_TRIANGLE};
+            for (int j = 0; j < 3; j++) {
+                transform_points(s, &pts[corner[j]], 1, &v[3 * t + (size_t)j]);
+                prims[t].cp[j] = v[3 * t + (size_t)j];
+            }
+        }
+    Light l;
+    memset(&l, 0, sizeof l);
+    l.L = l.color = v3_load(L);
+    l.intensity = 1.0f;
+    if (light_mesh_init(&l, v, n_tris, two_sided) != 0) {
+        free(v);
+        free(prims);
+        return scene_fail(s, RAYES_ERROR_INVALID_ARGUMENT,
+                          "area light mesh: no face has area (or out of memory)");
+    }
+    l.emitter = (int)s->n_objects;
+    uint32_t motion = s->current_motion;
+    if (motion)
+        log_warning_once("mesh light motion", "a mesh area light under a moving transform is "
+                                              "still, where the shutter opens");
+    s->current_motion = 0;
+    e = push_light(s, &l, prims, n_tris);
+    s->current_motion = motion;
+    free(v);
+    free(prims);
+    if (e != RAYES_OK)
+        light_fini(&l);
+    return e;
 }
 
 static int cmp_size(const void *a, const void *b)
@@ -1634,6 +1698,12 @@ RayesError rayes_scene_edit_light(RayesScene *s, size_t index, const RayesParam 
     for (int k = 0; k < 4; k++)
         l->P[k] = v3_add(l->P[k], d);
     l->from = v3_add(l->from, d);
+    if (l->mesh) {
+        for (size_t k = 0; k < 3 * l->mesh->n; k++)
+            l->mesh->v[k] = v3_add(l->mesh->v[k], d);
+        l->mesh->lo = v3_add(l->mesh->lo, d);
+        l->mesh->hi = v3_add(l->mesh->hi, d);
+    }
     for (size_t i = 0; i < s->n_prims; i++)
         if (s->objects[s->prims[i].object].light == (int)index) {
             translate_prim(&s->prims[i], d);
@@ -1651,6 +1721,8 @@ RayesError rayes_scene_get_light(const RayesScene *s, size_t index, float *inten
     Vec3 at = l->from;
     if (l->type == LIGHT_QUAD)
         at = v3_scale(v3_add(v3_add(l->P[0], l->P[1]), v3_add(l->P[2], l->P[3])), 0.25f);
+    else if (l->type == LIGHT_MESH) /* its bounding box's centre */
+        at = v3_scale(v3_add(l->mesh->lo, l->mesh->hi), 0.5f);
     else if (l->type != LIGHT_POINT && l->type != LIGHT_SPOT && l->type != LIGHT_DISK &&
              l->type != LIGHT_SPHERE)
         at = v3(0, 0, 0);

@@ -316,16 +316,17 @@ RenderObject *session_render_objects(const RayesScene *scene)
     return ro;
 }
 
-/* Ray masks; shadow rays pass through transparent objects (accel.h). */
+/* Ray masks; shadow rays pass through transparent objects (accel.h); subsurface
+ * objects and mesh lights' emitters have scenes of their own. */
 static uint32_t *object_masks(const RayesScene *scene, const RenderObject *ro)
 {
     uint32_t *m = calloc(scene->n_objects + 1, sizeof *m);
     if (m)
         for (size_t i = 0; i < scene->n_objects; i++)
-            m[i] = scene->objects[i].ray_mask |
-                   (ro[i].transparent ? ACCEL_MASK_TRANSPARENT : 0u) |
-                   (ro[i].shader && (shade_class_flags(ro[i].shader->cls) &
-                                     RAYES_SHADER_SUBSURFACE)
+            m[i] = scene->objects[i].ray_mask | (ro[i].transparent ? ACCEL_MASK_TRANSPARENT : 0u) |
+                   ((ro[i].shader &&
+                     (shade_class_flags(ro[i].shader->cls) & RAYES_SHADER_SUBSURFACE)) ||
+                            (ro[i].light >= 0 && scene->lights[ro[i].light].type == LIGHT_MESH)
                         ? ACCEL_MASK_OWN_SCENE
                         : 0u);
     return m;

@@ -4,6 +4,7 @@
 #include "shade/light.h"
 
 #include <math.h>
+#include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -235,6 +236,90 @@ static int env_sample(const Light *l, float a, float b, LightSample *s)
     return 1;
 }
 
+/* ------------------------------------------------------------ meshes */
+
+int light_mesh_init(Light *l, const Vec3 *v, size_t n, int two_sided)
+{
+    if (n == 0 || n > (size_t)INT32_MAX)
+        return -1;
+    LightMesh *m = calloc(1, sizeof *m);
+    if (!m)
+        return -1;
+    m->n = n;
+    m->v = malloc(3 * n * sizeof *m->v);
+    m->cdf = malloc((n + 1) * sizeof *m->cdf);
+    m->guide = malloc(n * sizeof *m->guide);
+    if (!m->v || !m->cdf || !m->guide) {
+        free(m->v);
+        free(m->cdf);
+        free(m->guide);
+        free(m);
+        return -1;
+    }
+    memcpy(m->v, v, 3 * n * sizeof *m->v);
+    double sum = 0.0;
+    m->lo = m->hi = v[0];
+    for (size_t k = 0; k < n; k++) {
+        Vec3 e = v3_cross(v3_sub(v[3 * k + 1], v[3 * k]), v3_sub(v[3 * k + 2], v[3 * k]));
+        m->cdf[k] = (float)sum;
+        float a = 0.5f * v3_length(e);
+        sum += isfinite(a) ? a : 0.0f;
+        for (int c = 0; c < 3; c++) {
+            m->lo = v3_min(m->lo, v[3 * k + c]);
+            m->hi = v3_max(m->hi, v[3 * k + c]);
+        }
+    }
+    if (!(sum > 0.0)) {
+        l->mesh = m;
+        light_fini(l);
+        return -1;
+    }
+    for (size_t k = 0; k < n; k++)
+        m->cdf[k] = (float)(m->cdf[k] / sum);
+    m->cdf[n] = 1.0f;
+    cdf_guide(m->cdf, (int)n, m->guide);
+    m->area = (float)sum;
+    l->type = LIGHT_MESH;
+    l->mesh = m;
+    l->two_sided = two_sided != 0;
+    return 0;
+}
+
+int light_mesh_finish(const Light *l, Vec3 wi, float t, Vec3 Ng, LightSample *s)
+{
+    float cos_y = -v3_dot(Ng, wi);
+    if (l->two_sided)
+        cos_y = fabsf(cos_y);
+    if (!(cos_y > 0.0f) || !(t > 0.0f))
+        return 0;
+    s->wi = wi;
+    s->dist = t;
+    s->Li = l->L;
+    s->pdf = t * t / (cos_y * l->mesh->area);
+    return 1;
+}
+
+/* A point of the mesh drawn by area with (a, b): a picks the triangle,
+ * and what is left of it within the triangle's interval and b the point. */
+static int mesh_sample(const Light *l, Vec3 o, float a, float b, LightSample *s)
+{
+    const LightMesh *m = l->mesh;
+    int k = cdf_find(m->cdf, m->guide, (int)m->n, a);
+    float w = m->cdf[k + 1] - m->cdf[k];
+    float r = w > 0.0f ? fminf(fmaxf((a - m->cdf[k]) / w, 0.0f), 1.0f) : 0.5f;
+    const Vec3 *p = &m->v[3 * (size_t)k];
+    float su = sqrtf(r); /* uniform over the triangle */
+    Vec3 y = v3_add(v3_scale(p[0], 1.0f - su),
+                    v3_add(v3_scale(p[1], su * (1.0f - b)), v3_scale(p[2], su * b)));
+    Vec3 n = v3_cross(v3_sub(p[1], p[0]), v3_sub(p[2], p[0]));
+    float len = v3_length(n);
+    Vec3 d = v3_sub(y, o);
+    float dist = v3_length(d);
+    if (!(dist > 0.0f) || !(len > 0.0f))
+        return 0;
+    return light_mesh_finish(l, v3_scale(d, 1.0f / dist), dist, v3_scale(n, 1.0f / len), s);
+}
+
 /* ------------------------------------------------------------ motion */
 
 const Light *light_at_time(const Light *l, float t, Light *tmp)
@@ -306,6 +391,17 @@ int light_below_plane(const Light *l, Vec3 o, Vec3 n)
             size = fmaxf(size, v3_length(d));
         }
         break;
+    case LIGHT_MESH:
+        top = -INFINITY, size = 0.0f;
+        for (int k = 0; k < 8; k++) { /* the bounding box's corners */
+            Vec3 c =
+                v3(k & 1 ? l->mesh->hi.x : l->mesh->lo.x, k & 2 ? l->mesh->hi.y : l->mesh->lo.y,
+                   k & 4 ? l->mesh->hi.z : l->mesh->lo.z);
+            Vec3 d = v3_sub(c, o);
+            top = fmaxf(top, v3_dot(d, n));
+            size = fmaxf(size, v3_length(d));
+        }
+        break;
     default:
         return 0;
     }
@@ -334,6 +430,12 @@ void light_bound_init(const Light *l, Vec3 o, LightBound *b)
         c = l->from;
         r2 = l->radius * l->radius;
         break;
+    case LIGHT_MESH: {
+        c = v3_scale(v3_add(l->mesh->lo, l->mesh->hi), 0.5f);
+        Vec3 h = v3_sub(l->mesh->hi, c);
+        r2 = v3_dot(h, h);
+        break;
+    }
     default:
         *b = (LightBound){.all = 1};
         return;
@@ -415,6 +517,8 @@ int light_sample(const Light *l, Vec3 o, float a, float b, LightSample *s)
         return 1;
     case LIGHT_ENVIRONMENT:
         return env_sample(l, a, b, s);
+    case LIGHT_MESH:
+        return mesh_sample(l, o, a, b, s);
     case LIGHT_AMBIENT:
         return 0;
     }
@@ -643,6 +747,13 @@ int light_env_load(Light *l, const char *path, int octahedral, char *err, size_t
 
 void light_fini(Light *l)
 {
+    if (l->mesh) {
+        free(l->mesh->v);
+        free(l->mesh->cdf);
+        free(l->mesh->guide);
+        free(l->mesh);
+        l->mesh = NULL;
+    }
     if (!l->env)
         return;
     free(l->env->rgb);

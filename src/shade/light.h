@@ -1,8 +1,9 @@
 /*
  * shade/light.h — light sources (DESIGN.md "Lights").
  *
- * Area lights (one-sided quads, one-sided disks, spheres emitting outward)
- * and the environment (dome) light have radiance and are sampled by
+ * Area lights (one-sided quads, one-sided disks, spheres emitting outward,
+ * meshes of triangles emitting from their fronts or both sides) and the
+ * environment (dome) light have radiance and are sampled by
  * direction with a solid-angle pdf, so the direct-lighting service can
  * weigh their samples against BSDF samples (multiple importance sampling);
  * light_intersect gives the radiance and pdf of a BSDF-sampled direction.
@@ -24,8 +25,9 @@
  * lighting services take it at each ray's time (light_at_time; DESIGN.md
  * "Motion blur and depth of field").
  *
- * Memory: a Light owns its map (light_fini frees it). Thread-safety: every
- * function but light_env_load and light_fini only reads the light.
+ * Memory: a Light owns its map or mesh (light_fini frees them).
+ * Thread-safety: every function but light_env_load, light_mesh_init and
+ * light_fini only reads the light.
  */
 #ifndef RAYES_SHADE_LIGHT_H
 #define RAYES_SHADE_LIGHT_H
@@ -42,7 +44,8 @@ typedef enum LightType {
     LIGHT_SPOT = 4,
     LIGHT_DISTANT = 5,
     LIGHT_AMBIENT = 6,
-    LIGHT_ENVIRONMENT = 7
+    LIGHT_ENVIRONMENT = 7,
+    LIGHT_MESH = 8
 } LightType;
 
 #define LIGHT_CATEGORY_MAX 128
@@ -64,6 +67,17 @@ typedef struct LightEnvMap {
     int *col_guide;     /* height * width: each row's col_cdf's */
 } LightEnvMap;
 
+/* A mesh light's triangles (world space), drawn by area: triangle k with
+ * probability (cdf[k + 1] - cdf[k]), then uniformly over it. */
+typedef struct LightMesh {
+    size_t n;    /* triangles */
+    Vec3 *v;     /* 3 n corners; the front is (v1 - v0) x (v2 - v0) */
+    float *cdf;  /* n + 1, from 0 to 1 */
+    int *guide;  /* n: where the search for k / n starts */
+    float area;  /* the whole mesh's */
+    Vec3 lo, hi; /* bounds */
+} LightMesh;
+
 typedef struct Light {
     LightType type;
     Vec3 P[4];          /* quad corners as a bilinear patch: P00, P10, P01, P11 */
@@ -79,6 +93,10 @@ typedef struct Light {
     float cos_outer, cos_inner, beam; /* spot: cone edge, full beam, beamdistribution */
     Mat4 world_from_light, light_from_world; /* environment: the map's rotation */
     LightEnvMap *env;   /* environment: NULL for a constant one */
+    LightMesh *mesh;    /* mesh: its triangles */
+    int two_sided;      /* mesh: emits from both sides */
+    int emitter;        /* mesh: the scene object camera rays see it as (its own
+                           Embree scene answers a BSDF direction: light_mesh_finish) */
     char category[LIGHT_CATEGORY_MAX]; /* comma-separated names */
     /* A light moving within the frame (made under a moving transform):
      * where it is at time t is the light above (at time[0]) moved by delta
@@ -113,7 +131,7 @@ static inline void light_quad_eval(const Light *l, float a, float b, Vec3 *P, Ve
 static inline int light_is_area(const Light *l)
 {
     return l->type == LIGHT_QUAD || l->type == LIGHT_DISK || l->type == LIGHT_SPHERE ||
-           l->type == LIGHT_ENVIRONMENT;
+           l->type == LIGHT_ENVIRONMENT || l->type == LIGHT_MESH;
 }
 
 /* Nonzero if every point of an area light (quad, disk, sphere) lies below
@@ -160,8 +178,20 @@ int light_sample(const Light *l, Vec3 o, float a, float b, LightSample *s);
 /* The area or environment light along the ray o + t wi (wi unit), ignoring
  * everything else: returns 1 and fills *s (dist the hit distance, Li the
  * radiance, pdf what light_sample would give wi) if the ray meets its
- * emitting side, else 0. */
+ * emitting side, else 0. A mesh light has no search of its own here (0):
+ * the renderer finds the hit in the emitter's Embree scene and calls
+ * light_mesh_finish. */
 int light_intersect(const Light *l, Vec3 o, Vec3 wi, LightSample *s);
+
+/* Makes l a mesh light of n triangles (corners v, 3 n, world space; the
+ * front is (v1 - v0) x (v2 - v0)); triangles without area are kept, never
+ * drawn. Returns 0, or -1 when out of memory or when no triangle has area. */
+int light_mesh_init(Light *l, const Vec3 *v, size_t n, int two_sided);
+
+/* A mesh light met at distance t along wi (unit) where the surface's unit
+ * geometric normal is Ng (front as above): 1 and *s filled if that side
+ * emits, else 0. */
+int light_mesh_finish(const Light *l, Vec3 wi, float t, Vec3 Ng, LightSample *s);
 
 /* The environment light's radiance along world direction d (unit). */
 Vec3 light_env_radiance(const Light *l, Vec3 d);
@@ -177,7 +207,7 @@ int light_env_load(Light *l, const char *path, int octahedral, char *err, size_t
 
 /* The light at time t: l itself when it is still, else *tmp, made from l
  * moved to t (positions, axes, sizes; an environment map's rotation),
- * sharing l's map. */
+ * sharing l's map. Mesh lights are still (the scene makes them so). */
 const Light *light_at_time(const Light *l, float t, Light *tmp);
 
 /* Frees what the light owns. */

@@ -62,6 +62,9 @@ typedef struct Record {
     int n_shader;
     float area_P[REC_MAX][4][3], area_L[REC_MAX][3];
     int n_area;
+    size_t mesh_light_faces[REC_MAX]; /* area_light_mesh: faces, radiance, sides */
+    float mesh_light_L[REC_MAX][3];
+    int mesh_light_two_sided[REC_MAX], n_mesh_light;
     RecShader light[REC_MAX]; /* type in name */
     int n_light;
     int links_mode;           /* the last set_light_links: RayesLightLinks */
@@ -281,6 +284,21 @@ static RayesError rec_area_light(void *t, const float P[4][3], const float L[3])
     return RAYES_OK;
 }
 
+static RayesError rec_area_light_mesh(void *t, size_t n_faces, const int *nv, const int *idx,
+                                      size_t n_points, const float *P, const float L[3],
+                                      int two_sided)
+{
+    Record *r = t;
+    (void)nv, (void)idx, (void)n_points, (void)P;
+    r->calls++;
+    if (r->n_mesh_light == REC_MAX)
+        return RAYES_ERROR_OUT_OF_MEMORY;
+    r->mesh_light_faces[r->n_mesh_light] = n_faces;
+    memcpy(r->mesh_light_L[r->n_mesh_light], L, sizeof r->mesh_light_L[0]);
+    r->mesh_light_two_sided[r->n_mesh_light++] = two_sided;
+    return RAYES_OK;
+}
+
 static RayesError rec_light(void *t, const char *type, const RayesParam *p, size_t n)
 {
     Record *r = t;
@@ -333,7 +351,8 @@ static IoSink record_sink(Record *r)
                     .set_light_links = rec_light_links,
                     .light_count = rec_light_count,
                     .get_error = rec_error,
-                    .subdivision_mesh = rec_subdiv};
+                    .subdivision_mesh = rec_subdiv,
+                    .area_light_mesh = rec_area_light_mesh};
 }
 
 static void record_free(Record *r)

@@ -157,20 +157,22 @@ static void test_materials(void)
                              "newmtl red\nKd 0.6 0.1 0.05\nd 1\nillum 1\n"
                              "newmtl shiny\nKd 0.2 0.3 0.4\nKs 0.5 0.5 0.5\nNs 40\nillum 2\n"
                              "newmtl wood\nKd 1 1 1\nmap_Kd -s 2 2 1 wood.png\n"
-                             "newmtl lamp\nKd 0 0 0\nKe 5 4 3\n");
+                             "newmtl lamp\nKd 0 0 0\nKe 5 4 3\n"
+                             "newmtl panel\nKe 1 2 3\n");
     static const char text[] = "mtllib m.mtl\n"
                                "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\n"
                                "usemtl red\nf 1 2 3\n"
                                "usemtl shiny\nf 1 3 4\n"
                                "usemtl wood\nf 1 2 3 4\n"
                                "usemtl lamp\nf 4 3 2 1\nf 1 2 3\n"
-                               "usemtl missing\nf 2 3 4\n";
+                               "usemtl missing\nf 2 3 4\n"
+                               "usemtl panel\nf 4 3 2 1\n";
     CHECK(parse(DIR "/scene.obj", text) == RAYES_OK);
     if (err[0])
         fprintf(stderr, "  %s\n", err);
-    /* default (the undefined material), red, shiny, wood, the lamp's triangle */
-    CHECK(rec.n_shader == 5 && rec.n_mesh == 5);
-    if (rec.n_shader != 5)
+    /* default (the undefined material), red, shiny, wood */
+    CHECK(rec.n_shader == 4 && rec.n_mesh == 4);
+    if (rec.n_shader != 4)
         return;
     const RayesParam *p;
     CHECK(strcmp(rec.shader[0].name, "matte") == 0);
@@ -183,11 +185,12 @@ static void test_materials(void)
     CHECK(strcmp(rec.shader[3].name, "paintedplastic") == 0);
     CHECK((p = rec_param(&rec.shader[3], "texturename")) &&
           strcmp(p->string, DIR "/wood.png") == 0);
-    CHECK(strcmp(rec.shader[4].name, "constant") == 0);
-    CHECK((p = rec_param(&rec.shader[4], "Cs")) && p->value[0] == 5.0f);
-    /* the lamp's quad is an area light, in order, with L = Ke */
-    CHECK(rec.n_area == 1);
-    CHECK(rec.area_P[0][0][0] == 0 && rec.area_P[0][0][1] == 1 && rec.area_L[0][1] == 4.0f);
+    /* the lamp's quad and triangle are one mesh light with L = Ke; the
+     * panel's one quad a quad light, in order */
+    CHECK(rec.n_area == 1 && rec.n_mesh_light == 1);
+    CHECK(rec.area_P[0][0][0] == 0 && rec.area_P[0][0][1] == 1 && rec.area_L[0][1] == 2.0f);
+    CHECK(rec.mesh_light_faces[0] == 2 && rec.mesh_light_L[0][1] == 4.0f &&
+          !rec.mesh_light_two_sided[0]);
     CHECK(rec.n_light == 0); /* something emits: no default light */
     CHECK(rec.n_camera == 1);
     record_free(&rec);

@@ -40,7 +40,12 @@ typedef struct Rec {
     float xform[16];
     Shader shader;
     /* geometry, with the transform and shader current then */
-    int n_meshes, n_quadrics, n_patches, n_area, n_lights, n_curves;
+    int n_meshes, n_quadrics, n_patches, n_area, n_lights, n_curves, n_mesh_lights;
+    struct {
+        size_t n_faces, n_points;
+        int two_sided, first[3]; /* the first face's indices */
+        float L[3];
+    } mesh_light[MAX_REC];
     struct {
         size_t n_faces, n_points;
         float centre[3]; /* mean of the points, object space */
@@ -255,6 +260,22 @@ static RayesError r_area(void *t, const float P[4][3], const float L[3])
     return RAYES_OK;
 }
 
+static RayesError r_area_mesh(void *t, size_t n_faces, const int *nv, const int *idx,
+                              size_t n_points, const float *P, const float L[3], int two_sided)
+{
+    Rec *r = t;
+    (void)nv, (void)P;
+    if (r->n_mesh_lights < MAX_REC) {
+        r->mesh_light[r->n_mesh_lights].n_faces = n_faces;
+        r->mesh_light[r->n_mesh_lights].n_points = n_points;
+        r->mesh_light[r->n_mesh_lights].two_sided = two_sided;
+        memcpy(r->mesh_light[r->n_mesh_lights].first, idx, sizeof(int[3]));
+        memcpy(r->mesh_light[r->n_mesh_lights].L, L, sizeof(float[3]));
+    }
+    r->n_mesh_lights++;
+    return RAYES_OK;
+}
+
 static RayesError r_light(void *t, const char *type, const RayesParam *p, size_t n)
 {
     Rec *r = t;
@@ -321,6 +342,7 @@ static IoSink stub(Rec *r)
                     .sphere = r_sphere,
                     .quadric = r_quadric,
                     .area_light = r_area,
+                    .area_light_mesh = r_area_mesh,
                     .light = r_light,
                     .get_error = r_error,
                     .pattern = r_pattern,
@@ -1193,24 +1215,47 @@ static void test_normal_map(void)
     free(r);
 }
 
-/* An emitting triangle that pairs with no other: a quad light with its
- * third corner twice (the triangle); a square of two triangles: one quad. */
+/* Emitters: a square of two triangles is one quad light; a lone
+ * triangle, and a mesh of more than four quads, one mesh light each, wound
+ * to face as pbrt's normals (here ReverseOrientation turns the second). */
 static void test_triangle_light(void)
 {
     Rec *r = malloc(sizeof *r);
     IoSettings s;
     char err[256];
-    CHECK(parse("t.pbrt",
-                "WorldBegin\nAreaLightSource \"diffuse\" \"rgb L\" [2 2 2]\n"
-                "Shape \"trianglemesh\" \"point3 P\" [0 0 0 1 0 0 0 1 0]\n"
-                "Shape \"trianglemesh\" \"point3 P\" [0 0 0 1 0 0 1 1 0 0 1 0] "
-                "\"integer indices\" [0 1 2 0 2 3]\n",
-                r, &s, err, sizeof err) == RAYES_OK);
-    CHECK(r->n_area == 2);
-    if (r->n_area == 2) {
-        const float want[4][3] = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 1, 0}};
-        CHECK(memcmp(r->area[0].P, want, sizeof want) == 0);
+    char text[2048];
+    int n = snprintf(text, sizeof text,
+                     "WorldBegin\nAreaLightSource \"diffuse\" \"rgb L\" [2 2 2]\n"
+                     "Shape \"trianglemesh\" \"point3 P\" [0 0 0 1 0 0 0 1 0]\n"
+                     "Shape \"trianglemesh\" \"point3 P\" [0 0 0 1 0 0 1 1 0 0 1 0] "
+                     "\"integer indices\" [0 1 2 0 2 3]\n"
+                     "AreaLightSource \"diffuse\" \"rgb L\" [3 3 3] \"bool twosided\" true\n"
+                     "ReverseOrientation\nShape \"bilinearmesh\" \"point3 P\" [");
+    for (int k = 0; k < 12; k++) /* a strip of 5 quads */
+        n += snprintf(text + n, sizeof text - (size_t)n, "%d %d 0 ", k / 2, k % 2);
+    n += snprintf(text + n, sizeof text - (size_t)n, "] \"integer indices\" [");
+    for (int k = 0; k < 5; k++)
+        n += snprintf(text + n, sizeof text - (size_t)n, "%d %d %d %d ", 2 * k, 2 * k + 2,
+                      2 * k + 1, 2 * k + 3);
+    snprintf(text + n, sizeof text - (size_t)n,
+             "]\n"
+             "Shape \"trianglemesh\" \"point3 P\" [0 0 0 1 0 0 0 1 0 1 1 0 2 0 0 2 1 0] "
+             "\"integer indices\" [0 1 2  1 3 2  1 4 3  4 5 3  0 2 3  0 4 5]\n");
+    CHECK(parse("t.pbrt", text, r, &s, err, sizeof err) == RAYES_OK);
+    CHECK(r->n_area == 1 && r->n_mesh_lights == 3);
+    if (r->n_area == 1 && r->n_mesh_lights == 3) {
         CHECK(r->area[0].L[0] == 2.0f);
+        CHECK(r->mesh_light[0].n_faces == 1 && r->mesh_light[0].L[0] == 2.0f);
+        const int want[3] = {0, 1, 2};
+        CHECK(memcmp(r->mesh_light[0].first, want, sizeof want) == 0 &&
+              !r->mesh_light[0].two_sided);
+        CHECK(r->mesh_light[1].n_faces == 5 && r->mesh_light[1].two_sided &&
+              r->mesh_light[1].L[0] == 3.0f);
+        const int strip[3] = {0, 1, 3}; /* ReverseOrientation: 0 2 3 1 turned */
+        CHECK(memcmp(r->mesh_light[1].first, strip, sizeof strip) == 0);
+        CHECK(r->mesh_light[2].n_faces == 6 && r->mesh_light[2].two_sided);
+        const int turned[3] = {0, 2, 1};
+        CHECK(memcmp(r->mesh_light[2].first, turned, sizeof turned) == 0);
     }
     free(r);
 }

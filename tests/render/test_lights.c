@@ -3,7 +3,8 @@
  * render/integrator.c, rayes_scene_light): analytic irradiance of point,
  * spot, distant, ambient, disk and sphere lights; multiple importance
  * sampling against brute-force estimates of a glossy lobe under small and
- * large quads; a constant-environment white furnace; an importance-sampled
+ * large quads, and under mesh lights of many faces; a closed mesh light
+ * against a sphere's closed form; a constant-environment white furnace; an importance-sampled
  * latitude-longitude map against a uniform-sphere estimate, its sampling
  * against a binary search and pixel_pdf (chi-square); categories;
  * emitters seen by the camera; determinism with every light type; errors.
@@ -50,6 +51,8 @@ static void fx_init(Fx *f, RayesScene *s)
     f->objs = calloc(s->n_objects + 1, sizeof *f->objs);
     for (size_t i = 0; i < s->n_objects; i++) {
         f->masks[i] = s->objects[i].ray_mask;
+        if (s->objects[i].light >= 0 && s->lights[s->objects[i].light].type == LIGHT_MESH)
+            f->masks[i] |= ACCEL_MASK_OWN_SCENE; /* as the session makes them */
         f->objs[i].light = s->objects[i].light;
         f->objs[i].shader = s->objects[i].shader.cls ? &s->objects[i].shader : NULL;
         memcpy(f->objs[i].Cs, s->objects[i].Cs, sizeof f->objs[i].Cs);
@@ -347,16 +350,24 @@ static double brute_glossy(Vec3 N, Vec3 V, float e, Vec3 c, float half, int m)
     return sum / m;
 }
 
-static void check_glossy_quad(float half, float roughness)
+static void mesh_light_square(RayesScene *s, Vec3 c, float half, int n, float L, int two_sided);
+
+/* A square light of side 2 half facing down at c, a quad light or (mesh)
+ * a mesh light of many faces tiling it (its lobe's directions found in the
+ * emitter's own scene). */
+static void check_glossy_light(float half, float roughness, int mesh)
 {
     RayesScene *s = rayes_scene_new();
     Vec3 c = v3(0.6f, 0.1f, 1.5f);
-    /* Turn +z to -z, centre at c. */
-    const float m[16] = {1, 0, 0, c.x, 0, -1, 0, c.y, 0, 0, -1, c.z, 0, 0, 0, 1};
-    CHECK(rayes_scene_set_transform(s, m) == RAYES_OK);
-    RayesParam p[4] = {ps("shape", "quad"), pf("width", 2 * half), pf("height", 2 * half),
-                       pf("intensity", 1)};
-    CHECK(rayes_scene_light(s, "arealight", p, 4) == RAYES_OK);
+    if (mesh) {
+        mesh_light_square(s, c, half, 6, 1.0f, 0);
+    } else { /* turn +z to -z, centre at c */
+        const float m[16] = {1, 0, 0, c.x, 0, -1, 0, c.y, 0, 0, -1, c.z, 0, 0, 0, 1};
+        CHECK(rayes_scene_set_transform(s, m) == RAYES_OK);
+        RayesParam p[4] = {ps("shape", "quad"), pf("width", 2 * half), pf("height", 2 * half),
+                           pf("intensity", 1)};
+        CHECK(rayes_scene_light(s, "arealight", p, 4) == RAYES_OK);
+    }
     Fx f;
     fx_init(&f, s);
     Vec3 N = v3(0, 0, 1), V = v3_normalize(v3(-0.5f, -0.1f, 1.0f)), I = v3_neg(V);
@@ -374,14 +385,122 @@ static void check_glossy_quad(float half, float roughness)
 
 static void test_mis_glossy_small_quad(void)
 {
-    check_glossy_quad(0.1f, 0.1f);
-    check_glossy_quad(0.1f, 0.02f);
+    check_glossy_light(0.1f, 0.1f, 0);
+    check_glossy_light(0.1f, 0.02f, 0);
 }
 
 static void test_mis_glossy_large_quad(void)
 {
-    check_glossy_quad(2.0f, 0.1f);
-    check_glossy_quad(2.0f, 0.02f);
+    check_glossy_light(2.0f, 0.1f, 0);
+    check_glossy_light(2.0f, 0.02f, 0);
+}
+
+/* ---------------------------------------------------------- mesh lights */
+
+/* The square of side 2 half about c in z = c.z as an n x n mesh light of
+ * quads and triangles in turn (counter-clockwise seen from -z: facing
+ * down), radiance L, one- or two-sided. */
+static void mesh_light_square(RayesScene *s, Vec3 c, float half, int n, float L, int two_sided)
+{
+    float *P = malloc(sizeof(float) * 3 * (size_t)((n + 1) * (n + 1)));
+    int *nv = malloc(sizeof(int) * (size_t)(2 * n * n)),
+        *idx = malloc(sizeof(int) * 6 * (size_t)(n * n));
+    size_t n_faces = 0, k = 0;
+    for (int j = 0; j <= n; j++)
+        for (int i = 0; i <= n; i++) {
+            float *p = &P[3 * (j * (n + 1) + i)];
+            p[0] = c.x - half + 2 * half * (float)i / (float)n;
+            p[1] = c.y - half + 2 * half * (float)j / (float)n;
+            p[2] = c.z;
+        }
+    for (int j = 0; j < n; j++)
+        for (int i = 0; i < n; i++) {
+            int a = j * (n + 1) + i, b = a + 1, d = a + n + 1, e = d + 1;
+            if ((i + j) % 2) { /* a quad */
+                nv[n_faces++] = 4;
+                idx[k++] = a, idx[k++] = d, idx[k++] = e, idx[k++] = b;
+            } else { /* two triangles */
+                nv[n_faces++] = 3, nv[n_faces++] = 3;
+                idx[k++] = a, idx[k++] = d, idx[k++] = e;
+                idx[k++] = a, idx[k++] = e, idx[k++] = b;
+            }
+        }
+    const float Lc[3] = {L, L, L};
+    CHECK(rayes_scene_area_light_mesh(s, n_faces, nv, idx, (size_t)((n + 1) * (n + 1)), P, Lc,
+                                      two_sided) == RAYES_OK);
+    free(P);
+    free(nv);
+    free(idx);
+}
+
+/* A mesh light of many faces lights as the one quad it tiles: diffuse
+ * irradiance against Lambert's closed form, the glossy highlight against
+ * the brute-force lobe estimate; from above, one-sided, nothing; two-sided,
+ * as from below. */
+static void test_mesh_light_irradiance(void)
+{
+    check_glossy_light(0.1f, 0.1f, 1);
+    check_glossy_light(2.0f, 0.02f, 1);
+    for (int two = 0; two < 2; two++) {
+        RayesScene *s = rayes_scene_new();
+        mesh_light_square(s, v3(0, 0, 1.5f), 1.0f, 5, 2.0f, two);
+        Fx f;
+        fx_init(&f, s);
+        double below = fx_irradiance(&f, v3(0, 0, 0), v3(0, 0, 1), 64, NULL);
+        double above = fx_irradiance(&f, v3(0, 0, 3), v3(0, 0, -1), 64, NULL);
+        Vec3 sq[4] = {v3(-1, -1, 1.5f), v3(1, -1, 1.5f), v3(1, 1, 1.5f), v3(-1, 1, 1.5f)};
+        double want = 2.0 * polygon_irradiance(v3(0, 0, 0), v3(0, 0, 1), sq, 4);
+        CHECK_NEAR(below / want, 1.0, 0.01);
+        if (two)
+            CHECK_NEAR(above / want, 1.0, 0.01);
+        else
+            CHECK(above == 0.0);
+        fx_fini(&f);
+    }
+}
+
+/* A closed mesh: a UV sphere of radius 1 (outward faces) at distance 3
+ * gives a sphere light's irradiance, L pi (R / D)^2, within its facets'
+ * loss of area; a mesh without area is refused. */
+static void test_mesh_light_sphere(void)
+{
+    enum { NU = 64, NV = 32 };
+    float *P = malloc(sizeof(float) * 3 * NU * (NV + 1));
+    int nv[NU * NV], idx[4 * NU * NV];
+    for (int j = 0; j <= NV; j++)
+        for (int i = 0; i < NU; i++) {
+            double th = PI * j / NV, ph = 2 * PI * i / NU;
+            float *p = &P[3 * (j * NU + i)];
+            p[0] = (float)(sin(th) * cos(ph)), p[1] = (float)(sin(th) * sin(ph));
+            p[2] = (float)(3 + cos(th));
+        }
+    size_t n_faces = 0, k = 0;
+    for (int j = 0; j < NV; j++)
+        for (int i = 0; i < NU; i++) {
+            int a = j * NU + i, b = j * NU + (i + 1) % NU;
+            nv[n_faces++] = 4; /* degenerate at the poles: triangles of no area in the fan */
+            idx[k++] = a, idx[k++] = a + NU, idx[k++] = b + NU, idx[k++] = b;
+        }
+    RayesScene *s = rayes_scene_new();
+    const float L[3] = {2, 2, 2};
+    CHECK(rayes_scene_area_light_mesh(s, n_faces, nv, idx, NU * (NV + 1), P, L, 0) == RAYES_OK);
+    Fx f;
+    fx_init(&f, s);
+    double E = fx_irradiance(&f, v3(0, 0, 0), v3(0, 0, 1), 256, NULL);
+    CHECK_NEAR(E / (2 * PI / 9), 0.995, 0.01);
+    /* inside the sphere: its faces face away, no light */
+    CHECK(fx_irradiance(&f, v3(0, 0, 3), v3(0, 0, 1), 16, NULL) == 0.0);
+    fx_fini(&f);
+    s = rayes_scene_new();
+    const float flat[9] = {0, 0, 0, 1, 1, 1, 2, 2, 2};
+    const int tri[3] = {0, 1, 2}, three = 3, two = 2;
+    CHECK(rayes_scene_area_light_mesh(s, 1, &three, tri, 3, flat, L, 0) ==
+          RAYES_ERROR_INVALID_ARGUMENT);
+    CHECK(strstr(rayes_scene_get_error(s), "no face has area") != NULL);
+    CHECK(rayes_scene_area_light_mesh(s, 1, &two, tri, 3, P, L, 0) == RAYES_ERROR_INVALID_ARGUMENT);
+    CHECK(s->n_lights == 0 && s->n_objects == 0 && s->n_prims == 0);
+    rayes_scene_release(s);
+    free(P);
 }
 
 /* ------------------------------------------------------- environments */
@@ -1013,6 +1132,23 @@ static void test_emitters_seen_by_camera(void)
         rayes_image_free(img);
         rayes_scene_release(s);
     }
+    /* A mesh light facing the camera, and one facing away: black unless
+     * two-sided. */
+    for (int k = 0; k < 3; k++) {
+        RayesScene *m = rayes_scene_new();
+        float eye[3] = {0, 0, -4}, target[3] = {0, 0, 0}, up[3] = {0, 1, 0};
+        CHECK(rayes_scene_set_camera(m, eye, target, up, 30.0f) == RAYES_OK);
+        const float P[12] = {-1, -1, 0, 1, -1, 0, 1, 1, 0, -1, 1, 0};
+        const int toward[6] = {0, 2, 1, 0, 3, 2}, away[6] = {0, 1, 2, 0, 2, 3}, nv[2] = {3, 3};
+        const float L[3] = {3, 2, 1};
+        CHECK(rayes_scene_area_light_mesh(m, 2, nv, k == 0 ? toward : away, 4, P, L, k == 2) ==
+              RAYES_OK);
+        RayesImage *img = render_scene(m, 1, 16);
+        const float *c = img ? &img->rgba[4 * (8 * 16 + 8)] : NULL;
+        CHECK(c && c[0] == (k == 1 ? 0.0f : 3.0f) && c[2] == (k == 1 ? 0.0f : 1.0f));
+        rayes_image_free(img);
+        rayes_scene_release(m);
+    }
     /* A disk seen from behind is black. */
     RayesScene *s = rayes_scene_new();
     float eye[3] = {0, 0, -4}, target[3] = {0, 0, 0}, up[3] = {0, 1, 0};
@@ -1050,6 +1186,9 @@ static RayesScene *every_light_scene(void)
     rayes_scene_light(s, "arealight", sph, 3);
     RayesParam dk[3] = {ps("shape", "disk"), pf("radius", 0.3f), pf("intensity", 5)};
     rayes_scene_light(s, "arealight", dk, 3);
+    const float tri[9] = {-0.3f, 2, 0.5f, 0.3f, 2, 0.5f, 0, 2, 0.9f}, L[3] = {4, 4, 4};
+    const int three[1] = {3}, corners[3] = {0, 2, 1};
+    rayes_scene_area_light_mesh(s, 1, three, corners, 3, tri, L, 1);
     RayesParam env[2] = {ps("mapname", RAYES_TEST_TMP "/test_lights_map.exr"),
                          pf("intensity", 0.2f)};
     rayes_scene_light(s, "environmentlight", env, 2);
@@ -1104,6 +1243,7 @@ TEST_MAIN(TEST(test_point_light_inverse_square), TEST(test_spot_light_cone),
           TEST(test_distant_light), TEST(test_ambient_light), TEST(test_disk_light_irradiance),
           TEST(test_sphere_light_irradiance), TEST(test_light_bound_keeps_every_hit),
           TEST(test_mis_glossy_small_quad), TEST(test_mis_glossy_large_quad),
+          TEST(test_mesh_light_irradiance), TEST(test_mesh_light_sphere),
           TEST(test_glossy_lights_against_brute_force),
           TEST(test_glossy_surroundings_against_brute_force),
           TEST(test_microfacet_against_brute_force), TEST(test_constant_environment_white_furnace),

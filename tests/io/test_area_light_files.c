@@ -1,0 +1,98 @@
+/*
+ * tests/io/test_area_light_files.c — RIB area lights of any polygons: up
+ * to four quads stay quad lights, more faces (triangles, polygons, holes)
+ * make one mesh light, "twosided" is read, and the writer's RIB reads back
+ * into the same light, corner for corner.
+ */
+#include <string.h>
+
+#include "io/rib_round_trip.h"
+#include "scene/scene.h"
+#include "shade/light.h"
+#include "test.h"
+
+#ifndef RAYES_TEST_DATA
+#error "RAYES_TEST_DATA must name the shared data directory"
+#endif
+
+#define WORLD(body) "WorldBegin\n" body "\nWorldEnd\n"
+
+static size_t count_type(const RayesScene *s, LightType type)
+{
+    size_t n = 0;
+    for (size_t k = 0; k < s->n_lights; k++)
+        n += s->lights[k].type == type;
+    return n;
+}
+
+/* Four quads: quad lights; five, or any other polygon: one mesh light. */
+static void test_polygons_under_area_lights(void)
+{
+    char err[256];
+    RayesError e;
+    RayesScene *s = rib_read_scene(
+        WORLD("AttributeBegin\nAreaLightSource \"arealight\" 1 \"intensity\" 2\n"
+              "PointsPolygons [4 4 4 4] [0 1 2 3 0 1 2 3 0 1 2 3 0 1 2 3] "
+              "\"P\" [0 0 0 1 0 0 1 1 0 0 1 0]\nAttributeEnd"),
+        &e, err, sizeof err);
+    CHECK(e == RAYES_OK && s->n_lights == 4 && count_type(s, LIGHT_QUAD) == 4);
+    Vec3 quad_front = v3(0, 0, 0), c;
+    if (s->n_lights == 4)
+        light_quad_eval(&s->lights[0], 0.5f, 0.5f, &c, &quad_front);
+    rayes_scene_release(s);
+    s = rib_read_scene(
+        WORLD("AttributeBegin\nAreaLightSource \"arealight\" 1 \"intensity\" 2\n"
+              "PointsPolygons [4 4 4 4 4] [0 1 2 3 0 1 2 3 0 1 2 3 0 1 2 3 0 1 2 3] "
+              "\"P\" [0 0 0 1 0 0 1 1 0 0 1 0]\nAttributeEnd\n"
+              "AttributeBegin\nAreaLightSource \"arealight\" 2 \"float twosided\" [1]\n"
+              "GeneralPolygon [4 3] \"P\" [0 0 0 4 0 0 4 4 0 0 4 0  1 1 0 2 1 0 1 2 0]\n"
+              "AttributeEnd\nPolygon \"P\" [0 0 0 1 0 0 1 1 0 0 1 0 0.5 2 0]"),
+        &e, err, sizeof err);
+    CHECK(e == RAYES_OK && s->n_lights == 2 && count_type(s, LIGHT_MESH) == 2);
+    if (s->n_lights == 2) {
+        const Light *a = &s->lights[0], *b = &s->lights[1];
+        CHECK(a->mesh->n == 10 && !a->two_sided && a->L.x == 2.0f);
+        CHECK_NEAR(a->mesh->area, 5.0, 1e-5);
+        CHECK(b->two_sided && b->L.x == 1.0f);
+        CHECK_NEAR(b->mesh->area, 16.0 - 0.5, 1e-5); /* the square less its hole */
+        /* facing as the same polygon's quad light */
+        Vec3 n = v3_cross(v3_sub(a->mesh->v[1], a->mesh->v[0]),
+                          v3_sub(a->mesh->v[2], a->mesh->v[0]));
+        CHECK(v3_dot(n, quad_front) > 0);
+    }
+    CHECK(s->n_objects >= 3); /* two emitters, and the plain polygon's object */
+    rayes_scene_release(s);
+}
+
+/* Written and read back: the same triangles bit for bit, the same sides. */
+static void test_round_trip(void)
+{
+    static const char text[] =
+        WORLD("Translate 0 0 5\nAttributeBegin\n"
+              "AreaLightSource \"arealight\" 1 \"color lightcolor\" [0.1 0.2 0.3] "
+              "\"float twosided\" [1]\n"
+              "PointsPolygons [3 5] [0 1 2 0 2 3 4 5] \"P\" [0 0 0 1 0 0 1 1 0.1 0.5 1.7 0 "
+              "-0.3 0.9 0 0 0.5 0]\nAttributeEnd");
+    char err[256];
+    RayesError e;
+    char *written = rib_round_trip(text, err, sizeof err);
+    CHECK(written && strstr(written, "\"float twosided\" [1]") != NULL);
+    RayesScene *a = rib_read_scene(text, &e, err, sizeof err);
+    CHECK(e == RAYES_OK);
+    RayesScene *b = written ? rib_read_scene(written, &e, err, sizeof err) : NULL;
+    CHECK(b && e == RAYES_OK);
+    if (b && a->n_lights == 1 && b->n_lights == 1) {
+        const LightMesh *m = a->lights[0].mesh, *n = b->lights[0].mesh;
+        CHECK(m && n && m->n == 4 && n->n == 4);
+        CHECK(m && n && memcmp(m->v, n->v, 3 * m->n * sizeof *m->v) == 0);
+        CHECK(b->lights[0].two_sided && b->lights[0].L.z == 0.3f);
+    } else {
+        CHECK(!"one light each");
+    }
+    rayes_scene_release(a);
+    if (b)
+        rayes_scene_release(b);
+    free(written);
+}
+
+TEST_MAIN(TEST(test_polygons_under_area_lights), TEST(test_round_trip))
