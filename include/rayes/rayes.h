@@ -568,7 +568,8 @@ RAYES_API RayesError rayes_scene_area_light(RayesScene *scene, const float P[4][
  * the front; fanned into triangles), indices into P (n_points points),
  * radiance L from each face's front, or from both sides if two_sided. One
  * light however many faces: its shadow rays draw points over the whole
- * mesh by area. Seen by camera and specular rays; it does not move within
+ * mesh (by area within clusters of faces, each weighed from the lit
+ * point). Seen by camera and specular rays; it does not move within
  * the frame (under a moving transform it stays where the shutter opens,
  * with one warning). */
 RAYES_API RayesError rayes_scene_area_light_mesh(RayesScene *scene, size_t n_faces,

@@ -151,17 +151,28 @@ static Vec3 transmittance(Worker *w, Vec3 o, Vec3 wi, float dist, RayDiff diff)
     return integrator_transmission(w, &shadow, diff);
 }
 
-/* light_intersect, and for a mesh light its emitter's own Embree scene:
- * the nearest face along wi, whatever else lies between (transmittance
- * asks that). */
-static int light_hit(Worker *w, const Light *l, Vec3 o, Vec3 wi, LightSample *s)
+/* light_intersect, and for a mesh light (seen as v says) its emitter's
+ * own Embree scene: the nearest face along wi, whatever else lies between
+ * (transmittance asks that). */
+static int light_hit(Worker *w, const Light *l, const LightMeshView *v, Vec3 o, Vec3 wi,
+                     LightSample *s)
 {
     if (l->type != LIGHT_MESH)
         return light_intersect(l, o, wi, s);
     Ray ray = {o, wi, 0.0f, INFINITY, RAYES_RAY_SHADOW, w->time};
     Hit hit;
-    return accel_intersect_object(w->rs->accel, (uint32_t)l->emitter, &ray, &hit) &&
-           light_mesh_finish(l, wi, hit.t, hit.Ng, s);
+    if (!accel_intersect_object(w->rs->accel, (uint32_t)l->emitter, &ray, &hit))
+        return 0;
+    uint32_t tri = w->rs->gs->grids[hit.grid].prim - l->mesh->first_prim;
+    return light_mesh_finish(l, v, tri, wi, hit.t, hit.Ng, s);
+}
+
+/* A light's sample from o, for a mesh light seen as v says. */
+static int light_draw(const Light *l, const LightMeshView *v, Vec3 o, float a, float b,
+                      LightSample *s)
+{
+    return l->type == LIGHT_MESH ? light_mesh_sample(l, v, o, a, b, s)
+                                 : light_sample(l, o, a, b, s);
 }
 
 /* The shadow rays a service asked for n_shadow_rays traces per light and
@@ -246,6 +257,12 @@ static void light_area(Worker *w, const DirectPoint *p, const Light *l, uint64_t
      * cosine <= 0 and adds nothing (the same sums, without drawing them) */
     if (light_below_plane(l, p->o, p->N))
         return;
+    LightMeshView view; /* a mesh light's clusters as the point sees them */
+    if (l->type == LIGHT_MESH) {
+        light_mesh_view(l, p->o, p->N, &view);
+        if (!(view.cdf[view.n] > 0.0f))
+            return; /* every cluster faces away or lies below the horizon */
+    }
     Vec3 sum_d = v3(0, 0, 0), sum_s = v3(0, 0, 0);
     LightBound bound;
     light_bound_init(l, p->o, &bound);
@@ -269,7 +286,7 @@ static void light_area(Worker *w, const DirectPoint *p, const Light *l, uint64_t
         LightSample lsb[CMJ_BATCH];
         unsigned char got[CMJ_BATCH];
         for (int j = 0; j < nb; j++)
-            got[j] = light_sample(l, p->o, la[j], lb[j], &lsb[j]) && lsb[j].pdf > 0.0f;
+            got[j] = light_draw(l, &view, p->o, la[j], lb[j], &lsb[j]) && lsb[j].pdf > 0.0f;
         for (int j = 0; j < nb; j++) {
             LightSample ls = lsb[j];
             /* The light's strategy. */
@@ -299,7 +316,7 @@ static void light_area(Worker *w, const DirectPoint *p, const Light *l, uint64_t
                 wi = sample_cosine_frame(p->lobe.t, p->lobe.b, p->N, ca[j], cb[j]);
                 cos_x = v3_dot(p->N, wi);
                 if (cos_x > 0.0f && v3_dot(p->Ng, wi) > 0.0f && light_bound_may_hit(&bound, wi) &&
-                    light_hit(w, l, p->o, wi, &ls) && v3_max_component(ls.Li) > 0.0f)
+                    light_hit(w, l, &view, p->o, wi, &ls) && v3_max_component(ls.Li) > 0.0f)
                     sum_d = v3_madd(sum_d,
                                     v3_mul(ls.Li, transmittance(w, p->o, wi, ls.dist, p->shadow)),
                                     power_heuristic(cos_x / (float)M_PI, ls.pdf));
@@ -311,7 +328,7 @@ static void light_area(Worker *w, const DirectPoint *p, const Light *l, uint64_t
                 continue;
             cos_x = v3_dot(p->N, wi);
             if (cos_x <= 0.0f || v3_dot(p->Ng, wi) <= 0.0f || !light_bound_may_hit(&bound, wi) ||
-                !light_hit(w, l, p->o, wi, &ls) || !(v3_max_component(ls.Li) > 0.0f))
+                !light_hit(w, l, &view, p->o, wi, &ls) || !(v3_max_component(ls.Li) > 0.0f))
                 continue;
             float pdf = lobe_pdf(&p->lobe, wi);
             if (!(pdf > 0.0f))
@@ -459,8 +476,9 @@ static Vec3 fiber_origin(const FiberPoint *p, Vec3 wi)
  * own samples (power heuristic). Delta lights' Li is what a Lambertian
  * cosine term scales (direct_lighting's (1/pi) Li cos); fibres take Li
  * the same. */
-static void fiber_light_samples(Worker *w, const FiberPoint *p, const Light *l, int m,
-                                uint32_t pattern, Vec3 *d, Vec3 *s)
+static void fiber_light_samples(Worker *w, const FiberPoint *p, const Light *l,
+                                const LightMeshView *view, int m, uint32_t pattern, Vec3 *d,
+                                Vec3 *s)
 {
     int area = light_is_area(l), spec = v3_length(p->V) > 0.0f;
     CmjPattern pat;
@@ -471,7 +489,7 @@ static void fiber_light_samples(Worker *w, const FiberPoint *p, const Light *l, 
         if (area)
             cmj_pattern_sample(&pat, (uint32_t)j, &a, &b);
         LightSample ls;
-        if (!light_sample(l, p->P, a, b, &ls) || !(v3_max_component(ls.Li) > 0.0f) ||
+        if (!light_draw(l, view, p->P, a, b, &ls) || !(v3_max_component(ls.Li) > 0.0f) ||
             (area && !(ls.pdf > 0.0f)))
             continue;
         ls.Li = v3_mul(ls.Li, transmittance(w, fiber_origin(p, ls.wi), ls.wi, ls.dist, p->shadow));
@@ -486,8 +504,8 @@ static void fiber_light_samples(Worker *w, const FiberPoint *p, const Light *l, 
 
 /* The highlight's own strategy for an area light: m directions from the
  * lobe that reach the light. */
-static void fiber_lobe_samples(Worker *w, const FiberPoint *p, const Light *l, int m,
-                               uint64_t key, Vec3 *s)
+static void fiber_lobe_samples(Worker *w, const FiberPoint *p, const Light *l,
+                               const LightMeshView *view, int m, uint64_t key, Vec3 *s)
 {
     CmjPattern pat_ab, pat_c;
     cmj_pattern_init(&pat_ab, (uint32_t)m, (uint32_t)hash_combine(key, 1));
@@ -498,8 +516,8 @@ static void fiber_lobe_samples(Worker *w, const FiberPoint *p, const Light *l, i
         cmj_pattern_sample(&pat_c, (uint32_t)j, &c, &c2);
         Vec3 wi;
         LightSample ls;
-        if (!fiber_lobe_sample(p->T, p->V, p->e, a, b, c, &wi) || !light_hit(w, l, p->P, wi, &ls) ||
-            !(v3_max_component(ls.Li) > 0.0f))
+        if (!fiber_lobe_sample(p->T, p->V, p->e, a, b, c, &wi) ||
+            !light_hit(w, l, view, p->P, wi, &ls) || !(v3_max_component(ls.Li) > 0.0f))
             continue;
         float pdf = fiber_lobe_pdf(p->T, p->V, wi, p->e);
         if (!(pdf > 0.0f))
@@ -537,9 +555,12 @@ static void svc_direct_fiber(const RayesShaderServices *sv, const RayesShadeCtx 
                 !light_category_match(l, category))
                 continue;
             int m = light_is_area(l) ? n : 1;
-            fiber_light_samples(w, &p, l, m, (uint32_t)hash_combine(key, k), &d, &s);
+            LightMeshView view; /* fibres light from every side: no horizon */
+            if (l->type == LIGHT_MESH)
+                light_mesh_view(l, p.P, v3(0, 0, 0), &view);
+            fiber_light_samples(w, &p, l, &view, m, (uint32_t)hash_combine(key, k), &d, &s);
             if (light_is_area(l) && v3_length(p.V) > 0.0f)
-                fiber_lobe_samples(w, &p, l, m, hash_combine(hash_combine(key, k), 1), &s);
+                fiber_lobe_samples(w, &p, l, &view, m, hash_combine(hash_combine(key, k), 1), &s);
         }
         if (diffuse)
             v3_store(diffuse[i], d);

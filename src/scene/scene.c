@@ -1031,6 +1031,7 @@ RayesError rayes_scene_area_light_mesh(RayesScene *s, size_t n_faces, const int 
                           "area light mesh: no face has area (or out of memory)");
     }
     l.emitter = (int)s->n_objects;
+    l.mesh->first_prim = (uint32_t)s->n_prims; /* push_light appends the triangles */
     uint32_t motion = s->current_motion;
     if (motion)
         log_warning_once("mesh light motion", "a mesh area light under a moving transform is "
@@ -1703,6 +1704,10 @@ RayesError rayes_scene_edit_light(RayesScene *s, size_t index, const RayesParam 
             l->mesh->v[k] = v3_add(l->mesh->v[k], d);
         l->mesh->lo = v3_add(l->mesh->lo, d);
         l->mesh->hi = v3_add(l->mesh->hi, d);
+        for (int c = 0; c < l->mesh->n_clusters; c++) {
+            l->mesh->cluster[c].lo = v3_add(l->mesh->cluster[c].lo, d);
+            l->mesh->cluster[c].hi = v3_add(l->mesh->cluster[c].hi, d);
+        }
     }
     for (size_t i = 0; i < s->n_prims; i++)
         if (s->objects[s->prims[i].object].light == (int)index) {

@@ -238,86 +238,331 @@ static int env_sample(const Light *l, float a, float b, LightSample *s)
 
 /* ------------------------------------------------------------ meshes */
 
+/* A triangle's unnormalised normal (twice its area). */
+static Vec3 tri_normal(const Vec3 *p)
+{
+    return v3_cross(v3_sub(p[1], p[0]), v3_sub(p[2], p[0]));
+}
+
+/* Places the k-th smallest of t[lo, hi) (by centroid coordinate key) at k,
+ * smaller ones before it (Hoare's selection). */
+static void select_kth(uint32_t *t, const float *key, size_t lo, size_t hi, size_t k)
+{
+    while (hi - lo > 1) {
+        float pivot = key[t[lo + (hi - lo) / 2]];
+        size_t i = lo, j = hi - 1;
+        while (i <= j) {
+            while (key[t[i]] < pivot)
+                i++;
+            while (key[t[j]] > pivot)
+                j--;
+            if (i <= j) {
+                uint32_t tmp = t[i];
+                t[i] = t[j];
+                t[j] = tmp;
+                i++;
+                if (j == 0)
+                    break;
+                j--;
+            }
+        }
+        if (k <= j)
+            hi = j + 1;
+        else if (k >= i)
+            lo = i;
+        else
+            return;
+    }
+}
+
+/* Splits t[lo, hi) at the median of its centroids' widest axis until a
+ * part holds at most `leaf` triangles or `depth` halvings are done; the
+ * parts become clusters in order. */
+static void cluster_split(LightMesh *m, const Vec3 *v, uint32_t *t, float *key, size_t lo,
+                          size_t hi, size_t leaf, int depth)
+{
+    if (hi - lo <= leaf || depth == 0) {
+        LightCluster *c = &m->cluster[m->n_clusters++];
+        c->start = (uint32_t)lo, c->end = (uint32_t)hi;
+        return;
+    }
+    Vec3 clo = v3(INFINITY, INFINITY, INFINITY), chi = v3_neg(clo);
+    for (size_t i = lo; i < hi; i++) {
+        const Vec3 *p = &v[3 * (size_t)t[i]];
+        Vec3 c = v3_scale(v3_add(v3_add(p[0], p[1]), p[2]), 1.0f / 3.0f);
+        clo = v3_min(clo, c), chi = v3_max(chi, c);
+    }
+    Vec3 e = v3_sub(chi, clo);
+    int axis = e.x >= e.y && e.x >= e.z ? 0 : e.y >= e.z ? 1 : 2;
+    for (size_t i = lo; i < hi; i++) {
+        const Vec3 *p = &v[3 * (size_t)t[i]];
+        key[t[i]] = axis == 0   ? p[0].x + p[1].x + p[2].x
+                    : axis == 1 ? p[0].y + p[1].y + p[2].y
+                                : p[0].z + p[1].z + p[2].z;
+    }
+    size_t mid = lo + (hi - lo) / 2;
+    select_kth(t, key, lo, hi, mid);
+    cluster_split(m, v, t, key, lo, mid, leaf, depth - 1);
+    cluster_split(m, v, t, key, mid, hi, leaf, depth - 1);
+}
+
+static int cmp_u32(const void *a, const void *b)
+{
+    uint32_t x = *(const uint32_t *)a, y = *(const uint32_t *)b;
+    return x < y ? -1 : x > y;
+}
+
+/* A cluster's bounds, area, and cone of front directions. */
+static void cluster_bound(LightMesh *m, LightCluster *c)
+{
+    Vec3 sum = v3(0, 0, 0);
+    c->lo = v3(INFINITY, INFINITY, INFINITY), c->hi = v3_neg(c->lo);
+    for (uint32_t k = c->start; k < c->end; k++) {
+        const Vec3 *p = &m->v[3 * (size_t)k];
+        sum = v3_add(sum, tri_normal(p));
+        for (int j = 0; j < 3; j++)
+            c->lo = v3_min(c->lo, p[j]), c->hi = v3_max(c->hi, p[j]);
+    }
+    c->area = m->cdf[c->end] - m->cdf[c->start]; /* the global running sums yet */
+    c->centre = v3_scale(v3_add(c->lo, c->hi), 0.5f);
+    Vec3 h = v3_sub(c->hi, c->centre);
+    c->radius2 = v3_dot(h, h);
+    c->sin_cone = 0.0f;
+    float len = v3_length(sum);
+    c->cos_cone = -1.0f;
+    c->axis = v3(0, 0, 1);
+    if (!(len > 0.0f))
+        return;
+    c->axis = v3_scale(sum, 1.0f / len);
+    float cos_min = 1.0f;
+    for (uint32_t k = c->start; k < c->end; k++) {
+        Vec3 n = tri_normal(&m->v[3 * (size_t)k]);
+        float l = v3_length(n);
+        if (l > 0.0f)
+            cos_min = fminf(cos_min, v3_dot(n, c->axis) / l);
+    }
+    c->cos_cone = fmaxf(-1.0f, cos_min - 1e-4f); /* a margin for rounding */
+    c->sin_cone = sqrtf(fmaxf(0.0f, 1.0f - c->cos_cone * c->cos_cone));
+}
+
+static void mesh_free(LightMesh *m);
+
 int light_mesh_init(Light *l, const Vec3 *v, size_t n, int two_sided)
 {
     if (n == 0 || n > (size_t)INT32_MAX)
         return -1;
     LightMesh *m = calloc(1, sizeof *m);
-    if (!m)
+    uint32_t *t = malloc(n * sizeof *t);
+    float *key = malloc(n * sizeof *key);
+    if (m) {
+        m->v = malloc(3 * n * sizeof *m->v);
+        m->cdf = malloc((n + 1) * sizeof *m->cdf);
+        m->cluster_of = malloc(n);
+    }
+    if (!m || !t || !key || !m->v || !m->cdf || !m->cluster_of) {
+        free(t);
+        free(key);
+        mesh_free(m);
         return -1;
+    }
     m->n = n;
-    m->v = malloc(3 * n * sizeof *m->v);
-    m->cdf = malloc((n + 1) * sizeof *m->cdf);
-    m->guide = malloc(n * sizeof *m->guide);
-    if (!m->v || !m->cdf || !m->guide) {
-        free(m->v);
-        free(m->cdf);
-        free(m->guide);
-        free(m);
-        return -1;
-    }
-    memcpy(m->v, v, 3 * n * sizeof *m->v);
-    double sum = 0.0;
-    m->lo = m->hi = v[0];
-    for (size_t k = 0; k < n; k++) {
-        Vec3 e = v3_cross(v3_sub(v[3 * k + 1], v[3 * k]), v3_sub(v[3 * k + 2], v[3 * k]));
-        m->cdf[k] = (float)sum;
-        float a = 0.5f * v3_length(e);
-        sum += isfinite(a) ? a : 0.0f;
-        for (int c = 0; c < 3; c++) {
-            m->lo = v3_min(m->lo, v[3 * k + c]);
-            m->hi = v3_max(m->hi, v[3 * k + c]);
-        }
-    }
-    if (!(sum > 0.0)) {
-        l->mesh = m;
-        light_fini(l);
-        return -1;
-    }
     for (size_t k = 0; k < n; k++)
-        m->cdf[k] = (float)(m->cdf[k] / sum);
-    m->cdf[n] = 1.0f;
-    cdf_guide(m->cdf, (int)n, m->guide);
+        t[k] = (uint32_t)k;
+    size_t leaf = (n + LIGHT_MESH_CLUSTERS - 1) / LIGHT_MESH_CLUSTERS;
+    cluster_split(m, v, t, key, 0, n, leaf, 4); /* 2^4 = LIGHT_MESH_CLUSTERS parts at most */
+    /* Within a cluster the mesh's own order, whose neighbours are mostly
+     * neighbours in space: the stratified numbers that pick triangles then
+     * spread over the surface (the selection's order scatters them). */
+    for (int c = 0; c < m->n_clusters; c++)
+        qsort(t + m->cluster[c].start, m->cluster[c].end - m->cluster[c].start, sizeof *t, cmp_u32);
+    double sum = 0.0;
+    for (size_t k = 0; k < n; k++) { /* the clusters' order, running area sums */
+        memcpy(&m->v[3 * k], &v[3 * (size_t)t[k]], 3 * sizeof *v);
+        m->cdf[k] = (float)sum;
+        float a = 0.5f * v3_length(tri_normal(&m->v[3 * k]));
+        sum += isfinite(a) ? a : 0.0f;
+    }
+    m->cdf[n] = (float)sum;
     m->area = (float)sum;
+    m->lo = v3(INFINITY, INFINITY, INFINITY);
+    m->hi = v3_neg(m->lo);
+    for (int c = 0; c < m->n_clusters; c++) {
+        LightCluster *cl = &m->cluster[c];
+        cluster_bound(m, cl);
+        for (uint32_t k = cl->start; k < cl->end; k++)
+            m->cluster_of[t[k]] = (uint8_t)c;
+        m->lo = v3_min(m->lo, cl->lo), m->hi = v3_max(m->hi, cl->hi);
+    }
+    for (int c = 0; c < m->n_clusters; c++) { /* each cluster's cdf from 0 to 1 */
+        LightCluster *cl = &m->cluster[c];
+        float base = m->cdf[cl->start];
+        for (uint32_t k = cl->start; k < cl->end; k++)
+            m->cdf[k] = cl->area > 0.0f ? (m->cdf[k] - base) / cl->area : 0.0f;
+    }
+    m->cdf[n] = 1.0f;
+    free(t);
+    free(key);
+    if (!(sum > 0.0)) {
+        mesh_free(m);
+        return -1;
+    }
     l->type = LIGHT_MESH;
     l->mesh = m;
     l->two_sided = two_sided != 0;
     return 0;
 }
 
-int light_mesh_finish(const Light *l, Vec3 wi, float t, Vec3 Ng, LightSample *s)
+/* cos(max(0, a - b)) and sin(max(0, a - b)) from the sines and cosines of
+ * angles a, b in [0, pi]. */
+static inline float cos_sub_clamped(float sa, float ca, float sb, float cb)
+{
+    return ca > cb ? 1.0f : ca * cb + sa * sb;
+}
+
+static inline float sin_sub_clamped(float sa, float ca, float sb, float cb)
+{
+    return ca > cb ? 0.0f : sa * cb - ca * sb;
+}
+
+/* sqrt(1 - c^2) for a cosine c that may round past 1 (no libm calls: this
+ * runs for every cluster at every lit point) */
+static inline float sin_of(float c)
+{
+    float s2 = 1.0f - c * c;
+    return s2 > 0.0f ? sqrtf(s2) : 0.0f;
+}
+
+/* The importance of cluster c from o (normal N, or zero), as
+ * light_mesh_view says: the cosines bounded by the cone and by the ball
+ * around the cluster's bounds. */
+static float cluster_importance(const LightCluster *c, int two_sided, Vec3 o, Vec3 N)
+{
+    if (!(c->area > 0.0f))
+        return 0.0f;
+    Vec3 w = v3_sub(o, c->centre);
+    float r2 = c->radius2, d2 = v3_dot(w, w);
+    if (!(d2 > r2 * 1.0001f)) /* o within the ball: no bound on the angles */
+        return c->area / (r2 > 1e-30f ? r2 : 1e-30f);
+    float inv_d = 1.0f / sqrtf(d2), sin_b = sqrtf(r2) * inv_d, cos_b = sin_of(sin_b);
+    Vec3 wn = v3_scale(w, inv_d);
+    float cos_e = 1.0f;
+    if (!two_sided && c->cos_cone > -1.0f) { /* the faces' fronts toward o */
+        float cw = v3_dot(c->axis, wn), sw = sin_of(cw);
+        float c1 = cos_sub_clamped(sw, cw, c->sin_cone, c->cos_cone);
+        float s1 = sin_sub_clamped(sw, cw, c->sin_cone, c->cos_cone);
+        cos_e = cos_sub_clamped(s1, c1, sin_b, cos_b);
+        if (!(cos_e > 0.0f))
+            return 0.0f;
+    }
+    float cos_i = 1.0f;
+    if (N.x != 0.0f || N.y != 0.0f || N.z != 0.0f) { /* above o's horizon */
+        float ci = -v3_dot(N, wn);
+        cos_i = cos_sub_clamped(sin_of(ci), ci, sin_b, cos_b);
+        if (!(cos_i > 0.0f))
+            return 0.0f;
+    }
+    return c->area * cos_e * cos_i / d2;
+}
+
+void light_mesh_view(const Light *l, Vec3 o, Vec3 N, LightMeshView *v)
+{
+    const LightMesh *m = l->mesh;
+    v->n = m->n_clusters;
+    float sum = 0.0f;
+    for (int c = 0; c < m->n_clusters; c++) {
+        v->cdf[c] = sum;
+        float imp = cluster_importance(&m->cluster[c], l->two_sided, o, N);
+        sum += isfinite(imp) ? imp : 0.0f;
+    }
+    v->cdf[m->n_clusters] = sum;
+}
+
+/* The probability of cluster c in v. */
+static float view_pmf(const LightMeshView *v, int c)
+{
+    return v->cdf[v->n] > 0.0f ? (v->cdf[c + 1] - v->cdf[c]) / v->cdf[v->n] : 0.0f;
+}
+
+/* Cluster c's point at distance t along wi (unit) with unit normal Ng:
+ * its radiance and pdf in *s if its emitting side faces the ray's origin. */
+static int mesh_finish(const Light *l, const LightMeshView *v, int c, Vec3 wi, float t, Vec3 Ng,
+                       LightSample *s)
 {
     float cos_y = -v3_dot(Ng, wi);
     if (l->two_sided)
         cos_y = fabsf(cos_y);
-    if (!(cos_y > 0.0f) || !(t > 0.0f))
+    float p = view_pmf(v, c) / l->mesh->cluster[c].area; /* per unit area */
+    if (!(cos_y > 0.0f) || !(t > 0.0f) || !(p > 0.0f))
         return 0;
     s->wi = wi;
     s->dist = t;
     s->Li = l->L;
-    s->pdf = t * t / (cos_y * l->mesh->area);
+    s->pdf = t * t / cos_y * p;
     return 1;
 }
 
-/* A point of the mesh drawn by area with (a, b): a picks the triangle,
- * and what is left of it within the triangle's interval and b the point. */
-static int mesh_sample(const Light *l, Vec3 o, float a, float b, LightSample *s)
+int light_mesh_finish(const Light *l, const LightMeshView *v, uint32_t tri, Vec3 wi, float t,
+                      Vec3 Ng, LightSample *s)
+{
+    return tri < l->mesh->n && mesh_finish(l, v, l->mesh->cluster_of[tri], wi, t, Ng, s);
+}
+
+/* The largest k in [lo, hi) with cdf[k] <= x. */
+static uint32_t cdf_search(const float *cdf, uint32_t lo, uint32_t hi, float x)
+{
+    while (hi - lo > 1) {
+        uint32_t mid = lo + (hi - lo) / 2;
+        if (cdf[mid] <= x)
+            lo = mid;
+        else
+            hi = mid;
+    }
+    return lo;
+}
+
+int light_mesh_sample(const Light *l, const LightMeshView *v, Vec3 o, float a, float b,
+                      LightSample *s)
 {
     const LightMesh *m = l->mesh;
-    int k = cdf_find(m->cdf, m->guide, (int)m->n, a);
-    float w = m->cdf[k + 1] - m->cdf[k];
-    float r = w > 0.0f ? fminf(fmaxf((a - m->cdf[k]) / w, 0.0f), 1.0f) : 0.5f;
+    float total = v->cdf[v->n];
+    if (!(total > 0.0f))
+        return 0;
+    /* the cluster, then what is left of a: the triangle, then what is
+     * left: the point with b */
+    float x = a * total;
+    int c = 0;
+    while (c + 1 < v->n && v->cdf[c + 1] <= x)
+        c++;
+    while (c + 1 < v->n && !(v->cdf[c + 1] > v->cdf[c])) /* skip weightless ones */
+        c++;
+    float wc = v->cdf[c + 1] - v->cdf[c];
+    float r = wc > 0.0f ? fminf(fmaxf((x - v->cdf[c]) / wc, 0.0f), 0.99999994f) : 0.5f;
+    const LightCluster *cl = &m->cluster[c];
+    uint32_t k = cdf_search(m->cdf, cl->start, cl->end, r);
+    while (k + 1 < cl->end && !(m->cdf[k + 1] > m->cdf[k]))
+        k++;
+    float w = (k + 1 < cl->end ? m->cdf[k + 1] : 1.0f) - m->cdf[k];
+    float u = w > 0.0f ? fminf(fmaxf((r - m->cdf[k]) / w, 0.0f), 1.0f) : 0.5f;
     const Vec3 *p = &m->v[3 * (size_t)k];
-    float su = sqrtf(r); /* uniform over the triangle */
+    float su = sqrtf(u); /* uniform over the triangle */
     Vec3 y = v3_add(v3_scale(p[0], 1.0f - su),
                     v3_add(v3_scale(p[1], su * (1.0f - b)), v3_scale(p[2], su * b)));
-    Vec3 n = v3_cross(v3_sub(p[1], p[0]), v3_sub(p[2], p[0]));
+    Vec3 n = tri_normal(p);
     float len = v3_length(n);
     Vec3 d = v3_sub(y, o);
     float dist = v3_length(d);
     if (!(dist > 0.0f) || !(len > 0.0f))
         return 0;
-    return light_mesh_finish(l, v3_scale(d, 1.0f / dist), dist, v3_scale(n, 1.0f / len), s);
+    return mesh_finish(l, v, c, v3_scale(d, 1.0f / dist), dist, v3_scale(n, 1.0f / len), s);
+}
+
+/* A mesh light's sample without a view made for the point: one made here,
+ * without a horizon. */
+static int mesh_sample(const Light *l, Vec3 o, float a, float b, LightSample *s)
+{
+    LightMeshView v;
+    light_mesh_view(l, o, v3(0, 0, 0), &v);
+    return light_mesh_sample(l, &v, o, a, b, s);
 }
 
 /* ------------------------------------------------------------ motion */
@@ -745,15 +990,20 @@ int light_env_load(Light *l, const char *path, int octahedral, char *err, size_t
     return 0;
 }
 
+static void mesh_free(LightMesh *m)
+{
+    if (!m)
+        return;
+    free(m->v);
+    free(m->cdf);
+    free(m->cluster_of);
+    free(m);
+}
+
 void light_fini(Light *l)
 {
-    if (l->mesh) {
-        free(l->mesh->v);
-        free(l->mesh->cdf);
-        free(l->mesh->guide);
-        free(l->mesh);
-        l->mesh = NULL;
-    }
+    mesh_free(l->mesh);
+    l->mesh = NULL;
     if (!l->env)
         return;
     free(l->env->rgb);

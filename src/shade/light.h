@@ -33,6 +33,7 @@
 #define RAYES_SHADE_LIGHT_H
 
 #include <stddef.h>
+#include <stdint.h>
 
 #include "util/vec.h"
 
@@ -67,16 +68,40 @@ typedef struct LightEnvMap {
     int *col_guide;     /* height * width: each row's col_cdf's */
 } LightEnvMap;
 
-/* A mesh light's triangles (world space), drawn by area: triangle k with
- * probability (cdf[k + 1] - cdf[k]), then uniformly over it. */
+/* A mesh light's triangles (world space) in clusters of neighbours, at
+ * most LIGHT_MESH_CLUSTERS: a point draws a cluster by an importance its
+ * bounds give from there (LightMeshView), then a triangle of it by area,
+ * then a point uniformly in the triangle. */
+#define LIGHT_MESH_CLUSTERS 16
+
+typedef struct LightCluster {
+    Vec3 lo, hi;              /* bounds */
+    Vec3 centre;              /* of the ball around the bounds */
+    float radius2;            /* its radius squared */
+    Vec3 axis;                /* unit; every face's front lies within the cone about it */
+    float cos_cone, sin_cone; /* the cone's half-angle (cos_cone -1: any direction) */
+    float area;
+    uint32_t start, end; /* its triangles in LightMesh.v's order */
+} LightCluster;
+
 typedef struct LightMesh {
-    size_t n;    /* triangles */
-    Vec3 *v;     /* 3 n corners; the front is (v1 - v0) x (v2 - v0) */
-    float *cdf;  /* n + 1, from 0 to 1 */
-    int *guide;  /* n: where the search for k / n starts */
-    float area;  /* the whole mesh's */
-    Vec3 lo, hi; /* bounds */
+    size_t n;            /* triangles */
+    Vec3 *v;             /* 3 n corners, cluster by cluster; the front is
+                            (v1 - v0) x (v2 - v0) */
+    float *cdf;          /* n + 1: within each cluster from 0 (at start) to 1 (end) */
+    uint8_t *cluster_of; /* n: triangle k of the scene's order (prim first_prim + k) */
+    LightCluster cluster[LIGHT_MESH_CLUSTERS];
+    int n_clusters;
+    uint32_t first_prim; /* the scene primitive of its first triangle */
+    float area;          /* the whole mesh's */
+    Vec3 lo, hi;         /* bounds */
 } LightMesh;
+
+/* A mesh light's clusters weighed as seen from one point: cdf over them. */
+typedef struct LightMeshView {
+    int n;
+    float cdf[LIGHT_MESH_CLUSTERS + 1]; /* cdf[n] the total; 0: nothing reaches the point */
+} LightMeshView;
 
 typedef struct Light {
     LightType type;
@@ -184,14 +209,27 @@ int light_sample(const Light *l, Vec3 o, float a, float b, LightSample *s);
 int light_intersect(const Light *l, Vec3 o, Vec3 wi, LightSample *s);
 
 /* Makes l a mesh light of n triangles (corners v, 3 n, world space; the
- * front is (v1 - v0) x (v2 - v0)); triangles without area are kept, never
- * drawn. Returns 0, or -1 when out of memory or when no triangle has area. */
+ * front is (v1 - v0) x (v2 - v0)), clustered; triangles without area are
+ * kept, never drawn. Returns 0, or -1 when out of memory or when no
+ * triangle has area. */
 int light_mesh_init(Light *l, const Vec3 *v, size_t n, int two_sided);
 
-/* A mesh light met at distance t along wi (unit) where the surface's unit
- * geometric normal is Ng (front as above): 1 and *s filled if that side
- * emits, else 0. */
-int light_mesh_finish(const Light *l, Vec3 wi, float t, Vec3 Ng, LightSample *s);
+/* Weighs a mesh light's clusters for the point o with normal N (zero: no
+ * horizon), each by its area over the distance squared, times bounds on
+ * the cosines at both ends: a cluster whose faces all face away from o, or
+ * that lies wholly below o's horizon, gets 0 (it could give nothing). */
+void light_mesh_view(const Light *l, Vec3 o, Vec3 N, LightMeshView *v);
+
+/* light_sample for a mesh light seen as v says (from the same o). */
+int light_mesh_sample(const Light *l, const LightMeshView *v, Vec3 o, float a, float b,
+                      LightSample *s);
+
+/* A mesh light met at distance t along wi (unit) on its triangle tri (the
+ * scene's order) where the unit geometric normal is Ng (front as above):
+ * 1 and *s filled (the pdf light_mesh_sample would give with v) if that
+ * side emits, else 0. */
+int light_mesh_finish(const Light *l, const LightMeshView *v, uint32_t tri, Vec3 wi, float t,
+                      Vec3 Ng, LightSample *s);
 
 /* The environment light's radiance along world direction d (unit). */
 Vec3 light_env_radiance(const Light *l, Vec3 d);
