@@ -546,6 +546,17 @@ typedef enum RayesQuadric {
 RAYES_API RayesError rayes_scene_quadric(RayesScene *scene, RayesQuadric type,
                                          const float *params, size_t n_params, unsigned flags);
 
+/* An emitting quadric (an area light): the quadric as rayes_scene_quadric
+ * makes it, emitting radiance L from its front (the side its normal
+ * points to, as above) or from both sides if two_sided. It is made a mesh
+ * light (rayes_scene_area_light_mesh) of its surface cut in steps of
+ * about 5.6 degrees around z and along curved profiles, which camera rays
+ * see. */
+RAYES_API RayesError rayes_scene_area_light_quadric(RayesScene *scene, RayesQuadric type,
+                                                    const float *params, size_t n_params,
+                                                    unsigned flags, const float L[3],
+                                                    int two_sided);
+
 /* A volume (memo 6.1): the box bound = xmin, xmax, ymin, ymax, zmin, zmax
  * of object space (RenderMan's Volume "box"), filled by a medium that the
  * current shader describes: its opacity method returns the extinction

@@ -393,14 +393,20 @@ static int shape_bilinearmesh(Parser *P, const Token *t, ParamList *pl)
         return r;
     }
     int flip = P->gs.reverse != swaps_handedness(P->gs.ctm);
+    int emits = P->gs.area.on && !P->recording;
+    float *N = emits && np ? points_of(P, t, np) : NULL; /* the quads face as N */
+    if (emits && np && !N) {
+        free(pts);
+        return -1;
+    }
     for (size_t f = 0; f < n_idx / 4; f++) {
         int v[4];
         for (int k = 0; k < 4; k++)
             v[k] = ip ? (int)ip->num[4 * f + k] : k;
         int r;
-        if (P->gs.area.on && !P->recording) {
+        if (emits) {
             int q[4] = {v[0], v[1], v[3], v[2]}; /* around the patch */
-            r = emit_area_quad(P, t, pts, NULL, q);
+            r = emit_area_quad(P, t, pts, N, q);
         } else {
             Op patch = {.patch_pv = (np ? 1 : 0) | (uvp ? 2 : 0)};
             static const int order[2][4] = {{0, 1, 2, 3}, {1, 0, 3, 2}};
@@ -416,10 +422,12 @@ static int shape_bilinearmesh(Parser *P, const Token *t, ParamList *pl)
         }
         if (r != 0) {
             free(pts);
+            free(N);
             return -1;
         }
     }
     free(pts);
+    free(N);
     return 0;
 }
 
@@ -482,9 +490,6 @@ static int shape_quadric(Parser *P, const Token *t, const char *type, ParamList 
         q = RAYES_QUADRIC_SPHERE;
         qp[0] = (float)radius, qp[1] = (float)zmin, qp[2] = (float)zmax, qp[3] = (float)phimax;
         n = 4;
-        if (P->gs.area.on && (zmin > -radius || zmax < radius || phimax < 360))
-            pbrt_warn_at(P, t->line, t->col, "partial sphere light", "sphere: a partial emitting "
-                         "sphere emits as a whole sphere");
     } else if (strcmp(type, "cylinder") == 0) {
         double zmin = pbrt_get_float(pl, "zmin", -1), zmax = pbrt_get_float(pl, "zmax", 1);
         if (!(zmin != zmax))
@@ -495,7 +500,7 @@ static int shape_quadric(Parser *P, const Token *t, const char *type, ParamList 
     } else {
         height = pbrt_get_float(pl, "height", 0.0);
         double inner = pbrt_get_float(pl, "innerradius", 0.0);
-        if (inner > 0 && inner < radius && !P->gs.area.on) {
+        if (inner > 0 && inner < radius) {
             /* an annulus: RenderMan's hyperboloid of the line from the rim
              * in to the inner radius, parameterised (and facing) as the
              * disk is */
@@ -507,29 +512,43 @@ static int shape_quadric(Parser *P, const Token *t, const char *type, ParamList 
         } else {
             if (inner > 0)
                 pbrt_warn_at(P, t->line, t->col, "disk innerradius",
-                             "disk: \"innerradius\" %s; the disk is whole",
-                             inner >= radius ? "is not below the radius" : "on an emitter");
+                             "disk: \"innerradius\" is not below the radius; the disk is whole");
             q = RAYES_QUADRIC_DISK;
             qp[0] = (float)height, qp[1] = (float)radius, qp[2] = (float)phimax;
             n = 3;
         }
     }
-    if (!P->gs.area.on || P->recording || q == RAYES_QUADRIC_CYLINDER) {
+    int whole = phimax >= 360 &&
+                (q == RAYES_QUADRIC_DISK || (q == RAYES_QUADRIC_SPHERE && qp[1] <= -qp[0] &&
+                                             qp[2] >= qp[0] && !P->gs.reverse));
+    if (!P->gs.area.on || P->recording || (!whole && !P->sink->area_light_quadric)) {
         if (P->gs.area.on)
             pbrt_warn_at(P, t->line, t->col,
-                         P->recording ? "instanced area light" : "cylinder light",
+                         P->recording ? "instanced area light" : "quadric light",
                          "%s: this emitter is not supported (%s); the shape does not emit", type,
-                         P->recording ? "inside ObjectBegin"
-                                      : "rayes' area lights are quads, disks and spheres");
+                         P->recording ? "inside ObjectBegin" : "the scene takes no quadric lights");
         return pbrt_emit_quadric(P, t, q, qp, n, flags);
     }
     pbrt_grow_quadric(P, q, qp); /* emitters count in the world's bound too */
-    if (q == RAYES_QUADRIC_SPHERE) {
-        if (P->gs.reverse)
-            pbrt_warn_at(P, t->line, t->col, "inward sphere light", "sphere: an inward-emitting "
-                         "sphere (ReverseOrientation) emits outward in rayes");
-        return quadric_light(P, t, "sphere", (float)radius, P->gs.ctm);
+    if (!whole) {
+        /* a cylinder, a partial sphere or disk, an annulus, an inward
+         * sphere: a mesh light of the quadric, facing as pbrt's normal does
+         * (a normal transformed stays on its side whatever the handedness,
+         * where rayes's front follows the transformed surface) */
+        float m[16];
+        if (!pbrt_mat_finite(P->gs.ctm))
+            return FAIL_TOK(P, t, "the current transform is not finite");
+        pbrt_mat_to_float(P->gs.ctm, m);
+        if (swaps_handedness(P->gs.ctm))
+            flags ^= RAYES_QUADRIC_REVERSE;
+        RayesError e = P->sink->set_transform(P->sink->target, m);
+        if (e == RAYES_OK)
+            e = P->sink->area_light_quadric(P->sink->target, q, qp, n, flags, P->gs.area.L,
+                                            P->gs.area.twosided);
+        return e == RAYES_OK ? 0 : pbrt_sink_failed(P, t, e);
     }
+    if (q == RAYES_QUADRIC_SPHERE)
+        return quadric_light(P, t, "sphere", (float)radius, P->gs.ctm);
     double m[16], tr[16], flip[16];
     pbrt_mat_identity(tr);
     tr[11] = height;

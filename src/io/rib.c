@@ -387,7 +387,7 @@ static int motion_end(Rib *r)
     }
     SinkState *st;
     const IoSink *s = rib_out_sink(r, &st);
-    if (r->motion_kind == 2 && r->motion_n > 1 && s->motion_end &&
+    if (r->motion_kind == 2 && r->motion_n > 1 && s->motion_end && s->motion_begin && !r->a.area &&
         s->motion_end(s->target) != RAYES_OK)
         return rib_sink_failed(r, s);
     return 0;
@@ -415,11 +415,17 @@ static int motion_request(Rib *r, const char *q, const Args *a, int (*run)(Rib *
     }
     SinkState *st;
     const IoSink *s = rib_out_sink(r, &st);
-    if (!s->motion_begin || r->motion_n < 2) {
+    if (!s->motion_begin || r->motion_n < 2 || r->a.area) {
         if (k == 0)
             return 0;
-        rib_warn_once(r, "MotionBegin", "deformation blur is not supported here: the first "
-                                        "sample of each motion block is used");
+        if (r->a.area)
+            rib_warn_once(r, "MotionBegin area",
+                          "emitting geometry does not deform: the first "
+                          "sample of its motion block is used");
+        else
+            rib_warn_once(r, "MotionBegin",
+                          "deformation blur is not supported here: the first "
+                          "sample of each motion block is used");
         return 1;
     }
     if (k > 0)

@@ -369,14 +369,16 @@ static int emit_polys(Rib *r, const Polys *g, const float *P, size_t n_points, c
         }
         poly_at[p] = at, poly_nv[p] = nv;
         if (r->a.area && nl == 1 && g->loop_n[loop] == 4) {
-            float Q[4][3];
-            for (int k = 0; k < 4; k++)
-                memcpy(Q[flip ? 3 - k : k], &P[3 * v[k]], sizeof Q[0]);
             SinkState *st;
             const IoSink *s = rib_out_sink(r, &st);
             e = rib_emit_begin(r, NULL);
-            if (e == 0 && s->area_light(s->target, (const float(*)[3])Q, r->a.area_L) != RAYES_OK)
-                e = rib_sink_failed(r, s);
+            for (int side = 0; e == 0 && side < 1 + r->a.area_twosided; side++) {
+                float Q[4][3]; /* "twosided": the reversed quad too */
+                for (int k = 0; k < 4; k++)
+                    memcpy(Q[flip ^ side ? 3 - k : k], &P[3 * v[k]], sizeof Q[0]);
+                if (s->area_light(s->target, (const float(*)[3])Q, r->a.area_L) != RAYES_OK)
+                    e = rib_sink_failed(r, s);
+            }
         } else {
             if (r->a.area)
                 rib_warn_once(r, "area shape",
@@ -1090,9 +1092,18 @@ static int h_quadric(Rib *r, const Args *a)
         if (e == 0) {
             SinkState *st;
             const IoSink *s = rib_out_sink(r, &st);
-            if (s->quadric(s->target, q[k].type, v, (size_t)q[k].n,
-                           flip_of(r) ? RAYES_QUADRIC_REVERSE : 0) != RAYES_OK)
+            unsigned flags = flip_of(r) ? RAYES_QUADRIC_REVERSE : 0;
+            if (r->a.area && !s->area_light_quadric)
+                rib_warn_once(r, "area quadric",
+                              "this scene takes no emitting quadrics: they "
+                              "are surfaces");
+            if (r->a.area && s->area_light_quadric) { /* an emitter */
+                if (s->area_light_quadric(s->target, q[k].type, v, (size_t)q[k].n, flags,
+                                          r->a.area_L, r->a.area_twosided) != RAYES_OK)
+                    e = rib_sink_failed(r, s);
+            } else if (s->quadric(s->target, q[k].type, v, (size_t)q[k].n, flags) != RAYES_OK) {
                 e = rib_sink_failed(r, s);
+            }
         }
         e = e > 0 ? 0 : e;
     }

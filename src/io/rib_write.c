@@ -1239,6 +1239,20 @@ static RayesError w_area_light_mesh(void *t, size_t n_faces, const int *nv, cons
     return RAYES_OK;
 }
 
+static RayesError w_area_light_quadric(void *t, RayesQuadric type, const float *p, size_t n,
+                                       unsigned flags, const float L[3], int two_sided)
+{
+    RibWriter *w = t;
+    if (!finite_all(L, 3) || L[0] < 0 || L[1] < 0 || L[2] < 0)
+        return fail(w, RAYES_ERROR_INVALID_ARGUMENT,
+                    "area light quadric: expected a non-negative radiance");
+    FILE *f = area_light_begin(w, L);
+    fprintf(f, "%s\n", two_sided ? " \"float twosided\" [1]" : "");
+    RayesError e = w_quadric(w, type, p, n, flags);
+    fprintf(f, "AttributeEnd\n");
+    return e;
+}
+
 static RayesError w_light(void *t, const char *type, const RayesParam *p, size_t n)
 {
     RibWriter *w = t;
@@ -1447,6 +1461,7 @@ IoSink io_rib_writer_sink(RibWriter *w)
         .solid_begin = w_solid_begin,
         .solid_end = w_solid_end,
         .area_light_mesh = w_area_light_mesh,
+        .area_light_quadric = w_area_light_quadric,
     };
 }
 

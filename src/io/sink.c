@@ -139,6 +139,13 @@ static RayesError scene_area_light_mesh(void *t, size_t n_faces, const int *n_ve
     return rayes_scene_area_light_mesh(t, n_faces, n_verts, indices, n_points, P, L, two_sided);
 }
 
+static RayesError scene_area_light_quadric(void *t, RayesQuadric type, const float *params,
+                                           size_t n, unsigned flags, const float L[3],
+                                           int two_sided)
+{
+    return rayes_scene_area_light_quadric(t, type, params, n, flags, L, two_sided);
+}
+
 static RayesError scene_light(void *t, const char *type, const RayesParam *p, size_t n)
 {
     return rayes_scene_light(t, type, p, n);
@@ -267,6 +274,7 @@ IoSink io_sink_scene(RayesScene *scene)
         .solid_begin = scene_solid_begin,
         .solid_end = scene_solid_end,
         .area_light_mesh = scene_area_light_mesh,
+        .area_light_quadric = scene_area_light_quadric,
     };
 }
 

@@ -122,6 +122,11 @@ typedef struct IoSink {
     RayesError (*area_light_mesh)(void *target, size_t n_faces, const int *n_verts,
                                   const int *indices, size_t n_points, const float *P,
                                   const float L[3], int two_sided);
+    /* rayes_scene_area_light_quadric (last: readers draw emitting
+     * quadrics as ordinary surfaces, with one warning, for sinks without). */
+    RayesError (*area_light_quadric)(void *target, RayesQuadric type, const float *params,
+                                     size_t n_params, unsigned flags, const float L[3],
+                                     int two_sided);
 } IoSink;
 
 /* A sink that builds scene through rayes.h (borrowed, not retained). */

@@ -993,9 +993,10 @@ RayesError rayes_scene_area_light_mesh(RayesScene *s, size_t n_faces, const int 
     if (!scene_finite(P, 3 * n_points) || !scene_finite(L, 3) || L[0] < 0 || L[1] < 0 || L[2] < 0)
         return scene_fail(s, RAYES_ERROR_INVALID_ARGUMENT,
                           "area light mesh: expected finite points and a non-negative radiance");
-    if (s->open_master >= 0)
+    if (s->open_master >= 0 || s->deforming)
         return scene_fail(s, RAYES_ERROR_INVALID_ARGUMENT,
-                          "area light mesh: not allowed in an object block");
+                          "area light mesh: not allowed in an object block or a deformation "
+                          "(emitters do not deform)");
     size_t n_corners = 0;
     RayesError e = check_faces(s, "area light mesh", n_faces, n_verts, indices, n_points, 3,
                                INT32_MAX, "3 or more", &n_corners);
@@ -1039,6 +1040,8 @@ RayesError rayes_scene_area_light_mesh(RayesScene *s, size_t n_faces, const int 
     s->current_motion = 0;
     e = push_light(s, &l, prims, n_tris);
     s->current_motion = motion;
+    if (e == RAYES_OK) /* it shadows: its near faces hide its far ones, as other lights */
+        s->objects[s->n_objects - 1].ray_mask |= s->current_visibility & RAYES_RAY_SHADOW;
     free(v);
     free(prims);
     if (e != RAYES_OK)
@@ -1707,6 +1710,7 @@ RayesError rayes_scene_edit_light(RayesScene *s, size_t index, const RayesParam 
         for (int c = 0; c < l->mesh->n_clusters; c++) {
             l->mesh->cluster[c].lo = v3_add(l->mesh->cluster[c].lo, d);
             l->mesh->cluster[c].hi = v3_add(l->mesh->cluster[c].hi, d);
+            l->mesh->cluster[c].centre = v3_add(l->mesh->cluster[c].centre, d);
         }
     }
     for (size_t i = 0; i < s->n_prims; i++)
@@ -1924,8 +1928,9 @@ RayesError rayes_scene_set_search_path(RayesScene *s, const char *kind, const ch
 
 /* RenderMan's quadrics: checks the parameters and stores them with angles
  * in radians (the sphere's zmin, zmax as latitudes). */
-RayesError rayes_scene_quadric(RayesScene *s, RayesQuadric type, const float *params, size_t n,
-                               unsigned flags)
+/* The primitive of a quadric (rayes.h's parameters, checked). */
+static RayesError quadric_prim(RayesScene *s, RayesQuadric type, const float *params, size_t n,
+                               unsigned flags, Prim *out)
 {
     static const struct {
         const char *name, *params;
@@ -1997,5 +2002,78 @@ RayesError rayes_scene_quadric(RayesScene *s, RayesQuadric type, const float *pa
     }
     if (bad)
         return scene_fail(s, RAYES_ERROR_INVALID_ARGUMENT, "%s: expected %s", name, bad);
+    *out = p;
+    return RAYES_OK;
+}
+
+RayesError rayes_scene_quadric(RayesScene *s, RayesQuadric type, const float *params, size_t n,
+                               unsigned flags)
+{
+    Prim p;
+    RayesError e = quadric_prim(s, type, params, n, flags, &p);
+    if (e != RAYES_OK)
+        return e;
     return add_prim(s, &p);
+}
+
+/* A quadric's steps around z (u) and along its profile (v) for a mesh
+ * light: about 64 for a full turn, 32 over a half circle of profile, one
+ * for straight profiles. */
+static void quadric_steps(const Prim *p, int *nu, int *nv)
+{
+    const float *q = p->quadric.p;
+    static const int theta_at[7] = {3, 3, 2, 2, 3, 6, 4}; /* thetamax's index by kind */
+    float turns = fabsf(q[theta_at[p->quadric.kind]]) / (2.0f * (float)M_PI);
+    *nu = (int)ceilf(64.0f * turns);
+    *nu = *nu < 8 ? 8 : *nu;
+    *nv = 1;
+    if (p->quadric.kind == RAYES_QUADRIC_SPHERE)
+        *nv = (int)ceilf(32.0f * fabsf(q[2] - q[1]) / (float)M_PI);
+    else if (p->quadric.kind == RAYES_QUADRIC_TORUS)
+        *nv = (int)ceilf(32.0f * fabsf(q[3] - q[2]) / (float)M_PI);
+    else if (p->quadric.kind == RAYES_QUADRIC_PARABOLOID)
+        *nv = 16;
+    *nv = *nv < 1 ? 1 : *nv;
+}
+
+/* The quadric tessellated (quads of (u, v) steps, wound as dPdu x dPdv
+ * faces: its front) and made a mesh light. */
+RayesError rayes_scene_area_light_quadric(RayesScene *s, RayesQuadric type, const float *params,
+                                          size_t n, unsigned flags, const float L[3], int two_sided)
+{
+    if (!s || !L)
+        return RAYES_ERROR_INVALID_ARGUMENT;
+    Prim p;
+    RayesError e = quadric_prim(s, type, params, n, flags, &p);
+    if (e != RAYES_OK)
+        return e;
+    int nu, nv;
+    quadric_steps(&p, &nu, &nv);
+    size_t n_points = (size_t)(nu + 1) * (size_t)(nv + 1), n_faces = (size_t)nu * (size_t)nv;
+    float *P = malloc(3 * n_points * sizeof *P);
+    int *nverts = malloc(n_faces * sizeof *nverts), *idx = malloc(4 * n_faces * sizeof *idx);
+    if (!P || !nverts || !idx) {
+        free(P);
+        free(nverts);
+        free(idx);
+        return scene_fail(s, RAYES_ERROR_OUT_OF_MEMORY, "out of memory");
+    }
+    for (int j = 0; j <= nv; j++)
+        for (int i = 0; i <= nu; i++) {
+            Vec3 x, du, dv;
+            geom_quadric_eval(&p, (float)i / (float)nu, (float)j / (float)nv, &x, &du, &dv);
+            v3_store(&P[3 * ((size_t)j * (size_t)(nu + 1) + (size_t)i)], x);
+        }
+    size_t k = 0;
+    for (int j = 0; j < nv; j++)
+        for (int i = 0; i < nu; i++) {
+            int a = j * (nu + 1) + i;
+            nverts[k / 4] = 4;
+            idx[k++] = a, idx[k++] = a + 1, idx[k++] = a + nu + 2, idx[k++] = a + nu + 1;
+        }
+    e = rayes_scene_area_light_mesh(s, n_faces, nverts, idx, n_points, P, L, two_sided);
+    free(P);
+    free(nverts);
+    free(idx);
+    return e;
 }

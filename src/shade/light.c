@@ -244,6 +244,13 @@ static Vec3 tri_normal(const Vec3 *p)
     return v3_cross(v3_sub(p[1], p[0]), v3_sub(p[2], p[0]));
 }
 
+/* A triangle's area (0 when not finite). */
+static float tri_area(const Vec3 *p)
+{
+    float a = 0.5f * v3_length(tri_normal(p));
+    return isfinite(a) ? a : 0.0f;
+}
+
 /* Places the k-th smallest of t[lo, hi) (by centroid coordinate key) at k,
  * smaller ones before it (Hoare's selection). */
 static void select_kth(uint32_t *t, const float *key, size_t lo, size_t hi, size_t k)
@@ -323,7 +330,6 @@ static void cluster_bound(LightMesh *m, LightCluster *c)
         for (int j = 0; j < 3; j++)
             c->lo = v3_min(c->lo, p[j]), c->hi = v3_max(c->hi, p[j]);
     }
-    c->area = m->cdf[c->end] - m->cdf[c->start]; /* the global running sums yet */
     c->centre = v3_scale(v3_add(c->lo, c->hi), 0.5f);
     Vec3 h = v3_sub(c->hi, c->centre);
     c->radius2 = v3_dot(h, h);
@@ -375,31 +381,32 @@ int light_mesh_init(Light *l, const Vec3 *v, size_t n, int two_sided)
      * spread over the surface (the selection's order scatters them). */
     for (int c = 0; c < m->n_clusters; c++)
         qsort(t + m->cluster[c].start, m->cluster[c].end - m->cluster[c].start, sizeof *t, cmp_u32);
-    double sum = 0.0;
-    for (size_t k = 0; k < n; k++) { /* the clusters' order, running area sums */
+    double sum = 0.0;              /* the whole mesh's area */
+    for (size_t k = 0; k < n; k++) /* the clusters' order */
         memcpy(&m->v[3 * k], &v[3 * (size_t)t[k]], 3 * sizeof *v);
-        m->cdf[k] = (float)sum;
-        float a = 0.5f * v3_length(tri_normal(&m->v[3 * k]));
-        sum += isfinite(a) ? a : 0.0f;
-    }
-    m->cdf[n] = (float)sum;
-    m->area = (float)sum;
     m->lo = v3(INFINITY, INFINITY, INFINITY);
     m->hi = v3_neg(m->lo);
     for (int c = 0; c < m->n_clusters; c++) {
+        /* each cluster's cdf from 0 to 1, summed in double from its start
+         * (a running sum over a large mesh loses small faces) */
         LightCluster *cl = &m->cluster[c];
+        double area = 0.0;
+        for (uint32_t k = cl->start; k < cl->end; k++)
+            area += tri_area(&m->v[3 * (size_t)k]);
+        double run = 0.0;
+        for (uint32_t k = cl->start; k < cl->end; k++) {
+            m->cdf[k] = area > 0.0 ? (float)(run / area) : 0.0f;
+            run += tri_area(&m->v[3 * (size_t)k]);
+        }
         cluster_bound(m, cl);
+        cl->area = (float)area;
+        sum += area;
         for (uint32_t k = cl->start; k < cl->end; k++)
             m->cluster_of[t[k]] = (uint8_t)c;
         m->lo = v3_min(m->lo, cl->lo), m->hi = v3_max(m->hi, cl->hi);
     }
-    for (int c = 0; c < m->n_clusters; c++) { /* each cluster's cdf from 0 to 1 */
-        LightCluster *cl = &m->cluster[c];
-        float base = m->cdf[cl->start];
-        for (uint32_t k = cl->start; k < cl->end; k++)
-            m->cdf[k] = cl->area > 0.0f ? (m->cdf[k] - base) / cl->area : 0.0f;
-    }
     m->cdf[n] = 1.0f;
+    m->area = (float)sum;
     free(t);
     free(key);
     if (!(sum > 0.0)) {

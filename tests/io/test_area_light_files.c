@@ -95,4 +95,39 @@ static void test_round_trip(void)
     free(written);
 }
 
-TEST_MAIN(TEST(test_polygons_under_area_lights), TEST(test_round_trip))
+/* Quadrics under an area light emit (mesh lights of their surfaces) and
+ * are written back as the quadric; a deforming emitter keeps its first
+ * sample, where the motion block was an error for the scene. */
+static void test_quadrics_and_motion(void)
+{
+    static const char text[] =
+        WORLD("AttributeBegin\nAreaLightSource \"arealight\" 1 \"intensity\" 3\n"
+              "Cylinder 0.1 0 1 360\nAttributeEnd\n"
+              "AttributeBegin\nAreaLightSource \"arealight\" 2\nMotionBegin [0 1]\n"
+              "Polygon \"P\" [0 0 0 1 0 0 1 1 0 0.5 1.5 0 0 1 0]\n"
+              "Polygon \"P\" [0 0 1 1 0 1 1 1 1 0.5 1.5 1 0 1 1]\nMotionEnd\nAttributeEnd");
+    char err[256];
+    RayesError e;
+    RayesScene *a = rib_read_scene(text, &e, err, sizeof err);
+    CHECK(e == RAYES_OK && a->n_lights == 2 && count_type(a, LIGHT_MESH) == 2);
+    if (a->n_lights == 2) {
+        CHECK(a->lights[0].L.x == 3.0f && a->lights[0].mesh->n >= 64);
+        CHECK(a->lights[1].mesh->lo.z == 0.0f && a->lights[1].mesh->hi.z == 0.0f);
+    }
+    char *written = rib_round_trip(text, err, sizeof err);
+    CHECK(written &&
+          strstr(written, "[3 3 3]\nCylinder 0.100000001 0 1 360\nAttributeEnd") != NULL);
+    RayesScene *b = written ? rib_read_scene(written, &e, err, sizeof err) : NULL;
+    CHECK(b && e == RAYES_OK && b->n_lights == 2);
+    if (b && a->n_lights == 2 && b->n_lights == 2) {
+        const LightMesh *m = a->lights[0].mesh, *n = b->lights[0].mesh;
+        CHECK(m->n == n->n && memcmp(m->v, n->v, 3 * m->n * sizeof *m->v) == 0);
+    }
+    rayes_scene_release(a);
+    if (b)
+        rayes_scene_release(b);
+    free(written);
+}
+
+TEST_MAIN(TEST(test_polygons_under_area_lights), TEST(test_round_trip),
+          TEST(test_quadrics_and_motion))

@@ -41,6 +41,12 @@ typedef struct Rec {
     Shader shader;
     /* geometry, with the transform and shader current then */
     int n_meshes, n_quadrics, n_patches, n_area, n_lights, n_curves, n_mesh_lights;
+    int n_quadric_lights;
+    struct {
+        RayesQuadric type;
+        unsigned flags;
+        int two_sided;
+    } quadric_light[MAX_REC];
     struct {
         size_t n_faces, n_points;
         int two_sided, first[3]; /* the first face's indices */
@@ -276,6 +282,20 @@ static RayesError r_area_mesh(void *t, size_t n_faces, const int *nv, const int 
     return RAYES_OK;
 }
 
+static RayesError r_area_quadric(void *t, RayesQuadric type, const float *p, size_t n,
+                                 unsigned flags, const float L[3], int two_sided)
+{
+    Rec *r = t;
+    (void)p, (void)n, (void)L;
+    if (r->n_quadric_lights < MAX_REC) {
+        r->quadric_light[r->n_quadric_lights].type = type;
+        r->quadric_light[r->n_quadric_lights].flags = flags;
+        r->quadric_light[r->n_quadric_lights].two_sided = two_sided;
+    }
+    r->n_quadric_lights++;
+    return RAYES_OK;
+}
+
 static RayesError r_light(void *t, const char *type, const RayesParam *p, size_t n)
 {
     Rec *r = t;
@@ -343,6 +363,7 @@ static IoSink stub(Rec *r)
                     .quadric = r_quadric,
                     .area_light = r_area,
                     .area_light_mesh = r_area_mesh,
+                    .area_light_quadric = r_area_quadric,
                     .light = r_light,
                     .get_error = r_error,
                     .pattern = r_pattern,
@@ -642,6 +663,10 @@ static void test_lights(void)
         "  Shape \"disk\" \"float radius\" 0.5\n"
         "  Shape \"bilinearmesh\" \"point3 P\" [0 0 0 1 0 0 0 1 0 1 1 0]\n"
         "  Shape \"curve\" \"point3 P\" [0 0 0 1 1 1 2 2 2 3 3 3]\n"
+        "  Shape \"cylinder\" \"float radius\" 0.1\n"
+        "  Shape \"sphere\" \"float zmin\" 0\n"
+        "  ReverseOrientation\n"
+        "  Shape \"sphere\"\n"
         "AttributeEnd\n"
         "Shape \"bilinearmesh\" \"point3 P\" [0 0 0 1 0 0 0 1 0 1 1 0]\n";
     RayesError e = parse("t.pbrt", text, r, &s, err, sizeof err);
@@ -675,6 +700,13 @@ static void test_lights(void)
     }
     CHECK(r->n_area == 1 && r->n_patches == 1); /* the emitting patch, then a plain one */
     CHECK(r->n_curves == 1);                     /* a curve under an area light does not emit */
+    /* a cylinder, a half sphere and an inward sphere: quadric lights */
+    CHECK(r->n_quadric_lights == 3);
+    if (r->n_quadric_lights == 3) {
+        CHECK(r->quadric_light[0].type == RAYES_QUADRIC_CYLINDER && !r->quadric_light[0].flags);
+        CHECK(r->quadric_light[1].type == RAYES_QUADRIC_SPHERE);
+        CHECK(r->quadric_light[2].flags == RAYES_QUADRIC_REVERSE);
+    }
     if (r->n_area == 1) {
         CHECK_NEAR(r->area[0].L[1], 6, 0);
         float(*P)[3] = r->area[0].P; /* around the patch: p00 p10 p11 p01, normal +z */

@@ -579,6 +579,60 @@ static void test_mesh_light_sphere(void)
     free(P);
 }
 
+/* Emitting quadrics (rayes_scene_area_light_quadric, made mesh lights): a
+ * disk at z = 1.5 facing up, against the disk's closed form 1.5 above it
+ * (its 64-gon has 0.16% less area), dark from its back, lit from both
+ * sides when two-sided, only from below when reversed; a two-sided closed sphere lights
+ * a point outside as a one-sided one does (its near faces hide its far
+ * faces' inner sides: mesh lights shadow). */
+static void test_quadric_lights(void)
+{
+    const float L[3] = {2, 2, 2}, disk[3] = {1.5f, 1.0f, 360.0f};
+    double want = 2.0 * PI * 1.0 / (1.5 * 1.5 + 1.0) * 0.9984;
+    for (int k = 0; k < 3; k++) { /* plain, two-sided, reversed */
+        RayesScene *s = rayes_scene_new();
+        CHECK(rayes_scene_area_light_quadric(s, RAYES_QUADRIC_DISK, disk, 3,
+                                             k == 2 ? RAYES_QUADRIC_REVERSE : 0, L,
+                                             k == 1) == RAYES_OK);
+        CHECK(s->n_lights == 1 && s->lights[0].type == LIGHT_MESH);
+        Fx f;
+        fx_init(&f, s);
+        double above = fx_irradiance_mean(&f, v3(0, 0, 3), v3(0, 0, -1), 64, 4);
+        double below = fx_irradiance_mean(&f, v3(0, 0, 0), v3(0, 0, 1), 64, 4);
+        if (k == 2) { /* facing down */
+            CHECK(above == 0.0);
+            CHECK_NEAR(below / want, 1.0, 0.01);
+        } else { /* facing up (+z), or both */
+            CHECK(k == 1 || below == 0.0);
+            CHECK_NEAR(above / want, 1.0, 0.01);
+            if (k == 1)
+                CHECK_NEAR(below / want, 1.0, 0.01);
+        }
+        fx_fini(&f);
+    }
+    const float ball[4] = {1, -1, 1, 360};
+    double E[2];
+    for (int two = 0; two < 2; two++) {
+        RayesScene *s = rayes_scene_new();
+        const float up[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 3, 0, 0, 0, 1};
+        CHECK(rayes_scene_set_transform(s, up) == RAYES_OK);
+        CHECK(rayes_scene_area_light_quadric(s, RAYES_QUADRIC_SPHERE, ball, 4, 0, L, two) ==
+              RAYES_OK);
+        Fx f;
+        fx_init(&f, s);
+        E[two] = fx_irradiance_mean(&f, v3(0, 0, 0), v3(0, 0, 1), 64, 16);
+        fx_fini(&f);
+    }
+    CHECK_NEAR(E[0] / (2 * PI / 9), 1.0, 0.015);
+    CHECK_NEAR(E[1] / E[0], 1.0, 0.02);
+    RayesScene *s = rayes_scene_new();
+    const float bad[4] = {-1, 0, 1, 360};
+    CHECK(rayes_scene_area_light_quadric(s, RAYES_QUADRIC_CYLINDER, bad, 4, 0, L, 0) ==
+          RAYES_ERROR_INVALID_ARGUMENT);
+    CHECK(s->n_lights == 0);
+    rayes_scene_release(s);
+}
+
 /* ------------------------------------------------------- environments */
 
 /* The preview preset at size x size pixels, spp samples, on threads. */
@@ -1320,7 +1374,8 @@ TEST_MAIN(TEST(test_point_light_inverse_square), TEST(test_spot_light_cone),
           TEST(test_sphere_light_irradiance), TEST(test_light_bound_keeps_every_hit),
           TEST(test_mis_glossy_small_quad), TEST(test_mis_glossy_large_quad),
           TEST(test_mesh_light_clusters_keep_every_face), TEST(test_mesh_light_irradiance),
-          TEST(test_mesh_light_sphere), TEST(test_glossy_lights_against_brute_force),
+          TEST(test_mesh_light_sphere), TEST(test_quadric_lights),
+          TEST(test_glossy_lights_against_brute_force),
           TEST(test_glossy_surroundings_against_brute_force),
           TEST(test_microfacet_against_brute_force), TEST(test_constant_environment_white_furnace),
           TEST(test_sample_clamp), TEST(test_chrome_ball_white_furnace),
