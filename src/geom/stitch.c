@@ -344,9 +344,15 @@ static double curve_at(const Curve *c, const Vec3 *P, double t, Vec3 *at, int *f
     *found = 0;
     /* Sides are sorted by lo, none longer than len: those covering t
      * start in [t - len, t]. */
-    size_t hi = c->n;
-    while (hi > 0 && c->s[hi - 1].lo > t)
-        hi--;
+    size_t lo = 0, hi = c->n; /* the first side starting past t (a binary search: a
+                                 mesh's straight rows make curves of thousands of sides) */
+    while (lo < hi) {
+        size_t mid = lo + (hi - lo) / 2;
+        if (c->s[mid].lo > t)
+            hi = mid;
+        else
+            lo = mid + 1;
+    }
     for (size_t k = hi; k-- > 0 && c->s[k].lo >= t - c->len;) {
         const Side *sd = &c->s[k];
         if (t > sd->hi)
@@ -431,6 +437,22 @@ static Side *collect_sides(const GridSet *gs, const Prim *prims, size_t *n)
     return sides;
 }
 
+/* Nonzero when a curve's sides are single segments over the same range
+ * whose ends are the same bits on every side: nothing to move (a dense
+ * mesh's edges between faces diced whole, nearly all of its curves). */
+static int settled(const Curve *c, const Vec3 *P)
+{
+    const Side *s0 = &c->s[0];
+    for (size_t k = 0; k < c->n; k++) {
+        const Side *sd = &c->s[k];
+        if (sd->n != 1 || sd->lo != s0->lo || sd->hi != s0->hi ||
+            memcmp(&P[side_vertex(sd, 0)], &P[side_vertex(s0, 0)], sizeof *P) != 0 ||
+            memcmp(&P[side_vertex(sd, 1)], &P[side_vertex(s0, 1)], sizeof *P) != 0)
+            return 0;
+    }
+    return 1;
+}
+
 int geom_stitch(GridSet *gs, const Prim *prims)
 {
     size_t n;
@@ -445,7 +467,7 @@ int geom_stitch(GridSet *gs, const Prim *prims)
             for (b = a; b < n && !memcmp(sides[b].key, sides[a].key, sizeof sides[a].key); b++)
                 c.len = fmax(c.len, sides[b].hi - sides[b].lo);
             c.n = b - a;
-            if (c.n < 2)
+            if (c.n < 2 || settled(&c, gs->P))
                 continue;
             long m = stitch_curve(&c, gs->P);
             if (m < 0) {
