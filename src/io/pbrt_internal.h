@@ -112,7 +112,9 @@ typedef struct Material {
 
 typedef struct AreaLight {
     int on;
-    float L[3]; /* radiance, scale included */
+    float L[3];      /* radiance, scale included: the current shape's (pbrt_area_power) */
+    float L_base[3]; /* L and scale as given */
+    double power;    /* "power" (watts per pbrt shape), or 0 */
     int twosided;
 } AreaLight;
 
@@ -397,6 +399,12 @@ int pbrt_d_namedmaterial(Parser *P, const Token *t);
 int pbrt_d_texture(Parser *P, const Token *t);
 int pbrt_d_shape(Parser *P, const Token *t); /* pbrt_shape.c */
 int pbrt_d_arealight(Parser *P, const Token *t); /* pbrt_light.c */
+/* An area light's radiance for the next shape, of n_prims pbrt shapes
+ * (triangles, bilinear patches, one quadric) over `area` square units of
+ * the world: with "power", each pbrt shape emits that power, as pbrt-v4
+ * makes a light of each (L_base power n_prims / (pi area sides)); else
+ * L_base. Sets P->gs.area.L. */
+void pbrt_area_power(Parser *P, size_t n_prims, double area);
 int pbrt_d_light(Parser *P, const Token *t);
 int pbrt_d_makenamedmedium(Parser *P, const Token *t); /* pbrt_medium.c */
 int pbrt_d_mediuminterface(Parser *P, const Token *t);

@@ -13,13 +13,6 @@
 
 #include "io/pbrt_internal.h"
 
-/* ------------------------------------------------------------ colours */
-
-static float luminance(const float c[3])
-{
-    return 0.2126f * c[0] + 0.7152f * c[1] + 0.0722f * c[2];
-}
-
 /* ------------------------------------------------------------ directives */
 
 int pbrt_d_arealight(Parser *P, const Token *t)
@@ -52,16 +45,23 @@ int pbrt_d_arealight(Parser *P, const Token *t)
     if (pbrt_find(&pl, "filename"))
         pbrt_warn_at(P, t->line, t->col, "area filename", "AreaLightSource: image emission "
                      "(\"filename\") is not supported; using L");
-    if (pbrt_find(&pl, "power"))
-        pbrt_warn_at(P, t->line, t->col, "area power",
-                     "AreaLightSource: \"power\" is not supported (it needs the shape's area); "
-                     "using L and scale");
+    double power = pbrt_get_float(&pl, "power", 0.0);
+    P->gs.area.power = power > 0 && isfinite(power) ? power : 0.0;
     for (int c = 0; c < 3; c++)
-        P->gs.area.L[c] = (float)(L[c] * scale);
+        P->gs.area.L[c] = P->gs.area.L_base[c] = (float)(L[c] * scale);
     P->gs.area.on = 1;
     pbrt_warn_unused(P, &pl, "AreaLightSource", type);
     pbrt_params_free(&pl);
     return 0;
+}
+
+void pbrt_area_power(Parser *P, size_t n_prims, double area)
+{
+    double k = 1.0;
+    if (P->gs.area.power > 0 && area > 0 && isfinite(area))
+        k = P->gs.area.power * (double)n_prims / (PI * area * (P->gs.area.twosided ? 2 : 1));
+    for (int c = 0; c < 3; c++)
+        P->gs.area.L[c] = (float)(P->gs.area.L_base[c] * k);
 }
 
 int pbrt_d_light(Parser *P, const Token *t)
@@ -109,8 +109,8 @@ int pbrt_d_light(Parser *P, const Token *t)
             double c0 = cos(cone * PI / 180), c1 = cos((cone - delta) * PI / 180);
             k_e = 2 * PI * ((1 - c1) + (c1 - c0) / 2);
         }
-        if (power > 0 && luminance(col) > 0)
-            scale *= power / (k_e * luminance(col));
+        if (power > 0) /* as pbrt-v4: an rgb colour's own luminance stays in it */
+            scale *= power / k_e;
         rtype = type[0] == 's' ? "spotlight" : "pointlight";
     } else if (strcmp(type, "distant") == 0) {
         if (pbrt_get_color(P, &pl, "L", one, col, NULL) < 0)
@@ -123,8 +123,8 @@ int pbrt_d_light(Parser *P, const Token *t)
         lp[n++] = (RayesParam){.name = "to", .type = RAYES_PARAM_COLOR,
                                .value = {(float)to[0], (float)to[1], (float)to[2]}};
         double E = pbrt_get_float(&pl, "illuminance", 0.0);
-        if (E > 0 && luminance(col) > 0)
-            scale *= E / luminance(col);
+        if (E > 0)
+            scale *= E;
         rtype = "distantlight";
     } else if (strcmp(type, "infinite") == 0) {
         if (pbrt_get_color(P, &pl, "L", one, col, NULL) < 0)

@@ -38,6 +38,32 @@ static void quad_normal(const float *pts, const int *f, double out[3])
     pbrt_cross3d(c, d, out);
 }
 
+/* The world area of faces (fanned) of object-space points pts under the
+ * current transform: what an area light's "power" spreads over. */
+static double world_area(const Parser *P, size_t n_faces, const int *n_verts, const int *idx,
+                         const float *pts)
+{
+    const double *m = P->gs.ctm;
+    double sum = 0;
+    const int *f = idx;
+    for (size_t i = 0; i < n_faces; f += n_verts[i], i++) {
+        double w[64][3];
+        int n = n_verts[i] < 64 ? n_verts[i] : 64;
+        for (int k = 0; k < n; k++)
+            for (int r = 0; r < 3; r++)
+                w[k][r] = m[4 * r] * pts[3 * f[k]] + m[4 * r + 1] * pts[3 * f[k] + 1] +
+                          m[4 * r + 2] * pts[3 * f[k] + 2] + m[4 * r + 3];
+        for (int k = 1; k + 1 < n; k++) {
+            double u[3], v[3], c[3];
+            for (int r = 0; r < 3; r++)
+                u[r] = w[k][r] - w[0][r], v[r] = w[k + 1][r] - w[0][r];
+            pbrt_cross3d(u, v, c);
+            sum += 0.5 * sqrt(pbrt_dot3d(c, c));
+        }
+    }
+    return sum;
+}
+
 /* Emits one emitting quad q (indices into pts; N per vertex or NULL). */
 static int emit_area_quad(Parser *P, const Token *t, const float *pts, const float *N,
                           const int q[4])
@@ -172,6 +198,7 @@ static int shape_mesh(Parser *P, const Token *t, const char *what, size_t n_face
                      "is not emitting",
                      what);
     } else if (P->gs.area.on) {
+        pbrt_area_power(P, n_faces, world_area(P, n_faces, n_verts, idx, pts));
         int q[AREA_QUADS][4];
         size_t n_quads = 0, i = 0;
         const int *f = idx;
@@ -369,6 +396,16 @@ static int shape_bilinearmesh(Parser *P, const Token *t, ParamList *pl)
     float *pts = points_of(P, t, pp);
     if (!pts)
         return -1;
+    if (P->gs.area.on && !P->recording) { /* "power": per patch, over their area */
+        double area = 0;
+        for (size_t f = 0; f < n_idx / 4; f++) {
+            int v[4], nv = 4;
+            for (int k = 0; k < 4; k++) /* around the patch: p00 p10 p11 p01 */
+                v[k] = ip ? (int)ip->num[4 * f + (size_t)(k < 2 ? k : 5 - k)] : (k < 2 ? k : 5 - k);
+            area += world_area(P, 1, &nv, v, pts);
+        }
+        pbrt_area_power(P, n_idx / 4, area);
+    }
     if (P->gs.area.on && !P->recording && n_idx / 4 > AREA_QUADS && P->sink->area_light_mesh) {
         /* many emitting patches: one mesh light of their corners, around */
         size_t n_faces = n_idx / 4;
@@ -530,6 +567,14 @@ static int shape_quadric(Parser *P, const Token *t, const char *type, ParamList 
         return pbrt_emit_quadric(P, t, q, qp, n, flags);
     }
     pbrt_grow_quadric(P, q, qp); /* emitters count in the world's bound too */
+    double sweep = phimax / 360.0, area; /* object space, then scaled as the transform does */
+    if (q == RAYES_QUADRIC_SPHERE || q == RAYES_QUADRIC_CYLINDER)
+        area = 2 * PI * radius * fabs((double)qp[2] - qp[1]) * sweep;
+    else if (q == RAYES_QUADRIC_HYPERBOLOID) /* the annulus */
+        area = PI * (radius * radius - (double)qp[3] * qp[3]) * sweep;
+    else
+        area = PI * radius * radius * sweep;
+    pbrt_area_power(P, 1, area * pow(fabs(pbrt_mat_det3(P->gs.ctm)), 2.0 / 3.0));
     if (!whole) {
         /* a cylinder, a partial sphere or disk, an annulus, an inward
          * sphere: a mesh light of the quadric, facing as pbrt's normal does

@@ -15,6 +15,8 @@
 #include "rayes/rayes.h"
 #include "test.h"
 
+static const double PI_D = 3.14159265358979323846;
+
 #ifndef RAYES_TEST_DATA
 #error "RAYES_TEST_DATA must name the shared data directory"
 #endif
@@ -1292,6 +1294,41 @@ static void test_triangle_light(void)
     free(r);
 }
 
+/* "power" on area lights (pbrt-v4: each triangle, patch or quadric emits
+ * it): a square of two triangles, a lone triangle, a two-sided one, a
+ * sphere scaled twice; on point lights 4 pi watts of an rgb colour keep
+ * the colour's own luminance, as pbrt's do. */
+static void test_light_power(void)
+{
+    Rec *r = malloc(sizeof *r);
+    IoSettings s;
+    char err[256];
+    CHECK(parse("t.pbrt",
+                "WorldBegin\nAreaLightSource \"diffuse\" \"rgb L\" [1 2 1] \"float power\" 100\n"
+                "Shape \"trianglemesh\" \"point3 P\" [0 0 0 2 0 0 2 2 0 0 2 0] "
+                "\"integer indices\" [0 1 2 0 2 3]\n"
+                "Shape \"trianglemesh\" \"point3 P\" [0 0 0 2 0 0 0 2 0]\n"
+                "AreaLightSource \"diffuse\" \"float power\" 100 \"bool twosided\" true\n"
+                "Shape \"trianglemesh\" \"point3 P\" [0 0 0 2 0 0 0 2 0]\n"
+                "AreaLightSource \"diffuse\" \"float power\" 100\n"
+                "Scale 2 2 2\nShape \"sphere\"\n"
+                "LightSource \"point\" \"rgb I\" [2 2 2] \"float power\" 12.566371\n",
+                r, &s, err, sizeof err) == RAYES_OK);
+    const double tri = 100 / (PI_D * 2); /* each triangle of area 2 emits 100 */
+    CHECK(r->n_area == 1 && r->n_mesh_lights == 2 && r->n_lights == 2);
+    if (r->n_area == 1 && r->n_mesh_lights == 2 && r->n_lights == 2) {
+        CHECK_NEAR(r->area[0].L[0], tri, 1e-4);
+        CHECK_NEAR(r->area[0].L[1], 2 * tri, 1e-4);
+        CHECK_NEAR(r->mesh_light[0].L[0], tri, 1e-4);
+        CHECK_NEAR(r->mesh_light[1].L[0], tri / 2, 1e-4); /* two-sided: half each side */
+        const RayesParam *c = param(&r->light[0].params, "lightcolor");
+        CHECK(c && fabs(c->value[0] - 100 / (PI_D * 16 * PI_D)) < 1e-4); /* area 16 pi */
+        const RayesParam *in = param(&r->light[1].params, "intensity");
+        CHECK(in && fabs(in->value[0] - 1) < 1e-5);
+    }
+    free(r);
+}
+
 /* A disk with an inner radius: an annulus, RenderMan's hyperboloid of the
  * line from the rim in (facing as the disk); without, a disk. */
 static void test_annulus(void)
@@ -1541,8 +1578,8 @@ static void test_exposure(void)
 TEST_MAIN(TEST(test_filters), TEST(test_exposure), TEST(test_subsurface_material),
           TEST(test_filter_warnings), TEST(test_import), TEST(test_film_types),
           TEST(test_measured_material), TEST(test_thin_dielectric), TEST(test_annulus),
-          TEST(test_triangle_light), TEST(test_normal_map), TEST(test_anisotropic_roughness),
-          TEST(test_maxdepth), TEST(test_spectrum_files), TEST(test_cornell_box),
-          TEST(test_transforms), TEST(test_materials), TEST(test_lights),
+          TEST(test_triangle_light), TEST(test_light_power), TEST(test_normal_map),
+          TEST(test_anisotropic_roughness), TEST(test_maxdepth), TEST(test_spectrum_files),
+          TEST(test_cornell_box), TEST(test_transforms), TEST(test_materials), TEST(test_lights),
           TEST(test_instances_include_ply), TEST(test_errors), TEST(test_normals_and_uv),
           TEST(test_textures), TEST(test_coated_conductor_textures))
