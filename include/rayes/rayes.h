@@ -596,7 +596,13 @@ RAYES_API RayesError rayes_scene_area_light_mesh(RayesScene *scene, size_t n_fac
  * comma-separated list the direct-lighting service's category argument
  * selects on). Types, RenderMan's semantics (angles in degrees):
  *   "pointlight"       "from" (default 0 0 0): irradiance intensity / d^2
- *                      at normal incidence
+ *                      at normal incidence, times the map "mapname" (if
+ *                      given) in the direction from the light, in the
+ *                      current rotation: "mapping" "latlong" or
+ *                      "octahedral" as an environment's, or "projection"
+ *                      (the image projected along +z over "fov", 90,
+ *                      degrees on its shorter side; black elsewhere);
+ *                      spotlights take a map too
  *   "spotlight"        "from" (0 0 0), "to" (0 0 1), "coneangle" (30),
  *                      "conedeltaangle" (5), "beamdistribution" (2): a
  *                      point light times smoothstep(cos(cone), cos(cone -

@@ -143,6 +143,51 @@ int pbrt_d_light(Parser *P, const Token *t)
                          "\"illuminance\" is not supported; using scale");
         pbrt_find(&pl, "portal");
         rtype = "environmentlight";
+    } else if (strcmp(type, "goniometric") == 0 || strcmp(type, "projection") == 0) {
+        /* a point light at the light space's origin, its intensity by
+         * direction from an image: goniometric, an equal-area octahedral
+         * square about the light's y axis (pbrt swaps y and z) times I;
+         * projection, an image projected along +z over fov degrees */
+        int gonio = type[0] == 'g';
+        if (gonio && pbrt_get_color(P, &pl, "I", one, col, NULL) < 0)
+            r = -1;
+        if (!gonio)
+            col[0] = col[1] = col[2] = 1;
+        const char *file = pbrt_get_string(&pl, "filename", NULL);
+        if (!file && !r)
+            r = FAIL_TOK(P, t, "LightSource \"%s\": expected \"string filename\"", type);
+        if (!r)
+            r = pbrt_resolve(P, t, file, map_path, sizeof map_path);
+        lp[n++] = (RayesParam){.name = "mapname", .type = RAYES_PARAM_STRING, .string = map_path};
+        lp[n++] = (RayesParam){.name = "mapping",
+                               .type = RAYES_PARAM_STRING,
+                               .string = gonio ? "octahedral" : "projection"};
+        if (!gonio)
+            lp[n++] = (RayesParam){.name = "fov",
+                                   .type = RAYES_PARAM_FLOAT,
+                                   .value = {(float)pbrt_get_float(&pl, "fov", 90.0)}};
+        if (pbrt_find(&pl, "power"))
+            pbrt_warn_at(P, t->line, t->col, "map light power",
+                         "LightSource \"%s\": \"power\" "
+                         "is not supported (it needs the image's mean); using scale",
+                         type);
+        if (!r) {
+            lp[n++] = (RayesParam){
+                .name = "intensity", .type = RAYES_PARAM_FLOAT, .value = {(float)scale}};
+            lp[n++] = (RayesParam){
+                .name = "lightcolor", .type = RAYES_PARAM_COLOR, .value = {col[0], col[1], col[2]}};
+            pbrt_warn_unused(P, &pl, "LightSource", type);
+            double m[16], swap[16];
+            pbrt_mat_identity(swap);
+            if (gonio) { /* pbrt's goniometric images have +y up: y and z swapped */
+                swap[5] = swap[10] = 0;
+                swap[6] = swap[9] = 1;
+            }
+            pbrt_mat_mul(P->gs.ctm, swap, m);
+            r = pbrt_emit_light(P, t, m, "pointlight", lp, n);
+        }
+        pbrt_params_free(&pl);
+        return r;
     } else {
         char key[96];
         snprintf(key, sizeof key, "light %.60s", type);

@@ -582,11 +582,28 @@ static int h_light_source(Rib *r, const Args *a)
     }
     L->index = -1;
     set_light_on(&r->a, (size_t)(L - r->lights), 1);
-    static const char *const names[] = {"intensity", "lightcolor", "from", "to", "coneangle",
-                                        "conedeltaangle", "beamdistribution", "__category", NULL};
+    static const char *const names[] = {
+        "intensity",      "lightcolor",       "from",       "to",  "coneangle",
+        "conedeltaangle", "beamdistribution", "__category", "fov", NULL};
     int env = strcmp(type, "environmentlight") == 0;
+    int mapped = strcmp(type, "pointlight") == 0 || strcmp(type, "spotlight") == 0;
     for (size_t k = 0; k < n && L->n < RIB_LIGHT_PARAMS; k++) {
         const Param *q = &p[k];
+        if (mapped && (strcmp(q->d.name, "mapname") == 0 || strcmp(q->d.name, "mapping") == 0) &&
+            environment_map(L, q, &L->params[L->n], L->names[L->n], sizeof L->names[0])) {
+            /* rayes' own: a point or spot light's intensity by direction */
+            if (L->mapname[0] && strcmp(L->names[L->n], "mapname") == 0 &&
+                !texture_found(r, L->mapname)) {
+                rib_warn_once(r, "point light map",
+                              "light \"%s\": map \"%.200s\" is not found as given nor on the "
+                              "texture search path; the light is even",
+                              name, L->mapname);
+                L->mapname[0] = '\0';
+                continue;
+            }
+            L->n++;
+            continue;
+        }
         if (env && environment_map(L, q, &L->params[L->n], L->names[L->n], sizeof L->names[0])) {
             /* a production light's map that is not there (a renderer's own
              * format elsewhere): the constant environment, as before */

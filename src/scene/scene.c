@@ -1344,7 +1344,7 @@ int scene_prepare(const RayesScene *s, int width, int height, const DiceOptions 
 typedef struct LightParams {
     float intensity, color[3], from[3], to[3];
     float coneangle, conedeltaangle, beamdistribution;
-    float radius, width, height;
+    float radius, width, height, fov;
     const char *mapname, *mapping, *shape, *category;
 } LightParams;
 
@@ -1367,6 +1367,7 @@ static const LightParamDesc light_param_descs[] = {
     {"height", RAYES_PARAM_FLOAT, offsetof(LightParams, height)},
     {"mapname", RAYES_PARAM_STRING, offsetof(LightParams, mapname)},
     {"mapping", RAYES_PARAM_STRING, offsetof(LightParams, mapping)},
+    {"fov", RAYES_PARAM_FLOAT, offsetof(LightParams, fov)},
     {"shape", RAYES_PARAM_STRING, offsetof(LightParams, shape)},
     {"__category", RAYES_PARAM_STRING, offsetof(LightParams, category)},
 };
@@ -1383,6 +1384,7 @@ static RayesError light_params(RayesScene *s, const char *type, const RayesParam
                         .radius = 1,
                         .width = 1,
                         .height = 1,
+                        .fov = 90,
                         .mapname = "",
                         .mapping = "latlong",
                         .shape = "quad",
@@ -1479,6 +1481,37 @@ static RayesError push_light(RayesScene *s, const Light *l, const Prim *prims, s
 
 #define DISK_FAN 64 /* triangles of the polygon a disk light shows the camera */
 
+/* A light's map (an environment's radiance, or a point or spot light's
+ * intensity by direction) in the rotation of m: lp's mapname read with its
+ * mapping; a projection's field of view. */
+static RayesError light_map(RayesScene *s, const char *type, const LightParams *lp, const Mat4 *m,
+                            Light *l)
+{
+    Mat4 rot = *m;
+    rot.m[0][3] = rot.m[1][3] = rot.m[2][3] = 0.0f;
+    l->world_from_light = rot;
+    mat4_invert(rot, &l->light_from_world);
+    int octahedral = strcmp(lp->mapping, "octahedral") == 0;
+    int projection = strcmp(lp->mapping, "projection") == 0 && l->type != LIGHT_ENVIRONMENT;
+    if (!octahedral && !projection && strcmp(lp->mapping, "latlong") != 0)
+        return scene_fail(s, RAYES_ERROR_INVALID_ARGUMENT,
+                          "%s: unknown mapping \"%s\"; expected latlong or octahedral%s", type,
+                          lp->mapping, l->type != LIGHT_ENVIRONMENT ? " or projection" : "");
+    if (projection && !(lp->fov > 0.0f && lp->fov < 180.0f))
+        return scene_fail(s, RAYES_ERROR_INVALID_ARGUMENT,
+                          "%s: expected a projection's fov in (0, 180) degrees", type);
+    l->map_projection = projection;
+    l->map_tan = projection ? tanf(lp->fov * (float)(M_PI / 360.0)) : 0.0f;
+    if (!lp->mapname[0])
+        return RAYES_OK;
+    char err[400], path[1024];
+    if (scene_find_texture(s, lp->mapname, path, sizeof path) != 0)
+        return scene_fail(s, RAYES_ERROR_INVALID_ARGUMENT, "%s: map name too long", type);
+    if (light_env_load(l, path, octahedral, err, sizeof err) != 0)
+        return scene_fail(s, RAYES_ERROR_IO, "%s", err);
+    return RAYES_OK;
+}
+
 RayesError rayes_scene_light(RayesScene *s, const char *type, const RayesParam *params,
                              size_t n_params)
 {
@@ -1511,10 +1544,18 @@ RayesError rayes_scene_light(RayesScene *s, const char *type, const RayesParam *
     const Mat4 *m = &s->world_from_object;
     l.from = mat4_point(m, v3_load(lp.from));
     Vec3 to = mat4_point(m, v3_load(lp.to));
+    if (t < 2 && lp.mapname[0]) { /* a point or spot light's intensity by direction */
+        e = light_map(s, type, &lp, m, &l);
+        if (e != RAYES_OK)
+            return e;
+    }
     switch (t) {
     case 0:
         l.type = LIGHT_POINT;
-        return push_light(s, &l, NULL, 0);
+        e = push_light(s, &l, NULL, 0);
+        if (e != RAYES_OK)
+            light_fini(&l);
+        return e;
     case 1:
     case 2:
         l.type = t == 1 ? LIGHT_SPOT : LIGHT_DISTANT;
@@ -1534,31 +1575,18 @@ RayesError rayes_scene_light(RayesScene *s, const char *type, const RayesParam *
             l.cos_inner = cosf(fmaxf(lp.coneangle - lp.conedeltaangle, 0.0f) * rad);
             l.beam = lp.beamdistribution;
         }
-        return push_light(s, &l, NULL, 0);
+        e = push_light(s, &l, NULL, 0);
+        if (e != RAYES_OK)
+            light_fini(&l);
+        return e;
     case 3:
         l.type = LIGHT_AMBIENT;
         return push_light(s, &l, NULL, 0);
     case 4: {
         l.type = LIGHT_ENVIRONMENT;
-        Mat4 rot = *m;
-        rot.m[0][3] = rot.m[1][3] = rot.m[2][3] = 0.0f;
-        l.world_from_light = rot;
-        mat4_invert(rot, &l.light_from_world);
-        int octahedral = strcmp(lp.mapping, "octahedral") == 0;
-        if (!octahedral && strcmp(lp.mapping, "latlong") != 0)
-            return scene_fail(
-                s, RAYES_ERROR_INVALID_ARGUMENT,
-                "environmentlight: unknown mapping \"%s\"; expected latlong or octahedral",
-                lp.mapping);
-        if (lp.mapname[0]) {
-            char err[400], path[1024];
-            if (scene_find_texture(s, lp.mapname, path, sizeof path) != 0)
-                return scene_fail(s, RAYES_ERROR_INVALID_ARGUMENT,
-                                  "environmentlight: map name too long");
-            if (light_env_load(&l, path, octahedral, err, sizeof err) != 0)
-                return scene_fail(s, RAYES_ERROR_IO, "%s", err);
-        }
-        e = push_light(s, &l, NULL, 0);
+        e = light_map(s, type, &lp, m, &l);
+        if (e == RAYES_OK)
+            e = push_light(s, &l, NULL, 0);
         if (e != RAYES_OK)
             light_fini(&l);
         return e;

@@ -174,6 +174,30 @@ Vec3 light_env_radiance(const Light *l, Vec3 d)
     return env_texel(l, u, v);
 }
 
+/* A point or spot light's intensity toward world direction d (unit, from
+ * the light) by its map: the latitude-longitude map's texel, or through a
+ * projection along the light's +z of tan(fov / 2) = map_tan on the
+ * shorter side of the image (its first row at light-space +y's end), black
+ * outside it and behind. */
+static Vec3 point_map(const Light *l, Vec3 d)
+{
+    if (!l->map_projection)
+        return light_env_radiance(l, d);
+    const LightEnvMap *m = l->env;
+    Vec3 ld = mat4_vector(&l->light_from_world, d);
+    if (!(ld.z > 1e-3f * v3_length(ld)))
+        return v3(0, 0, 0);
+    float x = ld.x / (ld.z * l->map_tan), y = ld.y / (ld.z * l->map_tan);
+    float aspect = (float)m->width / (float)m->height;
+    float xr = aspect > 1.0f ? aspect : 1.0f, yr = aspect > 1.0f ? 1.0f : 1.0f / aspect;
+    float u = 0.5f * (x / xr + 1.0f), v = 0.5f * (1.0f - y / yr);
+    if (!(u >= 0.0f && u < 1.0f && v >= 0.0f && v < 1.0f))
+        return v3(0, 0, 0);
+    int px, py;
+    const float *c = &m->rgb[3 * (size_t)env_pixel(m, u, v, &px, &py)];
+    return v3_mul(l->L, v3(c[0], c[1], c[2]));
+}
+
 /* Index i with cdf[i] <= x < cdf[i + 1] among n intervals, skipping empty
  * ones: the largest i < n with cdf[i] <= x, the binary search's answer
  * exactly, found from the guide table's start for x (guide: n entries). */
@@ -758,8 +782,9 @@ int light_sample(const Light *l, Vec3 o, float a, float b, LightSample *s)
             float c = -v3_dot(s->wi, l->dir);
             k *= light_smoothstep(l->cos_outer, l->cos_inner, c) * powf(fmaxf(c, 0.0f), l->beam);
         }
-        s->Li = v3_scale(l->L, k);
-        return k > 0.0f;
+        Vec3 I = l->env ? point_map(l, v3_neg(s->wi)) : l->L;
+        s->Li = v3_scale(I, k);
+        return k > 0.0f && v3_max_component(s->Li) > 0.0f;
     }
     case LIGHT_DISTANT:
         s->wi = v3_neg(l->dir);

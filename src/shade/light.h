@@ -117,7 +117,12 @@ typedef struct Light {
     float area;         /* disk */
     float cos_outer, cos_inner, beam; /* spot: cone edge, full beam, beamdistribution */
     Mat4 world_from_light, light_from_world; /* environment: the map's rotation */
-    LightEnvMap *env;   /* environment: NULL for a constant one */
+    LightEnvMap *env;                        /* environment: NULL for a constant one; point and spot
+                                                lights: their intensity by direction, or NULL */
+    int map_projection;                      /* point and spot lights: env is an image projected
+                                                along the light's +z (see light_sample), not a
+                                                latitude-longitude map of directions */
+    float map_tan;                           /* that projection's tan(fov / 2) */
     LightMesh *mesh;    /* mesh: its triangles */
     int two_sided;      /* mesh: emits from both sides */
     int emitter;        /* mesh: the scene object camera rays see it as (its own

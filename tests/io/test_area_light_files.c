@@ -6,6 +6,8 @@
  */
 #include <string.h>
 
+#include "image/image.h"
+#include "io/pbrt.h"
 #include "io/rib_round_trip.h"
 #include "scene/scene.h"
 #include "shade/light.h"
@@ -129,5 +131,45 @@ static void test_quadrics_and_motion(void)
     free(written);
 }
 
+/* pbrt-v4's goniometric light: its equal-area square's centre is the
+ * light space's +y (pbrt swaps y and z), times I and scale; projection
+ * lights take their fov. */
+static void test_pbrt_goniometric(void)
+{
+    const char *path = RAYES_TEST_TMP "/test_gonio.exr";
+    float px[8 * 8 * 4];
+    for (int i = 0; i < 64; i++) {
+        int x = i % 8, y = i / 8, centre = (x == 3 || x == 4) && (y == 3 || y == 4);
+        for (int c = 0; c < 3; c++)
+            px[4 * i + c] = centre ? 10.0f : 0.5f;
+        px[4 * i + 3] = 1;
+    }
+    CHECK(image_write_exr(path, 8, 8, px, NULL, 0) == RAYES_OK);
+    char text[512];
+    snprintf(text, sizeof text,
+             "WorldBegin\nLightSource \"goniometric\" \"string filename\" \"%s\" "
+             "\"rgb I\" [1 2 1] \"float scale\" 3\n"
+             "LightSource \"projection\" \"string filename\" \"%s\" \"float fov\" 30\n",
+             path, path);
+    RayesScene *s = rayes_scene_new();
+    IoSink sink = io_sink_scene(s);
+    IoSettings settings;
+    io_settings_init(&settings);
+    char err[256];
+    CHECK(io_pbrt_parse("t.pbrt", (const unsigned char *)text, strlen(text), &sink, NULL, &settings,
+                        err, sizeof err) == RAYES_OK);
+    CHECK(s->n_lights == 2);
+    if (s->n_lights == 2) {
+        LightSample up, side;
+        CHECK(light_sample(&s->lights[0], v3(0, 1, 0), 0.5f, 0.5f, &up)); /* above the light */
+        CHECK(light_sample(&s->lights[0], v3(1, 0, 0), 0.5f, 0.5f, &side));
+        CHECK_NEAR(up.Li.y, 3 * 2 * 10, 0.1 * 60); /* toward +y: the centre */
+        CHECK_NEAR(side.Li.y, 3 * 2 * 0.5, 0.1 * 3);
+        CHECK(s->lights[1].map_projection &&
+              fabsf(s->lights[1].map_tan - tanf(0.2617994f)) < 1e-5f);
+    }
+    rayes_scene_release(s);
+}
+
 TEST_MAIN(TEST(test_polygons_under_area_lights), TEST(test_round_trip),
-          TEST(test_quadrics_and_motion))
+          TEST(test_quadrics_and_motion), TEST(test_pbrt_goniometric))

@@ -847,6 +847,48 @@ static void write_test_map(const char *path)
     free(p);
 }
 
+/* Point lights with maps: an image projected along +z (fov 90, its first
+ * row at +y, black outside and behind), and a latitude-longitude map of
+ * intensity by direction (the test map: 7 red at +z, its top row green). */
+static void test_point_light_maps(void)
+{
+    const char *path = RAYES_TEST_TMP "/test_lights_slide.exr";
+    float px[2 * 2 * 4] = {1, 0, 0, 1, 0, 1, 0, 1,  /* top: red, green */
+                           0, 0, 1, 1, 1, 1, 1, 1}; /* bottom: blue, white */
+    CHECK(image_write_exr(path, 2, 2, px, NULL, 0) == RAYES_OK);
+    RayesScene *s = rayes_scene_new();
+    RayesParam p[4] = {ps("mapname", path), ps("mapping", "projection"), pf("fov", 90),
+                       pf("intensity", 2)};
+    CHECK(rayes_scene_light(s, "pointlight", p, 4) == RAYES_OK);
+    const float at[4][3] = {{-0.5f, 0.5f, 1}, {0.5f, 0.5f, 1}, {-0.5f, -0.5f, 1}, {0.5f, -0.5f, 1}};
+    for (int k = 0; k < 4 && s->n_lights == 1; k++) {
+        LightSample ls;
+        Vec3 o = v3_load(at[k]);
+        CHECK(light_sample(&s->lights[0], o, 0.5f, 0.5f, &ls));
+        float d2 = v3_dot(o, o);
+        CHECK_NEAR(ls.Li.x * d2, 2 * px[4 * k], 1e-5);
+        CHECK_NEAR(ls.Li.y * d2, 2 * px[4 * k + 1], 1e-5);
+        CHECK_NEAR(ls.Li.z * d2, 2 * px[4 * k + 2], 1e-5);
+    }
+    LightSample ls;
+    CHECK(s->n_lights == 1 && !light_sample(&s->lights[0], v3(2, 0, 1), 0.5f, 0.5f, &ls));
+    CHECK(s->n_lights == 1 && !light_sample(&s->lights[0], v3(0, 0, -1), 0.5f, 0.5f, &ls));
+    RayesParam bad[3] = {ps("mapname", path), ps("mapping", "projection"), pf("fov", 180)};
+    CHECK(rayes_scene_light(s, "spotlight", bad, 3) == RAYES_ERROR_INVALID_ARGUMENT);
+    rayes_scene_release(s);
+    write_test_map(RAYES_TEST_TMP "/test_lights_map.exr");
+    s = rayes_scene_new();
+    RayesParam g[1] = {ps("mapname", RAYES_TEST_TMP "/test_lights_map.exr")};
+    CHECK(rayes_scene_light(s, "pointlight", g, 1) == RAYES_OK);
+    if (s->n_lights == 1) {
+        CHECK(light_sample(&s->lights[0], v3(0, 0, 3), 0.5f, 0.5f, &ls));
+        CHECK_NEAR(ls.Li.x * 9, 7, 1e-4); /* toward +z */
+        CHECK(light_sample(&s->lights[0], v3(0, 3, 0), 0.5f, 0.5f, &ls));
+        CHECK_NEAR(ls.Li.y * 9, 5, 1e-4); /* straight up: the top row */
+    }
+    rayes_scene_release(s);
+}
+
 static void test_environment_map_importance_sampling(void)
 {
     const char *path = RAYES_TEST_TMP "/test_lights_map.exr";
@@ -1381,5 +1423,5 @@ TEST_MAIN(TEST(test_point_light_inverse_square), TEST(test_spot_light_cone),
           TEST(test_sample_clamp), TEST(test_chrome_ball_white_furnace),
           TEST(test_glass_ball_white_furnace), TEST(test_environment_map_importance_sampling),
           TEST(test_environment_map_sampling_consistency), TEST(test_octahedral_environment_map),
-          TEST(test_categories), TEST(test_emitters_seen_by_camera),
+          TEST(test_point_light_maps), TEST(test_categories), TEST(test_emitters_seen_by_camera),
           TEST(test_every_light_any_thread_count), TEST(test_bad_lights))
