@@ -673,8 +673,8 @@ static void test_lights(void)
         "Shape \"bilinearmesh\" \"point3 P\" [0 0 0 1 0 0 0 1 0 1 1 0]\n";
     RayesError e = parse("t.pbrt", text, r, &s, err, sizeof err);
     CHECK(e == RAYES_OK);
-    CHECK(r->n_lights == 6);
-    if (r->n_lights == 6) {
+    CHECK(r->n_lights == 7);
+    if (r->n_lights == 7) {
         CHECK(strcmp(r->light[0].type, "pointlight") == 0);
         const Shader *p = &r->light[0].params;
         CHECK(param(p, "intensity") && param(p, "intensity")->value[0] == 4);
@@ -691,14 +691,18 @@ static void test_lights(void)
         p = &r->light[3].params;
         CHECK(param(p, "mapping") && strcmp(param(p, "mapping")->string, "octahedral") == 0);
         CHECK(param(p, "mapname") && strstr(param(p, "mapname")->string, "sky.exr") != NULL);
-        CHECK(strcmp(r->light[4].type, "arealight") == 0); /* the sphere */
+        CHECK(strcmp(r->light[4].type, "pointlight") == 0); /* goniometric: a map */
         p = &r->light[4].params;
+        CHECK(param(p, "mapping") && strcmp(param(p, "mapping")->string, "octahedral") == 0);
+        CHECK(param(p, "mapname") && strstr(param(p, "mapname")->string, "x.exr") != NULL);
+        CHECK(strcmp(r->light[5].type, "arealight") == 0); /* the sphere */
+        p = &r->light[5].params;
         CHECK(param(p, "shape") && strcmp(param(p, "shape")->string, "sphere") == 0);
         CHECK(param(p, "radius") && param(p, "radius")->value[0] == 0.25f);
         CHECK(param(p, "lightcolor") && param(p, "lightcolor")->value[0] == 6);
-        CHECK_NEAR(r->light[4].xform[7], 1, 0);
-        CHECK(strcmp(r->light[5].type, "arealight") == 0 && param(&r->light[5].params, "shape") &&
-              strcmp(param(&r->light[5].params, "shape")->string, "disk") == 0);
+        CHECK_NEAR(r->light[5].xform[7], 1, 0);
+        CHECK(strcmp(r->light[6].type, "arealight") == 0 && param(&r->light[6].params, "shape") &&
+              strcmp(param(&r->light[6].params, "shape")->string, "disk") == 0);
     }
     CHECK(r->n_area == 1 && r->n_patches == 1); /* the emitting patch, then a plain one */
     CHECK(r->n_curves == 1);                     /* a curve under an area light does not emit */
