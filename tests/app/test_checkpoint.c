@@ -82,6 +82,25 @@ static int wait_for(const char *path)
     return 0;
 }
 
+/* Waits up to 60 s for the file at path to hold text. */
+static int wait_for_text(const char *path, const char *text)
+{
+    for (int i = 0; i < 60000; i++) {
+        char buf[4096] = "";
+        FILE *f = fopen(path, "r");
+        if (f) {
+            size_t n = fread(buf, 1, sizeof buf - 1, f);
+            buf[n] = '\0';
+            fclose(f);
+            if (strstr(buf, text))
+                return 1;
+        }
+        struct timespec ts = {0, 1000000};
+        nanosleep(&ts, NULL);
+    }
+    return 0;
+}
+
 static void test_resume_after_crash(void)
 {
     mkdir(DIR, 0755);
@@ -117,12 +136,15 @@ static void test_sigterm_saves(void)
 {
     unlink(DIR "/term.exr.checkpoint");
     unlink(DIR "/term.exr");
-    const char *args[] = {SCENE, "--threads", "1", "--checkpoint", "1000", "-o", "term.exr", NULL};
+    unlink(DIR "/term.out"); /* an earlier run's progress lines are not this one's */
+    const char *args[] = {SCENE,        "--threads", "1",  "--checkpoint", "1000",
+                          "--progress", "json",      "-o", "term.exr",     NULL};
     pid_t pid = start("term", args);
-    /* the first tile's statistics cannot be seen from here: wait for the
-     * process to be busy, then ask it to stop */
-    struct timespec ts = {0, 300000000};
-    nanosleep(&ts, NULL);
+    /* wait for its first progress line (a tile done, the handler long
+     * installed: a fixed wait was too short under ThreadSanitizer on a
+     * loaded machine, and the signal came before the handler), then ask it
+     * to stop */
+    CHECK(wait_for_text(DIR "/term.out", "\"event\": \"progress\""));
     kill(pid, SIGTERM);
     int status = finish(pid);
     if (status == 0) { /* finished first: nothing to test on this machine */
