@@ -53,9 +53,6 @@ static void set_opacity(const RayesShadeCtx *ctx, RayesShadeOutputs *out)
         }
 }
 
-typedef void (*ChunkFn)(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
-                        const void *params, RayesShadeOutputs *out);
-
 /* The shading normals of a normal map (pbrt-v4's "normalmap": a linear
  * image whose texel n = 2 rgb - 1 is in the frame of x = dP/ds, z = N,
  * y = z cross x; the pattern "normalmap" holds it): dP/ds from dPdu, dPdv
@@ -93,26 +90,36 @@ static void normal_map(const RayesShaderServices *sv, const RayesShadeCtx *ctx, 
     }
 }
 
+/* A shader's chunk function and parameters, for shade_chunks. */
+typedef struct MappedChunk {
+    ShadeChunkFn fn;
+    const void *params;
+} MappedChunk;
+
+/* One slice: its normals bent by the normal map, if one is bound, then
+ * the shader's function. */
+static void mapped_chunk(const RayesShaderServices *sv, const RayesShadeCtx *sub,
+                         const void *params, RayesShadeOutputs *out)
+{
+    const MappedChunk *m = params;
+    RayesShadeCtx ctx = *sub;
+    Rgb mapped[SHADE_CHUNK];
+    if (shade_param_bound(&ctx, "normalmap")) {
+        normal_map(sv, &ctx, mapped);
+        ctx.N = (const float(*)[3])mapped;
+    }
+    m->fn(sv, &ctx, m->params, out);
+}
+
 /* Runs fn on SHADE_CHUNK-point slices; Irradiance, if asked for, is left
  * to fn (zeroed first). */
 static void by_chunks(const RayesShaderServices *sv, const RayesShadeCtx *ctx, const void *params,
-                      RayesShadeOutputs *out, ChunkFn fn)
+                      RayesShadeOutputs *out, ShadeChunkFn fn)
 {
     if (out->Irradiance)
         memset(out->Irradiance, 0, ctx->n_points * sizeof *out->Irradiance);
-    for (size_t start = 0; start < ctx->n_points; start += SHADE_CHUNK) {
-        size_t n = ctx->n_points - start < SHADE_CHUNK ? ctx->n_points - start : SHADE_CHUNK;
-        RayesShadeCtx sub;
-        shade_ctx_slice(ctx, start, n, &sub);
-        RayesShadeOutputs o = {out->Ci + start, out->Oi + start,
-                               out->Irradiance ? out->Irradiance + start : NULL, NULL};
-        Rgb mapped[SHADE_CHUNK];
-        if (shade_param_bound(&sub, "normalmap")) {
-            normal_map(sv, &sub, mapped);
-            sub.N = (const float(*)[3])mapped;
-        }
-        fn(sv, &sub, params, &o);
-    }
+    const MappedChunk m = {fn, params};
+    shade_chunks(sv, ctx, &m, out, mapped_chunk);
     set_opacity(ctx, out);
 }
 

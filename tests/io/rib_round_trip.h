@@ -1,7 +1,8 @@
 /*
  * tests/io/rib_round_trip.h — RIB texts for the tests that read a
- * writer's RIB back (curves, blobbies, solids): the writer's text for a
- * RIB text, and a RIB text read into a new scene. Header-only.
+ * writer's RIB back (curves, blobbies, solids, area lights): the writer's
+ * text for a RIB text, and a RIB or pbrt-v4 text read into a new scene.
+ * Header-only.
  */
 #ifndef RAYES_TESTS_IO_RIB_ROUND_TRIP_H
 #define RAYES_TESTS_IO_RIB_ROUND_TRIP_H
@@ -10,6 +11,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "io/pbrt.h"
 #include "io/rib.h"
 #include "io/rib_write.h"
 #include "io/sink.h"
@@ -27,6 +29,21 @@ static RayesScene *rib_read_scene(const char *text, RayesError *e, char *err, si
     err[0] = '\0';
     *e = io_rib_parse("t.rib", (const unsigned char *)text, strlen(text), &sink, &opt, &settings,
                       err, n);
+    return s;
+}
+
+/* A new scene (release it) of a pbrt-v4 text named t.pbrt; *e the
+ * reader's result, err its message. */
+static inline RayesScene *pbrt_read_scene(const char *text, RayesError *e, char *err, size_t n)
+{
+    RayesScene *s = rayes_scene_new();
+    IoSink sink = io_sink_scene(s);
+    IoSettings settings;
+    io_settings_init(&settings);
+    IoReadOptions opt = {RAYES_TEST_DATA, -1};
+    err[0] = '\0';
+    *e = io_pbrt_parse("t.pbrt", (const unsigned char *)text, strlen(text), &sink, &opt, &settings,
+                       err, n);
     return s;
 }
 

@@ -7,7 +7,6 @@
 #include <string.h>
 
 #include "image/image.h"
-#include "io/pbrt.h"
 #include "io/rib_round_trip.h"
 #include "scene/scene.h"
 #include "shade/light.h"
@@ -151,13 +150,10 @@ static void test_pbrt_goniometric(void)
              "\"rgb I\" [1 2 1] \"float scale\" 3\n"
              "LightSource \"projection\" \"string filename\" \"%s\" \"float fov\" 30\n",
              path, path);
-    RayesScene *s = rayes_scene_new();
-    IoSink sink = io_sink_scene(s);
-    IoSettings settings;
-    io_settings_init(&settings);
     char err[256];
-    CHECK(io_pbrt_parse("t.pbrt", (const unsigned char *)text, strlen(text), &sink, NULL, &settings,
-                        err, sizeof err) == RAYES_OK);
+    RayesError e;
+    RayesScene *s = pbrt_read_scene(text, &e, err, sizeof err);
+    CHECK(e == RAYES_OK);
     CHECK(s->n_lights == 2);
     if (s->n_lights == 2) {
         LightSample up, side;

@@ -21,17 +21,8 @@ static char err[1024];
 
 static RayesScene *read(const char *text, int pbrt, RayesError *e)
 {
-    if (!pbrt)
-        return rib_read_scene(text, e, err, sizeof err);
-    RayesScene *s = rayes_scene_new();
-    IoSink sink = io_sink_scene(s);
-    IoSettings settings;
-    io_settings_init(&settings);
-    IoReadOptions opt = {RAYES_TEST_DATA, -1};
-    err[0] = '\0';
-    *e = io_pbrt_parse("t.pbrt", (const unsigned char *)text, strlen(text), &sink, &opt, &settings,
-                       err, sizeof err);
-    return s;
+    return pbrt ? pbrt_read_scene(text, e, err, sizeof err)
+                : rib_read_scene(text, e, err, sizeof err);
 }
 
 static const char *const rib_text =
