@@ -288,9 +288,46 @@ static int nearest_power_of_two(int n)
     return (int64_t)n * n > 2 * (int64_t)p * p ? 2 * p : p;
 }
 
+/* Whether a domain of a flat triangle needs one micropolygon, found from
+ * its three corners alone (a dense mesh's faces: the lattice costs 15
+ * evaluations and projections). Every lattice line lies inside the
+ * triangle, in raster space too (a projection in front of the eye maps it
+ * to a triangle), so none is longer than its longest edge; the corners
+ * place it against the view as the lattice does (side planes and the eye
+ * plane bound convex half-spaces), and the off-screen factor, left out,
+ * only lengthens the unit. rate: the target edge in pixels. */
+static int one_micropolygon(const Prim *prim, const Domain *d, const DiceCamera *cam, float rate)
+{
+    if (prim->type != PRIM_TRIANGLE)
+        return 0;
+    Vec3 c[3] = {domain_point(prim, d, 0.0f, 0.0f), domain_point(prim, d, 1.0f, 0.0f),
+                 domain_point(prim, d, 0.0f, 1.0f)};
+    float s[3][2], outside = 0.0f, longest = 0.0f, unit;
+    ViewPlace place = view_place(cam, c, 3, s, &outside);
+    if (place == VIEW_ON && !cam->isotropic) {
+        for (int k = 0; k < 3; k++)
+            longest =
+                fmaxf(longest, hypotf(s[(k + 1) % 3][0] - s[k][0], s[(k + 1) % 3][1] - s[k][1]) /
+                                   cam->pixel);
+        unit = rate;
+    } else {
+        Bounds3 box = bounds_empty();
+        for (int k = 0; k < 3; k++) {
+            box = bounds_add(box, c[k]);
+            longest = fmaxf(longest, v3_length(v3_sub(c[(k + 1) % 3], c[k])));
+        }
+        float dist = fmaxf(bounds_distance(box, cam->eye), cam->min_distance);
+        unit = rate * (cam->pixel_width + cam->pixel_angle * dist);
+    }
+    return longest * 1.001f <= 0.999f * unit; /* margins for the lattice's roundings */
+}
 
 static Estimate estimate(const Prim *prim, const Domain *d, const DiceCamera *cam)
 {
+    float scale = cam->rate_scale > 1.0f ? cam->rate_scale : 1.0f;
+    float rate = sqrtf(fmaxf(prim->shading_rate, 1e-6f)) * scale; /* edge, in pixels */
+    if (d->triangular && one_micropolygon(prim, d, cam, rate))
+        return (Estimate){1, 1, -1};
     Vec3 p[LATTICE][LATTICE];
     float s[LATTICE * LATTICE][2];
     Vec3 pts[LATTICE * LATTICE];
@@ -306,8 +343,7 @@ static Estimate estimate(const Prim *prim, const Domain *d, const DiceCamera *ca
             box = bounds_add(box, p[j][i]);
             pts[n++] = p[j][i];
         }
-    float outside = 0.0f, scale = cam->rate_scale > 1.0f ? cam->rate_scale : 1.0f;
-    float rate = sqrtf(fmaxf(prim->shading_rate, 1e-6f)) * scale; /* edge, in pixels */
+    float outside = 0.0f;
     ViewPlace place = view_place(cam, pts, n, s, &outside);
     float len[3], unit;
     if (place == VIEW_ON && !cam->isotropic) {
@@ -625,6 +661,7 @@ typedef struct Walk {
     const DiceCamera *cam;
     Limits lim;
     size_t vertices; /* counted, when gs is NULL */
+    size_t grids;    /* counted, when gs is NULL */
 } Walk;
 
 static int leaf(Walk *w, const Domain *d, Estimate e)
@@ -632,6 +669,7 @@ static int leaf(Walk *w, const Domain *d, Estimate e)
     if (w->gs)
         return d->triangular ? dice_triangle(w->gs, w->prim, w->prim_index, w->pool, d, e, w->lim)
                              : dice_quad(w->gs, w->prim, w->prim_index, w->pool, d, e, w->lim);
+    w->grids++;
     if (d->triangular) {
         size_t n = (size_t)RY_MIN(e.n_u, w->lim.tri);
         w->vertices += (n + 1) * (n + 2) / 2;
@@ -769,7 +807,7 @@ int geom_dice_prim(GridSet *gs, const Prim *prim, uint32_t prim_index, const flo
 {
     Prim copy;
     prim = facing_eye(prim, cam, &copy);
-    Walk w = {gs, prim, prim_index, pv_pool, cam, limits_of(cam), 0};
+    Walk w = {gs, prim, prim_index, pv_pool, cam, limits_of(cam), 0, 0};
     Domain d = whole_domain(prim);
     size_t first = gs->n_grids;
     if (split_dice(&w, &d, 0) != 0)
@@ -778,12 +816,14 @@ int geom_dice_prim(GridSet *gs, const Prim *prim, uint32_t prim_index, const flo
     return 0;
 }
 
-size_t geom_count_prim(const Prim *prim, const DiceCamera *cam)
+size_t geom_count_prim(const Prim *prim, const DiceCamera *cam, size_t *grids)
 {
     Prim copy;
     prim = facing_eye(prim, cam, &copy);
-    Walk w = {NULL, prim, 0, NULL, cam, limits_of(cam), 0};
+    Walk w = {NULL, prim, 0, NULL, cam, limits_of(cam), 0, 0};
     Domain d = whole_domain(prim);
     split_dice(&w, &d, 0);
+    if (grids)
+        *grids += w.grids;
     return w.vertices;
 }

@@ -411,8 +411,9 @@ void geom_gridset_fini(GridSet *gs);
 int geom_dice_prim(GridSet *gs, const Prim *prim, uint32_t prim_index, const float *pv_pool,
                    const DiceCamera *cam);
 
-/* The grid vertices geom_dice_prim would add for prim, without dicing. */
-size_t geom_count_prim(const Prim *prim, const DiceCamera *cam);
+/* The grid vertices geom_dice_prim would add for prim, without dicing;
+ * adds the grids to *grids when that is not NULL. */
+size_t geom_count_prim(const Prim *prim, const DiceCamera *cam, size_t *grids);
 
 /* Recomputes a grid's mean edge and curvature from its vertices (after
  * displacement has moved them). */

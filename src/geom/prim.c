@@ -199,8 +199,8 @@ void geom_prim_eval(const Prim *prim, float u, float v, Vec3 *P, Vec3 *dPdu, Vec
     case PRIM_BICUBIC:
         eval_bicubic(c, u, v, P, dPdu, dPdv);
         break;
-    case PRIM_TRIANGLE:
-        *P = v3_add(c[0], v3_add(v3_scale(v3_sub(c[1], c[0]), u), v3_scale(v3_sub(c[2], c[0]), v)));
+    case PRIM_TRIANGLE: /* weights, not differences: the corners are exact, bit for bit */
+        *P = v3_add(v3_scale(c[0], 1.0f - u - v), v3_add(v3_scale(c[1], u), v3_scale(c[2], v)));
         *dPdu = v3_sub(c[1], c[0]);
         *dPdv = v3_sub(c[2], c[0]);
         break;

@@ -1226,6 +1226,24 @@ static int master_cameras(const RayesScene *s, const GridSet *gs, DiceCamera *ca
     return 0;
 }
 
+/* The grid vertices primitives first.. of s need at cams' rates (blurred
+ * ones coarser), counted without dicing (the same walk as dicing); the
+ * grids are added to *grids when that is not NULL. */
+static size_t count_from(const RayesScene *s, const DiceCamera *cams, size_t first, size_t *grids)
+{
+    size_t total = 0;
+    for (size_t k = first; k < s->n_prims; k++) {
+        const DiceCamera *ck = &cams[s->prims[k].master];
+        if (ck->grid_size < 0)
+            continue;
+        Prim p = s->prims[k];
+        float c = scene_blur_dice_factor(s, k, ck);
+        p.shading_rate *= c * c; /* a rate is an area */
+        total += geom_count_prim(&p, ck, grids);
+    }
+    return total;
+}
+
 /* Dices (and displaces) every primitive into gs, world geometry with
  * cams[0] and master m's with cams[m + 1] (skipping masters no instance
  * places), or stops as soon as gs holds more than budget vertices (0: no
@@ -1244,19 +1262,8 @@ static size_t dice_all(const RayesScene *s, const DiceCamera *cams, size_t budge
         blurred.shading_rate *= coarser * coarser; /* a rate is an area */
         if (geom_dice_prim(gs, &blurred, (uint32_t)i, s->pv, cam) != 0)
             return (size_t)-1;
-        if (budget && gs->n_vertices > budget) {
-            size_t total = gs->n_vertices;
-            for (size_t k = i + 1; k < s->n_prims; k++) {
-                const DiceCamera *ck = &cams[s->prims[k].master];
-                if (ck->grid_size < 0)
-                    continue;
-                Prim later = s->prims[k];
-                float c = scene_blur_dice_factor(s, k, ck);
-                later.shading_rate *= c * c;
-                total += geom_count_prim(&later, ck);
-            }
-            return total;
-        }
+        if (budget && gs->n_vertices > budget)
+            return gs->n_vertices + count_from(s, cams, i + 1, NULL);
         /* Normals of displaced surfaces: differences over 1e-3 of the scene radius.
          * Curves and points are not displaced (as in RenderMan). */
         const Prim *p = &s->prims[i];
@@ -1269,8 +1276,25 @@ static size_t dice_all(const RayesScene *s, const DiceCamera *cams, size_t budge
     return 0;
 }
 
+/* About the bytes grids take with their ray tracing data: per vertex its
+ * position, normal, derivatives, (u, v) and the primitive variables the
+ * scene carries, and Embree's share; per grid its record and Embree's
+ * (measured on a mesh of 8 million triangles diced whole: 362 bytes a
+ * grid of three vertices, 78 of them Embree's; this says 414). */
+static double grid_bytes(const RayesScene *s, size_t vertices, size_t grids)
+{
+    unsigned pv = 0;
+    for (size_t i = 0; i < s->n_prims; i++)
+        pv |= s->prims[i].pv;
+    double per_vertex = 4 * sizeof(Vec3) + 2 * sizeof(float) + 24.0;
+    per_vertex += (pv & GEOM_PV_N ? sizeof(Vec3) : 0) + (pv & GEOM_PV_ST ? 6 * sizeof(float) : 0) +
+                  (pv & GEOM_PV_CS ? sizeof(Vec3) : 0) + (pv & GEOM_PV_OS ? sizeof(Vec3) : 0);
+    return (double)vertices * per_vertex + (double)grids * (sizeof(Grid) + 64.0);
+}
+
 int scene_prepare(const RayesScene *s, int width, int height, const DiceOptions *dice,
-                  TextureSystem *textures, GridSet *gs, float *coarsened)
+                  TextureSystem *textures, GridSet *gs, float *coarsened, char *err,
+                  size_t err_size)
 {
     DicingServices sv;
     shade_dicing_services_init(&sv, textures);
@@ -1289,19 +1313,44 @@ int scene_prepare(const RayesScene *s, int width, int height, const DiceOptions 
     size_t budget = dice ? dice->vertex_budget : 0;
     /* Over the budget: vertices go as the inverse square of the edge, so
      * edges longer by the square root of the excess (and 5%) fit, but
-     * for the grids' minimum sizes; a few rounds at most. */
-    size_t first_need = 0;
-    for (int round = 0;; round++) {
-        size_t need = dice_all(s, cams, round < 8 ? budget : 0, &sv, 1e-3f * radius, gs);
-        if (need == (size_t)-1) {
+     * for the grids' minimum sizes. The first dicing stops at the
+     * budget; the rates are then found by counting alone (at most eight
+     * rounds, and none after one that saved under 1%: primitives at their
+     * minimum sizes, a dense mesh's, cannot shrink) and the scene diced
+     * once more. */
+    size_t first_need = dice_all(s, cams, budget, &sv, 1e-3f * radius, gs);
+    if (first_need == (size_t)-1) {
+        free(cams);
+        return -1;
+    }
+    if (first_need) {
+        size_t need = first_need, grids = 0;
+        for (int round = 0; round < 8 && need > budget; round++) {
+            for (size_t m = 0; m <= s->n_masters; m++)
+                cams[m].rate_scale *= 1.05f * sqrtf((float)need / (float)budget);
+            size_t before = need;
+            grids = 0;
+            need = count_from(s, cams, 0, &grids);
+            if ((double)need > 0.99 * (double)before)
+                break;
+        }
+        /* Too big for the memory left: a clear error, not the kernel's
+         * out-of-memory killer halfway through. */
+        double bytes = grid_bytes(s, need, grids), room = dice ? dice->memory_limit : 0.0;
+        if (room <= 0.0) {
+            uint64_t phys = mem_physical_bytes(), rss = mem_rss_bytes();
+            room = phys > rss ? 0.9 * (double)(phys - rss) : 0.0;
+        }
+        if (bytes > room) {
+            if (err && err_size)
+                snprintf(err, err_size,
+                         "render: the scene needs %zu grid vertices in %zu grids, about %.1f GB, "
+                         "more than the %.1f GB of memory left; raise the shading rate or "
+                         "simplify the geometry",
+                         need, grids, bytes / 1e9, room / 1e9);
             free(cams);
             return -1;
         }
-        if (need == 0)
-            break;
-        first_need = first_need ? first_need : need;
-        for (size_t m = 0; m <= s->n_masters; m++)
-            cams[m].rate_scale *= 1.05f * sqrtf((float)need / (float)budget);
         GeomInstance *keep = gs->instances; /* the instances stay; the grids go */
         size_t n_keep = gs->n_instances, n_moving = gs->n_moving_instances;
         Mat4 *keep_motion = gs->instance_motion;
@@ -1314,6 +1363,10 @@ int scene_prepare(const RayesScene *s, int width, int height, const DiceOptions 
         gs->instance_motion = keep_motion;
         gs->n_moving_instances = n_moving;
         gs->n_masters = s->n_masters;
+        if (dice_all(s, cams, 0, &sv, 1e-3f * radius, gs) == (size_t)-1) {
+            free(cams);
+            return -1;
+        }
     }
     float rate_scale = cams[0].rate_scale;
     int failed = geom_stitch(gs, s->prims) != 0 || scene_motion_prepare(s, cams, gs) != 0;

@@ -251,6 +251,8 @@ typedef struct DiceOptions {
     float offscreen;      /* >= 1: edge factor far off screen (DiceCamera.offscreen); 0: 1 */
     size_t vertex_budget; /* grid vertices, at most; 0: no budget */
     int isotropic;        /* 1: on screen by distance too (DiceCamera.isotropic) */
+    double memory_limit;  /* bytes the grids of a scene over the budget may take; 0: 90% of
+                             the memory the machine has beyond the process's */
 } DiceOptions;
 
 /* Dices every primitive of a committed scene for its camera making an
@@ -259,10 +261,13 @@ typedef struct DiceOptions {
  * texture lookups read from textures, which may be NULL). A scene that
  * would exceed the vertex budget is diced again with every micropolygon
  * edge longer by one factor, found by counting, with one warning; the
- * factor is written to *coarsened when that is not NULL (1: none).
- * Returns 0, or -1 when out of memory. */
+ * factor is written to *coarsened when that is not NULL (1: none). One
+ * whose grids would still take more than dice->memory_limit is refused,
+ * with a message in err (err_size bytes; err may be NULL).
+ * Returns 0, or -1 when out of memory or refused. */
 int scene_prepare(const RayesScene *scene, int width, int height, const DiceOptions *dice,
-                  TextureSystem *textures, GridSet *gs, float *coarsened);
+                  TextureSystem *textures, GridSet *gs, float *coarsened, char *err,
+                  size_t err_size);
 
 /* Runs the displacement shaders of the primitives of grids [first_grid,
  * n_grids) of gs (displace.c); normals come from differences over step

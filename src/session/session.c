@@ -390,13 +390,13 @@ RayesError session_prepare(RayesScene *scene, const RenderSettings *set, Texture
     p->masks = p->objects ? object_masks(scene, p->objects) : NULL;
     char err[300] = "";
     DiceOptions dice = {set->grid_size, set->dice_offscreen, set->vertex_budget,
-                        set->dice_isotropic};
+                        set->dice_isotropic, 0.0};
     if (!p->objects || !p->masks ||
-        scene_prepare(scene, set->width, set->height, &dice, textures, &p->gs, &p->coarsened) !=
-            0) {
+        scene_prepare(scene, set->width, set->height, &dice, textures, &p->gs, &p->coarsened, err,
+                      sizeof err) != 0) {
         session_prepared_fini(p);
         return session_fail(scene, RAYES_ERROR_OUT_OF_MEMORY,
-                            "render: out of memory preparing the scene");
+                            err[0] ? err : "render: out of memory preparing the scene");
     }
     p->accel = accel_new(&p->gs, p->masks, scene->n_objects, err, sizeof err);
     if (!p->accel) {

@@ -22,5 +22,9 @@ double time_cpu(void);
 
 /* The process's peak resident set size in bytes (0 if unknown). */
 uint64_t mem_peak_rss_bytes(void);
+/* The process's resident memory now (0 if unknown), and the machine's
+ * physical memory (UINT64_MAX if unknown), bytes. */
+uint64_t mem_rss_bytes(void);
+uint64_t mem_physical_bytes(void);
 
 #endif /* RAYES_UTIL_LOG_H */

@@ -325,7 +325,9 @@ static size_t dice_vertices(const Prim *p, const DiceCamera *cam, GridSet *gs)
 {
     geom_gridset_init(gs);
     CHECK(geom_dice_prim(gs, p, 0, NULL, cam) == 0);
-    CHECK(geom_count_prim(p, cam) == gs->n_vertices); /* counting agrees with dicing */
+    size_t grids = 0; /* counting agrees with dicing */
+    CHECK(geom_count_prim(p, cam, &grids) == gs->n_vertices);
+    CHECK(grids == gs->n_grids);
     return gs->n_vertices;
 }
 

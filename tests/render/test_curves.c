@@ -34,7 +34,7 @@ static void trace_init(Traced *t, RayesScene *s)
 {
     CHECK(rayes_scene_commit(s) == RAYES_OK);
     geom_gridset_init(&t->gs);
-    CHECK(scene_prepare(s, 256, 256, NULL, NULL, &t->gs, NULL) == 0);
+    CHECK(scene_prepare(s, 256, 256, NULL, NULL, &t->gs, NULL, NULL, 0) == 0);
     uint32_t mask[4] = {~0u, ~0u, ~0u, ~0u};
     char err[256];
     t->accel = accel_new(&t->gs, mask, 4, err, sizeof err);

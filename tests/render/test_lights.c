@@ -46,7 +46,7 @@ static void fx_init(Fx *f, RayesScene *s)
     f->s = s;
     CHECK(rayes_scene_commit(s) == RAYES_OK);
     geom_gridset_init(&f->gs);
-    CHECK(scene_prepare(s, 64, 64, NULL, NULL, &f->gs, NULL) == 0);
+    CHECK(scene_prepare(s, 64, 64, NULL, NULL, &f->gs, NULL, NULL, 0) == 0);
     f->masks = calloc(s->n_objects + 1, sizeof *f->masks);
     f->objs = calloc(s->n_objects + 1, sizeof *f->objs);
     for (size_t i = 0; i < s->n_objects; i++) {

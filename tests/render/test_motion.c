@@ -595,7 +595,7 @@ static void test_moving_hits(void)
     CHECK(rayes_scene_commit(s) == RAYES_OK);
     GridSet gs;
     geom_gridset_init(&gs);
-    CHECK(scene_prepare(s, 64, 64, NULL, NULL, &gs, NULL) == 0);
+    CHECK(scene_prepare(s, 64, 64, NULL, NULL, &gs, NULL, NULL, 0) == 0);
     CHECK(gs.n_times == 3);
     size_t moving = 0, still_vertices = 0;
     for (size_t g = 0; g < gs.n_grids; g++) {

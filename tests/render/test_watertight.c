@@ -105,7 +105,7 @@ static long leaks(const RayesScene *s, int n)
 {
     GridSet gs;
     geom_gridset_init(&gs);
-    CHECK(scene_prepare(s, IMAGE, IMAGE, NULL, NULL, &gs, NULL) == 0);
+    CHECK(scene_prepare(s, IMAGE, IMAGE, NULL, NULL, &gs, NULL, NULL, 0) == 0);
     uint32_t masks[2] = {RAYES_RAY_CAMERA, RAYES_RAY_CAMERA};
     char err[256];
     Accel *a = accel_new(&gs, masks, 2, err, sizeof err);
@@ -315,7 +315,7 @@ static void test_hole_lets_rays_through(void)
     CHECK(rayes_scene_commit(s) == RAYES_OK);
     GridSet gs;
     geom_gridset_init(&gs);
-    CHECK(scene_prepare(s, 64, 64, NULL, NULL, &gs, NULL) == 0);
+    CHECK(scene_prepare(s, 64, 64, NULL, NULL, &gs, NULL, NULL, 0) == 0);
     uint32_t mask = RAYES_RAY_CAMERA;
     char err[256];
     Accel *a = accel_new(&gs, &mask, 1, err, sizeof err);

@@ -3,9 +3,12 @@
  * under the camera stays within a budget of grid vertices when one is
  * set, coarsened by one factor found by counting, the same on every
  * call; without a budget it needs more; the off-screen factor dices
- * what the camera does not see coarser.
+ * what the camera does not see coarser; a dense mesh over the budget
+ * stops coarsening once it cannot shrink, keeps its corners bit for bit,
+ * and one too big for the memory left is refused with a message.
  */
 #include <math.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "rayes/rayes.h"
@@ -27,7 +30,7 @@ static size_t prepare(RayesScene *s, const DiceOptions *o, float *coarsened)
 {
     GridSet gs;
     geom_gridset_init(&gs);
-    CHECK(scene_prepare(s, 256, 256, o, NULL, &gs, coarsened) == 0);
+    CHECK(scene_prepare(s, 256, 256, o, NULL, &gs, coarsened, NULL, 0) == 0);
     size_t n = gs.n_vertices;
     geom_gridset_fini(&gs);
     return n;
@@ -73,4 +76,78 @@ static void test_isotropic(void)
     rayes_scene_release(s);
 }
 
-TEST_MAIN(TEST(test_vertex_budget), TEST(test_offscreen_factor), TEST(test_isotropic))
+/* A bumpy sheet of 2 n^2 triangles, each far below a pixel. */
+static RayesScene *dense_mesh(int n, float **points)
+{
+    RayesScene *s = rayes_scene_new();
+    const float eye[3] = {0, 0, -50}, at[3] = {0, 0, 0}, up[3] = {0, 1, 0};
+    CHECK(rayes_scene_set_camera(s, eye, at, up, 30.0f) == RAYES_OK);
+    int m = n + 1, *nv = malloc(2 * (size_t)n * n * sizeof *nv);
+    int *idx = malloc(6 * (size_t)n * n * sizeof *idx);
+    float *P = malloc(3 * (size_t)m * m * sizeof *P);
+    CHECK(nv && idx && P);
+    for (int j = 0; j < m; j++)
+        for (int i = 0; i < m; i++) {
+            float *p = &P[3 * (j * m + i)];
+            p[0] = 0.37f * i / n - 0.2f, p[1] = 0.41f * j / n - 0.2f;
+            p[2] = 0.01f * sinf(0.7f * i) * cosf(0.3f * j);
+        }
+    for (int j = 0, f = 0; j < n; j++)
+        for (int i = 0; i < n; i++, f += 2) {
+            int a = j * m + i, b = a + 1, c = a + m + 1, d = a + m;
+            const int tri[6] = {a, b, c, a, c, d};
+            memcpy(&idx[3 * f], tri, sizeof tri);
+            nv[f] = nv[f + 1] = 3;
+        }
+    CHECK(rayes_scene_polygon_mesh(s, 2 * (size_t)n * n, nv, idx, (size_t)m * m, P) == RAYES_OK);
+    CHECK(rayes_scene_commit(s) == RAYES_OK);
+    free(nv), free(idx);
+    *points = P;
+    return s;
+}
+
+/* Points by value (-0 is 0: a corner weighed by 1 and two 0s may
+ * come out +0 where the point holds -0). */
+static int cmp_points(const void *a, const void *b)
+{
+    const float *p = a, *q = b;
+    for (int k = 0; k < 3; k++)
+        if (p[k] != q[k])
+            return p[k] < q[k] ? -1 : 1;
+    return 0;
+}
+
+static void test_dense_mesh(void)
+{
+    const int n = 60; /* 7,200 triangles: 21,600 vertices at one micropolygon each */
+    float *P;
+    RayesScene *s = dense_mesh(n, &P);
+    size_t m2 = (size_t)(n + 1) * (n + 1);
+    qsort(P, m2, 3 * sizeof *P, cmp_points);
+    DiceOptions tight = {0, 4.0f, 5000, 0, 0.0};
+    GridSet gs;
+    geom_gridset_init(&gs);
+    float c = 0.0f;
+    CHECK(scene_prepare(s, 256, 256, &tight, NULL, &gs, &c, NULL, 0) == 0);
+    CHECK(gs.n_grids == 2 * (size_t)n * n && gs.n_vertices == 3 * gs.n_grids);
+    /* one round: coarser rates did not shrink it, so no more were tried
+     * (eight rounds would have made edges 1.05 sqrt(4.3) ^ 8 longer) */
+    CHECK(c > 2.0f && c < 2.5f);
+    size_t on_corner = 0; /* exact corners, and stitching moved none */
+    for (size_t v = 0; v < gs.n_vertices; v++)
+        on_corner += bsearch(&gs.P[v], P, m2, 3 * sizeof *P, cmp_points) != NULL;
+    CHECK(on_corner == gs.n_vertices);
+    geom_gridset_fini(&gs);
+    /* refused: the grids would take more than the memory left */
+    DiceOptions small = {0, 4.0f, 5000, 0, 1e6};
+    char err[300] = "";
+    geom_gridset_init(&gs);
+    CHECK(scene_prepare(s, 256, 256, &small, NULL, &gs, NULL, err, sizeof err) == -1);
+    CHECK(strstr(err, "21600 grid vertices in 7200 grids") && strstr(err, "memory left"));
+    geom_gridset_fini(&gs);
+    free(P);
+    rayes_scene_release(s);
+}
+
+TEST_MAIN(TEST(test_vertex_budget), TEST(test_offscreen_factor), TEST(test_isotropic),
+          TEST(test_dense_mesh))

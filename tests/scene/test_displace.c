@@ -73,7 +73,7 @@ static void test_sine_plane_is_analytic(void)
     RayesScene *s = plane_scene(1, rates, 1);
     GridSet gs;
     geom_gridset_init(&gs);
-    CHECK(scene_prepare(s, 200, 200, NULL, NULL, &gs, NULL) == 0);
+    CHECK(scene_prepare(s, 200, 200, NULL, NULL, &gs, NULL, NULL, 0) == 0);
     CHECK(gs.n_vertices > 100);
     double worst_p = 0.0, worst_n = 0.0;
     for (size_t i = 0; i < gs.n_vertices; i++) {
@@ -105,7 +105,7 @@ static void test_neighbours_agree(void)
     RayesScene *s = plane_scene(2, rates, 0);
     GridSet gs;
     geom_gridset_init(&gs);
-    CHECK(scene_prepare(s, 20, 20, NULL, NULL, &gs, NULL) == 0);
+    CHECK(scene_prepare(s, 20, 20, NULL, NULL, &gs, NULL, NULL, 0) == 0);
     CHECK(gs.n_grids == 2);
     CHECK(gs.grids[0].nu != gs.grids[1].nu);
     int matches = 0;
@@ -142,7 +142,7 @@ static void test_bound_clamps(void)
     CHECK(rayes_scene_commit(s) == RAYES_OK);
     GridSet gs;
     geom_gridset_init(&gs);
-    CHECK(scene_prepare(s, 100, 100, NULL, NULL, &gs, NULL) == 0);
+    CHECK(scene_prepare(s, 100, 100, NULL, NULL, &gs, NULL, NULL, 0) == 0);
     float most = 0.0f;
     for (size_t i = 0; i < gs.n_vertices; i++)
         most = fmaxf(most, fabsf(gs.P[i].z));
@@ -222,7 +222,7 @@ static void test_bumpy_texture(void)
     for (int with = 0; with < 2; with++) {
         GridSet gs;
         geom_gridset_init(&gs);
-        CHECK(scene_prepare(s, 50, 50, NULL, with ? ts : NULL, &gs, NULL) == 0);
+        CHECK(scene_prepare(s, 50, 50, NULL, with ? ts : NULL, &gs, NULL, NULL, 0) == 0);
         float lo = INFINITY, hi = -INFINITY;
         for (size_t i = 0; i < gs.n_vertices; i++)
             lo = fminf(lo, gs.P[i].z), hi = fmaxf(hi, gs.P[i].z);
@@ -279,7 +279,7 @@ static void test_pattern_displacement(void)
     CHECK(rayes_scene_commit(s) == RAYES_OK);
     GridSet gs;
     geom_gridset_init(&gs);
-    CHECK(scene_prepare(s, 100, 100, NULL, NULL, &gs, NULL) == 0);
+    CHECK(scene_prepare(s, 100, 100, NULL, NULL, &gs, NULL, NULL, 0) == 0);
     size_t checked = 0, bad = 0;
     for (size_t i = 0; i < gs.n_vertices; i++) {
         float x = gs.P[i].x, y = gs.P[i].y, z = gs.P[i].z;

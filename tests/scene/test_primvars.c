@@ -35,7 +35,7 @@ static int prepare(RayesScene *s, GridSet *gs)
     CHECK(rayes_scene_set_camera(s, eye, at, up, 40.0f) == RAYES_OK);
     CHECK(rayes_scene_commit(s) == RAYES_OK);
     geom_gridset_init(gs);
-    return scene_prepare(s, 64, 64, NULL, NULL, gs, NULL);
+    return scene_prepare(s, 64, 64, NULL, NULL, gs, NULL, NULL, 0);
 }
 
 /* Every vertex of every grid: st and Cs are the functions of its P. */
@@ -222,7 +222,7 @@ static void test_smooth_normals(void)
     CHECK(rayes_scene_set_camera(s, eye, at, up, 40.0f) == RAYES_OK);
     CHECK(rayes_scene_commit(s) == RAYES_OK);
     geom_gridset_init(&gs);
-    CHECK(scene_prepare(s, 64, 64, NULL, NULL, &gs, NULL) == 0);
+    CHECK(scene_prepare(s, 64, 64, NULL, NULL, &gs, NULL, NULL, 0) == 0);
     double worst_given = 0.0, worst_shared = 0.0, facet = 0.0;
     for (size_t g = 0; g < gs.n_grids; g++) {
         const Grid *a = &gs.grids[g];

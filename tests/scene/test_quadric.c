@@ -82,7 +82,7 @@ static void check_case(const Case *c, unsigned flags, float tx)
     CHECK(rayes_scene_commit(s) == RAYES_OK);
     GridSet gs;
     geom_gridset_init(&gs);
-    CHECK(scene_prepare(s, 64, 64, NULL, NULL, &gs, NULL) == 0);
+    CHECK(scene_prepare(s, 64, 64, NULL, NULL, &gs, NULL, NULL, 0) == 0);
     CHECK(gs.n_vertices > 16);
     double worst = 0.0, theta_max = 0.0;
     size_t inward = 0, judged = 0;
