@@ -55,6 +55,23 @@ static int test_run(const TestCase *cases, size_t n)
     return failed_tests ? 1 : 0;
 }
 
+/* The faces of an (n + 1) x (n + 1) lattice of points, row by row: 2 n^2
+ * triangles, counts in nv (3 each) and corners in idx (6 n^2 ints),
+ * wound (i, j), (i + 1, j + 1), (i + 1, j) and (i, j), (i, j + 1),
+ * (i + 1, j + 1). */
+static inline void test_lattice_triangles(int n, int *nv, int *idx)
+{
+    int m = n + 1;
+    for (int j = 0, f = 0; j < n; j++)
+        for (int i = 0; i < n; i++, f += 2) {
+            int a = j * m + i, b = a + 1, c = a + m + 1, d = a + m;
+            const int tri[6] = {a, c, b, a, d, c};
+            for (int k = 0; k < 6; k++)
+                idx[3 * f + k] = tri[k];
+            nv[f] = nv[f + 1] = 3;
+        }
+}
+
 #define TEST_MAIN(...)                                                                 \
     int main(void)                                                                     \
     {                                                                                  \

@@ -1,7 +1,8 @@
 /*
  * The radiosity cache in the renderer (render/): interpolation reproduces a
  * linear function exactly at every resolution, for quad grids of every size
- * and triangular grids of every subdivision up to the default gridsize, and
+ * and triangular grids of every subdivision up to the default gridsize
+ * (but a triangle of one micropolygon's coarse level: its centroid), and
  * of the largest sizes a larger gridsize allows; levels alias as documented;
  * images do not depend on the cache budget (evicted entries refill to the
  * same bytes) nor on threads.
@@ -53,6 +54,11 @@ static size_t tri_values(const Grid *g, int level, uint16_t *v)
 {
     int m = level == CACHE_FINE ? g->nu : level == CACHE_MEDIUM ? (g->nu + 3) / 4 : 1;
     size_t n = 0;
+    if (level == CACHE_COARSE && g->nu == 1) { /* one micropolygon: its centroid */
+        for (int c = 0; c < 3; c++)
+            v[c] = half_from_float(linear(1.0f / 3.0f, 1.0f / 3.0f));
+        return 1;
+    }
     for (int j = 0; j <= m; j++)
         for (int i = 0; i + j <= m; i++) {
             float f = linear((float)i / m, (float)j / m);
@@ -93,8 +99,12 @@ static void test_interpolation_is_exact_for_linear_functions(void)
                         }
                         Hit h = {.gu = a, .gv = b};
                         Vec3 r = radiosity_interpolate(&g, &h, level, vals);
-                        /* Half precision at values around 2..5: 2^-9 relative. */
-                        CHECK_NEAR(r.x, linear(a, b), 5e-3);
+                        /* Half precision at values around 2..5: 2^-9 relative;
+                         * a triangle of one micropolygon's coarse level is
+                         * its centroid's value, everywhere. */
+                        int centroid = tri && nu == 1 && level == CACHE_COARSE;
+                        float want = centroid ? linear(1.0f / 3.0f, 1.0f / 3.0f) : linear(a, b);
+                        CHECK_NEAR(r.x, want, 5e-3);
                         worst_level_checks++;
                     }
                 }
@@ -216,6 +226,67 @@ static void test_grid_size(void)
     rayes_scene_release(s);
 }
 
+/* A floor of 80,000 triangles, each below a micropolygon, before a wall
+ * the camera sees: the wall's diffuse rays look up the floor's grids of
+ * one triangle at the coarse level, their centroids (radiosity.c
+ * tri_level_m). Returns the image mean; *depth1 the shading points at
+ * diffuse depth 1. */
+static double dense_floor(int cache, uint64_t *depth1)
+{
+    RayesScene *s = rayes_scene_new();
+    const float eye[3] = {0, 1, -3}, at[3] = {0, 1, 0}, up[3] = {0, 1, 0};
+    CHECK(rayes_scene_set_camera(s, eye, at, up, 40.0f) == RAYES_OK);
+    RayesParam dl[2] = {{"intensity", RAYES_PARAM_FLOAT, {3.0f, 0, 0}, NULL},
+                        {"to", RAYES_PARAM_COLOR, {0.2f, -1.0f, 0.4f}, NULL}};
+    CHECK(rayes_scene_light(s, "distantlight", dl, 2) == RAYES_OK);
+    const float wall[4][3] = {{-3, 0, 1}, {3, 0, 1}, {-3, 3, 1}, {3, 3, 1}};
+    CHECK(rayes_scene_bilinear_patch(s, wall) == RAYES_OK);
+    enum { N = 200, M = N + 1 };
+    static float P[3 * M * M];
+    static int nv[2 * N * N], idx[6 * N * N];
+    for (int j = 0; j < M; j++)
+        for (int i = 0; i < M; i++) {
+            float *p = &P[3 * (j * M + i)];
+            p[0] = -3.0f + 6.0f * i / N, p[1] = 0.0f, p[2] = -3.0f + 4.0f * j / N;
+        }
+    test_lattice_triangles(N, nv, idx);
+    const float red[3] = {0.9f, 0.2f, 0.1f};
+    RayesParam cs = {"Cs", RAYES_PARAM_COLOR, {red[0], red[1], red[2]}, NULL};
+    CHECK(rayes_scene_set_shader(s, "matte", &cs, 1) == RAYES_OK);
+    CHECK(rayes_scene_polygon_mesh(s, 2 * N * N, nv, idx, M * M, P) == RAYES_OK);
+    CHECK(rayes_scene_commit(s) == RAYES_OK);
+    RayesRenderOptions o;
+    rayes_render_options_init(&o, RAYES_QUALITY_PREVIEW);
+    o.width = o.height = 48;
+    o.spp = 4;
+    o.threads = 2;
+    o.cache = cache;
+    RayesImage *img = NULL;
+    RayesStats *st = NULL;
+    CHECK(rayes_render(s, &o, &img, &st) == RAYES_OK);
+    const RayesStat *d = st ? rayes_stats_find(st, "shading_points/by_depth") : NULL;
+    *depth1 = d && d->n_counts > 1 ? d->counts[1] : 0;
+    double mean = 0.0;
+    for (int i = 0; img && i < img->width * img->height; i++)
+        mean += img->rgba[4 * i] / (double)(img->width * img->height);
+    rayes_image_free(img);
+    rayes_stats_free(st);
+    rayes_scene_release(s);
+    return mean;
+}
+
+/* Cached, the floor's coarse lookups shade one point per miss, as many as
+ * the uncached render (its corners made three times as many), and the
+ * red bounced onto the wall is the same within noise. */
+static void test_dense_mesh_coarse_level(void)
+{
+    uint64_t on, off;
+    double mean_on = dense_floor(1, &on), mean_off = dense_floor(0, &off);
+    CHECK(off > 1000);
+    CHECK(on <= off + off / 10);
+    CHECK(fabs(mean_on - mean_off) < 0.02 * mean_off);
+}
+
 TEST_MAIN(TEST(test_interpolation_is_exact_for_linear_functions), TEST(test_medium_aliasing),
           TEST(test_level_choice), TEST(test_same_bytes_for_any_budget_and_threads),
-          TEST(test_grid_size))
+          TEST(test_grid_size), TEST(test_dense_mesh_coarse_level))

@@ -92,13 +92,7 @@ static RayesScene *dense_mesh(int n, float **points)
             p[0] = 0.37f * i / n - 0.2f, p[1] = 0.41f * j / n - 0.2f;
             p[2] = 0.01f * sinf(0.7f * i) * cosf(0.3f * j);
         }
-    for (int j = 0, f = 0; j < n; j++)
-        for (int i = 0; i < n; i++, f += 2) {
-            int a = j * m + i, b = a + 1, c = a + m + 1, d = a + m;
-            const int tri[6] = {a, b, c, a, c, d};
-            memcpy(&idx[3 * f], tri, sizeof tri);
-            nv[f] = nv[f + 1] = 3;
-        }
+    test_lattice_triangles(n, nv, idx);
     CHECK(rayes_scene_polygon_mesh(s, 2 * (size_t)n * n, nv, idx, (size_t)m * m, P) == RAYES_OK);
     CHECK(rayes_scene_commit(s) == RAYES_OK);
     free(nv), free(idx);
