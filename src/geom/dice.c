@@ -295,7 +295,9 @@ static int nearest_power_of_two(int n)
  * to a triangle), so none is longer than its longest edge; the corners
  * place it against the view as the lattice does (side planes and the eye
  * plane bound convex half-spaces), and the off-screen factor, left out,
- * only lengthens the unit. rate: the target edge in pixels. */
+ * only lengthens the unit. (Far from the origin the lattice's sums of
+ * roundings could say two where this says one: DESIGN.md.) rate: the
+ * target edge in pixels. */
 static int one_micropolygon(const Prim *prim, const Domain *d, const DiceCamera *cam, float rate)
 {
     if (prim->type != PRIM_TRIANGLE)

@@ -447,10 +447,13 @@ static long stitch_curve(const Curve *c, Vec3 *P, Moved *mv)
 /* Nonzero for a grid of one micropolygon over a whole undisplaced
  * triangle (a dense mesh's faces, nearly all of its grids): its vertices
  * are the triangle's corners, bit for bit (geom_prim_eval weighs them),
- * as are its neighbours' copies of them, and a finer neighbour's
- * vertices along its straight edges lie on them to a rounding. Nothing
- * to stitch: its sides are not collected (for a mesh of 8 million
- * triangles, 2.7 GB of sides and a fifth of the preparation). */
+ * as are its neighbours' copies of them, and a finer undisplaced
+ * neighbour's vertices along its straight edges lie on them to a
+ * rounding. Nothing to stitch, in a scene where nothing stitched is
+ * displaced (a displaced neighbour, of another mesh sharing the corners'
+ * bits, must be moved onto its edge): its sides are not collected (for a
+ * mesh of 8 million triangles, 2.7 GB of sides and a fifth of the
+ * preparation). */
 static int whole_flat_triangle(const Grid *g, const Prim *prim)
 {
     static const float whole[3][2] = {{0, 0}, {1, 0}, {0, 1}};
@@ -525,11 +528,15 @@ static Side *collect_sides(const GridSet *gs, const Prim *prims, size_t *n)
     *n = 0;
     if (!sides)
         return NULL;
+    int displaced = 0;
+    for (size_t g = 0; g < gs->n_grids && !displaced; g++)
+        displaced =
+            geom_prim_stitched(&prims[gs->grids[g].prim]) && prims[gs->grids[g].prim].displacement;
     for (size_t g = 0; g < gs->n_grids; g++) {
         const Grid *grid = &gs->grids[g];
         const Prim *prim = &prims[grid->prim];
         if (grid->shape != GEOM_SHAPE_SURFACE || !geom_prim_stitched(prim) ||
-            whole_flat_triangle(grid, prim))
+            (!displaced && whole_flat_triangle(grid, prim)))
             continue;
         for (int side = 0; side < 4; side++)
             *n += (size_t)grid_side(grid, prim, side, &sides[*n]);

@@ -1226,6 +1226,16 @@ static int master_cameras(const RayesScene *s, const GridSet *gs, DiceCamera *ca
     return 0;
 }
 
+/* Primitive i as cam dices it: its shading rate coarser when it is
+ * blurred (scene_blur_dice_factor). */
+static Prim as_diced(const RayesScene *s, size_t i, const DiceCamera *cam)
+{
+    Prim p = s->prims[i];
+    float c = scene_blur_dice_factor(s, i, cam);
+    p.shading_rate *= c * c; /* a rate is an area */
+    return p;
+}
+
 /* The grid vertices primitives first.. of s need at cams' rates (blurred
  * ones coarser), counted without dicing (the same walk as dicing); the
  * grids are added to *grids when that is not NULL. */
@@ -1236,9 +1246,7 @@ static size_t count_from(const RayesScene *s, const DiceCamera *cams, size_t fir
         const DiceCamera *ck = &cams[s->prims[k].master];
         if (ck->grid_size < 0)
             continue;
-        Prim p = s->prims[k];
-        float c = scene_blur_dice_factor(s, k, ck);
-        p.shading_rate *= c * c; /* a rate is an area */
+        Prim p = as_diced(s, k, ck);
         total += geom_count_prim(&p, ck, grids);
     }
     return total;
@@ -1257,9 +1265,7 @@ static size_t dice_all(const RayesScene *s, const DiceCamera *cams, size_t budge
         const DiceCamera *cam = &cams[s->prims[i].master];
         if (cam->grid_size < 0)
             continue;
-        Prim blurred = s->prims[i];
-        float coarser = scene_blur_dice_factor(s, i, cam);
-        blurred.shading_rate *= coarser * coarser; /* a rate is an area */
+        Prim blurred = as_diced(s, i, cam);
         if (geom_dice_prim(gs, &blurred, (uint32_t)i, s->pv, cam) != 0)
             return (size_t)-1;
         if (budget && gs->n_vertices > budget)
@@ -1276,11 +1282,24 @@ static size_t dice_all(const RayesScene *s, const DiceCamera *cams, size_t budge
     return 0;
 }
 
+/* Whether the primitives' smallest grids (three vertices or four each)
+ * already exceed the budget: then the first dicing, which would stop at
+ * the budget, is left out for counting (a mesh of 8 million triangles:
+ * 2 GB of grids diced and dropped, 8 of its 25 s). */
+static int over_budget(const RayesScene *s, const DiceCamera *cams, size_t budget)
+{
+    size_t least = 0;
+    for (size_t i = 0; i < s->n_prims && budget; i++)
+        if (cams[s->prims[i].master].grid_size >= 0)
+            least += geom_prim_triangular(&s->prims[i]) ? 3 : 4;
+    return budget && least > budget;
+}
+
 /* About the bytes grids take with their ray tracing data: per vertex its
  * position, normal, derivatives, (u, v) and the primitive variables the
  * scene carries, and Embree's share; per grid its record and Embree's
  * (measured on a mesh of 8 million triangles diced whole: 362 bytes a
- * grid of three vertices, 78 of them Embree's; this says 414). */
+ * grid of three vertices, 78 of them Embree's; this says 420). */
 static double grid_bytes(const RayesScene *s, size_t vertices, size_t grids)
 {
     unsigned pv = 0;
@@ -1318,7 +1337,9 @@ int scene_prepare(const RayesScene *s, int width, int height, const DiceOptions 
      * rounds, and none after one that saved under 1%: primitives at their
      * minimum sizes, a dense mesh's, cannot shrink) and the scene diced
      * once more. */
-    size_t first_need = dice_all(s, cams, budget, &sv, 1e-3f * radius, gs);
+    size_t first_need = over_budget(s, cams, budget)
+                            ? count_from(s, cams, 0, NULL)
+                            : dice_all(s, cams, budget, &sv, 1e-3f * radius, gs);
     if (first_need == (size_t)-1) {
         free(cams);
         return -1;
@@ -1334,8 +1355,21 @@ int scene_prepare(const RayesScene *s, int width, int height, const DiceOptions 
             if ((double)need > 0.99 * (double)before)
                 break;
         }
-        /* Too big for the memory left: a clear error, not the kernel's
-         * out-of-memory killer halfway through. */
+        GeomInstance *keep = gs->instances; /* the instances stay; the grids go */
+        size_t n_keep = gs->n_instances, n_moving = gs->n_moving_instances;
+        Mat4 *keep_motion = gs->instance_motion;
+        gs->instances = NULL;
+        gs->instance_motion = NULL;
+        geom_gridset_fini(gs);
+        geom_gridset_init(gs);
+        gs->instances = keep;
+        gs->n_instances = n_keep;
+        gs->instance_motion = keep_motion;
+        gs->n_moving_instances = n_moving;
+        gs->n_masters = s->n_masters;
+        /* Too big for the memory left (measured with the first dicing
+         * dropped): a clear error, not the kernel's out-of-memory killer
+         * half way through. */
         double bytes = grid_bytes(s, need, grids), room = dice ? dice->memory_limit : 0.0;
         if (room <= 0.0) {
             uint64_t phys = mem_physical_bytes(), rss = mem_rss_bytes();
@@ -1351,18 +1385,6 @@ int scene_prepare(const RayesScene *s, int width, int height, const DiceOptions 
             free(cams);
             return -1;
         }
-        GeomInstance *keep = gs->instances; /* the instances stay; the grids go */
-        size_t n_keep = gs->n_instances, n_moving = gs->n_moving_instances;
-        Mat4 *keep_motion = gs->instance_motion;
-        gs->instances = NULL;
-        gs->instance_motion = NULL;
-        geom_gridset_fini(gs);
-        geom_gridset_init(gs);
-        gs->instances = keep;
-        gs->n_instances = n_keep;
-        gs->instance_motion = keep_motion;
-        gs->n_moving_instances = n_moving;
-        gs->n_masters = s->n_masters;
         if (dice_all(s, cams, 0, &sv, 1e-3f * radius, gs) == (size_t)-1) {
             free(cams);
             return -1;

@@ -23,7 +23,8 @@ double time_cpu(void);
 /* The process's peak resident set size in bytes (0 if unknown). */
 uint64_t mem_peak_rss_bytes(void);
 /* The process's resident memory now (0 if unknown), and the machine's
- * physical memory (UINT64_MAX if unknown), bytes. */
+ * physical memory, or its container's limit when lower (UINT64_MAX if
+ * unknown), bytes. */
 uint64_t mem_rss_bytes(void);
 uint64_t mem_physical_bytes(void);
 

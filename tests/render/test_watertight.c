@@ -290,6 +290,36 @@ static void test_displaced_mixed_mesh_is_watertight(void)
     rayes_scene_release(s);
 }
 
+/* The icosahedron as two meshes sharing edges: ten faces displaced, ten
+ * undisplaced and each one micropolygon (shading rate 1e6), whose grids
+ * need no stitching among themselves (geom/stitch.c whole_flat_triangle)
+ * but must hold the displaced faces' sides on their edges (1,935 leaked
+ * rays when they were left out). */
+static void test_displaced_beside_one_micropolygon_faces(void)
+{
+    float P[12][3];
+    int idx[60], nv[20];
+    icosahedron(P, idx);
+    for (int f = 0; f < 20; f++)
+        nv[f] = 3;
+    RayesScene *s = scene_with_marker();
+    const RayesParam amp = {"amplitude", RAYES_PARAM_FLOAT, {0.03f, 0, 0}, NULL};
+    CHECK(rayes_scene_set_displacement(s, "fractal", &amp, 1) == RAYES_OK);
+    CHECK(rayes_scene_set_displacement_bound(s, 0.2f) == RAYES_OK);
+    CHECK(rayes_scene_polygon_mesh(s, 10, nv, idx, 12, &P[0][0]) == RAYES_OK);
+    CHECK(rayes_scene_set_displacement(s, NULL, NULL, 0) == RAYES_OK);
+    CHECK(rayes_scene_set_shading_rate(s, 1e6f) == RAYES_OK);
+    CHECK(rayes_scene_polygon_mesh(s, 10, nv + 10, idx + 30, 12, &P[0][0]) == RAYES_OK);
+    CHECK(rayes_scene_set_shading_rate(s, 16.0f) == RAYES_OK);
+    add_marker(s);
+    CHECK(rayes_scene_commit(s) == RAYES_OK);
+    long n = leaks(s, 2);
+    printf("displaced beside one-micropolygon faces: %ld leaked rays of %d\n", n,
+           4 * IMAGE * IMAGE);
+    CHECK(n == 0);
+    rayes_scene_release(s);
+}
+
 /* Holes are holes: a flat 3 x 3 Catmull-Clark grid whose middle face is a
  * hole; rays through the middle of the hole (a square of half its size)
  * miss, rays through the other faces' middles hit. */
@@ -340,7 +370,8 @@ static void test_hole_lets_rays_through(void)
     rayes_scene_release(s);
 }
 
-TEST_MAIN(TEST(test_hole_lets_rays_through), TEST(test_subdivision_mesh_is_watertight), TEST(test_polygon_mesh_is_watertight),
-          TEST(test_ngon_mesh_is_watertight), TEST(test_loop_mesh_is_watertight),
-          TEST(test_triangle_mesh_is_watertight),
-          TEST(test_displaced_mixed_mesh_is_watertight))
+TEST_MAIN(TEST(test_hole_lets_rays_through), TEST(test_subdivision_mesh_is_watertight),
+          TEST(test_polygon_mesh_is_watertight), TEST(test_ngon_mesh_is_watertight),
+          TEST(test_loop_mesh_is_watertight), TEST(test_triangle_mesh_is_watertight),
+          TEST(test_displaced_mixed_mesh_is_watertight),
+          TEST(test_displaced_beside_one_micropolygon_faces))
