@@ -209,10 +209,13 @@ static void test_ngon_mesh_is_watertight(void)
     rayes_scene_release(s);
 }
 
-/* A perturbed icosahedron, its 20 faces counter-clockwise from outside,
+/* A perturbed icosahedron, its 20 faces (3 corners each, in nv)
+ * counter-clockwise from outside,
  * scaled to hold the marker: a closed mesh of triangles only. */
-static void icosahedron(float P[12][3], int idx[60])
+static void icosahedron(float P[12][3], int idx[60], int nv[20])
 {
+    for (int f = 0; f < 20; f++)
+        nv[f] = 3;
     static const int faces[20][3] = {
         {0, 11, 5}, {0, 5, 1},  {0, 1, 7},   {0, 7, 10}, {0, 10, 11}, {1, 5, 9}, {5, 11, 4},
         {11, 10, 2}, {10, 7, 6}, {7, 1, 8},  {3, 9, 4},  {3, 4, 2},   {3, 2, 6}, {3, 6, 8},
@@ -233,9 +236,7 @@ static void test_loop_mesh_is_watertight(void)
 {
     float P[12][3];
     int idx[60], nv[20];
-    icosahedron(P, idx);
-    for (int f = 0; f < 20; f++)
-        nv[f] = 3;
+    icosahedron(P, idx, nv);
     RayesScene *s = scene_with_marker();
     CHECK(rayes_scene_subdivision_mesh(s, RAYES_SUBDIV_LOOP, 20, nv, idx, 12, &P[0][0], NULL,
                                        NULL, 0) == RAYES_OK);
@@ -253,9 +254,7 @@ static void test_triangle_mesh_is_watertight(void)
 {
     float P[12][3];
     int idx[60], nv[20];
-    icosahedron(P, idx);
-    for (int f = 0; f < 20; f++)
-        nv[f] = 3;
+    icosahedron(P, idx, nv);
     RayesScene *s = scene_with_marker();
     CHECK(rayes_scene_polygon_mesh(s, 20, nv, idx, 12, &P[0][0]) == RAYES_OK);
     add_marker(s);
@@ -299,9 +298,7 @@ static void test_displaced_beside_one_micropolygon_faces(void)
 {
     float P[12][3];
     int idx[60], nv[20];
-    icosahedron(P, idx);
-    for (int f = 0; f < 20; f++)
-        nv[f] = 3;
+    icosahedron(P, idx, nv);
     RayesScene *s = scene_with_marker();
     const RayesParam amp = {"amplitude", RAYES_PARAM_FLOAT, {0.03f, 0, 0}, NULL};
     CHECK(rayes_scene_set_displacement(s, "fractal", &amp, 1) == RAYES_OK);
