@@ -589,30 +589,22 @@ static int h_light_source(Rib *r, const Args *a)
     int mapped = strcmp(type, "pointlight") == 0 || strcmp(type, "spotlight") == 0;
     for (size_t k = 0; k < n && L->n < RIB_LIGHT_PARAMS; k++) {
         const Param *q = &p[k];
-        if (mapped && (strcmp(q->d.name, "mapname") == 0 || strcmp(q->d.name, "mapping") == 0) &&
+        /* a map: a point or spot light's intensity by direction (rayes'
+         * own), or an environment's */
+        int map_param =
+            env ||
+            (mapped && (strcmp(q->d.name, "mapname") == 0 || strcmp(q->d.name, "mapping") == 0));
+        if (map_param &&
             environment_map(L, q, &L->params[L->n], L->names[L->n], sizeof L->names[0])) {
-            /* rayes' own: a point or spot light's intensity by direction */
-            if (L->mapname[0] && strcmp(L->names[L->n], "mapname") == 0 &&
-                !texture_found(r, L->mapname)) {
-                rib_warn_once(r, "point light map",
-                              "light \"%s\": map \"%.200s\" is not found as given nor on the "
-                              "texture search path; the light is even",
-                              name, L->mapname);
-                L->mapname[0] = '\0';
-                continue;
-            }
-            L->n++;
-            continue;
-        }
-        if (env && environment_map(L, q, &L->params[L->n], L->names[L->n], sizeof L->names[0])) {
-            /* a production light's map that is not there (a renderer's own
-             * format elsewhere): the constant environment, as before */
-            if (strcmp(name, "environmentlight") != 0 && L->mapname[0] &&
+            /* a map that is not there (for a production light, a renderer's
+             * own format elsewhere): an even light, a constant environment */
+            if ((mapped || strcmp(name, "environmentlight") != 0) && L->mapname[0] &&
                 strcmp(L->names[L->n], "mapname") == 0 && !texture_found(r, L->mapname)) {
-                rib_warn_once(r, "light map",
-                              "light shader \"%s\": map \"%.200s\" is not found "
-                              "as given nor on the texture search path; a constant environment",
-                              name, L->mapname);
+                rib_warn_once(r, mapped ? "point light map" : "light map",
+                              "light%s \"%s\": map \"%.200s\" is not found as given nor on the "
+                              "texture search path; %s",
+                              mapped ? "" : " shader", name, L->mapname,
+                              mapped ? "the light is even" : "a constant environment");
                 L->mapname[0] = '\0';
                 continue;
             }

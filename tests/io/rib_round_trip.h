@@ -17,9 +17,14 @@
 #include "io/sink.h"
 #include "rayes/rayes.h"
 
-/* A new scene (release it) of a RIB text named t.rib; *e the reader's
- * result, err its message. */
-static RayesScene *rib_read_scene(const char *text, RayesError *e, char *err, size_t n)
+typedef RayesError (*SceneParse)(const char *name, const unsigned char *data, size_t size,
+                                 const IoSink *sink, const IoReadOptions *options,
+                                 IoSettings *settings, char *err, size_t err_size);
+
+/* A new scene (release it) of a text read by parse as file `name`; *e
+ * the reader's result, err its message. */
+static inline RayesScene *read_scene_text(SceneParse parse, const char *name, const char *text,
+                                          RayesError *e, char *err, size_t n)
 {
     RayesScene *s = rayes_scene_new();
     IoSink sink = io_sink_scene(s);
@@ -27,24 +32,19 @@ static RayesScene *rib_read_scene(const char *text, RayesError *e, char *err, si
     io_settings_init(&settings);
     IoReadOptions opt = {RAYES_TEST_DATA, -1};
     err[0] = '\0';
-    *e = io_rib_parse("t.rib", (const unsigned char *)text, strlen(text), &sink, &opt, &settings,
-                      err, n);
+    *e = parse(name, (const unsigned char *)text, strlen(text), &sink, &opt, &settings, err, n);
     return s;
 }
 
-/* A new scene (release it) of a pbrt-v4 text named t.pbrt; *e the
- * reader's result, err its message. */
+/* A RIB text named t.rib, and a pbrt-v4 text named t.pbrt. */
+static RayesScene *rib_read_scene(const char *text, RayesError *e, char *err, size_t n)
+{
+    return read_scene_text(io_rib_parse, "t.rib", text, e, err, n);
+}
+
 static inline RayesScene *pbrt_read_scene(const char *text, RayesError *e, char *err, size_t n)
 {
-    RayesScene *s = rayes_scene_new();
-    IoSink sink = io_sink_scene(s);
-    IoSettings settings;
-    io_settings_init(&settings);
-    IoReadOptions opt = {RAYES_TEST_DATA, -1};
-    err[0] = '\0';
-    *e = io_pbrt_parse("t.pbrt", (const unsigned char *)text, strlen(text), &sink, &opt, &settings,
-                       err, n);
-    return s;
+    return read_scene_text(io_pbrt_parse, "t.pbrt", text, e, err, n);
 }
 
 /* The written RIB (malloc'd; free it), or NULL if reading or writing
