@@ -11,6 +11,7 @@
 #define RAYES_RENDER_PATH_H
 
 #include "render/render.h"
+#include "shade/diffusion.h"
 
 /* The simplified ray differential of DESIGN.md: the footprint at distance t
  * is width + t * spread. */
@@ -35,6 +36,16 @@ static inline float path_footprint(RayDiff d, float t)
 
 typedef struct GridShading GridShading;
 
+/* A medium under a surface as the subsurface service uses it
+ * (subsurface.c): its three channels' profile constants and its lengths
+ * in scene units, and the parameters they came from. */
+typedef struct SubsurfaceMedium {
+    RayesSubsurfaceParams params;
+    DiffusionChannel ch[3];
+    float scale; /* scene units per mm */
+    float mfp;   /* the mean over channels of 1 / sigma_t', scene units */
+} SubsurfaceMedium;
+
 /* Workers sit side by side in one array, each written all the time by its
  * own thread (statistics, cache counters, the ray's time): aligned to a
  * cache line, so that no two share one. */
@@ -53,6 +64,10 @@ typedef struct Worker {
     float time;                   /* the time of the ray being shaded (scene time): rays the
                                      shading traces take it (integrator_trace sets and restores
                                      it; a cache fill sets its segment's middle) */
+    SubsurfaceMedium medium;      /* the subsurface service's last medium: a shader passes
+                                     the same one call after call, and setting one up is
+                                     three profiles' constants (subsurface.c) */
+    int has_medium;
 } Worker;
 
 /* What a shading context's `renderer` points to: per point (indexed from

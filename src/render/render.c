@@ -212,21 +212,31 @@ static void render_samples(Frame *f, Worker *w, int px, int py, int x0, int y0, 
     uint32_t pattern = (uint32_t)hash_combine(pixel_key, DIM_PIXEL);
     const Camera *cam = &f->rs->camera;
     uint32_t n = (uint32_t)(set->pattern_spp > 0 ? set->pattern_spp : set->spp);
+    /* the block's patterns, their shuffles tabled once for its samples */
+    CmjPattern pixel_pat, lens_pat;
+    uint32_t pat_block = UINT32_MAX;
     for (int k = k0; k < k1; k++) {
         uint32_t s = (uint32_t)(set->first_sample + k), block = s / n;
         uint32_t p = block ? (uint32_t)hash_combine(pattern, block) : pattern;
         float jx, jy, lu = 0.5f, lv = 0.5f, time = cam->shutter[0];
+        if (block != pat_block) {
+            if (!f->adaptive)
+                cmj_pattern_init(&pixel_pat, n, p);
+            if (cam->lens_radius > 0.0f)
+                cmj_pattern_init(&lens_pat, n, (uint32_t)hash_combine(p, DIM_LENS));
+            pat_block = block;
+        }
         if (f->adaptive) /* stratified over all the blocks a pixel takes */
             sobol_owen_2d(s, pattern, &jx, &jy);
         else
-            cmj_sample_2d(s % n, n, p, &jx, &jy);
+            cmj_pattern_sample(&pixel_pat, s % n, &jx, &jy);
         /* Time and lens position: stratified over the same n samples, with
          * patterns of their own (DESIGN.md "Sampling and determinism"). */
         if (cam->shutter[1] > cam->shutter[0])
             time += (cam->shutter[1] - cam->shutter[0]) *
                     stratified_1d(s % n, n, (uint32_t)hash_combine(p, DIM_TIME));
         if (cam->lens_radius > 0.0f)
-            cmj_sample_2d(s % n, n, (uint32_t)hash_combine(p, DIM_LENS), &lu, &lv);
+            cmj_pattern_sample(&lens_pat, s % n, &lu, &lv);
         float x = (float)px + jx, y = (float)py + jy;
         RayDiff diff = {cam->pixel_width, cam->pixel_spread, 0.0f, 0.0f};
         Ray ray = render_camera_ray_at(f->rs, set->width, set->height, x, y, time, lu, lv,

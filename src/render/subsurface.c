@@ -25,6 +25,7 @@
 #include "render/subsurface.h"
 
 #include <math.h>
+#include <string.h>
 
 #include "render/integrator.h"
 #include "render/radiosity.h"
@@ -33,15 +34,16 @@
 
 #define SUBSURFACE_PI 3.14159265358979f
 
-/* The medium of a call: its three channels and lengths in scene units. */
-typedef struct Medium {
-    DiffusionChannel ch[3];
-    float scale; /* scene units per mm */
-    float mfp;   /* the mean over channels of 1 / sigma_t', scene units */
-} Medium;
+typedef SubsurfaceMedium Medium;
 
-static void medium_init(const RayesSubsurfaceParams *p, Medium *m)
+/* The medium of a call's parameters: the worker's last one when they are
+ * the same (a shader's calls, chunk after chunk), else set up again. */
+static const Medium *medium_of(Worker *w, const RayesSubsurfaceParams *p)
 {
+    Medium *m = &w->medium;
+    if (w->has_medium && memcmp(&m->params, p, sizeof *p) == 0)
+        return m;
+    m->params = *p;
     m->scale = p->scale > 0.0f ? p->scale : 1.0f;
     float mfp = 0.0f;
     for (int c = 0; c < 3; c++) {
@@ -49,6 +51,8 @@ static void medium_init(const RayesSubsurfaceParams *p, Medium *m)
         mfp += m->ch[c].zr / 3.0f;
     }
     m->mfp = mfp * m->scale;
+    w->has_medium = 1;
+    return m;
 }
 
 /* A unit direction uniform over the sphere, from a point of [0,1)^2. */
@@ -131,8 +135,7 @@ void subsurface_service(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
     Worker *w = ps->w;
     int n = n_rays > 0 ? n_rays : w->set->subsurface_rays;
     const GridSet *gs = w->rs->gs;
-    Medium m;
-    medium_init(p, &m);
+    const Medium *m = medium_of(w, p);
     for (size_t i = 0; i < ctx->n_points; i++) {
         size_t j = ctx->first_point + i;
         if (n <= 0 || ps->grid >= gs->n_grids) {
@@ -146,6 +149,6 @@ void subsurface_service(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
                               .object = gs->grids[ps->grid].object,
                               .key = hash_combine(ps->keys[j], DIM_SUBSURFACE)};
         w->stats.subsurface_points++;
-        v3_store(out[i], integrate_point(w, &m, &sp, n));
+        v3_store(out[i], integrate_point(w, m, &sp, n));
     }
 }

@@ -3,6 +3,7 @@
  */
 #include "util/media.h"
 
+#include <ctype.h>
 #include <stddef.h>
 #include <strings.h>
 
@@ -22,10 +23,15 @@ const MeasuredMedium media_measured[] = {
     {NULL, {0, 0, 0}, {0, 0, 0}},
 };
 
+/* Shaders look their preset up at every call: the names are lower case,
+ * so a first letter that differs skips the comparison. */
 const MeasuredMedium *media_find(const char *name)
 {
-    for (const MeasuredMedium *m = media_measured; name && m->name; m++)
-        if (strcasecmp(name, m->name) == 0)
+    if (!name)
+        return NULL;
+    int first = tolower((unsigned char)name[0]);
+    for (const MeasuredMedium *m = media_measured; m->name; m++)
+        if (first == m->name[0] && strcasecmp(name, m->name) == 0)
             return m;
     return NULL;
 }
