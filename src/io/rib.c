@@ -509,9 +509,6 @@ static const RibRequest own_requests[] = {
     {"NuPatch", h_skip},
     {"TrimCurve", h_skip},
     {"Procedural2", h_skip},
-    {"Bxdf", h_skip},
-    {"Light", h_skip},
-    {"Integrator", h_skip},
     {"DisplayChannel", h_skip},
     {"DisplayFilter", h_skip},
     {"SampleFilter", h_skip},
@@ -557,9 +554,9 @@ static const RibRequest own_requests[] = {
     {NULL, NULL},
 };
 
-static const RibRequest *const tables[] = {rib_frame_requests, rib_state_requests,
-                                           rib_params_requests, rib_shade_requests,
-                                           rib_prim_requests, rib_curves_requests, own_requests};
+static const RibRequest *const tables[] = {
+    rib_frame_requests, rib_state_requests, rib_params_requests, rib_shade_requests,
+    rib_ris_requests,   rib_prim_requests,  rib_curves_requests, own_requests};
 
 static int dispatch(Rib *r, const Args *a)
 {

@@ -1180,6 +1180,9 @@ static int h_geometry(Rib *r, const Args *a)
     const char *name = rib_get_string(r, a, &i, "a geometry name");
     if (!name)
         return -1;
+    int light = rib_ris_geometry_light(r, name);
+    if (light != 0)
+        return light < 0 ? -1 : 0;
     if (strcmp(name, "teapot") != 0) {
         char key[128];
         snprintf(key, sizeof key, "geometry %s", name);

@@ -113,12 +113,15 @@ typedef struct Attr {
     int area_twosided;         /* its "twosided" (rayes's own parameter; default 0) */
     unsigned char on[RIB_MAX_LIGHTS / 8]; /* bit k: Rib.lights[k] is on */
     float area_L[3];
+    char area_map[256]; /* its environment map (RenderMan 19-20's envsphere), or "" */
     float ubasis[16], vbasis[16];
     int ustep, vstep;
     int lod_coarse; /* DetailRange ends before infinity: a coarser representation,
                        whose primitives are skipped */
     int roundcurve; /* Attribute "dice" "roundcurve": curves without N are tubes */
     uint32_t visibility; /* Attribute "visibility": RayesRayType bits of the rays that see it */
+    int camera_said;     /* Attribute "visibility" "camera" 1 is in force (RenderMan 21's
+                            lights are seen by the camera only then) */
     int hitmode;         /* Attribute "shade" "transmissionhitmode": RayesTransmissionHitMode */
     int opacity_cache;   /* Attribute "shade" "opacitycache": 0, its opacity is never cached */
     float motionfactor, focusfactor; /* Attribute "dice" "motionfactor", "focusfactor" */
@@ -156,6 +159,7 @@ typedef struct Light {
     char category[128];
     char mapname[1024]; /* an environment light's map, as given */
     char mapping[32];   /* and its layout ("latlong", "octahedral") */
+    char shape[16];     /* an arealight's ("quad", "disk", "sphere") */
     size_t n;
     float M[16];   /* world_from_light (camera_from_light before WorldBegin) */
     int n_motion;  /* a light moving within the frame (MotionBegin around its transform,
@@ -163,6 +167,9 @@ typedef struct Light {
     float motion_time[RIB_MAX_TIMES];
     float motion_M[RIB_MAX_TIMES][16];
     int pre_world;
+    int own_visibility; /* a light with geometry of its own seen by the rays of visibility
+                           (RenderMan 21's), else the geometry's visibility as it is */
+    uint32_t visibility;
     long index;    /* the sink's index of the light once sent, else -1 */
 } Light;
 
@@ -378,6 +385,35 @@ const IoSink *rib_out_sink(Rib *r, SinkState **st);
 int rib_emit_begin(Rib *r, const float *Cs);
 /* Sends the lights never sent and the light links, if they changed. */
 int rib_send_lights(Rib *r);
+/* The name of the Pattern that reached the sink a reference names: ref
+ * itself, or RenderMan's "pattern:output" without its output (in buf);
+ * NULL if none did. */
+const char *rib_pattern_name(const Rib *r, const char *ref, char *buf, size_t size);
+/* Whether a texture name is a readable file as given or on the texture
+ * search path. */
+int rib_texture_found(const Rib *r, const char *name);
+/* A shader record of name with copies of the parameters p (floats arrays
+ * are not taken), the attributes' to point to; NULL with the error set. */
+ShaderRec *rib_shader_rec(Rib *r, const char *name, const RayesParam *p, size_t n);
+/* A new light record of type under handle, in the current transform and
+ * on; NULL with the error set. */
+Light *rib_new_light(Rib *r, const char *handle, const char *type);
+/* Appends a parameter to a light record (a string one must be named
+ * mapname, mapping, shape or __category). */
+void rib_light_param(Light *L, const char *name, RayesParamType type, const float v[3],
+                     const char *string);
+
+/* ------------------------------ rib_ris.c: RenderMan 19 and later (RIS) */
+
+extern const RibRequest rib_ris_requests[];
+/* Geometry "rectlight", "disklight", "spherelight", "distantlight" or
+ * "envsphere" under AreaLightSource (RenderMan 19 and 20): the light of
+ * that shape; 1 if name is one of them, 0 if not, -1 on error. */
+int rib_ris_geometry_light(Rib *r, const char *name);
+/* A Pattern class of RenderMan's that rayes translates ("PxrTexture"):
+ * rayes' class and parameters in *type, p (at most 4); 0 if not one. */
+int rib_ris_pattern(Rib *r, const char *cls, const Param *p, size_t n, const char **type,
+                    RayesParam *out, size_t *n_out);
 /* At WorldEnd: sends the lights on then that were never sent, and ends
  * the world's lights. */
 int rib_flush_lights(Rib *r);

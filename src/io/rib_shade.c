@@ -69,6 +69,7 @@ static char *light_string(Light *L, const char *name)
 {
     return strcmp(name, "mapname") == 0   ? L->mapname
            : strcmp(name, "mapping") == 0 ? L->mapping
+           : strcmp(name, "shape") == 0   ? L->shape
                                           : L->category;
 }
 
@@ -85,6 +86,11 @@ static int send_light(Rib *r, Light *L)
     if (L->n_motion > 1 && !s->set_transform_motion)
         rib_warn_once(r, "MotionBegin", "this sink has no motion blur: the first sample of "
                                         "each motion block is used");
+    if (L->own_visibility && s->set_visibility) { /* the geometry's is sent again after */
+        if (s->set_visibility(s->target, L->visibility) != RAYES_OK)
+            return rib_sink_failed(r, s);
+        r->real.have_visibility = 0;
+    }
     if ((moving ? s->set_transform_motion(s->target, (size_t)L->n_motion, L->motion_time,
                                           (const float(*)[16])L->motion_M)
                 : s->set_transform(s->target, L->M)) != RAYES_OK ||
@@ -278,7 +284,6 @@ static int in_list(const char *const *list, const char *s)
     return 0;
 }
 
-/* A new shader record of name with the parameters the API can take. */
 /* Whether a Pattern of that name reached the sink. */
 static int pattern_sent(const Rib *r, const char *name)
 {
@@ -288,11 +293,24 @@ static int pattern_sent(const Rib *r, const char *name)
     return 0;
 }
 
+const char *rib_pattern_name(const Rib *r, const char *ref, char *buf, size_t size)
+{
+    if (pattern_sent(r, ref))
+        return ref;
+    const char *colon = strrchr(ref, ':'); /* RenderMan's "pattern:output" */
+    if (!colon || (size_t)(colon - ref) >= size)
+        return NULL;
+    memcpy(buf, ref, (size_t)(colon - ref));
+    buf[colon - ref] = '\0';
+    return pattern_sent(r, buf) ? buf : NULL;
+}
+
 /* make_shader's flags: keep only Kd and Ka (a stand-in for an unknown
  * shader); pass float arrays (a Pattern's data, densitygrid's density). */
 #define SHADER_ONLY_K 1
 #define SHADER_ARRAYS 2
 
+/* A new shader record of name with the parameters the API can take. */
 static ShaderRec *make_shader(Rib *r, const char *name, const Param *p, size_t n, int flags)
 {
     ShaderRec *sh = calloc(1, sizeof *sh);
@@ -313,7 +331,11 @@ static ShaderRec *make_shader(Rib *r, const char *name, const Param *p, size_t n
         if (!q->declared)
             continue;
         RayesParam o = {NULL, RAYES_PARAM_NONE, {0, 0, 0}, NULL};
-        if (q->d.reference && q->v->n == 1 && !pattern_sent(r, q->v->s[0])) {
+        char ref[160];
+        const char *pattern = q->d.reference && q->v->n == 1
+                                  ? rib_pattern_name(r, q->v->s[0], ref, sizeof ref)
+                                  : NULL;
+        if (q->d.reference && q->v->n == 1 && !pattern) {
             char key[128];
             snprintf(key, sizeof key, "reference %.100s", q->v->s[0]);
             rib_warn_once(r, key,
@@ -324,7 +346,7 @@ static ShaderRec *make_shader(Rib *r, const char *name, const Param *p, size_t n
         }
         if (q->d.ty == TY_STRING && q->v->n == 1) {
             o.type = q->d.reference ? RAYES_PARAM_PATTERN : RAYES_PARAM_STRING;
-            o.string = rib_strdup(q->v->s[0]);
+            o.string = rib_strdup(pattern ? pattern : q->v->s[0]);
             if (!o.string)
                 return NULL;
         } else if ((q->d.ty == TY_FLOAT || q->d.ty == TY_INT) && q->v->n == 1) {
@@ -354,6 +376,35 @@ static ShaderRec *make_shader(Rib *r, const char *name, const Param *p, size_t n
         if (!o.name) {
             free((char *)o.string);
             free((float *)o.floats);
+            return NULL;
+        }
+        sh->params[sh->n++] = o;
+    }
+    return sh;
+}
+
+ShaderRec *rib_shader_rec(Rib *r, const char *name, const RayesParam *p, size_t n)
+{
+    ShaderRec *sh = calloc(1, sizeof *sh);
+    if (sh)
+        sh->params = calloc(n + 1, sizeof *sh->params);
+    if (!sh || !sh->params) {
+        free(sh);
+        rib_error(r, "out of memory");
+        return NULL;
+    }
+    sh->next = r->shaders;
+    r->shaders = sh;
+    snprintf(sh->name, sizeof sh->name, "%s", name);
+    for (size_t i = 0; i < n; i++) {
+        RayesParam o = p[i];
+        o.name = rib_strdup(p[i].name);
+        o.string = p[i].string ? rib_strdup(p[i].string) : NULL;
+        o.floats = NULL;
+        if (!o.name || (p[i].string && !o.string)) {
+            free((char *)o.name);
+            free((char *)o.string);
+            rib_error(r, "out of memory");
             return NULL;
         }
         sh->params[sh->n++] = o;
@@ -465,7 +516,7 @@ static int environment_map(Light *L, const Param *q, RayesParam *o, char *name, 
 /* Whether a texture name is a readable file as given or on the texture
  * search path (the file's, then $RAYES_TEXTURE_PATH), as the scene will
  * look for it. */
-static int texture_found(const Rib *r, const char *name)
+int rib_texture_found(const Rib *r, const char *name)
 {
     if (access(name, R_OK) == 0)
         return 1;
@@ -490,6 +541,62 @@ static Light *find_light(Rib *r, const char *handle)
         if (strcmp(r->lights[k].handle, handle) == 0)
             return &r->lights[k];
     return NULL;
+}
+
+Light *rib_new_light(Rib *r, const char *handle, const char *type)
+{
+    if (r->n_lights >= RIB_MAX_LIGHTS) {
+        rib_error(r, "more than %d lights", RIB_MAX_LIGHTS);
+        return NULL;
+    }
+    /* A handle used before: a second light; the first keeps lighting as
+     * it is, and the handle names the new one from now on. */
+    Light *L = find_light(r, handle);
+    if (L)
+        L->handle[0] = '\0';
+    Light *nl = realloc(r->lights, (r->n_lights + 1) * sizeof *nl);
+    if (!nl) {
+        rib_error(r, "out of memory");
+        return NULL;
+    }
+    r->lights = nl;
+    L = &r->lights[r->n_lights++];
+    memset(L, 0, sizeof *L);
+    snprintf(L->handle, sizeof L->handle, "%s", handle);
+    snprintf(L->type, sizeof L->type, "%s", type);
+    memcpy(L->M, r->a.M, sizeof L->M);
+    L->pre_world = !r->in_world;
+    if (r->in_world && r->a.n_motion > 1) { /* a light moving within the frame */
+        L->n_motion = r->a.n_motion;
+        memcpy(L->motion_time, r->a.motion_time, (size_t)L->n_motion * sizeof *L->motion_time);
+        memcpy(L->motion_M, r->a.motion_M, (size_t)L->n_motion * sizeof L->motion_M[0]);
+    }
+    L->index = -1;
+    set_light_on(&r->a, (size_t)(L - r->lights), 1);
+    return L;
+}
+
+void rib_light_param(Light *L, const char *name, RayesParamType type, const float v[3],
+                     const char *string)
+{
+    if (L->n >= RIB_LIGHT_PARAMS)
+        return;
+    RayesParam *o = &L->params[L->n];
+    snprintf(L->names[L->n], sizeof L->names[0], "%s", name);
+    *o = (RayesParam){.name = L->names[L->n], .type = type};
+    if (type == RAYES_PARAM_STRING) {
+        char *dst = light_string(L, name);
+        size_t size = dst == L->mapname   ? sizeof L->mapname
+                      : dst == L->mapping ? sizeof L->mapping
+                      : dst == L->shape   ? sizeof L->shape
+                                          : sizeof L->category;
+        snprintf(dst, size, "%s", string);
+        o->string = dst;
+    } else {
+        for (int c = 0; c < (type == RAYES_PARAM_COLOR ? 3 : 1); c++)
+            o->value[c] = v[c];
+    }
+    L->n++;
 }
 
 static int h_light_source(Rib *r, const Args *a)
@@ -526,6 +633,8 @@ static int h_light_source(Rib *r, const Args *a)
         type = "ambientlight";
     else if (strcmp(name, "environmentlight") == 0)
         type = "environmentlight";
+    else if (strcmp(name, "arealight") == 0) /* rayes' own (what the writer writes) */
+        type = "arealight";
     else if (in_list(environment_lights, name)) {
         /* Production environment and occlusion lights: an environment
          * light (of their map, if given), whose shadow rays give the
@@ -554,37 +663,19 @@ static int h_light_source(Rib *r, const Args *a)
         free(p);
         return 0;
     }
-    if (r->n_lights >= RIB_MAX_LIGHTS) {
+    Light *L = rib_new_light(r, handle, type);
+    if (!L) {
         free(p);
-        return rib_error(r, "more than %d lights", RIB_MAX_LIGHTS);
+        return -1;
     }
-    /* A handle used before: a second light; the first keeps lighting as
-     * it is, and the handle names the new one from now on. */
-    Light *L = find_light(r, handle);
-    if (L)
-        L->handle[0] = '\0';
-    Light *nl = realloc(r->lights, (r->n_lights + 1) * sizeof *nl);
-    if (!nl) {
-        free(p);
-        return rib_error(r, "out of memory");
+    if (strcmp(type, "arealight") == 0) { /* its shape is seen as the attributes say */
+        L->own_visibility = 1;
+        L->visibility = r->a.visibility;
     }
-    r->lights = nl;
-    L = &r->lights[r->n_lights++];
-    memset(L, 0, sizeof *L);
-    snprintf(L->handle, sizeof L->handle, "%s", handle);
-    snprintf(L->type, sizeof L->type, "%s", type);
-    memcpy(L->M, r->a.M, sizeof L->M);
-    L->pre_world = !r->in_world;
-    if (r->in_world && r->a.n_motion > 1) { /* a light moving within the frame */
-        L->n_motion = r->a.n_motion;
-        memcpy(L->motion_time, r->a.motion_time, (size_t)L->n_motion * sizeof *L->motion_time);
-        memcpy(L->motion_M, r->a.motion_M, (size_t)L->n_motion * sizeof L->motion_M[0]);
-    }
-    L->index = -1;
-    set_light_on(&r->a, (size_t)(L - r->lights), 1);
     static const char *const names[] = {
         "intensity",      "lightcolor",       "from",       "to",  "coneangle",
-        "conedeltaangle", "beamdistribution", "__category", "fov", NULL};
+        "conedeltaangle", "beamdistribution", "__category", "fov", "shape",
+        "width",          "height",           "radius",     NULL};
     int env = strcmp(type, "environmentlight") == 0;
     int mapped = strcmp(type, "pointlight") == 0 || strcmp(type, "spotlight") == 0;
     for (size_t k = 0; k < n && L->n < RIB_LIGHT_PARAMS; k++) {
@@ -599,7 +690,7 @@ static int h_light_source(Rib *r, const Args *a)
             /* a map that is not there (for a production light, a renderer's
              * own format elsewhere): an even light, a constant environment */
             if ((mapped || strcmp(name, "environmentlight") != 0) && L->mapname[0] &&
-                strcmp(L->names[L->n], "mapname") == 0 && !texture_found(r, L->mapname)) {
+                strcmp(L->names[L->n], "mapname") == 0 && !rib_texture_found(r, L->mapname)) {
                 rib_warn_once(r, mapped ? "point light map" : "light map",
                               "light%s \"%s\": map \"%.200s\" is not found as given nor on the "
                               "texture search path; %s",
@@ -622,9 +713,10 @@ static int h_light_source(Rib *r, const Args *a)
         if (q->d.ty == TY_STRING) {
             if (q->v->n != 1)
                 continue;
-            snprintf(L->category, sizeof L->category, "%s", q->v->s[0]);
+            char *dst = light_string(L, q->d.name);
+            snprintf(dst, dst == L->shape ? sizeof L->shape : sizeof L->category, "%s", q->v->s[0]);
             o->type = RAYES_PARAM_STRING;
-            o->string = L->category;
+            o->string = dst;
         } else if (q->v->n == 3) {
             o->type = RAYES_PARAM_COLOR;
             for (int c = 0; c < 3; c++)
@@ -667,10 +759,23 @@ static int h_area_light(Rib *r, const Args *a)
     size_t n;
     if (rib_get_params(r, a, i, &p, &n) != 0)
         return -1;
+    /* RenderMan 19 and 20's PxrAreaLight and PxrStdAreaLight add an
+     * exposure (a power of 2) and spell the colour lightColor */
     const Param *in = rib_find_param(p, n, "intensity"), *lc = rib_find_param(p, n, "lightcolor");
+    const Param *ex = rib_find_param(p, n, "exposure");
+    if (!lc)
+        lc = rib_find_param(p, n, "lightColor");
     float I = in && rib_is_num(in->v) && in->v->n == 1 ? (float)in->v->d[0] : 1;
+    if (ex && rib_is_num(ex->v) && ex->v->n == 1)
+        I *= exp2f(fminf(fmaxf((float)ex->v->d[0], -126.0f), 126.0f));
     for (int c = 0; c < 3; c++)
         r->a.area_L[c] = I * (lc && rib_is_num(lc->v) && lc->v->n == 3 ? (float)lc->v->d[c] : 1);
+    r->a.area_map[0] = '\0';
+    for (size_t k = 0; k < n; k++) /* an envsphere's map (rib_ris.c) */
+        if (p[k].d.ty == TY_STRING && p[k].v->n == 1 &&
+            (in_list(environment_maps, p[k].d.name) || strcmp(p[k].d.name, "rman__EnvMap") == 0 ||
+             strcmp(p[k].d.name, "lightcolormap") == 0))
+            snprintf(r->a.area_map, sizeof r->a.area_map, "%s", p[k].v->s[0]);
     const Param *ts = rib_find_param(p, n, "twosided");
     r->a.area_twosided = ts && rib_is_num(ts->v) && ts->v->n == 1 && ts->v->d[0] != 0;
     free(p);
@@ -734,6 +839,11 @@ static int h_pattern(Rib *r, const Args *a)
     if (!name || rib_get_params(r, a, i, &p, &n) != 0)
         return -1;
     const IoSink *s = r->sink;
+    RayesParam ris[4];
+    size_t n_ris = 0;
+    const char *as = NULL; /* a RenderMan class rayes translates (rib_ris.c) */
+    if (!in_list(builtin_patterns, type) && rib_ris_pattern(r, type, p, n, &as, ris, &n_ris))
+        type = as;
     if (!in_list(builtin_patterns, type) || !s->pattern) {
         char key[128];
         snprintf(key, sizeof key, "pattern %.100s", type);
@@ -745,7 +855,8 @@ static int h_pattern(Rib *r, const Args *a)
         free(p);
         return 0;
     }
-    ShaderRec *sh = make_shader(r, type, p, n, SHADER_ARRAYS);
+    ShaderRec *sh =
+        as ? rib_shader_rec(r, type, ris, n_ris) : make_shader(r, type, p, n, SHADER_ARRAYS);
     free(p);
     if (!sh)
         return -1;

@@ -778,6 +778,8 @@ static int attribute_visibility(Rib *r, const Param *q)
         r->a.visibility |= bits;
     else
         r->a.visibility &= ~bits;
+    if (bits & RAYES_RAY_CAMERA)
+        r->a.camera_said = q->v->d[0] != 0;
     return 0;
 }
 

@@ -482,14 +482,20 @@ static void test_patterns(void)
     CHECK(rec.pattern_M[3] == 1 && rec.pattern_M[7] == 2 && rec.pattern_M[11] == 3);
     CHECK(strcmp(rec.shader, "diffuse") == 0 &&
           strcmp(rec.shader_pattern, "reflectance=0:checks") == 0);
-    /* RenderMan's own pattern classes are not built: skipped with a
-     * warning, and what references them keeps its default */
+    /* RenderMan's own pattern classes are not built (but PxrTexture, an
+     * imagemap): skipped with a warning, and what references them keeps
+     * its default; a reference's ":output" is RenderMan's */
     rec.pattern[0] = '\0';
-    CHECK(parse(WORLD("Pattern \"PxrTexture\" \"tex\" \"string filename\" [\"a.tex\"]\n"
-                      "Surface \"diffuse\" \"reference color reflectance\" [\"tex:resultRGB\"]\n"
+    CHECK(parse(WORLD("Pattern \"PxrFractal\" \"f\" \"int layers\" [4]\n"
+                      "Surface \"diffuse\" \"reference color reflectance\" [\"f:resultRGB\"]\n"
                       "Polygon \"P\" [0 0 0 1 0 0 1 1 0]")) == RAYES_OK);
     CHECK(rec.pattern[0] == '\0' && strcmp(rec.shader, "diffuse") == 0 &&
           rec.shader_pattern[0] == '\0');
+    CHECK(parse(WORLD("Pattern \"PxrTexture\" \"tex\" \"string filename\" [\"a.tex\"]\n"
+                      "Surface \"diffuse\" \"reference color reflectance\" [\"tex:resultRGB\"]\n"
+                      "Polygon \"P\" [0 0 0 1 0 0 1 1 0]")) == RAYES_OK);
+    CHECK(strcmp(rec.pattern, "imagemap tex") == 0 &&
+          strcmp(rec.shader_pattern, "reflectance=tex") == 0);
     /* the grid classes, a float array among their parameters */
     CHECK(parse(WORLD("Pattern \"densitygrid\" \"g\" \"float nx\" 2 \"float density\" [0.5 1.5]\n"
                       "Pattern \"nanovdb\" \"c\" \"string filename\" \"cloud.nvdb\"\n")) ==

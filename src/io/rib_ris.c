@@ -1,0 +1,464 @@
+/*
+ * io/rib_ris.c — RenderMan 19 and later (RIS): Bxdf, Light, Integrator,
+ * the geometric area lights of RenderMan 19 and 20 (Geometry "rectlight"
+ * and its kin under AreaLightSource) and the PxrTexture pattern,
+ * translated to rayes' own shaders and lights (docs/rib.md "RenderMan 19
+ * and later"). RIS describes materials by physically based lobes and
+ * lights by shapes of unit size; rayes keeps the base colour, the
+ * specular and refraction lobes and the lights' radiance, and says once
+ * what it leaves out.
+ *
+ * Lights: radiance intensity * 2^exposure * lightColor, divided by the
+ * emitting area when areaNormalize is set; shapes of RenderMan's unit
+ * size (a 1 x 1 rectangle and a disk of diameter 1 in z = 0 emitting
+ * toward +z, a sphere of diameter 1) scaled by the transform, as rayes'
+ * "arealight"; a distant light is a disk of angleExtent degrees
+ * (0.53, the sun) seen along +z, whose irradiance is its radiance times
+ * its solid angle (areaNormalize: the intensity is the irradiance).
+ */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "io/rib_reader.h"
+
+/* ------------------------------------------------------------ values */
+
+static const Param *value(const Param *p, size_t n, const char *name, size_t count)
+{
+    const Param *q = rib_find_param(p, n, name);
+    return q && !q->d.reference && rib_is_num(q->v) && q->v->n == count ? q : NULL;
+}
+
+static float num(const Param *p, size_t n, const char *name, float dflt)
+{
+    const Param *q = value(p, n, name, 1);
+    return q ? (float)q->v->d[0] : dflt;
+}
+
+/* A colour (three numbers, or one grey). */
+static void color(const Param *p, size_t n, const char *name, const float dflt[3], float out[3])
+{
+    const Param *q = value(p, n, name, 3), *g = value(p, n, name, 1);
+    for (int c = 0; c < 3; c++)
+        out[c] = q ? (float)q->v->d[c] : g ? (float)g->v->d[0] : dflt[c];
+}
+
+static float max3(const float c[3])
+{
+    return fmaxf(c[0], fmaxf(c[1], c[2]));
+}
+
+static const char *string(const Param *p, size_t n, const char *name)
+{
+    const Param *q = rib_find_param(p, n, name);
+    return q && q->d.ty == TY_STRING && !q->d.reference && q->v->n == 1 ? q->v->s[0] : NULL;
+}
+
+/* ------------------------------------------------------------ Bxdf */
+
+/* The parameters of one translated shader. */
+typedef struct Out {
+    RayesParam p[8];
+    char pattern[8][160];
+    size_t n;
+} Out;
+
+static void out_float(Out *o, const char *name, float v)
+{
+    o->p[o->n++] = (RayesParam){name, RAYES_PARAM_FLOAT, {v, 0, 0}, NULL};
+}
+
+static void out_color(Out *o, const char *name, const float c[3])
+{
+    o->p[o->n++] = (RayesParam){name, RAYES_PARAM_COLOR, {c[0], c[1], c[2]}, NULL};
+}
+
+/* A colour parameter that may reference a pattern ("tex:resultRGB", the
+ * pattern's output after the colon): the pattern, if rayes has it;
+ * otherwise the value (times gain), or dflt. */
+static void out_colour_of(Rib *r, Out *o, const char *bxdf, const Param *p, size_t n,
+                          const char *from, const char *to, const float dflt[3], float gain)
+{
+    const Param *q = rib_find_param(p, n, from);
+    if (q && q->d.reference && q->v->n == 1 && q->d.ty == TY_STRING) {
+        char buf[160];
+        const char *name = rib_pattern_name(r, q->v->s[0], buf, sizeof buf);
+        if (name) {
+            snprintf(o->pattern[o->n], sizeof o->pattern[0], "%s", name);
+            name = o->pattern[o->n];
+            if (gain != 1.0f)
+                rib_warn_once(r, "ris gain pattern",
+                              "Bxdf \"%s\": a gain other than 1 on a pattern is not applied",
+                              bxdf);
+            o->p[o->n++] = (RayesParam){to, RAYES_PARAM_PATTERN, {0, 0, 0}, name};
+            return;
+        }
+        char key[200];
+        snprintf(key, sizeof key, "ris reference %.150s", q->v->s[0]);
+        rib_warn_once(r, key,
+                      "Bxdf \"%s\": \"%s\" names the pattern \"%.100s\", which is not "
+                      "defined or of a class rayes has not; its value is used",
+                      bxdf, from, q->v->s[0]);
+    }
+    float c[3];
+    color(p, n, from, dflt, c);
+    for (int k = 0; k < 3; k++)
+        c[k] *= gain;
+    out_color(o, to, c);
+}
+
+static int referenced(const Param *p, size_t n, const char *name)
+{
+    const Param *q = rib_find_param(p, n, name);
+    return q && q->d.reference;
+}
+
+/* PxrSurface (and PxrLayerSurface): its glass lobe when it refracts; else
+ * its diffuse lobe under a coat of its specular (or clearcoat) lobe, or
+ * that lobe alone as a conductor (artistic face colour, or the physical
+ * mode's index and extinction). */
+static const char *pxr_surface(Rib *r, const char *cls, const Param *p, size_t n, Out *o)
+{
+    static const float d18[3] = {0.18f, 0.18f, 0.18f}, zero[3] = {0, 0, 0};
+    static const float ior[3] = {1.5f, 1.5f, 1.5f};
+    if (num(p, n, "refractionGain", 0) > 0) {
+        out_float(o, "eta", num(p, n, "glassIor", 1.5f));
+        out_float(o, "roughness", num(p, n, "glassRoughness", 0.1f));
+        return "dielectric";
+    }
+    float gain = num(p, n, "diffuseGain", 1), dc[3], face[3], edge[3], rough[3], coat[3];
+    color(p, n, "diffuseColor", d18, dc);
+    color(p, n, "specularFaceColor", zero, face);
+    color(p, n, "specularEdgeColor", zero, edge);
+    color(p, n, "roughSpecularFaceColor", zero, rough);
+    color(p, n, "clearcoatFaceColor", zero, coat);
+    int physical = num(p, n, "specularFresnelMode", 0) != 0;
+    float eta[3], k[3];
+    color(p, n, "specularIor", ior, eta);
+    color(p, n, "specularExtinctionCoeff", zero, k);
+    int spec = max3(face) > 0 || max3(edge) > 0 || max3(rough) > 0 ||
+               (physical && (max3(eta) != 1.0f || max3(k) > 0));
+    int diffuse = gain > 0 && (max3(dc) > 0 || referenced(p, n, "diffuseColor"));
+    if (num(p, n, "subsurfaceGain", 0) > 0 || num(p, n, "glowGain", 0) > 0 ||
+        num(p, n, "fuzzGain", 0) > 0 || num(p, n, "singlescatterGain", 0) > 0)
+        rib_warn_once(r, "ris lobes",
+                      "Bxdf \"%s\": its subsurface, glow, fuzz and single-scatter lobes are not "
+                      "translated (diffuse, specular, clearcoat and glass are)",
+                      cls);
+    if (diffuse) {
+        out_colour_of(r, o, cls, p, n, "diffuseColor", "reflectance", d18, gain);
+        if (!spec && max3(coat) <= 0)
+            return "diffuse";
+        out_float(o, "roughness", spec ? num(p, n, "specularRoughness", 0.2f)
+                                       : num(p, n, "clearcoatRoughness", 0));
+        return "coateddiffuse";
+    }
+    if (!spec && max3(coat) <= 0) {
+        out_color(o, "reflectance", zero);
+        return "diffuse";
+    }
+    if (physical) {
+        out_color(o, "eta", eta);
+        out_color(o, "k", k);
+    } else {
+        out_colour_of(r, o, cls, p, n, "specularFaceColor", "reflectance",
+                      spec ? face : coat, 1);
+    }
+    out_float(o, "roughness", num(p, n, "specularRoughness", 0.2f));
+    return "conductor";
+}
+
+/* PxrDisney: a conductor of its base colour when mostly metallic, else
+ * the base colour under a coat (its specular lobe) or bare. */
+static const char *pxr_disney(Rib *r, const char *cls, const Param *p, size_t n, Out *o)
+{
+    static const float base[3] = {0.2f, 0.5f, 0.8f};
+    out_colour_of(r, o, cls, p, n, "baseColor", "reflectance", base, 1);
+    float rough = num(p, n, "roughness", 0.25f);
+    if (num(p, n, "metallic", 0) >= 0.5f) {
+        out_float(o, "roughness", rough);
+        return "conductor";
+    }
+    if (num(p, n, "specular", 0.5f) <= 0 && num(p, n, "clearcoat", 0) <= 0)
+        return "diffuse";
+    out_float(o, "roughness", rough);
+    return "coateddiffuse";
+}
+
+static int h_bxdf(Rib *r, const Args *a)
+{
+    size_t i = 0;
+    const char *cls = rib_get_string(r, a, &i, "a Bxdf class");
+    if (!cls)
+        return -1;
+    if (i < a->n && (a->n - i) % 2 == 1 && !rib_get_string(r, a, &i, "a Bxdf name"))
+        return -1;
+    Param *p;
+    size_t n;
+    if (rib_get_params(r, a, i, &p, &n) != 0)
+        return -1;
+    static const float half[3] = {0.5f, 0.5f, 0.5f}, one[3] = {1, 1, 1}, zero[3] = {0, 0, 0};
+    Out o = {.n = 0};
+    const char *shader = "diffuse";
+    if (strcmp(cls, "PxrDiffuse") == 0) {
+        out_colour_of(r, &o, cls, p, n, "diffuseColor", "reflectance", half, 1);
+    } else if (strcmp(cls, "PxrLMDiffuse") == 0) {
+        out_colour_of(r, &o, cls, p, n, "frontColor", "reflectance", half, 1);
+    } else if (strcmp(cls, "PxrSurface") == 0 || strcmp(cls, "PxrLayerSurface") == 0) {
+        shader = pxr_surface(r, cls, p, n, &o);
+    } else if (strcmp(cls, "PxrDisney") == 0 || strcmp(cls, "PxrDisneyBsdf") == 0) {
+        shader = pxr_disney(r, cls, p, n, &o);
+    } else if (strcmp(cls, "PxrConstant") == 0) {
+        float e[3]; /* emitColor: the surface's own light, nothing reflected */
+        color(p, n, "emitColor", one, e);
+        shader = "matte";
+        out_float(&o, "Ka", 0);
+        out_float(&o, "Kd", 0);
+        out_color(&o, "Ke", e);
+    } else if (strcmp(cls, "PxrGlass") == 0 || strcmp(cls, "PxrLMGlass") == 0) {
+        shader = "dielectric";
+        out_float(&o, "eta", num(p, n, "ior", num(p, n, "eta", 1.5f)));
+        out_float(&o, "roughness", num(p, n, "roughness", 0));
+    } else if (strcmp(cls, "PxrLMPlastic") == 0) {
+        shader = "coateddiffuse";
+        out_colour_of(r, &o, cls, p, n, "diffuseColor", "reflectance", half, 1);
+        out_float(&o, "roughness", num(p, n, "specularRoughness", num(p, n, "roughness", 0.1f)));
+    } else if (strcmp(cls, "PxrLMMetal") == 0) {
+        shader = "conductor";
+        float c[3];
+        color(p, n, "specularColor", one, c);
+        out_color(&o, "reflectance", c);
+        out_float(&o, "roughness", num(p, n, "roughness", 0.1f));
+    } else if (strcmp(cls, "PxrLightEmission") == 0 || strcmp(cls, "PxrBlack") == 0) {
+        out_color(&o, "reflectance", zero); /* an emitter's own surface: its light is the
+                                               AreaLightSource's */
+    } else {
+        char key[128];
+        snprintf(key, sizeof key, "bxdf %.100s", cls);
+        rib_warn_once(r, key, "Bxdf \"%s\" is not one rayes translates: a grey diffuse instead",
+                      cls);
+    }
+    free(p);
+    ShaderRec *sh = rib_shader_rec(r, shader, o.p, o.n);
+    if (!sh)
+        return -1;
+    r->a.surface = sh;
+    return 0;
+}
+
+/* ------------------------------------------------------------ lights */
+
+/* The area the transform M gives a unit square of z = 0 (a disk's and a
+ * sphere's scale their unit ones' alike, in the plane's two directions). */
+static float plane_scale(const float M[16])
+{
+    float x[3] = {M[0], M[1], M[2]}, y[3] = {M[4], M[5], M[6]};
+    float cx = x[1] * y[2] - x[2] * y[1], cy = x[2] * y[0] - x[0] * y[2],
+          cz = x[0] * y[1] - x[1] * y[0];
+    return sqrtf(cx * cx + cy * cy + cz * cz);
+}
+
+/* The solid angle of a disk of angular diameter deg degrees: 2 pi (1 -
+ * cos h) for the half angle h, as 4 pi sin^2(h / 2) (the sun's 1 - cos
+ * is too near 0 for a float's cosine). */
+static float disk_solid_angle(float deg)
+{
+    float s = sinf(0.25f * fminf(fmaxf(deg, 0.0f), 360.0f) * (float)(M_PI / 180.0));
+    return 4.0f * (float)M_PI * s * s;
+}
+
+/* A RenderMan 19-21 light is a thing of the scene, not of the attribute
+ * block it is placed in (area lights light everything, docs/rib.md): on for the geometry after the block ends too
+ * (Illuminate still turns it off). */
+static void on_everywhere(Rib *r, const Light *l)
+{
+    size_t k = (size_t)(l - r->lights);
+    for (size_t d = 0; d < r->depth; d++)
+        r->stack[d].a.on[k / 8] |= (unsigned char)(1u << (k % 8));
+}
+
+/* Adds light cls (a RenderMan 21 Light, or the shape of a RenderMan 19-20
+ * area light: "PxrRectLight", "PxrDiskLight", "PxrSphereLight",
+ * "PxrDistantLight", "PxrDomeLight") of radiance L; 1 if made, 0 if rayes
+ * has no such light (warned), -1 on error. */
+static int make_light(Rib *r, const char *handle, const char *cls, const float L[3],
+                      int normalize, float angle, const char *map)
+{
+    if (r->rec || r->in_object) {
+        rib_warn_once(r, "light in object", "lights inside ObjectBegin are ignored");
+        return 0;
+    }
+    int rect = strcmp(cls, "PxrRectLight") == 0, disk = strcmp(cls, "PxrDiskLight") == 0;
+    int sphere = strcmp(cls, "PxrSphereLight") == 0, dist = strcmp(cls, "PxrDistantLight") == 0;
+    int dome = strcmp(cls, "PxrDomeLight") == 0;
+    if (!rect && !disk && !sphere && !dist && !dome) {
+        char key[128];
+        snprintf(key, sizeof key, "light %.100s", cls);
+        rib_warn_once(r, key,
+                      "light \"%s\" is not one rayes translates (PxrRectLight, PxrDiskLight, "
+                      "PxrSphereLight, PxrDistantLight, PxrDomeLight); the light is skipped",
+                      cls);
+        return 0;
+    }
+    float scale = 1; /* normalize: radiance over the area of the shape as placed */
+    if (normalize && (rect || disk || sphere)) {
+        float area = plane_scale(r->a.M) * (rect ? 1.0f : (float)M_PI * 0.25f);
+        if (sphere) /* a uniform scale s: 4 pi (s / 2)^2, s^2 from the plane's */
+            area = plane_scale(r->a.M) * (float)M_PI;
+        scale = area > 0 ? 1.0f / area : 1.0f;
+    } else if (dist && !normalize) {
+        scale = disk_solid_angle(angle); /* irradiance of a disk of that radiance */
+    }
+    float I = fmaxf(fmaxf(L[0], L[1]), L[2]) * scale, c[3];
+    for (int k = 0; k < 3; k++)
+        c[k] = I > 0 ? L[k] * scale / I : 0;
+    const char *type = dist ? "distantlight" : dome ? "environmentlight" : "arealight";
+    Light *l = rib_new_light(r, handle, type);
+    if (!l)
+        return -1;
+    float v[3] = {I, 0, 0};
+    rib_light_param(l, "intensity", RAYES_PARAM_FLOAT, v, NULL);
+    rib_light_param(l, "lightcolor", RAYES_PARAM_COLOR, c, NULL);
+    if (rect || disk || sphere) {
+        rib_light_param(l, "shape", RAYES_PARAM_STRING, NULL,
+                        rect ? "quad" : disk ? "disk" : "sphere");
+        float half[3] = {0.5f, 0, 0};
+        if (!rect)
+            rib_light_param(l, "radius", RAYES_PARAM_FLOAT, half, NULL);
+    } else if (dist) {
+        float from[3] = {0, 0, 0}, to[3] = {0, 0, 1};
+        rib_light_param(l, "from", RAYES_PARAM_COLOR, from, NULL);
+        rib_light_param(l, "to", RAYES_PARAM_COLOR, to, NULL);
+    } else if (map && map[0]) {
+        if (rib_texture_found(r, map))
+            rib_light_param(l, "mapname", RAYES_PARAM_STRING, NULL, map);
+        else
+            rib_warn_once(r, "light map",
+                          "light \"%s\": map \"%.200s\" is not found as given nor on the "
+                          "texture search path; a constant environment",
+                          cls, map);
+    }
+    on_everywhere(r, l);
+    return 1;
+}
+
+/* Light "class" "handle" params (RenderMan 21 and later). */
+static int h_light(Rib *r, const Args *a)
+{
+    size_t i = 0;
+    const char *cls = rib_get_string(r, a, &i, "a light class");
+    char handle[RIB_MAX_HANDLE];
+    if (!cls || rib_get_handle(r, a, &i, handle) != 0)
+        return -1;
+    Param *p;
+    size_t n;
+    if (rib_get_params(r, a, i, &p, &n) != 0)
+        return -1;
+    static const float one[3] = {1, 1, 1};
+    float L[3], I = num(p, n, "intensity", strcmp(cls, "PxrDistantLight") == 0 ? 50000 : 1);
+    I *= exp2f(fminf(fmaxf(num(p, n, "exposure", 0), -126), 126));
+    color(p, n, "lightColor", one, L);
+    for (int k = 0; k < 3; k++)
+        L[k] *= I;
+    if (num(p, n, "enableTemperature", 0) != 0)
+        rib_warn_once(r, "ris temperature", "lights' colour temperature is not applied");
+    const char *map = string(p, n, "lightColorMap");
+    int e = make_light(r, handle, cls, L, num(p, n, "areaNormalize", 0) != 0,
+                       num(p, n, "angleExtent", 0.53f), map);
+    free(p);
+    if (e > 0) { /* RenderMan 21's lights are not seen by the camera unless said */
+        Light *l = &r->lights[r->n_lights - 1];
+        l->own_visibility = 1;
+        l->visibility = r->a.camera_said ? r->a.visibility : r->a.visibility & ~RAYES_RAY_CAMERA;
+    }
+    return e < 0 ? -1 : 0;
+}
+
+int rib_ris_geometry_light(Rib *r, const char *name)
+{
+    static const char *const shapes[][2] = {{"rectlight", "PxrRectLight"},
+                                           {"disklight", "PxrDiskLight"},
+                                           {"spherelight", "PxrSphereLight"},
+                                           {"distantlight", "PxrDistantLight"},
+                                           {"envsphere", "PxrDomeLight"}};
+    const char *cls = NULL;
+    for (size_t k = 0; k < sizeof shapes / sizeof shapes[0]; k++)
+        if (strcmp(name, shapes[k][0]) == 0)
+            cls = shapes[k][1];
+    if (!cls)
+        return 0;
+    if (!r->a.area) {
+        char key[128];
+        snprintf(key, sizeof key, "geometry %s", name);
+        rib_warn_once(r, key, "Geometry \"%s\" outside AreaLightSource: skipped", name);
+        return 1;
+    }
+    if (!r->in_world)
+        return 1;
+    char handle[RIB_MAX_HANDLE];
+    snprintf(handle, sizeof handle, "@area%zu", r->n_lights);
+    return make_light(r, handle, cls, r->a.area_L, 0, 0.53f, r->a.area_map) < 0 ? -1 : 1;
+}
+
+/* ------------------------------------------------------------ Integrator */
+
+/* The most diffuse bounces a maxPathLength gives (as pbrt's maxdepth). */
+enum { RIS_DIFFUSE_BOUNCES = 8 };
+
+static int h_integrator(Rib *r, const Args *a)
+{
+    size_t i = 0;
+    const char *cls = rib_get_string(r, a, &i, "an integrator class");
+    if (!cls)
+        return -1;
+    if (i < a->n && (a->n - i) % 2 == 1 && !rib_get_string(r, a, &i, "an integrator name"))
+        return -1;
+    Param *p;
+    size_t n;
+    if (rib_get_params(r, a, i, &p, &n) != 0)
+        return -1;
+    /* maxPathLength counts the camera ray's segment: N - 1 diffuse
+     * bounces (each cached apart, so capped as pbrt's maxdepth is) */
+    float len = num(p, n, "maxPathLength", 10);
+    free(p);
+    if (strcmp(cls, "PxrDirectLighting") == 0) {
+        r->settings->bounces = 0;
+        return 0;
+    }
+    if (!(len >= 0 && len <= 1e6))
+        return rib_error(r, "\"%s\": expected maxPathLength >= 0", cls);
+    int bounces = len >= 1 ? (int)len - 1 : 0;
+    r->settings->bounces = bounces < RIS_DIFFUSE_BOUNCES ? bounces : RIS_DIFFUSE_BOUNCES;
+    r->settings->specular_depth = (int)len;
+    if (bounces > RIS_DIFFUSE_BOUNCES)
+        rib_warn_once(r, "ris bounces",
+                      "Integrator \"%s\" maxPathLength %g: %d diffuse bounces, not %d (each "
+                      "costs about as much as the first; --bounces N for more)",
+                      cls, len, RIS_DIFFUSE_BOUNCES, bounces);
+    return 0;
+}
+
+/* ------------------------------------------------------------ patterns */
+
+int rib_ris_pattern(Rib *r, const char *cls, const Param *p, size_t n, const char **type,
+                    RayesParam *out, size_t *n_out)
+{
+    (void)r;
+    if (strcmp(cls, "PxrTexture") != 0)
+        return 0;
+    const char *file = string(p, n, "filename");
+    *type = "imagemap";
+    *n_out = 0;
+    if (file)
+        out[(*n_out)++] = (RayesParam){"filename", RAYES_PARAM_STRING, {0, 0, 0}, file};
+    return 1;
+}
+
+const RibRequest rib_ris_requests[] = {
+    {"Bxdf", h_bxdf},
+    {"Light", h_light},
+    {"Integrator", h_integrator},
+    {NULL, NULL},
+};

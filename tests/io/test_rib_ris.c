@@ -1,0 +1,335 @@
+/*
+ * RenderMan 19 and later in RIB files (io/rib_ris.c): Bxdf classes as
+ * rayes' shaders, Light classes as its lights (radiance, exposure,
+ * areaNormalize, the sun's solid angle, on after their block, unseen by
+ * the camera unless said), RenderMan 19-20's Geometry "rectlight" under
+ * AreaLightSource, Integrator's maxPathLength as bounces; rendered, a
+ * PxrRectLight lights a box as the same quad as a classic area light
+ * does, and a PxrTexture reaches the diffuse colour that references it.
+ */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "io/rib.h"
+#include "rayes/rayes.h"
+#include "record_sink.h"
+#include "rib_round_trip.h"
+#include "test.h"
+
+static Record rec;
+static IoSettings settings;
+static char err[1024];
+
+static RayesError rib(const char *text)
+{
+    record_free(&rec);
+    IoSink s = record_sink(&rec);
+    io_settings_init(&settings);
+    IoReadOptions opt = {RAYES_TEST_DATA, -1};
+    size_t n = strlen(text);
+    unsigned char *copy = malloc(n + 1);
+    memcpy(copy, text, n);
+    err[0] = '\0';
+    RayesError e = io_rib_parse("t.rib", copy, n, &s, &opt, &settings, err, sizeof err);
+    free(copy);
+    if (e != RAYES_OK)
+        fprintf(stderr, "%s\n", err);
+    return e;
+}
+
+#define WORLD(body) "Projection \"perspective\" \"fov\" 40\nWorldBegin\n" body "\nWorldEnd\n"
+#define TRI "Polygon \"P\" [0 0 1 1 0 1 1 1 1]\n"
+
+static float param(const RecShader *s, const char *name, int c)
+{
+    const RayesParam *p = rec_param(s, name);
+    return p ? p->value[c] : NAN;
+}
+
+/* The shader the one triangle after a Bxdf was made with. */
+static const RecShader *bxdf(const char *line)
+{
+    char text[1024];
+    snprintf(text, sizeof text, WORLD("%s\n" TRI), line);
+    CHECK(rib(text) == RAYES_OK);
+    CHECK(rec.n_shader >= 1);
+    return &rec.shader[rec.n_shader - 1];
+}
+
+static void test_bxdfs(void)
+{
+    const RecShader *s = bxdf("Bxdf \"PxrDiffuse\" \"d\" \"color diffuseColor\" [0.2 0.4 0.6]");
+    CHECK(strcmp(s->name, "diffuse") == 0);
+    CHECK_NEAR(param(s, "reflectance", 2), 0.6, 1e-6);
+    s = bxdf("Bxdf \"PxrLMDiffuse\" \"d\" \"color frontColor\" [0.1 0.2 0.3]");
+    CHECK(strcmp(s->name, "diffuse") == 0 && fabsf(param(s, "reflectance", 1) - 0.2f) < 1e-6f);
+    /* PxrSurface: the diffuse lobe (times its gain) under the specular
+     * one; the specular lobe alone, artistic or physical; glass */
+    s = bxdf("Bxdf \"PxrSurface\" \"s\" \"float diffuseGain\" [0.5] \"color diffuseColor\" "
+             "[0.8 0.6 0.4] \"color specularFaceColor\" [0.04 0.04 0.04] "
+             "\"float specularRoughness\" [0.3]");
+    CHECK(strcmp(s->name, "coateddiffuse") == 0);
+    CHECK_NEAR(param(s, "reflectance", 0), 0.4, 1e-6);
+    CHECK_NEAR(param(s, "roughness", 0), 0.3, 1e-6);
+    s = bxdf("Bxdf \"PxrSurface\" \"s\" \"float diffuseGain\" [0] "
+             "\"color specularFaceColor\" [1 0.8 0.3]");
+    CHECK(strcmp(s->name, "conductor") == 0);
+    CHECK_NEAR(param(s, "reflectance", 2), 0.3, 1e-6);
+    CHECK_NEAR(param(s, "roughness", 0), 0.2, 1e-6); /* RenderMan's default */
+    s = bxdf("Bxdf \"PxrSurface\" \"s\" \"float diffuseGain\" [0] \"int specularFresnelMode\" "
+             "[1] \"color specularIor\" [0.2 0.9 1.1] \"color specularExtinctionCoeff\" [3.9 "
+             "2.4 2.1]");
+    CHECK(strcmp(s->name, "conductor") == 0);
+    CHECK_NEAR(param(s, "eta", 1), 0.9, 1e-6);
+    CHECK_NEAR(param(s, "k", 0), 3.9, 1e-6);
+    s = bxdf("Bxdf \"PxrSurface\" \"s\" \"float refractionGain\" [1] \"float glassIor\" [1.33]");
+    CHECK(strcmp(s->name, "dielectric") == 0 && fabsf(param(s, "eta", 0) - 1.33f) < 1e-6f);
+    s = bxdf("Bxdf \"PxrSurface\" \"s\"");
+    CHECK(strcmp(s->name, "diffuse") == 0); /* RenderMan's default: 0.18 grey, no specular */
+    CHECK_NEAR(param(s, "reflectance", 0), 0.18, 1e-6);
+    /* PxrDisney: a conductor when metallic; its default base colour */
+    s = bxdf("Bxdf \"PxrDisney\" \"m\" \"color baseColor\" [0.9 0.6 0.2] \"float metallic\" [1]");
+    CHECK(strcmp(s->name, "conductor") == 0 && fabsf(param(s, "reflectance", 1) - 0.6f) < 1e-6f);
+    s = bxdf("Bxdf \"PxrDisney\" \"m\"");
+    CHECK(strcmp(s->name, "coateddiffuse") == 0);
+    CHECK_NEAR(param(s, "reflectance", 2), 0.8, 1e-6);
+    s = bxdf("Bxdf \"PxrConstant\" \"c\" \"color emitColor\" [2 1 0.5]");
+    CHECK(strcmp(s->name, "matte") == 0 && param(s, "Kd", 0) == 0.0f);
+    CHECK_NEAR(param(s, "Ke", 0), 2, 1e-6);
+    s = bxdf("Bxdf \"PxrGlass\" \"g\" \"float ior\" [1.6]");
+    CHECK(strcmp(s->name, "dielectric") == 0 && fabsf(param(s, "eta", 0) - 1.6f) < 1e-6f);
+    /* an unknown class: a grey diffuse, with a warning, not an error */
+    s = bxdf("Bxdf \"PxrMarschnerHair\" \"h\" \"float diffuseGain\" [1]");
+    CHECK(strcmp(s->name, "diffuse") == 0);
+    /* Bxdf is an attribute, as Surface is */
+    CHECK(rib(WORLD("AttributeBegin\nBxdf \"PxrDiffuse\" \"d\"\nAttributeEnd\n" TRI)) == RAYES_OK);
+    CHECK(rec.n_shader >= 1 && strcmp(rec.shader[rec.n_shader - 1].name, "matte") == 0);
+}
+
+/* The last light made. */
+static const RecShader *light(void)
+{
+    CHECK(rec.n_light >= 1);
+    return &rec.light[rec.n_light > 0 ? rec.n_light - 1 : 0];
+}
+
+static void test_lights(void)
+{
+    /* radiance intensity 2^exposure lightColor, kept as intensity (its
+     * largest channel) and colour; a unit square emitting toward +z */
+    CHECK(rib(WORLD("AttributeBegin\nLight \"PxrRectLight\" \"k\" \"float intensity\" [2] "
+                    "\"float exposure\" [1] \"color lightColor\" [1 0.5 0.25]\nAttributeEnd\n" TRI)) ==
+          RAYES_OK);
+    CHECK(rec.n_light == 1 && strcmp(light()->name, "arealight") == 0);
+    CHECK_NEAR(param(light(), "intensity", 0), 4, 1e-6);
+    CHECK_NEAR(param(light(), "lightcolor", 1), 0.5, 1e-6);
+    const RayesParam *shape = rec_param(light(), "shape");
+    CHECK(shape && strcmp(shape->string, "quad") == 0);
+    /* on after its block: the triangle is linked to every light */
+    CHECK(rec.links_mode == RAYES_LIGHT_LINKS_ALL);
+    /* areaNormalize: over the area of the square as scaled (2 x 3) */
+    CHECK(rib(WORLD("AttributeBegin\nScale 2 3 1\nLight \"PxrRectLight\" \"k\" \"float "
+                    "intensity\" [12] \"int areaNormalize\" [1]\nAttributeEnd\n" TRI)) == RAYES_OK);
+    CHECK_NEAR(param(light(), "intensity", 0), 2, 1e-5);
+    /* disks and spheres of diameter 1 */
+    CHECK(rib(WORLD("Light \"PxrSphereLight\" \"b\"\nLight \"PxrDiskLight\" \"d\"\n" TRI)) ==
+          RAYES_OK);
+    CHECK(rec.n_light == 2);
+    CHECK(strcmp(rec_param(&rec.light[0], "shape")->string, "sphere") == 0);
+    CHECK_NEAR(param(&rec.light[0], "radius", 0), 0.5, 0);
+    CHECK(strcmp(rec_param(&rec.light[1], "shape")->string, "disk") == 0);
+    /* the sun: RenderMan's default radiance over a disk of 0.53 degrees,
+     * irradiance = radiance x solid angle, along +z */
+    CHECK(rib(WORLD("Light \"PxrDistantLight\" \"sun\"\n" TRI)) == RAYES_OK);
+    CHECK(strcmp(light()->name, "distantlight") == 0);
+    double omega = 2 * M_PI * (1 - cos(0.265 * M_PI / 180));
+    CHECK_NEAR(param(light(), "intensity", 0), 50000 * omega, 1e-3);
+    CHECK_NEAR(param(light(), "to", 2), 1, 0);
+    CHECK(rib(WORLD("Light \"PxrDistantLight\" \"sun\" \"float intensity\" [3] "
+                    "\"int areaNormalize\" [1]\n" TRI)) == RAYES_OK);
+    CHECK_NEAR(param(light(), "intensity", 0), 3, 1e-6);
+    CHECK(rib(WORLD("Light \"PxrDomeLight\" \"sky\" \"float intensity\" [0.5]\n" TRI)) ==
+          RAYES_OK);
+    CHECK(strcmp(light()->name, "environmentlight") == 0);
+    /* classes rayes does not translate: skipped with a warning */
+    CHECK(rib(WORLD("Light \"PxrMeshLight\" \"m\"\nLight \"PxrAovLight\" \"a\"\n" TRI)) ==
+          RAYES_OK);
+    CHECK(rec.n_light == 0);
+    /* Illuminate turns one off */
+    CHECK(rib(WORLD("Light \"PxrRectLight\" \"k\"\nIlluminate \"k\" 0\n" TRI)) == RAYES_OK);
+    CHECK(rec.n_light == 1 && rec.links_mode == RAYES_LIGHT_LINKS_EXCEPT);
+    /* a light needs its handle */
+    CHECK(rib(WORLD("Light \"PxrRectLight\"\n")) != RAYES_OK);
+}
+
+static void test_geometry_lights(void)
+{
+    /* RenderMan 19 and 20: the light's shape as Geometry under
+     * AreaLightSource, its exposure and lightColor */
+    CHECK(rib(WORLD("AttributeBegin\nAreaLightSource \"PxrStdAreaLight\" \"a\" \"float "
+                    "exposure\" [2] \"color lightColor\" [1 1 0.5]\nBxdf \"PxrLightEmission\" "
+                    "\"e\"\nGeometry \"rectlight\"\nAttributeEnd\n" TRI)) == RAYES_OK);
+    CHECK(rec.n_light == 1 && strcmp(light()->name, "arealight") == 0);
+    CHECK_NEAR(param(light(), "intensity", 0), 4, 1e-6);
+    CHECK_NEAR(param(light(), "lightcolor", 2), 0.5, 1e-6);
+    CHECK(rec.links_mode == RAYES_LIGHT_LINKS_ALL); /* area lights light everything */
+    CHECK(rib(WORLD("AreaLightSource \"PxrStdAreaLight\" \"a\"\nGeometry \"spherelight\"\n"
+                    "Geometry \"envsphere\"\n" TRI)) == RAYES_OK);
+    CHECK(rec.n_light == 2 && strcmp(rec.light[1].name, "environmentlight") == 0);
+    /* outside AreaLightSource the shapes are skipped */
+    CHECK(rib(WORLD("Geometry \"rectlight\"\n" TRI)) == RAYES_OK);
+    CHECK(rec.n_light == 0);
+}
+
+static void test_integrator(void)
+{
+    CHECK(rib("Integrator \"PxrPathTracer\" \"pt\" \"int maxPathLength\" [4]\n" WORLD(TRI)) ==
+          RAYES_OK);
+    CHECK(settings.bounces == 3 && settings.specular_depth == 4);
+    CHECK(rib("Integrator \"PxrVCM\" \"v\" \"int maxPathLength\" [20]\n" WORLD(TRI)) == RAYES_OK);
+    CHECK(settings.bounces == 8 && settings.specular_depth == 20); /* capped, as pbrt's */
+    CHECK(rib("Integrator \"PxrDirectLighting\" \"d\"\n" WORLD(TRI)) == RAYES_OK);
+    CHECK(settings.bounces == 0);
+    CHECK(rib("Integrator \"PxrPathTracer\" \"pt\" \"int maxPathLength\" [-1]\n" WORLD(TRI)) !=
+          RAYES_OK);
+}
+
+enum { SIZE = 32 };
+
+/* A box open toward the camera lit from its ceiling by light (a RIB
+ * fragment placed in the ceiling's frame: z = 0, emitting down). */
+static void box_text(char *text, size_t size, const char *light, const char *extra)
+{
+    snprintf(text, size,
+             "Projection \"perspective\" \"fov\" [40]\nTranslate 0 0 3.5\nWorldBegin\n"
+             "AttributeBegin\nTranslate 0 0.99 0\nRotate 90 1 0 0\nScale 0.6 0.6 1\n%s\n"
+             "AttributeEnd\n%s\n"
+             "Bxdf \"PxrDiffuse\" \"w\" \"color diffuseColor\" [0.7 0.7 0.7]\n"
+             "Polygon \"P\" [-1 -1 -1  1 -1 -1  1 -1 1  -1 -1 1]\n"
+             "Polygon \"P\" [-1 -1 1  1 -1 1  1 1 1  -1 1 1]\n"
+             "Polygon \"P\" [-1 1 -1  -1 1 1  1 1 1  1 1 -1]\n"
+             "Polygon \"P\" [-1 -1 -1  -1 -1 1  -1 1 1  -1 1 -1]\n"
+             "Polygon \"P\" [1 -1 -1  1 1 -1  1 1 1  1 -1 1]\n"
+             "WorldEnd\n",
+             light, extra);
+}
+
+/* A RIB text rendered at SIZE x SIZE, 4 samples, no bounces. */
+static RayesImage *render_text(const char *text)
+{
+    RayesError e;
+    RayesScene *s = rib_read_scene(text, &e, err, sizeof err);
+    RayesImage *img = NULL;
+    if (e != RAYES_OK)
+        fprintf(stderr, "%s\n", err);
+    CHECK(e == RAYES_OK);
+    if (e == RAYES_OK && rayes_scene_commit(s) == RAYES_OK) {
+        RayesRenderOptions o;
+        rayes_render_options_init(&o, RAYES_QUALITY_PREVIEW);
+        o.width = o.height = SIZE;
+        o.spp = 4;
+        o.threads = 2;
+        o.bounces = 0;
+        CHECK(rayes_render(s, &o, &img, NULL) == RAYES_OK);
+    }
+    rayes_scene_release(s);
+    return img;
+}
+
+static RayesImage *render_box(const char *light, const char *extra)
+{
+    char text[4096];
+    box_text(text, sizeof text, light, extra);
+    return render_text(text);
+}
+
+/* The mean of channel c over rows y0 and down. */
+static double mean(const RayesImage *a, int c, int y0)
+{
+    double t = 0;
+    for (int i = y0 * SIZE; i < SIZE * SIZE; i++)
+        t += a->rgba[4 * i + c];
+    return t / ((SIZE - y0) * SIZE);
+}
+
+/* The light's pixels: the top rows' middle, where the ceiling light is. */
+static double light_pixels(const RayesImage *a)
+{
+    double t = 0;
+    for (int y = 0; y < SIZE / 8; y++)
+        for (int x = SIZE / 2 - 2; x < SIZE / 2 + 2; x++)
+            t += a->rgba[4 * (y * SIZE + x) + 1];
+    return t;
+}
+
+static void test_rendered(void)
+{
+    /* a PxrRectLight seen by the camera is the quad a classic area light
+     * of the same radiance and corners makes: the same image */
+    RayesImage *ris = render_box("Attribute \"visibility\" \"int camera\" [1]\n"
+                                 "Light \"PxrRectLight\" \"k\" \"float intensity\" [3] "
+                                 "\"float exposure\" [1] \"color lightColor\" [1 0.8 0.6]",
+                                 "");
+    RayesImage *classic = render_box("AreaLightSource \"arealight\" 1 \"intensity\" [6] "
+                                     "\"lightcolor\" [1 0.8 0.6]\n"
+                                     "Polygon \"P\" [-0.5 -0.5 0  0.5 -0.5 0  0.5 0.5 0  -0.5 0.5 0]",
+                                     "");
+    RayesImage *unseen = render_box("Light \"PxrRectLight\" \"k\" \"float intensity\" [6] "
+                                    "\"color lightColor\" [1 0.8 0.6]",
+                                    "");
+    CHECK(ris && classic && unseen);
+    if (ris && classic && unseen) {
+        for (int c = 0; c < 3; c++)
+            CHECK_NEAR(mean(ris, c, 0), mean(classic, c, 0), 0.005 * mean(classic, c, 0));
+        CHECK(mean(ris, 1, 0) > 0.05);
+        /* unseen by the camera (RenderMan 21's default): the light's
+         * pixels are the dark ceiling behind it, the room below as lit */
+        CHECK(light_pixels(unseen) < 0.2 * light_pixels(ris));
+        CHECK_NEAR(mean(unseen, 0, SIZE / 4), mean(ris, 0, SIZE / 4), 0.01 * mean(ris, 0, SIZE / 4));
+    }
+    /* written as rayes' own RIB and read back: the same image, the light
+     * unseen as before */
+    char text[4096];
+    box_text(text, sizeof text,
+             "Light \"PxrRectLight\" \"k\" \"float intensity\" [6] \"color lightColor\" [1 0.8 "
+             "0.6]",
+             "");
+    char *written = rib_round_trip(text, err, sizeof err);
+    CHECK(written != NULL);
+    RayesImage *back = written ? render_text(written) : NULL;
+    CHECK(back && unseen && memcmp(back->rgba, unseen->rgba, sizeof(float) * 4 * SIZE * SIZE) == 0);
+    free(written);
+    rayes_image_free(back);
+    rayes_image_free(ris);
+    rayes_image_free(classic);
+    rayes_image_free(unseen);
+    /* a PxrTexture referenced by diffuseColor colours the right wall */
+    FILE *f = fopen(RAYES_TEST_TMP "/test_rib_ris_red.ppm", "wb");
+    CHECK(f != NULL);
+    if (f) {
+        fprintf(f, "P6 2 2 255\n");
+        for (int i = 0; i < 4; i++)
+            fputc(255, f), fputc(0, f), fputc(0, f);
+        fclose(f);
+    }
+    RayesImage *tex = render_box(
+        "Light \"PxrRectLight\" \"k\" \"float intensity\" [6]",
+        "AttributeBegin\nPattern \"PxrTexture\" \"t\" \"string filename\" [\"" RAYES_TEST_TMP
+        "/test_rib_ris_red.ppm\"]\nBxdf \"PxrDiffuse\" \"r\" \"reference color diffuseColor\" "
+        "[\"t:resultRGB\"]\nPolygon \"P\" [0.99 -1 -1  0.99 1 -1  0.99 1 1  0.99 -1 1] \"st\" "
+        "[0 0 0 1 1 1 1 0]\nAttributeEnd");
+    CHECK(tex != NULL);
+    if (tex) { /* the right wall's pixels: red, not grey */
+        double r = 0, g = 0;
+        for (int y = SIZE / 4; y < 3 * SIZE / 4; y++)
+            for (int x = 7 * SIZE / 8; x < SIZE; x++)
+                r += tex->rgba[4 * (y * SIZE + x)], g += tex->rgba[4 * (y * SIZE + x) + 1];
+        CHECK(r > 0.01 && g < 0.05 * r);
+    }
+    rayes_image_free(tex);
+}
+
+TEST_MAIN(TEST(test_bxdfs), TEST(test_lights), TEST(test_geometry_lights), TEST(test_integrator),
+          TEST(test_rendered))
