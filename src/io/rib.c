@@ -506,8 +506,6 @@ static const RibRequest own_requests[] = {
     {"ReadArchive", h_read_archive},
     {"Procedural", h_procedural},
     /* tier 1 and 2: read and skipped with one warning per request name */
-    {"NuPatch", h_skip},
-    {"TrimCurve", h_skip},
     {"Procedural2", h_skip},
     {"DisplayChannel", h_skip},
     {"DisplayFilter", h_skip},

@@ -22,7 +22,7 @@
 /* Whether the front of a surface is opposite to the right-hand rule in
  * world space: RenderMan's orientation against the handedness of object
  * space (camera space is left-handed), and a mirror in world_from_object. */
-static int flip_of(Rib *r)
+int rib_flip(Rib *r)
 {
     double det_wo = rib_mat_det3(r->a.M);
     double det_co = rib_mat_det3(r->camera_from_world) * det_wo;
@@ -320,7 +320,7 @@ static int few_quads(const Polys *g)
 /* The polygons of g as one mesh light (tessellated as surfaces are). */
 static int emit_area_mesh(Rib *r, const Polys *g, const float *P, size_t n_points)
 {
-    int flip = flip_of(r), e = 0;
+    int flip = rib_flip(r), e = 0;
     RibFaces faces = {0};
     for (size_t p = 0, loop = 0, at = 0; p < g->n_polys && e == 0; p++) {
         size_t nl = g->n_loops ? (size_t)g->n_loops[p] : 1, nv = 0;
@@ -352,7 +352,7 @@ static int emit_polys(Rib *r, const Polys *g, const float *P, size_t n_points, c
     }
     RibVar vars[RIB_N_VARS];
     rib_vars(r, par, n_par, vars);
-    int flip = flip_of(r);
+    int flip = rib_flip(r);
     RibFaces faces = {0};
     size_t *face_poly = NULL, *poly_at = NULL, *poly_nv = NULL, cap_f = 0, cap_a = 0, cap_n = 0;
     size_t loop = 0, at = 0;
@@ -784,7 +784,7 @@ static int subdivision_mesh(Rib *r, const Args *a, int per)
      * corner, facevarying values with it. */
     if (e == 0 && !(order = malloc((n_idx + 1) * sizeof *order)))
         e = rib_error(r, "out of memory");
-    int flip = e == 0 && flip_of(r);
+    int flip = e == 0 && rib_flip(r);
     for (size_t f = 0, at = 0; e == 0 && f < n_faces; at += (size_t)nverts[f++])
         for (int k = 0; k < nverts[f]; k++)
             order[at + (size_t)k] = at + (size_t)(flip && k ? nverts[f] - k : k);
@@ -834,9 +834,9 @@ static int h_hierarchical_subdivision_mesh(Rib *r, const Args *a)
     return subdivision_mesh(r, a, 3);
 }
 
-static int emit_bicubic(Rib *r, float B[16][3], const PvOut *pv)
+int rib_emit_bicubic(Rib *r, float B[16][3], const PvOut *pv)
 {
-    if (flip_of(r))
+    if (rib_flip(r))
         for (int j = 0; j < 4; j++)
             for (int k = 0; k < 2; k++)
                 for (int c = 0; c < 3; c++) {
@@ -857,7 +857,7 @@ static int emit_bicubic(Rib *r, float B[16][3], const PvOut *pv)
 static int emit_bilinear(Rib *r, const float P[4][3], const PvOut *pv)
 {
     float Q[4][3];
-    int flip = flip_of(r);
+    int flip = rib_flip(r);
     for (int k = 0; k < 4; k++)
         memcpy(Q[flip ? k ^ 1 : k], P[k], sizeof Q[0]);
     int e = rib_emit_begin(r, NULL);
@@ -941,13 +941,13 @@ static int h_patch(Rib *r, const Args *a)
         rib_vars(r, p, n, vars);
         static const size_t corners[4] = {0, 1, 2, 3};
         static const size_t all[16] = {0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15};
-        e = patch_vars(r, vars, 0, corners, corners, all, (int)want, flip_of(r), &pv);
+        e = patch_vars(r, vars, 0, corners, corners, all, (int)want, rib_flip(r), &pv);
     }
     if (e == 0) {
         if (cubic) {
             float B[16][3];
             rib_basis_to_bezier(r->a.ubasis, r->a.vbasis, (const float(*)[3])P, B);
-            e = emit_bicubic(r, B, &pv);
+            e = rib_emit_bicubic(r, B, &pv);
         } else {
             e = emit_bilinear(r, (const float(*)[3])P, &pv);
         }
@@ -1020,7 +1020,7 @@ static int h_patch_mesh(Rib *r, const Args *a)
         rib_warn_unused(r, p, n);
         rib_vars(r, p, n, vars);
     }
-    int flip = flip_of(r);
+    int flip = rib_flip(r);
     for (long pv = 0; e == 0 && pv < nvp; pv++)
         for (long pu = 0; e == 0 && pu < nup; pu++) {
             size_t vi[4] = {(size_t)(pv * nuvar + pu), (size_t)(pv * nuvar + (pu + 1) % nuvar),
@@ -1041,7 +1041,7 @@ static int h_patch_mesh(Rib *r, const Args *a)
             if (e == 0 && cubic) {
                 float B[16][3];
                 rib_basis_to_bezier(r->a.ubasis, r->a.vbasis, (const float(*)[3])G, B);
-                e = emit_bicubic(r, B, &out);
+                e = rib_emit_bicubic(r, B, &out);
             } else if (e == 0) {
                 e = emit_bilinear(r, (const float(*)[3])G, &out);
             }
@@ -1092,7 +1092,7 @@ static int h_quadric(Rib *r, const Args *a)
         if (e == 0) {
             SinkState *st;
             const IoSink *s = rib_out_sink(r, &st);
-            unsigned flags = flip_of(r) ? RAYES_QUADRIC_REVERSE : 0;
+            unsigned flags = rib_flip(r) ? RAYES_QUADRIC_REVERSE : 0;
             if (r->a.area && !s->area_light_quadric)
                 rib_warn_once(r, "area quadric",
                               "this scene takes no emitting quadrics: they "
@@ -1162,7 +1162,7 @@ static RayesError teapot_patch(void *t, const float P[16][3], const RayesPrimvar
     memcpy(B, P, sizeof B);
     const PvOut none = {0};
     (void)pv, (void)n_pv; /* the patch file has none */
-    if (emit_bicubic(tt->r, B, &none) != 0) {
+    if (rib_emit_bicubic(tt->r, B, &none) != 0) {
         tt->failed = 1;
         return RAYES_ERROR_INVALID_ARGUMENT;
     }
@@ -1224,6 +1224,8 @@ const RibRequest rib_prim_requests[] = {
     {"Hyperboloid", h_quadric},
     {"Paraboloid", h_quadric},
     {"Geometry", h_geometry},
+    {"NuPatch", rib_nupatch},
+    {"TrimCurve", rib_trim_curve},
     {"Volume", h_volume},
     {"SubdivisionMesh", h_subdivision_mesh},
     {"HierarchicalSubdivisionMesh", h_hierarchical_subdivision_mesh},

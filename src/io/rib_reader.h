@@ -114,6 +114,7 @@ typedef struct Attr {
     unsigned char on[RIB_MAX_LIGHTS / 8]; /* bit k: Rib.lights[k] is on */
     float area_L[3];
     char area_map[256]; /* its environment map (RenderMan 19-20's envsphere), or "" */
+    int trimmed;        /* TrimCurve with loops in force (not applied) */
     float ubasis[16], vbasis[16];
     int ustep, vstep;
     int lod_coarse; /* DetailRange ends before infinity: a coarser representation,
@@ -402,6 +403,16 @@ Light *rib_new_light(Rib *r, const char *handle, const char *type);
  * mapname, mapping, shape or __category). */
 void rib_light_param(Light *L, const char *name, RayesParamType type, const float v[3],
                      const char *string);
+
+/* Whether the current orientation flips a patch (its u reverses). */
+int rib_flip(Rib *r);
+/* Sends a bicubic Bezier patch (u fastest; flipped as rib_flip says). */
+int rib_emit_bicubic(Rib *r, float B[16][3], const PvOut *pv);
+
+/* ------------------------------------------- rib_nurbs.c: NuPatch */
+
+int rib_nupatch(Rib *r, const Args *a);
+int rib_trim_curve(Rib *r, const Args *a);
 
 /* ------------------------------ rib_ris.c: RenderMan 19 and later (RIS) */
 

@@ -1,0 +1,392 @@
+/*
+ * io/rib_nurbs.c — RenderMan's NuPatch: a non-uniform rational B-spline
+ * surface of any order, made bicubic Bezier patches (docs/rib.md).
+ *
+ * Each span of the knot vectors within [umin, umax] x [vmin, vmax] is
+ * evaluated exactly (de Boor's algorithm on the homogeneous points Pw,
+ * then divided by w) at a 4 x 4 lattice of parameters, and the bicubic
+ * Bezier patch through those 16 points is sent: the same surface, exactly,
+ * when the span is a polynomial of degree 3 or less in each direction
+ * (order 2 to 4, every w equal). A rational span (a circle's arc) or one
+ * of higher order is approximated so: it is checked against the exact
+ * surface between the lattice points and split in four until the two
+ * agree within NURBS_TOLERANCE of its size (a quarter circle in one
+ * piece is off by 3e-4 of its radius; each split divides that by 16).
+ * Texture coordinates default to (u, v), RenderMan's for NURBS; "st"
+ * (or "s" and "t") of class varying, one value per span corner, are
+ * interpolated bilinearly across each span. Trim curves are not applied.
+ */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "io/rib_reader.h"
+
+#define NURBS_MAX_ORDER 32
+#define NURBS_MAX_POINTS (1L << 24)
+/* A NuPatch makes at most this many Bezier patches (a hostile file's
+ * knot vector of a million spans is an error, not a long wait). */
+#define NURBS_MAX_PATCHES (1L << 22)
+#define NURBS_TOLERANCE 1e-4f
+#define NURBS_MAX_SPLITS 5
+
+typedef struct Nurbs {
+    int n[2], order[2];  /* control points and order in u (0) and v (1) */
+    const float *knot[2];
+    const float *Pw;     /* n[0] x n[1] homogeneous points, u fastest */
+} Nurbs;
+
+/* de Boor on dim-float points d[0..p] of span k (knots t), at x: the
+ * points are overwritten, the result is d[p]. */
+static void de_boor(float (*d)[4], const float *t, int k, int p, float x)
+{
+    for (int r = 1; r <= p; r++)
+        for (int j = p; j >= r; j--) {
+            int i = k - p + j;
+            float den = t[i + p + 1 - r] - t[i];
+            float a = den > 0 ? (x - t[i]) / den : 0;
+            for (int c = 0; c < 4; c++)
+                d[j][c] = (1 - a) * d[j - 1][c] + a * d[j][c];
+        }
+}
+
+/* The surface at (u, v) in span (ku, kv): a point. */
+static void eval(const Nurbs *s, int ku, int kv, float u, float v, float out[3])
+{
+    int pu = s->order[0] - 1, pv = s->order[1] - 1;
+    float row[NURBS_MAX_ORDER][4], col[NURBS_MAX_ORDER][4];
+    for (int j = 0; j <= pv; j++) {
+        int l = kv - pv + j;
+        for (int q = 0; q <= pu; q++)
+            memcpy(row[q], &s->Pw[4 * ((size_t)l * (size_t)s->n[0] + (size_t)(ku - pu + q))],
+                   sizeof row[0]);
+        de_boor(row, s->knot[0], ku, pu, u);
+        memcpy(col[j], row[pu], sizeof col[0]);
+    }
+    de_boor(col, s->knot[1], kv, pv, v);
+    float w = col[pv][3];
+    if (!(fabsf(w) > 1e-30f))
+        w = 1e-30f;
+    for (int c = 0; c < 3; c++)
+        out[c] = col[pv][c] / w;
+}
+
+/* The inverse of the cubic Bernstein basis sampled at 0, 1/3, 2/3, 1:
+ * the Bezier control values of the cubic through four such samples. */
+static const float bezier_from_samples[4][4] = {{1, 0, 0, 0},
+                                                {-5.0f / 6, 3, -1.5f, 1.0f / 3},
+                                                {1.0f / 3, -1.5f, 3, -5.0f / 6},
+                                                {0, 0, 0, 1}};
+
+static float bernstein(int i, float t)
+{
+    float s = 1 - t;
+    return i == 0 ? s * s * s : i == 1 ? 3 * t * s * s : i == 2 ? 3 * t * t * s : t * t * t;
+}
+
+/* The bicubic Bezier patch through the surface at a 4 x 4 lattice of
+ * [u0, u1] x [v0, v1] in span (ku, kv); B[4 j + i], i along u. */
+static void fit(const Nurbs *s, int ku, int kv, const float u[2], const float v[2],
+                float B[16][3])
+{
+    float S[4][4][3], T[4][4][3];
+    for (int l = 0; l < 4; l++)
+        for (int k = 0; k < 4; k++)
+            eval(s, ku, kv, u[0] + (u[1] - u[0]) * (float)k / 3, v[0] + (v[1] - v[0]) * (float)l / 3,
+                 S[l][k]);
+    for (int l = 0; l < 4; l++) /* along u */
+        for (int i = 0; i < 4; i++)
+            for (int c = 0; c < 3; c++) {
+                float x = 0;
+                for (int k = 0; k < 4; k++)
+                    x += bezier_from_samples[i][k] * S[l][k][c];
+                T[l][i][c] = x;
+            }
+    for (int j = 0; j < 4; j++) /* along v */
+        for (int i = 0; i < 4; i++)
+            for (int c = 0; c < 3; c++) {
+                float x = 0;
+                for (int l = 0; l < 4; l++)
+                    x += bezier_from_samples[j][l] * T[l][i][c];
+                B[4 * j + i][c] = x;
+            }
+}
+
+/* How far the patch B strays from the surface between its lattice
+ * points, over the patch's size. */
+static float fit_error(const Nurbs *s, int ku, int kv, const float u[2], const float v[2],
+                       const float B[16][3])
+{
+    float lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    for (int k = 0; k < 16; k++)
+        for (int c = 0; c < 3; c++)
+            lo[c] = fminf(lo[c], B[k][c]), hi[c] = fmaxf(hi[c], B[k][c]);
+    float size = sqrtf((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) +
+                       (hi[2] - lo[2]) * (hi[2] - lo[2]));
+    float worst = 0;
+    for (int b = 0; b < 3; b++)
+        for (int a = 0; a < 3; a++) {
+            float x = (1 + 2 * (float)a) / 6, y = (1 + 2 * (float)b) / 6, P[3], Q[3] = {0, 0, 0};
+            eval(s, ku, kv, u[0] + (u[1] - u[0]) * x, v[0] + (v[1] - v[0]) * y, P);
+            for (int j = 0; j < 4; j++)
+                for (int i = 0; i < 4; i++) {
+                    float w = bernstein(i, x) * bernstein(j, y);
+                    for (int c = 0; c < 3; c++)
+                        Q[c] += w * B[4 * j + i][c];
+                }
+            float d = sqrtf((P[0] - Q[0]) * (P[0] - Q[0]) + (P[1] - Q[1]) * (P[1] - Q[1]) +
+                            (P[2] - Q[2]) * (P[2] - Q[2]));
+            worst = fmaxf(worst, d);
+        }
+    return size > 0 ? worst / size : 0;
+}
+
+/* What a NuPatch call sends its patches with. */
+typedef struct Emit {
+    Rib *r;
+    const Nurbs *s;
+    int exact;        /* polynomial of order <= 4: one patch a span */
+    const float *st;  /* varying st at the span corners (span lattice, u fastest), or NULL */
+    int spans_u;
+    long made;
+    int unconverged;
+} Emit;
+
+/* st at (u, v) of span (su, sv) spanning [u0, u1] x [v0, v1]. */
+static void st_at(const Emit *e, int su, int sv, const float span_u[2], const float span_v[2],
+                  float u, float v, float out[2])
+{
+    if (!e->st) {
+        out[0] = u, out[1] = v;
+        return;
+    }
+    float x = (u - span_u[0]) / (span_u[1] - span_u[0]), y = (v - span_v[0]) / (span_v[1] - span_v[0]);
+    size_t w = (size_t)e->spans_u + 1, a = (size_t)sv * w + (size_t)su;
+    const float *c[4] = {&e->st[2 * a], &e->st[2 * (a + 1)], &e->st[2 * (a + w)],
+                         &e->st[2 * (a + w + 1)]};
+    for (int k = 0; k < 2; k++)
+        out[k] = (1 - y) * ((1 - x) * c[0][k] + x * c[1][k]) + y * ((1 - x) * c[2][k] + x * c[3][k]);
+}
+
+/* Sends the patches of [u0, u1] x [v0, v1] in span (ku, kv), split while
+ * the fit strays. */
+static int emit_part(Emit *e, int ku, int kv, int su, int sv, const float span_u[2],
+                     const float span_v[2], const float u[2], const float v[2], int depth)
+{
+    float B[16][3];
+    fit(e->s, ku, kv, u, v, B);
+    if (!e->exact && fit_error(e->s, ku, kv, u, v, B) > NURBS_TOLERANCE) {
+        if (depth < NURBS_MAX_SPLITS) {
+            float um = 0.5f * (u[0] + u[1]), vm = 0.5f * (v[0] + v[1]);
+            const float us[2][2] = {{u[0], um}, {um, u[1]}}, vs[2][2] = {{v[0], vm}, {vm, v[1]}};
+            for (int b = 0; b < 2; b++)
+                for (int a = 0; a < 2; a++)
+                    if (emit_part(e, ku, kv, su, sv, span_u, span_v, us[a], vs[b], depth + 1) != 0)
+                        return -1;
+            return 0;
+        }
+        e->unconverged = 1;
+    }
+    if (++e->made > NURBS_MAX_PATCHES)
+        return rib_error(e->r, "NuPatch: more than %ld patches", NURBS_MAX_PATCHES);
+    float st[4][2];
+    const float cu[4] = {u[0], u[1], u[0], u[1]}, cv[4] = {v[0], v[0], v[1], v[1]};
+    int flip = rib_flip(e->r); /* the patch's u reverses: so do its corners' values */
+    for (int k = 0; k < 4; k++)
+        st_at(e, su, sv, span_u, span_v, cu[k], cv[k], st[flip ? k ^ 1 : k]);
+    PvOut pv = {.n = 1};
+    pv.pv[0] = (RayesPrimvar){"st", RAYES_PRIMVAR_VARYING, &st[0][0], 4};
+    return rib_emit_bicubic(e->r, B, &pv);
+}
+
+/* A knot vector of n + order values, non-decreasing and finite. */
+static int read_knots(Rib *r, const Args *a, size_t *i, int n, int order, float **out,
+                      const char *what)
+{
+    size_t count = (size_t)n + (size_t)order;
+    float *k = malloc(count * sizeof *k);
+    if (!k)
+        return rib_error(r, "out of memory");
+    if (rib_get_floats(r, a, i, k, count, what) != 0) {
+        free(k);
+        return -1;
+    }
+    for (size_t j = 0; j < count; j++)
+        if (!isfinite(k[j]) || (j > 0 && k[j] < k[j - 1])) {
+            free(k);
+            return rib_error(r, "NuPatch: %s must be finite and non-decreasing", what);
+        }
+    *out = k;
+    return 0;
+}
+
+/* n, order, knots, min and max of one direction. */
+static int read_direction(Rib *r, const Args *a, size_t *i, int dir, int *n, int *order,
+                          float **knot, float range[2])
+{
+    const char *names[2] = {"u", "v"};
+    float no[2];
+    char what[32];
+    snprintf(what, sizeof what, "n%s and %sorder", names[dir], names[dir]);
+    if (rib_get_floats(r, a, i, no, 1, what) != 0 || rib_get_floats(r, a, i, no + 1, 1, what) != 0)
+        return -1;
+    if (!(no[0] >= 1 && no[0] <= NURBS_MAX_POINTS && no[0] == floorf(no[0])) ||
+        !(no[1] >= 2 && no[1] <= NURBS_MAX_ORDER && no[1] == floorf(no[1])))
+        return rib_error(r,
+                         "NuPatch: expected n%s >= 1 and %sorder from 2 to %d (whole numbers), "
+                         "found %g and %g",
+                         names[dir], names[dir], NURBS_MAX_ORDER, no[0], no[1]);
+    *n = (int)no[0];
+    *order = (int)no[1];
+    snprintf(what, sizeof what, "the %s knots", names[dir]);
+    if (read_knots(r, a, i, *n, *order, knot, what) != 0)
+        return -1;
+    snprintf(what, sizeof what, "%smin and %smax", names[dir], names[dir]);
+    if (rib_get_floats(r, a, i, range, 2, what) != 0)
+        return -1;
+    if (*order > *n) /* RenderMan: a spline of order n, on the knots it has */
+        *order = *n;
+    if (*order < 2)
+        return rib_error(r, "NuPatch: one control point in %s makes no surface", names[dir]);
+    /* the parameters the knots define a surface over */
+    float lo = (*knot)[*order - 1], hi = (*knot)[*n];
+    range[0] = fmaxf(range[0], lo);
+    range[1] = fminf(range[1], hi);
+    if (!(range[0] < range[1]))
+        return rib_error(r, "NuPatch: the %s range is empty within the knots [%g, %g]",
+                         names[dir], lo, hi);
+    return 0;
+}
+
+/* The spans of one direction within range: their knot index k (knot[k] <
+ * knot[k + 1]) and their clipped parameter intervals. */
+static int spans(const float *knot, int n, int order, const float range[2], int *k, float (*iv)[2])
+{
+    int m = 0;
+    for (int j = order - 1; j < n; j++) {
+        float a = fmaxf(knot[j], range[0]), b = fminf(knot[j + 1], range[1]);
+        if (knot[j] < knot[j + 1] && a < b) {
+            k[m] = j;
+            iv[m][0] = a;
+            iv[m][1] = b;
+            m++;
+        }
+    }
+    return m;
+}
+
+int rib_nupatch(Rib *r, const Args *a)
+{
+    size_t i = 0;
+    Nurbs s = {.Pw = NULL};
+    float *knot[2] = {NULL, NULL}, range[2][2], *Pw = NULL;
+    int *k[2] = {NULL, NULL};
+    float(*iv[2])[2] = {NULL, NULL};
+    Param *p = NULL;
+    size_t n_p = 0;
+    int e = read_direction(r, a, &i, 0, &s.n[0], &s.order[0], &knot[0], range[0]);
+    if (e == 0)
+        e = read_direction(r, a, &i, 1, &s.n[1], &s.order[1], &knot[1], range[1]);
+    if (e == 0 && (long)s.n[0] * s.n[1] > NURBS_MAX_POINTS)
+        e = rib_error(r, "NuPatch: more than %ld control points", NURBS_MAX_POINTS);
+    if (e == 0)
+        e = rib_get_params(r, a, i, &p, &n_p);
+    size_t np = e == 0 ? (size_t)s.n[0] * (size_t)s.n[1] : 0;
+    int rational = 0;
+    if (e == 0) { /* Pw as given (homogeneous), or P with w = 1 */
+        const Param *pw = rib_find_param(p, n_p, "Pw"), *pp = rib_find_param(p, n_p, "P");
+        const Param *q = pw ? pw : pp;
+        size_t size = pw ? 4 : 3;
+        if (!q || !rib_is_num(q->v))
+            e = rib_error(r, "NuPatch: expected \"P\" or \"Pw\"");
+        else if (q->v->n != np * size)
+            e = rib_error(r, "NuPatch: \"%s\" needs %d x %d = %zu points, found %zu values",
+                          pw ? "Pw" : "P", s.n[0], s.n[1], np, q->v->n);
+        else if (!(Pw = malloc(np * 4 * sizeof *Pw)))
+            e = rib_error(r, "out of memory");
+        for (size_t j = 0; e == 0 && j < np; j++) {
+            for (size_t c = 0; c < 4; c++)
+                Pw[4 * j + c] = c < size ? (float)q->v->d[size * j + c] : 1.0f;
+            if (!isfinite(Pw[4 * j]) || !isfinite(Pw[4 * j + 1]) || !isfinite(Pw[4 * j + 2]) ||
+                !(Pw[4 * j + 3] > 0 && isfinite(Pw[4 * j + 3])))
+                e = rib_error(r, "NuPatch: point %zu is not finite or its w is not positive", j);
+            rational |= Pw[4 * j + 3] != Pw[3];
+        }
+    }
+    int m[2] = {0, 0};
+    for (int d = 0; e == 0 && d < 2; d++) {
+        k[d] = malloc((size_t)s.n[d] * sizeof *k[d]);
+        iv[d] = malloc((size_t)s.n[d] * sizeof *iv[d]);
+        if (!k[d] || !iv[d])
+            e = rib_error(r, "out of memory");
+        else
+            m[d] = spans(knot[d], s.n[d], s.order[d], range[d], k[d], iv[d]);
+    }
+    if (e == 0 && (long)m[0] * m[1] > NURBS_MAX_PATCHES)
+        e = rib_error(r, "NuPatch: more than %ld spans", NURBS_MAX_PATCHES);
+    /* st (or s and t) of class varying: one value a span corner */
+    float *st = NULL;
+    if (e == 0) {
+        const Param *qst = rib_find_param(p, n_p, "st"), *qs = rib_find_param(p, n_p, "s"),
+                    *qt = rib_find_param(p, n_p, "t");
+        size_t corners = (size_t)(m[0] + 1) * (size_t)(m[1] + 1);
+        int pair = qst && rib_is_num(qst->v) && qst->v->n == 2 * corners;
+        int apart = qs && qt && rib_is_num(qs->v) && rib_is_num(qt->v) &&
+                    qs->v->n == corners && qt->v->n == corners;
+        if ((qst || qs || qt) && !pair && !apart)
+            rib_warn_once(r, "nupatch st",
+                          "NuPatch: st (or s and t) needs one value per span corner (varying); "
+                          "the patch's (u, v) are used");
+        else if (pair || apart) {
+            st = malloc(2 * corners * sizeof *st);
+            if (!st)
+                e = rib_error(r, "out of memory");
+            for (size_t j = 0; e == 0 && j < corners; j++) {
+                st[2 * j] = (float)(pair ? qst->v->d[2 * j] : qs->v->d[j]);
+                st[2 * j + 1] = (float)(pair ? qst->v->d[2 * j + 1] : qt->v->d[j]);
+            }
+        }
+        for (size_t j = 0; j < n_p; j++) {
+            const char *name = p[j].d.name;
+            if (strcmp(name, "P") != 0 && strcmp(name, "Pw") != 0 && strcmp(name, "st") != 0 &&
+                strcmp(name, "s") != 0 && strcmp(name, "t") != 0) {
+                char key[128];
+                snprintf(key, sizeof key, "nupatch %.100s", name);
+                rib_warn_once(r, key, "NuPatch: \"%s\" is not used (P, Pw and st are)", name);
+            }
+        }
+    }
+    if (e == 0 && r->a.trimmed)
+        rib_warn_once(r, "nupatch trim",
+                      "NuPatch: trim curves are not applied (the whole patch renders)");
+    s.knot[0] = knot[0];
+    s.knot[1] = knot[1];
+    s.Pw = Pw;
+    Emit em = {r, &s, !rational && s.order[0] <= 4 && s.order[1] <= 4, st, m[0], 0, 0};
+    for (int sv = 0; e == 0 && sv < m[1]; sv++)
+        for (int su = 0; e == 0 && su < m[0]; su++)
+            e = emit_part(&em, k[0][su], k[1][sv], su, sv, iv[0][su], iv[1][sv], iv[0][su],
+                          iv[1][sv], 0);
+    if (e == 0 && em.unconverged)
+        rib_warn_once(r, "nupatch fit",
+                      "NuPatch: a span of high order or strong weights is approximated "
+                      "coarser than 1e-4 of its size");
+    free(st);
+    free(p);
+    free(Pw);
+    for (int d = 0; d < 2; d++) {
+        free(knot[d]);
+        free(k[d]);
+        free(iv[d]);
+    }
+    return e;
+}
+
+/* TrimCurve nloops ncurves order knot min max n u v w: the trim curves of
+ * the NuPatches after it (an attribute); read, and not applied. */
+int rib_trim_curve(Rib *r, const Args *a)
+{
+    r->a.trimmed = a->n > 0 && rib_is_num(&a->v[0]) && a->v[0].n > 0;
+    return 0;
+}
