@@ -310,8 +310,9 @@ const char *rib_pattern_name(const Rib *r, const char *ref, char *buf, size_t si
 #define SHADER_ONLY_K 1
 #define SHADER_ARRAYS 2
 
-/* A new shader record of name with the parameters the API can take. */
-static ShaderRec *make_shader(Rib *r, const char *name, const Param *p, size_t n, int flags)
+/* An empty shader record of name with room for n parameters, kept on the
+ * reader's list (freed with it); NULL with the error set. */
+static ShaderRec *new_shader(Rib *r, const char *name, size_t n)
 {
     ShaderRec *sh = calloc(1, sizeof *sh);
     if (sh)
@@ -324,6 +325,15 @@ static ShaderRec *make_shader(Rib *r, const char *name, const Param *p, size_t n
     sh->next = r->shaders;
     r->shaders = sh;
     snprintf(sh->name, sizeof sh->name, "%s", name);
+    return sh;
+}
+
+/* A new shader record of name with the parameters the API can take. */
+static ShaderRec *make_shader(Rib *r, const char *name, const Param *p, size_t n, int flags)
+{
+    ShaderRec *sh = new_shader(r, name, n);
+    if (!sh)
+        return NULL;
     for (size_t i = 0; i < n; i++) {
         const Param *q = &p[i];
         if ((flags & SHADER_ONLY_K) && strcmp(q->d.name, "Kd") != 0 && strcmp(q->d.name, "Ka") != 0)
@@ -385,17 +395,9 @@ static ShaderRec *make_shader(Rib *r, const char *name, const Param *p, size_t n
 
 ShaderRec *rib_shader_rec(Rib *r, const char *name, const RayesParam *p, size_t n)
 {
-    ShaderRec *sh = calloc(1, sizeof *sh);
-    if (sh)
-        sh->params = calloc(n + 1, sizeof *sh->params);
-    if (!sh || !sh->params) {
-        free(sh);
-        rib_error(r, "out of memory");
+    ShaderRec *sh = new_shader(r, name, n);
+    if (!sh)
         return NULL;
-    }
-    sh->next = r->shaders;
-    r->shaders = sh;
-    snprintf(sh->name, sizeof sh->name, "%s", name);
     for (size_t i = 0; i < n; i++) {
         RayesParam o = p[i];
         o.name = rib_strdup(p[i].name);

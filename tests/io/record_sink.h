@@ -11,6 +11,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "io/rib.h"
 #include "io/sink.h"
 
 #define REC_MAX 64
@@ -367,6 +368,29 @@ static void record_free(Record *r)
     for (int i = 0; i < r->n_patch; i++)
         rec_free_primvars(&r->patch[i].pv);
     r->n_patch = 0;
+}
+
+/* A RIB text read as file t.rib into a fresh recording (from a copy of
+ * exactly its length, so that reading past its end is caught); settings
+ * receive what the file says of the render (NULL: not kept), err the
+ * message of an error. */
+static inline RayesError record_rib(Record *rec, const char *text, IoSettings *settings, char *err,
+                                    size_t err_size)
+{
+    record_free(rec);
+    IoSink s = record_sink(rec);
+    IoSettings own;
+    if (!settings)
+        settings = &own;
+    io_settings_init(settings);
+    IoReadOptions opt = {RAYES_TEST_DATA, -1};
+    size_t n = strlen(text);
+    unsigned char *copy = malloc(n + 1);
+    memcpy(copy, text, n);
+    err[0] = '\0';
+    RayesError e = io_rib_parse("t.rib", copy, n, &s, &opt, settings, err, err_size);
+    free(copy);
+    return e;
 }
 
 /* The parameter of that name, or NULL. */

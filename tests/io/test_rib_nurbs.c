@@ -21,18 +21,7 @@ static char err[1024];
 
 static RayesError rib(const char *text)
 {
-    record_free(&rec);
-    IoSink s = record_sink(&rec);
-    IoSettings settings;
-    io_settings_init(&settings);
-    IoReadOptions opt = {RAYES_TEST_DATA, -1};
-    size_t n = strlen(text);
-    unsigned char *copy = malloc(n + 1);
-    memcpy(copy, text, n);
-    err[0] = '\0';
-    RayesError e = io_rib_parse("t.rib", copy, n, &s, &opt, &settings, err, sizeof err);
-    free(copy);
-    return e;
+    return record_rib(&rec, text, NULL, err, sizeof err);
 }
 
 #define WORLD(body) "Projection \"perspective\" \"fov\" 40\nWorldBegin\n" body "\nWorldEnd\n"

@@ -24,16 +24,7 @@ static char err[1024];
 
 static RayesError rib(const char *text)
 {
-    record_free(&rec);
-    IoSink s = record_sink(&rec);
-    io_settings_init(&settings);
-    IoReadOptions opt = {RAYES_TEST_DATA, -1};
-    size_t n = strlen(text);
-    unsigned char *copy = malloc(n + 1);
-    memcpy(copy, text, n);
-    err[0] = '\0';
-    RayesError e = io_rib_parse("t.rib", copy, n, &s, &opt, &settings, err, sizeof err);
-    free(copy);
+    RayesError e = record_rib(&rec, text, &settings, err, sizeof err);
     if (e != RAYES_OK)
         fprintf(stderr, "%s\n", err);
     return e;

@@ -20,17 +20,7 @@ static char err[1024];
 
 static RayesError rib(const char *text)
 {
-    IoSink s = record_sink(&rec);
-    IoSettings settings;
-    io_settings_init(&settings);
-    IoReadOptions opt = {RAYES_TEST_DATA, -1};
-    size_t n = strlen(text);
-    unsigned char *copy = malloc(n + 1);
-    memcpy(copy, text, n);
-    err[0] = '\0';
-    RayesError e = io_rib_parse("t.rib", copy, n, &s, &opt, &settings, err, sizeof err);
-    free(copy);
-    return e;
+    return record_rib(&rec, text, NULL, err, sizeof err);
 }
 
 #define CUBE_FACES "[4 4 4 4 4 4] [0 1 3 2 2 3 5 4 4 5 7 6 6 7 1 0 1 7 5 3 6 0 2 4]"
