@@ -751,6 +751,7 @@ static void rib_fini(Rib *r)
         free(s->params);
         free(s);
     }
+    rib_trims_free(r);
     free(r->decls);
     free(r->lights);
     free(r->area_handles);

@@ -14,7 +14,15 @@
  * piece is off by 3e-4 of its radius; each split divides that by 16).
  * Texture coordinates default to (u, v), RenderMan's for NURBS; "st"
  * (or "s" and "t") of class varying, one value per span corner, are
- * interpolated bilinearly across each span. Trim curves are not applied.
+ * interpolated bilinearly across each span.
+ *
+ * Trim curves (TrimCurve, an attribute) are made polygons in (u, v), each
+ * curve 16 segments a knot span; a piece of the surface the loops cross
+ * is split in four, down to 1/128 of its span, and each piece is kept or
+ * cut by whether its centre lies inside the loops (odd crossings):
+ * RenderMan's default cuts the insides away, Attribute "trimcurve"
+ * "sense" "outside" the outsides. Trimmed edges are so exact to 1/128 of a
+ * span, in steps.
  */
 #include <math.h>
 #include <stdio.h>
@@ -30,6 +38,19 @@
 #define NURBS_MAX_PATCHES (1L << 22)
 #define NURBS_TOLERANCE 1e-4f
 #define NURBS_MAX_SPLITS 5
+
+#define TRIM_SEGMENTS 16 /* polygon edges per knot span of a trim curve */
+#define TRIM_MAX_POINTS (1L << 20)
+#define TRIM_SPLITS 7 /* a crossed piece is split down to 1/128 of its span */
+
+/* The loops of a TrimCurve as polygons in (u, v). */
+typedef struct TrimSet {
+    size_t n_loops;
+    size_t *first; /* loop k: points first[k] .. first[k + 1] - 1 (closed) */
+    float (*pt)[2];
+    float lo[2], hi[2];
+    struct TrimSet *next;
+} TrimSet;
 
 typedef struct Nurbs {
     int n[2], order[2];  /* control points and order in u (0) and v (1) */
@@ -151,7 +172,62 @@ typedef struct Emit {
     int spans_u;
     long made;
     int unconverged;
+    const TrimSet *trim; /* or NULL */
+    int trim_outside;
 } Emit;
+
+/* Whether segment a-b passes through the open rectangle (Liang-Barsky). */
+static int segment_crosses(const float a[2], const float b[2], const float u[2], const float v[2])
+{
+    float t0 = 0, t1 = 1, d[2] = {b[0] - a[0], b[1] - a[1]};
+    const float lo[2] = {u[0], v[0]}, hi[2] = {u[1], v[1]};
+    for (int k = 0; k < 2; k++) {
+        if (d[k] == 0) {
+            if (!(a[k] > lo[k] && a[k] < hi[k]))
+                return 0;
+            continue;
+        }
+        float ta = (lo[k] - a[k]) / d[k], tb = (hi[k] - a[k]) / d[k];
+        if (ta > tb) {
+            float x = ta;
+            ta = tb, tb = x;
+        }
+        t0 = fmaxf(t0, ta);
+        t1 = fminf(t1, tb);
+        if (t0 >= t1)
+            return 0;
+    }
+    return 1;
+}
+
+/* Whether (x, y) lies inside the loops: an odd number of crossings. */
+static int inside_loops(const TrimSet *t, float x, float y)
+{
+    int in = 0;
+    for (size_t k = 0; k < t->n_loops; k++)
+        for (size_t i = t->first[k], j = t->first[k + 1] - 1; i < t->first[k + 1]; j = i++) {
+            const float *a = t->pt[i], *b = t->pt[j];
+            if ((a[1] > y) != (b[1] > y) && x < a[0] + (y - a[1]) * (b[0] - a[0]) / (b[1] - a[1]))
+                in = !in;
+        }
+    return in;
+}
+
+/* A piece of the surface against the trim loops: 1 kept whole, 0 cut
+ * away whole, -1 crossed by them. */
+static int trim_state(const Emit *e, const float u[2], const float v[2])
+{
+    const TrimSet *t = e->trim;
+    if (!t)
+        return 1;
+    if (u[1] > t->lo[0] && u[0] < t->hi[0] && v[1] > t->lo[1] && v[0] < t->hi[1])
+        for (size_t k = 0; k < t->n_loops; k++)
+            for (size_t i = t->first[k], j = t->first[k + 1] - 1; i < t->first[k + 1]; j = i++)
+                if (segment_crosses(t->pt[j], t->pt[i], u, v))
+                    return -1;
+    int in = inside_loops(t, 0.5f * (u[0] + u[1]), 0.5f * (v[0] + v[1]));
+    return in == e->trim_outside;
+}
 
 /* st at (u, v) of span (su, sv) spanning [u0, u1] x [v0, v1]. */
 static void st_at(const Emit *e, int su, int sv, const float span_u[2], const float span_v[2],
@@ -170,10 +246,26 @@ static void st_at(const Emit *e, int su, int sv, const float span_u[2], const fl
 }
 
 /* Sends the patches of [u0, u1] x [v0, v1] in span (ku, kv), split while
- * the fit strays. */
+ * the fit strays (depth splits so far) or trim loops cross it (tdepth). */
 static int emit_part(Emit *e, int ku, int kv, int su, int sv, const float span_u[2],
-                     const float span_v[2], const float u[2], const float v[2], int depth)
+                     const float span_v[2], const float u[2], const float v[2], int depth,
+                     int tdepth)
 {
+    int trim = trim_state(e, u, v);
+    if (trim < 0 && tdepth < TRIM_SPLITS) {
+        float um = 0.5f * (u[0] + u[1]), vm = 0.5f * (v[0] + v[1]);
+        const float us[2][2] = {{u[0], um}, {um, u[1]}}, vs[2][2] = {{v[0], vm}, {vm, v[1]}};
+        for (int b = 0; b < 2; b++)
+            for (int a = 0; a < 2; a++)
+                if (emit_part(e, ku, kv, su, sv, span_u, span_v, us[a], vs[b], depth + 1,
+                              tdepth + 1) != 0)
+                    return -1;
+        return 0;
+    }
+    if (trim < 0) /* as fine as trims go: by its centre */
+        trim = inside_loops(e->trim, 0.5f * (u[0] + u[1]), 0.5f * (v[0] + v[1])) == e->trim_outside;
+    if (trim == 0)
+        return 0;
     float B[16][3];
     fit(e->s, ku, kv, u, v, B);
     if (!e->exact && fit_error(e->s, ku, kv, u, v, B) > NURBS_TOLERANCE) {
@@ -182,7 +274,8 @@ static int emit_part(Emit *e, int ku, int kv, int su, int sv, const float span_u
             const float us[2][2] = {{u[0], um}, {um, u[1]}}, vs[2][2] = {{v[0], vm}, {vm, v[1]}};
             for (int b = 0; b < 2; b++)
                 for (int a = 0; a < 2; a++)
-                    if (emit_part(e, ku, kv, su, sv, span_u, span_v, us[a], vs[b], depth + 1) != 0)
+                    if (emit_part(e, ku, kv, su, sv, span_u, span_v, us[a], vs[b], depth + 1,
+                                  TRIM_SPLITS) != 0) /* a piece the loops cross no more */
                         return -1;
             return 0;
         }
@@ -357,17 +450,16 @@ int rib_nupatch(Rib *r, const Args *a)
             }
         }
     }
-    if (e == 0 && r->a.trimmed)
-        rib_warn_once(r, "nupatch trim",
-                      "NuPatch: trim curves are not applied (the whole patch renders)");
     s.knot[0] = knot[0];
     s.knot[1] = knot[1];
     s.Pw = Pw;
-    Emit em = {r, &s, !rational && s.order[0] <= 4 && s.order[1] <= 4, st, m[0], 0, 0};
+    Emit em = {r,  &s,        !rational && s.order[0] <= 4 && s.order[1] <= 4,
+               st, m[0],      0,
+               0,  r->a.trim, r->a.trim_outside};
     for (int sv = 0; e == 0 && sv < m[1]; sv++)
         for (int su = 0; e == 0 && su < m[0]; su++)
             e = emit_part(&em, k[0][su], k[1][sv], su, sv, iv[0][su], iv[1][sv], iv[0][su],
-                          iv[1][sv], 0);
+                          iv[1][sv], 0, 0);
     if (e == 0 && em.unconverged)
         rib_warn_once(r, "nupatch fit",
                       "NuPatch: a span of high order or strong weights is approximated "
@@ -383,10 +475,134 @@ int rib_nupatch(Rib *r, const Args *a)
     return e;
 }
 
-/* TrimCurve nloops ncurves order knot min max n u v w: the trim curves of
- * the NuPatches after it (an attribute); read, and not applied. */
+/* A TrimCurve that does not read (as PRMan, which says so and renders
+ * on): one warning, and the NuPatches after it are not trimmed. */
+static int trim_bad(Rib *r, const char *what)
+{
+    rib_warn_once(r, "trimcurve bad", "TrimCurve: %s; the trim is ignored", what);
+    r->a.trim = NULL;
+    return 0;
+}
+
+/* A numeric array argument of count values (count 0: any), or NULL. */
+static const Arg *array_arg(const Args *a, size_t i, size_t count)
+{
+    if (i >= a->n || !rib_is_num(&a->v[i]) || (count && a->v[i].n != count))
+        return NULL;
+    return &a->v[i];
+}
+
+/* TrimCurve [ncurves] [order] [knot] [min] [max] [n] [u] [v] [w] (the
+ * loops' count is ncurves'): the trim loops of the NuPatches after it,
+ * an attribute; an empty one ends trimming. */
 int rib_trim_curve(Rib *r, const Args *a)
 {
-    r->a.trimmed = a->n > 0 && rib_is_num(&a->v[0]) && a->v[0].n > 0;
+    const Arg *nc = array_arg(a, 0, 0);
+    if (!nc)
+        return trim_bad(r, "expected the curves of each loop (numbers)");
+    if (nc->n == 0) {
+        r->a.trim = NULL;
+        return 0;
+    }
+    size_t curves = 0;
+    for (size_t k = 0; k < nc->n; k++) {
+        if (!(nc->d[k] >= 1 && nc->d[k] <= 1e6 && nc->d[k] == floor(nc->d[k])))
+            return trim_bad(r, "a loop needs a whole number of curves (1 or more)");
+        curves += (size_t)nc->d[k];
+    }
+    const Arg *order = array_arg(a, 1, curves), *n = array_arg(a, 5, curves);
+    if (!order || !n)
+        return trim_bad(r, "expected an order and a point count per curve");
+    size_t knots = 0, points = 0;
+    for (size_t c = 0; c < curves; c++) {
+        if (!(order->d[c] >= 2 && order->d[c] <= NURBS_MAX_ORDER &&
+              order->d[c] == floor(order->d[c])) ||
+            !(n->d[c] >= order->d[c] && n->d[c] <= TRIM_MAX_POINTS && n->d[c] == floor(n->d[c])))
+            return trim_bad(r, "a curve needs an order from 2 to 32 and as many points or more");
+        knots += (size_t)(order->d[c] + n->d[c]);
+        points += (size_t)n->d[c];
+    }
+    if (points > TRIM_MAX_POINTS)
+        return trim_bad(r, "more than 2^20 points");
+    const Arg *knot = array_arg(a, 2, knots), *lo = array_arg(a, 3, curves);
+    const Arg *hi = array_arg(a, 4, curves), *u = array_arg(a, 6, points);
+    const Arg *v = array_arg(a, 7, points), *w = array_arg(a, 8, points);
+    if (!knot)
+        return trim_bad(r, "expected order + n knots per curve");
+    if (!lo || !hi || !u || !v || !w)
+        return trim_bad(r, "expected a min and a max per curve, and n u, v and w per curve");
+    for (size_t q = 0; q < points; q++)
+        if (!(w->d[q] > 0))
+            return trim_bad(r, "a point's w is not positive");
+    TrimSet *t = calloc(1, sizeof *t);
+    size_t cap = points * TRIM_SEGMENTS + curves + 1;
+    if (t) {
+        t->first = calloc(nc->n + 1, sizeof *t->first);
+        t->pt = malloc(cap * sizeof *t->pt);
+    }
+    if (!t || !t->first || !t->pt) {
+        if (t)
+            free(t->first), free(t->pt);
+        free(t);
+        return rib_error(r, "out of memory");
+    }
+    t->next = r->trims;
+    r->trims = t;
+    t->n_loops = nc->n;
+    size_t np = 0, c = 0, ko = 0, po = 0;
+    float cp[NURBS_MAX_ORDER][4];
+    for (size_t l = 0; l < nc->n; l++) {
+        t->first[l] = np;
+        for (size_t j = 0; j < (size_t)nc->d[l]; j++, c++) {
+            int ord = (int)order->d[c], cn = (int)n->d[c], p = ord - 1;
+            const double *kn = knot->d + ko;
+            float kf[2 * NURBS_MAX_ORDER];
+            for (int sp = p; sp < cn; sp++) { /* each knot span within [min, max] */
+                float a0 = fmaxf((float)kn[sp], (float)lo->d[c]);
+                float a1 = fminf((float)kn[sp + 1], (float)hi->d[c]);
+                if (!(kn[sp] < kn[sp + 1]) || !(a0 < a1))
+                    continue;
+                for (int q = 0; q < 2 * ord; q++) /* the knots de Boor reads, as floats */
+                    kf[q] = (float)kn[sp - p + q];
+                for (int seg = 0; seg < TRIM_SEGMENTS && np < cap; seg++) {
+                    float x = a0 + (a1 - a0) * (float)seg / TRIM_SEGMENTS;
+                    for (int q = 0; q <= p; q++) {
+                        size_t pi = po + (size_t)(sp - p + q);
+                        float ww = (float)w->d[pi];
+                        cp[q][0] = (float)u->d[pi] * ww, cp[q][1] = (float)v->d[pi] * ww;
+                        cp[q][2] = ww, cp[q][3] = 0;
+                    }
+                    de_boor(cp, kf, p, p, x); /* kf holds knots sp - p .. sp + p + 1 */
+                    t->pt[np][0] = cp[p][0] / cp[p][2];
+                    t->pt[np][1] = cp[p][1] / cp[p][2];
+                    if (!isfinite(t->pt[np][0]) || !isfinite(t->pt[np][1]))
+                        t->pt[np][0] = t->pt[np][1] = 0; /* w underflowed: a point at 0 */
+                    np++;
+                }
+            }
+            ko += (size_t)(ord + cn);
+            po += (size_t)cn;
+        }
+        if (np - t->first[l] < 3) /* a loop of less than a triangle cuts nothing */
+            np = t->first[l];
+    }
+    t->first[nc->n] = np;
+    t->lo[0] = t->lo[1] = INFINITY;
+    t->hi[0] = t->hi[1] = -INFINITY;
+    for (size_t q = 0; q < np; q++)
+        for (int k = 0; k < 2; k++)
+            t->lo[k] = fminf(t->lo[k], t->pt[q][k]), t->hi[k] = fmaxf(t->hi[k], t->pt[q][k]);
+    r->a.trim = np ? t : NULL;
     return 0;
+}
+
+void rib_trims_free(Rib *r)
+{
+    while (r->trims) {
+        TrimSet *t = r->trims;
+        r->trims = t->next;
+        free(t->first);
+        free(t->pt);
+        free(t);
+    }
 }

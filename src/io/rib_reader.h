@@ -114,7 +114,9 @@ typedef struct Attr {
     unsigned char on[RIB_MAX_LIGHTS / 8]; /* bit k: Rib.lights[k] is on */
     float area_L[3];
     char area_map[256]; /* its environment map (RenderMan 19-20's envsphere), or "" */
-    int trimmed;        /* TrimCurve with loops in force (not applied) */
+    const struct TrimSet *trim; /* TrimCurve in force (rib_nurbs.c), or NULL */
+    int trim_outside;           /* Attribute "trimcurve" "sense" "outside": the loops'
+                                   outsides are cut away, not their insides */
     float ubasis[16], vbasis[16];
     int ustep, vstep;
     int lod_coarse; /* DetailRange ends before infinity: a coarser representation,
@@ -210,6 +212,7 @@ typedef struct Rib {
     size_t depth;
     long next_gen;
     ShaderRec *shaders;
+    struct TrimSet *trims; /* every TrimCurve read (rib_nurbs.c) */
 
     int in_world;
     int worlds;
@@ -413,6 +416,7 @@ int rib_emit_bicubic(Rib *r, float B[16][3], const PvOut *pv);
 
 int rib_nupatch(Rib *r, const Args *a);
 int rib_trim_curve(Rib *r, const Args *a);
+void rib_trims_free(Rib *r);
 
 /* ------------------------------ rib_ris.c: RenderMan 19 and later (RIS) */
 

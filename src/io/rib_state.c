@@ -875,6 +875,16 @@ static int h_option_attribute(Rib *r, const Args *a)
                    strcmp(q->d.name, "opacitycachememory") == 0 && rib_is_num(q->v) &&
                    q->v->n == 1) {
             e = set_opacity_cache_memory(r, q->v->d[0]);
+        } else if (!option && strcmp(group, "trimcurve") == 0 && strcmp(q->d.name, "sense") == 0 &&
+                   !rib_is_num(q->v) && q->v->n == 1) {
+            const char *v = q->v->s[0]; /* which side of the trim loops is cut away */
+            if (strcmp(v, "inside") == 0 || strcmp(v, "outside") == 0)
+                r->a.trim_outside = v[0] == 'o';
+            else
+                e = rib_error(r,
+                              "Attribute \"trimcurve\" \"sense\": expected \"inside\" or "
+                              "\"outside\", found \"%.64s\"",
+                              v);
         } else if (!option && strcmp(group, "dice") == 0 && strcmp(q->d.name, "roundcurve") == 0 &&
                    rib_is_num(q->v) && q->v->n == 1) {
             r->a.roundcurve = q->v->d[0] != 0;

@@ -205,12 +205,69 @@ static void test_reading(void)
     CHECK(rib(WORLD("NuPatch 2 2 [0 0 1 1] 0 1 2 2 [0 0 1 1] 0 1 \"Pw\" [0 0 0 1 1 0 0 0 "
                     "0 1 0 1 1 1 0 1]")) != RAYES_OK &&
           strstr(err, "w is not positive"));
-    /* trim curves: read, the whole patch drawn (with a warning) */
+    /* a TrimCurve that does not read (too few knots): warned, ignored */
     snprintf(text, sizeof text,
-             WORLD("TrimCurve [1] [2] [0 0 1 1] [0] [1] [2] [0.2 0.8] [0.2 0.8] [1 1]\n"
+             WORLD("TrimCurve [1] [2] [0 0 1] [0] [1] [2] [0.2 0.8] [0.2 0.8] [1 1]\n"
                    "NuPatch 5 4 [0 1 2 3 4 5 6 7 8] 3 5 5 4 [0 1 2 3 4 5 6 7 8] 3 5 \"P\" [%s]"),
              P);
     CHECK(rib(text) == RAYES_OK && rec.n_patch == 4);
 }
 
-TEST_MAIN(TEST(test_polynomial_spans_exact), TEST(test_rational_sphere), TEST(test_reading))
+/* The centres of the patches sent: how many lie inside |x|, |y| < h and
+ * how many outside |x|, |y| < h2. */
+static void centres(float h, float h2, int *in, int *out)
+{
+    *in = *out = 0;
+    for (int k = 0; k < rec.n_patch; k++) {
+        float c[3];
+        bezier((const float(*)[3])rec.patch[k].P, 0.5f, 0.5f, c);
+        *in += fabsf(c[0]) < h && fabsf(c[1]) < h;
+        *out += fabsf(c[0]) > h2 || fabsf(c[1]) > h2;
+    }
+}
+
+/* A flat 2 x 2 square, (u, v) over [0, 1]^2, after trim. */
+#define SQUARE_NUPATCH(trim)                                                                       \
+    WORLD(trim "NuPatch 2 2 [0 0 1 1] 0 1 2 2 [0 0 1 1] 0 1 \"P\" [-1 -1 0 1 -1 0 -1 1 0 1 1 0]")
+#define SQUARE_LOOP                                                                                \
+    "TrimCurve [1] [2] [0 0 1 2 3 4 4] [0] [4] [5] [0.2 0.8 0.8 0.2 0.2] [0.2 0.2 0.8 0.8 0.2] "   \
+    "[1 1 1 1 1]\n"
+
+static void test_trim(void)
+{
+    int in, out;
+    CHECK(rib(SQUARE_NUPATCH("")) == RAYES_OK && rec.n_patch == 1);
+    /* RenderMan's default: the loop's inside, (u, v) in [0.2, 0.8]^2, is
+     * cut away, to 1/128 of the patch */
+    CHECK(rib(SQUARE_NUPATCH(SQUARE_LOOP)) == RAYES_OK);
+    centres(0.59f, 0.61f, &in, &out);
+    CHECK(rec.n_patch > 1 && in == 0 && out > 0);
+    /* "sense" "outside": only the inside stays */
+    CHECK(rib(SQUARE_NUPATCH("Attribute \"trimcurve\" \"sense\" \"outside\"\n" SQUARE_LOOP)) ==
+          RAYES_OK);
+    centres(0.61f, 0.61f, &in, &out);
+    CHECK(rec.n_patch > 1 && in == rec.n_patch && out == 0);
+    CHECK(rib(SQUARE_NUPATCH("Attribute \"trimcurve\" \"sense\" \"sideways\"\n")) != RAYES_OK);
+    /* an attribute: AttributeEnd and an empty TrimCurve end it */
+    CHECK(rib(SQUARE_NUPATCH("AttributeBegin\n" SQUARE_LOOP "AttributeEnd\n")) == RAYES_OK &&
+          rec.n_patch == 1);
+    CHECK(rib(SQUARE_NUPATCH(SQUARE_LOOP "TrimCurve [] [] [] [] [] [] [] [] []\n")) == RAYES_OK &&
+          rec.n_patch == 1);
+    /* a rational circle of radius 0.3 about the centre: a round hole,
+     * its edge within 1/128 of the patch (1/64 of its width 2) */
+    CHECK(rib(SQUARE_NUPATCH("TrimCurve [1] [3] [0 0 0 1 1 2 2 3 3 4 4 4] [0] [4] [9] "
+                             "[0.8 0.8 0.5 0.2 0.2 0.2 0.5 0.8 0.8] "
+                             "[0.5 0.8 0.8 0.8 0.5 0.2 0.2 0.2 0.5] "
+                             "[1 0.70710678 1 0.70710678 1 0.70710678 1 0.70710678 1]\n")) ==
+          RAYES_OK);
+    float nearest = INFINITY; /* the kept piece nearest the centre */
+    for (int k = 0; k < rec.n_patch; k++) {
+        float c[3];
+        bezier((const float(*)[3])rec.patch[k].P, 0.5f, 0.5f, c);
+        nearest = fminf(nearest, sqrtf(c[0] * c[0] + c[1] * c[1]));
+    }
+    CHECK(rec.n_patch > 1 && nearest > 0.6f - 2.0f / 128 && nearest < 0.6f + 4.0f / 128);
+}
+
+TEST_MAIN(TEST(test_polynomial_spans_exact), TEST(test_rational_sphere), TEST(test_reading),
+          TEST(test_trim))
