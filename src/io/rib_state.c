@@ -407,10 +407,11 @@ static int h_projection(Rib *r, const Args *a)
         return -1;
     const Param *fov = rib_find_param(p, n, "fov");
     int e = 0;
-    if (strcmp(name, "orthographic") == 0) {
+    /* RenderMan 21 and later name them PxrPerspective, PxrOrthographic */
+    if (strcmp(name, "orthographic") == 0 || strcmp(name, "PxrOrthographic") == 0) {
         r->projection = RAYES_PROJECTION_ORTHOGRAPHIC;
     } else {
-        if (strcmp(name, "perspective") != 0)
+        if (strcmp(name, "perspective") != 0 && strcmp(name, "PxrPerspective") != 0)
             rib_warn_once(r, name, "projection \"%s\" is not supported; perspective used", name);
         r->projection = RAYES_PROJECTION_PERSPECTIVE;
         r->fov = 90;
@@ -875,6 +876,21 @@ static int h_option_attribute(Rib *r, const Args *a)
                    strcmp(q->d.name, "opacitycachememory") == 0 && rib_is_num(q->v) &&
                    q->v->n == 1) {
             e = set_opacity_cache_memory(r, q->v->d[0]);
+        } else if (option && strcmp(group, "ri") == 0 &&
+                   strcmp(q->d.name, "FormatResolution") == 0 && rib_is_num(q->v) && q->v->n == 2) {
+            /* RenderMan 21 and later's Format */
+            double w = q->v->d[0], h = q->v->d[1];
+            if (!(w >= 1 && w <= 65536 && h >= 1 && h <= 65536))
+                e = rib_error(r, "the image size must be 1 to 65536 pixels");
+            else {
+                r->width = r->settings->width = (int)w;
+                r->height = r->settings->height = (int)h;
+            }
+        } else if (option && strcmp(group, "ri") == 0 &&
+                   strcmp(q->d.name, "FormatPixelAspectRatio") == 0 && rib_is_num(q->v) &&
+                   q->v->n == 1) {
+            if (q->v->d[0] != 1)
+                rib_warn_once(r, "pixel aspect", "pixel aspect ratio %g treated as 1", q->v->d[0]);
         } else if (!option && strcmp(group, "trimcurve") == 0 && strcmp(q->d.name, "sense") == 0 &&
                    !rib_is_num(q->v) && q->v->n == 1) {
             const char *v = q->v->s[0]; /* which side of the trim loops is cut away */

@@ -187,6 +187,17 @@ static void test_integrator(void)
           RAYES_OK);
 }
 
+/* RenderMan 21's names for the image size and the projections. */
+static void test_options(void)
+{
+    CHECK(rib("Option \"ri\" \"int[2] FormatResolution\" [320 200] \"float "
+              "FormatPixelAspectRatio\" [1]\nProjection \"PxrPerspective\" \"float fov\" [30]\n"
+              "WorldBegin\n" TRI "WorldEnd\n") == RAYES_OK);
+    CHECK(settings.width == 320 && settings.height == 200);
+    CHECK(rib("Option \"ri\" \"int[2] FormatResolution\" [0 200]\n" WORLD(TRI)) != RAYES_OK);
+    CHECK(rib("Projection \"PxrOrthographic\"\nWorldBegin\n" TRI "WorldEnd\n") == RAYES_OK);
+}
+
 enum { SIZE = 32 };
 
 /* A box open toward the camera lit from its ceiling by light (a RIB
@@ -323,4 +334,4 @@ static void test_rendered(void)
 }
 
 TEST_MAIN(TEST(test_bxdfs), TEST(test_lights), TEST(test_geometry_lights), TEST(test_integrator),
-          TEST(test_rendered))
+          TEST(test_options), TEST(test_rendered))
