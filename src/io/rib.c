@@ -553,8 +553,9 @@ static const RibRequest own_requests[] = {
 };
 
 static const RibRequest *const tables[] = {
-    rib_frame_requests, rib_state_requests, rib_params_requests, rib_shade_requests,
-    rib_ris_requests,   rib_prim_requests,  rib_curves_requests, own_requests};
+    rib_frame_requests,  rib_state_requests, rib_params_requests,
+    rib_shade_requests,  rib_ris_requests,   rib_prim_requests,
+    rib_curves_requests, rib_nurbs_requests, own_requests};
 
 static int dispatch(Rib *r, const Args *a)
 {
@@ -575,7 +576,8 @@ static int dispatch(Rib *r, const Args *a)
     for (size_t t = 0; t < sizeof tables / sizeof tables[0]; t++)
         for (const RibRequest *k = tables[t]; k->name; k++)
             if (strcmp(k->name, q) == 0) {
-                if ((tables[t] == rib_prim_requests || tables[t] == rib_curves_requests) &&
+                if ((tables[t] == rib_prim_requests || tables[t] == rib_curves_requests ||
+                     tables[t] == rib_nurbs_requests) &&
                     r->a.lod_coarse)
                     return 0;
                 r->pv_block_color = 0;

@@ -178,6 +178,7 @@ static int h_world_begin(Rib *r, const Args *a)
     rib_mat_identity(r->a.M);
     r->a.n_motion = 0;
     r->in_world = 1;
+    r->world_depth = r->depth;
     float sw[4];
     const float *screen = NULL;
     if (r->have_screen) {

@@ -369,7 +369,7 @@ static int spans(const float *knot, int n, int order, const float range[2], int 
     return m;
 }
 
-int rib_nupatch(Rib *r, const Args *a)
+static int h_nupatch(Rib *r, const Args *a)
 {
     size_t i = 0;
     Nurbs s = {.Pw = NULL};
@@ -495,7 +495,7 @@ static const Arg *array_arg(const Args *a, size_t i, size_t count)
 /* TrimCurve [ncurves] [order] [knot] [min] [max] [n] [u] [v] [w] (the
  * loops' count is ncurves'): the trim loops of the NuPatches after it,
  * an attribute; an empty one ends trimming. */
-int rib_trim_curve(Rib *r, const Args *a)
+static int h_trim_curve(Rib *r, const Args *a)
 {
     const Arg *nc = array_arg(a, 0, 0);
     if (!nc)
@@ -606,3 +606,9 @@ void rib_trims_free(Rib *r)
         free(t);
     }
 }
+
+const RibRequest rib_nurbs_requests[] = {
+    {"NuPatch", h_nupatch},
+    {"TrimCurve", h_trim_curve},
+    {NULL, NULL},
+};

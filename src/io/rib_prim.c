@@ -1224,8 +1224,6 @@ const RibRequest rib_prim_requests[] = {
     {"Hyperboloid", h_quadric},
     {"Paraboloid", h_quadric},
     {"Geometry", h_geometry},
-    {"NuPatch", rib_nupatch},
-    {"TrimCurve", rib_trim_curve},
     {"Volume", h_volume},
     {"SubdivisionMesh", h_subdivision_mesh},
     {"HierarchicalSubdivisionMesh", h_hierarchical_subdivision_mesh},

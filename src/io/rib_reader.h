@@ -15,6 +15,9 @@
  *                 (transform, shader, light links) before a primitive
  *   rib_prim.c    geometric primitives: polygons, patches, quadrics,
  *                 Geometry, and their primitive variables
+ *   rib_nurbs.c   NuPatch and TrimCurve
+ *   rib_ris.c     RenderMan 19 and later: Bxdf, Light, Integrator, the
+ *                 geometric area lights of RenderMan 19 and 20
  *   rib_frame.c   the block structure: frames, worlds, object definitions
  *
  * with rib_lex.c (tokens), rib_geom.c (tessellation, bases, matrices) and
@@ -22,7 +25,8 @@
  * request goes into its concern's file, with a line in that file's table
  * of requests (RibRequest), which rib.c's dispatch reads. The files call
  * one way only (tools/check_deps): rib.c calls them all, rib_frame.c
- * rib_state.c and rib_shade.c, rib_prim.c rib_shade.c, and every file
+ * rib_state.c and rib_shade.c, rib_nurbs.c rib_prim.c, rib_prim.c
+ * rib_ris.c and rib_shade.c, rib_ris.c rib_shade.c, and every file
  * rib_params.c, which calls none.
  *
  * State: the attribute state (transform, colour, shaders, orientation,
@@ -115,6 +119,7 @@ typedef struct Attr {
     float area_L[3];
     char area_map[256]; /* its environment map (RenderMan 19-20's envsphere), or "" */
     const struct TrimSet *trim; /* TrimCurve in force (rib_nurbs.c), or NULL */
+    int area_normalize;         /* its areaNormalize (RenderMan 19-20's geometry lights) */
     int trim_outside;           /* Attribute "trimcurve" "sense" "outside": the loops'
                                    outsides are cut away, not their insides */
     float ubasis[16], vbasis[16];
@@ -213,6 +218,7 @@ typedef struct Rib {
     long next_gen;
     ShaderRec *shaders;
     struct TrimSet *trims; /* every TrimCurve read (rib_nurbs.c) */
+    size_t world_depth;    /* the attribute stack's depth at WorldBegin */
 
     int in_world;
     int worlds;
@@ -414,8 +420,7 @@ int rib_emit_bicubic(Rib *r, float B[16][3], const PvOut *pv);
 
 /* ------------------------------------------- rib_nurbs.c: NuPatch */
 
-int rib_nupatch(Rib *r, const Args *a);
-int rib_trim_curve(Rib *r, const Args *a);
+extern const RibRequest rib_nurbs_requests[];
 void rib_trims_free(Rib *r);
 
 /* ------------------------------ rib_ris.c: RenderMan 19 and later (RIS) */
@@ -425,10 +430,7 @@ extern const RibRequest rib_ris_requests[];
  * "envsphere" under AreaLightSource (RenderMan 19 and 20): the light of
  * that shape; 1 if name is one of them, 0 if not, -1 on error. */
 int rib_ris_geometry_light(Rib *r, const char *name);
-/* A Pattern class of RenderMan's that rayes translates ("PxrTexture"):
- * rayes' class and parameters in *type, p (at most 4); 0 if not one. */
-int rib_ris_pattern(Rib *r, const char *cls, const Param *p, size_t n, const char **type,
-                    RayesParam *out, size_t *n_out);
+
 /* At WorldEnd: sends the lights on then that were never sent, and ends
  * the world's lights. */
 int rib_flush_lights(Rib *r);

@@ -21,6 +21,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "io/rib_internal.h"
 #include "io/rib_reader.h"
 
 /* ------------------------------------------------------------ values */
@@ -147,12 +148,20 @@ static const char *pxr_surface(Rib *r, const char *cls, const Param *p, size_t n
                       "Bxdf \"%s\": its subsurface, glow, fuzz and single-scatter lobes are not "
                       "translated (diffuse, specular, clearcoat and glass are)",
                       cls);
+    /* the lobe that shines: the primary specular, else the rough
+     * specular, else the clearcoat; its colour and roughness */
+    int primary = max3(face) > 0 || max3(edge) > 0 || (physical && spec);
+    float roughness = primary           ? num(p, n, "specularRoughness", 0.2f)
+                      : max3(rough) > 0 ? num(p, n, "roughSpecularRoughness", 0.6f)
+                                        : num(p, n, "clearcoatRoughness", 0);
+    float shine[3];
+    for (int c = 0; c < 3; c++)
+        shine[c] = primary ? fmaxf(face[c], edge[c]) : max3(rough) > 0 ? rough[c] : coat[c];
     if (diffuse) {
         out_colour_of(r, o, cls, p, n, "diffuseColor", "reflectance", d18, gain);
         if (!spec && max3(coat) <= 0)
             return "diffuse";
-        out_float(o, "roughness", spec ? num(p, n, "specularRoughness", 0.2f)
-                                       : num(p, n, "clearcoatRoughness", 0));
+        out_float(o, "roughness", roughness);
         return "coateddiffuse";
     }
     if (!spec && max3(coat) <= 0) {
@@ -162,11 +171,12 @@ static const char *pxr_surface(Rib *r, const char *cls, const Param *p, size_t n
     if (physical) {
         out_color(o, "eta", eta);
         out_color(o, "k", k);
+    } else if (primary && max3(face) > 0) {
+        out_colour_of(r, o, cls, p, n, "specularFaceColor", "reflectance", shine, 1);
     } else {
-        out_colour_of(r, o, cls, p, n, "specularFaceColor", "reflectance",
-                      spec ? face : coat, 1);
+        out_color(o, "reflectance", shine);
     }
-    out_float(o, "roughness", num(p, n, "specularRoughness", 0.2f));
+    out_float(o, "roughness", roughness);
     return "conductor";
 }
 
@@ -275,7 +285,7 @@ static float disk_solid_angle(float deg)
 static void on_everywhere(Rib *r, const Light *l)
 {
     size_t k = (size_t)(l - r->lights);
-    for (size_t d = 0; d < r->depth; d++)
+    for (size_t d = r->world_depth; d < r->depth; d++) /* the world's blocks only */
         r->stack[d].a.on[k / 8] |= (unsigned char)(1u << (k % 8));
 }
 
@@ -318,6 +328,17 @@ static int make_light(Rib *r, const char *handle, const char *cls, const float L
     Light *l = rib_new_light(r, handle, type);
     if (!l)
         return -1;
+    if ((rect || disk) && rib_mat_det3(r->a.M) < 0) {
+        /* a mirroring transform (exporters write them: RenderMan for
+         * Blender's and hdPrman's lights all have one) turns the shape's
+         * winding, not the side RenderMan emits from: mirror it back in
+         * y, which leaves a unit square or disk where it was */
+        for (int c = 0; c < 4; c++) {
+            l->M[4 + c] = -l->M[4 + c];
+            for (int t = 0; t < l->n_motion; t++)
+                l->motion_M[t][4 + c] = -l->motion_M[t][4 + c];
+        }
+    }
     float v[3] = {I, 0, 0};
     rib_light_param(l, "intensity", RAYES_PARAM_FLOAT, v, NULL);
     rib_light_param(l, "lightcolor", RAYES_PARAM_COLOR, c, NULL);
@@ -368,7 +389,9 @@ static int h_light(Rib *r, const Args *a)
     int e = make_light(r, handle, cls, L, num(p, n, "areaNormalize", 0) != 0,
                        num(p, n, "angleExtent", 0.53f), map);
     free(p);
-    if (e > 0) { /* RenderMan 21's lights are not seen by the camera unless said */
+    if (e > 0 && (strcmp(cls, "PxrRectLight") == 0 || strcmp(cls, "PxrDiskLight") == 0 ||
+                  strcmp(cls, "PxrSphereLight") == 0)) {
+        /* RenderMan 21's lights are not seen by the camera unless said */
         Light *l = &r->lights[r->n_lights - 1];
         l->own_visibility = 1;
         l->visibility = r->a.camera_said ? r->a.visibility : r->a.visibility & ~RAYES_RAY_CAMERA;
@@ -399,7 +422,13 @@ int rib_ris_geometry_light(Rib *r, const char *name)
         return 1;
     char handle[RIB_MAX_HANDLE];
     snprintf(handle, sizeof handle, "@area%zu", r->n_lights);
-    return make_light(r, handle, cls, r->a.area_L, 0, 0.53f, r->a.area_map) < 0 ? -1 : 1;
+    int e = make_light(r, handle, cls, r->a.area_L, r->a.area_normalize, 0.53f, r->a.area_map);
+    if (e > 0 && strcmp(cls, "PxrDomeLight") != 0) { /* seen as the attributes say */
+        Light *l = &r->lights[r->n_lights - 1];
+        l->own_visibility = 1;
+        l->visibility = r->a.visibility;
+    }
+    return e < 0 ? -1 : 1;
 }
 
 /* ------------------------------------------------------------ Integrator */
@@ -438,22 +467,6 @@ static int h_integrator(Rib *r, const Args *a)
                       "costs about as much as the first; --bounces N for more)",
                       cls, len, RIS_DIFFUSE_BOUNCES, bounces);
     return 0;
-}
-
-/* ------------------------------------------------------------ patterns */
-
-int rib_ris_pattern(Rib *r, const char *cls, const Param *p, size_t n, const char **type,
-                    RayesParam *out, size_t *n_out)
-{
-    (void)r;
-    if (strcmp(cls, "PxrTexture") != 0)
-        return 0;
-    const char *file = string(p, n, "filename");
-    *type = "imagemap";
-    *n_out = 0;
-    if (file)
-        out[(*n_out)++] = (RayesParam){"filename", RAYES_PARAM_STRING, {0, 0, 0}, file};
-    return 1;
 }
 
 const RibRequest rib_ris_requests[] = {

@@ -772,6 +772,8 @@ static int h_area_light(Rib *r, const Args *a)
         I *= exp2f(fminf(fmaxf((float)ex->v->d[0], -126.0f), 126.0f));
     for (int c = 0; c < 3; c++)
         r->a.area_L[c] = I * (lc && rib_is_num(lc->v) && lc->v->n == 3 ? (float)lc->v->d[c] : 1);
+    const Param *an = rib_find_param(p, n, "areaNormalize");
+    r->a.area_normalize = an && rib_is_num(an->v) && an->v->n == 1 && an->v->d[0] != 0;
     r->a.area_map[0] = '\0';
     for (size_t k = 0; k < n; k++) /* an envsphere's map (rib_ris.c) */
         if (p[k].d.ty == TY_STRING && p[k].v->n == 1 &&
@@ -828,6 +830,21 @@ int rib_flush_lights(Rib *r)
     return 0;
 }
 
+/* A Pattern class of RenderMan's that rayes translates: PxrTexture of a
+ * file, an imagemap (its type and parameters in *type, out); 0 if not. */
+static int ris_pattern(const char *cls, const Param *p, size_t n, const char **type,
+                       RayesParam *out, size_t *n_out)
+{
+    const Param *f = rib_find_param(p, n, "filename");
+    if (strcmp(cls, "PxrTexture") != 0 || !f || f->d.ty != TY_STRING || f->d.reference ||
+        f->v->n != 1 || !f->v->s[0][0])
+        return 0;
+    *type = "imagemap";
+    out[0] = (RayesParam){"filename", RAYES_PARAM_STRING, {0, 0, 0}, f->v->s[0]};
+    *n_out = 1;
+    return 1;
+}
+
 /* Pattern "type" "name" params: rayes' patterns (pbrt-v4's texture
  * classes, rayes_scene_pattern) in the current transform, sent at once,
  * so that shaders sent later may take them ("reference pattern NAME"). */
@@ -843,8 +860,8 @@ static int h_pattern(Rib *r, const Args *a)
     const IoSink *s = r->sink;
     RayesParam ris[4];
     size_t n_ris = 0;
-    const char *as = NULL; /* a RenderMan class rayes translates (rib_ris.c) */
-    if (!in_list(builtin_patterns, type) && rib_ris_pattern(r, type, p, n, &as, ris, &n_ris))
+    const char *as = NULL; /* a RenderMan class rayes translates */
+    if (!in_list(builtin_patterns, type) && ris_pattern(type, p, n, &as, ris, &n_ris))
         type = as;
     if (!in_list(builtin_patterns, type) || !s->pattern) {
         char key[128];

@@ -75,6 +75,14 @@ static void test_bxdfs(void)
     CHECK(strcmp(s->name, "conductor") == 0);
     CHECK_NEAR(param(s, "eta", 1), 0.9, 1e-6);
     CHECK_NEAR(param(s, "k", 0), 3.9, 1e-6);
+    /* the lobe that shines gives the conductor its colour and roughness */
+    s = bxdf("Bxdf \"PxrSurface\" \"s\" \"float diffuseGain\" [0] \"color specularEdgeColor\" "
+             "[1 1 1]");
+    CHECK(strcmp(s->name, "conductor") == 0 && param(s, "reflectance", 0) == 1.0f);
+    s = bxdf("Bxdf \"PxrSurface\" \"s\" \"float diffuseGain\" [0] \"color clearcoatFaceColor\" "
+             "[0.5 0.5 0.5] \"float clearcoatRoughness\" [0.05]");
+    CHECK(strcmp(s->name, "conductor") == 0 && param(s, "reflectance", 1) == 0.5f);
+    CHECK_NEAR(param(s, "roughness", 0), 0.05, 1e-6);
     s = bxdf("Bxdf \"PxrSurface\" \"s\" \"float refractionGain\" [1] \"float glassIor\" [1.33]");
     CHECK(strcmp(s->name, "dielectric") == 0 && fabsf(param(s, "eta", 0) - 1.33f) < 1e-6f);
     s = bxdf("Bxdf \"PxrSurface\" \"s\"");
@@ -94,6 +102,10 @@ static void test_bxdfs(void)
     /* an unknown class: a grey diffuse, with a warning, not an error */
     s = bxdf("Bxdf \"PxrMarschnerHair\" \"h\" \"float diffuseGain\" [1]");
     CHECK(strcmp(s->name, "diffuse") == 0);
+    /* a PxrTexture without a file is not translated: warned, the value used */
+    CHECK(rib(WORLD("Pattern \"PxrTexture\" \"t\"\nBxdf \"PxrDiffuse\" \"d\" \"reference color "
+                    "diffuseColor\" [\"t:resultRGB\"]\n" TRI)) == RAYES_OK);
+    CHECK(strcmp(rec.shader[rec.n_shader - 1].name, "diffuse") == 0);
     /* Bxdf is an attribute, as Surface is */
     CHECK(rib(WORLD("AttributeBegin\nBxdf \"PxrDiffuse\" \"d\"\nAttributeEnd\n" TRI)) == RAYES_OK);
     CHECK(rec.n_shader >= 1 && strcmp(rec.shader[rec.n_shader - 1].name, "matte") == 0);
@@ -304,6 +316,25 @@ static void test_rendered(void)
     CHECK(back && unseen && memcmp(back->rgba, unseen->rgba, sizeof(float) * 4 * SIZE * SIZE) == 0);
     free(written);
     rayes_image_free(back);
+    /* lights under a mirroring transform, as exporters write them, still
+     * emit along their +z; RenderMan 19-20's rectlight is seen as its
+     * block's visibility says */
+    RayesImage *mirrored = render_box("Scale -1 1 1\nLight \"PxrRectLight\" \"k\" \"float "
+                                      "intensity\" [6] \"color lightColor\" [1 0.8 0.6]",
+                                      "");
+    RayesImage *hidden = render_box("Attribute \"visibility\" \"int camera\" [0]\n"
+                                    "AreaLightSource \"PxrStdAreaLight\" \"a\" \"float "
+                                    "exposure\" [1] \"float intensity\" [3] \"color lightColor\" "
+                                    "[1 0.8 0.6]\nGeometry \"rectlight\"",
+                                    "");
+    CHECK(mirrored && hidden && unseen);
+    if (mirrored && hidden && unseen) {
+        /* the same square, its corners in another order: the same light */
+        CHECK_NEAR(mean(mirrored, 0, 0), mean(unseen, 0, 0), 0.01 * mean(unseen, 0, 0));
+        CHECK(memcmp(hidden->rgba, unseen->rgba, sizeof(float) * 4 * SIZE * SIZE) == 0);
+    }
+    rayes_image_free(mirrored);
+    rayes_image_free(hidden);
     rayes_image_free(ris);
     rayes_image_free(classic);
     rayes_image_free(unseen);
