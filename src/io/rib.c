@@ -817,11 +817,13 @@ RayesError io_rib_parse(const char *name, const unsigned char *data, size_t size
                  frame);
         e = -1;
     }
+    int lit = r.lit;
     rib_fini(&r);
     if (e == 0) { /* pass 2: the selected frame into the sink */
         rib_init(&r, 2, sink, options, settings, err, err_size);
         r.top_name = name;
         r.selected = selected;
+        r.unlit_file = !lit;
         e = run(&r, name, data, size);
         if (e == 0 && r.n_lights > 0)
             e = rib_flush_lights(&r); /* a file without WorldEnd */

@@ -189,6 +189,19 @@ static int h_world_begin(Rib *r, const Args *a)
         memcpy(sw, fa >= 1 ? s : t, sizeof sw);
         screen = sw;
     }
+    if (r->width == 0) {
+        /* no Format: RenderMan's 640 x 480, or 640 wide at the frame's
+         * aspect ratio (FrameAspectRatio, else ScreenWindow's), so that
+         * the picture is not stretched */
+        float aspect = 4.0f / 3.0f;
+        if (r->frame_aspect > 0)
+            aspect = r->frame_aspect;
+        else if (r->have_screen && r->screen[3] > r->screen[2] && r->screen[1] > r->screen[0])
+            aspect = (r->screen[1] - r->screen[0]) / (r->screen[3] - r->screen[2]);
+        float h = roundf(640.0f / aspect);
+        r->settings->width = 640;
+        r->settings->height = h >= 1 && h <= 65536 ? (int)h : 480;
+    }
     const IoSink *s = r->sink;
     if (s->set_camera_matrix(s->target, r->camera_from_world, (RayesProjection)r->projection,
                              r->fov, screen) != RAYES_OK)

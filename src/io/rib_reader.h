@@ -219,6 +219,9 @@ typedef struct Rib {
     ShaderRec *shaders;
     struct TrimSet *trims; /* every TrimCurve read (rib_nurbs.c) */
     size_t world_depth;    /* the attribute stack's depth at WorldBegin */
+    int lit;               /* a light was made (pass 1: anywhere in the file) */
+    int unlit_file;        /* pass 2: the file makes no light, so geometry without a
+                              Surface is drawn with RenderMan's defaultsurface */
 
     int in_world;
     int worlds;

@@ -48,7 +48,10 @@ static int send_shader(Rib *r, const IoSink *s, const float Cs[3])
     p[n++] = (RayesParam){"Cs", RAYES_PARAM_COLOR, {Cs[0], Cs[1], Cs[2]}, NULL};
     if (memcmp(r->a.Os, white, sizeof white) != 0)
         p[n++] = (RayesParam){"Os", RAYES_PARAM_COLOR, {r->a.Os[0], r->a.Os[1], r->a.Os[2]}, NULL};
-    RayesError e = s->set_shader(s->target, sh ? sh->name : "matte", p, n);
+    /* no Surface: matte, or RenderMan's defaultsurface in a file without
+     * lights (which matte would draw black) */
+    const char *name = sh ? sh->name : r->unlit_file ? "defaultsurface" : "matte";
+    RayesError e = s->set_shader(s->target, name, p, n);
     free(p);
     return e == RAYES_OK ? 0 : rib_sink_failed(r, s);
 }
@@ -266,10 +269,10 @@ int rib_emit_begin(Rib *r, const float *Cs)
 
 /* ------------------------------------------------------------ shaders */
 
-static const char *const builtin_surfaces[] = {"matte", "plastic", "metal", "shinymetal",
-                                               "constant", "glass", "mirror", "paintedplastic",
-                                               "diffuse", "conductor", "dielectric",
-                                               "coateddiffuse", "subsurface", NULL};
+static const char *const builtin_surfaces[] = {
+    "matte",      "plastic",       "metal",          "shinymetal",     "constant",
+    "glass",      "mirror",        "paintedplastic", "diffuse",        "conductor",
+    "dielectric", "coateddiffuse", "subsurface",     "defaultsurface", NULL};
 static const char *const builtin_displacements[] = {"bumpy", "fractal", "displace", NULL};
 /* rayes' pattern classes (rayes_scene_pattern): pbrt-v4's textures. */
 static const char *const builtin_patterns[] = {
@@ -436,15 +439,17 @@ static int h_surface(Rib *r, const Args *a)
         return -1;
     }
     int known = shader_known(r, builtin_surfaces, name);
+    /* in a file without lights, RenderMan's own stand-in, which needs none */
+    const char *instead = r->unlit_file ? "defaultsurface" : "matte";
     if (!known) {
         char key[128];
         snprintf(key, sizeof key, "surface %s", name);
         rib_warn_once(r, key,
-                  "surface shader \"%s\" is neither built in nor a plugin on the shader path: "
-                  "matte instead (with its Ka, Kd)",
-                  name);
+                      "surface shader \"%s\" is neither built in nor a plugin on the shader "
+                      "path: %s instead (with its Ka, Kd)",
+                      name, instead);
     }
-    ShaderRec *sh = make_shader(r, known ? name : "matte", p, n, known ? 0 : SHADER_ONLY_K);
+    ShaderRec *sh = make_shader(r, known ? name : instead, p, n, known ? 0 : SHADER_ONLY_K);
     free(p);
     if (!sh)
         return -1;
@@ -556,6 +561,7 @@ Light *rib_new_light(Rib *r, const char *handle, const char *type)
     Light *L = find_light(r, handle);
     if (L)
         L->handle[0] = '\0';
+    r->lit = 1;
     Light *nl = realloc(r->lights, (r->n_lights + 1) * sizeof *nl);
     if (!nl) {
         rib_error(r, "out of memory");
@@ -782,6 +788,7 @@ static int h_area_light(Rib *r, const Args *a)
             snprintf(r->a.area_map, sizeof r->a.area_map, "%s", p[k].v->s[0]);
     const Param *ts = rib_find_param(p, n, "twosided");
     r->a.area_twosided = ts && rib_is_num(ts->v) && ts->v->n == 1 && ts->v->d[0] != 0;
+    r->lit = 1;
     free(p);
     if (r->in_object) {
         rib_warn_once(r, "area light in object",

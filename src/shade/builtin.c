@@ -13,6 +13,7 @@
  */
 #include "shade/builtin.h"
 
+#include <math.h>
 #include <stddef.h>
 #include <string.h>
 
@@ -264,6 +265,66 @@ const RayesShaderClass shade_class_constant = {
     .name = "constant",
     .lighting = constant_lighting,
     .diffuselighting = constant_lighting,
+};
+
+/* ---- defaultsurface
+ *
+ * RenderMan's default surface, what files that set none are drawn with
+ * when they have no lights: Ci = Cs (Ka + Kd (I.N)^2), a headlight-like
+ * look by the facing ratio that needs no light. It reflects no light:
+ * diffuse rays see it black. */
+
+typedef struct DefaultParams {
+    float Ka, Kd;
+} DefaultParams;
+
+static void default_lighting(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
+                             const void *params, RayesShadeOutputs *out)
+{
+    (void)sv;
+    const DefaultParams *p = params;
+    for (size_t i = 0; i < ctx->n_points; i++) {
+        float d = 0;
+        if (ctx->I) {
+            const float *I = ctx->I[i], *N = ctx->N[i];
+            float ii = I[0] * I[0] + I[1] * I[1] + I[2] * I[2];
+            float nn = N[0] * N[0] + N[1] * N[1] + N[2] * N[2];
+            if (ii > 0 && nn > 0)
+                d = (I[0] * N[0] + I[1] * N[1] + I[2] * N[2]) / sqrtf(ii * nn);
+        }
+        for (int c = 0; c < 3; c++)
+            out->Ci[i][c] = cs(ctx, i, c) * (p->Ka + p->Kd * d * d);
+    }
+    if (out->Irradiance)
+        memset(out->Irradiance, 0, ctx->n_points * sizeof *out->Irradiance);
+    set_opacity(ctx, out);
+}
+
+static void default_diffuselighting(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
+                                    const void *params, RayesShadeOutputs *out)
+{
+    (void)sv, (void)params;
+    for (size_t i = 0; i < ctx->n_points; i++)
+        out->Ci[i][0] = out->Ci[i][1] = out->Ci[i][2] = 0;
+    if (out->Irradiance)
+        memset(out->Irradiance, 0, ctx->n_points * sizeof *out->Irradiance);
+    set_opacity(ctx, out);
+}
+
+static const RayesShaderParamDesc default_params[] = {
+    {"Ka", RAYES_PARAM_FLOAT, offsetof(DefaultParams, Ka), {0.2f, 0, 0}},
+    {"Kd", RAYES_PARAM_FLOAT, offsetof(DefaultParams, Kd), {0.8f, 0, 0}},
+};
+
+const RayesShaderClass shade_class_defaultsurface = {
+    .abi_version = RAYES_SHADER_ABI_VERSION,
+    .struct_size = sizeof(RayesShaderClass),
+    .name = "defaultsurface",
+    .params_size = sizeof(DefaultParams),
+    .params = default_params,
+    .n_params = sizeof default_params / sizeof default_params[0],
+    .lighting = default_lighting,
+    .diffuselighting = default_diffuselighting,
 };
 
 /* ---- paintedplastic

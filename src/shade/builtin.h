@@ -11,6 +11,7 @@ extern const RayesShaderClass shade_class_matte;    /* Lambertian: Ka, Kd, Ke */
 extern const RayesShaderClass shade_class_plastic;  /* Ka, Kd, Ks, roughness, specularcolor */
 extern const RayesShaderClass shade_class_mirror;   /* perfect specular: Kr, specularcolor */
 extern const RayesShaderClass shade_class_constant; /* Ci = Cs */
+extern const RayesShaderClass shade_class_defaultsurface; /* Cs (Ka + Kd (I.N)^2): no lights */
 extern const RayesShaderClass shade_class_hair; /* fibres: Ka, Kd, Ks, roughness, specularcolor */
 extern const RayesShaderClass shade_class_stainedglass; /* coloured opacity: Kd, frequency,
                                                            leadwidth, clarity */

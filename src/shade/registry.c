@@ -23,7 +23,7 @@ static const RayesShaderClass *const builtin_classes[] = {
     &shade_class_thindielectric, &shade_class_diffusetransmission,
     &shade_class_homogeneous,    &shade_class_turbulence,
     &shade_class_subsurface,     &shade_class_wood,
-    &shade_class_brickwall,
+    &shade_class_brickwall,      &shade_class_defaultsurface,
 };
 
 const RayesShaderClass *shade_find_class(const char *name)

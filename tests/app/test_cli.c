@@ -517,14 +517,32 @@ static void test_null_displacement(void)
 }
 
 /* A scene without lights: one warning naming the scene and the way out,
- * and a black image; --default-light adds a headlight that lights it. */
+ * and a black image of a matte sphere; --default-light adds a headlight
+ * that lights it. Without a Surface, RenderMan's defaultsurface draws it
+ * (it needs no light). */
 static void test_default_light(void)
 {
     static Run r;
     setup();
     write_text(SCRATCH_DIR "/dark.rib", "Projection \"perspective\" \"fov\" 40\n"
-                                        "WorldBegin\nTranslate 0 0 5\nSphere 1 -1 1 360\n"
-                                        "WorldEnd\n");
+                                        "WorldBegin\nTranslate 0 0 5\nSurface \"matte\"\n"
+                                        "Sphere 1 -1 1 360\nWorldEnd\n");
+    write_text(SCRATCH_DIR "/nosurface.rib", "Projection \"perspective\" \"fov\" 40\n"
+                                             "WorldBegin\nTranslate 0 0 5\nSphere 1 -1 1 360\n"
+                                             "WorldEnd\n");
+    run(&r, NULL,
+        ARGS("render", SCRATCH_DIR "/nosurface.rib", "--res", "16", "--spp", "1", "--quiet", "-o",
+             SCRATCH_DIR "/nosurface.exr"));
+    CHECK(r.status == 0 && strstr(r.err, "the scene has no lights"));
+    {
+        int w = 0, h = 0;
+        float *px = NULL;
+        char err[256];
+        CHECK(image_read_exr(SCRATCH_DIR "/nosurface.exr", &w, &h, &px, err, sizeof err) ==
+              RAYES_OK);
+        CHECK(px && px[4 * (8 * w + 8)] > 0.5f); /* the sphere's middle: Ka + Kd */
+        free(px);
+    }
     float mean[2] = {-1, -1};
     for (int lit = 0; lit < 2; lit++) {
         const char *out = lit ? SCRATCH_DIR "/lit.exr" : SCRATCH_DIR "/dark.exr";

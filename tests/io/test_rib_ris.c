@@ -106,8 +106,12 @@ static void test_bxdfs(void)
     CHECK(rib(WORLD("Pattern \"PxrTexture\" \"t\"\nBxdf \"PxrDiffuse\" \"d\" \"reference color "
                     "diffuseColor\" [\"t:resultRGB\"]\n" TRI)) == RAYES_OK);
     CHECK(strcmp(rec.shader[rec.n_shader - 1].name, "diffuse") == 0);
-    /* Bxdf is an attribute, as Surface is */
+    /* Bxdf is an attribute, as Surface is (after the block, the default:
+     * in a file without lights, RenderMan's defaultsurface) */
     CHECK(rib(WORLD("AttributeBegin\nBxdf \"PxrDiffuse\" \"d\"\nAttributeEnd\n" TRI)) == RAYES_OK);
+    CHECK(rec.n_shader >= 1 && strcmp(rec.shader[rec.n_shader - 1].name, "defaultsurface") == 0);
+    CHECK(rib(WORLD("LightSource \"pointlight\" 1\nAttributeBegin\nBxdf \"PxrDiffuse\" \"d\"\n"
+                    "AttributeEnd\n" TRI)) == RAYES_OK);
     CHECK(rec.n_shader >= 1 && strcmp(rec.shader[rec.n_shader - 1].name, "matte") == 0);
 }
 
