@@ -264,7 +264,7 @@ static int h_bxdf(Rib *r, const Args *a)
  * sphere's scale their unit ones' alike, in the plane's two directions). */
 static float plane_scale(const float M[16])
 {
-    float x[3] = {M[0], M[1], M[2]}, y[3] = {M[4], M[5], M[6]};
+    float x[3] = {M[0], M[4], M[8]}, y[3] = {M[1], M[5], M[9]}; /* columns: the axes */
     float cx = x[1] * y[2] - x[2] * y[1], cy = x[2] * y[0] - x[0] * y[2],
           cz = x[0] * y[1] - x[1] * y[0];
     return sqrtf(cx * cx + cy * cy + cz * cz);
@@ -333,10 +333,10 @@ static int make_light(Rib *r, const char *handle, const char *cls, const float L
          * Blender's and hdPrman's lights all have one) turns the shape's
          * winding, not the side RenderMan emits from: mirror it back in
          * y, which leaves a unit square or disk where it was */
-        for (int c = 0; c < 4; c++) {
-            l->M[4 + c] = -l->M[4 + c];
+        for (int c = 1; c < 16; c += 4) { /* column 1: the image of y */
+            l->M[c] = -l->M[c];
             for (int t = 0; t < l->n_motion; t++)
-                l->motion_M[t][4 + c] = -l->motion_M[t][4 + c];
+                l->motion_M[t][c] = -l->motion_M[t][c];
         }
     }
     float v[3] = {I, 0, 0};

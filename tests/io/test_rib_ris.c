@@ -136,9 +136,11 @@ static void test_lights(void)
     CHECK(shape && strcmp(shape->string, "quad") == 0);
     /* on after its block: the triangle is linked to every light */
     CHECK(rec.links_mode == RAYES_LIGHT_LINKS_ALL);
-    /* areaNormalize: over the area of the square as scaled (2 x 3) */
-    CHECK(rib(WORLD("AttributeBegin\nScale 2 3 1\nLight \"PxrRectLight\" \"k\" \"float "
-                    "intensity\" [12] \"int areaNormalize\" [1]\nAttributeEnd\n" TRI)) == RAYES_OK);
+    /* areaNormalize: over the area of the square as scaled (2 x 3) and
+     * turned */
+    CHECK(rib(WORLD("AttributeBegin\nRotate 30 1 0 0\nScale 2 3 1\nLight \"PxrRectLight\" \"k\" "
+                    "\"float intensity\" [12] \"int areaNormalize\" [1]\nAttributeEnd\n" TRI)) ==
+          RAYES_OK);
     CHECK_NEAR(param(light(), "intensity", 0), 2, 1e-5);
     /* disks and spheres of diameter 1 */
     CHECK(rib(WORLD("Light \"PxrSphereLight\" \"b\"\nLight \"PxrDiskLight\" \"d\"\n" TRI)) ==
