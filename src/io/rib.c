@@ -372,6 +372,63 @@ static int is_transform_request(const char *q)
     return 0;
 }
 
+/* The most a transform turns between two samples sent on (radians): the
+ * renderer blends samples linearly, which cuts a turn's arc by its chord
+ * (an object turning 90 degrees between two samples would shrink to 0.71
+ * of its size half way); 10 degrees leaves 0.4%. */
+#define RIB_MOTION_TURN ((float)(M_PI / 18))
+
+/* A transform motion block's samples, more of them where its request
+ * turns, each blended in the request's own frame (about its origin, as
+ * PRMan moves the request's parameters: Rotate 0 to Rotate 90 passes
+ * Rotate 45), at most RIB_MAX_TIMES. */
+static void motion_turns(Rib *r)
+{
+    size_t n = r->motion_n, total = 1;
+    float inv[16], local[RIB_MAX_TIMES][16];
+    int sub[RIB_MAX_TIMES], any = 0;
+    if (n < 2 || rib_mat_inverse(r->motion_pre, inv) != 0)
+        return;
+    for (size_t k = 0; k < n; k++)
+        rib_mat_mul(inv, r->motion_M[k], local[k]);
+    for (size_t k = 0; k + 1 < n; k++) {
+        float turn = rib_mat_turn(local[k], local[k + 1]);
+        float steps = ceilf(turn / RIB_MOTION_TURN - 1e-3f); /* 90 degrees: 9 */
+        sub[k] = steps > 1 ? (int)fminf(steps, 64) : 1;
+        any |= sub[k] > 1;
+        total += (size_t)sub[k];
+    }
+    if (!any)
+        return;
+    while (total > RIB_MAX_TIMES) { /* the most samples where the most turn */
+        size_t big = 0;
+        for (size_t k = 1; k + 1 < n; k++)
+            if (sub[k] > sub[big])
+                big = k;
+        sub[big]--;
+        total--;
+    }
+    float times[RIB_MAX_TIMES], M[RIB_MAX_TIMES][16];
+    size_t m = 0;
+    for (size_t k = 0; k + 1 < n; k++)
+        for (int j = 0; j < sub[k]; j++, m++) {
+            float f = (float)j / (float)sub[k], L[16];
+            times[m] = r->motion_time[k] + f * (r->motion_time[k + 1] - r->motion_time[k]);
+            if (j == 0) {
+                memcpy(M[m], r->motion_M[k], sizeof M[m]);
+                continue;
+            }
+            rib_mat_blend(local[k], local[k + 1], f, L);
+            rib_mat_mul(r->motion_pre, L, M[m]);
+        }
+    times[m] = r->motion_time[n - 1];
+    memcpy(M[m], r->motion_M[n - 1], sizeof M[m]);
+    m++;
+    r->motion_n = m;
+    memcpy(r->motion_time, times, m * sizeof *times);
+    memcpy(r->motion_M, M, m * sizeof M[0]);
+}
+
 static int motion_end(Rib *r)
 {
     r->motion = 0;
@@ -379,6 +436,7 @@ static int motion_end(Rib *r)
         return rib_error(r, "the block has %d requests for %zu times", r->motion_seen,
                          r->motion_n);
     if (r->motion_kind == 1) {
+        motion_turns(r);
         memcpy(r->a.M, r->motion_M[0], sizeof r->a.M);
         r->a.n_motion = r->motion_n > 1 ? (int)r->motion_n : 0;
         memcpy(r->a.motion_time, r->motion_time, r->motion_n * sizeof *r->motion_time);

@@ -79,6 +79,128 @@ double rib_mat_det3(const float m[16])
            (double)m[2] * ((double)m[4] * m[9] - (double)m[5] * m[8]);
 }
 
+/* The polar decomposition of m's 3 x 3 part, A = Q S (Q a rotation, S
+ * symmetric; a mirror's -1 goes into S), by Higham's iteration Q <- (Q +
+ * Q^-T) / 2. Returns 0, or -1 when A is singular. */
+static int polar(const float m[16], double Q[3][3], double S[3][3])
+{
+    double A[3][3];
+    for (int r = 0; r < 3; r++)
+        for (int c = 0; c < 3; c++)
+            A[r][c] = m[4 * r + c];
+    double det = A[0][0] * (A[1][1] * A[2][2] - A[1][2] * A[2][1]) -
+                 A[0][1] * (A[1][0] * A[2][2] - A[1][2] * A[2][0]) +
+                 A[0][2] * (A[1][0] * A[2][1] - A[1][1] * A[2][0]);
+    if (!(fabs(det) > 1e-30) || !isfinite(det))
+        return -1;
+    double sign = det < 0 ? -1 : 1;
+    for (int r = 0; r < 3; r++)
+        for (int c = 0; c < 3; c++)
+            Q[r][c] = sign * A[r][c];
+    for (int it = 0; it < 40; it++) {
+        double d = Q[0][0] * (Q[1][1] * Q[2][2] - Q[1][2] * Q[2][1]) -
+                   Q[0][1] * (Q[1][0] * Q[2][2] - Q[1][2] * Q[2][0]) +
+                   Q[0][2] * (Q[1][0] * Q[2][1] - Q[1][1] * Q[2][0]);
+        double C[3][3]; /* the cofactors: Q^-T = C / det */
+        for (int r = 0; r < 3; r++)
+            for (int c = 0; c < 3; c++) {
+                int r1 = (r + 1) % 3, r2 = (r + 2) % 3, c1 = (c + 1) % 3, c2 = (c + 2) % 3;
+                C[r][c] = Q[r1][c1] * Q[r2][c2] - Q[r1][c2] * Q[r2][c1];
+            }
+        double change = 0;
+        for (int r = 0; r < 3; r++)
+            for (int c = 0; c < 3; c++) {
+                double q = 0.5 * (Q[r][c] + C[r][c] / d);
+                change = fmax(change, fabs(q - Q[r][c]));
+                Q[r][c] = q;
+            }
+        if (change < 1e-12)
+            break;
+    }
+    for (int r = 0; r < 3; r++) /* S = Q^T A */
+        for (int c = 0; c < 3; c++)
+            S[r][c] = Q[0][r] * A[0][c] + Q[1][r] * A[1][c] + Q[2][r] * A[2][c];
+    return 0;
+}
+
+/* A rotation matrix's unit quaternion (w, x, y, z). */
+static void quaternion(double R[3][3], double q[4])
+{
+    double t = R[0][0] + R[1][1] + R[2][2];
+    if (t > 0) {
+        double s = 2 * sqrt(t + 1);
+        q[0] = s / 4, q[1] = (R[2][1] - R[1][2]) / s, q[2] = (R[0][2] - R[2][0]) / s,
+        q[3] = (R[1][0] - R[0][1]) / s;
+    } else if (R[0][0] > R[1][1] && R[0][0] > R[2][2]) {
+        double s = 2 * sqrt(1 + R[0][0] - R[1][1] - R[2][2]);
+        q[0] = (R[2][1] - R[1][2]) / s, q[1] = s / 4, q[2] = (R[0][1] + R[1][0]) / s,
+        q[3] = (R[0][2] + R[2][0]) / s;
+    } else if (R[1][1] > R[2][2]) {
+        double s = 2 * sqrt(1 + R[1][1] - R[0][0] - R[2][2]);
+        q[0] = (R[0][2] - R[2][0]) / s, q[1] = (R[0][1] + R[1][0]) / s, q[2] = s / 4,
+        q[3] = (R[1][2] + R[2][1]) / s;
+    } else {
+        double s = 2 * sqrt(1 + R[2][2] - R[0][0] - R[1][1]);
+        q[0] = (R[1][0] - R[0][1]) / s, q[1] = (R[0][2] + R[2][0]) / s,
+        q[2] = (R[1][2] + R[2][1]) / s, q[3] = s / 4;
+    }
+}
+
+float rib_mat_turn(const float a[16], const float b[16])
+{
+    double Qa[3][3], Qb[3][3], S[3][3], qa[4], qb[4];
+    if (polar(a, Qa, S) != 0 || polar(b, Qb, S) != 0)
+        return 0;
+    quaternion(Qa, qa);
+    quaternion(Qb, qb);
+    double d = fabs(qa[0] * qb[0] + qa[1] * qb[1] + qa[2] * qb[2] + qa[3] * qb[3]);
+    return (float)(2 * acos(fmin(d, 1.0)));
+}
+
+void rib_mat_blend(const float a[16], const float b[16], float f, float out[16])
+{
+    double Qa[3][3], Qb[3][3], Sa[3][3], Sb[3][3], qa[4], qb[4], q[4];
+    if (polar(a, Qa, Sa) != 0 || polar(b, Qb, Sb) != 0 ||
+        (rib_mat_det3(a) < 0) != (rib_mat_det3(b) < 0)) {
+        for (int k = 0; k < 16; k++) /* singular, or a mirror at one end only */
+            out[k] = a[k] + (b[k] - a[k]) * f;
+        return;
+    }
+    quaternion(Qa, qa);
+    quaternion(Qb, qb);
+    double d = qa[0] * qb[0] + qa[1] * qb[1] + qa[2] * qb[2] + qa[3] * qb[3];
+    if (d < 0) /* the shorter arc */
+        for (int k = 0; k < 4; k++)
+            qb[k] = -qb[k];
+    d = fabs(d);
+    double wa = 1 - f, wb = f;
+    if (d < 0.9999999) {
+        double th = acos(d), s = sin(th);
+        wa = sin((1 - f) * th) / s, wb = sin(f * th) / s;
+    }
+    double n = 0;
+    for (int k = 0; k < 4; k++)
+        q[k] = wa * qa[k] + wb * qb[k], n += q[k] * q[k];
+    n = sqrt(n);
+    for (int k = 0; k < 4; k++)
+        q[k] /= n;
+    double w = q[0], x = q[1], y = q[2], z = q[3];
+    double R[3][3] = {{1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)},
+                      {2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)},
+                      {2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)}};
+    for (int r = 0; r < 3; r++)
+        for (int c = 0; c < 3; c++) {
+            double v = 0;
+            for (int k = 0; k < 3; k++)
+                v += R[r][k] * (Sa[k][c] + (Sb[k][c] - Sa[k][c]) * f);
+            out[4 * r + c] = (float)v;
+        }
+    for (int r = 0; r < 4; r++) /* translation and the projective row: linear */
+        out[4 * r + 3] = a[4 * r + 3] + (b[4 * r + 3] - a[4 * r + 3]) * f;
+    for (int c = 0; c < 3; c++)
+        out[12 + c] = a[12 + c] + (b[12 + c] - a[12 + c]) * f;
+}
+
 /* --------------------------------------------------------- tessellation */
 
 void rib_faces_fini(RibFaces *f)

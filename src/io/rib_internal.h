@@ -19,6 +19,14 @@ void rib_mat_mul(const float a[16], const float b[16], float out[16]); /* out = 
 int rib_mat_inverse(const float m[16], float out[16]);
 /* The determinant of the upper-left 3 x 3 (negative: a mirror). */
 double rib_mat_det3(const float m[16]);
+/* The angle (radians) between the rotations of two transforms (their
+ * polar decompositions'); 0 if either is singular. */
+float rib_mat_turn(const float a[16], const float b[16]);
+/* The transform a fraction f from a to b as a motion goes: translation
+ * and stretch linearly, rotation along the shorter arc about the
+ * transforms' own origin; linear when either is singular or only one
+ * mirrors. */
+void rib_mat_blend(const float a[16], const float b[16], float f, float out[16]);
 
 /* --------------------------------------------------------- tessellation */
 

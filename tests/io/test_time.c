@@ -17,6 +17,7 @@
 #include "io/rib_write.h"
 #include "io/sink.h"
 #include "rayes/rayes.h"
+#include "record_sink.h"
 #include "test.h"
 
 #define W 48
@@ -475,7 +476,61 @@ static void test_moving_instance(void)
     rayes_image_free(still);
 }
 
-TEST_MAIN(TEST(test_rib_transform_motion), TEST(test_rib_deformation_and_camera),
-          TEST(test_rib_depth_of_field), TEST(test_rib_errors), TEST(test_pbrt_motion_and_lens),
-          TEST(test_writer_round_trip), TEST(test_rib_deforming_points_and_curves),
-          TEST(test_rib_moving_light), TEST(test_moving_instance))
+/* The transform samples a recording sink last received. */
+static struct {
+    size_t n;
+    float times[RAYES_MAX_TIMES], M[RAYES_MAX_TIMES][16];
+} turns;
+
+static RayesError rec_turns(void *t, size_t n, const float *times, const float (*M)[16])
+{
+    (void)t;
+    turns.n = n;
+    memcpy(turns.times, times, n * sizeof *times);
+    memcpy(turns.M, M, n * sizeof M[0]);
+    return RAYES_OK;
+}
+
+/* A transform that turns within a motion block is sent with samples at
+ * most 10 degrees apart, blended about the turning request's own origin
+ * (as PRMan moves Rotate's angle): a sphere 1.5 from the axis stays 1.5
+ * from it all the way (two samples blended as matrices cut across: 1.06
+ * half way). */
+static void test_rib_turning_motion(void)
+{
+    (void)rec_param;
+    static Record rec;
+    IoSink s = record_sink(&rec);
+    s.set_transform_motion = rec_turns;
+    IoSettings settings;
+    io_settings_init(&settings);
+    IoReadOptions opt = {NULL, -1};
+    const char *text = "Projection \"perspective\" \"fov\" 40\nShutter 0 1\nWorldBegin\n"
+                       "MotionBegin [0 1]\nRotate 0 0 0 1\nRotate 90 0 0 1\nMotionEnd\n"
+                       "Translate 1.5 0 0\nSphere 0.3 -0.3 0.3 360\nWorldEnd\n";
+    turns.n = 0;
+    CHECK(io_rib_parse("t.rib", (const unsigned char *)text, strlen(text), &s, &opt, &settings, err,
+                       sizeof err) == RAYES_OK);
+    CHECK(turns.n == 10); /* 90 degrees in steps of 10 */
+    for (size_t k = 0; k < turns.n; k++) {
+        const float *m = turns.M[k]; /* the sphere's centre: the translation column */
+        float angle = atan2f(m[7], m[3]) * (float)(180 / M_PI);
+        CHECK_NEAR(hypotf(m[3], m[7]), 1.5, 1e-4);
+        CHECK_NEAR(angle, 90 * turns.times[k], 1e-3);
+        CHECK_NEAR(turns.times[k], k / 9.0, 1e-6);
+    }
+    /* a motion that does not turn keeps its samples */
+    const char *slide = "Projection \"perspective\" \"fov\" 40\nShutter 0 1\nWorldBegin\n"
+                        "MotionBegin [0 1]\nTranslate 0 0 0\nTranslate 1 0 0\nMotionEnd\n"
+                        "Sphere 0.3 -0.3 0.3 360\nWorldEnd\n";
+    CHECK(io_rib_parse("t.rib", (const unsigned char *)slide, strlen(slide), &s, &opt, &settings,
+                       err, sizeof err) == RAYES_OK);
+    CHECK(turns.n == 2);
+    record_free(&rec);
+}
+
+TEST_MAIN(TEST(test_rib_transform_motion), TEST(test_rib_turning_motion),
+          TEST(test_rib_deformation_and_camera), TEST(test_rib_depth_of_field),
+          TEST(test_rib_errors), TEST(test_pbrt_motion_and_lens), TEST(test_writer_round_trip),
+          TEST(test_rib_deforming_points_and_curves), TEST(test_rib_moving_light),
+          TEST(test_moving_instance))
