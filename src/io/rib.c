@@ -378,21 +378,75 @@ static int is_transform_request(const char *q)
  * of its size half way); 10 degrees leaves 0.4%. */
 #define RIB_MOTION_TURN ((float)(M_PI / 18))
 
+/* Whether every sample of the block is request q. */
+static int all_samples(const Rib *r, const char *q)
+{
+    for (size_t k = 0; k < r->motion_n; k++)
+        if (strcmp(r->motion_req[k], q) != 0)
+            return 0;
+    return 1;
+}
+
+/* The rotation of deg degrees about axis (not zero), as Rotate makes it. */
+static void rotation(float deg, const float axis[3], float m[16])
+{
+    double len =
+        sqrt((double)axis[0] * axis[0] + (double)axis[1] * axis[1] + (double)axis[2] * axis[2]);
+    double x = axis[0] / len, y = axis[1] / len, z = axis[2] / len;
+    double th = deg * M_PI / 180, c = cos(th), s = sin(th), t = 1 - c;
+    const float rm[16] = {(float)(t * x * x + c),
+                          (float)(t * x * y - s * z),
+                          (float)(t * x * z + s * y),
+                          0,
+                          (float)(t * x * y + s * z),
+                          (float)(t * y * y + c),
+                          (float)(t * y * z - s * x),
+                          0,
+                          (float)(t * x * z - s * y),
+                          (float)(t * y * z + s * x),
+                          (float)(t * z * z + c),
+                          0,
+                          0,
+                          0,
+                          0,
+                          1};
+    memcpy(m, rm, sizeof rm);
+}
+
 /* A transform motion block's samples, more of them where its request
- * turns, each blended in the request's own frame (about its origin, as
- * PRMan moves the request's parameters: Rotate 0 to Rotate 90 passes
- * Rotate 45), at most RIB_MAX_TIMES. */
+ * turns, at most RIB_MAX_TIMES: Rotates about one axis move their angle
+ * (as PRMan moves a request's parameters: Rotate 0 to Rotate 360 spins
+ * once); other turning requests are blended in their own frame (about
+ * their origin; Transform's is the world's), rotation by slerp.
+ * Translate and Scale move linearly already. */
 static void motion_turns(Rib *r)
 {
     size_t n = r->motion_n, total = 1;
     float inv[16], local[RIB_MAX_TIMES][16];
     int sub[RIB_MAX_TIMES], any = 0;
-    if (n < 2 || rib_mat_inverse(r->motion_pre, inv) != 0)
+    int rotate = all_samples(r, "Rotate"), whole = 1;
+    for (size_t k = 0; k < n; k++) /* Transform and Identity set the whole matrix */
+        whole &=
+            strcmp(r->motion_req[k], "Transform") == 0 || strcmp(r->motion_req[k], "Identity") == 0;
+    for (size_t k = 1; rotate && k < n; k++) { /* one axis, the same direction */
+        const float *a = r->motion_rotate[0] + 1, *b = r->motion_rotate[k] + 1;
+        double la = sqrt((double)a[0] * a[0] + (double)a[1] * a[1] + (double)a[2] * a[2]);
+        double lb = sqrt((double)b[0] * b[0] + (double)b[1] * b[1] + (double)b[2] * b[2]);
+        double d = (a[0] * b[0] + a[1] * b[1] + a[2] * b[2]) / (la * lb);
+        rotate = la > 0 && lb > 0 && d > 0.999999;
+    }
+    if (n < 2 || (!rotate && !whole && !all_samples(r, "ConcatTransform")))
+        return;
+    if (whole)
+        rib_mat_identity(inv);
+    else if (rib_mat_inverse(r->motion_pre, inv) != 0)
         return;
     for (size_t k = 0; k < n; k++)
         rib_mat_mul(inv, r->motion_M[k], local[k]);
     for (size_t k = 0; k + 1 < n; k++) {
-        float turn = rib_mat_turn(local[k], local[k + 1]);
+        float turn = rotate ? fabsf(r->motion_rotate[k + 1][0] - r->motion_rotate[k][0]) *
+                                  (float)(M_PI / 180)
+                            : rib_mat_turn(local[k], local[k + 1]);
         float steps = ceilf(turn / RIB_MOTION_TURN - 1e-3f); /* 90 degrees: 9 */
         sub[k] = steps > 1 ? (int)fminf(steps, 64) : 1;
         any |= sub[k] > 1;
@@ -418,8 +472,16 @@ static void motion_turns(Rib *r)
                 memcpy(M[m], r->motion_M[k], sizeof M[m]);
                 continue;
             }
-            rib_mat_blend(local[k], local[k + 1], f, L);
-            rib_mat_mul(r->motion_pre, L, M[m]);
+            if (rotate)
+                rotation(r->motion_rotate[k][0] +
+                             f * (r->motion_rotate[k + 1][0] - r->motion_rotate[k][0]),
+                         r->motion_rotate[k] + 1, L);
+            else
+                rib_mat_blend(local[k], local[k + 1], f, L);
+            if (whole)
+                memcpy(M[m], L, sizeof M[m]);
+            else
+                rib_mat_mul(r->motion_pre, L, M[m]);
         }
     times[m] = r->motion_time[n - 1];
     memcpy(M[m], r->motion_M[n - 1], sizeof M[m]);
@@ -465,6 +527,12 @@ static int motion_request(Rib *r, const char *q, const Args *a, int (*run)(Rib *
                             "or one primitive)");
     r->motion_kind = transform ? 1 : 2;
     if (transform) {
+        snprintf(r->motion_req[k], sizeof r->motion_req[k], "%.19s", q);
+        size_t i = 0; /* a Rotate's parameters, which motion_turns moves (the
+                         request checks them itself) */
+        if (strcmp(q, "Rotate") == 0 &&
+            (a->n < 1 || rib_get_floats(r, a, &i, r->motion_rotate[k], 4, "angle dx dy dz") != 0))
+            r->motion_req[k][0] = '\0';
         memcpy(r->a.M, r->motion_pre, sizeof r->a.M);
         r->a.n_motion = 0;
         int rc = run(r, a);

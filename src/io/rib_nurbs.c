@@ -38,6 +38,12 @@
 #define NURBS_MAX_PATCHES (1L << 22)
 #define NURBS_TOLERANCE 1e-4f
 #define NURBS_MAX_SPLITS 5
+/* In a deformation motion block every sample must make the same patches:
+ * a span that is not exact is split so many times, whatever its fit. */
+#define NURBS_MOTION_SPLITS 2
+/* The work a file's NURBS may take, in multiply-adds of de Boor and trim
+ * tests: a few seconds; a small hostile file could ask for hours. */
+#define NURBS_MAX_WORK 2e9
 
 #define TRIM_SEGMENTS 16 /* polygon edges per knot span of a trim curve */
 #define TRIM_MAX_POINTS (1L << 20)
@@ -56,6 +62,7 @@ typedef struct Nurbs {
     int n[2], order[2];  /* control points and order in u (0) and v (1) */
     const float *knot[2];
     const float *Pw;     /* n[0] x n[1] homogeneous points, u fastest */
+    double *work;        /* the file's NURBS work so far (Rib.nurbs_work) */
 } Nurbs;
 
 /* de Boor on dim-float points d[0..p] of span k (knots t), at x: the
@@ -77,6 +84,7 @@ static void eval(const Nurbs *s, int ku, int kv, float u, float v, float out[3])
 {
     int pu = s->order[0] - 1, pv = s->order[1] - 1;
     float row[NURBS_MAX_ORDER][4], col[NURBS_MAX_ORDER][4];
+    *s->work += (double)(pu + 1) * (pv + 1) * (pu + pv + 2);
     for (int j = 0; j <= pv; j++) {
         int l = kv - pv + j;
         for (int q = 0; q <= pu; q++)
@@ -168,8 +176,9 @@ typedef struct Emit {
     Rib *r;
     const Nurbs *s;
     int exact;        /* polynomial of order <= 4: one patch a span */
-    const float *st;  /* varying st at the span corners (span lattice, u fastest), or NULL */
-    int spans_u;
+    int fixed;        /* in a deformation motion block: NURBS_MOTION_SPLITS */
+    const float *st;  /* varying st, one per knot span corner (u fastest), or NULL */
+    size_t st_w;      /* corners along u: n[0] - order[0] + 2 */
     long made;
     int unconverged;
     const TrimSet *trim; /* or NULL */
@@ -220,6 +229,7 @@ static int trim_state(const Emit *e, const float u[2], const float v[2])
     const TrimSet *t = e->trim;
     if (!t)
         return 1;
+    e->r->nurbs_work += 8.0 * (double)t->first[t->n_loops];
     if (u[1] > t->lo[0] && u[0] < t->hi[0] && v[1] > t->lo[1] && v[0] < t->hi[1])
         for (size_t k = 0; k < t->n_loops; k++)
             for (size_t i = t->first[k], j = t->first[k + 1] - 1; i < t->first[k + 1]; j = i++)
@@ -229,16 +239,18 @@ static int trim_state(const Emit *e, const float u[2], const float v[2])
     return in == e->trim_outside;
 }
 
-/* st at (u, v) of span (su, sv) spanning [u0, u1] x [v0, v1]. */
-static void st_at(const Emit *e, int su, int sv, const float span_u[2], const float span_v[2],
-                  float u, float v, float out[2])
+/* st at (u, v) in knot span (ku, kv): varying values are RenderMan's, one
+ * per knot span corner (empty spans too), bilinear over the span. */
+static void st_at(const Emit *e, int ku, int kv, float u, float v, float out[2])
 {
     if (!e->st) {
         out[0] = u, out[1] = v;
         return;
     }
-    float x = (u - span_u[0]) / (span_u[1] - span_u[0]), y = (v - span_v[0]) / (span_v[1] - span_v[0]);
-    size_t w = (size_t)e->spans_u + 1, a = (size_t)sv * w + (size_t)su;
+    const float *tu = e->s->knot[0], *tv = e->s->knot[1];
+    float x = (u - tu[ku]) / (tu[ku + 1] - tu[ku]), y = (v - tv[kv]) / (tv[kv + 1] - tv[kv]);
+    size_t w = e->st_w;
+    size_t a = (size_t)(kv - (e->s->order[1] - 1)) * w + (size_t)(ku - (e->s->order[0] - 1));
     const float *c[4] = {&e->st[2 * a], &e->st[2 * (a + 1)], &e->st[2 * (a + w)],
                          &e->st[2 * (a + w + 1)]};
     for (int k = 0; k < 2; k++)
@@ -247,18 +259,21 @@ static void st_at(const Emit *e, int su, int sv, const float span_u[2], const fl
 
 /* Sends the patches of [u0, u1] x [v0, v1] in span (ku, kv), split while
  * the fit strays (depth splits so far) or trim loops cross it (tdepth). */
-static int emit_part(Emit *e, int ku, int kv, int su, int sv, const float span_u[2],
-                     const float span_v[2], const float u[2], const float v[2], int depth,
+static int emit_part(Emit *e, int ku, int kv, const float u[2], const float v[2], int depth,
                      int tdepth)
 {
+    if (e->r->nurbs_work > NURBS_MAX_WORK)
+        return rib_error(e->r,
+                         "NuPatch: the file's NURBS need more than %.0e evaluations; "
+                         "refused",
+                         NURBS_MAX_WORK);
     int trim = trim_state(e, u, v);
     if (trim < 0 && tdepth < TRIM_SPLITS) {
         float um = 0.5f * (u[0] + u[1]), vm = 0.5f * (v[0] + v[1]);
         const float us[2][2] = {{u[0], um}, {um, u[1]}}, vs[2][2] = {{v[0], vm}, {vm, v[1]}};
         for (int b = 0; b < 2; b++)
             for (int a = 0; a < 2; a++)
-                if (emit_part(e, ku, kv, su, sv, span_u, span_v, us[a], vs[b], depth + 1,
-                              tdepth + 1) != 0)
+                if (emit_part(e, ku, kv, us[a], vs[b], depth + 1, tdepth + 1) != 0)
                     return -1;
         return 0;
     }
@@ -268,18 +283,24 @@ static int emit_part(Emit *e, int ku, int kv, int su, int sv, const float span_u
         return 0;
     float B[16][3];
     fit(e->s, ku, kv, u, v, B);
-    if (!e->exact && fit_error(e->s, ku, kv, u, v, B) > NURBS_TOLERANCE) {
-        if (depth < NURBS_MAX_SPLITS) {
+    int split = 0;
+    if (!e->exact && e->fixed)
+        split = depth < NURBS_MOTION_SPLITS;
+    else if (!e->exact && fit_error(e->s, ku, kv, u, v, B) > NURBS_TOLERANCE) {
+        split = depth < NURBS_MAX_SPLITS;
+        e->unconverged |= !split;
+    }
+    {
+        if (split) {
             float um = 0.5f * (u[0] + u[1]), vm = 0.5f * (v[0] + v[1]);
             const float us[2][2] = {{u[0], um}, {um, u[1]}}, vs[2][2] = {{v[0], vm}, {vm, v[1]}};
             for (int b = 0; b < 2; b++)
                 for (int a = 0; a < 2; a++)
-                    if (emit_part(e, ku, kv, su, sv, span_u, span_v, us[a], vs[b], depth + 1,
-                                  TRIM_SPLITS) != 0) /* a piece the loops cross no more */
+                    if (emit_part(e, ku, kv, us[a], vs[b], depth + 1, TRIM_SPLITS) !=
+                        0) /* a piece the loops cross no more */
                         return -1;
             return 0;
         }
-        e->unconverged = 1;
     }
     if (++e->made > NURBS_MAX_PATCHES)
         return rib_error(e->r, "NuPatch: more than %ld patches", NURBS_MAX_PATCHES);
@@ -287,7 +308,7 @@ static int emit_part(Emit *e, int ku, int kv, int su, int sv, const float span_u
     const float cu[4] = {u[0], u[1], u[0], u[1]}, cv[4] = {v[0], v[0], v[1], v[1]};
     int flip = rib_flip(e->r); /* the patch's u reverses: so do its corners' values */
     for (int k = 0; k < 4; k++)
-        st_at(e, su, sv, span_u, span_v, cu[k], cv[k], st[flip ? k ^ 1 : k]);
+        st_at(e, ku, kv, cu[k], cv[k], st[flip ? k ^ 1 : k]);
     PvOut pv = {.n = 1};
     pv.pv[0] = (RayesPrimvar){"st", RAYES_PRIMVAR_VARYING, &st[0][0], 4};
     return rib_emit_bicubic(e->r, B, &pv);
@@ -423,7 +444,8 @@ static int h_nupatch(Rib *r, const Args *a)
     if (e == 0) {
         const Param *qst = rib_find_param(p, n_p, "st"), *qs = rib_find_param(p, n_p, "s"),
                     *qt = rib_find_param(p, n_p, "t");
-        size_t corners = (size_t)(m[0] + 1) * (size_t)(m[1] + 1);
+        /* RenderMan's count: one per knot span corner, empty spans too */
+        size_t corners = (size_t)(s.n[0] - s.order[0] + 2) * (size_t)(s.n[1] - s.order[1] + 2);
         int pair = qst && rib_is_num(qst->v) && qst->v->n == 2 * corners;
         int apart = qs && qt && rib_is_num(qs->v) && rib_is_num(qt->v) &&
                     qs->v->n == corners && qt->v->n == corners;
@@ -453,13 +475,19 @@ static int h_nupatch(Rib *r, const Args *a)
     s.knot[0] = knot[0];
     s.knot[1] = knot[1];
     s.Pw = Pw;
-    Emit em = {r,  &s,        !rational && s.order[0] <= 4 && s.order[1] <= 4,
-               st, m[0],      0,
-               0,  r->a.trim, r->a.trim_outside};
-    for (int sv = 0; e == 0 && sv < m[1]; sv++)
+    s.work = &r->nurbs_work;
+    Emit em = {.r = r,
+               .s = &s,
+               .exact = !rational && s.order[0] <= 4 && s.order[1] <= 4,
+               .fixed = r->motion, /* transforms are consumed there: a deformation */
+               .st = st,
+               .st_w = (size_t)(s.n[0] - s.order[0] + 2),
+               .trim = r->a.trim,
+               .trim_outside = r->a.trim_outside};
+    /* the first pass checks the file: patches are made in the second */
+    for (int sv = 0; e == 0 && r->pass == 2 && sv < m[1]; sv++)
         for (int su = 0; e == 0 && su < m[0]; su++)
-            e = emit_part(&em, k[0][su], k[1][sv], su, sv, iv[0][su], iv[1][sv], iv[0][su],
-                          iv[1][sv], 0, 0);
+            e = emit_part(&em, k[0][su], k[1][sv], iv[0][su], iv[1][sv], 0, 0);
     if (e == 0 && em.unconverged)
         rib_warn_once(r, "nupatch fit",
                       "NuPatch: a span of high order or strong weights is approximated "
@@ -564,13 +592,13 @@ static int h_trim_curve(Rib *r, const Args *a)
                     continue;
                 for (int q = 0; q < 2 * ord; q++) /* the knots de Boor reads, as floats */
                     kf[q] = (float)kn[sp - p + q];
-                for (int seg = 0; seg < TRIM_SEGMENTS && np < cap; seg++) {
-                    float x = a0 + (a1 - a0) * (float)seg / TRIM_SEGMENTS;
-                    for (int q = 0; q <= p; q++) {
+                int segs = ord == 2 ? 1 : TRIM_SEGMENTS; /* a line is one segment */
+                for (int seg = 0; seg < segs && np < cap; seg++) {
+                    float x = a0 + (a1 - a0) * (float)seg / (float)segs;
+                    for (int q = 0; q <= p; q++) { /* homogeneous (u, v, w), as Pw */
                         size_t pi = po + (size_t)(sp - p + q);
-                        float ww = (float)w->d[pi];
-                        cp[q][0] = (float)u->d[pi] * ww, cp[q][1] = (float)v->d[pi] * ww;
-                        cp[q][2] = ww, cp[q][3] = 0;
+                        cp[q][0] = (float)u->d[pi], cp[q][1] = (float)v->d[pi];
+                        cp[q][2] = (float)w->d[pi], cp[q][3] = 0;
                     }
                     de_boor(cp, kf, p, p, x); /* kf holds knots sp - p .. sp + p + 1 */
                     t->pt[np][0] = cp[p][0] / cp[p][2];

@@ -219,6 +219,7 @@ typedef struct Rib {
     ShaderRec *shaders;
     struct TrimSet *trims; /* every TrimCurve read (rib_nurbs.c) */
     size_t world_depth;    /* the attribute stack's depth at WorldBegin */
+    double nurbs_work;     /* the NuPatch and trim work of the pass (rib_nurbs.c) */
     int lit;               /* a light was made (pass 1: anywhere in the file) */
     int unlit_file;        /* pass 2: the file makes no light, so geometry without a
                               Surface is drawn with RenderMan's defaultsurface */
@@ -238,6 +239,8 @@ typedef struct Rib {
     float motion_time[RIB_MAX_TIMES];
     float motion_pre[16];
     int motion_pre_n;
+    char motion_req[RIB_MAX_TIMES][20];    /* each sample's request (a transform block) */
+    float motion_rotate[RIB_MAX_TIMES][4]; /* a Rotate sample's angle and axis */
     float motion_M[RIB_MAX_TIMES][16];
     int projection;            /* RayesProjection */
     float fov;

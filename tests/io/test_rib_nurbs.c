@@ -80,6 +80,15 @@ static void test_polynomial_spans_exact(void)
     CHECK(st && st->cls == RAYES_PRIMVAR_VARYING && st->count == 4);
     if (st)
         CHECK(st->data[6] == 3.0f && st->data[7] == 2.0f);
+    /* varying st: one value per knot span corner, an empty span's too
+     * (RenderMan's count, (nu - uorder + 2) (nv - vorder + 2)): the span
+     * after the empty one reads corners 2 and 3 */
+    CHECK(rib(WORLD("NuPatch 5 3 [0 0 0 1 1 2 2 2] 0 2 2 2 [0 0 1 1] 0 1 \"P\" [0 0 0 1 0 0 2 0 0 "
+                    "3 0 0 4 0 0 0 1 0 1 1 0 2 1 0 3 1 0 4 1 0] \"st\" [0 0 1 0 2 0 3 0 0 1 1 1 "
+                    "2 1 3 1]")) == RAYES_OK);
+    CHECK(rec.n_patch == 2);
+    st = rec.n_patch == 2 ? rec_primvar(&rec.patch[1].pv, "st") : NULL;
+    CHECK(st && st->data[0] == 2.0f && st->data[2] == 3.0f && st->data[7] == 1.0f);
     /* a range inside the knots: only the spans it covers, cut at it */
     snprintf(text, sizeof text,
              WORLD("NuPatch 5 4 [0 1 2 3 4 5 6 7 8] 3.5 5 5 4 [0 1 2 3 4 5 6 7 8] 3 4 \"P\" [%s]"),
@@ -177,6 +186,60 @@ static void test_rational_sphere(void)
     rayes_image_free(img[1]);
 }
 
+static RayesError rec_motion_begin(void *t, size_t n, const float *times)
+{
+    (void)t, (void)n, (void)times;
+    return RAYES_OK;
+}
+
+static RayesError rec_motion_end(void *t)
+{
+    (void)t;
+    return RAYES_OK;
+}
+
+/* A rational patch whose centre weight changes between the samples of a
+ * deformation: each sample the same patches (a fit that splits by its own
+ * error would split them apart and pair them wrongly, or fail). */
+static void test_deforming(void)
+{
+    char text[4096];
+    const char *pts = "-1 -1 0 1  0 -1 0 1  1 -1 0 1  -1 0 0 1  0 0 %s %s  1 0 0 1  "
+                      "-1 1 0 1  0 1 0 1  1 1 0 1";
+    char a[512], b[512];
+    snprintf(a, sizeof a, pts, "0.9", "0.9");
+    snprintf(b, sizeof b, pts, "20", "20");
+    snprintf(text, sizeof text,
+             "Projection \"perspective\" \"fov\" 40\nShutter 0 1\nWorldBegin\nTranslate 0 0 5\n"
+             "MotionBegin [0 1]\nNuPatch 3 3 [0 0 0 1 1 1] 0 1 3 3 [0 0 0 1 1 1] 0 1 \"Pw\" [%s]\n"
+             "NuPatch 3 3 [0 0 0 1 1 1] 0 1 3 3 [0 0 0 1 1 1] 0 1 \"Pw\" [%s]\nMotionEnd\n"
+             "WorldEnd\n",
+             a, b);
+    RayesError e;
+    RayesScene *s = rib_read_scene(text, &e, err, sizeof err);
+    CHECK(e == RAYES_OK);
+    CHECK(e == RAYES_OK && rayes_scene_commit(s) == RAYES_OK);
+    rayes_scene_release(s);
+    /* the samples' patches, recorded one after the other: as many, over
+     * the same (u, v) pieces */
+    record_free(&rec);
+    IoSink sink = record_sink(&rec);
+    sink.motion_begin = rec_motion_begin;
+    sink.motion_end = rec_motion_end;
+    IoSettings settings;
+    io_settings_init(&settings);
+    IoReadOptions opt = {NULL, -1};
+    CHECK(io_rib_parse("t.rib", (const unsigned char *)text, strlen(text), &sink, &opt, &settings,
+                       err, sizeof err) == RAYES_OK);
+    int half = rec.n_patch / 2;
+    CHECK(rec.n_patch > 2 && rec.n_patch % 2 == 0);
+    for (int k = 0; k < half && k < REC_MAX / 2; k++) {
+        const RayesPrimvar *a = rec_primvar(&rec.patch[k].pv, "st");
+        const RayesPrimvar *b = rec_primvar(&rec.patch[half + k].pv, "st");
+        CHECK(a && b && memcmp(a->data, b->data, 8 * sizeof(float)) == 0);
+    }
+}
+
 static void test_reading(void)
 {
     (void)rec_param, (void)rib_round_trip; /* the headers' helpers this file does not need */
@@ -201,6 +264,23 @@ static void test_reading(void)
                     "[0 0 0]")) != RAYES_OK &&
           strstr(err, "range is empty"));
     CHECK(rib(WORLD("NuPatch 1e9 4 [0] 0 1 1 2 [0 1] 0 1 \"P\" [0 0 0]")) != RAYES_OK);
+    /* a small file asking for hours of work is refused: an order-32
+     * rational patch of many spans */
+    {
+        static char big[1 << 17];
+        size_t k = (size_t)snprintf(big, sizeof big, "WorldBegin\nNuPatch 64 32 [");
+        for (int j = 0; j < 96; j++)
+            k += (size_t)snprintf(big + k, sizeof big - k, "%d ", j);
+        k += (size_t)snprintf(big + k, sizeof big - k, "] 31 64 64 32 [");
+        for (int j = 0; j < 96; j++)
+            k += (size_t)snprintf(big + k, sizeof big - k, "%d ", j);
+        k += (size_t)snprintf(big + k, sizeof big - k, "] 31 64 \"Pw\" [");
+        for (int j = 0; j < 64 * 64; j++)
+            k += (size_t)snprintf(big + k, sizeof big - k, "%d %d %d %d ", j % 64, j / 64, j % 7,
+                                  1 + j % 3);
+        snprintf(big + k, sizeof big - k, "]\nWorldEnd\n");
+        CHECK(rib(big) != RAYES_OK && strstr(err, "refused"));
+    }
     /* w must be positive */
     CHECK(rib(WORLD("NuPatch 2 2 [0 0 1 1] 0 1 2 2 [0 0 1 1] 0 1 \"Pw\" [0 0 0 1 1 0 0 0 "
                     "0 1 0 1 1 1 0 1]")) != RAYES_OK &&
@@ -255,9 +335,11 @@ static void test_trim(void)
           rec.n_patch == 1);
     /* a rational circle of radius 0.3 about the centre: a round hole,
      * its edge within 1/128 of the patch (1/64 of its width 2) */
+    /* (u and v given times w: homogeneous, as RenderMan's spec and
+     * modellers write them) */
     CHECK(rib(SQUARE_NUPATCH("TrimCurve [1] [3] [0 0 0 1 1 2 2 3 3 4 4 4] [0] [4] [9] "
-                             "[0.8 0.8 0.5 0.2 0.2 0.2 0.5 0.8 0.8] "
-                             "[0.5 0.8 0.8 0.8 0.5 0.2 0.2 0.2 0.5] "
+                             "[0.8 0.56568542 0.5 0.14142136 0.2 0.14142136 0.5 0.56568542 0.8] "
+                             "[0.5 0.56568542 0.8 0.56568542 0.5 0.14142136 0.2 0.14142136 0.5] "
                              "[1 0.70710678 1 0.70710678 1 0.70710678 1 0.70710678 1]\n")) ==
           RAYES_OK);
     float nearest = INFINITY; /* the kept piece nearest the centre */
@@ -270,4 +352,4 @@ static void test_trim(void)
 }
 
 TEST_MAIN(TEST(test_polynomial_spans_exact), TEST(test_rational_sphere), TEST(test_reading),
-          TEST(test_trim))
+          TEST(test_trim), TEST(test_deforming))

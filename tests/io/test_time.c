@@ -506,6 +506,7 @@ static void test_rib_turning_motion(void)
     io_settings_init(&settings);
     IoReadOptions opt = {NULL, -1};
     const char *text = "Projection \"perspective\" \"fov\" 40\nShutter 0 1\nWorldBegin\n"
+                       "Translate 0 3 0\n"
                        "MotionBegin [0 1]\nRotate 0 0 0 1\nRotate 90 0 0 1\nMotionEnd\n"
                        "Translate 1.5 0 0\nSphere 0.3 -0.3 0.3 360\nWorldEnd\n";
     turns.n = 0;
@@ -514,11 +515,41 @@ static void test_rib_turning_motion(void)
     CHECK(turns.n == 10); /* 90 degrees in steps of 10 */
     for (size_t k = 0; k < turns.n; k++) {
         const float *m = turns.M[k]; /* the sphere's centre: the translation column */
-        float angle = atan2f(m[7], m[3]) * (float)(180 / M_PI);
-        CHECK_NEAR(hypotf(m[3], m[7]), 1.5, 1e-4);
+        float angle = atan2f(m[7] - 3, m[3]) * (float)(180 / M_PI);
+        CHECK_NEAR(hypotf(m[3], m[7] - 3), 1.5, 1e-4);
         CHECK_NEAR(angle, 90 * turns.times[k], 1e-3);
         CHECK_NEAR(turns.times[k], k / 9.0, 1e-6);
     }
+    /* a Rotate moves its angle: a whole turn spins once (16 samples, the
+     * most), three quarters go the long way */
+    const char *spin = "Projection \"perspective\" \"fov\" 40\nShutter 0 1\nWorldBegin\n"
+                       "MotionBegin [0 1]\nRotate 0 0 0 1\nRotate %s 0 0 1\nMotionEnd\n"
+                       "Translate 1 0 0\nSphere 0.3 -0.3 0.3 360\nWorldEnd\n";
+    char t2[512];
+    snprintf(t2, sizeof t2, spin, "360");
+    CHECK(io_rib_parse("t.rib", (const unsigned char *)t2, strlen(t2), &s, &opt, &settings, err,
+                       sizeof err) == RAYES_OK);
+    CHECK(turns.n == RAYES_MAX_TIMES);
+    CHECK(turns.n > 8 && turns.M[turns.n / 2][3] < -0.9f); /* half way: the far side */
+    snprintf(t2, sizeof t2, spin, "270");
+    CHECK(io_rib_parse("t.rib", (const unsigned char *)t2, strlen(t2), &s, &opt, &settings, err,
+                       sizeof err) == RAYES_OK);
+    CHECK(turns.n == 16);
+    for (size_t k = 0; k < turns.n; k++)
+        CHECK_NEAR(atan2f(turns.M[k][7], turns.M[k][3]),
+                   remainderf(270 * turns.times[k] * (float)(M_PI / 180), 2 * (float)M_PI), 1e-3);
+    /* Transform sets the whole matrix: blended in the world's frame, not
+     * the Scale's before it (which would stretch it half way) */
+    const char *whole = "Projection \"perspective\" \"fov\" 40\nShutter 0 1\nWorldBegin\n"
+                        "Scale 3 1 1\nMotionBegin [0 1]\n"
+                        "Transform [1 0 0 0 0 1 0 0 0 0 1 0 0 0 0 1]\n"
+                        "Transform [0 1 0 0 -1 0 0 0 0 0 1 0 0 0 0 1]\nMotionEnd\n"
+                        "Sphere 0.3 -0.3 0.3 360\nWorldEnd\n";
+    CHECK(io_rib_parse("t.rib", (const unsigned char *)whole, strlen(whole), &s, &opt, &settings,
+                       err, sizeof err) == RAYES_OK);
+    CHECK(turns.n == 10);
+    for (size_t k = 0; k < turns.n; k++)
+        CHECK_NEAR(hypotf(turns.M[k][0], turns.M[k][4]), 1, 1e-4); /* x's image: unit */
     /* a motion that does not turn keeps its samples */
     const char *slide = "Projection \"perspective\" \"fov\" 40\nShutter 0 1\nWorldBegin\n"
                         "MotionBegin [0 1]\nTranslate 0 0 0\nTranslate 1 0 0\nMotionEnd\n"
