@@ -387,32 +387,6 @@ static int all_samples(const Rib *r, const char *q)
     return 1;
 }
 
-/* The rotation of deg degrees about axis (not zero), as Rotate makes it. */
-static void rotation(float deg, const float axis[3], float m[16])
-{
-    double len =
-        sqrt((double)axis[0] * axis[0] + (double)axis[1] * axis[1] + (double)axis[2] * axis[2]);
-    double x = axis[0] / len, y = axis[1] / len, z = axis[2] / len;
-    double th = deg * M_PI / 180, c = cos(th), s = sin(th), t = 1 - c;
-    const float rm[16] = {(float)(t * x * x + c),
-                          (float)(t * x * y - s * z),
-                          (float)(t * x * z + s * y),
-                          0,
-                          (float)(t * x * y + s * z),
-                          (float)(t * y * y + c),
-                          (float)(t * y * z - s * x),
-                          0,
-                          (float)(t * x * z - s * y),
-                          (float)(t * y * z + s * x),
-                          (float)(t * z * z + c),
-                          0,
-                          0,
-                          0,
-                          0,
-                          1};
-    memcpy(m, rm, sizeof rm);
-}
-
 /* A transform motion block's samples, more of them where its request
  * turns, at most RIB_MAX_TIMES: Rotates about one axis move their angle
  * (as PRMan moves a request's parameters: Rotate 0 to Rotate 360 spins
@@ -473,9 +447,9 @@ static void motion_turns(Rib *r)
                 continue;
             }
             if (rotate)
-                rotation(r->motion_rotate[k][0] +
-                             f * (r->motion_rotate[k + 1][0] - r->motion_rotate[k][0]),
-                         r->motion_rotate[k] + 1, L);
+                rib_mat_rotate(r->motion_rotate[k][0] +
+                                   f * (r->motion_rotate[k + 1][0] - r->motion_rotate[k][0]),
+                               r->motion_rotate[k] + 1, L);
             else
                 rib_mat_blend(local[k], local[k + 1], f, L);
             if (whole)

@@ -79,6 +79,20 @@ double rib_mat_det3(const float m[16])
            (double)m[2] * ((double)m[4] * m[9] - (double)m[5] * m[8]);
 }
 
+void rib_mat_rotate(float deg, const float axis[3], float m[16])
+{
+    double len =
+        sqrt((double)axis[0] * axis[0] + (double)axis[1] * axis[1] + (double)axis[2] * axis[2]);
+    double x = axis[0] / len, y = axis[1] / len, z = axis[2] / len;
+    double th = deg * M_PI / 180, c = cos(th), s = sin(th), t = 1 - c;
+    rib_mat_identity(m);
+    m[0] = (float)(t * x * x + c), m[1] = (float)(t * x * y - s * z);
+    m[2] = (float)(t * x * z + s * y), m[4] = (float)(t * x * y + s * z);
+    m[5] = (float)(t * y * y + c), m[6] = (float)(t * y * z - s * x);
+    m[8] = (float)(t * x * z - s * y), m[9] = (float)(t * y * z + s * x);
+    m[10] = (float)(t * z * z + c);
+}
+
 /* The polar decomposition of m's 3 x 3 part, A = Q S (Q a rotation, S
  * symmetric; a mirror's -1 goes into S), by Higham's iteration Q <- (Q +
  * Q^-T) / 2. Returns 0, or -1 when A is singular. */

@@ -17,6 +17,9 @@ void rib_mat_identity(float m[16]);
 void rib_mat_mul(const float a[16], const float b[16], float out[16]); /* out = a b */
 /* out = m^-1; returns -1 (out untouched) when m is singular. */
 int rib_mat_inverse(const float m[16], float out[16]);
+/* The rotation of deg degrees about axis (not zero: the caller checks),
+ * right-handed, as RIB's Rotate makes it. */
+void rib_mat_rotate(float deg, const float axis[3], float m[16]);
 /* The determinant of the upper-left 3 x 3 (negative: a mirror). */
 double rib_mat_det3(const float m[16]);
 /* The angle (radians) between the rotations of two transforms (their

@@ -57,16 +57,9 @@ static int h_rotate(Rib *r, const Args *a)
     float v[4], m[16];
     if (rib_get_floats(r, a, &i, v, 4, "angle dx dy dz") != 0)
         return -1;
-    double len = sqrt((double)v[1] * v[1] + (double)v[2] * v[2] + (double)v[3] * v[3]);
-    if (!(len > 0))
+    if (!(sqrt((double)v[1] * v[1] + (double)v[2] * v[2] + (double)v[3] * v[3]) > 0))
         return rib_error(r, "the rotation axis is zero");
-    double x = v[1] / len, y = v[2] / len, z = v[3] / len;
-    double th = v[0] * M_PI / 180, c = cos(th), s = sin(th), t = 1 - c;
-    float rm[16] = {(float)(t * x * x + c), (float)(t * x * y - s * z), (float)(t * x * z + s * y), 0,
-                    (float)(t * x * y + s * z), (float)(t * y * y + c), (float)(t * y * z - s * x), 0,
-                    (float)(t * x * z - s * y), (float)(t * y * z + s * x), (float)(t * z * z + c), 0,
-                    0, 0, 0, 1};
-    memcpy(m, rm, sizeof m);
+    rib_mat_rotate(v[0], v + 1, m);
     concat(r, m);
     return 0;
 }
