@@ -197,17 +197,25 @@ static const char *pxr_disney(Rib *r, const char *cls, const Param *p, size_t n,
     return "coateddiffuse";
 }
 
-static int h_bxdf(Rib *r, const Args *a)
+/* RIS's "class" "name" params (the name optional; parameters come in
+ * pairs): the class and the parameters, or NULL with the error set. */
+static const char *class_and_params(Rib *r, const Args *a, const char *what, Param **p, size_t *n)
 {
     size_t i = 0;
-    const char *cls = rib_get_string(r, a, &i, "a Bxdf class");
+    const char *cls = rib_get_string(r, a, &i, what);
     if (!cls)
-        return -1;
-    if (i < a->n && (a->n - i) % 2 == 1 && !rib_get_string(r, a, &i, "a Bxdf name"))
-        return -1;
+        return NULL;
+    if (i < a->n && (a->n - i) % 2 == 1 && !rib_get_string(r, a, &i, "a name"))
+        return NULL;
+    return rib_get_params(r, a, i, p, n) == 0 ? cls : NULL;
+}
+
+static int h_bxdf(Rib *r, const Args *a)
+{
     Param *p;
     size_t n;
-    if (rib_get_params(r, a, i, &p, &n) != 0)
+    const char *cls = class_and_params(r, a, "a Bxdf class", &p, &n);
+    if (!cls)
         return -1;
     static const float half[3] = {0.5f, 0.5f, 0.5f}, one[3] = {1, 1, 1}, zero[3] = {0, 0, 0};
     Out o = {.n = 0};
@@ -438,15 +446,10 @@ enum { RIS_DIFFUSE_BOUNCES = 8 };
 
 static int h_integrator(Rib *r, const Args *a)
 {
-    size_t i = 0;
-    const char *cls = rib_get_string(r, a, &i, "an integrator class");
-    if (!cls)
-        return -1;
-    if (i < a->n && (a->n - i) % 2 == 1 && !rib_get_string(r, a, &i, "an integrator name"))
-        return -1;
     Param *p;
     size_t n;
-    if (rib_get_params(r, a, i, &p, &n) != 0)
+    const char *cls = class_and_params(r, a, "an integrator class", &p, &n);
+    if (!cls)
         return -1;
     /* maxPathLength counts the camera ray's segment: N - 1 diffuse
      * bounces (each cached apart, so capped as pbrt's maxdepth is) */

@@ -300,17 +300,6 @@ static void default_lighting(const RayesShaderServices *sv, const RayesShadeCtx 
     set_opacity(ctx, out);
 }
 
-static void default_diffuselighting(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
-                                    const void *params, RayesShadeOutputs *out)
-{
-    (void)sv, (void)params;
-    for (size_t i = 0; i < ctx->n_points; i++)
-        out->Ci[i][0] = out->Ci[i][1] = out->Ci[i][2] = 0;
-    if (out->Irradiance)
-        memset(out->Irradiance, 0, ctx->n_points * sizeof *out->Irradiance);
-    set_opacity(ctx, out);
-}
-
 static const RayesShaderParamDesc default_params[] = {
     {"Ka", RAYES_PARAM_FLOAT, offsetof(DefaultParams, Ka), {0.2f, 0, 0}},
     {"Kd", RAYES_PARAM_FLOAT, offsetof(DefaultParams, Kd), {0.8f, 0, 0}},
@@ -324,7 +313,7 @@ const RayesShaderClass shade_class_defaultsurface = {
     .params = default_params,
     .n_params = sizeof default_params / sizeof default_params[0],
     .lighting = default_lighting,
-    .diffuselighting = default_diffuselighting,
+    .diffuselighting = black, /* it reflects no light */
 };
 
 /* ---- paintedplastic
