@@ -359,6 +359,8 @@ static int h_motion_begin(Rib *r, const Args *a)
     r->motion_kind = 0;
     memcpy(r->motion_pre, r->a.M, sizeof r->motion_pre);
     r->motion_pre_n = r->a.n_motion;
+    memcpy(r->motion_pre_time, r->a.motion_time, sizeof r->motion_pre_time);
+    memcpy(r->motion_pre_M, r->a.motion_M, sizeof r->motion_pre_M);
     return 0;
 }
 
@@ -387,17 +389,58 @@ static int all_samples(const Rib *r, const char *q)
     return 1;
 }
 
+/* M before the block at time t: an earlier block's samples blended (a
+ * motion block after another, as a child's transform moves within its
+ * parent's), else the one matrix. */
+static void pre_at(const Rib *r, float t, float out[16])
+{
+    int n = r->motion_pre_n;
+    const float *tm = r->motion_pre_time;
+    if (n < 2) {
+        memcpy(out, r->motion_pre, 16 * sizeof *out);
+        return;
+    }
+    int k = 0;
+    while (k + 1 < n && t > tm[k + 1])
+        k++;
+    if (k + 1 >= n || t <= tm[k])
+        memcpy(out, r->motion_pre_M[k + 1 >= n ? n - 1 : k], 16 * sizeof *out);
+    else if (t == tm[k + 1])
+        memcpy(out, r->motion_pre_M[k + 1], 16 * sizeof *out);
+    else
+        rib_mat_blend(r->motion_pre_M[k], r->motion_pre_M[k + 1], (t - tm[k]) / (tm[k + 1] - tm[k]),
+                      out);
+}
+
+/* The block's own transform a fraction f from its sample k to k + 1
+ * (local: each sample in the frame before the block). */
+static void local_between(const Rib *r, float local[][16], int rotate, size_t k, float f,
+                          float L[16])
+{
+    if (f <= 0.0f)
+        memcpy(L, local[k], 16 * sizeof *L);
+    else if (rotate)
+        rib_mat_rotate(r->motion_rotate[k][0] +
+                           f * (r->motion_rotate[k + 1][0] - r->motion_rotate[k][0]),
+                       r->motion_rotate[k] + 1, L);
+    else
+        rib_mat_blend(local[k], local[k + 1], f, L);
+}
+
 /* A transform motion block's samples, more of them where its request
  * turns, at most RIB_MAX_TIMES: Rotates about one axis move their angle
  * (as PRMan moves a request's parameters: Rotate 0 to Rotate 360 spins
  * once); other turning requests are blended in their own frame (about
  * their origin; Transform's is the world's), rotation by slerp.
- * Translate and Scale move linearly already. */
-static void motion_turns(Rib *r)
+ * Translate and Scale move linearly already. When the transform before
+ * the block moved too (an earlier block), each sample is the block's
+ * request at its time after that motion at the same time, at the times of
+ * both blocks. */
+static void motion_transforms(Rib *r)
 {
-    size_t n = r->motion_n, total = 1;
-    float inv[16], local[RIB_MAX_TIMES][16];
-    int sub[RIB_MAX_TIMES], any = 0;
+    size_t n = r->motion_n, total = 1, n_extra = 0;
+    float inv[16], pre[16], local[RIB_MAX_TIMES][16], extra[RIB_MAX_TIMES];
+    int sub[RIB_MAX_TIMES], any = r->motion_pre_n > 1;
     int rotate = all_samples(r, "Rotate"), whole = 1;
     for (size_t k = 0; k < n; k++) /* Transform and Identity set the whole matrix */
         whole &=
@@ -409,18 +452,23 @@ static void motion_turns(Rib *r)
         double d = (a[0] * b[0] + a[1] * b[1] + a[2] * b[2]) / (la * lb);
         rotate = la > 0 && lb > 0 && d > 0.999999;
     }
-    if (n < 2 || (!rotate && !whole && !all_samples(r, "ConcatTransform")))
+    int turning = n >= 2 && (rotate || whole || all_samples(r, "ConcatTransform"));
+    if (!turning && !any)
         return;
-    if (whole)
-        rib_mat_identity(inv);
-    else if (rib_mat_inverse(r->motion_pre, inv) != 0)
-        return;
-    for (size_t k = 0; k < n; k++)
-        rib_mat_mul(inv, r->motion_M[k], local[k]);
+    for (size_t k = 0; k < n; k++) {
+        pre_at(r, r->motion_time[k], pre);
+        if (whole)
+            memcpy(local[k], r->motion_M[k], sizeof local[k]);
+        else if (rib_mat_inverse(pre, inv) == 0)
+            rib_mat_mul(inv, r->motion_M[k], local[k]);
+        else
+            return; /* a singular transform before the block: its samples as they are */
+    }
     for (size_t k = 0; k + 1 < n; k++) {
-        float turn = rotate ? fabsf(r->motion_rotate[k + 1][0] - r->motion_rotate[k][0]) *
-                                  (float)(M_PI / 180)
-                            : rib_mat_turn(local[k], local[k + 1]);
+        float turn = !turning ? 0.0f
+                     : rotate ? fabsf(r->motion_rotate[k + 1][0] - r->motion_rotate[k][0]) *
+                                    (float)(M_PI / 180)
+                              : rib_mat_turn(local[k], local[k + 1]);
         float steps = ceilf(turn / RIB_MOTION_TURN - 1e-3f); /* 90 degrees: 9 */
         sub[k] = steps > 1 ? (int)fminf(steps, 64) : 1;
         any |= sub[k] > 1;
@@ -428,6 +476,14 @@ static void motion_turns(Rib *r)
     }
     if (!any)
         return;
+    for (int j = 0; !whole && j < r->motion_pre_n; j++) { /* the earlier block's own times */
+        size_t k = 0;
+        while (k < n && r->motion_time[k] != r->motion_pre_time[j])
+            k++;
+        if (k == n && n + n_extra < RIB_MAX_TIMES)
+            extra[n_extra++] = r->motion_pre_time[j];
+    }
+    total += n_extra;
     while (total > RIB_MAX_TIMES) { /* the most samples where the most turn */
         size_t big = 0;
         for (size_t k = 1; k + 1 < n; k++)
@@ -436,30 +492,46 @@ static void motion_turns(Rib *r)
         sub[big]--;
         total--;
     }
-    float times[RIB_MAX_TIMES], M[RIB_MAX_TIMES][16];
-    size_t m = 0;
-    for (size_t k = 0; k + 1 < n; k++)
-        for (int j = 0; j < sub[k]; j++, m++) {
-            float f = (float)j / (float)sub[k], L[16];
-            times[m] = r->motion_time[k] + f * (r->motion_time[k + 1] - r->motion_time[k]);
-            if (j == 0) {
-                memcpy(M[m], r->motion_M[k], sizeof M[m]);
-                continue;
-            }
-            if (rotate)
-                rib_mat_rotate(r->motion_rotate[k][0] +
-                                   f * (r->motion_rotate[k + 1][0] - r->motion_rotate[k][0]),
-                               r->motion_rotate[k] + 1, L);
-            else
-                rib_mat_blend(local[k], local[k + 1], f, L);
-            if (whole)
-                memcpy(M[m], L, sizeof M[m]);
-            else
-                rib_mat_mul(r->motion_pre, L, M[m]);
+    float times[RIB_MAX_TIMES], M[RIB_MAX_TIMES][16], L[16];
+    size_t m = 0, own[RIB_MAX_TIMES]; /* own: 1 + the block's sample, kept exact */
+    for (size_t k = 0; k < n; k++)
+        for (int j = 0; j < (k + 1 < n ? sub[k] : 1); j++, m++) {
+            float f = j == 0 ? 0.0f : (float)j / (float)sub[k];
+            times[m] = j == 0 ? r->motion_time[k]
+                              : r->motion_time[k] + f * (r->motion_time[k + 1] - r->motion_time[k]);
+            local_between(r, local, rotate, k, f, M[m]);
+            own[m] = j == 0 ? k + 1 : 0;
         }
-    times[m] = r->motion_time[n - 1];
-    memcpy(M[m], r->motion_M[n - 1], sizeof M[m]);
-    m++;
+    for (size_t e = 0; e < n_extra; e++, m++) { /* sorted in below */
+        float t = extra[e];
+        size_t k = 0;
+        while (k + 1 < n && t > r->motion_time[k + 1])
+            k++;
+        float f = k + 1 < n ? (t - r->motion_time[k]) / (r->motion_time[k + 1] - r->motion_time[k])
+                            : 0.0f;
+        local_between(r, local, rotate, k, fmaxf(f, 0.0f), M[m]);
+        times[m] = t;
+        own[m] = 0;
+    }
+    for (size_t i = 1; i < m; i++) /* insertion sort by time */
+        for (size_t j = i; j > 0 && times[j - 1] > times[j]; j--) {
+            float t = times[j];
+            size_t o = own[j];
+            times[j] = times[j - 1], times[j - 1] = t;
+            own[j] = own[j - 1], own[j - 1] = o;
+            memcpy(L, M[j], sizeof L);
+            memcpy(M[j], M[j - 1], sizeof L);
+            memcpy(M[j - 1], L, sizeof L);
+        }
+    for (size_t k = 0; k < m; k++) {
+        if (own[k])
+            memcpy(M[k], r->motion_M[own[k] - 1], sizeof M[k]);
+        if (own[k] || whole)
+            continue;
+        pre_at(r, times[k], pre);
+        memcpy(L, M[k], sizeof L);
+        rib_mat_mul(pre, L, M[k]);
+    }
     r->motion_n = m;
     memcpy(r->motion_time, times, m * sizeof *times);
     memcpy(r->motion_M, M, m * sizeof M[0]);
@@ -472,7 +544,7 @@ static int motion_end(Rib *r)
         return rib_error(r, "the block has %d requests for %zu times", r->motion_seen,
                          r->motion_n);
     if (r->motion_kind == 1) {
-        motion_turns(r);
+        motion_transforms(r);
         memcpy(r->a.M, r->motion_M[0], sizeof r->a.M);
         r->a.n_motion = r->motion_n > 1 ? (int)r->motion_n : 0;
         memcpy(r->a.motion_time, r->motion_time, r->motion_n * sizeof *r->motion_time);
@@ -507,7 +579,7 @@ static int motion_request(Rib *r, const char *q, const Args *a, int (*run)(Rib *
         if (strcmp(q, "Rotate") == 0 &&
             (a->n < 1 || rib_get_floats(r, a, &i, r->motion_rotate[k], 4, "angle dx dy dz") != 0))
             r->motion_req[k][0] = '\0';
-        memcpy(r->a.M, r->motion_pre, sizeof r->a.M);
+        pre_at(r, r->motion_time[k], r->a.M);
         r->a.n_motion = 0;
         int rc = run(r, a);
         memcpy(r->motion_M[k], r->a.M, sizeof r->a.M);

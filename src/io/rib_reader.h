@@ -233,12 +233,15 @@ typedef struct Rib {
     float dof[3];              /* DepthOfField fstop focallength focaldistance; fstop 0: none */
     /* A MotionBegin block: its times, the request count so far, what it
      * holds (1: transforms, 2: primitives, 0: nothing yet), and for
-     * transforms M before it and after each sample. */
+     * transforms M before it (with its own motion, from an earlier block)
+     * and after each sample. */
     int motion_kind;
     size_t motion_n;
     float motion_time[RIB_MAX_TIMES];
     float motion_pre[16];
-    int motion_pre_n;
+    int motion_pre_n; /* M before the block moved: its samples */
+    float motion_pre_time[RIB_MAX_TIMES];
+    float motion_pre_M[RIB_MAX_TIMES][16];
     char motion_req[RIB_MAX_TIMES][20];    /* each sample's request (a transform block) */
     float motion_rotate[RIB_MAX_TIMES][4]; /* a Rotate sample's angle and axis */
     float motion_M[RIB_MAX_TIMES][16];

@@ -560,8 +560,60 @@ static void test_rib_turning_motion(void)
     record_free(&rec);
 }
 
+/* Motion blocks one after another compose: a child's block moves within
+ * its parent's moving frame, at the times of both (the second block used
+ * to start from the first one's opening transform, still). */
+static void test_rib_consecutive_motion(void)
+{
+    static Record rec;
+    IoSink s = record_sink(&rec);
+    s.set_transform_motion = rec_turns;
+    IoSettings settings;
+    io_settings_init(&settings);
+    IoReadOptions opt = {NULL, -1};
+    const char *spin = "Projection \"perspective\" \"fov\" 40\nShutter 0 1\nWorldBegin\n"
+                       "MotionBegin [0 1]\nTranslate 0 0 0\nTranslate 2 0 0\nMotionEnd\n"
+                       "MotionBegin [0 1]\nRotate 0 0 0 1\nRotate 90 0 0 1\nMotionEnd\n"
+                       "Translate 1 0 0\nSphere 0.3 -0.3 0.3 360\nWorldEnd\n";
+    turns.n = 0;
+    CHECK(io_rib_parse("t.rib", (const unsigned char *)spin, strlen(spin), &s, &opt, &settings, err,
+                       sizeof err) == RAYES_OK);
+    CHECK(turns.n == 10);
+    for (size_t k = 0; k < turns.n; k++) { /* the centre: (2t + cos 90t, sin 90t) */
+        float t = turns.times[k], a = 90 * t * (float)(M_PI / 180);
+        CHECK_NEAR(turns.M[k][3], 2 * t + cosf(a), 1e-4);
+        CHECK_NEAR(turns.M[k][7], sinf(a), 1e-4);
+    }
+    /* blocks at different times: every time of both, each block blended at
+     * the other's */
+    const char *times = "Projection \"perspective\" \"fov\" 40\nShutter 0 1\nWorldBegin\n"
+                        "MotionBegin [0 0.5 1]\nTranslate 0 0 0\nTranslate 1 0 0\n"
+                        "Translate 3 0 0\nMotionEnd\n"
+                        "MotionBegin [0 1]\nTranslate 0 0 0\nTranslate 0 1 0\nMotionEnd\n"
+                        "Sphere 0.3 -0.3 0.3 360\nWorldEnd\n";
+    turns.n = 0;
+    CHECK(io_rib_parse("t.rib", (const unsigned char *)times, strlen(times), &s, &opt, &settings,
+                       err, sizeof err) == RAYES_OK);
+    CHECK(turns.n == 3);
+    static const float want[3][3] = {{0, 0, 0}, {0.5f, 1, 0.5f}, {1, 3, 1}};
+    for (size_t k = 0; k < 3 && k < turns.n; k++) {
+        CHECK_NEAR(turns.times[k], want[k][0], 1e-6);
+        CHECK_NEAR(turns.M[k][3], want[k][1], 1e-5);
+        CHECK_NEAR(turns.M[k][7], want[k][2], 1e-5);
+    }
+    /* a still transform after a block moves every sample */
+    const char *after = "Projection \"perspective\" \"fov\" 40\nShutter 0 1\nWorldBegin\n"
+                        "MotionBegin [0 1]\nTranslate 0 0 0\nTranslate 0 1 0\nMotionEnd\n"
+                        "Translate 5 0 0\nSphere 0.3 -0.3 0.3 360\nWorldEnd\n";
+    turns.n = 0;
+    CHECK(io_rib_parse("t.rib", (const unsigned char *)after, strlen(after), &s, &opt, &settings,
+                       err, sizeof err) == RAYES_OK);
+    CHECK(turns.n == 2 && turns.M[0][3] == 5 && turns.M[1][3] == 5 && turns.M[1][7] == 1);
+    record_free(&rec);
+}
+
 TEST_MAIN(TEST(test_rib_transform_motion), TEST(test_rib_turning_motion),
-          TEST(test_rib_deformation_and_camera), TEST(test_rib_depth_of_field),
-          TEST(test_rib_errors), TEST(test_pbrt_motion_and_lens), TEST(test_writer_round_trip),
-          TEST(test_rib_deforming_points_and_curves), TEST(test_rib_moving_light),
-          TEST(test_moving_instance))
+          TEST(test_rib_consecutive_motion), TEST(test_rib_deformation_and_camera),
+          TEST(test_rib_depth_of_field), TEST(test_rib_errors), TEST(test_pbrt_motion_and_lens),
+          TEST(test_writer_round_trip), TEST(test_rib_deforming_points_and_curves),
+          TEST(test_rib_moving_light), TEST(test_moving_instance))
