@@ -491,6 +491,23 @@ static RayesError rec_turns(void *t, size_t n, const float *times, const float (
     return RAYES_OK;
 }
 
+/* Reads RIB text into a recording sink whose transform motions land in
+ * turns; 1 if it read. */
+static int parse_turns(const char *text)
+{
+    static Record rec;
+    IoSink s = record_sink(&rec);
+    s.set_transform_motion = rec_turns;
+    IoSettings settings;
+    io_settings_init(&settings);
+    IoReadOptions opt = {NULL, -1};
+    turns.n = 0;
+    int ok = io_rib_parse("t.rib", (const unsigned char *)text, strlen(text), &s, &opt, &settings,
+                          err, sizeof err) == RAYES_OK;
+    record_free(&rec);
+    return ok;
+}
+
 /* A transform that turns within a motion block is sent with samples at
  * most 10 degrees apart, blended about the turning request's own origin
  * (as PRMan moves Rotate's angle): a sphere 1.5 from the axis stays 1.5
@@ -499,19 +516,11 @@ static RayesError rec_turns(void *t, size_t n, const float *times, const float (
 static void test_rib_turning_motion(void)
 {
     (void)rec_param;
-    static Record rec;
-    IoSink s = record_sink(&rec);
-    s.set_transform_motion = rec_turns;
-    IoSettings settings;
-    io_settings_init(&settings);
-    IoReadOptions opt = {NULL, -1};
     const char *text = "Projection \"perspective\" \"fov\" 40\nShutter 0 1\nWorldBegin\n"
                        "Translate 0 3 0\n"
                        "MotionBegin [0 1]\nRotate 0 0 0 1\nRotate 90 0 0 1\nMotionEnd\n"
                        "Translate 1.5 0 0\nSphere 0.3 -0.3 0.3 360\nWorldEnd\n";
-    turns.n = 0;
-    CHECK(io_rib_parse("t.rib", (const unsigned char *)text, strlen(text), &s, &opt, &settings, err,
-                       sizeof err) == RAYES_OK);
+    CHECK(parse_turns(text));
     CHECK(turns.n == 10); /* 90 degrees in steps of 10 */
     for (size_t k = 0; k < turns.n; k++) {
         const float *m = turns.M[k]; /* the sphere's centre: the translation column */
@@ -527,13 +536,11 @@ static void test_rib_turning_motion(void)
                        "Translate 1 0 0\nSphere 0.3 -0.3 0.3 360\nWorldEnd\n";
     char t2[512];
     snprintf(t2, sizeof t2, spin, "360");
-    CHECK(io_rib_parse("t.rib", (const unsigned char *)t2, strlen(t2), &s, &opt, &settings, err,
-                       sizeof err) == RAYES_OK);
+    CHECK(parse_turns(t2));
     CHECK(turns.n == RAYES_MAX_TIMES);
     CHECK(turns.n > 8 && turns.M[turns.n / 2][3] < -0.9f); /* half way: the far side */
     snprintf(t2, sizeof t2, spin, "270");
-    CHECK(io_rib_parse("t.rib", (const unsigned char *)t2, strlen(t2), &s, &opt, &settings, err,
-                       sizeof err) == RAYES_OK);
+    CHECK(parse_turns(t2));
     CHECK(turns.n == 16);
     for (size_t k = 0; k < turns.n; k++)
         CHECK_NEAR(atan2f(turns.M[k][7], turns.M[k][3]),
@@ -545,8 +552,7 @@ static void test_rib_turning_motion(void)
                         "Transform [1 0 0 0 0 1 0 0 0 0 1 0 0 0 0 1]\n"
                         "Transform [0 1 0 0 -1 0 0 0 0 0 1 0 0 0 0 1]\nMotionEnd\n"
                         "Sphere 0.3 -0.3 0.3 360\nWorldEnd\n";
-    CHECK(io_rib_parse("t.rib", (const unsigned char *)whole, strlen(whole), &s, &opt, &settings,
-                       err, sizeof err) == RAYES_OK);
+    CHECK(parse_turns(whole));
     CHECK(turns.n == 10);
     for (size_t k = 0; k < turns.n; k++)
         CHECK_NEAR(hypotf(turns.M[k][0], turns.M[k][4]), 1, 1e-4); /* x's image: unit */
@@ -554,10 +560,8 @@ static void test_rib_turning_motion(void)
     const char *slide = "Projection \"perspective\" \"fov\" 40\nShutter 0 1\nWorldBegin\n"
                         "MotionBegin [0 1]\nTranslate 0 0 0\nTranslate 1 0 0\nMotionEnd\n"
                         "Sphere 0.3 -0.3 0.3 360\nWorldEnd\n";
-    CHECK(io_rib_parse("t.rib", (const unsigned char *)slide, strlen(slide), &s, &opt, &settings,
-                       err, sizeof err) == RAYES_OK);
+    CHECK(parse_turns(slide));
     CHECK(turns.n == 2);
-    record_free(&rec);
 }
 
 /* Motion blocks one after another compose: a child's block moves within
@@ -565,19 +569,11 @@ static void test_rib_turning_motion(void)
  * to start from the first one's opening transform, still). */
 static void test_rib_consecutive_motion(void)
 {
-    static Record rec;
-    IoSink s = record_sink(&rec);
-    s.set_transform_motion = rec_turns;
-    IoSettings settings;
-    io_settings_init(&settings);
-    IoReadOptions opt = {NULL, -1};
     const char *spin = "Projection \"perspective\" \"fov\" 40\nShutter 0 1\nWorldBegin\n"
                        "MotionBegin [0 1]\nTranslate 0 0 0\nTranslate 2 0 0\nMotionEnd\n"
                        "MotionBegin [0 1]\nRotate 0 0 0 1\nRotate 90 0 0 1\nMotionEnd\n"
                        "Translate 1 0 0\nSphere 0.3 -0.3 0.3 360\nWorldEnd\n";
-    turns.n = 0;
-    CHECK(io_rib_parse("t.rib", (const unsigned char *)spin, strlen(spin), &s, &opt, &settings, err,
-                       sizeof err) == RAYES_OK);
+    CHECK(parse_turns(spin));
     CHECK(turns.n == 10);
     for (size_t k = 0; k < turns.n; k++) { /* the centre: (2t + cos 90t, sin 90t) */
         float t = turns.times[k], a = 90 * t * (float)(M_PI / 180);
@@ -591,9 +587,7 @@ static void test_rib_consecutive_motion(void)
                         "Translate 3 0 0\nMotionEnd\n"
                         "MotionBegin [0 1]\nTranslate 0 0 0\nTranslate 0 1 0\nMotionEnd\n"
                         "Sphere 0.3 -0.3 0.3 360\nWorldEnd\n";
-    turns.n = 0;
-    CHECK(io_rib_parse("t.rib", (const unsigned char *)times, strlen(times), &s, &opt, &settings,
-                       err, sizeof err) == RAYES_OK);
+    CHECK(parse_turns(times));
     CHECK(turns.n == 3);
     static const float want[3][3] = {{0, 0, 0}, {0.5f, 1, 0.5f}, {1, 3, 1}};
     for (size_t k = 0; k < 3 && k < turns.n; k++) {
@@ -605,11 +599,8 @@ static void test_rib_consecutive_motion(void)
     const char *after = "Projection \"perspective\" \"fov\" 40\nShutter 0 1\nWorldBegin\n"
                         "MotionBegin [0 1]\nTranslate 0 0 0\nTranslate 0 1 0\nMotionEnd\n"
                         "Translate 5 0 0\nSphere 0.3 -0.3 0.3 360\nWorldEnd\n";
-    turns.n = 0;
-    CHECK(io_rib_parse("t.rib", (const unsigned char *)after, strlen(after), &s, &opt, &settings,
-                       err, sizeof err) == RAYES_OK);
+    CHECK(parse_turns(after));
     CHECK(turns.n == 2 && turns.M[0][3] == 5 && turns.M[1][3] == 5 && turns.M[1][7] == 1);
-    record_free(&rec);
 }
 
 TEST_MAIN(TEST(test_rib_transform_motion), TEST(test_rib_turning_motion),
