@@ -528,8 +528,8 @@ void merge_settings(Args *a, const IoSettings *s)
     }
     if (!(a->set & SET_SPP) && s->spp > 0)
         o->spp = s->spp;
-    if (!(a->set & SET_MAX_SPP) && s->max_spp > 0)
-        o->max_spp = s->max_spp;
+    if (!(a->set & (SET_MAX_SPP | SET_SPP)) && s->max_spp > 0)
+        o->max_spp = s->max_spp; /* --spp alone: the samples asked, none added */
     if (!(a->set & SET_ADAPTIVE_ERROR) && s->adaptive_error > 0.0f)
         o->adaptive_error = s->adaptive_error;
     if (!(a->set & SET_CLAMP) && s->sample_clamp > 0.0f)

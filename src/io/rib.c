@@ -336,6 +336,49 @@ static int h_procedural(Rib *r, const Args *a)
     return 0;
 }
 
+/* Procedural2 "DelayedReadArchive2" "SimpleBound" "string filename" [f]
+ * ...: RenderMan 20's form of DelayedReadArchive (what RenderMan for Maya
+ * writes), read here as ReadArchive; other kinds are skipped. */
+static int h_procedural2(Rib *r, const Args *a)
+{
+    size_t i = 0;
+    const char *kind = rib_get_string(r, a, &i, "a procedural name");
+    if (!kind || !rib_get_string(r, a, &i, "a bound function name"))
+        return -1;
+    char key[128];
+    snprintf(key, sizeof key, "procedural2 %s", kind);
+    if (strcmp(kind, "DelayedReadArchive2") != 0) {
+        rib_warn_once(r, key, "Procedural2 \"%s\" is not supported and skipped", kind);
+        return 0;
+    }
+    Param *p;
+    size_t n;
+    if (rib_get_params(r, a, i, &p, &n) != 0)
+        return -1;
+    const Param *f = rib_find_param(p, n, "filename");
+    char *name = f && f->d.ty == TY_STRING && f->v->n == 1 ? rib_strdup(f->v->s[0]) : NULL;
+    free(p);
+    if (!name)
+        return rib_error(r, "Procedural2 \"DelayedReadArchive2\" needs a \"string filename\"");
+    int e = read_archive(r, name);
+    free(name);
+    return e;
+}
+
+/* GeometricRepresentation "primitive" is every surface's default; points
+ * and lines (a wireframe) are drawn as surfaces, with one warning. */
+static int h_geometric_representation(Rib *r, const Args *a)
+{
+    size_t i = 0;
+    const char *kind = rib_get_string(r, a, &i, "a representation name");
+    if (!kind)
+        return -1;
+    if (strcmp(kind, "primitive") != 0)
+        rib_warn_once(r, "GeometricRepresentation",
+                      "GeometricRepresentation \"%s\" is not supported: surfaces are drawn", kind);
+    return 0;
+}
+
 /* ----------------------------------------------------------- dispatch */
 
 /* MotionBegin [t0 t1 ...]: the requests up to MotionEnd are the samples of
@@ -678,7 +721,8 @@ static const RibRequest own_requests[] = {
     {"ReadArchive", h_read_archive},
     {"Procedural", h_procedural},
     /* tier 1 and 2: read and skipped with one warning per request name */
-    {"Procedural2", h_skip},
+    {"Procedural2", h_procedural2},
+    {"GeometricRepresentation", h_geometric_representation},
     {"DisplayChannel", h_skip},
     {"DisplayFilter", h_skip},
     {"SampleFilter", h_skip},
@@ -721,6 +765,15 @@ static const RibRequest own_requests[] = {
     {"EditEnd", h_skip},
     {"CameraBegin", h_skip},
     {"CameraEnd", h_skip},
+    {"MakeOcclusion", h_skip},
+    {"VolumePixelSamples", h_skip},
+    {"VPInterior", h_skip},
+    {"VPSurface", h_skip},
+    {"VPAtmosphere", h_skip},
+    {"EditWorldBegin", h_skip},
+    {"EditWorldEnd", h_skip},
+    {"EditAttributeBegin", h_skip},
+    {"EditAttributeEnd", h_skip},
     {NULL, NULL},
 };
 

@@ -128,8 +128,8 @@ static int h_curves(Rib *r, const Args *a)
     const char *wrap = e == 0 ? rib_get_string(r, a, &i, "\"periodic\" or \"nonperiodic\"") : NULL;
     if (e == 0 && !wrap)
         e = -1;
-    int periodic = wrap && strcmp(wrap, "periodic") == 0;
-    if (e == 0 && !periodic && strcmp(wrap, "nonperiodic") != 0)
+    int periodic = wrap && (strcmp(wrap, "periodic") == 0 || strcmp(wrap, "wrap") == 0);
+    if (e == 0 && !periodic && strcmp(wrap, "nonperiodic") != 0 && strcmp(wrap, "nowrap") != 0)
         e = rib_error(r, "expected \"periodic\" or \"nonperiodic\", found \"%s\"", wrap);
     if (e == 0)
         e = rib_get_params(r, a, i, &p, &n);

@@ -960,9 +960,9 @@ static int h_patch(Rib *r, const Args *a)
 
 static int wrap_of(Rib *r, const char *s, int *periodic)
 {
-    if (strcmp(s, "periodic") == 0)
+    if (strcmp(s, "periodic") == 0 || strcmp(s, "wrap") == 0) /* ri.h's RI_WRAP too */
         *periodic = 1;
-    else if (strcmp(s, "nonperiodic") == 0)
+    else if (strcmp(s, "nonperiodic") == 0 || strcmp(s, "nowrap") == 0)
         *periodic = 0;
     else
         return rib_error(r, "expected \"periodic\" or \"nonperiodic\", found \"%s\"", s);

@@ -815,7 +815,12 @@ static int h_illuminate(Rib *r, const Args *a)
                               rib_handle_name(handle));
                 return 0;
             }
-        return rib_error(r, "no light has the handle %s", rib_handle_name(handle));
+        /* a light skipped (a shader rayes does not have) or never given:
+         * RenderMan reports it and goes on */
+        rib_warn_once(r, "Illuminate unknown",
+                      "Illuminate: no light has the handle %s; ignored (a light skipped?)",
+                      rib_handle_name(handle));
+        return 0;
     }
     set_light_on(&r->a, (size_t)(L - r->lights), on != 0);
     return 0;

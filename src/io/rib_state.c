@@ -555,15 +555,16 @@ static int h_display(Rib *r, const Args *a)
     return 0;
 }
 
-/* One positive count of a Hider parameter (RenderMan's "minsamples",
- * "maxsamples"), or 0 if absent; -1 on error. */
+/* One count of a Hider parameter (RenderMan's "minsamples",
+ * "maxsamples"), or 0 if absent or 0 (RenderMan's own choice, which
+ * RenderMan for Maya writes); -1 on error. */
 static int hider_count(Rib *r, const Param *p, size_t n, const char *name)
 {
     const Param *q = rib_find_param(p, n, name);
     if (!q)
         return 0;
-    if (!rib_is_num(q->v) || q->v->n != 1 || !(q->v->d[0] >= 1 && q->v->d[0] <= 1 << 20))
-        return rib_arg_error(r, q->v, "\"%s\" needs one count from 1 to 1048576", name);
+    if (!rib_is_num(q->v) || q->v->n != 1 || !(q->v->d[0] >= 0 && q->v->d[0] <= 1 << 20))
+        return rib_arg_error(r, q->v, "\"%s\" needs one count from 0 to 1048576", name);
     return (int)q->v->d[0];
 }
 

@@ -446,6 +446,35 @@ static void test_rib_grid_size(void)
     CHECK(strstr(json, "\"grid_size\": 128,") != NULL);
 }
 
+/* --spp on the command line takes the samples asked for everywhere: a
+ * file's adaptive sampling (Hider "maxsamples") is off unless --max-spp
+ * asks for it too. */
+static void test_spp_over_file_sampling(void)
+{
+    static Run r;
+    char json[8192];
+    setup();
+    write_text(SCRATCH_DIR "/adapt.rib", "Hider \"raytrace\" \"int minsamples\" [4] "
+                                         "\"int maxsamples\" [512]\nPixelVariance 0.0001\n"
+                                         "Projection \"perspective\" \"fov\" 40\n"
+                                         "WorldBegin\nLightSource \"pointlight\" 1\n"
+                                         "Translate 0 0 5\nSphere 1 -1 1 360\nWorldEnd\n");
+    run(&r, NULL,
+        ARGS("render", SCRATCH_DIR "/adapt.rib", "--res", "16", "--spp", "2", "--quiet", "-o",
+             SCRATCH_DIR "/adapt.png", "--stats", SCRATCH_DIR "/adapt.json"));
+    CHECK(r.status == 0);
+    read_file(SCRATCH_DIR "/adapt.json", json, sizeof json);
+    CHECK(strstr(json, "\"camera\": 512,") != NULL); /* 16 x 16 x 2 */
+    run(&r, NULL,
+        ARGS("render", SCRATCH_DIR "/adapt.rib", "--res", "16", "--quiet", "-o",
+             SCRATCH_DIR "/adapt.png", "--stats", SCRATCH_DIR "/adapt.json"));
+    CHECK(r.status == 0);
+    read_file(SCRATCH_DIR "/adapt.json", json, sizeof json);
+    const char *c = strstr(json, "\"camera\": ");
+    long camera = c ? strtol(c + 10, NULL, 10) : 0;
+    CHECK(camera > 1024); /* the file's: 4 a pixel, more at the sphere's edge */
+}
+
 /* RIB's Option "limits" "opacitycachememory" (KB) sets the opacity
  * entries' budget unless --opacity-cache-mb says otherwise. */
 static void test_rib_opacity_cache_memory(void)
@@ -732,7 +761,7 @@ static void test_background_imager(void)
 TEST_MAIN(TEST(test_version_and_help), TEST(test_no_arguments), TEST(test_usage_errors),
           TEST(test_missing_data), TEST(test_render_outputs), TEST(test_render_summary),
           TEST(test_data_from_environment), TEST(test_unwritable_output), TEST(test_shader_path),
-          TEST(test_render_obj), TEST(test_rib_grid_size), TEST(test_rib_opacity_cache_memory),
-          TEST(test_vertex_budget), TEST(test_null_displacement), TEST(test_default_light),
-          TEST(test_convert), TEST(test_bad_scene_file), TEST(test_frames_and_crop),
-          TEST(test_background_imager))
+          TEST(test_render_obj), TEST(test_rib_grid_size), TEST(test_spp_over_file_sampling),
+          TEST(test_rib_opacity_cache_memory), TEST(test_vertex_budget),
+          TEST(test_null_displacement), TEST(test_default_light), TEST(test_convert),
+          TEST(test_bad_scene_file), TEST(test_frames_and_crop), TEST(test_background_imager))
