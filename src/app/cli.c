@@ -47,6 +47,9 @@ static const char render_options[] =
     "                          0.02)\n"
     "  --clamp V               scale each camera sample down so no component exceeds V\n"
     "                          (fewer fireflies, biased darker; default 0: off)\n"
+    "  --png-curve srgb|linear PNG colour: the sRGB curve, or values as they are\n"
+    "                          (RenderMan's 8-bit files; default: RIB files before\n"
+    "                          RenderMan 19 linear, others sRGB)\n"
     "  --threads N             worker threads (default: all cores)\n"
     "  --bounces N             maximum diffuse depth (default 1)\n"
     "  --quality Q             preview (4 shadow, 4 diffuse rays), final (64; 1024 at\n"
@@ -361,6 +364,10 @@ void parse_args(int argc, char **argv, Args *a)
         } else if (strcmp(o, "--adaptive-error") == 0) {
             opt->adaptive_error = parse_float(o, v, 1e-6f, 1e6f);
             a->set |= SET_ADAPTIVE_ERROR;
+        } else if (strcmp(o, "--png-curve") == 0) {
+            if (strcmp(v, "srgb") != 0 && strcmp(v, "linear") != 0)
+                die_usage("--png-curve: expected srgb or linear, found \"%s\"", v);
+            a->png_curve = v[0] == 's' ? IO_CURVE_SRGB : IO_CURVE_LINEAR;
         } else if (strcmp(o, "--clamp") == 0) {
             opt->sample_clamp = parse_float(o, v, 0.0f, 1e30f);
             a->set |= SET_CLAMP;
@@ -569,10 +576,11 @@ RayesError default_light(const Args *a, RayesScene *scene)
     if (e != RAYES_OK)
         return e;
     static const float identity[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
-    RayesParam p[2] = {{"from", RAYES_PARAM_COLOR, {0, 0, 0}, NULL},
-                       {"to", RAYES_PARAM_COLOR, {z[0], z[1], z[2]}, NULL}};
+    RayesParam p[3] = {{"from", RAYES_PARAM_COLOR, {0, 0, 0}, NULL},
+                       {"to", RAYES_PARAM_COLOR, {z[0], z[1], z[2]}, NULL},
+                       {"intensity", RAYES_PARAM_FLOAT, {(float)M_PI, 0, 0}, NULL}}; /* Cs */
     if ((e = rayes_scene_set_transform(scene, identity)) == RAYES_OK)
-        e = rayes_scene_light(scene, "distantlight", p, 2);
+        e = rayes_scene_light(scene, "distantlight", p, 3);
     if (e == RAYES_OK && !a->quiet)
         fprintf(stderr, "rayes: note: %s: the scene has no lights; a headlight was added\n",
                 a->scene);

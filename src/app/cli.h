@@ -53,6 +53,7 @@ typedef struct Args {
     const char *shader_path;    /* --shader-path: put before the scene's own shader path */
     int quiet;
     int default_light;          /* --default-light: a headlight for a scene without lights */
+    int png_curve;              /* --png-curve: IO_CURVE_*, IO_CURVE_UNSAID: the scene file's */
     RayesRenderOptions opt;
     /* rayes view */
     int view;                   /* set before parse_args: the view options are accepted */

@@ -266,7 +266,8 @@ static void apply_exposure(RayesImage *img, float gain, float gamma)
 
 /* An image's pixels as written: a crop window's alone in a PNG; in an
  * EXR the crop is the data window of the whole display window. */
-static RayesError write_output(const Output *o, const RayesImage *img, char *err, size_t n)
+static RayesError write_output(const Output *o, const RayesImage *img, int linear, char *err,
+                               size_t n)
 {
     int win[4] = {0, 0, img->width, img->height};
     if (img->crop[2] > 0)
@@ -274,7 +275,7 @@ static RayesError write_output(const Output *o, const RayesImage *img, char *err
     if (o->format != IMAGE_FORMAT_PNG)
         return image_write_exr_window(o->path, img->width, img->height, img->rgba, win, err, n);
     if (win[2] == img->width && win[3] == img->height)
-        return image_write_png(o->path, img->width, img->height, img->rgba, err, n);
+        return image_write_png_curve(o->path, img->width, img->height, img->rgba, linear, err, n);
     float *crop = malloc(sizeof(float) * 4 * (size_t)win[2] * (size_t)win[3]);
     if (!crop) {
         snprintf(err, n, "%s: out of memory", o->path);
@@ -284,7 +285,7 @@ static RayesError write_output(const Output *o, const RayesImage *img, char *err
         memcpy(crop + 4 * (size_t)y * (size_t)win[2],
                img->rgba + 4 * ((size_t)(win[1] + y) * (size_t)img->width + (size_t)win[0]),
                sizeof(float) * 4 * (size_t)win[2]);
-    RayesError e = image_write_png(o->path, win[2], win[3], crop, err, n);
+    RayesError e = image_write_png_curve(o->path, win[2], win[3], crop, linear, err, n);
     free(crop);
     return e;
 }
@@ -525,7 +526,9 @@ static int render_job(Args a, int frame, int number, Distributed *d)
         img->rgba[4 * i + 3] = 1.0f; /* a pbrt film: no alpha, the environment opaque */
     int written = 0; /* outputs written whole */
     while (written < a.n_outputs && status == 0) {
-        if (write_output(&a.outputs[written], img, err, sizeof err) == RAYES_OK) {
+        int curve = a.png_curve != IO_CURVE_UNSAID ? a.png_curve : settings.png_curve;
+        if (write_output(&a.outputs[written], img, curve == IO_CURVE_LINEAR, err, sizeof err) ==
+            RAYES_OK) {
             written++;
         } else {
             fprintf(stderr, "rayes: %s\n", err);

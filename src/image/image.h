@@ -43,6 +43,12 @@ RayesError image_write_exr_window(const char *path, int width, int height, const
 RayesError image_write_png(const char *path, int width, int height, const float *rgba,
                         char *err, size_t err_size);
 
+/* The same, or with linear 1 the values quantized as they are (clamped to
+ * [0, 1]) with no colour chunk: what RenderMan writes to 8 bits, its
+ * Exposure gamma the only curve. */
+RayesError image_write_png_curve(const char *path, int width, int height, const float *rgba,
+                                 int linear, char *err, size_t err_size);
+
 /* Dispatch on the extension; an unknown extension is INVALID_ARGUMENT. */
 RayesError image_write(const char *path, int width, int height, const float *rgba,
                           char *err, size_t err_size);

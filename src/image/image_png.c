@@ -5,6 +5,8 @@
  * values clamped to [0, 1] (NaN becomes 0); alpha is stored linearly, as
  * PNG requires. The file carries an sRGB chunk, with the gAMA and cHRM
  * chunks that the PNG specification asks for beside it for older readers.
+ * image_write_png_curve can instead quantize the values as they are, with
+ * no colour chunk (RenderMan's 8-bit files: its Exposure is the curve).
  *
  * Reading: any PNG (palette, grey, 1 to 16 bits, interlaced, with or
  * without alpha or tRNS) is converted by libpng to 8-bit RGBA, then colour
@@ -53,6 +55,7 @@ typedef struct PngIo {
 typedef struct PngImage {
     int width, height; /* pixels */
     const float *rgba; /* width * height * 4, top row first */
+    int linear;        /* 1: values quantized as they are, no colour chunk */
 } PngImage;
 
 /* ------------------------------------------------------------ callbacks */
@@ -147,13 +150,15 @@ static int write_png_all(png_structp png, png_infop info, const PngImage *image,
     png_set_IHDR(png, info, (png_uint_32)image->width, (png_uint_32)image->height, 8,
                  PNG_COLOR_TYPE_RGB_ALPHA, PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT,
                  PNG_FILTER_TYPE_DEFAULT);
-    png_set_sRGB_gAMA_and_cHRM(png, info, PNG_sRGB_INTENT_PERCEPTUAL);
+    if (!image->linear)
+        png_set_sRGB_gAMA_and_cHRM(png, info, PNG_sRGB_INTENT_PERCEPTUAL);
     png_write_info(png, info);
     for (int y = 0; y < image->height; y++) {
         const float *src = image->rgba + (size_t)y * (size_t)image->width * 4;
         for (int x = 0; x < image->width; x++) {
             for (int c = 0; c < 3; c++)
-                row[4 * x + c] = encode_srgb8(src[4 * x + c]);
+                row[4 * x + c] =
+                    image->linear ? encode_linear8(src[4 * x + c]) : encode_srgb8(src[4 * x + c]);
             row[4 * x + 3] = encode_linear8(src[4 * x + 3]);
         }
         png_write_row(png, row);
@@ -192,12 +197,18 @@ static RayesError write_png_body(FILE *file, const char *path, const void *data,
 RayesError image_write_png(const char *path, int width, int height, const float *rgba, char *err,
                         size_t err_size)
 {
+    return image_write_png_curve(path, width, height, rgba, 0, err, err_size);
+}
+
+RayesError image_write_png_curve(const char *path, int width, int height, const float *rgba,
+                                 int linear, char *err, size_t err_size)
+{
     if (!path || !rgba || width <= 0 || height <= 0) {
         image_set_error(err, err_size, "%s: cannot write PNG: invalid arguments (%d x %d pixels%s)",
                      path ? path : "(null)", width, height, rgba ? "" : ", no pixels");
         return RAYES_ERROR_INVALID_ARGUMENT;
     }
-    PngImage image = {width, height, rgba};
+    PngImage image = {width, height, rgba, linear != 0};
     return image_write_via_temp(path, write_png_body, &image, err, err_size);
 }
 

@@ -1069,7 +1069,7 @@ static RayesError emit_camera(Emit *e, int light)
     const RayesParam p[3] = {
         {"from", RAYES_PARAM_COLOR, {c[0] - d, c[1] + d, c[2] + d}, NULL},
         {"to", RAYES_PARAM_COLOR, {c[0], c[1], c[2]}, NULL},
-        {"intensity", RAYES_PARAM_FLOAT, {1, 0, 0}, NULL},
+        {"intensity", RAYES_PARAM_FLOAT, {(float)M_PI, 0, 0}, NULL}, /* facing: Cs */
     };
     res = e->sink->light(e->sink->target, "distantlight", p, 3);
     return res == RAYES_OK ? RAYES_OK : sink_fail(e, res, "the default light");

@@ -1042,7 +1042,7 @@ RayesError io_rib_parse(const char *name, const unsigned char *data, size_t size
                  frame);
         e = -1;
     }
-    int lit = r.lit;
+    int lit = r.lit, ris = r.ris;
     rib_fini(&r);
     if (e == 0) { /* pass 2: the selected frame into the sink */
         rib_init(&r, 2, sink, options, settings, err, err_size);
@@ -1052,6 +1052,11 @@ RayesError io_rib_parse(const char *name, const unsigned char *data, size_t size
         e = run(&r, name, data, size);
         if (e == 0 && r.n_lights > 0)
             e = rib_flush_lights(&r); /* a file without WorldEnd */
+        /* 8-bit files as RenderMan writes them (its Exposure the only
+         * curve), unless the file says otherwise or is RenderMan 19's or
+         * later (physically based, seen through sRGB) */
+        if (settings->png_curve == IO_CURVE_UNSAID)
+            settings->png_curve = ris ? IO_CURVE_SRGB : IO_CURVE_LINEAR;
         rib_fini(&r);
     }
     free(inflated);

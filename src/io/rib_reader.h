@@ -221,6 +221,7 @@ typedef struct Rib {
     size_t world_depth;    /* the attribute stack's depth at WorldBegin */
     double nurbs_work;     /* the NuPatch and trim work of the pass (rib_nurbs.c) */
     int lit;               /* a light was made (pass 1: anywhere in the file) */
+    int ris;               /* a RenderMan 19+ request was read (Bxdf, Light, Integrator) */
     int unlit_file;        /* pass 2: the file makes no light, so geometry without a
                               Surface is drawn with RenderMan's defaultsurface */
 

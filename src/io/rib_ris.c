@@ -212,6 +212,7 @@ static const char *class_and_params(Rib *r, const Args *a, const char *what, Par
 
 static int h_bxdf(Rib *r, const Args *a)
 {
+    r->ris = 1;
     Param *p;
     size_t n;
     const char *cls = class_and_params(r, a, "a Bxdf class", &p, &n);
@@ -376,6 +377,7 @@ static int make_light(Rib *r, const char *handle, const char *cls, const float L
 /* Light "class" "handle" params (RenderMan 21 and later). */
 static int h_light(Rib *r, const Args *a)
 {
+    r->ris = 1;
     size_t i = 0;
     const char *cls = rib_get_string(r, a, &i, "a light class");
     char handle[RIB_MAX_HANDLE];
@@ -446,6 +448,7 @@ enum { RIS_DIFFUSE_BOUNCES = 8 };
 
 static int h_integrator(Rib *r, const Args *a)
 {
+    r->ris = 1;
     Param *p;
     size_t n;
     const char *cls = class_and_params(r, a, "an integrator class", &p, &n);

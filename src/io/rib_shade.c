@@ -607,6 +607,11 @@ void rib_light_param(Light *L, const char *name, RayesParamType type, const floa
     L->n++;
 }
 
+static int intensity(const Param *q)
+{
+    return strcmp(q->d.name, "intensity") == 0;
+}
+
 static int h_light_source(Rib *r, const Args *a)
 {
     size_t i = 0;
@@ -631,9 +636,9 @@ static int h_light_source(Rib *r, const Args *a)
     }
     const char *type = NULL;
     int spot = 0;
-    if (strcmp(name, "pointlight") == 0)
+    if (strcmp(name, "pointlight") == 0 || strcmp(name, "shadowpoint") == 0)
         type = "pointlight";
-    else if (strcmp(name, "distantlight") == 0)
+    else if (strcmp(name, "distantlight") == 0 || strcmp(name, "shadowdistant") == 0)
         type = "distantlight";
     else if (strcmp(name, "spotlight") == 0 || strcmp(name, "shadowspot") == 0)
         type = "spotlight", spot = 1;
@@ -686,6 +691,17 @@ static int h_light_source(Rib *r, const Args *a)
         "width",          "height",           "radius",     NULL};
     int env = strcmp(type, "environmentlight") == 0;
     int mapped = strcmp(type, "pointlight") == 0 || strcmp(type, "spotlight") == 0;
+    /* RenderMan's point, spot and distant lights: diffuse() sums Cl (L.N)
+     * with no 1/pi, so their intensity is pi times rayes' (DESIGN.md,
+     * "Lights"); the default intensity 1 too */
+    int unit = mapped || strcmp(type, "distantlight") == 0;
+    if (unit && !rib_find_param(p, n, "intensity")) {
+        RayesParam *o = &L->params[L->n];
+        snprintf(L->names[L->n], sizeof L->names[0], "intensity");
+        *o =
+            (RayesParam){.name = L->names[L->n], .type = RAYES_PARAM_FLOAT, .value = {(float)M_PI}};
+        L->n++;
+    }
     for (size_t k = 0; k < n && L->n < RIB_LIGHT_PARAMS; k++) {
         const Param *q = &p[k];
         /* a map: a point or spot light's intensity by direction (rayes'
@@ -728,10 +744,10 @@ static int h_light_source(Rib *r, const Args *a)
         } else if (q->v->n == 3) {
             o->type = RAYES_PARAM_COLOR;
             for (int c = 0; c < 3; c++)
-                o->value[c] = (float)q->v->d[c];
+                o->value[c] = (float)(q->v->d[c] * (unit && intensity(q) ? M_PI : 1.0));
         } else if (q->v->n == 1) {
             o->type = RAYES_PARAM_FLOAT;
-            o->value[0] = (float)q->v->d[0];
+            o->value[0] = (float)(q->v->d[0] * (unit && intensity(q) ? M_PI : 1.0));
             if (spot && (strcmp(q->d.name, "coneangle") == 0 ||
                          strcmp(q->d.name, "conedeltaangle") == 0))
                 o->value[0] = (float)(o->value[0] * 180 / M_PI); /* RenderMan gives radians */

@@ -916,6 +916,16 @@ static int h_option_attribute(Rib *r, const Args *a)
                 e = rib_error(r, "Option \"shutter\" \"offset\": expected a finite time");
             else
                 r->shutter_offset = (float)q->v->d[0];
+        } else if (option && strcmp(group, "rayes") == 0 && strcmp(q->d.name, "pngcurve") == 0 &&
+                   q->d.ty == TY_STRING && q->v->n == 1) {
+            const char *c = q->v->s[0];
+            if (strcmp(c, "srgb") != 0 && strcmp(c, "linear") != 0)
+                e = rib_error(r,
+                              "Option \"rayes\" \"pngcurve\": expected \"srgb\" or "
+                              "\"linear\", found \"%s\"",
+                              c);
+            else
+                r->settings->png_curve = c[0] == 's' ? IO_CURVE_SRGB : IO_CURVE_LINEAR;
         } else if (!option && strcmp(group, "identifier") == 0) {
             /* names are for messages only */
         } else if (!(!option && strcmp(group, "displacementbound") == 0)) {

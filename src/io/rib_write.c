@@ -1262,6 +1262,12 @@ static RayesError w_light(void *t, const char *type, const RayesParam *p, size_t
      * degrees: they are written apart, in radians to 17 digits, so the
      * reader's conversion back gives the same float. */
     int spot = strcmp(type, "spotlight") == 0;
+    /* RenderMan's point, spot and distant lights are pi times as intense
+     * as rayes' (the reader's conversion): written apart, to 17 digits,
+     * always (the default 1 too) */
+    int unit = spot || strcmp(type, "pointlight") == 0 || strcmp(type, "distantlight") == 0;
+    double I[3] = {1.0, 1.0, 1.0};
+    int I_color = 0;
     RayesParam rest[64];
     double angle[2] = {-1.0, -1.0};
     size_t n_rest = 0;
@@ -1270,7 +1276,12 @@ static RayesError w_light(void *t, const char *type, const RayesParam *p, size_t
                 : strcmp(p[i].name, "coneangle") == 0                 ? 0
                 : strcmp(p[i].name, "conedeltaangle") == 0            ? 1
                                                                       : -1;
-        if (k >= 0)
+        if (unit && p[i].name && strcmp(p[i].name, "intensity") == 0 &&
+            (p[i].type == RAYES_PARAM_FLOAT || p[i].type == RAYES_PARAM_COLOR)) {
+            I_color = p[i].type == RAYES_PARAM_COLOR;
+            for (int c = 0; c < 3; c++)
+                I[c] = p[i].value[I_color ? c : 0];
+        } else if (k >= 0)
             angle[k] = (double)p[i].value[0] * M_PI / 180.0;
         else if (n_rest < sizeof rest / sizeof rest[0])
             rest[n_rest++] = p[i];
@@ -1288,6 +1299,11 @@ static RayesError w_light(void *t, const char *type, const RayesParam *p, size_t
         for (int k = 0; k < 2; k++)
             if (angle[k] >= 0.0)
                 fprintf(w->world.f, " \"float %s\" [%.17g]", angle_names[k], angle[k]);
+        if (unit && I_color)
+            fprintf(w->world.f, " \"color intensity\" [%.17g %.17g %.17g]", I[0] / M_PI,
+                    I[1] / M_PI, I[2] / M_PI);
+        else if (unit)
+            fprintf(w->world.f, " \"float intensity\" [%.17g]", I[0] / M_PI);
         fprintf(w->world.f, "\n");
         if (h < 4097 && !w_linked(w, (size_t)h - 1)) {
             fprintf(w->world.f, "Illuminate %d 0\n", h);
@@ -1501,6 +1517,9 @@ static void settings_rib(FILE *f, const IoSettings *s)
                 (double)s->background[0], (double)s->background[1], (double)s->background[2]);
     if (s->exposure_gain != 1.0f || s->exposure_gamma != 1.0f)
         fprintf(f, "Exposure %.9g %.9g\n", (double)s->exposure_gain, (double)s->exposure_gamma);
+    /* the curve always: a RIB file without it is read as RenderMan's */
+    fprintf(f, "Option \"rayes\" \"string pngcurve\" [\"%s\"]\n",
+            s->png_curve == IO_CURVE_LINEAR ? "linear" : "srgb");
     if (s->crop[0] != 0.0f || s->crop[1] != 1.0f || s->crop[2] != 0.0f || s->crop[3] != 1.0f)
         fprintf(f, "CropWindow %.9g %.9g %.9g %.9g\n", (double)s->crop[0], (double)s->crop[1],
                 (double)s->crop[2], (double)s->crop[3]);

@@ -169,9 +169,14 @@ typedef struct IoSettings {
                                  composited over, before exposure; [3] 1 when given */
     int opaque;               /* 1: the format's films have no alpha (pbrt): images are
                                  written with alpha 1, the environment seen as pbrt shows it */
+    int png_curve;            /* 8-bit files: IO_CURVE_SRGB (also 0, unsaid) or
+                                 IO_CURVE_LINEAR (RenderMan's: values quantized as they are,
+                                 after its Exposure) */
     IoDisplay displays[IO_MAX_DISPLAYS];
     int n_displays;
 } IoSettings;
+
+enum { IO_CURVE_UNSAID, IO_CURVE_SRGB, IO_CURVE_LINEAR };
 
 void io_settings_init(IoSettings *settings);
 

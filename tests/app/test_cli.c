@@ -475,6 +475,39 @@ static void test_spp_over_file_sampling(void)
     CHECK(camera > 1024); /* the file's: 4 a pixel, more at the sphere's edge */
 }
 
+/* --png-curve: a classic RIB file's PNG is RenderMan's (linear) unless
+ * the command line asks for sRGB, which lifts a mid grey. */
+static void test_png_curve(void)
+{
+    static Run r;
+    setup();
+    write_text(SCRATCH_DIR "/grey.rib", "Projection \"perspective\" \"fov\" 10\n"
+                                        "WorldBegin\nLightSource \"ambientlight\" 1 "
+                                        "\"intensity\" 0.25\nSurface \"matte\"\n"
+                                        "Translate 0 0 5\nSphere 1 -1 1 360\nWorldEnd\n");
+    float *px[2] = {NULL, NULL};
+    const char *curve[2] = {"linear", "srgb"};
+    for (int k = 0; k < 2; k++) {
+        char out[256], err[256];
+        snprintf(out, sizeof out, SCRATCH_DIR "/grey-%s.png", curve[k]);
+        run(&r, NULL,
+            k == 0 ? ARGS("render", SCRATCH_DIR "/grey.rib", "--res", "8", "--spp", "1", "--quiet",
+                          "--bounces", "0", "-o", out)
+                   : ARGS("render", SCRATCH_DIR "/grey.rib", "--res", "8", "--spp", "1", "--quiet",
+                          "--bounces", "0", "--png-curve", "srgb", "-o", out));
+        CHECK(r.status == 0);
+        int w, h;
+        CHECK(image_read_png(out, &w, &h, &px[k], err, sizeof err) == RAYES_OK);
+    }
+    /* read back as sRGB: the linear file's 64 is 0.0513, the sRGB one's 0.25 */
+    CHECK(px[0] && fabsf(px[0][4 * (4 * 8 + 4)] - 0.0513f) < 0.002f);
+    CHECK(px[1] && fabsf(px[1][4 * (4 * 8 + 4)] - 0.25f) < 0.003f);
+    free(px[0]);
+    free(px[1]);
+    expect_error(2, NULL, ARGS("render", "--png-curve", "log"),
+                 (const char *const[]){"--png-curve", NULL});
+}
+
 /* RIB's Option "limits" "opacitycachememory" (KB) sets the opacity
  * entries' budget unless --opacity-cache-mb says otherwise. */
 static void test_rib_opacity_cache_memory(void)
@@ -762,6 +795,6 @@ TEST_MAIN(TEST(test_version_and_help), TEST(test_no_arguments), TEST(test_usage_
           TEST(test_missing_data), TEST(test_render_outputs), TEST(test_render_summary),
           TEST(test_data_from_environment), TEST(test_unwritable_output), TEST(test_shader_path),
           TEST(test_render_obj), TEST(test_rib_grid_size), TEST(test_spp_over_file_sampling),
-          TEST(test_rib_opacity_cache_memory), TEST(test_vertex_budget),
+          TEST(test_png_curve), TEST(test_rib_opacity_cache_memory), TEST(test_vertex_budget),
           TEST(test_null_displacement), TEST(test_default_light), TEST(test_convert),
           TEST(test_bad_scene_file), TEST(test_frames_and_crop), TEST(test_background_imager))

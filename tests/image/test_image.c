@@ -644,7 +644,38 @@ static void test_concurrent_writes(void)
     }
 }
 
+/* RenderMan's 8-bit files: values quantized as they are, no sRGB chunk
+ * (read back, the bytes pass through the sRGB decoding every PNG gets). */
+static void test_png_linear_curve(void)
+{
+    static const float rgba[2 * 4] = {0.5f, 0.25f, 1.5f, 1.0f, -1.0f, 0.0031308f, 1.0f, 0.5f};
+    char path[512], err[512] = "";
+    scratch(path, sizeof path, "linear.png");
+    CHECK(image_write_png_curve(path, 2, 1, rgba, 1, err, sizeof err) == RAYES_OK);
+    FILE *f = fopen(path, "rb");
+    unsigned char bytes[4096];
+    size_t n = f ? fread(bytes, 1, sizeof bytes, f) : 0;
+    if (f)
+        fclose(f);
+    int srgb_chunk = 0;
+    for (size_t i = 0; i + 4 <= n; i++)
+        srgb_chunk |= memcmp(bytes + i, "sRGB", 4) == 0 || memcmp(bytes + i, "gAMA", 4) == 0;
+    CHECK(n > 0 && !srgb_chunk);
+    int w = 0, h = 0;
+    float *back = NULL;
+    CHECK(image_read_png(path, &w, &h, &back, err, sizeof err) == RAYES_OK);
+    /* 0.5 was stored as 128, which the reader takes for sRGB: 0.2158 */
+    CHECK(back && fabsf(back[0] - 0.21586f) < 1e-3f && back[2] == 1.0f && back[4] == 0.0f);
+    CHECK(back && fabsf(back[7] - 128.0f / 255.0f) < 1e-6f); /* alpha linear as always */
+    free(back);
+    CHECK(image_write_png_curve(path, 2, 1, rgba, 0, err, sizeof err) == RAYES_OK);
+    CHECK(image_read_png(path, &w, &h, &back, err, sizeof err) == RAYES_OK);
+    CHECK(back && fabsf(back[0] - 0.5f) < 3e-3f); /* the sRGB curve both ways */
+    free(back);
+}
+
 TEST_MAIN(TEST(test_exr_round_trip), TEST(test_exr_header), TEST(test_exr_reads_other_layouts),
-          TEST(test_png_round_trip), TEST(test_png_reads_grey), TEST(test_format_dispatch),
-          TEST(test_bad_arguments), TEST(test_missing_directory), TEST(test_read_bad_files),
-          TEST(test_failed_write_keeps_target), TEST(test_concurrent_writes))
+          TEST(test_png_round_trip), TEST(test_png_linear_curve), TEST(test_png_reads_grey),
+          TEST(test_format_dispatch), TEST(test_bad_arguments), TEST(test_missing_directory),
+          TEST(test_read_bad_files), TEST(test_failed_write_keeps_target),
+          TEST(test_concurrent_writes))

@@ -656,8 +656,8 @@ static void test_handles(void)
                       "Polygon \"P\" [0 0 0 1 0 0 1 1 0]\nIlluminate 1 0\n"
                       "Polygon \"P\" [0 0 0 1 0 0 1 1 0]")) == RAYES_OK);
     CHECK(rec.lights == 2);
-    CHECK_NEAR(rec.light_params[0][0], 2, 0);
-    CHECK_NEAR(rec.light_params[1][0], 3, 0);
+    CHECK_NEAR(rec.light_params[0][0], (float)(2 * M_PI), 0); /* RenderMan's units: pi */
+    CHECK_NEAR(rec.light_params[1][0], (float)(3 * M_PI), 0);
     CHECK(rec.links_mode == RAYES_LIGHT_LINKS_EXCEPT && rec.n_links == 1 && rec.links[0] == 1);
     /* The same after geometry saw the first, and for string handles */
     CHECK(parse(WORLD("LightSource \"pointlight\" \"key\"\nPolygon \"P\" [0 0 0 1 0 0 1 1 0]\n"

@@ -3,8 +3,11 @@
  * rib_shade.c, rib_prim.c): requests RenderMan accepts that used to stop
  * a file (GeometricRepresentation, Illuminate of a light that was
  * skipped, Hider counts of 0, ri.h's "wrap" and "nowrap", RenderMan 20's
- * Procedural2 "DelayedReadArchive2").
+ * Procedural2 "DelayedReadArchive2"); the classic lights' units (matte
+ * facing a pointlight of intensity 16 at 4 units shades to exactly Cs, as
+ * diffuse() has no 1/pi).
  */
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -86,4 +89,62 @@ static void test_procedural2(void)
     remove(path);
 }
 
-TEST_MAIN(TEST(test_requests_renderman_accepts), TEST(test_procedural2))
+/* The centre pixel of a RIB file rendered at 8 x 8, no bounces. */
+static float centre(const char *text)
+{
+    RayesScene *s = rayes_scene_new();
+    IoSink sink = io_sink_scene(s);
+    IoSettings st;
+    io_settings_init(&st);
+    IoReadOptions opt = {NULL, -1};
+    float v = NAN;
+    RayesRenderOptions o;
+    rayes_render_options_init(&o, RAYES_QUALITY_PREVIEW);
+    o.width = o.height = 8, o.spp = 4, o.bounces = 0, o.threads = 1;
+    RayesImage *img = NULL;
+    if (io_rib_parse("t.rib", (const unsigned char *)text, strlen(text), &sink, &opt, &st, err,
+                     sizeof err) == RAYES_OK &&
+        rayes_scene_commit(s) == RAYES_OK && rayes_render(s, &o, &img, NULL) == RAYES_OK)
+        v = img->rgba[4 * (4 * 8 + 4)];
+    rayes_image_free(img);
+    rayes_scene_release(s);
+    return v;
+}
+
+/* RenderMan's point, spot and distant lights: intensity over distance
+ * squared times (L.N), no 1/pi (diffuse() in the RI spec); an
+ * ambientlight's intensity is ambient() itself. */
+static void test_classic_light_units(void)
+{
+#define LIT(light)                                                                                 \
+    "Projection \"perspective\" \"fov\" 10\nWorldBegin\n" light "\n"                               \
+    "Surface \"matte\"\nTranslate 0 0 5\nSphere 1 -1 1 360\nWorldEnd\n"
+    CHECK_NEAR(centre(LIT("LightSource \"pointlight\" 1 \"intensity\" 16")), 1.0, 0.01);
+    CHECK_NEAR(centre(LIT("LightSource \"pointlight\" 1")), 1.0 / 16, 0.001); /* default 1 */
+    CHECK_NEAR(centre(LIT("LightSource \"distantlight\" 1 \"intensity\" 0.5")), 0.5, 0.01);
+    CHECK_NEAR(centre(LIT("LightSource \"spotlight\" 1 \"intensity\" 8 \"to\" [0 0 1]")), 0.5,
+               0.01);
+    CHECK_NEAR(centre(LIT("LightSource \"ambientlight\" 1 \"intensity\" 0.25")), 0.25, 0.001);
+#undef LIT
+}
+
+/* 8-bit files: classic RIB files as RenderMan writes them (linear, its
+ * Exposure the curve); RenderMan 19's and later through sRGB; the file's
+ * own Option "rayes" "pngcurve" over both. */
+static void test_png_curve(void)
+{
+    CHECK(rib(WORLD(DISTANT QUAD)) == RAYES_OK && settings.png_curve == IO_CURVE_LINEAR);
+    CHECK(rib(WORLD("Bxdf \"PxrDiffuse\" \"d\"\n" DISTANT QUAD)) == RAYES_OK &&
+          settings.png_curve == IO_CURVE_SRGB);
+    CHECK(rib("Option \"rayes\" \"string pngcurve\" [\"srgb\"]\n" WORLD(DISTANT QUAD)) ==
+              RAYES_OK &&
+          settings.png_curve == IO_CURVE_SRGB);
+    CHECK(rib("Option \"rayes\" \"string pngcurve\" [\"linear\"]\n" WORLD(
+              "Bxdf \"PxrDiffuse\" \"d\"\n" QUAD)) == RAYES_OK &&
+          settings.png_curve == IO_CURVE_LINEAR);
+    CHECK(rib("Option \"rayes\" \"string pngcurve\" [\"log\"]\n" WORLD(QUAD)) != RAYES_OK);
+    CHECK(strstr(err, "pngcurve") != NULL);
+}
+
+TEST_MAIN(TEST(test_requests_renderman_accepts), TEST(test_procedural2),
+          TEST(test_classic_light_units), TEST(test_png_curve))

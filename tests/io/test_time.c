@@ -347,7 +347,7 @@ static void test_rib_moving_light(void)
 {
     const char *fmt = "%sShutter 0 1\nTranslate 0 0 5\nWorldBegin\nTransformBegin\n"
                       "MotionBegin [0 1]\nTranslate %s 0 -1\nTranslate %s 0 -1\nMotionEnd\n"
-                      "LightSource \"pointlight\" 1 \"intensity\" [3.14159]\nTransformEnd\n"
+                      "LightSource \"pointlight\" 1 \"intensity\" [1]\nTransformEnd\n"
                       "Surface \"matte\"\n"
                       "Patch \"bilinear\" \"P\" [-4 -4 0 4 -4 0 -4 4 0 4 4 0]\nWorldEnd\n";
     char text[4][2048];
