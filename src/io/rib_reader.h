@@ -120,6 +120,7 @@ typedef struct Attr {
     char area_map[256]; /* its environment map (RenderMan 19-20's envsphere), or "" */
     const struct TrimSet *trim; /* TrimCurve in force (rib_nurbs.c), or NULL */
     int area_normalize;         /* its areaNormalize (RenderMan 19-20's geometry lights) */
+    int area_unseen;            /* its rman__LightPrimaryVisibility 0: the camera sees none */
     int trim_outside;           /* Attribute "trimcurve" "sense" "outside": the loops'
                                    outsides are cut away, not their insides */
     float ubasis[16], vbasis[16];

@@ -405,6 +405,12 @@ static int h_light(Rib *r, const Args *a)
         Light *l = &r->lights[r->n_lights - 1];
         l->own_visibility = 1;
         l->visibility = r->a.camera_said ? r->a.visibility : r->a.visibility & ~RAYES_RAY_CAMERA;
+    } else if (e > 0 && strcmp(cls, "PxrDomeLight") == 0) {
+        /* the dome: the background the camera sees unless the attributes
+         * hide it ("visibility" "camera" 0) */
+        Light *l = &r->lights[r->n_lights - 1];
+        l->own_visibility = 1;
+        l->visibility = r->a.visibility;
     }
     return e < 0 ? -1 : 0;
 }
@@ -433,10 +439,10 @@ int rib_ris_geometry_light(Rib *r, const char *name)
     char handle[RIB_MAX_HANDLE];
     snprintf(handle, sizeof handle, "@area%zu", r->n_lights);
     int e = make_light(r, handle, cls, r->a.area_L, r->a.area_normalize, 0.53f, r->a.area_map);
-    if (e > 0 && strcmp(cls, "PxrDomeLight") != 0) { /* seen as the attributes say */
+    if (e > 0) { /* seen as the attributes say, and the envsphere's primary visibility */
         Light *l = &r->lights[r->n_lights - 1];
         l->own_visibility = 1;
-        l->visibility = r->a.visibility;
+        l->visibility = r->a.visibility & (r->a.area_unseen ? ~(uint32_t)RAYES_RAY_CAMERA : ~0u);
     }
     return e < 0 ? -1 : 1;
 }

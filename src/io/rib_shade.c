@@ -681,7 +681,8 @@ static int h_light_source(Rib *r, const Args *a)
         free(p);
         return -1;
     }
-    if (strcmp(type, "arealight") == 0) { /* its shape is seen as the attributes say */
+    if (strcmp(type, "arealight") == 0 || strcmp(type, "environmentlight") == 0) {
+        /* its shape, or the background, is seen as the attributes say */
         L->own_visibility = 1;
         L->visibility = r->a.visibility;
     }
@@ -802,6 +803,8 @@ static int h_area_light(Rib *r, const Args *a)
             (in_list(environment_maps, p[k].d.name) || strcmp(p[k].d.name, "rman__EnvMap") == 0 ||
              strcmp(p[k].d.name, "lightcolormap") == 0))
             snprintf(r->a.area_map, sizeof r->a.area_map, "%s", p[k].v->s[0]);
+    const Param *pv = rib_find_param(p, n, "rman__LightPrimaryVisibility");
+    r->a.area_unseen = pv && rib_is_num(pv->v) && pv->v->n == 1 && pv->v->d[0] == 0;
     const Param *ts = rib_find_param(p, n, "twosided");
     r->a.area_twosided = ts && rib_is_num(ts->v) && ts->v->n == 1 && ts->v->d[0] != 0;
     r->lit = 1;

@@ -296,7 +296,9 @@ static Vec3 trace_layers(Worker *w, const Ray *ray, uint32_t kind, int diffuse_d
         Vec3 L = v3(0, 0, 0);
         int sees_lights = !(kind & (RAYES_RAY_DIFFUSE | PATH_RAY_GLOSSY));
         for (size_t k = 0; sees_lights && k < w->rs->n_lights; k++)
-            if (w->rs->lights[k].type == LIGHT_ENVIRONMENT) {
+            if (w->rs->lights[k].type == LIGHT_ENVIRONMENT &&
+                (w->rs->lights[k].seen_by &
+                 (kind & RAYES_RAY_CAMERA ? RAYES_RAY_CAMERA : RAYES_RAY_SPECULAR))) {
                 Light moved; /* a turning map: its rotation at the ray's time */
                 L = v3_add(L, light_env_radiance(light_at_time(&w->rs->lights[k], ray->time,
                                                                &moved),

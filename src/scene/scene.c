@@ -1659,6 +1659,7 @@ RayesError rayes_scene_light(RayesScene *s, const char *type, const RayesParam *
         return push_light(s, &l, NULL, 0);
     case 4: {
         l.type = LIGHT_ENVIRONMENT;
+        l.seen_by = s->current_visibility;
         e = light_map(s, type, &lp, m, &l);
         if (e == RAYES_OK)
             e = push_light(s, &l, NULL, 0);

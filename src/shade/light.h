@@ -128,6 +128,8 @@ typedef struct Light {
     int emitter;        /* mesh: the scene object camera rays see it as (its own
                            Embree scene answers a BSDF direction: light_mesh_finish) */
     char category[LIGHT_CATEGORY_MAX]; /* comma-separated names */
+    uint32_t seen_by; /* environment: the RayesRayType bits of the rays that see it as
+                         the background (the visibility when it was made) */
     /* A light moving within the frame (made under a moving transform):
      * where it is at time t is the light above (at time[0]) moved by delta
      * blended linearly between the samples around t (light_at_time). */

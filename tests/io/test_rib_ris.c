@@ -370,5 +370,47 @@ static void test_rendered(void)
     rayes_image_free(tex);
 }
 
+/* A dome (RenderMan 21's Light, RenderMan 20's envsphere) is the
+ * background the camera sees, unless the attributes hide it; hidden, it
+ * still lights; written and read back, it stays hidden. */
+static void test_dome_visibility(void)
+{
+#define DOME_SCENE(attr, light)                                                                    \
+    "Projection \"perspective\" \"fov\" [40]\nWorldBegin\nAttributeBegin\n" attr light             \
+    "AttributeEnd\nBxdf \"PxrDiffuse\" \"d\"\nTranslate 0 0 5\nSphere 1 -1 1 360\nWorldEnd\n"
+#define DOME "Light \"PxrDomeLight\" \"dome\" \"float intensity\" [0.5]\n"
+#define ENVSPHERE(pv)                                                                              \
+    "AreaLightSource \"PxrStdEnvMapLight\" \"e\" \"float intensity\" [0.5]" pv                     \
+    "\nGeometry \"envsphere\"\n"
+#define HIDE "Attribute \"visibility\" \"int camera\" [0]\n"
+    RayesImage *seen = render_text(DOME_SCENE("", DOME));
+    RayesImage *hidden = render_text(DOME_SCENE(HIDE, DOME));
+    RayesImage *env_hidden =
+        render_text(DOME_SCENE("", ENVSPHERE(" \"float rman__LightPrimaryVisibility\" [0]")));
+    RayesImage *env_attr = render_text(DOME_SCENE(HIDE, ENVSPHERE("")));
+    char *written = rib_round_trip(DOME_SCENE(HIDE, DOME), err, sizeof err);
+    RayesImage *back = written ? render_text(written) : NULL;
+    CHECK(seen && hidden && env_hidden && env_attr && back);
+    if (seen && hidden && env_hidden && env_attr && back) {
+        int corner = 0, centre = 4 * (SIZE / 2 * SIZE + SIZE / 2);
+        CHECK_NEAR(seen->rgba[corner], 0.5, 1e-4); /* the dome's radiance */
+        CHECK(hidden->rgba[corner] == 0.0f && hidden->rgba[corner + 3] == 0.0f);
+        CHECK(env_hidden->rgba[corner] == 0.0f && env_attr->rgba[corner] == 0.0f);
+        CHECK(hidden->rgba[centre] > 0.1f); /* the sphere: lit by the hidden dome */
+        CHECK_NEAR(hidden->rgba[centre], seen->rgba[centre], 1e-6);
+        CHECK(memcmp(back->rgba, hidden->rgba, sizeof(float) * 4 * SIZE * SIZE) == 0);
+    }
+    free(written);
+    rayes_image_free(seen);
+    rayes_image_free(hidden);
+    rayes_image_free(env_hidden);
+    rayes_image_free(env_attr);
+    rayes_image_free(back);
+#undef DOME_SCENE
+#undef DOME
+#undef ENVSPHERE
+#undef HIDE
+}
+
 TEST_MAIN(TEST(test_bxdfs), TEST(test_lights), TEST(test_geometry_lights), TEST(test_integrator),
-          TEST(test_options), TEST(test_rendered))
+          TEST(test_options), TEST(test_rendered), TEST(test_dome_visibility))
