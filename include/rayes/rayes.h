@@ -906,6 +906,13 @@ typedef struct RayesRenderOptions {
                                   side: default 8, even, 2 to 64 */
     const char *pointcloud_out; /* point-based GI: NULL, or a file the point cloud is written
                                    to (binary PLY: x y z nx ny nz area r g b, docs/cli.md) */
+    const volatile int *stop;   /* may be NULL: when *stop becomes nonzero (another thread
+                                   or a signal handler sets it, with an atomic store such as
+                                   __atomic_store_n) rayes_render stops within a ray, even
+                                   inside a tile: the tiles under way are abandoned and
+                                   RAYES_ERROR_CANCELLED returned (tiles done before were
+                                   passed to tile_done). Sessions ignore it: an abandoned
+                                   fill would leave its cache entry wrong */
 } RayesRenderOptions;
 
 /* Fills options with the defaults of a quality preset: 512 x 512, 4 pixel

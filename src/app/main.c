@@ -39,10 +39,13 @@ typedef struct Progress {
 } Progress;
 
 static volatile sig_atomic_t interrupted; /* the signal that interrupted, or 0 */
+static volatile int stop;                 /* 1 once interrupted: the workers read it
+                                             (RayesRenderOptions.stop), atomically */
 
 static void on_signal(int sig)
 {
     interrupted = sig;
+    __atomic_store_n(&stop, 1, __ATOMIC_RELAXED); /* lock-free: safe in a handler */
 }
 
 static void format_time(char *buf, size_t n, double s)
@@ -477,6 +480,7 @@ static int render_job(Args a, int frame, int number, Distributed *d)
     }
     Progress prog = {.start = time_now(), .tty = isatty(2), .last_percent = -1, .quiet = a.quiet,
                      .json = a.progress_json, .frame = number};
+    a.opt.stop = &stop; /* within a ray of the signal, even inside a tile */
     a.opt.progress = on_progress;
     a.opt.progress_user = &prog;
     signal(SIGINT, on_signal);

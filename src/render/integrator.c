@@ -368,6 +368,11 @@ static Vec3 trace_volumes(Worker *w, const Ray *ray, uint32_t kind, int diffuse_
 Vec3 integrator_trace(Worker *w, const Ray *ray, uint32_t kind, int diffuse_depth,
                       int specular_depth, uint64_t key, RayDiff diff, float *alpha)
 {
+    if (render_stop_requested(w->set)) { /* abandoned: nothing of this frame is kept */
+        if (alpha)
+            *alpha = 0.0f;
+        return v3(0, 0, 0);
+    }
     float t, a, outer = w->time;
     w->time = ray->time; /* what the hit's shading traces inherits */
     Vec3 L = trace_volumes(w, ray, kind, diffuse_depth, specular_depth, key, diff, &t, &a);

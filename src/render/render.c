@@ -360,10 +360,20 @@ static void report_progress(Frame *f)
     pthread_mutex_unlock(&f->progress_lock);
 }
 
+/* Whether the frame was stopped (RenderSettings.stop): then cancelled. */
+static int stopped(Frame *f)
+{
+    if (!render_stop_requested(f->set))
+        return 0;
+    atomic_store(&f->cancelled, 1);
+    return 1;
+}
+
 static void render_tile(void *ctx, size_t task, int worker)
 {
     Frame *f = ctx;
     const RenderSettings *set = f->set;
+    stopped(f);
     if (set->cancel && atomic_load(set->cancel))
         atomic_store(&f->cancelled, 1);
     if (atomic_load(&f->cancelled))
@@ -396,6 +406,10 @@ static void render_tile(void *ctx, size_t task, int worker)
                 double lum = 0.0, lum2 = 0.0;
                 render_samples(f, w, px, py, x0, y0, tw, th, acc, 0, set->spp, 1, &lum, &lum2);
             }
+    if (stopped(f)) { /* its rays came back black somewhere: abandoned */
+        free(acc);
+        return;
+    }
     for (int y = 0; y < th; y++)
         for (int x = 0; x < tw; x++) {
             const float *a = acc[y * tw + x];

@@ -121,6 +121,8 @@ typedef struct RenderSettings {
     float filter_width;           /* pixels */
     uint64_t seed;
     int (*progress)(void *user, double fraction); /* nonzero: cancel */
+    const volatile int *stop; /* nonzero: stop now, abandoning tiles under way (rays come back
+                                 black; the frame is cancelled): one-shot renders only */
     void *progress_user;
     Cache *cache;            /* the cache (every data type), or NULL: uncached */
     int radiosity_cache;     /* 1: diffuse hits read radiosity from cache */
@@ -207,6 +209,13 @@ Ray render_camera_ray(const RenderScene *rs, int width, int height, float x, flo
  * centre. */
 Ray render_camera_ray_at(const RenderScene *rs, int width, int height, float x, float y,
                          float time, float lu, float lv, float *lens, float *focus);
+
+/* Whether set->stop asks the frame to stop (read atomically: another
+ * thread or a signal handler writes it). */
+static inline int render_stop_requested(const RenderSettings *set)
+{
+    return set->stop && __atomic_load_n(set->stop, __ATOMIC_RELAXED) != 0;
+}
 
 /* Renders a frame into rgba (width * height * 4 floats, top row first) and
  * adds to stats. Returns 0, or 1 if the progress callback or set->cancel

@@ -80,6 +80,7 @@ RayesError rayes_session_new(RayesScene *scene, const RayesRenderOptions *option
     double t0 = time_now();
     s->options = *options;
     s->set = session_settings(options);
+    s->set.stop = NULL; /* its cache outlives a pass: fills must finish (rayes.h) */
     atomic_init(&s->cancel, 0);
     size_t n = (size_t)s->set.width * s->set.height;
     s->accum = malloc(n * sizeof *s->accum);

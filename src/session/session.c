@@ -219,6 +219,7 @@ RenderSettings session_settings(const RayesRenderOptions *o)
         .seed = o->seed,
         .progress = o->progress,
         .progress_user = o->progress_user,
+        .stop = o->stop,
         .cache_resolution = o->cache_resolution,
         .cache_k = o->cache_k,
         .grid_size = o->grid_size,

@@ -336,6 +336,63 @@ static void test_cancel_from_another_thread(void)
     rayes_scene_release(s);
 }
 
+typedef struct Stopper {
+    volatile int flag;
+    int after_ms;
+} Stopper;
+
+static void *stop_later(void *arg)
+{
+    Stopper *st = arg;
+    struct timespec ts = {st->after_ms / 1000, (long)(st->after_ms % 1000) * 1000000L};
+    nanosleep(&ts, NULL);
+    __atomic_store_n(&st->flag, 1, __ATOMIC_RELAXED);
+    return NULL;
+}
+
+static double now_s(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+/* RayesRenderOptions.stop ends a one-shot render within a ray, even in
+ * the middle of its only tile (a farm's SIGTERM used to wait for the
+ * tile: minutes in a deep interior): RAYES_ERROR_CANCELLED, no tile
+ * reported. Set before the render, nothing is traced at all. */
+static void test_stop_inside_a_tile(void)
+{
+    RayesScene *s = scene("cornell-teapots");
+    RayesRenderOptions o = options(256, 2, RAYES_FILTER_BOX);
+    o.width = o.height = 128;
+    o.tile_size = 128; /* one tile, one thread's: about 35 s in a Release build */
+    o.bounces = 8;
+    o.diffuse_rays = o.diffuse_rays_deep = 16;
+    TileCount t = {.hits = calloc(128 * 128, sizeof(int))};
+    pthread_mutex_init(&t.lock, NULL);
+    o.tile_done = count_tile;
+    o.tile_user = &t;
+    Stopper st = {0, 300};
+    o.stop = &st.flag;
+    pthread_t th;
+    pthread_create(&th, NULL, stop_later, &st);
+    double t0 = now_s();
+    RayesImage *img = NULL;
+    CHECK(rayes_render(s, &o, &img, NULL) == RAYES_ERROR_CANCELLED);
+    double took = now_s() - t0;
+    pthread_join(th, NULL);
+    printf("  stopped 0.3 s into a one-tile render: returned after %.2f s\n", took);
+    CHECK(took < 10.0); /* the tile alone takes far longer, even on one fast core */
+    CHECK(t.calls == 0 && img == NULL);
+    rayes_image_free(img);
+    CHECK(rayes_render(s, &o, &img, NULL) == RAYES_ERROR_CANCELLED); /* stopped already */
+    CHECK(t.calls == 0);
+    pthread_mutex_destroy(&t.lock);
+    free(t.hits);
+    rayes_scene_release(s);
+}
+
 static void test_edit_errors(void)
 {
     RayesScene *s = scene("cornell-teapots");
@@ -369,4 +426,5 @@ static void test_edit_errors(void)
 TEST_MAIN(TEST(test_passes_equal_render), TEST(test_light_edit_equals_fresh_render),
           TEST(test_shader_edit_equals_fresh_render), TEST(test_light_move_equals_fresh_render),
           TEST(test_camera_move_keeps_cache), TEST(test_tiles_and_cancel),
-          TEST(test_cancel_from_another_thread), TEST(test_edit_errors))
+          TEST(test_cancel_from_another_thread), TEST(test_stop_inside_a_tile),
+          TEST(test_edit_errors))
