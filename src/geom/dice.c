@@ -386,6 +386,13 @@ static Estimate estimate(const Prim *prim, const Domain *d, const DiceCamera *ca
     return e;
 }
 
+static int reserve_primvars(GridSet *gs, size_t cap, unsigned want);
+
+int geom_gridset_want_primvars(GridSet *gs, unsigned want)
+{
+    return (want & ~gs->pv_arrays) ? reserve_primvars(gs, gs->cap_vertices, want) : 0;
+}
+
 /* Grows (or first allocates, when a GEOM_PV_* bit of want is new) the
  * primitive variable arrays to cap vertices. */
 static int reserve_primvars(GridSet *gs, size_t cap, unsigned want)

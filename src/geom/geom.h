@@ -419,6 +419,11 @@ size_t geom_count_prim(const Prim *prim, const DiceCamera *cam, size_t *grids);
  * displacement has moved them). */
 void geom_grid_measure(GridSet *gs, Grid *g);
 
+/* Allocates the primitive variable arrays of the GEOM_PV_* bits of want
+ * that gs has not yet, for every vertex it can hold; 0, or -1 when out of
+ * memory. */
+int geom_gridset_want_primvars(GridSet *gs, unsigned want);
+
 /* Sets the sagitta of grids [first, n_grids) of gs, all of one primitive
  * and measured, to the largest bound among them. */
 void geom_bound_sagitta(GridSet *gs, size_t first);

@@ -41,13 +41,16 @@ static RayesError send_displacement(Parser *P, const Material *mat)
         return P->have_sent && P->sent.displaced
                    ? P->sink->set_displacement(P->sink->target, "", NULL, 0)
                    : RAYES_OK;
-    RayesParam amount = {
-        .name = "amount", .type = RAYES_PARAM_FLOAT, .value = {mat->displacement_v, 0, 0}};
+    /* pbrt-v4's material displacement is a bump map: the shading normal
+     * of the surface displaced along N, the surface where it is */
+    RayesParam p[2] = {
+        {.name = "amount", .type = RAYES_PARAM_FLOAT, .value = {mat->displacement_v, 0, 0}},
+        {.name = "__bump", .type = RAYES_PARAM_FLOAT, .value = {1, 0, 0}}};
     if (mat->displaced == 2)
-        amount = (RayesParam){.name = "amount",
-                              .type = RAYES_PARAM_PATTERN,
-                              .string = P->textures[mat->displacement_tex].pattern};
-    return P->sink->set_displacement(P->sink->target, "displace", &amount, 1);
+        p[0] = (RayesParam){.name = "amount",
+                            .type = RAYES_PARAM_PATTERN,
+                            .string = P->textures[mat->displacement_tex].pattern};
+    return P->sink->set_displacement(P->sink->target, "displace", p, 2);
 }
 
 /* Sends m as the sink's transform; 0, or -1 when it is not finite or the

@@ -192,18 +192,29 @@ static int displace_grid(const RayesScene *s, GridSet *gs, Grid *g, float step,
             put3(sc->out[i], v3_madd(get3(sc->P[i]), d, bound / len));
         }
     }
+    if (inst->bump && geom_gridset_want_primvars(gs, GEOM_PV_N) != 0)
+        return -1;
     for (size_t k = 0; k < n; k++) {
         size_t vtx = g->first_vertex + k;
         Vec3 du = v3_scale(v3_sub(get3(sc->out[2 * n + k]), get3(sc->out[n + k])), 0.5f / hu[k]);
         Vec3 dv = v3_scale(v3_sub(get3(sc->out[4 * n + k]), get3(sc->out[3 * n + k])), 0.5f / hv[k]);
         Vec3 N = v3_cross(du, dv);
         float scale = v3_length(du) * v3_length(dv);
+        if (inst->bump) { /* the normal bends, the surface stays (a bump map) */
+            Vec3 Ns = scale > 0.0f && v3_length(N) > 1e-6f * scale ? v3_normalize(N) : gs->N[vtx];
+            gs->Ns[vtx] = v3_dot(Ns, gs->N[vtx]) < 0.0f ? v3_neg(Ns) : Ns;
+            continue;
+        }
         gs->P[vtx] = get3(sc->out[k]);
         if (scale > 0.0f && v3_length(N) > 1e-6f * scale) {
             gs->N[vtx] = v3_normalize(N);
             gs->dPdu[vtx] = du;
             gs->dPdv[vtx] = dv;
         } /* else a degenerate point (a pole): keep the undisplaced frame */
+    }
+    if (inst->bump) { /* the bent normals are the grid's shading normals */
+        g->primvars |= GEOM_PV_N;
+        return 0;
     }
     g->primvars &= (uint8_t)~GEOM_PV_N; /* the displaced surface's normals replace N */
     geom_grid_measure(gs, g);

@@ -379,6 +379,22 @@ RayesError rayes_scene_set_displacement(RayesScene *s, const char *name, const R
     if (!cls->displacement)
         return scene_fail(s, RAYES_ERROR_INVALID_ARGUMENT,
                           "shader \"%s\" has no displacement method", name);
+    /* "__bump" 1: the displaced surface's normal bends the shading normal,
+     * and the surface stays where it is (a bump map) */
+    int bump = 0;
+    RayesParam own[64];
+    size_t n_own = 0;
+    for (size_t i = 0; i < n_params; i++) {
+        if (params[i].name && strcmp(params[i].name, "__bump") == 0 &&
+            params[i].type == RAYES_PARAM_FLOAT)
+            bump = params[i].value[0] != 0.0f;
+        else if (n_own < sizeof own / sizeof own[0])
+            own[n_own++] = params[i];
+        else
+            return scene_fail(s, RAYES_ERROR_INVALID_ARGUMENT,
+                              "displacement shader \"%s\": more than 64 parameters", name);
+    }
+    params = own, n_params = n_own;
     e = check_params(s, "displacement shader", name, params, n_params);
     if (e != RAYES_OK)
         return e;
@@ -394,6 +410,7 @@ RayesError rayes_scene_set_displacement(RayesScene *s, const char *name, const R
         shade_instance_fini(inst);
         return e;
     }
+    inst->bump = bump;
     s->current_displacement = (uint32_t)++s->n_displacements;
     return RAYES_OK;
 }

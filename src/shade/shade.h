@@ -20,6 +20,8 @@ typedef struct ShaderInstance {
                                       patterns are the scene's), what methods see in
                                       ctx->patterns */
     size_t n_patterns;
+    int bump; /* a displacement that bends the shading normal alone (its
+                 "__bump" 1, pbrt's material displacement): P stays */
 } ShaderInstance;
 
 /* Makes an instance: defaults, then params by name. Unknown names and type

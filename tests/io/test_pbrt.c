@@ -1018,6 +1018,8 @@ static void test_textures(void)
     CHECK(strcmp(r->displacement.name, "displace") == 0 &&
           param(&r->displacement, "amount")->type == RAYES_PARAM_FLOAT &&
           param(&r->displacement, "amount")->value[0] == 0.25f);
+    /* pbrt-v4's material displacement is a bump map */
+    CHECK(param(&r->displacement, "__bump") && param(&r->displacement, "__bump")->value[0] == 1);
     free(r);
 }
 

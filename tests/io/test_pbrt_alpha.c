@@ -9,6 +9,10 @@
  * [-1, 1]^2 of it); a point light low at x = 4 is hidden from the whole
  * visible floor by a wall at x = 2.5, out of view, which carries the
  * alpha.
+ *
+ * Also pbrt-v4's material "displacement", a bump map: the shading normal
+ * bends, the surface stays (it used to move, and swelled a scene's
+ * cushions over its table).
  */
 #include <math.h>
 #include <stdio.h>
@@ -188,5 +192,48 @@ static void test_bad_alpha(void)
     rayes_scene_release(s);
 }
 
+/* A sphere before the camera, its material's displacement amount as
+ * given ("" none). */
+static RayesImage *bumped_sphere(const char *amount)
+{
+    char text[2048];
+    snprintf(text, sizeof text,
+             "LookAt 0 0 -5  0 0 0  0 1 0\nCamera \"perspective\" \"float fov\" 30\n"
+             "WorldBegin\nLightSource \"distant\" \"point3 from\" [0 1 -1] \"point3 to\" "
+             "[0 0 0] \"rgb L\" [3 3 3]\n"
+             "Texture \"ridges\" \"float\" \"checkerboard\" \"float uscale\" 16 "
+             "\"float vscale\" 8 \"float tex1\" 0 \"float tex2\" 0.05\n"
+             "Material \"diffuse\" \"rgb reflectance\" [0.6 0.6 0.6] %s\n"
+             "Shape \"sphere\" \"float radius\" 0.8\n",
+             amount);
+    return render_read(io_pbrt_parse, text, 1);
+}
+
+static void test_displacement_is_bump(void)
+{
+    RayesImage *plain = bumped_sphere(""), *shifted = bumped_sphere("\"float displacement\" 0.3"),
+               *ridged = bumped_sphere("\"texture displacement\" \"ridges\"");
+    CHECK(plain && shifted && ridged);
+    if (plain && shifted && ridged) {
+        double cover_moved = 0, shade_moved = 0, shade_bent = 0;
+        for (int i = 0; i < SIZE * SIZE; i++) {
+            cover_moved =
+                fmax(cover_moved, fabs(shifted->rgba[4 * i + 3] - plain->rgba[4 * i + 3]));
+            cover_moved = fmax(cover_moved, fabs(ridged->rgba[4 * i + 3] - plain->rgba[4 * i + 3]));
+            shade_moved = fmax(shade_moved, fabs(shifted->rgba[4 * i] - plain->rgba[4 * i]));
+            shade_bent = fmax(shade_bent, fabs(ridged->rgba[4 * i] - plain->rgba[4 * i]));
+        }
+        printf("  pbrt displacement: coverage moved %.3g, a constant's shading %.3g, a "
+               "checkerboard's %.3g\n",
+               cover_moved, shade_moved, shade_bent);
+        CHECK(cover_moved == 0.0); /* the surface is where it was (0.3 used to grow it) */
+        CHECK(shade_moved < 1e-3); /* a constant offset bends nothing */
+        CHECK(shade_bent > 0.05);  /* the checkerboard's steps tilt the normal */
+    }
+    rayes_image_free(plain);
+    rayes_image_free(shifted);
+    rayes_image_free(ridged);
+}
+
 TEST_MAIN(TEST(test_constant_alpha), TEST(test_texture_alpha), TEST(test_rib_round_trip),
-          TEST(test_bad_alpha))
+          TEST(test_bad_alpha), TEST(test_displacement_is_bump))
