@@ -867,13 +867,20 @@ typedef struct CoatedParams {
     float reflectance[3], roughness, eta, thickness, normalmap[3];
 } CoatedParams;
 
-/* A Lambertian base under a smooth or glossy dielectric coat. Light reaches
- * the base through the coat with the hemispherical average 1 - Favg and
- * leaves toward the viewer with 1 - F(cos_v); the coat reflects
- * F(cos_v) * the reflected radiance. diffuselighting is the average of the
- * base term over cosine-weighted views: base (1 - Favg)^2, so lighting's
- * base term is diffuselighting's times (1 - F(cos_v)) / (1 - Favg). The
- * coat's absorption is exp(-2 thickness) (normal incidence, down and up). */
+/* A Lambertian base of albedo R under a smooth or glossy dielectric coat
+ * of index eta. Light reaches the base through the coat with the
+ * hemispherical average 1 - Favg, and what the base reflects leaves toward
+ * the viewer with 1 - F(cos_v), compressed into the coat's solid angle by
+ * 1 / eta^2, after bouncing between base and coat: 1 / (1 - R Fint), Fint
+ * the coat's reflectance seen from inside (total internal reflection
+ * included), 1 - (1 - Favg) / eta^2 (0.596 at eta 1.5). So R = 1 keeps all
+ * the light (the coat's Favg plus (1 - Favg) from the base), as pbrt-v4's
+ * layered coateddiffuse does, whose closed form this is with Favg for the
+ * incident F (dark bases were 2 times too bright, white ones 16% too dark).
+ * The coat reflects F(cos_v) * the reflected radiance. diffuselighting
+ * averages the base term over cosine-weighted views (1 - Favg in place of
+ * 1 - F(cos_v)). The coat absorbs exp(-2 thickness) (normal incidence,
+ * down and up). */
 static void coated_chunk(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
                          const void *params, RayesShadeOutputs *out)
 {
@@ -888,12 +895,14 @@ static void coated_chunk(const RayesShaderServices *sv, const RayesShadeCtx *ctx
         alphas(sv, ctx, p->roughness, alpha);
         glossy_reflection(sv, ctx, alpha, L);
     }
+    float eta2 = p->eta > 0.0f ? p->eta * p->eta : 1.0f, fint = 1.0f - (1.0f - favg) / eta2;
     for (size_t i = 0; i < ctx->n_points; i++) {
-        float base = (1.0f - favg) * (1.0f - favg) * expf(-2.0f * fmaxf(thick[i], 0.0f));
+        float base = (1.0f - favg) * (1.0f - favg) * expf(-2.0f * fmaxf(thick[i], 0.0f)) / eta2;
         float F = ctx->I ? fresnel_dielectric(cos_view(ctx, i), p->eta) : 0.0f;
         float view = ctx->I ? (1.0f - F) / (1.0f - favg) : 1.0f;
         for (int c = 0; c < 3; c++) {
-            out->Ci[i][c] = cs(ctx, i, c) * refl[i][c] * base * view * E[i][c];
+            float R = cs(ctx, i, c) * refl[i][c];
+            out->Ci[i][c] = R * base * view * E[i][c] / fmaxf(1.0f - R * fint, 1e-3f);
             if (ctx->I)
                 out->Ci[i][c] += F * L[i][c];
         }
