@@ -350,7 +350,9 @@ static void test_diffuselighting_is_view_independent_part(void)
 
 /* Radiance 1 from everywhere and albedo 1: glass and the smooth
  * dielectric return exactly 1 (R + T = 1, TIR included), the Lambertian
- * shaders 1, conductors and the coated base at most 1. */
+ * shaders 1, the coated white base 1 (what its coat sends back inside
+ * reaches the viewer after bounces: pbrt-v4's layered model; it lost 8%
+ * before), conductors at most 1. */
 static void test_shader_furnace(void)
 {
     static const Spec white[] = {
@@ -371,7 +373,7 @@ static void test_shader_furnace(void)
         RayesShadeCtx ctx = random_context(7 + k, 1.0f);
         RayesShadeOutputs out = {Ci, Oi, NULL, NULL};
         shade_run_lighting(&stub_full, &ctx, &m, &out);
-        int exact = k < 4;
+        int exact = k < 4 || k == 6;
         for (int i = 0; i < N; i++)
             for (int c = 0; c < 3; c++) {
                 if (exact)
