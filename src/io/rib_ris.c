@@ -125,8 +125,14 @@ static const char *pxr_surface(Rib *r, const char *cls, const Param *p, size_t n
     static const float d18[3] = {0.18f, 0.18f, 0.18f}, zero[3] = {0, 0, 0};
     static const float ior[3] = {1.5f, 1.5f, 1.5f};
     if (num(p, n, "refractionGain", 0) > 0) {
+        static const float white[3] = {1, 1, 1};
+        float tint[3];
+        color(p, n, "refractionColor", white, tint); /* each crossing: in and out */
+        for (int c = 0; c < 3; c++)
+            tint[c] *= fminf(num(p, n, "refractionGain", 1), 1.0f);
         out_float(o, "eta", num(p, n, "glassIor", 1.5f));
         out_float(o, "roughness", num(p, n, "glassRoughness", 0.1f));
+        out_color(o, "transmitcolor", tint);
         return "dielectric";
     }
     float gain = num(p, n, "diffuseGain", 1), dc[3], face[3], edge[3], rough[3], coat[3];

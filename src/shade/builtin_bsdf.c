@@ -597,7 +597,7 @@ const RayesShaderClass shade_class_glass = {
 };
 
 typedef struct DielectricParams {
-    float eta, roughness, normalmap[3];
+    float eta, roughness, normalmap[3], transmitcolor[3];
 } DielectricParams;
 
 static void dielectric_chunk(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
@@ -607,15 +607,16 @@ static void dielectric_chunk(const RayesShaderServices *sv, const RayesShadeCtx 
     memset(out->Ci, 0, ctx->n_points * sizeof *out->Ci);
     if (!ctx->I)
         return;
-    Rgb R[SHADE_CHUNK], T[SHADE_CHUNK], one[SHADE_CHUNK];
+    Rgb R[SHADE_CHUNK], T[SHADE_CHUNK], one[SHADE_CHUNK], tint[SHADE_CHUNK];
     float alpha[SHADE_CHUNK];
     for (size_t i = 0; i < ctx->n_points; i++)
-        one[i][0] = one[i][1] = one[i][2] = 1.0f;
+        for (int c = 0; c < 3; c++)
+            one[i][c] = 1.0f, tint[i][c] = p->transmitcolor[c];
     alphas(sv, ctx, p->roughness, alpha);
-    fresnel_split(sv, ctx, p->eta, alpha, 1, (const Rgb *)one, (const Rgb *)one, R, T);
+    fresnel_split(sv, ctx, p->eta, alpha, 1, (const Rgb *)one, (const Rgb *)tint, R, T);
     for (size_t i = 0; i < ctx->n_points; i++)
         for (int c = 0; c < 3; c++)
-            out->Ci[i][c] = R[i][c] + T[i][c];
+            out->Ci[i][c] = R[i][c] + tint[i][c] * T[i][c]; /* at each crossing */
 }
 
 static void dielectric_lighting(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
@@ -628,6 +629,7 @@ static const RayesShaderParamDesc dielectric_params[] = {
     {"eta", RAYES_PARAM_FLOAT, offsetof(DielectricParams, eta), {1.5f, 0, 0}},
     {"roughness", RAYES_PARAM_FLOAT, offsetof(DielectricParams, roughness), {0, 0, 0}},
     {"normalmap", RAYES_PARAM_COLOR, offsetof(DielectricParams, normalmap), {0.5f, 0.5f, 1.0f}},
+    {"transmitcolor", RAYES_PARAM_COLOR, offsetof(DielectricParams, transmitcolor), {1, 1, 1}},
 };
 
 const RayesShaderClass shade_class_dielectric = {

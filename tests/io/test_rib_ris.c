@@ -85,6 +85,11 @@ static void test_bxdfs(void)
     CHECK_NEAR(param(s, "roughness", 0), 0.05, 1e-6);
     s = bxdf("Bxdf \"PxrSurface\" \"s\" \"float refractionGain\" [1] \"float glassIor\" [1.33]");
     CHECK(strcmp(s->name, "dielectric") == 0 && fabsf(param(s, "eta", 0) - 1.33f) < 1e-6f);
+    CHECK(param(s, "transmitcolor", 0) == 1.0f); /* clear by default */
+    s = bxdf("Bxdf \"PxrSurface\" \"s\" \"float refractionGain\" [1] \"color refractionColor\" "
+             "[0 0.9 0]");
+    CHECK(strcmp(s->name, "dielectric") == 0 && param(s, "transmitcolor", 0) == 0.0f &&
+          fabsf(param(s, "transmitcolor", 1) - 0.9f) < 1e-6f); /* green glass (it was clear) */
     s = bxdf("Bxdf \"PxrSurface\" \"s\"");
     CHECK(strcmp(s->name, "diffuse") == 0); /* RenderMan's default: 0.18 grey, no specular */
     CHECK_NEAR(param(s, "reflectance", 0), 0.18, 1e-6);
@@ -412,5 +417,32 @@ static void test_dome_visibility(void)
 #undef HIDE
 }
 
+/* PxrSurface's refractionColor tints its glass at each crossing: a
+ * sphere against a white dome shows it twice (0.9^2 green) and a little
+ * white reflection. */
+static void test_tinted_glass(void)
+{
+    RayesImage *img = render_text(
+        "Projection \"perspective\" \"fov\" [20]\nWorldBegin\nAttributeBegin\n"
+        "Attribute \"visibility\" \"int camera\" [1]\n"
+        "Light \"PxrDomeLight\" \"dome\" \"float intensity\" [1]\nAttributeEnd\n"
+        "Bxdf \"PxrSurface\" \"g\" \"float diffuseGain\" [0] \"float refractionGain\" [1] "
+        "\"color refractionColor\" [0 0.9 0] \"float glassRoughness\" [0]\n"
+        "Translate 0 0 5\nSphere 1 -1 1 360\nWorldEnd\n");
+    CHECK(img != NULL);
+    if (img) { /* the middle 8 x 8 pixels (deeper crossings end by roulette) */
+        double c[3] = {0, 0, 0};
+        for (int y = SIZE / 2 - 4; y < SIZE / 2 + 4; y++)
+            for (int x = SIZE / 2 - 4; x < SIZE / 2 + 4; x++)
+                for (int k = 0; k < 3; k++)
+                    c[k] += img->rgba[4 * (y * SIZE + x) + k] / 64.0;
+        printf("  green glass against a white dome: %.3f %.3f %.3f\n", c[0], c[1], c[2]);
+        CHECK(c[1] > 0.7 && c[1] < 0.9); /* 0.04 + 0.96^2 0.81, and inner reflections */
+        CHECK(c[0] < 0.1 && c[2] < 0.1);
+    }
+    rayes_image_free(img);
+}
+
 TEST_MAIN(TEST(test_bxdfs), TEST(test_lights), TEST(test_geometry_lights), TEST(test_integrator),
-          TEST(test_options), TEST(test_rendered), TEST(test_dome_visibility))
+          TEST(test_options), TEST(test_rendered), TEST(test_dome_visibility),
+          TEST(test_tinted_glass))
