@@ -179,6 +179,9 @@ typedef struct Emit {
     int fixed;        /* in a deformation motion block: NURBS_MOTION_SPLITS */
     const float *st;  /* varying st, one per knot span corner (u fastest), or NULL */
     size_t st_w;      /* corners along u: n[0] - order[0] + 2 */
+    const Nurbs *cs_vertex;   /* vertex Cs: the surface's weights times the colours, or NULL */
+    const float *cs_varying;  /* varying Cs, one per knot span corner, or NULL */
+    const float *cs_constant; /* constant Cs, or NULL */
     long made;
     int unconverged;
     const TrimSet *trim; /* or NULL */
@@ -257,6 +260,33 @@ static void st_at(const Emit *e, int ku, int kv, float u, float v, float out[2])
         out[k] = (1 - y) * ((1 - x) * c[0][k] + x * c[1][k]) + y * ((1 - x) * c[2][k] + x * c[3][k]);
 }
 
+/* Cs at (u, v) in knot span (ku, kv), as the file gives it: vertex colours
+ * through the surface's own (rational) basis, varying ones bilinear over
+ * the span as st, a constant one. 0 if the file gives none. */
+static int cs_at(const Emit *e, int ku, int kv, float u, float v, float out[3])
+{
+    if (e->cs_vertex) {
+        eval(e->cs_vertex, ku, kv, u, v, out);
+        return 1;
+    }
+    if (e->cs_constant) {
+        memcpy(out, e->cs_constant, 3 * sizeof *out);
+        return 1;
+    }
+    if (!e->cs_varying)
+        return 0;
+    const float *tu = e->s->knot[0], *tv = e->s->knot[1];
+    float x = (u - tu[ku]) / (tu[ku + 1] - tu[ku]), y = (v - tv[kv]) / (tv[kv + 1] - tv[kv]);
+    size_t w = e->st_w;
+    size_t a = (size_t)(kv - (e->s->order[1] - 1)) * w + (size_t)(ku - (e->s->order[0] - 1));
+    const float *c[4] = {&e->cs_varying[3 * a], &e->cs_varying[3 * (a + 1)],
+                         &e->cs_varying[3 * (a + w)], &e->cs_varying[3 * (a + w + 1)]};
+    for (int k = 0; k < 3; k++)
+        out[k] =
+            (1 - y) * ((1 - x) * c[0][k] + x * c[1][k]) + y * ((1 - x) * c[2][k] + x * c[3][k]);
+    return 1;
+}
+
 /* Sends the patches of [u0, u1] x [v0, v1] in span (ku, kv), split while
  * the fit strays (depth splits so far) or trim loops cross it (tdepth). */
 static int emit_part(Emit *e, int ku, int kv, const float u[2], const float v[2], int depth,
@@ -304,13 +334,17 @@ static int emit_part(Emit *e, int ku, int kv, const float u[2], const float v[2]
     }
     if (++e->made > NURBS_MAX_PATCHES)
         return rib_error(e->r, "NuPatch: more than %ld patches", NURBS_MAX_PATCHES);
-    float st[4][2];
+    float st[4][2], cs[4][3];
     const float cu[4] = {u[0], u[1], u[0], u[1]}, cv[4] = {v[0], v[0], v[1], v[1]};
-    int flip = rib_flip(e->r); /* the patch's u reverses: so do its corners' values */
-    for (int k = 0; k < 4; k++)
+    int flip = rib_flip(e->r), coloured = 0; /* the patch's u reverses: so do its corners' */
+    for (int k = 0; k < 4; k++) {
         st_at(e, ku, kv, cu[k], cv[k], st[flip ? k ^ 1 : k]);
+        coloured = cs_at(e, ku, kv, cu[k], cv[k], cs[flip ? k ^ 1 : k]);
+    }
     PvOut pv = {.n = 1};
     pv.pv[0] = (RayesPrimvar){"st", RAYES_PRIMVAR_VARYING, &st[0][0], 4};
+    if (coloured)
+        pv.pv[pv.n++] = (RayesPrimvar){"Cs", RAYES_PRIMVAR_VARYING, &cs[0][0], 4};
     return rib_emit_bicubic(e->r, B, &pv);
 }
 
@@ -440,7 +474,8 @@ static int h_nupatch(Rib *r, const Args *a)
     if (e == 0 && (long)m[0] * m[1] > NURBS_MAX_PATCHES)
         e = rib_error(r, "NuPatch: more than %ld spans", NURBS_MAX_PATCHES);
     /* st (or s and t) of class varying: one value a span corner */
-    float *st = NULL;
+    float *st = NULL, *cw = NULL, *cs_var = NULL, cs_const[3];
+    int have_const = 0;
     if (e == 0) {
         const Param *qst = rib_find_param(p, n_p, "st"), *qs = rib_find_param(p, n_p, "s"),
                     *qt = rib_find_param(p, n_p, "t");
@@ -462,13 +497,41 @@ static int h_nupatch(Rib *r, const Args *a)
                 st[2 * j + 1] = (float)(pair ? qst->v->d[2 * j + 1] : qt->v->d[j]);
             }
         }
+        /* Cs: vertex (through the surface's basis, weighted as P is),
+         * varying (a span corner each) or constant */
+        const Param *qc = rib_find_param(p, n_p, "Cs");
+        size_t points = (size_t)s.n[0] * (size_t)s.n[1];
+        if (qc && rib_is_num(qc->v) && qc->v->n == 3 * points && qc->d.cls == CLS_VERTEX) {
+            cw = malloc(4 * points * sizeof *cw);
+            if (!cw)
+                e = rib_error(r, "out of memory");
+            for (size_t j = 0; e == 0 && j < points; j++) {
+                for (int c = 0; c < 3; c++)
+                    cw[4 * j + c] = (float)qc->v->d[3 * j + c] * Pw[4 * j + 3];
+                cw[4 * j + 3] = Pw[4 * j + 3];
+            }
+        } else if (qc && rib_is_num(qc->v) && qc->v->n == 3 * corners && qc->d.cls != CLS_VERTEX) {
+            cs_var = malloc(3 * corners * sizeof *cs_var);
+            if (!cs_var)
+                e = rib_error(r, "out of memory");
+            for (size_t j = 0; e == 0 && j < 3 * corners; j++)
+                cs_var[j] = (float)qc->v->d[j];
+        } else if (qc && rib_is_num(qc->v) && qc->v->n == 3) {
+            for (int c = 0; c < 3; c++)
+                cs_const[c] = (float)qc->v->d[c];
+            have_const = 1;
+        } else if (qc) {
+            rib_warn_once(r, "nupatch Cs",
+                          "NuPatch: Cs needs one colour per control point (vertex), per span "
+                          "corner (varying) or one (constant); not used");
+        }
         for (size_t j = 0; j < n_p; j++) {
             const char *name = p[j].d.name;
             if (strcmp(name, "P") != 0 && strcmp(name, "Pw") != 0 && strcmp(name, "st") != 0 &&
-                strcmp(name, "s") != 0 && strcmp(name, "t") != 0) {
+                strcmp(name, "s") != 0 && strcmp(name, "t") != 0 && strcmp(name, "Cs") != 0) {
                 char key[128];
                 snprintf(key, sizeof key, "nupatch %.100s", name);
-                rib_warn_once(r, key, "NuPatch: \"%s\" is not used (P, Pw and st are)", name);
+                rib_warn_once(r, key, "NuPatch: \"%s\" is not used (P, Pw, st and Cs are)", name);
             }
         }
     }
@@ -484,6 +547,11 @@ static int h_nupatch(Rib *r, const Args *a)
                .st_w = (size_t)(s.n[0] - s.order[0] + 2),
                .trim = r->a.trim,
                .trim_outside = r->a.trim_outside};
+    Nurbs colours = s;
+    colours.Pw = cw;
+    em.cs_vertex = cw ? &colours : NULL;
+    em.cs_varying = cs_var;
+    em.cs_constant = have_const ? cs_const : NULL;
     /* the first pass checks the file: patches are made in the second */
     for (int sv = 0; e == 0 && r->pass == 2 && sv < m[1]; sv++)
         for (int su = 0; e == 0 && su < m[0]; su++)
@@ -493,6 +561,8 @@ static int h_nupatch(Rib *r, const Args *a)
                       "NuPatch: a span of high order or strong weights is approximated "
                       "coarser than 1e-4 of its size");
     free(st);
+    free(cw);
+    free(cs_var);
     free(p);
     free(Pw);
     for (int d = 0; d < 2; d++) {

@@ -351,5 +351,49 @@ static void test_trim(void)
     CHECK(rec.n_patch > 1 && nearest > 0.6f - 2.0f / 128 && nearest < 0.6f + 4.0f / 128);
 }
 
+/* Cs: vertex colours through the surface's own basis, weighted as its
+ * points are (a rational patch pulls the colour toward heavy points),
+ * varying ones a span corner each, a constant one; reached the patches'
+ * corners (Houdini's NuPatches were left uncoloured). */
+static void test_colours(void)
+{
+    /* bilinear: red at u = 0, blue at u = 1 */
+    CHECK(rib(WORLD("NuPatch 2 2 [0 0 1 1] 0 1 2 2 [0 0 1 1] 0 1 \"P\" [0 0 1 1 0 1 0 1 1 1 1 1] "
+                    "\"vertex color Cs\" [1 0 0 0 0 1 1 0 0 0 0 1]")) == RAYES_OK);
+    const RayesPrimvar *cs = rec.n_patch == 1 ? rec_primvar(&rec.patch[0].pv, "Cs") : NULL;
+    CHECK(cs && cs->count == 4);
+    if (cs)
+        CHECK(cs->data[0] == 1 && cs->data[2] == 0 && cs->data[3] == 0 && cs->data[5] == 1);
+    /* rational, quadratic in u, red, green, blue along u, the middle point
+     * weighing 3: at u = 0.5 (a corner, the span being split) green is
+     * 0.5 3 / (0.25 + 1.5 + 0.25) = 0.75, where unweighted it would be 0.5 */
+    CHECK(rib(WORLD("NuPatch 3 3 [0 0 0 1 1 1] 0 1 2 2 [0 0 1 1] 0 1 \"Pw\" [0 0 1 1  1.5 0 3 3  "
+                    "1 0 1 1  0 1 1 1  1.5 3 3 3  1 1 1 1] \"vertex color Cs\" [1 0 0 0 1 0 0 0 1 "
+                    "1 0 0 0 1 0 0 0 1]")) == RAYES_OK);
+    int found = 0, middle = 0;
+    for (int k = 0; k < rec.n_patch; k++) {
+        const RayesPrimvar *c = rec_primvar(&rec.patch[k].pv, "Cs");
+        found += c != NULL;
+        for (int j = 0; c && j < 4; j++) {
+            CHECK_NEAR(c->data[3 * j] + c->data[3 * j + 1] + c->data[3 * j + 2], 1, 1e-5);
+            middle += fabsf(c->data[3 * j + 1] - 0.75f) < 1e-4f;
+        }
+    }
+    CHECK(found == rec.n_patch && found > 0 && middle > 0);
+    /* varying: a span corner each; constant: one */
+    CHECK(rib(WORLD("NuPatch 2 2 [0 0 1 1] 0 1 2 2 [0 0 1 1] 0 1 \"P\" [0 0 1 1 0 1 0 1 1 1 1 1] "
+                    "\"varying color Cs\" [0 1 0 0 1 0 0 0 1 0 0 1]")) == RAYES_OK);
+    cs = rec.n_patch == 1 ? rec_primvar(&rec.patch[0].pv, "Cs") : NULL;
+    CHECK(cs && cs->data[1] == 1 && cs->data[11] == 1);
+    CHECK(rib(WORLD("NuPatch 2 2 [0 0 1 1] 0 1 2 2 [0 0 1 1] 0 1 \"P\" [0 0 1 1 0 1 0 1 1 1 1 1] "
+                    "\"constant color Cs\" [0.2 0.4 0.6]")) == RAYES_OK);
+    cs = rec.n_patch == 1 ? rec_primvar(&rec.patch[0].pv, "Cs") : NULL;
+    CHECK(cs && cs->data[9] == 0.2f && cs->data[11] == 0.6f);
+    /* a count that fits no class: the patch uncoloured (one warning) */
+    CHECK(rib(WORLD("NuPatch 2 2 [0 0 1 1] 0 1 2 2 [0 0 1 1] 0 1 \"P\" [0 0 1 1 0 1 0 1 1 1 1 1] "
+                    "\"vertex color Cs\" [1 0 0 0 0 1]")) == RAYES_OK);
+    CHECK(rec.n_patch == 1 && rec_primvar(&rec.patch[0].pv, "Cs") == NULL);
+}
+
 TEST_MAIN(TEST(test_polynomial_spans_exact), TEST(test_rational_sphere), TEST(test_reading),
-          TEST(test_trim), TEST(test_deforming))
+          TEST(test_trim), TEST(test_deforming), TEST(test_colours))
