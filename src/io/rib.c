@@ -684,6 +684,26 @@ static int h_detail_range(Rib *r, const Args *a)
     return 0;
 }
 
+/* TextureCoordinates s1 t1 s2 t2 s3 t3 s4 t4: st at the corners of a
+ * Patch without its own (RenderMan's default 0 0 1 0 0 1 1 1 is (u, v));
+ * an attribute. Patch meshes and quadrics keep (u, v). */
+static int h_texture_coordinates(Rib *r, const Args *a)
+{
+    size_t i = 0;
+    float v[8];
+    if (rib_get_floats(r, a, &i, v, 8, "8 numbers (s1 t1 s2 t2 s3 t3 s4 t4)") != 0)
+        return -1;
+    static const float unit[8] = {0, 0, 1, 0, 0, 1, 1, 1};
+    r->a.have_texcoords = 0;
+    for (int k = 0; k < 8; k++) {
+        if (!isfinite(v[k]))
+            return rib_error(r, "TextureCoordinates: expected finite numbers");
+        r->a.texcoords[k] = v[k];
+        r->a.have_texcoords |= v[k] != unit[k];
+    }
+    return 0;
+}
+
 static int h_skip(Rib *r, const Args *a)
 {
     (void)a;
@@ -750,7 +770,7 @@ static const RibRequest own_requests[] = {
     {"Else", h_skip},
     {"IfEnd", h_skip},
     {"Matte", h_matte},
-    {"TextureCoordinates", h_skip},
+    {"TextureCoordinates", h_texture_coordinates},
     {"Bound", h_skip},
     {"ColorSamples", h_skip},
     {"ClippingPlane", h_skip},

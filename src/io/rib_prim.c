@@ -939,6 +939,8 @@ static int h_patch(Rib *r, const Args *a)
     if (e == 0) {
         rib_warn_unused(r, p, n);
         rib_vars(r, p, n, vars);
+        if (!vars[1].d && r->a.have_texcoords) /* TextureCoordinates: st at the corners */
+            vars[1] = (RibVar){r->a.texcoords, NULL, CLS_VARYING, 2};
         static const size_t corners[4] = {0, 1, 2, 3};
         static const size_t all[16] = {0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15};
         e = patch_vars(r, vars, 0, corners, corners, all, (int)want, rib_flip(r), &pv);

@@ -108,6 +108,8 @@ typedef struct Attr {
     float M[16];               /* camera_from_object before WorldBegin, world_from_object after */
     int orient;
     float Cs[3], Os[3];
+    double texcoords[8];       /* TextureCoordinates: st at a patch's four corners */
+    int have_texcoords;        /* 1 when they are not RenderMan's default (0 0 1 0 0 1 1 1) */
     long color_gen;            /* changes with Cs/Os */
     const ShaderRec *surface;  /* NULL: matte */
     const ShaderRec *displacement;

@@ -89,6 +89,31 @@ static void test_procedural2(void)
     remove(path);
 }
 
+/* TextureCoordinates: st at a Patch's corners when it gives none (it was
+ * read and skipped: textures on classic patches sat at (u, v)). */
+static void test_texture_coordinates(void)
+{
+#define PATCH "Patch \"bilinear\" \"P\" [0 0 1 1 0 1 0 1 1 1 1 1]"
+    CHECK(rib(WORLD("TextureCoordinates 0 0 2 0 0 2 2 2\n" PATCH)) == RAYES_OK);
+    const RayesPrimvar *st = rec.n_patch == 1 ? rec_primvar(&rec.patch[0].pv, "st") : NULL;
+    CHECK(st && st->count == 4);
+    if (st)
+        CHECK(st->data[2] == 2 && st->data[3] == 0 && st->data[6] == 2 && st->data[7] == 2);
+    /* the default, or the patch's own st: as before */
+    CHECK(rib(WORLD("TextureCoordinates 0 0 1 0 0 1 1 1\n" PATCH)) == RAYES_OK);
+    CHECK(rec.n_patch == 1 && rec_primvar(&rec.patch[0].pv, "st") == NULL);
+    CHECK(rib(WORLD("TextureCoordinates 0 0 2 0 0 2 2 2\n" PATCH " \"st\" [0 0 5 0 0 5 5 5]")) ==
+          RAYES_OK);
+    st = rec.n_patch == 1 ? rec_primvar(&rec.patch[0].pv, "st") : NULL;
+    CHECK(st && st->data[2] == 5);
+    /* an attribute: AttributeEnd restores it */
+    CHECK(rib(WORLD("AttributeBegin\nTextureCoordinates 0 0 2 0 0 2 2 2\nAttributeEnd\n" PATCH)) ==
+          RAYES_OK);
+    CHECK(rec.n_patch == 1 && rec_primvar(&rec.patch[0].pv, "st") == NULL);
+    CHECK(rib(WORLD("TextureCoordinates 0 0 1\n" PATCH)) != RAYES_OK);
+#undef PATCH
+}
+
 /* The centre pixel of a RIB file rendered at 8 x 8, no bounces. */
 static float centre(const char *text)
 {
@@ -147,4 +172,4 @@ static void test_png_curve(void)
 }
 
 TEST_MAIN(TEST(test_requests_renderman_accepts), TEST(test_procedural2),
-          TEST(test_classic_light_units), TEST(test_png_curve))
+          TEST(test_classic_light_units), TEST(test_png_curve), TEST(test_texture_coordinates))
