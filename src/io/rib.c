@@ -29,6 +29,7 @@
 #include <zlib.h>
 
 #include "io/rib_reader.h"
+#include "io/zip.h"
 #include "util/log.h"
 
 /* -------------------------------------------------------------- files */
@@ -263,10 +264,19 @@ static int file_exists(const char *path)
     return stat(path, &st) == 0 && S_ISREG(st.st_mode);
 }
 
-static int read_archive(Rib *r, const char *name)
+static int read_archive(Rib *r, const char *name_in)
 {
     if (r->archive_depth >= RIB_MAX_ARCHIVE_DEPTH)
         return rib_error(r, "archives nested more than %d deep (a loop?)", RIB_MAX_ARCHIVE_DEPTH);
+    /* "file.zip!member": a member of a zip file, found as the file is */
+    char name[2048];
+    snprintf(name, sizeof name, "%s", name_in);
+    char *bang = strstr(name, ".zip!");
+    const char *member = NULL;
+    if (bang) {
+        bang[4] = '\0';
+        member = bang + 5;
+    }
     char path[4096] = "";
     if (name[0] == '/') {
         snprintf(path, sizeof path, "%s", name);
@@ -292,10 +302,12 @@ static int read_archive(Rib *r, const char *name)
     size_t size;
     if (!file_exists(path))
         return rib_error(r, "archive \"%s\": not found (as %s, nor on the archive search path)",
-                         name, path);
-    unsigned char *data = read_gz(path, &size, err, sizeof err);
+                         name_in, path);
+    unsigned char *data =
+        member ? io_zip_member(path, member, RIB_MAX_FILE_BYTES, &size, err, sizeof err)
+               : read_gz(path, &size, err, sizeof err);
     if (!data)
-        return rib_error(r, "archive \"%s\": %s", name, err);
+        return rib_error(r, "archive \"%s\": %s", name_in, err);
     RibLexer *outer = r->lx;
     const char *outer_file = r->file;
     char req[64];

@@ -3,7 +3,8 @@
  * rib_shade.c, rib_prim.c): requests RenderMan accepts that used to stop
  * a file (GeometricRepresentation, Illuminate of a light that was
  * skipped, Hider counts of 0, ri.h's "wrap" and "nowrap", RenderMan 20's
- * Procedural2 "DelayedReadArchive2"); the classic lights' units (matte
+ * Procedural2 "DelayedReadArchive2", zip archives "file.zip!member");
+ * the classic lights' units (matte
  * facing a pointlight of intensity 16 at 4 units shades to exactly Cs, as
  * diffuse() has no 1/pi).
  */
@@ -11,6 +12,8 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+
+#include <zlib.h>
 
 #include "io/rib.h"
 #include "rayes/rayes.h"
@@ -114,6 +117,95 @@ static void test_texture_coordinates(void)
 #undef PATCH
 }
 
+static void put16(unsigned char *p, unsigned v)
+{
+    p[0] = (unsigned char)v, p[1] = (unsigned char)(v >> 8);
+}
+
+static void put32(unsigned char *p, unsigned long v)
+{
+    put16(p, (unsigned)(v & 0xffff)), put16(p + 2, (unsigned)(v >> 16));
+}
+
+/* A zip file of two members, "a.rib" stored and "dir/b.rib" deflated, as
+ * RenderMan for Maya packs archives; its bytes written to path. */
+static void write_zip(const char *path, const char *a, const char *b)
+{
+    unsigned char out[4096], packed[1024];
+    z_stream z = {0};
+    deflateInit2(&z, 9, Z_DEFLATED, -15, 8, Z_DEFAULT_STRATEGY);
+    z.next_in = (unsigned char *)b, z.avail_in = (uInt)strlen(b);
+    z.next_out = packed, z.avail_out = sizeof packed;
+    deflate(&z, Z_FINISH);
+    size_t plen = sizeof packed - z.avail_out;
+    deflateEnd(&z);
+    const char *names[2] = {"a.rib", "dir/b.rib"};
+    const unsigned char *data[2] = {(const unsigned char *)a, packed};
+    size_t csize[2] = {strlen(a), plen}, usize[2] = {strlen(a), strlen(b)}, local[2], n = 0;
+    for (int k = 0; k < 2; k++) { /* local headers and data */
+        local[k] = n;
+        unsigned char *h = out + n;
+        memset(h, 0, 30);
+        put32(h, 0x04034b50), put16(h + 4, 20), put16(h + 8, k ? 8 : 0);
+        put32(h + 18, csize[k]), put32(h + 22, usize[k]), put16(h + 26, (unsigned)strlen(names[k]));
+        n += 30;
+        memcpy(out + n, names[k], strlen(names[k])), n += strlen(names[k]);
+        memcpy(out + n, data[k], csize[k]), n += csize[k];
+    }
+    size_t dir = n;
+    for (int k = 0; k < 2; k++) { /* the central directory */
+        unsigned char *h = out + n;
+        memset(h, 0, 46);
+        put32(h, 0x02014b50), put16(h + 4, 20), put16(h + 6, 20), put16(h + 10, k ? 8 : 0);
+        put32(h + 20, csize[k]), put32(h + 24, usize[k]), put16(h + 28, (unsigned)strlen(names[k]));
+        put32(h + 42, local[k]);
+        n += 46;
+        memcpy(out + n, names[k], strlen(names[k])), n += strlen(names[k]);
+    }
+    unsigned char *e = out + n;
+    memset(e, 0, 22);
+    put32(e, 0x06054b50), put16(e + 8, 2), put16(e + 10, 2), put32(e + 12, n - dir);
+    put32(e + 16, dir);
+    n += 22;
+    FILE *f = fopen(path, "wb");
+    CHECK(f != NULL);
+    if (f) {
+        fwrite(out, 1, n, f);
+        fclose(f);
+    }
+}
+
+/* ReadArchive "file.zip!member": a member of a zip file, stored or
+ * deflated (RenderMan for Maya's archives were "not found"). */
+static void test_zip_archives(void)
+{
+    const char *zip = RAYES_TEST_TMP "/compat_archives.zip";
+    write_zip(zip, QUAD, QUAD QUAD);
+    char text[1024];
+    snprintf(text, sizeof text, WORLD("ReadArchive \"%s!a.rib\"\nReadArchive \"%s!dir/b.rib\""),
+             zip, zip);
+    CHECK(rib(text) == RAYES_OK);
+    CHECK(rec.n_mesh == 3); /* one quad stored, two deflated */
+    snprintf(text, sizeof text, WORLD("ReadArchive \"%s!c.rib\""), zip);
+    CHECK(rib(text) != RAYES_OK && strstr(err, "no such member c.rib") != NULL);
+    /* a damaged or foreign file: one line, no crash */
+    FILE *f = fopen(zip, "r+b");
+    if (f) {
+        fseek(f, -4, SEEK_END);
+        fputc(0x7f, f); /* the directory's offset's high byte: far out */
+        fclose(f);
+    }
+    snprintf(text, sizeof text, WORLD("ReadArchive \"%s!a.rib\""), zip);
+    CHECK(rib(text) != RAYES_OK && strstr(err, "damaged") != NULL);
+    f = fopen(zip, "wb");
+    if (f) {
+        fputs(QUAD, f);
+        fclose(f);
+    }
+    CHECK(rib(text) != RAYES_OK && strstr(err, "not a zip file") != NULL);
+    remove(zip);
+}
+
 /* The centre pixel of a RIB file rendered at 8 x 8, no bounces. */
 static float centre(const char *text)
 {
@@ -172,4 +264,5 @@ static void test_png_curve(void)
 }
 
 TEST_MAIN(TEST(test_requests_renderman_accepts), TEST(test_procedural2),
-          TEST(test_classic_light_units), TEST(test_png_curve), TEST(test_texture_coordinates))
+          TEST(test_classic_light_units), TEST(test_png_curve), TEST(test_texture_coordinates),
+          TEST(test_zip_archives))
