@@ -568,6 +568,14 @@ RAYES_API RayesError rayes_scene_area_light_quadric(RayesScene *scene, RayesQuad
  * shadow rays their extinction. */
 RAYES_API RayesError rayes_scene_volume(RayesScene *scene, const float bound[6]);
 
+/* The same medium, only inside the closed surface of the geometry added
+ * last (its object): a ray's segment counts only where the ray leaves
+ * that surface through its back, as after entering it (glass holding a
+ * coloured liquid, pbrt-v4's MediumInterface inside a shape); shadow rays
+ * do not cross it (they meet its surface first). The box still bounds the
+ * march. INVALID_ARGUMENT without geometry before it. */
+RAYES_API RayesError rayes_scene_volume_inside(RayesScene *scene, const float bound[6]);
+
 /* A one-sided emitting quad (an area light) with vertices P[0..3] in order
  * around the quad; it emits radiance L from the side toward which
  * (P1 - P0) x (P2 - P0) points, and is seen by the camera. */

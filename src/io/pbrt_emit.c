@@ -96,14 +96,15 @@ int pbrt_emit_pattern_in(Parser *P, const Token *t, const double m[16], const ch
 }
 
 int pbrt_emit_volume(Parser *P, const Token *t, const double m[16], const RayesParam *params,
-                     size_t n, const float bound[6])
+                     size_t n, const float bound[6], int inside)
 {
     if (send_transform(P, t, m) != 0)
         return -1;
     P->have_sent = 0; /* the shader changes under the material last sent */
     RayesError e = P->sink->set_shader(P->sink->target, "homogeneous", params, n);
     if (e == RAYES_OK)
-        e = P->sink->volume(P->sink->target, bound);
+        e = inside && P->sink->volume_inside ? P->sink->volume_inside(P->sink->target, bound)
+                                             : P->sink->volume(P->sink->target, bound);
     return e != RAYES_OK ? pbrt_sink_failed(P, t, e) : 0;
 }
 

@@ -368,10 +368,12 @@ int pbrt_emit_pattern(Parser *P, const Token *t, const char *name, const char *t
 int pbrt_emit_pattern_in(Parser *P, const Token *t, const double m[16], const char *name,
                          const char *type, const RayesParam *params, size_t n);
 /* A volume (rayes_scene_volume) of the box bound in the space of m, with
- * the built-in "homogeneous" shader of these parameters; the next shape
- * sends its material again. The sink must have the volume method. */
+ * the built-in "homogeneous" shader of these parameters; inside 1: only
+ * inside the shape just sent (rayes_scene_volume_inside, when the sink
+ * has it). The next shape sends its material again. The sink must have
+ * the volume method. */
 int pbrt_emit_volume(Parser *P, const Token *t, const double m[16], const RayesParam *params,
-                     size_t n, const float bound[6]);
+                     size_t n, const float bound[6], int inside);
 /* Sends the recorded object o under the current transform. */
 int pbrt_replay(Parser *P, const Token *t, Object *o);
 

@@ -267,9 +267,12 @@ int pbrt_medium_shape(Parser *P, const Token *t)
     size_t n = medium_params(md, q);
     if (uniform) {
         const float box[6] = {md->p0[0], md->p1[0], md->p0[1], md->p1[1], md->p0[2], md->p1[2]};
-        return pbrt_emit_volume(P, t, md->m, q, n, box);
+        return pbrt_emit_volume(P, t, md->m, q, n, box, 0);
     }
-    return pbrt_emit_volume(P, t, P->gs.ctm, q, n, b);
+    /* a shape drawn as a surface (glass round a liquid) bounds its medium
+     * itself; an interface one (left out) by its box */
+    int surface = strcmp(P->gs.material.shader, PBRT_INVISIBLE) != 0;
+    return pbrt_emit_volume(P, t, P->gs.ctm, q, n, b, surface);
 }
 
 void pbrt_media_free(Parser *P)
@@ -320,5 +323,5 @@ int pbrt_medium_camera(Parser *P)
     size_t n = medium_params(md, q);
     double identity[16];
     pbrt_mat_identity(identity);
-    return pbrt_emit_volume(P, &t, identity, q, n, box);
+    return pbrt_emit_volume(P, &t, identity, q, n, box, 0);
 }

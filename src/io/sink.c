@@ -116,6 +116,11 @@ static RayesError scene_sphere(void *t, float radius)
     return rayes_scene_sphere(t, radius);
 }
 
+static RayesError scene_volume_inside(void *t, const float bound[6])
+{
+    return rayes_scene_volume_inside(t, bound);
+}
+
 static RayesError scene_volume(void *t, const float bound[6])
 {
     return rayes_scene_volume(t, bound);
@@ -258,6 +263,7 @@ IoSink io_sink_scene(RayesScene *scene)
         .points = scene_points,
         .pattern = scene_pattern,
         .volume = scene_volume,
+        .volume_inside = scene_volume_inside,
         .set_visibility = scene_set_visibility,
         .set_opacity_mode = scene_set_opacity_mode,
         .object_begin = scene_object_begin,

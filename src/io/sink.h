@@ -127,6 +127,9 @@ typedef struct IoSink {
     RayesError (*area_light_quadric)(void *target, RayesQuadric type, const float *params,
                                      size_t n_params, unsigned flags, const float L[3],
                                      int two_sided);
+    /* rayes_scene_volume_inside (last; NULL: readers make the box volume,
+     * as before). */
+    RayesError (*volume_inside)(void *target, const float bound[6]);
 } IoSink;
 
 /* A sink that builds scene through rayes.h (borrowed, not retained). */

@@ -285,11 +285,12 @@ Vec3 integrator_transmission(Worker *w, const Ray *ray, RayDiff diff)
  * diffuse hits) or the opacity cache's (cached diffuse hits). */
 static Vec3 trace_layers(Worker *w, const Ray *ray, uint32_t kind, int diffuse_depth,
                          int specular_depth, uint64_t key, RayDiff diff, float *t, float *alpha,
-                         int layer)
+                         int layer, int64_t *leaving)
 {
     Hit hit;
     *t = INFINITY;
     *alpha = 0.0f;
+    *leaving = -1;
     if (!accel_intersect(w->rs->accel, ray, &hit)) {
         /* Environment lights: seen by camera and specular rays; black to
          * diffuse rays, as direct lighting integrates them. */
@@ -309,6 +310,8 @@ static Vec3 trace_layers(Worker *w, const Ray *ray, uint32_t kind, int diffuse_d
     *t = hit.t;
     *alpha = 1.0f;
     const RenderObject *obj = render_object(w->rs, hit.grid, hit.instance);
+    if (v3_dot(hit.Ng, ray->d) > 0.0f) /* out through its back: the ray was inside it */
+        *leaving = obj - w->rs->objects;
     if (obj->light >= 0) {
         /* Emitters: seen by camera and specular rays, on their front side
          * or both (not by glossy-lobe rays: direct lighting has them). */
@@ -341,9 +344,10 @@ static Vec3 trace_layers(Worker *w, const Ray *ray, uint32_t kind, int diffuse_d
     Ray next = *ray;
     next.tnear = hit.t + path_ray_epsilon(w) / fmaxf(v3_length(ray->d), 1e-30f);
     float t_behind, a_behind;
+    int64_t behind;
     Vec3 L = trace_layers(w, &next, kind, diffuse_depth, specular_depth,
                           hash_combine(key, 0x6c61796572ull /* "layer" */), diff, &t_behind,
-                          &a_behind, layer + 1);
+                          &a_behind, layer + 1, &behind);
     float cover = 1.0f - (T.x + T.y + T.z) / 3.0f;
     *alpha = cover + (1.0f - cover) * a_behind;
     return v3_add(Ci, v3_mul(T, L));
@@ -354,12 +358,14 @@ static Vec3 trace_layers(Worker *w, const Ray *ray, uint32_t kind, int diffuse_d
 static Vec3 trace_volumes(Worker *w, const Ray *ray, uint32_t kind, int diffuse_depth,
                           int specular_depth, uint64_t key, RayDiff diff, float *t, float *alpha)
 {
-    Vec3 L = trace_layers(w, ray, kind, diffuse_depth, specular_depth, key, diff, t, alpha, 0);
+    int64_t leaving;
+    Vec3 L =
+        trace_layers(w, ray, kind, diffuse_depth, specular_depth, key, diff, t, alpha, 0, &leaving);
     if (!w->rs->n_volumes)
         return L;
     Vec3 T;
     float tmax = isfinite(*t) ? *t : ray->tfar;
-    Vec3 Lv = volume_radiance(w, ray, tmax, kind, diffuse_depth, specular_depth,
+    Vec3 Lv = volume_radiance(w, ray, tmax, leaving, kind, diffuse_depth, specular_depth,
                               hash_combine(key, 0x766f6c756d65ull /* "volume" */), diff, &T);
     *alpha = 1.0f - (1.0f - *alpha) * (T.x + T.y + T.z) / 3.0f;
     return v3_add(Lv, v3_mul(T, L));

@@ -416,8 +416,8 @@ Vec3 volume_transmittance(Worker *w, const Ray *ray, RayDiff diff)
     for (size_t k = 0; k < w->rs->n_volumes; k++) {
         const RenderVolume *v = &w->rs->volumes[k];
         float t0, t1;
-        if (!clip(v, ray, ray->tfar, &t0, &t1))
-            continue;
+        if (v->inside >= 0 || !clip(v, ray, ray->tfar, &t0, &t1))
+            continue; /* inside its object: shadow rays from outside cross its surface first */
         if (!counted++)
             w->stats.rays_transmission++;
         March m = march(w, v, ray, t0, t1, ray_jitter(ray), v->uniform ? 1 : VOLUME_MAX_STEPS);
@@ -440,8 +440,8 @@ Vec3 volume_transmittance(Worker *w, const Ray *ray, RayDiff diff)
     return T;
 }
 
-Vec3 volume_radiance(Worker *w, const Ray *ray, float tmax, uint32_t kind, int diffuse_depth,
-                     int specular_depth, uint64_t key, RayDiff diff, Vec3 *T)
+Vec3 volume_radiance(Worker *w, const Ray *ray, float tmax, int64_t leaving, uint32_t kind,
+                     int diffuse_depth, int specular_depth, uint64_t key, RayDiff diff, Vec3 *T)
 {
     Vec3 L = v3(0, 0, 0);
     *T = v3(1, 1, 1);
@@ -450,8 +450,8 @@ Vec3 volume_radiance(Worker *w, const Ray *ray, float tmax, uint32_t kind, int d
         const RenderVolume *v = &w->rs->volumes[k];
         const RenderObject *obj = &w->rs->objects[v->object];
         float t0, t1;
-        if (!clip(v, ray, tmax, &t0, &t1))
-            continue;
+        if ((v->inside >= 0 && v->inside != leaving) || !clip(v, ray, tmax, &t0, &t1))
+            continue; /* bounded by an object the ray is not inside */
         uint64_t vkey = hash_combine(key, 0x766f6c0000ull + k);
         March m = march(w, v, ray, t0, t1, rng_float(vkey),
                         v->uniform ? VOLUME_LIGHT_SAMPLES : VOLUME_MAX_STEPS);

@@ -33,6 +33,9 @@ typedef struct RenderVolume {
     int n_brick[3];              /* bricks along each axis */
     uint32_t key_base;           /* cache keys: patch key_base + brick index */
     float voxel;                 /* a fine voxel's size, world units (the march step) */
+    int64_t inside;              /* -1, or the RenderObject whose surfaces bound it: a ray's
+                                    segment is in it only when the ray leaves that object
+                                    through its back (rayes_scene_volume_inside) */
     int uniform;                 /* 1: the same extinction everywhere (the homogeneous shader
                                     without patterns): transmittance takes one step, scattering
                                     one per lighting point */
@@ -60,8 +63,9 @@ Vec3 volume_transmittance(Worker *w, const Ray *ray, RayDiff diff);
 /* The light the volumes send toward ray->o along ray->d from [tnear,
  * tmax] (camera and specular rays of type kind, at the given depths, the
  * key naming its random numbers), and in *T the transmittance over that
- * segment, by which what lies beyond it is seen. */
-Vec3 volume_radiance(Worker *w, const Ray *ray, float tmax, uint32_t kind, int diffuse_depth,
-                     int specular_depth, uint64_t key, RayDiff diff, Vec3 *T);
+ * segment, by which what lies beyond it is seen. leaving: the object
+ * whose back the segment ends on (-1: none), for volumes inside one. */
+Vec3 volume_radiance(Worker *w, const Ray *ray, float tmax, int64_t leaving, uint32_t kind,
+                     int diffuse_depth, int specular_depth, uint64_t key, RayDiff diff, Vec3 *T);
 
 #endif /* RAYES_RENDER_VOLUME_H */

@@ -59,6 +59,7 @@ RayesScene *rayes_scene_new(void)
     s->world_from_object = mat4_identity();
     s->shading_rate = 1.0f;
     s->current_object = -1;
+    s->last_geometry_object = -1;
     s->current_visibility =
         RAYES_RAY_CAMERA | RAYES_RAY_DIFFUSE | RAYES_RAY_SPECULAR | RAYES_RAY_SHADOW;
     s->current_opacity_cache = 1;
@@ -468,6 +469,7 @@ static RayesError add_prim(RayesScene *s, Prim *p)
         return scene_fail(s, RAYES_ERROR_OUT_OF_MEMORY, "out of memory");
     p->object = s->current_object == SCENE_OBJECT_INHERIT ? GEOM_OBJECT_INHERIT
                                                           : (uint32_t)s->current_object;
+    s->last_geometry_object = s->current_object == SCENE_OBJECT_INHERIT ? -1 : s->current_object;
     p->master = s->open_master >= 0 ? (uint32_t)s->open_master + 1 : 0;
     p->solid = 0;
     if (s->open_solid >= 0 && p->master == 0) {
@@ -925,7 +927,7 @@ RayesError rayes_scene_sphere(RayesScene *s, float radius)
     return add_prim(s, &p);
 }
 
-RayesError rayes_scene_volume(RayesScene *s, const float bound[6])
+static RayesError add_volume(RayesScene *s, const float bound[6], int64_t inside)
 {
     if (!s || !bound)
         return RAYES_ERROR_INVALID_ARGUMENT;
@@ -945,11 +947,27 @@ RayesError rayes_scene_volume(RayesScene *s, const float bound[6])
         return scene_fail(s, RAYES_ERROR_OUT_OF_MEMORY, "out of memory");
     SceneVolume *v = &s->volumes[s->n_volumes++];
     v->object = (uint32_t)s->current_object;
+    v->inside = inside;
     v->world_from_object = s->world_from_object;
     memcpy(v->bound, bound, sizeof v->bound);
     v->shading_rate = s->shading_rate;
     scene_mark(s, SCENE_CHANGE_GEOMETRY);
     return RAYES_OK;
+}
+
+RayesError rayes_scene_volume(RayesScene *s, const float bound[6])
+{
+    return add_volume(s, bound, -1);
+}
+
+RayesError rayes_scene_volume_inside(RayesScene *s, const float bound[6])
+{
+    if (!s)
+        return RAYES_ERROR_INVALID_ARGUMENT;
+    if (s->last_geometry_object < 0)
+        return scene_fail(s, RAYES_ERROR_INVALID_ARGUMENT,
+                          "volume inside: no geometry before it (a closed shape bounds it)");
+    return add_volume(s, bound, s->last_geometry_object);
 }
 
 static void light_motion(const RayesScene *s, Light *l);

@@ -40,6 +40,7 @@ typedef struct SceneObject {
  * filled by its object's shader. */
 typedef struct SceneVolume {
     uint32_t object;
+    int64_t inside; /* -1, or the object whose surfaces bound it */
     Mat4 world_from_object;
     float bound[6];           /* xmin, xmax, ymin, ymax, zmin, zmax */
     float shading_rate;
@@ -159,6 +160,7 @@ struct RayesScene {
     Mat4 world_from_object;   /* the current transform */
     float shading_rate;       /* the current shading rate */
     int64_t current_object;   /* object of geometry added next; -1: make a default matte */
+    int64_t last_geometry_object; /* the object of the last primitive added, or -1 */
     Prim *prims;
     size_t n_prims, cap_prims;
     struct SubdivMesh **subdivs; /* subdivision meshes, owned; their patches are prims */

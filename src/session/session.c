@@ -376,6 +376,7 @@ static int prepare_volumes(const RayesScene *scene, const RenderSettings *set, P
         if (bricks == 0)
             continue; /* a singular transform: nothing to march */
         v->uniform = volume_uniform(&p->objects[sv->object]);
+        v->inside = sv->inside;
         base += bricks;
         p->n_volumes++;
     }

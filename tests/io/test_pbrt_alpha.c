@@ -12,7 +12,8 @@
  *
  * Also pbrt-v4's material "displacement", a bump map: the shading normal
  * bends, the surface stays (it used to move, and swelled a scene's
- * cushions over its table).
+ * cushions over its table); and a medium inside a glass shape, which
+ * fills the shape, not its bounding box.
  */
 #include <math.h>
 #include <stdio.h>
@@ -235,5 +236,33 @@ static void test_displacement_is_bump(void)
     rayes_image_free(ridged);
 }
 
+/* A glass sphere holding an absorbing medium before a white sky: the
+ * sky beside the sphere, inside its bounding box, is untinted (the box
+ * was filled: a green square); through the sphere, red and blue are
+ * absorbed. */
+static void test_medium_inside_glass(void)
+{
+    const char *text =
+        "LookAt 0 0 -5  0 0 0  0 1 0\nCamera \"perspective\" \"float fov\" 22\n"
+        "WorldBegin\nLightSource \"infinite\" \"rgb L\" [1 1 1]\n"
+        "MakeNamedMedium \"green\" \"string type\" \"homogeneous\" \"rgb sigma_a\" [4 0.2 4] "
+        "\"rgb sigma_s\" [0 0 0]\n"
+        "AttributeBegin\nMediumInterface \"green\" \"\"\nMaterial \"dielectric\" "
+        "\"float eta\" 1.01\nShape \"sphere\" \"float radius\" 0.9\nAttributeEnd\n";
+    RayesImage *img = render_read(io_pbrt_parse, text, 1);
+    CHECK(img != NULL);
+    if (img) {
+        /* a corner of the sphere's box on screen (the sphere covers most
+         * of the frame: its box's corners lie outside the disc) */
+        const float *corner = &img->rgba[4 * (1 * SIZE + 1)];
+        const float *mid = &img->rgba[4 * (SIZE / 2 * SIZE + SIZE / 2)];
+        printf("  medium in glass: beside %.3f %.3f %.3f, through %.3f %.3f %.3f\n", corner[0],
+               corner[1], corner[2], mid[0], mid[1], mid[2]);
+        CHECK(corner[0] > 0.95f && corner[1] > 0.95f && corner[2] > 0.95f);
+        CHECK(mid[1] > 0.5f && mid[0] < 0.1f && mid[2] < 0.1f); /* exp(-4 * 1.8) red */
+    }
+    rayes_image_free(img);
+}
+
 TEST_MAIN(TEST(test_constant_alpha), TEST(test_texture_alpha), TEST(test_rib_round_trip),
-          TEST(test_bad_alpha), TEST(test_displacement_is_bump))
+          TEST(test_bad_alpha), TEST(test_displacement_is_bump), TEST(test_medium_inside_glass))
