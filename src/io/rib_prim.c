@@ -1127,6 +1127,9 @@ static int h_volume(Rib *r, const Args *a)
         rib_get_floats(r, a, &i, dims, 3, "the voxel counts nx ny nz") != 0 ||
         rib_get_params(r, a, i, &p, &n) != 0)
         return -1;
+    /* rayes' own "inside" 1: only inside the geometry just before it */
+    const Param *in = rib_find_param(p, n, "inside");
+    int inside = in && rib_is_num(in->v) && in->v->n == 1 && in->v->d[0] != 0;
     free(p);
     if (strcmp(type, "box") != 0) {
         char key[128];
@@ -1142,7 +1145,8 @@ static int h_volume(Rib *r, const Args *a)
         const IoSink *s = rib_out_sink(r, &st);
         if (!s->volume)
             rib_warn_once(r, "volume sink", "Volume is not supported here; skipped");
-        else if (s->volume(s->target, b) != RAYES_OK)
+        else if ((inside && s->volume_inside ? s->volume_inside(s->target, b)
+                                             : s->volume(s->target, b)) != RAYES_OK)
             e = rib_sink_failed(r, s);
     }
     return e > 0 ? 0 : e;

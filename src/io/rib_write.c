@@ -1148,14 +1148,25 @@ static RayesError w_quadric(void *t, RayesQuadric type, const float *p, size_t n
     return RAYES_OK;
 }
 
-static RayesError w_volume(void *t, const float b[6])
+static RayesError volume(RibWriter *w, const float b[6], int inside)
 {
-    RibWriter *w = t;
     if (!b || !finite_all(b, 6))
         return fail(w, RAYES_ERROR_INVALID_ARGUMENT, "volume: bound not finite");
-    fprintf(w->world.f, "Volume \"box\" [%.9g %.9g %.9g %.9g %.9g %.9g] [1 1 1]\n", (double)b[0],
-            (double)b[1], (double)b[2], (double)b[3], (double)b[4], (double)b[5]);
+    fprintf(w->world.f, "Volume \"box\" [%.9g %.9g %.9g %.9g %.9g %.9g] [1 1 1]%s\n", (double)b[0],
+            (double)b[1], (double)b[2], (double)b[3], (double)b[4], (double)b[5],
+            inside ? " \"constant int inside\" [1]" : "");
     return RAYES_OK;
+}
+
+static RayesError w_volume(void *t, const float b[6])
+{
+    return volume(t, b, 0);
+}
+
+/* Inside the geometry written just before (rayes' own parameter). */
+static RayesError w_volume_inside(void *t, const float b[6])
+{
+    return volume(t, b, 1);
 }
 
 static RayesError w_sphere(void *t, float r)
@@ -1451,6 +1462,7 @@ IoSink io_rib_writer_sink(RibWriter *w)
         .sphere = w_sphere,
         .quadric = w_quadric,
         .volume = w_volume,
+        .volume_inside = w_volume_inside,
         .area_light = w_area_light,
         .light = w_light,
         .set_light_links = w_set_light_links,

@@ -261,6 +261,31 @@ static void test_medium_inside_glass(void)
         CHECK(corner[0] > 0.95f && corner[1] > 0.95f && corner[2] > 0.95f);
         CHECK(mid[1] > 0.5f && mid[0] < 0.1f && mid[2] < 0.1f); /* exp(-4 * 1.8) red */
     }
+    /* written as RIB (rayes' "inside" on the Volume) and read back: the
+     * same image */
+    char err[512], *rib = NULL;
+    size_t size = 0;
+    RibWriter *w = io_rib_writer_new();
+    IoSink sink = io_rib_writer_sink(w);
+    IoSettings settings;
+    io_settings_init(&settings);
+    CHECK(io_pbrt_parse("medium.pbrt", (const unsigned char *)text, strlen(text), &sink, NULL,
+                        &settings, err, sizeof err) == RAYES_OK);
+    FILE *f = open_memstream(&rib, &size);
+    CHECK(io_rib_writer_finish(w, &settings, f, err, sizeof err) == RAYES_OK);
+    fclose(f);
+    CHECK(rib && strstr(rib, "\"constant int inside\" [1]") != NULL);
+    RayesImage *back = rib ? render_read(io_rib_parse, rib, 1) : NULL;
+    CHECK(img && back);
+    if (img && back) {
+        float d = 0;
+        for (int i = 0; i < 4 * SIZE * SIZE; i++)
+            d = fmaxf(d, fabsf(img->rgba[i] - back->rgba[i]));
+        CHECK(d < 1e-4f);
+    }
+    rayes_image_free(back);
+    io_rib_writer_free(w);
+    free(rib);
     rayes_image_free(img);
 }
 
