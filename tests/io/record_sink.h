@@ -393,6 +393,16 @@ static inline RayesError record_rib(Record *rec, const char *text, IoSettings *s
     return e;
 }
 
+/* record_rib, printing the error when the text is refused. */
+static inline RayesError record_rib_said(Record *rec, const char *text, IoSettings *settings,
+                                         char *err, size_t err_size)
+{
+    RayesError e = record_rib(rec, text, settings, err, err_size);
+    if (e != RAYES_OK)
+        fprintf(stderr, "%s\n", err);
+    return e;
+}
+
 /* The parameter of that name, or NULL. */
 static const RayesParam *rec_param(const RecShader *s, const char *name)
 {

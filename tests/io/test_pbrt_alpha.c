@@ -145,33 +145,44 @@ static void test_texture_alpha(void)
 
 /* Converted to RIB (the writer keeps Os bound to the pattern), the scene
  * renders the same. */
-static void test_rib_round_trip(void)
+/* The pbrt text written as RIB by the RIB writer (new string, or NULL). */
+static char *pbrt_as_rib(const char *text)
 {
-    char text[4096], err[512], *rib = NULL;
+    char err[512], *rib = NULL;
     size_t size = 0;
-    scene_text("\"texture alpha\" \"checks\"", text, sizeof text);
     RibWriter *w = io_rib_writer_new();
     IoSink sink = io_rib_writer_sink(w);
     IoSettings settings;
     io_settings_init(&settings);
-    CHECK(io_pbrt_parse("alpha.pbrt", (const unsigned char *)text, strlen(text), &sink, NULL,
-                        &settings, err, sizeof err) == RAYES_OK);
+    CHECK(io_pbrt_parse("t.pbrt", (const unsigned char *)text, strlen(text), &sink, NULL, &settings,
+                        err, sizeof err) == RAYES_OK);
     FILE *f = open_memstream(&rib, &size);
     CHECK(io_rib_writer_finish(w, &settings, f, err, sizeof err) == RAYES_OK);
     fclose(f);
-    CHECK(strstr(rib, "\"reference pattern Os\"") != NULL);
+    io_rib_writer_free(w);
+    return rib;
+}
+
+/* The largest difference of two images' values (1 if either is missing). */
+static float max_diff(const RayesImage *a, const RayesImage *b)
+{
+    float d = a && b ? 0.0f : 1.0f;
+    for (int i = 0; a && b && i < 4 * SIZE * SIZE; i++)
+        d = fmaxf(d, fabsf(a->rgba[i] - b->rgba[i]));
+    return d;
+}
+
+static void test_rib_round_trip(void)
+{
+    char text[4096];
+    scene_text("\"texture alpha\" \"checks\"", text, sizeof text);
+    char *rib = pbrt_as_rib(text);
+    CHECK(rib && strstr(rib, "\"reference pattern Os\"") != NULL);
     RayesImage *a = render_pbrt("\"texture alpha\" \"checks\"", 0),
-               *b = render_read(io_rib_parse, rib, 0);
-    CHECK(a && b);
-    if (a && b) {
-        float d = 0;
-        for (int i = 0; i < 4 * SIZE * SIZE; i++)
-            d = fmaxf(d, fabsf(a->rgba[i] - b->rgba[i]));
-        CHECK(d < 1e-4f);
-    }
+               *b = rib ? render_read(io_rib_parse, rib, 0) : NULL;
+    CHECK(max_diff(a, b) < 1e-4f);
     rayes_image_free(a);
     rayes_image_free(b);
-    io_rib_writer_free(w);
     free(rib);
 }
 
@@ -263,28 +274,11 @@ static void test_medium_inside_glass(void)
     }
     /* written as RIB (rayes' "inside" on the Volume) and read back: the
      * same image */
-    char err[512], *rib = NULL;
-    size_t size = 0;
-    RibWriter *w = io_rib_writer_new();
-    IoSink sink = io_rib_writer_sink(w);
-    IoSettings settings;
-    io_settings_init(&settings);
-    CHECK(io_pbrt_parse("medium.pbrt", (const unsigned char *)text, strlen(text), &sink, NULL,
-                        &settings, err, sizeof err) == RAYES_OK);
-    FILE *f = open_memstream(&rib, &size);
-    CHECK(io_rib_writer_finish(w, &settings, f, err, sizeof err) == RAYES_OK);
-    fclose(f);
+    char *rib = pbrt_as_rib(text);
     CHECK(rib && strstr(rib, "\"constant int inside\" [1]") != NULL);
     RayesImage *back = rib ? render_read(io_rib_parse, rib, 1) : NULL;
-    CHECK(img && back);
-    if (img && back) {
-        float d = 0;
-        for (int i = 0; i < 4 * SIZE * SIZE; i++)
-            d = fmaxf(d, fabsf(img->rgba[i] - back->rgba[i]));
-        CHECK(d < 1e-4f);
-    }
+    CHECK(img && max_diff(img, back) < 1e-4f);
     rayes_image_free(back);
-    io_rib_writer_free(w);
     free(rib);
     rayes_image_free(img);
 }

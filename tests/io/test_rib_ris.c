@@ -24,10 +24,7 @@ static char err[1024];
 
 static RayesError rib(const char *text)
 {
-    RayesError e = record_rib(&rec, text, &settings, err, sizeof err);
-    if (e != RAYES_OK)
-        fprintf(stderr, "%s\n", err);
-    return e;
+    return record_rib_said(&rec, text, &settings, err, sizeof err);
 }
 
 #define WORLD(body) "Projection \"perspective\" \"fov\" 40\nWorldBegin\n" body "\nWorldEnd\n"
