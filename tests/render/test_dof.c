@@ -216,5 +216,5 @@ static void test_focusfactor(void)
     rayes_image_free(b);
 }
 
-TEST_MAIN(TEST(test_focus_and_circle_of_confusion), TEST(test_focusfactor),
+TEST_MAIN(TEST_THREADS(test_focus_and_circle_of_confusion), TEST(test_focusfactor),
           TEST(test_defocus_reads_coarser))

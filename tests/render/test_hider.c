@@ -229,6 +229,6 @@ static void test_sharp_reflections_per_sample(void)
     rayes_image_free(b);
 }
 
-TEST_MAIN(TEST(test_agrees_with_raytrace), TEST(test_highlights_not_smeared), TEST(test_irradiance_interpolation),
-          TEST(test_any_thread_count), TEST(test_sharp_reflections_per_sample),
-          TEST(test_shading_follows_vertices))
+TEST_MAIN(TEST(test_agrees_with_raytrace), TEST(test_highlights_not_smeared),
+          TEST_THREADS(test_irradiance_interpolation), TEST_THREADS(test_any_thread_count),
+          TEST(test_sharp_reflections_per_sample), TEST(test_shading_follows_vertices))

@@ -975,10 +975,11 @@ static void test_moving_instance_threads_and_hider(void)
     rayes_image_free(f);
 }
 
-TEST_MAIN(TEST(test_moving_instance_cached), TEST(test_moving_instance_threads_and_hider),
-          TEST(test_moving_instance), TEST(test_moving_hits), TEST(test_moving_sphere_coverage),
-          TEST(test_moving_points_and_curves), TEST(test_deforming_points_and_curves),
-          TEST(test_moving_light_shadow), TEST(test_moving_light_cached),
-          TEST(test_grid_hider_motion), TEST(test_motionfactor),
-          TEST(test_cached_segments_match_uncached), TEST(test_motion_determinism),
-          TEST(test_deformation_equals_transform), TEST(test_bad_motion), TEST(test_camera_motion))
+TEST_MAIN(TEST(test_moving_instance_cached), TEST_THREADS(test_moving_instance_threads_and_hider),
+          TEST_THREADS(test_moving_instance), TEST(test_moving_hits),
+          TEST(test_moving_sphere_coverage), TEST(test_moving_points_and_curves),
+          TEST(test_deforming_points_and_curves), TEST(test_moving_light_shadow),
+          TEST(test_moving_light_cached), TEST_THREADS(test_grid_hider_motion),
+          TEST(test_motionfactor), TEST(test_cached_segments_match_uncached),
+          TEST_THREADS(test_motion_determinism), TEST(test_deformation_equals_transform),
+          TEST(test_bad_motion), TEST(test_camera_motion))
