@@ -70,7 +70,7 @@ int cmd_assemble(int argc, char **argv)
     if (status == 0) {
         int win[4] = {u[0], u[1], u[2] - u[0], u[3] - u[1]};
         char err[1024];
-        if (image_write_exr_window(out, size[0], size[1], full, win, err, sizeof err) !=
+        if (image_write_exr_window(out, size[0], size[1], full, win, 0, err, sizeof err) !=
             RAYES_OK) {
             fprintf(stderr, "rayes: %s\n", err);
             status = 1;

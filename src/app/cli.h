@@ -35,6 +35,7 @@ enum {
 typedef struct Output {
     char path[600];
     ImageFormat format;
+    int no_alpha; /* a display of mode "rgb": R, G, B only */
 } Output;
 
 typedef struct Args {

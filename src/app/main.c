@@ -206,18 +206,21 @@ static void scene_stem(const char *scene, char *out, size_t size)
         *dot = '\0';
 }
 
-static void add_output(Args *a, const char *path, ImageFormat format)
+static void add_output(Args *a, const char *path, ImageFormat format, int no_alpha)
 {
     if (a->n_outputs == MAX_OUTPUTS)
         return;
-    snprintf(a->outputs[a->n_outputs].path, sizeof a->outputs[0].path, "%s", path);
-    a->outputs[a->n_outputs++].format = format;
+    Output *o = &a->outputs[a->n_outputs++];
+    snprintf(o->path, sizeof o->path, "%s", path);
+    o->format = format;
+    o->no_alpha = no_alpha;
 }
 
 /* The images a file's displays ask for: exr/openexr and png by type,
  * file and tiff by the name's extension, else OpenEXR (with a note);
  * framebuffer windows write nothing; displays of other modes than rgb and
- * rgba (AOVs) are skipped with a warning each. */
+ * rgba (AOVs) are skipped with a warning each. Mode rgb writes no alpha,
+ * as RenderMan's displays do: a black background. */
 static void outputs_from_displays(Args *a, const IoSettings *s)
 {
     for (int i = 0; i < s->n_displays && i < IO_MAX_DISPLAYS; i++) {
@@ -230,14 +233,15 @@ static void outputs_from_displays(Args *a, const IoSettings *s)
         }
         if (strcasecmp(type, "framebuffer") == 0)
             continue;
+        int rgb = strcasecmp(d->mode, "rgb") == 0;
         if (strcasecmp(type, "exr") == 0 || strcasecmp(type, "openexr") == 0) {
-            add_output(a, d->name, IMAGE_FORMAT_EXR);
+            add_output(a, d->name, IMAGE_FORMAT_EXR, rgb);
         } else if (strcasecmp(type, "png") == 0) {
-            add_output(a, d->name, IMAGE_FORMAT_PNG);
+            add_output(a, d->name, IMAGE_FORMAT_PNG, rgb);
         } else if (strcasecmp(type, "file") == 0 || strcasecmp(type, "tiff") == 0) {
             ImageFormat f = image_format_from_path(d->name);
             if (f != IMAGE_FORMAT_UNKNOWN) {
-                add_output(a, d->name, f);
+                add_output(a, d->name, f, rgb);
                 continue;
             }
             char path[600];
@@ -246,7 +250,7 @@ static void outputs_from_displays(Args *a, const IoSettings *s)
             snprintf(path, sizeof path, "%.*s.exr", stem, d->name);
             fprintf(stderr, "rayes: note: display \"%s\" (%s): written as OpenEXR to %s\n",
                     d->name, type, path);
-            add_output(a, path, IMAGE_FORMAT_EXR);
+            add_output(a, path, IMAGE_FORMAT_EXR, rgb);
         } else {
             fprintf(stderr, "rayes: warning: display \"%s\": type \"%s\" is not supported; "
                             "skipped\n", d->name, type);
@@ -272,13 +276,15 @@ static void apply_exposure(RayesImage *img, float gain, float gamma)
 static RayesError write_output(const Output *o, const RayesImage *img, int linear, char *err,
                                size_t n)
 {
+    int flags = (linear ? IMAGE_LINEAR : 0) | (o->no_alpha ? IMAGE_NO_ALPHA : 0);
     int win[4] = {0, 0, img->width, img->height};
     if (img->crop[2] > 0)
         memcpy(win, img->crop, sizeof win);
     if (o->format != IMAGE_FORMAT_PNG)
-        return image_write_exr_window(o->path, img->width, img->height, img->rgba, win, err, n);
+        return image_write_exr_window(o->path, img->width, img->height, img->rgba, win, flags, err,
+                                      n);
     if (win[2] == img->width && win[3] == img->height)
-        return image_write_png_curve(o->path, img->width, img->height, img->rgba, linear, err, n);
+        return image_write_png_curve(o->path, img->width, img->height, img->rgba, flags, err, n);
     float *crop = malloc(sizeof(float) * 4 * (size_t)win[2] * (size_t)win[3]);
     if (!crop) {
         snprintf(err, n, "%s: out of memory", o->path);
@@ -288,7 +294,7 @@ static RayesError write_output(const Output *o, const RayesImage *img, int linea
         memcpy(crop + 4 * (size_t)y * (size_t)win[2],
                img->rgba + 4 * ((size_t)(win[1] + y) * (size_t)img->width + (size_t)win[0]),
                sizeof(float) * 4 * (size_t)win[2]);
-    RayesError e = image_write_png_curve(o->path, win[2], win[3], crop, linear, err, n);
+    RayesError e = image_write_png_curve(o->path, win[2], win[3], crop, flags, err, n);
     free(crop);
     return e;
 }
@@ -450,7 +456,7 @@ static int render_job(Args a, int frame, int number, Distributed *d)
             if (settings.n_displays > 0)
                 fprintf(stderr, "rayes: note: %s: no display writes a file; writing %s\n",
                         a.scene, path);
-            add_output(&a, path, IMAGE_FORMAT_EXR);
+            add_output(&a, path, IMAGE_FORMAT_EXR, 0);
         }
     }
     if (a.skip_existing) { /* a farm's retry: the frame is done when all its outputs are */

@@ -29,25 +29,32 @@ typedef enum ImageFormat {
 /* The format named by a path's extension (.exr, .png, any case). */
 ImageFormat image_format_from_path(const char *path);
 
+/* What the writers below write beyond the pixels' colours:
+ * IMAGE_LINEAR (PNG) the values quantized as they are (clamped to [0, 1])
+ * with no colour chunk: what RenderMan writes to 8 bits, its Exposure
+ * gamma the only curve (else the sRGB curve and chunk);
+ * IMAGE_NO_ALPHA R, G, B only (RenderMan's display mode "rgb": what no
+ * surface covers is black, not transparent). */
+enum { IMAGE_LINEAR = 1, IMAGE_NO_ALPHA = 2 };
+
 /* EXR: half-float R, G, B, A channels, ZIP compression, scanlines, with a
  * "renderer" string attribute. */
 RayesError image_write_exr(const char *path, int width, int height, const float *rgba,
                         char *err, size_t err_size);
 /* The same with the data window x, y, w, h of window[] (a crop: the
- * display window stays width x height, as OpenEXR intends). */
+ * display window stays width x height, as OpenEXR intends) and flags
+ * (IMAGE_NO_ALPHA). */
 RayesError image_write_exr_window(const char *path, int width, int height, const float *rgba,
-                                  const int window[4], char *err, size_t err_size);
+                                  const int window[4], int flags, char *err, size_t err_size);
 
 /* PNG: 8-bit RGBA, sRGB-encoded (the sRGB transfer curve applied to the
  * clamped linear values, alpha linear), with an sRGB chunk. */
 RayesError image_write_png(const char *path, int width, int height, const float *rgba,
                         char *err, size_t err_size);
 
-/* The same, or with linear 1 the values quantized as they are (clamped to
- * [0, 1]) with no colour chunk: what RenderMan writes to 8 bits, its
- * Exposure gamma the only curve. */
+/* The same with flags (IMAGE_LINEAR, IMAGE_NO_ALPHA). */
 RayesError image_write_png_curve(const char *path, int width, int height, const float *rgba,
-                                 int linear, char *err, size_t err_size);
+                                 int flags, char *err, size_t err_size);
 
 /* Dispatch on the extension; an unknown extension is INVALID_ARGUMENT. */
 RayesError image_write(const char *path, int width, int height, const float *rgba,

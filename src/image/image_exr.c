@@ -70,6 +70,7 @@ typedef struct ExrImage {
     int width, height; /* pixels: the display window */
     const float *rgba; /* width * height * 4, top row first */
     int x0, y0, w, h;  /* the data window written: its corner and size */
+    int channels;      /* 4: R, G, B, A; 3: R, G, B */
 } ExrImage;
 
 /* ------------------------------------------------------------ callbacks */
@@ -211,7 +212,7 @@ static exr_result_t define_part(exr_context_t ctx, const ExrImage *image)
                                           EXR_LINEORDER_INCREASING_Y, EXR_COMPRESSION_ZIP);
     /* Perceptual treatment only matters to lossy codecs; say it right. */
     static const char *const names[4] = {"R", "G", "B", "A"};
-    for (int i = 0; i < 4 && rv == EXR_ERR_SUCCESS; i++)
+    for (int i = 0; i < image->channels && rv == EXR_ERR_SUCCESS; i++)
         rv = exr_add_channel(ctx, part, names[i], EXR_PIXEL_HALF,
                              i == 3 ? EXR_PERCEPTUALLY_LINEAR : EXR_PERCEPTUALLY_LOGARITHMIC, 1, 1);
     if (rv == EXR_ERR_SUCCESS)
@@ -297,11 +298,11 @@ RayesError image_write_exr(const char *path, int width, int height, const float 
                         size_t err_size)
 {
     const int all[4] = {0, 0, width, height};
-    return image_write_exr_window(path, width, height, rgba, all, err, err_size);
+    return image_write_exr_window(path, width, height, rgba, all, 0, err, err_size);
 }
 
 RayesError image_write_exr_window(const char *path, int width, int height, const float *rgba,
-                                  const int window[4], char *err, size_t err_size)
+                                  const int window[4], int flags, char *err, size_t err_size)
 {
     if (!path || !rgba || width <= 0 || height <= 0 || width > MAX_SIDE || window[0] < 0 ||
         window[1] < 0 || window[2] <= 0 || window[3] <= 0 || window[0] + window[2] > width ||
@@ -310,7 +311,8 @@ RayesError image_write_exr_window(const char *path, int width, int height, const
                      path ? path : "(null)", width, height, rgba ? "" : ", no pixels");
         return RAYES_ERROR_INVALID_ARGUMENT;
     }
-    ExrImage image = {width, height, rgba, window[0], window[1], window[2], window[3]};
+    ExrImage image = {width,     height,    rgba,      window[0],
+                      window[1], window[2], window[3], flags & IMAGE_NO_ALPHA ? 3 : 4};
     return image_write_via_temp(path, write_exr_body, &image, err, err_size);
 }
 

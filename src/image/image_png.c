@@ -56,6 +56,7 @@ typedef struct PngImage {
     int width, height; /* pixels */
     const float *rgba; /* width * height * 4, top row first */
     int linear;        /* 1: values quantized as they are, no colour chunk */
+    int channels;      /* 4: RGBA, 3: RGB */
 } PngImage;
 
 /* ------------------------------------------------------------ callbacks */
@@ -142,24 +143,25 @@ static uint8_t encode_linear8(float value)
 }
 
 /* Runs libpng over the whole image; returns 0, or -1 after a libpng error
- * (the message in io). row holds width * 4 bytes. */
+ * (the message in io). row holds width * image->channels bytes. */
 static int write_png_all(png_structp png, png_infop info, const PngImage *image, uint8_t *row)
 {
     if (setjmp(png_jmpbuf(png)))
         return -1;
     png_set_IHDR(png, info, (png_uint_32)image->width, (png_uint_32)image->height, 8,
-                 PNG_COLOR_TYPE_RGB_ALPHA, PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT,
-                 PNG_FILTER_TYPE_DEFAULT);
+                 image->channels == 4 ? PNG_COLOR_TYPE_RGB_ALPHA : PNG_COLOR_TYPE_RGB,
+                 PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
     if (!image->linear)
         png_set_sRGB_gAMA_and_cHRM(png, info, PNG_sRGB_INTENT_PERCEPTUAL);
     png_write_info(png, info);
     for (int y = 0; y < image->height; y++) {
         const float *src = image->rgba + (size_t)y * (size_t)image->width * 4;
-        for (int x = 0; x < image->width; x++) {
+        for (int x = 0, k = image->channels; x < image->width; x++) {
             for (int c = 0; c < 3; c++)
-                row[4 * x + c] =
+                row[k * x + c] =
                     image->linear ? encode_linear8(src[4 * x + c]) : encode_srgb8(src[4 * x + c]);
-            row[4 * x + 3] = encode_linear8(src[4 * x + 3]);
+            if (k == 4)
+                row[4 * x + 3] = encode_linear8(src[4 * x + 3]);
         }
         png_write_row(png, row);
     }
@@ -201,14 +203,15 @@ RayesError image_write_png(const char *path, int width, int height, const float 
 }
 
 RayesError image_write_png_curve(const char *path, int width, int height, const float *rgba,
-                                 int linear, char *err, size_t err_size)
+                                 int flags, char *err, size_t err_size)
 {
     if (!path || !rgba || width <= 0 || height <= 0) {
         image_set_error(err, err_size, "%s: cannot write PNG: invalid arguments (%d x %d pixels%s)",
                      path ? path : "(null)", width, height, rgba ? "" : ", no pixels");
         return RAYES_ERROR_INVALID_ARGUMENT;
     }
-    PngImage image = {width, height, rgba, linear != 0};
+    PngImage image = {width, height, rgba, (flags & IMAGE_LINEAR) != 0,
+                      flags & IMAGE_NO_ALPHA ? 3 : 4};
     return image_write_via_temp(path, write_png_body, &image, err, err_size);
 }
 

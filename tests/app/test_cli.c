@@ -791,10 +791,50 @@ static void test_background_imager(void)
     free(px);
 }
 
+/* The colour type byte of a PNG's header (2 RGB, 6 RGBA), -1 if none. */
+static int png_colour_type(const char *path)
+{
+    unsigned char head[26];
+    FILE *f = fopen(path, "rb");
+    size_t n = f ? fread(head, 1, sizeof head, f) : 0;
+    if (f)
+        fclose(f);
+    return n == sizeof head && memcmp(head + 12, "IHDR", 4) == 0 ? head[25] : -1;
+}
+
+/* A display of mode "rgb" writes R, G, B only (the background black, as
+ * RenderMan writes it), one of mode "rgba" and -o keep alpha. */
+static void test_display_modes(void)
+{
+    static Run r;
+    setup();
+    write_text(SCRATCH_DIR "/modes.rib",
+               "Format 8 8 1\nDisplay \"" SCRATCH_DIR "/modes-rgb.png\" \"file\" \"rgb\"\n"
+               "Display \"+" SCRATCH_DIR "/modes-rgba.png\" \"file\" \"rgba\"\n"
+               "Display \"+" SCRATCH_DIR "/modes-rgb.exr\" \"file\" \"rgb\"\n"
+               "WorldBegin\nSurface \"constant\"\nTranslate 0 0 5\nSphere 0.5 -0.5 0.5 360\n"
+               "WorldEnd\n");
+    run(&r, NULL, ARGS("render", SCRATCH_DIR "/modes.rib", "--spp", "1", "--quiet"));
+    CHECK(r.status == 0);
+    CHECK(png_colour_type(SCRATCH_DIR "/modes-rgb.png") == 2);
+    CHECK(png_colour_type(SCRATCH_DIR "/modes-rgba.png") == 6);
+    int w = 0, h = 0;
+    float *px = NULL;
+    char err[256];
+    CHECK(image_read_exr(SCRATCH_DIR "/modes-rgb.exr", &w, &h, &px, err, sizeof err) == RAYES_OK);
+    CHECK(px && w == 8 && h == 8 && px[0] == 0.0f && px[3] == 1.0f); /* black, opaque */
+    free(px);
+    run(&r, NULL,
+        ARGS("render", SCRATCH_DIR "/modes.rib", "--spp", "1", "--quiet", "-o",
+             SCRATCH_DIR "/modes-o.png"));
+    CHECK(r.status == 0 && png_colour_type(SCRATCH_DIR "/modes-o.png") == 6);
+}
+
 TEST_MAIN(TEST(test_version_and_help), TEST(test_no_arguments), TEST(test_usage_errors),
           TEST(test_missing_data), TEST(test_render_outputs), TEST(test_render_summary),
           TEST(test_data_from_environment), TEST(test_unwritable_output), TEST(test_shader_path),
           TEST(test_render_obj), TEST(test_rib_grid_size), TEST(test_spp_over_file_sampling),
           TEST(test_png_curve), TEST(test_rib_opacity_cache_memory), TEST(test_vertex_budget),
           TEST(test_null_displacement), TEST(test_default_light), TEST(test_convert),
-          TEST(test_bad_scene_file), TEST(test_frames_and_crop), TEST(test_background_imager))
+          TEST(test_bad_scene_file), TEST(test_frames_and_crop), TEST(test_background_imager),
+          TEST(test_display_modes))

@@ -674,8 +674,38 @@ static void test_png_linear_curve(void)
     free(back);
 }
 
+/* RenderMan's display mode "rgb": R, G, B only, in PNG (colour type 2 in
+ * the header) and EXR; read back, alpha is 1 and the colours are kept. */
+static void test_no_alpha(void)
+{
+    static const float rgba[2 * 4] = {0.5f, 0.25f, 1.0f, 0.25f, 0.0f, 0.0f, 0.0f, 0.0f};
+    char path[512], err[512] = "";
+    scratch(path, sizeof path, "rgb.png");
+    CHECK(image_write_png_curve(path, 2, 1, rgba, IMAGE_LINEAR | IMAGE_NO_ALPHA, err, sizeof err) ==
+          RAYES_OK);
+    FILE *f = fopen(path, "rb");
+    unsigned char head[26] = {0};
+    CHECK(f && fread(head, 1, sizeof head, f) == sizeof head);
+    if (f)
+        fclose(f);
+    CHECK(memcmp(head + 12, "IHDR", 4) == 0 && head[25] == 2); /* RGB, 8 bits */
+    int w = 0, h = 0;
+    float *back = NULL;
+    CHECK(image_read_png(path, &w, &h, &back, err, sizeof err) == RAYES_OK && w == 2 && h == 1);
+    CHECK(back && back[3] == 1.0f && back[7] == 1.0f && back[2] == 1.0f && back[4] == 0.0f);
+    free(back);
+    scratch(path, sizeof path, "rgb.exr");
+    const int all[4] = {0, 0, 2, 1};
+    CHECK(image_write_exr_window(path, 2, 1, rgba, all, IMAGE_NO_ALPHA, err, sizeof err) ==
+          RAYES_OK);
+    back = NULL;
+    CHECK(image_read_exr(path, &w, &h, &back, err, sizeof err) == RAYES_OK);
+    CHECK(back && back[0] == 0.5f && back[1] == 0.25f && back[3] == 1.0f && back[7] == 1.0f);
+    free(back);
+}
+
 TEST_MAIN(TEST(test_exr_round_trip), TEST(test_exr_header), TEST(test_exr_reads_other_layouts),
-          TEST(test_png_round_trip), TEST(test_png_linear_curve), TEST(test_png_reads_grey),
-          TEST(test_format_dispatch), TEST(test_bad_arguments), TEST(test_missing_directory),
-          TEST(test_read_bad_files), TEST(test_failed_write_keeps_target),
-          TEST(test_concurrent_writes))
+          TEST(test_png_round_trip), TEST(test_png_linear_curve), TEST(test_no_alpha),
+          TEST(test_png_reads_grey), TEST(test_format_dispatch), TEST(test_bad_arguments),
+          TEST(test_missing_directory), TEST(test_read_bad_files),
+          TEST(test_failed_write_keeps_target), TEST(test_concurrent_writes))

@@ -118,7 +118,7 @@ static void test_exr_data_window(void)
     const int win[4] = {2, 3, 5, 4};
     char path[512], err[256];
     snprintf(path, sizeof path, "%s/test_crop.exr", RAYES_TEST_TMP);
-    CHECK(image_write_exr_window(path, W, H, rgba, win, err, sizeof err) == RAYES_OK);
+    CHECK(image_write_exr_window(path, W, H, rgba, win, 0, err, sizeof err) == RAYES_OK);
     int w = 0, h = 0;
     float *back = NULL;
     CHECK(image_read_exr(path, &w, &h, &back, err, sizeof err) == RAYES_OK);
@@ -131,7 +131,7 @@ static void test_exr_data_window(void)
     CHECK(same);
     free(back);
     const int outside[4] = {6, 0, 4, 7};
-    CHECK(image_write_exr_window(path, W, H, rgba, outside, err, sizeof err) ==
+    CHECK(image_write_exr_window(path, W, H, rgba, outside, 0, err, sizeof err) ==
           RAYES_ERROR_INVALID_ARGUMENT);
     remove(path);
 }
