@@ -484,6 +484,11 @@ static int shape_plymesh(Parser *P, const Token *t, ParamList *pl)
     PlyMesh m;
     if (io_ply_read(path, &m, err, sizeof err) != RAYES_OK)
         return FAIL_TOK(P, t, "plymesh: %s", err);
+    if (m.n_bad_normals)
+        pbrt_warn_at(P, t->line, t->col, "ply normals",
+                     "plymesh: %s: %zu vertex normal(s) not finite or zero; their faces' "
+                     "normals are used",
+                     path, m.n_bad_normals);
     int r = shape_mesh(P, t, "plymesh", m.n_faces, m.n_verts, m.indices, m.n_vertices, m.P, m.N,
                        m.uv);
     io_ply_mesh_fini(&m);

@@ -281,7 +281,7 @@ static int read_value(Ply *r, PlyType t, double *out, const char *element, long 
         char *endp;
         errno = 0;
         double v = t == PLY_F32 || t == PLY_F64 ? strtod(tok, &endp) : (double)strtoll(tok, &endp, 10);
-        if (*endp != '\0' || errno != 0 || !isfinite(v)) {
+        if (*endp != '\0' || errno != 0) { /* "nan" and "inf" are the caller's to judge */
             for (size_t k = 0; k < n && k < 20; k++)
                 if (tok[k] < 0x20 || tok[k] >= 0x7f || tok[k] == '"')
                     tok[k] = '?';
@@ -321,9 +321,7 @@ static int read_value(Ply *r, PlyType t, double *out, const char *element, long 
     case PLY_F64: { double v; memcpy(&v, b, 8); *out = v; break; }
     default: *out = 0; break;
     }
-    if (!isfinite(*out))
-        return fail(r, "%s %ld: a value is not a finite number", element, index);
-    return 0;
+    return 0; /* not finite: the caller's to judge (a count or index fails its range) */
 }
 
 /* ------------------------------------------------------------- body */
@@ -396,7 +394,9 @@ static int read_element(Ply *r, const PlyElement *e, PlyMesh *m, int is_vertex, 
             }
             for (int c = 0; c < 3; c++)
                 if (!isfinite(m->P[3 * i + c]))
-                    return fail(r, "vertex %ld: a coordinate is out of float range", i);
+                    return fail(r, "vertex %ld: a coordinate is not a finite float", i);
+            if (m->uv && !(isfinite(m->uv[2 * i]) && isfinite(m->uv[2 * i + 1])))
+                return fail(r, "vertex %ld: a texture coordinate is not a finite float", i);
         }
     }
     return 0;
@@ -543,6 +543,63 @@ static int finish_faces(Ply *r, PlyMesh *m)
     return 0;
 }
 
+static int normal_ok(const float *n)
+{
+    float len2 = n[0] * n[0] + n[1] * n[1] + n[2] * n[2];
+    return isfinite(len2) && len2 > 0.0f;
+}
+
+/* Vertex normals that are NaN, infinite or zero (exporters write them at
+ * degenerate vertices: Bitterli's lamp has 285) become the sum of their
+ * faces' normals, each turned toward its face's good vertex normals;
+ * pbrt-v4 shades such a triangle with its geometric normal. A vertex no
+ * good face touches gets its faces' sum anyway, or +z. */
+static void repair_normals(PlyMesh *m)
+{
+    unsigned char *bad = NULL;
+    for (size_t i = 0; i < m->n_vertices; i++)
+        if (!normal_ok(&m->N[3 * i])) {
+            if (!bad && !(bad = calloc(m->n_vertices, 1)))
+                break; /* out of memory: the zeroes below make it +z */
+            bad[i] = 1;
+            m->n_bad_normals++;
+            m->N[3 * i] = m->N[3 * i + 1] = m->N[3 * i + 2] = 0.0f;
+        }
+    if (!m->n_bad_normals)
+        return;
+    size_t at = 0;
+    for (size_t f = 0; bad && f < m->n_faces; at += (size_t)m->n_verts[f++]) {
+        const int *v = m->indices + at;
+        int n = m->n_verts[f];
+        double a[3], b[3], fn[3], good[3] = {0, 0, 0};
+        sub3(&m->P[3 * v[n == 4 ? 2 : 1]], &m->P[3 * v[0]], a);
+        sub3(&m->P[3 * v[n == 4 ? 3 : 2]], &m->P[3 * v[n == 4 ? 1 : 0]], b);
+        cross3(a, b, fn);
+        int any_bad = 0;
+        for (int k = 0; k < n; k++) {
+            any_bad |= bad[v[k]];
+            for (int c = 0; c < 3 && !bad[v[k]]; c++)
+                good[c] += m->N[3 * v[k] + c];
+        }
+        if (!any_bad)
+            continue;
+        double s = fn[0] * good[0] + fn[1] * good[1] + fn[2] * good[2] < 0 ? -1.0 : 1.0;
+        for (int k = 0; k < n; k++)
+            for (int c = 0; c < 3 && bad[v[k]]; c++)
+                m->N[3 * v[k] + c] += (float)(s * fn[c]);
+    }
+    for (size_t i = 0; i < m->n_vertices; i++) {
+        float *nv = &m->N[3 * i];
+        if (!normal_ok(nv))
+            nv[0] = nv[1] = 0.0f, nv[2] = 1.0f;
+        float len = sqrtf(nv[0] * nv[0] + nv[1] * nv[1] + nv[2] * nv[2]);
+        if (bad && bad[i])
+            for (int c = 0; c < 3; c++)
+                nv[c] /= len;
+    }
+    free(bad);
+}
+
 RayesError io_ply_parse(const char *name, const unsigned char *data, size_t size, PlyMesh *mesh,
                         char *err, size_t err_size)
 {
@@ -556,6 +613,8 @@ RayesError io_ply_parse(const char *name, const unsigned char *data, size_t size
         if (r.format != FORMAT_ASCII)
             r.line = 0; /* binary errors name the element instead */
         bad = read_body(&r, mesh) || finish_faces(&r, mesh);
+        if (!bad && mesh->N)
+            repair_normals(mesh);
     }
     free(r.raw_counts);
     free(r.raw_indices);

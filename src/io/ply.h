@@ -32,6 +32,7 @@ typedef struct PlyMesh {
     size_t n_indices;  /* the sum of n_verts */
     size_t n_split;    /* faces of the file that were split (non-planar quads, n-gons) */
     size_t n_skipped;  /* faces of the file with fewer than 3 vertices, left out */
+    size_t n_bad_normals; /* vertex normals NaN, infinite or zero: their faces' instead */
 } PlyMesh;
 
 /* Parses data[0..size) (not NUL-terminated) into mesh, which is zeroed

@@ -193,6 +193,7 @@ static void test_errors(void)
     expect_error("ply\nformat ascii 1.0\nelement vertex 1\n", "expected \"end_header\"");
     expect_error(HDR "0 0 0\n1 0 0\n0 1 0\n3 0 1 3\n", "t.ply: face 0 uses vertex 3 but the file has 3 vertices");
     expect_error(HDR "0 0 0\n1 0 x\n", "t.ply:11:5: expected a number in vertex 1, found \"x\"");
+    expect_error(HDR "0 0 0\n1 nan 0\n", "vertex 1: a coordinate is not a finite float");
     expect_error(HDR "0 0 0\n1 0 0\n0 1 0\n3 0 1\n", "expected a value of face 0, found the end");
     expect_error("ply\nformat binary_little_endian 1.0\nelement vertex 1000000\nproperty float x\n"
                  "property float y\nproperty float z\nelement face 0\n"
@@ -209,4 +210,30 @@ static void test_errors(void)
     expect_error(IHDR("int") "3 0 1 -1\n", "face 0: vertex index -1 is not an integer");
 }
 
-TEST_MAIN(TEST(test_ascii), TEST(test_binary), TEST(test_errors))
+/* Vertex normals NaN, infinite or zero become their faces' normals, turned
+ * toward the faces' good vertex normals (pbrt-v4 shades such faces with
+ * their geometric normal); the others stay as given. */
+static void test_bad_normals(void)
+{
+    static const char text[] =
+        "ply\nformat ascii 1.0\nelement vertex 6\n"
+        "property float x\nproperty float y\nproperty float z\n"
+        "property float nx\nproperty float ny\nproperty float nz\n"
+        "element face 2\nproperty list uchar int vertex_indices\nend_header\n"
+        "0 0 0 nan nan nan\n1 0 0 0 0.6 0.8\n1 1 0 0 0 1\n0 1 0 0 0 1\n"
+        "5 0 0 0 0 0\n5 1 0 inf 0 0\n"
+        "4 0 1 2 3\n3 4 1 5\n"; /* the square +z; the triangle wound -z */
+    PlyMesh m;
+    char err[256];
+    CHECK(parse_exact(text, strlen(text), &m, err, sizeof err) == RAYES_OK);
+    CHECK(m.n_bad_normals == 3);
+    if (m.N && m.n_vertices == 6) {
+        for (int v = 0; v < 6; v++) /* all +z but vertex 1's, as given */
+            if (v != 1)
+                CHECK(m.N[3 * v] == 0.0f && m.N[3 * v + 1] == 0.0f && m.N[3 * v + 2] == 1.0f);
+        CHECK(m.N[4] == 0.6f && m.N[5] == 0.8f);
+    }
+    io_ply_mesh_fini(&m);
+}
+
+TEST_MAIN(TEST(test_ascii), TEST(test_binary), TEST(test_errors), TEST(test_bad_normals))
