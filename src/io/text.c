@@ -12,6 +12,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <zlib.h>
 
 void text_init(TextReader *r, const char *name, const char *text, size_t size, char *err,
                size_t err_size)
@@ -125,33 +126,40 @@ int text_at_end(TextReader *r)
 
 char *text_read_file(const char *path, size_t *size, char *err, size_t err_size)
 {
-    FILE *f = fopen(path, "rb");
+    errno = 0;
+    gzFile f = gzopen(path, "rb");
     if (!f) {
-        snprintf(err, err_size, "%s: cannot open: %s", path, strerror(errno));
+        snprintf(err, err_size, "%s: cannot open: %s", path,
+                 errno ? strerror(errno) : "out of memory");
         return NULL;
     }
     size_t cap = 1 << 16, n = 0;
     char *buf = malloc(cap);
-    while (buf) {
+    const char *why = buf ? NULL : "out of memory";
+    while (!why) {
         if (n + 1 >= cap) {
-            char *b = realloc(buf, cap * 2);
+            char *b = cap > TEXT_MAX_FILE_BYTES ? NULL : realloc(buf, cap * 2);
             if (!b) {
-                free(buf);
-                buf = NULL;
+                why = cap > TEXT_MAX_FILE_BYTES ? "larger than 4 GB" : "out of memory";
                 break;
             }
             buf = b;
             cap *= 2;
         }
-        size_t got = fread(buf + n, 1, cap - 1 - n, f);
-        n += got;
+        size_t want = cap - 1 - n > (1u << 30) ? (1u << 30) : cap - 1 - n;
+        int got = gzread(f, buf + n, (unsigned)want);
+        if (got < 0) {
+            int code;
+            why = gzerror(f, &code);
+            break;
+        }
         if (got == 0)
             break;
+        n += (size_t)got;
     }
-    int bad = ferror(f);
-    fclose(f);
-    if (!buf || bad) {
-        snprintf(err, err_size, "%s: %s", path, buf ? "read error" : "out of memory");
+    gzclose(f);
+    if (why) {
+        snprintf(err, err_size, "%s: %s", path, why);
         free(buf);
         return NULL;
     }

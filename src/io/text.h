@@ -32,7 +32,11 @@ int text_float(TextReader *r, float *out, const char *what);
 /* Nonzero if only white space and comments remain. */
 int text_at_end(TextReader *r);
 
-/* The whole file, NUL-terminated (new, free()), or NULL with err filled. */
+/* The whole file, NUL-terminated (new, free()), or NULL with err filled.
+ * Read through zlib, which passes plain files through: gzip-compressed
+ * files (pbrt-v4's `Include "hair.pbrt.gz"`) read as plain ones do. At
+ * most TEXT_MAX_FILE_BYTES uncompressed. */
+#define TEXT_MAX_FILE_BYTES ((size_t)4 << 30)
 char *text_read_file(const char *path, size_t *size, char *err, size_t err_size);
 
 #endif /* RAYES_IO_TEXT_H */

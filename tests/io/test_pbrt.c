@@ -10,9 +10,11 @@
 #include <string.h>
 #include <sys/stat.h>
 #include <unistd.h>
+#include <zlib.h>
 
 #include "io/pbrt.h"
 #include "rayes/rayes.h"
+
 #include "test.h"
 
 static const double PI_D = 3.14159265358979323846;
@@ -790,6 +792,19 @@ static void test_instances_include_ply(void)
     e = parse(path, "WorldBegin\nInclude \"test_pbrt_tail.pbrt\"\n  \"float radius\" [ \"x\" ]\n",
               r, &s, err, sizeof err);
     CHECK(e == RAYES_ERROR_PARSE && strstr(err, "test_pbrt_main.pbrt:3:") != NULL);
+    /* gzip-compressed files read as plain ones (pbrt-v4-scenes' hair.pbrt.gz) */
+    snprintf(path, sizeof path, "%s/test_pbrt_gz.pbrt.gz", RAYES_TEST_TMP);
+    gzFile gz = gzopen(path, "wb");
+    CHECK(gz != NULL);
+    if (gz) {
+        gzputs(gz, "Shape \"sphere\" \"float radius\" 2\n");
+        gzclose(gz);
+    }
+    snprintf(path, sizeof path, "%s/test_pbrt_main.pbrt", RAYES_TEST_TMP);
+    e = parse(path, "WorldBegin\nInclude \"test_pbrt_gz.pbrt.gz\"\n", r, &s, err, sizeof err);
+    CHECK(e == RAYES_OK && r->n_quadrics == 1);
+    if (e == RAYES_OK && r->n_quadrics == 1)
+        CHECK_NEAR(r->quadric[0].p[0], 2, 0);
     /* relative paths, inside included files too, are relative to the
      * directory of the file given (pbrt-v4's search directory), not to the
      * including file's */
