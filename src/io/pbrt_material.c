@@ -671,9 +671,15 @@ static int subsurface_medium(Parser *P, const Token *t, ParamList *pl, Material 
         return 0;
     }
     if (pbrt_find(pl, "reflectance")) {
-        if (pbrt_get_color(P, pl, "reflectance", one, a, NULL) < 0 ||
-            pbrt_get_color(P, pl, "mfp", one, b, NULL) < 0)
+        const Texture *tex = NULL;
+        int k = pbrt_get_color(P, pl, "reflectance", one, a, &tex);
+        if (k < 0 || pbrt_get_color(P, pl, "mfp", one, b, NULL) < 0)
             return -1;
+        if (k == 2) { /* a texture: the medium of a mid reflectance, tinted by it per point */
+            static const float mid[3] = {0.5f, 0.5f, 0.5f};
+            memcpy(a, mid, sizeof a);
+            mat_pattern(m, "reflectance", (size_t)(tex - P->textures));
+        }
         pbrt_mat_color(m, "reflectance", a);
         pbrt_mat_color(m, "mfp", b);
         return 0;

@@ -92,15 +92,35 @@ static float schlick(float cos_o, float eta)
 #define HAS(sv, m)                                                                                 \
     ((sv)->struct_size >= offsetof(RayesShaderServices, m) + sizeof((sv)->m) && (sv)->m != NULL)
 
+/* A pattern bound to "reflectance" (pbrt-v4's textured reflectance, a
+ * skin's albedo map): the medium stays the constant's (how far light
+ * diffuses), each point's colour is the pattern's: the diffusion times
+ * pattern / constant. Without a pattern, 1. */
+static void reflectance_tint(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
+                             const SubsurfaceParams *p, float (*tint)[3])
+{
+    if (!shade_param_bound(ctx, "reflectance")) {
+        for (size_t i = 0; i < ctx->n_points; i++)
+            tint[i][0] = tint[i][1] = tint[i][2] = 1.0f;
+        return;
+    }
+    shade_param_color(sv, ctx, "reflectance", p->reflectance, tint);
+    for (size_t i = 0; i < ctx->n_points; i++)
+        for (int c = 0; c < 3; c++)
+            tint[i][c] =
+                p->reflectance[c] > 0.0f ? fmaxf(tint[i][c], 0.0f) / p->reflectance[c] : 0.0f;
+}
+
 static void lighting_chunk(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
                            const void *params, RayesShadeOutputs *out)
 {
     const SubsurfaceParams *p = params;
     RayesSubsurfaceParams m;
     medium(p, &m);
-    float sss[SHADE_CHUNK][3], spec[SHADE_CHUNK][3], rough[SHADE_CHUNK];
+    float sss[SHADE_CHUNK][3], spec[SHADE_CHUNK][3], rough[SHADE_CHUNK], tint[SHADE_CHUNK][3];
     memset(sss, 0, sizeof sss);
     memset(spec, 0, sizeof spec);
+    reflectance_tint(sv, ctx, p, tint);
     if (p->Kd > 0.0f && HAS(sv, subsurface))
         sv->subsurface(sv, ctx, &m, (int)p->samples, sss);
     /* roughness 0 (pbrt's smooth boundary) is a sharp coat, not the
@@ -116,7 +136,8 @@ static void lighting_chunk(const RayesShaderServices *sv, const RayesShadeCtx *c
                       ctx->I[i][2] * ctx->N[i][2]);
         float F = schlick(cos_o, m.eta);
         for (int c = 0; c < 3; c++)
-            out->Ci[i][c] = cs(ctx, i, c) * p->Kd * (1.0f - F) * sss[i][c] + p->Ks * F * spec[i][c];
+            out->Ci[i][c] = cs(ctx, i, c) * tint[i][c] * p->Kd * (1.0f - F) * sss[i][c] +
+                            p->Ks * F * spec[i][c];
     }
 }
 
@@ -126,8 +147,9 @@ static void diffuse_chunk(const RayesShaderServices *sv, const RayesShadeCtx *ct
     const SubsurfaceParams *p = params;
     RayesSubsurfaceParams m;
     medium(p, &m);
-    float dd[SHADE_CHUNK][3], id[SHADE_CHUNK][3], Rd[3];
+    float dd[SHADE_CHUNK][3], id[SHADE_CHUNK][3], Rd[3], tint[SHADE_CHUNK][3];
     memset(id, 0, sizeof id);
+    reflectance_tint(sv, ctx, p, tint);
     for (int c = 0; c < 3; c++) {
         DiffusionChannel ch;
         diffusion_channel(&m, c, &ch);
@@ -138,7 +160,7 @@ static void diffuse_chunk(const RayesShaderServices *sv, const RayesShadeCtx *ct
         sv->indirect_diffuse(sv, ctx, 0, id);
     for (size_t i = 0; i < ctx->n_points; i++)
         for (int c = 0; c < 3; c++)
-            out->Ci[i][c] = cs(ctx, i, c) * p->Kd * Rd[c] * (dd[i][c] + id[i][c]);
+            out->Ci[i][c] = cs(ctx, i, c) * tint[i][c] * p->Kd * Rd[c] * (dd[i][c] + id[i][c]);
 }
 
 /* Runs fn on SHADE_CHUNK-point slices, then Oi = Os and Ci *= Oi. */

@@ -7,8 +7,9 @@
  * (a mirror of the bright zenith), where it is rough as the all-rough one
  * (dim: its wide lobe mostly sees black), and both kinds of check are in
  * the picture. A textured conductor reflectance, an image map with
- * uscale and invert, and a textured displacement render without warnings
- * too, and the displaced plane differs from the flat one.
+ * uscale and invert, a textured subsurface reflectance and a textured
+ * displacement render without warnings too, the reflectances' halves in
+ * their ratio, and the displaced plane differs from the flat one.
  */
 #include <math.h>
 #include <stdio.h>
@@ -170,7 +171,20 @@ static void test_other_textured_parameters(void)
         printf("displacement: %d of %d pixels changed\n", moved, RES * RES);
         CHECK(moved > RES * RES / 50); /* the raised checks come nearer, and their walls show */
     }
-    free(r), free(f), free(d);
+    /* subsurface's textured reflectance colours each point as the diffuse
+     * plane's does (the same step between the halves; the coat adds its
+     * reflection of the zenith to both); it rendered white: the texture
+     * was read as the default 1 */
+    write_scene("skin.pbrt", "Material \"subsurface\" \"texture reflectance\" \"half\" "
+                             "\"rgb mfp\" [0.05 0.05 0.05]");
+    float *k = render("skin.pbrt");
+    if (k && f) {
+        double step = quadrant(k, 1) - quadrant(k, 0), want = quadrant(f, 1) - quadrant(f, 0);
+        printf("subsurface: left %.3f right %.3f (step %.3f, diffuse %.3f)\n", quadrant(k, 0),
+               quadrant(k, 1), step, want);
+        CHECK(fabs(step - want) < 0.1 * want);
+    }
+    free(r), free(f), free(d), free(k);
 }
 
 TEST_MAIN(TEST(test_textured_roughness), TEST(test_other_textured_parameters))
