@@ -141,7 +141,10 @@ int pbrt_d_light(Parser *P, const Token *t)
         if (pbrt_get_float(&pl, "illuminance", 0.0) > 0)
             pbrt_warn_at(P, t->line, t->col, "infinite illuminance", "LightSource \"infinite\": "
                          "\"illuminance\" is not supported; using scale");
-        pbrt_find(&pl, "portal");
+        if (pbrt_find(&pl, "portal")) /* the same image, drawn with more noise indoors */
+            pbrt_warn_at(P, t->line, t->col, "infinite portal",
+                         "LightSource \"infinite\": \"portal\" is not used to sample the light; "
+                         "the whole environment is sampled (the same image, noisier indoors)");
         rtype = "environmentlight";
     } else if (strcmp(type, "goniometric") == 0 || strcmp(type, "projection") == 0) {
         /* a point light at the light space's origin, its intensity by

@@ -1220,6 +1220,22 @@ static void test_film_types(void)
     free(r);
 }
 
+/* An infinite light's "portal" (pbrt-v4 samples the window only) is not
+ * dropped silently: one warning at the directive, the light still made. */
+static void test_portal_warns(void)
+{
+    Rec *r = malloc(sizeof *r);
+    ParseRun pr = {.name = "t.pbrt",
+                   .r = r,
+                   .text =
+                       "WorldBegin\n"
+                       "LightSource \"infinite\" \"point3 portal\" [0 0 0 1 0 0 1 1 0 0 1 0]\n"};
+    const char *said = stderr_of(run_parse, &pr);
+    CHECK(pr.e == RAYES_OK && r->n_lights == 1);
+    CHECK(strstr(said, "t.pbrt:2:1: LightSource \"infinite\": \"portal\" is not used") != NULL);
+    free(r);
+}
+
 /* measured (a tabulated BSDF file rayes does not read) becomes matte with
  * one warning naming the type at the directive; the shape under it keeps
  * its geometry. */
@@ -1598,9 +1614,10 @@ static void test_exposure(void)
 
 TEST_MAIN(TEST(test_filters), TEST(test_exposure), TEST(test_subsurface_material),
           TEST(test_filter_warnings), TEST(test_import), TEST(test_film_types),
-          TEST(test_measured_material), TEST(test_thin_dielectric), TEST(test_annulus),
-          TEST(test_triangle_light), TEST(test_light_power), TEST(test_normal_map),
-          TEST(test_anisotropic_roughness), TEST(test_maxdepth), TEST(test_spectrum_files),
-          TEST(test_cornell_box), TEST(test_transforms), TEST(test_materials), TEST(test_lights),
-          TEST(test_instances_include_ply), TEST(test_errors), TEST(test_normals_and_uv),
-          TEST(test_textures), TEST(test_coated_conductor_textures))
+          TEST(test_measured_material), TEST(test_portal_warns), TEST(test_thin_dielectric),
+          TEST(test_annulus), TEST(test_triangle_light), TEST(test_light_power),
+          TEST(test_normal_map), TEST(test_anisotropic_roughness), TEST(test_maxdepth),
+          TEST(test_spectrum_files), TEST(test_cornell_box), TEST(test_transforms),
+          TEST(test_materials), TEST(test_lights), TEST(test_instances_include_ply),
+          TEST(test_errors), TEST(test_normals_and_uv), TEST(test_textures),
+          TEST(test_coated_conductor_textures))
