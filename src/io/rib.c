@@ -736,6 +736,38 @@ static int h_matte(Rib *r, const Args *a)
     return 0;
 }
 
+/* MakeTexture "picture" "texture" ... and MakeLatLongEnvironment (the
+ * same two names first): to rayes the made texture is the picture itself
+ * (OpenImageIO MIP-maps any image as it reads it, and a latitude-longitude
+ * picture is what environments read), so from here on the texture's name
+ * stands for the picture's; the wrap modes and filter are not kept. */
+static int h_make_texture(Rib *r, const Args *a)
+{
+    size_t i = 0;
+    const char *in = rib_get_string(r, a, &i, "a picture name");
+    const char *out = in ? rib_get_string(r, a, &i, "a texture name") : NULL;
+    if (!out)
+        return -1;
+    char key[96];
+    snprintf(key, sizeof key, "made %s", r->req);
+    if (strlen(in) >= sizeof r->made->from || strlen(out) >= sizeof r->made->made ||
+        !rib_texture_found(r, in)) {
+        rib_warn_once(r, key,
+                      "%s: the picture \"%.200s\" is not found (or its name is too long); "
+                      "\"%.200s\" is not made",
+                      r->req, in, out);
+        return 0;
+    }
+    RibTextureAlias *m = realloc(r->made, (r->n_made + 1) * sizeof *m);
+    if (!m)
+        return rib_error(r, "out of memory");
+    r->made = m;
+    snprintf(m[r->n_made].made, sizeof m->made, "%s", out);
+    snprintf(m[r->n_made].from, sizeof m->from, "%s", in);
+    r->n_made++;
+    return 0;
+}
+
 static int h_archive_begin(Rib *r, const Args *a)
 {
     h_skip(r, a);
@@ -760,10 +792,10 @@ static const RibRequest own_requests[] = {
     {"SampleFilter", h_skip},
     {"Camera", h_skip},
     {"MakeShadow", h_skip},
-    {"MakeTexture", h_skip},
+    {"MakeTexture", h_make_texture},
     {"MakeBump", h_skip},
     {"MakeCubeFaceEnvironment", h_skip},
-    {"MakeLatLongEnvironment", h_skip},
+    {"MakeLatLongEnvironment", h_make_texture},
     {"MakeBrickMap", h_skip},
     {"Atmosphere", h_skip},
     {"Interior", h_skip},
@@ -1013,6 +1045,7 @@ static void rib_fini(Rib *r)
     rib_trims_free(r);
     free(r->decls);
     free(r->lights);
+    free(r->made);
     free(r->area_handles);
     free(r->links);
     for (size_t k = 0; k < r->n_objects; k++)

@@ -201,6 +201,12 @@ typedef struct StackEntry {
     int solid_sent; /* SolidBegin: the sink was told (solid_begin) */
 } StackEntry;
 
+/* A texture the file makes from an image (MakeTexture "in.tif"
+ * "out.tex"): rayes reads the image itself wherever the made name is used. */
+typedef struct RibTextureAlias {
+    char made[256], from[256];
+} RibTextureAlias;
+
 typedef struct Rib {
     int pass;                  /* 1: check and list frames, 2: read into the sink */
     const IoSink *sink;
@@ -281,6 +287,8 @@ typedef struct Rib {
 
     char archive_path[4096];
     char texture_path[4096];   /* the texture search path as the sink has it ("&" expanded) */
+    RibTextureAlias *made;     /* MakeTexture, MakeLatLongEnvironment: made name -> image */
+    size_t n_made;
     char *coordsys_names;      /* CoordinateSystem: n x 64 names */
     float *coordsys_M;
     int *coordsys_world;
@@ -415,6 +423,9 @@ const char *rib_pattern_name(const Rib *r, const char *ref, char *buf, size_t si
 /* Whether a texture name is a readable file as given or on the texture
  * search path. */
 int rib_texture_found(const Rib *r, const char *name);
+/* The image a texture name stands for: the source image of the file's
+ * MakeTexture or MakeLatLongEnvironment that made it, else name. */
+const char *rib_texture_source(const Rib *r, const char *name);
 /* A shader record of name with copies of the parameters p (floats arrays
  * are not taken), the attributes' to point to; NULL with the error set. */
 ShaderRec *rib_shader_rec(Rib *r, const char *name, const RayesParam *p, size_t n);

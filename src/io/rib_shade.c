@@ -359,7 +359,7 @@ static ShaderRec *make_shader(Rib *r, const char *name, const Param *p, size_t n
         }
         if (q->d.ty == TY_STRING && q->v->n == 1) {
             o.type = q->d.reference ? RAYES_PARAM_PATTERN : RAYES_PARAM_STRING;
-            o.string = rib_strdup(pattern ? pattern : q->v->s[0]);
+            o.string = rib_strdup(pattern ? pattern : rib_texture_source(r, q->v->s[0]));
             if (!o.string)
                 return NULL;
         } else if ((q->d.ty == TY_FLOAT || q->d.ty == TY_INT) && q->v->n == 1) {
@@ -508,14 +508,16 @@ static const char *const environment_maps[] = {"mapname",        "envmap",      
 
 /* An environment light's string parameter q as rayes' mapname or mapping
  * into L; 0 if q is neither. */
-static int environment_map(Light *L, const Param *q, RayesParam *o, char *name, size_t size)
+static int environment_map(const Rib *r, Light *L, const Param *q, RayesParam *o, char *name,
+                           size_t size)
 {
     int map = in_list(environment_maps, q->d.name);
     if ((!map && strcmp(q->d.name, "mapping") != 0) || q->d.ty != TY_STRING || q->v->n != 1)
         return 0;
     snprintf(name, size, "%s", map ? "mapname" : "mapping");
     char *dst = light_string(L, name);
-    snprintf(dst, map ? sizeof L->mapname : sizeof L->mapping, "%s", q->v->s[0]);
+    snprintf(dst, map ? sizeof L->mapname : sizeof L->mapping, "%s",
+             map ? rib_texture_source(r, q->v->s[0]) : q->v->s[0]);
     *o = (RayesParam){.name = name, .type = RAYES_PARAM_STRING, .string = dst};
     return 1;
 }
@@ -540,6 +542,14 @@ int rib_texture_found(const Rib *r, const char *name)
             d += len + (d[len] == ':');
         }
     return 0;
+}
+
+const char *rib_texture_source(const Rib *r, const char *name)
+{
+    for (size_t k = r->n_made; k-- > 0;) /* the last made of a name counts */
+        if (strcmp(r->made[k].made, name) == 0)
+            return r->made[k].from;
+    return name;
 }
 
 static Light *find_light(Rib *r, const char *handle)
@@ -711,7 +721,7 @@ static int h_light_source(Rib *r, const Args *a)
             env ||
             (mapped && (strcmp(q->d.name, "mapname") == 0 || strcmp(q->d.name, "mapping") == 0));
         if (map_param &&
-            environment_map(L, q, &L->params[L->n], L->names[L->n], sizeof L->names[0])) {
+            environment_map(r, L, q, &L->params[L->n], L->names[L->n], sizeof L->names[0])) {
             /* a map that is not there (for a production light, a renderer's
              * own format elsewhere): an even light, a constant environment */
             if ((mapped || strcmp(name, "environmentlight") != 0) && L->mapname[0] &&

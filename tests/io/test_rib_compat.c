@@ -15,6 +15,7 @@
 
 #include <zlib.h>
 
+#include "image/image.h"
 #include "io/rib.h"
 #include "rayes/rayes.h"
 #include "record_sink.h"
@@ -260,6 +261,33 @@ static void test_png_curve(void)
     CHECK(strstr(err, "pngcurve") != NULL);
 }
 
-TEST_MAIN(TEST(test_requests_renderman_accepts), TEST(test_procedural2),
+/* MakeTexture and MakeLatLongEnvironment: the made name stands for the
+ * picture (shader and environment map parameters get its path); a
+ * picture that is not there makes nothing (a warning), the name kept. */
+static void test_made_textures(void)
+{
+    const char *pic = RAYES_TEST_TMP "/compat_pic.png";
+    static const float rgba[4] = {1, 0, 0, 1};
+    char e[256], text[2048];
+    CHECK(image_write_png(pic, 1, 1, rgba, e, sizeof e) == RAYES_OK);
+    snprintf(text, sizeof text,
+             "MakeTexture \"%s\" \"pic.tex\" \"periodic\" \"periodic\" \"gaussian\" 1 1\n"
+             "MakeLatLongEnvironment \"%s\" \"sky.env\" \"gaussian\" 1 1\n" WORLD(
+                 "LightSource \"environmentlight\" 1 \"string mapname\" \"sky.env\"\n"
+                 "Surface \"paintedplastic\" \"texturename\" \"pic.tex\"\n" QUAD),
+             pic, pic);
+    CHECK(rib(text) == RAYES_OK);
+    const RayesParam *tn =
+        rec.n_shader > 0 ? rec_param(&rec.shader[rec.n_shader - 1], "texturename") : NULL;
+    CHECK(tn && tn->string && strcmp(tn->string, pic) == 0);
+    const RayesParam *mn = rec.n_light > 0 ? rec_param(&rec.light[0], "mapname") : NULL;
+    CHECK(mn && mn->string && strcmp(mn->string, pic) == 0);
+    CHECK(rib("MakeTexture \"nowhere.png\" \"x.tex\" \"black\" \"black\" \"box\" 1 1\n" WORLD(
+              "Surface \"paintedplastic\" \"texturename\" \"x.tex\"\n" QUAD)) == RAYES_OK);
+    tn = rec.n_shader > 0 ? rec_param(&rec.shader[rec.n_shader - 1], "texturename") : NULL;
+    CHECK(tn && tn->string && strcmp(tn->string, "x.tex") == 0);
+}
+
+TEST_MAIN(TEST(test_requests_renderman_accepts), TEST(test_procedural2), TEST(test_made_textures),
           TEST(test_classic_light_units), TEST(test_png_curve), TEST(test_texture_coordinates),
           TEST(test_zip_archives))
