@@ -853,8 +853,9 @@ static int h_option_attribute(Rib *r, const Args *a)
             double d = q->v->d[0];
             r->settings->specular_depth = !(d > 0) ? 0 : d > 1e6 ? 1000000 : (int)d;
         } else if (option && strcmp(group, "limits") == 0 && strcmp(q->d.name, "gridsize") == 0 &&
-                   rib_is_num(q->v) && q->v->n == 1) {
-            e = set_grid_size(r, q->v->d[0]);
+                   rib_is_num(q->v) && (q->v->n == 1 || q->v->n == 2)) {
+            /* Aqsis's older form gives a grid's sides: [32 32], 1024 */
+            e = set_grid_size(r, q->v->n == 2 ? q->v->d[0] * q->v->d[1] : q->v->d[0]);
         } else if (option && strcmp(group, "limits") == 0 &&
                    strcmp(q->d.name, "texturememory") == 0 && rib_is_num(q->v) && q->v->n == 1) {
             /* RenderMan's texture cache, in KB */

@@ -59,6 +59,9 @@ static void test_requests_renderman_accepts(void)
     CHECK(rec.n_patch == 2); /* wrapped in u: the closing patch too */
     CHECK(rib(WORLD("PatchMesh \"bilinear\" 2 \"around\" 2 \"nowrap\" "
                     "\"P\" [0 0 1 1 0 1 0 1 1 1 1 1]")) != RAYES_OK);
+    /* Aqsis's older "gridsize": a grid's two sides */
+    CHECK(rib("Option \"limits\" \"gridsize\" [32 32]\n" WORLD(QUAD)) == RAYES_OK);
+    CHECK(settings.grid_size == 1024);
     rib(WORLD("Curves \"linear\" [2] \"nowrap\" \"P\" [0 0 1 0 1 1] \"constantwidth\" [0.1]"));
     CHECK(strstr(err, "curves") != NULL && strstr(err, "periodic") == NULL); /* read to the sink */
 }
