@@ -90,16 +90,31 @@ static void tex_number(ParamList *pl, const char *name, RayesParam *out, size_t 
         p->used = 0; /* the wrong type: warned about as unused */
 }
 
-/* pbrt's (u, v) mapping parameters. Only "uv" mapping is built. */
+/* pbrt's (u, v) mapping and its parameters: "uv" (uscale ... vdelta),
+ * "spherical", "cylindrical" (in the texture's space) or "planar" (v1,
+ * v2, udelta, vdelta); another name warns and maps by "uv". */
 static void tex_mapping(Parser *P, const Token *t, ParamList *pl, RayesParam *out, size_t *n)
 {
     static const char *const names[] = {"uscale", "vscale", "udelta", "vdelta"};
     for (int k = 0; k < 4; k++)
         tex_number(pl, names[k], out, n);
     const char *mapping = pbrt_get_string(pl, "mapping", "uv");
-    if (strcmp(mapping, "uv") != 0)
+    if (strcmp(mapping, "spherical") == 0 || strcmp(mapping, "cylindrical") == 0 ||
+        strcmp(mapping, "planar") == 0) {
+        out[(*n)++] =
+            (RayesParam){.name = "mapping", .type = RAYES_PARAM_STRING, .string = mapping};
+        static const char *const axes[2] = {"v1", "v2"};
+        for (int k = 0; k < 2 && strcmp(mapping, "planar") == 0; k++) {
+            const double *v = pbrt_get_point(pl, axes[k]);
+            if (v)
+                out[(*n)++] = (RayesParam){.name = axes[k],
+                                           .type = RAYES_PARAM_COLOR,
+                                           .value = {(float)v[0], (float)v[1], (float)v[2]}};
+        }
+    } else if (strcmp(mapping, "uv") != 0) {
         pbrt_warn_at(P, t->line, t->col, "texture mapping",
                      "Texture: mapping \"%.40s\" is not supported; using \"uv\"", mapping);
+    }
 }
 
 static void mean2(const float a[3], const float b[3], float out[3])

@@ -61,6 +61,8 @@ struct RayesPattern {
     float num[4];                 /* the class's numbers (ClassDesc's 'n' slots) */
     float vec[3];                 /* directionmix's dir, world space, unit */
     float uv[4];                  /* uscale, vscale, udelta, vdelta */
+    int mapping;                  /* MAP_UV ... MAP_PLANAR: pbrt-v4's (u, v) of a point */
+    float v1[3], v2[3];           /* planar: the texture-space axes of u and v */
     float texture_from_world[16]; /* row-major; the 3-D classes' space */
     char filename[1024];          /* imagemap */
     char encoding[32];            /* imagemap: "" (the file's), "sRGB", "linear", "gamma G" */
@@ -134,6 +136,13 @@ static const ClassDesc classes[] = {
 
 static const char *const uv_names[4] = {"uscale", "vscale", "udelta", "vdelta"};
 
+/* pbrt-v4's texture mappings (textures.h), in the pattern's space: the
+ * surface's (u, v); the sphere's (theta / pi, phi / 2 pi) about the
+ * origin; the cylinder's ((pi + atan2(y, x)) / 2 pi, z) about z; the
+ * plane's (P.v1 + udelta, P.v2 + vdelta). */
+enum { MAP_UV, MAP_SPHERICAL, MAP_CYLINDRICAL, MAP_PLANAR };
+static const char *const mapping_names[4] = {"uv", "spherical", "cylindrical", "planar"};
+
 /* ------------------------------------------------------------ making */
 
 static const ClassDesc *find_class(const char *type)
@@ -162,6 +171,22 @@ static int set_slot(Pattern *p, const ClassDesc *c, const RayesParam *q, Pattern
             p->uv[k] = q->value[0];
             return 0;
         }
+    if (c->uv && strcmp(q->name, "mapping") == 0 && q->type == RAYES_PARAM_STRING) {
+        for (int k = 0; k < 4; k++)
+            if (q->string && strcmp(q->string, mapping_names[k]) == 0) {
+                p->mapping = k;
+                return 0;
+            }
+        snprintf(err, err_size,
+                 "pattern \"%s\": mapping \"%.40s\" is not uv, spherical, cylindrical or planar",
+                 c->name, q->string ? q->string : "");
+        return -1;
+    }
+    if (c->uv && (strcmp(q->name, "v1") == 0 || strcmp(q->name, "v2") == 0) &&
+        q->type == RAYES_PARAM_COLOR) {
+        memcpy(q->name[1] == '1' ? p->v1 : p->v2, q->value, sizeof p->v1);
+        return 0;
+    }
     const Slot *s = find_slot(c, q->name);
     int ok = s && ((s->what == 'i' && q->type != RAYES_PARAM_STRING) ||
                    (s->what == 'n' && q->type == RAYES_PARAM_FLOAT) ||
@@ -357,6 +382,7 @@ Pattern *pattern_new(const char *type, const RayesParam *params, size_t n_params
     p->kind = c->kind;
     p->depth = 1;
     p->uv[0] = p->uv[1] = 1.0f;
+    p->v1[0] = p->v2[1] = 1.0f; /* pbrt's planar defaults: x and y */
     for (int k = 0; k < MAX_SLOTS && c->slots[k].name; k++) {
         const Slot *s = &c->slots[k];
         if (s->what == 'i')
@@ -430,11 +456,59 @@ static void eval_input(const Input *in, Eval *e, Rgb *out)
         memcpy(out[i], in->value, sizeof out[i]);
 }
 
-/* pbrt's (u, v) and its footprint at point i, after uscale ... vdelta. */
+static void point_at(const Pattern *p, const Eval *e, size_t i, float q[3], float dx[3],
+                     float dy[3]);
+
+/* The (s, t) of a texture-space point q by mapping m (not MAP_UV). */
+static void map_point(const Pattern *p, const float q[3], float st[2])
+{
+    if (p->mapping == MAP_SPHERICAL) {
+        float len = sqrtf(q[0] * q[0] + q[1] * q[1] + q[2] * q[2]);
+        float z = len > 0.0f ? fminf(fmaxf(q[2] / len, -1.0f), 1.0f) : 1.0f;
+        float phi = atan2f(q[1], q[0]);
+        st[0] = acosf(z) / (float)M_PI;
+        st[1] = (phi < 0.0f ? phi + 2.0f * (float)M_PI : phi) / (2.0f * (float)M_PI);
+    } else if (p->mapping == MAP_CYLINDRICAL) {
+        st[0] = ((float)M_PI + atan2f(q[1], q[0])) / (2.0f * (float)M_PI);
+        st[1] = q[2];
+    } else {
+        st[0] = q[0] * p->v1[0] + q[1] * p->v1[1] + q[2] * p->v1[2] + p->uv[2];
+        st[1] = q[0] * p->v2[0] + q[1] * p->v2[1] + q[2] * p->v2[2] + p->uv[3];
+    }
+}
+
+/* The change of a mapped coordinate, across the seam of an angle taken
+ * the short way round. */
+static float map_delta(const Pattern *p, int k, float d)
+{
+    int angle =
+        (p->mapping == MAP_SPHERICAL && k == 1) || (p->mapping == MAP_CYLINDRICAL && k == 0);
+    if (angle && fabsf(d) > 0.5f)
+        d -= copysignf(1.0f, d);
+    return fabsf(d);
+}
+
+/* pbrt's (u, v) and its footprint at point i: the surface's after
+ * uscale ... vdelta, or the mapping's of the point (its footprint the
+ * mapped change across the point's dPdu du and dPdv dv). */
 static void uv_at(const Pattern *p, const Eval *e, size_t i, float *u, float *v, float *du,
                   float *dv)
 {
     const RayesShadeCtx *c = e->ctx;
+    if (p->mapping != MAP_UV) {
+        float q[3], dx[3], dy[3], qx[3], qy[3], st[2], sx[2], sy[2];
+        point_at(p, e, i, q, dx, dy);
+        for (int k = 0; k < 3; k++)
+            qx[k] = q[k] + dx[k], qy[k] = q[k] + dy[k];
+        map_point(p, q, st);
+        map_point(p, qx, sx);
+        map_point(p, qy, sy);
+        *u = st[0];
+        *v = st[1];
+        *du = fmaxf(map_delta(p, 0, sx[0] - st[0]), map_delta(p, 0, sy[0] - st[0]));
+        *dv = fmaxf(map_delta(p, 1, sx[1] - st[1]), map_delta(p, 1, sy[1] - st[1]));
+        return;
+    }
     float s = c->s ? c->s[i] : c->u ? c->u[i] : 0.0f;
     float t = c->t ? c->t[i] : c->v ? c->v[i] : 0.0f;
     float ws = e->ds ? e->ds[i] : c->du ? c->du[i] : 0.0f;

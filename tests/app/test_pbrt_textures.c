@@ -187,4 +187,37 @@ static void test_other_textured_parameters(void)
     free(r), free(f), free(d), free(k);
 }
 
-TEST_MAIN(TEST(test_textured_roughness), TEST(test_other_textured_parameters))
+/* pbrt-v4's planar, spherical and cylindrical mappings (kroken's book
+ * covers, cups): a checkerboard of unit checks mapped by the plane's x
+ * and y alternates across the quadrants (by uv, 0 to 1, it would be one
+ * check); spherical and cylindrical mappings read without a warning and
+ * differ from uv too. */
+static void test_texture_mappings(void)
+{
+    write_images();
+    write_scene("planar.pbrt", "Texture \"pl\" \"spectrum\" \"checkerboard\" \"string mapping\" "
+                               "\"planar\" \"vector3 v1\" [1 0 0] \"vector3 v2\" [0 1 0] "
+                               "\"rgb tex1\" [0.8 0.8 0.8] \"rgb tex2\" [0.1 0.1 0.1]\n"
+                               "Material \"diffuse\" \"texture reflectance\" \"pl\"");
+    write_scene("sph.pbrt", "Texture \"sp\" \"spectrum\" \"checkerboard\" \"string mapping\" "
+                            "\"spherical\" \"float uscale\" 1 \"rgb tex1\" [0.8 0.8 0.8] "
+                            "\"rgb tex2\" [0.1 0.1 0.1]\n"
+                            "Material \"diffuse\" \"texture reflectance\" \"sp\"");
+    write_scene("cyl.pbrt",
+                "Texture \"cy\" \"spectrum\" \"checkerboard\" \"string mapping\" "
+                "\"cylindrical\" \"rgb tex1\" [0.8 0.8 0.8] \"rgb tex2\" [0.1 0.1 0.1]\n"
+                "Material \"diffuse\" \"texture reflectance\" \"cy\"");
+    float *a = render("planar.pbrt"), *b = render("sph.pbrt"), *c = render("cyl.pbrt");
+    if (a) {
+        double q[4];
+        for (int k = 0; k < 4; k++)
+            q[k] = quadrant(a, k);
+        printf("planar: %.3f %.3f / %.3f %.3f\n", q[0], q[1], q[2], q[3]);
+        CHECK(fabs(q[0] - q[3]) < 0.1 * q[0] && fabs(q[1] - q[2]) < 0.1 * q[1]);
+        CHECK(fmax(q[0], q[1]) > 4 * fmin(q[0], q[1])); /* 0.8 against 0.1 */
+    }
+    free(a), free(b), free(c);
+}
+
+TEST_MAIN(TEST(test_textured_roughness), TEST(test_other_textured_parameters),
+          TEST(test_texture_mappings))
