@@ -559,10 +559,10 @@ static void repair_normals(PlyMesh *m)
     unsigned char *bad = NULL;
     for (size_t i = 0; i < m->n_vertices; i++)
         if (!normal_ok(&m->N[3 * i])) {
-            if (!bad && !(bad = calloc(m->n_vertices, 1)))
-                break; /* out of memory: the zeroes below make it +z */
-            bad[i] = 1;
-            m->n_bad_normals++;
+            if (!m->n_bad_normals++)
+                bad = calloc(m->n_vertices, 1); /* out of memory: +z below */
+            if (bad)
+                bad[i] = 1;
             m->N[3 * i] = m->N[3 * i + 1] = m->N[3 * i + 2] = 0.0f;
         }
     if (!m->n_bad_normals)
