@@ -138,9 +138,9 @@ char *text_read_file(const char *path, size_t *size, char *err, size_t err_size)
     const char *why = buf ? NULL : "out of memory";
     while (!why) {
         if (n + 1 >= cap) {
-            char *b = cap > TEXT_MAX_FILE_BYTES ? NULL : realloc(buf, cap * 2);
+            char *b = cap >= TEXT_MAX_FILE_BYTES ? NULL : realloc(buf, cap * 2);
             if (!b) {
-                why = cap > TEXT_MAX_FILE_BYTES ? "larger than 4 GB" : "out of memory";
+                why = cap >= TEXT_MAX_FILE_BYTES ? "larger than 4 GB" : "out of memory";
                 break;
             }
             buf = b;
