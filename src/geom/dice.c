@@ -56,6 +56,8 @@ void geom_gridset_init(GridSet *gs)
 void geom_gridset_fini(GridSet *gs)
 {
     free(gs->grids);
+    free(gs->grid_cluster);
+    free(gs->clusters);
     free(gs->P);
     free(gs->N);
     free(gs->dPdu);

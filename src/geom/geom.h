@@ -259,9 +259,21 @@ typedef struct GeomInstance {
                               fields above are sample 0's); geom_instance_at blends them */
 } GeomInstance;
 
+/* A cluster of tiny neighbouring grids of one object (geom/cluster.c): the
+ * radiosity cache's levels coarser than one grid. */
+typedef struct GeomCluster {
+    uint32_t rep;    /* the member grid nearest its middle, whose middle it is shaded at */
+    uint32_t parent; /* the cluster of clusters it is in, index + 1; 0: none */
+    float edge;      /* its size, the square root of its area (its grids' units) */
+} GeomCluster;
+
 typedef struct GridSet {
     Grid *grids;           /* one per patch; the index is the patch id */
     size_t n_grids;
+    uint32_t *grid_cluster; /* per grid, the smallest cluster it is in, index + 1; 0: none.
+                              NULL: no clusters (geom_cluster_grids) */
+    GeomCluster *clusters;  /* owned */
+    size_t n_clusters;
     Vec3 *P;               /* vertex positions, world */
     Vec3 *N;               /* unit normals, world (front = dPdu x dPdv) */
     Vec3 *dPdu, *dPdv;     /* derivatives with respect to the primitive's u, v */
@@ -440,6 +452,16 @@ int geom_prim_stitched(const Prim *prim);
  * displacement, before the ray tracing structure is built. Returns 0, or
  * -1 when out of memory (gs is then partly stitched). */
 int geom_stitch(GridSet *gs, const Prim *prims);
+
+/* 1 if g is small enough to be clustered: a still surface grid outside
+ * solids of at most 2 x 2 micropolygons (a dense mesh's face). */
+int geom_grid_tiny(const Grid *g);
+
+/* Groups gs's tiny grids into clusters of neighbours of one object and
+ * those into clusters of clusters (GridSet.grid_cluster, .clusters;
+ * geom/cluster.c), replacing any made before. Run once the grids are
+ * final. Returns 0, or -1 when out of memory (then there are none). */
+int geom_cluster_grids(GridSet *gs);
 
 /* Vertex count of a grid. */
 static inline size_t geom_grid_n_vertices(const Grid *g)

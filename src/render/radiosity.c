@@ -149,6 +149,19 @@ int radiosity_choose_level(const Grid *g, float footprint, float k, int forced)
     return CACHE_FINE;
 }
 
+uint32_t radiosity_choose_cluster(const GridSet *gs, uint32_t grid, float footprint, float k)
+{
+    uint32_t best = 0;
+    if (!gs->grid_cluster)
+        return 0;
+    for (uint32_t c = gs->grid_cluster[grid]; c; c = gs->clusters[c - 1].parent) {
+        if (gs->clusters[c - 1].edge > k * footprint)
+            break;
+        best = c;
+    }
+    return best;
+}
+
 /* --------------------------------------------------------------- fills */
 
 typedef struct FillJob {
@@ -281,6 +294,33 @@ static void layout_points(const GridSet *gs, const Grid *g, int level, int side,
         }
 }
 
+/* A tiny grid's middle, the one point of its cluster's fill: the centroid
+ * of a triangular grid, the middle of a quad grid's vertices (bilinear
+ * between the nearest). */
+static void middle_point(const GridSet *gs, const Grid *g, int side, const RenderObject *obj,
+                         const GeomInstance *gi, int segment, FillPoints *fp)
+{
+    uint32_t vtx[4];
+    float wt[4];
+    int nv;
+    if (g->triangular) {
+        int vi[3][2];
+        float n = (float)g->nu;
+        tri_cell(g->nu, n / 3.0f, n / 3.0f, vi, wt);
+        for (int k = 0; k < 3; k++)
+            vtx[k] = geom_tri_vertex(g->nu, (uint32_t)vi[k][0], (uint32_t)vi[k][1]);
+        nv = 3;
+    } else {
+        int i0 = (g->nu - 1) / 2, j0 = (g->nv - 1) / 2, i1 = g->nu / 2, j1 = g->nv / 2;
+        uint32_t nu = g->nu;
+        vtx[0] = (uint32_t)(j0 * nu + i0), vtx[1] = (uint32_t)(j0 * nu + i1);
+        vtx[2] = (uint32_t)(j1 * nu + i0), vtx[3] = (uint32_t)(j1 * nu + i1);
+        wt[0] = wt[1] = wt[2] = wt[3] = 0.25f;
+        nv = 4;
+    }
+    put_point(gs, g, fp, 0, vtx, wt, nv, side, obj, gi, segment);
+}
+
 /* Moves each point toward the middle of its level's points, along its
  * surface, by twice its ray offset. A vertex on a grid's rim may lie in
  * another surface's plane (a floor's edge against a wall): its rays toward
@@ -369,8 +409,13 @@ static void fill_radiosity(void *user, const CacheKey *key, size_t n, float (*ou
     FillJob *job = user;
     Worker *w = job->w;
     const GridSet *gs = w->rs->gs;
-    const Grid *g = &gs->grids[key->patch];
-    const RenderObject *obj = render_object(w->rs, key->patch, key->instance);
+    /* A cluster's one value is shaded at the middle of its member nearest
+     * its own (keys past the grids name clusters: cluster_key). */
+    const GeomCluster *cl =
+        key->patch >= gs->n_grids ? &gs->clusters[key->patch - gs->n_grids] : NULL;
+    uint32_t grid = cl ? cl->rep : key->patch;
+    const Grid *g = &gs->grids[grid];
+    const RenderObject *obj = render_object(w->rs, grid, key->instance);
     const GeomInstance *gi = render_instance(w->rs, key->instance);
     /* A grid seen through a moving instance moves too: filled per segment,
      * at the segment's middle, the instance where it is then. */
@@ -392,7 +437,10 @@ static void fill_radiosity(void *user, const CacheKey *key, size_t n, float (*ou
     fp.u = f1, fp.v = f1 + n, fp.du = f1 + 2 * n, fp.dv = f1 + 3 * n, fp.curv = f1 + 4 * n;
     fp.offset = f1 + 5 * n, fp.s = f1 + 6 * n, fp.t = f1 + 7 * n, fp.ds = f1 + 8 * n;
     fp.dt = f1 + 9 * n, fp.dst = (float(*)[4])(f1 + 10 * n);
-    layout_points(gs, g, key->level, key->side, obj, gi, key->segment, &fp);
+    if (cl)
+        middle_point(gs, g, key->side, obj, gi, key->segment, &fp);
+    else
+        layout_points(gs, g, key->level, key->side, obj, gi, key->segment, &fp);
     uint64_t fill_key = hash_combine(hash_combine(w->set->seed, 0x7261646f73ull /* "rados" */),
                                      ((uint64_t)key->patch << 32) | ((uint64_t)key->depth << 16) |
                                          ((uint64_t)key->side << 8) | key->level);
@@ -411,6 +459,11 @@ static void fill_radiosity(void *user, const CacheKey *key, size_t n, float (*ou
                     : 0.5f * (cam->shutter[0] + cam->shutter[1]);
     float width = level_edge(g, key->level) * scale, du, dv;
     level_footprint(g, key->level, &du, &dv);
+    if (cl) { /* the member's footprint, grown to the cluster's */
+        float grow = cl->edge / fmaxf(level_edge(g, CACHE_COARSE), 1e-30f);
+        width = cl->edge * scale;
+        du *= fmaxf(grow, 1.0f), dv *= fmaxf(grow, 1.0f);
+    }
     for (size_t i = 0; i < n; i++) {
         fp.du[i] = du;
         fp.dv[i] = dv;
@@ -423,8 +476,8 @@ static void fill_radiosity(void *user, const CacheKey *key, size_t n, float (*ou
     }
     nudge_inward(&fp, n);
     int own_st = (g->primvars & GEOM_PV_ST) != 0;
-    PathState ps = {w, fp.keys, fp.diff, fp.curv, fp.offset, NULL, key->patch,
-                    own_st ? fp.ds : NULL, own_st ? fp.dt : NULL, 0, NULL, key->instance,
+    PathState ps = {w, fp.keys, fp.diff, fp.curv, fp.offset, NULL, grid, own_st ? fp.ds : NULL,
+                    own_st ? fp.dt : NULL, 0, NULL, key->instance,
                     /* irradiance is shared by every subsurface ray near it: more
                      * light samples than a camera hit's (DESIGN.md) */
                     key->type == CACHE_IRRADIANCE ? w->set->irradiance_shadow_rays : 0};
@@ -543,15 +596,30 @@ static Vec3 cached_at_hit(Worker *w, const Hit *hit, int type, int depth, int si
     int segment = moves ? geom_motion_segment(gs, time, &f) : 0;
     /* the footprint in the grid's units (a master's, through an instance) */
     float footprint = path_footprint(diff, hit->t) / (gi ? gi->scale : 1.0f);
-    int level = radiosity_choose_level(g, footprint, w->set->cache_k, w->set->cache_resolution);
+    FillJob job = {w, hit->grid};
     CacheKey key = {.patch = hit->grid,
                     .depth = (uint16_t)depth,
                     .segment = (uint8_t)segment,
                     .side = (uint8_t)side,
                     .type = (uint8_t)type,
-                    .level = (uint8_t)level,
+                    .level = CACHE_COARSE,
                     .instance = hit->instance};
-    FillJob job = {w, hit->grid};
+    uint32_t cluster = 0;
+    if (type != CACHE_OPACITY && w->set->cache_resolution < 0)
+        cluster = radiosity_choose_cluster(gs, hit->grid, footprint, w->set->cache_k);
+    if (cluster) {
+        key.patch = (uint32_t)gs->n_grids + cluster - 1;
+        w->stats.cluster_lookups++;
+        return value(cache_lookup(&w->cache, &key, 1, fill_radiosity, &job), 0);
+    }
+    int level = radiosity_choose_level(g, footprint, w->set->cache_k, w->set->cache_resolution);
+    key = (CacheKey){.patch = hit->grid,
+                     .depth = (uint16_t)depth,
+                     .segment = (uint8_t)segment,
+                     .side = (uint8_t)side,
+                     .type = (uint8_t)type,
+                     .level = (uint8_t)level,
+                     .instance = hit->instance};
     const uint16_t *vals =
         cache_lookup(&w->cache, &key, level_values(g, level), fill_radiosity, &job);
     return radiosity_interpolate(g, hit, level, vals);

@@ -13,6 +13,12 @@
  * (>= 0), after aliasing a MEDIUM level that equals FINE or COARSE. */
 int radiosity_choose_level(const Grid *g, float footprint, float k, int forced);
 
+/* The coarsest cluster (geom/cluster.c) that grid `grid` is in whose size is
+ * at most k * footprint: its index + 1, or 0 if none (the grid's own
+ * levels serve). Radiosity and irradiance only: the memo's opacity stays
+ * per grid (a cut-out's holes are its own). */
+uint32_t radiosity_choose_cluster(const GridSet *gs, uint32_t grid, float footprint, float k);
+
 /* The cached radiosity leaving the hit toward the ray (filling the entry on
  * a miss). */
 Vec3 radiosity_at_hit(Worker *w, const Ray *ray, const Hit *hit, int diffuse_depth, RayDiff diff);

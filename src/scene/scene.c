@@ -1443,6 +1443,8 @@ int scene_prepare(const RayesScene *s, int width, int height, const DiceOptions 
             if (gs->solids[k].end <= k)
                 gs->solids[k].end = (uint32_t)s->n_solids;
     }
+    if (dice && dice->clusters && geom_cluster_grids(gs) != 0)
+        return -1;
     if (coarsened)
         *coarsened = rate_scale;
     return 0;

@@ -255,6 +255,8 @@ typedef struct DiceOptions {
     int isotropic;        /* 1: on screen by distance too (DiceCamera.isotropic) */
     double memory_limit;  /* bytes the grids of a scene over the budget may take; 0: 90% of
                              the memory the machine has beyond the process's */
+    int clusters;         /* 1: tiny grids are clustered for the radiosity and irradiance
+                             caches (geom_cluster_grids) */
 } DiceOptions;
 
 /* Dices every primitive of a committed scene for its camera making an
@@ -265,7 +267,8 @@ typedef struct DiceOptions {
  * edge longer by one factor, found by counting, with one warning; the
  * factor is written to *coarsened when that is not NULL (1: none). One
  * whose grids would still take more than dice->memory_limit is refused,
- * with a message in err (err_size bytes; err may be NULL).
+ * with a message in err (err_size bytes; err may be NULL). Tiny grids are
+ * then clustered where dice->clusters says so.
  * Returns 0, or -1 when out of memory or refused. */
 int scene_prepare(const RayesScene *scene, int width, int height, const DiceOptions *dice,
                   TextureSystem *textures, GridSet *gs, float *coarsened, char *err,

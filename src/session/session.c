@@ -391,8 +391,12 @@ RayesError session_prepare(RayesScene *scene, const RenderSettings *set, Texture
     p->objects = session_render_objects(scene);
     p->masks = p->objects ? object_masks(scene, p->objects) : NULL;
     char err[300] = "";
-    DiceOptions dice = {set->grid_size, set->dice_offscreen, set->vertex_budget,
-                        set->dice_isotropic, 0.0};
+    DiceOptions dice = {set->grid_size,
+                        set->dice_offscreen,
+                        set->vertex_budget,
+                        set->dice_isotropic,
+                        0.0,
+                        set->radiosity_cache || set->irradiance_cache};
     if (!p->objects || !p->masks ||
         scene_prepare(scene, set->width, set->height, &dice, textures, &p->gs, &p->coarsened, err,
                       sizeof err) != 0) {

@@ -109,6 +109,8 @@ RayesStats *session_stats_new(const RenderSettings *set, const RenderStats *rs, 
     count(s, "subsurface/irradiance_points", rs->irradiance_points);
     count(s, "grids", gs->n_grids);
     count(s, "grid_vertices", gs->n_vertices);
+    count(s, "clusters/count", gs->n_clusters);
+    count(s, "clusters/lookups", rs->cluster_lookups);
     /* Motion blur: the geometry's time samples, its moving grids, and the
      * radiosity entries filled for them per motion segment. */
     uint64_t moving = 0;
@@ -127,6 +129,8 @@ RayesStats *session_stats_new(const RenderSettings *set, const RenderStats *rs, 
     count(s, "memory/accel_bytes", accel_bytes);
     size_t geom_bytes = gs->n_vertices * (4 * sizeof(Vec3) + 2 * sizeof(float)) +
                         gs->n_grids * sizeof(Grid) +
+                        (gs->grid_cluster ? gs->n_grids * sizeof *gs->grid_cluster : 0) +
+                        gs->n_clusters * sizeof(GeomCluster) +
                         (size_t)(n_times - 1) * gs->n_motion_vertices * 4 * sizeof(Vec3);
     count(s, "memory/grid_bytes", geom_bytes);
     count(s, "resolution/width", (uint64_t)set->width);

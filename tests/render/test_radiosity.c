@@ -287,6 +287,92 @@ static void test_dense_mesh_coarse_level(void)
     CHECK(fabs(mean_on - mean_off) < 0.02 * mean_off);
 }
 
+/* A closed box [-1, 1]^3 of six walls of 2 x 40 x 40 triangles each, below
+ * a micropolygon, lit by a point light at its centre, seen from inside;
+ * 3 bounces. Its statistics in *st. */
+static RayesImage *dense_room(int cache, int threads, double mb, RayesStats **st)
+{
+    enum { N = 40, M = N + 1, F = 2 * N * N };
+    RayesScene *s = rayes_scene_new();
+    const float eye[3] = {0.8f, 0.3f, -0.9f}, at[3] = {-1, -0.2f, 1}, up[3] = {0, 1, 0};
+    CHECK(rayes_scene_set_camera(s, eye, at, up, 70.0f) == RAYES_OK);
+    RayesParam light[2] = {{"intensity", RAYES_PARAM_FLOAT, {1.0f, 0, 0}, NULL},
+                           {"from", RAYES_PARAM_COLOR, {0.3f, 0.5f, 0.2f}, NULL}};
+    CHECK(rayes_scene_light(s, "pointlight", light, 2) == RAYES_OK);
+    RayesParam kd = {"Kd", RAYES_PARAM_FLOAT, {0.8f, 0, 0}, NULL};
+    CHECK(rayes_scene_set_shader(s, "matte", &kd, 1) == RAYES_OK);
+    static float P[6][3 * M * M];
+    static int nv[F], idx[3 * F];
+    test_lattice_triangles(N, nv, idx);
+    for (int w = 0; w < 6; w++) {
+        int a = w / 2, b = (a + 1) % 3, c = (a + 2) % 3; /* wall at x_a = +-1 */
+        for (int j = 0; j < M; j++)
+            for (int i = 0; i < M; i++) {
+                float *p = &P[w][3 * (j * M + i)];
+                p[a] = w % 2 ? 1.0f : -1.0f;
+                p[b] = -1.0f + 2.0f * i / N;
+                p[c] = -1.0f + 2.0f * j / N;
+            }
+        CHECK(rayes_scene_polygon_mesh(s, F, nv, idx, M * M, P[w]) == RAYES_OK);
+    }
+    CHECK(rayes_scene_commit(s) == RAYES_OK);
+    RayesRenderOptions o;
+    rayes_render_options_init(&o, RAYES_QUALITY_PREVIEW);
+    o.width = o.height = 40;
+    o.spp = 4;
+    o.threads = threads;
+    o.bounces = 3;
+    o.cache = cache;
+    o.cache_mb = mb;
+    RayesImage *img = NULL;
+    CHECK(rayes_render(s, &o, &img, st) == RAYES_OK);
+    rayes_scene_release(s);
+    return img;
+}
+
+static double image_mean(const RayesImage *img)
+{
+    double sum = 0.0;
+    for (size_t k = 0; img && k < (size_t)img->width * img->height; k++)
+        sum += img->rgba[4 * k] + img->rgba[4 * k + 1] + img->rgba[4 * k + 2];
+    return img ? sum / (3.0 * img->width * img->height) : 0.0;
+}
+
+static uint64_t count(const RayesStats *st, const char *name, int i)
+{
+    const RayesStat *x = st ? rayes_stats_find(st, name) : NULL;
+    if (!x)
+        return 0;
+    return x->kind == RAYES_STAT_COUNTS ? (i < (int)x->n_counts ? x->counts[i] : 0) : x->count;
+}
+
+/* Diffuse rays wider than a face read one value for a cluster of faces
+ * (geom/cluster.c): the shading points at depths 2 and 3 drop far below
+ * the uncached render's (they grew past them, about 4 a lookup, with one
+ * entry per face), the mean stays within noise, and the bytes do not
+ * depend on threads or on a budget that evicts. */
+static void test_dense_room_clusters(void)
+{
+    RayesStats *on = NULL, *off = NULL;
+    RayesImage *a = dense_room(1, 2, 100, &on), *b = dense_room(0, 2, 100, &off);
+    CHECK(count(on, "clusters/count", 0) > 6 * 2 * 40 * 40 / 256);
+    CHECK(count(on, "clusters/lookups", 0) > 1000);
+    uint64_t deep_on =
+        count(on, "shading_points/by_depth", 2) + count(on, "shading_points/by_depth", 3);
+    uint64_t deep_off =
+        count(off, "shading_points/by_depth", 2) + count(off, "shading_points/by_depth", 3);
+    CHECK(deep_off > 1000 && deep_on < deep_off / 3);
+    double m_on = image_mean(a), m_off = image_mean(b);
+    CHECK(m_off > 0.0 && fabs(m_on / m_off - 1.0) < 0.03);
+    RayesImage *c = dense_room(1, 1, 0.05, NULL);
+    CHECK(same(a, c));
+    rayes_image_free(a);
+    rayes_image_free(b);
+    rayes_image_free(c);
+    rayes_stats_free(on);
+    rayes_stats_free(off);
+}
+
 TEST_MAIN(TEST(test_interpolation_is_exact_for_linear_functions), TEST(test_medium_aliasing),
           TEST(test_level_choice), TEST(test_same_bytes_for_any_budget_and_threads),
-          TEST(test_grid_size), TEST(test_dense_mesh_coarse_level))
+          TEST(test_grid_size), TEST(test_dense_mesh_coarse_level), TEST(test_dense_room_clusters))
