@@ -147,7 +147,7 @@ static void face_outside(HitPoint *hp, int *backfacing)
  * opacity. */
 static Vec3 shade_hit(Worker *w, const Ray *ray, const Hit *hit, const RenderObject *obj,
                       uint32_t kind, int diffuse_depth, int specular_depth, uint64_t key,
-                      RayDiff diff, int path, Vec3 *Oi_out)
+                      RayDiff diff, Vec3 *Oi_out)
 {
     HitPoint hp;
     int backfacing = !hit_point(w, ray, hit, obj, &hp);
@@ -158,17 +158,8 @@ static Vec3 shade_hit(Worker *w, const Ray *ray, const Hit *hit, const RenderObj
     hit_footprint(&hp);
     path_st_footprint(hp.dst, hp.du, hp.dv, &hp.ds, &hp.dt);
     int own_st = (w->rs->gs->grids[hit->grid].primvars & GEOM_PV_ST) != 0;
-    PathState ps = {w,
-                    &hp.key,
-                    &hp.diff,
-                    &hp.curvature,
-                    &hp.offset,
-                    NULL,
-                    hit->grid,
-                    own_st ? &hp.ds : NULL,
-                    own_st ? &hp.dt : NULL,
-                    path,
-                    NULL,
+    PathState ps = {w, &hp.key, &hp.diff, &hp.curvature, &hp.offset, NULL, hit->grid,
+                    own_st ? &hp.ds : NULL, own_st ? &hp.dt : NULL, 1, NULL,
                     hit->instance};
     RayesShadeCtx ctx = {
         .n_points = 1,
@@ -234,7 +225,7 @@ Vec3 integrator_irradiance(Worker *w, const Ray *ray, const Hit *hit, uint64_t k
     if (!obj->shader)
         return v3(0, 0, 0);
     Vec3 Oi;
-    return shade_hit(w, ray, hit, obj, RAYES_RAY_SUBSURFACE, 0, 0, key, diff, PATH_OWN, &Oi);
+    return shade_hit(w, ray, hit, obj, RAYES_RAY_SUBSURFACE, 0, 0, key, diff, &Oi);
 }
 
 Vec3 integrator_opacity(Worker *w, const Ray *ray, Hit *hit, const AccelCrossing *crossing,
@@ -251,7 +242,7 @@ Vec3 integrator_opacity(Worker *w, const Ray *ray, Hit *hit, const AccelCrossing
         return radiosity_opacity_at_hit(w, hit, diff);
     Vec3 Oi;
     accel_crossing_normal(crossing, hit);
-    shade_hit(w, ray, hit, obj, RAYES_RAY_TRANSMISSION, 0, 0, 0, diff, PATH_OWN, &Oi);
+    shade_hit(w, ray, hit, obj, RAYES_RAY_TRANSMISSION, 0, 0, 0, diff, &Oi);
     return Oi;
 }
 
@@ -332,9 +323,8 @@ static Vec3 trace_layers(Worker *w, const Ray *ray, uint32_t kind, int diffuse_d
     }
     int see_through = obj->transparent && layer < INTEGRATOR_MAX_LAYERS;
     Vec3 Ci, Oi = v3(1, 1, 1);
-    int uncached = 0;
-    if (kind == RAYES_RAY_DIFFUSE && w->set->radiosity_cache &&
-        (Ci = radiosity_at_hit(w, ray, &hit, diffuse_depth, diff, &uncached), !uncached)) {
+    if (kind == RAYES_RAY_DIFFUSE && w->set->radiosity_cache) {
+        Ci = radiosity_at_hit(w, ray, &hit, diffuse_depth, diff);
         if (see_through)
             Oi = integrator_opacity(w, ray, &hit, NULL, diff);
     } else if (kind == RAYES_RAY_CAMERA && w->grid_shading &&
@@ -342,8 +332,7 @@ static Vec3 trace_layers(Worker *w, const Ray *ray, uint32_t kind, int diffuse_d
         /* the grid hider's shaded grid (a master's grid per instance; Ci
          * and Oi of a transparent one) */
     } else {
-        Ci = shade_hit(w, ray, &hit, obj, kind, diffuse_depth, specular_depth, key, diff,
-                       uncached ? PATH_INSTEAD_OF_CACHE : PATH_OWN, &Oi);
+        Ci = shade_hit(w, ray, &hit, obj, kind, diffuse_depth, specular_depth, key, diff, &Oi);
     }
     if (!see_through)
         return Ci;

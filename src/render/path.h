@@ -74,15 +74,6 @@ typedef struct Worker {
  * ctx->first_point), the sample key its random numbers derive from, the ray
  * differential that arrived (width = footprint at the point), the grid's
  * curvature, and how far rays leaving the point start from it. */
-/* What a shaded point is (PathState.path). */
-typedef enum PathKind {
-    PATH_GRID = 0,            /* a cache fill's or the grid hider's points: their diffuse
-                                 rays are the presets' */
-    PATH_OWN = 1,             /* a path's own hit: past the branch depth, one diffuse ray */
-    PATH_INSTEAD_OF_CACHE = 2 /* a diffuse hit the cache declined (radiosity_at_hit): one
-                                 diffuse ray, whatever the branch depth */
-} PathKind;
-
 typedef struct PathState {
     Worker *w;
     const uint64_t *keys;
@@ -95,8 +86,9 @@ typedef struct PathState {
     const float *ds, *dt;         /* texture filter widths in (s, t) where the points have
                                      texture coordinates of their own (primitive variable st),
                                      or NULL: the texture service then takes ctx->du, dv */
-    int path;                     /* PathKind: a path's own hit (integrator.c), or 0: a
-                                     grid (a cache fill, the grid hider) */
+    int path;                     /* 1: a path's own hit (integrator.c), not a grid (a cache
+                                     fill, the grid hider): past the branch depth its diffuse
+                                     rays are one */
     float (*irradiance)[3];       /* per point, where direct lighting leaves pi times its
                                      diffuse result (the shader's Irradiance output, memo
                                      6.2), or NULL: not asked for */

@@ -584,25 +584,9 @@ Vec3 radiosity_interpolate(const Grid *g, const Hit *hit, int level, const uint1
     return r;
 }
 
-/* Diffuse depths whose lookups may fill the fine level: 1, the rays of
- * camera hits. Deeper rays are a fill's, and ask for the fine level only
- * close to where they start (a contact, a corner): such entries are the
- * largest (up to 289 points, each tracing the presets' diffuse rays) and
- * seldom read again, and each fill's rays found more of them at the next
- * depth. Bitterli's classroom at 160 x 90, 8 samples: 2.1 and 3.2 million
- * shading points at depths 2 and 3 against the uncached render's 0.9 and
- * 0.8, and 8 bounces did not finish in 600 s (uncached 19 s). Such a hit
- * is shaded as a path's own, tracing one diffuse ray: 8 bounces in 26 s;
- * on the memo's box (256 x 256, 3 bounces) 588,000 shading points fell to
- * 476,000 and the cached time from 1.71 to 1.43 times 1 bounce's, its bias
- * unchanged. */
-#define RADIOSITY_FINE_DEPTHS 2
-
-/* The cached value of a type at a hit; with `uncached` (radiosity at a
- * diffuse hit), *uncached = 1 and nothing cached where the hit is better
- * shaded as a path's own (RADIOSITY_FINE_DEPTHS). */
+/* The cached value of a type at a hit. */
 static Vec3 cached_at_hit(Worker *w, const Hit *hit, int type, int depth, int side, RayDiff diff,
-                          float time, int *uncached)
+                          float time)
 {
     const GridSet *gs = w->rs->gs;
     const Grid *g = &gs->grids[hit->grid];
@@ -629,12 +613,6 @@ static Vec3 cached_at_hit(Worker *w, const Hit *hit, int type, int depth, int si
         return value(cache_lookup(&w->cache, &key, 1, fill_radiosity, &job), 0);
     }
     int level = radiosity_choose_level(g, footprint, w->set->cache_k, w->set->cache_resolution);
-    if (uncached && depth >= RADIOSITY_FINE_DEPTHS && level == CACHE_FINE &&
-        w->set->cache_resolution < 0) {
-        *uncached = 1; /* the caller shades the hit as a path's (DESIGN.md) */
-        w->stats.cache_declined++;
-        return v3(0, 0, 0);
-    }
     key = (CacheKey){.patch = hit->grid,
                      .depth = (uint16_t)depth,
                      .segment = (uint8_t)segment,
@@ -647,24 +625,23 @@ static Vec3 cached_at_hit(Worker *w, const Hit *hit, int type, int depth, int si
     return radiosity_interpolate(g, hit, level, vals);
 }
 
-Vec3 radiosity_at_hit(Worker *w, const Ray *ray, const Hit *hit, int diffuse_depth, RayDiff diff,
-                      int *uncached)
+Vec3 radiosity_at_hit(Worker *w, const Ray *ray, const Hit *hit, int diffuse_depth, RayDiff diff)
 {
     int side = v3_dot(hit->Ng, ray->d) < 0.0f ? 0 : 1;
-    return cached_at_hit(w, hit, CACHE_RADIOSITY, diffuse_depth, side, diff, ray->time, uncached);
+    return cached_at_hit(w, hit, CACHE_RADIOSITY, diffuse_depth, side, diff, ray->time);
 }
 
 Vec3 radiosity_irradiance_at_hit(Worker *w, const Ray *ray, const Hit *hit, float footprint)
 {
     /* The outside: the side the ray leaves the object through. */
     int side = v3_dot(hit->Ng, ray->d) < 0.0f ? 1 : 0;
-    return cached_at_hit(w, hit, CACHE_IRRADIANCE, 0, side, (RayDiff){footprint, 0.0f}, ray->time,
-                         NULL);
+    return cached_at_hit(w, hit, CACHE_IRRADIANCE, 0, side, (RayDiff){footprint, 0.0f},
+                         ray->time);
 }
 
 Vec3 radiosity_opacity_at_hit(Worker *w, const Hit *hit, RayDiff diff)
 {
     /* The memo's assumption: one opacity per point, whatever the side and
      * the depth. */
-    return cached_at_hit(w, hit, CACHE_OPACITY, 0, 0, diff, w->time, NULL);
+    return cached_at_hit(w, hit, CACHE_OPACITY, 0, 0, diff, w->time);
 }

@@ -20,11 +20,8 @@ int radiosity_choose_level(const Grid *g, float footprint, float k, int forced);
 uint32_t radiosity_choose_cluster(const GridSet *gs, uint32_t grid, float footprint, float k);
 
 /* The cached radiosity leaving the hit toward the ray (filling the entry on
- * a miss); or, at diffuse depths past the first where the footprint asks
- * for the fine level, nothing, with *uncached = 1: the caller shades the
- * hit as a path's own (PATH_INSTEAD_OF_CACHE, one diffuse ray). */
-Vec3 radiosity_at_hit(Worker *w, const Ray *ray, const Hit *hit, int diffuse_depth, RayDiff diff,
-                      int *uncached);
+ * a miss). */
+Vec3 radiosity_at_hit(Worker *w, const Ray *ray, const Hit *hit, int diffuse_depth, RayDiff diff);
 
 /* The cached opacity at a hit (memo 6.1): entries of data type opacity, of
  * the front side and depth 0 whatever the ray, filled by the shader's

@@ -449,7 +449,6 @@ static void merge_stats(RenderStats *into, const RenderStats *s)
     into->irradiance_points += s->irradiance_points;
     into->instance_fills += s->instance_fills;
     into->cluster_lookups += s->cluster_lookups;
-    into->cache_declined += s->cache_declined;
     into->pbgi_gathers += s->pbgi_gathers;
     for (int k = 0; k < GEOM_MAX_TIMES - 1; k++)
         into->segment_fills[k] += s->segment_fills[k];

@@ -190,8 +190,6 @@ typedef struct RenderStats {
     uint64_t pbgi_gathers;      /* point-based GI: points gathered from the cloud */
     uint64_t cluster_lookups;   /* radiosity and irradiance lookups a cluster of tiny grids
                                    answered (geom/cluster.c; counted in the coarse level's) */
-    uint64_t cache_declined;    /* diffuse hits past depth 1 asking for the fine level, shaded
-                                   as paths' instead (radiosity.c RADIOSITY_FINE_DEPTHS) */
     uint64_t segment_fills[GEOM_MAX_TIMES - 1]; /* radiosity cache fills of moving grids, by
                                                    motion segment (the entries each made) */
 } RenderStats;

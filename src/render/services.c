@@ -579,8 +579,7 @@ static void svc_indirect_diffuse(const RayesShaderServices *sv, const RayesShade
     int n = n_rays > 0 ? n_rays : depth == 0 ? w->set->diffuse_rays : w->set->diffuse_rays_deep;
     if (depth >= w->set->bounces)
         n = 0;
-    if (n > 1 && (ps->path == PATH_INSTEAD_OF_CACHE ||
-                  (ps->path == PATH_OWN && depth >= w->set->branch_depth)))
+    if (ps->path && n > 1 && depth >= w->set->branch_depth)
         n = 1; /* an uncached hit past the branch depth: one ray follows the path */
     IrrGrid *irr = ps->irr;
     if (irr && n > 0 && ctx->N == irr->N + ctx->first_point) {

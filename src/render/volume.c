@@ -197,8 +197,7 @@ static RayesShadeCtx points_ctx(const VolumePoints *p, size_t n, uint32_t ray_ty
 /* Runs the opacity method on p's n points: sigma_t into p->Oi. */
 static void run_extinction(Worker *w, const RenderObject *obj, VolumePoints *p, size_t n)
 {
-    PathState ps = {w,    p->keys,    p->diff, p->zero1, p->zero1,
-                    NULL, UINT32_MAX, NULL,    NULL,     PATH_OWN};
+    PathState ps = {w, p->keys, p->diff, p->zero1, p->zero1, NULL, UINT32_MAX, NULL, NULL, 1};
     RayesShadeCtx ctx = points_ctx(p, n, RAYES_RAY_TRANSMISSION, 0, 0, 0, &ps);
     RayesShadeOutputs o = {p->Ci, p->Oi, NULL, NULL};
     w->stats.opacity_points += n;
@@ -478,8 +477,7 @@ Vec3 volume_radiance(Worker *w, const Ray *ray, float tmax, int64_t leaving, uin
                 lp.keys[j] = p.keys[i];
                 lp.diff[j] = p.diff[i];
             }
-            PathState ps = {w,    lp.keys,    lp.diff, lp.zero1, lp.zero1,
-                            NULL, UINT32_MAX, NULL,    NULL,     PATH_OWN};
+            PathState ps = {w, lp.keys, lp.diff, lp.zero1, lp.zero1, NULL, UINT32_MAX, NULL, NULL, 1};
             RayesShadeCtx ctx = points_ctx(&lp, (size_t)n_light, kind & ~PATH_RAY_GLOSSY, 1,
                                            diffuse_depth, specular_depth, &ps);
             RayesShadeOutputs o = {lp.Ci, lp.Oi, NULL, NULL};

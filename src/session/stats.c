@@ -111,7 +111,6 @@ RayesStats *session_stats_new(const RenderSettings *set, const RenderStats *rs, 
     count(s, "grid_vertices", gs->n_vertices);
     count(s, "clusters/count", gs->n_clusters);
     count(s, "clusters/lookups", rs->cluster_lookups);
-    count(s, "radiosity/fine_as_paths", rs->cache_declined);
     /* Motion blur: the geometry's time samples, its moving grids, and the
      * radiosity entries filled for them per motion segment. */
     uint64_t moving = 0;

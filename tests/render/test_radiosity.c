@@ -373,43 +373,6 @@ static void test_dense_room_clusters(void)
     rayes_stats_free(off);
 }
 
-/* Past the first bounce, a hit whose footprint asks for the fine level is
- * shaded as a path's own (one diffuse ray) instead of filling a grid's
- * largest entry (radiosity.c RADIOSITY_FINE_DEPTHS): the box at 3 bounces
- * has such hits (near its corners and the teapots' contacts), none with the
- * level forced, and the image keeps the uncached one's mean. */
-static void test_deep_fine_hits_are_paths(void)
-{
-    RayesScene *s = teapots();
-    RayesRenderOptions o;
-    rayes_render_options_init(&o, RAYES_QUALITY_PREVIEW);
-    o.width = o.height = 48;
-    o.spp = 4;
-    o.bounces = 3;
-    o.threads = 2;
-    double mean[3];
-    uint64_t paths[3], deep[3];
-    for (int i = 0; i < 3; i++) {
-        o.cache = i < 2;
-        o.cache_resolution = i == 1 ? CACHE_FINE : -1;
-        RayesImage *img = NULL;
-        RayesStats *st = NULL;
-        CHECK(rayes_render(s, &o, &img, &st) == RAYES_OK);
-        mean[i] = image_mean(img);
-        paths[i] = count(st, "radiosity/fine_as_paths", 0);
-        deep[i] = count(st, "shading_points/by_depth", 3);
-        rayes_image_free(img);
-        rayes_stats_free(st);
-    }
-    CHECK(paths[0] > 100 && paths[1] == 0);
-    CHECK(deep[0] < deep[1]);
-    /* 1.7% dark, the coarse cells of a box diced for 48 x 48 (forced fine:
-     * 0.2%) */
-    CHECK(mean[2] > 0.0 && fabs(mean[0] / mean[2] - 1.0) < 0.03);
-    rayes_scene_release(s);
-}
-
 TEST_MAIN(TEST(test_interpolation_is_exact_for_linear_functions), TEST(test_medium_aliasing),
           TEST(test_level_choice), TEST(test_same_bytes_for_any_budget_and_threads),
-          TEST(test_grid_size), TEST(test_dense_mesh_coarse_level), TEST(test_dense_room_clusters),
-          TEST(test_deep_fine_hits_are_paths))
+          TEST(test_grid_size), TEST(test_dense_mesh_coarse_level), TEST(test_dense_room_clusters))
