@@ -52,7 +52,9 @@ typedef enum CacheType {
 
 /* What an entry is for. Two keys are equal iff all fields are. */
 typedef struct CacheKey {
-    uint32_t patch;    /* patch id (a master's, for instances: see instance) */
+    uint32_t patch;    /* patch id (a master's, for instances: see instance); past the
+                          grids, a cluster of tiny grids (radiosity, irradiance) or a
+                          volume's brick (opacity) */
     uint16_t depth;    /* diffuse depth */
     uint8_t segment;   /* motion segment */
     uint8_t side;      /* 0: front (dPdu x dPdv), 1: back */

@@ -21,7 +21,9 @@
  * CLUSTER_CONE of the run's first (so the run's normals span at most twice
  * that, the cache's bend limit, and all face one side), and the run's box
  * stays within CLUSTER_COMPACT times the square root of its area (a jump of
- * the Morton curve does not join two distant pieces). A cluster with one
+ * the Morton curve does not join two distant pieces) and its middles
+ * within CLUSTER_THICK times that along its normal (layers of one object
+ * facing one way, a board on a board, do not join). A cluster with one
  * child is its child and is not kept.
  *
  * Memory: 4 bytes a grid and 12 a cluster, kept; 104 bytes a tiny grid and
@@ -46,6 +48,9 @@
 #define CLUSTER_LEVELS 2
 #define CLUSTER_CONE 0.25f    /* radians: half the cache's bend limit */
 #define CLUSTER_COMPACT 3.0f  /* box diagonal over the square root of the area */
+#define CLUSTER_THICK                                                                              \
+    0.25f /* spread along the normal over the square root of the area:                             \
+             stacked layers (foliage, boards) stay apart */
 
 /* A grid small enough to cluster: a surface of at most 2 x 2
  * micropolygons, still (a moving grid's entries are per motion segment)
@@ -189,8 +194,19 @@ typedef struct Build {
     float area;
     Vec3 weighted;   /* sum of area x middle */
     Bounds3 box;
+    float depth[2]; /* the range of its middles (and its children's thickness) along normal */
     uint64_t group;
 } Build;
+
+/* Child c's range along r's normal: its middle, give or take half its
+ * own thickness. */
+static void depth_along(const Build *r, const Build *c, float *lo, float *hi)
+{
+    float mid = v3_dot(v3_scale(c->weighted, 1.0f / c->area), r->normal);
+    float half = 0.5f * (c->depth[1] - c->depth[0]);
+    *lo = fminf(r->depth[0], mid - half);
+    *hi = fmaxf(r->depth[1], mid + half);
+}
 
 /* Whether run r may take child c (a grid's shape as a cluster of one). */
 static int may_join(const Build *r, const Build *c)
@@ -201,14 +217,17 @@ static int may_join(const Build *r, const Build *c)
     if (acosf(cosine) + c->cone > CLUSTER_CONE)
         return 0;
     Bounds3 b = bounds_union(r->box, c->box);
-    float diag = v3_length(v3_sub(b.hi, b.lo)), area = r->area + c->area;
-    return diag * diag <= CLUSTER_COMPACT * CLUSTER_COMPACT * area;
+    float diag = v3_length(v3_sub(b.hi, b.lo)), area = r->area + c->area, lo, hi;
+    depth_along(r, c, &lo, &hi);
+    return diag * diag <= CLUSTER_COMPACT * CLUSTER_COMPACT * area &&
+           (hi - lo) * (hi - lo) <= CLUSTER_THICK * CLUSTER_THICK * area;
 }
 
 static void join(Build *r, const Build *c)
 {
     float cosine = fminf(fmaxf(v3_dot(r->normal, c->normal), -1.0f), 1.0f);
     r->cone = fmaxf(r->cone, acosf(cosine) + c->cone);
+    depth_along(r, c, &r->depth[0], &r->depth[1]);
     r->end = c->end;
     r->children++;
     r->area += c->area;
@@ -271,8 +290,10 @@ static void drop(GridSet *gs)
 static Build grid_unit(const Rec *r, uint32_t k)
 {
     const Shape *s = &r->shape;
-    return (Build){k, k + 1, 1, 0, s->normal, 0.0f, s->area, v3_scale(s->middle, s->area), s->box,
-                   r->group};
+    float d = v3_dot(s->middle, s->normal);
+    return (Build){k,         k + 1,  1,       0,
+                   s->normal, 0.0f,   s->area, v3_scale(s->middle, s->area),
+                   s->box,    {d, d}, r->group};
 }
 
 /* Runs of the records in order (the first level), then runs of the runs
@@ -421,6 +442,10 @@ int geom_cluster_grids(GridSet *gs)
         c->parent = 0;
         kept[r] = (uint32_t)++gs->n_clusters;
     }
+    if (!failed && gs->n_clusters && gs->n_clusters < rs.n) { /* only the kept */
+        GeomCluster *fit = realloc(gs->clusters, gs->n_clusters * sizeof *fit);
+        gs->clusters = fit ? fit : gs->clusters;
+    }
     for (size_t r = 0; !failed && r < rs.n; r++) {
         uint32_t up = rs.b[r].parent;
         while (up && !kept[up - 1])
@@ -446,5 +471,7 @@ int geom_cluster_grids(GridSet *gs)
         drop(gs);
         return -1;
     }
+    if (!gs->n_clusters) /* every run a single grid */
+        drop(gs);
     return 0;
 }

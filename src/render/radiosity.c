@@ -8,10 +8,14 @@
  *
  * At a diffuse hit the resolution is chosen from the ray's footprint (the
  * coarsest level whose micropolygon edge is at most k times the footprint,
- * DESIGN.md, and bends through at most RADIOSITY_MAX_BEND), the entry for (patch, diffuse depth, side, RADIOSITY, level)
- * is looked up, and on a miss filled by running prelighting and
+ * DESIGN.md, and bends through at most RADIOSITY_MAX_BEND), the entry for (patch, diffuse depth,
+ * side, RADIOSITY, level) is looked up, and on a miss filled by running prelighting and
  * diffuselighting on every vertex of the grid at that level; the hit's value
  * is interpolated: bilinear in the quad cell, barycentric in the triangle.
+ * Coarser still, for radiosity and irradiance on an opaque object: the
+ * clusters of tiny grids (geom/cluster.c), one value each, keyed by patch
+ * n_grids + the cluster's index (volume.c's bricks use the same range for
+ * opacity, a type clusters never have).
  *
  * Level layouts, per grid:
  *   quad FINE    all nu x nv vertices, in vertex order;
@@ -410,9 +414,10 @@ static void fill_radiosity(void *user, const CacheKey *key, size_t n, float (*ou
     Worker *w = job->w;
     const GridSet *gs = w->rs->gs;
     /* A cluster's one value is shaded at the middle of its member nearest
-     * its own (keys past the grids name clusters: cluster_key). */
+     * its own (keys past the grids name clusters: cached_at_hit). */
     const GeomCluster *cl =
         key->patch >= gs->n_grids ? &gs->clusters[key->patch - gs->n_grids] : NULL;
+    RY_DCHECK(!cl || (key->type != CACHE_OPACITY && key->patch - gs->n_grids < gs->n_clusters));
     uint32_t grid = cl ? cl->rep : key->patch;
     const Grid *g = &gs->grids[grid];
     const RenderObject *obj = render_object(w->rs, grid, key->instance);
@@ -604,8 +609,13 @@ static Vec3 cached_at_hit(Worker *w, const Hit *hit, int type, int depth, int si
                     .type = (uint8_t)type,
                     .level = CACHE_COARSE,
                     .instance = hit->instance};
+    /* Clusters (no bend limit of their own: their normals span at most
+     * the bend limit) for radiosity and irradiance, not opacity, and not
+     * on a transparent object, whose Ci is premultiplied by its own
+     * opacity (a cut-out's holes would take a member's light). */
     uint32_t cluster = 0;
-    if (type != CACHE_OPACITY && w->set->cache_resolution < 0)
+    if (type != CACHE_OPACITY && w->set->cache_resolution < 0 &&
+        !render_object(w->rs, hit->grid, hit->instance)->transparent)
         cluster = radiosity_choose_cluster(gs, hit->grid, footprint, w->set->cache_k);
     if (cluster) {
         key.patch = (uint32_t)gs->n_grids + cluster - 1;
@@ -613,13 +623,7 @@ static Vec3 cached_at_hit(Worker *w, const Hit *hit, int type, int depth, int si
         return value(cache_lookup(&w->cache, &key, 1, fill_radiosity, &job), 0);
     }
     int level = radiosity_choose_level(g, footprint, w->set->cache_k, w->set->cache_resolution);
-    key = (CacheKey){.patch = hit->grid,
-                     .depth = (uint16_t)depth,
-                     .segment = (uint8_t)segment,
-                     .side = (uint8_t)side,
-                     .type = (uint8_t)type,
-                     .level = (uint8_t)level,
-                     .instance = hit->instance};
+    key.level = (uint8_t)level;
     const uint16_t *vals =
         cache_lookup(&w->cache, &key, level_values(g, level), fill_radiosity, &job);
     return radiosity_interpolate(g, hit, level, vals);

@@ -14,22 +14,22 @@ enum { N = 48 }; /* lattice cells along a side */
  * cells of [0, 1]^2 in the plane z = 0 (or, where fold says, its right half
  * turned up into the plane x = 0.5); object(i, j) per cell, and every
  * other triangle wound backwards where flip says. */
-static void lattice(GridSet *gs, int fold, int (*object)(int, int), int flip)
+static void lattice_layers(GridSet *gs, int fold, int (*object)(int, int), int flip, int layers)
 {
     geom_gridset_init(gs);
-    size_t n = 2 * N * N;
+    size_t n = 2 * N * N * (size_t)layers + (layers > 1);
     gs->grids = calloc(n, sizeof *gs->grids);
     gs->P = calloc(3 * n, sizeof *gs->P);
     gs->N = calloc(3 * n, sizeof *gs->N);
     CHECK(gs->grids && gs->P && gs->N);
     for (int j = 0; j < N; j++)
         for (int i = 0; i < N; i++)
-            for (int t = 0; t < 2; t++) {
+            for (int t = 0; t < 2 * layers; t++) {
                 size_t g = gs->n_grids++;
-                float x0 = (float)i / N, y0 = (float)j / N, h = 1.0f / N;
-                Vec3 c[3] = {v3(x0, y0, 0), v3(x0 + h, y0 + h, 0), v3(x0 + h, y0, 0)};
-                if (t)
-                    c[1] = v3(x0, y0 + h, 0), c[2] = v3(x0 + h, y0 + h, 0);
+                float x0 = (float)i / N, y0 = (float)j / N, h = 1.0f / N, z = 0.05f * (t / 2);
+                Vec3 c[3] = {v3(x0, y0, z), v3(x0 + h, y0 + h, z), v3(x0 + h, y0, z)};
+                if (t % 2)
+                    c[1] = v3(x0, y0 + h, z), c[2] = v3(x0 + h, y0 + h, z);
                 int backwards = flip && (i + j + t) % 2;
                 Vec3 normal = v3(0, 0, backwards ? 1.0f : -1.0f);
                 if (backwards) {
@@ -46,7 +46,24 @@ static void lattice(GridSet *gs, int fold, int (*object)(int, int), int flip)
                 gs->grids[g] = (Grid){.first_vertex = (uint32_t)(3 * g), .nu = 1, .triangular = 1,
                                       .edge = h, .object = object ? (uint32_t)object(i, j) : 0};
             }
+    if (layers > 1) { /* one face far above, of another object: the layers' middles then
+                         interleave in Morton order (they would sort one after the other) */
+        size_t g = gs->n_grids++;
+        for (int k = 0; k < 3; k++)
+            gs->P[3 * g + k] = v3(k == 1 ? 0.01f : 0.0f, k == 2 ? 0.01f : 0.0f, 10.0f),
+                          gs->N[3 * g + k] = v3(0, 0, -1);
+        gs->grids[g] = (Grid){.first_vertex = (uint32_t)(3 * g),
+                              .nu = 1,
+                              .triangular = 1,
+                              .edge = 0.01f,
+                              .object = 1};
+    }
     gs->n_vertices = 3 * n;
+}
+
+static void lattice(GridSet *gs, int fold, int (*object)(int, int), int flip)
+{
+    lattice_layers(gs, fold, object, flip, 1);
 }
 
 /* The members of cluster c (index + 1): grids whose chain reaches it. */
@@ -177,4 +194,25 @@ static void test_only_tiny_grids(void)
     geom_gridset_fini(&gs);
 }
 
-TEST_MAIN(TEST(test_flat_lattice), TEST(test_clusters_keep_apart), TEST(test_only_tiny_grids))
+/* Two layers of one object facing one way, 0.05 apart (a board on a
+ * board, leaves over leaves): no cluster joins them, though their boxes
+ * are compact. */
+static void test_layers_stay_apart(void)
+{
+    GridSet gs;
+    lattice_layers(&gs, 0, NULL, 0, 2);
+    CHECK(geom_cluster_grids(&gs) == 0 && gs.n_clusters > 0);
+    uint32_t *m = malloc(gs.n_grids * sizeof *m);
+    CHECK(m != NULL);
+    for (size_t c = 0; m && c < gs.n_clusters; c++) {
+        size_t n = members(&gs, (uint32_t)c + 1, m);
+        for (size_t k = 1; k < n; k++)
+            CHECK(gs.P[gs.grids[m[k]].first_vertex].z == gs.P[gs.grids[m[0]].first_vertex].z);
+    }
+    free(m);
+    check_clusters(&gs);
+    geom_gridset_fini(&gs);
+}
+
+TEST_MAIN(TEST(test_flat_lattice), TEST(test_clusters_keep_apart), TEST(test_only_tiny_grids),
+          TEST(test_layers_stay_apart))
