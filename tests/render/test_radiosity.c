@@ -336,6 +336,54 @@ static RayesImage *dense_room(int cache, int threads, double mb, RayesStats **st
     return dense_room_os(cache, threads, mb, 1.0f, st);
 }
 
+/* The same room with its six walls instances of one master wall of
+ * 2 x 40 x 40 triangles (each instance its own cache entries, memo 3.1). */
+static RayesImage *dense_room_instanced(int threads, double mb, RayesStats **st)
+{
+    enum { N = 40, M = N + 1, F = 2 * N * N };
+    RayesScene *s = rayes_scene_new();
+    const float eye[3] = {0.8f, 0.3f, -0.9f}, at[3] = {-1, -0.2f, 1}, up[3] = {0, 1, 0};
+    CHECK(rayes_scene_set_camera(s, eye, at, up, 70.0f) == RAYES_OK);
+    RayesParam light[2] = {{"intensity", RAYES_PARAM_FLOAT, {1.0f, 0, 0}, NULL},
+                           {"from", RAYES_PARAM_COLOR, {0.3f, 0.5f, 0.2f}, NULL}};
+    CHECK(rayes_scene_light(s, "pointlight", light, 2) == RAYES_OK);
+    RayesParam kd = {"Kd", RAYES_PARAM_FLOAT, {0.8f, 0, 0}, NULL};
+    CHECK(rayes_scene_set_shader(s, "matte", &kd, 1) == RAYES_OK);
+    static float P[3 * M * M];
+    static int nv[F], idx[3 * F];
+    test_lattice_triangles(N, nv, idx);
+    for (int j = 0; j < M; j++)
+        for (int i = 0; i < M; i++) {
+            float *p = &P[3 * (j * M + i)];
+            p[0] = -1.0f + 2.0f * i / N, p[1] = -1.0f + 2.0f * j / N, p[2] = 0.0f;
+        }
+    CHECK(rayes_scene_object_begin(s, "wall") == RAYES_OK);
+    CHECK(rayes_scene_polygon_mesh(s, F, nv, idx, M * M, P) == RAYES_OK);
+    CHECK(rayes_scene_object_end(s) == RAYES_OK);
+    for (int w = 0; w < 6; w++) { /* the master's x, y, z to world axes b, c, a; at x_a = +-1 */
+        int a = w / 2, b = (a + 1) % 3, c = (a + 2) % 3;
+        float m[16] = {0};
+        for (int r = 0; r < 3; r++)
+            m[4 * r] = r == b, m[4 * r + 1] = r == c, m[4 * r + 2] = r == a,
+                  m[4 * r + 3] = r == a ? (w % 2 ? 1.0f : -1.0f) : 0.0f;
+        m[15] = 1.0f;
+        CHECK(rayes_scene_set_transform(s, m) == RAYES_OK);
+        CHECK(rayes_scene_object_instance(s, "wall") == RAYES_OK);
+    }
+    CHECK(rayes_scene_commit(s) == RAYES_OK);
+    RayesRenderOptions o;
+    rayes_render_options_init(&o, RAYES_QUALITY_PREVIEW);
+    o.width = o.height = 40;
+    o.spp = 4;
+    o.threads = threads;
+    o.bounces = 3;
+    o.cache_mb = mb;
+    RayesImage *img = NULL;
+    CHECK(rayes_render(s, &o, &img, st) == RAYES_OK);
+    rayes_scene_release(s);
+    return img;
+}
+
 static double image_mean(const RayesImage *img)
 {
     double sum = 0.0;
@@ -386,6 +434,27 @@ static void test_dense_room_clusters(void)
     rayes_stats_free(off);
 }
 
+/* Clusters of a master's grids serve each instance apart: the instanced
+ * room reads clusters, keeps the plain room's mean within noise, and its
+ * bytes do not depend on threads or on a budget that evicts. */
+static void test_clusters_through_instances(void)
+{
+    RayesStats *st = NULL;
+    RayesImage *a = dense_room_instanced(2, 100, &st), *plain = dense_room(0, 2, 100, NULL);
+    CHECK(count(st, "clusters/count", 0) > 2 * 40 * 40 / 256);
+    CHECK(count(st, "clusters/lookups", 0) > 1000);
+    CHECK(count(st, "instances/count", 0) == 6);
+    double m = image_mean(a), m_plain = image_mean(plain);
+    CHECK(m_plain > 0.0 && fabs(m / m_plain - 1.0) < 0.03);
+    RayesImage *b = dense_room_instanced(1, 0.05, NULL);
+    CHECK(same(a, b));
+    rayes_image_free(a);
+    rayes_image_free(b);
+    rayes_image_free(plain);
+    rayes_stats_free(st);
+}
+
 TEST_MAIN(TEST(test_interpolation_is_exact_for_linear_functions), TEST(test_medium_aliasing),
           TEST(test_level_choice), TEST(test_same_bytes_for_any_budget_and_threads),
-          TEST(test_grid_size), TEST(test_dense_mesh_coarse_level), TEST(test_dense_room_clusters))
+          TEST(test_grid_size), TEST(test_dense_mesh_coarse_level), TEST(test_dense_room_clusters),
+          TEST(test_clusters_through_instances))
