@@ -287,12 +287,10 @@ static void test_dense_mesh_coarse_level(void)
     CHECK(fabs(mean_on - mean_off) < 0.02 * mean_off);
 }
 
-/* A closed box [-1, 1]^3 of six walls of 2 x 40 x 40 triangles each, below
- * a micropolygon, lit by a point light at its centre, seen from inside;
- * 3 bounces. Its statistics in *st. */
-static RayesImage *dense_room_os(int cache, int threads, double mb, float os, RayesStats **st)
+/* The room's camera inside it, a point light near its centre and matte
+ * walls of opacity os; geometry to be added. */
+static RayesScene *room_begin(float os)
 {
-    enum { N = 40, M = N + 1, F = 2 * N * N };
     RayesScene *s = rayes_scene_new();
     const float eye[3] = {0.8f, 0.3f, -0.9f}, at[3] = {-1, -0.2f, 1}, up[3] = {0, 1, 0};
     CHECK(rayes_scene_set_camera(s, eye, at, up, 70.0f) == RAYES_OK);
@@ -302,20 +300,12 @@ static RayesImage *dense_room_os(int cache, int threads, double mb, float os, Ra
     RayesParam kd[2] = {{"Kd", RAYES_PARAM_FLOAT, {0.8f, 0, 0}, NULL},
                         {"Os", RAYES_PARAM_COLOR, {os, os, os}, NULL}};
     CHECK(rayes_scene_set_shader(s, "matte", kd, 2) == RAYES_OK);
-    static float P[6][3 * M * M];
-    static int nv[F], idx[3 * F];
-    test_lattice_triangles(N, nv, idx);
-    for (int w = 0; w < 6; w++) {
-        int a = w / 2, b = (a + 1) % 3, c = (a + 2) % 3; /* wall at x_a = +-1 */
-        for (int j = 0; j < M; j++)
-            for (int i = 0; i < M; i++) {
-                float *p = &P[w][3 * (j * M + i)];
-                p[a] = w % 2 ? 1.0f : -1.0f;
-                p[b] = -1.0f + 2.0f * i / N;
-                p[c] = -1.0f + 2.0f * j / N;
-            }
-        CHECK(rayes_scene_polygon_mesh(s, F, nv, idx, M * M, P[w]) == RAYES_OK);
-    }
+    return s;
+}
+
+/* Commits s and renders it at 40 x 40, 4 samples, 3 bounces; releases s. */
+static RayesImage *room_render(RayesScene *s, int cache, int threads, double mb, RayesStats **st)
+{
     CHECK(rayes_scene_commit(s) == RAYES_OK);
     RayesRenderOptions o;
     rayes_render_options_init(&o, RAYES_QUALITY_PREVIEW);
@@ -331,34 +321,49 @@ static RayesImage *dense_room_os(int cache, int threads, double mb, float os, Ra
     return img;
 }
 
+/* A wall of 2 x 40 x 40 triangles: the plane x_a = side over [-1, 1] in
+ * the other two axes (b = a + 1 along the lattice's rows, c = a + 2). */
+enum { ROOM_N = 40, ROOM_M = ROOM_N + 1, ROOM_F = 2 * ROOM_N * ROOM_N };
+
+static void room_wall(RayesScene *s, int a, float side)
+{
+    static float P[3 * ROOM_M * ROOM_M];
+    static int nv[ROOM_F], idx[3 * ROOM_F];
+    int b = (a + 1) % 3, c = (a + 2) % 3;
+    test_lattice_triangles(ROOM_N, nv, idx);
+    for (int j = 0; j < ROOM_M; j++)
+        for (int i = 0; i < ROOM_M; i++) {
+            float *p = &P[3 * (j * ROOM_M + i)];
+            p[a] = side;
+            p[b] = -1.0f + 2.0f * i / ROOM_N;
+            p[c] = -1.0f + 2.0f * j / ROOM_N;
+        }
+    CHECK(rayes_scene_polygon_mesh(s, ROOM_F, nv, idx, ROOM_M * ROOM_M, P) == RAYES_OK);
+}
+
+/* A closed box [-1, 1]^3 of six walls of 2 x 40 x 40 triangles each, below
+ * a micropolygon, lit by a point light near its centre, seen from inside;
+ * 3 bounces. Its statistics in *st. */
+static RayesImage *dense_room_os(int cache, int threads, double mb, float os, RayesStats **st)
+{
+    RayesScene *s = room_begin(os);
+    for (int w = 0; w < 6; w++) /* wall at x_a = +-1 */
+        room_wall(s, w / 2, w % 2 ? 1.0f : -1.0f);
+    return room_render(s, cache, threads, mb, st);
+}
+
 static RayesImage *dense_room(int cache, int threads, double mb, RayesStats **st)
 {
     return dense_room_os(cache, threads, mb, 1.0f, st);
 }
 
-/* The same room with its six walls instances of one master wall of
- * 2 x 40 x 40 triangles (each instance its own cache entries, memo 3.1). */
+/* The same room with its six walls instances of one master wall (each
+ * instance its own cache entries, memo 3.1). */
 static RayesImage *dense_room_instanced(int threads, double mb, RayesStats **st)
 {
-    enum { N = 40, M = N + 1, F = 2 * N * N };
-    RayesScene *s = rayes_scene_new();
-    const float eye[3] = {0.8f, 0.3f, -0.9f}, at[3] = {-1, -0.2f, 1}, up[3] = {0, 1, 0};
-    CHECK(rayes_scene_set_camera(s, eye, at, up, 70.0f) == RAYES_OK);
-    RayesParam light[2] = {{"intensity", RAYES_PARAM_FLOAT, {1.0f, 0, 0}, NULL},
-                           {"from", RAYES_PARAM_COLOR, {0.3f, 0.5f, 0.2f}, NULL}};
-    CHECK(rayes_scene_light(s, "pointlight", light, 2) == RAYES_OK);
-    RayesParam kd = {"Kd", RAYES_PARAM_FLOAT, {0.8f, 0, 0}, NULL};
-    CHECK(rayes_scene_set_shader(s, "matte", &kd, 1) == RAYES_OK);
-    static float P[3 * M * M];
-    static int nv[F], idx[3 * F];
-    test_lattice_triangles(N, nv, idx);
-    for (int j = 0; j < M; j++)
-        for (int i = 0; i < M; i++) {
-            float *p = &P[3 * (j * M + i)];
-            p[0] = -1.0f + 2.0f * i / N, p[1] = -1.0f + 2.0f * j / N, p[2] = 0.0f;
-        }
+    RayesScene *s = room_begin(1.0f);
     CHECK(rayes_scene_object_begin(s, "wall") == RAYES_OK);
-    CHECK(rayes_scene_polygon_mesh(s, F, nv, idx, M * M, P) == RAYES_OK);
+    room_wall(s, 2, 0.0f);
     CHECK(rayes_scene_object_end(s) == RAYES_OK);
     for (int w = 0; w < 6; w++) { /* the master's x, y, z to world axes b, c, a; at x_a = +-1 */
         int a = w / 2, b = (a + 1) % 3, c = (a + 2) % 3;
@@ -370,18 +375,7 @@ static RayesImage *dense_room_instanced(int threads, double mb, RayesStats **st)
         CHECK(rayes_scene_set_transform(s, m) == RAYES_OK);
         CHECK(rayes_scene_object_instance(s, "wall") == RAYES_OK);
     }
-    CHECK(rayes_scene_commit(s) == RAYES_OK);
-    RayesRenderOptions o;
-    rayes_render_options_init(&o, RAYES_QUALITY_PREVIEW);
-    o.width = o.height = 40;
-    o.spp = 4;
-    o.threads = threads;
-    o.bounces = 3;
-    o.cache_mb = mb;
-    RayesImage *img = NULL;
-    CHECK(rayes_render(s, &o, &img, st) == RAYES_OK);
-    rayes_scene_release(s);
-    return img;
+    return room_render(s, 1, threads, mb, st);
 }
 
 static double image_mean(const RayesImage *img)
