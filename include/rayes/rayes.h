@@ -921,6 +921,10 @@ typedef struct RayesRenderOptions {
                                    RAYES_ERROR_CANCELLED returned (tiles done before were
                                    passed to tile_done). Sessions ignore it: an abandoned
                                    fill would leave its cache entry wrong */
+    int cache_fine_depth;       /* the deepest diffuse depth whose hits may read the fine
+                                   radiosity level: deeper hits read medium at finest, the
+                                   wider differentials of rays after several bounces (memo
+                                   5.1). Default 1; 0 to 128 (128: the rule alone) */
 } RayesRenderOptions;
 
 /* Fills options with the defaults of a quality preset: 512 x 512, 4 pixel

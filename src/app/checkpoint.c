@@ -73,7 +73,7 @@ uint64_t checkpoint_digest(const char *scene, int frame, const RayesRenderOption
     HASH(h, o->branch_depth), HASH(h, o->dice_offscreen), HASH(h, o->dice_isotropic);
     HASH(h, o->vertex_budget), HASH(h, o->crop), HASH(h, o->opacity_cache);
     HASH(h, o->volume_step), HASH(h, o->subsurface_rays), HASH(h, o->irradiance_cache);
-    HASH(h, o->irradiance_shadow_rays);
+    HASH(h, o->irradiance_shadow_rays), HASH(h, o->cache_fine_depth);
     return h;
 }
 

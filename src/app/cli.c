@@ -88,6 +88,8 @@ static const char render_options[] =
     "  --cache-resolution R    auto (by ray differentials), coarse, medium or fine\n"
     "  --cache-k K             use the coarsest resolution whose micropolygons are at\n"
     "                          most K times the ray footprint (default 1)\n"
+    "  --cache-fine-depth N    hits of diffuse depth above N read the medium resolution\n"
+    "                          at finest (default 1; 128: by differentials alone)\n"
     "  --gridsize N            micropolygons per grid, at most (default 256, or the\n"
     "                          scene file's; 1 to 4096): the size of a cache entry\n"
     "  --dice-offscreen F      micropolygons off screen up to F times longer (default 4;\n"
@@ -448,6 +450,8 @@ void parse_args(int argc, char **argv, Args *a)
             opt->cache_resolution = parse_resolution(v);
         else if (strcmp(o, "--cache-k") == 0)
             opt->cache_k = parse_float(o, v, 1e-3f, 1e3f);
+        else if (strcmp(o, "--cache-fine-depth") == 0)
+            opt->cache_fine_depth = (int)parse_long(o, v, 0, 128);
         else if (strcmp(o, "--gridsize") == 0) {
             opt->grid_size = (int)parse_long(o, v, 1, 4096);
             a->set |= SET_GRID_SIZE;

@@ -135,6 +135,7 @@ typedef struct RenderSettings {
     float volume_step;       /* ray marching steps, in fine voxels of each volume */
     int cache_resolution;    /* -1: by differentials; else a forced CacheLevel */
     float cache_k;           /* resolution rule constant (DESIGN.md) */
+    int cache_fine_depth;    /* deeper radiosity lookups read medium at finest */
     int grid_size;           /* micropolygons per grid, at most (dicing; geom.h) */
     float dice_offscreen;    /* off-screen dicing factor (DiceOptions) */
     size_t vertex_budget;    /* grid vertices, at most; 0: none (DiceOptions) */

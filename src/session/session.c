@@ -68,6 +68,7 @@ void rayes_render_options_init(RayesRenderOptions *o, RayesQuality quality)
     o->cache_split[2] = 0.5f;
     o->cache_resolution = -1;
     o->cache_k = 1.0f;
+    o->cache_fine_depth = 1;
     o->grid_size = GEOM_GRID_SIZE;
     o->branch_depth = 1;
     o->dice_offscreen = 4.0f;
@@ -156,11 +157,12 @@ RayesError session_check_options(RayesScene *scene, const RayesRenderOptions *o)
     else if (!(o->cache_mb >= 0.0) || o->cache_mb > 1e7 || !(o->cache_k > 0.0f) ||
              !(o->opacity_cache_mb >= 0.0) || o->opacity_cache_mb > 1e7 ||
              !(o->irradiance_cache_mb >= 0.0) || o->irradiance_cache_mb > 1e7 ||
-             o->cache_resolution < -1 || o->cache_resolution > 2 || o->cache_split[0] < 0.0f ||
-             o->cache_split[1] < 0.0f || o->cache_split[2] < 0.0f ||
+             o->cache_resolution < -1 || o->cache_resolution > 2 || o->cache_fine_depth < 0 ||
+             o->cache_fine_depth > 128 || o->cache_split[0] < 0.0f || o->cache_split[1] < 0.0f ||
+             o->cache_split[2] < 0.0f ||
              !(o->cache_split[0] + o->cache_split[1] + o->cache_split[2] <= 1.0001f))
         what = "options: cache budget 0 to 1e7 MB, split shares >= 0 summing to at most 1, "
-               "k > 0, resolution -1 to 2";
+               "k > 0, resolution -1 to 2, fine depth 0 to 128";
     else if (!(o->volume_step >= 0.01f) || !(o->volume_step <= 1000.0f))
         what = "options: volume step must be 0.01 to 1000 voxels";
     else if (o->grid_size < 1 || o->grid_size > GEOM_MAX_GRID_SIZE)
@@ -222,6 +224,7 @@ RenderSettings session_settings(const RayesRenderOptions *o)
         .stop = o->stop,
         .cache_resolution = o->cache_resolution,
         .cache_k = o->cache_k,
+        .cache_fine_depth = o->cache_fine_depth,
         .grid_size = o->grid_size,
         .dice_offscreen = o->dice_offscreen,
         .vertex_budget = (size_t)o->vertex_budget,

@@ -201,9 +201,11 @@ static void test_closed_box_corners(void)
     printf("  closed box, 8 bounces: exact %.4f, fine level %.4f, by differentials %.4f\n", exact,
            fine, any);
     CHECK(fabs(fine / exact - 1) < 0.02);
-    /* the coarse level's corners interpolated over a wall's large grids
-     * stay below its peak: the memo's bias, not light lost */
-    CHECK(fabs(any / exact - 1) < 0.12);
+    /* the coarse level's points interpolated over a wall's large grids
+     * stay below its peak: the memo's bias, not light lost. At the grids'
+     * corners, against the walls' dark edges, they were 9.6% dark; at
+     * their quadrants' middles 3.7% (radiosity.c COARSE_INSET). */
+    CHECK(fabs(any / exact - 1) < 0.06);
 }
 
 TEST_MAIN(TEST(test_closed_box_corners), TEST(test_furnace_each_bounce_count),

@@ -2,7 +2,8 @@
  * The radiosity cache in the renderer (render/): interpolation reproduces a
  * linear function exactly at every resolution, for quad grids of every size
  * and triangular grids of every subdivision up to the default gridsize
- * (but a triangle of one micropolygon's coarse level: its centroid), and
+ * (the coarse level between its inset points and held beyond them; a
+ * triangle of one micropolygon's coarse level: its centroid), and
  * of the largest sizes a larger gridsize allows; levels alias as documented;
  * images do not depend on the cache budget (evicted entries refill to the
  * same bytes) nor on threads.
@@ -40,9 +41,11 @@ static size_t quad_values(const Grid *g, int level, uint16_t *v)
     size_t n = 0;
     for (int j = 0; j < mv; j++)
         for (int i = 0; i < mu; i++) {
-            int fi = level == CACHE_FINE ? i : level == CACHE_MEDIUM ? knot(i, g->nu) : i * (g->nu - 1);
-            int fj = level == CACHE_FINE ? j : level == CACHE_MEDIUM ? knot(j, g->nv) : j * (g->nv - 1);
+            int fi = level == CACHE_FINE ? i : knot(i, g->nu);
+            int fj = level == CACHE_FINE ? j : knot(j, g->nv);
             float f = linear((float)fi / (g->nu - 1), (float)fj / (g->nv - 1));
+            if (level == CACHE_COARSE) /* the quadrants' middles */
+                f = linear(i ? 0.75f : 0.25f, j ? 0.75f : 0.25f);
             for (int c = 0; c < 3; c++)
                 v[3 * n + c] = half_from_float(f);
             n++;
@@ -62,6 +65,8 @@ static size_t tri_values(const Grid *g, int level, uint16_t *v)
     for (int j = 0; j <= m; j++)
         for (int i = 0; i + j <= m; i++) {
             float f = linear((float)i / m, (float)j / m);
+            if (level == CACHE_COARSE) /* the corner triangles' middles */
+                f = linear(i ? 2.0f / 3.0f : 1.0f / 6.0f, j ? 2.0f / 3.0f : 1.0f / 6.0f);
             for (int c = 0; c < 3; c++)
                 v[3 * n + c] = half_from_float(f);
             n++;
@@ -74,6 +79,20 @@ static size_t tri_values(const Grid *g, int level, uint16_t *v)
 static int next_side(int n)
 {
     return n < 17 ? n + 1 : n < 33 ? 33 : n < 64 ? 64 : n + 1;
+}
+
+/* What the coarse level reads at (a, b): the linear function there between
+ * its points, and beyond them at the nearest point of their square
+ * (triangle: clamped barycentric coordinates). */
+static float coarse_want(int tri, float a, float b)
+{
+    if (!tri)
+        return linear(fminf(fmaxf(a, 0.25f), 0.75f), fminf(fmaxf(b, 0.25f), 0.75f));
+    float w[3] = {0, fmaxf(2.0f * a - 1.0f / 3.0f, 0.0f), fmaxf(2.0f * b - 1.0f / 3.0f, 0.0f)};
+    w[0] = fmaxf(1.0f - (2.0f * a - 1.0f / 3.0f) - (2.0f * b - 1.0f / 3.0f), 0.0f);
+    float sum = w[0] + w[1] + w[2];
+    return linear((w[0] / 6 + w[1] * 2 / 3 + w[2] / 6) / sum,
+                  (w[0] / 6 + w[1] / 6 + w[2] * 2 / 3) / sum);
 }
 
 static void test_interpolation_is_exact_for_linear_functions(void)
@@ -103,7 +122,9 @@ static void test_interpolation_is_exact_for_linear_functions(void)
                          * a triangle of one micropolygon's coarse level is
                          * its centroid's value, everywhere. */
                         int centroid = tri && nu == 1 && level == CACHE_COARSE;
-                        float want = centroid ? linear(1.0f / 3.0f, 1.0f / 3.0f) : linear(a, b);
+                        float want = centroid                ? linear(1.0f / 3.0f, 1.0f / 3.0f)
+                                     : level == CACHE_COARSE ? coarse_want(tri, a, b)
+                                                             : linear(a, b);
                         CHECK_NEAR(r.x, want, 5e-3);
                         worst_level_checks++;
                     }
@@ -448,7 +469,59 @@ static void test_clusters_through_instances(void)
     rayes_stats_free(st);
 }
 
+/* The benchmark box at 3 bounces, 32 x 32, one sample, reading the fine
+ * level to diffuse depth fine_depth at most; its statistics in *st. */
+static RayesImage *teapots_deep(int fine_depth, int threads, RayesStats **st)
+{
+    RayesScene *s = teapots();
+    RayesRenderOptions o;
+    rayes_render_options_init(&o, RAYES_QUALITY_PREVIEW);
+    o.width = o.height = 32;
+    o.spp = 1;
+    o.bounces = 3;
+    o.threads = threads;
+    o.cache_fine_depth = fine_depth;
+    RayesImage *img = NULL;
+    CHECK(rayes_render(s, &o, &img, st) == RAYES_OK);
+    rayes_scene_release(s);
+    return img;
+}
+
+/* Past the first bounce no hit reads the fine level (radiosity.c): the
+ * fills of the second and third bounces shade fewer points than with the
+ * fine level to any depth (near the teapots' contacts with the floor, short
+ * rays ask for it), the image mean stays within the cache's bias, and the
+ * bytes do not depend on threads; out of range is refused. */
+static void test_fine_depth(void)
+{
+    RayesStats *lim = NULL, *all = NULL;
+    RayesImage *a = teapots_deep(1, 2, &lim), *b = teapots_deep(128, 2, &all);
+    uint64_t deep_lim =
+        count(lim, "shading_points/by_depth", 2) + count(lim, "shading_points/by_depth", 3);
+    uint64_t deep_all =
+        count(all, "shading_points/by_depth", 2) + count(all, "shading_points/by_depth", 3);
+    CHECK(count(lim, "shading_points/by_depth", 1) == count(all, "shading_points/by_depth", 1));
+    CHECK(deep_all > 1000 && deep_lim < deep_all * 3 / 4);
+    double m = image_mean(a), m_all = image_mean(b);
+    CHECK(m_all > 0.0 && fabs(m / m_all - 1.0) < 0.02);
+    RayesImage *c = teapots_deep(1, 1, NULL);
+    CHECK(same(a, c));
+    RayesScene *s = teapots();
+    RayesRenderOptions o;
+    rayes_render_options_init(&o, RAYES_QUALITY_PREVIEW);
+    o.cache_fine_depth = 129;
+    RayesImage *img = NULL;
+    CHECK(rayes_render(s, &o, &img, NULL) == RAYES_ERROR_INVALID_ARGUMENT && !img);
+    CHECK(strstr(rayes_scene_get_error(s), "fine depth 0 to 128") != NULL);
+    rayes_scene_release(s);
+    rayes_image_free(a);
+    rayes_image_free(b);
+    rayes_image_free(c);
+    rayes_stats_free(lim);
+    rayes_stats_free(all);
+}
+
 TEST_MAIN(TEST(test_interpolation_is_exact_for_linear_functions), TEST(test_medium_aliasing),
           TEST(test_level_choice), TEST(test_same_bytes_for_any_budget_and_threads),
           TEST(test_grid_size), TEST(test_dense_mesh_coarse_level), TEST(test_dense_room_clusters),
-          TEST(test_clusters_through_instances))
+          TEST(test_clusters_through_instances), TEST(test_fine_depth))
