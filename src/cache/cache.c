@@ -15,6 +15,16 @@
  * if nobody holds it, it is freed at once, otherwise by its last release.
  * Its bytes stay counted until it is freed, so the budget is never exceeded.
  *
+ * Lending: a shard's budget is its share of its level's (the split), and
+ * every byte a shard counts is also taken from its partition's atomic
+ * count, which never exceeds the partition's budget. A shard at its share
+ * may go on past it with bytes the other levels leave unused (not its own
+ * level's: those are its sibling shards'); a shard within its share that
+ * finds the partition full takes its bytes back from shards past theirs
+ * (reclaim, their least recently used entries first). So a level that
+ * thrashes borrows what the others do not use, and gives it back as they
+ * need it.
+ *
  * Locks: one shard lock at a time; the fill function runs with no lock held
  * (it may look up other keys: a fill at diffuse depth d only looks up depth
  * d + 1, so waits cannot form a cycle). CacheLocal slots are touched only by
@@ -54,7 +64,17 @@ static inline uint16_t *entry_values(CacheEntry *e)
     return (uint16_t *)(e + 1);
 }
 
+/* A partition's budget and what its shards count against it. */
+typedef struct Part {
+    uint64_t budget;
+    atomic_uint_fast64_t used, peak;
+    atomic_uint_fast64_t level_used[CACHE_N_LEVELS];
+    uint64_t level_budget[CACHE_N_LEVELS];
+} Part;
+
 typedef struct Shard {
+    Part *part;
+    int level;
     pthread_mutex_t lock;
     pthread_cond_t filled;        /* an entry became ready */
     CacheEntry **table;           /* n_slots chains, NULL if the budget allows none */
@@ -71,6 +91,7 @@ struct Cache {
      * part_of[type] (all in 0 for cache_new, each its own for
      * cache_new_typed), whose budget they share. */
     Shard shards[CACHE_N_TYPES][CACHE_N_LEVELS][CACHE_SHARDS];
+    Part parts[CACHE_N_TYPES];
     uint8_t part_of[CACHE_N_TYPES];
     uint64_t budget;                     /* all partitions */
     uint64_t type_budget[CACHE_N_TYPES]; /* of partition t */
@@ -105,9 +126,34 @@ static int key_equal(const CacheKey *a, const CacheKey *b)
            a->instance == b->instance;
 }
 
-/* Returns 0, or -1 when out of memory. */
-static int shard_init(Shard *s, uint64_t budget, size_t nominal)
+/* Counts n more bytes of s against its partition; with take, only if they
+ * fit its budget (returns 0 if not). Caller holds s's lock. */
+static int part_add(Shard *s, uint64_t n, int take)
 {
+    Part *p = s->part;
+    uint_fast64_t u = atomic_load(&p->used);
+    do {
+        if (take && u + n > p->budget)
+            return 0;
+    } while (!atomic_compare_exchange_weak(&p->used, &u, u + n));
+    uint_fast64_t peak = atomic_load(&p->peak);
+    while (u + n > peak && !atomic_compare_exchange_weak(&p->peak, &peak, u + n))
+        ;
+    atomic_fetch_add(&p->level_used[s->level], n);
+    return 1;
+}
+
+static void part_sub(Shard *s, uint64_t n)
+{
+    atomic_fetch_sub(&s->part->used, n);
+    atomic_fetch_sub(&s->part->level_used[s->level], n);
+}
+
+/* Returns 0, or -1 when out of memory. */
+static int shard_init(Shard *s, Part *part, int level, uint64_t budget, size_t nominal)
+{
+    s->part = part;
+    s->level = level;
     pthread_mutex_init(&s->lock, NULL);
     pthread_cond_init(&s->filled, NULL);
     s->lru.prev = s->lru.next = &s->lru;
@@ -124,6 +170,7 @@ static int shard_init(Shard *s, uint64_t budget, size_t nominal)
         return -1;
     s->n_slots = n;
     s->bytes = s->peak = n * sizeof(CacheEntry *);
+    part_add(s, s->bytes, 0); /* within the share, which is within the budget */
     return 0;
 }
 
@@ -156,13 +203,17 @@ static Cache *cache_new_parts(const uint64_t budget_bytes[CACHE_N_TYPES],
     atomic_init(&c->timestamp, 1);
     pthread_mutex_init(&c->counters_lock, NULL);
     for (int t = 0; t < CACHE_N_TYPES; t++) {
-        c->type_budget[t] = budget_bytes[t];
+        Part *p = &c->parts[t];
+        c->type_budget[t] = p->budget = budget_bytes[t];
         c->budget += budget_bytes[t];
+        atomic_init(&p->used, 0);
+        atomic_init(&p->peak, 0);
         for (int l = 0; l < CACHE_N_LEVELS; l++) {
             float f = split[l] < 0.0f ? 0.0f : split[l];
-            c->level_budget[t][l] = (uint64_t)((double)budget_bytes[t] * f);
+            c->level_budget[t][l] = p->level_budget[l] = (uint64_t)((double)budget_bytes[t] * f);
+            atomic_init(&p->level_used[l], 0);
             for (int s = 0; s < CACHE_SHARDS; s++)
-                if (shard_init(&c->shards[t][l][s], c->level_budget[t][l] / CACHE_SHARDS,
+                if (shard_init(&c->shards[t][l][s], p, l, c->level_budget[t][l] / CACHE_SHARDS,
                                nominal_values[l]) != 0)
                     failed = 1;
         }
@@ -241,25 +292,72 @@ static void table_unlink(Shard *s, CacheEntry *e)
 
 static void entry_free(Shard *s, CacheEntry *e)
 {
-    s->bytes -= cache_entry_bytes(e->n_values);
+    uint64_t n = cache_entry_bytes(e->n_values);
+    s->bytes -= n;
+    part_sub(s, n);
     free(e);
 }
 
-/* Evicts least recently used entries until `need` more bytes fit. Returns 1
- * if they fit; evicts nothing if they cannot fit even with every unpinned
- * entry gone. Caller holds the shard lock. */
-static int make_room(Shard *s, uint64_t need)
+static void evict_lru(Shard *s)
 {
-    if (s->bytes - s->lru_bytes + need > s->budget)
-        return 0;
-    while (s->bytes + need > s->budget && s->lru.next != &s->lru) {
-        CacheEntry *victim = s->lru.next;
-        lru_unlink(s, victim);
-        table_unlink(s, victim);
-        s->evictions[victim->key.type]++;
-        entry_free(s, victim);
+    CacheEntry *victim = s->lru.next;
+    lru_unlink(s, victim);
+    table_unlink(s, victim);
+    s->evictions[victim->key.type]++;
+    entry_free(s, victim);
+}
+
+/* What a shard past its share may borrow: bytes of the partition's budget
+ * that neither are used nor belong to its own level's unused share. */
+static int may_borrow(const Shard *s, uint64_t need)
+{
+    Part *p = s->part;
+    uint64_t used = atomic_load(&p->used), level = atomic_load(&p->level_used[s->level]);
+    uint64_t own_unused = level < p->level_budget[s->level] ? p->level_budget[s->level] - level : 0;
+    return used + need + own_unused <= p->budget;
+}
+
+/* Counts need more bytes in s: within its share, or borrowed, or in place
+ * of its own least recently used entries, as few as make room. Returns 0
+ * if they do not fit, evicting nothing when even every unpinned entry of
+ * its own would not make room; then *reclaim = 1 if the shard is within
+ * its share and others hold the partition's bytes. Caller holds the lock. */
+static int take_room(Shard *s, uint64_t need, int *reclaim)
+{
+    *reclaim = 0;
+    for (;;) {
+        int within = s->bytes + need <= s->budget;
+        if ((within || may_borrow(s, need)) && part_add(s, need, 1))
+            return 1;
+        if (within) {
+            *reclaim = 1;
+            return 0;
+        }
+        if (s->lru.next == &s->lru || s->bytes - s->lru_bytes + need > s->budget)
+            return 0;
+        evict_lru(s);
     }
-    return s->bytes + need <= s->budget;
+}
+
+/* Evicts least recently used entries of the partition's shards past their
+ * share until need bytes are freed or none is past. Holds no lock but one
+ * shard's at a time. */
+static void reclaim(Cache *c, const Part *p, uint64_t need)
+{
+    uint64_t freed = 0;
+    for (int t = 0; t < CACHE_N_TYPES && freed < need; t++)
+        for (int l = 0; l < CACHE_N_LEVELS && freed < need; l++)
+            for (int i = 0; i < CACHE_SHARDS && freed < need; i++) {
+                Shard *s = &c->shards[t][l][i];
+                if (s->part != p)
+                    break;
+                pthread_mutex_lock(&s->lock);
+                while (s->bytes > s->budget && s->lru.next != &s->lru && freed < need) {
+                    freed += cache_entry_bytes(s->lru.next->n_values);
+                    evict_lru(s);
+                }
+                pthread_mutex_unlock(&s->lock);
+            }
 }
 
 /* Drops a reference. Caller does not hold the shard lock. */
@@ -334,7 +432,9 @@ static CacheEntry *find_or_insert(Cache *c, const CacheKey *key, uint64_t hash, 
 {
     Shard *s = shard_of(c, key, hash);
     uint64_t now = cache_timestamp(c);
+    int reclaimed = 0;
     *inserted = 0;
+again:
     if (pthread_mutex_trylock(&s->lock) != 0) {
         ctr->contended++;
         pthread_mutex_lock(&s->lock);
@@ -367,7 +467,16 @@ static CacheEntry *find_or_insert(Cache *c, const CacheKey *key, uint64_t hash, 
         return e;
     }
     uint64_t need = cache_entry_bytes(n_values);
-    if (s->table && make_room(s, need) && (e = malloc(need)) != NULL) {
+    int reclaim_others = 0, counted = s->table && take_room(s, need, &reclaim_others);
+    if (!counted && reclaim_others && !reclaimed) {
+        pthread_mutex_unlock(&s->lock); /* one lock at a time */
+        reclaim(c, s->part, need);
+        reclaimed = 1;
+        goto again; /* another thread may have inserted the key meanwhile */
+    }
+    if (counted && (e = malloc(need)) == NULL)
+        part_sub(s, need);
+    if (counted && e) {
         memset(e, 0, sizeof *e);
         e->key = *key;
         e->hash = hash;
@@ -468,6 +577,8 @@ void cache_get_stats(const Cache *cc, CacheStats *st)
     memcpy(st->counters, c->counters, sizeof st->counters);
     pthread_mutex_unlock(&c->counters_lock);
     for (int t = 0; t < CACHE_N_TYPES; t++)
+        st->type_peak_bytes[t] = atomic_load(&c->parts[t].peak);
+    for (int t = 0; t < CACHE_N_TYPES; t++)
         for (int l = 0; l < CACHE_N_LEVELS; l++) {
             st->type_budget_bytes[t] = c->type_budget[c->part_of[t]];
             st->level_budget_bytes[l] += c->level_budget[t][l];
@@ -478,7 +589,6 @@ void cache_get_stats(const Cache *cc, CacheStats *st)
                 st->type_entries[t][l] += sh->entries; /* partition t's */
                 st->bytes[l] += sh->bytes;
                 st->peak_bytes[l] += sh->peak;
-                st->type_peak_bytes[t] += sh->peak;
                 for (int t = 0; t < CACHE_N_TYPES; t++)
                     st->counters[l][t].evictions += sh->evictions[t];
                 pthread_mutex_unlock(&sh->lock);

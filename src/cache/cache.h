@@ -7,8 +7,9 @@
  *  - per data type (radiosity, opacity, irradiance: memo 6, one cache whose
  *    keys carry the type) a budget of its own, and within it
  *  - three resolutions (COARSE, MEDIUM, FINE), each with its own share of the
- *    byte budget (default 25% / 25% / 50% of 100 MB) and least-recently-used
- *    replacement;
+ *    byte budget (default 25% / 25% / 50% of 100 MB; a resolution past its
+ *    share borrows what the others leave unused, until they need it back)
+ *    and least-recently-used replacement;
  *  - each resolution is split into shards (a lock, a hash table, an LRU list
  *    and an equal part of the resolution's budget); LRU is exact within a
  *    shard;
@@ -87,16 +88,19 @@ typedef struct CacheStats {
     uint64_t level_budget_bytes[CACHE_N_LEVELS];          /* these four: all types summed */
     uint64_t entries[CACHE_N_LEVELS];                     /* resident now */
     uint64_t bytes[CACHE_N_LEVELS];                       /* counted now */
-    uint64_t peak_bytes[CACHE_N_LEVELS];                  /* sum of the shards' peaks */
+    uint64_t peak_bytes[CACHE_N_LEVELS];                  /* sum of the shards' peaks (a
+                                                       level may borrow past its share) */
     uint64_t type_budget_bytes[CACHE_N_TYPES];            /* the budget of the type's partition; */
     uint64_t type_entries[CACHE_N_TYPES][CACHE_N_LEVELS]; /* these two: partition t's (the
                                                        type's in a cache_new_typed cache) */
-    uint64_t type_peak_bytes[CACHE_N_TYPES];
+    uint64_t type_peak_bytes[CACHE_N_TYPES]; /* the partition's peak, within its budget */
     CacheCounters counters[CACHE_N_LEVELS][CACHE_N_TYPES];
 } CacheStats;
 
 /* A new cache whose data type t has budget_bytes[t], split among the
- * resolutions by fractions split[level] (summing to at most 1): entries of
+ * resolutions by fractions split[level] (summing to at most 1; a level
+ * whose share is full borrows what the others leave unused, and gives it
+ * back as they need it): entries of
  * one type never evict another's (the radiosity budget is the user's
  * "cache size", the opacity budget RenderMan's "opacitycachememory"). A
  * type of budget 0 fills a private entry at every lookup. Returns NULL

@@ -114,14 +114,16 @@ static void check_counters_add_up(const CacheStats *s)
         }
 }
 
-/* The budget holds at every level, now and at the peak. */
+/* The budget holds, now and at the peak (a level may borrow past its
+ * share what the others leave unused). */
 static int budget_holds(const CacheStats *s)
 {
-    int ok = 1;
+    uint64_t bytes = 0, peak = 0;
     for (int l = 0; l < CACHE_N_LEVELS; l++)
-        ok &= s->bytes[l] <= s->level_budget_bytes[l] &&
-              s->peak_bytes[l] <= s->level_budget_bytes[l];
-    return ok;
+        bytes += s->bytes[l];
+    for (int t = 0; t < CACHE_N_TYPES; t++)
+        peak += s->type_peak_bytes[t];
+    return bytes <= s->budget_bytes && peak <= s->budget_bytes;
 }
 
 static void sleep_us(long us)
@@ -620,14 +622,18 @@ static void test_budget_random(void)
     }
 }
 
-/* A budget smaller than one entry: correct values from private fills, a
- * fill every time, nothing resident, the budget kept. */
+/* A budget smaller than one entry (or, all of it coarse, a shard's share
+ * smaller than one entry: a shard never borrows its own level's unused
+ * share): correct values from private fills, a fill every time, nothing
+ * resident, the budget kept. */
 static void test_budget_too_small(void)
 {
     uint64_t e = cache_entry_bytes(4);
     const uint64_t budgets[] = {0, 1, 63, 8 * (e - 1), 8 * (e + sizeof(void *)) - 8};
     for (size_t b = 0; b < sizeof budgets / sizeof budgets[0]; b++)
         for (int sp = 0; sp < 2; sp++) {
+            if (!sp && budgets[b] >= e) /* the coarse share may borrow the others' */
+                continue;
             Cache *c = cache_new(budgets[b], sp ? split_coarse : split_default);
             Filler f = {0};
             int fills = 0;
@@ -648,6 +654,48 @@ static void test_budget_too_small(void)
             check_counters_add_up(&s);
             cache_free(c);
         }
+}
+
+/* A level whose share is full borrows what the others leave unused:
+ * coarse entries alone fill most of the budget; fine entries then take
+ * back what their share needs (coarse ones evicted) and stay, and the
+ * budget holds all along. */
+static void test_levels_lend(void)
+{
+    const uint64_t budget = 400000;
+    Cache *c = cache_new(budget, split_default);
+    Filler f = {0};
+    uint64_t coarse_e = cache_entry_bytes(4), fine_e = cache_entry_bytes(289);
+    uint32_t n_coarse = (uint32_t)(budget / coarse_e);
+    for (uint32_t i = 0; i < n_coarse; i++) {
+        CacheKey k = key_at(i, CACHE_COARSE);
+        lookup_once(c, &f, &k, 4, NULL);
+    }
+    CacheStats s = stats_of(c);
+    CHECK(budget_holds(&s));
+    /* past its share (25%) by what medium and fine leave */
+    CHECK(s.bytes[CACHE_COARSE] > s.level_budget_bytes[CACHE_COARSE] * 3);
+    uint64_t coarse_before = s.entries[CACHE_COARSE];
+    uint32_t n_fine = (uint32_t)(s.level_budget_bytes[CACHE_FINE] / fine_e / 2);
+    int fine_fills = 0;
+    for (uint32_t i = 0; i < n_fine; i++) {
+        CacheKey k = key_at(i, CACHE_FINE);
+        fine_fills += lookup_once(c, &f, &k, 289, NULL);
+    }
+    s = stats_of(c);
+    CHECK(budget_holds(&s));
+    CHECK(fine_fills == (int)n_fine && n_fine >= 40);
+    CHECK(s.entries[CACHE_FINE] == n_fine); /* each shard's keys within its share */
+    CHECK(s.entries[CACHE_COARSE] < coarse_before);
+    CHECK(s.bytes[CACHE_COARSE] + 8 * coarse_e >= s.level_budget_bytes[CACHE_COARSE]);
+    int refills = 0; /* the fine entries stayed */
+    for (uint32_t i = 0; i < n_fine; i++) {
+        CacheKey k = key_at(i, CACHE_FINE);
+        refills += lookup_once(c, &f, &k, 289, NULL);
+    }
+    CHECK(refills == 0);
+    check_counters_add_up(&s);
+    cache_free(c);
 }
 
 /* ---- timestamps ---- */
@@ -957,9 +1005,8 @@ TEST_MAIN(TEST(test_hit_miss_counters), TEST(test_local_reuse), TEST(test_half_s
           TEST(test_n_values_honoured), TEST(test_keys_separate_every_field),
           TEST(test_random_keys_distinct), TEST(test_lru_matches_model),
           TEST(test_lru_touch_and_pin), TEST(test_unfittable_entry_evicts_nothing),
-          TEST(test_budget_random), TEST(test_budget_too_small),
+          TEST(test_budget_random), TEST(test_budget_too_small), TEST(test_levels_lend),
           TEST(test_bump_invalidates), TEST(test_bump_invalidates_private),
           TEST(test_old_entries_age_out), TEST(test_bump_replaces_in_place),
           TEST(test_waiters_share_one_fill), TEST(test_bump_during_fill_wakes_waiters),
-          TEST(test_recursive_fill),
-          TEST(test_refill_deterministic))
+          TEST(test_recursive_fill), TEST(test_refill_deterministic))
