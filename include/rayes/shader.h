@@ -162,9 +162,14 @@ typedef struct RayesShaderClass {
 
 /* What a class tells the renderer before rendering. */
 typedef enum RayesShaderFlags {
-    RAYES_SHADER_SUBSURFACE = 1u << 0 /* its methods call the subsurface service: objects
-                                         shaded by it get an acceleration structure of
-                                         their own for subsurface rays (memo 6.2) */
+    RAYES_SHADER_SUBSURFACE = 1u << 0, /* its methods call the subsurface service: objects
+                                          shaded by it get an acceleration structure of
+                                          their own for subsurface rays (memo 6.2) */
+    RAYES_SHADER_THIN_SHADOW = 1u << 1 /* its opacity method is a refracting surface's thin
+                                          shadow (glass): other objects' shadow and diffuse
+                                          rays see through it, but the shadow rays its own
+                                          methods cast find it opaque, since its lobes
+                                          trace the light that crosses it */
 } RayesShaderFlags;
 
 /* Diffusion profiles of the subsurface service. */

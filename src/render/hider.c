@@ -284,7 +284,10 @@ static Rgb *shade_grid(Worker *w, uint32_t gi, uint32_t instance, int seg)
     RayesShadeOutputs out = {.Ci = Ci, .Oi = Oi};
     w->stats.shading_points[0] += n;
     uint64_t sharp = w->sharp_rays;
+    const RenderObject *outer = w->shading;
+    w->shading = obj;
     shade_run_lighting(w->services, &ctx, obj->shader, &out);
+    w->shading = outer;
     memcpy(ci, Ci, n * sizeof *ci);
     if (obj->transparent)
         memcpy(ci + n, Oi, n * sizeof *ci);

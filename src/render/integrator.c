@@ -202,7 +202,10 @@ static Vec3 shade_hit(Worker *w, const Ray *ray, const Hit *hit, const RenderObj
         shade_run_diffuselighting(w->services, &ctx, obj->shader, &out);
     } else {
         w->stats.shading_points[RY_MIN(diffuse_depth, RENDER_MAX_DEPTH)]++;
+        const RenderObject *outer = w->shading;
+        w->shading = obj;
         shade_run_lighting(w->services, &ctx, obj->shader, &out);
+        w->shading = outer;
     }
     *Oi_out = v3(Oi[0][0], Oi[0][1], Oi[0][2]);
     return v3(Ci[0][0], Ci[0][1], Ci[0][2]);
@@ -233,7 +236,7 @@ Vec3 integrator_opacity(Worker *w, const Ray *ray, Hit *hit, const AccelCrossing
 {
     const GridSet *gs = w->rs->gs;
     const RenderObject *obj = render_object(w->rs, hit->grid, hit->instance);
-    if (!obj->transparent)
+    if (!obj->transparent || (obj->thin_shadow && obj == w->shading))
         return v3(1, 1, 1);
     if (!obj->opacity_shader && !obj->Os_pattern) /* Os alone: no shader runs */
         return (gs->grids[hit->grid].primvars & GEOM_PV_OS) ? hit_Os(gs, hit, obj)

@@ -68,6 +68,8 @@ typedef struct Worker {
                                      the same one call after call, and setting one up is
                                      three profiles' constants (subsurface.c) */
     int has_medium;
+    const struct RenderObject *shading; /* the object whose shader runs (its thin shadow is
+                                           opaque to it: RAYES_SHADER_THIN_SHADOW) */
 } Worker;
 
 /* What a shading context's `renderer` points to: per point (indexed from

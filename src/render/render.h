@@ -43,6 +43,8 @@ typedef struct RenderObject {
     uint8_t opacity_shader;                /* 1: its opacity is its shader's opacity method's
                                               (transmissionhitmode "shader"); 0: Os alone */
     uint8_t opacity_cached;                /* 1: its opacity may come from the cache (memo 6.1) */
+    uint8_t thin_shadow;                   /* 1: opaque to the shadow rays its own shader casts
+                                              (RAYES_SHADER_THIN_SHADOW) */
     const unsigned char *lit; /* n_lights flags, nonzero: that light illuminates it (its
                                  light links); NULL: every light does */
 } RenderObject;

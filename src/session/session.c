@@ -310,6 +310,8 @@ RenderObject *session_render_objects(const RayesScene *scene)
             so->light < 0 && (ro[i].opacity_shader || so->Os_pattern || so->Os[0] < 1.0f ||
                               so->Os[1] < 1.0f || so->Os[2] < 1.0f || so->Os_primvar_below_1);
         ro[i].opacity_cached = so->opacity_cache != 0;
+        ro[i].thin_shadow =
+            ro[i].opacity_shader && shade_class_flags(so->shader.cls) & RAYES_SHADER_THIN_SHADOW;
         if (so->links == 0)
             continue;
         unsigned char *mine = lit + (size_t)(so->links - 1) * scene->n_lights;

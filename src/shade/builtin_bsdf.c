@@ -539,6 +539,33 @@ static void fresnel_split(const RayesShaderServices *sv, const RayesShadeCtx *ct
         }
 }
 
+/* Thin shadows of glass: the opacity a shadow ray, or a diffuse ray (it
+ * has no view: ctx->I is NULL), meets at a dielectric's surface, as if
+ * light crossed it unbent: Os (1 - (1 - R0) tint) a crossing, R0 Fresnel's
+ * reflectance at normal incidence, so a solid's two crossings pass
+ * (1 - R0)^2 tint^2 (0.92 at eta 1.5). Opaque, glass cast black shadows
+ * and was black to diffuse rays: a table under a glass jug, a room behind
+ * a glass door lost the light that pbrt-v4 carries there as caustics
+ * (DESIGN.md "Built-in BSDFs and shaders"). */
+static void thin_shadow(const RayesShadeCtx *ctx, float eta, const Rgb *tint,
+                        RayesShadeOutputs *out)
+{
+    float T0 = 1.0f - fresnel_dielectric(1.0f, eta);
+    for (size_t i = 0; i < ctx->n_points; i++)
+        for (int c = 0; c < 3; c++) {
+            float T = fminf(fmaxf(T0 * tint[i][c], 0.0f), 1.0f);
+            out->Oi[i][c] = (ctx->Os ? ctx->Os[i][c] : 1.0f) * (1.0f - T);
+        }
+}
+
+/* glass's tint of what it transmits: Cs transmitcolor Kt. */
+static void glass_tint(const RayesShadeCtx *ctx, const GlassParams *p, Rgb *tint)
+{
+    for (size_t i = 0; i < ctx->n_points; i++)
+        for (int c = 0; c < 3; c++)
+            tint[i][c] = cs(ctx, i, c) * p->transmitcolor[c] * p->Kt;
+}
+
 static void glass_chunk(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
                         const void *params, RayesShadeOutputs *out)
 {
@@ -548,11 +575,10 @@ static void glass_chunk(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
         return; /* no view-independent lobe */
     Rgb R[SHADE_CHUNK], T[SHADE_CHUNK], ds[SHADE_CHUNK], wR[SHADE_CHUNK], wT[SHADE_CHUNK];
     float e[SHADE_CHUNK];
+    glass_tint(ctx, p, wT);
     for (size_t i = 0; i < ctx->n_points; i++) {
-        for (int c = 0; c < 3; c++) {
+        for (int c = 0; c < 3; c++)
             wR[i][c] = p->specularcolor[c] * p->Kr;
-            wT[i][c] = cs(ctx, i, c) * p->transmitcolor[c] * p->Kt;
-        }
         e[i] = p->roughness > 0.0f ? 1.0f / p->roughness : 0.0f;
     }
     fresnel_split(sv, ctx, p->eta, e, 0, (const Rgb *)wR, (const Rgb *)wT, R, T);
@@ -569,10 +595,27 @@ static void glass_chunk(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
                             cs(ctx, i, c) * p->transmitcolor[c] * p->Kt * T[i][c];
 }
 
+static void glass_opacity_chunk(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
+                                const void *params, RayesShadeOutputs *out)
+{
+    (void)sv;
+    Rgb tint[SHADE_CHUNK];
+    glass_tint(ctx, params, tint);
+    thin_shadow(ctx, ((const GlassParams *)params)->eta, (const Rgb *)tint, out);
+}
+
+static void glass_opacity(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
+                          const void *params, RayesShadeOutputs *out)
+{
+    shade_chunks(sv, ctx, params, out, glass_opacity_chunk);
+}
+
 static void glass_lighting(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
                            const void *params, RayesShadeOutputs *out)
 {
     by_chunks(sv, ctx, params, out, glass_chunk);
+    if (!ctx->I) /* a diffuse ray sees through, as a shadow ray does */
+        glass_opacity(sv, ctx, params, out);
 }
 
 static const RayesShaderParamDesc glass_params[] = {
@@ -592,8 +635,10 @@ const RayesShaderClass shade_class_glass = {
     .params_size = sizeof(GlassParams),
     .params = glass_params,
     .n_params = sizeof glass_params / sizeof glass_params[0],
+    .opacity = glass_opacity,
     .lighting = glass_lighting,
-    .diffuselighting = glass_lighting, /* without I: black */
+    .diffuselighting = glass_lighting, /* without I: black, and thin-shadow Oi */
+    .flags = RAYES_SHADER_THIN_SHADOW,
 };
 
 typedef struct DielectricParams {
@@ -619,10 +664,30 @@ static void dielectric_chunk(const RayesShaderServices *sv, const RayesShadeCtx 
             out->Ci[i][c] = R[i][c] + tint[i][c] * T[i][c]; /* at each crossing */
 }
 
+static void dielectric_opacity_chunk(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
+                                     const void *params, RayesShadeOutputs *out)
+{
+    (void)sv;
+    const DielectricParams *p = params;
+    Rgb tint[SHADE_CHUNK];
+    for (size_t i = 0; i < ctx->n_points; i++)
+        for (int c = 0; c < 3; c++)
+            tint[i][c] = p->transmitcolor[c];
+    thin_shadow(ctx, p->eta, (const Rgb *)tint, out);
+}
+
+static void dielectric_opacity(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
+                               const void *params, RayesShadeOutputs *out)
+{
+    shade_chunks(sv, ctx, params, out, dielectric_opacity_chunk);
+}
+
 static void dielectric_lighting(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
                                 const void *params, RayesShadeOutputs *out)
 {
     by_chunks(sv, ctx, params, out, dielectric_chunk);
+    if (!ctx->I) /* a diffuse ray sees through, as a shadow ray does */
+        dielectric_opacity(sv, ctx, params, out);
 }
 
 static const RayesShaderParamDesc dielectric_params[] = {
@@ -639,8 +704,10 @@ const RayesShaderClass shade_class_dielectric = {
     .params_size = sizeof(DielectricParams),
     .params = dielectric_params,
     .n_params = sizeof dielectric_params / sizeof dielectric_params[0],
+    .opacity = dielectric_opacity,
     .lighting = dielectric_lighting,
-    .diffuselighting = dielectric_lighting, /* without I: black */
+    .diffuselighting = dielectric_lighting, /* without I: black, and thin-shadow Oi */
+    .flags = RAYES_SHADER_THIN_SHADOW,
 };
 
 /* ------------------------------------------------------------ diffuse */

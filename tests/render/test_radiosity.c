@@ -166,21 +166,30 @@ static RayesScene *teapots(void)
     return s;
 }
 
-static RayesImage *render(double cache_mb, int threads, int cache)
+/* The benchmark box at size x size, one sample, reading the fine level to
+ * diffuse depth fine_depth at most; its statistics in *st if st. */
+static RayesImage *teapots_render(int size, int bounces, int fine_depth, double cache_mb,
+                                  int threads, int cache, RayesStats **st)
 {
     RayesScene *s = teapots();
     RayesRenderOptions o;
     rayes_render_options_init(&o, RAYES_QUALITY_PREVIEW);
-    o.width = o.height = 40;
+    o.width = o.height = size;
     o.spp = 1;
-    o.bounces = 2;
+    o.bounces = bounces;
     o.threads = threads;
     o.cache = cache;
     o.cache_mb = cache_mb;
+    o.cache_fine_depth = fine_depth;
     RayesImage *img = NULL;
-    CHECK(rayes_render(s, &o, &img, NULL) == RAYES_OK);
+    CHECK(rayes_render(s, &o, &img, st) == RAYES_OK);
     rayes_scene_release(s);
     return img;
+}
+
+static RayesImage *render(double cache_mb, int threads, int cache)
+{
+    return teapots_render(40, 2, 1, cache_mb, threads, cache, NULL);
 }
 
 static int same(const RayesImage *a, const RayesImage *b)
@@ -469,22 +478,10 @@ static void test_clusters_through_instances(void)
     rayes_stats_free(st);
 }
 
-/* The benchmark box at 3 bounces, 32 x 32, one sample, reading the fine
- * level to diffuse depth fine_depth at most; its statistics in *st. */
+/* The benchmark box at 3 bounces, 32 x 32. */
 static RayesImage *teapots_deep(int fine_depth, int threads, RayesStats **st)
 {
-    RayesScene *s = teapots();
-    RayesRenderOptions o;
-    rayes_render_options_init(&o, RAYES_QUALITY_PREVIEW);
-    o.width = o.height = 32;
-    o.spp = 1;
-    o.bounces = 3;
-    o.threads = threads;
-    o.cache_fine_depth = fine_depth;
-    RayesImage *img = NULL;
-    CHECK(rayes_render(s, &o, &img, st) == RAYES_OK);
-    rayes_scene_release(s);
-    return img;
+    return teapots_render(32, 3, fine_depth, 100, threads, 1, st);
 }
 
 /* Past the first bounce no hit reads the fine level (radiosity.c): the
