@@ -99,6 +99,106 @@ static int area_finish(const Light *l, Vec3 wi, float d, Vec3 ny, LightSample *s
     return 1;
 }
 
+/* ------------------------------------------------- spherical rectangles
+ *
+ * A rectangular quad light is sampled uniformly in the solid angle it
+ * subtends (Urena, Fajardo and King 2013, "An area-preserving
+ * parametrization for spherical rectangles"), not by area: by area, a
+ * point near a large light (a wall beside a window-sized one) draws most
+ * samples where the light is seen at a grazing angle, and their 1 / d^2
+ * weights made its direct light speckle (Bitterli's kitchen at 64 shadow
+ * rays a pixel; a point 0.05 below a 2 x 2 light, 16 samples: 8% off by
+ * area, 1.6% by solid angle). Quads that are not rectangles, and
+ * rectangles under SPHRECT_MIN steradians (about as far as they are wide,
+ * where both weigh their samples alike and area sampling is cheaper: at
+ * every solid angle the set-up and the trigonometry cost the memo's box
+ * about 10% of its render), keep area sampling; sampling and
+ * light_intersect's pdf use the same rule. */
+
+#define SPHRECT_MIN 0.25f
+
+typedef struct SphRect {
+    Vec3 o, x, y, z;
+    float x0, x1, y0, y1, z0, b0, b1, k, S;
+} SphRect;
+
+static int sphrect_setup(const Light *l, Vec3 o, SphRect *r);
+
+/* Nonzero, and r set up, if l is a rectangle of solid angle at least
+ * SPHRECT_MIN whose emitting side o is on. A shading point draws all its
+ * samples of a light in a row: the thread's last answer is kept (keyed by
+ * the light's corners, since a moving light is a copy made per time). */
+static int sphrect_init(const Light *l, Vec3 o, SphRect *r)
+{
+    static _Thread_local struct {
+        Vec3 P[4], o;
+        SphRect r;
+        int ok, valid;
+    } last;
+    if (last.valid && memcmp(last.P, l->P, sizeof last.P) == 0 && last.o.x == o.x &&
+        last.o.y == o.y && last.o.z == o.z) {
+        *r = last.r;
+        return last.ok;
+    }
+    last.ok = sphrect_setup(l, o, &last.r);
+    memcpy(last.P, l->P, sizeof last.P);
+    last.o = o;
+    last.valid = 1;
+    *r = last.r;
+    return last.ok;
+}
+
+static int sphrect_setup(const Light *l, Vec3 o, SphRect *r)
+{
+    Vec3 e1 = v3_sub(l->P[1], l->P[0]), e2 = v3_sub(l->P[2], l->P[0]);
+    float l1 = v3_length(e1), l2 = v3_length(e2);
+    Vec3 off = v3_sub(l->P[3], v3_add(l->P[1], e2));
+    if (!(l1 > 0.0f && l2 > 0.0f) || fabsf(v3_dot(e1, e2)) > 1e-4f * l1 * l2 ||
+        v3_length(off) > 1e-4f * (l1 + l2))
+        return 0;
+    Vec3 n = v3_cross(e1, e2), d = v3_sub(l->P[0], o);
+    if (!(v3_dot(d, n) < 0.0f)) /* behind the emitting side: nothing, as by area */
+        return 0;
+    r->o = o;
+    r->x = v3_scale(e1, 1.0f / l1);
+    r->y = v3_scale(e2, 1.0f / l2);
+    r->z = v3_cross(r->x, r->y);
+    r->x0 = v3_dot(d, r->x), r->y0 = v3_dot(d, r->y), r->z0 = v3_dot(d, r->z);
+    if (r->z0 > 0.0f)
+        r->z0 = -r->z0, r->z = v3_neg(r->z);
+    r->x1 = r->x0 + l1, r->y1 = r->y0 + l2;
+    Vec3 v00 = v3(r->x0, r->y0, r->z0), v01 = v3(r->x0, r->y1, r->z0);
+    Vec3 v10 = v3(r->x1, r->y0, r->z0), v11 = v3(r->x1, r->y1, r->z0);
+    Vec3 n0 = v3_normalize(v3_cross(v00, v10)), n1 = v3_normalize(v3_cross(v10, v11));
+    Vec3 n2 = v3_normalize(v3_cross(v11, v01)), n3 = v3_normalize(v3_cross(v01, v00));
+    float g0 = acosf(fminf(fmaxf(-v3_dot(n0, n1), -1.0f), 1.0f));
+    float g1 = acosf(fminf(fmaxf(-v3_dot(n1, n2), -1.0f), 1.0f));
+    float g2 = acosf(fminf(fmaxf(-v3_dot(n2, n3), -1.0f), 1.0f));
+    float g3 = acosf(fminf(fmaxf(-v3_dot(n3, n0), -1.0f), 1.0f));
+    r->b0 = n0.z, r->b1 = n2.z;
+    r->k = 2.0f * PI - g2 - g3;
+    r->S = g0 + g1 - r->k;
+    return isfinite(r->S) && r->S >= SPHRECT_MIN;
+}
+
+/* The rectangle's point of solid-angle parameters (a, b) in [0, 1)^2. */
+static Vec3 sphrect_point(const SphRect *r, float a, float b)
+{
+    float au = a * r->S + r->k, sa = sinf(au);
+    float fu = (cosf(au) * r->b0 - r->b1) / (sa != 0.0f ? sa : 1e-30f);
+    float cu = copysignf(1.0f, fu) / sqrtf(fu * fu + r->b0 * r->b0);
+    cu = fminf(fmaxf(cu, -1.0f), 1.0f);
+    float xu = -(cu * r->z0) / fmaxf(sqrtf(1.0f - cu * cu), 1e-30f);
+    xu = fminf(fmaxf(xu, r->x0), r->x1);
+    float dd = sqrtf(xu * xu + r->z0 * r->z0);
+    float h0 = r->y0 / sqrtf(dd * dd + r->y0 * r->y0), h1 = r->y1 / sqrtf(dd * dd + r->y1 * r->y1);
+    float hv = h0 + b * (h1 - h0), hv2 = hv * hv;
+    float yv = hv2 < 1.0f - 1e-6f ? hv * dd / sqrtf(1.0f - hv2) : r->y1;
+    yv = fminf(fmaxf(yv, r->y0), r->y1);
+    return v3_add(r->o,
+                  v3_add(v3_add(v3_scale(r->x, xu), v3_scale(r->y, yv)), v3_scale(r->z, r->z0)));
+}
+
 /* ------------------------------------------------------------ disks */
 
 static void concentric_disk(float a, float b, float *x, float *y)
@@ -729,10 +829,23 @@ int light_sample(const Light *l, Vec3 o, float a, float b, LightSample *s)
     switch (l->type) {
     case LIGHT_QUAD: {
         Vec3 y, ny;
-        light_quad_eval(l, a, b, &y, &ny);
+        SphRect r;
+        int by_angle = sphrect_init(l, o, &r);
+        if (by_angle)
+            y = sphrect_point(&r, a, b);
+        else
+            light_quad_eval(l, a, b, &y, &ny);
         Vec3 d = v3_sub(y, o);
         float dist = v3_length(d);
-        return dist > 0.0f && area_finish(l, v3_scale(d, 1.0f / dist), dist, ny, s);
+        if (!by_angle)
+            return dist > 0.0f && area_finish(l, v3_scale(d, 1.0f / dist), dist, ny, s);
+        if (!(dist > 0.0f))
+            return 0;
+        s->wi = v3_scale(d, 1.0f / dist);
+        s->dist = dist;
+        s->Li = l->L;
+        s->pdf = 1.0f / r.S;
+        return 1;
     }
     case LIGHT_DISK: {
         float x, z;
@@ -814,7 +927,12 @@ int light_intersect(const Light *l, Vec3 o, Vec3 wi, LightSample *s)
         Vec3 y = v3_madd(o, wi, t), p, ny;
         quad_invert(l, y, &a, &b);
         light_quad_eval(l, a, b, &p, &ny);
-        return area_finish(l, wi, t, ny, s);
+        if (!area_finish(l, wi, t, ny, s))
+            return 0;
+        SphRect r; /* the pdf of the sampling light_sample does */
+        if (sphrect_init(l, o, &r))
+            s->pdf = 1.0f / r.S;
+        return 1;
     }
     case LIGHT_DISK: {
         float den = v3_dot(wi, l->normal);

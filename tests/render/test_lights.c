@@ -392,6 +392,35 @@ static void check_glossy_light(float half, float roughness, int mesh)
     fx_fini(&f);
 }
 
+/* A point close below a large rectangular light, near its edge (a wall
+ * beside a window-sized light): the light is sampled by solid angle
+ * (light.c sphrect_point), so 16 samples find its irradiance within 3%
+ * at each of 8 points along the edge (measured 1.6%; by area, samples
+ * land where the light is seen at a grazing angle, weighted by 1 / d^2:
+ * 8.1%). */
+static void test_quad_light_close(void)
+{
+    RayesScene *s = rayes_scene_new();
+    const float m[16] = {1, 0, 0, 0, 0, -1, 0, 0, 0, 0, -1, 0.05f, 0, 0, 0, 1};
+    CHECK(rayes_scene_set_transform(s, m) == RAYES_OK);
+    RayesParam p[4] = {ps("shape", "quad"), pf("width", 2), pf("height", 2), pf("intensity", 1)};
+    CHECK(rayes_scene_light(s, "arealight", p, 4) == RAYES_OK);
+    Fx f;
+    fx_init(&f, s);
+    Vec3 quad[4] = {v3(-1, -1, 0.05f), v3(1, -1, 0.05f), v3(1, 1, 0.05f), v3(-1, 1, 0.05f)};
+    Vec3 N = v3(0, 0, 1);
+    double worst = 0.0, least = 1e30;
+    for (int k = 0; k < 8; k++) { /* points along the edge */
+        Vec3 P = v3(0.97f, -0.7f + 0.2f * (float)k, 0);
+        double d[3], sp[3], ref = polygon_irradiance(P, N, quad, 4);
+        fx_direct(&f, P, N, NULL, 16, NULL, 0.1f, 1, d, sp);
+        worst = fmax(worst, fabs(PI * d[0] / ref - 1.0));
+        least = fmin(least, ref);
+    }
+    CHECK(least > 1.0 && worst < 0.03);
+    fx_fini(&f);
+}
+
 static void test_mis_glossy_small_quad(void)
 {
     check_glossy_light(0.1f, 0.1f, 0);
@@ -784,7 +813,6 @@ static void test_glass_ball_white_furnace(void)
     CHECK_NEAR(glass_ball_mean(1.0001f, 0.1f), 0.5, 0.05);
     for (int k = 0; k < 2; k++) {
         double rough = glass_ball_mean(1.5f, k ? 0.1f : 0.02f);
-        printf("rough %g\n", rough);
         CHECK(rough > 0.3 && rough < 0.5);
     }
 }
@@ -1493,7 +1521,7 @@ TEST_MAIN(TEST(test_point_light_inverse_square), TEST(test_spot_light_cone),
           TEST(test_microfacet_against_brute_force), TEST(test_constant_environment_white_furnace),
           TEST(test_sample_clamp), TEST(test_chrome_ball_white_furnace),
           TEST(test_glass_ball_white_furnace), TEST(test_glass_thin_shadow),
-          TEST(test_environment_map_importance_sampling),
+          TEST(test_quad_light_close), TEST(test_environment_map_importance_sampling),
           TEST(test_environment_map_sampling_consistency), TEST(test_octahedral_environment_map),
           TEST(test_point_light_maps), TEST(test_categories), TEST(test_emitters_seen_by_camera),
           TEST(test_every_light_any_thread_count), TEST(test_bad_lights))
