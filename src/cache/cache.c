@@ -93,9 +93,7 @@ struct Cache {
     Shard shards[CACHE_N_TYPES][CACHE_N_LEVELS][CACHE_SHARDS];
     Part parts[CACHE_N_TYPES];
     uint8_t part_of[CACHE_N_TYPES];
-    uint64_t budget;                     /* all partitions */
-    uint64_t type_budget[CACHE_N_TYPES]; /* of partition t */
-    uint64_t level_budget[CACHE_N_TYPES][CACHE_N_LEVELS];
+    uint64_t budget; /* all partitions */
     atomic_uint_fast64_t timestamp;
     pthread_mutex_t counters_lock;
     CacheCounters counters[CACHE_N_LEVELS][CACHE_N_TYPES];
@@ -204,16 +202,16 @@ static Cache *cache_new_parts(const uint64_t budget_bytes[CACHE_N_TYPES],
     pthread_mutex_init(&c->counters_lock, NULL);
     for (int t = 0; t < CACHE_N_TYPES; t++) {
         Part *p = &c->parts[t];
-        c->type_budget[t] = p->budget = budget_bytes[t];
+        p->budget = budget_bytes[t];
         c->budget += budget_bytes[t];
         atomic_init(&p->used, 0);
         atomic_init(&p->peak, 0);
         for (int l = 0; l < CACHE_N_LEVELS; l++) {
             float f = split[l] < 0.0f ? 0.0f : split[l];
-            c->level_budget[t][l] = p->level_budget[l] = (uint64_t)((double)budget_bytes[t] * f);
+            p->level_budget[l] = (uint64_t)((double)budget_bytes[t] * f);
             atomic_init(&p->level_used[l], 0);
             for (int s = 0; s < CACHE_SHARDS; s++)
-                if (shard_init(&c->shards[t][l][s], p, l, c->level_budget[t][l] / CACHE_SHARDS,
+                if (shard_init(&c->shards[t][l][s], p, l, p->level_budget[l] / CACHE_SHARDS,
                                nominal_values[l]) != 0)
                     failed = 1;
         }
@@ -339,25 +337,23 @@ static int take_room(Shard *s, uint64_t need, int *reclaim)
     }
 }
 
-/* Evicts least recently used entries of the partition's shards past their
+/* Evicts least recently used entries of partition p's shards past their
  * share until need bytes are freed or none is past. Holds no lock but one
  * shard's at a time. */
 static void reclaim(Cache *c, const Part *p, uint64_t need)
 {
     uint64_t freed = 0;
-    for (int t = 0; t < CACHE_N_TYPES && freed < need; t++)
-        for (int l = 0; l < CACHE_N_LEVELS && freed < need; l++)
-            for (int i = 0; i < CACHE_SHARDS && freed < need; i++) {
-                Shard *s = &c->shards[t][l][i];
-                if (s->part != p)
-                    break;
-                pthread_mutex_lock(&s->lock);
-                while (s->bytes > s->budget && s->lru.next != &s->lru && freed < need) {
-                    freed += cache_entry_bytes(s->lru.next->n_values);
-                    evict_lru(s);
-                }
-                pthread_mutex_unlock(&s->lock);
+    Shard(*part)[CACHE_SHARDS] = c->shards[p - c->parts]; /* partition t: shards[t] */
+    for (int l = 0; l < CACHE_N_LEVELS && freed < need; l++)
+        for (int i = 0; i < CACHE_SHARDS && freed < need; i++) {
+            Shard *s = &part[l][i];
+            pthread_mutex_lock(&s->lock);
+            while (s->bytes > s->budget && s->lru.next != &s->lru && freed < need) {
+                freed += cache_entry_bytes(s->lru.next->n_values);
+                evict_lru(s);
             }
+            pthread_mutex_unlock(&s->lock);
+        }
 }
 
 /* Drops a reference. Caller does not hold the shard lock. */
@@ -389,7 +385,7 @@ void cache_local_init(CacheLocal *local, Cache *cache)
     for (int l = 0; l < CACHE_N_LEVELS; l++) {
         uint64_t level_budget = 0;
         for (int t = 0; t < CACHE_N_TYPES; t++)
-            level_budget += cache->level_budget[t][l];
+            level_budget += cache->parts[t].level_budget[l];
         uint64_t capacity = level_budget / cache_entry_bytes(nominal_values[l]);
         uint32_t n = (uint32_t)cache_local_slots[l];
         while (n > 4 && (uint64_t)n * 32 > capacity)
@@ -580,8 +576,8 @@ void cache_get_stats(const Cache *cc, CacheStats *st)
         st->type_peak_bytes[t] = atomic_load(&c->parts[t].peak);
     for (int t = 0; t < CACHE_N_TYPES; t++)
         for (int l = 0; l < CACHE_N_LEVELS; l++) {
-            st->type_budget_bytes[t] = c->type_budget[c->part_of[t]];
-            st->level_budget_bytes[l] += c->level_budget[t][l];
+            st->type_budget_bytes[t] = c->parts[c->part_of[t]].budget;
+            st->level_budget_bytes[l] += c->parts[t].level_budget[l];
             for (int s = 0; s < CACHE_SHARDS; s++) {
                 Shard *sh = &c->shards[t][l][s];
                 pthread_mutex_lock(&sh->lock);

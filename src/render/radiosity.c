@@ -83,6 +83,7 @@ static int quad_level_index(int level, int k, int n)
  * are bilinear (barycentric); toward the rim they are held, never
  * extrapolated. */
 #define COARSE_INSET 0.25f
+#define COARSE_SPAN (1.0f - 2.0f * COARSE_INSET) /* the points' span, of the grid's */
 
 /* Subdivisions of a triangular level of a grid of n subdivisions; 0: one
  * value, at the centroid. A grid of one micropolygon (a dense mesh's
@@ -318,7 +319,7 @@ static void layout_points(const GridSet *gs, const Grid *g, int level, int side,
             int vi[3][2];
             float wt[3], x = (float)i * n / m, y = (float)j * n / m, c = (float)n / 3.0f;
             if (level == CACHE_COARSE) /* halfway from the centroid to the corner */
-                x = c + (x - c) * 0.5f, y = c + (y - c) * 0.5f;
+                x = c + (x - c) * COARSE_SPAN, y = c + (y - c) * COARSE_SPAN;
             tri_cell(n, x, y, vi, wt);
             uint32_t vtx[3];
             for (int k = 0; k < 3; k++)
@@ -604,8 +605,8 @@ Vec3 radiosity_interpolate(const Grid *g, const Hit *hit, int level, const uint1
         if (level == CACHE_FINE)
             return bilinear(vals, g->nu, g->nv, x, y);
         if (level == CACHE_COARSE) /* bilinear clamps beyond the points */
-            return bilinear(vals, 2, 2, (hit->gu - COARSE_INSET) / (1.0f - 2.0f * COARSE_INSET),
-                            (hit->gv - COARSE_INSET) / (1.0f - 2.0f * COARSE_INSET));
+            return bilinear(vals, 2, 2, (hit->gu - COARSE_INSET) / COARSE_SPAN,
+                            (hit->gv - COARSE_INSET) / COARSE_SPAN);
         return bilinear(vals, medium_knots(g->nu), medium_knots(g->nv),
                         medium_coord(x, g->nu), medium_coord(y, g->nv));
     }
@@ -616,7 +617,9 @@ Vec3 radiosity_interpolate(const Grid *g, const Hit *hit, int level, const uint1
     int vi[3][2];
     float wt[3];
     if (level == CACHE_COARSE) { /* barycentric in the points' triangle, clamped */
-        float b[3] = {0, 2.0f * hit->gu - 1.0f / 3.0f, 2.0f * hit->gv - 1.0f / 3.0f};
+        const float third = 1.0f / 3.0f;
+        float b[3] = {0, third + (hit->gu - third) / COARSE_SPAN,
+                      third + (hit->gv - third) / COARSE_SPAN};
         b[0] = 1.0f - b[1] - b[2];
         float sum = 0.0f;
         for (int k = 0; k < 3; k++)
