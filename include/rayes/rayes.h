@@ -572,8 +572,11 @@ RAYES_API RayesError rayes_scene_volume(RayesScene *scene, const float bound[6])
  * last (its object): a ray's segment counts only where the ray leaves
  * that surface through its back, as after entering it (glass holding a
  * coloured liquid, pbrt-v4's MediumInterface inside a shape); shadow rays
- * do not cross it (they meet its surface first). The box still bounds the
- * march. INVALID_ARGUMENT without geometry before it. */
+ * do not cross it (they meet its surface first). Geometry seen by no ray
+ * (rayes_scene_set_visibility(scene, 0): pbrt's "interface" shapes) only
+ * bounds the medium: every ray, shadow rays too, is in it between its
+ * crossings of that surface. The box still bounds the march.
+ * INVALID_ARGUMENT without geometry before it. */
 RAYES_API RayesError rayes_scene_volume_inside(RayesScene *scene, const float bound[6]);
 
 /* A one-sided emitting quad (an area light) with vertices P[0..3] in order

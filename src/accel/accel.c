@@ -135,7 +135,10 @@ static int attach(Level *lv, RTCGeometry geom, uint32_t mask, Geom g)
 {
     if (mask & ACCEL_MASK_TRANSPARENT)
         rtcSetGeometryOccludedFilterFunction(geom, transmission_filter);
-    rtcSetGeometryMask(geom, mask & ~(ACCEL_MASK_TRANSPARENT | ACCEL_MASK_OWN_SCENE));
+    uint32_t seen = mask & ~(ACCEL_MASK_TRANSPARENT | ACCEL_MASK_OWN_SCENE);
+    /* An object no ray type sees but with a scene of its own (a hidden
+     * volume bound) keeps a bit that only its scene's queries carry. */
+    rtcSetGeometryMask(geom, seen || !(mask & ACCEL_MASK_OWN_SCENE) ? seen : ACCEL_MASK_OWN_SCENE);
     rtcCommitGeometry(geom);
     unsigned id = (unsigned)lv->n_geoms;
     if (!lv->only_also)

@@ -13,6 +13,7 @@
 #include <string.h>
 
 #include "io/pbrt_internal.h"
+#include "rayes/shader.h"
 
 #define PBRT_MAX_REPLAYED 10000000L /* primitives emitted by ObjectInstance, in all */
 
@@ -136,22 +137,57 @@ void pbrt_grow_quadric(Parser *P, RayesQuadric q, const float *qp)
     pbrt_grow_bound(P, c, 2);
 }
 
+/* Every object's visibility but a hidden bound's: rayes's default, since
+ * pbrt has none of its own. */
+#define PBRT_SEEN (RAYES_RAY_CAMERA | RAYES_RAY_DIFFUSE | RAYES_RAY_SPECULAR | RAYES_RAY_SHADOW)
+
+/* An "interface" shape (no surface) is sent only when it bounds a medium of
+ * its own, and then as an object no ray sees (a plain matte, which never
+ * shades): 1 to skip it. */
+static int skip_interface(Parser *P)
+{
+    return strcmp(P->gs.material.shader, PBRT_INVISIBLE) == 0 && !pbrt_medium_hidden_bound(P);
+}
+
+int pbrt_shown_again(Parser *P, const Token *t)
+{
+    if (!P->shape_hidden)
+        return 0;
+    RayesError e = P->sink->set_visibility(P->sink->target, PBRT_SEEN);
+    return e != RAYES_OK ? pbrt_sink_failed(P, t, e) : 0;
+}
+
+static int send_material(Parser *P, const Token *t, const Material *mat)
+{
+    if (P->have_sent && memcmp(&P->sent, mat, sizeof *mat) == 0)
+        return 0;
+    RayesParam params[MAT_MAX_PARAMS + 1];
+    material_params(P, mat, params);
+    RayesError e = P->sink->set_shader(P->sink->target, mat->shader, params, (size_t)mat->n);
+    if (e == RAYES_OK)
+        e = send_displacement(P, mat);
+    if (e != RAYES_OK)
+        return pbrt_sink_failed(P, t, e);
+    P->sent = *mat;
+    P->have_sent = 1;
+    return 0;
+}
+
+/* The transform and material of a shape about to be sent; an interface
+ * one's object is seen by no ray (pbrt_shown_again turns visibility back). */
 static int send_state(Parser *P, const Token *t, const double m[16], const Material *mat)
 {
-    RayesError e;
     if (send_transform(P, t, m) != 0)
         return -1;
-    if (!P->have_sent || memcmp(&P->sent, mat, sizeof *mat) != 0) {
-        RayesParam params[MAT_MAX_PARAMS + 1];
-        material_params(P, mat, params);
-        e = P->sink->set_shader(P->sink->target, mat->shader, params, (size_t)mat->n);
-        if (e == RAYES_OK)
-            e = send_displacement(P, mat);
-        if (e != RAYES_OK)
-            return pbrt_sink_failed(P, t, e);
-        P->sent = *mat;
-        P->have_sent = 1;
-    }
+    if (strcmp(mat->shader, PBRT_INVISIBLE) != 0)
+        return send_material(P, t, mat);
+    RayesError e = P->sink->set_visibility(P->sink->target, 0);
+    if (e == RAYES_OK)
+        e = P->sink->set_shader(P->sink->target, "matte", NULL, 0);
+    if (e != RAYES_OK)
+        return pbrt_sink_failed(P, t, e);
+    P->have_sent = 0;
+    P->shape_hidden = 1;
     return 0;
 }
 
@@ -235,7 +271,7 @@ static int emit_mesh(Parser *P, const Token *t, size_t n_faces, const int *n_ver
                      size_t n_points, const float *pts, const float *N, const float *uv, int subdiv)
 {
     pbrt_grow_bound(P, pts, n_points);
-    if (n_faces == 0 || strcmp(P->gs.material.shader, PBRT_INVISIBLE) == 0)
+    if (n_faces == 0 || skip_interface(P))
         return 0;
     if (P->recording) {
         Op *op = new_op(P, t, OP_MESH);
@@ -301,7 +337,7 @@ int pbrt_emit_quadric(Parser *P, const Token *t, RayesQuadric q, const float *qp
     if (q == RAYES_QUADRIC_SPHERE || q == RAYES_QUADRIC_CYLINDER || q == RAYES_QUADRIC_DISK ||
         q == RAYES_QUADRIC_HYPERBOLOID)
         pbrt_grow_quadric(P, q, qp);
-    if (strcmp(P->gs.material.shader, PBRT_INVISIBLE) == 0)
+    if (skip_interface(P))
         return 0;
     if (P->recording) {
         Op *op = new_op(P, t, OP_QUADRIC);
@@ -332,7 +368,7 @@ static RayesError send_patch(Parser *P, const Op *op)
 int pbrt_emit_patch(Parser *P, const Token *t, const Op *patch)
 {
     pbrt_grow_bound(P, &patch->patch[0][0], 4);
-    if (strcmp(P->gs.material.shader, PBRT_INVISIBLE) == 0)
+    if (skip_interface(P))
         return 0;
     if (P->recording) {
         Op *op = new_op(P, t, OP_PATCH);

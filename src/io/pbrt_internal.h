@@ -222,6 +222,8 @@ typedef struct Parser {
     size_t n_media;
     float shape_bound[6]; /* object-space bounds of the Shape being read (x0 x1 y0 y1 z0 z1) */
     int have_shape_bound;
+    int shape_hidden;     /* the Shape being read was sent seen by no ray (an "interface" shape
+                             that bounds its medium: pbrt_medium_hidden_bound) */
     float world_bound[6]; /* world-space bounds of every Shape outside ObjectBegin so far */
     int have_world_bound;
     char camera_medium[128]; /* the outside medium current at Camera, "" for none */
@@ -411,8 +413,16 @@ int pbrt_d_light(Parser *P, const Token *t);
 int pbrt_d_makenamedmedium(Parser *P, const Token *t); /* pbrt_medium.c */
 int pbrt_d_mediuminterface(Parser *P, const Token *t);
 /* After a Shape: the volume of its inside medium, if it has one, over
- * P->shape_bound (pbrt_emit_* grow it). */
+ * P->shape_bound (pbrt_emit_* grow it), only inside the shape when it
+ * was sent (a surface, or an "interface" shape sent hidden). */
 int pbrt_medium_shape(Parser *P, const Token *t);
+/* Whether the current "interface" shape bounds a medium of its own that
+ * the sink can make: it is then sent seen by no ray, so that its medium
+ * fills the shape and not its whole box. */
+int pbrt_medium_hidden_bound(Parser *P);
+/* After a Shape sent hidden and its medium: what follows is seen again
+ * (pbrt_emit.c). */
+int pbrt_shown_again(Parser *P, const Token *t);
 /* At the end of the file: the camera's medium, if any, as a volume over
  * the scene's bounds and the camera. */
 int pbrt_medium_camera(Parser *P);

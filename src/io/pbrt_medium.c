@@ -231,6 +231,17 @@ static void grow_world_bound(Parser *P)
     }
 }
 
+int pbrt_medium_hidden_bound(Parser *P)
+{
+    const char *in = P->gs.inside, *out = P->gs.outside;
+    if (strcmp(P->gs.material.shader, PBRT_INVISIBLE) != 0 || !in[0] || strcmp(in, out) == 0 ||
+        P->recording || !P->sink->volume || !P->sink->pattern || !P->sink->volume_inside ||
+        !P->sink->set_visibility)
+        return 0;
+    const Medium *md = find_medium(P, in);
+    return md && strcmp(md->type, "none") != 0;
+}
+
 int pbrt_medium_shape(Parser *P, const Token *t)
 {
     const char *in = P->gs.inside, *out = P->gs.outside;
@@ -267,12 +278,12 @@ int pbrt_medium_shape(Parser *P, const Token *t)
     size_t n = medium_params(md, q);
     if (uniform) {
         const float box[6] = {md->p0[0], md->p1[0], md->p0[1], md->p1[1], md->p0[2], md->p1[2]};
-        return pbrt_emit_volume(P, t, md->m, q, n, box, 0);
+        return pbrt_emit_volume(P, t, md->m, q, n, box, P->shape_hidden);
     }
     /* a shape drawn as a surface (glass round a liquid) bounds its medium
-     * itself; an interface one (left out) by its box */
+     * itself, and so does an interface one sent hidden; else its box does */
     int surface = strcmp(P->gs.material.shader, PBRT_INVISIBLE) != 0;
-    return pbrt_emit_volume(P, t, P->gs.ctm, q, n, b, surface);
+    return pbrt_emit_volume(P, t, P->gs.ctm, q, n, b, surface || P->shape_hidden);
 }
 
 void pbrt_media_free(Parser *P)

@@ -769,6 +769,7 @@ int pbrt_d_shape(Parser *P, const Token *t)
         return -1;
     }
     P->have_shape_bound = 0;
+    P->shape_hidden = 0;
     Material saved = P->gs.material, with_alpha;
     r = shape_alpha(P, t, &pl, &with_alpha);
     if (r == 1)
@@ -783,5 +784,7 @@ int pbrt_d_shape(Parser *P, const Token *t)
     if (!r)
         pbrt_warn_unused(P, &pl, "Shape", type);
     pbrt_params_free(&pl);
-    return r ? r : pbrt_medium_shape(P, t);
+    if (!r)
+        r = pbrt_medium_shape(P, t);
+    return r ? r : pbrt_shown_again(P, t);
 }

@@ -15,6 +15,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "accel/accel.h"
 #include "shade/builtin.h"
 #include "util/check.h"
 #include "util/half.h"
@@ -100,6 +101,47 @@ static float ray_jitter(const Ray *ray)
     for (int k = 0; k < 6; k++)
         h = hash_combine(h, bits[k]);
     return rng_float(h);
+}
+
+/* Crossings of a hidden bounding surface a ray follows, at most: past
+ * them the ray stays as the last one left it. A closed surface makes a
+ * segment of every two; one whose normals disagree may make one of each. */
+#define VOLUME_MAX_CROSSINGS 64
+#define VOLUME_MAX_SEGMENTS (VOLUME_MAX_CROSSINGS + 1)
+
+/* The parts of [t0, t1] along the ray inside a volume's hidden bounding
+ * object (v->hidden_bound), at most VOLUME_MAX_SEGMENTS of them, into seg;
+ * returns their count. Its surfaces are met one after another
+ * in its own scene: a crossing against the normal enters it, one along
+ * the normal leaves it (its inside is behind its normals, as for
+ * rayes_scene_volume_inside), and the first crossing says whether the
+ * ray started inside. */
+static int inside_segments(const Worker *w, const RenderVolume *v, const Ray *ray, float t0,
+                           float t1, float (*seg)[2])
+{
+    Ray r = *ray;
+    r.tnear = 0.0f;
+    r.tfar = INFINITY;
+    int n = 0, inside = -1; /* -1: not known yet */
+    float from = t0;
+    for (int k = 0; k < VOLUME_MAX_CROSSINGS; k++) {
+        Hit h;
+        if (!accel_intersect_object(w->rs->accel, (uint32_t)v->inside, &r, &h))
+            break;
+        int entering = v3_dot(h.Ng, ray->d) < 0.0f;
+        if (inside < 0)
+            inside = !entering;
+        if (inside && h.t > from && from < t1)
+            seg[n][0] = from, seg[n][1] = fminf(h.t, t1), n++;
+        inside = entering;
+        from = fmaxf(h.t, t0);
+        if (h.t >= t1)
+            return n;
+        r.tnear = nextafterf(h.t, INFINITY) + 1e-6f * h.t;
+    }
+    if (inside > 0 && from < t1) /* left inside (an open surface, or too many crossings) */
+        seg[n][0] = from, seg[n][1] = t1, n++;
+    return n;
 }
 
 /* Steps through [t0, t1]: n of them, dt apart (ray parameter), the first
@@ -415,29 +457,110 @@ Vec3 volume_transmittance(Worker *w, const Ray *ray, RayDiff diff)
     int counted = 0;
     for (size_t k = 0; k < w->rs->n_volumes; k++) {
         const RenderVolume *v = &w->rs->volumes[k];
-        float t0, t1;
-        if (v->inside >= 0 || !clip(v, ray, ray->tfar, &t0, &t1))
-            continue; /* inside its object: shadow rays from outside cross its surface first */
-        if (!counted++)
+        float t0, t1, seg[VOLUME_MAX_SEGMENTS][2];
+        /* inside a visible object: shadow rays from outside cross its
+         * surface first */
+        if ((v->inside >= 0 && !v->hidden_bound) || !clip(v, ray, ray->tfar, &t0, &t1))
+            continue;
+        int n_seg = 1;
+        if (v->hidden_bound)
+            n_seg = inside_segments(w, v, ray, t0, t1, seg);
+        else
+            seg[0][0] = t0, seg[0][1] = t1;
+        if (n_seg && !counted++)
             w->stats.rays_transmission++;
-        March m = march(w, v, ray, t0, t1, ray_jitter(ray), v->uniform ? 1 : VOLUME_MAX_STEPS);
         const RenderObject *obj = &w->rs->objects[v->object];
         Vec3 tau = v3(0, 0, 0);
-        if (w->set->opacity_cache && obj->opacity_cached) {
-            tau = optical_depth_cached(w, v, ray, diff, &m);
-        } else {
-            VolumePoints p;
-            points_alloc(&p, (size_t)m.n);
-            march_points(v, obj, ray, &m, 0, diff, &p);
-            run_extinction(w, obj, &p, (size_t)m.n);
-            for (int i = 0; i < m.n; i++)
-                tau = v3_madd(tau, v3_load(p.Oi[i]), m.dl);
-            points_free(&p);
+        for (int s = 0; s < n_seg; s++) {
+            March m = march(w, v, ray, seg[s][0], seg[s][1], ray_jitter(ray),
+                            v->uniform ? 1 : VOLUME_MAX_STEPS);
+            if (w->set->opacity_cache && obj->opacity_cached) {
+                tau = v3_add(tau, optical_depth_cached(w, v, ray, diff, &m));
+            } else {
+                VolumePoints p;
+                points_alloc(&p, (size_t)m.n);
+                march_points(v, obj, ray, &m, 0, diff, &p);
+                run_extinction(w, obj, &p, (size_t)m.n);
+                for (int i = 0; i < m.n; i++)
+                    tau = v3_madd(tau, v3_load(p.Oi[i]), m.dl);
+                points_free(&p);
+            }
+            w->stats.volume_steps += (uint64_t)m.n;
         }
-        w->stats.volume_steps += (uint64_t)m.n;
         T = v3_mul(T, v3_exp_neg(tau));
     }
     return T;
+}
+
+/* The light one segment [t0, t1] of the ray through volume v adds, into
+ * *Lv, and its transmittance, into *Tv. */
+static void segment_radiance(Worker *w, const RenderVolume *v, const Ray *ray, float t0, float t1,
+                             uint32_t kind, int diffuse_depth, int specular_depth, uint64_t vkey,
+                             RayDiff diff, Vec3 *Lv_out, Vec3 *Tv_out)
+{
+    const RenderObject *obj = &w->rs->objects[v->object];
+    int scatter = (kind & (RAYES_RAY_CAMERA | RAYES_RAY_SPECULAR)) != 0;
+    March m = march(w, v, ray, t0, t1, rng_float(vkey),
+                    v->uniform ? VOLUME_LIGHT_SAMPLES : VOLUME_MAX_STEPS);
+    VolumePoints p;
+    points_alloc(&p, (size_t)m.n);
+    march_points(v, obj, ray, &m, vkey, diff, &p);
+    extinction_at(w, v, ray, diff, &m, &p);
+    w->stats.volume_steps += (uint64_t)m.n;
+    int n_light = RY_MIN(m.n, VOLUME_LIGHT_SAMPLES);
+    VolumePoints lp;
+    if (scatter) {
+        /* The source at n_light of the steps, one per stratum of the
+         * segment; a step takes its stratum's. */
+        points_alloc(&lp, (size_t)n_light);
+        for (int j = 0; j < n_light; j++) {
+            int i = light_step(j, m.n, n_light);
+            memcpy(lp.P[j], p.P[i], sizeof lp.P[j]);
+            memcpy(lp.N[j], p.N[i], sizeof lp.N[j]);
+            memcpy(lp.I[j], p.I[i], sizeof lp.I[j]);
+            memcpy(lp.Cs[j], p.Cs[i], sizeof lp.Cs[j]);
+            memcpy(lp.Os[j], p.Os[i], sizeof lp.Os[j]);
+            lp.u[j] = p.u[i], lp.v[j] = p.v[i], lp.s[j] = p.s[i];
+            lp.keys[j] = p.keys[i];
+            lp.diff[j] = p.diff[i];
+        }
+        PathState ps = {w, lp.keys, lp.diff, lp.zero1, lp.zero1, NULL, UINT32_MAX, NULL, NULL, 1};
+        RayesShadeCtx ctx = points_ctx(&lp, (size_t)n_light, kind & ~PATH_RAY_GLOSSY, 1,
+                                       diffuse_depth, specular_depth, &ps);
+        RayesShadeOutputs o = {lp.Ci, lp.Oi, NULL, NULL};
+        w->stats.shading_points[RY_MIN(diffuse_depth, RENDER_MAX_DEPTH)] += (uint64_t)n_light;
+        shade_run_lighting(w->services, &ctx, obj->shader, &o);
+        /* the source per unit extinction, interpolated between the
+         * lighting points (linearly: its error is second order) and
+         * times each step's own extinction */
+        for (int i = 0, j = 0; i < m.n; i++) {
+            while (j + 1 < n_light && light_step(j + 1, m.n, n_light) <= i)
+                j++;
+            int a = light_step(j, m.n, n_light), b = j + 1 < n_light ? j + 1 : j;
+            int ib = light_step(b, m.n, n_light);
+            float f = ib > a ? fminf(fmaxf((float)(i - a) / (float)(ib - a), 0.0f), 1.0f) : 0.0f;
+            for (int c = 0; c < 3; c++) {
+                float ra = lp.Oi[j][c] > 0.0f ? lp.Ci[j][c] / lp.Oi[j][c] : 0.0f;
+                float rb = lp.Oi[b][c] > 0.0f ? lp.Ci[b][c] / lp.Oi[b][c] : 0.0f;
+                p.Ci[i][c] = (ra + (rb - ra) * f) * p.Oi[i][c];
+            }
+        }
+        points_free(&lp);
+    }
+    /* Front to back: each step adds its source times the transmittance
+     * to its middle, then attenuates what lies behind it. */
+    Vec3 Tv = v3(1, 1, 1), Lv = v3(0, 0, 0);
+    for (int i = 0; i < m.n; i++) {
+        Vec3 step = v3_exp_neg(v3_scale(v3_load(p.Oi[i]), m.dl));
+        if (scatter) {
+            Vec3 half = v3_exp_neg(v3_scale(v3_load(p.Oi[i]), 0.5f * m.dl));
+            Lv = v3_add(Lv, v3_scale(v3_mul(v3_mul(Tv, half), v3_load(p.Ci[i])), m.dl));
+        }
+        Tv = v3_mul(Tv, step);
+    }
+    points_free(&p);
+    *Lv_out = Lv;
+    *Tv_out = Tv;
 }
 
 Vec3 volume_radiance(Worker *w, const Ray *ray, float tmax, int64_t leaving, uint32_t kind,
@@ -445,75 +568,25 @@ Vec3 volume_radiance(Worker *w, const Ray *ray, float tmax, int64_t leaving, uin
 {
     Vec3 L = v3(0, 0, 0);
     *T = v3(1, 1, 1);
-    int scatter = (kind & (RAYES_RAY_CAMERA | RAYES_RAY_SPECULAR)) != 0;
     for (size_t k = 0; k < w->rs->n_volumes; k++) {
         const RenderVolume *v = &w->rs->volumes[k];
-        const RenderObject *obj = &w->rs->objects[v->object];
-        float t0, t1;
-        if ((v->inside >= 0 && v->inside != leaving) || !clip(v, ray, tmax, &t0, &t1))
+        float t0, t1, seg[VOLUME_MAX_SEGMENTS][2];
+        if ((v->inside >= 0 && !v->hidden_bound && v->inside != leaving) ||
+            !clip(v, ray, tmax, &t0, &t1))
             continue; /* bounded by an object the ray is not inside */
+        int n_seg = 1;
+        if (v->hidden_bound)
+            n_seg = inside_segments(w, v, ray, t0, t1, seg);
+        else
+            seg[0][0] = t0, seg[0][1] = t1;
         uint64_t vkey = hash_combine(key, 0x766f6c0000ull + k);
-        March m = march(w, v, ray, t0, t1, rng_float(vkey),
-                        v->uniform ? VOLUME_LIGHT_SAMPLES : VOLUME_MAX_STEPS);
-        VolumePoints p;
-        points_alloc(&p, (size_t)m.n);
-        march_points(v, obj, ray, &m, vkey, diff, &p);
-        extinction_at(w, v, ray, diff, &m, &p);
-        w->stats.volume_steps += (uint64_t)m.n;
-        int n_light = RY_MIN(m.n, VOLUME_LIGHT_SAMPLES);
-        VolumePoints lp;
-        if (scatter) {
-            /* The source at n_light of the steps, one per stratum of the
-             * segment; a step takes its stratum's. */
-            points_alloc(&lp, (size_t)n_light);
-            for (int j = 0; j < n_light; j++) {
-                int i = light_step(j, m.n, n_light);
-                memcpy(lp.P[j], p.P[i], sizeof lp.P[j]);
-                memcpy(lp.N[j], p.N[i], sizeof lp.N[j]);
-                memcpy(lp.I[j], p.I[i], sizeof lp.I[j]);
-                memcpy(lp.Cs[j], p.Cs[i], sizeof lp.Cs[j]);
-                memcpy(lp.Os[j], p.Os[i], sizeof lp.Os[j]);
-                lp.u[j] = p.u[i], lp.v[j] = p.v[i], lp.s[j] = p.s[i];
-                lp.keys[j] = p.keys[i];
-                lp.diff[j] = p.diff[i];
-            }
-            PathState ps = {w, lp.keys, lp.diff, lp.zero1, lp.zero1, NULL, UINT32_MAX, NULL, NULL, 1};
-            RayesShadeCtx ctx = points_ctx(&lp, (size_t)n_light, kind & ~PATH_RAY_GLOSSY, 1,
-                                           diffuse_depth, specular_depth, &ps);
-            RayesShadeOutputs o = {lp.Ci, lp.Oi, NULL, NULL};
-            w->stats.shading_points[RY_MIN(diffuse_depth, RENDER_MAX_DEPTH)] += (uint64_t)n_light;
-            shade_run_lighting(w->services, &ctx, obj->shader, &o);
-            /* the source per unit extinction, interpolated between the
-             * lighting points (linearly: its error is second order) and
-             * times each step's own extinction */
-            for (int i = 0, j = 0; i < m.n; i++) {
-                while (j + 1 < n_light && light_step(j + 1, m.n, n_light) <= i)
-                    j++;
-                int a = light_step(j, m.n, n_light), b = j + 1 < n_light ? j + 1 : j;
-                int ib = light_step(b, m.n, n_light);
-                float f = ib > a ? fminf(fmaxf((float)(i - a) / (float)(ib - a), 0.0f), 1.0f) : 0.0f;
-                for (int c = 0; c < 3; c++) {
-                    float ra = lp.Oi[j][c] > 0.0f ? lp.Ci[j][c] / lp.Oi[j][c] : 0.0f;
-                    float rb = lp.Oi[b][c] > 0.0f ? lp.Ci[b][c] / lp.Oi[b][c] : 0.0f;
-                    p.Ci[i][c] = (ra + (rb - ra) * f) * p.Oi[i][c];
-                }
-            }
-            points_free(&lp);
+        for (int s = 0; s < n_seg; s++) {
+            Vec3 Lv, Tv;
+            segment_radiance(w, v, ray, seg[s][0], seg[s][1], kind, diffuse_depth, specular_depth,
+                             s ? hash_combine(vkey, (uint64_t)s) : vkey, diff, &Lv, &Tv);
+            L = v3_add(L, v3_mul(*T, Lv));
+            *T = v3_mul(*T, Tv);
         }
-        /* Front to back: each step adds its source times the transmittance
-         * to its middle, then attenuates what lies behind it. */
-        Vec3 Tv = v3(1, 1, 1), Lv = v3(0, 0, 0);
-        for (int i = 0; i < m.n; i++) {
-            Vec3 step = v3_exp_neg(v3_scale(v3_load(p.Oi[i]), m.dl));
-            if (scatter) {
-                Vec3 half = v3_exp_neg(v3_scale(v3_load(p.Oi[i]), 0.5f * m.dl));
-                Lv = v3_add(Lv, v3_scale(v3_mul(v3_mul(Tv, half), v3_load(p.Ci[i])), m.dl));
-            }
-            Tv = v3_mul(Tv, step);
-        }
-        points_free(&p);
-        L = v3_add(L, v3_mul(*T, Lv));
-        *T = v3_mul(*T, Tv);
     }
     return L;
 }

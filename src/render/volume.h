@@ -36,6 +36,9 @@ typedef struct RenderVolume {
     int64_t inside;              /* -1, or the RenderObject whose surfaces bound it: a ray's
                                     segment is in it only when the ray leaves that object
                                     through its back (rayes_scene_volume_inside) */
+    int hidden_bound;            /* 1: that object is seen by no ray (a pbrt "interface"
+                                    shape): a ray is in the volume between its crossings of
+                                    the object's surfaces, found in its own scene */
     int uniform;                 /* 1: the same extinction everywhere (the homogeneous shader
                                     without patterns): transmittance takes one step, scattering
                                     one per lighting point */

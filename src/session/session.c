@@ -322,19 +322,35 @@ RenderObject *session_render_objects(const RayesScene *scene)
     return ro;
 }
 
+/* Whether object o, which bounds a volume, is seen by no ray: a pbrt
+ * "interface" shape, which only says where its medium is. */
+static int session_hidden_bound(const RayesScene *scene, int64_t o)
+{
+    return (scene->objects[o].ray_mask & (RAYES_RAY_CAMERA | RAYES_RAY_SHADOW | RAYES_RAY_DIFFUSE |
+                                          RAYES_RAY_SPECULAR | RAYES_RAY_TRANSMISSION)) == 0;
+}
+
 /* Ray masks; shadow rays pass through transparent objects (accel.h); subsurface
  * objects and mesh lights' emitters have scenes of their own. */
 static uint32_t *object_masks(const RayesScene *scene, const RenderObject *ro)
 {
     uint32_t *m = calloc(scene->n_objects + 1, sizeof *m);
-    if (m)
-        for (size_t i = 0; i < scene->n_objects; i++)
-            m[i] = scene->objects[i].ray_mask | (ro[i].transparent ? ACCEL_MASK_TRANSPARENT : 0u) |
-                   ((ro[i].shader &&
-                     (shade_class_flags(ro[i].shader->cls) & RAYES_SHADER_SUBSURFACE)) ||
-                            (ro[i].light >= 0 && scene->lights[ro[i].light].type == LIGHT_MESH)
-                        ? ACCEL_MASK_OWN_SCENE
-                        : 0u);
+    if (!m)
+        return NULL;
+    for (size_t i = 0; i < scene->n_objects; i++)
+        m[i] =
+            scene->objects[i].ray_mask | (ro[i].transparent ? ACCEL_MASK_TRANSPARENT : 0u) |
+            ((ro[i].shader && (shade_class_flags(ro[i].shader->cls) & RAYES_SHADER_SUBSURFACE)) ||
+                     (ro[i].light >= 0 && scene->lights[ro[i].light].type == LIGHT_MESH)
+                 ? ACCEL_MASK_OWN_SCENE
+                 : 0u);
+    /* the hidden surfaces that bound volumes: their crossings are found in
+     * a scene of their own (volume.c) */
+    for (size_t i = 0; i < scene->n_volumes; i++) {
+        int64_t o = scene->volumes[i].inside;
+        if (o >= 0 && (size_t)o < scene->n_objects && session_hidden_bound(scene, o))
+            m[o] |= ACCEL_MASK_OWN_SCENE;
+    }
     return m;
 }
 
@@ -382,6 +398,7 @@ static int prepare_volumes(const RayesScene *scene, const RenderSettings *set, P
             continue; /* a singular transform: nothing to march */
         v->uniform = volume_uniform(&p->objects[sv->object]);
         v->inside = sv->inside;
+        v->hidden_bound = sv->inside >= 0 && session_hidden_bound(scene, sv->inside);
         base += bricks;
         p->n_volumes++;
     }

@@ -283,5 +283,74 @@ static void test_medium_inside_glass(void)
     rayes_image_free(img);
 }
 
+/* pbrt's "interface" shapes (no surface) bound their media: rays meet
+ * the medium between their crossings of the shape, not in its bounding box.
+ * An absorbing sphere of radius 1 (sigma_a 0.5) seen along its axis, over
+ * a floor lit through it: its centre passes exp(-1) twice (the camera's
+ * ray and the floor's light), a corner of its box (inside the box, outside
+ * the sphere) all; two closed cubes in one mesh, 0.5 and 0.8 deep, pass
+ * exp(-0.5 * 1.3) where the box gave exp(-1). Written as RIB (the shape
+ * hidden from every ray) and read back: the same image. */
+static void test_medium_inside_interface(void)
+{
+    const char *sphere =
+        "LookAt 0 5 0  0 0 0  0 0 1\n"
+        "Camera \"orthographic\" \"float screenwindow\" [-1.5 1.5 -1.5 1.5]\n"
+        "WorldBegin\nLightSource \"distant\" \"point3 from\" [0 10 0] \"point3 to\" [0 0 0] "
+        "\"rgb L\" [3.14159265 3.14159265 3.14159265]\n"
+        "MakeNamedMedium \"absorb\" \"string type\" \"homogeneous\" \"rgb sigma_a\" "
+        "[0.5 0.5 0.5] \"rgb sigma_s\" [0 0 0]\n"
+        "AttributeBegin\nTranslate 0 2 0\nMaterial \"interface\"\n"
+        "MediumInterface \"absorb\" \"\"\nShape \"sphere\" \"float radius\" [1]\nAttributeEnd\n"
+        "AttributeBegin\nMaterial \"diffuse\" \"rgb reflectance\" [1 1 1]\n"
+        "Shape \"bilinearmesh\" \"point3 P\" [-3 0 -3  3 0 -3  -3 0 3  3 0 3] "
+        "\"integer indices\" [0 1 2 3]\nAttributeEnd\n";
+    RayesImage *img = render_read(io_pbrt_parse, sphere, 1);
+    CHECK(img != NULL);
+    if (img) {
+        /* pixel centres at +-0.047 and at 1.17 (x and z) from the axis */
+        const float *mid = &img->rgba[4 * (SIZE / 2 * SIZE + SIZE / 2)];
+        const float *corner = &img->rgba[4 * ((SIZE / 2 + 13) * SIZE + SIZE / 2 + 13)];
+        printf("  medium in an interface sphere: through %.4f (exp(-2) %.4f), beside %.4f\n",
+               mid[0], expf(-2.0f), corner[0]);
+        CHECK(fabsf(mid[0] - expf(-2.0f)) < 0.01f);
+        CHECK(fabsf(corner[0] - 1.0f) < 1e-3f);
+    }
+    char *rib = pbrt_as_rib(sphere);
+    CHECK(rib && strstr(rib, "\"int camera\" [0] \"int diffuse\" [0] \"int specular\" [0] "
+                             "\"int transmission\" [0]") != NULL);
+    RayesImage *back = rib ? render_read(io_rib_parse, rib, 1) : NULL;
+    CHECK(img && max_diff(img, back) < 1e-4f);
+    rayes_image_free(back);
+    free(rib);
+    rayes_image_free(img);
+
+    const char *cubes =
+        "LookAt 0 0 -5  0 0 0  0 1 0\n"
+        "Camera \"orthographic\" \"float screenwindow\" [-1 1 -1 1]\n"
+        "WorldBegin\nLightSource \"infinite\" \"rgb L\" [1 1 1]\n"
+        "MakeNamedMedium \"absorb\" \"string type\" \"homogeneous\" \"rgb sigma_a\" "
+        "[0.5 0.5 0.5] \"rgb sigma_s\" [0 0 0]\n"
+        "AttributeBegin\nMaterial \"interface\"\nMediumInterface \"absorb\" \"\"\n"
+        "Shape \"trianglemesh\" \"point3 P\" ["
+        "-.5 -.5 -1 .5 -.5 -1 -.5 .5 -1 .5 .5 -1 -.5 -.5 -.5 .5 -.5 -.5 -.5 .5 -.5 .5 .5 -.5 "
+        "-.5 -.5 .2 .5 -.5 .2 -.5 .5 .2 .5 .5 .2 -.5 -.5 1 .5 -.5 1 -.5 .5 1 .5 .5 1] "
+        "\"integer indices\" [0 2 1 1 2 3 4 5 6 5 7 6 0 4 2 2 4 6 1 3 5 3 7 5 0 1 4 1 5 4 2 6 3 "
+        "3 6 7 8 10 9 9 10 11 12 13 14 13 15 14 8 12 10 10 12 14 9 11 13 11 15 13 8 9 12 9 13 "
+        "12 10 14 11 11 14 15]\nAttributeEnd\n";
+    img = render_read(io_pbrt_parse, cubes, 1);
+    CHECK(img != NULL);
+    if (img) {
+        const float *mid = &img->rgba[4 * (SIZE / 2 * SIZE + SIZE / 2)];
+        const float *beside = &img->rgba[4 * (1 * SIZE + 1)];
+        printf("  medium in two interface cubes: through %.4f (exp(-0.65) %.4f), beside %.4f\n",
+               mid[0], expf(-0.65f), beside[0]);
+        CHECK(fabsf(mid[0] - expf(-0.65f)) < 2e-3f);
+        CHECK(fabsf(beside[0] - 1.0f) < 1e-3f);
+    }
+    rayes_image_free(img);
+}
+
 TEST_MAIN(TEST(test_constant_alpha), TEST(test_texture_alpha), TEST(test_rib_round_trip),
-          TEST(test_bad_alpha), TEST(test_displacement_is_bump), TEST(test_medium_inside_glass))
+          TEST(test_bad_alpha), TEST(test_displacement_is_bump), TEST(test_medium_inside_glass),
+          TEST(test_medium_inside_interface))
