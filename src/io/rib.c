@@ -818,7 +818,6 @@ static const RibRequest own_requests[] = {
     {"Bound", h_skip},
     {"ColorSamples", h_skip},
     {"ClippingPlane", h_skip},
-    {"Skew", h_skip},
     {"Resource", h_skip},
     {"ResourceBegin", h_skip},
     {"ResourceEnd", h_skip},

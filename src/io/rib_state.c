@@ -64,6 +64,43 @@ static int h_rotate(Rib *r, const Args *a)
     return 0;
 }
 
+/* RenderMan's shear: points move along the second vector (a), so that the
+ * first (d1, at angle theta from a) turns by the given angle toward it:
+ * p' = p + k (p . b) a, b the unit vector in their plane perpendicular to
+ * a on d1's side, k = cot(theta - angle) - cot(theta). The angle must lie
+ * in (theta - 180, theta) degrees, as the specification says. */
+static int h_skew(Rib *r, const Args *a)
+{
+    size_t i = 0;
+    float v[7], m[16];
+    if (rib_get_floats(r, a, &i, v, 7, "angle dx1 dy1 dz1 dx2 dy2 dz2") != 0)
+        return -1;
+    double d1[3] = {v[1], v[2], v[3]}, ax[3] = {v[4], v[5], v[6]};
+    double l1 = sqrt(d1[0] * d1[0] + d1[1] * d1[1] + d1[2] * d1[2]);
+    double la = sqrt(ax[0] * ax[0] + ax[1] * ax[1] + ax[2] * ax[2]);
+    if (!(l1 > 0) || !(la > 0) || !isfinite(l1) || !isfinite(la) || !isfinite(v[0]))
+        return rib_error(r, "expected two finite non-zero vectors and a finite angle");
+    double dot = 0, b[3], lb = 0;
+    for (int k = 0; k < 3; k++)
+        ax[k] /= la, d1[k] /= l1, dot += d1[k] * ax[k];
+    for (int k = 0; k < 3; k++)
+        b[k] = d1[k] - dot * ax[k], lb += b[k] * b[k];
+    lb = sqrt(lb);
+    double theta = acos(fmax(-1.0, fmin(1.0, dot))), angle = v[0] * M_PI / 180;
+    if (!(lb > 1e-9) || !(angle < theta) || !(angle > theta - M_PI))
+        return rib_error(r,
+                         "expected an angle between %g and %g degrees (the vectors are %g "
+                         "degrees apart), found %g",
+                         theta * 180 / M_PI - 180, theta * 180 / M_PI, theta * 180 / M_PI, v[0]);
+    double k = 1 / tan(theta - angle) - 1 / tan(theta);
+    rib_mat_identity(m);
+    for (int row = 0; row < 3; row++)
+        for (int col = 0; col < 3; col++)
+            m[4 * row + col] += (float)(k * ax[row] * b[col] / lb);
+    concat(r, m);
+    return 0;
+}
+
 static int get_matrix(Rib *r, const Args *a, float m[16])
 {
     size_t i = 0;
@@ -973,21 +1010,47 @@ static int h_basis(Rib *r, const Args *a)
 /* ------------------------------------------------------------ requests */
 
 const RibRequest rib_state_requests[] = {
-    {"AttributeBegin", h_attribute_begin}, {"AttributeEnd", h_attribute_end},
-    {"SolidBegin", h_solid_begin}, {"SolidEnd", h_solid_end},
-    {"TransformBegin", h_transform_begin}, {"TransformEnd", h_transform_end},
-    {"Identity", h_identity}, {"Transform", h_transform}, {"ConcatTransform", h_concat},
-    {"Translate", h_translate}, {"Rotate", h_rotate}, {"Scale", h_scale},
-    {"Perspective", h_perspective}, {"CoordinateSystem", h_coordinate_system},
-    {"ScopedCoordinateSystem", h_coordinate_system}, {"CoordSysTransform", h_coordsys_transform},
-    {"Format", h_format}, {"FrameAspectRatio", h_frame_aspect}, {"ScreenWindow", h_screen_window},
-    {"CropWindow", h_crop_window}, {"Projection", h_projection}, {"Clipping", h_clipping},
-    {"Shutter", h_shutter}, {"DepthOfField", h_depth_of_field},
-    {"PixelSamples", h_pixel_samples}, {"PixelFilter", h_pixel_filter},
-    {"PixelVariance", h_pixel_variance}, {"Exposure", h_exposure}, {"Quantize", h_quantize},
-    {"Imager", h_imager}, {"Display", h_display}, {"Hider", h_hider},
-    {"ShadingRate", h_shading_rate}, {"Sides", h_sides}, {"Orientation", h_orientation},
-    {"ReverseOrientation", h_reverse_orientation}, {"Color", h_color}, {"Opacity", h_color},
-    {"Attribute", h_option_attribute}, {"Option", h_option_attribute}, {"Basis", h_basis},
+    {"AttributeBegin", h_attribute_begin},
+    {"AttributeEnd", h_attribute_end},
+    {"SolidBegin", h_solid_begin},
+    {"SolidEnd", h_solid_end},
+    {"TransformBegin", h_transform_begin},
+    {"TransformEnd", h_transform_end},
+    {"Identity", h_identity},
+    {"Transform", h_transform},
+    {"ConcatTransform", h_concat},
+    {"Translate", h_translate},
+    {"Rotate", h_rotate},
+    {"Scale", h_scale},
+    {"Skew", h_skew},
+    {"Perspective", h_perspective},
+    {"CoordinateSystem", h_coordinate_system},
+    {"ScopedCoordinateSystem", h_coordinate_system},
+    {"CoordSysTransform", h_coordsys_transform},
+    {"Format", h_format},
+    {"FrameAspectRatio", h_frame_aspect},
+    {"ScreenWindow", h_screen_window},
+    {"CropWindow", h_crop_window},
+    {"Projection", h_projection},
+    {"Clipping", h_clipping},
+    {"Shutter", h_shutter},
+    {"DepthOfField", h_depth_of_field},
+    {"PixelSamples", h_pixel_samples},
+    {"PixelFilter", h_pixel_filter},
+    {"PixelVariance", h_pixel_variance},
+    {"Exposure", h_exposure},
+    {"Quantize", h_quantize},
+    {"Imager", h_imager},
+    {"Display", h_display},
+    {"Hider", h_hider},
+    {"ShadingRate", h_shading_rate},
+    {"Sides", h_sides},
+    {"Orientation", h_orientation},
+    {"ReverseOrientation", h_reverse_orientation},
+    {"Color", h_color},
+    {"Opacity", h_color},
+    {"Attribute", h_option_attribute},
+    {"Option", h_option_attribute},
+    {"Basis", h_basis},
     {NULL, NULL},
 };

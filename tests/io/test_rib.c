@@ -332,6 +332,25 @@ static void test_camera_and_transforms(void)
     CHECK(parse(WORLD("Scale -1 1 1\nCylinder 1 0 1 360")) == RAYES_OK);
     CHECK(rec.quadric_flags == RAYES_QUADRIC_REVERSE);
 
+    /* Skew: points slide along the second vector; the first turns by the
+     * angle toward it. 45 degrees of y toward x: x' = x + y. */
+    CHECK(parse(WORLD("Skew 45 0 1 0 1 0 0\nSphere 1 -1 1 360")) == RAYES_OK);
+    CHECK_NEAR(rec.M[0], 1, 1e-6);
+    CHECK_NEAR(rec.M[1], 1, 1e-6);
+    CHECK_NEAR(rec.M[4], 0, 1e-6);
+    CHECK_NEAR(rec.M[5], 1, 1e-6);
+    /* 30 degrees of y toward (1 1 0), 45 degrees from it: y turns by 30
+     * degrees in the xy plane, (1 1 0) stays */
+    CHECK(parse(WORLD("Skew 30 0 1 0 1 1 0\nSphere 1 -1 1 360")) == RAYES_OK);
+    double yx = rec.M[1], yy = rec.M[5], yz = rec.M[9];
+    CHECK_NEAR(atan2(yx, yy) * 180 / M_PI, 30, 1e-4);
+    CHECK_NEAR(yz, 0, 1e-6);
+    CHECK_NEAR(rec.M[0] + rec.M[1], 1, 1e-5);
+    CHECK_NEAR(rec.M[4] + rec.M[5], 1, 1e-5);
+    /* an angle past the vectors' own is an error at its line */
+    CHECK(parse(WORLD("Skew 90 0 1 0 1 0 0\nSphere 1 -1 1 360")) == RAYES_ERROR_PARSE);
+    CHECK(parse(WORLD("Skew 10 0 1 0 0 2 0\nSphere 1 -1 1 360")) == RAYES_ERROR_PARSE);
+
     CHECK(parse("ScreenWindow -1 1 -0.5 0.5\nProjection \"orthographic\"\n"
                 "WorldBegin\nWorldEnd\n") == RAYES_OK);
     CHECK(rec.projection == RAYES_PROJECTION_ORTHOGRAPHIC && rec.have_screen);
