@@ -142,11 +142,11 @@ void pbrt_grow_quadric(Parser *P, RayesQuadric q, const float *qp)
 #define PBRT_SEEN (RAYES_RAY_CAMERA | RAYES_RAY_DIFFUSE | RAYES_RAY_SPECULAR | RAYES_RAY_SHADOW)
 
 /* An "interface" shape (no surface) is sent only when it bounds a medium of
- * its own, and then as an object no ray sees (a plain matte, which never
+ * its own (P->shape_bounds), and then as an object no ray sees (a plain matte, which never
  * shades): 1 to skip it. */
 static int skip_interface(Parser *P)
 {
-    return strcmp(P->gs.material.shader, PBRT_INVISIBLE) == 0 && !pbrt_medium_hidden_bound(P);
+    return strcmp(P->gs.material.shader, PBRT_INVISIBLE) == 0 && !P->shape_bounds;
 }
 
 int pbrt_shown_again(Parser *P, const Token *t)

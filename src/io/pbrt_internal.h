@@ -222,8 +222,9 @@ typedef struct Parser {
     size_t n_media;
     float shape_bound[6]; /* object-space bounds of the Shape being read (x0 x1 y0 y1 z0 z1) */
     int have_shape_bound;
-    int shape_hidden;     /* the Shape being read was sent seen by no ray (an "interface" shape
-                             that bounds its medium: pbrt_medium_hidden_bound) */
+    int shape_bounds;     /* the Shape being read is an "interface" one that bounds its medium
+                             (pbrt_medium_hidden_bound): it is sent, seen by no ray */
+    int shape_hidden;     /* and it was sent so */
     float world_bound[6]; /* world-space bounds of every Shape outside ObjectBegin so far */
     int have_world_bound;
     char camera_medium[128]; /* the outside medium current at Camera, "" for none */

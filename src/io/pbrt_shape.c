@@ -769,6 +769,7 @@ int pbrt_d_shape(Parser *P, const Token *t)
         return -1;
     }
     P->have_shape_bound = 0;
+    P->shape_bounds = pbrt_medium_hidden_bound(P);
     P->shape_hidden = 0;
     Material saved = P->gs.material, with_alpha;
     r = shape_alpha(P, t, &pl, &with_alpha);
