@@ -572,7 +572,8 @@ RAYES_API RayesError rayes_scene_volume(RayesScene *scene, const float bound[6])
  * last (its object): a ray's segment counts only where the ray leaves
  * that surface through its back, as after entering it (glass holding a
  * coloured liquid, pbrt-v4's MediumInterface inside a shape); shadow rays
- * do not cross it (they meet its surface first). Geometry seen by no ray
+ * cross it only where the surface lets them through (a glass's thin
+ * shadow, tinted by the liquid). Geometry seen by no ray
  * (rayes_scene_set_visibility(scene, 0): pbrt's "interface" shapes) only
  * bounds the medium: every ray, shadow rays too, is in it between its
  * crossings of that surface. The box still bounds the march.

@@ -458,12 +458,11 @@ Vec3 volume_transmittance(Worker *w, const Ray *ray, RayDiff diff)
     for (size_t k = 0; k < w->rs->n_volumes; k++) {
         const RenderVolume *v = &w->rs->volumes[k];
         float t0, t1, seg[VOLUME_MAX_SEGMENTS][2];
-        /* inside a visible object: shadow rays from outside cross its
-         * surface first */
-        if ((v->inside >= 0 && !v->hidden_bound) || !clip(v, ray, ray->tfar, &t0, &t1))
+        /* inside an opaque object: no shadow ray from outside reaches it */
+        if ((v->inside >= 0 && !v->shadow_crosses) || !clip(v, ray, ray->tfar, &t0, &t1))
             continue;
         int n_seg = 1;
-        if (v->hidden_bound)
+        if (v->shadow_crosses)
             n_seg = inside_segments(w, v, ray, t0, t1, seg);
         else
             seg[0][0] = t0, seg[0][1] = t1;

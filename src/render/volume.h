@@ -39,6 +39,9 @@ typedef struct RenderVolume {
     int hidden_bound;            /* 1: that object is seen by no ray (a pbrt "interface"
                                     shape): a ray is in the volume between its crossings of
                                     the object's surfaces, found in its own scene */
+    int shadow_crosses;          /* 1: shadow rays cross that object (hidden, or letting them
+                                    through: a glass's thin shadow), so transmission finds their
+                                    segments inside it the same way */
     int uniform;                 /* 1: the same extinction everywhere (the homogeneous shader
                                     without patterns): transmittance takes one step, scattering
                                     one per lighting point */

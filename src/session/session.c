@@ -344,11 +344,13 @@ static uint32_t *object_masks(const RayesScene *scene, const RenderObject *ro)
                      (ro[i].light >= 0 && scene->lights[ro[i].light].type == LIGHT_MESH)
                  ? ACCEL_MASK_OWN_SCENE
                  : 0u);
-    /* the hidden surfaces that bound volumes: their crossings are found in
-     * a scene of their own (volume.c) */
+    /* the surfaces bounding volumes that rays cross (hidden ones, and ones
+     * shadow rays pass through): their crossings are found in a scene of
+     * their own (volume.c) */
     for (size_t i = 0; i < scene->n_volumes; i++) {
         int64_t o = scene->volumes[i].inside;
-        if (o >= 0 && (size_t)o < scene->n_objects && session_hidden_bound(scene, o))
+        if (o >= 0 && (size_t)o < scene->n_objects &&
+            (session_hidden_bound(scene, o) || ro[o].transparent))
             m[o] |= ACCEL_MASK_OWN_SCENE;
     }
     return m;
@@ -399,6 +401,8 @@ static int prepare_volumes(const RayesScene *scene, const RenderSettings *set, P
         v->uniform = volume_uniform(&p->objects[sv->object]);
         v->inside = sv->inside;
         v->hidden_bound = sv->inside >= 0 && session_hidden_bound(scene, sv->inside);
+        v->shadow_crosses =
+            v->hidden_bound || (sv->inside >= 0 && p->objects[sv->inside].transparent);
         base += bricks;
         p->n_volumes++;
     }

@@ -351,6 +351,39 @@ static void test_medium_inside_interface(void)
     rayes_image_free(img);
 }
 
+/* Glass lets shadow rays through (its thin shadow, (1 - R0)^2 for a
+ * solid), and so through the medium it holds: a glass ball of wine casts
+ * a red shadow. The distant light at 45 degrees puts the ball's shadow
+ * beside it; the floor's centre pixel's shadow ray crosses the ball's
+ * diameter, 2: 0.9216 exp(-0.1 * 2) red, 0.9216 exp(-2 * 2) green and
+ * blue (it was 0.9216 in all three: the medium was skipped). */
+static void test_medium_in_glass_shadow(void)
+{
+    const char *text =
+        "LookAt -2 5 0  -2 0 0  0 0 1\n"
+        "Camera \"orthographic\" \"float screenwindow\" [-0.5 0.5 -0.5 0.5]\n"
+        "WorldBegin\nLightSource \"distant\" \"point3 from\" [1 1 0] \"point3 to\" [0 0 0] "
+        "\"rgb L\" [4.44288294 4.44288294 4.44288294]\n"
+        "MakeNamedMedium \"wine\" \"string type\" \"homogeneous\" \"rgb sigma_a\" [0.1 2 2] "
+        "\"rgb sigma_s\" [0 0 0]\n"
+        "AttributeBegin\nTranslate 0 2 0\nMaterial \"dielectric\" \"float eta\" 1.5\n"
+        "MediumInterface \"wine\" \"\"\nShape \"sphere\" \"float radius\" [1]\nAttributeEnd\n"
+        "AttributeBegin\nMaterial \"diffuse\" \"rgb reflectance\" [1 1 1]\n"
+        "Shape \"bilinearmesh\" \"point3 P\" [-4 0 -2  0 0 -2  -4 0 2  0 0 2] "
+        "\"integer indices\" [0 1 2 3]\nAttributeEnd\n";
+    RayesImage *img = render_read(io_pbrt_parse, text, 1);
+    CHECK(img != NULL);
+    if (img) {
+        const float *mid = &img->rgba[4 * (SIZE / 2 * SIZE + SIZE / 2)];
+        float red = 0.9216f * expf(-0.2f), green = 0.9216f * expf(-4.0f);
+        printf("  shadow of wine in glass: %.4f %.4f %.4f (expected %.4f %.4f %.4f)\n", mid[0],
+               mid[1], mid[2], red, green, green);
+        CHECK(fabsf(mid[0] - red) < 0.01f);
+        CHECK(fabsf(mid[1] - green) < 0.003f && fabsf(mid[2] - green) < 0.003f);
+    }
+    rayes_image_free(img);
+}
+
 TEST_MAIN(TEST(test_constant_alpha), TEST(test_texture_alpha), TEST(test_rib_round_trip),
           TEST(test_bad_alpha), TEST(test_displacement_is_bump), TEST(test_medium_inside_glass),
-          TEST(test_medium_inside_interface))
+          TEST(test_medium_inside_interface), TEST(test_medium_in_glass_shadow))
