@@ -286,6 +286,10 @@ Vec3 integrator_transmission(Worker *w, const Ray *ray, RayDiff diff)
  * premultiplied Ci is composited over what lies behind it, front to back:
  * Ci + (1 - Oi) L_behind, Oi the shader's (camera, specular and uncached
  * diffuse hits) or the opacity cache's (cached diffuse hits). */
+static Vec3 trace_volumes(Worker *w, const Ray *ray, uint32_t kind, int diffuse_depth,
+                          int specular_depth, uint64_t key, RayDiff diff, float *t, float *alpha,
+                          int layer);
+
 static Vec3 trace_layers(Worker *w, const Ray *ray, uint32_t kind, int diffuse_depth,
                          int specular_depth, uint64_t key, RayDiff diff, float *t, float *alpha,
                          int layer, int64_t *leaving)
@@ -346,24 +350,26 @@ static Vec3 trace_layers(Worker *w, const Ray *ray, uint32_t kind, int diffuse_d
     /* What lies behind, from just past the hit (never the same surface). */
     Ray next = *ray;
     next.tnear = hit.t + path_ray_epsilon(w) / fmaxf(v3_length(ray->d), 1e-30f);
-    float t_behind, a_behind;
-    int64_t behind;
-    Vec3 L = trace_layers(w, &next, kind, diffuse_depth, specular_depth,
-                          hash_combine(key, 0x6c61796572ull /* "layer" */), diff, &t_behind,
-                          &a_behind, layer + 1, &behind);
+    float t_behind, a_behind; /* the volumes between it and the next surface too */
+    Vec3 L = trace_volumes(w, &next, kind, diffuse_depth, specular_depth,
+                           hash_combine(key, 0x6c61796572ull /* "layer" */), diff, &t_behind,
+                           &a_behind, layer + 1);
     float cover = 1.0f - (T.x + T.y + T.z) / 3.0f;
     *alpha = cover + (1.0f - cover) * a_behind;
     return v3_add(Ci, v3_mul(T, L));
 }
 
-/* trace_layers, seen through the volumes in front of what the ray hits:
- * their light added, what lies behind attenuated (volume.h). */
+/* trace_layers from layer on, seen through the volumes in front of what
+ * the ray hits: their light added, what lies behind attenuated
+ * (volume.h). A transparent surface's layer behind it comes here again, so
+ * the volumes behind it count too. */
 static Vec3 trace_volumes(Worker *w, const Ray *ray, uint32_t kind, int diffuse_depth,
-                          int specular_depth, uint64_t key, RayDiff diff, float *t, float *alpha)
+                          int specular_depth, uint64_t key, RayDiff diff, float *t, float *alpha,
+                          int layer)
 {
     int64_t leaving;
-    Vec3 L =
-        trace_layers(w, ray, kind, diffuse_depth, specular_depth, key, diff, t, alpha, 0, &leaving);
+    Vec3 L = trace_layers(w, ray, kind, diffuse_depth, specular_depth, key, diff, t, alpha, layer,
+                          &leaving);
     if (!w->rs->n_volumes)
         return L;
     Vec3 T;
@@ -384,7 +390,7 @@ Vec3 integrator_trace(Worker *w, const Ray *ray, uint32_t kind, int diffuse_dept
     }
     float t, a, outer = w->time;
     w->time = ray->time; /* what the hit's shading traces inherits */
-    Vec3 L = trace_volumes(w, ray, kind, diffuse_depth, specular_depth, key, diff, &t, &a);
+    Vec3 L = trace_volumes(w, ray, kind, diffuse_depth, specular_depth, key, diff, &t, &a, 0);
     w->time = outer;
     if (alpha)
         *alpha = a;
@@ -396,7 +402,7 @@ Vec3 integrator_trace_hit(Worker *w, const Ray *ray, uint32_t kind, int diffuse_
 {
     float a, outer = w->time;
     w->time = ray->time;
-    Vec3 L = trace_volumes(w, ray, kind, diffuse_depth, specular_depth, key, diff, t, &a);
+    Vec3 L = trace_volumes(w, ray, kind, diffuse_depth, specular_depth, key, diff, t, &a, 0);
     w->time = outer;
     return L;
 }

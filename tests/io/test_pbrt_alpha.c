@@ -384,6 +384,39 @@ static void test_medium_in_glass_shadow(void)
     rayes_image_free(img);
 }
 
+/* A fog the camera is in, seen through a half-transparent black pane
+ * (alpha 0.5) 2 units away, before a white emitter 11 units away: the
+ * fog behind the pane counts too, 0.5 exp(-0.1 * 11), beside the pane
+ * exp(-1.1) (only the fog before the pane counted: 0.5 exp(-0.2)). */
+static void test_fog_behind_transparent(void)
+{
+    const char *text =
+        "LookAt 0 0 -1  0 0 1  0 1 0\n"
+        "MakeNamedMedium \"fog\" \"string type\" \"homogeneous\" \"rgb sigma_a\" [0.1 0.1 0.1] "
+        "\"rgb sigma_s\" [0 0 0]\nMediumInterface \"\" \"fog\"\n"
+        "Camera \"orthographic\" \"float screenwindow\" [-1 1 -1 1]\nWorldBegin\n"
+        "AttributeBegin\nMaterial \"diffuse\" \"rgb reflectance\" [0 0 0]\n"
+        "AreaLightSource \"diffuse\" \"rgb L\" [1 1 1]\n"
+        "Shape \"bilinearmesh\" \"point3 P\" [-5 -5 10  -5 5 10  5 -5 10  5 5 10] "
+        "\"integer indices\" [0 1 2 3]\nAttributeEnd\n"
+        "AttributeBegin\nMaterial \"diffuse\" \"rgb reflectance\" [0 0 0]\n"
+        "Shape \"bilinearmesh\" \"point3 P\" [0 -1 1  1 -1 1  0 1 1  1 1 1] "
+        "\"integer indices\" [0 1 2 3] \"float alpha\" 0.5\nAttributeEnd\n";
+    RayesImage *img = render_read(io_pbrt_parse, text, 1);
+    CHECK(img != NULL);
+    if (img) {
+        const float *beside = &img->rgba[4 * (SIZE / 2 * SIZE + SIZE / 4)];
+        const float *through = &img->rgba[4 * (SIZE / 2 * SIZE + 3 * SIZE / 4)];
+        printf("  fog beside a half-transparent pane %.4f (exp(-1.1) %.4f), through it %.4f "
+               "(%.4f)\n",
+               beside[0], expf(-1.1f), through[0], 0.5f * expf(-1.1f));
+        CHECK(fabsf(beside[0] - expf(-1.1f)) < 2e-3f);
+        CHECK(fabsf(through[0] - 0.5f * expf(-1.1f)) < 2e-3f);
+    }
+    rayes_image_free(img);
+}
+
 TEST_MAIN(TEST(test_constant_alpha), TEST(test_texture_alpha), TEST(test_rib_round_trip),
           TEST(test_bad_alpha), TEST(test_displacement_is_bump), TEST(test_medium_inside_glass),
-          TEST(test_medium_inside_interface), TEST(test_medium_in_glass_shadow))
+          TEST(test_medium_inside_interface), TEST(test_medium_in_glass_shadow),
+          TEST(test_fog_behind_transparent))
