@@ -181,6 +181,8 @@ static int send_state(Parser *P, const Token *t, const double m[16], const Mater
         return -1;
     if (strcmp(mat->shader, PBRT_INVISIBLE) != 0)
         return send_material(P, t, mat);
+    if (P->shape_hidden)
+        return 0; /* the shape's next piece (a bilinear mesh's patch): the same object */
     RayesError e = P->sink->set_visibility(P->sink->target, 0);
     if (e == RAYES_OK)
         e = P->sink->set_shader(P->sink->target, "matte", NULL, 0);

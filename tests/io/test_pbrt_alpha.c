@@ -349,6 +349,31 @@ static void test_medium_inside_interface(void)
         CHECK(fabsf(beside[0] - 1.0f) < 1e-3f);
     }
     rayes_image_free(img);
+
+    /* a unit cube of six bilinear patches in one Shape (each patch sent on
+     * its own: they must make one bound), turned 30 degrees about y and 20
+     * about x: the axis ray's chord is 1 / max |d| in the cube's frame,
+     * 1.2288 */
+    const char *patches =
+        "LookAt 0 0 -5  0 0 0  0 1 0\n"
+        "Camera \"orthographic\" \"float screenwindow\" [-1 1 -1 1]\n"
+        "WorldBegin\nLightSource \"infinite\" \"rgb L\" [1 1 1]\n"
+        "MakeNamedMedium \"absorb\" \"string type\" \"homogeneous\" \"rgb sigma_a\" "
+        "[0.5 0.5 0.5] \"rgb sigma_s\" [0 0 0]\n"
+        "AttributeBegin\nRotate 30 0 1 0\nRotate 20 1 0 0\nMaterial \"interface\"\n"
+        "MediumInterface \"absorb\" \"\"\n"
+        "Shape \"bilinearmesh\" \"point3 P\" [-.5 -.5 -.5 .5 -.5 -.5 -.5 .5 -.5 .5 .5 -.5 "
+        "-.5 -.5 .5 .5 -.5 .5 -.5 .5 .5 .5 .5 .5] \"integer indices\" [0 2 1 3 4 5 6 7 0 4 2 6 "
+        "1 3 5 7 0 1 4 5 2 6 3 7]\nAttributeEnd\n";
+    img = render_read(io_pbrt_parse, patches, 1);
+    CHECK(img != NULL);
+    if (img) {
+        const float *mid = &img->rgba[4 * (SIZE / 2 * SIZE + SIZE / 2)];
+        printf("  medium in an interface cube of patches: through %.4f (exp(-0.6144) %.4f)\n",
+               mid[0], expf(-0.6144f));
+        CHECK(fabsf(mid[0] - expf(-0.6144f)) < 2e-3f);
+    }
+    rayes_image_free(img);
 }
 
 /* Glass lets shadow rays through (its thin shadow, (1 - R0)^2 for a
