@@ -470,9 +470,10 @@ Vec3 volume_transmittance(Worker *w, const Ray *ray, RayDiff diff)
             w->stats.rays_transmission++;
         const RenderObject *obj = &w->rs->objects[v->object];
         Vec3 tau = v3(0, 0, 0);
+        float jitter = ray_jitter(ray);
         for (int s = 0; s < n_seg; s++) {
-            March m = march(w, v, ray, seg[s][0], seg[s][1], ray_jitter(ray),
-                            v->uniform ? 1 : VOLUME_MAX_STEPS);
+            March m =
+                march(w, v, ray, seg[s][0], seg[s][1], jitter, v->uniform ? 1 : VOLUME_MAX_STEPS);
             if (w->set->opacity_cache && obj->opacity_cached) {
                 tau = v3_add(tau, optical_depth_cached(w, v, ray, diff, &m));
             } else {

@@ -330,6 +330,14 @@ static int session_hidden_bound(const RayesScene *scene, int64_t o)
                                           RAYES_RAY_SPECULAR | RAYES_RAY_TRANSMISSION)) == 0;
 }
 
+/* Whether shadow rays cross object o, which bounds a volume (hidden, or
+ * letting them through): the volume's segments inside it are then found
+ * from its crossings, in a scene of its own (volume.c). */
+static int session_crossed_bound(const RayesScene *scene, const RenderObject *ro, int64_t o)
+{
+    return session_hidden_bound(scene, o) || ro[o].transparent;
+}
+
 /* Ray masks; shadow rays pass through transparent objects (accel.h); subsurface
  * objects and mesh lights' emitters have scenes of their own. */
 static uint32_t *object_masks(const RayesScene *scene, const RenderObject *ro)
@@ -344,13 +352,9 @@ static uint32_t *object_masks(const RayesScene *scene, const RenderObject *ro)
                      (ro[i].light >= 0 && scene->lights[ro[i].light].type == LIGHT_MESH)
                  ? ACCEL_MASK_OWN_SCENE
                  : 0u);
-    /* the surfaces bounding volumes that rays cross (hidden ones, and ones
-     * shadow rays pass through): their crossings are found in a scene of
-     * their own (volume.c) */
     for (size_t i = 0; i < scene->n_volumes; i++) {
         int64_t o = scene->volumes[i].inside;
-        if (o >= 0 && (size_t)o < scene->n_objects &&
-            (session_hidden_bound(scene, o) || ro[o].transparent))
+        if (o >= 0 && (size_t)o < scene->n_objects && session_crossed_bound(scene, ro, o))
             m[o] |= ACCEL_MASK_OWN_SCENE;
     }
     return m;
@@ -401,8 +405,7 @@ static int prepare_volumes(const RayesScene *scene, const RenderSettings *set, P
         v->uniform = volume_uniform(&p->objects[sv->object]);
         v->inside = sv->inside;
         v->hidden_bound = sv->inside >= 0 && session_hidden_bound(scene, sv->inside);
-        v->shadow_crosses =
-            v->hidden_bound || (sv->inside >= 0 && p->objects[sv->inside].transparent);
+        v->shadow_crosses = sv->inside >= 0 && session_crossed_bound(scene, p->objects, sv->inside);
         base += bricks;
         p->n_volumes++;
     }

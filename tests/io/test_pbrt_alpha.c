@@ -283,6 +283,33 @@ static void test_medium_inside_glass(void)
     rayes_image_free(img);
 }
 
+/* Renders a pbrt scene as render_read does and copies n of its pixels
+ * (x, y) into out; 0 if it did not render. */
+static int render_pixels(const char *text, const int (*xy)[2], int n, float (*out)[3])
+{
+    RayesImage *img = render_read(io_pbrt_parse, text, 1);
+    CHECK(img != NULL);
+    if (!img)
+        return 0;
+    for (int k = 0; k < n; k++)
+        memcpy(out[k], &img->rgba[4 * (xy[k][1] * SIZE + xy[k][0])], sizeof out[k]);
+    rayes_image_free(img);
+    return 1;
+}
+
+/* The pixel in the middle of the image. */
+static const int MIDDLE[1][2] = {{SIZE / 2, SIZE / 2}};
+
+/* An absorbing medium (sigma_a 0.5), and an orthographic view along +z
+ * over [-1, 1]^2 under a white sky. */
+#define ABSORB                                                                                     \
+    "MakeNamedMedium \"absorb\" \"string type\" \"homogeneous\" \"rgb sigma_a\" "                  \
+    "[0.5 0.5 0.5] \"rgb sigma_s\" [0 0 0]\n"
+#define AXIS_VIEW                                                                                  \
+    "LookAt 0 0 -5  0 0 0  0 1 0\n"                                                                \
+    "Camera \"orthographic\" \"float screenwindow\" [-1 1 -1 1]\n"                                 \
+    "WorldBegin\nLightSource \"infinite\" \"rgb L\" [1 1 1]\n" ABSORB
+
 /* pbrt's "interface" shapes (no surface) bound their media: rays meet
  * the medium between their crossings of the shape, not in its bounding box.
  * An absorbing sphere of radius 1 (sigma_a 0.5) seen along its axis, over
@@ -297,9 +324,7 @@ static void test_medium_inside_interface(void)
         "LookAt 0 5 0  0 0 0  0 0 1\n"
         "Camera \"orthographic\" \"float screenwindow\" [-1.5 1.5 -1.5 1.5]\n"
         "WorldBegin\nLightSource \"distant\" \"point3 from\" [0 10 0] \"point3 to\" [0 0 0] "
-        "\"rgb L\" [3.14159265 3.14159265 3.14159265]\n"
-        "MakeNamedMedium \"absorb\" \"string type\" \"homogeneous\" \"rgb sigma_a\" "
-        "[0.5 0.5 0.5] \"rgb sigma_s\" [0 0 0]\n"
+        "\"rgb L\" [3.14159265 3.14159265 3.14159265]\n" ABSORB
         "AttributeBegin\nTranslate 0 2 0\nMaterial \"interface\"\n"
         "MediumInterface \"absorb\" \"\"\nShape \"sphere\" \"float radius\" [1]\nAttributeEnd\n"
         "AttributeBegin\nMaterial \"diffuse\" \"rgb reflectance\" [1 1 1]\n"
@@ -326,54 +351,37 @@ static void test_medium_inside_interface(void)
     rayes_image_free(img);
 
     const char *cubes =
-        "LookAt 0 0 -5  0 0 0  0 1 0\n"
-        "Camera \"orthographic\" \"float screenwindow\" [-1 1 -1 1]\n"
-        "WorldBegin\nLightSource \"infinite\" \"rgb L\" [1 1 1]\n"
-        "MakeNamedMedium \"absorb\" \"string type\" \"homogeneous\" \"rgb sigma_a\" "
-        "[0.5 0.5 0.5] \"rgb sigma_s\" [0 0 0]\n"
-        "AttributeBegin\nMaterial \"interface\"\nMediumInterface \"absorb\" \"\"\n"
-        "Shape \"trianglemesh\" \"point3 P\" ["
-        "-.5 -.5 -1 .5 -.5 -1 -.5 .5 -1 .5 .5 -1 -.5 -.5 -.5 .5 -.5 -.5 -.5 .5 -.5 .5 .5 -.5 "
-        "-.5 -.5 .2 .5 -.5 .2 -.5 .5 .2 .5 .5 .2 -.5 -.5 1 .5 -.5 1 -.5 .5 1 .5 .5 1] "
-        "\"integer indices\" [0 2 1 1 2 3 4 5 6 5 7 6 0 4 2 2 4 6 1 3 5 3 7 5 0 1 4 1 5 4 2 6 3 "
-        "3 6 7 8 10 9 9 10 11 12 13 14 13 15 14 8 12 10 10 12 14 9 11 13 11 15 13 8 9 12 9 13 "
-        "12 10 14 11 11 14 15]\nAttributeEnd\n";
-    img = render_read(io_pbrt_parse, cubes, 1);
-    CHECK(img != NULL);
-    if (img) {
-        const float *mid = &img->rgba[4 * (SIZE / 2 * SIZE + SIZE / 2)];
-        const float *beside = &img->rgba[4 * (1 * SIZE + 1)];
+        AXIS_VIEW "AttributeBegin\nMaterial \"interface\"\nMediumInterface \"absorb\" \"\"\n"
+                  "Shape \"trianglemesh\" \"point3 P\" ["
+                  "-.5 -.5 -1 .5 -.5 -1 -.5 .5 -1 .5 .5 -1 -.5 -.5 -.5 .5 -.5 -.5 -.5 .5 -.5 .5 .5 "
+                  "-.5 -.5 -.5 .2 .5 -.5 .2 -.5 .5 .2 .5 .5 .2 -.5 -.5 1 .5 -.5 1 -.5 .5 1 .5 .5 "
+                  "1] \"integer indices\" [0 2 1 1 2 3 4 5 6 5 7 6 0 4 2 2 4 6 1 3 5 3 7 5 0 1 4 "
+                  "1 5 4 2 6 3 3 6 7 8 10 9 9 10 11 12 13 14 13 15 14 8 12 10 10 12 14 9 11 13 "
+                  "11 15 13 8 9 12 9 13 12 10 14 11 11 14 15]\nAttributeEnd\n";
+    const int at[2][2] = {{SIZE / 2, SIZE / 2}, {1, 1}};
+    float px[2][3];
+    if (render_pixels(cubes, at, 2, px)) {
         printf("  medium in two interface cubes: through %.4f (exp(-0.65) %.4f), beside %.4f\n",
-               mid[0], expf(-0.65f), beside[0]);
-        CHECK(fabsf(mid[0] - expf(-0.65f)) < 2e-3f);
-        CHECK(fabsf(beside[0] - 1.0f) < 1e-3f);
+               px[0][0], expf(-0.65f), px[1][0]);
+        CHECK(fabsf(px[0][0] - expf(-0.65f)) < 2e-3f);
+        CHECK(fabsf(px[1][0] - 1.0f) < 1e-3f);
     }
-    rayes_image_free(img);
 
     /* a unit cube of six bilinear patches in one Shape (each patch sent on
      * its own: they must make one bound), turned 30 degrees about y and 20
      * about x: the axis ray's chord is 1 / max |d| in the cube's frame,
      * 1.2288 */
     const char *patches =
-        "LookAt 0 0 -5  0 0 0  0 1 0\n"
-        "Camera \"orthographic\" \"float screenwindow\" [-1 1 -1 1]\n"
-        "WorldBegin\nLightSource \"infinite\" \"rgb L\" [1 1 1]\n"
-        "MakeNamedMedium \"absorb\" \"string type\" \"homogeneous\" \"rgb sigma_a\" "
-        "[0.5 0.5 0.5] \"rgb sigma_s\" [0 0 0]\n"
-        "AttributeBegin\nRotate 30 0 1 0\nRotate 20 1 0 0\nMaterial \"interface\"\n"
-        "MediumInterface \"absorb\" \"\"\n"
-        "Shape \"bilinearmesh\" \"point3 P\" [-.5 -.5 -.5 .5 -.5 -.5 -.5 .5 -.5 .5 .5 -.5 "
-        "-.5 -.5 .5 .5 -.5 .5 -.5 .5 .5 .5 .5 .5] \"integer indices\" [0 2 1 3 4 5 6 7 0 4 2 6 "
-        "1 3 5 7 0 1 4 5 2 6 3 7]\nAttributeEnd\n";
-    img = render_read(io_pbrt_parse, patches, 1);
-    CHECK(img != NULL);
-    if (img) {
-        const float *mid = &img->rgba[4 * (SIZE / 2 * SIZE + SIZE / 2)];
+        AXIS_VIEW "AttributeBegin\nRotate 30 0 1 0\nRotate 20 1 0 0\nMaterial \"interface\"\n"
+                  "MediumInterface \"absorb\" \"\"\n"
+                  "Shape \"bilinearmesh\" \"point3 P\" [-.5 -.5 -.5 .5 -.5 -.5 -.5 .5 -.5 .5 .5 "
+                  "-.5 -.5 -.5 .5 .5 -.5 .5 -.5 .5 .5 .5 .5 .5] \"integer indices\" [0 2 1 3 4 5 "
+                  "6 7 0 4 2 6 1 3 5 7 0 1 4 5 2 6 3 7]\nAttributeEnd\n";
+    if (render_pixels(patches, MIDDLE, 1, px)) {
         printf("  medium in an interface cube of patches: through %.4f (exp(-0.6144) %.4f)\n",
-               mid[0], expf(-0.6144f));
-        CHECK(fabsf(mid[0] - expf(-0.6144f)) < 2e-3f);
+               px[0][0], expf(-0.6144f));
+        CHECK(fabsf(px[0][0] - expf(-0.6144f)) < 2e-3f);
     }
-    rayes_image_free(img);
 }
 
 /* Glass lets shadow rays through (its thin shadow, (1 - R0)^2 for a
@@ -396,17 +404,14 @@ static void test_medium_in_glass_shadow(void)
         "AttributeBegin\nMaterial \"diffuse\" \"rgb reflectance\" [1 1 1]\n"
         "Shape \"bilinearmesh\" \"point3 P\" [-4 0 -2  0 0 -2  -4 0 2  0 0 2] "
         "\"integer indices\" [0 1 2 3]\nAttributeEnd\n";
-    RayesImage *img = render_read(io_pbrt_parse, text, 1);
-    CHECK(img != NULL);
-    if (img) {
-        const float *mid = &img->rgba[4 * (SIZE / 2 * SIZE + SIZE / 2)];
+    float mid[1][3];
+    if (render_pixels(text, MIDDLE, 1, mid)) {
         float red = 0.9216f * expf(-0.2f), green = 0.9216f * expf(-4.0f);
-        printf("  shadow of wine in glass: %.4f %.4f %.4f (expected %.4f %.4f %.4f)\n", mid[0],
-               mid[1], mid[2], red, green, green);
-        CHECK(fabsf(mid[0] - red) < 0.01f);
-        CHECK(fabsf(mid[1] - green) < 0.003f && fabsf(mid[2] - green) < 0.003f);
+        printf("  shadow of wine in glass: %.4f %.4f %.4f (expected %.4f %.4f %.4f)\n", mid[0][0],
+               mid[0][1], mid[0][2], red, green, green);
+        CHECK(fabsf(mid[0][0] - red) < 0.01f);
+        CHECK(fabsf(mid[0][1] - green) < 0.003f && fabsf(mid[0][2] - green) < 0.003f);
     }
-    rayes_image_free(img);
 }
 
 /* A fog the camera is in, seen through a half-transparent black pane
@@ -427,18 +432,15 @@ static void test_fog_behind_transparent(void)
         "AttributeBegin\nMaterial \"diffuse\" \"rgb reflectance\" [0 0 0]\n"
         "Shape \"bilinearmesh\" \"point3 P\" [0 -1 1  1 -1 1  0 1 1  1 1 1] "
         "\"integer indices\" [0 1 2 3] \"float alpha\" 0.5\nAttributeEnd\n";
-    RayesImage *img = render_read(io_pbrt_parse, text, 1);
-    CHECK(img != NULL);
-    if (img) {
-        const float *beside = &img->rgba[4 * (SIZE / 2 * SIZE + SIZE / 4)];
-        const float *through = &img->rgba[4 * (SIZE / 2 * SIZE + 3 * SIZE / 4)];
+    const int at[2][2] = {{SIZE / 4, SIZE / 2}, {3 * SIZE / 4, SIZE / 2}};
+    float px[2][3];
+    if (render_pixels(text, at, 2, px)) {
         printf("  fog beside a half-transparent pane %.4f (exp(-1.1) %.4f), through it %.4f "
                "(%.4f)\n",
-               beside[0], expf(-1.1f), through[0], 0.5f * expf(-1.1f));
-        CHECK(fabsf(beside[0] - expf(-1.1f)) < 2e-3f);
-        CHECK(fabsf(through[0] - 0.5f * expf(-1.1f)) < 2e-3f);
+               px[0][0], expf(-1.1f), px[1][0], 0.5f * expf(-1.1f));
+        CHECK(fabsf(px[0][0] - expf(-1.1f)) < 2e-3f);
+        CHECK(fabsf(px[1][0] - 0.5f * expf(-1.1f)) < 2e-3f);
     }
-    rayes_image_free(img);
 }
 
 TEST_MAIN(TEST(test_constant_alpha), TEST(test_texture_alpha), TEST(test_rib_round_trip),
