@@ -571,12 +571,13 @@ RAYES_API RayesError rayes_scene_volume(RayesScene *scene, const float bound[6])
 /* The same medium, only inside the closed surface of the geometry added
  * last (its object): a ray's segment counts only where the ray leaves
  * that surface through its back, as after entering it (glass holding a
- * coloured liquid, pbrt-v4's MediumInterface inside a shape); shadow rays
- * cross it only where the surface lets them through (a glass's thin
- * shadow, tinted by the liquid). Geometry seen by no ray
- * (rayes_scene_set_visibility(scene, 0): pbrt's "interface" shapes) only
+ * coloured liquid); shadow rays cross it only where the surface lets them
+ * through (a glass's thin shadow, tinted by the liquid). Geometry seen by
+ * no ray (rayes_scene_set_visibility(scene, 0): how the pbrt reader sends
+ * the shapes a MediumInterface names a medium on, docs/pbrt.md) only
  * bounds the medium: every ray, shadow rays too, is in it between its
- * crossings of that surface. The box still bounds the march.
+ * crossings of that surface, entering it against the surface's normals.
+ * The box still bounds the march.
  * INVALID_ARGUMENT without geometry before it. */
 RAYES_API RayesError rayes_scene_volume_inside(RayesScene *scene, const float bound[6]);
 

@@ -493,6 +493,8 @@ static int parse_buffer(Parser *P, const char *name, const char *dir, const char
             break;
     }
     if (r == 0 && P->depth == 1 && P->world) /* the top file's end: its lexer names it */
+        r = pbrt_media_send(P);
+    if (r == 0 && P->depth == 1 && P->world)
         r = pbrt_medium_camera(P);
     P->depth--;
     P->lx = saved; /* an error's message, written already, names the innermost file */
@@ -512,18 +514,8 @@ static void parser_free(Parser *P)
         free(lx->text);
         free(lx);
     }
-    for (size_t i = 0; i < P->n_objects; i++) {
-        for (size_t k = 0; k < P->objects[i].n_ops; k++) {
-            Op *op = &P->objects[i].ops[k];
-            free(op->mat);
-            free(op->n_verts);
-            free(op->idx);
-            free(op->pts);
-            free(op->N);
-            free(op->uv);
-        }
-        free(P->objects[i].ops);
-    }
+    for (size_t i = 0; i < P->n_objects; i++)
+        pbrt_object_free(&P->objects[i]);
     free(P->objects);
     free(P->stack);
     free(P->coordsys);

@@ -444,6 +444,29 @@ static int send_instance(Parser *P, const Token *t, Object *o)
     return e != RAYES_OK ? pbrt_sink_failed(P, t, e) : 0;
 }
 
+void pbrt_object_free(Object *o)
+{
+    for (size_t k = 0; k < o->n_ops; k++) {
+        Op *op = &o->ops[k];
+        free(op->mat);
+        free(op->n_verts);
+        free(op->idx);
+        free(op->pts);
+        free(op->N);
+        free(op->uv);
+    }
+    free(o->ops);
+    o->ops = NULL;
+    o->n_ops = o->cap_ops = 0;
+}
+
+int pbrt_emit_bound(Parser *P, const Token *t, const Object *o)
+{
+    static const double identity[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
+    P->shape_hidden = 0; /* the first shape makes the hidden object, the rest join it */
+    return send_ops(P, t, o, identity);
+}
+
 int pbrt_replay(Parser *P, const Token *t, Object *o)
 {
     if (P->sink->object_begin && P->sink->object_end && P->sink->object_instance)

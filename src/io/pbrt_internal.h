@@ -150,25 +150,6 @@ typedef struct Texture {
     int is_float;      /* a "float" texture (else "spectrum") */
 } Texture;
 
-/* A named medium (MakeNamedMedium): the homogeneous shader's parameters
- * and, for grids, the density pattern, sent with the first shape that
- * bounds it. */
-typedef struct Medium {
-    char name[128];
-    char type[16];       /* "homogeneous", "uniformgrid" or "nanovdb" */
-    double m[16];        /* world_from_medium: the transform at MakeNamedMedium */
-    float extinction[3]; /* (sigma_a + sigma_s) scale */
-    float albedo[3];     /* sigma_s / (sigma_a + sigma_s) */
-    float emission[3];   /* sigma_a scale Le Lescale */
-    float g;
-    size_t res[3];            /* uniformgrid: nx ny nz */
-    float *density;           /* uniformgrid: nx ny nz values, owned */
-    float p0[3], p1[3];       /* uniformgrid: the grid's box, medium space */
-    char filename[PBRT_PATH]; /* nanovdb: resolved */
-    char pattern[160];        /* the sink's pattern of the density once sent, else "" */
-    int sent;                 /* the pattern was sent */
-} Medium;
-
 typedef enum OpKind { OP_MESH, OP_QUADRIC, OP_PATCH } OpKind;
 
 typedef struct Op {
@@ -196,6 +177,31 @@ typedef struct Object {
     size_t n_ops, cap_ops;
 } Object;
 
+/* A named medium (MakeNamedMedium): the homogeneous shader's parameters
+ * and, for grids, the density pattern; and the shapes that bound it
+ * (MediumInterface), recorded to be sent at the end of the file as one
+ * hidden object, the medium's volume inside it (pbrt_media_send). */
+typedef struct Medium {
+    char name[128];
+    char type[16];       /* "homogeneous", "uniformgrid" or "nanovdb" */
+    double m[16];        /* world_from_medium: the transform at MakeNamedMedium */
+    float extinction[3]; /* (sigma_a + sigma_s) scale */
+    float albedo[3];     /* sigma_s / (sigma_a + sigma_s) */
+    float emission[3];   /* sigma_a scale Le Lescale */
+    float g;
+    size_t res[3];            /* uniformgrid: nx ny nz */
+    float *density;           /* uniformgrid: nx ny nz values, owned */
+    float p0[3], p1[3];       /* uniformgrid: the grid's box, medium space */
+    char filename[PBRT_PATH]; /* nanovdb: resolved */
+    char pattern[160];        /* the sink's pattern of the density once sent, else "" */
+    int sent;                 /* the pattern was sent */
+    Object bound;             /* the shapes with the medium on a side, hidden, each turned so
+                                 that the medium lies behind its normals */
+    float box[6];             /* their bounds, world space (xmin, xmax, ymin, ...) */
+    int have_box;             /* box holds a point */
+    int line, col;            /* where the first of them was read */
+} Medium;
+
 typedef struct Parser {
     const IoSink *sink;
     const IoReadOptions *options;
@@ -222,9 +228,9 @@ typedef struct Parser {
     size_t n_media;
     float shape_bound[6]; /* object-space bounds of the Shape being read (x0 x1 y0 y1 z0 z1) */
     int have_shape_bound;
-    int shape_bounds;     /* the Shape being read is an "interface" one that bounds its medium
-                             (pbrt_medium_hidden_bound): it is sent, seen by no ray */
-    int shape_hidden;     /* and it was sent so */
+    int shape_bounds;     /* the Shape being read is recorded into a medium's bound (an
+                             "interface" one too: pbrt_medium_bounded) */
+    int shape_hidden;     /* a bound's shapes are being sent, seen by no ray */
     float world_bound[6]; /* world-space bounds of every Shape outside ObjectBegin so far */
     int have_world_bound;
     char camera_medium[128]; /* the outside medium current at Camera, "" for none */
@@ -377,6 +383,8 @@ int pbrt_emit_pattern_in(Parser *P, const Token *t, const double m[16], const ch
  * the volume method. */
 int pbrt_emit_volume(Parser *P, const Token *t, const double m[16], const RayesParam *params,
                      size_t n, const float bound[6], int inside);
+/* Frees o's Ops. */
+void pbrt_object_free(Object *o);
 /* Sends the recorded object o under the current transform. */
 int pbrt_replay(Parser *P, const Token *t, Object *o);
 
@@ -413,15 +421,22 @@ void pbrt_area_power(Parser *P, size_t n_prims, double area);
 int pbrt_d_light(Parser *P, const Token *t);
 int pbrt_d_makenamedmedium(Parser *P, const Token *t); /* pbrt_medium.c */
 int pbrt_d_mediuminterface(Parser *P, const Token *t);
-/* After a Shape: the volume of its inside medium, if it has one, over
- * P->shape_bound (pbrt_emit_* grow it), only inside the shape when it
- * was sent (a surface, or an "interface" shape sent hidden). */
+/* After a Shape: checks its MediumInterface's media (defined, and
+ * renderable here, else a warning) and grows the camera medium's bounds. */
 int pbrt_medium_shape(Parser *P, const Token *t);
-/* Whether the current "interface" shape bounds a medium of its own that
- * the sink can make: it is then sent seen by no ray, so that its medium
- * fills the shape and not its whole box. */
-int pbrt_medium_hidden_bound(Parser *P);
-/* After a Shape sent hidden and its medium: what follows is seen again
+/* The medium on one side of the Shape being read (side 0 its inside,
+ * behind its normals; 1 its outside) that the shape bounds, or NULL: none,
+ * the same on both sides, the camera's, or not renderable here. */
+Medium *pbrt_medium_bounded(Parser *P, int side);
+/* Grows md's box by the Shape just recorded into its bound. */
+void pbrt_medium_grow(Parser *P, Medium *md, const Token *t);
+/* At the end of the file: each medium's bound, seen by no ray, and its
+ * volume inside it (rayes_scene_volume_inside). */
+int pbrt_media_send(Parser *P);
+/* Sends a medium's bound: its shapes as one object seen by no ray
+ * (pbrt_emit.c). */
+int pbrt_emit_bound(Parser *P, const Token *t, const Object *o);
+/* After a medium's bound (sent hidden) and its volume: what follows is seen again
  * (pbrt_emit.c). */
 int pbrt_shown_again(Parser *P, const Token *t);
 /* At the end of the file: the camera's medium, if any, as a volume over

@@ -1,9 +1,9 @@
 /*
  * io/pbrt_medium.c — pbrt-v4's participating media (pbrt_internal.h):
  * MakeNamedMedium of type "homogeneous", "uniformgrid" and "nanovdb",
- * MediumInterface, and the rayes volume (rayes_scene_volume with the
- * built-in "homogeneous" shader) that a shape with an inside medium
- * bounds. docs/pbrt.md lists the mapping:
+ * MediumInterface, and the rayes volumes (rayes_scene_volume_inside with
+ * the built-in "homogeneous" shader) that the shapes naming a medium
+ * bound. docs/pbrt.md lists the mapping:
  *
  *   extinction = (sigma_a + sigma_s) scale, albedo = sigma_s / (sigma_a +
  *   sigma_s), g = g, emission = sigma_a scale Le Lescale (pbrt's source
@@ -11,14 +11,20 @@
  *   (uniformgrid, its p0 p1 in the medium's space) or a "nanovdb" pattern
  *   (the file's "density" grid, its world space the medium's space).
  *
- * The volume's box is the shape's object-space bounds (the emitted
- * primitives grow P->shape_bound), except for a uniformgrid, whose box
- * is p0..p1 in the medium's space, where its density is. rayes' volumes
- * are boxes: a medium inside a sphere fills the sphere's bounding box.
- * The camera's medium (the outside medium current at Camera) fills a box
- * around every shape outside ObjectBegin and the camera, made at the end of
- * the file; a shape whose outside medium is the camera's is in it. Other
- * media outside shapes are skipped with one warning.
+ * A shape with a different medium on each side (MediumInterface) bounds
+ * both: it is recorded (pbrt_shape.c, bound_media) into each medium's
+ * bound, turned so that the medium lies behind its normals, and at the
+ * end of the file each bound is sent as one object seen by no ray, then
+ * the medium's volume inside it (rayes_scene_volume_inside): a liquid
+ * closed by its flat top (medium inside) and the glass's wall (medium
+ * outside) fills what they close. The march's box is the scene's bounds
+ * for a homogeneous medium (where the shapes leave it open, a ray stays in
+ * it, as pbrt's ray stays in its medium to the next interface), the
+ * shapes' for a nanovdb one and p0..p1 in the medium's space for a
+ * uniformgrid, where its density is. The camera's medium (the outside
+ * medium current at Camera) fills a box around every shape outside
+ * ObjectBegin and the camera, made at the end of the file; a shape whose
+ * outside medium is the camera's is in it.
  */
 #include <math.h>
 #include <stdio.h>
@@ -207,89 +213,110 @@ static int send_density(Parser *P, const Token *t, Medium *md)
     return pbrt_emit_pattern_in(P, t, md->m, md->pattern, "nanovdb", q, 1);
 }
 
-/* Grows P->world_bound by the shape just read (its bounds' corners under
- * the CTM); shapes inside ObjectBegin are placed by their instances and
- * are not counted. */
-static void grow_world_bound(Parser *P)
+/* Grows box (world space; *have: it holds a point) by the Shape just read
+ * (its bounds' corners under the CTM). */
+static void grow_box(const Parser *P, float *box, int *have)
 {
-    if (!P->have_shape_bound || P->recording)
-        return;
     const double *m = P->gs.ctm;
     const float *b = P->shape_bound;
-    float *w = P->world_bound;
     for (int c = 0; c < 8; c++) {
         double p[3] = {b[c & 1], b[2 + (c >> 1 & 1)], b[4 + (c >> 2)]};
         for (int k = 0; k < 3; k++) {
             float v = (float)(m[4 * k] * p[0] + m[4 * k + 1] * p[1] + m[4 * k + 2] * p[2] +
                               m[4 * k + 3]);
-            if (!P->have_world_bound || v < w[2 * k])
-                w[2 * k] = v;
-            if (!P->have_world_bound || v > w[2 * k + 1])
-                w[2 * k + 1] = v;
+            if (!*have || v < box[2 * k])
+                box[2 * k] = v;
+            if (!*have || v > box[2 * k + 1])
+                box[2 * k + 1] = v;
         }
-        P->have_world_bound = 1;
+        *have = 1;
     }
-}
-
-int pbrt_medium_hidden_bound(Parser *P)
-{
-    const char *in = P->gs.inside, *out = P->gs.outside;
-    if (strcmp(P->gs.material.shader, PBRT_INVISIBLE) != 0 || !in[0] || strcmp(in, out) == 0 ||
-        P->recording || !P->sink->volume || !P->sink->pattern || !P->sink->volume_inside ||
-        !P->sink->set_visibility)
-        return 0;
-    const Medium *md = find_medium(P, in);
-    return md && strcmp(md->type, "none") != 0;
 }
 
 int pbrt_medium_shape(Parser *P, const Token *t)
 {
-    const char *in = P->gs.inside, *out = P->gs.outside;
-    grow_world_bound(P);
-    if (out[0] && strcmp(in, out) != 0 && strcmp(out, P->camera_medium) != 0)
-        pbrt_warn_at(P, t->line, t->col, "outside medium",
-                     "MediumInterface: the medium outside a shape (\"%.60s\") is not rendered; "
-                     "rayes fills only the inside of shapes",
-                     out);
-    if (!in[0] || strcmp(in, out) == 0)
-        return 0;
-    Medium *md = find_medium(P, in);
-    if (!md)
-        return FAIL_TOK(P, t,
-                        "MediumInterface names the medium \"%.60s\", which no "
-                        "MakeNamedMedium defined",
-                        in);
-    if (strcmp(md->type, "none") == 0)
-        return 0;
-    const char *skip = P->recording                            ? "inside ObjectBegin"
-                       : !P->sink->volume || !P->sink->pattern ? "this output takes no volumes"
-                                                               : NULL;
-    const float *b = P->shape_bound;
-    int uniform = strcmp(md->type, "uniformgrid") == 0;
-    if (!skip && !uniform && (!P->have_shape_bound || !(b[1] > b[0] && b[3] > b[2] && b[5] > b[4])))
-        skip = "the shape is flat";
-    if (skip) {
-        pbrt_warn_at(P, t->line, t->col, skip, "medium \"%.60s\": %s; not rendered", in, skip);
-        return 0;
+    if (P->have_shape_bound && !P->recording) /* shapes inside ObjectBegin: placed by instances */
+        grow_box(P, P->world_bound, &P->have_world_bound);
+    for (int side = 0; side < 2; side++) {
+        const char *name = side ? P->gs.outside : P->gs.inside;
+        if (!name[0] || strcmp(P->gs.inside, P->gs.outside) == 0)
+            continue;
+        const Medium *md = find_medium(P, name);
+        if (!md)
+            return FAIL_TOK(P, t,
+                            "MediumInterface names the medium \"%.60s\", which no "
+                            "MakeNamedMedium defined",
+                            name);
+        const char *skip = P->recording                            ? "inside ObjectBegin"
+                           : !P->sink->volume || !P->sink->pattern ? "this output takes no volumes"
+                           : !P->sink->volume_inside || !P->sink->set_visibility
+                               ? "this output takes no bounded volumes"
+                               : NULL;
+        if (skip && strcmp(md->type, "none") != 0 && strcmp(name, P->camera_medium) != 0)
+            pbrt_warn_at(P, t->line, t->col, skip, "medium \"%.60s\": %s; not rendered", name,
+                         skip);
     }
-    if (send_density(P, t, md) != 0)
-        return -1;
-    RayesParam q[5];
-    size_t n = medium_params(md, q);
-    if (uniform) {
-        const float box[6] = {md->p0[0], md->p1[0], md->p0[1], md->p1[1], md->p0[2], md->p1[2]};
-        return pbrt_emit_volume(P, t, md->m, q, n, box, P->shape_hidden);
+    return 0;
+}
+
+Medium *pbrt_medium_bounded(Parser *P, int side)
+{
+    const char *name = side ? P->gs.outside : P->gs.inside;
+    if (!name[0] || strcmp(P->gs.inside, P->gs.outside) == 0 ||
+        strcmp(name, P->camera_medium) == 0 || P->recording || !P->sink->volume ||
+        !P->sink->pattern || !P->sink->volume_inside || !P->sink->set_visibility)
+        return NULL;
+    Medium *md = find_medium(P, name);
+    return md && strcmp(md->type, "none") != 0 ? md : NULL;
+}
+
+void pbrt_medium_grow(Parser *P, Medium *md, const Token *t)
+{
+    if (!P->have_shape_bound)
+        return;
+    if (!md->have_box)
+        md->line = t->line, md->col = t->col;
+    grow_box(P, md->box, &md->have_box);
+}
+
+int pbrt_media_send(Parser *P)
+{
+    static const double identity[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
+    for (size_t i = 0; i < P->n_media; i++) {
+        Medium *md = &P->media[i];
+        if (!md->bound.n_ops)
+            continue;
+        Token t = {.line = md->line, .col = md->col};
+        if (pbrt_emit_bound(P, &t, &md->bound) != 0 || send_density(P, &t, md) != 0)
+            return -1;
+        RayesParam q[5];
+        size_t n = medium_params(md, q);
+        /* The march's box: a uniformgrid's density is in its box, a
+         * nanovdb's in its shapes'; a homogeneous medium fills the scene's
+         * bounds. The volume is only inside its shapes either way, but
+         * where they leave it open a ray stays in it to the next surface,
+         * as in pbrt (a fog behind a room's front wall fills the room). */
+        int r;
+        if (strcmp(md->type, "uniformgrid") == 0) {
+            const float box[6] = {md->p0[0], md->p1[0], md->p0[1], md->p1[1], md->p0[2], md->p1[2]};
+            r = pbrt_emit_volume(P, &t, md->m, q, n, box, 1);
+        } else {
+            int whole = strcmp(md->type, "homogeneous") == 0 && P->have_world_bound;
+            r = pbrt_emit_volume(P, &t, identity, q, n, whole ? P->world_bound : md->box, 1);
+        }
+        if (r != 0 || pbrt_shown_again(P, &t) != 0)
+            return -1;
+        P->shape_hidden = 0;
     }
-    /* a shape drawn as a surface (glass round a liquid) bounds its medium
-     * itself, and so does an interface one sent hidden; else its box does */
-    int surface = strcmp(P->gs.material.shader, PBRT_INVISIBLE) != 0;
-    return pbrt_emit_volume(P, t, P->gs.ctm, q, n, b, surface || P->shape_hidden);
+    return 0;
 }
 
 void pbrt_media_free(Parser *P)
 {
-    for (size_t i = 0; i < P->n_media; i++)
+    for (size_t i = 0; i < P->n_media; i++) {
         free(P->media[i].density);
+        pbrt_object_free(&P->media[i].bound);
+    }
     free(P->media);
 }
 

@@ -757,6 +757,38 @@ static int shape_of_type(Parser *P, const Token *t, const char *type, ParamList 
     return 1;
 }
 
+/* The Shape (of type and pl) recorded, seen by no ray, into the bound of
+ * the medium on each side of it (MediumInterface), turned so that the
+ * medium lies behind its normals: a liquid in a glass is bounded by its
+ * top (its medium inside) and by the glass's inner wall (its medium
+ * outside), neither closed alone (pbrt_media_send sends them). */
+static int bound_media(Parser *P, const Token *t, const char *type, ParamList *pl)
+{
+    if (P->gs.area.on || strcmp(type, "curve") == 0)
+        return 0; /* an emitter or a curve bounds no medium */
+    for (int side = 0; side < 2; side++) {
+        Medium *md = pbrt_medium_bounded(P, side);
+        if (!md)
+            continue;
+        Material saved = P->gs.material;
+        int reverse = P->gs.reverse;
+        pbrt_mat_init(&P->gs.material, PBRT_INVISIBLE);
+        P->gs.reverse ^= side;
+        P->recording = &md->bound;
+        P->shape_bounds = 1;
+        P->have_shape_bound = 0;
+        int r = shape_of_type(P, t, type, pl);
+        P->recording = NULL;
+        P->shape_bounds = 0;
+        P->gs.reverse = reverse;
+        P->gs.material = saved;
+        if (r < 0)
+            return -1;
+        pbrt_medium_grow(P, md, t);
+    }
+    return 0;
+}
+
 int pbrt_d_shape(Parser *P, const Token *t)
 {
     char type[64];
@@ -769,7 +801,7 @@ int pbrt_d_shape(Parser *P, const Token *t)
         return -1;
     }
     P->have_shape_bound = 0;
-    P->shape_bounds = pbrt_medium_hidden_bound(P);
+    P->shape_bounds = 0;
     P->shape_hidden = 0;
     Material saved = P->gs.material, with_alpha;
     r = shape_alpha(P, t, &pl, &with_alpha);
@@ -784,8 +816,10 @@ int pbrt_d_shape(Parser *P, const Token *t)
     }
     if (!r)
         pbrt_warn_unused(P, &pl, "Shape", type);
-    pbrt_params_free(&pl);
     if (!r)
         r = pbrt_medium_shape(P, t);
-    return r ? r : pbrt_shown_again(P, t);
+    if (!r)
+        r = bound_media(P, t, type, &pl);
+    pbrt_params_free(&pl);
+    return r;
 }
