@@ -199,7 +199,8 @@ typedef struct Medium {
                                  that the medium lies behind its normals */
     float box[6];             /* their bounds, world space (xmin, xmax, ymin, ...) */
     int have_box;             /* box holds a point */
-    int line, col;            /* where the first of them was read */
+    const char *file;         /* where the first of them was read (a lexer's name: the parser's */
+    int line, col;            /* until it is freed) */
 } Medium;
 
 typedef struct Parser {

@@ -272,41 +272,80 @@ Medium *pbrt_medium_bounded(Parser *P, int side)
 
 void pbrt_medium_grow(Parser *P, Medium *md, const Token *t)
 {
-    if (!P->have_shape_bound)
-        return;
-    if (!md->have_box)
-        md->line = t->line, md->col = t->col;
-    grow_box(P, md->box, &md->have_box);
+    if (!md->file)
+        md->file = P->lx->name, md->line = t->line, md->col = t->col;
+    if (P->have_shape_bound)
+        grow_box(P, md->box, &md->have_box);
+}
+
+/* box widened by a thousandth of its diagonal (at least 1e-3) on each
+ * axis: surfaces on its sides are in it, and a flat one (a medium named
+ * by one disk) is a box; 0 if it is not finite. */
+static int padded(const float in[6], float box[6])
+{
+    float diag = 0.0f;
+    for (int k = 0; k < 3; k++)
+        diag += (in[2 * k + 1] - in[2 * k]) * (in[2 * k + 1] - in[2 * k]);
+    float pad = fmaxf(1e-3f * sqrtf(diag), 1e-3f);
+    for (int k = 0; k < 3; k++) {
+        float a = in[2 * k], b = in[2 * k + 1]; /* in may be box */
+        box[2 * k] = a - pad, box[2 * k + 1] = b + pad;
+    }
+    for (int k = 0; k < 6; k++)
+        if (!isfinite(box[k]))
+            return 0;
+    return 1;
+}
+
+/* One medium's bound and its volume. */
+static int send_bounded(Parser *P, Medium *md, const Token *t)
+{
+    static const double identity[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
+    float box[6];
+    int whole = strcmp(md->type, "homogeneous") == 0 && P->have_world_bound;
+    if (!padded(whole ? P->world_bound : md->box, box)) {
+        pbrt_warn_at(P, t->line, t->col, "medium bounds",
+                     "medium \"%.60s\": its shapes' bounds are not finite; not rendered", md->name);
+        return 0;
+    }
+    if (pbrt_emit_bound(P, t, &md->bound) != 0 || send_density(P, t, md) != 0)
+        return -1;
+    RayesParam q[5];
+    size_t n = medium_params(md, q);
+    /* The march's box: a uniformgrid's density is in its box, a nanovdb's
+     * in its shapes'; a homogeneous medium fills the scene's bounds. The
+     * volume is only inside its shapes either way, but a ray that crosses
+     * them into the medium where they leave it open stays in it to its next
+     * surface, as in pbrt (a fog behind a room's front wall). */
+    int r;
+    if (strcmp(md->type, "uniformgrid") == 0) {
+        const float grid[6] = {md->p0[0], md->p1[0], md->p0[1], md->p1[1], md->p0[2], md->p1[2]};
+        r = pbrt_emit_volume(P, t, md->m, q, n, grid, 1);
+    } else {
+        r = pbrt_emit_volume(P, t, identity, q, n, box, 1);
+    }
+    if (r != 0 || pbrt_shown_again(P, t) != 0)
+        return -1;
+    P->shape_hidden = 0;
+    return 0;
 }
 
 int pbrt_media_send(Parser *P)
 {
-    static const double identity[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
+    Lexer *top = P->lx;
     for (size_t i = 0; i < P->n_media; i++) {
         Medium *md = &P->media[i];
         if (!md->bound.n_ops)
             continue;
+        /* messages name the file of the medium's first shape */
+        Lexer at = *top;
+        at.name = md->file ? md->file : top->name;
+        P->lx = &at;
         Token t = {.line = md->line, .col = md->col};
-        if (pbrt_emit_bound(P, &t, &md->bound) != 0 || send_density(P, &t, md) != 0)
+        int r = send_bounded(P, md, &t);
+        P->lx = top;
+        if (r != 0)
             return -1;
-        RayesParam q[5];
-        size_t n = medium_params(md, q);
-        /* The march's box: a uniformgrid's density is in its box, a
-         * nanovdb's in its shapes'; a homogeneous medium fills the scene's
-         * bounds. The volume is only inside its shapes either way, but
-         * where they leave it open a ray stays in it to the next surface,
-         * as in pbrt (a fog behind a room's front wall fills the room). */
-        int r;
-        if (strcmp(md->type, "uniformgrid") == 0) {
-            const float box[6] = {md->p0[0], md->p1[0], md->p0[1], md->p1[1], md->p0[2], md->p1[2]};
-            r = pbrt_emit_volume(P, &t, md->m, q, n, box, 1);
-        } else {
-            int whole = strcmp(md->type, "homogeneous") == 0 && P->have_world_bound;
-            r = pbrt_emit_volume(P, &t, identity, q, n, whole ? P->world_bound : md->box, 1);
-        }
-        if (r != 0 || pbrt_shown_again(P, &t) != 0)
-            return -1;
-        P->shape_hidden = 0;
     }
     return 0;
 }
@@ -349,12 +388,13 @@ int pbrt_medium_camera(Parser *P)
         box[2 * k] = P->have_world_bound ? fminf(P->world_bound[2 * k], eye[k]) : eye[k];
         box[2 * k + 1] = P->have_world_bound ? fmaxf(P->world_bound[2 * k + 1], eye[k]) : eye[k];
     }
-    float diag = 0.0f;
-    for (int k = 0; k < 3; k++)
-        diag += (box[2 * k + 1] - box[2 * k]) * (box[2 * k + 1] - box[2 * k]);
-    float pad = fmaxf(1e-3f * sqrtf(diag), 1e-3f);
-    for (int k = 0; k < 3; k++)
-        box[2 * k] -= pad, box[2 * k + 1] += pad;
+    if (!padded(box, box)) {
+        pbrt_warn_at(P, t.line, t.col, "camera medium bounds",
+                     "the camera's medium \"%.60s\": the scene's bounds are not finite; not "
+                     "rendered",
+                     md->name);
+        return 0;
+    }
     if (send_density(P, &t, md) != 0)
         return -1;
     RayesParam q[5];

@@ -135,6 +135,49 @@ static int pair_quad(const float *pts, const int *a, const int *b, int q[4])
 /* The most quads an emitter makes quad lights of; more, one mesh light. */
 enum { AREA_QUADS = 4 };
 
+/* Whether a face of n corners f (indices into pts) must be wound the other
+ * way for its front to be pbrt's: its object-space winding's normal,
+ * turned toward the sum of its N when given, reversed by
+ * ReverseOrientation and by a transform that swaps handedness. */
+static int face_flips(const Parser *P, int n, const int *f, const float *pts, const float *N)
+{
+    double g[3] = {0, 0, 0}, d[3];
+    for (int k = 1; k + 1 < n; k++) { /* the fan's normals, summed */
+        double u[3], v[3], c[3];
+        sub3d(&pts[3 * f[k]], &pts[3 * f[0]], u);
+        sub3d(&pts[3 * f[k + 1]], &pts[3 * f[0]], v);
+        pbrt_cross3d(u, v, c);
+        for (int j = 0; j < 3; j++)
+            g[j] += c[j];
+    }
+    memcpy(d, g, sizeof d);
+    if (N) {
+        for (int j = 0; j < 3; j++) {
+            d[j] = 0;
+            for (int k = 0; k < n; k++)
+                d[j] += N[3 * f[k] + j];
+        }
+        if (pbrt_dot3d(d, d) == 0)
+            memcpy(d, g, sizeof d);
+    }
+    return ((pbrt_dot3d(g, d) < 0) != P->gs.reverse) != swaps_handedness(P->gs.ctm);
+}
+
+/* Winds every face of a mesh as face_flips says (idx is rewritten). */
+static void orient_faces(const Parser *P, size_t n_faces, const int *n_verts, int *idx,
+                         const float *pts, const float *N)
+{
+    int *f = idx;
+    for (size_t i = 0; i < n_faces; f += n_verts[i], i++) {
+        int flip = face_flips(P, n_verts[i], f, pts, N);
+        for (int k = 1; flip && k < n_verts[i] - k; k++) { /* reverse after the first corner */
+            int tmp = f[k];
+            f[k] = f[n_verts[i] - k];
+            f[n_verts[i] - k] = tmp;
+        }
+    }
+}
+
 /* Emits a mesh's faces as one mesh light: each face wound so that its
  * front is pbrt's (the object-space winding's normal, turned toward the
  * face's N when given, reversed by ReverseOrientation and by a transform
@@ -143,35 +186,7 @@ static int emit_area_mesh(Parser *P, const Token *t, size_t n_faces, const int *
                           size_t n_points, const float *pts, const float *N)
 {
     pbrt_grow_bound(P, pts, n_points); /* emitters count in the world's bound too */
-    int swaps = swaps_handedness(P->gs.ctm);
-    int *f = idx;
-    for (size_t i = 0; i < n_faces; f += n_verts[i], i++) {
-        double g[3] = {0, 0, 0}, d[3];
-        for (int k = 1; k + 1 < n_verts[i]; k++) { /* the fan's normals, summed */
-            double u[3], v[3], c[3];
-            sub3d(&pts[3 * f[k]], &pts[3 * f[0]], u);
-            sub3d(&pts[3 * f[k + 1]], &pts[3 * f[0]], v);
-            pbrt_cross3d(u, v, c);
-            for (int j = 0; j < 3; j++)
-                g[j] += c[j];
-        }
-        memcpy(d, g, sizeof d);
-        if (N) {
-            for (int j = 0; j < 3; j++) {
-                d[j] = 0;
-                for (int k = 0; k < n_verts[i]; k++)
-                    d[j] += N[3 * f[k] + j];
-            }
-            if (pbrt_dot3d(d, d) == 0)
-                memcpy(d, g, sizeof d);
-        }
-        int flip = ((pbrt_dot3d(g, d) < 0) != P->gs.reverse) != swaps;
-        for (int k = 1; flip && k < n_verts[i] - k; k++) { /* reverse after the first corner */
-            int tmp = f[k];
-            f[k] = f[n_verts[i] - k];
-            f[n_verts[i] - k] = tmp;
-        }
-    }
+    orient_faces(P, n_faces, n_verts, idx, pts, N);
     float m[16];
     if (!pbrt_mat_finite(P->gs.ctm))
         return FAIL_TOK(P, t, "the current transform is not finite");
@@ -224,7 +239,11 @@ static int shape_mesh(Parser *P, const Token *t, const char *what, size_t n_face
                 return -1;
         return 0;
     }
-    if (P->gs.reverse != swaps_handedness(P->gs.ctm)) {
+    if (P->shape_bounds) {
+        /* a medium's bound: its sides are pbrt's geometric normal's,
+         * which faces N when given */
+        orient_faces(P, n_faces, n_verts, idx, pts, N);
+    } else if (P->gs.reverse != swaps_handedness(P->gs.ctm)) {
         int *f = idx;
         for (size_t i = 0; i < n_faces; f += n_verts[i], i++) {
             int tmp = f[1];
@@ -431,8 +450,9 @@ static int shape_bilinearmesh(Parser *P, const Token *t, ParamList *pl)
     }
     int flip = P->gs.reverse != swaps_handedness(P->gs.ctm);
     int emits = P->gs.area.on && !P->recording;
-    float *N = emits && np ? points_of(P, t, np) : NULL; /* the quads face as N */
-    if (emits && np && !N) {
+    /* emitting quads face as N, and so do a medium's bound's patches */
+    float *N = (emits || P->shape_bounds) && np ? points_of(P, t, np) : NULL;
+    if ((emits || P->shape_bounds) && np && !N) {
         free(pts);
         return -1;
     }
@@ -447,8 +467,10 @@ static int shape_bilinearmesh(Parser *P, const Token *t, ParamList *pl)
         } else {
             Op patch = {.patch_pv = (np ? 1 : 0) | (uvp ? 2 : 0)};
             static const int order[2][4] = {{0, 1, 2, 3}, {1, 0, 3, 2}};
+            int q[4] = {v[0], v[1], v[3], v[2]}; /* around the patch */
+            int turn = P->shape_bounds && N ? face_flips(P, 4, q, pts, N) : flip;
             for (int k = 0; k < 4; k++) {
-                size_t j = (size_t)v[order[flip][k]];
+                size_t j = (size_t)v[order[turn][k]];
                 memcpy(patch.patch[k], &pts[3 * j], sizeof patch.patch[k]);
                 for (int c = 0; c < 3 && np; c++)
                     patch.patch_N[k][c] = (float)np->num[3 * j + (size_t)c];
@@ -764,15 +786,16 @@ static int shape_of_type(Parser *P, const Token *t, const char *type, ParamList 
  * outside), neither closed alone (pbrt_media_send sends them). */
 static int bound_media(Parser *P, const Token *t, const char *type, ParamList *pl)
 {
-    if (P->gs.area.on || strcmp(type, "curve") == 0)
-        return 0; /* an emitter or a curve bounds no medium */
+    if (strcmp(type, "curve") == 0)
+        return 0; /* a curve has no sides */
     for (int side = 0; side < 2; side++) {
         Medium *md = pbrt_medium_bounded(P, side);
         if (!md)
             continue;
         Material saved = P->gs.material;
-        int reverse = P->gs.reverse;
+        int reverse = P->gs.reverse, area = P->gs.area.on;
         pbrt_mat_init(&P->gs.material, PBRT_INVISIBLE);
+        P->gs.area.on = 0; /* an emitter's copy is only a bound */
         P->gs.reverse ^= side;
         P->recording = &md->bound;
         P->shape_bounds = 1;
@@ -781,6 +804,7 @@ static int bound_media(Parser *P, const Token *t, const char *type, ParamList *p
         P->recording = NULL;
         P->shape_bounds = 0;
         P->gs.reverse = reverse;
+        P->gs.area.on = area;
         P->gs.material = saved;
         if (r < 0)
             return -1;

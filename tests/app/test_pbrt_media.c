@@ -36,7 +36,7 @@ static const char *const box_shape =
 
 static void write_scene(const char *name, const char *media)
 {
-    char text[4096], path[512];
+    char text[20000], path[512];
     snprintf(
         text, sizeof text,
         "LookAt 0 0 6  0 0 0  0 1 0\n"
@@ -255,50 +255,99 @@ static void test_camera_medium(void)
     CHECK(strstr(err_text, "cam-nope.pbrt:3:1: the camera's medium \"nope\"") != NULL);
 }
 
-/* A quad of the slab's boundary under MediumInterface in out, corners
- * p[0..3] counter-clockwise seen from the side its normal points to. */
-static void piece(char *buf, size_t size, const char *in, const char *out, const char *p,
-                  int reverse)
+/* Face f (0 to 5: axis f / 2, its low side for even f) of the box
+ * [lo, hi] as a pbrt quad naming the medium "slab" on the box's inside,
+ * in one of six ways (style f): its corners wound out or in, by
+ * ReverseOrientation, by "normal N" against the winding, or mirrored by
+ * its transform (pbrt's side: the winding's normal, turned toward N when
+ * given, reversed by ReverseOrientation and by a mirror). */
+static void box_face(char *buf, size_t size, const float lo[3], const float hi[3], int f)
 {
+    int a = f / 2, b = (a + 1) % 3, c = (a + 2) % 3, high = f % 2;
+    float q[4][3];
+    static const int corner[4][2] = {{0, 0}, {1, 0}, {1, 1}, {0, 1}}; /* normal +axis a */
+    for (int k = 0; k < 4; k++) {
+        int j = high ? k : 3 - k; /* wound out: toward -axis a on the low side */
+        q[k][a] = high ? hi[a] : lo[a];
+        q[k][b] = corner[j][0] ? hi[b] : lo[b];
+        q[k][c] = corner[j][1] ? hi[c] : lo[c];
+    }
+    int in = f == 1 || f == 3 || f == 5;       /* "" "slab": the normal must point in */
+    int wound_in = f == 1 || f == 3 || f == 5; /* 1, 3 wound in; 5 by ReverseOrientation */
+    const char *extra = "";
+    char normals[256] = "";
+    if (f == 2) { /* "slab" "", wound in, N out */
+        wound_in = 1;
+        float n = high ? 1.0f : -1.0f;
+        snprintf(normals, sizeof normals, " \"normal N\" [%g %g %g %g %g %g %g %g %g %g %g %g]",
+                 a == 0 ? n : 0, a == 1 ? n : 0, a == 2 ? n : 0, a == 0 ? n : 0, a == 1 ? n : 0,
+                 a == 2 ? n : 0, a == 0 ? n : 0, a == 1 ? n : 0, a == 2 ? n : 0, a == 0 ? n : 0,
+                 a == 1 ? n : 0, a == 2 ? n : 0);
+    }
+    if (f == 5) { /* "" "slab", wound out and reversed */
+        wound_in = 0;
+        extra = "ReverseOrientation\n";
+    }
+    if (f == 3) { /* "" "slab", its corners' axis b mirrored back by Scale: wound out */
+        wound_in = 0;
+        extra = a == 0 ? "Scale 1 -1 1\n" : a == 1 ? "Scale 1 1 -1\n" : "Scale -1 1 1\n";
+        for (int k = 0; k < 4; k++)
+            q[k][b] = -q[k][b];
+    }
+    char pts[512] = "";
+    for (int k = 0; k < 4; k++) {
+        int j = wound_in ? 3 - k : k;
+        size_t n = strlen(pts);
+        snprintf(pts + n, sizeof pts - n, "%g %g %g  ", q[j][0], q[j][1], q[j][2]);
+    }
     size_t n = strlen(buf);
     snprintf(buf + n, size - n,
              "AttributeBegin\nMediumInterface \"%s\" \"%s\"\n%sMaterial \"interface\"\n"
-             "Shape \"trianglemesh\" \"point3 P\" [%s] \"integer indices\" [0 1 2 0 2 3]\n"
+             "Shape \"trianglemesh\" \"point3 P\" [%s]%s \"integer indices\" [0 1 2 0 2 3]\n"
              "AttributeEnd\n",
-             in, out, reverse ? "ReverseOrientation\n" : "", p);
+             in ? "" : "slab", in ? "slab" : "", extra, pts, normals);
 }
 
 /* The slab bounded by six open pieces, as pbrt-v4 scenes bound a liquid (a
  * flat top with the medium inside, a glass's wall with it outside): each
- * quad names the medium on the side it lies, and together they close it.
- * The top's normal points up, away from the slab (its inside); the
- * bottom's up, into it (its outside: given facing down and reversed); two
- * sides face out, two in. The floor is exp(-2 tau) of the open one, as
- * under the closed box, and no warning. */
+ * quad names the medium on one side, and together they close it. The box
+ * is thin along axis k and turned so that axis k is the view's: the
+ * centre's rays cross faces 2k and 2k + 1, so the three turns try the six
+ * ways a face names its side (box_face). The floor is exp(-2 tau) of the
+ * open one each time, as under the closed box, with no warning. */
 static void test_open_pieces(void)
 {
     mkdir(TMP, 0755);
-    char text[8192] = "MakeNamedMedium \"slab\" \"string type\" \"homogeneous\"\n"
-                      "  \"rgb sigma_a\" [0.2 0.2 0.2] \"rgb sigma_s\" [0 0 0] \"float scale\" 2\n";
-    piece(text, sizeof text, "slab", "", "-5 -5 2  5 -5 2  5 5 2  -5 5 2", 0);   /* top */
-    piece(text, sizeof text, "", "slab", "-5 -5 1  -5 5 1  5 5 1  5 -5 1", 1);   /* bottom */
-    piece(text, sizeof text, "slab", "", "5 -5 1  5 5 1  5 5 2  5 -5 2", 0);     /* +x, out */
-    piece(text, sizeof text, "", "slab", "-5 -5 1  -5 -5 2  -5 5 2  -5 5 1", 0); /* -x, in */
-    piece(text, sizeof text, "slab", "", "5 5 1  -5 5 1  -5 5 2  5 5 2", 0);     /* +y, out */
-    piece(text, sizeof text, "", "slab", "-5 -5 1  5 -5 1  5 -5 2  -5 -5 2", 0); /* -y, in */
+    static const char *const turn[3] = {"Rotate -90 0 1 0\n", "Rotate 90 1 0 0\n", ""};
     char err_text[4096];
-    write_scene("open-pieces.pbrt", text);
     write_scene("open-none.pbrt", "# no medium\n");
-    float *img = render("open-pieces.pbrt", err_text, sizeof err_text);
-    CHECK(img != NULL && strstr(err_text, "warning") == NULL);
     float *open = render("open-none.pbrt", err_text, sizeof err_text);
     CHECK(open != NULL);
-    if (img && open) {
-        double ratio = centre(img) / centre(open), want = exp(-2.0 * 0.4);
-        fprintf(stderr, "open pieces: %g of the open floor, exp(-2 tau) = %g\n", ratio, want);
-        CHECK(fabs(ratio - want) < 0.01 * want);
+    for (int k = 0; k < 3; k++) {
+        char text[16384] =
+            "MakeNamedMedium \"slab\" \"string type\" \"homogeneous\"\n"
+            "  \"rgb sigma_a\" [0.2 0.2 0.2] \"rgb sigma_s\" [0 0 0] \"float scale\" 2\n"
+            "AttributeBegin\n";
+        strcat(text, turn[k]);
+        float lo[3] = {-5, -5, -5}, hi[3] = {5, 5, 5};
+        lo[k] = 1, hi[k] = 2;
+        for (int f = 0; f < 6; f++)
+            box_face(text, sizeof text, lo, hi, f);
+        strcat(text, "AttributeEnd\n");
+        char name[64];
+        snprintf(name, sizeof name, "open-pieces-%d.pbrt", k);
+        write_scene(name, text);
+        float *img = render(name, err_text, sizeof err_text);
+        CHECK(img != NULL && strstr(err_text, "warning") == NULL);
+        if (img && open) {
+            double ratio = centre(img) / centre(open), want = exp(-2.0 * 0.4);
+            fprintf(stderr,
+                    "open pieces, thin along axis %d: %g of the open floor, exp(-2 tau) = %g\n", k,
+                    ratio, want);
+            CHECK(fabs(ratio - want) < 0.01 * want);
+        }
+        free(img);
     }
-    free(img);
     free(open);
 }
 
@@ -316,6 +365,23 @@ static void test_undefined_medium(void)
     free(img);
     CHECK(strstr(err_text, "undefined.pbrt:12:") != NULL &&
           strstr(err_text, "the medium \"smoke\", which no MakeNamedMedium defined") != NULL);
+    /* a medium named by one flat shape alone, the scene's only shape: its
+     * box is widened, not an error */
+    FILE *f = fopen(TMP "/flat.pbrt", "w");
+    if (f) {
+        fprintf(f,
+                "LookAt 0 0 6  0 0 0  0 1 0\nCamera \"perspective\" \"float fov\" 10\n"
+                "Film \"rgb\" \"integer xresolution\" %d \"integer yresolution\" %d\n"
+                "WorldBegin\nLightSource \"distant\" \"rgb L\" [1 1 1]\n"
+                "MakeNamedMedium \"fog\" \"string type\" \"homogeneous\"\n"
+                "AttributeBegin\nMediumInterface \"fog\" \"\"\nMaterial \"interface\"\n"
+                "Shape \"disk\" \"float radius\" 2\nAttributeEnd\n",
+                RES, RES);
+        fclose(f);
+    }
+    img = render("flat.pbrt", err_text, sizeof err_text);
+    CHECK(img != NULL && strstr(err_text, "warning") == NULL);
+    free(img);
 }
 
 TEST_MAIN(TEST(test_absorbing_slabs), TEST(test_camera_medium), TEST(test_open_pieces),
