@@ -131,6 +131,8 @@ static int h_object_instance(Rib *r, const Args *a)
         rib_warn_once(r, "outside world", "geometry outside WorldBegin/WorldEnd is ignored");
         return 0;
     }
+    if (rib_collapsed(r))
+        return 0;
     if (rib_send_lights(r) != 0)
         return -1;
     RayesError e = rib_recording_replay(o->rec, r->sink, r->a.M);

@@ -414,6 +414,11 @@ const IoSink *rib_out_sink(Rib *r, SinkState **st);
 /* Brings the sink up to date before a primitive; Cs overrides the
  * colour (a per-face colour) when not NULL. 1: skip (outside the world). */
 int rib_emit_begin(Rib *r, const float *Cs);
+/* 1, with one warning, when the current transform (at any motion sample)
+ * is finite but singular (a Scale 0 0 0): what follows collapses to
+ * nothing, and RenderMan draws nothing of it; 0 otherwise (a transform
+ * that is not finite is left to the sink's error). */
+int rib_collapsed(Rib *r);
 /* Sends the lights never sent and the light links, if they changed. */
 int rib_send_lights(Rib *r);
 /* The name of the Pattern that reached the sink a reference names: ref

@@ -25,6 +25,7 @@
 #include <unistd.h>
 
 #include "io/rib_reader.h"
+#include "util/vec.h"
 
 /* ---------------------------------------------------------- emission */
 
@@ -207,14 +208,37 @@ int rib_block_color_only(const Rib *r)
            r->a.color_gen != r->object_color_gen;
 }
 
+int rib_collapsed(Rib *r)
+{
+    int n = r->a.n_motion > 1 ? r->a.n_motion : 1;
+    for (int k = 0; k < n; k++) {
+        const float *m = n > 1 ? r->a.motion_M[k] : r->a.M;
+        int finite = 1;
+        for (int i = 0; i < 16; i++)
+            finite &= isfinite(m[i]) != 0;
+        Mat4 inv;
+        if (finite && !mat4_invert(mat4_from_array(m), &inv)) {
+            rib_warn_once(r, "singular transform",
+                          "%s under a singular transform (a Scale of 0) is flat or a point: not "
+                          "drawn",
+                          r->req);
+            return 1;
+        }
+    }
+    return 0;
+}
+
 /* Brings the sink up to date before a primitive; Cs overrides the
- * colour (a per-face colour) when not NULL. 1: skip (outside the world). */
+ * colour (a per-face colour) when not NULL. 1: skip (outside the world,
+ * or collapsed by a singular transform, as RenderMan draws nothing). */
 int rib_emit_begin(Rib *r, const float *Cs)
 {
     if (!r->in_world && !r->rec && !r->in_object) {
         rib_warn_once(r, "outside world", "geometry outside WorldBegin/WorldEnd is ignored");
         return 1;
     }
+    if (rib_collapsed(r))
+        return 1;
     if (!r->rec && !r->in_object && rib_send_lights(r) != 0)
         return -1;
     SinkState *st;

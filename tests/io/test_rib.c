@@ -350,6 +350,15 @@ static void test_camera_and_transforms(void)
     /* an angle past the vectors' own is an error at its line */
     CHECK(parse(WORLD("Skew 90 0 1 0 1 0 0\nSphere 1 -1 1 360")) == RAYES_ERROR_PARSE);
     CHECK(parse(WORLD("Skew 10 0 1 0 0 2 0\nSphere 1 -1 1 360")) == RAYES_ERROR_PARSE);
+    /* A Scale of 0 collapses what follows to nothing: RenderMan draws
+     * nothing (a particle system's dead embers), rayes skips it (the
+     * scene's transforms must be invertible); the rest is drawn */
+    CHECK(parse(WORLD("AttributeBegin\nScale 0 0 0\nSphere 1 -1 1 360\nPolygon \"P\" [0 0 0 1 0 0 "
+                      "1 1 0]\nAttributeEnd\nSphere 1 -1 1 360")) == RAYES_OK);
+    CHECK(rec.quadrics == 1 && rec.meshes == 0);
+    CHECK(parse(WORLD("Scale 1 0 1\nObjectBegin \"o\"\nSphere 1 -1 1 360\nObjectEnd\n"
+                      "ObjectInstance \"o\"")) == RAYES_OK);
+    CHECK(rec.quadrics == 0);
 
     CHECK(parse("ScreenWindow -1 1 -0.5 0.5\nProjection \"orthographic\"\n"
                 "WorldBegin\nWorldEnd\n") == RAYES_OK);
