@@ -384,7 +384,8 @@ int rib_check_counts(Rib *r, const Param *p, size_t n, const Counts *c)
 /* Warns once per parameter name a primitive does not use. */
 void rib_warn_unused(Rib *r, const Param *p, size_t n)
 {
-    static const char *const used[] = {"P", "Pw", "Cs", "Os", "N", "Np", "st", "s", "t", NULL};
+    static const char *const used[] = {"P",  "Pw", "Pz", "Cs", "Os", "N",
+                                       "Np", "st", "s",  "t",  NULL};
     for (size_t i = 0; i < n; i++) {
         int u = !p[i].declared;
         for (int k = 0; used[k]; k++)

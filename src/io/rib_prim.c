@@ -244,7 +244,7 @@ float *rib_get_points(Rib *r, const Param *p, size_t n_par, size_t *n_points)
     const Param *Pw = rib_find_param(p, n_par, "Pw");
     if (!P && !Pw) {
         if (rib_find_param(p, n_par, "Pz"))
-            rib_error(r, "\"Pz\" (height fields) is not supported; give \"P\"");
+            rib_error(r, "\"Pz\" (a height field) is for Patch and PatchMesh; give \"P\"");
         else
             rib_error(r, "expected the positions \"P\"");
         return NULL;
@@ -276,6 +276,44 @@ float *rib_get_points(Rib *r, const Param *p, size_t n_par, size_t *n_points)
             out[3 * i + c] = fabs(x) < FLT_MAX ? (float)x : 0.0f;
         }
     }
+    return out;
+}
+
+/* The points of an nu x nv patch mesh (u fastest): rib_get_points', or
+ * from a height field "Pz" (RenderMan's: each point's x and y are the
+ * mesh's surface parameters at it, i / (nu - 1) and j / (nv - 1), over nu
+ * and nv where the mesh wraps); new array. */
+static float *grid_points(Rib *r, const Param *p, size_t n_par, long nu, long nv, int uwrap,
+                          int vwrap, size_t *n_points)
+{
+    const Param *Pz = rib_find_param(p, n_par, "Pz");
+    if (!Pz || rib_find_param(p, n_par, "P") || rib_find_param(p, n_par, "Pw"))
+        return rib_get_points(r, p, n_par, n_points);
+    const Arg *v = Pz->v;
+    if (v->kind != ARG_NUMS && v->kind != ARG_NUM) {
+        rib_error(r, "\"Pz\" needs numbers");
+        return NULL;
+    }
+    if (v->n != (size_t)(nu * nv)) {
+        rib_arg_error(r, v, "\"Pz\" needs %ld x %ld = %ld heights, found %zu", nu, nv, nu * nv,
+                      v->n);
+        return NULL;
+    }
+    *n_points = v->n;
+    float *out = malloc(*n_points * 3 * sizeof *out);
+    if (!out) {
+        rib_error(r, "out of memory");
+        return NULL;
+    }
+    long su = uwrap ? nu : nu - 1, sv = vwrap ? nv : nv - 1;
+    for (long j = 0; j < nv; j++)
+        for (long i = 0; i < nu; i++) {
+            float *o = &out[3 * (size_t)(j * nu + i)];
+            double z = v->d[j * nu + i];
+            o[0] = su > 0 ? (float)((double)i / (double)su) : 0.0f;
+            o[1] = sv > 0 ? (float)((double)j / (double)sv) : 0.0f;
+            o[2] = fabs(z) < FLT_MAX ? (float)z : 0.0f;
+        }
     return out;
 }
 
@@ -925,7 +963,7 @@ static int h_patch(Rib *r, const Args *a)
     int e = 0;
     if (!cubic && strcmp(type, "bilinear") != 0)
         e = rib_error(r, "expected \"bilinear\" or \"bicubic\", found \"%s\"", type);
-    float *P = e == 0 ? rib_get_points(r, p, n, &np) : NULL;
+    float *P = e == 0 ? grid_points(r, p, n, cubic ? 4 : 2, cubic ? 4 : 2, 0, 0, &np) : NULL;
     if (e == 0 && !P)
         e = -1;
     size_t want = cubic ? 16 : 4;
@@ -1009,7 +1047,7 @@ static int h_patch_mesh(Rib *r, const Args *a)
     Param *p;
     if (rib_get_params(r, a, i, &p, &n) != 0)
         return -1;
-    float *P = rib_get_points(r, p, n, &np);
+    float *P = grid_points(r, p, n, nu, nv, up, vp, &np);
     int e = P ? 0 : -1;
     if (e == 0 && np != (size_t)(nu * nv))
         e = rib_error(r, "\"P\" needs %ld x %ld = %ld points, found %zu", nu, nv, nu * nv, np);

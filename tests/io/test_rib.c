@@ -40,6 +40,7 @@ typedef struct Rec {
     int link_calls, links_mode;  /* set_light_links calls, the last one's mode */
     size_t links[8], n_links;    /* and its lights */
     float first_bicubic[16][3];
+    float last_bilinear[4][3];
     float last_mesh_P0[3];
     float area_P[4][3];
     unsigned quadric_flags;
@@ -147,8 +148,9 @@ static const RayesPrimvar *last_pv(const char *name)
 }
 static RayesError s_bilinear(void *t, const float P[4][3], const RayesPrimvar *pv, size_t n_pv)
 {
-    (void)t, (void)P;
+    (void)t;
     rec.bilinear++;
+    memcpy(rec.last_bilinear, P, sizeof rec.last_bilinear);
     s_primvars(pv, n_pv);
     return RAYES_OK;
 }
@@ -350,6 +352,30 @@ static void test_camera_and_transforms(void)
     /* an angle past the vectors' own is an error at its line */
     CHECK(parse(WORLD("Skew 90 0 1 0 1 0 0\nSphere 1 -1 1 360")) == RAYES_ERROR_PARSE);
     CHECK(parse(WORLD("Skew 10 0 1 0 0 2 0\nSphere 1 -1 1 360")) == RAYES_ERROR_PARSE);
+    /* "Pz", a height field: x and y are the mesh's surface parameters at
+     * each point (over nu and nv where it wraps); elsewhere it is an error */
+    CHECK(parse(WORLD("PatchMesh \"bilinear\" 3 \"nonperiodic\" 2 \"nonperiodic\" "
+                      "\"Pz\" [0 1 2 3 4 5]")) == RAYES_OK);
+    CHECK(rec.bilinear == 2);
+    CHECK_NEAR(rec.last_bilinear[0][0], 0.5, 1e-6); /* the second patch: (0.5, 0, 1) */
+    CHECK_NEAR(rec.last_bilinear[0][1], 0.0, 1e-6);
+    CHECK_NEAR(rec.last_bilinear[0][2], 1.0, 1e-6);
+    CHECK_NEAR(rec.last_bilinear[3][0], 1.0, 1e-6); /* ... to (1, 1, 5) */
+    CHECK_NEAR(rec.last_bilinear[3][1], 1.0, 1e-6);
+    CHECK_NEAR(rec.last_bilinear[3][2], 5.0, 1e-6);
+    CHECK(parse(WORLD("PatchMesh \"bilinear\" 2 \"periodic\" 2 \"nonperiodic\" "
+                      "\"Pz\" [0 1 2 3]")) == RAYES_OK);
+    CHECK(rec.bilinear == 2);
+    CHECK_NEAR(rec.last_bilinear[0][0], 0.5, 1e-6); /* u wraps: x = i / 2 */
+    CHECK(parse(WORLD("Patch \"bilinear\" \"Pz\" [0 0 0 2]")) == RAYES_OK);
+    CHECK(rec.bilinear == 1);
+    CHECK_NEAR(rec.last_bilinear[3][0], 1.0, 1e-6);
+    CHECK_NEAR(rec.last_bilinear[3][2], 2.0, 1e-6);
+    CHECK(parse(WORLD("PatchMesh \"bilinear\" 3 \"nonperiodic\" 2 \"nonperiodic\" "
+                      "\"Pz\" [0 1 2 3 4]")) == RAYES_ERROR_PARSE);
+    CHECK(strstr(err, "\"Pz\" needs 3 x 2 = 6 heights, found 5") != NULL);
+    CHECK(parse(WORLD("Polygon \"Pz\" [0 1 2]")) == RAYES_ERROR_PARSE);
+    CHECK(strstr(err, "for Patch and PatchMesh") != NULL);
     /* A Scale of 0 collapses what follows to nothing: RenderMan draws
      * nothing (a particle system's dead embers), rayes skips it (the
      * scene's transforms must be invertible); the rest is drawn */
