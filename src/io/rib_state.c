@@ -798,6 +798,26 @@ static int visibility_string(Rib *r, const char *v)
     return 0;
 }
 
+/* BMRT's Attribute "render" "string casts_shadows": "none" (hidden from
+ * shadow rays), "opaque" and "Os" (Os alone), "shade" (the shader), as
+ * "transmission" takes them. 0 done, -1 error, 1 not ours. */
+static int attribute_render(Rib *r, const Param *q)
+{
+    if (strcmp(q->d.name, "casts_shadows") != 0 || q->v->n != 1 || rib_is_num(q->v))
+        return 1;
+    const char *v = q->v->s[0];
+    if (strcmp(v, "none") == 0)
+        return visibility_string(r, "transparent");
+    if (strcmp(v, "shade") == 0)
+        return visibility_string(r, "shader");
+    if (strcmp(v, "opaque") == 0 || strcmp(v, "Os") == 0)
+        return visibility_string(r, v);
+    return rib_error(r,
+                     "Attribute \"render\" \"casts_shadows\": expected \"none\", \"opaque\", "
+                     "\"Os\" or \"shade\", found \"%.64s\"",
+                     v);
+}
+
 /* One parameter of Attribute "visibility": 0 done, -1 error, 1 not ours. */
 static int attribute_visibility(Rib *r, const Param *q)
 {
@@ -864,6 +884,7 @@ static int h_option_attribute(Rib *r, const Args *a)
         int mine = option                             ? 1
                    : strcmp(group, "visibility") == 0 ? attribute_visibility(r, q)
                    : strcmp(group, "shade") == 0      ? attribute_shade(r, q)
+                   : strcmp(group, "render") == 0     ? attribute_render(r, q)
                                                       : 1;
         if (mine <= 0) {
             e = mine;

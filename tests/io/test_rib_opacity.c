@@ -116,6 +116,19 @@ static void test_visibility(void)
     m = last_mask("WorldBegin\nAttribute \"visibility\" \"int trace\" [0]\n"
                   "Sphere 1 -1 1 360\nWorldEnd\n");
     CHECK(!(m & (RAYES_RAY_DIFFUSE | RAYES_RAY_SPECULAR)) && (m & RAYES_RAY_SHADOW));
+    /* BMRT's casts_shadows: "none" hides the object from shadow rays, the
+     * others cast them (the RenderMan Repository's scenes set it) */
+    m = last_mask("WorldBegin\nAttribute \"render\" \"string casts_shadows\" [\"none\"]\n"
+                  "Sphere 1 -1 1 360\nWorldEnd\n");
+    CHECK(!(m & RAYES_RAY_SHADOW) && (m & RAYES_RAY_CAMERA));
+    m = last_mask("WorldBegin\nDeclare \"casts_shadows\" \"string\"\n"
+                  "Attribute \"render\" \"casts_shadows\" \"none\"\n"
+                  "Attribute \"render\" \"casts_shadows\" \"shade\"\n"
+                  "Sphere 1 -1 1 360\nWorldEnd\n");
+    CHECK(m & RAYES_RAY_SHADOW);
+    m = last_mask("WorldBegin\nAttribute \"render\" \"casts_shadows\" \"none\"\n"
+                  "Sphere 1 -1 1 360\nWorldEnd\n");
+    CHECK(!(m & RAYES_RAY_SHADOW));
     RayesImage *open = render_rib("", NULL);
     RayesImage *shadow = render_rib("AttributeBegin\nAttribute \"visibility\" \"int camera\" [0]\n"
                                     "Color [1 0 0]\n" BLOCKER "AttributeEnd\n",
