@@ -891,6 +891,15 @@ static int h_option_attribute(Rib *r, const Args *a)
         } else if (option && strcmp(group, "searchpath") == 0 && q->v->kind != ARG_NUM &&
                    q->v->kind != ARG_NUMS && q->v->n == 1) {
             e = search_path(r, q->d.name, q->v->s[0]);
+        } else if (!option && strcmp(group, "light") == 0 && strcmp(q->d.name, "shadows") == 0 &&
+                   !rib_is_num(q->v) && q->v->n == 1) {
+            /* BMRT's ray-traced shadows of the lights that follow: rayes'
+             * lights always cast them */
+            if (strcmp(q->v->s[0], "on") != 0)
+                rib_warn_once(r, "light shadows",
+                              "Attribute \"light\" \"shadows\" \"%.16s\": rayes' lights always "
+                              "cast shadows; ignored",
+                              q->v->s[0]);
         } else if (!option && strcmp(group, "displacementbound") == 0 &&
                    strcmp(q->d.name, "sphere") == 0 && rib_is_num(q->v) && q->v->n == 1) {
             r->a.bound = (float)fabs(q->v->d[0]);

@@ -578,6 +578,29 @@ static void test_null_displacement(void)
     CHECK(r.status == 0 && r.err[0] == '\0');
 }
 
+/* BMRT's Attribute "light" "shadows": "on" is what rayes' lights do (no
+ * warning), "off" warns that they cast shadows anyway. */
+static void test_light_shadows_attribute(void)
+{
+    static Run r;
+    setup();
+    for (int off = 0; off < 2; off++) {
+        char text[512];
+        snprintf(text, sizeof text,
+                 "Projection \"perspective\" \"fov\" 40\nWorldBegin\n"
+                 "Attribute \"light\" \"string shadows\" [\"%s\"]\n"
+                 "LightSource \"pointlight\" 1 \"from\" [0 0 0]\nTranslate 0 0 5\n"
+                 "Surface \"matte\"\nSphere 1 -1 1 360\nWorldEnd\n",
+                 off ? "off" : "on");
+        write_text(SCRATCH_DIR "/shadows.rib", text);
+        run(&r, NULL,
+            ARGS("render", SCRATCH_DIR "/shadows.rib", "--res", "16", "--spp", "1", "--quiet", "-o",
+                 SCRATCH_DIR "/shadows.png"));
+        CHECK(r.status == 0);
+        CHECK(off ? strstr(r.err, "lights always cast shadows") != NULL : r.err[0] == '\0');
+    }
+}
+
 /* A scene without lights: one warning naming the scene and the way out,
  * and a black image of a matte sphere; --default-light adds a headlight
  * that lights it. Without a Surface, RenderMan's defaultsurface draws it
@@ -837,4 +860,4 @@ TEST_MAIN(TEST(test_version_and_help), TEST(test_no_arguments), TEST(test_usage_
           TEST(test_png_curve), TEST(test_rib_opacity_cache_memory), TEST(test_vertex_budget),
           TEST(test_null_displacement), TEST(test_default_light), TEST(test_convert),
           TEST(test_bad_scene_file), TEST(test_frames_and_crop), TEST(test_background_imager),
-          TEST(test_display_modes))
+          TEST(test_display_modes), TEST(test_light_shadows_attribute))
