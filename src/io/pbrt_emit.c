@@ -462,7 +462,8 @@ void pbrt_object_free(Object *o)
 
 int pbrt_emit_bound(Parser *P, const Token *t, const Object *o)
 {
-    static const double identity[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
+    double identity[16];
+    pbrt_mat_identity(identity);
     P->shape_hidden = 0; /* the first shape makes the hidden object, the rest join it */
     return send_ops(P, t, o, identity);
 }

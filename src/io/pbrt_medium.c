@@ -233,13 +233,32 @@ static void grow_box(const Parser *P, float *box, int *have)
     }
 }
 
+/* Why the current Shape's media cannot be rendered here, or NULL. */
+static const char *bound_skip(const Parser *P)
+{
+    return P->recording                                          ? "inside ObjectBegin"
+           : !P->sink->volume || !P->sink->pattern               ? "this output takes no volumes"
+           : !P->sink->volume_inside || !P->sink->set_visibility ? "this output takes no bounded "
+                                                                   "volumes"
+                                                                 : NULL;
+}
+
+/* The name of the medium on one side of the current Shape that it may
+ * bound (0 its inside, 1 its outside), or NULL: none, or the same on both
+ * sides. */
+static const char *side_name(const Parser *P, int side)
+{
+    const char *name = side ? P->gs.outside : P->gs.inside;
+    return name[0] && strcmp(P->gs.inside, P->gs.outside) != 0 ? name : NULL;
+}
+
 int pbrt_medium_shape(Parser *P, const Token *t)
 {
     if (P->have_shape_bound && !P->recording) /* shapes inside ObjectBegin: placed by instances */
         grow_box(P, P->world_bound, &P->have_world_bound);
     for (int side = 0; side < 2; side++) {
-        const char *name = side ? P->gs.outside : P->gs.inside;
-        if (!name[0] || strcmp(P->gs.inside, P->gs.outside) == 0)
+        const char *name = side_name(P, side);
+        if (!name)
             continue;
         const Medium *md = find_medium(P, name);
         if (!md)
@@ -247,11 +266,7 @@ int pbrt_medium_shape(Parser *P, const Token *t)
                             "MediumInterface names the medium \"%.60s\", which no "
                             "MakeNamedMedium defined",
                             name);
-        const char *skip = P->recording                            ? "inside ObjectBegin"
-                           : !P->sink->volume || !P->sink->pattern ? "this output takes no volumes"
-                           : !P->sink->volume_inside || !P->sink->set_visibility
-                               ? "this output takes no bounded volumes"
-                               : NULL;
+        const char *skip = bound_skip(P);
         if (skip && strcmp(md->type, "none") != 0 && strcmp(name, P->camera_medium) != 0)
             pbrt_warn_at(P, t->line, t->col, skip, "medium \"%.60s\": %s; not rendered", name,
                          skip);
@@ -261,10 +276,8 @@ int pbrt_medium_shape(Parser *P, const Token *t)
 
 Medium *pbrt_medium_bounded(Parser *P, int side)
 {
-    const char *name = side ? P->gs.outside : P->gs.inside;
-    if (!name[0] || strcmp(P->gs.inside, P->gs.outside) == 0 ||
-        strcmp(name, P->camera_medium) == 0 || P->recording || !P->sink->volume ||
-        !P->sink->pattern || !P->sink->volume_inside || !P->sink->set_visibility)
+    const char *name = side_name(P, side);
+    if (!name || strcmp(name, P->camera_medium) == 0 || bound_skip(P))
         return NULL;
     Medium *md = find_medium(P, name);
     return md && strcmp(md->type, "none") != 0 ? md : NULL;
@@ -300,7 +313,8 @@ static int padded(const float in[6], float box[6])
 /* One medium's bound and its volume. */
 static int send_bounded(Parser *P, Medium *md, const Token *t)
 {
-    static const double identity[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
+    double identity[16];
+    pbrt_mat_identity(identity);
     float box[6];
     int whole = strcmp(md->type, "homogeneous") == 0 && P->have_world_bound;
     if (!padded(whole ? P->world_bound : md->box, box)) {
