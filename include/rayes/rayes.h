@@ -636,8 +636,29 @@ RAYES_API RayesError rayes_scene_area_light_mesh(RayesScene *scene, size_t n_fac
  *                      origin in z = 0, both emitting toward +z, or
  *                      "sphere" of "radius" (1) emitting outward; seen by
  *                      camera and specular rays
- * An unknown type is RAYES_ERROR_INVALID_ARGUMENT; an unreadable map is
- * RAYES_ERROR_IO. */
+ *   "uberlight"        Barzel's light (RenderMan's uberlight) at the origin
+ *                      of the current transform, aiming along +z: its
+ *                      intensity is shaped, not physical (no distance
+ *                      falloff by default): "lighttype" "spot" (default)
+ *                      or "omni", "cuton" (0.01), "cutoff" (1e6),
+ *                      "nearedge", "faredge" (0), "falloff" (0),
+ *                      "falloffdist" (1), "maxintensity" (1),
+ *                      "parallelrays" (0), "shearx", "sheary" (0), "width",
+ *                      "height" (1), "wedge", "hedge" (0.1), "roundness"
+ *                      (1), "beamdistribution" (0), "slidename" (an image),
+ *                      "noiseamp" (0), "noisefreq" (4), "noiseoffset",
+ *                      "shadowcolor" (0 0 0), "shadowcheat" (a light-space
+ *                      vector), "blockermatrix" (FLOATS, 16: the blocker's
+ *                      space to world, as rayes_scene_set_transform's) with
+ *                      "blockerwidth", "blockerheight" (1), "blockerwedge",
+ *                      "blockerhedge" (0.1), "blockerround" (1)
+ *                      (docs/DESIGN.md "Lights")
+ * Every light but ambient and environment lights also takes "shadows"
+ * (FLOAT, default 1; 0: nothing shadows it), "__nondiffuse" and
+ * "__nonspecular" (FLOAT, default 0; 1: it adds nothing to direct
+ * lighting's diffuse, or specular, output).
+ * An unknown type is RAYES_ERROR_INVALID_ARGUMENT; an unreadable map or
+ * slide is RAYES_ERROR_IO. */
 RAYES_API RayesError rayes_scene_light(RayesScene *scene, const char *type,
                                        const RayesParam *params, size_t n_params);
 

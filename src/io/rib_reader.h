@@ -131,6 +131,7 @@ typedef struct Attr {
                        whose primitives are skipped */
     int roundcurve; /* Attribute "dice" "roundcurve": curves without N are tubes */
     uint32_t visibility; /* Attribute "visibility": RayesRayType bits of the rays that see it */
+    int shadowless;      /* Attribute "light" "shadows" "off": the lights that follow cast none */
     int camera_said;     /* Attribute "visibility" "camera" 1 is in force (RenderMan 21's
                             lights are seen by the camera only then) */
     int hitmode;         /* Attribute "shade" "transmissionhitmode": RayesTransmissionHitMode */
@@ -160,7 +161,7 @@ typedef struct SinkState {
     int have_blur;
 } SinkState;
 
-#define RIB_LIGHT_PARAMS 12
+#define RIB_LIGHT_PARAMS 40
 
 typedef struct Light {
     char handle[RIB_MAX_HANDLE]; /* "" once a later light took the handle */
@@ -171,6 +172,8 @@ typedef struct Light {
     char mapname[1024]; /* an environment light's map, as given */
     char mapping[32];   /* and its layout ("latlong", "octahedral") */
     char shape[16];     /* an arealight's ("quad", "disk", "sphere") */
+    char lighttype[16]; /* an uberlight's ("spot", "omni") */
+    float blocker[16];  /* an uberlight's blockermatrix (world_from_blocker) */
     size_t n;
     float M[16];   /* world_from_light (camera_from_light before WorldBegin) */
     int n_motion;  /* a light moving within the frame (MotionBegin around its transform,
@@ -405,12 +408,16 @@ int rib_push(Rib *r, int attribute);
 int rib_pop(Rib *r, int attribute);
 /* world_from_camera, or the identity (with a warning) when singular. */
 void rib_world_from_camera(Rib *r, float m[16]);
-
-/* -------------------------------------------- rib_shade.c: the sink's state */
-
+/* The matrix of the coordinate system named (CoordinateSystem), as the
+ * current transform would be after CoordSysTransform: 0, or -1 if no such
+ * system was made. */
+int rib_coordsys(Rib *r, const char *name, float M[16]);
 /* The sink geometry goes to (the recording inside ObjectBegin) and what
  * it was last sent. */
 const IoSink *rib_out_sink(Rib *r, SinkState **st);
+
+/* -------------------------------------------- rib_shade.c: the sink's state */
+
 /* Brings the sink up to date before a primitive; Cs overrides the
  * colour (a per-face colour) when not NULL. 1: skip (outside the world). */
 int rib_emit_begin(Rib *r, const float *Cs);

@@ -29,12 +29,6 @@
 
 /* ---------------------------------------------------------- emission */
 
-const IoSink *rib_out_sink(Rib *r, SinkState **st)
-{
-    *st = r->rec || r->in_object ? &r->recorded : &r->real;
-    return r->rec ? &r->rec_sink : r->sink;
-}
-
 static const float white[3] = {1, 1, 1};
 
 static int send_shader(Rib *r, const IoSink *s, const float Cs[3])
@@ -71,10 +65,11 @@ static void set_light_on(Attr *a, size_t k, int on)
 /* Where a light keeps the string parameter of that name. */
 static char *light_string(Light *L, const char *name)
 {
-    return strcmp(name, "mapname") == 0   ? L->mapname
-           : strcmp(name, "mapping") == 0 ? L->mapping
-           : strcmp(name, "shape") == 0   ? L->shape
-                                          : L->category;
+    return strcmp(name, "mapname") == 0 || strcmp(name, "slidename") == 0 ? L->mapname
+           : strcmp(name, "mapping") == 0                                 ? L->mapping
+           : strcmp(name, "shape") == 0                                   ? L->shape
+           : strcmp(name, "lighttype") == 0                               ? L->lighttype
+                                                                          : L->category;
 }
 
 static int send_light(Rib *r, Light *L)
@@ -85,6 +80,8 @@ static int send_light(Rib *r, Light *L)
         L->params[i].name = L->names[i];
         if (L->params[i].type == RAYES_PARAM_STRING)
             L->params[i].string = light_string(L, L->names[i]);
+        if (L->params[i].type == RAYES_PARAM_FLOATS) /* the blocker's matrix */
+            L->params[i].floats = L->blocker;
     }
     int moving = L->n_motion > 1 && s->set_transform_motion;
     if (L->n_motion > 1 && !s->set_transform_motion)
@@ -628,10 +625,11 @@ void rib_light_param(Light *L, const char *name, RayesParamType type, const floa
     *o = (RayesParam){.name = L->names[L->n], .type = type};
     if (type == RAYES_PARAM_STRING) {
         char *dst = light_string(L, name);
-        size_t size = dst == L->mapname   ? sizeof L->mapname
-                      : dst == L->mapping ? sizeof L->mapping
-                      : dst == L->shape   ? sizeof L->shape
-                                          : sizeof L->category;
+        size_t size = dst == L->mapname     ? sizeof L->mapname
+                      : dst == L->mapping   ? sizeof L->mapping
+                      : dst == L->shape     ? sizeof L->shape
+                      : dst == L->lighttype ? sizeof L->lighttype
+                                            : sizeof L->category;
         snprintf(dst, size, "%s", string);
         o->string = dst;
     } else {
@@ -644,6 +642,113 @@ void rib_light_param(Light *L, const char *name, RayesParamType type, const floa
 static int intensity(const Param *q)
 {
     return strcmp(q->d.name, "intensity") == 0;
+}
+
+/* uberlight's parameters (Barzel's light as Gritz's shader names them)
+ * that rayes reads; the others (shadow map lookups, shadownsamps) are not
+ * needed by ray-traced shadows. */
+static const char *const uber_floats[] = {
+    "cuton",        "cutoff",       "nearedge",     "faredge",
+    "falloff",      "falloffdist",  "maxintensity", "parallelrays",
+    "shearx",       "sheary",       "width",        "height",
+    "wedge",        "hedge",        "roundness",    "beamdistribution",
+    "noiseamp",     "noisefreq",    "blockerwidth", "blockerheight",
+    "blockerwedge", "blockerhedge", "blockerround", NULL};
+static const char *const uber_vectors[] = {"noiseoffset", "shadowcolor", "shadowcheat", NULL};
+static const char *const uber_others[] = {
+    "intensity",     "lightcolor",     "lighttype",     "slidename",  "shadowmap",
+    "shadowname",    "raytraceshadow", "blockercoords", "shadows",    "blockermatrix",
+    "__nonspecular", "nonspecular",    "__nondiffuse",  "nondiffuse", NULL};
+
+/* The shader declares its parameters: an uberlight's that rayes reads
+ * need no Declare (their values' kind and count are checked where read). */
+static void uber_declare(Param *p, size_t n)
+{
+    for (size_t k = 0; k < n; k++)
+        if (!p[k].declared &&
+            (in_list(uber_floats, p[k].d.name) || in_list(uber_vectors, p[k].d.name) ||
+             in_list(uber_others, p[k].d.name))) {
+            p[k].declared = 1;
+            p[k].d.array = rib_is_num(p[k].v) && p[k].v->n > 0 ? (int)p[k].v->n : 1;
+        }
+}
+
+/* L's blocker matrix (L->blocker, filled) as its "blockermatrix". */
+static void blocker_param(Light *L)
+{
+    if (L->n >= RIB_LIGHT_PARAMS)
+        return;
+    snprintf(L->names[L->n], sizeof L->names[0], "blockermatrix");
+    L->params[L->n] = (RayesParam){
+        .name = L->names[L->n], .type = RAYES_PARAM_FLOATS, .floats = L->blocker, .n_floats = 16};
+    L->n++;
+}
+
+/* An uberlight's parameters into L (intensity and lightcolor are read as
+ * any light's): its shaping, slide, blocker (its coordinate system's
+ * matrix), and whether it casts shadows, which in RenderMan it does only
+ * with a shadow map or BMRT's raytraceshadow (rayes traces them either
+ * way). Parameters need no declaration (the shader declares them). */
+static int uber_params(Rib *r, Light *L, const Param *p, size_t n)
+{
+    int shadows = 0;
+    for (size_t k = 0; k < n; k++) {
+        const Param *q = &p[k];
+        const char *nm = q->d.name;
+        int num = rib_is_num(q->v), str = !num && q->v->n == 1;
+        if (str && (strcmp(nm, "shadowmap") == 0 || strcmp(nm, "shadowname") == 0)) {
+            shadows |= q->v->s[0][0] != '\0';
+        } else if (num && q->v->n == 1 && strcmp(nm, "raytraceshadow") == 0) {
+            shadows |= q->v->d[0] != 0.0;
+        } else if (num && q->v->n == 1 && strcmp(nm, "shadows") == 0) {
+            shadows = q->v->d[0] != 0.0 ? 1 : -1; /* rayes' own, as written: it decides */
+        } else if (num && q->v->n == 16 && strcmp(nm, "blockermatrix") == 0) {
+            for (int c = 0; c < 16; c++) /* rayes' own: world_from_blocker as written */
+                L->blocker[c] = (float)q->v->d[c];
+            blocker_param(L);
+        } else if (num && q->v->n == 1 &&
+                   (strcmp(nm, "__nonspecular") == 0 || strcmp(nm, "nonspecular") == 0 ||
+                    strcmp(nm, "__nondiffuse") == 0 || strcmp(nm, "nondiffuse") == 0)) {
+            float v[3] = {(float)q->v->d[0], 0, 0};
+            rib_light_param(L, strstr(nm, "specular") ? "__nonspecular" : "__nondiffuse",
+                            RAYES_PARAM_FLOAT, v, NULL);
+        } else if (num && q->v->n == 1 && in_list(uber_floats, nm)) {
+            /* maxintensity is an intensity: RenderMan's, pi times rayes' */
+            float v[3] = {(float)(q->v->d[0] * (strcmp(nm, "maxintensity") == 0 ? M_PI : 1.0)), 0,
+                          0};
+            rib_light_param(L, nm, RAYES_PARAM_FLOAT, v, NULL);
+        } else if (num && q->v->n == 3 && in_list(uber_vectors, nm)) {
+            float v[3] = {(float)q->v->d[0], (float)q->v->d[1], (float)q->v->d[2]};
+            rib_light_param(L, nm, RAYES_PARAM_COLOR, v, NULL);
+        } else if (str && strcmp(nm, "lighttype") == 0) {
+            const char *t = q->v->s[0];
+            if (strcmp(t, "spot") != 0 && strcmp(t, "omni") != 0) {
+                rib_warn_once(r, "uber lighttype",
+                              "uberlight: lighttype \"%.32s\" is not built in; \"omni\" instead",
+                              t);
+                t = "omni";
+            }
+            rib_light_param(L, "lighttype", RAYES_PARAM_STRING, NULL, t);
+        } else if (str && strcmp(nm, "slidename") == 0 && q->v->s[0][0]) {
+            const char *t = rib_texture_source(r, q->v->s[0]);
+            if (!rib_texture_found(r, t))
+                rib_warn_once(r, "uber slide",
+                              "uberlight: slide \"%.200s\" is not found as given nor on the "
+                              "texture search path; no slide",
+                              t);
+            else
+                rib_light_param(L, "slidename", RAYES_PARAM_STRING, NULL, t);
+        } else if (str && strcmp(nm, "blockercoords") == 0 && q->v->s[0][0]) {
+            if (rib_coordsys(r, q->v->s[0], L->blocker) != 0)
+                return rib_error(r, "uberlight: unknown blockercoords \"%.64s\"", q->v->s[0]);
+            blocker_param(L);
+        }
+    }
+    if (shadows <= 0 || r->a.shadowless) {
+        static const float off[3] = {0, 0, 0};
+        rib_light_param(L, "shadows", RAYES_PARAM_FLOAT, off, NULL);
+    }
+    return 0;
 }
 
 static int h_light_source(Rib *r, const Args *a)
@@ -664,6 +769,8 @@ static int h_light_source(Rib *r, const Args *a)
     if (rib_get_params(r, a, i, &p, &n) != 0)
         return -1;
     static const Counts one = {1, 1, 1, 1};
+    if (strcmp(name, "uberlight") == 0)
+        uber_declare(p, n);
     if (rib_check_counts(r, p, n, &one) != 0) {
         free(p);
         return -1;
@@ -682,6 +789,8 @@ static int h_light_source(Rib *r, const Args *a)
         type = "environmentlight";
     else if (strcmp(name, "arealight") == 0) /* rayes' own (what the writer writes) */
         type = "arealight";
+    else if (strcmp(name, "uberlight") == 0) /* Barzel's */
+        type = "uberlight";
     else if (in_list(environment_lights, name)) {
         /* Production environment and occlusion lights: an environment
          * light (of their map, if given), whose shadow rays give the
@@ -720,16 +829,30 @@ static int h_light_source(Rib *r, const Args *a)
         L->own_visibility = 1;
         L->visibility = r->a.visibility;
     }
-    static const char *const names[] = {
-        "intensity",      "lightcolor",       "from",       "to",  "coneangle",
-        "conedeltaangle", "beamdistribution", "__category", "fov", "shape",
-        "width",          "height",           "radius",     NULL};
+    static const char *const names[] = {"intensity",
+                                        "lightcolor",
+                                        "from",
+                                        "to",
+                                        "coneangle",
+                                        "conedeltaangle",
+                                        "beamdistribution",
+                                        "__category",
+                                        "fov",
+                                        "shape",
+                                        "width",
+                                        "height",
+                                        "radius",
+                                        "shadows",
+                                        "__nondiffuse",
+                                        "__nonspecular",
+                                        NULL};
     int env = strcmp(type, "environmentlight") == 0;
     int mapped = strcmp(type, "pointlight") == 0 || strcmp(type, "spotlight") == 0;
     /* RenderMan's point, spot and distant lights: diffuse() sums Cl (L.N)
      * with no 1/pi, so their intensity is pi times rayes' (DESIGN.md,
      * "Lights"); the default intensity 1 too */
-    int unit = mapped || strcmp(type, "distantlight") == 0;
+    int uber = strcmp(type, "uberlight") == 0;
+    int unit = mapped || uber || strcmp(type, "distantlight") == 0;
     if (unit && !rib_find_param(p, n, "intensity")) {
         RayesParam *o = &L->params[L->n];
         snprintf(L->names[L->n], sizeof L->names[0], "intensity");
@@ -764,14 +887,18 @@ static int h_light_source(Rib *r, const Args *a)
         if (env && strcmp(q->d.name, "intensity") != 0 && strcmp(q->d.name, "lightcolor") != 0 &&
             strcmp(q->d.name, "__category") != 0)
             continue; /* an environment light has no position or cone */
-        if (!in_list(names, q->d.name) || !q->declared)
+        if (!in_list(names, q->d.name) || (!q->declared && !(uber && intensity(q))))
             continue;
+        if (uber && !intensity(q) && strcmp(q->d.name, "lightcolor") != 0 &&
+            strcmp(q->d.name, "__category") != 0)
+            continue; /* the shaping's are uber_params' */
         RayesParam *o = &L->params[L->n];
         snprintf(L->names[L->n], sizeof L->names[0], "%s", q->d.name);
         o->name = L->names[L->n];
         if (q->d.ty == TY_STRING) {
-            if (q->v->n != 1)
-                continue;
+            if (q->v->n != 1 ||
+                (strcmp(q->d.name, "shape") != 0 && strcmp(q->d.name, "__category") != 0))
+                continue; /* a string where a number belongs */
             char *dst = light_string(L, q->d.name);
             snprintf(dst, dst == L->shape ? sizeof L->shape : sizeof L->category, "%s", q->v->s[0]);
             o->type = RAYES_PARAM_STRING;
@@ -791,8 +918,13 @@ static int h_light_source(Rib *r, const Args *a)
         }
         L->n++;
     }
+    int e = uber ? uber_params(r, L, p, n) : 0;
+    if (r->a.shadowless && !uber) {
+        static const float off[3] = {0, 0, 0};
+        rib_light_param(L, "shadows", RAYES_PARAM_FLOAT, off, NULL);
+    }
     free(p);
-    return 0;
+    return e;
 }
 
 static int h_area_light(Rib *r, const Args *a)

@@ -323,19 +323,32 @@ static int h_coordsys_transform(Rib *r, const Args *a)
             rib_mat_identity(r->a.M);
         return 0;
     }
+    if (rib_coordsys(r, name, r->a.M) != 0)
+        return rib_error(r, "unknown coordinate system \"%s\"", name);
+    return 0;
+}
+
+const IoSink *rib_out_sink(Rib *r, SinkState **st)
+{
+    *st = r->rec || r->in_object ? &r->recorded : &r->real;
+    return r->rec ? &r->rec_sink : r->sink;
+}
+
+int rib_coordsys(Rib *r, const char *name, float M[16])
+{
     for (size_t k = r->n_coordsys; k-- > 0;)
         if (strcmp(&r->coordsys_names[64 * k], name) == 0) {
             const float *m = &r->coordsys_M[16 * k];
             if (r->in_world && !r->coordsys_world[k]) {
                 float wc[16];
                 rib_world_from_camera(r, wc);
-                rib_mat_mul(wc, m, r->a.M);
+                rib_mat_mul(wc, m, M);
             } else {
-                memcpy(r->a.M, m, 16 * sizeof *m);
+                memcpy(M, m, 16 * sizeof *m);
             }
             return 0;
         }
-    return rib_error(r, "unknown coordinate system \"%s\"", name);
+    return -1;
 }
 
 /* ------------------------------------------------------------ options */
@@ -893,12 +906,13 @@ static int h_option_attribute(Rib *r, const Args *a)
             e = search_path(r, q->d.name, q->v->s[0]);
         } else if (!option && strcmp(group, "light") == 0 && strcmp(q->d.name, "shadows") == 0 &&
                    !rib_is_num(q->v) && q->v->n == 1) {
-            /* BMRT's ray-traced shadows of the lights that follow: rayes'
-             * lights always cast them */
-            if (strcmp(q->v->s[0], "on") != 0)
+            /* BMRT's ray-traced shadows of the lights that follow */
+            if (strcmp(q->v->s[0], "on") == 0 || strcmp(q->v->s[0], "off") == 0)
+                r->a.shadowless = strcmp(q->v->s[0], "off") == 0;
+            else
                 rib_warn_once(r, "light shadows",
-                              "Attribute \"light\" \"shadows\" \"%.16s\": rayes' lights always "
-                              "cast shadows; ignored",
+                              "Attribute \"light\" \"shadows\" \"%.16s\": expected \"on\" or "
+                              "\"off\"; ignored",
                               q->v->s[0]);
         } else if (!option && strcmp(group, "displacementbound") == 0 &&
                    strcmp(q->d.name, "sphere") == 0 && rib_is_num(q->v) && q->v->n == 1) {

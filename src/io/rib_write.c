@@ -1276,7 +1276,10 @@ static RayesError w_light(void *t, const char *type, const RayesParam *p, size_t
     /* RenderMan's point, spot and distant lights are pi times as intense
      * as rayes' (the reader's conversion): written apart, to 17 digits,
      * always (the default 1 too) */
-    int unit = spot || strcmp(type, "pointlight") == 0 || strcmp(type, "distantlight") == 0;
+    int uber = strcmp(type, "uberlight") == 0;
+    int unit = spot || uber || strcmp(type, "pointlight") == 0 || strcmp(type, "distantlight") == 0;
+    int shadows_given = 0;
+    double maxintensity = -1.0;
     double I[3] = {1.0, 1.0, 1.0};
     int I_color = 0;
     RayesParam rest[64];
@@ -1292,11 +1295,17 @@ static RayesError w_light(void *t, const char *type, const RayesParam *p, size_t
             I_color = p[i].type == RAYES_PARAM_COLOR;
             for (int c = 0; c < 3; c++)
                 I[c] = p[i].value[I_color ? c : 0];
-        } else if (k >= 0)
+        } else if (k >= 0) {
             angle[k] = (double)p[i].value[0] * M_PI / 180.0;
-        else if (n_rest < sizeof rest / sizeof rest[0])
+        } else if (uber && p[i].name && strcmp(p[i].name, "maxintensity") == 0 &&
+                   p[i].type == RAYES_PARAM_FLOAT) {
+            maxintensity = (double)p[i].value[0]; /* an intensity: pi times in RenderMan */
+        } else if (uber && p[i].type == RAYES_PARAM_FLOATS) {
+            continue; /* the blocker's matrix, written apart as an array */
+        } else if (n_rest < sizeof rest / sizeof rest[0]) {
+            shadows_given |= p[i].name && strcmp(p[i].name, "shadows") == 0;
             rest[n_rest++] = p[i];
-        else
+        } else
             return fail(w, RAYES_ERROR_INVALID_ARGUMENT, "light: too many parameters");
     }
     char *text = NULL;
@@ -1315,6 +1324,16 @@ static RayesError w_light(void *t, const char *type, const RayesParam *p, size_t
                     I[1] / M_PI, I[2] / M_PI);
         else if (unit)
             fprintf(w->world.f, " \"float intensity\" [%.17g]", I[0] / M_PI);
+        if (maxintensity >= 0.0)
+            fprintf(w->world.f, " \"float maxintensity\" [%.17g]", maxintensity / M_PI);
+        if (uber && !shadows_given) /* rayes' default; RenderMan's uberlight casts none */
+            fprintf(w->world.f, " \"float shadows\" [1]");
+        for (size_t i = 0; uber && i < n; i++)
+            if (p[i].type == RAYES_PARAM_FLOATS && p[i].name && p[i].floats &&
+                finite_all(p[i].floats, p[i].n_floats)) {
+                fprintf(w->world.f, " \"float[%zu] %s\" ", p[i].n_floats, p[i].name);
+                floats(w->world.f, p[i].floats, p[i].n_floats);
+            }
         fprintf(w->world.f, "\n");
         if (h < 4097 && !w_linked(w, (size_t)h - 1)) {
             fprintf(w->world.f, "Illuminate %d 0\n", h);

@@ -207,22 +207,58 @@ typedef struct DirectPoint {
     float spread;   /* the point's own ray spread */
 } DirectPoint;
 
-/* A delta light (point, spot, distant): one shadow ray. */
+/* The transmittance toward light l (transmittance's), 1 for a light
+ * nothing shadows. */
+static Vec3 light_transmittance(Worker *w, const Light *l, Vec3 o, Vec3 wi, float dist,
+                                RayDiff diff)
+{
+    return l->shadowless ? v3(1, 1, 1) : transmittance(w, o, wi, dist, diff);
+}
+
+/* A delta light's one direction from o (point, spot, distant, uber):
+ * 0 when it sends nothing there. The shadow ray is u->sw, u->sdist. */
+static int delta_sample(const Light *l, Vec3 o, LightUberSample *u)
+{
+    if (l->type == LIGHT_UBER)
+        return light_uber_sample(l, o, u);
+    if (!light_sample(l, o, 0.5f, 0.5f, &u->s))
+        return 0;
+    u->sw = u->s.wi;
+    u->sdist = u->s.dist;
+    return 1;
+}
+
+/* What arrives at o of delta_sample's u: Li times the transmittance of its
+ * shadow ray; an uberlight's shadowed share gets its shadowcolor, and its
+ * blocker counts as a shadow (Barzel's: Ls + (Li - Ls) unoccluded). */
+static Vec3 delta_arriving(Worker *w, const Light *l, Vec3 o, const LightUberSample *u,
+                           RayDiff diff)
+{
+    Vec3 T = light_transmittance(w, l, o, u->sw, u->sdist, diff);
+    if (l->type != LIGHT_UBER)
+        return v3_mul(u->s.Li, T);
+    Vec3 v = v3_scale(T, u->unblocked);
+    return v3_add(u->Ls, v3_mul(v3_sub(u->s.Li, u->Ls), v));
+}
+
+/* A delta light (point, spot, distant, uber): one shadow ray. */
 static void light_delta(Worker *w, const DirectPoint *p, const Light *l, Vec3 *diffuse,
                         Vec3 *spec)
 {
-    LightSample ls;
-    if (!light_sample(l, p->o, 0.5f, 0.5f, &ls))
+    LightUberSample u;
+    if (!delta_sample(l, p->o, &u))
         return;
-    float cos_x = v3_dot(p->N, ls.wi);
-    if (cos_x <= 0.0f || v3_dot(p->Ng, ls.wi) <= 0.0f)
+    Vec3 wi = u.s.wi;
+    float cos_x = v3_dot(p->N, wi);
+    if (cos_x <= 0.0f || v3_dot(p->Ng, wi) <= 0.0f)
         return;
     /* one ray, not a share of a solid angle: the point's own spread */
     RayDiff one = {p->shadow.width, p->spread};
-    Vec3 Li = v3_mul(ls.Li, transmittance(w, p->o, ls.wi, ls.dist, one));
-    *diffuse = v3_madd(*diffuse, Li, cos_x / (float)M_PI);
+    Vec3 Li = delta_arriving(w, l, p->o, &u, one);
+    if (p->diff)
+        *diffuse = v3_madd(*diffuse, Li, cos_x / (float)M_PI);
     if (p->spec)
-        *spec = v3_madd(*spec, Li, cos_x * lobe_f(&p->lobe, ls.wi));
+        *spec = v3_madd(*spec, Li, cos_x * lobe_f(&p->lobe, wi));
 }
 
 /* Nonzero if the diffuse lobe's strategy is worth its samples for a light
@@ -298,7 +334,7 @@ static void light_area(Worker *w, const DirectPoint *p, const Light *l, uint64_t
                     float lobe = sqrtf(1.0f / (n * ls.pdf));
                     lobe = p->shadow.spread < lobe ? p->shadow.spread : lobe;
                     RayDiff sd = {p->shadow.width, p->spread > lobe ? p->spread : lobe};
-                    Vec3 Li = v3_mul(ls.Li, transmittance(w, p->o, ls.wi, ls.dist, sd));
+                    Vec3 Li = v3_mul(ls.Li, light_transmittance(w, l, p->o, ls.wi, ls.dist, sd));
                     float wd = lobe ? power_heuristic(ls.pdf, cos_x / (float)M_PI) : 1.0f;
                     if (p->diff)
                         sum_d = v3_madd(sum_d, Li, wd * cos_x / ((float)M_PI * ls.pdf));
@@ -317,9 +353,10 @@ static void light_area(Worker *w, const DirectPoint *p, const Light *l, uint64_t
                 cos_x = v3_dot(p->N, wi);
                 if (cos_x > 0.0f && v3_dot(p->Ng, wi) > 0.0f && light_bound_may_hit(&bound, wi) &&
                     light_hit(w, l, &view, p->o, wi, &ls) && v3_max_component(ls.Li) > 0.0f)
-                    sum_d = v3_madd(sum_d,
-                                    v3_mul(ls.Li, transmittance(w, p->o, wi, ls.dist, p->shadow)),
-                                    power_heuristic(cos_x / (float)M_PI, ls.pdf));
+                    sum_d = v3_madd(
+                        sum_d,
+                        v3_mul(ls.Li, light_transmittance(w, l, p->o, wi, ls.dist, p->shadow)),
+                        power_heuristic(cos_x / (float)M_PI, ls.pdf));
             }
             if (!p->spec)
                 continue;
@@ -333,7 +370,7 @@ static void light_area(Worker *w, const DirectPoint *p, const Light *l, uint64_t
             float pdf = lobe_pdf(&p->lobe, wi);
             if (!(pdf > 0.0f))
                 continue;
-            Vec3 Li = v3_mul(ls.Li, transmittance(w, p->o, wi, ls.dist, p->shadow));
+            Vec3 Li = v3_mul(ls.Li, light_transmittance(w, l, p->o, wi, ls.dist, p->shadow));
             float f = lobe_f(&p->lobe, wi);
             sum_s = v3_madd(sum_s, Li, power_heuristic(pdf, ls.pdf) * f * cos_x / pdf);
         }
@@ -390,12 +427,17 @@ static void direct_lighting(const RayesShadeCtx *ctx, int n_shadow_rays, const c
             if (l->type == LIGHT_AMBIENT || !render_lit_by(obj, k) ||
                 !light_category_match(l, category))
                 continue;
+            DirectPoint q = p; /* the outputs this light adds to */
+            q.diff = p.diff && !l->nondiffuse;
+            q.spec = p.spec && !l->nonspecular;
+            if (!q.diff && !q.spec)
+                continue;
             if (light_is_area(l))
-                light_area(w, &p, l,
-                           hash_combine(hash_combine(ps->keys[point(ctx, i)], DIM_LIGHT), k), n,
-                           &d, &s);
+                light_area(w, &q, l,
+                           hash_combine(hash_combine(ps->keys[point(ctx, i)], DIM_LIGHT), k), n, &d,
+                           &s);
             else
-                light_delta(w, &p, l, &d, &s);
+                light_delta(w, &q, l, &d, &s);
         }
         if (diffuse)
             v3_store(diffuse[i], d);
@@ -489,16 +531,27 @@ static void fiber_light_samples(Worker *w, const FiberPoint *p, const Light *l,
         if (area)
             cmj_pattern_sample(&pat, (uint32_t)j, &a, &b);
         LightSample ls;
-        if (!light_draw(l, view, p->P, a, b, &ls) || !(v3_max_component(ls.Li) > 0.0f) ||
-            (area && !(ls.pdf > 0.0f)))
-            continue;
-        ls.Li = v3_mul(ls.Li, transmittance(w, fiber_origin(p, ls.wi), ls.wi, ls.dist, p->shadow));
+        if (!area) { /* a delta light: its shadow ray may aim elsewhere (uberlight) */
+            LightUberSample u;
+            if (!delta_sample(l, p->P, &u))
+                continue;
+            ls = u.s;
+            ls.Li = delta_arriving(w, l, fiber_origin(p, ls.wi), &u, p->shadow);
+        } else {
+            if (!light_draw(l, view, p->P, a, b, &ls) || !(v3_max_component(ls.Li) > 0.0f) ||
+                !(ls.pdf > 0.0f))
+                continue;
+            ls.Li = v3_mul(ls.Li, light_transmittance(w, l, fiber_origin(p, ls.wi), ls.wi, ls.dist,
+                                                      p->shadow));
+        }
         float weight = area ? 1.0f / (ls.pdf * (float)m) : 1.0f;
         float ws = area && spec ? power_heuristic(ls.pdf, fiber_lobe_pdf(p->T, p->V, ls.wi, p->e))
                                 : 1.0f;
         fiber_terms(p->T, p->V, ls.wi, p->e, &fd, &fs);
-        *d = v3_madd(*d, ls.Li, fd * weight);
-        *s = v3_madd(*s, ls.Li, fs * weight * ws);
+        if (!l->nondiffuse)
+            *d = v3_madd(*d, ls.Li, fd * weight);
+        if (!l->nonspecular)
+            *s = v3_madd(*s, ls.Li, fs * weight * ws);
     }
 }
 
@@ -522,7 +575,8 @@ static void fiber_lobe_samples(Worker *w, const FiberPoint *p, const Light *l,
         float pdf = fiber_lobe_pdf(p->T, p->V, wi, p->e);
         if (!(pdf > 0.0f))
             continue;
-        ls.Li = v3_mul(ls.Li, transmittance(w, fiber_origin(p, wi), wi, ls.dist, p->shadow));
+        ls.Li =
+            v3_mul(ls.Li, light_transmittance(w, l, fiber_origin(p, wi), wi, ls.dist, p->shadow));
         fiber_terms(p->T, p->V, wi, p->e, &fd, &fs);
         *s = v3_madd(*s, ls.Li, fs * power_heuristic(pdf, ls.pdf) / (pdf * (float)m));
     }
@@ -905,14 +959,22 @@ static void svc_direct_volume(const RayesShaderServices *sv, const RayesShadeCtx
                 if (m > 1)
                     cmj_pattern_sample(&pattern, (uint32_t)s, &a, &b);
                 LightSample ls;
-                if (!light_sample(l, P, a, b, &ls) || !(v3_max_component(ls.Li) > 0.0f) ||
-                    (light_is_area(l) && !(ls.pdf > 0.0f)))
-                    continue;
-                float weight = light_is_area(l) ? 1.0f / (ls.pdf * (float)m) : 1.0f;
                 RayDiff sd = {ps->diff[j].width, ps->diff[j].spread};
-                if (light_is_area(l))
+                Vec3 T = v3(1, 1, 1);
+                if (!light_is_area(l)) { /* its shadow ray may aim elsewhere (uberlight) */
+                    LightUberSample u;
+                    if (!delta_sample(l, P, &u))
+                        continue;
+                    ls = u.s;
+                    ls.Li = delta_arriving(w, l, P, &u, sd);
+                } else {
+                    if (!light_sample(l, P, a, b, &ls) || !(v3_max_component(ls.Li) > 0.0f) ||
+                        !(ls.pdf > 0.0f))
+                        continue;
                     sd.spread = fmaxf(sd.spread, sqrtf(1.0f / ((float)m * ls.pdf)));
-                Vec3 T = transmittance(w, P, ls.wi, ls.dist, sd);
+                    T = light_transmittance(w, l, P, ls.wi, ls.dist, sd);
+                }
+                float weight = light_is_area(l) ? 1.0f / (ls.pdf * (float)m) : 1.0f;
                 float p = v3_length(I) > 0.0f ? phase_hg(g, v3_dot(ls.wi, I))
                                               : 1.0f / (4.0f * (float)M_PI);
                 /* delta lights' Li is irradiance-like (direct_lighting's Li cos / pi for a

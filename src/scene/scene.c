@@ -1455,9 +1455,17 @@ int scene_prepare(const RayesScene *s, int width, int height, const DiceOptions 
 /* The parameters of rayes_scene_light, checked and with defaults. */
 typedef struct LightParams {
     float intensity, color[3], from[3], to[3];
-    float coneangle, conedeltaangle, beamdistribution;
+    float coneangle, conedeltaangle, beamdistribution; /* beamdistribution NAN: not given */
     float radius, width, height, fov;
     const char *mapname, *mapping, *shape, *category;
+    float shadows, nondiffuse, nonspecular;
+    /* uberlight's */
+    const char *lighttype, *slidename;
+    float cuton, cutoff, nearedge, faredge, falloff, falloffdist, maxintensity, parallelrays;
+    float shearx, sheary, wedge, hedge, roundness, noiseamp, noisefreq, noiseoffset[3];
+    float shadowcolor[3], shadowcheat[3];
+    const float *blockermatrix; /* 16 floats, or NULL: no blocker */
+    float blockerwidth, blockerheight, blockerwedge, blockerhedge, blockerround;
 } LightParams;
 
 typedef struct LightParamDesc {
@@ -1482,6 +1490,35 @@ static const LightParamDesc light_param_descs[] = {
     {"fov", RAYES_PARAM_FLOAT, offsetof(LightParams, fov)},
     {"shape", RAYES_PARAM_STRING, offsetof(LightParams, shape)},
     {"__category", RAYES_PARAM_STRING, offsetof(LightParams, category)},
+    {"shadows", RAYES_PARAM_FLOAT, offsetof(LightParams, shadows)},
+    {"__nondiffuse", RAYES_PARAM_FLOAT, offsetof(LightParams, nondiffuse)},
+    {"__nonspecular", RAYES_PARAM_FLOAT, offsetof(LightParams, nonspecular)},
+    {"lighttype", RAYES_PARAM_STRING, offsetof(LightParams, lighttype)},
+    {"slidename", RAYES_PARAM_STRING, offsetof(LightParams, slidename)},
+    {"cuton", RAYES_PARAM_FLOAT, offsetof(LightParams, cuton)},
+    {"cutoff", RAYES_PARAM_FLOAT, offsetof(LightParams, cutoff)},
+    {"nearedge", RAYES_PARAM_FLOAT, offsetof(LightParams, nearedge)},
+    {"faredge", RAYES_PARAM_FLOAT, offsetof(LightParams, faredge)},
+    {"falloff", RAYES_PARAM_FLOAT, offsetof(LightParams, falloff)},
+    {"falloffdist", RAYES_PARAM_FLOAT, offsetof(LightParams, falloffdist)},
+    {"maxintensity", RAYES_PARAM_FLOAT, offsetof(LightParams, maxintensity)},
+    {"parallelrays", RAYES_PARAM_FLOAT, offsetof(LightParams, parallelrays)},
+    {"shearx", RAYES_PARAM_FLOAT, offsetof(LightParams, shearx)},
+    {"sheary", RAYES_PARAM_FLOAT, offsetof(LightParams, sheary)},
+    {"wedge", RAYES_PARAM_FLOAT, offsetof(LightParams, wedge)},
+    {"hedge", RAYES_PARAM_FLOAT, offsetof(LightParams, hedge)},
+    {"roundness", RAYES_PARAM_FLOAT, offsetof(LightParams, roundness)},
+    {"noiseamp", RAYES_PARAM_FLOAT, offsetof(LightParams, noiseamp)},
+    {"noisefreq", RAYES_PARAM_FLOAT, offsetof(LightParams, noisefreq)},
+    {"noiseoffset", RAYES_PARAM_COLOR, offsetof(LightParams, noiseoffset)},
+    {"shadowcolor", RAYES_PARAM_COLOR, offsetof(LightParams, shadowcolor)},
+    {"shadowcheat", RAYES_PARAM_COLOR, offsetof(LightParams, shadowcheat)},
+    {"blockermatrix", RAYES_PARAM_FLOATS, offsetof(LightParams, blockermatrix)},
+    {"blockerwidth", RAYES_PARAM_FLOAT, offsetof(LightParams, blockerwidth)},
+    {"blockerheight", RAYES_PARAM_FLOAT, offsetof(LightParams, blockerheight)},
+    {"blockerwedge", RAYES_PARAM_FLOAT, offsetof(LightParams, blockerwedge)},
+    {"blockerhedge", RAYES_PARAM_FLOAT, offsetof(LightParams, blockerhedge)},
+    {"blockerround", RAYES_PARAM_FLOAT, offsetof(LightParams, blockerround)},
 };
 
 static RayesError light_params(RayesScene *s, const char *type, const RayesParam *params,
@@ -1492,7 +1529,7 @@ static RayesError light_params(RayesScene *s, const char *type, const RayesParam
                         .to = {0, 0, 1},
                         .coneangle = 30,
                         .conedeltaangle = 5,
-                        .beamdistribution = 2,
+                        .beamdistribution = NAN,
                         .radius = 1,
                         .width = 1,
                         .height = 1,
@@ -1500,7 +1537,23 @@ static RayesError light_params(RayesScene *s, const char *type, const RayesParam
                         .mapname = "",
                         .mapping = "latlong",
                         .shape = "quad",
-                        .category = ""};
+                        .category = "",
+                        .shadows = 1,
+                        .lighttype = "spot",
+                        .slidename = "",
+                        .cuton = 0.01f,
+                        .cutoff = 1e6f,
+                        .falloffdist = 1,
+                        .maxintensity = 1,
+                        .wedge = 0.1f,
+                        .hedge = 0.1f,
+                        .roundness = 1,
+                        .noisefreq = 4,
+                        .blockerwidth = 1,
+                        .blockerheight = 1,
+                        .blockerwedge = 0.1f,
+                        .blockerhedge = 0.1f,
+                        .blockerround = 1};
     for (size_t i = 0; i < n_params; i++) {
         const RayesParam *p = &params[i];
         if (!p->name)
@@ -1520,10 +1573,18 @@ static RayesError light_params(RayesScene *s, const char *type, const RayesParam
         if (!ok)
             return scene_fail(s, RAYES_ERROR_INVALID_ARGUMENT, "%s: parameter \"%s\" expects a %s",
                               type, p->name,
-                              d->type == RAYES_PARAM_FLOAT   ? "float"
-                              : d->type == RAYES_PARAM_COLOR ? "3-vector (RAYES_PARAM_COLOR)"
-                                                             : "string");
+                              d->type == RAYES_PARAM_FLOAT    ? "float"
+                              : d->type == RAYES_PARAM_COLOR  ? "3-vector (RAYES_PARAM_COLOR)"
+                              : d->type == RAYES_PARAM_FLOATS ? "16-float matrix"
+                                                              : "string");
         char *dst = (char *)lp + d->offset;
+        if (d->type == RAYES_PARAM_FLOATS) { /* a matrix */
+            if (!p->floats || p->n_floats != 16 || !scene_finite(p->floats, 16))
+                return scene_fail(s, RAYES_ERROR_INVALID_ARGUMENT,
+                                  "%s: parameter \"%s\" expects 16 finite floats", type, p->name);
+            *(const float **)dst = p->floats;
+            continue;
+        }
         if (d->type == RAYES_PARAM_STRING) {
             if (!p->string)
                 return scene_fail(s, RAYES_ERROR_INVALID_ARGUMENT,
@@ -1624,6 +1685,91 @@ static RayesError light_map(RayesScene *s, const char *type, const LightParams *
     return RAYES_OK;
 }
 
+/* Barzel's light (uberlight): its space is the current transform; lp's
+ * shaping checked and kept in l->uber (DESIGN.md "Lights"). */
+static RayesError uber_light(RayesScene *s, const LightParams *lp, Light *l)
+{
+    LightUber *u = &l->uber;
+    const char *lt = lp->lighttype;
+    if (strcmp(lt, "spot") != 0 && strcmp(lt, "omni") != 0)
+        return scene_fail(s, RAYES_ERROR_INVALID_ARGUMENT,
+                          "uberlight: unknown lighttype \"%.40s\"; expected spot or omni", lt);
+    if (!(lp->width > 0.0f) || !(lp->height > 0.0f) || lp->wedge < 0.0f || lp->hedge < 0.0f ||
+        lp->roundness < 0.0f || lp->roundness > 1.0f || lp->beamdistribution < 0.0f)
+        return scene_fail(s, RAYES_ERROR_INVALID_ARGUMENT,
+                          "uberlight: expected a positive width and height, wedge, hedge and "
+                          "beamdistribution >= 0 and roundness in [0, 1]");
+    if (lp->nearedge < 0.0f || lp->faredge < 0.0f || lp->cutoff < lp->cuton ||
+        !(lp->falloffdist > 0.0f) || !(lp->maxintensity > 0.0f) || lp->falloff < 0.0f ||
+        lp->noiseamp < 0.0f)
+        return scene_fail(s, RAYES_ERROR_INVALID_ARGUMENT,
+                          "uberlight: expected nearedge, faredge, falloff and noiseamp >= 0, "
+                          "cutoff >= cuton and a positive falloffdist and maxintensity");
+    if (lp->blockermatrix &&
+        (!(lp->blockerwidth > 0.0f) || !(lp->blockerheight > 0.0f) || lp->blockerwedge < 0.0f ||
+         lp->blockerhedge < 0.0f || lp->blockerround < 0.0f || lp->blockerround > 1.0f))
+        return scene_fail(s, RAYES_ERROR_INVALID_ARGUMENT,
+                          "uberlight: expected a positive blockerwidth and blockerheight, "
+                          "blockerwedge and blockerhedge >= 0 and blockerround in [0, 1]");
+    l->type = LIGHT_UBER;
+    l->world_from_light = s->world_from_object;
+    if (!mat4_invert(l->world_from_light, &l->light_from_world))
+        return scene_fail(s, RAYES_ERROR_INVALID_ARGUMENT, "uberlight: a singular transform");
+    l->from = mat4_point(&l->world_from_light, v3(0, 0, 0));
+    l->dir = v3_normalize(mat4_vector(&l->world_from_light, v3(0, 0, 1)));
+    u->omni = strcmp(lt, "omni") == 0;
+    u->parallel = lp->parallelrays != 0.0f;
+    u->cuton = lp->cuton;
+    u->cutoff = lp->cutoff;
+    u->nearedge = lp->nearedge;
+    u->faredge = lp->faredge;
+    u->falloff = lp->falloff;
+    u->falloffdist = lp->falloffdist;
+    u->maxintensity = lp->maxintensity;
+    u->maxratio = lp->intensity > 0.0f ? lp->maxintensity / lp->intensity : 1.0f;
+    u->shearx = lp->shearx;
+    u->sheary = lp->sheary;
+    u->width = lp->width;
+    u->height = lp->height;
+    u->wedge = lp->wedge;
+    u->hedge = lp->hedge;
+    u->roundness = lp->roundness;
+    u->beam = lp->beamdistribution;
+    /* the cone RenderMan's illuminate() lets light through: the
+     * cross-section's farthest corner, sheared, with room to spare */
+    float r = 1.4142136f * fmaxf(lp->height + lp->hedge + fabsf(lp->sheary),
+                                 lp->width + lp->wedge + fabsf(lp->shearx));
+    u->cos_cone = 1.0f / sqrtf(1.0f + r * r);
+    u->noiseamp = lp->noiseamp;
+    u->noisefreq = lp->noisefreq;
+    u->noiseoffset = v3_load(lp->noiseoffset);
+    u->shadowcolor = v3_load(lp->shadowcolor);
+    u->cheat = v3_load(lp->shadowcheat);
+    if (lp->blockermatrix) {
+        if (!mat4_invert(mat4_from_array(lp->blockermatrix), &u->blocker_from_world))
+            return scene_fail(s, RAYES_ERROR_INVALID_ARGUMENT,
+                              "uberlight: a singular blockermatrix");
+        u->blocker = 1;
+        u->bwidth = lp->blockerwidth;
+        u->bheight = lp->blockerheight;
+        u->bwedge = lp->blockerwedge;
+        u->bhedge = lp->blockerhedge;
+        u->bround = lp->blockerround;
+    }
+    if (lp->slidename[0]) {
+        char err[400], path[1024];
+        if (scene_find_texture(s, lp->slidename, path, sizeof path) != 0)
+            return scene_fail(s, RAYES_ERROR_INVALID_ARGUMENT, "uberlight: slide name too long");
+        if (light_env_load(l, path, 0, err, sizeof err) != 0)
+            return scene_fail(s, RAYES_ERROR_IO, "%s", err);
+        u->slide = 1;
+    }
+    RayesError e = push_light(s, l, NULL, 0);
+    if (e != RAYES_OK)
+        light_fini(l);
+    return e;
+}
+
 RayesError rayes_scene_light(RayesScene *s, const char *type, const RayesParam *params,
                              size_t n_params)
 {
@@ -1632,27 +1778,35 @@ RayesError rayes_scene_light(RayesScene *s, const char *type, const RayesParam *
     if (s->open_master >= 0)
         return scene_fail(s, RAYES_ERROR_INVALID_ARGUMENT, "light: not allowed in an object block");
     static const char *const types[] = {"pointlight",   "spotlight",        "distantlight",
-                                        "ambientlight", "environmentlight", "arealight"};
+                                        "ambientlight", "environmentlight", "arealight",
+                                        "uberlight"};
     int t = -1;
-    for (int k = 0; k < 6; k++)
+    for (int k = 0; k < 7; k++)
         if (strcmp(type, types[k]) == 0)
             t = k;
     if (t < 0)
         return scene_fail(
             s, RAYES_ERROR_INVALID_ARGUMENT,
             "unknown light type \"%s\"; expected pointlight, spotlight, distantlight, "
-            "ambientlight, environmentlight or arealight",
+            "ambientlight, environmentlight, arealight or uberlight",
             type);
     LightParams lp;
     RayesError e = light_params(s, type, params, n_params, &lp);
     if (e != RAYES_OK)
         return e;
+    if (isnan(lp.beamdistribution)) /* RenderMan's defaults */
+        lp.beamdistribution = t == 6 ? 0.0f : 2.0f;
     Light l;
     memset(&l, 0, sizeof l);
     snprintf(l.category, sizeof l.category, "%s", lp.category);
+    l.shadowless = lp.shadows == 0.0f;
+    l.nondiffuse = lp.nondiffuse != 0.0f;
+    l.nonspecular = lp.nonspecular != 0.0f;
     l.L = v3_scale(v3_load(lp.color), lp.intensity);
     l.intensity = lp.intensity;
     l.color = v3_load(lp.color);
+    if (t == 6)
+        return uber_light(s, &lp, &l);
     const Mat4 *m = &s->world_from_object;
     l.from = mat4_point(m, v3_load(lp.from));
     Vec3 to = mat4_point(m, v3_load(lp.to));
@@ -1721,6 +1875,9 @@ RayesError rayes_scene_light(RayesScene *s, const char *type, const RayesParam *
             memcpy(made->category, l.category, sizeof l.category);
             made->intensity = l.intensity;
             made->color = l.color;
+            made->shadowless = l.shadowless;
+            made->nondiffuse = l.nondiffuse;
+            made->nonspecular = l.nonspecular;
         }
         return e;
     }
@@ -1836,6 +1993,13 @@ RayesError rayes_scene_edit_light(RayesScene *s, size_t index, const RayesParam 
     l->intensity = intensity;
     l->color = color;
     l->L = v3_scale(color, intensity);
+    if (l->type == LIGHT_UBER) { /* maxintensity stays what it was */
+        l->uber.maxratio = intensity > 0.0f ? l->uber.maxintensity / intensity : 1.0f;
+        l->world_from_light.m[0][3] += d.x; /* moved with "translate" */
+        l->world_from_light.m[1][3] += d.y;
+        l->world_from_light.m[2][3] += d.z;
+        mat4_invert(l->world_from_light, &l->light_from_world);
+    }
     scene_mark(s, SCENE_CHANGE_SHADING);
     if (v3_length(d) == 0.0f || l->type == LIGHT_DISTANT || l->type == LIGHT_AMBIENT ||
         l->type == LIGHT_ENVIRONMENT)
@@ -1874,7 +2038,7 @@ RayesError rayes_scene_get_light(const RayesScene *s, size_t index, float *inten
     else if (l->type == LIGHT_MESH) /* its bounding box's centre */
         at = v3_scale(v3_add(l->mesh->lo, l->mesh->hi), 0.5f);
     else if (l->type != LIGHT_POINT && l->type != LIGHT_SPOT && l->type != LIGHT_DISK &&
-             l->type != LIGHT_SPHERE)
+             l->type != LIGHT_SPHERE && l->type != LIGHT_UBER)
         at = v3(0, 0, 0);
     if (intensity)
         *intensity = l->intensity;

@@ -9,6 +9,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "shade/noise.h"
 #include "shade/texture.h"
 
 static const float PI = 3.14159265358979f;
@@ -730,6 +731,11 @@ const Light *light_at_time(const Light *l, float t, Light *tmp)
         Vec3 x = mat4_vector(&D, v3(1, 0, 0));
         tmp->radius = l->radius * v3_length(x);
     }
+    if (l->type == LIGHT_UBER) { /* its whole space moves */
+        tmp->world_from_light = mat4_mul(D, l->world_from_light);
+        if (!mat4_invert(tmp->world_from_light, &tmp->light_from_world))
+            return l;
+    }
     if (l->type == LIGHT_ENVIRONMENT) { /* the rotation alone */
         Mat4 R = D;
         R.m[0][3] = R.m[1][3] = R.m[2][3] = 0.0f;
@@ -824,6 +830,153 @@ void light_bound_init(const Light *l, Vec3 o, LightBound *b)
     b->all = !(b->d2 > b->r2) || !(b->r2 < INFINITY);
 }
 
+/* ---------------------------------------------------------- uberlight */
+
+/* RenderMan's smoothstep, exactly: 0 below lo, 1 from hi on (a step at
+ * lo == hi), Hermite between. */
+static float rsl_smoothstep(float lo, float hi, float x)
+{
+    if (x < lo)
+        return 0.0f;
+    if (x >= hi)
+        return 1.0f;
+    float t = (x - lo) / (hi - lo);
+    return t * t * (3.0f - 2.0f * t);
+}
+
+/* a b / ((b x)^e + (a y)^e)^(1/e): 1 on the superellipse of half-axes
+ * (a, b), above 1 inside it; scaled by the larger term, so that no power
+ * overflows at large exponents (roundness near 0). */
+static float superellipse_level(float x, float y, float a, float b, float e)
+{
+    float u = b * x, v = a * y, m = fmaxf(u, v);
+    if (!(m > 0.0f))
+        return INFINITY; /* the centre */
+    return a * b / (m * powf(powf(u / m, e) + powf(v / m, e), 1.0f / e));
+}
+
+float light_superellipse(float x, float y, float a, float b, float A, float B, float roundness)
+{
+    x = fabsf(x);
+    y = fabsf(y);
+    if (roundness < 1e-6f)
+        return 1.0f - (1.0f - rsl_smoothstep(a, A, x)) * (1.0f - rsl_smoothstep(b, B, y));
+    float e = 2.0f / roundness;
+    return rsl_smoothstep(superellipse_level(x, y, a, b, e), superellipse_level(x, y, A, B, e),
+                          1.0f);
+}
+
+/* The slide's colour at light-space point p: the image stretched over the
+ * cross-section (width + wedge by height + hedge at z = 1), its first row
+ * at +y, bilinear, black outside it and behind the light. */
+static Vec3 uber_slide(const Light *l, Vec3 p)
+{
+    const LightUber *u = &l->uber;
+    const LightEnvMap *m = l->env;
+    if (!(p.z > 0.0f))
+        return v3(0, 0, 0);
+    float s = 0.5f + 0.5f * p.x / (p.z * (u->width + u->wedge));
+    float t = 0.5f - 0.5f * p.y / (p.z * (u->height + u->hedge));
+    if (!(s >= 0.0f && s <= 1.0f && t >= 0.0f && t <= 1.0f))
+        return v3(0, 0, 0);
+    float x = s * (float)m->width - 0.5f, y = t * (float)m->height - 0.5f;
+    float fx = floorf(x), fy = floorf(y), ax = x - fx, ay = y - fy;
+    Vec3 c = v3(0, 0, 0);
+    for (int j = 0; j < 2; j++)
+        for (int i = 0; i < 2; i++) {
+            int px = (int)fx + i, py = (int)fy + j;
+            px = px < 0 ? 0 : px >= m->width ? m->width - 1 : px;
+            py = py < 0 ? 0 : py >= m->height ? m->height - 1 : py;
+            const float *q = &m->rgb[3 * ((size_t)py * (size_t)m->width + (size_t)px)];
+            float wgt = (i ? ax : 1.0f - ax) * (j ? ay : 1.0f - ay);
+            c = v3_madd(c, v3(q[0], q[1], q[2]), wgt);
+        }
+    return c;
+}
+
+/* The shaping of the light's intensity at light-space point p (Barzel's
+ * section 4): depth cut on and off, distance falloff, beam falloff, the
+ * superellipse cross-section and projected noise. */
+static float uber_shape(const LightUber *u, Vec3 p)
+{
+    float len = v3_length(p);
+    float z = u->omni ? len : p.z;
+    if (!u->omni && !(z >= u->cos_cone * len && z > 0.0f))
+        return 0.0f; /* outside the cone the cross-section fits in, or behind */
+    float k = rsl_smoothstep(u->cuton - u->nearedge, u->cuton, z) *
+              (1.0f - rsl_smoothstep(u->cutoff, u->cutoff + u->faredge, z));
+    if (!(k > 0.0f))
+        return 0.0f;
+    if (u->falloff != 0.0f) {
+        if (len > u->falloffdist) {
+            k *= powf(u->falloffdist / len, u->falloff);
+        } else if (u->maxratio != 1.0f) {
+            /* within falloffdist the intensity rises smoothly to maxratio
+             * at the light instead of without bound (1 at falloffdist) */
+            float s = logf(1.0f / u->maxratio), beta = -u->falloff / s;
+            k *= u->maxratio * expf(fminf(s * powf(len / u->falloffdist, beta), 60.0f));
+        }
+    }
+    if (!u->omni && u->beam > 0.0f)
+        k *= powf(fmaxf(p.z / len, 0.0f), u->beam);
+    if (!u->omni)
+        k *=
+            1.0f - light_superellipse(p.x / z - u->shearx, p.y / z - u->sheary, u->width, u->height,
+                                      u->width + u->wedge, u->height + u->hedge, u->roundness);
+    if (u->noiseamp > 0.0f && k > 0.0f) {
+        float f = u->noisefreq;
+        float n = 0.5f + 0.5f * noise3(f * (p.x + u->noiseoffset.x), f * (p.y + u->noiseoffset.y),
+                                       0.0f); /* RenderMan's noise, in [0, 1] */
+        k *= rsl_smoothstep(0.0f, 1.0f, 0.5f + u->noiseamp * (n - 0.5f));
+    }
+    return k;
+}
+
+int light_uber_sample(const Light *l, Vec3 o, LightUberSample *us)
+{
+    const LightUber *u = &l->uber;
+    Vec3 p = mat4_point(&l->light_from_world, o);
+    float k = uber_shape(u, p);
+    if (!(k > 0.0f))
+        return 0;
+    /* the origin of its shadows: the light, or for parallel rays the
+     * point's foot on the plane z = cuton; moved by the cheat */
+    Vec3 origin = u->parallel ? mat4_point(&l->world_from_light, v3(p.x, p.y, u->cuton)) : l->from;
+    origin = v3_add(origin, mat4_vector(&l->world_from_light, u->cheat));
+    LightSample *s = &us->s;
+    if (u->parallel) {
+        s->wi = v3_neg(l->dir);
+        s->dist = INFINITY;
+    } else {
+        Vec3 d = v3_sub(l->from, o);
+        s->dist = v3_length(d);
+        if (!(s->dist > 0.0f))
+            return 0;
+        s->wi = v3_scale(d, 1.0f / s->dist);
+    }
+    s->pdf = 0.0f;
+    Vec3 lc = l->L;
+    if (u->slide && l->env)
+        lc = v3_mul(lc, uber_slide(l, p));
+    s->Li = v3_scale(lc, k);
+    us->Ls = v3_scale(v3_mul(u->shadowcolor, v3(l->intensity, l->intensity, l->intensity)), k);
+    Vec3 sd = v3_sub(origin, o);
+    us->sdist = v3_length(sd);
+    us->sw = us->sdist > 0.0f ? v3_scale(sd, 1.0f / us->sdist) : s->wi;
+    us->unblocked = 1.0f;
+    if (u->blocker) { /* the segment from the point to the shadows' origin */
+        Vec3 b1 = mat4_point(&u->blocker_from_world, o);
+        Vec3 b2 = mat4_point(&u->blocker_from_world, origin);
+        if (b1.z * b2.z < 0.0f) {
+            Vec3 v = v3_sub(b1, b2), q = v3_sub(b1, v3_scale(v, b1.z / v.z));
+            us->unblocked =
+                light_superellipse(q.x, q.y, u->bwidth, u->bheight, u->bwidth + u->bwedge,
+                                   u->bheight + u->bhedge, u->bround);
+        }
+    }
+    return v3_max_component(s->Li) > 0.0f || v3_max_component(us->Ls) > 0.0f;
+}
+
 int light_sample(const Light *l, Vec3 o, float a, float b, LightSample *s)
 {
     switch (l->type) {
@@ -909,6 +1062,14 @@ int light_sample(const Light *l, Vec3 o, float a, float b, LightSample *s)
         return env_sample(l, a, b, s);
     case LIGHT_MESH:
         return mesh_sample(l, o, a, b, s);
+    case LIGHT_UBER: {
+        LightUberSample us;
+        if (!light_uber_sample(l, o, &us))
+            return 0;
+        *s = us.s; /* unshadowed, behind the blocker as it lets through */
+        s->Li = v3_add(us.Ls, v3_scale(v3_sub(us.s.Li, us.Ls), us.unblocked));
+        return v3_max_component(s->Li) > 0.0f;
+    }
     case LIGHT_AMBIENT:
         return 0;
     }

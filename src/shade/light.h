@@ -46,7 +46,8 @@ typedef enum LightType {
     LIGHT_DISTANT = 5,
     LIGHT_AMBIENT = 6,
     LIGHT_ENVIRONMENT = 7,
-    LIGHT_MESH = 8
+    LIGHT_MESH = 8,
+    LIGHT_UBER = 9
 } LightType;
 
 #define LIGHT_CATEGORY_MAX 128
@@ -103,6 +104,30 @@ typedef struct LightMeshView {
     float cdf[LIGHT_MESH_CLUSTERS + 1]; /* cdf[n] the total; 0: nothing reaches the point */
 } LightMeshView;
 
+/* Barzel's light ("Lighting Controls for Computer Cinematography", 1997;
+ * RenderMan's uberlight): a delta light at the origin of its own space
+ * aiming along +z, whose intensity at a point is shaped in that space, not
+ * physically: cut on and off by depth, a chosen distance falloff, a
+ * superellipse cross-section, a beam falloff, a slide and projected noise;
+ * its shadows may be off, coloured, cast from elsewhere (the cheat) or by
+ * a blocker, a superellipse that stands in no ray's way (light_uber). */
+typedef struct LightUber {
+    int omni;     /* 1: every direction, depth = distance */
+    int parallel; /* 1: rays along +z, shadows toward z = cuton */
+    float cuton, cutoff, nearedge, faredge;
+    float falloff, falloffdist, maxintensity, maxratio; /* maxratio: over intensity */
+    float shearx, sheary, width, height, wedge, hedge, roundness, beam;
+    float cos_cone; /* spot: the cone holding the cross-section */
+    float noiseamp, noisefreq;
+    Vec3 noiseoffset; /* in the light's space */
+    Vec3 shadowcolor; /* what a shadowed point gets instead of lightcolor */
+    Vec3 cheat;       /* the shadows' origin moved by this (light space) */
+    int slide;        /* 1: env is a slide over the cross-section */
+    int blocker;      /* 1: a blocker in the plane z = 0 of blocker_from_world */
+    Mat4 blocker_from_world;
+    float bwidth, bheight, bwedge, bhedge, bround;
+} LightUber;
+
 typedef struct Light {
     LightType type;
     Vec3 P[4];          /* quad corners as a bilinear patch: P00, P10, P01, P11 */
@@ -130,6 +155,10 @@ typedef struct Light {
     char category[LIGHT_CATEGORY_MAX]; /* comma-separated names */
     uint32_t seen_by; /* environment: the RayesRayType bits of the rays that see it as
                          the background (the visibility when it was made) */
+    int shadowless;   /* 1: nothing shadows it (shadow rays are not traced) */
+    int nondiffuse;   /* 1: it adds nothing to direct lighting's diffuse output */
+    int nonspecular;  /* 1: nor to its specular one (RenderMan's __nonspecular) */
+    LightUber uber;   /* uberlight: its shaping, in world_from_light's space */
     /* A light moving within the frame (made under a moving transform):
      * where it is at time t is the light above (at time[0]) moved by delta
      * blended linearly between the samples around t (light_at_time). */
@@ -165,6 +194,28 @@ static inline int light_is_area(const Light *l)
     return l->type == LIGHT_QUAD || l->type == LIGHT_DISK || l->type == LIGHT_SPHERE ||
            l->type == LIGHT_ENVIRONMENT || l->type == LIGHT_MESH;
 }
+
+/* What an uberlight sends toward a point: s as light_sample gives it (wi
+ * toward the light, Li what arrives unshadowed), Ls what arrives where
+ * the shadow ray is blocked (shadowcolor's), the shadow ray (sw, sdist:
+ * toward the origin of its shadows), and the share a blocker lets through.
+ * Arriving: Ls + (Li - Ls) * unblocked * transmittance along the ray. */
+typedef struct LightUberSample {
+    LightSample s;
+    Vec3 Ls;
+    Vec3 sw;
+    float sdist;
+    float unblocked;
+} LightUberSample;
+
+/* An uberlight as seen from o: 0 when it sends nothing there, else fills
+ * *u. light_sample gives u->s with the blocker applied and no shadows. */
+int light_uber_sample(const Light *l, Vec3 o, LightUberSample *u);
+
+/* Barzel's superellipse clip at (x, y): 0 inside the superellipse of
+ * half-axes (a, b), 1 outside the one of (A, B), smooth between; roundness
+ * 0 gives rectangles, 1 ellipses. */
+float light_superellipse(float x, float y, float a, float b, float A, float B, float roundness);
 
 /* Nonzero if every point of an area light (quad, disk, sphere) lies below
  * the plane through o with unit normal n, by a margin: no direction from o

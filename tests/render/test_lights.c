@@ -1482,6 +1482,238 @@ static void test_every_light_any_thread_count(void)
 
 /* --------------------------------------------------------------- errors */
 
+/* ---------------------------------------------------------- uberlight */
+
+/* Irradiance from an uberlight at the origin aiming +z (the identity
+ * transform), at P facing it: light_sample's Li times the cosine. */
+static double uber_at(const Light *l, Vec3 P, Vec3 N)
+{
+    LightSample ls;
+    if (!light_sample(l, P, 0.5f, 0.5f, &ls))
+        return 0.0;
+    return ls.Li.x * fmax(0.0, v3_dot(N, ls.wi));
+}
+
+/* Barzel's shaping, each control alone: depth cut on and off with their
+ * smooth edges, the cross-section (a sharp rectangle, an ellipse, sheared),
+ * the beam falloff, the distance falloff with its smooth clamp, omni and
+ * parallel rays; and the superellipse's own values. */
+static void test_uber_light_shaping(void)
+{
+    CHECK(light_superellipse(0, 0, 1, 1, 2, 2, 1) == 0.0f);
+    CHECK(light_superellipse(3, 0, 1, 1, 2, 2, 1) == 1.0f);
+    CHECK_NEAR(light_superellipse(1.5f, 0, 1, 1, 2, 2, 1), 0.5, 1e-6); /* halfway, smoothstep */
+    CHECK(light_superellipse(0.9f, 0.9f, 1, 1, 1, 1, 0) == 0.0f);      /* a square's corner */
+    CHECK(light_superellipse(0.9f, 0.9f, 1, 1, 1, 1, 1) == 1.0f);      /* outside the circle */
+    CHECK(light_superellipse(0.6f, 0.6f, 1, 1, 1.0001f, 1.0001f, 1) == 0.0f);
+    CHECK(light_superellipse(0.5f, 0.5f, 1, 1, 1, 1, 0.01f) == 0.0f); /* no overflow */
+    struct {
+        RayesParam p[6];
+        int n;
+        Vec3 P;
+        double expected;
+    } c[] = {
+        /* a sharp 1 x 0.5 rectangle (wedge, hedge 0, roundness 0) */
+        {{pf("wedge", 0), pf("hedge", 0), pf("roundness", 0), pf("height", 0.5f)},
+         4,
+         v3(4.9f, 0, 5),
+         1},
+        {{pf("wedge", 0), pf("hedge", 0), pf("roundness", 0), pf("height", 0.5f)},
+         4,
+         v3(5.1f, 0, 5),
+         0},
+        {{pf("wedge", 0), pf("hedge", 0), pf("roundness", 0), pf("height", 0.5f)},
+         4,
+         v3(0, 2.6f, 5),
+         0},
+        {{pf("wedge", 0), pf("hedge", 0), pf("roundness", 0), pf("height", 0.5f)},
+         4,
+         v3(4, 2, 5),
+         1}, /* the corner is lit */
+        {{pf("wedge", 0), pf("hedge", 0), pf("roundness", 1), pf("height", 0.5f)},
+         4,
+         v3(4, 2, 5),
+         0}, /* not in the ellipse */
+        {{pf("wedge", 0), pf("hedge", 0), pf("shearx", 1)},
+         3,
+         v3(9.9f, 0, 5),
+         1}, /* sheared: the centre at x / z = 1 */
+        {{pf("wedge", 0), pf("hedge", 0), pf("shearx", 1)}, 3, v3(-0.1f, 0, 5), 0},
+        /* depth: cuton 2 with a near edge of 1; cutoff 10 and far edge 2 */
+        {{pf("cuton", 2), pf("nearedge", 1)}, 2, v3(0, 0, 1.5f), 0.5},
+        {{pf("cuton", 2), pf("nearedge", 1)}, 2, v3(0, 0, 0.9f), 0},
+        {{pf("cutoff", 10), pf("faredge", 2)}, 2, v3(0, 0, 11), 0.5},
+        {{pf("cutoff", 10), pf("faredge", 2)}, 2, v3(0, 0, 12.5f), 0},
+        /* the beam: cos^2 */
+        {{pf("beamdistribution", 2)}, 1, v3(3, 0, 4), 0.8 * 0.8},
+        /* falloff 2 beyond falloffdist 4: (4 / d)^2; 1 at falloffdist */
+        {{pf("falloff", 2), pf("falloffdist", 4), pf("maxintensity", 3)}, 3, v3(0, 0, 8), 0.25},
+        {{pf("falloff", 2), pf("falloffdist", 4), pf("maxintensity", 3)}, 3, v3(0, 0, 4), 1},
+        /* omni: behind the light, depth by distance */
+        {{ps("lighttype", "omni"), pf("cuton", 2)}, 2, v3(0, 0, -3), 1},
+        {{ps("lighttype", "omni"), pf("cuton", 2)}, 2, v3(0, 0, -1), 0},
+    };
+    for (size_t k = 0; k < sizeof c / sizeof c[0]; k++) {
+        RayesScene *s = rayes_scene_new();
+        CHECK(rayes_scene_light(s, "uberlight", c[k].p, (size_t)c[k].n) == RAYES_OK);
+        if (s->n_lights == 1) {
+            /* facing the light: its shaping alone */
+            double got = uber_at(&s->lights[0], c[k].P, v3_normalize(v3_neg(c[k].P)));
+            if (fabs(got - c[k].expected) > 1e-5)
+                fprintf(stderr, "  case %zu: %.6f, expected %.6f\n", k, got, c[k].expected);
+            CHECK_NEAR(got, c[k].expected, 1e-5);
+        }
+        rayes_scene_release(s);
+    }
+    /* omni lights every side at depth above cuton; the distance falloff
+     * rises smoothly to maxintensity toward the light, never above */
+    RayesScene *s = rayes_scene_new();
+    RayesParam omni[1] = {ps("lighttype", "omni")};
+    CHECK(rayes_scene_light(s, "uberlight", omni, 1) == RAYES_OK);
+    CHECK_NEAR(uber_at(&s->lights[0], v3(0, -3, 0), v3(0, 1, 0)), 1.0, 1e-6);
+    rayes_scene_release(s);
+    s = rayes_scene_new();
+    RayesParam fall[4] = {ps("lighttype", "omni"), pf("falloff", 2), pf("falloffdist", 4),
+                          pf("maxintensity", 3)};
+    CHECK(rayes_scene_light(s, "uberlight", fall, 4) == RAYES_OK);
+    double last = 0.0;
+    for (float d = 3.9f; d > 0.05f; d -= 0.25f) {
+        double k = uber_at(&s->lights[0], v3(0, 0, d), v3(0, 0, -1));
+        CHECK(k > last && k <= 3.0 && k < 4.0 * 4.0 / (d * d));
+        last = k;
+    }
+    CHECK(last > 2.9); /* near the light: maxintensity */
+    rayes_scene_release(s);
+    /* parallel rays: along -z from anywhere in the cone, so a floor facing
+     * the light gets its full intensity off the axis too */
+    s = rayes_scene_new();
+    RayesParam par[2] = {pf("parallelrays", 1), pf("intensity", 2)};
+    CHECK(rayes_scene_light(s, "uberlight", par, 2) == RAYES_OK);
+    LightSample ls;
+    CHECK(light_sample(&s->lights[0], v3(3, 1, 5), 0.5f, 0.5f, &ls));
+    CHECK_NEAR(ls.wi.z, -1.0, 1e-6);
+    CHECK_NEAR(ls.Li.x, 2.0, 1e-6);
+    rayes_scene_release(s);
+}
+
+/* A unit square at depth z centred at (x, 0), facing -z (a bilinear patch). */
+static void square_at(RayesScene *s, float x, float z, float half)
+{
+    const float P[4][3] = {
+        {x - half, -half, z}, {x + half, -half, z}, {x - half, half, z}, {x + half, half, z}};
+    CHECK(rayes_scene_bilinear_patch(s, P) == RAYES_OK);
+}
+
+/* Shadows of an uberlight at the origin aiming +z on a point at (0, 0, 6)
+ * facing it, a square between: ray traced (the default), off, coloured,
+ * cast toward a cheated origin, and a blocker's (no geometry). */
+static void test_uber_light_shadows(void)
+{
+    struct {
+        RayesParam p[4];
+        int n;
+        float sq_x; /* the square's centre, z = 3 (NAN: none) */
+        double r, g;
+    } c[] = {
+        {{pf("intensity", 1)}, 1, NAN, 1, 1},
+        {{pf("intensity", 1)}, 1, 0, 0, 0},
+        {{pf("shadows", 0)}, 1, 0, 1, 1},
+        {{pv("shadowcolor", 0.25f, 0.5f, 1)}, 1, 0, 0.25, 0.5},
+        /* the cheat moves the shadows' origin 4 along +x: a square off
+         * the light's path but on the cheated one shadows, the one on the
+         * light's path does not */
+        {{pv("shadowcheat", 4, 0, 0)}, 1, 2, 0, 0},
+        {{pv("shadowcheat", 4, 0, 0)}, 1, 0, 1, 1},
+    };
+    for (size_t k = 0; k < sizeof c / sizeof c[0]; k++) {
+        RayesScene *s = rayes_scene_new();
+        CHECK(rayes_scene_light(s, "uberlight", c[k].p, (size_t)c[k].n) == RAYES_OK);
+        if (!isnan(c[k].sq_x))
+            square_at(s, c[k].sq_x, 3, 0.5f);
+        Fx f;
+        fx_init(&f, s);
+        double d[3], sp[3];
+        fx_direct(&f, v3(0, 0, 6), v3(0, 0, -1), NULL, 1, NULL, 0.1f, 1, d, sp);
+        if (fabs(PI * d[0] - c[k].r) > 1e-4)
+            fprintf(stderr, "  case %zu: %.6f, expected %.6f\n", k, PI * d[0], c[k].r);
+        CHECK_NEAR(PI * d[0], c[k].r, 1e-4);
+        CHECK_NEAR(PI * d[1], c[k].g, 1e-4);
+        fx_fini(&f);
+    }
+    /* A blocker: a sharp 0.5 x 0.5 square in the plane z = 3 of its own
+     * space (translated 0.2 along y), no geometry: (0, 0, 6) lies behind it,
+     * (3, 0, 6) beside (the segment crosses z = 3 at x = 1.5). */
+    const float M[16] = {1, 0, 0, 0, 0, 1, 0, 0.2f, 0, 0, 1, 3, 0, 0, 0, 1};
+    RayesParam b[6] = {{"blockermatrix", RAYES_PARAM_FLOATS, {0, 0, 0}, NULL, M, 16},
+                       pf("blockerwidth", 0.5f),
+                       pf("blockerheight", 0.5f),
+                       pf("blockerwedge", 0),
+                       pf("blockerhedge", 0),
+                       pf("blockerround", 0)};
+    RayesScene *s = rayes_scene_new();
+    CHECK(rayes_scene_light(s, "uberlight", b, 6) == RAYES_OK);
+    CHECK(s->n_lights == 1 && s->lights[0].uber.blocker);
+    CHECK_NEAR(uber_at(&s->lights[0], v3(0, 0, 6), v3(0, 0, -1)), 0.0, 0.0);
+    CHECK_NEAR(uber_at(&s->lights[0], v3(0, 1.6f, 6), v3(0, 0, -1)), 6 / sqrt(36 + 2.56), 1e-5);
+    CHECK(uber_at(&s->lights[0], v3(3, 0, 6), v3(0, 0, -1)) > 0.8);
+    rayes_scene_release(s);
+}
+
+/* A slide over the cross-section: each quarter of a 2 x 2 image on its
+ * quarter of the beam (the first row at +y); black outside. */
+static void test_uber_light_slide(void)
+{
+    const char *path = RAYES_TEST_TMP "/test_lights_uberslide.exr";
+    float px[2 * 2 * 4] = {1, 0, 0, 1, 0, 1, 0, 1,  /* top: red, green */
+                           0, 0, 1, 1, 1, 1, 1, 1}; /* bottom: blue, white */
+    CHECK(image_write_exr(path, 2, 2, px, NULL, 0) == RAYES_OK);
+    RayesScene *s = rayes_scene_new();
+    RayesParam p[3] = {ps("slidename", path), pf("wedge", 0), pf("hedge", 0)};
+    CHECK(rayes_scene_light(s, "uberlight", p, 3) == RAYES_OK);
+    const float at[4][3] = {{-0.7f, 0.7f, 1}, {0.7f, 0.7f, 1}, {-0.7f, -0.7f, 1}, {0.7f, -0.7f, 1}};
+    for (int k = 0; k < 4 && s->n_lights == 1; k++) {
+        LightSample ls;
+        CHECK(light_sample(&s->lights[0], v3_load(at[k]), 0.5f, 0.5f, &ls));
+        /* bilinear between texel centres at s = 1/4, 3/4: 0.85 is past them */
+        CHECK_NEAR(ls.Li.x, px[4 * k], 1e-5);
+        CHECK_NEAR(ls.Li.y, px[4 * k + 1], 1e-5);
+        CHECK_NEAR(ls.Li.z, px[4 * k + 2], 1e-5);
+    }
+    rayes_scene_release(s);
+}
+
+/* Any light may cast no shadows, or light only the diffuse or only the
+ * specular output (RenderMan's __nondiffuse, __nonspecular). */
+static void test_light_output_flags(void)
+{
+    for (int k = 0; k < 4; k++) {
+        RayesScene *s = rayes_scene_new();
+        RayesParam p[3] = {pv("from", 0, 0, 0), pf("intensity", 36),
+                           k == 0   ? pf("shadows", 0)
+                           : k == 1 ? pf("__nondiffuse", 1)
+                           : k == 2 ? pf("__nonspecular", 1)
+                                    : pf("shadows", 1)};
+        CHECK(rayes_scene_light(s, "pointlight", p, 3) == RAYES_OK);
+        square_at(s, 0, 3, 0.5f);
+        Fx f;
+        fx_init(&f, s);
+        double d[3], sp[3];
+        Vec3 I = v3(0, 0, 1);
+        fx_direct(&f, v3(0, 0, 6), v3(0, 0, -1), &I, 1, NULL, 0.1f, 1, d, sp);
+        /* unshadowed: 36 / 36 = 1 (times the cosine 1) */
+        CHECK_NEAR(PI * d[0], k == 0 ? 1.0 : 0.0, 1e-5);
+        CHECK(k == 0 ? sp[0] > 0.0 : sp[0] == 0.0);
+        fx_fini(&f);
+        s = rayes_scene_new();
+        CHECK(rayes_scene_light(s, "pointlight", p, 3) == RAYES_OK);
+        fx_init(&f, s); /* no square */
+        fx_direct(&f, v3(0, 0, 6), v3(0, 0, -1), &I, 1, NULL, 0.1f, 1, d, sp);
+        CHECK_NEAR(PI * d[0], k == 1 ? 0.0 : 1.0, 1e-5);
+        CHECK(k == 2 ? sp[0] == 0.0 : sp[0] > 0.0);
+        fx_fini(&f);
+    }
+}
+
 static void test_bad_lights(void)
 {
     RayesScene *s = rayes_scene_new();
@@ -1505,6 +1737,23 @@ static void test_bad_lights(void)
     RayesParam nan = pf("radius", NAN);
     CHECK(rayes_scene_light(s, "arealight", &nan, 1) == RAYES_ERROR_INVALID_ARGUMENT);
     CHECK(rayes_scene_light(s, NULL, NULL, 0) == RAYES_ERROR_INVALID_ARGUMENT);
+    rayes_scene_clear_error(s);
+    RayesParam area = ps("lighttype", "arealight");
+    CHECK(rayes_scene_light(s, "uberlight", &area, 1) == RAYES_ERROR_INVALID_ARGUMENT);
+    CHECK(strstr(rayes_scene_get_error(s), "lighttype \"arealight\"") != NULL);
+    RayesParam round = pf("roundness", 2), width = pf("width", 0), fd = pf("falloffdist", 0);
+    CHECK(rayes_scene_light(s, "uberlight", &round, 1) == RAYES_ERROR_INVALID_ARGUMENT);
+    CHECK(rayes_scene_light(s, "uberlight", &width, 1) == RAYES_ERROR_INVALID_ARGUMENT);
+    CHECK(rayes_scene_light(s, "uberlight", &fd, 1) == RAYES_ERROR_INVALID_ARGUMENT);
+    const float zero[16] = {0}, nine[9] = {0};
+    RayesParam sing = {"blockermatrix", RAYES_PARAM_FLOATS, {0, 0, 0}, NULL, zero, 16};
+    RayesParam short9 = {"blockermatrix", RAYES_PARAM_FLOATS, {0, 0, 0}, NULL, nine, 9};
+    rayes_scene_clear_error(s);
+    CHECK(rayes_scene_light(s, "uberlight", &sing, 1) == RAYES_ERROR_INVALID_ARGUMENT);
+    CHECK(strstr(rayes_scene_get_error(s), "singular") != NULL);
+    CHECK(rayes_scene_light(s, "uberlight", &short9, 1) == RAYES_ERROR_INVALID_ARGUMENT);
+    RayesParam noslide = ps("slidename", "/nonexistent/slide.tx");
+    CHECK(rayes_scene_light(s, "uberlight", &noslide, 1) == RAYES_ERROR_IO);
     CHECK(s->n_lights == 0); /* failed calls change nothing */
     CHECK(s->n_objects == 0 && s->n_prims == 0);
     rayes_scene_release(s);
@@ -1524,4 +1773,6 @@ TEST_MAIN(TEST(test_point_light_inverse_square), TEST(test_spot_light_cone),
           TEST(test_quad_light_close), TEST(test_environment_map_importance_sampling),
           TEST(test_environment_map_sampling_consistency), TEST(test_octahedral_environment_map),
           TEST(test_point_light_maps), TEST(test_categories), TEST(test_emitters_seen_by_camera),
-          TEST(test_every_light_any_thread_count), TEST(test_bad_lights))
+          TEST(test_every_light_any_thread_count), TEST(test_uber_light_shaping),
+          TEST(test_uber_light_shadows), TEST(test_uber_light_slide), TEST(test_light_output_flags),
+          TEST(test_bad_lights))

@@ -1,0 +1,202 @@
+/*
+ * The RIB reader's uberlight (Barzel's light, as Gritz's shader names its
+ * parameters; io/rib_shade.c) and its shadows, rendered through
+ * io_sink_scene: undeclared parameters are read, intensity is RenderMan's
+ * (pi times rayes'), shadows are cast only with a shadow map or BMRT's
+ * raytraceshadow, shadowcolor colours them, Attribute "light" "shadows"
+ * "off" turns them off for any light, a blocker is found by its
+ * CoordinateSystem; the RIB writer writes it all back.
+ *
+ * The scenes: the camera and the light at the origin looking down +z at a
+ * matte floor at z = 6; a square at z = 3 that the camera does not see but
+ * shadow rays do, its shadow the middle of the image.
+ */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "rayes/rayes.h"
+#include "test.h"
+
+#include "io/rib_round_trip.h"
+
+enum { SIZE = 24 };
+
+static const char *const floor_rib =
+    "Projection \"perspective\" \"fov\" [40]\nWorldBegin\n"
+    "Surface \"matte\"\nPolygon \"P\" [-4 -4 6  4 -4 6  4 4 6  -4 4 6]\n";
+
+#define SQUARE                                                                                     \
+    "AttributeBegin\nAttribute \"visibility\" \"int camera\" [0]\n"                                \
+    "Polygon \"P\" [-0.5 -0.5 3  0.5 -0.5 3  0.5 0.5 3  -0.5 0.5 3]\nAttributeEnd\n"
+
+/* The floor lit by the RIB text light, then more (geometry or ""). */
+static RayesImage *render_text(const char *text)
+{
+    RayesError e;
+    char err[512];
+    RayesScene *s = rib_read_scene(text, &e, err, sizeof err);
+    if (e != RAYES_OK)
+        fprintf(stderr, "  %s\n", err);
+    CHECK(e == RAYES_OK);
+    RayesImage *img = NULL;
+    if (e == RAYES_OK && rayes_scene_commit(s) == RAYES_OK) {
+        RayesRenderOptions o;
+        rayes_render_options_init(&o, RAYES_QUALITY_PREVIEW);
+        o.width = o.height = SIZE;
+        o.spp = 1;
+        o.threads = 2;
+        o.bounces = 0;
+        CHECK(rayes_render(s, &o, &img, NULL) == RAYES_OK);
+    }
+    rayes_scene_release(s);
+    return img;
+}
+
+static RayesImage *render_light(const char *light, const char *more)
+{
+    char text[4096];
+    snprintf(text, sizeof text, "%s%s%sWorldEnd\n", light, floor_rib, more);
+    return render_text(text);
+}
+
+/* The mean of channel c over the middle 4 x 4 pixels. */
+static double middle(const RayesImage *img, int c)
+{
+    double t = 0;
+    for (int y = SIZE / 2 - 2; y < SIZE / 2 + 2; y++)
+        for (int x = SIZE / 2 - 2; x < SIZE / 2 + 2; x++)
+            t += img->rgba[4 * (y * SIZE + x) + c];
+    return t / 16.0;
+}
+
+static double pixel(const RayesImage *img, int x, int y)
+{
+    return img->rgba[4 * (y * SIZE + x)];
+}
+
+static void test_uberlight_reads(void)
+{
+    /* Undeclared, as the RenderMan Repository's scenes give them: a sharp
+     * square cross-section of half-width 0.2 at unit depth. The middle of
+     * the floor faces the light: Kd Cs cos I = 2 (RenderMan's intensity,
+     * no falloff by default); the corner pixels lie outside. */
+    RayesImage *img = render_light(
+        "LightSource \"uberlight\" 1 \"intensity\" 2 \"width\" [.2] \"height\" .2 \"wedge\" 0 "
+        "\"hedge\" 0 \"roundness\" 0\n",
+        "");
+    CHECK(img != NULL);
+    if (img) {
+        CHECK_NEAR(middle(img, 0), 2.0, 0.01);
+        CHECK(pixel(img, 0, 0) == 0.0 && pixel(img, SIZE - 1, SIZE - 1) == 0.0);
+        rayes_image_free(img);
+    }
+    /* BMRT's area lighttype is omni (with a warning), lighting the corners */
+    img = render_light("LightSource \"uberlight\" 1 \"string lighttype\" \"arealight\"\n", "");
+    CHECK(img && pixel(img, 0, 0) > 0.5);
+    rayes_image_free(img);
+    /* an unknown blocker coordinate system is an error naming it */
+    RayesError e;
+    char err[512];
+    RayesScene *s = rib_read_scene("WorldBegin\nLightSource \"uberlight\" 1 \"string "
+                                   "blockercoords\" \"nowhere\"\nWorldEnd\n",
+                                   &e, err, sizeof err);
+    CHECK(e != RAYES_OK && strstr(err, "nowhere") && strstr(err, "t.rib:2"));
+    rayes_scene_release(s);
+}
+
+/* Shadows: none without a shadow map or raytraceshadow (RenderMan's
+ * uberlight traces no rays), ray traced with either; shadowcolor lights
+ * the shadow; Attribute "light" "shadows" "off" turns off any light's. */
+static void test_uberlight_shadows(void)
+{
+    RayesImage *open = render_light("LightSource \"uberlight\" 1\n", "");
+    RayesImage *none = render_light("LightSource \"uberlight\" 1\n", SQUARE);
+    RayesImage *traced = render_light("LightSource \"uberlight\" 1 \"raytraceshadow\" 1\n", SQUARE);
+    RayesImage *mapped =
+        render_light("LightSource \"uberlight\" 1 \"string shadowmap\" \"l.shd\"\n", SQUARE);
+    RayesImage *coloured = render_light(
+        "LightSource \"uberlight\" 1 \"shadowmap\" \"l.shd\" \"shadowcolor\" [0.25 0.5 1]\n",
+        SQUARE);
+    RayesImage *off = render_light("Attribute \"light\" \"shadows\" \"off\"\n"
+                                   "LightSource \"uberlight\" 1 \"raytraceshadow\" 1\n",
+                                   SQUARE);
+    RayesImage *point_on = render_light("LightSource \"pointlight\" 1 \"intensity\" 36\n", SQUARE);
+    RayesImage *point_off = render_light("Attribute \"light\" \"string shadows\" [\"off\"]\n"
+                                         "LightSource \"pointlight\" 1 \"intensity\" 36\n",
+                                         SQUARE);
+    CHECK(open && none && traced && mapped && coloured && off && point_on && point_off);
+    if (open && none && traced && mapped && coloured && off && point_on && point_off) {
+        double m = middle(open, 0);
+        CHECK(m > 0.9);
+        CHECK_NEAR(middle(none, 0), m, 1e-4);
+        CHECK(middle(traced, 0) == 0.0 && middle(mapped, 0) == 0.0);
+        CHECK_NEAR(middle(coloured, 0), 0.25 * m, 1e-4);
+        CHECK_NEAR(middle(coloured, 1), 0.5 * m, 1e-4);
+        CHECK_NEAR(middle(coloured, 2), m, 1e-4);
+        CHECK_NEAR(middle(off, 0), m, 1e-4);
+        CHECK(middle(point_on, 0) == 0.0 && middle(point_off, 0) > 0.9);
+    }
+    RayesImage *all[] = {open, none, traced, mapped, coloured, off, point_on, point_off};
+    for (size_t k = 0; k < sizeof all / sizeof all[0]; k++)
+        rayes_image_free(all[k]);
+}
+
+/* A blocker in the coordinate system "blk" (z = 3): the middle is dark,
+ * the corners lit; after AttributeEnd the system is still known. */
+static void test_uberlight_blocker(void)
+{
+    RayesImage *img = render_light(
+        "TransformBegin\nTranslate 0 0 3\nCoordinateSystem \"blk\"\nTransformEnd\n"
+        "LightSource \"uberlight\" 1 \"string lighttype\" \"omni\" \"string blockercoords\" "
+        "\"blk\" \"blockerwidth\" 0.3 \"blockerheight\" 0.3 \"blockerwedge\" 0 \"blockerhedge\" 0 "
+        "\"blockerround\" 0\n",
+        "");
+    CHECK(img != NULL);
+    if (img) {
+        CHECK(middle(img, 0) == 0.0);
+        CHECK(pixel(img, 0, 0) > 0.5);
+        rayes_image_free(img);
+    }
+}
+
+/* rayes convert: the writer's RIB renders the same image (shaping, shadows
+ * on, shadowcolor, blocker, falloff with maxintensity, a shadowless light,
+ * nonspecular). */
+static void test_uberlight_round_trip(void)
+{
+    char text[4096], err[512];
+    snprintf(text, sizeof text, "%s%s%sWorldEnd\n",
+             "TransformBegin\nTranslate 0.5 0 3\nCoordinateSystem \"blk\"\nTransformEnd\n"
+             "LightSource \"uberlight\" 1 \"intensity\" 3 \"raytraceshadow\" 1 \"shadowcolor\" "
+             "[0.1 0.2 0.3] \"falloff\" 2 \"falloffdist\" 4 \"maxintensity\" 5 \"shearx\" 0.1 "
+             "\"width\" 0.4 \"roundness\" 0.5 \"beamdistribution\" 1 \"blockercoords\" \"blk\" "
+             "\"blockerwidth\" 0.2 \"nonspecular\" 1 \"noiseamp\" 0.5\n"
+             "Translate 1 0 0\nLightSource \"uberlight\" 2 \"lighttype\" \"omni\" \"cuton\" 5 "
+             "\"nearedge\" 1\n",
+             floor_rib, SQUARE);
+    char *written = rib_round_trip(text, err, sizeof err);
+    CHECK(written != NULL);
+    if (!written) {
+        fprintf(stderr, "  %s\n", err);
+        return;
+    }
+    CHECK(strstr(written, "uberlight") && strstr(written, "blockermatrix"));
+    RayesImage *a = render_text(text), *b = render_text(written);
+    CHECK(a && b);
+    if (a && b) {
+        double worst = 0.0, sum = 0.0;
+        for (int i = 0; i < 4 * SIZE * SIZE; i++) {
+            worst = fmax(worst, fabs(a->rgba[i] - b->rgba[i]));
+            sum += a->rgba[i];
+        }
+        CHECK(worst < 1e-5 && sum > 10.0);
+    }
+    rayes_image_free(a);
+    rayes_image_free(b);
+    free(written);
+}
+
+TEST_MAIN(TEST(test_uberlight_reads), TEST(test_uberlight_shadows), TEST(test_uberlight_blocker),
+          TEST(test_uberlight_round_trip))
