@@ -24,7 +24,9 @@ int pbrt_sink_failed(Parser *P, const Token *t, RayesError e)
     return -1;
 }
 
-static void material_params(const Parser *P, const Material *m, RayesParam out[MAT_MAX_PARAMS + 1])
+/* m's parameters (a mix's classes "a" and "b" after them); returns how many. */
+static size_t material_params(const Parser *P, const Material *m,
+                              RayesParam out[MAT_MAX_PARAMS + 2])
 {
     for (int i = 0; i < m->n; i++) {
         out[i] = (RayesParam){.name = m->p[i].name, .type = m->p[i].type};
@@ -32,6 +34,11 @@ static void material_params(const Parser *P, const Material *m, RayesParam out[M
         if (m->p[i].type == RAYES_PARAM_PATTERN)
             out[i].string = P->textures[m->p[i].tex].pattern;
     }
+    size_t n = (size_t)m->n;
+    for (int k = 0; k < 2 && m->mix[k][0]; k++)
+        out[n++] =
+            (RayesParam){.name = k ? "b" : "a", .type = RAYES_PARAM_STRING, .string = m->mix[k]};
+    return n;
 }
 
 /* The displacement of mat (the built-in "displace" of its amount), or
@@ -161,9 +168,9 @@ static int send_material(Parser *P, const Token *t, const Material *mat)
 {
     if (P->have_sent && memcmp(&P->sent, mat, sizeof *mat) == 0)
         return 0;
-    RayesParam params[MAT_MAX_PARAMS + 1];
-    material_params(P, mat, params);
-    RayesError e = P->sink->set_shader(P->sink->target, mat->shader, params, (size_t)mat->n);
+    RayesParam params[MAT_MAX_PARAMS + 2];
+    size_t n = material_params(P, mat, params);
+    RayesError e = P->sink->set_shader(P->sink->target, mat->shader, params, n);
     if (e == RAYES_OK)
         e = send_displacement(P, mat);
     if (e != RAYES_OK)

@@ -35,7 +35,7 @@
 
 #define PBRT_PATH 1024
 #define PBRT_MAX_WARNED 512 /* kinds of warning said per read */
-#define MAT_MAX_PARAMS 10
+#define MAT_MAX_PARAMS 24   /* a mix: two materials' (10 each, say) and its amount */
 /* The shader name of pbrt's "interface" material: shapes with it are not
  * emitted (they only bound media). */
 #define PBRT_INVISIBLE "(interface)"
@@ -97,9 +97,11 @@ typedef struct ParamList {
  * materials compare with memcmp. */
 typedef struct Material {
     char shader[24];
+    char mix[2][24]; /* a "mix": its two materials' classes (their parameters are
+                        "a:NAME" and "b:NAME") */
     int n;
     struct {
-        char name[16];
+        char name[24];
         RayesParamType type; /* FLOAT, COLOR, or PATTERN */
         float v[3];
         size_t tex; /* PATTERN: the index of its Texture in Parser.textures */

@@ -536,9 +536,53 @@ static RayesParam reflectance_input(const Parser *P, const Material *m, const ch
     return (RayesParam){.name = name, .type = RAYES_PARAM_COLOR, .value = {c[0], c[1], c[2]}};
 }
 
+/* A "mix" shader of materials a and b by amount (q: its pattern, or
+ * the constant c): their classes and each parameter as "a:NAME" or
+ * "b:NAME". Returns 0, or -1 when that cannot be said (either is a mix or
+ * displaced, or the parameters do not fit), m untouched. */
+static int mix_of(Parser *P, const Material *a, const Material *b, const RayesParam *q, float c,
+                  Material *m)
+{
+    const Material *ab[2] = {a, b};
+    if (a->mix[0][0] || b->mix[0][0] || a->n + b->n + 1 > MAT_MAX_PARAMS)
+        return -1;
+    Material out;
+    pbrt_mat_init(&out, "mix");
+    for (int k = 0; k < 2; k++) {
+        snprintf(out.mix[k], sizeof out.mix[k], "%s", ab[k]->shader);
+        for (int i = 0; i < ab[k]->n; i++) {
+            out.p[out.n] = ab[k]->p[i];
+            snprintf(out.p[out.n].name, sizeof out.p[out.n].name, "%c:%s", 'a' + k,
+                     ab[k]->p[i].name);
+            out.n++;
+        }
+    }
+    /* pbrt's displacement belongs to a material, not to their mix: the
+     * first one's (a mix cannot displace two ways) */
+    for (int k = 1; k >= 0; k--)
+        if (ab[k]->displaced) {
+            out.displaced = ab[k]->displaced;
+            out.displacement_v = ab[k]->displacement_v;
+            out.displacement_tex = ab[k]->displacement_tex;
+        }
+    if (q->type == RAYES_PARAM_PATTERN) {
+        size_t i = 0;
+        while (i < P->n_textures && P->textures[i].pattern != q->string)
+            i++;
+        if (i == P->n_textures)
+            return -1;
+        mat_pattern(&out, "amount", i);
+    } else {
+        mat_float(&out, "amount", c);
+    }
+    *m = out;
+    return 0;
+}
+
 /* pbrt's mix of two materials: two diffuse ones are one diffuse material
  * whose reflectance is their mix (a "mix" pattern when either reflectance
- * or the amount is a texture); others take the heavier one. */
+ * or the amount is a texture); others a "mix" shader of the two (mix_of),
+ * or where that cannot be said the heavier one. */
 static int mix_material(Parser *P, const Token *t, ParamList *pl, Material *m)
 {
     static const float half[3] = {0.5f, 0.5f, 0.5f};
@@ -576,10 +620,13 @@ static int mix_material(Parser *P, const Token *t, ParamList *pl, Material *m)
         mat_pattern(m, "reflectance", (size_t)i);
         return 0;
     }
+    if (mix_of(P, a, b, &q[2], amount[0], m) == 0)
+        return 0;
     *m = amount[0] > 0.5f ? *b : *a;
     pbrt_warn_at(P, t->line, t->col, "mix",
-                 "mix: rayes cannot blend these materials; using the heavier one (\"%.60s\")",
-                 amount[0] > 0.5f ? names->str[1] : names->str[0]);
+                 "mix: rayes cannot blend these materials (a mix within a mix, or more than %d "
+                 "parameters between them); using the heavier one (\"%.60s\")",
+                 MAT_MAX_PARAMS - 1, amount[0] > 0.5f ? names->str[1] : names->str[0]);
     return 0;
 }
 

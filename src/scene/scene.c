@@ -244,6 +244,77 @@ RayesError rayes_scene_set_shading_rate(RayesScene *s, float rate)
 
 /* Makes an object; the surface colour and opacity are taken from the
  * reserved parameters "Cs" and "Os" (RenderMan's Color and Opacity). */
+static RayesError find_shader(RayesScene *s, const char *name, const RayesShaderClass **cls,
+                              int record);
+
+#define MIX_MAX_DEPTH 8 /* mixes of mixes, at most */
+
+/* An instance of cls with params (their patterns bound). A class with
+ * children (mix) takes its own parameters here, and makes its two
+ * materials of the classes its "a" and "b" name, each with the parameters
+ * "a:NAME" (or "b:NAME") as NAME, mixes among them down to MIX_MAX_DEPTH.
+ * On failure nothing is left made. */
+static RayesError make_instance(RayesScene *s, const RayesShaderClass *cls,
+                                const RayesParam *params, size_t n, ShaderInstance *inst, int depth)
+{
+    int mix = (shade_class_flags(cls) & SHADE_CLASS_CHILDREN) != 0;
+    RayesParam *own = malloc((n ? n : 1) * sizeof *own);
+    if (!own)
+        return scene_fail(s, RAYES_ERROR_OUT_OF_MEMORY, "out of memory");
+    size_t n_own = 0;
+    for (size_t i = 0; i < n; i++)
+        if (!mix || !(params[i].name[0] && params[i].name[1] == ':'))
+            own[n_own++] = params[i];
+    char err[256];
+    if (shade_instance_init(inst, cls, own, n_own, err, sizeof err) != 0) {
+        free(own);
+        return scene_fail(s, RAYES_ERROR_OUT_OF_MEMORY, "%s", err);
+    }
+    RayesError e = scene_bind_patterns(s, inst, own, n_own);
+    ShaderInstance *ch = mix && e == RAYES_OK ? calloc(2, sizeof *ch) : NULL;
+    if (mix && e == RAYES_OK && !ch)
+        e = scene_fail(s, RAYES_ERROR_OUT_OF_MEMORY, "out of memory");
+    if (mix && e == RAYES_OK && depth >= MIX_MAX_DEPTH)
+        e = scene_fail(s, RAYES_ERROR_INVALID_ARGUMENT, "mix: nested more than %d deep",
+                       MIX_MAX_DEPTH);
+    int made = 0;
+    for (int k = 0; k < 2 && ch && e == RAYES_OK; k++) {
+        const char key[2] = {(char)('a' + k), '\0'};
+        const char *cname = NULL;
+        n_own = 0;
+        for (size_t i = 0; i < n; i++) {
+            const char *nm = params[i].name;
+            if (strcmp(nm, key) == 0 && params[i].type == RAYES_PARAM_STRING)
+                cname = params[i].string;
+            else if (nm[0] == key[0] && nm[1] == ':') {
+                own[n_own] = params[i];
+                own[n_own++].name = nm + 2;
+            }
+        }
+        const RayesShaderClass *ccls = NULL;
+        if (!cname || !cname[0])
+            e = scene_fail(s, RAYES_ERROR_INVALID_ARGUMENT,
+                           "mix: expected \"string %s\" naming the class of its material %s", key,
+                           key);
+        else
+            e = find_shader(s, cname, &ccls, 1);
+        if (e == RAYES_OK)
+            e = make_instance(s, ccls, own, n_own, &ch[k], depth + 1);
+        made += e == RAYES_OK;
+    }
+    free(own);
+    if (e != RAYES_OK) {
+        for (int k = 0; k < made; k++)
+            shade_instance_fini(&ch[k]);
+        free(ch);
+        shade_instance_fini(inst);
+        return e;
+    }
+    if (ch)
+        shade_instance_adopt(inst, ch, 2);
+    return RAYES_OK;
+}
+
 static RayesError add_object(RayesScene *s, const RayesShaderClass *cls, const RayesParam *params,
                              size_t n_params, int light)
 {
@@ -284,17 +355,10 @@ static RayesError add_object(RayesScene *s, const RayesShaderClass *cls, const R
         for (int c = 0; c < 3; c++)
             dst[c] = params[i].value[single ? 0 : c];
     }
-    char err[256];
-    if (cls && shade_instance_init(&o->shader, cls, rest, n_rest, err, sizeof err) != 0) {
-        free(rest);
-        return scene_fail(s, RAYES_ERROR_OUT_OF_MEMORY, "%s", err);
-    }
-    RayesError bound = cls ? scene_bind_patterns(s, &o->shader, rest, n_rest) : RAYES_OK;
+    RayesError made = cls ? make_instance(s, cls, rest, n_rest, &o->shader, 0) : RAYES_OK;
     free(rest);
-    if (bound != RAYES_OK) {
-        shade_instance_fini(&o->shader);
-        return bound;
-    }
+    if (made != RAYES_OK)
+        return made;
     s->current_object = light >= 0 ? s->current_object : (int64_t)s->n_objects;
     s->n_objects++;
     scene_mark(s, SCENE_CHANGE_GEOMETRY);
@@ -2118,6 +2182,11 @@ RayesError rayes_scene_edit_shader(RayesScene *s, size_t object, const RayesPara
         shade_instance_fini(&trial);
         return e;
     }
+    trial.children = o->shader.children; /* a mix keeps its materials (and the
+                                            pointer its block holds to them) */
+    trial.n_children = o->shader.n_children;
+    o->shader.children = NULL;
+    o->shader.n_children = 0;
     shade_instance_fini(&o->shader);
     o->shader = trial;
     memcpy(o->Cs, Cs, sizeof Cs);

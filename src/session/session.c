@@ -303,7 +303,7 @@ RenderObject *session_render_objects(const RayesScene *scene)
         memcpy(ro[i].Cs, so->Cs, sizeof ro[i].Cs);
         memcpy(ro[i].Os, so->Os, sizeof ro[i].Os);
         ro[i].light = so->light;
-        ro[i].opacity_shader = so->shader.cls && so->shader.cls->opacity &&
+        ro[i].opacity_shader = shade_instance_has_opacity(&so->shader) &&
                                so->transmission_hitmode == RAYES_TRANSMISSION_SHADER;
         ro[i].Os_pattern = so->Os_pattern;
         ro[i].transparent =
@@ -311,7 +311,7 @@ RenderObject *session_render_objects(const RayesScene *scene)
                               so->Os[1] < 1.0f || so->Os[2] < 1.0f || so->Os_primvar_below_1);
         ro[i].opacity_cached = so->opacity_cache != 0;
         ro[i].thin_shadow =
-            ro[i].opacity_shader && shade_class_flags(so->shader.cls) & RAYES_SHADER_THIN_SHADOW;
+            ro[i].opacity_shader && shade_instance_flags(&so->shader) & RAYES_SHADER_THIN_SHADOW;
         if (so->links == 0)
             continue;
         unsigned char *mine = lit + (size_t)(so->links - 1) * scene->n_lights;
@@ -346,12 +346,11 @@ static uint32_t *object_masks(const RayesScene *scene, const RenderObject *ro)
     if (!m)
         return NULL;
     for (size_t i = 0; i < scene->n_objects; i++)
-        m[i] =
-            scene->objects[i].ray_mask | (ro[i].transparent ? ACCEL_MASK_TRANSPARENT : 0u) |
-            ((ro[i].shader && (shade_class_flags(ro[i].shader->cls) & RAYES_SHADER_SUBSURFACE)) ||
-                     (ro[i].light >= 0 && scene->lights[ro[i].light].type == LIGHT_MESH)
-                 ? ACCEL_MASK_OWN_SCENE
-                 : 0u);
+        m[i] = scene->objects[i].ray_mask | (ro[i].transparent ? ACCEL_MASK_TRANSPARENT : 0u) |
+               ((ro[i].shader && (shade_instance_flags(ro[i].shader) & RAYES_SHADER_SUBSURFACE)) ||
+                        (ro[i].light >= 0 && scene->lights[ro[i].light].type == LIGHT_MESH)
+                    ? ACCEL_MASK_OWN_SCENE
+                    : 0u);
     for (size_t i = 0; i < scene->n_volumes; i++) {
         int64_t o = scene->volumes[i].inside;
         if (o >= 0 && (size_t)o < scene->n_objects && session_crossed_bound(scene, ro, o))

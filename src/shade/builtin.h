@@ -28,6 +28,7 @@ extern const RayesShaderClass shade_class_turbulence; /* volume: the same, frequ
 extern const RayesShaderClass shade_class_subsurface; /* memo 6.2: preset, sigma_s, sigma_a,
                                                          albedo, diffusemeanfreepath, eta,
                                                          unitlength, profile, Kd, Ks, ... */
+extern const RayesShaderClass shade_class_mix;        /* two materials blended by amount (mix.c) */
 extern const RayesShaderClass shade_class_bumpy;    /* displacement: Km, frequency, texturename */
 extern const RayesShaderClass shade_class_fractal;  /* displacement: the memo's fractal noise */
 extern const RayesShaderClass shade_class_displace; /* displacement: P + amount N (a pattern) */

@@ -70,6 +70,8 @@ int shade_instance_init(ShaderInstance *inst, const RayesShaderClass *cls,
     inst->cls = cls;
     inst->patterns = NULL;
     inst->n_patterns = 0;
+    inst->children = NULL;
+    inst->n_children = 0;
     inst->params = calloc(1, cls->params_size ? cls->params_size : 1);
     if (!inst->params) {
         snprintf(err, err_size, "out of memory");
@@ -88,6 +90,39 @@ void shade_instance_fini(ShaderInstance *inst)
     free(inst->patterns);
     inst->patterns = NULL;
     inst->n_patterns = 0;
+    for (size_t i = 0; i < inst->n_children; i++)
+        shade_instance_fini(&inst->children[i]);
+    free(inst->children);
+    inst->children = NULL;
+    inst->n_children = 0;
+}
+
+void shade_instance_adopt(ShaderInstance *inst, ShaderInstance *children, size_t n)
+{
+    inst->children = children;
+    inst->n_children = n;
+    if (shade_class_flags(inst->cls) & SHADE_CLASS_CHILDREN)
+        memcpy(inst->params, &inst->children, sizeof inst->children);
+}
+
+int shade_instance_has_opacity(const ShaderInstance *inst)
+{
+    if (!inst || !inst->cls)
+        return 0;
+    if (!(shade_class_flags(inst->cls) & SHADE_CLASS_CHILDREN))
+        return inst->cls->opacity != NULL;
+    for (size_t i = 0; i < inst->n_children; i++)
+        if (shade_instance_has_opacity(&inst->children[i]))
+            return 1;
+    return 0;
+}
+
+uint32_t shade_instance_flags(const ShaderInstance *inst)
+{
+    uint32_t f = inst ? shade_class_flags(inst->cls) & ~SHADE_CLASS_CHILDREN : 0u;
+    for (size_t i = 0; inst && i < inst->n_children; i++)
+        f |= shade_instance_flags(&inst->children[i]);
+    return f;
 }
 
 int shade_instance_bind(ShaderInstance *inst, const char *name, const RayesPattern *pattern,

@@ -10,6 +10,7 @@
 #define RAYES_SHADE_SHADE_H
 
 #include <stddef.h>
+#include <stdint.h>
 
 #include "rayes/shader.h"
 
@@ -22,7 +23,15 @@ typedef struct ShaderInstance {
     size_t n_patterns;
     int bump; /* a displacement that bends the shading normal alone (its
                  "__bump" 1, pbrt's material displacement): P stays */
+    struct ShaderInstance *children; /* a class of SHADE_CLASS_CHILDREN's: the instances
+                                        it shades with (owned array), else NULL */
+    size_t n_children;
 } ShaderInstance;
+
+/* rayes' own flag (no plugin sets it): the class shades with other
+ * instances, its children (mix.c), which shade_instance_adopt gives it; its
+ * parameter block begins with a `const ShaderInstance *` to them. */
+#define SHADE_CLASS_CHILDREN (1u << 31)
 
 /* Makes an instance: defaults, then params by name. Unknown names and type
  * mismatches get a warning naming the shader and the parameter (once per
@@ -35,6 +44,11 @@ int shade_instance_init(ShaderInstance *inst, const RayesShaderClass *cls,
 int shade_instance_apply(ShaderInstance *inst, const RayesParam *params, size_t n_params,
                          int strict, char *err, size_t err_size);
 void shade_instance_fini(ShaderInstance *inst);
+
+/* Gives a SHADE_CLASS_CHILDREN instance its n children (a malloc'd array of
+ * initialised instances, owned from now on: shade_instance_fini ends
+ * them). */
+void shade_instance_adopt(ShaderInstance *inst, ShaderInstance *children, size_t n);
 
 /* Binds the FLOAT or COLOR parameter `name` of the instance to pattern (a
  * later binding of the same name replaces it). Returns 0, or -1 with err
@@ -81,6 +95,15 @@ static inline uint32_t shade_class_flags(const RayesShaderClass *cls)
                ? cls->flags
                : 0u;
 }
+
+/* The flags an object shaded by inst needs: its class's, and its
+ * children's (a mix of a subsurface material needs the object's own
+ * scene), without SHADE_CLASS_CHILDREN. */
+uint32_t shade_instance_flags(const ShaderInstance *inst);
+
+/* Nonzero if inst computes opacity: its class has an opacity method, or
+ * for a class with children, one of them does. */
+int shade_instance_has_opacity(const ShaderInstance *inst);
 
 /* Points per chunk when a shader needs scratch arrays on the stack. */
 #define SHADE_CHUNK 64

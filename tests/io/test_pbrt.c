@@ -30,9 +30,9 @@ static const double PI_D = 3.14159265358979323846;
 typedef struct Shader {
     char name[32];
     int n;
-    RayesParam p[8];
-    char str[8][256];
-    char names[8][32];
+    RayesParam p[24];
+    char str[24][256];
+    char names[24][32];
 } Shader;
 
 typedef struct Rec {
@@ -94,7 +94,7 @@ static void copy_params(Shader *s, const char *name, const RayesParam *p, size_t
 {
     memset(s, 0, sizeof *s);
     snprintf(s->name, sizeof s->name, "%s", name ? name : "");
-    for (size_t i = 0; i < n && i < 8; i++) {
+    for (size_t i = 0; i < n && i < 24; i++) {
         s->p[i] = p[i];
         snprintf(s->names[i], sizeof s->names[i], "%s", p[i].name);
         s->p[i].name = s->names[i]; /* the caller's strings are borrowed */
@@ -1612,12 +1612,52 @@ static void test_exposure(void)
                  "t.pbrt:1:1: Film: expected maxcomponentvalue > 0");
 }
 
-TEST_MAIN(TEST(test_filters), TEST(test_exposure), TEST(test_subsurface_material),
-          TEST(test_filter_warnings), TEST(test_import), TEST(test_film_types),
-          TEST(test_measured_material), TEST(test_portal_warns), TEST(test_thin_dielectric),
-          TEST(test_annulus), TEST(test_triangle_light), TEST(test_light_power),
-          TEST(test_normal_map), TEST(test_anisotropic_roughness), TEST(test_maxdepth),
-          TEST(test_spectrum_files), TEST(test_cornell_box), TEST(test_transforms),
-          TEST(test_materials), TEST(test_lights), TEST(test_instances_include_ply),
-          TEST(test_errors), TEST(test_normals_and_uv), TEST(test_textures),
-          TEST(test_coated_conductor_textures))
+/* pbrt's mix of two materials of other classes: the "mix" shader, its
+ * materials' classes in "a" and "b", their parameters as "a:NAME" and
+ * "b:NAME", the amount a pattern; a mix within a mix takes the heavier. */
+static void test_mix_classes(void)
+{
+    Rec *r = calloc(1, sizeof *r);
+    IoSettings s;
+    char err[512];
+    const char *text =
+        "Camera \"perspective\"\nWorldBegin\n"
+        "Texture \"checks\" \"float\" \"checkerboard\" \"float uscale\" 4\n"
+        "MakeNamedMaterial \"red\" \"string type\" \"coateddiffuse\" \"rgb reflectance\" [0.8 "
+        "0.1 0.1]\n"
+        "MakeNamedMaterial \"gold\" \"string type\" \"conductor\" \"float roughness\" 0.2\n"
+        "MakeNamedMaterial \"both\" \"string type\" \"mix\" \"string materials\" [\"red\" "
+        "\"gold\"] \"texture amount\" \"checks\"\n"
+        "MakeNamedMaterial \"deeper\" \"string type\" \"mix\" \"string materials\" [\"both\" "
+        "\"red\"] \"float amount\" 0.75\n"
+        "NamedMaterial \"both\"\n"
+        "Shape \"trianglemesh\" \"point3 P\" [0 0 0 1 0 0 0 1 0]\n"
+        "NamedMaterial \"deeper\"\n"
+        "Shape \"trianglemesh\" \"point3 P\" [0 0 0 1 0 0 0 1 0]\n";
+    CHECK(parse("t.pbrt", text, r, &s, err, sizeof err) == RAYES_OK);
+    CHECK(r->n_meshes == 2);
+    if (r->n_meshes == 2) {
+        const Shader *sh = &r->mesh[0].shader;
+        CHECK(strcmp(sh->name, "mix") == 0);
+        CHECK(param(sh, "a") && strcmp(param(sh, "a")->string, "coateddiffuse") == 0);
+        CHECK(param(sh, "b") && strcmp(param(sh, "b")->string, "conductor") == 0);
+        CHECK(param(sh, "a:reflectance") &&
+              fabsf(param(sh, "a:reflectance")->value[0] - 0.8f) < 1e-6f);
+        CHECK(param(sh, "b:roughness") && param(sh, "b:roughness")->value[0] > 0.0f);
+        CHECK(param(sh, "amount") && param(sh, "amount")->type == RAYES_PARAM_PATTERN);
+        CHECK(bound_pattern(r, sh, "amount") >= 0);
+        /* a mix of a mix and another: the heavier (amount 0.75: "red") */
+        CHECK(strcmp(r->mesh[1].shader.name, "coateddiffuse") == 0);
+    }
+    free(r);
+}
+
+TEST_MAIN(TEST(test_filters), TEST(test_mix_classes), TEST(test_exposure),
+          TEST(test_subsurface_material), TEST(test_filter_warnings), TEST(test_import),
+          TEST(test_film_types), TEST(test_measured_material), TEST(test_portal_warns),
+          TEST(test_thin_dielectric), TEST(test_annulus), TEST(test_triangle_light),
+          TEST(test_light_power), TEST(test_normal_map), TEST(test_anisotropic_roughness),
+          TEST(test_maxdepth), TEST(test_spectrum_files), TEST(test_cornell_box),
+          TEST(test_transforms), TEST(test_materials), TEST(test_lights),
+          TEST(test_instances_include_ply), TEST(test_errors), TEST(test_normals_and_uv),
+          TEST(test_textures), TEST(test_coated_conductor_textures))
