@@ -24,21 +24,16 @@ int pbrt_sink_failed(Parser *P, const Token *t, RayesError e)
     return -1;
 }
 
-/* m's parameters (a mix's classes "a" and "b" after them); returns how many. */
-static size_t material_params(const Parser *P, const Material *m,
-                              RayesParam out[MAT_MAX_PARAMS + 2])
+static void material_params(const Parser *P, const Material *m, RayesParam out[MAT_MAX_PARAMS])
 {
     for (int i = 0; i < m->n; i++) {
         out[i] = (RayesParam){.name = m->p[i].name, .type = m->p[i].type};
         memcpy(out[i].value, m->p[i].v, sizeof out[i].value);
         if (m->p[i].type == RAYES_PARAM_PATTERN)
             out[i].string = P->textures[m->p[i].tex].pattern;
+        if (m->p[i].type == RAYES_PARAM_STRING) /* a mix's classes */
+            out[i].string = m->p[i].s;
     }
-    size_t n = (size_t)m->n;
-    for (int k = 0; k < 2 && m->mix[k][0]; k++)
-        out[n++] =
-            (RayesParam){.name = k ? "b" : "a", .type = RAYES_PARAM_STRING, .string = m->mix[k]};
-    return n;
 }
 
 /* The displacement of mat (the built-in "displace" of its amount), or
@@ -168,9 +163,9 @@ static int send_material(Parser *P, const Token *t, const Material *mat)
 {
     if (P->have_sent && memcmp(&P->sent, mat, sizeof *mat) == 0)
         return 0;
-    RayesParam params[MAT_MAX_PARAMS + 2];
-    size_t n = material_params(P, mat, params);
-    RayesError e = P->sink->set_shader(P->sink->target, mat->shader, params, n);
+    RayesParam params[MAT_MAX_PARAMS];
+    material_params(P, mat, params);
+    RayesError e = P->sink->set_shader(P->sink->target, mat->shader, params, (size_t)mat->n);
     if (e == RAYES_OK)
         e = send_displacement(P, mat);
     if (e != RAYES_OK)

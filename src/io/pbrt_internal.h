@@ -97,14 +97,13 @@ typedef struct ParamList {
  * materials compare with memcmp. */
 typedef struct Material {
     char shader[24];
-    char mix[2][24]; /* a "mix": its two materials' classes (their parameters are
-                        "a:NAME" and "b:NAME") */
     int n;
     struct {
         char name[24];
-        RayesParamType type; /* FLOAT, COLOR, or PATTERN */
+        RayesParamType type; /* FLOAT, COLOR, PATTERN, or STRING (a mix's classes) */
         float v[3];
         size_t tex; /* PATTERN: the index of its Texture in Parser.textures */
+        char s[24]; /* STRING */
     } p[MAT_MAX_PARAMS];
     int displaced; /* pbrt's "displacement": 1 a constant (displacement_v), 2 a
                       texture (displacement_tex) */

@@ -537,23 +537,28 @@ static RayesParam reflectance_input(const Parser *P, const Material *m, const ch
 }
 
 /* A "mix" shader of materials a and b by amount (q: its pattern, or
- * the constant c): their classes and each parameter as "a:NAME" or
- * "b:NAME". Returns 0, or -1 when that cannot be said (either is a mix or
- * displaced, or the parameters do not fit), m untouched. */
+ * the constant c): their classes as "a" and "b", each parameter as
+ * "a:NAME" or "b:NAME" (a mix's own too, so mixes nest). Returns 0, or -1
+ * when that cannot be said (the parameters or their names do not fit), m
+ * untouched. */
 static int mix_of(Parser *P, const Material *a, const Material *b, const RayesParam *q, float c,
                   Material *m)
 {
     const Material *ab[2] = {a, b};
-    if (a->mix[0][0] || b->mix[0][0] || a->n + b->n + 1 > MAT_MAX_PARAMS)
+    if (a->n + b->n + 3 > MAT_MAX_PARAMS)
         return -1;
     Material out;
     pbrt_mat_init(&out, "mix");
     for (int k = 0; k < 2; k++) {
-        snprintf(out.mix[k], sizeof out.mix[k], "%s", ab[k]->shader);
+        snprintf(out.p[out.n].name, sizeof out.p[out.n].name, "%c", 'a' + k);
+        out.p[out.n].type = RAYES_PARAM_STRING;
+        snprintf(out.p[out.n].s, sizeof out.p[out.n].s, "%s", ab[k]->shader);
+        out.n++;
         for (int i = 0; i < ab[k]->n; i++) {
             out.p[out.n] = ab[k]->p[i];
-            snprintf(out.p[out.n].name, sizeof out.p[out.n].name, "%c:%s", 'a' + k,
-                     ab[k]->p[i].name);
+            if ((size_t)snprintf(out.p[out.n].name, sizeof out.p[out.n].name, "%c:%s", 'a' + k,
+                                 ab[k]->p[i].name) >= sizeof out.p[out.n].name)
+                return -1; /* nested too deep for the name */
             out.n++;
         }
     }
@@ -624,9 +629,9 @@ static int mix_material(Parser *P, const Token *t, ParamList *pl, Material *m)
         return 0;
     *m = amount[0] > 0.5f ? *b : *a;
     pbrt_warn_at(P, t->line, t->col, "mix",
-                 "mix: rayes cannot blend these materials (a mix within a mix, or more than %d "
-                 "parameters between them); using the heavier one (\"%.60s\")",
-                 MAT_MAX_PARAMS - 1, amount[0] > 0.5f ? names->str[1] : names->str[0]);
+                 "mix: rayes cannot blend these materials (more than %d parameters between them, "
+                 "or mixes nested too deep); using the heavier one (\"%.60s\")",
+                 MAT_MAX_PARAMS - 3, amount[0] > 0.5f ? names->str[1] : names->str[0]);
     return 0;
 }
 

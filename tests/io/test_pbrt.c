@@ -1614,7 +1614,7 @@ static void test_exposure(void)
 
 /* pbrt's mix of two materials of other classes: the "mix" shader, its
  * materials' classes in "a" and "b", their parameters as "a:NAME" and
- * "b:NAME", the amount a pattern; a mix within a mix takes the heavier. */
+ * "b:NAME", the amount a pattern; a mix within a mix nests. */
 static void test_mix_classes(void)
 {
     Rec *r = calloc(1, sizeof *r);
@@ -1646,8 +1646,15 @@ static void test_mix_classes(void)
         CHECK(param(sh, "b:roughness") && param(sh, "b:roughness")->value[0] > 0.0f);
         CHECK(param(sh, "amount") && param(sh, "amount")->type == RAYES_PARAM_PATTERN);
         CHECK(bound_pattern(r, sh, "amount") >= 0);
-        /* a mix of a mix and another: the heavier (amount 0.75: "red") */
-        CHECK(strcmp(r->mesh[1].shader.name, "coateddiffuse") == 0);
+        /* a mix of a mix and another: nested, the inner one's parameters
+         * "a:"-prefixed once more */
+        sh = &r->mesh[1].shader;
+        CHECK(strcmp(sh->name, "mix") == 0);
+        CHECK(param(sh, "a") && strcmp(param(sh, "a")->string, "mix") == 0);
+        CHECK(param(sh, "a:b") && strcmp(param(sh, "a:b")->string, "conductor") == 0);
+        CHECK(param(sh, "a:a:reflectance") && param(sh, "b:reflectance"));
+        CHECK(bound_pattern(r, sh, "a:amount") >= 0);
+        CHECK(param(sh, "amount") && fabsf(param(sh, "amount")->value[0] - 0.75f) < 1e-6f);
     }
     free(r);
 }
