@@ -1594,6 +1594,20 @@ static void test_uber_light_shaping(void)
     CHECK_NEAR(ls.wi.z, -1.0, 1e-6);
     CHECK_NEAR(ls.Li.x, 2.0, 1e-6);
     rayes_scene_release(s);
+    /* the viewer's edits: moved, the shaping moves along; a new intensity
+     * keeps maxintensity where it was */
+    s = rayes_scene_new();
+    RayesParam lit[5] = {pf("wedge", 0), pf("hedge", 0), pf("falloff", 2), pf("falloffdist", 4),
+                         pf("maxintensity", 3)};
+    CHECK(rayes_scene_light(s, "uberlight", lit, 5) == RAYES_OK);
+    RayesParam move[2] = {pv("translate", 10, 0, 0), pf("intensity", 1.5f)};
+    CHECK(rayes_scene_edit_light(s, 0, move, 2) == RAYES_OK);
+    float at[3];
+    CHECK(rayes_scene_get_light(s, 0, NULL, NULL, at) == RAYES_OK && at[0] == 10.0f);
+    CHECK_NEAR(uber_at(&s->lights[0], v3(10, 0, 8), v3(0, 0, -1)), 1.5 * 0.25, 1e-6);
+    CHECK(uber_at(&s->lights[0], v3(0, 0, 8), v3(0, 0, -1)) == 0.0); /* outside, now */
+    CHECK_NEAR(s->lights[0].uber.maxratio, 2.0, 1e-6);
+    rayes_scene_release(s);
 }
 
 /* A unit square at depth z centred at (x, 0), facing -z (a bilinear patch). */
