@@ -45,15 +45,16 @@ static RayesError send_displacement(Parser *P, const Material *mat)
                    ? P->sink->set_displacement(P->sink->target, "", NULL, 0)
                    : RAYES_OK;
     /* pbrt-v4's material displacement is a bump map: the shading normal
-     * of the surface displaced along N, the surface where it is */
+     * of the surface displaced along N, the surface where it is; a
+     * plymesh's (3) moves the surface */
     RayesParam p[2] = {
         {.name = "amount", .type = RAYES_PARAM_FLOAT, .value = {mat->displacement_v, 0, 0}},
         {.name = "__bump", .type = RAYES_PARAM_FLOAT, .value = {1, 0, 0}}};
-    if (mat->displaced == 2)
+    if (mat->displaced == 2 || mat->displaced == 3)
         p[0] = (RayesParam){.name = "amount",
                             .type = RAYES_PARAM_PATTERN,
                             .string = P->textures[mat->displacement_tex].pattern};
-    return P->sink->set_displacement(P->sink->target, "displace", p, 2);
+    return P->sink->set_displacement(P->sink->target, "displace", p, mat->displaced <= 2 ? 2 : 1);
 }
 
 /* Sends m as the sink's transform; 0, or -1 when it is not finite or the

@@ -106,7 +106,8 @@ typedef struct Material {
         char s[24]; /* STRING */
     } p[MAT_MAX_PARAMS];
     int displaced; /* pbrt's "displacement": 1 a constant (displacement_v), 2 a
-                      texture (displacement_tex) */
+                      texture (displacement_tex), both bump maps; a plymesh's, which
+                      moves the surface: 3 a texture, 4 a constant */
     float displacement_v;
     size_t displacement_tex;
 } Material;
@@ -412,6 +413,12 @@ int pbrt_d_material(Parser *P, const Token *t); /* pbrt_material.c */
 int pbrt_d_makenamedmaterial(Parser *P, const Token *t);
 int pbrt_d_namedmaterial(Parser *P, const Token *t);
 int pbrt_d_texture(Parser *P, const Token *t);
+/* A plymesh's "texture displacement" (pbrt-v4's: each vertex moved along
+ * its normal by the float texture, in object space) into m, for that shape
+ * alone: m->displaced 3 (4 for a texture that is a constant), scaled by the
+ * current transform's uniform scale (world units). Returns 0 (nothing
+ * given: m unchanged), or -1 (an error in P). */
+int pbrt_shape_displacement(Parser *P, const Token *t, ParamList *pl, Material *m);
 int pbrt_d_shape(Parser *P, const Token *t); /* pbrt_shape.c */
 int pbrt_d_arealight(Parser *P, const Token *t); /* pbrt_light.c */
 /* An area light's radiance for the next shape, of n_prims pbrt shapes

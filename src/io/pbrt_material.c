@@ -509,6 +509,46 @@ static int mat_displacement(Parser *P, ParamList *pl, Material *m)
     return 0;
 }
 
+int pbrt_shape_displacement(Parser *P, const Token *t, ParamList *pl, Material *m)
+{
+    Param *d = pbrt_find(pl, "displacement");
+    if (!d)
+        return 0;
+    static const float zero[3] = {0, 0, 0};
+    float c[3];
+    const Texture *tex = NULL;
+    int k = pbrt_get_color(P, pl, "displacement", zero, c, &tex);
+    if (k < 0)
+        return -1;
+    /* object-space lengths: the transform's uniform scale, cube root of
+     * its linear part's determinant */
+    const double *M = P->gs.ctm;
+    double det = M[0] * (M[5] * M[10] - M[6] * M[9]) - M[1] * (M[4] * M[10] - M[6] * M[8]) +
+                 M[2] * (M[4] * M[9] - M[5] * M[8]);
+    float scale = (float)cbrt(fabs(det));
+    if (!(isfinite(scale) && scale > 0.0f))
+        scale = 1.0f;
+    if (k != 2) { /* a texture that is a constant (or a float given) */
+        m->displaced = c[0] != 0.0f ? 4 : 0;
+        m->displacement_v = c[0] * scale;
+        return 0;
+    }
+    size_t i = (size_t)(tex - P->textures);
+    if (fabsf(scale - 1.0f) > 1e-6f) {
+        RayesParam q[2] = {
+            {.name = "tex", .type = RAYES_PARAM_PATTERN, .string = P->textures[i].pattern},
+            {.name = "scale", .type = RAYES_PARAM_FLOAT, .value = {scale, 0, 0}}};
+        float standin[3] = {c[0] * scale, c[1] * scale, c[2] * scale};
+        long s = define_pattern(P, t, " displacement", 1, "scale", q, 2, standin);
+        if (s < 0)
+            return -1;
+        i = (size_t)s;
+    }
+    m->displaced = 3;
+    m->displacement_tex = i;
+    return 0;
+}
+
 static int diffuse_material(Parser *P, ParamList *pl, Material *m, const char *param)
 {
     static const float half[3] = {0.5f, 0.5f, 0.5f};

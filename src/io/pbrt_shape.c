@@ -495,10 +495,11 @@ static int shape_plymesh(Parser *P, const Token *t, ParamList *pl)
     const char *file = pbrt_get_string(pl, "filename", NULL);
     if (!file)
         return FAIL_TOK(P, t, "plymesh: expected \"string filename\"");
-    Param *d = pbrt_find(pl, "displacement");
-    if (d)
-        pbrt_warn_at(P, d->line, d->col, "ply displacement", "plymesh: \"displacement\" is not "
-                     "supported (no displacement)");
+    /* pbrt-v4 refines the mesh to "edgelength" and moves its vertices;
+     * rayes dices it by the shading rate and displaces the grids (the
+     * caller restores the material after the shape) */
+    if (pbrt_shape_displacement(P, t, pl, &P->gs.material) != 0)
+        return -1;
     pbrt_find(pl, "edgelength");
     char path[PBRT_PATH], err[600];
     if (pbrt_resolve(P, t, file, path, sizeof path) != 0)

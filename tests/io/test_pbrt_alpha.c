@@ -443,7 +443,72 @@ static void test_fog_behind_transparent(void)
     }
 }
 
-TEST_MAIN(TEST(test_constant_alpha), TEST(test_texture_alpha), TEST(test_rib_round_trip),
-          TEST(test_bad_alpha), TEST(test_displacement_is_bump), TEST(test_medium_inside_glass),
+/* The mean image row (0 at the top) of the alpha-weighted pixels. */
+static double mean_row(const RayesImage *img)
+{
+    double sum = 0.0, w = 0.0;
+    for (int y = 0; y < SIZE; y++)
+        for (int x = 0; x < SIZE; x++) {
+            double a = img->rgba[4 * (y * SIZE + x) + 3];
+            sum += a * y;
+            w += a;
+        }
+    return w > 0.0 ? sum / w : -1.0;
+}
+
+/* A plymesh's "texture displacement" (pbrt-v4's: each vertex moved along
+ * its normal by the texture, in object space) moves the surface: a flat
+ * square under Scale 2 displaced by a constant 0.5 rises to z = 1, seen
+ * from the side a little above; by a checkerboard of 0 and 0.5, half of
+ * it does; without the displacement it stays. */
+static void test_plymesh_displacement_moves(void)
+{
+    char path[512];
+    snprintf(path, sizeof path, "%s/test_pbrt_alpha_quad.ply", RAYES_TEST_TMP);
+    FILE *f = fopen(path, "wb");
+    CHECK(f != NULL);
+    if (!f)
+        return;
+    fputs("ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\n"
+          "property float z\nproperty float nx\nproperty float ny\nproperty float nz\n"
+          "property float u\nproperty float v\nelement face 1\n"
+          "property list uchar int vertex_indices\nend_header\n"
+          "-1 -1 0 0 0 1 0 0\n1 -1 0 0 0 1 1 0\n1 1 0 0 0 1 1 1\n-1 1 0 0 0 1 0 1\n"
+          "4 0 1 2 3\n",
+          f);
+    fclose(f);
+    double row[3];
+    static const char *const shift[3] = {
+        "", " \"texture displacement\" \"lift\" \"float edgelength\" 0.1",
+        " \"texture displacement\" \"cells\""};
+    for (int k = 0; k < 3; k++) {
+        char text[2048];
+        snprintf(text, sizeof text,
+                 "LookAt 0 -12 2  0 0 0.5  0 0 1\nCamera \"perspective\" \"float fov\" 30\n"
+                 "WorldBegin\nLightSource \"distant\" \"point3 from\" [0 0 5] \"point3 to\" "
+                 "[0 0 0]\n"
+                 "Texture \"lift\" \"float\" \"constant\" \"float value\" 0.5\n"
+                 "Texture \"cells\" \"float\" \"checkerboard\" \"float uscale\" 2 "
+                 "\"float vscale\" 2 \"float tex1\" 0 \"float tex2\" 0.5\n"
+                 "Scale 2 2 2\nShape \"plymesh\" \"string filename\" \"%s\"%s\n",
+                 path, shift[k]);
+        RayesImage *img = render_read(io_pbrt_parse, text, 1);
+        CHECK(img != NULL);
+        row[k] = img ? mean_row(img) : -1.0;
+        rayes_image_free(img);
+    }
+    /* up in world z by 1 at 12 units: about 1 / (12 tan 15) of the half
+     * height, 5 of the 32 rows */
+    printf("  plymesh displacement: mean row %.2f without, %.2f lifted, %.2f by cells\n", row[0],
+           row[1], row[2]);
+    CHECK(row[0] > 0.0 && row[1] > 0.0 && row[2] > 0.0);
+    CHECK(row[0] - row[1] > 3.0 && row[0] - row[1] < 7.0);
+    /* half its cells lifted as far (a pattern, scaled too): between */
+    CHECK(row[2] < row[0] - 1.0 && row[2] > row[1] + 0.5);
+}
+
+TEST_MAIN(TEST(test_constant_alpha), TEST(test_plymesh_displacement_moves),
+          TEST(test_texture_alpha), TEST(test_rib_round_trip), TEST(test_bad_alpha),
+          TEST(test_displacement_is_bump), TEST(test_medium_inside_glass),
           TEST(test_medium_inside_interface), TEST(test_medium_in_glass_shadow),
           TEST(test_fog_behind_transparent))
