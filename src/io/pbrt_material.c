@@ -528,8 +528,14 @@ int pbrt_shape_displacement(Parser *P, const Token *t, ParamList *pl, Material *
     float scale = (float)cbrt(fabs(det));
     if (!(isfinite(scale) && scale > 0.0f))
         scale = 1.0f;
+    if (k != 2 && c[0] == 0.0f)
+        return 0; /* nothing moves: the material's own bump, if any, stays */
+    if (m->displaced)
+        pbrt_warn_at(P, d->line, d->col, "ply displacement and bump",
+                     "plymesh: its displacement replaces its material's \"displacement\" (a "
+                     "bump map) on this shape");
     if (k != 2) { /* a texture that is a constant (or a float given) */
-        m->displaced = c[0] != 0.0f ? 4 : 0;
+        m->displaced = 4;
         m->displacement_v = c[0] * scale;
         return 0;
     }
@@ -585,7 +591,11 @@ static int mix_of(Parser *P, const Material *a, const Material *b, const RayesPa
                   Material *m)
 {
     const Material *ab[2] = {a, b};
-    if (a->n + b->n + 3 > MAT_MAX_PARAMS)
+    /* one slot left for a shape's alpha or normal map; an interface (no
+     * surface) or a material carrying Cs (hair's colour, the object's, not
+     * a child's) cannot be a mix's */
+    if (a->n + b->n + 4 > MAT_MAX_PARAMS || strcmp(a->shader, PBRT_INVISIBLE) == 0 ||
+        strcmp(b->shader, PBRT_INVISIBLE) == 0 || mat_get(a, "Cs") || mat_get(b, "Cs"))
         return -1;
     Material out;
     pbrt_mat_init(&out, "mix");
@@ -669,9 +679,10 @@ static int mix_material(Parser *P, const Token *t, ParamList *pl, Material *m)
         return 0;
     *m = amount[0] > 0.5f ? *b : *a;
     pbrt_warn_at(P, t->line, t->col, "mix",
-                 "mix: rayes cannot blend these materials (more than %d parameters between them, "
-                 "or mixes nested too deep); using the heavier one (\"%.60s\")",
-                 MAT_MAX_PARAMS - 3, amount[0] > 0.5f ? names->str[1] : names->str[0]);
+                 "mix: rayes cannot blend these materials (an interface, hair, more than %d "
+                 "parameters between them, or mixes nested too deep); using the heavier one "
+                 "(\"%.60s\")",
+                 MAT_MAX_PARAMS - 4, amount[0] > 0.5f ? names->str[1] : names->str[0]);
     return 0;
 }
 

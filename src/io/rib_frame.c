@@ -215,6 +215,9 @@ static int h_world_begin(Rib *r, const Args *a)
     for (size_t k = 0; k < r->n_lights; k++)
         if (r->lights[k].pre_world) {
             rib_mat_mul(wc, r->lights[k].M, r->lights[k].M);
+            for (size_t i = 0; i < r->lights[k].n; i++) /* an uberlight's blocker too */
+                if (r->lights[k].params[i].type == RAYES_PARAM_FLOATS)
+                    rib_mat_mul(wc, r->lights[k].blocker, r->lights[k].blocker);
             r->lights[k].pre_world = 0;
         }
     memset(&r->real, 0, sizeof r->real);

@@ -744,6 +744,10 @@ static int uber_params(Rib *r, Light *L, const Param *p, size_t n)
             blocker_param(L);
         }
     }
+    if (!rib_find_param(p, n, "maxintensity")) { /* RenderMan's default 1: pi of rayes' */
+        const float pi[3] = {(float)M_PI, 0, 0};
+        rib_light_param(L, "maxintensity", RAYES_PARAM_FLOAT, pi, NULL);
+    }
     if (shadows <= 0 || r->a.shadowless) {
         static const float off[3] = {0, 0, 0};
         rib_light_param(L, "shadows", RAYES_PARAM_FLOAT, off, NULL);

@@ -606,14 +606,14 @@ static void svc_direct_fiber(const RayesShaderServices *sv, const RayesShadeCtx 
             Light moved; /* a light moving within the frame: where it is at w->time */
             const Light *l = light_at_time(&w->rs->lights[k], w->time, &moved);
             if (l->type == LIGHT_AMBIENT || !render_lit_by(obj, k) ||
-                !light_category_match(l, category))
+                !light_category_match(l, category) || (l->nondiffuse && l->nonspecular))
                 continue;
             int m = light_is_area(l) ? n : 1;
             LightMeshView view; /* fibres light from every side: no horizon */
             if (l->type == LIGHT_MESH)
                 light_mesh_view(l, p.P, v3(0, 0, 0), &view);
             fiber_light_samples(w, &p, l, &view, m, (uint32_t)hash_combine(key, k), &d, &s);
-            if (light_is_area(l) && v3_length(p.V) > 0.0f)
+            if (light_is_area(l) && v3_length(p.V) > 0.0f && !l->nonspecular)
                 fiber_lobe_samples(w, &p, l, &view, m, hash_combine(hash_combine(key, k), 1), &s);
         }
         if (diffuse)

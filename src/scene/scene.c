@@ -1749,6 +1749,23 @@ static RayesError light_map(RayesScene *s, const char *type, const LightParams *
     return RAYES_OK;
 }
 
+/* Whether a light parameter is an uberlight's alone. */
+static int uber_only(const char *name)
+{
+    static const char *const shared[] = {
+        "intensity",      "lightcolor",       "from",          "to",    "coneangle",
+        "conedeltaangle", "beamdistribution", "radius",        "width", "height",
+        "mapname",        "mapping",          "fov",           "shape", "__category",
+        "shadows",        "__nondiffuse",     "__nonspecular", NULL};
+    for (int k = 0; shared[k]; k++)
+        if (strcmp(shared[k], name) == 0)
+            return 0;
+    for (size_t k = 0; k < sizeof light_param_descs / sizeof *light_param_descs; k++)
+        if (strcmp(light_param_descs[k].name, name) == 0)
+            return 1;
+    return 0;
+}
+
 /* Barzel's light (uberlight): its space is the current transform; lp's
  * shaping checked and kept in l->uber (DESIGN.md "Lights"). */
 static RayesError uber_light(RayesScene *s, const LightParams *lp, Light *l)
@@ -1825,7 +1842,7 @@ static RayesError uber_light(RayesScene *s, const LightParams *lp, Light *l)
         if (scene_find_texture(s, lp->slidename, path, sizeof path) != 0)
             return scene_fail(s, RAYES_ERROR_INVALID_ARGUMENT, "uberlight: slide name too long");
         if (light_env_load(l, path, 0, err, sizeof err) != 0)
-            return scene_fail(s, RAYES_ERROR_IO, "%s", err);
+            return scene_fail(s, RAYES_ERROR_IO, "uberlight slide: %s", err);
         u->slide = 1;
     }
     RayesError e = push_light(s, l, NULL, 0);
@@ -1860,6 +1877,13 @@ RayesError rayes_scene_light(RayesScene *s, const char *type, const RayesParam *
         return e;
     if (isnan(lp.beamdistribution)) /* RenderMan's defaults */
         lp.beamdistribution = t == 6 ? 0.0f : 2.0f;
+    for (size_t i = 0; t != 6 && i < n_params; i++) /* the shaping is uberlight's alone */
+        if (uber_only(params[i].name)) {
+            char key[128];
+            snprintf(key, sizeof key, "light:%s:%s", type, params[i].name);
+            log_warning_once(key, "%s has no parameter \"%s\" (an uberlight's); ignored", type,
+                             params[i].name);
+        }
     Light l;
     memset(&l, 0, sizeof l);
     snprintf(l.category, sizeof l.category, "%s", lp.category);
@@ -2154,6 +2178,14 @@ RayesError rayes_scene_edit_shader(RayesScene *s, size_t object, const RayesPara
             free(rest);
             return scene_fail(s, RAYES_ERROR_INVALID_ARGUMENT,
                               "edit shader: a parameter has no name or is not finite");
+        }
+        if (o->shader.n_children && (strcmp(p->name, "a") == 0 || strcmp(p->name, "b") == 0)) {
+            free(trial.params);
+            free(rest);
+            return scene_fail(s, RAYES_ERROR_INVALID_ARGUMENT,
+                              "edit shader: a mix's materials (\"%s\") cannot be edited; its "
+                              "\"amount\" can",
+                              p->name);
         }
         float *dst = strcmp(p->name, "Cs") == 0 ? Cs : strcmp(p->name, "Os") == 0 ? Os : NULL;
         if (dst && (p->type == RAYES_PARAM_FLOAT || p->type == RAYES_PARAM_COLOR)) {

@@ -910,11 +910,13 @@ static float uber_shape(const LightUber *u, Vec3 p)
     if (u->falloff != 0.0f) {
         if (len > u->falloffdist) {
             k *= powf(u->falloffdist / len, u->falloff);
-        } else if (u->maxratio != 1.0f) {
+        } else if (u->maxratio > 1.0f) {
             /* within falloffdist the intensity rises smoothly to maxratio
-             * at the light instead of without bound (1 at falloffdist) */
+             * at the light instead of without bound (1 at falloffdist);
+             * with maxintensity at or below intensity it stays at 1 there
+             * (Gritz's formula would grow without bound) */
             float s = logf(1.0f / u->maxratio), beta = -u->falloff / s;
-            k *= u->maxratio * expf(fminf(s * powf(len / u->falloffdist, beta), 60.0f));
+            k *= u->maxratio * expf(s * powf(len / u->falloffdist, beta));
         }
     }
     if (!u->omni && u->beam > 0.0f)

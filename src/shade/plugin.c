@@ -19,6 +19,8 @@
 #include <string.h>
 #include <unistd.h>
 
+#include "shade/shade.h"
+
 typedef struct Plugin {
     char *path;                    /* real path of the file, owned */
     void *handle;                  /* dlopen handle, never closed */
@@ -108,6 +110,10 @@ int shade_plugin_check_class(const RayesShaderClass *cls, const char *name, char
     }
     if (!cls->lighting) {
         snprintf(err, err_size, "class \"%s\" has no lighting method (required)", name);
+        return -1;
+    }
+    if (shade_class_flags(cls) & SHADE_CLASS_CHILDREN) { /* rayes' own bit: a built-in mix */
+        snprintf(err, err_size, "class \"%s\" sets flag bit 31, which is rayes' own", name);
         return -1;
     }
     if (cls->params_size > PLUGIN_MAX_PARAMS_SIZE || cls->scratch_size > PLUGIN_MAX_SCRATCH_SIZE) {

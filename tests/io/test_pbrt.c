@@ -1630,13 +1630,18 @@ static void test_mix_classes(void)
         "\"gold\"] \"texture amount\" \"checks\"\n"
         "MakeNamedMaterial \"deeper\" \"string type\" \"mix\" \"string materials\" [\"both\" "
         "\"red\"] \"float amount\" 0.75\n"
+        "MakeNamedMaterial \"none\" \"string type\" \"interface\"\n"
+        "MakeNamedMaterial \"cut\" \"string type\" \"mix\" \"string materials\" [\"none\" "
+        "\"red\"] \"float amount\" 0.75\n"
         "NamedMaterial \"both\"\n"
         "Shape \"trianglemesh\" \"point3 P\" [0 0 0 1 0 0 0 1 0]\n"
         "NamedMaterial \"deeper\"\n"
+        "Shape \"trianglemesh\" \"point3 P\" [0 0 0 1 0 0 0 1 0]\n"
+        "NamedMaterial \"cut\"\n"
         "Shape \"trianglemesh\" \"point3 P\" [0 0 0 1 0 0 0 1 0]\n";
     CHECK(parse("t.pbrt", text, r, &s, err, sizeof err) == RAYES_OK);
-    CHECK(r->n_meshes == 2);
-    if (r->n_meshes == 2) {
+    CHECK(r->n_meshes == 3);
+    if (r->n_meshes == 3) {
         const Shader *sh = &r->mesh[0].shader;
         CHECK(strcmp(sh->name, "mix") == 0);
         CHECK(param(sh, "a") && strcmp(param(sh, "a")->string, "coateddiffuse") == 0);
@@ -1655,6 +1660,8 @@ static void test_mix_classes(void)
         CHECK(param(sh, "a:a:reflectance") && param(sh, "b:reflectance"));
         CHECK(bound_pattern(r, sh, "a:amount") >= 0);
         CHECK(param(sh, "amount") && fabsf(param(sh, "amount")->value[0] - 0.75f) < 1e-6f);
+        /* with an interface (no surface): the heavier, as before */
+        CHECK(strcmp(r->mesh[2].shader.name, "coateddiffuse") == 0);
     }
     free(r);
 }

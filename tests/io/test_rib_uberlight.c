@@ -92,6 +92,12 @@ static void test_uberlight_reads(void)
         CHECK(pixel(img, 0, 0) == 0.0 && pixel(img, SIZE - 1, SIZE - 1) == 0.0);
         rayes_image_free(img);
     }
+    /* a falloff whose falloffdist lies beyond the floor: RenderMan's
+     * default maxintensity (1, as the intensity) keeps it at the intensity
+     * there (it grew without bound when the default missed the factor pi) */
+    img = render_light("LightSource \"uberlight\" 1 \"falloff\" 2 \"falloffdist\" 8\n", "");
+    CHECK(img && fabs(middle(img, 0) - 1.0) < 0.01);
+    rayes_image_free(img);
     /* BMRT's area lighttype is omni (with a warning), lighting the corners */
     img = render_light("LightSource \"uberlight\" 1 \"string lighttype\" \"arealight\"\n", "");
     CHECK(img && pixel(img, 0, 0) > 0.5);

@@ -1584,6 +1584,14 @@ static void test_uber_light_shaping(void)
     }
     CHECK(last > 2.9); /* near the light: maxintensity */
     rayes_scene_release(s);
+    /* maxintensity at or below intensity: 1 within falloffdist, bounded */
+    s = rayes_scene_new();
+    RayesParam low[5] = {ps("lighttype", "omni"), pf("falloff", 2), pf("falloffdist", 4),
+                         pf("maxintensity", 0.5f), pf("intensity", 1)};
+    CHECK(rayes_scene_light(s, "uberlight", low, 5) == RAYES_OK);
+    CHECK_NEAR(uber_at(&s->lights[0], v3(0, 0, 0.5f), v3(0, 0, -1)), 1.0, 1e-6);
+    CHECK_NEAR(uber_at(&s->lights[0], v3(0, 0, 8), v3(0, 0, -1)), 0.25, 1e-6);
+    rayes_scene_release(s);
     /* parallel rays: along -z from anywhere in the cone, so a floor facing
      * the light gets its full intensity off the axis too */
     s = rayes_scene_new();

@@ -173,8 +173,11 @@ static void test_mix_flags(void)
         RayesParam amount = pf("amount", 0.75f);
         CHECK(rayes_scene_edit_shader(s, 1, &amount, 1) == RAYES_OK);
         CHECK(s->objects[1].shader.n_children == 2);
-        RayesParam child = pf("a:Kd", 0.5f);
+        RayesParam child = pf("a:Kd", 0.5f), cls = ps("a", "conductor");
         CHECK(rayes_scene_edit_shader(s, 1, &child, 1) == RAYES_ERROR_INVALID_ARGUMENT);
+        rayes_scene_clear_error(s);
+        CHECK(rayes_scene_edit_shader(s, 1, &cls, 1) == RAYES_ERROR_INVALID_ARGUMENT);
+        CHECK(strstr(rayes_scene_get_error(s), "materials") != NULL);
     }
     rayes_scene_release(s);
 }
