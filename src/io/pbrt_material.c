@@ -522,10 +522,7 @@ int pbrt_shape_displacement(Parser *P, const Token *t, ParamList *pl, Material *
         return -1;
     /* object-space lengths: the transform's uniform scale, cube root of
      * its linear part's determinant */
-    const double *M = P->gs.ctm;
-    double det = M[0] * (M[5] * M[10] - M[6] * M[9]) - M[1] * (M[4] * M[10] - M[6] * M[8]) +
-                 M[2] * (M[4] * M[9] - M[5] * M[8]);
-    float scale = (float)cbrt(fabs(det));
+    float scale = (float)cbrt(fabs(pbrt_mat_det3(P->gs.ctm)));
     if (!(isfinite(scale) && scale > 0.0f))
         scale = 1.0f;
     if (k != 2 && c[0] == 0.0f)

@@ -427,17 +427,22 @@ static void direct_lighting(const RayesShadeCtx *ctx, int n_shadow_rays, const c
             if (l->type == LIGHT_AMBIENT || !render_lit_by(obj, k) ||
                 !light_category_match(l, category))
                 continue;
-            DirectPoint q = p; /* the outputs this light adds to */
-            q.diff = p.diff && !l->nondiffuse;
-            q.spec = p.spec && !l->nonspecular;
-            if (!q.diff && !q.spec)
-                continue;
+            const DirectPoint *use = &p;
+            DirectPoint q; /* a light for one lobe: the outputs it adds to */
+            if (l->nondiffuse || l->nonspecular) {
+                q = p;
+                q.diff = p.diff && !l->nondiffuse;
+                q.spec = p.spec && !l->nonspecular;
+                if (!q.diff && !q.spec)
+                    continue;
+                use = &q;
+            }
             if (light_is_area(l))
-                light_area(w, &q, l,
+                light_area(w, use, l,
                            hash_combine(hash_combine(ps->keys[point(ctx, i)], DIM_LIGHT), k), n, &d,
                            &s);
             else
-                light_delta(w, &q, l, &d, &s);
+                light_delta(w, use, l, &d, &s);
         }
         if (diffuse)
             v3_store(diffuse[i], d);

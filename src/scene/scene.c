@@ -1536,6 +1536,7 @@ typedef struct LightParamDesc {
     const char *name;
     RayesParamType type;
     size_t offset;
+    int uber; /* 1: an uberlight's alone (others warn and ignore it) */
 } LightParamDesc;
 
 static const LightParamDesc light_param_descs[] = {
@@ -1557,32 +1558,32 @@ static const LightParamDesc light_param_descs[] = {
     {"shadows", RAYES_PARAM_FLOAT, offsetof(LightParams, shadows)},
     {"__nondiffuse", RAYES_PARAM_FLOAT, offsetof(LightParams, nondiffuse)},
     {"__nonspecular", RAYES_PARAM_FLOAT, offsetof(LightParams, nonspecular)},
-    {"lighttype", RAYES_PARAM_STRING, offsetof(LightParams, lighttype)},
-    {"slidename", RAYES_PARAM_STRING, offsetof(LightParams, slidename)},
-    {"cuton", RAYES_PARAM_FLOAT, offsetof(LightParams, cuton)},
-    {"cutoff", RAYES_PARAM_FLOAT, offsetof(LightParams, cutoff)},
-    {"nearedge", RAYES_PARAM_FLOAT, offsetof(LightParams, nearedge)},
-    {"faredge", RAYES_PARAM_FLOAT, offsetof(LightParams, faredge)},
-    {"falloff", RAYES_PARAM_FLOAT, offsetof(LightParams, falloff)},
-    {"falloffdist", RAYES_PARAM_FLOAT, offsetof(LightParams, falloffdist)},
-    {"maxintensity", RAYES_PARAM_FLOAT, offsetof(LightParams, maxintensity)},
-    {"parallelrays", RAYES_PARAM_FLOAT, offsetof(LightParams, parallelrays)},
-    {"shearx", RAYES_PARAM_FLOAT, offsetof(LightParams, shearx)},
-    {"sheary", RAYES_PARAM_FLOAT, offsetof(LightParams, sheary)},
-    {"wedge", RAYES_PARAM_FLOAT, offsetof(LightParams, wedge)},
-    {"hedge", RAYES_PARAM_FLOAT, offsetof(LightParams, hedge)},
-    {"roundness", RAYES_PARAM_FLOAT, offsetof(LightParams, roundness)},
-    {"noiseamp", RAYES_PARAM_FLOAT, offsetof(LightParams, noiseamp)},
-    {"noisefreq", RAYES_PARAM_FLOAT, offsetof(LightParams, noisefreq)},
-    {"noiseoffset", RAYES_PARAM_COLOR, offsetof(LightParams, noiseoffset)},
-    {"shadowcolor", RAYES_PARAM_COLOR, offsetof(LightParams, shadowcolor)},
-    {"shadowcheat", RAYES_PARAM_COLOR, offsetof(LightParams, shadowcheat)},
-    {"blockermatrix", RAYES_PARAM_FLOATS, offsetof(LightParams, blockermatrix)},
-    {"blockerwidth", RAYES_PARAM_FLOAT, offsetof(LightParams, blockerwidth)},
-    {"blockerheight", RAYES_PARAM_FLOAT, offsetof(LightParams, blockerheight)},
-    {"blockerwedge", RAYES_PARAM_FLOAT, offsetof(LightParams, blockerwedge)},
-    {"blockerhedge", RAYES_PARAM_FLOAT, offsetof(LightParams, blockerhedge)},
-    {"blockerround", RAYES_PARAM_FLOAT, offsetof(LightParams, blockerround)},
+    {"lighttype", RAYES_PARAM_STRING, offsetof(LightParams, lighttype), 1},
+    {"slidename", RAYES_PARAM_STRING, offsetof(LightParams, slidename), 1},
+    {"cuton", RAYES_PARAM_FLOAT, offsetof(LightParams, cuton), 1},
+    {"cutoff", RAYES_PARAM_FLOAT, offsetof(LightParams, cutoff), 1},
+    {"nearedge", RAYES_PARAM_FLOAT, offsetof(LightParams, nearedge), 1},
+    {"faredge", RAYES_PARAM_FLOAT, offsetof(LightParams, faredge), 1},
+    {"falloff", RAYES_PARAM_FLOAT, offsetof(LightParams, falloff), 1},
+    {"falloffdist", RAYES_PARAM_FLOAT, offsetof(LightParams, falloffdist), 1},
+    {"maxintensity", RAYES_PARAM_FLOAT, offsetof(LightParams, maxintensity), 1},
+    {"parallelrays", RAYES_PARAM_FLOAT, offsetof(LightParams, parallelrays), 1},
+    {"shearx", RAYES_PARAM_FLOAT, offsetof(LightParams, shearx), 1},
+    {"sheary", RAYES_PARAM_FLOAT, offsetof(LightParams, sheary), 1},
+    {"wedge", RAYES_PARAM_FLOAT, offsetof(LightParams, wedge), 1},
+    {"hedge", RAYES_PARAM_FLOAT, offsetof(LightParams, hedge), 1},
+    {"roundness", RAYES_PARAM_FLOAT, offsetof(LightParams, roundness), 1},
+    {"noiseamp", RAYES_PARAM_FLOAT, offsetof(LightParams, noiseamp), 1},
+    {"noisefreq", RAYES_PARAM_FLOAT, offsetof(LightParams, noisefreq), 1},
+    {"noiseoffset", RAYES_PARAM_COLOR, offsetof(LightParams, noiseoffset), 1},
+    {"shadowcolor", RAYES_PARAM_COLOR, offsetof(LightParams, shadowcolor), 1},
+    {"shadowcheat", RAYES_PARAM_COLOR, offsetof(LightParams, shadowcheat), 1},
+    {"blockermatrix", RAYES_PARAM_FLOATS, offsetof(LightParams, blockermatrix), 1},
+    {"blockerwidth", RAYES_PARAM_FLOAT, offsetof(LightParams, blockerwidth), 1},
+    {"blockerheight", RAYES_PARAM_FLOAT, offsetof(LightParams, blockerheight), 1},
+    {"blockerwedge", RAYES_PARAM_FLOAT, offsetof(LightParams, blockerwedge), 1},
+    {"blockerhedge", RAYES_PARAM_FLOAT, offsetof(LightParams, blockerhedge), 1},
+    {"blockerround", RAYES_PARAM_FLOAT, offsetof(LightParams, blockerround), 1},
 };
 
 static RayesError light_params(RayesScene *s, const char *type, const RayesParam *params,
@@ -1752,17 +1753,9 @@ static RayesError light_map(RayesScene *s, const char *type, const LightParams *
 /* Whether a light parameter is an uberlight's alone. */
 static int uber_only(const char *name)
 {
-    static const char *const shared[] = {
-        "intensity",      "lightcolor",       "from",          "to",    "coneangle",
-        "conedeltaangle", "beamdistribution", "radius",        "width", "height",
-        "mapname",        "mapping",          "fov",           "shape", "__category",
-        "shadows",        "__nondiffuse",     "__nonspecular", NULL};
-    for (int k = 0; shared[k]; k++)
-        if (strcmp(shared[k], name) == 0)
-            return 0;
     for (size_t k = 0; k < sizeof light_param_descs / sizeof *light_param_descs; k++)
         if (strcmp(light_param_descs[k].name, name) == 0)
-            return 1;
+            return light_param_descs[k].uber;
     return 0;
 }
 

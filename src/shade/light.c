@@ -961,7 +961,7 @@ int light_uber_sample(const Light *l, Vec3 o, LightUberSample *us)
     if (u->slide && l->env)
         lc = v3_mul(lc, uber_slide(l, p));
     s->Li = v3_scale(lc, k);
-    us->Ls = v3_scale(v3_mul(u->shadowcolor, v3(l->intensity, l->intensity, l->intensity)), k);
+    us->Ls = v3_scale(u->shadowcolor, l->intensity * k);
     Vec3 sd = v3_sub(origin, o);
     us->sdist = v3_length(sd);
     us->sw = us->sdist > 0.0f ? v3_scale(sd, 1.0f / us->sdist) : s->wi;
