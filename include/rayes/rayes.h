@@ -951,6 +951,12 @@ typedef struct RayesRenderOptions {
                                    radiosity level: deeper hits read medium at finest, the
                                    wider differentials of rays after several bounces (memo
                                    5.1). Default 1; 0 to 128 (128: the rule alone) */
+    int env_guide;              /* 1 (default but in the reference preset): an environment
+                                   light's samples at camera hits are drawn where the hit's
+                                   grid sees the environment (a window's sky), by weights
+                                   its fill traces once per grid and keeps in the cache
+                                   (data type guide, 16 MB); unbiased either way, 0 draws
+                                   by the map's brightness alone (DESIGN.md "Lights") */
 } RayesRenderOptions;
 
 /* Fills options with the defaults of a quality preset: 512 x 512, 4 pixel

@@ -79,6 +79,8 @@ static const char render_options[] =
     "                          each lends the others what it leaves unused\n"
     "  --irradiance-cache on|off  cache the irradiance subsurface rays find (default on)\n"
     "  --irradiance-cache-mb MB   the irradiance entries' budget in megabytes (default 20)\n"
+    "  --env-guide on|off      draw an environment light's samples where each grid sees it\n"
+    "                          (default on; off in --quality reference)\n"
     "  --opacity-cache on|off  cache opacity() results for shadow and transmission rays\n"
     "                          (default on)\n"
     "  --opacity-cache-mb MB   the opacity entries' budget in megabytes (default 20)\n"
@@ -432,7 +434,11 @@ void parse_args(int argc, char **argv, Args *a)
             opt->irradiance_cache = strcmp(v, "on") == 0;
         } else if (strcmp(o, "--irradiance-cache-mb") == 0)
             opt->irradiance_cache_mb = parse_float(o, v, 0.0f, 1e7f);
-        else if (strcmp(o, "--opacity-cache") == 0) {
+        else if (strcmp(o, "--env-guide") == 0) {
+            if (strcmp(v, "on") != 0 && strcmp(v, "off") != 0)
+                die_usage("--env-guide: expected on or off, got \"%s\"", v);
+            opt->env_guide = strcmp(v, "on") == 0;
+        } else if (strcmp(o, "--opacity-cache") == 0) {
             if (strcmp(v, "on") != 0 && strcmp(v, "off") != 0)
                 die_usage("--opacity-cache: expected on or off, got \"%s\"", v);
             opt->opacity_cache = strcmp(v, "on") == 0;

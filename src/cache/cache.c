@@ -177,7 +177,7 @@ static Cache *cache_new_parts(const uint64_t budget_bytes[CACHE_N_TYPES],
 
 Cache *cache_new(uint64_t budget_bytes, const float split[CACHE_N_LEVELS])
 {
-    uint64_t budgets[CACHE_N_TYPES] = {budget_bytes, 0, 0};
+    uint64_t budgets[CACHE_N_TYPES] = {budget_bytes};
     return cache_new_parts(budgets, split, 1);
 }
 

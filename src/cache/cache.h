@@ -5,6 +5,7 @@
  *
  * Structure (memo 3.1, DESIGN.md "The multiresolution cache"):
  *  - per data type (radiosity, opacity, irradiance: memo 6, one cache whose
+ *    keys carry the type; and rayes's environment guides)
  *    keys carry the type) a budget of its own, and within it
  *  - three resolutions (COARSE, MEDIUM, FINE), each with its own share of the
  *    byte budget (default 25% / 25% / 50% of 100 MB; a resolution past its
@@ -48,7 +49,8 @@ typedef enum CacheType {
     CACHE_RADIOSITY = 0,
     CACHE_OPACITY = 1,
     CACHE_IRRADIANCE = 2,
-    CACHE_N_TYPES = 3
+    CACHE_GUIDE = 3, /* an environment light's weights per grid (render/envguide.c) */
+    CACHE_N_TYPES = 4
 } CacheType;
 
 /* What an entry is for. Two keys are equal iff all fields are. */

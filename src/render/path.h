@@ -51,6 +51,16 @@ typedef struct SubsurfaceMedium {
  * cache line, so that no two share one. */
 #define WORKER_ALIGN 64
 
+/* The guide a worker built last for one environment light (envguide.c):
+ * points of one grid come one after another, so it is looked up once. */
+#define ENVGUIDE_LIGHTS 2
+typedef struct GuideSlot {
+    uint32_t patch, instance;
+    int side;
+    int state; /* 0: empty; 1: g usable; 2: no guide for that key */
+    LightGuide g;
+} GuideSlot;
+
 typedef struct Worker {
     _Alignas(WORKER_ALIGN) const RenderScene *rs;
     const RenderSettings *set;
@@ -70,6 +80,9 @@ typedef struct Worker {
     int has_medium;
     const struct RenderObject *shading; /* the object whose shader runs (its thin shadow is
                                            opaque to it: RAYES_SHADER_THIN_SHADOW) */
+    GuideSlot guides[ENVGUIDE_LIGHTS];  /* environment lights' last guides (envguide.h) */
+    const uint32_t *guide_pixels;       /* envguide_pixels's counts, or NULL: no guides (but
+                                           the grid hider's) */
 } Worker;
 
 /* What a shading context's `renderer` points to: per point (indexed from

@@ -567,6 +567,54 @@ void radiosity_shade_grid(Worker *w, uint32_t grid, uint32_t instance, int depth
     fill_radiosity(&job, &key, level_values(g, CACHE_FINE), out);
 }
 
+int radiosity_patch_points(Worker *w, uint32_t patch, uint32_t instance, int side, Vec3 P[4],
+                           Vec3 N[4], float *offset)
+{
+    const GridSet *gs = w->rs->gs;
+    int cluster = patch >= gs->n_grids;
+    uint32_t grid = cluster ? gs->clusters[patch - gs->n_grids].rep : patch;
+    const Grid *g = &gs->grids[grid];
+    size_t n = cluster ? 1 : level_values(g, CACHE_COARSE); /* 4, 3 or 1 */
+    RY_CHECK(n >= 1 && n <= 4);
+    float f3[9][4][3], f1[10][4], dst[4][4];
+    uint64_t keys[4];
+    RayDiff diff[4];
+    FillPoints fp = {.P = f3[0],
+                     .N = f3[1],
+                     .Ng = f3[2],
+                     .dPdu = f3[3],
+                     .dPdv = f3[4],
+                     .Cs = f3[5],
+                     .Os = f3[6],
+                     .Ci = f3[7],
+                     .Oi = f3[8],
+                     .u = f1[0],
+                     .v = f1[1],
+                     .s = f1[2],
+                     .t = f1[3],
+                     .dst = dst,
+                     .du = f1[4],
+                     .dv = f1[5],
+                     .ds = f1[6],
+                     .dt = f1[7],
+                     .curv = f1[8],
+                     .offset = f1[9],
+                     .keys = keys,
+                     .diff = diff};
+    const RenderObject *obj = render_object(w->rs, grid, instance);
+    const GeomInstance *gi = render_instance(w->rs, instance);
+    if (cluster)
+        middle_point(gs, g, side, obj, gi, 0, &fp);
+    else
+        layout_points(gs, g, CACHE_COARSE, side, obj, gi, 0, &fp);
+    for (size_t i = 0; i < n; i++) {
+        P[i] = v3_load(fp.P[i]);
+        N[i] = v3_load(fp.Ng[i]);
+    }
+    *offset = path_ray_offset_in(w, g, instance);
+    return (int)n;
+}
+
 /* -------------------------------------------------------- interpolation */
 
 static Vec3 value(const uint16_t *vals, size_t i)

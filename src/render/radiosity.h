@@ -42,6 +42,15 @@ Vec3 radiosity_irradiance_at_hit(Worker *w, const Ray *ray, const Hit *hit, floa
 void radiosity_shade_grid(Worker *w, uint32_t grid, uint32_t instance, int depth, int side,
                           float (*out)[3]);
 
+/* A patch's points as its coarse fill shades them (a quad grid's four,
+ * a triangular grid's three or its centroid; past the grids, a cluster:
+ * its representative's middle), on side side, through instance (0:
+ * none), at the shutter's segment 0: their world positions, unit
+ * geometric normals (facing the side) and the offset their rays start at.
+ * Returns how many (1 to 4). */
+int radiosity_patch_points(Worker *w, uint32_t patch, uint32_t instance, int side, Vec3 P[4],
+                           Vec3 N[4], float *offset);
+
 /* Interpolates a level's values at a hit. */
 Vec3 radiosity_interpolate(const Grid *g, const Hit *hit, int level, const uint16_t *values);
 

@@ -17,6 +17,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "render/envguide.h"
 #include "render/hider.h"
 #include "render/integrator.h"
 #include "render/services.h"
@@ -348,6 +349,52 @@ static double frame_mean(Frame *f, Worker *w)
     return sum / (FRAME_SAMPLES * FRAME_SAMPLES);
 }
 
+/* The environment guides' pixel counts (Worker.guide_pixels): the pixels
+ * of the whole frame (not the crop window: the same guides for every crop
+ * and machine) whose centre's camera ray first meets each guide patch,
+ * counted by atomic adds (the same sums in any order). */
+typedef struct CountJob {
+    const RenderScene *rs;
+    const RenderSettings *set;
+    uint32_t *count;
+} CountJob;
+
+static void count_row(void *ctx, size_t row, int worker)
+{
+    (void)worker;
+    const CountJob *job = ctx;
+    const RenderScene *rs = job->rs;
+    const Camera *cam = &rs->camera;
+    float time = 0.5f * (cam->shutter[0] + cam->shutter[1]);
+    for (int x = 0; x < job->set->width; x++) {
+        float lens, focus;
+        Ray ray = render_camera_ray_at(rs, job->set->width, job->set->height, (float)x + 0.5f,
+                                       (float)row + 0.5f, time, 0.5f, 0.5f, &lens, &focus);
+        Hit hit;
+        if (accel_intersect(rs->accel, &ray, &hit) && hit.grid < rs->gs->n_grids)
+            __atomic_fetch_add(&job->count[envguide_patch(rs->gs, hit.grid)], 1u, __ATOMIC_RELAXED);
+    }
+}
+
+/* The counts, or NULL where no guide is drawn by them (off, uncached, the
+ * grid hider's vertices count instead, or no environment light that casts
+ * shadows). */
+static uint32_t *guide_pixels(const RenderScene *rs, const RenderSettings *set, int threads)
+{
+    if (!set->env_guide || !set->cache || set->hider == 1)
+        return NULL;
+    int any = 0;
+    for (size_t k = 0; k < rs->n_lights; k++)
+        any |= rs->lights[k].type == LIGHT_ENVIRONMENT && !rs->lights[k].shadowless;
+    if (!any)
+        return NULL;
+    uint32_t *count = calloc(rs->gs->n_grids + rs->gs->n_clusters, sizeof *count);
+    RY_CHECK(count != NULL);
+    CountJob job = {rs, set, count};
+    thread_parallel_for(threads, (size_t)set->height, count_row, &job);
+    return count;
+}
+
 static void report_progress(Frame *f)
 {
     size_t done = atomic_fetch_add(&f->tiles_done, 1) + 1;
@@ -478,9 +525,13 @@ int render_frame(const RenderScene *rs, const RenderSettings *set, float *rgba, 
         gsh = hider_new(rs, set);
         RY_CHECK(gsh != NULL);
     }
+    uint32_t *pixels = guide_pixels(rs, set, threads);
     for (int i = 0; i < threads; i++) {
-        f.workers[i] = (Worker){.rs = rs, .set = set, .grid_shading = gsh,
-                                .services = &render_services};
+        f.workers[i] = (Worker){.rs = rs,
+                                .set = set,
+                                .grid_shading = gsh,
+                                .services = &render_services,
+                                .guide_pixels = pixels};
         if (set->cache)
             cache_local_init(&f.workers[i].cache, set->cache);
     }
@@ -496,6 +547,7 @@ int render_frame(const RenderScene *rs, const RenderSettings *set, float *rgba, 
             cache_local_fini(&f.workers[i].cache);
     }
     free(f.workers);
+    free(pixels);
     hider_free(gsh);
     pthread_mutex_destroy(&f.progress_lock);
     return atomic_load(&f.cancelled) ? 1 : 0;

@@ -30,6 +30,9 @@
  * they take the camera hits' count up to this (memo 6.2; DESIGN.md,
  * subsurface scattering). */
 #define RENDER_IRRADIANCE_SHADOW_RAYS 16
+/* The environment guides' cache budget (envguide.h): some 270 bytes a
+ * grid's guide, so 16 MB hold about 60,000 grids' at once. */
+#define RENDER_GUIDE_CACHE_BYTES 16000000
 
 typedef struct RenderObject {
     const ShaderInstance *shader;          /* surface shader (NULL for lights) */
@@ -130,6 +133,7 @@ typedef struct RenderSettings {
     int radiosity_cache;     /* 1: diffuse hits read radiosity from cache */
     int opacity_cache;       /* 1: shadow and diffuse rays read opacity from cache */
     int irradiance_cache;    /* 1: subsurface rays read irradiance from cache (memo 6.2) */
+    int env_guide;           /* 1: environment lights drawn by per-grid guides (envguide.h) */
     int subsurface_rays;     /* subsurface rays per shading point (the service's 0) */
     int irradiance_shadow_rays; /* shadow rays per light at irradiance cache fills' points
                                    (the shader's 0): the option, or

@@ -17,6 +17,7 @@
 #include <math.h>
 #include <string.h>
 
+#include "render/envguide.h"
 #include "render/integrator.h"
 #include "render/irrgrid.h"
 #include "render/pbgi.h"
@@ -205,6 +206,7 @@ typedef struct DirectPoint {
     int spec;       /* the specular output is wanted */
     RayDiff shadow; /* its shadow rays' differential, for rays drawn from a lobe */
     float spread;   /* the point's own ray spread */
+    const LightGuide *guide; /* the environment light's guide here, or NULL (envguide.h) */
 } DirectPoint;
 
 /* The transmittance toward light l (transmittance's), 1 for a light
@@ -322,7 +324,9 @@ static void light_area(Worker *w, const DirectPoint *p, const Light *l, uint64_t
         LightSample lsb[CMJ_BATCH];
         unsigned char got[CMJ_BATCH];
         for (int j = 0; j < nb; j++)
-            got[j] = light_draw(l, &view, p->o, la[j], lb[j], &lsb[j]) && lsb[j].pdf > 0.0f;
+            got[j] = (p->guide ? light_guide_sample(l, p->guide, la[j], lb[j], &lsb[j])
+                               : light_draw(l, &view, p->o, la[j], lb[j], &lsb[j])) &&
+                     lsb[j].pdf > 0.0f;
         for (int j = 0; j < nb; j++) {
             LightSample ls = lsb[j];
             /* The light's strategy. */
@@ -352,11 +356,14 @@ static void light_area(Worker *w, const DirectPoint *p, const Light *l, uint64_t
                 wi = sample_cosine_frame(p->lobe.t, p->lobe.b, p->N, ca[j], cb[j]);
                 cos_x = v3_dot(p->N, wi);
                 if (cos_x > 0.0f && v3_dot(p->Ng, wi) > 0.0f && light_bound_may_hit(&bound, wi) &&
-                    light_hit(w, l, &view, p->o, wi, &ls) && v3_max_component(ls.Li) > 0.0f)
+                    light_hit(w, l, &view, p->o, wi, &ls) && v3_max_component(ls.Li) > 0.0f) {
+                    if (p->guide)
+                        ls.pdf *= light_guide_factor(l, p->guide, wi);
                     sum_d = v3_madd(
                         sum_d,
                         v3_mul(ls.Li, light_transmittance(w, l, p->o, wi, ls.dist, p->shadow)),
                         power_heuristic(cos_x / (float)M_PI, ls.pdf));
+                }
             }
             if (!p->spec)
                 continue;
@@ -370,6 +377,8 @@ static void light_area(Worker *w, const DirectPoint *p, const Light *l, uint64_t
             float pdf = lobe_pdf(&p->lobe, wi);
             if (!(pdf > 0.0f))
                 continue;
+            if (p->guide)
+                ls.pdf *= light_guide_factor(l, p->guide, wi);
             Vec3 Li = v3_mul(ls.Li, light_transmittance(w, l, p->o, wi, ls.dist, p->shadow));
             float f = lobe_f(&p->lobe, wi);
             sum_s = v3_madd(sum_s, Li, power_heuristic(pdf, ls.pdf) * f * cos_x / pdf);
@@ -409,6 +418,7 @@ static void direct_lighting(const RayesShadeCtx *ctx, int n_shadow_rays, const c
     int n = shadow_ray_count(w, ctx, n_shadow_rays);
     int want_spec = specular && ctx->I;
     const RenderObject *obj = lit_object(ps);
+    int guided = ctx->diffuse_depth == 0 && w->set->env_guide;
     for (size_t i = 0; i < ctx->n_points; i++) {
         Vec3 d = v3(0, 0, 0), s = v3(0, 0, 0);
         DirectPoint p;
@@ -421,12 +431,20 @@ static void direct_lighting(const RayesShadeCtx *ctx, int n_shadow_rays, const c
         p.diff = diffuse != NULL;
         p.shadow = shadow_diff(ps, point(ctx, i), n);
         p.spread = ps->diff[point(ctx, i)].spread;
+        int env_slot = 0; /* environment lights so far: each its guide's slot */
         for (size_t k = 0; k < w->rs->n_lights && n > 0; k++) {
             Light moved; /* a light moving within the frame: where it is at w->time */
             const Light *l = light_at_time(&w->rs->lights[k], w->time, &moved);
+            int slot = l->type == LIGHT_ENVIRONMENT ? env_slot++ : -1;
             if (l->type == LIGHT_AMBIENT || !render_lit_by(obj, k) ||
                 !light_category_match(l, category))
                 continue;
+            /* camera hits draw an environment by their grid's guide (a
+             * moving one, whose bins move, by itself alone) */
+            p.guide = slot >= 0 && guided && l == &w->rs->lights[k]
+                          ? envguide_get(w, l, slot, ps->grid, ps->instance,
+                                         ctx->backfacing ? ctx->backfacing[i] != 0 : 0, n)
+                          : NULL;
             const DirectPoint *use = &p;
             DirectPoint q; /* a light for one lobe: the outputs it adds to */
             if (l->nondiffuse || l->nonspecular) {

@@ -82,6 +82,7 @@ void rayes_render_options_init(RayesRenderOptions *o, RayesQuality quality)
     o->adaptive_error = 0.02f;
     o->irradiance_cache = quality != RAYES_QUALITY_REFERENCE;
     o->irradiance_cache_mb = 20.0;
+    o->env_guide = quality != RAYES_QUALITY_REFERENCE;
     o->subsurface_rays = quality == RAYES_QUALITY_PREVIEW ? 4 : 64;
     o->pbgi_max_solid_angle = 0.05f;
     o->pbgi_raster = 8;
@@ -235,6 +236,7 @@ RenderSettings session_settings(const RayesRenderOptions *o)
         .radiosity_cache = o->cache != 0,
         .opacity_cache = o->opacity_cache != 0,
         .irradiance_cache = o->irradiance_cache != 0,
+        .env_guide = o->env_guide != 0,
         .subsurface_rays = o->subsurface_rays,
         /* the camera's count, at most RENDER_IRRADIANCE_SHADOW_RAYS (DESIGN.md) */
         .irradiance_shadow_rays = o->irradiance_shadow_rays > 0 ? o->irradiance_shadow_rays
@@ -267,6 +269,8 @@ Cache *session_cache(const RayesRenderOptions *o)
         budgets[CACHE_OPACITY] = (uint64_t)(o->opacity_cache_mb * 1e6);
     if (o->irradiance_cache)
         budgets[CACHE_IRRADIANCE] = (uint64_t)(o->irradiance_cache_mb * 1e6);
+    if (o->env_guide)
+        budgets[CACHE_GUIDE] = RENDER_GUIDE_CACHE_BYTES;
     return cache_new_typed(budgets, o->cache_split);
 }
 
@@ -548,7 +552,7 @@ RayesError rayes_render(RayesScene *scene, const RayesRenderOptions *opt, RayesI
     e = session_prepare(scene, &set, textures, &prep);
     if (e != RAYES_OK)
         goto done;
-    if (opt->cache || opt->opacity_cache || opt->irradiance_cache) {
+    if (opt->cache || opt->opacity_cache || opt->irradiance_cache || opt->env_guide) {
         cache = session_cache(opt);
         if (!cache) {
             e = session_fail(scene, RAYES_ERROR_OUT_OF_MEMORY,

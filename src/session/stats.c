@@ -198,47 +198,35 @@ void session_stats_add_cache(RayesStats *s, const CacheStats *cs)
 /* Each data type's own counters (memo 6: one cache, keys with a data
  * type): cache/radiosity/LEVEL/... and cache/opacity/LEVEL/..., for the
  * types that had a budget or lookups. */
-static const char *const typed_names[3][CACHE_N_LEVELS][7] = {
-    {{"cache/radiosity/coarse/lookups", "cache/radiosity/coarse/hits",
-      "cache/radiosity/coarse/misses", "cache/radiosity/coarse/fills",
-      "cache/radiosity/coarse/evictions", "cache/radiosity/coarse/entries",
-      "cache/radiosity/coarse/hit_rate"},
-     {"cache/radiosity/medium/lookups", "cache/radiosity/medium/hits",
-      "cache/radiosity/medium/misses", "cache/radiosity/medium/fills",
-      "cache/radiosity/medium/evictions", "cache/radiosity/medium/entries",
-      "cache/radiosity/medium/hit_rate"},
-     {"cache/radiosity/fine/lookups", "cache/radiosity/fine/hits", "cache/radiosity/fine/misses",
-      "cache/radiosity/fine/fills", "cache/radiosity/fine/evictions",
-      "cache/radiosity/fine/entries", "cache/radiosity/fine/hit_rate"}},
-    {{"cache/opacity/coarse/lookups", "cache/opacity/coarse/hits", "cache/opacity/coarse/misses",
-      "cache/opacity/coarse/fills", "cache/opacity/coarse/evictions",
-      "cache/opacity/coarse/entries", "cache/opacity/coarse/hit_rate"},
-     {"cache/opacity/medium/lookups", "cache/opacity/medium/hits", "cache/opacity/medium/misses",
-      "cache/opacity/medium/fills", "cache/opacity/medium/evictions",
-      "cache/opacity/medium/entries", "cache/opacity/medium/hit_rate"},
-     {"cache/opacity/fine/lookups", "cache/opacity/fine/hits", "cache/opacity/fine/misses",
-      "cache/opacity/fine/fills", "cache/opacity/fine/evictions", "cache/opacity/fine/entries",
-      "cache/opacity/fine/hit_rate"}},
-    {{"cache/irradiance/coarse/lookups", "cache/irradiance/coarse/hits",
-      "cache/irradiance/coarse/misses", "cache/irradiance/coarse/fills",
-      "cache/irradiance/coarse/evictions", "cache/irradiance/coarse/entries",
-      "cache/irradiance/coarse/hit_rate"},
-     {"cache/irradiance/medium/lookups", "cache/irradiance/medium/hits",
-      "cache/irradiance/medium/misses", "cache/irradiance/medium/fills",
-      "cache/irradiance/medium/evictions", "cache/irradiance/medium/entries",
-      "cache/irradiance/medium/hit_rate"},
-     {"cache/irradiance/fine/lookups", "cache/irradiance/fine/hits",
-      "cache/irradiance/fine/misses", "cache/irradiance/fine/fills",
-      "cache/irradiance/fine/evictions", "cache/irradiance/fine/entries",
-      "cache/irradiance/fine/hit_rate"}}};
+static const char *const typed_names[4][CACHE_N_LEVELS][7] = {
+#define TYPE_NAMES(t)                                                                              \
+    {                                                                                              \
+        {                                                                                          \
+            "cache/" t "/coarse/lookups",   "cache/" t "/coarse/hits",                             \
+            "cache/" t "/coarse/misses",    "cache/" t "/coarse/fills",                            \
+            "cache/" t "/coarse/evictions", "cache/" t "/coarse/entries",                          \
+            "cache/" t "/coarse/hit_rate"},                                                        \
+            {"cache/" t "/medium/lookups",   "cache/" t "/medium/hits",                            \
+             "cache/" t "/medium/misses",    "cache/" t "/medium/fills",                           \
+             "cache/" t "/medium/evictions", "cache/" t "/medium/entries",                         \
+             "cache/" t "/medium/hit_rate"},                                                       \
+        {                                                                                          \
+            "cache/" t "/fine/lookups", "cache/" t "/fine/hits", "cache/" t "/fine/misses",        \
+                "cache/" t "/fine/fills", "cache/" t "/fine/evictions",                            \
+                "cache/" t "/fine/entries", "cache/" t "/fine/hit_rate"                            \
+        }                                                                                          \
+    }
+    TYPE_NAMES("radiosity"), TYPE_NAMES("opacity"), TYPE_NAMES("irradiance"), TYPE_NAMES("guide")
+#undef TYPE_NAMES
+};
 
 static void session_stats_add_cache_types(RayesStats *s, const CacheStats *cs)
 {
-    static const int types[3] = {CACHE_RADIOSITY, CACHE_OPACITY, CACHE_IRRADIANCE};
-    static const char *const budgets[3] = {"cache/radiosity/budget_bytes",
-                                           "cache/opacity/budget_bytes",
-                                           "cache/irradiance/budget_bytes"};
-    for (int k = 0; k < 3; k++) {
+    static const int types[4] = {CACHE_RADIOSITY, CACHE_OPACITY, CACHE_IRRADIANCE, CACHE_GUIDE};
+    static const char *const budgets[4] = {
+        "cache/radiosity/budget_bytes", "cache/opacity/budget_bytes",
+        "cache/irradiance/budget_bytes", "cache/guide/budget_bytes"};
+    for (int k = 0; k < 4; k++) {
         int t = types[k];
         uint64_t lookups = 0;
         for (int l = 0; l < CACHE_N_LEVELS; l++)

@@ -361,6 +361,175 @@ static int env_sample(const Light *l, float a, float b, LightSample *s)
     return 1;
 }
 
+/* ------------------------------------------- guided environment */
+
+/* The map's guide bins (LightEnvMap.bin_x0 ...). 0, or -1 out of memory. */
+static int env_bins(LightEnvMap *m)
+{
+    int w = m->width, h = m->height;
+    for (int i = 0; i <= LIGHT_GUIDE_U; i++) /* the first x with x * U / w >= i */
+        m->bin_x0[i] = (int)(((int64_t)i * w + LIGHT_GUIDE_U - 1) / LIGHT_GUIDE_U);
+    for (int j = 0; j <= LIGHT_GUIDE_V; j++)
+        m->bin_y0[j] = (int)(((int64_t)j * h + LIGHT_GUIDE_V - 1) / LIGHT_GUIDE_V);
+    m->band_cdf = malloc((size_t)LIGHT_GUIDE_U * ((size_t)h + 1) * sizeof *m->band_cdf);
+    if (!m->band_cdf)
+        return -1;
+    for (int i = 0; i < LIGHT_GUIDE_U; i++) {
+        float *band = &m->band_cdf[(size_t)i * (h + 1)];
+        double acc = 0.0, bin = 0.0;
+        band[0] = 0.0f;
+        for (int y = 0; y < h; y++) {
+            double r = 0.0;
+            for (int x = m->bin_x0[i]; x < m->bin_x0[i + 1]; x++)
+                r += m->pixel_pdf[(size_t)y * w + x];
+            acc += r;
+            bin += r;
+            band[y + 1] = (float)acc;
+            int j = (int)((int64_t)y * LIGHT_GUIDE_V / h);
+            if (y + 1 == m->bin_y0[j + 1]) { /* the bin's last row */
+                m->bin_mass[j * LIGHT_GUIDE_U + i] = (float)bin;
+                bin = 0.0;
+            }
+        }
+    }
+    return 0;
+}
+
+/* The guide bin of world direction d. */
+static int env_bin(const Light *l, Vec3 d)
+{
+    const LightEnvMap *m = l->env;
+    float u, v;
+    if (m) {
+        env_dir_to_uv(l, d, &u, &v);
+    } else { /* a constant environment's bins: world space, as it is drawn */
+        u = 0.5f + atan2f(-d.x, d.z) / (2.0f * PI);
+        v = acosf(fminf(fmaxf(d.y, -1.0f), 1.0f)) / PI;
+    }
+    int i, j;
+    if (m) {
+        int x, y;
+        env_pixel(m, u, v, &x, &y);
+        i = (int)((int64_t)x * LIGHT_GUIDE_U / m->width);
+        j = (int)((int64_t)y * LIGHT_GUIDE_V / m->height);
+    } else {
+        i = (int)(u * LIGHT_GUIDE_U), j = (int)(v * LIGHT_GUIDE_V);
+        i = i < 0 ? 0 : i >= LIGHT_GUIDE_U ? LIGHT_GUIDE_U - 1 : i;
+        j = j < 0 ? 0 : j >= LIGHT_GUIDE_V ? LIGHT_GUIDE_V - 1 : j;
+    }
+    return j * LIGHT_GUIDE_U + i;
+}
+
+float light_guide_mass(const Light *l, int b)
+{
+    if (l->env)
+        return l->env->bin_mass[b];
+    /* a constant environment: the band's share of the sphere */
+    float v0 = (float)(b / LIGHT_GUIDE_U) / LIGHT_GUIDE_V, v1 = v0 + 1.0f / LIGHT_GUIDE_V;
+    return 0.5f * (cosf(PI * v0) - cosf(PI * v1)) / LIGHT_GUIDE_U;
+}
+
+/* The interval i of cdf[lo .. hi] (hi - lo intervals) with cdf[i] <= x <
+ * cdf[i + 1], skipping empty ones. */
+static int range_find(const float *cdf, int lo, int hi, float x)
+{
+    while (hi - lo > 1) {
+        int mid = (lo + hi) / 2;
+        if (cdf[mid] <= x)
+            lo = mid;
+        else
+            hi = mid;
+    }
+    return lo;
+}
+
+int light_guide_bin_sample(const Light *l, int b, float a, float c, LightSample *s)
+{
+    const LightEnvMap *m = l->env;
+    int bi = b % LIGHT_GUIDE_U, bj = b / LIGHT_GUIDE_U;
+    if (!m) {
+        float z0 = cosf(PI * (float)bj / LIGHT_GUIDE_V),
+              z1 = cosf(PI * (float)(bj + 1) / LIGHT_GUIDE_V);
+        float z = z0 + c * (z1 - z0);
+        float phi = (((float)bi + a) / LIGHT_GUIDE_U - 0.5f) * 2.0f * PI;
+        float r = sqrtf(fmaxf(0.0f, 1.0f - z * z));
+        s->wi = v3(-r * sinf(phi), z, r * cosf(phi)); /* env_bin's inverse */
+        s->Li = l->L;
+        s->pdf = 1.0f / (4.0f * PI);
+        s->dist = INFINITY;
+        return 1;
+    }
+    int w = m->width, h = m->height;
+    int x0 = m->bin_x0[bi], x1 = m->bin_x0[bi + 1], y0 = m->bin_y0[bj], y1 = m->bin_y0[bj + 1];
+    if (x1 <= x0 || y1 <= y0)
+        return 0;
+    const float *band = &m->band_cdf[(size_t)bi * (h + 1)];
+    float mass = band[y1] - band[y0];
+    if (!(mass > 0.0f))
+        return 0;
+    float t = band[y0] + a * mass;
+    int y = range_find(band, y0, y1, t);
+    float dr = band[y + 1] - band[y];
+    float fy = dr > 0.0f ? (t - band[y]) / dr : 0.5f;
+    const float *cc = &m->col_cdf[(size_t)y * (w + 1)];
+    float lo = cc[x0], span = cc[x1] - lo;
+    if (!(span > 0.0f))
+        return 0;
+    float tx = lo + c * span;
+    int x = range_find(cc, x0, x1, tx);
+    float dc = cc[x + 1] - cc[x];
+    float fx = dc > 0.0f ? (tx - cc[x]) / dc : 0.5f;
+    float st, u = ((float)x + fminf(fmaxf(fx, 0.0f), 0.9999f)) / (float)w;
+    float v = ((float)y + fminf(fmaxf(fy, 0.0f), 0.9999f)) / (float)h;
+    s->wi = env_uv_to_dir(l, u, v, &st);
+    float p = m->pixel_pdf[(size_t)y * w + x];
+    if (!(st > 0.0f) || !(p > 0.0f))
+        return 0;
+    const float *rgb = &m->rgb[3 * ((size_t)y * w + x)];
+    s->Li = v3_mul(l->L, v3(rgb[0], rgb[1], rgb[2]));
+    s->pdf = p * (float)w * (float)h / (2.0f * PI * PI * st);
+    s->dist = INFINITY;
+    return 1;
+}
+
+int light_guide_init(const Light *l, const float *w, LightGuide *g)
+{
+    double acc = 0.0, sum[LIGHT_GUIDE_BINS + 1];
+    sum[0] = 0.0;
+    for (int b = 0; b < LIGHT_GUIDE_BINS; b++) {
+        acc += (double)light_guide_mass(l, b) * (double)fmaxf(w[b], 0.0f);
+        sum[b + 1] = acc;
+    }
+    if (!(acc > 0.0))
+        return 0;
+    for (int b = 0; b <= LIGHT_GUIDE_BINS; b++)
+        g->cdf[b] = (float)(sum[b] / acc);
+    g->cdf[LIGHT_GUIDE_BINS] = 1.0f;
+    for (int b = 0; b < LIGHT_GUIDE_BINS; b++)
+        g->scale[b] = (float)((double)fmaxf(w[b], 0.0f) / acc);
+    return 1;
+}
+
+int light_guide_sample(const Light *l, const LightGuide *g, float a, float b, LightSample *s)
+{
+    int k = range_find(g->cdf, 0, LIGHT_GUIDE_BINS, a);
+    while (k < LIGHT_GUIDE_BINS - 1 && !(g->cdf[k + 1] > g->cdf[k]))
+        k++; /* a at an empty bin's edge */
+    float d = g->cdf[k + 1] - g->cdf[k];
+    if (!(d > 0.0f))
+        return 0;
+    float a2 = fminf(fmaxf((a - g->cdf[k]) / d, 0.0f), 0.99999994f);
+    if (!light_guide_bin_sample(l, k, a2, b, s))
+        return 0;
+    s->pdf *= g->scale[k];
+    return s->pdf > 0.0f;
+}
+
+float light_guide_factor(const Light *l, const LightGuide *g, Vec3 wi)
+{
+    return g->scale[env_bin(l, wi)];
+}
+
 /* ------------------------------------------------------------ meshes */
 
 /* A triangle's unnormalised normal (twice its area). */
@@ -1298,6 +1467,12 @@ int light_env_load(Light *l, const char *path, int octahedral, char *err, size_t
         cdf_guide(&m->col_cdf[(size_t)y * (w + 1)], w, &m->col_guide[(size_t)y * w]);
     free(row);
     free(rgba);
+    if (env_bins(m) != 0) {
+        l->env = m;
+        light_fini(l);
+        snprintf(err, err_size, "environment light: out of memory for %s", path);
+        return -1;
+    }
     light_fini(l);
     l->env = m;
     return 0;
@@ -1325,6 +1500,7 @@ void light_fini(Light *l)
     free(l->env->pixel_pdf);
     free(l->env->row_guide);
     free(l->env->col_guide);
+    free(l->env->band_cdf);
     free(l->env);
     l->env = NULL;
 }

@@ -53,6 +53,11 @@ typedef enum LightType {
 #define LIGHT_CATEGORY_MAX 128
 #define LIGHT_MAX_TIMES 16 /* a moving light's time samples, at most (RAYES_MAX_TIMES) */
 
+/* An environment light's guide bins (LightGuide, below). */
+#define LIGHT_GUIDE_U 16
+#define LIGHT_GUIDE_V 8
+#define LIGHT_GUIDE_BINS (LIGHT_GUIDE_U * LIGHT_GUIDE_V)
+
 /* A latitude-longitude map with its sampling distribution: pixel (x, y)
  * weighted by its luminance times sin(theta) at its centre, drawn as a row
  * (marginal cdf) then a column (that row's conditional cdf). Each cdf has
@@ -67,7 +72,28 @@ typedef struct LightEnvMap {
     float *pixel_pdf;   /* width * height: probability of drawing the pixel */
     int *row_guide;     /* height: row_cdf's */
     int *col_guide;     /* height * width: each row's col_cdf's */
+    /* Its guide bins (LightGuide): bin (i, j) holds the pixels of columns
+     * bin_x0[i] .. bin_x0[i + 1] - 1 and rows bin_y0[j] .. bin_y0[j + 1] - 1
+     * (pixel x is in bin x * LIGHT_GUIDE_U / width); band_cdf[i * (height
+     * + 1) + y] sums pixel_pdf over rows above y of column band i, and
+     * bin_mass[j * LIGHT_GUIDE_U + i] is the bin's probability. */
+    int bin_x0[LIGHT_GUIDE_U + 1], bin_y0[LIGHT_GUIDE_V + 1];
+    float *band_cdf;
+    float bin_mass[LIGHT_GUIDE_BINS];
 } LightEnvMap;
+
+/* Guided sampling of an environment light (DESIGN.md "Lights"): its
+ * directions cut into LIGHT_GUIDE_U x LIGHT_GUIDE_V bins of the map's
+ * latitude-longitude parameters (a map's bins end at pixel edges), and
+ * its own pdf reweighted per bin by weights a caller knows better (how
+ * much of each bin a surface sees): pdf(wi) = the light's pdf(wi) x
+ * scale[bin of wi]. Drawn as a bin (by mass x weight), then a direction
+ * of the bin by the light's own distribution there. Any positive weights
+ * keep every estimate unbiased; a weight of 0 leaves its bin's light out. */
+typedef struct LightGuide {
+    float cdf[LIGHT_GUIDE_BINS + 1]; /* over the bins, of mass x weight */
+    float scale[LIGHT_GUIDE_BINS];   /* weight / sum of mass x weight */
+} LightGuide;
 
 /* A mesh light's triangles (world space) in clusters of neighbours, at
  * most LIGHT_MESH_CLUSTERS: a point draws a cluster by an importance its
@@ -288,6 +314,26 @@ int light_mesh_sample(const Light *l, const LightMeshView *v, Vec3 o, float a, f
  * side emits, else 0. */
 int light_mesh_finish(const Light *l, const LightMeshView *v, uint32_t tri, Vec3 wi, float t,
                       Vec3 Ng, LightSample *s);
+
+/* The probability that the environment light's own sampling draws a
+ * direction of guide bin b (the bins' sum is 1; 0 for an empty map). */
+float light_guide_mass(const Light *l, int b);
+
+/* A direction of bin b of an environment light drawn from (a, c) in
+ * [0, 1)^2 by the light's distribution within the bin; s->pdf is the
+ * light's own (unguided) pdf. 0 when the bin sends nothing. */
+int light_guide_bin_sample(const Light *l, int b, float a, float c, LightSample *s);
+
+/* Makes g from weights w[b] >= 0 of the environment light l's bins.
+ * Returns 0 (g unusable) when no bin has both mass and weight. */
+int light_guide_init(const Light *l, const float *w, LightGuide *g);
+
+/* light_sample of an environment light drawn by guide g. */
+int light_guide_sample(const Light *l, const LightGuide *g, float a, float b, LightSample *s);
+
+/* The factor g puts on the light's own pdf toward world direction wi
+ * (unit): light_intersect's pdf times this is the guided draw's. */
+float light_guide_factor(const Light *l, const LightGuide *g, Vec3 wi);
 
 /* The environment light's radiance along world direction d (unit). */
 Vec3 light_env_radiance(const Light *l, Vec3 d);
