@@ -5,8 +5,8 @@
  *
  * Structure (memo 3.1, DESIGN.md "The multiresolution cache"):
  *  - per data type (radiosity, opacity, irradiance: memo 6, one cache whose
- *    keys carry the type; and rayes's environment guides)
- *    keys carry the type) a budget of its own, and within it
+ *    keys carry the type; and rayes's environment guides) a budget of its
+ *    own, and within it
  *  - three resolutions (COARSE, MEDIUM, FINE), each with its own share of the
  *    byte budget (default 25% / 25% / 50% of 100 MB; a resolution past its
  *    share borrows what the others leave unused, until they need it back)

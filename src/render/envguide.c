@@ -48,7 +48,14 @@ static void fill_guide(void *user, const CacheKey *key, size_t n, float (*out)[3
     const Light *l = job->l;
     const Camera *cam = &w->rs->camera;
     float outer_time = w->time;
-    w->time = 0.5f * (cam->shutter[0] + cam->shutter[1]); /* whichever ray asked */
+    const RenderObject *outer_shading = w->shading;
+    const GridSet *gs = w->rs->gs;
+    uint32_t grid =
+        key->patch >= gs->n_grids ? gs->clusters[key->patch - gs->n_grids].rep : key->patch;
+    /* whichever ray asked: the shutter's middle, and the patch's own
+     * object (its thin shadow is its own, RAYES_SHADER_THIN_SHADOW) */
+    w->time = 0.5f * (cam->shutter[0] + cam->shutter[1]);
+    w->shading = render_object(w->rs, grid, key->instance);
     Vec3 P[4], N[4], o[4];
     float offset;
     int np = radiosity_patch_points(w, key->patch, key->instance, key->side, P, N, &offset);
@@ -78,6 +85,7 @@ static void fill_guide(void *user, const CacheKey *key, size_t n, float (*out)[3
         top = fmaxf(top, wt[b]);
     }
     w->time = outer_time;
+    w->shading = outer_shading;
     /* Each bin takes half its brightest neighbour's weight: the light
      * seen through an opening moves across bins from point to point of
      * the patch (parallax), and a bin next to a seen one is likely seen
@@ -140,11 +148,12 @@ const LightGuide *envguide_get(Worker *w, const Light *l, int slot, uint32_t gri
         return NULL;
     uint32_t patch = envguide_patch(gs, grid);
     GuideSlot *g = &w->guides[slot];
-    if (g->state && g->patch == patch && g->instance == instance && g->side == side)
+    if (g->state && g->patch == patch && g->instance == instance && g->side == side && g->n == n)
         return g->state == 1 ? &g->g : NULL;
+    g->patch = patch, g->instance = instance, g->side = side, g->n = n;
     /* about half the bins lie above a surface's horizon */
     if (patch_samples(w, patch, n) < GUIDE_PAYS * GUIDE_RAYS * LIGHT_GUIDE_BINS / 2) {
-        g->patch = patch, g->instance = instance, g->side = side, g->state = 2;
+        g->state = 2;
         return NULL;
     }
     CacheKey key = {.patch = patch,
@@ -158,7 +167,6 @@ const LightGuide *envguide_get(Worker *w, const Light *l, int slot, uint32_t gri
     float wt[LIGHT_GUIDE_BINS];
     for (int b = 0; b < LIGHT_GUIDE_BINS; b++)
         wt[b] = half_to_float_finite(v[b]);
-    g->patch = patch, g->instance = instance, g->side = side;
     g->state = light_guide_init(l, wt, &g->g) ? 1 : 2;
     return g->state == 1 ? &g->g : NULL;
 }

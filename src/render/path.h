@@ -56,8 +56,8 @@ typedef struct SubsurfaceMedium {
 #define ENVGUIDE_LIGHTS 2
 typedef struct GuideSlot {
     uint32_t patch, instance;
-    int side;
-    int state; /* 0: empty; 1: g usable; 2: no guide for that key */
+    int side, n; /* n: the shadow rays its decision was made for */
+    int state;   /* 0: empty; 1: g usable; 2: no guide for that key */
     LightGuide g;
 } GuideSlot;
 

@@ -304,10 +304,10 @@ static void light_area(Worker *w, const DirectPoint *p, const Light *l, uint64_t
     Vec3 sum_d = v3(0, 0, 0), sum_s = v3(0, 0, 0);
     LightBound bound;
     light_bound_init(l, p->o, &bound);
-    int lobe = p->diff && lobe_strategy_useful(&bound); /* the cosine strategy */
+    int cosine = p->diff && lobe_strategy_useful(&bound); /* the cosine strategy */
     CmjPattern pattern, pat_cos, pat_bp; /* the light's, the cosine's and the lobe's */
     cmj_pattern_init(&pattern, (uint32_t)n, (uint32_t)key);
-    if (lobe)
+    if (cosine)
         cmj_pattern_init(&pat_cos, (uint32_t)n, (uint32_t)hash_combine(key, 1));
     if (p->spec)
         cmj_pattern_init(&pat_bp, (uint32_t)n, (uint32_t)hash_combine(key, 2));
@@ -315,7 +315,7 @@ static void light_area(Worker *w, const DirectPoint *p, const Light *l, uint64_t
     for (int s0 = 0; s0 < n; s0 += CMJ_BATCH) {
         int nb = n - s0 < CMJ_BATCH ? n - s0 : CMJ_BATCH;
         cmj_pattern_samples(&pattern, (uint32_t)s0, (uint32_t)nb, la, lb);
-        if (lobe)
+        if (cosine)
             cmj_pattern_samples(&pat_cos, (uint32_t)s0, (uint32_t)nb, ca, cb);
         if (p->spec)
             cmj_pattern_samples(&pat_bp, (uint32_t)s0, (uint32_t)nb, ba, bb);
@@ -335,11 +335,12 @@ static void light_area(Worker *w, const DirectPoint *p, const Light *l, uint64_t
                 if (cos_x > 0.0f && v3_dot(p->Ng, ls.wi) > 0.0f &&
                     v3_max_component(ls.Li) > 0.0f) {
                     /* each of the n samples stands for 1 / (n pdf) of solid angle */
-                    float lobe = sqrtf(1.0f / (n * ls.pdf));
-                    lobe = p->shadow.spread < lobe ? p->shadow.spread : lobe;
-                    RayDiff sd = {p->shadow.width, p->spread > lobe ? p->spread : lobe};
+                    float spread = sqrtf(1.0f / (n * ls.pdf));
+                    spread = p->shadow.spread < spread ? p->shadow.spread : spread;
+                    RayDiff sd = {p->shadow.width, p->spread > spread ? p->spread : spread};
                     Vec3 Li = v3_mul(ls.Li, light_transmittance(w, l, p->o, ls.wi, ls.dist, sd));
-                    float wd = lobe ? power_heuristic(ls.pdf, cos_x / (float)M_PI) : 1.0f;
+                    /* weighed against the cosine strategy only where it is drawn */
+                    float wd = cosine ? power_heuristic(ls.pdf, cos_x / (float)M_PI) : 1.0f;
                     if (p->diff)
                         sum_d = v3_madd(sum_d, Li, wd * cos_x / ((float)M_PI * ls.pdf));
                     if (p->spec) {
@@ -352,7 +353,7 @@ static void light_area(Worker *w, const DirectPoint *p, const Light *l, uint64_t
             /* The diffuse lobe's strategy: weight (cos / pi) / pdf = 1. */
             Vec3 wi;
             float cos_x;
-            if (lobe) {
+            if (cosine) {
                 wi = sample_cosine_frame(p->lobe.t, p->lobe.b, p->N, ca[j], cb[j]);
                 cos_x = v3_dot(p->N, wi);
                 if (cos_x > 0.0f && v3_dot(p->Ng, wi) > 0.0f && light_bound_may_hit(&bound, wi) &&
@@ -418,7 +419,10 @@ static void direct_lighting(const RayesShadeCtx *ctx, int n_shadow_rays, const c
     int n = shadow_ray_count(w, ctx, n_shadow_rays);
     int want_spec = specular && ctx->I;
     const RenderObject *obj = lit_object(ps);
-    int guided = ctx->diffuse_depth == 0 && w->set->env_guide;
+    /* camera hits only: not an irradiance fill's points (depth 0 too, with
+     * a shadow-ray count of their own), whose guides would depend on
+     * which lookup came first */
+    int guided = ctx->diffuse_depth == 0 && w->set->env_guide && ps->shadow_rays == 0;
     for (size_t i = 0; i < ctx->n_points; i++) {
         Vec3 d = v3(0, 0, 0), s = v3(0, 0, 0);
         DirectPoint p;

@@ -375,16 +375,16 @@ static int env_bins(LightEnvMap *m)
     if (!m->band_cdf)
         return -1;
     for (int i = 0; i < LIGHT_GUIDE_U; i++) {
-        float *band = &m->band_cdf[(size_t)i * (h + 1)];
+        double *band = &m->band_cdf[(size_t)i * (h + 1)];
         double acc = 0.0, bin = 0.0;
-        band[0] = 0.0f;
+        band[0] = 0.0;
         for (int y = 0; y < h; y++) {
             double r = 0.0;
             for (int x = m->bin_x0[i]; x < m->bin_x0[i + 1]; x++)
                 r += m->pixel_pdf[(size_t)y * w + x];
             acc += r;
             bin += r;
-            band[y + 1] = (float)acc;
+            band[y + 1] = acc;
             int j = (int)((int64_t)y * LIGHT_GUIDE_V / h);
             if (y + 1 == m->bin_y0[j + 1]) { /* the bin's last row */
                 m->bin_mass[j * LIGHT_GUIDE_U + i] = (float)bin;
@@ -463,14 +463,21 @@ int light_guide_bin_sample(const Light *l, int b, float a, float c, LightSample 
     int x0 = m->bin_x0[bi], x1 = m->bin_x0[bi + 1], y0 = m->bin_y0[bj], y1 = m->bin_y0[bj + 1];
     if (x1 <= x0 || y1 <= y0)
         return 0;
-    const float *band = &m->band_cdf[(size_t)bi * (h + 1)];
-    float mass = band[y1] - band[y0];
-    if (!(mass > 0.0f))
+    const double *band = &m->band_cdf[(size_t)bi * (h + 1)];
+    double mass = band[y1] - band[y0];
+    if (!(mass > 0.0))
         return 0;
-    float t = band[y0] + a * mass;
-    int y = range_find(band, y0, y1, t);
-    float dr = band[y + 1] - band[y];
-    float fy = dr > 0.0f ? (t - band[y]) / dr : 0.5f;
+    double t = band[y0] + a * mass;
+    int y = y0, top = y1; /* the row with band[y] <= t < band[y + 1] */
+    while (top - y > 1) {
+        int mid = (y + top) / 2;
+        if (band[mid] <= t)
+            y = mid;
+        else
+            top = mid;
+    }
+    double dr = band[y + 1] - band[y];
+    float fy = dr > 0.0 ? (float)((t - band[y]) / dr) : 0.5f;
     const float *cc = &m->col_cdf[(size_t)y * (w + 1)];
     float lo = cc[x0], span = cc[x1] - lo;
     if (!(span > 0.0f))

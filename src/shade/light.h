@@ -78,7 +78,7 @@ typedef struct LightEnvMap {
      * + 1) + y] sums pixel_pdf over rows above y of column band i, and
      * bin_mass[j * LIGHT_GUIDE_U + i] is the bin's probability. */
     int bin_x0[LIGHT_GUIDE_U + 1], bin_y0[LIGHT_GUIDE_V + 1];
-    float *band_cdf;
+    double *band_cdf; /* double: a sky row's share beside a sun's in its band */
     float bin_mass[LIGHT_GUIDE_BINS];
 } LightEnvMap;
 

@@ -7,7 +7,9 @@
  * constant environment. Then a room lit through a window: guided and
  * unguided renders agree in the mean with a many-sample reference, the
  * guided one is closer, guides were filled, and the guided image is the
- * same bytes on 1 and 2 threads and in a crop window.
+ * same bytes on 1 and 2 threads and in a crop window, and with a marble
+ * ball's irradiance fills on 1 and 8 threads. And direct lighting's
+ * multiple importance sampling at fills of one shadow ray.
  */
 #include <math.h>
 #include <stdlib.h>
@@ -136,7 +138,7 @@ static void test_guide_sampling(void)
  * its walls facing in, with a window 1.2 x 1 in its left wall (x = -2),
  * under a constant environment; the camera at the front looks at the back
  * wall, which only the window's sky lights. */
-static RayesScene *window_room(void)
+static RayesScene *window_room(int marble)
 {
     RayesScene *s = rayes_scene_new();
     float eye[3] = {1.2f, 1.5f, 0.3f}, target[3] = {-0.5f, 1.2f, 6}, up[3] = {0, 1, 0};
@@ -163,6 +165,13 @@ static RayesScene *window_room(void)
                                {quads[q][3][0], quads[q][3][1], quads[q][3][2]},
                                {quads[q][2][0], quads[q][2][1], quads[q][2][2]}};
         CHECK(rayes_scene_bilinear_patch(s, P) == RAYES_OK);
+    }
+    if (marble) { /* a marble ball under the window: irradiance fills at depth 0 */
+        RayesParam m[3] = {ps("preset", "marble"), pf("unitlength", 0.2f), pf("Ks", 0.5f)};
+        CHECK(rayes_scene_set_shader(s, "subsurface", m, 3) == RAYES_OK);
+        float T[16] = {1, 0, 0, -1.0f, 0, 1, 0, 0.9f, 0, 0, 1, 3.0f, 0, 0, 0, 1}; /* row-major */
+        CHECK(rayes_scene_set_transform(s, T) == RAYES_OK);
+        CHECK(rayes_scene_sphere(s, 0.9f) == RAYES_OK);
     }
     RayesParam e[1] = {pf("intensity", 1)};
     CHECK(rayes_scene_light(s, "environmentlight", e, 1) == RAYES_OK);
@@ -210,7 +219,7 @@ static double rms_from(const RayesImage *a, const RayesImage *ref)
 
 static void test_guide_window_room(void)
 {
-    RayesScene *s = window_room();
+    RayesScene *s = window_room(0);
     RayesStats *stats = NULL;
     RayesImage *ref = render_room(s, 0, 256, 2, 100.0, NULL, NULL);
     RayesImage *off = render_room(s, 0, 4, 2, 100.0, NULL, NULL);
@@ -250,4 +259,64 @@ static void test_guide_window_room(void)
     rayes_scene_release(s);
 }
 
-TEST_MAIN(TEST(test_guide_sampling), TEST(test_guide_window_room))
+/* Camera hits are guided and the marble's irradiance fills (depth 0 too,
+ * with a shadow-ray count of their own, filled by whichever thread's
+ * lookup comes first) are not: the same bytes on 1 and 8 threads (a
+ * worker's remembered guide decision once leaked into the fills, whose
+ * values then depended on the order of lookups). */
+static void test_guide_threads_with_irradiance(void)
+{
+    RayesScene *s = window_room(1);
+    RayesStats *st = NULL;
+    RayesImage *one = render_room(s, 1, 1, 1, 100.0, NULL, &st);
+    const RayesStat *irr = rayes_stats_find(st, "subsurface/irradiance_points");
+    CHECK(irr && irr->count > 1000); /* the ball is in view, its fills ran */
+    rayes_stats_free(st);
+    RayesImage *four = render_room(s, 1, 1, 8, 100.0, NULL, NULL);
+    if (one && four)
+        CHECK(memcmp(one->rgba, four->rgba, sizeof(float) * 4 * 96 * 96) == 0);
+    rayes_image_free(one);
+    rayes_image_free(four);
+    rayes_scene_release(s);
+}
+
+/* A floor and a wall under a constant environment, one bounce: the fills'
+ * points take 1 shadow ray or 8, the same light in the mean. With 1 ray
+ * and a fill's zero spread the light's strategy once took weight 1 while
+ * the cosine strategy's samples were added too (0.836 against 0.654). */
+static void test_one_shadow_ray_fills(void)
+{
+    RayesScene *s = rayes_scene_new();
+    float eye[3] = {0, 1.5f, -4}, target[3] = {0, 0.5f, 2}, up[3] = {0, 1, 0};
+    CHECK(rayes_scene_set_camera(s, eye, target, up, 50.0f) == RAYES_OK);
+    RayesParam kd = pf("Kd", 0.8f);
+    CHECK(rayes_scene_set_shader(s, "matte", &kd, 1) == RAYES_OK);
+    const float floor_[4][3] = {{-4, 0, -4}, {4, 0, -4}, {-4, 0, 4}, {4, 0, 4}};
+    const float wall[4][3] = {{-4, 0, 4}, {4, 0, 4}, {-4, 4, 4}, {4, 4, 4}};
+    CHECK(rayes_scene_bilinear_patch(s, floor_) == RAYES_OK);
+    CHECK(rayes_scene_bilinear_patch(s, wall) == RAYES_OK);
+    RayesParam e[1] = {pf("intensity", 1)};
+    CHECK(rayes_scene_light(s, "environmentlight", e, 1) == RAYES_OK);
+    CHECK(rayes_scene_commit(s) == RAYES_OK);
+    double mean[2] = {0, 0};
+    for (int k = 0; k < 2; k++) {
+        RayesRenderOptions o;
+        rayes_render_options_init(&o, RAYES_QUALITY_PREVIEW);
+        o.width = o.height = 32;
+        o.spp = 4;
+        o.bounces = 1;
+        o.env_guide = 0;
+        o.shadow_rays_deep = k ? 8 : 1;
+        RayesImage *img = NULL;
+        CHECK(rayes_render(s, &o, &img, NULL) == RAYES_OK);
+        if (img)
+            mean[k] = mean_of(img);
+        rayes_image_free(img);
+    }
+    CHECK(mean[1] > 0.1);
+    CHECK_NEAR(mean[0] / mean[1], 1.0, 0.03);
+    rayes_scene_release(s);
+}
+
+TEST_MAIN(TEST(test_guide_sampling), TEST(test_guide_window_room), TEST(test_one_shadow_ray_fills),
+          TEST_THREADS(test_guide_threads_with_irradiance))
