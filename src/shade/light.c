@@ -327,10 +327,27 @@ static void cdf_guide(const float *cdf, int n, int *guide)
     }
 }
 
+/* The sample at fraction (fx, fy) of map pixel (x, y): its direction,
+ * radiance and the light's own pdf; 0 where the pixel sends nothing. */
+static int env_pixel_sample(const Light *l, int x, int y, float fx, float fy, LightSample *s)
+{
+    const LightEnvMap *m = l->env;
+    float st, u = ((float)x + fminf(fmaxf(fx, 0.0f), 0.9999f)) / (float)m->width;
+    float v = ((float)y + fminf(fmaxf(fy, 0.0f), 0.9999f)) / (float)m->height;
+    s->wi = env_uv_to_dir(l, u, v, &st);
+    float p = m->pixel_pdf[(size_t)y * m->width + x];
+    if (!(st > 0.0f) || !(p > 0.0f))
+        return 0;
+    const float *c = &m->rgb[3 * ((size_t)y * m->width + x)];
+    s->Li = v3_mul(l->L, v3(c[0], c[1], c[2]));
+    s->pdf = p * (float)m->width * (float)m->height / (2.0f * PI * PI * st);
+    s->dist = INFINITY;
+    return 1;
+}
+
 static int env_sample(const Light *l, float a, float b, LightSample *s)
 {
     const LightEnvMap *m = l->env;
-    float u, v, st;
     if (!m) {
         float z = 1.0f - 2.0f * a, r = sqrtf(fmaxf(0.0f, 1.0f - z * z)), phi = 2.0f * PI * b;
         s->wi = v3(r * cosf(phi), r * sinf(phi), z);
@@ -348,17 +365,7 @@ static int env_sample(const Light *l, float a, float b, LightSample *s)
     int x = cdf_find(cc, &m->col_guide[(size_t)y * m->width], m->width, b);
     float dc = cc[x + 1] - cc[x];
     float fx = dc > 0.0f ? (b - cc[x]) / dc : 0.5f;
-    u = ((float)x + fminf(fmaxf(fx, 0.0f), 0.9999f)) / (float)m->width;
-    v = ((float)y + fminf(fmaxf(fy, 0.0f), 0.9999f)) / (float)m->height;
-    s->wi = env_uv_to_dir(l, u, v, &st);
-    float p = m->pixel_pdf[(size_t)y * m->width + x];
-    if (!(st > 0.0f) || !(p > 0.0f))
-        return 0;
-    const float *c = &m->rgb[3 * ((size_t)y * m->width + x)];
-    s->Li = v3_mul(l->L, v3(c[0], c[1], c[2]));
-    s->pdf = p * (float)m->width * (float)m->height / (2.0f * PI * PI * st);
-    s->dist = INFINITY;
-    return 1;
+    return env_pixel_sample(l, x, y, fx, fy, s);
 }
 
 /* ------------------------------------------- guided environment */
@@ -443,6 +450,19 @@ static int range_find(const float *cdf, int lo, int hi, float x)
     return lo;
 }
 
+/* range_find over a cdf of doubles. */
+static int range_find_d(const double *cdf, int lo, int hi, double x)
+{
+    while (hi - lo > 1) {
+        int mid = (lo + hi) / 2;
+        if (cdf[mid] <= x)
+            lo = mid;
+        else
+            hi = mid;
+    }
+    return lo;
+}
+
 int light_guide_bin_sample(const Light *l, int b, float a, float c, LightSample *s)
 {
     const LightEnvMap *m = l->env;
@@ -468,14 +488,7 @@ int light_guide_bin_sample(const Light *l, int b, float a, float c, LightSample 
     if (!(mass > 0.0))
         return 0;
     double t = band[y0] + a * mass;
-    int y = y0, top = y1; /* the row with band[y] <= t < band[y + 1] */
-    while (top - y > 1) {
-        int mid = (y + top) / 2;
-        if (band[mid] <= t)
-            y = mid;
-        else
-            top = mid;
-    }
+    int y = range_find_d(band, y0, y1, t);
     double dr = band[y + 1] - band[y];
     float fy = dr > 0.0 ? (float)((t - band[y]) / dr) : 0.5f;
     const float *cc = &m->col_cdf[(size_t)y * (w + 1)];
@@ -486,17 +499,7 @@ int light_guide_bin_sample(const Light *l, int b, float a, float c, LightSample 
     int x = range_find(cc, x0, x1, tx);
     float dc = cc[x + 1] - cc[x];
     float fx = dc > 0.0f ? (tx - cc[x]) / dc : 0.5f;
-    float st, u = ((float)x + fminf(fmaxf(fx, 0.0f), 0.9999f)) / (float)w;
-    float v = ((float)y + fminf(fmaxf(fy, 0.0f), 0.9999f)) / (float)h;
-    s->wi = env_uv_to_dir(l, u, v, &st);
-    float p = m->pixel_pdf[(size_t)y * w + x];
-    if (!(st > 0.0f) || !(p > 0.0f))
-        return 0;
-    const float *rgb = &m->rgb[3 * ((size_t)y * w + x)];
-    s->Li = v3_mul(l->L, v3(rgb[0], rgb[1], rgb[2]));
-    s->pdf = p * (float)w * (float)h / (2.0f * PI * PI * st);
-    s->dist = INFINITY;
-    return 1;
+    return env_pixel_sample(l, x, y, fx, fy, s);
 }
 
 int light_guide_init(const Light *l, const float *w, LightGuide *g)
