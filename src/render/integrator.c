@@ -187,14 +187,18 @@ static Vec3 shade_hit(Worker *w, const Ray *ray, const Hit *hit, const RenderObj
     path_apply_Os_pattern(w, obj, &ctx, &hp.Os);
     float Ci[1][3] = {{0, 0, 0}}, Oi[1][3] = {{1, 1, 1}}, E[1][3] = {{0, 0, 0}};
     RayesShadeOutputs out = {Ci, Oi, NULL, NULL};
+    /* Whatever the kind, the hit is shaded as its own object: a glass's
+     * thin shadow is opaque to its own light samples alone, not to those
+     * of what its refraction rays reach (RAYES_SHADER_THIN_SHADOW). */
+    const RenderObject *outer = w->shading;
+    w->shading = obj;
     if (kind == RAYES_RAY_SUBSURFACE) {
         w->stats.irradiance_points++;
         out.Irradiance = ps.irradiance = E;
         shade_run_diffuselighting(w->services, &ctx, obj->shader, &out);
-        *Oi_out = v3(1, 1, 1);
-        return v3(E[0][0], E[0][1], E[0][2]);
-    }
-    if (kind == RAYES_RAY_TRANSMISSION) {
+        Oi[0][0] = Oi[0][1] = Oi[0][2] = 1.0f;
+        Ci[0][0] = E[0][0], Ci[0][1] = E[0][1], Ci[0][2] = E[0][2];
+    } else if (kind == RAYES_RAY_TRANSMISSION) {
         w->stats.opacity_points++;
         shade_run_opacity(w->services, &ctx, obj->shader, &out);
     } else if (kind == RAYES_RAY_DIFFUSE) {
@@ -202,11 +206,9 @@ static Vec3 shade_hit(Worker *w, const Ray *ray, const Hit *hit, const RenderObj
         shade_run_diffuselighting(w->services, &ctx, obj->shader, &out);
     } else {
         w->stats.shading_points[RY_MIN(diffuse_depth, RENDER_MAX_DEPTH)]++;
-        const RenderObject *outer = w->shading;
-        w->shading = obj;
         shade_run_lighting(w->services, &ctx, obj->shader, &out);
-        w->shading = outer;
     }
+    w->shading = outer;
     *Oi_out = v3(Oi[0][0], Oi[0][1], Oi[0][2]);
     return v3(Ci[0][0], Ci[0][1], Ci[0][2]);
 }

@@ -489,7 +489,12 @@ static void fill_radiosity(void *user, const CacheKey *key, size_t n, float (*ou
      * shutter's: its rays leave then, whichever ray's lookup filled it
      * (DESIGN.md "Motion blur"). */
     float outer_time = w->time;
+    const RenderObject *outer_shading = w->shading;
     const Camera *cam = &w->rs->camera;
+    /* and as the grid's own object, whoever asked: a fill asked for by a
+     * glass's refraction ray found that glass opaque to its shadow rays (a
+     * floor seen through a pane was black, and the cache kept it) */
+    w->shading = obj;
     w->time = moves ? geom_segment_mid_time(gs, key->segment)
                     : 0.5f * (cam->shutter[0] + cam->shutter[1]);
     float width = level_edge(g, key->level) * scale, du, dv;
@@ -550,6 +555,7 @@ static void fill_radiosity(void *user, const CacheKey *key, size_t n, float (*ou
         w->stats.segment_fills[key->segment]++;
     fill_run(w, key->type, &ctx, obj, &fp, f3 + 9 * n, out);
     w->time = outer_time;
+    w->shading = outer_shading;
     free(f3);
     free(f1);
     free(fp.keys);

@@ -109,12 +109,6 @@ RayesError rayes_scene_object_instance(RayesScene *s, const char *name)
                           m < 0 ? "object instance: no object block is named \"%.64s\""
                                 : "object instance: \"%.64s\" is the block being defined",
                           name);
-    const float(*a)[4] = s->world_from_object.m;
-    if (a[3][0] != 0.0f || a[3][1] != 0.0f || a[3][2] != 0.0f || a[3][3] != 1.0f)
-        return scene_fail(s, RAYES_ERROR_INVALID_ARGUMENT,
-                          "object instance \"%.64s\": the transform is projective (expected "
-                          "an affine one)",
-                          name);
     SceneMaster *mm = &s->masters[m];
     uint64_t leaves = mm->leaves;
     SceneMaster *parent = s->open_master >= 0 ? &s->masters[s->open_master] : NULL;

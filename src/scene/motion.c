@@ -94,11 +94,14 @@ RayesError rayes_scene_set_transform_motion(RayesScene *s, size_t n, const float
         return e;
     Mat4 W[GEOM_MAX_TIMES], inv0;
     for (size_t k = 0; k < n; k++) {
-        W[k] = mat4_from_array(M[k]);
         Mat4 inv;
-        if (!scene_finite(M[k], 16) || !mat4_invert(W[k], &inv))
+        if (!scene_finite(M[k], 16) || !mat4_invert(mat4_from_array(M[k]), &inv))
             return scene_fail(s, RAYES_ERROR_INVALID_ARGUMENT,
                               "transform motion: expected finite, invertible matrices");
+        if (!scene_affine(M[k]))
+            return scene_fail(s, RAYES_ERROR_INVALID_ARGUMENT, AFFINE_EXPECTED, "transform motion");
+        W[k] = scene_unit_w(M[k]);
+        mat4_invert(W[k], &inv);
         if (k == 0)
             inv0 = inv;
     }

@@ -197,7 +197,9 @@ RayesError rayes_scene_set_transform(RayesScene *s, const float m[16])
     if (!scene_finite(m, 16) || !mat4_invert(mat4_from_array(m), &inv))
         return scene_fail(s, RAYES_ERROR_INVALID_ARGUMENT,
                           "transform: expected a finite, invertible matrix");
-    s->world_from_object = mat4_from_array(m);
+    if (!scene_affine(m))
+        return scene_fail(s, RAYES_ERROR_INVALID_ARGUMENT, AFFINE_EXPECTED, "transform");
+    s->world_from_object = scene_unit_w(m);
     s->current_motion = 0;
     return RAYES_OK;
 }
@@ -524,6 +526,9 @@ RayesError rayes_scene_solid_end(RayesScene *s)
 
 static RayesError add_prim(RayesScene *s, Prim *p)
 {
+    /* a subdivision patch's points were checked with its mesh's */
+    if (p->type != PRIM_SUBDIV && !scene_within(scene_prim_bounds(p)))
+        return scene_fail(s, RAYES_ERROR_INVALID_ARGUMENT, WITHIN_EXPECTED, "primitive");
     if (s->current_object == -1) {
         RayesError e = rayes_scene_set_shader(s, "matte", NULL, 0);
         if (e != RAYES_OK)
@@ -599,6 +604,15 @@ RayesError scene_push_values(RayesScene *s, Prim *p, unsigned mask, const float 
     memcpy(s->pv + s->n_pv, values, n * sizeof *values);
     s->n_pv += n;
     return RAYES_OK;
+}
+
+/* The bounds of the n points at xyz (three floats each). */
+static Bounds3 bounds_of(const float *xyz, size_t n)
+{
+    Bounds3 b = bounds_empty();
+    for (size_t i = 0; i < n; i++)
+        b = bounds_add(b, v3_load(xyz + 3 * i));
+    return b;
 }
 
 static void transform_points(const RayesScene *s, const float (*P)[3], size_t n, Vec3 *out)
@@ -931,6 +945,10 @@ RayesError rayes_scene_subdivision_mesh(RayesScene *s, RayesSubdivScheme scheme,
     if (!world)
         return scene_fail(s, RAYES_ERROR_OUT_OF_MEMORY, "out of memory");
     transform_points(s, (const float(*)[3])P, n_points, (Vec3 *)world);
+    if (!scene_within(bounds_of(world, n_points))) {
+        free(world);
+        return scene_fail(s, RAYES_ERROR_INVALID_ARGUMENT, WITHIN_EXPECTED, "subdivision mesh");
+    }
     float *N = world + 3 * n_points;
     for (size_t i = 0; i < n_n; i++) {
         Vec3 n = mat4_vector(&set.normal_from_object, v3_load(set.by[0]->data + 3 * i));
@@ -1054,6 +1072,8 @@ RayesError rayes_scene_area_light(RayesScene *s, const float P[4][3], const floa
     l->type = LIGHT_QUAD;
     Vec3 v[4];
     transform_points(s, P, 4, v);
+    if (!scene_within(bounds_of(&v[0].x, 4)))
+        return scene_fail(s, RAYES_ERROR_INVALID_ARGUMENT, WITHIN_EXPECTED, "area light");
     l->P[0] = v[0];
     l->P[1] = v[1];
     l->P[2] = v[3];
@@ -1120,6 +1140,11 @@ RayesError rayes_scene_area_light_mesh(RayesScene *s, size_t n_faces, const int 
                 prims[t].cp[j] = v[3 * t + (size_t)j];
             }
         }
+    if (!scene_within(bounds_of(&v[0].x, 3 * n_tris))) {
+        free(v);
+        free(prims);
+        return scene_fail(s, RAYES_ERROR_INVALID_ARGUMENT, WITHIN_EXPECTED, "area light mesh");
+    }
     Light l;
     memset(&l, 0, sizeof l);
     l.L = l.color = v3_load(L);

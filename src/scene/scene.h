@@ -334,6 +334,28 @@ RayesError scene_fail(RayesScene *scene, RayesError e, const char *fmt, ...)
     __attribute__((format(printf, 3, 4))); /* valid.c */
 /* 1 if the n floats at v are all finite (valid.c). */
 int scene_finite(const float *v, size_t n);
+/* 1 if the box b lies within SCENE_MAX_COORD of the origin on every axis
+ * (valid.c; an empty box does). Farther, squared distances overflow a
+ * float: a ray from such a point is not valid to Embree (a quad 1e20 wide
+ * failed its assertion) and dicing what spans it does not end (1e24: out
+ * of memory). */
+#define SCENE_MAX_COORD 1e18f
+int scene_within(Bounds3 b);
+#define WITHIN_EXPECTED                                                                            \
+    "%s: geometry reaches beyond 1e18 from the origin in world space (float arithmetic on rays "   \
+    "and dicing fails there); expected coordinates within 1e18"
+/* 1 if the row-major matrix m is affine up to a homogeneous scale: its
+ * last row 0 0 0 w, w != 0 (valid.c; scene_unit_w divides w out). Geometry is transformed point by
+ * point, so a projective row sends the points where it gives w = 0 through
+ * infinity: rays from near them are not valid, and dicing what spans them
+ * does not end. AFFINE_EXPECTED is the message, its %s the call. */
+int scene_affine(const float m[16]);
+/* An affine m with its homogeneous scale divided out (last row 0 0 0 1),
+ * as the scene keeps it: instances hand Embree its 3 x 4 part. */
+Mat4 scene_unit_w(const float m[16]);
+#define AFFINE_EXPECTED                                                                            \
+    "%s: expected an affine matrix, not a projective one (a perspective row other than 0 0 0 "     \
+    "w sends geometry through infinity; is a translation in the wrong row or column?)"
 RayesError scene_push_values(RayesScene *scene, Prim *p, unsigned mask, const float *values,
                              size_t n);
 /* Notes whether an Os primitive variable of n values (or none: NULL) has

@@ -29,3 +29,24 @@ int scene_finite(const float *v, size_t n)
             return 0;
     return 1;
 }
+
+int scene_within(Bounds3 b)
+{
+    const float m = SCENE_MAX_COORD;
+    return b.lo.x >= -m && b.lo.y >= -m && b.lo.z >= -m && b.hi.x <= m && b.hi.y <= m &&
+           b.hi.z <= m;
+}
+
+int scene_affine(const float m[16])
+{
+    return m[12] == 0.0f && m[13] == 0.0f && m[14] == 0.0f && m[15] != 0.0f;
+}
+
+Mat4 scene_unit_w(const float m[16])
+{
+    Mat4 r = mat4_from_array(m);
+    for (int i = 0; m[15] != 1.0f && i < 4; i++)
+        for (int j = 0; j < 4; j++)
+            r.m[i][j] /= m[15];
+    return r;
+}
