@@ -402,6 +402,24 @@ struct RayesShaderServices {
      * (supports()). */
     void (*microfacet)(const RayesShaderServices *sv, const RayesShadeCtx *ctx, const float *alpha,
                        int n_rays, float (*out)[3]);
+
+    /* RenderMan's diffuse() and specular(), with the shadow rays of one
+     * direct_lighting call (the same arguments): diffuse[i] as
+     * direct_lighting's; specular[i] = (1/pi) * integral of L_light
+     * (N.H)^(1 / roughness[i]) dw, with no cosine and no normalisation
+     * (roughness NULL: 0.1). Under RenderMan's point, spot and distant
+     * lights, whose intensity the RIB reader multiplies by pi, that is the
+     * RenderMan specification's sum of Cl (N.H)^(1 / roughness): the
+     * classic shaders' highlight, dimmer than direct_lighting's normalised
+     * lobe by about 8 / (e + 8) and brighter toward grazing light. (PRMan
+     * and Aqsis raise N.H to 8 / roughness instead; the reference pictures
+     * of classic RIB files measured match the specification.) Area and
+     * environment lights are sampled with multiple importance sampling
+     * against the Blinn-Phong lobe of that exponent. Older renderers lack
+     * it (supports()). */
+    void (*classic_lighting)(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
+                             int n_shadow_rays, const char *category, const float *roughness,
+                             float (*diffuse)[3], float (*specular)[3]);
 };
 
 #ifdef __cplusplus

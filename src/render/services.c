@@ -48,7 +48,12 @@ typedef struct Lobe {
     Vec3 Vl;      /* GGX's: V in the frame, kept just above the surface */
     float e;      /* Blinn-Phong's exponent */
     float alpha;  /* GGX's width; 0: Blinn-Phong */
+    int classic;  /* Blinn-Phong as RenderMan's specular(): (N.H)^e / (pi N.L) */
 } Lobe;
+
+/* The lobes point_lobe makes. */
+
+enum { LOBE_BLINN, LOBE_GGX, LOBE_CLASSIC };
 
 /* GGX's narrowest lobe: a smaller width is taken as this one (a mirror is
  * indirect_specular's). */
@@ -56,7 +61,7 @@ typedef struct Lobe {
 
 static Lobe lobe_blinn(Vec3 N, Vec3 V, float e)
 {
-    Lobe l = {N, N, N, V, V, e, 0.0f};
+    Lobe l = {N, N, N, V, V, e, 0.0f, 0};
     v3_basis(N, &l.t, &l.b);
     return l;
 }
@@ -88,6 +93,10 @@ static float lobe_f(const Lobe *l, Vec3 wi)
     }
     Vec3 H = v3_normalize(v3_add(wi, l->V));
     float nh = fmaxf(v3_dot(l->N, H), 0.0f);
+    if (l->classic) { /* f cos = (N.H)^e / pi: no cosine, as RSL sums Cl (N.H)^e */
+        float cos_i = v3_dot(l->N, wi);
+        return cos_i > 0.0f ? powf(nh, l->e) / ((float)M_PI * cos_i) : 0.0f;
+    }
     return (l->e + 8.0f) / (8.0f * (float)M_PI) * powf(nh, l->e);
 }
 
@@ -401,18 +410,21 @@ static const RenderObject *lit_object(const PathState *ps)
     return ps->grid < rs->gs->n_grids ? render_object(rs, ps->grid, ps->instance) : &every;
 }
 
-/* The specular lobe of point i: GGX of width[i] (ggx), else Blinn-Phong
- * of exponent 1 / width[i], a roughness (NULL or not above 0: 0.1). */
-static Lobe point_lobe(Vec3 N, Vec3 V, const float *width, size_t i, int ggx)
+/* The specular lobe of point i, of kind LOBE_*: GGX of width[i], else
+ * Blinn-Phong of exponent 1 / width[i], a roughness (NULL or not above 0:
+ * 0.1), normalised or RenderMan's. */
+static Lobe point_lobe(Vec3 N, Vec3 V, const float *width, size_t i, int kind)
 {
-    if (ggx)
+    if (kind == LOBE_GGX)
         return lobe_ggx(N, V, width ? width[i] : 0.0f);
-    return lobe_blinn(N, V, 1.0f / (width && width[i] > 0.0f ? width[i] : 0.1f));
+    Lobe l = lobe_blinn(N, V, 1.0f / (width && width[i] > 0.0f ? width[i] : 0.1f));
+    l.classic = kind == LOBE_CLASSIC;
+    return l;
 }
 
-/* direct_lighting with the lobe of point_lobe. */
+/* direct_lighting with the lobe of point_lobe of that kind. */
 static void direct_lighting(const RayesShadeCtx *ctx, int n_shadow_rays, const char *category,
-                            const float *width, int ggx, float (*diffuse)[3], float (*specular)[3])
+                            const float *width, int kind, float (*diffuse)[3], float (*specular)[3])
 {
     const PathState *ps = ctx->renderer;
     Worker *w = ps->w;
@@ -430,7 +442,7 @@ static void direct_lighting(const RayesShadeCtx *ctx, int n_shadow_rays, const c
         p.Ng = v3_load(ctx->Ng[i]);
         p.o = v3_madd(v3_load(ctx->P[i]), p.Ng, ps->offset[point(ctx, i)]);
         p.V = ctx->I ? v3_neg(v3_load(ctx->I[i])) : v3(0, 0, 0);
-        p.lobe = point_lobe(p.N, p.V, width, i, ggx);
+        p.lobe = point_lobe(p.N, p.V, width, i, kind);
         p.spec = want_spec;
         p.diff = diffuse != NULL;
         p.shadow = shadow_diff(ps, point(ctx, i), n);
@@ -480,7 +492,15 @@ static void svc_direct_lighting(const RayesShaderServices *sv, const RayesShadeC
                                 float (*diffuse)[3], float (*specular)[3])
 {
     (void)sv;
-    direct_lighting(ctx, n_shadow_rays, category, roughness, 0, diffuse, specular);
+    direct_lighting(ctx, n_shadow_rays, category, roughness, LOBE_BLINN, diffuse, specular);
+}
+
+static void svc_classic_lighting(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
+                                 int n_shadow_rays, const char *category, const float *roughness,
+                                 float (*diffuse)[3], float (*specular)[3])
+{
+    (void)sv;
+    direct_lighting(ctx, n_shadow_rays, category, roughness, LOBE_CLASSIC, diffuse, specular);
 }
 
 /* Kajiya-Kay's terms for tangent T, toward the light wi and the viewer V
@@ -820,7 +840,7 @@ static void svc_indirect_specular(const RayesShaderServices *sv, const RayesShad
  * lobe (half vectors about N), to which emitters look black, each
  * weighted by f cos / pdf. One lobe for lights and for the rest: the sum
  * is the lobe's integral of all incident light. */
-static void glossy(const RayesShadeCtx *ctx, const float *width, int ggx, int n_rays,
+static void glossy(const RayesShadeCtx *ctx, const float *width, int kind, int n_rays,
                    float (*out)[3])
 {
     const PathState *ps = ctx->renderer;
@@ -829,7 +849,7 @@ static void glossy(const RayesShadeCtx *ctx, const float *width, int ggx, int n_
         memset(out, 0, ctx->n_points * sizeof *out);
         return;
     }
-    direct_lighting(ctx, 0, NULL, width, ggx, NULL, out);
+    direct_lighting(ctx, 0, NULL, width, kind, NULL, out);
     if (ctx->specular_depth >= w->set->specular_depth)
         return;
     int n = n_rays > 0 ? n_rays
@@ -839,7 +859,7 @@ static void glossy(const RayesShadeCtx *ctx, const float *width, int ggx, int n_
         n = 1; /* past the branch depth: one ray follows the lobe */
     for (size_t i = 0; i < ctx->n_points; i++) {
         Vec3 N = v3_load(ctx->N[i]), Ng = v3_load(ctx->Ng[i]), sum = v3(0, 0, 0);
-        Lobe lobe = point_lobe(N, v3_neg(v3_load(ctx->I[i])), width, i, ggx);
+        Lobe lobe = point_lobe(N, v3_neg(v3_load(ctx->I[i])), width, i, kind);
         uint64_t key = hash_combine(ps->keys[point(ctx, i)], DIM_SPECULAR);
         CmjPattern pat;
         cmj_pattern_init(&pat, (uint32_t)n, (uint32_t)key);
@@ -864,14 +884,14 @@ static void svc_glossy(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
                        const float *roughness, int n_rays, float (*out)[3])
 {
     (void)sv;
-    glossy(ctx, roughness, 0, n_rays, out);
+    glossy(ctx, roughness, LOBE_BLINN, n_rays, out);
 }
 
 static void svc_microfacet(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
                            const float *alpha, int n_rays, float (*out)[3])
 {
     (void)sv;
-    glossy(ctx, alpha, 1, n_rays, out);
+    glossy(ctx, alpha, LOBE_GGX, n_rays, out);
 }
 
 static void svc_indirect_refraction(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
@@ -1122,6 +1142,7 @@ static const char *const service_names[] = {
     "direct_volume",
     "subsurface",
     "microfacet",
+    "classic_lighting",
 };
 
 static int svc_supports(const RayesShaderServices *sv, const char *service)
@@ -1158,4 +1179,5 @@ const RayesShaderServices render_services = {
     .pattern = svc_pattern,
     .subsurface = subsurface_service,
     .microfacet = svc_microfacet,
+    .classic_lighting = svc_classic_lighting,
 };

@@ -131,6 +131,16 @@ const RayesShaderClass shade_class_matte = {
     .diffuselighting = matte_lighting, /* matte is view-independent throughout */
 };
 
+void shade_classic_lighting(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
+                            const float *roughness, float (*diffuse)[3], float (*specular)[3])
+{
+    size_t need = offsetof(RayesShaderServices, classic_lighting) + sizeof sv->classic_lighting;
+    if (sv->struct_size >= need && sv->classic_lighting)
+        sv->classic_lighting(sv, ctx, 0, NULL, roughness, diffuse, specular);
+    else
+        sv->direct_lighting(sv, ctx, 0, NULL, roughness, diffuse, specular);
+}
+
 /* ---- plastic */
 
 static void plastic_diffuse_chunk(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
@@ -149,7 +159,7 @@ static void plastic_chunk(const RayesShaderServices *sv, const RayesShadeCtx *ct
     float rough[SHADE_CHUNK];
     for (size_t i = 0; i < ctx->n_points; i++)
         rough[i] = p->roughness;
-    sv->direct_lighting(sv, ctx, 0, NULL, rough, dd, ds); /* one set of shadow rays for both */
+    shade_classic_lighting(sv, ctx, rough, dd, ds); /* one set of shadow rays for both */
     sv->indirect_diffuse(sv, ctx, 0, id);
     if (sv->ambient)
         sv->ambient(sv, ctx, am);
@@ -361,7 +371,7 @@ static void painted_chunk_common(const RayesShaderServices *sv, const RayesShade
     for (size_t i = 0; i < ctx->n_points; i++)
         rough[i] = p->roughness;
     highlight = highlight && ctx->I;
-    sv->direct_lighting(sv, ctx, 0, NULL, rough, dd, highlight ? ds : NULL);
+    shade_classic_lighting(sv, ctx, rough, dd, highlight ? ds : NULL);
     sv->indirect_diffuse(sv, ctx, 0, id);
     if (sv->ambient)
         sv->ambient(sv, ctx, am);

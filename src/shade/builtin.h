@@ -58,6 +58,13 @@ float shade_service_checker(const RayesShaderServices *sv, float s, float t, flo
 int shade_texture_service(TextureSystem *ts, const RayesShadeCtx *ctx, const char *name,
                           const float *s, const float *t, const float *ds, const float *dt,
                           float (*rgb)[3], float *alpha);
+/* RenderMan's diffuse() and specular(Nf, V, roughness) at the points, with
+ * one set of shadow rays (either output may be NULL): the classic_lighting
+ * service, or from a renderer without it direct_lighting, whose highlight
+ * is its own normalised lobe. The classic shaders' lighting (builtin.c). */
+void shade_classic_lighting(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
+                            const float *roughness, float (*diffuse)[3], float (*specular)[3]);
+
 /* plastic with a texture: Ka, Kd, Ks, roughness, specularcolor, texturename */
 extern const RayesShaderClass shade_class_paintedplastic;
 

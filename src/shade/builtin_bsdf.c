@@ -262,7 +262,7 @@ static void metal_chunk(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
     if (ctx->I) {
         for (size_t i = 0; i < ctx->n_points; i++)
             rough[i] = p->roughness;
-        sv->direct_lighting(sv, ctx, 0, NULL, rough, NULL, ds);
+        shade_classic_lighting(sv, ctx, rough, NULL, ds);
     }
     for (size_t i = 0; i < ctx->n_points; i++)
         for (int c = 0; c < 3; c++)
@@ -333,7 +333,7 @@ static void shinymetal_chunk(const RayesShaderServices *sv, const RayesShadeCtx 
     if (ctx->I) {
         for (size_t i = 0; i < ctx->n_points; i++)
             rough[i] = p->roughness;
-        sv->direct_lighting(sv, ctx, 0, NULL, rough, NULL, ds);
+        shade_classic_lighting(sv, ctx, rough, NULL, ds);
         environment(sv, ctx, p->texturename, env);
     }
     for (size_t i = 0; i < ctx->n_points; i++)
@@ -587,7 +587,7 @@ static void glass_chunk(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
         float rough[SHADE_CHUNK];
         for (size_t i = 0; i < ctx->n_points; i++)
             rough[i] = p->roughness > 0.0f ? p->roughness : 0.1f;
-        sv->direct_lighting(sv, ctx, 0, NULL, rough, NULL, ds);
+        shade_classic_lighting(sv, ctx, rough, NULL, ds);
     }
     for (size_t i = 0; i < ctx->n_points; i++)
         for (int c = 0; c < 3; c++)
