@@ -39,7 +39,8 @@ static const char render_options[] =
     "                          (0: after every tile) and when interrupted\n"
     "  --resume                render only the tiles OUTPUT.checkpoint lacks; the image is\n"
     "                          the same bytes as an uninterrupted render's\n"
-    "  --res W[xH]             resolution in pixels (default 512x512)\n"
+    "  --res W[xH]             resolution in pixels (default 512x512); W alone keeps a\n"
+    "                          scene file's aspect ratio (else square)\n"
     "  --spp N                 pixel samples (default 4)\n"
     "  --max-spp N             adaptive sampling: a noisy pixel takes further blocks of\n"
     "                          --spp samples, up to N (default 0: off)\n"
@@ -226,7 +227,9 @@ static float parse_float(const char *opt, const char *s, float lo, float hi)
     return v;
 }
 
-static void parse_res(const char *s, RayesRenderOptions *o)
+/* --res W or WxH; returns 1 for W alone (a square, unless the scene file
+ * gives an aspect ratio: merge_settings). */
+static int parse_res(const char *s, RayesRenderOptions *o)
 {
     char w[32];
     const char *x = s ? strchr(s, 'x') : NULL;
@@ -234,9 +237,10 @@ static void parse_res(const char *s, RayesRenderOptions *o)
         snprintf(w, sizeof w, "%.*s", (int)(x - s), s);
         o->width = (int)parse_long("--res", w, 1, 65536);
         o->height = (int)parse_long("--res", x + 1, 1, 65536);
-    } else {
-        o->width = o->height = (int)parse_long("--res", s, 1, 65536);
+        return 0;
     }
+    o->width = o->height = (int)parse_long("--res", s, 1, 65536);
+    return 1;
 }
 
 static void parse_split(const char *s, float split[3])
@@ -358,8 +362,8 @@ void parse_args(int argc, char **argv, Args *a)
                 die_usage("-o: the file name is too long");
             snprintf(out->path, sizeof out->path, "%s", v);
         } else if (strcmp(o, "--res") == 0) {
-            parse_res(v, opt);
-            a->set |= SET_RES;
+            a->set = (a->set & ~(unsigned)SET_RES_WIDTH) | SET_RES |
+                     (parse_res(v, opt) ? SET_RES_WIDTH : 0);
         } else if (strcmp(o, "--spp") == 0) {
             opt->spp = (int)parse_long(o, v, 1, 1 << 20);
             a->set |= SET_SPP;
@@ -543,6 +547,10 @@ void merge_settings(Args *a, const IoSettings *s)
     if (!(a->set & SET_RES) && s->width > 0 && s->height > 0) {
         o->width = s->width;
         o->height = s->height;
+    } else if ((a->set & SET_RES_WIDTH) && s->width > 0 && s->height > 0) {
+        /* a width alone keeps the file's framing: a 1280 x 720 file at --res 640 is 640 x 360 */
+        double h = (double)o->width * s->height / s->width;
+        o->height = h < 1.0 ? 1 : h > 65536.0 ? 65536 : (int)(h + 0.5);
     }
     if (!(a->set & SET_SPP) && s->spp > 0)
         o->spp = s->spp;

@@ -28,7 +28,8 @@ enum {
     SET_OPACITY_CACHE_MB = 512,
     SET_MAX_SPP = 1024,
     SET_ADAPTIVE_ERROR = 2048,
-    SET_CLAMP = 4096
+    SET_CLAMP = 4096,
+    SET_RES_WIDTH = 8192 /* --res W alone: the height follows the file's aspect ratio */
 };
 
 /* An image to write. */

@@ -648,6 +648,14 @@ static int cmd_convert(int argc, char **argv)
     IoSink sink = io_rib_writer_sink(w);
     char err[1024];
     RayesError e = load_scene(in, data_dir, frame, &sink, &settings, err, sizeof err);
+    if (e == RAYES_OK && !(settings.width > 0 && settings.height > 0)) {
+        /* a built-in scene: the size it renders at, so the RIB file (whose
+         * Format would otherwise be RenderMan's 640 x 480) frames it alike */
+        RayesRenderOptions d;
+        rayes_render_options_init(&d, RAYES_QUALITY_PREVIEW);
+        settings.width = d.width;
+        settings.height = d.height;
+    }
     int status = e == RAYES_OK ? write_rib(w, &settings, out) : load_status(in, e);
     if (e != RAYES_OK)
         fprintf(stderr, "rayes: %s\n", err);
