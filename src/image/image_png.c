@@ -3,10 +3,14 @@
  *
  * Writing: 8-bit RGBA. Colour is the sRGB transfer curve applied to linear
  * values clamped to [0, 1] (NaN becomes 0); alpha is stored linearly, as
- * PNG requires. The file carries an sRGB chunk, with the gAMA and cHRM
- * chunks that the PNG specification asks for beside it for older readers.
- * image_write_png_curve can instead quantize the values as they are, with
- * no colour chunk (RenderMan's 8-bit files: its Exposure is the curve).
+ * PNG requires. The renderer's colour is premultiplied by alpha (as EXR
+ * keeps it); PNG's is not, so RGBA files store colour / alpha (a pixel
+ * of alpha 0 black): stored premultiplied, every viewer multiplied it by
+ * alpha again, and silhouettes and glows over the background came out
+ * dark (a half-covered white edge pixel showed 0.25 over black, not 0.5). The file carries an sRGB
+ * chunk, with the gAMA and cHRM chunks that the PNG specification asks for beside it for older
+ * readers. image_write_png_curve can instead quantize the values as they are, with no colour chunk
+ * (RenderMan's 8-bit files: its Exposure is the curve).
  *
  * Reading: any PNG (palette, grey, 1 to 16 bits, interlaced, with or
  * without alpha or tRNS) is converted by libpng to 8-bit RGBA, then colour
@@ -157,11 +161,15 @@ static int write_png_all(png_structp png, png_infop info, const PngImage *image,
     for (int y = 0; y < image->height; y++) {
         const float *src = image->rgba + (size_t)y * (size_t)image->width * 4;
         for (int x = 0, k = image->channels; x < image->width; x++) {
-            for (int c = 0; c < 3; c++)
-                row[k * x + c] =
-                    image->linear ? encode_linear8(src[4 * x + c]) : encode_srgb8(src[4 * x + c]);
+            float a = src[4 * x + 3];
+            /* RGBA: straight colour; RGB keeps what lies over black */
+            float unmul = k == 4 ? (a > 0.0f && a < 1.0f ? 1.0f / a : a > 0.0f) : 1.0f;
+            for (int c = 0; c < 3; c++) {
+                float v = src[4 * x + c] * unmul;
+                row[k * x + c] = image->linear ? encode_linear8(v) : encode_srgb8(v);
+            }
             if (k == 4)
-                row[4 * x + 3] = encode_linear8(src[4 * x + 3]);
+                row[4 * x + 3] = encode_linear8(a);
         }
         png_write_row(png, row);
     }
