@@ -291,9 +291,9 @@ int rib_emit_begin(Rib *r, const float *Cs)
 /* ------------------------------------------------------------ shaders */
 
 static const char *const builtin_surfaces[] = {
-    "matte",      "plastic",       "metal",          "shinymetal",     "constant",
-    "glass",      "mirror",        "paintedplastic", "diffuse",        "conductor",
-    "dielectric", "coateddiffuse", "subsurface",     "defaultsurface", NULL};
+    "matte",      "plastic",        "metal",   "shinymetal", "constant",   "glass",
+    "mirror",     "paintedplastic", "diffuse", "conductor",  "dielectric", "coateddiffuse",
+    "subsurface", "defaultsurface", "glow",    NULL};
 static const char *const builtin_displacements[] = {"bumpy", "fractal", "displace", NULL};
 /* rayes' pattern classes (rayes_scene_pattern): pbrt-v4's textures. */
 static const char *const builtin_patterns[] = {
@@ -446,6 +446,19 @@ static int shader_known(Rib *r, const char *const *builtins, const char *name)
            (r->sink->has_shader && r->sink->has_shader(r->sink->target, name));
 }
 
+/* The RenderMan Companion's copies of the classics under its own names
+ * (Listings 16.2 and 16.4: the same parameters and bodies) and its glow
+ * (16.26), as files written with its shader set name them. */
+static const char *surface_alias(const char *name)
+{
+    static const char *const alias[][2] = {
+        {"RCPlastic", "plastic"}, {"RCMatte", "matte"}, {"RCGlow", "glow"}};
+    for (size_t k = 0; k < sizeof alias / sizeof alias[0]; k++)
+        if (strcmp(name, alias[k][0]) == 0)
+            return alias[k][1];
+    return name;
+}
+
 static int h_surface(Rib *r, const Args *a)
 {
     size_t i = 0;
@@ -459,6 +472,8 @@ static int h_surface(Rib *r, const Args *a)
         free(p);
         return -1;
     }
+    if (!shader_known(r, builtin_surfaces, name)) /* a plugin of that name comes first */
+        name = surface_alias(name);
     int known = shader_known(r, builtin_surfaces, name);
     /* in a file without lights, RenderMan's own stand-in, which needs none */
     const char *instead = r->unlit_file ? "defaultsurface" : "matte";

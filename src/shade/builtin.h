@@ -16,6 +16,7 @@ extern const RayesShaderClass shade_class_hair; /* fibres: Ka, Kd, Ks, roughness
 extern const RayesShaderClass shade_class_stainedglass; /* coloured opacity: Kd, frequency,
                                                            leadwidth, clarity */
 extern const RayesShaderClass shade_class_occlusion;    /* ambient occlusion: samples, maxdist */
+extern const RayesShaderClass shade_class_glow; /* the RenderMan Companion's halo: attenuation */
 extern const RayesShaderClass shade_class_diffusetransmission; /* Lambertian reflection and
                                                                   transmission: reflectance,
                                                                   transmittance, scale */

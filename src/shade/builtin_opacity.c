@@ -1,8 +1,9 @@
 /*
  * shade/builtin_opacity.c — built-in shaders about opacity (memo 6.1):
  * stainedglass, whose opacity method colours shadows, thindielectric
- * (pbrt-v4's thin glass: a sheet light passes straight through), and
- * occlusion, RenderMan's classic ambient occlusion shader.
+ * (pbrt-v4's thin glass: a sheet light passes straight through),
+ * occlusion, RenderMan's classic ambient occlusion shader, and glow, the
+ * RenderMan Companion's halo.
  */
 #include <math.h>
 #include <stddef.h>
@@ -334,4 +335,69 @@ const RayesShaderClass shade_class_occlusion = {
     .n_params = sizeof occlusion_params / sizeof occlusion_params[0],
     .lighting = occlusion_lighting,
     .diffuselighting = occlusion_lighting,
+};
+
+/* ---- glow
+ *
+ * The RenderMan Companion's glow (Listing 16.26), a halo on a sphere about
+ * a light bulb: seen face on it is Cs and opaque, toward its rim it fades
+ * as cos^(2 attenuation) of the view to the normal, and its far side is
+ * clear. It is a picture of light, not matter: its opacity method and its
+ * diffuselighting are clear, so it casts no shadow and diffuse rays pass
+ * it (it lights nothing either; a light inside it does). */
+
+typedef struct GlowParams {
+    float attenuation;
+} GlowParams;
+
+static void glow_lighting(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
+                          const void *params, RayesShadeOutputs *out)
+{
+    (void)sv;
+    const GlowParams *p = params;
+    for (size_t i = 0; i < ctx->n_points; i++) {
+        float f = 0.0f; /* RSL: (I.N)^2 / (I.I N.N), to the attenuation, where I.N < 0 */
+        if (ctx->I && !(ctx->backfacing && ctx->backfacing[i])) {
+            const float *I = ctx->I[i], *N = ctx->N[i];
+            float in = I[0] * N[0] + I[1] * N[1] + I[2] * N[2];
+            float ii = I[0] * I[0] + I[1] * I[1] + I[2] * I[2];
+            float nn = N[0] * N[0] + N[1] * N[1] + N[2] * N[2];
+            if (in < 0.0f && ii > 0.0f && nn > 0.0f)
+                f = powf(in * in / (ii * nn), p->attenuation);
+        }
+        for (int c = 0; c < 3; c++) {
+            out->Oi[i][c] = (ctx->Os ? ctx->Os[i][c] : 1.0f) * f;
+            out->Ci[i][c] = (ctx->Cs ? ctx->Cs[i][c] : 1.0f) * out->Oi[i][c];
+        }
+    }
+}
+
+/* Clear and black: what shadow rays and diffuse rays see of a glow. */
+static void glow_clear(const RayesShaderServices *sv, const RayesShadeCtx *ctx, const void *params,
+                       RayesShadeOutputs *out)
+{
+    (void)sv, (void)params;
+    for (size_t i = 0; i < ctx->n_points; i++)
+        for (int c = 0; c < 3; c++) {
+            out->Ci[i][c] = 0.0f;
+            out->Oi[i][c] = 0.0f;
+            if (out->Irradiance)
+                out->Irradiance[i][c] = 0.0f;
+        }
+}
+
+static const RayesShaderParamDesc glow_params[] = {
+    {"attenuation", RAYES_PARAM_FLOAT, offsetof(GlowParams, attenuation), {2, 0, 0}},
+};
+
+const RayesShaderClass shade_class_glow = {
+    .abi_version = RAYES_SHADER_ABI_VERSION,
+    .struct_size = sizeof(RayesShaderClass),
+    .name = "glow",
+    .params_size = sizeof(GlowParams),
+    .params = glow_params,
+    .n_params = sizeof glow_params / sizeof glow_params[0],
+    .opacity = glow_clear,
+    .lighting = glow_lighting,
+    .diffuselighting = glow_clear,
 };

@@ -7,6 +7,7 @@
  */
 #include "shade/shade.h"
 
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -277,6 +278,34 @@ static void *call_begin(const ShaderInstance *inst, const RayesShadeCtx *ctx, Ra
     return scratch;
 }
 
+/* A method's outputs that are not finite (a plugin's division by zero)
+ * become what cannot harm the rest of the frame: Ci and Irradiance 0, Oi
+ * opaque; said once per class and method. Left alone, one NaN in a cache
+ * fill would spread through the interpolation to every lookup near it, and
+ * a NaN pixel poisons filters, adaptive sampling and the files. */
+static void finite_outputs(const RayesShaderClass *cls, const char *method, size_t n,
+                           RayesShadeOutputs *out)
+{
+    size_t bad = 0;
+    for (size_t i = 0; i < n; i++)
+        for (int c = 0; c < 3; c++) {
+            if (out->Ci && !isfinite(out->Ci[i][c]))
+                out->Ci[i][c] = 0.0f, bad++;
+            if (out->Oi && !isfinite(out->Oi[i][c]))
+                out->Oi[i][c] = 1.0f, bad++;
+            if (out->Irradiance && !isfinite(out->Irradiance[i][c]))
+                out->Irradiance[i][c] = 0.0f, bad++;
+        }
+    if (bad) {
+        char key[96];
+        snprintf(key, sizeof key, "nonfinite:%s:%s", cls->name, method);
+        log_warning_once(key,
+                         "shader \"%s\": its %s method returned values that are not finite; "
+                         "they are taken as 0 (Oi: opaque)",
+                         cls->name, method);
+    }
+}
+
 void shade_run_lighting(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
                         const ShaderInstance *inst, RayesShadeOutputs *out)
 {
@@ -291,6 +320,7 @@ void shade_run_lighting(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
     cls->lighting(sv, &c, inst->params, out);
     if (cls->postlighting)
         cls->postlighting(sv, &c, inst->params, out);
+    finite_outputs(cls, "lighting", ctx->n_points, out);
     free(scratch);
 }
 
@@ -317,6 +347,7 @@ void shade_run_diffuselighting(const RayesShaderServices *sv, const RayesShadeCt
                          cls->name);
         cls->lighting(sv, &c, inst->params, out);
     }
+    finite_outputs(cls, "diffuselighting", ctx->n_points, out);
     free(scratch);
 }
 
@@ -336,5 +367,6 @@ void shade_run_opacity(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
     if (failed)
         return;
     cls->opacity(sv, &c, inst->params, out);
+    finite_outputs(cls, "opacity", ctx->n_points, out);
     free(scratch);
 }

@@ -466,6 +466,15 @@ static void test_shaders_and_lights(void)
     CHECK_NEAR(rec.Cs[0], 1, 0);
     CHECK_NEAR(rec.Cs[1], 0, 0);
     CHECK(rec.quads == 1 && rec.tris == 1);
+    /* the RenderMan Companion's names for the classics */
+    CHECK(parse(WORLD("Surface \"RCPlastic\" \"Ks\" 0.3\nPolygon \"P\" [0 0 0 1 0 0 1 1 0]")) ==
+          RAYES_OK);
+    CHECK(strcmp(rec.shader, "plastic") == 0);
+    CHECK(parse(WORLD("Surface \"RCMatte\" \"Kd\" 0.7\nPolygon \"P\" [0 0 0 1 0 0 1 1 0]")) ==
+          RAYES_OK);
+    CHECK(strcmp(rec.shader, "matte") == 0);
+    CHECK(parse(WORLD("Surface \"RCGlow\"\nSphere 1 -1 1 360")) == RAYES_OK);
+    CHECK(strcmp(rec.shader, "glow") == 0);
     /* Illuminate off before any geometry: the light is sent, and the
      * geometry is linked to every light except it */
     CHECK(parse(WORLD("LightSource \"pointlight\" 1\nIlluminate 1 0\n"

@@ -493,7 +493,79 @@ static void test_ctx_slice(void)
     CHECK(sub.u == NULL && sub.Cs == NULL);
 }
 
+/* A class whose methods return NaN and infinity at every other point (a
+ * plugin dividing by zero): the renderer takes Ci 0 and Oi opaque there,
+ * and keeps the finite points as they are. */
+static void nan_method(const RayesShaderServices *sv, const RayesShadeCtx *ctx, const void *params,
+                       RayesShadeOutputs *out)
+{
+    (void)sv, (void)params;
+    for (size_t i = 0; i < ctx->n_points; i++)
+        for (int c = 0; c < 3; c++) {
+            float bad = c == 1 ? INFINITY : NAN;
+            out->Ci[i][c] = i % 2 ? bad : 0.25f;
+            out->Oi[i][c] = i % 2 ? bad : 0.5f;
+        }
+}
+
+static void test_nonfinite_outputs(void)
+{
+    static const RayesShaderClass cls = {.abi_version = RAYES_SHADER_ABI_VERSION,
+                                         .struct_size = sizeof(RayesShaderClass),
+                                         .name = "nanny",
+                                         .lighting = nan_method,
+                                         .diffuselighting = nan_method,
+                                         .opacity = nan_method};
+    ShaderInstance inst;
+    char err[128];
+    CHECK(shade_instance_init(&inst, &cls, NULL, 0, err, sizeof err) == 0);
+    RayesShadeCtx ctx = context();
+    RayesShadeOutputs out = {Ci, Oi, NULL, NULL};
+    for (int method = 0; method < 3; method++) {
+        if (method == 0)
+            shade_run_lighting(&stub, &ctx, &inst, &out);
+        else if (method == 1)
+            shade_run_diffuselighting(&stub, &ctx, &inst, &out);
+        else
+            shade_run_opacity(&stub, &ctx, &inst, &out);
+        for (int i = 0; i < N; i++)
+            for (int c = 0; c < 3; c++) {
+                CHECK(Ci[i][c] == (i % 2 ? 0.0f : 0.25f));
+                CHECK(Oi[i][c] == (i % 2 ? 1.0f : 0.5f));
+            }
+    }
+    shade_instance_fini(&inst);
+}
+
+/* glow (the RenderMan Companion's halo): face on Cs and opaque, at 60
+ * degrees cos^(2 attenuation) = 1/16 for the default 2 (premultiplied),
+ * its back clear; clear and black to shadow and diffuse rays. */
+static void test_glow(void)
+{
+    ShaderInstance g = instance("glow", NULL, 0);
+    RayesShadeCtx ctx = context();
+    int back[N] = {0};
+    back[N - 1] = 1;
+    ctx.backfacing = back;
+    for (int i = 0; i < N; i++) { /* I at 0 and 60 degrees from -N, in turn */
+        float th = i % 2 ? (float)(M_PI / 3) : 0.0f;
+        I[i][0] = sinf(th), I[i][1] = 0.0f, I[i][2] = -cosf(th);
+    }
+    RayesShadeOutputs out = {Ci, Oi, NULL, NULL};
+    shade_run_lighting(&stub, &ctx, &g, &out);
+    for (int i = 0; i < N; i++) {
+        float f = i == N - 1 ? 0.0f : i % 2 ? 1.0f / 16.0f : 1.0f;
+        CHECK_NEAR(Oi[i][1], f, 1e-5);
+        CHECK_NEAR(Ci[i][1], 0.5 * f, 1e-5); /* Cs 0.5 */
+    }
+    shade_run_opacity(&stub, &ctx, &g, &out);
+    CHECK(Oi[0][0] == 0.0f && Oi[2][1] == 0.0f);
+    shade_run_diffuselighting(&stub, &ctx, &g, &out);
+    CHECK(Ci[0][0] == 0.0f && Oi[0][0] == 0.0f);
+    shade_instance_fini(&g);
+}
+
 TEST_MAIN(TEST(test_matte), TEST(test_plastic_splits_highlight), TEST(test_mirror_reflects),
           TEST(test_params_and_lookup), TEST(test_diffuselighting_is_view_independent_part),
           TEST(test_shader_furnace), TEST(test_glass_fresnel_and_sides), TEST(test_metals),
-          TEST(test_ctx_slice))
+          TEST(test_ctx_slice), TEST(test_nonfinite_outputs), TEST(test_glow))
