@@ -345,10 +345,14 @@ int scene_within(Bounds3 b);
     "%s: geometry reaches beyond 1e18 from the origin in world space (float arithmetic on rays "   \
     "and dicing fails there); expected coordinates within 1e18"
 /* 1 if the row-major matrix m is affine up to a homogeneous scale: its
- * last row 0 0 0 w, w != 0 (valid.c; scene_unit_w divides w out). Geometry is transformed point by
+ * last row 0 0 0 w, w != 0 (valid.c; scene_unit_w divides w out), the
+ * zeros within SCENE_AFFINE_EPS of w together: exporters write noise there
+ * (Maya's MTOR, a camera's perspective row -4.8e-9 -6.8e-18 -5.0e-9 1, in
+ * the RenderMan repository), which scene_unit_w drops. Geometry is transformed point by
  * point, so a projective row sends the points where it gives w = 0 through
  * infinity: rays from near them are not valid, and dicing what spans them
  * does not end. AFFINE_EXPECTED is the message, its %s the call. */
+#define SCENE_AFFINE_EPS 1e-6f
 int scene_affine(const float m[16]);
 /* An affine m with its homogeneous scale divided out (last row 0 0 0 1),
  * as the scene keeps it: instances hand Embree its 3 x 4 part. */

@@ -39,12 +39,14 @@ int scene_within(Bounds3 b)
 
 int scene_affine(const float m[16])
 {
-    return m[12] == 0.0f && m[13] == 0.0f && m[14] == 0.0f && m[15] != 0.0f;
+    float w = fabsf(m[15]);
+    return w > 0.0f && fabsf(m[12]) + fabsf(m[13]) + fabsf(m[14]) <= SCENE_AFFINE_EPS * w;
 }
 
 Mat4 scene_unit_w(const float m[16])
 {
     Mat4 r = mat4_from_array(m);
+    r.m[3][0] = r.m[3][1] = r.m[3][2] = 0.0f; /* within SCENE_AFFINE_EPS: an exporter's noise */
     for (int i = 0; m[15] != 1.0f && i < 4; i++)
         for (int j = 0; j < 4; j++)
             r.m[i][j] /= m[15];

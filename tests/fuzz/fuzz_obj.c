@@ -80,8 +80,11 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     if (!devnull)
         devnull = fopen("/dev/null", "w");
     sink = io_rib_writer_sink(w);
+    /* the scene's limit on where geometry may lie (1e18 from the origin)
+     * is the renderer's, not the file's: a RIB file may hold it */
+    int limit = e != RAYES_OK && strstr(err, "geometry reaches beyond") != NULL;
     RayesError e2 = io_obj_parse(name, text, size, &sink, &ro, &settings, err, sizeof err);
-    if ((e == RAYES_OK) != (e2 == RAYES_OK))
+    if ((e == RAYES_OK) != (e2 == RAYES_OK) && !(limit && e2 == RAYES_OK))
         abort(); /* both sinks accept what the reader sends */
     if (e2 == RAYES_OK && devnull && io_rib_writer_finish(w, &settings, devnull, err, sizeof err))
         abort();

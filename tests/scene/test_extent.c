@@ -34,6 +34,12 @@ static void test_projective_transforms_are_refused(void)
     CHECK(rayes_scene_set_transform_motion(s, 2, times, motion) == RAYES_ERROR_INVALID_ARGUMENT);
     CHECK(said(s, "transform motion: expected an affine matrix"));
 
+    /* an exporter's noise in the perspective row (Maya's MTOR wrote
+     * -4.8e-9 -6.8e-18 -5.0e-9 1 in a camera transform) is affine, the
+     * noise dropped */
+    const float noisy[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, -4.8e-9f, -6.8e-18f, -5.0e-9f, 1};
+    CHECK(rayes_scene_set_transform(s, noisy) == RAYES_OK);
+    CHECK(s->world_from_object.m[3][0] == 0.0f && s->world_from_object.m[3][2] == 0.0f);
     /* w = 2 everywhere: a uniform scale by 1/2, as RenderMan reads it */
     const float halve[16] = {1, 0, 0, 4, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 2};
     CHECK(rayes_scene_set_transform(s, halve) == RAYES_OK);
