@@ -134,8 +134,7 @@ const RayesShaderClass shade_class_matte = {
 void shade_classic_lighting(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
                             const float *roughness, float (*diffuse)[3], float (*specular)[3])
 {
-    size_t need = offsetof(RayesShaderServices, classic_lighting) + sizeof sv->classic_lighting;
-    if (sv->struct_size >= need && sv->classic_lighting)
+    if (SHADE_HAS_SERVICE(sv, classic_lighting))
         sv->classic_lighting(sv, ctx, 0, NULL, roughness, diffuse, specular);
     else
         sv->direct_lighting(sv, ctx, 0, NULL, roughness, diffuse, specular);

@@ -32,11 +32,6 @@
 
 typedef float Rgb[3];
 
-/* Whether the renderer's table holds service m: within the size it was
- * built with, and set (supports() alone trusts the renderer's word). */
-#define HAS_SERVICE(sv, m)                                                                       \
-    ((sv)->struct_size >= offsetof(RayesShaderServices, m) + sizeof((sv)->m) && (sv)->m != NULL)
-
 static float cs(const RayesShadeCtx *ctx, size_t i, int c)
 {
     return ctx->Cs ? ctx->Cs[i][c] : 1.0f;
@@ -212,12 +207,12 @@ static void glossy_reflection(const RayesShaderServices *sv, const RayesShadeCtx
             shade_ctx_slice(ctx, i, 1, &one);
             glossy_reflection(sv, &one, &alpha[i], &L[i]);
         }
-    } else if (mirrors == 0 && HAS_SERVICE(sv, microfacet)) {
+    } else if (mirrors == 0 && SHADE_HAS_SERVICE(sv, microfacet)) {
         sv->microfacet(sv, ctx, alpha, 0, L);
     } else {
         for (size_t i = 0; i < ctx->n_points; i++)
             w[i] = alpha[i] > 0.0f ? bsdf_blinn_exponent_from_alpha(alpha[i]) : 0.0f;
-        if (mirrors == ctx->n_points || !HAS_SERVICE(sv, glossy)) {
+        if (mirrors == ctx->n_points || !SHADE_HAS_SERVICE(sv, glossy)) {
             reflection(sv, ctx, w, L);
             return;
         }
@@ -380,7 +375,7 @@ typedef struct GlassParams {
 static int branches(const RayesShaderServices *sv, const RayesShadeCtx *ctx)
 {
     float depth = 0.0f;
-    if (!HAS_SERVICE(sv, random) || !HAS_SERVICE(sv, option) ||
+    if (!SHADE_HAS_SERVICE(sv, random) || !SHADE_HAS_SERVICE(sv, option) ||
         sv->option(sv, ctx, "branchdepth", &depth, 1) != 1)
         return 1;
     return (float)(ctx->diffuse_depth + ctx->specular_depth) < depth;
@@ -403,7 +398,7 @@ static float max3(const float v[3])
 static int lobe_rays(const RayesShaderServices *sv, const RayesShadeCtx *ctx)
 {
     float n[2] = {1.0f, 1.0f};
-    if (!branches(sv, ctx) || !HAS_SERVICE(sv, option) ||
+    if (!branches(sv, ctx) || !SHADE_HAS_SERVICE(sv, option) ||
         sv->option(sv, ctx, "diffuserays", n, 2) < 1)
         return 1;
     int k = (int)n[ctx->diffuse_depth > 0];
@@ -424,7 +419,7 @@ static void rough_refraction(const RayesShaderServices *sv, const RayesShadeCtx 
     v3_basis(N, &t, &b);
     Vec3 wo = v3(v3_dot(V, t), v3_dot(V, b), fmaxf(v3_dot(V, N), 1e-4f));
     L[0] = L[1] = L[2] = 0.0f;
-    int rnd = HAS_SERVICE(sv, random); /* else the strata's middles, a golden-ratio walk */
+    int rnd = SHADE_HAS_SERVICE(sv, random); /* else the strata's middles, a golden-ratio walk */
     for (int s = 0; s < n; s++) {
         float u1 =
             ((float)s + (rnd ? sv->random(sv, one, 0, 1u + 2u * (uint32_t)s) : 0.5f)) / (float)n;

@@ -89,9 +89,6 @@ static float schlick(float cos_o, float eta)
     return f0 + (1.0f - f0) * m * m * m * m * m;
 }
 
-#define HAS(sv, m)                                                                                 \
-    ((sv)->struct_size >= offsetof(RayesShaderServices, m) + sizeof((sv)->m) && (sv)->m != NULL)
-
 /* A pattern bound to "reflectance" (pbrt-v4's textured reflectance, a
  * skin's albedo map): the medium stays the constant's (how far light
  * diffuses), each point's colour is the pattern's: the diffusion times
@@ -121,7 +118,7 @@ static void lighting_chunk(const RayesShaderServices *sv, const RayesShadeCtx *c
     memset(sss, 0, sizeof sss);
     memset(spec, 0, sizeof spec);
     reflectance_tint(sv, ctx, p, tint);
-    if (p->Kd > 0.0f && HAS(sv, subsurface))
+    if (p->Kd > 0.0f && SHADE_HAS_SERVICE(sv, subsurface))
         sv->subsurface(sv, ctx, &m, (int)p->samples, sss);
     /* roughness 0 (pbrt's smooth boundary) is a sharp coat, not the
      * service's default 0.1 */

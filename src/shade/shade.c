@@ -153,11 +153,6 @@ int shade_instance_bind(ShaderInstance *inst, const char *name, const RayesPatte
     return 0;
 }
 
-/* Whether the renderer's table holds service m (within the size it was
- * built with, and set). */
-#define HAS_SERVICE(sv, m)                                                                         \
-    ((sv)->struct_size >= offsetof(RayesShaderServices, m) + sizeof((sv)->m) && (sv)->m != NULL)
-
 static const RayesPattern *bound(const RayesShadeCtx *ctx, const char *name)
 {
     for (size_t i = 0; ctx->patterns && i < ctx->n_patterns; i++)
@@ -175,7 +170,7 @@ void shade_param_color(const RayesShaderServices *sv, const RayesShadeCtx *ctx, 
                        const float value[3], float (*out)[3])
 {
     const RayesPattern *p = bound(ctx, name);
-    if (p && HAS_SERVICE(sv, pattern)) {
+    if (p && SHADE_HAS_SERVICE(sv, pattern)) {
         sv->pattern(sv, ctx, p, out);
         return;
     }
@@ -187,7 +182,7 @@ void shade_param_float(const RayesShaderServices *sv, const RayesShadeCtx *ctx, 
                        float value, float *out)
 {
     const RayesPattern *p = bound(ctx, name);
-    if (!p || !HAS_SERVICE(sv, pattern)) {
+    if (!p || !SHADE_HAS_SERVICE(sv, pattern)) {
         for (size_t i = 0; i < ctx->n_points; i++)
             out[i] = value;
         return;

@@ -14,6 +14,12 @@
 
 #include "rayes/shader.h"
 
+/* Whether the renderer's services table holds service m: within the size
+ * it was built with, and set (supports() alone trusts the renderer's
+ * word). Built-in shaders ask it before using a service appended later. */
+#define SHADE_HAS_SERVICE(sv, m)                                                                   \
+    ((sv)->struct_size >= offsetof(RayesShaderServices, m) + sizeof((sv)->m) && (sv)->m != NULL)
+
 typedef struct ShaderInstance {
     const RayesShaderClass *cls;
     void *params;               /* the parameter block, cls->params_size bytes, owned */
