@@ -79,6 +79,82 @@ double rib_mat_det3(const float m[16])
            (double)m[2] * ((double)m[4] * m[9] - (double)m[5] * m[8]);
 }
 
+double rib_polygon_area(const float M[16], const float *P, const int *idx, int n)
+{
+    double w[3][3], area = 0.0; /* the fan's apex and the last two points, placed */
+    for (int k = 0; k < n; k++) {
+        const float *p = &P[3 * idx[k]];
+        double *q = w[k < 2 ? k : 2];
+        for (int i = 0; i < 3; i++)
+            q[i] =
+                (double)M[4 * i] * p[0] + (double)M[4 * i + 1] * p[1] + (double)M[4 * i + 2] * p[2];
+        if (k >= 2) {
+            double a[3], b[3];
+            for (int i = 0; i < 3; i++)
+                a[i] = w[1][i] - w[0][i], b[i] = w[2][i] - w[0][i];
+            double cx = a[1] * b[2] - a[2] * b[1], cy = a[2] * b[0] - a[0] * b[2],
+                   cz = a[0] * b[1] - a[1] * b[0];
+            area += 0.5 * sqrt(cx * cx + cy * cy + cz * cz);
+            memcpy(w[1], w[2], sizeof w[1]);
+        }
+    }
+    return area;
+}
+
+/* The point (r, z) a fraction t along quadric type's profile (RenderMan's
+ * parameters v), which it sweeps about z. */
+static void quadric_profile(int type, const float *v, double t, double *r, double *z)
+{
+    switch (type) {
+    case RAYES_QUADRIC_SPHERE: { /* radius zmin zmax */
+        double R = fabs(v[0]), lo = asin(fmax(-1.0, fmin(1.0, v[1] / fmax(R, 1e-30)))),
+               hi = asin(fmax(-1.0, fmin(1.0, v[2] / fmax(R, 1e-30))));
+        double phi = lo + t * (hi - lo);
+        *r = R * cos(phi), *z = R * sin(phi);
+        break;
+    }
+    case RAYES_QUADRIC_CYLINDER: /* radius zmin zmax */
+        *r = fabs(v[0]), *z = v[1] + t * (v[2] - v[1]);
+        break;
+    case RAYES_QUADRIC_CONE: /* height radius */
+        *r = fabs(v[1]) * (1.0 - t), *z = t * v[0];
+        break;
+    case RAYES_QUADRIC_DISK: /* height radius */
+        *r = fabs(v[1]) * t, *z = v[0];
+        break;
+    case RAYES_QUADRIC_PARABOLOID: /* rmax zmin zmax */
+        *z = v[1] + t * (v[2] - v[1]);
+        *r = v[2] != 0.0f ? fabs(v[0]) * sqrt(fmax(0.0, *z / v[2])) : 0.0;
+        break;
+    case RAYES_QUADRIC_HYPERBOLOID: { /* point1 point2: the line swept */
+        double x = v[0] + t * (v[3] - v[0]), y = v[1] + t * (v[4] - v[1]);
+        *r = sqrt(x * x + y * y), *z = v[2] + t * (v[5] - v[2]);
+        break;
+    }
+    default: { /* torus: major minor phimin phimax */
+        double phi = (v[2] + t * (v[3] - v[2])) * M_PI / 180.0;
+        *r = v[0] + v[1] * cos(phi), *z = v[1] * sin(phi);
+        break;
+    }
+    }
+}
+
+double rib_quadric_area(const float M[16], int type, const float *v)
+{
+    static const int theta_at[7] = {3, 3, 2, 2, 3, 6, 4}; /* thetamax's index */
+    if (type < 0 || type > 6)
+        return 0.0;
+    double theta = fmin(fabs((double)v[theta_at[type]]), 360.0) * M_PI / 180.0, sum = 0.0, r0, z0;
+    quadric_profile(type, v, 0.0, &r0, &z0);
+    for (int k = 1; k <= 256; k++) {
+        double r1, z1;
+        quadric_profile(type, v, k / 256.0, &r1, &z1);
+        sum += 0.5 * (fabs(r0) + fabs(r1)) * hypot(r1 - r0, z1 - z0);
+        r0 = r1, z0 = z1;
+    }
+    return theta * sum * pow(fabs(rib_mat_det3(M)), 2.0 / 3.0);
+}
+
 void rib_mat_rotate(float deg, const float axis[3], float m[16])
 {
     double len =

@@ -22,6 +22,14 @@ int rib_mat_inverse(const float m[16], float out[16]);
 void rib_mat_rotate(float deg, const float axis[3], float m[16]);
 /* The determinant of the upper-left 3 x 3 (negative: a mirror). */
 double rib_mat_det3(const float m[16]);
+/* The area, once M places it, of the polygon of n >= 3 points P[3 idx[k]]
+ * (a fan from its first: exact for convex and planar ones). */
+double rib_polygon_area(const float M[16], const float *P, const int *idx, int n);
+/* The area, once M places it, of quadric type (RayesQuadric) of
+ * RenderMan's parameters v (a surface of revolution summed over 256 steps
+ * of its profile; a transform that is not a uniform scale is taken as the
+ * uniform scale of the same volume). */
+double rib_quadric_area(const float M[16], int type, const float *v);
 /* The angle (radians) between the rotations of two transforms (their
  * polar decompositions'); 0 if either is singular. */
 float rib_mat_turn(const float a[16], const float b[16]);

@@ -339,6 +339,32 @@ static int grow_sizes(size_t **a, size_t *cap, size_t n)
     return 0;
 }
 
+/* The radiance of the area light in force on shapes of area A (as
+ * placed): BMRT's and Pixie's arealight give a point light's intensity,
+ * with which each of its samples lights a point (I cos / d^2, averaged
+ * over the shape), so a radiance of pi I / A in rayes' units (RSL's pi,
+ * as for point lights); other area lights give the radiance. */
+static void area_radiance(const Rib *r, double A, float L[3])
+{
+    double k = !r->a.area_point_units ? 1.0 : A > 0.0 ? M_PI / A : 0.0;
+    for (int c = 0; c < 3; c++)
+        L[c] = (float)fmin((double)r->a.area_L[c] * k, FLT_MAX);
+}
+
+/* The area of the polygons of g (points P), as placed. */
+static double polys_area(const Rib *r, const Polys *g, const float *P)
+{
+    double A = 0.0;
+    for (size_t p = 0, loop = 0, at = 0; p < g->n_polys; p++) {
+        size_t nl = g->n_loops ? (size_t)g->n_loops[p] : 1;
+        A += rib_polygon_area(r->a.M, P, &g->idx[at], g->loop_n[loop]); /* its outline */
+        for (size_t k = 0; k < nl; k++)
+            at += (size_t)g->loop_n[loop + k];
+        loop += nl;
+    }
+    return A;
+}
+
 /* Nonzero when the polygons of g are at most AREA_QUADS quads of one loop
  * each: under an area light, quad lights (sampled exactly as quads). */
 #define AREA_QUADS 4
@@ -372,8 +398,10 @@ static int emit_area_mesh(Rib *r, const Polys *g, const float *P, size_t n_point
     if (e == 0 && faces.n_faces > 0 && (e = rib_emit_begin(r, NULL)) == 0) {
         SinkState *st;
         const IoSink *s = rib_out_sink(r, &st);
-        if (s->area_light_mesh(s->target, faces.n_faces, faces.n_verts, faces.idx, n_points, P,
-                               r->a.area_L, r->a.area_twosided) != RAYES_OK)
+        float L[3];
+        area_radiance(r, polys_area(r, g, P), L);
+        if (s->area_light_mesh(s->target, faces.n_faces, faces.n_verts, faces.idx, n_points, P, L,
+                               r->a.area_twosided) != RAYES_OK)
             e = rib_sink_failed(r, s);
     }
     rib_faces_fini(&faces);
@@ -395,6 +423,9 @@ static int emit_polys(Rib *r, const Polys *g, const float *P, size_t n_points, c
     size_t *face_poly = NULL, *poly_at = NULL, *poly_nv = NULL, cap_f = 0, cap_a = 0, cap_n = 0;
     size_t loop = 0, at = 0;
     int e = 0;
+    float L[3];
+    if (r->a.area)
+        area_radiance(r, polys_area(r, g, P), L);
     for (size_t p = 0; p < g->n_polys && e == 0; p++) {
         size_t nl = g->n_loops ? (size_t)g->n_loops[p] : 1;
         size_t nv = 0;
@@ -414,7 +445,7 @@ static int emit_polys(Rib *r, const Polys *g, const float *P, size_t n_points, c
                 float Q[4][3]; /* "twosided": the reversed quad too */
                 for (int k = 0; k < 4; k++)
                     memcpy(Q[flip ^ side ? 3 - k : k], &P[3 * v[k]], sizeof Q[0]);
-                if (s->area_light(s->target, (const float(*)[3])Q, r->a.area_L) != RAYES_OK)
+                if (s->area_light(s->target, (const float(*)[3])Q, L) != RAYES_OK)
                     e = rib_sink_failed(r, s);
             }
         } else {
@@ -909,7 +940,10 @@ static int emit_bilinear(Rib *r, const float P[4][3], const PvOut *pv)
         memcpy(A[1], Q[1], sizeof A[0]);
         memcpy(A[2], Q[3], sizeof A[0]);
         memcpy(A[3], Q[2], sizeof A[0]);
-        return s->area_light(s->target, (const float(*)[3])A, r->a.area_L) == RAYES_OK
+        static const int around[4] = {0, 1, 2, 3};
+        float L[3];
+        area_radiance(r, rib_polygon_area(r->a.M, &A[0][0], around, 4), L);
+        return s->area_light(s->target, (const float(*)[3])A, L) == RAYES_OK
                    ? 0
                    : rib_sink_failed(r, s);
     }
@@ -1138,8 +1172,10 @@ static int h_quadric(Rib *r, const Args *a)
                               "this scene takes no emitting quadrics: they "
                               "are surfaces");
             if (r->a.area && s->area_light_quadric) { /* an emitter */
-                if (s->area_light_quadric(s->target, q[k].type, v, (size_t)q[k].n, flags,
-                                          r->a.area_L, r->a.area_twosided) != RAYES_OK)
+                float L[3];
+                area_radiance(r, rib_quadric_area(r->a.M, (int)q[k].type, v), L);
+                if (s->area_light_quadric(s->target, q[k].type, v, (size_t)q[k].n, flags, L,
+                                          r->a.area_twosided) != RAYES_OK)
                     e = rib_sink_failed(r, s);
             } else if (s->quadric(s->target, q[k].type, v, (size_t)q[k].n, flags) != RAYES_OK) {
                 e = rib_sink_failed(r, s);

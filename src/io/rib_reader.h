@@ -122,6 +122,8 @@ typedef struct Attr {
     char area_map[256]; /* its environment map (RenderMan 19-20's envsphere), or "" */
     const struct TrimSet *trim; /* TrimCurve in force (rib_nurbs.c), or NULL */
     int area_normalize;         /* its areaNormalize (RenderMan 19-20's geometry lights) */
+    int area_point_units;       /* BMRT's and Pixie's arealight: area_L is a point light's
+                                   intensity spread over each shape (rib_prim.c) */
     int area_unseen;            /* its rman__LightPrimaryVisibility 0: the camera sees none */
     int trim_outside;           /* Attribute "trimcurve" "sense" "outside": the loops'
                                    outsides are cut away, not their insides */
@@ -131,7 +133,8 @@ typedef struct Attr {
                        whose primitives are skipped */
     int roundcurve; /* Attribute "dice" "roundcurve": curves without N are tubes */
     uint32_t visibility; /* Attribute "visibility": RayesRayType bits of the rays that see it */
-    int shadowless;      /* Attribute "light" "shadows" "off": the lights that follow cast none */
+    int shadows; /* Attribute "light" "shadows" (BMRT's): "on" 1, the lights that follow cast
+                    ray-traced shadows; "off" -1, none; 0 unsaid (each shader's own way) */
     int camera_said;     /* Attribute "visibility" "camera" 1 is in force (RenderMan 21's
                             lights are seen by the camera only then) */
     int hitmode;         /* Attribute "shade" "transmissionhitmode": RayesTransmissionHitMode */

@@ -763,9 +763,34 @@ static int uber_params(Rib *r, Light *L, const Param *p, size_t n)
         const float pi[3] = {(float)M_PI, 0, 0};
         rib_light_param(L, "maxintensity", RAYES_PARAM_FLOAT, pi, NULL);
     }
-    if (shadows <= 0 || r->a.shadowless) {
+    if (shadows == 0 && r->a.shadows > 0)
+        shadows = 1; /* BMRT's Attribute "light" "shadows" "on" */
+    if (shadows <= 0 || r->a.shadows < 0) {
         static const float off[3] = {0, 0, 0};
         rib_light_param(L, "shadows", RAYES_PARAM_FLOAT, off, NULL);
+    }
+    return 0;
+}
+
+/* Whether a light shader of RenderMan's casts shadows when nothing else
+ * says: pointlight, spotlight and distantlight trace none; shadowpoint,
+ * shadowspot and shadowdistant cast their maps' (shadowname, or
+ * shadowpoint's six sf* faces; "raytrace" among them), which rayes
+ * traces; rayes' other lights (environment, area) cast theirs. */
+static int casts_shadows(const char *name, const char *type, const Param *p, size_t n)
+{
+    if (strcmp(type, "pointlight") != 0 && strcmp(type, "spotlight") != 0 &&
+        strcmp(type, "distantlight") != 0)
+        return 1;
+    if (strncmp(name, "shadow", 6) != 0)
+        return 0;
+    for (size_t k = 0; k < n; k++) {
+        const char *nm = p[k].d.name;
+        int map =
+            strcmp(nm, "shadowname") == 0 || (strncmp(nm, "sf", 2) == 0 && strchr("pn", nm[2]) &&
+                                              nm[2] && strchr("xyz", nm[3]) && nm[3] && !nm[4]);
+        if (map && !rib_is_num(p[k].v) && p[k].v->n == 1 && p[k].v->s[0][0])
+            return 1;
     }
     return 0;
 }
@@ -938,7 +963,9 @@ static int h_light_source(Rib *r, const Args *a)
         L->n++;
     }
     int e = uber ? uber_params(r, L, p, n) : 0;
-    if (r->a.shadowless && !uber) {
+    const Param *said = rib_find_param(p, n, "shadows");
+    if (!uber && !(said && said->declared) &&
+        (r->a.shadows < 0 || (r->a.shadows == 0 && !casts_shadows(name, type, p, n)))) {
         static const float off[3] = {0, 0, 0};
         rib_light_param(L, "shadows", RAYES_PARAM_FLOAT, off, NULL);
     }
@@ -982,6 +1009,9 @@ static int h_area_light(Rib *r, const Args *a)
         r->a.area_L[c] = I * (lc && rib_is_num(lc->v) && lc->v->n == 3 ? (float)lc->v->d[c] : 1);
     const Param *an = rib_find_param(p, n, "areaNormalize");
     r->a.area_normalize = an && rib_is_num(an->v) && an->v->n == 1 && an->v->d[0] != 0;
+    /* BMRT's arealight (and Pixie's) takes a point light's intensity; rayes'
+     * own, as its writer writes it, only a radiance in lightcolor */
+    r->a.area_point_units = strcmp(name, "arealight") == 0 && in != NULL;
     r->a.area_map[0] = '\0';
     for (size_t k = 0; k < n; k++) /* an envsphere's map (rib_ris.c) */
         if (p[k].d.ty == TY_STRING && p[k].v->n == 1 &&

@@ -908,7 +908,7 @@ static int h_option_attribute(Rib *r, const Args *a)
                    !rib_is_num(q->v) && q->v->n == 1) {
             /* BMRT's ray-traced shadows of the lights that follow */
             if (strcmp(q->v->s[0], "on") == 0 || strcmp(q->v->s[0], "off") == 0)
-                r->a.shadowless = strcmp(q->v->s[0], "off") == 0;
+                r->a.shadows = strcmp(q->v->s[0], "on") == 0 ? 1 : -1;
             else
                 rib_warn_once(r, "light shadows",
                               "Attribute \"light\" \"shadows\" \"%.16s\": expected \"on\" or "

@@ -1326,7 +1326,7 @@ static RayesError w_light(void *t, const char *type, const RayesParam *p, size_t
             fprintf(w->world.f, " \"float intensity\" [%.17g]", I[0] / M_PI);
         if (maxintensity >= 0.0)
             fprintf(w->world.f, " \"float maxintensity\" [%.17g]", maxintensity / M_PI);
-        if (uber && !shadows_given) /* rayes' default; RenderMan's uberlight casts none */
+        if (unit && !shadows_given) /* rayes' default; RenderMan's lights cast none */
             fprintf(w->world.f, " \"float shadows\" [1]");
         for (size_t i = 0; uber && i < n; i++)
             if (p[i].type == RAYES_PARAM_FLOATS && p[i].name && p[i].floats &&

@@ -4,6 +4,7 @@
  * make one mesh light, "twosided" is read, and the writer's RIB reads back
  * into the same light, corner for corner.
  */
+#include <math.h>
 #include <string.h>
 
 #include "image/image.h"
@@ -26,7 +27,10 @@ static size_t count_type(const RayesScene *s, LightType type)
     return n;
 }
 
-/* Four quads: quad lights; five, or any other polygon: one mesh light. */
+/* Four quads: quad lights; five, or any other polygon: one mesh light.
+ * An arealight's intensity is BMRT's, a point light's spread over the
+ * shapes it is given to (a radiance of pi I / area); a lightcolor alone
+ * is the radiance (rayes' own). */
 static void test_polygons_under_area_lights(void)
 {
     char err[256];
@@ -37,6 +41,7 @@ static void test_polygons_under_area_lights(void)
               "\"P\" [0 0 0 1 0 0 1 1 0 0 1 0]\nAttributeEnd"),
         &e, err, sizeof err);
     CHECK(e == RAYES_OK && s->n_lights == 4 && count_type(s, LIGHT_QUAD) == 4);
+    CHECK(s->n_lights == 4 && fabsf(s->lights[0].L.x - (float)M_PI * 2 / 4) < 1e-5f);
     Vec3 quad_front = v3(0, 0, 0), c;
     if (s->n_lights == 4)
         light_quad_eval(&s->lights[0], 0.5f, 0.5f, &c, &quad_front);
@@ -52,7 +57,8 @@ static void test_polygons_under_area_lights(void)
     CHECK(e == RAYES_OK && s->n_lights == 2 && count_type(s, LIGHT_MESH) == 2);
     if (s->n_lights == 2) {
         const Light *a = &s->lights[0], *b = &s->lights[1];
-        CHECK(a->mesh->n == 10 && !a->two_sided && a->L.x == 2.0f);
+        CHECK(a->mesh->n == 10 && !a->two_sided);
+        CHECK_NEAR(a->L.x, M_PI * 2.0 / 5.0, 1e-5); /* five unit squares */
         CHECK_NEAR(a->mesh->area, 5.0, 1e-5);
         CHECK(b->two_sided && b->L.x == 1.0f);
         CHECK_NEAR(b->mesh->area, 16.0 - 0.5, 1e-5); /* the square less its hole */
@@ -112,22 +118,76 @@ static void test_quadrics_and_motion(void)
     RayesScene *a = rib_read_scene(text, &e, err, sizeof err);
     CHECK(e == RAYES_OK && a->n_lights == 2 && count_type(a, LIGHT_MESH) == 2);
     if (a->n_lights == 2) {
-        CHECK(a->lights[0].L.x == 3.0f && a->lights[0].mesh->n >= 64);
+        /* BMRT's units: pi 3 over the tube's 2 pi 0.1 */
+        CHECK_NEAR(a->lights[0].L.x, 15.0, 15.0 * 1e-4);
+        CHECK(a->lights[0].mesh->n >= 64);
         CHECK(a->lights[1].mesh->lo.z == 0.0f && a->lights[1].mesh->hi.z == 0.0f);
     }
     char *written = rib_round_trip(text, err, sizeof err);
-    CHECK(written &&
-          strstr(written, "[3 3 3]\nCylinder 0.100000001 0 1 360\nAttributeEnd") != NULL);
+    CHECK(written && strstr(written, "\nCylinder 0.100000001 0 1 360\nAttributeEnd") != NULL);
     RayesScene *b = written ? rib_read_scene(written, &e, err, sizeof err) : NULL;
     CHECK(b && e == RAYES_OK && b->n_lights == 2);
     if (b && a->n_lights == 2 && b->n_lights == 2) {
         const LightMesh *m = a->lights[0].mesh, *n = b->lights[0].mesh;
         CHECK(m->n == n->n && memcmp(m->v, n->v, 3 * m->n * sizeof *m->v) == 0);
+        CHECK(a->lights[0].L.x == b->lights[0].L.x); /* written as the radiance */
     }
     rayes_scene_release(a);
     if (b)
         rayes_scene_release(b);
     free(written);
+}
+
+/* BMRT's arealight lights as a point light of its intensity spread over
+ * the shape: a small square, disk or bilinear patch of intensity 4, two
+ * units from a white matte floor, gives it 4 / 2^2 = 1 below (RSL's
+ * diffuse() has no 1 / pi), a small sphere a quarter of that (the mean of
+ * its samples' cosines toward the floor, as BMRT averages them). */
+static void test_bmrt_units(void)
+{
+    static const struct {
+        const char *shape;
+        double expect;
+    } cases[] = {
+        {"Polygon \"P\" [-0.05 -0.05 4  0.05 -0.05 4  0.05 0.05 4  -0.05 0.05 4]", 1.0},
+        {"Translate 0 0 4\nDisk 0 0.05 360", 1.0},
+        {"Patch \"bilinear\" \"P\" [-0.05 -0.05 4  0.05 -0.05 4  -0.05 0.05 4  0.05 0.05 4]", 1.0},
+        {"Translate 0 0 4\nSphere 0.05 -0.05 0.05 360", 0.25},
+    };
+    for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
+        char text[1024], err[256];
+        snprintf(text, sizeof text,
+                 "Format 8 8 1\nProjection \"perspective\" \"fov\" [4]\nWorldBegin\n"
+                 "AttributeBegin\nAttribute \"visibility\" \"int camera\" [0]\n"
+                 "AreaLightSource \"arealight\" 1 \"intensity\" [4] \"float twosided\" [%d]\n"
+                 "%s\nAttributeEnd\nSurface \"matte\"\n"
+                 "Polygon \"P\" [-9 -9 6  9 -9 6  9 9 6  -9 9 6]\nWorldEnd\n",
+                 k < 3, cases[k].shape);
+        RayesError e;
+        RayesScene *s = rib_read_scene(text, &e, err, sizeof err);
+        CHECK(e == RAYES_OK && s->n_lights >= 1); /* a two-sided quad: two */
+        RayesImage *img = NULL;
+        if (e == RAYES_OK && rayes_scene_commit(s) == RAYES_OK) {
+            RayesRenderOptions o;
+            rayes_render_options_init(&o, RAYES_QUALITY_PREVIEW);
+            o.width = o.height = 8;
+            o.bounces = 0;
+            o.spp = 64;
+            o.threads = 2;
+            CHECK(rayes_render(s, &o, &img, NULL) == RAYES_OK);
+        }
+        if (img) {
+            double m = 0; /* the four middle pixels */
+            for (int y = 3; y < 5; y++)
+                for (int x = 3; x < 5; x++)
+                    m += img->rgba[4 * (8 * y + x)] / 4.0;
+            CHECK_NEAR(m, cases[k].expect, 0.02 * cases[k].expect);
+            if (fabs(m - cases[k].expect) > 0.02 * cases[k].expect)
+                fprintf(stderr, "  %s: %g\n", cases[k].shape, m);
+        }
+        rayes_image_free(img);
+        rayes_scene_release(s);
+    }
 }
 
 /* pbrt-v4's goniometric light: its equal-area square's centre is the
@@ -168,4 +228,4 @@ static void test_pbrt_goniometric(void)
 }
 
 TEST_MAIN(TEST(test_polygons_under_area_lights), TEST(test_round_trip),
-          TEST(test_quadrics_and_motion), TEST(test_pbrt_goniometric))
+          TEST(test_quadrics_and_motion), TEST(test_bmrt_units), TEST(test_pbrt_goniometric))

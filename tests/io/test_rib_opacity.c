@@ -28,7 +28,7 @@ enum { SIZE = 24 };
 
 static const char *const floor_rib =
     "Projection \"perspective\" \"fov\" [40]\nWorldBegin\n"
-    "LightSource \"pointlight\" 1 \"from\" [0 0 0] \"intensity\" [36]\n"
+    "LightSource \"shadowpoint\" 1 \"sfpz\" \"raytrace\" \"from\" [0 0 0] \"intensity\" [36]\n"
     "Surface \"matte\"\nPolygon \"P\" [-4 -4 6  4 -4 6  4 4 6  -4 4 6]\n";
 
 /* The floor, then blocker (RIB text ending in geometry, or ""), opacity

@@ -294,10 +294,11 @@ static void test_rendered(void)
                                  "Light \"PxrRectLight\" \"k\" \"float intensity\" [3] "
                                  "\"float exposure\" [1] \"color lightColor\" [1 0.8 0.6]",
                                  "");
-    RayesImage *classic = render_box("AreaLightSource \"arealight\" 1 \"intensity\" [6] "
-                                     "\"lightcolor\" [1 0.8 0.6]\n"
-                                     "Polygon \"P\" [-0.5 -0.5 0  0.5 -0.5 0  0.5 0.5 0  -0.5 0.5 0]",
-                                     "");
+    RayesImage *classic =
+        render_box("AreaLightSource \"arealight\" 1 "
+                   "\"lightcolor\" [6 4.8 3.6]\n"
+                   "Polygon \"P\" [-0.5 -0.5 0  0.5 -0.5 0  0.5 0.5 0  -0.5 0.5 0]",
+                   "");
     RayesImage *unseen = render_box("Light \"PxrRectLight\" \"k\" \"float intensity\" [6] "
                                     "\"color lightColor\" [1 0.8 0.6]",
                                     "");

@@ -128,25 +128,77 @@ static void test_uberlight_shadows(void)
     RayesImage *off = render_light("Attribute \"light\" \"shadows\" \"off\"\n"
                                    "LightSource \"uberlight\" 1 \"raytraceshadow\" 1\n",
                                    SQUARE);
-    RayesImage *point_on = render_light("LightSource \"pointlight\" 1 \"intensity\" 36\n", SQUARE);
-    RayesImage *point_off = render_light("Attribute \"light\" \"string shadows\" [\"off\"]\n"
-                                         "LightSource \"pointlight\" 1 \"intensity\" 36\n",
-                                         SQUARE);
-    CHECK(open && none && traced && mapped && coloured && off && point_on && point_off);
-    if (open && none && traced && mapped && coloured && off && point_on && point_off) {
+    RayesImage *on = render_light("Attribute \"light\" \"shadows\" \"on\"\n"
+                                  "LightSource \"uberlight\" 1\n",
+                                  SQUARE);
+    CHECK(open && none && traced && mapped && coloured && off && on);
+    if (open && none && traced && mapped && coloured && off && on) {
         double m = middle(open, 0);
         CHECK(m > 0.9);
         CHECK_NEAR(middle(none, 0), m, 1e-4);
-        CHECK(middle(traced, 0) == 0.0 && middle(mapped, 0) == 0.0);
+        CHECK(middle(traced, 0) == 0.0 && middle(mapped, 0) == 0.0 && middle(on, 0) == 0.0);
         CHECK_NEAR(middle(coloured, 0), 0.25 * m, 1e-4);
         CHECK_NEAR(middle(coloured, 1), 0.5 * m, 1e-4);
         CHECK_NEAR(middle(coloured, 2), m, 1e-4);
         CHECK_NEAR(middle(off, 0), m, 1e-4);
-        CHECK(middle(point_on, 0) == 0.0 && middle(point_off, 0) > 0.9);
     }
-    RayesImage *all[] = {open, none, traced, mapped, coloured, off, point_on, point_off};
+    RayesImage *all[] = {open, none, traced, mapped, coloured, off, on};
     for (size_t k = 0; k < sizeof all / sizeof all[0]; k++)
         rayes_image_free(all[k]);
+}
+
+/* RenderMan's classic lights: pointlight, spotlight and distantlight
+ * trace no shadows; shadowpoint, shadowspot and shadowdistant cast those
+ * of a map (shadowname, shadowpoint's sf* faces), none without one;
+ * BMRT's Attribute "light" "shadows" "on" and rayes' own "shadows" 1 cast
+ * them for any, "off" and "shadows" 0 for none; the writer keeps each. */
+static void test_classic_light_shadows(void)
+{
+    static const struct {
+        const char *light;
+        int shadowed;
+    } cases[] = {
+        {"LightSource \"pointlight\" 1 \"intensity\" 36\n", 0},
+        {"LightSource \"spotlight\" 1 \"intensity\" 36 \"coneangle\" 0.6\n", 0},
+        {"LightSource \"distantlight\" 1\n", 0},
+        {"LightSource \"shadowpoint\" 1 \"intensity\" 36\n", 0},
+        {"LightSource \"shadowpoint\" 1 \"intensity\" 36 \"string sfpz\" \"pz.shd\"\n", 1},
+        {"LightSource \"shadowspot\" 1 \"intensity\" 36 \"coneangle\" 0.6 \"string shadowname\" "
+         "\"raytrace\"\n",
+         1},
+        {"LightSource \"shadowspot\" 1 \"intensity\" 36 \"string shadowname\" \"\"\n", 0},
+        {"LightSource \"shadowdistant\" 1 \"string shadowname\" \"d.shd\"\n", 1},
+        {"Attribute \"light\" \"string shadows\" [\"on\"]\n"
+         "LightSource \"pointlight\" 1 \"intensity\" 36\n",
+         1},
+        {"Attribute \"light\" \"string shadows\" [\"off\"]\n"
+         "LightSource \"shadowdistant\" 1 \"string shadowname\" \"d.shd\"\n",
+         0},
+        {"LightSource \"pointlight\" 1 \"intensity\" 36 \"float shadows\" [1]\n", 1},
+        {"Attribute \"light\" \"string shadows\" [\"on\"]\n"
+         "LightSource \"pointlight\" 1 \"intensity\" 36 \"float shadows\" [0]\n",
+         0},
+    };
+    for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
+        char text[4096], err[512];
+        snprintf(text, sizeof text, "%s%s%sWorldEnd\n", cases[k].light, floor_rib, SQUARE);
+        RayesImage *img = render_text(text);
+        char *written = rib_round_trip(text, err, sizeof err);
+        RayesImage *again = written ? render_text(written) : NULL;
+        CHECK(img && again);
+        if (img && again) {
+            if (cases[k].shadowed)
+                CHECK(middle(img, 0) == 0.0 && pixel(img, 0, 0) > 0.0);
+            else
+                CHECK(middle(img, 0) > 0.0);
+            CHECK_NEAR(middle(again, 0), middle(img, 0), 1e-5);
+        }
+        if (!img || !again || (cases[k].shadowed != (middle(img, 0) == 0.0)))
+            fprintf(stderr, "  case %zu: %s", k, cases[k].light);
+        rayes_image_free(img);
+        rayes_image_free(again);
+        free(written);
+    }
 }
 
 /* A blocker in the coordinate system "blk" (z = 3): the middle is dark,
@@ -204,5 +256,6 @@ static void test_uberlight_round_trip(void)
     free(written);
 }
 
-TEST_MAIN(TEST(test_uberlight_reads), TEST(test_uberlight_shadows), TEST(test_uberlight_blocker),
+TEST_MAIN(TEST(test_uberlight_reads), TEST(test_uberlight_shadows),
+          TEST(test_classic_light_shadows), TEST(test_uberlight_blocker),
           TEST(test_uberlight_round_trip))

@@ -146,12 +146,12 @@ static void test_calls(void)
                  "Surface \"matte\"\n"));
     CHECK(has(t, "AttributeBegin\nAreaLightSource \"arealight\" 1 \"color lightcolor\" [17 12 4]\n"
                  "Polygon \"P\" [0 0 0 1 0 0 0 1 0 1 1 0]\nAttributeEnd\n"));
-    /* RenderMan's units: 4 / pi */
+    /* RenderMan's units: 4 / pi; shadows said, since RenderMan's cast none */
     CHECK(has(t, "LightSource \"pointlight\" 2 \"point from\" [1 2 3] \"float intensity\" "
-                 "[1.2732395447351628]\n"));
-    CHECK(has(
-        t, "[1.2732395447351628]\nIlluminate 2 0\nLightSource \"ambientlight\" 3\nIlluminate 3 0\n"
-           "Illuminate 2 1\nIlluminate 3 1\n"));
+                 "[1.2732395447351628] \"float shadows\" [1]\n"));
+    CHECK(has(t, "[1.2732395447351628] \"float shadows\" [1]\nIlluminate 2 0\nLightSource "
+                 "\"ambientlight\" 3\nIlluminate 3 0\n"
+                 "Illuminate 2 1\nIlluminate 3 1\n"));
     CHECK(!has(t, "Illuminate 1"));
     CHECK(has(t, "WorldEnd\n"));
     free(t);
