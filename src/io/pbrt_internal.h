@@ -195,7 +195,10 @@ typedef struct Medium {
     float *density;           /* uniformgrid: nx ny nz values, owned */
     float p0[3], p1[3];       /* uniformgrid: the grid's box, medium space */
     char filename[PBRT_PATH]; /* nanovdb: resolved */
+    float Lescale;            /* nanovdb: the temperature grid's blackbody emission scale */
+    float temp_offset, temp_scale; /* nanovdb: temperaturecutoff, temperaturescale */
     char pattern[160];        /* the sink's pattern of the density once sent, else "" */
+    char temperature[176];    /* nanovdb: the sink's pattern of its optional temperature grid */
     int sent;                 /* the pattern was sent */
     Object bound;             /* the shapes with the medium on a side, hidden, each turned so
                                  that the medium lies behind its normals */

@@ -55,7 +55,13 @@ static int medium_coefficients(Parser *P, ParamList *pl, Medium *md)
         pbrt_get_color(P, pl, "Le", zero, Le, NULL) < 0)
         return -1;
     float scale = (float)pbrt_get_float(pl, "scale", 1.0);
-    float Lescale = (float)pbrt_get_float(pl, "Lescale", 1.0);
+    /* older pbrt-v4 spelled it LeScale; its temperature offset also
+     * temperatureoffset */
+    float Lescale = (float)pbrt_get_float(pl, "Lescale", pbrt_get_float(pl, "LeScale", 1.0));
+    md->Lescale = Lescale;
+    md->temp_offset = (float)pbrt_get_float(pl, "temperaturecutoff",
+                                            pbrt_get_float(pl, "temperatureoffset", 0.0));
+    md->temp_scale = (float)pbrt_get_float(pl, "temperaturescale", 1.0);
     md->g = (float)pbrt_get_float(pl, "g", 0.0);
     for (int c = 0; c < 3; c++) {
         float st = sa[c] + ss[c];
@@ -172,7 +178,7 @@ int pbrt_d_mediuminterface(Parser *P, const Token *t)
 }
 
 /* The homogeneous shader's parameters for md into q; returns the count. */
-static size_t medium_params(const Medium *md, RayesParam q[5])
+static size_t medium_params(const Medium *md, RayesParam q[9])
 {
     size_t n = 0;
     q[n++] = (RayesParam){.name = "extinction", .type = RAYES_PARAM_COLOR};
@@ -185,6 +191,16 @@ static size_t medium_params(const Medium *md, RayesParam q[5])
     if (md->pattern[0])
         q[n++] =
             (RayesParam){.name = "density", .type = RAYES_PARAM_PATTERN, .string = md->pattern};
+    if (md->temperature[0]) { /* pbrt's emission sigma_a Lescale B(T) */
+        q[n++] = (RayesParam){
+            .name = "temperature", .type = RAYES_PARAM_PATTERN, .string = md->temperature};
+        q[n++] = (RayesParam){
+            .name = "temperatureoffset", .type = RAYES_PARAM_FLOAT, .value = {md->temp_offset}};
+        q[n++] = (RayesParam){
+            .name = "temperaturescale", .type = RAYES_PARAM_FLOAT, .value = {md->temp_scale}};
+        q[n++] = (RayesParam){
+            .name = "blackbodyscale", .type = RAYES_PARAM_FLOAT, .value = {md->Lescale}};
+    }
     return n;
 }
 
@@ -209,8 +225,16 @@ static int send_density(Parser *P, const Token *t, Medium *md)
              .n_floats = md->res[0] * md->res[1] * md->res[2]}};
         return pbrt_emit_pattern_in(P, t, md->m, md->pattern, "densitygrid", q, 6);
     }
-    RayesParam q[1] = {{.name = "filename", .type = RAYES_PARAM_STRING, .string = md->filename}};
-    return pbrt_emit_pattern_in(P, t, md->m, md->pattern, "nanovdb", q, 1);
+    RayesParam q[3] = {{.name = "filename", .type = RAYES_PARAM_STRING, .string = md->filename},
+                       {.name = "grid", .type = RAYES_PARAM_STRING, .string = "temperature"},
+                       {.name = "optional", .type = RAYES_PARAM_FLOAT, .value = {1}}};
+    if (pbrt_emit_pattern_in(P, t, md->m, md->pattern, "nanovdb", q, 1) != 0)
+        return -1;
+    if (md->Lescale == 0.0f) /* no emission asked for: the grid is not read */
+        return 0;
+    /* its temperature grid, if the file has one (pbrt reads it if there) */
+    snprintf(md->temperature, sizeof md->temperature, "%s temperature", md->pattern);
+    return pbrt_emit_pattern_in(P, t, md->m, md->temperature, "nanovdb", q, 3);
 }
 
 /* Grows box (world space; *have: it holds a point) by the Shape just read
@@ -324,7 +348,7 @@ static int send_bounded(Parser *P, Medium *md, const Token *t)
     }
     if (pbrt_emit_bound(P, t, &md->bound) != 0 || send_density(P, t, md) != 0)
         return -1;
-    RayesParam q[5];
+    RayesParam q[9];
     size_t n = medium_params(md, q);
     /* The march's box: a uniformgrid's density is in its box, a nanovdb's
      * in its shapes'; a homogeneous medium fills the scene's bounds. The
@@ -411,7 +435,7 @@ int pbrt_medium_camera(Parser *P)
     }
     if (send_density(P, &t, md) != 0)
         return -1;
-    RayesParam q[5];
+    RayesParam q[9];
     size_t n = medium_params(md, q);
     double identity[16];
     pbrt_mat_identity(identity);

@@ -9,10 +9,16 @@
  * (a densitygrid or nanovdb grid, shade_param_float), negative values
  * read as 0; lighting() = sigma_s * (the direct
  * light the phase function scatters toward the viewer, the direct_volume
- * service) + density * emission, sigma_s = albedo * sigma_t. Volume points
- * carry their position in the box in u, v and s (0 to 1).
+ * service) + density * emission + sigma_a * blackbodyscale * B(T), sigma_s
+ * = albedo * sigma_t, sigma_a = sigma_t - sigma_s, B(T) the blackbody of
+ * temperature T = (temperature - temperatureoffset) * temperaturescale
+ * (temperature may be bound to a pattern: pbrt-v4's nanovdb temperature
+ * grid) as pbrt-v4 emits it: Planck's spectrum divided by its peak, in
+ * linear sRGB, 0 at or below 100 K. Volume points carry their position
+ * in the box in u, v and s (0 to 1).
  */
 #include <math.h>
+#include <pthread.h>
 #include <stddef.h>
 #include <string.h>
 
@@ -31,7 +37,76 @@ typedef struct VolumeParams {
     float octaves;
     float falloff;       /* turbulence only: 1 fades the density to 0 at the box's inscribed
                             sphere (a puff), 0 fills the box */
+    float temperature;   /* kelvin, or a pattern's (blackbody emission) */
+    float temperatureoffset, temperaturescale;
+    float blackbodyscale; /* blackbody radiance per unit absorption; 0: none */
 } VolumeParams;
+
+/* ---- blackbody emission
+ *
+ * B(T) tabled over log T from 100 K to 100,000 K (hotter reads the last):
+ * Planck's law over 360-830 nm in 1 nm steps divided by its value at
+ * Wien's peak (pbrt-v4's BlackbodySpectrum), to CIE XYZ through the
+ * colour matching functions' multi-lobe fit of Wyman, Sloan and Shirley
+ * (2013) normalised so that a spectrum of 1 has Y = 1 (pbrt's film), then
+ * to linear sRGB. */
+
+enum { BB_N = 512 };
+static const double bb_lo = 100.0, bb_hi = 100000.0;
+static float bb_table[BB_N][3];
+static pthread_once_t bb_once = PTHREAD_ONCE_INIT;
+
+static double lobe(double l, double mu, double s1, double s2)
+{
+    double t = (l - mu) / (l < mu ? s1 : s2);
+    return exp(-0.5 * t * t);
+}
+
+static double planck(double l_nm, double T)
+{
+    double l = l_nm * 1e-9, c = 299792458.0, h = 6.62606957e-34, kb = 1.3806488e-23;
+    return 2.0 * h * c * c / (pow(l, 5) * (exp(h * c / (l * kb * T)) - 1.0));
+}
+
+static void bb_init(void)
+{
+    double ybar_sum = 0.0;
+    for (int l = 360; l <= 830; l++)
+        ybar_sum += 0.821 * lobe(l, 568.8, 46.9, 40.5) + 0.286 * lobe(l, 530.9, 16.3, 31.1);
+    for (int k = 0; k < BB_N; k++) {
+        double T = bb_lo * pow(bb_hi / bb_lo, k / (double)(BB_N - 1));
+        double peak = planck(2.8977721e-3 / T * 1e9, T), X = 0, Y = 0, Z = 0;
+        for (int l = 360; l <= 830; l++) {
+            double b = planck(l, T) / peak;
+            X += b * (1.056 * lobe(l, 599.8, 37.9, 31.0) + 0.362 * lobe(l, 442.0, 16.0, 26.7) -
+                      0.065 * lobe(l, 501.1, 20.4, 26.2));
+            Y += b * (0.821 * lobe(l, 568.8, 46.9, 40.5) + 0.286 * lobe(l, 530.9, 16.3, 31.1));
+            Z += b * (1.217 * lobe(l, 437.0, 11.8, 36.0) + 0.681 * lobe(l, 459.0, 26.0, 13.8));
+        }
+        X /= ybar_sum, Y /= ybar_sum, Z /= ybar_sum;
+        double rgb[3] = {3.2404542 * X - 1.5371385 * Y - 0.4985314 * Z,
+                         -0.9692660 * X + 1.8760108 * Y + 0.0415560 * Z,
+                         0.0556434 * X - 0.2040259 * Y + 1.0572252 * Z};
+        for (int c = 0; c < 3; c++)
+            bb_table[k][c] = (float)fmax(rgb[c], 0.0);
+    }
+}
+
+/* B(T) into out (0 at or below 100 K). */
+static void blackbody(float T, float out[3])
+{
+    if (!(T > (float)bb_lo)) {
+        out[0] = out[1] = out[2] = 0.0f;
+        return;
+    }
+    pthread_once(&bb_once, bb_init);
+    double x = log(fmin((double)T, bb_hi) / bb_lo) / log(bb_hi / bb_lo) * (BB_N - 1);
+    int k = (int)x;
+    k = k > BB_N - 2 ? BB_N - 2 : k;
+    float f = (float)(x - k);
+    for (int c = 0; c < 3; c++)
+        out[c] = (1.0f - f) * bb_table[k][c] + f * bb_table[k + 1][c];
+}
 
 /* The density pattern at point i: 1 for homogeneous media. */
 typedef float (*DensityFn)(const RayesShaderServices *sv, const RayesShadeCtx *ctx, size_t i,
@@ -88,16 +163,27 @@ static void volume_lighting(const RayesShaderServices *sv, const RayesShadeCtx *
         size_t n = ctx->n_points - start < SHADE_CHUNK ? ctx->n_points - start : SHADE_CHUNK;
         RayesShadeCtx sub;
         shade_ctx_slice(ctx, start, n, &sub);
-        Rgb sigma[SHADE_CHUNK], light[SHADE_CHUNK];
+        Rgb sigma[SHADE_CHUNK], light[SHADE_CHUNK], hot[SHADE_CHUNK];
         extinction(sv, &sub, p, fn, sigma);
+        if (p->blackbodyscale > 0.0f) { /* sigma_a B(T) */
+            float T[SHADE_CHUNK];
+            shade_param_float(sv, &sub, "temperature", p->temperature, T);
+            for (size_t i = 0; i < n; i++) {
+                blackbody((T[i] - p->temperatureoffset) * p->temperaturescale, hot[i]);
+                for (int c = 0; c < 3; c++)
+                    hot[i][c] *= p->blackbodyscale * sigma[i][c] * (1.0f - p->albedo[c]);
+            }
+        } else {
+            memset(hot, 0, n * sizeof *hot);
+        }
         int lit = sv->direct_volume && (p->albedo[0] > 0 || p->albedo[1] > 0 || p->albedo[2] > 0);
         if (lit)
             sv->direct_volume(sv, &sub, 0, NULL, p->g, light);
         for (size_t i = 0; i < n; i++)
             for (int c = 0; c < 3; c++) {
                 float d = p->extinction[c] > 0.0f ? sigma[i][c] / p->extinction[c] : 0.0f;
-                out->Ci[start + i][c] =
-                    (lit ? p->albedo[c] * sigma[i][c] * light[i][c] : 0.0f) + d * p->emission[c];
+                out->Ci[start + i][c] = (lit ? p->albedo[c] * sigma[i][c] * light[i][c] : 0.0f) +
+                                        d * p->emission[c] + hot[i][c];
                 out->Oi[start + i][c] = sigma[i][c];
                 if (out->Irradiance)
                     out->Irradiance[start + i][c] = 0.0f;
@@ -129,12 +215,27 @@ static void turbulence_lighting(const RayesShaderServices *sv, const RayesShadeC
     volume_lighting(sv, ctx, params, turbulence_density, out);
 }
 
-#define VOLUME_COMMON_PARAMS                                                                  \
-    {"density", RAYES_PARAM_FLOAT, offsetof(VolumeParams, density), {1, 0, 0}},               \
-        {"extinction", RAYES_PARAM_COLOR, offsetof(VolumeParams, extinction), {1, 1, 1}},     \
-        {"albedo", RAYES_PARAM_COLOR, offsetof(VolumeParams, albedo), {0.8f, 0.8f, 0.8f}},    \
-        {"g", RAYES_PARAM_FLOAT, offsetof(VolumeParams, g), {0, 0, 0}},                       \
-        {"emission", RAYES_PARAM_COLOR, offsetof(VolumeParams, emission), {0, 0, 0}}
+#define VOLUME_COMMON_PARAMS                                                                       \
+    {"density", RAYES_PARAM_FLOAT, offsetof(VolumeParams, density), {1, 0, 0}},                    \
+        {"extinction", RAYES_PARAM_COLOR, offsetof(VolumeParams, extinction), {1, 1, 1}},          \
+        {"albedo", RAYES_PARAM_COLOR, offsetof(VolumeParams, albedo), {0.8f, 0.8f, 0.8f}},         \
+        {"g", RAYES_PARAM_FLOAT, offsetof(VolumeParams, g), {0, 0, 0}},                            \
+        {"emission", RAYES_PARAM_COLOR, offsetof(VolumeParams, emission), {0, 0, 0}},              \
+        {"temperature", RAYES_PARAM_FLOAT, offsetof(VolumeParams, temperature), {0, 0, 0}},        \
+        {"temperatureoffset",                                                                      \
+         RAYES_PARAM_FLOAT,                                                                        \
+         offsetof(VolumeParams, temperatureoffset),                                                \
+         {0, 0, 0}},                                                                               \
+        {"temperaturescale",                                                                       \
+         RAYES_PARAM_FLOAT,                                                                        \
+         offsetof(VolumeParams, temperaturescale),                                                 \
+         {1, 0, 0}},                                                                               \
+    {                                                                                              \
+        "blackbodyscale", RAYES_PARAM_FLOAT, offsetof(VolumeParams, blackbodyscale),               \
+        {                                                                                          \
+            0, 0, 0                                                                                \
+        }                                                                                          \
+    }
 
 static const RayesShaderParamDesc homogeneous_params[] = {VOLUME_COMMON_PARAMS};
 

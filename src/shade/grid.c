@@ -214,6 +214,8 @@ static VoxelGrid *open_grid(const GridMeta *m, unsigned codec, const unsigned ch
     return NULL;
 }
 
+#define NO_GRID "no grid " /* the message of a grid that is not in the file */
+
 VoxelGrid *grid_parse_nanovdb(const unsigned char *data, size_t size, const char *name,
                               const char *path, char *err, size_t err_size)
 {
@@ -269,9 +271,14 @@ VoxelGrid *grid_parse_nanovdb(const unsigned char *data, size_t size, const char
         if (done)
             return g;
     }
-    snprintf(err, err_size, "%s: no grid \"%s\" (the file has %s)", path, name,
+    snprintf(err, err_size, "%s: " NO_GRID "\"%s\" (the file has %s)", path, name,
              names[0] ? names : "no grids");
     return NULL;
+}
+
+int grid_error_missing(const char *err)
+{
+    return err && strstr(err, ": " NO_GRID "\"") != NULL;
 }
 
 VoxelGrid *grid_read_nanovdb(const char *path, const char *name, char *err, size_t err_size)

@@ -33,6 +33,10 @@ VoxelGrid *grid_new_dense(const size_t res[3], const float *values, size_t n_val
  * a float grid. The caller owns the result. */
 VoxelGrid *grid_read_nanovdb(const char *path, const char *name, char *err, size_t err_size);
 
+/* Nonzero when err, as grid_read_nanovdb filled it, says only that the
+ * file has no grid of the name asked for (an optional grid's absence). */
+int grid_error_missing(const char *err);
+
 /* As grid_read_nanovdb, from the file's bytes (path only names it in
  * messages): the fuzz target's entry. */
 VoxelGrid *grid_parse_nanovdb(const unsigned char *data, size_t size, const char *name,

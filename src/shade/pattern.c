@@ -270,7 +270,8 @@ static int dense_grid(Pattern *p, const RayesParam *params, size_t n, char *err,
 }
 
 /* The grid classes' parameters: densitygrid's nx ny nz, density, p0, p1
- * (pbrt-v4's uniformgrid medium), nanovdb's filename and grid. Unknown or
+ * (pbrt-v4's uniformgrid medium), nanovdb's filename, grid and optional
+ * (nonzero: a file without that grid reads 0 everywhere). Unknown or
  * mistyped parameters are refused like set_slot's. */
 static int make_grid(Pattern *p, const ClassDesc *c, const RayesParam *params, size_t n, char *err,
                      size_t err_size)
@@ -279,8 +280,9 @@ static int make_grid(Pattern *p, const ClassDesc *c, const RayesParam *params, s
     static const RayesParamType dense_types[] = {RAYES_PARAM_FLOAT, RAYES_PARAM_FLOAT,
                                                  RAYES_PARAM_FLOAT, RAYES_PARAM_FLOATS,
                                                  RAYES_PARAM_COLOR, RAYES_PARAM_COLOR};
-    static const char *const vdb_names[] = {"filename", "grid", NULL};
-    static const RayesParamType vdb_types[] = {RAYES_PARAM_STRING, RAYES_PARAM_STRING};
+    static const char *const vdb_names[] = {"filename", "grid", "optional", NULL};
+    static const RayesParamType vdb_types[] = {RAYES_PARAM_STRING, RAYES_PARAM_STRING,
+                                               RAYES_PARAM_FLOAT};
     int dense = p->kind == PK_DENSITYGRID;
     const char *const *names = dense ? dense_names : vdb_names;
     const RayesParamType *types = dense ? dense_types : vdb_types;
@@ -311,8 +313,15 @@ static int make_grid(Pattern *p, const ClassDesc *c, const RayesParam *params, s
             snprintf(err, err_size, "pattern \"nanovdb\": no filename");
             return -1;
         }
+        const RayesParam *optional = grid_param(params, n, "optional", RAYES_PARAM_FLOAT);
         p->grid = grid_read_nanovdb(file->string, name && name->string ? name->string : "density",
                                     grid_err, sizeof grid_err);
+        if (!p->grid && optional && optional->value[0] != 0.0f && grid_error_missing(grid_err)) {
+            /* an optional grid the file lacks (pbrt's temperature): 0 everywhere */
+            static const size_t one[3] = {1, 1, 1};
+            static const float zero = 0.0f, p0[3] = {0, 0, 0}, p1[3] = {1, 1, 1};
+            p->grid = grid_new_dense(one, &zero, 1, p0, p1, grid_err, sizeof grid_err);
+        }
     }
     if (!p->grid) {
         snprintf(err, err_size, "pattern \"%s\": %s", c->name, grid_err);

@@ -144,6 +144,85 @@ static void test_absorbing_slabs(void)
     CHECK(open > 0.1);
 }
 
+/* pbrt-v4's nanovdb temperature grid: the slab emits sigma_a Lescale B(T)
+ * per unit length, T = (temperature - temperaturecutoff) *
+ * temperaturescale and B Planck's spectrum over its peak, so the camera
+ * ray through its unit depth gains Lescale B(T) (1 - exp(-sigma_a)) over
+ * the same slab without the grid: linear in Lescale, red over green over
+ * blue at 2000 K, near white and near 1 in luminance at 6500 K (its peak
+ * in the visible), nothing at 200 K; a file without the grid emits
+ * nothing and reads without a warning. */
+static void test_nanovdb_temperature(void)
+{
+    mkdir(TMP, 0755);
+    static float d[8][8][8], t[8][8][8];
+    for (int i = 0; i < 512; i++)
+        d[i >> 6][i >> 3 & 7][i & 7] = 1.0f, t[i >> 6][i >> 3 & 7][i & 7] = 1000.0f;
+    const double o[3] = {-7, -7, 0};
+    CHECK(nvdb_write(TMP "/dens.nvdb", "density", (const float(*)[8][8])d, 2.0, o) == 0);
+    CHECK(nvdb_write(TMP "/temp.nvdb", "temperature", (const float(*)[8][8])t, 2.0, o) == 0);
+    /* one file of both grids: two segments */
+    FILE *out = fopen(TMP "/fire.nvdb", "wb");
+    for (int k = 0; k < 2 && out; k++) {
+        FILE *in = fopen(k ? TMP "/temp.nvdb" : TMP "/dens.nvdb", "rb");
+        char buf[8192];
+        size_t n;
+        while (in && (n = fread(buf, 1, sizeof buf, in)) > 0)
+            CHECK(fwrite(buf, 1, n, out) == n);
+        if (in)
+            fclose(in);
+    }
+    CHECK(out && fclose(out) == 0);
+    static const struct {
+        const char *file, *params;
+    } cases[] = {
+        {"dens.nvdb", "\"float Lescale\" 1"},                              /* no grid */
+        {"fire.nvdb", "\"float Lescale\" 1 \"float temperaturescale\" 2"}, /* 2000 K */
+        {"fire.nvdb", "\"float Lescale\" 2 \"float temperaturescale\" 2"},
+        {"fire.nvdb", "\"float Lescale\" 1 \"float temperaturescale\" 6.5"}, /* 6500 K */
+        {"fire.nvdb", "\"float Lescale\" 1 \"float temperaturecutoff\" 900 "
+                      "\"float temperaturescale\" 2"}, /* 200 K */
+    };
+    enum { N = sizeof cases / sizeof cases[0] };
+    double rgb[N][3] = {{0}};
+    for (int k = 0; k < N; k++) {
+        char media[2048], name[64], err_text[4096];
+        snprintf(media, sizeof media,
+                 "MakeNamedMedium \"slab\" \"string type\" \"nanovdb\" \"string filename\" "
+                 "\"%s\"\n  \"rgb sigma_a\" [1 1 1] \"rgb sigma_s\" [0 0 0] %s\n"
+                 "AttributeBegin\nMediumInterface \"slab\" \"\"\nMaterial \"interface\"\n%s"
+                 "AttributeEnd\n",
+                 cases[k].file, cases[k].params, box_shape);
+        snprintf(name, sizeof name, "temperature%d.pbrt", k);
+        write_scene(name, media);
+        float *img = render(name, err_text, sizeof err_text);
+        CHECK(img != NULL && strstr(err_text, "warning") == NULL);
+        if (!img)
+            continue;
+        for (int c = 0; c < 3; c++) {
+            for (int y = RES / 2 - 4; y < RES / 2 + 4; y++)
+                for (int x = RES / 2 - 4; x < RES / 2 + 4; x++)
+                    rgb[k][c] += img[4 * (y * RES + x) + c] / 64.0;
+        }
+        free(img);
+    }
+    double gain = 1.0 - exp(-1.0), B[N][3];
+    for (int k = 1; k < N; k++)
+        for (int c = 0; c < 3; c++)
+            B[k][c] = (rgb[k][c] - rgb[0][c]) / gain; /* Lescale B(T) */
+    fprintf(stderr, "B(2000 K) = %g %g %g, B(6500 K) = %g %g %g, B(200 K) = %g\n", B[1][0], B[1][1],
+            B[1][2], B[3][0], B[3][1], B[3][2], B[4][0]);
+    CHECK(rgb[0][0] > 0.03); /* the lit floor through the slab, no emission */
+    CHECK(B[1][0] > B[1][1] && B[1][1] > B[1][2] && B[1][2] >= 0.0 && B[1][0] > 0.01);
+    for (int c = 0; c < 3; c++) {
+        CHECK_NEAR(B[2][c], 2.0 * B[1][c], 2e-3 * rgb[2][c]); /* the floor's march noise */
+        CHECK(fabs(B[4][c]) < 1e-4);
+    }
+    double Y = 0.2126 * B[3][0] + 0.7152 * B[3][1] + 0.0722 * B[3][2];
+    CHECK(Y > 0.8 && Y < 1.0);
+    CHECK(fabs(B[3][0] - B[3][2]) < 0.15 * Y && fabs(B[3][1] - B[3][2]) < 0.15 * Y);
+}
+
 /* The camera's medium (MediumInterface before Camera) fills the scene's
  * bounds and the eye: looking straight down at the floor 6 below through
  * absorbing fog, the camera ray crosses 6 and the shadow ray to the
@@ -384,5 +463,5 @@ static void test_undefined_medium(void)
     free(img);
 }
 
-TEST_MAIN(TEST(test_absorbing_slabs), TEST(test_camera_medium), TEST(test_open_pieces),
-          TEST(test_undefined_medium))
+TEST_MAIN(TEST(test_absorbing_slabs), TEST(test_nanovdb_temperature), TEST(test_camera_medium),
+          TEST(test_open_pieces), TEST(test_undefined_medium))
