@@ -581,6 +581,16 @@ RAYES_API RayesError rayes_scene_volume(RayesScene *scene, const float bound[6])
  * INVALID_ARGUMENT without geometry before it. */
 RAYES_API RayesError rayes_scene_volume_inside(RayesScene *scene, const float bound[6]);
 
+/* An atmosphere (RenderMan's Atmosphere): a volume of the current shader,
+ * as rayes_scene_volume's, filling the space between the eye and the
+ * surfaces camera rays meet. Camera rays see it in front of what they hit,
+ * and not at all where they meet nothing (the background stays as it is);
+ * shadow, diffuse and specular rays cross it untouched (RenderMan applies
+ * an atmosphere to the light reaching the eye alone). Its box is the
+ * scene's bounds and the eye, found when the scene is rendered. A scene
+ * has at most one: a second replaces the first. */
+RAYES_API RayesError rayes_scene_atmosphere(RayesScene *scene);
+
 /* A one-sided emitting quad (an area light) with vertices P[0..3] in order
  * around the quad; it emits radiance L from the side toward which
  * (P1 - P0) x (P2 - P0) points, and is seen by the camera. */

@@ -797,7 +797,6 @@ static const RibRequest own_requests[] = {
     {"MakeCubeFaceEnvironment", h_skip},
     {"MakeLatLongEnvironment", h_make_texture},
     {"MakeBrickMap", h_skip},
-    {"Atmosphere", h_skip},
     {"Interior", h_skip},
     {"Exterior", h_skip},
     {"Deformation", h_skip},

@@ -112,6 +112,7 @@ typedef struct Attr {
     int have_texcoords;        /* 1 when they are not RenderMan's default (0 0 1 0 0 1 1 1) */
     long color_gen;            /* changes with Cs/Os */
     const ShaderRec *surface;  /* NULL: matte */
+    const ShaderRec *atmosphere; /* Atmosphere in force (rayes' volume shader), or NULL */
     const ShaderRec *displacement;
     float shading_rate;
     float bound;
@@ -281,6 +282,8 @@ typedef struct Rib {
     RibRecording *rec;         /* the object being defined, when the sink has no instances */
     int in_object;             /* 1: inside ObjectBegin, sent to a sink with instances
                                   (object_begin); the block's state is `recorded` */
+    const ShaderRec *world_atmosphere; /* the world's atmosphere: that of its first primitive
+                                          under one, sent at WorldEnd */
     const void *object_surface; /* the surface and colour generation at that ObjectBegin: */
     long object_color_gen;     /* geometry under them inherits each instance's shader */
     int pv_block_color;        /* the request's primitive carries the block's Color as a

@@ -238,6 +238,14 @@ int rib_emit_begin(Rib *r, const float *Cs)
         return 1;
     if (!r->rec && !r->in_object && rib_send_lights(r) != 0)
         return -1;
+    if (r->a.atmosphere && !r->rec && !r->in_object) {
+        if (!r->world_atmosphere)
+            r->world_atmosphere = r->a.atmosphere;
+        else if (r->world_atmosphere != r->a.atmosphere)
+            rib_warn_once(r, "atmospheres",
+                          "rayes renders one Atmosphere per scene: that of the first primitive "
+                          "under one; this primitive's is not used");
+    }
     SinkState *st;
     const IoSink *s = rib_out_sink(r, &st);
     if (send_transform(r, s, st) != 0)
@@ -1060,10 +1068,32 @@ static int h_illuminate(Rib *r, const Args *a)
     return 0;
 }
 
-/* At WorldEnd: sends the lights on then that were never sent, and ends
- * the world's lights (the next world starts with none, and all links). */
+/* The world's atmosphere, once its primitives are all sent: its volume
+ * shader, then the atmosphere (rayes_scene_atmosphere). */
+static int send_atmosphere(Rib *r)
+{
+    const ShaderRec *sh = r->world_atmosphere;
+    r->world_atmosphere = NULL;
+    SinkState *st;
+    const IoSink *s = rib_out_sink(r, &st);
+    if (!s->atmosphere) {
+        rib_warn_once(r, "atmosphere sink", "this output takes no Atmosphere; it is dropped");
+        return 0;
+    }
+    st->have_shader = 0; /* the next primitive's shader is sent again */
+    if (s->set_shader(s->target, sh->name, sh->params, sh->n) != RAYES_OK ||
+        s->atmosphere(s->target) != RAYES_OK)
+        return rib_sink_failed(r, s);
+    return 0;
+}
+
+/* At WorldEnd: sends the world's atmosphere and the lights on then that
+ * were never sent, and ends the world's lights (the next world starts
+ * with none, and all links). */
 int rib_flush_lights(Rib *r)
 {
+    if (r->world_atmosphere && send_atmosphere(r) != 0)
+        return -1;
     for (size_t k = 0; k < r->n_lights; k++) {
         Light *L = &r->lights[k];
         if (L->index < 0 && light_on(&r->a, k) && send_light(r, L) != 0)
@@ -1133,9 +1163,133 @@ static int h_pattern(Rib *r, const Args *a)
     return 0;
 }
 
+/* ------------------------------------------------------------ atmosphere */
+
+/* A float parameter's value, or def. */
+static double param_float(const Param *p, size_t n, const char *name, double def)
+{
+    const Param *q = rib_find_param(p, n, name);
+    return q && rib_is_num(q->v) && q->v->n >= 1 && isfinite(q->v->d[0]) ? q->v->d[0] : def;
+}
+
+/* A colour parameter (three values, or one for all), or def. */
+static void param_color(const Param *p, size_t n, const char *name, double def, double out[3])
+{
+    const Param *q = rib_find_param(p, n, name);
+    int ok = q && rib_is_num(q->v) && (q->v->n == 1 || q->v->n == 3);
+    for (int c = 0; c < 3; c++)
+        out[c] =
+            ok && isfinite(q->v->d[q->v->n == 3 ? c : 0]) ? q->v->d[q->v->n == 3 ? c : 0] : def;
+}
+
+/* The homogeneous medium of RenderMan's standard fog and of Gritz's smoke
+ * shaders (docs/rib.md "Atmosphere"): extinction, albedo and emission per
+ * unit length into q (count returned). A light's Cl in RSL is pi times
+ * the radiance rayes' lights give, and the isotropic phase function 1 / (4
+ * pi) of it is scattered: a shader's in-scattering k Cl per unit length is
+ * an albedo of 4 k / sigma_t. */
+static size_t atmosphere_params(Rib *r, const char *name, const Param *p, size_t n, RayesParam q[3])
+{
+    double ext[3], alb[3] = {0, 0, 0}, emi[3] = {0, 0, 0};
+    if (strcmp(name, "fog") == 0) { /* Ci = mix(background, Ci, exp(-d / distance)) */
+        double dist = param_float(p, n, "distance", 1.0), bg[3];
+        param_color(p, n, "background", 0.0, bg);
+        dist = dist > 1e-30 ? dist : 1e-30;
+        for (int c = 0; c < 3; c++)
+            ext[c] = 1.0 / dist, emi[c] = bg[c] / dist;
+    } else if (strcmp(name, "noisysmoke") == 0 || rib_find_param(p, n, "density") ||
+               rib_find_param(p, n, "lightscale")) {
+        /* BMRT's noisysmoke (the uberlight figures call it smoke): extinction
+         * density scatter, and lightscale Cl density (1 - exp(-density
+         * stepsize scatter)) scattered per unit length (its steps' dC = dO
+         * lighttau) */
+        double noise = param_float(p, n, "use_noise", 1.0) != 0.0 ? 0.5 : 1.0;
+        double g = param_float(p, n, "density", 60.0) * noise, s[3];
+        double ss = param_float(p, n, "stepsize", 0.1), k = param_float(p, n, "lightscale", 15.0);
+        int lit = param_float(p, n, "use_lighting", 1.0) != 0.0;
+        param_color(p, n, "scatter", 1.0, s);
+        for (int c = 0; c < 3; c++) {
+            ext[c] = g * s[c];
+            double dO = 1.0 - exp(-g * ss * s[c]), e = k * g * dO; /* per unit length, per Cl */
+            if (lit)
+                alb[c] = ext[c] > 0.0 ? 4.0 * e / ext[c] : 0.0;
+            else
+                emi[c] = e;
+        }
+    } else { /* the Advanced RenderMan's smoke: density 0.5 of opacdensity, lightdensity */
+        double od = param_float(p, n, "opacdensity", 1.0);
+        double ld = param_float(p, n, "lightdensity", 1.0), s[3];
+        param_color(p, n, "scatter", 1.0, s);
+        for (int c = 0; c < 3; c++) {
+            ext[c] = 0.5 * od * s[c];
+            alb[c] = ext[c] > 0.0 ? 4.0 * 0.5 * ld / ext[c] : 0.0;
+        }
+    }
+    if ((strcmp(name, "fog") != 0 && param_float(p, n, "use_noise", 0.0) != 0.0) ||
+        param_float(p, n, "smokeoctaves", 0.0) > 0.0)
+        rib_warn_once(r, "atmosphere noise",
+                      "Atmosphere \"%s\": its noise is not reproduced (the smoke's mean "
+                      "density instead)",
+                      name);
+    q[0] = (RayesParam){.name = "extinction", .type = RAYES_PARAM_COLOR};
+    q[1] = (RayesParam){.name = "albedo", .type = RAYES_PARAM_COLOR};
+    q[2] = (RayesParam){.name = "emission", .type = RAYES_PARAM_COLOR};
+    for (int c = 0; c < 3; c++) {
+        q[0].value[c] = (float)fmin(fmax(ext[c], 0.0), 1e30);
+        q[1].value[c] = (float)fmin(fmax(alb[c], 0.0), 1e30);
+        q[2].value[c] = (float)fmin(fmax(emi[c], 0.0), 1e30);
+    }
+    return 3;
+}
+
+/* Atmosphere "name" params: RenderMan's fog, Gritz's smoke and noisysmoke
+ * as a homogeneous medium, rayes' own volume shaders as given; "null" (or
+ * "") none; others (depthcue among them) are skipped with one warning. */
+static int h_atmosphere(Rib *r, const Args *a)
+{
+    size_t i = 0;
+    const char *name = rib_get_string(r, a, &i, "a shader name");
+    Param *p;
+    size_t n;
+    if (!name || rib_get_params(r, a, i, &p, &n) != 0)
+        return -1;
+    static const char *const own[] = {"homogeneous", "turbulence", NULL};
+    static const char *const mapped[] = {"fog", "smoke", "noisysmoke", NULL};
+    ShaderRec *sh = NULL;
+    if (in_list(own, name)) {
+        static const Counts one = {1, 1, 1, 1};
+        if (rib_check_counts(r, p, n, &one) != 0) {
+            free(p);
+            return -1;
+        }
+        sh = make_shader(r, name, p, n, 0);
+    } else if (in_list(mapped, name)) {
+        RayesParam q[3];
+        sh = rib_shader_rec(r, "homogeneous", q, atmosphere_params(r, name, p, n, q));
+    } else {
+        if (name[0] && strcmp(name, "null") != 0) {
+            char key[128];
+            snprintf(key, sizeof key, "atmosphere %.100s", name);
+            rib_warn_once(r, key,
+                          "atmosphere shader \"%s\" is not built in (fog, smoke, noisysmoke, "
+                          "homogeneous, turbulence); no atmosphere",
+                          name);
+        }
+        free(p);
+        r->a.atmosphere = NULL;
+        return 0;
+    }
+    free(p);
+    if (!sh)
+        return -1;
+    r->a.atmosphere = sh;
+    return 0;
+}
+
 /* ------------------------------------------------------------ requests */
 
 const RibRequest rib_shade_requests[] = {
+    {"Atmosphere", h_atmosphere},
     {"Surface", h_surface},
     {"Displacement", h_displacement},
     {"LightSource", h_light_source},

@@ -49,6 +49,10 @@ struct RibWriter {
     FILE *world_f;           /* the world stream's FILE while motion holds the output */
     size_t motion_n;         /* the block's time samples (0: none open) */
     float motion_time[RAYES_MAX_TIMES];
+    char *shader;            /* the last shader's name and parameters as written (for
+                                Atmosphere), owned, or NULL */
+    char *atmosphere;        /* the Atmosphere line, written first in the world (it is
+                                an attribute of the primitives after it), owned, or NULL */
     char error[256];         /* the last error, "" if none */
 };
 
@@ -96,6 +100,8 @@ void io_rib_writer_free(RibWriter *w)
     stream_close(&w->world);
     stream_close(&w->motion);
     free(w->links);
+    free(w->shader);
+    free(w->atmosphere);
     free(w);
 }
 
@@ -570,9 +576,41 @@ static RayesError w_set_shader(void *t, const char *name, const RayesParam *p, s
         fprintf(f, "Surface ");
         string(f, name);
         fprintf(f, "%s\n", text ? text : "");
+        size_t len = strlen(name) + (text ? strlen(text) : 0) + 4;
+        free(w->shader);
+        w->shader = malloc(len);
+        if (!w->shader)
+            e = fail(w, RAYES_ERROR_OUT_OF_MEMORY, "out of memory");
+        else
+            snprintf(w->shader, len, "%s%c%s", name, 0, text ? text : "");
     }
     free(text);
     return e;
+}
+
+/* Atmosphere of the shader set last (rayes' volume shader and its
+ * parameters, which the reader takes as they are), kept for the world's
+ * start, where it applies to every primitive. */
+static RayesError w_atmosphere(void *t)
+{
+    RibWriter *w = t;
+    if (!w->shader)
+        return fail(w, RAYES_ERROR_INVALID_ARGUMENT, "atmosphere: no shader");
+    char *line = NULL;
+    size_t size = 0;
+    FILE *f = open_memstream(&line, &size);
+    if (!f)
+        return fail(w, RAYES_ERROR_OUT_OF_MEMORY, "out of memory");
+    fprintf(f, "Atmosphere ");
+    string(f, w->shader);
+    fprintf(f, "%s\n", w->shader + strlen(w->shader) + 1);
+    if (fclose(f) != 0 || !line) {
+        free(line);
+        return fail(w, RAYES_ERROR_OUT_OF_MEMORY, "out of memory");
+    }
+    free(w->atmosphere);
+    w->atmosphere = line;
+    return RAYES_OK;
 }
 
 static RayesError w_set_displacement(void *t, const char *name, const RayesParam *p, size_t n)
@@ -1482,6 +1520,7 @@ IoSink io_rib_writer_sink(RibWriter *w)
         .quadric = w_quadric,
         .volume = w_volume,
         .volume_inside = w_volume_inside,
+        .atmosphere = w_atmosphere,
         .area_light = w_area_light,
         .light = w_light,
         .set_light_links = w_set_light_links,
@@ -1607,7 +1646,7 @@ RayesError io_rib_writer_finish(RibWriter *w, const IoSettings *s, FILE *out, ch
     if (w->fov_y > 0.0f)
         fprintf(out, "Projection \"perspective\" \"fov\" [%.9g]\n", rib_fov(w, s));
     fwrite(w->camera.buf, 1, w->camera.size, out);
-    fprintf(out, "WorldBegin\n");
+    fprintf(out, "WorldBegin\n%s", w->atmosphere ? w->atmosphere : "");
     fwrite(w->world.buf, 1, w->world.size, out);
     fprintf(out, "%sWorldEnd\n", w->in_transform ? "TransformEnd\n" : "");
     if (fflush(out) != 0 || ferror(out)) {

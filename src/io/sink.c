@@ -126,6 +126,11 @@ static RayesError scene_volume(void *t, const float bound[6])
     return rayes_scene_volume(t, bound);
 }
 
+static RayesError scene_atmosphere(void *t)
+{
+    return rayes_scene_atmosphere(t);
+}
+
 static RayesError scene_quadric(void *t, RayesQuadric type, const float *params, size_t n,
                                 unsigned flags)
 {
@@ -264,6 +269,7 @@ IoSink io_sink_scene(RayesScene *scene)
         .pattern = scene_pattern,
         .volume = scene_volume,
         .volume_inside = scene_volume_inside,
+        .atmosphere = scene_atmosphere,
         .set_visibility = scene_set_visibility,
         .set_opacity_mode = scene_set_opacity_mode,
         .object_begin = scene_object_begin,

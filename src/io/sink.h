@@ -130,6 +130,9 @@ typedef struct IoSink {
     /* rayes_scene_volume_inside (last; NULL: readers make the box volume,
      * as before). */
     RayesError (*volume_inside)(void *target, const float bound[6]);
+    /* rayes_scene_atmosphere (last; NULL: readers drop the atmosphere with
+     * one warning). */
+    RayesError (*atmosphere)(void *target);
 } IoSink;
 
 /* A sink that builds scene through rayes.h (borrowed, not retained). */

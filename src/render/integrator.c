@@ -376,8 +376,9 @@ static Vec3 trace_volumes(Worker *w, const Ray *ray, uint32_t kind, int diffuse_
         return L;
     Vec3 T;
     float tmax = isfinite(*t) ? *t : ray->tfar;
-    Vec3 Lv = volume_radiance(w, ray, tmax, leaving, kind, diffuse_depth, specular_depth,
-                              hash_combine(key, 0x766f6c756d65ull /* "volume" */), diff, &T);
+    Vec3 Lv =
+        volume_radiance(w, ray, tmax, leaving, isfinite(*t), kind, diffuse_depth, specular_depth,
+                        hash_combine(key, 0x766f6c756d65ull /* "volume" */), diff, &T);
     *alpha = 1.0f - (1.0f - *alpha) * (T.x + T.y + T.z) / 3.0f;
     return v3_add(Lv, v3_mul(T, L));
 }

@@ -458,8 +458,10 @@ Vec3 volume_transmittance(Worker *w, const Ray *ray, RayDiff diff)
     for (size_t k = 0; k < w->rs->n_volumes; k++) {
         const RenderVolume *v = &w->rs->volumes[k];
         float t0, t1, seg[VOLUME_MAX_SEGMENTS][2];
-        /* inside an opaque object: no shadow ray from outside reaches it */
-        if ((v->inside >= 0 && !v->shadow_crosses) || !clip(v, ray, ray->tfar, &t0, &t1))
+        /* inside an opaque object: no shadow ray from outside reaches it;
+         * an atmosphere stands between surfaces and the eye alone */
+        if (v->atmosphere || (v->inside >= 0 && !v->shadow_crosses) ||
+            !clip(v, ray, ray->tfar, &t0, &t1))
             continue;
         int n_seg = 1;
         if (v->shadow_crosses)
@@ -563,7 +565,7 @@ static void segment_radiance(Worker *w, const RenderVolume *v, const Ray *ray, f
     *Tv_out = Tv;
 }
 
-Vec3 volume_radiance(Worker *w, const Ray *ray, float tmax, int64_t leaving, uint32_t kind,
+Vec3 volume_radiance(Worker *w, const Ray *ray, float tmax, int64_t leaving, int hit, uint32_t kind,
                      int diffuse_depth, int specular_depth, uint64_t key, RayDiff diff, Vec3 *T)
 {
     Vec3 L = v3(0, 0, 0);
@@ -571,6 +573,8 @@ Vec3 volume_radiance(Worker *w, const Ray *ray, float tmax, int64_t leaving, uin
     for (size_t k = 0; k < w->rs->n_volumes; k++) {
         const RenderVolume *v = &w->rs->volumes[k];
         float t0, t1, seg[VOLUME_MAX_SEGMENTS][2];
+        if (v->atmosphere && (kind != RAYES_RAY_CAMERA || !hit))
+            continue; /* RenderMan's atmosphere: the light reaching the eye from a surface */
         if ((v->inside >= 0 && !v->hidden_bound && v->inside != leaving) ||
             !clip(v, ray, tmax, &t0, &t1))
             continue; /* bounded by an object the ray is not inside */

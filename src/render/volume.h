@@ -42,6 +42,8 @@ typedef struct RenderVolume {
     int shadow_crosses;          /* 1: shadow rays cross that object (hidden, or letting them
                                     through: a glass's thin shadow), so transmission finds their
                                     segments inside it the same way */
+    int atmosphere;              /* 1: RenderMan's atmosphere (rayes_scene_atmosphere): camera
+                                    rays that hit a surface see it, no other ray */
     int uniform;                 /* 1: the same extinction everywhere (the homogeneous shader
                                     without patterns): transmittance takes one step, scattering
                                     one per lighting point */
@@ -70,8 +72,9 @@ Vec3 volume_transmittance(Worker *w, const Ray *ray, RayDiff diff);
  * tmax] (camera and specular rays of type kind, at the given depths, the
  * key naming its random numbers), and in *T the transmittance over that
  * segment, by which what lies beyond it is seen. leaving: the object
- * whose back the segment ends on (-1: none), for volumes inside one. */
-Vec3 volume_radiance(Worker *w, const Ray *ray, float tmax, int64_t leaving, uint32_t kind,
+ * whose back the segment ends on (-1: none), for volumes inside one; hit:
+ * the segment ends on a surface (an atmosphere is seen only then). */
+Vec3 volume_radiance(Worker *w, const Ray *ray, float tmax, int64_t leaving, int hit, uint32_t kind,
                      int diffuse_depth, int specular_depth, uint64_t key, RayDiff diff, Vec3 *T);
 
 #endif /* RAYES_RENDER_VOLUME_H */

@@ -1009,7 +1009,7 @@ RayesError rayes_scene_sphere(RayesScene *s, float radius)
     return add_prim(s, &p);
 }
 
-static RayesError add_volume(RayesScene *s, const float bound[6], int64_t inside)
+static RayesError add_volume(RayesScene *s, const float bound[6], int64_t inside, int atmosphere)
 {
     if (!s || !bound)
         return RAYES_ERROR_INVALID_ARGUMENT;
@@ -1025,11 +1025,18 @@ static RayesError add_volume(RayesScene *s, const float bound[6], int64_t inside
         if (e != RAYES_OK)
             return e;
     }
-    if (grow((void **)&s->volumes, &s->cap_volumes, s->n_volumes, sizeof *s->volumes) != 0)
-        return scene_fail(s, RAYES_ERROR_OUT_OF_MEMORY, "out of memory");
-    SceneVolume *v = &s->volumes[s->n_volumes++];
+    SceneVolume *v = NULL;
+    for (size_t i = 0; atmosphere && i < s->n_volumes && !v; i++)
+        if (s->volumes[i].atmosphere)
+            v = &s->volumes[i]; /* the one atmosphere, replaced */
+    if (!v) {
+        if (grow((void **)&s->volumes, &s->cap_volumes, s->n_volumes, sizeof *s->volumes) != 0)
+            return scene_fail(s, RAYES_ERROR_OUT_OF_MEMORY, "out of memory");
+        v = &s->volumes[s->n_volumes++];
+    }
     v->object = (uint32_t)s->current_object;
     v->inside = inside;
+    v->atmosphere = atmosphere;
     v->world_from_object = s->world_from_object;
     memcpy(v->bound, bound, sizeof v->bound);
     v->shading_rate = s->shading_rate;
@@ -1039,7 +1046,13 @@ static RayesError add_volume(RayesScene *s, const float bound[6], int64_t inside
 
 RayesError rayes_scene_volume(RayesScene *s, const float bound[6])
 {
-    return add_volume(s, bound, -1);
+    return add_volume(s, bound, -1, 0);
+}
+
+RayesError rayes_scene_atmosphere(RayesScene *s)
+{
+    static const float unit[6] = {0, 1, 0, 1, 0, 1}; /* unused: the scene's bounds */
+    return add_volume(s, unit, -1, 1);
 }
 
 RayesError rayes_scene_volume_inside(RayesScene *s, const float bound[6])
@@ -1049,7 +1062,7 @@ RayesError rayes_scene_volume_inside(RayesScene *s, const float bound[6])
     if (s->last_geometry_object < 0)
         return scene_fail(s, RAYES_ERROR_INVALID_ARGUMENT,
                           "volume inside: no geometry before it (a closed shape bounds it)");
-    return add_volume(s, bound, s->last_geometry_object);
+    return add_volume(s, bound, s->last_geometry_object, 0);
 }
 
 static void light_motion(const RayesScene *s, Light *l);
@@ -1270,6 +1283,8 @@ Bounds3 scene_bounds(const RayesScene *s)
     Bounds3 b = bounds_empty();
     for (size_t i = 0; i < s->n_volumes; i++) {
         const SceneVolume *v = &s->volumes[i];
+        if (v->atmosphere)
+            continue; /* it has the others' bounds */
         for (int k = 0; k < 8; k++)
             b = bounds_add(b, mat4_point(&v->world_from_object,
                                          v3(v->bound[k & 1], v->bound[2 + (k >> 1 & 1)],

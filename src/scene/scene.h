@@ -44,6 +44,7 @@ typedef struct SceneVolume {
     Mat4 world_from_object;
     float bound[6];           /* xmin, xmax, ymin, ymax, zmin, zmax */
     float shading_rate;
+    int atmosphere; /* 1: rayes_scene_atmosphere's (bound unused: the scene's, at render) */
 } SceneVolume;
 
 /* A named pattern (rayes_scene_pattern, patterns.c). */

@@ -388,23 +388,36 @@ static int prepare_volumes(const RayesScene *scene, const RenderSettings *set, P
     uint32_t base = (uint32_t)p->gs.n_grids;
     for (size_t i = 0; i < scene->n_volumes; i++) {
         const SceneVolume *sv = &scene->volumes[i];
+        Mat4 world_from_object = sv->world_from_object;
+        Vec3 lo = v3(sv->bound[0], sv->bound[2], sv->bound[4]);
+        Vec3 hi = v3(sv->bound[1], sv->bound[3], sv->bound[5]);
         Bounds3 wb = bounds_empty();
-        for (int k = 0; k < 8; k++)
-            wb = bounds_add(wb, mat4_point(&sv->world_from_object,
-                                           v3(sv->bound[k & 1], sv->bound[2 + (k >> 1 & 1)],
-                                              sv->bound[4 + (k >> 2)])));
-        Vec3 near = v3(fminf(fmaxf(cam.eye.x, wb.lo.x), wb.hi.x),
-                       fminf(fmaxf(cam.eye.y, wb.lo.y), wb.hi.y),
-                       fminf(fmaxf(cam.eye.z, wb.lo.z), wb.hi.z));
+        if (sv->atmosphere) { /* the scene's bounds and the eye, a thousandth wider */
+            wb = bounds_add(scene_bounds(scene), cam.eye);
+            Vec3 pad = v3_scale(v3(1, 1, 1), fmaxf(1e-3f * v3_length(v3_sub(wb.hi, wb.lo)), 1e-3f));
+            wb.lo = v3_sub(wb.lo, pad), wb.hi = v3_add(wb.hi, pad);
+            world_from_object = mat4_identity();
+            lo = wb.lo, hi = wb.hi;
+        } else {
+            for (int k = 0; k < 8; k++)
+                wb = bounds_add(wb, mat4_point(&sv->world_from_object,
+                                               v3(sv->bound[k & 1], sv->bound[2 + (k >> 1 & 1)],
+                                                  sv->bound[4 + (k >> 2)])));
+        }
+        /* voxels a pixel wide where the box is nearest the eye (an
+         * atmosphere, around the eye: at the scene's middle) */
+        Vec3 near = sv->atmosphere ? v3_scale(v3_add(wb.lo, wb.hi), 0.5f)
+                                   : v3(fminf(fmaxf(cam.eye.x, wb.lo.x), wb.hi.x),
+                                        fminf(fmaxf(cam.eye.y, wb.lo.y), wb.hi.y),
+                                        fminf(fmaxf(cam.eye.z, wb.lo.z), wb.hi.z));
         float dist =
             fmaxf(v3_length(v3_sub(near, cam.eye)), 1e-3f * v3_length(v3_sub(wb.hi, wb.lo)));
         float voxel = (cam.pixel_width + cam.pixel_spread * dist) * sqrtf(sv->shading_rate);
         RenderVolume *v = &p->volumes[p->n_volumes];
-        uint32_t bricks = volume_init(v, sv->object, &sv->world_from_object,
-                                      v3(sv->bound[0], sv->bound[2], sv->bound[4]),
-                                      v3(sv->bound[1], sv->bound[3], sv->bound[5]), voxel, base);
+        uint32_t bricks = volume_init(v, sv->object, &world_from_object, lo, hi, voxel, base);
         if (bricks == 0)
             continue; /* a singular transform: nothing to march */
+        v->atmosphere = sv->atmosphere;
         v->uniform = volume_uniform(&p->objects[sv->object]);
         v->inside = sv->inside;
         v->hidden_bound = sv->inside >= 0 && session_hidden_bound(scene, sv->inside);
