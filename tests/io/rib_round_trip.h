@@ -1,8 +1,8 @@
 /*
  * tests/io/rib_round_trip.h — RIB texts for the tests that read a
  * writer's RIB back (curves, blobbies, solids, area lights): the writer's
- * text for a RIB text, and a RIB or pbrt-v4 text read into a new scene.
- * Header-only.
+ * text for a RIB text, a RIB or pbrt-v4 text read into a new scene, and
+ * a RIB text rendered. Header-only.
  */
 #ifndef RAYES_TESTS_IO_RIB_ROUND_TRIP_H
 #define RAYES_TESTS_IO_RIB_ROUND_TRIP_H
@@ -74,6 +74,31 @@ static char *rib_round_trip(const char *text, char *err, size_t n)
         fclose(f);
     io_rib_writer_free(w);
     return buf;
+}
+
+/* A RIB text rendered at size x size with spp pixel samples (preview, no
+ * bounces, 2 threads): the image (free it), or NULL, the reader's or the
+ * renderer's message on stderr. */
+static inline RayesImage *rib_render_text(const char *text, int size, int spp)
+{
+    RayesError e;
+    char err[512];
+    RayesScene *s = rib_read_scene(text, &e, err, sizeof err);
+    RayesImage *img = NULL;
+    if (e != RAYES_OK) {
+        fprintf(stderr, "  %s\n", err);
+    } else if (rayes_scene_commit(s) == RAYES_OK) {
+        RayesRenderOptions o;
+        rayes_render_options_init(&o, RAYES_QUALITY_PREVIEW);
+        o.width = o.height = size;
+        o.spp = spp;
+        o.threads = 2;
+        o.bounces = 0;
+        if (rayes_render(s, &o, &img, NULL) != RAYES_OK)
+            fprintf(stderr, "  render: %s\n", rayes_scene_get_error(s));
+    }
+    rayes_scene_release(s);
+    return img;
 }
 
 #endif /* RAYES_TESTS_IO_RIB_ROUND_TRIP_H */

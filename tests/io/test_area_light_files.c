@@ -155,7 +155,7 @@ static void test_bmrt_units(void)
         {"Translate 0 0 4\nSphere 0.05 -0.05 0.05 360", 0.25},
     };
     for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
-        char text[1024], err[256];
+        char text[1024];
         snprintf(text, sizeof text,
                  "Format 8 8 1\nProjection \"perspective\" \"fov\" [4]\nWorldBegin\n"
                  "AttributeBegin\nAttribute \"visibility\" \"int camera\" [0]\n"
@@ -163,19 +163,8 @@ static void test_bmrt_units(void)
                  "%s\nAttributeEnd\nSurface \"matte\"\n"
                  "Polygon \"P\" [-9 -9 6  9 -9 6  9 9 6  -9 9 6]\nWorldEnd\n",
                  k < 3, cases[k].shape);
-        RayesError e;
-        RayesScene *s = rib_read_scene(text, &e, err, sizeof err);
-        CHECK(e == RAYES_OK && s->n_lights >= 1); /* a two-sided quad: two */
-        RayesImage *img = NULL;
-        if (e == RAYES_OK && rayes_scene_commit(s) == RAYES_OK) {
-            RayesRenderOptions o;
-            rayes_render_options_init(&o, RAYES_QUALITY_PREVIEW);
-            o.width = o.height = 8;
-            o.bounces = 0;
-            o.spp = 64;
-            o.threads = 2;
-            CHECK(rayes_render(s, &o, &img, NULL) == RAYES_OK);
-        }
+        RayesImage *img = rib_render_text(text, 8, 64);
+        CHECK(img != NULL);
         if (img) {
             double m = 0; /* the four middle pixels */
             for (int y = 3; y < 5; y++)
@@ -186,7 +175,6 @@ static void test_bmrt_units(void)
                 fprintf(stderr, "  %s: %g\n", cases[k].shape, m);
         }
         rayes_image_free(img);
-        rayes_scene_release(s);
     }
 }
 

@@ -27,27 +27,9 @@ static const char *const square_rib =
     "LightSource \"distantlight\" 1 \"intensity\" 1\n"
     "Surface \"matte\"\nPolygon \"P\" [-1 -1 6  1 -1 6  1 1 6  -1 1 6]\nWorldEnd\n";
 
-/* The image of the RIB text, or NULL; *err_out the reader's message. */
 static RayesImage *render_text(const char *text)
 {
-    RayesError e;
-    char err[512];
-    RayesScene *s = rib_read_scene(text, &e, err, sizeof err);
-    if (e != RAYES_OK)
-        fprintf(stderr, "  %s\n", err);
-    CHECK(e == RAYES_OK);
-    RayesImage *img = NULL;
-    if (e == RAYES_OK && rayes_scene_commit(s) == RAYES_OK) {
-        RayesRenderOptions o;
-        rayes_render_options_init(&o, RAYES_QUALITY_PREVIEW);
-        o.width = o.height = SIZE;
-        o.spp = 4;
-        o.threads = 2;
-        o.bounces = 0;
-        CHECK(rayes_render(s, &o, &img, NULL) == RAYES_OK);
-    }
-    rayes_scene_release(s);
-    return img;
+    return rib_render_text(text, SIZE, 4);
 }
 
 /* The square under the atmosphere text (or ""). */

@@ -34,24 +34,7 @@ static const char *const floor_rib =
 /* The floor lit by the RIB text light, then more (geometry or ""). */
 static RayesImage *render_text(const char *text)
 {
-    RayesError e;
-    char err[512];
-    RayesScene *s = rib_read_scene(text, &e, err, sizeof err);
-    if (e != RAYES_OK)
-        fprintf(stderr, "  %s\n", err);
-    CHECK(e == RAYES_OK);
-    RayesImage *img = NULL;
-    if (e == RAYES_OK && rayes_scene_commit(s) == RAYES_OK) {
-        RayesRenderOptions o;
-        rayes_render_options_init(&o, RAYES_QUALITY_PREVIEW);
-        o.width = o.height = SIZE;
-        o.spp = 1;
-        o.threads = 2;
-        o.bounces = 0;
-        CHECK(rayes_render(s, &o, &img, NULL) == RAYES_OK);
-    }
-    rayes_scene_release(s);
-    return img;
+    return rib_render_text(text, SIZE, 1);
 }
 
 static RayesImage *render_light(const char *light, const char *more)
