@@ -22,6 +22,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <strings.h>
 #include <unistd.h>
 
 #include "io/rib_reader.h"
@@ -782,16 +783,17 @@ static int uber_params(Rib *r, Light *L, const Param *p, size_t n)
 
 /* Whether a light shader of RenderMan's casts shadows when nothing else
  * says: pointlight, spotlight and distantlight trace none; shadowpoint,
- * shadowspot and shadowdistant cast their maps' (shadowname, or
- * shadowpoint's six sf* faces; "raytrace" among them), which rayes
- * traces; rayes' other lights (environment, area) cast theirs. */
+ * shadowspot and shadowdistant, and the stand-ins for lights rayes does
+ * not have, cast their maps' (shadowname, or shadowpoint's six sf*
+ * faces; "raytrace" among them), which rayes traces; rayes' other lights
+ * (environment, area) cast theirs. */
 static int casts_shadows(const char *name, const char *type, const Param *p, size_t n)
 {
     if (strcmp(type, "pointlight") != 0 && strcmp(type, "spotlight") != 0 &&
         strcmp(type, "distantlight") != 0)
         return 1;
-    if (strncmp(name, "shadow", 6) != 0)
-        return 0;
+    if (strcmp(name, type) == 0)
+        return 0; /* the shadows of a shadow light's, or a stand-in's, map */
     for (size_t k = 0; k < n; k++) {
         const char *nm = p[k].d.name;
         int map =
@@ -801,6 +803,32 @@ static int casts_shadows(const char *name, const char *type, const Param *p, siz
             return 1;
     }
     return 0;
+}
+
+/* Whether name holds word, in any case. */
+static int names_it(const char *name, const char *word)
+{
+    size_t n = strlen(word);
+    for (const char *s = name; *s; s++)
+        if (strncasecmp(s, word, n) == 0)
+            return 1;
+    return 0;
+}
+
+/* The classic light that stands in for a light shader rayes does not
+ * have, by what its parameters and name say it is: a cone ("coneangle")
+ * a spotlight; "distant", "directional" or "sun" in its name a distant
+ * light; "point" (but not a point light without falloff) a point light;
+ * else NULL. */
+static const char *stand_in_light(const char *name, const Param *p, size_t n)
+{
+    if (rib_find_param(p, n, "coneangle"))
+        return "spotlight";
+    if (names_it(name, "distant") || names_it(name, "directional") || names_it(name, "sun"))
+        return "distantlight";
+    if (names_it(name, "point") && !names_it(name, "nofall"))
+        return "pointlight";
+    return NULL;
 }
 
 static int h_light_source(Rib *r, const Args *a)
@@ -827,7 +855,7 @@ static int h_light_source(Rib *r, const Args *a)
         free(p);
         return -1;
     }
-    const char *type = NULL;
+    const char *type = NULL, *stand_in = NULL;
     int spot = 0;
     if (strcmp(name, "pointlight") == 0 || strcmp(name, "shadowpoint") == 0)
         type = "pointlight";
@@ -862,6 +890,15 @@ static int h_light_source(Rib *r, const Args *a)
     } else if (!type && strcmp(name, "indirectlight") == 0) {
         rib_warn_once(r, "light indirectlight", "light shader \"indirectlight\" is skipped: rayes "
                                                 "computes indirect light itself (--bounces)");
+    } else if (!type && (stand_in = stand_in_light(name, p, n)) != NULL) {
+        type = stand_in;
+        spot = strcmp(type, "spotlight") == 0;
+        char key[128];
+        snprintf(key, sizeof key, "light %s", name);
+        rib_warn_once(r, key,
+                      "light shader \"%s\" is not built in: a %s of its intensity, lightcolor, "
+                      "from and to%s instead (its other parameters are not read)",
+                      name, type, spot ? ", cone and beam distribution" : "");
     } else if (!type) {
         char key[128];
         snprintf(key, sizeof key, "light %s", name);
@@ -876,7 +913,8 @@ static int h_light_source(Rib *r, const Args *a)
         free(p);
         return -1;
     }
-    if (strcmp(type, "arealight") == 0 || strcmp(type, "environmentlight") == 0) {
+    int env = !stand_in && strcmp(type, "environmentlight") == 0;
+    if (env || (!stand_in && strcmp(type, "arealight") == 0)) {
         /* its shape, or the background, is seen as the attributes say */
         L->own_visibility = 1;
         L->visibility = r->a.visibility;
@@ -898,7 +936,6 @@ static int h_light_source(Rib *r, const Args *a)
                                         "__nondiffuse",
                                         "__nonspecular",
                                         NULL};
-    int env = strcmp(type, "environmentlight") == 0;
     int mapped = strcmp(type, "pointlight") == 0 || strcmp(type, "spotlight") == 0;
     /* RenderMan's point, spot and distant lights: diffuse() sums Cl (L.N)
      * with no 1/pi, so their intensity is pi times rayes' (DESIGN.md,

@@ -184,6 +184,41 @@ static void test_classic_light_shadows(void)
     }
 }
 
+/* Light shaders rayes does not have stand in by what they say they are:
+ * one with a cone is the spotlight of its parameters (the same image),
+ * one named a distant, directional or sun light the distant light, one
+ * named a point light the point light, each without shadows unless a map
+ * is named; any other is skipped (a black floor). */
+static void test_stand_in_lights(void)
+{
+    static const char *const pairs[][2] = {
+        {"LightSource \"spotlight\" 1 \"intensity\" 36 \"coneangle\" 0.6\n",
+         "LightSource \"myblockerspot\" 1 \"intensity\" 36 \"coneangle\" 0.6 \"blockername\" "
+         "\"star.tx\"\n"},
+        {"LightSource \"distantlight\" 1 \"intensity\" 0.5\n",
+         "LightSource \"MKshadowdistant_rim\" 1 \"intensity\" 0.5 \"shadowname\" \"\"\n"},
+        {"LightSource \"pointlight\" 1 \"intensity\" 36\n",
+         "LightSource \"mtorPointLight\" 1 \"intensity\" 36\n"},
+        {"LightSource \"shadowspot\" 1 \"intensity\" 36 \"coneangle\" 0.6 \"shadowname\" \"s\"\n",
+         "LightSource \"TLblockerspot\" 1 \"intensity\" 36 \"coneangle\" 0.6 \"shadowname\" "
+         "\"s\"\n"},
+    };
+    for (size_t k = 0; k < sizeof pairs / sizeof pairs[0]; k++) {
+        RayesImage *a = render_light(pairs[k][0], SQUARE), *b = render_light(pairs[k][1], SQUARE);
+        CHECK(a && b);
+        if (a && b) {
+            CHECK(pixel(a, 0, 0) > 0.05);
+            for (int i = 0; i < 4 * SIZE * SIZE; i++)
+                CHECK(fabsf(a->rgba[i] - b->rgba[i]) < 1e-6f);
+        }
+        rayes_image_free(a);
+        rayes_image_free(b);
+    }
+    RayesImage *none = render_light("LightSource \"pointnofalloff\" 1 \"intensity\" 36\n", "");
+    CHECK(none && pixel(none, 0, 0) == 0.0 && middle(none, 0) == 0.0);
+    rayes_image_free(none);
+}
+
 /* A blocker in the coordinate system "blk" (z = 3): the middle is dark,
  * the corners lit; after AttributeEnd the system is still known. */
 static void test_uberlight_blocker(void)
@@ -240,5 +275,5 @@ static void test_uberlight_round_trip(void)
 }
 
 TEST_MAIN(TEST(test_uberlight_reads), TEST(test_uberlight_shadows),
-          TEST(test_classic_light_shadows), TEST(test_uberlight_blocker),
-          TEST(test_uberlight_round_trip))
+          TEST(test_classic_light_shadows), TEST(test_stand_in_lights),
+          TEST(test_uberlight_blocker), TEST(test_uberlight_round_trip))
