@@ -642,11 +642,14 @@ Light *rib_new_light(Rib *r, const char *handle, const char *type)
 void rib_light_param(Light *L, const char *name, RayesParamType type, const float v[3],
                      const char *string)
 {
-    if (L->n >= RIB_LIGHT_PARAMS)
+    size_t at = 0; /* a parameter of that name is replaced */
+    while (at < L->n && strcmp(L->names[at], name) != 0)
+        at++;
+    if (at >= RIB_LIGHT_PARAMS)
         return;
-    RayesParam *o = &L->params[L->n];
-    snprintf(L->names[L->n], sizeof L->names[0], "%s", name);
-    *o = (RayesParam){.name = L->names[L->n], .type = type};
+    RayesParam *o = &L->params[at];
+    snprintf(L->names[at], sizeof L->names[0], "%s", name);
+    *o = (RayesParam){.name = L->names[at], .type = type};
     if (type == RAYES_PARAM_STRING) {
         char *dst = light_string(L, name);
         size_t size = dst == L->mapname     ? sizeof L->mapname
@@ -660,7 +663,7 @@ void rib_light_param(Light *L, const char *name, RayesParamType type, const floa
         for (int c = 0; c < (type == RAYES_PARAM_COLOR ? 3 : 1); c++)
             o->value[c] = v[c];
     }
-    L->n++;
+    L->n += at == L->n;
 }
 
 static int intensity(const Param *q)
@@ -708,12 +711,51 @@ static void blocker_param(Light *L)
     L->n++;
 }
 
+/* A float parameter's value, or def. */
+static double param_float(const Param *p, size_t n, const char *name, double def)
+{
+    const Param *q = rib_find_param(p, n, name);
+    return q && rib_is_num(q->v) && q->v->n >= 1 && isfinite(q->v->d[0]) ? q->v->d[0] : def;
+}
+
+/* A colour parameter (three values, or one for all), or def. */
+static void param_color(const Param *p, size_t n, const char *name, double def, double out[3])
+{
+    const Param *q = rib_find_param(p, n, name);
+    int ok = q && rib_is_num(q->v) && (q->v->n == 1 || q->v->n == 3);
+    for (int c = 0; c < 3; c++)
+        out[c] =
+            ok && isfinite(q->v->d[q->v->n == 3 ? c : 0]) ? q->v->d[q->v->n == 3 ? c : 0] : def;
+}
+
+/* l_uber's Maya cone: coneAngle (degrees, its full width; Maya's least,
+ * 0.006, means none) and penumbraAngle narrow the spot to a round cross
+ * section of half width tan(coneAngle / 2), fading to tan((coneAngle +
+ * penumbraAngle) / 2), where width and height were wider. */
+static void cone_shape(Light *L, const Param *p, size_t n)
+{
+    double cone = param_float(p, n, "coneAngle", 0.006);
+    if (!(cone > 0.006) || cone >= 179.0)
+        return;
+    double pen = fmax(param_float(p, n, "penumbraAngle", 0.0), 0.0);
+    double inner = tan(cone * M_PI / 360.0);
+    double outer = tan(fmin(cone + pen, 179.0) * M_PI / 360.0);
+    double w = fmin(param_float(p, n, "width", 1.0), inner);
+    double h = fmin(param_float(p, n, "height", 1.0), inner);
+    const float v[4][3] = {{(float)w}, {(float)h}, {(float)(outer - w)}, {(float)(outer - h)}};
+    static const char *const names[4] = {"width", "height", "wedge", "hedge"};
+    for (int k = 0; k < 4; k++)
+        rib_light_param(L, names[k], RAYES_PARAM_FLOAT, v[k], NULL);
+    static const float round[3] = {1, 0, 0};
+    rib_light_param(L, "roundness", RAYES_PARAM_FLOAT, round, NULL);
+}
+
 /* An uberlight's parameters into L (intensity and lightcolor are read as
  * any light's): its shaping, slide, blocker (its coordinate system's
  * matrix), and whether it casts shadows, which in RenderMan it does only
  * with a shadow map or BMRT's raytraceshadow (rayes traces them either
  * way). Parameters need no declaration (the shader declares them). */
-static int uber_params(Rib *r, Light *L, const Param *p, size_t n)
+static int uber_params(Rib *r, Light *L, const Param *p, size_t n, int l_uber)
 {
     int shadows = 0;
     for (size_t k = 0; k < n; k++) {
@@ -744,6 +786,19 @@ static int uber_params(Rib *r, Light *L, const Param *p, size_t n)
         } else if (num && q->v->n == 3 && in_list(uber_vectors, nm)) {
             float v[3] = {(float)q->v->d[0], (float)q->v->d[1], (float)q->v->d[2]};
             rib_light_param(L, nm, RAYES_PARAM_COLOR, v, NULL);
+        } else if (num && q->v->n == 1 && strcmp(nm, "lighttype") == 0) {
+            /* Lancaster's l_uber (Maya's lights): 0 spot, 2 BMRT's area,
+             * 3 directional (parallel rays), else omni */
+            int k = (int)q->v->d[0];
+            if (k == 2)
+                rib_warn_once(r, "uber lighttype",
+                              "uberlight: lighttype \"arealight\" is not built in; \"omni\" "
+                              "instead");
+            if (k == 3) {
+                static const float one[3] = {1, 0, 0};
+                rib_light_param(L, "parallelrays", RAYES_PARAM_FLOAT, one, NULL);
+            }
+            rib_light_param(L, "lighttype", RAYES_PARAM_STRING, NULL, k == 0 ? "spot" : "omni");
         } else if (str && strcmp(nm, "lighttype") == 0) {
             const char *t = q->v->s[0];
             if (strcmp(t, "spot") != 0 && strcmp(t, "omni") != 0) {
@@ -767,6 +822,19 @@ static int uber_params(Rib *r, Light *L, const Param *p, size_t n)
                 return rib_error(r, "uberlight: unknown blockercoords \"%.64s\"", q->v->s[0]);
             blocker_param(L);
         }
+    }
+    for (int k = 0; l_uber && k < 2; k++) /* l_uber's edges are sharp unless said */
+        if (!rib_find_param(p, n, k ? "hedge" : "wedge")) {
+            static const float zero[3] = {0, 0, 0};
+            rib_light_param(L, k ? "hedge" : "wedge", RAYES_PARAM_FLOAT, zero, NULL);
+        }
+    if (l_uber)
+        cone_shape(L, p, n);
+    if (param_float(p, n, "falloff", 0.0) == 0.0 &&
+        !(param_float(p, n, "falloffdist", 1.0) > 0.0)) {
+        /* unused without falloff (l_uber writes 0) */
+        static const float one[3] = {1, 0, 0};
+        rib_light_param(L, "falloffdist", RAYES_PARAM_FLOAT, one, NULL);
     }
     if (!rib_find_param(p, n, "maxintensity")) { /* RenderMan's default 1: pi of rayes' */
         const float pi[3] = {(float)M_PI, 0, 0};
@@ -849,7 +917,7 @@ static int h_light_source(Rib *r, const Args *a)
     if (rib_get_params(r, a, i, &p, &n) != 0)
         return -1;
     static const Counts one = {1, 1, 1, 1};
-    if (strcmp(name, "uberlight") == 0)
+    if (strcmp(name, "uberlight") == 0 || strcmp(name, "l_uber") == 0)
         uber_declare(p, n);
     if (rib_check_counts(r, p, n, &one) != 0) {
         free(p);
@@ -869,7 +937,7 @@ static int h_light_source(Rib *r, const Args *a)
         type = "environmentlight";
     else if (strcmp(name, "arealight") == 0) /* rayes' own (what the writer writes) */
         type = "arealight";
-    else if (strcmp(name, "uberlight") == 0) /* Barzel's */
+    else if (strcmp(name, "uberlight") == 0 || strcmp(name, "l_uber") == 0) /* Barzel's */
         type = "uberlight";
     else if (in_list(environment_lights, name)) {
         /* Production environment and occlusion lights: an environment
@@ -1007,7 +1075,7 @@ static int h_light_source(Rib *r, const Args *a)
         }
         L->n++;
     }
-    int e = uber ? uber_params(r, L, p, n) : 0;
+    int e = uber ? uber_params(r, L, p, n, strcmp(name, "l_uber") == 0) : 0;
     const Param *said = rib_find_param(p, n, "shadows");
     if (!uber && !(said && said->declared) &&
         (r->a.shadows < 0 || (r->a.shadows == 0 && !casts_shadows(name, type, p, n)))) {
@@ -1201,23 +1269,6 @@ static int h_pattern(Rib *r, const Args *a)
 }
 
 /* ------------------------------------------------------------ atmosphere */
-
-/* A float parameter's value, or def. */
-static double param_float(const Param *p, size_t n, const char *name, double def)
-{
-    const Param *q = rib_find_param(p, n, name);
-    return q && rib_is_num(q->v) && q->v->n >= 1 && isfinite(q->v->d[0]) ? q->v->d[0] : def;
-}
-
-/* A colour parameter (three values, or one for all), or def. */
-static void param_color(const Param *p, size_t n, const char *name, double def, double out[3])
-{
-    const Param *q = rib_find_param(p, n, name);
-    int ok = q && rib_is_num(q->v) && (q->v->n == 1 || q->v->n == 3);
-    for (int c = 0; c < 3; c++)
-        out[c] =
-            ok && isfinite(q->v->d[q->v->n == 3 ? c : 0]) ? q->v->d[q->v->n == 3 ? c : 0] : def;
-}
 
 /* The homogeneous medium of RenderMan's standard fog and of Gritz's smoke
  * shaders (docs/rib.md "Atmosphere"): extinction, albedo and emission per

@@ -42,7 +42,7 @@ static void test_requests_renderman_accepts(void)
     CHECK(rib(WORLD("GeometricRepresentation \"lines\"\n" QUAD)) == RAYES_OK && rec.n_mesh == 1);
     CHECK(rib(WORLD("GeometricRepresentation\n" QUAD)) != RAYES_OK); /* no name */
     /* a light rayes skips, then Illuminate of it: the rest still lights */
-    CHECK(rib(WORLD("LightSource \"l_uber\" 1 \"intensity\" 1\nIlluminate 1 1\n" DISTANT
+    CHECK(rib(WORLD("LightSource \"attenlight\" 1 \"intensity\" 1\nIlluminate 1 1\n" DISTANT
                     "Illuminate 7 0\n" QUAD)) == RAYES_OK);
     CHECK(rec.n_light == 1 && rec.n_mesh == 1);
     /* Hider counts of 0: RenderMan's own choice (RenderMan for Maya) */

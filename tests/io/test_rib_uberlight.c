@@ -219,6 +219,37 @@ static void test_stand_in_lights(void)
     rayes_image_free(none);
 }
 
+/* Lancaster's l_uber (Maya's lights through MTOR): its numeric lighttype
+ * (0 spot, 3 directional), Maya's coneAngle (full width, degrees) a round
+ * cone, sharp edges by default, and falloffdist 0 without falloff read
+ * (it was an error). A 20 degree cone lights the middle of the floor 6
+ * away (radius 1.06) but not the corners (2.2 away); a 60 degree one
+ * both. */
+static void test_l_uber(void)
+{
+    RayesImage *narrow =
+        render_light("LightSource \"l_uber\" 1 \"float lighttype\" [0] \"float coneAngle\" [20] "
+                     "\"float penumbraAngle\" [0] \"float falloff\" [0] \"float falloffdist\" [0] "
+                     "\"float intensity\" [36]\n",
+                     "");
+    RayesImage *wide = render_light("LightSource \"l_uber\" 1 \"float lighttype\" [0] \"float "
+                                    "coneAngle\" [60] \"float intensity\" [36]\n",
+                                    "");
+    RayesImage *sun = render_light(
+        "LightSource \"l_uber\" 1 \"float lighttype\" [3] \"float intensity\" [1]\n", "");
+    CHECK(narrow && wide && sun);
+    if (narrow && wide && sun) {
+        CHECK(middle(narrow, 0) > 0.5 && pixel(narrow, 0, 0) == 0.0);
+        CHECK(middle(wide, 0) > 0.5 && pixel(wide, 0, 0) > 0.3);
+        /* parallel rays straight down: no falloff with distance or angle
+         * beyond the floor's cosine, so the corner nearly the middle */
+        CHECK(pixel(sun, 0, 0) > 0.9 * middle(sun, 0) && middle(sun, 0) > 0.1);
+    }
+    rayes_image_free(narrow);
+    rayes_image_free(wide);
+    rayes_image_free(sun);
+}
+
 /* A blocker in the coordinate system "blk" (z = 3): the middle is dark,
  * the corners lit; after AttributeEnd the system is still known. */
 static void test_uberlight_blocker(void)
@@ -275,5 +306,5 @@ static void test_uberlight_round_trip(void)
 }
 
 TEST_MAIN(TEST(test_uberlight_reads), TEST(test_uberlight_shadows),
-          TEST(test_classic_light_shadows), TEST(test_stand_in_lights),
+          TEST(test_classic_light_shadows), TEST(test_stand_in_lights), TEST(test_l_uber),
           TEST(test_uberlight_blocker), TEST(test_uberlight_round_trip))
