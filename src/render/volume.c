@@ -398,6 +398,14 @@ static void extinction_at(Worker *w, const RenderVolume *v, const Ray *ray, RayD
     /* object space is an affine image of world space: step along it */
     Vec3 q0 = mat4_point(&v->object_from_world, ray->o);
     Vec3 dq = mat4_vector(&v->object_from_world, ray->d);
+    if (v->uniform && m->n > 0) { /* one extinction everywhere: one lookup */
+        float t = m->t0 + m->jitter * m->dt;
+        Vec3 s = extinction_cached(w, v, v3_madd(q0, dq, t), diff.width + diff.spread * t * len,
+                                   &last);
+        for (int i = 0; i < m->n; i++)
+            v3_store(p->Oi[i], s);
+        return;
+    }
     for (int i = 0; i < m->n; i++) {
         float t = m->t0 + ((float)i + m->jitter) * m->dt;
         v3_store(p->Oi[i], extinction_cached(w, v, v3_madd(q0, dq, t),
