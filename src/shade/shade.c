@@ -8,6 +8,7 @@
 #include "shade/shade.h"
 
 #include <math.h>
+#include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -278,9 +279,25 @@ static void *call_begin(const ShaderInstance *inst, const RayesShadeCtx *ctx, Ra
  * opaque; said once per class and method. Left alone, one NaN in a cache
  * fill would spread through the interpolation to every lookup near it, and
  * a NaN pixel poisons filters, adaptive sampling and the files. */
+/* Whether the n colours at v (NULL: none) are all finite: an exponent of
+ * all ones is infinity or NaN; a branch-free pass the compiler vectorises. */
+static int all_finite(const float (*v)[3], size_t n)
+{
+    uint32_t hit = 0;
+    for (size_t k = 0; v && k < 3 * n; k++) {
+        uint32_t u;
+        memcpy(&u, &v[0][0] + k, sizeof u);
+        hit |= (u & 0x7f800000u) == 0x7f800000u;
+    }
+    return !hit;
+}
+
 static void finite_outputs(const RayesShaderClass *cls, const char *method, size_t n,
                            RayesShadeOutputs *out)
 {
+    if (all_finite((const float(*)[3])out->Ci, n) && all_finite((const float(*)[3])out->Oi, n) &&
+        all_finite((const float(*)[3])out->Irradiance, n))
+        return;
     size_t bad = 0;
     for (size_t i = 0; i < n; i++)
         for (int c = 0; c < 3; c++) {
