@@ -195,6 +195,7 @@ typedef struct Medium {
     float *density;           /* uniformgrid: nx ny nz values, owned */
     float p0[3], p1[3];       /* uniformgrid: the grid's box, medium space */
     char filename[PBRT_PATH]; /* nanovdb: resolved */
+    char grids[2][64];        /* nanovdb: its density and temperature grids' names */
     float Lescale;            /* nanovdb: the temperature grid's blackbody emission scale */
     float temp_offset, temp_scale; /* nanovdb: temperaturecutoff, temperaturescale */
     char pattern[160];        /* the sink's pattern of the density once sent, else "" */

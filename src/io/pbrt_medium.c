@@ -59,8 +59,8 @@ static int medium_coefficients(Parser *P, ParamList *pl, Medium *md)
      * temperatureoffset */
     float Lescale = (float)pbrt_get_float(pl, "Lescale", pbrt_get_float(pl, "LeScale", 1.0));
     md->Lescale = Lescale;
-    md->temp_offset = (float)pbrt_get_float(pl, "temperaturecutoff",
-                                            pbrt_get_float(pl, "temperatureoffset", 0.0));
+    md->temp_offset = (float)pbrt_get_float(pl, "temperatureoffset",
+                                            pbrt_get_float(pl, "temperaturecutoff", 0.0));
     md->temp_scale = (float)pbrt_get_float(pl, "temperaturescale", 1.0);
     md->g = (float)pbrt_get_float(pl, "g", 0.0);
     for (int c = 0; c < 3; c++) {
@@ -139,6 +139,11 @@ int pbrt_d_makenamedmedium(Parser *P, const Token *t)
                 r = FAIL_TOK(P, t, "nanovdb: expected a \"filename\"");
             else
                 r = pbrt_resolve(P, t, file, md.filename, sizeof md.filename);
+            /* the grids' names (pbrt-v4's gridname and temperaturename) */
+            snprintf(md.grids[0], sizeof md.grids[0], "%s",
+                     pbrt_get_string(&pl, "gridname", "density"));
+            snprintf(md.grids[1], sizeof md.grids[1], "%s",
+                     pbrt_get_string(&pl, "temperaturename", "temperature"));
         }
     }
     if (!r)
@@ -226,10 +231,11 @@ static int send_density(Parser *P, const Token *t, Medium *md)
         return pbrt_emit_pattern_in(P, t, md->m, md->pattern, "densitygrid", q, 6);
     }
     RayesParam q[3] = {{.name = "filename", .type = RAYES_PARAM_STRING, .string = md->filename},
-                       {.name = "grid", .type = RAYES_PARAM_STRING, .string = "temperature"},
+                       {.name = "grid", .type = RAYES_PARAM_STRING, .string = md->grids[0]},
                        {.name = "optional", .type = RAYES_PARAM_FLOAT, .value = {1}}};
-    if (pbrt_emit_pattern_in(P, t, md->m, md->pattern, "nanovdb", q, 1) != 0)
+    if (pbrt_emit_pattern_in(P, t, md->m, md->pattern, "nanovdb", q, 2) != 0)
         return -1;
+    q[1].string = md->grids[1];
     if (md->Lescale == 0.0f) /* no emission asked for: the grid is not read */
         return 0;
     /* its temperature grid, if the file has one (pbrt reads it if there) */

@@ -151,7 +151,8 @@ static void test_absorbing_slabs(void)
  * the same slab without the grid: linear in Lescale, red over green over
  * blue at 2000 K, near white and near 1 in luminance at 6500 K (its peak
  * in the visible), nothing at 200 K; a file without the grid emits
- * nothing and reads without a warning. */
+ * nothing and reads without a warning; grids of other names are found by
+ * gridname and temperaturename. */
 static void test_nanovdb_temperature(void)
 {
     mkdir(TMP, 0755);
@@ -161,18 +162,25 @@ static void test_nanovdb_temperature(void)
     const double o[3] = {-7, -7, 0};
     CHECK(nvdb_write(TMP "/dens.nvdb", "density", (const float(*)[8][8])d, 2.0, o) == 0);
     CHECK(nvdb_write(TMP "/temp.nvdb", "temperature", (const float(*)[8][8])t, 2.0, o) == 0);
-    /* one file of both grids: two segments */
-    FILE *out = fopen(TMP "/fire.nvdb", "wb");
-    for (int k = 0; k < 2 && out; k++) {
-        FILE *in = fopen(k ? TMP "/temp.nvdb" : TMP "/dens.nvdb", "rb");
-        char buf[8192];
-        size_t n;
-        while (in && (n = fread(buf, 1, sizeof buf, in)) > 0)
-            CHECK(fwrite(buf, 1, n, out) == n);
-        if (in)
-            fclose(in);
+    CHECK(nvdb_write(TMP "/smoke.nvdb", "smoke", (const float(*)[8][8])d, 2.0, o) == 0);
+    CHECK(nvdb_write(TMP "/heat.nvdb", "heat", (const float(*)[8][8])t, 2.0, o) == 0);
+    /* files of both grids: two segments */
+    static const char *const parts[2][3] = {
+        {TMP "/fire.nvdb", TMP "/dens.nvdb", TMP "/temp.nvdb"},
+        {TMP "/fire2.nvdb", TMP "/smoke.nvdb", TMP "/heat.nvdb"}};
+    for (int f = 0; f < 2; f++) {
+        FILE *out = fopen(parts[f][0], "wb");
+        for (int k = 0; k < 2 && out; k++) {
+            FILE *in = fopen(parts[f][1 + k], "rb");
+            char buf[8192];
+            size_t n;
+            while (in && (n = fread(buf, 1, sizeof buf, in)) > 0)
+                CHECK(fwrite(buf, 1, n, out) == n);
+            if (in)
+                fclose(in);
+        }
+        CHECK(out && fclose(out) == 0);
     }
-    CHECK(out && fclose(out) == 0);
     static const struct {
         const char *file, *params;
     } cases[] = {
@@ -182,6 +190,8 @@ static void test_nanovdb_temperature(void)
         {"fire.nvdb", "\"float Lescale\" 1 \"float temperaturescale\" 6.5"}, /* 6500 K */
         {"fire.nvdb", "\"float Lescale\" 1 \"float temperaturecutoff\" 900 "
                       "\"float temperaturescale\" 2"}, /* 200 K */
+        {"fire2.nvdb", "\"string gridname\" \"smoke\" \"string temperaturename\" \"heat\" "
+                       "\"float Lescale\" 1 \"float temperaturescale\" 2"}, /* 2000 K */
     };
     enum { N = sizeof cases / sizeof cases[0] };
     double rgb[N][3] = {{0}};
@@ -218,6 +228,8 @@ static void test_nanovdb_temperature(void)
         CHECK_NEAR(B[2][c], 2.0 * B[1][c], 2e-3 * rgb[2][c]); /* the floor's march noise */
         CHECK(fabs(B[4][c]) < 1e-4);
     }
+    for (int c = 0; c < 3; c++)
+        CHECK_NEAR(B[5][c], B[1][c], 1e-6 + 1e-3 * rgb[1][c]);
     double Y = 0.2126 * B[3][0] + 0.7152 * B[3][1] + 0.0722 * B[3][2];
     CHECK(Y > 0.8 && Y < 1.0);
     CHECK(fabs(B[3][0] - B[3][2]) < 0.15 * Y && fabs(B[3][1] - B[3][2]) < 0.15 * Y);
