@@ -468,13 +468,20 @@ static const char *surface_alias(const char *name)
     return name;
 }
 
-static int h_surface(Rib *r, const Args *a)
+/* A shader request's name and parameters (free *p); -1 on error. */
+static int shader_args(Rib *r, const Args *a, const char **name, Param **p, size_t *n)
 {
     size_t i = 0;
-    const char *name = rib_get_string(r, a, &i, "a shader name");
+    *name = rib_get_string(r, a, &i, "a shader name");
+    return *name && rib_get_params(r, a, i, p, n) == 0 ? 0 : -1;
+}
+
+static int h_surface(Rib *r, const Args *a)
+{
+    const char *name;
     Param *p;
     size_t n;
-    if (!name || rib_get_params(r, a, i, &p, &n) != 0)
+    if (shader_args(r, a, &name, &p, &n) != 0)
         return -1;
     static const Counts one = {1, 1, 1, 1};
     if (rib_check_counts(r, p, n, &one) != 0) {
@@ -504,11 +511,10 @@ static int h_surface(Rib *r, const Args *a)
 
 static int h_displacement(Rib *r, const Args *a)
 {
-    size_t i = 0;
-    const char *name = rib_get_string(r, a, &i, "a shader name");
+    const char *name;
     Param *p;
     size_t n;
-    if (!name || rib_get_params(r, a, i, &p, &n) != 0)
+    if (shader_args(r, a, &name, &p, &n) != 0)
         return -1;
     static const Counts one = {1, 1, 1, 1};
     if (rib_check_counts(r, p, n, &one) != 0) {
@@ -1335,11 +1341,10 @@ static size_t atmosphere_params(Rib *r, const char *name, const Param *p, size_t
  * "") none; others (depthcue among them) are skipped with one warning. */
 static int h_atmosphere(Rib *r, const Args *a)
 {
-    size_t i = 0;
-    const char *name = rib_get_string(r, a, &i, "a shader name");
+    const char *name;
     Param *p;
     size_t n;
-    if (!name || rib_get_params(r, a, i, &p, &n) != 0)
+    if (shader_args(r, a, &name, &p, &n) != 0)
         return -1;
     static const char *const own[] = {"homogeneous", "turbulence", NULL};
     static const char *const mapped[] = {"fog", "smoke", "noisysmoke", NULL};
