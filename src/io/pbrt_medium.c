@@ -55,8 +55,8 @@ static int medium_coefficients(Parser *P, ParamList *pl, Medium *md)
         pbrt_get_color(P, pl, "Le", zero, Le, NULL) < 0)
         return -1;
     float scale = (float)pbrt_get_float(pl, "scale", 1.0);
-    /* older pbrt-v4 spelled it LeScale; its temperature offset also
-     * temperatureoffset */
+    /* older pbrt-v4 spelled it LeScale, and the temperature offset
+     * temperaturecutoff (read when temperatureoffset is not given) */
     float Lescale = (float)pbrt_get_float(pl, "Lescale", pbrt_get_float(pl, "LeScale", 1.0));
     md->Lescale = Lescale;
     md->temp_offset = (float)pbrt_get_float(pl, "temperatureoffset",

@@ -867,7 +867,7 @@ static int casts_shadows(const char *name, const char *type, const Param *p, siz
         strcmp(type, "distantlight") != 0)
         return 1;
     if (strcmp(name, type) == 0)
-        return 0; /* the shadows of a shadow light's, or a stand-in's, map */
+        return 0; /* pointlight, spotlight, distantlight: none; the others by their map */
     for (size_t k = 0; k < n; k++) {
         const char *nm = p[k].d.name;
         int map =
@@ -923,7 +923,8 @@ static int h_light_source(Rib *r, const Args *a)
     if (rib_get_params(r, a, i, &p, &n) != 0)
         return -1;
     static const Counts one = {1, 1, 1, 1};
-    if (strcmp(name, "uberlight") == 0 || strcmp(name, "l_uber") == 0)
+    int l_uber = strcmp(name, "l_uber") == 0; /* Lancaster's, with Maya's controls */
+    if (strcmp(name, "uberlight") == 0 || l_uber)
         uber_declare(p, n);
     if (rib_check_counts(r, p, n, &one) != 0) {
         free(p);
@@ -943,7 +944,7 @@ static int h_light_source(Rib *r, const Args *a)
         type = "environmentlight";
     else if (strcmp(name, "arealight") == 0) /* rayes' own (what the writer writes) */
         type = "arealight";
-    else if (strcmp(name, "uberlight") == 0 || strcmp(name, "l_uber") == 0) /* Barzel's */
+    else if (strcmp(name, "uberlight") == 0 || l_uber) /* Barzel's */
         type = "uberlight";
     else if (in_list(environment_lights, name)) {
         /* Production environment and occlusion lights: an environment
@@ -1081,7 +1082,7 @@ static int h_light_source(Rib *r, const Args *a)
         }
         L->n++;
     }
-    int e = uber ? uber_params(r, L, p, n, strcmp(name, "l_uber") == 0) : 0;
+    int e = uber ? uber_params(r, L, p, n, l_uber) : 0;
     const Param *said = rib_find_param(p, n, "shadows");
     if (!uber && !(said && said->declared) &&
         (r->a.shadows < 0 || (r->a.shadows == 0 && !casts_shadows(name, type, p, n)))) {

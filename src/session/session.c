@@ -373,8 +373,10 @@ RayesError session_fail(RayesScene *scene, RayesError e, const char *msg)
 /* The render form of the scene's volumes: fine voxels about a pixel wide at
  * the box's nearest point to the eye (times the square root of its
  * shading rate, as grids are diced), their bricks' cache keys after the
- * grids'. Returns 0, or -1 when out of memory. */
-static int prepare_volumes(const RayesScene *scene, const RenderSettings *set, Prepared *p)
+ * grids'; an atmosphere's box is bounds (the scene's) and the eye. Returns 0,
+ * or -1 when out of memory. */
+static int prepare_volumes(const RayesScene *scene, const RenderSettings *set, Bounds3 bounds,
+                           Prepared *p)
 {
     if (!scene->n_volumes)
         return 0;
@@ -393,7 +395,7 @@ static int prepare_volumes(const RayesScene *scene, const RenderSettings *set, P
         Vec3 hi = v3(sv->bound[1], sv->bound[3], sv->bound[5]);
         Bounds3 wb = bounds_empty();
         if (sv->atmosphere) { /* the scene's bounds and the eye, a thousandth wider */
-            wb = bounds_add(scene_bounds(scene), cam.eye);
+            wb = bounds_add(bounds, cam.eye);
             Vec3 pad = v3_scale(v3(1, 1, 1), fmaxf(1e-3f * v3_length(v3_sub(wb.hi, wb.lo)), 1e-3f));
             wb.lo = v3_sub(wb.lo, pad), wb.hi = v3_add(wb.hi, pad);
             world_from_object = mat4_identity();
@@ -460,7 +462,7 @@ RayesError session_prepare(RayesScene *scene, const RenderSettings *set, Texture
     p->scene_radius = scene->n_prims || scene->n_volumes
                           ? fmaxf(0.5f * v3_length(v3_sub(b.hi, b.lo)), 1e-6f)
                           : 1.0f;
-    if (prepare_volumes(scene, set, p) != 0) {
+    if (prepare_volumes(scene, set, b, p) != 0) {
         session_prepared_fini(p);
         return session_fail(scene, RAYES_ERROR_OUT_OF_MEMORY,
                             "render: out of memory preparing the volumes");

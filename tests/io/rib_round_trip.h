@@ -101,4 +101,15 @@ static inline RayesImage *rib_render_text(const char *text, int size, int spp)
     return img;
 }
 
+/* The mean of channel c over the middle 2 half x 2 half pixels of a size
+ * x size image. */
+static inline double rib_image_middle(const RayesImage *img, int size, int half, int c)
+{
+    double t = 0;
+    for (int y = size / 2 - half; y < size / 2 + half; y++)
+        for (int x = size / 2 - half; x < size / 2 + half; x++)
+            t += img->rgba[4 * (y * size + x) + c];
+    return t / (4.0 * half * half);
+}
+
 #endif /* RAYES_TESTS_IO_RIB_ROUND_TRIP_H */

@@ -43,11 +43,7 @@ static RayesImage *render_atmosphere(const char *atmosphere)
 
 static double middle(const RayesImage *img, int c)
 {
-    double sum = 0;
-    for (int y = SIZE / 2 - 2; y < SIZE / 2 + 2; y++)
-        for (int x = SIZE / 2 - 2; x < SIZE / 2 + 2; x++)
-            sum += img->rgba[4 * (y * SIZE + x) + c];
-    return sum / 16.0;
+    return rib_image_middle(img, SIZE, 2, c);
 }
 
 /* Fog of distance 4 and a coloured background: the middle as the formula

@@ -47,11 +47,7 @@ static RayesImage *render_light(const char *light, const char *more)
 /* The mean of channel c over the middle 4 x 4 pixels. */
 static double middle(const RayesImage *img, int c)
 {
-    double t = 0;
-    for (int y = SIZE / 2 - 2; y < SIZE / 2 + 2; y++)
-        for (int x = SIZE / 2 - 2; x < SIZE / 2 + 2; x++)
-            t += img->rgba[4 * (y * SIZE + x) + c];
-    return t / 16.0;
+    return rib_image_middle(img, SIZE, 2, c);
 }
 
 static double pixel(const RayesImage *img, int x, int y)
