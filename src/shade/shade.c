@@ -379,6 +379,7 @@ void shade_run_opacity(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
     if (failed)
         return;
     cls->opacity(sv, &c, inst->params, out);
-    finite_outputs(cls, "opacity", ctx->n_points, out);
+    RayesShadeOutputs Oi = {NULL, out->Oi, NULL, NULL}; /* the method's one output */
+    finite_outputs(cls, "opacity", ctx->n_points, &Oi);
     free(scratch);
 }
