@@ -420,6 +420,40 @@ void cache_local_fini(CacheLocal *local)
     memset(local->counters, 0, sizeof local->counters);
 }
 
+/* Doubles s's hash table when it holds more entries than slots, so chains
+ * stay about one entry long: a table sized for a level's nominal entries
+ * (memo Figure 2's) held 8 a chain where a level borrowed the others'
+ * bytes for small entries (coarse fills of a dense mesh at 8 bounces:
+ * walking them was a fifth of the render). The new slots' bytes are
+ * counted like an entry's, and the table stays as it is when they do not
+ * fit the partition's budget. Caller holds s's lock. */
+static void table_grow(Shard *s)
+{
+    size_t n = s->n_slots, grown = 2 * n;
+    if (s->entries <= n || grown > ((size_t)1 << 24))
+        return;
+    uint64_t extra = (grown - n) * sizeof(CacheEntry *);
+    if (!part_add(s, extra, 1))
+        return;
+    CacheEntry **table = calloc(grown, sizeof *table);
+    if (!table) {
+        part_sub(s, extra);
+        return;
+    }
+    for (size_t i = 0; i < n; i++)
+        for (CacheEntry *e = s->table[i], *next; e; e = next) {
+            next = e->hnext;
+            CacheEntry **chain = &table[e->hash & (grown - 1)];
+            e->hnext = *chain;
+            *chain = e;
+        }
+    free(s->table);
+    s->table = table;
+    s->n_slots = grown;
+    s->bytes += extra;
+    s->peak = s->bytes > s->peak ? s->bytes : s->peak;
+}
+
 /* Finds a current entry and takes a reference (waiting until it is ready),
  * or inserts a new pinned, unready entry for the caller to fill (*inserted =
  * 1), or returns NULL if none fits. Drops a stale entry it meets. */
@@ -487,6 +521,7 @@ again:
         s->bytes += need;
         s->peak = s->bytes > s->peak ? s->bytes : s->peak;
         *inserted = 1;
+        table_grow(s);
     }
     pthread_mutex_unlock(&s->lock);
     return e;
@@ -584,6 +619,7 @@ void cache_get_stats(const Cache *cc, CacheStats *st)
                 st->entries[l] += sh->entries;
                 st->type_entries[t][l] += sh->entries; /* partition t's */
                 st->bytes[l] += sh->bytes;
+                st->slots[l] += sh->n_slots;
                 st->peak_bytes[l] += sh->peak;
                 for (int t = 0; t < CACHE_N_TYPES; t++)
                     st->counters[l][t].evictions += sh->evictions[t];

@@ -90,6 +90,8 @@ typedef struct CacheStats {
     uint64_t level_budget_bytes[CACHE_N_LEVELS];          /* these four: all types summed */
     uint64_t entries[CACHE_N_LEVELS];                     /* resident now */
     uint64_t bytes[CACHE_N_LEVELS];                       /* counted now */
+    uint64_t slots[CACHE_N_LEVELS]; /* hash slots now (8 bytes each, in bytes): a shard's table
+                                       doubles when its entries outnumber its slots */
     uint64_t peak_bytes[CACHE_N_LEVELS];                  /* sum of the shards' peaks (a
                                                        level may borrow past its share) */
     uint64_t type_budget_bytes[CACHE_N_TYPES];            /* the budget of the type's partition; */

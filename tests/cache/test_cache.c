@@ -615,7 +615,9 @@ static void test_budget_random(void)
                 counted += s.counters[l][t].lookups;
             /* nothing held, no bumps: exactly table + resident entries */
             if (!w.mixed_sizes)
-                CHECK(s.bytes[l] == s0.bytes[l] + s.entries[l] * cache_entry_bytes(level_n[l]));
+                CHECK(s.bytes[l] == s.slots[l] * sizeof(void *) +
+                                        s.entries[l] * cache_entry_bytes(level_n[l]));
+            CHECK(s.slots[l] >= s0.slots[l]);
         }
         CHECK(counted == lookups);
         cache_free(c);
@@ -695,6 +697,36 @@ static void test_levels_lend(void)
     }
     CHECK(refills == 0);
     check_counters_add_up(&s);
+    cache_free(c);
+}
+
+/* A level that borrows holds far more entries than its table was sized
+ * for: each shard's table doubles as its entries outnumber its slots, so a
+ * lookup walks chains of about one entry, and the slots' bytes are counted
+ * within the budget. */
+static void test_tables_grow(void)
+{
+    const uint64_t budget = 10000000;
+    Cache *c = cache_new(budget, split_default);
+    Filler f = {0};
+    CacheStats s0 = stats_of(c);
+    const uint32_t n = 60000; /* 6.2 MB of coarse entries: 2.5 times the share */
+    for (uint32_t i = 0; i < n; i++) {
+        CacheKey k = key_at(i, CACHE_COARSE);
+        lookup_once(c, &f, &k, 4, NULL);
+    }
+    CacheStats s = stats_of(c);
+    CHECK(s.entries[CACHE_COARSE] == n);
+    CHECK(s0.slots[CACHE_COARSE] < n / 2);
+    CHECK(s.slots[CACHE_COARSE] >= n && s.slots[CACHE_COARSE] <= 4 * n);
+    CHECK(s.bytes[CACHE_COARSE] == s.slots[CACHE_COARSE] * sizeof(void *) + n * cache_entry_bytes(4));
+    CHECK(budget_holds(&s));
+    int refills = 0; /* every entry is still found */
+    for (uint32_t i = 0; i < n; i++) {
+        CacheKey k = key_at(i, CACHE_COARSE);
+        refills += lookup_once(c, &f, &k, 4, NULL);
+    }
+    CHECK(refills == 0);
     cache_free(c);
 }
 
@@ -1005,7 +1037,7 @@ TEST_MAIN(TEST(test_hit_miss_counters), TEST(test_local_reuse), TEST(test_half_s
           TEST(test_n_values_honoured), TEST(test_keys_separate_every_field),
           TEST(test_random_keys_distinct), TEST(test_lru_matches_model),
           TEST(test_lru_touch_and_pin), TEST(test_unfittable_entry_evicts_nothing),
-          TEST(test_budget_random), TEST(test_budget_too_small), TEST(test_levels_lend),
+          TEST(test_budget_random), TEST(test_budget_too_small), TEST(test_levels_lend), TEST(test_tables_grow),
           TEST(test_bump_invalidates), TEST(test_bump_invalidates_private),
           TEST(test_old_entries_age_out), TEST(test_bump_replaces_in_place),
           TEST(test_waiters_share_one_fill), TEST(test_bump_during_fill_wakes_waiters),
