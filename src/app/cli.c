@@ -13,6 +13,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 #include "io/builtin.h"
 #include "io/scene_file.h"
@@ -115,7 +116,8 @@ static const char render_options[] =
     "                          8; even, 2 to 64)\n"
     "  --pointcloud-out FILE.ply  point-based GI: write the point cloud (binary PLY)\n"
     "  --texture-mb MB         texture cache budget in megabytes (default 64)\n"
-    "  --data DIR              data directory (teapot.bpt); default $RAYES_DATA\n"
+    "  --data DIR              data directory (teapot.bpt); default $RAYES_DATA, else\n"
+    "                          ../shared/data beside the checkout that built rayes\n"
     "  --shader-path DIRS      directories of shader plugins NAME.so, ':'-separated;\n"
     "                          searched before $RAYES_SHADER_PATH\n"
     "  --default-light         a headlight (a distant light along the view) when the\n"
@@ -143,7 +145,8 @@ static const char convert_text[] =
     "ASCII RIB (docs/convert.md says what is kept).\n"
     "\n"
     "options:\n"
-    "  --data DIR              data directory (teapot.bpt); default $RAYES_DATA\n"
+    "  --data DIR              data directory (teapot.bpt); default $RAYES_DATA, else\n"
+    "                          ../shared/data beside the checkout that built rayes\n"
     "  --frame N               the frame of a RIB file to read (default: the last)\n"
     "  --quiet                 no \"wrote OUT.rib\" line\n";
 
@@ -517,7 +520,28 @@ void parse_args(int argc, char **argv, Args *a)
     if (!a->scene)
         a->scene = "cornell";
     if (!a->data_dir)
-        a->data_dir = getenv("RAYES_DATA");
+        a->data_dir = default_data_dir();
+}
+
+const char *default_data_dir(void)
+{
+    const char *env = getenv("RAYES_DATA");
+    if (env)
+        return env;
+    static char dir[PATH_MAX + 32];
+    char exe[PATH_MAX];
+    ssize_t n = readlink("/proc/self/exe", exe, sizeof exe - 1);
+    if (n <= 0)
+        return NULL;
+    exe[n] = '\0';
+    char *slash = strrchr(exe, '/');
+    if (!slash)
+        return NULL;
+    *slash = '\0'; /* CHECKOUT/build: the data is CHECKOUT/../shared/data */
+    char probe[PATH_MAX + 64];
+    snprintf(dir, sizeof dir, "%s/../../shared/data", exe);
+    snprintf(probe, sizeof probe, "%s/teapot.bpt", dir);
+    return access(probe, R_OK) == 0 ? dir : NULL;
 }
 
 /* Builds the scene `scene` names (a scene file, else a built-in scene)

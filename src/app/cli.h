@@ -77,6 +77,11 @@ long parse_long(const char *opt, const char *s, long lo, long hi);
 /* Prints "rayes: MESSAGE" and the usage hint, exits with status 2. */
 void die_usage(const char *fmt, ...) __attribute__((noreturn, format(printf, 1, 2)));
 
+/* The data directory (teapot.bpt) when no --data gives one: $RAYES_DATA,
+ * else ../shared/data beside the checkout whose build/ holds this program
+ * (the benchmark data's place), when it holds teapot.bpt; else NULL. */
+const char *default_data_dir(void);
+
 /* Builds the scene `scene` names (a scene file, else a built-in scene)
  * into sink; settings receive what a file gives. */
 RayesError load_scene(const char *scene, const char *data_dir, int frame, const IoSink *sink,

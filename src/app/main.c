@@ -607,7 +607,7 @@ static int write_rib(RibWriter *w, const IoSettings *settings, const char *out)
 /* rayes convert IN OUT.rib [--data DIR] [--frame N] [--quiet] */
 static int cmd_convert(int argc, char **argv)
 {
-    const char *in = NULL, *out = NULL, *data_dir = getenv("RAYES_DATA");
+    const char *in = NULL, *out = NULL, *data_dir = default_data_dir();
     int frame = -1, quiet = 0;
     for (int i = 2; i < argc; i++) {
         const char *o = argv[i], *v = i + 1 < argc ? argv[i + 1] : NULL;

@@ -45,7 +45,7 @@ extern char **environ;
 /* What one run left behind. */
 typedef struct Run {
     int status;     /* exit status, or -1 if the child did not exit normally */
-    char out[8192]; /* stdout, NUL-terminated (truncated) */
+    char out[16384]; /* stdout, NUL-terminated (truncated) */
     char err[8192]; /* stderr, NUL-terminated (truncated) */
 } Run;
 
@@ -63,9 +63,9 @@ static void read_file(const char *path, char *buf, size_t size)
 /* Runs RAYES_BIN with argv (NULL-terminated, without the program name) in
  * SCRATCH_DIR, RAYES_DATA removed from the environment and set to data if
  * data is not NULL. */
-static void run(Run *r, const char *data, const char *const *argv)
+static void run_bin(Run *r, const char *bin, const char *data, const char *const *argv)
 {
-    const char *args[32] = {RAYES_BIN};
+    const char *args[32] = {bin};
     int n = 1;
     for (; argv[n - 1] && n < 31; n++)
         args[n] = argv[n - 1];
@@ -89,7 +89,7 @@ static void run(Run *r, const char *data, const char *const *argv)
         FILE *e = freopen(ERR_FILE, "w", stderr);
         if (!o || !e || chdir(SCRATCH_DIR) != 0)
             _exit(127);
-        execve(RAYES_BIN, (char *const *)args, (char *const *)env);
+        execve(bin, (char *const *)args, (char *const *)env);
         _exit(127);
     }
     int ws = 0;
@@ -98,6 +98,11 @@ static void run(Run *r, const char *data, const char *const *argv)
         r->status = WEXITSTATUS(ws);
     read_file(OUT_FILE, r->out, sizeof r->out);
     read_file(ERR_FILE, r->err, sizeof r->err);
+}
+
+static void run(Run *r, const char *data, const char *const *argv)
+{
+    run_bin(r, RAYES_BIN, data, argv);
 }
 
 static int count_char(const char *s, char c)
@@ -112,6 +117,20 @@ static int exists(const char *path)
 {
     struct stat st;
     return stat(path, &st) == 0;
+}
+
+static void copy_file(const char *from, const char *to)
+{
+    FILE *a = fopen(from, "rb"), *b = fopen(to, "wb");
+    char buf[65536];
+    size_t n;
+    while (a && b && (n = fread(buf, 1, sizeof buf, a)) > 0)
+        CHECK(fwrite(buf, 1, n, b) == n);
+    CHECK(a && b);
+    if (a)
+        fclose(a);
+    if (b)
+        fclose(b);
 }
 
 static long file_size(const char *path)
@@ -220,11 +239,26 @@ static void test_usage_errors(void)
     CHECK(!exists(SCRATCH_DIR "/nosuchscene.exr"));
 }
 
+/* Without --data or RAYES_DATA, the program finds ../shared/data beside
+ * the checkout that built it (where RAYES_TEST_DATA is); a copy elsewhere
+ * finds none and says where to point. */
 static void test_missing_data(void)
 {
+    static Run r;
     setup();
-    expect_error(1, NULL, ARGS("render", "cornell-teapots", "--res", "16", "--quiet"),
-                 ARGS("teapot.bpt", "--data"));
+    remove(SCRATCH_DIR "/cornell-teapots.exr");
+    run(&r, NULL, ARGS("render", "cornell-teapots", "--res", "8", "--spp", "1", "--quiet"));
+    CHECK(r.status == 0 && r.err[0] == '\0');
+    CHECK(file_size(SCRATCH_DIR "/cornell-teapots.exr") > 8);
+    remove(SCRATCH_DIR "/cornell-teapots.exr");
+    mkdir(SCRATCH_DIR "/bin", 0777);
+    copy_file(RAYES_BIN, SCRATCH_DIR "/bin/rayes");
+    chmod(SCRATCH_DIR "/bin/rayes", 0755);
+    run_bin(&r, SCRATCH_DIR "/bin/rayes", NULL,
+            ARGS("render", "cornell-teapots", "--res", "16", "--quiet"));
+    CHECK(r.status == 1 && count_char(r.err, '\n') == 1);
+    CHECK(strstr(r.err, "teapot.bpt") && strstr(r.err, "--data"));
+    remove(SCRATCH_DIR "/bin/rayes");
     expect_error(1, NULL,
                  ARGS("render", "cornell-teapots", "--res", "16", "--data",
                       SCRATCH_DIR "/no-such-dir"),
