@@ -725,6 +725,16 @@ static int h_skip(Rib *r, const Args *a)
     return 0;
 }
 
+/* ShadingInterpolation "smooth" is what rayes does (the grid hider
+ * interpolates its vertices' colours; the ray tracing hider shades every
+ * hit): nothing to say. "constant" (flat micropolygons) warns. */
+static int h_shading_interpolation(Rib *r, const Args *a)
+{
+    if (a->n == 1 && a->v[0].s && a->v[0].n == 1 && strcmp(a->v[0].s[0], "smooth") == 0)
+        return 0;
+    return h_skip(r, a);
+}
+
 /* Matte 0 is every surface's default: nothing to say; Matte 1 (a holdout)
  * is drawn as an ordinary surface, with one warning. */
 static int h_matte(Rib *r, const Args *a)
@@ -804,7 +814,7 @@ static const RibRequest own_requests[] = {
     {"DetailRange", h_detail_range},
     {"RelativeDetail", h_skip},
     {"GeometricApproximation", h_skip},
-    {"ShadingInterpolation", h_skip},
+    {"ShadingInterpolation", h_shading_interpolation},
     {"ShaderLayer", h_skip},
     {"ConnectShaderLayers", h_skip},
     {"Shader", h_skip},

@@ -1164,9 +1164,11 @@ static int h_illuminate(Rib *r, const Args *a)
     if (!L) {
         for (size_t k = 0; k < r->n_area_handles; k++)
             if (strcmp(r->area_handles[k], handle) == 0) {
-                rib_warn_once(r, "Illuminate area", "Illuminate of the area light %s is ignored: "
-                                                    "area lights light everything",
-                              rib_handle_name(handle));
+                if (on == 0) /* on, it says what rayes does already */
+                    rib_warn_once(r, "Illuminate area",
+                                  "Illuminate of the area light %s is ignored: "
+                                  "area lights light everything",
+                                  rib_handle_name(handle));
                 return 0;
             }
         /* a light skipped (a shader rayes does not have) or never given:

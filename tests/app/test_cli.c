@@ -678,6 +678,37 @@ static void test_light_shadows_attribute(void)
     }
 }
 
+/* Requests that say what rayes does draw no warning (ShadingInterpolation
+ * "smooth", Illuminate turning an area light on); their other forms say
+ * what is not done, once. */
+static void test_quiet_requests(void)
+{
+    static Run r;
+    setup();
+    static const char *const requests[4] = {"ShadingInterpolation \"smooth\"", "Illuminate 2 1",
+                                            "ShadingInterpolation \"constant\"", "Illuminate 2 0"};
+    for (int k = 0; k < 4; k++) {
+        char text[512];
+        snprintf(text, sizeof text,
+                 "Projection \"perspective\" \"fov\" 40\nWorldBegin\n"
+                 "LightSource \"pointlight\" 1 \"from\" [0 0 0]\n"
+                 "AttributeBegin\nAreaLightSource \"arealight\" 2\nTranslate 0 2 5\n"
+                 "Disk 0 0.5 360\nAttributeEnd\n%s\nTranslate 0 0 5\n"
+                 "Surface \"matte\"\nSphere 1 -1 1 360\nWorldEnd\n",
+                 requests[k]);
+        write_text(SCRATCH_DIR "/quiet.rib", text);
+        run(&r, NULL,
+            ARGS("render", SCRATCH_DIR "/quiet.rib", "--res", "16", "--spp", "1", "--quiet", "-o",
+                 SCRATCH_DIR "/quiet.png"));
+        CHECK(r.status == 0);
+        CHECK(k < 2 ? r.err[0] == '\0' : count_char(r.err, '\n') == 1);
+        if (k == 2)
+            CHECK(strstr(r.err, "ShadingInterpolation") != NULL);
+        if (k == 3)
+            CHECK(strstr(r.err, "Illuminate of the area light 2") != NULL);
+    }
+}
+
 /* A scene without lights: one warning naming the scene and the way out,
  * and a black image of a matte sphere; --default-light adds a headlight
  * that lights it. Without a Surface, RenderMan's defaultsurface draws it
@@ -937,5 +968,5 @@ TEST_MAIN(TEST(test_version_and_help), TEST(test_no_arguments), TEST(test_usage_
           TEST(test_png_curve), TEST(test_rib_opacity_cache_memory), TEST(test_vertex_budget),
           TEST(test_null_displacement), TEST(test_default_light), TEST(test_convert),
           TEST(test_bad_scene_file), TEST(test_frames_and_crop), TEST(test_background_imager),
-          TEST(test_display_modes), TEST(test_light_shadows_attribute),
+          TEST(test_display_modes), TEST(test_light_shadows_attribute), TEST(test_quiet_requests),
           TEST(test_res_width_keeps_aspect))
