@@ -80,6 +80,12 @@ typedef struct Worker {
     int has_medium;
     const struct RenderObject *shading; /* the object whose shader runs (its thin shadow is
                                            opaque to it: RAYES_SHADER_THIN_SHADOW) */
+    float split;                        /* the rays the path being traced has split into so far (a
+                                           glossy lobe's n at a camera hit: n), 1 at a camera ray
+                                           and in cache fills: a path's own hit under a split of m
+                                           traces n / m of its n diffuse and shadow rays (at least
+                                           1), so a lobe of 1024 rays does not trace 1024 x 1024
+                                           (services.c "split_rays") */
     GuideSlot guides[ENVGUIDE_LIGHTS];  /* environment lights' last guides (envguide.h) */
     const uint32_t *guide_pixels;       /* envguide_pixels's counts, or NULL: no guides (but
                                            the grid hider's) */

@@ -488,9 +488,10 @@ static void fill_radiosity(void *user, const CacheKey *key, size_t n, float (*ou
     /* A moving grid is shaded at its segment's middle, a still one at the
      * shutter's: its rays leave then, whichever ray's lookup filled it
      * (DESIGN.md "Motion blur"). */
-    float outer_time = w->time;
+    float outer_time = w->time, outer_split = w->split;
     const RenderObject *outer_shading = w->shading;
     const Camera *cam = &w->rs->camera;
+    w->split = 1.0f; /* a fill is the same whichever path asked */
     /* and as the grid's own object, whoever asked: a fill asked for by a
      * glass's refraction ray found that glass opaque to its shadow rays (a
      * floor seen through a pane was black, and the cache kept it) */
@@ -555,6 +556,7 @@ static void fill_radiosity(void *user, const CacheKey *key, size_t n, float (*ou
         w->stats.segment_fills[key->segment]++;
     fill_run(w, key->type, &ctx, obj, &fp, f3 + 9 * n, out);
     w->time = outer_time;
+    w->split = outer_split;
     w->shading = outer_shading;
     free(f3);
     free(f1);

@@ -527,7 +527,8 @@ int render_frame(const RenderScene *rs, const RenderSettings *set, float *rgba, 
     }
     uint32_t *pixels = guide_pixels(rs, set, threads);
     for (int i = 0; i < threads; i++) {
-        f.workers[i] = (Worker){.rs = rs,
+        f.workers[i] = (Worker){.split = 1.0f,
+                                .rs = rs,
                                 .set = set,
                                 .grid_shading = gsh,
                                 .services = &render_services,

@@ -8,7 +8,8 @@
  * them per bounce; the image keeps its expectation (1 for clear glass,
  * and the fully branched image's for tinted glass, whose paths end by
  * Russian roulette); a glossy lobe traces one ray past the branch
- * depth; and so does an uncached diffuse hit (a white furnace).
+ * depth; and so does an uncached diffuse hit (a white furnace); a path
+ * split into a glossy lobe's rays traces its share of diffuse rays.
  */
 #include <string.h>
 
@@ -161,5 +162,69 @@ static void test_uncached_diffuse_path(void)
     rayes_scene_release(s);
 }
 
-TEST_MAIN(TEST(test_uncached_diffuse_path), TEST(test_deep_glass_stays_a_path), TEST(test_same_expectation_as_branching),
+/* A rough glass ball filling the frame in a furnace whose wall (albedo
+ * 0.5, emitting 1) bounces light once, 64 diffuse rays a camera hit. The
+ * ball's reflection and refraction lobes take 64 rays each at the camera
+ * hit; each wall hit they reach is a path split 64 ways, so it traces
+ * 64 / 64 = 1 diffuse ray (and one shadow ray, were there lights), not
+ * 64: some 128 a camera ray rather than 8192. The image keeps the
+ * expectation of one ray a lobe and a hit. */
+static Result render_split(int diffuse_rays, int spp, uint64_t *diffuse)
+{
+    RayesScene *s = rayes_scene_new();
+    float eye[3] = {0, 0, -4}, target[3] = {0, 0, 0}, up[3] = {0, 1, 0};
+    rayes_scene_set_camera(s, eye, target, up, 20.0f);
+    RayesParam wall[3] = {
+        {"Kd", RAYES_PARAM_FLOAT, {0.5f, 0, 0}, NULL},
+        {"Ke", RAYES_PARAM_COLOR, {1, 1, 1}, NULL},
+        {"Cs", RAYES_PARAM_COLOR, {1, 1, 1}, NULL},
+    };
+    CHECK(rayes_scene_set_shader(s, "matte", wall, 3) == RAYES_OK);
+    CHECK(rayes_scene_sphere(s, 20.0f) == RAYES_OK);
+    RayesParam glass[2] = {
+        {"eta", RAYES_PARAM_FLOAT, {1.5f, 0, 0}, NULL},
+        {"roughness", RAYES_PARAM_FLOAT, {0.05f, 0, 0}, NULL},
+    };
+    CHECK(rayes_scene_set_shader(s, "glass", glass, 2) == RAYES_OK);
+    CHECK(rayes_scene_sphere(s, 1.0f) == RAYES_OK);
+    CHECK(rayes_scene_commit(s) == RAYES_OK);
+    RayesRenderOptions o;
+    rayes_render_options_init(&o, RAYES_QUALITY_PREVIEW);
+    o.width = o.height = 8;
+    o.spp = spp;
+    o.bounces = 1;
+    o.diffuse_rays = diffuse_rays;
+    o.threads = 2;
+    RayesImage *img = NULL;
+    RayesStats *st = NULL;
+    CHECK(rayes_render(s, &o, &img, &st) == RAYES_OK);
+    Result r = {0, 0, 0};
+    for (int i = 0; img && i < img->width * img->height; i++)
+        r.mean += img->rgba[4 * i];
+    r.mean /= img ? img->width * img->height : 1;
+    const RayesStat *cam = rayes_stats_find(st, "rays/camera");
+    const RayesStat *dif = rayes_stats_find(st, "rays/diffuse");
+    CHECK(cam && dif);
+    r.camera = cam ? cam->count : 0;
+    *diffuse = dif ? dif->count : 0;
+    rayes_stats_free(st);
+    rayes_image_free(img);
+    rayes_scene_release(s);
+    return r;
+}
+
+static void test_split_lobe_keeps_counts(void)
+{
+    uint64_t dif_split, dif_one;
+    Result split = render_split(64, 16, &dif_split);
+    Result one = render_split(1, 1024, &dif_one);
+    /* and the cache fills' 4 a point */
+    CHECK(dif_split <= split.camera * 3 * 64);
+    CHECK(dif_split >= split.camera * 64);
+    CHECK(split.mean > 1.2 && split.mean < 1.6);
+    CHECK_NEAR(split.mean / one.mean, 1.0, 0.02);
+}
+
+TEST_MAIN(TEST(test_split_lobe_keeps_counts), TEST(test_uncached_diffuse_path),
+          TEST(test_deep_glass_stays_a_path), TEST(test_same_expectation_as_branching),
           TEST(test_glossy_lobe_one_ray_deep))
