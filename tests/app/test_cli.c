@@ -653,6 +653,16 @@ static void test_null_displacement(void)
     CHECK(r.status == 0 && r.err[0] == '\0');
 }
 
+/* Renders RIB text at 16 x 16, 1 sample, into r; it must succeed. */
+static void render_rib_text(Run *r, const char *text)
+{
+    write_text(SCRATCH_DIR "/text.rib", text);
+    run(r, NULL,
+        ARGS("render", SCRATCH_DIR "/text.rib", "--res", "16", "--spp", "1", "--quiet", "-o",
+             SCRATCH_DIR "/text.png"));
+    CHECK(r->status == 0);
+}
+
 /* BMRT's Attribute "light" "shadows": "on" and "off" are read silently
  * (the lights that follow cast shadows or not), anything else warns. */
 static void test_light_shadows_attribute(void)
@@ -668,11 +678,7 @@ static void test_light_shadows_attribute(void)
                  "LightSource \"pointlight\" 1 \"from\" [0 0 0]\nTranslate 0 0 5\n"
                  "Surface \"matte\"\nSphere 1 -1 1 360\nWorldEnd\n",
                  values[k]);
-        write_text(SCRATCH_DIR "/shadows.rib", text);
-        run(&r, NULL,
-            ARGS("render", SCRATCH_DIR "/shadows.rib", "--res", "16", "--spp", "1", "--quiet", "-o",
-                 SCRATCH_DIR "/shadows.png"));
-        CHECK(r.status == 0);
+        render_rib_text(&r, text);
         /* "off" turns the lights' shadows off (tests/io/test_rib_uberlight.c) */
         CHECK(k == 2 ? strstr(r.err, "expected \"on\" or \"off\"") != NULL : r.err[0] == '\0');
     }
@@ -696,11 +702,7 @@ static void test_quiet_requests(void)
                  "Disk 0 0.5 360\nAttributeEnd\n%s\nTranslate 0 0 5\n"
                  "Surface \"matte\"\nSphere 1 -1 1 360\nWorldEnd\n",
                  requests[k]);
-        write_text(SCRATCH_DIR "/quiet.rib", text);
-        run(&r, NULL,
-            ARGS("render", SCRATCH_DIR "/quiet.rib", "--res", "16", "--spp", "1", "--quiet", "-o",
-                 SCRATCH_DIR "/quiet.png"));
-        CHECK(r.status == 0);
+        render_rib_text(&r, text);
         CHECK(k < 2 ? r.err[0] == '\0' : count_char(r.err, '\n') == 1);
         if (k == 2)
             CHECK(strstr(r.err, "ShadingInterpolation") != NULL);

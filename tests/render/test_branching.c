@@ -18,8 +18,33 @@
 
 typedef struct Result {
     double mean;          /* red channel over the image */
-    uint64_t camera, specular;
+    uint64_t camera, specular, diffuse;
 } Result;
+
+/* Commits and renders s with o on 2 threads, and releases it. */
+static Result run(RayesScene *s, RayesRenderOptions *o)
+{
+    CHECK(rayes_scene_commit(s) == RAYES_OK);
+    o->threads = 2;
+    RayesImage *img = NULL;
+    RayesStats *st = NULL;
+    CHECK(rayes_render(s, o, &img, &st) == RAYES_OK);
+    Result r = {0, 0, 0, 0};
+    for (int i = 0; img && i < img->width * img->height; i++)
+        r.mean += img->rgba[4 * i];
+    r.mean /= img ? img->width * img->height : 1;
+    const RayesStat *cam = rayes_stats_find(st, "rays/camera");
+    const RayesStat *spec = rayes_stats_find(st, "rays/specular");
+    const RayesStat *dif = rayes_stats_find(st, "rays/diffuse");
+    CHECK(cam && spec && dif);
+    r.camera = cam ? cam->count : 0;
+    r.specular = spec ? spec->count : 0;
+    r.diffuse = dif ? dif->count : 0;
+    rayes_stats_free(st);
+    rayes_image_free(img);
+    rayes_scene_release(s);
+    return r;
+}
 
 static void translate(RayesScene *s, float x, float y, float z)
 {
@@ -50,7 +75,6 @@ static Result render(int specular_depth, int branch_depth, float tint, float rou
         translate(s, 0.05f * (float)k, 0.0f, 0.0f);
         CHECK(rayes_scene_sphere(s, 1.0f - 0.3f * (float)k) == RAYES_OK);
     }
-    CHECK(rayes_scene_commit(s) == RAYES_OK);
     RayesRenderOptions o;
     rayes_render_options_init(&o, RAYES_QUALITY_PREVIEW);
     o.width = o.height = 16;
@@ -58,23 +82,7 @@ static Result render(int specular_depth, int branch_depth, float tint, float rou
     o.bounces = 0;
     o.specular_depth = specular_depth;
     o.branch_depth = branch_depth;
-    o.threads = 2;
-    RayesImage *img = NULL;
-    RayesStats *st = NULL;
-    CHECK(rayes_render(s, &o, &img, &st) == RAYES_OK);
-    Result r = {0, 0, 0};
-    for (int i = 0; img && i < img->width * img->height; i++)
-        r.mean += img->rgba[4 * i];
-    r.mean /= img ? img->width * img->height : 1;
-    const RayesStat *cam = rayes_stats_find(st, "rays/camera");
-    const RayesStat *spec = rayes_stats_find(st, "rays/specular");
-    CHECK(cam && spec);
-    r.camera = cam ? cam->count : 0;
-    r.specular = spec ? spec->count : 0;
-    rayes_stats_free(st);
-    rayes_image_free(img);
-    rayes_scene_release(s);
-    return r;
+    return run(s, &o);
 }
 
 static void test_deep_glass_stays_a_path(void)
@@ -137,29 +145,18 @@ static void test_uncached_diffuse_path(void)
     };
     CHECK(rayes_scene_set_shader(s, "matte", p, 3) == RAYES_OK);
     CHECK(rayes_scene_sphere(s, 10.0f) == RAYES_OK);
-    CHECK(rayes_scene_commit(s) == RAYES_OK);
     RayesRenderOptions o;
     rayes_render_options_init(&o, RAYES_QUALITY_PREVIEW);
     o.width = o.height = 16;
     o.spp = 4;
     o.bounces = 8;
     o.cache = 0;
-    o.threads = 2;
-    RayesImage *img = NULL;
-    RayesStats *st = NULL;
-    CHECK(rayes_render(s, &o, &img, &st) == RAYES_OK);
-    double sum = 0.0, expected = 0.0, ak = 1.0;
-    for (int i = 0; img && i < img->width * img->height; i++)
-        sum += img->rgba[4 * i];
+    Result r = run(s, &o);
+    double expected = 0.0, ak = 1.0;
     for (int k = 0; k <= 8; k++, ak *= a)
         expected += ak;
-    CHECK_NEAR(sum / (16 * 16) / expected, 1.0, 0.01);
-    const RayesStat *cam = rayes_stats_find(st, "rays/camera");
-    const RayesStat *dif = rayes_stats_find(st, "rays/diffuse");
-    CHECK(cam && dif && dif->count <= cam->count * (4 + 4 * 7));
-    rayes_stats_free(st);
-    rayes_image_free(img);
-    rayes_scene_release(s);
+    CHECK_NEAR(r.mean / expected, 1.0, 0.01);
+    CHECK(r.diffuse <= r.camera * (4 + 4 * 7));
 }
 
 /* A rough glass ball filling the frame in a furnace whose wall (albedo
@@ -169,7 +166,7 @@ static void test_uncached_diffuse_path(void)
  * 64 / 64 = 1 diffuse ray (and one shadow ray, were there lights), not
  * 64: some 128 a camera ray rather than 8192. The image keeps the
  * expectation of one ray a lobe and a hit. */
-static Result render_split(int diffuse_rays, int spp, uint64_t *diffuse)
+static Result render_split(int diffuse_rays, int spp)
 {
     RayesScene *s = rayes_scene_new();
     float eye[3] = {0, 0, -4}, target[3] = {0, 0, 0}, up[3] = {0, 1, 0};
@@ -187,40 +184,21 @@ static Result render_split(int diffuse_rays, int spp, uint64_t *diffuse)
     };
     CHECK(rayes_scene_set_shader(s, "glass", glass, 2) == RAYES_OK);
     CHECK(rayes_scene_sphere(s, 1.0f) == RAYES_OK);
-    CHECK(rayes_scene_commit(s) == RAYES_OK);
     RayesRenderOptions o;
     rayes_render_options_init(&o, RAYES_QUALITY_PREVIEW);
     o.width = o.height = 8;
     o.spp = spp;
     o.bounces = 1;
     o.diffuse_rays = diffuse_rays;
-    o.threads = 2;
-    RayesImage *img = NULL;
-    RayesStats *st = NULL;
-    CHECK(rayes_render(s, &o, &img, &st) == RAYES_OK);
-    Result r = {0, 0, 0};
-    for (int i = 0; img && i < img->width * img->height; i++)
-        r.mean += img->rgba[4 * i];
-    r.mean /= img ? img->width * img->height : 1;
-    const RayesStat *cam = rayes_stats_find(st, "rays/camera");
-    const RayesStat *dif = rayes_stats_find(st, "rays/diffuse");
-    CHECK(cam && dif);
-    r.camera = cam ? cam->count : 0;
-    *diffuse = dif ? dif->count : 0;
-    rayes_stats_free(st);
-    rayes_image_free(img);
-    rayes_scene_release(s);
-    return r;
+    return run(s, &o);
 }
 
 static void test_split_lobe_keeps_counts(void)
 {
-    uint64_t dif_split, dif_one;
-    Result split = render_split(64, 16, &dif_split);
-    Result one = render_split(1, 1024, &dif_one);
+    Result split = render_split(64, 16), one = render_split(1, 1024);
     /* and the cache fills' 4 a point */
-    CHECK(dif_split <= split.camera * 3 * 64);
-    CHECK(dif_split >= split.camera * 64);
+    CHECK(split.diffuse <= split.camera * 3 * 64);
+    CHECK(split.diffuse >= split.camera * 64);
     CHECK(split.mean > 1.2 && split.mean < 1.6);
     CHECK_NEAR(split.mean / one.mean, 1.0, 0.02);
 }
