@@ -768,7 +768,10 @@ static int uber_params(Rib *r, Light *L, const Param *p, size_t n, int l_uber)
         const Param *q = &p[k];
         const char *nm = q->d.name;
         int num = rib_is_num(q->v), str = !num && q->v->n == 1;
-        if (str && (strcmp(nm, "shadowmap") == 0 || strcmp(nm, "shadowname") == 0)) {
+        if (str && (strcmp(nm, "shadowmap") == 0 || strcmp(nm, "shadowname") == 0 ||
+                    (l_uber && strlen(nm) == 3 && nm[0] == 's' && strchr("pn", nm[1]) &&
+                     strchr("xyz", nm[2])))) {
+            /* l_uber's spx ... snz: a point light's six shadow maps */
             shadows |= q->v->s[0][0] != '\0';
         } else if (num && q->v->n == 1 && strcmp(nm, "raytraceshadow") == 0) {
             shadows |= q->v->d[0] != 0.0;
@@ -836,11 +839,18 @@ static int uber_params(Rib *r, Light *L, const Param *p, size_t n, int l_uber)
         }
     if (l_uber)
         cone_shape(L, p, n);
-    if (param_float(p, n, "falloff", 0.0) == 0.0 &&
-        !(param_float(p, n, "falloffdist", 1.0) > 0.0)) {
-        /* unused without falloff (l_uber writes 0) */
+    double falloff = param_float(p, n, "falloff", 0.0);
+    double falloffdist = param_float(p, n, "falloffdist", 1.0);
+    if ((falloff == 0.0 || l_uber) && !(falloffdist > 0.0)) {
+        /* unused without falloff (l_uber writes 0); with it, l_uber's law
+         * (1 / (d - falloffdist))^falloff is 1 / d^falloff, Barzel's with a
+         * falloffdist of 1 */
         static const float one[3] = {1, 0, 0};
         rib_light_param(L, "falloffdist", RAYES_PARAM_FLOAT, one, NULL);
+    } else if (l_uber && falloff != 0.0) {
+        rib_warn_once(r, "l_uber falloff",
+                      "l_uber: its distance falloff (1 / (d - falloffdist))^falloff is taken as "
+                      "Barzel's (falloffdist / d)^falloff");
     }
     if (!rib_find_param(p, n, "maxintensity")) { /* RenderMan's default 1: pi of rayes' */
         const float pi[3] = {(float)M_PI, 0, 0};

@@ -217,10 +217,11 @@ static void test_stand_in_lights(void)
 
 /* Lancaster's l_uber (Maya's lights through MTOR): its numeric lighttype
  * (0 spot, 3 directional), Maya's coneAngle (full width, degrees) a round
- * cone, sharp edges by default, and falloffdist 0 without falloff read
- * (it was an error). A 20 degree cone lights the middle of the floor 6
- * away (radius 1.06) but not the corners (2.2 away); a 60 degree one
- * both. */
+ * cone, sharp edges by default, and falloffdist 0 read (it was an error):
+ * unused without falloff, with it l_uber's (1 / (d - falloffdist))^falloff
+ * (MTOR writes 0: 1 / d^falloff). A 20 degree cone lights the middle of
+ * the floor 6 away (radius 1.06) but not the corners (2.2 away); a 60
+ * degree one both. Its six shadow maps (spx ... snz) turn shadows on. */
 static void test_l_uber(void)
 {
     RayesImage *narrow =
@@ -244,6 +245,23 @@ static void test_l_uber(void)
     rayes_image_free(narrow);
     rayes_image_free(wide);
     rayes_image_free(sun);
+    /* omni, linear falloff from the light: 36 / 6 under it */
+    RayesImage *fall = render_light("LightSource \"l_uber\" 1 \"float lighttype\" [1] \"float "
+                                    "falloff\" [1] \"float falloffdist\" [0] \"float intensity\" "
+                                    "[36]\n",
+                                    "");
+    CHECK(fall && fabs(middle(fall, 0) - 6.0) < 0.05);
+    rayes_image_free(fall);
+    const char *maps[] = {"", "\"string spx\" [\"\"] ", "\"string snz\" [\"p.shd6.tex\"] "};
+    for (int k = 0; k < 3; k++) {
+        char light[256];
+        snprintf(light, sizeof light,
+                 "LightSource \"l_uber\" 1 \"float lighttype\" [1] %s\"float intensity\" [6]\n",
+                 maps[k]);
+        RayesImage *img = render_light(light, SQUARE);
+        CHECK(img && (k == 2 ? middle(img, 0) == 0.0 : middle(img, 0) > 5.0));
+        rayes_image_free(img);
+    }
 }
 
 /* A blocker in the coordinate system "blk" (z = 3): the middle is dark,
