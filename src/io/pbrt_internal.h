@@ -185,7 +185,7 @@ typedef struct Object {
  * hidden object, the medium's volume inside it (pbrt_media_send). */
 typedef struct Medium {
     char name[128];
-    char type[16];       /* "homogeneous", "uniformgrid" or "nanovdb" */
+    char type[16];       /* "homogeneous", "uniformgrid", "cloud" or "nanovdb" */
     double m[16];        /* world_from_medium: the transform at MakeNamedMedium */
     float extinction[3]; /* (sigma_a + sigma_s) scale */
     float albedo[3];     /* sigma_s / (sigma_a + sigma_s) */
@@ -193,7 +193,8 @@ typedef struct Medium {
     float g;
     size_t res[3];            /* uniformgrid: nx ny nz */
     float *density;           /* uniformgrid: nx ny nz values, owned */
-    float p0[3], p1[3];       /* uniformgrid: the grid's box, medium space */
+    float p0[3], p1[3];       /* uniformgrid, cloud: the box, medium space */
+    float cloud[3];           /* cloud: density, wispiness, frequency */
     char filename[PBRT_PATH]; /* nanovdb: resolved */
     char grids[2][64];        /* nanovdb: its density and temperature grids' names */
     float Lescale;            /* nanovdb: the temperature grid's blackbody emission scale */

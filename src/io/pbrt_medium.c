@@ -72,6 +72,31 @@ static int medium_coefficients(Parser *P, ParamList *pl, Medium *md)
     return 0;
 }
 
+/* A box's p0 and p1 (default 0 0 0 and 1 1 1) for the type. */
+static int medium_box(Parser *P, const Token *t, ParamList *pl, Medium *md)
+{
+    const double *p0 = pbrt_get_point(pl, "p0"), *p1 = pbrt_get_point(pl, "p1");
+    for (int k = 0; k < 3; k++) {
+        md->p0[k] = p0 ? (float)p0[k] : 0.0f;
+        md->p1[k] = p1 ? (float)p1[k] : 1.0f;
+        if (!(md->p1[k] > md->p0[k]))
+            return FAIL_TOK(P, t, "%s: expected p0 below p1 on every axis", md->type);
+    }
+    return 0;
+}
+
+/* cloud's density, wispiness and frequency, and its box. */
+static int medium_cloud(Parser *P, const Token *t, ParamList *pl, Medium *md)
+{
+    md->cloud[0] = (float)pbrt_get_float(pl, "density", 1.0);
+    md->cloud[1] = (float)pbrt_get_float(pl, "wispiness", 1.0);
+    md->cloud[2] = (float)pbrt_get_float(pl, "frequency", 5.0);
+    for (int k = 0; k < 3; k++)
+        if (!isfinite(md->cloud[k]) || fabsf(md->cloud[k]) > 1e6f)
+            return FAIL_TOK(P, t, "cloud: expected density, wispiness and frequency within 1e6");
+    return medium_box(P, t, pl, md);
+}
+
 /* uniformgrid's nx ny nz, density, p0 and p1. */
 static int medium_grid(Parser *P, const Token *t, ParamList *pl, Medium *md)
 {
@@ -94,14 +119,7 @@ static int medium_grid(Parser *P, const Token *t, ParamList *pl, Medium *md)
         return FAIL_TOK(P, t, "out of memory");
     for (size_t i = 0; i < n; i++)
         md->density[i] = (float)d->num[i];
-    const double *p0 = pbrt_get_point(pl, "p0"), *p1 = pbrt_get_point(pl, "p1");
-    for (int k = 0; k < 3; k++) {
-        md->p0[k] = p0 ? (float)p0[k] : 0.0f;
-        md->p1[k] = p1 ? (float)p1[k] : 1.0f;
-        if (!(md->p1[k] > md->p0[k]))
-            return FAIL_TOK(P, t, "uniformgrid: expected p0 below p1 on every axis");
-    }
-    return 0;
+    return medium_box(P, t, pl, md);
 }
 
 int pbrt_d_makenamedmedium(Parser *P, const Token *t)
@@ -118,7 +136,7 @@ int pbrt_d_makenamedmedium(Parser *P, const Token *t)
     const char *type = pbrt_get_string(&pl, "type", "");
     int r = 0;
     if (strcmp(type, "homogeneous") != 0 && strcmp(type, "uniformgrid") != 0 &&
-        strcmp(type, "nanovdb") != 0) {
+        strcmp(type, "cloud") != 0 && strcmp(type, "nanovdb") != 0) {
         char key[96];
         snprintf(key, sizeof key, "medium %.60s", type);
         pbrt_warn_at(P, t->line, t->col, key,
@@ -133,6 +151,8 @@ int pbrt_d_makenamedmedium(Parser *P, const Token *t)
         r = medium_coefficients(P, &pl, &md);
         if (!r && strcmp(type, "uniformgrid") == 0)
             r = medium_grid(P, t, &pl, &md);
+        if (!r && strcmp(type, "cloud") == 0)
+            r = medium_cloud(P, t, &pl, &md);
         if (!r && strcmp(type, "nanovdb") == 0) {
             const char *file = pbrt_get_string(&pl, "filename", "");
             if (!file[0])
@@ -229,6 +249,13 @@ static int send_density(Parser *P, const Token *t, Medium *md)
              .floats = md->density,
              .n_floats = md->res[0] * md->res[1] * md->res[2]}};
         return pbrt_emit_pattern_in(P, t, md->m, md->pattern, "densitygrid", q, 6);
+    }
+    if (strcmp(md->type, "cloud") == 0) {
+        RayesParam q[3] = {
+            {.name = "density", .type = RAYES_PARAM_FLOAT, .value = {md->cloud[0]}},
+            {.name = "wispiness", .type = RAYES_PARAM_FLOAT, .value = {md->cloud[1]}},
+            {.name = "frequency", .type = RAYES_PARAM_FLOAT, .value = {md->cloud[2]}}};
+        return pbrt_emit_pattern_in(P, t, md->m, md->pattern, "cloud", q, 3);
     }
     RayesParam q[3] = {{.name = "filename", .type = RAYES_PARAM_STRING, .string = md->filename},
                        {.name = "grid", .type = RAYES_PARAM_STRING, .string = md->grids[0]},
@@ -362,7 +389,7 @@ static int send_bounded(Parser *P, Medium *md, const Token *t)
      * them into the medium where they leave it open stays in it to its next
      * surface, as in pbrt (a fog behind a room's front wall). */
     int r;
-    if (strcmp(md->type, "uniformgrid") == 0) {
+    if (strcmp(md->type, "uniformgrid") == 0 || strcmp(md->type, "cloud") == 0) {
         const float grid[6] = {md->p0[0], md->p1[0], md->p0[1], md->p1[1], md->p0[2], md->p1[2]};
         r = pbrt_emit_volume(P, t, md->m, q, n, grid, 1);
     } else {
@@ -443,6 +470,11 @@ int pbrt_medium_camera(Parser *P)
         return -1;
     RayesParam q[9];
     size_t n = medium_params(md, q);
+    if (strcmp(md->type, "uniformgrid") == 0 || strcmp(md->type, "cloud") == 0) {
+        /* their density is in their box alone (pbrt clips to it) */
+        const float grid[6] = {md->p0[0], md->p1[0], md->p0[1], md->p1[1], md->p0[2], md->p1[2]};
+        return pbrt_emit_volume(P, &t, md->m, q, n, grid, 0);
+    }
     double identity[16];
     pbrt_mat_identity(identity);
     return pbrt_emit_volume(P, &t, identity, q, n, box, 0);

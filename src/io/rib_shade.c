@@ -306,8 +306,9 @@ static const char *const builtin_surfaces[] = {
 static const char *const builtin_displacements[] = {"bumpy", "fractal", "displace", NULL};
 /* rayes' pattern classes (rayes_scene_pattern): pbrt-v4's textures. */
 static const char *const builtin_patterns[] = {
-    "constant", "scale",    "mix",   "directionmix", "checkerboard", "imagemap", "bilerp", "dots",
-    "fbm",      "wrinkled", "windy", "marble",       "densitygrid",  "nanovdb",  NULL};
+    "constant", "scale", "mix",      "directionmix", "checkerboard", "imagemap", "bilerp",
+    "dots",     "fbm",   "wrinkled", "windy",        "marble",       "cloud",    "densitygrid",
+    "nanovdb",  NULL};
 
 static int in_list(const char *const *list, const char *s)
 {

@@ -44,6 +44,7 @@ typedef enum PatternKind {
     PK_WRINKLED,
     PK_WINDY,
     PK_MARBLE,
+    PK_CLOUD,
     PK_DENSITYGRID,
     PK_NANOVDB
 } PatternKind;
@@ -129,6 +130,10 @@ static const ClassDesc classes[] = {
       {"roughness", 'n', 1, {.5f}},
       {"scale", 'n', 2, {1}},
       {"variation", 'n', 3, {.2f}}}},
+    {"cloud",
+     PK_CLOUD,
+     0,
+     {{"density", 'n', 0, {1}}, {"wispiness", 'n', 1, {1}}, {"frequency", 'n', 2, {5}}}},
     /* their parameters are read by make_grid */
     {"densitygrid", PK_DENSITYGRID, 0, {{NULL, 0, 0, {0}}}},
     {"nanovdb", PK_NANOVDB, 0, {{NULL, 0, 0, {0}}}},
@@ -684,6 +689,47 @@ static void eval_image(const Pattern *p, Eval *e, Rgb *out)
     }
 }
 
+/* The gradient of noise3 at q by forward differences (pbrt's DNoise). */
+static void noise_gradient(const float q[3], float g[3])
+{
+    const float h = 0.01f;
+    float n0 = noise3(q[0], q[1], q[2]);
+    g[0] = (noise3(q[0] + h, q[1], q[2]) - n0) / h;
+    g[1] = (noise3(q[0], q[1] + h, q[2]) - n0) / h;
+    g[2] = (noise3(q[0], q[1], q[2] + h) - n0) / h;
+}
+
+/* pbrt-v4's cloud medium's density at medium-space point q, in [0, 1]:
+ * five octaves of noise at the frequency, their lookup point stirred by
+ * two octaves of the noise's gradient (wispiness), thinning with height
+ * (y) and solid below y = 0.5 - 1/2 of the bottom. Every octave is
+ * evaluated: a density is sampled at points, its footprint the march's. */
+static float cloud_density(const Pattern *p, const float q[3])
+{
+    float density = p->num[0], wisp = p->num[1], freq = p->num[2];
+    float pp[3] = {freq * q[0], freq * q[1], freq * q[2]};
+    if (wisp > 0.0f) {
+        float omega = 0.05f * wisp, lambda = 10.0f;
+        for (int k = 0; k < 2; k++) {
+            float at[3] = {lambda * pp[0], lambda * pp[1], lambda * pp[2]}, g[3];
+            noise_gradient(at, g);
+            for (int c = 0; c < 3; c++)
+                pp[c] += omega * g[c];
+            omega *= 0.5f;
+            lambda *= NOISE_LACUNARITY;
+        }
+    }
+    float d = 0.0f, omega = 0.5f, lambda = 1.0f;
+    for (int k = 0; k < 5; k++) {
+        d += omega * noise3(lambda * pp[0], lambda * pp[1], lambda * pp[2]);
+        omega *= 0.5f;
+        lambda *= NOISE_LACUNARITY;
+    }
+    d = fminf(fmaxf((1.0f - q[1]) * 4.5f * density * d, 0.0f), 1.0f);
+    d += 2.0f * fmaxf(0.0f, 0.5f - q[1]);
+    return fminf(fmaxf(d, 0.0f), 1.0f);
+}
+
 static void eval_noise(const Pattern *p, const Eval *e, Rgb *out)
 {
     for (size_t i = 0; i < e->ctx->n_points; i++) {
@@ -691,6 +737,8 @@ static void eval_noise(const Pattern *p, const Eval *e, Rgb *out)
         point_at(p, e, i, q, dx, dy);
         if (p->kind == PK_FBM || p->kind == PK_WRINKLED) {
             grey(out[i], fractal(q, dx, dy, p->num[1], (int)p->num[0], p->kind == PK_WRINKLED));
+        } else if (p->kind == PK_CLOUD) {
+            grey(out[i], cloud_density(p, q));
         } else if (p->kind == PK_WINDY) {
             float q1[3], dx1[3], dy1[3];
             for (int k = 0; k < 3; k++)
@@ -749,6 +797,7 @@ static void eval_node(const Pattern *p, Eval *e, Rgb *out)
     case PK_WRINKLED:
     case PK_WINDY:
     case PK_MARBLE:
+    case PK_CLOUD:
         eval_noise(p, e, out);
         return;
     case PK_DENSITYGRID:

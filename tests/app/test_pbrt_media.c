@@ -144,6 +144,64 @@ static void test_absorbing_slabs(void)
     CHECK(open > 0.1);
 }
 
+/* pbrt-v4's "cloud" medium in the slab: its density is 1 where the
+ * medium's y is at most 0 (the cloud's solid bottom) and 0 at y >= 1, so
+ * moved there (a Translate before MakeNamedMedium) it absorbs as the
+ * homogeneous slab does, or not at all; between, its noise varies it over
+ * the floor (the spread of the centre's pixels) and it absorbs less than
+ * the solid bottom. Above y = 0.5 with a density of 0 it is empty (the
+ * noise's term, (1 - y) 4.5 density, is 0; above y = 1 it would be
+ * positive where the noise is negative, as in pbrt). Its density is in its
+ * box p0..p1 alone. */
+static void test_cloud(void)
+{
+    mkdir(TMP, 0755);
+    const char *shift[4] = {"50", "-50", "-0.3", "-0.3"}; /* medium y = world y - shift */
+    const char *density[4] = {"2", "0", "2", "2"};
+    const char *box[4] = {"[-50 -100 1] \"point3 p1\" [50 0 2]",
+                          "[-50 1 1] \"point3 p1\" [50 100 2]", "[-50 -1 1] \"point3 p1\" [50 1 2]",
+                          "[-50 -1 3] \"point3 p1\" [50 1 4]"};
+    double c[5], spread[5];
+    for (int k = 0; k < 5; k++) {
+        char media[2048], name[32], err_text[4096];
+        if (k < 4)
+            snprintf(
+                media, sizeof media,
+                "AttributeBegin\nTranslate 0 %s 0\n"
+                "MakeNamedMedium \"c\" \"string type\" \"cloud\" \"point3 p0\" %s\n"
+                "  \"rgb sigma_a\" [0.4 0.4 0.4] \"rgb sigma_s\" [0 0 0] \"float density\" %s\n"
+                "AttributeEnd\n"
+                "AttributeBegin\nMediumInterface \"c\" \"\"\nMaterial \"interface\"\n%s"
+                "AttributeEnd\n",
+                shift[k], box[k], density[k], box_shape);
+        else
+            snprintf(media, sizeof media, "# no medium\n");
+        snprintf(name, sizeof name, "cloud%d.pbrt", k);
+        write_scene(name, media);
+        float *img = render(name, err_text, sizeof err_text);
+        CHECK(img != NULL && strstr(err_text, "warning") == NULL);
+        c[k] = spread[k] = 0.0;
+        if (!img)
+            continue;
+        c[k] = centre(img);
+        float lo = INFINITY, hi = -INFINITY;
+        for (int y = RES / 2 - 4; y < RES / 2 + 4; y++)
+            for (int x = RES / 2 - 4; x < RES / 2 + 4; x++)
+                lo = fminf(lo, img[4 * (y * RES + x)]), hi = fmaxf(hi, img[4 * (y * RES + x)]);
+        spread[k] = hi - lo;
+        free(img);
+    }
+    double open = c[4], want = exp(-2.0 * 0.4);
+    fprintf(stderr,
+            "cloud: solid %g, empty %g, noise %g (spread %g), outside %g of the open floor\n",
+            c[0] / open, c[1] / open, c[2] / open, spread[2] / open, c[3] / open);
+    CHECK(open > 0.1);
+    CHECK(fabs(c[0] / open - want) < 0.01 * want); /* solid */
+    CHECK(fabs(c[1] / open - 1.0) < 0.005);        /* empty */
+    CHECK(c[2] / open > want + 0.02 && c[2] / open < 0.99 && spread[2] > 0.01 * open);
+    CHECK(fabs(c[3] / open - 1.0) < 0.005); /* the box misses the slab */
+}
+
 /* pbrt-v4's nanovdb temperature grid: the slab emits sigma_a Lescale B(T)
  * per unit length, T = (temperature - temperaturecutoff) *
  * temperaturescale and B Planck's spectrum over its peak, so the camera
@@ -475,5 +533,5 @@ static void test_undefined_medium(void)
     free(img);
 }
 
-TEST_MAIN(TEST(test_absorbing_slabs), TEST(test_nanovdb_temperature), TEST(test_camera_medium),
-          TEST(test_open_pieces), TEST(test_undefined_medium))
+TEST_MAIN(TEST(test_absorbing_slabs), TEST(test_cloud), TEST(test_nanovdb_temperature),
+          TEST(test_camera_medium), TEST(test_open_pieces), TEST(test_undefined_medium))
