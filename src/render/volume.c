@@ -29,6 +29,17 @@
  * renderers light volumes more coarsely than they sample extinction. */
 #define VOLUME_LIGHT_SAMPLES 16
 
+/* A march ends where the optical depth on every channel passes this:
+ * the transmittance is below 1e-4 there (exp(-9.21)), and what lies
+ * behind adds at most that much of itself (RenderMan's opacity
+ * threshold, at 0.9999). */
+#define VOLUME_TAU_CUTOFF 9.21f
+
+static int opaque_enough(Vec3 tau)
+{
+    return tau.x > VOLUME_TAU_CUTOFF && tau.y > VOLUME_TAU_CUTOFF && tau.z > VOLUME_TAU_CUTOFF;
+}
+
 uint32_t volume_init(RenderVolume *v, uint32_t object, const Mat4 *world_from_object, Vec3 lo,
                      Vec3 hi, float voxel, uint32_t key_base)
 {
@@ -384,14 +395,31 @@ static Vec3 extinction_cached(Worker *w, const RenderVolume *v, Vec3 q, float fo
     return v3(out[0], out[1], out[2]);
 }
 
-/* sigma_t at the march's samples into p->Oi (p holds the samples' points). */
-static void extinction_at(Worker *w, const RenderVolume *v, const Ray *ray, RayDiff diff,
-                          const March *m, VolumePoints *p)
+/* sigma_t at the march's samples into p->Oi (p holds the samples' points),
+ * up to the step where the march is opaque enough (VOLUME_TAU_CUTOFF):
+ * returns the count of steps before it and that one. Uncached, the
+ * shader runs on chunks of steps in turn. */
+static int extinction_at(Worker *w, const RenderVolume *v, const Ray *ray, RayDiff diff,
+                         const March *m, VolumePoints *p)
 {
     const RenderObject *obj = &w->rs->objects[v->object];
+    Vec3 tau = v3(0, 0, 0);
     if (!(w->set->opacity_cache && obj->opacity_cached)) {
-        run_extinction(w, obj, p, (size_t)m->n);
-        return;
+        enum { CHUNK = 64 };
+        for (int i0 = 0; i0 < m->n; i0 += CHUNK) {
+            int n = RY_MIN(CHUNK, m->n - i0);
+            VolumePoints part = *p; /* the chunk's points: p's arrays from i0 */
+            part.P += i0, part.N += i0, part.I += i0, part.Cs += i0, part.Os += i0;
+            part.Ci += i0, part.Oi += i0, part.u += i0, part.v += i0, part.s += i0;
+            part.keys += i0, part.diff += i0, part.back += i0;
+            run_extinction(w, obj, &part, (size_t)n);
+            for (int i = i0; i < i0 + n; i++) {
+                tau = v3_madd(tau, v3_load(p->Oi[i]), m->dl);
+                if (opaque_enough(tau))
+                    return i + 1;
+            }
+        }
+        return m->n;
     }
     float len = v3_length(ray->d);
     LastBrick last = LAST_BRICK_NONE;
@@ -404,13 +432,18 @@ static void extinction_at(Worker *w, const RenderVolume *v, const Ray *ray, RayD
                                    &last);
         for (int i = 0; i < m->n; i++)
             v3_store(p->Oi[i], s);
-        return;
+        return m->n;
     }
     for (int i = 0; i < m->n; i++) {
         float t = m->t0 + ((float)i + m->jitter) * m->dt;
-        v3_store(p->Oi[i], extinction_cached(w, v, v3_madd(q0, dq, t),
-                                             diff.width + diff.spread * t * len, &last));
+        Vec3 s =
+            extinction_cached(w, v, v3_madd(q0, dq, t), diff.width + diff.spread * t * len, &last);
+        v3_store(p->Oi[i], s);
+        tau = v3_madd(tau, s, m->dl);
+        if (opaque_enough(tau))
+            return i + 1;
     }
+    return m->n;
 }
 
 /* The step of lighting point j of n_light on a march of n steps: the
@@ -418,6 +451,53 @@ static void extinction_at(Worker *w, const RenderVolume *v, const Ray *ray, RayD
 static int light_step(int j, int n, int n_light)
 {
     return (int)(((float)j + 0.5f) * (float)n / (float)n_light);
+}
+
+/* The steps of a march's lighting points, increasing, into at[]; returns
+ * their count, at most n_light. With as many steps as points, every step.
+ * Else the middles of n_light strata of equal weight, a step's weight what
+ * it adds to the ray, T (1 - exp(-sigma_t dl)) (the mean over channels),
+ * a step holding several middles taken once: the points gather where the
+ * ray sees the medium, not in empty space or behind its opaque front
+ * (steps of equal count put most of them where they added nothing to a
+ * dense cloud, which came out 9% dark beside 512 points, 7.5% with its
+ * march cut at VOLUME_TAU_CUTOFF; now within noise). Where no step adds
+ * anything, strata of equal step counts (light_step). */
+static int light_steps(const VolumePoints *p, const March *m, int n_light, int *at)
+{
+    if (n_light >= m->n) {
+        for (int i = 0; i < m->n; i++)
+            at[i] = i;
+        return m->n;
+    }
+    double total = 0.0, tau = 0.0;
+    for (int i = 0; i < m->n; i++) {
+        double s = (double)(p->Oi[i][0] + p->Oi[i][1] + p->Oi[i][2]) / 3.0 * m->dl;
+        total += exp(-tau) * -expm1(-s);
+        tau += s;
+    }
+    if (!(total > 1e-12) || !isfinite(total)) {
+        for (int j = 0; j < n_light; j++)
+            at[j] = light_step(j, m->n, n_light);
+        return n_light;
+    }
+    int n = 0, j = 0;
+    double sum = 0.0;
+    tau = 0.0;
+    for (int i = 0; i < m->n && j < n_light; i++) {
+        double s = (double)(p->Oi[i][0] + p->Oi[i][1] + p->Oi[i][2]) / 3.0 * m->dl;
+        sum += exp(-tau) * -expm1(-s);
+        tau += s;
+        int taken = 0;
+        while (j < n_light && ((double)j + 0.5) / n_light * total <= sum) {
+            if (!taken++)
+                at[n++] = i;
+            j++;
+        }
+    }
+    if (n == 0) /* roundings left every middle past the last step */
+        at[n++] = m->n - 1;
+    return n;
 }
 
 /* Fills p with the march's sample points. */
@@ -451,10 +531,13 @@ static Vec3 optical_depth_cached(Worker *w, const RenderVolume *v, const Ray *ra
     Vec3 dq = mat4_vector(&v->object_from_world, ray->d), tau = v3(0, 0, 0);
     for (int i = 0; i < m->n; i++) {
         float t = m->t0 + ((float)i + m->jitter) * m->dt;
-        tau = v3_add(tau, extinction_cached(w, v, v3_madd(q0, dq, t),
-                                            diff.width + diff.spread * t * len, &last));
+        tau = v3_add(tau, v3_scale(extinction_cached(w, v, v3_madd(q0, dq, t),
+                                                     diff.width + diff.spread * t * len, &last),
+                                   m->dl));
+        if (opaque_enough(tau))
+            break; /* the steps beyond could only darken it further */
     }
-    return v3_scale(tau, m->dl);
+    return tau;
 }
 
 /* ----------------------------------------------------------- the rays */
@@ -490,12 +573,14 @@ Vec3 volume_transmittance(Worker *w, const Ray *ray, RayDiff diff)
                 VolumePoints p;
                 points_alloc(&p, (size_t)m.n);
                 march_points(v, obj, ray, &m, 0, diff, &p);
-                run_extinction(w, obj, &p, (size_t)m.n);
-                for (int i = 0; i < m.n; i++)
+                int n = extinction_at(w, v, ray, diff, &m, &p);
+                for (int i = 0; i < n; i++)
                     tau = v3_madd(tau, v3_load(p.Oi[i]), m.dl);
                 points_free(&p);
             }
             w->stats.volume_steps += (uint64_t)m.n;
+            if (opaque_enough(tau))
+                break;
         }
         T = v3_mul(T, v3_exp_neg(tau));
     }
@@ -515,16 +600,17 @@ static void segment_radiance(Worker *w, const RenderVolume *v, const Ray *ray, f
     VolumePoints p;
     points_alloc(&p, (size_t)m.n);
     march_points(v, obj, ray, &m, vkey, diff, &p);
-    extinction_at(w, v, ray, diff, &m, &p);
+    m.n = extinction_at(w, v, ray, diff, &m, &p); /* the steps before it is opaque enough */
     w->stats.volume_steps += (uint64_t)m.n;
-    int n_light = RY_MIN(m.n, VOLUME_LIGHT_SAMPLES);
     VolumePoints lp;
     if (scatter) {
-        /* The source at n_light of the steps, one per stratum of the
-         * segment; a step takes its stratum's. */
+        /* The source at n_light of the steps (light_steps), interpolated
+         * between them. */
+        int at[VOLUME_LIGHT_SAMPLES];
+        int n_light = light_steps(&p, &m, RY_MIN(m.n, VOLUME_LIGHT_SAMPLES), at);
         points_alloc(&lp, (size_t)n_light);
         for (int j = 0; j < n_light; j++) {
-            int i = light_step(j, m.n, n_light);
+            int i = at[j];
             memcpy(lp.P[j], p.P[i], sizeof lp.P[j]);
             memcpy(lp.N[j], p.N[i], sizeof lp.N[j]);
             memcpy(lp.I[j], p.I[i], sizeof lp.I[j]);
@@ -544,10 +630,10 @@ static void segment_radiance(Worker *w, const RenderVolume *v, const Ray *ray, f
          * lighting points (linearly: its error is second order) and
          * times each step's own extinction */
         for (int i = 0, j = 0; i < m.n; i++) {
-            while (j + 1 < n_light && light_step(j + 1, m.n, n_light) <= i)
+            while (j + 1 < n_light && at[j + 1] <= i)
                 j++;
-            int a = light_step(j, m.n, n_light), b = j + 1 < n_light ? j + 1 : j;
-            int ib = light_step(b, m.n, n_light);
+            int a = at[j], b = j + 1 < n_light ? j + 1 : j;
+            int ib = at[b];
             float f = ib > a ? fminf(fmaxf((float)(i - a) / (float)(ib - a), 0.0f), 1.0f) : 0.0f;
             for (int c = 0; c < 3; c++) {
                 float ra = lp.Oi[j][c] > 0.0f ? lp.Ci[j][c] / lp.Oi[j][c] : 0.0f;
