@@ -901,7 +901,7 @@ static void run_pass(Pass *p, const RayesShaderServices *services, RenderStats *
     RY_CHECK(p->workers != NULL);
     memset(p->workers, 0, (size_t)threads * sizeof *p->workers);
     for (int i = 0; i < threads; i++) {
-        p->workers[i] = (Worker){.rs = p->rs, .set = p->set, .services = services};
+        p->workers[i] = (Worker){.rs = p->rs, .set = p->set, .services = services, .split = 1.0f};
         if (p->set->cache)
             cache_local_init(&p->workers[i].cache, p->set->cache);
     }

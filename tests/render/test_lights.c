@@ -66,7 +66,7 @@ static void fx_init(Fx *f, RayesScene *s)
                           .n_lights = s->n_lights, .scene_radius = 10.0f};
     f->set = (RenderSettings){.width = 64, .height = 64, .spp = 1, .threads = 1,
                               .tile_size = 16, .shadow_rays = 16, .shadow_rays_deep = 16};
-    f->w = (Worker){.rs = &f->rs, .set = &f->set, .services = &render_services};
+    f->w = (Worker){.rs = &f->rs, .set = &f->set, .services = &render_services, .split = 1.0f};
 }
 
 static void fx_fini(Fx *f)
