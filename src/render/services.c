@@ -809,6 +809,32 @@ static Vec3 trace_specular(const RayesShadeCtx *ctx, size_t i, Vec3 d, uint64_t 
                             NULL);
 }
 
+/* A glossy lobe's rays when n were asked for a whole hemisphere (the
+ * depth-0 diffuse count): in proportion to the lobe's solid angle, about
+ * 4 pi alpha^2 about the mirror direction (GGX's width alpha; Blinn-Phong's
+ * exponent e as alpha^2 = 2 / (e + 2)), against the cosine-weighted
+ * hemisphere's pi, so that its rays lie as close together as n diffuse
+ * rays' and a bright patch in the lobe is met as often: n 4 alpha^2,
+ * at least GLOSSY_MIN_RAYS and at most n. The final preset's 1024 rays a
+ * lobe were 1024 for a near mirror too (Bitterli's veach-mis at 128 pixels,
+ * final: 27 s, 8.6 s now; docs/performance.md). */
+#define GLOSSY_MIN_RAYS 16
+
+/* n times the lobe's share of the hemisphere, share, within the bounds. */
+static int glossy_share(int n, float share)
+{
+    if (n <= GLOSSY_MIN_RAYS)
+        return n;
+    float m = ceilf((float)n * fminf(share, 1.0f));
+    return m < GLOSSY_MIN_RAYS ? GLOSSY_MIN_RAYS : m > (float)n ? n : (int)m;
+}
+
+static int glossy_ray_count(const Lobe *l, int n)
+{
+    float a2 = l->alpha > 0.0f ? l->alpha * l->alpha : 2.0f / (l->e + 2.0f);
+    return glossy_share(n, 4.0f * a2);
+}
+
 static void svc_indirect_specular(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
                                   const float (*dir)[3], const float *roughness, int n_rays,
                                   float (*out)[3])
@@ -839,6 +865,8 @@ static void svc_indirect_specular(const RayesShaderServices *sv, const RayesShad
         if (n > 1 && ctx->diffuse_depth + ctx->specular_depth >= w->set->branch_depth)
             n = 1; /* past the branch depth: one ray follows the lobe */
         float e = 1.0f / r;
+        if (n_rays <= 0) /* cos^e about d covers 2 pi / (e + 1) of the sphere */
+            n = glossy_share(n, 2.0f / (e + 1.0f));
         Vec3 Ng = v3_load(ctx->Ng[i]), sum = v3(0, 0, 0), t, b;
         v3_basis(d, &t, &b);
         CmjPattern pat;
@@ -881,15 +909,17 @@ static void glossy(const RayesShadeCtx *ctx, const float *width, int kind, int n
     direct_lighting(ctx, 0, NULL, width, kind, NULL, out);
     if (ctx->specular_depth >= w->set->specular_depth)
         return;
-    int n = n_rays > 0 ? n_rays
-            : ctx->diffuse_depth == 0 ? w->set->diffuse_rays
-                                      : w->set->diffuse_rays_deep;
-    if (n > 1 && ctx->diffuse_depth + ctx->specular_depth >= w->set->branch_depth)
-        n = 1; /* past the branch depth: one ray follows the lobe */
+    int n_all = n_rays > 0                ? n_rays
+                : ctx->diffuse_depth == 0 ? w->set->diffuse_rays
+                                          : w->set->diffuse_rays_deep;
+    if (n_all > 1 && ctx->diffuse_depth + ctx->specular_depth >= w->set->branch_depth)
+        n_all = 1; /* past the branch depth: one ray follows the lobe */
     for (size_t i = 0; i < ctx->n_points; i++) {
         Vec3 N = v3_load(ctx->N[i]), Ng = v3_load(ctx->Ng[i]), sum = v3(0, 0, 0);
         Lobe lobe = point_lobe(N, v3_neg(v3_load(ctx->I[i])), width, i, kind);
         uint64_t key = hash_combine(ps->keys[point(ctx, i)], DIM_SPECULAR);
+        /* a shader's own count is kept; the renderer's is the lobe's share */
+        int n = n_rays > 0 ? n_all : glossy_ray_count(&lobe, n_all);
         CmjPattern pat;
         cmj_pattern_init(&pat, (uint32_t)n, (uint32_t)key);
         SPLIT_BEGIN(w, n);

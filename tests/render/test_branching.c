@@ -9,8 +9,10 @@
  * and the fully branched image's for tinted glass, whose paths end by
  * Russian roulette); a glossy lobe traces one ray past the branch
  * depth; and so does an uncached diffuse hit (a white furnace); a path
- * split into a glossy lobe's rays traces its share of diffuse rays.
+ * split into a glossy lobe's rays traces its share of diffuse rays; a
+ * lobe takes its share of the hemisphere's rays.
  */
+#include <stdio.h>
 #include <string.h>
 
 #include "rayes/rayes.h"
@@ -193,6 +195,52 @@ static Result render_split(int diffuse_rays, int spp)
     return run(s, &o);
 }
 
+/* A rough copper ball filling the frame in a white furnace, 1024 diffuse
+ * rays a camera hit (final's), no bounces: its GGX lobe of width alpha
+ * takes 1024 times 4 alpha^2 rays (its share of the hemisphere), at least
+ * 16 and at most 1024: alpha 0.05 takes 16, 0.25 takes 256, 0.6 all 1024
+ * (a lobe's ray may leave below the surface: not traced); preview's 4 stay
+ * 4. The image is the same furnace within noise at every count. */
+static Result render_copper(float alpha, int diffuse_rays)
+{
+    RayesScene *s = rayes_scene_new();
+    float eye[3] = {0, 0, -4}, target[3] = {0, 0, 0}, up[3] = {0, 1, 0};
+    rayes_scene_set_camera(s, eye, target, up, 10.0f);
+    RayesParam wall[3] = {
+        {"Kd", RAYES_PARAM_FLOAT, {0, 0, 0}, NULL},
+        {"Ke", RAYES_PARAM_COLOR, {1, 1, 1}, NULL},
+        {"Cs", RAYES_PARAM_COLOR, {1, 1, 1}, NULL},
+    };
+    CHECK(rayes_scene_set_shader(s, "matte", wall, 3) == RAYES_OK);
+    CHECK(rayes_scene_sphere(s, 20.0f) == RAYES_OK);
+    RayesParam copper[1] = {{"roughness", RAYES_PARAM_FLOAT, {alpha * alpha, 0, 0}, NULL}};
+    CHECK(rayes_scene_set_shader(s, "conductor", copper, 1) == RAYES_OK);
+    CHECK(rayes_scene_sphere(s, 1.0f) == RAYES_OK);
+    RayesRenderOptions o;
+    rayes_render_options_init(&o, RAYES_QUALITY_PREVIEW);
+    o.width = o.height = 8;
+    o.spp = 4;
+    o.bounces = 0;
+    o.diffuse_rays = diffuse_rays;
+    return run(s, &o);
+}
+
+static void test_glossy_rays_by_width(void)
+{
+    const float alpha[3] = {0.05f, 0.25f, 0.6f};
+    const int want[3] = {16, 256, 1024};
+    for (int k = 0; k < 3; k++) {
+        Result r = render_copper(alpha[k], 1024), p = render_copper(alpha[k], 4);
+        double per = (double)r.specular / (double)r.camera;
+        fprintf(stderr, "alpha %g: %g lobe rays a camera ray (%d asked), mean %g; preview %g\n",
+                (double)alpha[k], per, want[k], r.mean, (double)p.specular / (double)p.camera);
+        CHECK(per <= want[k] && per > (k < 2 ? 0.9 : 0.6) * want[k]); /* wide: more below */
+        CHECK((double)p.specular / (double)p.camera <= 4.0);
+        CHECK(r.mean > 0.5 && r.mean < 1.0);
+        CHECK_NEAR(p.mean / r.mean, 1.0, 0.03);
+    }
+}
+
 static void test_split_lobe_keeps_counts(void)
 {
     Result split = render_split(64, 16), one = render_split(1, 1024);
@@ -203,6 +251,6 @@ static void test_split_lobe_keeps_counts(void)
     CHECK_NEAR(split.mean / one.mean, 1.0, 0.02);
 }
 
-TEST_MAIN(TEST(test_split_lobe_keeps_counts), TEST(test_uncached_diffuse_path),
-          TEST(test_deep_glass_stays_a_path), TEST(test_same_expectation_as_branching),
-          TEST(test_glossy_lobe_one_ray_deep))
+TEST_MAIN(TEST(test_glossy_rays_by_width), TEST(test_split_lobe_keeps_counts),
+          TEST(test_uncached_diffuse_path), TEST(test_deep_glass_stays_a_path),
+          TEST(test_same_expectation_as_branching), TEST(test_glossy_lobe_one_ray_deep))
