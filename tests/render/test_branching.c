@@ -48,6 +48,23 @@ static Result run(RayesScene *s, RayesRenderOptions *o)
     return r;
 }
 
+/* A scene seen from (0, 0, -4) over fov degrees, inside a furnace: a
+ * sphere of radius 20 emitting 1, of albedo kd. */
+static RayesScene *furnace(float kd, float fov)
+{
+    RayesScene *s = rayes_scene_new();
+    float eye[3] = {0, 0, -4}, target[3] = {0, 0, 0}, up[3] = {0, 1, 0};
+    rayes_scene_set_camera(s, eye, target, up, fov);
+    RayesParam wall[3] = {
+        {"Kd", RAYES_PARAM_FLOAT, {kd, 0, 0}, NULL},
+        {"Ke", RAYES_PARAM_COLOR, {1, 1, 1}, NULL},
+        {"Cs", RAYES_PARAM_COLOR, {1, 1, 1}, NULL},
+    };
+    CHECK(rayes_scene_set_shader(s, "matte", wall, 3) == RAYES_OK);
+    CHECK(rayes_scene_sphere(s, 20.0f) == RAYES_OK);
+    return s;
+}
+
 static void translate(RayesScene *s, float x, float y, float z)
 {
     float m[16] = {1, 0, 0, x, 0, 1, 0, y, 0, 0, 1, z, 0, 0, 0, 1};
@@ -57,16 +74,7 @@ static void translate(RayesScene *s, float x, float y, float z)
 /* tint: the glass's transmitcolor; roughness 0: smooth. */
 static Result render(int specular_depth, int branch_depth, float tint, float roughness, int spp)
 {
-    RayesScene *s = rayes_scene_new();
-    float eye[3] = {0, 0, -4}, target[3] = {0, 0, 0}, up[3] = {0, 1, 0};
-    rayes_scene_set_camera(s, eye, target, up, 30.0f);
-    RayesParam wall[3] = {
-        {"Kd", RAYES_PARAM_FLOAT, {0, 0, 0}, NULL},
-        {"Ke", RAYES_PARAM_COLOR, {1, 1, 1}, NULL},
-        {"Cs", RAYES_PARAM_COLOR, {1, 1, 1}, NULL},
-    };
-    CHECK(rayes_scene_set_shader(s, "matte", wall, 3) == RAYES_OK);
-    CHECK(rayes_scene_sphere(s, 20.0f) == RAYES_OK);
+    RayesScene *s = furnace(0.0f, 30.0f);
     RayesParam glass[3] = {
         {"eta", RAYES_PARAM_FLOAT, {1.5f, 0, 0}, NULL},
         {"transmitcolor", RAYES_PARAM_COLOR, {tint, tint, tint}, NULL},
@@ -170,16 +178,7 @@ static void test_uncached_diffuse_path(void)
  * expectation of one ray a lobe and a hit. */
 static Result render_split(int diffuse_rays, int spp)
 {
-    RayesScene *s = rayes_scene_new();
-    float eye[3] = {0, 0, -4}, target[3] = {0, 0, 0}, up[3] = {0, 1, 0};
-    rayes_scene_set_camera(s, eye, target, up, 20.0f);
-    RayesParam wall[3] = {
-        {"Kd", RAYES_PARAM_FLOAT, {0.5f, 0, 0}, NULL},
-        {"Ke", RAYES_PARAM_COLOR, {1, 1, 1}, NULL},
-        {"Cs", RAYES_PARAM_COLOR, {1, 1, 1}, NULL},
-    };
-    CHECK(rayes_scene_set_shader(s, "matte", wall, 3) == RAYES_OK);
-    CHECK(rayes_scene_sphere(s, 20.0f) == RAYES_OK);
+    RayesScene *s = furnace(0.5f, 20.0f);
     RayesParam glass[2] = {
         {"eta", RAYES_PARAM_FLOAT, {1.5f, 0, 0}, NULL},
         {"roughness", RAYES_PARAM_FLOAT, {0.05f, 0, 0}, NULL},
@@ -203,16 +202,7 @@ static Result render_split(int diffuse_rays, int spp)
  * 4. The image is the same furnace within noise at every count. */
 static Result render_copper(float alpha, int diffuse_rays)
 {
-    RayesScene *s = rayes_scene_new();
-    float eye[3] = {0, 0, -4}, target[3] = {0, 0, 0}, up[3] = {0, 1, 0};
-    rayes_scene_set_camera(s, eye, target, up, 10.0f);
-    RayesParam wall[3] = {
-        {"Kd", RAYES_PARAM_FLOAT, {0, 0, 0}, NULL},
-        {"Ke", RAYES_PARAM_COLOR, {1, 1, 1}, NULL},
-        {"Cs", RAYES_PARAM_COLOR, {1, 1, 1}, NULL},
-    };
-    CHECK(rayes_scene_set_shader(s, "matte", wall, 3) == RAYES_OK);
-    CHECK(rayes_scene_sphere(s, 20.0f) == RAYES_OK);
+    RayesScene *s = furnace(0.0f, 10.0f);
     RayesParam copper[1] = {{"roughness", RAYES_PARAM_FLOAT, {alpha * alpha, 0, 0}, NULL}};
     CHECK(rayes_scene_set_shader(s, "conductor", copper, 1) == RAYES_OK);
     CHECK(rayes_scene_sphere(s, 1.0f) == RAYES_OK);

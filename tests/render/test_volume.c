@@ -30,6 +30,18 @@ static RayesParam pc(const char *name, float r, float g, float b)
     return (RayesParam){name, RAYES_PARAM_COLOR, {r, g, b}, NULL};
 }
 
+/* A densitygrid pattern of 2 x 2 x 2 voxels of the one value sigma over
+ * x, y in [-30, 30] and z in [z0, z1]: a marched medium, unlike the
+ * constant's one step. */
+static void constant_grid(RayesScene *s, const char *name, float sigma, float z0, float z1)
+{
+    const float d[8] = {sigma, sigma, sigma, sigma, sigma, sigma, sigma, sigma};
+    RayesParam q[6] = {pf("nx", 2), pf("ny", 2), pf("nz", 2), pc("p0", -30, -30, z0),
+                       pc("p1", 30, 30, z1)};
+    q[5] = (RayesParam){"density", RAYES_PARAM_FLOATS, {0}, NULL, d, 8};
+    CHECK(rayes_scene_pattern(s, name, "densitygrid", q, 6) == RAYES_OK);
+}
+
 static RayesScene *new_scene(void)
 {
     RayesScene *s = rayes_scene_new();
@@ -111,11 +123,7 @@ static RayesImage *floor_under_grid_slab(int kind, float sigma, int cached)
         RayesParam q[1] = {{"filename", RAYES_PARAM_STRING, {0}, path}};
         CHECK(rayes_scene_pattern(s, "cloud", "nanovdb", q, 1) == RAYES_OK);
     } else {
-        const float d[8] = {sigma, sigma, sigma, sigma, sigma, sigma, sigma, sigma};
-        RayesParam q[6] = {pf("nx", 2), pf("ny", 2), pf("nz", 2), pc("p0", -30, -30, 7),
-                           pc("p1", 30, 30, 10)};
-        q[5] = (RayesParam){"density", RAYES_PARAM_FLOATS, {0}, NULL, d, 8};
-        CHECK(rayes_scene_pattern(s, "cloud", "densitygrid", q, 6) == RAYES_OK);
+        constant_grid(s, "cloud", sigma, 7, 10);
     }
     RayesParam v[2] = {{"density", RAYES_PARAM_PATTERN, {0}, "cloud"}, pc("albedo", 0, 0, 0)};
     CHECK(rayes_scene_set_shader(s, "homogeneous", v, 2) == RAYES_OK);
@@ -170,11 +178,7 @@ static void test_uniform_volume_one_step(void)
         floor_matte(s);
         RayesParam lp[2] = {pc("from", 0, 0, 20), pf("intensity", 400.0f)};
         CHECK(rayes_scene_light(s, "pointlight", lp, 2) == RAYES_OK);
-        const float d[8] = {0.5f, 0.5f, 0.5f, 0.5f, 0.5f, 0.5f, 0.5f, 0.5f};
-        RayesParam q[6] = {pf("nx", 2), pf("ny", 2), pf("nz", 2), pc("p0", -30, -30, 7),
-                           pc("p1", 30, 30, 10)};
-        q[5] = (RayesParam){"density", RAYES_PARAM_FLOATS, {0}, NULL, d, 8};
-        CHECK(rayes_scene_pattern(s, "cloud", "densitygrid", q, 6) == RAYES_OK);
+        constant_grid(s, "cloud", 0.5f, 7, 10);
         RayesParam v[2] = {grid ? (RayesParam){"density", RAYES_PARAM_PATTERN, {0}, "cloud"}
                                 : pf("density", 0.5f),
                            pc("albedo", 0, 0, 0)};
@@ -239,11 +243,7 @@ static RayesScene *marched_slab(float sigma)
     RayesScene *s = new_scene();
     RayesParam lp[3] = {pc("from", 0, 0, 1), pc("to", 0, 0, 0), pf("intensity", 10.0f)};
     CHECK(rayes_scene_light(s, "distantlight", lp, 3) == RAYES_OK);
-    const float d[8] = {sigma, sigma, sigma, sigma, sigma, sigma, sigma, sigma};
-    RayesParam q[6] = {pf("nx", 2), pf("ny", 2), pf("nz", 2), pc("p0", -30, -30, 0),
-                       pc("p1", 30, 30, 3)};
-    q[5] = (RayesParam){"density", RAYES_PARAM_FLOATS, {0}, NULL, d, 8};
-    CHECK(rayes_scene_pattern(s, "slab", "densitygrid", q, 6) == RAYES_OK);
+    constant_grid(s, "slab", sigma, 0, 3);
     RayesParam v[2] = {{"density", RAYES_PARAM_PATTERN, {0}, "slab"}, pc("albedo", 1, 1, 1)};
     CHECK(rayes_scene_set_shader(s, "homogeneous", v, 2) == RAYES_OK);
     const float box[6] = {-10, 10, -10, 10, 1, 2};
