@@ -270,6 +270,17 @@ static int send_density(Parser *P, const Token *t, Medium *md)
     return pbrt_emit_pattern_in(P, t, md->m, md->temperature, "nanovdb", q, 3);
 }
 
+/* A medium whose density lies in its box p0..p1 (medium space) alone:
+ * the box into grid, as the volume's bound takes it; 0 for the others. */
+static int own_box(const Medium *md, float grid[6])
+{
+    if (strcmp(md->type, "uniformgrid") != 0 && strcmp(md->type, "cloud") != 0)
+        return 0;
+    for (int k = 0; k < 3; k++)
+        grid[2 * k] = md->p0[k], grid[2 * k + 1] = md->p1[k];
+    return 1;
+}
+
 /* Grows box (world space; *have: it holds a point) by the Shape just read
  * (its bounds' corners under the CTM). */
 static void grow_box(const Parser *P, float *box, int *have)
@@ -389,8 +400,8 @@ static int send_bounded(Parser *P, Medium *md, const Token *t)
      * them into the medium where they leave it open stays in it to its next
      * surface, as in pbrt (a fog behind a room's front wall). */
     int r;
-    if (strcmp(md->type, "uniformgrid") == 0 || strcmp(md->type, "cloud") == 0) {
-        const float grid[6] = {md->p0[0], md->p1[0], md->p0[1], md->p1[1], md->p0[2], md->p1[2]};
+    float grid[6];
+    if (own_box(md, grid)) {
         r = pbrt_emit_volume(P, t, md->m, q, n, grid, 1);
     } else {
         r = pbrt_emit_volume(P, t, identity, q, n, box, 1);
@@ -470,11 +481,9 @@ int pbrt_medium_camera(Parser *P)
         return -1;
     RayesParam q[9];
     size_t n = medium_params(md, q);
-    if (strcmp(md->type, "uniformgrid") == 0 || strcmp(md->type, "cloud") == 0) {
-        /* their density is in their box alone (pbrt clips to it) */
-        const float grid[6] = {md->p0[0], md->p1[0], md->p0[1], md->p1[1], md->p0[2], md->p1[2]};
+    float grid[6];
+    if (own_box(md, grid)) /* pbrt clips them to it */
         return pbrt_emit_volume(P, &t, md->m, q, n, grid, 0);
-    }
     double identity[16];
     pbrt_mat_identity(identity);
     return pbrt_emit_volume(P, &t, identity, q, n, box, 0);

@@ -835,6 +835,19 @@ static int glossy_ray_count(const Lobe *l, int n)
     return glossy_share(n, 4.0f * a2);
 }
 
+/* The rays a glossy lobe is asked for: a shader's own n_rays, else the
+ * renderer's diffuse count for the depth (glossy_share's n), one past the
+ * branch depth. */
+static int lobe_rays(const Worker *w, const RayesShadeCtx *ctx, int n_rays)
+{
+    int n = n_rays > 0                ? n_rays
+            : ctx->diffuse_depth == 0 ? w->set->diffuse_rays
+                                      : w->set->diffuse_rays_deep;
+    if (n > 1 && ctx->diffuse_depth + ctx->specular_depth >= w->set->branch_depth)
+        n = 1; /* past the branch depth: one ray follows the lobe */
+    return n;
+}
+
 static void svc_indirect_specular(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
                                   const float (*dir)[3], const float *roughness, int n_rays,
                                   float (*out)[3])
@@ -859,11 +872,7 @@ static void svc_indirect_specular(const RayesShaderServices *sv, const RayesShad
         }
         /* A glossy lobe: directions with density proportional to cos^e of
          * their angle to d; those below the surface bring nothing. */
-        int n = n_rays > 0 ? n_rays
-                : ctx->diffuse_depth == 0 ? w->set->diffuse_rays
-                                          : w->set->diffuse_rays_deep;
-        if (n > 1 && ctx->diffuse_depth + ctx->specular_depth >= w->set->branch_depth)
-            n = 1; /* past the branch depth: one ray follows the lobe */
+        int n = lobe_rays(w, ctx, n_rays);
         float e = 1.0f / r;
         if (n_rays <= 0) /* cos^e about d covers 2 pi / (e + 1) of the sphere */
             n = glossy_share(n, 2.0f / (e + 1.0f));
@@ -909,11 +918,7 @@ static void glossy(const RayesShadeCtx *ctx, const float *width, int kind, int n
     direct_lighting(ctx, 0, NULL, width, kind, NULL, out);
     if (ctx->specular_depth >= w->set->specular_depth)
         return;
-    int n_all = n_rays > 0                ? n_rays
-                : ctx->diffuse_depth == 0 ? w->set->diffuse_rays
-                                          : w->set->diffuse_rays_deep;
-    if (n_all > 1 && ctx->diffuse_depth + ctx->specular_depth >= w->set->branch_depth)
-        n_all = 1; /* past the branch depth: one ray follows the lobe */
+    int n_all = lobe_rays(w, ctx, n_rays);
     for (size_t i = 0; i < ctx->n_points; i++) {
         Vec3 N = v3_load(ctx->N[i]), Ng = v3_load(ctx->Ng[i]), sum = v3(0, 0, 0);
         Lobe lobe = point_lobe(N, v3_neg(v3_load(ctx->I[i])), width, i, kind);
