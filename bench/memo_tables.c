@@ -156,6 +156,10 @@ static Row run(const Args *a, int size, int spp, int bounces, int cache, double 
     o.threads = a->threads;
     o.cache = cache;
     o.cache_mb = budget_mb;
+    /* the budget bounds the cache (Table 4): no other data type's to borrow
+     * (the memo's boxes have no volumes, subsurface or environment light) */
+    o.opacity_cache_mb = o.irradiance_cache_mb = 0.0;
+    o.env_guide = 0;
     o.cache_k = (float)a->cache_k;
     if (a->quality == RAYES_QUALITY_REFERENCE) {
         /* The memo's reference (Figure 5): 4096 diffuse and 64 shadow rays at
@@ -962,6 +966,8 @@ static RayesRenderOptions figure8_options(const Args *a, int size, int threads, 
     o.shadow_rays = a->shadow_rays;
     o.opacity_cache = opacity_cache;
     o.opacity_cache_mb = opacity_mb;
+    o.cache_mb = o.irradiance_cache_mb = 0.0; /* opacity_mb bounds the cache */
+    o.env_guide = 0;                          /* (no environment light) */
     return o;
 }
 

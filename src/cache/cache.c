@@ -15,15 +15,17 @@
  * if nobody holds it, it is freed at once, otherwise by its last release.
  * Its bytes stay counted until it is freed, so the budget is never exceeded.
  *
- * Lending: a shard's budget is its share of its level's (the split), and
- * every byte a shard counts is also taken from its partition's atomic
- * count, which never exceeds the partition's budget. A shard at its share
- * may go on past it with bytes the other levels leave unused (not its own
- * level's: those are its sibling shards'); a shard within its share that
- * finds the partition full takes its bytes back from shards past theirs
- * (reclaim, their least recently used entries first). So a level that
- * thrashes borrows what the others do not use, and gives it back as they
- * need it.
+ * Lending: a shard's budget is its share of its level's (the split) of its
+ * partition's (the type's), and every byte a shard counts is also taken
+ * from the cache's atomic count, which never exceeds the sum of the
+ * partitions' budgets (the pool). A shard at its share may go on past it
+ * with bytes the pool leaves unused: other levels' and other types' (not
+ * its own level's in its own partition: those are its sibling shards');
+ * a shard within its share that finds the pool full takes its bytes back
+ * from shards past theirs (reclaim, its own partition's first, their least
+ * recently used entries first). So a level or a type that thrashes
+ * borrows what the others do not use, and gives it back as they need it;
+ * a type within its budget is never evicted by another.
  *
  * Locks: one shard lock at a time; the fill function runs with no lock held
  * (it may look up other keys: a fill at diffuse depth d only looks up depth
@@ -64,8 +66,15 @@ static inline uint16_t *entry_values(CacheEntry *e)
     return (uint16_t *)(e + 1);
 }
 
-/* A partition's budget and what its shards count against it. */
+/* The bytes every partition counts against the sum of their budgets. */
+typedef struct Pool {
+    uint64_t budget;
+    atomic_uint_fast64_t used, peak;
+} Pool;
+
+/* A partition's budget (its share of the pool) and what its shards count. */
 typedef struct Part {
+    Pool *pool;
     uint64_t budget;
     atomic_uint_fast64_t used, peak;
     atomic_uint_fast64_t level_used[CACHE_N_LEVELS];
@@ -93,7 +102,7 @@ struct Cache {
     Shard shards[CACHE_N_TYPES][CACHE_N_LEVELS][CACHE_SHARDS];
     Part parts[CACHE_N_TYPES];
     uint8_t part_of[CACHE_N_TYPES];
-    uint64_t budget; /* all partitions */
+    Pool pool; /* all partitions */
     atomic_uint_fast64_t timestamp;
     pthread_mutex_t counters_lock;
     CacheCounters counters[CACHE_N_LEVELS][CACHE_N_TYPES];
@@ -124,27 +133,35 @@ static int key_equal(const CacheKey *a, const CacheKey *b)
            a->instance == b->instance;
 }
 
-/* Counts n more bytes of s against its partition; with take, only if they
- * fit its budget (returns 0 if not). Caller holds s's lock. */
+/* Counts n more bytes of s against its partition and the pool; with take,
+ * only if they fit the pool's budget (returns 0 if not). Caller holds s's
+ * lock. */
 static int part_add(Shard *s, uint64_t n, int take)
 {
     Part *p = s->part;
-    uint_fast64_t u = atomic_load(&p->used);
+    uint_fast64_t u = atomic_load(&p->pool->used);
     do {
-        if (take && u + n > p->budget)
+        if (take && u + n > p->pool->budget)
             return 0;
-    } while (!atomic_compare_exchange_weak(&p->used, &u, u + n));
-    uint_fast64_t peak = atomic_load(&p->peak);
-    while (u + n > peak && !atomic_compare_exchange_weak(&p->peak, &peak, u + n))
+    } while (!atomic_compare_exchange_weak(&p->pool->used, &u, u + n));
+    uint_fast64_t peak = atomic_load(&p->pool->peak);
+    while (u + n > peak && !atomic_compare_exchange_weak(&p->pool->peak, &peak, u + n))
+        ;
+    uint_fast64_t now = atomic_fetch_add(&p->used, n) + n;
+    peak = atomic_load(&p->peak);
+    while (now > peak && !atomic_compare_exchange_weak(&p->peak, &peak, now))
         ;
     atomic_fetch_add(&p->level_used[s->level], n);
     return 1;
 }
 
+/* The pool's count last, as part_add's first: the partitions' counts
+ * never sum past the pool's, nor their peaks past its budget. */
 static void part_sub(Shard *s, uint64_t n)
 {
-    atomic_fetch_sub(&s->part->used, n);
     atomic_fetch_sub(&s->part->level_used[s->level], n);
+    atomic_fetch_sub(&s->part->used, n);
+    atomic_fetch_sub(&s->part->pool->used, n);
 }
 
 /* Returns 0, or -1 when out of memory. */
@@ -200,10 +217,14 @@ static Cache *cache_new_parts(const uint64_t budget_bytes[CACHE_N_TYPES],
     int failed = 0;
     atomic_init(&c->timestamp, 1);
     pthread_mutex_init(&c->counters_lock, NULL);
+    atomic_init(&c->pool.used, 0);
+    atomic_init(&c->pool.peak, 0);
+    for (int t = 0; t < CACHE_N_TYPES; t++)
+        c->pool.budget += budget_bytes[t];
     for (int t = 0; t < CACHE_N_TYPES; t++) {
         Part *p = &c->parts[t];
+        p->pool = &c->pool;
         p->budget = budget_bytes[t];
-        c->budget += budget_bytes[t];
         atomic_init(&p->used, 0);
         atomic_init(&p->peak, 0);
         for (int l = 0; l < CACHE_N_LEVELS; l++) {
@@ -305,14 +326,14 @@ static void evict_lru(Shard *s)
     entry_free(s, victim);
 }
 
-/* What a shard past its share may borrow: bytes of the partition's budget
- * that neither are used nor belong to its own level's unused share. */
+/* What a shard past its share may borrow: bytes of the pool that neither
+ * are used nor belong to its own level's unused share in its partition. */
 static int may_borrow(const Shard *s, uint64_t need)
 {
     Part *p = s->part;
-    uint64_t used = atomic_load(&p->used), level = atomic_load(&p->level_used[s->level]);
+    uint64_t used = atomic_load(&p->pool->used), level = atomic_load(&p->level_used[s->level]);
     uint64_t own_unused = level < p->level_budget[s->level] ? p->level_budget[s->level] - level : 0;
-    return used + need + own_unused <= p->budget;
+    return used + need + own_unused <= p->pool->budget;
 }
 
 /* Counts need more bytes in s: within its share, or borrowed, or in place
@@ -337,23 +358,26 @@ static int take_room(Shard *s, uint64_t need, int *reclaim)
     }
 }
 
-/* Evicts least recently used entries of partition p's shards past their
- * share until need bytes are freed or none is past. Holds no lock but one
- * shard's at a time. */
+/* Evicts least recently used entries of shards past their share, partition
+ * p's first, then the other partitions' in order, until need bytes are
+ * freed or none is past. Holds no lock but one shard's at a time. */
 static void reclaim(Cache *c, const Part *p, uint64_t need)
 {
     uint64_t freed = 0;
-    Shard(*part)[CACHE_SHARDS] = c->shards[p - c->parts]; /* partition t: shards[t] */
-    for (int l = 0; l < CACHE_N_LEVELS && freed < need; l++)
-        for (int i = 0; i < CACHE_SHARDS && freed < need; i++) {
-            Shard *s = &part[l][i];
-            pthread_mutex_lock(&s->lock);
-            while (s->bytes > s->budget && s->lru.next != &s->lru && freed < need) {
-                freed += cache_entry_bytes(s->lru.next->n_values);
-                evict_lru(s);
+    int own = (int)(p - c->parts);
+    for (int k = 0; k < CACHE_N_TYPES && freed < need; k++) {
+        Shard(*part)[CACHE_SHARDS] = c->shards[(own + k) % CACHE_N_TYPES]; /* partition t */
+        for (int l = 0; l < CACHE_N_LEVELS && freed < need; l++)
+            for (int i = 0; i < CACHE_SHARDS && freed < need; i++) {
+                Shard *s = &part[l][i];
+                pthread_mutex_lock(&s->lock);
+                while (s->bytes > s->budget && s->lru.next != &s->lru && freed < need) {
+                    freed += cache_entry_bytes(s->lru.next->n_values);
+                    evict_lru(s);
+                }
+                pthread_mutex_unlock(&s->lock);
             }
-            pthread_mutex_unlock(&s->lock);
-        }
+    }
 }
 
 /* Drops a reference. Caller does not hold the shard lock. */
@@ -603,7 +627,8 @@ void cache_get_stats(const Cache *cc, CacheStats *st)
 {
     Cache *c = (Cache *)cc;
     memset(st, 0, sizeof *st);
-    st->budget_bytes = c->budget;
+    st->budget_bytes = c->pool.budget;
+    st->peak_total_bytes = atomic_load(&c->pool.peak);
     pthread_mutex_lock(&c->counters_lock);
     memcpy(st->counters, c->counters, sizeof st->counters);
     pthread_mutex_unlock(&c->counters_lock);

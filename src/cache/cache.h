@@ -6,7 +6,8 @@
  * Structure (memo 3.1, DESIGN.md "The multiresolution cache"):
  *  - per data type (radiosity, opacity, irradiance: memo 6, one cache whose
  *    keys carry the type; and rayes's environment guides) a budget of its
- *    own, and within it
+ *    own (a type past it borrows what the others leave unused, until they
+ *    need it back), and within it
  *  - three resolutions (COARSE, MEDIUM, FINE), each with its own share of the
  *    byte budget (default 25% / 25% / 50% of 100 MB; a resolution past its
  *    share borrows what the others leave unused, until they need it back)
@@ -87,6 +88,7 @@ typedef struct CacheCounters {
 
 typedef struct CacheStats {
     uint64_t budget_bytes;                                /* whole budget, all types */
+    uint64_t peak_total_bytes;                            /* all types', at its peak */
     uint64_t level_budget_bytes[CACHE_N_LEVELS];          /* these four: all types summed */
     uint64_t entries[CACHE_N_LEVELS];                     /* resident now */
     uint64_t bytes[CACHE_N_LEVELS];                       /* counted now */
@@ -97,18 +99,21 @@ typedef struct CacheStats {
     uint64_t type_budget_bytes[CACHE_N_TYPES];            /* the budget of the type's partition; */
     uint64_t type_entries[CACHE_N_TYPES][CACHE_N_LEVELS]; /* these two: partition t's (the
                                                        type's in a cache_new_typed cache) */
-    uint64_t type_peak_bytes[CACHE_N_TYPES]; /* the partition's peak, within its budget */
+    uint64_t type_peak_bytes[CACHE_N_TYPES]; /* the partition's peak (past its budget when it
+                                                borrowed the others') */
     CacheCounters counters[CACHE_N_LEVELS][CACHE_N_TYPES];
 } CacheStats;
 
 /* A new cache whose data type t has budget_bytes[t], split among the
  * resolutions by fractions split[level] (summing to at most 1; a level
  * whose share is full borrows what the others leave unused, and gives it
- * back as they need it): entries of
- * one type never evict another's (the radiosity budget is the user's
- * "cache size", the opacity budget RenderMan's "opacitycachememory"). A
- * type of budget 0 fills a private entry at every lookup. Returns NULL
- * when out of memory. */
+ * back as they need it). Types lend the same way: a type past its budget
+ * borrows what the other types leave unused, and gives it back as they
+ * need it, so the cache holds at most the budgets' sum and entries of a
+ * type within its budget are never evicted by another's (the radiosity
+ * budget is the user's "cache size", the opacity budget RenderMan's
+ * "opacitycachememory"). A type of budget 0 borrows nothing: it fills a
+ * private entry at every lookup. Returns NULL when out of memory. */
 Cache *cache_new_typed(const uint64_t budget_bytes[CACHE_N_TYPES],
                        const float split[CACHE_N_LEVELS]);
 /* A cache whose types all share one budget (entries of any type may evict

@@ -168,6 +168,7 @@ void session_stats_add_cache(RayesStats *s, const CacheStats *cs)
          "cache/fine/evictions", "cache/fine/entries", "cache/fine/bytes", "cache/fine/hit_rate"},
     };
     count(s, "cache/budget_bytes", cs->budget_bytes);
+    count(s, "cache/peak_bytes", cs->peak_total_bytes);
     for (int l = 0; l < CACHE_N_LEVELS; l++) {
         const CacheCounters *c = &cs->counters[l][CACHE_RADIOSITY];
         count(s, names[l][0], c->lookups);
@@ -226,6 +227,8 @@ static void session_stats_add_cache_types(RayesStats *s, const CacheStats *cs)
     static const char *const budgets[4] = {
         "cache/radiosity/budget_bytes", "cache/opacity/budget_bytes",
         "cache/irradiance/budget_bytes", "cache/guide/budget_bytes"};
+    static const char *const peaks[4] = {"cache/radiosity/peak_bytes", "cache/opacity/peak_bytes",
+                                         "cache/irradiance/peak_bytes", "cache/guide/peak_bytes"};
     for (int k = 0; k < 4; k++) {
         int t = types[k];
         uint64_t lookups = 0;
@@ -234,6 +237,7 @@ static void session_stats_add_cache_types(RayesStats *s, const CacheStats *cs)
         if (cs->type_budget_bytes[t] == 0 && lookups == 0)
             continue;
         count(s, budgets[k], cs->type_budget_bytes[t]);
+        count(s, peaks[k], cs->type_peak_bytes[t]); /* past the budget: it borrowed */
         for (int l = 0; l < CACHE_N_LEVELS; l++) {
             const CacheCounters *c = &cs->counters[l][t];
             const char *const *n = typed_names[k][l];

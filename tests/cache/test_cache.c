@@ -122,8 +122,9 @@ static int budget_holds(const CacheStats *s)
     for (int l = 0; l < CACHE_N_LEVELS; l++)
         bytes += s->bytes[l];
     for (int t = 0; t < CACHE_N_TYPES; t++)
-        peak += s->type_peak_bytes[t];
-    return bytes <= s->budget_bytes && peak <= s->budget_bytes;
+        peak = s->type_peak_bytes[t] > peak ? s->type_peak_bytes[t] : peak;
+    return bytes <= s->budget_bytes && s->peak_total_bytes <= s->budget_bytes &&
+           peak <= s->peak_total_bytes;
 }
 
 static void sleep_us(long us)
@@ -700,6 +701,59 @@ static void test_levels_lend(void)
     cache_free(c);
 }
 
+/* A data type whose budget is full borrows what the other types leave
+ * unused: opacity entries alone go far past opacity's budget; radiosity
+ * entries then take back what their budget needs (opacity ones evicted)
+ * and stay; a type of budget 0 borrows nothing (its lookups fill
+ * privately); the pool holds all along. */
+static void test_types_lend(void)
+{
+    uint64_t budgets[CACHE_N_TYPES] = {0};
+    budgets[CACHE_RADIOSITY] = 400000;
+    budgets[CACHE_OPACITY] = 100000;
+    Cache *c = cache_new_typed(budgets, split_default);
+    Filler f = {0};
+    uint64_t fine_e = cache_entry_bytes(289);
+    uint32_t n_opacity = (uint32_t)(500000 / fine_e);
+    for (uint32_t i = 0; i < n_opacity; i++) {
+        CacheKey k = key_at(i, CACHE_FINE);
+        k.type = CACHE_OPACITY;
+        lookup_once(c, &f, &k, 289, NULL);
+    }
+    CacheStats s = stats_of(c);
+    CHECK(budget_holds(&s) && s.budget_bytes == 500000);
+    uint64_t opacity_before = s.type_entries[CACHE_OPACITY][CACHE_FINE];
+    CHECK(opacity_before * fine_e > 3 * budgets[CACHE_OPACITY]); /* radiosity's, lent */
+    CHECK(s.type_peak_bytes[CACHE_OPACITY] > budgets[CACHE_OPACITY]);
+    /* radiosity within its fine share takes it back */
+    uint32_t n_fine = (uint32_t)(s.level_budget_bytes[CACHE_FINE] / fine_e / 4);
+    int fills = 0;
+    for (uint32_t i = 0; i < n_fine; i++) {
+        CacheKey k = key_at(i, CACHE_FINE);
+        fills += lookup_once(c, &f, &k, 289, NULL);
+    }
+    s = stats_of(c);
+    CHECK(budget_holds(&s));
+    CHECK(fills == (int)n_fine && n_fine >= 20);
+    CHECK(s.type_entries[CACHE_RADIOSITY][CACHE_FINE] == n_fine);
+    CHECK(s.type_entries[CACHE_OPACITY][CACHE_FINE] < opacity_before);
+    CHECK(s.counters[CACHE_FINE][CACHE_OPACITY].evictions > 0);
+    CHECK(s.counters[CACHE_FINE][CACHE_RADIOSITY].evictions == 0);
+    int refills = 0; /* the radiosity entries stayed */
+    for (uint32_t i = 0; i < n_fine; i++) {
+        CacheKey k = key_at(i, CACHE_FINE);
+        refills += lookup_once(c, &f, &k, 289, NULL);
+    }
+    CHECK(refills == 0);
+    /* irradiance has no budget: nothing lent, nothing kept */
+    CacheKey k = key_at(1, CACHE_FINE);
+    k.type = CACHE_IRRADIANCE;
+    CHECK(lookup_once(c, &f, &k, 289, NULL) == 1 && lookup_once(c, &f, &k, 289, NULL) == 1);
+    CHECK(stats_of(c).type_entries[CACHE_IRRADIANCE][CACHE_FINE] == 0);
+    check_counters_add_up(&s);
+    cache_free(c);
+}
+
 /* A level that borrows holds far more entries than its table was sized
  * for: each shard's table doubles as its entries outnumber its slots, so a
  * lookup walks chains of about one entry, and the slots' bytes are counted
@@ -1037,8 +1091,9 @@ TEST_MAIN(TEST(test_hit_miss_counters), TEST(test_local_reuse), TEST(test_half_s
           TEST(test_n_values_honoured), TEST(test_keys_separate_every_field),
           TEST(test_random_keys_distinct), TEST(test_lru_matches_model),
           TEST(test_lru_touch_and_pin), TEST(test_unfittable_entry_evicts_nothing),
-          TEST(test_budget_random), TEST(test_budget_too_small), TEST(test_levels_lend), TEST(test_tables_grow),
-          TEST(test_bump_invalidates), TEST(test_bump_invalidates_private),
-          TEST(test_old_entries_age_out), TEST(test_bump_replaces_in_place),
-          TEST(test_waiters_share_one_fill), TEST(test_bump_during_fill_wakes_waiters),
-          TEST(test_recursive_fill), TEST(test_refill_deterministic))
+          TEST(test_budget_random), TEST(test_budget_too_small), TEST(test_levels_lend),
+          TEST(test_types_lend), TEST(test_tables_grow), TEST(test_bump_invalidates),
+          TEST(test_bump_invalidates_private), TEST(test_old_entries_age_out),
+          TEST(test_bump_replaces_in_place), TEST(test_waiters_share_one_fill),
+          TEST(test_bump_during_fill_wakes_waiters), TEST(test_recursive_fill),
+          TEST(test_refill_deterministic))

@@ -263,7 +263,8 @@ static void run(uint64_t budget, long bump_period_us, int expect_hits)
         }
     }
     CHECK(counted == lookups);
-    CHECK(total <= s.budget_bytes && peak <= s.budget_bytes);
+    CHECK(total <= s.budget_bytes && peak <= s.budget_bytes &&
+          s.peak_total_bytes <= s.budget_bytes);
     uint64_t fills = counted - hits, evictions = 0;
     for (int l = 0; l < CACHE_N_LEVELS; l++)
         for (int t = 0; t < CACHE_N_TYPES; t++)

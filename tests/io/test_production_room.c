@@ -39,8 +39,10 @@ static RayesScene *built(void)
     return s;
 }
 
-/* A small render: its pixels (free them), and the stats' counts wanted. */
-static float *render(RayesScene *s, int threads, double cache_mb, unsigned long long counts[4])
+/* A small render: its pixels (free them), and the stats' counts wanted
+ * (rays by type, grids, radiosity evictions). The other data types get no
+ * budget, so that cache_mb bounds the cache (types lend theirs). */
+static float *render(RayesScene *s, int threads, double cache_mb, unsigned long long counts[5])
 {
     RayesRenderOptions o;
     rayes_render_options_init(&o, RAYES_QUALITY_PREVIEW);
@@ -50,13 +52,16 @@ static float *render(RayesScene *s, int threads, double cache_mb, unsigned long 
     o.threads = threads;
     o.bounces = 1;
     o.cache_mb = cache_mb;
+    o.opacity_cache_mb = o.irradiance_cache_mb = 0.0;
+    o.env_guide = 0;
     RayesImage *img = NULL;
     RayesStats *st = NULL;
     CHECK(rayes_render(s, &o, &img, &st) == RAYES_OK);
     if (!img || !st)
         return NULL;
-    static const char *const names[4] = {"rays/shadow", "rays/diffuse", "rays/specular", "grids"};
-    for (int k = 0; counts && k < 4; k++) {
+    static const char *const names[5] = {"rays/shadow", "rays/diffuse", "rays/specular", "grids",
+                                         "cache/radiosity/fine/evictions"};
+    for (int k = 0; counts && k < 5; k++) {
         const RayesStat *x = rayes_stats_find(st, names[k]);
         counts[k] = x ? x->count : 0;
     }
@@ -93,13 +98,14 @@ static void test_builds_with_twenty_lights(void)
 static void test_render_is_deterministic(void)
 {
     RayesScene *s = built();
-    unsigned long long c[4] = {0};
+    unsigned long long c[5] = {0}, t[5] = {0};
     float *two = render(s, 2, 100.0, c);
     float *one = render(s, 1, 100.0, NULL);
-    float *tiny = render(s, 2, 0.02, NULL); /* 20 kB: entries evicted and filled again */
+    float *tiny = render(s, 2, 0.02, t); /* 20 kB: entries evicted and filled again */
     CHECK(same(two, one));
     CHECK(same(two, tiny));
     CHECK(c[0] > 0 && c[1] > 0 && c[2] > 0 && c[3] > 500);
+    CHECK(c[4] == 0 && t[4] > 0);
     /* not black: the room is lit */
     double sum = 0.0;
     for (int i = 0; two && i < W * H; i++)

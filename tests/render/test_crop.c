@@ -36,6 +36,8 @@ static RayesImage *render(RayesScene *s, RayesQuality q, RayesHider hider, int w
     o.tile_size = 8;
     o.threads = threads;
     o.cache_mb = cache_mb;
+    if (cache_mb < 1.0) /* a budget meant to evict: no other type's to borrow */
+        o.opacity_cache_mb = o.irradiance_cache_mb = 0.0, o.env_guide = 0;
     o.hider = hider;
     o.diffuse_rays = o.diffuse_rays < 16 ? o.diffuse_rays : 16;
     o.diffuse_rays_deep = o.diffuse_rays_deep < 8 ? o.diffuse_rays_deep : 8;

@@ -15,6 +15,7 @@
 #include <string.h>
 
 #include "accel/accel.h"
+#include "cache_stats.h"
 #include "geom/geom.h"
 #include "io/builtin.h"
 #include "io/sink.h"
@@ -451,6 +452,8 @@ static RayesImage *box_render_with(int cache, double cache_mb, int threads, cons
     o.diffuse_rays = 16;
     o.cache = cache;
     o.cache_mb = cache_mb;
+    if (cache_mb < 1.0) /* a budget meant to evict: no other type's to borrow */
+        o.opacity_cache_mb = o.irradiance_cache_mb = 0.0, o.env_guide = 0;
     if (crop)
         memcpy(o.crop, crop, sizeof o.crop);
     RayesImage *img = NULL;
@@ -506,12 +509,15 @@ static void test_cached_segments_match_uncached(void)
     rayes_image_free(b);
 }
 
-/* The same bytes for 1 and 2 threads, a 0.5 MB cache, and in a crop
+/* The same bytes for 1 and 2 threads, a 200 kB cache (evicting), and in a crop
  * window. */
 static void test_motion_determinism(void)
 {
     RayesImage *a = box_render(1, 100, 2, NULL, NULL), *b = box_render(1, 100, 1, NULL, NULL);
-    RayesImage *c = box_render(1, 0.5, 2, NULL, NULL);
+    RayesStats *st = NULL;
+    RayesImage *c = box_render(1, 0.2, 2, NULL, &st);
+    CHECK(test_cache_evictions(st, "radiosity") > 0);
+    rayes_stats_free(st);
     const float crop[4] = {0.3f, 0.7f, 0.4f, 0.9f};
     RayesImage *d = box_render(1, 100, 2, crop, NULL);
     CHECK(a && b && c && d);

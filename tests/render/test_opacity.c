@@ -16,6 +16,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "cache_stats.h"
 #include "rayes/rayes.h"
 #include "rayes/shader.h"
 #include "test.h"
@@ -81,6 +82,8 @@ static RayesImage *render(RayesScene *s, int threads, double cache_mb, int opaci
     o.bounces = 0;
     o.opacity_cache = opacity_cache;
     o.opacity_cache_mb = cache_mb;
+    if (cache_mb < 1.0) /* a budget meant to evict: no other type's to borrow */
+        o.cache_mb = o.irradiance_cache_mb = 0.0, o.env_guide = 0;
     RayesImage *img = NULL;
     CHECK(rayes_render(s, &o, &img, stats) == RAYES_OK);
     return img;
@@ -272,7 +275,11 @@ static void test_opacity_cache_within_noise_and_deterministic(void)
     RayesImage *cached = render(s, 2, 20.0, 1, RAYES_QUALITY_FINAL, &st);
     RayesImage *uncached = render(s, 2, 20.0, 0, RAYES_QUALITY_FINAL, NULL);
     RayesImage *one = render(s, 1, 20.0, 1, RAYES_QUALITY_FINAL, NULL);
-    RayesImage *tiny = render(s, 3, 0.002, 1, RAYES_QUALITY_FINAL, NULL);
+    RayesStats *tiny_st = NULL;
+    RayesImage *tiny = render(s, 3, 0.002, 1, RAYES_QUALITY_FINAL, &tiny_st);
+    /* refilled: the budget holds too little (here, not one entry) */
+    CHECK(test_cache_count(tiny_st, "opacity", "fills") > test_cache_count(st, "opacity", "fills"));
+    rayes_stats_free(tiny_st);
     if (cached && uncached && one && tiny) {
         double a[3], b[3];
         mean_rgb(cached, a);

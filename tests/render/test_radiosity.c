@@ -11,6 +11,7 @@
 #include <math.h>
 #include <string.h>
 
+#include "cache_stats.h"
 #include "io/builtin.h"
 #include "io/sink.h"
 #include "rayes/rayes.h"
@@ -180,6 +181,8 @@ static RayesImage *teapots_render(int size, int bounces, int fine_depth, double 
     o.threads = threads;
     o.cache = cache;
     o.cache_mb = cache_mb;
+    o.opacity_cache_mb = o.irradiance_cache_mb = 0.0; /* no budget to lend: cache_mb bounds */
+    o.env_guide = 0;                                  /* the cache (no environment light) */
     o.cache_fine_depth = fine_depth;
     RayesImage *img = NULL;
     CHECK(rayes_render(s, &o, &img, st) == RAYES_OK);
@@ -204,9 +207,12 @@ static void test_same_bytes_for_any_budget_and_threads(void)
     const double budgets[] = {0.05, 0.0, 100};
     const int threads[] = {2, 3, 4};
     for (int i = 0; i < 3; i++) {
-        RayesImage *img = render(budgets[i], threads[i], 1);
+        RayesStats *st = NULL;
+        RayesImage *img = teapots_render(40, 2, 1, budgets[i], threads[i], 1, &st);
         CHECK(same(ref, img));
+        CHECK((test_cache_evictions(st, "radiosity") > 0) == (budgets[i] == 0.05));
         rayes_image_free(img);
+        rayes_stats_free(st);
     }
     RayesImage *off = render(100, 2, 0);
     CHECK(!same(ref, off)); /* caching changes the estimate (it is biased) */
@@ -345,6 +351,8 @@ static RayesImage *room_render(RayesScene *s, int cache, int threads, double mb,
     o.bounces = 3;
     o.cache = cache;
     o.cache_mb = mb;
+    if (mb < 1.0) /* a budget meant to evict: no other type's to borrow */
+        o.opacity_cache_mb = o.irradiance_cache_mb = 0.0, o.env_guide = 0;
     RayesImage *img = NULL;
     CHECK(rayes_render(s, &o, &img, st) == RAYES_OK);
     rayes_scene_release(s);
@@ -442,8 +450,12 @@ static void test_dense_room_clusters(void)
     CHECK(deep_off > 1000 && deep_on < deep_off / 3);
     double m_on = image_mean(a), m_off = image_mean(b);
     CHECK(m_off > 0.0 && fabs(m_on / m_off - 1.0) < 0.03);
-    RayesImage *c = dense_room(1, 1, 0.05, NULL);
+    RayesStats *tiny = NULL;
+    RayesImage *c = dense_room(1, 1, 0.05, &tiny);
     CHECK(same(a, c));
+    CHECK(test_cache_evictions(on, "radiosity") == 0 &&
+          test_cache_evictions(tiny, "radiosity") > 0);
+    rayes_stats_free(tiny);
     /* Partly transparent walls keep their own levels: a cluster's one
      * value, premultiplied by one member's opacity, would not do for a
      * cut-out's holes. */
@@ -470,8 +482,11 @@ static void test_clusters_through_instances(void)
     CHECK(count(st, "instances/count", 0) == 6);
     double m = image_mean(a), m_plain = image_mean(plain);
     CHECK(m_plain > 0.0 && fabs(m / m_plain - 1.0) < 0.03);
-    RayesImage *b = dense_room_instanced(1, 0.05, NULL);
+    RayesStats *tiny = NULL;
+    RayesImage *b = dense_room_instanced(1, 0.05, &tiny);
     CHECK(same(a, b));
+    CHECK(test_cache_evictions(tiny, "radiosity") > 0);
+    rayes_stats_free(tiny);
     rayes_image_free(a);
     rayes_image_free(b);
     rayes_image_free(plain);

@@ -107,6 +107,8 @@ static RayesImage *render_res(RayesScene *s, int res, int threads, int rays, int
     o.subsurface_rays = rays;
     o.irradiance_cache = cached;
     o.irradiance_cache_mb = mb;
+    if (mb < 1.0) /* a budget meant to evict: no other type's to borrow */
+        o.cache_mb = o.opacity_cache_mb = 0.0, o.env_guide = 0;
     RayesImage *img = NULL;
     CHECK(rayes_render(s, &o, &img, stats) == RAYES_OK);
     return img;

@@ -14,6 +14,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "cache_stats.h"
 #include "nvdb_write.h"
 #include "rayes/rayes.h"
 #include "test.h"
@@ -71,6 +72,8 @@ static RayesImage *render(RayesScene *s, int threads, double opacity_mb, int cac
     o.bounces = 0;
     o.opacity_cache = cached;
     o.opacity_cache_mb = opacity_mb;
+    if (opacity_mb < 1.0) /* a budget meant to evict: no other type's to borrow */
+        o.cache_mb = o.irradiance_cache_mb = 0.0, o.env_guide = 0;
     RayesImage *img = NULL;
     CHECK(rayes_render(s, &o, &img, stats) == RAYES_OK);
     return img;
@@ -308,7 +311,10 @@ static void test_cached_extinction_within_noise_and_deterministic(void)
     RayesImage *cached = render(s, 2, 20.0, 1, &st);
     RayesImage *uncached = render(s, 2, 20.0, 0, NULL);
     RayesImage *one = render(s, 1, 20.0, 1, NULL);
-    RayesImage *tiny = render(s, 3, 0.01, 1, NULL);
+    RayesStats *tiny_st = NULL;
+    RayesImage *tiny = render(s, 3, 0.01, 1, &tiny_st);
+    CHECK(test_cache_evictions(tiny_st, "opacity") > 0);
+    rayes_stats_free(tiny_st);
     if (cached && uncached && one && tiny) {
         for (int c = 0; c < 3; c++) {
             fprintf(stderr, "cloud channel %d: cached %g, uncached %g\n", c, mean(cached, c),
