@@ -450,7 +450,7 @@ void cache_local_fini(CacheLocal *local)
  * bytes for small entries (coarse fills of a dense mesh at 8 bounces:
  * walking them was a fifth of the render). The new slots' bytes are
  * counted like an entry's, and the table stays as it is when they do not
- * fit the partition's budget. Caller holds s's lock. */
+ * fit the cache's budget (the pool). Caller holds s's lock. */
 static void table_grow(Shard *s)
 {
     size_t n = s->n_slots, grown = 2 * n;
