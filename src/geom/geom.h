@@ -35,15 +35,16 @@
                               (sqrt(GEOM_GRID_SIZE)); GEOM_MAX_GRID - 1 at most */
 #define GEOM_MAX_GRID_SIZE ((GEOM_MAX_GRID - 1) * (GEOM_MAX_GRID - 1)) /* largest gridsize */
 #define GEOM_MAX_TIMES 16  /* time samples of moving geometry, at most (motion blur) */
-#define GEOM_CURVE_RUN 3   /* segments of a curve one primitive holds, at most (what fits in
-                              a Prim's control points) */
+#define GEOM_CURVE_RUN                                                                             \
+    3 /* segments of a curve one primitive holds, at most (what fits in                            \
+         a bicubic patch's control points) */
 
 typedef enum PrimType {
     PRIM_BILINEAR = 1, /* cp[0..3] = P00, P10, P01, P11 */
-    PRIM_BICUBIC = 2,  /* cp[0..15] Bezier, row-major, u fastest */
+    PRIM_BICUBIC = 2,  /* big->cp[0..15] Bezier, row-major, u fastest */
     PRIM_TRIANGLE = 3, /* cp[0..2]; (u, v) are barycentrics of cp[1], cp[2] */
-    PRIM_SPHERE = 4,   /* sphere.radius at the origin of sphere.world_from_object */
-    PRIM_QUADRIC = 5,  /* one of RenderMan's quadrics (quadric.kind: RayesQuadric's values),
+    PRIM_SPHERE = 4,   /* big->sphere.radius at the origin of its world_from_object */
+    PRIM_QUADRIC = 5,  /* one of RenderMan's quadrics (big->quadric.kind: RayesQuadric's values),
                           swept about object-space z; see geom_quadric_eval */
     PRIM_SUBDIV = 6,   /* one patch of a subdivision mesh's limit surface (subdiv.h): a quad,
                           or a triangle (subdiv.triangular) with PRIM_TRIANGLE's (u, v) */
@@ -99,6 +100,35 @@ typedef struct GeomSolid {
     uint32_t end;    /* one past the last node of its subtree */
 } GeomSolid;
 
+/* What does not fit in a Prim: a bicubic patch's control points, a
+ * sphere's or a quadric's transforms, a curve run's centre line. A Prim
+ * is kept small because a dense mesh has one per face (DESIGN.md
+ * "Primitives"); the scene keeps these in an arena of its own
+ * (scene_add_prim copies the one a primitive points to). */
+typedef struct PrimBig {
+    union {
+        Vec3 cp[16]; /* bicubic: world-space Bezier control points */
+        struct {
+            Mat4 world_from_object;
+            Mat4 normal_from_object; /* inverse transpose, for normals */
+            float radius;
+        } sphere;
+        struct {
+            Mat4 world_from_object;
+            int kind;    /* RayesQuadric's value */
+            int reverse; /* 1: u runs backwards, so the normal turns inward */
+            float p[7];  /* RenderMan's parameters, thetamax (and phi) in radians */
+        } quadric;
+        struct {
+            Vec3 cp[3 * GEOM_CURVE_RUN + 1]; /* the centre line's Bezier control points,
+                                world: segment k's are cp[3k .. 3k + 3] */
+            float width[GEOM_CURVE_RUN + 1]; /* world units, at the segments' ends (linear
+                                between) */
+            Vec3 n[2]; /* ribbons (one segment each): the normals at its ends, world */
+        } curve;
+    };
+} PrimBig;
+
 typedef struct Prim {
     PrimType type;
     uint32_t object;       /* the object (shader, attributes) it belongs to, or
@@ -118,34 +148,20 @@ typedef struct Prim {
     float focusfactor;     /* coarser dicing when out of focus ("focusfactor"), 0: none */
     uint32_t displacement; /* the scene's displacement shader + 1, or 0: none */
     float displacement_bound; /* world units; 0: unbounded */
+    PrimBig *big;             /* bicubic, sphere, quadric and curve: the rest of it; else NULL */
     union {
-        Vec3 cp[16];       /* world-space control points */
-        struct {
-            Mat4 world_from_object;
-            Mat4 normal_from_object; /* inverse transpose, for normals */
-            float radius;
-        } sphere;
-        struct {
-            Mat4 world_from_object;
-            int kind;              /* RayesQuadric's value */
-            int reverse;           /* 1: u runs backwards, so the normal turns inward */
-            float p[7];            /* RenderMan's parameters, thetamax (and phi) in radians */
-        } quadric;
+        Vec3 cp[4]; /* bilinear and triangle: world-space control points (bicubic:
+                       big->cp; geom_prim_cp) */
         struct {
             const struct SubdivMesh *mesh; /* owned by the scene */
             uint32_t patch;                /* its patch number in the mesh */
             int triangular;                /* a Loop triangle */
         } subdiv;
         struct {
-            Vec3 cp[3 * GEOM_CURVE_RUN + 1]; /* the centre line's Bezier control points,
-                                world: segment k's are cp[3k .. 3k + 3] */
-            float width[GEOM_CURVE_RUN + 1]; /* world units, at the segments' ends (linear
-                                between) */
-            Vec3 n[2];       /* ribbons (one segment each): the normals at its ends, world */
             Vec3 facing;     /* round and flat: the ribbon diced faces this point (the eye:
                                 geom_dice_prim sets it) */
             uint8_t shape;   /* GEOM_SHAPE_ROUND_CURVE, _FLAT_CURVE, or _SURFACE: a ribbon
-                                oriented by n */
+                                oriented by big->curve.n */
             uint8_t n_seg;   /* segments in the run, 1 to GEOM_CURVE_RUN (1 for ribbons) */
         } curve;
         struct {
@@ -157,6 +173,12 @@ typedef struct Prim {
         } point;
     };
 } Prim;
+
+/* The control points of a bilinear, bicubic or triangular primitive. */
+static inline const Vec3 *geom_prim_cp(const Prim *prim)
+{
+    return prim->type == PRIM_BICUBIC ? prim->big->cp : prim->cp;
+}
 
 /* A curve run's frame at u: the centre line C, its derivative T (with
  * respect to u), the width w and its derivative dw, and the unit

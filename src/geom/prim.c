@@ -47,13 +47,13 @@ static void eval_bicubic(const Vec3 *cp, float u, float v, Vec3 *P, Vec3 *dPdu, 
 
 static void eval_sphere(const Prim *prim, float u, float v, Vec3 *P, Vec3 *dPdu, Vec3 *dPdv)
 {
-    float r = prim->sphere.radius;
+    float r = prim->big->sphere.radius;
     float phi = 2.0f * (float)M_PI * u, theta = (float)M_PI * v;
     float sp = sinf(phi), cp = cosf(phi), st = sinf(theta), ct = cosf(theta);
     Vec3 p = v3(r * st * cp, r * st * sp, -r * ct);
     Vec3 du = v3(-2.0f * (float)M_PI * r * st * sp, 2.0f * (float)M_PI * r * st * cp, 0.0f);
     Vec3 dv = v3((float)M_PI * r * ct * cp, (float)M_PI * r * ct * sp, (float)M_PI * r * st);
-    const Mat4 *m = &prim->sphere.world_from_object;
+    const Mat4 *m = &prim->big->sphere.world_from_object;
     *P = mat4_point(m, p);
     *dPdu = mat4_vector(m, du);
     *dPdv = mat4_vector(m, dv);
@@ -64,13 +64,13 @@ enum { Q_SPHERE, Q_CYLINDER, Q_CONE, Q_DISK, Q_PARABOLOID, Q_HYPERBOLOID, Q_TORU
 
 void geom_quadric_eval(const Prim *prim, float u, float v, Vec3 *P, Vec3 *dPdu, Vec3 *dPdv)
 {
-    const float *q = prim->quadric.p;
-    if (prim->quadric.reverse)
+    const float *q = prim->big->quadric.p;
+    if (prim->big->quadric.reverse)
         u = 1.0f - u;
     /* Surfaces of revolution: (rho cos theta, rho sin theta, z), rho and z
      * functions of v; the hyperboloid sweeps a line (qx, qy, qz) instead. */
     double rho = 0, drho = 0, z = 0, dz = 0, T;
-    switch (prim->quadric.kind) {
+    switch (prim->big->quadric.kind) {
     case Q_SPHERE: { /* radius, phimin, phimax (latitudes from zmin, zmax), thetamax */
         /* within the poles: -pi/2 as a float lies just beyond -pi/2, where
          * rho = r cos(phi) < 0 turned the pole's normal inward (and the
@@ -116,14 +116,14 @@ void geom_quadric_eval(const Prim *prim, float u, float v, Vec3 *P, Vec3 *dPdu, 
         Vec3 p = v3((float)(x * c - y * sn), (float)(x * sn + y * c), (float)(q[2] + v * (q[5] - q[2])));
         Vec3 du = v3((float)(T * (-x * sn - y * c)), (float)(T * (x * c - y * sn)), 0.0f);
         Vec3 dv = v3((float)(dx * c - dy * sn), (float)(dx * sn + dy * c), q[5] - q[2]);
-        *P = p, *dPdu = prim->quadric.reverse ? v3_neg(du) : du, *dPdv = dv;
+        *P = p, *dPdu = prim->big->quadric.reverse ? v3_neg(du) : du, *dPdv = dv;
         return;
     }
     }
     double th = u * T, c = cos(th), sn = sin(th);
     *P = v3((float)(rho * c), (float)(rho * sn), (float)z);
     Vec3 du = v3((float)(-rho * T * sn), (float)(rho * T * c), 0.0f);
-    *dPdu = prim->quadric.reverse ? v3_neg(du) : du;
+    *dPdu = prim->big->quadric.reverse ? v3_neg(du) : du;
     *dPdv = v3((float)(drho * c), (float)(drho * sn), (float)dz);
 }
 
@@ -149,7 +149,7 @@ void geom_curve_frame(const Prim *prim, float u, Vec3 *C, Vec3 *T, float *w, flo
 {
     float b[4], db[4], t;
     int k = geom_curve_segment(prim, u, &t), n = prim->curve.n_seg > 0 ? prim->curve.n_seg : 1;
-    const Vec3 *cp = prim->curve.cp + 3 * k;
+    const Vec3 *cp = prim->big->curve.cp + 3 * k;
     geom_bezier_basis(t, b, db);
     Vec3 c = v3(0, 0, 0), d = c;
     for (int j = 0; j < 4; j++) {
@@ -157,7 +157,7 @@ void geom_curve_frame(const Prim *prim, float u, Vec3 *C, Vec3 *T, float *w, flo
         d = v3_madd(d, cp[j], db[j] * (float)n);
     }
     Vec3 toward = prim->curve.shape == GEOM_SHAPE_SURFACE
-                      ? v3_lerp(prim->curve.n[0], prim->curve.n[1], t)
+                      ? v3_lerp(prim->big->curve.n[0], prim->big->curve.n[1], t)
                       : v3_sub(prim->curve.facing, c);
     Vec3 across = v3_cross(toward, d);
     float l = v3_length(across);
@@ -165,7 +165,7 @@ void geom_curve_frame(const Prim *prim, float u, Vec3 *C, Vec3 *T, float *w, flo
                                                                    : any_perpendicular(d);
     *C = c;
     *T = d;
-    float w0 = prim->curve.width[k], w1 = prim->curve.width[k + 1];
+    float w0 = prim->big->curve.width[k], w1 = prim->big->curve.width[k + 1];
     *w = w0 + (w1 - w0) * t;
     *dw = (w1 - w0) * (float)n;
 }
@@ -187,7 +187,7 @@ static void eval_point(const Prim *prim, float u, float v, Vec3 *P, Vec3 *dPdu, 
 
 void geom_prim_eval(const Prim *prim, float u, float v, Vec3 *P, Vec3 *dPdu, Vec3 *dPdv)
 {
-    const Vec3 *c = prim->cp;
+    const Vec3 *c = prim->type <= PRIM_TRIANGLE ? geom_prim_cp(prim) : NULL;
     switch (prim->type) {
     case PRIM_BILINEAR: {
         Vec3 a = v3_lerp(c[0], c[1], u), b = v3_lerp(c[2], c[3], u);
@@ -215,7 +215,7 @@ void geom_prim_eval(const Prim *prim, float u, float v, Vec3 *P, Vec3 *dPdu, Vec
     }
     case PRIM_QUADRIC: {
         Vec3 p, du, dv;
-        const Mat4 *m = &prim->quadric.world_from_object;
+        const Mat4 *m = &prim->big->quadric.world_from_object;
         geom_quadric_eval(prim, u, v, &p, &du, &dv);
         *P = mat4_point(m, p);
         *dPdu = mat4_vector(m, du);
@@ -244,7 +244,7 @@ Vec3 geom_prim_normal(const Prim *prim, float u, float v)
         /* Exact at the poles too: the normal is the object-space position. */
         float phi = 2.0f * (float)M_PI * u, theta = (float)M_PI * v;
         Vec3 n = v3(sinf(theta) * cosf(phi), sinf(theta) * sinf(phi), -cosf(theta));
-        return v3_normalize(mat4_vector(&prim->sphere.normal_from_object, n));
+        return v3_normalize(mat4_vector(&prim->big->sphere.normal_from_object, n));
     }
     geom_prim_eval(prim, u, v, &P, &du, &dv);
     Vec3 n = v3_cross(du, dv);

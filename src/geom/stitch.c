@@ -146,7 +146,7 @@ static int prim_side(const Prim *prim, int side, uint64_t key[2], float t[2])
         return 1;
     case PRIM_BICUBIC:
         for (int k = 0; k < 4; k++)
-            p[k] = prim->cp[bicubic[side][k]];
+            p[k] = prim->big->cp[bicubic[side][k]];
         points_side(p, 4, key, t);
         return 1;
     case PRIM_TRIANGLE: /* a polygon mesh's edge: keyed as a bilinear patch's */

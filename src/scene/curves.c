@@ -302,7 +302,8 @@ RayesError rayes_scene_curves(RayesScene *s, const RayesCurves *c, const RayesPr
          * early where the curve is not continuous (a basis and step that
          * leave gaps). */
         for (size_t seg = 0; seg < segs;) {
-            Prim p = {.type = PRIM_CURVE};
+            PrimBig big = {0};
+            Prim p = {.type = PRIM_CURVE, .big = &big};
             p.curve.shape = shape;
             float end[GEOM_CURVE_RUN + 1][N_VARS][3] = {{{0}}};
             int m = 0;
@@ -314,10 +315,10 @@ RayesError rayes_scene_curves(RayesScene *s, const RayesCurves *c, const RayesPr
                 src.varying[1] = vary + (seg + 1) % n_vary;
                 Vec3 cp[4];
                 segment_bezier(s, c, &src, cp);
-                if (m > 0 && v3_length(v3_sub(cp[0], p.curve.cp[3 * m])) >
+                if (m > 0 && v3_length(v3_sub(cp[0], p.big->curve.cp[3 * m])) >
                                  1e-5f * (1.0f + v3_length(cp[0])))
                     break;
-                memcpy(&p.curve.cp[3 * m], cp, sizeof cp);
+                memcpy(&p.big->curve.cp[3 * m], cp, sizeof cp);
                 if (m == 0)
                     seg_ends(&vars, &src, 0, end[0]);
                 seg_ends(&vars, &src, 1, end[m + 1]);
@@ -325,9 +326,9 @@ RayesError rayes_scene_curves(RayesScene *s, const RayesCurves *c, const RayesPr
             }
             p.curve.n_seg = (uint8_t)m;
             for (int j = 0; j <= m; j++)
-                p.curve.width[j] = fmaxf(end[j][VAR_WIDTH][0], 0.0f) * scale;
+                p.big->curve.width[j] = fmaxf(end[j][VAR_WIDTH][0], 0.0f) * scale;
             for (int side = 0; side < 2 && vars.by[VAR_N]; side++)
-                p.curve.n[side] = v3_normalize(
+                p.big->curve.n[side] = v3_normalize(
                     mat4_vector(&normal_from_object, v3_load(end[side ? m : 0][VAR_N])));
             if ((e = push_ends(s, &p, &vars, end, m + 1)) != RAYES_OK ||
                 (e = scene_add_prim(s, &p)) != RAYES_OK)

@@ -23,10 +23,10 @@ Bounds3 scene_prim_bounds(const Prim *p)
 {
     Bounds3 b = bounds_empty();
     if (p->type == PRIM_SPHERE) {
-        Vec3 c = mat4_point(&p->sphere.world_from_object, v3(0, 0, 0));
-        float r = p->sphere.radius;
+        Vec3 c = mat4_point(&p->big->sphere.world_from_object, v3(0, 0, 0));
+        float r = p->big->sphere.radius;
         for (int k = 0; k < 3; k++) {
-            Vec3 axis = mat4_vector(&p->sphere.world_from_object,
+            Vec3 axis = mat4_vector(&p->big->sphere.world_from_object,
                                     v3(k == 0 ? r : 0, k == 1 ? r : 0, k == 2 ? r : 0));
             float l = v3_length(axis);
             b = bounds_add(b, v3_add(c, v3(l, l, l)));
@@ -52,17 +52,17 @@ Bounds3 scene_prim_bounds(const Prim *p)
     }
     if (p->type == PRIM_CURVE || p->type == PRIM_POINT) { /* control points, widened */
         int n = p->type == PRIM_CURVE ? 3 * p->curve.n_seg + 1 : 1;
-        const Vec3 *c = p->type == PRIM_CURVE ? p->curve.cp : &p->point.centre;
+        const Vec3 *c = p->type == PRIM_CURVE ? p->big->curve.cp : &p->point.centre;
         float r = p->point.radius;
         for (int k = 0; p->type == PRIM_CURVE && k <= p->curve.n_seg; k++)
-            r = k ? fmaxf(r, 0.5f * p->curve.width[k]) : 0.5f * p->curve.width[0];
+            r = k ? fmaxf(r, 0.5f * p->big->curve.width[k]) : 0.5f * p->big->curve.width[0];
         for (int k = 0; k < n; k++)
             b = bounds_add(bounds_add(b, v3_sub(c[k], v3(r, r, r))), v3_add(c[k], v3(r, r, r)));
         return b;
     }
     int n = p->type == PRIM_BICUBIC ? 16 : p->type == PRIM_TRIANGLE ? 3 : 4;
     for (int k = 0; k < n; k++)
-        b = bounds_add(b, p->cp[k]);
+        b = bounds_add(b, geom_prim_cp(p)[k]);
     return b;
 }
 

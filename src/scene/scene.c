@@ -90,6 +90,9 @@ void rayes_scene_release(RayesScene *s)
     free(s->objects);
     free(s->solids);
     free(s->prims);
+    for (size_t i = 0; i < s->cap_bigs; i++)
+        free(s->bigs[i]);
+    free(s->bigs);
     free(s->motions);
     free(s->motion_prims);
     for (size_t i = 0; i < s->n_subdivs; i++)
@@ -524,6 +527,30 @@ RayesError rayes_scene_solid_end(RayesScene *s)
     return RAYES_OK;
 }
 
+#define SCENE_BIG_BLOCK 1024
+
+/* Copies what p->big points to into the scene's arena (blocks never move,
+ * so copies of the Prim share it) and points p there. */
+static RayesError intern_big(RayesScene *s, Prim *p)
+{
+    if (!p->big)
+        return RAYES_OK;
+    size_t block = s->n_bigs / SCENE_BIG_BLOCK;
+    if (block == s->cap_bigs) {
+        PrimBig **bigs = realloc(s->bigs, (block + 1) * sizeof *bigs);
+        if (!bigs)
+            return scene_fail(s, RAYES_ERROR_OUT_OF_MEMORY, "out of memory");
+        s->bigs = bigs;
+        if (!(bigs[block] = malloc(SCENE_BIG_BLOCK * sizeof *bigs[block])))
+            return scene_fail(s, RAYES_ERROR_OUT_OF_MEMORY, "out of memory");
+        s->cap_bigs++;
+    }
+    PrimBig *to = &s->bigs[block][s->n_bigs++ % SCENE_BIG_BLOCK];
+    *to = *p->big;
+    p->big = to;
+    return RAYES_OK;
+}
+
 static RayesError add_prim(RayesScene *s, Prim *p)
 {
     /* a subdivision patch's points were checked with its mesh's */
@@ -534,7 +561,8 @@ static RayesError add_prim(RayesScene *s, Prim *p)
         if (e != RAYES_OK)
             return e;
     }
-    if (grow((void **)&s->prims, &s->cap_prims, s->n_prims, sizeof *s->prims) != 0)
+    if (grow((void **)&s->prims, &s->cap_prims, s->n_prims, sizeof *s->prims) != 0 ||
+        intern_big(s, p) != RAYES_OK)
         return scene_fail(s, RAYES_ERROR_OUT_OF_MEMORY, "out of memory");
     p->object = s->current_object == SCENE_OBJECT_INHERIT ? GEOM_OBJECT_INHERIT
                                                           : (uint32_t)s->current_object;
@@ -787,8 +815,9 @@ RayesError rayes_scene_bicubic_patch_pv(RayesScene *s, const float P[16][3],
     for (int b = 0; b < GEOM_N_PV; b++)
         if (set.by[b] && set.by[b]->cls == RAYES_PRIMVAR_VERTEX)
             cubic |= primvar_names[b].bit;
-    Prim p = {.type = PRIM_BICUBIC};
-    transform_points(s, P, 16, p.cp);
+    PrimBig big;
+    Prim p = {.type = PRIM_BICUBIC, .big = &big};
+    transform_points(s, P, 16, big.cp);
     const PrimvarSource src[4] = {{0, 0, 0}, {0, 1, 1}, {0, 2, 2}, {0, 3, 3}};
     if ((e = push_primvars(s, &p, &set, src, 4, cubic)) != RAYES_OK)
         return e;
@@ -1000,12 +1029,13 @@ RayesError rayes_scene_sphere(RayesScene *s, float radius)
         return RAYES_ERROR_INVALID_ARGUMENT;
     if (!(radius > 0.0f) || !isfinite(radius))
         return scene_fail(s, RAYES_ERROR_INVALID_ARGUMENT, "sphere: expected a positive radius");
-    Prim p = {.type = PRIM_SPHERE};
+    PrimBig big;
+    Prim p = {.type = PRIM_SPHERE, .big = &big};
     Mat4 inv;
     mat4_invert(s->world_from_object, &inv);
-    p.sphere.world_from_object = s->world_from_object;
-    p.sphere.normal_from_object = mat4_transpose(inv);
-    p.sphere.radius = radius;
+    p.big->sphere.world_from_object = s->world_from_object;
+    p.big->sphere.normal_from_object = mat4_transpose(inv);
+    p.big->sphere.radius = radius;
     return add_prim(s, &p);
 }
 
@@ -1753,6 +1783,8 @@ static RayesError push_light(RayesScene *s, const Light *l, const Prim *prims, s
             return e;
         for (size_t i = 0; i < n_prims; i++) {
             Prim p = prims[i];
+            if (intern_big(s, &p) != RAYES_OK)
+                return RAYES_ERROR_OUT_OF_MEMORY;
             p.object = (uint32_t)(s->n_objects - 1);
             p.shading_rate = s->shading_rate;
             p.motion = s->current_motion; /* the emitter moves with the light */
@@ -2016,12 +2048,13 @@ RayesError rayes_scene_light(RayesScene *s, const char *type, const RayesParam *
         l.type = LIGHT_SPHERE;
         l.from = mat4_point(m, v3(0, 0, 0));
         l.radius = lp.radius * v3_length(mat4_vector(m, v3(1, 0, 0)));
-        Prim p = {.type = PRIM_SPHERE};
+        PrimBig big;
+        Prim p = {.type = PRIM_SPHERE, .big = &big};
         Mat4 inv;
         mat4_invert(*m, &inv);
-        p.sphere.world_from_object = *m;
-        p.sphere.normal_from_object = mat4_transpose(inv);
-        p.sphere.radius = lp.radius;
+        p.big->sphere.world_from_object = *m;
+        p.big->sphere.normal_from_object = mat4_transpose(inv);
+        p.big->sphere.radius = lp.radius;
         return push_light(s, &l, &p, 1);
     }
     if (strcmp(lp.shape, "disk") == 0) {
@@ -2080,11 +2113,13 @@ static void translate_prim(Prim *p, Vec3 d)
 {
     if (p->type == PRIM_SPHERE) {
         for (int k = 0; k < 3; k++)
-            p->sphere.world_from_object.m[k][3] += k == 0 ? d.x : k == 1 ? d.y : d.z;
+            p->big->sphere.world_from_object.m[k][3] += k == 0 ? d.x : k == 1 ? d.y : d.z;
         return;
     }
-    for (int k = 0; k < 16; k++)
-        p->cp[k] = v3_add(p->cp[k], d);
+    int n = p->type == PRIM_BICUBIC ? 16 : p->type == PRIM_TRIANGLE ? 3 : 4;
+    Vec3 *cp = p->type == PRIM_BICUBIC ? p->big->cp : p->cp;
+    for (int k = 0; k < n; k++)
+        cp[k] = v3_add(cp[k], d);
 }
 
 RayesError rayes_scene_edit_light(RayesScene *s, size_t index, const RayesParam *params,
@@ -2375,9 +2410,10 @@ RayesError rayes_scene_set_search_path(RayesScene *s, const char *kind, const ch
 
 /* RenderMan's quadrics: checks the parameters and stores them with angles
  * in radians (the sphere's zmin, zmax as latitudes). */
-/* The primitive of a quadric (rayes.h's parameters, checked). */
+/* The primitive of a quadric (rayes.h's parameters, checked), its
+ * transform and parameters in *big (out->big points there). */
 static RayesError quadric_prim(RayesScene *s, RayesQuadric type, const float *params, size_t n,
-                               unsigned flags, Prim *out)
+                               unsigned flags, Prim *out, PrimBig *big)
 {
     static const struct {
         const char *name, *params;
@@ -2401,12 +2437,13 @@ static RayesError quadric_prim(RayesScene *s, RayesQuadric type, const float *pa
     if (!(thetamax != 0.0f) || fabsf(thetamax) > 360.0f)
         return scene_fail(s, RAYES_ERROR_INVALID_ARGUMENT, "%s: expected 0 < |thetamax| <= 360",
                           name);
-    Prim p = {.type = PRIM_QUADRIC};
-    p.quadric.world_from_object = s->world_from_object;
-    p.quadric.kind = (int)type;
-    p.quadric.reverse = (flags & RAYES_QUADRIC_REVERSE) != 0;
-    memcpy(p.quadric.p, params, n * sizeof *params);
-    p.quadric.p[n - 1] = thetamax * deg;
+    *big = (PrimBig){0};
+    Prim p = {.type = PRIM_QUADRIC, .big = big};
+    p.big->quadric.world_from_object = s->world_from_object;
+    p.big->quadric.kind = (int)type;
+    p.big->quadric.reverse = (flags & RAYES_QUADRIC_REVERSE) != 0;
+    memcpy(p.big->quadric.p, params, n * sizeof *params);
+    p.big->quadric.p[n - 1] = thetamax * deg;
     const float *q = params;
     const char *bad = NULL;
     switch (type) {
@@ -2415,8 +2452,8 @@ static RayesError quadric_prim(RayesScene *s, RayesQuadric type, const float *pa
         if (!(r > 0.0f) || !(lo < hi))
             bad = "a positive radius and zmin != zmax overlapping [-radius, radius]";
         else {
-            p.quadric.p[1] = asinf(lo / r);
-            p.quadric.p[2] = asinf(hi / r);
+            p.big->quadric.p[1] = asinf(lo / r);
+            p.big->quadric.p[2] = asinf(hi / r);
         }
         break;
     }
@@ -2442,8 +2479,8 @@ static RayesError quadric_prim(RayesScene *s, RayesQuadric type, const float *pa
         if (!(q[1] > 0.0f) || !(q[2] != q[3]))
             bad = "rminor > 0 and phimin != phimax";
         else {
-            p.quadric.p[2] = q[2] * deg;
-            p.quadric.p[3] = q[3] * deg;
+            p.big->quadric.p[2] = q[2] * deg;
+            p.big->quadric.p[3] = q[3] * deg;
         }
         break;
     }
@@ -2457,7 +2494,8 @@ RayesError rayes_scene_quadric(RayesScene *s, RayesQuadric type, const float *pa
                                unsigned flags)
 {
     Prim p;
-    RayesError e = quadric_prim(s, type, params, n, flags, &p);
+    PrimBig big;
+    RayesError e = quadric_prim(s, type, params, n, flags, &p, &big);
     if (e != RAYES_OK)
         return e;
     return add_prim(s, &p);
@@ -2468,17 +2506,17 @@ RayesError rayes_scene_quadric(RayesScene *s, RayesQuadric type, const float *pa
  * for straight profiles. */
 static void quadric_steps(const Prim *p, int *nu, int *nv)
 {
-    const float *q = p->quadric.p;
+    const float *q = p->big->quadric.p;
     static const int theta_at[7] = {3, 3, 2, 2, 3, 6, 4}; /* thetamax's index by kind */
-    float turns = fabsf(q[theta_at[p->quadric.kind]]) / (2.0f * (float)M_PI);
+    float turns = fabsf(q[theta_at[p->big->quadric.kind]]) / (2.0f * (float)M_PI);
     *nu = (int)ceilf(64.0f * turns);
     *nu = *nu < 8 ? 8 : *nu;
     *nv = 1;
-    if (p->quadric.kind == RAYES_QUADRIC_SPHERE)
+    if (p->big->quadric.kind == RAYES_QUADRIC_SPHERE)
         *nv = (int)ceilf(32.0f * fabsf(q[2] - q[1]) / (float)M_PI);
-    else if (p->quadric.kind == RAYES_QUADRIC_TORUS)
+    else if (p->big->quadric.kind == RAYES_QUADRIC_TORUS)
         *nv = (int)ceilf(32.0f * fabsf(q[3] - q[2]) / (float)M_PI);
-    else if (p->quadric.kind == RAYES_QUADRIC_PARABOLOID)
+    else if (p->big->quadric.kind == RAYES_QUADRIC_PARABOLOID)
         *nv = 16;
     *nv = *nv < 1 ? 1 : *nv;
 }
@@ -2491,7 +2529,8 @@ RayesError rayes_scene_area_light_quadric(RayesScene *s, RayesQuadric type, cons
     if (!s || !L)
         return RAYES_ERROR_INVALID_ARGUMENT;
     Prim p;
-    RayesError e = quadric_prim(s, type, params, n, flags, &p);
+    PrimBig big;
+    RayesError e = quadric_prim(s, type, params, n, flags, &p, &big);
     if (e != RAYES_OK)
         return e;
     int nu, nv;

@@ -164,6 +164,8 @@ struct RayesScene {
     int64_t last_geometry_object; /* the object of the last primitive added, or -1 */
     Prim *prims;
     size_t n_prims, cap_prims;
+    PrimBig **bigs;              /* blocks of SCENE_BIG_BLOCK: what prims point to (Prim.big) */
+    size_t n_bigs, cap_bigs;     /* PrimBigs used, block pointers allocated */
     struct SubdivMesh **subdivs; /* subdivision meshes, owned; their patches are prims */
     size_t n_subdivs, cap_subdivs;
     float *pv;                /* primitive variable values of every prim (Prim.pv_first) */

@@ -33,11 +33,12 @@ static void test_bicubic_reproduces_bilinear(void)
 {
     Vec3 c[4] = {v3(0, 0, 0), v3(3, 0, 1), v3(0, 2, 0), v3(3, 3, 2)};
     Prim bl = bilinear(c[0], c[1], c[2], c[3]);
-    Prim bc = {.type = PRIM_BICUBIC, .shading_rate = 1.0f};
+    PrimBig big;
+    Prim bc = {.type = PRIM_BICUBIC, .shading_rate = 1.0f, .big = &big};
     for (int j = 0; j < 4; j++)
         for (int i = 0; i < 4; i++) {
             Vec3 a = v3_lerp(c[0], c[1], i / 3.0f), b = v3_lerp(c[2], c[3], i / 3.0f);
-            bc.cp[4 * j + i] = v3_lerp(a, b, j / 3.0f);
+            big.cp[4 * j + i] = v3_lerp(a, b, j / 3.0f);
         }
     for (float v = 0.0f; v <= 1.0f; v += 0.25f)
         for (float u = 0.0f; u <= 1.0f; u += 0.25f) {
@@ -65,12 +66,21 @@ static void test_bilinear_known_values(void)
     CHECK_NEAR(n.z, 1.0, 1e-6); /* dPdu x dPdv = x cross y */
 }
 
+/* A dense mesh keeps a primitive per face: what only some kinds need is
+ * out of line (PrimBig), so a Prim stays small. */
+static void test_prim_is_small(void)
+{
+    CHECK(sizeof(Prim) <= 112);
+    CHECK(sizeof(PrimBig) >= 16 * sizeof(Vec3));
+}
+
 static void test_sphere_eval_and_normal(void)
 {
-    Prim s = {.type = PRIM_SPHERE, .shading_rate = 1.0f};
-    s.sphere.world_from_object = mat4_translate(1, 2, 3);
-    s.sphere.normal_from_object = mat4_identity();
-    s.sphere.radius = 2.0f;
+    PrimBig big;
+    Prim s = {.type = PRIM_SPHERE, .shading_rate = 1.0f, .big = &big};
+    s.big->sphere.world_from_object = mat4_translate(1, 2, 3);
+    s.big->sphere.normal_from_object = mat4_identity();
+    s.big->sphere.radius = 2.0f;
     Vec3 P, du, dv;
     geom_prim_eval(&s, 0.0f, 0.5f, &P, &du, &dv);
     CHECK_NEAR(P.x, 3.0, 1e-5);
@@ -85,13 +95,14 @@ static void test_sphere_eval_and_normal(void)
 /* A degenerate row (the teapot lid's apex) still gets the limit normal. */
 static void test_degenerate_bicubic_normal(void)
 {
-    Prim bc = {.type = PRIM_BICUBIC, .shading_rate = 1.0f};
+    PrimBig big;
+    Prim bc = {.type = PRIM_BICUBIC, .shading_rate = 1.0f, .big = &big};
     for (int j = 0; j < 4; j++)
         for (int i = 0; i < 4; i++) {
             /* The first two rows at one height: a smooth dome, not a cone. */
             static const float z[4] = {1.0f, 1.0f, 0.8f, 0.5f};
             float r = j / 3.0f, a = 1.5707963f * i / 3.0f;
-            bc.cp[4 * j + i] = v3(r * cosf(a), r * sinf(a), z[j]);
+            big.cp[4 * j + i] = v3(r * cosf(a), r * sinf(a), z[j]);
         }
     Vec3 n = geom_prim_normal(&bc, 0.5f, 0.0f);
     CHECK(fabsf(n.z) > 0.99f);
@@ -418,7 +429,7 @@ static void test_thin_triangle(void)
     geom_gridset_fini(&gs);
 }
 
-TEST_MAIN(TEST(test_bezier_basis), TEST(test_bicubic_reproduces_bilinear),
+TEST_MAIN(TEST(test_bezier_basis), TEST(test_prim_is_small), TEST(test_bicubic_reproduces_bilinear),
           TEST(test_bilinear_known_values), TEST(test_sphere_eval_and_normal),
           TEST(test_degenerate_bicubic_normal), TEST(test_dicing_rate_from_camera),
           TEST(test_split_limits_grid_size), TEST(test_split_by_area), TEST(test_grid_size_option),

@@ -50,18 +50,18 @@ static void test_rib(void)
         const Prim *p = s->prims;
         CHECK(p[0].type == PRIM_CURVE && p[0].curve.shape == GEOM_SHAPE_FLAT_CURVE);
         CHECK(p[0].curve.n_seg == 2);
-        CHECK_NEAR(p[0].curve.width[0], 0.1, 1e-6);
-        CHECK_NEAR(p[0].curve.width[1], 0.2, 1e-6);
-        CHECK_NEAR(p[0].curve.width[2], 0.3, 1e-6);
+        CHECK_NEAR(p[0].big->curve.width[0], 0.1, 1e-6);
+        CHECK_NEAR(p[0].big->curve.width[1], 0.2, 1e-6);
+        CHECK_NEAR(p[0].big->curve.width[2], 0.3, 1e-6);
         /* The B-spline's first point: (P0 + 4 P1 + P2) / 6. */
-        CHECK_NEAR(p[0].curve.cp[0].x, 1.0, 1e-6);
-        CHECK_NEAR(p[0].curve.cp[0].y, 1.0 / 6.0, 1e-6);
+        CHECK_NEAR(p[0].big->curve.cp[0].x, 1.0, 1e-6);
+        CHECK_NEAR(p[0].big->curve.cp[0].y, 1.0 / 6.0, 1e-6);
         CHECK(p[1].curve.shape == GEOM_SHAPE_ROUND_CURVE && p[1].curve.n_seg == 3);
-        CHECK_NEAR(p[1].curve.width[3], 0.05, 1e-6);
+        CHECK_NEAR(p[1].big->curve.width[3], 0.05, 1e-6);
         CHECK(p[1].pv == GEOM_PV_CS);
         /* The periodic curve's last segment ends where it began. */
-        CHECK(v3_length(v3_sub(p[1].curve.cp[9], p[1].curve.cp[0])) < 1e-6f);
-        CHECK(p[2].curve.shape == GEOM_SHAPE_SURFACE && p[2].curve.n[0].z > 0.99f);
+        CHECK(v3_length(v3_sub(p[1].big->curve.cp[9], p[1].big->curve.cp[0])) < 1e-6f);
+        CHECK(p[2].curve.shape == GEOM_SHAPE_SURFACE && p[2].big->curve.n[0].z > 0.99f);
         CHECK(p[3].type == PRIM_POINT && p[3].point.shape == GEOM_SHAPE_DISK);
         CHECK_NEAR(p[4].point.radius, 0.25, 1e-6);
     }
@@ -104,11 +104,11 @@ static void test_pbrt(void)
         CHECK(p[0].curve.shape == GEOM_SHAPE_ROUND_CURVE && p[1].curve.shape == GEOM_SHAPE_SURFACE);
         CHECK(p[0].curve.n_seg == 2);
         /* Quadratic B-spline (0 0 0, 1 1 0, 2 0 0): from (0.5, 0.5) to (1.5, 0.5). */
-        CHECK_NEAR(p[0].curve.cp[0].x, 0.5, 1e-6);
-        CHECK_NEAR(p[0].curve.cp[3].x, 1.5, 1e-6);
-        CHECK_NEAR(p[0].curve.cp[3].y, 0.5, 1e-6);
-        CHECK_NEAR(p[0].curve.width[0], 0.2, 1e-6);
-        CHECK_NEAR(p[0].curve.width[2], 0.1, 1e-6);
+        CHECK_NEAR(p[0].big->curve.cp[0].x, 0.5, 1e-6);
+        CHECK_NEAR(p[0].big->curve.cp[3].x, 1.5, 1e-6);
+        CHECK_NEAR(p[0].big->curve.cp[3].y, 0.5, 1e-6);
+        CHECK_NEAR(p[0].big->curve.width[0], 0.2, 1e-6);
+        CHECK_NEAR(p[0].big->curve.width[2], 0.1, 1e-6);
     }
     rayes_scene_release(s);
     s = read("WorldBegin\nShape \"curve\" \"point3 P\" [0 0 0 1 1 0 2 0 0]\n", 1, &e);
@@ -130,9 +130,10 @@ static void test_write_back(void)
         if (a->prims[k].type == PRIM_CURVE) {
             CHECK(a->prims[k].curve.shape == b->prims[k].curve.shape);
             for (int j = 0; j < 4; j++)
-                CHECK(v3_length(v3_sub(a->prims[k].curve.cp[j], b->prims[k].curve.cp[j])) < 1e-5f);
+                CHECK(v3_length(v3_sub(a->prims[k].big->curve.cp[j],
+                                       b->prims[k].big->curve.cp[j])) < 1e-5f);
             CHECK(a->prims[k].curve.n_seg == b->prims[k].curve.n_seg);
-            CHECK_NEAR(a->prims[k].curve.width[1], b->prims[k].curve.width[1], 1e-6);
+            CHECK_NEAR(a->prims[k].big->curve.width[1], b->prims[k].big->curve.width[1], 1e-6);
         } else {
             CHECK(a->prims[k].point.shape == b->prims[k].point.shape);
             CHECK_NEAR(a->prims[k].point.radius, b->prims[k].point.radius, 1e-6);

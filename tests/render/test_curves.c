@@ -176,10 +176,10 @@ static void test_hermite_translated(void)
     CHECK(rayes_scene_curves(s, &c, NULL, 0) == RAYES_OK);
     CHECK(s->n_prims == 1);
     if (s->n_prims == 1) { /* Bezier: P0, P0 + T0 / 3, P1 - T1 / 3, P1 */
-        CHECK_NEAR(s->prims[0].curve.cp[0].x, 10.0, 1e-5);
-        CHECK_NEAR(s->prims[0].curve.cp[1].x, 11.0, 1e-5);
-        CHECK_NEAR(s->prims[0].curve.cp[2].x, 10.0, 1e-5);
-        CHECK_NEAR(s->prims[0].curve.cp[3].x, 11.0, 1e-5);
+        CHECK_NEAR(s->prims[0].big->curve.cp[0].x, 10.0, 1e-5);
+        CHECK_NEAR(s->prims[0].big->curve.cp[1].x, 11.0, 1e-5);
+        CHECK_NEAR(s->prims[0].big->curve.cp[2].x, 10.0, 1e-5);
+        CHECK_NEAR(s->prims[0].big->curve.cp[3].x, 11.0, 1e-5);
     }
     rayes_scene_release(s);
 }

@@ -204,8 +204,8 @@ static void test_rib(void)
         CHECK(s->prims[0].solid == 2 && s->prims[1].solid == 4 && s->prims[2].solid == 5);
         CHECK(s->prims[3].solid == 0);
         /* SolidBegin saves the transform: the last sphere is at the origin. */
-        CHECK(fabsf(s->prims[3].quadric.world_from_object.m[0][3]) < 1e-6f);
-        CHECK(fabsf(s->prims[2].quadric.world_from_object.m[1][3] - 1.0f) < 1e-6f);
+        CHECK(fabsf(s->prims[3].big->quadric.world_from_object.m[0][3]) < 1e-6f);
+        CHECK(fabsf(s->prims[2].big->quadric.world_from_object.m[1][3] - 1.0f) < 1e-6f);
     }
     rayes_scene_release(s);
     s = read_rib("WorldBegin\nSolidBegin \"xor\"\nSolidEnd\nWorldEnd\n", &e);
