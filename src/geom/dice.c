@@ -56,6 +56,7 @@ void geom_gridset_init(GridSet *gs)
 void geom_gridset_fini(GridSet *gs)
 {
     free(gs->grids);
+    free(gs->subs);
     free(gs->grid_cluster);
     free(gs->clusters);
     free(gs->P);
@@ -619,9 +620,19 @@ static int dice_quad(GridSet *gs, const Prim *prim, uint32_t prim_index, const f
         g->uv[0][0] = c[0][0], g->uv[0][1] = c[0][1];
         g->uv[1][0] = c[0][0] + step[0] * (float)(nu - 1);
         g->uv[1][1] = c[0][1] + step[1] * (float)(nv - 1);
-        g->sub_corner = (uint8_t)(1 + d->corner);
-        memcpy(g->sub, d->c, sizeof g->sub);
-        memcpy(g->tri, d->tri, sizeof g->tri);
+        if (gs->n_subs == gs->cap_subs) {
+            size_t cap = gs->cap_subs ? 2 * gs->cap_subs : 64;
+            GridSub *subs = realloc(gs->subs, cap * sizeof *subs);
+            if (!subs)
+                return -1;
+            gs->subs = subs;
+            gs->cap_subs = cap;
+        }
+        GridSub *sub = &gs->subs[gs->n_subs++];
+        sub->corner = (uint8_t)d->corner;
+        memcpy(sub->sub, d->c, sizeof sub->sub);
+        memcpy(sub->tri, d->tri, sizeof sub->tri);
+        g->sub = (uint32_t)gs->n_subs;
     }
     size_t base = gs->n_vertices;
     for (int j = 0; j < nv; j++)

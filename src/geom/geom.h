@@ -251,15 +251,20 @@ typedef struct Grid {
                               largest step in u and in v */
     uint8_t primvars;      /* GEOM_PV_* bits: the GridSet's Ns, st, Cs, Os hold its vertices'
                               values (else: N, uv, the object's colour and opacity) */
-    uint8_t sub_corner;    /* a quad over part of a triangle: 1 + the triangle's corner it
-                              starts at (split_quads), else 0; for stitching */
-    float sub[2][2];       /* such a quad: its rectangle of the quad's own (s, t), (s0, t0)
-                              and (s1, t1), in [0, 1] */
-    float tri[3][2];       /* such a quad: the triangle's corners, the primitive's (u, v) */
     uint8_t moving;        /* 1: its vertices differ between time samples (GridSet.Pt); its
                               radiosity is cached per motion segment */
+    uint32_t sub;          /* a quad over part of a triangle (dice.c's split_quads): its
+                              GridSet.subs index + 1, for stitching; else 0 */
     uint32_t motion_vertex; /* a moving grid: its first vertex in GridSet.Pt and the rest */
 } Grid;
+
+/* Where a quad over part of a triangle lies in it (Grid.sub). */
+typedef struct GridSub {
+    uint8_t corner;  /* the triangle's corner it starts at */
+    float sub[2][2]; /* its rectangle of the quad's own (s, t), (s0, t0) and (s1, t1),
+                        in [0, 1] */
+    float tri[3][2]; /* the triangle's corners, the primitive's (u, v) */
+} GridSub;
 
 /* One placement of a master (an object instance, nested ones flattened):
  * the master's grids, diced once in master space, are traced through an
@@ -292,6 +297,8 @@ typedef struct GeomCluster {
 typedef struct GridSet {
     Grid *grids;           /* one per patch; the index is the patch id */
     size_t n_grids;
+    GridSub *subs; /* Grid.sub's records */
+    size_t n_subs, cap_subs;
     uint32_t *grid_cluster; /* per grid, the smallest cluster it is in, index + 1; 0: none.
                               NULL: no clusters (geom_cluster_grids) */
     GeomCluster *clusters;  /* owned */

@@ -229,11 +229,12 @@ static int tri_segment(const Prim *prim, uint32_t prim_index, const float *a, co
 /* The key of a line inside a quad over part of a triangle (split_quads):
  * a line s or t = c of quad k (axis 0: t = c, 1: s = c), or (axis 2) the
  * spoke k from the midpoint of edge k to the centroid. */
-static void sub_quad_line(const Grid *g, int axis, float c, int k, uint64_t key[2])
+static void sub_quad_line(const Grid *g, const GridSub *sub, int axis, float c, int k,
+                          uint64_t key[2])
 {
     uint32_t bits;
     memcpy(&bits, &c, sizeof bits);
-    key[0] = hash_floats(hash_combine(0x5355425155414455ull, g->prim), &g->tri[0][0], 6);
+    key[0] = hash_floats(hash_combine(0x5355425155414455ull, g->prim), &sub->tri[0][0], 6);
     key[0] = hash_combine(hash_combine(key[0], (uint64_t)axis * 4 + (uint64_t)k), bits);
     key[1] = hash_combine(key[0], 0x9e3779b97f4a7c15ull);
 }
@@ -242,23 +243,23 @@ static void sub_quad_line(const Grid *g, int axis, float c, int k, uint64_t key[
  * t = 0) lie on half of the triangle's edges (corner k to k + 1 at
  * s / 2, corner k - 1 to k at 1 - t / 2), its sides s or t = 1 on the
  * spokes k and k - 1 it shares with the next and previous quads. */
-static int sub_quad_side(const Grid *g, const Prim *prim, int side, double s0, double s1,
-                         double c, uint64_t key[2], double *a, double *b)
+static int sub_quad_side(const Grid *g, const GridSub *sub, const Prim *prim, int side, double s0,
+                         double s1, double c, uint64_t key[2], double *a, double *b)
 {
-    int k = g->sub_corner - 1, prev = (k + 2) % 3;
+    int k = sub->corner, prev = (k + 2) % 3;
     double t[2];
     if (c == 0.0 && (side == 0 || side == 3)) {
         int e = side == 0 ? k : prev;
-        if (!tri_segment(prim, g->prim, g->tri[e], g->tri[(e + 1) % 3], key, t))
+        if (!tri_segment(prim, g->prim, sub->tri[e], sub->tri[(e + 1) % 3], key, t))
             return 0;
         double p0 = side == 0 ? 0.5 * s0 : 1.0 - 0.5 * s0, p1 = side == 0 ? 0.5 * s1 : 1.0 - 0.5 * s1;
         *a = t[0] + (t[1] - t[0]) * p0, *b = t[0] + (t[1] - t[0]) * p1;
         return 1;
     }
     if (c == 1.0 && (side == 1 || side == 2))
-        sub_quad_line(g, 2, 0.0f, side == 1 ? k : prev, key);
+        sub_quad_line(g, sub, 2, 0.0f, side == 1 ? k : prev, key);
     else
-        sub_quad_line(g, side == 0 || side == 2 ? 0 : 1, (float)c, k, key);
+        sub_quad_line(g, sub, side == 0 || side == 2 ? 0 : 1, (float)c, k, key);
     *a = s0, *b = s1;
     return 1;
 }
@@ -273,15 +274,15 @@ static int tri_grid_side(const Grid *g, const Prim *prim, int side, Side *out)
     return put_side(out, key, g->master, t[0], t[1], g->first_vertex, 0, g->nu, 1 + side);
 }
 
-/* The record of side `side` of grid g (of prim), or 0
- * when the side is on no curve a neighbour can share. */
-static int grid_side(const Grid *g, const Prim *prim, int side, Side *out)
+/* The record of side `side` of grid g (of prim; sub: its GridSub or NULL),
+ * or 0 when the side is on no curve a neighbour can share. */
+static int grid_side(const Grid *g, const GridSub *sub, const Prim *prim, int side, Side *out)
 {
     static const int on_v[4] = {1, 0, 1, 0}; /* the side is a line of constant v */
     if (g->triangular)
         return tri_grid_side(g, prim, side, out);
     int nu = g->nu, nv = g->nv;
-    const float(*r)[2] = g->sub_corner ? g->sub : g->uv; /* the domain's rectangle */
+    const float(*r)[2] = sub ? sub->sub : g->uv; /* the domain's rectangle */
     float c = side == 0 ? r[0][1] : side == 1 ? r[1][0] : side == 2 ? r[1][1] : r[0][0];
     int axis = on_v[side] ? 0 : 1; /* s runs along u or v */
     float s0 = r[0][axis], s1 = r[1][axis];
@@ -289,8 +290,8 @@ static int grid_side(const Grid *g, const Prim *prim, int side, Side *out)
     float t[2] = {0.0f, 1.0f};
     uint64_t key[2];
     double a, b;
-    if (g->sub_corner) {
-        if (!sub_quad_side(g, prim, side, s0, s1, c, key, &a, &b))
+    if (sub) {
+        if (!sub_quad_side(g, sub, prim, side, s0, s1, c, key, &a, &b))
             return 0;
     } else {
         if (c == border) {
@@ -539,7 +540,8 @@ static Side *collect_sides(const GridSet *gs, const Prim *prims, size_t *n)
             (!displaced && whole_flat_triangle(grid, prim)))
             continue;
         for (int side = 0; side < 4; side++)
-            *n += (size_t)grid_side(grid, prim, side, &sides[*n]);
+            *n += (size_t)grid_side(grid, grid->sub ? &gs->subs[grid->sub - 1] : NULL, prim, side,
+                                    &sides[*n]);
     }
     return sort_sides(sides, *n);
 }

@@ -128,7 +128,7 @@ RayesStats *session_stats_new(const RenderSettings *set, const RenderStats *rs, 
     count(s, "memory/peak_rss_bytes", mem_peak_rss_bytes());
     count(s, "memory/accel_bytes", accel_bytes);
     size_t geom_bytes = gs->n_vertices * (4 * sizeof(Vec3) + 2 * sizeof(float)) +
-                        gs->n_grids * sizeof(Grid) +
+                        gs->n_grids * sizeof(Grid) + gs->n_subs * sizeof(GridSub) +
                         (gs->grid_cluster ? gs->n_grids * sizeof *gs->grid_cluster : 0) +
                         gs->n_clusters * sizeof(GeomCluster) +
                         (size_t)(n_times - 1) * gs->n_motion_vertices * 4 * sizeof(Vec3);

@@ -66,12 +66,13 @@ static void test_bilinear_known_values(void)
     CHECK_NEAR(n.z, 1.0, 1e-6); /* dPdu x dPdv = x cross y */
 }
 
-/* A dense mesh keeps a primitive per face: what only some kinds need is
- * out of line (PrimBig), so a Prim stays small. */
+/* A dense mesh keeps a primitive and a grid per face: what only some
+ * need is out of line (PrimBig, GridSub), so both stay small. */
 static void test_prim_is_small(void)
 {
     CHECK(sizeof(Prim) <= 112);
     CHECK(sizeof(PrimBig) >= 16 * sizeof(Vec3));
+    CHECK(sizeof(Grid) <= 76);
 }
 
 static void test_sphere_eval_and_normal(void)
