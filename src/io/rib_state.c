@@ -831,6 +831,33 @@ static int attribute_render(Rib *r, const Param *q)
                      v);
 }
 
+/* Attributes that choose what rayes always does: the value that asks for
+ * it is taken silently, another is said once (rayes keeps its way). 0
+ * done, 1 not one of them. */
+static int attribute_always(Rib *r, const char *group, const Param *q)
+{
+    static const struct {
+        const char *group, *name, *what;
+    } always[] = {
+        {"render", "truedisplacement", "rayes always displaces the surface itself"},
+        {"trace", "displacements", "rays always see the displaced surface"},
+        {"dice", "binary", "rayes always dices at powers of two (for crack-free stitching)"},
+    };
+    for (size_t k = 0; k < sizeof always / sizeof always[0]; k++) {
+        if (strcmp(group, always[k].group) != 0 || strcmp(q->d.name, always[k].name) != 0 ||
+            !rib_is_num(q->v) || q->v->n != 1)
+            continue;
+        if (q->v->d[0] != 1) {
+            char key[96];
+            snprintf(key, sizeof key, "always %s:%s", group, q->d.name);
+            rib_warn_once(r, key, "Attribute \"%s\" \"%s\" %g: %s; ignored", group, q->d.name,
+                          q->v->d[0], always[k].what);
+        }
+        return 0;
+    }
+    return 1;
+}
+
 /* One parameter of Attribute "visibility": 0 done, -1 error, 1 not ours. */
 static int attribute_visibility(Rib *r, const Param *q)
 {
@@ -899,6 +926,8 @@ static int h_option_attribute(Rib *r, const Args *a)
                    : strcmp(group, "shade") == 0      ? attribute_shade(r, q)
                    : strcmp(group, "render") == 0     ? attribute_render(r, q)
                                                       : 1;
+        if (mine == 1 && !option)
+            mine = attribute_always(r, group, q);
         if (mine <= 0) {
             e = mine;
         } else if (option && strcmp(group, "searchpath") == 0 && q->v->kind != ARG_NUM &&

@@ -16,6 +16,7 @@
 #include "rayes/rayes.h"
 
 #include "test.h"
+#include "test_stderr.h"
 
 static const double PI_D = 3.14159265358979323846;
 
@@ -886,33 +887,6 @@ static void test_errors(void)
                  "checkerboard: expected dimension 2 or 3, found 4");
 }
 
-/* Runs fn with standard error in a file; returns what was written
- * (static, truncated to 8 KiB). */
-static const char *stderr_of(void (*fn)(void *), void *arg)
-{
-    static char text[8192];
-    const char *path = RAYES_TEST_TMP "/test_pbrt_stderr.txt";
-    fflush(stderr);
-    int saved = dup(2);
-    FILE *f = fopen(path, "w");
-    if (!f || saved < 0) {
-        text[0] = '\0';
-        return text;
-    }
-    dup2(fileno(f), 2);
-    fn(arg);
-    fflush(stderr);
-    dup2(saved, 2);
-    close(saved);
-    fclose(f);
-    f = fopen(path, "r");
-    size_t n = f ? fread(text, 1, sizeof text - 1, f) : 0;
-    text[n] = '\0';
-    if (f)
-        fclose(f);
-    return text;
-}
-
 /* Every texture class and every textured material parameter: patterns
  * of the right class and parameters, parameters bound to them, with no
  * warning but the one for two different anisotropic roughness textures. */
@@ -975,7 +949,7 @@ static void test_textures(void)
 {
     Rec *r = malloc(sizeof *r);
     TextureRun tr = {r, RAYES_OK};
-    const char *said = stderr_of(run_textures, &tr);
+    const char *said = test_stderr_of(run_textures, &tr);
     CHECK(tr.e == RAYES_OK);
     /* the one expected warning, and none of the old ones */
     CHECK(strstr(said, "textured uroughness and vroughness become one") != NULL);
@@ -1173,7 +1147,7 @@ static void test_import(void)
     ParseRun pr = {.name = path,
                    .r = r,
                    .text = "WorldBegin\nTranslate 0 0 5\nImport \"test_pbrt_import.pbrt\"\n"};
-    const char *said = stderr_of(run_parse, &pr);
+    const char *said = test_stderr_of(run_parse, &pr);
     CHECK(pr.e == RAYES_OK && r->n_quadrics == 1 && r->n_meshes == 1);
     CHECK(strstr(said, "warning") == NULL);
     if (r->n_quadrics == 1) {
@@ -1181,11 +1155,11 @@ static void test_import(void)
         CHECK_NEAR(r->quadric[0].xform[11], 5, 0); /* the importing file's transform applies */
     }
     pr.text = "WorldBegin\nImport \"test_pbrt_import_bad.pbrt\"\n";
-    stderr_of(run_parse, &pr);
+    test_stderr_of(run_parse, &pr);
     CHECK(pr.e == RAYES_ERROR_PARSE &&
           strstr(pr.err, "test_pbrt_import_bad.pbrt:2:33: expected a float value") != NULL);
     pr.text = "WorldBegin\nImport \"test_pbrt_none.pbrt\"\n";
-    stderr_of(run_parse, &pr);
+    test_stderr_of(run_parse, &pr);
     CHECK(pr.e == RAYES_ERROR_PARSE && strstr(pr.err, "Import: ") != NULL &&
           strstr(pr.err, "test_pbrt_none.pbrt") != NULL);
     free(r);
@@ -1205,7 +1179,7 @@ static void test_film_types(void)
                  "  \"float cropwindow\" [0 0.5 0 1]\nWorldBegin\n",
                  types[k]);
         ParseRun pr = {.name = "t.pbrt", .text = text, .r = r};
-        const char *said = stderr_of(run_parse, &pr);
+        const char *said = test_stderr_of(run_parse, &pr);
         CHECK(pr.e == RAYES_OK);
         CHECK(pr.s.width == 64 && pr.s.height == 32);
         CHECK(pr.s.n_displays == 1 && strcmp(pr.s.displays[0].name, "out.exr") == 0 &&
@@ -1230,7 +1204,7 @@ static void test_portal_warns(void)
                    .text =
                        "WorldBegin\n"
                        "LightSource \"infinite\" \"point3 portal\" [0 0 0 1 0 0 1 1 0 0 1 0]\n"};
-    const char *said = stderr_of(run_parse, &pr);
+    const char *said = test_stderr_of(run_parse, &pr);
     CHECK(pr.e == RAYES_OK && r->n_lights == 1);
     CHECK(strstr(said, "t.pbrt:2:1: LightSource \"infinite\": \"portal\" is not used") != NULL);
     free(r);
@@ -1249,7 +1223,7 @@ static void test_measured_material(void)
                 "Material \"measured\" \"string filename\" \"bsdfs/ilm_l3_37_metallic.bsdf\"\n"
                 "Shape \"trianglemesh\" \"point3 P\" [0 0 0 1 0 0 0 1 0]\n"
                 "Shape \"trianglemesh\" \"point3 P\" [0 0 0 1 0 0 0 1 0]\n"};
-    const char *said = stderr_of(run_parse, &pr);
+    const char *said = test_stderr_of(run_parse, &pr);
     CHECK(pr.e == RAYES_OK && r->n_meshes == 2);
     if (r->n_meshes == 2)
         CHECK(strcmp(r->mesh[0].shader.name, "matte") == 0 &&
@@ -1275,7 +1249,7 @@ static void test_normal_map(void)
                            "Shape \"trianglemesh\" \"point3 P\" [0 0 0 1 0 0 0 1 0]\n"
                            "Material \"hair\" \"string normalmap\" \"nm.png\"\n"
                            "Shape \"trianglemesh\" \"point3 P\" [0 0 0 1 0 0 0 1 0]\n"};
-    const char *said = stderr_of(run_parse, &pr);
+    const char *said = test_stderr_of(run_parse, &pr);
     CHECK(pr.e == RAYES_OK && r->n_meshes == 2);
     if (r->n_meshes == 2) {
         const RayesParam *nm = param(&r->mesh[0].shader, "normalmap");
@@ -1397,7 +1371,7 @@ static void test_thin_dielectric(void)
                    .text = "WorldBegin\n"
                            "Material \"thindielectric\" \"float eta\" 1.4\n"
                            "Shape \"trianglemesh\" \"point3 P\" [0 0 0 1 0 0 0 1 0]\n"};
-    const char *said = stderr_of(run_parse, &pr);
+    const char *said = test_stderr_of(run_parse, &pr);
     CHECK(pr.e == RAYES_OK && r->n_meshes == 1);
     if (r->n_meshes == 1) {
         const Shader *sh = &r->mesh[0].shader;
@@ -1427,7 +1401,7 @@ static void test_filter_warnings(void)
     Rec *r = malloc(sizeof *r);
     for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
         ParseRun pr = {.name = "t.pbrt", .text = cases[k].text, .r = r};
-        const char *said = stderr_of(run_parse, &pr);
+        const char *said = test_stderr_of(run_parse, &pr);
         CHECK(pr.e == RAYES_OK);
         CHECK(cases[k].want ? strstr(said, cases[k].want) != NULL
                             : strstr(said, "warning") == NULL);
@@ -1454,7 +1428,7 @@ static void test_anisotropic_roughness(void)
                 "Shape \"trianglemesh\" \"point3 P\" [0 0 0 1 0 0 0 1 0]\n"
                 "Material \"conductor\" \"float uroughness\" 0.2 \"float vroughness\" 0.2\n"
                 "Shape \"trianglemesh\" \"point3 P\" [0 0 0 1 0 0 0 1 0]\n"};
-    const char *said = stderr_of(run_parse, &pr);
+    const char *said = test_stderr_of(run_parse, &pr);
     CHECK(pr.e == RAYES_OK && r->n_meshes == 3);
     const char *w = strstr(said, "t.pbrt:2:1: uroughness 0.01 and vroughness 0.04 differ");
     CHECK(w != NULL);
@@ -1489,7 +1463,7 @@ static void test_maxdepth(void)
         snprintf(text, sizeof text, "Integrator \"path\" \"integer maxdepth\" %d\nWorldBegin\n",
                  cases[k].depth);
         ParseRun pr = {.name = "t.pbrt", .text = text, .r = r};
-        const char *said = stderr_of(run_parse, &pr);
+        const char *said = test_stderr_of(run_parse, &pr);
         CHECK(pr.e == RAYES_OK);
         CHECK(pr.s.bounces == cases[k].bounces && pr.s.specular_depth == cases[k].specular);
         CHECK((strstr(said, "t.pbrt:1:1: Integrator \"maxdepth\"") != NULL) == cases[k].warns);

@@ -15,6 +15,7 @@
 #include "io/rib_write.h"
 #include "rayes/rayes.h"
 #include "test.h"
+#include "test_stderr.h"
 
 #ifndef RAYES_TEST_DATA
 #error "RAYES_TEST_DATA must name the shared data directory"
@@ -1189,9 +1190,38 @@ static void test_detail_range(void)
     CHECK(strstr(err, "in order"));
 }
 
-TEST_MAIN(TEST(test_camera_and_transforms), TEST(test_settings), TEST(test_shaders_and_lights),
-          TEST(test_parameter_classes), TEST(test_patterns), TEST(test_polygons),
-          TEST(test_patch_mesh_bases), TEST(test_handles), TEST(test_objects_and_frames),
-          TEST(test_binary), TEST(test_gzip), TEST(test_errors), TEST(test_aqsis_files),
-          TEST(test_scene_sink), TEST(test_writer_round_trip), TEST(test_writer_primvars),
-          TEST(test_writer_split_quad), TEST(test_detail_range))
+typedef struct TextRun {
+    const char *text;
+    RayesError e;
+} TextRun;
+
+static void run_text(void *arg)
+{
+    TextRun *t = arg;
+    t->e = parse(t->text);
+}
+
+/* Attributes that ask for what rayes always does (true displacement, rays
+ * that see it, power-of-two dicing) are taken without a word; another
+ * value is said once, naming what rayes does instead. */
+static void test_attributes_rayes_always_does(void)
+{
+    TextRun yes = {WORLD("Attribute \"render\" \"truedisplacement\" [1]\n"
+                         "Attribute \"trace\" \"displacements\" [1]\n"
+                         "Attribute \"dice\" \"binary\" [1]\nSphere 1 -1 1 360")};
+    const char *said = test_stderr_of(run_text, &yes);
+    CHECK(yes.e == RAYES_OK && strstr(said, "warning") == NULL);
+    TextRun no = {WORLD("Attribute \"render\" \"truedisplacement\" [0]\nSphere 1 -1 1 360")};
+    said = test_stderr_of(run_text, &no);
+    CHECK(no.e == RAYES_OK);
+    CHECK(strstr(said, "t.rib:3: Attribute \"render\" \"truedisplacement\" 0: rayes always "
+                       "displaces the surface itself; ignored") != NULL);
+    CHECK(rec.quadrics == 1);
+}
+
+TEST_MAIN(TEST(test_camera_and_transforms), TEST(test_attributes_rayes_always_does),
+          TEST(test_settings), TEST(test_shaders_and_lights), TEST(test_parameter_classes),
+          TEST(test_patterns), TEST(test_polygons), TEST(test_patch_mesh_bases), TEST(test_handles),
+          TEST(test_objects_and_frames), TEST(test_binary), TEST(test_gzip), TEST(test_errors),
+          TEST(test_aqsis_files), TEST(test_scene_sink), TEST(test_writer_round_trip),
+          TEST(test_writer_primvars), TEST(test_writer_split_quad), TEST(test_detail_range))
