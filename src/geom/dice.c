@@ -26,6 +26,7 @@
 #include <string.h>
 
 #include "util/check.h"
+#include "util/grow.h"
 
 #define LATTICE 5           /* estimation lattice, per side */
 #define MAX_SPLIT_DEPTH 48  /* a bound on recursion for degenerate input */
@@ -435,14 +436,8 @@ static int reserve_primvars(GridSet *gs, size_t cap, unsigned want)
 
 static int reserve(GridSet *gs, size_t n_vertices, unsigned primvars)
 {
-    if (gs->n_grids == gs->cap_grids) {
-        size_t cap = gs->cap_grids ? 2 * gs->cap_grids : 64;
-        Grid *g = realloc(gs->grids, cap * sizeof *g);
-        if (!g)
-            return -1;
-        gs->grids = g;
-        gs->cap_grids = cap;
-    }
+    if (util_grow((void **)&gs->grids, &gs->cap_grids, gs->n_grids, sizeof *gs->grids) != 0)
+        return -1;
     if (gs->n_vertices + n_vertices > gs->cap_vertices) {
         size_t cap = gs->cap_vertices ? 2 * gs->cap_vertices : 4096;
         while (cap < gs->n_vertices + n_vertices)
@@ -620,14 +615,8 @@ static int dice_quad(GridSet *gs, const Prim *prim, uint32_t prim_index, const f
         g->uv[0][0] = c[0][0], g->uv[0][1] = c[0][1];
         g->uv[1][0] = c[0][0] + step[0] * (float)(nu - 1);
         g->uv[1][1] = c[0][1] + step[1] * (float)(nv - 1);
-        if (gs->n_subs == gs->cap_subs) {
-            size_t cap = gs->cap_subs ? 2 * gs->cap_subs : 64;
-            GridSub *subs = realloc(gs->subs, cap * sizeof *subs);
-            if (!subs)
-                return -1;
-            gs->subs = subs;
-            gs->cap_subs = cap;
-        }
+        if (util_grow((void **)&gs->subs, &gs->cap_subs, gs->n_subs, sizeof *gs->subs) != 0)
+            return -1;
         GridSub *sub = &gs->subs[gs->n_subs++];
         sub->corner = (uint8_t)d->corner;
         memcpy(sub->sub, d->c, sizeof sub->sub);

@@ -18,6 +18,7 @@
 
 #include "rayes/rayes.h"
 #include "scene/scene.h"
+#include "util/grow.h"
 
 /* The latest master of that name, or -1. */
 static int64_t find_master(const RayesScene *s, const char *name)
@@ -26,20 +27,6 @@ static int64_t find_master(const RayesScene *s, const char *name)
         if (strcmp(s->masters[m].name, name) == 0)
             return (int64_t)m;
     return -1;
-}
-
-/* Room for one more element of size elem in *array of *cap. 0, or -1. */
-static int grow_one(void **array, size_t *cap, size_t n, size_t elem)
-{
-    if (n < *cap)
-        return 0;
-    size_t c = *cap ? 2 * *cap : 16;
-    void *a = realloc(*array, c * elem);
-    if (!a)
-        return -1;
-    *array = a;
-    *cap = c;
-    return 0;
 }
 
 RayesError rayes_scene_object_begin(RayesScene *s, const char *name)
@@ -53,7 +40,7 @@ RayesError rayes_scene_object_begin(RayesScene *s, const char *name)
                           name, s->masters[s->open_master].name);
     if (s->n_masters >= UINT32_MAX - 1)
         return scene_fail(s, RAYES_ERROR_INVALID_ARGUMENT, "object begin: too many masters");
-    if (grow_one((void **)&s->masters, &s->cap_masters, s->n_masters, sizeof *s->masters) != 0)
+    if (util_grow((void **)&s->masters, &s->cap_masters, s->n_masters, sizeof *s->masters) != 0)
         return scene_fail(s, RAYES_ERROR_OUT_OF_MEMORY, "out of memory");
     SceneMaster *m = &s->masters[s->n_masters];
     memset(m, 0, sizeof *m);
@@ -123,8 +110,8 @@ RayesError rayes_scene_object_instance(RayesScene *s, const char *name)
         if (e != RAYES_OK)
             return e;
     }
-    if (grow_one((void **)&s->instances, &s->cap_instances, s->n_instances, sizeof *s->instances) !=
-        0)
+    if (util_grow((void **)&s->instances, &s->cap_instances, s->n_instances,
+                  sizeof *s->instances) != 0)
         return scene_fail(s, RAYES_ERROR_OUT_OF_MEMORY, "out of memory");
     s->instances[s->n_instances++] = (SceneInstance){
         .parent_from_master = s->world_from_object,

@@ -36,6 +36,7 @@
 
 #include "rayes/rayes.h"
 #include "scene/scene.h"
+#include "util/grow.h"
 
 /* 1 if times[0 .. n - 1] are finite and strictly increasing. */
 static int increasing(const float *times, size_t n)
@@ -136,14 +137,9 @@ RayesError rayes_scene_motion_begin(RayesScene *s, size_t n, const float *times)
 
 static int push_motion_prim(RayesScene *s, const Prim *p)
 {
-    if (s->n_motion_prims == s->cap_motion_prims) {
-        size_t cap = s->cap_motion_prims ? 2 * s->cap_motion_prims : 64;
-        Prim *a = realloc(s->motion_prims, cap * sizeof *a);
-        if (!a)
-            return -1;
-        s->motion_prims = a;
-        s->cap_motion_prims = cap;
-    }
+    if (util_grow((void **)&s->motion_prims, &s->cap_motion_prims, s->n_motion_prims,
+                  sizeof *s->motion_prims) != 0)
+        return -1;
     s->motion_prims[s->n_motion_prims++] = *p;
     return 0;
 }

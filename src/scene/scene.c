@@ -18,21 +18,8 @@
 #include "shade/builtin.h"
 #include "shade/registry.h"
 #include "util/check.h"
+#include "util/grow.h"
 #include "util/log.h"
-
-/* Grows *array (of *cap elements of size elem) to hold n + 1. */
-static int grow(void **array, size_t *cap, size_t n, size_t elem)
-{
-    if (n < *cap)
-        return 0;
-    size_t c = *cap ? 2 * *cap : 16;
-    void *p = realloc(*array, c * elem);
-    if (!p)
-        return -1;
-    *array = p;
-    *cap = c;
-    return 0;
-}
 
 /* The camera of rayes_scene_set_camera: an orthonormal frame looking from
  * eye at target, the fov spanning the image height. */
@@ -323,7 +310,7 @@ static RayesError make_instance(RayesScene *s, const RayesShaderClass *cls,
 static RayesError add_object(RayesScene *s, const RayesShaderClass *cls, const RayesParam *params,
                              size_t n_params, int light)
 {
-    if (grow((void **)&s->objects, &s->cap_objects, s->n_objects, sizeof *s->objects) != 0)
+    if (util_grow((void **)&s->objects, &s->cap_objects, s->n_objects, sizeof *s->objects) != 0)
         return scene_fail(s, RAYES_ERROR_OUT_OF_MEMORY, "out of memory");
     SceneObject *o = &s->objects[s->n_objects];
     memset(o, 0, sizeof *o);
@@ -468,8 +455,8 @@ RayesError rayes_scene_set_displacement(RayesScene *s, const char *name, const R
     e = check_params(s, "displacement shader", name, params, n_params);
     if (e != RAYES_OK)
         return e;
-    if (grow((void **)&s->displacements, &s->cap_displacements, s->n_displacements,
-             sizeof *s->displacements) != 0)
+    if (util_grow((void **)&s->displacements, &s->cap_displacements, s->n_displacements,
+                  sizeof *s->displacements) != 0)
         return scene_fail(s, RAYES_ERROR_OUT_OF_MEMORY, "out of memory");
     char err[256];
     ShaderInstance *inst = &s->displacements[s->n_displacements];
@@ -507,7 +494,7 @@ RayesError rayes_scene_solid_begin(RayesScene *s, RayesSolidOp op)
                           "solid: a solid inside a primitive solid (only primitives may be)");
     if (s->n_solids >= UINT32_MAX - 1)
         return scene_fail(s, RAYES_ERROR_INVALID_ARGUMENT, "solid: too many solids");
-    if (grow((void **)&s->solids, &s->cap_solids, s->n_solids, sizeof *s->solids) != 0)
+    if (util_grow((void **)&s->solids, &s->cap_solids, s->n_solids, sizeof *s->solids) != 0)
         return scene_fail(s, RAYES_ERROR_OUT_OF_MEMORY, "out of memory");
     s->solids[s->n_solids] = (GeomSolid){(uint32_t)op, (uint32_t)(s->open_solid + 1), 0};
     s->open_solid = (int64_t)s->n_solids++;
@@ -561,7 +548,7 @@ static RayesError add_prim(RayesScene *s, Prim *p)
         if (e != RAYES_OK)
             return e;
     }
-    if (grow((void **)&s->prims, &s->cap_prims, s->n_prims, sizeof *s->prims) != 0 ||
+    if (util_grow((void **)&s->prims, &s->cap_prims, s->n_prims, sizeof *s->prims) != 0 ||
         intern_big(s, p) != RAYES_OK)
         return scene_fail(s, RAYES_ERROR_OUT_OF_MEMORY, "out of memory");
     p->object = s->current_object == SCENE_OBJECT_INHERIT ? GEOM_OBJECT_INHERIT
@@ -1007,7 +994,7 @@ RayesError rayes_scene_subdivision_mesh(RayesScene *s, RayesSubdivScheme scheme,
     free(world);
     if (!mesh)
         return scene_fail(s, RAYES_ERROR_INVALID_ARGUMENT, "subdivision mesh: %s", err);
-    if (grow((void **)&s->subdivs, &s->cap_subdivs, s->n_subdivs, sizeof *s->subdivs) != 0) {
+    if (util_grow((void **)&s->subdivs, &s->cap_subdivs, s->n_subdivs, sizeof *s->subdivs) != 0) {
         geom_subdiv_free(mesh);
         return scene_fail(s, RAYES_ERROR_OUT_OF_MEMORY, "out of memory");
     }
@@ -1060,7 +1047,7 @@ static RayesError add_volume(RayesScene *s, const float bound[6], int64_t inside
         if (s->volumes[i].atmosphere)
             v = &s->volumes[i]; /* the one atmosphere, replaced */
     if (!v) {
-        if (grow((void **)&s->volumes, &s->cap_volumes, s->n_volumes, sizeof *s->volumes) != 0)
+        if (util_grow((void **)&s->volumes, &s->cap_volumes, s->n_volumes, sizeof *s->volumes) != 0)
             return scene_fail(s, RAYES_ERROR_OUT_OF_MEMORY, "out of memory");
         v = &s->volumes[s->n_volumes++];
     }
@@ -1108,7 +1095,7 @@ RayesError rayes_scene_area_light(RayesScene *s, const float P[4][3], const floa
     if (s->open_master >= 0)
         return scene_fail(s, RAYES_ERROR_INVALID_ARGUMENT,
                           "area light: not allowed in an object block");
-    if (grow((void **)&s->lights, &s->cap_lights, s->n_lights, sizeof *s->lights) != 0)
+    if (util_grow((void **)&s->lights, &s->cap_lights, s->n_lights, sizeof *s->lights) != 0)
         return scene_fail(s, RAYES_ERROR_OUT_OF_MEMORY, "out of memory");
     Light *l = &s->lights[s->n_lights];
     memset(l, 0, sizeof *l);
@@ -1137,7 +1124,7 @@ RayesError rayes_scene_area_light(RayesScene *s, const float P[4][3], const floa
     Prim p = {.type = PRIM_BILINEAR, .object = (uint32_t)(s->n_objects - 1),
               .shading_rate = s->shading_rate, .motion = s->current_motion};
     memcpy(p.cp, l->P, sizeof l->P);
-    if (grow((void **)&s->prims, &s->cap_prims, s->n_prims, sizeof *s->prims) != 0)
+    if (util_grow((void **)&s->prims, &s->cap_prims, s->n_prims, sizeof *s->prims) != 0)
         return scene_fail(s, RAYES_ERROR_OUT_OF_MEMORY, "out of memory");
     s->prims[s->n_prims++] = p;
     s->current_object = keep;
@@ -1236,7 +1223,7 @@ RayesError rayes_scene_set_light_links(RayesScene *s, RayesLightLinks mode, cons
         return RAYES_OK;
     }
     if (s->n_links >= UINT32_MAX - 1 ||
-        grow((void **)&s->links, &s->cap_links, s->n_links, sizeof *s->links) != 0)
+        util_grow((void **)&s->links, &s->cap_links, s->n_links, sizeof *s->links) != 0)
         return scene_fail(s, RAYES_ERROR_OUT_OF_MEMORY, "out of memory");
     size_t *copy = malloc((n_lights ? n_lights : 1) * sizeof *copy);
     if (!copy)
@@ -1770,10 +1757,10 @@ static void light_motion(const RayesScene *s, Light *l)
  * specular rays see (n_prims of them). */
 static RayesError push_light(RayesScene *s, const Light *l, const Prim *prims, size_t n_prims)
 {
-    if (grow((void **)&s->lights, &s->cap_lights, s->n_lights, sizeof *s->lights) != 0)
+    if (util_grow((void **)&s->lights, &s->cap_lights, s->n_lights, sizeof *s->lights) != 0)
         return scene_fail(s, RAYES_ERROR_OUT_OF_MEMORY, "out of memory");
     for (size_t i = 0; i < n_prims; i++)
-        if (grow((void **)&s->prims, &s->cap_prims, s->n_prims + i, sizeof *s->prims) != 0)
+        if (util_grow((void **)&s->prims, &s->cap_prims, s->n_prims + i, sizeof *s->prims) != 0)
             return scene_fail(s, RAYES_ERROR_OUT_OF_MEMORY, "out of memory");
     if (n_prims) {
         int64_t keep = s->current_object;
