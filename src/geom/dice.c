@@ -30,6 +30,7 @@
 
 #define LATTICE 5           /* estimation lattice, per side */
 #define MAX_SPLIT_DEPTH 48  /* a bound on recursion for degenerate input */
+#define SLIVER_MIN_RATE 4   /* a sliver diced finer than this along its length: sliver_shape */
 
 typedef struct Domain {
     float c[3][2]; /* quad: c[0] = (u0, v0), c[1] = (u1, v1); triangle: three corners */
@@ -47,6 +48,10 @@ typedef struct Domain {
 typedef struct Estimate {
     int n_u, n_v;  /* micropolygons needed along u and v (triangle: n_u per edge) */
     int thin_edge; /* triangle: the edge to bisect when split (thin_edge), or -1 */
+    int needle;    /* triangle: a needle's apex + 1 (sliver_shape), or 0 */
+    int cap;       /* triangle: a thin one's long edge + 1 when it is less than a
+                      micropolygon high (sliver_shape), or 0 */
+    double foot;   /* a cap's split: its apex's foot on that edge, as a dyadic fraction */
 } Estimate;
 
 void geom_gridset_init(GridSet *gs)
@@ -264,6 +269,64 @@ static int thin_edge(const Vec3 (*p)[LATTICE])
     return longest > 0.0f && longest * longest > 3.0f * area2 ? e : -1;
 }
 
+/* A sliver of a triangle: w holds its corners in space, r in the
+ * lattice's (raster or space), unit the micropolygon's edge there. A
+ * needle in space (its shortest edge at most a quarter of its longest)
+ * whose short edge is at most four micropolygons long gets *needle = the
+ * corner across that edge + 1 (dice_fan); another thin triangle
+ * less than a micropolygon high gets *cap = its long edge + 1 and *foot
+ * the point of that edge to split it at (into two needles). A triangular grid has one
+ * rate for its three edges and gave a sliver its long edge's rate across
+ * its width too: on Bitterli's staircase, slivers 13 pixels long and 0.3
+ * wide took 153 vertices each where a strip of 16 quads along them takes
+ * 34. The shape is the one in space: a wall seen edge on is a sliver on
+ * the screen only, and its grid serves the rays that meet it face on
+ * (radiosity, shadows) too. */
+static void sliver_shape(const Vec3 *w, const Vec3 *r, float unit, int *needle, int *cap,
+                         double *foot)
+{
+    float l[3];
+    int lo = 0, hi = 0;
+    for (int k = 0; k < 3; k++) {
+        l[k] = v3_length(v3_sub(w[(k + 1) % 3], w[k]));
+        lo = l[k] < l[lo] ? k : lo;
+        hi = l[k] > l[hi] ? k : hi;
+    }
+    float area2 = v3_length(v3_cross(v3_sub(w[1], w[0]), v3_sub(w[2], w[0])));
+    int thin = l[hi] > 0.0f && l[hi] * l[hi] > 3.0f * area2;
+    *needle = *cap = 0;
+    if (!thin)
+        return;
+    /* in the lattice's space: the short edge, and the height over the long one */
+    float r_lo = v3_length(v3_sub(r[(lo + 1) % 3], r[lo]));
+    float r_hi = v3_length(v3_sub(r[(hi + 1) % 3], r[hi]));
+    float r_area2 = v3_length(v3_cross(v3_sub(r[1], r[0]), v3_sub(r[2], r[0])));
+    if (4.0f * l[lo] <= l[hi]) {
+        if (r_lo <= 4.0f * unit)
+            *needle = (lo + 2) % 3 + 1; /* edge lo runs from corner lo to lo + 1 */
+    } else if (r_area2 <= unit * r_hi) {
+        /* Split at the apex's foot, rounded to a multiple of 2^-k whose
+         * step along the edge is two to four micropolygons (k at least 1,
+         * at most 12: the domain's corners stay exact), so the split
+         * point is a vertex of whatever shares the edge: a neighbour
+         * diced finer than that step has vertices at the multiples of its
+         * power-of-two step, one diced coarser is coarser than both parts
+         * (at most 1.42 micropolygons a step) all along, and stitching
+         * puts every vertex on its polyline (geom/stitch.c). Both parts
+         * are then needles (the foot at most two micropolygons off); at
+         * the midpoint the part that held the foot was a cap again,
+         * halved again and again. */
+        Vec3 e = v3_sub(w[(hi + 1) % 3], w[hi]);
+        double f = v3_dot(v3_sub(w[(hi + 2) % 3], w[hi]), e) / ((double)l[hi] * l[hi]);
+        int k = 1;
+        while (k < 12 && ldexp(2.0 * unit, k + 1) <= r_hi)
+            k++;
+        double steps = ldexp(1.0, k), at = round(f * steps);
+        *cap = hi + 1;
+        *foot = fmin(fmax(at, 1.0), steps - 1.0) / steps;
+    }
+}
+
 /* How a primitive's grids are traced (GeomShape). */
 static int prim_shape(const Prim *prim)
 {
@@ -333,7 +396,7 @@ static Estimate estimate(const Prim *prim, const Domain *d, const DiceCamera *ca
     float scale = cam->rate_scale > 1.0f ? cam->rate_scale : 1.0f;
     float rate = sqrtf(fmaxf(prim->shading_rate, 1e-6f)) * scale; /* edge, in pixels */
     if (d->triangular && one_micropolygon(prim, d, cam, rate))
-        return (Estimate){1, 1, -1};
+        return (Estimate){1, 1, -1, 0, 0, 0.5};
     Vec3 p[LATTICE][LATTICE];
     float s[LATTICE * LATTICE][2];
     Vec3 pts[LATTICE * LATTICE];
@@ -352,6 +415,7 @@ static Estimate estimate(const Prim *prim, const Domain *d, const DiceCamera *ca
     float outside = 0.0f;
     ViewPlace place = view_place(cam, pts, n, s, &outside);
     float len[3], unit;
+    const Vec3 world[3] = {p[0][0], p[0][LATTICE - 1], p[LATTICE - 1][0]}; /* a triangle's */
     if (place == VIEW_ON && !cam->isotropic) {
         /* Raster positions in the lattice's own layout, then measured as
          * points in the plane. */
@@ -370,11 +434,14 @@ static Estimate estimate(const Prim *prim, const Domain *d, const DiceCamera *ca
             unit *= 1.0f + (cam->offscreen - 1.0f) * fminf(outside, 1.0f);
     }
     lattice_lengths((const Vec3(*)[LATTICE])p, d->triangular, len);
-    Estimate e = {.thin_edge = -1};
+    Estimate e = {.thin_edge = -1, .foot = 0.5};
     if (d->triangular) {
         float l = fmaxf(len[0], fmaxf(len[1], len[2]));
         e.n_u = e.n_v = (int)fminf(ceilf(l / unit), 1e6f);
         e.thin_edge = thin_edge((const Vec3(*)[LATTICE])p);
+        const int last = LATTICE - 1;
+        Vec3 r[3] = {p[0][0], p[0][last], p[last][0]};
+        sliver_shape(world, r, unit, &e.needle, &e.cap, &e.foot);
     } else {
         e.n_u = (int)fminf(ceilf(len[0] / unit), 1e6f);
         e.n_v = (int)fminf(ceilf(len[1] / unit), 1e6f);
@@ -706,12 +773,20 @@ static int split_sub_triangle(Walk *w, const float *a, const float *b, const flo
     return split_dice(w, &sub, depth + 1);
 }
 
-/* A thin triangle: two halves at the midpoint of its long edge (thin:
- * that edge's first corner, k, to k + 1), corners kept in order. */
-static int split_triangle(Walk *w, const Domain *d, int thin, int depth)
+/* A thin triangle: two parts at a point of its long edge (thin: that
+ * edge's first corner, k, to k + 1), corners kept in order: at the edge's
+ * fraction `at` (a dyadic fraction: sliver_shape), or at its midpoint
+ * when that point is not exact in the domain's floats. */
+static int split_triangle(Walk *w, const Domain *d, int thin, double at, int depth)
 {
     int a = thin, b = (thin + 1) % 3;
-    float m[2] = {0.5f * (d->c[a][0] + d->c[b][0]), 0.5f * (d->c[a][1] + d->c[b][1])};
+    float m[2];
+    for (int c = 0; c < 2; c++) {
+        double x = d->c[a][c] + at * ((double)d->c[b][c] - d->c[a][c]);
+        m[c] = (float)x;
+        if ((double)m[c] != x)
+            at = 0.5, c = -1; /* again, at the midpoint (exact) */
+    }
     float half[2][3][2];
     for (int h = 0; h < 2; h++)
         memcpy(half[h], d->c, sizeof half[h]);
@@ -753,9 +828,34 @@ static int split_quads(Walk *w, const Domain *d, int depth)
     return 0;
 }
 
+/* A needle (sliver_shape) as a quad whose side t = 0 is its short edge
+ * and whose side t = 1 is its apex (GridSub.corner GEOM_FAN + apex): its
+ * rows cross it, so it dices finely along and once or twice across; the
+ * quad's rows and columns are the triangle's lines, its winding the
+ * triangle's. */
+static int dice_fan(Walk *w, const Domain *d, int apex, int depth)
+{
+    int b0 = (apex + 1) % 3, b1 = (apex + 2) % 3;
+    Domain fan = {.c = {{0, 0}, {1, 1}, {0, 0}}, .sub_quad = 1, .corner = GEOM_FAN + apex};
+    memcpy(fan.tri, d->c, sizeof fan.tri);
+    memcpy(fan.q[0], d->c[b0], sizeof fan.q[0]);
+    memcpy(fan.q[1], d->c[b1], sizeof fan.q[1]);
+    memcpy(fan.q[2], d->c[apex], sizeof fan.q[2]);
+    memcpy(fan.q[3], d->c[apex], sizeof fan.q[3]);
+    return split_dice(w, &fan, depth + 1);
+}
+
 static int split_dice(Walk *w, const Domain *d, int depth)
 {
     Estimate e = estimate(w->prim, d, w->cam);
+    /* Slivers a triangular grid would dice at their long edge's rate all
+     * over (below a few micropolygons it costs no more than a strip). */
+    if (d->triangular && e.n_u >= SLIVER_MIN_RATE && depth < MAX_SPLIT_DEPTH) {
+        if (e.needle)
+            return dice_fan(w, d, e.needle - 1, depth);
+        if (e.cap)
+            return split_triangle(w, d, e.cap - 1, e.foot, depth);
+    }
     if (w->prim->type == PRIM_POINT) {
         /* One grid per point (accel.h traces it whole), square. */
         e.n_u = e.n_v = RY_MIN(RY_MAX(e.n_u, e.n_v), w->lim.side);
@@ -769,7 +869,7 @@ static int split_dice(Walk *w, const Domain *d, int depth)
     if (d->triangular && e.thin_edge < 0)
         return split_quads(w, d, depth);
     if (d->triangular)
-        return split_triangle(w, d, e.thin_edge, depth);
+        return split_triangle(w, d, e.thin_edge, 0.5, depth);
     /* Across the longer direction (u on a tie). */
     int su = e.n_u >= e.n_v ? 2 : 1, sv = 3 - su;
     for (int j = 0; j < sv; j++)

@@ -258,9 +258,14 @@ typedef struct Grid {
     uint32_t motion_vertex; /* a moving grid: its first vertex in GridSet.Pt and the rest */
 } Grid;
 
-/* Where a quad over part of a triangle lies in it (Grid.sub). */
+/* Where a quad over part of a triangle lies in it (Grid.sub): one of the
+ * three quads a large triangle dices into (split_quads), from its corner
+ * `corner`; or a needle's fan (dice_fan, corner GEOM_FAN + the apex),
+ * whose side t = 0 is the edge across from the apex, from corner apex + 1
+ * (s = 0) to apex + 2, and side t = 1 the apex. */
+#define GEOM_FAN 3
 typedef struct GridSub {
-    uint8_t corner;  /* the triangle's corner it starts at */
+    uint8_t corner;  /* the triangle's corner it starts at, or GEOM_FAN + a fan's apex */
     float sub[2][2]; /* its rectangle of the quad's own (s, t), (s0, t0) and (s1, t1),
                         in [0, 1] */
     float tri[3][2]; /* the triangle's corners, the primitive's (u, v) */

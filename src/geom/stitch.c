@@ -51,13 +51,18 @@ typedef struct Side {
     uint32_t n;       /* segments */
     uint8_t tri_edge; /* a triangular grid's edge k, from corner k to k + 1: 1 + k; else 0 */
     uint8_t reversed; /* that edge runs from hi to lo */
+    uint8_t apex_back; /* a needle fan's side s = 1: its apex end is the apex row's
+                          first vertex, this many before the row's last (the fan's
+                          two sides meet in one vertex, as a grid's sides do) */
 } Side;
 
 /* The index in the GridSet of vertex i (from lo) of a side. */
 static size_t side_vertex(const Side *sd, uint32_t i)
 {
-    if (!sd->tri_edge)
-        return (size_t)((ptrdiff_t)sd->first + sd->stride * (ptrdiff_t)i);
+    if (!sd->tri_edge) {
+        size_t v = (size_t)((ptrdiff_t)sd->first + sd->stride * (ptrdiff_t)i);
+        return sd->apex_back && i == (sd->reversed ? 0 : sd->n) ? v - sd->apex_back : v;
+    }
     /* Edge 0 is row j = 0, edge 1 the diagonal i + j = n, edge 2 column i = 0. */
     uint32_t n = sd->n, k = sd->reversed ? n - i : i;
     uint32_t a = sd->tri_edge == 1 ? k : sd->tri_edge == 2 ? n - k : 0;
@@ -181,6 +186,7 @@ static int put_side(Side *out, const uint64_t key[2], uint32_t master, double a,
         out->key[0] = hash_combine(key[0], 0x4d4153544552ull + master);
     out->n = n;
     out->tri_edge = (uint8_t)tri_edge;
+    out->apex_back = 0;
     out->reversed = a > b;
     if (a > b && !tri_edge) {
         first += (size_t)(stride * (ptrdiff_t)n);
@@ -215,26 +221,46 @@ static int tri_segment(const Prim *prim, uint32_t prim_index, const float *a, co
         t[1] = e[0] + ((double)e[1] - e[0]) * pb;
         return 1;
     }
-    float ends[2][2] = {{a[0], a[1]}, {b[0], b[1]}};
-    int forward = memcmp(a, b, 2 * sizeof *a) <= 0 || (a[0] == b[0] && a[1] == b[1]);
-    if (!forward)
-        memcpy(ends[0], b, sizeof ends[0]), memcpy(ends[1], a, sizeof ends[1]);
-    key[0] = hash_floats(hash_combine(0x5452494c494e45ull, prim_index), &ends[0][0], 4);
+    /* A line inside: keyed by the line, not the segment, since a split
+     * triangle's halves may be split again along the segment their
+     * neighbour shares whole. Its direction scaled by a power of two to
+     * [1, 2) and pointing to +u (or +v), the parameter the projection on
+     * it: exact in doubles for a domain's dyadic corners, so the halves of
+     * a segment find its key and its parameters. */
+    double du = (double)b[0] - a[0], dv = (double)b[1] - a[1];
+    int ex;
+    if (du == 0.0 && dv == 0.0)
+        return 0;
+    frexp(fmax(fabs(du), fabs(dv)), &ex);
+    du = ldexp(du, 1 - ex), dv = ldexp(dv, 1 - ex);
+    if (du < 0.0 || (du == 0.0 && dv < 0.0))
+        du = -du, dv = -dv;
+    /* + 0.0: a zero of either sign keys alike */
+    double line[3] = {du + 0.0, dv + 0.0, (double)a[0] * dv - (double)a[1] * du + 0.0};
+    key[0] = hash_combine(0x5452494c494e45ull, prim_index);
+    for (int k = 0; k < 3; k++) {
+        uint64_t bits;
+        memcpy(&bits, &line[k], sizeof bits);
+        key[0] = hash_combine(key[0], bits);
+    }
     key[1] = hash_combine(key[0], 0x9e3779b97f4a7c15ull);
-    t[0] = forward ? 0.0 : 1.0;
-    t[1] = 1.0 - t[0];
+    t[0] = (double)a[0] * du + (double)a[1] * dv;
+    t[1] = (double)b[0] * du + (double)b[1] * dv;
     return 1;
 }
 
 /* The key of a line inside a quad over part of a triangle (split_quads):
  * a line s or t = c of quad k (axis 0: t = c, 1: s = c), or (axis 2) the
- * spoke k from the midpoint of edge k to the centroid. */
+ * spoke k from the midpoint of edge k to the centroid; k GEOM_FAN + apex
+ * for a fan's. */
 static void sub_quad_line(const Grid *g, const GridSub *sub, int axis, float c, int k,
                           uint64_t key[2])
 {
     uint32_t bits;
     memcpy(&bits, &c, sizeof bits);
     key[0] = hash_floats(hash_combine(0x5355425155414455ull, g->prim), &sub->tri[0][0], 6);
+    if (k >= GEOM_FAN) /* apart from split_quads' (whose keys stay as they were) */
+        key[0] = hash_combine(key[0], 0x46414eull /* "FAN" */);
     key[0] = hash_combine(hash_combine(key[0], (uint64_t)axis * 4 + (uint64_t)k), bits);
     key[1] = hash_combine(key[0], 0x9e3779b97f4a7c15ull);
 }
@@ -261,6 +287,35 @@ static int sub_quad_side(const Grid *g, const GridSub *sub, const Prim *prim, in
     else
         sub_quad_line(g, sub, side == 0 || side == 2 ? 0 : 1, (float)c, k, key);
     *a = s0, *b = s1;
+    return 1;
+}
+
+/* Side `side` of a needle's fan (dice_fan; apex k, base from k + 1 to
+ * k + 2): its side t = 0 on the base, s = 0 and 1 on the edges from the
+ * base's ends to the apex (the quad's map is linear along each), t = 1
+ * the apex itself (no line); lines inside it keyed as a sub-quad's. */
+static int fan_side(const Grid *g, const GridSub *sub, const Prim *prim, int side, double s0,
+                    double s1, double c, uint64_t key[2], double *a, double *b)
+{
+    int apex = sub->corner - GEOM_FAN, b0 = (apex + 1) % 3, b1 = (apex + 2) % 3;
+    const float *from = NULL, *to = NULL;
+    if (c == 0.0 && side == 0)
+        from = sub->tri[b0], to = sub->tri[b1];
+    else if (c == 0.0 && side == 3)
+        from = sub->tri[b0], to = sub->tri[apex];
+    else if (c == 1.0 && side == 1)
+        from = sub->tri[b1], to = sub->tri[apex];
+    else if (c == 1.0 && side == 2)
+        return 0;
+    if (!from) {
+        sub_quad_line(g, sub, side == 0 || side == 2 ? 0 : 1, (float)c, sub->corner, key);
+        *a = s0, *b = s1;
+        return 1;
+    }
+    double t[2];
+    if (!tri_segment(prim, g->prim, from, to, key, t))
+        return 0;
+    *a = t[0] + (t[1] - t[0]) * s0, *b = t[0] + (t[1] - t[0]) * s1;
     return 1;
 }
 
@@ -291,7 +346,8 @@ static int grid_side(const Grid *g, const GridSub *sub, const Prim *prim, int si
     uint64_t key[2];
     double a, b;
     if (sub) {
-        if (!sub_quad_side(g, sub, prim, side, s0, s1, c, key, &a, &b))
+        if (!(sub->corner >= GEOM_FAN ? fan_side : sub_quad_side)(g, sub, prim, side, s0, s1, c,
+                                                                  key, &a, &b))
             return 0;
     } else {
         if (c == border) {
@@ -312,7 +368,11 @@ static int grid_side(const Grid *g, const GridSub *sub, const Prim *prim, int si
                                           : base + (size_t)(nv - 1) * (size_t)nu;
     ptrdiff_t stride = on_v[side] ? 1 : nu;
     uint32_t n = (uint32_t)(on_v[side] ? nu - 1 : nv - 1);
-    return put_side(out, key, g->master, a, b, start, stride, n, 0);
+    if (!put_side(out, key, g->master, a, b, start, stride, n, 0))
+        return 0;
+    if (sub && sub->corner >= GEOM_FAN && side == 1 && r[1][1] == 1.0f)
+        out->apex_back = (uint8_t)(nu - 1);
+    return 1;
 }
 
 static int cmp_side(const void *pa, const void *pb)
@@ -339,10 +399,12 @@ typedef struct Curve {
 /* The largest spacing among the sides covering t, and the canonical
  * position at t (the least copy, over the sides with a vertex there) in
  * *at when some side has one; returns that spacing. */
-static double curve_at(const Curve *c, const Vec3 *P, double t, Vec3 *at, int *found)
+static double curve_at(const Curve *c, const Vec3 *P, double t, Vec3 *at, int *found,
+                       double *origin)
 {
     double H = 0.0;
     *found = 0;
+    *origin = 0.0;
     /* Sides are sorted by lo, none longer than len: those covering t
      * start in [t - len, t]. */
     size_t lo = 0, hi = c->n; /* the first side starting past t (a binary search: a
@@ -359,7 +421,8 @@ static double curve_at(const Curve *c, const Vec3 *P, double t, Vec3 *at, int *f
         if (t > sd->hi)
             continue;
         double h = (sd->hi - sd->lo) / sd->n, i = (t - sd->lo) / h;
-        H = fmax(H, h);
+        if (h > H)
+            H = h, *origin = sd->lo;
         if (i == floor(i)) {
             Vec3 p = P[side_vertex(sd, (uint32_t)i)];
             if (!*found || vec_less(p, *at))
@@ -375,16 +438,18 @@ static double curve_at(const Curve *c, const Vec3 *P, double t, Vec3 *at, int *f
  * rates that are not powers of two: left alone). */
 static int settle(const Curve *c, const Vec3 *P, const Side *sd, uint32_t i, Vec3 *out)
 {
-    double t = sd->lo + (sd->hi - sd->lo) * i / sd->n;
+    double t = sd->lo + (sd->hi - sd->lo) * i / sd->n, origin, unused;
     int found;
-    double H = curve_at(c, P, t, out, &found);
-    double t0 = floor(t / H) * H;
+    double H = curve_at(c, P, t, out, &found, &origin);
+    /* the coarsest side's vertex at or before t (its vertices lie at its
+     * lo plus multiples of H: a line inside a triangle starts anywhere) */
+    double t0 = origin + floor((t - origin) / H) * H;
     if (t0 == t)
         return found;
     Vec3 a, b;
     int fa, fb;
-    curve_at(c, P, t0, &a, &fa);
-    curve_at(c, P, t0 + H, &b, &fb);
+    curve_at(c, P, t0, &a, &fa, &unused);
+    curve_at(c, P, t0 + H, &b, &fb, &unused);
     if (!fa || !fb)
         return 0;
     *out = v3_add(a, v3_scale(v3_sub(b, a), (float)((t - t0) / H)));
@@ -562,6 +627,22 @@ static int settled(const Curve *c, const Vec3 *P)
     return 1;
 }
 
+/* A fan's apex row: every vertex where its first one was settled (that
+ * one stands for the apex on both of the fan's sides, Side.apex_back;
+ * the others lie on no side and would keep their own copy of it). */
+static void close_fans(GridSet *gs)
+{
+    for (size_t k = 0; k < gs->n_grids; k++) {
+        const Grid *g = &gs->grids[k];
+        const GridSub *sub = g->sub ? &gs->subs[g->sub - 1] : NULL;
+        if (!sub || sub->corner < GEOM_FAN || sub->sub[1][1] != 1.0f)
+            continue;
+        size_t row = g->first_vertex + (size_t)(g->nv - 1) * g->nu;
+        for (size_t i = 1; i < g->nu; i++)
+            gs->P[row + i] = gs->P[row];
+    }
+}
+
 int geom_stitch(GridSet *gs, const Prim *prims)
 {
     size_t n, words = gs->n_vertices / 64 + 1;
@@ -597,5 +678,6 @@ int geom_stitch(GridSet *gs, const Prim *prims)
         memset(mv.now, 0, words * sizeof *mv.now);
     }
     free(sides), free(mv.now), free(mv.before);
+    close_fans(gs);
     return 0;
 }

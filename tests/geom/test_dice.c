@@ -414,10 +414,23 @@ static void test_floor_through_eye_plane(void)
     geom_gridset_fini(&gs);
 }
 
+/* The grids of a sliver: quads (fans, GridSub corner GEOM_FAN + apex) or
+ * triangles; the number of fans. */
+static size_t fans(const GridSet *gs)
+{
+    size_t n = 0;
+    for (size_t g = 0; g < gs->n_grids; g++) {
+        const Grid *gr = &gs->grids[g];
+        n += !gr->triangular && gr->sub && gs->subs[gr->sub - 1].corner >= GEOM_FAN;
+    }
+    return n;
+}
+
 /* A long thin triangle (1000 x 1 units, one unit per micropolygon at its
- * nearest) is bisected across its long edge while it must split: 39,687
- * vertices, where splitting in fours (which keeps it as thin) gave
- * 198,336. */
+ * nearest) is a needle: a fan from its short edge, diced along it at the
+ * rate its length needs and once or twice across, in quads split along
+ * it: 3,003 vertices where bisecting it across its long edge gave 39,687
+ * and splitting in fours (which keeps it as thin) 198,336. */
 static void test_thin_triangle(void)
 {
     GridSet gs;
@@ -425,8 +438,35 @@ static void test_thin_triangle(void)
     t.cp[0] = v3(-500, 0, 0), t.cp[1] = v3(500, 0, 0), t.cp[2] = v3(-500, 1, 0);
     DiceCamera cam = camera();
     size_t n = dice_vertices(&t, &cam, &gs);
-    CHECK(n > 500 && n < 50000);
+    printf("  needle: %zu vertices, %zu grids, %zu fans\n", n, gs.n_grids, fans(&gs));
+    CHECK(n > 1000 && n < 4000);
+    CHECK(fans(&gs) == gs.n_grids);
     CHECK_NEAR(cell_area(&gs, 1.0f), 500.0, 0.01); /* the parts tile the triangle */
+    geom_gridset_fini(&gs);
+}
+
+/* A cap (its apex a unit above the middle of a 1000-unit edge) is halved
+ * across its long edge until its halves are needles, then fanned; a
+ * sliver seen edge on but fat in space is not a sliver (its grid serves
+ * rays that meet it face on). */
+static void test_sliver_cap(void)
+{
+    GridSet gs;
+    Prim t = {.type = PRIM_TRIANGLE, .shading_rate = 1.0f};
+    t.cp[0] = v3(-500, 0, 0), t.cp[1] = v3(500, 0, 0), t.cp[2] = v3(30, 1, 0);
+    DiceCamera cam = camera();
+    size_t n = dice_vertices(&t, &cam, &gs);
+    printf("  cap: %zu vertices, %zu grids, %zu fans\n", n, gs.n_grids, fans(&gs));
+    CHECK(n > 1000 && n < 8000);
+    CHECK(fans(&gs) >= 2 && fans(&gs) == gs.n_grids);
+    CHECK_NEAR(cell_area(&gs, 1.0f), 500.0, 0.01);
+    geom_gridset_fini(&gs);
+    /* Seen edge on from (0, 0, -100): a line on the screen, a right
+     * triangle of 10 x 10 units in space. */
+    DiceCamera view = view_camera(4.0f);
+    t.cp[0] = v3(-5, 0, -5), t.cp[1] = v3(5, 0, -5), t.cp[2] = v3(-5, 0, 5);
+    dice_vertices(&t, &view, &gs);
+    CHECK(fans(&gs) == 0);
     geom_gridset_fini(&gs);
 }
 
@@ -436,4 +476,4 @@ TEST_MAIN(TEST(test_bezier_basis), TEST(test_prim_is_small), TEST(test_bicubic_r
           TEST(test_split_limits_grid_size), TEST(test_split_by_area), TEST(test_grid_size_option),
           TEST(test_distance_based_rates), TEST(test_triangle_grid_counts),
           TEST(test_raster_oriented_dicing), TEST(test_offscreen_dicing),
-          TEST(test_floor_through_eye_plane), TEST(test_thin_triangle))
+          TEST(test_floor_through_eye_plane), TEST(test_thin_triangle), TEST(test_sliver_cap))

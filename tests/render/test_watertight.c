@@ -101,6 +101,8 @@ static void add_marker(RayesScene *s)
  * behind (a closed surface seen from outside is entered first; a ray
  * grazing the silhouette may meet the edge of a micropolygon turned a
  * hair away, which is no leak). */
+static size_t last_fans; /* the last leaks() scene's needle fans (dice.c dice_fan) */
+
 static long leaks(const RayesScene *s, int n)
 {
     GridSet gs;
@@ -112,6 +114,9 @@ static long leaks(const RayesScene *s, int n)
     CHECK(a != NULL);
     const SceneCamera *c = &s->camera;
     long leaked = 0;
+    last_fans = 0;
+    for (size_t g = 0; g < gs.n_grids; g++)
+        last_fans += gs.grids[g].sub && gs.subs[gs.grids[g].sub - 1].corner >= GEOM_FAN;
     for (int y = 0; a && y < IMAGE * n; y++)
         for (int x = 0; x < IMAGE * n; x++) {
             float sx = 2.0f * ((float)x + 0.5f) / (float)(IMAGE * n) - 1.0f;
@@ -317,6 +322,75 @@ static void test_displaced_beside_one_micropolygon_faces(void)
     rayes_scene_release(s);
 }
 
+enum { SLIVERS = 128 }; /* strips around the sliver cylinder */
+
+/* A closed cylinder (radius 1, height 2) of slivers: each of SLIVERS
+ * strips around it is four triangles about a point on a ring at y = 0.3,
+ * two needles (their short edges on the rims) and two caps (their long
+ * edges the strip's sides, split near their apexes' feet, not at their
+ * midpoints), and the ends are fans of needles; faces wound outward.
+ * Returns the faces. */
+static int sliver_cylinder(float P[3 * SLIVERS + 2][3], int idx[18 * SLIVERS])
+{
+    const float pi = 3.14159265f;
+    for (int i = 0; i < SLIVERS; i++) {
+        float a = 2.0f * pi * (float)i / SLIVERS, m = a + pi / SLIVERS;
+        float ring[3][3] = {
+            {cosf(a), -1, sinf(a)}, {cosf(a), 1, sinf(a)}, {cosf(m), 0.3f, sinf(m)}};
+        memcpy(P[3 * i], ring, sizeof ring);
+    }
+    float ends[2][3] = {{0, -1, 0}, {0, 1, 0}};
+    memcpy(P[3 * SLIVERS], ends, sizeof ends);
+    int f = 0;
+    for (int i = 0; i < SLIVERS; i++) {
+        int j = (i + 1) % SLIVERS, b0 = 3 * i, t0 = b0 + 1, m = b0 + 2, b1 = 3 * j, t1 = b1 + 1;
+        int tri[6][3] = {{b0, b1, m}, {t0, t1, m},           {b0, t0, m},
+                         {b1, t1, m}, {3 * SLIVERS, b0, b1}, {3 * SLIVERS + 1, t0, t1}};
+        for (int k = 0; k < 6; k++, f++) {
+            const float *p0 = P[tri[k][0]], *p1 = P[tri[k][1]], *p2 = P[tri[k][2]];
+            Vec3 n = v3_cross(v3(p1[0] - p0[0], p1[1] - p0[1], p1[2] - p0[2]),
+                              v3(p2[0] - p0[0], p2[1] - p0[1], p2[2] - p0[2]));
+            Vec3 c = v3(p0[0] + p1[0] + p2[0], p0[1] + p1[1] + p2[1], p0[2] + p1[2] + p2[2]);
+            int out = v3_dot(n, c) > 0.0f; /* the cylinder is star-shaped about 0 */
+            idx[3 * f] = tri[k][0];
+            idx[3 * f + 1] = tri[k][out ? 1 : 2];
+            idx[3 * f + 2] = tri[k][out ? 2 : 1];
+        }
+    }
+    return f;
+}
+
+/* Slivers dice as fans (needles) and caps split near their feet
+ * (geom/dice.c sliver_shape), along lines a triangular grid's neighbours
+ * do not share whole: plain, and displaced. */
+static void test_sliver_mesh_is_watertight(void)
+{
+    static float P[3 * SLIVERS + 2][3];
+    static int idx[18 * SLIVERS], nv[6 * SLIVERS];
+    int f = sliver_cylinder(P, idx);
+    for (int k = 0; k < f; k++)
+        nv[k] = 3;
+    for (int displaced = 0; displaced < 2; displaced++) {
+        RayesScene *s = scene_with_marker();
+        const RayesParam amp = {"amplitude", RAYES_PARAM_FLOAT, {0.01f, 0, 0}, NULL};
+        if (displaced) {
+            CHECK(rayes_scene_set_displacement(s, "fractal", &amp, 1) == RAYES_OK);
+            CHECK(rayes_scene_set_displacement_bound(s, 0.05f) == RAYES_OK);
+        }
+        CHECK(rayes_scene_polygon_mesh(s, (size_t)f, nv, idx, 3 * SLIVERS + 2, &P[0][0]) ==
+              RAYES_OK);
+        CHECK(rayes_scene_set_displacement(s, NULL, NULL, 0) == RAYES_OK);
+        add_marker(s);
+        CHECK(rayes_scene_commit(s) == RAYES_OK);
+        long n = leaks(s, 2);
+        printf("sliver mesh%s: %ld leaked rays of %d, %zu fans\n", displaced ? ", displaced" : "",
+               n, 4 * IMAGE * IMAGE, last_fans);
+        CHECK(n == 0);
+        CHECK(last_fans > (size_t)SLIVERS);
+        rayes_scene_release(s);
+    }
+}
+
 /* Holes are holes: a flat 3 x 3 Catmull-Clark grid whose middle face is a
  * hole; rays through the middle of the hole (a square of half its size)
  * miss, rays through the other faces' middles hit. */
@@ -371,4 +445,4 @@ TEST_MAIN(TEST(test_hole_lets_rays_through), TEST(test_subdivision_mesh_is_water
           TEST(test_polygon_mesh_is_watertight), TEST(test_ngon_mesh_is_watertight),
           TEST(test_loop_mesh_is_watertight), TEST(test_triangle_mesh_is_watertight),
           TEST(test_displaced_mixed_mesh_is_watertight),
-          TEST(test_displaced_beside_one_micropolygon_faces))
+          TEST(test_displaced_beside_one_micropolygon_faces), TEST(test_sliver_mesh_is_watertight))
