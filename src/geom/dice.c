@@ -776,17 +776,20 @@ static int split_sub_triangle(Walk *w, const float *a, const float *b, const flo
 /* A thin triangle: two parts at a point of its long edge (thin: that
  * edge's first corner, k, to k + 1), corners kept in order: at the edge's
  * fraction `at` (a dyadic fraction: sliver_shape), or at its midpoint
- * when that point is not exact in the domain's floats. */
+ * (rounded) when that point is not exact in the domain's floats. */
 static int split_triangle(Walk *w, const Domain *d, int thin, double at, int depth)
 {
     int a = thin, b = (thin + 1) % 3;
     float m[2];
+    int exact = 1;
     for (int c = 0; c < 2; c++) {
         double x = d->c[a][c] + at * ((double)d->c[b][c] - d->c[a][c]);
         m[c] = (float)x;
-        if ((double)m[c] != x)
-            at = 0.5, c = -1; /* again, at the midpoint (exact) */
+        exact &= (double)m[c] == x;
     }
+    if (!exact || at == 0.5) /* the midpoint, as floats give it */
+        for (int c = 0; c < 2; c++)
+            m[c] = 0.5f * (d->c[a][c] + d->c[b][c]);
     float half[2][3][2];
     for (int h = 0; h < 2; h++)
         memcpy(half[h], d->c, sizeof half[h]);

@@ -470,10 +470,37 @@ static void test_sliver_cap(void)
     geom_gridset_fini(&gs);
 }
 
+/* Slivers that split deep (collinear corners, a cap a million units long
+ * and a thousandth high, one far off its middle): dicing ends, with
+ * bounded vertices, where a cap's split point came to need more bits
+ * than the domain's floats hold (Bitterli's staircase hung there). */
+static void test_degenerate_slivers(void)
+{
+    static const float c[][3][3] = {
+        {{-1e6f, 0, 0}, {1e6f, 0, 0}, {3, 1e-3f, 0}},
+        {{-1e6f, 0, 0}, {1e6f, 0, 0}, {999000, 1e-3f, 0}},
+        {{-1e3f, 0, 0}, {1e3f, 0, 0}, {0.1f, 0, 0}},
+        {{1, 1, 1}, {1, 1, 1 + 1e-6f}, {1, 1 + 1e-7f, 1 + 3e-7f}},
+        {{-5e5f, 0, 0}, {5e5f, 0, 0}, {-4.99e5f, 2e-3f, 1e-3f}},
+    };
+    DiceCamera cam = camera();
+    for (size_t k = 0; k < sizeof c / sizeof c[0]; k++) {
+        GridSet gs;
+        Prim t = {.type = PRIM_TRIANGLE, .shading_rate = 1.0f};
+        for (int i = 0; i < 3; i++)
+            t.cp[i] = v3(c[k][i][0], c[k][i][1], c[k][i][2]);
+        size_t n = dice_vertices(&t, &cam, &gs);
+        printf("  degenerate sliver %zu: %zu vertices, %zu grids\n", k, n, gs.n_grids);
+        CHECK(n < 20000000);
+        geom_gridset_fini(&gs);
+    }
+}
+
 TEST_MAIN(TEST(test_bezier_basis), TEST(test_prim_is_small), TEST(test_bicubic_reproduces_bilinear),
           TEST(test_bilinear_known_values), TEST(test_sphere_eval_and_normal),
           TEST(test_degenerate_bicubic_normal), TEST(test_dicing_rate_from_camera),
           TEST(test_split_limits_grid_size), TEST(test_split_by_area), TEST(test_grid_size_option),
           TEST(test_distance_based_rates), TEST(test_triangle_grid_counts),
           TEST(test_raster_oriented_dicing), TEST(test_offscreen_dicing),
-          TEST(test_floor_through_eye_plane), TEST(test_thin_triangle), TEST(test_sliver_cap))
+          TEST(test_floor_through_eye_plane), TEST(test_thin_triangle), TEST(test_sliver_cap),
+          TEST(test_degenerate_slivers))
