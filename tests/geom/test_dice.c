@@ -494,6 +494,30 @@ static void test_degenerate_slivers(void)
         CHECK(n < 20000000);
         geom_gridset_fini(&gs);
     }
+    /* Random slivers: two corners up to 10^4 apart, the third near the
+     * line between them (up to 10^-6 off it) or near one of them, at
+     * every scale. */
+    uint32_t r = 12345;
+    size_t most = 0;
+    for (int k = 0; k < 3000; k++) {
+        float f[9];
+        for (int i = 0; i < 9; i++) {
+            r = r * 1664525u + 1013904223u;
+            f[i] = (float)(r >> 8) / 16777216.0f;
+        }
+        float len = powf(10.0f, 4.0f * f[0]), off = powf(10.0f, -6.0f + 6.0f * f[1]);
+        Prim t = {.type = PRIM_TRIANGLE, .shading_rate = 1.0f};
+        t.cp[0] = v3(-len * f[2], 5 * f[3], 10 * f[4]);
+        t.cp[1] = v3(t.cp[0].x + len, t.cp[0].y + off * f[5], t.cp[0].z);
+        float at = k % 3 == 0 ? f[6] : k % 3 == 1 ? 1e-4f * f[6] : 1.0f - 1e-4f * f[6];
+        t.cp[2] = v3(t.cp[0].x + len * at, t.cp[0].y + off * f[7], t.cp[0].z + off * f[8]);
+        GridSet gs;
+        size_t n = dice_vertices(&t, &cam, &gs);
+        most = n > most ? n : most;
+        geom_gridset_fini(&gs);
+    }
+    printf("  3000 random slivers: at most %zu vertices\n", most);
+    CHECK(most < 1000000);
 }
 
 TEST_MAIN(TEST(test_bezier_basis), TEST(test_prim_is_small), TEST(test_bicubic_reproduces_bilinear),
