@@ -1413,11 +1413,16 @@ static size_t count_from(const RayesScene *s, const DiceCamera *cams, size_t fir
  * places), or stops as soon as gs holds more than budget vertices (0: no
  * budget) and returns the vertices all primitives would need, counted;
  * else returns 0. -1 (as size_t) when out of memory. */
+/* What dice_all returns when *stop became nonzero. */
+#define DICE_STOPPED ((size_t)-2)
+
 static size_t dice_all(const RayesScene *s, const DiceCamera *cams, size_t budget,
-                       DicingServices *sv, float step, GridSet *gs)
+                       DicingServices *sv, float step, const volatile int *stop, GridSet *gs)
 {
     for (size_t i = 0; i < s->n_prims; i++) {
         size_t first = gs->n_grids;
+        if (stop && __atomic_load_n(stop, __ATOMIC_RELAXED))
+            return DICE_STOPPED;
         const DiceCamera *cam = &cams[s->prims[i].master];
         if (cam->grid_size < 0)
             continue;
@@ -1467,6 +1472,16 @@ static double grid_bytes(const RayesScene *s, size_t vertices, size_t grids)
     return (double)vertices * per_vertex + (double)grids * (sizeof(Grid) + 64.0);
 }
 
+/* scene_prepare's return when dice_all returned r (failed or stopped). */
+static int prepare_stopped(size_t r, char *err, size_t err_size)
+{
+    if (r != DICE_STOPPED)
+        return -1;
+    if (err && err_size)
+        snprintf(err, err_size, "render: cancelled");
+    return -2;
+}
+
 int scene_prepare(const RayesScene *s, int width, int height, const DiceOptions *dice,
                   TextureSystem *textures, GridSet *gs, float *coarsened, char *err,
                   size_t err_size)
@@ -1495,12 +1510,13 @@ int scene_prepare(const RayesScene *s, int width, int height, const DiceOptions 
      * sizes come in steps (a sphere at 64 x 48 stayed at 1156 vertices of
      * a 1000 budget), and a third such round in a row ends it: primitives
      * at their minimum sizes, a dense mesh's, cannot shrink. */
+    const volatile int *stop = dice ? dice->stop : NULL;
     size_t first_need = over_budget(s, cams, budget)
                             ? count_from(s, cams, 0, NULL)
-                            : dice_all(s, cams, budget, &sv, 1e-3f * radius, gs);
-    if (first_need == (size_t)-1) {
+                            : dice_all(s, cams, budget, &sv, 1e-3f * radius, stop, gs);
+    if (first_need == (size_t)-1 || first_need == DICE_STOPPED) {
         free(cams);
-        return -1;
+        return prepare_stopped(first_need, err, err_size);
     }
     if (first_need) {
         size_t need = first_need, grids = 0;
@@ -1549,9 +1565,10 @@ int scene_prepare(const RayesScene *s, int width, int height, const DiceOptions 
             free(cams);
             return -1;
         }
-        if (dice_all(s, cams, 0, &sv, 1e-3f * radius, gs) == (size_t)-1) {
+        size_t again = dice_all(s, cams, 0, &sv, 1e-3f * radius, stop, gs);
+        if (again == (size_t)-1 || again == DICE_STOPPED) {
             free(cams);
-            return -1;
+            return prepare_stopped(again, err, err_size);
         }
     }
     float rate_scale = cams[0].rate_scale;

@@ -260,6 +260,8 @@ typedef struct DiceOptions {
                              the memory the machine has beyond the process's */
     int clusters;         /* 1: tiny grids are clustered for the radiosity and irradiance
                              caches (geom_cluster_grids) */
+    const volatile int *stop; /* NULL, or dicing stops between primitives once *stop is
+                                 nonzero (RayesRenderOptions.stop) */
 } DiceOptions;
 
 /* Dices every primitive of a committed scene for its camera making an
@@ -272,7 +274,8 @@ typedef struct DiceOptions {
  * whose grids would still take more than dice->memory_limit is refused,
  * with a message in err (err_size bytes; err may be NULL). Tiny grids are
  * then clustered where dice->clusters says so.
- * Returns 0, or -1 when out of memory or refused. */
+ * Returns 0, -1 when out of memory or refused, or -2 when dice->stop
+ * stopped it ("render: cancelled" in err). */
 int scene_prepare(const RayesScene *scene, int width, int height, const DiceOptions *dice,
                   TextureSystem *textures, GridSet *gs, float *coarsened, char *err,
                   size_t err_size);

@@ -443,12 +443,15 @@ RayesError session_prepare(RayesScene *scene, const RenderSettings *set, Texture
                         set->vertex_budget,
                         set->dice_isotropic,
                         0.0,
-                        set->radiosity_cache || set->irradiance_cache};
-    if (!p->objects || !p->masks ||
-        scene_prepare(scene, set->width, set->height, &dice, textures, &p->gs, &p->coarsened, err,
-                      sizeof err) != 0) {
+                        set->radiosity_cache || set->irradiance_cache,
+                        set->stop};
+    int rc = !p->objects || !p->masks
+                 ? -1
+                 : scene_prepare(scene, set->width, set->height, &dice, textures, &p->gs,
+                                 &p->coarsened, err, sizeof err);
+    if (rc != 0) {
         session_prepared_fini(p);
-        return session_fail(scene, RAYES_ERROR_OUT_OF_MEMORY,
+        return session_fail(scene, rc == -2 ? RAYES_ERROR_CANCELLED : RAYES_ERROR_OUT_OF_MEMORY,
                             err[0] ? err : "render: out of memory preparing the scene");
     }
     p->accel = accel_new(&p->gs, p->masks, scene->n_objects, err, sizeof err);

@@ -5,7 +5,8 @@
  * call; without a budget it needs more; the off-screen factor dices
  * what the camera does not see coarser; a dense mesh over the budget
  * stops coarsening once it cannot shrink, keeps its corners bit for bit,
- * and one too big for the memory left is refused with a message.
+ * and one too big for the memory left is refused with a message; a stop
+ * flag stops it.
  */
 #include <math.h>
 #include <stdlib.h>
@@ -145,5 +146,24 @@ static void test_dense_mesh(void)
     rayes_scene_release(s);
 }
 
+/* A stop flag (a signal's, RayesRenderOptions.stop) stops dicing between
+ * primitives: scene_prepare returns -2 with "render: cancelled" (and
+ * rayes_render RAYES_ERROR_CANCELLED) where it prepared the whole scene
+ * first (a farm's SIGTERM waited for it). */
+static void test_stop_stops_dicing(void)
+{
+    RayesScene *s = floor_scene();
+    volatile int stop = 1;
+    DiceOptions o = {0, 4.0f, 0, .stop = &stop};
+    GridSet gs;
+    geom_gridset_init(&gs);
+    char err[64] = "";
+    CHECK(scene_prepare(s, 256, 256, &o, NULL, &gs, NULL, err, sizeof err) == -2);
+    CHECK(gs.n_grids == 0);
+    CHECK(strcmp(err, "render: cancelled") == 0);
+    geom_gridset_fini(&gs);
+    rayes_scene_release(s);
+}
+
 TEST_MAIN(TEST(test_vertex_budget), TEST(test_offscreen_factor), TEST(test_isotropic),
-          TEST(test_dense_mesh))
+          TEST(test_dense_mesh), TEST(test_stop_stops_dicing))
