@@ -47,7 +47,8 @@ typedef struct Domain {
 
 typedef struct Estimate {
     int n_u, n_v;  /* micropolygons needed along u and v (triangle: n_u per edge) */
-    int thin_edge; /* triangle: the edge to bisect when split (thin_edge), or -1 */
+    int thin_edge; /* triangle: its longest edge when thin (tri_shape) in the lattice's
+                      space, to bisect when it must split, or -1 */
     int needle;    /* triangle: a needle's apex + 1 (sliver_shape), or 0 */
     int cap;       /* triangle: a thin one's long edge + 1 when it is less than a
                       micropolygon high (sliver_shape), or 0 */
@@ -247,30 +248,34 @@ static void lattice_lengths(const Vec3 (*p)[LATTICE], int triangular, float len[
             len[2] += v3_length(v3_sub(p[j + 1][last - 1 - j], p[j][last - j]));
 }
 
-/* The edge of a triangle, in lattice space (0: c0-c1, 1: c1-c2, 2: c2-c0),
- * to bisect when the triangle must split and is thin (its longest edge
- * more than three times its height above it), else -1 (split_quads).
- * Split in four, a thin triangle kept its shape and its grids of slivers
- * grew with the square of its length; bisected across its long edge it
- * grows fatter (tests/geom/test_dice.c: a 1000:1 triangle dices into a
- * fifth of the vertices). */
-static int thin_edge(const Vec3 (*p)[LATTICE])
+/* A triangle's shape from its corners: edge k's length (corner k to
+ * k + 1), its shortest and longest edges (the first of equals), twice its
+ * area, and whether it is thin: its longest edge more than three times
+ * its height above it. A triangle that must split and is thin in the
+ * lattice's space is bisected across that edge (Estimate.thin_edge; else
+ * split_quads): split in four, a thin triangle kept its shape and its
+ * grids of slivers grew with the square of its length; bisected across
+ * its long edge it grows fatter. */
+typedef struct TriShape {
+    float l[3], area2;
+    int lo, hi, thin;
+} TriShape;
+
+static TriShape tri_shape(const Vec3 *c)
 {
-    const int last = LATTICE - 1;
-    Vec3 c[3] = {p[0][0], p[0][last], p[last][0]};
-    float l[3], longest = 0.0f;
-    int e = 0;
+    TriShape t = {.lo = 0, .hi = 0};
     for (int k = 0; k < 3; k++) {
-        l[k] = v3_length(v3_sub(c[(k + 1) % 3], c[k]));
-        if (l[k] > longest)
-            longest = l[k], e = k;
+        t.l[k] = v3_length(v3_sub(c[(k + 1) % 3], c[k]));
+        t.lo = t.l[k] < t.l[t.lo] ? k : t.lo;
+        t.hi = t.l[k] > t.l[t.hi] ? k : t.hi;
     }
-    float area2 = v3_length(v3_cross(v3_sub(c[1], c[0]), v3_sub(c[2], c[0])));
-    return longest > 0.0f && longest * longest > 3.0f * area2 ? e : -1;
+    t.area2 = v3_length(v3_cross(v3_sub(c[1], c[0]), v3_sub(c[2], c[0])));
+    t.thin = t.l[t.hi] > 0.0f && t.l[t.hi] * t.l[t.hi] > 3.0f * t.area2;
+    return t;
 }
 
-/* A sliver of a triangle: w holds its corners in space, r in the
- * lattice's (raster or space), unit the micropolygon's edge there. A
+/* A sliver of a triangle: w holds its corners in space, r its shape in
+ * the lattice's (raster or space), unit the micropolygon's edge there. A
  * needle in space (its shortest edge at most a quarter of its longest)
  * whose short edge is at most four micropolygons long gets *needle = the
  * corner across that edge + 1 (dice_fan); another thin triangle
@@ -282,29 +287,19 @@ static int thin_edge(const Vec3 (*p)[LATTICE])
  * 34. The shape is the one in space: a wall seen edge on is a sliver on
  * the screen only, and its grid serves the rays that meet it face on
  * (radiosity, shadows) too. */
-static void sliver_shape(const Vec3 *w, const Vec3 *r, float unit, int *needle, int *cap,
+static void sliver_shape(const Vec3 *w, const TriShape *r, float unit, int *needle, int *cap,
                          double *foot)
 {
-    float l[3];
-    int lo = 0, hi = 0;
-    for (int k = 0; k < 3; k++) {
-        l[k] = v3_length(v3_sub(w[(k + 1) % 3], w[k]));
-        lo = l[k] < l[lo] ? k : lo;
-        hi = l[k] > l[hi] ? k : hi;
-    }
-    float area2 = v3_length(v3_cross(v3_sub(w[1], w[0]), v3_sub(w[2], w[0])));
-    int thin = l[hi] > 0.0f && l[hi] * l[hi] > 3.0f * area2;
+    TriShape t = tri_shape(w);
     *needle = *cap = 0;
-    if (!thin)
+    if (!t.thin)
         return;
     /* in the lattice's space: the short edge, and the height over the long one */
-    float r_lo = v3_length(v3_sub(r[(lo + 1) % 3], r[lo]));
-    float r_hi = v3_length(v3_sub(r[(hi + 1) % 3], r[hi]));
-    float r_area2 = v3_length(v3_cross(v3_sub(r[1], r[0]), v3_sub(r[2], r[0])));
-    if (4.0f * l[lo] <= l[hi]) {
+    float r_lo = r->l[t.lo], r_hi = r->l[t.hi];
+    if (4.0f * t.l[t.lo] <= t.l[t.hi]) {
         if (r_lo <= 4.0f * unit)
-            *needle = (lo + 2) % 3 + 1; /* edge lo runs from corner lo to lo + 1 */
-    } else if (r_area2 <= unit * r_hi) {
+            *needle = (t.lo + 2) % 3 + 1; /* edge lo runs from corner lo to lo + 1 */
+    } else if (r->area2 <= unit * r_hi) {
         /* Split at the apex's foot, rounded to a multiple of 2^-k whose
          * step along the edge is two to four micropolygons (k at least 1,
          * at most 12: the domain's corners stay exact), so the split
@@ -316,8 +311,9 @@ static void sliver_shape(const Vec3 *w, const Vec3 *r, float unit, int *needle, 
          * are then needles (the foot at most two micropolygons off); at
          * the midpoint the part that held the foot was a cap again,
          * halved again and again. */
+        int hi = t.hi;
         Vec3 e = v3_sub(w[(hi + 1) % 3], w[hi]);
-        double f = v3_dot(v3_sub(w[(hi + 2) % 3], w[hi]), e) / ((double)l[hi] * l[hi]);
+        double f = v3_dot(v3_sub(w[(hi + 2) % 3], w[hi]), e) / ((double)t.l[hi] * t.l[hi]);
         int k = 1;
         while (k < 12 && ldexp(2.0 * unit, k + 1) <= r_hi)
             k++;
@@ -438,10 +434,10 @@ static Estimate estimate(const Prim *prim, const Domain *d, const DiceCamera *ca
     if (d->triangular) {
         float l = fmaxf(len[0], fmaxf(len[1], len[2]));
         e.n_u = e.n_v = (int)fminf(ceilf(l / unit), 1e6f);
-        e.thin_edge = thin_edge((const Vec3(*)[LATTICE])p);
-        const int last = LATTICE - 1;
-        Vec3 r[3] = {p[0][0], p[0][last], p[last][0]};
-        sliver_shape(world, r, unit, &e.needle, &e.cap, &e.foot);
+        const Vec3 r[3] = {p[0][0], p[0][LATTICE - 1], p[LATTICE - 1][0]};
+        TriShape rs = tri_shape(r);
+        e.thin_edge = rs.thin ? rs.hi : -1;
+        sliver_shape(world, &rs, unit, &e.needle, &e.cap, &e.foot);
     } else {
         e.n_u = (int)fminf(ceilf(len[0] / unit), 1e6f);
         e.n_v = (int)fminf(ceilf(len[1] / unit), 1e6f);

@@ -265,6 +265,19 @@ static void sub_quad_line(const Grid *g, const GridSub *sub, int axis, float c, 
     key[1] = hash_combine(key[0], 0x9e3779b97f4a7c15ull);
 }
 
+/* A side over fractions p0 to p1 of the segment from `from` to `to` (a
+ * triangle's corners, barycentric): its curve and its range of the
+ * curve's parameter (tri_segment). */
+static int on_segment(const Grid *g, const Prim *prim, const float *from, const float *to,
+                      double p0, double p1, uint64_t key[2], double *a, double *b)
+{
+    double t[2];
+    if (!tri_segment(prim, g->prim, from, to, key, t))
+        return 0;
+    *a = t[0] + (t[1] - t[0]) * p0, *b = t[0] + (t[1] - t[0]) * p1;
+    return 1;
+}
+
 /* Side `side` of a quad over part of a triangle: its outer sides (s or
  * t = 0) lie on half of the triangle's edges (corner k to k + 1 at
  * s / 2, corner k - 1 to k at 1 - t / 2), its sides s or t = 1 on the
@@ -273,14 +286,10 @@ static int sub_quad_side(const Grid *g, const GridSub *sub, const Prim *prim, in
                          double s1, double c, uint64_t key[2], double *a, double *b)
 {
     int k = sub->corner, prev = (k + 2) % 3;
-    double t[2];
     if (c == 0.0 && (side == 0 || side == 3)) {
         int e = side == 0 ? k : prev;
-        if (!tri_segment(prim, g->prim, sub->tri[e], sub->tri[(e + 1) % 3], key, t))
-            return 0;
         double p0 = side == 0 ? 0.5 * s0 : 1.0 - 0.5 * s0, p1 = side == 0 ? 0.5 * s1 : 1.0 - 0.5 * s1;
-        *a = t[0] + (t[1] - t[0]) * p0, *b = t[0] + (t[1] - t[0]) * p1;
-        return 1;
+        return on_segment(g, prim, sub->tri[e], sub->tri[(e + 1) % 3], p0, p1, key, a, b);
     }
     if (c == 1.0 && (side == 1 || side == 2))
         sub_quad_line(g, sub, 2, 0.0f, side == 1 ? k : prev, key);
@@ -307,15 +316,10 @@ static int fan_side(const Grid *g, const GridSub *sub, const Prim *prim, int sid
         from = sub->tri[b1], to = sub->tri[apex];
     else if (c == 1.0 && side == 2)
         return 0;
-    if (!from) {
-        sub_quad_line(g, sub, side == 0 || side == 2 ? 0 : 1, (float)c, sub->corner, key);
-        *a = s0, *b = s1;
-        return 1;
-    }
-    double t[2];
-    if (!tri_segment(prim, g->prim, from, to, key, t))
-        return 0;
-    *a = t[0] + (t[1] - t[0]) * s0, *b = t[0] + (t[1] - t[0]) * s1;
+    if (from)
+        return on_segment(g, prim, from, to, s0, s1, key, a, b);
+    sub_quad_line(g, sub, side == 0 || side == 2 ? 0 : 1, (float)c, sub->corner, key);
+    *a = s0, *b = s1;
     return 1;
 }
 
