@@ -547,15 +547,13 @@ const char *default_data_dir(void)
 
 /* Builds the scene `scene` names (a scene file, else a built-in scene)
  * into sink; settings receive what a file gives. */
-RayesError load_scene(const char *scene, const char *data_dir, int frame,
-                             const IoSink *sink, IoSettings *settings, char *err, size_t err_size)
+RayesError load_scene(const char *scene, const IoReadOptions *ro, const IoSink *sink,
+                      IoSettings *settings, char *err, size_t err_size)
 {
     io_settings_init(settings);
-    if (io_is_scene_file(scene)) {
-        IoReadOptions ro = {.data_dir = data_dir, .frame = frame};
-        return io_read_scene_file(scene, sink, &ro, settings, err, err_size);
-    }
-    return io_builtin_scene(scene, data_dir, sink, err, err_size);
+    if (io_is_scene_file(scene))
+        return io_read_scene_file(scene, sink, ro, settings, err, err_size);
+    return io_builtin_scene(scene, ro->data_dir, sink, err, err_size);
 }
 
 /* The exit status of a failed load: an unknown built-in name is a usage

@@ -84,7 +84,7 @@ const char *default_data_dir(void);
 
 /* Builds the scene `scene` names (a scene file, else a built-in scene)
  * into sink; settings receive what a file gives. */
-RayesError load_scene(const char *scene, const char *data_dir, int frame, const IoSink *sink,
+RayesError load_scene(const char *scene, const IoReadOptions *ro, const IoSink *sink,
                       IoSettings *settings, char *err, size_t err_size);
 
 /* The exit status of a failed load (2 for an unknown built-in, else 1). */

@@ -434,7 +434,9 @@ static int render_job(Args a, int frame, int number, Distributed *d)
     }
     IoSettings settings;
     IoSink sink = io_sink_scene(scene);
-    RayesError e = load_scene(a.scene, a.data_dir, frame, &sink, &settings, err, sizeof err);
+    IoReadOptions ro = {
+        .data_dir = a.data_dir, .frame = frame, .bounces_given = (a.set & SET_BOUNCES) != 0};
+    RayesError e = load_scene(a.scene, &ro, &sink, &settings, err, sizeof err);
     if (e == RAYES_OK && (e = default_light(&a, scene)) != RAYES_OK)
         snprintf(err, sizeof err, "%s: %s", a.scene, rayes_scene_get_error(scene));
     if (e == RAYES_OK && rayes_scene_commit(scene) != RAYES_OK) {
@@ -647,7 +649,8 @@ static int cmd_convert(int argc, char **argv)
     IoSettings settings;
     IoSink sink = io_rib_writer_sink(w);
     char err[1024];
-    RayesError e = load_scene(in, data_dir, frame, &sink, &settings, err, sizeof err);
+    IoReadOptions ro = {.data_dir = data_dir, .frame = frame};
+    RayesError e = load_scene(in, &ro, &sink, &settings, err, sizeof err);
     if (e == RAYES_OK && !(settings.width > 0 && settings.height > 0)) {
         /* a built-in scene: the size it renders at, so the RIB file (whose
          * Format would otherwise be RenderMan's 640 x 480) frames it alike */

@@ -791,7 +791,9 @@ int cmd_view(int argc, char **argv)
     char err[1024];
     IoSettings settings;
     IoSink sink = io_sink_scene(v.scene);
-    RayesError e = load_scene(a.scene, a.data_dir, a.frame, &sink, &settings, err, sizeof err);
+    IoReadOptions ro = {
+        .data_dir = a.data_dir, .frame = a.frame, .bounces_given = (a.set & SET_BOUNCES) != 0};
+    RayesError e = load_scene(a.scene, &ro, &sink, &settings, err, sizeof err);
     if (e == RAYES_OK && (e = default_light(&a, v.scene)) != RAYES_OK)
         snprintf(err, sizeof err, "%s: %s", a.scene, rayes_scene_get_error(v.scene));
     if (e == RAYES_OK && rayes_scene_commit(v.scene) != RAYES_OK) {

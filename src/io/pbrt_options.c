@@ -192,7 +192,7 @@ int pbrt_d_integrator(Parser *P, const Token *t)
     int bounces = depth >= 1 ? (int)fmin(depth - 1, 64) : 0;
     P->settings->bounces = bounces < PBRT_DIFFUSE_BOUNCES ? bounces : PBRT_DIFFUSE_BOUNCES;
     P->settings->specular_depth = (int)fmin(depth, 64);
-    if (bounces > PBRT_DIFFUSE_BOUNCES)
+    if (bounces > PBRT_DIFFUSE_BOUNCES && !(P->options && P->options->bounces_given))
         pbrt_warn_at(P, t->line, t->col, "maxdepth",
                      "Integrator \"maxdepth\" %g: %d diffuse bounces, not %d (each costs "
                      "about as much as the first and adds less than the one before; "

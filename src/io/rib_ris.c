@@ -479,7 +479,7 @@ static int h_integrator(Rib *r, const Args *a)
     int bounces = len >= 1 ? (int)len - 1 : 0;
     r->settings->bounces = bounces < RIS_DIFFUSE_BOUNCES ? bounces : RIS_DIFFUSE_BOUNCES;
     r->settings->specular_depth = (int)len;
-    if (bounces > RIS_DIFFUSE_BOUNCES)
+    if (bounces > RIS_DIFFUSE_BOUNCES && !(r->opt && r->opt->bounces_given))
         rib_warn_once(r, "ris bounces",
                       "Integrator \"%s\" maxPathLength %g: %d diffuse bounces, not %d (each "
                       "costs about as much as the first; --bounces N for more)",

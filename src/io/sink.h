@@ -198,6 +198,8 @@ const char *io_filter_name(int filter);
 typedef struct IoReadOptions {
     const char *data_dir;     /* where teapot.bpt lives (RIB's Geometry "teapot"); may be NULL */
     int frame;                /* RIB: the frame to read (FrameBegin n); -1: the last frame */
+    int bounces_given;        /* the caller sets the diffuse bounces: a file's depth past
+                                 the readers' cap is not worth a warning */
 } IoReadOptions;
 
 #endif /* RAYES_IO_SINK_H */

@@ -376,19 +376,25 @@ static IoSink stub(Rec *r)
 }
 
 /* Parses text from an exact-size heap copy; err gets the message. */
-static RayesError parse(const char *name, const char *text, Rec *r, IoSettings *s, char *err,
-                        size_t n)
+static RayesError parse_with(const char *name, const char *text, const IoReadOptions *opt, Rec *r,
+                             IoSettings *s, char *err, size_t n)
 {
     size_t size = strlen(text);
     unsigned char *copy = malloc(size ? size : 1);
     memcpy(copy, text, size);
     IoSink sink = stub(r);
     io_settings_init(s);
-    RayesError e = io_pbrt_parse(name, copy, size, &sink, NULL, s, err, n);
+    RayesError e = io_pbrt_parse(name, copy, size, &sink, opt, s, err, n);
     free(copy);
     if (e != RAYES_OK)
         fprintf(stderr, "  (parse: %s)\n", err);
     return e;
+}
+
+static RayesError parse(const char *name, const char *text, Rec *r, IoSettings *s, char *err,
+                        size_t n)
+{
+    return parse_with(name, text, NULL, r, s, err, n);
 }
 
 /* m p for a point p (row-major m). */
@@ -1118,6 +1124,7 @@ static void test_filters(void)
 /* A parse with standard error captured (stderr_of's argument). */
 typedef struct ParseRun {
     const char *name, *text;
+    const IoReadOptions *opt; /* NULL: none */
     Rec *r;
     IoSettings s;
     RayesError e;
@@ -1128,7 +1135,7 @@ static void run_parse(void *arg)
 {
     ParseRun *pr = arg;
     pr->err[0] = '\0';
-    pr->e = parse(pr->name, pr->text, pr->r, &pr->s, pr->err, sizeof pr->err);
+    pr->e = parse_with(pr->name, pr->text, pr->opt, pr->r, &pr->s, pr->err, sizeof pr->err);
 }
 
 /* Import reads a file as Include does (pbrt-v4 allows it only for shapes
@@ -1450,7 +1457,8 @@ static void test_anisotropic_roughness(void)
 }
 
 /* maxdepth: maxdepth - 1 diffuse bounces up to 8 and maxdepth as the
- * specular depth up to 64; past the cap one warning at the directive. */
+ * specular depth up to 64; past the cap one warning at the directive,
+ * unless the caller sets the bounces itself (rayes --bounces). */
 static void test_maxdepth(void)
 {
     static const struct {
@@ -1469,6 +1477,11 @@ static void test_maxdepth(void)
         CHECK((strstr(said, "t.pbrt:1:1: Integrator \"maxdepth\"") != NULL) == cases[k].warns);
         if (cases[k].warns)
             CHECK(strstr(said, ": 8 diffuse bounces, not ") != NULL);
+        IoReadOptions given = {.frame = -1, .bounces_given = 1};
+        pr.opt = &given;
+        said = test_stderr_of(run_parse, &pr);
+        CHECK(pr.e == RAYES_OK && pr.s.specular_depth == cases[k].specular);
+        CHECK(strstr(said, "maxdepth") == NULL);
     }
     free(r);
 }
