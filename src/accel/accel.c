@@ -99,6 +99,7 @@ struct Accel {
                                intersect_solids finds them), or NULL */
     atomic_llong bytes; /* Embree's allocations, from the memory monitor */
     AccelRecord *record; /* NULL, or where queries are kept (record.h) */
+    const volatile int *stop; /* nonzero: builds are cancelled (accel_new's) */
     char error[256];   /* the first Embree error */
 };
 
@@ -115,6 +116,15 @@ static bool on_memory(void *user, ssize_t bytes, bool post)
     (void)post;
     atomic_fetch_add(&a->bytes, (long long)bytes);
     return true;
+}
+
+/* Embree's build progress: false cancels the build once a stop is asked
+ * (called from Embree's build threads). */
+static bool on_progress(void *user, double done)
+{
+    const Accel *a = user;
+    (void)done;
+    return !__atomic_load_n(a->stop, __ATOMIC_RELAXED);
 }
 
 static int add_geom(Level *lv, Geom g)
@@ -600,6 +610,8 @@ static RTCScene new_scene(Accel *a, int robust)
      * sample lost; DESIGN.md). */
     rtcSetSceneFlags(scene, robust ? RTC_SCENE_FLAG_ROBUST : RTC_SCENE_FLAG_NONE);
     rtcSetSceneBuildQuality(scene, RTC_BUILD_QUALITY_MEDIUM);
+    if (a->stop)
+        rtcSetSceneProgressMonitorFunction(scene, on_progress, a);
     return scene;
 }
 
@@ -717,8 +729,8 @@ static uint8_t *inherit_transparency(const GridSet *gs, const uint32_t *object_m
     return t;
 }
 
-Accel *accel_new(const GridSet *gs, const uint32_t *object_mask, size_t n_objects, char *err,
-                 size_t err_size)
+Accel *accel_new(const GridSet *gs, const uint32_t *object_mask, size_t n_objects,
+                 const volatile int *stop, char *err, size_t err_size)
 {
     Accel *a = calloc(1, sizeof *a);
     uint32_t *order = malloc((gs->n_grids + 1) * sizeof *order);
@@ -744,6 +756,7 @@ Accel *accel_new(const GridSet *gs, const uint32_t *object_mask, size_t n_object
     }
     a->n_levels = gs->n_masters + 1;
     a->gs = gs;
+    a->stop = stop;
     if (n_objects)
         memcpy(a->object_mask, object_mask, n_objects * sizeof *object_mask);
     for (size_t k = 0; k < gs->n_solids; k++)
@@ -795,6 +808,11 @@ Accel *accel_new(const GridSet *gs, const uint32_t *object_mask, size_t n_object
             rtcCommitScene(a->solid_scene[k]);
     if (a->solids && rc == 0)
         rtcCommitScene(a->solids);
+    if (stop && __atomic_load_n(stop, __ATOMIC_RELAXED)) {
+        snprintf(err, err_size, "render: cancelled");
+        accel_free(a);
+        return NULL;
+    }
     if (rc != 0 || a->error[0]) {
         snprintf(err, err_size, "%s", a->error[0] ? a->error : "out of memory in Embree");
         accel_free(a);

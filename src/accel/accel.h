@@ -95,9 +95,10 @@ typedef Vec3 (*AccelOpacityFn)(void *user, const Ray *ray, Hit *hit,
 void accel_crossing_normal(const AccelCrossing *crossing, Hit *hit);
 
 /* Builds the acceleration structure. object_mask[o] is object o's ray
- * mask. Returns NULL and fills err on failure. */
+ * mask. Returns NULL and fills err on failure, and once *stop (if given)
+ * is nonzero: Embree's builds read it as they go. */
 Accel *accel_new(const GridSet *gs, const uint32_t *object_mask, size_t n_objects,
-                 char *err, size_t err_size);
+                 const volatile int *stop, char *err, size_t err_size);
 void accel_free(Accel *accel);
 
 /* The nearest hit in [tnear, tfar]; returns 1 and fills hit, or 0. */

@@ -483,9 +483,10 @@ int geom_prim_stitched(const Prim *prim);
  * primitives they were diced from, by Grid.prim) onto the polyline of the
  * coarsest grid along each shared line, so that neighbours diced at
  * different rates leave no crack (geom/stitch.c). Run after dicing and
- * displacement, before the ray tracing structure is built. Returns 0, or
- * -1 when out of memory (gs is then partly stitched). */
-int geom_stitch(GridSet *gs, const Prim *prims);
+ * displacement, before the ray tracing structure is built. Returns 0,
+ * -1 when out of memory or -2 once *stop (if given) is nonzero, read
+ * between lines (gs is then partly stitched). */
+int geom_stitch(GridSet *gs, const Prim *prims, const volatile int *stop);
 
 /* 1 if g is small enough to be clustered: a still surface grid outside
  * solids of at most 2 x 2 micropolygons (a dense mesh's face). */

@@ -647,7 +647,10 @@ static void close_fans(GridSet *gs)
     }
 }
 
-int geom_stitch(GridSet *gs, const Prim *prims)
+/* How many grid sides geom_stitch meets between two reads of its stop flag. */
+#define STITCH_STOP_EVERY 4096
+
+int geom_stitch(GridSet *gs, const Prim *prims, const volatile int *stop)
 {
     size_t n, words = gs->n_vertices / 64 + 1;
     Side *sides = collect_sides(gs, prims, &n);
@@ -660,13 +663,22 @@ int geom_stitch(GridSet *gs, const Prim *prims)
      * after the first settling only the curves a move touched (the same
      * positions: settling a curve whose vertices stayed moves nothing). */
     long moved = 1;
+    size_t seen = 0; /* sides met, for the stop flag's reads */
     for (int pass = 0; pass < STITCH_PASSES && moved > 0; pass++) {
         moved = 0;
         for (size_t a = 0, b; a < n; a = b) {
+            if (stop && seen >= STITCH_STOP_EVERY) {
+                seen = 0;
+                if (__atomic_load_n(stop, __ATOMIC_RELAXED)) {
+                    free(sides), free(mv.now), free(mv.before);
+                    return -2;
+                }
+            }
             Curve c = {&sides[a], 0, 0.0};
             for (b = a; b < n && !memcmp(sides[b].key, sides[a].key, sizeof sides[a].key); b++)
                 c.len = fmax(c.len, sides[b].hi - sides[b].lo);
             c.n = b - a;
+            seen += c.n;
             if (c.n < 2 || (pass > 0 && !curve_touched(&c, &mv)) || settled(&c, gs->P))
                 continue;
             long m = stitch_curve(&c, gs->P, &mv);

@@ -1572,8 +1572,11 @@ int scene_prepare(const RayesScene *s, int width, int height, const DiceOptions 
         }
     }
     float rate_scale = cams[0].rate_scale;
-    int failed = geom_stitch(gs, s->prims) != 0 || scene_motion_prepare(s, cams, gs) != 0;
+    int stitched = geom_stitch(gs, s->prims, stop);
+    int failed = stitched != 0 || scene_motion_prepare(s, cams, gs) != 0;
     free(cams);
+    if (stitched == -2)
+        return prepare_stopped(DICE_STOPPED, err, err_size);
     if (failed)
         return -1;
     if (first_need)

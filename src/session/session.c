@@ -454,10 +454,12 @@ RayesError session_prepare(RayesScene *scene, const RenderSettings *set, Texture
         return session_fail(scene, rc == -2 ? RAYES_ERROR_CANCELLED : RAYES_ERROR_OUT_OF_MEMORY,
                             err[0] ? err : "render: out of memory preparing the scene");
     }
-    p->accel = accel_new(&p->gs, p->masks, scene->n_objects, err, sizeof err);
+    p->accel = accel_new(&p->gs, p->masks, scene->n_objects, set->stop, err, sizeof err);
     if (!p->accel) {
         session_prepared_fini(p);
-        return session_fail(scene, RAYES_ERROR_OUT_OF_MEMORY, err);
+        return session_fail(
+            scene, render_stop_requested(set) ? RAYES_ERROR_CANCELLED : RAYES_ERROR_OUT_OF_MEMORY,
+            err);
     }
     for (size_t i = 0; i < scene->n_objects; i++)
         p->any_transparent |= p->objects[i].transparent;

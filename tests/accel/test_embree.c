@@ -29,7 +29,7 @@ static void test_quad_grid_hit(void)
     GridSet gs = scene();
     uint32_t masks[2] = {RAYES_RAY_CAMERA | RAYES_RAY_SHADOW, RAYES_RAY_CAMERA};
     char err[256];
-    Accel *a = accel_new(&gs, masks, 2, err, sizeof err);
+    Accel *a = accel_new(&gs, masks, 2, NULL, err, sizeof err);
     CHECK(a != NULL);
     if (!a)
         return;
@@ -71,7 +71,7 @@ static void test_triangle_grid_hit(void)
     GridSet gs = scene();
     uint32_t masks[2] = {RAYES_RAY_CAMERA, RAYES_RAY_CAMERA};
     char err[256];
-    Accel *a = accel_new(&gs, masks, 2, err, sizeof err);
+    Accel *a = accel_new(&gs, masks, 2, NULL, err, sizeof err);
     CHECK(a != NULL);
     if (!a)
         return;
@@ -141,7 +141,7 @@ static void test_concurrent_queries(void)
     GridSet gs = scene();
     uint32_t masks[2] = {RAYES_RAY_CAMERA, RAYES_RAY_CAMERA};
     char err[256];
-    Accel *a = accel_new(&gs, masks, 2, err, sizeof err);
+    Accel *a = accel_new(&gs, masks, 2, NULL, err, sizeof err);
     Par p = {a, 0};
     thread_parallel_for(4, 10000, par_task, &p);
     CHECK(p.mismatches == 0);
@@ -174,7 +174,7 @@ static Accel *both_with_mask(const GridSet *gs, uint32_t mask)
 {
     uint32_t masks[2] = {mask, mask};
     char err[256];
-    Accel *a = accel_new(gs, masks, 2, err, sizeof err);
+    Accel *a = accel_new(gs, masks, 2, NULL, err, sizeof err);
     CHECK(a != NULL);
     return a;
 }
@@ -236,5 +236,22 @@ static void test_own_scene_hits(void)
     geom_gridset_fini(&gs);
 }
 
-TEST_MAIN(TEST(test_quad_grid_hit), TEST(test_triangle_grid_hit), TEST(test_concurrent_queries),
-          TEST(test_transmission_crossings), TEST(test_own_scene_hits))
+/* A stop asked cancels the build: NULL, "render: cancelled"; a stop
+ * flag at 0 builds. */
+static void test_stop_cancels_build(void)
+{
+    GridSet gs = scene();
+    uint32_t masks[2] = {RAYES_RAY_CAMERA, RAYES_RAY_CAMERA};
+    char err[256] = "";
+    volatile int stop = 1, go = 0;
+    CHECK(accel_new(&gs, masks, 2, &stop, err, sizeof err) == NULL);
+    CHECK(strcmp(err, "render: cancelled") == 0);
+    Accel *a = accel_new(&gs, masks, 2, &go, err, sizeof err);
+    CHECK(a != NULL);
+    accel_free(a);
+    geom_gridset_fini(&gs);
+}
+
+TEST_MAIN(TEST(test_stop_cancels_build), TEST(test_quad_grid_hit), TEST(test_triangle_grid_hit),
+          TEST(test_concurrent_queries), TEST(test_transmission_crossings),
+          TEST(test_own_scene_hits))

@@ -37,7 +37,7 @@ static void trace_init(Traced *t, RayesScene *s)
     CHECK(scene_prepare(s, 256, 256, NULL, NULL, &t->gs, NULL, NULL, 0) == 0);
     uint32_t mask[4] = {~0u, ~0u, ~0u, ~0u};
     char err[256];
-    t->accel = accel_new(&t->gs, mask, 4, err, sizeof err);
+    t->accel = accel_new(&t->gs, mask, 4, NULL, err, sizeof err);
     CHECK(t->accel != NULL);
 }
 

@@ -59,7 +59,7 @@ static void fx_init(Fx *f, RayesScene *s)
         memcpy(f->objs[i].Os, s->objects[i].Os, sizeof f->objs[i].Os);
     }
     char err[300];
-    f->accel = accel_new(&f->gs, f->masks, s->n_objects, err, sizeof err);
+    f->accel = accel_new(&f->gs, f->masks, s->n_objects, NULL, err, sizeof err);
     CHECK(f->accel != NULL);
     f->rs = (RenderScene){.gs = &f->gs, .accel = f->accel, .objects = f->objs,
                           .n_objects = s->n_objects, .lights = s->lights,

@@ -613,7 +613,7 @@ static void test_moving_hits(void)
     CHECK(gs.n_motion_vertices + still_vertices == gs.n_vertices); /* only movers sampled */
     uint32_t masks[1] = {RAYES_RAY_CAMERA};
     char err[256];
-    Accel *a = accel_new(&gs, masks, 1, err, sizeof err);
+    Accel *a = accel_new(&gs, masks, 1, NULL, err, sizeof err);
     CHECK(a != NULL);
     /* Along -z through (0.3, 0.2): the patch at t = 0 faces the ray's
      * origin with +z; at t = 1 it is turned round and faces it with -z;

@@ -60,7 +60,7 @@ static void trace_init(Traced *t, const RayesScene *s)
     CHECK(scene_prepare(s, 256, 256, NULL, NULL, &t->gs, NULL, NULL, 0) == 0);
     uint32_t mask = RAYES_RAY_CAMERA | RAYES_RAY_SHADOW;
     char err[256];
-    t->a = accel_new(&t->gs, &mask, 1, err, sizeof err);
+    t->a = accel_new(&t->gs, &mask, 1, NULL, err, sizeof err);
     CHECK(t->a != NULL);
 }
 

@@ -110,7 +110,7 @@ static long leaks(const RayesScene *s, int n)
     CHECK(scene_prepare(s, IMAGE, IMAGE, NULL, NULL, &gs, NULL, NULL, 0) == 0);
     uint32_t masks[2] = {RAYES_RAY_CAMERA, RAYES_RAY_CAMERA};
     char err[256];
-    Accel *a = accel_new(&gs, masks, 2, err, sizeof err);
+    Accel *a = accel_new(&gs, masks, 2, NULL, err, sizeof err);
     CHECK(a != NULL);
     const SceneCamera *c = &s->camera;
     long leaked = 0;
@@ -419,7 +419,7 @@ static void test_hole_lets_rays_through(void)
     CHECK(scene_prepare(s, 64, 64, NULL, NULL, &gs, NULL, NULL, 0) == 0);
     uint32_t mask = RAYES_RAY_CAMERA;
     char err[256];
-    Accel *a = accel_new(&gs, &mask, 1, err, sizeof err);
+    Accel *a = accel_new(&gs, &mask, 1, NULL, err, sizeof err);
     CHECK(a != NULL);
     int hits_in_hole = 0, misses_elsewhere = 0;
     for (int k = 0; a && k < 21 * 21; k++) {

@@ -6,7 +6,7 @@
  * what the camera does not see coarser; a dense mesh over the budget
  * stops coarsening once it cannot shrink, keeps its corners bit for bit,
  * and one too big for the memory left is refused with a message; a stop
- * flag stops it.
+ * flag stops it, and stitching.
  */
 #include <math.h>
 #include <stdlib.h>
@@ -161,6 +161,16 @@ static void test_stop_stops_dicing(void)
     CHECK(scene_prepare(s, 256, 256, &o, NULL, &gs, NULL, err, sizeof err) == -2);
     CHECK(gs.n_grids == 0);
     CHECK(strcmp(err, "render: cancelled") == 0);
+    geom_gridset_fini(&gs);
+    rayes_scene_release(s);
+    /* stitching reads it between lines (the floor's 7,988 grids) */
+    s = floor_scene();
+    DiceOptions go = {0, 4.0f, 0, 0, 0.0};
+    geom_gridset_init(&gs);
+    CHECK(scene_prepare(s, 512, 512, &go, NULL, &gs, NULL, NULL, 0) == 0);
+    volatile int no = 0;
+    CHECK(geom_stitch(&gs, s->prims, &no) == 0);
+    CHECK(geom_stitch(&gs, s->prims, &stop) == -2);
     geom_gridset_fini(&gs);
     rayes_scene_release(s);
 }
