@@ -556,6 +556,10 @@ RayesError io_pbrt_parse(const char *name, const unsigned char *data, size_t siz
     P->iso = 100;
     P->gs.active = 3;
     P->fov = 90;
+    if (settings) { /* pbrt-v4's integrator when the file names none: volpath, maxdepth 5 */
+        settings->bounces = 4;
+        settings->specular_depth = 5;
+    }
     pbrt_mat_init(&P->gs.material, "diffuse"); /* pbrt's default material: diffuse 0.5 */
     static const float half[3] = {0.5f, 0.5f, 0.5f};
     pbrt_mat_color(&P->gs.material, "reflectance", half);

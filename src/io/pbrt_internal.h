@@ -344,6 +344,10 @@ void pbrt_warn_unused(Parser *P, ParamList *pl, const char *directive, const cha
  * NULL), 2 (a pattern texture in *tex, out = its stand-in) or -1 (error). */
 int pbrt_get_color(Parser *P, ParamList *pl, const char *name, const float def[3], float out[3],
                    const Texture **tex);
+/* A light's radiance or intensity parameter (L, I): as pbrt_get_color
+ * (default white, no textures), a spectrum or blackbody normalised to
+ * luminance 1 as pbrt-v4 normalises a light's spectrum. */
+int pbrt_get_emission(Parser *P, ParamList *pl, const char *name, float out[3]);
 /* A float parameter that may be a texture (its stand-in's mean grey then). */
 int pbrt_get_float_tex(Parser *P, ParamList *pl, const char *name, double def, double *out);
 /* The texture defined with that name latest, or NULL. */

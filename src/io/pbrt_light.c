@@ -26,7 +26,6 @@ int pbrt_d_arealight(Parser *P, const Token *t)
         pbrt_params_free(&pl);
         return -1;
     }
-    static const float one[3] = {1, 1, 1};
     memset(&P->gs.area, 0, sizeof P->gs.area);
     if (strcmp(type, "diffuse") != 0) {
         pbrt_warn_at(P, t->line, t->col, "area light type", "AreaLightSource \"%.40s\" is not "
@@ -35,7 +34,7 @@ int pbrt_d_arealight(Parser *P, const Token *t)
         return 0;
     }
     float L[3];
-    if (pbrt_get_color(P, &pl, "L", one, L, NULL) < 0) {
+    if (pbrt_get_emission(P, &pl, "L", L) < 0) {
         pbrt_params_free(&pl);
         return -1;
     }
@@ -75,7 +74,6 @@ int pbrt_d_light(Parser *P, const Token *t)
         pbrt_params_free(&pl);
         return -1;
     }
-    static const float one[3] = {1, 1, 1};
     double scale = pbrt_get_float(&pl, "scale", 1.0), power = pbrt_get_float(&pl, "power", 0.0);
     float col[3];
     RayesParam lp[8];
@@ -87,7 +85,7 @@ int pbrt_d_light(Parser *P, const Token *t)
         pbrt_warn_at(P, t->line, t->col, "instanced light", "LightSource inside ObjectBegin: the "
                      "light is added once, not per instance");
     if (strcmp(type, "point") == 0 || strcmp(type, "spot") == 0) {
-        if (pbrt_get_color(P, &pl, "I", one, col, NULL) < 0)
+        if (pbrt_get_emission(P, &pl, "I", col) < 0)
             r = -1;
         const double *from = pbrt_get_point(&pl, "from");
         from = from ? from : zero3;
@@ -113,7 +111,7 @@ int pbrt_d_light(Parser *P, const Token *t)
             scale *= power / k_e;
         rtype = type[0] == 's' ? "spotlight" : "pointlight";
     } else if (strcmp(type, "distant") == 0) {
-        if (pbrt_get_color(P, &pl, "L", one, col, NULL) < 0)
+        if (pbrt_get_emission(P, &pl, "L", col) < 0)
             r = -1;
         const double *from = pbrt_get_point(&pl, "from"), *to = pbrt_get_point(&pl, "to");
         from = from ? from : zero3;
@@ -127,7 +125,7 @@ int pbrt_d_light(Parser *P, const Token *t)
             scale *= E;
         rtype = "distantlight";
     } else if (strcmp(type, "infinite") == 0) {
-        if (pbrt_get_color(P, &pl, "L", one, col, NULL) < 0)
+        if (pbrt_get_emission(P, &pl, "L", col) < 0)
             r = -1;
         const char *file = pbrt_get_string(&pl, "filename", NULL);
         if (file && !r) {
@@ -152,7 +150,7 @@ int pbrt_d_light(Parser *P, const Token *t)
          * square about the light's y axis (pbrt swaps y and z) times I;
          * projection, an image projected along +z over fov degrees */
         int gonio = type[0] == 'g';
-        if (gonio && pbrt_get_color(P, &pl, "I", one, col, NULL) < 0)
+        if (gonio && pbrt_get_emission(P, &pl, "I", col) < 0)
             r = -1;
         if (!gonio)
             col[0] = col[1] = col[2] = 1;

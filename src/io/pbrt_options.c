@@ -189,7 +189,7 @@ int pbrt_d_integrator(Parser *P, const Token *t)
      * costs about as much as the first, while the light it adds falls as
      * the albedo's power: past PBRT_DIFFUSE_BOUNCES the bounces stop, with
      * one warning (docs/pbrt.md: the Cornell box's figures). */
-    int bounces = depth >= 1 ? (int)fmin(depth - 1, 64) : 0;
+    int bounces = depth >= 1 ? (int)fmin(depth - 1, 1e6) : 0;
     P->settings->bounces = bounces < PBRT_DIFFUSE_BOUNCES ? bounces : PBRT_DIFFUSE_BOUNCES;
     P->settings->specular_depth = (int)fmin(depth, 64);
     if (bounces > PBRT_DIFFUSE_BOUNCES && !(P->options && P->options->bounces_given))

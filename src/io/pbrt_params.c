@@ -424,6 +424,21 @@ int pbrt_get_color(Parser *P, ParamList *pl, const char *name, const float def[3
     }
 }
 
+int pbrt_get_emission(Parser *P, ParamList *pl, const char *name, float out[3])
+{
+    static const float white[3] = {1, 1, 1};
+    Param *p = pbrt_find(pl, name);
+    int k = pbrt_get_color(P, pl, name, white, out, NULL);
+    if (k == 1 && (p->type == PT_BLACKBODY || p->type == PT_SPECTRUM)) {
+        /* pbrt-v4 divides a light's spectrum by its luminance (lights.cpp,
+         * SpectrumToPhotometric): rgb is kept, a spectrum is 1 nit */
+        float Y = 0.2126f * out[0] + 0.7152f * out[1] + 0.0722f * out[2];
+        for (int c = 0; c < 3 && Y > 0.0f; c++)
+            out[c] /= Y;
+    }
+    return k;
+}
+
 /* A float parameter that may be a texture (its stand-in's mean grey then). */
 int pbrt_get_float_tex(Parser *P, ParamList *pl, const char *name, double def, double *out)
 {
