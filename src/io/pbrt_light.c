@@ -203,7 +203,15 @@ int pbrt_d_light(Parser *P, const Token *t)
         lp[n++] = (RayesParam){.name = "lightcolor", .type = RAYES_PARAM_COLOR,
                                .value = {col[0], col[1], col[2]}};
         pbrt_warn_unused(P, &pl, "LightSource", type);
-        r = pbrt_emit_light(P, t, P->gs.ctm, rtype, lp, n);
+        double m[16];
+        memcpy(m, P->gs.ctm, sizeof m);
+        if (strcmp(rtype, "distantlight") == 0 || strcmp(rtype, "environmentlight") == 0) {
+            /* pbrt turns only directions by these lights' transform: a
+             * perspective row is dropped (sssdragon's sky has one) */
+            m[12] = m[13] = m[14] = 0.0;
+            m[15] = 1.0;
+        }
+        r = pbrt_emit_light(P, t, m, rtype, lp, n);
     }
     pbrt_params_free(&pl);
     return r;

@@ -1460,6 +1460,31 @@ static void test_anisotropic_roughness(void)
     free(r);
 }
 
+/* A perspective row in the transform: dropped for a light that only
+ * turns directions (pbrt-v4-scenes' sssdragon sky), kept for a shape
+ * (which the scene refuses: it sends geometry through infinity). */
+static void test_projective_transform(void)
+{
+    Rec *r = malloc(sizeof *r);
+    IoSettings s;
+    char err[512] = "";
+#define PROJECTIVE "ConcatTransform [-0.22 0 -0.97 0 -0.97 0 0.22 0 0 1 0 8.87 0 0 0 1]\n"
+    CHECK(parse("t.pbrt",
+                "WorldBegin\n" PROJECTIVE "LightSource \"infinite\" \"rgb L\" [1 1 1]\n"
+                "LightSource \"distant\"\n",
+                r, &s, err, sizeof err) == RAYES_OK);
+    CHECK(r->n_lights == 2);
+    if (r->n_lights == 2)
+        CHECK(r->light[0].xform[14] == 0 && r->light[0].xform[15] == 1 &&
+              r->light[0].xform[6] == 1 && r->light[1].xform[14] == 0);
+    /* a shape keeps it (the scene refuses it: tests/scene) */
+    CHECK(parse("t.pbrt", "WorldBegin\n" PROJECTIVE "Shape \"sphere\"\n", r, &s, err, sizeof err) ==
+          RAYES_OK);
+    CHECK(r->quadric[0].xform[14] > 8.8f);
+#undef PROJECTIVE
+    free(r);
+}
+
 /* maxdepth: maxdepth - 1 diffuse bounces up to 8 and maxdepth as the
  * specular depth up to 64; past the cap one warning at the directive,
  * unless the caller sets the bounces itself (rayes --bounces). */
@@ -1669,7 +1694,7 @@ TEST_MAIN(TEST(test_filters), TEST(test_mix_classes), TEST(test_exposure),
           TEST(test_film_types), TEST(test_measured_material), TEST(test_portal_warns),
           TEST(test_thin_dielectric), TEST(test_annulus), TEST(test_triangle_light),
           TEST(test_light_power), TEST(test_normal_map), TEST(test_anisotropic_roughness),
-          TEST(test_maxdepth), TEST(test_spectrum_files), TEST(test_cornell_box),
-          TEST(test_transforms), TEST(test_materials), TEST(test_lights),
+          TEST(test_maxdepth), TEST(test_projective_transform), TEST(test_spectrum_files),
+          TEST(test_cornell_box), TEST(test_transforms), TEST(test_materials), TEST(test_lights),
           TEST(test_instances_include_ply), TEST(test_errors), TEST(test_normals_and_uv),
           TEST(test_textures), TEST(test_coated_conductor_textures))
