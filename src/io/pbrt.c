@@ -493,6 +493,8 @@ static int parse_buffer(Parser *P, const char *name, const char *dir, const char
             break;
     }
     if (r == 0 && P->depth == 1 && P->world) /* the top file's end: its lexer names it */
+        r = pbrt_deferred_shapes(P);
+    if (r == 0 && P->depth == 1 && P->world)
         r = pbrt_media_send(P);
     if (r == 0 && P->depth == 1 && P->world)
         r = pbrt_medium_camera(P);
@@ -522,6 +524,7 @@ static void parser_free(Parser *P)
     free(P->materials);
     free(P->textures);
     pbrt_media_free(P);
+    pbrt_defer_free(P);
     free(P->warned);
 }
 

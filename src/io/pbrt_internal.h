@@ -129,6 +129,12 @@ typedef struct GState {
     AreaLight area;
     char inside[128], outside[128]; /* MediumInterface: media names, "" for none */
     int kind; /* on the stack: 'A' AttributeBegin, 'T' TransformBegin, 'O' ObjectBegin */
+    /* A NamedMaterial of a name no MakeNamedMaterial has defined yet (pbrt
+     * looks it up at its shapes, after the whole file), "" for none; where
+     * it was, for the message if it never is (pbrt_defer.c) */
+    char pending[128];
+    const char *pending_file;
+    long pending_line, pending_col;
 } GState;
 
 typedef struct Named {
@@ -171,6 +177,17 @@ typedef struct Op {
     float patch_N[4][3], patch_uv[4][2];
     int subdiv; /* OP_MESH: a Loop subdivision surface (loopsubdiv) */
 } Op;
+
+/* A directive read again later (pbrt_defer.c): its lexer as it was after
+ * the directive's name, that name's token, the graphics state then, and
+ * for a MakeNamedMaterial its material's name. */
+typedef struct Deferred {
+    Lexer lx;
+    Token t;
+    GState gs;
+    char name[128];
+    int done; /* read again already */
+} Deferred;
 
 typedef struct Object {
     char name[128];
@@ -262,6 +279,13 @@ typedef struct Parser {
     int have_sent;
     char (*warned)[96];
     size_t n_warned;
+    /* forward references (pbrt_defer.c) */
+    Deferred *shapes; /* shapes whose NamedMaterial was not defined yet */
+    size_t n_shapes, cap_shapes;
+    Deferred *defs; /* MakeNamedMaterial whose textures were not defined yet */
+    size_t n_defs, cap_defs;
+    int missing_texture; /* a texture name was looked up and not found */
+    int rereading;       /* a deferred directive is read again: it is not deferred twice */
 } Parser;
 
 /* ------------------------------------------------ messages (pbrt_lex.c) */
@@ -429,6 +453,26 @@ int pbrt_d_texture(Parser *P, const Token *t);
  * given: m unchanged), or -1 (an error in P). */
 int pbrt_shape_displacement(Parser *P, const Token *t, ParamList *pl, Material *m);
 int pbrt_d_shape(Parser *P, const Token *t); /* pbrt_shape.c */
+/* Forward references (pbrt_defer.c). pbrt-v4 makes its named materials
+ * and textures after reading the whole file, so a file may name them
+ * before it defines them. A Shape whose NamedMaterial is not defined yet
+ * is deferred (its directive read again at the file's end), a
+ * MakeNamedMaterial whose textures are not defined yet likewise (read
+ * again when a NamedMaterial or a deferred shape first asks for it). */
+/* At the start of a Shape: 1 if it was deferred (its arguments skipped),
+ * 0 if it is read now, -1 on error. */
+int pbrt_defer_shape(Parser *P, const Token *t);
+/* In a MakeNamedMaterial that failed (r, the handler's result) for a
+ * texture not yet defined: 0 when it was deferred (the error dropped),
+ * else r. at: the lexer after the directive's name; name: the material's. */
+int pbrt_defer_material(Parser *P, const Lexer *at, const Token *t, const char *name, int r);
+/* The material named name, defined by a deferred MakeNamedMaterial read
+ * again now if it must be; NULL (no error) if none is, or on error (-1 in
+ * *r). */
+const Material *pbrt_named_material(Parser *P, const char *name, int *r);
+/* At the end of the file: the deferred shapes, each with its material. */
+int pbrt_deferred_shapes(Parser *P);
+void pbrt_defer_free(Parser *P);
 int pbrt_d_arealight(Parser *P, const Token *t); /* pbrt_light.c */
 /* An area light's radiance for the next shape, of n_prims pbrt shapes
  * (triangles, bilinear patches, one quadric) over `area` square units of

@@ -559,14 +559,6 @@ static int diffuse_material(Parser *P, ParamList *pl, Material *m, const char *p
     return mat_textured(P, pl, m, param, "reflectance", RAYES_PARAM_COLOR, half);
 }
 
-static const Material *named_material(Parser *P, const char *name)
-{
-    for (size_t i = P->n_materials; i-- > 0;)
-        if (strcmp(P->materials[i].name, name) == 0)
-            return &P->materials[i].m;
-    return NULL;
-}
-
 /* The reflectance of a diffuse material as a pattern input named name. */
 static RayesParam reflectance_input(const Parser *P, const Material *m, const char *name)
 {
@@ -641,10 +633,17 @@ static int mix_material(Parser *P, const Token *t, ParamList *pl, Material *m)
     Param *names = pbrt_find(pl, "materials");
     if (!names || names->n_str != 2)
         return FAIL_TOK(P, t, "mix: expected \"string materials\" with two material names");
-    const Material *a = named_material(P, names->str[0]), *b = named_material(P, names->str[1]);
-    if (!a || !b)
+    int ra, rb;
+    const Material *a = pbrt_named_material(P, names->str[0], &ra);
+    const Material *b = pbrt_named_material(P, names->str[1], &rb);
+    if (ra || rb)
+        return -1;
+    a = pbrt_named_material(P, names->str[0], &ra); /* b's definition may have moved it */
+    if (!a || !b) {
+        P->missing_texture = 1; /* perhaps defined further down */
         return FAIL_TOK(P, t, "mix: expected materials defined before, found \"%.60s\"",
                         !a ? names->str[0] : names->str[1]);
+    }
     RayesParam q[3];
     float amount[3];
     if (tex_input(P, pl, "amount", half, &q[2], amount) != 0)
@@ -939,17 +938,21 @@ int pbrt_d_material(Parser *P, const Token *t)
         r = pbrt_name_and_params(P, type, sizeof type, "a material type", &pl, NULL);
     if (!r)
         r = make_material(P, t, type, &pl, &P->gs.material);
-    if (!r)
+    if (!r) {
         pbrt_warn_unused(P, &pl, "Material", type);
+        P->gs.pending[0] = '\0';
+    }
     pbrt_params_free(&pl);
     return r;
 }
 
 int pbrt_d_makenamedmaterial(Parser *P, const Token *t)
 {
-    char name[128];
+    char name[128] = "";
     ParamList pl = {0};
     Material m;
+    Lexer at = *P->lx; /* for reading it again (pbrt_defer_material) */
+    P->missing_texture = 0;
     int r = pbrt_need_world(P, t, 1);
     if (!r)
         r = pbrt_name_and_params(P, name, sizeof name, "a material name", &pl, NULL);
@@ -975,7 +978,7 @@ int pbrt_d_makenamedmaterial(Parser *P, const Token *t)
         }
     }
     pbrt_params_free(&pl);
-    return r;
+    return pbrt_defer_material(P, &at, t, name, r);
 }
 
 int pbrt_d_namedmaterial(Parser *P, const Token *t)
@@ -985,12 +988,19 @@ int pbrt_d_namedmaterial(Parser *P, const Token *t)
     if (pbrt_need_world(P, t, 1) ||
         pbrt_expect_string(P, name, sizeof name, "a material name", &w) != 0)
         return -1;
-    const Material *m = named_material(P, name);
-    if (!m)
-        return FAIL_TOK(
-            P, &w,
-            "NamedMaterial: expected a material defined with MakeNamedMaterial, found \"%.60s\"",
-            name);
-    P->gs.material = *m;
+    int r;
+    const Material *m = pbrt_named_material(P, name, &r);
+    if (r)
+        return -1;
+    if (m) {
+        P->gs.material = *m;
+        P->gs.pending[0] = '\0';
+        return 0;
+    }
+    /* defined further down, perhaps: its shapes wait (pbrt_defer_shape) */
+    snprintf(P->gs.pending, sizeof P->gs.pending, "%s", name);
+    P->gs.pending_file = P->lx->name;
+    P->gs.pending_line = w.line;
+    P->gs.pending_col = w.col;
     return 0;
 }

@@ -406,6 +406,8 @@ int pbrt_get_color(Parser *P, ParamList *pl, const char *name, const float def[3
     case PT_TEXTURE: {
         const Texture *t = p->n_str > 0 ? pbrt_find_texture(P, p->str[0]) : NULL;
         if (!t)
+            P->missing_texture = 1; /* perhaps defined further down (pbrt_defer.c) */
+        if (!t)
             return pbrt_fail_at(P, p->line, p->col,
                                 "expected the name of a texture defined before, found \"%.60s\"",
                                 p->n_str > 0 ? p->str[0] : "");

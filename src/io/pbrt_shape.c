@@ -819,6 +819,8 @@ int pbrt_d_shape(Parser *P, const Token *t)
     char type[64];
     ParamList pl = {0};
     int r = pbrt_need_world(P, t, 1);
+    if (!r && (r = pbrt_defer_shape(P, t)) != 0)
+        return r > 0 ? 0 : -1;
     if (!r)
         r = pbrt_name_and_params(P, type, sizeof type, "a shape type", &pl, NULL);
     if (r) {

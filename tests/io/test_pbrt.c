@@ -867,8 +867,15 @@ static void test_errors(void)
                  "t.pbrt:3:3: trianglemesh: index 2 is 3 but P has 3 points");
     expect_error("WorldBegin\nShape \"trianglemesh\" \"point3 P\" [0 0 0 1 0]\n",
                  "t.pbrt:2:22: expected a multiple of 3 values");
-    expect_error("WorldBegin\nNamedMaterial \"nope\"\n", "t.pbrt:2:15: NamedMaterial: expected a "
-                 "material defined");
+    /* a NamedMaterial is looked up at its shapes, at the file's end */
+    expect_error("WorldBegin\nNamedMaterial \"nope\"\nShape \"sphere\"\n",
+                 "t.pbrt:2:15: NamedMaterial: expected a material defined");
+    expect_error("WorldBegin\nNamedMaterial \"n\"\nObjectBegin \"o\"\nShape \"sphere\"\n",
+                 "t.pbrt:2:15: NamedMaterial: expected a material defined with MakeNamedMaterial "
+                 "before an ObjectBegin's shapes");
+    expect_error("WorldBegin\nMakeNamedMaterial \"m\" \"string type\" \"diffuse\" \"texture "
+                 "reflectance\" \"t\"\nNamedMaterial \"m\"\n",
+                 "t.pbrt:2:47: expected the name of a texture defined before, found \"t\"");
     expect_error("WorldBegin\nAttributeEnd\n", "t.pbrt:2:1: AttributeEnd without a matching");
     expect_error("WorldBegin\nCamera \"perspective\"\n", "t.pbrt:2:1: expected this directive before "
                  "WorldBegin");
@@ -883,7 +890,7 @@ static void test_errors(void)
     expect_error("WorldBegin\nShape \"sphere\" \"float radius\" 1e999\n",
                  "t.pbrt:2:31: expected a value for \"float radius\", found \"1e999\"");
     /* an escaped newline in a name stays out of the one-line message (fuzz finding) */
-    expect_error("WorldBegin\nNamedMaterial \"a\\nb\"\n", "found \"a?b\"");
+    expect_error("WorldBegin\nNamedMaterial \"a\\nb\"\nShape \"sphere\"\n", "found \"a?b\"");
     expect_error("WorldBegin\nRotate 90 0 0 0\n", "t.pbrt:2:1: Rotate: expected a nonzero axis");
     expect_error("WorldBegin\nTexture \"a\" \"colour\" \"constant\"\n",
                  "t.pbrt:2:1: Texture \"a\": expected the type \"spectrum\" or \"float\"");
@@ -1460,6 +1467,50 @@ static void test_anisotropic_roughness(void)
     free(r);
 }
 
+/* Forward references, as pbrt-v4 allows them (it makes named materials
+ * and textures after reading the file): a NamedMaterial before its
+ * MakeNamedMaterial (its shapes wait for the file's end, in their own
+ * transform and area light), a MakeNamedMaterial before its texture (read
+ * again when first used), a mix before its materials; a NamedMaterial that
+ * no shape follows is no error. */
+static void test_forward_references(void)
+{
+    Rec *r = malloc(sizeof *r);
+    IoSettings s;
+    char err[512] = "";
+    const char *text =
+        "WorldBegin\n"
+        "AttributeBegin\n"
+        "  NamedMaterial \"later\"\n"
+        "  AreaLightSource \"diffuse\" \"rgb L\" [2 2 2]\n"
+        "  Translate 0 5 0\n"
+        "  Shape \"trianglemesh\" \"point3 P\" [0 0 0 1 0 0 0 0 1] \"integer indices\" [0 1 2]\n"
+        "AttributeEnd\n"
+        "NamedMaterial \"never\"\n"
+        "Material \"diffuse\"\n"
+        "Shape \"sphere\"\n"
+        "MakeNamedMaterial \"tex\" \"string type\" \"diffuse\" \"texture reflectance\" \"c\"\n"
+        "MakeNamedMaterial \"mixed\" \"string type\" \"mix\" \"string materials\" [\"tex\" "
+        "\"later\"]\n"
+        "Texture \"c\" \"spectrum\" \"checkerboard\"\n"
+        "MakeNamedMaterial \"later\" \"string type\" \"conductor\"\n"
+        "NamedMaterial \"tex\"\n"
+        "Shape \"trianglemesh\" \"point3 P\" [0 0 0 1 0 0 0 1 0] \"integer indices\" [0 1 2]\n"
+        "NamedMaterial \"mixed\"\n"
+        "Shape \"trianglemesh\" \"point3 P\" [0 0 0 1 0 0 0 1 0] \"integer indices\" [0 1 2]\n";
+    CHECK(parse("t.pbrt", text, r, &s, err, sizeof err) == RAYES_OK);
+    CHECK(r->n_quadrics == 1 && r->n_meshes == 2 && r->n_mesh_lights == 1);
+    if (r->n_meshes == 2) {
+        const RayesParam *refl = param(&r->mesh[0].shader, "reflectance");
+        CHECK(strcmp(r->mesh[0].shader.name, "diffuse") == 0 && refl &&
+              refl->type == RAYES_PARAM_PATTERN);
+        CHECK(strcmp(r->mesh[1].shader.name, "mix") == 0);
+    }
+    if (r->n_mesh_lights == 1) /* the emitter, read at the end under its own state */
+        CHECK(r->mesh_light[0].L[0] == 2);
+    free(r);
+}
+
 /* A perspective row in the transform: dropped for a light that only
  * turns directions (pbrt-v4-scenes' sssdragon sky), kept for a shape
  * (which the scene refuses: it sends geometry through infinity). */
@@ -1694,7 +1745,8 @@ TEST_MAIN(TEST(test_filters), TEST(test_mix_classes), TEST(test_exposure),
           TEST(test_film_types), TEST(test_measured_material), TEST(test_portal_warns),
           TEST(test_thin_dielectric), TEST(test_annulus), TEST(test_triangle_light),
           TEST(test_light_power), TEST(test_normal_map), TEST(test_anisotropic_roughness),
-          TEST(test_maxdepth), TEST(test_projective_transform), TEST(test_spectrum_files),
-          TEST(test_cornell_box), TEST(test_transforms), TEST(test_materials), TEST(test_lights),
-          TEST(test_instances_include_ply), TEST(test_errors), TEST(test_normals_and_uv),
-          TEST(test_textures), TEST(test_coated_conductor_textures))
+          TEST(test_maxdepth), TEST(test_projective_transform), TEST(test_forward_references),
+          TEST(test_spectrum_files), TEST(test_cornell_box), TEST(test_transforms),
+          TEST(test_materials), TEST(test_lights), TEST(test_instances_include_ply),
+          TEST(test_errors), TEST(test_normals_and_uv), TEST(test_textures),
+          TEST(test_coated_conductor_textures))
