@@ -189,6 +189,11 @@ typedef struct Deferred {
     int done; /* read again already */
 } Deferred;
 
+typedef struct DeferList {
+    Deferred *d;
+    size_t n, cap;
+} DeferList;
+
 typedef struct Object {
     char name[128];
     int sent;                 /* sent to a sink with instances as a master (object_begin) */
@@ -280,10 +285,8 @@ typedef struct Parser {
     char (*warned)[96];
     size_t n_warned;
     /* forward references (pbrt_defer.c) */
-    Deferred *shapes; /* shapes whose NamedMaterial was not defined yet */
-    size_t n_shapes, cap_shapes;
-    Deferred *defs; /* MakeNamedMaterial whose textures were not defined yet */
-    size_t n_defs, cap_defs;
+    DeferList shapes;    /* shapes whose NamedMaterial was not defined yet */
+    DeferList defs;      /* MakeNamedMaterial whose textures were not defined yet */
     int missing_texture; /* a texture name was looked up and not found */
     int rereading;       /* a deferred directive is read again: it is not deferred twice */
 } Parser;
@@ -429,6 +432,10 @@ int pbrt_replay(Parser *P, const Token *t, Object *o);
 /* A zeroed material of that shader, and a colour parameter added to it. */
 void pbrt_mat_init(Material *m, const char *shader);
 void pbrt_mat_color(Material *m, const char *name, const float c[3]);
+/* The material named name, defined by a deferred MakeNamedMaterial read
+ * again now if it must be (pbrt_defer.c); NULL if none is (no error), or
+ * on error (then *r is -1). Valid until the next material is defined. */
+const Material *pbrt_named_material(Parser *P, const char *name, int *r);
 
 /* ----------------------------------------------------------- directives */
 
@@ -453,25 +460,24 @@ int pbrt_d_texture(Parser *P, const Token *t);
  * given: m unchanged), or -1 (an error in P). */
 int pbrt_shape_displacement(Parser *P, const Token *t, ParamList *pl, Material *m);
 int pbrt_d_shape(Parser *P, const Token *t); /* pbrt_shape.c */
-/* Forward references (pbrt_defer.c). pbrt-v4 makes its named materials
- * and textures after reading the whole file, so a file may name them
- * before it defines them. A Shape whose NamedMaterial is not defined yet
- * is deferred (its directive read again at the file's end), a
- * MakeNamedMaterial whose textures are not defined yet likewise (read
- * again when a NamedMaterial or a deferred shape first asks for it). */
-/* At the start of a Shape: 1 if it was deferred (its arguments skipped),
- * 0 if it is read now, -1 on error. */
-int pbrt_defer_shape(Parser *P, const Token *t);
-/* In a MakeNamedMaterial that failed (r, the handler's result) for a
- * texture not yet defined: 0 when it was deferred (the error dropped),
- * else r. at: the lexer after the directive's name; name: the material's. */
-int pbrt_defer_material(Parser *P, const Lexer *at, const Token *t, const char *name, int r);
-/* The material named name, defined by a deferred MakeNamedMaterial read
- * again now if it must be; NULL (no error) if none is, or on error (-1 in
- * *r). */
-const Material *pbrt_named_material(Parser *P, const char *name, int *r);
-/* At the end of the file: the deferred shapes, each with its material. */
+/* Forward references. pbrt-v4 makes its named materials and textures
+ * after reading the whole file, so a file may name them before it defines
+ * them. A Shape whose NamedMaterial is not defined yet is deferred (read
+ * again at the file's end: pbrt_deferred_shapes), a MakeNamedMaterial
+ * whose textures are not defined yet likewise (read again when a
+ * NamedMaterial or a deferred shape first asks for it:
+ * pbrt_named_material, pbrt_material.c). */
 int pbrt_deferred_shapes(Parser *P);
+/* pbrt_defer.c: appends the directive whose name t was read (at: its
+ * lexer just after t; the graphics state as it is now), or NULL (an error
+ * in P). */
+Deferred *pbrt_defer(Parser *P, DeferList *list, const Lexer *at, const Token *t);
+/* Reads directive d again with its handler fn, under the graphics state
+ * gs; the parser's lexer and state are restored after. */
+int pbrt_reread(Parser *P, const Deferred *d, const GState *gs,
+                int (*fn)(Parser *P, const Token *t));
+/* The error of gs's pending NamedMaterial, at it, in its file; -1. */
+int pbrt_undefined_material(Parser *P, const GState *gs, const char *what);
 void pbrt_defer_free(Parser *P);
 int pbrt_d_arealight(Parser *P, const Token *t); /* pbrt_light.c */
 /* An area light's radiance for the next shape, of n_prims pbrt shapes

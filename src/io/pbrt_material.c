@@ -927,6 +927,52 @@ static int make_material(Parser *P, const Token *t, const char *type, ParamList 
     return strcmp(m->shader, PBRT_INVISIBLE) != 0 ? mat_displacement(P, pl, m) : 0;
 }
 
+/* ------------------------------------------------------------ forward references */
+
+/* In a MakeNamedMaterial that failed (r, the handler's result) for a
+ * texture or material not defined yet: 0 when it was deferred (the error
+ * dropped: it is read again when first asked for), else r. */
+static int defer_material(Parser *P, const Lexer *at, const Token *t, const char *name, int r)
+{
+    if (!r || !P->missing_texture || P->rereading || P->recording)
+        return r;
+    Deferred *d = pbrt_defer(P, &P->defs, at, t);
+    if (!d)
+        return -1;
+    snprintf(d->name, sizeof d->name, "%s", name);
+    if (P->err_size)
+        P->err[0] = '\0'; /* not an error yet */
+    return 0;
+}
+
+static const Material *find_material(const Parser *P, const char *name)
+{
+    for (size_t i = P->n_materials; i-- > 0;)
+        if (strcmp(P->materials[i].name, name) == 0)
+            return &P->materials[i].m;
+    return NULL;
+}
+
+const Material *pbrt_named_material(Parser *P, const char *name, int *r)
+{
+    *r = 0;
+    const Material *m = find_material(P, name);
+    for (size_t i = P->defs.n; !m && i-- > 0;) {
+        Deferred *d = &P->defs.d[i];
+        if (d->done || strcmp(d->name, name) != 0)
+            continue;
+        d->done = 1;        /* no loop through a mix of itself */
+        Deferred copy = *d; /* reading it again may grow P->defs */
+        if (pbrt_reread(P, &copy, &copy.gs, pbrt_d_makenamedmaterial) != 0) {
+            P->defs.d[i].done = 0; /* a mix being read may be deferred in turn, and ask again */
+            *r = -1;
+            return NULL;
+        }
+        m = find_material(P, name);
+    }
+    return m;
+}
+
 /* ------------------------------------------------------------ directives */
 
 int pbrt_d_material(Parser *P, const Token *t)
@@ -978,7 +1024,7 @@ int pbrt_d_makenamedmaterial(Parser *P, const Token *t)
         }
     }
     pbrt_params_free(&pl);
-    return pbrt_defer_material(P, &at, t, name, r);
+    return defer_material(P, &at, t, name, r);
 }
 
 int pbrt_d_namedmaterial(Parser *P, const Token *t)

@@ -814,12 +814,48 @@ static int bound_media(Parser *P, const Token *t, const char *type, ParamList *p
     return 0;
 }
 
+/* At the start of a Shape whose NamedMaterial is not defined yet: deferred
+ * to the file's end (its arguments skipped; 1), or an error inside
+ * ObjectBegin (-1); 0 when it is read now. */
+static int defer_shape(Parser *P, const Token *t)
+{
+    if (!P->gs.pending[0] || P->rereading)
+        return 0;
+    if (P->recording) /* an object's shapes are replayed by instances as they come */
+        return pbrt_undefined_material(P, &P->gs, " before an ObjectBegin's shapes");
+    if (!pbrt_defer(P, &P->shapes, P->lx, t))
+        return -1;
+    char type[64];
+    ParamList pl = {0};
+    int r = pbrt_name_and_params(P, type, sizeof type, "a shape type", &pl, NULL);
+    pbrt_params_free(&pl);
+    return r ? -1 : 1;
+}
+
+int pbrt_deferred_shapes(Parser *P)
+{
+    for (size_t i = 0; i < P->shapes.n; i++) {
+        GState gs = P->shapes.d[i].gs;
+        int r;
+        const Material *m = pbrt_named_material(P, gs.pending, &r);
+        if (r)
+            return -1;
+        if (!m)
+            return pbrt_undefined_material(P, &gs, "");
+        gs.material = *m;
+        gs.pending[0] = '\0';
+        if (pbrt_reread(P, &P->shapes.d[i], &gs, pbrt_d_shape) != 0)
+            return -1;
+    }
+    return 0;
+}
+
 int pbrt_d_shape(Parser *P, const Token *t)
 {
     char type[64];
     ParamList pl = {0};
     int r = pbrt_need_world(P, t, 1);
-    if (!r && (r = pbrt_defer_shape(P, t)) != 0)
+    if (!r && (r = defer_shape(P, t)) != 0)
         return r > 0 ? 0 : -1;
     if (!r)
         r = pbrt_name_and_params(P, type, sizeof type, "a shape type", &pl, NULL);

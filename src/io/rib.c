@@ -297,11 +297,17 @@ static int read_archive(Rib *r, const char *name_in)
                 }
             }
         }
+        /* then the working directory, as PRMan reads it (exporters write
+         * paths from the project's directory they render in) */
+        if (!file_exists(path) && file_exists(name))
+            snprintf(path, sizeof path, "%s", name);
     }
     char err[600];
     size_t size;
     if (!file_exists(path))
-        return rib_error(r, "archive \"%s\": not found (as %s, nor on the archive search path)",
+        return rib_error(r,
+                         "archive \"%s\": not found (as %s, in the working directory, nor on "
+                         "the archive search path)",
                          name_in, path);
     unsigned char *data =
         member ? io_zip_member(path, member, RIB_MAX_FILE_BYTES, &size, err, sizeof err)

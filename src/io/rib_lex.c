@@ -281,20 +281,23 @@ static int binary_token(RibLexer *lx, RibToken *t)
     return rib_lex_error_at(lx, lx->line, col_of(lx, at), "reserved binary RIB byte 0%o", code);
 }
 
+/* A string between double quotes or, as PRMan also reads them (Python
+ * exporters write them: LegoToR's ['name']), single quotes. */
 static int ascii_string(RibLexer *lx, RibToken *t)
 {
     const unsigned char *at = lx->p++;
     long line0 = lx->line, col0 = col_of(lx, at);
+    int quote = *at;
     size_t n = 0;
     for (;;) {
         if (lx->p >= lx->end)
-            return rib_lex_error_at(lx, line0, col0, "the string has no closing '\"'");
+            return rib_lex_error_at(lx, line0, col0, "the string has no closing '%c'", quote);
         if (buf_reserve(lx, n + 2) != 0)
             return lex_error(lx, at, "out of memory for a string");
         if (n > RIB_MAX_TOKEN_BYTES)
             return lex_error(lx, at, "a string longer than 64 MB");
         int c = *lx->p++;
-        if (c == '"')
+        if (c == quote)
             break;
         if (c == '\n') {
             lx->line++;
@@ -353,8 +356,8 @@ static int ascii_number(RibLexer *lx, RibToken *t)
 static int ascii_request(RibLexer *lx, RibToken *t)
 {
     const unsigned char *q = lx->p;
-    while (q < lx->end && *q < 0200 && !is_space(*q) && *q != '#' && *q != '"' && *q != '[' &&
-           *q != ']')
+    while (q < lx->end && *q < 0200 && !is_space(*q) && *q != '#' && *q != '"' && *q != '\'' &&
+           *q != '[' && *q != ']')
         q++;
     size_t n = (size_t)(q - lx->p);
     if (n > 63)
@@ -393,7 +396,7 @@ int rib_lex_next(RibLexer *lx, RibToken *t)
                 continue;
             return e;
         }
-        if (c == '"')
+        if (c == '"' || c == '\'')
             return ascii_string(lx, t);
         if (c == '[' || c == ']') {
             lx->p++;

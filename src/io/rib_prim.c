@@ -1169,6 +1169,15 @@ static int h_quadric(Rib *r, const Args *a)
             SinkState *st;
             const IoSink *s = rib_out_sink(r, &st);
             unsigned flags = rib_flip(r) ? RAYES_QUADRIC_REVERSE : 0;
+            /* a negative radius of a disk, cone or cylinder: the same
+             * surface, its parameters (and so its normals) turned over */
+            int ri = q[k].type == RAYES_QUADRIC_CYLINDER                                  ? 0
+                     : q[k].type == RAYES_QUADRIC_DISK || q[k].type == RAYES_QUADRIC_CONE ? 1
+                                                                                          : -1;
+            if (ri >= 0 && v[ri] < 0.0f) {
+                v[ri] = -v[ri];
+                flags ^= RAYES_QUADRIC_REVERSE;
+            }
             if (r->a.area && !s->area_light_quadric)
                 rib_warn_once(r, "area quadric",
                               "this scene takes no emitting quadrics: they "

@@ -453,6 +453,26 @@ int rib_ris_geometry_light(Rib *r, const char *name)
     return e < 0 ? -1 : 1;
 }
 
+/* ------------------------------------------------------------ Displace */
+
+/* RenderMan 21's Displace (PxrDisplace and its pattern network): not
+ * built; the surfaces are not displaced, with one warning. */
+static int h_displace(Rib *r, const Args *a)
+{
+    r->ris = 1;
+    Param *p;
+    size_t n;
+    const char *cls = class_and_params(r, a, "a displacement class", &p, &n);
+    if (!cls)
+        return -1;
+    free(p);
+    rib_warn_once(r, "ris displace",
+                  "Displace \"%s\": RenderMan's RIS displacement is not built; the surfaces "
+                  "that follow are not displaced",
+                  cls);
+    return 0;
+}
+
 /* ------------------------------------------------------------ Integrator */
 
 /* The most diffuse bounces a maxPathLength gives (as pbrt's maxdepth). */
@@ -488,8 +508,6 @@ static int h_integrator(Rib *r, const Args *a)
 }
 
 const RibRequest rib_ris_requests[] = {
-    {"Bxdf", h_bxdf},
-    {"Light", h_light},
-    {"Integrator", h_integrator},
-    {NULL, NULL},
+    {"Bxdf", h_bxdf},         {"Light", h_light}, {"Integrator", h_integrator},
+    {"Displace", h_displace}, {NULL, NULL},
 };

@@ -916,6 +916,46 @@ static const char *stand_in_light(const char *name, const Param *p, size_t n)
     return NULL;
 }
 
+/* A spot light's cone as RenderMan's spotlight computes it: cos(coneangle)
+ * and cos(coneangle - conedeltaangle), whatever the angles (students write
+ * degrees where radians belong: coneangle 20 is 20 radians, whose cosine
+ * PRMan takes). L's cone, in degrees by now, becomes the angles in
+ * [0, 180] of those cosines (the same for angles in range). */
+static void fold_cone(Light *L)
+{
+    float *cone = NULL, *delta = NULL;
+    for (size_t i = 0; i < L->n; i++) {
+        if (L->params[i].type != RAYES_PARAM_FLOAT)
+            continue;
+        if (strcmp(L->params[i].name, "coneangle") == 0)
+            cone = &L->params[i].value[0];
+        else if (strcmp(L->params[i].name, "conedeltaangle") == 0)
+            delta = &L->params[i].value[0];
+    }
+    if (!cone)
+        return;
+    double a = *cone * M_PI / 180, d = delta ? *delta * M_PI / 180 : 0.0;
+    double outer = acos(cos(a)), inner = acos(cos(a - d));
+    *cone = (float)fmax(outer * 180 / M_PI, 1e-3); /* (0, 180] */
+    if (delta)
+        *delta = (float)fmax((outer - inner) * 180 / M_PI, 0.0);
+}
+
+/* Whether a light's "from" and "to" (RenderMan's defaults 0 0 0 and
+ * 0 0 1) are one point: a direction of zero length. */
+static int aims_nowhere(const Param *p, size_t n)
+{
+    double from[3] = {0, 0, 0}, to[3] = {0, 0, 1};
+    const Param *f = rib_find_param(p, n, "from"), *t = rib_find_param(p, n, "to");
+    for (int c = 0; c < 3; c++) {
+        if (f && f->v->n == 3)
+            from[c] = f->v->d[c];
+        if (t && t->v->n == 3)
+            to[c] = t->v->d[c];
+    }
+    return from[0] == to[0] && from[1] == to[1] && from[2] == to[2];
+}
+
 static int h_light_source(Rib *r, const Args *a)
 {
     size_t i = 0;
@@ -989,6 +1029,14 @@ static int h_light_source(Rib *r, const Args *a)
         char key[128];
         snprintf(key, sizeof key, "light %s", name);
         rib_warn_once(r, key, "light shader \"%s\" is not built in; the light is skipped", name);
+    }
+    if (type && (strcmp(type, "distantlight") == 0 || strcmp(type, "spotlight") == 0) &&
+        aims_nowhere(p, n)) {
+        rib_warn_once(r, "light from to",
+                      "light \"%s\": \"from\" and \"to\" coincide, so it "
+                      "shines nowhere; skipped",
+                      name);
+        type = NULL;
     }
     if (!type) {
         free(p);
@@ -1093,6 +1141,8 @@ static int h_light_source(Rib *r, const Args *a)
         }
         L->n++;
     }
+    if (spot)
+        fold_cone(L);
     int e = uber ? uber_params(r, L, p, n, l_uber) : 0;
     const Param *said = rib_find_param(p, n, "shadows");
     if (!uber && !(said && said->declared) &&

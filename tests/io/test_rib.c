@@ -1219,9 +1219,40 @@ static void test_attributes_rayes_always_does(void)
     CHECK(rec.quadrics == 1);
 }
 
+/* What PRMan reads and renders that a strict reading refused (students'
+ * and exporters' files): single-quoted strings, a spotlight's coneangle
+ * outside (0, pi] taken through its cosine as RenderMan's spotlight takes
+ * it, a light whose from and to coincide skipped, a disk of negative
+ * radius (turned over), RenderMan 21's Displace (not built: a warning), an
+ * archive found in the working directory. */
+static void test_prman_leniency(void)
+{
+    CHECK(parse(WORLD(
+              "Surface 'plastic' 'Ks' 0.3\nLightSource 'spotlight' 1 'coneangle' 20 'intensity' 3\n"
+              "LightSource \"distantlight\" 2 \"to\" [0 0 0]\n"
+              "Displace \"PxrDisplace\" \"d\" \"float dispAmount\" [0.1]\n"
+              "Disk 1.2 -0.05 360\n")) == RAYES_OK);
+    CHECK(rec.lights == 1);
+    CHECK_NEAR(rec.light_params[0][0], acos(cos(20.0)) * 180 / M_PI, 1e-2);
+    CHECK(rec.quadrics == 1 && (rec.quadric_flags & RAYES_QUADRIC_REVERSE));
+    CHECK(parse(WORLD("Disk 1.2 0.05 360\n")) == RAYES_OK);
+    CHECK(rec.quadrics == 1 && !(rec.quadric_flags & RAYES_QUADRIC_REVERSE));
+    FILE *f = fopen("test_rib_cwd_archive.rib", "w");
+    CHECK(f != NULL);
+    if (!f)
+        return;
+    fputs("Sphere 1 -1 1 360\n", f);
+    fclose(f);
+    const char *text = WORLD("ReadArchive \"test_rib_cwd_archive.rib\"\n");
+    CHECK(parse_n("no_such_dir/scene.rib", text, strlen(text), -1) == RAYES_OK);
+    CHECK(rec.quadrics == 1);
+    remove("test_rib_cwd_archive.rib");
+}
+
 TEST_MAIN(TEST(test_camera_and_transforms), TEST(test_attributes_rayes_always_does),
           TEST(test_settings), TEST(test_shaders_and_lights), TEST(test_parameter_classes),
           TEST(test_patterns), TEST(test_polygons), TEST(test_patch_mesh_bases), TEST(test_handles),
           TEST(test_objects_and_frames), TEST(test_binary), TEST(test_gzip), TEST(test_errors),
           TEST(test_aqsis_files), TEST(test_scene_sink), TEST(test_writer_round_trip),
-          TEST(test_writer_primvars), TEST(test_writer_split_quad), TEST(test_detail_range))
+          TEST(test_writer_primvars), TEST(test_writer_split_quad), TEST(test_detail_range),
+          TEST(test_prman_leniency))
