@@ -456,6 +456,15 @@ static int shader_known(Rib *r, const char *const *builtins, const char *name)
            (r->sink->has_shader && r->sink->has_shader(r->sink->target, name));
 }
 
+/* A shader named by a path ("shaders/plastic", as some exporters and
+ * course files name the compiled shader): its last component when the
+ * whole name is neither built in nor a plugin. */
+static const char *shader_name(Rib *r, const char *const *builtins, const char *name)
+{
+    const char *slash = strrchr(name, '/');
+    return slash && slash[1] && !shader_known(r, builtins, name) ? slash + 1 : name;
+}
+
 /* The RenderMan Companion's copies of the classics under its own names
  * (Listings 16.2 and 16.4: the same parameters and bodies) and its glow
  * (16.26), as files written with its shader set name them. */
@@ -489,6 +498,7 @@ static int h_surface(Rib *r, const Args *a)
         free(p);
         return -1;
     }
+    name = shader_name(r, builtin_surfaces, name);
     if (!shader_known(r, builtin_surfaces, name)) /* a plugin of that name comes first */
         name = surface_alias(name);
     int known = shader_known(r, builtin_surfaces, name);
@@ -527,6 +537,7 @@ static int h_displacement(Rib *r, const Args *a)
         free(p);
         return 0;
     }
+    name = shader_name(r, builtin_displacements, name);
     if (!shader_known(r, builtin_displacements, name)) {
         char key[128];
         snprintf(key, sizeof key, "displacement %s", name);
@@ -903,8 +914,8 @@ static int names_it(const char *name, const char *word)
 /* The classic light that stands in for a light shader rayes does not
  * have, by what its parameters and name say it is: a cone ("coneangle")
  * a spotlight; "distant", "directional" or "sun" in its name a distant
- * light; "point" (but not a point light without falloff) a point light;
- * else NULL. */
+ * light; "point" (but not a point light without falloff), or a "from"
+ * without a "to", a point light; else NULL. */
 static const char *stand_in_light(const char *name, const Param *p, size_t n)
 {
     if (rib_find_param(p, n, "coneangle"))
@@ -913,6 +924,8 @@ static const char *stand_in_light(const char *name, const Param *p, size_t n)
         return "distantlight";
     if (names_it(name, "point") && !names_it(name, "nofall"))
         return "pointlight";
+    if (rib_find_param(p, n, "from") && !rib_find_param(p, n, "to"))
+        return "pointlight"; /* a position alone (shadowlight) */
     return NULL;
 }
 
@@ -960,6 +973,8 @@ static int h_light_source(Rib *r, const Args *a)
 {
     size_t i = 0;
     const char *name = rib_get_string(r, a, &i, "a light shader name");
+    if (name && strrchr(name, '/') && strrchr(name, '/')[1])
+        name = strrchr(name, '/') + 1; /* "shaders/pointlight": a path's last component */
     char handle[RIB_MAX_HANDLE];
     if (!name)
         return -1;
@@ -1158,6 +1173,8 @@ static int h_area_light(Rib *r, const Args *a)
 {
     size_t i = 0;
     const char *name = rib_get_string(r, a, &i, "a light shader name");
+    if (name && strrchr(name, '/') && strrchr(name, '/')[1])
+        name = strrchr(name, '/') + 1; /* "shaders/pointlight": a path's last component */
     char handle[RIB_MAX_HANDLE];
     if (!name)
         return -1;

@@ -1224,7 +1224,8 @@ static void test_attributes_rayes_always_does(void)
  * outside (0, pi] taken through its cosine as RenderMan's spotlight takes
  * it, a light whose from and to coincide skipped, a disk of negative
  * radius (turned over), RenderMan 21's Displace (not built: a warning), an
- * archive found in the working directory. */
+ * archive found in the working directory, shaders named by a path, a light
+ * shader with a position alone as a point light. */
 static void test_prman_leniency(void)
 {
     CHECK(parse(WORLD(
@@ -1235,6 +1236,11 @@ static void test_prman_leniency(void)
     CHECK(rec.lights == 1);
     CHECK_NEAR(rec.light_params[0][0], acos(cos(20.0)) * 180 / M_PI, 1e-2);
     CHECK(rec.quadrics == 1 && (rec.quadric_flags & RAYES_QUADRIC_REVERSE));
+    /* shaders named by a path: their last component */
+    CHECK(parse(WORLD("LightSource \"shaders/shadowlight\" 1 \"from\" [0 3 2]\n"
+                      "Surface \"shaders/plastic\" \"Ks\" 1\nSphere 1 -1 1 360\n")) == RAYES_OK);
+    CHECK(strcmp(rec.shader, "plastic") == 0);
+    CHECK(rec.lights == 1 && strcmp(rec.light_types[0], "pointlight") == 0);
     CHECK(parse(WORLD("Disk 1.2 0.05 360\n")) == RAYES_OK);
     CHECK(rec.quadrics == 1 && !(rec.quadric_flags & RAYES_QUADRIC_REVERSE));
     FILE *f = fopen("test_rib_cwd_archive.rib", "w");
