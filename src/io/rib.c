@@ -264,6 +264,26 @@ static int file_exists(const char *path)
     return stat(path, &st) == 0 && S_ISREG(st.st_mode);
 }
 
+/* Reads an inline archive's text as a ReadArchive reads a file. */
+static int read_inline(Rib *r, const struct InlineArchive *ia)
+{
+    RibLexer *outer = r->lx;
+    const char *outer_file = r->file;
+    char req[64];
+    long line = r->req_line, col = r->req_col;
+    memcpy(req, r->req, sizeof req);
+    r->archive_depth++;
+    r->first_line = ia->line;
+    int e = run(r, ia->file, (const unsigned char *)ia->text, ia->size);
+    r->first_line = 1;
+    r->archive_depth--;
+    r->lx = outer;
+    r->file = outer_file;
+    memcpy(r->req, req, sizeof req);
+    r->req_line = line, r->req_col = col;
+    return e;
+}
+
 static int read_archive(Rib *r, const char *name_in)
 {
     if (r->archive_depth >= RIB_MAX_ARCHIVE_DEPTH)
@@ -276,6 +296,11 @@ static int read_archive(Rib *r, const char *name_in)
     if (bang) {
         bang[4] = '\0';
         member = bang + 5;
+    }
+    for (size_t k = r->n_inline; k-- > 0;) { /* the newest of that name */
+        const struct InlineArchive *ia = &r->inline_archives[k];
+        if (strcmp(ia->name, name_in) == 0)
+            return read_inline(r, ia);
     }
     char path[4096] = "";
     if (name[0] == '/') {
@@ -784,10 +809,54 @@ static int h_make_texture(Rib *r, const Args *a)
     return 0;
 }
 
+/* ArchiveBegin "name" ... ArchiveEnd: an inline archive, kept (its text)
+ * for a ReadArchive of its name; nothing in it is read here. */
 static int h_archive_begin(Rib *r, const Args *a)
 {
-    h_skip(r, a);
+    size_t i = 0;
+    const char *name = rib_get_string(r, a, &i, "an archive name");
+    if (!name)
+        return -1;
+    free(r->archive_name);
+    if (!(r->archive_name = rib_strdup(name)))
+        return rib_error(r, "out of memory");
     r->archive_block = 1;
+    r->archive_body = NULL;
+    r->archive_line = r->req_line;
+    return 0;
+}
+
+/* At the ArchiveEnd of an inline archive: its text kept. */
+static int archive_end(Rib *r)
+{
+    r->archive_block = 0;
+    const unsigned char *body = r->archive_body ? r->archive_body : r->req_at;
+    if (!body || !r->req_at || r->req_at < body) {
+        rib_warn_once(r, "inline archive",
+                      "ArchiveBegin \"%s\": an inline archive in binary "
+                      "RIB is not kept; ReadArchive of its name looks for a file",
+                      r->archive_name);
+        return 0;
+    }
+    if (r->n_inline == r->cap_inline) {
+        size_t c = r->cap_inline ? 2 * r->cap_inline : 8;
+        struct InlineArchive *n = realloc(r->inline_archives, c * sizeof *n);
+        if (!n)
+            return rib_error(r, "out of memory");
+        r->inline_archives = n, r->cap_inline = c;
+    }
+    struct InlineArchive *ia = &r->inline_archives[r->n_inline];
+    size_t size = (size_t)(r->req_at - body);
+    ia->name = r->archive_name;
+    r->archive_name = NULL;
+    ia->file = rib_strdup(r->file);
+    ia->text = malloc(size ? size : 1);
+    ia->size = size;
+    ia->line = r->archive_body ? r->archive_line : r->req_line;
+    r->n_inline++;
+    if (!ia->file || !ia->text)
+        return rib_error(r, "out of memory");
+    memcpy(ia->text, body, size);
     return 0;
 }
 
@@ -866,9 +935,12 @@ static int dispatch(Rib *r, const Args *a)
     if (r->done)
         return 0;
     if (r->archive_block) {
-        if (strcmp(q, "ArchiveEnd") == 0)
-            r->archive_block = 0;
-        return 0;
+        if (!r->archive_body && strcmp(q, "ArchiveEnd") != 0 && r->req_at) {
+            /* from its line's start (columns hold), unless ArchiveBegin shares the line */
+            r->archive_body = r->req_at - (r->req_line != r->archive_line ? r->req_col - 1 : 0);
+            r->archive_line = r->req_line;
+        }
+        return strcmp(q, "ArchiveEnd") == 0 ? archive_end(r) : 0;
     }
     if (r->skipping && strcmp(q, "FrameEnd") != 0)
         return 0;
@@ -898,6 +970,8 @@ static int run(Rib *r, const char *name, const unsigned char *data, size_t size)
 {
     RibLexer lx;
     rib_lex_init(&lx, name, data, size, r->err, r->err_size);
+    lx.line = r->first_line; /* an inline archive's text: its lines in its file */
+    r->first_line = 1;
     r->lx = &lx;
     r->file = name;
     Args args = {0};
@@ -913,6 +987,10 @@ static int run(Rib *r, const char *name, const unsigned char *data, size_t size)
         snprintf(r->req, sizeof r->req, "%s", t.str);
         r->req_line = t.line;
         r->req_col = t.col;
+        /* where it starts (a name is on one line: the lexer's line) */
+        r->req_at = t.line == lx.line && lx.line_start + t.col - 1 <= lx.end
+                        ? lx.line_start + t.col - 1
+                        : NULL;
         args_clear(&args);
         e = read_args(r, &args, &t);
         if (e == 0)
@@ -1038,6 +1116,7 @@ static void rib_init(Rib *r, int pass, const IoSink *sink, const IoReadOptions *
     r->a.ustep = r->a.vstep = step;
     r->projection = RAYES_PROJECTION_ORTHOGRAPHIC; /* RenderMan's default */
     r->fov = 90;
+    r->first_line = 1;
     r->selected = -1;
     r->top_name = "";
 }
@@ -1070,6 +1149,13 @@ static void rib_fini(Rib *r)
     free(r->coordsys_M);
     free(r->coordsys_world);
     free(r->frames);
+    for (size_t k = 0; k < r->n_inline; k++) {
+        free(r->inline_archives[k].name);
+        free(r->inline_archives[k].file);
+        free(r->inline_archives[k].text);
+    }
+    free(r->inline_archives);
+    free(r->archive_name);
     for (size_t k = 0; k < r->n_warned; k++)
         free(r->warned[k]);
 }

@@ -313,6 +313,19 @@ typedef struct Rib {
     int frame_saved_shadow;
     int motion, motion_seen;
     int archive_block;
+    /* inline archives (ArchiveBegin "name" ... ArchiveEnd): their text, read
+     * by a ReadArchive of their name before any file */
+    struct InlineArchive {
+        char *name, *file, *text; /* owned */
+        size_t size;
+        long line; /* of the text's first request in file */
+    } * inline_archives;
+    size_t n_inline, cap_inline;
+    char *archive_name;                /* the block being skipped: its name, owned */
+    const unsigned char *archive_body; /* and its first request, NULL until read */
+    long archive_line;
+    const unsigned char *req_at; /* the current request's first byte in its text, or NULL */
+    long first_line;             /* the line run() starts its text at (1) */
 
     char *warned[RIB_MAX_WARNED];
     size_t n_warned;

@@ -1225,7 +1225,8 @@ static void test_attributes_rayes_always_does(void)
  * it, a light whose from and to coincide skipped, a disk of negative
  * radius (turned over), RenderMan 21's Displace (not built: a warning), an
  * archive found in the working directory, shaders named by a path, a light
- * shader with a position alone as a point light. */
+ * shader with a position alone as a point light, inline archives
+ * (ArchiveBegin ... ArchiveEnd). */
 static void test_prman_leniency(void)
 {
     CHECK(parse(WORLD(
@@ -1243,6 +1244,14 @@ static void test_prman_leniency(void)
     CHECK(rec.lights == 1 && strcmp(rec.light_types[0], "pointlight") == 0);
     CHECK(parse(WORLD("Disk 1.2 0.05 360\n")) == RAYES_OK);
     CHECK(rec.quadrics == 1 && !(rec.quadric_flags & RAYES_QUADRIC_REVERSE));
+    /* an inline archive, read where its name is asked for (twice here);
+     * its errors name their line in the file */
+    CHECK(parse("ArchiveBegin \"ball\"\nSphere 1 -1 1 360\nArchiveEnd\n" WORLD(
+              "ReadArchive \"ball\"\nTranslate 0 0 3\nReadArchive \"ball\"\n")) == RAYES_OK);
+    CHECK(rec.quadrics == 2);
+    CHECK(parse("ArchiveBegin \"a\"\n\n  Sphere 1\nArchiveEnd\nWorldBegin\nReadArchive \"a\"\n") !=
+          RAYES_OK);
+    CHECK(strstr(err, "t.rib:3:3: Sphere: expected") != NULL);
     FILE *f = fopen("test_rib_cwd_archive.rib", "w");
     CHECK(f != NULL);
     if (!f)
