@@ -981,7 +981,27 @@ static int h_option_attribute(Rib *r, const Args *a)
                    strcmp(q->d.name, "opacitycachememory") == 0 && rib_is_num(q->v) &&
                    q->v->n == 1) {
             e = set_opacity_cache_memory(r, q->v->d[0]);
-        } else if (option && strcmp(group, "ri") == 0 &&
+        } else if (!option && strcasecmp(group, "ri") == 0 &&
+                   strcmp(q->d.name, "Orientation") == 0 && !rib_is_num(q->v) && q->v->n == 1) {
+            /* RenderMan 22's Attribute "Ri": the requests' attributes */
+            static const char *const names[] = {"outside", "inside", "lh", "rh"};
+            int k = 0;
+            while (k < 4 && strcmp(q->v->s[0], names[k]) != 0)
+                k++;
+            if (k < 4)
+                r->a.orient = k;
+            else
+                e = rib_error(r,
+                              "Attribute \"Ri\" \"Orientation\": expected \"outside\", "
+                              "\"inside\", \"lh\" or \"rh\", found \"%.60s\"",
+                              q->v->s[0]);
+        } else if (!option && strcasecmp(group, "ri") == 0 &&
+                   strcmp(q->d.name, "ShadingRate") == 0 && rib_is_num(q->v) && q->v->n == 1 &&
+                   q->v->d[0] > 0) {
+            r->a.shading_rate = (float)q->v->d[0];
+        } else if (!option && strcasecmp(group, "ri") == 0 && strcmp(q->d.name, "Sides") == 0) {
+            /* rayes shades both sides, as Sides 2 */
+        } else if (option && strcasecmp(group, "ri") == 0 &&
                    strcmp(q->d.name, "FormatResolution") == 0 && rib_is_num(q->v) && q->v->n == 2) {
             /* RenderMan 21 and later's Format */
             double w = q->v->d[0], h = q->v->d[1];
@@ -991,7 +1011,7 @@ static int h_option_attribute(Rib *r, const Args *a)
                 r->width = r->settings->width = (int)w;
                 r->height = r->settings->height = (int)h;
             }
-        } else if (option && strcmp(group, "ri") == 0 &&
+        } else if (option && strcasecmp(group, "ri") == 0 &&
                    strcmp(q->d.name, "FormatPixelAspectRatio") == 0 && rib_is_num(q->v) &&
                    q->v->n == 1) {
             if (q->v->d[0] != 1)

@@ -1226,7 +1226,8 @@ static void test_attributes_rayes_always_does(void)
  * radius (turned over), RenderMan 21's Displace (not built: a warning), an
  * archive found in the working directory, shaders named by a path, a light
  * shader with a position alone as a point light, inline archives
- * (ArchiveBegin ... ArchiveEnd). */
+ * (ArchiveBegin ... ArchiveEnd), RenderMan 22's "Ri" options and
+ * attributes. */
 static void test_prman_leniency(void)
 {
     CHECK(parse(WORLD(
@@ -1242,7 +1243,14 @@ static void test_prman_leniency(void)
                       "Surface \"shaders/plastic\" \"Ks\" 1\nSphere 1 -1 1 360\n")) == RAYES_OK);
     CHECK(strcmp(rec.shader, "plastic") == 0);
     CHECK(rec.lights == 1 && strcmp(rec.light_types[0], "pointlight") == 0);
+    /* RenderMan 22's Option and Attribute "Ri" (capital R) */
+    CHECK(parse("Option \"Ri\" \"int[2] FormatResolution\" [320 180]\n" WORLD(
+              "Attribute \"Ri\" \"string Orientation\" [\"inside\"] \"int Sides\" [1]\n"
+              "Disk 1.2 0.05 360\n")) == RAYES_OK);
+    CHECK(settings.width == 320 && settings.height == 180);
+    unsigned inside = rec.quadric_flags & RAYES_QUADRIC_REVERSE;
     CHECK(parse(WORLD("Disk 1.2 0.05 360\n")) == RAYES_OK);
+    CHECK(inside != (rec.quadric_flags & RAYES_QUADRIC_REVERSE));
     CHECK(rec.quadrics == 1 && !(rec.quadric_flags & RAYES_QUADRIC_REVERSE));
     /* an inline archive, read where its name is asked for (twice here);
      * its errors name their line in the file */
