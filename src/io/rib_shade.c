@@ -914,18 +914,18 @@ static int names_it(const char *name, const char *word)
 /* The classic light that stands in for a light shader rayes does not
  * have, by what its parameters and name say it is: a cone ("coneangle")
  * a spotlight; "distant", "directional" or "sun" in its name a distant
- * light; "point" (but not a point light without falloff), or a "from"
- * without a "to", a point light; else NULL. */
+ * light; "point", or a "from" without a "to", a point light (but not a
+ * point light without falloff, "nofall"); else NULL. */
 static const char *stand_in_light(const char *name, const Param *p, size_t n)
 {
     if (rib_find_param(p, n, "coneangle"))
         return "spotlight";
     if (names_it(name, "distant") || names_it(name, "directional") || names_it(name, "sun"))
         return "distantlight";
-    if (names_it(name, "point") && !names_it(name, "nofall"))
-        return "pointlight";
-    if (rib_find_param(p, n, "from") && !rib_find_param(p, n, "to"))
-        return "pointlight"; /* a position alone (shadowlight) */
+    if (names_it(name, "nofall"))
+        return NULL;
+    if (names_it(name, "point") || (rib_find_param(p, n, "from") && !rib_find_param(p, n, "to")))
+        return "pointlight"; /* by name, or a position alone (a studio's shadowlight) */
     return NULL;
 }
 
