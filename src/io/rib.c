@@ -28,6 +28,7 @@
 #include <sys/stat.h>
 #include <zlib.h>
 
+#include "io/rib_cond.h"
 #include "io/rib_reader.h"
 #include "io/zip.h"
 #include "util/log.h"
@@ -893,10 +894,6 @@ static const RibRequest own_requests[] = {
     {"ShaderLayer", h_skip},
     {"ConnectShaderLayers", h_skip},
     {"Shader", h_skip},
-    {"IfBegin", h_skip},
-    {"ElseIf", h_skip},
-    {"Else", h_skip},
-    {"IfEnd", h_skip},
     {"Matte", h_matte},
     {"TextureCoordinates", h_texture_coordinates},
     {"Bound", h_skip},
@@ -929,6 +926,42 @@ static const RibRequest *const tables[] = {
     rib_shade_requests,  rib_ris_requests,   rib_prim_requests,
     rib_curves_requests, rib_nurbs_requests, own_requests};
 
+/* IfBegin "expr", ElseIf "expr", Else, IfEnd: which branch is read
+ * (rib_cond.c evaluates; nothing is defined, so defined() is false). */
+static int conditional(Rib *r, const Args *a)
+{
+    const char *q = r->req;
+    int begin = strcmp(q, "IfBegin") == 0, elseif = strcmp(q, "ElseIf") == 0;
+    unsigned char *top = r->n_cond ? &r->cond[r->n_cond - 1] : NULL;
+    if (!begin && !top)
+        return rib_error(r, "%s without IfBegin", q);
+    int value = 1;
+    if (begin || elseif) {
+        size_t i = 0;
+        const char *expr = rib_get_string(r, a, &i, "a condition");
+        if (!expr)
+            return -1;
+        int evaluate = begin ? !top || *top == 0 : *top == 1;
+        if (evaluate && rib_condition(expr, &value) != 0)
+            rib_warn_once(r, "condition",
+                          "%s \"%.100s\": an expression rayes cannot evaluate; "
+                          "its branch is read",
+                          q, expr);
+    }
+    if (begin) {
+        if (r->n_cond == (int)sizeof r->cond)
+            return rib_error(r, "IfBegin nested more than %zu deep", sizeof r->cond);
+        r->cond[r->n_cond++] = top && *top != 0 ? 3 : value ? 0 : 1;
+    } else if (strcmp(q, "IfEnd") == 0) {
+        r->n_cond--;
+    } else if (*top == 0) {
+        *top = 2; /* a branch was read: the rest are not */
+    } else if (*top == 1 && (!elseif || value)) {
+        *top = 0;
+    }
+    return 0;
+}
+
 static int dispatch(Rib *r, const Args *a)
 {
     const char *q = r->req;
@@ -942,6 +975,11 @@ static int dispatch(Rib *r, const Args *a)
         }
         return strcmp(q, "ArchiveEnd") == 0 ? archive_end(r) : 0;
     }
+    if (strcmp(q, "IfBegin") == 0 || strcmp(q, "ElseIf") == 0 || strcmp(q, "Else") == 0 ||
+        strcmp(q, "IfEnd") == 0)
+        return r->skipping ? 0 : conditional(r, a);
+    if (r->n_cond && r->cond[r->n_cond - 1] != 0)
+        return 0; /* a branch not taken */
     if (r->skipping && strcmp(q, "FrameEnd") != 0)
         return 0;
     if (r->motion && strcmp(q, "MotionEnd") == 0)

@@ -313,6 +313,11 @@ typedef struct Rib {
     int frame_saved_shadow;
     int motion, motion_seen;
     int archive_block;
+    /* conditional blocks (IfBegin ... IfEnd), innermost last: 0 the branch
+     * being read, 1 skipped with none taken yet, 2 skipped after one was
+     * taken, 3 skipped inside a skipped branch */
+    unsigned char cond[64];
+    int n_cond;
     /* inline archives (ArchiveBegin "name" ... ArchiveEnd): their text, read
      * by a ReadArchive of their name before any file */
     struct InlineArchive {

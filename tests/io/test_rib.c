@@ -1227,7 +1227,7 @@ static void test_attributes_rayes_always_does(void)
  * archive found in the working directory, shaders named by a path, a light
  * shader with a position alone as a point light, inline archives
  * (ArchiveBegin ... ArchiveEnd), RenderMan 22's "Ri" options and
- * attributes. */
+ * attributes, conditional blocks (IfBegin ... IfEnd: one branch). */
 static void test_prman_leniency(void)
 {
     CHECK(parse(WORLD(
@@ -1260,6 +1260,19 @@ static void test_prman_leniency(void)
     CHECK(parse("ArchiveBegin \"a\"\n\n  Sphere 1\nArchiveEnd\nWorldBegin\nReadArchive \"a\"\n") !=
           RAYES_OK);
     CHECK(strstr(err, "t.rib:3:3: Sphere: expected") != NULL);
+    /* conditional blocks: one branch is read; nothing is defined */
+    CHECK(parse(WORLD("IfBegin \"0\"\nLightSource \"pointlight\" 1\n"
+                      "ElseIf \"!defined(RMSTREE) && 'a' == \\\"a\\\"\"\n"
+                      "  IfBegin \"$user:pass == 'shadow' || (2 > 3)\"\n"
+                      "    LightSource \"pointlight\" 2\n"
+                      "  Else\n    LightSource \"distantlight\" 3\n  IfEnd\n"
+                      "Else\nLightSource \"spotlight\" 4\nIfEnd\nSphere 1 -1 1 360\n")) ==
+          RAYES_OK);
+    CHECK(rec.lights == 1 && strcmp(rec.light_types[0], "distantlight") == 0);
+    CHECK(parse(WORLD("IfBegin \"1\"\nIfBegin \"0\"\nElse\nSphere 1 -1 1 360\nIfEnd\nElse\n"
+                      "Sphere 1 -1 1 360\nIfEnd\n")) == RAYES_OK);
+    CHECK(rec.quadrics == 1);
+    CHECK(parse(WORLD("Else\n")) != RAYES_OK && strstr(err, "Else without IfBegin"));
     FILE *f = fopen("test_rib_cwd_archive.rib", "w");
     CHECK(f != NULL);
     if (!f)
