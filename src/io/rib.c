@@ -1193,6 +1193,7 @@ static void rib_fini(Rib *r)
         free(r->inline_archives[k].text);
     }
     free(r->inline_archives);
+    free(r->stand_ins);
     free(r->archive_name);
     for (size_t k = 0; k < r->n_warned; k++)
         free(r->warned[k]);

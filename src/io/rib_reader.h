@@ -318,6 +318,14 @@ typedef struct Rib {
      * taken, 3 skipped inside a skipped branch */
     unsigned char cond[64];
     int n_cond;
+    /* Pattern classes rayes has not (RenderMan's Pxr networks): the colour
+     * each passes on, its input's (PxrExposure's inputRGB, ...), for the
+     * parameters that reference it */
+    struct PatternStandIn {
+        char name[128];
+        float rgb[3];
+    } * stand_ins;
+    size_t n_stand_ins, cap_stand_ins;
     /* inline archives (ArchiveBegin "name" ... ArchiveEnd): their text, read
      * by a ReadArchive of their name before any file */
     struct InlineArchive {
@@ -456,6 +464,9 @@ int rib_send_lights(Rib *r);
  * itself, or RenderMan's "pattern:output" without its output (in buf);
  * NULL if none did. */
 const char *rib_pattern_name(const Rib *r, const char *ref, char *buf, size_t size);
+/* The colour an unbuilt pattern referenced as ref ("name:output") passes on
+ * (h_pattern's stand-in) into rgb; 0 if there is none. */
+int rib_pattern_stand_in(const Rib *r, const char *ref, float rgb[3]);
 /* Whether a texture name is a readable file as given or on the texture
  * search path. */
 int rib_texture_found(const Rib *r, const char *name);

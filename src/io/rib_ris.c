@@ -96,6 +96,13 @@ static void out_colour_of(Rib *r, Out *o, const char *bxdf, const Param *p, size
             o->p[o->n++] = (RayesParam){to, RAYES_PARAM_PATTERN, {0, 0, 0}, name};
             return;
         }
+        float c[3];
+        if (rib_pattern_stand_in(r, q->v->s[0], c)) { /* an unbuilt pattern's input */
+            for (int k = 0; k < 3; k++)
+                c[k] *= gain;
+            out_color(o, to, c);
+            return;
+        }
         char key[200];
         snprintf(key, sizeof key, "ris reference %.150s", q->v->s[0]);
         rib_warn_once(r, key,

@@ -339,6 +339,56 @@ const char *rib_pattern_name(const Rib *r, const char *ref, char *buf, size_t si
     return pattern_sent(r, buf) ? buf : NULL;
 }
 
+int rib_pattern_stand_in(const Rib *r, const char *ref, float rgb[3])
+{
+    const char *colon = strrchr(ref, ':');
+    size_t n = colon ? (size_t)(colon - ref) : strlen(ref);
+    for (size_t k = r->n_stand_ins; k-- > 0;) {
+        const struct PatternStandIn *si = &r->stand_ins[k];
+        if (strlen(si->name) == n && strncmp(si->name, ref, n) == 0) {
+            memcpy(rgb, si->rgb, 3 * sizeof *rgb);
+            return 1;
+        }
+    }
+    return 0;
+}
+
+/* An unbuilt pattern's stand-in: the colour of its input (the first of
+ * RenderMan's usual names for a pattern's main input that it gives, a
+ * constant or another stand-in), kept under its name. */
+static int add_stand_in(Rib *r, const char *name, const Param *p, size_t n)
+{
+    static const char *const inputs[] = {"inputRGB", "inputColor", "colorIn",     "input",
+                                         "color1",   "inputA",     "defaultColor"};
+    float rgb[3];
+    int found = 0;
+    for (size_t k = 0; !found && k < sizeof inputs / sizeof inputs[0]; k++) {
+        const Param *q = rib_find_param(p, n, inputs[k]);
+        if (!q)
+            continue;
+        if (q->d.reference && q->d.ty == TY_STRING && q->v->n == 1)
+            found = rib_pattern_stand_in(r, q->v->s[0], rgb);
+        else if (rib_is_num(q->v) && (q->v->n == 3 || q->v->n == 1)) {
+            for (int c = 0; c < 3; c++)
+                rgb[c] = (float)q->v->d[q->v->n == 3 ? c : 0];
+            found = 1;
+        }
+    }
+    if (!found || strlen(name) >= sizeof r->stand_ins[0].name)
+        return 0;
+    if (r->n_stand_ins == r->cap_stand_ins) {
+        size_t c = r->cap_stand_ins ? 2 * r->cap_stand_ins : 16;
+        struct PatternStandIn *m = realloc(r->stand_ins, c * sizeof *m);
+        if (!m)
+            return rib_error(r, "out of memory");
+        r->stand_ins = m, r->cap_stand_ins = c;
+    }
+    struct PatternStandIn *si = &r->stand_ins[r->n_stand_ins++];
+    snprintf(si->name, sizeof si->name, "%s", name);
+    memcpy(si->rgb, rgb, sizeof rgb);
+    return 0;
+}
+
 /* make_shader's flags: keep only Kd and Ka (a stand-in for an unknown
  * shader); pass float arrays (a Pattern's data, densitygrid's density). */
 #define SHADER_ONLY_K 1
@@ -1336,11 +1386,12 @@ static int h_pattern(Rib *r, const Args *a)
         snprintf(key, sizeof key, "pattern %.100s", type);
         rib_warn_once(r, key,
                       "Pattern \"%s\" is not a class rayes has (RenderMan's Pxr "
-                      "patterns are not built); ignored, and parameters that reference it keep "
-                      "their defaults",
+                      "patterns are not built); ignored: colours that reference it take its "
+                      "input's colour (inputRGB, inputColor, ...), others keep their defaults",
                       type);
+        int e = add_stand_in(r, name, p, n);
         free(p);
-        return 0;
+        return e;
     }
     ShaderRec *sh =
         as ? rib_shader_rec(r, type, ris, n_ris) : make_shader(r, type, p, n, SHADER_ARRAYS);

@@ -108,6 +108,17 @@ static void test_bxdfs(void)
     CHECK(rib(WORLD("Pattern \"PxrTexture\" \"t\"\nBxdf \"PxrDiffuse\" \"d\" \"reference color "
                     "diffuseColor\" [\"t:resultRGB\"]\n" TRI)) == RAYES_OK);
     CHECK(strcmp(rec.shader[rec.n_shader - 1].name, "diffuse") == 0);
+    /* a pattern rayes has not passes its input's colour on, through a chain */
+    CHECK(rib(WORLD("Pattern \"PxrExposure\" \"e\" \"color inputRGB\" [0.8 0.05 0.05]\n"
+                    "Pattern \"PxrColorCorrect\" \"c\" \"reference color inputRGB\" "
+                    "[\"e:resultRGB\"]\nBxdf \"PxrDiffuse\" \"d\" \"reference color "
+                    "diffuseColor\" [\"c:resultRGB\"]\n" TRI)) == RAYES_OK);
+    if (rec.n_shader >= 1) {
+        const RecShader *pass = &rec.shader[rec.n_shader - 1];
+        CHECK(strcmp(pass->name, "diffuse") == 0);
+        CHECK_NEAR(param(pass, "reflectance", 0), 0.8, 1e-6);
+        CHECK_NEAR(param(pass, "reflectance", 1), 0.05, 1e-6);
+    }
     /* Bxdf is an attribute, as Surface is (after the block, the default:
      * in a file without lights, RenderMan's defaultsurface) */
     CHECK(rib(WORLD("AttributeBegin\nBxdf \"PxrDiffuse\" \"d\"\nAttributeEnd\n" TRI)) == RAYES_OK);
