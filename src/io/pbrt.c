@@ -559,6 +559,7 @@ RayesError io_pbrt_parse(const char *name, const unsigned char *data, size_t siz
     P->iso = 100;
     P->gs.active = 3;
     P->fov = 90;
+    P->film_diagonal = 35;
     if (settings) { /* pbrt-v4's integrator when the file names none: volpath, maxdepth 5 */
         settings->bounces = 4;
         settings->specular_depth = 5;

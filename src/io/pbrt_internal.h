@@ -275,6 +275,8 @@ typedef struct Parser {
     float shutter[2];                 /* the camera's shutteropen, shutterclose */
     float iso;                        /* the film's iso (100: pbrt's default) */
     float lens_radius, focal_distance; /* the camera's lensradius, focaldistance */
+    double lens_image;    /* a realistic camera: its lens system's image distance, mm (0: none) */
+    double film_diagonal; /* the film's diagonal, mm (pbrt's 35) */
     RayesProjection projection;
     float fov;
     float screen[4];

@@ -8,9 +8,11 @@
  */
 #include <math.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "io/pbrt_internal.h"
+#include "io/text.h"
 
 /* ------------------------------------------------------------ directives */
 
@@ -25,6 +27,93 @@ int pbrt_d_colorspace(Parser *P, const Token *t)
                      "ColorSpace \"%.40s\": rayes works in linear sRGB; colours are taken as "
                      "they are", name);
     (void)t;
+    return 0;
+}
+
+#define PBRT_MAX_LENS_ELEMENTS 256
+
+/* The effective focal length (mm) of a realistic camera's lens file
+ * (pbrt's: radius, thickness, index of refraction of the medium after the
+ * interface (0: air, the aperture stop), aperture diameter per line, in mm,
+ * from the scene to the film), by paraxial ray transfer; -1 with the error
+ * set. */
+static double lens_focal_length(Parser *P, const Token *t, const char *file)
+{
+    char path[PBRT_PATH], err[600];
+    if (pbrt_resolve(P, t, file, path, sizeof path) != 0)
+        return -1;
+    size_t size;
+    char *text = text_read_file(path, &size, err, sizeof err);
+    if (!text) {
+        pbrt_fail_at(P, t->line, t->col, "Camera \"realistic\": %s", err);
+        return -1;
+    }
+    double v[4 * PBRT_MAX_LENS_ELEMENTS];
+    size_t n = 0;
+    int bad = 0;
+    for (char *s = text; !bad && *s;) {
+        if (*s == '#') {
+            while (*s && *s != '\n')
+                s++;
+        } else if (strchr(" \t\r\n,", *s)) {
+            s++;
+        } else {
+            char *end;
+            double x = strtod(s, &end);
+            if (end == s || !isfinite(x) || n >= sizeof v / sizeof v[0])
+                bad = 1;
+            else
+                v[n++] = x, s = end;
+        }
+    }
+    free(text);
+    /* (height, index times angle) through each interface, then its gap */
+    double a = 1, b = 0, c = 0, d = 1, n1 = 1;
+    for (size_t i = 0; !bad && i + 3 < n; i += 4) {
+        double radius = v[i], gap = v[i + 1], n2 = v[i + 2] > 0 ? v[i + 2] : 1;
+        double power = radius != 0 ? (n2 - n1) / radius : 0;
+        c -= power * a, d -= power * b;       /* refraction: [1 0; -power 1] */
+        a += gap / n2 * c, b += gap / n2 * d; /* the gap: [1 gap/n2; 0 1] */
+        n1 = n2;
+    }
+    double f = c < 0 ? -1 / c : -1;
+    if (bad || n == 0 || n % 4 != 0 || !(f > 0) || !isfinite(f)) {
+        pbrt_fail_at(P, t->line, t->col,
+                     "Camera \"realistic\": %s: expected lines of radius, "
+                     "thickness, index and aperture of a focusing lens system",
+                     path);
+        return -1;
+    }
+    return f;
+}
+
+/* A realistic camera as a thin lens of its lens system's focal length:
+ * the image distance at its focus distance into P->lens_image (mm; the
+ * field of view follows from the film's diagonal, emit_camera), the
+ * aperture (mm, scene units taken as metres, as pbrt scales the lens) as
+ * depth of field. */
+static int realistic_camera(Parser *P, const Token *t, ParamList *pl)
+{
+    const char *file = pbrt_get_string(pl, "lensfile", NULL);
+    if (!file)
+        return FAIL_TOK(P, t, "Camera \"realistic\": expected \"string lensfile\"");
+    double f = lens_focal_length(P, t, file);
+    double focus = pbrt_get_float(pl, "focusdistance", 10.0);
+    double aperture = pbrt_get_float(pl, "aperturediameter", 1.0);
+    if (f < 0)
+        return -1;
+    if (!(focus > 0.001 * f) || !isfinite(focus) || !(aperture >= 0) || !isfinite(aperture))
+        return FAIL_TOK(P, t,
+                        "Camera \"realistic\": expected focusdistance beyond the lens "
+                        "and aperturediameter >= 0");
+    double fm = 0.001 * f; /* metres */
+    P->lens_image = f * focus / (focus - fm);
+    P->lens_radius = (float)(0.0005 * aperture);
+    P->focal_distance = (float)focus;
+    pbrt_warn_at(P, t->line, t->col, "realistic camera",
+                 "Camera \"realistic\": a thin lens of its lens system's focal length (%.1f mm) "
+                 "and aperture; the system's distortion and vignetting are not rendered",
+                 f);
     return 0;
 }
 
@@ -51,7 +140,8 @@ int pbrt_d_camera(Parser *P, const Token *t)
     r = pbrt_set_coordsys(P, t, "camera", inv);
     P->projection = strcmp(type, "orthographic") == 0 ? RAYES_PROJECTION_ORTHOGRAPHIC
                                                       : RAYES_PROJECTION_PERSPECTIVE;
-    if (strcmp(type, "perspective") != 0 && strcmp(type, "orthographic") != 0)
+    int realistic = strcmp(type, "realistic") == 0;
+    if (strcmp(type, "perspective") != 0 && strcmp(type, "orthographic") != 0 && !realistic)
         pbrt_warn_at(P, t->line, t->col, "camera type",
                      "Camera \"%.40s\" is not supported; using a perspective camera", type);
     P->fov = (float)pbrt_get_float(&pl, "fov", 90.0);
@@ -80,6 +170,11 @@ int pbrt_d_camera(Parser *P, const Token *t)
     }
     P->shutter[0] = (float)open, P->shutter[1] = (float)close;
     P->lens_radius = (float)lens, P->focal_distance = (float)focus;
+    P->lens_image = 0;
+    if (realistic && realistic_camera(P, t, &pl) != 0) {
+        pbrt_params_free(&pl);
+        return -1;
+    }
     pbrt_warn_unused(P, &pl, "Camera", type);
     pbrt_params_free(&pl);
     return r;
@@ -102,6 +197,12 @@ int pbrt_d_film(Parser *P, const Token *t)
         return FAIL_TOK(P, t, "Film: expected resolutions from 1 to 65536");
     }
     s->width = (int)w, s->height = (int)h;
+    double diagonal = pbrt_get_float(&pl, "diagonal", 35.0);
+    if (!(diagonal > 0) || !isfinite(diagonal)) {
+        pbrt_params_free(&pl);
+        return FAIL_TOK(P, t, "Film: expected a diagonal > 0 (mm), found %g", diagonal);
+    }
+    P->film_diagonal = diagonal;
     const char *file = pbrt_get_string(&pl, "filename", NULL);
     if (file) {
         IoDisplay *d = &s->displays[0];
@@ -285,7 +386,14 @@ static int emit_camera(Parser *P, const Token *t)
     if (!pbrt_mat_finite(P->camera_from_world))
         return FAIL_TOK(P, t, "the camera transform is not finite");
     pbrt_mat_to_float(P->camera_from_world, m);
-    RayesError e = P->sink->set_camera_matrix(P->sink->target, m, P->projection, P->fov,
+    float fov = P->fov;
+    if (P->lens_image > 0) { /* a realistic camera: the film's shorter side over the lens */
+        double w = P->settings && P->settings->width > 0 ? P->settings->width : 1280,
+               h = P->settings && P->settings->height > 0 ? P->settings->height : 720;
+        double side = P->film_diagonal * fmin(w, h) / hypot(w, h);
+        fov = (float)(2 * atan(0.5 * side / P->lens_image) * 180 / PI);
+    }
+    RayesError e = P->sink->set_camera_matrix(P->sink->target, m, P->projection, fov,
                                               P->have_screen ? P->screen : NULL);
     if (e != RAYES_OK)
         return pbrt_sink_failed(P, t, e);

@@ -1467,6 +1467,39 @@ static void test_anisotropic_roughness(void)
     free(r);
 }
 
+/* Camera "realistic": a thin lens of its lens file's focal length (the
+ * 22 mm wide-angle lens of pbrt-v4-scenes, paraxially 22.02 mm), its field
+ * of view over the film's shorter side (pbrt's 35 mm diagonal); a missing
+ * lens file is an error naming it. */
+static void test_realistic_camera(void)
+{
+    write_file("test_pbrt_lens.dat",
+               "# radius sep n aperture\n35.98738 1.21638 1.54 23.716\n11.69718 9.9957 1 17.996\n"
+               "13.08714 5.12622 1.772 12.364\n-22.63294 1.76924 1.617 9.812\n"
+               "71.05802 0.8184 1 9.152\n0 2.27766 0 8.756\n-9.58584 2.43254 1.617 8.184\n"
+               "-11.28864 0.11506 1 9.152\n-166.7765 3.09606 1.713 10.648\n"
+               "-7.5911 1.32682 1.805 11.44\n-16.7662 3.98068 1 12.276\n"
+               "-7.70286 1.21638 1.617 13.42\n-11.97328 0 1 17.996\n");
+    Rec *r = malloc(sizeof *r);
+    IoSettings s;
+    char err[512] = "";
+    CHECK(
+        parse("t.pbrt",
+              "Camera \"realistic\" \"string lensfile\" \"test_pbrt_lens.dat\" \"float "
+              "focusdistance\" 1e6 \"float aperturediameter\" 0\n"
+              "Film \"rgb\" \"integer xresolution\" 160 \"integer yresolution\" 120\nWorldBegin\n",
+              r, &s, err, sizeof err) == RAYES_OK);
+    /* 2 atan(35 * 120 / 200 / 2 / 22.0235) */
+    CHECK_NEAR(r->fov, 2 * atan(21.0 / 2 / 22.0235) * 180 / M_PI, 0.02);
+    ParseRun pr = {.name = "t.pbrt",
+                   .text = "Camera \"realistic\" \"string lensfile\" \"no-such-lens.dat\"\n",
+                   .r = r};
+    test_stderr_of(run_parse, &pr);
+    CHECK(pr.e != RAYES_OK && strstr(pr.err, "no-such-lens.dat") != NULL);
+    remove("test_pbrt_lens.dat");
+    free(r);
+}
+
 /* Forward references, as pbrt-v4 allows them (it makes named materials
  * and textures after reading the file): a NamedMaterial before its
  * MakeNamedMaterial (its shapes wait for the file's end, in their own
@@ -1746,7 +1779,7 @@ TEST_MAIN(TEST(test_filters), TEST(test_mix_classes), TEST(test_exposure),
           TEST(test_thin_dielectric), TEST(test_annulus), TEST(test_triangle_light),
           TEST(test_light_power), TEST(test_normal_map), TEST(test_anisotropic_roughness),
           TEST(test_maxdepth), TEST(test_projective_transform), TEST(test_forward_references),
-          TEST(test_spectrum_files), TEST(test_cornell_box), TEST(test_transforms),
-          TEST(test_materials), TEST(test_lights), TEST(test_instances_include_ply),
-          TEST(test_errors), TEST(test_normals_and_uv), TEST(test_textures),
-          TEST(test_coated_conductor_textures))
+          TEST(test_realistic_camera), TEST(test_spectrum_files), TEST(test_cornell_box),
+          TEST(test_transforms), TEST(test_materials), TEST(test_lights),
+          TEST(test_instances_include_ply), TEST(test_errors), TEST(test_normals_and_uv),
+          TEST(test_textures), TEST(test_coated_conductor_textures))
