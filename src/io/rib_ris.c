@@ -387,6 +387,37 @@ static int make_light(Rib *r, const char *handle, const char *cls, const float L
     return 1;
 }
 
+/* A RenderMan 21 light's controls rayes has: enableShadows 0 casts no
+ * shadows, a diffuse or specular multiplier of 0 none of that light; what
+ * it has not (a cone, near-distance falloff, focus, shadow colour, other
+ * multipliers) is said once. */
+static void light_controls(Rib *r, const char *cls, Light *l, const Param *p, size_t n)
+{
+    static const float zero[3] = {0, 0, 0}, one[3] = {1, 1, 1};
+    if (num(p, n, "enableShadows", 1) == 0)
+        rib_light_param(l, "shadows", RAYES_PARAM_FLOAT, zero, NULL);
+    float diffuse = num(p, n, "diffuse", 1), specular = num(p, n, "specular", 1);
+    if (diffuse == 0)
+        rib_light_param(l, "__nondiffuse", RAYES_PARAM_FLOAT, one, NULL);
+    if (specular == 0)
+        rib_light_param(l, "__nonspecular", RAYES_PARAM_FLOAT, one, NULL);
+    float shadow[3];
+    color(p, n, "shadowColor", zero, shadow);
+    const char *unbuilt = (diffuse != 0 && diffuse != 1) || (specular != 0 && specular != 1)
+                              ? "diffuse and specular multipliers other than 0 and 1"
+                          : num(p, n, "coneAngle", 90) < 90       ? "coneAngle (a cone)"
+                          : num(p, n, "intensityNearDist", 0) > 0 ? "intensityNearDist"
+                          : num(p, n, "emissionFocus", 0) != 0    ? "emissionFocus"
+                          : shadow[0] != 0 || shadow[1] != 0 || shadow[2] != 0 ? "shadowColor"
+                                                                               : NULL;
+    if (unbuilt) {
+        char key[160];
+        snprintf(key, sizeof key, "ris light %.60s %.60s", cls, unbuilt);
+        rib_warn_once(r, key, "light \"%s\": %s not built; the light shines as without it", cls,
+                      unbuilt);
+    }
+}
+
 /* Light "class" "handle" params (RenderMan 21 and later). */
 static int h_light(Rib *r, const Args *a)
 {
@@ -411,6 +442,8 @@ static int h_light(Rib *r, const Args *a)
     const char *map = string(p, n, "lightColorMap");
     int e = make_light(r, handle, cls, L, num(p, n, "areaNormalize", 0) != 0,
                        num(p, n, "angleExtent", 0.53f), map);
+    if (e > 0)
+        light_controls(r, cls, &r->lights[r->n_lights - 1], p, n);
     free(p);
     if (e > 0 && (strcmp(cls, "PxrRectLight") == 0 || strcmp(cls, "PxrDiskLight") == 0 ||
                   strcmp(cls, "PxrSphereLight") == 0)) {

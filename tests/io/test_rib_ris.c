@@ -147,6 +147,12 @@ static void test_lights(void)
     CHECK_NEAR(param(light(), "lightcolor", 1), 0.5, 1e-6);
     const RayesParam *shape = rec_param(light(), "shape");
     CHECK(shape && strcmp(shape->string, "quad") == 0);
+    CHECK(rec_param(light(), "shadows") == NULL);
+    /* enableShadows 0 and a diffuse multiplier of 0 are rayes' own controls */
+    CHECK(rib(WORLD("Light \"PxrRectLight\" \"k\" \"int enableShadows\" [0] \"float diffuse\" [0] "
+                    "\"float coneAngle\" [20]\n" TRI)) == RAYES_OK);
+    CHECK(rec.n_light == 1 && param(light(), "shadows", 0) == 0.0f &&
+          param(light(), "__nondiffuse", 0) == 1.0f && rec_param(light(), "__nonspecular") == NULL);
     /* on after its block: the triangle is linked to every light */
     CHECK(rec.links_mode == RAYES_LIGHT_LINKS_ALL);
     /* areaNormalize: over the area of the square as scaled (2 x 3) and
