@@ -543,15 +543,22 @@ static int h_surface(Rib *r, const Args *a)
     size_t n;
     if (shader_args(r, a, &name, &p, &n) != 0)
         return -1;
+    name = shader_name(r, builtin_surfaces, name);
+    if (!shader_known(r, builtin_surfaces, name)) /* a plugin of that name comes first */
+        name = surface_alias(name);
+    int known = shader_known(r, builtin_surfaces, name);
+    if (!known) { /* only Ka and Kd are kept: the others' values are not checked */
+        size_t k = 0;
+        for (size_t i = 0; i < n; i++)
+            if (strcmp(p[i].d.name, "Ka") == 0 || strcmp(p[i].d.name, "Kd") == 0)
+                p[k++] = p[i];
+        n = k;
+    }
     static const Counts one = {1, 1, 1, 1};
     if (rib_check_counts(r, p, n, &one) != 0) {
         free(p);
         return -1;
     }
-    name = shader_name(r, builtin_surfaces, name);
-    if (!shader_known(r, builtin_surfaces, name)) /* a plugin of that name comes first */
-        name = surface_alias(name);
-    int known = shader_known(r, builtin_surfaces, name);
     /* in a file without lights, RenderMan's own stand-in, which needs none */
     const char *instead = r->unlit_file ? "defaultsurface" : "matte";
     if (!known) {

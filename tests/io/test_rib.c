@@ -1238,6 +1238,9 @@ static void test_prman_leniency(void)
     CHECK(rec.lights == 1);
     CHECK_NEAR(rec.light_params[0][0], acos(cos(20.0)) * 180 / M_PI, 1e-2);
     CHECK(rec.quadrics == 1 && (rec.quadric_flags & RAYES_QUADRIC_REVERSE));
+    /* an unknown shader keeps Ka and Kd only: its other values are not checked */
+    CHECK(parse(WORLD("Surface \"difSpec\" \"color myOpacity\" .9 \"Kd\" 0.5\n")) == RAYES_OK);
+    CHECK(parse(WORLD("Surface \"difSpec\" \"color Kd\" .9\n")) != RAYES_OK);
     /* shaders named by a path: their last component */
     CHECK(parse(WORLD("LightSource \"shaders/shadowlight\" 1 \"from\" [0 3 2]\n"
                       "Surface \"shaders/plastic\" \"Ks\" 1\nSphere 1 -1 1 360\n")) == RAYES_OK);
