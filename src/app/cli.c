@@ -604,11 +604,11 @@ void merge_settings(Args *a, const IoSettings *s)
         memcpy(o->crop, s->crop, sizeof o->crop);
 }
 
-RayesError default_light(const Args *a, RayesScene *scene)
+RayesError default_light(const Args *a, const IoSettings *s, RayesScene *scene)
 {
     if (rayes_scene_light_count(scene) > 0)
         return RAYES_OK;
-    if (!a->default_light) {
+    if (!a->default_light && !s->headlight) {
         fprintf(stderr, "rayes: warning: %s: the scene has no lights (--default-light adds a "
                         "headlight)\n", a->scene);
         return RAYES_OK;

@@ -94,10 +94,10 @@ int load_status(const char *scene, RayesError e);
 void merge_settings(Args *a, const IoSettings *s);
 
 /* A loaded scene without lights (before its commit): one warning, or with
- * --default-light a headlight, a distant light of intensity 1 along the
- * view. Returns what adding it returned (RAYES_OK when nothing was
- * added). */
-RayesError default_light(const Args *a, RayesScene *scene);
+ * --default-light (or a file that asks for one, s->headlight) a headlight,
+ * a distant light of intensity 1 along the view. Returns what adding it returned (RAYES_OK when
+ * nothing was added). */
+RayesError default_light(const Args *a, const IoSettings *s, RayesScene *scene);
 
 /* The usage text of every command, to f. */
 void print_usage(FILE *f);

@@ -1246,7 +1246,7 @@ RayesError io_rib_parse(const char *name, const unsigned char *data, size_t size
                  frame);
         e = -1;
     }
-    int lit = r.lit, ris = r.ris;
+    int lit = r.lit, ris = r.ris, integrator = r.integrator;
     rib_fini(&r);
     if (e == 0) { /* pass 2: the selected frame into the sink */
         rib_init(&r, 2, sink, options, settings, err, err_size);
@@ -1256,6 +1256,10 @@ RayesError io_rib_parse(const char *name, const unsigned char *data, size_t size
         e = run(&r, name, data, size);
         if (e == 0 && r.n_lights > 0)
             e = rib_flush_lights(&r); /* a file without WorldEnd */
+        /* RenderMan 19 and later with no Integrator: PRMan's PxrDefault,
+         * a light at the camera, which a file without lights shows */
+        if (e == 0 && ris && !integrator && !lit)
+            settings->headlight = 1;
         /* 8-bit files as RenderMan writes them (its Exposure the only
          * curve), unless the file says otherwise or is RenderMan 19's or
          * later (physically based, seen through sRGB) */

@@ -238,6 +238,7 @@ typedef struct Rib {
     double nurbs_work;     /* the NuPatch and trim work of the pass (rib_nurbs.c) */
     int lit;               /* a light was made (pass 1: anywhere in the file) */
     int ris;               /* a RenderMan 19+ request was read (Bxdf, Light, Integrator) */
+    int integrator;        /* an Integrator request was read */
     int unlit_file;        /* pass 2: the file makes no light, so geometry without a
                               Surface is drawn with RenderMan's defaultsurface */
 

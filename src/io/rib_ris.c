@@ -521,6 +521,7 @@ enum { RIS_DIFFUSE_BOUNCES = 8 };
 static int h_integrator(Rib *r, const Args *a)
 {
     r->ris = 1;
+    r->integrator = 1;
     Param *p;
     size_t n;
     const char *cls = class_and_params(r, a, "an integrator class", &p, &n);

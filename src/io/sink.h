@@ -173,6 +173,8 @@ typedef struct IoSettings {
     float exposure_gamma;     /* RIB Exposure; 1 when not given */
     float background[4];      /* RIB Imager "background": the colour the image is
                                  composited over, before exposure; [3] 1 when given */
+    int headlight;            /* 1: a scene without lights is lit by a light at the camera
+                                 (RIB RenderMan 19+ without an Integrator: PxrDefault's) */
     int opaque;               /* 1: the format's films have no alpha (pbrt): images are
                                  written with alpha 1, the environment seen as pbrt shows it */
     int png_curve;            /* 8-bit files: IO_CURVE_SRGB (also 0, unsaid) or

@@ -213,6 +213,16 @@ static void test_geometry_lights(void)
 
 static void test_integrator(void)
 {
+    /* no Integrator: PRMan's PxrDefault, a light at the camera, which a file
+     * without lights asks for */
+    CHECK(rib(WORLD("Bxdf \"PxrDiffuse\" \"d\"\n" TRI)) == RAYES_OK && settings.headlight == 1);
+    CHECK(rib("Integrator \"PxrPathTracer\" \"pt\"\n" WORLD("Bxdf \"PxrDiffuse\" \"d\"\n" TRI)) ==
+              RAYES_OK &&
+          settings.headlight == 0);
+    CHECK(rib(WORLD("Light \"PxrDomeLight\" \"dome\"\nBxdf \"PxrDiffuse\" \"d\"\n" TRI)) ==
+              RAYES_OK &&
+          settings.headlight == 0);
+    CHECK(rib(WORLD("Surface \"matte\"\n" TRI)) == RAYES_OK && settings.headlight == 0);
     CHECK(rib("Integrator \"PxrPathTracer\" \"pt\" \"int maxPathLength\" [4]\n" WORLD(TRI)) ==
           RAYES_OK);
     CHECK(settings.bounces == 3 && settings.specular_depth == 4);
