@@ -876,7 +876,6 @@ static const RibRequest own_requests[] = {
     {"DisplayChannel", h_skip},
     {"DisplayFilter", h_skip},
     {"SampleFilter", h_skip},
-    {"Camera", h_skip},
     {"MakeShadow", h_skip},
     {"MakeTexture", h_make_texture},
     {"MakeBump", h_skip},

@@ -164,6 +164,22 @@ static int send_time(Rib *r, const IoSink *s)
     return 0;
 }
 
+/* The named camera a world is seen from: the one Display's "string
+ * camera" names, or, when the transform at WorldBegin places no camera
+ * (the identity: RenderMan 22's layout restores it after declaring its
+ * camera), the last declared; else NULL (the current transform is the
+ * camera, as in classic files). */
+static const struct NamedCamera *named_camera(const Rib *r)
+{
+    for (int k = 0; r->display_camera[0] && k < r->n_cameras; k++)
+        if (strcmp(r->cameras[k].name, r->display_camera) == 0)
+            return &r->cameras[k];
+    float id[16];
+    rib_mat_identity(id);
+    return r->n_cameras > 0 && memcmp(r->a.M, id, sizeof id) == 0 ? &r->cameras[r->n_cameras - 1]
+                                                                  : NULL;
+}
+
 static int h_world_begin(Rib *r, const Args *a)
 {
     (void)a;
@@ -174,6 +190,9 @@ static int h_world_begin(Rib *r, const Args *a)
     if (r->worlds++ > 0 && !r->in_frame)
         rib_warn_once(r, "worlds", "several world blocks outside frames are read into one scene");
     memcpy(r->camera_from_world, r->a.M, sizeof r->a.M);
+    const struct NamedCamera *cam = named_camera(r);
+    if (cam)
+        memcpy(r->camera_from_world, cam->M, sizeof cam->M);
     r->camera_motion = r->a.n_motion;
     memcpy(r->camera_motion_time, r->a.motion_time, sizeof r->camera_motion_time);
     memcpy(r->camera_motion_M, r->a.motion_M, sizeof r->camera_motion_M);

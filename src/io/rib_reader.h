@@ -245,6 +245,14 @@ typedef struct Rib {
     int in_world;
     int worlds;
     float camera_from_world[16];
+    /* named cameras (Camera "name": RenderMan 22's layout declares the
+     * camera in a TransformBegin block; Display's "string camera" picks) */
+    struct NamedCamera {
+        char name[64];
+        float M[16]; /* camera_from_world at its Camera */
+    } cameras[8];
+    int n_cameras;
+    char display_camera[64];   /* the main Display's "camera", "" for none */
     int camera_motion;         /* camera_from_world moves: samples in camera_motion_M */
     float camera_motion_time[RIB_MAX_TIMES], camera_motion_M[RIB_MAX_TIMES][16];
     float shutter[2], shutter_offset; /* Shutter, Option "shutter" "offset" */

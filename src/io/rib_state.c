@@ -450,11 +450,12 @@ static int h_projection(Rib *r, const Args *a)
         return -1;
     const Param *fov = rib_find_param(p, n, "fov");
     int e = 0;
-    /* RenderMan 21 and later name them PxrPerspective, PxrOrthographic */
+    /* RenderMan 21 and later name them PxrPerspective (PxrCamera), PxrOrthographic */
     if (strcmp(name, "orthographic") == 0 || strcmp(name, "PxrOrthographic") == 0) {
         r->projection = RAYES_PROJECTION_ORTHOGRAPHIC;
     } else {
-        if (strcmp(name, "perspective") != 0 && strcmp(name, "PxrPerspective") != 0)
+        if (strcmp(name, "perspective") != 0 && strcmp(name, "PxrPerspective") != 0 &&
+            strcmp(name, "PxrCamera") != 0) /* PxrCamera: RenderMan 22's, its lens effects unread */
             rib_warn_once(r, name, "projection \"%s\" is not supported; perspective used", name);
         r->projection = RAYES_PROJECTION_PERSPECTIVE;
         r->fov = 90;
@@ -580,6 +581,34 @@ static int is_shadow_display(const char *type, const char *mode)
     return strcmp(type, "zfile") == 0 || strcmp(type, "shadow") == 0 || strcmp(mode, "z") == 0;
 }
 
+/* Camera "name": the camera as it is now (its transform) kept under that
+ * name, for WorldBegin (rib_frame.c); RenderMan 22's files declare it in
+ * a TransformBegin block and pick it by Display's "string camera". */
+static int h_camera(Rib *r, const Args *a)
+{
+    size_t i = 0;
+    const char *name = rib_get_string(r, a, &i, "a camera name");
+    if (!name)
+        return -1;
+    if (r->in_world) {
+        rib_warn_once(r, "camera in world", "Camera inside the world is ignored");
+        return 0;
+    }
+    int k = 0;
+    while (k < r->n_cameras && strcmp(r->cameras[k].name, name) != 0)
+        k++;
+    if (k == (int)(sizeof r->cameras / sizeof r->cameras[0])) {
+        rib_warn_once(r, "cameras", "more than %zu named cameras: the others are ignored",
+                      sizeof r->cameras / sizeof r->cameras[0]);
+        return 0;
+    }
+    snprintf(r->cameras[k].name, sizeof r->cameras[k].name, "%s", name);
+    memcpy(r->cameras[k].M, r->a.M, sizeof r->a.M);
+    if (k == r->n_cameras)
+        r->n_cameras++;
+    return 0;
+}
+
 static int h_display(Rib *r, const Args *a)
 {
     size_t i = 0;
@@ -598,6 +627,11 @@ static int h_display(Rib *r, const Args *a)
         rib_warn_once(r, "displays", "more than %d displays: the others are ignored", IO_MAX_DISPLAYS);
         return 0;
     }
+    for (size_t k = i; !extra && k + 1 < a->n; k++) /* "string camera" ["name"] */
+        if (a->v[k].kind == ARG_STR && a->v[k].n == 1 &&
+            (strcmp(a->v[k].s[0], "camera") == 0 || strcmp(a->v[k].s[0], "string camera") == 0) &&
+            (a->v[k + 1].kind == ARG_STR || a->v[k + 1].kind == ARG_STRS) && a->v[k + 1].n >= 1)
+            snprintf(r->display_camera, sizeof r->display_camera, "%s", a->v[k + 1].s[0]);
     IoDisplay *d = &s->displays[s->n_displays++];
     snprintf(d->name, sizeof d->name, "%s", name + extra);
     snprintf(d->type, sizeof d->type, "%s", type);
@@ -1135,6 +1169,7 @@ const RibRequest rib_state_requests[] = {
     {"Quantize", h_quantize},
     {"Imager", h_imager},
     {"Display", h_display},
+    {"Camera", h_camera},
     {"Hider", h_hider},
     {"ShadingRate", h_shading_rate},
     {"Sides", h_sides},

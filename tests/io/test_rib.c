@@ -1246,6 +1246,15 @@ static void test_prman_leniency(void)
                       "Surface \"shaders/plastic\" \"Ks\" 1\nSphere 1 -1 1 360\n")) == RAYES_OK);
     CHECK(strcmp(rec.shader, "plastic") == 0);
     CHECK(rec.lights == 1 && strcmp(rec.light_types[0], "pointlight") == 0);
+    /* RenderMan 22's named camera, declared in a block, picked by Display */
+    CHECK(parse("TransformBegin\nProjection \"PxrCamera\" \"float fov\" [30]\nTranslate 0 0 10\n"
+                "Camera \"main\"\nTransformEnd\nDisplay \"x.exr\" \"openexr\" \"rgba\" \"string "
+                "camera\" [\"main\"]\nWorldBegin\nSphere 1 -1 1 360\nWorldEnd\n") == RAYES_OK);
+    CHECK(rec.fov == 30.0f && rec.camera[11] == 10.0f);
+    /* a classic file's Camera names a coordinate frame; its transform stays */
+    CHECK(parse("Translate 0 0 5\nCamera \"shadowcam\"\nTranslate 0 0 2\nWorldBegin\nWorldEnd\n") ==
+          RAYES_OK);
+    CHECK(rec.camera[11] == 7.0f);
     /* RenderMan 22's Option and Attribute "Ri" (capital R) */
     CHECK(parse("Option \"Ri\" \"int[2] FormatResolution\" [320 180]\n" WORLD(
               "Attribute \"Ri\" \"string Orientation\" [\"inside\"] \"int Sides\" [1]\n"
