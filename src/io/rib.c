@@ -265,8 +265,10 @@ static int file_exists(const char *path)
     return stat(path, &st) == 0 && S_ISREG(st.st_mode);
 }
 
-/* Reads an inline archive's text as a ReadArchive reads a file. */
-static int read_inline(Rib *r, const struct InlineArchive *ia)
+/* Reads an archive's text (named name, its first line first_line) inside
+ * the current request, which is the current one again after. */
+static int run_archive(Rib *r, const char *name, const unsigned char *data, size_t size,
+                       long first_line)
 {
     RibLexer *outer = r->lx;
     const char *outer_file = r->file;
@@ -274,8 +276,8 @@ static int read_inline(Rib *r, const struct InlineArchive *ia)
     long line = r->req_line, col = r->req_col;
     memcpy(req, r->req, sizeof req);
     r->archive_depth++;
-    r->first_line = ia->line;
-    int e = run(r, ia->file, (const unsigned char *)ia->text, ia->size);
+    r->first_line = first_line;
+    int e = run(r, name, data, size);
     r->first_line = 1;
     r->archive_depth--;
     r->lx = outer;
@@ -283,6 +285,12 @@ static int read_inline(Rib *r, const struct InlineArchive *ia)
     memcpy(r->req, req, sizeof req);
     r->req_line = line, r->req_col = col;
     return e;
+}
+
+/* Reads an inline archive's text as a ReadArchive reads a file. */
+static int read_inline(Rib *r, const struct InlineArchive *ia)
+{
+    return run_archive(r, ia->file, (const unsigned char *)ia->text, ia->size, ia->line);
 }
 
 static int read_archive(Rib *r, const char *name_in)
@@ -340,19 +348,8 @@ static int read_archive(Rib *r, const char *name_in)
                : read_gz(path, &size, err, sizeof err);
     if (!data)
         return rib_error(r, "archive \"%s\": %s", name_in, err);
-    RibLexer *outer = r->lx;
-    const char *outer_file = r->file;
-    char req[64];
-    long line = r->req_line, col = r->req_col;
-    memcpy(req, r->req, sizeof req);
-    r->archive_depth++;
     char *path_copy = rib_strdup(path);
-    int e = path_copy ? run(r, path_copy, data, size) : rib_error(r, "out of memory");
-    r->archive_depth--;
-    r->lx = outer;
-    r->file = outer_file;
-    memcpy(r->req, req, sizeof req);
-    r->req_line = line, r->req_col = col;
+    int e = path_copy ? run_archive(r, path_copy, data, size, 1) : rib_error(r, "out of memory");
     free(path_copy);
     free(data);
     return e;
