@@ -25,8 +25,8 @@
 #include "io/pbrt_internal.h"
 
 /* Directives deferred at most per list: each holds a graphics state
- * (about 3 KB). */
-#define PBRT_MAX_DEFERRED (1u << 20)
+ * (about 4 KB), so at most about 1 GB. */
+#define PBRT_MAX_DEFERRED (1u << 18)
 
 Deferred *pbrt_defer(Parser *P, DeferList *list, const Lexer *at, const Token *t)
 {
@@ -64,7 +64,7 @@ int pbrt_reread(Parser *P, const Deferred *d, const GState *gs,
     P->lx = &lx;
     P->has_peek = 0;
     P->gs = *gs;
-    P->rereading = 1;
+    P->rereading++; /* how deep: mixes read again inside one another */
     int r = fn(P, &d->t);
     P->lx = saved_lx;
     P->gs = saved_gs;

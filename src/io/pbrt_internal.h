@@ -290,7 +290,8 @@ typedef struct Parser {
     DeferList shapes;    /* shapes whose NamedMaterial was not defined yet */
     DeferList defs;      /* MakeNamedMaterial whose textures were not defined yet */
     int missing_texture; /* a texture name was looked up and not found */
-    int rereading;       /* a deferred directive is read again: it is not deferred twice */
+    int rereading;       /* deferred directives being read again, nested (they are not
+                            deferred twice) */
 } Parser;
 
 /* ------------------------------------------------ messages (pbrt_lex.c) */
@@ -470,6 +471,9 @@ int pbrt_d_shape(Parser *P, const Token *t); /* pbrt_shape.c */
  * NamedMaterial or a deferred shape first asks for it:
  * pbrt_named_material, pbrt_material.c). */
 int pbrt_deferred_shapes(Parser *P);
+/* How deep deferred materials (mixes of mixes) are read again inside one
+ * another, at most: each level is a parse on the stack. */
+#define PBRT_MAX_REREAD 64
 /* pbrt_defer.c: appends the directive whose name t was read (at: its
  * lexer just after t; the graphics state as it is now), or NULL (an error
  * in P). */

@@ -961,6 +961,13 @@ const Material *pbrt_named_material(Parser *P, const char *name, int *r)
         Deferred *d = &P->defs.d[i];
         if (d->done || strcmp(d->name, name) != 0)
             continue;
+        if (P->rereading >= PBRT_MAX_REREAD) {
+            *r = FAIL_TOK(P, &d->t,
+                          "MakeNamedMaterial \"%.60s\": mixes of materials defined "
+                          "further down nest more than %d deep",
+                          name, PBRT_MAX_REREAD);
+            return NULL;
+        }
         d->done = 1;        /* no loop through a mix of itself */
         Deferred copy = *d; /* reading it again may grow P->defs */
         if (pbrt_reread(P, &copy, &copy.gs, pbrt_d_makenamedmaterial) != 0) {

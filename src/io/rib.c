@@ -287,9 +287,19 @@ static int run_archive(Rib *r, const char *name, const unsigned char *data, size
     return e;
 }
 
+/* Inline archive text read at most, in all: an archive read twice by
+ * each of 30 others nested would be 2^30 reads of it. */
+#define RIB_MAX_INLINE_READ ((size_t)256 << 20)
+
 /* Reads an inline archive's text as a ReadArchive reads a file. */
 static int read_inline(Rib *r, const struct InlineArchive *ia)
 {
+    r->inline_read += ia->size;
+    if (r->inline_read > RIB_MAX_INLINE_READ)
+        return rib_error(r,
+                         "inline archives read more than %zu MB of text in all (archives "
+                         "reading each other many times?)",
+                         RIB_MAX_INLINE_READ >> 20);
     return run_archive(r, ia->file, (const unsigned char *)ia->text, ia->size, ia->line);
 }
 
@@ -819,6 +829,7 @@ static int h_archive_begin(Rib *r, const Args *a)
     if (!(r->archive_name = rib_strdup(name)))
         return rib_error(r, "out of memory");
     r->archive_block = 1;
+    r->archive_nest = 0;
     r->archive_body = NULL;
     r->archive_line = r->req_line;
     return 0;
@@ -829,7 +840,10 @@ static int archive_end(Rib *r)
 {
     r->archive_block = 0;
     const unsigned char *body = r->archive_body ? r->archive_body : r->req_at;
-    if (!body || !r->req_at || r->req_at < body) {
+    int binary = 0;
+    for (const unsigned char *c = body; body && r->req_at && c < r->req_at && !binary; c++)
+        binary = *c >= 0200;
+    if (!body || !r->req_at || r->req_at < body || binary) {
         rib_warn_once(r, "inline archive",
                       "ArchiveBegin \"%s\": an inline archive in binary "
                       "RIB is not kept; ReadArchive of its name looks for a file",
@@ -965,15 +979,24 @@ static int dispatch(Rib *r, const Args *a)
         return 0;
     if (r->archive_block) {
         if (!r->archive_body && strcmp(q, "ArchiveEnd") != 0 && r->req_at) {
-            /* from its line's start (columns hold), unless ArchiveBegin shares the line */
-            r->archive_body = r->req_at - (r->req_line != r->archive_line ? r->req_col - 1 : 0);
+            /* from its line's start (columns hold) when only blanks come before it */
+            const unsigned char *at = r->req_at, *start = at - (r->req_col - 1);
+            while (at > start && (at[-1] == ' ' || at[-1] == '\t'))
+                at--;
+            r->archive_body = r->req_line != r->archive_line && at == start ? start : r->req_at;
             r->archive_line = r->req_line;
         }
-        return strcmp(q, "ArchiveEnd") == 0 ? archive_end(r) : 0;
+        if (strcmp(q, "ArchiveBegin") == 0)
+            r->archive_nest++; /* kept in the text, read with it */
+        else if (strcmp(q, "ArchiveEnd") == 0 && r->archive_nest > 0)
+            r->archive_nest--;
+        else if (strcmp(q, "ArchiveEnd") == 0)
+            return archive_end(r);
+        return 0;
     }
     if (strcmp(q, "IfBegin") == 0 || strcmp(q, "ElseIf") == 0 || strcmp(q, "Else") == 0 ||
         strcmp(q, "IfEnd") == 0)
-        return r->skipping ? 0 : conditional(r, a);
+        return conditional(r, a); /* in skipped frames too: both passes keep one stack */
     if (r->n_cond && r->cond[r->n_cond - 1] != 0)
         return 0; /* a branch not taken */
     if (r->skipping && strcmp(q, "FrameEnd") != 0)
@@ -1021,15 +1044,20 @@ static int run(Rib *r, const char *name, const unsigned char *data, size_t size)
         snprintf(r->req, sizeof r->req, "%s", t.str);
         r->req_line = t.line;
         r->req_col = t.col;
-        /* where it starts (a name is on one line: the lexer's line) */
-        r->req_at = t.line == lx.line && lx.line_start + t.col - 1 <= lx.end
-                        ? lx.line_start + t.col - 1
-                        : NULL;
+        /* where it starts, if written out (ASCII: a name is on one line,
+         * the lexer's) */
+        const unsigned char *at = lx.line_start + t.col - 1;
+        r->req_at = t.line == lx.line && at < lx.end && *at == (unsigned char)t.str[0] ? at : NULL;
         args_clear(&args);
         e = read_args(r, &args, &t);
         if (e == 0)
             e = dispatch(r, &args);
     }
+    if (e == 0 && r->archive_block) /* its text would end in another */
+        e = rib_error(r, "ArchiveBegin \"%s\": the text ends before its ArchiveEnd",
+                      r->archive_name ? r->archive_name : "");
+    r->archive_block = 0;
+    r->archive_body = NULL;
     args_clear(&args);
     free(args.v);
     rib_lex_fini(&lx);

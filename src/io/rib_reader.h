@@ -344,6 +344,8 @@ typedef struct Rib {
     } * inline_archives;
     size_t n_inline, cap_inline;
     char *archive_name;                /* the block being skipped: its name, owned */
+    int archive_nest;                  /* ArchiveBegin ... ArchiveEnd inside it */
+    size_t inline_read;                /* bytes of inline archives read, in all */
     const unsigned char *archive_body; /* and its first request, NULL until read */
     long archive_line;
     const unsigned char *req_at; /* the current request's first byte in its text, or NULL */

@@ -1018,9 +1018,9 @@ static int aims_nowhere(const Param *p, size_t n)
     double from[3] = {0, 0, 0}, to[3] = {0, 0, 1};
     const Param *f = rib_find_param(p, n, "from"), *t = rib_find_param(p, n, "to");
     for (int c = 0; c < 3; c++) {
-        if (f && f->v->n == 3)
+        if (f && rib_is_num(f->v) && f->v->n == 3)
             from[c] = f->v->d[c];
-        if (t && t->v->n == 3)
+        if (t && rib_is_num(t->v) && t->v->n == 3)
             to[c] = t->v->d[c];
     }
     return from[0] == to[0] && from[1] == to[1] && from[2] == to[2];

@@ -1541,6 +1541,29 @@ static void test_forward_references(void)
     }
     if (r->n_mesh_lights == 1) /* the emitter, read at the end under its own state */
         CHECK(r->mesh_light[0].L[0] == 2);
+    /* a chain of mixes each defined before its part: read again nested, up to
+     * a depth (64, PBRT_MAX_REREAD: each level is a parse on the stack), then
+     * an error */
+    for (int depth = 10; depth <= 100; depth += 90) {
+        size_t cap = 200 * (size_t)depth + 256, len = 0;
+        char *chain = malloc(cap);
+        len +=
+            (size_t)snprintf(chain + len, cap - len,
+                             "WorldBegin\nMakeNamedMaterial \"d\" \"string type\" \"diffuse\"\n");
+        for (int k = 0; k < depth; k++)
+            len += (size_t)snprintf(chain + len, cap - len,
+                                    "MakeNamedMaterial \"m%d\" \"string type\" \"mix\" \"string "
+                                    "materials\" [\"m%d\" \"d\"]\n",
+                                    k, k + 1);
+        snprintf(chain + len, cap - len,
+                 "MakeNamedMaterial \"m%d\" \"string type\" \"diffuse\"\nNamedMaterial \"m0\"\n"
+                 "Shape \"sphere\"\n",
+                 depth);
+        ParseRun pr = {.name = "t.pbrt", .text = chain, .r = r};
+        test_stderr_of(run_parse, &pr);
+        CHECK(depth < 64 ? pr.e == RAYES_OK : pr.e != RAYES_OK && strstr(pr.err, "nest more than"));
+        free(chain);
+    }
     free(r);
 }
 

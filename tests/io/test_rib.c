@@ -1285,6 +1285,19 @@ static void test_prman_leniency(void)
                       "Sphere 1 -1 1 360\nIfEnd\n")) == RAYES_OK);
     CHECK(rec.quadrics == 1);
     CHECK(parse(WORLD("Else\n")) != RAYES_OK && strstr(err, "Else without IfBegin"));
+    /* an archive's text that ends inside ArchiveBegin is an error; nested
+     * blocks are kept in the outer one's text; a light's from given as
+     * strings is not read as a position */
+    CHECK(parse("ArchiveBegin \"x\"\nSphere 1 -1 1 360\n") != RAYES_OK &&
+          strstr(err, "before its ArchiveEnd") != NULL);
+    CHECK(parse("ArchiveBegin \"x\"\nArchiveBegin \"y\"\nSphere 1 -1 1 360\nArchiveEnd\n"
+                "ArchiveEnd\n" WORLD("ReadArchive \"x\"\nReadArchive \"y\"\n")) == RAYES_OK);
+    CHECK(rec.quadrics == 1);
+    CHECK(parse("ArchiveBegin \"x\"\nArchiveBegin \"y\"\nSphere 1 -1 1 360\nArchiveEnd\n"
+                "ReadArchive \"x\"\nArchiveEnd\n" WORLD("ReadArchive \"x\"\n")) != RAYES_OK);
+    CHECK(parse(WORLD("LightSource \"spotlight\" 1 \"string[3] from\" [\"a\" \"b\" \"c\"]\n")) ==
+              RAYES_OK ||
+          err[0]);
     FILE *f = fopen("test_rib_cwd_archive.rib", "w");
     CHECK(f != NULL);
     if (!f)
