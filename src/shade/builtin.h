@@ -84,4 +84,10 @@ extern const RayesShaderClass shade_class_conductor;     /* eta, k, reflectance,
 extern const RayesShaderClass shade_class_dielectric;    /* eta, roughness */
 extern const RayesShaderClass shade_class_coateddiffuse; /* reflectance, roughness, eta, thickness */
 
+/* Whether the context's points branch (reflection and refraction both,
+ * a mix's two materials both) or follow one lobe: below the renderer's
+ * "branchdepth" they branch, and always when the renderer has no random
+ * service to choose with (builtin_bsdf.c). */
+int shade_branches(const RayesShaderServices *sv, const RayesShadeCtx *ctx);
+
 #endif /* RAYES_SHADE_BUILTIN_H */

@@ -369,10 +369,7 @@ typedef struct GlassParams {
     float specularcolor[3], transmitcolor[3];
 } GlassParams;
 
-/* Whether the context's points branch (reflection and refraction both)
- * or follow one lobe: below the renderer's "branchdepth" they branch, and
- * always when the renderer has no random service to choose with. */
-static int branches(const RayesShaderServices *sv, const RayesShadeCtx *ctx)
+int shade_branches(const RayesShaderServices *sv, const RayesShadeCtx *ctx)
 {
     float depth = 0.0f;
     if (!SHADE_HAS_SERVICE(sv, random) || !SHADE_HAS_SERVICE(sv, option) ||
@@ -398,7 +395,7 @@ static float max3(const float v[3])
 static int lobe_rays(const RayesShaderServices *sv, const RayesShadeCtx *ctx)
 {
     float n[2] = {1.0f, 1.0f};
-    if (!branches(sv, ctx) || !SHADE_HAS_SERVICE(sv, option) ||
+    if (!shade_branches(sv, ctx) || !SHADE_HAS_SERVICE(sv, option) ||
         sv->option(sv, ctx, "diffuserays", n, 2) < 1)
         return 1;
     int k = (int)n[ctx->diffuse_depth > 0];
@@ -474,7 +471,7 @@ static void fresnel_split(const RayesShaderServices *sv, const RayesShadeCtx *ct
         dir[i][0] = t.x, dir[i][1] = t.y, dir[i][2] = t.z;
         n_refr += F[i] < 1.0f;
     }
-    if (!branches(sv, ctx)) {
+    if (!shade_branches(sv, ctx)) {
         memset(R, 0, ctx->n_points * sizeof *R);
         memset(T, 0, ctx->n_points * sizeof *T);
         for (size_t i = 0; i < ctx->n_points; i++) {

@@ -10,7 +10,8 @@
  * Russian roulette); a glossy lobe traces one ray past the branch
  * depth; and so does an uncached diffuse hit (a white furnace); a path
  * split into a glossy lobe's rays traces its share of diffuse rays; a
- * lobe takes its share of the hemisphere's rays.
+ * lobe takes its share of the hemisphere's rays; a mix of two materials
+ * follows one of them.
  */
 #include <stdio.h>
 #include <string.h>
@@ -102,6 +103,38 @@ static void test_deep_glass_stays_a_path(void)
     CHECK(r.specular <= r.camera * (2 + 2 * 64));
     CHECK(r.specular < r.camera * 16); /* most paths leave after a few bounces */
     CHECK_NEAR(r.mean, 1.0, 0.01);     /* clear glass loses nothing */
+}
+
+/* A mix of two glasses follows one of them past the branch depth (each
+ * following its own lobe doubled the paths at every bounce: 2^depth), and
+ * keeps clear glass's expectation. */
+static void test_mix_stays_a_path(void)
+{
+    RayesScene *s = furnace(0.0f, 30.0f);
+    RayesParam mix[5] = {
+        {"a", RAYES_PARAM_STRING, {0, 0, 0}, "glass"},
+        {"b", RAYES_PARAM_STRING, {0, 0, 0}, "glass"},
+        {"a:eta", RAYES_PARAM_FLOAT, {1.5f, 0, 0}, NULL},
+        {"b:eta", RAYES_PARAM_FLOAT, {1.4f, 0, 0}, NULL},
+        {"amount", RAYES_PARAM_FLOAT, {0.5f, 0, 0}, NULL},
+    };
+    CHECK(rayes_scene_set_shader(s, "mix", mix, 5) == RAYES_OK);
+    for (int k = 0; k < 3; k++) {
+        translate(s, 0.05f * (float)k, 0.0f, 0.0f);
+        CHECK(rayes_scene_sphere(s, 1.0f - 0.3f * (float)k) == RAYES_OK);
+    }
+    RayesRenderOptions o;
+    rayes_render_options_init(&o, RAYES_QUALITY_PREVIEW);
+    o.width = o.height = 16;
+    o.spp = 16;
+    o.bounces = 0;
+    o.specular_depth = 20;
+    o.branch_depth = 1;
+    Result r = run(s, &o);
+    /* depth 0 branches (both glasses, reflection and refraction), then
+     * paths of at most 20 */
+    CHECK(r.specular <= r.camera * 4 * (1 + 20));
+    CHECK_NEAR(r.mean, 1.0, 0.02);
 }
 
 static void test_same_expectation_as_branching(void)
@@ -243,4 +276,5 @@ static void test_split_lobe_keeps_counts(void)
 
 TEST_MAIN(TEST(test_glossy_rays_by_width), TEST(test_split_lobe_keeps_counts),
           TEST(test_uncached_diffuse_path), TEST(test_deep_glass_stays_a_path),
-          TEST(test_same_expectation_as_branching), TEST(test_glossy_lobe_one_ray_deep))
+          TEST(test_same_expectation_as_branching), TEST(test_glossy_lobe_one_ray_deep),
+          TEST(test_mix_stays_a_path))
