@@ -111,12 +111,8 @@ static void hit_footprint(HitPoint *hp)
     Vec3 Ng = v3(hp->Ng[0], hp->Ng[1], hp->Ng[2]), I = v3(hp->I[0], hp->I[1], hp->I[2]);
     float w = hp->diff.width, cos_i = v3_dot(Ng, I);
     float stretch = 1.0f / fmaxf(fabsf(cos_i) / fmaxf(v3_length(I), 1e-30f), 1.0f / 64.0f);
-    Vec3 t1 = v3_sub(I, v3_scale(Ng, cos_i)), t2;
-    if (v3_length(t1) > 0.0f) {
-        t1 = v3_normalize(t1);
-        t2 = v3_cross(Ng, t1);
-    } else
-        v3_basis(Ng, &t1, &t2);
+    Vec3 t1, t2; /* along I's direction in the plane (stretched), and across it */
+    v3_basis_toward(Ng, I, &t1, &t2);
     const float *d[2] = {hp->dPdu, hp->dPdv};
     float *out[2] = {&hp->du, &hp->dv};
     for (int k = 0; k < 2; k++) {
@@ -243,7 +239,7 @@ Vec3 integrator_opacity(Worker *w, const Ray *ray, Hit *hit, const AccelCrossing
     if (!obj->opacity_shader && !obj->Os_pattern) /* Os alone: no shader runs */
         return (gs->grids[hit->grid].primvars & GEOM_PV_OS) ? hit_Os(gs, hit, obj)
                                                             : v3_load(obj->Os);
-    if (w->set->opacity_cache && obj->opacity_cached)
+    if (w->set->opacity_cache && obj->opacity_cached && !radiosity_opacity_too_fine(w, hit, diff))
         return radiosity_opacity_at_hit(w, hit, diff);
     Vec3 Oi;
     accel_crossing_normal(crossing, hit);

@@ -755,6 +755,16 @@ Vec3 radiosity_irradiance_at_hit(Worker *w, const Ray *ray, const Hit *hit, floa
                          ray->time);
 }
 
+int radiosity_opacity_too_fine(const Worker *w, const Hit *hit, RayDiff diff)
+{
+    if (w->set->cache_resolution >= 0)
+        return 0;
+    const GeomInstance *gi = render_instance(w->rs, hit->instance);
+    float footprint = path_footprint(diff, hit->t) / (gi ? gi->scale : 1.0f);
+    return w->rs->gs->grids[hit->grid].edge >
+           RADIOSITY_OPACITY_DETAIL * w->set->cache_k * footprint;
+}
+
 Vec3 radiosity_opacity_at_hit(Worker *w, const Hit *hit, RayDiff diff)
 {
     /* The memo's assumption: one opacity per point, whatever the side and

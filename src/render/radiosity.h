@@ -23,6 +23,19 @@ uint32_t radiosity_choose_cluster(const GridSet *gs, uint32_t grid, float footpr
  * a miss). */
 Vec3 radiosity_at_hit(Worker *w, const Ray *ray, const Hit *hit, int diffuse_depth, RayDiff diff);
 
+/* How many of a ray's footprints the finest opacity level's points may
+ * lie apart before the ray asks the shader at its hit instead. */
+#define RADIOSITY_OPACITY_DETAIL 2.0f
+
+/* 1 if the ray's footprint at the hit is finer than the opacity cache can
+ * show: the grid's micropolygons (its finest level's spacing) are more than
+ * RADIOSITY_OPACITY_DETAIL footprints long. A cut-out's detail lives in
+ * its pattern, not its dicing: a leaf off screen is diced coarsely, and
+ * the shadow it casts on what the camera sees would be as coarse (a sharp
+ * sun's rays keep the receiving point's footprint). With the resolution
+ * forced (`--cache-resolution`), 0. */
+int radiosity_opacity_too_fine(const Worker *w, const Hit *hit, RayDiff diff);
+
 /* The cached opacity at a hit (memo 6.1): entries of data type opacity, of
  * the front side and depth 0 whatever the ray, filled by the shader's
  * opacity method over the level's points. */

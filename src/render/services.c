@@ -288,8 +288,11 @@ static void light_delta(Worker *w, const DirectPoint *p, const Light *l, Vec3 *d
     float cos_x = v3_dot(p->N, wi);
     if (cos_x <= 0.0f || v3_dot(p->Ng, wi) <= 0.0f)
         return;
-    /* one ray, not a share of a solid angle: the point's own spread */
-    RayDiff one = {p->shadow.width, p->spread};
+    /* one ray, not a share of a solid angle: the point's footprint carried
+     * to the light unspread (a distant light's rays from neighbouring points
+     * run parallel, a point light's converge), so a cut-out's shadow is as
+     * sharp as the cut-out */
+    RayDiff one = {p->shadow.width, 0.0f};
     Vec3 Li = delta_arriving(w, l, p->o, &u, one);
     if (p->diff)
         *diffuse = v3_madd(*diffuse, Li, cos_x / (float)M_PI);

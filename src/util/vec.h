@@ -72,6 +72,22 @@ static inline void v3_basis(Vec3 n, Vec3 *t, Vec3 *b)
     *b = v3(c, sign + n.y * n.y * a, -n.y);
 }
 
+/* An orthonormal frame (t, b) of the plane normal to unit n whose t is
+ * d's direction in that plane (d need not be unit). Near d = +-n that
+ * direction is rounding error, which normalised would lie along n: there
+ * v3_basis's frame serves. */
+static inline void v3_basis_toward(Vec3 n, Vec3 d, Vec3 *t, Vec3 *b)
+{
+    Vec3 p = v3_sub(d, v3_scale(n, v3_dot(n, d)));
+    float l = v3_length(p);
+    if (!(l > 1e-4f * v3_length(d))) {
+        v3_basis(n, t, b);
+        return;
+    }
+    *t = v3_scale(p, 1.0f / l);
+    *b = v3_cross(n, *t);
+}
+
 static inline Bounds3 bounds_empty(void)
 {
     return (Bounds3){v3(INFINITY, INFINITY, INFINITY), v3(-INFINITY, -INFINITY, -INFINITY)};

@@ -247,6 +247,58 @@ static void test_cutout_shadow_matches_geometry(void)
     }
 }
 
+/* Pixels of a floor image strictly between shadowed and lit (a tenth to
+ * nine tenths of the brightest): the blurred ones. */
+static int blurred_pixels(const RayesImage *img)
+{
+    float top = 0.0f;
+    for (int i = 0; i < RES * RES; i++)
+        top = fmaxf(top, img->rgba[4 * i]);
+    int n = 0;
+    for (int i = 0; i < RES * RES; i++)
+        n += img->rgba[4 * i] > 0.1f * top && img->rgba[4 * i] < 0.9f * top;
+    return n;
+}
+
+/* A distant light straight down casts a cut-out's shadow as sharp as the
+ * cut-out however high it hangs: the shadow ray of a delta light carries
+ * the floor point's footprint, not the camera's spread (at 20 units that
+ * spread is 0.2, two fifths of a cell), at normal incidence the footprint
+ * is not lost to rounding (it was, in patches: the pattern then
+ * point-sampled there and filtered beside), and with the opacity cache the
+ * cut-out, diced coarsely behind the eye, is asked at the hit since its
+ * cached points lie too far apart for such a fine ray. */
+static void test_cutout_shadow_from_afar_is_sharp(void)
+{
+    for (int cached = 0; cached < 2; cached++) {
+        RayesScene *s = new_scene();
+        floor_matte(s);
+        CHECK(rayes_scene_set_visibility(s, RAYES_RAY_SHADOW) == RAYES_OK);
+        RayesParam cb[2] = {pf("uscale", 4.0f), pf("vscale", 4.0f)};
+        CHECK(rayes_scene_pattern(s, "cells", "checkerboard", cb, 2) == RAYES_OK);
+        RayesParam p[2] = {pf("Kd", 1.0f),
+                           (RayesParam){"Os", RAYES_PARAM_PATTERN, {0, 0, 0}, "cells"}};
+        CHECK(rayes_scene_set_shader(s, "matte", p, 2) == RAYES_OK);
+        quad_at(s, 1.0f, 20.0f);
+        RayesParam l[3] = {(RayesParam){"from", RAYES_PARAM_COLOR, {0, 0, 1}, NULL},
+                           (RayesParam){"to", RAYES_PARAM_COLOR, {0, 0, 0}, NULL},
+                           pf("intensity", 1)};
+        CHECK(rayes_scene_light(s, "distantlight", l, 3) == RAYES_OK);
+        RayesImage *img = render(s, 2, 20.0, cached, RAYES_QUALITY_PREVIEW, NULL);
+        rayes_scene_release(s);
+        if (!img)
+            continue;
+        /* the cells' 6 inner edges run 32 pixels each, between pixels: at
+         * most the pixels either side of them blurred (705 uncached with
+         * the camera's spread; cached from the coarse grid, 1024) */
+        int blurred = blurred_pixels(img);
+        fprintf(stderr, "cut-out at 20 units (%s): %d of %d pixels blurred\n",
+                cached ? "cached" : "uncached", blurred, RES * RES);
+        CHECK(blurred <= 6 * 32 * 2);
+        rayes_image_free(img);
+    }
+}
+
 /* A curved stained-glass sheet (the stainedglass shader's opacity method,
  * coloured) over the floor under an area light, camera-visible. */
 static RayesScene *stained_glass_scene(void)
@@ -487,6 +539,7 @@ static void test_diffuse_transmission(void)
 TEST_MAIN(TEST(test_stacked_sheets_multiply_in_any_order),
           TEST(test_half_transparent_sheet_halves_irradiance),
           TEST(test_ambient_occlusion_closed_forms), TEST(test_cutout_shadow_matches_geometry),
+          TEST(test_cutout_shadow_from_afar_is_sharp),
           TEST(test_opacity_cache_within_noise_and_deterministic), TEST(test_camera_sees_through),
           TEST(test_grid_hider_transparent_grids), TEST(test_bad_attributes), TEST(test_thin_glass),
           TEST(test_diffuse_transmission))

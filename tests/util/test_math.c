@@ -41,6 +41,27 @@ static void test_basis_is_orthonormal(void)
     }
 }
 
+/* v3_basis_toward's t is d's direction in the plane; for d along n, or
+ * off it by rounding alone, still a frame of the plane (it once lay along
+ * n, and a hit's texture footprint came out zero). */
+static void test_basis_toward(void)
+{
+    Vec3 n = v3_normalize(v3(1e-8f, -1.0f, 3e-8f)), t, b;
+    const Vec3 ds[] = {v3(0, 1, 0), v3(0, -2, 0), v3(1e-7f, 1, 0), v3(0, 0.99999994f, 1e-9f),
+                       v3(1, 1, 0)};
+    for (size_t i = 0; i < sizeof ds / sizeof ds[0]; i++) {
+        v3_basis_toward(n, ds[i], &t, &b);
+        CHECK_NEAR(v3_dot(t, n), 0.0, 1e-5);
+        CHECK_NEAR(v3_dot(b, n), 0.0, 1e-5);
+        CHECK_NEAR(v3_dot(t, b), 0.0, 1e-5);
+        CHECK_NEAR(v3_length(t), 1.0, 1e-5);
+        CHECK_NEAR(v3_length(b), 1.0, 1e-5);
+    }
+    v3_basis_toward(v3(0, 0, 1), v3(3, 0, -5), &t, &b);
+    CHECK_NEAR(t.x, 1.0, 1e-6);
+    CHECK_NEAR(b.y, 1.0, 1e-6);
+}
+
 /* Every count n puts at most one sample in each of its m x k strata (one
  * in each when n = m k), and n = m k whenever n has a divisor between
  * half of floor(sqrt(n)) and sqrt(n). */
@@ -172,7 +193,7 @@ static void test_bounds_distance(void)
 }
 
 TEST_MAIN(TEST(test_matrix_inverse), TEST(test_rotation_is_right_handed),
-          TEST(test_basis_is_orthonormal), TEST(test_cmj_stratified), TEST(test_cmj_uniform_on_average),
-          TEST(test_cmj_deterministic_and_pattern_dependent), TEST(test_cmj_pattern_equals_samples),
-          TEST(test_hash_combine_is_ordered), TEST(test_cosine_hemisphere_moments),
-          TEST(test_bounds_distance))
+          TEST(test_basis_is_orthonormal), TEST(test_basis_toward), TEST(test_cmj_stratified),
+          TEST(test_cmj_uniform_on_average), TEST(test_cmj_deterministic_and_pattern_dependent),
+          TEST(test_cmj_pattern_equals_samples), TEST(test_hash_combine_is_ordered),
+          TEST(test_cosine_hemisphere_moments), TEST(test_bounds_distance))
