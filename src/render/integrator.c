@@ -181,6 +181,19 @@ static Vec3 shade_hit(Worker *w, const Ray *ray, const Hit *hit, const RenderObj
         .dst = own_st ? (const float(*)[4]) & hp.dst : NULL,
     };
     path_apply_Os_pattern(w, obj, &ctx, &hp.Os);
+    /* A hole in a cut-out: Os 0 here (a pattern's, a primitive
+     * variable's), and no opacity method that could say otherwise. Its
+     * lighting would be multiplied by 0 (Ci is premultiplied; the built-in
+     * shaders multiply by Os) after casting its shadow and diffuse rays:
+     * the ray goes on behind it unshaded, as a path tracer's alpha test
+     * lets it. */
+    if (obj->transparent && !obj->opacity_shader &&
+        (kind & (RAYES_RAY_CAMERA | RAYES_RAY_SPECULAR | RAYES_RAY_DIFFUSE)) &&
+        !(fmaxf(fmaxf(hp.Os[0], hp.Os[1]), hp.Os[2]) > 0.0f)) {
+        w->stats.holes++;
+        *Oi_out = v3(0, 0, 0);
+        return v3(0, 0, 0);
+    }
     float Ci[1][3] = {{0, 0, 0}}, Oi[1][3] = {{1, 1, 1}}, E[1][3] = {{0, 0, 0}};
     RayesShadeOutputs out = {Ci, Oi, NULL, NULL};
     /* Whatever the kind, the hit is shaded as its own object: a glass's
@@ -327,11 +340,14 @@ static Vec3 trace_layers(Worker *w, const Ray *ray, uint32_t kind, int diffuse_d
         return l->L;
     }
     int see_through = obj->transparent && layer < INTEGRATOR_MAX_LAYERS;
-    Vec3 Ci, Oi = v3(1, 1, 1);
+    Vec3 Ci = v3(0, 0, 0), Oi = v3(1, 1, 1);
     if (kind == RAYES_RAY_DIFFUSE && w->set->radiosity_cache) {
-        Ci = radiosity_at_hit(w, ray, &hit, diffuse_depth, diff);
         if (see_through)
             Oi = integrator_opacity(w, ray, &hit, NULL, diff);
+        if (see_through && !obj->opacity_shader && !(v3_max_component(Oi) > 0.0f))
+            w->stats.holes++; /* a cut-out's hole (shade_hit's) */
+        else
+            Ci = radiosity_at_hit(w, ray, &hit, diffuse_depth, diff);
     } else if (kind == RAYES_RAY_CAMERA && w->grid_shading &&
                hider_camera_hit(w, ray, &hit, &Ci, &Oi)) {
         /* the grid hider's shaded grid (a master's grid per instance; Ci

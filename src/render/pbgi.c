@@ -913,6 +913,7 @@ static void run_pass(Pass *p, const RayesShaderServices *services, RenderStats *
         stats->rays_specular += s->rays_specular;
         stats->opacity_points += s->opacity_points;
         stats->transparent_hits += s->transparent_hits;
+        stats->holes += s->holes;
         for (int d = 0; d <= RENDER_MAX_DEPTH; d++)
             stats->shading_points[d] += s->shading_points[d];
         if (p->set->cache)

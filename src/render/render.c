@@ -489,6 +489,7 @@ static void merge_stats(RenderStats *into, const RenderStats *s)
     into->ambient_lookups += s->ambient_lookups;
     into->opacity_points += s->opacity_points;
     into->transparent_hits += s->transparent_hits;
+    into->holes += s->holes;
     into->rays_transmission += s->rays_transmission;
     into->volume_steps += s->volume_steps;
     into->rays_subsurface += s->rays_subsurface;

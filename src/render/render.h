@@ -185,6 +185,8 @@ typedef struct RenderStats {
                                   uncached transmission hits) */
     uint64_t transparent_hits; /* surfaces shadow rays passed through (or stopped at) that
                                   were partly transparent */
+    uint64_t holes;            /* camera, specular and diffuse hits on a cut-out's hole (Os
+                                  0, no opacity method), passed unshaded */
     uint64_t rays_transmission; /* shadow and transmission rays that marched a volume (also
                                    counted in rays_shadow) */
     uint64_t volume_steps;      /* ray marching steps through volumes */

@@ -104,6 +104,7 @@ RayesStats *session_stats_new(const RenderSettings *set, const RenderStats *rs, 
     count(s, "lighting/ambient_points", rs->ambient_lookups);
     count(s, "opacity/shading_points", rs->opacity_points);
     count(s, "opacity/transparent_hits", rs->transparent_hits);
+    count(s, "opacity/holes", rs->holes);
     count(s, "volume/steps", rs->volume_steps);
     count(s, "subsurface/points", rs->subsurface_points);
     count(s, "subsurface/irradiance_points", rs->irradiance_points);

@@ -444,6 +444,41 @@ static void test_grid_hider_transparent_grids(void)
     rayes_image_free(one);
 }
 
+/* A camera ray through a cut-out's hole (Os 0, no opacity method) is not
+ * shaded there: a sheet whose Os pattern is 0 everywhere, in front of the
+ * white floor, is one hole; every ray passes it unshaded (it was shaded
+ * first, and its premultiplied colour was 0) and is shaded once, at the
+ * floor, which it sees whole. */
+static void test_holes_pass_unshaded(void)
+{
+    RayesScene *s = new_scene();
+    RayesParam white[1] = {pc("Cs", 1, 1, 1)};
+    CHECK(rayes_scene_set_shader(s, "constant", white, 1) == RAYES_OK);
+    quad_at(s, 2.0f, 0.0f);
+    RayesParam zero[1] = {pf("value", 0.0f)};
+    CHECK(rayes_scene_pattern(s, "none", "constant", zero, 1) == RAYES_OK);
+    RayesParam p[2] = {pc("Cs", 1, 0, 0),
+                       (RayesParam){"Os", RAYES_PARAM_PATTERN, {0, 0, 0}, "none"}};
+    CHECK(rayes_scene_set_shader(s, "matte", p, 2) == RAYES_OK);
+    quad_at(s, 1.0f, 1.0f);
+    point_light(s, 5.0f);
+    RayesStats *st = NULL;
+    RayesImage *img = render(s, 2, 20.0, 1, RAYES_QUALITY_PREVIEW, &st);
+    const RayesStat *sp = rayes_stats_find(st, "shading_points/by_depth");
+    const RayesStat *h = rayes_stats_find(st, "opacity/holes");
+    uint64_t rays = RES * RES, depth0 = sp && sp->n_counts ? sp->counts[0] : 0;
+    fprintf(stderr, "holes: %llu of %llu camera rays, %llu depth-0 points\n",
+            h ? (unsigned long long)h->count : 0ull, (unsigned long long)rays,
+            (unsigned long long)depth0);
+    CHECK(h && h->count == rays);
+    CHECK(depth0 == rays);
+    for (int i = 0; img && i < RES * RES; i++)
+        CHECK_NEAR(img->rgba[4 * i], 1.0, 1e-6);
+    rayes_image_free(img);
+    rayes_stats_free(st);
+    rayes_scene_release(s);
+}
+
 static void test_bad_attributes(void)
 {
     RayesScene *s = rayes_scene_new();
@@ -541,5 +576,5 @@ TEST_MAIN(TEST(test_stacked_sheets_multiply_in_any_order),
           TEST(test_ambient_occlusion_closed_forms), TEST(test_cutout_shadow_matches_geometry),
           TEST(test_cutout_shadow_from_afar_is_sharp),
           TEST(test_opacity_cache_within_noise_and_deterministic), TEST(test_camera_sees_through),
-          TEST(test_grid_hider_transparent_grids), TEST(test_bad_attributes), TEST(test_thin_glass),
-          TEST(test_diffuse_transmission))
+          TEST(test_grid_hider_transparent_grids), TEST(test_holes_pass_unshaded),
+          TEST(test_bad_attributes), TEST(test_thin_glass), TEST(test_diffuse_transmission))
