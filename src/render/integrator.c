@@ -188,8 +188,8 @@ static Vec3 shade_hit(Worker *w, const Ray *ray, const Hit *hit, const RenderObj
      * the ray goes on behind it unshaded, as a path tracer's alpha test
      * lets it. */
     if (obj->transparent && !obj->opacity_shader &&
-        (kind & (RAYES_RAY_CAMERA | RAYES_RAY_SPECULAR | RAYES_RAY_DIFFUSE)) &&
-        !(fmaxf(fmaxf(hp.Os[0], hp.Os[1]), hp.Os[2]) > 0.0f)) {
+        (kind & (RAYES_RAY_CAMERA | RAYES_RAY_SPECULAR | RAYES_RAY_DIFFUSE)) && hp.Os[0] <= 0.0f &&
+        hp.Os[1] <= 0.0f && hp.Os[2] <= 0.0f) { /* NaN: shaded */
         w->stats.holes++;
         *Oi_out = v3(0, 0, 0);
         return v3(0, 0, 0);
@@ -252,7 +252,11 @@ Vec3 integrator_opacity(Worker *w, const Ray *ray, Hit *hit, const AccelCrossing
     if (!obj->opacity_shader && !obj->Os_pattern) /* Os alone: no shader runs */
         return (gs->grids[hit->grid].primvars & GEOM_PV_OS) ? hit_Os(gs, hit, obj)
                                                             : v3_load(obj->Os);
-    if (w->set->opacity_cache && obj->opacity_cached && !radiosity_opacity_too_fine(w, hit, diff))
+    /* A shadow ray (a crossing) too fine for the cache asks the shader; a
+     * diffuse ray's hit (no crossing) keeps the cache's, as its Ci is the
+     * radiosity cache's, premultiplied by the same cached opacity. */
+    if (w->set->opacity_cache && obj->opacity_cached &&
+        !(crossing && radiosity_opacity_too_fine(w, hit, diff)))
         return radiosity_opacity_at_hit(w, hit, diff);
     Vec3 Oi;
     accel_crossing_normal(crossing, hit);
@@ -344,7 +348,7 @@ static Vec3 trace_layers(Worker *w, const Ray *ray, uint32_t kind, int diffuse_d
     if (kind == RAYES_RAY_DIFFUSE && w->set->radiosity_cache) {
         if (see_through)
             Oi = integrator_opacity(w, ray, &hit, NULL, diff);
-        if (see_through && !obj->opacity_shader && !(v3_max_component(Oi) > 0.0f))
+        if (see_through && !obj->opacity_shader && Oi.x <= 0.0f && Oi.y <= 0.0f && Oi.z <= 0.0f)
             w->stats.holes++; /* a cut-out's hole (shade_hit's) */
         else
             Ci = radiosity_at_hit(w, ray, &hit, diffuse_depth, diff);

@@ -26,7 +26,9 @@ Vec3 integrator_trace_hit(Worker *w, const Ray *ray, uint32_t kind, int diffuse_
  * (memo 6.1) or, uncached, the shader's opacity method at the hit. diff is
  * the ray's differential (its footprint chooses the cache resolution).
  * crossing: a transmission query's (whose hit may lack Ng until a shader
- * runs), or NULL for a hit with Ng. */
+ * runs; a footprint too fine for the cache asks the shader,
+ * radiosity_opacity_too_fine), or NULL for a diffuse ray's hit with Ng
+ * (always the cache's, matching its cached radiosity). */
 Vec3 integrator_opacity(Worker *w, const Ray *ray, Hit *hit, const AccelCrossing *crossing,
                         RayDiff diff);
 

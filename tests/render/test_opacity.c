@@ -290,7 +290,7 @@ static void test_cutout_shadow_from_afar_is_sharp(void)
             continue;
         /* the cells' 6 inner edges run 32 pixels each, between pixels: at
          * most the pixels either side of them blurred (705 uncached with
-         * the camera's spread; cached from the coarse grid, 1024) */
+         * the camera's spread; cached from the coarse grid, 1002) */
         int blurred = blurred_pixels(img);
         fprintf(stderr, "cut-out at 20 units (%s): %d of %d pixels blurred\n",
                 cached ? "cached" : "uncached", blurred, RES * RES);

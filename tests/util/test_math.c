@@ -57,6 +57,19 @@ static void test_basis_toward(void)
         CHECK_NEAR(v3_length(t), 1.0, 1e-5);
         CHECK_NEAR(v3_length(b), 1.0, 1e-5);
     }
+    /* along a normal of float length not exactly 1: the old projection
+     * normalised came out along n (t.n = 0.99 for (1, 2, 3)) */
+    const Vec3 ns[] = {v3_normalize(v3(1, 2, 3)), v3_normalize(v3(-2, 1, 0.5f)),
+                       v3_normalize(v3(0.3f, -0.7f, 0.2f))};
+    const float cs[] = {1.0f, -3.7f, 0.25f};
+    for (size_t i = 0; i < sizeof ns / sizeof ns[0]; i++)
+        for (size_t k = 0; k < sizeof cs / sizeof cs[0]; k++) {
+            v3_basis_toward(ns[i], v3_scale(ns[i], cs[k]), &t, &b);
+            CHECK_NEAR(v3_dot(t, ns[i]), 0.0, 1e-5);
+            CHECK_NEAR(v3_dot(b, ns[i]), 0.0, 1e-5);
+            CHECK_NEAR(v3_length(t), 1.0, 1e-5);
+            CHECK_NEAR(v3_length(b), 1.0, 1e-5);
+        }
     v3_basis_toward(v3(0, 0, 1), v3(3, 0, -5), &t, &b);
     CHECK_NEAR(t.x, 1.0, 1e-6);
     CHECK_NEAR(b.y, 1.0, 1e-6);
