@@ -155,7 +155,9 @@ static int imagemap_params(Parser *P, const Token *t, ParamList *pl, int is_floa
     if (is_float)
         q[(*n)++] = (RayesParam){.name = "channel", .type = RAYES_PARAM_FLOAT};
     const char *wrap = pbrt_get_string(pl, "wrap", "repeat");
-    if (strcmp(wrap, "repeat") != 0)
+    if (strcmp(wrap, "black") == 0 || strcmp(wrap, "clamp") == 0)
+        q[(*n)++] = (RayesParam){.name = "wrap", .type = RAYES_PARAM_STRING, .string = wrap};
+    else if (strcmp(wrap, "repeat") != 0) /* octahedralsphere: an environment map's */
         pbrt_warn_at(P, t->line, t->col, "imagemap wrap",
                      "imagemap: wrap \"%.40s\" is not supported; the image repeats", wrap);
     (void)pbrt_find(pl, "filter"); /* rayes always filters (OpenImageIO's anisotropic MIP) */

@@ -1218,6 +1218,7 @@ static void rib_fini(Rib *r)
     }
     free(r->inline_archives);
     free(r->stand_ins);
+    free(r->manifolds);
     free(r->archive_name);
     for (size_t k = 0; k < r->n_warned; k++)
         free(r->warned[k]);

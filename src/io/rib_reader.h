@@ -97,6 +97,8 @@ typedef struct Param {
 typedef struct ShaderRec {
     char name[64];
     char pattern[160];  /* a Pattern's name once the sink has it, else "" */
+    int channels;       /* a PxrTexture's imagemap: its outputs resultR ... resultA are
+                           its channels (rib_pattern_ref) */
     RayesParam *params; /* names and strings owned */
     size_t n;
     struct ShaderRec *next;
@@ -335,6 +337,14 @@ typedef struct Rib {
         float rgb[3];
     } * stand_ins;
     size_t n_stand_ins, cap_stand_ins;
+    /* PxrManifold2D's placements of s and t, by name, for the textures and
+     * checkers that reference them */
+    struct RisManifold {
+        char name[128];
+        float scale[2], offset[2];
+        int invert_t; /* -1: not given */
+    } * manifolds;
+    size_t n_manifolds, cap_manifolds;
     /* inline archives (ArchiveBegin "name" ... ArchiveEnd): their text, read
      * by a ReadArchive of their name before any file */
     struct InlineArchive {
@@ -475,6 +485,18 @@ int rib_send_lights(Rib *r);
  * itself, or RenderMan's "pattern:output" without its output (in buf);
  * NULL if none did. */
 const char *rib_pattern_name(const Rib *r, const char *ref, char *buf, size_t size);
+/* rib_pattern_name for a parameter's reference: a PxrTexture's resultR,
+ * resultG, resultB or resultA (resultF: its red) is that channel of its
+ * image, sent under the reference's whole name the first time it is named
+ * (an imagemap with "channel"); other outputs are the pattern itself. */
+const char *rib_pattern_ref(Rib *r, const char *ref, char *buf, size_t size);
+/* Pattern "type" "name" p: sends the pattern sh (RenderMan's class
+ * translated by rib_ris.c, p unused) or rayes' class type of p, in the
+ * current transform; a class rayes has not is a stand-in (its input's
+ * colour, for the parameters that reference it) with one warning. Frees
+ * p. */
+int rib_pattern_define(Rib *r, const char *type, const char *name, Param *p, size_t n,
+                       ShaderRec *sh);
 /* The colour an unbuilt pattern referenced as ref ("name:output") passes on
  * (h_pattern's stand-in) into rgb; 0 if there is none. */
 int rib_pattern_stand_in(const Rib *r, const char *ref, float rgb[3]);

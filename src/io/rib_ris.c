@@ -1,7 +1,8 @@
 /*
  * io/rib_ris.c — RenderMan 19 and later (RIS): Bxdf, Light, Integrator,
  * the geometric area lights of RenderMan 19 and 20 (Geometry "rectlight"
- * and its kin under AreaLightSource) and the PxrTexture pattern,
+ * and its kin under AreaLightSource) and the patterns PxrTexture,
+ * PxrNormalMap, PxrChecker, PxrMix and PxrManifold2D,
  * translated to rayes' own shaders and lights (docs/rib.md "RenderMan 19
  * and later"). RIS describes materials by physically based lobes and
  * lights by shapes of unit size; rayes keeps the base colour, the
@@ -20,9 +21,11 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <strings.h>
 
 #include "io/rib_internal.h"
 #include "io/rib_reader.h"
+#include "util/grow.h"
 
 /* ------------------------------------------------------------ values */
 
@@ -66,6 +69,11 @@ typedef struct Out {
     size_t n;
 } Out;
 
+static void out_string(Out *o, const char *name, const char *v)
+{
+    o->p[o->n++] = (RayesParam){name, RAYES_PARAM_STRING, {0, 0, 0}, v};
+}
+
 static void out_float(Out *o, const char *name, float v)
 {
     o->p[o->n++] = (RayesParam){name, RAYES_PARAM_FLOAT, {v, 0, 0}, NULL};
@@ -85,7 +93,7 @@ static void out_colour_of(Rib *r, Out *o, const char *bxdf, const Param *p, size
     const Param *q = rib_find_param(p, n, from);
     if (q && q->d.reference && q->v->n == 1 && q->d.ty == TY_STRING) {
         char buf[160];
-        const char *name = rib_pattern_name(r, q->v->s[0], buf, sizeof buf);
+        const char *name = rib_pattern_ref(r, q->v->s[0], buf, sizeof buf);
         if (name) {
             snprintf(o->pattern[o->n], sizeof o->pattern[0], "%s", name);
             name = o->pattern[o->n];
@@ -106,7 +114,7 @@ static void out_colour_of(Rib *r, Out *o, const char *bxdf, const Param *p, size
         char key[200];
         snprintf(key, sizeof key, "ris reference %.150s", q->v->s[0]);
         rib_warn_once(r, key,
-                      "Bxdf \"%s\": \"%s\" names the pattern \"%.100s\", which is not "
+                      "\"%s\": \"%s\" names the pattern \"%.100s\", which is not "
                       "defined or of a class rayes has not; its value is used",
                       bxdf, from, q->v->s[0]);
     }
@@ -223,6 +231,27 @@ static const char *class_and_params(Rib *r, const Args *a, const char *what, Par
     return rib_get_params(r, a, i, p, n) == 0 ? cls : NULL;
 }
 
+/* RenderMan's bumpNormal (the Bxdf's, or its lobes'), connected to a
+ * PxrNormalMap: rayes' "normalmap" bound to that pattern. */
+static void out_normal_map(Rib *r, Out *o, const Param *p, size_t n)
+{
+    static const char *const names[] = {"bumpNormal", "diffuseBumpNormal", "specularBumpNormal"};
+    for (int k = 0; k < 3 && o->n < 8; k++) {
+        const Param *q = rib_find_param(p, n, names[k]);
+        char buf[160];
+        const char *name = q && q->d.reference && q->d.ty == TY_STRING && q->v->n == 1
+                               ? rib_pattern_ref(r, q->v->s[0], buf, sizeof buf)
+                               : NULL;
+        if (name) {
+            snprintf(o->pattern[o->n], sizeof o->pattern[0], "%s", name);
+            o->p[o->n] =
+                (RayesParam){"normalmap", RAYES_PARAM_PATTERN, {0, 0, 0}, o->pattern[o->n]};
+            o->n++;
+            return;
+        }
+    }
+}
+
 static int h_bxdf(Rib *r, const Args *a)
 {
     r->ris = 1;
@@ -234,36 +263,36 @@ static int h_bxdf(Rib *r, const Args *a)
     static const float half[3] = {0.5f, 0.5f, 0.5f}, one[3] = {1, 1, 1}, zero[3] = {0, 0, 0};
     Out o = {.n = 0};
     const char *shader = "diffuse";
-    if (strcmp(cls, "PxrDiffuse") == 0) {
+    if (strcasecmp(cls, "PxrDiffuse") == 0) {
         out_colour_of(r, &o, cls, p, n, "diffuseColor", "reflectance", half, 1);
-    } else if (strcmp(cls, "PxrLMDiffuse") == 0) {
+    } else if (strcasecmp(cls, "PxrLMDiffuse") == 0) {
         out_colour_of(r, &o, cls, p, n, "frontColor", "reflectance", half, 1);
-    } else if (strcmp(cls, "PxrSurface") == 0 || strcmp(cls, "PxrLayerSurface") == 0) {
+    } else if (strcasecmp(cls, "PxrSurface") == 0 || strcasecmp(cls, "PxrLayerSurface") == 0) {
         shader = pxr_surface(r, cls, p, n, &o);
-    } else if (strcmp(cls, "PxrDisney") == 0 || strcmp(cls, "PxrDisneyBsdf") == 0) {
+    } else if (strcasecmp(cls, "PxrDisney") == 0 || strcasecmp(cls, "PxrDisneyBsdf") == 0) {
         shader = pxr_disney(r, cls, p, n, &o);
-    } else if (strcmp(cls, "PxrConstant") == 0) {
+    } else if (strcasecmp(cls, "PxrConstant") == 0) {
         float e[3]; /* emitColor: the surface's own light, nothing reflected */
         color(p, n, "emitColor", one, e);
         shader = "matte";
         out_float(&o, "Ka", 0);
         out_float(&o, "Kd", 0);
         out_color(&o, "Ke", e);
-    } else if (strcmp(cls, "PxrGlass") == 0 || strcmp(cls, "PxrLMGlass") == 0) {
+    } else if (strcasecmp(cls, "PxrGlass") == 0 || strcasecmp(cls, "PxrLMGlass") == 0) {
         shader = "dielectric";
         out_float(&o, "eta", num(p, n, "ior", num(p, n, "eta", 1.5f)));
         out_float(&o, "roughness", num(p, n, "roughness", 0));
-    } else if (strcmp(cls, "PxrLMPlastic") == 0) {
+    } else if (strcasecmp(cls, "PxrLMPlastic") == 0) {
         shader = "coateddiffuse";
         out_colour_of(r, &o, cls, p, n, "diffuseColor", "reflectance", half, 1);
         out_float(&o, "roughness", num(p, n, "specularRoughness", num(p, n, "roughness", 0.1f)));
-    } else if (strcmp(cls, "PxrLMMetal") == 0) {
+    } else if (strcasecmp(cls, "PxrLMMetal") == 0) {
         shader = "conductor";
         float c[3];
         color(p, n, "specularColor", one, c);
         out_color(&o, "reflectance", c);
         out_float(&o, "roughness", num(p, n, "roughness", 0.1f));
-    } else if (strcmp(cls, "PxrLightEmission") == 0 || strcmp(cls, "PxrBlack") == 0) {
+    } else if (strcasecmp(cls, "PxrLightEmission") == 0 || strcasecmp(cls, "PxrBlack") == 0) {
         out_color(&o, "reflectance", zero); /* an emitter's own surface: its light is the
                                                AreaLightSource's */
     } else {
@@ -272,12 +301,138 @@ static int h_bxdf(Rib *r, const Args *a)
         rib_warn_once(r, key, "Bxdf \"%s\" is not one rayes translates: a grey diffuse instead",
                       cls);
     }
+    if (strcmp(shader, "matte") != 0)
+        out_normal_map(r, &o, p, n);
     free(p);
     ShaderRec *sh = rib_shader_rec(r, shader, o.p, o.n);
     if (!sh)
         return -1;
     r->a.surface = sh;
     return 0;
+}
+
+/* ------------------------------------------------------------ patterns */
+
+/* The manifold a pattern's "manifold" references ("name:result"), or NULL. */
+static const struct RisManifold *manifold_of(const Rib *r, const Param *p, size_t n)
+{
+    const Param *q = rib_find_param(p, n, "manifold");
+    if (!q || !q->d.reference || q->d.ty != TY_STRING || q->v->n != 1)
+        return NULL;
+    const char *ref = q->v->s[0], *colon = strrchr(ref, ':');
+    size_t len = colon ? (size_t)(colon - ref) : strlen(ref);
+    for (size_t k = r->n_manifolds; k-- > 0;)
+        if (strlen(r->manifolds[k].name) == len && strncmp(r->manifolds[k].name, ref, len) == 0)
+            return &r->manifolds[k];
+    return NULL;
+}
+
+/* PxrManifold2D: kept by name (a later one of the same name replaces it
+ * for the patterns after it). */
+static int keep_manifold(Rib *r, const char *name, const Param *p, size_t n)
+{
+    if (num(p, n, "angle", 0) != 0)
+        rib_warn_once(r, "ris manifold angle",
+                      "PxrManifold2D: a rotation (\"angle\") is not applied");
+    const char *ps = string(p, n, "primvarS");
+    if (ps && ps[0])
+        rib_warn_once(r, "ris manifold primvar",
+                      "PxrManifold2D: \"primvarS\" is not used; the surface's st is");
+    if (strlen(name) >= sizeof r->manifolds[0].name)
+        return 0;
+    if (util_grow((void **)&r->manifolds, &r->cap_manifolds, r->n_manifolds,
+                  sizeof *r->manifolds) != 0)
+        return rib_error(r, "out of memory");
+    struct RisManifold *m = &r->manifolds[r->n_manifolds++];
+    snprintf(m->name, sizeof m->name, "%s", name);
+    m->scale[0] = num(p, n, "scaleS", 1), m->scale[1] = num(p, n, "scaleT", 1);
+    m->offset[0] = num(p, n, "offsetS", 0), m->offset[1] = num(p, n, "offsetT", 0);
+    m->invert_t = value(p, n, "invertT", 1) ? num(p, n, "invertT", 1) != 0 : -1;
+    return 0;
+}
+
+/* RenderMan's placement of a 2-D pattern as rayes' uscale, vscale,
+ * udelta and vdelta: RenderMan reads the image at (scaleS s + offsetS,
+ * scaleT t + offsetT), that t inverted (1 - t') when invertT is on (its
+ * default: Maya's t runs up, RenderMan's images down); rayes' imagemap
+ * reads it at (uscale s + udelta, 1 - (vscale (1 - t) + vdelta)). The
+ * pattern's own invertT counts, else the manifold's. */
+static void placement(const Rib *r, const Param *p, size_t n, Out *o)
+{
+    const struct RisManifold *m = manifold_of(r, p, n);
+    float sc[2] = {1, 1}, off[2] = {0, 0};
+    int invert = 1;
+    if (m) {
+        memcpy(sc, m->scale, sizeof sc), memcpy(off, m->offset, sizeof off);
+        invert = m->invert_t != 0;
+    }
+    if (value(p, n, "invertT", 1))
+        invert = num(p, n, "invertT", 1) != 0;
+    out_float(o, "uscale", sc[0]);
+    out_float(o, "udelta", off[0]);
+    out_float(o, "vscale", invert ? -sc[1] : sc[1]);
+    out_float(o, "vdelta", invert ? off[1] + sc[1] : 1.0f - sc[1] - off[1]);
+}
+
+/* A Pattern of RenderMan's classes that rayes translates: 1 with a new
+ * record of the rayes pattern in *sh (its class in (*sh)->name); 2 for a
+ * PxrManifold2D, kept for the patterns that reference it (nothing to
+ * send); 0 for a class it does not translate (or a texture without a
+ * file); -1 on error. */
+static int ris_pattern(Rib *r, const char *cls, const char *name, const Param *p, size_t n,
+                       ShaderRec **sh)
+{
+    static const float black[3] = {0, 0, 0}, white[3] = {1, 1, 1}, half[3] = {.5f, .5f, .5f};
+    Out o = {.n = 0};
+    const char *type;
+    *sh = NULL;
+    if (strcasecmp(cls, "PxrManifold2D") == 0)
+        return keep_manifold(r, name, p, n) == 0 ? 2 : -1;
+    if (strcasecmp(cls, "PxrTexture") == 0) {
+        const char *file = string(p, n, "filename");
+        if (!file || !file[0])
+            return 0;
+        type = "imagemap";
+        out_string(&o, "filename", rib_texture_source(r, file));
+        /* texels as they are, unless linearize asks for sRGB's inverse */
+        out_string(&o, "encoding", num(p, n, "linearize", 0) != 0 ? "sRGB" : "linear");
+        placement(r, p, n, &o);
+    } else if (strcasecmp(cls, "PxrNormalMap") == 0) {
+        /* a tangent-space normal map (rgb 2 n - 1, green along t), for
+         * the Bxdf's bumpNormal: rayes' "normalmap" */
+        const char *file = string(p, n, "filename");
+        if (!file || !file[0])
+            return 0;
+        type = "imagemap";
+        out_string(&o, "filename", rib_texture_source(r, file));
+        out_string(&o, "encoding", "linear");
+        placement(r, p, n, &o);
+        if (num(p, n, "bumpScale", 1) != 1 || num(p, n, "flipX", 0) != 0 ||
+            num(p, n, "flipY", 0) != 0 || num(p, n, "invertBump", 0) != 0)
+            rib_warn_once(r, "ris normal map",
+                          "PxrNormalMap: bumpScale, flipX, flipY and invertBump are not applied");
+    } else if (strcasecmp(cls, "PxrChecker") == 0) {
+        /* one check per unit of the manifold's s and t, colorA's where
+         * both floors' sum is even */
+        type = "checkerboard";
+        out_colour_of(r, &o, cls, p, n, "colorA", "tex1", white, 1);
+        out_colour_of(r, &o, cls, p, n, "colorB", "tex2", black, 1);
+        if (num(p, n, "mode", 0) != 0 || num(p, n, "dimensions", 2) == 3)
+            out_float(&o, "dimension", 3);
+        placement(r, p, n, &o);
+    } else if (strcasecmp(cls, "PxrMix") == 0) {
+        type = "mix"; /* (1 - mix) color1 + mix color2 */
+        out_colour_of(r, &o, cls, p, n, "color1", "tex1", black, 1);
+        out_colour_of(r, &o, cls, p, n, "color2", "tex2", white, 1);
+        out_colour_of(r, &o, cls, p, n, "mix", "amount", half, 1);
+    } else {
+        return 0;
+    }
+    *sh = rib_shader_rec(r, type, o.p, o.n);
+    if (!*sh)
+        return -1;
+    (*sh)->channels = strcmp(type, "imagemap") == 0;
+    return 1;
 }
 
 /* ------------------------------------------------------------ lights */
@@ -322,9 +477,10 @@ static int make_light(Rib *r, const char *handle, const char *cls, const float L
         rib_warn_once(r, "light in object", "lights inside ObjectBegin are ignored");
         return 0;
     }
-    int rect = strcmp(cls, "PxrRectLight") == 0, disk = strcmp(cls, "PxrDiskLight") == 0;
-    int sphere = strcmp(cls, "PxrSphereLight") == 0, dist = strcmp(cls, "PxrDistantLight") == 0;
-    int dome = strcmp(cls, "PxrDomeLight") == 0;
+    int rect = strcasecmp(cls, "PxrRectLight") == 0, disk = strcasecmp(cls, "PxrDiskLight") == 0;
+    int sphere = strcasecmp(cls, "PxrSphereLight") == 0,
+        dist = strcasecmp(cls, "PxrDistantLight") == 0;
+    int dome = strcasecmp(cls, "PxrDomeLight") == 0;
     if (!rect && !disk && !sphere && !dist && !dome) {
         char key[128];
         snprintf(key, sizeof key, "light %.100s", cls);
@@ -432,7 +588,7 @@ static int h_light(Rib *r, const Args *a)
     if (rib_get_params(r, a, i, &p, &n) != 0)
         return -1;
     static const float one[3] = {1, 1, 1};
-    float L[3], I = num(p, n, "intensity", strcmp(cls, "PxrDistantLight") == 0 ? 50000 : 1);
+    float L[3], I = num(p, n, "intensity", strcasecmp(cls, "PxrDistantLight") == 0 ? 50000 : 1);
     I *= exp2f(fminf(fmaxf(num(p, n, "exposure", 0), -126), 126));
     color(p, n, "lightColor", one, L);
     for (int k = 0; k < 3; k++)
@@ -445,13 +601,13 @@ static int h_light(Rib *r, const Args *a)
     if (e > 0)
         light_controls(r, cls, &r->lights[r->n_lights - 1], p, n);
     free(p);
-    if (e > 0 && (strcmp(cls, "PxrRectLight") == 0 || strcmp(cls, "PxrDiskLight") == 0 ||
-                  strcmp(cls, "PxrSphereLight") == 0)) {
+    if (e > 0 && (strcasecmp(cls, "PxrRectLight") == 0 || strcasecmp(cls, "PxrDiskLight") == 0 ||
+                  strcasecmp(cls, "PxrSphereLight") == 0)) {
         /* RenderMan 21's lights are not seen by the camera unless said */
         Light *l = &r->lights[r->n_lights - 1];
         l->own_visibility = 1;
         l->visibility = r->a.camera_said ? r->a.visibility : r->a.visibility & ~RAYES_RAY_CAMERA;
-    } else if (e > 0 && strcmp(cls, "PxrDomeLight") == 0) {
+    } else if (e > 0 && strcasecmp(cls, "PxrDomeLight") == 0) {
         /* the dome: the background the camera sees unless the attributes
          * hide it ("visibility" "camera" 0) */
         Light *l = &r->lights[r->n_lights - 1];
@@ -531,7 +687,7 @@ static int h_integrator(Rib *r, const Args *a)
      * bounces (each cached apart, so capped as pbrt's maxdepth is) */
     float len = num(p, n, "maxPathLength", 10);
     free(p);
-    if (strcmp(cls, "PxrDirectLighting") == 0) {
+    if (strcasecmp(cls, "PxrDirectLighting") == 0) {
         r->settings->bounces = 0;
         return 0;
     }
@@ -548,7 +704,27 @@ static int h_integrator(Rib *r, const Args *a)
     return 0;
 }
 
+/* Pattern "class" "name" params: RenderMan's classes rayes translates,
+ * else rib_pattern_define's (rayes' own classes, or a stand-in). */
+static int h_pattern(Rib *r, const Args *a)
+{
+    size_t i = 0;
+    const char *type = rib_get_string(r, a, &i, "a pattern class");
+    const char *name = type ? rib_get_string(r, a, &i, "a pattern name") : NULL;
+    Param *p;
+    size_t n;
+    if (!name || rib_get_params(r, a, i, &p, &n) != 0)
+        return -1;
+    ShaderRec *sh = NULL;
+    int ris = ris_pattern(r, type, name, p, n, &sh);
+    if (ris < 0 || ris == 2) {
+        free(p);
+        return ris < 0 ? -1 : 0;
+    }
+    return rib_pattern_define(r, type, name, p, n, sh);
+}
+
 const RibRequest rib_ris_requests[] = {
-    {"Bxdf", h_bxdf},         {"Light", h_light}, {"Integrator", h_integrator},
-    {"Displace", h_displace}, {NULL, NULL},
+    {"Pattern", h_pattern},       {"Bxdf", h_bxdf},         {"Light", h_light},
+    {"Integrator", h_integrator}, {"Displace", h_displace}, {NULL, NULL},
 };

@@ -339,6 +339,39 @@ const char *rib_pattern_name(const Rib *r, const char *ref, char *buf, size_t si
     return pattern_sent(r, buf) ? buf : NULL;
 }
 
+const char *rib_pattern_ref(Rib *r, const char *ref, char *buf, size_t size)
+{
+    const char *name = rib_pattern_name(r, ref, buf, size);
+    if (!name || name == ref)
+        return name;
+    static const char *const outputs[] = {"resultR", "resultG", "resultB", "resultA", "resultF"};
+    const char *output = strrchr(ref, ':') + 1;
+    int ch = -1;
+    for (int k = 0; k < 5; k++)
+        if (strcmp(output, outputs[k]) == 0)
+            ch = k == 4 ? 0 : k;
+    const ShaderRec *base = r->shaders;
+    while (base && !(base->pattern[0] && strcmp(base->pattern, name) == 0))
+        base = base->next;
+    if (ch < 0 || !base || !base->channels || strlen(ref) >= sizeof base->pattern ||
+        base->n >= 15 || !r->sink->pattern)
+        return name;
+    RayesParam q[16];
+    size_t n = 0;
+    for (size_t k = 0; k < base->n; k++)
+        if (strcmp(base->params[k].name, "channel") != 0)
+            q[n++] = base->params[k];
+    q[n++] = (RayesParam){"channel", RAYES_PARAM_FLOAT, {(float)ch, 0, 0}, NULL};
+    ShaderRec *v = rib_shader_rec(r, base->name, q, n);
+    const IoSink *s = r->sink;
+    if (!v || s->set_transform(s->target, r->a.M) != RAYES_OK ||
+        s->pattern(s->target, ref, v->name, v->params, v->n) != RAYES_OK)
+        return name; /* the image's colour, as before */
+    r->real.have_M = 0;
+    snprintf(v->pattern, sizeof v->pattern, "%s", ref);
+    return ref;
+}
+
 int rib_pattern_stand_in(const Rib *r, const char *ref, float rgb[3])
 {
     const char *colon = strrchr(ref, ':');
@@ -426,9 +459,8 @@ static ShaderRec *make_shader(Rib *r, const char *name, const Param *p, size_t n
             continue;
         RayesParam o = {NULL, RAYES_PARAM_NONE, {0, 0, 0}, NULL};
         char ref[160];
-        const char *pattern = q->d.reference && q->v->n == 1
-                                  ? rib_pattern_name(r, q->v->s[0], ref, sizeof ref)
-                                  : NULL;
+        const char *pattern =
+            q->d.reference && q->v->n == 1 ? rib_pattern_ref(r, q->v->s[0], ref, sizeof ref) : NULL;
         if (q->d.reference && q->v->n == 1 && !pattern) {
             char key[128];
             snprintf(key, sizeof key, "reference %.100s", q->v->s[0]);
@@ -1355,54 +1387,33 @@ int rib_flush_lights(Rib *r)
     return 0;
 }
 
-/* A Pattern class of RenderMan's that rayes translates: PxrTexture of a
- * file, an imagemap (its type and parameters in *type, out); 0 if not. */
-static int ris_pattern(const char *cls, const Param *p, size_t n, const char **type,
-                       RayesParam *out, size_t *n_out)
+int rib_pattern_define(Rib *r, const char *type, const char *name, Param *p, size_t n,
+                       ShaderRec *sh)
 {
-    const Param *f = rib_find_param(p, n, "filename");
-    if (strcmp(cls, "PxrTexture") != 0 || !f || f->d.ty != TY_STRING || f->d.reference ||
-        f->v->n != 1 || !f->v->s[0][0])
-        return 0;
-    *type = "imagemap";
-    out[0] = (RayesParam){"filename", RAYES_PARAM_STRING, {0, 0, 0}, f->v->s[0]};
-    *n_out = 1;
-    return 1;
-}
-
-/* Pattern "type" "name" params: rayes' patterns (pbrt-v4's texture
- * classes, rayes_scene_pattern) in the current transform, sent at once,
- * so that shaders sent later may take them ("reference pattern NAME"). */
-static int h_pattern(Rib *r, const Args *a)
-{
-    size_t i = 0;
-    const char *type = rib_get_string(r, a, &i, "a pattern class");
-    const char *name = type ? rib_get_string(r, a, &i, "a pattern name") : NULL;
-    Param *p;
-    size_t n;
-    if (!name || rib_get_params(r, a, i, &p, &n) != 0)
-        return -1;
     const IoSink *s = r->sink;
-    RayesParam ris[4];
-    size_t n_ris = 0;
-    const char *as = NULL; /* a RenderMan class rayes translates */
-    if (!in_list(builtin_patterns, type) && ris_pattern(type, p, n, &as, ris, &n_ris))
-        type = as;
-    if (!in_list(builtin_patterns, type) || !s->pattern) {
+    if (sh) {
+        free(p);
+        p = NULL, n = 0;
+        type = sh->name;
+    }
+    if ((!sh && !in_list(builtin_patterns, type)) || !s->pattern) {
         char key[128];
         snprintf(key, sizeof key, "pattern %.100s", type);
-        rib_warn_once(r, key,
-                      "Pattern \"%s\" is not a class rayes has (RenderMan's Pxr "
-                      "patterns are not built); ignored: colours that reference it take its "
-                      "input's colour (inputRGB, inputColor, ...), others keep their defaults",
-                      type);
-        int e = add_stand_in(r, name, p, n);
+        rib_warn_once(
+            r, key,
+            "Pattern \"%s\" is not a class rayes has (of RenderMan's Pxr "
+            "patterns PxrTexture, PxrNormalMap, PxrChecker, PxrMix and PxrManifold2D are "
+            "built); ignored: colours that reference it take its input's colour (inputRGB, "
+            "inputColor, ...), others keep their defaults",
+            type);
+        int e = sh ? 0 : add_stand_in(r, name, p, n);
         free(p);
         return e;
     }
-    ShaderRec *sh =
-        as ? rib_shader_rec(r, type, ris, n_ris) : make_shader(r, type, p, n, SHADER_ARRAYS);
-    free(p);
+    if (!sh) {
+        sh = make_shader(r, type, p, n, SHADER_ARRAYS);
+        free(p);
+    }
     if (!sh)
         return -1;
     if (s->set_transform(s->target, r->a.M) != RAYES_OK ||
@@ -1527,6 +1538,5 @@ const RibRequest rib_shade_requests[] = {
     {"LightSource", h_light_source},
     {"AreaLightSource", h_area_light},
     {"Illuminate", h_illuminate},
-    {"Pattern", h_pattern},
     {NULL, NULL},
 };

@@ -67,6 +67,7 @@ struct RayesPattern {
     float texture_from_world[16]; /* row-major; the 3-D classes' space */
     char filename[1024];          /* imagemap */
     char encoding[32];            /* imagemap: "" (the file's), "sRGB", "linear", "gamma G" */
+    char wrap[16];                /* imagemap: "" or "repeat", "black", "clamp" */
     VoxelGrid *grid;              /* densitygrid, nanovdb: owned */
 };
 
@@ -109,6 +110,7 @@ static const ClassDesc classes[] = {
      1,
      {{"filename", 's', 0, {0}},
       {"encoding", 's', 1, {0}},
+      {"wrap", 's', 2, {0}},
       {"scale", 'n', 0, {1}},
       {"invert", 'n', 1, {0}},
       {"channel", 'n', 2, {-1}}}},
@@ -210,8 +212,10 @@ static int set_slot(Pattern *p, const ClassDesc *c, const RayesParam *q, Pattern
         memcpy(p->vec, q->value, sizeof p->vec);
     } else if (s->what == 's') {
         const char *v = q->string ? q->string : "";
-        char *dst = s->index == 0 ? p->filename : p->encoding;
-        size_t size = s->index == 0 ? sizeof p->filename : sizeof p->encoding;
+        char *dst = s->index == 0 ? p->filename : s->index == 1 ? p->encoding : p->wrap;
+        size_t size = s->index == 0   ? sizeof p->filename
+                      : s->index == 1 ? sizeof p->encoding
+                                      : sizeof p->wrap;
         if (strlen(v) >= size) {
             snprintf(err, err_size, "pattern \"%s\": \"%s\" is too long", c->name, q->name);
             return -1;
@@ -347,6 +351,13 @@ static int check_pattern(Pattern *p, const ClassDesc *c, char *err, size_t err_s
         char tail;
         if (!p->filename[0]) {
             snprintf(err, err_size, "pattern \"imagemap\": no filename");
+            return -1;
+        }
+        if (p->wrap[0] && strcmp(p->wrap, "repeat") != 0 && strcmp(p->wrap, "black") != 0 &&
+            strcmp(p->wrap, "clamp") != 0) {
+            snprintf(err, err_size,
+                     "pattern \"imagemap\": wrap \"%s\" is not \"repeat\", \"black\" or \"clamp\"",
+                     p->wrap);
             return -1;
         }
         if (p->encoding[0] && strcmp(p->encoding, "sRGB") != 0 &&
@@ -671,8 +682,11 @@ static void eval_image(const Pattern *p, Eval *e, Rgb *out)
         uv_at(p, e, i, &u, &v, &ds[i], &dt[i]);
         s[i] = u, t[i] = 1.0f - v; /* images have (0, 0) at the top left */
     }
-    if (!e->ts ||
-        texture_lookup_encoded(e->ts, p->filename, p->encoding, n, s, t, ds, dt, out, alpha) != 0) {
+    if (!e->ts || texture_lookup_encoded(e->ts, p->filename, p->encoding,
+                                         strcmp(p->wrap, "black") == 0   ? TEXTURE_WRAP_BLACK
+                                         : strcmp(p->wrap, "clamp") == 0 ? TEXTURE_WRAP_CLAMP
+                                                                         : TEXTURE_WRAP_REPEAT,
+                                         n, s, t, ds, dt, out, alpha) != 0) {
         e->failed = 1;
         memset(out, 0, n * sizeof *out);
         for (size_t i = 0; i < n; i++)

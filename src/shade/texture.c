@@ -164,16 +164,16 @@ static void *impl_of(TextureSystem *ts)
 int texture_lookup(TextureSystem *ts, const char *name, size_t n, const float *s, const float *t,
                    const float *ds, const float *dt, float (*rgb)[3], float *alpha)
 {
-    return texture_lookup_encoded(ts, name, NULL, n, s, t, ds, dt, rgb, alpha);
+    return texture_lookup_encoded(ts, name, NULL, TEXTURE_WRAP_REPEAT, n, s, t, ds, dt, rgb, alpha);
 }
 
-int texture_lookup_encoded(TextureSystem *ts, const char *name, const char *encoding, size_t n,
-                           const float *s, const float *t, const float *ds, const float *dt,
-                           float (*rgb)[3], float *alpha)
+int texture_lookup_encoded(TextureSystem *ts, const char *name, const char *encoding,
+                           TextureWrap wrap, size_t n, const float *s, const float *t,
+                           const float *ds, const float *dt, float (*rgb)[3], float *alpha)
 {
     void *impl = impl_of(ts);
     if (impl)
-        return module->lookup(impl, name, encoding, n, s, t, ds, dt, rgb, alpha);
+        return module->lookup(impl, name, encoding, wrap, n, s, t, ds, dt, rgb, alpha);
     memset(rgb, 0, n * sizeof *rgb);
     for (size_t i = 0; alpha && i < n; i++)
         alpha[i] = 1.0f;

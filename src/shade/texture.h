@@ -56,14 +56,24 @@ void texture_system_free(TextureSystem *ts);
 int texture_lookup(TextureSystem *ts, const char *name, size_t n, const float *s, const float *t,
                    const float *ds, const float *dt, float (*rgb)[3], float *alpha);
 
+/* What a lookup finds outside [0, 1]: the image again (periodic), black
+ * (and alpha 0), or its edge's texels (pbrt's "repeat", "black" and
+ * "clamp"). */
+typedef enum TextureWrap {
+    TEXTURE_WRAP_REPEAT,
+    TEXTURE_WRAP_BLACK,
+    TEXTURE_WRAP_CLAMP
+} TextureWrap;
+
 /* texture_lookup with the texels' encoding given, as pbrt's imagemap gives
  * it: NULL or "" the file's own (integer files sRGB unless they say they
  * are linear), "sRGB", "linear" (integer texels as they are, over their
- * maximum) or "gamma G" (raised to G). Float files are linear whatever it
- * says. The same file under two encodings is two textures. */
-int texture_lookup_encoded(TextureSystem *ts, const char *name, const char *encoding, size_t n,
-                           const float *s, const float *t, const float *ds, const float *dt,
-                           float (*rgb)[3], float *alpha);
+ * maximum) or "gamma G" (raised to G); and the wrap. Float files are
+ * linear whatever it says. The same file under two encodings is two
+ * textures. */
+int texture_lookup_encoded(TextureSystem *ts, const char *name, const char *encoding,
+                           TextureWrap wrap, size_t n, const float *s, const float *t,
+                           const float *ds, const float *dt, float (*rgb)[3], float *alpha);
 
 /* The statistics so far (loads: tiles read; file_reads: files opened;
  * evictions: tiles no longer resident; bytes: OpenImageIO's cache memory;

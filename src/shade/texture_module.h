@@ -17,7 +17,7 @@
 
 #include "shade/texture.h"
 
-#define TEXTURE_MODULE_VERSION 1
+#define TEXTURE_MODULE_VERSION 2
 #define TEXTURE_MODULE_ENTRY "rayes_texture_module"
 #define TEXTURE_MODULE_FILE "librayes_oiio.so"
 
@@ -28,8 +28,8 @@ typedef struct TextureModule {
     /* texture.h's functions, on the module's own systems. */
     void *(*system_new)(const char *search_path, uint64_t budget_bytes, float width);
     void (*system_free)(void *ts);
-    int (*lookup)(void *ts, const char *name, const char *encoding, size_t n, const float *s,
-                  const float *t, const float *ds, const float *dt, float (*rgb)[3],
+    int (*lookup)(void *ts, const char *name, const char *encoding, TextureWrap wrap, size_t n,
+                  const float *s, const float *t, const float *ds, const float *dt, float (*rgb)[3],
                   float *alpha);
     void (*get_stats)(void *ts, TextureStats *stats);
     int (*read_image)(const char *path, int *w, int *h, float **rgba, char *err,

@@ -567,6 +567,7 @@ static void test_materials(void)
         "PixelFilter \"gaussian\" \"float xradius\" 1\n"
         "WorldBegin\n"
         "Texture \"grid\" \"spectrum\" \"imagemap\" \"string filename\" \"tex/grid.png\"\n"
+        "  \"string wrap\" \"clamp\"\n"
         "MakeNamedMaterial \"a\" \"string type\" \"diffuse\" \"rgb reflectance\" [0.2 0.4 0.6]\n"
         "MakeNamedMaterial \"b\" \"string type\" \"diffuse\" \"float reflectance\" 1\n"
         "Material \"conductor\" \"spectrum eta\" \"metal-Au-eta\" \"spectrum k\" \"metal-Au-k\"\n"
@@ -642,6 +643,8 @@ static void test_materials(void)
     CHECK(g >= 0 && strcmp(r->pattern[g].type, "imagemap") == 0 &&
           param(&r->pattern[g].params, "filename") &&
           strcmp(param(&r->pattern[g].params, "filename")->string, "dir/tex/grid.png") == 0);
+    CHECK(g >= 0 && param(&r->pattern[g].params, "wrap") &&
+          strcmp(param(&r->pattern[g].params, "wrap")->string, "clamp") == 0);
     sh = &r->mesh[6].shader;
     CHECK(strcmp(sh->name, "conductor") == 0 && param(sh, "reflectance") && !param(sh, "eta"));
     sh = &r->mesh[7].shader; /* 6500 K: nearly white, normalised to a maximum of 1 */

@@ -61,6 +61,7 @@ typedef struct Rec {
     char light_map[16][64];  /* each light's mapname, "" if none */
     char shader_pattern[64]; /* the last shader's first pattern parameter: "param=pattern" */
     char pattern[64];        /* the last pattern: "type name" */
+    char pattern_log[512];   /* every pattern since cleared: "type name(param=value,...);" */
     float pattern_M[16];     /* the transform current then */
 } Rec;
 
@@ -108,8 +109,19 @@ static RayesError s_shader(void *t, const char *name, const RayesParam *p, size_
 static RayesError s_pattern(void *t, const char *name, const char *type, const RayesParam *p,
                             size_t n)
 {
-    (void)t, (void)p, (void)n;
+    (void)t;
     snprintf(rec.pattern, sizeof rec.pattern, "%s %s", type, name);
+    char *log = rec.pattern_log + strlen(rec.pattern_log);
+    size_t room = sizeof rec.pattern_log - (size_t)(log - rec.pattern_log);
+    int w = snprintf(log, room, "%s %s(", type, name);
+    for (size_t i = 0; i < n && w > 0 && (size_t)w < room; i++) {
+        if (p[i].type == RAYES_PARAM_STRING || p[i].type == RAYES_PARAM_PATTERN)
+            w += snprintf(log + w, room - (size_t)w, "%s=%s,", p[i].name, p[i].string);
+        else
+            w += snprintf(log + w, room - (size_t)w, "%s=%g,", p[i].name, p[i].value[0]);
+    }
+    if (w > 0 && (size_t)w < room)
+        snprintf(log + w, room - (size_t)w, ");");
     memcpy(rec.pattern_M, rec.M, sizeof rec.M);
     return RAYES_OK;
 }
@@ -560,6 +572,41 @@ static void test_patterns(void)
                       "Polygon \"P\" [0 0 0 1 0 0 1 1 0]")) == RAYES_OK);
     CHECK(strcmp(rec.pattern, "imagemap tex") == 0 &&
           strcmp(rec.shader_pattern, "reflectance=tex") == 0);
+    /* RenderMan's placement: a PxrManifold2D's scale and offset, t
+     * inverted by default (invertT), texels as they are unless linearize;
+     * PxrChecker and PxrMix; a texture's alpha output is its own pattern */
+    rec.pattern_log[0] = '\0';
+    CHECK(parse(WORLD("Pattern \"PxrManifold2D\" \"m\" \"float scaleS\" [4] \"float scaleT\" "
+                      "[2] \"float offsetT\" [0.5]\n"
+                      "Pattern \"PxrTexture\" \"logo\" \"string filename\" [\"a.tex\"] "
+                      "\"reference struct manifold\" [\"m:result\"]\n"
+                      "Pattern \"PxrTexture\" \"up\" \"string filename\" [\"b.tex\"] "
+                      "\"int invertT\" [0] \"int linearize\" [1]\n"
+                      "Pattern \"PxrChecker\" \"c\" \"color colorA\" [1 0 0] "
+                      "\"reference struct manifold\" [\"m:result\"]\n"
+                      "Pattern \"PxrMix\" \"mx\" \"reference color color1\" [\"c:resultRGB\"] "
+                      "\"reference color color2\" [\"logo:resultRGB\"] \"reference float mix\" "
+                      "[\"logo:resultA\"]\n"
+                      "Surface \"diffuse\" \"reference color reflectance\" [\"mx:resultRGB\"]\n"
+                      "Polygon \"P\" [0 0 0 1 0 0 1 1 0]")) == RAYES_OK);
+    CHECK(strcmp(rec.pattern_log,
+                 "imagemap logo(filename=a.tex,encoding=linear,uscale=4,udelta=0,vscale=-2,"
+                 "vdelta=2.5,);"
+                 "imagemap up(filename=b.tex,encoding=sRGB,uscale=1,udelta=0,vscale=1,vdelta=0,);"
+                 "checkerboard c(tex1=1,tex2=0,uscale=4,udelta=0,vscale=-2,vdelta=2.5,);"
+                 "imagemap logo:resultA(filename=a.tex,encoding=linear,uscale=4,udelta=0,"
+                 "vscale=-2,vdelta=2.5,channel=3,);"
+                 "mix mx(tex1=c,tex2=logo,amount=logo:resultA,);") == 0);
+    CHECK(strcmp(rec.shader_pattern, "reflectance=mx") == 0);
+    /* a Bxdf's bumpNormal from a PxrNormalMap: rayes' normalmap, a linear
+     * image */
+    rec.pattern_log[0] = '\0';
+    CHECK(parse(WORLD("Pattern \"PxrNormalMap\" \"nm\" \"string filename\" [\"n.tx\"]\n"
+                      "Bxdf \"PxrSurface\" \"d\" \"reference normal bumpNormal\" [\"nm:resultN\"]\n"
+                      "Polygon \"P\" [0 0 0 1 0 0 1 1 0]")) == RAYES_OK);
+    CHECK(strcmp(rec.pattern_log, "imagemap nm(filename=n.tx,encoding=linear,uscale=1,udelta=0,"
+                                  "vscale=-1,vdelta=1,);") == 0);
+    CHECK(strcmp(rec.shader_pattern, "normalmap=nm") == 0);
     /* the grid classes, a float array among their parameters */
     CHECK(parse(WORLD("Pattern \"densitygrid\" \"g\" \"float nx\" 2 \"float density\" [0.5 1.5]\n"
                       "Pattern \"nanovdb\" \"c\" \"string filename\" \"cloud.nvdb\"\n")) ==

@@ -119,6 +119,10 @@ static void test_bxdfs(void)
         CHECK_NEAR(param(pass, "reflectance", 0), 0.8, 1e-6);
         CHECK_NEAR(param(pass, "reflectance", 1), 0.05, 1e-6);
     }
+    /* a class named in other capitals (as a Mac's or Windows's plugin
+     * lookup finds it) */
+    s = bxdf("Bxdf \"PXRDisney\" \"d\" \"color baseColor\" [0.1 0.6 0.5] \"float metallic\" [1]");
+    CHECK(strcmp(s->name, "conductor") == 0 && fabsf(param(s, "reflectance", 1) - 0.6f) < 1e-6f);
     /* Bxdf is an attribute, as Surface is (after the block, the default:
      * in a file without lights, RenderMan's defaultsurface) */
     CHECK(rib(WORLD("AttributeBegin\nBxdf \"PxrDiffuse\" \"d\"\nAttributeEnd\n" TRI)) == RAYES_OK);
@@ -468,6 +472,89 @@ static void test_tinted_glass(void)
     rayes_image_free(img);
 }
 
+/* The mean of channel c over the pixels x0 <= x < x1, y0 <= y < y1. */
+static double region(const RayesImage *a, int c, int x0, int x1, int y0, int y1)
+{
+    double t = 0;
+    for (int y = y0; y < y1; y++)
+        for (int x = x0; x < x1; x++)
+            t += a->rgba[4 * (y * SIZE + x) + c];
+    return t / ((x1 - x0) * (y1 - y0));
+}
+
+/* PxrTexture as PRMan reads it: t inverted by default (a quad whose st
+ * runs up, as Maya's do, shows the image's top row at its top), texels as
+ * they are unless linearize; a PxrChecker of a manifold's 2 x 1 checks. */
+static void test_patterns_rendered(void)
+{
+    FILE *f = fopen(RAYES_TEST_TMP "/test_rib_ris_rb.ppm", "wb"); /* top red, bottom blue */
+    CHECK(f != NULL);
+    if (f) {
+        fprintf(f, "P6 2 2 255\n");
+        static const unsigned char px[12] = {255, 0, 0, 255, 0, 0, 0, 0, 255, 0, 0, 255};
+        fwrite(px, 1, sizeof px, f);
+        fclose(f);
+    }
+    f = fopen(RAYES_TEST_TMP "/test_rib_ris_grey.ppm", "wb");
+    CHECK(f != NULL);
+    if (f) {
+        fprintf(f, "P6 1 1 255\n");
+        fputc(128, f), fputc(128, f), fputc(128, f);
+        fclose(f);
+    }
+#define PATTERN_SCENE(pattern)                                                                     \
+    "Projection \"orthographic\"\nWorldBegin\nTranslate 0 0 5\n"                                   \
+    "Light \"PxrDomeLight\" \"d\" \"float intensity\" [1]\n" pattern                               \
+    "Bxdf \"PxrDiffuse\" \"x\" \"reference color diffuseColor\" [\"p:resultRGB\"]\n"               \
+    "Polygon \"P\" [-1 1 0  1 1 0  1 -1 0  -1 -1 0] \"st\" [0 1  1 1  1 0  0 0]\nWorldEnd\n"
+#define TEX(file, extra)                                                                           \
+    "Pattern \"PxrTexture\" \"p\" \"string filename\" [\"" RAYES_TEST_TMP "/" file "\"] " extra "\n"
+    RayesImage *dflt = render_text(PATTERN_SCENE(TEX("test_rib_ris_rb.ppm", "")));
+    RayesImage *upright =
+        render_text(PATTERN_SCENE(TEX("test_rib_ris_rb.ppm", "\"int invertT\" [0]")));
+    RayesImage *raw = render_text(PATTERN_SCENE(TEX("test_rib_ris_grey.ppm", "")));
+    RayesImage *lin =
+        render_text(PATTERN_SCENE(TEX("test_rib_ris_grey.ppm", "\"int linearize\" [1]")));
+    RayesImage *check = render_text(PATTERN_SCENE(
+        "Pattern \"PxrManifold2D\" \"m\" \"float scaleS\" [2]\n"
+        "Pattern \"PxrChecker\" \"p\" \"color colorA\" [1 1 0] \"color colorB\" [0 0 1] "
+        "\"reference struct manifold\" [\"m:result\"]\n"));
+    CHECK(dflt && upright && raw && lin && check);
+    if (dflt && upright && raw && lin && check) {
+        int q = SIZE / 4, h = SIZE / 2;
+        /* the top quarter's middle, the bottom quarter's */
+        /* the rows through the texels' centres (a 2 x 2 image, bilinear) */
+        printf("  top row: red %.3f blue %.3f; invertT 0: red %.3f blue %.3f\n",
+               region(dflt, 0, q, 3 * q, q - 1, q + 1), region(dflt, 2, q, 3 * q, q - 1, q + 1),
+               region(upright, 0, q, 3 * q, q - 1, q + 1),
+               region(upright, 2, q, 3 * q, q - 1, q + 1));
+        CHECK(region(dflt, 0, q, 3 * q, q - 1, q + 1) > 0.8);
+        CHECK(region(dflt, 2, q, 3 * q, q - 1, q + 1) < 0.1);
+        CHECK(region(dflt, 2, q, 3 * q, 3 * q - 1, 3 * q + 1) > 0.8);
+        CHECK(region(upright, 2, q, 3 * q, q - 1, q + 1) > 0.8);
+        CHECK(region(upright, 0, q, 3 * q, q - 1, q + 1) < 0.1);
+        /* 128 / 255 as it is, and through sRGB's inverse: 0.216 */
+        printf("  grey texel: %.3f raw, %.3f linearized\n", region(raw, 1, q, 3 * q, q, 3 * q),
+               region(lin, 1, q, 3 * q, q, 3 * q));
+        CHECK_NEAR(region(raw, 1, q, 3 * q, q, 3 * q), 128.0 / 255.0, 0.03);
+        CHECK_NEAR(region(lin, 1, q, 3 * q, q, 3 * q), 0.216, 0.01);
+        /* two checks across, one up: yellow then blue along the top half */
+        double left = region(check, 0, 4, q, 4, h - 4),
+               right = region(check, 0, h + 4, 3 * q, 4, h - 4);
+        double below = region(check, 0, 4, q, h + 4, SIZE - 4);
+        printf("  checker: %.3f %.3f above, %.3f below\n", left, right, below);
+        CHECK((left > 0.8 && right < 0.05) || (left < 0.05 && right > 0.8));
+        CHECK(fabs(below - left) < 0.05); /* one check up: the same below */
+    }
+    rayes_image_free(dflt);
+    rayes_image_free(upright);
+    rayes_image_free(raw);
+    rayes_image_free(lin);
+    rayes_image_free(check);
+#undef PATTERN_SCENE
+#undef TEX
+}
+
 TEST_MAIN(TEST(test_bxdfs), TEST(test_lights), TEST(test_geometry_lights), TEST(test_integrator),
           TEST(test_options), TEST(test_rendered), TEST(test_dome_visibility),
-          TEST(test_tinted_glass))
+          TEST(test_tinted_glass), TEST(test_patterns_rendered))

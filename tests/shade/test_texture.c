@@ -165,6 +165,24 @@ static void test_texel_centres_and_wrap(void)
     CHECK(texture_lookup(ts, "wrap.exr", 1, &s, &t, NULL, NULL, rgb, NULL) == 0);
     for (int c = 0; c < 3; c++)
         CHECK_NEAR(rgb[0][c], 0.5f * (img[c] + img[4 * (w - 1) + c]), 1e-6);
+    /* pbrt's other wraps: outside [0, 1] black (alpha 0) or the edge's
+     * texels; inside, the same texels as periodic */
+    for (int k = 0; k < 3; k++) {
+        float ss[3] = {-0.4f, 1.7f, (0.5f + 2.0f) / (float)w}, tt = (0.5f + 1.0f) / (float)h;
+        float black[1][3], clamp[1][3], ab, ac;
+        CHECK(texture_lookup_encoded(ts, "wrap.exr", NULL, TEXTURE_WRAP_BLACK, 1, &ss[k], &tt, NULL,
+                                     NULL, black, &ab) == 0);
+        CHECK(texture_lookup_encoded(ts, "wrap.exr", NULL, TEXTURE_WRAP_CLAMP, 1, &ss[k], &tt, NULL,
+                                     NULL, clamp, &ac) == 0);
+        int x = k == 0 ? 0 : k == 1 ? w - 1 : 2; /* the column clamp reads */
+        const float *texel = &img[4 * (1 * w + x)];
+        for (int c = 0; c < 3; c++) {
+            CHECK_NEAR(clamp[0][c], texel[c], 1e-6);
+            CHECK_NEAR(black[0][c], k == 2 ? texel[c] : 0.0f, 1e-6);
+        }
+        CHECK_NEAR(ac, texel[3], 1e-6);
+        CHECK_NEAR(ab, k == 2 ? texel[3] : 0.0f, 1e-6);
+    }
     texture_system_free(ts);
     free(img);
 }

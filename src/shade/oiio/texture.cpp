@@ -305,12 +305,13 @@ extern "C" int texture_lookup(TextureSystem *ts, const char *name, size_t n, con
                               const float *t, const float *ds, const float *dt, float (*rgb)[3],
                               float *alpha)
 {
-    return texture_lookup_encoded(ts, name, NULL, n, s, t, ds, dt, rgb, alpha);
+    return texture_lookup_encoded(ts, name, NULL, TEXTURE_WRAP_REPEAT, n, s, t, ds, dt, rgb, alpha);
 }
 
 extern "C" int texture_lookup_encoded(TextureSystem *ts, const char *name, const char *encoding,
-                                      size_t n, const float *s, const float *t, const float *ds,
-                                      const float *dt, float (*rgb)[3], float *alpha)
+                                      TextureWrap wrap, size_t n, const float *s, const float *t,
+                                      const float *ds, const float *dt, float (*rgb)[3],
+                                      float *alpha)
 {
     ts->lookups.fetch_add(n, std::memory_order_relaxed);
     Entry e = name && name[0] ? entry_of(ts, name, encoding) : Entry();
@@ -321,7 +322,9 @@ extern "C" int texture_lookup_encoded(TextureSystem *ts, const char *name, const
         return -1;
     }
     OIIO::TextureOpt opt;
-    opt.swrap = opt.twrap = OIIO::TextureOpt::WrapPeriodic;
+    opt.swrap = opt.twrap = wrap == TEXTURE_WRAP_BLACK   ? OIIO::TextureOpt::WrapBlack
+                            : wrap == TEXTURE_WRAP_CLAMP ? OIIO::TextureOpt::WrapClamp
+                                                         : OIIO::TextureOpt::WrapPeriodic;
     opt.interpmode = OIIO::TextureOpt::InterpBilinear;
     opt.mipmode = OIIO::TextureOpt::MipModeAniso;
     int has_alpha = e.channels == 2 || e.channels >= 4;
@@ -453,11 +456,12 @@ static void system_free(void *ts)
     texture_system_free(static_cast<TextureSystem *>(ts));
 }
 
-static int lookup(void *ts, const char *name, const char *encoding, size_t n, const float *s,
-                  const float *t, const float *ds, const float *dt, float (*rgb)[3], float *alpha)
+static int lookup(void *ts, const char *name, const char *encoding, TextureWrap wrap, size_t n,
+                  const float *s, const float *t, const float *ds, const float *dt, float (*rgb)[3],
+                  float *alpha)
 {
-    return texture_lookup_encoded(static_cast<TextureSystem *>(ts), name, encoding, n, s, t, ds,
-                                  dt, rgb, alpha);
+    return texture_lookup_encoded(static_cast<TextureSystem *>(ts), name, encoding, wrap, n, s, t,
+                                  ds, dt, rgb, alpha);
 }
 
 static void get_stats(void *ts, TextureStats *stats)
