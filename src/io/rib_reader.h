@@ -335,6 +335,7 @@ typedef struct Rib {
     struct PatternStandIn {
         char name[128];
         float rgb[3];
+        char alias[160]; /* its input is this pattern (sent), passed on; else "" */
     } * stand_ins;
     size_t n_stand_ins, cap_stand_ins;
     /* PxrManifold2D's placements of s and t, by name, for the textures and
@@ -482,7 +483,8 @@ int rib_collapsed(Rib *r);
 /* Sends the lights never sent and the light links, if they changed. */
 int rib_send_lights(Rib *r);
 /* The name of the Pattern that reached the sink a reference names: ref
- * itself, or RenderMan's "pattern:output" without its output (in buf);
+ * itself, or RenderMan's "pattern:output" without its output (in buf), or
+ * the pattern an unbuilt pattern of that name passes on (its input's);
  * NULL if none did. */
 const char *rib_pattern_name(const Rib *r, const char *ref, char *buf, size_t size);
 /* rib_pattern_name for a parameter's reference: a PxrTexture's resultR,

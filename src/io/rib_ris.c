@@ -2,7 +2,7 @@
  * io/rib_ris.c — RenderMan 19 and later (RIS): Bxdf, Light, Integrator,
  * the geometric area lights of RenderMan 19 and 20 (Geometry "rectlight"
  * and its kin under AreaLightSource) and the patterns PxrTexture,
- * PxrNormalMap, PxrChecker, PxrMix and PxrManifold2D,
+ * PxrNormalMap, PxrChecker, PxrMix, PxrExposure and PxrManifold2D,
  * translated to rayes' own shaders and lights (docs/rib.md "RenderMan 19
  * and later"). RIS describes materials by physically based lobes and
  * lights by shapes of unit size; rayes keeps the base colour, the
@@ -420,6 +420,12 @@ static int ris_pattern(Rib *r, const char *cls, const char *name, const Param *p
         if (num(p, n, "mode", 0) != 0 || num(p, n, "dimensions", 2) == 3)
             out_float(&o, "dimension", 3);
         placement(r, p, n, &o);
+    } else if (strcasecmp(cls, "PxrExposure") == 0) {
+        type = "scale"; /* inputRGB 2^stops */
+        float gain = exp2f(num(p, n, "stops", 0));
+        float g[3] = {gain, gain, gain};
+        out_colour_of(r, &o, cls, p, n, "inputRGB", "tex", white, 1);
+        out_color(&o, "scale", g);
     } else if (strcasecmp(cls, "PxrMix") == 0) {
         type = "mix"; /* (1 - mix) color1 + mix color2 */
         out_colour_of(r, &o, cls, p, n, "color1", "tex1", black, 1);

@@ -332,11 +332,20 @@ const char *rib_pattern_name(const Rib *r, const char *ref, char *buf, size_t si
     if (pattern_sent(r, ref))
         return ref;
     const char *colon = strrchr(ref, ':'); /* RenderMan's "pattern:output" */
-    if (!colon || (size_t)(colon - ref) >= size)
-        return NULL;
-    memcpy(buf, ref, (size_t)(colon - ref));
-    buf[colon - ref] = '\0';
-    return pattern_sent(r, buf) ? buf : NULL;
+    size_t len = colon ? (size_t)(colon - ref) : strlen(ref);
+    if (colon && len < size) {
+        memcpy(buf, ref, len);
+        buf[len] = '\0';
+        if (pattern_sent(r, buf))
+            return buf;
+    }
+    /* an unbuilt pattern whose input is a pattern passes that pattern on */
+    for (size_t k = r->n_stand_ins; k-- > 0;) {
+        const struct PatternStandIn *si = &r->stand_ins[k];
+        if (strlen(si->name) == len && strncmp(si->name, ref, len) == 0)
+            return si->alias[0] && strlen(si->alias) < size ? strcpy(buf, si->alias) : NULL;
+    }
+    return NULL;
 }
 
 const char *rib_pattern_ref(Rib *r, const char *ref, char *buf, size_t size)
@@ -393,13 +402,21 @@ static int add_stand_in(Rib *r, const char *name, const Param *p, size_t n)
 {
     static const char *const inputs[] = {"inputRGB", "inputColor", "colorIn",     "input",
                                          "color1",   "inputA",     "defaultColor"};
-    float rgb[3];
+    float rgb[3] = {0, 0, 0};
+    char alias[160] = "";
     int found = 0;
     for (size_t k = 0; !found && k < sizeof inputs / sizeof inputs[0]; k++) {
         const Param *q = rib_find_param(p, n, inputs[k]);
         if (!q)
             continue;
-        if (q->d.reference && q->d.ty == TY_STRING && q->v->n == 1)
+        char buf[160];
+        const char *via = q->d.reference && q->d.ty == TY_STRING && q->v->n == 1
+                              ? rib_pattern_ref(r, q->v->s[0], buf, sizeof buf)
+                              : NULL;
+        if (via) {
+            snprintf(alias, sizeof alias, "%s", via);
+            found = 1;
+        } else if (q->d.reference && q->d.ty == TY_STRING && q->v->n == 1)
             found = rib_pattern_stand_in(r, q->v->s[0], rgb);
         else if (rib_is_num(q->v) && (q->v->n == 3 || q->v->n == 1)) {
             for (int c = 0; c < 3; c++)
@@ -419,6 +436,7 @@ static int add_stand_in(Rib *r, const char *name, const Param *p, size_t n)
     struct PatternStandIn *si = &r->stand_ins[r->n_stand_ins++];
     snprintf(si->name, sizeof si->name, "%s", name);
     memcpy(si->rgb, rgb, sizeof rgb);
+    snprintf(si->alias, sizeof si->alias, "%s", alias);
     return 0;
 }
 
@@ -1391,31 +1409,26 @@ int rib_pattern_define(Rib *r, const char *type, const char *name, Param *p, siz
                        ShaderRec *sh)
 {
     const IoSink *s = r->sink;
-    if (sh) {
-        free(p);
-        p = NULL, n = 0;
-        type = sh->name;
-    }
     if ((!sh && !in_list(builtin_patterns, type)) || !s->pattern) {
         char key[128];
         snprintf(key, sizeof key, "pattern %.100s", type);
         rib_warn_once(
             r, key,
-            "Pattern \"%s\" is not a class rayes has (of RenderMan's Pxr "
-            "patterns PxrTexture, PxrNormalMap, PxrChecker, PxrMix and PxrManifold2D are "
-            "built); ignored: colours that reference it take its input's colour (inputRGB, "
+            "Pattern \"%s\" is not a class rayes has (of RenderMan's Pxr patterns PxrTexture, "
+            "PxrNormalMap, PxrChecker, PxrMix, PxrExposure and PxrManifold2D are built); "
+            "ignored: colours that reference it take its input's colour or pattern (inputRGB, "
             "inputColor, ...), others keep their defaults",
             type);
-        int e = sh ? 0 : add_stand_in(r, name, p, n);
+        int e = add_stand_in(r, name, p, n);
         free(p);
         return e;
     }
-    if (!sh) {
+    if (!sh)
         sh = make_shader(r, type, p, n, SHADER_ARRAYS);
-        free(p);
-    }
+    free(p);
     if (!sh)
         return -1;
+    type = sh->name;
     if (s->set_transform(s->target, r->a.M) != RAYES_OK ||
         s->pattern(s->target, name, type, sh->params, sh->n) != RAYES_OK)
         return rib_sink_failed(r, s);

@@ -607,6 +607,18 @@ static void test_patterns(void)
     CHECK(strcmp(rec.pattern_log, "imagemap nm(filename=n.tx,encoding=linear,uscale=1,udelta=0,"
                                   "vscale=-1,vdelta=1,);") == 0);
     CHECK(strcmp(rec.shader_pattern, "normalmap=nm") == 0);
+    /* PxrExposure: its input times 2^stops; an unbuilt class after it
+     * (PxrColorCorrect) passes the pattern of its input on */
+    rec.pattern_log[0] = '\0';
+    CHECK(
+        parse(WORLD("Pattern \"PxrExposure\" \"e\" \"color inputRGB\" [0.25 0.5 0.1] "
+                    "\"float stops\" [1]\n"
+                    "Pattern \"PxrColorCorrect\" \"c\" \"reference color inputRGB\" "
+                    "[\"e:resultRGB\"]\n"
+                    "Bxdf \"PxrDiffuse\" \"d\" \"reference color diffuseColor\" [\"c:resultRGB\"]\n"
+                    "Polygon \"P\" [0 0 0 1 0 0 1 1 0]")) == RAYES_OK);
+    CHECK(strcmp(rec.pattern_log, "scale e(tex=0.25,scale=2,);") == 0);
+    CHECK(strcmp(rec.shader_pattern, "reflectance=e") == 0);
     /* the grid classes, a float array among their parameters */
     CHECK(parse(WORLD("Pattern \"densitygrid\" \"g\" \"float nx\" 2 \"float density\" [0.5 1.5]\n"
                       "Pattern \"nanovdb\" \"c\" \"string filename\" \"cloud.nvdb\"\n")) ==
