@@ -303,6 +303,10 @@ static int read_inline(Rib *r, const struct InlineArchive *ia)
     return run_archive(r, ia->file, (const unsigned char *)ia->text, ia->size, ia->line);
 }
 
+/* Directories above the including file's that a relative archive name is
+ * looked for in, last. */
+#define RIB_ARCHIVE_UP 4
+
 static int read_archive(Rib *r, const char *name_in)
 {
     if (r->archive_depth >= RIB_MAX_ARCHIVE_DEPTH)
@@ -345,13 +349,28 @@ static int read_archive(Rib *r, const char *name_in)
          * paths from the project's directory they render in) */
         if (!file_exists(path) && file_exists(name))
             snprintf(path, sizeof path, "%s", name);
+        /* then the directories above the including file's: the project's
+         * directory, when rayes runs elsewhere */
+        char up[4096];
+        if (dir)
+            snprintf(up, sizeof up, "%.*s", dir, r->file);
+        else
+            snprintf(up, sizeof up, ".");
+        for (int k = 0; k < RIB_ARCHIVE_UP && !file_exists(path) && strlen(up) + 4 < sizeof up;
+             k++) {
+            char cand[4096];
+            strcat(up, "/..");
+            if ((size_t)snprintf(cand, sizeof cand, "%s/%s", up, name) < sizeof cand &&
+                file_exists(cand))
+                memcpy(path, cand, sizeof path);
+        }
     }
     char err[600];
     size_t size;
     if (!file_exists(path))
         return rib_error(r,
-                         "archive \"%s\": not found (as %s, in the working directory, nor on "
-                         "the archive search path)",
+                         "archive \"%s\": not found (as %s, in the working directory, in the "
+                         "directories above the file's, nor on the archive search path)",
                          name_in, path);
     unsigned char *data =
         member ? io_zip_member(path, member, RIB_MAX_FILE_BYTES, &size, err, sizeof err)
@@ -1201,6 +1220,9 @@ static void rib_fini(Rib *r)
     free(r->decls);
     free(r->lights);
     free(r->made);
+    for (size_t k = 0; k < r->n_found; k++)
+        free(r->found[k]);
+    free(r->found);
     free(r->area_handles);
     free(r->links);
     for (size_t k = 0; k < r->n_objects; k++)

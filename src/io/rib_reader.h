@@ -338,6 +338,10 @@ typedef struct Rib {
         char alias[160]; /* its input is this pattern (sent), passed on; else "" */
     } * stand_ins;
     size_t n_stand_ins, cap_stand_ins;
+    /* texture names found beside the scene's file rather than where PRMan
+     * looks (rib_texture_source), kept for the parameters that use them */
+    char **found;
+    size_t n_found, cap_found;
     /* PxrManifold2D's placements of s and t, by name, for the textures and
      * checkers that reference them */
     struct RisManifold {
@@ -506,8 +510,12 @@ int rib_pattern_stand_in(const Rib *r, const char *ref, float rgb[3]);
  * search path. */
 int rib_texture_found(const Rib *r, const char *name);
 /* The image a texture name stands for: the source image of the file's
- * MakeTexture or MakeLatLongEnvironment that made it, else name. */
-const char *rib_texture_source(const Rib *r, const char *name);
+ * MakeTexture or MakeLatLongEnvironment that made it; a relative name
+ * found neither as given (the working directory, where PRMan looks) nor
+ * on the texture search path but beside the file being read or in a
+ * directory up to 4 above it (the scene rendered from elsewhere): that
+ * path; else name. */
+const char *rib_texture_source(Rib *r, const char *name);
 /* A shader record of name with copies of the parameters p (floats arrays
  * are not taken), the attributes' to point to; NULL with the error set. */
 ShaderRec *rib_shader_rec(Rib *r, const char *name, const RayesParam *p, size_t n);

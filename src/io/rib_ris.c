@@ -537,6 +537,7 @@ static int make_light(Rib *r, const char *handle, const char *cls, const float L
         rib_light_param(l, "from", RAYES_PARAM_COLOR, from, NULL);
         rib_light_param(l, "to", RAYES_PARAM_COLOR, to, NULL);
     } else if (map && map[0]) {
+        map = rib_texture_source(r, map);
         if (rib_texture_found(r, map))
             rib_light_param(l, "mapname", RAYES_PARAM_STRING, NULL, map);
         else

@@ -26,6 +26,7 @@
 #include <unistd.h>
 
 #include "io/rib_reader.h"
+#include "util/grow.h"
 #include "util/vec.h"
 
 /* ---------------------------------------------------------- emission */
@@ -678,8 +679,7 @@ static const char *const environment_maps[] = {"mapname",        "envmap",      
 
 /* An environment light's string parameter q as rayes' mapname or mapping
  * into L; 0 if q is neither. */
-static int environment_map(const Rib *r, Light *L, const Param *q, RayesParam *o, char *name,
-                           size_t size)
+static int environment_map(Rib *r, Light *L, const Param *q, RayesParam *o, char *name, size_t size)
 {
     int map = in_list(environment_maps, q->d.name);
     if ((!map && strcmp(q->d.name, "mapping") != 0) || q->d.ty != TY_STRING || q->v->n != 1)
@@ -714,11 +714,61 @@ int rib_texture_found(const Rib *r, const char *name)
     return 0;
 }
 
-const char *rib_texture_source(const Rib *r, const char *name)
+/* Whether name looks like a file's (a path or a name with an extension),
+ * not a word such as "raytrace" or "vertical". */
+static int file_like(const char *name)
+{
+    const char *base = strrchr(name, '/');
+    base = base ? base + 1 : name;
+    return base[0] && (strchr(base, '.') || base != name);
+}
+
+/* name relative to the directory of the file being read or one of the
+ * RIB_TEXTURE_UP directories above it, the first that holds it, kept in
+ * r; NULL if none does. */
+#define RIB_TEXTURE_UP 4
+static const char *beside_scene(Rib *r, const char *name)
+{
+    const char *slash = strrchr(r->file, '/');
+    char dir[4096], path[4096];
+    if ((size_t)snprintf(dir, sizeof dir, "%.*s", slash ? (int)(slash - r->file) : 1,
+                         slash ? r->file : ".") >= sizeof dir)
+        return NULL;
+    for (int up = 0; up <= RIB_TEXTURE_UP; up++) {
+        if ((size_t)snprintf(path, sizeof path, "%s/%s", dir, name) >= sizeof path)
+            return NULL;
+        if (access(path, R_OK) == 0) {
+            for (size_t k = 0; k < r->n_found; k++) /* the same path, kept once */
+                if (strcmp(r->found[k], path) == 0)
+                    return r->found[k];
+            char *kept = rib_strdup(path);
+            if (!kept ||
+                util_grow((void **)&r->found, &r->cap_found, r->n_found, sizeof *r->found) != 0) {
+                free(kept);
+                return NULL;
+            }
+            return r->found[r->n_found++] = kept;
+        }
+        if (strlen(dir) + 4 >= sizeof dir)
+            return NULL;
+        strcat(dir, "/..");
+    }
+    return NULL;
+}
+
+const char *rib_texture_source(Rib *r, const char *name)
 {
     for (size_t k = r->n_made; k-- > 0;) /* the last made of a name counts */
         if (strcmp(r->made[k].made, name) == 0)
             return r->made[k].from;
+    /* PRMan reads a relative name from the working directory (the
+     * project's, where the file was rendered); rendered from elsewhere,
+     * the file's own directory and those above it hold it */
+    if (name[0] && name[0] != '/' && file_like(name) && !rib_texture_found(r, name)) {
+        const char *found = beside_scene(r, name);
+        if (found)
+            return found;
+    }
     return name;
 }
 

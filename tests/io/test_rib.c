@@ -8,6 +8,7 @@
  * AddressSanitizer sees any read past the end.
  */
 #include <string.h>
+#include <sys/stat.h>
 #include <zlib.h>
 
 #include "io/builtin.h"
@@ -61,7 +62,7 @@ typedef struct Rec {
     char light_map[16][64];  /* each light's mapname, "" if none */
     char shader_pattern[64]; /* the last shader's first pattern parameter: "param=pattern" */
     char pattern[64];        /* the last pattern: "type name" */
-    char pattern_log[512];   /* every pattern since cleared: "type name(param=value,...);" */
+    char pattern_log[1024];  /* every pattern since cleared: "type name(param=value,...);" */
     float pattern_M[16];     /* the transform current then */
 } Rec;
 
@@ -548,6 +549,45 @@ static void test_shaders_and_lights(void)
 
 /* Pattern requests reach the sink at once, in the current transform, and
  * a shader's "reference pattern NAME" parameter names one. */
+/* A project's file rendered from elsewhere: a relative texture name that
+ * is not in the working directory (where PRMan looks) is found beside the
+ * file or above it, and an archive named from the project's directory is
+ * found above the including file's. */
+static void write_text(const char *path, const char *text)
+{
+    FILE *f = fopen(path, "w");
+    CHECK(f != NULL);
+    if (f) {
+        fputs(text, f);
+        fclose(f);
+    }
+}
+
+static void test_project_relative(void)
+{
+    mkdir(RAYES_TEST_TMP "/proj", 0755);
+    mkdir(RAYES_TEST_TMP "/proj/textures", 0755);
+    mkdir(RAYES_TEST_TMP "/proj/rib", 0755);
+    write_text(RAYES_TEST_TMP "/proj/textures/wood.ppm", "P3 1 1 255 200 100 50\n");
+    write_text(RAYES_TEST_TMP "/proj/rib/geo.rib", "Polygon \"P\" [0 0 0 1 0 0 1 1 0]\n");
+    write_text(RAYES_TEST_TMP "/proj/rib/scene.rib",
+               "WorldBegin\nPattern \"PxrTexture\" \"w\" \"string filename\" "
+               "[\"textures/wood.ppm\"]\nPattern \"PxrTexture\" \"m\" \"string filename\" "
+               "[\"textures/missing.ppm\"]\nReadArchive \"rib/geo.rib\"\nWorldEnd\n");
+    memset(&rec, 0, sizeof rec);
+    io_settings_init(&settings);
+    IoReadOptions opt = {RAYES_TEST_DATA, -1};
+    RayesError e =
+        io_rib_read(RAYES_TEST_TMP "/proj/rib/scene.rib", &stub, &opt, &settings, err, sizeof err);
+    if (e != RAYES_OK)
+        fprintf(stderr, "%s\n", err);
+    CHECK(e == RAYES_OK && rec.meshes == 1);
+    CHECK(strstr(rec.pattern_log,
+                 "imagemap w(filename=" RAYES_TEST_TMP "/proj/rib/../textures/wood.ppm,") != NULL);
+    /* a name found nowhere is kept as it is (the texture system warns) */
+    CHECK(strstr(rec.pattern_log, "imagemap m(filename=textures/missing.ppm,") != NULL);
+}
+
 static void test_patterns(void)
 {
     CHECK(parse(WORLD("Translate 1 2 3\n"
@@ -1371,8 +1411,8 @@ static void test_prman_leniency(void)
 
 TEST_MAIN(TEST(test_camera_and_transforms), TEST(test_attributes_rayes_always_does),
           TEST(test_settings), TEST(test_shaders_and_lights), TEST(test_parameter_classes),
-          TEST(test_patterns), TEST(test_polygons), TEST(test_patch_mesh_bases), TEST(test_handles),
-          TEST(test_objects_and_frames), TEST(test_binary), TEST(test_gzip), TEST(test_errors),
-          TEST(test_aqsis_files), TEST(test_scene_sink), TEST(test_writer_round_trip),
-          TEST(test_writer_primvars), TEST(test_writer_split_quad), TEST(test_detail_range),
-          TEST(test_prman_leniency))
+          TEST(test_patterns), TEST(test_project_relative), TEST(test_polygons),
+          TEST(test_patch_mesh_bases), TEST(test_handles), TEST(test_objects_and_frames),
+          TEST(test_binary), TEST(test_gzip), TEST(test_errors), TEST(test_aqsis_files),
+          TEST(test_scene_sink), TEST(test_writer_round_trip), TEST(test_writer_primvars),
+          TEST(test_writer_split_quad), TEST(test_detail_range), TEST(test_prman_leniency))
