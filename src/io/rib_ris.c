@@ -25,6 +25,7 @@
 
 #include "io/rib_internal.h"
 #include "io/rib_reader.h"
+#include "util/colour.h"
 #include "util/grow.h"
 
 /* ------------------------------------------------------------ values */
@@ -600,8 +601,12 @@ static int h_light(Rib *r, const Args *a)
     color(p, n, "lightColor", one, L);
     for (int k = 0; k < 3; k++)
         L[k] *= I;
-    if (num(p, n, "enableTemperature", 0) != 0)
-        rib_warn_once(r, "ris temperature", "lights' colour temperature is not applied");
+    if (num(p, n, "enableTemperature", 0) != 0) { /* a tint; 6500 K white */
+        float tint[3];
+        colour_temperature(num(p, n, "temperature", 6500), tint);
+        for (int k = 0; k < 3; k++)
+            L[k] *= tint[k];
+    }
     const char *map = string(p, n, "lightColorMap");
     int e = make_light(r, handle, cls, L, num(p, n, "areaNormalize", 0) != 0,
                        num(p, n, "angleExtent", 0.53f), map);

@@ -165,6 +165,23 @@ static void test_lights(void)
                     "\"float intensity\" [12] \"int areaNormalize\" [1]\nAttributeEnd\n" TRI)) ==
           RAYES_OK);
     CHECK_NEAR(param(light(), "intensity", 0), 2, 1e-5);
+    /* a colour temperature tints the light (6500 K white), its luminance
+     * kept */
+    CHECK(rib(WORLD("Light \"PxrSphereLight\" \"w\" \"int enableTemperature\" [1] \"float "
+                    "temperature\" [6500]\nLight \"PxrSphereLight\" \"c\" \"float intensity\" "
+                    "[2] \"int enableTemperature\" [1] \"float temperature\" [3000]\n" TRI)) ==
+          RAYES_OK);
+    CHECK(rec.n_light == 2);
+    if (rec.n_light == 2) {
+        float c[3], w[3];
+        for (int k = 0; k < 3; k++) {
+            w[k] = param(&rec.light[0], "intensity", 0) * param(&rec.light[0], "lightcolor", k);
+            c[k] = param(&rec.light[1], "intensity", 0) * param(&rec.light[1], "lightcolor", k);
+        }
+        CHECK(fabsf(w[0] - w[1]) < 1e-4f && fabsf(w[2] - w[1]) < 1e-4f);
+        CHECK(c[0] > 1.2f * c[1] && c[1] > 1.5f * c[2]); /* 3000 K: orange */
+        CHECK_NEAR(0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2], 2, 1e-4);
+    }
     /* disks and spheres of diameter 1 */
     CHECK(rib(WORLD("Light \"PxrSphereLight\" \"b\"\nLight \"PxrDiskLight\" \"d\"\n" TRI)) ==
           RAYES_OK);
