@@ -27,6 +27,7 @@
 #include "io/rib_reader.h"
 #include "util/colour.h"
 #include "util/grow.h"
+#include "util/sky.h"
 
 /* ------------------------------------------------------------ values */
 
@@ -491,10 +492,12 @@ static int make_light(Rib *r, const char *handle, const char *cls, const float L
     if (!rect && !disk && !sphere && !dist && !dome) {
         char key[128];
         snprintf(key, sizeof key, "light %.100s", cls);
-        rib_warn_once(r, key,
-                      "light \"%s\" is not one rayes translates (PxrRectLight, PxrDiskLight, "
-                      "PxrSphereLight, PxrDistantLight, PxrDomeLight); the light is skipped",
-                      cls);
+        rib_warn_once(
+            r, key,
+            "light \"%s\" is not one rayes translates (PxrRectLight, PxrDiskLight, "
+            "PxrSphereLight, PxrDistantLight, PxrDomeLight, PxrEnvDayLight); the light is "
+            "skipped",
+            cls);
         return 0;
     }
     float scale = 1; /* normalize: radiance over the area of the shape as placed */
@@ -582,6 +585,100 @@ static void light_controls(Rib *r, const char *cls, Light *l, const Param *p, si
     }
 }
 
+/* Turns a light's frame by Rx(90) (its y column becomes its z, its z
+ * minus its y): light-space +y then lies where +z did. */
+static void zenith_to_y(Light *l)
+{
+    for (int t = -1; t < l->n_motion; t++) {
+        float *M = t < 0 ? l->M : l->motion_M[t];
+        for (int row = 0; row < 16; row += 4) {
+            float y = M[row + 1];
+            M[row + 1] = M[row + 2], M[row + 2] = -y;
+        }
+    }
+}
+
+/* PxrEnvDayLight (RenderMan 21's; PxrStdEnvDayLight is RenderMan 20's):
+ * a clear sky, an environmentlight of rayes' "sky" (util/sky.h:
+ * Preetham et al.'s, haziness its turbidity, skyTint its colour, the
+ * ground below the horizon of groundColor), and its sun, a distant light
+ * of Hottel's radiance (sunTint) over a disk of sunSize x 0.53 degrees,
+ * both in cd/m^2 times intensity 2^exposure 1e-5, as PRMan scales them.
+ * The sun's direction is sunDirection (+y the zenith), or, when a month is
+ * given, its place at that hour, day and month seen from latitude and
+ * longitude (+z north, +x east). Returns 1, 0 (skipped) or -1. */
+static int day_light(Rib *r, const char *handle, const char *cls, const Param *p, size_t n)
+{
+    if (r->rec || r->in_object) {
+        rib_warn_once(r, "light in object", "lights inside ObjectBegin are ignored");
+        return 0;
+    }
+    static const float up[3] = {0, 1, 0}, one[3] = {1, 1, 1}, grey[3] = {.18f, .18f, .18f};
+    float gain = num(p, n, "intensity", strcasecmp(cls, "PxrStdEnvDayLight") == 0 ? 1e-5f : 1) *
+                 exp2f(fminf(fmaxf(num(p, n, "exposure", 0), -126), 126));
+    if (strcasecmp(cls, "PxrEnvDayLight") == 0)
+        gain *= 1e-5f; /* RenderMan 21: the model's cd/m^2, 100 000 times too bright, scaled */
+    float dir[3], sky_tint[3], sun_tint[3], ground[3];
+    color(p, n, value(p, n, "sunDirection", 3) ? "sunDirection" : "direction", up, dir);
+    int month = (int)num(p, n, "month", 0);
+    if (month >= 1 && month <= 12)
+        sky_sun_direction(month, (int)num(p, n, "day", 1), num(p, n, "hour", 14.633333f),
+                          num(p, n, "zone", -8), num(p, n, "latitude", 37.7749f),
+                          num(p, n, "longitude", -122.4194f), dir);
+    /* RenderMan 21's sky has its zenith at +z, RenderMan 20's and 22's at
+     * +y: the zenith is the one of them the transform turns nearer the
+     * world's +y (RenderMan for Maya 21 writes a Rotate -90 1 0 0 before
+     * it), and a +z zenith is turned to rayes' +y (the directions by Rx(-90),
+     * the frame's columns by Rx(90)) */
+    const float *M = r->a.M;
+    float ly = hypotf(hypotf(M[1], M[5]), M[9]), lz = hypotf(hypotf(M[2], M[6]), M[10]);
+    int zup = lz > 0 && ly > 0 && M[6] / lz > M[5] / ly;
+    if (zup) {
+        float y = dir[1];
+        dir[1] = dir[2], dir[2] = -y;
+    }
+    color(p, n, "skyTint", one, sky_tint);
+    color(p, n, "sunTint", one, sun_tint);
+    color(p, n, "groundColor", grey, ground);
+    float haziness = fminf(fmaxf(num(p, n, "haziness", 2), 1.7f), 10.0f);
+    Light *l = rib_new_light(r, handle, "environmentlight");
+    if (!l)
+        return -1;
+    if (zup)
+        zenith_to_y(l);
+    float I = gain * max3(sky_tint), c[3], v[3] = {I, 0, 0};
+    for (int k = 0; k < 3; k++)
+        c[k] = I > 0 ? gain * sky_tint[k] / I : 0;
+    rib_light_param(l, "intensity", RAYES_PARAM_FLOAT, v, NULL);
+    rib_light_param(l, "lightcolor", RAYES_PARAM_COLOR, c, NULL);
+    rib_light_param(l, "mapping", RAYES_PARAM_STRING, NULL, "sky");
+    rib_light_param(l, "sundirection", RAYES_PARAM_COLOR, dir, NULL);
+    float hz[3] = {haziness, 0, 0};
+    rib_light_param(l, "haziness", RAYES_PARAM_FLOAT, hz, NULL);
+    rib_light_param(l, "groundcolor", RAYES_PARAM_COLOR, ground, NULL);
+    on_everywhere(r, l);
+    l->own_visibility = 1; /* the sky: the background, unless hidden */
+    l->visibility = r->a.visibility;
+    Sky sky;
+    sky_init(&sky, dir, haziness);
+    float sun[3];
+    sky_sun_radiance(&sky, sun);
+    if (dir[1] <= 0 || max3(sun) <= 0)
+        return 1; /* set: the sky of dusk alone */
+    float L[3];
+    for (int k = 0; k < 3; k++)
+        L[k] = sun[k] * sun_tint[k] * gain;
+    int e = make_light(r, handle, "PxrDistantLight", L, 0,
+                       0.53f * fmaxf(num(p, n, "sunSize", 1), 0.0f), NULL);
+    if (e > 0) { /* it shines from the sun, along -dir in the light's space */
+        float to[3] = {-sky.sun[0], -sky.sun[1], -sky.sun[2]};
+        rib_light_param(&r->lights[r->n_lights - 1], "to", RAYES_PARAM_COLOR, to, NULL);
+        if (zup)
+            zenith_to_y(&r->lights[r->n_lights - 1]);
+    }
+    return e;
+}
+
 /* Light "class" "handle" params (RenderMan 21 and later). */
 static int h_light(Rib *r, const Args *a)
 {
@@ -608,8 +705,14 @@ static int h_light(Rib *r, const Args *a)
             L[k] *= tint[k];
     }
     const char *map = string(p, n, "lightColorMap");
-    int e = make_light(r, handle, cls, L, num(p, n, "areaNormalize", 0) != 0,
-                       num(p, n, "angleExtent", 0.53f), map);
+    int day = strcasecmp(cls, "PxrEnvDayLight") == 0 || strcasecmp(cls, "PxrStdEnvDayLight") == 0;
+    int e = day ? day_light(r, handle, cls, p, n)
+                : make_light(r, handle, cls, L, num(p, n, "areaNormalize", 0) != 0,
+                             num(p, n, "angleExtent", 0.53f), map);
+    if (day) {
+        free(p);
+        return e < 0 ? -1 : 0;
+    }
     if (e > 0)
         light_controls(r, cls, &r->lights[r->n_lights - 1], p, n);
     free(p);

@@ -1225,23 +1225,11 @@ static int h_light_source(Rib *r, const Args *a)
         L->own_visibility = 1;
         L->visibility = r->a.visibility;
     }
-    static const char *const names[] = {"intensity",
-                                        "lightcolor",
-                                        "from",
-                                        "to",
-                                        "coneangle",
-                                        "conedeltaangle",
-                                        "beamdistribution",
-                                        "__category",
-                                        "fov",
-                                        "shape",
-                                        "width",
-                                        "height",
-                                        "radius",
-                                        "shadows",
-                                        "__nondiffuse",
-                                        "__nonspecular",
-                                        NULL};
+    static const char *const names[] = {
+        "intensity",  "lightcolor", "sundirection", "haziness",       "groundcolor",
+        "from",       "to",         "coneangle",    "conedeltaangle", "beamdistribution",
+        "__category", "fov",        "shape",        "width",          "height",
+        "radius",     "shadows",    "__nondiffuse", "__nonspecular",  NULL};
     int mapped = strcmp(type, "pointlight") == 0 || strcmp(type, "spotlight") == 0;
     /* RenderMan's point, spot and distant lights: diffuse() sums Cl (L.N)
      * with no 1/pi, so their intensity is pi times rayes' (DESIGN.md,
@@ -1280,8 +1268,9 @@ static int h_light_source(Rib *r, const Args *a)
             continue;
         }
         if (env && strcmp(q->d.name, "intensity") != 0 && strcmp(q->d.name, "lightcolor") != 0 &&
-            strcmp(q->d.name, "__category") != 0)
-            continue; /* an environment light has no position or cone */
+            strcmp(q->d.name, "__category") != 0 && strcmp(q->d.name, "sundirection") != 0 &&
+            strcmp(q->d.name, "haziness") != 0 && strcmp(q->d.name, "groundcolor") != 0)
+            continue; /* an environment light has no position or cone (a sky has its sun) */
         if (!in_list(names, q->d.name) || (!q->declared && !(uber && intensity(q))))
             continue;
         if (uber && !intensity(q) && strcmp(q->d.name, "lightcolor") != 0 &&

@@ -1608,6 +1608,7 @@ typedef struct LightParams {
     float radius, width, height, fov;
     const char *mapname, *mapping, *shape, *category;
     float shadows, nondiffuse, nonspecular;
+    float sundirection[3], haziness, groundcolor[3]; /* an environment's "sky" */
     /* uberlight's */
     const char *lighttype, *slidename;
     float cuton, cutoff, nearedge, faredge, falloff, falloffdist, maxintensity, parallelrays;
@@ -1637,6 +1638,9 @@ static const LightParamDesc light_param_descs[] = {
     {"height", RAYES_PARAM_FLOAT, offsetof(LightParams, height)},
     {"mapname", RAYES_PARAM_STRING, offsetof(LightParams, mapname)},
     {"mapping", RAYES_PARAM_STRING, offsetof(LightParams, mapping)},
+    {"sundirection", RAYES_PARAM_COLOR, offsetof(LightParams, sundirection)},
+    {"haziness", RAYES_PARAM_FLOAT, offsetof(LightParams, haziness)},
+    {"groundcolor", RAYES_PARAM_COLOR, offsetof(LightParams, groundcolor)},
     {"fov", RAYES_PARAM_FLOAT, offsetof(LightParams, fov)},
     {"shape", RAYES_PARAM_STRING, offsetof(LightParams, shape)},
     {"__category", RAYES_PARAM_STRING, offsetof(LightParams, category)},
@@ -1686,6 +1690,9 @@ static RayesError light_params(RayesScene *s, const char *type, const RayesParam
                         .fov = 90,
                         .mapname = "",
                         .mapping = "latlong",
+                        .sundirection = {0, 1, 0},
+                        .haziness = 2,
+                        .groundcolor = {0.18f, 0.18f, 0.18f},
                         .shape = "quad",
                         .category = "",
                         .shadows = 1,
@@ -1818,10 +1825,20 @@ static RayesError light_map(RayesScene *s, const char *type, const LightParams *
     mat4_invert(rot, &l->light_from_world);
     int octahedral = strcmp(lp->mapping, "octahedral") == 0;
     int projection = strcmp(lp->mapping, "projection") == 0 && l->type != LIGHT_ENVIRONMENT;
-    if (!octahedral && !projection && strcmp(lp->mapping, "latlong") != 0)
+    int sky = strcmp(lp->mapping, "sky") == 0 && l->type == LIGHT_ENVIRONMENT;
+    if (!octahedral && !projection && !sky && strcmp(lp->mapping, "latlong") != 0)
         return scene_fail(s, RAYES_ERROR_INVALID_ARGUMENT,
-                          "%s: unknown mapping \"%s\"; expected latlong or octahedral%s", type,
-                          lp->mapping, l->type != LIGHT_ENVIRONMENT ? " or projection" : "");
+                          "%s: unknown mapping \"%s\"; expected latlong, octahedral%s", type,
+                          lp->mapping, l->type != LIGHT_ENVIRONMENT ? " or projection" : " or sky");
+    if (sky) { /* a clear sky of its sun, no map */
+        char err[400];
+        if (!(lp->haziness > 0.0f && lp->haziness < 100.0f))
+            return scene_fail(s, RAYES_ERROR_INVALID_ARGUMENT,
+                              "%s: expected a sky's haziness in (0, 100)", type);
+        if (light_env_sky(l, lp->sundirection, lp->haziness, lp->groundcolor, err, sizeof err) != 0)
+            return scene_fail(s, RAYES_ERROR_OUT_OF_MEMORY, "%s", err);
+        return RAYES_OK;
+    }
     if (projection && !(lp->fov > 0.0f && lp->fov < 180.0f))
         return scene_fail(s, RAYES_ERROR_INVALID_ARGUMENT,
                           "%s: expected a projection's fov in (0, 180) degrees", type);

@@ -11,6 +11,7 @@
 
 #include "shade/noise.h"
 #include "shade/texture.h"
+#include "util/sky.h"
 
 static const float PI = 3.14159265358979f;
 
@@ -1382,6 +1383,9 @@ static float *octahedral_to_latlong(const float *src, int n)
     return out;
 }
 
+static int env_from_rgba(Light *l, float *rgba, int w, int h, const char *path, char *err,
+                         size_t err_size);
+
 int light_env_load(Light *l, const char *path, int octahedral, char *err, size_t err_size)
 {
     int w = 0, h = 0;
@@ -1411,6 +1415,14 @@ int light_env_load(Light *l, const char *path, int octahedral, char *err, size_t
         rgba = ll;
         w = 2 * h;
     }
+    return env_from_rgba(l, rgba, w, h, path, err, err_size);
+}
+
+/* Makes l's map (its pixels and their sampling tables) of rgba (w x h,
+ * latitude-longitude; freed here); path names it in errors. */
+static int env_from_rgba(Light *l, float *rgba, int w, int h, const char *path, char *err,
+                         size_t err_size)
+{
     LightEnvMap *m = calloc(1, sizeof *m);
     size_t n = (size_t)w * h;
     if (m) {
@@ -1486,6 +1498,46 @@ int light_env_load(Light *l, const char *path, int octahedral, char *err, size_t
     light_fini(l);
     l->env = m;
     return 0;
+}
+
+int light_env_sky(Light *l, const float sun[3], float turbidity, const float ground[3], char *err,
+                  size_t err_size)
+{
+    enum { W = 512, H = 256 };
+    float *rgba = malloc((size_t)4 * W * H * sizeof *rgba);
+    if (!rgba) {
+        snprintf(err, err_size, "environment light: out of memory for its sky");
+        return -1;
+    }
+    Sky sky;
+    sky_init(&sky, sun, turbidity);
+    /* the sky's irradiance on the ground, and the sun's: what a Lambertian
+     * ground of the given albedo returns below the horizon */
+    double E[3] = {0, 0, 0};
+    for (int y = 0; y < H; y++)
+        for (int x = 0; x < W; x++) {
+            float phi = (((float)x + 0.5f) / (float)W - 0.5f) * 2.0f * PI;
+            float theta = ((float)y + 0.5f) / (float)H * PI, st = sinf(theta);
+            float d[3] = {-st * sinf(phi), cosf(theta), st * cosf(phi)}; /* as env_uv_to_dir */
+            float *o = &rgba[4 * ((size_t)y * W + x)];
+            sky_radiance(&sky, d, o);
+            o[3] = 1.0f;
+            double dw = (2.0 * PI / W) * (PI / H) * st; /* the pixel's solid angle */
+            for (int k = 0; k < 3; k++)
+                E[k] += o[k] * fmax(d[1], 0.0f) * dw;
+        }
+    float sun_rgb[3];
+    sky_sun_radiance(&sky, sun_rgb);
+    double sun_sr = 2.0 * PI * (1.0 - cos(0.265 * PI / 180.0)); /* a 0.53-degree disk */
+    for (int k = 0; k < 3; k++)
+        E[k] += sun_rgb[k] * sun_sr * sky.sun[1];
+    for (int y = H / 2; y < H; y++) /* the rows below the horizon */
+        for (int x = 0; x < W; x++) {
+            float *o = &rgba[4 * ((size_t)y * W + x)];
+            for (int k = 0; k < 3; k++)
+                o[k] = (float)(ground[k] * E[k] / PI);
+        }
+    return env_from_rgba(l, rgba, W, H, "its sky", err, err_size);
 }
 
 static void mesh_free(LightMesh *m)

@@ -347,6 +347,14 @@ Vec3 light_env_radiance(const Light *l, Vec3 d);
  * err. */
 int light_env_load(Light *l, const char *path, int octahedral, char *err, size_t err_size);
 
+/* An environment map of a clear sky (util/sky.h: Preetham et al.'s, in
+ * cd/m^2, the sun's disk left out: a distant light is the sun) for the
+ * sun direction sun (light space, +y the zenith) and turbidity, 512 x 256
+ * latitude-longitude; below the horizon a Lambertian ground of albedo
+ * ground lit by that sky and sun. Returns 0, or -1 with a message. */
+int light_env_sky(Light *l, const float sun[3], float turbidity, const float ground[3], char *err,
+                  size_t err_size);
+
 /* The light at time t: l itself when it is still, else *tmp, made from l
  * moved to t (positions, axes, sizes; an environment map's rotation),
  * sharing l's map. Mesh lights are still (the scene makes them so). */

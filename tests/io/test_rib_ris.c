@@ -182,6 +182,39 @@ static void test_lights(void)
         CHECK(c[0] > 1.2f * c[1] && c[1] > 1.5f * c[2]); /* 3000 K: orange */
         CHECK_NEAR(0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2], 2, 1e-4);
     }
+    /* PxrEnvDayLight: rayes' sky and a distant sun shining from its
+     * direction; RenderMan 21's +z zenith (what a Rotate -90 1 0 0 turns
+     * up) is rayes' +y */
+    CHECK(rib(WORLD("Light \"PxrEnvDayLight\" \"d\" \"vector sunDirection\" [0.6 0.8 0]\n" TRI)) ==
+          RAYES_OK);
+    CHECK(rec.n_light == 2);
+    if (rec.n_light == 2) {
+        const RayesParam *m = rec_param(&rec.light[0], "mapping");
+        CHECK(strcmp(rec.light[0].name, "environmentlight") == 0 && m &&
+              strcmp(m->string, "sky") == 0);
+        CHECK_NEAR(param(&rec.light[0], "sundirection", 1), 0.8, 1e-6);
+        CHECK_NEAR(param(&rec.light[0], "intensity", 0), 1e-5, 1e-9);
+        CHECK(strcmp(rec.light[1].name, "distantlight") == 0);
+        CHECK_NEAR(param(&rec.light[1], "to", 0), -0.6, 1e-5);
+        CHECK_NEAR(param(&rec.light[1], "to", 1), -0.8, 1e-5);
+        /* the sun at 37 degrees up: Hottel's beam, about 0.13 cd/m^2 x 1e-5 x 0.53 degrees' solid
+         * angle */
+        float lum = 0;
+        for (int k = 0; k < 3; k++)
+            lum += (k == 0   ? 0.2126f
+                    : k == 1 ? 0.7152f
+                             : 0.0722f) *
+                   param(&rec.light[1], "intensity", 0) * param(&rec.light[1], "lightcolor", k);
+        printf("  the sun's irradiance: %.4f\n", lum);
+        CHECK(lum > 0.65f && lum < 0.9f);
+    }
+    CHECK(rib(WORLD("Rotate -90 1 0 0\nLight \"PxrEnvDayLight\" \"d\" \"vector sunDirection\" "
+                    "[0 0 1] \"float haziness\" [4]\n" TRI)) == RAYES_OK);
+    CHECK(rec.n_light == 2);
+    if (rec.n_light == 2) {
+        CHECK_NEAR(param(&rec.light[0], "sundirection", 1), 1, 1e-6);
+        CHECK_NEAR(param(&rec.light[0], "haziness", 0), 4, 1e-6);
+    }
     /* disks and spheres of diameter 1 */
     CHECK(rib(WORLD("Light \"PxrSphereLight\" \"b\"\nLight \"PxrDiskLight\" \"d\"\n" TRI)) ==
           RAYES_OK);
