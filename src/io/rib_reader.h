@@ -99,6 +99,7 @@ typedef struct ShaderRec {
     char pattern[160];  /* a Pattern's name once the sink has it, else "" */
     int channels;       /* a PxrTexture's imagemap: its outputs resultR ... resultA are
                            its channels (rib_pattern_ref) */
+    const struct ShaderRec *of; /* a channel's pattern: the image's record */
     RayesParam *params; /* names and strings owned */
     size_t n;
     struct ShaderRec *next;

@@ -620,11 +620,6 @@ static int day_light(Rib *r, const char *handle, const char *cls, const Param *p
         gain *= 1e-5f; /* RenderMan 21: the model's cd/m^2, 100 000 times too bright, scaled */
     float dir[3], sky_tint[3], sun_tint[3], ground[3];
     color(p, n, value(p, n, "sunDirection", 3) ? "sunDirection" : "direction", up, dir);
-    int month = (int)num(p, n, "month", 0);
-    if (month >= 1 && month <= 12)
-        sky_sun_direction(month, (int)num(p, n, "day", 1), num(p, n, "hour", 14.633333f),
-                          num(p, n, "zone", -8), num(p, n, "latitude", 37.7749f),
-                          num(p, n, "longitude", -122.4194f), dir);
     /* RenderMan 21's sky has its zenith at +z, RenderMan 20's and 22's at
      * +y: the zenith is the one of them the transform turns nearer the
      * world's +y (RenderMan for Maya 21 writes a Rotate -90 1 0 0 before
@@ -637,6 +632,11 @@ static int day_light(Rib *r, const char *handle, const char *cls, const Param *p
         float y = dir[1];
         dir[1] = dir[2], dir[2] = -y;
     }
+    int month = (int)num(p, n, "month", 0); /* the heliodon's: +y already the zenith */
+    if (month >= 1 && month <= 12)
+        sky_sun_direction(month, (int)num(p, n, "day", 1), num(p, n, "hour", 14.633333f),
+                          num(p, n, "zone", -8), num(p, n, "latitude", 37.7749f),
+                          num(p, n, "longitude", -122.4194f), dir);
     color(p, n, "skyTint", one, sky_tint);
     color(p, n, "sunTint", one, sun_tint);
     color(p, n, "groundColor", grey, ground);
@@ -706,10 +706,13 @@ static int h_light(Rib *r, const Args *a)
     }
     const char *map = string(p, n, "lightColorMap");
     int day = strcasecmp(cls, "PxrEnvDayLight") == 0 || strcasecmp(cls, "PxrStdEnvDayLight") == 0;
+    size_t before = r->n_lights;
     int e = day ? day_light(r, handle, cls, p, n)
                 : make_light(r, handle, cls, L, num(p, n, "areaNormalize", 0) != 0,
                              num(p, n, "angleExtent", 0.53f), map);
-    if (day) {
+    if (day) { /* the sky and its sun take the light's controls */
+        for (size_t k = before; e > 0 && k < r->n_lights; k++)
+            light_controls(r, cls, &r->lights[k], p, n);
         free(p);
         return e < 0 ? -1 : 0;
     }

@@ -349,23 +349,44 @@ const char *rib_pattern_name(const Rib *r, const char *ref, char *buf, size_t si
     return NULL;
 }
 
+/* The newest record sent under pattern name, or NULL. */
+static const ShaderRec *sent_as(const Rib *r, const char *name)
+{
+    const ShaderRec *s = r->shaders; /* newest first */
+    while (s && !(s->pattern[0] && strcmp(s->pattern, name) == 0))
+        s = s->next;
+    return s;
+}
+
 const char *rib_pattern_ref(Rib *r, const char *ref, char *buf, size_t size)
 {
-    const char *name = rib_pattern_name(r, ref, buf, size);
-    if (!name || name == ref)
-        return name;
     static const char *const outputs[] = {"resultR", "resultG", "resultB", "resultA", "resultF"};
-    const char *output = strrchr(ref, ':') + 1;
+    const char *colon = strrchr(ref, ':');
     int ch = -1;
-    for (int k = 0; k < 5; k++)
-        if (strcmp(output, outputs[k]) == 0)
+    for (int k = 0; colon && k < 5; k++)
+        if (strcmp(colon + 1, outputs[k]) == 0)
             ch = k == 4 ? 0 : k;
-    const ShaderRec *base = r->shaders;
-    while (base && !(base->pattern[0] && strcmp(base->pattern, name) == 0))
-        base = base->next;
-    if (ch < 0 || !base || !base->channels || strlen(ref) >= sizeof base->pattern ||
-        base->n >= 15 || !r->sink->pattern)
-        return name;
+    char base_ref[160], base_buf[160];
+    if (ch < 0 || (size_t)(colon - ref) >= sizeof base_ref)
+        return rib_pattern_name(r, ref, buf, size);
+    memcpy(base_ref, ref, (size_t)(colon - ref));
+    base_ref[colon - ref] = '\0';
+    /* the image: the pattern of that name, or the one a stand-in passes on */
+    const char *name = rib_pattern_name(r, base_ref, base_buf, sizeof base_buf);
+    if (!name)
+        return rib_pattern_name(r, ref, buf, size);
+    if (strlen(name) >= size)
+        return NULL;
+    memcpy(buf, name, strlen(name) + 1);
+    const ShaderRec *base = sent_as(r, name);
+    if (!base || !base->channels || strlen(ref) >= sizeof base->pattern || base->n >= 15 ||
+        !r->sink->pattern)
+        return buf;
+    /* the channel's own pattern, made once per definition of the image (a
+     * name used again for another texture gets its own) */
+    const ShaderRec *made = sent_as(r, ref);
+    if (made && made->of == base)
+        return ref;
     RayesParam q[16];
     size_t n = 0;
     for (size_t k = 0; k < base->n; k++)
@@ -376,9 +397,10 @@ const char *rib_pattern_ref(Rib *r, const char *ref, char *buf, size_t size)
     const IoSink *s = r->sink;
     if (!v || s->set_transform(s->target, r->a.M) != RAYES_OK ||
         s->pattern(s->target, ref, v->name, v->params, v->n) != RAYES_OK)
-        return name; /* the image's colour, as before */
+        return buf; /* the image's colour, as before */
     r->real.have_M = 0;
     snprintf(v->pattern, sizeof v->pattern, "%s", ref);
+    v->of = base;
     return ref;
 }
 

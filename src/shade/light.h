@@ -26,8 +26,8 @@
  * "Motion blur and depth of field").
  *
  * Memory: a Light owns its map or mesh (light_fini frees them).
- * Thread-safety: every function but light_env_load, light_mesh_init and
- * light_fini only reads the light.
+ * Thread-safety: every function but light_env_load, light_env_sky,
+ * light_mesh_init and light_fini only reads the light.
  */
 #ifndef RAYES_SHADE_LIGHT_H
 #define RAYES_SHADE_LIGHT_H

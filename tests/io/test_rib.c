@@ -647,6 +647,23 @@ static void test_patterns(void)
     CHECK(strcmp(rec.pattern_log, "imagemap nm(filename=n.tx,encoding=linear,uscale=1,udelta=0,"
                                   "vscale=-1,vdelta=1,);") == 0);
     CHECK(strcmp(rec.shader_pattern, "normalmap=nm") == 0);
+    /* a texture's name used again: its alpha is the new texture's */
+    rec.pattern_log[0] = '\0';
+    CHECK(parse(WORLD("Pattern \"PxrTexture\" \"tex\" \"string filename\" [\"a.tex\"]\n"
+                      "Pattern \"PxrMix\" \"m1\" \"reference float mix\" [\"tex:resultA\"]\n"
+                      "Pattern \"PxrTexture\" \"tex\" \"string filename\" [\"b.tex\"]\n"
+                      "Pattern \"PxrMix\" \"m2\" \"reference float mix\" [\"tex:resultA\"]\n"
+                      "Pattern \"PxrMix\" \"m3\" \"reference float mix\" [\"tex:resultA\"]\n")) ==
+          RAYES_OK);
+    const char *second = strstr(rec.pattern_log, "imagemap tex:resultA(filename=b.tex");
+    CHECK(strstr(rec.pattern_log, "imagemap tex:resultA(filename=a.tex") != NULL && second);
+    CHECK(second && strstr(second + 1, "imagemap tex:resultA") == NULL); /* m3 reuses it */
+    /* a stand-in passing a pattern on, referenced by its bare name */
+    CHECK(parse(WORLD("Pattern \"checkerboard\" \"img\"\n"
+                      "Pattern \"foo\" \"f\" \"reference pattern inputRGB\" [\"img\"]\n"
+                      "Surface \"diffuse\" \"reference pattern reflectance\" [\"f\"]\n"
+                      "Polygon \"P\" [0 0 0 1 0 0 1 1 0]")) == RAYES_OK);
+    CHECK(strcmp(rec.shader_pattern, "reflectance=img") == 0);
     /* PxrExposure: its input times 2^stops; an unbuilt class after it
      * (PxrColorCorrect) passes the pattern of its input on */
     rec.pattern_log[0] = '\0';

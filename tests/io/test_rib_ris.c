@@ -215,6 +215,13 @@ static void test_lights(void)
         CHECK_NEAR(param(&rec.light[0], "sundirection", 1), 1, 1e-6);
         CHECK_NEAR(param(&rec.light[0], "haziness", 0), 4, 1e-6);
     }
+    /* a date's sun in that frame: the heliodon's +y zenith as it is (the
+     * June noon at 40 degrees north, 73 degrees up) */
+    CHECK(
+        rib(WORLD("Rotate -90 1 0 0\nLight \"PxrEnvDayLight\" \"d\" \"int month\" [6] \"int day\" "
+                  "[21] \"float hour\" [12] \"float zone\" [-8] \"float latitude\" [40] \"float "
+                  "longitude\" [-120]\n" TRI)) == RAYES_OK);
+    CHECK(rec.n_light == 2 && param(&rec.light[0], "sundirection", 1) > 0.9f);
     /* disks and spheres of diameter 1 */
     CHECK(rib(WORLD("Light \"PxrSphereLight\" \"b\"\nLight \"PxrDiskLight\" \"d\"\n" TRI)) ==
           RAYES_OK);
