@@ -68,7 +68,7 @@ test-asan:
 # A test file that marks some cases TEST_THREADS (tests/test.h) runs only
 # those here: the images and numbers of the rest are checked by the Release
 # and AddressSanitizer builds at a twentieth of the cost.
-TSAN_TESTS = cache_test_cache cache_test_cache_stress util_test_math util_test_half \
+TSAN_TESTS = cache_test_cache cache_test_cache_stress util_test_math util_test_half util_test_sky \
              shade_test_plugin shade_test_texture_threads render_test_hider \
              render_test_determinism render_test_adaptive render_test_session render_test_opacity render_test_volume \
              render_test_subsurface render_test_instances render_test_motion render_test_dof render_test_pbgi \
