@@ -112,6 +112,17 @@ static inline void test_lattice_triangles(int n, int *nv, int *idx)
         }
 }
 
+/* Writes text to the file at path (a CHECK fails if it cannot be made). */
+static inline void test_write_text(const char *path, const char *text)
+{
+    FILE *f = fopen(path, "wb");
+    CHECK(f != NULL);
+    if (f) {
+        fputs(text, f);
+        fclose(f);
+    }
+}
+
 #define TEST_MAIN(...)                                                                 \
     int main(void)                                                                     \
     {                                                                                  \

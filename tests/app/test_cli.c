@@ -412,16 +412,6 @@ static void test_shader_path(void)
     CHECK(r.status == 0 && strstr(r.err, "\"brick\" is neither built in nor a plugin") != NULL);
 }
 
-static void write_text(const char *path, const char *text)
-{
-    FILE *f = fopen(path, "wb");
-    CHECK(f != NULL);
-    if (f) {
-        fputs(text, f);
-        fclose(f);
-    }
-}
-
 /* Nonzero if SCRATCH_DIR holds a file whose name contains part. */
 static int scratch_has(const char *part)
 {
@@ -444,7 +434,7 @@ static void test_render_obj(void)
 {
     static Run r;
     setup();
-    write_text(SCRATCH_DIR "/room.obj", OBJ_SCENE);
+    test_write_text(SCRATCH_DIR "/room.obj", OBJ_SCENE);
     remove(SCRATCH_DIR "/room.png");
     remove(SCRATCH_DIR "/room.exr");
     run(&r, NULL,
@@ -467,12 +457,12 @@ static void test_rib_grid_size(void)
     static Run r;
     char json[8192];
     setup();
-    write_text(SCRATCH_DIR "/grid.rib", "Option \"limits\" \"gridsize\" [32]\n"
-                                        "Option \"limits\" \"texturememory\" [2048]\n"
-                                        "Projection \"perspective\" \"fov\" 40\n"
-                                        "WorldBegin\nLightSource \"pointlight\" 1\n"
-                                        "Translate 0 0 5\nSphere 1 -1 1 360\n"
-                                        "WorldEnd\n");
+    test_write_text(SCRATCH_DIR "/grid.rib", "Option \"limits\" \"gridsize\" [32]\n"
+                                             "Option \"limits\" \"texturememory\" [2048]\n"
+                                             "Projection \"perspective\" \"fov\" 40\n"
+                                             "WorldBegin\nLightSource \"pointlight\" 1\n"
+                                             "Translate 0 0 5\nSphere 1 -1 1 360\n"
+                                             "WorldEnd\n");
     run(&r, NULL, ARGS("render", SCRATCH_DIR "/grid.rib", "--res", "16", "--spp", "1", "--quiet",
                        "-o", SCRATCH_DIR "/grid.png", "--stats", SCRATCH_DIR "/grid.json"));
     CHECK(r.status == 0 && r.err[0] == '\0');
@@ -495,11 +485,11 @@ static void test_spp_over_file_sampling(void)
     static Run r;
     char json[8192];
     setup();
-    write_text(SCRATCH_DIR "/adapt.rib", "Hider \"raytrace\" \"int minsamples\" [4] "
-                                         "\"int maxsamples\" [512]\nPixelVariance 0.0001\n"
-                                         "Projection \"perspective\" \"fov\" 40\n"
-                                         "WorldBegin\nLightSource \"pointlight\" 1\n"
-                                         "Translate 0 0 5\nSphere 1 -1 1 360\nWorldEnd\n");
+    test_write_text(SCRATCH_DIR "/adapt.rib", "Hider \"raytrace\" \"int minsamples\" [4] "
+                                              "\"int maxsamples\" [512]\nPixelVariance 0.0001\n"
+                                              "Projection \"perspective\" \"fov\" 40\n"
+                                              "WorldBegin\nLightSource \"pointlight\" 1\n"
+                                              "Translate 0 0 5\nSphere 1 -1 1 360\nWorldEnd\n");
     run(&r, NULL,
         ARGS("render", SCRATCH_DIR "/adapt.rib", "--res", "16x16", "--spp", "2", "--quiet", "-o",
              SCRATCH_DIR "/adapt.png", "--stats", SCRATCH_DIR "/adapt.json"));
@@ -524,9 +514,10 @@ static void test_res_width_keeps_aspect(void)
 {
     static Run r;
     setup();
-    write_text(SCRATCH_DIR "/wide.rib", "Format 64 36 1\nProjection \"perspective\" \"fov\" 40\n"
-                                        "WorldBegin\nLightSource \"pointlight\" 1\n"
-                                        "Translate 0 0 5\nSphere 1 -1 1 360\nWorldEnd\n");
+    test_write_text(SCRATCH_DIR "/wide.rib",
+                    "Format 64 36 1\nProjection \"perspective\" \"fov\" 40\n"
+                    "WorldBegin\nLightSource \"pointlight\" 1\n"
+                    "Translate 0 0 5\nSphere 1 -1 1 360\nWorldEnd\n");
     const struct {
         const char *res;
         int w, h;
@@ -561,10 +552,10 @@ static void test_png_curve(void)
 {
     static Run r;
     setup();
-    write_text(SCRATCH_DIR "/grey.rib", "Projection \"perspective\" \"fov\" 10\n"
-                                        "WorldBegin\nLightSource \"ambientlight\" 1 "
-                                        "\"intensity\" 0.25\nSurface \"matte\"\n"
-                                        "Translate 0 0 5\nSphere 1 -1 1 360\nWorldEnd\n");
+    test_write_text(SCRATCH_DIR "/grey.rib", "Projection \"perspective\" \"fov\" 10\n"
+                                             "WorldBegin\nLightSource \"ambientlight\" 1 "
+                                             "\"intensity\" 0.25\nSurface \"matte\"\n"
+                                             "Translate 0 0 5\nSphere 1 -1 1 360\nWorldEnd\n");
     float *px[2] = {NULL, NULL};
     const char *curve[2] = {"linear", "srgb"};
     for (int k = 0; k < 2; k++) {
@@ -595,11 +586,11 @@ static void test_rib_opacity_cache_memory(void)
     static Run r;
     char json[8192];
     setup();
-    write_text(SCRATCH_DIR "/ocm.rib", "Option \"limits\" \"opacitycachememory\" [2048]\n"
-                                       "Projection \"perspective\" \"fov\" 40\n"
-                                       "WorldBegin\nLightSource \"pointlight\" 1\n"
-                                       "Translate 0 0 5\nSphere 1 -1 1 360\n"
-                                       "WorldEnd\n");
+    test_write_text(SCRATCH_DIR "/ocm.rib", "Option \"limits\" \"opacitycachememory\" [2048]\n"
+                                            "Projection \"perspective\" \"fov\" 40\n"
+                                            "WorldBegin\nLightSource \"pointlight\" 1\n"
+                                            "Translate 0 0 5\nSphere 1 -1 1 360\n"
+                                            "WorldEnd\n");
     run(&r, NULL,
         ARGS("render", SCRATCH_DIR "/ocm.rib", "--res", "8", "--spp", "1", "--quiet", "-o",
              SCRATCH_DIR "/ocm.png", "--stats", SCRATCH_DIR "/ocm.json"));
@@ -625,10 +616,10 @@ static void test_vertex_budget(void)
     static Run r;
     char json[8192];
     setup();
-    write_text(SCRATCH_DIR "/budget.rib", "Projection \"perspective\" \"fov\" 40\n"
-                                          "WorldBegin\nLightSource \"pointlight\" 1\n"
-                                          "Translate 0 0 5\nSphere 1 -1 1 360\n"
-                                          "WorldEnd\n");
+    test_write_text(SCRATCH_DIR "/budget.rib", "Projection \"perspective\" \"fov\" 40\n"
+                                               "WorldBegin\nLightSource \"pointlight\" 1\n"
+                                               "Translate 0 0 5\nSphere 1 -1 1 360\n"
+                                               "WorldEnd\n");
     /* 64 x 48 (RIB's 4:3): the sphere's grid sizes come in steps, and a
      * round of coarsening that saved nothing once stopped at 1156 */
     run(&r, NULL,
@@ -650,10 +641,10 @@ static void test_null_displacement(void)
 {
     static Run r;
     setup();
-    write_text(SCRATCH_DIR "/null.rib", "Projection \"perspective\" \"fov\" 40\n"
-                                        "WorldBegin\nLightSource \"pointlight\" 1\n"
-                                        "Displacement \"bumpy\"\nDisplacement \"null\"\n"
-                                        "Translate 0 0 5\nSphere 1 -1 1 360\nWorldEnd\n");
+    test_write_text(SCRATCH_DIR "/null.rib", "Projection \"perspective\" \"fov\" 40\n"
+                                             "WorldBegin\nLightSource \"pointlight\" 1\n"
+                                             "Displacement \"bumpy\"\nDisplacement \"null\"\n"
+                                             "Translate 0 0 5\nSphere 1 -1 1 360\nWorldEnd\n");
     run(&r, NULL,
         ARGS("render", SCRATCH_DIR "/null.rib", "--res", "16", "--spp", "1", "--quiet", "-o",
              SCRATCH_DIR "/null.png"));
@@ -663,7 +654,7 @@ static void test_null_displacement(void)
 /* Renders RIB text at 16 x 16, 1 sample, into r; it must succeed. */
 static void render_rib_text(Run *r, const char *text)
 {
-    write_text(SCRATCH_DIR "/text.rib", text);
+    test_write_text(SCRATCH_DIR "/text.rib", text);
     run(r, NULL,
         ARGS("render", SCRATCH_DIR "/text.rib", "--res", "16", "--spp", "1", "--quiet", "-o",
              SCRATCH_DIR "/text.png"));
@@ -726,12 +717,12 @@ static void test_default_light(void)
 {
     static Run r;
     setup();
-    write_text(SCRATCH_DIR "/dark.rib", "Projection \"perspective\" \"fov\" 40\n"
-                                        "WorldBegin\nTranslate 0 0 5\nSurface \"matte\"\n"
-                                        "Sphere 1 -1 1 360\nWorldEnd\n");
-    write_text(SCRATCH_DIR "/nosurface.rib", "Projection \"perspective\" \"fov\" 40\n"
-                                             "WorldBegin\nTranslate 0 0 5\nSphere 1 -1 1 360\n"
-                                             "WorldEnd\n");
+    test_write_text(SCRATCH_DIR "/dark.rib", "Projection \"perspective\" \"fov\" 40\n"
+                                             "WorldBegin\nTranslate 0 0 5\nSurface \"matte\"\n"
+                                             "Sphere 1 -1 1 360\nWorldEnd\n");
+    test_write_text(SCRATCH_DIR "/nosurface.rib", "Projection \"perspective\" \"fov\" 40\n"
+                                                  "WorldBegin\nTranslate 0 0 5\nSphere 1 -1 1 360\n"
+                                                  "WorldEnd\n");
     run(&r, NULL,
         ARGS("render", SCRATCH_DIR "/nosurface.rib", "--res", "16", "--spp", "1", "--quiet", "-o",
              SCRATCH_DIR "/nosurface.exr"));
@@ -800,7 +791,7 @@ static void test_convert(void)
     CHECK(r.status == 0);
     CHECK(same_file(SCRATCH_DIR "/builtin.exr", SCRATCH_DIR "/converted.exr"));
     /* a scene file converts too, and says what it wrote */
-    write_text(SCRATCH_DIR "/room.obj", OBJ_SCENE);
+    test_write_text(SCRATCH_DIR "/room.obj", OBJ_SCENE);
     run(&r, NULL, ARGS("convert", SCRATCH_DIR "/room.obj", SCRATCH_DIR "/room.rib"));
     CHECK(r.status == 0 && strstr(r.out, "room.rib") != NULL);
     CHECK(file_size(SCRATCH_DIR "/room.rib") > 100);
@@ -817,7 +808,7 @@ static void test_convert(void)
 static void test_bad_scene_file(void)
 {
     setup();
-    write_text(SCRATCH_DIR "/bad.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 4\n");
+    test_write_text(SCRATCH_DIR "/bad.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 4\n");
     remove(SCRATCH_DIR "/bad.png");
     remove(SCRATCH_DIR "/bad.rib");
     expect_error(1, NULL,
@@ -850,7 +841,7 @@ static void test_frames_and_crop(void)
                  f, f - 2);
         strcat(rib, frame);
     }
-    write_text(SCRATCH_DIR "/frames.rib", rib);
+    test_write_text(SCRATCH_DIR "/frames.rib", rib);
     for (int f = 1; f <= 3; f++) {
         char path[256];
         snprintf(path, sizeof path, SCRATCH_DIR "/fr.%04d.png", f);
@@ -908,10 +899,11 @@ static void test_background_imager(void)
 {
     static Run r;
     setup();
-    write_text(SCRATCH_DIR "/bg.rib",
-               "Format 16 16 1\nExposure 1 2\nImager \"background\" \"color bgcolor\" [0.25 0 1]\n"
-               "WorldBegin\nSurface \"constant\"\nColor [0 1 0]\nTranslate 0 0 5\n"
-               "Sphere 0.5 -0.5 0.5 360\nWorldEnd\n");
+    test_write_text(
+        SCRATCH_DIR "/bg.rib",
+        "Format 16 16 1\nExposure 1 2\nImager \"background\" \"color bgcolor\" [0.25 0 1]\n"
+        "WorldBegin\nSurface \"constant\"\nColor [0 1 0]\nTranslate 0 0 5\n"
+        "Sphere 0.5 -0.5 0.5 360\nWorldEnd\n");
     run(&r, NULL,
         ARGS("render", SCRATCH_DIR "/bg.rib", "--spp", "4", "--quiet", "-o",
              SCRATCH_DIR "/bg.exr"));
@@ -948,12 +940,12 @@ static void test_display_modes(void)
 {
     static Run r;
     setup();
-    write_text(SCRATCH_DIR "/modes.rib",
-               "Format 8 8 1\nDisplay \"" SCRATCH_DIR "/modes-rgb.png\" \"file\" \"rgb\"\n"
-               "Display \"+" SCRATCH_DIR "/modes-rgba.png\" \"file\" \"rgba\"\n"
-               "Display \"+" SCRATCH_DIR "/modes-rgb.exr\" \"file\" \"rgb\"\n"
-               "WorldBegin\nSurface \"constant\"\nTranslate 0 0 5\nSphere 0.5 -0.5 0.5 360\n"
-               "WorldEnd\n");
+    test_write_text(SCRATCH_DIR "/modes.rib",
+                    "Format 8 8 1\nDisplay \"" SCRATCH_DIR "/modes-rgb.png\" \"file\" \"rgb\"\n"
+                    "Display \"+" SCRATCH_DIR "/modes-rgba.png\" \"file\" \"rgba\"\n"
+                    "Display \"+" SCRATCH_DIR "/modes-rgb.exr\" \"file\" \"rgb\"\n"
+                    "WorldBegin\nSurface \"constant\"\nTranslate 0 0 5\nSphere 0.5 -0.5 0.5 360\n"
+                    "WorldEnd\n");
     run(&r, NULL, ARGS("render", SCRATCH_DIR "/modes.rib", "--spp", "1", "--quiet"));
     CHECK(r.status == 0);
     CHECK(png_colour_type(SCRATCH_DIR "/modes-rgb.png") == 2);

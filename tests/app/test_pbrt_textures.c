@@ -27,12 +27,7 @@ static void write_text(const char *name, const char *text)
 {
     char path[512];
     snprintf(path, sizeof path, "%s/%s", TMP, name);
-    FILE *f = fopen(path, "w");
-    CHECK(f != NULL);
-    if (f) {
-        fputs(text, f);
-        fclose(f);
-    }
+    test_write_text(path, text);
 }
 
 /* An equal-area octahedral map (pbrt-v4's infinite light), 64 x 64:

@@ -23,12 +23,7 @@ static void write_text(const char *name, const char *text)
 {
     char path[600];
     snprintf(path, sizeof path, DIR "/%s", name);
-    FILE *f = fopen(path, "w");
-    CHECK(f != NULL);
-    if (f) {
-        fputs(text, f);
-        fclose(f);
-    }
+    test_write_text(path, text);
 }
 
 /* Runs "rayes view ARGS" in DIR with env before it; returns the exit

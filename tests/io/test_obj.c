@@ -41,16 +41,6 @@ static RayesError parse(const char *name, const char *text)
     return e;
 }
 
-static void write_file(const char *path, const char *text)
-{
-    FILE *f = fopen(path, "wb");
-    CHECK(f != NULL);
-    if (f) {
-        fputs(text, f);
-        fclose(f);
-    }
-}
-
 /* The point of corner c of face f of mesh m. */
 static const float *corner(const RecMesh *m, size_t f, int c)
 {
@@ -153,12 +143,12 @@ static void test_materials(void)
 {
     mkdir(RAYES_TEST_TMP, 0777);
     mkdir(DIR, 0777);
-    write_file(DIR "/m.mtl", "# materials\n"
-                             "newmtl red\nKd 0.6 0.1 0.05\nd 1\nillum 1\n"
-                             "newmtl shiny\nKd 0.2 0.3 0.4\nKs 0.5 0.5 0.5\nNs 40\nillum 2\n"
-                             "newmtl wood\nKd 1 1 1\nmap_Kd -s 2 2 1 wood.png\n"
-                             "newmtl lamp\nKd 0 0 0\nKe 5 4 3\n"
-                             "newmtl panel\nKe 1 2 3\n");
+    test_write_text(DIR "/m.mtl", "# materials\n"
+                                  "newmtl red\nKd 0.6 0.1 0.05\nd 1\nillum 1\n"
+                                  "newmtl shiny\nKd 0.2 0.3 0.4\nKs 0.5 0.5 0.5\nNs 40\nillum 2\n"
+                                  "newmtl wood\nKd 1 1 1\nmap_Kd -s 2 2 1 wood.png\n"
+                                  "newmtl lamp\nKd 0 0 0\nKe 5 4 3\n"
+                                  "newmtl panel\nKe 1 2 3\n");
     static const char text[] = "mtllib m.mtl\n"
                                "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\n"
                                "usemtl red\nf 1 2 3\n"
@@ -292,15 +282,15 @@ static void test_errors(void)
     /* an MTL error names the MTL file */
     mkdir(RAYES_TEST_TMP, 0777);
     mkdir(DIR, 0777);
-    write_file(DIR "/bad.mtl", "newmtl a\nKd 1 0.5\n");
+    test_write_text(DIR "/bad.mtl", "newmtl a\nKd 1 0.5\n");
     CHECK(parse(DIR "/b.obj", "mtllib bad.mtl\n") == RAYES_ERROR_PARSE);
     CHECK(strstr(err, DIR "/bad.mtl:2:9: expected the third colour component") == err);
     CHECK(rec.calls == 0);
-    write_file(DIR "/bad.mtl", "Kd 1 0.5 1\n");
+    test_write_text(DIR "/bad.mtl", "Kd 1 0.5 1\n");
     CHECK(parse(DIR "/b.obj", "mtllib bad.mtl\n") == RAYES_ERROR_PARSE);
     CHECK(strstr(err, DIR "/bad.mtl:1:1: expected newmtl") == err);
     /* a negative emission would be a negative area light (fuzz) */
-    write_file(DIR "/bad.mtl", "newmtl a\nKe 1 -1 1\n");
+    test_write_text(DIR "/bad.mtl", "newmtl a\nKe 1 -1 1\n");
     CHECK(parse(DIR "/b.obj", "mtllib bad.mtl\n") == RAYES_ERROR_PARSE);
     CHECK(strstr(err, DIR "/bad.mtl:2:1: Ke: an emission must not be negative") == err);
 }
@@ -319,7 +309,7 @@ static void test_read_file(void)
 {
     mkdir(RAYES_TEST_TMP, 0777);
     mkdir(DIR, 0777);
-    write_file(DIR "/t.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+    test_write_text(DIR "/t.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
     IoSink sink = record_sink(&rec);
     IoSettings st;
     io_settings_init(&st);

@@ -404,16 +404,6 @@ static void xform_point(const float m[16], const float p[3], float out[3])
         out[r] = m[4 * r] * p[0] + m[4 * r + 1] * p[1] + m[4 * r + 2] * p[2] + m[4 * r + 3];
 }
 
-static void write_file(const char *path, const char *text)
-{
-    FILE *f = fopen(path, "wb");
-    CHECK(f != NULL);
-    if (f) {
-        fputs(text, f);
-        fclose(f);
-    }
-}
-
 /* ------------------------------------------------------------- tests */
 
 static void test_cornell_box(void)
@@ -743,12 +733,13 @@ static void test_instances_include_ply(void)
     IoSettings s;
     char err[512] = "", path[512], text[2048];
     snprintf(path, sizeof path, "%s/test_pbrt_quad.ply", RAYES_TEST_TMP);
-    write_file(path, "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\n"
-                     "property float y\nproperty float z\nelement face 1\n"
-                     "property list uchar int vertex_indices\nend_header\n"
-                     "0 0 0\n1 0 0\n1 1 0\n0 1 0\n4 0 1 2 3\n");
+    test_write_text(path, "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\n"
+                          "property float y\nproperty float z\nelement face 1\n"
+                          "property list uchar int vertex_indices\nend_header\n"
+                          "0 0 0\n1 0 0\n1 1 0\n0 1 0\n4 0 1 2 3\n");
     snprintf(path, sizeof path, "%s/test_pbrt_inc.pbrt", RAYES_TEST_TMP);
-    write_file(path, "# included\nShape \"plymesh\" \"string filename\" \"test_pbrt_quad.ply\"\n");
+    test_write_text(path,
+                    "# included\nShape \"plymesh\" \"string filename\" \"test_pbrt_quad.ply\"\n");
     snprintf(text, sizeof text,
              "WorldBegin\n"
              "ObjectBegin \"thing\"\n"
@@ -785,7 +776,7 @@ static void test_instances_include_ply(void)
     CHECK(e == RAYES_OK && r->n_area == 2 && r->n_meshes == 0);
     /* an error inside an included file names that file */
     snprintf(path, sizeof path, "%s/test_pbrt_bad.pbrt", RAYES_TEST_TMP);
-    write_file(path, "\n  Shape \"sphere\" \"float radius\" [ \"x\" ]\n");
+    test_write_text(path, "\n  Shape \"sphere\" \"float radius\" [ \"x\" ]\n");
     snprintf(path, sizeof path, "%s/test_pbrt_main.pbrt", RAYES_TEST_TMP);
     e = parse(path, "WorldBegin\nInclude \"test_pbrt_bad.pbrt\"\n", r, &s, err, sizeof err);
     CHECK(e == RAYES_ERROR_PARSE && strstr(err, "test_pbrt_bad.pbrt:2:35: expected a float "
@@ -794,7 +785,7 @@ static void test_instances_include_ply(void)
      * included file takes the parameters that follow the Include, and an
      * error after it names the including file again */
     snprintf(path, sizeof path, "%s/test_pbrt_tail.pbrt", RAYES_TEST_TMP);
-    write_file(path, "Shape \"sphere\"");
+    test_write_text(path, "Shape \"sphere\"");
     snprintf(path, sizeof path, "%s/test_pbrt_main.pbrt", RAYES_TEST_TMP);
     e = parse(path, "WorldBegin\nInclude \"test_pbrt_tail.pbrt\"\n  \"float radius\" 3\n"
                     "Shape \"sphere\"\n", r, &s, err, sizeof err);
@@ -826,16 +817,16 @@ static void test_instances_include_ply(void)
     snprintf(sub, sizeof sub, "%s/test_pbrt_sub", RAYES_TEST_TMP);
     mkdir(sub, 0777);
     snprintf(path, sizeof path, "%s/test_pbrt_sub/a.pbrt", RAYES_TEST_TMP);
-    write_file(path, "Include \"test_pbrt_sub/b.pbrt\"\n"
-                     "Shape \"plymesh\" \"string filename\" \"test_pbrt_quad.ply\"\n");
+    test_write_text(path, "Include \"test_pbrt_sub/b.pbrt\"\n"
+                          "Shape \"plymesh\" \"string filename\" \"test_pbrt_quad.ply\"\n");
     snprintf(path, sizeof path, "%s/test_pbrt_sub/b.pbrt", RAYES_TEST_TMP);
-    write_file(path, "Shape \"plymesh\" \"string filename\" \"test_pbrt_quad.ply\"\n");
+    test_write_text(path, "Shape \"plymesh\" \"string filename\" \"test_pbrt_quad.ply\"\n");
     snprintf(path, sizeof path, "%s/test_pbrt_main.pbrt", RAYES_TEST_TMP);
     e = parse(path, "WorldBegin\nInclude \"test_pbrt_sub/a.pbrt\"\n", r, &s, err, sizeof err);
     CHECK(e == RAYES_OK && r->n_meshes == 2);
     /* a file including itself stops at the depth limit */
     snprintf(path, sizeof path, "%s/test_pbrt_self.pbrt", RAYES_TEST_TMP);
-    write_file(path, "Include \"test_pbrt_self.pbrt\"\nInclude \"test_pbrt_self.pbrt\"\n");
+    test_write_text(path, "Include \"test_pbrt_self.pbrt\"\nInclude \"test_pbrt_self.pbrt\"\n");
     e = parse(path, "WorldBegin\nInclude \"test_pbrt_self.pbrt\"\n", r, &s, err, sizeof err);
     CHECK(e == RAYES_ERROR_PARSE && strstr(err, "nested Include") != NULL);
     free(r);
@@ -1086,11 +1077,12 @@ static void test_normals_and_uv(void)
     CHECK_NEAR(r->st0[0], 0.5, 0);
     CHECK_NEAR(r->st0[1], 1, 0);
     snprintf(path, sizeof path, "%s/test_pbrt_nuv.ply", RAYES_TEST_TMP);
-    write_file(path, "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\n"
-                     "property float y\nproperty float z\nproperty float nx\nproperty float ny\n"
-                     "property float nz\nproperty float u\nproperty float v\nelement face 1\n"
-                     "property list uchar int vertex_indices\nend_header\n"
-                     "0 0 0 0 0 1 0.5 0.25\n1 0 0 0 0 1 1 0\n0 1 0 0 0 1 0 1\n3 0 1 2\n");
+    test_write_text(path,
+                    "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\n"
+                    "property float y\nproperty float z\nproperty float nx\nproperty float ny\n"
+                    "property float nz\nproperty float u\nproperty float v\nelement face 1\n"
+                    "property list uchar int vertex_indices\nend_header\n"
+                    "0 0 0 0 0 1 0.5 0.25\n1 0 0 0 0 1 1 0\n0 1 0 0 0 1 0 1\n3 0 1 2\n");
     char text[1024];
     snprintf(text, sizeof text, "WorldBegin\nShape \"plymesh\" \"string filename\" \"%s\"\n",
              path);
@@ -1160,10 +1152,10 @@ static void test_import(void)
     Rec *r = malloc(sizeof *r);
     char path[512];
     snprintf(path, sizeof path, "%s/test_pbrt_import.pbrt", RAYES_TEST_TMP);
-    write_file(path, "# imported\nShape \"sphere\" \"float radius\" 2\n"
-                     "Shape \"trianglemesh\" \"point3 P\" [0 0 0 1 0 0 0 1 0]\n");
+    test_write_text(path, "# imported\nShape \"sphere\" \"float radius\" 2\n"
+                          "Shape \"trianglemesh\" \"point3 P\" [0 0 0 1 0 0 0 1 0]\n");
     snprintf(path, sizeof path, "%s/test_pbrt_import_bad.pbrt", RAYES_TEST_TMP);
-    write_file(path, "\nShape \"sphere\" \"float radius\" [ \"x\" ]\n");
+    test_write_text(path, "\nShape \"sphere\" \"float radius\" [ \"x\" ]\n");
     snprintf(path, sizeof path, "%s/test_pbrt_main.pbrt", RAYES_TEST_TMP);
     ParseRun pr = {.name = path,
                    .r = r,
@@ -1476,13 +1468,14 @@ static void test_anisotropic_roughness(void)
  * lens file is an error naming it. */
 static void test_realistic_camera(void)
 {
-    write_file("test_pbrt_lens.dat",
-               "# radius sep n aperture\n35.98738 1.21638 1.54 23.716\n11.69718 9.9957 1 17.996\n"
-               "13.08714 5.12622 1.772 12.364\n-22.63294 1.76924 1.617 9.812\n"
-               "71.05802 0.8184 1 9.152\n0 2.27766 0 8.756\n-9.58584 2.43254 1.617 8.184\n"
-               "-11.28864 0.11506 1 9.152\n-166.7765 3.09606 1.713 10.648\n"
-               "-7.5911 1.32682 1.805 11.44\n-16.7662 3.98068 1 12.276\n"
-               "-7.70286 1.21638 1.617 13.42\n-11.97328 0 1 17.996\n");
+    test_write_text(
+        "test_pbrt_lens.dat",
+        "# radius sep n aperture\n35.98738 1.21638 1.54 23.716\n11.69718 9.9957 1 17.996\n"
+        "13.08714 5.12622 1.772 12.364\n-22.63294 1.76924 1.617 9.812\n"
+        "71.05802 0.8184 1 9.152\n0 2.27766 0 8.756\n-9.58584 2.43254 1.617 8.184\n"
+        "-11.28864 0.11506 1 9.152\n-166.7765 3.09606 1.713 10.648\n"
+        "-7.5911 1.32682 1.805 11.44\n-16.7662 3.98068 1 12.276\n"
+        "-7.70286 1.21638 1.617 13.42\n-11.97328 0 1 17.996\n");
     Rec *r = malloc(sizeof *r);
     IoSettings s;
     char err[512] = "";
@@ -1641,7 +1634,7 @@ static void test_spectrum_files(void)
     IoSettings s;
     char err[512] = "", path[512];
     snprintf(path, sizeof path, "%s/test_pbrt_refl.spd", RAYES_TEST_TMP);
-    write_file(path, "# reflectance\n400 0.1\n500 0.3\n600 0.5\n700 0.9 # red end\n");
+    test_write_text(path, "# reflectance\n400 0.1\n500 0.3\n600 0.5\n700 0.9 # red end\n");
     snprintf(path, sizeof path, "%s/test_pbrt_main.pbrt", RAYES_TEST_TMP);
     RayesError e = parse(path,
                          "WorldBegin\nMaterial \"diffuse\" \"spectrum reflectance\" "
@@ -1658,7 +1651,7 @@ static void test_spectrum_files(void)
         CHECK_NEAR(refl->value[2], 0.2, 1e-6); /* 450 nm */
     }
     snprintf(path, sizeof path, "%s/test_pbrt_bad.spd", RAYES_TEST_TMP);
-    write_file(path, "400 0.1\n500\n");
+    test_write_text(path, "400 0.1\n500\n");
     snprintf(path, sizeof path, "%s/test_pbrt_main.pbrt", RAYES_TEST_TMP);
     e = parse(path,
               "WorldBegin\nMaterial \"diffuse\" \"spectrum reflectance\" \"test_pbrt_bad.spd\"\n",

@@ -553,27 +553,17 @@ static void test_shaders_and_lights(void)
  * is not in the working directory (where PRMan looks) is found beside the
  * file or above it, and an archive named from the project's directory is
  * found above the including file's. */
-static void write_text(const char *path, const char *text)
-{
-    FILE *f = fopen(path, "w");
-    CHECK(f != NULL);
-    if (f) {
-        fputs(text, f);
-        fclose(f);
-    }
-}
-
 static void test_project_relative(void)
 {
     mkdir(RAYES_TEST_TMP "/proj", 0755);
     mkdir(RAYES_TEST_TMP "/proj/textures", 0755);
     mkdir(RAYES_TEST_TMP "/proj/rib", 0755);
-    write_text(RAYES_TEST_TMP "/proj/textures/wood.ppm", "P3 1 1 255 200 100 50\n");
-    write_text(RAYES_TEST_TMP "/proj/rib/geo.rib", "Polygon \"P\" [0 0 0 1 0 0 1 1 0]\n");
-    write_text(RAYES_TEST_TMP "/proj/rib/scene.rib",
-               "WorldBegin\nPattern \"PxrTexture\" \"w\" \"string filename\" "
-               "[\"textures/wood.ppm\"]\nPattern \"PxrTexture\" \"m\" \"string filename\" "
-               "[\"textures/missing.ppm\"]\nReadArchive \"rib/geo.rib\"\nWorldEnd\n");
+    test_write_text(RAYES_TEST_TMP "/proj/textures/wood.ppm", "P3 1 1 255 200 100 50\n");
+    test_write_text(RAYES_TEST_TMP "/proj/rib/geo.rib", "Polygon \"P\" [0 0 0 1 0 0 1 1 0]\n");
+    test_write_text(RAYES_TEST_TMP "/proj/rib/scene.rib",
+                    "WorldBegin\nPattern \"PxrTexture\" \"w\" \"string filename\" "
+                    "[\"textures/wood.ppm\"]\nPattern \"PxrTexture\" \"m\" \"string filename\" "
+                    "[\"textures/missing.ppm\"]\nReadArchive \"rib/geo.rib\"\nWorldEnd\n");
     memset(&rec, 0, sizeof rec);
     io_settings_init(&settings);
     IoReadOptions opt = {RAYES_TEST_DATA, -1};
