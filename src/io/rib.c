@@ -351,19 +351,10 @@ static int read_archive(Rib *r, const char *name_in)
             snprintf(path, sizeof path, "%s", name);
         /* then the directories above the including file's: the project's
          * directory, when rayes runs elsewhere */
-        char up[4096];
-        if (dir)
-            snprintf(up, sizeof up, "%.*s", dir, r->file);
-        else
-            snprintf(up, sizeof up, ".");
-        for (int k = 0; k < RIB_ARCHIVE_UP && !file_exists(path) && strlen(up) + 4 < sizeof up;
-             k++) {
-            char cand[4096];
-            strcat(up, "/..");
-            if ((size_t)snprintf(cand, sizeof cand, "%s/%s", up, name) < sizeof cand &&
-                file_exists(cand))
-                memcpy(path, cand, sizeof path);
-        }
+        char cand[4096];
+        if (!file_exists(path) &&
+            rib_find_above(r->file, name, RIB_ARCHIVE_UP, cand, sizeof cand) == 0)
+            memcpy(path, cand, sizeof path);
     }
     char err[600];
     size_t size;

@@ -517,6 +517,10 @@ int rib_texture_found(const Rib *r, const char *name);
  * directory up to 4 above it (the scene rendered from elsewhere): that
  * path; else name. */
 const char *rib_texture_source(Rib *r, const char *name);
+/* The path of a readable file name relative to the directory of file or
+ * one of the levels directories above it (the nearest), in out: 0, or -1
+ * if none holds it. */
+int rib_find_above(const char *file, const char *name, int levels, char *out, size_t size);
 /* A shader record of name with copies of the parameters p (floats arrays
  * are not taken), the attributes' to point to; NULL with the error set. */
 ShaderRec *rib_shader_rec(Rib *r, const char *name, const RayesParam *p, size_t n);

@@ -23,6 +23,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <strings.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include "io/rib_reader.h"
@@ -745,37 +746,45 @@ static int file_like(const char *name)
     return base[0] && (strchr(base, '.') || base != name);
 }
 
-/* name relative to the directory of the file being read or one of the
- * RIB_TEXTURE_UP directories above it, the first that holds it, kept in
- * r; NULL if none does. */
+int rib_find_above(const char *file, const char *name, int levels, char *out, size_t size)
+{
+    const char *slash = strrchr(file, '/');
+    char dir[4096];
+    if (slash == file)
+        snprintf(dir, sizeof dir, "/");
+    else if ((size_t)snprintf(dir, sizeof dir, "%.*s", slash ? (int)(slash - file) : 1,
+                              slash ? file : ".") >= sizeof dir)
+        return -1;
+    for (int up = 0; up <= levels; up++) {
+        struct stat st;
+        if ((size_t)snprintf(out, size, "%s/%s", dir, name) >= size)
+            return -1;
+        if (stat(out, &st) == 0 && S_ISREG(st.st_mode) && access(out, R_OK) == 0)
+            return 0;
+        if (strlen(dir) + 4 >= sizeof dir)
+            return -1;
+        strcat(dir, "/..");
+    }
+    return -1;
+}
+
+/* name beside the file being read or in one of the RIB_TEXTURE_UP
+ * directories above it, kept in r; NULL if none holds it. */
 #define RIB_TEXTURE_UP 4
 static const char *beside_scene(Rib *r, const char *name)
 {
-    const char *slash = strrchr(r->file, '/');
-    char dir[4096], path[4096];
-    if ((size_t)snprintf(dir, sizeof dir, "%.*s", slash ? (int)(slash - r->file) : 1,
-                         slash ? r->file : ".") >= sizeof dir)
+    char path[4096];
+    if (rib_find_above(r->file, name, RIB_TEXTURE_UP, path, sizeof path) != 0)
         return NULL;
-    for (int up = 0; up <= RIB_TEXTURE_UP; up++) {
-        if ((size_t)snprintf(path, sizeof path, "%s/%s", dir, name) >= sizeof path)
-            return NULL;
-        if (access(path, R_OK) == 0) {
-            for (size_t k = 0; k < r->n_found; k++) /* the same path, kept once */
-                if (strcmp(r->found[k], path) == 0)
-                    return r->found[k];
-            char *kept = rib_strdup(path);
-            if (!kept ||
-                util_grow((void **)&r->found, &r->cap_found, r->n_found, sizeof *r->found) != 0) {
-                free(kept);
-                return NULL;
-            }
-            return r->found[r->n_found++] = kept;
-        }
-        if (strlen(dir) + 4 >= sizeof dir)
-            return NULL;
-        strcat(dir, "/..");
+    for (size_t k = 0; k < r->n_found; k++) /* the same path, kept once */
+        if (strcmp(r->found[k], path) == 0)
+            return r->found[k];
+    char *kept = rib_strdup(path);
+    if (!kept || util_grow((void **)&r->found, &r->cap_found, r->n_found, sizeof *r->found) != 0) {
+        free(kept);
+        return NULL;
     }
-    return NULL;
+    return r->found[r->n_found++] = kept;
 }
 
 const char *rib_texture_source(Rib *r, const char *name)
