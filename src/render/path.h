@@ -35,6 +35,7 @@ static inline float path_footprint(RayDiff d, float t)
 }
 
 typedef struct GridShading GridShading;
+typedef struct OpacityTable OpacityTable;
 
 /* A medium under a surface as the subsurface service uses it
  * (subsurface.c): its three channels' profile constants and its lengths
@@ -67,6 +68,7 @@ typedef struct Worker {
     RenderStats stats;
     CacheLocal cache;             /* this thread's part of the radiosity cache */
     GridShading *grid_shading; /* the grid hider's shaded grids, or NULL (hider.h) */
+    OpacityTable *opacity_table; /* coarse opacity of transparent grids, or NULL (optable.h) */
     const RayesShaderServices *services; /* what shaders run here call (services.h) */
     uint64_t sharp_rays;          /* perfect mirror and refraction rays traced from points at
                                      depth 0 (the grid hider asks whether a grid's shading

@@ -38,6 +38,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "render/optable.h"
 #include "util/check.h"
 #include "util/half.h"
 #include "util/rng.h"
@@ -736,9 +737,20 @@ static Vec3 cached_at_hit(Worker *w, const Hit *hit, int type, int depth, int si
         w->set->cache_resolution < 0)
         level = effective_level(g, CACHE_MEDIUM);
     key.level = (uint8_t)level;
-    const uint16_t *vals =
-        cache_lookup(&w->cache, &key, level_values(g, level), fill_radiosity, &job);
-    return radiosity_interpolate(g, hit, level, vals);
+    size_t n = level_values(g, level);
+    if (type == CACHE_OPACITY && !moves) {
+        uint16_t scratch[3 * OPTABLE_VALUES];
+        int filled;
+        const uint16_t *vals =
+            optable_values(w->opacity_table, &key, n, fill_radiosity, &job, scratch, &filled);
+        if (vals) {
+            w->stats.table_lookups++;
+            w->stats.table_fills += (uint64_t)filled;
+            return radiosity_interpolate(g, hit, level, vals);
+        }
+    }
+    return radiosity_interpolate(g, hit, level,
+                                 cache_lookup(&w->cache, &key, n, fill_radiosity, &job));
 }
 
 Vec3 radiosity_at_hit(Worker *w, const Ray *ray, const Hit *hit, int diffuse_depth, RayDiff diff)

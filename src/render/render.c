@@ -20,6 +20,7 @@
 #include "render/envguide.h"
 #include "render/hider.h"
 #include "render/integrator.h"
+#include "render/optable.h"
 #include "render/services.h"
 #include "util/check.h"
 #include "util/rng.h"
@@ -490,6 +491,8 @@ static void merge_stats(RenderStats *into, const RenderStats *s)
     into->opacity_points += s->opacity_points;
     into->transparent_hits += s->transparent_hits;
     into->holes += s->holes;
+    into->table_lookups += s->table_lookups;
+    into->table_fills += s->table_fills;
     into->rays_transmission += s->rays_transmission;
     into->volume_steps += s->volume_steps;
     into->rays_subsurface += s->rays_subsurface;
@@ -526,12 +529,19 @@ int render_frame(const RenderScene *rs, const RenderSettings *set, float *rgba, 
         gsh = hider_new(rs, set);
         RY_CHECK(gsh != NULL);
     }
+    OpacityTable *optable = NULL;
+    if (set->cache && set->opacity_cache) {
+        CacheStats cst;
+        cache_get_stats(set->cache, &cst);
+        optable = optable_new(rs, cst.type_budget_bytes[CACHE_OPACITY]);
+    }
     uint32_t *pixels = guide_pixels(rs, set, threads);
     for (int i = 0; i < threads; i++) {
         f.workers[i] = (Worker){.split = 1.0f,
                                 .rs = rs,
                                 .set = set,
                                 .grid_shading = gsh,
+                                .opacity_table = optable,
                                 .services = &render_services,
                                 .guide_pixels = pixels};
         if (set->cache)
@@ -548,9 +558,11 @@ int render_frame(const RenderScene *rs, const RenderSettings *set, float *rgba, 
         if (set->cache)
             cache_local_fini(&f.workers[i].cache);
     }
+    stats->table_bytes = RY_MAX(stats->table_bytes, optable_bytes(optable));
     free(f.workers);
     free(pixels);
     hider_free(gsh);
+    optable_free(optable);
     pthread_mutex_destroy(&f.progress_lock);
     return atomic_load(&f.cancelled) ? 1 : 0;
 }

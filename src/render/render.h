@@ -187,6 +187,10 @@ typedef struct RenderStats {
                                   were partly transparent */
     uint64_t holes;            /* camera, specular and diffuse hits on a cut-out's hole (Os
                                   0, no opacity method), passed unshaded */
+    uint64_t table_lookups;    /* coarse opacity read from the opacity table (optable.h; not
+                                  in the cache's counters) */
+    uint64_t table_fills;      /* and the slots filled */
+    uint64_t table_bytes;      /* the table's bytes at the frame's end */
     uint64_t rays_transmission; /* shadow and transmission rays that marched a volume (also
                                    counted in rays_shadow) */
     uint64_t volume_steps;      /* ray marching steps through volumes */

@@ -105,6 +105,8 @@ RayesStats *session_stats_new(const RenderSettings *set, const RenderStats *rs, 
     count(s, "opacity/shading_points", rs->opacity_points);
     count(s, "opacity/transparent_hits", rs->transparent_hits);
     count(s, "opacity/holes", rs->holes);
+    count(s, "opacity/table_lookups", rs->table_lookups);
+    count(s, "opacity/table_fills", rs->table_fills);
     count(s, "volume/steps", rs->volume_steps);
     count(s, "subsurface/points", rs->subsurface_points);
     count(s, "subsurface/irradiance_points", rs->irradiance_points);
@@ -134,6 +136,7 @@ RayesStats *session_stats_new(const RenderSettings *set, const RenderStats *rs, 
                         gs->n_clusters * sizeof(GeomCluster) +
                         (size_t)(n_times - 1) * gs->n_motion_vertices * 4 * sizeof(Vec3);
     count(s, "memory/grid_bytes", geom_bytes);
+    count(s, "memory/opacity_table_bytes", rs->table_bytes);
     count(s, "resolution/width", (uint64_t)set->width);
     count(s, "resolution/height", (uint64_t)set->height);
     count(s, "spp", (uint64_t)set->spp);

@@ -571,10 +571,92 @@ static void test_diffuse_transmission(void)
     CHECK_NEAR(sheet("diffusetransmission", 0.25f, 0.5f, -5.0f), 0.5 * lit, 1e-4 * lit);
 }
 
+/* Cut-out squares (a checkerboard Os) over a lit floor, one placed once
+ * and three as instances of a master, with a bounce and the coarse cache
+ * level forced: shadow and diffuse rays read the squares' coarse opacity
+ * from the opacity table (optable.h). Rendered with the instances'
+ * tables and without (a budget too small for one: the cache serves them),
+ * on one thread and two, the bytes are the same. */
+static RayesImage *cutout_instances(int threads, double opacity_mb, RayesStats **st)
+{
+    RayesScene *s = new_scene();
+    floor_matte(s);
+    RayesParam cb[2] = {pf("uscale", 4.0f), pf("vscale", 4.0f)};
+    CHECK(rayes_scene_pattern(s, "cells", "checkerboard", cb, 2) == RAYES_OK);
+    RayesParam p[2] = {pf("Kd", 1.0f), (RayesParam){"Os", RAYES_PARAM_PATTERN, {0, 0, 0}, "cells"}};
+    CHECK(rayes_scene_object_begin(s, "leaf") == RAYES_OK);
+    CHECK(rayes_scene_set_shader(s, "matte", p, 2) == RAYES_OK);
+    quad_at(s, 0.1f, 0.0f);
+    CHECK(rayes_scene_object_end(s) == RAYES_OK);
+    const float at[3][3] = {{-0.5f, -0.5f, 2.0f}, {0.5f, -0.4f, 2.4f}, {0.0f, 0.5f, 2.8f}};
+    for (int k = 0; k < 4; k++) { /* then back to the identity */
+        const float m[16] = {1, 0, 0, k < 3 ? at[k][0] : 0, 0, 1, 0, k < 3 ? at[k][1] : 0,
+                             0, 0, 1, k < 3 ? at[k][2] : 0, 0, 0, 0, 1};
+        CHECK(rayes_scene_set_transform(s, m) == RAYES_OK);
+        if (k < 3)
+            CHECK(rayes_scene_object_instance(s, "leaf") == RAYES_OK);
+    }
+    CHECK(rayes_scene_set_shader(s, "matte", p, 2) == RAYES_OK);
+    quad_at(s, 0.1f, 1.6f);
+    point_light(s, 5.0f);
+    CHECK(rayes_scene_commit(s) == RAYES_OK);
+    RayesRenderOptions o;
+    rayes_render_options_init(&o, RAYES_QUALITY_PREVIEW);
+    o.width = o.height = RES;
+    o.spp = 1;
+    o.threads = threads;
+    o.bounces = 1;
+    o.opacity_cache_mb = opacity_mb;
+    o.cache_resolution = 0; /* coarse: as rays far wider than a leaf see it */
+    RayesImage *img = NULL;
+    CHECK(rayes_render(s, &o, &img, st) == RAYES_OK);
+    rayes_scene_release(s);
+    return img;
+}
+
+static unsigned long long stat_count(const RayesStats *st, const char *name)
+{
+    const RayesStat *x = st ? rayes_stats_find(st, name) : NULL;
+    return x ? x->count : 0;
+}
+
+static void test_opacity_table_same_bytes_as_cache(void)
+{
+    RayesStats *st = NULL, *small_st = NULL;
+    RayesImage *a = cutout_instances(2, 20.0, &st), *b = cutout_instances(1, 20.0, NULL);
+    RayesImage *c = cutout_instances(2, 0.0, &small_st);
+    unsigned long long lookups = stat_count(st, "opacity/table_lookups");
+    unsigned long long fills = stat_count(st, "opacity/table_fills");
+    unsigned long long small = stat_count(small_st, "opacity/table_lookups");
+    fprintf(stderr,
+            "opacity table: %llu lookups, %llu fills, %llu bytes; %llu lookups in 0 bytes; "
+            "cache %llu %llu %llu\n",
+            lookups, fills, stat_count(st, "memory/opacity_table_bytes"), small,
+            stat_count(st, "cache/opacity/coarse/lookups"),
+            stat_count(st, "cache/opacity/medium/lookups"),
+            stat_count(st, "cache/opacity/fine/lookups"));
+    /* four grids' slots (one square's, three instances'), each filled once,
+     * or twice when two threads met at it */
+    CHECK(lookups > 100 && fills >= 4 && fills <= 8);
+    CHECK(small > 0 && small < lookups); /* the world's square alone */
+    CHECK(test_cache_count(small_st, "opacity", "lookups") > 0);
+    if (a && b && c) {
+        size_t bytes = sizeof(float) * 4 * RES * RES;
+        CHECK(memcmp(a->rgba, b->rgba, bytes) == 0);
+        CHECK(memcmp(a->rgba, c->rgba, bytes) == 0);
+    }
+    rayes_stats_free(st);
+    rayes_stats_free(small_st);
+    rayes_image_free(a);
+    rayes_image_free(b);
+    rayes_image_free(c);
+}
+
 TEST_MAIN(TEST(test_stacked_sheets_multiply_in_any_order),
           TEST(test_half_transparent_sheet_halves_irradiance),
           TEST(test_ambient_occlusion_closed_forms), TEST(test_cutout_shadow_matches_geometry),
           TEST(test_cutout_shadow_from_afar_is_sharp),
           TEST(test_opacity_cache_within_noise_and_deterministic), TEST(test_camera_sees_through),
           TEST(test_grid_hider_transparent_grids), TEST(test_holes_pass_unshaded),
-          TEST(test_bad_attributes), TEST(test_thin_glass), TEST(test_diffuse_transmission))
+          TEST(test_bad_attributes), TEST(test_thin_glass), TEST(test_diffuse_transmission),
+          TEST(test_opacity_table_same_bytes_as_cache))
