@@ -39,6 +39,7 @@
 #include <string.h>
 
 #include "util/check.h"
+#include "util/rng.h"
 
 typedef struct MicroTri {
     uint32_t grid;     /* patch id */
@@ -138,13 +139,16 @@ static int add_geom(Level *lv, Geom g)
 }
 
 static void transmission_filter(const struct RTCFilterFunctionNArguments *args);
+static void keep_filter(const struct RTCFilterFunctionNArguments *args);
 
 /* Commits geom with its ray mask into the level's scene as the next
  * geometry, whose primitives map back to grids through g. */
 static int attach(Level *lv, RTCGeometry geom, uint32_t mask, Geom g)
 {
-    if (mask & ACCEL_MASK_TRANSPARENT)
+    if (mask & ACCEL_MASK_TRANSPARENT) {
         rtcSetGeometryOccludedFilterFunction(geom, transmission_filter);
+        rtcSetGeometryIntersectFilterFunction(geom, keep_filter);
+    }
     uint32_t seen = mask & ~(ACCEL_MASK_TRANSPARENT | ACCEL_MASK_OWN_SCENE);
     /* An object no ray type sees but with a scene of its own (a hidden
      * volume bound) keeps a bit that only its scene's queries carry. */
@@ -1131,22 +1135,36 @@ static void hit_normal(const Accel *a, const Ray *ray, Hit *hit)
     }
 }
 
-/* The nearest hit in scene (the world's or an object's own), under mask.
+/* What an intersection query carries: Embree hands the context to the
+ * filter of transparent objects, which keeps every hit unless keep is set
+ * (accel_intersect_stochastic). */
+typedef struct IntersectCtx {
+    struct RTCIntersectContext rtc; /* first: the filter casts back */
+    const Accel *accel;
+    const Ray *ray;
+    AccelKeepFn keep;
+    void *user;
+    uint64_t key;
+} IntersectCtx;
+
+/* The nearest hit in scene (the world's or an object's own), under mask,
+ * transparent objects' hits kept as ctx says (its ray and accel set here).
  * With embree_ng, a quad's or triangle's Ng is the one Embree found (of
  * the triangle of the cell it hit: the cell's own for a flat one, facing
  * the same way), and the micropolygon's vertices are not read. */
-static int intersect_scene(const Accel *a, RTCScene scene, const Ray *ray, uint32_t mask,
-                           int embree_ng, Hit *hit)
+static int intersect_in(const Accel *a, RTCScene scene, const Ray *ray, uint32_t mask,
+                        int embree_ng, IntersectCtx *ctx, Hit *hit)
 {
-    struct RTCIntersectContext ctx;
-    rtcInitIntersectContext(&ctx);
+    rtcInitIntersectContext(&ctx->rtc);
+    ctx->accel = a;
+    ctx->ray = ray;
     struct RTCRayHit rh;
     set_ray(a, &rh.ray, ray);
     rh.ray.mask = mask;
     rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
     rh.hit.primID = RTC_INVALID_GEOMETRY_ID;
     rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
-    rtcIntersect1(scene, &ctx, &rh);
+    rtcIntersect1(scene, &ctx->rtc, &rh);
     if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID)
         return 0;
     if (!embree_ng)
@@ -1154,6 +1172,13 @@ static int intersect_scene(const Accel *a, RTCScene scene, const Ray *ray, uint3
     else if (make_hit(a, ray, &rh.hit, rh.ray.tfar, 0, hit))
         hit->Ng = unit_or_zero(v3(rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z));
     return 1;
+}
+
+static int intersect_scene(const Accel *a, RTCScene scene, const Ray *ray, uint32_t mask,
+                           int embree_ng, Hit *hit)
+{
+    IntersectCtx ctx = {.keep = NULL};
+    return intersect_in(a, scene, ray, mask, embree_ng, &ctx, hit);
 }
 
 void accel_attach_record(Accel *a, AccelRecord *record)
@@ -1259,12 +1284,14 @@ static int intersect_solids(const Accel *a, const Ray *ray, Hit *hit)
     return 0;
 }
 
-int accel_intersect(const Accel *a, const Ray *ray, Hit *hit)
+/* The nearest hit in the world, transparent objects' hits kept as ctx
+ * says, and on the solids. */
+static int intersect_world(const Accel *a, const Ray *ray, IntersectCtx *ctx, Hit *hit)
 {
     if (a->record)
         accel_record_ray(a->record, ACCEL_QUERY_INTERSECT, 0, ray);
     int found =
-        intersect_scene(a, a->levels[0].scene, ray, ray->mask & ~ACCEL_MASK_SOLID, 0, hit);
+        intersect_in(a, a->levels[0].scene, ray, ray->mask & ~ACCEL_MASK_SOLID, 0, ctx, hit);
     if (!a->gs->n_solids)
         return found;
     Ray r = *ray;
@@ -1276,6 +1303,12 @@ int accel_intersect(const Accel *a, const Ray *ray, Hit *hit)
         return 1;
     }
     return found;
+}
+
+int accel_intersect(const Accel *a, const Ray *ray, Hit *hit)
+{
+    IntersectCtx ctx = {.keep = NULL};
+    return intersect_world(a, ray, &ctx, hit);
 }
 
 int accel_intersect_object(const Accel *a, uint32_t object, const Ray *ray, Hit *hit)
@@ -1311,12 +1344,41 @@ typedef struct TransmissionCtx {
     AccelOpacityFn opacity;
     void *user;
     Vec3 T; /* the product so far */
+    float roulette;   /* below it, crossings play Russian roulette */
+    uint64_t ray_key; /* the ray's draws derive from it */
     int n_seen;
     struct {
         unsigned inst, geom, prim;
         float t;
     } seen[TRANSMISSION_SEEN];
 } TransmissionCtx;
+
+/* A number in [0, 1) for a hit of a query whose draws derive from key:
+ * from the primitive and the place on it, so a hit Embree reports twice
+ * draws the same. */
+static float hit_draw(uint64_t key, const struct RTCHit *h)
+{
+    uint32_t u, v;
+    memcpy(&u, &h->u, sizeof u);
+    memcpy(&v, &h->v, sizeof v);
+    uint64_t prim = hash_combine(((uint64_t)h->instID[0] << 32) ^ h->geomID, h->primID);
+    return rng_float(hash_combine(hash_combine(key, prim), ((uint64_t)u << 32) | v));
+}
+
+/* A key from a ray's origin and direction (pbrt-v4 draws its stochastic
+ * alpha from the same): shadow rays carry no sample key. */
+static uint64_t ray_key(const Ray *ray)
+{
+    uint32_t b[6];
+    memcpy(&b[0], &ray->o.x, sizeof b[0]);
+    memcpy(&b[1], &ray->o.y, sizeof b[1]);
+    memcpy(&b[2], &ray->o.z, sizeof b[2]);
+    memcpy(&b[3], &ray->d.x, sizeof b[3]);
+    memcpy(&b[4], &ray->d.y, sizeof b[4]);
+    memcpy(&b[5], &ray->d.z, sizeof b[5]);
+    return hash_combine(hash_combine(((uint64_t)b[0] << 32) | b[1], ((uint64_t)b[2] << 32) | b[3]),
+                        ((uint64_t)b[4] << 32) | b[5]);
+}
 
 /* Embree's occlusion filter on transparent objects: multiplies the
  * query's transmittance by 1 - opacity and rejects the hit (traversal goes
@@ -1351,14 +1413,19 @@ static void transmission_filter(const struct RTCFilterFunctionNArguments *args)
     AccelCrossing crossing = {tc->accel, tc->ray, 0};
     crossing.no_normal = make_hit(tc->accel, tc->ray, h, tfar, 0, &hit);
     Vec3 op = tc->opacity(tc->user, tc->ray, &hit, &crossing);
-    tc->T = v3(tc->T.x * (1.0f - fminf(fmaxf(op.x, 0.0f), 1.0f)),
-               tc->T.y * (1.0f - fminf(fmaxf(op.y, 0.0f), 1.0f)),
-               tc->T.z * (1.0f - fminf(fmaxf(op.z, 0.0f), 1.0f)));
+    Vec3 t = v3(1.0f - fminf(fmaxf(op.x, 0.0f), 1.0f), 1.0f - fminf(fmaxf(op.y, 0.0f), 1.0f),
+                1.0f - fminf(fmaxf(op.z, 0.0f), 1.0f));
+    if (v3_max_component(tc->T) < tc->roulette) {
+        float q = v3_max_component(t);
+        t = hit_draw(tc->ray_key, h) < q ? v3_scale(t, 1.0f / q) : v3(0, 0, 0);
+    }
+    tc->T = v3_mul(tc->T, t);
     if (v3_max_component(tc->T) > 0.0f)
         args->valid[0] = 0; /* seen through: look further */
 }
 
-Vec3 accel_transmission(const Accel *a, const Ray *ray, AccelOpacityFn opacity, void *user)
+Vec3 accel_transmission(const Accel *a, const Ray *ray, AccelOpacityFn opacity, void *user,
+                        float roulette)
 {
     if (a->record)
         accel_record_ray(a->record, ACCEL_QUERY_TRANSMISSION, 0, ray);
@@ -1369,6 +1436,8 @@ Vec3 accel_transmission(const Accel *a, const Ray *ray, AccelOpacityFn opacity, 
     tc.opacity = opacity;
     tc.user = user;
     tc.T = v3(1, 1, 1);
+    tc.roulette = roulette;
+    tc.ray_key = roulette > 0.0f ? ray_key(ray) : 0;
     tc.n_seen = 0;
     Hit h;
     if (a->gs->n_solids && intersect_solids(a, ray, &h))
@@ -1377,6 +1446,31 @@ Vec3 accel_transmission(const Accel *a, const Ray *ray, AccelOpacityFn opacity, 
     set_ray(a, &r, ray);
     rtcOccluded1(a->levels[0].scene, &tc.rtc, &r);
     return r.tfar < 0.0f ? v3(0, 0, 0) : tc.T;
+}
+
+/* Embree's intersection filter on transparent objects: with a keep
+ * function, passes the hit unless a number drawn from the query's key and
+ * the hit falls below the probability of keeping it. */
+static void keep_filter(const struct RTCFilterFunctionNArguments *args)
+{
+    RY_CHECK(args->N == 1);
+    const IntersectCtx *ic = (const IntersectCtx *)args->context;
+    if (args->valid[0] != -1 || !ic->keep)
+        return;
+    const struct RTCHit *h = (const struct RTCHit *)args->hit;
+    float tfar = ((const struct RTCRay *)args->ray)->tfar; /* as in transmission_filter */
+    Hit hit;
+    AccelCrossing crossing = {ic->accel, ic->ray, 0};
+    crossing.no_normal = make_hit(ic->accel, ic->ray, h, tfar, 0, &hit);
+    if (!(hit_draw(ic->key, h) < ic->keep(ic->user, ic->ray, &hit, &crossing)))
+        args->valid[0] = 0;
+}
+
+int accel_intersect_stochastic(const Accel *a, const Ray *ray, AccelKeepFn keep, void *user,
+                               uint64_t key, Hit *hit)
+{
+    IntersectCtx ctx = {.keep = keep, .user = user, .key = key};
+    return intersect_world(a, ray, &ctx, hit);
 }
 
 int accel_occluded(const Accel *a, const Ray *ray)

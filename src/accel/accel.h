@@ -110,6 +110,21 @@ int accel_intersect(const Accel *accel, const Ray *ray, Hit *hit);
  * triangle hit (facing as accel_intersect's: the same for a flat cell). */
 int accel_intersect_object(const Accel *accel, uint32_t object, const Ray *ray, Hit *hit);
 
+/* The probability in [0, 1] that a transparent object's hit is kept by
+ * accel_intersect_stochastic (asked as AccelOpacityFn is, with the same
+ * hit; it must not trace rays). */
+typedef float (*AccelKeepFn)(void *user, const Ray *ray, Hit *hit, const AccelCrossing *crossing);
+
+/* accel_intersect, where each hit on a transparent object is kept with the
+ * probability keep gives it, by a number in [0, 1) drawn from key and the
+ * hit (its primitive and its place on it: the same hit, reported twice,
+ * gets the same draw), and passed otherwise: the nearest kept hit. Kept
+ * with probability a, a cut-out of opacity a is what a path tracer's
+ * stochastic alpha makes it: the ray stops at layer k with the probability
+ * that compositing the layers would weight it by, in one traversal. */
+int accel_intersect_stochastic(const Accel *accel, const Ray *ray, AccelKeepFn keep, void *user,
+                               uint64_t key, Hit *hit);
+
 /* Returns 1 if anything lies in [tnear, tfar]. */
 int accel_occluded(const Accel *accel, const Ray *ray);
 
@@ -118,8 +133,17 @@ int accel_occluded(const Accel *accel, const Ray *ray);
  * counted once (Embree may report a hit twice); an opaque object's hit, or
  * a product reaching 0, ends the query at 0. opacity is called from inside
  * Embree's traversal, on the calling thread, for transparent objects only;
- * it must not trace rays. */
-Vec3 accel_transmission(const Accel *accel, const Ray *ray, AccelOpacityFn opacity, void *user);
+ * it must not trace rays.
+ *
+ * Once the product's largest component has fallen below roulette, each
+ * further crossing of transmittance t (RGB) ends the query at 0 with
+ * probability 1 - max(t), and is otherwise counted as t / max(t): Russian
+ * roulette, the same in expectation, by a number drawn from the ray (its
+ * origin and direction) and the hit, so the same ray gives the same
+ * answer. A ray through foliage stops after a few leaves past the
+ * threshold instead of crossing them all. 0: every crossing multiplies. */
+Vec3 accel_transmission(const Accel *accel, const Ray *ray, AccelOpacityFn opacity, void *user,
+                        float roulette);
 
 /* Bytes Embree reported allocating for the structure. */
 size_t accel_memory_bytes(const Accel *accel);

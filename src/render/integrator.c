@@ -200,7 +200,9 @@ static Vec3 shade_hit(Worker *w, const Ray *ray, const Hit *hit, const RenderObj
      * thin shadow is opaque to its own light samples alone, not to those
      * of what its refraction rays reach (RAYES_SHADER_THIN_SHADOW). */
     const RenderObject *outer = w->shading;
+    int outer_depth = w->depth;
     w->shading = obj;
+    w->depth = diffuse_depth;
     if (kind == RAYES_RAY_SUBSURFACE) {
         w->stats.irradiance_points++;
         out.Irradiance = ps.irradiance = E;
@@ -218,6 +220,7 @@ static Vec3 shade_hit(Worker *w, const Ray *ray, const Hit *hit, const RenderObj
         shade_run_lighting(w->services, &ctx, obj->shader, &out);
     }
     w->shading = outer;
+    w->depth = outer_depth;
     *Oi_out = v3(Oi[0][0], Oi[0][1], Oi[0][2]);
     return v3(Ci[0][0], Ci[0][1], Ci[0][2]);
 }
@@ -285,11 +288,30 @@ Vec3 integrator_transmission(Worker *w, const Ray *ray, RayDiff diff)
         T = accel_occluded(w->rs->accel, ray) ? v3(0, 0, 0) : v3(1, 1, 1);
     } else {
         ShadowRay sr = {w, diff};
-        T = accel_transmission(w->rs->accel, ray, shadow_opacity, &sr);
+        T = accel_transmission(w->rs->accel, ray, shadow_opacity, &sr,
+                               w->depth > 0 ? INTEGRATOR_SHADOW_ROULETTE : 0.0f);
     }
     if (w->rs->n_volumes && v3_max_component(T) > 0.0f)
         T = v3_mul(T, volume_transmittance(w, ray, diff));
     return T;
+}
+
+/* AccelKeepFn of cached diffuse rays: a transparent hit of grey opacity a
+ * is kept with probability a (a coloured one always: trace_layers
+ * composites it), its opacity read as trace_layers reads it. */
+static float diffuse_keep(void *user, const Ray *ray, Hit *hit, const AccelCrossing *crossing)
+{
+    ShadowRay *sr = user;
+    Worker *w = sr->w;
+    const RenderObject *obj = render_object(w->rs, hit->grid, hit->instance);
+    if (!obj->transparent)
+        return 1.0f;
+    if (!(w->set->opacity_cache && obj->opacity_cached)) /* a shader may run at the hit */
+        accel_crossing_normal(crossing, hit);
+    Vec3 Oi = integrator_opacity(w, ray, hit, NULL, sr->diff);
+    if (Oi.x != Oi.y || Oi.y != Oi.z)
+        return 1.0f;
+    return fminf(fmaxf(Oi.x, 0.0f), 1.0f);
 }
 
 /* Surfaces a ray sees through before the next is taken as opaque. */
@@ -313,7 +335,14 @@ static Vec3 trace_layers(Worker *w, const Ray *ray, uint32_t kind, int diffuse_d
     *t = INFINITY;
     *alpha = 0.0f;
     *leaving = -1;
-    if (!accel_intersect(w->rs->accel, ray, &hit)) {
+    /* A cached diffuse ray meets cut-outs stochastically: one traversal
+     * to the layer it stops at, instead of one per layer in front of it,
+     * each looked up in the radiosity cache (foliage: a dozen; DESIGN.md
+     * "Opacity"). */
+    int stochastic = kind == RAYES_RAY_DIFFUSE && w->set->radiosity_cache && w->rs->any_transparent;
+    ShadowRay sr = {w, diff};
+    if (!(stochastic ? accel_intersect_stochastic(w->rs->accel, ray, diffuse_keep, &sr, key, &hit)
+                     : accel_intersect(w->rs->accel, ray, &hit))) {
         /* Environment lights: seen by camera and specular rays; black to
          * diffuse rays, as direct lighting integrates them. */
         Vec3 L = v3(0, 0, 0);
@@ -346,8 +375,16 @@ static Vec3 trace_layers(Worker *w, const Ray *ray, uint32_t kind, int diffuse_d
     int see_through = obj->transparent && layer < INTEGRATOR_MAX_LAYERS;
     Vec3 Ci = v3(0, 0, 0), Oi = v3(1, 1, 1);
     if (kind == RAYES_RAY_DIFFUSE && w->set->radiosity_cache) {
-        if (see_through)
+        if (obj->transparent) /* the opacity diffuse_keep kept it by */
             Oi = integrator_opacity(w, ray, &hit, NULL, diff);
+        if (obj->transparent && Oi.x == Oi.y && Oi.y == Oi.z) {
+            /* kept with probability Oi: the premultiplied radiosity over
+             * it, and nothing behind (what lay in front was passed) */
+            float a = fminf(fmaxf(Oi.x, 0.0f), 1.0f);
+            return a > 0.0f
+                       ? v3_scale(radiosity_at_hit(w, ray, &hit, diffuse_depth, diff), 1.0f / a)
+                       : v3(0, 0, 0);
+        }
         if (see_through && !obj->opacity_shader && Oi.x <= 0.0f && Oi.y <= 0.0f && Oi.z <= 0.0f)
             w->stats.holes++; /* a cut-out's hole (shade_hit's) */
         else

@@ -82,6 +82,9 @@ typedef struct Worker {
     int has_medium;
     const struct RenderObject *shading; /* the object whose shader runs (its thin shadow is
                                            opaque to it: RAYES_SHADER_THIN_SHADOW) */
+    int depth;                          /* the diffuse depth of the point being shaded (0 at a
+                                           camera ray's hit; a fill's key's): its shadow rays
+                                           play Russian roulette deeper (integrator.h) */
     float split;                        /* the rays the path being traced has split into so far (a
                                            glossy lobe's n at a camera hit: n), 1 at a camera ray
                                            and in cache fills: a path's own hit under a split of m

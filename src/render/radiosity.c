@@ -491,12 +491,14 @@ static void fill_radiosity(void *user, const CacheKey *key, size_t n, float (*ou
      * (DESIGN.md "Motion blur"). */
     float outer_time = w->time, outer_split = w->split;
     const RenderObject *outer_shading = w->shading;
+    int outer_depth = w->depth;
     const Camera *cam = &w->rs->camera;
     w->split = 1.0f; /* a fill is the same whichever path asked */
     /* and as the grid's own object, whoever asked: a fill asked for by a
      * glass's refraction ray found that glass opaque to its shadow rays (a
      * floor seen through a pane was black, and the cache kept it) */
     w->shading = obj;
+    w->depth = key->depth;
     w->time = moves ? geom_segment_mid_time(gs, key->segment)
                     : 0.5f * (cam->shutter[0] + cam->shutter[1]);
     float width = level_edge(g, key->level) * scale, du, dv;
@@ -559,6 +561,7 @@ static void fill_radiosity(void *user, const CacheKey *key, size_t n, float (*ou
     w->time = outer_time;
     w->split = outer_split;
     w->shading = outer_shading;
+    w->depth = outer_depth;
     free(f3);
     free(f1);
     free(fp.keys);

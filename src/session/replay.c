@@ -45,7 +45,7 @@ static void replay_run(void *ctx, size_t task, int worker)
             accel_occluded(rp->accel, &r->ray);
             break;
         case ACCEL_QUERY_TRANSMISSION:
-            accel_transmission(rp->accel, &r->ray, clear, NULL);
+            accel_transmission(rp->accel, &r->ray, clear, NULL, 0.0f);
             break;
         }
     }

@@ -1,6 +1,7 @@
 /* Embree hits on known geometry (accel/). */
 #include "accel/accel.h"
 
+#include <math.h>
 #include <string.h>
 
 #include "rayes/shader.h"
@@ -191,7 +192,7 @@ static void test_transmission_crossings(void)
                          {v3(22, 2, 0), v3(0, 0, 1), 0.0f, 1e9f, RAYES_RAY_SHADOW}};
     for (int k = 0; k < 2; k++) {
         Crossings c = {0};
-        Vec3 T = accel_transmission(a, &rays[k], half_clear, &c);
+        Vec3 T = accel_transmission(a, &rays[k], half_clear, &c, 0.0f);
         CHECK(c.n == 1);
         CHECK(c.no_normal == 1);
         CHECK_NEAR(T.x, 0.5, 1e-6);
@@ -252,6 +253,125 @@ static void test_stop_cancels_build(void)
     geom_gridset_fini(&gs);
 }
 
+/* Four transparent 10 x 10 squares (object 0) stacked at z = 1, 2, 3, 4,
+ * and an opaque one (object 1) at z = 5. */
+static GridSet stack(void)
+{
+    GridSet gs;
+    geom_gridset_init(&gs);
+    DiceCamera cam = {.eye = v3(0, 0, -100), .pixel_angle = 0.01f, .min_distance = 1e-3f};
+    for (int k = 1; k <= 5; k++) {
+        float z = (float)k;
+        Prim quad = {.type = PRIM_BILINEAR, .object = k == 5, .shading_rate = 1.0f};
+        quad.cp[0] = v3(-5, -5, z), quad.cp[1] = v3(5, -5, z), quad.cp[2] = v3(-5, 5, z),
+        quad.cp[3] = v3(5, 5, z);
+        geom_dice_prim(&gs, &quad, (uint32_t)k - 1, NULL, &cam);
+    }
+    return gs;
+}
+
+static float keep_p(void *user, const Ray *ray, Hit *hit, const AccelCrossing *crossing)
+{
+    (void)ray, (void)hit, (void)crossing;
+    return *(const float *)user;
+}
+
+static Vec3 opacity_p(void *user, const Ray *ray, Hit *hit, const AccelCrossing *crossing)
+{
+    (void)ray, (void)hit, (void)crossing;
+    float p = *(const float *)user;
+    return v3(p, 0.5f * p, 0.25f * p); /* coloured: red the most opaque */
+}
+
+static Ray stack_ray(int i, uint32_t mask)
+{
+    float x = -4.9f + 9.8f * (float)(i % 97) / 97.0f, y = -4.9f + 9.8f * (float)(i / 97) / 97.0f;
+    return (Ray){v3(x, y, 0), v3(0.01f, 0, 1), 0.0f, 1e9f, mask};
+}
+
+/* Kept with probability p, the layer a ray stops at is k with probability
+ * p (1 - p)^k (the weight compositing gives it), the opaque square behind
+ * when all pass; the same ray and key stop at the same layer; p 1 is
+ * accel_intersect and p 0 passes every layer. */
+static void test_intersect_stochastic(void)
+{
+    GridSet gs = stack();
+    uint32_t masks[2] = {RAYES_RAY_DIFFUSE | ACCEL_MASK_TRANSPARENT, RAYES_RAY_DIFFUSE};
+    char err[256];
+    Accel *a = accel_new(&gs, masks, 2, NULL, err, sizeof err);
+    CHECK(a != NULL);
+    if (!a)
+        return;
+    enum { N = 97 * 97 };
+    float p = 0.4f;
+    int at[5] = {0};
+    for (int i = 0; i < N; i++) {
+        Ray r = stack_ray(i, RAYES_RAY_DIFFUSE);
+        Hit h, again, plain;
+        CHECK(accel_intersect_stochastic(a, &r, keep_p, &p, (uint64_t)i, &h));
+        CHECK(accel_intersect_stochastic(a, &r, keep_p, &p, (uint64_t)i, &again));
+        CHECK(h.grid == again.grid && h.t == again.t);
+        int layer = (int)lrintf(r.o.z + h.t * r.d.z) - 1;
+        CHECK(layer >= 0 && layer < 5);
+        at[layer < 0 ? 0 : layer > 4 ? 4 : layer]++;
+        float one = 1.0f, zero = 0.0f;
+        CHECK(accel_intersect_stochastic(a, &r, keep_p, &one, (uint64_t)i, &h));
+        CHECK(accel_intersect(a, &r, &plain));
+        CHECK(h.grid == plain.grid && h.t == plain.t && h.gu == plain.gu && h.gv == plain.gv);
+        CHECK(accel_intersect_stochastic(a, &r, keep_p, &zero, (uint64_t)i, &h));
+        CHECK_NEAR(r.o.z + h.t * r.d.z, 5.0, 1e-3);
+    }
+    for (int k = 0; k < 5; k++) {
+        double expect = (k < 4 ? p : 1.0) * pow(1.0 - p, k);
+        /* binomial: within 4 standard deviations */
+        CHECK_NEAR(at[k] / (double)N, expect, 4.0 * sqrt(expect * (1.0 - expect) / N));
+    }
+    accel_free(a);
+    geom_gridset_fini(&gs);
+}
+
+/* Past the roulette threshold a transmission query's crossings end it or
+ * are rescaled: the mean over rays is the product through the four
+ * layers (the opaque square is seen by no shadow ray), each ray's answer
+ * is the same asked again, and threshold 0 multiplies every crossing. */
+static void test_transmission_roulette(void)
+{
+    GridSet gs = stack();
+    uint32_t masks[2] = {RAYES_RAY_SHADOW | ACCEL_MASK_TRANSPARENT, 0};
+    char err[256];
+    Accel *a = accel_new(&gs, masks, 2, NULL, err, sizeof err);
+    CHECK(a != NULL);
+    if (!a)
+        return;
+    enum { N = 97 * 97 };
+    float p = 0.4f;
+    double mean[3] = {0, 0, 0};
+    int stopped = 0;
+    for (int i = 0; i < N; i++) {
+        Ray r = stack_ray(i, RAYES_RAY_SHADOW);
+        Vec3 T = accel_transmission(a, &r, opacity_p, &p, 0.85f);
+        Vec3 again = accel_transmission(a, &r, opacity_p, &p, 0.85f);
+        CHECK(T.x == again.x && T.y == again.y && T.z == again.z);
+        Vec3 exact = accel_transmission(a, &r, opacity_p, &p, 0.0f);
+        CHECK_NEAR(exact.x, pow(0.6, 4), 1e-6);
+        CHECK_NEAR(exact.y, pow(0.8, 4), 1e-6);
+        CHECK_NEAR(exact.z, pow(0.9, 4), 1e-6);
+        stopped += T.y == 0.0f;
+        mean[0] += T.x / N, mean[1] += T.y / N, mean[2] += T.z / N;
+    }
+    /* the largest component, blue's, falls below 0.85 after two crossings
+     * (0.81): the last two each end a ray with probability 0.1 */
+    fprintf(stderr, "roulette: means %g %g %g, exact %g %g %g; %d of %d stopped\n", mean[0],
+            mean[1], mean[2], pow(0.6, 4), pow(0.8, 4), pow(0.9, 4), stopped, N);
+    CHECK_NEAR(stopped / (double)N, 1.0 - 0.81, 0.02);
+    CHECK_NEAR(mean[0] / pow(0.6, 4), 1.0, 0.02);
+    CHECK_NEAR(mean[1] / pow(0.8, 4), 1.0, 0.02);
+    CHECK_NEAR(mean[2] / pow(0.9, 4), 1.0, 0.02);
+    accel_free(a);
+    geom_gridset_fini(&gs);
+}
+
 TEST_MAIN(TEST(test_stop_cancels_build), TEST(test_quad_grid_hit), TEST(test_triangle_grid_hit),
           TEST(test_concurrent_queries), TEST(test_transmission_crossings),
-          TEST(test_own_scene_hits))
+          TEST(test_own_scene_hits), TEST(test_intersect_stochastic),
+          TEST(test_transmission_roulette))

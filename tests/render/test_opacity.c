@@ -652,6 +652,56 @@ static void test_opacity_table_same_bytes_as_cache(void)
     rayes_image_free(c);
 }
 
+/* A wall seen by the floor through three grey sheets (Os 0.4, seen by
+ * diffuse rays alone) at one bounce, the light between floor and sheets:
+ * cached diffuse rays stop at a sheet with the probability of its
+ * opacity (accel_intersect_stochastic) and take its radiosity over it,
+ * uncached ones composite every layer; the floor's light is the same
+ * within noise. */
+static double floor_through_sheets(int cache)
+{
+    RayesScene *s = new_scene();
+    floor_matte(s);
+    RayesParam w[1] = {pf("Kd", 1.0f)};
+    CHECK(rayes_scene_set_shader(s, "matte", w, 1) == RAYES_OK);
+    const float wall[4][3] = {{1.6f, -2, 0}, {1.6f, 2, 0}, {1.6f, -2, 3}, {1.6f, 2, 3}};
+    CHECK(rayes_scene_bilinear_patch(s, wall) == RAYES_OK);
+    RayesParam g[2] = {pf("Kd", 0.5f), pc("Os", 0.4f, 0.4f, 0.4f)};
+    CHECK(rayes_scene_set_shader(s, "matte", g, 2) == RAYES_OK);
+    CHECK(rayes_scene_set_visibility(s, RAYES_RAY_DIFFUSE) == RAYES_OK);
+    for (int k = 0; k < 3; k++) {
+        float x = 1.0f + 0.15f * (float)k;
+        const float P[4][3] = {{x, -2, 0}, {x, 2, 0}, {x, -2, 2}, {x, 2, 2}};
+        CHECK(rayes_scene_bilinear_patch(s, P) == RAYES_OK);
+    }
+    RayesParam l[2] = {(RayesParam){"from", RAYES_PARAM_COLOR, {0.5f, 0, 2.5f}, NULL},
+                       pf("intensity", 4.0f)};
+    CHECK(rayes_scene_light(s, "pointlight", l, 2) == RAYES_OK);
+    CHECK(rayes_scene_commit(s) == RAYES_OK);
+    RayesRenderOptions o;
+    rayes_render_options_init(&o, RAYES_QUALITY_FINAL);
+    o.width = o.height = 16;
+    o.spp = 4;
+    o.bounces = 1;
+    o.cache = cache;
+    RayesImage *img = NULL;
+    CHECK(rayes_render(s, &o, &img, NULL) == RAYES_OK);
+    rayes_scene_release(s);
+    double m[3] = {0, 0, 0};
+    if (img)
+        mean_rgb(img, m);
+    rayes_image_free(img);
+    return m[0];
+}
+
+static void test_diffuse_rays_through_sheets(void)
+{
+    double cached = floor_through_sheets(1), uncached = floor_through_sheets(0);
+    fprintf(stderr, "floor through sheets: cached %g, uncached %g\n", cached, uncached);
+    CHECK(uncached > 0.01);
+    CHECK_NEAR(cached / uncached, 1.0, 0.015); /* without the 1 / a: 3.5% dark */
+}
+
 TEST_MAIN(TEST(test_stacked_sheets_multiply_in_any_order),
           TEST(test_half_transparent_sheet_halves_irradiance),
           TEST(test_ambient_occlusion_closed_forms), TEST(test_cutout_shadow_matches_geometry),
@@ -659,4 +709,4 @@ TEST_MAIN(TEST(test_stacked_sheets_multiply_in_any_order),
           TEST(test_opacity_cache_within_noise_and_deterministic), TEST(test_camera_sees_through),
           TEST(test_grid_hider_transparent_grids), TEST(test_holes_pass_unshaded),
           TEST(test_bad_attributes), TEST(test_thin_glass), TEST(test_diffuse_transmission),
-          TEST(test_opacity_table_same_bytes_as_cache))
+          TEST(test_opacity_table_same_bytes_as_cache), TEST(test_diffuse_rays_through_sheets))
