@@ -12,8 +12,8 @@
  *   memo_tables figure5 [--size N] [--spp N] [--out DIR] [--data DIR] [--scene S]
  *                       [--pbgi-solid-angle SR[,SR...]] [--pbgi-raster N] [--final-rays N[,N...]]
  *   memo_tables figure8 [--size N] [--spp N] [--threads N] [--shadow-rays N]
- *                       [--ao-samples N] [--check-size N] [--experiment a|b|ab] [--out DIR]
- *                       [--repeat N] [--only off|on]
+ *                       [--ao-samples N] [--check-size N] [--experiment a|b|c|ab|...]
+ *                       [--leaves N] [--out DIR] [--repeat N] [--only off|on]
  *
  * table1: preview quality, bounces 1..B (default 3), caching off and on:
  * shading points, rays, time, speed-up and hit rates per resolution; with
@@ -43,7 +43,9 @@
  * (a) coloured soft shadows of a curved stained-glass window, (b) ambient
  * occlusion from a leaf cut out of a square by its texture's alpha; rays,
  * opacity shader runs, times, hit rates, the bias of the cached image and
- * its determinism across threads and opacity budgets (see figure8 below).
+ * its determinism across threads and opacity budgets (see figure8 below);
+ * and, not the memo's, (c) a crown of --leaves cut-out leaves (default
+ * 20,000) at one bounce (bench/foliage).
  * Images (PNG) and a JSON record of every row go to --out (default
  * bench-out/).
  */
@@ -76,7 +78,10 @@ typedef struct Args {
     int shadow_rays;              /* figure8: shadow rays per shading point (8a) */
     int ao_samples;               /* figure8: occlusion rays per shading point (8b) */
     int check_size;               /* figure8: pixels of the determinism renders */
-    const char *experiment;       /* figure8: "a", "b" or "ab" */
+    const char *experiment;       /* figure8: any of "a", "b" and "c" */
+    int leaves;                   /* figure8 c: cut-out leaves in the crown */
+    int foliage;                  /* figure8: 1 while experiment c renders (one bounce,
+                                     radiosity cached) */
     int repeat;                   /* figure8: renders of each mode; the shortest counts */
     int only;                     /* figure8: -1 both; 0 or 1 one render, opacity caching
                                      off or on (for a profiler), nothing compared */
@@ -112,6 +117,7 @@ typedef struct Row {
                                             the points of the grids the cache filled) */
     unsigned long long transparent_hits; /* surfaces shadow rays passed through */
     double opacity_hit[3];               /* opacity cache hit rates, coarse/medium/fine */
+    unsigned long long table_lookups;    /* opacity read from the opacity table instead */
     float *rgba;
     int w, h;
 } Row;
@@ -243,6 +249,7 @@ static void measure(RayesScene *scene, const RayesRenderOptions *o, Row *r_out)
     r.h = img->height;
     r.opacity_points = find(st, "opacity/shading_points")->count;
     r.transparent_hits = find(st, "opacity/transparent_hits")->count;
+    r.table_lookups = find(st, "opacity/table_lookups")->count;
     static const char *const ohr[3] = {"cache/opacity/coarse/hit_rate",
                                        "cache/opacity/medium/hit_rate",
                                        "cache/opacity/fine/hit_rate"};
@@ -324,6 +331,7 @@ static void parse(int argc, char **argv, Args *a)
     a->shadow_rays = 24;
     a->ao_samples = 48;
     a->experiment = "ab";
+    a->leaves = 20000;
     a->only = -1;
     a->repeat = 2;
     a->pbgi_solid_angle = 0.05f;
@@ -372,6 +380,8 @@ static void parse(int argc, char **argv, Args *a)
             a->only = strcmp(v, "on") == 0 ? 1 : strcmp(v, "off") == 0 ? 0 : -2;
         else if (strcmp(o, "--experiment") == 0)
             a->experiment = v;
+        else if (strcmp(o, "--leaves") == 0)
+            a->leaves = atoi(v);
         else if (strcmp(o, "--replay") == 0)
             a->replay = atoi(v);
         else if (strcmp(o, "--pbgi-solid-angle") == 0) {
@@ -954,6 +964,66 @@ static RayesScene *leaf_scene(const char *leaf_png, int ao_samples)
     return s;
 }
 
+/* 8c (not the memo's): a crown of n cut-out leaves (the leaf image's
+ * alpha, each leaf a 0.24 square at a random place in a ball of radius 3
+ * and a random orientation) over a floor, under a low sun and a dim fill
+ * light; a shadow ray through it crosses a dozen leaves, and at one
+ * bounce the floor's and the leaves' diffuse rays cross them too. */
+static RayesScene *crown_scene(const char *leaf_png, int n)
+{
+    RayesScene *s = rayes_scene_new();
+    if (!s)
+        die("out of memory");
+    const float eye[3] = {0, -12, 3}, at[3] = {0, 0, 3.2f}, up[3] = {0, 0, 1};
+    check(s, rayes_scene_set_camera(s, eye, at, up, 45.0f));
+    RayesParam m[1] = {fparam("Kd", 0.8f)};
+    check(s, rayes_scene_set_shader(s, "matte", m, 1));
+    floor_quad(s, -20, 20, -20, 20);
+    RayesParam pm[2] = {(RayesParam){"filename", RAYES_PARAM_STRING, {0, 0, 0}, leaf_png},
+                        fparam("channel", 3.0f)};
+    check(s, rayes_scene_pattern(s, "leaf", "imagemap", pm, 2));
+    RayesParam lp[3] = {fparam("Kd", 0.8f), cparam("Cs", 0.2f, 0.5f, 0.1f),
+                        (RayesParam){"Os", RAYES_PARAM_PATTERN, {0, 0, 0}, "leaf"}};
+    check(s, rayes_scene_set_shader(s, "matte", lp, 3));
+    uint64_t x = 0x9e3779b97f4a7c15ull; /* xorshift: the same crown every run */
+#define UNIT() (x ^= x << 13, x ^= x >> 7, x ^= x << 17, (float)(x >> 40) / 16777216.0f)
+    for (int i = 0; i < n; i++) {
+        float c[3], u[3], v[3], r;
+        do { /* a point in the ball */
+            for (int k = 0; k < 3; k++)
+                c[k] = 2.0f * UNIT() - 1.0f;
+        } while ((r = c[0] * c[0] + c[1] * c[1] + c[2] * c[2]) > 1.0f);
+        for (int k = 0; k < 3; k++) /* two axes: u random, v across it */
+            u[k] = 2.0f * UNIT() - 1.0f;
+        float w[3] = {UNIT() - 0.5f, UNIT() - 0.5f, UNIT() - 0.5f};
+        v[0] = u[1] * w[2] - u[2] * w[1], v[1] = u[2] * w[0] - u[0] * w[2];
+        v[2] = u[0] * w[1] - u[1] * w[0];
+        float lu = sqrtf(u[0] * u[0] + u[1] * u[1] + u[2] * u[2]);
+        float lv = sqrtf(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+        if (lu < 1e-3f || lv < 1e-3f)
+            continue;
+        float P[4][3];
+        for (int k = 0; k < 3; k++) {
+            float o = 3.0f * c[k] + (k == 2 ? 4.0f : 0.0f), du = 0.12f * u[k] / lu,
+                  dv = 0.12f * v[k] / lv;
+            P[0][k] = o - du - dv, P[1][k] = o + du - dv, P[2][k] = o - du + dv;
+            P[3][k] = o + du + dv;
+        }
+        check(s, rayes_scene_bilinear_patch(s, P));
+    }
+#undef UNIT
+    RayesParam sun[3] = {(RayesParam){"from", RAYES_PARAM_COLOR, {1, -1, 3}, NULL},
+                         (RayesParam){"to", RAYES_PARAM_COLOR, {0, 0, 0}, NULL},
+                         fparam("intensity", 2.5f)};
+    check(s, rayes_scene_light(s, "distantlight", sun, 3));
+    RayesParam fill[3] = {(RayesParam){"from", RAYES_PARAM_COLOR, {-1, -2, 1}, NULL},
+                          (RayesParam){"to", RAYES_PARAM_COLOR, {0, 0, 0}, NULL},
+                          fparam("intensity", 0.4f)};
+    check(s, rayes_scene_light(s, "distantlight", fill, 3));
+    check(s, rayes_scene_commit(s));
+    return s;
+}
+
 static RayesRenderOptions figure8_options(const Args *a, int size, int threads, int opacity_cache,
                                           double opacity_mb)
 {
@@ -963,11 +1033,16 @@ static RayesRenderOptions figure8_options(const Args *a, int size, int threads, 
     o.spp = a->spp;
     o.threads = threads;
     o.bounces = 0;
-    o.shadow_rays = a->shadow_rays;
+    if (!a->foliage) /* the crown: the preset's */
+        o.shadow_rays = a->shadow_rays;
     o.opacity_cache = opacity_cache;
     o.opacity_cache_mb = opacity_mb;
     o.cache_mb = o.irradiance_cache_mb = 0.0; /* opacity_mb bounds the cache */
     o.env_guide = 0;                          /* (no environment light) */
+    if (a->foliage) {                         /* a bounce through the crown, its radiosity cached */
+        o.bounces = 1;
+        o.cache_mb = 100.0;
+    }
     return o;
 }
 
@@ -1029,7 +1104,7 @@ static void write_row(const Args *a, const char *tag, const Row *r)
  * --check-size on 1 thread and with a 2 kB opacity budget against the
  * same on a->threads, bit for bit. */
 static void figure8_experiment(const Args *a, FILE *j, const char *tag, RayesScene *scene,
-                               int first, Montage *m)
+                               int first, Montage *m, int row)
 {
     RayesRenderOptions o = figure8_options(a, a->size, a->threads, 0, 20.0);
     Row off = {.cache = 0}, on = {.cache = 1};
@@ -1062,7 +1137,7 @@ static void figure8_experiment(const Args *a, FILE *j, const char *tag, RayesSce
     accuracy(&on, &off, &mrel, &trel, where, sizeof where);
     write_row(a, tag, &off);
     write_row(a, tag, &on);
-    write_diff(a, tag, &on, &off, m, first ? 0 : 1);
+    write_diff(a, tag, &on, &off, m, row);
 
     Row base = on, one = {.cache = 1}, tiny = {.cache = 1};
     if (a->check_size != a->size) {
@@ -1087,9 +1162,11 @@ static void figure8_experiment(const Args *a, FILE *j, const char *tag, RayesSce
     human(hits[1], sizeof hits[1], on.transparent_hits);
     printf("%-3s | %-3s | %9s %9s %9s | %7.2fs %7.2fs | %s\n", tag, "off", rays[0], hits[0], pts[0],
            off.time_s, off.cpu_s, "-");
-    printf("%-3s | %-3s | %9s %9s %9s | %7.2fs %7.2fs | %.2f / %.2f / %.2f\n", tag, "on", rays[1],
-           hits[1], pts[1], on.time_s, on.cpu_s, 100 * on.opacity_hit[0], 100 * on.opacity_hit[1],
-           100 * on.opacity_hit[2]);
+    char table[32];
+    human(table, sizeof table, on.table_lookups);
+    printf("%-3s | %-3s | %9s %9s %9s | %7.2fs %7.2fs | %.2f / %.2f / %.2f; table %s\n", tag, "on",
+           rays[1], hits[1], pts[1], on.time_s, on.cpu_s, 100 * on.opacity_hit[0],
+           100 * on.opacity_hit[1], 100 * on.opacity_hit[2], table);
     printf("    speed-up %.2f (cpu %.2f); cached vs uncached: mean %.3f%%, worst 32x32 tile "
            "%.3f%% (%s)\n",
            off.time_s / on.time_s, off.cpu_s / on.cpu_s, 100 * mrel, 100 * trel, where);
@@ -1104,12 +1181,13 @@ static void figure8_experiment(const Args *a, FILE *j, const char *tag, RayesSce
             "\"transparent_hits\": %llu, \"opacity_points_off\": %llu, \"opacity_points_on\": "
             "%llu, \"time_off_s\": %.3f, \"time_on_s\": %.3f, \"cpu_off_s\": %.3f, "
             "\"cpu_on_s\": %.3f, \"speedup\": %.4f, \"hit_rate\": {\"coarse\": %.5f, "
-            "\"medium\": %.5f, \"fine\": %.5f}, \"mean_rel\": %.6f, \"max_tile_rel\": %.6f, "
-            "\"check_size\": %d, \"identical_1_thread\": %d, \"identical_tiny_budget\": %d}",
+            "\"medium\": %.5f, \"fine\": %.5f}, \"table_lookups\": %llu, \"mean_rel\": %.6f, "
+            "\"max_tile_rel\": %.6f, \"check_size\": %d, \"identical_1_thread\": %d, "
+            "\"identical_tiny_budget\": %d}",
             first ? "" : ",", tag, on.shadow, on.rays, on.transparent_hits, off.opacity_points,
             on.opacity_points, off.time_s, on.time_s, off.cpu_s, on.cpu_s, off.time_s / on.time_s,
-            on.opacity_hit[0], on.opacity_hit[1], on.opacity_hit[2], mrel, trel, a->check_size,
-            same_one, same_tiny);
+            on.opacity_hit[0], on.opacity_hit[1], on.opacity_hit[2], on.table_lookups, mrel, trel,
+            a->check_size, same_one, same_tiny);
     if (base.rgba != on.rgba)
         free(base.rgba);
     free(off.rgba);
@@ -1120,8 +1198,8 @@ static void figure8_experiment(const Args *a, FILE *j, const char *tag, RayesSce
 
 static void figure8(const Args *a, FILE *j)
 {
-    printf("Figure 8 (%dx%d, %d spp, %d threads, no bounces): opacity caching off and on, the "
-           "shortest of %d renders each\n",
+    printf("Figure 8 (%dx%d, %d spp, %d threads, no bounces; c: one): opacity caching off and "
+           "on, the shortest of %d renders each\n",
            a->size, a->size, a->spp, a->threads, a->repeat);
     printf("%-3s | %-3s | %9s %9s %9s | %8s %8s | %s\n", "fig", "opc", "sh.rays", "transp.",
            "opac.pts", "time", "cpu", "opacity hit % coarse/medium/fine");
@@ -1129,25 +1207,37 @@ static void figure8(const Args *a, FILE *j)
             a->spp, a->threads);
     int first = 1;
     Montage m = {a->size / ((a->size + 255) / 256), 0, NULL};
-    m.rows = (strchr(a->experiment, 'a') != NULL) + (strchr(a->experiment, 'b') != NULL);
+    m.rows = (strchr(a->experiment, 'a') != NULL) + (strchr(a->experiment, 'b') != NULL) +
+             (strchr(a->experiment, 'c') != NULL);
+    int row = 0;
     m.rgba = calloc((size_t)3 * m.tile * m.tile * (m.rows ? m.rows : 1) * 4, sizeof *m.rgba);
     if (!m.rgba)
         die("out of memory");
     if (strchr(a->experiment, 'a')) {
         RayesScene *s = stained_glass_scene();
-        figure8_experiment(a, j, "a", s, first, &m);
+        figure8_experiment(a, j, "a", s, first, &m, row++);
         rayes_scene_release(s);
         first = 0;
     }
-    if (strchr(a->experiment, 'b')) {
+    if (strchr(a->experiment, 'b') || strchr(a->experiment, 'c')) {
         char dir[] = "/tmp/rayes-figure8-XXXXXX", png[64];
         if (!mkdtemp(dir))
             die("cannot make a temporary directory");
         snprintf(png, sizeof png, "%s/leaf.png", dir);
         write_leaf(png, 512);
-        RayesScene *s = leaf_scene(png, a->ao_samples);
-        figure8_experiment(a, j, "b", s, first, &m);
-        rayes_scene_release(s);
+        if (strchr(a->experiment, 'b')) {
+            RayesScene *s = leaf_scene(png, a->ao_samples);
+            figure8_experiment(a, j, "b", s, first, &m, row++);
+            rayes_scene_release(s);
+            first = 0;
+        }
+        if (strchr(a->experiment, 'c')) {
+            RayesScene *s = crown_scene(png, a->leaves);
+            Args c = *a;
+            c.foliage = 1;
+            figure8_experiment(&c, j, "c", s, first, &m, row++);
+            rayes_scene_release(s);
+        }
         remove(png);
         rmdir(dir);
     }
