@@ -170,14 +170,20 @@ static Vec3 half_clear(void *user, const Ray *ray, Hit *hit, const AccelCrossing
     return v3(0.5f, 0.25f, 0.0f);
 }
 
-/* The scene's two objects under one mask. */
-static Accel *both_with_mask(const GridSet *gs, uint32_t mask)
+/* The scene's two objects under masks m0 and m1. */
+static Accel *with_masks(const GridSet *gs, uint32_t m0, uint32_t m1)
 {
-    uint32_t masks[2] = {mask, mask};
+    uint32_t masks[2] = {m0, m1};
     char err[256];
     Accel *a = accel_new(gs, masks, 2, NULL, err, sizeof err);
     CHECK(a != NULL);
     return a;
+}
+
+/* The scene's two objects under one mask. */
+static Accel *both_with_mask(const GridSet *gs, uint32_t mask)
+{
+    return with_masks(gs, mask, mask);
 }
 
 static void test_transmission_crossings(void)
@@ -296,10 +302,7 @@ static Ray stack_ray(int i, uint32_t mask)
 static void test_intersect_stochastic(void)
 {
     GridSet gs = stack();
-    uint32_t masks[2] = {RAYES_RAY_DIFFUSE | ACCEL_MASK_TRANSPARENT, RAYES_RAY_DIFFUSE};
-    char err[256];
-    Accel *a = accel_new(&gs, masks, 2, NULL, err, sizeof err);
-    CHECK(a != NULL);
+    Accel *a = with_masks(&gs, RAYES_RAY_DIFFUSE | ACCEL_MASK_TRANSPARENT, RAYES_RAY_DIFFUSE);
     if (!a)
         return;
     enum { N = 97 * 97 };
@@ -337,10 +340,7 @@ static void test_intersect_stochastic(void)
 static void test_transmission_roulette(void)
 {
     GridSet gs = stack();
-    uint32_t masks[2] = {RAYES_RAY_SHADOW | ACCEL_MASK_TRANSPARENT, 0};
-    char err[256];
-    Accel *a = accel_new(&gs, masks, 2, NULL, err, sizeof err);
-    CHECK(a != NULL);
+    Accel *a = with_masks(&gs, RAYES_RAY_SHADOW | ACCEL_MASK_TRANSPARENT, 0);
     if (!a)
         return;
     enum { N = 97 * 97 };
