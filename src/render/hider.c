@@ -281,6 +281,9 @@ static Rgb *shade_grid(Worker *w, uint32_t gi, uint32_t instance, int seg)
         .dst = own_st ? (const float(*)[4])dsts : NULL,
     };
     path_apply_Os_pattern(w, obj, &ctx, Os);
+    size_t holes = path_count_holes(obj, n, (const float(*)[3])Os);
+    ps.holes = holes > 0;
+    w->stats.hole_points += holes;
     RayesShadeOutputs out = {.Ci = Ci, .Oi = Oi};
     w->stats.shading_points[0] += n;
     uint64_t sharp = w->sharp_rays;

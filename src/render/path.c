@@ -48,3 +48,11 @@ void path_apply_Os_pattern(const Worker *w, const RenderObject *obj, const Rayes
                 Os[start + i][c] *= fminf(fmaxf(m[i][c], 0.0f), 1.0f);
     }
 }
+
+size_t path_count_holes(const RenderObject *obj, size_t n, const float (*Os)[3])
+{
+    size_t holes = 0;
+    for (size_t i = 0; obj->transparent && !obj->opacity_shader && i < n; i++)
+        holes += Os[i][0] <= 0.0f && Os[i][1] <= 0.0f && Os[i][2] <= 0.0f;
+    return holes;
+}

@@ -123,6 +123,12 @@ typedef struct PathState {
     int shadow_rays;              /* shadow rays per light where the shader asks for the
                                      default, or 0: the renderer's setting for the depth
                                      (an irradiance cache fill sets its own) */
+    int holes;                    /* 1: the points are a cut-out's (transparent, no opacity
+                                     method), and one whose Os is 0 is a hole: its
+                                     premultiplied Ci is 0 whatever its light, so the
+                                     lighting services cast none of its rays (a fill's or
+                                     the grid hider's points; a path's own hole is never
+                                     shaded) */
 } PathState;
 
 /* The texture-space footprint of a point whose parameter footprint is
@@ -161,5 +167,9 @@ float path_ray_epsilon(const Worker *w);
  * filtered over the points' footprints; ctx->renderer is a PathState. */
 void path_apply_Os_pattern(const Worker *w, const RenderObject *obj, const RayesShadeCtx *ctx,
                            float (*Os)[3]);
+
+/* The holes among n points of obj (Os 0 in every channel) when obj is a
+ * cut-out without an opacity method (PathState.holes), else 0. */
+size_t path_count_holes(const RenderObject *obj, size_t n, const float (*Os)[3]);
 
 #endif /* RAYES_RENDER_PATH_H */

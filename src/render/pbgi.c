@@ -914,6 +914,9 @@ static void run_pass(Pass *p, const RayesShaderServices *services, RenderStats *
         stats->opacity_points += s->opacity_points;
         stats->transparent_hits += s->transparent_hits;
         stats->holes += s->holes;
+        stats->hole_points += s->hole_points;
+        stats->table_lookups += s->table_lookups;
+        stats->table_fills += s->table_fills;
         for (int d = 0; d <= RENDER_MAX_DEPTH; d++)
             stats->shading_points[d] += s->shading_points[d];
         if (p->set->cache)

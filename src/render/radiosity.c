@@ -554,6 +554,11 @@ static void fill_radiosity(void *user, const CacheKey *key, size_t n, float (*ou
         .dst = own_st ? (const float(*)[4])fp.dst : NULL,
     };
     path_apply_Os_pattern(w, obj, &ctx, fp.Os);
+    if (key->type == CACHE_RADIOSITY) {
+        size_t holes = path_count_holes(obj, n, (const float(*)[3])fp.Os);
+        ps.holes = holes > 0;
+        w->stats.hole_points += holes;
+    }
     w->stats.instance_fills += key->instance != 0 && key->type == CACHE_RADIOSITY;
     if (moves && key->type == CACHE_RADIOSITY)
         w->stats.segment_fills[key->segment]++;

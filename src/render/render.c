@@ -491,6 +491,7 @@ static void merge_stats(RenderStats *into, const RenderStats *s)
     into->opacity_points += s->opacity_points;
     into->transparent_hits += s->transparent_hits;
     into->holes += s->holes;
+    into->hole_points += s->hole_points;
     into->table_lookups += s->table_lookups;
     into->table_fills += s->table_fills;
     into->rays_transmission += s->rays_transmission;

@@ -187,6 +187,8 @@ typedef struct RenderStats {
                                   were partly transparent */
     uint64_t holes;            /* camera, specular and diffuse hits on a cut-out's hole (Os
                                   0, no opacity method), passed unshaded */
+    uint64_t hole_points;      /* points of fills and the grid hider's grids in such holes,
+                                  their lighting's rays not cast (PathState.holes) */
     uint64_t table_lookups;    /* coarse opacity read from the opacity table (optable.h; not
                                   in the cache's counters) */
     uint64_t table_fills;      /* and the slots filled */

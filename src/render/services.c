@@ -459,6 +459,15 @@ static Lobe point_lobe(Vec3 N, Vec3 V, const float *width, size_t i, int kind)
     return l;
 }
 
+/* 1 if point i is a hole of a cut-out (PathState.holes): no rays of its
+ * own, its lighting 0. */
+static int hole(const RayesShadeCtx *ctx, size_t i)
+{
+    const PathState *ps = ctx->renderer;
+    return ps->holes && !ps->irradiance && ctx->Os && ctx->Os[i][0] <= 0.0f &&
+           ctx->Os[i][1] <= 0.0f && ctx->Os[i][2] <= 0.0f;
+}
+
 /* direct_lighting with the lobe of point_lobe of that kind. */
 static void direct_lighting(const RayesShadeCtx *ctx, int n_shadow_rays, const char *category,
                             const float *width, int kind, float (*diffuse)[3], float (*specular)[3])
@@ -474,6 +483,13 @@ static void direct_lighting(const RayesShadeCtx *ctx, int n_shadow_rays, const c
     int guided = ctx->diffuse_depth == 0 && w->set->env_guide && ps->shadow_rays == 0;
     for (size_t i = 0; i < ctx->n_points; i++) {
         Vec3 d = v3(0, 0, 0), s = v3(0, 0, 0);
+        if (hole(ctx, i)) {
+            if (diffuse)
+                v3_store(diffuse[i], d);
+            if (specular)
+                v3_store(specular[i], s);
+            continue;
+        }
         DirectPoint p;
         p.N = v3_load(ctx->N[i]);
         p.Ng = v3_load(ctx->Ng[i]);
@@ -743,6 +759,10 @@ static void svc_indirect_diffuse(const RayesShaderServices *sv, const RayesShade
     /* Each ray stands for 1/n of the hemisphere: its spread never shrinks. */
     float lobe_spread = n > 0 ? 1.0f / sqrtf((float)n) : 0.0f;
     for (size_t i = 0; i < ctx->n_points; i++) {
+        if (hole(ctx, i)) {
+            v3_store(out[i], v3(0, 0, 0));
+            continue;
+        }
         size_t j = point(ctx, i);
         Vec3 P = v3_load(ctx->P[i]), N = v3_load(ctx->N[i]), Ng = v3_load(ctx->Ng[i]);
         Vec3 o = v3_madd(P, Ng, ps->offset[j]), sum = v3(0, 0, 0);

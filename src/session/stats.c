@@ -105,6 +105,7 @@ RayesStats *session_stats_new(const RenderSettings *set, const RenderStats *rs, 
     count(s, "opacity/shading_points", rs->opacity_points);
     count(s, "opacity/transparent_hits", rs->transparent_hits);
     count(s, "opacity/holes", rs->holes);
+    count(s, "opacity/hole_points", rs->hole_points);
     count(s, "opacity/table_lookups", rs->table_lookups);
     count(s, "opacity/table_fills", rs->table_fills);
     count(s, "volume/steps", rs->volume_steps);

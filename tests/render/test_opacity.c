@@ -702,6 +702,51 @@ static void test_diffuse_rays_through_sheets(void)
     CHECK_NEAR(cached / uncached, 1.0, 0.015); /* without the 1 / a: 3.5% dark */
 }
 
+/* Holes cast no rays: a checkerboard cut-out (half its cells Os 0) seen by
+ * diffuse and shadow rays alone, over a lit floor at one bounce: of its
+ * fills' points, those in the holes are counted (opacity/hole_points) and
+ * cast none of their rays (PathState.holes); the same square at a constant
+ * Os 0.5 has none. Returns the share of fill points in holes. */
+static double fill_holes(int checker)
+{
+    RayesScene *s = new_scene();
+    floor_matte(s);
+    RayesParam cb[2] = {pf("uscale", 4.0f), pf("vscale", 4.0f)};
+    CHECK(rayes_scene_pattern(s, "cells", "checkerboard", cb, 2) == RAYES_OK);
+    RayesParam p[2] = {pf("Kd", 1.0f),
+                       checker ? (RayesParam){"Os", RAYES_PARAM_PATTERN, {0, 0, 0}, "cells"}
+                               : pc("Os", 0.5f, 0.5f, 0.5f)};
+    CHECK(rayes_scene_set_shader(s, "matte", p, 2) == RAYES_OK);
+    CHECK(rayes_scene_set_visibility(s, RAYES_RAY_DIFFUSE | RAYES_RAY_SHADOW) == RAYES_OK);
+    quad_at(s, 1.0f, 1.0f);
+    point_light(s, 0.5f); /* under the square: its underside, which the floor sees, is lit */
+    CHECK(rayes_scene_commit(s) == RAYES_OK);
+    RayesRenderOptions o;
+    rayes_render_options_init(&o, RAYES_QUALITY_PREVIEW);
+    o.width = o.height = RES;
+    o.spp = 1;
+    o.bounces = 1;
+    RayesStats *st = NULL;
+    RayesImage *img = NULL;
+    CHECK(rayes_render(s, &o, &img, &st) == RAYES_OK);
+    const RayesStat *depth = rayes_stats_find(st, "shading_points/by_depth");
+    double fill = depth && depth->n_counts > 1 ? (double)depth->counts[1] : 0.0;
+    double holes = (double)stat_count(st, "opacity/hole_points");
+    rayes_stats_free(st);
+    rayes_image_free(img);
+    rayes_scene_release(s);
+    CHECK(fill > 0.0);
+    return fill > 0.0 ? holes / fill : 0.0;
+}
+
+static void test_holes_cast_no_rays(void)
+{
+    double cut = fill_holes(1), half = fill_holes(0);
+    fprintf(stderr, "fill points in holes: cut-out %g, Os 0.5 %g\n", cut, half);
+    CHECK(half == 0.0);
+    CHECK(cut > 0.0 && cut < 0.6); /* at most half the cells, less their filtered edges */
+}
+
 TEST_MAIN(TEST(test_stacked_sheets_multiply_in_any_order),
           TEST(test_half_transparent_sheet_halves_irradiance),
           TEST(test_ambient_occlusion_closed_forms), TEST(test_cutout_shadow_matches_geometry),
@@ -709,4 +754,5 @@ TEST_MAIN(TEST(test_stacked_sheets_multiply_in_any_order),
           TEST(test_opacity_cache_within_noise_and_deterministic), TEST(test_camera_sees_through),
           TEST(test_grid_hider_transparent_grids), TEST(test_holes_pass_unshaded),
           TEST(test_bad_attributes), TEST(test_thin_glass), TEST(test_diffuse_transmission),
-          TEST(test_opacity_table_same_bytes_as_cache), TEST(test_diffuse_rays_through_sheets))
+          TEST(test_opacity_table_same_bytes_as_cache), TEST(test_diffuse_rays_through_sheets),
+          TEST(test_holes_cast_no_rays))
