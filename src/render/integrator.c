@@ -188,8 +188,8 @@ static Vec3 shade_hit(Worker *w, const Ray *ray, const Hit *hit, const RenderObj
      * the ray goes on behind it unshaded, as a path tracer's alpha test
      * lets it. */
     if (obj->transparent && !obj->opacity_shader &&
-        (kind & (RAYES_RAY_CAMERA | RAYES_RAY_SPECULAR | RAYES_RAY_DIFFUSE)) && hp.Os[0] <= 0.0f &&
-        hp.Os[1] <= 0.0f && hp.Os[2] <= 0.0f) { /* NaN: shaded */
+        (kind & (RAYES_RAY_CAMERA | RAYES_RAY_SPECULAR | RAYES_RAY_DIFFUSE)) &&
+        path_clear(hp.Os)) { /* NaN: shaded */
         w->stats.holes++;
         *Oi_out = v3(0, 0, 0);
         return v3(0, 0, 0);

@@ -53,6 +53,6 @@ size_t path_count_holes(const RenderObject *obj, size_t n, const float (*Os)[3])
 {
     size_t holes = 0;
     for (size_t i = 0; obj->transparent && !obj->opacity_shader && i < n; i++)
-        holes += Os[i][0] <= 0.0f && Os[i][1] <= 0.0f && Os[i][2] <= 0.0f;
+        holes += path_clear(Os[i]);
     return holes;
 }

@@ -168,8 +168,15 @@ float path_ray_epsilon(const Worker *w);
 void path_apply_Os_pattern(const Worker *w, const RenderObject *obj, const RayesShadeCtx *ctx,
                            float (*Os)[3]);
 
-/* The holes among n points of obj (Os 0 in every channel) when obj is a
- * cut-out without an opacity method (PathState.holes), else 0. */
+/* 1 if opacity Os is 0 in every channel: where a cut-out has a hole (NaN
+ * is not). */
+static inline int path_clear(const float Os[3])
+{
+    return Os[0] <= 0.0f && Os[1] <= 0.0f && Os[2] <= 0.0f;
+}
+
+/* The holes among n points of obj (path_clear) when obj is a cut-out
+ * without an opacity method (PathState.holes), else 0. */
 size_t path_count_holes(const RenderObject *obj, size_t n, const float (*Os)[3]);
 
 #endif /* RAYES_RENDER_PATH_H */

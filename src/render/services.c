@@ -464,8 +464,7 @@ static Lobe point_lobe(Vec3 N, Vec3 V, const float *width, size_t i, int kind)
 static int hole(const RayesShadeCtx *ctx, size_t i)
 {
     const PathState *ps = ctx->renderer;
-    return ps->holes && !ps->irradiance && ctx->Os && ctx->Os[i][0] <= 0.0f &&
-           ctx->Os[i][1] <= 0.0f && ctx->Os[i][2] <= 0.0f;
+    return ps->holes && !ps->irradiance && ctx->Os && path_clear(ctx->Os[i]);
 }
 
 /* direct_lighting with the lobe of point_lobe of that kind. */
