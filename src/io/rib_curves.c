@@ -60,16 +60,18 @@ static int read_vars(Rib *r, const Param *p, size_t n, Vars *v)
         const Param *q = rib_var_param(r, p, n, names[k].name, names[k].size);
         if (q)
             e = add_var(r, v, q, names[k].name, names[k].size);
-        else if (k == 1 && rib_block_color_only(r)) { /* the block's Color as a constant Cs */
+        else if ((k == 1 || k == 3) && rib_block_color_only(r) &&
+                 (k == 1 ? r->a.cs_gen != r->object_cs_gen : r->a.os_gen != r->object_os_gen)) {
+            /* the block's Color or Opacity as a constant Cs or Os */
             float *d = malloc(3 * sizeof *d);
             if (!d) {
                 e = rib_error(r, "out of memory");
                 break;
             }
             for (int c = 0; c < 3; c++)
-                d[c] = r->a.Cs[c];
+                d[c] = k == 1 ? r->a.Cs[c] : r->a.Os[c];
             v->data[v->n] = d;
-            v->pv[v->n++] = (RayesPrimvar){"Cs", RAYES_PRIMVAR_CONSTANT, d, 1};
+            v->pv[v->n++] = (RayesPrimvar){names[k].name, RAYES_PRIMVAR_CONSTANT, d, 1};
             r->pv_block_color = 1;
         }
     }

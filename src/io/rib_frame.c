@@ -66,6 +66,8 @@ static int h_object_begin(Rib *r, const Args *a)
         r->in_object = 1;
         r->object_surface = r->a.surface;
         r->object_color_gen = r->a.color_gen;
+        r->object_cs_gen = r->a.cs_gen;
+        r->object_os_gen = r->a.os_gen;
     } else {
         r->rec = rib_recording_new();
         if (!r->rec)

@@ -87,7 +87,8 @@ static void rib_vars(Rib *r, const Param *p, size_t n, RibVar vars[RIB_N_VARS])
     const Param *cs = rib_var_param(r, p, n, "Cs", 3);
     if (cs)
         vars[2] = (RibVar){cs->v->d, NULL, cs->d.cls, 3};
-    else if (rib_block_color_only(r)) { /* the block's Color, on the instance's shader */
+    else if (rib_block_color_only(r) && r->a.cs_gen != r->object_cs_gen) {
+        /* the block's Color, on the instance's shader */
         for (int c = 0; c < 3; c++)
             r->block_Cs[c] = r->a.Cs[c];
         vars[2] = (RibVar){r->block_Cs, NULL, CLS_CONSTANT, 3};
@@ -96,6 +97,13 @@ static void rib_vars(Rib *r, const Param *p, size_t n, RibVar vars[RIB_N_VARS])
     const Param *os = rib_var_param(r, p, n, "Os", 3);
     if (os)
         vars[3] = (RibVar){os->v->d, NULL, os->d.cls, 3};
+    else if (rib_block_color_only(r) && r->a.os_gen != r->object_os_gen) {
+        /* the block's Opacity, likewise */
+        for (int c = 0; c < 3; c++)
+            r->block_Os[c] = r->a.Os[c];
+        vars[3] = (RibVar){r->block_Os, NULL, CLS_CONSTANT, 3};
+        r->pv_block_color = 1;
+    }
 }
 
 static void var_value(const RibVar *v, size_t j, float out[3])

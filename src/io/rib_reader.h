@@ -114,6 +114,7 @@ typedef struct Attr {
     double texcoords[8];       /* TextureCoordinates: st at a patch's four corners */
     int have_texcoords;        /* 1 when they are not RenderMan's default (0 0 1 0 0 1 1 1) */
     long color_gen;            /* changes with Cs/Os */
+    long cs_gen, os_gen;       /* change with Cs, with Os (an object block's own) */
     const ShaderRec *surface;  /* NULL: matte */
     const ShaderRec *atmosphere; /* Atmosphere in force (rayes' volume shader), or NULL */
     const ShaderRec *displacement;
@@ -298,9 +299,11 @@ typedef struct Rib {
                                           under one, sent at WorldEnd */
     const void *object_surface; /* the surface and colour generation at that ObjectBegin: */
     long object_color_gen;     /* geometry under them inherits each instance's shader */
-    int pv_block_color;        /* the request's primitive carries the block's Color as a
-                                  constant Cs (rib_block_color_only), so it still inherits */
-    double block_Cs[3];
+    long object_cs_gen, object_os_gen; /* Cs's and Os's generations there */
+    int pv_block_color;                /* the request's primitive carries the block's Color or
+                                          Opacity as a constant Cs or Os (rib_block_color_only), so
+                                          it still inherits */
+    double block_Cs[3], block_Os[3];
     IoSink rec_sink;
     char rec_key[RIB_MAX_HANDLE];
     float rec_saved_M[16];

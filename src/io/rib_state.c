@@ -741,8 +741,10 @@ static int h_color(Rib *r, const Args *a)
     float v[3];
     if (rib_get_floats(r, a, &i, v, 3, "a colour") != 0)
         return -1;
-    memcpy(strcmp(r->req, "Color") == 0 ? r->a.Cs : r->a.Os, v, sizeof v);
+    int colour = strcmp(r->req, "Color") == 0;
+    memcpy(colour ? r->a.Cs : r->a.Os, v, sizeof v);
     r->a.color_gen = ++r->next_gen;
+    *(colour ? &r->a.cs_gen : &r->a.os_gen) = r->a.color_gen;
     return 0;
 }
 

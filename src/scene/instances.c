@@ -121,6 +121,12 @@ RayesError rayes_scene_object_instance(RayesScene *s, const char *name)
         .object = s->current_object == SCENE_OBJECT_INHERIT ? GEOM_OBJECT_INHERIT
                                                             : (uint32_t)s->current_object,
     };
+    if (mm->inherit_Os_below_1) { /* its see-through geometry takes this object */
+        if (s->current_object != SCENE_OBJECT_INHERIT)
+            s->objects[s->current_object].Os_primvar_below_1 = 1;
+        else if (parent)
+            parent->inherit_Os_below_1 = 1;
+    }
     if (parent) {
         parent->leaves = total;
         parent->depth = mm->depth + 1 > parent->depth ? mm->depth + 1 : parent->depth;

@@ -566,8 +566,12 @@ static RayesError add_prim(RayesScene *s, Prim *p)
         log_warning_once("solid master", "solids inside object definitions are drawn as their "
                                          "primitives (not combined)");
     }
-    if ((p->pv & GEOM_PV_OS) && s->pv_Os_below_1 && p->object != GEOM_OBJECT_INHERIT)
-        s->objects[p->object].Os_primvar_below_1 = 1;
+    if ((p->pv & GEOM_PV_OS) && s->pv_Os_below_1) {
+        if (p->object != GEOM_OBJECT_INHERIT)
+            s->objects[p->object].Os_primvar_below_1 = 1;
+        else if (p->master) /* the objects of its block's instances (object_instance) */
+            s->masters[p->master - 1].inherit_Os_below_1 = 1;
+    }
     p->shading_rate = s->shading_rate;
     p->motion = s->current_motion;
     p->motionfactor = s->motionfactor;

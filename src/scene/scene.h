@@ -70,6 +70,9 @@ typedef struct SceneMaster {
                                  makes when flattened (itself if it has primitives, plus its
                                  nested instances'); caps the flattened count */
     int depth;                /* 1 + the deepest nesting of its instances' masters */
+    uint8_t inherit_Os_below_1; /* 1: geometry of it (or of a master it places) that takes
+                                   each instance's object carries an Os primitive variable
+                                   below 1, so that object must be drawn transparent */
 } SceneMaster;
 
 /* One rayes_scene_object_instance. */

@@ -4,6 +4,7 @@
  * instances, not copies: counts, the shader an instance inherits, nesting
  * (RIB), errors naming file:line, and the RIB writer's round trip.
  */
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -129,6 +130,40 @@ static void test_rib_block_colour_instance_surface(void)
     rayes_scene_release(s);
 }
 
+/* A block that sets Opacity but no Surface or Color: its geometry keeps
+ * each instance's Surface and Color and the block's opacity (PRMan's
+ * attributes in a block override the instance's), drawn see-through even
+ * though the instance's object is opaque; nested blocks pass it on. */
+static void test_rib_block_opacity(void)
+{
+    static const char *const blocks[2] = {
+        "ObjectBegin \"card\"\nOpacity [0.5 0.5 0.5]\n"
+        "  Polygon \"P\" [-0.8 -0.8 0  0.8 -0.8 0  0.8 0.8 0  -0.8 0.8 0]\n"
+        "ObjectEnd\n",
+        "ObjectBegin \"inner\"\nOpacity [0.5 0.5 0.5]\n"
+        "  Polygon \"P\" [-0.8 -0.8 0  0.8 -0.8 0  0.8 0.8 0  -0.8 0.8 0]\n"
+        "ObjectEnd\nObjectBegin \"card\"\nObjectInstance \"inner\"\nObjectEnd\n"};
+    for (int nested = 0; nested < 2; nested++) {
+        char text[1024];
+        snprintf(text, sizeof text,
+                 "%s%sAttributeBegin\nSurface \"constant\"\nColor [1 0 0]\n"
+                 "Translate 1 0 0\nObjectInstance \"card\"\nAttributeEnd\n"
+                 "AttributeBegin\nSurface \"constant\"\nColor [0 1 0]\nOpacity [0.25 0.25 0.25]\n"
+                 "Translate -1 0 0\nObjectInstance \"card\"\nAttributeEnd\nWorldEnd\n",
+                 RIB_HEAD, blocks[nested]);
+        RayesScene *s = rayes_scene_new();
+        CHECK(read_into(s, "t.rib", text) == RAYES_OK);
+        RayesImage *img = NULL;
+        CHECK(render_stat(s, "instances/count", &img) == 2);
+        const float *left = &img->rgba[4 * (24 * 48 + 12)], *right = &img->rgba[4 * (24 * 48 + 36)];
+        /* the instance's red and green at the block's half opacity (premultiplied) */
+        CHECK(fabsf(right[0] - 0.5f) < 0.01f && right[1] < 0.01f && fabsf(right[3] - 0.5f) < 0.01f);
+        CHECK(fabsf(left[1] - 0.5f) < 0.01f && left[0] < 0.01f && fabsf(left[3] - 0.5f) < 0.01f);
+        rayes_image_free(img);
+        rayes_scene_release(s);
+    }
+}
+
 /* ObjectInstance inside ObjectBegin (RenderMan allows it): 2 x 3 balls. */
 static void test_rib_nested(void)
 {
@@ -250,7 +285,7 @@ static void test_aqsis_objectinstance(void)
     rayes_scene_release(s);
 }
 
-TEST_MAIN(TEST(test_aqsis_objectinstance), TEST(test_rib_instances_inherit_colour), TEST(test_rib_block_colour_kept),
-          TEST(test_rib_block_colour_instance_surface),
-          TEST(test_rib_nested), TEST(test_errors), TEST(test_pbrt_instances),
-          TEST(test_rib_writer_round_trip))
+TEST_MAIN(TEST(test_aqsis_objectinstance), TEST(test_rib_instances_inherit_colour),
+          TEST(test_rib_block_colour_kept), TEST(test_rib_block_colour_instance_surface),
+          TEST(test_rib_block_opacity), TEST(test_rib_nested), TEST(test_errors),
+          TEST(test_pbrt_instances), TEST(test_rib_writer_round_trip))
