@@ -342,10 +342,11 @@ static int mtl_map(Lexer *L, const char *mtl_dir, char *out, size_t out_size)
     }
     if (!last)
         return lex_expected(L, tok, 0, "a texture file name");
-    if (last[0] == '/' || !mtl_dir[0])
-        snprintf(out, out_size, "%.*s", (int)last_n, last);
-    else
-        snprintf(out, out_size, "%s%.*s", mtl_dir, (int)last_n, last);
+    int w = last[0] == '/' || !mtl_dir[0]
+                ? snprintf(out, out_size, "%.*s", (int)last_n, last)
+                : snprintf(out, out_size, "%s%.*s", mtl_dir, (int)last_n, last);
+    if (w < 0 || (size_t)w >= out_size)
+        return lex_expected(L, last, last_n, "a shorter texture path");
     return 0;
 }
 

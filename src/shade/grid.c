@@ -263,7 +263,9 @@ VoxelGrid *grid_parse_nanovdb(const unsigned char *data, size_t size, const char
                 snprintf(err, err_size, "%s: truncated NanoVDB file (grid \"%s\")", path, m->name);
             } else {
                 size_t used = strlen(names);
-                snprintf(names + used, sizeof names - used, "%s\"%s\"", used ? ", " : "", m->name);
+                if (snprintf(names + used, sizeof names - used, "%s\"%s\"", used ? ", " : "",
+                             m->name) >= (int)(sizeof names - used))
+                    names[used] = '\0'; /* a name the list has no room for is left out */
                 at += (size_t)m->file_size;
             }
         }

@@ -434,7 +434,7 @@ static void test_bad_definitions(void)
     expect_refused("imagemap", NULL, 0, "no filename");
     /* nesting: 16 levels are fine, 17 are not */
     Made m = {0};
-    static char names[20][8];
+    static char names[20][16]; /* "p" and any int */
     RayesParam first[] = {COLOR("value", 1, 1, 1)};
     snprintf(names[0], sizeof names[0], "p0");
     make(&m, names[0], "constant", first, 1, NULL);
