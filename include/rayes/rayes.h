@@ -967,6 +967,8 @@ typedef struct RayesRenderOptions {
                                    its fill traces once per grid and keeps in the cache
                                    (data type guide, 16 MB); unbiased either way, 0 draws
                                    by the map's brightness alone (DESIGN.md "Lights") */
+    unsigned aovs;              /* RayesAov bits: the arbitrary output variables the image
+                                   carries beside its colour (RayesImage.aov). Default 0 */
 } RayesRenderOptions;
 
 /* Fills options with the defaults of a quality preset: 512 x 512, 4 pixel
@@ -1009,11 +1011,43 @@ RAYES_API void rayes_stats_free(RayesStats *stats);
 
 /* --------------------------------------------------------------- render */
 
+/* Arbitrary output variables (AOVs): what the first surface each camera
+ * sample meets says about itself, for compositing and for inspecting a
+ * scene. Deterministic as the colour is. Samples the filter weighs
+ * positively decide the "nearest" ones; N and P are filtered as colour is
+ * (a pixel on an edge blends toward 0). Surfaces behind a transparent one
+ * do not count; lights seen directly do (their own object). */
+typedef enum RayesAov {
+    RAYES_AOV_Z = 1u << 0,     /* "Z": camera-space depth of the pixel's nearest sample
+                                  (distance along the view axis; orthographic too); +inf
+                                  where no sample meets a surface */
+    RAYES_AOV_N = 1u << 1,     /* "N.X" "N.Y" "N.Z": world-space shading normal, facing the
+                                  camera */
+    RAYES_AOV_P = 1u << 2,     /* "P.X" "P.Y" "P.Z": world-space position */
+    RAYES_AOV_ID = 1u << 3,    /* "id": 1 + the object (shader binding) of the nearest
+                                  sample, in the order the scene made them; 0: none */
+    RAYES_AOV_PATCH = 1u << 4, /* "patch": 1 + the grid (diced patch, the radiosity cache's
+                                  entry) of the nearest sample; 0: none */
+    RAYES_AOV_ALL = 0x1f
+} RayesAov;
+
+#define RAYES_AOV_CHANNELS_MAX 9 /* rayes_aov_channels(RAYES_AOV_ALL) */
+
+/* The float channels of aovs (RayesAov bits), and the name of channel c
+ * ("Z", "N.X", ...; NULL when c is out of range): channels come in the
+ * order of the bits. */
+RAYES_API int rayes_aov_channels(unsigned aovs);
+RAYES_API const char *rayes_aov_channel_name(unsigned aovs, int channel);
+
 typedef struct RayesImage {
     int width, height;  /* pixels */
     float *rgba;        /* width * height * 4 floats, linear RGB and alpha, top row first */
     int crop[4];        /* the pixels rendered: x, y, width, height (a crop window; outside
                            it rgba is 0); width 0: all of them */
+    unsigned aovs;      /* the RayesAov bits rendered (RayesRenderOptions.aovs) */
+    int aov_channels;   /* rayes_aov_channels(aovs) */
+    float *aov;         /* width * height * aov_channels floats, or NULL: channel c of a
+                           pixel is rayes_aov_channel_name(aovs, c) */
 } RayesImage;
 
 /* Renders a committed scene. On success *image (free with

@@ -124,10 +124,40 @@ static const char render_options[] =
     "  --default-light         a headlight (a distant light along the view) when the\n"
     "                          scene has no lights\n"
     "  --stats FILE.json       write statistics as JSON\n"
+    "  --aov LIST              arbitrary output variables written as float channels beside\n"
+    "                          the colour of EXR outputs, a comma-separated list of z (Z:\n"
+    "                          depth), N (world normal), P (world position), id (object),\n"
+    "                          patch (the grid, the radiosity cache's entry), all\n"
     "  --replay-rays           keep the render's rays and trace them again unshaded: the\n"
     "                          summary and the statistics' replay block say what ray\n"
     "                          casting alone costs (48 bytes a ray while rendering)\n"
     "  --quiet                 no progress bar and no summary\n";
+
+/* --aov's list: names of RayesAov, comma-separated. */
+static unsigned parse_aovs(const char *v)
+{
+    static const struct {
+        const char *name;
+        unsigned aov;
+    } names[] = {{"z", RAYES_AOV_Z},   {"N", RAYES_AOV_N},         {"P", RAYES_AOV_P},
+                 {"id", RAYES_AOV_ID}, {"patch", RAYES_AOV_PATCH}, {"all", RAYES_AOV_ALL}};
+    unsigned aovs = 0;
+    for (const char *s = v; *s;) {
+        size_t n = strcspn(s, ","), k = 0;
+        while (k < sizeof names / sizeof names[0] &&
+               !(strlen(names[k].name) == n && strncmp(names[k].name, s, n) == 0))
+            k++;
+        if (k == sizeof names / sizeof names[0])
+            die_usage("--aov: expected z, N, P, id, patch or all (comma-separated), found "
+                      "\"%.*s\"",
+                      (int)n, s);
+        aovs |= names[k].aov;
+        s += n + (s[n] == ',');
+    }
+    if (!aovs)
+        die_usage("--aov: expected z, N, P, id, patch or all");
+    return aovs;
+}
 
 static const char view_options[] =
     "view options (and every option above; docs/view.md):\n"
@@ -390,6 +420,8 @@ void parse_args(int argc, char **argv, Args *a)
             a->frames = v;
         else if (strcmp(o, "--checkpoint") == 0)
             a->checkpoint_s = parse_float(o, v, 0.0f, 1e7f);
+        else if (strcmp(o, "--aov") == 0)
+            opt->aovs |= parse_aovs(v);
         else if (strcmp(o, "--progress") == 0) {
             if (strcmp(v, "json") != 0 && strcmp(v, "bar") != 0)
                 die_usage("--progress: expected json or bar, got \"%s\"", v);

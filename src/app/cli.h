@@ -37,6 +37,10 @@ typedef struct Output {
     char path[600];
     ImageFormat format;
     int no_alpha; /* a display of mode "rgb": R, G, B only */
+    int display;  /* a scene file's display: it writes aovs (and colour unless no_colour);
+                     else (-o) colour and every AOV rendered */
+    unsigned aovs;
+    int no_colour; /* a display of AOVs alone ("z", "N"): their channels, no R, G, B, A */
 } Output;
 
 typedef struct Args {

@@ -206,54 +206,121 @@ static void scene_stem(const char *scene, char *out, size_t size)
         *dot = '\0';
 }
 
-static void add_output(Args *a, const char *path, ImageFormat format, int no_alpha)
+static Output *add_output(Args *a, const char *path, ImageFormat format, int no_alpha)
 {
     if (a->n_outputs == MAX_OUTPUTS)
-        return;
+        return NULL;
     Output *o = &a->outputs[a->n_outputs++];
+    memset(o, 0, sizeof *o);
     snprintf(o->path, sizeof o->path, "%s", path);
     o->format = format;
     o->no_alpha = no_alpha;
+    return o;
+}
+
+/* A display's mode: colour ("rgb", "rgba") and AOVs ("z", "N", "P",
+ * "id", "patch", with or without a type: "normal N"), comma-separated, or
+ * RenderMan's "rgbz" and "rgbaz". 0 when nothing in it is rendered (each
+ * part that is not is warned of); *colour 1 rgb, 2 rgba, 0 none. */
+static int display_mode(const IoDisplay *d, int aovs_ok, int *colour, unsigned *aovs)
+{
+    static const struct {
+        const char *name;
+        unsigned aov;
+    } names[] = {{"z", RAYES_AOV_Z},
+                 {"N", RAYES_AOV_N},
+                 {"P", RAYES_AOV_P},
+                 {"id", RAYES_AOV_ID},
+                 {"patch", RAYES_AOV_PATCH}};
+    *colour = 0, *aovs = 0;
+    char mode[sizeof d->mode];
+    snprintf(mode, sizeof mode, "%s", d->mode[0] ? d->mode : "rgba");
+    for (char *save = NULL, *tok = strtok_r(mode, ",", &save); tok;
+         tok = strtok_r(NULL, ",", &save)) {
+        while (*tok == ' ')
+            tok++;
+        const char *space = strrchr(tok, ' '), *name = space ? space + 1 : tok;
+        unsigned aov = 0;
+        for (size_t k = 0; k < sizeof names / sizeof names[0]; k++)
+            if (strcmp(name, names[k].name) == 0 || (k == 0 && strcmp(name, "Z") == 0))
+                aov = names[k].aov;
+        int rgb = strcasecmp(name, "rgb") == 0 || strcasecmp(name, "rgbz") == 0,
+            rgba = strcasecmp(name, "rgba") == 0 || strcasecmp(name, "rgbaz") == 0;
+        if (strcasecmp(name, "rgbz") == 0 || strcasecmp(name, "rgbaz") == 0)
+            aov = RAYES_AOV_Z;
+        if (rgb || rgba)
+            *colour = *colour == 2 || rgba ? 2 : 1;
+        if (aov && aovs_ok)
+            *aovs |= aov;
+        else if (aov || !(rgb || rgba))
+            fprintf(stderr,
+                    "rayes: warning: display \"%s\": \"%s\" is not rendered (%s); "
+                    "left out\n",
+                    d->name, tok,
+                    aov ? "AOVs are for one process without --checkpoint or --resume"
+                        : "only rgb, rgba, z, N, P, id and patch");
+    }
+    return *colour || *aovs;
 }
 
 /* The images a file's displays ask for: exr/openexr and png by type,
  * file and tiff by the name's extension, else OpenEXR (with a note);
- * framebuffer windows write nothing; displays of other modes than rgb and
- * rgba (AOVs) are skipped with a warning each. Mode rgb writes no alpha,
- * as RenderMan's displays do: a black background. */
-static void outputs_from_displays(Args *a, const IoSettings *s)
+ * framebuffer windows write nothing. A display's mode may name AOVs
+ * (display_mode): an EXR of them beside the colour, or alone; a PNG holds
+ * colour alone. --aov's AOVs go beside the colour of every EXR display. Mode rgb writes no alpha,
+ * as RenderMan's displays do: a black background. The AOVs asked for are added to a->opt.aovs. */
+static void outputs_from_displays(Args *a, const IoSettings *s, int aovs_ok)
 {
+    unsigned cli = a->opt.aovs; /* --aov's: beside the colour of every EXR display */
     for (int i = 0; i < s->n_displays && i < IO_MAX_DISPLAYS; i++) {
         const IoDisplay *d = &s->displays[i];
         const char *type = d->type[0] ? d->type : "file";
-        if (d->mode[0] && strcasecmp(d->mode, "rgb") != 0 && strcasecmp(d->mode, "rgba") != 0) {
-            fprintf(stderr, "rayes: warning: display \"%s\": mode \"%s\" is not rendered (only "
-                            "rgb and rgba); skipped\n", d->name, d->mode);
-            continue;
-        }
         if (strcasecmp(type, "framebuffer") == 0)
             continue;
-        int rgb = strcasecmp(d->mode, "rgb") == 0;
+        int colour;
+        unsigned aovs;
+        if (!display_mode(d, aovs_ok, &colour, &aovs))
+            continue;
+        int rgb = colour == 1;
+        ImageFormat f = IMAGE_FORMAT_UNKNOWN;
+        char path[600];
+        snprintf(path, sizeof path, "%s", d->name);
         if (strcasecmp(type, "exr") == 0 || strcasecmp(type, "openexr") == 0) {
-            add_output(a, d->name, IMAGE_FORMAT_EXR, rgb);
+            f = IMAGE_FORMAT_EXR;
         } else if (strcasecmp(type, "png") == 0) {
-            add_output(a, d->name, IMAGE_FORMAT_PNG, rgb);
+            f = IMAGE_FORMAT_PNG;
         } else if (strcasecmp(type, "file") == 0 || strcasecmp(type, "tiff") == 0) {
-            ImageFormat f = image_format_from_path(d->name);
-            if (f != IMAGE_FORMAT_UNKNOWN) {
-                add_output(a, d->name, f, rgb);
-                continue;
-            }
-            char path[600];
+            f = image_format_from_path(d->name);
+        } else {
+            fprintf(stderr,
+                    "rayes: warning: display \"%s\": type \"%s\" is not supported; "
+                    "skipped\n",
+                    d->name, type);
+            continue;
+        }
+        if (f == IMAGE_FORMAT_UNKNOWN) {
             const char *slash = strrchr(d->name, '/'), *dot = strrchr(d->name, '.');
             int stem = dot && (!slash || dot > slash) ? (int)(dot - d->name) : (int)strlen(d->name);
             snprintf(path, sizeof path, "%.*s.exr", stem, d->name);
             fprintf(stderr, "rayes: note: display \"%s\" (%s): written as OpenEXR to %s\n",
                     d->name, type, path);
-            add_output(a, path, IMAGE_FORMAT_EXR, rgb);
-        } else {
-            fprintf(stderr, "rayes: warning: display \"%s\": type \"%s\" is not supported; "
-                            "skipped\n", d->name, type);
+            f = IMAGE_FORMAT_EXR;
+        }
+        if (f == IMAGE_FORMAT_PNG && aovs) {
+            fprintf(stderr,
+                    "rayes: warning: display \"%s\": AOVs are written to EXR files "
+                    "only; %s\n",
+                    d->name, colour ? "its colour alone is written" : "skipped");
+            aovs = 0;
+            if (!colour)
+                continue;
+        }
+        Output *o = add_output(a, path, f, rgb);
+        if (o) {
+            o->display = 1;
+            o->aovs = aovs | (colour && f == IMAGE_FORMAT_EXR ? cli : 0);
+            o->no_colour = !colour;
+            a->opt.aovs |= aovs;
         }
     }
 }
@@ -280,9 +347,33 @@ static RayesError write_output(const Output *o, const RayesImage *img, int linea
     int win[4] = {0, 0, img->width, img->height};
     if (img->crop[2] > 0)
         memcpy(win, img->crop, sizeof win);
-    if (o->format != IMAGE_FORMAT_PNG)
-        return image_write_exr_window(o->path, img->width, img->height, img->rgba, win, flags, err,
-                                      n);
+    if (o->format != IMAGE_FORMAT_PNG) {
+        /* the AOVs it writes: a display's own (a subset of the image's), or all */
+        unsigned want = img->aov ? (o->display ? o->aovs & img->aovs : img->aovs) : 0;
+        int k = rayes_aov_channels(want);
+        const char *names[RAYES_AOV_CHANNELS_MAX];
+        float *aov = want == img->aovs ? img->aov : NULL;
+        size_t npix = (size_t)img->width * (size_t)img->height;
+        if (k && !aov && !(aov = malloc(sizeof(float) * (size_t)k * npix))) {
+            snprintf(err, n, "%s: out of memory", o->path);
+            return RAYES_ERROR_OUT_OF_MEMORY;
+        }
+        for (int c = 0, from = 0; c < k; c++) {
+            names[c] = rayes_aov_channel_name(want, c);
+            while (strcmp(rayes_aov_channel_name(img->aovs, from), names[c]) != 0)
+                from++;
+            for (size_t i = 0; aov != img->aov && i < npix; i++)
+                aov[(size_t)k * i + (size_t)c] =
+                    img->aov[(size_t)img->aov_channels * i + (size_t)from];
+        }
+        if (o->no_colour && k)
+            flags |= IMAGE_NO_COLOUR;
+        RayesError e = image_write_exr_aov(o->path, img->width, img->height, img->rgba, win, flags,
+                                           aov, k, names, err, n);
+        if (aov != img->aov)
+            free(aov);
+        return e;
+    }
     if (win[2] == img->width && win[3] == img->height)
         return image_write_png_curve(o->path, img->width, img->height, img->rgba, flags, err, n);
     float *crop = malloc(sizeof(float) * 4 * (size_t)win[2] * (size_t)win[3]);
@@ -372,6 +463,14 @@ static int cmd_render(int argc, char **argv)
     parse_args(argc, argv, &a);
     if (d && (a.checkpoint_s >= 0.0 || a.resume))
         die_usage("--checkpoint and --resume are for one process, not an MPI job");
+    if (a.opt.aovs && (d || a.checkpoint_s >= 0.0 || a.resume))
+        die_usage("--aov is for one process without --checkpoint or --resume (their tiles carry "
+                  "colour alone)");
+    int exr = a.n_outputs == 0; /* a scene file's displays may be EXR; the default is */
+    for (int k = 0; k < a.n_outputs; k++)
+        exr |= a.outputs[k].format == IMAGE_FORMAT_EXR;
+    if (a.opt.aovs && !exr)
+        fprintf(stderr, "rayes: warning: --aov: no -o output is EXR, where AOVs are written\n");
     if (distribute_rank(d) != 0) /* rank 0 speaks for the job */
         a.quiet = 1, a.progress_json = 0, a.stats_path = NULL;
     if (!a.frames) {
@@ -450,7 +549,7 @@ static int render_job(Args a, int frame, int number, Distributed *d)
     }
     merge_settings(&a, &settings);
     if (a.n_outputs == 0) {
-        outputs_from_displays(&a, &settings);
+        outputs_from_displays(&a, &settings, !d && a.checkpoint_s < 0.0 && !a.resume);
         if (a.n_outputs == 0) {
             char stem[512], path[600];
             scene_stem(a.scene, stem, sizeof stem);

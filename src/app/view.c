@@ -774,6 +774,8 @@ int cmd_view(int argc, char **argv)
 {
     Args a = {.view = 1};
     parse_args(argc, argv, &a);
+    if (a.opt.aovs)
+        die_usage("--aov: rayes view shows colour alone; use rayes render");
 #ifndef RAYES_HAVE_SDL
     if (!a.headless) {
         fprintf(stderr, "rayes: view: built without SDL2 (libsdl2-dev); use --headless\n");

@@ -35,7 +35,7 @@ ImageFormat image_format_from_path(const char *path);
  * gamma the only curve (else the sRGB curve and chunk);
  * IMAGE_NO_ALPHA R, G, B only (RenderMan's display mode "rgb": what no
  * surface covers is black, not transparent). */
-enum { IMAGE_LINEAR = 1, IMAGE_NO_ALPHA = 2 };
+enum { IMAGE_LINEAR = 1, IMAGE_NO_ALPHA = 2, IMAGE_NO_COLOUR = 4 /* EXR: the AOVs alone */ };
 
 /* EXR: half-float R, G, B, A channels, ZIP compression, scanlines, with a
  * "renderer" string attribute. */
@@ -46,6 +46,13 @@ RayesError image_write_exr(const char *path, int width, int height, const float 
  * (IMAGE_NO_ALPHA). */
 RayesError image_write_exr_window(const char *path, int width, int height, const float *rgba,
                                   const int window[4], int flags, char *err, size_t err_size);
+
+/* The same with aov_channels 32-bit float channels more, named
+ * aov_names[c], from aov (width * height * aov_channels floats): a
+ * render's AOVs (RayesImage.aov) beside its colour. */
+RayesError image_write_exr_aov(const char *path, int width, int height, const float *rgba,
+                               const int window[4], int flags, const float *aov, int aov_channels,
+                               const char *const *aov_names, char *err, size_t err_size);
 
 /* PNG: 8-bit RGBA, sRGB-encoded (the sRGB transfer curve applied to the
  * clamped linear values, alpha linear), with an sRGB chunk. */

@@ -71,6 +71,9 @@ typedef struct ExrImage {
     const float *rgba; /* width * height * 4, top row first */
     int x0, y0, w, h;  /* the data window written: its corner and size */
     int channels;      /* 4: R, G, B, A; 3: R, G, B */
+    const float *aov;  /* width * height * aov_channels floats, or NULL */
+    int aov_channels;
+    const char *const *aov_names; /* their channels' names (32-bit float channels) */
 } ExrImage;
 
 /* ------------------------------------------------------------ callbacks */
@@ -215,23 +218,33 @@ static exr_result_t define_part(exr_context_t ctx, const ExrImage *image)
     for (int i = 0; i < image->channels && rv == EXR_ERR_SUCCESS; i++)
         rv = exr_add_channel(ctx, part, names[i], EXR_PIXEL_HALF,
                              i == 3 ? EXR_PERCEPTUALLY_LINEAR : EXR_PERCEPTUALLY_LOGARITHMIC, 1, 1);
+    for (int i = 0; i < image->aov_channels && rv == EXR_ERR_SUCCESS; i++)
+        rv = exr_add_channel(ctx, part, image->aov_names[i], EXR_PIXEL_FLOAT,
+                             EXR_PERCEPTUALLY_LINEAR, 1, 1);
     if (rv == EXR_ERR_SUCCESS)
         rv = exr_attr_set_string(ctx, part, "renderer", "rayes");
     return rv;
 }
 
 /* Points the encoder's channels (sorted by name) at the interleaved floats
- * of the chunk's first line. */
-static void bind_encode_channels(exr_encode_pipeline_t *encoder, const float *first_line, int width)
+ * of the chunk's first line y: RGBA's, or the AOVs'. */
+static void bind_encode_channels(exr_encode_pipeline_t *encoder, const ExrImage *image, int y)
 {
+    size_t first = (size_t)y * (size_t)image->width + (size_t)image->x0;
     for (int c = 0; c < encoder->channel_count; c++) {
         exr_coding_channel_info_t *chan = &encoder->channels[c];
-        int slot = rgba_slot(chan->channel_name);
-        chan->encode_from_ptr = (const uint8_t *)(first_line + (slot < 0 ? 0 : slot));
+        int slot = rgba_slot(chan->channel_name), n = 4;
+        const float *from = image->rgba + first * 4;
+        for (int k = 0; slot < 0 && k < image->aov_channels; k++)
+            if (strcmp(chan->channel_name, image->aov_names[k]) == 0) {
+                slot = k, n = image->aov_channels;
+                from = image->aov + first * (size_t)n;
+            }
+        chan->encode_from_ptr = (const uint8_t *)(from + (slot < 0 ? 0 : slot));
         chan->user_data_type = EXR_PIXEL_FLOAT;
         chan->user_bytes_per_element = (int16_t)sizeof(float);
-        chan->user_pixel_stride = (int32_t)(4 * sizeof(float));
-        chan->user_line_stride = (int32_t)(4 * sizeof(float)) * width;
+        chan->user_pixel_stride = (int32_t)(n * sizeof(float));
+        chan->user_line_stride = (int32_t)(n * sizeof(float)) * image->width;
     }
 }
 
@@ -253,9 +266,7 @@ static exr_result_t write_chunks(exr_context_t ctx, const ExrImage *image)
                          : exr_encoding_initialize(ctx, 0, &cinfo, &encoder);
         if (rv != EXR_ERR_SUCCESS)
             break;
-        bind_encode_channels(&encoder,
-                             image->rgba + ((size_t)y * (size_t)image->width + (size_t)image->x0) * 4,
-                             image->width);
+        bind_encode_channels(&encoder, image, y);
         if (!initialized) {
             initialized = true;
             rv = exr_encoding_choose_default_routines(ctx, 0, &encoder);
@@ -304,6 +315,21 @@ RayesError image_write_exr(const char *path, int width, int height, const float 
 RayesError image_write_exr_window(const char *path, int width, int height, const float *rgba,
                                   const int window[4], int flags, char *err, size_t err_size)
 {
+    return image_write_exr_aov(path, width, height, rgba, window, flags, NULL, 0, NULL, err,
+                               err_size);
+}
+
+RayesError image_write_exr_aov(const char *path, int width, int height, const float *rgba,
+                               const int window[4], int flags, const float *aov, int aov_channels,
+                               const char *const *aov_names, char *err, size_t err_size)
+{
+    for (int i = 0; i < aov_channels; i++) /* names EXR can hold, none of R, G, B, A twice */
+        if (!aov || !aov_names || !aov_names[i] || !aov_names[i][0] ||
+            rgba_slot(aov_names[i]) >= 0) {
+            image_set_error(err, err_size, "%s: cannot write EXR: invalid AOV channel %d",
+                            path ? path : "(null)", i);
+            return RAYES_ERROR_INVALID_ARGUMENT;
+        }
     if (!path || !rgba || width <= 0 || height <= 0 || width > MAX_SIDE || window[0] < 0 ||
         window[1] < 0 || window[2] <= 0 || window[3] <= 0 || window[0] + window[2] > width ||
         window[1] + window[3] > height) {
@@ -311,8 +337,11 @@ RayesError image_write_exr_window(const char *path, int width, int height, const
                      path ? path : "(null)", width, height, rgba ? "" : ", no pixels");
         return RAYES_ERROR_INVALID_ARGUMENT;
     }
-    ExrImage image = {width,     height,    rgba,      window[0],
-                      window[1], window[2], window[3], flags & IMAGE_NO_ALPHA ? 3 : 4};
+    ExrImage image = {width,     height,       rgba,      window[0],
+                      window[1], window[2],    window[3], flags & IMAGE_NO_ALPHA ? 3 : 4,
+                      aov,       aov_channels, aov_names};
+    if ((flags & IMAGE_NO_COLOUR) && aov_channels > 0)
+        image.channels = 0;
     return image_write_via_temp(path, write_exr_body, &image, err, err_size);
 }
 

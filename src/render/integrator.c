@@ -327,6 +327,21 @@ static Vec3 trace_volumes(Worker *w, const Ray *ray, uint32_t kind, int diffuse_
                           int specular_depth, uint64_t key, RayDiff diff, float *t, float *alpha,
                           int layer);
 
+/* A camera sample's AOVs from the surface it sees first (RayesAov): the
+ * first it meets that is not a hole (a cut-out's Os 0 is passed). */
+static void aov_capture(Worker *w, const Ray *ray, const Hit *hit, const RenderObject *obj)
+{
+    HitPoint hp;
+    hit_point(w, ray, hit, obj, &hp);
+    AovSample *a = w->aov;
+    a->set = 1;
+    a->P = v3_load(hp.P);
+    a->N = v3_load(hp.N);
+    a->z = v3_dot(v3_sub(a->P, ray->o), w->rs->camera.forward);
+    a->id = (uint32_t)(obj - w->rs->objects) + 1;
+    a->patch = hit->grid + 1;
+}
+
 static Vec3 trace_layers(Worker *w, const Ray *ray, uint32_t kind, int diffuse_depth,
                          int specular_depth, uint64_t key, RayDiff diff, float *t, float *alpha,
                          int layer, int64_t *leaving)
@@ -363,7 +378,10 @@ static Vec3 trace_layers(Worker *w, const Ray *ray, uint32_t kind, int diffuse_d
     const RenderObject *obj = render_object(w->rs, hit.grid, hit.instance);
     if (v3_dot(hit.Ng, ray->d) > 0.0f) /* out through its back: the ray was inside it */
         *leaving = obj - w->rs->objects;
+    int aov = w->aov && !w->aov->set && kind == RAYES_RAY_CAMERA;
     if (obj->light >= 0) {
+        if (aov)
+            aov_capture(w, ray, &hit, obj);
         /* Emitters: seen by camera and specular rays, on their front side
          * or both (not by glossy-lobe rays: direct lighting has them). */
         const Light *l = &w->rs->lights[obj->light];
@@ -396,6 +414,8 @@ static Vec3 trace_layers(Worker *w, const Ray *ray, uint32_t kind, int diffuse_d
     } else {
         Ci = shade_hit(w, ray, &hit, obj, kind, diffuse_depth, specular_depth, key, diff, &Oi);
     }
+    if (aov && !(obj->transparent && !(v3_max_component(Oi) > 0.0f))) /* not a hole */
+        aov_capture(w, ray, &hit, obj);
     if (!see_through)
         return Ci;
     Vec3 T = v3(1.0f - fminf(fmaxf(Oi.x, 0.0f), 1.0f), 1.0f - fminf(fmaxf(Oi.y, 0.0f), 1.0f),

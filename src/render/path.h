@@ -94,6 +94,7 @@ typedef struct Worker {
     GuideSlot guides[ENVGUIDE_LIGHTS];  /* environment lights' last guides (envguide.h) */
     const uint32_t *guide_pixels;       /* envguide_pixels's counts, or NULL: no guides (but
                                            the grid hider's) */
+    AovSample *aov;                     /* the camera sample being traced's AOVs, or NULL */
 } Worker;
 
 /* What a shading context's `renderer` points to: per point (indexed from

@@ -52,6 +52,9 @@ typedef struct Frame {
     int adaptive;             /* adaptive sampling (RenderSettings.max_spp) */
     double frame_mean;        /* adaptive sampling: the frame's mean luminance (estimated) */
     int margin;               /* pixels of neighbours whose samples reach a tile */
+    int aov_channels;         /* rayes_aov_channels(set->aovs) */
+    float **aov_acc;          /* per worker, its tile's AOV sums (AOV_ACC floats a pixel), or
+                                 NULL: no AOVs */
     atomic_int cancelled;
     atomic_size_t tiles_done;
     pthread_mutex_t progress_lock;
@@ -198,6 +201,44 @@ static double relative_variance(int n, double y, double y2)
     return mean > 0.0 ? fmax(var, 0.0) / (mean * mean) : 0.0;
 }
 
+/* A tile pixel's AOV sums: the nearest sample's z, id and patch (among
+ * those the filter weighs positively; the first of equals), then w N and
+ * w P summed as colours are. */
+enum { AOV_Z, AOV_ID, AOV_PATCH, AOV_N, AOV_P = AOV_N + 3, AOV_ACC = AOV_P + 3 };
+
+static void aov_splat(float *a, const AovSample *s, float wgt)
+{
+    if (!s->set)
+        return;
+    if (wgt > 0.0f && s->z < a[AOV_Z]) {
+        a[AOV_Z] = s->z;
+        a[AOV_ID] = (float)s->id;
+        a[AOV_PATCH] = (float)s->patch;
+    }
+    const float v[6] = {s->N.x, s->N.y, s->N.z, s->P.x, s->P.y, s->P.z};
+    for (int c = 0; c < 6; c++)
+        a[AOV_N + c] += wgt * v[c];
+}
+
+/* The tile's AOVs into the frame's (RenderSettings.aov), channels in the
+ * order of the bits (rayes_aov_channel_name). */
+static void aov_write(const Frame *f, const float *acc5, const float *a, float *out)
+{
+    unsigned aovs = f->set->aovs;
+    float inv = acc5[4] > 0.0f ? 1.0f / acc5[4] : 0.0f;
+    int c = 0;
+    if (aovs & RAYES_AOV_Z)
+        out[c++] = a[AOV_Z];
+    for (int k = 0; k < 3 && (aovs & RAYES_AOV_N); k++)
+        out[c++] = a[AOV_N + k] * inv;
+    for (int k = 0; k < 3 && (aovs & RAYES_AOV_P); k++)
+        out[c++] = a[AOV_P + k] * inv;
+    if (aovs & RAYES_AOV_ID)
+        out[c++] = a[AOV_ID];
+    if (aovs & RAYES_AOV_PATCH)
+        out[c++] = a[AOV_PATCH];
+}
+
 /* Samples k0 to k1 - 1 of pixel (px, py), splatted into the tile's
  * accumulators when splat is set (with adaptive sampling, the first block
  * of a pixel just outside the filter's reach is taken for its variance
@@ -250,8 +291,12 @@ static void render_samples(Frame *f, Worker *w, int px, int py, int x0, int y0, 
         diff.lens /= sqrtf((float)n);
         float alpha;
         w->stats.rays_camera++;
+        AovSample aov = {0};
+        float *aov_acc = f->aov_acc ? f->aov_acc[w - f->workers] : NULL;
+        w->aov = aov_acc ? &aov : NULL;
         Vec3 L = integrator_trace(w, &ray, RAYES_RAY_CAMERA, 0, 0,
                                   hash_combine(pixel_key, (uint64_t)s + 1), diff, &alpha);
+        w->aov = NULL;
         float top = fmaxf(L.x, fmaxf(L.y, L.z));
         if (set->sample_clamp > 0.0f && top > set->sample_clamp) /* as pbrt-v4's film does */
             L = v3_scale(L, set->sample_clamp / top);
@@ -267,6 +312,8 @@ static void render_samples(Frame *f, Worker *w, int px, int py, int x0, int y0, 
                 if (wgt == 0.0f)
                     continue; /* negative lobes count */
                 float *a = acc[(qy - y0) * tw + (qx - x0)];
+                if (aov_acc)
+                    aov_splat(&aov_acc[AOV_ACC * (size_t)((qy - y0) * tw + (qx - x0))], &aov, wgt);
                 a[0] += wgt * L.x;
                 a[1] += wgt * L.y;
                 a[2] += wgt * L.z;
@@ -444,6 +491,16 @@ static void render_tile(void *ctx, size_t task, int worker)
         for (int y = 0; y < th; y++)
             memcpy(acc[y * tw], set->accum[(size_t)(y0 + y) * set->width + x0], sizeof *acc * tw);
     Worker *w = &f->workers[worker];
+    float *aov_acc = NULL;
+    if (f->aov_acc) {
+        aov_acc = malloc(sizeof *aov_acc * AOV_ACC * (size_t)tw * th);
+        RY_CHECK(aov_acc != NULL);
+        for (size_t i = 0; i < (size_t)tw * th; i++) {
+            memset(&aov_acc[AOV_ACC * i], 0, sizeof *aov_acc * AOV_ACC);
+            aov_acc[AOV_ACC * i + AOV_Z] = INFINITY;
+        }
+        f->aov_acc[worker] = aov_acc;
+    }
     int ex0 = RY_MAX(x0 - f->margin, 0), ex1 = RY_MIN(x0 + tw + f->margin, set->width);
     int ey0 = RY_MAX(y0 - f->margin, 0), ey1 = RY_MIN(y0 + th + f->margin, set->height);
     if (f->adaptive)
@@ -456,6 +513,7 @@ static void render_tile(void *ctx, size_t task, int worker)
             }
     if (stopped(f)) { /* its rays came back black somewhere: abandoned */
         free(acc);
+        free(aov_acc);
         return;
     }
     for (int y = 0; y < th; y++)
@@ -466,7 +524,12 @@ static void render_tile(void *ctx, size_t task, int worker)
             for (int c = 0; c < 4; c++)
                 out[c] = a[c] * inv;
             out[3] = fminf(fmaxf(out[3], 0.0f), 1.0f); /* coverage, rung by negative lobes */
+            if (aov_acc)
+                aov_write(f, a, &aov_acc[AOV_ACC * (size_t)(y * tw + x)],
+                          &set->aov[(size_t)f->aov_channels *
+                                    ((size_t)(y0 + y) * set->width + (x0 + x))]);
         }
+    free(aov_acc);
     if (set->accum)
         for (int y = 0; y < th; y++)
             memcpy(set->accum[(size_t)(y0 + y) * set->width + x0], acc[y * tw], sizeof *acc * tw);
@@ -550,6 +613,12 @@ int render_frame(const RenderScene *rs, const RenderSettings *set, float *rgba, 
     }
     if (!set->accum)
         memset(rgba, 0, sizeof(float) * 4 * (size_t)set->width * set->height);
+    if (set->aovs && set->aov && !set->accum) {
+        f.aov_channels = rayes_aov_channels(set->aovs);
+        memset(set->aov, 0, sizeof(float) * (size_t)f.aov_channels * set->width * set->height);
+        f.aov_acc = calloc((size_t)threads, sizeof *f.aov_acc);
+        RY_CHECK(f.aov_acc != NULL);
+    }
     f.adaptive = set->max_spp > set->spp && !set->accum;
     if (f.adaptive)
         f.frame_mean = frame_mean(&f, &f.workers[0]);
@@ -561,6 +630,7 @@ int render_frame(const RenderScene *rs, const RenderSettings *set, float *rgba, 
     }
     stats->table_bytes = RY_MAX(stats->table_bytes, optable_bytes(optable));
     free(f.workers);
+    free(f.aov_acc);
     free(pixels);
     hider_free(gsh);
     optable_free(optable);

@@ -112,6 +112,16 @@ static inline const GeomInstance *render_instance(const RenderScene *rs, uint32_
     return instance ? &rs->gs->instances[instance - 1] : (const GeomInstance *)0;
 }
 
+/* What a camera sample's first visible surface says (RayesAov), filled by
+ * the integrator (integrator.c) where Worker.aov points. */
+typedef struct AovSample {
+    int set;        /* 0: no surface (yet) */
+    float z;        /* along the camera's view axis from the ray's origin */
+    Vec3 N, P;      /* world: the shading normal facing the ray, the point */
+    uint32_t id;    /* 1 + the render object */
+    uint32_t patch; /* 1 + the grid */
+} AovSample;
+
 typedef struct RenderSettings {
     int width, height, spp, threads, tile_size;
     int crop[4];                  /* the pixels rendered: x0, y0, x1, y1 (exclusive ends);
@@ -167,6 +177,9 @@ typedef struct RenderSettings {
                                      g % pattern_spp of block g / pattern_spp's pattern */
     float (*accum)[5];            /* width * height running sums (w r, w g, w b, w a, w) the
                                      frame adds to, or NULL: the frame's samples alone */
+    unsigned aovs;                /* RayesAov bits (not with accum) */
+    float *aov;                   /* width * height * rayes_aov_channels(aovs) floats the
+                                     frame writes, or NULL */
     atomic_int *cancel;           /* nonzero: stop (tiles not yet started are skipped) */
     void (*tile_done)(void *user, int x, int y, int w, int h, const float *rgba, int stride);
     void *tile_user;              /* tile_done gets the frame's rgba and its row stride */

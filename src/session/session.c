@@ -119,7 +119,36 @@ void rayes_image_free(RayesImage *image)
     if (!image)
         return;
     free(image->rgba);
+    free(image->aov);
     free(image);
+}
+
+/* The AOVs' channels, in the order of their bits (RayesAov). */
+static const struct {
+    unsigned aov;
+    const char *names[3];
+} aov_table[] = {{RAYES_AOV_Z, {"Z"}},
+                 {RAYES_AOV_N, {"N.X", "N.Y", "N.Z"}},
+                 {RAYES_AOV_P, {"P.X", "P.Y", "P.Z"}},
+                 {RAYES_AOV_ID, {"id"}},
+                 {RAYES_AOV_PATCH, {"patch"}}};
+
+int rayes_aov_channels(unsigned aovs)
+{
+    int n = 0;
+    for (size_t k = 0; k < sizeof aov_table / sizeof aov_table[0]; k++)
+        for (int c = 0; c < 3 && (aovs & aov_table[k].aov) && aov_table[k].names[c]; c++)
+            n++;
+    return n;
+}
+
+const char *rayes_aov_channel_name(unsigned aovs, int channel)
+{
+    for (size_t k = 0; k < sizeof aov_table / sizeof aov_table[0]; k++)
+        for (int c = 0; c < 3 && (aovs & aov_table[k].aov) && aov_table[k].names[c]; c++)
+            if (channel-- == 0)
+                return aov_table[k].names[c];
+    return NULL;
 }
 
 RayesError session_check_options(RayesScene *scene, const RayesRenderOptions *o)
@@ -153,6 +182,8 @@ RayesError session_check_options(RayesScene *scene, const RayesRenderOptions *o)
                "solid angle in (0, 12.57] and its raster even, 2 to 64";
     else if (o->hider != RAYES_HIDER_RAYTRACE && o->hider != RAYES_HIDER_GRID)
         what = "options: hider must be RAYES_HIDER_RAYTRACE or RAYES_HIDER_GRID";
+    else if (o->aovs & ~(unsigned)RAYES_AOV_ALL)
+        what = "options: aovs must be RayesAov bits";
     else if (o->tile_size < 1 || o->threads < 0 || o->threads > 1024)
         what = "options: tile size must be positive and threads 0 to 1024";
     else if (!(o->cache_mb >= 0.0) || o->cache_mb > 1e7 || !(o->cache_k > 0.0f) ||
@@ -558,6 +589,10 @@ RayesError rayes_render(RayesScene *scene, const RayesRenderOptions *opt, RayesI
     memset(&prep, 0, sizeof prep);
     RayesImage *img = calloc(1, sizeof *img);
     float *rgba = malloc(sizeof(float) * 4 * (size_t)set.width * set.height);
+    size_t aov_floats = (size_t)rayes_aov_channels(opt->aovs) * set.width * set.height;
+    float *aov = aov_floats ? malloc(sizeof(float) * aov_floats) : NULL;
+    set.aovs = aov ? opt->aovs : 0;
+    set.aov = aov;
     Cache *cache = NULL;
     AccelRecord *record = NULL;
     TextureSystem *textures = session_textures(scene, opt->texture_mb, opt->texture_width);
@@ -565,7 +600,7 @@ RayesError rayes_render(RayesScene *scene, const RayesRenderOptions *opt, RayesI
     PbgiCloud *cloud = NULL;
     PbgiTimes pbgi_times = {0};
     set.textures = textures;
-    if (!img || !rgba || !textures) {
+    if (!img || !rgba || !textures || (aov_floats && !aov)) {
         e = session_fail(scene, RAYES_ERROR_OUT_OF_MEMORY, "render: out of memory");
         goto done;
     }
@@ -645,6 +680,10 @@ RayesError rayes_render(RayesScene *scene, const RayesRenderOptions *opt, RayesI
     img->width = set.width;
     img->height = set.height;
     img->rgba = rgba;
+    img->aovs = set.aovs;
+    img->aov_channels = rayes_aov_channels(set.aovs);
+    img->aov = aov;
+    aov = NULL;
     if (set.crop[0] > 0 || set.crop[1] > 0 || set.crop[2] < set.width || set.crop[3] < set.height) {
         img->crop[0] = set.crop[0], img->crop[1] = set.crop[1];
         img->crop[2] = set.crop[2] - set.crop[0], img->crop[3] = set.crop[3] - set.crop[1];
@@ -659,6 +698,7 @@ done:
     session_prepared_fini(&prep);
     texture_system_free(textures);
     free(rgba);
+    free(aov);
     free(img);
     return e;
 }

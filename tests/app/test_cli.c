@@ -962,6 +962,68 @@ static void test_display_modes(void)
     CHECK(r.status == 0 && png_colour_type(SCRATCH_DIR "/modes-o.png") == 6);
 }
 
+/* The EXR channels oiiotool lists for path ("" when it is not installed). */
+static void exr_channels(const char *path, char *out, size_t size)
+{
+    char cmd[1024];
+    snprintf(cmd, sizeof cmd, "oiiotool --info -v %s 2>/dev/null | grep 'channel list'", path);
+    FILE *p = popen(cmd, "r");
+    size_t n = p ? fread(out, 1, size - 1, p) : 0;
+    out[n] = '\0';
+    if (p)
+        pclose(p);
+}
+
+/* AOVs: --aov's beside the colour of -o's EXR; a display whose mode names
+ * AOVs writes them, alone or beside colour; a PNG or an unknown mode is
+ * warned of; bad lists and --aov with --checkpoint are usage errors. */
+static void test_aovs(void)
+{
+    static Run r;
+    setup();
+    test_write_text(SCRATCH_DIR "/aov.rib",
+                    "Format 16 12 1\nDisplay \"" SCRATCH_DIR
+                    "/aov-beauty.exr\" \"openexr\" \"rgba\"\n"
+                    "Display \"+" SCRATCH_DIR "/aov-z.exr\" \"openexr\" \"z\"\n"
+                    "Display \"+" SCRATCH_DIR "/aov-np.exr\" \"openexr\" \"normal N,rgb\"\n"
+                    "Display \"+" SCRATCH_DIR "/aov-n.png\" \"png\" \"N\"\n"
+                    "Display \"+" SCRATCH_DIR "/aov-d.exr\" \"openexr\" \"color diffuse\"\n"
+                    "Projection \"perspective\" \"fov\" 40\n"
+                    "WorldBegin\nTranslate 0 0 5\nSphere 1 -1 1 360\nWorldEnd\n");
+    run(&r, NULL, ARGS("render", SCRATCH_DIR "/aov.rib", "--spp", "1", "--quiet", "--aov", "id"));
+    CHECK(r.status == 0);
+    CHECK(strstr(r.err, "aov-n.png") && strstr(r.err, "EXR files only"));
+    CHECK(strstr(r.err, "color diffuse") && strstr(r.err, "not rendered"));
+    CHECK(access(SCRATCH_DIR "/aov-z.exr", F_OK) == 0 &&
+          access(SCRATCH_DIR "/aov-n.png", F_OK) != 0);
+    CHECK(access(SCRATCH_DIR "/aov-d.exr", F_OK) != 0);
+    int w = 0, h = 0;
+    float *px = NULL;
+    char err[256], ch[1024];
+    CHECK(image_read_exr(SCRATCH_DIR "/aov-np.exr", &w, &h, &px, err, sizeof err) == RAYES_OK);
+    CHECK(w == 16 && h == 12);
+    free(px);
+    exr_channels(SCRATCH_DIR "/aov-z.exr", ch, sizeof ch);
+    if (ch[0]) { /* oiiotool is installed */
+        CHECK(strstr(ch, "Z") && !strstr(ch, "R"));
+        exr_channels(SCRATCH_DIR "/aov-np.exr", ch, sizeof ch);
+        CHECK(strstr(ch, "N.X") && strstr(ch, "B") && !strstr(ch, "A") && strstr(ch, "id"));
+        exr_channels(SCRATCH_DIR "/aov-beauty.exr", ch, sizeof ch);
+        CHECK(strstr(ch, "id") && strstr(ch, "A") && !strstr(ch, "Z"));
+    }
+    run(&r, NULL,
+        ARGS("render", SCRATCH_DIR "/aov.rib", "--spp", "1", "--quiet", "--aov", "z,P", "-o",
+             SCRATCH_DIR "/aov-o.exr", "-o", SCRATCH_DIR "/aov-o.png"));
+    CHECK(r.status == 0 && access(SCRATCH_DIR "/aov-o.png", F_OK) == 0);
+    exr_channels(SCRATCH_DIR "/aov-o.exr", ch, sizeof ch);
+    if (ch[0])
+        CHECK(strstr(ch, "Z") && strstr(ch, "P.Z") && strstr(ch, "R") && !strstr(ch, "N.X"));
+    run(&r, NULL, ARGS("render", SCRATCH_DIR "/aov.rib", "--aov", "z,depth"));
+    CHECK(r.status == 2 && strstr(r.err, "depth"));
+    run(&r, NULL, ARGS("render", SCRATCH_DIR "/aov.rib", "--aov", "z", "--checkpoint", "5"));
+    CHECK(r.status == 2 && strstr(r.err, "--aov"));
+}
+
 TEST_MAIN(TEST(test_version_and_help), TEST(test_no_arguments), TEST(test_usage_errors),
           TEST(test_missing_data), TEST(test_render_outputs), TEST(test_render_summary),
           TEST(test_data_from_environment), TEST(test_unwritable_output), TEST(test_shader_path),
@@ -970,4 +1032,4 @@ TEST_MAIN(TEST(test_version_and_help), TEST(test_no_arguments), TEST(test_usage_
           TEST(test_null_displacement), TEST(test_default_light), TEST(test_convert),
           TEST(test_bad_scene_file), TEST(test_frames_and_crop), TEST(test_background_imager),
           TEST(test_display_modes), TEST(test_light_shadows_attribute), TEST(test_quiet_requests),
-          TEST(test_res_width_keeps_aspect))
+          TEST(test_res_width_keeps_aspect), TEST(test_aovs))
