@@ -1028,10 +1028,16 @@ typedef enum RayesAov {
                                   sample, in the order the scene made them; 0: none */
     RAYES_AOV_PATCH = 1u << 4, /* "patch": 1 + the grid (diced patch, the radiosity cache's
                                   entry) of the nearest sample; 0: none */
-    RAYES_AOV_ALL = 0x1f
+    RAYES_AOV_CACHE = 1u << 5, /* "cache": the radiosity cache's resolution the pixel's
+                                  diffuse rays read at their first hits, by ray differentials
+                                  (memo 3.2), averaged over the pixel's look-ups: 0 coarse
+                                  (or a cluster of grids), 1 medium, 2 fine; -1 where no
+                                  sample traced any of its own (lights, the background,
+                                  --cache off, and grids the grid hider shades once) */
+    RAYES_AOV_ALL = 0x3f
 } RayesAov;
 
-#define RAYES_AOV_CHANNELS_MAX 9 /* rayes_aov_channels(RAYES_AOV_ALL) */
+#define RAYES_AOV_CHANNELS_MAX 10 /* rayes_aov_channels(RAYES_AOV_ALL) */
 
 /* The float channels of aovs (RayesAov bits), and the name of channel c
  * ("Z", "N.X", ...; NULL when c is out of range): channels come in the

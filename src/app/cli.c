@@ -127,7 +127,8 @@ static const char render_options[] =
     "  --aov LIST              arbitrary output variables written as float channels beside\n"
     "                          the colour of EXR outputs, a comma-separated list of z (Z:\n"
     "                          depth), N (world normal), P (world position), id (object),\n"
-    "                          patch (the grid, the radiosity cache's entry), all\n"
+    "                          patch (the grid, the radiosity cache's entry), cache (the\n"
+    "                          resolution diffuse rays read: 0 coarse to 2 fine), all\n"
     "  --replay-rays           keep the render's rays and trace them again unshaded: the\n"
     "                          summary and the statistics' replay block say what ray\n"
     "                          casting alone costs (48 bytes a ray while rendering)\n"
@@ -139,8 +140,9 @@ static unsigned parse_aovs(const char *v)
     static const struct {
         const char *name;
         unsigned aov;
-    } names[] = {{"z", RAYES_AOV_Z},   {"N", RAYES_AOV_N},         {"P", RAYES_AOV_P},
-                 {"id", RAYES_AOV_ID}, {"patch", RAYES_AOV_PATCH}, {"all", RAYES_AOV_ALL}};
+    } names[] = {{"z", RAYES_AOV_Z},    {"N", RAYES_AOV_N},         {"P", RAYES_AOV_P},
+                 {"id", RAYES_AOV_ID},  {"patch", RAYES_AOV_PATCH}, {"cache", RAYES_AOV_CACHE},
+                 {"all", RAYES_AOV_ALL}};
     unsigned aovs = 0;
     for (const char *s = v; *s;) {
         size_t n = strcspn(s, ","), k = 0;
@@ -148,14 +150,14 @@ static unsigned parse_aovs(const char *v)
                !(strlen(names[k].name) == n && strncmp(names[k].name, s, n) == 0))
             k++;
         if (k == sizeof names / sizeof names[0])
-            die_usage("--aov: expected z, N, P, id, patch or all (comma-separated), found "
+            die_usage("--aov: expected z, N, P, id, patch, cache or all (comma-separated), found "
                       "\"%.*s\"",
                       (int)n, s);
         aovs |= names[k].aov;
         s += n + (s[n] == ',');
     }
     if (!aovs)
-        die_usage("--aov: expected z, N, P, id, patch or all");
+        die_usage("--aov: expected z, N, P, id, patch, cache or all");
     return aovs;
 }
 

@@ -227,11 +227,8 @@ static int display_mode(const IoDisplay *d, int aovs_ok, int *colour, unsigned *
     static const struct {
         const char *name;
         unsigned aov;
-    } names[] = {{"z", RAYES_AOV_Z},
-                 {"N", RAYES_AOV_N},
-                 {"P", RAYES_AOV_P},
-                 {"id", RAYES_AOV_ID},
-                 {"patch", RAYES_AOV_PATCH}};
+    } names[] = {{"z", RAYES_AOV_Z},   {"N", RAYES_AOV_N},         {"P", RAYES_AOV_P},
+                 {"id", RAYES_AOV_ID}, {"patch", RAYES_AOV_PATCH}, {"cache", RAYES_AOV_CACHE}};
     *colour = 0, *aovs = 0;
     char mode[sizeof d->mode];
     snprintf(mode, sizeof mode, "%s", d->mode[0] ? d->mode : "rgba");
@@ -258,7 +255,7 @@ static int display_mode(const IoDisplay *d, int aovs_ok, int *colour, unsigned *
                     "left out\n",
                     d->name, tok,
                     aov ? "AOVs are for one process without --checkpoint or --resume"
-                        : "only rgb, rgba, z, N, P, id and patch");
+                        : "only rgb, rgba, z, N, P, id, patch and cache");
     }
     return *colour || *aovs;
 }

@@ -385,12 +385,15 @@ int hider_camera_hit(Worker *w, const Ray *ray, const Hit *hit, Vec3 *L, Vec3 *O
              * at the shutter's middle, whichever ray came first; a moving
              * grid's by every time of its segment, whose middle it takes */
             float outer = w->time, outer_split = w->split;
+            AovSample *outer_aov = w->aov; /* shared by every sample: none's own */
+            w->aov = NULL;
             w->time = moving ? geom_segment_mid_time(gs, seg)
                              : 0.5f * (w->rs->camera.shutter[0] + w->rs->camera.shutter[1]);
             w->split = 1.0f;
             ci = shade_grid(w, gi, hit->instance, seg);
             w->time = outer;
             w->split = outer_split;
+            w->aov = outer_aov;
             atomic_store_explicit(slot, ci, memory_order_release);
         }
         pthread_mutex_unlock(lock);

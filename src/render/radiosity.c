@@ -731,6 +731,9 @@ static Vec3 cached_at_hit(Worker *w, const Hit *hit, int type, int depth, int si
     if (type != CACHE_OPACITY && w->set->cache_resolution < 0 &&
         !render_object(w->rs, hit->grid, hit->instance)->transparent)
         cluster = radiosity_choose_cluster(gs, hit->grid, footprint, w->set->cache_k);
+    AovSample *aov = type == CACHE_RADIOSITY && depth == 1 ? w->aov : NULL;
+    if (aov) /* a camera sample's own diffuse ray at its first hit (RAYES_AOV_CACHE) */
+        aov->lookups++;
     if (cluster) {
         key.patch = (uint32_t)gs->n_grids + cluster - 1;
         w->stats.cluster_lookups++;
@@ -745,6 +748,8 @@ static Vec3 cached_at_hit(Worker *w, const Hit *hit, int type, int depth, int si
         w->set->cache_resolution < 0)
         level = effective_level(g, CACHE_MEDIUM);
     key.level = (uint8_t)level;
+    if (aov)
+        aov->levels += (float)level;
     size_t n = level_values(g, level);
     if (type == CACHE_OPACITY && !moves) {
         uint16_t scratch[3 * OPTABLE_VALUES];

@@ -202,9 +202,19 @@ static double relative_variance(int n, double y, double y2)
 }
 
 /* A tile pixel's AOV sums: the nearest sample's z, id and patch (among
- * those the filter weighs positively; the first of equals), then w N and
- * w P summed as colours are. */
-enum { AOV_Z, AOV_ID, AOV_PATCH, AOV_N, AOV_P = AOV_N + 3, AOV_ACC = AOV_P + 3 };
+ * those the filter weighs positively; the first of equals), the cache
+ * levels and look-ups of those samples, then w N and w P summed as
+ * colours are. */
+enum {
+    AOV_Z,
+    AOV_ID,
+    AOV_PATCH,
+    AOV_LEVELS,
+    AOV_LOOKUPS,
+    AOV_N,
+    AOV_P = AOV_N + 3,
+    AOV_ACC = AOV_P + 3
+};
 
 static void aov_splat(float *a, const AovSample *s, float wgt)
 {
@@ -214,6 +224,10 @@ static void aov_splat(float *a, const AovSample *s, float wgt)
         a[AOV_Z] = s->z;
         a[AOV_ID] = (float)s->id;
         a[AOV_PATCH] = (float)s->patch;
+    }
+    if (wgt > 0.0f) {
+        a[AOV_LEVELS] += s->levels;
+        a[AOV_LOOKUPS] += (float)s->lookups;
     }
     const float v[6] = {s->N.x, s->N.y, s->N.z, s->P.x, s->P.y, s->P.z};
     for (int c = 0; c < 6; c++)
@@ -237,6 +251,8 @@ static void aov_write(const Frame *f, const float *acc5, const float *a, float *
         out[c++] = a[AOV_ID];
     if (aovs & RAYES_AOV_PATCH)
         out[c++] = a[AOV_PATCH];
+    if (aovs & RAYES_AOV_CACHE)
+        out[c++] = a[AOV_LOOKUPS] > 0.0f ? a[AOV_LEVELS] / a[AOV_LOOKUPS] : -1.0f;
 }
 
 /* Samples k0 to k1 - 1 of pixel (px, py), splatted into the tile's

@@ -120,6 +120,8 @@ typedef struct AovSample {
     Vec3 N, P;      /* world: the shading normal facing the ray, the point */
     uint32_t id;    /* 1 + the render object */
     uint32_t patch; /* 1 + the grid */
+    uint32_t lookups; /* radiosity look-ups of the sample's own diffuse rays' first hits */
+    float levels;     /* and the sum of their resolutions (0 coarse, 1 medium, 2 fine) */
 } AovSample;
 
 typedef struct RenderSettings {

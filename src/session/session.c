@@ -131,7 +131,8 @@ static const struct {
                  {RAYES_AOV_N, {"N.X", "N.Y", "N.Z"}},
                  {RAYES_AOV_P, {"P.X", "P.Y", "P.Z"}},
                  {RAYES_AOV_ID, {"id"}},
-                 {RAYES_AOV_PATCH, {"patch"}}};
+                 {RAYES_AOV_PATCH, {"patch"}},
+                 {RAYES_AOV_CACHE, {"cache"}}};
 
 int rayes_aov_channels(unsigned aovs)
 {

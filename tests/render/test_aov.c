@@ -4,7 +4,8 @@
  * their own ids and no surface gives Z +inf and id 0; a cut-out's hole
  * passes to what lies behind; the colour is the same bytes with AOVs or
  * without, and the AOVs the same bytes on 1 and 2 threads and in a crop
- * window; the EXR writer names every channel.
+ * window; the cache's resolution is read where diffuse rays were traced;
+ * the EXR writer names every channel.
  */
 #include <math.h>
 #include <stdio.h>
@@ -87,6 +88,7 @@ static void test_channels(void)
     CHECK(strcmp(rayes_aov_channel_name(RAYES_AOV_N | RAYES_AOV_ID, 3), "id") == 0);
     CHECK(rayes_aov_channel_name(RAYES_AOV_N | RAYES_AOV_ID, 4) == NULL);
     CHECK(strcmp(rayes_aov_channel_name(RAYES_AOV_ALL, 8), "patch") == 0);
+    CHECK(strcmp(rayes_aov_channel_name(RAYES_AOV_ALL, 9), "cache") == 0);
     RayesScene *s = planes(0, 0);
     RayesRenderOptions o;
     rayes_render_options_init(&o, RAYES_QUALITY_PREVIEW);
@@ -170,6 +172,19 @@ static void test_deterministic(void)
         ids += two->aov[RAYES_AOV_CHANNELS_MAX * i + 7] != two->aov[RAYES_AOV_CHANNELS_MAX * (i - 1) + 7];
     CHECK(part->crop[2] > 0 && differ == 0);
     CHECK(ids > 10); /* walls, boxes and the light are objects of their own */
+    /* the cache's resolutions: 0 to 2 where diffuse rays were traced, -1
+     * on the light (which traces none); all three levels read somewhere */
+    int traced = 0, none = 0, levels[3] = {0, 0, 0};
+    for (size_t i = 0; i < n; i++) {
+        float c = two->aov[RAYES_AOV_CHANNELS_MAX * i + 9];
+        CHECK(c == -1.0f || (c >= 0.0f && c <= 2.0f));
+        traced += c >= 0.0f;
+        none += c == -1.0f;
+        if (c >= 0.0f)
+            levels[(int)lroundf(c)]++;
+    }
+    CHECK(traced > (int)n / 2 && none > 0);
+    CHECK(levels[0] > 0 && levels[1] > 0 && levels[2] > 0);
     rayes_image_free(plain);
     rayes_image_free(two);
     rayes_image_free(one);
