@@ -218,9 +218,10 @@ static Output *add_output(Args *a, const char *path, ImageFormat format, int no_
     return o;
 }
 
-/* A display's mode: colour ("rgb", "rgba") and AOVs ("z", "N", "P",
- * "id", "patch", with or without a type: "normal N"), comma-separated, or
- * RenderMan's "rgbz" and "rgbaz". 0 when nothing in it is rendered (each
+/* A display's mode: colour ("rgb", "rgba", RenderMan RIS's "Ci" and
+ * "Ci,a") and AOVs ("z", "N", "P", "id", "patch", "cache", with or
+ * without a type: "normal N"), comma-separated, or RenderMan's "rgbz"
+ * and "rgbaz". 0 when nothing in it is rendered (each
  * part that is not is warned of); *colour 1 rgb, 2 rgba, 0 none. */
 static int display_mode(const IoDisplay *d, int aovs_ok, int *colour, unsigned *aovs)
 {
@@ -241,8 +242,11 @@ static int display_mode(const IoDisplay *d, int aovs_ok, int *colour, unsigned *
         for (size_t k = 0; k < sizeof names / sizeof names[0]; k++)
             if (strcmp(name, names[k].name) == 0 || (k == 0 && strcmp(name, "Z") == 0))
                 aov = names[k].aov;
-        int rgb = strcasecmp(name, "rgb") == 0 || strcasecmp(name, "rgbz") == 0,
-            rgba = strcasecmp(name, "rgba") == 0 || strcasecmp(name, "rgbaz") == 0;
+        /* RenderMan RIS's beauty is "Ci,a" (RenderMan for Blender's, Maya's) */
+        int rgb = strcasecmp(name, "rgb") == 0 || strcasecmp(name, "rgbz") == 0 ||
+                  strcmp(name, "Ci") == 0,
+            rgba = strcasecmp(name, "rgba") == 0 || strcasecmp(name, "rgbaz") == 0 ||
+                   (strcmp(name, "a") == 0 && *colour);
         if (strcasecmp(name, "rgbz") == 0 || strcasecmp(name, "rgbaz") == 0)
             aov = RAYES_AOV_Z;
         if (rgb || rgba)

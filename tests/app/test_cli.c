@@ -988,6 +988,7 @@ static void test_aovs(void)
                     "Display \"+" SCRATCH_DIR "/aov-np.exr\" \"openexr\" \"normal N,rgb\"\n"
                     "Display \"+" SCRATCH_DIR "/aov-n.png\" \"png\" \"N\"\n"
                     "Display \"+" SCRATCH_DIR "/aov-d.exr\" \"openexr\" \"color diffuse\"\n"
+                    "Display \"+" SCRATCH_DIR "/aov-ci.exr\" \"openexr\" \"Ci,a\"\n"
                     "Projection \"perspective\" \"fov\" 40\n"
                     "WorldBegin\nTranslate 0 0 5\nSphere 1 -1 1 360\nWorldEnd\n");
     run(&r, NULL, ARGS("render", SCRATCH_DIR "/aov.rib", "--spp", "1", "--quiet", "--aov", "id"));
@@ -1010,6 +1011,8 @@ static void test_aovs(void)
         CHECK(strstr(ch, "N.X") && strstr(ch, "B") && !strstr(ch, "A") && strstr(ch, "id"));
         exr_channels(SCRATCH_DIR "/aov-beauty.exr", ch, sizeof ch);
         CHECK(strstr(ch, "id") && strstr(ch, "A") && !strstr(ch, "Z"));
+        exr_channels(SCRATCH_DIR "/aov-ci.exr", ch, sizeof ch); /* RIS's beauty */
+        CHECK(strstr(ch, "R") && strstr(ch, "A"));
     }
     run(&r, NULL,
         ARGS("render", SCRATCH_DIR "/aov.rib", "--spp", "1", "--quiet", "--aov", "z,P", "-o",
