@@ -1014,8 +1014,10 @@ RAYES_API void rayes_stats_free(RayesStats *stats);
 /* Arbitrary output variables (AOVs): what the first surface each camera
  * sample meets says about itself, for compositing and for inspecting a
  * scene. Deterministic as the colour is. Samples the filter weighs
- * positively decide the "nearest" ones; N and P are filtered as colour is
- * (a pixel on an edge blends toward 0). Surfaces behind a transparent one
+ * positively decide the "nearest" ones (and feed "cache"); N and P are
+ * filtered as colour is (a pixel on an edge blends toward 0). Ids are
+ * floats, exact to 2^24; outside a crop window every channel is 0.
+ * rayes_render alone renders them (a session refuses them). Surfaces behind a transparent one
  * do not count; lights seen directly do (their own object). */
 typedef enum RayesAov {
     RAYES_AOV_Z = 1u << 0,     /* "Z": camera-space depth of the pixel's nearest sample
@@ -1027,7 +1029,8 @@ typedef enum RayesAov {
     RAYES_AOV_ID = 1u << 3,    /* "id": 1 + the object (shader binding) of the nearest
                                   sample, in the order the scene made them; 0: none */
     RAYES_AOV_PATCH = 1u << 4, /* "patch": 1 + the grid (diced patch, the radiosity cache's
-                                  entry) of the nearest sample; 0: none */
+                                  entry; an instance's: its master's grid) of the nearest
+                                  sample; 0: none */
     RAYES_AOV_CACHE = 1u << 5, /* "cache": the radiosity cache's resolution the pixel's
                                   diffuse rays read at their first hits, by ray differentials
                                   (memo 3.2), averaged over the pixel's look-ups: 0 coarse

@@ -23,10 +23,16 @@ static int add_part(const char *path, float **full, int size[2], int u[4])
     char err[1024];
     int disp[2], win[4];
     float *px = NULL;
-    if (image_read_exr_window(path, disp, win, &px, err, sizeof err) != RAYES_OK) {
+    int others = 0;
+    if (image_read_exr_parts(path, disp, win, &px, &others, err, sizeof err) != RAYES_OK) {
         fprintf(stderr, "rayes: %s\n", err);
         return 1;
     }
+    if (others)
+        fprintf(stderr,
+                "rayes: warning: %s: its %d channels besides R, G, B, A (AOVs) are not "
+                "joined; the assembled image holds colour alone\n",
+                path, others);
     if (!*full) {
         size[0] = disp[0], size[1] = disp[1];
         *full = calloc((size_t)disp[0] * (size_t)disp[1] * 4, sizeof(float));

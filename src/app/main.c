@@ -253,13 +253,16 @@ static int display_mode(const IoDisplay *d, int aovs_ok, int *colour, unsigned *
             *colour = *colour == 2 || rgba ? 2 : 1;
         if (aov && aovs_ok)
             *aovs |= aov;
-        else if (aov || !(rgb || rgba))
+        else if (aov)
             fprintf(stderr,
-                    "rayes: warning: display \"%s\": \"%s\" is not rendered (%s); "
-                    "left out\n",
-                    d->name, tok,
-                    aov ? "AOVs are for one process without --checkpoint or --resume"
-                        : "only rgb, rgba, z, N, P, id, patch and cache");
+                    "rayes: warning: display \"%s\": the AOV of \"%s\" is not written (AOVs are "
+                    "for one process without --checkpoint or --resume)%s\n",
+                    d->name, tok, rgb || rgba ? "; its colour is" : "");
+        else if (!(rgb || rgba))
+            fprintf(stderr,
+                    "rayes: warning: display \"%s\": \"%s\" is not rendered (only rgb, rgba, z, "
+                    "N, P, id, patch and cache); left out\n",
+                    d->name, tok);
     }
     return *colour || *aovs;
 }
@@ -467,11 +470,7 @@ static int cmd_render(int argc, char **argv)
     if (a.opt.aovs && (d || a.checkpoint_s >= 0.0 || a.resume))
         die_usage("--aov is for one process without --checkpoint or --resume (their tiles carry "
                   "colour alone)");
-    int exr = a.n_outputs == 0; /* a scene file's displays may be EXR; the default is */
-    for (int k = 0; k < a.n_outputs; k++)
-        exr |= a.outputs[k].format == IMAGE_FORMAT_EXR;
-    if (a.opt.aovs && !exr)
-        fprintf(stderr, "rayes: warning: --aov: no -o output is EXR, where AOVs are written\n");
+
     if (distribute_rank(d) != 0) /* rank 0 speaks for the job */
         a.quiet = 1, a.progress_json = 0, a.stats_path = NULL;
     if (!a.frames) {
@@ -561,6 +560,13 @@ static int render_job(Args a, int frame, int number, Distributed *d)
             add_output(&a, path, IMAGE_FORMAT_EXR, 0);
         }
     }
+    unsigned aovs_written = 0; /* the AOVs some output holds */
+    for (int k = 0; k < a.n_outputs; k++)
+        if (a.outputs[k].format == IMAGE_FORMAT_EXR)
+            aovs_written |= a.outputs[k].display ? a.outputs[k].aovs : a.opt.aovs;
+    if (a.opt.aovs & ~aovs_written)
+        fprintf(stderr, "rayes: warning: --aov: no EXR output holds %s; they are not written\n",
+                aovs_written ? "some of the AOVs" : "the AOVs");
     if (a.skip_existing) { /* a farm's retry: the frame is done when all its outputs are */
         int all = 1;
         for (int i = 0; i < a.n_outputs; i++)

@@ -79,6 +79,9 @@ RayesError image_read_exr(const char *path, int *width, int *height, float **rgb
  * image is the data window's pixels): a crop rendered with --crop. */
 RayesError image_read_exr_window(const char *path, int display[2], int window[4], float **rgba,
                                  char *err, size_t err_size);
+/* The same, and *others the channels besides R, G, B, A (AOVs), not read. */
+RayesError image_read_exr_parts(const char *path, int display[2], int window[4], float **rgba,
+                                int *others, char *err, size_t err_size);
 
 /* Reads a PNG (any bit depth/colour type, converted to RGBA) and decodes
  * sRGB to linear. *rgba is new (free()). */

@@ -354,6 +354,7 @@ typedef struct ExrTarget {
     int x0, y0;        /* the data window's minimum corner */
     bool tiled;        /* tiles, else scanlines */
     int display[4];    /* the display window: minimum corner, width, height */
+    int others;        /* channels other than R, G, B, A (AOVs), not read */
 } ExrTarget;
 
 /* Points the decoder's channels at the chunk's first pixel in target;
@@ -543,10 +544,11 @@ static RayesError check_header(exr_const_context_t ctx, const char *path, ExrTar
         image_set_error(err, err_size, "%s: cannot read EXR: deep images are not supported", path);
         return RAYES_ERROR_PARSE;
     }
-    int found = 0;
+    int found = 0, others = 0;
     for (int i = 0; i < channels->num_channels; i++) {
         const exr_attr_chlist_entry_t *entry = &channels->entries[i];
         int slot = rgba_slot(entry->name.str);
+        others += slot < 0;
         if (slot < 0)
             continue;
         if (entry->x_sampling != 1 || entry->y_sampling != 1) {
@@ -566,8 +568,14 @@ static RayesError check_header(exr_const_context_t ctx, const char *path, ExrTar
                      path, (long long)w, (long long)h);
         return RAYES_ERROR_PARSE;
     }
-    *target = (ExrTarget){NULL, (int)w, (int)h, dw.min.x, dw.min.y, storage == EXR_STORAGE_TILED,
-                          {dw.min.x, dw.min.y, (int)w, (int)h}};
+    *target = (ExrTarget){NULL,
+                          (int)w,
+                          (int)h,
+                          dw.min.x,
+                          dw.min.y,
+                          storage == EXR_STORAGE_TILED,
+                          {dw.min.x, dw.min.y, (int)w, (int)h},
+                          others};
     exr_attr_box2i_t disp;
     if (exr_get_display_window(ctx, 0, &disp) == EXR_ERR_SUCCESS) {
         int64_t dw_ = (int64_t)disp.max.x - disp.min.x + 1, dh = (int64_t)disp.max.y - disp.min.y + 1;
@@ -627,9 +635,17 @@ RayesError image_read_exr(const char *path, int *width, int *height, float **rgb
 RayesError image_read_exr_window(const char *path, int display[2], int window[4], float **rgba,
                                  char *err, size_t err_size)
 {
+    return image_read_exr_parts(path, display, window, rgba, NULL, err, err_size);
+}
+
+RayesError image_read_exr_parts(const char *path, int display[2], int window[4], float **rgba,
+                                int *others, char *err, size_t err_size)
+{
     ExrTarget t = {0};
     RayesError e = read_exr(path, &t, err, err_size);
     *rgba = t.rgba;
+    if (others)
+        *others = e == RAYES_OK ? t.others : 0;
     if (e == RAYES_OK) {
         display[0] = t.display[2], display[1] = t.display[3];
         window[0] = t.x0 - t.display[0], window[1] = t.y0 - t.display[1];

@@ -74,6 +74,9 @@ RayesError rayes_session_new(RayesScene *scene, const RayesRenderOptions *option
     RayesError e = session_check_options(scene, options);
     if (e != RAYES_OK)
         return e;
+    if (options->aovs) /* its passes accumulate colour alone */
+        return session_fail(scene, RAYES_ERROR_INVALID_ARGUMENT,
+                            "session: AOVs are rendered by rayes_render alone");
     RayesSession *s = calloc(1, sizeof *s);
     if (!s)
         return RAYES_ERROR_OUT_OF_MEMORY;

@@ -112,7 +112,8 @@ static void test_opencue_token(void)
     CHECK(strstr(text, "{\"event\": \"frame\", \"frame\": 3, \"status\": 0") != NULL);
 }
 
-/* Four crops and rayes assemble: the whole frame's bytes. */
+/* Four crops and rayes assemble: the whole frame's bytes (a part's AOVs
+ * are left out with a warning). */
 static void test_crops_assembled(void)
 {
     mkdir(SCRATCH, 0755);
@@ -144,6 +145,18 @@ static void test_crops_assembled(void)
         fclose(f);
     CHECK(strstr(err, "parts/other.exr: a 48 x 32 frame") != NULL);
     CHECK(sh("$RAYES assemble only-one.exr") == 2);
+    /* parts with AOVs: their colour joined, their AOVs not, with a warning */
+    CHECK(sh("$RAYES render cornell --res 96x64 --spp 2 --quiet --crop 0,0.5,0,0.5 --aov z -o "
+             "parts/aov.exr") == 0);
+    CHECK(sh("$RAYES assemble joined.exr parts/aov.exr parts/p1.exr parts/p2.exr parts/p3.exr "
+             "2>joined.err") == 0);
+    CHECK(same_bytes(SCRATCH "/joined.exr", SCRATCH "/whole.exr"));
+    f = fopen(SCRATCH "/joined.err", "r");
+    n = f ? fread(err, 1, sizeof err - 1, f) : 0;
+    err[n] = '\0';
+    if (f)
+        fclose(f);
+    CHECK(strstr(err, "parts/aov.exr") && strstr(err, "not joined"));
 }
 
 TEST_MAIN(TEST(test_slurm_array_task), TEST(test_opencue_token), TEST(test_crops_assembled))

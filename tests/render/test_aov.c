@@ -95,6 +95,9 @@ static void test_channels(void)
     o.aovs = 1u << 7;
     RayesImage *img = NULL;
     CHECK(rayes_render(s, &o, &img, NULL) == RAYES_ERROR_INVALID_ARGUMENT && img == NULL);
+    o.aovs = RAYES_AOV_Z; /* sessions accumulate colour alone */
+    RayesSession *session = NULL;
+    CHECK(rayes_session_new(s, &o, &session) == RAYES_ERROR_INVALID_ARGUMENT && !session);
     rayes_scene_release(s);
 }
 
