@@ -220,18 +220,21 @@ static Output *add_output(Args *a, const char *path, ImageFormat format, int no_
 
 /* A display's mode: colour ("rgb", "rgba", RenderMan RIS's "Ci" and
  * "Ci,a") and AOVs ("z", "N", "P", "id", "patch", "cache", with or
- * without a type: "normal N"), comma-separated, or RenderMan's "rgbz"
- * and "rgbaz". 0 when nothing in it is rendered (each
- * part that is not is warned of); *colour 1 rgb, 2 rgba, 0 none. */
+ * without a type: "normal N"; RenderMan's denoiser channels "zfiltered"
+ * and "normal" are z and N), comma-separated, or RenderMan's "rgbz" and
+ * "rgbaz". 0 when nothing in it is rendered; what is not is warned of in
+ * one line; *colour 1 rgb, 2 rgba, 0 none. */
 static int display_mode(const IoDisplay *d, int aovs_ok, int *colour, unsigned *aovs)
 {
     static const struct {
         const char *name;
         unsigned aov;
-    } names[] = {{"z", RAYES_AOV_Z},   {"N", RAYES_AOV_N},         {"P", RAYES_AOV_P},
-                 {"id", RAYES_AOV_ID}, {"patch", RAYES_AOV_PATCH}, {"cache", RAYES_AOV_CACHE}};
+    } names[] = {{"z", RAYES_AOV_Z},    {"Z", RAYES_AOV_Z},         {"zfiltered", RAYES_AOV_Z},
+                 {"N", RAYES_AOV_N},    {"normal", RAYES_AOV_N},    {"P", RAYES_AOV_P},
+                 {"id", RAYES_AOV_ID},  {"patch", RAYES_AOV_PATCH}, {"cache", RAYES_AOV_CACHE},
+                 {"rgbz", RAYES_AOV_Z}, {"rgbaz", RAYES_AOV_Z}};
     *colour = 0, *aovs = 0;
-    char mode[sizeof d->mode];
+    char mode[sizeof d->mode], skipped[2 * sizeof d->mode] = "", unwritten[2 * sizeof d->mode] = "";
     snprintf(mode, sizeof mode, "%s", d->mode[0] ? d->mode : "rgba");
     for (char *save = NULL, *tok = strtok_r(mode, ",", &save); tok;
          tok = strtok_r(NULL, ",", &save)) {
@@ -240,30 +243,32 @@ static int display_mode(const IoDisplay *d, int aovs_ok, int *colour, unsigned *
         const char *space = strrchr(tok, ' '), *name = space ? space + 1 : tok;
         unsigned aov = 0;
         for (size_t k = 0; k < sizeof names / sizeof names[0]; k++)
-            if (strcmp(name, names[k].name) == 0 || (k == 0 && strcmp(name, "Z") == 0))
+            if (strcmp(name, names[k].name) == 0)
                 aov = names[k].aov;
         /* RenderMan RIS's beauty is "Ci,a" (RenderMan for Blender's, Maya's) */
-        int rgb = strcasecmp(name, "rgb") == 0 || strcasecmp(name, "rgbz") == 0 ||
+        int rgb = strcasecmp(name, "rgb") == 0 || strcmp(name, "rgbz") == 0 ||
                   strcmp(name, "Ci") == 0,
-            rgba = strcasecmp(name, "rgba") == 0 || strcasecmp(name, "rgbaz") == 0 ||
+            rgba = strcasecmp(name, "rgba") == 0 || strcmp(name, "rgbaz") == 0 ||
                    (strcmp(name, "a") == 0 && *colour);
-        if (strcasecmp(name, "rgbz") == 0 || strcasecmp(name, "rgbaz") == 0)
-            aov = RAYES_AOV_Z;
         if (rgb || rgba)
             *colour = *colour == 2 || rgba ? 2 : 1;
+        char *list = !aov && !(rgb || rgba) ? skipped : aov && !aovs_ok ? unwritten : NULL;
         if (aov && aovs_ok)
             *aovs |= aov;
-        else if (aov)
-            fprintf(stderr,
-                    "rayes: warning: display \"%s\": the AOV of \"%s\" is not written (AOVs are "
-                    "for one process without --checkpoint or --resume)%s\n",
-                    d->name, tok, rgb || rgba ? "; its colour is" : "");
-        else if (!(rgb || rgba))
-            fprintf(stderr,
-                    "rayes: warning: display \"%s\": \"%s\" is not rendered (only rgb, rgba, z, "
-                    "N, P, id, patch and cache); left out\n",
-                    d->name, tok);
+        else if (list) /* "a", "b", ... */
+            snprintf(list + strlen(list), sizeof skipped - strlen(list), "%s\"%s\"",
+                     list[0] ? ", " : "", tok);
     }
+    if (unwritten[0])
+        fprintf(stderr,
+                "rayes: warning: display \"%s\": AOVs %s are not written (AOVs are for one "
+                "process without --checkpoint or --resume)\n",
+                d->name, unwritten);
+    if (skipped[0])
+        fprintf(stderr,
+                "rayes: warning: display \"%s\": %s not rendered (only rgb, rgba, z, N, P, id, "
+                "patch and cache); left out\n",
+                d->name, skipped);
     return *colour || *aovs;
 }
 

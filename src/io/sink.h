@@ -144,7 +144,8 @@ IoSink io_sink_scene(RayesScene *scene);
 typedef struct IoDisplay {
     char name[512];  /* file name as given ("+" of an extra RIB display removed) */
     char type[32];   /* "file", "exr", "openexr", "png", "tiff", "framebuffer", ... */
-    char mode[32];   /* "rgb", "rgba", "z", ... ("rgba" when the file says nothing) */
+    char mode[256];  /* "rgb", "rgba", "z", "Ci,a,...", ... ("rgba" when the file says
+                        nothing) */
 } IoDisplay;
 
 /* Render settings a scene file gives; a field the file does not set keeps

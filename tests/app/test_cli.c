@@ -988,13 +988,15 @@ static void test_aovs(void)
                     "Display \"+" SCRATCH_DIR "/aov-np.exr\" \"openexr\" \"normal N,rgb\"\n"
                     "Display \"+" SCRATCH_DIR "/aov-n.png\" \"png\" \"N\"\n"
                     "Display \"+" SCRATCH_DIR "/aov-d.exr\" \"openexr\" \"color diffuse\"\n"
-                    "Display \"+" SCRATCH_DIR "/aov-ci.exr\" \"openexr\" \"Ci,a\"\n"
+                    "Display \"+" SCRATCH_DIR "/aov-ci.exr\" \"openexr\" "
+                    "\"Ci,a,mse,albedo,albedo_var,diffuse,diffuse_mse,specular,zfiltered,normal\"\n"
                     "Projection \"perspective\" \"fov\" 40\n"
                     "WorldBegin\nTranslate 0 0 5\nSphere 1 -1 1 360\nWorldEnd\n");
     run(&r, NULL, ARGS("render", SCRATCH_DIR "/aov.rib", "--spp", "1", "--quiet", "--aov", "id"));
     CHECK(r.status == 0);
     CHECK(strstr(r.err, "aov-n.png") && strstr(r.err, "EXR files only"));
     CHECK(strstr(r.err, "color diffuse") && strstr(r.err, "not rendered"));
+    CHECK(strstr(r.err, "\"mse\", \"albedo\"")); /* one line for the display */
     CHECK(access(SCRATCH_DIR "/aov-z.exr", F_OK) == 0 &&
           access(SCRATCH_DIR "/aov-n.png", F_OK) != 0);
     CHECK(access(SCRATCH_DIR "/aov-d.exr", F_OK) != 0);
@@ -1011,8 +1013,8 @@ static void test_aovs(void)
         CHECK(strstr(ch, "N.X") && strstr(ch, "B") && !strstr(ch, "A") && strstr(ch, "id"));
         exr_channels(SCRATCH_DIR "/aov-beauty.exr", ch, sizeof ch);
         CHECK(strstr(ch, "id") && strstr(ch, "A") && !strstr(ch, "Z"));
-        exr_channels(SCRATCH_DIR "/aov-ci.exr", ch, sizeof ch); /* RIS's beauty */
-        CHECK(strstr(ch, "R") && strstr(ch, "A"));
+        exr_channels(SCRATCH_DIR "/aov-ci.exr", ch, sizeof ch); /* RIS's denoiser display */
+        CHECK(strstr(ch, "R") && strstr(ch, "A") && strstr(ch, "Z") && strstr(ch, "N.X"));
     }
     run(&r, NULL,
         ARGS("render", SCRATCH_DIR "/aov.rib", "--spp", "1", "--quiet", "--aov", "z,P", "-o",
