@@ -72,13 +72,13 @@ TSAN_TESTS = cache_test_cache cache_test_cache_stress util_test_math util_test_h
              shade_test_plugin shade_test_texture_threads render_test_hider \
              render_test_determinism render_test_adaptive render_test_session render_test_opacity render_test_volume \
              render_test_subsurface render_test_instances render_test_motion render_test_dof render_test_pbgi \
-             render_test_envguide \
+             render_test_envguide render_test_aov \
              rayes_app app_test_view app_test_checkpoint
 test-tsan:
 	@# configured every time: the targets below must be known to make even if added since
 	@cmake -S . -B build-tsan -DCMAKE_BUILD_TYPE=RelWithDebInfo -DRAYES_TSAN=ON >/dev/null
 	cmake --build build-tsan -j $(JOBS) --target $(TSAN_TESTS)
-	cd build-tsan && TSAN_OPTIONS="halt_on_error=1 suppressions=$(CURDIR)/tools/tsan.supp" ctest --output-on-failure -j $(JOBS) -R '^(cache|util)/|^shade/test_plugin$$|^shade/test_texture_threads$$|^render/test_(hider|determinism|adaptive|session|opacity|volume|subsurface|instances|motion|dof|pbgi|envguide)$$|^app/test_(view|checkpoint)$$'
+	cd build-tsan && TSAN_OPTIONS="halt_on_error=1 suppressions=$(CURDIR)/tools/tsan.supp" ctest --output-on-failure -j $(JOBS) -R '^(cache|util)/|^shade/test_plugin$$|^shade/test_texture_threads$$|^render/test_(hider|determinism|adaptive|session|opacity|volume|subsurface|instances|motion|dof|pbgi|envguide|aov)$$|^app/test_(view|checkpoint)$$'
 
 # Fuzzing: every tests/fuzz/fuzz_NAME.c is a target, run on a scratch copy
 # of its seeds tests/fuzz/corpus_NAME/ (the repository's seeds stay as they
