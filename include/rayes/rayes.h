@@ -1035,8 +1035,9 @@ typedef enum RayesAov {
                                   diffuse rays read at their first hits, by ray differentials
                                   (memo 3.2), averaged over the pixel's look-ups: 0 coarse
                                   (or a cluster of grids), 1 medium, 2 fine; -1 where no
-                                  sample traced any of its own (lights, the background,
-                                  --cache off, and grids the grid hider shades once) */
+                                  sample traced any (lights, the background, --cache off).
+                                  With the grid hider, a grid's mean over the rays of its
+                                  shading counts as one look-up of each sample on it */
     RAYES_AOV_ALL = 0x3f
 } RayesAov;
 

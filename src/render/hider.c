@@ -289,14 +289,20 @@ static Rgb *shade_grid(Worker *w, uint32_t gi, uint32_t instance, int seg)
     uint64_t sharp = w->sharp_rays;
     const RenderObject *outer = w->shading;
     w->shading = obj;
+    /* the cache AOV's count of the grid's own diffuse rays (RAYES_AOV_CACHE) */
+    AovSample grid_aov = {0}, *outer_aov = w->aov;
+    w->aov = w->set->aovs & RAYES_AOV_CACHE ? &grid_aov : NULL;
     shade_run_lighting(w->services, &ctx, obj->shader, &out);
+    w->aov = outer_aov;
     w->shading = outer;
     memcpy(ci, Ci, n * sizeof *ci);
     if (obj->transparent)
         memcpy(ci + n, Oi, n * sizeof *ci);
-    /* the trailer: 1 if the grid reflects or refracts sharply (hider_camera_hit) */
+    /* the trailer: 1 if the grid reflects or refracts sharply (hider_camera_hit),
+     * then the cache levels its diffuse rays read and their number */
     ci[n_ci][0] = w->sharp_rays != sharp ? 1.0f : 0.0f;
-    ci[n_ci][1] = ci[n_ci][2] = 0.0f;
+    ci[n_ci][1] = grid_aov.levels;
+    ci[n_ci][2] = (float)grid_aov.lookups;
     free(irr_E);
     free(back);
     free(f3);
@@ -386,7 +392,7 @@ int hider_camera_hit(Worker *w, const Ray *ray, const Hit *hit, Vec3 *L, Vec3 *O
              * grid's by every time of its segment, whose middle it takes */
             float outer = w->time, outer_split = w->split;
             AovSample *outer_aov = w->aov; /* shared by every sample: none's own */
-            w->aov = NULL;
+            w->aov = NULL;                 /* (shade_grid counts the grid's apart) */
             w->time = moving ? geom_segment_mid_time(gs, seg)
                              : 0.5f * (w->rs->camera.shutter[0] + w->rs->camera.shutter[1]);
             w->split = 1.0f;
@@ -405,9 +411,15 @@ int hider_camera_hit(Worker *w, const Ray *ray, const Hit *hit, Vec3 *L, Vec3 *O
     if (!corners(hit, g->first_vertex, ci, gsh->contrast, L))
         return 0;
     *Oi = v3(1, 1, 1);
-    if (!transparent)
-        return 1;
     /* Opacity is no noisy estimate: a cut-out's edge (corners of 0 and 1)
      * or any step beyond HIDER_OPACITY_STEP is shaded where the ray hits. */
-    return corners(hit, g->first_vertex, ci + geom_grid_n_vertices(g), HIDER_OPACITY_STEP, Oi);
+    if (transparent &&
+        !corners(hit, g->first_vertex, ci + geom_grid_n_vertices(g), HIDER_OPACITY_STEP, Oi))
+        return 0;
+    const float *trailer = ci[grid_values(g, transparent)];
+    if (w->aov && trailer[2] > 0.0f) { /* the grid's mean level, as one look-up */
+        w->aov->levels += trailer[1] / trailer[2];
+        w->aov->lookups++;
+    }
+    return 1;
 }

@@ -74,6 +74,21 @@ static RayesImage *render(RayesScene *s, unsigned aovs, int threads, int size, c
     return img;
 }
 
+/* The cache AOV alone, at 48 x 48 with the given hider. */
+static RayesImage *render_hider(RayesScene *s, RayesHider hider, int threads)
+{
+    RayesRenderOptions o;
+    rayes_render_options_init(&o, RAYES_QUALITY_PREVIEW);
+    o.width = o.height = 48;
+    o.spp = 4;
+    o.threads = threads;
+    o.hider = hider;
+    o.aovs = RAYES_AOV_CACHE;
+    RayesImage *img = NULL;
+    CHECK(rayes_render(s, &o, &img, NULL) == RAYES_OK);
+    return img;
+}
+
 static const float *aov_at(const RayesImage *img, int x, int y)
 {
     return &img->aov[(size_t)img->aov_channels * ((size_t)y * img->width + x)];
@@ -188,6 +203,17 @@ static void test_deterministic(void)
     }
     CHECK(traced > (int)n / 2 && none > 0);
     CHECK(levels[0] > 0 && levels[1] > 0 && levels[2] > 0);
+    /* the grid hider: a grid's mean level, the same on any threads */
+    RayesImage *g1 = render_hider(s, RAYES_HIDER_GRID, 1),
+               *g2 = render_hider(s, RAYES_HIDER_GRID, 2);
+    CHECK(memcmp(g1->aov, g2->aov, n * sizeof(float)) == 0);
+    CHECK(memcmp(g1->rgba, g2->rgba, n * 4 * sizeof(float)) == 0);
+    traced = 0;
+    for (size_t i = 0; i < n; i++)
+        traced += g2->aov[i] >= 0.0f && g2->aov[i] <= 2.0f;
+    CHECK(traced > (int)n / 2);
+    rayes_image_free(g1);
+    rayes_image_free(g2);
     rayes_image_free(plain);
     rayes_image_free(two);
     rayes_image_free(one);
