@@ -35,6 +35,8 @@ ImageFormat image_format_from_path(const char *path);
  * gamma the only curve (else the sRGB curve and chunk);
  * IMAGE_NO_ALPHA R, G, B only (RenderMan's display mode "rgb": what no
  * surface covers is black, not transparent). */
+#define IMAGE_AOV_NAME 64 /* an AOV channel's name, its NUL included, at most */
+
 enum { IMAGE_LINEAR = 1, IMAGE_NO_ALPHA = 2, IMAGE_NO_COLOUR = 4 /* EXR: the AOVs alone */ };
 
 /* EXR: half-float R, G, B, A channels, ZIP compression, scanlines, with a
@@ -79,9 +81,15 @@ RayesError image_read_exr(const char *path, int *width, int *height, float **rgb
  * image is the data window's pixels): a crop rendered with --crop. */
 RayesError image_read_exr_window(const char *path, int display[2], int window[4], float **rgba,
                                  char *err, size_t err_size);
-/* The same, and *others the channels besides R, G, B, A (AOVs), not read. */
-RayesError image_read_exr_parts(const char *path, int display[2], int window[4], float **rgba,
-                                int *others, char *err, size_t err_size);
+/* The same, with up to max_aov of its float channels besides R, G, B, A
+ * (AOVs, not subsampled, names under IMAGE_AOV_NAME bytes): *n_aov of
+ * them into *aov (window's pixels, *n_aov floats each, in the file's
+ * order; new, free(); NULL when none), their names in names[]; *others
+ * (may be NULL) counts every channel besides R, G, B, A. aov, n_aov and
+ * names may be NULL to read none. */
+RayesError image_read_exr_aov(const char *path, int display[2], int window[4], float **rgba,
+                              float **aov, int *n_aov, char (*names)[IMAGE_AOV_NAME], int max_aov,
+                              int *others, char *err, size_t err_size);
 
 /* Reads a PNG (any bit depth/colour type, converted to RGBA) and decodes
  * sRGB to linear. *rgba is new (free()). */

@@ -354,23 +354,34 @@ typedef struct ExrTarget {
     int x0, y0;        /* the data window's minimum corner */
     bool tiled;        /* tiles, else scanlines */
     int display[4];    /* the display window: minimum corner, width, height */
-    int others;        /* channels other than R, G, B, A (AOVs), not read */
+    int others;        /* channels other than R, G, B, A (AOVs) */
+    /* Asked for: up to max_aov of those, not subsampled, read as floats into
+     * aov (n_aov a pixel, in the file's order), their names in aov_names. */
+    int max_aov, n_aov;
+    char (*aov_names)[IMAGE_AOV_NAME];
+    float *aov;
 } ExrTarget;
 
-/* Points the decoder's channels at the chunk's first pixel in target;
- * channels other than R, G, B, A get NULL, which means skip. The strides
- * are what unpack_rgba follows; the type and size tell the library's
- * routine chooser that we convert, so it never reads straight into them. */
-static void bind_decode_channels(exr_decode_pipeline_t *decoder, float *first_pixel, int width)
+/* Points the decoder's channels at the chunk's first pixel (offset first
+ * in target's images): R, G, B, A into rgba, the AOVs asked for into aov;
+ * other channels get NULL, which means skip. The strides are what
+ * unpack_rgba follows; the type and size tell the library's routine
+ * chooser that we convert, so it never reads straight into them. */
+static void bind_decode_channels(exr_decode_pipeline_t *decoder, const ExrTarget *target,
+                                 size_t first)
 {
     for (int c = 0; c < decoder->channel_count; c++) {
         exr_coding_channel_info_t *chan = &decoder->channels[c];
-        int slot = rgba_slot(chan->channel_name);
-        chan->decode_to_ptr = slot < 0 ? NULL : (uint8_t *)(first_pixel + slot);
+        int slot = rgba_slot(chan->channel_name), n = 4;
+        float *to = slot < 0 ? NULL : target->rgba + first * 4 + slot;
+        for (int k = 0; slot < 0 && k < target->n_aov; k++)
+            if (strcmp(chan->channel_name, target->aov_names[k]) == 0)
+                n = target->n_aov, to = target->aov + first * (size_t)n + k;
+        chan->decode_to_ptr = (uint8_t *)to;
         chan->user_data_type = EXR_PIXEL_FLOAT;
         chan->user_bytes_per_element = (int16_t)sizeof(float);
-        chan->user_pixel_stride = (int32_t)(4 * sizeof(float));
-        chan->user_line_stride = (int32_t)(4 * sizeof(float)) * width;
+        chan->user_pixel_stride = (int32_t)(n * sizeof(float));
+        chan->user_line_stride = (int32_t)(n * sizeof(float)) * target->width;
     }
 }
 
@@ -391,10 +402,11 @@ static float half_to_float(uint16_t h)
     return f;
 }
 
-/* Converts n little-endian values of one channel's line to floats 4 apart. */
-static void convert_line(float *dst, const uint8_t *src, int n, uint16_t data_type)
+/* Converts n little-endian values of one channel's line to floats stride
+ * apart. */
+static void convert_line(float *dst, int stride, const uint8_t *src, int n, uint16_t data_type)
 {
-    for (int x = 0; x < n; x++, dst += 4) {
+    for (int x = 0; x < n; x++, dst += stride) {
         if (data_type == EXR_PIXEL_HALF) {
             *dst = half_to_float((uint16_t)(src[2 * x] | src[2 * x + 1] << 8));
             continue;
@@ -428,9 +440,10 @@ static exr_result_t unpack_rgba(exr_decode_pipeline_t *decoder)
             size_t n_bytes = (size_t)chan->width * (size_t)chan->bytes_per_element;
             if ((size_t)(end - src) < n_bytes)
                 return EXR_ERR_CORRUPT_CHUNK;
-            if (chan->decode_to_ptr) /* R, G, B, A: never subsampled (checked) */
+            if (chan->decode_to_ptr) /* R, G, B, A and AOVs: never subsampled (checked) */
                 convert_line((float *)(chan->decode_to_ptr + (size_t)y * chan->user_line_stride),
-                             src, chan->width, chan->data_type);
+                             chan->user_pixel_stride / (int)sizeof(float), src, chan->width,
+                             chan->data_type);
             src += n_bytes;
         }
     }
@@ -461,8 +474,7 @@ static exr_result_t decode_chunk(exr_const_context_t ctx, ExrDecoder *decoder,
                                            : exr_decoding_initialize(ctx, 0, cinfo, pipe);
     if (rv != EXR_ERR_SUCCESS)
         return rv;
-    bind_decode_channels(pipe, target->rgba + ((size_t)row * target->width + (size_t)col) * 4,
-                         target->width);
+    bind_decode_channels(pipe, target, (size_t)row * target->width + (size_t)col);
     if (!decoder->initialized) {
         decoder->initialized = true;
         rv = exr_decoding_choose_default_routines(ctx, 0, pipe);
@@ -544,11 +556,14 @@ static RayesError check_header(exr_const_context_t ctx, const char *path, ExrTar
         image_set_error(err, err_size, "%s: cannot read EXR: deep images are not supported", path);
         return RAYES_ERROR_PARSE;
     }
-    int found = 0, others = 0;
+    int found = 0, others = 0, n_aov = 0;
     for (int i = 0; i < channels->num_channels; i++) {
         const exr_attr_chlist_entry_t *entry = &channels->entries[i];
         int slot = rgba_slot(entry->name.str);
         others += slot < 0;
+        if (slot < 0 && n_aov < target->max_aov && entry->x_sampling == 1 &&
+            entry->y_sampling == 1 && strlen(entry->name.str) < IMAGE_AOV_NAME)
+            snprintf(target->aov_names[n_aov++], IMAGE_AOV_NAME, "%s", entry->name.str);
         if (slot < 0)
             continue;
         if (entry->x_sampling != 1 || entry->y_sampling != 1) {
@@ -575,7 +590,11 @@ static RayesError check_header(exr_const_context_t ctx, const char *path, ExrTar
                           dw.min.y,
                           storage == EXR_STORAGE_TILED,
                           {dw.min.x, dw.min.y, (int)w, (int)h},
-                          others};
+                          others,
+                          target->max_aov,
+                          n_aov,
+                          target->aov_names,
+                          NULL};
     exr_attr_box2i_t disp;
     if (exr_get_display_window(ctx, 0, &disp) == EXR_ERR_SUCCESS) {
         int64_t dw_ = (int64_t)disp.max.x - disp.min.x + 1, dh = (int64_t)disp.max.y - disp.min.y + 1;
@@ -595,7 +614,10 @@ static RayesError read_part(exr_const_context_t ctx, const ExrIo *io, const char
         return status;
     size_t n_pixels = (size_t)target->width * (size_t)target->height;
     target->rgba = malloc(n_pixels * 4 * sizeof(float));
-    if (!target->rgba) {
+    target->aov = target->n_aov ? calloc(n_pixels * (size_t)target->n_aov, sizeof(float)) : NULL;
+    if (!target->rgba || (target->n_aov && !target->aov)) {
+        free(target->rgba), free(target->aov);
+        target->rgba = NULL, target->aov = NULL;
         image_set_error(err, err_size, "%s: out of memory", path);
         return RAYES_ERROR_OUT_OF_MEMORY;
     }
@@ -607,8 +629,8 @@ static RayesError read_part(exr_const_context_t ctx, const ExrIo *io, const char
     }
     exr_result_t rv = target->tiled ? read_tiles(ctx, target) : read_scanlines(ctx, target);
     if (rv != EXR_ERR_SUCCESS) {
-        free(target->rgba);
-        target->rgba = NULL;
+        free(target->rgba), free(target->aov);
+        target->rgba = NULL, target->aov = NULL;
         return report(io, rv, path, "cannot read EXR pixels", RAYES_ERROR_PARSE, err, err_size);
     }
     return RAYES_OK;
@@ -635,15 +657,21 @@ RayesError image_read_exr(const char *path, int *width, int *height, float **rgb
 RayesError image_read_exr_window(const char *path, int display[2], int window[4], float **rgba,
                                  char *err, size_t err_size)
 {
-    return image_read_exr_parts(path, display, window, rgba, NULL, err, err_size);
+    return image_read_exr_aov(path, display, window, rgba, NULL, NULL, NULL, 0, NULL, err,
+                              err_size);
 }
 
-RayesError image_read_exr_parts(const char *path, int display[2], int window[4], float **rgba,
-                                int *others, char *err, size_t err_size)
+RayesError image_read_exr_aov(const char *path, int display[2], int window[4], float **rgba,
+                              float **aov, int *n_aov, char (*names)[IMAGE_AOV_NAME], int max_aov,
+                              int *others, char *err, size_t err_size)
 {
-    ExrTarget t = {0};
+    ExrTarget t = {.max_aov = aov && n_aov && names ? max_aov : 0, .aov_names = names};
     RayesError e = read_exr(path, &t, err, err_size);
     *rgba = t.rgba;
+    if (aov)
+        *aov = t.aov;
+    if (n_aov)
+        *n_aov = e == RAYES_OK ? t.n_aov : 0;
     if (others)
         *others = e == RAYES_OK ? t.others : 0;
     if (e == RAYES_OK) {
@@ -667,7 +695,7 @@ static RayesError read_exr(const char *path, ExrTarget *out, char *err, size_t e
     exr_context_t ctx = NULL;
     exr_result_t rv = exr_start_read(&ctx, path, &init);
     RayesError status = RAYES_OK;
-    ExrTarget target = {0};
+    ExrTarget target = {.max_aov = out->max_aov, .aov_names = out->aov_names};
     if (rv != EXR_ERR_SUCCESS)
         status = report(&io, rv, path, "not a readable EXR file", RAYES_ERROR_PARSE, err, err_size);
     else

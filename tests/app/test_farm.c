@@ -112,8 +112,7 @@ static void test_opencue_token(void)
     CHECK(strstr(text, "{\"event\": \"frame\", \"frame\": 3, \"status\": 0") != NULL);
 }
 
-/* Four crops and rayes assemble: the whole frame's bytes (a part's AOVs
- * are left out with a warning). */
+/* Four crops and rayes assemble: the whole frame's bytes, AOVs too. */
 static void test_crops_assembled(void)
 {
     mkdir(SCRATCH, 0755);
@@ -145,18 +144,30 @@ static void test_crops_assembled(void)
         fclose(f);
     CHECK(strstr(err, "parts/other.exr: a 48 x 32 frame") != NULL);
     CHECK(sh("$RAYES assemble only-one.exr") == 2);
-    /* parts with AOVs: their colour joined, their AOVs not, with a warning */
-    CHECK(sh("$RAYES render cornell --res 96x64 --spp 2 --quiet --crop 0,0.5,0,0.5 --aov z -o "
-             "parts/aov.exr") == 0);
-    CHECK(sh("$RAYES assemble joined.exr parts/aov.exr parts/p1.exr parts/p2.exr parts/p3.exr "
-             "2>joined.err") == 0);
-    CHECK(same_bytes(SCRATCH "/joined.exr", SCRATCH "/whole.exr"));
-    f = fopen(SCRATCH "/joined.err", "r");
+    /* parts with AOVs: joined too, the whole frame's bytes; a part without
+     * them leaves the colour alone, with a warning */
+    CHECK(sh("$RAYES render cornell --res 96x64 --spp 2 --quiet --aov z,N,id -o whole-aov.exr") ==
+          0);
+    for (int i = 0; i < 4; i++) {
+        char cmd[512];
+        snprintf(cmd, sizeof cmd,
+                 "$RAYES render cornell --res 96x64 --spp 2 --quiet --crop %s --aov z,N,id -o "
+                 "parts/a%d.exr",
+                 crops[i], i);
+        CHECK(sh(cmd) == 0);
+    }
+    CHECK(sh("$RAYES assemble joined.exr parts/a0.exr parts/a1.exr parts/a2.exr parts/a3.exr") ==
+          0);
+    CHECK(same_bytes(SCRATCH "/joined.exr", SCRATCH "/whole-aov.exr"));
+    CHECK(sh("$RAYES assemble mixed-aov.exr parts/a0.exr parts/p1.exr parts/p2.exr parts/p3.exr "
+             "2>mixed-aov.err") == 0);
+    CHECK(same_bytes(SCRATCH "/mixed-aov.exr", SCRATCH "/whole.exr"));
+    f = fopen(SCRATCH "/mixed-aov.err", "r");
     n = f ? fread(err, 1, sizeof err - 1, f) : 0;
     err[n] = '\0';
     if (f)
         fclose(f);
-    CHECK(strstr(err, "parts/aov.exr") && strstr(err, "not joined"));
+    CHECK(strstr(err, "parts/p1.exr") && strstr(err, "colour alone"));
 }
 
 TEST_MAIN(TEST(test_slurm_array_task), TEST(test_opencue_token), TEST(test_crops_assembled))
