@@ -135,25 +135,32 @@ static const char render_options[] =
     "  --quiet                 no progress bar and no summary\n";
 
 /* --aov's list: names of RayesAov, comma-separated. */
-static unsigned parse_aovs(const char *v)
+unsigned aov_named(const char *name, size_t n)
 {
     static const struct {
         const char *name;
         unsigned aov;
-    } names[] = {{"z", RAYES_AOV_Z},    {"N", RAYES_AOV_N},         {"P", RAYES_AOV_P},
+    } names[] = {{"z", RAYES_AOV_Z},    {"Z", RAYES_AOV_Z},         {"zfiltered", RAYES_AOV_Z},
+                 {"N", RAYES_AOV_N},    {"normal", RAYES_AOV_N},    {"P", RAYES_AOV_P},
                  {"id", RAYES_AOV_ID},  {"patch", RAYES_AOV_PATCH}, {"cache", RAYES_AOV_CACHE},
                  {"all", RAYES_AOV_ALL}};
+    for (size_t k = 0; k < sizeof names / sizeof names[0]; k++)
+        if (strlen(names[k].name) == n && strncmp(names[k].name, name, n) == 0)
+            return names[k].aov;
+    return 0;
+}
+
+static unsigned parse_aovs(const char *v)
+{
     unsigned aovs = 0;
     for (const char *s = v; *s;) {
-        size_t n = strcspn(s, ","), k = 0;
-        while (k < sizeof names / sizeof names[0] &&
-               !(strlen(names[k].name) == n && strncmp(names[k].name, s, n) == 0))
-            k++;
-        if (k == sizeof names / sizeof names[0])
+        size_t n = strcspn(s, ",");
+        unsigned aov = aov_named(s, n);
+        if (!aov)
             die_usage("--aov: expected z, N, P, id, patch, cache or all (comma-separated), found "
                       "\"%.*s\"",
                       (int)n, s);
-        aovs |= names[k].aov;
+        aovs |= aov;
         s += n + (s[n] == ',');
     }
     if (!aovs)

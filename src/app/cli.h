@@ -78,6 +78,11 @@ void parse_args(int argc, char **argv, Args *a);
  * error otherwise. */
 long parse_long(const char *opt, const char *s, long lo, long hi);
 
+/* The RayesAov bits an AOV's name (its first n characters) stands for, or
+ * 0: z (Z, RenderMan's denoiser's zfiltered), N (normal), P, id, patch,
+ * cache, all. --aov's list and a RIB display's mode both read them. */
+unsigned aov_named(const char *name, size_t n);
+
 /* Prints "rayes: MESSAGE" and the usage hint, exits with status 2. */
 void die_usage(const char *fmt, ...) __attribute__((noreturn, format(printf, 1, 2)));
 

@@ -226,13 +226,6 @@ static Output *add_output(Args *a, const char *path, ImageFormat format, int no_
  * one line; *colour 1 rgb, 2 rgba, 0 none. */
 static int display_mode(const IoDisplay *d, int aovs_ok, int *colour, unsigned *aovs)
 {
-    static const struct {
-        const char *name;
-        unsigned aov;
-    } names[] = {{"z", RAYES_AOV_Z},    {"Z", RAYES_AOV_Z},         {"zfiltered", RAYES_AOV_Z},
-                 {"N", RAYES_AOV_N},    {"normal", RAYES_AOV_N},    {"P", RAYES_AOV_P},
-                 {"id", RAYES_AOV_ID},  {"patch", RAYES_AOV_PATCH}, {"cache", RAYES_AOV_CACHE},
-                 {"rgbz", RAYES_AOV_Z}, {"rgbaz", RAYES_AOV_Z}};
     *colour = 0, *aovs = 0;
     char mode[sizeof d->mode], skipped[2 * sizeof d->mode] = "", unwritten[2 * sizeof d->mode] = "";
     snprintf(mode, sizeof mode, "%s", d->mode[0] ? d->mode : "rgba");
@@ -241,10 +234,9 @@ static int display_mode(const IoDisplay *d, int aovs_ok, int *colour, unsigned *
         while (*tok == ' ')
             tok++;
         const char *space = strrchr(tok, ' '), *name = space ? space + 1 : tok;
-        unsigned aov = 0;
-        for (size_t k = 0; k < sizeof names / sizeof names[0]; k++)
-            if (strcmp(name, names[k].name) == 0)
-                aov = names[k].aov;
+        int z = strcmp(name, "rgbz") == 0 || strcmp(name, "rgbaz") == 0; /* colour and Z */
+        unsigned aov =
+            strcmp(name, "all") == 0 ? 0 : aov_named(name, strlen(name)) | (z ? RAYES_AOV_Z : 0);
         /* RenderMan RIS's beauty is "Ci,a" (RenderMan for Blender's, Maya's) */
         int rgb = strcasecmp(name, "rgb") == 0 || strcmp(name, "rgbz") == 0 ||
                   strcmp(name, "Ci") == 0,

@@ -112,6 +112,31 @@ static void test_opencue_token(void)
     CHECK(strstr(text, "{\"event\": \"frame\", \"frame\": 3, \"status\": 0") != NULL);
 }
 
+/* The four quarters of the cornell frame at 96 x 64 with options extra,
+ * into parts/PREFIX0.exr to parts/PREFIX3.exr. */
+static void render_crops(const char *extra, const char *prefix)
+{
+    const char *crops[4] = {"0,0.5,0,0.5", "0.5,1,0,0.5", "0,0.5,0.5,1", "0.5,1,0.5,1"};
+    for (int i = 0; i < 4; i++) {
+        char cmd[512];
+        snprintf(cmd, sizeof cmd,
+                 "$RAYES render cornell --res 96x64 --spp 2 --quiet --crop %s %s -o "
+                 "parts/%s%d.exr",
+                 crops[i], extra, prefix, i);
+        CHECK(sh(cmd) == 0);
+    }
+}
+
+/* A text file's start into buf ("" if it cannot be read). */
+static void read_text(const char *path, char *buf, size_t size)
+{
+    FILE *f = fopen(path, "r");
+    size_t n = f ? fread(buf, 1, size - 1, f) : 0;
+    buf[n] = '\0';
+    if (f)
+        fclose(f);
+}
+
 /* Four crops and rayes assemble: the whole frame's bytes, AOVs too. */
 static void test_crops_assembled(void)
 {
@@ -119,14 +144,7 @@ static void test_crops_assembled(void)
     mkdir(SCRATCH "/parts", 0755);
     unlink(SCRATCH "/poster.exr");
     CHECK(sh("$RAYES render cornell --res 96x64 --spp 2 --quiet -o whole.exr") == 0);
-    const char *crops[4] = {"0,0.5,0,0.5", "0.5,1,0,0.5", "0,0.5,0.5,1", "0.5,1,0.5,1"};
-    for (int i = 0; i < 4; i++) {
-        char cmd[512];
-        snprintf(cmd, sizeof cmd,
-                 "$RAYES render cornell --res 96x64 --spp 2 --quiet --crop %s -o parts/p%d.exr",
-                 crops[i], i);
-        CHECK(sh(cmd) == 0);
-    }
+    render_crops("", "p");
     CHECK(sh("$RAYES assemble poster.exr parts/p0.exr parts/p1.exr parts/p2.exr parts/p3.exr") ==
           0);
     CHECK(same_bytes(SCRATCH "/poster.exr", SCRATCH "/whole.exr"));
@@ -136,37 +154,22 @@ static void test_crops_assembled(void)
     unlink(SCRATCH "/mixed.exr");
     CHECK(sh("$RAYES assemble mixed.exr parts/p0.exr parts/other.exr 2>mixed.err") == 1);
     CHECK(!file_exists(SCRATCH "/mixed.exr"));
-    char err[1024] = "";
-    FILE *f = fopen(SCRATCH "/mixed.err", "r");
-    size_t n = f ? fread(err, 1, sizeof err - 1, f) : 0;
-    err[n] = '\0';
-    if (f)
-        fclose(f);
+    char err[1024];
+    read_text(SCRATCH "/mixed.err", err, sizeof err);
     CHECK(strstr(err, "parts/other.exr: a 48 x 32 frame") != NULL);
     CHECK(sh("$RAYES assemble only-one.exr") == 2);
     /* parts with AOVs: joined too, the whole frame's bytes; a part without
      * them leaves the colour alone, with a warning */
     CHECK(sh("$RAYES render cornell --res 96x64 --spp 2 --quiet --aov z,N,id -o whole-aov.exr") ==
           0);
-    for (int i = 0; i < 4; i++) {
-        char cmd[512];
-        snprintf(cmd, sizeof cmd,
-                 "$RAYES render cornell --res 96x64 --spp 2 --quiet --crop %s --aov z,N,id -o "
-                 "parts/a%d.exr",
-                 crops[i], i);
-        CHECK(sh(cmd) == 0);
-    }
+    render_crops("--aov z,N,id", "a");
     CHECK(sh("$RAYES assemble joined.exr parts/a0.exr parts/a1.exr parts/a2.exr parts/a3.exr") ==
           0);
     CHECK(same_bytes(SCRATCH "/joined.exr", SCRATCH "/whole-aov.exr"));
     CHECK(sh("$RAYES assemble mixed-aov.exr parts/a0.exr parts/p1.exr parts/p2.exr parts/p3.exr "
              "2>mixed-aov.err") == 0);
     CHECK(same_bytes(SCRATCH "/mixed-aov.exr", SCRATCH "/whole.exr"));
-    f = fopen(SCRATCH "/mixed-aov.err", "r");
-    n = f ? fread(err, 1, sizeof err - 1, f) : 0;
-    err[n] = '\0';
-    if (f)
-        fclose(f);
+    read_text(SCRATCH "/mixed-aov.err", err, sizeof err);
     CHECK(strstr(err, "parts/p1.exr") && strstr(err, "colour alone"));
 }
 
