@@ -852,7 +852,8 @@ typedef struct RayesRenderOptions {
     uint64_t seed;             /* changes every random number */
     int tile_size;             /* pixels */
     int cache;                 /* 1: the radiosity cache at diffuse hits (default); 0: off */
-    double cache_mb;           /* cache budget in megabytes (10^6 bytes), default 100 */
+    double cache_mb;           /* cache budget in megabytes (10^6 bytes), default 100; 0 turns
+                                  the radiosity cache off (as cache 0) */
     float cache_split[3];      /* budget shares of coarse, medium, fine (default .25 .25 .5) */
     int cache_resolution;      /* -1: chosen by ray differentials (default); 0, 1, 2: always
                                   coarse, medium, fine */
@@ -899,7 +900,7 @@ typedef struct RayesRenderOptions {
                                 and transmission rays run the shader at every hit */
     double opacity_cache_mb; /* the opacity entries' budget in megabytes (10^6 bytes;
                                 RenderMan's "opacitycachememory"), default 20, apart from
-                                cache_mb */
+                                cache_mb; 0 turns the opacity cache off */
     float volume_step;         /* volumes are ray marched in steps of this many fine voxels
                                   (a voxel projects to about a pixel at the volume's nearest
                                   point, times the square root of its shading rate): default
@@ -914,7 +915,7 @@ typedef struct RayesRenderOptions {
                                   per grid at the three resolutions, data type irradiance
                                   (memo 6.2); 0: the shader runs at every subsurface hit */
     double irradiance_cache_mb; /* the irradiance entries' budget in megabytes (10^6 bytes),
-                                  default 20, apart from cache_mb */
+                                  default 20, apart from cache_mb; 0 turns it off */
     int irradiance_shadow_rays; /* shadow rays per light at each point of an irradiance
                                    cache fill, where the shader asks for the default: a
                                    cached value is shared by every subsurface ray near it,

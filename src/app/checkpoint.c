@@ -62,17 +62,21 @@ uint64_t checkpoint_digest(const char *scene, int frame, const RayesRenderOption
             h = fnv(h, buf, n);
         fclose(f);
     }
-    /* the options that change pixels (not threads, budgets or callbacks) */
+    /* the options that change pixels (not threads, budgets or callbacks; a
+     * budget of 0 turns its cache off) */
+    int cache = o->cache && o->cache_mb > 0.0;
+    int opacity_cache = o->opacity_cache && o->opacity_cache_mb > 0.0;
+    int irradiance_cache = o->irradiance_cache && o->irradiance_cache_mb > 0.0;
     HASH(h, frame);
     HASH(h, o->width), HASH(h, o->height), HASH(h, o->spp), HASH(h, o->bounces);
     HASH(h, o->shadow_rays), HASH(h, o->shadow_rays_deep), HASH(h, o->diffuse_rays);
     HASH(h, o->diffuse_rays_deep), HASH(h, o->specular_depth), HASH(h, o->filter);
-    HASH(h, o->filter_width), HASH(h, o->seed), HASH(h, o->tile_size), HASH(h, o->cache);
+    HASH(h, o->filter_width), HASH(h, o->seed), HASH(h, o->tile_size), HASH(h, cache);
     HASH(h, o->cache_resolution), HASH(h, o->cache_k), HASH(h, o->hider);
     HASH(h, o->irradiance), HASH(h, o->texture_width), HASH(h, o->grid_size);
     HASH(h, o->branch_depth), HASH(h, o->dice_offscreen), HASH(h, o->dice_isotropic);
-    HASH(h, o->vertex_budget), HASH(h, o->crop), HASH(h, o->opacity_cache);
-    HASH(h, o->volume_step), HASH(h, o->subsurface_rays), HASH(h, o->irradiance_cache);
+    HASH(h, o->vertex_budget), HASH(h, o->crop), HASH(h, opacity_cache);
+    HASH(h, o->volume_step), HASH(h, o->subsurface_rays), HASH(h, irradiance_cache);
     HASH(h, o->irradiance_shadow_rays), HASH(h, o->cache_fine_depth);
     return h;
 }

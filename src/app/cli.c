@@ -77,7 +77,7 @@ static const char render_options[] =
     "  --seed N                changes every random number (default 0)\n"
     "  --cache on|off          the radiosity cache at diffuse hits (default on; off for\n"
     "                          --quality reference)\n"
-    "  --cache-mb MB           cache budget in megabytes (default 100)\n"
+    "  --cache-mb MB           cache budget in megabytes (default 100; 0: --cache off)\n"
     "  --cache-split C,M,F     budget shares of coarse, medium, fine (default .25,.25,.5);\n"
     "                          each lends the others what it leaves unused\n"
     "  --irradiance-cache on|off  cache the irradiance subsurface rays find (default on)\n"

@@ -89,8 +89,9 @@ RayesError rayes_session_new(RayesScene *scene, const RayesRenderOptions *option
     s->accum = malloc(n * sizeof *s->accum);
     s->rgba = calloc(n * 4, sizeof *s->rgba); /* 0 outside a crop window */
     s->textures = session_textures(scene, options->texture_mb, options->texture_width);
-    int cached =
-        options->cache || options->opacity_cache || options->irradiance_cache || options->env_guide;
+    int cached = session_caches(options, CACHE_RADIOSITY) ||
+                 session_caches(options, CACHE_OPACITY) ||
+                 session_caches(options, CACHE_IRRADIANCE) || options->env_guide;
     if (cached)
         s->cache = session_cache(options);
     if (!s->accum || !s->rgba || !s->textures || (cached && !s->cache)) {

@@ -265,9 +265,9 @@ RenderSettings session_settings(const RayesRenderOptions *o)
         .branch_depth = o->branch_depth,
         .hider = o->hider == RAYES_HIDER_GRID,
         .irradiance = o->irradiance != 0,
-        .radiosity_cache = o->cache != 0,
-        .opacity_cache = o->opacity_cache != 0,
-        .irradiance_cache = o->irradiance_cache != 0,
+        .radiosity_cache = session_caches(o, CACHE_RADIOSITY),
+        .opacity_cache = session_caches(o, CACHE_OPACITY),
+        .irradiance_cache = session_caches(o, CACHE_IRRADIANCE),
         .env_guide = o->env_guide != 0,
         .subsurface_rays = o->subsurface_rays,
         /* the camera's count, at most RENDER_IRRADIANCE_SHADOW_RAYS (DESIGN.md) */
@@ -292,14 +292,27 @@ RenderSettings session_settings(const RayesRenderOptions *o)
     return s;
 }
 
+int session_caches(const RayesRenderOptions *o, int t)
+{
+    switch (t) {
+    case CACHE_RADIOSITY:
+        return o->cache && o->cache_mb > 0.0;
+    case CACHE_OPACITY:
+        return o->opacity_cache && o->opacity_cache_mb > 0.0;
+    case CACHE_IRRADIANCE:
+        return o->irradiance_cache && o->irradiance_cache_mb > 0.0;
+    }
+    return 0;
+}
+
 Cache *session_cache(const RayesRenderOptions *o)
 {
     uint64_t budgets[CACHE_N_TYPES] = {0};
-    if (o->cache)
+    if (session_caches(o, CACHE_RADIOSITY))
         budgets[CACHE_RADIOSITY] = (uint64_t)(o->cache_mb * 1e6);
-    if (o->opacity_cache)
+    if (session_caches(o, CACHE_OPACITY))
         budgets[CACHE_OPACITY] = (uint64_t)(o->opacity_cache_mb * 1e6);
-    if (o->irradiance_cache)
+    if (session_caches(o, CACHE_IRRADIANCE))
         budgets[CACHE_IRRADIANCE] = (uint64_t)(o->irradiance_cache_mb * 1e6);
     if (o->env_guide)
         budgets[CACHE_GUIDE] = RENDER_GUIDE_CACHE_BYTES;
@@ -608,7 +621,8 @@ RayesError rayes_render(RayesScene *scene, const RayesRenderOptions *opt, RayesI
     e = session_prepare(scene, &set, textures, &prep);
     if (e != RAYES_OK)
         goto done;
-    if (opt->cache || opt->opacity_cache || opt->irradiance_cache || opt->env_guide) {
+    if (session_caches(opt, CACHE_RADIOSITY) || session_caches(opt, CACHE_OPACITY) ||
+        session_caches(opt, CACHE_IRRADIANCE) || opt->env_guide) {
         cache = session_cache(opt);
         if (!cache) {
             e = session_fail(scene, RAYES_ERROR_OUT_OF_MEMORY,

@@ -42,13 +42,18 @@ RenderSettings session_settings(const RayesRenderOptions *options);
  * be NULL); 1 if it holds any. */
 int session_crop_pixels(const RayesRenderOptions *options, int rect[4]);
 
+/* 1 if data type t (CACHE_RADIOSITY, _OPACITY, _IRRADIANCE) is cached:
+ * its switch is on and its budget above 0 (a budget of 0 turns it off, as
+ * RenderMan's cache memory limits do). */
+int session_caches(const RayesRenderOptions *o, int t);
+
+/* The cache of a render: a budget per data type session_caches keeps
+ * (cache_mb, opacity_cache_mb, irradiance_cache_mb; one Cache). NULL when
+ * out of memory. */
+Cache *session_cache(const RayesRenderOptions *o);
+
 /* The texture system of a render: the scene's texture path, then
  * $RAYES_TEXTURE_PATH's. NULL when out of memory. */
-/* The cache of a render: radiosity with cache_mb if o->cache, opacity with
- * opacity_cache_mb if o->opacity_cache, irradiance with irradiance_cache_mb
- * if o->irradiance_cache (one Cache, a budget per data
- * type). NULL when out of memory. */
-Cache *session_cache(const RayesRenderOptions *o);
 TextureSystem *session_textures(const RayesScene *scene, double mb, float width);
 
 /* The render-side view of the scene's objects (shader, Cs, Os, light), or

@@ -624,7 +624,7 @@ static void test_opacity_table_same_bytes_as_cache(void)
 {
     RayesStats *st = NULL, *small_st = NULL;
     RayesImage *a = cutout_instances(2, 20.0, &st), *b = cutout_instances(1, 20.0, NULL);
-    RayesImage *c = cutout_instances(2, 0.0, &small_st);
+    RayesImage *c = cutout_instances(2, 1e-6, &small_st); /* 1 byte: no entry fits */
     unsigned long long lookups = stat_count(st, "opacity/table_lookups");
     unsigned long long fills = stat_count(st, "opacity/table_fills");
     unsigned long long small = stat_count(small_st, "opacity/table_lookups");

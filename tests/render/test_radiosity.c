@@ -204,7 +204,7 @@ static int same(const RayesImage *a, const RayesImage *b)
 static void test_same_bytes_for_any_budget_and_threads(void)
 {
     RayesImage *ref = render(100, 1, 1);
-    const double budgets[] = {0.05, 0.0, 100};
+    const double budgets[] = {0.05, 1e-6, 100}; /* 1 byte: every lookup fills privately */
     const int threads[] = {2, 3, 4};
     for (int i = 0; i < 3; i++) {
         RayesStats *st = NULL;
@@ -216,6 +216,9 @@ static void test_same_bytes_for_any_budget_and_threads(void)
     }
     RayesImage *off = render(100, 2, 0);
     CHECK(!same(ref, off)); /* caching changes the estimate (it is biased) */
+    RayesImage *zero = render(0.0, 2, 1); /* a budget of 0 is the cache off */
+    CHECK(same(off, zero));
+    rayes_image_free(zero);
     rayes_image_free(off);
     rayes_image_free(ref);
 }
