@@ -823,6 +823,14 @@ typedef enum RayesGi {
 typedef void (*RayesTileFn)(void *user, int x, int y, int w, int h, const float *rgba,
                             int stride);
 
+/* A finished tile's AOVs (RayesRenderOptions.aovs): the pixels [x, x + w)
+ * x [y, y + h) of aov, channels floats a pixel (rayes_aov_channels, in
+ * rayes_aov_channel_name's order), rows stride pixels apart. Called just
+ * before the tile's RayesTileFn, on the same thread; valid during the
+ * call. */
+typedef void (*RayesTileAovFn)(void *user, int x, int y, int w, int h, const float *aov,
+                               int channels, int stride);
+
 /* Which tile a render thread takes next: an index into the frame's tiles
  * (tiles_x * tiles_y of tile_size pixels over the crop window, row by
  * row), or -1 when no tile is left for this render. Called from worker
@@ -970,6 +978,8 @@ typedef struct RayesRenderOptions {
                                    by the map's brightness alone (DESIGN.md "Lights") */
     unsigned aovs;              /* RayesAov bits: the arbitrary output variables the image
                                    carries beside its colour (RayesImage.aov). Default 0 */
+    RayesTileAovFn tile_aov_done; /* may be NULL: called with each tile's AOVs (when aovs
+                                     is not 0) just before tile_done, with tile_user */
 } RayesRenderOptions;
 
 /* Fills options with the defaults of a quality preset: 512 x 512, 4 pixel

@@ -4,9 +4,10 @@
  *
  * File layout (this machine's byte order: a checkpoint resumes on the
  * machine, or the farm's kind of machine, that wrote it):
- *   "RAYESCK1", digest (u64), width, height, tile size, crop x0 y0 x1 y1,
- *   tiles x, tiles y (i32 each), a byte per tile (1: done), then the done
- *   tiles' pixels in tile order, w * h * 4 floats each.
+ *   "RAYESCK2", digest (u64), width, height, tile size, crop x0 y0 x1 y1,
+ *   tiles x, tiles y, AOV bits (i32 each), a byte per tile (1: done), then
+ *   the done tiles' pixels in tile order, w * h * 4 floats each, each
+ *   followed by its AOVs, w * h * rayes_aov_channels floats.
  */
 #include "app/checkpoint.h"
 
@@ -20,8 +21,8 @@
 #include "app/tiles.h"
 #include "util/log.h"
 
-#define MAGIC "RAYESCK1"
-#define HEADER_INTS 9
+#define MAGIC "RAYESCK2"
+#define HEADER_INTS 10
 
 enum { TILE_PENDING = 0, TILE_RESUMED = 1, TILE_DONE = 2 };
 
@@ -32,6 +33,9 @@ struct Checkpoint {
     TileGrid g;             /* the render's tiles */
     unsigned char *state;   /* TILE_* per tile */
     float *rgba;            /* the frame, width * height * 4: finished tiles' pixels */
+    unsigned aovs;          /* the render's AOVs (RayesRenderOptions.aovs) */
+    int k;                  /* their channels */
+    float *aov;             /* the frame's, width * height * k: finished tiles' */
     int next;               /* the tile source's next candidate */
     int resumed;            /* tiles read from the file */
     double every_s, last_save;
@@ -77,8 +81,17 @@ uint64_t checkpoint_digest(const char *scene, int frame, const RayesRenderOption
     HASH(h, o->branch_depth), HASH(h, o->dice_offscreen), HASH(h, o->dice_isotropic);
     HASH(h, o->vertex_budget), HASH(h, o->crop), HASH(h, opacity_cache);
     HASH(h, o->volume_step), HASH(h, o->subsurface_rays), HASH(h, irradiance_cache);
-    HASH(h, o->irradiance_shadow_rays), HASH(h, o->cache_fine_depth);
+    HASH(h, o->irradiance_shadow_rays), HASH(h, o->cache_fine_depth), HASH(h, o->aovs);
     return h;
+}
+
+/* The file's header after the digest. */
+static void header(const Checkpoint *c, int32_t h[HEADER_INTS])
+{
+    int32_t v[HEADER_INTS] = {c->width,     c->height,       c->g.size,    c->g.crop[0],
+                              c->g.crop[1], c->g.crop[2],    c->g.crop[3], c->g.tiles_x,
+                              c->g.tiles_y, (int32_t)c->aovs};
+    memcpy(h, v, sizeof v);
 }
 
 static int n_tiles(const Checkpoint *c)
@@ -103,9 +116,8 @@ static int load(Checkpoint *c, char *err, size_t err_size)
     char magic[8];
     uint64_t digest;
     int32_t hdr[HEADER_INTS];
-    int32_t want[HEADER_INTS] = {c->width,     c->height,    c->g.size,    c->g.crop[0],
-                                 c->g.crop[1], c->g.crop[2], c->g.crop[3], c->g.tiles_x,
-                                 c->g.tiles_y};
+    int32_t want[HEADER_INTS];
+    header(c, want);
     int r = -1;
     if (read_exact(f, magic, 8) || memcmp(magic, MAGIC, 8) || read_exact(f, &digest, 8) ||
         read_exact(f, hdr, sizeof hdr)) {
@@ -131,6 +143,12 @@ static int load(Checkpoint *c, char *err, size_t err_size)
                     snprintf(err, err_size, "%s: truncated checkpoint", c->path);
                     r = -1;
                 }
+            for (int y = 0; y < q[3] && r == 1 && c->k; y++)
+                if (read_exact(f, &c->aov[(size_t)c->k * ((size_t)(q[1] + y) * c->width + q[0])],
+                               sizeof(float) * (size_t)c->k * (size_t)q[2])) {
+                    snprintf(err, err_size, "%s: truncated checkpoint", c->path);
+                    r = -1;
+                }
         }
     }
     fclose(f);
@@ -148,9 +166,8 @@ int checkpoint_save(Checkpoint *c, char *err, size_t err_size)
         snprintf(err, err_size, "%s: cannot write checkpoint: %s", c->tmp, strerror(errno));
         return -1;
     }
-    int32_t hdr[HEADER_INTS] = {c->width,     c->height,    c->g.size,    c->g.crop[0],
-                                c->g.crop[1], c->g.crop[2], c->g.crop[3], c->g.tiles_x,
-                                c->g.tiles_y};
+    int32_t hdr[HEADER_INTS];
+    header(c, hdr);
     int ok = fwrite(MAGIC, 1, 8, f) == 8 && fwrite(&c->digest, 8, 1, f) == 1 &&
              fwrite(hdr, sizeof hdr, 1, f) == 1;
     unsigned char *done = malloc((size_t)n_tiles(c));
@@ -166,6 +183,9 @@ int checkpoint_save(Checkpoint *c, char *err, size_t err_size)
         for (int y = 0; ok && y < q[3]; y++)
             ok = fwrite(&c->rgba[4 * ((size_t)(q[1] + y) * c->width + q[0])], sizeof(float) * 4,
                         (size_t)q[2], f) == (size_t)q[2];
+        for (int y = 0; ok && c->k && y < q[3]; y++)
+            ok = fwrite(&c->aov[(size_t)c->k * ((size_t)(q[1] + y) * c->width + q[0])],
+                        sizeof(float) * (size_t)c->k, (size_t)q[2], f) == (size_t)q[2];
     }
     free(done);
     ok = fclose(f) == 0 && ok;
@@ -187,6 +207,21 @@ static int source(void *user, int tiles_x, int tiles_y)
     while (c->next < n_tiles(c) && c->state[c->next] != TILE_PENDING)
         c->next++;
     return c->next < n_tiles(c) ? c->next++ : -1;
+}
+
+/* Before tile_done, on the same thread: the tile's AOVs. */
+static void tile_aov_done(void *user, int x, int y, int w, int h, const float *aov, int channels,
+                          int stride)
+{
+    Checkpoint *c = user;
+    if (channels != c->k || tile_at(&c->g, x, y) < 0)
+        return;
+    pthread_mutex_lock(&c->lock);
+    for (int r = 0; r < h; r++)
+        memcpy(&c->aov[(size_t)c->k * ((size_t)(y + r) * c->width + x)],
+               &aov[(size_t)c->k * ((size_t)(y + r) * stride + x)],
+               sizeof(float) * (size_t)c->k * (size_t)w);
+    pthread_mutex_unlock(&c->lock);
 }
 
 static void tile_done(void *user, int x, int y, int w, int h, const float *rgba, int stride)
@@ -227,8 +262,12 @@ Checkpoint *checkpoint_new(const char *path, uint64_t digest, const RayesRenderO
     c->last_save = time_now();
     c->state = calloc((size_t)n_tiles(c) + 1, 1);
     c->rgba = calloc((size_t)c->width * (size_t)c->height * 4, sizeof(float));
+    c->aovs = o->aovs;
+    c->k = rayes_aov_channels(o->aovs);
+    c->aov =
+        c->k ? calloc((size_t)c->width * (size_t)c->height * (size_t)c->k, sizeof(float)) : NULL;
     pthread_mutex_init(&c->lock, NULL);
-    if (!c->state || !c->rgba) {
+    if (!c->state || !c->rgba || (c->k && !c->aov)) {
         snprintf(err, err_size, "%s: out of memory", path);
         checkpoint_free(c);
         return NULL;
@@ -250,6 +289,7 @@ void checkpoint_attach(Checkpoint *c, RayesRenderOptions *o)
     o->tile_source = source;
     o->tile_source_user = c;
     o->tile_done = tile_done;
+    o->tile_aov_done = c->k ? tile_aov_done : NULL;
     o->tile_user = c;
 }
 
@@ -268,8 +308,11 @@ void checkpoint_fill(const Checkpoint *c, RayesImage *img)
         int q[4];
         tile_rect(&c->g, t, q);
         for (int y = 0; y < q[3]; y++) {
-            size_t at = 4 * ((size_t)(q[1] + y) * c->width + q[0]);
-            memcpy(&img->rgba[at], &c->rgba[at], sizeof(float) * 4 * (size_t)q[2]);
+            size_t at = (size_t)(q[1] + y) * c->width + q[0];
+            memcpy(&img->rgba[4 * at], &c->rgba[4 * at], sizeof(float) * 4 * (size_t)q[2]);
+            if (c->k && img->aov && img->aovs == c->aovs)
+                memcpy(&img->aov[(size_t)c->k * at], &c->aov[(size_t)c->k * at],
+                       sizeof(float) * (size_t)c->k * (size_t)q[2]);
         }
     }
 }
@@ -287,5 +330,6 @@ void checkpoint_free(Checkpoint *c)
     pthread_mutex_destroy(&c->lock);
     free(c->state);
     free(c->rgba);
+    free(c->aov);
     free(c);
 }

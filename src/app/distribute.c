@@ -5,7 +5,8 @@
  * Messages (MPI_COMM_WORLD, point to point):
  *   TAG_ASK   rank r -> 0, empty: a render thread of r wants a tile
  *   TAG_GIVE  0 -> r, one int: the tile's index, or -1: none left
- *   TAG_TILE  r -> 0, bytes: x y w h (4 ints) and w h 4 floats of pixels
+ *   TAG_TILE  r -> 0, bytes: x y w h (4 ints), w h 4 floats of pixels, then
+ *             w h k floats of their AOVs (k = rayes_aov_channels, often 0)
  *   TAG_DONE  r -> 0, STAT_COUNT doubles: r's statistics; its last message
  * A rank's messages to rank 0 arrive in the order sent (MPI's ordering
  * between one pair on one communicator), so its tiles precede its DONE.
@@ -47,7 +48,7 @@ static const char *const stat_names[] = {
 struct Distributed {
     int rank, size;
     pthread_mutex_t mpi_lock;   /* every MPI call */
-    pthread_mutex_t tiles_lock; /* rank 0: next, tiles_of */
+    pthread_mutex_t tiles_lock; /* rank 0: next, tiles_of; other ranks: aov */
     /* the frame */
     TileGrid g;
     int width;
@@ -55,6 +56,9 @@ struct Distributed {
     int (*band)[2];             /* rank 0: per rank, its band's tiles not handed out [lo, hi) */
     int *owner;                 /* rank 0: per tile, the rank that rendered it */
     float *remote;              /* rank 0: the other ranks' tiles, width x height x 4 */
+    int k;                      /* AOV channels a pixel (RayesRenderOptions.aovs) */
+    float *remote_aov;          /* rank 0: the other ranks' AOVs, width x height x k */
+    const float *aov;           /* other ranks: the frame's AOVs (tile_aov_done's) */
     double (*stats)[STAT_COUNT + 1]; /* rank 0: per rank */
     int rendered;               /* this rank's tiles */
     pthread_t answering;
@@ -138,12 +142,17 @@ static void put_tile(Distributed *d, const unsigned char *buf, int n)
         return;
     memcpy(r, buf, sizeof r);
     if (r[0] < 0 || r[1] < 0 || r[2] <= 0 || r[3] <= 0 || r[0] + r[2] > d->g.crop[2] ||
-        r[1] + r[3] > d->g.crop[3] || n != (int)(sizeof r + sizeof(float) * 4 * r[2] * r[3]))
+        r[1] + r[3] > d->g.crop[3] ||
+        n != (int)(sizeof r + sizeof(float) * (size_t)(4 + d->k) * r[2] * r[3]))
         return;
     const float *px = (const float *)(buf + sizeof r);
     for (int y = 0; y < r[3]; y++)
         memcpy(&d->remote[4 * ((size_t)(r[1] + y) * d->width + r[0])], px + 4 * y * r[2],
                sizeof(float) * 4 * (size_t)r[2]);
+    px += 4 * (size_t)r[2] * r[3];
+    for (int y = 0; y < r[3] && d->k; y++)
+        memcpy(&d->remote_aov[(size_t)d->k * ((size_t)(r[1] + y) * d->width + r[0])],
+               px + (size_t)d->k * y * r[2], sizeof(float) * (size_t)d->k * (size_t)r[2]);
 }
 
 /* Rank 0's answering thread: tiles to the asking ranks, their tiles and
@@ -198,11 +207,28 @@ static int remote_source(void *user, int tiles_x, int tiles_y)
     return t;
 }
 
+/* Just before send_tile, on the same thread: where the frame's AOVs are
+ * (the same buffer for every tile of a frame). */
+static void note_aov(void *user, int x, int y, int w, int h, const float *aov, int channels,
+                     int stride)
+{
+    Distributed *d = user;
+    (void)x, (void)y, (void)w, (void)h, (void)stride;
+    pthread_mutex_lock(&d->tiles_lock); /* render threads write it at once */
+    if (channels == d->k)
+        d->aov = aov;
+    pthread_mutex_unlock(&d->tiles_lock);
+}
+
 static void send_tile(void *user, int x, int y, int w, int h, const float *rgba, int stride)
 {
     Distributed *d = user;
     int r[4] = {x, y, w, h};
-    size_t n = sizeof r + sizeof(float) * 4 * (size_t)w * (size_t)h;
+    pthread_mutex_lock(&d->tiles_lock);
+    const float *frame_aov = d->aov;
+    pthread_mutex_unlock(&d->tiles_lock);
+    int k = frame_aov ? d->k : 0; /* rank 0 refuses a tile short of its AOVs */
+    size_t n = sizeof r + sizeof(float) * (size_t)(4 + k) * (size_t)w * (size_t)h;
     unsigned char *buf = malloc(n);
     if (!buf) {
         fprintf(stderr, "rayes: rank %d: out of memory\n", d->rank);
@@ -212,6 +238,11 @@ static void send_tile(void *user, int x, int y, int w, int h, const float *rgba,
     for (int j = 0; j < h; j++)
         memcpy(buf + sizeof r + sizeof(float) * 4 * (size_t)j * w,
                &rgba[4 * ((size_t)(y + j) * stride + x)], sizeof(float) * 4 * (size_t)w);
+    unsigned char *aov = buf + sizeof r + sizeof(float) * 4 * (size_t)w * h;
+    for (int j = 0; j < h && k; j++)
+        memcpy(aov + sizeof(float) * (size_t)k * j * w,
+               &frame_aov[(size_t)k * ((size_t)(y + j) * stride + x)],
+               sizeof(float) * (size_t)k * (size_t)w);
     pthread_mutex_lock(&d->mpi_lock);
     MPI_Send(buf, (int)n, MPI_BYTE, 0, TAG_TILE, MPI_COMM_WORLD);
     pthread_mutex_unlock(&d->mpi_lock);
@@ -226,14 +257,17 @@ int distribute_frame_begin(Distributed *d, RayesRenderOptions *o, char *err, siz
     d->width = o->width;
     d->next = 0;
     d->rendered = 0;
+    d->k = rayes_aov_channels(o->aovs);
+    d->aov = NULL;
     if (d->rank != 0) {
         o->tile_source = remote_source;
         o->tile_source_user = d;
         o->tile_done = send_tile;
+        o->tile_aov_done = d->k ? note_aov : NULL;
         o->tile_user = d;
         return 0;
     }
-    free(d->owner), free(d->remote), free(d->stats), free(d->band);
+    free(d->owner), free(d->remote), free(d->remote_aov), free(d->stats), free(d->band);
     d->band = calloc((size_t)d->size, sizeof *d->band);
     for (int r = 0; d->band && r < d->size; r++) {
         d->band[r][0] = (int)((long)tile_count(&d->g) * r / d->size);
@@ -241,8 +275,10 @@ int distribute_frame_begin(Distributed *d, RayesRenderOptions *o, char *err, siz
     }
     d->owner = calloc((size_t)tile_count(&d->g) + 1, sizeof *d->owner);
     d->remote = calloc((size_t)o->width * (size_t)o->height * 4, sizeof(float));
+    d->remote_aov =
+        d->k ? calloc((size_t)o->width * (size_t)o->height * (size_t)d->k, sizeof(float)) : NULL;
     d->stats = calloc((size_t)d->size, sizeof *d->stats);
-    if (!d->owner || !d->remote || !d->stats || !d->band) {
+    if (!d->owner || !d->remote || (d->k && !d->remote_aov) || !d->stats || !d->band) {
         snprintf(err, err_size, "out of memory");
         return -1;
     }
@@ -282,8 +318,11 @@ int distribute_frame_end(Distributed *d, RayesImage *img, const RayesStats *stat
         if (d->owner[t] == 0)
             continue;
         for (int y = 0; y < q[3]; y++) {
-            size_t at = 4 * ((size_t)(q[1] + y) * d->width + q[0]);
-            memcpy(&img->rgba[at], &d->remote[at], sizeof(float) * 4 * (size_t)q[2]);
+            size_t at = (size_t)(q[1] + y) * d->width + q[0];
+            memcpy(&img->rgba[4 * at], &d->remote[4 * at], sizeof(float) * 4 * (size_t)q[2]);
+            if (d->k && img->aov && img->aov_channels == d->k)
+                memcpy(&img->aov[(size_t)d->k * at], &d->remote_aov[(size_t)d->k * at],
+                       sizeof(float) * (size_t)d->k * (size_t)q[2]);
         }
     }
     if (left) {
@@ -379,7 +418,7 @@ void distribute_end(Distributed *d)
     if (!d)
         return;
     MPI_Finalize();
-    free(d->owner), free(d->remote), free(d->stats), free(d->band);
+    free(d->owner), free(d->remote), free(d->remote_aov), free(d->stats), free(d->band);
     pthread_mutex_destroy(&d->mpi_lock);
     pthread_mutex_destroy(&d->tiles_lock);
     free(d);

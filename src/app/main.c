@@ -464,9 +464,6 @@ static int cmd_render(int argc, char **argv)
     parse_args(argc, argv, &a);
     if (d && (a.checkpoint_s >= 0.0 || a.resume))
         die_usage("--checkpoint and --resume are for one process, not an MPI job");
-    if (a.opt.aovs && (d || a.checkpoint_s >= 0.0 || a.resume))
-        die_usage("--aov is for one process without --checkpoint or --resume (their tiles carry "
-                  "colour alone)");
 
     if (distribute_rank(d) != 0) /* rank 0 speaks for the job */
         a.quiet = 1, a.progress_json = 0, a.stats_path = NULL;

@@ -550,6 +550,8 @@ static void render_tile(void *ctx, size_t task, int worker)
         for (int y = 0; y < th; y++)
             memcpy(set->accum[(size_t)(y0 + y) * set->width + x0], acc[y * tw], sizeof *acc * tw);
     free(acc);
+    if (set->tile_aov_done && set->aov)
+        set->tile_aov_done(set->tile_user, x0, y0, tw, th, set->aov, f->aov_channels, set->width);
     if (set->tile_done)
         set->tile_done(set->tile_user, x0, y0, tw, th, f->rgba, set->width);
     report_progress(f);

@@ -185,6 +185,8 @@ typedef struct RenderSettings {
     atomic_int *cancel;           /* nonzero: stop (tiles not yet started are skipped) */
     void (*tile_done)(void *user, int x, int y, int w, int h, const float *rgba, int stride);
     void *tile_user;              /* tile_done gets the frame's rgba and its row stride */
+    void (*tile_aov_done)(void *user, int x, int y, int w, int h, const float *aov, int channels,
+                          int stride); /* before tile_done: the frame's aov */
     int (*tile_source)(void *user, int tiles_x, int tiles_y); /* NULL: every tile */
     void *tile_source_user;
 } RenderSettings;

@@ -283,6 +283,7 @@ RenderSettings session_settings(const RayesRenderOptions *o)
         .pbgi_raster = o->pbgi_raster,
         .tile_done = o->tile_done,
         .tile_user = o->tile_user,
+        .tile_aov_done = o->tile_aov_done,
         .tile_source = o->tile_source,
         .tile_source_user = o->tile_source_user,
     };

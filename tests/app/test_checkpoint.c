@@ -2,8 +2,8 @@
  * tests/app/test_checkpoint.c — `--checkpoint` and `--resume` (src/app/
  * checkpoint.c) through the command line: a render stopped (SIGSTOP, as
  * soon as its first checkpoint exists, then SIGKILL: a crash) and resumed
- * writes the same bytes as an uninterrupted render, having rendered only
- * the missing tiles, and removes its checkpoint; SIGTERM saves one and
+ * writes the same bytes as an uninterrupted render (its AOVs too), having
+ * rendered only the missing tiles, and removes its checkpoint; SIGTERM saves one and
  * exits 143; a checkpoint of other options is ignored with a note; a
  * damaged one is one line naming it, status 1, no output; a bad
  * --checkpoint value is a usage error.
@@ -101,35 +101,54 @@ static int wait_for_text(const char *path, const char *text)
     return 0;
 }
 
-static void test_resume_after_crash(void)
+/* A render stopped at its first checkpoint and resumed is the same bytes
+ * as a whole one; with aovs (--aov's value, or NULL) its AOV channels too. */
+static void resume_after_crash(const char *aovs)
 {
     mkdir(DIR, 0755);
-    unlink(DIR "/crash.exr.checkpoint");
-    unlink(DIR "/crash.exr");
-    const char *full[] = {SCENE, "--threads", "2", "-o", "full.exr", NULL};
+    const char *out = aovs ? "crash-aov.exr" : "crash.exr",
+               *whole = aovs ? "full-aov.exr" : "full.exr";
+    char ck[256], path[256], full_path[256];
+    snprintf(ck, sizeof ck, DIR "/%s.checkpoint", out);
+    snprintf(path, sizeof path, DIR "/%s", out);
+    snprintf(full_path, sizeof full_path, DIR "/%s", whole);
+    unlink(ck);
+    unlink(path);
+    const char *aov = aovs ? "--aov" : NULL; /* ends the lists here without AOVs */
+    const char *full[] = {SCENE, "--threads", "2", "-o", whole, aov, aovs, NULL};
     CHECK(run("full", full) == 0);
     /* one thread, a checkpoint after every tile; frozen at the first */
-    const char *part[] = {SCENE, "--threads", "1", "--checkpoint", "0", "-o", "crash.exr", NULL};
+    const char *part[] = {SCENE, "--threads", "1", "--checkpoint", "0", "-o", out, aov, aovs, NULL};
     pid_t pid = start("crash", part);
-    CHECK(wait_for(DIR "/crash.exr.checkpoint"));
+    CHECK(wait_for(ck));
     kill(pid, SIGSTOP);
-    CHECK(!file_exists(DIR "/crash.exr")); /* stopped before the end */
+    CHECK(!file_exists(path)); /* stopped before the end */
     kill(pid, SIGKILL);
     finish(pid);
-    CHECK(file_exists(DIR "/crash.exr.checkpoint") && !file_exists(DIR "/crash.exr"));
+    CHECK(file_exists(ck) && !file_exists(path));
     /* resumed on two threads: the rest of the tiles, the same bytes */
-    const char *resume[] = {"cornell", "--res", "192", "--spp", "16", "--threads", "2",
-                            "--resume", "-o", "crash.exr", NULL};
+    const char *resume[] = {"cornell",  "--res", "192", "--spp", "16", "--threads", "2",
+                            "--resume", "-o",    out,   aov,     aovs, NULL};
     CHECK(run("resume", resume) == 0);
-    char out[4096];
-    read_text("resume", "out", out, sizeof out);
+    char text[4096];
+    read_text("resume", "out", text, sizeof text);
     int tiles = 0;
-    const char *at = strstr(out, "resumed");
+    const char *at = strstr(text, "resumed");
     CHECK(at && sscanf(at, "resumed %d tiles", &tiles) == 1);
-    fprintf(stderr, "resumed %d of 36 tiles\n", tiles);
+    fprintf(stderr, "resumed %d of 36 tiles%s\n", tiles, aovs ? " with AOVs" : "");
     CHECK(tiles >= 1 && tiles < 36);
-    CHECK(same_bytes(DIR "/crash.exr", DIR "/full.exr"));
-    CHECK(!file_exists(DIR "/crash.exr.checkpoint")); /* removed once written */
+    CHECK(same_bytes(path, full_path));
+    CHECK(!file_exists(ck)); /* removed once written */
+}
+
+static void test_resume_after_crash(void)
+{
+    resume_after_crash(NULL);
+}
+
+static void test_resume_with_aovs(void)
+{
+    resume_after_crash("all");
 }
 
 static void test_sigterm_saves(void)
@@ -195,5 +214,5 @@ static void test_other_options_and_damage(void)
     CHECK(!file_exists(DIR "/u.exr"));
 }
 
-TEST_MAIN(TEST(test_resume_after_crash), TEST(test_sigterm_saves),
+TEST_MAIN(TEST(test_resume_after_crash), TEST(test_resume_with_aovs), TEST(test_sigterm_saves),
           TEST(test_other_options_and_damage))

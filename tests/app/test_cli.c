@@ -1025,8 +1025,6 @@ static void test_aovs(void)
         CHECK(strstr(ch, "Z") && strstr(ch, "P.Z") && strstr(ch, "R") && !strstr(ch, "N.X"));
     run(&r, NULL, ARGS("render", SCRATCH_DIR "/aov.rib", "--aov", "z,depth"));
     CHECK(r.status == 2 && strstr(r.err, "depth"));
-    run(&r, NULL, ARGS("render", SCRATCH_DIR "/aov.rib", "--aov", "z", "--checkpoint", "5"));
-    CHECK(r.status == 2 && strstr(r.err, "--aov"));
 }
 
 TEST_MAIN(TEST(test_version_and_help), TEST(test_no_arguments), TEST(test_usage_errors),

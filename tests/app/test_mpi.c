@@ -50,7 +50,8 @@ static void test_same_bytes_as_one_process(void)
     mkdir(SCRATCH, 0755);
     if (!have_mpi())
         return;
-    const char *modes[2] = {"--quality preview --spp 4", "--quality final --spp 1 --diffuse-rays 16"};
+    const char *modes[2] = {"--quality preview --spp 4",
+                            "--quality final --spp 1 --diffuse-rays 16 --aov all"};
     for (int m = 0; m < 2; m++) {
         char cmd[2048], mpi[256], one[512], many[512], out[512];
         snprintf(one, sizeof one, SCRATCH "/one-%d.exr", m);
