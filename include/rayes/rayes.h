@@ -1031,28 +1031,34 @@ RAYES_API void rayes_stats_free(RayesStats *stats);
  * rayes_render alone renders them (a session refuses them). Surfaces behind a transparent one
  * do not count; lights seen directly do (their own object). */
 typedef enum RayesAov {
-    RAYES_AOV_Z = 1u << 0,     /* "Z": camera-space depth of the pixel's nearest sample
-                                  (distance along the view axis; orthographic too); +inf
-                                  where no sample meets a surface */
-    RAYES_AOV_N = 1u << 1,     /* "N.X" "N.Y" "N.Z": world-space shading normal, facing the
-                                  camera */
-    RAYES_AOV_P = 1u << 2,     /* "P.X" "P.Y" "P.Z": world-space position */
-    RAYES_AOV_ID = 1u << 3,    /* "id": 1 + the object (shader binding) of the nearest
-                                  sample, in the order the scene made them; 0: none */
-    RAYES_AOV_PATCH = 1u << 4, /* "patch": 1 + the grid (diced patch, the radiosity cache's
-                                  entry; an instance's: its master's grid) of the nearest
-                                  sample; 0: none */
-    RAYES_AOV_CACHE = 1u << 5, /* "cache": the radiosity cache's resolution the pixel's
-                                  diffuse rays read at their first hits, by ray differentials
-                                  (memo 3.2), averaged over the pixel's look-ups: 0 coarse
-                                  (or a cluster of grids), 1 medium, 2 fine; -1 where no
-                                  sample traced any (lights, the background, --cache off).
-                                  With the grid hider, a grid's mean over the rays of its
-                                  shading counts as one look-up of each sample on it */
-    RAYES_AOV_ALL = 0x3f
+    RAYES_AOV_Z = 1u << 0,      /* "Z": camera-space depth of the pixel's nearest sample
+                                   (distance along the view axis; orthographic too); +inf
+                                   where no sample meets a surface */
+    RAYES_AOV_N = 1u << 1,      /* "N.X" "N.Y" "N.Z": world-space shading normal, facing the
+                                   camera */
+    RAYES_AOV_P = 1u << 2,      /* "P.X" "P.Y" "P.Z": world-space position */
+    RAYES_AOV_ID = 1u << 3,     /* "id": 1 + the object (shader binding) of the nearest
+                                   sample, in the order the scene made them; 0: none */
+    RAYES_AOV_PATCH = 1u << 4,  /* "patch": 1 + the grid (diced patch, the radiosity cache's
+                                   entry; an instance's: its master's grid) of the nearest
+                                   sample; 0: none */
+    RAYES_AOV_CACHE = 1u << 5,  /* "cache": the radiosity cache's resolution the pixel's
+                                   diffuse rays read at their first hits, by ray differentials
+                                   (memo 3.2), averaged over the pixel's look-ups: 0 coarse
+                                   (or a cluster of grids), 1 medium, 2 fine; -1 where no
+                                   sample traced any (lights, the background, --cache off).
+                                   With the grid hider, a grid's mean over the rays of its
+                                   shading counts as one look-up of each sample on it */
+    RAYES_AOV_ALBEDO = 1u << 6, /* "albedo.R" "albedo.G" "albedo.B": the colour the surface
+                                  reflects (a denoiser's albedo feature): its shader's
+                                  lighting method run again in a white furnace (radiance 1
+                                  from everywhere, nothing traced), filtered as colour is; a
+                                  light seen directly gives its hue (its colour over its
+                                  largest component) */
+    RAYES_AOV_ALL = 0x7f
 } RayesAov;
 
-#define RAYES_AOV_CHANNELS_MAX 10 /* rayes_aov_channels(RAYES_AOV_ALL) */
+#define RAYES_AOV_CHANNELS_MAX 13 /* rayes_aov_channels(RAYES_AOV_ALL) */
 
 /* The float channels of aovs (RayesAov bits), and the name of channel c
  * ("Z", "N.X", ...; NULL when c is out of range): channels come in the

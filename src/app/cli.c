@@ -140,10 +140,11 @@ unsigned aov_named(const char *name, size_t n)
     static const struct {
         const char *name;
         unsigned aov;
-    } names[] = {{"z", RAYES_AOV_Z},    {"Z", RAYES_AOV_Z},         {"zfiltered", RAYES_AOV_Z},
-                 {"N", RAYES_AOV_N},    {"normal", RAYES_AOV_N},    {"P", RAYES_AOV_P},
-                 {"id", RAYES_AOV_ID},  {"patch", RAYES_AOV_PATCH}, {"cache", RAYES_AOV_CACHE},
-                 {"all", RAYES_AOV_ALL}};
+    } names[] = {
+        {"z", RAYES_AOV_Z},           {"Z", RAYES_AOV_Z},         {"zfiltered", RAYES_AOV_Z},
+        {"N", RAYES_AOV_N},           {"normal", RAYES_AOV_N},    {"P", RAYES_AOV_P},
+        {"id", RAYES_AOV_ID},         {"patch", RAYES_AOV_PATCH}, {"cache", RAYES_AOV_CACHE},
+        {"albedo", RAYES_AOV_ALBEDO}, {"all", RAYES_AOV_ALL}};
     for (size_t k = 0; k < sizeof names / sizeof names[0]; k++)
         if (strlen(names[k].name) == n && strncmp(names[k].name, name, n) == 0)
             return names[k].aov;
@@ -157,14 +158,15 @@ static unsigned parse_aovs(const char *v)
         size_t n = strcspn(s, ",");
         unsigned aov = aov_named(s, n);
         if (!aov)
-            die_usage("--aov: expected z, N, P, id, patch, cache or all (comma-separated), found "
+            die_usage("--aov: expected z, N, P, id, patch, cache, albedo or all (comma-separated), "
+                      "found "
                       "\"%.*s\"",
                       (int)n, s);
         aovs |= aov;
         s += n + (s[n] == ',');
     }
     if (!aovs)
-        die_usage("--aov: expected z, N, P, id, patch, cache or all");
+        die_usage("--aov: expected z, N, P, id, patch, cache, albedo or all");
     return aovs;
 }
 

@@ -237,9 +237,22 @@ int pbrt_d_film(Parser *P, const Token *t)
     }
     if (isfinite(mcv))
         s->sample_clamp = (float)mcv;
-    if (strcmp(type, "rgb") != 0)
+    /* pbrt-v4's gbuffer film: an EXR of the colour with the first hit's
+     * albedo, depth, normal and position, which rayes's AOVs are (in world
+     * space, where pbrt's default is the camera's) */
+    int gbuffer = strcmp(type, "gbuffer") == 0 && file && s->n_displays == 1 &&
+                  strcmp(s->displays[0].type, "openexr") == 0;
+    if (gbuffer) {
+        snprintf(s->displays[0].mode, sizeof s->displays[0].mode, "rgba,albedo,z,N,P");
+        const char *space = pbrt_get_string(&pl, "coordinatesystem", "camera");
+        if (strcmp(space, "world") != 0)
+            pbrt_warn_at(P, t->line, t->col, "gbuffer space",
+                         "Film \"gbuffer\": N and P are written in world space, not \"%.40s\"",
+                         space);
+    } else if (strcmp(type, "rgb") != 0) {
         pbrt_warn_at(P, t->line, t->col, "film type", "Film \"%.40s\": written as an rgb film",
                      type);
+    }
     pbrt_warn_unused(P, &pl, "Film", type);
     pbrt_params_free(&pl);
     return 0;

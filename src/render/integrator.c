@@ -136,6 +136,68 @@ static void face_outside(HitPoint *hp, int *backfacing)
     *backfacing = !*backfacing;
 }
 
+/* A hit's shading context and what it points at (set up by shade_site;
+ * it must not move afterwards). */
+typedef struct ShadeSite {
+    HitPoint hp;
+    PathState ps;
+    int backfacing;
+    RayesShadeCtx ctx;
+} ShadeSite;
+
+/* The context of one point: the hit as a ray of type kind sees it (with
+ * RAYES_RAY_SUBSURFACE, on the side the ray leaves through). */
+static void shade_site(Worker *w, const Ray *ray, const Hit *hit, const RenderObject *obj,
+                       uint32_t kind, int diffuse_depth, int specular_depth, uint64_t key,
+                       RayDiff diff, ShadeSite *s)
+{
+    HitPoint *hp = &s->hp;
+    s->backfacing = !hit_point(w, ray, hit, obj, hp);
+    if (kind == RAYES_RAY_SUBSURFACE)
+        face_outside(hp, &s->backfacing);
+    hp->key = key;
+    hp->diff = (RayDiff){path_footprint(diff, hit->t), diff.spread};
+    hit_footprint(hp);
+    path_st_footprint(hp->dst, hp->du, hp->dv, &hp->ds, &hp->dt);
+    int own_st = (w->rs->gs->grids[hit->grid].primvars & GEOM_PV_ST) != 0;
+    s->ps = (PathState){w,
+                        &hp->key,
+                        &hp->diff,
+                        &hp->curvature,
+                        &hp->offset,
+                        NULL,
+                        hit->grid,
+                        own_st ? &hp->ds : NULL,
+                        own_st ? &hp->dt : NULL,
+                        1,
+                        NULL,
+                        hit->instance};
+    s->ctx = (RayesShadeCtx){
+        .n_points = 1,
+        .ray_type = kind & ~PATH_RAY_GLOSSY,
+        .diffuse_depth = diffuse_depth,
+        .specular_depth = specular_depth,
+        .P = (const float(*)[3])hp->P,
+        .N = (const float(*)[3])hp->N,
+        .Ng = (const float(*)[3])hp->Ng,
+        .dPdu = (const float(*)[3])hp->dPdu,
+        .dPdv = (const float(*)[3])hp->dPdv,
+        .u = &hp->u,
+        .v = &hp->v,
+        .s = &hp->s,
+        .t = &hp->t,
+        .du = &hp->du,
+        .dv = &hp->dv,
+        .I = (const float(*)[3])hp->I,
+        .Cs = (const float(*)[3])hp->Cs,
+        .Os = (const float(*)[3])hp->Os,
+        .renderer = &s->ps,
+        .backfacing = &s->backfacing,
+        .dst = own_st ? (const float(*)[4]) & hp->dst : NULL,
+    };
+    path_apply_Os_pattern(w, obj, &s->ctx, &hp->Os);
+}
+
 /* Shades the hit as a ray of type kind sees it (lighting, diffuselighting,
  * or with kind RAYES_RAY_TRANSMISSION the opacity method; with
  * RAYES_RAY_SUBSURFACE diffuselighting on the side the ray leaves through,
@@ -145,42 +207,8 @@ static Vec3 shade_hit(Worker *w, const Ray *ray, const Hit *hit, const RenderObj
                       uint32_t kind, int diffuse_depth, int specular_depth, uint64_t key,
                       RayDiff diff, Vec3 *Oi_out)
 {
-    HitPoint hp;
-    int backfacing = !hit_point(w, ray, hit, obj, &hp);
-    if (kind == RAYES_RAY_SUBSURFACE)
-        face_outside(&hp, &backfacing);
-    hp.key = key;
-    hp.diff = (RayDiff){path_footprint(diff, hit->t), diff.spread};
-    hit_footprint(&hp);
-    path_st_footprint(hp.dst, hp.du, hp.dv, &hp.ds, &hp.dt);
-    int own_st = (w->rs->gs->grids[hit->grid].primvars & GEOM_PV_ST) != 0;
-    PathState ps = {w, &hp.key, &hp.diff, &hp.curvature, &hp.offset, NULL, hit->grid,
-                    own_st ? &hp.ds : NULL, own_st ? &hp.dt : NULL, 1, NULL,
-                    hit->instance};
-    RayesShadeCtx ctx = {
-        .n_points = 1,
-        .ray_type = kind & ~PATH_RAY_GLOSSY,
-        .diffuse_depth = diffuse_depth,
-        .specular_depth = specular_depth,
-        .P = (const float(*)[3])hp.P,
-        .N = (const float(*)[3])hp.N,
-        .Ng = (const float(*)[3])hp.Ng,
-        .dPdu = (const float(*)[3])hp.dPdu,
-        .dPdv = (const float(*)[3])hp.dPdv,
-        .u = &hp.u,
-        .v = &hp.v,
-        .s = &hp.s,
-        .t = &hp.t,
-        .du = &hp.du,
-        .dv = &hp.dv,
-        .I = (const float(*)[3])hp.I,
-        .Cs = (const float(*)[3])hp.Cs,
-        .Os = (const float(*)[3])hp.Os,
-        .renderer = &ps,
-        .backfacing = &backfacing,
-        .dst = own_st ? (const float(*)[4]) & hp.dst : NULL,
-    };
-    path_apply_Os_pattern(w, obj, &ctx, &hp.Os);
+    ShadeSite site;
+    shade_site(w, ray, hit, obj, kind, diffuse_depth, specular_depth, key, diff, &site);
     /* A hole in a cut-out: Os 0 here (a pattern's, a primitive
      * variable's), and no opacity method that could say otherwise. Its
      * lighting would be multiplied by 0 (Ci is premultiplied; the built-in
@@ -189,7 +217,7 @@ static Vec3 shade_hit(Worker *w, const Ray *ray, const Hit *hit, const RenderObj
      * lets it. */
     if (obj->transparent && !obj->opacity_shader &&
         (kind & (RAYES_RAY_CAMERA | RAYES_RAY_SPECULAR | RAYES_RAY_DIFFUSE)) &&
-        path_clear(hp.Os)) { /* NaN: shaded */
+        path_clear(site.hp.Os)) { /* NaN: shaded */
         w->stats.holes++;
         *Oi_out = v3(0, 0, 0);
         return v3(0, 0, 0);
@@ -205,19 +233,19 @@ static Vec3 shade_hit(Worker *w, const Ray *ray, const Hit *hit, const RenderObj
     w->depth = diffuse_depth;
     if (kind == RAYES_RAY_SUBSURFACE) {
         w->stats.irradiance_points++;
-        out.Irradiance = ps.irradiance = E;
-        shade_run_diffuselighting(w->services, &ctx, obj->shader, &out);
+        out.Irradiance = site.ps.irradiance = E;
+        shade_run_diffuselighting(w->services, &site.ctx, obj->shader, &out);
         Oi[0][0] = Oi[0][1] = Oi[0][2] = 1.0f;
         Ci[0][0] = E[0][0], Ci[0][1] = E[0][1], Ci[0][2] = E[0][2];
     } else if (kind == RAYES_RAY_TRANSMISSION) {
         w->stats.opacity_points++;
-        shade_run_opacity(w->services, &ctx, obj->shader, &out);
+        shade_run_opacity(w->services, &site.ctx, obj->shader, &out);
     } else if (kind == RAYES_RAY_DIFFUSE) {
         w->stats.shading_points[RY_MIN(diffuse_depth, RENDER_MAX_DEPTH)]++;
-        shade_run_diffuselighting(w->services, &ctx, obj->shader, &out);
+        shade_run_diffuselighting(w->services, &site.ctx, obj->shader, &out);
     } else {
         w->stats.shading_points[RY_MIN(diffuse_depth, RENDER_MAX_DEPTH)]++;
-        shade_run_lighting(w->services, &ctx, obj->shader, &out);
+        shade_run_lighting(w->services, &site.ctx, obj->shader, &out);
     }
     w->shading = outer;
     w->depth = outer_depth;
@@ -329,7 +357,8 @@ static Vec3 trace_volumes(Worker *w, const Ray *ray, uint32_t kind, int diffuse_
 
 /* A camera sample's AOVs from the surface it sees first (RayesAov): the
  * first it meets that is not a hole (a cut-out's Os 0 is passed). */
-static void aov_capture(Worker *w, const Ray *ray, const Hit *hit, const RenderObject *obj)
+static void aov_capture(Worker *w, const Ray *ray, const Hit *hit, const RenderObject *obj,
+                        uint64_t key, RayDiff diff)
 {
     HitPoint hp;
     hit_point(w, ray, hit, obj, &hp);
@@ -340,6 +369,27 @@ static void aov_capture(Worker *w, const Ray *ray, const Hit *hit, const RenderO
     a->z = v3_dot(v3_sub(a->P, ray->o), w->rs->camera.forward);
     a->id = (uint32_t)(obj - w->rs->objects) + 1;
     a->patch = hit->grid + 1;
+    if (!(w->set->aovs & RAYES_AOV_ALBEDO))
+        return;
+    if (obj->light >= 0) { /* its hue */
+        Vec3 L = w->rs->lights[obj->light].L;
+        float m = v3_max_component(L);
+        a->albedo = m > 0.0f ? v3_scale(L, 1.0f / m) : v3(0, 0, 0);
+        return;
+    }
+    if (!obj->shader || !w->albedo_services)
+        return;
+    /* The shader's lighting in a white furnace: nothing traced, nothing
+     * counted, no random number of the colour's drawn. */
+    ShadeSite site;
+    shade_site(w, ray, hit, obj, RAYES_RAY_CAMERA, 0, 0, key, diff, &site);
+    float Ci[1][3] = {{0, 0, 0}}, Oi[1][3] = {{1, 1, 1}};
+    RayesShadeOutputs out = {Ci, Oi, NULL, NULL};
+    const RenderObject *outer = w->shading;
+    w->shading = obj;
+    shade_run_lighting(w->albedo_services, &site.ctx, obj->shader, &out);
+    w->shading = outer;
+    a->albedo = v3(Ci[0][0], Ci[0][1], Ci[0][2]);
 }
 
 static Vec3 trace_layers(Worker *w, const Ray *ray, uint32_t kind, int diffuse_depth,
@@ -381,7 +431,7 @@ static Vec3 trace_layers(Worker *w, const Ray *ray, uint32_t kind, int diffuse_d
     int aov = w->aov && !w->aov->set && kind == RAYES_RAY_CAMERA;
     if (obj->light >= 0) {
         if (aov)
-            aov_capture(w, ray, &hit, obj);
+            aov_capture(w, ray, &hit, obj, key, diff);
         /* Emitters: seen by camera and specular rays, on their front side
          * or both (not by glossy-lobe rays: direct lighting has them). */
         const Light *l = &w->rs->lights[obj->light];
@@ -415,7 +465,7 @@ static Vec3 trace_layers(Worker *w, const Ray *ray, uint32_t kind, int diffuse_d
         Ci = shade_hit(w, ray, &hit, obj, kind, diffuse_depth, specular_depth, key, diff, &Oi);
     }
     if (aov && !(obj->transparent && !(v3_max_component(Oi) > 0.0f))) /* not a hole */
-        aov_capture(w, ray, &hit, obj);
+        aov_capture(w, ray, &hit, obj, key, diff);
     if (!see_through)
         return Ci;
     Vec3 T = v3(1.0f - fminf(fmaxf(Oi.x, 0.0f), 1.0f), 1.0f - fminf(fmaxf(Oi.y, 0.0f), 1.0f),

@@ -70,6 +70,7 @@ typedef struct Worker {
     GridShading *grid_shading; /* the grid hider's shaded grids, or NULL (hider.h) */
     OpacityTable *opacity_table; /* coarse opacity of transparent grids, or NULL (optable.h) */
     const RayesShaderServices *services; /* what shaders run here call (services.h) */
+    const RayesShaderServices *albedo_services; /* the albedo AOV's furnace (services.h) */
     uint64_t sharp_rays;          /* perfect mirror and refraction rays traced from points at
                                      depth 0 (the grid hider asks whether a grid's shading
                                      traced any: hider.c) */

@@ -203,8 +203,8 @@ static double relative_variance(int n, double y, double y2)
 
 /* A tile pixel's AOV sums: the nearest sample's z, id and patch (among
  * those the filter weighs positively; the first of equals), the cache
- * levels and look-ups of those samples, then w N and w P summed as
- * colours are. */
+ * levels and look-ups of those samples, then w N, w P and w albedo summed
+ * as colours are. */
 enum {
     AOV_Z,
     AOV_ID,
@@ -213,7 +213,8 @@ enum {
     AOV_LOOKUPS,
     AOV_N,
     AOV_P = AOV_N + 3,
-    AOV_ACC = AOV_P + 3
+    AOV_ALBEDO = AOV_P + 3,
+    AOV_ACC = AOV_ALBEDO + 3
 };
 
 static void aov_splat(float *a, const AovSample *s, float wgt)
@@ -229,8 +230,9 @@ static void aov_splat(float *a, const AovSample *s, float wgt)
         a[AOV_LEVELS] += s->levels;
         a[AOV_LOOKUPS] += (float)s->lookups;
     }
-    const float v[6] = {s->N.x, s->N.y, s->N.z, s->P.x, s->P.y, s->P.z};
-    for (int c = 0; c < 6; c++)
+    const float v[9] = {s->N.x, s->N.y,      s->N.z,      s->P.x,     s->P.y,
+                        s->P.z, s->albedo.x, s->albedo.y, s->albedo.z};
+    for (int c = 0; c < 9; c++)
         a[AOV_N + c] += wgt * v[c];
 }
 
@@ -253,6 +255,8 @@ static void aov_write(const Frame *f, const float *acc5, const float *a, float *
         out[c++] = a[AOV_PATCH];
     if (aovs & RAYES_AOV_CACHE)
         out[c++] = a[AOV_LOOKUPS] > 0.0f ? a[AOV_LEVELS] / a[AOV_LOOKUPS] : -1.0f;
+    for (int k = 0; k < 3 && (aovs & RAYES_AOV_ALBEDO); k++)
+        out[c++] = a[AOV_ALBEDO + k] * inv;
 }
 
 /* Samples k0 to k1 - 1 of pixel (px, py), splatted into the tile's
@@ -625,6 +629,7 @@ int render_frame(const RenderScene *rs, const RenderSettings *set, float *rgba, 
                                 .grid_shading = gsh,
                                 .opacity_table = optable,
                                 .services = &render_services,
+                                .albedo_services = &albedo_services,
                                 .guide_pixels = pixels};
         if (set->cache)
             cache_local_init(&f.workers[i].cache, set->cache);

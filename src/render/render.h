@@ -122,6 +122,7 @@ typedef struct AovSample {
     uint32_t patch; /* 1 + the grid */
     uint32_t lookups; /* radiosity look-ups of the sample's own diffuse rays' first hits */
     float levels;     /* and the sum of their resolutions (0 coarse, 1 medium, 2 fine) */
+    Vec3 albedo;      /* the shader's lighting in a white furnace (albedo_services) */
 } AovSample;
 
 typedef struct RenderSettings {

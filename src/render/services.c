@@ -24,6 +24,7 @@
 #include "render/subsurface.h"
 #include "shade/bsdf.h"
 #include "shade/builtin.h"
+#include "shade/diffusion.h"
 #include "shade/noise.h"
 #include "shade/pattern.h"
 #include "util/check.h"
@@ -1280,4 +1281,142 @@ const RayesShaderServices render_services = {
     .subsurface = subsurface_service,
     .microfacet = svc_microfacet,
     .classic_lighting = svc_classic_lighting,
+};
+
+/* ------------------------------------------------ the albedo's furnace */
+
+static void fill(const RayesShadeCtx *ctx, float (*out)[3], float v)
+{
+    for (size_t i = 0; out && i < ctx->n_points; i++)
+        out[i][0] = out[i][1] = out[i][2] = v;
+}
+
+static void alb_direct_lighting(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
+                                int n_shadow_rays, const char *category, const float *roughness,
+                                float (*diffuse)[3], float (*specular)[3])
+{
+    (void)sv, (void)n_shadow_rays, (void)category, (void)roughness;
+    fill(ctx, diffuse, 1.0f);
+    fill(ctx, specular, ctx->I ? 1.0f : 0.0f);
+}
+
+static void alb_classic_lighting(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
+                                 int n_shadow_rays, const char *category, const float *roughness,
+                                 float (*diffuse)[3], float (*specular)[3])
+{
+    (void)sv, (void)n_shadow_rays, (void)category;
+    fill(ctx, diffuse, 1.0f);
+    for (size_t i = 0; specular && i < ctx->n_points; i++) {
+        float r = roughness ? roughness[i] : 0.1f, e = r > 0.0f ? 1.0f / r : 1e6f;
+        specular[i][0] = specular[i][1] = specular[i][2] = 8.0f / (e + 8.0f);
+    }
+}
+
+static void alb_direct_fiber(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
+                             int n_shadow_rays, const char *category, const float (*T)[3],
+                             const float *roughness, float (*diffuse)[3], float (*specular)[3])
+{
+    (void)sv, (void)n_shadow_rays, (void)category, (void)T, (void)roughness;
+    fill(ctx, diffuse, 1.0f);
+    fill(ctx, specular, ctx->I ? 1.0f : 0.0f);
+}
+
+static void alb_ambient(const RayesShaderServices *sv, const RayesShadeCtx *ctx, float (*out)[3])
+{
+    (void)sv;
+    fill(ctx, out, 0.0f);
+}
+
+static void alb_indirect_diffuse(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
+                                 int n_rays, float (*out)[3])
+{
+    (void)sv, (void)n_rays;
+    fill(ctx, out, 0.0f);
+}
+
+static void alb_indirect_specular(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
+                                  const float (*dir)[3], const float *roughness, int n_rays,
+                                  float (*out)[3])
+{
+    (void)sv, (void)dir, (void)n_rays;
+    for (size_t i = 0; i < ctx->n_points; i++) /* a mirror: 1; a lobe: direct lighting's */
+        out[i][0] = out[i][1] = out[i][2] = !roughness || !(roughness[i] > 0.0f) ? 1.0f : 0.0f;
+}
+
+static void alb_lobe(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
+                     const float *roughness, int n_rays, float (*out)[3])
+{
+    (void)sv, (void)roughness, (void)n_rays;
+    fill(ctx, out, ctx->I ? 1.0f : 0.0f);
+}
+
+static void alb_indirect_refraction(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
+                                    const float (*dir)[3], float (*out)[3])
+{
+    (void)sv, (void)dir;
+    fill(ctx, out, 1.0f);
+}
+
+static void alb_transmission(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
+                             const float (*to)[3], float (*out)[3])
+{
+    (void)sv, (void)to;
+    fill(ctx, out, 1.0f);
+}
+
+static void alb_occlusion(const RayesShaderServices *sv, const RayesShadeCtx *ctx, int n_rays,
+                          float maxdist, float (*out)[3])
+{
+    (void)sv, (void)n_rays, (void)maxdist;
+    fill(ctx, out, 0.0f);
+}
+
+static void alb_direct_volume(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
+                              int n_shadow_rays, const char *category, float g, float (*out)[3])
+{
+    (void)sv, (void)n_shadow_rays, (void)category, (void)g;
+    fill(ctx, out, 0.0f);
+}
+
+/* Under irradiance pi everywhere the diffusion integral is Rd. */
+static void alb_subsurface(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
+                           const RayesSubsurfaceParams *p, int n_rays, float (*out)[3])
+{
+    (void)sv, (void)n_rays;
+    float Rd[3];
+    for (int c = 0; c < 3; c++) {
+        DiffusionChannel ch;
+        diffusion_channel(p, c, &ch);
+        Rd[c] = ch.Rd;
+    }
+    for (size_t i = 0; i < ctx->n_points; i++)
+        out[i][0] = Rd[0], out[i][1] = Rd[1], out[i][2] = Rd[2];
+}
+
+const RayesShaderServices albedo_services = {
+    .abi_version = RAYES_SHADER_ABI_VERSION,
+    .struct_size = sizeof(RayesShaderServices),
+    .direct_lighting = alb_direct_lighting,
+    .ambient = alb_ambient,
+    .indirect_diffuse = alb_indirect_diffuse,
+    .indirect_specular = alb_indirect_specular,
+    .indirect_refraction = alb_indirect_refraction,
+    .transmission = alb_transmission,
+    .occlusion = alb_occlusion,
+    .direct_volume = alb_direct_volume,
+    .texture = svc_texture,
+    .noise = shade_service_noise,
+    .fbm = shade_service_fbm,
+    .turbulence = shade_service_turbulence,
+    .attribute = svc_attribute,
+    .option = svc_option,
+    .checker = shade_service_checker,
+    .supports = svc_supports,
+    .random = svc_random,
+    .glossy = alb_lobe,
+    .direct_fiber = alb_direct_fiber,
+    .pattern = svc_pattern,
+    .subsurface = alb_subsurface,
+    .microfacet = alb_lobe,
+    .classic_lighting = alb_classic_lighting,
 };

@@ -132,7 +132,8 @@ static const struct {
                  {RAYES_AOV_P, {"P.X", "P.Y", "P.Z"}},
                  {RAYES_AOV_ID, {"id"}},
                  {RAYES_AOV_PATCH, {"patch"}},
-                 {RAYES_AOV_CACHE, {"cache"}}};
+                 {RAYES_AOV_CACHE, {"cache"}},
+                 {RAYES_AOV_ALBEDO, {"albedo.R", "albedo.G", "albedo.B"}}};
 
 int rayes_aov_channels(unsigned aovs)
 {

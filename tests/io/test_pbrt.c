@@ -1199,7 +1199,12 @@ static void test_film_types(void)
               strcmp(pr.s.displays[0].type, "openexr") == 0);
         CHECK_NEAR(pr.s.crop[1], 0.5, 0);
         char want[128];
-        snprintf(want, sizeof want, "t.pbrt:2:1: Film \"%s\": written as an rgb film", types[k]);
+        snprintf(want, sizeof want,
+                 k == 0 ? "t.pbrt:2:1: Film \"%s\": N and P are written in world space"
+                        : "t.pbrt:2:1: Film \"%s\": written as an rgb film",
+                 types[k]);
+        /* gbuffer's channels are rayes's AOVs */
+        CHECK(strcmp(pr.s.displays[0].mode, k == 0 ? "rgba,albedo,z,N,P" : "rgba") == 0);
         CHECK(strstr(said, want) != NULL);
         if (!strstr(said, want))
             fprintf(stderr, "  got \"%s\"\n", said);

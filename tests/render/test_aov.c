@@ -104,6 +104,7 @@ static void test_channels(void)
     CHECK(rayes_aov_channel_name(RAYES_AOV_N | RAYES_AOV_ID, 4) == NULL);
     CHECK(strcmp(rayes_aov_channel_name(RAYES_AOV_ALL, 8), "patch") == 0);
     CHECK(strcmp(rayes_aov_channel_name(RAYES_AOV_ALL, 9), "cache") == 0);
+    CHECK(strcmp(rayes_aov_channel_name(RAYES_AOV_ALL, 12), "albedo.B") == 0);
     RayesScene *s = planes(0, 0);
     RayesRenderOptions o;
     rayes_render_options_init(&o, RAYES_QUALITY_PREVIEW);
@@ -137,14 +138,62 @@ static void test_plane(void)
                 CHECK(fabsf(a[4] - wx) < 0.5f * pixel && fabsf(a[5] - wy) < 0.5f * pixel);
                 CHECK(fabsf(a[6]) < 1e-5f);
                 CHECK(a[7] == 1.0f && a[8] >= 1.0f);
+                CHECK(fabsf(a[10] - 1.0f) < 1e-4f && fabsf(a[12] - 1.0f) < 1e-4f); /* Kd 1 */
             } else if (fabsf(wx) > 1.0f + pixel && fabsf(wy) > 1.0f + pixel) { /* beside it */
                 CHECK(isinf(a[0]) && a[0] > 0.0f && a[7] == 0.0f && a[8] == 0.0f);
-                CHECK(a[1] == 0.0f && a[2] == 0.0f && a[3] == 0.0f);
+                CHECK(a[1] == 0.0f && a[2] == 0.0f && a[3] == 0.0f && a[10] == 0.0f);
             }
         }
     CHECK(inside > SIZE * SIZE / 5); /* the plane is 0.55 of the view across */
     rayes_image_free(img);
     rayes_scene_release(s);
+}
+
+/* The albedo of a plane across the view shaded by shader with params,
+ * at the centre pixel (the albedo AOV alone: 3 channels). */
+static void plane_albedo(const char *shader, const RayesParam *params, int n, float out[3])
+{
+    RayesScene *s = rayes_scene_new();
+    const float eye[3] = {0, 0, 5}, at[3] = {0, 0, 0}, up[3] = {0, 1, 0};
+    CHECK(rayes_scene_set_camera(s, eye, at, up, 20.0f) == RAYES_OK);
+    CHECK(rayes_scene_set_shader(s, shader, params, n) == RAYES_OK);
+    const float whole[4][3] = {{-3, -3, 0}, {3, -3, 0}, {-3, 3, 0}, {3, 3, 0}};
+    CHECK(rayes_scene_bilinear_patch(s, whole) == RAYES_OK);
+    RayesParam l[3] = {(RayesParam){"from", RAYES_PARAM_COLOR, {1, 2, 5}, NULL},
+                       (RayesParam){"to", RAYES_PARAM_COLOR, {0, 0, 0}, NULL},
+                       (RayesParam){"intensity", RAYES_PARAM_FLOAT, {3, 0, 0}, NULL}};
+    CHECK(rayes_scene_light(s, "distantlight", l, 3) == RAYES_OK);
+    CHECK(rayes_scene_commit(s) == RAYES_OK);
+    RayesImage *img = render(s, RAYES_AOV_ALBEDO, 2, 8, NULL);
+    CHECK(img->aov_channels == 3 &&
+          strcmp(rayes_aov_channel_name(RAYES_AOV_ALBEDO, 1), "albedo.G") == 0);
+    memcpy(out, aov_at(img, 4, 4), 3 * sizeof(float));
+    rayes_image_free(img);
+    rayes_scene_release(s);
+}
+
+/* The albedo is what each shader reflects of white light from everywhere,
+ * whatever the scene's lights: Kd Cs for matte (its ambient term is the
+ * ambient lights', 0), a pbrt diffuse's reflectance, a mirror's Kr
+ * specularcolor, a dielectric's reflection and refraction together (1). */
+static void test_albedo(void)
+{
+    float a[3];
+    RayesParam matte[2] = {{"Kd", RAYES_PARAM_FLOAT, {0.5f, 0, 0}, NULL},
+                           pc("Cs", 1.0f, 0.5f, 0.25f)};
+    plane_albedo("matte", matte, 2, a);
+    CHECK(fabsf(a[0] - 0.5f) < 1e-4f && fabsf(a[1] - 0.25f) < 1e-4f &&
+          fabsf(a[2] - 0.125f) < 1e-4f);
+    RayesParam diffuse[1] = {pc("reflectance", 0.2f, 0.4f, 0.6f)};
+    plane_albedo("diffuse", diffuse, 1, a);
+    CHECK(fabsf(a[0] - 0.2f) < 1e-4f && fabsf(a[1] - 0.4f) < 1e-4f && fabsf(a[2] - 0.6f) < 1e-4f);
+    RayesParam mirror[2] = {{"Kr", RAYES_PARAM_FLOAT, {0.8f, 0, 0}, NULL},
+                            pc("specularcolor", 1.0f, 0.5f, 1.0f)};
+    plane_albedo("mirror", mirror, 2, a);
+    CHECK(fabsf(a[0] - 0.8f) < 1e-4f && fabsf(a[1] - 0.4f) < 1e-4f && fabsf(a[2] - 0.8f) < 1e-4f);
+    plane_albedo("dielectric", NULL, 0, a);
+    fprintf(stderr, "dielectric albedo %g %g %g\n", a[0], a[1], a[2]);
+    CHECK(fabsf(a[0] - 1.0f) < 0.02f && fabsf(a[1] - 1.0f) < 0.02f && fabsf(a[2] - 1.0f) < 0.02f);
 }
 
 /* Two objects: their own ids; a hole in front passes to them. */
@@ -257,5 +306,5 @@ static void test_exr(void)
     rayes_scene_release(s);
 }
 
-TEST_MAIN(TEST(test_channels), TEST(test_plane), TEST(test_ids_and_holes), TEST(test_deterministic),
-          TEST(test_exr))
+TEST_MAIN(TEST(test_channels), TEST(test_plane), TEST(test_albedo), TEST(test_ids_and_holes),
+          TEST(test_deterministic), TEST(test_exr))
