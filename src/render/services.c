@@ -1076,6 +1076,45 @@ static float phase_hg(float g, float c)
     return (1.0f - g * g) / (4.0f * (float)M_PI * d * sqrtf(fmaxf(d, 1e-12f)));
 }
 
+/* A direction of Henyey-Greenstein's lobe of asymmetry g about the unit
+ * axis (its density phase_hg(g, d . axis)), from u1, u2 in [0, 1). */
+static Vec3 sample_hg(float g, Vec3 axis, float u1, float u2)
+{
+    float c;
+    if (fabsf(g) < 1e-3f) {
+        c = 1.0f - 2.0f * u1;
+    } else {
+        float q = (1.0f - g * g) / (1.0f - g + 2.0f * g * u1);
+        c = (1.0f + g * g - q * q) / (2.0f * g);
+    }
+    c = fminf(fmaxf(c, -1.0f), 1.0f);
+    float s = sqrtf(fmaxf(0.0f, 1.0f - c * c)), phi = 2.0f * (float)M_PI * u2;
+    Vec3 t, b;
+    v3_basis(axis, &t, &b);
+    return v3_add(v3_add(v3_scale(t, s * cosf(phi)), v3_scale(b, s * sinf(phi))),
+                  v3_scale(axis, c));
+}
+
+/* Multiple scattering at a medium's point j: one ray drawn from the phase
+ * function (so its weight, phase over density, is 1) and traced as a
+ * diffuse ray one depth deeper; the surfaces it meets give their
+ * radiosity (the cache's, or their shading), the media it crosses their
+ * own scattered light. Lights are direct_volume's: a ray that meets one,
+ * or the environment, brings nothing. */
+static Vec3 medium_indirect(Worker *w, const RayesShadeCtx *ctx, const PathState *ps, size_t j,
+                            Vec3 P, Vec3 I, float g)
+{
+    uint64_t key = hash_combine(ps->keys[j], DIM_MEDIUM);
+    Vec3 axis = v3_length(I) > 0.0f ? v3_normalize(I) : v3(0, 0, 1);
+    Vec3 d = sample_hg(v3_length(I) > 0.0f ? g : 0.0f, axis, rng_float(key),
+                       rng_float(hash_combine(key, 1)));
+    Ray ray = {P, d, 0.0f, INFINITY, RAYES_RAY_DIFFUSE, w->time};
+    w->stats.rays_diffuse++;
+    RayDiff diff = {ps->diff[j].width, fmaxf(ps->diff[j].spread, 1.0f)};
+    return integrator_trace(w, &ray, RAYES_RAY_DIFFUSE, ctx->diffuse_depth + 1, ctx->specular_depth,
+                            hash_combine(key, 2), diff, NULL);
+}
+
 static void svc_direct_volume(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
                               int n_shadow_rays, const char *category, float g, float (*out)[3])
 {
@@ -1130,6 +1169,8 @@ static void svc_direct_volume(const RayesShaderServices *sv, const RayesShadeCtx
                 sum = v3_add(sum, v3_scale(v3_mul(ls.Li, T), p * weight));
             }
         }
+        if (ctx->diffuse_depth < w->set->bounces && !w->set->pbgi)
+            sum = v3_add(sum, medium_indirect(w, ctx, ps, j, P, I, g));
         v3_store(out[i], sum);
     }
 }

@@ -29,6 +29,13 @@
  * renderers light volumes more coarsely than they sample extinction. */
 #define VOLUME_LIGHT_SAMPLES 16
 
+/* The same for a diffuse ray's segment (a radiosity fill's, a medium's
+ * scattered ray): many of them stand for one surface point's or one
+ * medium point's light, so each is lit at one point, and a medium's
+ * scattered light follows one path through the bounces (its lighting
+ * point's own scattered ray) instead of branching at each. */
+#define VOLUME_DIFFUSE_LIGHT_SAMPLES 1
+
 /* A march ends where the optical depth on every channel passes this:
  * the transmittance is below 1e-4 there (exp(-9.21)), and what lies
  * behind adds at most that much of itself (RenderMan's opacity
@@ -462,8 +469,11 @@ static int light_step(int j, int n, int n_light)
  * (steps of equal count put most of them where they added nothing to a
  * dense cloud, which came out 9% dark beside 512 points, 7.5% with its
  * march cut at VOLUME_TAU_CUTOFF; now within noise). Where no step adds
- * anything, strata of equal step counts (light_step). */
-static int light_steps(const VolumePoints *p, const March *m, int n_light, int *at)
+ * anything, strata of equal step counts (light_step). u places the
+ * points in their strata: 0.5 their middles; a diffuse ray's one point is
+ * drawn in proportion to the weight (u random), so its source, taken as
+ * the whole segment's, is right on average. */
+static int light_steps(const VolumePoints *p, const March *m, int n_light, float u, int *at)
 {
     if (n_light >= m->n) {
         for (int i = 0; i < m->n; i++)
@@ -489,7 +499,7 @@ static int light_steps(const VolumePoints *p, const March *m, int n_light, int *
         sum += exp(-tau) * -expm1(-s);
         tau += s;
         int taken = 0;
-        while (j < n_light && ((double)j + 0.5) / n_light * total <= sum) {
+        while (j < n_light && ((double)j + u) / n_light * total <= sum) {
             if (!taken++)
                 at[n++] = i;
             j++;
@@ -594,7 +604,11 @@ static void segment_radiance(Worker *w, const RenderVolume *v, const Ray *ray, f
                              RayDiff diff, Vec3 *Lv_out, Vec3 *Tv_out)
 {
     const RenderObject *obj = &w->rs->objects[v->object];
-    int scatter = (kind & (RAYES_RAY_CAMERA | RAYES_RAY_SPECULAR)) != 0;
+    /* Every ray that carries light sees the medium's: camera and specular
+     * rays, and diffuse rays (multiple scattering: the light a medium
+     * scatters reaches surfaces and other parts of it) */
+    int scatter = (kind & (RAYES_RAY_CAMERA | RAYES_RAY_SPECULAR | RAYES_RAY_DIFFUSE)) != 0;
+    int max_light = kind & RAYES_RAY_DIFFUSE ? VOLUME_DIFFUSE_LIGHT_SAMPLES : VOLUME_LIGHT_SAMPLES;
     March m = march(w, v, ray, t0, t1, rng_float(vkey),
                     v->uniform ? VOLUME_LIGHT_SAMPLES : VOLUME_MAX_STEPS);
     VolumePoints p;
@@ -607,7 +621,8 @@ static void segment_radiance(Worker *w, const RenderVolume *v, const Ray *ray, f
         /* The source at n_light of the steps (light_steps), interpolated
          * between them. */
         int at[VOLUME_LIGHT_SAMPLES];
-        int n_light = light_steps(&p, &m, RY_MIN(m.n, VOLUME_LIGHT_SAMPLES), at);
+        float u = max_light == 1 ? rng_float(hash_combine(vkey, 0x6c6974ull)) : 0.5f;
+        int n_light = light_steps(&p, &m, RY_MIN(m.n, max_light), u, at);
         points_alloc(&lp, (size_t)n_light);
         for (int j = 0; j < n_light; j++) {
             int i = at[j];

@@ -97,7 +97,8 @@ enum {
     DIM_SUBSURFACE = 9, /* subsurface rays from a probe point (memo 6.2) */
     DIM_TIME = 10,      /* camera rays' times in the shutter */
     DIM_LENS = 11,      /* camera rays' positions on the lens */
-    DIM_FRAME = 12      /* adaptive sampling's estimate of the frame's mean */
+    DIM_FRAME = 12,     /* adaptive sampling's estimate of the frame's mean */
+    DIM_MEDIUM = 13     /* a medium's scattered rays (multiple scattering) */
 };
 
 #endif /* RAYES_UTIL_RNG_H */

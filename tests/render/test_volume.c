@@ -339,6 +339,52 @@ static void test_cached_extinction_within_noise_and_deterministic(void)
     rayes_scene_release(s);
 }
 
+/* A furnace: a cube of a medium of albedo 1 under a uniform environment
+ * of radiance 1. Whatever it scatters, the light leaving it is 1 in every
+ * direction; single scattering alone (no bounces) falls short, since the
+ * light it scatters again is lost. The mean of the central pixels. */
+static double furnace(float sigma, int bounces, int threads)
+{
+    RayesScene *s = new_scene();
+    RayesParam e = {"intensity", RAYES_PARAM_FLOAT, {1, 0, 0}, NULL};
+    CHECK(rayes_scene_light(s, "environmentlight", &e, 1) == RAYES_OK);
+    RayesParam v[2] = {pf("density", sigma), pc("albedo", 1, 1, 1)};
+    CHECK(rayes_scene_set_shader(s, "homogeneous", v, 2) == RAYES_OK);
+    const float box[6] = {-1, 1, -1, 1, -1, 1};
+    CHECK(rayes_scene_volume(s, box) == RAYES_OK);
+    CHECK(rayes_scene_commit(s) == RAYES_OK);
+    RayesRenderOptions o;
+    rayes_render_options_init(&o, RAYES_QUALITY_PREVIEW);
+    o.width = o.height = 16;
+    o.spp = 16;
+    o.threads = threads;
+    o.bounces = bounces;
+    RayesImage *img = NULL;
+    CHECK(rayes_render(s, &o, &img, NULL) == RAYES_OK);
+    double m = 0.0;
+    for (int y = 4; img && y < 12; y++)
+        for (int x = 4; x < 12; x++)
+            m += (img->rgba[4 * (y * 16 + x)] + img->rgba[4 * (y * 16 + x) + 1] +
+                  img->rgba[4 * (y * 16 + x) + 2]) /
+                 (3.0 * 64.0);
+    rayes_image_free(img);
+    rayes_scene_release(s);
+    return m;
+}
+
+/* Multiple scattering (DESIGN.md "Volumes"): the furnace comes out 1
+ * with bounces enough for its optical depth, and the same bytes on any
+ * threads. */
+static void test_multiple_scattering_furnace(void)
+{
+    double single = furnace(1.0f, 0, 2), one = furnace(1.0f, 1, 2), many = furnace(1.0f, 8, 2);
+    fprintf(stderr, "furnace, albedo 1: %.4f single scattering, %.4f one bounce, %.4f eight\n",
+            single, one, many);
+    CHECK(single < 0.9 && one > single && many > one);
+    CHECK(fabs(many - 1.0) < 0.03);
+    CHECK(furnace(1.0f, 8, 1) == many);
+}
+
 static void test_bad_volume(void)
 {
     RayesScene *s = rayes_scene_new();
@@ -349,6 +395,7 @@ static void test_bad_volume(void)
     rayes_scene_release(s);
 }
 
-TEST_MAIN(TEST(test_homogeneous_slab_transmittance), TEST(test_uniform_volume_one_step),
-          TEST(test_dense_single_scattering), TEST(test_single_scattering_closed_form),
+TEST_MAIN(TEST(test_homogeneous_slab_transmittance), TEST(test_multiple_scattering_furnace),
+          TEST(test_uniform_volume_one_step), TEST(test_dense_single_scattering),
+          TEST(test_single_scattering_closed_form),
           TEST(test_cached_extinction_within_noise_and_deterministic), TEST(test_bad_volume))
