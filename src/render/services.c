@@ -1095,6 +1095,9 @@ static Vec3 sample_hg(float g, Vec3 axis, float u1, float u2)
                   v3_scale(axis, c));
 }
 
+/* Rays of multiple scattering a medium's lighting call traces, at most. */
+#define MEDIUM_RAYS 4
+
 /* Multiple scattering at a medium's point j: one ray drawn from the phase
  * function (so its weight, phase over density, is 1) and traced as a
  * diffuse ray one depth deeper; the surfaces it meets give their
@@ -1123,6 +1126,16 @@ static void svc_direct_volume(const RayesShaderServices *sv, const RayesShadeCtx
     Worker *w = ps->w;
     int n = shadow_ray_count(w, ctx, n_shadow_rays);
     g = fminf(fmaxf(g, -0.99f), 0.99f);
+    /* Multiple scattering from one point in stride (a camera segment's 16
+     * lighting points: 4 rays, each standing for its neighbours), the
+     * first at random: the light a medium scatters again varies slowly
+     * along a ray, its direct light does not */
+    int indirect = ctx->diffuse_depth < w->set->bounces && !w->set->pbgi && ctx->n_points > 0;
+    size_t stride = (ctx->n_points + MEDIUM_RAYS - 1) / MEDIUM_RAYS, first = 0;
+    if (indirect && stride > 1)
+        first = (size_t)(rng_float(hash_combine(ps->keys[point(ctx, 0)], DIM_MEDIUM + 100)) *
+                         (float)stride) %
+                stride;
     for (size_t i = 0; i < ctx->n_points; i++) {
         size_t j = point(ctx, i);
         Vec3 P = v3_load(ctx->P[i]), I = ctx->I ? v3_load(ctx->I[i]) : v3(0, 0, 0);
@@ -1169,8 +1182,8 @@ static void svc_direct_volume(const RayesShaderServices *sv, const RayesShadeCtx
                 sum = v3_add(sum, v3_scale(v3_mul(ls.Li, T), p * weight));
             }
         }
-        if (ctx->diffuse_depth < w->set->bounces && !w->set->pbgi)
-            sum = v3_add(sum, medium_indirect(w, ctx, ps, j, P, I, g));
+        if (indirect && i % stride == first)
+            sum = v3_add(sum, v3_scale(medium_indirect(w, ctx, ps, j, P, I, g), (float)stride));
         v3_store(out[i], sum);
     }
 }
