@@ -365,10 +365,13 @@ struct RayesShaderServices {
      * light). Shadow rays as direct_lighting's (n_shadow_rays, category),
      * attenuated by surfaces' opacity and volumes' extinction. A medium of
      * scattering coefficient sigma_s scatters sigma_s * out[i] toward the
-     * viewer per unit length. Below the render's maximum diffuse depth,
-     * out[i] also holds the light arriving from everything else (surfaces,
-     * the medium itself: multiple scattering), one ray drawn from the
-     * phase function. Older renderers lack it (supports()). */
+     * viewer per unit length. Below the render's maximum diffuse depth, a
+     * call for all lights (category NULL or "") also adds to out[i] the
+     * light arriving from everything else (surfaces, the medium itself:
+     * multiple scattering), by rays drawn from the phase function; a call
+     * for a category adds none, so a shader summing categories counts it
+     * once if one of its calls is for all lights, else not at all. Older
+     * renderers lack it (supports()). */
     void (*direct_volume)(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
                           int n_shadow_rays, const char *category, float g, float (*out)[3]);
 

@@ -1130,7 +1130,8 @@ static void svc_direct_volume(const RayesShaderServices *sv, const RayesShadeCtx
      * lighting points: 4 rays, each standing for its neighbours), the
      * first at random: the light a medium scatters again varies slowly
      * along a ray, its direct light does not */
-    int indirect = ctx->diffuse_depth < w->set->bounces && !w->set->pbgi && ctx->n_points > 0;
+    int indirect = ctx->diffuse_depth < w->set->bounces && !w->set->pbgi && ctx->n_points > 0 &&
+                   (!category || !category[0]); /* once: with every light, not a category */
     size_t stride = (ctx->n_points + MEDIUM_RAYS - 1) / MEDIUM_RAYS, first = 0;
     if (indirect && stride > 1)
         first = (size_t)(rng_float(hash_combine(ps->keys[point(ctx, 0)], DIM_MEDIUM + 100)) *
