@@ -360,36 +360,37 @@ static Vec3 trace_volumes(Worker *w, const Ray *ray, uint32_t kind, int diffuse_
 static void aov_capture(Worker *w, const Ray *ray, const Hit *hit, const RenderObject *obj,
                         uint64_t key, RayDiff diff)
 {
-    HitPoint hp;
-    hit_point(w, ray, hit, obj, &hp);
+    /* The albedo: the shader's lighting in a white furnace (nothing
+     * traced, nothing counted, no random number of the colour's drawn),
+     * on the hit's context, whose point the other AOVs read too. */
+    int albedo =
+        (w->set->aovs & RAYES_AOV_ALBEDO) && obj->light < 0 && obj->shader && w->albedo_services;
+    ShadeSite site;
+    if (albedo)
+        shade_site(w, ray, hit, obj, RAYES_RAY_CAMERA, 0, 0, key, diff, &site);
+    else
+        hit_point(w, ray, hit, obj, &site.hp);
+    const HitPoint *hp = &site.hp;
     AovSample *a = w->aov;
     a->set = 1;
-    a->P = v3_load(hp.P);
-    a->N = v3_load(hp.N);
+    a->P = v3_load(hp->P);
+    a->N = v3_load(hp->N);
     a->z = v3_dot(v3_sub(a->P, ray->o), w->rs->camera.forward);
     a->id = (uint32_t)(obj - w->rs->objects) + 1;
     a->patch = hit->grid + 1;
-    if (!(w->set->aovs & RAYES_AOV_ALBEDO))
-        return;
-    if (obj->light >= 0) { /* its hue */
+    if (albedo) {
+        float Ci[1][3] = {{0, 0, 0}}, Oi[1][3] = {{1, 1, 1}};
+        RayesShadeOutputs out = {Ci, Oi, NULL, NULL};
+        const RenderObject *outer = w->shading;
+        w->shading = obj;
+        shade_run_lighting(w->albedo_services, &site.ctx, obj->shader, &out);
+        w->shading = outer;
+        a->albedo = v3(Ci[0][0], Ci[0][1], Ci[0][2]);
+    } else if ((w->set->aovs & RAYES_AOV_ALBEDO) && obj->light >= 0) { /* its hue */
         Vec3 L = w->rs->lights[obj->light].L;
         float m = v3_max_component(L);
         a->albedo = m > 0.0f ? v3_scale(L, 1.0f / m) : v3(0, 0, 0);
-        return;
     }
-    if (!obj->shader || !w->albedo_services)
-        return;
-    /* The shader's lighting in a white furnace: nothing traced, nothing
-     * counted, no random number of the colour's drawn. */
-    ShadeSite site;
-    shade_site(w, ray, hit, obj, RAYES_RAY_CAMERA, 0, 0, key, diff, &site);
-    float Ci[1][3] = {{0, 0, 0}}, Oi[1][3] = {{1, 1, 1}};
-    RayesShadeOutputs out = {Ci, Oi, NULL, NULL};
-    const RenderObject *outer = w->shading;
-    w->shading = obj;
-    shade_run_lighting(w->albedo_services, &site.ctx, obj->shader, &out);
-    w->shading = outer;
-    a->albedo = v3(Ci[0][0], Ci[0][1], Ci[0][2]);
 }
 
 static Vec3 trace_layers(Worker *w, const Ray *ray, uint32_t kind, int diffuse_depth,
