@@ -189,6 +189,17 @@ typedef struct RayesSubsurfaceParams {
     int profile;      /* RayesSubsurfaceProfile */
 } RayesSubsurfaceParams;
 
+/* A fibre (hair, fur) for the hair service: pbrt-v4's hair BSDF. */
+typedef struct RayesHairParams {
+    const float (*T)[3];       /* per point, the fibre's direction (a curve's dPdu) */
+    const float *h;            /* per point, where the ray met the fibre's width, -1 to 1
+                                  (a curve's 2 v - 1); NULL: 0, the axis */
+    const float (*sigma_a)[3]; /* per point, absorption per unit of the fibre's radius */
+    float eta;                 /* the fibre's index (0: 1.55) */
+    float beta_m, beta_n;      /* longitudinal and azimuthal roughness, 0 to 1 (0: 0.3) */
+    float alpha;               /* the cuticle scales' tilt, degrees (pbrt's 2) */
+} RayesHairParams;
+
 /* What a plugin exports under RAYES_SHADER_ENTRY_NAME. */
 typedef const RayesShaderClass *(*RayesShaderEntry)(void);
 #define RAYES_SHADER_ENTRY_NAME "rayes_shader_entry"
@@ -426,6 +437,21 @@ struct RayesShaderServices {
     void (*classic_lighting)(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
                              int n_shadow_rays, const char *category, const float *roughness,
                              float (*diffuse)[3], float (*specular)[3]);
+
+    /* Light scattered by fibres toward the viewer (-I) with pbrt-v4's hair
+     * BSDF (Chiang et al. 2016: reflection off the cuticle, transmission
+     * through the fibre, one internal reflection, and the rest, each with
+     * its longitudinal and azimuthal spread, tinted by sigma_a along its
+     * path inside): out[i] = integral over the whole sphere of L(w) f(-I,
+     * w) |cos| dw. The scene's lights by multiple importance sampling of
+     * n_shadow_rays light samples against as many drawn from the BSDF (0:
+     * the renderer's setting); everything else by n_rays rays drawn from
+     * the BSDF (0: the renderer's diffuse count for the depth; one past the
+     * branch depth), read as diffuse rays (their hits' view-independent
+     * light, through the radiosity cache). Zero without I. Older renderers
+     * lack it (supports()). */
+    void (*hair)(const RayesShaderServices *sv, const RayesShadeCtx *ctx, const RayesHairParams *p,
+                 int n_shadow_rays, int n_rays, float (*out)[3]);
 };
 
 #ifdef __cplusplus

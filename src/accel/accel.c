@@ -1034,6 +1034,38 @@ static int shape_flat(int shape)
 }
 
 /* A curve segment's hit: u along it, half way across the grid's 2 rows. */
+/* Where a ray met a curve's width, 0 to 1 across the ribbon diced facing
+ * the eye (its rows v = 0 and 1): (h + 1) / 2, h the signed distance of the
+ * hit from the centre line across the ray, over the radius (a tube's sine
+ * of the angle between its normal and the view about the axis, a
+ * ribbon's offset; the hair BSDF's h). The centre and radius are the
+ * segment's at u, the rows' midpoints and half their distance. Instanced
+ * curves (master space) keep the middle. */
+static float curve_across(const Accel *a, const Grid *grid, uint32_t b, float u, const Ray *ray,
+                          float t, int instanced)
+{
+    if (instanced)
+        return 0.5f;
+    const GridSet *gs = a->gs;
+    float rt = embree_time(a, ray);
+    uint32_t w = grid->nu;
+    Vec3 p0 = vertex_at(gs, grid, b, rt), p1 = vertex_at(gs, grid, b + 1, rt);
+    Vec3 q0 = vertex_at(gs, grid, b + w, rt), q1 = vertex_at(gs, grid, b + w + 1, rt);
+    Vec3 c0 = v3_scale(v3_add(p0, q0), 0.5f), c1 = v3_scale(v3_add(p1, q1), 0.5f);
+    float r = 0.5f * ((1.0f - u) * v3_length(v3_sub(q0, p0)) + u * v3_length(v3_sub(q1, p1)));
+    Vec3 T = v3_sub(c1, c0), wo = v3_neg(ray->d);
+    float lt = v3_length(T), lo = v3_length(wo);
+    if (!(lt > 0.0f) || !(lo > 0.0f) || !(r > 0.0f))
+        return 0.5f;
+    T = v3_scale(T, 1.0f / lt), wo = v3_scale(wo, 1.0f / lo);
+    float perp = sqrtf(fmaxf(0.0f, 1.0f - v3_dot(wo, T) * v3_dot(wo, T)));
+    if (!(perp > 1e-6f))
+        return 0.5f;
+    Vec3 P = v3_madd(ray->o, ray->d, t), C = v3_lerp(c0, c1, u);
+    float h = v3_dot(v3_cross(v3_sub(P, C), wo), T) / (r * perp);
+    return isfinite(h) ? 0.5f * (fminf(fmaxf(h, -1.0f), 1.0f) + 1.0f) : 0.5f;
+}
+
 static void curve_hit(const Accel *a, const Geom *g, const struct RTCHit *h, const Ray *ray,
                       Hit *hit)
 {
@@ -1041,12 +1073,13 @@ static void curve_hit(const Accel *a, const Geom *g, const struct RTCHit *h, con
     const Grid *grid = &a->gs->grids[seg->grid];
     float u = fminf(fmaxf(h->u, 0.0f), 1.0f);
     uint32_t b = grid->first_vertex + seg->i, w = grid->nu;
+    float v = curve_across(a, grid, b, u, ray, hit->t, hit->instance != 0);
     hit->grid = seg->grid;
     hit->gu = ((float)seg->i + u) / (float)(w - 1u);
-    hit->gv = 0.5f;
+    hit->gv = v;
     hit->n_vertex = 4;
     const uint32_t vtx[4] = {b, b + 1, b + w, b + w + 1};
-    const float wt[4] = {0.5f * (1.0f - u), 0.5f * u, 0.5f * (1.0f - u), 0.5f * u};
+    const float wt[4] = {(1.0f - v) * (1.0f - u), (1.0f - v) * u, v * (1.0f - u), v * u};
     memcpy(hit->vertex, vtx, sizeof vtx);
     memcpy(hit->weight, wt, sizeof wt);
     hit->Ng = shape_normal(h, ray, g->shape);

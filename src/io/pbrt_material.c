@@ -583,10 +583,9 @@ static int mix_of(Parser *P, const Material *a, const Material *b, const RayesPa
 {
     const Material *ab[2] = {a, b};
     /* one slot left for a shape's alpha or normal map; an interface (no
-     * surface) or a material carrying Cs (hair's colour, the object's, not
-     * a child's) cannot be a mix's */
+     * surface) cannot be a mix's */
     if (a->n + b->n + 4 > MAT_MAX_PARAMS || strcmp(a->shader, PBRT_INVISIBLE) == 0 ||
-        strcmp(b->shader, PBRT_INVISIBLE) == 0 || mat_get(a, "Cs") || mat_get(b, "Cs"))
+        strcmp(b->shader, PBRT_INVISIBLE) == 0)
         return -1;
     Material out;
     pbrt_mat_init(&out, "mix");
@@ -677,7 +676,7 @@ static int mix_material(Parser *P, const Token *t, ParamList *pl, Material *m)
         return 0;
     *m = amount[0] > 0.5f ? *b : *a;
     pbrt_warn_at(P, t->line, t->col, "mix",
-                 "mix: rayes cannot blend these materials (an interface, hair, more than %d "
+                 "mix: rayes cannot blend these materials (an interface, more than %d "
                  "parameters between them, or mixes nested too deep); using the heavier one "
                  "(\"%.60s\")",
                  MAT_MAX_PARAMS - 4, amount[0] > 0.5f ? names->str[1] : names->str[0]);
@@ -726,42 +725,29 @@ static int conductor_material(Parser *P, const Token *t, const char *type, Param
     return 0;
 }
 
-/* pbrt-v4's hair as rayes's Kajiya-Kay `hair` (docs/pbrt.md): its colour
- * the reflectance pbrt's SigmaAFromReflectance inverts (given, or from
- * sigma_a, or from eumelanin and pheomelanin: pbrt's default 1.3 of
- * eumelanin), its highlight as sharp as beta_m says (roughness beta_m^2). */
+/* pbrt-v4's hair as rayes's `physicalhair` (docs/pbrt.md), the same
+ * BSDF (Chiang et al. 2016): sigma_a, reflectance or the melanin
+ * concentrations, which the shader takes in pbrt's order (sigma_a, then
+ * reflectance, then melanin: 1.3 of eumelanin when none is given), each
+ * a constant or a texture; eta, beta_m, beta_n and alpha. */
 static int hair_material(Parser *P, ParamList *pl, Material *m)
 {
-    static const float none[3] = {-1, -1, -1};
-    float refl[3], sigma[3];
-    if (pbrt_get_color(P, pl, "reflectance", none, refl, NULL) < 0 ||
-        pbrt_get_color(P, pl, "sigma_a", none, sigma, NULL) < 0)
+    static const float none[3] = {-1, -1, -1}, zero[3] = {0, 0, 0};
+    pbrt_mat_init(m, "physicalhair");
+    int given = pbrt_find(pl, "sigma_a") || pbrt_find(pl, "reflectance") ||
+                pbrt_find(pl, "eumelanin") || pbrt_find(pl, "pheomelanin");
+    if (mat_textured(P, pl, m, "sigma_a", "sigma_a", RAYES_PARAM_COLOR, none) != 0 ||
+        mat_textured(P, pl, m, "reflectance", "reflectance", RAYES_PARAM_COLOR, none) != 0)
         return -1;
-    double bm = pbrt_get_float(pl, "beta_m", 0.3), bn = pbrt_get_float(pl, "beta_n", 0.3);
-    int melanin = pbrt_find(pl, "eumelanin") || pbrt_find(pl, "pheomelanin");
-    double eu = pbrt_get_float(pl, "eumelanin", 0.0), pheo = pbrt_get_float(pl, "pheomelanin", 0.0);
-    (void)pbrt_find(pl, "eta"), (void)pbrt_find(pl, "alpha"); /* the lobes' shape: not modelled */
-    float c[3];
-    if (refl[0] >= 0.0f && sigma[0] < 0.0f) { /* pbrt: sigma_a first, then reflectance */
-        memcpy(c, refl, sizeof c);
-    } else {
-        if (sigma[0] < 0.0f) {
-            static const float eu_a[3] = {0.419f, 0.697f, 1.37f}, pheo_a[3] = {0.187f, 0.4f, 1.05f};
-            if (!melanin)
-                eu = 1.3;
-            for (int k = 0; k < 3; k++)
-                sigma[k] = (float)(eu * eu_a[k] + pheo * pheo_a[k]);
-        }
-        double d = 5.969 - 0.215 * bn + 2.532 * bn * bn - 10.73 * pow(bn, 3) + 5.574 * pow(bn, 4) +
-                   0.245 * pow(bn, 5);
-        for (int k = 0; k < 3; k++)
-            c[k] = (float)exp(-sqrt(fmax(sigma[k], 0.0f)) * d);
+    if (given) { /* pbrt's 1.3 of eumelanin only when nothing names the colour */
+        if (mat_textured(P, pl, m, "eumelanin", "eumelanin", RAYES_PARAM_FLOAT, zero) != 0 ||
+            mat_textured(P, pl, m, "pheomelanin", "pheomelanin", RAYES_PARAM_FLOAT, zero) != 0)
+            return -1;
     }
-    pbrt_mat_init(m, "hair");
-    pbrt_mat_color(m, "Cs", c);
-    mat_float(m, "Kd", 1.0f);
-    mat_float(m, "Ks", 0.15f);
-    mat_float(m, "roughness", (float)fmax(bm * bm, 1e-3));
+    mat_float(m, "eta", (float)pbrt_get_float(pl, "eta", 1.55));
+    mat_float(m, "beta_m", (float)pbrt_get_float(pl, "beta_m", 0.3));
+    mat_float(m, "beta_n", (float)pbrt_get_float(pl, "beta_n", 0.3));
+    mat_float(m, "alpha", (float)pbrt_get_float(pl, "alpha", 2.0));
     return 0;
 }
 

@@ -25,6 +25,7 @@
 #include "shade/bsdf.h"
 #include "shade/builtin.h"
 #include "shade/diffusion.h"
+#include "shade/hair.h"
 #include "shade/noise.h"
 #include "shade/pattern.h"
 #include "util/check.h"
@@ -724,12 +725,128 @@ static void svc_direct_fiber(const RayesShaderServices *sv, const RayesShadeCtx 
     }
 }
 
-static void svc_indirect_diffuse(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
-                                 int n_rays, float (*out)[3])
+/* ------------------------------------------------------------ hair */
+
+/* What the hair service needs of one point: the fibre's point (its
+ * origin, offset and shadow rays' differential), its frame (x along the
+ * fibre) and its BSDF for the view. */
+typedef struct HairPoint {
+    FiberPoint f;
+    Vec3 y, z;
+    Vec3 wo; /* toward the viewer, in the frame */
+    HairBsdf bsdf;
+} HairPoint;
+
+static Vec3 hair_local(const HairPoint *p, Vec3 d)
 {
-    (void)sv;
+    return v3(v3_dot(d, p->f.T), v3_dot(d, p->y), v3_dot(d, p->z));
+}
+
+static Vec3 hair_world(const HairPoint *p, Vec3 l)
+{
+    return v3_add(v3_scale(p->f.T, l.x), v3_add(v3_scale(p->y, l.y), v3_scale(p->z, l.z)));
+}
+
+/* A direction drawn from the BSDF with the pair (a, b) and c: world wi and
+ * its density. */
+static int hair_draw(const HairPoint *p, float a, float b, float c, Vec3 *wi, float *pdf)
+{
+    Vec3 l;
+    if (!hair_bsdf_sample(&p->bsdf, p->wo, c, a, b, &l, pdf))
+        return 0;
+    *wi = hair_world(p, l);
+    return 1;
+}
+
+/* One light's light toward the viewer: a delta light's one ray, or m
+ * light samples and m BSDF samples weighed by the power heuristic. */
+static Vec3 hair_light(Worker *w, const HairPoint *p, const Light *l, int m, uint64_t key)
+{
+    Vec3 sum = v3(0, 0, 0);
+    if (!light_is_area(l)) {
+        LightUberSample u;
+        if (!delta_sample(l, p->f.P, &u))
+            return sum;
+        Vec3 f = hair_bsdf_f(&p->bsdf, p->wo, hair_local(p, u.s.wi));
+        if (!(v3_max_component(f) > 0.0f))
+            return sum;
+        RayDiff one = {p->f.shadow.width, 0.0f};
+        return v3_mul(f, delta_arriving(w, l, fiber_origin(&p->f, u.s.wi), &u, one));
+    }
+    LightMeshView view; /* fibres light from every side: no horizon */
+    if (l->type == LIGHT_MESH)
+        light_mesh_view(l, p->f.P, v3(0, 0, 0), &view);
+    LightBound bound;
+    light_bound_init(l, p->f.P, &bound);
+    CmjPattern pat, pat_ab, pat_c;
+    cmj_pattern_init(&pat, (uint32_t)m, (uint32_t)key);
+    cmj_pattern_init(&pat_ab, (uint32_t)m, (uint32_t)hash_combine(key, 1));
+    cmj_pattern_init(&pat_c, (uint32_t)m, (uint32_t)hash_combine(key, 2));
+    for (int j = 0; j < m; j++) {
+        float a, b, c, unused, pdf;
+        LightSample ls;
+        cmj_pattern_sample(&pat, (uint32_t)j, &a, &b);
+        if (light_draw(l, &view, p->f.P, a, b, &ls) && ls.pdf > 0.0f &&
+            v3_max_component(ls.Li) > 0.0f) {
+            Vec3 wl = hair_local(p, ls.wi);
+            Vec3 f = hair_bsdf_f(&p->bsdf, p->wo, wl);
+            if (v3_max_component(f) > 0.0f) {
+                /* each of the m samples stands for 1 / (m pdf) of solid angle */
+                float spread = fminf(p->f.shadow.spread, sqrtf(1.0f / ((float)m * ls.pdf)));
+                RayDiff sd = {p->f.shadow.width, spread};
+                Vec3 Li = v3_mul(ls.Li, light_transmittance(w, l, fiber_origin(&p->f, ls.wi), ls.wi,
+                                                            ls.dist, sd));
+                float wt = power_heuristic(ls.pdf, hair_bsdf_pdf(&p->bsdf, p->wo, wl));
+                sum = v3_add(sum, v3_scale(v3_mul(Li, f), wt / ls.pdf));
+            }
+        }
+        cmj_pattern_sample(&pat_ab, (uint32_t)j, &a, &b);
+        cmj_pattern_sample(&pat_c, (uint32_t)j, &c, &unused);
+        Vec3 wi;
+        if (!hair_draw(p, a, b, c, &wi, &pdf) || !light_bound_may_hit(&bound, wi) ||
+            !light_hit(w, l, &view, p->f.P, wi, &ls) || !(v3_max_component(ls.Li) > 0.0f))
+            continue;
+        Vec3 f = hair_bsdf_f(&p->bsdf, p->wo, hair_local(p, wi));
+        Vec3 Li = v3_mul(
+            ls.Li, light_transmittance(w, l, fiber_origin(&p->f, wi), wi, ls.dist, p->f.shadow));
+        sum = v3_add(sum, v3_scale(v3_mul(Li, f), power_heuristic(pdf, ls.pdf) / pdf));
+    }
+    return v3_scale(sum, 1.0f / (float)m);
+}
+
+/* Everything but the lights: n rays drawn from the BSDF, read as diffuse
+ * rays (svc_indirect_diffuse's), to which emitters look black. */
+static Vec3 hair_indirect(Worker *w, const RayesShadeCtx *ctx, const HairPoint *p, int n,
+                          uint64_t key, RayDiff diff)
+{
+    Vec3 sum = v3(0, 0, 0);
+    CmjPattern pat_ab, pat_c;
+    cmj_pattern_init(&pat_ab, (uint32_t)n, (uint32_t)key);
+    cmj_pattern_init(&pat_c, (uint32_t)n, (uint32_t)hash_combine(key, 1));
+    for (int s = 0; s < n; s++) {
+        float a, b, c, unused, pdf;
+        Vec3 wi;
+        cmj_pattern_sample(&pat_ab, (uint32_t)s, &a, &b);
+        cmj_pattern_sample(&pat_c, (uint32_t)s, &c, &unused);
+        if (!hair_draw(p, a, b, c, &wi, &pdf))
+            continue;
+        Ray ray = {fiber_origin(&p->f, wi), wi, 0.0f, INFINITY, RAYES_RAY_DIFFUSE, w->time};
+        w->stats.rays_diffuse++;
+        Vec3 L =
+            integrator_trace(w, &ray, RAYES_RAY_DIFFUSE, ctx->diffuse_depth + 1,
+                             ctx->specular_depth, hash_combine(key, (uint64_t)s + 2), diff, NULL);
+        Vec3 f = hair_bsdf_f(&p->bsdf, p->wo, hair_local(p, wi));
+        sum = v3_add(sum, v3_scale(v3_mul(L, f), 1.0f / pdf));
+    }
+    return n > 0 ? v3_scale(sum, 1.0f / (float)n) : sum;
+}
+
+/* The rays a service reading its hits as diffuse rays traces at a point
+ * (n_rays: a shader's own count; 0: the renderer's for the depth, over
+ * the path's split); none at the last bounce, one past the branch depth. */
+static int diffuse_ray_count(const Worker *w, const RayesShadeCtx *ctx, int n_rays)
+{
     const PathState *ps = ctx->renderer;
-    Worker *w = ps->w;
     int depth = ctx->diffuse_depth;
     int n = n_rays > 0 ? n_rays : depth == 0 ? w->set->diffuse_rays : w->set->diffuse_rays_deep;
     if (n_rays <= 0)
@@ -738,6 +855,65 @@ static void svc_indirect_diffuse(const RayesShaderServices *sv, const RayesShade
         n = 0;
     if (ps->path && n > 1 && depth >= w->set->branch_depth)
         n = 1; /* an uncached hit past the branch depth: one ray follows the path */
+    return n;
+}
+
+static void svc_hair(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
+                     const RayesHairParams *hp, int n_shadow_rays, int n_rays, float (*out)[3])
+{
+    (void)sv;
+    const PathState *ps = ctx->renderer;
+    Worker *w = ps->w;
+    memset(out, 0, ctx->n_points * sizeof *out);
+    if (!ctx->I || !hp || !hp->T || !hp->sigma_a)
+        return;
+    int n = shadow_ray_count(w, ctx, n_shadow_rays), n_ind = diffuse_ray_count(w, ctx, n_rays);
+    const RenderObject *obj = lit_object(ps);
+    float lobe_spread = n_ind > 0 ? 1.0f / sqrtf((float)n_ind) : 0.0f;
+    for (size_t i = 0; i < ctx->n_points; i++) {
+        HairPoint p;
+        Vec3 T = v3_load(hp->T[i]);
+        if (hole(ctx, i) || !(v3_length(T) > 0.0f))
+            continue;
+        size_t j = point(ctx, i);
+        p.f.P = v3_load(ctx->P[i]);
+        p.f.Ng = v3_load(ctx->Ng[i]);
+        p.f.T = v3_normalize(T);
+        p.f.V = v3_normalize(v3_neg(v3_load(ctx->I[i])));
+        p.f.offset = ps->offset[j];
+        p.f.shadow = shadow_diff(ps, j, n);
+        v3_basis(p.f.T, &p.y, &p.z);
+        p.wo = hair_local(&p, p.f.V);
+        hair_bsdf_init(&p.bsdf, hp->h ? hp->h[i] : 0.0f, hp->eta > 0.0f ? hp->eta : 1.55f,
+                       v3_load(hp->sigma_a[i]), hp->beta_m > 0.0f ? hp->beta_m : 0.3f,
+                       hp->beta_n > 0.0f ? hp->beta_n : 0.3f, hp->alpha);
+        uint64_t key = hash_combine(ps->keys[j], DIM_LIGHT);
+        Vec3 sum = v3(0, 0, 0);
+        for (size_t k = 0; k < w->rs->n_lights && n > 0; k++) {
+            Light moved; /* a light moving within the frame: where it is at w->time */
+            const Light *l = light_at_time(&w->rs->lights[k], w->time, &moved);
+            if (l->type == LIGHT_AMBIENT || !render_lit_by(obj, k) ||
+                (l->nondiffuse && l->nonspecular))
+                continue;
+            sum = v3_add(sum, hair_light(w, &p, l, light_is_area(l) ? n : 1, hash_combine(key, k)));
+        }
+        if (n_ind > 0) {
+            RayDiff diff = {ps->diff[j].width, fmaxf(ps->diff[j].spread, lobe_spread)};
+            sum = v3_add(sum, hair_indirect(w, ctx, &p, n_ind,
+                                            hash_combine(ps->keys[j], DIM_DIFFUSE), diff));
+        }
+        v3_store(out[i], sum);
+    }
+}
+
+static void svc_indirect_diffuse(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
+                                 int n_rays, float (*out)[3])
+{
+    (void)sv;
+    const PathState *ps = ctx->renderer;
+    Worker *w = ps->w;
+    int depth = ctx->diffuse_depth;
+    int n = diffuse_ray_count(w, ctx, n_rays);
     IrrGrid *irr = ps->irr;
     if (irr && n > 0 && ctx->N == irr->N + ctx->first_point) {
         /* A grid's own points with its own normals: interpolate (irrgrid.h),
@@ -1299,6 +1475,7 @@ static const char *const service_names[] = {
     "subsurface",
     "microfacet",
     "classic_lighting",
+    "hair",
 };
 
 static int svc_supports(const RayesShaderServices *sv, const char *service)
@@ -1336,6 +1513,7 @@ const RayesShaderServices render_services = {
     .subsurface = subsurface_service,
     .microfacet = svc_microfacet,
     .classic_lighting = svc_classic_lighting,
+    .hair = svc_hair,
 };
 
 /* ------------------------------------------------ the albedo's furnace */
@@ -1448,6 +1626,36 @@ static void alb_subsurface(const RayesShaderServices *sv, const RayesShadeCtx *c
         out[i][0] = Rd[0], out[i][1] = Rd[1], out[i][2] = Rd[2];
 }
 
+/* The fibre's directional albedo toward -I: its BSDF's integral over the
+ * sphere, by HAIR_ALBEDO_SAMPLES stratified draws from it. */
+#define HAIR_ALBEDO_SAMPLES 64
+static void alb_hair(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
+                     const RayesHairParams *hp, int n_shadow_rays, int n_rays, float (*out)[3])
+{
+    (void)sv, (void)n_shadow_rays, (void)n_rays;
+    memset(out, 0, ctx->n_points * sizeof *out);
+    for (size_t i = 0; ctx->I && hp && hp->T && hp->sigma_a && i < ctx->n_points; i++) {
+        Vec3 T = v3_load(hp->T[i]), y, z, sum = v3(0, 0, 0);
+        if (!(v3_length(T) > 0.0f))
+            continue;
+        T = v3_normalize(T);
+        v3_basis(T, &y, &z);
+        Vec3 V = v3_neg(v3_load(ctx->I[i])), wo = v3(v3_dot(V, T), v3_dot(V, y), v3_dot(V, z));
+        HairBsdf b;
+        hair_bsdf_init(&b, hp->h ? hp->h[i] : 0.0f, hp->eta > 0.0f ? hp->eta : 1.55f,
+                       v3_load(hp->sigma_a[i]), hp->beta_m > 0.0f ? hp->beta_m : 0.3f,
+                       hp->beta_n > 0.0f ? hp->beta_n : 0.3f, hp->alpha);
+        for (int k = 0; k < HAIR_ALBEDO_SAMPLES; k++) {
+            float a = ((float)(k % 8) + 0.5f) / 8.0f, c = ((float)(k / 8) + 0.5f) / 8.0f, pdf;
+            float u = ((float)((k * 29) % HAIR_ALBEDO_SAMPLES) + 0.5f) / HAIR_ALBEDO_SAMPLES;
+            Vec3 wi;
+            if (hair_bsdf_sample(&b, wo, u, a, c, &wi, &pdf))
+                sum = v3_madd(sum, hair_bsdf_f(&b, wo, wi), 1.0f / pdf);
+        }
+        v3_store(out[i], v3_scale(sum, 1.0f / HAIR_ALBEDO_SAMPLES));
+    }
+}
+
 const RayesShaderServices albedo_services = {
     .abi_version = RAYES_SHADER_ABI_VERSION,
     .struct_size = sizeof(RayesShaderServices),
@@ -1474,4 +1682,5 @@ const RayesShaderServices albedo_services = {
     .subsurface = alb_subsurface,
     .microfacet = alb_lobe,
     .classic_lighting = alb_classic_lighting,
+    .hair = alb_hair,
 };

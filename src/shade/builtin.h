@@ -13,6 +13,9 @@ extern const RayesShaderClass shade_class_mirror;   /* perfect specular: Kr, spe
 extern const RayesShaderClass shade_class_constant; /* Ci = Cs */
 extern const RayesShaderClass shade_class_defaultsurface; /* Cs (Ka + Kd (I.N)^2): no lights */
 extern const RayesShaderClass shade_class_hair; /* fibres: Ka, Kd, Ks, roughness, specularcolor */
+extern const RayesShaderClass shade_class_physicalhair; /* pbrt-v4's hair: sigma_a, reflectance,
+                                                           eumelanin, pheomelanin, eta, beta_m,
+                                                           beta_n, alpha */
 extern const RayesShaderClass shade_class_stainedglass; /* coloured opacity: Kd, frequency,
                                                            leadwidth, clarity */
 extern const RayesShaderClass shade_class_occlusion;    /* ambient occlusion: samples, maxdist */

@@ -762,14 +762,8 @@ static void diffusetransmission_chunk(const RayesShaderServices *sv, const Rayes
     shade_param_color(sv, ctx, "reflectance", p->reflectance, refl);
     shade_param_color(sv, ctx, "transmittance", p->transmittance, tran);
     diffuse_light(sv, ctx, E, out);
-    RayesShadeCtx back = *ctx; /* the other side */
-    for (size_t i = 0; i < ctx->n_points; i++)
-        for (int c = 0; c < 3; c++) {
-            Nb[i][c] = -ctx->N[i][c];
-            Ngb[i][c] = -(ctx->Ng ? ctx->Ng : ctx->N)[i][c];
-        }
-    back.N = (const float(*)[3])Nb;
-    back.Ng = (const float(*)[3])Ngb;
+    RayesShadeCtx back; /* the other side */
+    shade_ctx_turned(ctx, Nb, Ngb, &back);
     RayesShadeOutputs ob = {NULL, NULL, NULL, NULL};
     diffuse_light(sv, &back, Eb, &ob);
     for (size_t i = 0; i < ctx->n_points; i++)

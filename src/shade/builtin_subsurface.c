@@ -160,28 +160,16 @@ static void diffuse_chunk(const RayesShaderServices *sv, const RayesShadeCtx *ct
             out->Ci[i][c] = cs(ctx, i, c) * tint[i][c] * p->Kd * Rd[c] * (dd[i][c] + id[i][c]);
 }
 
-/* Runs fn on SHADE_CHUNK-point slices, then Oi = Os and Ci *= Oi. */
-static void by_chunks(const RayesShaderServices *sv, const RayesShadeCtx *ctx, const void *params,
-                      RayesShadeOutputs *out, ShadeChunkFn fn)
-{
-    shade_chunks(sv, ctx, params, out, fn);
-    for (size_t i = 0; i < ctx->n_points; i++)
-        for (int c = 0; c < 3; c++) {
-            out->Oi[i][c] = ctx->Os ? ctx->Os[i][c] : 1.0f;
-            out->Ci[i][c] *= out->Oi[i][c];
-        }
-}
-
 static void subsurface_lighting(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
                                 const void *params, RayesShadeOutputs *out)
 {
-    by_chunks(sv, ctx, params, out, lighting_chunk);
+    shade_chunks_opacity(sv, ctx, params, out, lighting_chunk);
 }
 
 static void subsurface_diffuselighting(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
                                        const void *params, RayesShadeOutputs *out)
 {
-    by_chunks(sv, ctx, params, out, diffuse_chunk);
+    shade_chunks_opacity(sv, ctx, params, out, diffuse_chunk);
 }
 
 #define P_(f) offsetof(SubsurfaceParams, f)

@@ -20,7 +20,7 @@ static const RayesShaderClass *const builtin_classes[] = {
     &shade_class_glow,        &shade_class_thindielectric, &shade_class_diffusetransmission,
     &shade_class_homogeneous, &shade_class_turbulence,     &shade_class_subsurface,
     &shade_class_wood,        &shade_class_brickwall,      &shade_class_defaultsurface,
-    &shade_class_mix,
+    &shade_class_mix,         &shade_class_physicalhair,
 };
 
 const RayesShaderClass *shade_find_class(const char *name)

@@ -226,6 +226,29 @@ void shade_chunks(const RayesShaderServices *sv, const RayesShadeCtx *ctx, const
     }
 }
 
+void shade_chunks_opacity(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
+                          const void *params, RayesShadeOutputs *out, ShadeChunkFn fn)
+{
+    shade_chunks(sv, ctx, params, out, fn);
+    for (size_t i = 0; i < ctx->n_points; i++)
+        for (int c = 0; c < 3; c++) {
+            out->Oi[i][c] = ctx->Os ? ctx->Os[i][c] : 1.0f;
+            out->Ci[i][c] *= out->Oi[i][c];
+        }
+}
+
+void shade_ctx_turned(const RayesShadeCtx *ctx, float (*N)[3], float (*Ng)[3], RayesShadeCtx *back)
+{
+    *back = *ctx;
+    for (size_t i = 0; i < ctx->n_points; i++)
+        for (int c = 0; c < 3; c++) {
+            N[i][c] = -ctx->N[i][c];
+            Ng[i][c] = -(ctx->Ng ? ctx->Ng : ctx->N)[i][c];
+        }
+    back->N = (const float(*)[3])N;
+    back->Ng = (const float(*)[3])Ng;
+}
+
 /* Scratch for a call on ctx's points, if the class needs it and the caller
  * gave none: n_points * scratch_size zeroed bytes, set in *c. Returns the
  * block to free (NULL if none was made), or sets *failed when out of

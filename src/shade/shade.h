@@ -126,4 +126,13 @@ typedef void (*ShadeChunkFn)(const RayesShaderServices *sv, const RayesShadeCtx 
 void shade_chunks(const RayesShaderServices *sv, const RayesShadeCtx *ctx, const void *params,
                   RayesShadeOutputs *out, ShadeChunkFn fn);
 
+/* shade_chunks, then Oi = Os (1 without it) and Ci premultiplied by it. */
+void shade_chunks_opacity(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
+                          const void *params, RayesShadeOutputs *out, ShadeChunkFn fn);
+
+/* The other side of ctx's points (at most SHADE_CHUNK): *back is ctx with
+ * N and Ng (N without it) turned over, held in N and Ng, so that services
+ * called on it light that side and send its rays from there. */
+void shade_ctx_turned(const RayesShadeCtx *ctx, float (*N)[3], float (*Ng)[3], RayesShadeCtx *back);
+
 #endif /* RAYES_SHADE_SHADE_H */

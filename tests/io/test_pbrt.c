@@ -618,13 +618,14 @@ static void test_materials(void)
     sh = &r->mesh[3].shader; /* mix of two diffuse: blended, 0.75 a + 0.25 b */
     CHECK(strcmp(sh->name, "diffuse") == 0 && param(sh, "reflectance") &&
           fabs(param(sh, "reflectance")->value[0] - (0.75 * 0.2 + 0.25)) < 1e-6);
-    /* hair: Kajiya-Kay, coloured by its melanin (pbrt's eumelanin 1.3:
-     * a dark brown, red above blue), beta_m 0.3 as roughness 0.09 */
-    CHECK(strcmp(r->mesh[4].shader.name, "hair") == 0);
-    const RayesParam *hc = param(&r->mesh[4].shader, "Cs");
-    const RayesParam *hr = param(&r->mesh[4].shader, "roughness");
-    CHECK(hc && hc->value[0] > hc->value[2] && hc->value[0] < 0.2f);
-    CHECK(hr && fabsf(hr->value[0] - 0.09f) < 1e-5f);
+    /* hair: pbrt's BSDF, coloured by its melanin (sigma_a and reflectance
+     * unset, so the shader takes the concentrations) */
+    CHECK(strcmp(r->mesh[4].shader.name, "physicalhair") == 0);
+    const RayesParam *hs = param(&r->mesh[4].shader, "sigma_a");
+    const RayesParam *hb = param(&r->mesh[4].shader, "beta_m");
+    CHECK(hs && hs->value[0] < 0.0f && param(&r->mesh[4].shader, "eumelanin") &&
+          fabsf(param(&r->mesh[4].shader, "eumelanin")->value[0] - 1.3f) < 1e-6f);
+    CHECK(hb && fabsf(hb->value[0] - 0.3f) < 1e-6f);
     sh = &r->mesh[5].shader; /* an image texture: a pattern on the reflectance */
     CHECK(strcmp(sh->name, "diffuse") == 0 && param(sh, "reflectance") &&
           param(sh, "reflectance")->type == RAYES_PARAM_PATTERN &&
@@ -1274,7 +1275,8 @@ static void test_normal_map(void)
         CHECK(nm && nm->type == RAYES_PARAM_PATTERN);
         CHECK(param(&r->mesh[1].shader, "normalmap") == NULL);
     }
-    CHECK(strstr(said, "t.pbrt:4:1: \"normalmap\" on a material rayes draws as \"hair\"") != NULL);
+    CHECK(strstr(said, "t.pbrt:4:1: \"normalmap\" on a material rayes draws as \"physicalhair\"") !=
+          NULL);
     free(r);
 }
 

@@ -80,6 +80,9 @@ static void test_round_tube_hits(void)
                 worst = fmaxf(worst, fabsf((5.0f - h.t) - sqrtf(0.01f - y * y)));
             if (got && j == 0)
                 CHECK(h.Ng.z > 0.99f && h.shape == GEOM_SHAPE_ROUND_CURVE);
+            /* across the width: the hair BSDF's h = y / r as v = (h + 1) / 2 */
+            if (got)
+                CHECK(fabsf(h.gv - 0.5f * (y / 0.1f + 1.0f)) < 0.01f);
         }
         Hit h;
         CHECK(!hit_along(&t, v3(x, 0.105f, 5), v3(0, 0, -1), &h));
@@ -110,6 +113,8 @@ static void test_flat_faces_ray(void)
     Hit h;
     /* From +x at y = 0 (width 0.3): hit within 0.15 of the axis, not beyond. */
     CHECK(hit_along(&t, v3(5, 0, 0.14f), v3(-1, 0, 0), &h));
+    CHECK(fabsf(h.gv - 0.5f * (0.14f / 0.15f + 1.0f)) < 0.01f || /* across, either way */
+          fabsf(h.gv - 0.5f * (1.0f - 0.14f / 0.15f)) < 0.01f);
     CHECK(!hit_along(&t, v3(5, 0, 0.16f), v3(-1, 0, 0), &h));
     CHECK(hit_along(&t, v3(5, 0.9f, 0.185f), v3(-1, 0, 0), &h)); /* width 0.39 there */
     CHECK(!hit_along(&t, v3(5, -0.9f, 0.185f), v3(-1, 0, 0), &h));
@@ -371,5 +376,77 @@ static void test_fiber_environment(void)
     }
 }
 
-TEST_MAIN(TEST(test_fiber_environment), TEST(test_hermite_translated), TEST(test_round_tube_hits), TEST(test_flat_faces_ray), TEST(test_bases),
-          TEST(test_points), TEST(test_bad_input), TEST(test_hair_field_caches))
+/* physicalhair (pbrt-v4's hair BSDF) in a white furnace: a fibre that
+ * absorbs nothing under an environment of radiance L shows L at every
+ * pixel across its width (the BSDF integrates to 1 for every view and
+ * offset), by direct light alone; a clump of such fibres, their light
+ * passed on by the cached Lambertian stand-in of albedo 1, too; an
+ * absorbing clump is darker and redder for pbrt's eumelanin. */
+static double hair_furnace(int clump, const float *sigma, int bounces, double *red_over_blue)
+{
+    RayesScene *s = new_scene();
+    RayesParam hp[1] = {{"sigma_a", RAYES_PARAM_COLOR, {0, 0, 0}, NULL}};
+    int n_hp = sigma ? 1 : 0;
+    if (sigma)
+        memcpy(hp[0].value, sigma, 3 * sizeof(float));
+    CHECK(rayes_scene_set_shader(s, "physicalhair", hp, n_hp) == RAYES_OK);
+    enum { M = 5 };
+    float P[M * M * 6];
+    int nv[M * M], n = clump ? M * M : 1;
+    for (int i = 0; i < n; i++) { /* vertical fibres 0.15 wide, 0.45 apart, in a square clump */
+        float x = clump ? 0.45f * (float)(i % M - M / 2) : 0.0f;
+        float z = clump ? 0.45f * (float)(i / M - M / 2) : 0.0f;
+        const float q[6] = {x, -2, z, x, 2, z};
+        memcpy(&P[6 * i], q, sizeof q);
+        nv[i] = 2;
+    }
+    RayesCurves c = {.degree = 1, .shape = RAYES_CURVE_ROUND, .n_curves = n, .n_verts = nv, .P = P};
+    const float w = 0.15f;
+    RayesPrimvar pv = {"width", RAYES_PRIMVAR_CONSTANT, &w, 1};
+    CHECK(rayes_scene_curves(s, &c, &pv, 1) == RAYES_OK);
+    RayesParam e = {"intensity", RAYES_PARAM_FLOAT, {0.5f, 0, 0}, NULL};
+    CHECK(rayes_scene_light(s, "environmentlight", &e, 1) == RAYES_OK);
+    CHECK(rayes_scene_commit(s) == RAYES_OK);
+    RayesRenderOptions o;
+    rayes_render_options_init(&o, RAYES_QUALITY_PREVIEW);
+    o.width = o.height = 64;
+    o.spp = 4;
+    o.shadow_rays = 16;
+    o.diffuse_rays = 64;
+    o.bounces = bounces;
+    o.threads = 2;
+    RayesImage *img = NULL;
+    CHECK(rayes_render(s, &o, &img, NULL) == RAYES_OK);
+    double sum[3] = {0, 0, 0};
+    int count = 0;
+    for (int y = 16; img && y < 48; y++) /* the middle rows: fibres' sides, not their ends */
+        for (int x = 0; x < 64; x++) {
+            const float *px = &img->rgba[4 * ((size_t)y * 64 + x)];
+            if (px[3] == 1.0f)
+                sum[0] += px[0], sum[1] += px[1], sum[2] += px[2], count++;
+        }
+    CHECK(count > (clump ? 300 : 30));
+    if (red_over_blue)
+        *red_over_blue = sum[2] > 0.0 ? sum[0] / sum[2] : 0.0;
+    rayes_image_free(img);
+    rayes_scene_release(s);
+    return count ? (sum[0] + sum[1] + sum[2]) / (3.0 * count) : 0.0;
+}
+
+static void test_physicalhair_furnace(void)
+{
+    double rb = 0.0;
+    CHECK(hair_furnace(0, NULL, 0, &rb) < 0.3 && rb > 1.2); /* pbrt's 1.3 of eumelanin: brown */
+    const float clear[3] = {0, 0, 0};
+    CHECK_NEAR(hair_furnace(0, clear, 0, NULL), 0.5, 0.01);
+    double lone = hair_furnace(1, clear, 0, NULL), many = hair_furnace(1, clear, 8, NULL);
+    CHECK(lone < 0.45);          /* without bounces, the fibres shadow each other */
+    CHECK_NEAR(many, 0.5, 0.01); /* with them, the light they pass on makes it up */
+    const float brown[3] = {0.54f, 0.91f, 1.78f};
+    double ratio = 0.0, dark = hair_furnace(1, brown, 8, &ratio);
+    CHECK(dark < 0.3 && ratio > 1.2);
+}
+
+TEST_MAIN(TEST(test_physicalhair_furnace), TEST(test_fiber_environment),
+          TEST(test_hermite_translated), TEST(test_round_tube_hits), TEST(test_flat_faces_ray),
+          TEST(test_bases), TEST(test_points), TEST(test_bad_input), TEST(test_hair_field_caches))
