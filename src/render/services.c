@@ -868,6 +868,10 @@ static void svc_hair(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
     if (!ctx->I || !hp || !hp->T || !hp->sigma_a)
         return;
     int n = shadow_ray_count(w, ctx, n_shadow_rays), n_ind = diffuse_ray_count(w, ctx, n_rays);
+    /* the BSDF turns with where each ray meets the fibre (h), which a grid's
+     * vertices, on its edges, cannot stand for: the grid hider shades such
+     * a grid where its rays hit, as it does a sharp mirror */
+    w->sharp_rays += ctx->diffuse_depth == 0 && ctx->specular_depth == 0;
     const RenderObject *obj = lit_object(ps);
     float lobe_spread = n_ind > 0 ? 1.0f / sqrtf((float)n_ind) : 0.0f;
     for (size_t i = 0; i < ctx->n_points; i++) {

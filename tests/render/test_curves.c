@@ -376,13 +376,17 @@ static void test_fiber_environment(void)
     }
 }
 
+static double hair_furnace_hider(int clump, const float *sigma, int bounces, double *red_over_blue,
+                                 RayesHider hider);
+
 /* physicalhair (pbrt-v4's hair BSDF) in a white furnace: a fibre that
  * absorbs nothing under an environment of radiance L shows L at every
  * pixel across its width (the BSDF integrates to 1 for every view and
  * offset), by direct light alone; a clump of such fibres, their light
  * passed on by the cached Lambertian stand-in of albedo 1, too; an
  * absorbing clump is darker and redder for pbrt's eumelanin. */
-static double hair_furnace(int clump, const float *sigma, int bounces, double *red_over_blue)
+static double hair_furnace_hider(int clump, const float *sigma, int bounces, double *red_over_blue,
+                                 RayesHider hider)
 {
     RayesScene *s = new_scene();
     RayesParam hp[1] = {{"sigma_a", RAYES_PARAM_COLOR, {0, 0, 0}, NULL}};
@@ -415,6 +419,7 @@ static double hair_furnace(int clump, const float *sigma, int bounces, double *r
     o.diffuse_rays = 64;
     o.bounces = bounces;
     o.threads = 2;
+    o.hider = hider;
     RayesImage *img = NULL;
     CHECK(rayes_render(s, &o, &img, NULL) == RAYES_OK);
     double sum[3] = {0, 0, 0};
@@ -433,16 +438,25 @@ static double hair_furnace(int clump, const float *sigma, int bounces, double *r
     return count ? (sum[0] + sum[1] + sum[2]) / (3.0 * count) : 0.0;
 }
 
+static double hair_furnace(int clump, const float *sigma, int bounces, double *red_over_blue)
+{
+    return hair_furnace_hider(clump, sigma, bounces, red_over_blue, RAYES_HIDER_RAYTRACE);
+}
+
 static void test_physicalhair_furnace(void)
 {
     double rb = 0.0;
     CHECK(hair_furnace(0, NULL, 0, &rb) < 0.3 && rb > 1.2); /* pbrt's 1.3 of eumelanin: brown */
     const float clear[3] = {0, 0, 0};
     CHECK_NEAR(hair_furnace(0, clear, 0, NULL), 0.5, 0.01);
+    /* the grid hider shades hair where its rays hit (its vertices are the
+     * fibre's edges, where an absorbing fibre's BSDF is another) */
+    const float brown[3] = {0.54f, 0.91f, 1.78f};
+    double traced = hair_furnace(0, brown, 0, NULL);
+    CHECK_NEAR(hair_furnace_hider(0, brown, 0, NULL, RAYES_HIDER_GRID), traced, 0.02 * traced);
     double lone = hair_furnace(1, clear, 0, NULL), many = hair_furnace(1, clear, 8, NULL);
     CHECK(lone < 0.45);          /* without bounces, the fibres shadow each other */
     CHECK_NEAR(many, 0.5, 0.01); /* with them, the light they pass on makes it up */
-    const float brown[3] = {0.54f, 0.91f, 1.78f};
     double ratio = 0.0, dark = hair_furnace(1, brown, 8, &ratio);
     CHECK(dark < 0.3 && ratio > 1.2);
 }
