@@ -193,7 +193,10 @@ typedef struct RayesSubsurfaceParams {
 typedef struct RayesHairParams {
     const float (*T)[3];       /* per point, the fibre's direction (a curve's dPdu) */
     const float *h;            /* per point, where the ray met the fibre's width, -1 to 1
-                                  (a curve's 2 v - 1); NULL: 0, the axis */
+                                  (a curve's 2 v - 1); outside [-1, 1], or h NULL: the
+                                  fibre integrated over its width (each sample an offset
+                                  of its own), what a pixel sees of a fibre thinner than
+                                  itself and a grid's vertex stands for */
     const float (*sigma_a)[3]; /* per point, absorption per unit of the fibre's radius */
     float eta;                 /* the fibre's index (0: 1.55) */
     float beta_m, beta_n;      /* longitudinal and azimuthal roughness, 0 to 1 (0: 0.3) */

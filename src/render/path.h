@@ -72,9 +72,8 @@ typedef struct Worker {
     const RayesShaderServices *services; /* what shaders run here call (services.h) */
     const RayesShaderServices *albedo_services; /* the albedo AOV's furnace (services.h) */
     uint64_t sharp_rays;          /* perfect mirror and refraction rays traced from points at
-                                     depth 0, and hair shaded there (the grid hider asks
-                                     whether a grid's shading depends on where a ray hits it:
-                                     hider.c) */
+                                     depth 0 (the grid hider asks whether a grid's shading
+                                     traced any: hider.c) */
     float time;                   /* the time of the ray being shaded (scene time): rays the
                                      shading traces take it (integrator_trace sets and restores
                                      it; a cache fill sets its segment's middle) */

@@ -729,13 +729,22 @@ static void svc_direct_fiber(const RayesShaderServices *sv, const RayesShadeCtx 
 
 /* What the hair service needs of one point: the fibre's point (its
  * origin, offset and shadow rays' differential), its frame (x along the
- * fibre) and its BSDF for the view. */
+ * fibre), the view in it and the BSDF for the view, at the point's offset
+ * h or, with across set, at an offset of its own for each sample (the
+ * fibre integrated over its width: hair_offset). */
 typedef struct HairPoint {
     FiberPoint f;
     Vec3 y, z;
     Vec3 wo; /* toward the viewer, in the frame */
     HairBsdf bsdf;
+    const RayesHairParams *params;
+    Vec3 sigma_a;
+    int across;    /* no offset given: each sample draws its own */
+    float h_shift; /* the samples' offsets' shift, from the point's key */
 } HairPoint;
+
+/* Offsets a delta light's one ray averages over, with across set. */
+#define HAIR_DELTA_OFFSETS 8
 
 static Vec3 hair_local(const HairPoint *p, Vec3 d)
 {
@@ -747,15 +756,55 @@ static Vec3 hair_world(const HairPoint *p, Vec3 l)
     return v3_add(v3_scale(p->f.T, l.x), v3_add(v3_scale(p->y, l.y), v3_scale(p->z, l.z)));
 }
 
-/* A direction drawn from the BSDF with the pair (a, b) and c: world wi and
+static void hair_bsdf_at(const HairPoint *p, float h, HairBsdf *b)
+{
+    const RayesHairParams *hp = p->params;
+    hair_bsdf_init(b, h, hp->eta > 0.0f ? hp->eta : 1.55f, p->sigma_a,
+                   hp->beta_m > 0.0f ? hp->beta_m : 0.3f, hp->beta_n > 0.0f ? hp->beta_n : 0.3f,
+                   hp->alpha);
+}
+
+/* The BSDF for sample j of m: the point's own, or with across set the
+ * BSDF at the j-th of m stratified offsets over the width (shifted per
+ * point), so the m samples together integrate over it. */
+static const HairBsdf *hair_offset(const HairPoint *p, int j, int m, HairBsdf *b)
+{
+    if (!p->across)
+        return &p->bsdf;
+    hair_bsdf_at(p, -1.0f + 2.0f * fmodf(((float)j + p->h_shift) / (float)m, 1.0f), b);
+    return b;
+}
+
+/* A direction drawn from BSDF b with the pair (a, b) and c: world wi and
  * its density. */
-static int hair_draw(const HairPoint *p, float a, float b, float c, Vec3 *wi, float *pdf)
+static int hair_draw(const HairPoint *p, const HairBsdf *bsdf, float a, float b, float c, Vec3 *wi,
+                     float *pdf)
 {
     Vec3 l;
-    if (!hair_bsdf_sample(&p->bsdf, p->wo, c, a, b, &l, pdf))
+    if (!hair_bsdf_sample(bsdf, p->wo, c, a, b, &l, pdf))
         return 0;
     *wi = hair_world(p, l);
     return 1;
+}
+
+/* A delta light's light toward the viewer: its one ray, through the BSDF
+ * at the point's offset or averaged over HAIR_DELTA_OFFSETS of them. */
+static Vec3 hair_delta(Worker *w, const HairPoint *p, const Light *l)
+{
+    LightUberSample u;
+    if (!delta_sample(l, p->f.P, &u))
+        return v3(0, 0, 0);
+    Vec3 wl = hair_local(p, u.s.wi), f = v3(0, 0, 0);
+    int k = p->across ? HAIR_DELTA_OFFSETS : 1;
+    for (int j = 0; j < k; j++) {
+        HairBsdf b;
+        f = v3_add(f, hair_bsdf_f(hair_offset(p, j, k, &b), p->wo, wl));
+    }
+    f = v3_scale(f, 1.0f / (float)k);
+    if (!(v3_max_component(f) > 0.0f))
+        return v3(0, 0, 0);
+    RayDiff one = {p->f.shadow.width, 0.0f};
+    return v3_mul(f, delta_arriving(w, l, fiber_origin(&p->f, u.s.wi), &u, one));
 }
 
 /* One light's light toward the viewer: a delta light's one ray, or m
@@ -763,16 +812,8 @@ static int hair_draw(const HairPoint *p, float a, float b, float c, Vec3 *wi, fl
 static Vec3 hair_light(Worker *w, const HairPoint *p, const Light *l, int m, uint64_t key)
 {
     Vec3 sum = v3(0, 0, 0);
-    if (!light_is_area(l)) {
-        LightUberSample u;
-        if (!delta_sample(l, p->f.P, &u))
-            return sum;
-        Vec3 f = hair_bsdf_f(&p->bsdf, p->wo, hair_local(p, u.s.wi));
-        if (!(v3_max_component(f) > 0.0f))
-            return sum;
-        RayDiff one = {p->f.shadow.width, 0.0f};
-        return v3_mul(f, delta_arriving(w, l, fiber_origin(&p->f, u.s.wi), &u, one));
-    }
+    if (!light_is_area(l))
+        return hair_delta(w, p, l);
     LightMeshView view; /* fibres light from every side: no horizon */
     if (l->type == LIGHT_MESH)
         light_mesh_view(l, p->f.P, v3(0, 0, 0), &view);
@@ -785,28 +826,30 @@ static Vec3 hair_light(Worker *w, const HairPoint *p, const Light *l, int m, uin
     for (int j = 0; j < m; j++) {
         float a, b, c, unused, pdf;
         LightSample ls;
+        HairBsdf own;
+        const HairBsdf *bsdf = hair_offset(p, j, m, &own);
         cmj_pattern_sample(&pat, (uint32_t)j, &a, &b);
         if (light_draw(l, &view, p->f.P, a, b, &ls) && ls.pdf > 0.0f &&
             v3_max_component(ls.Li) > 0.0f) {
             Vec3 wl = hair_local(p, ls.wi);
-            Vec3 f = hair_bsdf_f(&p->bsdf, p->wo, wl);
+            Vec3 f = hair_bsdf_f(bsdf, p->wo, wl);
             if (v3_max_component(f) > 0.0f) {
                 /* each of the m samples stands for 1 / (m pdf) of solid angle */
                 float spread = fminf(p->f.shadow.spread, sqrtf(1.0f / ((float)m * ls.pdf)));
                 RayDiff sd = {p->f.shadow.width, spread};
                 Vec3 Li = v3_mul(ls.Li, light_transmittance(w, l, fiber_origin(&p->f, ls.wi), ls.wi,
                                                             ls.dist, sd));
-                float wt = power_heuristic(ls.pdf, hair_bsdf_pdf(&p->bsdf, p->wo, wl));
+                float wt = power_heuristic(ls.pdf, hair_bsdf_pdf(bsdf, p->wo, wl));
                 sum = v3_add(sum, v3_scale(v3_mul(Li, f), wt / ls.pdf));
             }
         }
         cmj_pattern_sample(&pat_ab, (uint32_t)j, &a, &b);
         cmj_pattern_sample(&pat_c, (uint32_t)j, &c, &unused);
         Vec3 wi;
-        if (!hair_draw(p, a, b, c, &wi, &pdf) || !light_bound_may_hit(&bound, wi) ||
+        if (!hair_draw(p, bsdf, a, b, c, &wi, &pdf) || !light_bound_may_hit(&bound, wi) ||
             !light_hit(w, l, &view, p->f.P, wi, &ls) || !(v3_max_component(ls.Li) > 0.0f))
             continue;
-        Vec3 f = hair_bsdf_f(&p->bsdf, p->wo, hair_local(p, wi));
+        Vec3 f = hair_bsdf_f(bsdf, p->wo, hair_local(p, wi));
         Vec3 Li = v3_mul(
             ls.Li, light_transmittance(w, l, fiber_origin(&p->f, wi), wi, ls.dist, p->f.shadow));
         sum = v3_add(sum, v3_scale(v3_mul(Li, f), power_heuristic(pdf, ls.pdf) / pdf));
@@ -826,16 +869,18 @@ static Vec3 hair_indirect(Worker *w, const RayesShadeCtx *ctx, const HairPoint *
     for (int s = 0; s < n; s++) {
         float a, b, c, unused, pdf;
         Vec3 wi;
+        HairBsdf own;
+        const HairBsdf *bsdf = hair_offset(p, s, n, &own);
         cmj_pattern_sample(&pat_ab, (uint32_t)s, &a, &b);
         cmj_pattern_sample(&pat_c, (uint32_t)s, &c, &unused);
-        if (!hair_draw(p, a, b, c, &wi, &pdf))
+        if (!hair_draw(p, bsdf, a, b, c, &wi, &pdf))
             continue;
         Ray ray = {fiber_origin(&p->f, wi), wi, 0.0f, INFINITY, RAYES_RAY_DIFFUSE, w->time};
         w->stats.rays_diffuse++;
         Vec3 L =
             integrator_trace(w, &ray, RAYES_RAY_DIFFUSE, ctx->diffuse_depth + 1,
                              ctx->specular_depth, hash_combine(key, (uint64_t)s + 2), diff, NULL);
-        Vec3 f = hair_bsdf_f(&p->bsdf, p->wo, hair_local(p, wi));
+        Vec3 f = hair_bsdf_f(bsdf, p->wo, hair_local(p, wi));
         sum = v3_add(sum, v3_scale(v3_mul(L, f), 1.0f / pdf));
     }
     return n > 0 ? v3_scale(sum, 1.0f / (float)n) : sum;
@@ -868,10 +913,6 @@ static void svc_hair(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
     if (!ctx->I || !hp || !hp->T || !hp->sigma_a)
         return;
     int n = shadow_ray_count(w, ctx, n_shadow_rays), n_ind = diffuse_ray_count(w, ctx, n_rays);
-    /* the BSDF turns with where each ray meets the fibre (h), which a grid's
-     * vertices, on its edges, cannot stand for: the grid hider shades such
-     * a grid where its rays hit, as it does a sharp mirror */
-    w->sharp_rays += ctx->diffuse_depth == 0 && ctx->specular_depth == 0;
     const RenderObject *obj = lit_object(ps);
     float lobe_spread = n_ind > 0 ? 1.0f / sqrtf((float)n_ind) : 0.0f;
     for (size_t i = 0; i < ctx->n_points; i++) {
@@ -888,9 +929,12 @@ static void svc_hair(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
         p.f.shadow = shadow_diff(ps, j, n);
         v3_basis(p.f.T, &p.y, &p.z);
         p.wo = hair_local(&p, p.f.V);
-        hair_bsdf_init(&p.bsdf, hp->h ? hp->h[i] : 0.0f, hp->eta > 0.0f ? hp->eta : 1.55f,
-                       v3_load(hp->sigma_a[i]), hp->beta_m > 0.0f ? hp->beta_m : 0.3f,
-                       hp->beta_n > 0.0f ? hp->beta_n : 0.3f, hp->alpha);
+        p.params = hp;
+        p.sigma_a = v3_load(hp->sigma_a[i]);
+        float h = hp->h ? hp->h[i] : 2.0f;
+        p.across = !(h >= -1.0f && h <= 1.0f);
+        p.h_shift = rng_float(hash_combine(hash_combine(ps->keys[j], DIM_SHADER), 0x6861u));
+        hair_bsdf_at(&p, p.across ? 0.0f : h, &p.bsdf);
         uint64_t key = hash_combine(ps->keys[j], DIM_LIGHT);
         Vec3 sum = v3(0, 0, 0);
         for (size_t k = 0; k < w->rs->n_lights && n > 0; k++) {
@@ -1646,10 +1690,17 @@ static void alb_hair(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
         v3_basis(T, &y, &z);
         Vec3 V = v3_neg(v3_load(ctx->I[i])), wo = v3(v3_dot(V, T), v3_dot(V, y), v3_dot(V, z));
         HairBsdf b;
-        hair_bsdf_init(&b, hp->h ? hp->h[i] : 0.0f, hp->eta > 0.0f ? hp->eta : 1.55f,
+        float h = hp->h ? hp->h[i] : 2.0f;
+        int across = !(h >= -1.0f && h <= 1.0f); /* the width's mean: an offset a draw */
+        hair_bsdf_init(&b, across ? 0.0f : h, hp->eta > 0.0f ? hp->eta : 1.55f,
                        v3_load(hp->sigma_a[i]), hp->beta_m > 0.0f ? hp->beta_m : 0.3f,
                        hp->beta_n > 0.0f ? hp->beta_n : 0.3f, hp->alpha);
         for (int k = 0; k < HAIR_ALBEDO_SAMPLES; k++) {
+            if (across)
+                hair_bsdf_init(&b, -1.0f + 2.0f * ((float)k + 0.5f) / HAIR_ALBEDO_SAMPLES,
+                               hp->eta > 0.0f ? hp->eta : 1.55f, v3_load(hp->sigma_a[i]),
+                               hp->beta_m > 0.0f ? hp->beta_m : 0.3f,
+                               hp->beta_n > 0.0f ? hp->beta_n : 0.3f, hp->alpha);
             float a = ((float)(k % 8) + 0.5f) / 8.0f, c = ((float)(k / 8) + 0.5f) / 8.0f, pdf;
             float u = ((float)((k * 29) % HAIR_ALBEDO_SAMPLES) + 0.5f) / HAIR_ALBEDO_SAMPLES;
             Vec3 wi;

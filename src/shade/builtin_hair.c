@@ -9,7 +9,9 @@
  * melanin concentrations "eumelanin" and "pheomelanin" (pbrt's default:
  * 1.3 of eumelanin, brown). "eta", "beta_m", "beta_n" and "alpha" shape
  * the lobes (1.55, 0.3, 0.3, 2 degrees). The fibre's direction is dPdu,
- * where the ray met its width 2 v - 1 (a curve's v runs across it).
+ * where the ray met its width 2 v - 1 (a curve's v runs across it); at v
+ * 0 or 1, a grid's vertex on the fibre's edge (the grid hider shades
+ * those), the service integrates over the width instead.
  *
  *   lighting         Ci = the hair service's scattered light toward -I.
  *   diffuselighting  view-independent, for the radiosity diffuse rays
@@ -66,7 +68,10 @@ static void hair_chunk(const RayesShaderServices *sv, const RayesShadeCtx *ctx, 
     for (size_t i = 0; i < ctx->n_points; i++) {
         for (int c = 0; c < 3; c++)
             T[i][c] = ctx->dPdu ? ctx->dPdu[i][c] : 0.0f;
-        h[i] = ctx->v ? 2.0f * ctx->v[i] - 1.0f : 0.0f;
+        /* a grid's vertex (the grid hider's) lies on the fibre's edge,
+         * v 0 or 1, and stands for the fibre's whole width */
+        float v = ctx->v ? ctx->v[i] : 0.5f;
+        h[i] = v > 0.0f && v < 1.0f ? 2.0f * v - 1.0f : 2.0f;
     }
     RayesHairParams hp = {
         (const float(*)[3])T, h, (const float(*)[3])sigma, p->eta, p->beta_m, p->beta_n, p->alpha};
