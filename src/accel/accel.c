@@ -1039,13 +1039,17 @@ static int shape_flat(int shape)
  * hit from the centre line across the ray, over the radius (a tube's sine
  * of the angle between its normal and the view about the axis, a
  * ribbon's offset; the hair BSDF's h). The centre and radius are the
- * segment's at u, the rows' midpoints and half their distance. Instanced
- * curves (master space) keep the middle. */
+ * segment's at u, the rows' midpoints and half their distance; an
+ * instance's curve (gi not NULL) is met in its master's space. */
 static float curve_across(const Accel *a, const Grid *grid, uint32_t b, float u, const Ray *ray,
-                          float t, int instanced)
+                          float t, const GeomInstance *gi)
 {
-    if (instanced)
-        return 0.5f;
+    Ray local = *ray;
+    if (gi) {
+        local.o = mat4_point(&gi->master_from_world, ray->o);
+        local.d = mat4_vector(&gi->master_from_world, ray->d);
+        ray = &local; /* the same t: the map is affine */
+    }
     const GridSet *gs = a->gs;
     float rt = embree_time(a, ray);
     uint32_t w = grid->nu;
@@ -1067,13 +1071,13 @@ static float curve_across(const Accel *a, const Grid *grid, uint32_t b, float u,
 }
 
 static void curve_hit(const Accel *a, const Geom *g, const struct RTCHit *h, const Ray *ray,
-                      Hit *hit)
+                      const GeomInstance *gi, Hit *hit)
 {
     const CurveSeg *seg = &g->segs[h->primID];
     const Grid *grid = &a->gs->grids[seg->grid];
     float u = fminf(fmaxf(h->u, 0.0f), 1.0f);
     uint32_t b = grid->first_vertex + seg->i, w = grid->nu;
-    float v = curve_across(a, grid, b, u, ray, hit->t, hit->instance != 0);
+    float v = curve_across(a, grid, b, u, ray, hit->t, gi);
     hit->grid = seg->grid;
     hit->gu = ((float)seg->i + u) / (float)(w - 1u);
     hit->gv = v;
@@ -1141,7 +1145,7 @@ static int make_hit(const Accel *a, const Ray *ray, const struct RTCHit *h, floa
         planar_tri_hit(a, g, h->primID, h->u, h->v, embree_time(a, ray), normal, hit);
         break;
     case KIND_CURVES:
-        curve_hit(a, g, h, ray, hit);
+        curve_hit(a, g, h, ray, gi, hit);
         break;
     case KIND_POINTS:
         point_hit(a, g, h, ray, tfar, gi, hit);

@@ -466,6 +466,66 @@ static void test_physicalhair_furnace(void)
     CHECK(dark < 0.3 && ratio > 1.2);
 }
 
-TEST_MAIN(TEST(test_physicalhair_furnace), TEST(test_fiber_environment),
-          TEST(test_hermite_translated), TEST(test_round_tube_hits), TEST(test_flat_faces_ray),
-          TEST(test_bases), TEST(test_points), TEST(test_bad_input), TEST(test_hair_field_caches))
+/* The light of a brown fibre lit from the side by a distant light, the
+ * fibre placed by an instance of a master (rotated and moved) or given
+ * in world space: the same, since an instance's hits know where they met
+ * the width too (in the master's space); the BSDF at the axis alone
+ * would be far darker. */
+static double side_lit_fibre(int instanced)
+{
+    RayesScene *s = new_scene();
+    RayesParam hp[1] = {{"sigma_a", RAYES_PARAM_COLOR, {0.54f, 0.91f, 1.78f}, NULL}};
+    CHECK(rayes_scene_set_shader(s, "physicalhair", hp, 1) == RAYES_OK);
+    const float P[6] = {0, -2, 0, 0, 2, 0}, W[6] = {-2, 0, 0, 2, 0, 0};
+    const int nv = 2;
+    const float w = 0.3f;
+    RayesPrimvar pv = {"width", RAYES_PRIMVAR_CONSTANT, &w, 1};
+    if (instanced) { /* a horizontal master turned upright, moved along x and back */
+        RayesCurves c = {
+            .degree = 1, .shape = RAYES_CURVE_ROUND, .n_curves = 1, .n_verts = &nv, .P = W};
+        CHECK(rayes_scene_object_begin(s, "fibre") == RAYES_OK);
+        CHECK(rayes_scene_curves(s, &c, &pv, 1) == RAYES_OK);
+        CHECK(rayes_scene_object_end(s) == RAYES_OK);
+        const float turn[16] = {0, -1, 0, 0, 1, 0, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
+        CHECK(rayes_scene_set_transform(s, turn) == RAYES_OK);
+        CHECK(rayes_scene_object_instance(s, "fibre") == RAYES_OK);
+        const float away[16] = {1, 0, 0, 50, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
+        CHECK(rayes_scene_set_transform(s, away) == RAYES_OK); /* a second, out of view */
+        CHECK(rayes_scene_object_instance(s, "fibre") == RAYES_OK);
+    } else {
+        RayesCurves c = {
+            .degree = 1, .shape = RAYES_CURVE_ROUND, .n_curves = 1, .n_verts = &nv, .P = P};
+        CHECK(rayes_scene_curves(s, &c, &pv, 1) == RAYES_OK);
+    }
+    RayesParam lp[3] = {{"from", RAYES_PARAM_COLOR, {1, 0, -1}, NULL},
+                        {"to", RAYES_PARAM_COLOR, {0, 0, 0}, NULL},
+                        {"intensity", RAYES_PARAM_FLOAT, {3, 0, 0}, NULL}};
+    CHECK(rayes_scene_light(s, "distantlight", lp, 3) == RAYES_OK);
+    CHECK(rayes_scene_commit(s) == RAYES_OK);
+    RayesRenderOptions o;
+    rayes_render_options_init(&o, RAYES_QUALITY_PREVIEW);
+    o.width = o.height = 64;
+    o.spp = 4;
+    o.bounces = 0;
+    o.threads = 2;
+    RayesImage *img = NULL;
+    CHECK(rayes_render(s, &o, &img, NULL) == RAYES_OK);
+    double total = 0.0;
+    for (size_t k = 0; img && k < (size_t)64 * 64; k++)
+        total += img->rgba[4 * k] + img->rgba[4 * k + 1] + img->rgba[4 * k + 2];
+    rayes_image_free(img);
+    rayes_scene_release(s);
+    return total;
+}
+
+static void test_physicalhair_instances(void)
+{
+    double world = side_lit_fibre(0), inst = side_lit_fibre(1);
+    CHECK(world > 0.0);
+    CHECK_NEAR(inst, world, 0.01 * world);
+}
+
+TEST_MAIN(TEST(test_physicalhair_furnace), TEST(test_physicalhair_instances),
+          TEST(test_fiber_environment), TEST(test_hermite_translated), TEST(test_round_tube_hits),
+          TEST(test_flat_faces_ray), TEST(test_bases), TEST(test_points), TEST(test_bad_input),
+          TEST(test_hair_field_caches))
