@@ -756,12 +756,18 @@ static Vec3 hair_world(const HairPoint *p, Vec3 l)
     return v3_add(v3_scale(p->f.T, l.x), v3_add(v3_scale(p->y, l.y), v3_scale(p->z, l.z)));
 }
 
-static void hair_bsdf_at(const HairPoint *p, float h, HairBsdf *b)
+/* The BSDF of a fibre of sigma_a at offset h, the parameters' zeros
+ * taken as their defaults (shader.h). */
+static void hair_params_bsdf(const RayesHairParams *hp, Vec3 sigma_a, float h, HairBsdf *b)
 {
-    const RayesHairParams *hp = p->params;
-    hair_bsdf_init(b, h, hp->eta > 0.0f ? hp->eta : 1.55f, p->sigma_a,
+    hair_bsdf_init(b, h, hp->eta > 0.0f ? hp->eta : 1.55f, sigma_a,
                    hp->beta_m > 0.0f ? hp->beta_m : 0.3f, hp->beta_n > 0.0f ? hp->beta_n : 0.3f,
                    hp->alpha);
+}
+
+static void hair_bsdf_at(const HairPoint *p, float h, HairBsdf *b)
+{
+    hair_params_bsdf(p->params, p->sigma_a, h, b);
 }
 
 /* The BSDF for sample j of m: the point's own, or with across set the
@@ -775,11 +781,25 @@ static const HairBsdf *hair_offset(const HairPoint *p, int j, int m, HairBsdf *b
     return b;
 }
 
-/* A direction drawn from BSDF b with the pair (a, b) and c: world wi and
- * its density. */
-static int hair_draw(const HairPoint *p, const HairBsdf *bsdf, float a, float b, float c, Vec3 *wi,
+/* The BSDF's draws of one strategy: a pattern of pairs for M_p and one
+ * more for the lobe and N_p, keyed apart. */
+typedef struct HairDraws {
+    CmjPattern ab, c;
+} HairDraws;
+
+static void hair_draws_init(HairDraws *d, int n, uint64_t key_ab, uint64_t key_c)
+{
+    cmj_pattern_init(&d->ab, (uint32_t)n, (uint32_t)key_ab);
+    cmj_pattern_init(&d->c, (uint32_t)n, (uint32_t)key_c);
+}
+
+/* Draw j from BSDF bsdf: world wi and its density. Returns 0 when none. */
+static int hair_draw(const HairPoint *p, const HairBsdf *bsdf, const HairDraws *d, int j, Vec3 *wi,
                      float *pdf)
 {
+    float a, b, c, unused;
+    cmj_pattern_sample(&d->ab, (uint32_t)j, &a, &b);
+    cmj_pattern_sample(&d->c, (uint32_t)j, &c, &unused);
     Vec3 l;
     if (!hair_bsdf_sample(bsdf, p->wo, c, a, b, &l, pdf))
         return 0;
@@ -819,12 +839,12 @@ static Vec3 hair_light(Worker *w, const HairPoint *p, const Light *l, int m, uin
         light_mesh_view(l, p->f.P, v3(0, 0, 0), &view);
     LightBound bound;
     light_bound_init(l, p->f.P, &bound);
-    CmjPattern pat, pat_ab, pat_c;
+    CmjPattern pat;
+    HairDraws draws;
     cmj_pattern_init(&pat, (uint32_t)m, (uint32_t)key);
-    cmj_pattern_init(&pat_ab, (uint32_t)m, (uint32_t)hash_combine(key, 1));
-    cmj_pattern_init(&pat_c, (uint32_t)m, (uint32_t)hash_combine(key, 2));
+    hair_draws_init(&draws, m, hash_combine(key, 1), hash_combine(key, 2));
     for (int j = 0; j < m; j++) {
-        float a, b, c, unused, pdf;
+        float a, b, pdf;
         LightSample ls;
         HairBsdf own;
         const HairBsdf *bsdf = hair_offset(p, j, m, &own);
@@ -843,10 +863,8 @@ static Vec3 hair_light(Worker *w, const HairPoint *p, const Light *l, int m, uin
                 sum = v3_add(sum, v3_scale(v3_mul(Li, f), wt / ls.pdf));
             }
         }
-        cmj_pattern_sample(&pat_ab, (uint32_t)j, &a, &b);
-        cmj_pattern_sample(&pat_c, (uint32_t)j, &c, &unused);
         Vec3 wi;
-        if (!hair_draw(p, bsdf, a, b, c, &wi, &pdf) || !light_bound_may_hit(&bound, wi) ||
+        if (!hair_draw(p, bsdf, &draws, j, &wi, &pdf) || !light_bound_may_hit(&bound, wi) ||
             !light_hit(w, l, &view, p->f.P, wi, &ls) || !(v3_max_component(ls.Li) > 0.0f))
             continue;
         Vec3 f = hair_bsdf_f(bsdf, p->wo, hair_local(p, wi));
@@ -863,17 +881,14 @@ static Vec3 hair_indirect(Worker *w, const RayesShadeCtx *ctx, const HairPoint *
                           uint64_t key, RayDiff diff)
 {
     Vec3 sum = v3(0, 0, 0);
-    CmjPattern pat_ab, pat_c;
-    cmj_pattern_init(&pat_ab, (uint32_t)n, (uint32_t)key);
-    cmj_pattern_init(&pat_c, (uint32_t)n, (uint32_t)hash_combine(key, 1));
+    HairDraws draws;
+    hair_draws_init(&draws, n, key, hash_combine(key, 1));
     for (int s = 0; s < n; s++) {
-        float a, b, c, unused, pdf;
+        float pdf;
         Vec3 wi;
         HairBsdf own;
         const HairBsdf *bsdf = hair_offset(p, s, n, &own);
-        cmj_pattern_sample(&pat_ab, (uint32_t)s, &a, &b);
-        cmj_pattern_sample(&pat_c, (uint32_t)s, &c, &unused);
-        if (!hair_draw(p, bsdf, a, b, c, &wi, &pdf))
+        if (!hair_draw(p, bsdf, &draws, s, &wi, &pdf))
             continue;
         Ray ray = {fiber_origin(&p->f, wi), wi, 0.0f, INFINITY, RAYES_RAY_DIFFUSE, w->time};
         w->stats.rays_diffuse++;
@@ -1692,15 +1707,12 @@ static void alb_hair(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
         HairBsdf b;
         float h = hp->h ? hp->h[i] : 2.0f;
         int across = !(h >= -1.0f && h <= 1.0f); /* the width's mean: an offset a draw */
-        hair_bsdf_init(&b, across ? 0.0f : h, hp->eta > 0.0f ? hp->eta : 1.55f,
-                       v3_load(hp->sigma_a[i]), hp->beta_m > 0.0f ? hp->beta_m : 0.3f,
-                       hp->beta_n > 0.0f ? hp->beta_n : 0.3f, hp->alpha);
+        Vec3 sigma = v3_load(hp->sigma_a[i]);
+        hair_params_bsdf(hp, sigma, across ? 0.0f : h, &b);
         for (int k = 0; k < HAIR_ALBEDO_SAMPLES; k++) {
             if (across)
-                hair_bsdf_init(&b, -1.0f + 2.0f * ((float)k + 0.5f) / HAIR_ALBEDO_SAMPLES,
-                               hp->eta > 0.0f ? hp->eta : 1.55f, v3_load(hp->sigma_a[i]),
-                               hp->beta_m > 0.0f ? hp->beta_m : 0.3f,
-                               hp->beta_n > 0.0f ? hp->beta_n : 0.3f, hp->alpha);
+                hair_params_bsdf(hp, sigma, -1.0f + 2.0f * ((float)k + 0.5f) / HAIR_ALBEDO_SAMPLES,
+                                 &b);
             float a = ((float)(k % 8) + 0.5f) / 8.0f, c = ((float)(k / 8) + 0.5f) / 8.0f, pdf;
             float u = ((float)((k * 29) % HAIR_ALBEDO_SAMPLES) + 0.5f) / HAIR_ALBEDO_SAMPLES;
             Vec3 wi;
