@@ -318,20 +318,49 @@ int pbrt_emit_subdiv(Parser *P, const Token *t, size_t n_faces, const int *n_ver
     return emit_mesh(P, t, n_faces, n_verts, idx, n_points, pts, NULL, uv, 1);
 }
 
+/* Records curves c with their primitive variables (at most 2: "width",
+ * one float a value, and "N", three) as an Op of the object being defined. */
+static int record_curves(Parser *P, const Token *t, const RayesCurves *c, const RayesPrimvar *pv,
+                         size_t n_pv)
+{
+    size_t n_points = 0, n_varying = 0;
+    if (rayes_curves_counts(c, &n_points, &n_varying) != 0 || n_pv > 2)
+        return FAIL_TOK(P, t, "curve: not a whole number of segments");
+    Op *op = new_op(P, t, OP_CURVES);
+    if (!op)
+        return -1;
+    op->curves = *c;
+    op->n_points = n_points;
+    op->n_verts = malloc((c->n_curves ? c->n_curves : 1) * sizeof(int));
+    op->pts = copy_floats(c->P, 3 * n_points);
+    if (!op->n_verts || !op->pts)
+        return FAIL_TOK(P, t, "out of memory");
+    memcpy(op->n_verts, c->n_verts, c->n_curves * sizeof(int));
+    op->curves.n_verts = op->n_verts;
+    op->curves.P = op->pts;
+    for (size_t i = 0; i < n_pv; i++) {
+        size_t size = strcmp(pv[i].name, "width") == 0 ? 1 : 3;
+        float *data = copy_floats(pv[i].data, size * pv[i].count);
+        if (!data)
+            return FAIL_TOK(P, t, "out of memory");
+        op->curve_pv[i] = pv[i];
+        op->curve_pv[i].data = data;
+        op->n_curve_pv = i + 1;
+    }
+    return 0;
+}
+
 int pbrt_emit_curves(Parser *P, const Token *t, const RayesCurves *c, const RayesPrimvar *pv,
                      size_t n_pv)
 {
     if (strcmp(P->gs.material.shader, PBRT_INVISIBLE) == 0)
         return 0;
-    if (P->recording) {
-        pbrt_warn_at(P, t->line, t->col, "curve instance",
-                     "curve: curves inside ObjectBegin are not instanced yet; skipped");
-        return 0;
-    }
-    if (send_state(P, t, P->gs.ctm, &P->gs.material) != 0)
-        return -1;
     if (!P->sink->curves)
         return FAIL_TOK(P, t, "curve: this sink takes no curves");
+    if (P->recording)
+        return record_curves(P, t, c, pv, n_pv);
+    if (send_state(P, t, P->gs.ctm, &P->gs.material) != 0)
+        return -1;
     RayesError e = P->sink->curves(P->sink->target, c, pv, n_pv);
     return e != RAYES_OK ? pbrt_sink_failed(P, t, e) : 0;
 }
@@ -415,6 +444,8 @@ static int send_ops(Parser *P, const Token *t, const Object *o, const double ctm
                           op->uv, op->subdiv);
         else if (op->kind == OP_QUADRIC)
             e = P->sink->quadric(P->sink->target, op->q, op->qp, op->n_qp, op->flags);
+        else if (op->kind == OP_CURVES)
+            e = P->sink->curves(P->sink->target, &op->curves, op->curve_pv, op->n_curve_pv);
         else
             e = send_patch(P, op);
         if (e != RAYES_OK)
@@ -457,6 +488,8 @@ void pbrt_object_free(Object *o)
         free(op->pts);
         free(op->N);
         free(op->uv);
+        for (size_t i = 0; i < op->n_curve_pv; i++)
+            free((float *)op->curve_pv[i].data);
     }
     free(o->ops);
     o->ops = NULL;

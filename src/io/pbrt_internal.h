@@ -158,7 +158,7 @@ typedef struct Texture {
     int is_float;      /* a "float" texture (else "spectrum") */
 } Texture;
 
-typedef enum OpKind { OP_MESH, OP_QUADRIC, OP_PATCH } OpKind;
+typedef enum OpKind { OP_MESH, OP_QUADRIC, OP_PATCH, OP_CURVES } OpKind;
 
 typedef struct Op {
     OpKind kind;
@@ -176,6 +176,11 @@ typedef struct Op {
     int patch_pv;         /* GEOM-like bits: 1 patch_N, 2 patch_uv given */
     float patch_N[4][3], patch_uv[4][2];
     int subdiv; /* OP_MESH: a Loop subdivision surface (loopsubdiv) */
+    /* OP_CURVES: the curves (n_verts and pts, owned, are its arrays) and
+     * their primitive variables (width, N), whose data are owned */
+    RayesCurves curves;
+    RayesPrimvar curve_pv[2];
+    size_t n_curve_pv;
 } Op;
 
 /* A directive read again later (pbrt_defer.c): its lexer as it was after

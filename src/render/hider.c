@@ -222,7 +222,9 @@ static Rgb *shade_grid(Worker *w, uint32_t gi, uint32_t instance, int seg)
          * along the view in orthographic projection. */
         Vec3 to = v3_sub(Pk, cam->eye);
         float dist = cam->tan_half_fov > 0.0f ? v3_length(to) : v3_dot(to, cam->forward);
-        Vec3 d = cam->tan_half_fov > 0.0f && dist > 0.0f ? v3_scale(to, 1.0f / dist) : cam->forward;
+        Vec3 d = render_view_toward(cam, Pk);
+        if (inst && render_faces_ray(g->shape)) /* faces this instance's eye */
+            Nk = Ngk = render_facing(d, duk, g->shape, Ngk);
         back[k] = v3_dot(Ngk, d) > 0.0f; /* the eye sees the back: shade that side */
         if (back[k])
             Nk = v3_neg(Nk), Ngk = v3_neg(Ngk);

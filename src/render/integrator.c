@@ -87,6 +87,8 @@ static int hit_point(const Worker *w, const Ray *ray, const Hit *hit, const Rend
     if (v3_dot(N, Ng) < 0.0f || hit->shape == GEOM_SHAPE_ROUND_CURVE ||
         hit->shape == GEOM_SHAPE_SPHERE) /* across a silhouette; round shapes' own normal */
         N = Ng;
+    else if (render_faces_ray(hit->shape))
+        N = render_facing(ray->d, du, hit->shape, Ng);
     v3_store(hp->P, v3_madd(ray->o, ray->d, hit->t));
     v3_store(hp->N, N);
     v3_store(hp->Ng, Ng);

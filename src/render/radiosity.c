@@ -275,6 +275,22 @@ static void put_point(const GridSet *gs, const Grid *g, FillPoints *fp, size_t p
     fp->v[p] = v;
 }
 
+/* A ray-facing shape's fill points through an instance: their normals
+ * face the eye from this instance (the master's, diced for another
+ * instance's view, need not), turned for side 1 as put_point turns them. */
+static void face_instance_eye(const Camera *cam, int shape, int side, size_t n, FillPoints *fp)
+{
+    for (size_t p = 0; p < n; p++) {
+        Vec3 P = v3_load(fp->P[p]), Ng = v3_load(fp->Ng[p]);
+        Vec3 N = render_facing(render_view_toward(cam, P), v3_load(fp->dPdu[p]), shape,
+                               side ? v3_neg(Ng) : Ng);
+        if (side)
+            N = v3_neg(N);
+        v3_store(fp->N[p], N);
+        v3_store(fp->Ng[p], N);
+    }
+}
+
 /* Positions of the level's points on the fine grid. */
 static void layout_points(const GridSet *gs, const Grid *g, int level, int side,
                           const RenderObject *obj, const GeomInstance *gi, int segment,
@@ -477,6 +493,8 @@ static void fill_radiosity(void *user, const CacheKey *key, size_t n, float (*ou
         middle_point(gs, g, key->side, obj, gi, key->segment, &fp);
     else
         layout_points(gs, g, key->level, key->side, obj, gi, key->segment, &fp);
+    if (gi && render_faces_ray(g->shape))
+        face_instance_eye(&w->rs->camera, g->shape, key->side, n, &fp);
     uint64_t fill_key = hash_combine(hash_combine(w->set->seed, 0x7261646f73ull /* "rados" */),
                                      ((uint64_t)key->patch << 32) | ((uint64_t)key->depth << 16) |
                                          ((uint64_t)key->side << 8) | key->level);

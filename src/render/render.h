@@ -80,6 +80,36 @@ typedef struct Camera {
     Vec3 motion_z[GEOM_MAX_TIMES];
 } Camera;
 
+/* Whether shape faces each ray (flat curves without N, disks of points):
+ * its grids' normals face the eye it was diced for, which for an
+ * instance's master is the eye seen from another instance. */
+static inline int render_faces_ray(int shape)
+{
+    return shape == GEOM_SHAPE_FLAT_CURVE || shape == GEOM_SHAPE_DISK;
+}
+
+/* The normal of a ray-facing shape seen along d, as pbrt's flat curves
+ * face the ray: -d made perpendicular to the curve's tangent du (a disk:
+ * -d itself), unit; fallback when d lies along du. */
+static inline Vec3 render_facing(Vec3 d, Vec3 du, int shape, Vec3 fallback)
+{
+    Vec3 n = v3_neg(d);
+    float tt = v3_dot(du, du);
+    if (shape == GEOM_SHAPE_FLAT_CURVE && tt > 0.0f)
+        n = v3_madd(n, du, -v3_dot(n, du) / tt);
+    float len = v3_length(n);
+    return len > 1e-6f * v3_length(d) ? v3_scale(n, 1.0f / len) : fallback;
+}
+
+/* The direction of the camera ray toward P: from the eye in perspective,
+ * along the view in orthographic projection. */
+static inline Vec3 render_view_toward(const Camera *cam, Vec3 P)
+{
+    Vec3 to = v3_sub(P, cam->eye);
+    float dist = cam->tan_half_fov > 0.0f ? v3_length(to) : 0.0f;
+    return dist > 0.0f ? v3_scale(to, 1.0f / dist) : cam->forward;
+}
+
 typedef struct RenderScene {
     const GridSet *gs;
     const Accel *accel;

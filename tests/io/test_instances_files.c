@@ -233,6 +233,57 @@ static void test_pbrt_instances(void)
     rayes_scene_release(s);
 }
 
+/* The mean of channel c over the columns [x0, x1) of img. */
+static double column_mean(const RayesImage *img, int c, int x0, int x1)
+{
+    double sum = 0.0;
+    for (int y = 0; y < img->height; y++)
+        for (int x = x0; x < x1; x++)
+            sum += img->rgba[4 * ((size_t)y * (size_t)img->width + (size_t)x) + (size_t)c];
+    return sum / ((double)img->height * (double)(x1 - x0));
+}
+
+#define PBRT_CURVE_HEAD                                                                            \
+    "LookAt 0 0 -6  0 0 0  0 1 0\nCamera \"perspective\" \"float fov\" 40\nWorldBegin\n"           \
+    "LightSource \"point\" \"point3 from\" [0 0 -4] \"float scale\" 20\n"                          \
+    "Material \"diffuse\" \"rgb reflectance\" [0.8 0.4 0.2]\n"
+#define PBRT_TUFT                                                                                  \
+    "  Shape \"curve\" \"point3 P\" [0 -1 0  0.1 -0.3 0  -0.1 0.3 0  0 1 0] \"float width\" 0.2\n" \
+    "  Shape \"curve\" \"point3 P\" [0.3 -1 0  0.4 -0.3 0  0.2 0.3 0  0.3 1 0] \"float width\" "   \
+    "0.2\n"
+
+/* pbrt-v4 curves inside ObjectBegin are instanced (they were skipped):
+ * a tuft of two curves placed left and right draws as its copies do. */
+static void test_pbrt_curve_instances(void)
+{
+    RayesScene *s = rayes_scene_new();
+    CHECK(read_into(s, "t.pbrt",
+                    PBRT_CURVE_HEAD "ObjectBegin \"tuft\"\n" PBRT_TUFT "ObjectEnd\n"
+                                    "AttributeBegin\nTranslate 1 0 0\nObjectInstance \"tuft\"\n"
+                                    "AttributeEnd\nAttributeBegin\nTranslate -1 0 0\n"
+                                    "ObjectInstance \"tuft\"\nAttributeEnd\n") == RAYES_OK);
+    CHECK(rayes_scene_instance_count(s) == 2);
+    RayesImage *inst = NULL, *copies = NULL;
+    CHECK(render_stat(s, "instances/masters", &inst) == 1);
+    rayes_scene_release(s);
+    s = rayes_scene_new();
+    CHECK(read_into(s, "t.pbrt",
+                    PBRT_CURVE_HEAD "AttributeBegin\nTranslate 1 0 0\n" PBRT_TUFT
+                                    "AttributeEnd\nAttributeBegin\nTranslate -1 0 0\n" PBRT_TUFT
+                                    "AttributeEnd\n") == RAYES_OK);
+    CHECK(render_stat(s, "instances/masters", &copies) == 0);
+    rayes_scene_release(s);
+    int w = inst->width;
+    for (int half = 0; half < 2; half++) {
+        double a = column_mean(inst, 0, half * w / 2, (half + 1) * w / 2);
+        double b = column_mean(copies, 0, half * w / 2, (half + 1) * w / 2);
+        CHECK(b > 0.01);                /* each half shows a tuft */
+        CHECK(fabs(a - b) <= 0.01 * b); /* drawn as the copies are */
+    }
+    rayes_image_free(inst);
+    rayes_image_free(copies);
+}
+
 /* RIB -> RIB writer -> RIB: the blocks and instances survive, and the
  * second file reads into the same instances. */
 static void test_rib_writer_round_trip(void)
@@ -288,4 +339,5 @@ static void test_aqsis_objectinstance(void)
 TEST_MAIN(TEST(test_aqsis_objectinstance), TEST(test_rib_instances_inherit_colour),
           TEST(test_rib_block_colour_kept), TEST(test_rib_block_colour_instance_surface),
           TEST(test_rib_block_opacity), TEST(test_rib_nested), TEST(test_errors),
-          TEST(test_pbrt_instances), TEST(test_rib_writer_round_trip))
+          TEST(test_pbrt_instances), TEST(test_pbrt_curve_instances),
+          TEST(test_rib_writer_round_trip))
