@@ -1232,6 +1232,7 @@ static void rib_fini(Rib *r)
     free(r->inline_archives);
     free(r->stand_ins);
     free(r->manifolds);
+    free(r->bumps);
     free(r->archive_name);
     for (size_t k = 0; k < r->n_warned; k++)
         free(r->warned[k]);

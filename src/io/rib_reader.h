@@ -100,6 +100,7 @@ typedef struct ShaderRec {
     int channels;       /* a PxrTexture's imagemap: its outputs resultR ... resultA are
                            its channels (rib_pattern_ref) */
     const struct ShaderRec *of; /* a channel's pattern: the image's record */
+    int bump;           /* a displacement made from a Bxdf's PxrBump (shading normal only) */
     RayesParam *params; /* names and strings owned */
     size_t n;
     struct ShaderRec *next;
@@ -354,6 +355,15 @@ typedef struct Rib {
         int invert_t; /* -1: not given */
     } * manifolds;
     size_t n_manifolds, cap_manifolds;
+    /* PxrBump patterns, by name: the pattern of their height (sent) and
+     * their scale, for the Bxdfs whose bumpNormal references them */
+    struct RisBump {
+        char name[128];
+        char height[160];
+        float scale;
+    } * bumps;
+    size_t n_bumps, cap_bumps;
+    unsigned n_internal; /* patterns the RIS translation made itself (their names) */
     /* inline archives (ArchiveBegin "name" ... ArchiveEnd): their text, read
      * by a ReadArchive of their name before any file */
     struct InlineArchive {

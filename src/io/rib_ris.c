@@ -1,10 +1,11 @@
 /*
  * io/rib_ris.c — RenderMan 19 and later (RIS): Bxdf, Light, Integrator,
- * the geometric area lights of RenderMan 19 and 20 (Geometry "rectlight"
- * and its kin under AreaLightSource) and the patterns PxrTexture,
- * PxrNormalMap, PxrChecker, PxrMix, PxrExposure and PxrManifold2D,
- * translated to rayes' own shaders and lights (docs/rib.md "RenderMan 19
- * and later"). RIS describes materials by physically based lobes and
+ * Displace (PxrDisplace), the geometric area lights of RenderMan 19 and
+ * 20 (Geometry "rectlight" and its kin under AreaLightSource) and the
+ * patterns PxrTexture, PxrNormalMap, PxrBump, PxrFractal, PxrChecker,
+ * PxrMix, PxrExposure, PxrDispTransform and PxrManifold2D, translated to
+ * rayes' own shaders, patterns and lights (docs/rib.md "RenderMan 19 and
+ * later"); bumps and displacements become the built-in "displace". RIS describes materials by physically based lobes and
  * lights by shapes of unit size; rayes keeps the base colour, the
  * specular and refraction lobes and the lights' radiance, and says once
  * what it leaves out.
@@ -254,6 +255,54 @@ static void out_normal_map(Rib *r, Out *o, const Param *p, size_t n)
     }
 }
 
+/* The PxrBump a Bxdf's bumpNormal references ("bump:resultN"), or NULL. */
+static const struct RisBump *bump_of(const Rib *r, const Param *p, size_t n)
+{
+    static const char *const names[] = {"bumpNormal", "diffuseBumpNormal", "specularBumpNormal"};
+    for (int k = 0; k < 3; k++) {
+        const Param *q = rib_find_param(p, n, names[k]);
+        if (!q || !q->d.reference || q->d.ty != TY_STRING || q->v->n != 1)
+            continue;
+        const char *ref = q->v->s[0], *colon = strrchr(ref, ':');
+        size_t len = colon ? (size_t)(colon - ref) : strlen(ref);
+        for (size_t b = r->n_bumps; b-- > 0;)
+            if (strlen(r->bumps[b].name) == len && strncmp(r->bumps[b].name, ref, len) == 0)
+                return &r->bumps[b];
+    }
+    return NULL;
+}
+
+/* A Bxdf's bump (its bumpNormal referencing a PxrBump): the built-in
+ * "displace" of the bump's height as a bump map (the shading normal
+ * bends, the surface stays), the displacement of the geometry that
+ * follows; a Bxdf without one ends the bump of the one before. A
+ * displacement of the file's own (Displace, Displacement) is kept: an
+ * object has one. */
+static int bxdf_bump(Rib *r, const char *cls, const Param *p, size_t n)
+{
+    const struct RisBump *b = bump_of(r, p, n);
+    if (!b) {
+        if (r->a.displacement && r->a.displacement->bump)
+            r->a.displacement = NULL;
+        return 0;
+    }
+    if (r->a.displacement && !r->a.displacement->bump) {
+        rib_warn_once(r, "ris bump and displacement",
+                      "Bxdf \"%s\": its PxrBump is not applied to a displaced surface (the "
+                      "displacement is kept)",
+                      cls);
+        return 0;
+    }
+    RayesParam q[2] = {{"amount", RAYES_PARAM_PATTERN, {0, 0, 0}, b->height},
+                       {"__bump", RAYES_PARAM_FLOAT, {1, 0, 0}, NULL}};
+    ShaderRec *sh = rib_shader_rec(r, "displace", q, 2);
+    if (!sh)
+        return -1;
+    sh->bump = 1;
+    r->a.displacement = sh;
+    return 0;
+}
+
 static int h_bxdf(Rib *r, const Args *a)
 {
     r->ris = 1;
@@ -305,7 +354,10 @@ static int h_bxdf(Rib *r, const Args *a)
     }
     if (strcmp(shader, "matte") != 0)
         out_normal_map(r, &o, p, n);
+    int e = bxdf_bump(r, cls, p, n);
     free(p);
+    if (e != 0)
+        return -1;
     ShaderRec *sh = rib_shader_rec(r, shader, o.p, o.n);
     if (!sh)
         return -1;
@@ -314,6 +366,57 @@ static int h_bxdf(Rib *r, const Args *a)
 }
 
 /* ------------------------------------------------------------ patterns */
+
+/* The size a transform gives object-space lengths: the cube root of its
+ * determinant's magnitude (a uniform scale's factor). RenderMan's bumps
+ * and displacements are in object space, rayes' in world space. */
+static float object_scale(const float M[16])
+{
+    double det = (double)M[0] * ((double)M[5] * M[10] - (double)M[6] * M[9]) -
+                 (double)M[1] * ((double)M[4] * M[10] - (double)M[6] * M[8]) +
+                 (double)M[2] * ((double)M[4] * M[9] - (double)M[5] * M[8]);
+    double k = cbrt(fabs(det));
+    return k > 0.0 && k < 1e30 ? (float)k : 1.0f;
+}
+
+/* Sends a pattern the translation makes itself, of class type under
+ * transform M, named in *name (a name starting with a space, which no
+ * file's reference can name). 0, or -1 with the error set. */
+static int send_internal(Rib *r, const char *type, const RayesParam *q, size_t n, const float M[16],
+                         char name[160])
+{
+    const IoSink *s = r->sink;
+    snprintf(name, 160, " ris %u %s", ++r->n_internal, type);
+    ShaderRec *sh = rib_shader_rec(r, type, q, n);
+    if (!sh)
+        return -1;
+    if (s->set_transform(s->target, M) != RAYES_OK ||
+        s->pattern(s->target, name, sh->name, sh->params, sh->n) != RAYES_OK)
+        return rib_sink_failed(r, s);
+    r->real.have_M = 0;
+    snprintf(sh->pattern, sizeof sh->pattern, "%s", name);
+    return 0;
+}
+
+/* The parameters of a + b x, x the pattern src: a mix from a to a + b by
+ * x (mix takes its amount as it is, so x may lie outside [0, 1]). */
+static size_t affine_params(float a, float b, const char *src, RayesParam q[3])
+{
+    q[0] = (RayesParam){"tex1", RAYES_PARAM_COLOR, {a, a, a}, NULL};
+    q[1] = (RayesParam){"tex2", RAYES_PARAM_COLOR, {a + b, a + b, a + b}, NULL};
+    q[2] = (RayesParam){"amount", RAYES_PARAM_PATTERN, {0, 0, 0}, src};
+    return 3;
+}
+
+/* The pattern a float parameter references ("tex:resultF"), sent, in buf;
+ * NULL when it references none rayes has (or is not a reference). */
+static const char *float_ref(Rib *r, const Param *p, size_t n, const char *name, char buf[160])
+{
+    const Param *q = rib_find_param(p, n, name);
+    if (!q || !q->d.reference || q->d.ty != TY_STRING || q->v->n != 1)
+        return NULL;
+    return rib_pattern_ref(r, q->v->s[0], buf, 160);
+}
 
 /* The manifold a pattern's "manifold" references ("name:result"), or NULL. */
 static const struct RisManifold *manifold_of(const Rib *r, const Param *p, size_t n)
@@ -376,6 +479,77 @@ static void placement(const Rib *r, const Param *p, size_t n, Out *o)
     out_float(o, "vdelta", invert ? off[1] + sc[1] : 1.0f - sc[1] - off[1]);
 }
 
+/* PxrBump: kept by name with the pattern of its height, the object-space
+ * scale applied (rayes' displacements are in world units): its texture's
+ * channel, or the pattern its inputBump references. A bump of neither is
+ * flat and kept as none. */
+static int keep_bump(Rib *r, const char *name, const Param *p, size_t n)
+{
+    float scale = num(p, n, "scale", 1) * object_scale(r->a.M);
+    char height[160], src_buf[160];
+    const char *file = string(p, n, "filename");
+    if (file && file[0]) {
+        Out o = {.n = 0};
+        out_string(&o, "filename", rib_texture_source(r, file));
+        out_string(&o, "encoding", "linear");
+        out_float(&o, "channel", num(p, n, "firstChannel", 0));
+        out_float(&o, "scale", scale);
+        placement(r, p, n, &o);
+        if (send_internal(r, "imagemap", o.p, o.n, r->a.M, height) != 0)
+            return -1;
+    } else {
+        const char *src = float_ref(r, p, n, "inputBump", src_buf);
+        if (!src || strlen(name) >= sizeof r->bumps[0].name)
+            return 0;
+        RayesParam q[3];
+        size_t nq = affine_params(0, scale, src, q);
+        if (send_internal(r, "mix", q, nq, r->a.M, height) != 0)
+            return -1;
+    }
+    if (strlen(name) >= sizeof r->bumps[0].name)
+        return 0;
+    if (util_grow((void **)&r->bumps, &r->cap_bumps, r->n_bumps, sizeof *r->bumps) != 0)
+        return rib_error(r, "out of memory");
+    struct RisBump *b = &r->bumps[r->n_bumps++];
+    snprintf(b->name, sizeof b->name, "%s", name);
+    snprintf(b->height, sizeof b->height, "%s", height);
+    b->scale = scale;
+    return 0;
+}
+
+/* PxrFractal's noise: rayes' fbm (turbulent: the sum of |noise|, pbrt's
+ * wrinkled) of layers octaves, each weighed lacunarity^-(3 - 2 dimension)
+ * times the one before, over the object's space (its default manifold)
+ * times frequency, shifted by variation; sent, its name in fbm. rayes'
+ * octaves double the frequency (lacunarity 2) and have no erosion. */
+static int fractal_noise(Rib *r, const Param *p, size_t n, char fbm[160])
+{
+    float f = num(p, n, "frequency", 1), lac = num(p, n, "lacunarity", 2);
+    float dim = num(p, n, "dimension", 1), var = num(p, n, "variation", 0);
+    float omega = powf(lac > 1.0f ? lac : 2.0f, -(3.0f - 2.0f * dim));
+    if (!(omega >= 0.0f && omega <= 1.0f))
+        omega = omega > 1.0f ? 1.0f : 0.5f;
+    if (fabsf(lac - 2.0f) > 0.01f || num(p, n, "erosion", 0) != 0)
+        rib_warn_once(r, "ris fractal",
+                      "PxrFractal: lacunarity other than 2 and erosion are not applied");
+    if (referenced(p, n, "manifold"))
+        rib_warn_once(r, "ris fractal manifold",
+                      "PxrFractal: its manifold is not used; the noise is over object space");
+    RayesParam q[2] = {{"octaves", RAYES_PARAM_FLOAT, {num(p, n, "layers", 6), 0, 0}, NULL},
+                       {"roughness", RAYES_PARAM_FLOAT, {omega, 0, 0}, NULL}};
+    /* texture space = frequency (object space + shift): M S(1/f) T(-shift) */
+    float M[16], inv = f != 0.0f && isfinite(f) ? 1.0f / f : 1.0f;
+    const float shift[3] = {12.9898f * var, 78.233f * var, 37.719f * var};
+    memcpy(M, r->a.M, sizeof M);
+    for (int row = 0; row < 3; row++) {
+        for (int c = 0; c < 3; c++)
+            M[4 * row + c] *= inv;
+        for (int c = 0; c < 3; c++)
+            M[4 * row + 3] -= M[4 * row + c] * shift[c];
+    }
+    return send_internal(r, num(p, n, "turbulent", 0) != 0 ? "wrinkled" : "fbm", q, 2, M, fbm);
+}
+
 /* A Pattern of RenderMan's classes that rayes translates: 1 with a new
  * record of the rayes pattern in *sh (its class in (*sh)->name); 2 for a
  * PxrManifold2D, kept for the patterns that reference it (nothing to
@@ -390,7 +564,39 @@ static int ris_pattern(Rib *r, const char *cls, const char *name, const Param *p
     *sh = NULL;
     if (strcasecmp(cls, "PxrManifold2D") == 0)
         return keep_manifold(r, name, p, n) == 0 ? 2 : -1;
-    if (strcasecmp(cls, "PxrTexture") == 0) {
+    if (strcasecmp(cls, "PxrBump") == 0)
+        return keep_bump(r, name, p, n) == 0 ? 2 : -1;
+    if (strcasecmp(cls, "PxrFractal") == 0) {
+        char fbm[160];
+        if (fractal_noise(r, p, n, fbm) != 0)
+            return -1;
+        type = "mix"; /* RenderMan's fractal lies in [0, 1]: 0.5 + amplitude fbm / 2 */
+        o.n = affine_params(0.5f, 0.5f * num(p, n, "amplitude", 1), fbm, o.p);
+        snprintf(o.pattern[2], sizeof o.pattern[2], "%s", fbm);
+        o.p[2].string = o.pattern[2];
+    } else if (strcasecmp(cls, "PxrDispTransform") == 0) {
+        char buf[160];
+        const char *src = float_ref(r, p, n, "dispScalar", buf);
+        if (!src || num(p, n, "dispType", 1) != 1)
+            return 0; /* a constant, or a vector: not built */
+        snprintf(o.pattern[2], sizeof o.pattern[2], "%s", src);
+        type = "mix";
+        float h = num(p, n, "dispHeight", 1), d = num(p, n, "dispDepth", 1);
+        float c = num(p, n, "dispCenter", 0.5f), mode = num(p, n, "dispRemapMode", 0);
+        /* none: v h; centred: (v - c) h; depth and height: from -d at 0 to h
+         * at 1 (RenderMan's spline through them, here a line) */
+        o.n = mode == 1   ? affine_params(-h * c, h, o.pattern[2], o.p)
+              : mode == 2 ? affine_params(-d, h + d, o.pattern[2], o.p)
+                          : affine_params(0, h, o.pattern[2], o.p);
+        if (mode == 1 && d != h)
+            rib_warn_once(r, "ris disp depth",
+                          "PxrDispTransform: dispDepth is taken as dispHeight (one scale "
+                          "for both sides)");
+        const char *space = string(p, n, "dispScaleSpace");
+        if (space && strcmp(space, "object") != 0)
+            rib_warn_once(r, "ris disp space",
+                          "PxrDispTransform: dispScaleSpace \"%s\" is read as object space", space);
+    } else if (strcasecmp(cls, "PxrTexture") == 0) {
         const char *file = string(p, n, "filename");
         if (!file || !file[0])
             return 0;
@@ -771,6 +977,48 @@ int rib_ris_geometry_light(Rib *r, const char *name)
 
 /* RenderMan 21's Displace (PxrDisplace and its pattern network): not
  * built; the surfaces are not displaced, with one warning. */
+/* RIS's Displace: PxrDisplace's scalar displacement (dispAmount times
+ * dispScalar along N, object space) as the built-in "displace" of the
+ * surfaces that follow; vector displacement and other classes are not
+ * built (no displacement, one warning). */
+static int ris_displace(Rib *r, const char *cls, const Param *p, size_t n)
+{
+    r->a.displacement = NULL;
+    if (strcasecmp(cls, "PxrDisplace") != 0) {
+        rib_warn_once(r, "ris displace",
+                      "Displace \"%s\": only PxrDisplace's scalar displacement is built; the "
+                      "surfaces that follow are not displaced",
+                      cls);
+        return 0;
+    }
+    if (referenced(p, n, "dispVector") || referenced(p, n, "modelDispVector"))
+        rib_warn_once(r, "ris displace vector",
+                      "PxrDisplace: vector displacement (dispVector, modelDispVector) is not "
+                      "built; only dispScalar displaces");
+    if (num(p, n, "enabled", 1) == 0)
+        return 0;
+    float amount = num(p, n, "dispAmount", 1) * object_scale(r->a.M);
+    char buf[160], height[160];
+    const char *src = float_ref(r, p, n, "dispScalar", buf);
+    RayesParam q[3];
+    if (src) {
+        size_t nq = affine_params(0, amount, src, q);
+        if (send_internal(r, "mix", q, nq, r->a.M, height) != 0)
+            return -1;
+        q[0] = (RayesParam){"amount", RAYES_PARAM_PATTERN, {0, 0, 0}, height};
+    } else {
+        float v = num(p, n, "dispScalar", 0) * amount;
+        if (v == 0.0f)
+            return 0;
+        q[0] = (RayesParam){"amount", RAYES_PARAM_FLOAT, {v, 0, 0}, NULL};
+    }
+    ShaderRec *sh = rib_shader_rec(r, "displace", q, 1);
+    if (!sh)
+        return -1;
+    r->a.displacement = sh;
+    return 0;
+}
+
 static int h_displace(Rib *r, const Args *a)
 {
     r->ris = 1;
@@ -779,12 +1027,9 @@ static int h_displace(Rib *r, const Args *a)
     const char *cls = class_and_params(r, a, "a displacement class", &p, &n);
     if (!cls)
         return -1;
+    int e = ris_displace(r, cls, p, n);
     free(p);
-    rib_warn_once(r, "ris displace",
-                  "Displace \"%s\": RenderMan's RIS displacement is not built; the surfaces "
-                  "that follow are not displaced",
-                  cls);
-    return 0;
+    return e;
 }
 
 /* ------------------------------------------------------------ Integrator */

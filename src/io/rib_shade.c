@@ -1485,7 +1485,8 @@ int rib_pattern_define(Rib *r, const char *type, const char *name, Param *p, siz
         rib_warn_once(
             r, key,
             "Pattern \"%s\" is not a class rayes has (of RenderMan's Pxr patterns PxrTexture, "
-            "PxrNormalMap, PxrChecker, PxrMix, PxrExposure and PxrManifold2D are built); "
+            "PxrNormalMap, PxrBump, PxrFractal, PxrChecker, PxrMix, PxrExposure, scalar "
+            "PxrDispTransform and PxrManifold2D are built); "
             "ignored: colours that reference it take its input's colour or pattern (inputRGB, "
             "inputColor, ...), others keep their defaults",
             type);

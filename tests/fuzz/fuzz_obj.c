@@ -8,6 +8,7 @@
  * "fuzz.obj:". An input is the OBJ up to its first NUL byte; what follows
  * is written as m.mtl beside it (in a scratch directory made once), so
  * "mtllib m.mtl" fuzzes the MTL reader too; other names find nothing.
+ * The directory is removed at exit.
  *
  * Build and run: make fuzz (tests/fuzz/CMakeLists.txt), seeds in
  * tests/fuzz/corpus_obj/.
@@ -29,6 +30,14 @@ static char name[128], mtl[128];
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
 
+/* The scratch directory goes when the fuzzer exits (libFuzzer's runs end
+ * in exit()), so test runs leave nothing in /tmp. */
+static void remove_scratch(void)
+{
+    unlink(mtl);
+    rmdir(dir);
+}
+
 static void check_message(RayesError e, const char *err)
 {
     if (e == RAYES_OK && err[0] != '\0')
@@ -49,6 +58,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
             abort();
         snprintf(name, sizeof name, "%s/fuzz.obj", dir);
         snprintf(mtl, sizeof mtl, "%s/m.mtl", dir);
+        atexit(remove_scratch);
     }
     const unsigned char *nul = size ? memchr(data, 0, size) : NULL;
     FILE *f = fopen(mtl, "wb");

@@ -592,7 +592,7 @@ static void test_patterns(void)
      * imagemap): skipped with a warning, and what references them keeps
      * its default; a reference's ":output" is RenderMan's */
     rec.pattern[0] = '\0';
-    CHECK(parse(WORLD("Pattern \"PxrFractal\" \"f\" \"int layers\" [4]\n"
+    CHECK(parse(WORLD("Pattern \"PxrWorley\" \"f\" \"float frequency\" [4]\n"
                       "Surface \"diffuse\" \"reference color reflectance\" [\"f:resultRGB\"]\n"
                       "Polygon \"P\" [0 0 0 1 0 0 1 1 0]")) == RAYES_OK);
     CHECK(rec.pattern[0] == '\0' && strcmp(rec.shader, "diffuse") == 0 &&

@@ -612,6 +612,128 @@ static void test_patterns_rendered(void)
 #undef TEX
 }
 
+/* The spread of channel c over the pixels whose alpha is over 1/2, and
+ * their count. */
+static double spread(const RayesImage *a, int c, int *count)
+{
+    double sum = 0.0, sq = 0.0;
+    int m = 0;
+    for (int k = 0; k < SIZE * SIZE; k++)
+        if (a->rgba[4 * k + 3] > 0.5f) {
+            double v = a->rgba[4 * k + c];
+            sum += v, sq += v * v, m++;
+        }
+    *count = m;
+    return m ? sqrt(fmax(sq / m - (sum / m) * (sum / m), 0.0)) : 0.0;
+}
+
+/* RIS bump and displacement: a PxrBump of a PxrFractal on a Bxdf's
+ * bumpNormal bends the shading normals of a plane lit from the side (the
+ * flat plane's pixels all alike; scale 0 gives the flat image), a PxrBump
+ * of a texture with a step bends them along the step alone; PxrDisplace
+ * moves a sphere's surface by dispScalar dispAmount in object units
+ * (through a PxrDispTransform's centring too). */
+static void test_bump_and_displacement(void)
+{
+    /* left half 0, right half 1: flat but for ramps between the halves'
+     * middle texels, at s = 1/2 and (repeated) at s = 0 */
+    FILE *f = fopen(RAYES_TEST_TMP "/test_rib_ris_step.ppm", "wb");
+    CHECK(f != NULL);
+    if (f) {
+        fprintf(f, "P6 8 1 255\n");
+        for (int k = 0; k < 24; k++)
+            fputc(k < 12 ? 0 : 255, f);
+        fclose(f);
+    }
+#define PLANE(pattern, bump)                                                                       \
+    "Projection \"orthographic\"\nWorldBegin\nTranslate 0 0 5\n"                                   \
+    "AttributeBegin\nRotate -70 0 1 0\n"                                                           \
+    "Light \"PxrDistantLight\" \"s\" \"float intensity\" [2] \"int areaNormalize\" [1]\n"          \
+    "AttributeEnd\n" pattern                                                                       \
+    "Bxdf \"PxrDiffuse\" \"x\" \"color diffuseColor\" [0.5 0.5 0.5] " bump                         \
+    "\nPolygon \"P\" [-1 1 0  1 1 0  1 -1 0  -1 -1 0] \"st\" [0 1  1 1  1 0  0 0]\nWorldEnd\n"
+#define FRACTAL(scale)                                                                             \
+    "Pattern \"PxrFractal\" \"f\" \"float frequency\" [1.5]\n"                                     \
+    "Pattern \"PxrBump\" \"b\" \"reference float inputBump\" [\"f:resultF\"] \"float scale\" "     \
+    "[" scale "]\n"
+#define BUMP "\"reference normal bumpNormal\" [\"b:resultN\"]"
+    RayesImage *flat = render_text(PLANE("", ""));
+    RayesImage *bumped = render_text(PLANE(FRACTAL("0.1"), BUMP));
+    RayesImage *zero = render_text(PLANE(FRACTAL("0"), BUMP));
+    RayesImage *step =
+        render_text(PLANE("Pattern \"PxrBump\" \"b\" \"string filename\" [\"" RAYES_TEST_TMP
+                          "/test_rib_ris_step.ppm\"] \"float scale\" [0.2]\n",
+                          BUMP));
+    CHECK(flat && bumped && zero && step);
+    if (flat && bumped && zero && step) {
+        int nf = 0, nb = 0;
+        double sf = spread(flat, 1, &nf), sb = spread(bumped, 1, &nb);
+        printf("  plane lit from the side: spread %.4f flat, %.4f bumped (%d, %d pixels)\n", sf, sb,
+               nf, nb);
+        CHECK(nf == SIZE * SIZE && nb == SIZE * SIZE);
+        CHECK(sf < 0.002 && sb > 0.01);
+        double worst = 0.0;
+        for (int k = 0; k < 4 * SIZE * SIZE; k++)
+            worst = fmax(worst, fabs((double)zero->rgba[k] - flat->rgba[k]));
+        CHECK(worst < 1e-4);
+        /* the step's ridge in the middle columns; the halves as flat */
+        double mid = region(step, 1, SIZE / 2 - 1, SIZE / 2 + 1, 4, SIZE - 4);
+        double left = region(step, 1, SIZE / 8 + 1, 3 * SIZE / 8 - 1, 4, SIZE - 4);
+        double right = region(step, 1, 5 * SIZE / 8 + 1, 7 * SIZE / 8 - 1, 4, SIZE - 4);
+        double plain = region(flat, 1, 2, SIZE - 2, 4, SIZE - 4);
+        printf("  step bump: %.4f left, %.4f middle, %.4f right, flat %.4f\n", left, mid, right,
+               plain);
+        CHECK(fabs(left - plain) < 0.01 * plain && fabs(right - plain) < 0.01 * plain);
+        CHECK(fabs(mid - plain) > 0.1 * plain);
+    }
+    rayes_image_free(flat);
+    rayes_image_free(bumped);
+    rayes_image_free(zero);
+    rayes_image_free(step);
+    /* a sphere of radius 1 (0.5 in its object space, scaled by 2) pushed
+     * out by 0.25 object units: radius 1.5, 2.25 times the pixels */
+#define BALL(pattern, displace)                                                                    \
+    "Projection \"orthographic\"\nScreenWindow -2 2 -2 2\nWorldBegin\n"                            \
+    "Translate 0 0 5\nLight \"PxrDomeLight\" \"d\" \"float intensity\" [1]\nScale 2 2 2\n"         \
+    "Attribute \"displacementbound\" \"float sphere\" [0.5]\n" pattern displace                    \
+    "Bxdf \"PxrDiffuse\" \"x\"\nSphere 0.5 -0.5 0.5 360\nWorldEnd\n"
+#define HALF_TEX                                                                                   \
+    "Pattern \"PxrTexture\" \"t\" \"string filename\" [\"" RAYES_TEST_TMP                          \
+    "/test_rib_ris_grey.ppm\"]\n"
+    RayesImage *ball = render_text(BALL("", ""));
+    RayesImage *pushed =
+        render_text(BALL("", "Displace \"PxrDisplace\" \"p\" \"float dispScalar\" [0.25]\n"));
+    RayesImage *textured =
+        render_text(BALL(HALF_TEX, "Displace \"PxrDisplace\" \"p\" "
+                                   "\"reference float dispScalar\" [\"t:resultR\"] "
+                                   "\"float dispAmount\" [0.5]\n"));
+    RayesImage *centred = render_text(
+        BALL(HALF_TEX "Pattern \"PxrDispTransform\" \"c\" \"reference float dispScalar\" "
+                      "[\"t:resultR\"] \"int dispRemapMode\" [1] \"float dispCenter\" [0.502]\n",
+             "Displace \"PxrDisplace\" \"p\" \"reference float dispScalar\" [\"c:resultF\"]\n"));
+    CHECK(ball && pushed && textured && centred);
+    if (ball && pushed && textured && centred) {
+        double a0 = region(ball, 3, 0, SIZE, 0, SIZE), a1 = region(pushed, 3, 0, SIZE, 0, SIZE);
+        double a2 = region(textured, 3, 0, SIZE, 0, SIZE),
+               a3 = region(centred, 3, 0, SIZE, 0, SIZE);
+        printf("  sphere coverage: %.4f, displaced %.4f (x %.3f), textured %.4f, centred %.4f\n",
+               a0, a1, a1 / a0, a2, a3);
+        CHECK_NEAR(a1 / a0, 2.25, 0.12);
+        double r2 = 1.0 + 2.0 * 0.5 * 128.0 / 255.0; /* the grey texel, half, doubled */
+        CHECK_NEAR(a2 / a0, r2 * r2, 0.12);
+        CHECK_NEAR(a3, a0, 0.03 * a0);
+    }
+    rayes_image_free(ball);
+    rayes_image_free(pushed);
+    rayes_image_free(textured);
+    rayes_image_free(centred);
+#undef PLANE
+#undef FRACTAL
+#undef BUMP
+#undef BALL
+#undef HALF_TEX
+}
+
 TEST_MAIN(TEST(test_bxdfs), TEST(test_lights), TEST(test_geometry_lights), TEST(test_integrator),
           TEST(test_options), TEST(test_rendered), TEST(test_dome_visibility),
-          TEST(test_tinted_glass), TEST(test_patterns_rendered))
+          TEST(test_tinted_glass), TEST(test_patterns_rendered), TEST(test_bump_and_displacement))
