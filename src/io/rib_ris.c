@@ -66,9 +66,10 @@ static const char *string(const Param *p, size_t n, const char *name)
 /* ------------------------------------------------------------ Bxdf */
 
 /* The parameters of one translated shader. */
+#define OUT_MAX 12
 typedef struct Out {
-    RayesParam p[8];
-    char pattern[8][160];
+    RayesParam p[OUT_MAX];
+    char pattern[OUT_MAX][160];
     size_t n;
 } Out;
 
@@ -134,6 +135,57 @@ static int referenced(const Param *p, size_t n, const char *name)
     return q && q->d.reference;
 }
 
+/* PxrSurface's subsurface lobe (subsurfaceGain > 0) as rayes' subsurface
+ * (memo 6.2): RenderMan's albedo (subsurfaceColor) and diffuse mean free
+ * path (subsurfaceDmfp times subsurfaceDmfpColor, in mm; unitLength scene
+ * units a mm, 0.1 for centimetres), the dipole for Jensen's and d'Eon's
+ * models and Burley's normalized diffusion for the others, weighed by the
+ * gain, under the specular lobe when there is one (roughness >= 0). A
+ * textured subsurfaceColor tints each point, the medium keeping a
+ * constant albedo; the diffuse lobe gives way to it. */
+static const char *pxr_subsurface(Rib *r, const char *cls, const Param *p, size_t n, Out *o,
+                                  float roughness)
+{
+    static const float albedo[3] = {0.83f, 0.791f, 0.753f},
+                       dmfp_colour[3] = {0.851f, 0.557f, 0.395f};
+    const Param *q = rib_find_param(p, n, "subsurfaceColor");
+    char buf[160];
+    const char *tex = q && q->d.reference && q->d.ty == TY_STRING && q->v->n == 1
+                          ? rib_pattern_ref(r, q->v->s[0], buf, sizeof buf)
+                          : NULL;
+    float a[3], dc[3], d = num(p, n, "subsurfaceDmfp", 10);
+    color(p, n, "subsurfaceColor", albedo, a);
+    color(p, n, "subsurfaceDmfpColor", dmfp_colour, dc);
+    if (tex) { /* the pattern over the albedo the medium keeps: its tint */
+        out_color(o, "albedo", albedo);
+        out_color(o, "reflectance", albedo);
+        snprintf(o->pattern[o->n], sizeof o->pattern[0], "%s", tex);
+        o->p[o->n] = (RayesParam){"reflectance", RAYES_PARAM_PATTERN, {0, 0, 0}, o->pattern[o->n]};
+        o->n++;
+    } else {
+        out_color(o, "albedo", a);
+    }
+    float dmfp[3] = {d * dc[0], d * dc[1], d * dc[2]};
+    out_color(o, "diffusemeanfreepath", dmfp);
+    out_float(o, "unitlength", num(p, n, "unitLength", 0.1f));
+    out_float(o, "ior", num(p, n, "subsurfaceIor", 1.4f));
+    float type = num(p, n, "subsurfaceType", 0);
+    out_string(o, "profile", type == 0 || type == 1 ? "dipole" : "burley");
+    if (type > 2)
+        rib_warn_once(r, "ris subsurface type",
+                      "Bxdf \"%s\": subsurfaceType %g (multiple mean free paths, path traced) is "
+                      "rendered with Burley's normalized diffusion",
+                      cls, (double)type);
+    out_float(o, "Kd", fminf(num(p, n, "subsurfaceGain", 0), 1.0f));
+    out_float(o, "Ks", roughness >= 0.0f ? 1.0f : 0.0f);
+    if (roughness >= 0.0f)
+        out_float(o, "roughness", roughness);
+    if (num(p, n, "diffuseGain", 1) > 0 && num(p, n, "subsurfaceGain", 0) < 1)
+        rib_warn_once(r, "ris subsurface diffuse",
+                      "Bxdf \"%s\": with a subsurface lobe its diffuse lobe is not added", cls);
+    return "subsurface";
+}
+
 /* PxrSurface (and PxrLayerSurface): its glass lobe when it refracts; else
  * its diffuse lobe under a coat of its specular (or clearcoat) lobe, or
  * that lobe alone as a conductor (artistic face colour, or the physical
@@ -166,11 +218,11 @@ static const char *pxr_surface(Rib *r, const char *cls, const Param *p, size_t n
     int spec = max3(face) > 0 || max3(edge) > 0 || max3(rough) > 0 ||
                (physical && (max3(eta) != 1.0f || max3(k) > 0));
     int diffuse = gain > 0 && (max3(dc) > 0 || referenced(p, n, "diffuseColor"));
-    if (num(p, n, "subsurfaceGain", 0) > 0 || num(p, n, "glowGain", 0) > 0 ||
-        num(p, n, "fuzzGain", 0) > 0 || num(p, n, "singlescatterGain", 0) > 0)
+    if (num(p, n, "glowGain", 0) > 0 || num(p, n, "fuzzGain", 0) > 0 ||
+        num(p, n, "singlescatterGain", 0) > 0)
         rib_warn_once(r, "ris lobes",
-                      "Bxdf \"%s\": its subsurface, glow, fuzz and single-scatter lobes are not "
-                      "translated (diffuse, specular, clearcoat and glass are)",
+                      "Bxdf \"%s\": its glow, fuzz and single-scatter lobes are not translated "
+                      "(diffuse, subsurface, specular, clearcoat and glass are)",
                       cls);
     /* the lobe that shines: the primary specular, else the rough
      * specular, else the clearcoat; its colour and roughness */
@@ -181,6 +233,8 @@ static const char *pxr_surface(Rib *r, const char *cls, const Param *p, size_t n
     float shine[3];
     for (int c = 0; c < 3; c++)
         shine[c] = primary ? fmaxf(face[c], edge[c]) : max3(rough) > 0 ? rough[c] : coat[c];
+    if (num(p, n, "subsurfaceGain", 0) > 0)
+        return pxr_subsurface(r, cls, p, n, o, spec || max3(coat) > 0 ? roughness : -1.0f);
     if (diffuse) {
         out_colour_of(r, o, cls, p, n, "diffuseColor", "reflectance", d18, gain);
         if (!spec && max3(coat) <= 0)
@@ -239,7 +293,7 @@ static const char *class_and_params(Rib *r, const Args *a, const char *what, Par
 static void out_normal_map(Rib *r, Out *o, const Param *p, size_t n)
 {
     static const char *const names[] = {"bumpNormal", "diffuseBumpNormal", "specularBumpNormal"};
-    for (int k = 0; k < 3 && o->n < 8; k++) {
+    for (int k = 0; k < 3 && o->n < OUT_MAX; k++) {
         const Param *q = rib_find_param(p, n, names[k]);
         char buf[160];
         const char *name = q && q->d.reference && q->d.ty == TY_STRING && q->v->n == 1

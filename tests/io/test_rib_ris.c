@@ -612,6 +612,52 @@ static void test_patterns_rendered(void)
 #undef TEX
 }
 
+/* PxrSurface's subsurface lobe: rayes' subsurface (memo 6.2) of
+ * RenderMan's albedo and diffuse mean free path (subsurfaceDmfp times its
+ * colour, mm) in unitLength's scale, the model's profile; lit from behind,
+ * a sphere of it glows on the side the camera sees, where a diffuse one
+ * is dark. */
+static void test_subsurface_lobe(void)
+{
+    const RecShader *s =
+        bxdf("Bxdf \"PxrSurface\" \"s\" \"float subsurfaceGain\" [1] "
+             "\"color subsurfaceColor\" [0.5 0.4 0.3] \"float subsurfaceDmfp\" [2] "
+             "\"color subsurfaceDmfpColor\" [1 0.5 0.25] \"float unitLength\" [0.2]");
+    CHECK(strcmp(s->name, "subsurface") == 0);
+    CHECK_NEAR(param(s, "albedo", 1), 0.4, 1e-6);
+    CHECK_NEAR(param(s, "diffusemeanfreepath", 0), 2.0, 1e-6);
+    CHECK_NEAR(param(s, "diffusemeanfreepath", 2), 0.5, 1e-6);
+    CHECK_NEAR(param(s, "unitlength", 0), 0.2, 1e-6);
+    CHECK_NEAR(param(s, "Ks", 0), 0.0, 1e-6); /* no specular lobe */
+    const RayesParam *prof = rec_param(s, "profile");
+    CHECK(prof && prof->string && strcmp(prof->string, "dipole") == 0);
+    s = bxdf("Bxdf \"PxrSurface\" \"s\" \"float subsurfaceGain\" [1] \"int subsurfaceType\" [2] "
+             "\"color specularFaceColor\" [0.04 0.04 0.04]");
+    prof = rec_param(s, "profile");
+    CHECK(prof && prof->string && strcmp(prof->string, "burley") == 0);
+    CHECK_NEAR(param(s, "Ks", 0), 1.0, 1e-6);
+    CHECK_NEAR(param(s, "diffusemeanfreepath", 1), 10 * 0.557, 1e-5); /* RenderMan's defaults */
+#define BACKLIT(bxdf)                                                                              \
+    "Projection \"orthographic\"\nScreenWindow -1.2 1.2 -1.2 1.2\nWorldBegin\nTranslate 0 0 5\n"   \
+    "AttributeBegin\nRotate 180 0 1 0\n"                                                           \
+    "Light \"PxrDistantLight\" \"s\" \"float intensity\" [3] \"int areaNormalize\" [1]\n"          \
+    "AttributeEnd\n" bxdf "\nSphere 1 -1 1 360\nWorldEnd\n"
+    RayesImage *sss = render_text(BACKLIT("Bxdf \"PxrSurface\" \"a\" \"float subsurfaceGain\" [1] "
+                                          "\"float unitLength\" [1]"));
+    RayesImage *dif =
+        render_text(BACKLIT("Bxdf \"PxrSurface\" \"b\" \"color diffuseColor\" [0.8 0.8 0.8]"));
+    CHECK(sss && dif);
+    if (sss && dif) {
+        int q = SIZE / 4;
+        double a = region(sss, 1, q, 3 * q, q, 3 * q), b = region(dif, 1, q, 3 * q, q, 3 * q);
+        printf("  lit from behind, the middle: subsurface %.4f, diffuse %.4f\n", a, b);
+        CHECK(a > 0.02 && b < 0.001);
+    }
+    rayes_image_free(sss);
+    rayes_image_free(dif);
+#undef BACKLIT
+}
+
 /* The spread of channel c over the pixels whose alpha is over 1/2, and
  * their count. */
 static double spread(const RayesImage *a, int c, int *count)
@@ -736,4 +782,5 @@ static void test_bump_and_displacement(void)
 
 TEST_MAIN(TEST(test_bxdfs), TEST(test_lights), TEST(test_geometry_lights), TEST(test_integrator),
           TEST(test_options), TEST(test_rendered), TEST(test_dome_visibility),
-          TEST(test_tinted_glass), TEST(test_patterns_rendered), TEST(test_bump_and_displacement))
+          TEST(test_tinted_glass), TEST(test_patterns_rendered), TEST(test_bump_and_displacement),
+          TEST(test_subsurface_lobe))
