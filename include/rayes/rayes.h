@@ -227,7 +227,8 @@ RAYES_API RayesError rayes_scene_set_displacement_bound(RayesScene *scene, float
  *   "imagemap"      "filename" (STRING, on the texture search path) times
  *                   "scale", "invert" (1: 1 - value), "encoding" (STRING:
  *                   "sRGB", "linear" or "gamma G", for integer files; default
- *                   the file's), "channel" (-1: RGB, else that channel grey)
+ *                   the file's), "channel" (-1: RGB, 0 to 3 that channel grey,
+ *                   -2 the matte: alpha if the file has it, else channel 0)
  *   "bilerp"        v00 v01 v10 v11 (constants) over (u, v)
  *   "dots"          inside, outside: polka dots on the (u, v) cells
  *   "fbm", "wrinkled", "windy", "marble"  pbrt's noise patterns (octaves,

@@ -229,9 +229,12 @@ typedef struct Material {
     char name[128];
     float Kd[3], Ks[3], Ke[3];
     float Ns;           /* Phong exponent; -1: not given */
-    float d;            /* dissolve (1 opaque), read, not rendered */
+    float d;            /* dissolve: the opacity (1 opaque) */
     int illum;          /* illumination model, read, not rendered */
     char map_Kd[1024];  /* texture path, resolved against the MTL's directory; "" none */
+    char map_d[1024];   /* the opacity's texture (a cut-out), resolved likewise; "" none */
+    int map_d_channel;  /* its channel: 0-3, or -2 the matte (alpha if any, else grey) */
+    int map_d_sent;     /* its pattern made (once per material) */
     int defined;        /* given by a newmtl */
 } Material;
 
@@ -350,6 +353,27 @@ static int mtl_map(Lexer *L, const char *mtl_dir, char *out, size_t out_size)
     return 0;
 }
 
+/* A map's "-imfchan c" option (r, g, b: that channel; m: the matte;
+ * l, z: the first), read ahead of mtl_map: the channel, -2 (the matte,
+ * map_d's default) when not given. The lexer is left where it was. */
+static int map_channel(Lexer *L)
+{
+    const char *save = L->p, *tok;
+    size_t n;
+    int ch = -2;
+    while ((n = lex_token(L, &tok)) > 0)
+        if (is_kw(tok, n, "-imfchan")) {
+            n = lex_token(L, &tok);
+            ch = n == 1 && tok[0] == 'r'   ? 0
+                 : n == 1 && tok[0] == 'g' ? 1
+                 : n == 1 && tok[0] == 'b' ? 2
+                 : n == 1 && tok[0] == 'm' ? -2
+                                           : 0;
+        }
+    L->p = save;
+    return ch;
+}
+
 static void dir_of(const char *path, char *dir, size_t size)
 {
     const char *slash = strrchr(path, '/');
@@ -419,6 +443,10 @@ static int mtl_statement(Obj *o, Lexer *L, const char *mtl_dir, const char *kw, 
     }
     if (is_kw(kw, n, "map_Kd"))
         return mtl_map(L, mtl_dir, mt->map_Kd, sizeof mt->map_Kd);
+    if (is_kw(kw, n, "map_d")) {
+        mt->map_d_channel = map_channel(L);
+        return mtl_map(L, mtl_dir, mt->map_d, sizeof mt->map_d);
+    }
     char key[40];
     snprintf(key, sizeof key, "mtl %.*s", (int)(n < 30 ? n : 30), kw);
     char s[32];
@@ -833,19 +861,57 @@ static float roughness_of(float Ns)
     return Ns <= 1.0f ? 1.0f : fmaxf(1.0f / Ns, 0.001f);
 }
 
+/* The opacity of material m as the reserved shader parameter "Os" in *out
+ * (its name NULL for an opaque material): d, or map_d's texture (times d),
+ * a pattern made once per material under a name that starts with a space
+ * (cutout holds it). The texture's values are opacities, read linear. */
+static RayesError opacity_of(Emit *e, Material *m, char cutout[48], RayesParam *out)
+{
+    float d = fminf(fmaxf(m->d, 0.0f), 1.0f);
+    out->name = NULL;
+    if (!m->map_d[0]) {
+        if (d < 1.0f)
+            *out = (RayesParam){"Os", RAYES_PARAM_COLOR, {d, d, d}, NULL};
+        return RAYES_OK;
+    }
+    snprintf(cutout, 48, " obj map_d %zu", (size_t)(m - e->o->mats));
+    if (!m->map_d_sent) {
+        if (!e->sink->pattern) {
+            obj_warn(e->o, "map_d sink", "%s: map_d cut-outs are not kept by this output",
+                     e->o->name);
+            return RAYES_OK;
+        }
+        RayesParam q[4] = {{"filename", RAYES_PARAM_STRING, {0, 0, 0}, m->map_d},
+                           {"encoding", RAYES_PARAM_STRING, {0, 0, 0}, "linear"},
+                           {"channel", RAYES_PARAM_FLOAT, {(float)m->map_d_channel, 0, 0}, NULL},
+                           {"scale", RAYES_PARAM_FLOAT, {d, 0, 0}, NULL}};
+        RayesError r = e->sink->pattern(e->sink->target, cutout, "imagemap", q, 4);
+        if (r != RAYES_OK) {
+            char what[200];
+            snprintf(what, sizeof what, "material \"%s\": map_d", m->name);
+            return sink_fail(e, r, what);
+        }
+        m->map_d_sent = 1;
+    }
+    *out = (RayesParam){"Os", RAYES_PARAM_PATTERN, {1, 1, 1}, cutout};
+    return RAYES_OK;
+}
+
 /* The shader of a material (NULL: the default, matte grey). */
-static RayesError material_shader(Emit *e, const Material *m)
+static RayesError material_shader(Emit *e, Material *m)
 {
     static const float grey[3] = {0.8f, 0.8f, 0.8f};
     const float *Kd = m ? m->Kd : grey;
-    RayesParam p[6];
+    RayesParam p[7];
     size_t n = 0;
     p[n++] = (RayesParam){"Cs", RAYES_PARAM_COLOR, {Kd[0], Kd[1], Kd[2]}, NULL};
     if (!m)
         return set_shader(e, "matte", p, n, "(none)");
-    if (m->d < 1.0f)
-        obj_warn(e->o, "dissolve", "%s: material \"%s\": transparency (d, Tr) is not rendered",
-                 e->o->name, m->name);
+    char cutout[48];
+    RayesError r = opacity_of(e, m, cutout, &p[n]);
+    if (r != RAYES_OK)
+        return r;
+    n += p[n].name != NULL;
     float ks = max3(m->Ks);
     if (!m->map_Kd[0] && !(ks > 0.0f))
         return set_shader(e, "matte", p, n, m->name);
@@ -1029,7 +1095,7 @@ static RayesError emit_material(Emit *e, int mi)
 {
     Obj *o = e->o;
     Mesh m = {{0}, {0}};
-    const Material *mt = mi >= 0 ? &o->mats[mi] : NULL;
+    Material *mt = mi >= 0 ? &o->mats[mi] : NULL;
     RayesError r = RAYES_OK;
     size_t k = 0;
     for (size_t f = 0; f < o->face_nv.n && r == RAYES_OK; k += (size_t)o->face_nv.a[f], f++)

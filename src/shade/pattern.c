@@ -369,8 +369,8 @@ static int check_pattern(Pattern *p, const ClassDesc *c, char *err, size_t err_s
                      p->encoding);
             return -1;
         }
-        if (!(p->num[2] >= -1.0f && p->num[2] <= 3.0f)) {
-            snprintf(err, err_size, "pattern \"imagemap\": channel must be -1 to 3");
+        if (!(p->num[2] >= -2.0f && p->num[2] <= 3.0f)) {
+            snprintf(err, err_size, "pattern \"imagemap\": channel must be -2 to 3");
             return -1;
         }
     }
@@ -693,6 +693,10 @@ static void eval_image(const Pattern *p, Eval *e, Rgb *out)
             alpha[i] = 1.0f;
     }
     int ch = (int)p->num[2];
+    if (ch == -2) { /* the matte: the alpha channel if the file has one, else the first */
+        int nc = e->ts ? texture_channels(e->ts, p->filename, p->encoding) : 0;
+        ch = nc == 2 || nc >= 4 ? 3 : 0;
+    }
     for (size_t i = 0; i < n; i++) {
         if (ch >= 0)
             grey(out[i], ch == 3 ? alpha[i] : out[i][ch]);

@@ -180,6 +180,12 @@ int texture_lookup_encoded(TextureSystem *ts, const char *name, const char *enco
     return -1;
 }
 
+int texture_channels(TextureSystem *ts, const char *name, const char *encoding)
+{
+    void *impl = impl_of(ts);
+    return impl ? module->channels(impl, name, encoding) : 0;
+}
+
 void texture_get_stats(TextureSystem *ts, TextureStats *stats)
 {
     void *impl = atomic_load(&ts->impl);

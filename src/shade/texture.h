@@ -75,6 +75,10 @@ int texture_lookup_encoded(TextureSystem *ts, const char *name, const char *enco
                            TextureWrap wrap, size_t n, const float *s, const float *t,
                            const float *ds, const float *dt, float (*rgb)[3], float *alpha);
 
+/* How many channels texture `name` has (3 rgb, 4 rgba, 1 grey, 2 grey and
+ * alpha), found as a lookup finds it; 0 when it cannot be read. */
+int texture_channels(TextureSystem *ts, const char *name, const char *encoding);
+
 /* The statistics so far (loads: tiles read; file_reads: files opened;
  * evictions: tiles no longer resident; bytes: OpenImageIO's cache memory;
  * peak_bytes: an estimate from its peak tile count). */

@@ -17,7 +17,7 @@
 
 #include "shade/texture.h"
 
-#define TEXTURE_MODULE_VERSION 2
+#define TEXTURE_MODULE_VERSION 3
 #define TEXTURE_MODULE_ENTRY "rayes_texture_module"
 #define TEXTURE_MODULE_FILE "librayes_oiio.so"
 
@@ -32,6 +32,7 @@ typedef struct TextureModule {
                   const float *s, const float *t, const float *ds, const float *dt, float (*rgb)[3],
                   float *alpha);
     void (*get_stats)(void *ts, TextureStats *stats);
+    int (*channels)(void *ts, const char *name, const char *encoding);
     int (*read_image)(const char *path, int *w, int *h, float **rgba, char *err,
                       size_t err_size);
 } TextureModule;

@@ -14,6 +14,8 @@
 
 #include "io/obj.h"
 #include "io/record_sink.h"
+#include "io/sink.h"
+#include "rayes/rayes.h"
 #include "test.h"
 
 #ifndef RAYES_TEST_TMP
@@ -320,6 +322,116 @@ static void test_read_file(void)
     CHECK(strstr(err, DIR "/none.obj") != NULL);
 }
 
+/* The red and green means over columns [x0, x1) and rows [y0, y1). */
+static void means(const RayesImage *img, int x0, int x1, int y0, int y1, double *r, double *g)
+{
+    double sr = 0.0, sg = 0.0;
+    for (int y = y0; y < y1; y++)
+        for (int x = x0; x < x1; x++) {
+            const float *px = img->rgba + 4 * ((size_t)y * (size_t)img->width + (size_t)x);
+            sr += px[0], sg += px[1];
+        }
+    *r = sr / ((x1 - x0) * (y1 - y0)), *g = sg / ((x1 - x0) * (y1 - y0));
+}
+
+/* A green quad with the material `cut` before a red wall, rendered at 64
+ * x 64 (the quad covers the middle half of the view). */
+static RayesImage *render_cut(const char *cut)
+{
+    char mtl[512];
+    snprintf(mtl, sizeof mtl, "newmtl back\nKd 0.8 0.05 0.05\nnewmtl cut\nKd 0.05 0.8 0.05\n%s\n",
+             cut);
+    test_write_text(DIR "/cut.mtl", mtl);
+    test_write_text(DIR "/cut.obj", "mtllib cut.mtl\n"
+                                    "v -1 -1 0\nv 1 -1 0\nv 1 1 0\nv -1 1 0\n"
+                                    "v -9 -9 -1\nv 9 -9 -1\nv 9 9 -1\nv -9 9 -1\n"
+                                    "vt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\n"
+                                    "usemtl back\nf 5 6 7 8\nusemtl cut\nf 1/1 2/2 3/3 4/4\n");
+    RayesScene *s = rayes_scene_new();
+    IoSink sink = io_sink_scene(s);
+    IoSettings st;
+    io_settings_init(&st);
+    RayesImage *img = NULL;
+    CHECK(io_obj_read(DIR "/cut.obj", &sink, NULL, &st, err, sizeof err) == RAYES_OK);
+    const float eye[3] = {0, 0, 5.4f}, at[3] = {0, 0, 0}, up[3] = {0, 1, 0};
+    CHECK(rayes_scene_set_camera(s, eye, at, up, 43.6f) ==
+          RAYES_OK); /* the quad: the middle half */
+    if (rayes_scene_commit(s) == RAYES_OK) {
+        RayesRenderOptions o;
+        rayes_render_options_init(&o, RAYES_QUALITY_PREVIEW);
+        o.width = o.height = 64;
+        o.spp = 4;
+        o.bounces = 0;
+        o.threads = 2;
+        CHECK(rayes_render(s, &o, &img, NULL) == RAYES_OK);
+    }
+    rayes_scene_release(s);
+    return img;
+}
+
+/* MTL transparency: d (and Tr) is the opacity, map_d a cut-out by its
+ * texture's matte (a grey mask's value, an RGBA image's alpha) or the
+ * channel -imfchan names; where it is 0 the wall behind shows. */
+static void test_transparency(void)
+{
+    mkdir(RAYES_TEST_TMP, 0777);
+    mkdir(DIR, 0777);
+    /* a grey mask: its left half opaque; an RGBA TGA: its top half */
+    FILE *f = fopen(DIR "/mask.ppm", "wb");
+    CHECK(f != NULL);
+    if (f) {
+        fprintf(f, "P6 8 1 255\n");
+        for (int k = 0; k < 24; k++)
+            fputc(k < 12 ? 255 : 0, f);
+        fclose(f);
+    }
+    f = fopen(DIR "/leaf.tga", "wb");
+    CHECK(f != NULL);
+    if (f) {
+        const unsigned char hdr[18] = {0, 0, 2, 0, 0, 0, 0, 0, 0, 0, 0, 0, 1, 0, 8, 0, 32, 0x28};
+        fwrite(hdr, 1, sizeof hdr, f);
+        for (int y = 0; y < 8; y++) { /* top-left origin: rows top down, BGRA */
+            const unsigned char px[4] = {40, 200, 40, (unsigned char)(y < 4 ? 255 : 0)};
+            fwrite(px, 1, sizeof px, f);
+        }
+        fclose(f);
+    }
+    RayesImage *solid = render_cut("");
+    RayesImage *half = render_cut("d 0.5");
+    RayesImage *tr = render_cut("Tr 0.5");
+    RayesImage *mask = render_cut("map_d mask.ppm");
+    RayesImage *leaf = render_cut("map_d leaf.tga");
+    RayesImage *red = render_cut("map_d -imfchan r leaf.tga"); /* its red: 40 / 255, nearly clear */
+    CHECK(solid && half && tr && mask && leaf && red);
+    if (solid && half && tr && mask && leaf && red) {
+        double r0, g0, r1, g1, r2, g2, r3, g3;
+        means(solid, 24, 40, 24, 40, &r0, &g0);
+        CHECK(g0 > 4 * r0); /* green */
+        means(half, 24, 40, 24, 40, &r1, &g1);
+        means(tr, 24, 40, 24, 40, &r2, &g2);
+        printf("  opaque quad r %.3f g %.3f; d 0.5: r %.3f g %.3f\n", r0, g0, r1, g1);
+        CHECK(r1 > 2 * r0 && g1 < 0.8 * g0 && fabs(r1 - r2) < 1e-6 && fabs(g1 - g2) < 1e-6);
+        /* the mask: the quad's left quarter green, its right quarter the wall */
+        means(mask, 18, 22, 24, 40, &r1, &g1);
+        means(mask, 42, 46, 24, 40, &r2, &g2);
+        printf("  mask: left r %.3f g %.3f, right r %.3f g %.3f\n", r1, g1, r2, g2);
+        CHECK(g1 > 4 * r1 && r2 > 4 * g2);
+        /* the TGA's alpha: its top quarter green, its bottom quarter the wall */
+        means(leaf, 24, 40, 18, 22, &r1, &g1);
+        means(leaf, 24, 40, 42, 46, &r2, &g2);
+        means(red, 24, 40, 18, 22, &r3, &g3);
+        printf("  alpha: top r %.3f g %.3f, bottom r %.3f g %.3f; red channel: r %.3f g %.3f\n", r1,
+               g1, r2, g2, r3, g3);
+        CHECK(g1 > 4 * r1 && r2 > 4 * g2 && r3 > 2 * g3);
+    }
+    rayes_image_free(solid);
+    rayes_image_free(half);
+    rayes_image_free(tr);
+    rayes_image_free(mask);
+    rayes_image_free(leaf);
+    rayes_image_free(red);
+}
+
 TEST_MAIN(TEST(test_face_syntax), TEST(test_ngons), TEST(test_materials),
           TEST(test_default_camera_and_light), TEST(test_errors), TEST(test_unknown_statements),
-          TEST(test_read_file), TEST(test_normals_and_texture_coordinates))
+          TEST(test_read_file), TEST(test_normals_and_texture_coordinates), TEST(test_transparency))

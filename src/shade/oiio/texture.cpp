@@ -352,6 +352,12 @@ extern "C" int texture_lookup_encoded(TextureSystem *ts, const char *name, const
     return 0;
 }
 
+extern "C" int texture_channels(TextureSystem *ts, const char *name, const char *encoding)
+{
+    Entry e = name && name[0] ? entry_of(ts, name, encoding) : Entry();
+    return e.path.empty() ? 0 : e.channels;
+}
+
 extern "C" void texture_get_stats(TextureSystem *ts, TextureStats *st)
 {
     std::memset(st, 0, sizeof *st);
@@ -469,10 +475,15 @@ static void get_stats(void *ts, TextureStats *stats)
     texture_get_stats(static_cast<TextureSystem *>(ts), stats);
 }
 
+static int channels(void *ts, const char *name, const char *encoding)
+{
+    return texture_channels(static_cast<TextureSystem *>(ts), name, encoding);
+}
+
 extern "C" __attribute__((visibility("default"))) const TextureModule *rayes_texture_module(void)
 {
-    static const TextureModule table = {TEXTURE_MODULE_VERSION, set_warning, system_new,
-                                        system_free,            lookup,      get_stats,
-                                        texture_read_image};
+    static const TextureModule table = {
+        TEXTURE_MODULE_VERSION, set_warning, system_new, system_free, lookup, get_stats, channels,
+        texture_read_image};
     return &table;
 }
