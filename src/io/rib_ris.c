@@ -309,6 +309,14 @@ static void out_normal_map(Rib *r, Out *o, const Param *p, size_t n)
     }
 }
 
+/* Whether a reference ("node:output", or "node") names node. */
+static int names_node(const char *ref, const char *node)
+{
+    const char *colon = strrchr(ref, ':');
+    size_t len = colon ? (size_t)(colon - ref) : strlen(ref);
+    return strlen(node) == len && strncmp(node, ref, len) == 0;
+}
+
 /* The PxrBump a Bxdf's bumpNormal references ("bump:resultN"), or NULL. */
 static const struct RisBump *bump_of(const Rib *r, const Param *p, size_t n)
 {
@@ -317,10 +325,8 @@ static const struct RisBump *bump_of(const Rib *r, const Param *p, size_t n)
         const Param *q = rib_find_param(p, n, names[k]);
         if (!q || !q->d.reference || q->d.ty != TY_STRING || q->v->n != 1)
             continue;
-        const char *ref = q->v->s[0], *colon = strrchr(ref, ':');
-        size_t len = colon ? (size_t)(colon - ref) : strlen(ref);
         for (size_t b = r->n_bumps; b-- > 0;)
-            if (strlen(r->bumps[b].name) == len && strncmp(r->bumps[b].name, ref, len) == 0)
+            if (names_node(q->v->s[0], r->bumps[b].name))
                 return &r->bumps[b];
     }
     return NULL;
@@ -478,10 +484,8 @@ static const struct RisManifold *manifold_of(const Rib *r, const Param *p, size_
     const Param *q = rib_find_param(p, n, "manifold");
     if (!q || !q->d.reference || q->d.ty != TY_STRING || q->v->n != 1)
         return NULL;
-    const char *ref = q->v->s[0], *colon = strrchr(ref, ':');
-    size_t len = colon ? (size_t)(colon - ref) : strlen(ref);
     for (size_t k = r->n_manifolds; k-- > 0;)
-        if (strlen(r->manifolds[k].name) == len && strncmp(r->manifolds[k].name, ref, len) == 0)
+        if (names_node(q->v->s[0], r->manifolds[k].name))
             return &r->manifolds[k];
     return NULL;
 }
