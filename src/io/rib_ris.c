@@ -759,8 +759,8 @@ static int make_light(Rib *r, const char *handle, const char *cls, const float L
         rib_warn_once(
             r, key,
             "light \"%s\" is not one rayes translates (PxrRectLight, PxrDiskLight, "
-            "PxrSphereLight, PxrDistantLight, PxrDomeLight, PxrEnvDayLight); the light is "
-            "skipped",
+            "PxrSphereLight, PxrDistantLight, PxrDomeLight, PxrEnvDayLight, PxrMeshLight); "
+            "the light is skipped",
             cls);
         return 0;
     }
@@ -944,6 +944,35 @@ static int day_light(Rib *r, const char *handle, const char *cls, const Param *p
 }
 
 /* Light "class" "handle" params (RenderMan 21 and later). */
+/* PxrMeshLight: the geometry that follows in its attribute block emits
+ * radiance L from its front, as under a classic AreaLightSource (a few
+ * quads as quad lights, other meshes as one mesh light, quadrics as
+ * theirs); areaNormalize divides by each shape's area. Its handle is an
+ * area light's (Illuminate knows it; area lights light everything). */
+static int mesh_light(Rib *r, const char *handle, const float L[3], int normalize)
+{
+    if (r->in_object || r->rec) {
+        rib_warn_once(r, "light in object", "lights inside ObjectBegin are ignored");
+        return 0;
+    }
+    if (r->n_area_handles >= RIB_MAX_LIGHTS)
+        return rib_error(r, "more than %d area light handles", RIB_MAX_LIGHTS);
+    char(*nh)[RIB_MAX_HANDLE] = realloc(r->area_handles, (r->n_area_handles + 1) * sizeof *nh);
+    if (!nh)
+        return rib_error(r, "out of memory");
+    r->area_handles = nh;
+    snprintf(nh[r->n_area_handles++], RIB_MAX_HANDLE, "%s", handle);
+    memcpy(r->a.area_L, L, sizeof r->a.area_L);
+    r->a.area_normalize = normalize;
+    r->a.area_point_units = 0;
+    r->a.area_map[0] = '\0';
+    r->a.area_unseen = 0;
+    r->a.area_twosided = 0;
+    r->a.area = 1;
+    r->lit = 1;
+    return 0;
+}
+
 static int h_light(Rib *r, const Args *a)
 {
     r->ris = 1;
@@ -967,6 +996,11 @@ static int h_light(Rib *r, const Args *a)
         colour_temperature(num(p, n, "temperature", 6500), tint);
         for (int k = 0; k < 3; k++)
             L[k] *= tint[k];
+    }
+    if (strcasecmp(cls, "PxrMeshLight") == 0) {
+        int e = mesh_light(r, handle, L, num(p, n, "areaNormalize", 0) != 0);
+        free(p);
+        return e;
     }
     const char *map = string(p, n, "lightColorMap");
     int day = strcasecmp(cls, "PxrEnvDayLight") == 0 || strcasecmp(cls, "PxrStdEnvDayLight") == 0;

@@ -612,6 +612,23 @@ static void test_patterns_rendered(void)
 #undef TEX
 }
 
+/* PxrMeshLight: the geometry after it in its block emits intensity
+ * times lightColor (a quad as a quad light, triangles as a mesh light);
+ * geometry after the block does not. */
+static void test_mesh_light(void)
+{
+    CHECK(rib(WORLD(
+              "AttributeBegin\n"
+              "Light \"PxrMeshLight\" \"m\" \"float intensity\" [2] \"color lightColor\" [1 0.5 "
+              "0.25] \"float exposure\" [1]\n"
+              "Polygon \"P\" [0 0 1  1 0 1  1 1 1  0 1 1]\n"
+              "PointsPolygons [3 3] [0 1 2 0 2 3] \"P\" [0 0 2  1 0 2  1 1 2  0 1 2.5]\n"
+              "AttributeEnd\n" TRI)) == RAYES_OK);
+    CHECK(rec.n_area == 1 && rec.n_mesh_light == 1 && rec.n_mesh == 1);
+    CHECK(rec.area_L[0][0] == 4.0f && rec.area_L[0][2] == 1.0f); /* 2 x 2^1 x colour */
+    CHECK(rec.mesh_light_faces[0] == 2 && rec.mesh_light_L[0][1] == 2.0f);
+}
+
 /* PxrSurface's subsurface lobe: rayes' subsurface (memo 6.2) of
  * RenderMan's albedo and diffuse mean free path (subsurfaceDmfp times its
  * colour, mm) in unitLength's scale, the model's profile; lit from behind,
@@ -783,4 +800,4 @@ static void test_bump_and_displacement(void)
 TEST_MAIN(TEST(test_bxdfs), TEST(test_lights), TEST(test_geometry_lights), TEST(test_integrator),
           TEST(test_options), TEST(test_rendered), TEST(test_dome_visibility),
           TEST(test_tinted_glass), TEST(test_patterns_rendered), TEST(test_bump_and_displacement),
-          TEST(test_subsurface_lobe))
+          TEST(test_subsurface_lobe), TEST(test_mesh_light))
