@@ -121,6 +121,9 @@ typedef struct Attr {
     const ShaderRec *displacement;
     float shading_rate;
     float bound;
+    int light_filter; /* a LightFilter in force (RIS): its gain multiplies the
+                         lights declared after it in the block */
+    float light_filter_gain[3];
     int area;                  /* AreaLightSource in force */
     int area_twosided;         /* its "twosided" (rayes's own parameter; default 0) */
     unsigned char on[RIB_MAX_LIGHTS / 8]; /* bit k: Rib.lights[k] is on */

@@ -973,6 +973,65 @@ static int mesh_light(Rib *r, const char *handle, const float L[3], int normaliz
     return 0;
 }
 
+/* LightFilter "class" "handle" params (RenderMan 21 and later): bound
+ * to the lights declared after it in its attribute block, as a Bxdf is to
+ * geometry (the last one wins). PxrIntMultLightFilter scales them by
+ * intensity times 2^exposure (invert: by its inverse), tinted by
+ * colorTint; the filters that shape or block light (barn doors, blockers,
+ * rods, gobos, cookies, ramps) are not built: the lights shine unfiltered,
+ * one warning naming the class. */
+static int h_light_filter(Rib *r, const Args *a)
+{
+    r->ris = 1;
+    Param *p;
+    size_t n;
+    const char *cls = class_and_params(r, a, "a light filter class", &p, &n);
+    if (!cls)
+        return -1;
+    if (strcasecmp(cls, "PxrIntMultLightFilter") == 0) {
+        static const float one[3] = {1, 1, 1};
+        float g =
+            num(p, n, "intensity", 1) * exp2f(fminf(fmaxf(num(p, n, "exposure", 0), -126), 126));
+        if (num(p, n, "invert", 0) != 0)
+            g = g != 0.0f ? 1.0f / g : 0.0f;
+        float tint[3];
+        color(p, n, "colorTint", one, tint);
+        for (int k = 0; k < 3; k++)
+            r->a.light_filter_gain[k] = g * tint[k];
+        r->a.light_filter = 1;
+        if (num(p, n, "saturation", 1) != 1)
+            rib_warn_once(r, "light filter saturation",
+                          "LightFilter \"%s\": saturation is not applied", cls);
+    } else {
+        r->a.light_filter = 0; /* the last one bound wins */
+        char key[128];
+        snprintf(key, sizeof key, "light filter %.100s", cls);
+        rib_warn_once(r, key,
+                      "LightFilter \"%s\" is not built (of RenderMan's filters only "
+                      "PxrIntMultLightFilter is): the lights shine unfiltered",
+                      cls);
+    }
+    free(p);
+    return 0;
+}
+
+/* EnableLightFilter "light" "filter" on: filters are on by default; one
+ * turned off for the primitives after it is not (one warning). */
+static int h_enable_light_filter(Rib *r, const Args *a)
+{
+    size_t i = 0;
+    char light[RIB_MAX_HANDLE], filter[RIB_MAX_HANDLE];
+    float on;
+    if (rib_get_handle(r, a, &i, light) != 0 || rib_get_handle(r, a, &i, filter) != 0 ||
+        rib_get_floats(r, a, &i, &on, 1, "0 or 1") != 0)
+        return -1;
+    if (on == 0)
+        rib_warn_once(r, "EnableLightFilter",
+                      "EnableLightFilter: turning a filter off for some primitives is not "
+                      "built; ignored");
+    return 0;
+}
+
 static int h_light(Rib *r, const Args *a)
 {
     r->ris = 1;
@@ -997,6 +1056,9 @@ static int h_light(Rib *r, const Args *a)
         for (int k = 0; k < 3; k++)
             L[k] *= tint[k];
     }
+    if (r->a.light_filter) /* RenderMan binds a filter to the lights after it */
+        for (int k = 0; k < 3; k++)
+            L[k] *= r->a.light_filter_gain[k];
     if (strcasecmp(cls, "PxrMeshLight") == 0) {
         int e = mesh_light(r, handle, L, num(p, n, "areaNormalize", 0) != 0);
         free(p);
@@ -1180,6 +1242,12 @@ static int h_pattern(Rib *r, const Args *a)
 }
 
 const RibRequest rib_ris_requests[] = {
-    {"Pattern", h_pattern},       {"Bxdf", h_bxdf},         {"Light", h_light},
-    {"Integrator", h_integrator}, {"Displace", h_displace}, {NULL, NULL},
+    {"Pattern", h_pattern},
+    {"Bxdf", h_bxdf},
+    {"Light", h_light},
+    {"Integrator", h_integrator},
+    {"Displace", h_displace},
+    {"LightFilter", h_light_filter},
+    {"EnableLightFilter", h_enable_light_filter},
+    {NULL, NULL},
 };

@@ -612,6 +612,30 @@ static void test_patterns_rendered(void)
 #undef TEX
 }
 
+/* LightFilter binds to the lights after it in its block:
+ * PxrIntMultLightFilter scales them (intensity 2^exposure colorTint);
+ * lights after the block, and filters rayes does not build, leave them
+ * as they are; EnableLightFilter is read. They refused the file. */
+static void test_light_filters(void)
+{
+    CHECK(rib(WORLD("AttributeBegin\n"
+                    "LightFilter \"PxrIntMultLightFilter\" \"f\" \"float intensity\" [3] "
+                    "\"float exposure\" [-1] \"color colorTint\" [1 0.5 1]\n"
+                    "Light \"PxrRectLight\" \"a\" \"float intensity\" [2]\n"
+                    "AttributeEnd\n"
+                    "Light \"PxrRectLight\" \"b\" \"float intensity\" [2]\n"
+                    "LightFilter \"PxrBarnDoorLightFilter\" \"d\" \"float top\" [0.2]\n"
+                    "Light \"PxrRectLight\" \"c\" \"float intensity\" [2]\n"
+                    "EnableLightFilter \"c\" \"d\" 0\n" TRI)) == RAYES_OK);
+    CHECK(rec.n_light == 3);
+    if (rec.n_light == 3) {
+        CHECK_NEAR(param(&rec.light[0], "intensity", 0), 3, 1e-6); /* 2 x 3 / 2 */
+        CHECK_NEAR(param(&rec.light[0], "lightcolor", 1), 0.5, 1e-6);
+        CHECK_NEAR(param(&rec.light[1], "intensity", 0), 2, 1e-6);
+        CHECK_NEAR(param(&rec.light[2], "intensity", 0), 2, 1e-6);
+    }
+}
+
 /* PxrMeshLight: the geometry after it in its block emits intensity
  * times lightColor (a quad as a quad light, triangles as a mesh light);
  * geometry after the block does not. */
@@ -800,4 +824,4 @@ static void test_bump_and_displacement(void)
 TEST_MAIN(TEST(test_bxdfs), TEST(test_lights), TEST(test_geometry_lights), TEST(test_integrator),
           TEST(test_options), TEST(test_rendered), TEST(test_dome_visibility),
           TEST(test_tinted_glass), TEST(test_patterns_rendered), TEST(test_bump_and_displacement),
-          TEST(test_subsurface_lobe), TEST(test_mesh_light))
+          TEST(test_subsurface_lobe), TEST(test_mesh_light), TEST(test_light_filters))
