@@ -248,6 +248,11 @@ typedef struct Obj {
     IntVec face_idx;         /* 0-based vertex indices, face after face (per corner) */
     IntVec face_vt, face_vn; /* per corner: 0-based vt and vn indices, -1 none */
     IntVec face_mat;         /* material per face, -1 the default */
+    IntVec face_s;           /* smoothing group per face, 0 off */
+    int cur_s;               /* the s statement's group in force, 0 off */
+    int any_s;               /* some face is in a smoothing group */
+    float *smooth_N;         /* per corner: its smoothing group's normal at its vertex
+                                (obj_smooth_normals), NULL when no face is in one */
     Material *mats;
     size_t n_mats, cap_mats;
     int cur_mat;             /* usemtl's, -1 the default */
@@ -577,8 +582,10 @@ static int obj_face(Obj *o, Lexer *L, const char *kw)
         return lex_error_at(L, count ? tok : kw, "expected at least 3 vertices in a face, found %d",
                             count);
     }
-    if (ipush(&o->face_nv, count) != 0 || ipush(&o->face_mat, o->cur_mat) != 0)
+    if (ipush(&o->face_nv, count) != 0 || ipush(&o->face_mat, o->cur_mat) != 0 ||
+        ipush(&o->face_s, o->cur_s) != 0)
         return oom(L);
+    o->any_s |= o->cur_s != 0;
     return 0;
 }
 
@@ -641,8 +648,20 @@ static int obj_statement(Obj *o, Lexer *L, const char *kw, size_t n)
         return obj_attribute(L, 3, 3, 3, &o->n_vn, &o->vn);
     if (is_kw(kw, n, "f") || is_kw(kw, n, "fo"))
         return obj_face(o, L, kw);
-    if (is_kw(kw, n, "g") || is_kw(kw, n, "o") || is_kw(kw, n, "s")) {
-        const char *tok; /* names and smoothing groups: read, not used */
+    if (is_kw(kw, n, "s")) { /* s N, s off (0): the smoothing group of the faces after */
+        const char *tok;
+        size_t k = lex_token(L, &tok);
+        float g;
+        if (is_kw(tok, k, "off"))
+            o->cur_s = 0;
+        else if (k > 0 && parse_float(tok, k, &g) == 0 && g >= 0 && g == floorf(g) && g < 1e9f)
+            o->cur_s = (int)g;
+        else
+            return lex_expected(L, tok, k, "a smoothing group number or off");
+        return lex_expect_end(L, "the end of the line");
+    }
+    if (is_kw(kw, n, "g") || is_kw(kw, n, "o")) {
+        const char *tok; /* names: read, not used */
         while (lex_token(L, &tok) > 0)
             ;
         return 0;
@@ -926,6 +945,58 @@ static RayesError material_shader(Emit *e, Material *m)
     return set_shader(e, m->map_Kd[0] ? "paintedplastic" : "plastic", p, n, m->name);
 }
 
+/* Smoothing groups: every corner's normal in o->smooth_N. A corner of a
+ * face in group g > 0 takes the sum of the area-weighted (Newell) normals
+ * of the faces of group g around its vertex, across materials, as OBJ's
+ * smoothing groups mean; a corner of a face in no group takes its face's
+ * normal (flat). The sums live in an open-addressed table keyed by
+ * (vertex, group). Returns 0, or -1 when out of memory. */
+static int obj_smooth_normals(Obj *o)
+{
+    size_t corners = o->face_idx.n, cap = 16;
+    while (cap < 2 * corners)
+        cap *= 2;
+    uint64_t *keys = malloc(cap * sizeof *keys);
+    double(*sum)[3] = calloc(cap, sizeof *sum);
+    o->smooth_N = malloc((3 * corners + 1) * sizeof *o->smooth_N);
+    double(*face_N)[3] = malloc((o->face_nv.n + 1) * sizeof *face_N);
+    size_t *slot = malloc((corners + 1) * sizeof *slot);
+    int ok = keys && sum && o->smooth_N && face_N && slot;
+    for (size_t i = 0; ok && i < cap; i++)
+        keys[i] = UINT64_MAX;
+    size_t c = 0;
+    for (size_t f = 0; ok && f < o->face_nv.n; c += (size_t)o->face_nv.a[f], f++) {
+        const int *fv = &o->face_idx.a[c];
+        newell(o, fv, o->face_nv.a[f], face_N[f]);
+        for (int j = 0; j < o->face_nv.a[f] && o->face_s.a[f] != 0; j++) {
+            uint64_t key = ((uint64_t)(uint32_t)fv[j] << 32) | (uint32_t)o->face_s.a[f];
+            size_t h = (size_t)((key * 0x9E3779B97F4A7C15ull) >> 20) & (cap - 1);
+            while (keys[h] != UINT64_MAX && keys[h] != key)
+                h = (h + 1) & (cap - 1);
+            keys[h] = key;
+            slot[c + (size_t)j] = h;
+            for (int a = 0; a < 3; a++)
+                sum[h][a] += face_N[f][a];
+        }
+    }
+    c = 0;
+    for (size_t f = 0; ok && f < o->face_nv.n; c += (size_t)o->face_nv.a[f], f++)
+        for (int j = 0; j < o->face_nv.a[f]; j++) {
+            const double *v = o->face_s.a[f] != 0 ? sum[slot[c + (size_t)j]] : face_N[f];
+            double len = sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+            const double *u = len > 0.0 ? v : face_N[f]; /* opposite faces cancelled */
+            len = len > 0.0 ? len : sqrt(u[0] * u[0] + u[1] * u[1] + u[2] * u[2]);
+            for (int a = 0; a < 3; a++)
+                o->smooth_N[3 * (c + (size_t)j) + (size_t)a] =
+                    len > 0.0 ? (float)(u[a] / len) : (a == 2 ? 1.0f : 0.0f);
+        }
+    free(keys);
+    free(sum);
+    free(face_N);
+    free(slot);
+    return ok ? 0 : -1;
+}
+
 /* The facevarying N (vn) and st (vt: t = 1 - v, OBJ's v running up the
  * image) of mesh m's corners into pv, when every corner has them (with
  * one warning when only some do). Returns the count; the data are in
@@ -940,6 +1011,8 @@ static size_t corner_primvars(Emit *e, const Mesh *m, RayesPrimvar pv[2], float 
         for (int q = 0; q < 2; q++)
             has[q] &= vals[q] >= 0, any[q] |= vals[q] >= 0;
     }
+    if (o->smooth_N) /* every corner has a normal: vn, its smoothing group's or its face's */
+        has[0] = 1, any[0] = 0;
     for (int q = 0; q < 2; q++)
         if (any[q] && !has[q])
             obj_warn(e->o, q ? "some vt" : "some vn", "%s: faces of one material with and "
@@ -952,7 +1025,10 @@ static size_t corner_primvars(Emit *e, const Mesh *m, RayesPrimvar pv[2], float 
     for (size_t i = 0; i < n; i++) {
         int c = m->idx.a[i];
         if (has[0])
-            memcpy(N + 3 * i, &o->vn.a[3 * (size_t)o->face_vn.a[c]], 3 * sizeof *N);
+            memcpy(N + 3 * i,
+                   o->face_vn.a[c] >= 0 ? &o->vn.a[3 * (size_t)o->face_vn.a[c]]
+                                        : &o->smooth_N[3 * (size_t)c],
+                   3 * sizeof *N);
         if (has[1]) {
             const float *t = &o->vt.a[2 * (size_t)o->face_vt.a[c]];
             st[2 * i] = t[0], st[2 * i + 1] = 1.0f - t[1];
@@ -1165,6 +1241,10 @@ static RayesError obj_emit(Obj *o, const IoSink *sink)
     for (size_t f = 0; f < o->face_mat.n; f++)
         if (o->face_mat.a[f] >= 0 && !o->mats[o->face_mat.a[f]].defined)
             o->face_mat.a[f] = -1;
+    if (r == RAYES_OK && o->any_s && obj_smooth_normals(o) != 0) {
+        snprintf(o->err, o->err_size, "%s: out of memory", o->name);
+        r = RAYES_ERROR_OUT_OF_MEMORY;
+    }
     for (int mi = -1; mi < (int)o->n_mats && r == RAYES_OK; mi++)
         r = emit_material(&e, mi);
     if (r == RAYES_OK)
@@ -1197,6 +1277,8 @@ RayesError io_obj_parse(const char *name, const unsigned char *data, size_t size
     free(o.vt.a);
     free(o.vn.a);
     free(o.face_mat.a);
+    free(o.face_s.a);
+    free(o.smooth_N);
     free(o.mats);
     return r;
 }

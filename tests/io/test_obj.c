@@ -265,6 +265,53 @@ static void test_normals_and_texture_coordinates(void)
     record_free(&rec);
 }
 
+/* The normal of corner c of face f of m, and whether it is n. */
+static int corner_normal_is(const RecMesh *m, size_t f, int c, float x, float y, float z)
+{
+    const RayesPrimvar *N = rec_primvar(&m->pv, "N");
+    if (!N || N->cls != RAYES_PRIMVAR_FACEVARYING)
+        return 0;
+    const float *v = &N->data[3 * (3 * f + (size_t)c)];
+    return fabsf(v[0] - x) < 1e-6f && fabsf(v[1] - y) < 1e-6f && fabsf(v[2] - z) < 1e-6f;
+}
+
+/* Smoothing groups: faces of one group share their vertices' normals (the
+ * sum of their area-weighted normals), so a fold between two faces of
+ * group 1 is smooth; faces in different groups, or in none, stay flat;
+ * a file without s statements sends no normals. */
+static void test_smoothing_groups(void)
+{
+    static const char fold[] = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\n";
+    char text[256];
+    const float h = (float)(1.0 / sqrt(2.0));
+    for (int mode = 0; mode < 3; mode++) {
+        /* the face in z = 0 faces +z, the one in y = 0 faces +y; they
+         * share the edge from vertex 1 to 2 */
+        static const char *const s[3][2] = {{"s 1", "s 1"}, {"s 1", "s 2"}, {"s off", "s 0"}};
+        snprintf(text, sizeof text, "%s%s\nf 1 2 3\n%s\nf 2 1 4\n", fold, s[mode][0], s[mode][1]);
+        CHECK(parse("s.obj", text) == RAYES_OK);
+        CHECK(rec.n_mesh == 1 && rec.mesh[0].n_faces == 2);
+        const RecMesh *m = &rec.mesh[0];
+        if (mode == 2) {
+            CHECK(rec_primvar(&m->pv, "N") == NULL); /* flat, as without s */
+            record_free(&rec);
+            continue;
+        }
+        for (size_t f = 0; f < 2; f++)
+            for (int c = 0; c < 3; c++) {
+                const float *p = corner(m, f, c);
+                int shared = p[1] == 0 && p[2] == 0; /* on the fold's edge */
+                if (mode == 0 && shared)
+                    CHECK(corner_normal_is(m, f, c, 0, h, h));
+                else if (f == 0)
+                    CHECK(corner_normal_is(m, f, c, 0, 0, 1));
+                else
+                    CHECK(corner_normal_is(m, f, c, 0, 1, 0));
+            }
+        record_free(&rec);
+    }
+}
+
 static void test_errors(void)
 {
     expect_error("v 1 2\n", "bad.obj:1:6: expected a vertex coordinate, found the end");
@@ -434,4 +481,5 @@ static void test_transparency(void)
 
 TEST_MAIN(TEST(test_face_syntax), TEST(test_ngons), TEST(test_materials),
           TEST(test_default_camera_and_light), TEST(test_errors), TEST(test_unknown_statements),
-          TEST(test_read_file), TEST(test_normals_and_texture_coordinates), TEST(test_transparency))
+          TEST(test_read_file), TEST(test_normals_and_texture_coordinates), TEST(test_transparency),
+          TEST(test_smoothing_groups))
