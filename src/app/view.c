@@ -48,6 +48,7 @@
 #include "app/cli.h"
 #include "app/view.h"
 #include "image/image.h"
+#include "util/colour.h"
 #include "util/log.h"
 #include "util/vec.h"
 
@@ -580,7 +581,7 @@ static uint8_t to_display(float x, float gain, float inv_gamma)
     x = fmaxf(x * gain, 0.0f);
     if (inv_gamma != 1.0f)
         x = powf(x, inv_gamma);
-    x = x <= 0.0031308f ? 12.92f * x : 1.055f * powf(x, 1.0f / 2.4f) - 0.055f;
+    x = colour_linear_to_srgb(x);
     return (uint8_t)lrintf(fminf(fmaxf(x, 0.0f), 1.0f) * 255.0f);
 }
 
@@ -613,9 +614,7 @@ static int screenshot(SDL_Renderer *r, View *v, const char *path)
         for (size_t i = 0; i < (size_t)w * h; i++)
             for (int c = 0; c < 4; c++) {
                 float x = px[4 * i + c] / 255.0f; /* back to linear, so the file holds it */
-                rgba[4 * i + c] = c == 3 ? 1.0f
-                                  : x <= 0.04045f ? x / 12.92f
-                                                  : powf((x + 0.055f) / 1.055f, 2.4f);
+                rgba[4 * i + c] = c == 3 ? 1.0f : colour_srgb_to_linear(x);
             }
         status = image_write_png(path, w, h, rgba, err, sizeof err) == RAYES_OK ? 0 : -1;
         if (status)

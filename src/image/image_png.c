@@ -27,6 +27,7 @@
  */
 #include "image/image.h"
 #include "image/image_internal.h"
+#include "util/colour.h"
 
 #include <errno.h>
 #include <math.h>
@@ -135,8 +136,7 @@ static uint8_t encode_srgb8(float linear)
         return 0;
     if (linear >= 1.0f)
         return 255;
-    float v = linear <= 0.0031308f ? 12.92f * linear : 1.055f * powf(linear, 1.0f / 2.4f) - 0.055f;
-    return (uint8_t)(v * 255.0f + 0.5f);
+    return (uint8_t)(colour_linear_to_srgb(linear) * 255.0f + 0.5f);
 }
 
 static uint8_t encode_linear8(float value)
@@ -276,7 +276,7 @@ static float *decode_pixels(const PngIo *io)
     float linear[256];
     for (int i = 0; i < 256; i++) {
         float v = (float)i / 255.0f;
-        linear[i] = v <= 0.04045f ? v / 12.92f : powf((v + 0.055f) / 1.055f, 2.4f);
+        linear[i] = colour_srgb_to_linear(v);
     }
     for (size_t i = 0; i < n; i += 4) {
         rgba[i + 0] = linear[io->pixels[i + 0]];

@@ -28,6 +28,7 @@
 #include <sys/stat.h>
 
 #include "io/text.h"
+#include "util/colour.h"
 #include "util/log.h"
 
 #define OBJ_MAX_EARCLIP 1024 /* bigger faces are fanned (ear clipping is cubic) */
@@ -242,6 +243,10 @@ typedef struct Obj {
     const char *name;        /* the OBJ file, for messages */
     char dir[2048];          /* its directory with a final '/', or "" */
     FloatVec v;              /* x y z per vertex */
+    FloatVec vc;             /* r g b per vertex (v x y z r g b) while every vertex so far
+                                has one */
+    int vc_broken;           /* some vertex has no colour: none are used */
+    float vc_max;            /* the largest component given (over 1: 0-255 values) */
     size_t n_vt, n_vn;       /* counts */
     FloatVec vt, vn;         /* u v per texture coordinate, x y z per normal */
     IntVec face_nv;          /* vertices per face */
@@ -589,10 +594,11 @@ static int obj_face(Obj *o, Lexer *L, const char *kw)
     return 0;
 }
 
-/* v x y z [w] or v x y z r g b: the position is kept. */
+/* v x y z [w] or v x y z r g b: the position is kept, and the colour
+ * while every vertex has one. */
 static int obj_vertex(Obj *o, Lexer *L)
 {
-    float x[3], extra;
+    float x[3], extra[4];
     for (int k = 0; k < 3; k++)
         if (lex_float(L, &x[k], "a vertex coordinate") != 0)
             return -1;
@@ -600,10 +606,11 @@ static int obj_vertex(Obj *o, Lexer *L)
     size_t n;
     int more = 0;
     while ((n = lex_token(L, &tok)) > 0) {
-        if (more == 4 || parse_float(tok, n, &extra) != 0)
+        if (more == 4 || parse_float(tok, n, &extra[more]) != 0)
             return lex_expected(L, tok, n, more == 4 ? "the end of the line" : "a number");
         more++;
     }
+    const float *rgb = extra;
     if (more == 2)
         return lex_expected(L, tok, 0, "the third colour component");
     if (o->v.n / 3 >= INT_MAX - 1)
@@ -611,6 +618,14 @@ static int obj_vertex(Obj *o, Lexer *L)
     for (int k = 0; k < 3; k++)
         if (fpush(&o->v, x[k]) != 0)
             return oom(L);
+    if (more == 3 && !o->vc_broken) { /* a colour: kept while every vertex has one */
+        for (int k = 0; k < 3; k++)
+            if (fpush(&o->vc, rgb[k]) != 0)
+                return oom(L);
+        o->vc_max = fmaxf(o->vc_max, fmaxf(rgb[0], fmaxf(rgb[1], rgb[2])));
+    } else if (more != 3) {
+        o->vc_broken = 1;
+    }
     return 0;
 }
 
@@ -1041,6 +1056,30 @@ static size_t corner_primvars(Emit *e, const Mesh *m, RayesPrimvar pv[2], float 
     return k;
 }
 
+/* The colours of mesh m's points (e->local's order) as linear Cs in *Cs
+ * (malloc'd; NULL when the file's vertices do not all have one): the
+ * values are sRGB-encoded, as scanners and MeshLab write them, over 1 or
+ * (when some exceeds 1) over 255. Returns 0, or -1 when out of memory. */
+static int vertex_colours(Emit *e, const Mesh *m, float **Cs)
+{
+    const Obj *o = e->o;
+    *Cs = NULL;
+    if (o->vc_broken || o->vc.n != o->v.n || o->vc.n == 0)
+        return 0;
+    size_t n_points = e->P.n / 3;
+    float *c = malloc((3 * n_points + 1) * sizeof *c), k = o->vc_max > 1.0f ? 1.0f / 255.0f : 1.0f;
+    if (!c)
+        return -1;
+    for (size_t i = 0; i < m->idx.n; i++) {
+        int g = o->face_idx.a[m->idx.a[i]], l = e->local[g];
+        for (int a = 0; a < 3; a++)
+            c[3 * (size_t)l + (size_t)a] = colour_srgb_to_linear(
+                fminf(fmaxf(o->vc.a[3 * (size_t)g + (size_t)a] * k, 0.0f), 1.0f));
+    }
+    *Cs = c;
+    return 0;
+}
+
 /* The faces of mesh m as one polygon mesh, with only the points they use. */
 static RayesError emit_mesh(Emit *e, const Mesh *m, const char *mat)
 {
@@ -1063,11 +1102,15 @@ static RayesError emit_mesh(Emit *e, const Mesh *m, const char *mat)
         }
         idx.a[i] = e->local[g];
     }
+    RayesPrimvar pv[3];
+    float *store = NULL, *Cs = NULL;
+    size_t n_pv = r == RAYES_OK ? corner_primvars(e, m, pv, &store) : 0;
+    if (r == RAYES_OK && vertex_colours(e, m, &Cs) != 0)
+        r = RAYES_ERROR_OUT_OF_MEMORY;
+    if (Cs)
+        pv[n_pv++] = (RayesPrimvar){"Cs", RAYES_PRIMVAR_VERTEX, Cs, e->P.n / 3};
     for (size_t i = 0; i < m->idx.n; i++)
         e->local[e->o->face_idx.a[m->idx.a[i]]] = -1;
-    RayesPrimvar pv[2];
-    float *store = NULL;
-    size_t n_pv = r == RAYES_OK ? corner_primvars(e, m, pv, &store) : 0;
     if (r == RAYES_OK) {
         r = e->sink->polygon_mesh(e->sink->target, m->nv.n, m->nv.a, idx.a, e->P.n / 3, e->P.a,
                                   pv, n_pv);
@@ -1080,6 +1123,7 @@ static RayesError emit_mesh(Emit *e, const Mesh *m, const char *mat)
         snprintf(e->o->err, e->o->err_size, "%s: out of memory", e->o->name);
     }
     free(store);
+    free(Cs);
     free(idx.a);
     return r;
 }
@@ -1270,6 +1314,7 @@ RayesError io_obj_parse(const char *name, const unsigned char *data, size_t size
     else
         r = obj_emit(&o, sink);
     free(o.v.a);
+    free(o.vc.a);
     free(o.face_nv.a);
     free(o.face_idx.a);
     free(o.face_vt.a);

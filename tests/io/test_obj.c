@@ -312,6 +312,40 @@ static void test_smoothing_groups(void)
     }
 }
 
+/* Vertex colours (v x y z r g b, an extension scanners and MeshLab
+ * write): a vertex-class Cs of the mesh's points, sRGB-encoded values made
+ * linear, 0-255 values when some exceeds 1; none when a vertex has none. */
+static void test_vertex_colours(void)
+{
+    CHECK(parse("c.obj", "v 0 0 0 0.5 0.5 0.5\nv 1 0 0 1 0 0\nv 0 1 0 0 0 1\nf 1 2 3\n") ==
+          RAYES_OK);
+    CHECK(rec.n_mesh == 1);
+    const RecMesh *m = &rec.mesh[0];
+    const RayesPrimvar *Cs = rec_primvar(&m->pv, "Cs");
+    CHECK(Cs && Cs->cls == RAYES_PRIMVAR_VERTEX && Cs->count == 3);
+    for (int c = 0; Cs && c < 3; c++) {
+        const float *p = corner(m, 0, c), *k = &Cs->data[3 * (size_t)m->idx[c]];
+        if (p[0] == 0 && p[1] == 0)
+            CHECK_NEAR(k[1], 0.2140, 1e-4); /* sRGB 0.5 */
+        else if (p[0] == 1)
+            CHECK(k[0] == 1.0f && k[1] == 0.0f);
+        else
+            CHECK(k[2] == 1.0f && k[0] == 0.0f);
+    }
+    record_free(&rec);
+    CHECK(parse("c.obj", "v 0 0 0 255 128 0\nv 1 0 0 0 0 0\nv 0 1 0 0 0 0\nf 1 2 3\n") == RAYES_OK);
+    Cs = rec_primvar(&rec.mesh[0].pv, "Cs");
+    CHECK(Cs != NULL);
+    for (int c = 0; Cs && c < 3; c++)
+        if (corner(&rec.mesh[0], 0, c)[0] == 0 && corner(&rec.mesh[0], 0, c)[1] == 0)
+            CHECK(Cs->data[3 * (size_t)rec.mesh[0].idx[c]] == 1.0f &&
+                  fabsf(Cs->data[3 * (size_t)rec.mesh[0].idx[c] + 1] - 0.2159f) < 1e-3f);
+    record_free(&rec);
+    CHECK(parse("c.obj", "v 0 0 0 1 0 0\nv 1 0 0\nv 0 1 0 0 0 1\nf 1 2 3\n") == RAYES_OK);
+    CHECK(rec_primvar(&rec.mesh[0].pv, "Cs") == NULL);
+    record_free(&rec);
+}
+
 static void test_errors(void)
 {
     expect_error("v 1 2\n", "bad.obj:1:6: expected a vertex coordinate, found the end");
@@ -482,4 +516,4 @@ static void test_transparency(void)
 TEST_MAIN(TEST(test_face_syntax), TEST(test_ngons), TEST(test_materials),
           TEST(test_default_camera_and_light), TEST(test_errors), TEST(test_unknown_statements),
           TEST(test_read_file), TEST(test_normals_and_texture_coordinates), TEST(test_transparency),
-          TEST(test_smoothing_groups))
+          TEST(test_smoothing_groups), TEST(test_vertex_colours))
