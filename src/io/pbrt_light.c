@@ -128,13 +128,16 @@ int pbrt_d_light(Parser *P, const Token *t)
         if (pbrt_get_emission(P, &pl, "L", col) < 0)
             r = -1;
         const char *file = pbrt_get_string(&pl, "filename", NULL);
-        if (file && !r) {
-            /* pbrt-v4's maps are equal-area octahedral squares */
-            r = pbrt_resolve(P, t, file, map_path, sizeof map_path);
+        const char *v3_map = file ? NULL : pbrt_get_string(&pl, "mapname", NULL);
+        if ((file || v3_map) && !r) {
+            /* pbrt-v4's maps are equal-area octahedral squares; pbrt-v3's
+             * ("mapname") latitude-longitude maps with +z up */
+            r = pbrt_resolve(P, t, file ? file : v3_map, map_path, sizeof map_path);
             lp[n++] =
                 (RayesParam){.name = "mapname", .type = RAYES_PARAM_STRING, .string = map_path};
-            lp[n++] =
-                (RayesParam){.name = "mapping", .type = RAYES_PARAM_STRING, .string = "octahedral"};
+            lp[n++] = (RayesParam){.name = "mapping",
+                                   .type = RAYES_PARAM_STRING,
+                                   .string = file ? "octahedral" : "latlong-zup"};
         }
         if (pbrt_get_float(&pl, "illuminance", 0.0) > 0)
             pbrt_warn_at(P, t->line, t->col, "infinite illuminance", "LightSource \"infinite\": "

@@ -177,9 +177,12 @@ static int texture_params(Parser *P, const Token *t, const char *cls, ParamList 
     float a[3], b[3], c[3], d[3];
     if (strcmp(cls, "constant") == 0)
         return tex_input(P, pl, "value", one, &q[(*n)++], standin) ? -1 : 1;
-    if (strcmp(cls, "scale") == 0) {
-        if (tex_input(P, pl, "tex", one, &q[0], a) || tex_input(P, pl, "scale", one, &q[1], b))
+    if (strcmp(cls, "scale") == 0) { /* pbrt-v3's names its factors tex1 and tex2 */
+        int v3 = !pbrt_find(pl, "tex") && !pbrt_find(pl, "scale");
+        if (tex_input(P, pl, v3 ? "tex1" : "tex", one, &q[0], a) ||
+            tex_input(P, pl, v3 ? "tex2" : "scale", one, &q[1], b))
             return -1;
+        q[0].name = "tex", q[1].name = "scale";
         *n = 2;
         for (int k = 0; k < 3; k++)
             standin[k] = a[k] * b[k];
@@ -498,7 +501,10 @@ static int mat_displacement(Parser *P, ParamList *pl, Material *m)
     static const float zero[3] = {0, 0, 0};
     float c[3];
     const Texture *tex = NULL;
-    int k = pbrt_get_color(P, pl, "displacement", zero, c, &tex);
+    /* pbrt-v3 called it "bumpmap" */
+    const char *name =
+        pbrt_find(pl, "displacement") || !pbrt_find(pl, "bumpmap") ? "displacement" : "bumpmap";
+    int k = pbrt_get_color(P, pl, name, zero, c, &tex);
     if (k < 0)
         return -1;
     if (k == 2) {
@@ -632,18 +638,23 @@ static int mix_material(Parser *P, const Token *t, ParamList *pl, Material *m)
 {
     static const float half[3] = {0.5f, 0.5f, 0.5f};
     Param *names = pbrt_find(pl, "materials");
-    if (!names || names->n_str != 2)
+    /* pbrt-v3's: namedmaterial1 and namedmaterial2 */
+    const char *n1 = pbrt_get_string(pl, "namedmaterial1", NULL);
+    const char *n2 = pbrt_get_string(pl, "namedmaterial2", NULL);
+    const char *mats[2] = {names && names->n_str == 2 ? names->str[0] : n1,
+                           names && names->n_str == 2 ? names->str[1] : n2};
+    if (!mats[0] || !mats[1])
         return FAIL_TOK(P, t, "mix: expected \"string materials\" with two material names");
     int ra, rb;
-    const Material *a = pbrt_named_material(P, names->str[0], &ra);
-    const Material *b = pbrt_named_material(P, names->str[1], &rb);
+    const Material *a = pbrt_named_material(P, mats[0], &ra);
+    const Material *b = pbrt_named_material(P, mats[1], &rb);
     if (ra || rb)
         return -1;
-    a = pbrt_named_material(P, names->str[0], &ra); /* b's definition may have moved it */
+    a = pbrt_named_material(P, mats[0], &ra); /* b's definition may have moved it */
     if (!a || !b) {
         P->missing_texture = 1; /* perhaps defined further down */
         return FAIL_TOK(P, t, "mix: expected materials defined before, found \"%.60s\"",
-                        !a ? names->str[0] : names->str[1]);
+                        !a ? mats[0] : mats[1]);
     }
     RayesParam q[3];
     float amount[3];
@@ -679,7 +690,7 @@ static int mix_material(Parser *P, const Token *t, ParamList *pl, Material *m)
                  "mix: rayes cannot blend these materials (an interface, more than %d "
                  "parameters between them, or mixes nested too deep); using the heavier one "
                  "(\"%.60s\")",
-                 MAT_MAX_PARAMS - 4, amount[0] > 0.5f ? names->str[1] : names->str[0]);
+                 MAT_MAX_PARAMS - 4, amount[0] > 0.5f ? mats[1] : mats[0]);
     return 0;
 }
 
@@ -817,8 +828,182 @@ static int subsurface_material(Parser *P, const Token *t, ParamList *pl, Materia
     return 0;
 }
 
+/* ------------------------------------------------- pbrt-v3's materials */
+
+/* pbrt-v3's roughness as rayes' (alpha squared): remapped (its default)
+ * through v3's polynomial in log(roughness) (TrowbridgeReitz's
+ * RoughnessToAlpha, not v4's square root), or alpha itself with
+ * "remaproughness" false; uroughness and vroughness as their alphas'
+ * geometric mean. Constants (a texture's constant value). */
+static int v3_roughness(Parser *P, ParamList *pl, double def, Material *m)
+{
+    double r, ru, rv;
+    if (pbrt_get_float_tex(P, pl, "roughness", def, &r) != 0 ||
+        pbrt_get_float_tex(P, pl, "uroughness", r, &ru) != 0 ||
+        pbrt_get_float_tex(P, pl, "vroughness", r, &rv) != 0)
+        return -1;
+    Param *remap = pbrt_find(pl, "remaproughness");
+    int alpha_given = remap && remap->n_num && remap->num[0] == 0.0;
+    double a[2], in[2] = {ru, rv};
+    for (int k = 0; k < 2; k++) {
+        double x = log(fmax(in[k], 1e-3));
+        a[k] = alpha_given
+                   ? fmax(in[k], 0.0)
+                   : 1.62142 + x * (0.819955 + x * (0.1734 + x * (0.0171201 + x * 0.000640711)));
+        a[k] = fmax(a[k], 0.0);
+    }
+    mat_float(m, "roughness", (float)(a[0] * a[1]));
+    return 0;
+}
+
+/* The index of refraction of a pbrt-v3 material: "eta", or its older
+ * "index", else def. */
+static float v3_eta(Parser *P, ParamList *pl, double def)
+{
+    static const float none[3] = {-1, -1, -1};
+    float c[3];
+    if (pbrt_get_color(P, pl, "eta", none, c, NULL) > 0)
+        return (c[0] + c[1] + c[2]) / 3.0f;
+    return (float)pbrt_get_float(pl, "index", def);
+}
+
+/* A parameter of pbrt-v3's that rayes does not draw, warned once when it
+ * is not its harmless default (dflt). */
+static void v3_unused(Parser *P, const Token *t, ParamList *pl, const char *type, const char *name,
+                      float dflt)
+{
+    static const float none[3] = {-1, -1, -1};
+    float c[3];
+    int k = pbrt_get_color(P, pl, name, none, c, NULL);
+    if (k != 0 && !(k == 1 && c[0] == dflt && c[1] == dflt && c[2] == dflt)) {
+        char key[96];
+        snprintf(key, sizeof key, "v3 %s %s", type, name);
+        pbrt_warn_at(P, t->line, t->col, key, "%s: \"%s\" is not drawn (rayes' %s)", type, name,
+                     type[0] == 'u' ? "uber is a plastic" : "approximation leaves it out");
+    }
+}
+
+/* pbrt-v3's materials (matte, plastic, uber, substrate, metal, mirror,
+ * glass, translucent, disney, kdsubsurface) as rayes' shaders
+ * (docs/pbrt.md); 1 if type is one, 0 if not, -1 on error. */
+static int v3_material(Parser *P, const Token *t, const char *type, ParamList *pl, Material *m)
+{
+    static const float half[3] = {.5f, .5f, .5f}, quarter[3] = {.25f, .25f, .25f},
+                       one[3] = {1, 1, 1}, r09[3] = {.9f, .9f, .9f};
+    if (strcmp(type, "matte") == 0) {
+        v3_unused(P, t, pl, type, "sigma", 0);
+        return diffuse_material(P, pl, m, "Kd") ? -1 : 1;
+    }
+    if (strcmp(type, "plastic") == 0 || strcmp(type, "uber") == 0 ||
+        strcmp(type, "substrate") == 0) {
+        /* a Lambertian base plus a dielectric glossy lobe scaled by Ks */
+        int sub = type[0] == 's';
+        pbrt_mat_init(m, "coateddiffuse");
+        if (mat_textured(P, pl, m, "Kd", "reflectance", RAYES_PARAM_COLOR, sub ? half : quarter) ||
+            mat_textured(P, pl, m, "Ks", "specular", RAYES_PARAM_COLOR, sub ? half : quarter) ||
+            v3_roughness(P, pl, 0.1, m))
+            return -1;
+        mat_float(m, "eta", type[0] == 'u' ? v3_eta(P, pl, 1.5) : 1.5f);
+        mat_float(m, "thickness", 0.0f);
+        if (type[0] == 'u') {
+            v3_unused(P, t, pl, type, "Kr", 0);
+            v3_unused(P, t, pl, type, "Kt", 0);
+            float op[3];
+            if (pbrt_get_color(P, pl, "opacity", one, op, NULL) < 0)
+                return -1;
+            if (op[0] < 1.0f || op[1] < 1.0f || op[2] < 1.0f)
+                pbrt_mat_color(m, "Os", op);
+        }
+        return 1;
+    }
+    if (strcmp(type, "metal") == 0) {
+        static const float cu_eta[3] = {0.200f, 0.924f, 1.102f}, cu_k[3] = {3.912f, 2.452f, 2.142f};
+        pbrt_mat_init(m, "conductor");
+        if (mat_textured(P, pl, m, "eta", "eta", RAYES_PARAM_COLOR, cu_eta) ||
+            mat_textured(P, pl, m, "k", "k", RAYES_PARAM_COLOR, cu_k) ||
+            v3_roughness(P, pl, 0.01, m))
+            return -1;
+        return 1;
+    }
+    if (strcmp(type, "mirror") == 0) {
+        pbrt_mat_init(m, "conductor");
+        if (mat_textured(P, pl, m, "Kr", "reflectance", RAYES_PARAM_COLOR, r09))
+            return -1;
+        mat_float(m, "roughness", 0.0f);
+        return 1;
+    }
+    if (strcmp(type, "glass") == 0) {
+        float kt[3];
+        pbrt_mat_init(m, "dielectric");
+        mat_float(m, "eta", v3_eta(P, pl, 1.5));
+        if (v3_roughness(P, pl, 0.0, m) || pbrt_get_color(P, pl, "Kt", one, kt, NULL) < 0)
+            return -1;
+        if (kt[0] != 1.0f || kt[1] != 1.0f || kt[2] != 1.0f)
+            pbrt_mat_color(m, "transmitcolor", kt);
+        v3_unused(P, t, pl, type, "Kr", 1);
+        return 1;
+    }
+    if (strcmp(type, "translucent") == 0) {
+        float kd[3], re[3], tr[3], refl[3], tran[3];
+        if (pbrt_get_color(P, pl, "Kd", quarter, kd, NULL) < 0 ||
+            pbrt_get_color(P, pl, "reflect", half, re, NULL) < 0 ||
+            pbrt_get_color(P, pl, "transmit", half, tr, NULL) < 0)
+            return -1;
+        for (int c = 0; c < 3; c++)
+            refl[c] = kd[c] * re[c], tran[c] = kd[c] * tr[c];
+        pbrt_mat_init(m, "diffusetransmission");
+        pbrt_mat_color(m, "reflectance", refl);
+        pbrt_mat_color(m, "transmittance", tran);
+        v3_unused(P, t, pl, type, "Ks", 0.25f);
+        (void)pbrt_find(pl, "roughness");
+        return 1;
+    }
+    if (strcmp(type, "disney") == 0) {
+        /* mostly metal: a conductor of its colour; mostly transmissive: a
+         * dielectric; else its colour under a coat of its specular (0.5
+         * is the F0 of index 1.5); roughness r is alpha r^2 */
+        double rough = pbrt_get_float(pl, "roughness", 0.5), r4 = rough * rough * rough * rough;
+        if (pbrt_get_float(pl, "spectrans", 0.0) > 0.5) {
+            pbrt_mat_init(m, "dielectric");
+            mat_float(m, "eta", v3_eta(P, pl, 1.5));
+            mat_float(m, "roughness", (float)r4);
+            return 1;
+        }
+        int metal = pbrt_get_float(pl, "metallic", 0.0) >= 0.5;
+        pbrt_mat_init(m, metal ? "conductor" : "coateddiffuse");
+        if (mat_textured(P, pl, m, "color", "reflectance", RAYES_PARAM_COLOR, half))
+            return -1;
+        mat_float(m, "roughness", (float)r4);
+        if (!metal) {
+            float s = (float)pbrt_get_float(pl, "specular", 0.5) / 0.5f, sc[3] = {s, s, s};
+            pbrt_mat_color(m, "specular", sc);
+            mat_float(m, "thickness", 0.0f);
+        }
+        return 1;
+    }
+    if (strcmp(type, "kdsubsurface") == 0) {
+        /* the medium of total diffuse reflectance Kd and mean free path
+         * mfp (scene units, over scale) */
+        float kd[3], mfp[3];
+        if (pbrt_get_color(P, pl, "Kd", half, kd, NULL) < 0 ||
+            pbrt_get_color(P, pl, "mfp", one, mfp, NULL) < 0)
+            return -1;
+        double scale = pbrt_get_float(pl, "scale", 1.0);
+        pbrt_mat_init(m, "subsurface");
+        pbrt_mat_color(m, "reflectance", kd);
+        pbrt_mat_color(m, "mfp", mfp);
+        mat_float(m, "unitlength", (float)(scale > 0.0 ? 1.0 / scale : 1.0));
+        mat_float(m, "eta", (float)pbrt_get_float(pl, "eta", 1.33));
+        return v3_roughness(P, pl, 0.0, m) ? -1 : 1;
+    }
+    return 0;
+}
+
 static int material_of_type(Parser *P, const Token *t, const char *type, ParamList *pl, Material *m)
 {
+    int v3 = v3_material(P, t, type, pl, m);
+    if (v3 != 0)
+        return v3 < 0 ? -1 : 0;
     if (strcmp(type, "diffuse") == 0)
         return diffuse_material(P, pl, m, "reflectance");
     if (strcmp(type, "coateddiffuse") == 0)

@@ -249,7 +249,7 @@ int pbrt_d_film(Parser *P, const Token *t)
             pbrt_warn_at(P, t->line, t->col, "gbuffer space",
                          "Film \"gbuffer\": N and P are written in world space, not \"%.40s\"",
                          space);
-    } else if (strcmp(type, "rgb") != 0) {
+    } else if (strcmp(type, "rgb") != 0 && strcmp(type, "image") != 0) { /* v3's is "image" */
         pbrt_warn_at(P, t->line, t->col, "film type", "Film \"%.40s\": written as an rgb film",
                      type);
     }

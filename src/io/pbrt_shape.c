@@ -532,6 +532,43 @@ static int quadric_light(Parser *P, const Token *t, const char *shape, float rad
     return pbrt_emit_light(P, t, m, "arealight", lp, 4);
 }
 
+/* pbrt-v3's cone, paraboloid and hyperboloid (v4 dropped them): the
+ * quadrics RenderMan's Cone, Paraboloid and Hyperboloid make, which pbrt's
+ * are (cone: "radius" 1, "height" 1; paraboloid: "radius" 1, "zmin" 0,
+ * "zmax" 1; hyperboloid: "point p1" (0 0 0), "point p2" (1 1 1); each
+ * "phimax" 360). Under an area light they warn and do not emit. */
+static int shape_v3_quadric(Parser *P, const Token *t, const char *type, ParamList *pl)
+{
+    double phimax = pbrt_get_float(pl, "phimax", 360.0);
+    if (!(phimax > 0 && phimax <= 360))
+        return FAIL_TOK(P, t, "%s: expected phimax in (0, 360], found %g", type, phimax);
+    float qp[7];
+    size_t n;
+    RayesQuadric q;
+    if (strcmp(type, "cone") == 0) {
+        q = RAYES_QUADRIC_CONE, n = 3;
+        qp[0] = (float)pbrt_get_float(pl, "height", 1.0);
+        qp[1] = (float)pbrt_get_float(pl, "radius", 1.0);
+    } else if (strcmp(type, "paraboloid") == 0) {
+        q = RAYES_QUADRIC_PARABOLOID, n = 4;
+        qp[0] = (float)pbrt_get_float(pl, "radius", 1.0);
+        qp[1] = (float)pbrt_get_float(pl, "zmin", 0.0);
+        qp[2] = (float)pbrt_get_float(pl, "zmax", 1.0);
+    } else {
+        static const double origin[3] = {0, 0, 0}, ones[3] = {1, 1, 1};
+        const double *p1 = pbrt_get_point(pl, "p1"), *p2 = pbrt_get_point(pl, "p2");
+        p1 = p1 ? p1 : origin, p2 = p2 ? p2 : ones;
+        q = RAYES_QUADRIC_HYPERBOLOID, n = 7;
+        for (int k = 0; k < 3; k++)
+            qp[k] = (float)p1[k], qp[3 + k] = (float)p2[k];
+    }
+    qp[n - 1] = (float)phimax;
+    if (P->gs.area.on)
+        pbrt_warn_at(P, t->line, t->col, "v3 quadric light",
+                     "%s: this emitter is not supported; the shape does not emit", type);
+    return pbrt_emit_quadric(P, t, q, qp, n, P->gs.reverse ? RAYES_QUADRIC_REVERSE : 0);
+}
+
 static int shape_quadric(Parser *P, const Token *t, const char *type, ParamList *pl)
 {
     double radius = pbrt_get_float(pl, "radius", 1.0);
@@ -772,6 +809,9 @@ static int shape_of_type(Parser *P, const Token *t, const char *type, ParamList 
         return shape_plymesh(P, t, pl);
     if (strcmp(type, "curve") == 0)
         return shape_curve(P, t, pl);
+    if (strcmp(type, "cone") == 0 || strcmp(type, "paraboloid") == 0 ||
+        strcmp(type, "hyperboloid") == 0)
+        return shape_v3_quadric(P, t, type, pl);
     if (strcmp(type, "sphere") == 0 || strcmp(type, "disk") == 0 || strcmp(type, "cylinder") == 0)
         return shape_quadric(P, t, type, pl);
     char key[96];

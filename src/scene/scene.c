@@ -1828,12 +1828,15 @@ static RayesError light_map(RayesScene *s, const char *type, const LightParams *
     l->world_from_light = rot;
     mat4_invert(rot, &l->light_from_world);
     int octahedral = strcmp(lp->mapping, "octahedral") == 0;
+    int zup = strcmp(lp->mapping, "latlong-zup") == 0;
     int projection = strcmp(lp->mapping, "projection") == 0 && l->type != LIGHT_ENVIRONMENT;
     int sky = strcmp(lp->mapping, "sky") == 0 && l->type == LIGHT_ENVIRONMENT;
-    if (!octahedral && !projection && !sky && strcmp(lp->mapping, "latlong") != 0)
+    if (!octahedral && !zup && !projection && !sky && strcmp(lp->mapping, "latlong") != 0)
         return scene_fail(s, RAYES_ERROR_INVALID_ARGUMENT,
-                          "%s: unknown mapping \"%s\"; expected latlong, octahedral%s", type,
-                          lp->mapping, l->type != LIGHT_ENVIRONMENT ? " or projection" : " or sky");
+                          "%s: unknown mapping \"%s\"; expected latlong, latlong-zup, "
+                          "octahedral%s",
+                          type, lp->mapping,
+                          l->type != LIGHT_ENVIRONMENT ? " or projection" : " or sky");
     if (sky) { /* a clear sky of its sun, no map */
         char err[400];
         if (!(lp->haziness > 0.0f && lp->haziness < 100.0f))
@@ -1853,7 +1856,10 @@ static RayesError light_map(RayesScene *s, const char *type, const LightParams *
     char err[400], path[1024];
     if (scene_find_texture(s, lp->mapname, path, sizeof path) != 0)
         return scene_fail(s, RAYES_ERROR_INVALID_ARGUMENT, "%s: map name too long", type);
-    if (light_env_load(l, path, octahedral, err, sizeof err) != 0)
+    int layout = octahedral ? LIGHT_MAP_OCTAHEDRAL
+                 : zup      ? LIGHT_MAP_LATLONG_ZUP
+                            : LIGHT_MAP_LATLONG;
+    if (light_env_load(l, path, layout, err, sizeof err) != 0)
         return scene_fail(s, RAYES_ERROR_IO, "%s", err);
     return RAYES_OK;
 }
@@ -1942,7 +1948,7 @@ static RayesError uber_light(RayesScene *s, const LightParams *lp, Light *l)
         char err[400], path[1024];
         if (scene_find_texture(s, lp->slidename, path, sizeof path) != 0)
             return scene_fail(s, RAYES_ERROR_INVALID_ARGUMENT, "uberlight: slide name too long");
-        if (light_env_load(l, path, 0, err, sizeof err) != 0)
+        if (light_env_load(l, path, LIGHT_MAP_LATLONG, err, sizeof err) != 0)
             return scene_fail(s, RAYES_ERROR_IO, "uberlight slide: %s", err);
         u->slide = 1;
     }

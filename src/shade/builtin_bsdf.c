@@ -920,6 +920,7 @@ const RayesShaderClass shade_class_conductor = {
 
 typedef struct CoatedParams {
     float reflectance[3], roughness, eta, thickness, normalmap[3];
+    float specular[3]; /* unset (negative): layered; else pbrt-v3's plastic (below) */
 } CoatedParams;
 
 /* A Lambertian base of albedo R under a smooth or glossy dielectric coat
@@ -935,15 +936,21 @@ typedef struct CoatedParams {
  * The coat reflects F(cos_v) * the reflected radiance. diffuselighting
  * averages the base term over cosine-weighted views (1 - Favg in place of
  * 1 - F(cos_v)). The coat absorbs exp(-2 thickness) (normal incidence,
- * down and up). */
+ * down and up). With "specular" S given, the two are not layered: pbrt-v3's
+ * plastic and uber, a Lambertian base R plus S times the coat's reflection
+ * F(cos_v) L, neither dimming the other. */
 static void coated_chunk(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
                          const void *params, RayesShadeOutputs *out)
 {
     const CoatedParams *p = params;
-    Rgb E[SHADE_CHUNK], L[SHADE_CHUNK], refl[SHADE_CHUNK];
+    Rgb E[SHADE_CHUNK], L[SHADE_CHUNK], refl[SHADE_CHUNK], spec[SHADE_CHUNK];
     float alpha[SHADE_CHUNK], thick[SHADE_CHUNK];
     shade_param_color(sv, ctx, "reflectance", p->reflectance, refl);
     shade_param_float(sv, ctx, "thickness", p->thickness, thick);
+    int plastic = shade_param_bound(ctx, "specular") ||
+                  (p->specular[0] >= 0.0f && p->specular[1] >= 0.0f && p->specular[2] >= 0.0f);
+    if (plastic)
+        shade_param_color(sv, ctx, "specular", p->specular, spec);
     diffuse_light(sv, ctx, E, out);
     float favg = fresnel_dielectric_average(p->eta);
     if (ctx->I) {
@@ -957,9 +964,10 @@ static void coated_chunk(const RayesShaderServices *sv, const RayesShadeCtx *ctx
         float view = ctx->I ? (1.0f - F) / (1.0f - favg) : 1.0f;
         for (int c = 0; c < 3; c++) {
             float R = cs(ctx, i, c) * refl[i][c];
-            out->Ci[i][c] = R * base * view * E[i][c] / fmaxf(1.0f - R * fint, 1e-3f);
+            out->Ci[i][c] =
+                plastic ? R * E[i][c] : R * base * view * E[i][c] / fmaxf(1.0f - R * fint, 1e-3f);
             if (ctx->I)
-                out->Ci[i][c] += F * L[i][c];
+                out->Ci[i][c] += (plastic ? fmaxf(spec[i][c], 0.0f) : 1.0f) * F * L[i][c];
         }
     }
 }
@@ -976,6 +984,7 @@ static const RayesShaderParamDesc coated_params[] = {
     {"eta", RAYES_PARAM_FLOAT, offsetof(CoatedParams, eta), {1.5f, 0, 0}},
     {"thickness", RAYES_PARAM_FLOAT, offsetof(CoatedParams, thickness), {0.01f, 0, 0}},
     {"normalmap", RAYES_PARAM_COLOR, offsetof(CoatedParams, normalmap), {0.5f, 0.5f, 1.0f}},
+    {"specular", RAYES_PARAM_COLOR, offsetof(CoatedParams, specular), {-1, -1, -1}},
 };
 
 const RayesShaderClass shade_class_coateddiffuse = {

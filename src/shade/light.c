@@ -1383,10 +1383,44 @@ static float *octahedral_to_latlong(const float *src, int n)
     return out;
 }
 
+/* A latitude-longitude map src (w x h RGBA) whose poles are its space's
+ * +z and -z and whose longitude runs from +x toward +y (pbrt-v3's, the
+ * direction (sin theta cos phi, sin theta sin phi, cos theta) at (phi / 2
+ * pi, theta / pi)) resampled into rayes' (y up, env_uv_to_dir) of the same
+ * size, bilinearly, around in longitude: new array, or NULL. */
+static float *zup_to_latlong(const float *src, int w, int h)
+{
+    float *out = malloc((size_t)w * h * 4 * sizeof *out);
+    if (!out)
+        return NULL;
+    for (int y = 0; y < h; y++)
+        for (int x = 0; x < w; x++) {
+            float phi = (((float)x + 0.5f) / (float)w - 0.5f) * 2.0f * PI;
+            float theta = ((float)y + 0.5f) / (float)h * PI, st = sinf(theta);
+            Vec3 ld = v3(-st * sinf(phi), cosf(theta), st * cosf(phi)); /* as env_uv_to_dir */
+            float p2 = atan2f(ld.y, ld.x), t2 = acosf(fminf(fmaxf(ld.z, -1.0f), 1.0f));
+            if (p2 < 0.0f)
+                p2 += 2.0f * PI;
+            float fx = p2 / (2.0f * PI) * (float)w - 0.5f, fy = t2 / PI * (float)h - 0.5f;
+            int x0 = (int)floorf(fx), y0 = (int)floorf(fy);
+            float tx = fx - (float)x0, ty = fy - (float)y0;
+            float *o = &out[4 * ((size_t)y * w + x)];
+            memset(o, 0, 4 * sizeof *o);
+            for (int k = 0; k < 4; k++) {
+                int sx = ((x0 + (k & 1)) % w + w) % w, sy = y0 + (k >> 1);
+                sy = sy < 0 ? 0 : sy >= h ? h - 1 : sy;
+                float wgt = ((k & 1) ? tx : 1.0f - tx) * ((k >> 1) ? ty : 1.0f - ty);
+                for (int c = 0; c < 4; c++)
+                    o[c] += wgt * src[4 * ((size_t)sy * w + sx) + (size_t)c];
+            }
+        }
+    return out;
+}
+
 static int env_from_rgba(Light *l, float *rgba, int w, int h, const char *path, char *err,
                          size_t err_size);
 
-int light_env_load(Light *l, const char *path, int octahedral, char *err, size_t err_size)
+int light_env_load(Light *l, const char *path, int layout, char *err, size_t err_size)
 {
     int w = 0, h = 0;
     float *rgba = NULL;
@@ -1397,7 +1431,16 @@ int light_env_load(Light *l, const char *path, int octahedral, char *err, size_t
         free(rgba);
         return -1;
     }
-    if (octahedral) {
+    if (layout == LIGHT_MAP_LATLONG_ZUP) {
+        float *ll = zup_to_latlong(rgba, w, h);
+        free(rgba);
+        if (!ll) {
+            snprintf(err, err_size, "environment light: out of memory for %s", path);
+            return -1;
+        }
+        rgba = ll;
+    }
+    if (layout == LIGHT_MAP_OCTAHEDRAL) {
         if (w != h) {
             snprintf(err, err_size,
                      "environment light: %s: an octahedral map must be square, "

@@ -338,14 +338,22 @@ float light_guide_factor(const Light *l, const LightGuide *g, Vec3 wi);
 /* The environment light's radiance along world direction d (unit). */
 Vec3 light_env_radiance(const Light *l, Vec3 d);
 
+/* How an environment map's pixels lie on the sphere of directions. */
+enum {
+    LIGHT_MAP_LATLONG = 0,    /* rayes' latitude-longitude (y up) */
+    LIGHT_MAP_OCTAHEDRAL = 1, /* pbrt-v4's equal-area octahedral square */
+    LIGHT_MAP_LATLONG_ZUP = 2 /* pbrt-v3's latitude-longitude: +z up, longitude from +x to +y */
+};
+
 /* Reads an environment map (any format OpenImageIO reads, linear) and
- * builds its distribution. A latitude-longitude map (octahedral 0) is
- * used as it is; a square equal-area octahedral map (pbrt-v4's, octahedral
- * 1: light-space direction d at Clarberg's EqualAreaSphereToSquare(d), its
- * (0, 0) the top left) is resampled, bilinearly, into a latitude-longitude
- * map of twice its width. Returns 0, or -1 with a one-line message in
- * err. */
-int light_env_load(Light *l, const char *path, int octahedral, char *err, size_t err_size);
+ * builds its distribution. A latitude-longitude map (LIGHT_MAP_LATLONG)
+ * is used as it is; a square equal-area octahedral map (pbrt-v4's,
+ * LIGHT_MAP_OCTAHEDRAL: light-space direction d at Clarberg's
+ * EqualAreaSphereToSquare(d), its (0, 0) the top left) is resampled,
+ * bilinearly, into a latitude-longitude map of twice its width; pbrt-v3's
+ * z-up latitude-longitude (LIGHT_MAP_LATLONG_ZUP) into rayes' of its size.
+ * Returns 0, or -1 with a one-line message in err. */
+int light_env_load(Light *l, const char *path, int layout, char *err, size_t err_size);
 
 /* An environment map of a clear sky (util/sky.h: Preetham et al.'s, in
  * cd/m^2, the sun's disk left out: a distant light is the sun) for the

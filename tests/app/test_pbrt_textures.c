@@ -214,5 +214,45 @@ static void test_texture_mappings(void)
     free(a), free(b), free(c);
 }
 
-TEST_MAIN(TEST(test_textured_roughness), TEST(test_other_textured_parameters),
-          TEST(test_texture_mappings))
+/* pbrt-v3's infinite light ("mapname"): a latitude-longitude map with +z
+ * up and longitude from +x toward +y. 16 x 8 texels: the upper half
+ * (theta < 90 degrees) red where phi < 180 (y > 0) and green where not,
+ * the lower half blue. Seen by a narrow camera looking along (1, 1, 1),
+ * (1, -1, 1) and (1, 0, -1): red, green, blue. */
+static void test_v3_infinite_map(void)
+{
+    enum { W = 16, H = 8 };
+    static float map[W * H * 4];
+    for (int y = 0; y < H; y++)
+        for (int x = 0; x < W; x++) {
+            float *t = &map[4 * (y * W + x)];
+            t[0] = y < H / 2 && x < W / 2 ? 1.0f : 0.0f;
+            t[1] = y < H / 2 && x >= W / 2 ? 1.0f : 0.0f;
+            t[2] = y >= H / 2 ? 1.0f : 0.0f;
+            t[3] = 1.0f;
+        }
+    char err[300];
+    mkdir(TMP, 0755);
+    CHECK(image_write_exr(TMP "/v3sky.exr", W, H, map, err, sizeof err) == RAYES_OK);
+    static const char *const look[3] = {"1 1 1", "1 -1 1", "1 0 -1"};
+    for (int k = 0; k < 3; k++) {
+        char text[1024], name[32];
+        snprintf(text, sizeof text,
+                 "LookAt 0 0 0  %s  0 0 1\nCamera \"perspective\" \"float fov\" 5\n"
+                 "Film \"image\" \"integer xresolution\" %d \"integer yresolution\" %d\n"
+                 "WorldBegin\nLightSource \"infinite\" \"string mapname\" \"v3sky.exr\"\n",
+                 look[k], RES, RES);
+        snprintf(name, sizeof name, "v3sky%d.pbrt", k);
+        write_text(name, text);
+        float *img = render(name);
+        if (!img)
+            continue;
+        const float *c = &img[4 * ((RES / 2) * RES + RES / 2)];
+        printf("  looking along (%s): %.3f %.3f %.3f\n", look[k], c[0], c[1], c[2]);
+        CHECK(c[k] > 0.9f && c[(k + 1) % 3] < 0.1f && c[(k + 2) % 3] < 0.1f);
+        free(img);
+    }
+}
+
+TEST_MAIN(TEST(test_textured_roughness), TEST(test_v3_infinite_map),
+          TEST(test_other_textured_parameters), TEST(test_texture_mappings))

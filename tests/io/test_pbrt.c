@@ -1799,7 +1799,121 @@ static void test_mix_classes(void)
     free(r);
 }
 
-TEST_MAIN(TEST(test_filters), TEST(test_mix_classes), TEST(test_exposure),
+/* pbrt-v3's materials (Bitterli's and pbrt-v3-scenes' files): matte,
+ * plastic, uber and substrate (a Lambertian base plus a coat's lobe
+ * scaled by Ks), metal, mirror, glass (index), translucent, disney,
+ * kdsubsurface, v3's mix names and bumpmap; v3's roughness remapping
+ * (RoughnessToAlpha, not v4's square root); the infinite light's mapname
+ * (a z-up latitude-longitude map) and the image film, without warnings. */
+static void test_pbrt_v3(void)
+{
+    Rec *r = malloc(sizeof *r);
+    static const char *const mats[] = {
+        "Material \"matte\" \"rgb Kd\" [0.2 0.4 0.6]",
+        "Material \"plastic\" \"rgb Kd\" [0.5 0.1 0.1] \"rgb Ks\" [0.3 0.3 0.3] \"float "
+        "roughness\" 0.1",
+        "Material \"uber\" \"rgb Kd\" [0.1 0.2 0.3] \"float index\" 1.4 \"rgb opacity\" [0.5 0.5 "
+        "0.5]",
+        "Material \"metal\" \"rgb eta\" [0.2 0.9 1.1] \"rgb k\" [3.9 2.4 2.1]",
+        "Material \"mirror\"",
+        "Material \"glass\" \"float index\" 1.33 \"rgb Kt\" [0.9 1 0.9]",
+        "Material \"substrate\" \"rgb Kd\" [0.6 0.6 0.6] \"rgb Ks\" [0.2 0.2 0.2] "
+        "\"float uroughness\" 0.01 \"float vroughness\" 0.01 \"bool remaproughness\" \"false\"",
+        "Material \"translucent\" \"rgb Kd\" [0.5 0.5 0.5] \"rgb reflect\" [0.4 0.4 0.4]",
+        "Material \"disney\" \"rgb color\" [0.7 0.5 0.3] \"float metallic\" 1 \"float roughness\" "
+        "0.5",
+        "Material \"kdsubsurface\" \"rgb Kd\" [0.8 0.7 0.6] \"float mfp\" 2 \"float scale\" 4",
+        "MakeNamedMaterial \"a\" \"string type\" \"matte\" \"rgb Kd\" [0.2 0.2 0.2]\n"
+        "MakeNamedMaterial \"b\" \"string type\" \"plastic\"\n"
+        "Texture \"bumps\" \"float\" \"scale\" \"float tex1\" 0.5 \"float tex2\" 0.1\n"
+        "Material \"mix\" \"string namedmaterial1\" \"a\" \"string namedmaterial2\" \"b\" "
+        "\"float amount\" 0.5 \"texture bumpmap\" \"bumps\"",
+    };
+    enum { N = sizeof mats / sizeof mats[0] };
+    char text[8192] = "Film \"image\" \"integer xresolution\" 16 \"integer yresolution\" 16\n"
+                      "WorldBegin\nLightSource \"infinite\" \"string mapname\" \"sky.exr\"\n";
+    for (int k = 0; k < N; k++) {
+        strncat(text, mats[k], sizeof text - strlen(text) - 1);
+        strncat(text,
+                "\nShape \"trianglemesh\" \"point P\" [0 0 0 1 0 0 0 1 0] "
+                "\"integer indices\" [0 1 2]\n",
+                sizeof text - strlen(text) - 1);
+    }
+    strncat(
+        text,
+        "Shape \"cone\" \"float height\" 2 \"float radius\" 0.5\nShape \"paraboloid\"\n"
+        "Shape \"hyperboloid\" \"point p1\" [1 0 0] \"point p2\" [0 1 1] \"float phimax\" 180\n",
+        sizeof text - strlen(text) - 1);
+    ParseRun pr = {.name = "v3/t.pbrt", .text = text, .r = r};
+    const char *said = test_stderr_of(run_parse, &pr);
+    RayesError e = pr.e;
+    if (strstr(said, "warning"))
+        fprintf(stderr, "  %s", said);
+    CHECK(e == RAYES_OK && strstr(said, "warning") == NULL);
+    CHECK(r->n_meshes == N);
+    if (e != RAYES_OK || r->n_meshes != N) {
+        free(r);
+        return;
+    }
+    const Shader *sh = &r->mesh[0].shader;
+    CHECK(strcmp(sh->name, "diffuse") == 0 &&
+          fabsf(param(sh, "reflectance")->value[1] - 0.4f) < 1e-6f);
+    sh = &r->mesh[1].shader; /* v3's alpha of roughness 0.1, 0.4618, squared */
+    CHECK(strcmp(sh->name, "coateddiffuse") == 0 && param(sh, "specular") &&
+          fabsf(param(sh, "specular")->value[0] - 0.3f) < 1e-6f &&
+          fabsf(param(sh, "roughness")->value[0] - 0.21322f) < 1e-4f);
+    sh = &r->mesh[2].shader;
+    CHECK(strcmp(sh->name, "coateddiffuse") == 0 &&
+          fabsf(param(sh, "eta")->value[0] - 1.4f) < 1e-6f && param(sh, "Os") &&
+          fabsf(param(sh, "Os")->value[0] - 0.5f) < 1e-6f);
+    sh = &r->mesh[3].shader; /* metal's default roughness 0.01: alpha 0.1389 */
+    CHECK(strcmp(sh->name, "conductor") == 0 && fabsf(param(sh, "k")->value[0] - 3.9f) < 1e-6f &&
+          fabsf(param(sh, "roughness")->value[0] - 0.0193f) < 1e-5f);
+    sh = &r->mesh[4].shader;
+    CHECK(strcmp(sh->name, "conductor") == 0 &&
+          fabsf(param(sh, "reflectance")->value[0] - 0.9f) < 1e-6f &&
+          param(sh, "roughness")->value[0] == 0.0f);
+    sh = &r->mesh[5].shader;
+    CHECK(strcmp(sh->name, "dielectric") == 0 &&
+          fabsf(param(sh, "eta")->value[0] - 1.33f) < 1e-6f && param(sh, "transmitcolor") &&
+          fabsf(param(sh, "transmitcolor")->value[0] - 0.9f) < 1e-6f);
+    sh = &r->mesh[6].shader; /* alpha 0.01 given: roughness 1e-4 */
+    CHECK(strcmp(sh->name, "coateddiffuse") == 0 &&
+          fabsf(param(sh, "roughness")->value[0] - 1e-4f) < 1e-7f);
+    sh = &r->mesh[7].shader;
+    CHECK(strcmp(sh->name, "diffusetransmission") == 0 &&
+          fabsf(param(sh, "reflectance")->value[0] - 0.2f) < 1e-6f &&
+          fabsf(param(sh, "transmittance")->value[0] - 0.25f) < 1e-6f);
+    sh = &r->mesh[8].shader; /* Disney's alpha r^2: rayes' roughness r^4 */
+    CHECK(strcmp(sh->name, "conductor") == 0 &&
+          fabsf(param(sh, "roughness")->value[0] - 0.0625f) < 1e-6f);
+    sh = &r->mesh[9].shader;
+    CHECK(strcmp(sh->name, "subsurface") == 0 &&
+          fabsf(param(sh, "unitlength")->value[0] - 0.25f) < 1e-6f &&
+          fabsf(param(sh, "mfp")->value[0] - 2.0f) < 1e-6f);
+    sh = &r->mesh[10].shader; /* a matte and a plastic: a mix shader */
+    CHECK(strcmp(sh->name, "mix") == 0 && param(sh, "a") &&
+          strcmp(param(sh, "a")->string, "diffuse") == 0);
+    /* v3's quadrics, as RenderMan's */
+    CHECK(r->n_quadrics == 3);
+    if (r->n_quadrics == 3) {
+        CHECK(r->quadric[0].type == RAYES_QUADRIC_CONE && r->quadric[0].n == 3 &&
+              r->quadric[0].p[0] == 2.0f && r->quadric[0].p[1] == 0.5f &&
+              r->quadric[0].p[2] == 360.0f);
+        CHECK(r->quadric[1].type == RAYES_QUADRIC_PARABOLOID && r->quadric[1].n == 4 &&
+              r->quadric[1].p[0] == 1.0f && r->quadric[1].p[2] == 1.0f);
+        CHECK(r->quadric[2].type == RAYES_QUADRIC_HYPERBOLOID && r->quadric[2].n == 7 &&
+              r->quadric[2].p[0] == 1.0f && r->quadric[2].p[4] == 1.0f &&
+              r->quadric[2].p[6] == 180.0f);
+    }
+    CHECK(r->n_lights == 1 && strcmp(r->light[0].type, "environmentlight") == 0);
+    const Shader *lp = &r->light[0].params;
+    CHECK(param(lp, "mapping") && strcmp(param(lp, "mapping")->string, "latlong-zup") == 0);
+    CHECK(param(lp, "mapname") && strstr(param(lp, "mapname")->string, "sky.exr") != NULL);
+    free(r);
+}
+
+TEST_MAIN(TEST(test_filters), TEST(test_pbrt_v3), TEST(test_mix_classes), TEST(test_exposure),
           TEST(test_subsurface_material), TEST(test_filter_warnings), TEST(test_import),
           TEST(test_film_types), TEST(test_measured_material), TEST(test_portal_warns),
           TEST(test_thin_dielectric), TEST(test_annulus), TEST(test_triangle_light),
