@@ -157,15 +157,20 @@ int pbrt_d_light(Parser *P, const Token *t)
             r = -1;
         if (!gonio)
             col[0] = col[1] = col[2] = 1;
+        /* pbrt-v3 names the image "mapname"; its goniometric one is a
+         * z-up latitude-longitude map (v4's an octahedral square) */
         const char *file = pbrt_get_string(&pl, "filename", NULL);
-        if (!file && !r)
+        const char *v3_map = file ? NULL : pbrt_get_string(&pl, "mapname", NULL);
+        if (!file && !v3_map && !r)
             r = FAIL_TOK(P, t, "LightSource \"%s\": expected \"string filename\"", type);
         if (!r)
-            r = pbrt_resolve(P, t, file, map_path, sizeof map_path);
+            r = pbrt_resolve(P, t, file ? file : v3_map, map_path, sizeof map_path);
         lp[n++] = (RayesParam){.name = "mapname", .type = RAYES_PARAM_STRING, .string = map_path};
         lp[n++] = (RayesParam){.name = "mapping",
                                .type = RAYES_PARAM_STRING,
-                               .string = gonio ? "octahedral" : "projection"};
+                               .string = !gonio ? "projection"
+                                         : file ? "octahedral"
+                                                : "latlong-zup"};
         if (!gonio)
             lp[n++] = (RayesParam){.name = "fov",
                                    .type = RAYES_PARAM_FLOAT,

@@ -1831,7 +1831,9 @@ static void test_pbrt_v3(void)
     };
     enum { N = sizeof mats / sizeof mats[0] };
     char text[8192] = "Film \"image\" \"integer xresolution\" 16 \"integer yresolution\" 16\n"
-                      "WorldBegin\nLightSource \"infinite\" \"string mapname\" \"sky.exr\"\n";
+                      "WorldBegin\nLightSource \"infinite\" \"string mapname\" \"sky.exr\"\n"
+                      "LightSource \"goniometric\" \"string mapname\" \"g.exr\"\n"
+                      "LightSource \"projection\" \"string mapname\" \"p.exr\"\n";
     for (int k = 0; k < N; k++) {
         strncat(text, mats[k], sizeof text - strlen(text) - 1);
         strncat(text,
@@ -1906,10 +1908,17 @@ static void test_pbrt_v3(void)
               r->quadric[2].p[0] == 1.0f && r->quadric[2].p[4] == 1.0f &&
               r->quadric[2].p[6] == 180.0f);
     }
-    CHECK(r->n_lights == 1 && strcmp(r->light[0].type, "environmentlight") == 0);
+    CHECK(r->n_lights == 3 && strcmp(r->light[0].type, "environmentlight") == 0);
     const Shader *lp = &r->light[0].params;
     CHECK(param(lp, "mapping") && strcmp(param(lp, "mapping")->string, "latlong-zup") == 0);
     CHECK(param(lp, "mapname") && strstr(param(lp, "mapname")->string, "sky.exr") != NULL);
+    if (r->n_lights == 3) { /* v3's goniometric map: z-up latitude-longitude too */
+        lp = &r->light[1].params;
+        CHECK(param(lp, "mapping") && strcmp(param(lp, "mapping")->string, "latlong-zup") == 0);
+        lp = &r->light[2].params;
+        CHECK(param(lp, "mapping") && strcmp(param(lp, "mapping")->string, "projection") == 0 &&
+              strstr(param(lp, "mapname")->string, "p.exr") != NULL);
+    }
     free(r);
 }
 
