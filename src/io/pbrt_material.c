@@ -150,6 +150,9 @@ static int imagemap_params(Parser *P, const Token *t, ParamList *pl, int is_floa
             P, ep->line, ep->col,
             "imagemap: expected encoding \"sRGB\", \"linear\" or \"gamma G\", found \"%.40s\"",
             enc);
+    Param *gamma = enc ? NULL : pbrt_find(pl, "gamma"); /* pbrt-v3's: sRGB or linear */
+    if (gamma && gamma->type == PT_BOOL && gamma->n_num > 0)
+        enc = gamma->num[0] != 0 ? "sRGB" : "linear";
     if (enc)
         q[(*n)++] = (RayesParam){.name = "encoding", .type = RAYES_PARAM_STRING, .string = enc};
     if (is_float)
@@ -162,6 +165,7 @@ static int imagemap_params(Parser *P, const Token *t, ParamList *pl, int is_floa
                      "imagemap: wrap \"%.40s\" is not supported; the image repeats", wrap);
     (void)pbrt_find(pl, "filter"); /* rayes always filters (OpenImageIO's anisotropic MIP) */
     (void)pbrt_find(pl, "maxanisotropy");
+    (void)pbrt_find(pl, "trilinear"); /* pbrt-v3's filter choice */
     float sc = (float)pbrt_get_float(pl, "scale", 1.0);
     standin[0] = standin[1] = standin[2] = sc;
     tex_mapping(P, t, pl, q, n);

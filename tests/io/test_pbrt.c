@@ -1809,6 +1809,9 @@ static void test_pbrt_v3(void)
 {
     Rec *r = malloc(sizeof *r);
     static const char *const mats[] = {
+        "Texture \"im\" \"color\" \"imagemap\" \"string filename\" \"a.png\" \"bool gamma\" "
+        "\"false\" "
+        "\"bool trilinear\" \"true\"\nMaterial \"matte\" \"texture Kd\" \"im\"",
         "Material \"matte\" \"rgb Kd\" [0.2 0.4 0.6]",
         "Material \"plastic\" \"rgb Kd\" [0.5 0.1 0.1] \"rgb Ks\" [0.3 0.3 0.3] \"float "
         "roughness\" 0.1",
@@ -1857,43 +1860,48 @@ static void test_pbrt_v3(void)
         free(r);
         return;
     }
-    const Shader *sh = &r->mesh[0].shader;
+    const Shader *sh = &r->mesh[0].shader; /* v3's gamma false: a linear image */
+    const RayesParam *kd = param(sh, "reflectance");
+    int g = kd && kd->type == RAYES_PARAM_PATTERN ? pattern_index(r, kd->string) : -1;
+    CHECK(strcmp(sh->name, "diffuse") == 0 && g >= 0 && param(&r->pattern[g].params, "encoding") &&
+          strcmp(param(&r->pattern[g].params, "encoding")->string, "linear") == 0);
+    sh = &r->mesh[1].shader;
     CHECK(strcmp(sh->name, "diffuse") == 0 &&
           fabsf(param(sh, "reflectance")->value[1] - 0.4f) < 1e-6f);
-    sh = &r->mesh[1].shader; /* v3's alpha of roughness 0.1, 0.4618, squared */
+    sh = &r->mesh[2].shader; /* v3's alpha of roughness 0.1, 0.4618, squared */
     CHECK(strcmp(sh->name, "coateddiffuse") == 0 && param(sh, "specular") &&
           fabsf(param(sh, "specular")->value[0] - 0.3f) < 1e-6f &&
           fabsf(param(sh, "roughness")->value[0] - 0.21322f) < 1e-4f);
-    sh = &r->mesh[2].shader;
+    sh = &r->mesh[3].shader;
     CHECK(strcmp(sh->name, "coateddiffuse") == 0 &&
           fabsf(param(sh, "eta")->value[0] - 1.4f) < 1e-6f && param(sh, "Os") &&
           fabsf(param(sh, "Os")->value[0] - 0.5f) < 1e-6f);
-    sh = &r->mesh[3].shader; /* metal's default roughness 0.01: alpha 0.1389 */
+    sh = &r->mesh[4].shader; /* metal's default roughness 0.01: alpha 0.1389 */
     CHECK(strcmp(sh->name, "conductor") == 0 && fabsf(param(sh, "k")->value[0] - 3.9f) < 1e-6f &&
           fabsf(param(sh, "roughness")->value[0] - 0.0193f) < 1e-5f);
-    sh = &r->mesh[4].shader;
+    sh = &r->mesh[5].shader;
     CHECK(strcmp(sh->name, "conductor") == 0 &&
           fabsf(param(sh, "reflectance")->value[0] - 0.9f) < 1e-6f &&
           param(sh, "roughness")->value[0] == 0.0f);
-    sh = &r->mesh[5].shader;
+    sh = &r->mesh[6].shader;
     CHECK(strcmp(sh->name, "dielectric") == 0 &&
           fabsf(param(sh, "eta")->value[0] - 1.33f) < 1e-6f && param(sh, "transmitcolor") &&
           fabsf(param(sh, "transmitcolor")->value[0] - 0.9f) < 1e-6f);
-    sh = &r->mesh[6].shader; /* alpha 0.01 given: roughness 1e-4 */
+    sh = &r->mesh[7].shader; /* alpha 0.01 given: roughness 1e-4 */
     CHECK(strcmp(sh->name, "coateddiffuse") == 0 &&
           fabsf(param(sh, "roughness")->value[0] - 1e-4f) < 1e-7f);
-    sh = &r->mesh[7].shader;
+    sh = &r->mesh[8].shader;
     CHECK(strcmp(sh->name, "diffusetransmission") == 0 &&
           fabsf(param(sh, "reflectance")->value[0] - 0.2f) < 1e-6f &&
           fabsf(param(sh, "transmittance")->value[0] - 0.25f) < 1e-6f);
-    sh = &r->mesh[8].shader; /* Disney's alpha r^2: rayes' roughness r^4 */
+    sh = &r->mesh[9].shader; /* Disney's alpha r^2: rayes' roughness r^4 */
     CHECK(strcmp(sh->name, "conductor") == 0 &&
           fabsf(param(sh, "roughness")->value[0] - 0.0625f) < 1e-6f);
-    sh = &r->mesh[9].shader;
+    sh = &r->mesh[10].shader;
     CHECK(strcmp(sh->name, "subsurface") == 0 &&
           fabsf(param(sh, "unitlength")->value[0] - 0.25f) < 1e-6f &&
           fabsf(param(sh, "mfp")->value[0] - 2.0f) < 1e-6f);
-    sh = &r->mesh[10].shader; /* a matte and a plastic: a mix shader */
+    sh = &r->mesh[11].shader; /* a matte and a plastic: a mix shader */
     CHECK(strcmp(sh->name, "mix") == 0 && param(sh, "a") &&
           strcmp(param(sh, "a")->string, "diffuse") == 0);
     /* v3's quadrics, as RenderMan's */
