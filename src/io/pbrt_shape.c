@@ -297,6 +297,53 @@ static Param *uv_param(Parser *P, ParamList *pl, const char *what, size_t n_poin
     return uv;
 }
 
+/* pbrt-v3's heightfield (v4 dropped it): nu x nv heights Pz over the
+ * unit square, x = i / (nu - 1) and y = j / (nv - 1), as a mesh of two
+ * triangles a cell with uv = (x, y), as pbrt-v3 refines it. At most 2^24
+ * points. */
+static int shape_heightfield(Parser *P, const Token *t, ParamList *pl)
+{
+    double nu = pbrt_get_float(pl, "nu", 0.0), nv = pbrt_get_float(pl, "nv", 0.0);
+    Param *pz = pbrt_find(pl, "Pz");
+    if (!(nu >= 2 && nv >= 2 && nu == floor(nu) && nv == floor(nv) && nu * nv <= 16777216.0))
+        return FAIL_TOK(P, t,
+                        "heightfield: expected integer nu and nv of at least 2 (at most "
+                        "2^24 points)");
+    size_t w = (size_t)nu, h = (size_t)nv, n_points = w * h;
+    if (!pz || pz->n_num != n_points)
+        return FAIL_TOK(P, t, "heightfield: expected \"float Pz\" with nu nv = %zu values",
+                        n_points);
+    size_t n_faces = 2 * (w - 1) * (h - 1);
+    float *pts = malloc(3 * n_points * sizeof *pts), *uv = malloc(2 * n_points * sizeof *uv);
+    int *nvs = malloc(n_faces * sizeof *nvs), *idx = malloc(3 * n_faces * sizeof *idx);
+    int r = -1;
+    if (!pts || !uv || !nvs || !idx) {
+        FAIL_TOK(P, t, "out of memory");
+    } else {
+        for (size_t j = 0; j < h; j++)
+            for (size_t i = 0; i < w; i++) {
+                size_t k = j * w + i;
+                pts[3 * k] = uv[2 * k] = (float)i / (float)(w - 1);
+                pts[3 * k + 1] = uv[2 * k + 1] = (float)j / (float)(h - 1);
+                pts[3 * k + 2] = (float)pz->num[k];
+            }
+        size_t f = 0;
+        for (size_t j = 0; j + 1 < h; j++)
+            for (size_t i = 0; i + 1 < w; i++) {
+                int a = (int)(j * w + i), b = a + 1, c = a + (int)w + 1, d = a + (int)w;
+                const int tri[6] = {a, b, c, a, c, d};
+                memcpy(&idx[3 * f], tri, sizeof tri);
+                nvs[f++] = 3, nvs[f++] = 3;
+            }
+        r = shape_mesh(P, t, "heightfield", n_faces, nvs, idx, n_points, pts, NULL, uv);
+    }
+    free(pts);
+    free(uv);
+    free(nvs);
+    free(idx);
+    return r;
+}
+
 static int shape_trianglemesh(Parser *P, const Token *t, ParamList *pl)
 {
     Param *pp = pbrt_find(pl, "P"), *ip = pbrt_find(pl, "indices"), *np = pbrt_find(pl, "N");
@@ -809,6 +856,8 @@ static int shape_of_type(Parser *P, const Token *t, const char *type, ParamList 
         return shape_plymesh(P, t, pl);
     if (strcmp(type, "curve") == 0)
         return shape_curve(P, t, pl);
+    if (strcmp(type, "heightfield") == 0)
+        return shape_heightfield(P, t, pl);
     if (strcmp(type, "cone") == 0 || strcmp(type, "paraboloid") == 0 ||
         strcmp(type, "hyperboloid") == 0)
         return shape_v3_quadric(P, t, type, pl);

@@ -1844,19 +1844,20 @@ static void test_pbrt_v3(void)
                 "\"integer indices\" [0 1 2]\n",
                 sizeof text - strlen(text) - 1);
     }
-    strncat(
-        text,
-        "Shape \"cone\" \"float height\" 2 \"float radius\" 0.5\nShape \"paraboloid\"\n"
-        "Shape \"hyperboloid\" \"point p1\" [1 0 0] \"point p2\" [0 1 1] \"float phimax\" 180\n",
-        sizeof text - strlen(text) - 1);
+    strncat(text,
+            "Shape \"cone\" \"float height\" 2 \"float radius\" 0.5\nShape \"paraboloid\"\n"
+            "Shape \"hyperboloid\" \"point p1\" [1 0 0] \"point p2\" [0 1 1] \"float phimax\" 180\n"
+            "Shape \"heightfield\" \"integer nu\" 3 \"integer nv\" 2 \"float Pz\" [0 1 0 0 1 0]\n",
+            sizeof text - strlen(text) - 1);
     ParseRun pr = {.name = "v3/t.pbrt", .text = text, .r = r};
     const char *said = test_stderr_of(run_parse, &pr);
     RayesError e = pr.e;
     if (strstr(said, "warning"))
         fprintf(stderr, "  %s", said);
     CHECK(e == RAYES_OK && strstr(said, "warning") == NULL);
-    CHECK(r->n_meshes == N);
-    if (e != RAYES_OK || r->n_meshes != N) {
+    CHECK(r->n_meshes == N + 1); /* and the heightfield: 3 x 2 heights, 4 triangles */
+    CHECK(r->mesh[N].n_faces == 4 && r->mesh[N].n_points == 6);
+    if (e != RAYES_OK || r->n_meshes != N + 1) {
         free(r);
         return;
     }
