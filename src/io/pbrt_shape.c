@@ -393,11 +393,12 @@ static int shape_trianglemesh(Parser *P, const Token *t, ParamList *pl)
 }
 
 /* loopsubdiv: the Loop limit surface of a triangle mesh, diced like every
- * surface ("levels" is pbrt's fixed refinement, not needed). */
+ * surface ("levels", v3's "nlevels", is pbrt's fixed refinement, not needed). */
 static int shape_loopsubdiv(Parser *P, const Token *t, ParamList *pl)
 {
     Param *pp = pbrt_find(pl, "P"), *ip = pbrt_find(pl, "indices"), *lv = pbrt_find(pl, "levels");
     (void)lv; /* read, so it is not reported as unused */
+    (void)pbrt_find(pl, "nlevels"); /* pbrt-v3's name for it */
     if (!pp || pp->n_num < 9 || pp->n_num % 3 != 0)
         return FAIL_TOK(P, t, "loopsubdiv: expected \"point3 P\" with at least 3 points");
     size_t n_points = pp->n_num / 3;
