@@ -41,6 +41,8 @@ int pbrt_d_arealight(Parser *P, const Token *t)
     double scale = pbrt_get_float(&pl, "scale", 1.0);
     Param *tw = pbrt_find(&pl, "twosided");
     P->gs.area.twosided = tw && tw->n_num > 0 && tw->num[0] != 0;
+    (void)pbrt_find(&pl, "nsamples"); /* pbrt-v3's samples a light: rayes' shadow rays */
+    (void)pbrt_find(&pl, "samples");
     if (pbrt_find(&pl, "filename"))
         pbrt_warn_at(P, t->line, t->col, "area filename", "AreaLightSource: image emission "
                      "(\"filename\") is not supported; using L");
@@ -75,6 +77,7 @@ int pbrt_d_light(Parser *P, const Token *t)
         return -1;
     }
     double scale = pbrt_get_float(&pl, "scale", 1.0), power = pbrt_get_float(&pl, "power", 0.0);
+    (void)pbrt_find(&pl, "nsamples"); /* pbrt-v3's samples a light: rayes' shadow rays */
     float col[3];
     RayesParam lp[8];
     char map_path[4096];

@@ -304,6 +304,10 @@ int pbrt_d_integrator(Parser *P, const Token *t)
      * the albedo's power: past PBRT_DIFFUSE_BOUNCES the bounces stop, with
      * one warning (docs/pbrt.md: the Cornell box's figures). */
     int bounces = depth >= 1 ? (int)fmin(depth - 1, 1e6) : 0;
+    /* pbrt-v3's directlighting and whitted: direct light and specular
+     * paths alone, maxdepth their specular depth */
+    if (strcmp(type, "directlighting") == 0 || strcmp(type, "whitted") == 0)
+        bounces = 0;
     P->settings->bounces = bounces < PBRT_DIFFUSE_BOUNCES ? bounces : PBRT_DIFFUSE_BOUNCES;
     P->settings->specular_depth = (int)fmin(depth, 64);
     if (bounces > PBRT_DIFFUSE_BOUNCES && !(P->options && P->options->bounces_given))
@@ -319,6 +323,7 @@ int pbrt_d_integrator(Parser *P, const Token *t)
                      "cache)", type);
     pbrt_find(&pl, "regularize");
     pbrt_find(&pl, "lightsampler");
+    pbrt_find(&pl, "strategy"); /* pbrt-v3 directlighting's: rayes samples every light */
     pbrt_warn_unused(P, &pl, "Integrator", type);
     pbrt_params_free(&pl);
     return 0;
