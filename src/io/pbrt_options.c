@@ -228,9 +228,18 @@ int pbrt_d_film(Parser *P, const Token *t)
         return FAIL_TOK(P, t, "Film: expected iso > 0, found %g", iso);
     }
     P->iso = (float)iso;
+    /* pbrt-v3's image film: "scale" multiplies the image (as iso / 100
+     * does) and "maxsampleluminance" clamps samples */
+    double v3_scale = pbrt_get_float(&pl, "scale", 1.0);
+    if (!(v3_scale > 0) || !isfinite(v3_scale)) {
+        pbrt_params_free(&pl);
+        return FAIL_TOK(P, t, "Film: expected scale > 0, found %g", v3_scale);
+    }
+    P->iso *= (float)v3_scale;
     /* pbrt-v4 clamps each sample's largest component to this (infinite by
      * default): rayes's sample clamp */
-    double mcv = pbrt_get_float(&pl, "maxcomponentvalue", INFINITY);
+    double mcv = pbrt_get_float(&pl, "maxcomponentvalue",
+                                pbrt_get_float(&pl, "maxsampleluminance", INFINITY));
     if (!(mcv > 0)) {
         pbrt_params_free(&pl);
         return FAIL_TOK(P, t, "Film: expected maxcomponentvalue > 0, found %g", mcv);

@@ -1833,7 +1833,8 @@ static void test_pbrt_v3(void)
         "\"float amount\" 0.5 \"texture bumpmap\" \"bumps\"",
     };
     enum { N = sizeof mats / sizeof mats[0] };
-    char text[8192] = "Film \"image\" \"integer xresolution\" 16 \"integer yresolution\" 16\n"
+    char text[8192] = "Film \"image\" \"integer xresolution\" 16 \"integer yresolution\" 16 "
+                      "\"float scale\" 2 \"float maxsampleluminance\" 10\n"
                       "Integrator \"directlighting\" \"integer maxdepth\" 7\n"
                       "WorldBegin\nLightSource \"infinite\" \"string mapname\" \"sky.exr\"\n"
                       "LightSource \"goniometric\" \"string mapname\" \"g.exr\"\n"
@@ -1857,6 +1858,7 @@ static void test_pbrt_v3(void)
         fprintf(stderr, "  %s", said);
     CHECK(e == RAYES_OK && strstr(said, "warning") == NULL);
     CHECK(pr.s.bounces == 0 && pr.s.specular_depth == 7); /* directlighting: direct light */
+    CHECK(pr.s.exposure_gain == 2.0f && pr.s.sample_clamp == 10.0f); /* the image film's */
     CHECK(r->n_meshes == N + 1); /* and the heightfield: 3 x 2 heights, 4 triangles */
     CHECK(r->mesh[N].n_faces == 4 && r->mesh[N].n_points == 6);
     if (e != RAYES_OK || r->n_meshes != N + 1) {
