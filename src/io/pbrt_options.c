@@ -357,9 +357,13 @@ int pbrt_d_filter(Parser *P, const Token *t)
     while (k < n && strcmp(type, filters[k].name) != 0)
         k++;
     if (k < n) {
-        double rx = pbrt_get_float(&pl, "xradius", filters[k].radius);
-        double ry = pbrt_get_float(&pl, "yradius", rx);
+        /* pbrt-v3 called the radii xwidth and ywidth, and Gaussian's
+         * falloff alpha (ignored, as v4's sigma is) */
+        double rx =
+            pbrt_get_float(&pl, "xradius", pbrt_get_float(&pl, "xwidth", filters[k].radius));
+        double ry = pbrt_get_float(&pl, "yradius", pbrt_get_float(&pl, "ywidth", rx));
         pbrt_find(&pl, "sigma");
+        pbrt_find(&pl, "alpha");
         double B = pbrt_get_float(&pl, "B", 1.0 / 3), C = pbrt_get_float(&pl, "C", 1.0 / 3);
         double tau = pbrt_get_float(&pl, "tau", 3);
         if (fabs(B - 1.0 / 3) > 1e-3 || fabs(C - 1.0 / 3) > 1e-3 || fabs(tau - 3) > 1e-3)

@@ -1836,6 +1836,7 @@ static void test_pbrt_v3(void)
     char text[8192] = "Film \"image\" \"integer xresolution\" 16 \"integer yresolution\" 16 "
                       "\"float scale\" 2 \"float maxsampleluminance\" 10\n"
                       "Integrator \"directlighting\" \"integer maxdepth\" 7\n"
+                      "PixelFilter \"triangle\" \"float xwidth\" 1 \"float ywidth\" 1\n"
                       "WorldBegin\nLightSource \"infinite\" \"string mapname\" \"sky.exr\"\n"
                       "LightSource \"goniometric\" \"string mapname\" \"g.exr\"\n"
                       "LightSource \"projection\" \"string mapname\" \"p.exr\"\n";
@@ -1859,6 +1860,7 @@ static void test_pbrt_v3(void)
     CHECK(e == RAYES_OK && strstr(said, "warning") == NULL);
     CHECK(pr.s.bounces == 0 && pr.s.specular_depth == 7); /* directlighting: direct light */
     CHECK(pr.s.exposure_gain == 2.0f && pr.s.sample_clamp == 10.0f); /* the image film's */
+    CHECK(pr.s.filter_width == 2.0f);                                /* v3's xwidth is the radius */
     CHECK(r->n_meshes == N + 1); /* and the heightfield: 3 x 2 heights, 4 triangles */
     CHECK(r->mesh[N].n_faces == 4 && r->mesh[N].n_points == 6);
     if (e != RAYES_OK || r->n_meshes != N + 1) {
