@@ -10,6 +10,8 @@
  * uscale and invert, a textured subsurface reflectance and a textured
  * displacement render without warnings too, the reflectances' halves in
  * their ratio, and the displaced plane differs from the flat one.
+ * pbrt-v3: a z-up sky map seen along three directions, and Bitterli's
+ * Cornell box in v3's words rendering the bytes of its v4 form.
  */
 #include <math.h>
 #include <stdio.h>
@@ -254,5 +256,69 @@ static void test_v3_infinite_map(void)
     }
 }
 
-TEST_MAIN(TEST(test_textured_roughness), TEST(test_v3_infinite_map),
+/* text with every `from` replaced by `to` (malloc'd). */
+static char *replaced(const char *text, const char *from, const char *to)
+{
+    size_t n = 0, lf = strlen(from), lt = strlen(to);
+    for (const char *p = strstr(text, from); p; p = strstr(p + lf, from))
+        n++;
+    char *out = malloc(strlen(text) + n * (lt > lf ? lt - lf : 0) + 1), *o = out;
+    if (!out)
+        return NULL;
+    for (const char *p = text;;) {
+        const char *q = strstr(p, from);
+        size_t k = q ? (size_t)(q - p) : strlen(p);
+        memcpy(o, p, k), o += k;
+        if (!q)
+            break;
+        memcpy(o, to, lt), o += lt;
+        p = q + lf;
+    }
+    *o = '\0';
+    return out;
+}
+
+/* Bitterli's Cornell box in pbrt-v3's words (matte and Kd, the image
+ * film, xwidth, point and float uv) renders the same bytes as in pbrt-v4's
+ * (diffuse and reflectance, ...). */
+static void test_v3_cornell_box(void)
+{
+    FILE *f = fopen(RAYES_TEST_DATA "/scenes/pbrt-bitterli/cornell-box/scene-v4.pbrt", "rb");
+    CHECK(f != NULL);
+    if (!f)
+        return;
+    static char v4[65536];
+    size_t n = fread(v4, 1, sizeof v4 - 1, f);
+    fclose(f);
+    v4[n] = '\0';
+    static const char *const pairs[][2] = {{"[ 512 ]", "[ 64 ]"},
+                                           {"[ \"diffuse\" ]", "[ \"matte\" ]"},
+                                           {"rgb reflectance", "rgb Kd"},
+                                           {"Film \"rgb\"", "Film \"image\""},
+                                           {"float xradius", "float xwidth"},
+                                           {"float yradius", "float ywidth"},
+                                           {"point3 P", "point P"},
+                                           {"point2 uv", "float uv"}};
+    char *v3 = replaced(v4, pairs[0][0], pairs[0][1]), *four = v3 ? strdup(v3) : NULL;
+    for (size_t k = 1; v3 && k < sizeof pairs / sizeof pairs[0]; k++) {
+        char *next = replaced(v3, pairs[k][0], pairs[k][1]);
+        free(v3);
+        v3 = next;
+    }
+    CHECK(v3 && four && strstr(v3, "\"matte\"") && !strstr(v3, "reflectance"));
+    mkdir(TMP, 0755);
+    if (v3 && four) {
+        write_text("cornell3.pbrt", v3);
+        write_text("cornell4.pbrt", four);
+        float *a = render("cornell3.pbrt"), *b = render("cornell4.pbrt");
+        CHECK(a && b && memcmp(a, b, (size_t)RES * RES * 4 * sizeof *a) == 0);
+        CHECK(a && quadrant(a, 0) > 0.03); /* lit (the red wall's corner) */
+        free(a);
+        free(b);
+    }
+    free(v3);
+    free(four);
+}
+
+TEST_MAIN(TEST(test_textured_roughness), TEST(test_v3_infinite_map), TEST(test_v3_cornell_box),
           TEST(test_other_textured_parameters), TEST(test_texture_mappings))
