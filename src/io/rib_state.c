@@ -1093,8 +1093,9 @@ static int h_option_attribute(Rib *r, const Args *a)
                               c);
             else
                 r->settings->png_curve = c[0] == 's' ? IO_CURVE_SRGB : IO_CURVE_LINEAR;
-        } else if (!option && strcmp(group, "identifier") == 0) {
-            /* names are for messages only */
+        } else if (strcmp(group, "identifier") == 0 || strcmp(group, "user") == 0) {
+            /* names are for messages only; user data is for the user's own
+             * shaders (PRMan keeps it without a word) */
         } else if (!(!option && strcmp(group, "displacementbound") == 0)) {
             char key[160];
             snprintf(key, sizeof key, "%s %s:%s", r->req, group, q->d.name);

@@ -1314,7 +1314,9 @@ static void test_attributes_rayes_always_does(void)
 {
     TextRun yes = {WORLD("Attribute \"render\" \"truedisplacement\" [1]\n"
                          "Attribute \"trace\" \"displacements\" [1]\n"
-                         "Attribute \"dice\" \"binary\" [1]\nSphere 1 -1 1 360")};
+                         "Attribute \"dice\" \"binary\" [1]\n"
+                         "Attribute \"user\" \"string look\" [\"wet\"] \"float id\" [3]\n"
+                         "Sphere 1 -1 1 360")};
     const char *said = test_stderr_of(run_text, &yes);
     CHECK(yes.e == RAYES_OK && strstr(said, "warning") == NULL);
     TextRun no = {WORLD("Attribute \"render\" \"truedisplacement\" [0]\nSphere 1 -1 1 360")};
@@ -1329,7 +1331,7 @@ static void test_attributes_rayes_always_does(void)
  * and exporters' files): single-quoted strings, a spotlight's coneangle
  * outside (0, pi] taken through its cosine as RenderMan's spotlight takes
  * it, a light whose from and to coincide skipped, a disk of negative
- * radius (turned over), RenderMan 21's Displace (not built: a warning), an
+ * radius (turned over), RenderMan 21's Displace (a PxrDisplace of nothing), an
  * archive found in the working directory, shaders named by a path, a light
  * shader with a position alone as a point light, inline archives
  * (ArchiveBegin ... ArchiveEnd), RenderMan 22's "Ri" options and
