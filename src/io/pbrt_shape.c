@@ -820,6 +820,7 @@ done:
 static int shape_alpha(Parser *P, const Token *t, ParamList *pl, Material *out)
 {
     Param *p = pbrt_find(pl, "alpha");
+    (void)pbrt_find(pl, "shadowalpha"); /* pbrt-v3's, for shadows: alpha already cuts them */
     const Texture *tex = NULL;
     float a[3];
     static const float one[3] = {1, 1, 1};
