@@ -666,14 +666,23 @@ static int obj_statement(Obj *o, Lexer *L, const char *kw, size_t n)
     if (is_kw(kw, n, "s")) { /* s N, s off (0): the smoothing group of the faces after */
         const char *tok;
         size_t k = lex_token(L, &tok);
-        float g;
-        if (is_kw(tok, k, "off"))
+        double g;
+        char *end = NULL, buf[32];
+        snprintf(buf, sizeof buf, "%.*s", (int)(k < 31 ? k : 31), k ? tok : "");
+        g = k ? strtod(buf, &end) : 0.0;
+        if (is_kw(tok, k, "off") || (end && *end == '\0' && g == 0.0))
             o->cur_s = 0;
-        else if (k > 0 && parse_float(tok, k, &g) == 0 && g >= 0 && g == floorf(g) && g < 1e9f)
-            o->cur_s = (int)g;
-        else
-            return lex_expected(L, tok, k, "a smoothing group number or off");
-        return lex_expect_end(L, "the end of the line");
+        else if (end && *end == '\0' && g > 0.0 && isfinite(g))
+            o->cur_s = (int)fmod(floor(g), 2147483647.0) + 1; /* large (bitmask) groups too */
+        else { /* "s", "s on" (exporters write them): group 1; other words, one warning */
+            if (k && !is_kw(tok, k, "on"))
+                obj_warn(o, "s value", "%s:%ld: \"s %.20s\": taken as smoothing group 1", L->name,
+                         L->line, buf);
+            o->cur_s = 2; /* group 1's */
+        }
+        while (lex_token(L, &tok) > 0)
+            ;
+        return 0;
     }
     if (is_kw(kw, n, "g") || is_kw(kw, n, "o")) {
         const char *tok; /* names: read, not used */

@@ -838,14 +838,20 @@ static int subsurface_material(Parser *P, const Token *t, ParamList *pl, Materia
  * through v3's polynomial in log(roughness) (TrowbridgeReitz's
  * RoughnessToAlpha, not v4's square root), or alpha itself with
  * "remaproughness" false; uroughness and vroughness as their alphas'
- * geometric mean. Constants (a texture's constant value). */
-static int v3_roughness(Parser *P, ParamList *pl, double def, Material *m)
+ * geometric mean. Materials that are specular at roughness 0 (v3's glass
+ * and kdsubsurface test it before remapping: zero_is_smooth) stay 0.
+ * Constants (a texture's constant value). */
+static int v3_roughness(Parser *P, ParamList *pl, double def, int zero_is_smooth, Material *m)
 {
     double r, ru, rv;
     if (pbrt_get_float_tex(P, pl, "roughness", def, &r) != 0 ||
         pbrt_get_float_tex(P, pl, "uroughness", r, &ru) != 0 ||
         pbrt_get_float_tex(P, pl, "vroughness", r, &rv) != 0)
         return -1;
+    if (zero_is_smooth && ru == 0.0 && rv == 0.0) { /* v3's glass: specular, no remap */
+        mat_float(m, "roughness", 0.0f);
+        return 0;
+    }
     Param *remap = pbrt_find(pl, "remaproughness");
     int alpha_given = remap && remap->n_num && remap->num[0] == 0.0;
     double a[2], in[2] = {ru, rv};
@@ -905,7 +911,7 @@ static int v3_material(Parser *P, const Token *t, const char *type, ParamList *p
         pbrt_mat_init(m, "coateddiffuse");
         if (mat_textured(P, pl, m, "Kd", "reflectance", RAYES_PARAM_COLOR, sub ? half : quarter) ||
             mat_textured(P, pl, m, "Ks", "specular", RAYES_PARAM_COLOR, sub ? half : quarter) ||
-            v3_roughness(P, pl, 0.1, m))
+            v3_roughness(P, pl, 0.1, 0, m))
             return -1;
         mat_float(m, "eta", type[0] == 'u' ? v3_eta(P, pl, 1.5) : 1.5f);
         mat_float(m, "thickness", 0.0f);
@@ -925,7 +931,7 @@ static int v3_material(Parser *P, const Token *t, const char *type, ParamList *p
         pbrt_mat_init(m, "conductor");
         if (mat_textured(P, pl, m, "eta", "eta", RAYES_PARAM_COLOR, cu_eta) ||
             mat_textured(P, pl, m, "k", "k", RAYES_PARAM_COLOR, cu_k) ||
-            v3_roughness(P, pl, 0.01, m))
+            v3_roughness(P, pl, 0.01, 0, m))
             return -1;
         return 1;
     }
@@ -940,7 +946,7 @@ static int v3_material(Parser *P, const Token *t, const char *type, ParamList *p
         float kt[3];
         pbrt_mat_init(m, "dielectric");
         mat_float(m, "eta", v3_eta(P, pl, 1.5));
-        if (v3_roughness(P, pl, 0.0, m) || pbrt_get_color(P, pl, "Kt", one, kt, NULL) < 0)
+        if (v3_roughness(P, pl, 0.0, 1, m) || pbrt_get_color(P, pl, "Kt", one, kt, NULL) < 0)
             return -1;
         if (kt[0] != 1.0f || kt[1] != 1.0f || kt[2] != 1.0f)
             pbrt_mat_color(m, "transmitcolor", kt);
@@ -987,18 +993,19 @@ static int v3_material(Parser *P, const Token *t, const char *type, ParamList *p
     }
     if (strcmp(type, "kdsubsurface") == 0) {
         /* the medium of total diffuse reflectance Kd and mean free path
-         * mfp (scene units, over scale) */
+         * scale mfp in scene units (v3's mfree): rayes' mfp of the
+         * subsurface shader, in mm, times unitlength */
         float kd[3], mfp[3];
         if (pbrt_get_color(P, pl, "Kd", half, kd, NULL) < 0 ||
-            pbrt_get_color(P, pl, "mfp", one, mfp, NULL) < 0)
+            pbrt_get_color(P, pl, "mfp", half, mfp, NULL) < 0)
             return -1;
         double scale = pbrt_get_float(pl, "scale", 1.0);
         pbrt_mat_init(m, "subsurface");
         pbrt_mat_color(m, "reflectance", kd);
         pbrt_mat_color(m, "mfp", mfp);
-        mat_float(m, "unitlength", (float)(scale > 0.0 ? 1.0 / scale : 1.0));
+        mat_float(m, "unitlength", (float)(scale > 0.0 ? scale : 1.0));
         mat_float(m, "eta", (float)pbrt_get_float(pl, "eta", 1.33));
-        return v3_roughness(P, pl, 0.0, m) ? -1 : 1;
+        return v3_roughness(P, pl, 0.0, 1, m) ? -1 : 1;
     }
     return 0;
 }

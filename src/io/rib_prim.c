@@ -351,11 +351,20 @@ static int grow_sizes(size_t **a, size_t *cap, size_t n)
  * placed): BMRT's and Pixie's arealight give a point light's intensity,
  * with which each of its samples lights a point (I cos / d^2, averaged
  * over the shape), so a radiance of pi I / A in rayes' units (RSL's pi,
- * as for point lights); other area lights give the radiance (A is not
- * needed: callers measure it only for the former). */
+ * as for point lights); RenderMan's areaNormalize (PxrMeshLight's, RenderMan
+ * 19-20's area lights') divides the radiance by A; other area lights give
+ * the radiance (A is not needed: callers measure it only when
+ * area_measured says). */
+static int area_measured(const Rib *r)
+{
+    return r->a.area_point_units || r->a.area_normalize;
+}
+
 static void area_radiance(const Rib *r, double A, float L[3])
 {
-    double k = !r->a.area_point_units ? 1.0 : A > 0.0 ? M_PI / A : 0.0;
+    double k = r->a.area_point_units ? (A > 0.0 ? M_PI / A : 0.0)
+               : r->a.area_normalize ? (A > 0.0 ? 1.0 / A : 0.0)
+                                     : 1.0;
     for (int c = 0; c < 3; c++)
         L[c] = (float)fmin((double)r->a.area_L[c] * k, FLT_MAX);
 }
@@ -408,7 +417,7 @@ static int emit_area_mesh(Rib *r, const Polys *g, const float *P, size_t n_point
         SinkState *st;
         const IoSink *s = rib_out_sink(r, &st);
         float L[3];
-        area_radiance(r, r->a.area_point_units ? polys_area(r, g, P) : 0.0, L);
+        area_radiance(r, area_measured(r) ? polys_area(r, g, P) : 0.0, L);
         if (s->area_light_mesh(s->target, faces.n_faces, faces.n_verts, faces.idx, n_points, P, L,
                                r->a.area_twosided) != RAYES_OK)
             e = rib_sink_failed(r, s);
@@ -434,7 +443,7 @@ static int emit_polys(Rib *r, const Polys *g, const float *P, size_t n_points, c
     int e = 0;
     float L[3];
     if (r->a.area)
-        area_radiance(r, r->a.area_point_units ? polys_area(r, g, P) : 0.0, L);
+        area_radiance(r, area_measured(r) ? polys_area(r, g, P) : 0.0, L);
     for (size_t p = 0; p < g->n_polys && e == 0; p++) {
         size_t nl = g->n_loops ? (size_t)g->n_loops[p] : 1;
         size_t nv = 0;
@@ -951,8 +960,7 @@ static int emit_bilinear(Rib *r, const float P[4][3], const PvOut *pv)
         memcpy(A[3], Q[2], sizeof A[0]);
         static const int around[4] = {0, 1, 2, 3};
         float L[3];
-        area_radiance(
-            r, r->a.area_point_units ? rib_polygon_area(r->a.M, &A[0][0], around, 4) : 0.0, L);
+        area_radiance(r, area_measured(r) ? rib_polygon_area(r->a.M, &A[0][0], around, 4) : 0.0, L);
         return s->area_light(s->target, (const float(*)[3])A, L) == RAYES_OK
                    ? 0
                    : rib_sink_failed(r, s);
@@ -1193,8 +1201,7 @@ static int h_quadric(Rib *r, const Args *a)
             if (r->a.area && s->area_light_quadric) { /* an emitter */
                 float L[3];
                 area_radiance(
-                    r, r->a.area_point_units ? rib_quadric_area(r->a.M, (int)q[k].type, v) : 0.0,
-                    L);
+                    r, area_measured(r) ? rib_quadric_area(r->a.M, (int)q[k].type, v) : 0.0, L);
                 if (s->area_light_quadric(s->target, q[k].type, v, (size_t)q[k].n, flags, L,
                                           r->a.area_twosided) != RAYES_OK)
                     e = rib_sink_failed(r, s);

@@ -441,11 +441,19 @@ static float object_scale(const float M[16])
 
 /* Sends a pattern the translation makes itself, of class type under
  * transform M, named in *name (a name starting with a space, which no
- * file's reference can name). 0, or -1 with the error set. */
+ * file's reference can name; "" when the sink takes no patterns). 0, or
+ * -1 with the error set. */
 static int send_internal(Rib *r, const char *type, const RayesParam *q, size_t n, const float M[16],
                          char name[160])
 {
     const IoSink *s = r->sink;
+    name[0] = '\0';
+    if (!s->pattern) { /* a sink without patterns (name stays "") */
+        rib_warn_once(r, "ris internal pattern",
+                      "this output takes no patterns: RenderMan's bumps, displacements and "
+                      "fractals are left out");
+        return 0;
+    }
     snprintf(name, 160, " ris %u %s", ++r->n_internal, type);
     ShaderRec *sh = rib_shader_rec(r, type, q, n);
     if (!sh)
@@ -550,11 +558,19 @@ static int keep_bump(Rib *r, const char *name, const Param *p, size_t n)
         Out o = {.n = 0};
         out_string(&o, "filename", rib_texture_source(r, file));
         out_string(&o, "encoding", "linear");
-        out_float(&o, "channel", num(p, n, "firstChannel", 0));
+        float ch = num(p, n, "firstChannel", 0);
+        if (!(ch >= 0 && ch <= 3)) {
+            rib_warn_once(r, "ris bump channel",
+                          "PxrBump: firstChannel %g is not 0 to 3; channel 0 is used", (double)ch);
+            ch = 0;
+        }
+        out_float(&o, "channel", floorf(ch));
         out_float(&o, "scale", scale);
         placement(r, p, n, &o);
         if (send_internal(r, "imagemap", o.p, o.n, r->a.M, height) != 0)
             return -1;
+        if (!height[0])
+            return 0;
     } else {
         const char *src = float_ref(r, p, n, "inputBump", src_buf);
         if (!src || strlen(name) >= sizeof r->bumps[0].name)
@@ -563,6 +579,8 @@ static int keep_bump(Rib *r, const char *name, const Param *p, size_t n)
         size_t nq = affine_params(0, scale, src, q);
         if (send_internal(r, "mix", q, nq, r->a.M, height) != 0)
             return -1;
+        if (!height[0])
+            return 0;
     }
     if (strlen(name) >= sizeof r->bumps[0].name)
         return 0;
@@ -593,7 +611,13 @@ static int fractal_noise(Rib *r, const Param *p, size_t n, char fbm[160])
     if (referenced(p, n, "manifold"))
         rib_warn_once(r, "ris fractal manifold",
                       "PxrFractal: its manifold is not used; the noise is over object space");
-    RayesParam q[2] = {{"octaves", RAYES_PARAM_FLOAT, {num(p, n, "layers", 6), 0, 0}, NULL},
+    float layers = num(p, n, "layers", 6);
+    if (!(layers >= 0 && layers <= 32)) {
+        rib_warn_once(r, "ris fractal layers", "PxrFractal: layers %g taken as %d", (double)layers,
+                      layers > 32 ? 32 : 0);
+        layers = layers > 32 ? 32 : 0;
+    }
+    RayesParam q[2] = {{"octaves", RAYES_PARAM_FLOAT, {layers, 0, 0}, NULL},
                        {"roughness", RAYES_PARAM_FLOAT, {omega, 0, 0}, NULL}};
     /* texture space = frequency (object space + shift): M S(1/f) T(-shift) */
     float M[16], inv = f != 0.0f && isfinite(f) ? 1.0f / f : 1.0f;
@@ -628,6 +652,8 @@ static int ris_pattern(Rib *r, const char *cls, const char *name, const Param *p
         char fbm[160];
         if (fractal_noise(r, p, n, fbm) != 0)
             return -1;
+        if (!fbm[0])
+            return 0;
         type = "mix"; /* RenderMan's fractal lies in [0, 1]: 0.5 + amplitude fbm / 2 */
         o.n = affine_params(0.5f, 0.5f * num(p, n, "amplitude", 1), fbm, o.p);
         snprintf(o.pattern[2], sizeof o.pattern[2], "%s", fbm);
@@ -822,6 +848,19 @@ static int make_light(Rib *r, const char *handle, const char *cls, const float L
  * shadows, a diffuse or specular multiplier of 0 none of that light; what
  * it has not (a cone, near-distance falloff, focus, shadow colour, other
  * multipliers) is said once. */
+/* Multiplies light l's colour by gain (a LightFilter's): its lightcolor,
+ * or a lightcolor of the gain when it has none. */
+static void scale_light(Light *l, const float gain[3])
+{
+    for (size_t k = 0; k < l->n; k++)
+        if (l->params[k].name && strcmp(l->params[k].name, "lightcolor") == 0) {
+            for (int c = 0; c < 3; c++)
+                l->params[k].value[c] *= gain[c];
+            return;
+        }
+    rib_light_param(l, "lightcolor", RAYES_PARAM_COLOR, gain, NULL);
+}
+
 static void light_controls(Rib *r, const char *cls, Light *l, const Param *p, size_t n)
 {
     static const float zero[3] = {0, 0, 0}, one[3] = {1, 1, 1};
@@ -1070,9 +1109,12 @@ static int h_light(Rib *r, const Args *a)
     int e = day ? day_light(r, handle, cls, p, n)
                 : make_light(r, handle, cls, L, num(p, n, "areaNormalize", 0) != 0,
                              num(p, n, "angleExtent", 0.53f), map);
-    if (day) { /* the sky and its sun take the light's controls */
-        for (size_t k = before; e > 0 && k < r->n_lights; k++)
+    if (day) { /* the sky and its sun take the light's controls (and filter) */
+        for (size_t k = before; e > 0 && k < r->n_lights; k++) {
             light_controls(r, cls, &r->lights[k], p, n);
+            if (r->a.light_filter)
+                scale_light(&r->lights[k], r->a.light_filter_gain);
+        }
         free(p);
         return e < 0 ? -1 : 0;
     }
@@ -1159,6 +1201,8 @@ static int ris_displace(Rib *r, const char *cls, const Param *p, size_t n)
         size_t nq = affine_params(0, amount, src, q);
         if (send_internal(r, "mix", q, nq, r->a.M, height) != 0)
             return -1;
+        if (!height[0])
+            return 0;
         q[0] = (RayesParam){"amount", RAYES_PARAM_PATTERN, {0, 0, 0}, height};
     } else {
         float v = num(p, n, "dispScalar", 0) * amount;

@@ -693,9 +693,10 @@ static void eval_image(const Pattern *p, Eval *e, Rgb *out)
             alpha[i] = 1.0f;
     }
     int ch = (int)p->num[2];
-    if (ch == -2) { /* the matte: the alpha channel if the file has one, else the first */
+    if (ch == -2) { /* the matte: the alpha channel if the file has one, else the first;
+                       a file that cannot be read, its alpha (1: opaque) */
         int nc = e->ts ? texture_channels(e->ts, p->filename, p->encoding) : 0;
-        ch = nc == 2 || nc >= 4 ? 3 : 0;
+        ch = nc == 2 || nc >= 4 || nc == 0 ? 3 : 0;
     }
     for (size_t i = 0; i < n; i++) {
         if (ch >= 0)

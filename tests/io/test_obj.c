@@ -278,7 +278,8 @@ static int corner_normal_is(const RecMesh *m, size_t f, int c, float x, float y,
 /* Smoothing groups: faces of one group share their vertices' normals (the
  * sum of their area-weighted normals), so a fold between two faces of
  * group 1 is smooth; faces in different groups, or in none, stay flat;
- * a file without s statements sends no normals. */
+ * a file without s statements sends no normals. "s on" (exporters') is
+ * group 1; numbers of any size read. */
 static void test_smoothing_groups(void)
 {
     static const char fold[] = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\n";
@@ -287,7 +288,8 @@ static void test_smoothing_groups(void)
     for (int mode = 0; mode < 3; mode++) {
         /* the face in z = 0 faces +z, the one in y = 0 faces +y; they
          * share the edge from vertex 1 to 2 */
-        static const char *const s[3][2] = {{"s 1", "s 1"}, {"s 1", "s 2"}, {"s off", "s 0"}};
+        static const char *const s[3][2] = {
+            {"s 1", "s on"}, {"s 1", "s 4294967298"}, {"s off", "s 0"}};
         snprintf(text, sizeof text, "%s%s\nf 1 2 3\n%s\nf 2 1 4\n", fold, s[mode][0], s[mode][1]);
         CHECK(parse("s.obj", text) == RAYES_OK);
         CHECK(rec.n_mesh == 1 && rec.mesh[0].n_faces == 2);
@@ -483,7 +485,15 @@ static void test_transparency(void)
     RayesImage *mask = render_cut("map_d mask.ppm");
     RayesImage *leaf = render_cut("map_d leaf.tga");
     RayesImage *red = render_cut("map_d -imfchan r leaf.tga"); /* its red: 40 / 255, nearly clear */
-    CHECK(solid && half && tr && mask && leaf && red);
+    RayesImage *gone = render_cut("map_d missing.png"); /* unreadable: opaque, as without it */
+    CHECK(solid && half && tr && mask && leaf && red && gone);
+    if (solid && gone) {
+        double r0, g0, r1, g1;
+        means(solid, 24, 40, 24, 40, &r0, &g0);
+        means(gone, 24, 40, 24, 40, &r1, &g1);
+        CHECK(fabs(g1 - g0) < 0.01 * g0 && fabs(r1 - r0) < 0.01 + 0.01 * r0);
+    }
+    rayes_image_free(gone);
     if (solid && half && tr && mask && leaf && red) {
         double r0, g0, r1, g1, r2, g2, r3, g3;
         means(solid, 24, 40, 24, 40, &r0, &g0);

@@ -1894,6 +1894,7 @@ static void test_pbrt_v3(void)
     CHECK(strcmp(sh->name, "dielectric") == 0 &&
           fabsf(param(sh, "eta")->value[0] - 1.33f) < 1e-6f && param(sh, "transmitcolor") &&
           fabsf(param(sh, "transmitcolor")->value[0] - 0.9f) < 1e-6f);
+    CHECK(param(sh, "roughness") && param(sh, "roughness")->value[0] == 0.0f); /* v3: specular */
     sh = &r->mesh[7].shader; /* alpha 0.01 given: roughness 1e-4 */
     CHECK(strcmp(sh->name, "coateddiffuse") == 0 &&
           fabsf(param(sh, "roughness")->value[0] - 1e-4f) < 1e-7f);
@@ -1906,7 +1907,8 @@ static void test_pbrt_v3(void)
           fabsf(param(sh, "roughness")->value[0] - 0.0625f) < 1e-6f);
     sh = &r->mesh[10].shader;
     CHECK(strcmp(sh->name, "subsurface") == 0 &&
-          fabsf(param(sh, "unitlength")->value[0] - 0.25f) < 1e-6f &&
+          fabsf(param(sh, "unitlength")->value[0] - 4.0f) <
+              1e-6f && /* scale mfp: unitlength scale */
           fabsf(param(sh, "mfp")->value[0] - 2.0f) < 1e-6f);
     sh = &r->mesh[11].shader; /* a matte and a plastic: a mix shader */
     CHECK(strcmp(sh->name, "mix") == 0 && param(sh, "a") &&

@@ -651,6 +651,21 @@ static void test_mesh_light(void)
     CHECK(rec.n_area == 1 && rec.n_mesh_light == 1 && rec.n_mesh == 1);
     CHECK(rec.area_L[0][0] == 4.0f && rec.area_L[0][2] == 1.0f); /* 2 x 2^1 x colour */
     CHECK(rec.mesh_light_faces[0] == 2 && rec.mesh_light_L[0][1] == 2.0f);
+    /* areaNormalize: the radiance over each shape's area (a 2 x 2 quad) */
+    CHECK(
+        rib(WORLD("AttributeBegin\n"
+                  "Light \"PxrMeshLight\" \"m\" \"float intensity\" [8] \"int areaNormalize\" [1]\n"
+                  "Polygon \"P\" [0 0 1  2 0 1  2 2 1  0 2 1]\nAttributeEnd\n")) == RAYES_OK);
+    CHECK(rec.n_area == 1 && fabsf(rec.area_L[0][0] - 2.0f) < 1e-5f);
+    /* an output without patterns (this recording one) drops RenderMan's
+     * bumps, displacements and fractals and reads on */
+    CHECK(rib(WORLD(
+              "Pattern \"PxrFractal\" \"f\" \"int layers\" [40]\n"
+              "Pattern \"PxrBump\" \"b\" \"reference float inputBump\" [\"f:resultF\"]\n"
+              "Displace \"PxrDisplace\" \"d\" \"reference float dispScalar\" [\"f:resultF\"]\n"
+              "Bxdf \"PxrDiffuse\" \"x\" \"reference normal bumpNormal\" [\"b:resultN\"]\n" TRI)) ==
+          RAYES_OK);
+    CHECK(rec.n_mesh == 1);
 }
 
 /* PxrSurface's subsurface lobe: rayes' subsurface (memo 6.2) of
