@@ -1351,6 +1351,33 @@ static void equal_area_sphere_to_square(Vec3 d, float *u, float *v)
     *u = 0.5f * (uu + 1.0f), *v = 0.5f * (vv + 1.0f);
 }
 
+/* The light-space direction at the centre of texel (x, y) of rayes'
+ * latitude-longitude map of w x h (as env_uv_to_dir). */
+static Vec3 latlong_texel_dir(int x, int y, int w, int h)
+{
+    float phi = (((float)x + 0.5f) / (float)w - 0.5f) * 2.0f * PI;
+    float theta = ((float)y + 0.5f) / (float)h * PI, st = sinf(theta);
+    return v3(-st * sinf(phi), cosf(theta), st * cosf(phi));
+}
+
+/* The bilinear RGBA of src (w x h) at texel coordinates (fx, fy) (texel
+ * centres at + 0.5), rows clamped, columns clamped or (wrap) around. */
+static void bilinear_rgba(const float *src, int w, int h, float fx, float fy, int wrap,
+                          float out[4])
+{
+    int x0 = (int)floorf(fx), y0 = (int)floorf(fy);
+    float tx = fx - (float)x0, ty = fy - (float)y0;
+    memset(out, 0, 4 * sizeof *out);
+    for (int k = 0; k < 4; k++) {
+        int sx = x0 + (k & 1), sy = y0 + (k >> 1);
+        sx = wrap ? (sx % w + w) % w : sx < 0 ? 0 : sx >= w ? w - 1 : sx;
+        sy = sy < 0 ? 0 : sy >= h ? h - 1 : sy;
+        float wgt = ((k & 1) ? tx : 1.0f - tx) * ((k >> 1) ? ty : 1.0f - ty);
+        for (int c = 0; c < 4; c++)
+            out[c] += wgt * src[4 * ((size_t)sy * w + sx) + (size_t)c];
+    }
+}
+
 /* The octahedral map src (n x n RGBA) resampled into a latitude-longitude
  * map of 2n x n: new array, or NULL. */
 static float *octahedral_to_latlong(const float *src, int n)
@@ -1361,24 +1388,10 @@ static float *octahedral_to_latlong(const float *src, int n)
         return NULL;
     for (int y = 0; y < h; y++)
         for (int x = 0; x < w; x++) {
-            float phi = (((float)x + 0.5f) / (float)w - 0.5f) * 2.0f * PI;
-            float theta = ((float)y + 0.5f) / (float)h * PI, st = sinf(theta);
-            Vec3 ld = v3(-st * sinf(phi), cosf(theta), st * cosf(phi)); /* as env_uv_to_dir */
             float u, v;
-            equal_area_sphere_to_square(ld, &u, &v);
-            float fx = u * (float)n - 0.5f, fy = v * (float)n - 0.5f;
-            int x0 = (int)floorf(fx), y0 = (int)floorf(fy);
-            float tx = fx - (float)x0, ty = fy - (float)y0;
-            float *o = &out[4 * ((size_t)y * w + x)];
-            memset(o, 0, 4 * sizeof *o);
-            for (int k = 0; k < 4; k++) {
-                int sx = x0 + (k & 1), sy = y0 + (k >> 1);
-                sx = sx < 0 ? 0 : sx >= n ? n - 1 : sx;
-                sy = sy < 0 ? 0 : sy >= n ? n - 1 : sy;
-                float wgt = ((k & 1) ? tx : 1.0f - tx) * ((k >> 1) ? ty : 1.0f - ty);
-                for (int c = 0; c < 4; c++)
-                    o[c] += wgt * src[4 * ((size_t)sy * n + sx) + (size_t)c];
-            }
+            equal_area_sphere_to_square(latlong_texel_dir(x, y, w, h), &u, &v);
+            bilinear_rgba(src, n, n, u * (float)n - 0.5f, v * (float)n - 0.5f, 0,
+                          &out[4 * ((size_t)y * w + x)]);
         }
     return out;
 }
@@ -1395,24 +1408,12 @@ static float *zup_to_latlong(const float *src, int w, int h)
         return NULL;
     for (int y = 0; y < h; y++)
         for (int x = 0; x < w; x++) {
-            float phi = (((float)x + 0.5f) / (float)w - 0.5f) * 2.0f * PI;
-            float theta = ((float)y + 0.5f) / (float)h * PI, st = sinf(theta);
-            Vec3 ld = v3(-st * sinf(phi), cosf(theta), st * cosf(phi)); /* as env_uv_to_dir */
-            float p2 = atan2f(ld.y, ld.x), t2 = acosf(fminf(fmaxf(ld.z, -1.0f), 1.0f));
-            if (p2 < 0.0f)
-                p2 += 2.0f * PI;
-            float fx = p2 / (2.0f * PI) * (float)w - 0.5f, fy = t2 / PI * (float)h - 0.5f;
-            int x0 = (int)floorf(fx), y0 = (int)floorf(fy);
-            float tx = fx - (float)x0, ty = fy - (float)y0;
-            float *o = &out[4 * ((size_t)y * w + x)];
-            memset(o, 0, 4 * sizeof *o);
-            for (int k = 0; k < 4; k++) {
-                int sx = ((x0 + (k & 1)) % w + w) % w, sy = y0 + (k >> 1);
-                sy = sy < 0 ? 0 : sy >= h ? h - 1 : sy;
-                float wgt = ((k & 1) ? tx : 1.0f - tx) * ((k >> 1) ? ty : 1.0f - ty);
-                for (int c = 0; c < 4; c++)
-                    o[c] += wgt * src[4 * ((size_t)sy * w + sx) + (size_t)c];
-            }
+            Vec3 ld = latlong_texel_dir(x, y, w, h);
+            float phi = atan2f(ld.y, ld.x), theta = acosf(fminf(fmaxf(ld.z, -1.0f), 1.0f));
+            if (phi < 0.0f)
+                phi += 2.0f * PI;
+            bilinear_rgba(src, w, h, phi / (2.0f * PI) * (float)w - 0.5f,
+                          theta / PI * (float)h - 0.5f, 1, &out[4 * ((size_t)y * w + x)]);
         }
     return out;
 }
