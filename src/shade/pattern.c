@@ -16,6 +16,7 @@
 #include "shade/pattern.h"
 
 #include <math.h>
+#include <stdatomic.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -69,6 +70,8 @@ struct RayesPattern {
     char encoding[32];            /* imagemap: "" (the file's), "sRGB", "linear", "gamma G" */
     char wrap[16];                /* imagemap: "" or "repeat", "black", "clamp" */
     VoxelGrid *grid;              /* densitygrid, nanovdb: owned */
+    _Atomic int matte;            /* imagemap channel -2: the channel found + 1 (0: not yet;
+                                     a file's channels do not change, renders share it) */
 };
 
 /* A parameter of a class: an input ('i'), a number ('n'), a string ('s')
@@ -695,8 +698,12 @@ static void eval_image(const Pattern *p, Eval *e, Rgb *out)
     int ch = (int)p->num[2];
     if (ch == -2) { /* the matte: the alpha channel if the file has one, else the first;
                        a file that cannot be read, its alpha (1: opaque) */
-        int nc = e->ts ? texture_channels(e->ts, p->filename, p->encoding) : 0;
-        ch = nc == 2 || nc >= 4 || nc == 0 ? 3 : 0;
+        Pattern *mp = (Pattern *)p; /* the answer, kept once the file was read */
+        int known = atomic_load_explicit(&mp->matte, memory_order_relaxed);
+        int nc = known ? 0 : e->ts ? texture_channels(e->ts, p->filename, p->encoding) : 0;
+        ch = known ? known - 1 : nc == 2 || nc >= 4 || nc == 0 ? 3 : 0;
+        if (!known && nc > 0)
+            atomic_store_explicit(&mp->matte, ch + 1, memory_order_relaxed);
     }
     for (size_t i = 0; i < n; i++) {
         if (ch >= 0)
