@@ -134,6 +134,8 @@ int pbrt_d_makenamedmedium(Parser *P, const Token *t)
     snprintf(md.name, sizeof md.name, "%s", name);
     memcpy(md.m, P->gs.ctm, sizeof md.m);
     const char *type = pbrt_get_string(&pl, "type", "");
+    if (strcmp(type, "heterogeneous") == 0) /* pbrt-v3's name for the same grid */
+        type = "uniformgrid";
     int r = 0;
     if (strcmp(type, "homogeneous") != 0 && strcmp(type, "uniformgrid") != 0 &&
         strcmp(type, "cloud") != 0 && strcmp(type, "nanovdb") != 0) {

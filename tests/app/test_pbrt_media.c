@@ -7,7 +7,8 @@
  * slab's optical depth: sigma_a for "homogeneous" and for "nanovdb" (a
  * grid of one value written by nvdb_write.h, its voxel centres enclosing
  * the slab), and 0.75 sigma_a for a 1 x 1 x 1 "uniformgrid" whose box is
- * the slab in z (pbrt's grid fades to half its value at the box's faces). The
+ * the slab in z (pbrt's grid fades to half its value at the box's faces;
+ * pbrt-v3's "heterogeneous" alike). The
  * box itself is invisible; the files read without a warning. The camera's
  * medium fills the scene's bounds (exp(-sigma d) along camera and shadow
  * rays); a medium bounded by several open shapes, each naming it on
@@ -103,25 +104,30 @@ static void test_absorbing_slabs(void)
     const double o[3] = {-7, -7, 0};
     CHECK(nvdb_write(TMP "/one.nvdb", "density", (const float(*)[8][8])v, 2.0, o) == 0);
     const float sigma = 0.4f;
-    char media[4][1024];
+    char media[5][1024];
     snprintf(media[0], sizeof media[0], "# no medium\n");
-    const char *defs[3] = {
+    const char *defs[4] = {
         "MakeNamedMedium \"slab\" \"string type\" \"homogeneous\" \"rgb sigma_a\" [0.2 0.2 0.2]\n"
         "  \"rgb sigma_s\" [0 0 0] \"float scale\" 2\n",
         "MakeNamedMedium \"slab\" \"string type\" \"nanovdb\" \"string filename\" \"one.nvdb\"\n"
         "  \"rgb sigma_a\" [0.4 0.4 0.4] \"rgb sigma_s\" [0 0 0]\n",
         "MakeNamedMedium \"slab\" \"string type\" \"uniformgrid\" \"float density\" [2]\n"
         "  \"point3 p0\" [-50 -50 1] \"point3 p1\" [50 50 2] \"rgb sigma_a\" [0.2 0.2 0.2]\n"
-        "  \"rgb sigma_s\" [0 0 0] \"float g\" 0.3\n"};
-    for (int k = 0; k < 3; k++)
+        "  \"rgb sigma_s\" [0 0 0] \"float g\" 0.3\n",
+        /* pbrt-v3's name for the same grid */
+        "MakeNamedMedium \"slab\" \"string type\" \"heterogeneous\" \"float density\" [2]\n"
+        "  \"point p0\" [-50 -50 1] \"point p1\" [50 50 2] \"color sigma_a\" [0.2 0.2 0.2]\n"
+        "  \"color sigma_s\" [0 0 0] \"float g\" 0.3\n"};
+    for (int k = 0; k < 4; k++)
         snprintf(media[k + 1], sizeof media[k + 1],
                  "%sAttributeBegin\nMediumInterface \"slab\" \"\"\nMaterial \"interface\"\n%s"
                  "AttributeEnd\n",
                  defs[k], box_shape);
-    const double tau[4] = {0, sigma, sigma, 0.75 * sigma};
-    const char *names[4] = {"open.pbrt", "homogeneous.pbrt", "nanovdb.pbrt", "uniformgrid.pbrt"};
+    const double tau[5] = {0, sigma, sigma, 0.75 * sigma, 0.75 * sigma};
+    const char *names[5] = {"open.pbrt", "homogeneous.pbrt", "nanovdb.pbrt", "uniformgrid.pbrt",
+                            "heterogeneous.pbrt"};
     double open = 0;
-    for (int k = 0; k < 4; k++) {
+    for (int k = 0; k < 5; k++) {
         char err_text[4096];
         write_scene(names[k], media[k]);
         float *img = render(names[k], err_text, sizeof err_text);
