@@ -749,10 +749,13 @@ static int hair_material(Parser *P, ParamList *pl, Material *m)
 {
     static const float none[3] = {-1, -1, -1}, zero[3] = {0, 0, 0};
     pbrt_mat_init(m, "physicalhair");
-    int given = pbrt_find(pl, "sigma_a") || pbrt_find(pl, "reflectance") ||
-                pbrt_find(pl, "eumelanin") || pbrt_find(pl, "pheomelanin");
+    /* pbrt-v3 called the reflectance "color" */
+    const char *refl =
+        pbrt_find(pl, "reflectance") || !pbrt_find(pl, "color") ? "reflectance" : "color";
+    int given = pbrt_find(pl, "sigma_a") || pbrt_find(pl, refl) || pbrt_find(pl, "eumelanin") ||
+                pbrt_find(pl, "pheomelanin");
     if (mat_textured(P, pl, m, "sigma_a", "sigma_a", RAYES_PARAM_COLOR, none) != 0 ||
-        mat_textured(P, pl, m, "reflectance", "reflectance", RAYES_PARAM_COLOR, none) != 0)
+        mat_textured(P, pl, m, refl, "reflectance", RAYES_PARAM_COLOR, none) != 0)
         return -1;
     if (given) { /* pbrt's 1.3 of eumelanin only when nothing names the colour */
         if (mat_textured(P, pl, m, "eumelanin", "eumelanin", RAYES_PARAM_FLOAT, zero) != 0 ||

@@ -1826,6 +1826,7 @@ static void test_pbrt_v3(void)
         "Material \"disney\" \"rgb color\" [0.7 0.5 0.3] \"float metallic\" 1 \"float roughness\" "
         "0.5",
         "Material \"kdsubsurface\" \"rgb Kd\" [0.8 0.7 0.6] \"float mfp\" 2 \"float scale\" 4",
+        "Material \"hair\" \"rgb color\" [0.3 0.2 0.1]",
         "MakeNamedMaterial \"a\" \"string type\" \"matte\" \"rgb Kd\" [0.2 0.2 0.2]\n"
         "MakeNamedMaterial \"b\" \"string type\" \"plastic\"\n"
         "Texture \"bumps\" \"float\" \"scale\" \"float tex1\" 0.5 \"float tex2\" 0.1\n"
@@ -1910,7 +1911,10 @@ static void test_pbrt_v3(void)
           fabsf(param(sh, "unitlength")->value[0] - 4.0f) <
               1e-6f && /* scale mfp: unitlength scale */
           fabsf(param(sh, "mfp")->value[0] - 2.0f) < 1e-6f);
-    sh = &r->mesh[11].shader; /* a matte and a plastic: a mix shader */
+    sh = &r->mesh[11].shader; /* v3 hair's color is v4's reflectance */
+    CHECK(strcmp(sh->name, "physicalhair") == 0 && param(sh, "reflectance") &&
+          fabsf(param(sh, "reflectance")->value[0] - 0.3f) < 1e-6f);
+    sh = &r->mesh[12].shader; /* a matte and a plastic: a mix shader */
     CHECK(strcmp(sh->name, "mix") == 0 && param(sh, "a") &&
           strcmp(param(sh, "a")->string, "diffuse") == 0);
     /* v3's quadrics, as RenderMan's */
