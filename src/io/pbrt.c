@@ -316,7 +316,8 @@ static int d_ignored(Parser *P, const Token *t)
     if (!r)
         r = pbrt_parse_params(P, &pl);
     pbrt_params_free(&pl);
-    if (!r)
+    /* Accelerator chooses pbrt's own ray structure: nothing to say */
+    if (!r && strcmp(name, "Accelerator") != 0)
         pbrt_warn_at(P, t->line, t->col, name, "%s is not supported; ignored", name);
     return r;
 }

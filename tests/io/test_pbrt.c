@@ -1837,6 +1837,7 @@ static void test_pbrt_v3(void)
     char text[8192] = "Film \"image\" \"integer xresolution\" 16 \"integer yresolution\" 16 "
                       "\"float scale\" 2 \"float maxsampleluminance\" 10\n"
                       "Integrator \"directlighting\" \"integer maxdepth\" 7\n"
+                      "Accelerator \"kdtree\" \"integer maxprims\" 1\n"
                       "PixelFilter \"triangle\" \"float xwidth\" 1 \"float ywidth\" 1\n"
                       "WorldBegin\nLightSource \"infinite\" \"string mapname\" \"sky.exr\"\n"
                       "LightSource \"goniometric\" \"string mapname\" \"g.exr\"\n"
