@@ -622,8 +622,9 @@ RAYES_API RayesError rayes_scene_area_light_mesh(RayesScene *scene, size_t n_fac
  *   "pointlight"       "from" (default 0 0 0): irradiance intensity / d^2
  *                      at normal incidence, times the map "mapname" (if
  *                      given) in the direction from the light, in the
- *                      current rotation: "mapping" "latlong" or
- *                      "octahedral" as an environment's, or "projection"
+ *                      current rotation: "mapping" "latlong",
+ *                      "latlong-zup" or "octahedral" as an environment's,
+ *                      or "projection"
  *                      (the image projected along +z over "fov", 90,
  *                      degrees on its shorter side; black elsewhere);
  *                      spotlights take a map too
@@ -639,7 +640,9 @@ RAYES_API RayesError rayes_scene_area_light_mesh(RayesScene *scene, size_t n_fac
  *                      latitude-longitude map "mapname" (any format
  *                      OpenImageIO reads; as given, else on the texture
  *                      search path) if given, seen by camera and specular rays that miss
- *                      everything (docs/DESIGN.md: orientation)
+ *                      everything (docs/DESIGN.md: orientation); "mapping"
+ *                      "latlong" (+y up), "latlong-zup" (pbrt-v3's, +z up)
+ *                      or "octahedral" (pbrt-v4's), resampled when loaded
  *   "arealight"        radiance intensity * lightcolor from a "shape"
  *                      (default "quad"): "quad" the square of side
  *                      "width" x "height" (1 x 1) about the object-space
