@@ -25,6 +25,17 @@ static RayesScene *new_scene(void)
     return s;
 }
 
+/* Preview options: size x size pixels, 4 samples, 2 threads. */
+static RayesRenderOptions preview(int size)
+{
+    RayesRenderOptions o;
+    rayes_render_options_init(&o, RAYES_QUALITY_PREVIEW);
+    o.width = o.height = size;
+    o.spp = 4;
+    o.threads = 2;
+    return o;
+}
+
 typedef struct Traced {
     GridSet gs;
     Accel *accel;
@@ -292,12 +303,8 @@ static void test_hair_field_caches(void)
     RayesPrimvar pv = {"width", RAYES_PRIMVAR_CONSTANT, &w, 1};
     CHECK(rayes_scene_curves(s, &c, &pv, 1) == RAYES_OK);
     CHECK(rayes_scene_commit(s) == RAYES_OK);
-    RayesRenderOptions o;
-    rayes_render_options_init(&o, RAYES_QUALITY_PREVIEW);
-    o.width = o.height = 64;
-    o.spp = 4;
+    RayesRenderOptions o = preview(64);
     o.bounces = 1;
-    o.threads = 2;
     RayesImage *img = NULL;
     RayesStats *st = NULL;
     CHECK(rayes_render(s, &o, &img, &st) == RAYES_OK);
@@ -350,12 +357,8 @@ static void test_fiber_environment(void)
         RayesParam e = {"intensity", RAYES_PARAM_FLOAT, {0.5f, 0, 0}, NULL};
         CHECK(rayes_scene_light(s, "environmentlight", &e, 1) == RAYES_OK);
         CHECK(rayes_scene_commit(s) == RAYES_OK);
-        RayesRenderOptions o;
-        rayes_render_options_init(&o, RAYES_QUALITY_PREVIEW);
-        o.width = o.height = 32;
-        o.spp = 4;
+        RayesRenderOptions o = preview(32);
         o.shadow_rays = 64;
-        o.threads = 2;
         RayesImage *img = NULL;
         CHECK(rayes_render(s, &o, &img, NULL) == RAYES_OK);
         double sum = 0.0;
@@ -408,14 +411,10 @@ static double hair_furnace_hider(int clump, const float *sigma, int bounces, dou
     RayesParam e = {"intensity", RAYES_PARAM_FLOAT, {0.5f, 0, 0}, NULL};
     CHECK(rayes_scene_light(s, "environmentlight", &e, 1) == RAYES_OK);
     CHECK(rayes_scene_commit(s) == RAYES_OK);
-    RayesRenderOptions o;
-    rayes_render_options_init(&o, RAYES_QUALITY_PREVIEW);
-    o.width = o.height = 64;
-    o.spp = 4;
+    RayesRenderOptions o = preview(64);
     o.shadow_rays = 16;
     o.diffuse_rays = 64;
     o.bounces = bounces;
-    o.threads = 2;
     o.hider = hider;
     RayesImage *img = NULL;
     CHECK(rayes_render(s, &o, &img, NULL) == RAYES_OK);
@@ -502,12 +501,8 @@ static double side_lit_fibre(int instanced)
                         {"intensity", RAYES_PARAM_FLOAT, {3, 0, 0}, NULL}};
     CHECK(rayes_scene_light(s, "distantlight", lp, 3) == RAYES_OK);
     CHECK(rayes_scene_commit(s) == RAYES_OK);
-    RayesRenderOptions o;
-    rayes_render_options_init(&o, RAYES_QUALITY_PREVIEW);
-    o.width = o.height = 64;
-    o.spp = 4;
+    RayesRenderOptions o = preview(64);
     o.bounces = 0;
-    o.threads = 2;
     RayesImage *img = NULL;
     CHECK(rayes_render(s, &o, &img, NULL) == RAYES_OK);
     double total = 0.0;
@@ -574,12 +569,8 @@ static void flat_fibres(int instanced, RayesHider hider, double half[2])
                         {"intensity", RAYES_PARAM_FLOAT, {20, 0, 0}, NULL}};
     CHECK(rayes_scene_light(s, "pointlight", lp, 2) == RAYES_OK);
     CHECK(rayes_scene_commit(s) == RAYES_OK);
-    RayesRenderOptions o;
-    rayes_render_options_init(&o, RAYES_QUALITY_PREVIEW);
-    o.width = o.height = 64;
-    o.spp = 4;
+    RayesRenderOptions o = preview(64);
     o.bounces = 1;
-    o.threads = 2;
     o.hider = hider;
     RayesImage *img = NULL;
     CHECK(rayes_render(s, &o, &img, NULL) == RAYES_OK);
