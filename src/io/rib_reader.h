@@ -419,6 +419,9 @@ int rib_arg_error(Rib *r, const Arg *a, const char *fmt, ...) __attribute__((for
 void rib_warn_once(Rib *r, const char *key, const char *fmt, ...) __attribute__((format(printf, 3, 4)));
 /* The sink's own message as the request's error; returns -1. */
 int rib_sink_failed(Rib *r, const IoSink *s);
+/* Keeps an area light's handle (AreaLightSource, PxrMeshLight) for
+ * Illuminate; 0, or -1 with the error set. */
+int rib_add_area_handle(Rib *r, const char *handle);
 /* A copy of s (malloc), or NULL. */
 char *rib_strdup(const char *s);
 

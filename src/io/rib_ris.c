@@ -994,13 +994,8 @@ static int mesh_light(Rib *r, const char *handle, const float L[3], int normaliz
         rib_warn_once(r, "light in object", "lights inside ObjectBegin are ignored");
         return 0;
     }
-    if (r->n_area_handles >= RIB_MAX_LIGHTS)
-        return rib_error(r, "more than %d area light handles", RIB_MAX_LIGHTS);
-    char(*nh)[RIB_MAX_HANDLE] = realloc(r->area_handles, (r->n_area_handles + 1) * sizeof *nh);
-    if (!nh)
-        return rib_error(r, "out of memory");
-    r->area_handles = nh;
-    snprintf(nh[r->n_area_handles++], RIB_MAX_HANDLE, "%s", handle);
+    if (rib_add_area_handle(r, handle) != 0)
+        return -1;
     memcpy(r->a.area_L, L, sizeof r->a.area_L);
     r->a.area_normalize = normalize;
     r->a.area_point_units = 0;

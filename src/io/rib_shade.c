@@ -1346,6 +1346,18 @@ static int h_light_source(Rib *r, const Args *a)
     return e;
 }
 
+int rib_add_area_handle(Rib *r, const char *handle)
+{
+    if (r->n_area_handles >= RIB_MAX_LIGHTS)
+        return rib_error(r, "more than %d area light handles", RIB_MAX_LIGHTS);
+    char(*nh)[RIB_MAX_HANDLE] = realloc(r->area_handles, (r->n_area_handles + 1) * sizeof *nh);
+    if (!nh)
+        return rib_error(r, "out of memory");
+    r->area_handles = nh;
+    snprintf(nh[r->n_area_handles++], RIB_MAX_HANDLE, "%s", handle);
+    return 0;
+}
+
 static int h_area_light(Rib *r, const Args *a)
 {
     size_t i = 0;
@@ -1356,16 +1368,8 @@ static int h_area_light(Rib *r, const Args *a)
     if (!name)
         return -1;
     if (i < a->n && (a->n - i) % 2 == 1) {
-        if (rib_get_handle(r, a, &i, handle) != 0)
+        if (rib_get_handle(r, a, &i, handle) != 0 || rib_add_area_handle(r, handle) != 0)
             return -1;
-        if (r->n_area_handles >= RIB_MAX_LIGHTS)
-            return rib_error(r, "more than %d area light handles", RIB_MAX_LIGHTS);
-        char(*nh)[RIB_MAX_HANDLE] =
-            realloc(r->area_handles, (r->n_area_handles + 1) * sizeof *nh);
-        if (!nh)
-            return rib_error(r, "out of memory");
-        r->area_handles = nh;
-        memcpy(nh[r->n_area_handles++], handle, sizeof handle);
     }
     Param *p;
     size_t n;
