@@ -230,7 +230,7 @@ typedef struct Material {
     char name[128];
     float Kd[3], Ks[3], Ke[3];
     float Ns;           /* Phong exponent; -1: not given */
-    float d;            /* dissolve: the opacity (1 opaque) */
+    float d, Tr;        /* dissolve (the opacity) and transparency; -1 not given */
     int illum;          /* illumination model, read, not rendered */
     char map_Kd[1024];  /* texture path, resolved against the MTL's directory; "" none */
     char map_d[1024];   /* the opacity's texture (a cut-out), resolved likewise; "" none */
@@ -313,7 +313,7 @@ static int material_find(Obj *o, const char *tok, size_t n)
     snprintf(m->name, sizeof m->name, "%s", name);
     m->Kd[0] = m->Kd[1] = m->Kd[2] = 0.8f;
     m->Ns = -1.0f;
-    m->d = 1.0f;
+    m->d = m->Tr = -1.0f;
     m->illum = -1;
     return (int)o->n_mats++;
 }
@@ -438,9 +438,9 @@ static int mtl_statement(Obj *o, Lexer *L, const char *mtl_dir, const char *kw, 
         if (is_kw(kw, n, "Ns"))
             mt->Ns = f;
         else if (is_kw(kw, n, "d"))
-            mt->d = f;
+            mt->d = fminf(fmaxf(f, 0.0f), 1.0f);
         else if (is_kw(kw, n, "Tr"))
-            mt->d = 1.0f - f;
+            mt->Tr = fminf(fmaxf(f, 0.0f), 1.0f);
         return 0;
     }
     if (is_kw(kw, n, "illum")) {
@@ -904,13 +904,31 @@ static float roughness_of(float Ns)
     return Ns <= 1.0f ? 1.0f : fmaxf(1.0f / Ns, 0.001f);
 }
 
+/* The opacity of material m: d, else 1 - Tr, else 1. Both given, d wins
+ * (d is the MTL standard's; Tr is an extension some programs write as d's
+ * synonym, "d 1 Tr 1"); an opacity of 0 — every surface of the material
+ * invisible — is an exporter's mistake (3ds Max's and others' "d 0" for
+ * opaque, as Cesium's obj2gltf reads it too) and is taken as opaque, with
+ * one warning. */
+static float material_opacity(Obj *o, const Material *m)
+{
+    float d = m->d >= 0.0f ? m->d : m->Tr >= 0.0f ? 1.0f - m->Tr : 1.0f;
+    if (d > 0.0f)
+        return d;
+    obj_warn(o, "opacity 0",
+             "%s: material \"%s\" (and any other so made) has %s, which would make it "
+             "invisible; taken as opaque",
+             o->name, m->name, m->d >= 0.0f ? "d 0" : "Tr 1");
+    return 1.0f;
+}
+
 /* The opacity of material m as the reserved shader parameter "Os" in *out
  * (its name NULL for an opaque material): d, or map_d's texture (times d),
  * a pattern made once per material under a name that starts with a space
  * (cutout holds it). The texture's values are opacities, read linear. */
 static RayesError opacity_of(Emit *e, Material *m, char cutout[48], RayesParam *out)
 {
-    float d = fminf(fmaxf(m->d, 0.0f), 1.0f);
+    float d = material_opacity(e->o, m);
     out->name = NULL;
     if (!m->map_d[0]) {
         if (d < 1.0f)
@@ -940,11 +958,14 @@ static RayesError opacity_of(Emit *e, Material *m, char cutout[48], RayesParam *
     return RAYES_OK;
 }
 
-/* The shader of a material (NULL: the default, matte grey). */
+/* The shader of a material (NULL: the default, matte grey). A map_Kd
+ * replaces Kd, as Blender's and Mitsuba's importers read it (the MTL
+ * standard multiplies them, but exporters write their default Kd beside
+ * the map: 3ds Max's 0.588 made Sponza half as bright). */
 static RayesError material_shader(Emit *e, Material *m)
 {
-    static const float grey[3] = {0.8f, 0.8f, 0.8f};
-    const float *Kd = m ? m->Kd : grey;
+    static const float grey[3] = {0.8f, 0.8f, 0.8f}, white[3] = {1, 1, 1};
+    const float *Kd = !m ? grey : m->map_Kd[0] ? white : m->Kd;
     RayesParam p[7];
     size_t n = 0;
     p[n++] = (RayesParam){"Cs", RAYES_PARAM_COLOR, {Kd[0], Kd[1], Kd[2]}, NULL};

@@ -148,7 +148,7 @@ static void test_materials(void)
     test_write_text(DIR "/m.mtl", "# materials\n"
                                   "newmtl red\nKd 0.6 0.1 0.05\nd 1\nillum 1\n"
                                   "newmtl shiny\nKd 0.2 0.3 0.4\nKs 0.5 0.5 0.5\nNs 40\nillum 2\n"
-                                  "newmtl wood\nKd 1 1 1\nmap_Kd -s 2 2 1 wood.png\n"
+                                  "newmtl wood\nKd 0.47 0.47 0.47\nmap_Kd -s 2 2 1 wood.png\n"
                                   "newmtl lamp\nKd 0 0 0\nKe 5 4 3\n"
                                   "newmtl panel\nKe 1 2 3\n");
     static const char text[] = "mtllib m.mtl\n"
@@ -177,6 +177,8 @@ static void test_materials(void)
     CHECK(strcmp(rec.shader[3].name, "paintedplastic") == 0);
     CHECK((p = rec_param(&rec.shader[3], "texturename")) &&
           strcmp(p->string, DIR "/wood.png") == 0);
+    /* the map replaces Kd (3ds Max's default 0.47 beside it) */
+    CHECK((p = rec_param(&rec.shader[3], "Cs")) && p->value[0] == 1.0f && p->value[2] == 1.0f);
     /* the lamp's quad and triangle are one mesh light with L = Ke; the
      * panel's one quad a quad light, in order */
     CHECK(rec.n_area == 1 && rec.n_mesh_light == 1);
@@ -191,6 +193,35 @@ static void test_materials(void)
     CHECK(parse(DIR "/x.obj", "mtllib nosuch.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n") ==
           RAYES_OK);
     CHECK(rec.n_mesh == 1);
+    record_free(&rec);
+}
+
+/* d and Tr: d wins when both are given ("d 1 Tr 1", MeshLab's Tr as d's
+ * synonym), Tr alone is 1 - d, and an opacity of 0 ("d 0", which many
+ * exporters write for opaque) is opaque, not an invisible material. */
+static void test_opacity_words(void)
+{
+    mkdir(RAYES_TEST_TMP, 0777);
+    mkdir(DIR, 0777);
+    test_write_text(DIR "/o.mtl", "newmtl zero\nKd 0.5 0.5 0.5\nd 0.000000\nillum 2\n"
+                                  "newmtl both\nd 1\nTr 1\n"
+                                  "newmtl tr\nTr 0.25\n"
+                                  "newmtl trone\nTr 1\n"
+                                  "newmtl half\nd 0.5\n");
+    static const char text[] = "mtllib o.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\n"
+                               "usemtl zero\nf 1 2 3\nusemtl both\nf 1 2 3\n"
+                               "usemtl tr\nf 1 2 3\nusemtl trone\nf 1 2 3\n"
+                               "usemtl half\nf 1 2 3\n";
+    CHECK(parse(DIR "/o.obj", text) == RAYES_OK);
+    CHECK(rec.n_shader == 5);
+    if (rec.n_shader == 5) {
+        const RayesParam *p;
+        CHECK(rec_param(&rec.shader[0], "Os") == NULL); /* d 0: opaque */
+        CHECK(rec_param(&rec.shader[1], "Os") == NULL); /* d 1 wins over Tr 1 */
+        CHECK((p = rec_param(&rec.shader[2], "Os")) && p->value[0] == 0.75f);
+        CHECK(rec_param(&rec.shader[3], "Os") == NULL); /* Tr 1 alone: 0, opaque */
+        CHECK((p = rec_param(&rec.shader[4], "Os")) && p->value[1] == 0.5f);
+    }
     record_free(&rec);
 }
 
@@ -523,7 +554,7 @@ static void test_transparency(void)
     rayes_image_free(red);
 }
 
-TEST_MAIN(TEST(test_face_syntax), TEST(test_ngons), TEST(test_materials),
+TEST_MAIN(TEST(test_face_syntax), TEST(test_ngons), TEST(test_materials), TEST(test_opacity_words),
           TEST(test_default_camera_and_light), TEST(test_errors), TEST(test_unknown_statements),
           TEST(test_read_file), TEST(test_normals_and_texture_coordinates), TEST(test_transparency),
           TEST(test_smoothing_groups), TEST(test_vertex_colours))
