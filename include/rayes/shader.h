@@ -137,7 +137,8 @@ typedef void (*RayesShaderMethod)(const RayesShaderServices *sv, const RayesShad
 /* One entry of a class's parameter table. */
 typedef struct RayesShaderParamDesc {
     const char *name;        /* e.g. "Kd" */
-    RayesParamType type;     /* FLOAT: one float; COLOR: three floats; STRING: char[64] */
+    RayesParamType type;     /* FLOAT: one float; COLOR: three floats; STRING: char[64]
+                                (char[RAYES_SHADER_PATH_BYTES] with RAYES_SHADER_PATH_STRINGS) */
     size_t offset;           /* byte offset in the parameter block */
     float default_value[3];  /* FLOAT and COLOR defaults */
 } RayesShaderParamDesc;
@@ -162,15 +163,22 @@ typedef struct RayesShaderClass {
 
 /* What a class tells the renderer before rendering. */
 typedef enum RayesShaderFlags {
-    RAYES_SHADER_SUBSURFACE = 1u << 0, /* its methods call the subsurface service: objects
-                                          shaded by it get an acceleration structure of
-                                          their own for subsurface rays (memo 6.2) */
-    RAYES_SHADER_THIN_SHADOW = 1u << 1 /* its opacity method is a refracting surface's thin
-                                          shadow (glass): other objects' shadow and diffuse
-                                          rays see through it, but the shadow rays its own
-                                          methods cast find it opaque, since its lobes
-                                          trace the light that crosses it */
+    RAYES_SHADER_SUBSURFACE = 1u << 0,  /* its methods call the subsurface service: objects
+                                           shaded by it get an acceleration structure of
+                                           their own for subsurface rays (memo 6.2) */
+    RAYES_SHADER_THIN_SHADOW = 1u << 1, /* its opacity method is a refracting surface's thin
+                                           shadow (glass): other objects' shadow and diffuse
+                                           rays see through it, but the shadow rays its own
+                                           methods cast find it opaque, since its lobes
+                                           trace the light that crosses it */
+    RAYES_SHADER_PATH_STRINGS = 1u << 2 /* its STRING parameters are
+                                           char[RAYES_SHADER_PATH_BYTES], room for a file's
+                                           path (a texture's); without it char[64] */
 } RayesShaderFlags;
+
+/* The bytes of a STRING parameter of a class with RAYES_SHADER_PATH_STRINGS
+ * (a longer value is cut, with a warning). */
+#define RAYES_SHADER_PATH_BYTES 1024
 
 /* Diffusion profiles of the subsurface service. */
 typedef enum RayesSubsurfaceProfile {

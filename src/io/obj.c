@@ -18,6 +18,7 @@
  */
 #include "io/obj.h"
 
+#include <dirent.h>
 #include <errno.h>
 #include <limits.h>
 #include <math.h>
@@ -25,7 +26,9 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <strings.h>
 #include <sys/stat.h>
+#include <unistd.h>
 
 #include "io/text.h"
 #include "util/colour.h"
@@ -344,6 +347,81 @@ static int mtl_color(Lexer *L, float c[3])
                : -1;
 }
 
+/* Whether path names a readable file. */
+static int readable(const char *path)
+{
+    struct stat st;
+    return stat(path, &st) == 0 && S_ISREG(st.st_mode) && access(path, R_OK) == 0;
+}
+
+/* path's components after its first `from` bytes (a directory that
+ * exists, "" for the working one) matched against the directories' entries
+ * regardless of case, in place: a Windows-authored MTL's "Textures/Wall.JPG"
+ * for the disk's "textures/wall.jpg". Returns 0 when every component was
+ * found. */
+static int match_case(char *path, size_t from)
+{
+    for (char *comp = path + from; *comp;) {
+        char *end = strchr(comp, '/');
+        size_t len = end ? (size_t)(end - comp) : strlen(comp);
+        if (len == 0) { /* a leading or doubled slash */
+            comp++;
+            continue;
+        }
+        char dir[4096];
+        if (comp == path)
+            snprintf(dir, sizeof dir, ".");
+        else
+            snprintf(dir, sizeof dir, "%.*s", (int)(comp - path), path);
+        DIR *d = opendir(dir);
+        if (!d)
+            return -1;
+        const struct dirent *e;
+        int found = 0;
+        while (!found && (e = readdir(d)) != NULL)
+            if (strlen(e->d_name) == len && strncasecmp(e->d_name, comp, len) == 0) {
+                memcpy(comp, e->d_name, len);
+                found = 1;
+            }
+        closedir(d);
+        if (!found)
+            return -1;
+        comp += len;
+    }
+    return 0;
+}
+
+/* The file of a map statement as found on this machine, into out: the
+ * name relative to the MTL's directory (or absolute); else with Windows'
+ * backslashes as slashes; else matched regardless of case; else its last
+ * component beside the MTL (an absolute path of the machine that wrote
+ * it, "C:\\Users\\...\\wood.jpg"). Not found at all, the name as written
+ * (the texture's lookup then warns). Returns the length written, or -1
+ * when it does not fit. */
+static int map_path(const char *mtl_dir, const char *name, size_t n, char *out, size_t size)
+{
+    const char *dir = name[0] == '/' ? "" : mtl_dir;
+    int w = snprintf(out, size, "%s%.*s", dir, (int)n, name);
+    if (w < 0 || (size_t)w >= size || readable(out))
+        return w < 0 || (size_t)w >= size ? -1 : w;
+    char first[4096];
+    snprintf(first, sizeof first, "%s", out);
+    for (char *c = out + strlen(dir); *c; c++)
+        if (*c == '\\')
+            *c = '/';
+    if (readable(out) || (match_case(out, strlen(dir)) == 0 && readable(out)))
+        return w;
+    const char *base = out + strlen(out);
+    while (base > out && base[-1] != '/')
+        base--;
+    char alt[4096];
+    if (base > out + strlen(dir) &&
+        (size_t)snprintf(alt, sizeof alt, "%s%s", mtl_dir, base) < sizeof alt &&
+        (readable(alt) || (match_case(alt, strlen(mtl_dir)) == 0 && readable(alt))))
+        return snprintf(out, size, "%s", alt);
+    return snprintf(out, size, "%s", first);
+}
+
 /* map_Kd [options] file: the last token is the file name. */
 static int mtl_map(Lexer *L, const char *mtl_dir, char *out, size_t out_size)
 {
@@ -355,10 +433,7 @@ static int mtl_map(Lexer *L, const char *mtl_dir, char *out, size_t out_size)
     }
     if (!last)
         return lex_expected(L, tok, 0, "a texture file name");
-    int w = last[0] == '/' || !mtl_dir[0]
-                ? snprintf(out, out_size, "%.*s", (int)last_n, last)
-                : snprintf(out, out_size, "%s%.*s", mtl_dir, (int)last_n, last);
-    if (w < 0 || (size_t)w >= out_size)
+    if (map_path(mtl_dir, last, last_n, out, out_size) < 0)
         return lex_expected(L, last, last_n, "a shorter texture path");
     return 0;
 }

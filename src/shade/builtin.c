@@ -337,7 +337,7 @@ const RayesShaderClass shade_class_defaultsurface = {
 typedef struct PaintedPlasticParams {
     float Ka, Kd, Ks, roughness;
     float specularcolor[3];
-    char texturename[64];
+    char texturename[RAYES_SHADER_PATH_BYTES];
 } PaintedPlasticParams;
 
 typedef struct PaintedScratch {
@@ -433,6 +433,7 @@ const RayesShaderClass shade_class_paintedplastic = {
     .lighting = painted_lighting,
     .diffuselighting = painted_diffuselighting,
     .scratch_size = sizeof(PaintedScratch),
+    .flags = RAYES_SHADER_PATH_STRINGS,
 };
 
 /* ---- hair: Kajiya-Kay fibres (direct_fiber), for curves */

@@ -48,43 +48,6 @@ static void set_opacity(const RayesShadeCtx *ctx, RayesShadeOutputs *out)
         }
 }
 
-/* The shading normals of a normal map (pbrt-v4's "normalmap": a linear
- * image whose texel n = 2 rgb - 1 is in the frame of x = dP/ds, z = N,
- * y = z cross x; the pattern "normalmap" holds it): dP/ds from dPdu, dPdv
- * and the texture coordinates' derivatives (ctx->dst; without them s is u),
- * made perpendicular to N. A mapped normal that turns away from the
- * geometric normal keeps N. */
-static Vec3 ld(const float p[3]);
-
-static void normal_map(const RayesShaderServices *sv, const RayesShadeCtx *ctx, Rgb *out)
-{
-    static const float flat[3] = {0.5f, 0.5f, 1.0f};
-    Rgb tex[SHADE_CHUNK];
-    shade_param_color(sv, ctx, "normalmap", flat, tex);
-    for (size_t i = 0; i < ctx->n_points; i++) {
-        Vec3 N = ld(ctx->N[i]), du = ld(ctx->dPdu[i]), dv = ld(ctx->dPdv[i]), dPds = du;
-        if (ctx->dst) { /* [ds dt] = J [du dv]: dP/ds = (dt/dv dPdu - dt/du dPdv) / det J */
-            const float *j = ctx->dst[i];
-            float det = j[0] * j[3] - j[1] * j[2];
-            if (fabsf(det) > 1e-20f)
-                dPds = v3_scale(v3_sub(v3_scale(du, j[3]), v3_scale(dv, j[2])), 1.0f / det);
-        }
-        Vec3 T = v3_sub(dPds, v3_scale(N, v3_dot(N, dPds)));
-        float len = v3_length(T);
-        Vec3 m = N;
-        if (len > 0.0f && isfinite(len)) {
-            T = v3_scale(T, 1.0f / len);
-            Vec3 B = v3_cross(N, T);
-            Vec3 n = v3(2.0f * tex[i][0] - 1.0f, 2.0f * tex[i][1] - 1.0f, 2.0f * tex[i][2] - 1.0f);
-            m = v3_normalize(v3_add(v3_add(v3_scale(T, n.x), v3_scale(B, n.y)), v3_scale(N, n.z)));
-            Vec3 Ng = ctx->Ng ? ld(ctx->Ng[i]) : N;
-            if (!(v3_dot(m, Ng) > 0.0f) || !isfinite(m.x + m.y + m.z))
-                m = N;
-        }
-        out[i][0] = m.x, out[i][1] = m.y, out[i][2] = m.z;
-    }
-}
-
 /* A shader's chunk function and parameters, for shade_chunks. */
 typedef struct MappedChunk {
     ShadeChunkFn fn;
@@ -100,7 +63,7 @@ static void mapped_chunk(const RayesShaderServices *sv, const RayesShadeCtx *sub
     RayesShadeCtx ctx = *sub;
     Rgb mapped[SHADE_CHUNK];
     if (shade_param_bound(&ctx, "normalmap")) {
-        normal_map(sv, &ctx, mapped);
+        shade_normal_map(sv, &ctx, mapped);
         ctx.N = (const float(*)[3])mapped;
     }
     m->fn(sv, &ctx, m->params, out);
@@ -291,7 +254,7 @@ const RayesShaderClass shade_class_metal = {
 
 typedef struct ShinymetalParams {
     float Ka, Ks, Kr, roughness;
-    char texturename[64];
+    char texturename[RAYES_SHADER_PATH_BYTES];
 } ShinymetalParams;
 
 /* The environment around the mirror directions: the lat-long map
@@ -360,6 +323,7 @@ const RayesShaderClass shade_class_shinymetal = {
     .n_params = sizeof shinymetal_params / sizeof shinymetal_params[0],
     .lighting = shinymetal_lighting,
     .diffuselighting = shinymetal_lighting, /* without I: Cs Ka ambient only */
+    .flags = RAYES_SHADER_PATH_STRINGS,
 };
 
 /* ------------------------------------------------------------ glass, dielectric */

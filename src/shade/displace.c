@@ -25,7 +25,7 @@
 
 typedef struct BumpyParams {
     float Km, frequency;
-    char texturename[64];
+    char texturename[RAYES_SHADER_PATH_BYTES];
 } BumpyParams;
 
 typedef struct FractalParams {
@@ -145,6 +145,7 @@ const RayesShaderClass shade_class_bumpy = {
     .displacement = bumpy_displacement,
     .lighting = unshaded,
     .diffuselighting = unshaded,
+    .flags = RAYES_SHADER_PATH_STRINGS,
 };
 
 static const RayesShaderParamDesc fractal_params[] = {

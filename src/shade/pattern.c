@@ -70,8 +70,10 @@ struct RayesPattern {
     char encoding[32];            /* imagemap: "" (the file's), "sRGB", "linear", "gamma G" */
     char wrap[16];                /* imagemap: "" or "repeat", "black", "clamp" */
     VoxelGrid *grid;              /* densitygrid, nanovdb: owned */
-    _Atomic int matte;            /* imagemap channel -2: the channel found + 1 (0: not yet;
-                                     a file's channels do not change, renders share it) */
+    _Atomic int probed;           /* what the file's texels told, once read (0: not yet; a
+                                     file does not change, renders share it): channel -2,
+                                     the matte's channel + 1; -3 and -4, BUMP_HEIGHT or
+                                     BUMP_NORMAL */
 };
 
 /* A parameter of a class: an input ('i'), a number ('n'), a string ('s')
@@ -372,8 +374,8 @@ static int check_pattern(Pattern *p, const ClassDesc *c, char *err, size_t err_s
                      p->encoding);
             return -1;
         }
-        if (!(p->num[2] >= -2.0f && p->num[2] <= 3.0f)) {
-            snprintf(err, err_size, "pattern \"imagemap\": channel must be -2 to 3");
+        if (!(p->num[2] >= -4.0f && p->num[2] <= 3.0f)) {
+            snprintf(err, err_size, "pattern \"imagemap\": channel must be -4 to 3");
             return -1;
         }
     }
@@ -675,6 +677,51 @@ static float weight_at(const Pattern *p, const Eval *e, const Rgb *amount, size_
     }
 }
 
+enum { BUMP_HEIGHT = 1, BUMP_NORMAL = 2 };
+
+/* Whether the file of a bump slot (an OBJ's bump, map_Bump, norm) is a
+ * normal map or a height map, from its average texel (the lookup's widest
+ * footprint, the MIP pyramid's last level): a tangent-space normal map
+ * averages about (0.5, 0.5, 1) — blue well above red and green, both near
+ * a half — where a height map is grey. Kept once the file was read. */
+static int bump_kind(const Pattern *p, Eval *e)
+{
+    Pattern *mp = (Pattern *)p;
+    int known = atomic_load_explicit(&mp->probed, memory_order_relaxed);
+    if (known || !e->ts)
+        return known ? known : BUMP_HEIGHT;
+    float s = 0.5f, t = 0.5f, w = 1.0f, avg[1][3], alpha;
+    if (texture_lookup_encoded(e->ts, p->filename, p->encoding, TEXTURE_WRAP_REPEAT, 1, &s, &t, &w,
+                               &w, avg, &alpha) != 0)
+        return BUMP_HEIGHT; /* unreadable: the caller's texels are 0, flat either way */
+    const float r = avg[0][0], g = avg[0][1], b = avg[0][2];
+    int kind = texture_channels(e->ts, p->filename, p->encoding) >= 3 && b > 0.6f &&
+                       fabsf(r - 0.5f) < 0.2f && fabsf(g - 0.5f) < 0.2f && b - fmaxf(r, g) > 0.15f
+                   ? BUMP_NORMAL
+                   : BUMP_HEIGHT;
+    atomic_store_explicit(&mp->probed, kind, memory_order_relaxed);
+    return kind;
+}
+
+/* imagemap channel -3 and -4, a bump slot's file read either way: -3 its
+ * height (the first channel times scale; 0 for a normal map), -4 its
+ * normal (the texels, their x and y about 0.5 times scale, the strength;
+ * the flat (0.5, 0.5, 1) for a height map). out holds the texels. */
+static void bump_texels(const Pattern *p, Eval *e, int ch, Rgb *out)
+{
+    int normal = bump_kind(p, e) == BUMP_NORMAL;
+    for (size_t i = 0; i < e->ctx->n_points; i++) {
+        if (ch == -3) {
+            grey(out[i], normal ? 0.0f : p->num[0] * out[i][0]);
+        } else if (!normal) {
+            out[i][0] = out[i][1] = 0.5f, out[i][2] = 1.0f;
+        } else {
+            out[i][0] = 0.5f + p->num[0] * (out[i][0] - 0.5f);
+            out[i][1] = 0.5f + p->num[0] * (out[i][1] - 0.5f);
+        }
+    }
+}
+
 static void eval_image(const Pattern *p, Eval *e, Rgb *out)
 {
     size_t n = e->ctx->n_points;
@@ -696,14 +743,18 @@ static void eval_image(const Pattern *p, Eval *e, Rgb *out)
             alpha[i] = 1.0f;
     }
     int ch = (int)p->num[2];
+    if (ch == -3 || ch == -4) {
+        bump_texels(p, e, ch, out);
+        return;
+    }
     if (ch == -2) { /* the matte: the alpha channel if the file has one, else the first;
                        a file that cannot be read, its alpha (1: opaque) */
         Pattern *mp = (Pattern *)p; /* the answer, kept once the file was read */
-        int known = atomic_load_explicit(&mp->matte, memory_order_relaxed);
+        int known = atomic_load_explicit(&mp->probed, memory_order_relaxed);
         int nc = known ? 0 : e->ts ? texture_channels(e->ts, p->filename, p->encoding) : 0;
         ch = known ? known - 1 : nc == 2 || nc >= 4 || nc == 0 ? 3 : 0;
         if (!known && nc > 0)
-            atomic_store_explicit(&mp->matte, ch + 1, memory_order_relaxed);
+            atomic_store_explicit(&mp->probed, ch + 1, memory_order_relaxed);
     }
     for (size_t i = 0; i < n; i++) {
         if (ch >= 0)

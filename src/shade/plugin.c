@@ -31,8 +31,8 @@ typedef struct Plugin {
 static pthread_mutex_t registry_lock = PTHREAD_MUTEX_INITIALIZER;
 static Plugin *registry;           /* guarded by registry_lock */
 
-/* Bytes a parameter of that type occupies, or 0 for an unknown type. */
-static size_t param_bytes(RayesParamType type)
+/* Bytes a parameter of that type occupies in cls, or 0 for an unknown type. */
+static size_t param_bytes(const RayesShaderClass *cls, RayesParamType type)
 {
     switch (type) {
     case RAYES_PARAM_FLOAT:
@@ -40,7 +40,7 @@ static size_t param_bytes(RayesParamType type)
     case RAYES_PARAM_COLOR:
         return 3 * sizeof(float);
     case RAYES_PARAM_STRING:
-        return 64;
+        return shade_string_bytes(cls);
     default:
         return 0;
     }
@@ -53,7 +53,7 @@ static int check_param(const RayesShaderClass *cls, size_t i, char *err, size_t 
         snprintf(err, err_size, "parameter %zu has no name (or an absurd one)", i);
         return -1;
     }
-    size_t bytes = param_bytes(d->type);
+    size_t bytes = param_bytes(cls, d->type);
     if (bytes == 0) {
         snprintf(err, err_size, "parameter \"%s\" has unknown type %d; expected float, color or "
                  "string", d->name, (int)d->type);

@@ -14,6 +14,7 @@
 #include <string.h>
 
 #include "util/log.h"
+#include "util/vec.h"
 
 static const RayesShaderParamDesc *find_param(const RayesShaderClass *cls, const char *name)
 {
@@ -23,18 +24,26 @@ static const RayesShaderParamDesc *find_param(const RayesShaderClass *cls, const
     return NULL;
 }
 
-static void set_param(void *block, const RayesShaderParamDesc *d, RayesParamType type,
-                      const float value[3], const char *string)
+static void set_param(const RayesShaderClass *cls, void *block, const RayesShaderParamDesc *d,
+                      RayesParamType type, const float value[3], const char *string)
 {
     char *at = (char *)block + d->offset;
+    size_t bytes = shade_string_bytes(cls);
     if (d->type == RAYES_PARAM_FLOAT)
         memcpy(at, value, sizeof(float));
     else if (d->type == RAYES_PARAM_COLOR) {
         float c[3] = {value[0], type == RAYES_PARAM_FLOAT ? value[0] : value[1],
                       type == RAYES_PARAM_FLOAT ? value[0] : value[2]};
         memcpy(at, c, sizeof c);
-    } else if (d->type == RAYES_PARAM_STRING)
-        snprintf(at, 64, "%s", string ? string : "");
+    } else if (d->type == RAYES_PARAM_STRING &&
+               (size_t)snprintf(at, bytes, "%s", string ? string : "") >= bytes) {
+        char key[96];
+        snprintf(key, sizeof key, "long:%s:%s", cls->name, d->name);
+        log_warning_once(key,
+                         "shader \"%s\" parameter \"%s\": \"%.40s...\" is longer than %zu "
+                         "characters; cut",
+                         cls->name, d->name, string, bytes - 1);
+    }
 }
 
 int shade_instance_apply(ShaderInstance *inst, const RayesParam *params, size_t n_params,
@@ -61,7 +70,7 @@ int shade_instance_apply(ShaderInstance *inst, const RayesParam *params, size_t 
                              cls->name, params[i].name);
             continue;
         }
-        set_param(inst->params, d, params[i].type, params[i].value, params[i].string);
+        set_param(cls, inst->params, d, params[i].type, params[i].value, params[i].string);
     }
     return 0;
 }
@@ -80,7 +89,7 @@ int shade_instance_init(ShaderInstance *inst, const RayesShaderClass *cls,
         return -1;
     }
     for (size_t i = 0; i < cls->n_params; i++)
-        set_param(inst->params, &cls->params[i], cls->params[i].type,
+        set_param(cls, inst->params, &cls->params[i], cls->params[i].type,
                   cls->params[i].default_value, "");
     return shade_instance_apply(inst, params, n_params, 0, err, err_size);
 }
@@ -165,6 +174,42 @@ static const RayesPattern *bound(const RayesShadeCtx *ctx, const char *name)
 int shade_param_bound(const RayesShadeCtx *ctx, const char *name)
 {
     return bound(ctx, name) != NULL;
+}
+
+/* The shading normals of a normal map (pbrt-v4's "normalmap": a linear
+ * image whose texel n = 2 rgb - 1 is in the frame of x = dP/ds, z = N,
+ * y = z cross x; the pattern "normalmap" holds it): dP/ds from dPdu, dPdv
+ * and the texture coordinates' derivatives (ctx->dst; without them s is u),
+ * made perpendicular to N. A mapped normal that turns away from the
+ * geometric normal keeps N. */
+void shade_normal_map(const RayesShaderServices *sv, const RayesShadeCtx *ctx, float (*out)[3])
+{
+    static const float flat[3] = {0.5f, 0.5f, 1.0f};
+    float tex[SHADE_CHUNK][3];
+    shade_param_color(sv, ctx, "normalmap", flat, tex);
+    for (size_t i = 0; i < ctx->n_points; i++) {
+        Vec3 N = v3_load(ctx->N[i]), du = v3_load(ctx->dPdu[i]), dv = v3_load(ctx->dPdv[i]),
+             dPds = du;
+        if (ctx->dst) { /* [ds dt] = J [du dv]: dP/ds = (dt/dv dPdu - dt/du dPdv) / det J */
+            const float *j = ctx->dst[i];
+            float det = j[0] * j[3] - j[1] * j[2];
+            if (fabsf(det) > 1e-20f)
+                dPds = v3_scale(v3_sub(v3_scale(du, j[3]), v3_scale(dv, j[2])), 1.0f / det);
+        }
+        Vec3 T = v3_sub(dPds, v3_scale(N, v3_dot(N, dPds)));
+        float len = v3_length(T);
+        Vec3 m = N;
+        if (len > 0.0f && isfinite(len)) {
+            T = v3_scale(T, 1.0f / len);
+            Vec3 B = v3_cross(N, T);
+            Vec3 n = v3(2.0f * tex[i][0] - 1.0f, 2.0f * tex[i][1] - 1.0f, 2.0f * tex[i][2] - 1.0f);
+            m = v3_normalize(v3_add(v3_add(v3_scale(T, n.x), v3_scale(B, n.y)), v3_scale(N, n.z)));
+            Vec3 Ng = ctx->Ng ? v3_load(ctx->Ng[i]) : N;
+            if (!(v3_dot(m, Ng) > 0.0f) || !isfinite(m.x + m.y + m.z))
+                m = N;
+        }
+        out[i][0] = m.x, out[i][1] = m.y, out[i][2] = m.z;
+    }
 }
 
 void shade_param_color(const RayesShaderServices *sv, const RayesShadeCtx *ctx, const char *name,

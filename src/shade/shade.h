@@ -74,6 +74,12 @@ void shade_param_float(const RayesShaderServices *sv, const RayesShadeCtx *ctx, 
 /* Nonzero if ctx->patterns binds name. */
 int shade_param_bound(const RayesShadeCtx *ctx, const char *name);
 
+/* The shading normals at ctx's points (SHADE_CHUNK at most) of the normal
+ * map bound to "normalmap" (pbrt-v4's: texel n = 2 rgb - 1 in the frame of
+ * x = dP/ds, z = N, y = z cross x), into out; ctx->N where the mapped
+ * normal turns away from the geometric one. */
+void shade_normal_map(const RayesShaderServices *sv, const RayesShadeCtx *ctx, float (*out)[3]);
+
 /* Runs diffuselighting, or the fallback for classes without it: lighting
  * with I absent, whose services then return only view-independent (diffuse)
  * lobes; warns once per class. */
@@ -100,6 +106,12 @@ static inline uint32_t shade_class_flags(const RayesShaderClass *cls)
     return cls && cls->struct_size >= offsetof(RayesShaderClass, flags) + sizeof cls->flags
                ? cls->flags
                : 0u;
+}
+
+/* The bytes of a STRING parameter of cls. */
+static inline size_t shade_string_bytes(const RayesShaderClass *cls)
+{
+    return shade_class_flags(cls) & RAYES_SHADER_PATH_STRINGS ? RAYES_SHADER_PATH_BYTES : 64;
 }
 
 /* The flags an object shaded by inst needs: its class's, and its

@@ -225,6 +225,37 @@ static void test_opacity_words(void)
     record_free(&rec);
 }
 
+/* A map's file as a Windows-authored MTL names it: backslashes, other
+ * capitals than the disk's, or an absolute path of the machine that wrote
+ * it whose file lies beside the MTL. */
+static void test_map_paths(void)
+{
+    mkdir(RAYES_TEST_TMP, 0777);
+    mkdir(DIR, 0777);
+    mkdir(DIR "/tex", 0777);
+    test_write_text(DIR "/tex/wood.png", "not read by the parser");
+    test_write_text(DIR "/stone.png", "not read by the parser");
+    test_write_text(DIR "/p.mtl", "newmtl a\nmap_Kd tex\\wood.png\n"
+                                  "newmtl b\nmap_Kd TEX/Wood.PNG\n"
+                                  "newmtl c\nmap_Kd C:\\Users\\me\\Stone.png\n"
+                                  "newmtl d\nmap_Kd tex/gone.png\n");
+    CHECK(parse(DIR "/p.obj",
+                "mtllib p.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nusemtl a\nf 1 2 3\n"
+                "usemtl b\nf 1 2 3\nusemtl c\nf 1 2 3\nusemtl d\nf 1 2 3\n") == RAYES_OK);
+    CHECK(rec.n_shader == 4);
+    if (rec.n_shader == 4) {
+        const char *want[4] = {DIR "/tex/wood.png", DIR "/tex/wood.png", DIR "/stone.png",
+                               DIR "/tex/gone.png"};
+        for (int k = 0; k < 4; k++) {
+            const RayesParam *p = rec_param(&rec.shader[k], "texturename");
+            CHECK(p && strcmp(p->string, want[k]) == 0);
+            if (p && strcmp(p->string, want[k]) != 0)
+                printf("  material %d: %s, expected %s\n", k, p->string, want[k]);
+        }
+    }
+    record_free(&rec);
+}
+
 static void test_default_camera_and_light(void)
 {
     CHECK(parse("c.obj", "v -1 -2 -3\nv 3 -2 -3\nv 3 4 5\nf 1 2 3\n") == RAYES_OK);
@@ -555,6 +586,7 @@ static void test_transparency(void)
 }
 
 TEST_MAIN(TEST(test_face_syntax), TEST(test_ngons), TEST(test_materials), TEST(test_opacity_words),
-          TEST(test_default_camera_and_light), TEST(test_errors), TEST(test_unknown_statements),
-          TEST(test_read_file), TEST(test_normals_and_texture_coordinates), TEST(test_transparency),
+          TEST(test_map_paths), TEST(test_default_camera_and_light), TEST(test_errors),
+          TEST(test_unknown_statements), TEST(test_read_file),
+          TEST(test_normals_and_texture_coordinates), TEST(test_transparency),
           TEST(test_smoothing_groups), TEST(test_vertex_colours))
