@@ -228,7 +228,12 @@ RAYES_API RayesError rayes_scene_set_displacement_bound(RayesScene *scene, float
  *                   "scale", "invert" (1: 1 - value), "encoding" (STRING:
  *                   "sRGB", "linear" or "gamma G", for integer files; default
  *                   the file's), "channel" (-1: RGB, 0 to 3 that channel grey,
- *                   -2 the matte: alpha if the file has it, else channel 0)
+ *                   -2 the matte: alpha if the file has it, else channel 0;
+ *                   a bump slot's file, a normal map told from a height map
+ *                   by its average texel: -3 the height, channel 0 times
+ *                   scale, 0 for a normal map; -4 the normal, the texels
+ *                   with x and y about 0.5 times scale, (0.5, 0.5, 1) for a
+ *                   height map)
  *   "bilerp"        v00 v01 v10 v11 (constants) over (u, v)
  *   "dots"          inside, outside: polka dots on the (u, v) cells
  *   "fbm", "wrinkled", "windy", "marble"  pbrt's noise patterns (octaves,

@@ -239,6 +239,9 @@ typedef struct Material {
     char map_d[1024];   /* the opacity's texture (a cut-out), resolved likewise; "" none */
     int map_d_channel;  /* its channel: 0-3, or -2 the matte (alpha if any, else grey) */
     int map_d_sent;     /* its pattern made (once per material) */
+    char bump[1024];    /* bump, map_bump, norm, disp, ...: a height or normal map; "" none */
+    float bump_mult;    /* -bm: the height's scale, the normal's strength */
+    int bump_sent;      /* its two patterns made */
     int defined;        /* given by a newmtl */
 } Material;
 
@@ -318,6 +321,7 @@ static int material_find(Obj *o, const char *tok, size_t n)
     m->Ns = -1.0f;
     m->d = m->Tr = -1.0f;
     m->illum = -1;
+    m->bump_mult = 1.0f;
     return (int)o->n_mats++;
 }
 
@@ -459,6 +463,22 @@ static int map_channel(Lexer *L)
     return ch;
 }
 
+/* A bump map's "-bm mult" option, read ahead of mtl_map into *mult (left
+ * as it is when not given). The lexer is left where it was. */
+static int map_bump_mult(Lexer *L, float *mult)
+{
+    const char *save = L->p, *tok;
+    size_t n;
+    while ((n = lex_token(L, &tok)) > 0)
+        if (is_kw(tok, n, "-bm")) {
+            n = lex_token(L, &tok);
+            if (parse_float(tok, n, mult) != 0)
+                return lex_expected(L, tok, n, "a bump multiplier after -bm");
+        }
+    L->p = save;
+    return 0;
+}
+
 static void dir_of(const char *path, char *dir, size_t size)
 {
     const char *slash = strrchr(path, '/');
@@ -531,6 +551,13 @@ static int mtl_statement(Obj *o, Lexer *L, const char *mtl_dir, const char *kw, 
     if (is_kw(kw, n, "map_d")) {
         mt->map_d_channel = map_channel(L);
         return mtl_map(L, mtl_dir, mt->map_d, sizeof mt->map_d);
+    }
+    if (is_kw(kw, n, "bump") || is_kw(kw, n, "map_bump") || is_kw(kw, n, "map_Bump") ||
+        is_kw(kw, n, "norm") || is_kw(kw, n, "map_Norm") || is_kw(kw, n, "disp") ||
+        is_kw(kw, n, "map_Disp")) {
+        if (map_bump_mult(L, &mt->bump_mult) != 0)
+            return -1;
+        return mtl_map(L, mtl_dir, mt->bump, sizeof mt->bump);
     }
     char key[40];
     snprintf(key, sizeof key, "mtl %.*s", (int)(n < 30 ? n : 30), kw);
@@ -943,6 +970,7 @@ typedef struct Emit {
     float lo[3], hi[3];  /* bounds of the vertices drawn */
     int *local;          /* global vertex -> mesh vertex, -1 unused */
     FloatVec P;
+    int bumped; /* the last material sent had a bump map (a displacement) */
 } Emit;
 
 static RayesError sink_fail(Emit *e, RayesError r, const char *what)
@@ -1033,6 +1061,55 @@ static RayesError opacity_of(Emit *e, Material *m, char cutout[48], RayesParam *
     return RAYES_OK;
 }
 
+/* The bump map of material m (NULL: none) as the sink's displacement and
+ * *out, the shader's "normalmap" parameter (its name NULL without one).
+ * The file is read both ways, as a height map (imagemap channel -3: a
+ * bump, the shading normal of the surface displaced by height times -bm
+ * object units, the surface where it is) and as a tangent-space normal
+ * map (-4, of strength -bm), the texture module telling which it is from
+ * its texels (docs/obj.md); the other reads as flat. Two patterns made
+ * once per material, under names that start with a space (names holds
+ * them). A material without a bump after one with ends the displacement. */
+static RayesError bump_of(Emit *e, Material *m, char names[2][48], RayesParam *out)
+{
+    out->name = NULL;
+    if (!m || !m->bump[0]) {
+        RayesError r = RAYES_OK;
+        if (e->bumped && e->sink->set_displacement)
+            r = e->sink->set_displacement(e->sink->target, "", NULL, 0);
+        e->bumped = 0;
+        return r == RAYES_OK ? r : sink_fail(e, r, "the end of a bump map");
+    }
+    if (!e->sink->pattern || !e->sink->set_displacement) {
+        obj_warn(e->o, "bump sink", "%s: bump and normal maps are not kept by this output",
+                 e->o->name);
+        return RAYES_OK;
+    }
+    size_t k = (size_t)(m - e->o->mats);
+    snprintf(names[0], 48, " obj bump %zu height", k);
+    snprintf(names[1], 48, " obj bump %zu normal", k);
+    char what[200];
+    snprintf(what, sizeof what, "material \"%s\": its bump map", m->name);
+    for (int j = 0; j < 2 && !m->bump_sent; j++) {
+        RayesParam q[4] = {{"filename", RAYES_PARAM_STRING, {0, 0, 0}, m->bump},
+                           {"encoding", RAYES_PARAM_STRING, {0, 0, 0}, "linear"},
+                           {"channel", RAYES_PARAM_FLOAT, {j == 0 ? -3.0f : -4.0f, 0, 0}, NULL},
+                           {"scale", RAYES_PARAM_FLOAT, {m->bump_mult, 0, 0}, NULL}};
+        RayesError r = e->sink->pattern(e->sink->target, names[j], "imagemap", q, 4);
+        if (r != RAYES_OK)
+            return sink_fail(e, r, what);
+    }
+    m->bump_sent = 1;
+    const RayesParam d[2] = {{"amount", RAYES_PARAM_PATTERN, {0, 0, 0}, names[0]},
+                             {"__bump", RAYES_PARAM_FLOAT, {1, 0, 0}, NULL}};
+    RayesError r = e->sink->set_displacement(e->sink->target, "displace", d, 2);
+    if (r != RAYES_OK)
+        return sink_fail(e, r, what);
+    e->bumped = 1;
+    *out = (RayesParam){"normalmap", RAYES_PARAM_PATTERN, {0.5f, 0.5f, 1}, names[1]};
+    return RAYES_OK;
+}
+
 /* The shader of a material (NULL: the default, matte grey). A map_Kd
  * replaces Kd, as Blender's and Mitsuba's importers read it (the MTL
  * standard multiplies them, but exporters write their default Kd beside
@@ -1041,13 +1118,18 @@ static RayesError material_shader(Emit *e, Material *m)
 {
     static const float grey[3] = {0.8f, 0.8f, 0.8f}, white[3] = {1, 1, 1};
     const float *Kd = !m ? grey : m->map_Kd[0] ? white : m->Kd;
-    RayesParam p[7];
+    RayesParam p[8];
     size_t n = 0;
+    char bumps[2][48];
+    RayesError r = bump_of(e, m, bumps, &p[n]);
+    if (r != RAYES_OK)
+        return r;
+    n += p[n].name != NULL;
     p[n++] = (RayesParam){"Cs", RAYES_PARAM_COLOR, {Kd[0], Kd[1], Kd[2]}, NULL};
     if (!m)
         return set_shader(e, "matte", p, n, "(none)");
     char cutout[48];
-    RayesError r = opacity_of(e, m, cutout, &p[n]);
+    r = opacity_of(e, m, cutout, &p[n]);
     if (r != RAYES_OK)
         return r;
     n += p[n].name != NULL;
@@ -1328,9 +1410,12 @@ static RayesError emit_material(Emit *e, int mi)
             r = RAYES_ERROR_OUT_OF_MEMORY;
     if (r != RAYES_OK)
         snprintf(o->err, o->err_size, "%s: out of memory", o->name);
-    else if (mt && max3(mt->Ke) > 0.0f)
-        r = emit_emitter(e, mt, &m);
-    else if (m.nv.n > 0 && (r = material_shader(e, mt)) == RAYES_OK)
+    else if (mt && max3(mt->Ke) > 0.0f) {
+        char none[2][48];
+        RayesParam unused;
+        if ((r = bump_of(e, NULL, none, &unused)) == RAYES_OK) /* lights are not bumped */
+            r = emit_emitter(e, mt, &m);
+    } else if (m.nv.n > 0 && (r = material_shader(e, mt)) == RAYES_OK)
         r = emit_mesh(e, &m, mt ? mt->name : "(none)");
     free(m.nv.a);
     free(m.idx.a);

@@ -1083,8 +1083,9 @@ static int mat_normal_map(Parser *P, const Token *t, ParamList *pl, Material *m)
     const char *file = pbrt_get_string(pl, "normalmap", NULL);
     if (!file || !file[0])
         return 0;
-    static const char *const takes[] = {"diffuse",       "dielectric",          "conductor",
-                                        "coateddiffuse", "diffusetransmission", NULL};
+    static const char *const takes[] = {
+        "diffuse", "dielectric", "conductor", "coateddiffuse", "diffusetransmission",
+        "matte",   "plastic",    NULL};
     int k = 0;
     while (takes[k] && strcmp(m->shader, takes[k]) != 0)
         k++;

@@ -22,11 +22,13 @@
 typedef struct MatteParams {
     float Ka, Kd;
     float Ke[3];
+    float normalmap[3]; /* bound to a pattern, or the flat (0.5, 0.5, 1) */
 } MatteParams;
 
 typedef struct PlasticParams {
     float Ka, Kd, Ks, roughness;
     float specularcolor[3];
+    float normalmap[3];
 } PlasticParams;
 
 typedef struct MirrorParams {
@@ -88,6 +90,11 @@ static void by_chunks_scratch(const RayesShaderServices *sv, const RayesShadeCtx
             sub.scratch = (char *)ctx->scratch + start * scratch_size;
         RayesShadeOutputs o = {out->Ci + start, out->Oi + start,
                                out->Irradiance ? out->Irradiance + start : NULL, NULL};
+        float mapped[SHADE_CHUNK][3];
+        if (shade_param_bound(&sub, "normalmap")) { /* an OBJ's normal or bump map */
+            shade_normal_map(sv, &sub, mapped);
+            sub.N = (const float(*)[3])mapped;
+        }
         fn(sv, &sub, params, &o);
     }
     set_opacity(ctx, out);
@@ -118,6 +125,7 @@ static const RayesShaderParamDesc matte_params[] = {
     {"Ka", RAYES_PARAM_FLOAT, offsetof(MatteParams, Ka), {1, 0, 0}},
     {"Kd", RAYES_PARAM_FLOAT, offsetof(MatteParams, Kd), {1, 0, 0}},
     {"Ke", RAYES_PARAM_COLOR, offsetof(MatteParams, Ke), {0, 0, 0}},
+    {"normalmap", RAYES_PARAM_COLOR, offsetof(MatteParams, normalmap), {0.5f, 0.5f, 1.0f}},
 };
 
 const RayesShaderClass shade_class_matte = {
@@ -188,6 +196,7 @@ static const RayesShaderParamDesc plastic_params[] = {
     {"Ks", RAYES_PARAM_FLOAT, offsetof(PlasticParams, Ks), {0.5f, 0, 0}},
     {"roughness", RAYES_PARAM_FLOAT, offsetof(PlasticParams, roughness), {0.1f, 0, 0}},
     {"specularcolor", RAYES_PARAM_COLOR, offsetof(PlasticParams, specularcolor), {1, 1, 1}},
+    {"normalmap", RAYES_PARAM_COLOR, offsetof(PlasticParams, normalmap), {0.5f, 0.5f, 1.0f}},
 };
 
 const RayesShaderClass shade_class_plastic = {
@@ -337,6 +346,7 @@ const RayesShaderClass shade_class_defaultsurface = {
 typedef struct PaintedPlasticParams {
     float Ka, Kd, Ks, roughness;
     float specularcolor[3];
+    float normalmap[3];
     char texturename[RAYES_SHADER_PATH_BYTES];
 } PaintedPlasticParams;
 
@@ -417,9 +427,9 @@ static const RayesShaderParamDesc painted_params[] = {
     {"Kd", RAYES_PARAM_FLOAT, offsetof(PaintedPlasticParams, Kd), {0.5f, 0, 0}},
     {"Ks", RAYES_PARAM_FLOAT, offsetof(PaintedPlasticParams, Ks), {0.5f, 0, 0}},
     {"roughness", RAYES_PARAM_FLOAT, offsetof(PaintedPlasticParams, roughness), {0.1f, 0, 0}},
-    {"specularcolor", RAYES_PARAM_COLOR, offsetof(PaintedPlasticParams, specularcolor),
-     {1, 1, 1}},
+    {"specularcolor", RAYES_PARAM_COLOR, offsetof(PaintedPlasticParams, specularcolor), {1, 1, 1}},
     {"texturename", RAYES_PARAM_STRING, offsetof(PaintedPlasticParams, texturename), {0, 0, 0}},
+    {"normalmap", RAYES_PARAM_COLOR, offsetof(PaintedPlasticParams, normalmap), {0.5f, 0.5f, 1.0f}},
 };
 
 const RayesShaderClass shade_class_paintedplastic = {

@@ -514,6 +514,82 @@ static RayesImage *render_cut(const char *cut)
     return img;
 }
 
+/* Writes a w x h binary PPM of one colour per column (rgb of column x). */
+static void write_columns(const char *path, int w, int h,
+                          void (*rgb)(int x, int w, unsigned char c[3]))
+{
+    FILE *f = fopen(path, "wb");
+    CHECK(f != NULL);
+    if (!f)
+        return;
+    fprintf(f, "P6 %d %d 255\n", w, h);
+    for (int y = 0; y < h; y++)
+        for (int x = 0; x < w; x++) {
+            unsigned char c[3];
+            rgb(x, w, c);
+            fwrite(c, 1, 3, f);
+        }
+    fclose(f);
+}
+
+static void tilt_texel(int x, int w, unsigned char c[3]) /* n = (-0.3, 0, 0.954) */
+{
+    (void)x, (void)w;
+    c[0] = 89, c[1] = 128, c[2] = 249;
+}
+
+static void flat_texel(int x, int w, unsigned char c[3])
+{
+    (void)x, (void)w;
+    c[0] = 128, c[1] = 128, c[2] = 255;
+}
+
+static void ramp_texel(int x, int w, unsigned char c[3]) /* grey, rising along u */
+{
+    c[0] = c[1] = c[2] = (unsigned char)(255 * x / (w - 1));
+}
+
+/* bump, map_Bump and norm: a normal map's texels tilt the shading normal
+ * (toward the light from the upper left: brighter), a flat one changes
+ * nothing, and a grey height map is a bump of height times -bm object
+ * units (a ramp rising 1 unit over the 2-unit quad: a normal tilted 27
+ * degrees toward the light, or away with -bm -1). The same keyword reads
+ * either kind; the file's texels tell them apart. */
+static void test_bump_maps(void)
+{
+    mkdir(RAYES_TEST_TMP, 0777);
+    mkdir(DIR, 0777);
+    write_columns(DIR "/tilt.ppm", 8, 8, tilt_texel);
+    write_columns(DIR "/flatn.ppm", 8, 8, flat_texel);
+    write_columns(DIR "/ramp.ppm", 64, 4, ramp_texel);
+    RayesImage *plain = render_cut("");
+    RayesImage *tilt = render_cut("map_Bump -bm 1.0 tilt.ppm");
+    RayesImage *flat = render_cut("norm flatn.ppm");
+    RayesImage *up = render_cut("bump ramp.ppm");
+    RayesImage *down = render_cut("map_bump -bm -1 ramp.ppm");
+    CHECK(plain && tilt && flat && up && down);
+    if (plain && tilt && flat && up && down) {
+        double r, g0, g1, g2, g3, g4;
+        means(plain, 24, 40, 24, 40, &r, &g0);
+        means(tilt, 24, 40, 24, 40, &r, &g1);
+        means(flat, 24, 40, 24, 40, &r, &g2);
+        means(up, 24, 40, 24, 40, &r, &g3);
+        means(down, 24, 40, 24, 40, &r, &g4);
+        printf("  green: plain %.4f, normal map %.4f (x %.3f, expected 1.25), flat map %.4f, "
+               "ramp %.4f (x %.3f, expected 1.34), ramp -bm -1 %.4f (x %.3f, expected 0.45)\n",
+               g0, g1, g1 / g0, g2, g3, g3 / g0, g4, g4 / g0);
+        CHECK(fabs(g1 / g0 - 1.25) < 0.04);
+        CHECK(fabs(g2 / g0 - 1.0) < 0.01);
+        CHECK(fabs(g3 / g0 - 1.34) < 0.05);
+        CHECK(fabs(g4 / g0 - 0.45) < 0.05);
+    }
+    rayes_image_free(plain);
+    rayes_image_free(tilt);
+    rayes_image_free(flat);
+    rayes_image_free(up);
+    rayes_image_free(down);
+}
+
 /* MTL transparency: d (and Tr) is the opacity, map_d a cut-out by its
  * texture's matte (a grey mask's value, an RGBA image's alpha) or the
  * channel -imfchan names; where it is 0 the wall behind shows. */
@@ -586,7 +662,7 @@ static void test_transparency(void)
 }
 
 TEST_MAIN(TEST(test_face_syntax), TEST(test_ngons), TEST(test_materials), TEST(test_opacity_words),
-          TEST(test_map_paths), TEST(test_default_camera_and_light), TEST(test_errors),
-          TEST(test_unknown_statements), TEST(test_read_file),
+          TEST(test_map_paths), TEST(test_bump_maps), TEST(test_default_camera_and_light),
+          TEST(test_errors), TEST(test_unknown_statements), TEST(test_read_file),
           TEST(test_normals_and_texture_coordinates), TEST(test_transparency),
           TEST(test_smoothing_groups), TEST(test_vertex_colours))
