@@ -234,6 +234,8 @@ typedef struct Material {
     float Kd[3], Ks[3], Ke[3];
     float Ns;           /* Phong exponent; -1: not given */
     float d, Tr;        /* dissolve (the opacity) and transparency; -1 not given */
+    float Tf[3];        /* transmission filter; Tf[0] -1 not given */
+    float Ni;           /* index of refraction; -1 not given */
     int illum;          /* illumination model, read, not rendered */
     char map_Kd[1024];  /* texture path, resolved against the MTL's directory; "" none */
     char map_d[1024];   /* the opacity's texture (a cut-out), resolved likewise; "" none */
@@ -319,7 +321,7 @@ static int material_find(Obj *o, const char *tok, size_t n)
     snprintf(m->name, sizeof m->name, "%s", name);
     m->Kd[0] = m->Kd[1] = m->Kd[2] = 0.8f;
     m->Ns = -1.0f;
-    m->d = m->Tr = -1.0f;
+    m->d = m->Tr = m->Tf[0] = m->Ni = -1.0f;
     m->illum = -1;
     m->bump_mult = 1.0f;
     return (int)o->n_mats++;
@@ -517,7 +519,14 @@ static int mtl_statement(Obj *o, Lexer *L, const char *mtl_dir, const char *kw, 
             return lex_error_at(L, kw, "Ke: an emission must not be negative");
         return 0;
     }
-    if (is_kw(kw, n, "Ka") || is_kw(kw, n, "Tf")) {
+    if (is_kw(kw, n, "Tf")) {
+        if (mtl_color(L, mt->Tf) != 0)
+            return -1;
+        for (int c = 0; c < 3; c++)
+            mt->Tf[c] = fminf(fmaxf(mt->Tf[c], 0.0f), 1.0f);
+        return 0;
+    }
+    if (is_kw(kw, n, "Ka")) {
         float c[3];
         return mtl_color(L, c); /* read; rayes has no ambient colour per material */
     }
@@ -536,6 +545,8 @@ static int mtl_statement(Obj *o, Lexer *L, const char *mtl_dir, const char *kw, 
             mt->d = fminf(fmaxf(f, 0.0f), 1.0f);
         else if (is_kw(kw, n, "Tr"))
             mt->Tr = fminf(fmaxf(f, 0.0f), 1.0f);
+        else if (is_kw(kw, n, "Ni"))
+            mt->Ni = f;
         return 0;
     }
     if (is_kw(kw, n, "illum")) {
@@ -553,8 +564,8 @@ static int mtl_statement(Obj *o, Lexer *L, const char *mtl_dir, const char *kw, 
         return mtl_map(L, mtl_dir, mt->map_d, sizeof mt->map_d);
     }
     if (is_kw(kw, n, "bump") || is_kw(kw, n, "map_bump") || is_kw(kw, n, "map_Bump") ||
-        is_kw(kw, n, "norm") || is_kw(kw, n, "map_Norm") || is_kw(kw, n, "disp") ||
-        is_kw(kw, n, "map_Disp")) {
+        is_kw(kw, n, "norm") || is_kw(kw, n, "map_norm") || is_kw(kw, n, "map_Norm") ||
+        is_kw(kw, n, "disp") || is_kw(kw, n, "map_Disp")) {
         if (map_bump_mult(L, &mt->bump_mult) != 0)
             return -1;
         return mtl_map(L, mtl_dir, mt->bump, sizeof mt->bump);
@@ -1007,22 +1018,39 @@ static float roughness_of(float Ns)
     return Ns <= 1.0f ? 1.0f : fmaxf(1.0f / Ns, 0.001f);
 }
 
-/* The opacity of material m: d, else 1 - Tr, else 1. Both given, d wins
- * (d is the MTL standard's; Tr is an extension some programs write as d's
- * synonym, "d 1 Tr 1"); an opacity of 0 — every surface of the material
- * invisible — is an exporter's mistake (3ds Max's and others' "d 0" for
- * opaque, as Cesium's obj2gltf reads it too) and is taken as opaque, with
- * one warning. */
-static float material_opacity(Obj *o, const Material *m)
+/* Whether m's illumination model is one of MTL's transparent ones (4 and
+ * 9 glass, 6 and 7 refraction), whose light through is Tf's. */
+static int transparent_model(const Material *m)
+{
+    return m->illum == 4 || m->illum == 6 || m->illum == 7 || m->illum == 9;
+}
+
+/* What material m lets through, per channel, into T. A transparent model
+ * (illum 4, 6, 7, 9) passes its Tf when one is given other than white
+ * (Sibenik's windows: "d 0", "Tf 0.07 0.63 0.07", "illum 4"; or "d 1" with
+ * a yellow Tf), else 1 - d. Any other passes 1 - its opacity: d, else
+ * 1 - Tr, else 1 (both given, d wins: some programs write Tr as d's
+ * synonym, "d 1 Tr 1"); there an opacity of 0 — every surface of the
+ * material invisible — is an exporter's mistake (3ds Max's and others'
+ * "d 0" on opaque walls, as Cesium's obj2gltf reads it too) and is taken
+ * as opaque, with one warning. */
+static void material_transmission(Obj *o, const Material *m, float T[3])
 {
     float d = m->d >= 0.0f ? m->d : m->Tr >= 0.0f ? 1.0f - m->Tr : 1.0f;
-    if (d > 0.0f)
-        return d;
-    obj_warn(o, "opacity 0",
-             "%s: material \"%s\" (and any other so made) has %s, which would make it "
-             "invisible; taken as opaque",
-             o->name, m->name, m->d >= 0.0f ? "d 0" : "Tr 1");
-    return 1.0f;
+    int tinted = m->Tf[0] >= 0.0f && !(m->Tf[0] == 1.0f && m->Tf[1] == 1.0f && m->Tf[2] == 1.0f);
+    if (transparent_model(m)) {
+        for (int c = 0; c < 3; c++)
+            T[c] = tinted ? m->Tf[c] : 1.0f - d;
+        return;
+    }
+    if (!(d > 0.0f)) {
+        obj_warn(o, "opacity 0",
+                 "%s: material \"%s\" (and any other so made) has %s, which would make it "
+                 "invisible; taken as opaque",
+                 o->name, m->name, m->d >= 0.0f ? "d 0" : "Tr 1");
+        d = 1.0f;
+    }
+    T[0] = T[1] = T[2] = 1.0f - d;
 }
 
 /* The opacity of material m as the reserved shader parameter "Os" in *out
@@ -1031,11 +1059,13 @@ static float material_opacity(Obj *o, const Material *m)
  * (cutout holds it). The texture's values are opacities, read linear. */
 static RayesError opacity_of(Emit *e, Material *m, char cutout[48], RayesParam *out)
 {
-    float d = material_opacity(e->o, m);
+    float T[3];
+    material_transmission(e->o, m, T);
+    float d = 1.0f - (T[0] + T[1] + T[2]) / 3.0f;
     out->name = NULL;
     if (!m->map_d[0]) {
-        if (d < 1.0f)
-            *out = (RayesParam){"Os", RAYES_PARAM_COLOR, {d, d, d}, NULL};
+        if (T[0] > 0.0f || T[1] > 0.0f || T[2] > 0.0f)
+            *out = (RayesParam){"Os", RAYES_PARAM_COLOR, {1 - T[0], 1 - T[1], 1 - T[2]}, NULL};
         return RAYES_OK;
     }
     snprintf(cutout, 48, " obj map_d %zu", (size_t)(m - e->o->mats));
@@ -1125,6 +1155,15 @@ static RayesError material_shader(Emit *e, Material *m)
     if (r != RAYES_OK)
         return r;
     n += p[n].name != NULL;
+    if (m && (m->illum == 6 || m->illum == 7) && m->Ni > 1.01f && !m->map_d[0] &&
+        !(m->Tf[0] >= 0.0f && m->Tf[0] + m->Tf[1] + m->Tf[2] < 3.0f)) {
+        /* refraction on, an index above 1, clear: a sheet of glass that
+         * reflects by Fresnel's law and lets the rest through unbent (a
+         * window is a single face; a solid refracting glass would bend
+         * light into the room behind it). Tinted glass is a filter, Os. */
+        p[n++] = (RayesParam){"eta", RAYES_PARAM_FLOAT, {fminf(m->Ni, 10.0f), 0, 0}, NULL};
+        return set_shader(e, "thindielectric", p, n, m->name);
+    }
     p[n++] = (RayesParam){"Cs", RAYES_PARAM_COLOR, {Kd[0], Kd[1], Kd[2]}, NULL};
     if (!m)
         return set_shader(e, "matte", p, n, "(none)");

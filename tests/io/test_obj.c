@@ -207,20 +207,37 @@ static void test_opacity_words(void)
                                   "newmtl both\nd 1\nTr 1\n"
                                   "newmtl tr\nTr 0.25\n"
                                   "newmtl trone\nTr 1\n"
-                                  "newmtl half\nd 0.5\n");
+                                  "newmtl half\nd 0.5\n"
+                                  "newmtl win\nKd 0 0 0\nd 0\nTf 0.5 0.5 0.5\nillum 6\n"
+                                  "newmtl green\nd 0\nTf 0.25 0.75 0.125\nillum 4\n"
+                                  "newmtl yellow\nd 1\nTf 1 0.875 0\nillum 4\n"
+                                  "newmtl clear\nd 0\nillum 9\n"
+                                  "newmtl glass\nNi 1.5\nillum 7\n");
     static const char text[] = "mtllib o.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\n"
                                "usemtl zero\nf 1 2 3\nusemtl both\nf 1 2 3\n"
                                "usemtl tr\nf 1 2 3\nusemtl trone\nf 1 2 3\n"
-                               "usemtl half\nf 1 2 3\n";
+                               "usemtl half\nf 1 2 3\nusemtl win\nf 1 2 3\n"
+                               "usemtl green\nf 1 2 3\nusemtl yellow\nf 1 2 3\n"
+                               "usemtl clear\nf 1 2 3\nusemtl glass\nf 1 2 3\n";
     CHECK(parse(DIR "/o.obj", text) == RAYES_OK);
-    CHECK(rec.n_shader == 5);
-    if (rec.n_shader == 5) {
+    CHECK(rec.n_shader == 10);
+    if (rec.n_shader == 10) {
         const RayesParam *p;
         CHECK(rec_param(&rec.shader[0], "Os") == NULL); /* d 0: opaque */
         CHECK(rec_param(&rec.shader[1], "Os") == NULL); /* d 1 wins over Tr 1 */
         CHECK((p = rec_param(&rec.shader[2], "Os")) && p->value[0] == 0.75f);
         CHECK(rec_param(&rec.shader[3], "Os") == NULL); /* Tr 1 alone: 0, opaque */
         CHECK((p = rec_param(&rec.shader[4], "Os")) && p->value[1] == 0.5f);
+        /* the transparent models (illum 4, 6, 7, 9) pass Tf, else 1 - d */
+        CHECK((p = rec_param(&rec.shader[5], "Os")) && p->value[0] == 0.5f);
+        CHECK((p = rec_param(&rec.shader[6], "Os")) && p->value[0] == 0.75f &&
+              p->value[1] == 0.25f && p->value[2] == 0.875f);
+        CHECK((p = rec_param(&rec.shader[7], "Os")) && p->value[0] == 0.0f &&
+              p->value[1] == 0.125f && p->value[2] == 1.0f);
+        CHECK((p = rec_param(&rec.shader[8], "Os")) && p->value[0] == 0.0f);
+        /* refraction with an index: a thin sheet of glass */
+        CHECK(strcmp(rec.shader[9].name, "thindielectric") == 0 &&
+              (p = rec_param(&rec.shader[9], "eta")) && p->value[0] == 1.5f);
     }
     record_free(&rec);
 }
