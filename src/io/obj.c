@@ -244,6 +244,10 @@ typedef struct Material {
     char bump[1024];    /* bump, map_bump, norm, disp, ...: a height or normal map; "" none */
     float bump_mult;    /* -bm: the height's scale, the normal's strength */
     int bump_sent;      /* its two patterns made */
+    float Pr, Pm;       /* the PBR extension's roughness and metallic; -1 not given */
+    char map_Pr[1024];  /* their textures (grey), resolved as map_Kd; "" none */
+    char map_Pm[1024];
+    int pbr_sent;       /* the PBR patterns made */
     int defined;        /* given by a newmtl */
 } Material;
 
@@ -321,7 +325,7 @@ static int material_find(Obj *o, const char *tok, size_t n)
     snprintf(m->name, sizeof m->name, "%s", name);
     m->Kd[0] = m->Kd[1] = m->Kd[2] = 0.8f;
     m->Ns = -1.0f;
-    m->d = m->Tr = m->Tf[0] = m->Ni = -1.0f;
+    m->d = m->Tr = m->Tf[0] = m->Ni = m->Pr = m->Pm = -1.0f;
     m->illum = -1;
     m->bump_mult = 1.0f;
     return (int)o->n_mats++;
@@ -531,7 +535,7 @@ static int mtl_statement(Obj *o, Lexer *L, const char *mtl_dir, const char *kw, 
         return mtl_color(L, c); /* read; rayes has no ambient colour per material */
     }
     if (is_kw(kw, n, "Ns") || is_kw(kw, n, "d") || is_kw(kw, n, "Tr") || is_kw(kw, n, "Ni") ||
-        is_kw(kw, n, "sharpness")) {
+        is_kw(kw, n, "sharpness") || is_kw(kw, n, "Pr") || is_kw(kw, n, "Pm")) {
         /* "d -halo 0.5" is legal */
         const char *save = L->p, *tok;
         size_t k = lex_token(L, &tok);
@@ -547,6 +551,10 @@ static int mtl_statement(Obj *o, Lexer *L, const char *mtl_dir, const char *kw, 
             mt->Tr = fminf(fmaxf(f, 0.0f), 1.0f);
         else if (is_kw(kw, n, "Ni"))
             mt->Ni = f;
+        else if (is_kw(kw, n, "Pr"))
+            mt->Pr = fminf(fmaxf(f, 0.0f), 1.0f);
+        else if (is_kw(kw, n, "Pm"))
+            mt->Pm = fminf(fmaxf(f, 0.0f), 1.0f);
         return 0;
     }
     if (is_kw(kw, n, "illum")) {
@@ -559,6 +567,10 @@ static int mtl_statement(Obj *o, Lexer *L, const char *mtl_dir, const char *kw, 
     }
     if (is_kw(kw, n, "map_Kd"))
         return mtl_map(L, mtl_dir, mt->map_Kd, sizeof mt->map_Kd);
+    if (is_kw(kw, n, "map_Pr"))
+        return mtl_map(L, mtl_dir, mt->map_Pr, sizeof mt->map_Pr);
+    if (is_kw(kw, n, "map_Pm"))
+        return mtl_map(L, mtl_dir, mt->map_Pm, sizeof mt->map_Pm);
     if (is_kw(kw, n, "map_d")) {
         mt->map_d_channel = map_channel(L);
         return mtl_map(L, mtl_dir, mt->map_d, sizeof mt->map_d);
@@ -1140,6 +1152,127 @@ static RayesError bump_of(Emit *e, Material *m, char names[2][48], RayesParam *o
     return RAYES_OK;
 }
 
+/* Whether m uses the PBR extension (Blender's "PBR extensions", three.js
+ * and Model I/O write it): a roughness or metallic, given or mapped. */
+static int pbr_material(const Material *m)
+{
+    return m->Pr >= 0.0f || m->Pm >= 0.0f || m->map_Pr[0] || m->map_Pm[0];
+}
+
+/* Sends pattern name of class cls; RAYES_OK, or the sink's error said. */
+static RayesError obj_pattern(Emit *e, const Material *m, const char *name, const char *cls,
+                              const RayesParam *q, size_t n)
+{
+    RayesError r = e->sink->pattern(e->sink->target, name, cls, q, n);
+    if (r == RAYES_OK)
+        return r;
+    char what[200];
+    snprintf(what, sizeof what, "material \"%s\": its PBR textures", m->name);
+    return sink_fail(e, r, what);
+}
+
+/* The PBR patterns of material m (once): its base colour (map_Kd, sRGB),
+ * its roughness as rayes' (alpha squared: the map's Disney roughness to
+ * the fourth, as scale patterns of it by itself) and its metallic (map_Pm,
+ * linear), those it maps, under names[0..2]. */
+static RayesError pbr_patterns(Emit *e, Material *m, char names[3][48])
+{
+    size_t k = (size_t)(m - e->o->mats);
+    snprintf(names[0], 48, " obj Kd %zu", k);
+    snprintf(names[1], 48, " obj Pr %zu", k);
+    snprintf(names[2], 48, " obj Pm %zu", k);
+    if (m->pbr_sent)
+        return RAYES_OK;
+    RayesError r = RAYES_OK;
+    if (m->map_Kd[0]) {
+        const RayesParam q = {"filename", RAYES_PARAM_STRING, {0, 0, 0}, m->map_Kd};
+        r = obj_pattern(e, m, names[0], "imagemap", &q, 1);
+    }
+    if (r == RAYES_OK && m->map_Pr[0]) {
+        char r1[48], r2[48];
+        snprintf(r1, sizeof r1, " obj Pr1 %zu", k);
+        snprintf(r2, sizeof r2, " obj Pr2 %zu", k);
+        const RayesParam q[3] = {{"filename", RAYES_PARAM_STRING, {0, 0, 0}, m->map_Pr},
+                                 {"encoding", RAYES_PARAM_STRING, {0, 0, 0}, "linear"},
+                                 {"channel", RAYES_PARAM_FLOAT, {0, 0, 0}, NULL}};
+        const RayesParam sq[2] = {{"tex", RAYES_PARAM_PATTERN, {0, 0, 0}, r1},
+                                  {"scale", RAYES_PARAM_PATTERN, {0, 0, 0}, r1}};
+        const RayesParam fourth[2] = {{"tex", RAYES_PARAM_PATTERN, {0, 0, 0}, r2},
+                                      {"scale", RAYES_PARAM_PATTERN, {0, 0, 0}, r2}};
+        r = obj_pattern(e, m, r1, "imagemap", q, 3);
+        if (r == RAYES_OK)
+            r = obj_pattern(e, m, r2, "scale", sq, 2);
+        if (r == RAYES_OK)
+            r = obj_pattern(e, m, names[1], "scale", fourth, 2);
+    }
+    if (r == RAYES_OK && m->map_Pm[0]) {
+        const RayesParam q[3] = {{"filename", RAYES_PARAM_STRING, {0, 0, 0}, m->map_Pm},
+                                 {"encoding", RAYES_PARAM_STRING, {0, 0, 0}, "linear"},
+                                 {"channel", RAYES_PARAM_FLOAT, {0, 0, 0}, NULL}};
+        r = obj_pattern(e, m, names[2], "imagemap", q, 3);
+    }
+    m->pbr_sent = r == RAYES_OK;
+    return r;
+}
+
+/* A material of the PBR extension (its maps need a sink with patterns), the
+ * metallic-roughness model of glTF
+ * and Disney's principled BSDF: a dielectric lobe (coateddiffuse: the
+ * base colour under a glossy coat) and a metal one (conductor of the base
+ * colour's reflectance), each of GGX alpha = Pr^2 (0.5 when not given),
+ * mixed by the metallic (0 when not given; a map, or between 0 and 1: the
+ * "mix" shader). p holds the parameters so far (a normal map, the opacity),
+ * n of them; the lobes take the normal map, the surface the opacity. */
+static RayesError pbr_shader(Emit *e, Material *m, RayesParam p[16], size_t n)
+{
+    char names[3][48];
+    RayesError r = pbr_patterns(e, m, names);
+    if (r != RAYES_OK)
+        return r;
+    float rough = m->Pr >= 0.0f ? m->Pr : 0.5f;
+    RayesParam base =
+        m->map_Kd[0]
+            ? (RayesParam){"reflectance", RAYES_PARAM_PATTERN, {1, 1, 1}, names[0]}
+            : (RayesParam){"reflectance", RAYES_PARAM_COLOR, {m->Kd[0], m->Kd[1], m->Kd[2]}, NULL};
+    RayesParam r4 =
+        m->map_Pr[0]
+            ? (RayesParam){"roughness", RAYES_PARAM_PATTERN, {0, 0, 0}, names[1]}
+            : (RayesParam){
+                  "roughness", RAYES_PARAM_FLOAT, {rough * rough * rough * rough, 0, 0}, NULL};
+    float metal = m->Pm >= 0.0f ? m->Pm : 0.0f;
+    const char *one = !m->map_Pm[0] && metal <= 0.0f   ? "coateddiffuse"
+                      : !m->map_Pm[0] && metal >= 1.0f ? "conductor"
+                                                       : NULL;
+    RayesParam lobe[3] = {base, r4, {NULL, RAYES_PARAM_FLOAT, {0, 0, 0}, NULL}};
+    size_t n_lobe = 2, n_surface = 0;
+    RayesParam surface[2];
+    for (size_t i = 0; i < n; i++) /* the normal map goes to the lobes */
+        if (strcmp(p[i].name, "normalmap") == 0)
+            lobe[n_lobe++] = p[i];
+        else
+            surface[n_surface++] = p[i];
+    if (one) {
+        memcpy(p, surface, n_surface * sizeof *p);
+        memcpy(p + n_surface, lobe, n_lobe * sizeof *p);
+        return set_shader(e, one, p, n_surface + n_lobe, m->name);
+    }
+    static const char *const prefixed[2][3] = {{"a:reflectance", "a:roughness", "a:normalmap"},
+                                               {"b:reflectance", "b:roughness", "b:normalmap"}};
+    size_t c = 0;
+    memcpy(p, surface, n_surface * sizeof *p);
+    c = n_surface;
+    p[c++] = (RayesParam){"a", RAYES_PARAM_STRING, {0, 0, 0}, "coateddiffuse"};
+    p[c++] = (RayesParam){"b", RAYES_PARAM_STRING, {0, 0, 0}, "conductor"};
+    p[c++] = m->map_Pm[0] ? (RayesParam){"amount", RAYES_PARAM_PATTERN, {0, 0, 0}, names[2]}
+                          : (RayesParam){"amount", RAYES_PARAM_FLOAT, {metal, 0, 0}, NULL};
+    for (int k = 0; k < 2; k++)
+        for (size_t i = 0; i < n_lobe; i++) {
+            p[c] = lobe[i];
+            p[c++].name = prefixed[k][i];
+        }
+    return set_shader(e, "mix", p, c, m->name);
+}
+
 /* The shader of a material (NULL: the default, matte grey). A map_Kd
  * replaces Kd, as Blender's and Mitsuba's importers read it (the MTL
  * standard multiplies them, but exporters write their default Kd beside
@@ -1148,13 +1281,22 @@ static RayesError material_shader(Emit *e, Material *m)
 {
     static const float grey[3] = {0.8f, 0.8f, 0.8f}, white[3] = {1, 1, 1};
     const float *Kd = !m ? grey : m->map_Kd[0] ? white : m->Kd;
-    RayesParam p[8];
+    RayesParam p[16];
     size_t n = 0;
     char bumps[2][48];
     RayesError r = bump_of(e, m, bumps, &p[n]);
     if (r != RAYES_OK)
         return r;
     n += p[n].name != NULL;
+    if (m && pbr_material(m) &&
+        (e->sink->pattern || !(m->map_Kd[0] || m->map_Pr[0] || m->map_Pm[0]))) {
+        char cutout[48];
+        RayesError r2 = opacity_of(e, m, cutout, &p[n]);
+        if (r2 != RAYES_OK)
+            return r2;
+        n += p[n].name != NULL;
+        return pbr_shader(e, m, p, n);
+    }
     if (m && (m->illum == 6 || m->illum == 7) && m->Ni > 1.01f && !m->map_d[0] &&
         !(m->Tf[0] >= 0.0f && m->Tf[0] + m->Tf[1] + m->Tf[2] < 3.0f)) {
         /* refraction on, an index above 1, clear: a sheet of glass that

@@ -273,6 +273,38 @@ static void test_map_paths(void)
     record_free(&rec);
 }
 
+/* The PBR extension (Pr, Pm): a dielectric lobe under a glossy coat, a
+ * metal of the base colour, or their mix by the metallic; rayes' roughness
+ * is alpha squared, Pr^4. */
+static void test_pbr_extension(void)
+{
+    mkdir(RAYES_TEST_TMP, 0777);
+    mkdir(DIR, 0777);
+    test_write_text(DIR "/b.mtl", "newmtl gold\nKd 0.9 0.6 0.2\nPr 0.5\nPm 1\n"
+                                  "newmtl paint\nKd 0.2 0.3 0.8\nPr 0.25\nKs 0.5 0.5 0.5\n"
+                                  "newmtl half\nPm 0.5\nd 0.5\n");
+    CHECK(parse(DIR "/b.obj", "mtllib b.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nusemtl gold\nf 1 2 3\n"
+                              "usemtl paint\nf 1 2 3\nusemtl half\nf 1 2 3\n") == RAYES_OK);
+    CHECK(rec.n_shader == 3);
+    if (rec.n_shader == 3) {
+        const RayesParam *p;
+        CHECK(strcmp(rec.shader[0].name, "conductor") == 0);
+        CHECK((p = rec_param(&rec.shader[0], "reflectance")) && p->value[1] == 0.6f);
+        CHECK((p = rec_param(&rec.shader[0], "roughness")) && p->value[0] == 0.0625f);
+        CHECK(strcmp(rec.shader[1].name, "coateddiffuse") == 0);
+        CHECK((p = rec_param(&rec.shader[1], "reflectance")) && p->value[2] == 0.8f);
+        CHECK((p = rec_param(&rec.shader[1], "roughness")) &&
+              fabsf(p->value[0] - 0.25f * 0.25f * 0.25f * 0.25f) < 1e-9f);
+        CHECK(strcmp(rec.shader[2].name, "mix") == 0);
+        CHECK((p = rec_param(&rec.shader[2], "a")) && strcmp(p->string, "coateddiffuse") == 0);
+        CHECK((p = rec_param(&rec.shader[2], "b")) && strcmp(p->string, "conductor") == 0);
+        CHECK((p = rec_param(&rec.shader[2], "amount")) && p->value[0] == 0.5f);
+        CHECK((p = rec_param(&rec.shader[2], "b:roughness")) && p->value[0] == 0.0625f);
+        CHECK((p = rec_param(&rec.shader[2], "Os")) && p->value[0] == 0.5f);
+    }
+    record_free(&rec);
+}
+
 static void test_default_camera_and_light(void)
 {
     CHECK(parse("c.obj", "v -1 -2 -3\nv 3 -2 -3\nv 3 4 5\nf 1 2 3\n") == RAYES_OK);
@@ -679,7 +711,7 @@ static void test_transparency(void)
 }
 
 TEST_MAIN(TEST(test_face_syntax), TEST(test_ngons), TEST(test_materials), TEST(test_opacity_words),
-          TEST(test_map_paths), TEST(test_bump_maps), TEST(test_default_camera_and_light),
-          TEST(test_errors), TEST(test_unknown_statements), TEST(test_read_file),
-          TEST(test_normals_and_texture_coordinates), TEST(test_transparency),
+          TEST(test_map_paths), TEST(test_bump_maps), TEST(test_pbr_extension),
+          TEST(test_default_camera_and_light), TEST(test_errors), TEST(test_unknown_statements),
+          TEST(test_read_file), TEST(test_normals_and_texture_coordinates), TEST(test_transparency),
           TEST(test_smoothing_groups), TEST(test_vertex_colours))
