@@ -123,6 +123,11 @@ static const char render_options[] =
     "                          searched before $RAYES_SHADER_PATH\n"
     "  --default-light         a headlight (a distant light along the view) when the\n"
     "                          scene has no lights\n"
+    "  --look-from X,Y,Z       the camera's eye, world space (replaces the scene's\n"
+    "                          camera: perspective; OBJ files have none of their own)\n"
+    "  --look-at X,Y,Z         the point it looks at (default: along the scene's view)\n"
+    "  --up X,Y,Z              its up direction (default 0,1,0)\n"
+    "  --fov DEG               its vertical field of view (default 40)\n"
     "  --stats FILE.json       write statistics as JSON\n"
     "  --aov LIST              arbitrary output variables written as float channels beside\n"
     "                          the colour of EXR outputs, a comma-separated list of z (Z:\n"
@@ -271,6 +276,21 @@ static float parse_float(const char *opt, const char *s, float lo, float hi)
         die_usage("%s: expected a number from %g to %g, got \"%s\"", opt, lo, hi,
                   s ? s : "nothing");
     return v;
+}
+
+/* --look-from, --look-at, --up: "X,Y,Z", each finite. */
+static void parse_point(const char *opt, const char *s, float out[3])
+{
+    char buf[256], *save = NULL;
+    snprintf(buf, sizeof buf, "%s", s ? s : "");
+    for (int i = 0; i < 3; i++) {
+        char *tok = strtok_r(i == 0 ? buf : NULL, ",", &save);
+        if (!tok)
+            die_usage("%s: expected X,Y,Z, got \"%s\"", opt, s ? s : "nothing");
+        out[i] = parse_float(opt, tok, -1e30f, 1e30f);
+    }
+    if (strtok_r(NULL, ",", &save))
+        die_usage("%s: expected X,Y,Z, got \"%s\"", opt, s);
 }
 
 /* --res W or WxH; returns 1 for W alone (a square, unless the scene file
@@ -423,6 +443,18 @@ void parse_args(int argc, char **argv, Args *a)
             if (strcmp(v, "srgb") != 0 && strcmp(v, "linear") != 0)
                 die_usage("--png-curve: expected srgb or linear, found \"%s\"", v);
             a->png_curve = v[0] == 's' ? IO_CURVE_SRGB : IO_CURVE_LINEAR;
+        } else if (strcmp(o, "--look-from") == 0) {
+            parse_point(o, v, a->look_from);
+            a->camera |= CAMERA_FROM;
+        } else if (strcmp(o, "--look-at") == 0) {
+            parse_point(o, v, a->look_at);
+            a->camera |= CAMERA_AT;
+        } else if (strcmp(o, "--up") == 0) {
+            parse_point(o, v, a->up);
+            a->camera |= CAMERA_UP;
+        } else if (strcmp(o, "--fov") == 0) {
+            a->fov = parse_float(o, v, 0.01f, 179.0f);
+            a->camera |= CAMERA_FOV;
         } else if (strcmp(o, "--clamp") == 0) {
             opt->sample_clamp = parse_float(o, v, 0.0f, 1e30f);
             a->set |= SET_CLAMP;
@@ -646,6 +678,23 @@ void merge_settings(Args *a, const IoSettings *s)
         o->opacity_cache_mb = s->opacity_cache_mb;
     if (!(a->set & SET_CROP))
         memcpy(o->crop, s->crop, sizeof o->crop);
+}
+
+RayesError command_line_camera(const Args *a, RayesScene *scene)
+{
+    if (!a->camera)
+        return RAYES_OK;
+    float eye[3], x[3], y[3], z[3], at[3], up[3] = {0, 1, 0};
+    RayesError e = rayes_scene_get_camera(scene, eye, x, y, z);
+    if (e != RAYES_OK)
+        return e;
+    if (a->camera & CAMERA_FROM)
+        memcpy(eye, a->look_from, sizeof eye);
+    for (int k = 0; k < 3; k++)
+        at[k] = a->camera & CAMERA_AT ? a->look_at[k] : eye[k] + z[k];
+    if (a->camera & CAMERA_UP)
+        memcpy(up, a->up, sizeof up);
+    return rayes_scene_set_camera(scene, eye, at, up, a->camera & CAMERA_FOV ? a->fov : 40.0f);
 }
 
 RayesError default_light(const Args *a, const IoSettings *s, RayesScene *scene)

@@ -32,6 +32,9 @@ enum {
     SET_RES_WIDTH = 8192 /* --res W alone: the height follows the file's aspect ratio */
 };
 
+/* Camera options the command line gave (Args.camera). */
+enum { CAMERA_FROM = 1, CAMERA_AT = 2, CAMERA_UP = 4, CAMERA_FOV = 8 };
+
 /* An image to write. */
 typedef struct Output {
     char path[600];
@@ -59,6 +62,8 @@ typedef struct Args {
     const char *shader_path;    /* --shader-path: put before the scene's own shader path */
     int quiet;
     int default_light;          /* --default-light: a headlight for a scene without lights */
+    unsigned camera;            /* CAMERA_*: the camera options given */
+    float look_from[3], look_at[3], up[3], fov; /* --look-from, --look-at, --up, --fov */
     int png_curve;              /* --png-curve: IO_CURVE_*, IO_CURVE_UNSAID: the scene file's */
     RayesRenderOptions opt;
     /* rayes view */
@@ -101,6 +106,14 @@ int load_status(const char *scene, RayesError e);
 
 /* The file's settings where the command line gave none. */
 void merge_settings(Args *a, const IoSettings *s);
+
+/* A loaded scene's camera (before its commit) replaced by the command
+ * line's --look-from, --look-at, --up and --fov, when any is given: a
+ * perspective camera at the given eye (else the scene's) looking at the
+ * given point (else along the scene's view), up the given direction (else
+ * +y), of the given vertical field of view (else 40 degrees). Returns what
+ * setting it returned (the scene's error names a degenerate view). */
+RayesError command_line_camera(const Args *a, RayesScene *scene);
 
 /* A loaded scene without lights (before its commit): one warning, or with
  * --default-light (or a file that asks for one, s->headlight) a headlight,

@@ -530,7 +530,10 @@ static int render_job(Args a, int frame, int number, Distributed *d)
     IoReadOptions ro = {
         .data_dir = a.data_dir, .frame = frame, .bounces_given = (a.set & SET_BOUNCES) != 0};
     RayesError e = load_scene(a.scene, &ro, &sink, &settings, err, sizeof err);
-    if (e == RAYES_OK && (e = default_light(&a, &settings, scene)) != RAYES_OK)
+    if (e == RAYES_OK && (e = command_line_camera(&a, scene)) != RAYES_OK)
+        snprintf(err, sizeof err, "%s: the command line's camera: %s", a.scene,
+                 rayes_scene_get_error(scene));
+    else if (e == RAYES_OK && (e = default_light(&a, &settings, scene)) != RAYES_OK)
         snprintf(err, sizeof err, "%s: %s", a.scene, rayes_scene_get_error(scene));
     if (e == RAYES_OK && rayes_scene_commit(scene) != RAYES_OK) {
         e = RAYES_ERROR_PARSE;

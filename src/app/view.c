@@ -795,7 +795,10 @@ int cmd_view(int argc, char **argv)
     IoReadOptions ro = {
         .data_dir = a.data_dir, .frame = a.frame, .bounces_given = (a.set & SET_BOUNCES) != 0};
     RayesError e = load_scene(a.scene, &ro, &sink, &settings, err, sizeof err);
-    if (e == RAYES_OK && (e = default_light(&a, &settings, v.scene)) != RAYES_OK)
+    if (e == RAYES_OK && (e = command_line_camera(&a, v.scene)) != RAYES_OK)
+        snprintf(err, sizeof err, "%s: the command line's camera: %s", a.scene,
+                 rayes_scene_get_error(v.scene));
+    else if (e == RAYES_OK && (e = default_light(&a, &settings, v.scene)) != RAYES_OK)
         snprintf(err, sizeof err, "%s: %s", a.scene, rayes_scene_get_error(v.scene));
     if (e == RAYES_OK && rayes_scene_commit(v.scene) != RAYES_OK) {
         e = RAYES_ERROR_PARSE;

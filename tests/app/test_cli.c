@@ -765,6 +765,60 @@ static void test_default_light(void)
     CHECK(mean[0] == 0.0f && mean[1] > 0.02f);
 }
 
+/* The mean red of an EXR, -1 when it cannot be read. */
+static double exr_mean_red(const char *path)
+{
+    int w = 0, h = 0;
+    float *px = NULL;
+    char err[256];
+    if (image_read_exr(path, &w, &h, &px, err, sizeof err) != RAYES_OK || !px)
+        return -1.0;
+    double sum = 0.0;
+    for (int i = 0; i < w * h; i++)
+        sum += px[4 * i];
+    free(px);
+    return sum / (w * h);
+}
+
+/* --look-from, --look-at, --up and --fov replace the scene's camera: a
+ * matte sphere 5 units ahead under a headlight looks the same from behind
+ * it as from the file's camera, a view turned away from it is black, and a
+ * malformed point is a usage error. */
+static void test_camera_options(void)
+{
+    static Run r;
+    setup();
+    test_write_text(SCRATCH_DIR "/ahead.rib", "Projection \"perspective\" \"fov\" 40\n"
+                                              "WorldBegin\nTranslate 0 0 5\nSurface \"matte\"\n"
+                                              "Sphere 1 -1 1 360\nWorldEnd\n");
+    run(&r, NULL,
+        ARGS("render", SCRATCH_DIR "/ahead.rib", "--res", "24", "--spp", "4", "--quiet",
+             "--default-light", "-o", SCRATCH_DIR "/file_camera.exr"));
+    CHECK(r.status == 0);
+    run(&r, NULL,
+        ARGS("render", SCRATCH_DIR "/ahead.rib", "--res", "24", "--spp", "4", "--quiet",
+             "--default-light", "--look-from", "0,0,10", "--look-at", "0,0,5", "--up", "0,1,0",
+             "--fov", "40", "-o", SCRATCH_DIR "/behind.exr"));
+    CHECK(r.status == 0);
+    run(&r, NULL,
+        ARGS("render", SCRATCH_DIR "/ahead.rib", "--res", "24", "--spp", "4", "--quiet",
+             "--default-light", "--look-at", "0,0,-5", "-o", SCRATCH_DIR "/away.exr"));
+    CHECK(r.status == 0);
+    double file = exr_mean_red(SCRATCH_DIR "/file_camera.exr");
+    double behind = exr_mean_red(SCRATCH_DIR "/behind.exr");
+    double away = exr_mean_red(SCRATCH_DIR "/away.exr");
+    printf("  mean red: the file's camera %.4f, from behind %.4f, turned away %.4f\n", file, behind,
+           away);
+    CHECK(file > 0.05 && fabs(behind - file) < 0.01 * file && away == 0.0);
+    expect_error(2, NULL, ARGS("render", SCRATCH_DIR "/ahead.rib", "--look-from", "1,2"),
+                 ARGS("--look-from: expected X,Y,Z"));
+    run(&r, NULL,
+        ARGS("render", SCRATCH_DIR "/ahead.rib", "--quiet", "--look-from", "0,0,5", "--look-at",
+             "0,0,5", "-o", SCRATCH_DIR "/none.exr"));
+    CHECK(r.status == 1 && strstr(r.err, "the command line's camera") &&
+          !exists(SCRATCH_DIR "/none.exr"));
+}
+
 static void test_convert(void)
 {
     static Run r;
@@ -1033,7 +1087,8 @@ TEST_MAIN(TEST(test_version_and_help), TEST(test_no_arguments), TEST(test_usage_
           TEST(test_data_from_environment), TEST(test_unwritable_output), TEST(test_shader_path),
           TEST(test_render_obj), TEST(test_rib_grid_size), TEST(test_spp_over_file_sampling),
           TEST(test_png_curve), TEST(test_rib_opacity_cache_memory), TEST(test_vertex_budget),
-          TEST(test_null_displacement), TEST(test_default_light), TEST(test_convert),
-          TEST(test_bad_scene_file), TEST(test_frames_and_crop), TEST(test_background_imager),
-          TEST(test_display_modes), TEST(test_light_shadows_attribute), TEST(test_quiet_requests),
+          TEST(test_null_displacement), TEST(test_default_light), TEST(test_camera_options),
+          TEST(test_convert), TEST(test_bad_scene_file), TEST(test_frames_and_crop),
+          TEST(test_background_imager), TEST(test_display_modes),
+          TEST(test_light_shadows_attribute), TEST(test_quiet_requests),
           TEST(test_res_width_keeps_aspect), TEST(test_aovs))
