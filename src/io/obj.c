@@ -1579,27 +1579,50 @@ static RayesError emit_emitter(Emit *e, const Material *mt, const Mesh *m)
 }
 
 /* The faces of material mi (-1: the default) in file order. */
+/* Whether every corner of the face whose first corner is base has a vt. */
+static int face_has_vt(const Obj *o, size_t base, int n)
+{
+    for (int j = 0; j < n; j++)
+        if (o->face_vt.a[base + (size_t)j] < 0)
+            return 0;
+    return 1;
+}
+
+/* The faces of material mi (-1: the default) in file order: those whose
+ * corners all have texture coordinates as one mesh, the others as another
+ * (an object without a UV map sharing a textured object's material takes
+ * nothing from it). */
 static RayesError emit_material(Emit *e, int mi)
 {
     Obj *o = e->o;
-    Mesh m = {{0}, {0}};
+    Mesh m[2] = {{{0}, {0}}, {{0}, {0}}}; /* with vt, without */
     Material *mt = mi >= 0 ? &o->mats[mi] : NULL;
     RayesError r = RAYES_OK;
     size_t k = 0;
     for (size_t f = 0; f < o->face_nv.n && r == RAYES_OK; k += (size_t)o->face_nv.a[f], f++)
-        if (o->face_mat.a[f] == mi && triangulate(o, &m, (int)k, o->face_nv.a[f]) != 0)
+        if (o->face_mat.a[f] == mi &&
+            triangulate(o, &m[!face_has_vt(o, k, o->face_nv.a[f])], (int)k, o->face_nv.a[f]) != 0)
             r = RAYES_ERROR_OUT_OF_MEMORY;
+    if (m[0].nv.n == 0) { /* one mesh when no face has vt */
+        Mesh t = m[0];
+        m[0] = m[1], m[1] = t;
+    }
     if (r != RAYES_OK)
         snprintf(o->err, o->err_size, "%s: out of memory", o->name);
     else if (mt && max3(mt->Ke) > 0.0f) {
         char none[2][48];
         RayesParam unused;
         if ((r = bump_of(e, NULL, none, &unused)) == RAYES_OK) /* lights are not bumped */
-            r = emit_emitter(e, mt, &m);
-    } else if (m.nv.n > 0 && (r = material_shader(e, mt)) == RAYES_OK)
-        r = emit_mesh(e, &m, mt ? mt->name : "(none)");
-    free(m.nv.a);
-    free(m.idx.a);
+            for (int j = 0; j < 2 && r == RAYES_OK; j++)
+                r = m[j].nv.n > 0 ? emit_emitter(e, mt, &m[j]) : RAYES_OK;
+    } else if (m[0].nv.n > 0 && (r = material_shader(e, mt)) == RAYES_OK) {
+        for (int j = 0; j < 2 && r == RAYES_OK; j++)
+            r = emit_mesh(e, &m[j], mt ? mt->name : "(none)");
+    }
+    for (int j = 0; j < 2; j++) {
+        free(m[j].nv.a);
+        free(m[j].idx.a);
+    }
     return r;
 }
 
@@ -1656,7 +1679,10 @@ static RayesError obj_emit(Obj *o, const IoSink *sink)
     for (size_t f = 0; f < o->face_mat.n; f++)
         if (o->face_mat.a[f] >= 0 && !o->mats[o->face_mat.a[f]].defined)
             o->face_mat.a[f] = -1;
-    if (r == RAYES_OK && o->any_s && obj_smooth_normals(o) != 0) {
+    int some_vn = 0, all_vn = 1; /* corners without vn beside ones with: their faces' */
+    for (size_t c = 0; c < o->face_vn.n; c++)
+        some_vn |= o->face_vn.a[c] >= 0, all_vn &= o->face_vn.a[c] >= 0;
+    if (r == RAYES_OK && (o->any_s || (some_vn && !all_vn)) && obj_smooth_normals(o) != 0) {
         snprintf(o->err, o->err_size, "%s: out of memory", o->name);
         r = RAYES_ERROR_OUT_OF_MEMORY;
     }

@@ -66,6 +66,16 @@ static double area_z(const RecMesh *m)
 
 /* -------------------------------------------------------------- tests */
 
+/* The normal of corner c of face f of m, and whether it is n. */
+static int corner_normal_is(const RecMesh *m, size_t f, int c, float x, float y, float z)
+{
+    const RayesPrimvar *N = rec_primvar(&m->pv, "N");
+    if (!N || N->cls != RAYES_PRIMVAR_FACEVARYING)
+        return 0;
+    const float *v = &N->data[3 * (3 * f + (size_t)c)];
+    return fabsf(v[0] - x) < 1e-6f && fabsf(v[1] - y) < 1e-6f && fabsf(v[2] - z) < 1e-6f;
+}
+
 static void test_face_syntax(void)
 {
     static const char text[] = "# a square four ways\n"
@@ -79,16 +89,18 @@ static void test_face_syntax(void)
                                "f 1 2 \\\n 3 4"; /* continued, no final newline */
     CHECK(parse("sq.obj", text) == RAYES_OK);
     CHECK(err[0] == '\0');
-    CHECK(rec.n_mesh == 1 && rec.n_shader == 1);
-    if (rec.n_mesh == 1) {
-        const RecMesh *m = &rec.mesh[0];
-        CHECK(m->n_faces == 5 && m->n_points == 4);
-        CHECK(m->nv[0] == 3 && m->nv[4] == 4);
-        /* face 3: -4/-3/-1 -2/-1/1 -1/2/1 = vertices 1 3 4 */
-        CHECK(corner(m, 3, 0)[0] == 0 && corner(m, 3, 0)[1] == 0);
-        CHECK(corner(m, 3, 1)[0] == 1 && corner(m, 3, 1)[1] == 1);
-        CHECK(corner(m, 3, 2)[0] == 0 && corner(m, 3, 2)[1] == 1);
-        CHECK_NEAR(area_z(m), 0.5 * 4 + 1, 1e-6);
+    /* the faces with texture coordinates, then those without */
+    CHECK(rec.n_mesh == 2 && rec.n_shader == 1);
+    if (rec.n_mesh == 2) {
+        const RecMesh *m = &rec.mesh[0], *w = &rec.mesh[1];
+        CHECK(m->n_faces == 2 && m->n_points == 3 && w->n_faces == 3 && w->n_points == 4);
+        CHECK(w->nv[0] == 3 && w->nv[2] == 4);
+        CHECK(rec_primvar(&m->pv, "st") != NULL && rec_primvar(&w->pv, "st") == NULL);
+        /* -4/-3/-1 -2/-1/1 -1/2/1 = vertices 1 3 4 */
+        CHECK(corner(m, 1, 0)[0] == 0 && corner(m, 1, 0)[1] == 0);
+        CHECK(corner(m, 1, 1)[0] == 1 && corner(m, 1, 1)[1] == 1);
+        CHECK(corner(m, 1, 2)[0] == 0 && corner(m, 1, 2)[1] == 1);
+        CHECK_NEAR(area_z(m) + area_z(w), 0.5 * 4 + 1, 1e-6);
     }
     CHECK(strcmp(rec.shader[0].name, "matte") == 0);
     record_free(&rec);
@@ -370,20 +382,16 @@ static void test_normals_and_texture_coordinates(void)
             CHECK_NEAR(st->data[2 * (3 * f + (size_t)c) + 1], 1 - corner(m, f, c)[1], 0);
         }
     record_free(&rec);
-    CHECK(parse("p.obj", "v 0 0 0\nv 1 0 0\nv 1 1 0\nvn 0 0 1\nf 1//1 2//1 3//1\nf 1 2 3\n") ==
-          RAYES_OK);
-    CHECK(rec.n_mesh == 1 && rec.mesh[0].pv.n == 0);
+    /* a face without vn beside one with: its corners take its own normal */
+    CHECK(parse("p.obj", "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 1\nvn 0 1 0\nf 1//1 2//1 3//1\n"
+                         "f 1 3 4\n") == RAYES_OK);
+    CHECK(rec.n_mesh == 1 && rec.mesh[0].pv.n == 1);
+    if (rec.n_mesh == 1) {
+        const float r = 1.0f / sqrtf(3.0f); /* (1,1,0) x (0,1,1) normalised */
+        CHECK(corner_normal_is(&rec.mesh[0], 0, 0, 0, 1, 0));
+        CHECK(corner_normal_is(&rec.mesh[0], 1, 2, r, -r, r));
+    }
     record_free(&rec);
-}
-
-/* The normal of corner c of face f of m, and whether it is n. */
-static int corner_normal_is(const RecMesh *m, size_t f, int c, float x, float y, float z)
-{
-    const RayesPrimvar *N = rec_primvar(&m->pv, "N");
-    if (!N || N->cls != RAYES_PRIMVAR_FACEVARYING)
-        return 0;
-    const float *v = &N->data[3 * (3 * f + (size_t)c)];
-    return fabsf(v[0] - x) < 1e-6f && fabsf(v[1] - y) < 1e-6f && fabsf(v[2] - z) < 1e-6f;
 }
 
 /* Smoothing groups: faces of one group share their vertices' normals (the
