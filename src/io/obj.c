@@ -308,6 +308,14 @@ static int is_kw(const char *tok, size_t n, const char *kw)
     return strlen(kw) == n && memcmp(tok, kw, n) == 0;
 }
 
+/* An MTL statement's keyword, in any capitals: writers differ ("map_kd",
+ * "MAP_KD", "map_Bump"), and no two of MTL's keywords differ by case
+ * alone in meaning. */
+static int is_mtl_kw(const char *tok, size_t n, const char *kw)
+{
+    return strlen(kw) == n && strncasecmp(tok, kw, n) == 0;
+}
+
 /* The material of that name (created undefined if new), or -1 when out of
  * memory. */
 static int material_find(Obj *o, const char *tok, size_t n)
@@ -498,7 +506,7 @@ static void dir_of(const char *path, char *dir, size_t size)
 static int mtl_statement(Obj *o, Lexer *L, const char *mtl_dir, const char *kw, size_t n,
                          int *m)
 {
-    if (is_kw(kw, n, "newmtl")) {
+    if (is_mtl_kw(kw, n, "newmtl")) {
         const char *tok;
         size_t k = lex_token(L, &tok);
         if (k == 0)
@@ -512,30 +520,31 @@ static int mtl_statement(Obj *o, Lexer *L, const char *mtl_dir, const char *kw, 
         return lex_error_at(L, kw, "expected newmtl before the first material statement");
     Material *mt = &o->mats[*m];
     float f;
-    if (is_kw(kw, n, "Kd"))
+    if (is_mtl_kw(kw, n, "Kd"))
         return mtl_color(L, mt->Kd);
-    if (is_kw(kw, n, "Ks"))
+    if (is_mtl_kw(kw, n, "Ks"))
         return mtl_color(L, mt->Ks);
-    if (is_kw(kw, n, "Ke")) {
+    if (is_mtl_kw(kw, n, "Ke")) {
         if (mtl_color(L, mt->Ke) != 0)
             return -1;
         if (mt->Ke[0] < 0 || mt->Ke[1] < 0 || mt->Ke[2] < 0)
             return lex_error_at(L, kw, "Ke: an emission must not be negative");
         return 0;
     }
-    if (is_kw(kw, n, "Tf")) {
+    if (is_mtl_kw(kw, n, "Tf")) {
         if (mtl_color(L, mt->Tf) != 0)
             return -1;
         for (int c = 0; c < 3; c++)
             mt->Tf[c] = fminf(fmaxf(mt->Tf[c], 0.0f), 1.0f);
         return 0;
     }
-    if (is_kw(kw, n, "Ka")) {
+    if (is_mtl_kw(kw, n, "Ka")) {
         float c[3];
         return mtl_color(L, c); /* read; rayes has no ambient colour per material */
     }
-    if (is_kw(kw, n, "Ns") || is_kw(kw, n, "d") || is_kw(kw, n, "Tr") || is_kw(kw, n, "Ni") ||
-        is_kw(kw, n, "sharpness") || is_kw(kw, n, "Pr") || is_kw(kw, n, "Pm")) {
+    if (is_mtl_kw(kw, n, "Ns") || is_mtl_kw(kw, n, "d") || is_mtl_kw(kw, n, "Tr") ||
+        is_mtl_kw(kw, n, "Ni") || is_mtl_kw(kw, n, "sharpness") || is_mtl_kw(kw, n, "Pr") ||
+        is_mtl_kw(kw, n, "Pm")) {
         /* "d -halo 0.5" is legal */
         const char *save = L->p, *tok;
         size_t k = lex_token(L, &tok);
@@ -543,21 +552,21 @@ static int mtl_statement(Obj *o, Lexer *L, const char *mtl_dir, const char *kw, 
             L->p = save;
         if (lex_float(L, &f, "a number") != 0 || lex_expect_end(L, "the end of the line") != 0)
             return -1;
-        if (is_kw(kw, n, "Ns"))
+        if (is_mtl_kw(kw, n, "Ns"))
             mt->Ns = f;
-        else if (is_kw(kw, n, "d"))
+        else if (is_mtl_kw(kw, n, "d"))
             mt->d = fminf(fmaxf(f, 0.0f), 1.0f);
-        else if (is_kw(kw, n, "Tr"))
+        else if (is_mtl_kw(kw, n, "Tr"))
             mt->Tr = fminf(fmaxf(f, 0.0f), 1.0f);
-        else if (is_kw(kw, n, "Ni"))
+        else if (is_mtl_kw(kw, n, "Ni"))
             mt->Ni = f;
-        else if (is_kw(kw, n, "Pr"))
+        else if (is_mtl_kw(kw, n, "Pr"))
             mt->Pr = fminf(fmaxf(f, 0.0f), 1.0f);
-        else if (is_kw(kw, n, "Pm"))
+        else if (is_mtl_kw(kw, n, "Pm"))
             mt->Pm = fminf(fmaxf(f, 0.0f), 1.0f);
         return 0;
     }
-    if (is_kw(kw, n, "illum")) {
+    if (is_mtl_kw(kw, n, "illum")) {
         const char *tok;
         size_t k = lex_token(L, &tok);
         if (parse_float(tok, k, &f) != 0 || f != floorf(f) || f < 0 || f > 10)
@@ -565,19 +574,18 @@ static int mtl_statement(Obj *o, Lexer *L, const char *mtl_dir, const char *kw, 
         mt->illum = (int)f;
         return lex_expect_end(L, "the end of the line");
     }
-    if (is_kw(kw, n, "map_Kd"))
+    if (is_mtl_kw(kw, n, "map_Kd"))
         return mtl_map(L, mtl_dir, mt->map_Kd, sizeof mt->map_Kd);
-    if (is_kw(kw, n, "map_Pr"))
+    if (is_mtl_kw(kw, n, "map_Pr"))
         return mtl_map(L, mtl_dir, mt->map_Pr, sizeof mt->map_Pr);
-    if (is_kw(kw, n, "map_Pm"))
+    if (is_mtl_kw(kw, n, "map_Pm"))
         return mtl_map(L, mtl_dir, mt->map_Pm, sizeof mt->map_Pm);
-    if (is_kw(kw, n, "map_d")) {
+    if (is_mtl_kw(kw, n, "map_d")) {
         mt->map_d_channel = map_channel(L);
         return mtl_map(L, mtl_dir, mt->map_d, sizeof mt->map_d);
     }
-    if (is_kw(kw, n, "bump") || is_kw(kw, n, "map_bump") || is_kw(kw, n, "map_Bump") ||
-        is_kw(kw, n, "norm") || is_kw(kw, n, "map_norm") || is_kw(kw, n, "map_Norm") ||
-        is_kw(kw, n, "disp") || is_kw(kw, n, "map_Disp")) {
+    if (is_mtl_kw(kw, n, "bump") || is_mtl_kw(kw, n, "map_bump") || is_mtl_kw(kw, n, "norm") ||
+        is_mtl_kw(kw, n, "map_norm") || is_mtl_kw(kw, n, "disp") || is_mtl_kw(kw, n, "map_disp")) {
         if (map_bump_mult(L, &mt->bump_mult) != 0)
             return -1;
         return mtl_map(L, mtl_dir, mt->bump, sizeof mt->bump);

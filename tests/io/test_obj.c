@@ -293,7 +293,7 @@ static void test_pbr_extension(void)
     mkdir(RAYES_TEST_TMP, 0777);
     mkdir(DIR, 0777);
     test_write_text(DIR "/b.mtl", "newmtl gold\nKd 0.9 0.6 0.2\nPr 0.5\nPm 1\n"
-                                  "newmtl paint\nKd 0.2 0.3 0.8\nPr 0.25\nKs 0.5 0.5 0.5\n"
+                                  "NEWMTL paint\nkd 0.2 0.3 0.8\npr 0.25\nKS 0.5 0.5 0.5\n"
                                   "newmtl half\nPm 0.5\nd 0.5\n");
     CHECK(parse(DIR "/b.obj", "mtllib b.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nusemtl gold\nf 1 2 3\n"
                               "usemtl paint\nf 1 2 3\nusemtl half\nf 1 2 3\n") == RAYES_OK);
