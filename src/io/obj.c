@@ -440,12 +440,18 @@ static int map_path(const char *mtl_dir, const char *name, size_t n, char *out, 
     return snprintf(out, size, "%s", first);
 }
 
-/* map_Kd [options] file: the last token is the file name. */
+/* map_Kd [options] file: the last token is the file name, or where no
+ * such file is found and a longer tail of the statement (after its last
+ * option) names one, that tail: a name with spaces, as Blender writes
+ * "my texture.png". */
 static int mtl_map(Lexer *L, const char *mtl_dir, char *out, size_t out_size)
 {
-    const char *tok, *last = NULL;
+    const char *tok, *start[64], *last = NULL;
     size_t n, last_n = 0;
+    int k = 0;
     while ((n = lex_token(L, &tok)) > 0) {
+        if (k < 64)
+            start[k++] = tok;
         last = tok;
         last_n = n;
     }
@@ -453,6 +459,13 @@ static int mtl_map(Lexer *L, const char *mtl_dir, char *out, size_t out_size)
         return lex_expected(L, tok, 0, "a texture file name");
     if (map_path(mtl_dir, last, last_n, out, out_size) < 0)
         return lex_expected(L, last, last_n, "a shorter texture path");
+    const char *end = last + last_n;
+    for (int j = k - 2; j >= 0 && !readable(out) && start[j][0] != '-'; j--) {
+        char alt[4096];
+        if (map_path(mtl_dir, start[j], (size_t)(end - start[j]), alt, sizeof alt) >= 0 &&
+            readable(alt) && strlen(alt) < out_size)
+            snprintf(out, out_size, "%s", alt);
+    }
     return 0;
 }
 
@@ -615,39 +628,61 @@ static int mtl_parse(Obj *o, const char *path, const char *text, size_t size)
 }
 
 /* Reads each MTL the statement names; a missing one is a warning. */
+/* One material library, path as found (map_path); 0, or -1 on a parse
+ * error. A file that cannot be read is a warning. */
+static int obj_mtl_file(Obj *o, Lexer *L, const char *path)
+{
+    struct stat st;
+    char why[512];
+    size_t size = 0;
+    char *text = NULL;
+    if (stat(path, &st) != 0)
+        snprintf(why, sizeof why, "%s", strerror(errno));
+    else if (!S_ISREG(st.st_mode) || st.st_size > (1 << 28))
+        snprintf(why, sizeof why, "not a regular file of at most 256 MB");
+    else
+        text = text_read_file(path, &size, why, sizeof why);
+    if (!text) {
+        obj_warn(o, path, "%s:%ld: material library %s: %s; its materials are matte grey", L->name,
+                 L->line, path, why);
+        return 0;
+    }
+    int r = mtl_parse(o, path, text, size);
+    free(text);
+    return r;
+}
+
+/* mtllib a.mtl ...: each file, relative to the OBJ's directory and found
+ * as a map's file is (Windows' backslashes, other capitals); when some is
+ * not found and the whole list names one file, that file (a name with
+ * spaces: Blender writes "mtllib my scene.mtl"). */
 static int obj_mtllib(Obj *o, Lexer *L)
 {
-    const char *tok;
-    size_t n;
-    int any = 0;
+    const char *tok, *start[64], *end = NULL;
+    size_t n, len[64];
+    int k = 0;
     while ((n = lex_token(L, &tok)) > 0) {
-        char path[4096];
-        any = 1;
-        if (tok[0] == '/')
-            snprintf(path, sizeof path, "%.*s", (int)(n < 4000 ? n : 4000), tok);
-        else
-            snprintf(path, sizeof path, "%s%.*s", o->dir, (int)(n < 2000 ? n : 2000), tok);
-        struct stat st;
-        char why[512];
-        size_t size = 0;
-        char *text = NULL;
-        if (stat(path, &st) != 0)
-            snprintf(why, sizeof why, "%s", strerror(errno));
-        else if (!S_ISREG(st.st_mode) || st.st_size > (1 << 28))
-            snprintf(why, sizeof why, "not a regular file of at most 256 MB");
-        else
-            text = text_read_file(path, &size, why, sizeof why);
-        if (!text) {
-            obj_warn(o, path, "%s:%ld: material library %s: %s; its materials are matte grey",
-                     L->name, L->line, path, why);
-            continue;
-        }
-        int r = mtl_parse(o, path, text, size);
-        free(text);
-        if (r != 0)
+        if (k < 64)
+            start[k] = tok, len[k++] = n;
+        end = tok + n;
+    }
+    if (k == 0)
+        return lex_expected(L, tok, 0, "a material library file name");
+    char path[4096];
+    int all = 1;
+    for (int j = 0; j < k && all; j++)
+        all = map_path(o->dir, start[j], len[j], path, sizeof path) >= 0 && readable(path);
+    if (!all && k > 1 &&
+        map_path(o->dir, start[0], (size_t)(end - start[0]), path, sizeof path) >= 0 &&
+        readable(path))
+        return obj_mtl_file(o, L, path);
+    for (int j = 0; j < k; j++) {
+        if (map_path(o->dir, start[j], len[j], path, sizeof path) < 0)
+            return lex_expected(L, start[j], len[j], "a shorter material library path");
+        if (obj_mtl_file(o, L, path) != 0)
             return -1;
     }
-    return any ? 0 : lex_expected(L, tok, 0, "a material library file name");
+    return 0;
 }
 
 /* ----------------------------------------------------------- OBJ */

@@ -264,18 +264,22 @@ static void test_map_paths(void)
     mkdir(DIR "/tex", 0777);
     test_write_text(DIR "/tex/wood.png", "not read by the parser");
     test_write_text(DIR "/stone.png", "not read by the parser");
+    test_write_text(DIR "/my wood.png", "not read by the parser");
     test_write_text(DIR "/p.mtl", "newmtl a\nmap_Kd tex\\wood.png\n"
                                   "newmtl b\nmap_Kd TEX/Wood.PNG\n"
                                   "newmtl c\nmap_Kd C:\\Users\\me\\Stone.png\n"
                                   "newmtl d\nmap_Kd tex/gone.png\n");
+    test_write_text(DIR "/my lib.mtl", "newmtl e\nmap_Kd -s 1 1 1 my wood.png\n");
     CHECK(parse(DIR "/p.obj",
-                "mtllib p.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nusemtl a\nf 1 2 3\n"
-                "usemtl b\nf 1 2 3\nusemtl c\nf 1 2 3\nusemtl d\nf 1 2 3\n") == RAYES_OK);
-    CHECK(rec.n_shader == 4);
-    if (rec.n_shader == 4) {
-        const char *want[4] = {DIR "/tex/wood.png", DIR "/tex/wood.png", DIR "/stone.png",
-                               DIR "/tex/gone.png"};
-        for (int k = 0; k < 4; k++) {
+                "mtllib p.mtl\nmtllib my lib.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nusemtl a\n"
+                "f 1 2 3\nusemtl b\nf 1 2 3\nusemtl c\nf 1 2 3\nusemtl d\nf 1 2 3\n"
+                "usemtl e\nf 1 2 3\n") == RAYES_OK);
+    /* names with spaces, as Blender writes them: the library and the map */
+    CHECK(rec.n_shader == 5);
+    if (rec.n_shader == 5) {
+        const char *want[5] = {DIR "/tex/wood.png", DIR "/tex/wood.png", DIR "/stone.png",
+                               DIR "/tex/gone.png", DIR "/my wood.png"};
+        for (int k = 0; k < 5; k++) {
             const RayesParam *p = rec_param(&rec.shader[k], "texturename");
             CHECK(p && strcmp(p->string, want[k]) == 0);
             if (p && strcmp(p->string, want[k]) != 0)
