@@ -55,7 +55,8 @@ static uint64_t fnv(uint64_t h, const void *data, size_t n)
 
 #define HASH(h, field) ((h) = fnv((h), &(field), sizeof(field)))
 
-uint64_t checkpoint_digest(const char *scene, int frame, const RayesRenderOptions *o)
+uint64_t checkpoint_digest(const char *scene, int frame, const RayesRenderOptions *o,
+                           const void *extra, size_t n_extra)
 {
     uint64_t h = fnv(0xcbf29ce484222325ull, scene, strlen(scene));
     FILE *f = fopen(scene, "rb");
@@ -82,7 +83,7 @@ uint64_t checkpoint_digest(const char *scene, int frame, const RayesRenderOption
     HASH(h, o->vertex_budget), HASH(h, o->crop), HASH(h, opacity_cache);
     HASH(h, o->volume_step), HASH(h, o->subsurface_rays), HASH(h, irradiance_cache);
     HASH(h, o->irradiance_shadow_rays), HASH(h, o->cache_fine_depth), HASH(h, o->aovs);
-    return h;
+    return extra && n_extra ? fnv(h, extra, n_extra) : h;
 }
 
 /* The file's header after the digest. */

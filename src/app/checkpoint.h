@@ -28,8 +28,10 @@
 typedef struct Checkpoint Checkpoint;
 
 /* A digest of what decides the pixels of a render of scene (a file, whose
- * bytes are read, or a built-in name) at frame with options o. */
-uint64_t checkpoint_digest(const char *scene, int frame, const RayesRenderOptions *o);
+ * bytes are read, or a built-in name) at frame with options o, and the
+ * n bytes of extra (the command line's camera; NULL, 0: none). */
+uint64_t checkpoint_digest(const char *scene, int frame, const RayesRenderOptions *o,
+                           const void *extra, size_t n);
 
 /* A checkpoint at path for a render with options o, saved every every_s
  * seconds (0: after every tile); with resume, the tiles of a matching

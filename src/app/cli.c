@@ -680,21 +680,61 @@ void merge_settings(Args *a, const IoSettings *s)
         memcpy(o->crop, s->crop, sizeof o->crop);
 }
 
+/* v normalised, or v itself when it has no length. */
+static void normalise3(float v[3])
+{
+    float len = sqrtf(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+    for (int k = 0; k < 3 && len > 0.0f; k++)
+        v[k] /= len;
+}
+
+static void cross3(const float a[3], const float b[3], float out[3])
+{
+    out[0] = a[1] * b[2] - a[2] * b[1];
+    out[1] = a[2] * b[0] - a[0] * b[2];
+    out[2] = a[0] * b[1] - a[1] * b[0];
+}
+
 RayesError command_line_camera(const Args *a, RayesScene *scene)
 {
     if (!a->camera)
         return RAYES_OK;
-    float eye[3], x[3], y[3], z[3], at[3], up[3] = {0, 1, 0};
+    float eye[3], x[3], y[3], z[3], at[3], up[3], yz[3];
     RayesError e = rayes_scene_get_camera(scene, eye, x, y, z);
     if (e != RAYES_OK)
         return e;
+    cross3(y, z, yz); /* the scene's camera's handedness: x = +-(y cross z) */
+    float hand = x[0] * yz[0] + x[1] * yz[1] + x[2] * yz[2] < 0.0f ? -1.0f : 1.0f;
     if (a->camera & CAMERA_FROM)
         memcpy(eye, a->look_from, sizeof eye);
-    for (int k = 0; k < 3; k++)
+    for (int k = 0; k < 3; k++) {
         at[k] = a->camera & CAMERA_AT ? a->look_at[k] : eye[k] + z[k];
-    if (a->camera & CAMERA_UP)
-        memcpy(up, a->up, sizeof up);
-    return rayes_scene_set_camera(scene, eye, at, up, a->camera & CAMERA_FOV ? a->fov : 40.0f);
+        up[k] = a->camera & CAMERA_UP ? a->up[k] : y[k];
+    }
+    /* the new frame: z toward the point, y the up made perpendicular to
+     * it, x on the scene's side, so the image is not mirrored */
+    float Z[3] = {at[0] - eye[0], at[1] - eye[1], at[2] - eye[2]}, X[3], Y[3];
+    normalise3(Z);
+    float d = up[0] * Z[0] + up[1] * Z[1] + up[2] * Z[2];
+    for (int k = 0; k < 3; k++)
+        Y[k] = up[k] - d * Z[k];
+    normalise3(Y);
+    cross3(Y, Z, X);
+    float xl = sqrtf(X[0] * X[0] + X[1] * X[1] + X[2] * X[2]);
+    if (!(xl > 1e-6f)) /* the eye on the point, or up along the view */
+        return rayes_scene_set_camera(scene, eye, at, up, 40.0f); /* says which */
+    float m[16] = {0};
+    const float *rows[3] = {X, Y, Z};
+    for (int r = 0; r < 3; r++) {
+        float sign = r == 0 ? hand / xl : 1.0f;
+        for (int c = 0; c < 3; c++)
+            m[4 * r + c] = sign * rows[r][c];
+        m[4 * r + 3] = -(m[4 * r] * eye[0] + m[4 * r + 1] * eye[1] + m[4 * r + 2] * eye[2]);
+    }
+    m[15] = 1.0f;
+    e = rayes_scene_set_camera_matrix(scene, m, RAYES_PROJECTION_PERSPECTIVE,
+                                      a->camera & CAMERA_FOV ? a->fov : 40.0f, NULL);
+    return e == RAYES_OK ? rayes_scene_set_depth_of_field(scene, 0.0f, 1.0f) : e;
 }
 
 RayesError default_light(const Args *a, const IoSettings *s, RayesScene *scene)

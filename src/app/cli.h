@@ -109,10 +109,13 @@ void merge_settings(Args *a, const IoSettings *s);
 
 /* A loaded scene's camera (before its commit) replaced by the command
  * line's --look-from, --look-at, --up and --fov, when any is given: a
- * perspective camera at the given eye (else the scene's) looking at the
- * given point (else along the scene's view), up the given direction (else
- * +y), of the given vertical field of view (else 40 degrees). Returns what
- * setting it returned (the scene's error names a degenerate view). */
+ * still pinhole perspective camera at the given eye (else the scene's)
+ * looking at the given point (else along the scene's view), up the given
+ * direction (else the scene's camera's), of the given field of view
+ * across the image's shorter side (else 40 degrees), of the scene
+ * camera's handedness (RIB's and pbrt's left-handed camera spaces, OBJ's
+ * right-handed view: the image is not mirrored). Returns what setting it
+ * returned (the scene's error names a degenerate view). */
 RayesError command_line_camera(const Args *a, RayesScene *scene);
 
 /* A loaded scene without lights (before its commit): one warning, or with

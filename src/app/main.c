@@ -494,8 +494,13 @@ static Checkpoint *open_checkpoint(Args *a, int frame)
     char path[4200], err[1024];
     snprintf(path, sizeof path, "%s.checkpoint", a->outputs[0].path);
     double every = a->checkpoint_s >= 0.0 ? a->checkpoint_s : INFINITY;
-    Checkpoint *ck = checkpoint_new(path, checkpoint_digest(a->scene, frame, &a->opt), &a->opt,
-                                    every, a->resume, err, sizeof err);
+    float camera[11] = {(float)a->camera, a->fov}; /* the command line's view */
+    memcpy(camera + 2, a->look_from, sizeof a->look_from);
+    memcpy(camera + 5, a->look_at, sizeof a->look_at);
+    memcpy(camera + 8, a->up, sizeof a->up);
+    Checkpoint *ck = checkpoint_new(
+        path, checkpoint_digest(a->scene, frame, &a->opt, camera, a->camera ? sizeof camera : 0),
+        &a->opt, every, a->resume, err, sizeof err);
     if (!ck) {
         fprintf(stderr, "rayes: %s\n", err);
         return NULL;

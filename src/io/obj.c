@@ -247,6 +247,7 @@ typedef struct Material {
     float Pr, Pm;       /* the PBR extension's roughness and metallic; -1 not given */
     char map_Pr[1024];  /* their textures (grey), resolved as map_Kd; "" none */
     char map_Pm[1024];
+    int map_Pr_channel, map_Pm_channel; /* -imfchan: the channel read (0 by default) */
     int pbr_sent;       /* the PBR patterns made */
     int defined;        /* given by a newmtl */
 } Material;
@@ -411,17 +412,19 @@ static int match_case(char *path, size_t from)
 
 /* The file of a map statement as found on this machine, into out: the
  * name relative to the MTL's directory (or absolute); else with Windows'
- * backslashes as slashes; else matched regardless of case; else its last
- * component beside the MTL (an absolute path of the machine that wrote
- * it, "C:\\Users\\...\\wood.jpg"). Not found at all, the name as written
- * (the texture's lookup then warns). Returns the length written, or -1
- * when it does not fit. */
+ * backslashes as slashes; else matched regardless of case; else its
+ * tails beside the MTL, longest first (an absolute path of the machine
+ * that wrote it, "C:\\Users\\...\\textures\\wood.jpg"). Not found at all,
+ * the name as written (the texture's lookup then warns). Returns the
+ * length written, or -1 when it does not fit. */
 static int map_path(const char *mtl_dir, const char *name, size_t n, char *out, size_t size)
 {
     const char *dir = name[0] == '/' ? "" : mtl_dir;
     int w = snprintf(out, size, "%s%.*s", dir, (int)n, name);
-    if (w < 0 || (size_t)w >= size || readable(out))
-        return w < 0 || (size_t)w >= size ? -1 : w;
+    if (w < 0 || (size_t)w >= size)
+        return -1;
+    if (readable(out))
+        return w;
     char first[4096];
     snprintf(first, sizeof first, "%s", out);
     for (char *c = out + strlen(dir); *c; c++)
@@ -429,15 +432,21 @@ static int map_path(const char *mtl_dir, const char *name, size_t n, char *out, 
             *c = '/';
     if (readable(out) || (match_case(out, strlen(dir)) == 0 && readable(out)))
         return w;
-    const char *base = out + strlen(out);
-    while (base > out && base[-1] != '/')
-        base--;
-    char alt[4096];
-    if (base > out + strlen(dir) &&
-        (size_t)snprintf(alt, sizeof alt, "%s%s", mtl_dir, base) < sizeof alt &&
-        (readable(alt) || (match_case(alt, strlen(mtl_dir)) == 0 && readable(alt))))
-        return snprintf(out, size, "%s", alt);
-    return snprintf(out, size, "%s", first);
+    /* another machine's path ("C:/Users/.../textures/wall.png"): its
+     * tails beside the MTL, longest first ("textures/wall.png", then
+     * "wall.png") */
+    char written[4096];
+    snprintf(written, sizeof written, "%s", out + strlen(dir));
+    for (const char *t = strchr(written, '/'); t; t = strchr(t + 1, '/')) {
+        char alt[4096];
+        if ((size_t)snprintf(alt, sizeof alt, "%s%s", mtl_dir, t + 1) < sizeof alt &&
+            (readable(alt) || (match_case(alt, strlen(mtl_dir)) == 0 && readable(alt)))) {
+            w = snprintf(out, size, "%s", alt);
+            return w < 0 || (size_t)w >= size ? -1 : w;
+        }
+    }
+    w = snprintf(out, size, "%s", first);
+    return w < 0 || (size_t)w >= size ? -1 : w;
 }
 
 /* map_Kd [options] file: the last token is the file name, or where no
@@ -470,13 +479,14 @@ static int mtl_map(Lexer *L, const char *mtl_dir, char *out, size_t out_size)
 }
 
 /* A map's "-imfchan c" option (r, g, b: that channel; m: the matte;
- * l, z: the first), read ahead of mtl_map: the channel, -2 (the matte,
- * map_d's default) when not given. The lexer is left where it was. */
-static int map_channel(Lexer *L)
+ * l, z: the first), read ahead of mtl_map: the channel, def when not
+ * given. The lexer is left where it was. */
+static int map_channel(Lexer *L, int def)
 {
-    const char *save = L->p, *tok;
+    Lexer save = *L;
+    const char *tok;
     size_t n;
-    int ch = -2;
+    int ch = def;
     while ((n = lex_token(L, &tok)) > 0)
         if (is_kw(tok, n, "-imfchan")) {
             n = lex_token(L, &tok);
@@ -486,7 +496,7 @@ static int map_channel(Lexer *L)
                  : n == 1 && tok[0] == 'm' ? -2
                                            : 0;
         }
-    L->p = save;
+    *L = save;
     return ch;
 }
 
@@ -494,7 +504,8 @@ static int map_channel(Lexer *L)
  * as it is when not given). The lexer is left where it was. */
 static int map_bump_mult(Lexer *L, float *mult)
 {
-    const char *save = L->p, *tok;
+    Lexer save = *L;
+    const char *tok;
     size_t n;
     while ((n = lex_token(L, &tok)) > 0)
         if (is_kw(tok, n, "-bm")) {
@@ -502,7 +513,7 @@ static int map_bump_mult(Lexer *L, float *mult)
             if (parse_float(tok, n, mult) != 0)
                 return lex_expected(L, tok, n, "a bump multiplier after -bm");
         }
-    L->p = save;
+    *L = save;
     return 0;
 }
 
@@ -589,19 +600,31 @@ static int mtl_statement(Obj *o, Lexer *L, const char *mtl_dir, const char *kw, 
     }
     if (is_mtl_kw(kw, n, "map_Kd"))
         return mtl_map(L, mtl_dir, mt->map_Kd, sizeof mt->map_Kd);
-    if (is_mtl_kw(kw, n, "map_Pr"))
+    if (is_mtl_kw(kw, n, "map_Pr")) { /* packed textures name their channel */
+        mt->map_Pr_channel = map_channel(L, 0);
         return mtl_map(L, mtl_dir, mt->map_Pr, sizeof mt->map_Pr);
-    if (is_mtl_kw(kw, n, "map_Pm"))
+    }
+    if (is_mtl_kw(kw, n, "map_Pm")) {
+        mt->map_Pm_channel = map_channel(L, 0);
         return mtl_map(L, mtl_dir, mt->map_Pm, sizeof mt->map_Pm);
+    }
     if (is_mtl_kw(kw, n, "map_d")) {
-        mt->map_d_channel = map_channel(L);
+        mt->map_d_channel = map_channel(L, -2);
         return mtl_map(L, mtl_dir, mt->map_d, sizeof mt->map_d);
     }
     if (is_mtl_kw(kw, n, "bump") || is_mtl_kw(kw, n, "map_bump") || is_mtl_kw(kw, n, "norm") ||
         is_mtl_kw(kw, n, "map_norm") || is_mtl_kw(kw, n, "disp") || is_mtl_kw(kw, n, "map_disp")) {
-        if (map_bump_mult(L, &mt->bump_mult) != 0)
+        /* the first wins: files name one bump several ways ("map_bump",
+         * "bump", then "norm" of its normal map) */
+        float mult = 1.0f;
+        char file[1024];
+        if (map_bump_mult(L, &mult) != 0 || mtl_map(L, mtl_dir, file, sizeof file) != 0)
             return -1;
-        return mtl_map(L, mtl_dir, mt->bump, sizeof mt->bump);
+        if (!mt->bump[0]) {
+            snprintf(mt->bump, sizeof mt->bump, "%s", file);
+            mt->bump_mult = mult;
+        }
+        return 0;
     }
     char key[40];
     snprintf(key, sizeof key, "mtl %.*s", (int)(n < 30 ? n : 30), kw);
@@ -1108,6 +1131,21 @@ static void material_transmission(Obj *o, const Material *m, float T[3])
     T[0] = T[1] = T[2] = 1.0f - d;
 }
 
+/* Whether material m is clear glass: refraction on (illum 6 or 7) with an
+ * index above 1, untextured and untinted, and either dark (glass's Kd is
+ * black or nearly) or at least half transparent — not an opaque
+ * material an exporter marked so (a coloured surface of Ni 1.45 and d 0.9
+ * stays that surface, a little transparent). */
+static int clear_glass(Obj *o, const Material *m)
+{
+    if (!((m->illum == 6 || m->illum == 7) && m->Ni > 1.01f) || m->map_Kd[0] || m->map_d[0] ||
+        (m->Tf[0] >= 0.0f && m->Tf[0] + m->Tf[1] + m->Tf[2] < 3.0f))
+        return 0;
+    float T[3];
+    material_transmission(o, m, T);
+    return max3(m->Kd) <= 0.2f || T[0] >= 0.5f;
+}
+
 /* The opacity of material m as the reserved shader parameter "Os" in *out
  * (its name NULL for an opaque material): d, or map_d's texture (times d),
  * a pattern made once per material under a name that starts with a space
@@ -1235,9 +1273,10 @@ static RayesError pbr_patterns(Emit *e, Material *m, char names[3][48])
         char r1[48], r2[48];
         snprintf(r1, sizeof r1, " obj Pr1 %zu", k);
         snprintf(r2, sizeof r2, " obj Pr2 %zu", k);
-        const RayesParam q[3] = {{"filename", RAYES_PARAM_STRING, {0, 0, 0}, m->map_Pr},
-                                 {"encoding", RAYES_PARAM_STRING, {0, 0, 0}, "linear"},
-                                 {"channel", RAYES_PARAM_FLOAT, {0, 0, 0}, NULL}};
+        const RayesParam q[3] = {
+            {"filename", RAYES_PARAM_STRING, {0, 0, 0}, m->map_Pr},
+            {"encoding", RAYES_PARAM_STRING, {0, 0, 0}, "linear"},
+            {"channel", RAYES_PARAM_FLOAT, {(float)m->map_Pr_channel, 0, 0}, NULL}};
         const RayesParam sq[2] = {{"tex", RAYES_PARAM_PATTERN, {0, 0, 0}, r1},
                                   {"scale", RAYES_PARAM_PATTERN, {0, 0, 0}, r1}};
         const RayesParam fourth[2] = {{"tex", RAYES_PARAM_PATTERN, {0, 0, 0}, r2},
@@ -1249,9 +1288,10 @@ static RayesError pbr_patterns(Emit *e, Material *m, char names[3][48])
             r = obj_pattern(e, m, names[1], "scale", fourth, 2);
     }
     if (r == RAYES_OK && m->map_Pm[0]) {
-        const RayesParam q[3] = {{"filename", RAYES_PARAM_STRING, {0, 0, 0}, m->map_Pm},
-                                 {"encoding", RAYES_PARAM_STRING, {0, 0, 0}, "linear"},
-                                 {"channel", RAYES_PARAM_FLOAT, {0, 0, 0}, NULL}};
+        const RayesParam q[3] = {
+            {"filename", RAYES_PARAM_STRING, {0, 0, 0}, m->map_Pm},
+            {"encoding", RAYES_PARAM_STRING, {0, 0, 0}, "linear"},
+            {"channel", RAYES_PARAM_FLOAT, {(float)m->map_Pm_channel, 0, 0}, NULL}};
         r = obj_pattern(e, m, names[2], "imagemap", q, 3);
     }
     m->pbr_sent = r == RAYES_OK;
@@ -1340,14 +1380,12 @@ static RayesError material_shader(Emit *e, Material *m)
         n += p[n].name != NULL;
         return pbr_shader(e, m, p, n);
     }
-    if (m && (m->illum == 6 || m->illum == 7) && m->Ni > 1.01f && !m->map_d[0] &&
-        !(m->Tf[0] >= 0.0f && m->Tf[0] + m->Tf[1] + m->Tf[2] < 3.0f)) {
-        /* refraction on, an index above 1, clear: a sheet of glass that
-         * reflects by Fresnel's law and lets the rest through unbent (a
-         * window is a single face; a solid refracting glass would bend
-         * light into the room behind it). Tinted glass is a filter, Os. */
-        p[n++] = (RayesParam){"eta", RAYES_PARAM_FLOAT, {fminf(m->Ni, 10.0f), 0, 0}, NULL};
-        return set_shader(e, "thindielectric", p, n, m->name);
+    if (m && clear_glass(e->o, m)) {
+        /* a sheet of glass that reflects by Fresnel's law and lets the
+         * rest through unbent (a window is a single face; a solid
+         * refracting glass would bend light into the room behind it) */
+        const RayesParam eta = {"eta", RAYES_PARAM_FLOAT, {fminf(m->Ni, 10.0f), 0, 0}, NULL};
+        return set_shader(e, "thindielectric", &eta, 1, m->name);
     }
     p[n++] = (RayesParam){"Cs", RAYES_PARAM_COLOR, {Kd[0], Kd[1], Kd[2]}, NULL};
     if (!m)
@@ -1640,11 +1678,13 @@ static RayesError emit_material(Emit *e, int mi)
     Obj *o = e->o;
     Mesh m[2] = {{{0}, {0}}, {{0}, {0}}}; /* with vt, without */
     Material *mt = mi >= 0 ? &o->mats[mi] : NULL;
+    int emits = mt && max3(mt->Ke) > 0.0f; /* lights take no texture: one mesh */
     RayesError r = RAYES_OK;
     size_t k = 0;
     for (size_t f = 0; f < o->face_nv.n && r == RAYES_OK; k += (size_t)o->face_nv.a[f], f++)
         if (o->face_mat.a[f] == mi &&
-            triangulate(o, &m[!face_has_vt(o, k, o->face_nv.a[f])], (int)k, o->face_nv.a[f]) != 0)
+            triangulate(o, &m[!emits && !face_has_vt(o, k, o->face_nv.a[f])], (int)k,
+                        o->face_nv.a[f]) != 0)
             r = RAYES_ERROR_OUT_OF_MEMORY;
     if (m[0].nv.n == 0) { /* one mesh when no face has vt */
         Mesh t = m[0];
@@ -1652,12 +1692,11 @@ static RayesError emit_material(Emit *e, int mi)
     }
     if (r != RAYES_OK)
         snprintf(o->err, o->err_size, "%s: out of memory", o->name);
-    else if (mt && max3(mt->Ke) > 0.0f) {
+    else if (emits) {
         char none[2][48];
         RayesParam unused;
         if ((r = bump_of(e, NULL, none, &unused)) == RAYES_OK) /* lights are not bumped */
-            for (int j = 0; j < 2 && r == RAYES_OK; j++)
-                r = m[j].nv.n > 0 ? emit_emitter(e, mt, &m[j]) : RAYES_OK;
+            r = emit_emitter(e, mt, &m[0]);
     } else if (m[0].nv.n > 0 && (r = material_shader(e, mt)) == RAYES_OK) {
         for (int j = 0; j < 2 && r == RAYES_OK; j++)
             r = emit_mesh(e, &m[j], mt ? mt->name : "(none)");

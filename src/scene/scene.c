@@ -126,6 +126,7 @@ RayesError rayes_scene_set_camera(RayesScene *s, const float eye[3], const float
         return scene_fail(s, RAYES_ERROR_INVALID_ARGUMENT,
                           "camera: the eye equals the target, or up is parallel to the view");
     look_at(&s->camera, eye, target, up, fov);
+    s->camera.n_motion = 0; /* a still camera now: set_camera_motion comes after */
     scene_mark(s, SCENE_CHANGE_CAMERA);
     return RAYES_OK;
 }
@@ -158,6 +159,7 @@ RayesError rayes_scene_set_camera_matrix(RayesScene *s, const float m[16], Rayes
                           ? tanf(0.5f * fov * (float)(M_PI / 180.0))
                           : 0.0f;
     c->fov_vertical = 0;
+    c->n_motion = 0; /* a still camera now: set_camera_motion comes after */
     c->has_screen = screen != NULL;
     if (screen)
         memcpy(c->screen, screen, sizeof c->screen);

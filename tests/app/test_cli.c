@@ -810,6 +810,34 @@ static void test_camera_options(void)
     printf("  mean red: the file's camera %.4f, from behind %.4f, turned away %.4f\n", file, behind,
            away);
     CHECK(file > 0.05 && fabs(behind - file) < 0.01 * file && away == 0.0);
+    /* the view kept (--fov alone) keeps the image: a sphere right of the
+     * view stays on the right (RIB's left-handed camera is not mirrored),
+     * and a moving camera is replaced by the still one given */
+    test_write_text(SCRATCH_DIR "/side.rib",
+                    "Projection \"perspective\" \"fov\" 40\nShutter 0 1\n"
+                    "MotionBegin [0 1]\nTranslate 0 0 0\nTranslate 0 3 0\nMotionEnd\n"
+                    "WorldBegin\nTranslate 0 0 5\nSurface \"matte\"\n"
+                    "AttributeBegin\nTranslate 1.2 0 0\nSphere 0.6 -0.6 0.6 360\nAttributeEnd\n"
+                    "WorldEnd\n");
+    run(&r, NULL,
+        ARGS("render", SCRATCH_DIR "/side.rib", "--res", "32", "--spp", "4", "--quiet",
+             "--default-light", "--fov", "40", "-o", SCRATCH_DIR "/side.exr"));
+    CHECK(r.status == 0);
+    {
+        int w = 0, h = 0;
+        float *px = NULL;
+        char err[256];
+        double half[2] = {0, 0};
+        CHECK(image_read_exr(SCRATCH_DIR "/side.exr", &w, &h, &px, err, sizeof err) == RAYES_OK);
+        for (int y = 0; px && y < h; y++)
+            for (int x = 0; x < w; x++)
+                half[x >= w / 2] += px[4 * (y * w + x)];
+        free(px);
+        printf("  the sphere right of the view: left half %.3f, right half %.3f\n", half[0],
+               half[1]);
+        /* still (not moved 3 units up by the file's camera motion) and not mirrored */
+        CHECK(half[1] > 10.0 * half[0] + 0.5);
+    }
     expect_error(2, NULL, ARGS("render", SCRATCH_DIR "/ahead.rib", "--look-from", "1,2"),
                  ARGS("--look-from: expected X,Y,Z"));
     run(&r, NULL,

@@ -224,16 +224,18 @@ static void test_opacity_words(void)
                                   "newmtl green\nd 0\nTf 0.25 0.75 0.125\nillum 4\n"
                                   "newmtl yellow\nd 1\nTf 1 0.875 0\nillum 4\n"
                                   "newmtl clear\nd 0\nillum 9\n"
-                                  "newmtl glass\nNi 1.5\nillum 7\n");
+                                  "newmtl glass\nKd 0 0 0\nNi 1.5\nillum 7\n"
+                                  "newmtl redglaze\nKd 0.8 0 0\nNi 1.45\nd 0.9\nillum 6\n");
     static const char text[] = "mtllib o.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\n"
                                "usemtl zero\nf 1 2 3\nusemtl both\nf 1 2 3\n"
                                "usemtl tr\nf 1 2 3\nusemtl trone\nf 1 2 3\n"
                                "usemtl half\nf 1 2 3\nusemtl win\nf 1 2 3\n"
                                "usemtl green\nf 1 2 3\nusemtl yellow\nf 1 2 3\n"
-                               "usemtl clear\nf 1 2 3\nusemtl glass\nf 1 2 3\n";
+                               "usemtl clear\nf 1 2 3\nusemtl glass\nf 1 2 3\n"
+                               "usemtl redglaze\nf 1 2 3\n";
     CHECK(parse(DIR "/o.obj", text) == RAYES_OK);
-    CHECK(rec.n_shader == 10);
-    if (rec.n_shader == 10) {
+    CHECK(rec.n_shader == 11);
+    if (rec.n_shader == 11) {
         const RayesParam *p;
         CHECK(rec_param(&rec.shader[0], "Os") == NULL); /* d 0: opaque */
         CHECK(rec_param(&rec.shader[1], "Os") == NULL); /* d 1 wins over Tr 1 */
@@ -250,6 +252,10 @@ static void test_opacity_words(void)
         /* refraction with an index: a thin sheet of glass */
         CHECK(strcmp(rec.shader[9].name, "thindielectric") == 0 &&
               (p = rec_param(&rec.shader[9], "eta")) && p->value[0] == 1.5f);
+        /* an opaque colour an exporter marked illum 6 stays that colour */
+        CHECK(strcmp(rec.shader[10].name, "thindielectric") != 0 &&
+              (p = rec_param(&rec.shader[10], "Cs")) && p->value[0] == 0.8f &&
+              (p = rec_param(&rec.shader[10], "Os")) && fabsf(p->value[0] - 0.9f) < 1e-6f);
     }
     record_free(&rec);
 }
@@ -268,18 +274,21 @@ static void test_map_paths(void)
     test_write_text(DIR "/p.mtl", "newmtl a\nmap_Kd tex\\wood.png\n"
                                   "newmtl b\nmap_Kd TEX/Wood.PNG\n"
                                   "newmtl c\nmap_Kd C:\\Users\\me\\Stone.png\n"
-                                  "newmtl d\nmap_Kd tex/gone.png\n");
+                                  "newmtl d\nmap_Kd tex/gone.png\n"
+                                  "newmtl f\nmap_Kd D:\\work\\proj\\TEX\\wood.png\n");
     test_write_text(DIR "/my lib.mtl", "newmtl e\nmap_Kd -s 1 1 1 my wood.png\n");
     CHECK(parse(DIR "/p.obj",
                 "mtllib p.mtl\nmtllib my lib.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nusemtl a\n"
                 "f 1 2 3\nusemtl b\nf 1 2 3\nusemtl c\nf 1 2 3\nusemtl d\nf 1 2 3\n"
-                "usemtl e\nf 1 2 3\n") == RAYES_OK);
-    /* names with spaces, as Blender writes them: the library and the map */
-    CHECK(rec.n_shader == 5);
-    if (rec.n_shader == 5) {
-        const char *want[5] = {DIR "/tex/wood.png", DIR "/tex/wood.png", DIR "/stone.png",
-                               DIR "/tex/gone.png", DIR "/my wood.png"};
-        for (int k = 0; k < 5; k++) {
+                "usemtl e\nf 1 2 3\nusemtl f\nf 1 2 3\n") == RAYES_OK);
+    /* names with spaces, as Blender writes them: the library and the map
+     * (materials in the order their libraries define them: f before e);
+     * another machine's absolute path found by its tail */
+    CHECK(rec.n_shader == 6);
+    if (rec.n_shader == 6) {
+        const char *want[6] = {DIR "/tex/wood.png", DIR "/tex/wood.png", DIR "/stone.png",
+                               DIR "/tex/gone.png", DIR "/tex/wood.png", DIR "/my wood.png"};
+        for (int k = 0; k < 6; k++) {
             const RayesParam *p = rec_param(&rec.shader[k], "texturename");
             CHECK(p && strcmp(p->string, want[k]) == 0);
             if (p && strcmp(p->string, want[k]) != 0)
@@ -628,6 +637,19 @@ static void test_bump_maps(void)
     RayesImage *flat = render_cut("norm flatn.ppm");
     RayesImage *up = render_cut("bump ramp.ppm");
     RayesImage *down = render_cut("map_bump -bm -1 ramp.ppm");
+    /* the first of several bump statements wins, each with its own -bm;
+     * bumped glass (which takes no normal map) still loads */
+    RayesImage *first = render_cut("bump ramp.ppm\nmap_Bump -bm -1 tilt.ppm\ndisp flatn.ppm");
+    RayesImage *glass = render_cut("Kd 0 0 0\nNi 1.5\nillum 7\nbump tilt.ppm");
+    CHECK(first && glass);
+    if (first && plain) {
+        double r, g0, g5;
+        means(plain, 24, 40, 24, 40, &r, &g0);
+        means(first, 24, 40, 24, 40, &r, &g5);
+        CHECK(fabs(g5 / g0 - 1.34) < 0.05);
+    }
+    rayes_image_free(first);
+    rayes_image_free(glass);
     CHECK(plain && tilt && flat && up && down);
     if (plain && tilt && flat && up && down) {
         double r, g0, g1, g2, g3, g4;
