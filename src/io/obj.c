@@ -238,6 +238,8 @@ typedef struct Material {
     float Ni;           /* index of refraction; -1 not given */
     int illum;          /* illumination model, read, not rendered */
     char map_Kd[1024];  /* texture path, resolved against the MTL's directory; "" none */
+    char map_Ks[1024];  /* the specular colour's texture, resolved likewise; "" none */
+    int map_Ks_sent;    /* its pattern made */
     char map_d[1024];   /* the opacity's texture (a cut-out), resolved likewise; "" none */
     int map_d_channel;  /* its channel: 0-3, or -2 the matte (alpha if any, else grey) */
     int map_d_sent;     /* its pattern made (once per material) */
@@ -600,6 +602,8 @@ static int mtl_statement(Obj *o, Lexer *L, const char *mtl_dir, const char *kw, 
     }
     if (is_mtl_kw(kw, n, "map_Kd"))
         return mtl_map(L, mtl_dir, mt->map_Kd, sizeof mt->map_Kd);
+    if (is_mtl_kw(kw, n, "map_Ks"))
+        return mtl_map(L, mtl_dir, mt->map_Ks, sizeof mt->map_Ks);
     if (is_mtl_kw(kw, n, "map_Pr")) { /* packed textures name their channel */
         mt->map_Pr_channel = map_channel(L, 0);
         return mtl_map(L, mtl_dir, mt->map_Pr, sizeof mt->map_Pr);
@@ -1248,7 +1252,7 @@ static RayesError obj_pattern(Emit *e, const Material *m, const char *name, cons
     if (r == RAYES_OK)
         return r;
     char what[200];
-    snprintf(what, sizeof what, "material \"%s\": its PBR textures", m->name);
+    snprintf(what, sizeof what, "material \"%s\": its textures", m->name);
     return sink_fail(e, r, what);
 }
 
@@ -1396,12 +1400,25 @@ static RayesError material_shader(Emit *e, Material *m)
         return r;
     n += p[n].name != NULL;
     float ks = max3(m->Ks);
-    if (!m->map_Kd[0] && !(ks > 0.0f))
+    char ks_map[48];
+    int mapped = m->map_Ks[0] && e->sink->pattern;
+    if (mapped && !m->map_Ks_sent) { /* map_Ks times Ks (the map alone when Ks is 0) */
+        snprintf(ks_map, sizeof ks_map, " obj Ks %zu", (size_t)(m - e->o->mats));
+        const RayesParam q[2] = {{"filename", RAYES_PARAM_STRING, {0, 0, 0}, m->map_Ks},
+                                 {"scale", RAYES_PARAM_FLOAT, {ks > 0.0f ? ks : 1.0f, 0, 0}, NULL}};
+        if ((r = obj_pattern(e, m, ks_map, "imagemap", q, 2)) != RAYES_OK)
+            return r;
+        m->map_Ks_sent = 1;
+    }
+    snprintf(ks_map, sizeof ks_map, " obj Ks %zu", (size_t)(m - e->o->mats));
+    if (!m->map_Kd[0] && !(ks > 0.0f) && !mapped)
         return set_shader(e, "matte", p, n, m->name);
     p[n++] = (RayesParam){"Kd", RAYES_PARAM_FLOAT, {1, 0, 0}, NULL};
-    p[n++] = (RayesParam){"Ks", RAYES_PARAM_FLOAT, {ks > 0.0f ? 1.0f : 0.0f, 0, 0}, NULL};
+    p[n++] = (RayesParam){"Ks", RAYES_PARAM_FLOAT, {ks > 0.0f || mapped ? 1.0f : 0.0f, 0, 0}, NULL};
     p[n++] = (RayesParam){"roughness", RAYES_PARAM_FLOAT, {roughness_of(m->Ns), 0, 0}, NULL};
-    if (ks > 0.0f)
+    if (mapped)
+        p[n++] = (RayesParam){"specularcolor", RAYES_PARAM_PATTERN, {1, 1, 1}, ks_map};
+    else if (ks > 0.0f)
         p[n++] = (RayesParam){"specularcolor", RAYES_PARAM_COLOR,
                               {m->Ks[0], m->Ks[1], m->Ks[2]}, NULL};
     if (m->map_Kd[0])

@@ -172,10 +172,12 @@ static void plastic_chunk(const RayesShaderServices *sv, const RayesShadeCtx *ct
         sv->ambient(sv, ctx, am);
     else
         memset(am, 0, sizeof am);
+    float sc[SHADE_CHUNK][3]; /* specularcolor: a constant, or a map (an OBJ's map_Ks) */
+    shade_param_color(sv, ctx, "specularcolor", p->specularcolor, sc);
     for (size_t i = 0; i < ctx->n_points; i++)
         for (int c = 0; c < 3; c++)
             out->Ci[i][c] = cs(ctx, i, c) * (p->Ka * am[i][c] + p->Kd * (dd[i][c] + id[i][c])) +
-                            p->specularcolor[c] * p->Ks * ds[i][c];
+                            sc[i][c] * p->Ks * ds[i][c];
 }
 
 static void plastic_lighting(const RayesShaderServices *sv, const RayesShadeCtx *ctx,
@@ -386,10 +388,13 @@ static void painted_chunk_common(const RayesShaderServices *sv, const RayesShade
         sv->ambient(sv, ctx, am);
     else
         memset(am, 0, sizeof am);
+    float spc[SHADE_CHUNK][3]; /* specularcolor: a constant, or a map (an OBJ's map_Ks) */
+    if (highlight)
+        shade_param_color(sv, ctx, "specularcolor", p->specularcolor, spc);
     for (size_t i = 0; i < ctx->n_points; i++)
         for (int c = 0; c < 3; c++) {
             float diffuse = p->Ka * am[i][c] + p->Kd * (dd[i][c] + id[i][c]);
-            float spec = highlight ? p->specularcolor[c] * p->Ks * ds[i][c] : 0.0f;
+            float spec = highlight ? spc[i][c] * p->Ks * ds[i][c] : 0.0f;
             out->Ci[i][c] = cs(ctx, i, c) * sc[i].T[c] * diffuse + spec;
         }
     if (out->Irradiance)

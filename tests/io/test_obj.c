@@ -673,6 +673,46 @@ static void test_bump_maps(void)
     rayes_image_free(down);
 }
 
+static void white_texel(int x, int w, unsigned char c[3])
+{
+    (void)x, (void)w;
+    c[0] = c[1] = c[2] = 255;
+}
+
+static void black_texel(int x, int w, unsigned char c[3])
+{
+    (void)x, (void)w;
+    c[0] = c[1] = c[2] = 0;
+}
+
+/* map_Ks: the highlight's colour by a texture (times Ks): a white map is
+ * the highlight of Ks alone, a black one none. */
+static void test_specular_map(void)
+{
+    mkdir(RAYES_TEST_TMP, 0777);
+    mkdir(DIR, 0777);
+    write_columns(DIR "/white.ppm", 4, 4, white_texel);
+    write_columns(DIR "/black.ppm", 4, 4, black_texel);
+    RayesImage *shiny = render_cut("Ks 1 1 1\nNs 4");
+    RayesImage *white = render_cut("Ks 1 1 1\nNs 4\nmap_Ks white.ppm");
+    RayesImage *black = render_cut("Ks 1 1 1\nNs 4\nmap_Ks black.ppm");
+    RayesImage *dull = render_cut("Ks 0 0 0\nNs 4");
+    CHECK(shiny && white && black && dull);
+    if (shiny && white && black && dull) {
+        double r[4], g[4];
+        RayesImage *im[4] = {shiny, white, black, dull};
+        for (int k = 0; k < 4; k++)
+            means(im[k], 24, 40, 24, 40, &r[k], &g[k]);
+        printf("  red (the highlight): Ks %.4f, white map %.4f, black map %.4f, Ks 0 %.4f\n", r[0],
+               r[1], r[2], r[3]);
+        CHECK(r[0] > r[3] + 0.01 && fabs(r[1] - r[0]) < 1e-3 && fabs(r[2] - r[3]) < 1e-3);
+    }
+    rayes_image_free(shiny);
+    rayes_image_free(white);
+    rayes_image_free(black);
+    rayes_image_free(dull);
+}
+
 /* MTL transparency: d (and Tr) is the opacity, map_d a cut-out by its
  * texture's matte (a grey mask's value, an RGBA image's alpha) or the
  * channel -imfchan names; where it is 0 the wall behind shows. */
@@ -746,6 +786,7 @@ static void test_transparency(void)
 
 TEST_MAIN(TEST(test_face_syntax), TEST(test_ngons), TEST(test_materials), TEST(test_opacity_words),
           TEST(test_map_paths), TEST(test_bump_maps), TEST(test_pbr_extension),
-          TEST(test_default_camera_and_light), TEST(test_errors), TEST(test_unknown_statements),
-          TEST(test_read_file), TEST(test_normals_and_texture_coordinates), TEST(test_transparency),
+          TEST(test_specular_map), TEST(test_default_camera_and_light), TEST(test_errors),
+          TEST(test_unknown_statements), TEST(test_read_file),
+          TEST(test_normals_and_texture_coordinates), TEST(test_transparency),
           TEST(test_smoothing_groups), TEST(test_vertex_colours))
