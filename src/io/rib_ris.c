@@ -873,9 +873,20 @@ static void light_controls(Rib *r, const char *cls, Light *l, const Param *p, si
         rib_light_param(l, "__nonspecular", RAYES_PARAM_FLOAT, one, NULL);
     float shadow[3];
     color(p, n, "shadowColor", zero, shadow);
+    /* a rect or disk light's cone: its emission within coneAngle of its
+     * normal, softened over coneSoftness of it (rayes' arealight cone) */
+    float cone = num(p, n, "coneAngle", 90);
+    int shaped =
+        cone < 90 && (strcasecmp(cls, "PxrRectLight") == 0 || strcasecmp(cls, "PxrDiskLight") == 0);
+    if (shaped && cone > 0) {
+        float c[3] = {cone, 0, 0},
+              soft[3] = {fminf(fmaxf(num(p, n, "coneSoftness", 0), 0), 1), 0, 0};
+        rib_light_param(l, "cone", RAYES_PARAM_FLOAT, c, NULL);
+        rib_light_param(l, "conesoftness", RAYES_PARAM_FLOAT, soft, NULL);
+    }
     const char *unbuilt = (diffuse != 0 && diffuse != 1) || (specular != 0 && specular != 1)
                               ? "diffuse and specular multipliers other than 0 and 1"
-                          : num(p, n, "coneAngle", 90) < 90       ? "coneAngle (a cone)"
+                          : cone < 90 && !(shaped && cone > 0)    ? "coneAngle (a cone)"
                           : num(p, n, "intensityNearDist", 0) > 0 ? "intensityNearDist"
                           : num(p, n, "emissionFocus", 0) != 0    ? "emissionFocus"
                           : shadow[0] != 0 || shadow[1] != 0 || shadow[2] != 0 ? "shadowColor"

@@ -1257,10 +1257,11 @@ static int h_light_source(Rib *r, const Args *a)
         L->visibility = r->a.visibility;
     }
     static const char *const names[] = {
-        "intensity",  "lightcolor", "sundirection", "haziness",       "groundcolor",
-        "from",       "to",         "coneangle",    "conedeltaangle", "beamdistribution",
-        "__category", "fov",        "shape",        "width",          "height",
-        "radius",     "shadows",    "__nondiffuse", "__nonspecular",  NULL};
+        "intensity",    "lightcolor", "sundirection", "haziness",       "groundcolor",
+        "from",         "to",         "coneangle",    "conedeltaangle", "beamdistribution",
+        "__category",   "fov",        "shape",        "width",          "height",
+        "radius",       "shadows",    "__nondiffuse", "__nonspecular",  "cone",
+        "conesoftness", NULL};
     int mapped = strcmp(type, "pointlight") == 0 || strcmp(type, "spotlight") == 0;
     /* RenderMan's point, spot and distant lights: diffuse() sums Cl (L.N)
      * with no 1/pi, so their intensity is pi times rayes' (DESIGN.md,

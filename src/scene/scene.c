@@ -1612,6 +1612,7 @@ typedef struct LightParams {
     float intensity, color[3], from[3], to[3];
     float coneangle, conedeltaangle, beamdistribution; /* beamdistribution NAN: not given */
     float radius, width, height, fov;
+    float cone, conesoftness; /* arealight quad and disk: the emission's cone, degrees */
     const char *mapname, *mapping, *shape, *category;
     float shadows, nondiffuse, nonspecular;
     float sundirection[3], haziness, groundcolor[3]; /* an environment's "sky" */
@@ -1648,6 +1649,8 @@ static const LightParamDesc light_param_descs[] = {
     {"haziness", RAYES_PARAM_FLOAT, offsetof(LightParams, haziness)},
     {"groundcolor", RAYES_PARAM_COLOR, offsetof(LightParams, groundcolor)},
     {"fov", RAYES_PARAM_FLOAT, offsetof(LightParams, fov)},
+    {"cone", RAYES_PARAM_FLOAT, offsetof(LightParams, cone)},
+    {"conesoftness", RAYES_PARAM_FLOAT, offsetof(LightParams, conesoftness)},
     {"shape", RAYES_PARAM_STRING, offsetof(LightParams, shape)},
     {"__category", RAYES_PARAM_STRING, offsetof(LightParams, category)},
     {"shadows", RAYES_PARAM_FLOAT, offsetof(LightParams, shadows)},
@@ -1694,6 +1697,7 @@ static RayesError light_params(RayesScene *s, const char *type, const RayesParam
                         .width = 1,
                         .height = 1,
                         .fov = 90,
+                        .cone = 90,
                         .mapname = "",
                         .mapping = "latlong",
                         .sundirection = {0, 1, 0},
@@ -2059,6 +2063,13 @@ RayesError rayes_scene_light(RayesScene *s, const char *type, const RayesParam *
         break;
     }
     /* arealight */
+    if (!(lp.cone > 0.0f && lp.cone <= 180.0f) ||
+        !(lp.conesoftness >= 0.0f && lp.conesoftness <= 1.0f))
+        return scene_fail(s, RAYES_ERROR_INVALID_ARGUMENT,
+                          "arealight: expected a cone in (0, 180] degrees and a conesoftness in "
+                          "[0, 1]");
+    float cone = lp.cone < 90.0f ? lp.cone * (float)(M_PI / 180.0) : 0.0f; /* 90: none */
+    l.cone = cone, l.cone_start = cone * (1.0f - lp.conesoftness);
     if (strcmp(lp.shape, "quad") == 0) {
         if (!(lp.width > 0.0f) || !(lp.height > 0.0f))
             return scene_fail(s, RAYES_ERROR_INVALID_ARGUMENT,
@@ -2075,6 +2086,7 @@ RayesError rayes_scene_light(RayesScene *s, const char *type, const RayesParam *
             made->shadowless = l.shadowless;
             made->nondiffuse = l.nondiffuse;
             made->nonspecular = l.nonspecular;
+            made->cone = l.cone, made->cone_start = l.cone_start;
         }
         return e;
     }

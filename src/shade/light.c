@@ -88,15 +88,34 @@ static int ray_triangle(Vec3 o, Vec3 d, Vec3 p0, Vec3 p1, Vec3 p2, float *t)
 
 /* Solid-angle pdf and radiance of the quad point y (normal ny, |ny| the
  * Jacobian) seen along wi at distance d. */
+/* What a quad or disk light's cone lets out at cos_y, the cosine off its
+ * normal: 1 inside cone_start, 0 beyond cone, smoothstep between (in the
+ * angle, as USD's shaping:cone:softness). */
+static float cone_factor(const Light *l, float cos_y)
+{
+    if (!(l->cone > 0.0f))
+        return 1.0f;
+    float t = acosf(fminf(fmaxf(cos_y, -1.0f), 1.0f));
+    if (t >= l->cone)
+        return 0.0f;
+    if (t <= l->cone_start)
+        return 1.0f;
+    float x = (t - l->cone_start) / (l->cone - l->cone_start);
+    return 1.0f - x * x * (3.0f - 2.0f * x);
+}
+
 static int area_finish(const Light *l, Vec3 wi, float d, Vec3 ny, LightSample *s)
 {
     float jac = v3_length(ny);
     float cos_y = -v3_dot(ny, wi) / (jac > 0.0f ? jac : 1.0f);
     if (!(cos_y > 0.0f) || !(jac > 0.0f) || !(d > 0.0f))
         return 0;
+    float k = cone_factor(l, cos_y);
+    if (!(k > 0.0f))
+        return 0;
     s->wi = wi;
     s->dist = d;
-    s->Li = l->L;
+    s->Li = k < 1.0f ? v3_scale(l->L, k) : l->L;
     s->pdf = d * d / (cos_y * jac);
     return 1;
 }
@@ -1180,6 +1199,13 @@ int light_sample(const Light *l, Vec3 o, float a, float b, LightSample *s)
         s->dist = dist;
         s->Li = l->L;
         s->pdf = 1.0f / r.S;
+        if (l->cone > 0.0f) { /* a rectangle: one normal */
+            Vec3 p, n;
+            light_quad_eval(l, 0.5f, 0.5f, &p, &n);
+            float k = cone_factor(l, -v3_dot(v3_normalize(n), s->wi));
+            s->Li = v3_scale(l->L, k);
+            return k > 0.0f;
+        }
         return 1;
     }
     case LIGHT_DISK: {

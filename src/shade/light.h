@@ -167,6 +167,9 @@ typedef struct Light {
     float radius;       /* sphere */
     float area;         /* disk */
     float cos_outer, cos_inner, beam; /* spot: cone edge, full beam, beamdistribution */
+    float cone, cone_start;           /* quad, disk: the emission's cone (PxrRectLight's coneAngle,
+                                         USD's shaping:cone), radians off the normal: the light
+                                         fades from cone_start to cone and is 0 beyond; 0: none */
     Mat4 world_from_light, light_from_world; /* environment: the map's rotation */
     LightEnvMap *env;                        /* environment: NULL for a constant one; point and spot
                                                 lights: their intensity by direction, or NULL */

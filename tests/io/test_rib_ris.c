@@ -157,6 +157,13 @@ static void test_lights(void)
                     "\"float coneAngle\" [20]\n" TRI)) == RAYES_OK);
     CHECK(rec.n_light == 1 && param(light(), "shadows", 0) == 0.0f &&
           param(light(), "__nondiffuse", 0) == 1.0f && rec_param(light(), "__nonspecular") == NULL);
+    /* a rect light's coneAngle is rayes' arealight cone (degrees) */
+    CHECK(param(light(), "cone", 0) == 20.0f && param(light(), "conesoftness", 0) == 0.0f);
+    /* and what the writer writes back reads so */
+    CHECK(rib(WORLD("LightSource \"arealight\" 1 \"float cone\" [30] \"float conesoftness\" "
+                    "[0.25]\n" TRI)) == RAYES_OK);
+    CHECK(rec.n_light == 1 && param(light(), "cone", 0) == 30.0f &&
+          param(light(), "conesoftness", 0) == 0.25f);
     /* on after its block: the triangle is linked to every light */
     CHECK(rec.links_mode == RAYES_LIGHT_LINKS_ALL);
     /* areaNormalize: over the area of the square as scaled (2 x 3) and
@@ -639,6 +646,34 @@ static void test_light_filters(void)
 /* PxrMeshLight: the geometry after it in its block emits intensity
  * times lightColor (a quad as a quad light, triangles as a mesh light);
  * geometry after the block does not. */
+/* PxrRectLight's coneAngle: the floor below the light as lit as without a
+ * cone, the walls beyond it dark (no bounces); coneSoftness fades the
+ * edge, leaving the walls between. */
+static void test_light_cone(void)
+{
+    RayesImage *full = render_box("Light \"PxrRectLight\" \"k\" \"float intensity\" [6]", "");
+    RayesImage *cone = render_box(
+        "Light \"PxrRectLight\" \"k\" \"float intensity\" [6] \"float coneAngle\" [25]", "");
+    RayesImage *soft = render_box("Light \"PxrRectLight\" \"k\" \"float intensity\" [6] "
+                                  "\"float coneAngle\" [60] \"float coneSoftness\" [0.5]",
+                                  "");
+    CHECK(full && cone && soft);
+    if (full && cone && soft) {
+        double floor_full = region(full, 1, 12, 20, 27, 32),
+               floor_cone = region(cone, 1, 12, 20, 27, 32);
+        double wall_full = region(full, 1, 0, 3, 4, 14), wall_cone = region(cone, 1, 0, 3, 4, 14);
+        double wall_soft = region(soft, 1, 0, 3, 4, 14);
+        printf("  floor: %.4f, cone 25 %.4f; wall: %.4f, cone 25 %.4f, cone 60 soft %.4f\n",
+               floor_full, floor_cone, wall_full, wall_cone, wall_soft);
+        CHECK(fabs(floor_cone - floor_full) < 0.03 * floor_full);
+        CHECK(wall_cone < 0.05 * wall_full && wall_full > 0.01);
+        CHECK(wall_soft > wall_cone && wall_soft < wall_full);
+    }
+    rayes_image_free(full);
+    rayes_image_free(cone);
+    rayes_image_free(soft);
+}
+
 static void test_mesh_light(void)
 {
     CHECK(rib(WORLD(
@@ -839,4 +874,5 @@ static void test_bump_and_displacement(void)
 TEST_MAIN(TEST(test_bxdfs), TEST(test_lights), TEST(test_geometry_lights), TEST(test_integrator),
           TEST(test_options), TEST(test_rendered), TEST(test_dome_visibility),
           TEST(test_tinted_glass), TEST(test_patterns_rendered), TEST(test_bump_and_displacement),
-          TEST(test_subsurface_lobe), TEST(test_mesh_light), TEST(test_light_filters))
+          TEST(test_subsurface_lobe), TEST(test_light_cone), TEST(test_mesh_light),
+          TEST(test_light_filters))
