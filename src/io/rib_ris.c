@@ -779,21 +779,23 @@ static int make_light(Rib *r, const char *handle, const char *cls, const float L
     int sphere = strcasecmp(cls, "PxrSphereLight") == 0,
         dist = strcasecmp(cls, "PxrDistantLight") == 0;
     int dome = strcasecmp(cls, "PxrDomeLight") == 0;
-    if (!rect && !disk && !sphere && !dist && !dome) {
+    int tube = strcasecmp(cls, "PxrCylinderLight") == 0; /* along x, 1 long, 1 across */
+    if (!rect && !disk && !sphere && !dist && !dome && !tube) {
         char key[128];
         snprintf(key, sizeof key, "light %.100s", cls);
         rib_warn_once(
             r, key,
             "light \"%s\" is not one rayes translates (PxrRectLight, PxrDiskLight, "
-            "PxrSphereLight, PxrDistantLight, PxrDomeLight, PxrEnvDayLight, PxrMeshLight); "
+            "PxrSphereLight, PxrCylinderLight, PxrDistantLight, PxrDomeLight, PxrEnvDayLight, "
+            "PxrMeshLight); "
             "the light is skipped",
             cls);
         return 0;
     }
     float scale = 1; /* normalize: radiance over the area of the shape as placed */
-    if (normalize && (rect || disk || sphere)) {
+    if (normalize && (rect || disk || sphere || tube)) {
         float area = plane_scale(r->a.M) * (rect ? 1.0f : (float)M_PI * 0.25f);
-        if (sphere) /* a uniform scale s: 4 pi (s / 2)^2, s^2 from the plane's */
+        if (sphere || tube) /* a uniform scale s: 4 pi (s / 2)^2, or pi s s (its side) */
             area = plane_scale(r->a.M) * (float)M_PI;
         scale = area > 0 ? 1.0f / area : 1.0f;
     } else if (dist && !normalize) {
@@ -820,9 +822,12 @@ static int make_light(Rib *r, const char *handle, const char *cls, const float L
     float v[3] = {I, 0, 0};
     rib_light_param(l, "intensity", RAYES_PARAM_FLOAT, v, NULL);
     rib_light_param(l, "lightcolor", RAYES_PARAM_COLOR, c, NULL);
-    if (rect || disk || sphere) {
+    if (rect || disk || sphere || tube) {
         rib_light_param(l, "shape", RAYES_PARAM_STRING, NULL,
-                        rect ? "quad" : disk ? "disk" : "sphere");
+                        rect     ? "quad"
+                        : disk   ? "disk"
+                        : sphere ? "sphere"
+                                 : "cylinder");
         float half[3] = {0.5f, 0, 0};
         if (!rect)
             rib_light_param(l, "radius", RAYES_PARAM_FLOAT, half, NULL);
@@ -1127,8 +1132,9 @@ static int h_light(Rib *r, const Args *a)
     if (e > 0)
         light_controls(r, cls, &r->lights[r->n_lights - 1], p, n);
     free(p);
-    if (e > 0 && (strcasecmp(cls, "PxrRectLight") == 0 || strcasecmp(cls, "PxrDiskLight") == 0 ||
-                  strcasecmp(cls, "PxrSphereLight") == 0)) {
+    if (e > 0 &&
+        (strcasecmp(cls, "PxrRectLight") == 0 || strcasecmp(cls, "PxrDiskLight") == 0 ||
+         strcasecmp(cls, "PxrSphereLight") == 0 || strcasecmp(cls, "PxrCylinderLight") == 0)) {
         /* RenderMan 21's lights are not seen by the camera unless said */
         Light *l = &r->lights[r->n_lights - 1];
         l->own_visibility = 1;
@@ -1145,11 +1151,10 @@ static int h_light(Rib *r, const Args *a)
 
 int rib_ris_geometry_light(Rib *r, const char *name)
 {
-    static const char *const shapes[][2] = {{"rectlight", "PxrRectLight"},
-                                           {"disklight", "PxrDiskLight"},
-                                           {"spherelight", "PxrSphereLight"},
-                                           {"distantlight", "PxrDistantLight"},
-                                           {"envsphere", "PxrDomeLight"}};
+    static const char *const shapes[][2] = {
+        {"rectlight", "PxrRectLight"},       {"disklight", "PxrDiskLight"},
+        {"spherelight", "PxrSphereLight"},   {"cylinderlight", "PxrCylinderLight"},
+        {"distantlight", "PxrDistantLight"}, {"envsphere", "PxrDomeLight"}};
     const char *cls = NULL;
     for (size_t k = 0; k < sizeof shapes / sizeof shapes[0]; k++)
         if (strcmp(name, shapes[k][0]) == 0)

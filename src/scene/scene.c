@@ -2092,6 +2092,35 @@ RayesError rayes_scene_light(RayesScene *s, const char *type, const RayesParam *
     }
     if (!(lp.radius > 0.0f))
         return scene_fail(s, RAYES_ERROR_INVALID_ARGUMENT, "arealight: expected a positive radius");
+    if (strcmp(lp.shape, "cylinder") == 0) { /* RenderMan's tube: along object x, width long */
+        if (!(lp.width > 0.0f))
+            return scene_fail(s, RAYES_ERROR_INVALID_ARGUMENT,
+                              "arealight: expected a cylinder of positive width (its length)");
+        enum { SIDES = 32 };
+        float P[2 * SIDES][3], w = 0.5f * lp.width, L[3] = {l.L.x, l.L.y, l.L.z};
+        int nv[SIDES], idx[4 * SIDES];
+        for (int k = 0; k < SIDES; k++) {
+            float a = 2.0f * (float)M_PI * (float)k / SIDES;
+            float y = lp.radius * cosf(a), z = lp.radius * sinf(a);
+            P[2 * k][0] = -w, P[2 * k][1] = y, P[2 * k][2] = z;
+            P[2 * k + 1][0] = w, P[2 * k + 1][1] = y, P[2 * k + 1][2] = z;
+            int n = (k + 1) % SIDES; /* counter-clockwise seen from outside */
+            nv[k] = 4;
+            idx[4 * k] = 2 * k, idx[4 * k + 1] = 2 * n, idx[4 * k + 2] = 2 * n + 1;
+            idx[4 * k + 3] = 2 * k + 1;
+        }
+        e = rayes_scene_area_light_mesh(s, SIDES, nv, idx, 2 * SIDES, &P[0][0], L, 0);
+        if (e == RAYES_OK) {
+            Light *made = &s->lights[s->n_lights - 1];
+            memcpy(made->category, l.category, sizeof l.category);
+            made->intensity = l.intensity;
+            made->color = l.color;
+            made->shadowless = l.shadowless;
+            made->nondiffuse = l.nondiffuse;
+            made->nonspecular = l.nonspecular;
+        }
+        return e;
+    }
     if (strcmp(lp.shape, "sphere") == 0) {
         l.type = LIGHT_SPHERE;
         l.from = mat4_point(m, v3(0, 0, 0));
@@ -2127,7 +2156,8 @@ RayesError rayes_scene_light(RayesScene *s, const char *type, const RayesParam *
         return push_light(s, &l, fan, DISK_FAN);
     }
     return scene_fail(s, RAYES_ERROR_INVALID_ARGUMENT,
-                      "arealight: unknown shape \"%s\"; expected quad, disk or sphere", lp.shape);
+                      "arealight: unknown shape \"%s\"; expected quad, disk, sphere or cylinder",
+                      lp.shape);
 }
 
 /* ------------------------------------------------------------ edits */

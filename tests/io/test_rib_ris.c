@@ -674,6 +674,31 @@ static void test_light_cone(void)
     rayes_image_free(soft);
 }
 
+/* PxrCylinderLight: a tube along its x, 1 long and 1 across, lights the
+ * room as the same tube made by a classic area light's Cylinder does. */
+static void test_cylinder_light(void)
+{
+    CHECK(rib(WORLD("Light \"PxrCylinderLight\" \"t\" \"float intensity\" [2]\n" TRI)) == RAYES_OK);
+    const RayesParam *shape = rec.n_light == 1 ? rec_param(light(), "shape") : NULL;
+    CHECK(shape && strcmp(shape->string, "cylinder") == 0 && param(light(), "radius", 0) == 0.5f);
+    RayesImage *tube = render_box("Scale 0.6 0.6 0.6\nTranslate 0 0 0.5\n"
+                                  "Light \"PxrCylinderLight\" \"t\" \"float intensity\" [3]",
+                                  "");
+    RayesImage *classic = render_box("Scale 0.6 0.6 0.6\nTranslate 0 0 0.5\nRotate 90 0 1 0\n"
+                                     "Attribute \"visibility\" \"int camera\" [0]\n"
+                                     "AreaLightSource \"arealight\" 1 \"lightcolor\" [3 3 3]\n"
+                                     "Cylinder 0.5 -0.5 0.5 360",
+                                     "");
+    CHECK(tube && classic);
+    if (tube && classic) {
+        double a = mean(tube, 1, 0), b = mean(classic, 1, 0);
+        printf("  PxrCylinderLight %.4f, a classic Cylinder area light %.4f\n", a, b);
+        CHECK(a > 0.02 && fabs(a - b) < 0.03 * b);
+    }
+    rayes_image_free(tube);
+    rayes_image_free(classic);
+}
+
 static void test_mesh_light(void)
 {
     CHECK(rib(WORLD(
@@ -874,5 +899,5 @@ static void test_bump_and_displacement(void)
 TEST_MAIN(TEST(test_bxdfs), TEST(test_lights), TEST(test_geometry_lights), TEST(test_integrator),
           TEST(test_options), TEST(test_rendered), TEST(test_dome_visibility),
           TEST(test_tinted_glass), TEST(test_patterns_rendered), TEST(test_bump_and_displacement),
-          TEST(test_subsurface_lobe), TEST(test_light_cone), TEST(test_mesh_light),
-          TEST(test_light_filters))
+          TEST(test_subsurface_lobe), TEST(test_light_cone), TEST(test_cylinder_light),
+          TEST(test_mesh_light), TEST(test_light_filters))
