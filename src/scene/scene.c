@@ -1684,6 +1684,20 @@ static const LightParamDesc light_param_descs[] = {
     {"blockerround", RAYES_PARAM_FLOAT, offsetof(LightParams, blockerround), 1},
 };
 
+/* An area light made as geometry (a quad, a tube) takes the controls its
+ * parameters gave l: category, intensity and colour kept apart, shadows,
+ * diffuse and specular switches, the cone. */
+static void take_controls(Light *made, const Light *l)
+{
+    memcpy(made->category, l->category, sizeof l->category);
+    made->intensity = l->intensity;
+    made->color = l->color;
+    made->shadowless = l->shadowless;
+    made->nondiffuse = l->nondiffuse;
+    made->nonspecular = l->nonspecular;
+    made->cone = l->cone, made->cone_start = l->cone_start;
+}
+
 static RayesError light_params(RayesScene *s, const char *type, const RayesParam *params,
                                size_t n_params, LightParams *lp)
 {
@@ -2078,16 +2092,8 @@ RayesError rayes_scene_light(RayesScene *s, const char *type, const RayesParam *
         const float P[4][3] = {{-w, -h, 0}, {w, -h, 0}, {w, h, 0}, {-w, h, 0}};
         float L[3] = {l.L.x, l.L.y, l.L.z};
         e = rayes_scene_area_light(s, P, L);
-        if (e == RAYES_OK) {
-            Light *made = &s->lights[s->n_lights - 1];
-            memcpy(made->category, l.category, sizeof l.category);
-            made->intensity = l.intensity;
-            made->color = l.color;
-            made->shadowless = l.shadowless;
-            made->nondiffuse = l.nondiffuse;
-            made->nonspecular = l.nonspecular;
-            made->cone = l.cone, made->cone_start = l.cone_start;
-        }
+        if (e == RAYES_OK)
+            take_controls(&s->lights[s->n_lights - 1], &l);
         return e;
     }
     if (!(lp.radius > 0.0f))
@@ -2110,15 +2116,8 @@ RayesError rayes_scene_light(RayesScene *s, const char *type, const RayesParam *
             idx[4 * k + 3] = 2 * k + 1;
         }
         e = rayes_scene_area_light_mesh(s, SIDES, nv, idx, 2 * SIDES, &P[0][0], L, 0);
-        if (e == RAYES_OK) {
-            Light *made = &s->lights[s->n_lights - 1];
-            memcpy(made->category, l.category, sizeof l.category);
-            made->intensity = l.intensity;
-            made->color = l.color;
-            made->shadowless = l.shadowless;
-            made->nondiffuse = l.nondiffuse;
-            made->nonspecular = l.nonspecular;
-        }
+        if (e == RAYES_OK)
+            take_controls(&s->lights[s->n_lights - 1], &l);
         return e;
     }
     if (strcmp(lp.shape, "sphere") == 0) {
