@@ -1585,10 +1585,15 @@ int scene_prepare(const RayesScene *s, int width, int height, const DiceOptions 
         return prepare_stopped(DICE_STOPPED, err, err_size);
     if (failed)
         return -1;
-    if (first_need)
+    if (first_need) /* over the budget still: primitives diced finer than it allows
+                       (a dense mesh's faces take 3 or 4 vertices however far they are) */
         log_warning("dicing: the scene needs %zu grid vertices, more than the budget of %zu "
-                    "(--vertex-budget); micropolygons made %.2f times longer (%zu vertices)",
-                    first_need, budget, rate_scale, gs->n_vertices);
+                    "(--vertex-budget); micropolygons made %.2f times longer (%zu vertices%s)",
+                    first_need, budget, rate_scale, gs->n_vertices,
+                    gs->n_vertices > budget
+                        ? "; still over it: its primitives dice no coarser, a mesh's faces "
+                          "keeping 3 or 4 vertices however small"
+                        : "");
     if (s->n_solids) { /* the solids' tree, blocks still open closed at the end */
         if (!(gs->solids = malloc(s->n_solids * sizeof *gs->solids)))
             return -1;
