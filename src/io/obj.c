@@ -1150,6 +1150,19 @@ static int clear_glass(Obj *o, const Material *m)
     return max3(m->Kd) <= 0.2f || T[0] >= 0.5f;
 }
 
+/* Sends pattern name of class cls for material m's part what ("map_d",
+ * "its bump map"); RAYES_OK, or the sink's error said. */
+static RayesError obj_pattern(Emit *e, const Material *m, const char *what, const char *name,
+                              const char *cls, const RayesParam *q, size_t n)
+{
+    RayesError r = e->sink->pattern(e->sink->target, name, cls, q, n);
+    if (r == RAYES_OK)
+        return r;
+    char said[200];
+    snprintf(said, sizeof said, "material \"%s\": %s", m->name, what);
+    return sink_fail(e, r, said);
+}
+
 /* The opacity of material m as the reserved shader parameter "Os" in *out
  * (its name NULL for an opaque material): d, or map_d's texture (times d),
  * a pattern made once per material under a name that starts with a space
@@ -1176,12 +1189,9 @@ static RayesError opacity_of(Emit *e, Material *m, char cutout[48], RayesParam *
                            {"encoding", RAYES_PARAM_STRING, {0, 0, 0}, "linear"},
                            {"channel", RAYES_PARAM_FLOAT, {(float)m->map_d_channel, 0, 0}, NULL},
                            {"scale", RAYES_PARAM_FLOAT, {d, 0, 0}, NULL}};
-        RayesError r = e->sink->pattern(e->sink->target, cutout, "imagemap", q, 4);
-        if (r != RAYES_OK) {
-            char what[200];
-            snprintf(what, sizeof what, "material \"%s\": map_d", m->name);
-            return sink_fail(e, r, what);
-        }
+        RayesError r = obj_pattern(e, m, "map_d", cutout, "imagemap", q, 4);
+        if (r != RAYES_OK)
+            return r;
         m->map_d_sent = 1;
     }
     *out = (RayesParam){"Os", RAYES_PARAM_PATTERN, {1, 1, 1}, cutout};
@@ -1222,9 +1232,9 @@ static RayesError bump_of(Emit *e, Material *m, char names[2][48], RayesParam *o
                            {"encoding", RAYES_PARAM_STRING, {0, 0, 0}, "linear"},
                            {"channel", RAYES_PARAM_FLOAT, {j == 0 ? -3.0f : -4.0f, 0, 0}, NULL},
                            {"scale", RAYES_PARAM_FLOAT, {m->bump_mult, 0, 0}, NULL}};
-        RayesError r = e->sink->pattern(e->sink->target, names[j], "imagemap", q, 4);
+        RayesError r = obj_pattern(e, m, "its bump map", names[j], "imagemap", q, 4);
         if (r != RAYES_OK)
-            return sink_fail(e, r, what);
+            return r;
     }
     m->bump_sent = 1;
     const RayesParam d[2] = {{"amount", RAYES_PARAM_PATTERN, {0, 0, 0}, names[0]},
@@ -1244,18 +1254,6 @@ static int pbr_material(const Material *m)
     return m->Pr >= 0.0f || m->Pm >= 0.0f || m->map_Pr[0] || m->map_Pm[0];
 }
 
-/* Sends pattern name of class cls; RAYES_OK, or the sink's error said. */
-static RayesError obj_pattern(Emit *e, const Material *m, const char *name, const char *cls,
-                              const RayesParam *q, size_t n)
-{
-    RayesError r = e->sink->pattern(e->sink->target, name, cls, q, n);
-    if (r == RAYES_OK)
-        return r;
-    char what[200];
-    snprintf(what, sizeof what, "material \"%s\": its textures", m->name);
-    return sink_fail(e, r, what);
-}
-
 /* The PBR patterns of material m (once): its base colour (map_Kd, sRGB),
  * its roughness as rayes' (alpha squared: the map's Disney roughness to
  * the fourth, as scale patterns of it by itself) and its metallic (map_Pm,
@@ -1271,7 +1269,7 @@ static RayesError pbr_patterns(Emit *e, Material *m, char names[3][48])
     RayesError r = RAYES_OK;
     if (m->map_Kd[0]) {
         const RayesParam q = {"filename", RAYES_PARAM_STRING, {0, 0, 0}, m->map_Kd};
-        r = obj_pattern(e, m, names[0], "imagemap", &q, 1);
+        r = obj_pattern(e, m, "its textures", names[0], "imagemap", &q, 1);
     }
     if (r == RAYES_OK && m->map_Pr[0]) {
         char r1[48], r2[48];
@@ -1285,18 +1283,18 @@ static RayesError pbr_patterns(Emit *e, Material *m, char names[3][48])
                                   {"scale", RAYES_PARAM_PATTERN, {0, 0, 0}, r1}};
         const RayesParam fourth[2] = {{"tex", RAYES_PARAM_PATTERN, {0, 0, 0}, r2},
                                       {"scale", RAYES_PARAM_PATTERN, {0, 0, 0}, r2}};
-        r = obj_pattern(e, m, r1, "imagemap", q, 3);
+        r = obj_pattern(e, m, "its textures", r1, "imagemap", q, 3);
         if (r == RAYES_OK)
-            r = obj_pattern(e, m, r2, "scale", sq, 2);
+            r = obj_pattern(e, m, "its textures", r2, "scale", sq, 2);
         if (r == RAYES_OK)
-            r = obj_pattern(e, m, names[1], "scale", fourth, 2);
+            r = obj_pattern(e, m, "its textures", names[1], "scale", fourth, 2);
     }
     if (r == RAYES_OK && m->map_Pm[0]) {
         const RayesParam q[3] = {
             {"filename", RAYES_PARAM_STRING, {0, 0, 0}, m->map_Pm},
             {"encoding", RAYES_PARAM_STRING, {0, 0, 0}, "linear"},
             {"channel", RAYES_PARAM_FLOAT, {(float)m->map_Pm_channel, 0, 0}, NULL}};
-        r = obj_pattern(e, m, names[2], "imagemap", q, 3);
+        r = obj_pattern(e, m, "its textures", names[2], "imagemap", q, 3);
     }
     m->pbr_sent = r == RAYES_OK;
     return r;
@@ -1401,16 +1399,15 @@ static RayesError material_shader(Emit *e, Material *m)
     n += p[n].name != NULL;
     float ks = max3(m->Ks);
     char ks_map[48];
+    snprintf(ks_map, sizeof ks_map, " obj Ks %zu", (size_t)(m - e->o->mats));
     int mapped = m->map_Ks[0] && e->sink->pattern;
     if (mapped && !m->map_Ks_sent) { /* map_Ks times Ks (the map alone when Ks is 0) */
-        snprintf(ks_map, sizeof ks_map, " obj Ks %zu", (size_t)(m - e->o->mats));
         const RayesParam q[2] = {{"filename", RAYES_PARAM_STRING, {0, 0, 0}, m->map_Ks},
                                  {"scale", RAYES_PARAM_FLOAT, {ks > 0.0f ? ks : 1.0f, 0, 0}, NULL}};
-        if ((r = obj_pattern(e, m, ks_map, "imagemap", q, 2)) != RAYES_OK)
+        if ((r = obj_pattern(e, m, "map_Ks", ks_map, "imagemap", q, 2)) != RAYES_OK)
             return r;
         m->map_Ks_sent = 1;
     }
-    snprintf(ks_map, sizeof ks_map, " obj Ks %zu", (size_t)(m - e->o->mats));
     if (!m->map_Kd[0] && !(ks > 0.0f) && !mapped)
         return set_shader(e, "matte", p, n, m->name);
     p[n++] = (RayesParam){"Kd", RAYES_PARAM_FLOAT, {1, 0, 0}, NULL};

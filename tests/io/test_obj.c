@@ -602,16 +602,19 @@ static void write_columns(const char *path, int w, int h,
     fclose(f);
 }
 
-static void tilt_texel(int x, int w, unsigned char c[3]) /* n = (-0.3, 0, 0.954) */
+/* Writes a w x h binary PPM of one colour. */
+static void write_solid(const char *path, int w, int h, int r, int g, int b)
 {
-    (void)x, (void)w;
-    c[0] = 89, c[1] = 128, c[2] = 249;
-}
-
-static void flat_texel(int x, int w, unsigned char c[3])
-{
-    (void)x, (void)w;
-    c[0] = 128, c[1] = 128, c[2] = 255;
+    FILE *f = fopen(path, "wb");
+    CHECK(f != NULL);
+    if (!f)
+        return;
+    fprintf(f, "P6 %d %d 255\n", w, h);
+    for (int i = 0; i < w * h; i++) {
+        const unsigned char c[3] = {(unsigned char)r, (unsigned char)g, (unsigned char)b};
+        fwrite(c, 1, 3, f);
+    }
+    fclose(f);
 }
 
 static void ramp_texel(int x, int w, unsigned char c[3]) /* grey, rising along u */
@@ -629,8 +632,8 @@ static void test_bump_maps(void)
 {
     mkdir(RAYES_TEST_TMP, 0777);
     mkdir(DIR, 0777);
-    write_columns(DIR "/tilt.ppm", 8, 8, tilt_texel);
-    write_columns(DIR "/flatn.ppm", 8, 8, flat_texel);
+    write_solid(DIR "/tilt.ppm", 8, 8, 89, 128, 249); /* n = (-0.3, 0, 0.954) */
+    write_solid(DIR "/flatn.ppm", 8, 8, 128, 128, 255);
     write_columns(DIR "/ramp.ppm", 64, 4, ramp_texel);
     RayesImage *plain = render_cut("");
     RayesImage *tilt = render_cut("map_Bump -bm 1.0 tilt.ppm");
@@ -673,26 +676,14 @@ static void test_bump_maps(void)
     rayes_image_free(down);
 }
 
-static void white_texel(int x, int w, unsigned char c[3])
-{
-    (void)x, (void)w;
-    c[0] = c[1] = c[2] = 255;
-}
-
-static void black_texel(int x, int w, unsigned char c[3])
-{
-    (void)x, (void)w;
-    c[0] = c[1] = c[2] = 0;
-}
-
 /* map_Ks: the highlight's colour by a texture (times Ks): a white map is
  * the highlight of Ks alone, a black one none. */
 static void test_specular_map(void)
 {
     mkdir(RAYES_TEST_TMP, 0777);
     mkdir(DIR, 0777);
-    write_columns(DIR "/white.ppm", 4, 4, white_texel);
-    write_columns(DIR "/black.ppm", 4, 4, black_texel);
+    write_solid(DIR "/white.ppm", 4, 4, 255, 255, 255);
+    write_solid(DIR "/black.ppm", 4, 4, 0, 0, 0);
     RayesImage *shiny = render_cut("Ks 1 1 1\nNs 4");
     RayesImage *white = render_cut("Ks 1 1 1\nNs 4\nmap_Ks white.ppm");
     RayesImage *black = render_cut("Ks 1 1 1\nNs 4\nmap_Ks black.ppm");
