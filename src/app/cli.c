@@ -737,6 +737,18 @@ RayesError command_line_camera(const Args *a, RayesScene *scene)
     return e == RAYES_OK ? rayes_scene_set_depth_of_field(scene, 0.0f, 1.0f) : e;
 }
 
+IoReadOptions read_options(const Args *a, int frame)
+{
+    IoReadOptions ro = {
+        .data_dir = a->data_dir, .frame = frame, .bounces_given = (a->set & SET_BOUNCES) != 0};
+    ro.view = (a->camera & CAMERA_FROM ? IO_VIEW_FROM : 0) |
+              (a->camera & CAMERA_AT ? IO_VIEW_AT : 0) | (a->camera & CAMERA_UP ? IO_VIEW_UP : 0);
+    memcpy(ro.view_from, a->look_from, sizeof ro.view_from);
+    memcpy(ro.view_at, a->look_at, sizeof ro.view_at);
+    memcpy(ro.view_up, a->up, sizeof ro.view_up);
+    return ro;
+}
+
 RayesError default_light(const Args *a, const IoSettings *s, RayesScene *scene)
 {
     if (rayes_scene_light_count(scene) > 0)
@@ -751,11 +763,14 @@ RayesError default_light(const Args *a, const IoSettings *s, RayesScene *scene)
     if (e != RAYES_OK)
         return e;
     static const float identity[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
-    RayesParam p[3] = {{"from", RAYES_PARAM_COLOR, {0, 0, 0}, NULL},
+    /* no shadows: a camera inside a room would have them all (the wall
+     * behind it), and in front of the camera there are none to see */
+    RayesParam p[4] = {{"from", RAYES_PARAM_COLOR, {0, 0, 0}, NULL},
                        {"to", RAYES_PARAM_COLOR, {z[0], z[1], z[2]}, NULL},
-                       {"intensity", RAYES_PARAM_FLOAT, {(float)M_PI, 0, 0}, NULL}}; /* Cs */
+                       {"intensity", RAYES_PARAM_FLOAT, {(float)M_PI, 0, 0}, NULL}, /* Cs */
+                       {"shadows", RAYES_PARAM_FLOAT, {0, 0, 0}, NULL}};
     if ((e = rayes_scene_set_transform(scene, identity)) == RAYES_OK)
-        e = rayes_scene_light(scene, "distantlight", p, 3);
+        e = rayes_scene_light(scene, "distantlight", p, 4);
     if (e == RAYES_OK && !a->quiet)
         fprintf(stderr, "rayes: note: %s: the scene has no lights; a headlight was added\n",
                 a->scene);

@@ -118,10 +118,14 @@ void merge_settings(Args *a, const IoSettings *s);
  * returned (the scene's error names a degenerate view). */
 RayesError command_line_camera(const Args *a, RayesScene *scene);
 
+/* The reader's options for a's scene and frame: the data folder, whether
+ * the bounces are given, the command line's view (for OBJ's default light). */
+IoReadOptions read_options(const Args *a, int frame);
+
 /* A loaded scene without lights (before its commit): one warning, or with
  * --default-light (or a file that asks for one, s->headlight) a headlight,
- * a distant light of intensity 1 along the view. Returns what adding it returned (RAYES_OK when
- * nothing was added). */
+ * a distant light of intensity 1 along the view that casts no shadows. Returns what adding it
+ * returned (RAYES_OK when nothing was added). */
 RayesError default_light(const Args *a, const IoSettings *s, RayesScene *scene);
 
 /* The usage text of every command, to f. */

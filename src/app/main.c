@@ -532,8 +532,7 @@ static int render_job(Args a, int frame, int number, Distributed *d)
     }
     IoSettings settings;
     IoSink sink = io_sink_scene(scene);
-    IoReadOptions ro = {
-        .data_dir = a.data_dir, .frame = frame, .bounces_given = (a.set & SET_BOUNCES) != 0};
+    IoReadOptions ro = read_options(&a, frame);
     RayesError e = load_scene(a.scene, &ro, &sink, &settings, err, sizeof err);
     if (e == RAYES_OK && (e = command_line_camera(&a, scene)) != RAYES_OK)
         snprintf(err, sizeof err, "%s: the command line's camera: %s", a.scene,

@@ -792,8 +792,7 @@ int cmd_view(int argc, char **argv)
     char err[1024];
     IoSettings settings;
     IoSink sink = io_sink_scene(v.scene);
-    IoReadOptions ro = {
-        .data_dir = a.data_dir, .frame = a.frame, .bounces_given = (a.set & SET_BOUNCES) != 0};
+    IoReadOptions ro = read_options(&a, a.frame);
     RayesError e = load_scene(a.scene, &ro, &sink, &settings, err, sizeof err);
     if (e == RAYES_OK && (e = command_line_camera(&a, v.scene)) != RAYES_OK)
         snprintf(err, sizeof err, "%s: the command line's camera: %s", a.scene,

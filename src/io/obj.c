@@ -1064,6 +1064,7 @@ typedef struct Emit {
     int *local;          /* global vertex -> mesh vertex, -1 unused */
     FloatVec P;
     int bumped; /* the last material sent had a bump map (a displacement) */
+    const IoReadOptions *ro; /* the caller's view, for the default light; may be NULL */
 } Emit;
 
 static RayesError sink_fail(Emit *e, RayesError r, const char *what)
@@ -1722,10 +1723,22 @@ static RayesError emit_material(Emit *e, int mi)
     return r;
 }
 
+static void unit3(float v[3])
+{
+    float len = sqrtf(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+    for (int k = 0; k < 3 && len > 0.0f; k++)
+        v[k] /= len;
+}
+
 /* The default camera: on the +z side of the bounds' centre, looking down
  * -z with +y up, far enough that the bounding sphere fits a 40 degree
- * field of view. The default light: a distant light of intensity 1 from the
- * camera's upper left (the direction (-1, 1, 1) from the centre). */
+ * field of view. The default light follows the view the image is made
+ * from (this one, or the caller's, view): seen from outside the bounds, a
+ * distant light of intensity 1 from the view's upper left and behind
+ * (the direction (-1, 1, 1) from the centre for the default view); from
+ * inside them (a room, a courtyard), where walls would shadow any light
+ * from outside, a headlight: a distant light along the view that casts no
+ * shadows, as --default-light adds. */
 static RayesError emit_camera(Emit *e, int light)
 {
     float c[3], r2 = 0.0f;
@@ -1743,19 +1756,46 @@ static RayesError emit_camera(Emit *e, int light)
         return sink_fail(e, res, "the default camera");
     if (!light)
         return RAYES_OK;
-    const RayesParam p[3] = {
-        {"from", RAYES_PARAM_COLOR, {c[0] - d, c[1] + d, c[2] + d}, NULL},
-        {"to", RAYES_PARAM_COLOR, {c[0], c[1], c[2]}, NULL},
+    /* the view the image is made from: the caller's eye, point and up
+     * where it sets them (a point not set is straight ahead) */
+    unsigned v = e->ro ? e->ro->view : 0;
+    float E[3], Z[3], Y[3], X[3];
+    for (int k = 0; k < 3; k++) {
+        E[k] = v & IO_VIEW_FROM ? e->ro->view_from[k] : eye[k];
+        Z[k] = v & IO_VIEW_AT ? e->ro->view_at[k] - E[k] : c[k] - eye[k];
+        Y[k] = v & IO_VIEW_UP ? e->ro->view_up[k] : up[k];
+    }
+    unit3(Z);
+    float yz = Y[0] * Z[0] + Y[1] * Z[1] + Y[2] * Z[2];
+    for (int k = 0; k < 3; k++)
+        Y[k] -= yz * Z[k];
+    unit3(Y);
+    X[0] = Z[1] * Y[2] - Z[2] * Y[1]; /* the image's right */
+    X[1] = Z[2] * Y[0] - Z[0] * Y[2];
+    X[2] = Z[0] * Y[1] - Z[1] * Y[0];
+    int inside = !empty;
+    for (int k = 0; k < 3; k++)
+        inside &= E[k] > e->lo[k] && E[k] < e->hi[k];
+    RayesParam p[4] = {
+        {"from", RAYES_PARAM_COLOR, {0, 0, 0}, NULL},
+        {"to", RAYES_PARAM_COLOR, {Z[0], Z[1], Z[2]}, NULL},
         {"intensity", RAYES_PARAM_FLOAT, {(float)M_PI, 0, 0}, NULL}, /* facing: Cs */
+        {"shadows", RAYES_PARAM_FLOAT, {0, 0, 0}, NULL},
     };
-    res = e->sink->light(e->sink->target, "distantlight", p, 3);
+    if (!inside)
+        for (int k = 0; k < 3; k++) /* toward the centre from the view's upper left, behind */
+            p[0].value[k] = c[k] + d * (Y[k] - X[k] - Z[k]), p[1].value[k] = c[k];
+    res = e->sink->light(e->sink->target, "distantlight", p, inside ? 4 : 3);
     return res == RAYES_OK ? RAYES_OK : sink_fail(e, res, "the default light");
 }
 
-static RayesError obj_emit(Obj *o, const IoSink *sink)
+static RayesError obj_emit(Obj *o, const IoSink *sink, const IoReadOptions *ro)
 {
     static const float identity[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
-    Emit e = {.o = o, .sink = sink, .lo = {INFINITY, INFINITY, INFINITY},
+    Emit e = {.o = o,
+              .sink = sink,
+              .ro = ro,
+              .lo = {INFINITY, INFINITY, INFINITY},
               .hi = {-INFINITY, -INFINITY, -INFINITY}};
     for (size_t i = 0; i < o->n_mats; i++)
         if (!o->mats[i].defined)
@@ -1797,7 +1837,7 @@ RayesError io_obj_parse(const char *name, const unsigned char *data, size_t size
                         const IoSink *sink, const IoReadOptions *options, IoSettings *settings,
                         char *err, size_t err_size)
 {
-    (void)options, (void)settings; /* OBJ sets no render settings */
+    (void)settings; /* OBJ sets no render settings */
     Obj o = {.name = name, .cur_mat = -1, .err = err, .err_size = err_size};
     err[0] = '\0';
     dir_of(name, o.dir, sizeof o.dir);
@@ -1805,7 +1845,7 @@ RayesError io_obj_parse(const char *name, const unsigned char *data, size_t size
     if (obj_parse_text(&o, (const char *)data, size) != 0)
         r = strstr(err, "out of memory") ? RAYES_ERROR_OUT_OF_MEMORY : RAYES_ERROR_PARSE;
     else
-        r = obj_emit(&o, sink);
+        r = obj_emit(&o, sink, options);
     free(o.v.a);
     free(o.vc.a);
     free(o.face_nv.a);

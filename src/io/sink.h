@@ -203,6 +203,11 @@ typedef struct IoReadOptions {
     int frame;                /* RIB: the frame to read (FrameBegin n); -1: the last frame */
     int bounces_given;        /* the caller sets the diffuse bounces: a file's depth past
                                  the readers' cap is not worth a warning */
+    unsigned view;            /* IO_VIEW_*: what of the view the caller sets after reading
+                                 (the command line's camera; OBJ places its light for it) */
+    float view_from[3], view_at[3], view_up[3];
 } IoReadOptions;
+
+enum { IO_VIEW_FROM = 1, IO_VIEW_AT = 2, IO_VIEW_UP = 4 };
 
 #endif /* RAYES_IO_SINK_H */

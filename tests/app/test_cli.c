@@ -780,6 +780,48 @@ static double exr_mean_red(const char *path)
     return sum / (w * h);
 }
 
+/* A closed room seen from inside, with no lights: OBJ's default light and
+ * --default-light's headlight light its walls (any light that casts
+ * shadows from outside, or from behind the camera, leaves it black), and
+ * the OBJ's default light is its key light again once the view is outside. */
+static void test_default_light_inside(void)
+{
+    static Run r;
+    setup();
+    static const char *cube = "v -1 -1 -1\nv 1 -1 -1\nv 1 1 -1\nv -1 1 -1\n"
+                              "v -1 -1 1\nv 1 -1 1\nv 1 1 1\nv -1 1 1\n"
+                              "f 1 2 3 4\nf 5 8 7 6\nf 1 5 6 2\nf 4 3 7 8\nf 1 4 8 5\nf 2 6 7 3\n";
+    test_write_text(SCRATCH_DIR "/room.obj", cube);
+    test_write_text(SCRATCH_DIR "/room.rib",
+                    "Projection \"perspective\" \"fov\" 60\nWorldBegin\nSurface \"matte\"\n"
+                    "Scale 2 2 2\nPolygon \"P\" [-1 -1 1 1 -1 1 1 1 1 -1 1 1]\n"
+                    "Polygon \"P\" [-1 -1 -1 -1 1 -1 1 1 -1 1 -1 -1]\n"
+                    "Polygon \"P\" [-1 -1 -1 1 -1 -1 1 -1 1 -1 -1 1]\n"
+                    "Polygon \"P\" [-1 1 -1 -1 1 1 1 1 1 1 1 -1]\n"
+                    "Polygon \"P\" [-1 -1 -1 -1 -1 1 -1 1 1 -1 1 -1]\n"
+                    "Polygon \"P\" [1 -1 -1 1 1 -1 1 1 1 1 -1 1]\nWorldEnd\n");
+    run(&r, NULL,
+        ARGS("render", SCRATCH_DIR "/room.obj", "--res", "16", "--spp", "1", "--quiet",
+             "--look-from", "0.2,0.1,0.5", "--look-at", "0,-0.3,-1", "-o",
+             SCRATCH_DIR "/room_obj.exr"));
+    CHECK(r.status == 0);
+    run(&r, NULL,
+        ARGS("render", SCRATCH_DIR "/room.rib", "--res", "16", "--spp", "1", "--quiet",
+             "--default-light", "-o", SCRATCH_DIR "/room_rib.exr"));
+    CHECK(r.status == 0);
+    run(&r, NULL,
+        ARGS("render", SCRATCH_DIR "/room.obj", "--res", "16", "--spp", "1", "--quiet",
+             "--look-from", "0.2,0.1,5", "--look-at", "0,0,0", "-o",
+             SCRATCH_DIR "/room_outside.exr"));
+    CHECK(r.status == 0);
+    double obj = exr_mean_red(SCRATCH_DIR "/room_obj.exr");
+    double rib = exr_mean_red(SCRATCH_DIR "/room_rib.exr");
+    double outside = exr_mean_red(SCRATCH_DIR "/room_outside.exr");
+    printf("  mean red inside: OBJ's default light %.4f, --default-light %.4f; outside %.4f\n", obj,
+           rib, outside);
+    CHECK(obj > 0.2 && rib > 0.2 && outside > 0.05);
+}
+
 /* --look-from, --look-at, --up and --fov replace the scene's camera: a
  * matte sphere 5 units ahead under a headlight looks the same from behind
  * it as from the file's camera, a view turned away from it is black, and a
@@ -1115,8 +1157,8 @@ TEST_MAIN(TEST(test_version_and_help), TEST(test_no_arguments), TEST(test_usage_
           TEST(test_data_from_environment), TEST(test_unwritable_output), TEST(test_shader_path),
           TEST(test_render_obj), TEST(test_rib_grid_size), TEST(test_spp_over_file_sampling),
           TEST(test_png_curve), TEST(test_rib_opacity_cache_memory), TEST(test_vertex_budget),
-          TEST(test_null_displacement), TEST(test_default_light), TEST(test_camera_options),
-          TEST(test_convert), TEST(test_bad_scene_file), TEST(test_frames_and_crop),
-          TEST(test_background_imager), TEST(test_display_modes),
+          TEST(test_null_displacement), TEST(test_default_light), TEST(test_default_light_inside),
+          TEST(test_camera_options), TEST(test_convert), TEST(test_bad_scene_file),
+          TEST(test_frames_and_crop), TEST(test_background_imager), TEST(test_display_modes),
           TEST(test_light_shadows_attribute), TEST(test_quiet_requests),
           TEST(test_res_width_keeps_aspect), TEST(test_aovs))

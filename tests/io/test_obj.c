@@ -27,6 +27,8 @@
 static Record rec;
 static char err[512];
 
+static IoReadOptions read_options = {NULL, -1};
+
 static RayesError parse(const char *name, const char *text)
 {
     size_t n = strlen(text);
@@ -34,7 +36,7 @@ static RayesError parse(const char *name, const char *text)
     memcpy(copy, text, n);
     IoSink sink = record_sink(&rec);
     IoSettings st;
-    IoReadOptions ro = {NULL, -1};
+    IoReadOptions ro = read_options;
     io_settings_init(&st);
     RayesError e = io_obj_parse(name, (const unsigned char *)copy, n, &sink, &ro, &st, err,
                                 sizeof err);
@@ -345,9 +347,47 @@ static void test_default_camera_and_light(void)
     CHECK(from && from->value[0] < rec.at[0] && from->value[1] > rec.at[1] &&
           from->value[2] > rec.at[2]); /* upper left, in front */
     record_free(&rec);
+    CHECK(!rec_param(&rec.light[0], "shadows")); /* it casts them */
+    record_free(&rec);
     /* an empty file: a camera at the origin's front and a light, no geometry */
     CHECK(parse("e.obj", "") == RAYES_OK);
     CHECK(rec.n_camera == 1 && rec.n_mesh == 0 && rec.n_light == 1);
+    record_free(&rec);
+}
+
+/* The default light follows the view the caller will set: from behind
+ * the geometry (looking down +z) it comes from that view's upper left;
+ * from inside the bounds (a room) it is a headlight along the view that
+ * casts no shadows, since the walls would shadow any other. */
+static void test_default_light_follows_the_view(void)
+{
+    static const char *box = "v -2 -1 -2\nv 2 -1 -2\nv 2 1 2\nf 1 2 3\n";
+    read_options.view = IO_VIEW_FROM | IO_VIEW_AT;
+    memcpy(read_options.view_from, (float[3]){0, 0, -20}, sizeof read_options.view_from);
+    memcpy(read_options.view_at, (float[3]){0, 0, 0}, sizeof read_options.view_at);
+    CHECK(parse("behind.obj", box) == RAYES_OK && rec.n_light == 1);
+    const RayesParam *from = rec_param(&rec.light[0], "from"), *to = rec_param(&rec.light[0], "to");
+    CHECK(from && to);
+    if (from && to) {
+        float dir[3];
+        for (int k = 0; k < 3; k++)
+            dir[k] = from->value[k] - to->value[k];
+        /* the view's right is -x, its up +y, behind it -z */
+        CHECK(dir[0] > 0.5f * fabsf(dir[1]) && dir[1] > 0.0f && dir[2] < -0.5f * dir[1]);
+        CHECK(!rec_param(&rec.light[0], "shadows"));
+    }
+    record_free(&rec);
+    memcpy(read_options.view_from, (float[3]){0.5f, 0, 0}, sizeof read_options.view_from);
+    memcpy(read_options.view_at, (float[3]){0.5f, 0, 1}, sizeof read_options.view_at);
+    CHECK(parse("inside.obj", box) == RAYES_OK && rec.n_light == 1);
+    const RayesParam *shadows = rec_param(&rec.light[0], "shadows");
+    from = rec_param(&rec.light[0], "from"), to = rec_param(&rec.light[0], "to");
+    CHECK(shadows && shadows->value[0] == 0.0f && from && to);
+    if (from && to)
+        CHECK(to->value[2] - from->value[2] > 0.99f &&
+              fabsf(to->value[0] - from->value[0]) < 1e-6f);
+    record_free(&rec);
+    read_options.view = 0;
 }
 
 /* Bad input: the message, and nothing sent to the sink. */
@@ -777,7 +817,8 @@ static void test_transparency(void)
 
 TEST_MAIN(TEST(test_face_syntax), TEST(test_ngons), TEST(test_materials), TEST(test_opacity_words),
           TEST(test_map_paths), TEST(test_bump_maps), TEST(test_pbr_extension),
-          TEST(test_specular_map), TEST(test_default_camera_and_light), TEST(test_errors),
+          TEST(test_specular_map), TEST(test_default_camera_and_light),
+          TEST(test_default_light_follows_the_view), TEST(test_errors),
           TEST(test_unknown_statements), TEST(test_read_file),
           TEST(test_normals_and_texture_coordinates), TEST(test_transparency),
           TEST(test_smoothing_groups), TEST(test_vertex_colours))
