@@ -262,6 +262,32 @@ static Vec3 light_transmittance(Worker *w, const Light *l, Vec3 o, Vec3 wi, floa
     return l->shadowless ? v3(1, 1, 1) : transmittance(w, o, wi, dist, diff);
 }
 
+/* A direction wi that a lobe drew from o toward light l: 1 with the
+ * light's sample there (its pdf) and *Li its radiance times the
+ * transmittance, 0 when it adds nothing. An environment is hit by every
+ * direction, and its map's look-up is a cache miss where the shadow ray
+ * often ends on a wall (an interior lit through its windows): it traces
+ * the ray first and looks the map up only for a direction it sees (the
+ * same sums: an occluded direction adds 0 either way). */
+static int lobe_light(Worker *w, const Light *l, const LightMeshView *v, Vec3 o, Vec3 wi,
+                      RayDiff diff, LightSample *ls, Vec3 *Li)
+{
+    if (l->type == LIGHT_ENVIRONMENT) {
+        if (!light_env_may_emit(l, wi))
+            return 0;
+        Vec3 T = light_transmittance(w, l, o, wi, INFINITY, diff);
+        if (!(v3_max_component(T) > 0.0f) || !light_hit(w, l, v, o, wi, ls) ||
+            !(v3_max_component(ls->Li) > 0.0f))
+            return 0;
+        *Li = v3_mul(ls->Li, T);
+        return 1;
+    }
+    if (!light_hit(w, l, v, o, wi, ls) || !(v3_max_component(ls->Li) > 0.0f))
+        return 0;
+    *Li = v3_mul(ls->Li, light_transmittance(w, l, o, wi, ls->dist, diff));
+    return 1;
+}
+
 /* A delta light's one direction from o (point, spot, distant, uber):
  * 0 when it sends nothing there. The shadow ray is u->sw, u->sdist. */
 static int delta_sample(const Light *l, Vec3 o, LightUberSample *u)
@@ -404,14 +430,12 @@ static void light_area(Worker *w, const DirectPoint *p, const Light *l, uint64_t
             if (cosine) {
                 wi = sample_cosine_frame(p->lobe.t, p->lobe.b, p->N, ca[j], cb[j]);
                 cos_x = v3_dot(p->N, wi);
+                Vec3 Li;
                 if (cos_x > 0.0f && v3_dot(p->Ng, wi) > 0.0f && light_bound_may_hit(&bound, wi) &&
-                    light_hit(w, l, &view, p->o, wi, &ls) && v3_max_component(ls.Li) > 0.0f) {
+                    lobe_light(w, l, &view, p->o, wi, p->shadow, &ls, &Li)) {
                     if (p->guide)
                         ls.pdf *= light_guide_factor(l, p->guide, wi);
-                    sum_d = v3_madd(
-                        sum_d,
-                        v3_mul(ls.Li, light_transmittance(w, l, p->o, wi, ls.dist, p->shadow)),
-                        power_heuristic(cos_x / (float)M_PI, ls.pdf));
+                    sum_d = v3_madd(sum_d, Li, power_heuristic(cos_x / (float)M_PI, ls.pdf));
                 }
             }
             if (!p->spec)
@@ -420,15 +444,14 @@ static void light_area(Worker *w, const DirectPoint *p, const Light *l, uint64_t
             if (!lobe_sample(&p->lobe, ba[j], bb[j], &wi))
                 continue;
             cos_x = v3_dot(p->N, wi);
-            if (cos_x <= 0.0f || v3_dot(p->Ng, wi) <= 0.0f || !light_bound_may_hit(&bound, wi) ||
-                !light_hit(w, l, &view, p->o, wi, &ls) || !(v3_max_component(ls.Li) > 0.0f))
+            if (cos_x <= 0.0f || v3_dot(p->Ng, wi) <= 0.0f || !light_bound_may_hit(&bound, wi))
                 continue;
             float pdf = lobe_pdf(&p->lobe, wi);
-            if (!(pdf > 0.0f))
+            Vec3 Li;
+            if (!(pdf > 0.0f) || !lobe_light(w, l, &view, p->o, wi, p->shadow, &ls, &Li))
                 continue;
             if (p->guide)
                 ls.pdf *= light_guide_factor(l, p->guide, wi);
-            Vec3 Li = v3_mul(ls.Li, light_transmittance(w, l, p->o, wi, ls.dist, p->shadow));
             float f = lobe_f(&p->lobe, wi);
             sum_s = v3_madd(sum_s, Li, power_heuristic(pdf, ls.pdf) * f * cos_x / pdf);
         }

@@ -447,6 +447,13 @@ static int env_bin(const Light *l, Vec3 d)
     return j * LIGHT_GUIDE_U + i;
 }
 
+int light_env_may_emit(const Light *l, Vec3 d)
+{
+    if (!l->env)
+        return v3_max_component(l->L) > 0.0f;
+    return l->env->bin_mass[env_bin(l, d)] > 0.0f;
+}
+
 float light_guide_mass(const Light *l, int b)
 {
     if (l->env)

@@ -341,6 +341,12 @@ float light_guide_factor(const Light *l, const LightGuide *g, Vec3 wi);
 /* The environment light's radiance along world direction d (unit). */
 Vec3 light_env_radiance(const Light *l, Vec3 d);
 
+/* 0 when the environment light l sends nothing along world direction d
+ * (unit): its guide bin there is black (or the light is); 1 when it may.
+ * Reads no pixel of the map (a small table), so a caller can test a
+ * direction's occlusion before paying for the map's look-up. */
+int light_env_may_emit(const Light *l, Vec3 d);
+
 /* How an environment map's pixels lie on the sphere of directions. */
 enum {
     LIGHT_MAP_LATLONG = 0,    /* rayes' latitude-longitude (y up) */
