@@ -617,6 +617,22 @@ RAYES_API RayesError rayes_scene_area_light_mesh(RayesScene *scene, size_t n_fac
                                                  size_t n_points, const float *P, const float L[3],
                                                  int two_sided);
 
+/* rayes_scene_area_light_mesh with an emission texture (a sign, a screen, a
+ * stained window): the radiance at a point is L times the image's colour at
+ * its (s, t), interpolated over each face from st (2 floats a point; (0, 0)
+ * is the image's top left, clamped at its edges as pbrt-v4 reads it),
+ * bilinear on the image's full resolution. Seen so by camera and specular
+ * rays and by the shadow rays that reach it; shadow rays draw its points by
+ * area, not by the image's brightness. texture names an image any format
+ * OpenImageIO reads (integer files are sRGB and come back linear), found as
+ * shaders' textures are (as given, then on the texture search path) and
+ * read whole when the light is made: RAYES_ERROR_IO when it cannot be read. */
+RAYES_API RayesError rayes_scene_area_light_mesh_textured(RayesScene *scene, size_t n_faces,
+                                                          const int *n_verts, const int *indices,
+                                                          size_t n_points, const float *P,
+                                                          const float *st, const float L[3],
+                                                          int two_sided, const char *texture);
+
 /* A light source of the given type, with parameters (unknown names get
  * one warning; a wrong type is RAYES_ERROR_INVALID_ARGUMENT). Points and
  * directions are 3-vectors given as RAYES_PARAM_COLOR and transform by the

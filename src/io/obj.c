@@ -239,6 +239,7 @@ typedef struct Material {
     int illum;          /* illumination model, read, not rendered */
     char map_Kd[1024];  /* texture path, resolved against the MTL's directory; "" none */
     char map_Ks[1024];  /* the specular colour's texture, resolved likewise; "" none */
+    char map_Ke[1024];  /* the emission's texture (a textured mesh light), likewise; "" none */
     int map_Ks_sent;    /* its pattern made */
     char map_d[1024];   /* the opacity's texture (a cut-out), resolved likewise; "" none */
     int map_d_channel;  /* its channel: 0-3, or -2 the matte (alpha if any, else grey) */
@@ -604,6 +605,8 @@ static int mtl_statement(Obj *o, Lexer *L, const char *mtl_dir, const char *kw, 
         return mtl_map(L, mtl_dir, mt->map_Kd, sizeof mt->map_Kd);
     if (is_mtl_kw(kw, n, "map_Ks"))
         return mtl_map(L, mtl_dir, mt->map_Ks, sizeof mt->map_Ks);
+    if (is_mtl_kw(kw, n, "map_Ke"))
+        return mtl_map(L, mtl_dir, mt->map_Ke, sizeof mt->map_Ke);
     if (is_mtl_kw(kw, n, "map_Pr")) { /* packed textures name their channel */
         mt->map_Pr_channel = map_channel(L, 0);
         return mtl_map(L, mtl_dir, mt->map_Pr, sizeof mt->map_Pr);
@@ -1592,17 +1595,38 @@ static RayesError emit_mesh(Emit *e, const Mesh *m, const char *mat)
     return r;
 }
 
+/* 1 when material mt's emission is its map_Ke over the faces of m: every
+ * corner has a vt and the sink takes textured lights (else one warning:
+ * the emission is Ke alone). */
+static int light_textured(Emit *e, const Material *mt, const Mesh *m)
+{
+    if (!mt->map_Ke[0])
+        return 0;
+    int all_vt = 1;
+    for (size_t k = 0; k < m->idx.n && all_vt; k++)
+        all_vt = e->o->face_vt.a[m->idx.a[k]] >= 0;
+    if (all_vt && e->sink->area_light_mesh_textured && e->sink->area_light_mesh)
+        return 1;
+    obj_warn(e->o, "map_Ke untextured",
+             "%s: material \"%s\": map_Ke needs %s; it emits Ke "
+             "alone",
+             e->o->name, mt->name,
+             all_vt ? "a scene that takes textured lights" : "vt on every corner of its faces");
+    return 0;
+}
+
 /* The faces of an emissive material as one mesh light (its corners' points
- * in file order). */
-static RayesError emit_light_mesh(Emit *e, const Material *mt, const Mesh *m)
+ * in file order), textured by map_Ke over their vt when textured. */
+static RayesError emit_light_mesh(Emit *e, const Material *mt, const Mesh *m, int textured)
 {
     size_t n_corners = 0;
     for (size_t f = 0; f < m->nv.n; f++)
         n_corners += (size_t)m->nv.a[f];
     float *P = malloc(3 * n_corners * sizeof *P);
     int *idx = malloc(n_corners * sizeof *idx);
+    float *st = textured ? malloc(2 * n_corners * sizeof *st) : NULL;
     RayesError r = RAYES_ERROR_OUT_OF_MEMORY;
-    if (P && idx) {
+    if (P && idx && (st || !textured)) {
         for (size_t k = 0; k < n_corners; k++) {
             memcpy(&P[3 * k], vtx(e->o, e->o->face_idx.a[m->idx.a[k]]), 3 * sizeof *P);
             for (int a = 0; a < 3; a++) {
@@ -1610,9 +1634,17 @@ static RayesError emit_light_mesh(Emit *e, const Material *mt, const Mesh *m)
                 e->hi[a] = fmaxf(e->hi[a], P[3 * k + (size_t)a]);
             }
             idx[k] = (int)k;
+            if (st) { /* t = 1 - v: OBJ's v runs up the image */
+                size_t ti = (size_t)e->o->face_vt.a[m->idx.a[k]];
+                st[2 * k] = e->o->vt.a[2 * ti];
+                st[2 * k + 1] = 1.0f - e->o->vt.a[2 * ti + 1];
+            }
         }
-        r = e->sink->area_light_mesh(e->sink->target, m->nv.n, m->nv.a, idx, n_corners, P, mt->Ke,
-                                     0);
+        const float *Ke = mt->Ke;
+        r = textured ? e->sink->area_light_mesh_textured(e->sink->target, m->nv.n, m->nv.a, idx,
+                                                         n_corners, P, st, Ke, 0, mt->map_Ke)
+                     : e->sink->area_light_mesh(e->sink->target, m->nv.n, m->nv.a, idx, n_corners,
+                                                P, Ke, 0);
         if (r != RAYES_OK)
             r = sink_fail(e, r, "an emissive mesh");
         e->n_area_lights++;
@@ -1621,6 +1653,7 @@ static RayesError emit_light_mesh(Emit *e, const Material *mt, const Mesh *m)
     }
     free(P);
     free(idx);
+    free(st);
     return r;
 }
 
@@ -1634,8 +1667,11 @@ static RayesError emit_emitter(Emit *e, const Material *mt, const Mesh *m)
     int few_quads = m->nv.n <= AREA_QUADS;
     for (size_t f = 0; f < m->nv.n && few_quads; f++)
         few_quads = m->nv.a[f] == 4;
-    if (!few_quads && e->sink->area_light_mesh)
-        return emit_light_mesh(e, mt, m);
+    if (m->nv.n == 0) /* a material no face uses */
+        return RAYES_OK;
+    int textured = light_textured(e, mt, m);
+    if ((!few_quads || textured) && e->sink->area_light_mesh)
+        return emit_light_mesh(e, mt, m, textured);
     Mesh rest = {{0}, {0}};
     RayesError r = RAYES_OK;
     size_t k = 0;
@@ -1693,7 +1729,11 @@ static RayesError emit_material(Emit *e, int mi)
     Obj *o = e->o;
     Mesh m[2] = {{{0}, {0}}, {{0}, {0}}}; /* with vt, without */
     Material *mt = mi >= 0 ? &o->mats[mi] : NULL;
-    int emits = mt && max3(mt->Ke) > 0.0f; /* lights take no texture: one mesh */
+    /* a map without a colour emits the map's colours (Ke 0 or missing, as
+     * exporters write it beside the map) */
+    if (mt && mt->map_Ke[0] && !(max3(mt->Ke) > 0.0f))
+        mt->Ke[0] = mt->Ke[1] = mt->Ke[2] = 1.0f;
+    int emits = mt && max3(mt->Ke) > 0.0f; /* one mesh (vt or not) */
     RayesError r = RAYES_OK;
     size_t k = 0;
     for (size_t f = 0; f < o->face_nv.n && r == RAYES_OK; k += (size_t)o->face_nv.a[f], f++)

@@ -118,6 +118,7 @@ typedef struct AreaLight {
     float L_base[3]; /* L and scale as given */
     double power;    /* "power" (watts per pbrt shape), or 0 */
     int twosided;
+    char filename[PBRT_PATH]; /* "filename": its image (resolved), or "" */
 } AreaLight;
 
 typedef struct GState {

@@ -43,9 +43,19 @@ int pbrt_d_arealight(Parser *P, const Token *t)
     P->gs.area.twosided = tw && tw->n_num > 0 && tw->num[0] != 0;
     (void)pbrt_find(&pl, "nsamples"); /* pbrt-v3's samples a light: rayes' shadow rays */
     (void)pbrt_find(&pl, "samples");
-    if (pbrt_find(&pl, "filename"))
-        pbrt_warn_at(P, t->line, t->col, "area filename", "AreaLightSource: image emission "
-                     "(\"filename\") is not supported; using L");
+    const char *file = pbrt_get_string(&pl, "filename", NULL);
+    if (file && file[0]) { /* the image's colours, as pbrt-v4 (which refuses an L beside it) */
+        if (pbrt_resolve(P, t, file, P->gs.area.filename, sizeof P->gs.area.filename) != 0) {
+            pbrt_params_free(&pl);
+            return -1;
+        }
+        if (pbrt_find(&pl, "L"))
+            pbrt_warn_at(P, t->line, t->col, "area filename L",
+                         "AreaLightSource: \"L\" beside "
+                         "\"filename\" is ignored (pbrt-v4 refuses both); the image's colours "
+                         "emit");
+        L[0] = L[1] = L[2] = 1.0f;
+    }
     double power = pbrt_get_float(&pl, "power", 0.0);
     P->gs.area.power = power > 0 && isfinite(power) ? power : 0.0;
     for (int c = 0; c < 3; c++)

@@ -183,7 +183,7 @@ static void orient_faces(const Parser *P, size_t n_faces, const int *n_verts, in
  * face's N when given, reversed by ReverseOrientation and by a transform
  * that swaps handedness, as emit_area_quad's). idx is rewritten. */
 static int emit_area_mesh(Parser *P, const Token *t, size_t n_faces, const int *n_verts, int *idx,
-                          size_t n_points, const float *pts, const float *N)
+                          size_t n_points, const float *pts, const float *N, const float *uv)
 {
     pbrt_grow_bound(P, pts, n_points); /* emitters count in the world's bound too */
     orient_faces(P, n_faces, n_verts, idx, pts, N);
@@ -192,9 +192,18 @@ static int emit_area_mesh(Parser *P, const Token *t, size_t n_faces, const int *
         return FAIL_TOK(P, t, "the current transform is not finite");
     pbrt_mat_to_float(P->gs.ctm, m);
     RayesError e = P->sink->set_transform(P->sink->target, m);
+    float *st = NULL; /* the image's (s, t): pbrt looks it up at (u, 1 - v) */
+    if (e == RAYES_OK && uv && !(st = malloc(2 * n_points * sizeof *st)))
+        return FAIL_TOK(P, t, "out of memory");
+    for (size_t k = 0; st && k < n_points; k++)
+        st[2 * k] = uv[2 * k], st[2 * k + 1] = 1.0f - uv[2 * k + 1];
     if (e == RAYES_OK)
-        e = P->sink->area_light_mesh(P->sink->target, n_faces, n_verts, idx, n_points, pts,
-                                     P->gs.area.L, P->gs.area.twosided);
+        e = st ? P->sink->area_light_mesh_textured(P->sink->target, n_faces, n_verts, idx, n_points,
+                                                   pts, st, P->gs.area.L, P->gs.area.twosided,
+                                                   P->gs.area.filename)
+               : P->sink->area_light_mesh(P->sink->target, n_faces, n_verts, idx, n_points, pts,
+                                          P->gs.area.L, P->gs.area.twosided);
+    free(st);
     return e == RAYES_OK ? 0 : pbrt_sink_failed(P, t, e);
 }
 
@@ -214,6 +223,14 @@ static int shape_mesh(Parser *P, const Token *t, const char *what, size_t n_face
                      what);
     } else if (P->gs.area.on) {
         pbrt_area_power(P, n_faces, world_area(P, n_faces, n_verts, idx, pts));
+        if (P->gs.area.filename[0]) { /* an image over the faces: one textured mesh light */
+            if (uv && P->sink->area_light_mesh_textured && P->sink->area_light_mesh)
+                return emit_area_mesh(P, t, n_faces, n_verts, idx, n_points, pts, N, uv);
+            pbrt_warn_at(P, t->line, t->col, "area image uv",
+                         "%s: an area light's image needs the shape's \"uv\" here; it emits "
+                         "white (times scale)",
+                         what);
+        }
         int q[AREA_QUADS][4];
         size_t n_quads = 0, i = 0;
         const int *f = idx;
@@ -229,7 +246,7 @@ static int shape_mesh(Parser *P, const Token *t, const char *what, size_t n_face
             }
         }
         if (i < n_faces && P->sink->area_light_mesh)
-            return emit_area_mesh(P, t, n_faces, n_verts, idx, n_points, pts, N);
+            return emit_area_mesh(P, t, n_faces, n_verts, idx, n_points, pts, N, NULL);
         if (i < n_faces)
             pbrt_warn_at(P, t->line, t->col, "emitting mesh",
                          "%s: only its first %zu quads emit (the scene takes no mesh lights)", what,
@@ -473,23 +490,37 @@ static int shape_bilinearmesh(Parser *P, const Token *t, ParamList *pl)
         }
         pbrt_area_power(P, n_idx / 4, area);
     }
-    if (P->gs.area.on && !P->recording && n_idx / 4 > AREA_QUADS && P->sink->area_light_mesh) {
-        /* many emitting patches: one mesh light of their corners, around */
+    int textured = P->gs.area.filename[0] && P->sink->area_light_mesh_textured;
+    if (P->gs.area.on && !P->recording && (n_idx / 4 > AREA_QUADS || textured) &&
+        P->sink->area_light_mesh) {
+        /* many emitting patches, or an image over them: one mesh light of
+         * their corners, around */
         size_t n_faces = n_idx / 4;
         int *nv = malloc(n_faces * sizeof *nv), *idx = malloc(n_idx * sizeof *idx);
         float *N = np ? points_of(P, t, np) : NULL;
+        /* the image's uv: the mesh's, or a lone patch's default (pbrt's
+         * (0, 0) (1, 0) (0, 1) (1, 1) at p00 p10 p01 p11) */
+        float *uv = textured && (uvp || n_points == 4) ? malloc(2 * n_points * sizeof *uv) : NULL;
         int r = -1;
-        if (!nv || !idx || (np && !N)) {
+        if (!nv || !idx || (np && !N) || (textured && (uvp || n_points == 4) && !uv)) {
             FAIL_TOK(P, t, "out of memory");
         } else {
             static const int around[4] = {0, 1, 3, 2};
             for (size_t f = 0; f < n_faces; f++) {
                 nv[f] = 4;
                 for (int k = 0; k < 4; k++)
-                    idx[4 * f + (size_t)k] = (int)ip->num[4 * f + (size_t)around[k]];
+                    idx[4 * f + (size_t)k] =
+                        ip ? (int)ip->num[4 * f + (size_t)around[k]] : around[k];
             }
-            r = emit_area_mesh(P, t, n_faces, nv, idx, n_points, pts, N);
+            for (size_t k = 0; uv && k < 2 * n_points; k++)
+                uv[k] = uvp ? (float)uvp->num[k] : (float)((k & 1) ? k / 4 : (k / 2) % 2);
+            if (textured && !uv)
+                pbrt_warn_at(P, t->line, t->col, "area image uv",
+                             "bilinearmesh: an area light's image needs the shape's \"uv\" "
+                             "here; it emits white (times scale)");
+            r = emit_area_mesh(P, t, n_faces, nv, idx, n_points, pts, N, uv);
         }
+        free(uv);
         free(nv);
         free(idx);
         free(N);

@@ -399,8 +399,11 @@ static int few_quads(const Polys *g)
     return 1;
 }
 
-/* The polygons of g as one mesh light (tessellated as surfaces are). */
-static int emit_area_mesh(Rib *r, const Polys *g, const float *P, size_t n_points)
+/* The polygons of g as one mesh light (tessellated as surfaces are),
+ * textured by the area light's texture over tex_st (2 a point) when
+ * given. */
+static int emit_area_mesh(Rib *r, const Polys *g, const float *P, size_t n_points,
+                          const float *tex_st)
 {
     int flip = rib_flip(r), e = 0;
     RibFaces faces = {0};
@@ -418,8 +421,13 @@ static int emit_area_mesh(Rib *r, const Polys *g, const float *P, size_t n_point
         const IoSink *s = rib_out_sink(r, &st);
         float L[3];
         area_radiance(r, area_measured(r) ? polys_area(r, g, P) : 0.0, L);
-        if (s->area_light_mesh(s->target, faces.n_faces, faces.n_verts, faces.idx, n_points, P, L,
-                               r->a.area_twosided) != RAYES_OK)
+        RayesError res = tex_st
+                             ? s->area_light_mesh_textured(s->target, faces.n_faces, faces.n_verts,
+                                                           faces.idx, n_points, P, tex_st, L,
+                                                           r->a.area_twosided, r->a.area_texture)
+                             : s->area_light_mesh(s->target, faces.n_faces, faces.n_verts,
+                                                  faces.idx, n_points, P, L, r->a.area_twosided);
+        if (res != RAYES_OK)
             e = rib_sink_failed(r, s);
     }
     rib_faces_fini(&faces);
@@ -429,10 +437,33 @@ static int emit_area_mesh(Rib *r, const Polys *g, const float *P, size_t n_point
 static int emit_polys(Rib *r, const Polys *g, const float *P, size_t n_points, const Param *par,
                       size_t n_par)
 {
+    if (r->a.area && r->a.area_texture[0]) { /* a textured emitter: one mesh light */
+        SinkState *st;
+        const Param *stp = rib_find_param(par, n_par, "st");
+        if (!rib_out_sink(r, &st)->area_light_mesh_textured ||
+            !rib_out_sink(r, &st)->area_light_mesh)
+            rib_warn_once(r, "area texture sink",
+                          "this scene takes no textured area lights; "
+                          "the light's texture is not used");
+        else if (!stp || !rib_is_num(stp->v) || stp->v->n != 2 * n_points)
+            rib_warn_once(r, "area texture st",
+                          "a textured area light's shape has no vertex "
+                          "\"st\" (2 values a point); its texture is not used");
+        else {
+            float *stf = malloc(2 * n_points * sizeof *stf);
+            if (!stf)
+                return rib_error(r, "out of memory");
+            for (size_t k = 0; k < 2 * n_points; k++)
+                stf[k] = (float)stp->v->d[k];
+            int e = emit_area_mesh(r, g, P, n_points, stf);
+            free(stf);
+            return e;
+        }
+    }
     if (r->a.area && !few_quads(g)) {
         SinkState *st;
         if (rib_out_sink(r, &st)->area_light_mesh)
-            return emit_area_mesh(r, g, P, n_points);
+            return emit_area_mesh(r, g, P, n_points, NULL);
     }
     RibVar vars[RIB_N_VARS];
     rib_vars(r, par, n_par, vars);

@@ -129,6 +129,7 @@ typedef struct Attr {
     unsigned char on[RIB_MAX_LIGHTS / 8]; /* bit k: Rib.lights[k] is on */
     float area_L[3];
     char area_map[256]; /* its environment map (RenderMan 19-20's envsphere), or "" */
+    char area_texture[256];     /* rayes' arealight's "texturename": its emission texture, or "" */
     const struct TrimSet *trim; /* TrimCurve in force (rib_nurbs.c), or NULL */
     int area_normalize;         /* its areaNormalize (RenderMan 19-20's geometry lights) */
     int area_point_units;       /* BMRT's and Pixie's arealight: area_L is a point light's

@@ -1016,6 +1016,7 @@ static int mesh_light(Rib *r, const char *handle, const float L[3], int normaliz
     r->a.area_normalize = normalize;
     r->a.area_point_units = 0;
     r->a.area_map[0] = '\0';
+    r->a.area_texture[0] = '\0';
     r->a.area_unseen = 0;
     r->a.area_twosided = 0;
     r->a.area = 1;

@@ -1398,6 +1398,17 @@ static int h_area_light(Rib *r, const Args *a)
             (in_list(environment_maps, p[k].d.name) || strcmp(p[k].d.name, "rman__EnvMap") == 0 ||
              strcmp(p[k].d.name, "lightcolormap") == 0))
             snprintf(r->a.area_map, sizeof r->a.area_map, "%s", p[k].v->s[0]);
+    r->a.area_texture[0] = '\0'; /* rayes' own: an emission texture over the shapes' st */
+    const Param *tx = rib_find_param(p, n, "texturename");
+    if (tx && tx->d.ty == TY_STRING && tx->v->n == 1 && tx->v->s[0][0]) {
+        if (strlen(tx->v->s[0]) >= sizeof r->a.area_texture)
+            rib_warn_once(r, "area texture long",
+                          "AreaLightSource: texturename longer than %zu "
+                          "characters; the light is untextured",
+                          sizeof r->a.area_texture - 1);
+        else
+            snprintf(r->a.area_texture, sizeof r->a.area_texture, "%s", tx->v->s[0]);
+    }
     const Param *pv = rib_find_param(p, n, "rman__LightPrimaryVisibility");
     r->a.area_unseen = pv && rib_is_num(pv->v) && pv->v->n == 1 && pv->v->d[0] == 0;
     const Param *ts = rib_find_param(p, n, "twosided");

@@ -1245,11 +1245,10 @@ static RayesError w_area_light(void *t, const float P[4][3], const float L[3])
     return RAYES_OK;
 }
 
-static RayesError w_area_light_mesh(void *t, size_t n_faces, const int *nv, const int *idx,
-                                    size_t n_points, const float *P, const float L[3],
-                                    int two_sided)
+static RayesError area_light_mesh(RibWriter *w, size_t n_faces, const int *nv, const int *idx,
+                                  size_t n_points, const float *P, const float *st,
+                                  const float L[3], int two_sided, const char *texture)
 {
-    RibWriter *w = t;
     if (!n_faces || !nv || !idx || !P || !finite_all(P, 3 * n_points) || !finite_all(L, 3) ||
         L[0] < 0 || L[1] < 0 || L[2] < 0)
         return fail(w, RAYES_ERROR_INVALID_ARGUMENT,
@@ -1263,9 +1262,16 @@ static RayesError w_area_light_mesh(void *t, size_t n_faces, const int *nv, cons
             if (idx[k + (size_t)v] < 0 || (size_t)idx[k + (size_t)v] >= n_points)
                 return fail(w, RAYES_ERROR_INVALID_ARGUMENT, "area light mesh: index out of range");
     }
+    if (st && !finite_all(st, 2 * n_points))
+        return fail(w, RAYES_ERROR_INVALID_ARGUMENT,
+                    "area light mesh: expected finite texture coordinates");
     FILE *f = area_light_begin(w, L);
     if (two_sided)
         fprintf(f, " \"float twosided\" [1]");
+    if (texture) {
+        fprintf(f, " \"string texturename\" ");
+        string(f, texture);
+    }
     /* Written as the triangles the scene keeps, so that a mesh of a few
      * quads reads back as the same one light, not as quad lights. */
     size_t n_tris = k - 2 * n_faces;
@@ -1284,8 +1290,29 @@ static RayesError w_area_light_mesh(void *t, size_t n_faces, const int *nv, cons
                     idx[k], idx[k + (size_t)c], idx[k + (size_t)c + 1]);
     fprintf(f, "]\n  \"P\" ");
     floats(f, P, 3 * n_points);
+    if (st) {
+        fprintf(f, "\n  \"st\" ");
+        floats(f, st, 2 * n_points);
+    }
     fprintf(f, "\nAttributeEnd\n");
     return RAYES_OK;
+}
+
+static RayesError w_area_light_mesh(void *t, size_t n_faces, const int *nv, const int *idx,
+                                    size_t n_points, const float *P, const float L[3],
+                                    int two_sided)
+{
+    return area_light_mesh(t, n_faces, nv, idx, n_points, P, NULL, L, two_sided, NULL);
+}
+
+static RayesError w_area_light_mesh_textured(void *t, size_t n_faces, const int *nv, const int *idx,
+                                             size_t n_points, const float *P, const float *st,
+                                             const float L[3], int two_sided, const char *texture)
+{
+    if (!st || !texture || !texture[0])
+        return fail(t, RAYES_ERROR_INVALID_ARGUMENT,
+                    "area light mesh: expected texture coordinates and a texture");
+    return area_light_mesh(t, n_faces, nv, idx, n_points, P, st, L, two_sided, texture);
 }
 
 static RayesError w_area_light_quadric(void *t, RayesQuadric type, const float *p, size_t n,
@@ -1547,6 +1574,7 @@ IoSink io_rib_writer_sink(RibWriter *w)
         .solid_begin = w_solid_begin,
         .solid_end = w_solid_end,
         .area_light_mesh = w_area_light_mesh,
+        .area_light_mesh_textured = w_area_light_mesh_textured,
         .area_light_quadric = w_area_light_quadric,
     };
 }

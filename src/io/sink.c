@@ -149,6 +149,15 @@ static RayesError scene_area_light_mesh(void *t, size_t n_faces, const int *n_ve
     return rayes_scene_area_light_mesh(t, n_faces, n_verts, indices, n_points, P, L, two_sided);
 }
 
+static RayesError scene_area_light_mesh_textured(void *t, size_t n_faces, const int *n_verts,
+                                                 const int *indices, size_t n_points,
+                                                 const float *P, const float *st, const float L[3],
+                                                 int two_sided, const char *texture)
+{
+    return rayes_scene_area_light_mesh_textured(t, n_faces, n_verts, indices, n_points, P, st, L,
+                                                two_sided, texture);
+}
+
 static RayesError scene_area_light_quadric(void *t, RayesQuadric type, const float *params,
                                            size_t n, unsigned flags, const float L[3],
                                            int two_sided)
@@ -270,6 +279,7 @@ IoSink io_sink_scene(RayesScene *scene)
         .volume = scene_volume,
         .volume_inside = scene_volume_inside,
         .atmosphere = scene_atmosphere,
+        .area_light_mesh_textured = scene_area_light_mesh_textured,
         .set_visibility = scene_set_visibility,
         .set_opacity_mode = scene_set_opacity_mode,
         .object_begin = scene_object_begin,

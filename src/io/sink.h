@@ -133,6 +133,12 @@ typedef struct IoSink {
     /* rayes_scene_atmosphere (last; NULL: readers drop the atmosphere with
      * one warning). */
     RayesError (*atmosphere)(void *target);
+    /* rayes_scene_area_light_mesh_textured (last; NULL: readers make the
+     * emitter of radiance L alone, with one warning). */
+    RayesError (*area_light_mesh_textured)(void *target, size_t n_faces, const int *n_verts,
+                                           const int *indices, size_t n_points, const float *P,
+                                           const float *st, const float L[3], int two_sided,
+                                           const char *texture);
 } IoSink;
 
 /* A sink that builds scene through rayes.h (borrowed, not retained). */

@@ -441,6 +441,9 @@ static Vec3 trace_layers(Worker *w, const Ray *ray, uint32_t kind, int diffuse_d
         if ((kind & (RAYES_RAY_DIFFUSE | PATH_RAY_GLOSSY)) ||
             (!l->two_sided && v3_dot(hit.Ng, ray->d) >= 0.0f))
             return v3(0, 0, 0);
+        if (l->type == LIGHT_MESH && l->mesh->tex) /* its texture at the hit */
+            return light_mesh_radiance(l, w->rs->gs->grids[hit.grid].prim - l->mesh->first_prim,
+                                       v3_madd(ray->o, ray->d, hit.t));
         return l->L;
     }
     int see_through = obj->transparent && layer < INTEGRATOR_MAX_LAYERS;

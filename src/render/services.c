@@ -176,7 +176,7 @@ static int light_hit(Worker *w, const Light *l, const LightMeshView *v, Vec3 o, 
     if (!accel_intersect_object(w->rs->accel, (uint32_t)l->emitter, &ray, &hit))
         return 0;
     uint32_t tri = w->rs->gs->grids[hit.grid].prim - l->mesh->first_prim;
-    return light_mesh_finish(l, v, tri, wi, hit.t, hit.Ng, s);
+    return light_mesh_finish(l, v, tri, o, wi, hit.t, hit.Ng, s);
 }
 
 /* A light's sample from o, for a mesh light seen as v says. */

@@ -1139,15 +1139,21 @@ RayesError rayes_scene_area_light(RayesScene *s, const float P[4][3], const floa
 
 /* The emitter's geometry is the light's triangles; a moving transform is
  * taken at its first time (mesh lights are still: light.h). */
-RayesError rayes_scene_area_light_mesh(RayesScene *s, size_t n_faces, const int *n_verts,
-                                       const int *indices, size_t n_points, const float *P,
-                                       const float L[3], int two_sided)
+/* rayes_scene_area_light_mesh, with an emission texture when st and
+ * texture are given (rayes_scene_area_light_mesh_textured). */
+static RayesError area_light_mesh(RayesScene *s, size_t n_faces, const int *n_verts,
+                                  const int *indices, size_t n_points, const float *P,
+                                  const float *st, const char *texture, const float L[3],
+                                  int two_sided)
 {
     if (!s || !L || !n_faces || !n_verts || !indices || !P)
         return RAYES_ERROR_INVALID_ARGUMENT;
     if (!scene_finite(P, 3 * n_points) || !scene_finite(L, 3) || L[0] < 0 || L[1] < 0 || L[2] < 0)
         return scene_fail(s, RAYES_ERROR_INVALID_ARGUMENT,
                           "area light mesh: expected finite points and a non-negative radiance");
+    if (st && !scene_finite(st, 2 * n_points))
+        return scene_fail(s, RAYES_ERROR_INVALID_ARGUMENT,
+                          "area light mesh: expected finite texture coordinates");
     if (s->open_master >= 0 || s->deforming)
         return scene_fail(s, RAYES_ERROR_INVALID_ARGUMENT,
                           "area light mesh: not allowed in an object block or a deformation "
@@ -1160,9 +1166,11 @@ RayesError rayes_scene_area_light_mesh(RayesScene *s, size_t n_faces, const int 
     size_t n_tris = n_corners - 2 * n_faces; /* each face a fan */
     Vec3 *v = malloc(3 * n_tris * sizeof *v);
     Prim *prims = malloc(n_tris * sizeof *prims);
-    if (!v || !prims) {
+    float *tri_st = st ? malloc(6 * n_tris * sizeof *tri_st) : NULL;
+    if (!v || !prims || (st && !tri_st)) {
         free(v);
         free(prims);
+        free(tri_st);
         return scene_fail(s, RAYES_ERROR_OUT_OF_MEMORY, "out of memory");
     }
     const float(*pts)[3] = (const float(*)[3])P;
@@ -1174,11 +1182,15 @@ RayesError rayes_scene_area_light_mesh(RayesScene *s, size_t n_faces, const int 
             for (int j = 0; j < 3; j++) {
                 transform_points(s, &pts[corner[j]], 1, &v[3 * t + (size_t)j]);
                 prims[t].cp[j] = v[3 * t + (size_t)j];
+                if (tri_st)
+                    memcpy(&tri_st[6 * t + 2 * (size_t)j], &st[2 * (size_t)corner[j]],
+                           2 * sizeof *st);
             }
         }
     if (!scene_within(bounds_of(&v[0].x, 3 * n_tris))) {
         free(v);
         free(prims);
+        free(tri_st);
         return scene_fail(s, RAYES_ERROR_INVALID_ARGUMENT, WITHIN_EXPECTED, "area light mesh");
     }
     Light l;
@@ -1188,8 +1200,24 @@ RayesError rayes_scene_area_light_mesh(RayesScene *s, size_t n_faces, const int 
     if (light_mesh_init(&l, v, n_tris, two_sided) != 0) {
         free(v);
         free(prims);
+        free(tri_st);
         return scene_fail(s, RAYES_ERROR_INVALID_ARGUMENT,
                           "area light mesh: no face has area (or out of memory)");
+    }
+    if (tri_st) {
+        char path[1024], err[800];
+        int bad = 1;
+        if (scene_find_texture(s, texture, path, sizeof path) != 0)
+            snprintf(err, sizeof err, "area light mesh: texture name too long");
+        else
+            bad = light_mesh_texture(&l, tri_st, path, err, sizeof err) != 0;
+        free(tri_st);
+        if (bad) {
+            free(v);
+            free(prims);
+            light_fini(&l);
+            return scene_fail(s, RAYES_ERROR_IO, "%s", err);
+        }
     }
     l.emitter = (int)s->n_objects;
     l.mesh->first_prim = (uint32_t)s->n_prims; /* push_light appends the triangles */
@@ -1207,6 +1235,25 @@ RayesError rayes_scene_area_light_mesh(RayesScene *s, size_t n_faces, const int 
     if (e != RAYES_OK)
         light_fini(&l);
     return e;
+}
+
+RayesError rayes_scene_area_light_mesh(RayesScene *s, size_t n_faces, const int *n_verts,
+                                       const int *indices, size_t n_points, const float *P,
+                                       const float L[3], int two_sided)
+{
+    return area_light_mesh(s, n_faces, n_verts, indices, n_points, P, NULL, NULL, L, two_sided);
+}
+
+RayesError rayes_scene_area_light_mesh_textured(RayesScene *s, size_t n_faces, const int *n_verts,
+                                                const int *indices, size_t n_points, const float *P,
+                                                const float *st, const float L[3], int two_sided,
+                                                const char *texture)
+{
+    if (!st || !texture || !texture[0])
+        return s ? scene_fail(s, RAYES_ERROR_INVALID_ARGUMENT,
+                              "area light mesh: expected texture coordinates and a texture")
+                 : RAYES_ERROR_INVALID_ARGUMENT;
+    return area_light_mesh(s, n_faces, n_verts, indices, n_points, P, st, texture, L, two_sided);
 }
 
 static int cmp_size(const void *a, const void *b)

@@ -738,7 +738,12 @@ int light_mesh_init(Light *l, const Vec3 *v, size_t n, int two_sided)
     }
     m->cdf[n] = 1.0f;
     m->area = (float)sum;
-    free(t);
+    /* t: place -> scene triangle; kept inverted for light_mesh_texture
+     * (the same n words, reused) */
+    m->place = t;
+    for (size_t k = 0; k < n; k++)
+        ((uint32_t *)key)[t[k]] = (uint32_t)k;
+    memcpy(t, key, n * sizeof *t);
     free(key);
     if (!(sum > 0.0)) {
         mesh_free(m);
@@ -747,6 +752,38 @@ int light_mesh_init(Light *l, const Vec3 *v, size_t n, int two_sided)
     l->type = LIGHT_MESH;
     l->mesh = m;
     l->two_sided = two_sided != 0;
+    return 0;
+}
+
+int light_mesh_texture(Light *l, const float *st, const char *path, char *err, size_t err_size)
+{
+    LightMesh *m = l->mesh;
+    int w = 0, h = 0;
+    float *rgba = NULL;
+    char ierr[600];
+    if (texture_read_image(path, &w, &h, &rgba, ierr, sizeof ierr) != 0) {
+        snprintf(err, err_size, "area light texture: %s", ierr);
+        return -1;
+    }
+    size_t n_px = (size_t)w * (size_t)h;
+    m->st = malloc(6 * m->n * sizeof *m->st);
+    m->tex = malloc(3 * n_px * sizeof *m->tex);
+    if (!m->st || !m->tex) {
+        free(rgba);
+        free(m->st), free(m->tex);
+        m->st = m->tex = NULL;
+        snprintf(err, err_size, "area light texture %s: out of memory", path);
+        return -1;
+    }
+    for (size_t i = 0; i < n_px; i++)
+        for (int c = 0; c < 3; c++) {
+            float x = rgba[4 * i + (size_t)c];
+            m->tex[3 * i + (size_t)c] = isfinite(x) && x > 0.0f ? x : 0.0f;
+        }
+    free(rgba);
+    for (size_t k = 0; k < m->n; k++)
+        memcpy(&m->st[6 * (size_t)m->place[k]], &st[6 * k], 6 * sizeof *st);
+    m->tex_w = w, m->tex_h = h;
     return 0;
 }
 
@@ -839,10 +876,70 @@ static int mesh_finish(const Light *l, const LightMeshView *v, int c, Vec3 wi, f
     return 1;
 }
 
-int light_mesh_finish(const Light *l, const LightMeshView *v, uint32_t tri, Vec3 wi, float t,
-                      Vec3 Ng, LightSample *s)
+/* An rgb image (w x h, top row first) at (s, t) in [0, 1]^2: bilinear
+ * between its texels' centres, its edge texels beyond them. */
+static Vec3 rgb_bilinear(const float *rgb, int w, int h, float s, float t)
 {
-    return tri < l->mesh->n && mesh_finish(l, v, l->mesh->cluster_of[tri], wi, t, Ng, s);
+    float x = s * (float)w - 0.5f, y = t * (float)h - 0.5f;
+    float fx = floorf(x), fy = floorf(y), ax = x - fx, ay = y - fy;
+    Vec3 c = v3(0, 0, 0);
+    for (int j = 0; j < 2; j++)
+        for (int i = 0; i < 2; i++) {
+            int px = (int)fx + i, py = (int)fy + j;
+            px = px < 0 ? 0 : px >= w ? w - 1 : px;
+            py = py < 0 ? 0 : py >= h ? h - 1 : py;
+            const float *q = &rgb[3 * ((size_t)py * (size_t)w + (size_t)px)];
+            float wgt = (i ? ax : 1.0f - ax) * (j ? ay : 1.0f - ay);
+            c = v3_madd(c, v3(q[0], q[1], q[2]), wgt);
+        }
+    return c;
+}
+
+/* The emission texture at (s, t), clamped at the image's edges (pbrt-v4's
+ * lookup: a sign's border does not take the opposite one's). */
+static Vec3 mesh_texel(const LightMesh *m, float s, float t)
+{
+    return rgb_bilinear(m->tex, m->tex_w, m->tex_h, fminf(fmaxf(s, 0.0f), 1.0f),
+                        fminf(fmaxf(t, 0.0f), 1.0f));
+}
+
+/* The radiance at barycentrics (b1, b2) of the triangle at place k. */
+static Vec3 mesh_radiance_at(const Light *l, size_t k, float b1, float b2)
+{
+    const LightMesh *m = l->mesh;
+    if (!m->tex)
+        return l->L;
+    const float *st = &m->st[6 * k];
+    float b0 = 1.0f - b1 - b2;
+    return v3_mul(l->L, mesh_texel(m, b0 * st[0] + b1 * st[2] + b2 * st[4],
+                                   b0 * st[1] + b1 * st[3] + b2 * st[5]));
+}
+
+Vec3 light_mesh_radiance(const Light *l, uint32_t tri, Vec3 P)
+{
+    const LightMesh *m = l->mesh;
+    if (!m->tex || tri >= m->n)
+        return l->L;
+    size_t k = m->place[tri];
+    const Vec3 *p = &m->v[3 * k];
+    /* P's barycentrics in the triangle's plane */
+    Vec3 e1 = v3_sub(p[1], p[0]), e2 = v3_sub(p[2], p[0]), d = v3_sub(P, p[0]);
+    float d11 = v3_dot(e1, e1), d12 = v3_dot(e1, e2), d22 = v3_dot(e2, e2);
+    float d1 = v3_dot(d, e1), d2 = v3_dot(d, e2), den = d11 * d22 - d12 * d12;
+    if (!(fabsf(den) > 0.0f))
+        return mesh_radiance_at(l, k, 1.0f / 3.0f, 1.0f / 3.0f);
+    float b1 = (d22 * d1 - d12 * d2) / den, b2 = (d11 * d2 - d12 * d1) / den;
+    return mesh_radiance_at(l, k, fminf(fmaxf(b1, 0.0f), 1.0f), fminf(fmaxf(b2, 0.0f), 1.0f));
+}
+
+int light_mesh_finish(const Light *l, const LightMeshView *v, uint32_t tri, Vec3 o, Vec3 wi,
+                      float t, Vec3 Ng, LightSample *s)
+{
+    if (!(tri < l->mesh->n) || !mesh_finish(l, v, l->mesh->cluster_of[tri], wi, t, Ng, s))
+        return 0;
+    if (l->mesh->tex)
+        s->Li = light_mesh_radiance(l, tri, v3_madd(o, wi, t));
+    return 1;
 }
 
 /* The largest k in [lo, hi) with cdf[k] <= x. */
@@ -891,7 +988,11 @@ int light_mesh_sample(const Light *l, const LightMeshView *v, Vec3 o, float a, f
     float dist = v3_length(d);
     if (!(dist > 0.0f) || !(len > 0.0f))
         return 0;
-    return mesh_finish(l, v, c, v3_scale(d, 1.0f / dist), dist, v3_scale(n, 1.0f / len), s);
+    if (!mesh_finish(l, v, c, v3_scale(d, 1.0f / dist), dist, v3_scale(n, 1.0f / len), s))
+        return 0;
+    if (m->tex)
+        s->Li = mesh_radiance_at(l, k, su * (1.0f - b), su * b);
+    return 1;
 }
 
 /* A mesh light's sample without a view made for the point: one made here,
@@ -1085,19 +1186,7 @@ static Vec3 uber_slide(const Light *l, Vec3 p)
     float t = 0.5f - 0.5f * p.y / (p.z * (u->height + u->hedge));
     if (!(s >= 0.0f && s <= 1.0f && t >= 0.0f && t <= 1.0f))
         return v3(0, 0, 0);
-    float x = s * (float)m->width - 0.5f, y = t * (float)m->height - 0.5f;
-    float fx = floorf(x), fy = floorf(y), ax = x - fx, ay = y - fy;
-    Vec3 c = v3(0, 0, 0);
-    for (int j = 0; j < 2; j++)
-        for (int i = 0; i < 2; i++) {
-            int px = (int)fx + i, py = (int)fy + j;
-            px = px < 0 ? 0 : px >= m->width ? m->width - 1 : px;
-            py = py < 0 ? 0 : py >= m->height ? m->height - 1 : py;
-            const float *q = &m->rgb[3 * ((size_t)py * (size_t)m->width + (size_t)px)];
-            float wgt = (i ? ax : 1.0f - ax) * (j ? ay : 1.0f - ay);
-            c = v3_madd(c, v3(q[0], q[1], q[2]), wgt);
-        }
-    return c;
+    return rgb_bilinear(m->rgb, m->width, m->height, s, t);
 }
 
 /* The shaping of the light's intensity at light-space point p (Barzel's
@@ -1621,6 +1710,9 @@ static void mesh_free(LightMesh *m)
 {
     if (!m)
         return;
+    free(m->st);
+    free(m->place);
+    free(m->tex);
     free(m->v);
     free(m->cdf);
     free(m->cluster_of);

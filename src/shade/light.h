@@ -122,6 +122,13 @@ typedef struct LightMesh {
     uint32_t first_prim; /* the scene primitive of its first triangle */
     float area;          /* the whole mesh's */
     Vec3 lo, hi;         /* bounds */
+    /* An emission texture (light_mesh_texture): the radiance at a point is
+     * L times the image at its (s, t), bilinear, clamped at its edges,
+     * (0, 0) its top left. NULL: L everywhere. */
+    float *st;       /* 6 a triangle, in v's order: its corners' (s, t) */
+    uint32_t *place; /* n: triangle k of the scene's order -> its place in v */
+    float *tex;      /* tex_w x tex_h linear rgb, top row first */
+    int tex_w, tex_h;
 } LightMesh;
 
 /* A mesh light's clusters weighed as seen from one point: cdf over them. */
@@ -301,6 +308,17 @@ int light_intersect(const Light *l, Vec3 o, Vec3 wi, LightSample *s);
  * triangle has area. */
 int light_mesh_init(Light *l, const Vec3 *v, size_t n, int two_sided);
 
+/* Gives mesh light l (just made by light_mesh_init from the same n
+ * triangles) an emission texture: st holds each triangle's corners' (s, t),
+ * 6 floats a triangle in light_mesh_init's order, path names an image any
+ * format OpenImageIO reads (integer files sRGB, decoded to linear). Returns
+ * 0, or -1 with a message in err (the image cannot be read, or memory). */
+int light_mesh_texture(Light *l, const float *st, const char *path, char *err, size_t err_size);
+
+/* A mesh light's radiance at point P of its triangle tri (the scene's
+ * order): L, times its texture there when it has one. */
+Vec3 light_mesh_radiance(const Light *l, uint32_t tri, Vec3 P);
+
 /* Weighs a mesh light's clusters for the point o with normal N (zero: no
  * horizon), each by its area over the distance squared, times bounds on
  * the cosines at both ends: a cluster whose faces all face away from o, or
@@ -311,12 +329,12 @@ void light_mesh_view(const Light *l, Vec3 o, Vec3 N, LightMeshView *v);
 int light_mesh_sample(const Light *l, const LightMeshView *v, Vec3 o, float a, float b,
                       LightSample *s);
 
-/* A mesh light met at distance t along wi (unit) on its triangle tri (the
+/* A mesh light met at distance t along wi (unit) from o on its triangle tri (the
  * scene's order) where the unit geometric normal is Ng (front as above):
  * 1 and *s filled (the pdf light_mesh_sample would give with v) if that
  * side emits, else 0. */
-int light_mesh_finish(const Light *l, const LightMeshView *v, uint32_t tri, Vec3 wi, float t,
-                      Vec3 Ng, LightSample *s);
+int light_mesh_finish(const Light *l, const LightMeshView *v, uint32_t tri, Vec3 o, Vec3 wi,
+                      float t, Vec3 Ng, LightSample *s);
 
 /* The probability that the environment light's own sampling draws a
  * direction of guide bin b (the bins' sum is 1; 0 for an empty map). */

@@ -66,6 +66,8 @@ typedef struct Record {
     size_t mesh_light_faces[REC_MAX]; /* area_light_mesh: faces, radiance, sides */
     float mesh_light_L[REC_MAX][3];
     int mesh_light_two_sided[REC_MAX], n_mesh_light;
+    char mesh_light_texture[REC_MAX][256]; /* "" untextured */
+    float mesh_light_st0[REC_MAX][2];      /* the first point's (s, t) */
     RecShader light[REC_MAX]; /* type in name */
     int n_light;
     int links_mode;           /* the last set_light_links: RayesLightLinks */
@@ -285,9 +287,10 @@ static RayesError rec_area_light(void *t, const float P[4][3], const float L[3])
     return RAYES_OK;
 }
 
-static RayesError rec_area_light_mesh(void *t, size_t n_faces, const int *nv, const int *idx,
-                                      size_t n_points, const float *P, const float L[3],
-                                      int two_sided)
+static RayesError rec_area_light_mesh_textured(void *t, size_t n_faces, const int *nv,
+                                               const int *idx, size_t n_points, const float *P,
+                                               const float *st, const float L[3], int two_sided,
+                                               const char *texture)
 {
     Record *r = t;
     (void)nv, (void)idx, (void)n_points, (void)P;
@@ -296,8 +299,19 @@ static RayesError rec_area_light_mesh(void *t, size_t n_faces, const int *nv, co
         return RAYES_ERROR_OUT_OF_MEMORY;
     r->mesh_light_faces[r->n_mesh_light] = n_faces;
     memcpy(r->mesh_light_L[r->n_mesh_light], L, sizeof r->mesh_light_L[0]);
+    snprintf(r->mesh_light_texture[r->n_mesh_light], sizeof r->mesh_light_texture[0], "%s",
+             texture);
+    memcpy(r->mesh_light_st0[r->n_mesh_light], st, sizeof r->mesh_light_st0[0]);
     r->mesh_light_two_sided[r->n_mesh_light++] = two_sided;
     return RAYES_OK;
+}
+
+static RayesError rec_area_light_mesh(void *t, size_t n_faces, const int *nv, const int *idx,
+                                      size_t n_points, const float *P, const float L[3],
+                                      int two_sided)
+{
+    const float st0[2] = {0, 0};
+    return rec_area_light_mesh_textured(t, n_faces, nv, idx, n_points, P, st0, L, two_sided, "");
 }
 
 static RayesError rec_light(void *t, const char *type, const RayesParam *p, size_t n)
@@ -353,7 +367,8 @@ static IoSink record_sink(Record *r)
                     .light_count = rec_light_count,
                     .get_error = rec_error,
                     .subdivision_mesh = rec_subdiv,
-                    .area_light_mesh = rec_area_light_mesh};
+                    .area_light_mesh = rec_area_light_mesh,
+                    .area_light_mesh_textured = rec_area_light_mesh_textured};
 }
 
 static void record_free(Record *r)

@@ -215,5 +215,86 @@ static void test_pbrt_goniometric(void)
     rayes_scene_release(s);
 }
 
+/* Textured emitters: RIB's arealight "texturename" over the shape's st,
+ * written back and read again (the same texture coordinates, corner for
+ * corner); pbrt-v4's "filename" over a bilinear patch (its default uv,
+ * looked up at (u, 1 - v)) and over a triangle mesh's uv. */
+static void test_textured_emitters(void)
+{
+    const char *path = RAYES_TEST_TMP "/test_emit_tex.exr";
+    float px[4 * 2 * 4];
+    for (int i = 0; i < 8; i++)
+        for (int c = 0; c < 4; c++)
+            px[4 * i + c] = c == 3 ? 1.0f : (float)(i + c) / 8.0f;
+    CHECK(image_write_exr(path, 4, 2, px, NULL, 0) == RAYES_OK);
+    char text[1024];
+    snprintf(text, sizeof text,
+             WORLD("Translate 0 0 5\nAttributeBegin\n"
+                   "AreaLightSource \"arealight\" 1 \"color lightcolor\" [2 2 2] "
+                   "\"string texturename\" \"%s\"\n"
+                   "PointsPolygons [4] [0 1 2 3] \"P\" [0 0 0 1 0 0 1 1 0 0 1 0] "
+                   "\"st\" [0 1 1 1 1 0 0 0]\nAttributeEnd"),
+             path);
+    char err[256];
+    RayesError e;
+    char *written = rib_round_trip(text, err, sizeof err);
+    CHECK(written && strstr(written, "texturename") && strstr(written, "\"st\""));
+    RayesScene *a = rib_read_scene(text, &e, err, sizeof err);
+    CHECK(e == RAYES_OK);
+    RayesScene *b = written ? rib_read_scene(written, &e, err, sizeof err) : NULL;
+    CHECK(b && e == RAYES_OK);
+    if (b && a->n_lights == 1 && b->n_lights == 1 && a->lights[0].type == LIGHT_MESH &&
+        b->lights[0].type == LIGHT_MESH) {
+        const LightMesh *m = a->lights[0].mesh, *n = b->lights[0].mesh;
+        CHECK(m->tex && n->tex && m->tex_w == 4 && m->tex_h == 2 && n->n == m->n);
+        CHECK(m->st && n->st && memcmp(m->st, n->st, 6 * m->n * sizeof *m->st) == 0);
+        /* the corner at (0, 0, 0) of the file is st (0, 1): the image's
+         * bottom left; the light's radiance there is L times that texel */
+        Vec3 at = v3(0.001f, 0.001f, 5.0f), want = v3(2 * 4 / 8.0f, 2 * 5 / 8.0f, 2 * 6 / 8.0f);
+        uint32_t tri = 0;
+        for (uint32_t k = 0; k < m->n; k++) /* the triangle holding that corner */
+            for (int c = 0; c < 3; c++)
+                tri = m->v[3 * m->place[k] + (size_t)c].x == 0.0f &&
+                              m->v[3 * m->place[k] + (size_t)c].y == 0.0f
+                          ? k
+                          : tri;
+        Vec3 got = light_mesh_radiance(&a->lights[0], tri, at);
+        CHECK_NEAR(got.x, want.x, 0.02);
+        CHECK_NEAR(got.z, want.z, 0.02);
+    } else {
+        CHECK(!"one mesh light each");
+    }
+    rayes_scene_release(a);
+    if (b)
+        rayes_scene_release(b);
+    free(written);
+    /* pbrt-v4: a bilinear patch (default uv) and a triangle mesh's uv */
+    snprintf(text, sizeof text,
+             "WorldBegin\nAttributeBegin\nAreaLightSource \"diffuse\" \"string filename\" "
+             "\"%s\" \"float scale\" 3\n"
+             "Shape \"bilinearmesh\" \"point3 P\" [0 0 0 1 0 0 0 1 0 1 1 0]\nAttributeEnd\n"
+             "AttributeBegin\nAreaLightSource \"diffuse\" \"string filename\" \"%s\"\n"
+             "Shape \"trianglemesh\" \"point3 P\" [0 0 1 1 0 1 1 1 1] \"integer indices\" "
+             "[0 1 2] \"point2 uv\" [0 0 1 0 0.25 0.75]\nAttributeEnd\n",
+             path, path);
+    RayesScene *s = pbrt_read_scene(text, &e, err, sizeof err);
+    CHECK(e == RAYES_OK && s->n_lights == 2);
+    if (e == RAYES_OK && s->n_lights == 2 && s->lights[0].type == LIGHT_MESH &&
+        s->lights[1].type == LIGHT_MESH) {
+        const LightMesh *m = s->lights[0].mesh, *n = s->lights[1].mesh;
+        CHECK(m->tex && n->tex && s->lights[0].L.x == 3.0f && s->lights[1].L.x == 1.0f);
+        /* the triangle's third corner: uv (0.25, 0.75), st (0.25, 0.25) */
+        CHECK(n->n == 1 && n->st[4] == 0.25f && n->st[5] == 0.25f);
+        float lo = 1, hi = 0; /* the patch's t spans 0 to 1 */
+        for (size_t k = 0; k < 6 * m->n; k += 2)
+            lo = fminf(lo, m->st[k + 1]), hi = fmaxf(hi, m->st[k + 1]);
+        CHECK(lo == 0.0f && hi == 1.0f);
+    } else {
+        CHECK(!"two mesh lights");
+    }
+    rayes_scene_release(s);
+}
+
 TEST_MAIN(TEST(test_polygons_under_area_lights), TEST(test_round_trip),
-          TEST(test_quadrics_and_motion), TEST(test_bmrt_units), TEST(test_pbrt_goniometric))
+          TEST(test_quadrics_and_motion), TEST(test_bmrt_units), TEST(test_pbrt_goniometric),
+          TEST(test_textured_emitters))

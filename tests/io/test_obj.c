@@ -355,6 +355,33 @@ static void test_default_camera_and_light(void)
     record_free(&rec);
 }
 
+/* map_Ke: an emitter textured over its faces' vt (a sign, a screen), one
+ * mesh light however few quads, t = 1 - v, the map alone when Ke is 0 or
+ * missing; faces without vt emit Ke alone, with a warning. */
+static void test_emission_map(void)
+{
+    test_write_text(DIR "/sign.mtl", "newmtl sign\nKe 0 0 0\nmap_Ke sign.png\n"
+                                     "newmtl tinted\nKe 2 1 1\nmap_Ke sign.png\n");
+    test_write_text(DIR "/sign.png", "not read by the parser");
+    CHECK(parse(DIR "/sign.obj", "mtllib sign.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\n"
+                                 "vt 0.25 0\nvt 1 0\nvt 1 1\nvt 0 1\n"
+                                 "usemtl sign\nf 1/1 2/2 3/3 4/4\n"
+                                 "usemtl tinted\nf 1/1 2/2 3/3\n") == RAYES_OK);
+    CHECK(rec.n_area == 0 && rec.n_mesh_light == 2 && rec.n_light == 0);
+    CHECK(strcmp(rec.mesh_light_texture[0], DIR "/sign.png") == 0);
+    CHECK(rec.mesh_light_L[0][0] == 1.0f && rec.mesh_light_L[0][2] == 1.0f); /* the map alone */
+    CHECK(rec.mesh_light_st0[0][0] == 0.25f && rec.mesh_light_st0[0][1] == 1.0f);
+    CHECK(rec.mesh_light_L[1][0] == 2.0f && rec.mesh_light_texture[1][0] != '\0');
+    record_free(&rec);
+    /* without vt: Ke alone (here the map's white), untextured */
+    CHECK(parse(DIR "/sign2.obj", "mtllib sign.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\n"
+                                  "usemtl sign\nf 1 2 3\n") == RAYES_OK);
+    CHECK(rec.n_mesh_light == 1);
+    CHECK(rec.mesh_light_texture[0][0] == '\0');
+    CHECK(rec.mesh_light_L[0][1] == 1.0f);
+    record_free(&rec);
+}
+
 /* The default light follows the view the caller will set: from behind
  * the geometry (looking down +z) it comes from that view's upper left;
  * from inside the bounds (a room) it is a headlight along the view that
@@ -818,7 +845,7 @@ static void test_transparency(void)
 TEST_MAIN(TEST(test_face_syntax), TEST(test_ngons), TEST(test_materials), TEST(test_opacity_words),
           TEST(test_map_paths), TEST(test_bump_maps), TEST(test_pbr_extension),
           TEST(test_specular_map), TEST(test_default_camera_and_light),
-          TEST(test_default_light_follows_the_view), TEST(test_errors),
+          TEST(test_default_light_follows_the_view), TEST(test_emission_map), TEST(test_errors),
           TEST(test_unknown_statements), TEST(test_read_file),
           TEST(test_normals_and_texture_coordinates), TEST(test_transparency),
           TEST(test_smoothing_groups), TEST(test_vertex_colours))

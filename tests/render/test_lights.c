@@ -1516,6 +1516,93 @@ static void test_emitters_seen_by_camera(void)
     rayes_scene_release(s);
 }
 
+/* A textured mesh light (rayes_scene_area_light_mesh_textured): the
+ * camera sees L times the image at the hit's (s, t); a uniform image of
+ * 0.5 lights the floor as a light of L 0.5 does; an image red on one side
+ * and green on the other lights the floor under each side in its colour;
+ * a texture that cannot be read, or no st, is refused. */
+static void test_textured_mesh_light(void)
+{
+    const char *two = RAYES_TEST_TMP "/test_lights_emit_two.exr";
+    const char *grey = RAYES_TEST_TMP "/test_lights_emit_grey.exr";
+    float px[4 * 4] = {1, 0, 0, 1, 1, 0, 0, 1, 0, 1, 0, 1, 0, 1, 0, 1}; /* red red green green */
+    CHECK(image_write_exr(two, 4, 1, px, NULL, 0) == RAYES_OK);
+    for (int i = 0; i < 4; i++)
+        px[4 * i] = px[4 * i + 1] = px[4 * i + 2] = 0.5f;
+    CHECK(image_write_exr(grey, 4, 1, px, NULL, 0) == RAYES_OK);
+    const float P[12] = {-1, -1, 0, 1, -1, 0, 1, 1, 0, -1, 1, 0};
+    const float st[8] = {0, 1, 1, 1, 1, 0, 0, 0}; /* s along x, (0, 0) at the top left */
+    const int toward[6] = {0, 2, 1, 0, 3, 2}, nv[2] = {3, 3};
+    const float L2[3] = {2, 2, 2};
+    /* seen: each side's texel times L, exactly */
+    RayesScene *m = rayes_scene_new();
+    float eye[3] = {0, 0, -4}, target[3] = {0, 0, 0}, up[3] = {0, 1, 0};
+    CHECK(rayes_scene_set_camera(m, eye, target, up, 30.0f) == RAYES_OK);
+    CHECK(rayes_scene_area_light_mesh_textured(m, 2, nv, toward, 4, P, st, L2, 0, two) == RAYES_OK);
+    RayesImage *img = render_scene(m, 1, 16);
+    const float *a = img ? &img->rgba[4 * (8 * 16 + 2)] : NULL;
+    const float *b = img ? &img->rgba[4 * (8 * 16 + 13)] : NULL;
+    CHECK(a && b && a[0] + a[1] == 2.0f && b[0] + b[1] == 2.0f && a[2] == 0.0f);
+    CHECK(a && b && a[0] != b[0]); /* one side red, the other green */
+    rayes_image_free(img);
+    rayes_scene_release(m);
+    /* lighting a floor from above: the grey image against L 0.5, and the
+     * two colours under each side */
+    float floor_mean[3][2][3]; /* scene, half of the image (left, right), rgb */
+    for (int k = 0; k < 3; k++) {
+        RayesScene *s = rayes_scene_new();
+        float e2[3] = {0, 3, -3}, t2[3] = {0, 0, 0};
+        CHECK(rayes_scene_set_camera(s, e2, t2, up, 50.0f) == RAYES_OK);
+        RayesParam kd = pf("Kd", 1);
+        CHECK(rayes_scene_set_shader(s, "matte", &kd, 1) == RAYES_OK);
+        float fl[4][3] = {{-3, 0, -3}, {3, 0, -3}, {-3, 0, 3}, {3, 0, 3}};
+        CHECK(rayes_scene_bilinear_patch(s, fl) == RAYES_OK);
+        /* the light 1 unit up, facing down, s along x */
+        const float Q[12] = {-1, 1, -1, 1, 1, -1, 1, 1, 1, -1, 1, 1};
+        const int down[6] = {0, 1, 2, 0, 2, 3};
+        const float half[3] = {0.5f, 0.5f, 0.5f}, one[3] = {1, 1, 1};
+        RayesError e = k == 0 ? rayes_scene_area_light_mesh(s, 2, nv, down, 4, Q, half, 0)
+                              : rayes_scene_area_light_mesh_textured(s, 2, nv, down, 4, Q, st, one,
+                                                                     0, k == 1 ? grey : two);
+        CHECK(e == RAYES_OK);
+        img = render_scene(s, 2, 32);
+        for (int h = 0; h < 2; h++)
+            for (int c = 0; c < 3; c++) {
+                double sum = 0.0;
+                for (int y = 12; img && y < 32; y++)
+                    for (int x = h * 16; x < h * 16 + 16; x++)
+                        sum += img->rgba[4 * (y * 32 + x) + c];
+                floor_mean[k][h][c] = (float)(sum / (20 * 16));
+            }
+        rayes_image_free(img);
+        rayes_scene_release(s);
+    }
+    printf("  floor, left / right half (r g b): L 0.5 %.4f %.4f / %.4f %.4f, grey image %.4f "
+           "%.4f / %.4f %.4f, red and green %.4f %.4f / %.4f %.4f\n",
+           floor_mean[0][0][0], floor_mean[0][0][1], floor_mean[0][1][0], floor_mean[0][1][1],
+           floor_mean[1][0][0], floor_mean[1][0][1], floor_mean[1][1][0], floor_mean[1][1][1],
+           floor_mean[2][0][0], floor_mean[2][0][1], floor_mean[2][1][0], floor_mean[2][1][1]);
+    for (int h = 0; h < 2; h++)
+        for (int c = 0; c < 3; c++)
+            CHECK(floor_mean[0][h][c] > 0.05f &&
+                  fabsf(floor_mean[1][h][c] - floor_mean[0][h][c]) < 1e-4f * floor_mean[0][h][c]);
+    /* each half of the floor takes the colour of the light above it */
+    float r_l = floor_mean[2][0][0], g_l = floor_mean[2][0][1];
+    float r_r = floor_mean[2][1][0], g_r = floor_mean[2][1][1];
+    CHECK((r_l > 1.5f * g_l && g_r > 1.5f * r_r) || (g_l > 1.5f * r_l && r_r > 1.5f * g_r));
+    CHECK(floor_mean[2][0][2] < 1e-6f && floor_mean[2][1][2] < 1e-6f);
+    /* refused: an image that cannot be read, no st */
+    RayesScene *bad = rayes_scene_new();
+    CHECK(rayes_scene_area_light_mesh_textured(bad, 2, nv, toward, 4, P, st, L2, 0,
+                                               RAYES_TEST_TMP
+                                               "/no_such_emission.exr") == RAYES_ERROR_IO);
+    CHECK(strstr(rayes_scene_get_error(bad), "no_such_emission") != NULL);
+    CHECK(rayes_scene_area_light_mesh_textured(bad, 2, nv, toward, 4, P, NULL, L2, 0, two) ==
+          RAYES_ERROR_INVALID_ARGUMENT);
+    CHECK(rayes_scene_light_count(bad) == 0);
+    rayes_scene_release(bad);
+}
+
 /* ---------------------------------------------------------- determinism */
 
 static RayesScene *every_light_scene(void)
@@ -1878,6 +1965,6 @@ TEST_MAIN(TEST(test_point_light_inverse_square), TEST(test_spot_light_cone),
           TEST(test_quad_light_close), TEST(test_environment_map_importance_sampling),
           TEST(test_environment_map_sampling_consistency), TEST(test_octahedral_environment_map),
           TEST(test_point_light_maps), TEST(test_categories), TEST(test_emitters_seen_by_camera),
-          TEST(test_every_light_any_thread_count), TEST(test_uber_light_shaping),
-          TEST(test_uber_light_shadows), TEST(test_uber_light_slide), TEST(test_light_output_flags),
-          TEST(test_bad_lights))
+          TEST(test_textured_mesh_light), TEST(test_every_light_any_thread_count),
+          TEST(test_uber_light_shaping), TEST(test_uber_light_shadows), TEST(test_uber_light_slide),
+          TEST(test_light_output_flags), TEST(test_bad_lights))
