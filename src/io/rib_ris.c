@@ -831,6 +831,16 @@ static int make_light(Rib *r, const char *handle, const char *cls, const float L
         float half[3] = {0.5f, 0, 0};
         if (!rect)
             rib_light_param(l, "radius", RAYES_PARAM_FLOAT, half, NULL);
+        if (rect && map && map[0]) { /* lightColorMap: the image over the square */
+            map = rib_texture_source(r, map);
+            if (rib_texture_found(r, map))
+                rib_light_param(l, "mapname", RAYES_PARAM_STRING, NULL, map);
+            else
+                rib_warn_once(r, "rect light map",
+                              "light \"%s\": lightColorMap \"%.200s\" is not found as given nor "
+                              "on the texture search path; the light is even",
+                              cls, map);
+        }
     } else if (dist) {
         float from[3] = {0, 0, 0}, to[3] = {0, 0, 1};
         rib_light_param(l, "from", RAYES_PARAM_COLOR, from, NULL);

@@ -1263,6 +1263,7 @@ static int h_light_source(Rib *r, const Args *a)
         "radius",       "shadows",    "__nondiffuse", "__nonspecular",  "cone",
         "conesoftness", NULL};
     int mapped = strcmp(type, "pointlight") == 0 || strcmp(type, "spotlight") == 0;
+    int area_map = strcmp(type, "arealight") == 0; /* a quad's image over it */
     /* RenderMan's point, spot and distant lights: diffuse() sums Cl (L.N)
      * with no 1/pi, so their intensity is pi times rayes' (DESIGN.md,
      * "Lights"); the default intensity 1 too */
@@ -1281,18 +1282,20 @@ static int h_light_source(Rib *r, const Args *a)
          * own), or an environment's */
         int map_param =
             env ||
-            (mapped && (strcmp(q->d.name, "mapname") == 0 || strcmp(q->d.name, "mapping") == 0));
+            (mapped && (strcmp(q->d.name, "mapname") == 0 || strcmp(q->d.name, "mapping") == 0)) ||
+            (area_map && strcmp(q->d.name, "mapname") == 0);
         if (map_param &&
             environment_map(r, L, q, &L->params[L->n], L->names[L->n], sizeof L->names[0])) {
             /* a map that is not there (for a production light, a renderer's
              * own format elsewhere): an even light, a constant environment */
-            if ((mapped || strcmp(name, "environmentlight") != 0) && L->mapname[0] &&
+            if ((mapped || area_map || strcmp(name, "environmentlight") != 0) && L->mapname[0] &&
                 strcmp(L->names[L->n], "mapname") == 0 && !rib_texture_found(r, L->mapname)) {
-                rib_warn_once(r, mapped ? "point light map" : "light map",
+                int even = mapped || area_map;
+                rib_warn_once(r, even ? "point light map" : "light map",
                               "light%s \"%s\": map \"%.200s\" is not found as given nor on the "
                               "texture search path; %s",
-                              mapped ? "" : " shader", name, L->mapname,
-                              mapped ? "the light is even" : "a constant environment");
+                              even ? "" : " shader", name, L->mapname,
+                              even ? "the light is even" : "a constant environment");
                 L->mapname[0] = '\0';
                 continue;
             }

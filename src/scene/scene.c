@@ -2143,6 +2143,22 @@ RayesError rayes_scene_light(RayesScene *s, const char *type, const RayesParam *
         float w = 0.5f * lp.width, h = 0.5f * lp.height;
         const float P[4][3] = {{-w, -h, 0}, {w, -h, 0}, {w, h, 0}, {-w, h, 0}};
         float L[3] = {l.L.x, l.L.y, l.L.z};
+        if (lp.mapname[0]) { /* an image over it (PxrRectLight's lightColorMap): upright seen
+                                from the side it lights, its top at +y */
+            static const float st[8] = {0, 1, 1, 1, 1, 0, 0, 0};
+            static const int nv[1] = {4}, idx[4] = {0, 1, 2, 3};
+            if (cone > 0.0f)
+                log_warning_once("textured quad cone", "arealight: a quad with a map lights "
+                                                       "without its cone");
+            e = rayes_scene_area_light_mesh_textured(s, 1, nv, idx, 4, &P[0][0], st, L, 0,
+                                                     lp.mapname);
+            if (e == RAYES_OK) {
+                Light *made = &s->lights[s->n_lights - 1];
+                take_controls(made, &l);
+                made->cone = made->cone_start = 0.0f;
+            }
+            return e;
+        }
         e = rayes_scene_area_light(s, P, L);
         if (e == RAYES_OK)
             take_controls(&s->lights[s->n_lights - 1], &l);

@@ -293,6 +293,25 @@ static void test_textured_emitters(void)
         CHECK(!"two mesh lights");
     }
     rayes_scene_release(s);
+    /* RenderMan's PxrRectLight with a lightColorMap: a quad of the image,
+     * written back as rayes' arealight with its mapname, read again */
+    snprintf(text, sizeof text,
+             WORLD("Light \"PxrRectLight\" \"r\" \"float intensity\" [2] "
+                   "\"string lightColorMap\" \"%s\"\nBxdf \"PxrDiffuse\" \"d\"\n"
+                   "Polygon \"P\" [-3 -1 -3 3 -1 -3 3 -1 3 -3 -1 3]"),
+             path);
+    written = rib_round_trip(text, err, sizeof err);
+    CHECK(written && strstr(written, "\"string mapname\"") != NULL);
+    for (int pass = 0; pass < 2; pass++) {
+        RayesScene *q = rib_read_scene(pass ? (written ? written : "") : text, &e, err, sizeof err);
+        CHECK(e == RAYES_OK && q->n_lights == 1);
+        if (e == RAYES_OK && q->n_lights == 1) {
+            const Light *l = &q->lights[0];
+            CHECK(l->type == LIGHT_MESH && l->mesh->tex && l->mesh->n == 2 && l->L.x == 2.0f);
+        }
+        rayes_scene_release(q);
+    }
+    free(written);
 }
 
 TEST_MAIN(TEST(test_polygons_under_area_lights), TEST(test_round_trip),
