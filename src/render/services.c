@@ -264,18 +264,19 @@ static Vec3 light_transmittance(Worker *w, const Light *l, Vec3 o, Vec3 wi, floa
 
 /* A direction wi that a lobe drew from o toward light l: 1 with the
  * light's sample there (its pdf) and *Li its radiance times the
- * transmittance, 0 when it adds nothing. An environment is hit by every
+ * transmittance from o_shadow (o, or a fibre's side), 0 when it adds
+ * nothing. An environment is hit by every
  * direction, and its map's look-up is a cache miss where the shadow ray
  * often ends on a wall (an interior lit through its windows): it traces
  * the ray first and looks the map up only for a direction it sees (the
  * same sums: an occluded direction adds 0 either way). */
-static int lobe_light(Worker *w, const Light *l, const LightMeshView *v, Vec3 o, Vec3 wi,
-                      RayDiff diff, LightSample *ls, Vec3 *Li)
+static int lobe_light(Worker *w, const Light *l, const LightMeshView *v, Vec3 o, Vec3 o_shadow,
+                      Vec3 wi, RayDiff diff, LightSample *ls, Vec3 *Li)
 {
     if (l->type == LIGHT_ENVIRONMENT) {
         if (!light_env_may_emit(l, wi))
             return 0;
-        Vec3 T = light_transmittance(w, l, o, wi, INFINITY, diff);
+        Vec3 T = light_transmittance(w, l, o_shadow, wi, INFINITY, diff);
         if (!(v3_max_component(T) > 0.0f) || !light_hit(w, l, v, o, wi, ls) ||
             !(v3_max_component(ls->Li) > 0.0f))
             return 0;
@@ -284,7 +285,7 @@ static int lobe_light(Worker *w, const Light *l, const LightMeshView *v, Vec3 o,
     }
     if (!light_hit(w, l, v, o, wi, ls) || !(v3_max_component(ls->Li) > 0.0f))
         return 0;
-    *Li = v3_mul(ls->Li, light_transmittance(w, l, o, wi, ls->dist, diff));
+    *Li = v3_mul(ls->Li, light_transmittance(w, l, o_shadow, wi, ls->dist, diff));
     return 1;
 }
 
@@ -432,7 +433,7 @@ static void light_area(Worker *w, const DirectPoint *p, const Light *l, uint64_t
                 cos_x = v3_dot(p->N, wi);
                 Vec3 Li;
                 if (cos_x > 0.0f && v3_dot(p->Ng, wi) > 0.0f && light_bound_may_hit(&bound, wi) &&
-                    lobe_light(w, l, &view, p->o, wi, p->shadow, &ls, &Li)) {
+                    lobe_light(w, l, &view, p->o, p->o, wi, p->shadow, &ls, &Li)) {
                     if (p->guide)
                         ls.pdf *= light_guide_factor(l, p->guide, wi);
                     sum_d = v3_madd(sum_d, Li, power_heuristic(cos_x / (float)M_PI, ls.pdf));
@@ -448,7 +449,7 @@ static void light_area(Worker *w, const DirectPoint *p, const Light *l, uint64_t
                 continue;
             float pdf = lobe_pdf(&p->lobe, wi);
             Vec3 Li;
-            if (!(pdf > 0.0f) || !lobe_light(w, l, &view, p->o, wi, p->shadow, &ls, &Li))
+            if (!(pdf > 0.0f) || !lobe_light(w, l, &view, p->o, p->o, wi, p->shadow, &ls, &Li))
                 continue;
             if (p->guide)
                 ls.pdf *= light_guide_factor(l, p->guide, wi);
@@ -694,14 +695,12 @@ static void fiber_lobe_samples(Worker *w, const FiberPoint *p, const Light *l,
         cmj_pattern_sample(&pat_c, (uint32_t)j, &c, &c2);
         Vec3 wi;
         LightSample ls;
-        if (!fiber_lobe_sample(p->T, p->V, p->e, a, b, c, &wi) ||
-            !light_hit(w, l, view, p->P, wi, &ls) || !(v3_max_component(ls.Li) > 0.0f))
+        if (!fiber_lobe_sample(p->T, p->V, p->e, a, b, c, &wi))
             continue;
         float pdf = fiber_lobe_pdf(p->T, p->V, wi, p->e);
-        if (!(pdf > 0.0f))
+        if (!(pdf > 0.0f) ||
+            !lobe_light(w, l, view, p->P, fiber_origin(p, wi), wi, p->shadow, &ls, &ls.Li))
             continue;
-        ls.Li =
-            v3_mul(ls.Li, light_transmittance(w, l, fiber_origin(p, wi), wi, ls.dist, p->shadow));
         fiber_terms(p->T, p->V, wi, p->e, &fd, &fs);
         *s = v3_madd(*s, ls.Li, fs * power_heuristic(pdf, ls.pdf) / (pdf * (float)m));
     }
@@ -887,12 +886,11 @@ static Vec3 hair_light(Worker *w, const HairPoint *p, const Light *l, int m, uin
             }
         }
         Vec3 wi;
+        Vec3 Li;
         if (!hair_draw(p, bsdf, &draws, j, &wi, &pdf) || !light_bound_may_hit(&bound, wi) ||
-            !light_hit(w, l, &view, p->f.P, wi, &ls) || !(v3_max_component(ls.Li) > 0.0f))
+            !lobe_light(w, l, &view, p->f.P, fiber_origin(&p->f, wi), wi, p->f.shadow, &ls, &Li))
             continue;
         Vec3 f = hair_bsdf_f(bsdf, p->wo, hair_local(p, wi));
-        Vec3 Li = v3_mul(
-            ls.Li, light_transmittance(w, l, fiber_origin(&p->f, wi), wi, ls.dist, p->f.shadow));
         sum = v3_add(sum, v3_scale(v3_mul(Li, f), power_heuristic(pdf, ls.pdf) / pdf));
     }
     return v3_scale(sum, 1.0f / (float)m);
