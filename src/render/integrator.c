@@ -444,6 +444,8 @@ static Vec3 trace_layers(Worker *w, const Ray *ray, uint32_t kind, int diffuse_d
         if (l->type == LIGHT_MESH && l->mesh->tex) /* its texture at the hit */
             return light_mesh_radiance(l, w->rs->gs->grids[hit.grid].prim - l->mesh->first_prim,
                                        v3_madd(ray->o, ray->d, hit.t));
+        if (l->cone > 0.0f) /* seen from outside its cone, dark, as it lights */
+            return v3_scale(l->L, light_cone_factor(l, -v3_dot(hit.Ng, v3_normalize(ray->d))));
         return l->L;
     }
     int see_through = obj->transparent && layer < INTEGRATOR_MAX_LAYERS;

@@ -104,6 +104,11 @@ static float cone_factor(const Light *l, float cos_y)
     return 1.0f - x * x * (3.0f - 2.0f * x);
 }
 
+float light_cone_factor(const Light *l, float cos_y)
+{
+    return cone_factor(l, cos_y);
+}
+
 static int area_finish(const Light *l, Vec3 wi, float d, Vec3 ny, LightSample *s)
 {
     float jac = v3_length(ny);

@@ -315,6 +315,11 @@ int light_mesh_init(Light *l, const Vec3 *v, size_t n, int two_sided);
  * 0, or -1 with a message in err (the image cannot be read, or memory). */
 int light_mesh_texture(Light *l, const float *st, const char *path, char *err, size_t err_size);
 
+/* What a quad's or disk's emission cone (Light.cone) leaves of its
+ * radiance toward a direction at cos_y to its normal: 1 within the cone's
+ * start, fading by a smoothstep to 0 at its edge; 1 without a cone. */
+float light_cone_factor(const Light *l, float cos_y);
+
 /* A mesh light's radiance at point P of its triangle tri (the scene's
  * order): L, times its texture there when it has one. */
 Vec3 light_mesh_radiance(const Light *l, uint32_t tri, Vec3 P);

@@ -1503,6 +1503,26 @@ static void test_emitters_seen_by_camera(void)
         rayes_image_free(img);
         rayes_scene_release(m);
     }
+    /* A quad with an emission cone of 25 degrees, seen head-on: its
+     * radiance; turned 60 degrees away: dark, as it lights nothing there */
+    for (int turned = 0; turned < 2; turned++) {
+        RayesScene *q = rayes_scene_new();
+        float eye[3] = {0, 0, -4}, target[3] = {0, 0, 0}, up[3] = {0, 1, 0};
+        CHECK(rayes_scene_set_camera(q, eye, target, up, 30.0f) == RAYES_OK);
+        float c = cosf(turned ? 60.0f * (float)M_PI / 180.0f : 0.0f);
+        float sn = sqrtf(1.0f - c * c);
+        /* y flipped and z turned toward the camera (-z), then about y */
+        const float m[16] = {c, 0, -sn, 0, 0, -1, 0, 0, -sn, 0, -c, 0, 0, 0, 0, 1};
+        CHECK(rayes_scene_set_transform(q, m) == RAYES_OK);
+        RayesParam p[4] = {ps("shape", "quad"), pf("width", 1.5f), pf("cone", 25.0f),
+                           pv("lightcolor", 3, 2, 1)};
+        CHECK(rayes_scene_light(q, "arealight", p, 4) == RAYES_OK);
+        RayesImage *img = render_scene(q, 1, 16);
+        const float *px = img ? &img->rgba[4 * (8 * 16 + 8)] : NULL;
+        CHECK(px && px[3] == 1.0f && px[0] == (turned ? 0.0f : 3.0f));
+        rayes_image_free(img);
+        rayes_scene_release(q);
+    }
     /* A disk seen from behind is black. */
     RayesScene *s = rayes_scene_new();
     float eye[3] = {0, 0, -4}, target[3] = {0, 0, 0}, up[3] = {0, 1, 0};
