@@ -626,7 +626,8 @@ RAYES_API RayesError rayes_scene_area_light_mesh(RayesScene *scene, size_t n_fac
  * area, not by the image's brightness. texture names an image any format
  * OpenImageIO reads (integer files are sRGB and come back linear), found as
  * shaders' textures are (as given, then on the texture search path) and
- * read whole when the light is made: RAYES_ERROR_IO when it cannot be read. */
+ * read whole when the light is made (halved until at most 2048 texels a
+ * side): RAYES_ERROR_IO when it cannot be read. */
 RAYES_API RayesError rayes_scene_area_light_mesh_textured(RayesScene *scene, size_t n_faces,
                                                           const int *n_verts, const int *indices,
                                                           size_t n_points, const float *P,

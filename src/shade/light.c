@@ -770,6 +770,26 @@ int light_mesh_texture(Light *l, const float *st, const char *path, char *err, s
         snprintf(err, err_size, "area light texture: %s", ierr);
         return -1;
     }
+    /* kept whole in memory, at most LIGHT_TEXTURE_MAX texels a side: a
+     * larger image is halved (2 x 2 means) until it fits (a 4096-square
+     * emission image would hold 200 MB) */
+    while (w > LIGHT_TEXTURE_MAX || h > LIGHT_TEXTURE_MAX) {
+        int w2 = (w + 1) / 2, h2 = (h + 1) / 2;
+        for (int y = 0; y < h2; y++)
+            for (int x = 0; x < w2; x++) {
+                float sum[4] = {0, 0, 0, 0};
+                int n = 0;
+                for (int j = 2 * y; j < 2 * y + 2 && j < h; j++)
+                    for (int i = 2 * x; i < 2 * x + 2 && i < w; i++, n++)
+                        for (int c = 0; c < 4; c++) {
+                            float v = rgba[4 * ((size_t)j * (size_t)w + (size_t)i) + (size_t)c];
+                            sum[c] += isfinite(v) && v > 0.0f ? v : 0.0f;
+                        }
+                for (int c = 0; c < 4; c++) /* in place: (x, y) is read before written */
+                    rgba[4 * ((size_t)y * (size_t)w2 + (size_t)x) + (size_t)c] = sum[c] / (float)n;
+            }
+        w = w2, h = h2;
+    }
     size_t n_px = (size_t)w * (size_t)h;
     m->st = malloc(6 * m->n * sizeof *m->st);
     m->tex = malloc(3 * n_px * sizeof *m->tex);

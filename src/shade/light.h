@@ -308,6 +308,9 @@ int light_intersect(const Light *l, Vec3 o, Vec3 wi, LightSample *s);
  * triangle has area. */
 int light_mesh_init(Light *l, const Vec3 *v, size_t n, int two_sided);
 
+/* The largest side of an emission texture kept (light_mesh_texture). */
+#define LIGHT_TEXTURE_MAX 2048
+
 /* Gives mesh light l (just made by light_mesh_init from the same n
  * triangles) an emission texture: st holds each triangle's corners' (s, t),
  * 6 floats a triangle in light_mesh_init's order, path names an image any

@@ -293,6 +293,30 @@ static void test_textured_emitters(void)
         CHECK(!"two mesh lights");
     }
     rayes_scene_release(s);
+    /* an image wider than LIGHT_TEXTURE_MAX is halved until it fits, its
+     * halves keeping their colours */
+    const char *wide = RAYES_TEST_TMP "/test_emit_wide.exr";
+    enum { WIDE = 2 * LIGHT_TEXTURE_MAX + 4 };
+    float *row = calloc(4 * WIDE * 3, sizeof *row);
+    for (int i = 0; row && i < WIDE * 3; i++) {
+        row[4 * i + ((i % WIDE) < WIDE / 2 ? 0 : 1)] = 1.0f; /* red, then green */
+        row[4 * i + 3] = 1.0f;
+    }
+    CHECK(row && image_write_exr(wide, WIDE, 3, row, NULL, 0) == RAYES_OK);
+    free(row);
+    snprintf(text, sizeof text,
+             "WorldBegin\nAreaLightSource \"diffuse\" \"string filename\" \"%s\"\n"
+             "Shape \"bilinearmesh\" \"point3 P\" [0 0 0 1 0 0 0 1 0 1 1 0]\n",
+             wide);
+    s = pbrt_read_scene(text, &e, err, sizeof err);
+    CHECK(e == RAYES_OK && s->n_lights == 1);
+    if (e == RAYES_OK && s->n_lights == 1 && s->lights[0].type == LIGHT_MESH) {
+        const LightMesh *m = s->lights[0].mesh;
+        CHECK(m->tex_w == WIDE / 4 && m->tex_h == 1);
+        CHECK(m->tex && m->tex[0] == 1.0f && m->tex[1] == 0.0f); /* the left: red */
+        CHECK(m->tex && m->tex[3 * (m->tex_w - 1) + 1] == 1.0f); /* the right: green */
+    }
+    rayes_scene_release(s);
     /* RenderMan's PxrRectLight with a lightColorMap: a quad of the image,
      * written back as rayes' arealight with its mapname, read again */
     snprintf(text, sizeof text,
