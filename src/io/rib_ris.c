@@ -764,6 +764,20 @@ static void on_everywhere(Rib *r, const Light *l)
         r->stack[d].a.on[k / 8] |= (unsigned char)(1u << (k % 8));
 }
 
+/* Light l's mapname, map (found as textures are), or one warning saying
+ * what the light is without it. */
+static void map_param(Rib *r, Light *l, const char *cls, const char *map, const char *without)
+{
+    map = rib_texture_source(r, map);
+    if (rib_texture_found(r, map))
+        rib_light_param(l, "mapname", RAYES_PARAM_STRING, NULL, map);
+    else
+        rib_warn_once(r, "light map",
+                      "light \"%s\": map \"%.200s\" is not found as given nor on the texture "
+                      "search path; %s",
+                      cls, map, without);
+}
+
 /* Adds light cls (a RenderMan 21 Light, or the shape of a RenderMan 19-20
  * area light: "PxrRectLight", "PxrDiskLight", "PxrSphereLight",
  * "PxrDistantLight", "PxrDomeLight") of radiance L; 1 if made, 0 if rayes
@@ -831,29 +845,14 @@ static int make_light(Rib *r, const char *handle, const char *cls, const float L
         float half[3] = {0.5f, 0, 0};
         if (!rect)
             rib_light_param(l, "radius", RAYES_PARAM_FLOAT, half, NULL);
-        if (rect && map && map[0]) { /* lightColorMap: the image over the square */
-            map = rib_texture_source(r, map);
-            if (rib_texture_found(r, map))
-                rib_light_param(l, "mapname", RAYES_PARAM_STRING, NULL, map);
-            else
-                rib_warn_once(r, "rect light map",
-                              "light \"%s\": lightColorMap \"%.200s\" is not found as given nor "
-                              "on the texture search path; the light is even",
-                              cls, map);
-        }
+        if (rect && map && map[0]) /* lightColorMap: the image over the square */
+            map_param(r, l, cls, map, "the light is even");
     } else if (dist) {
         float from[3] = {0, 0, 0}, to[3] = {0, 0, 1};
         rib_light_param(l, "from", RAYES_PARAM_COLOR, from, NULL);
         rib_light_param(l, "to", RAYES_PARAM_COLOR, to, NULL);
     } else if (map && map[0]) {
-        map = rib_texture_source(r, map);
-        if (rib_texture_found(r, map))
-            rib_light_param(l, "mapname", RAYES_PARAM_STRING, NULL, map);
-        else
-            rib_warn_once(r, "light map",
-                          "light \"%s\": map \"%.200s\" is not found as given nor on the "
-                          "texture search path; a constant environment",
-                          cls, map);
+        map_param(r, l, cls, map, "a constant environment");
     }
     on_everywhere(r, l);
     return 1;
