@@ -627,7 +627,8 @@ RAYES_API RayesError rayes_scene_area_light_mesh(RayesScene *scene, size_t n_fac
  * OpenImageIO reads (integer files are sRGB and come back linear), found as
  * shaders' textures are (as given, then on the texture search path) and
  * read whole when the light is made (halved until at most 2048 texels a
- * side): RAYES_ERROR_IO when it cannot be read. */
+ * side); one that cannot be read is said once (a warning) and the light
+ * emits L alone, as a surface's missing texture is left out. */
 RAYES_API RayesError rayes_scene_area_light_mesh_textured(RayesScene *scene, size_t n_faces,
                                                           const int *n_verts, const int *indices,
                                                           size_t n_points, const float *P,

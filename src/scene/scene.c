@@ -1212,11 +1212,10 @@ static RayesError area_light_mesh(RayesScene *s, size_t n_faces, const int *n_ve
         else
             bad = light_mesh_texture(&l, tri_st, path, err, sizeof err) != 0;
         free(tri_st);
-        if (bad) {
-            free(v);
-            free(prims);
-            light_fini(&l);
-            return scene_fail(s, RAYES_ERROR_IO, "%s", err);
+        if (bad) { /* as a surface's texture that cannot be read: said, and left out */
+            char key[128];
+            snprintf(key, sizeof key, "emission texture %.100s", texture);
+            log_warning_once(key, "%s; the light emits its radiance alone", err);
         }
     }
     l.emitter = (int)s->n_objects;
